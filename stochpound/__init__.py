@@ -1,0 +1,13 @@
+"""stochpound: stochastic analysis of earthquake pounding between adjacent buildings.
+
+The main entry points are :func:`load_scene` (read and validate a scene file)
+and :func:`simulate` (run one scene and return an :class:`xarray.Dataset`).
+"""
+
+__version__ = "0.1.0"
+
+from stochpound.errors import RecordError, SceneError, StochpoundError  # noqa: E402
+from stochpound.scene_file import load_scene, scene_from_dict  # noqa: E402
+from stochpound.simulate import simulate  # noqa: E402
+
+__all__ = ["__version__", "load_scene", "scene_from_dict", "simulate", "SceneError", "RecordError", "StochpoundError"]

@@ -1,0 +1,33 @@
+"""``stochpound simulate SCENE.toml --out RUN.nc``: run one scene."""
+
+from __future__ import annotations
+
+import click
+
+from stochpound.errors import StochpoundError
+from stochpound.result import write_dataset
+from stochpound.scene_file import load_scene
+from stochpound.simulate import METHODS, simulate as run_simulation
+from stochpound.solvers.ivp import INTEGRATORS
+
+
+@click.command()
+@click.argument("scene_file", type=click.Path(dir_okay=False))
+@click.option("--out", "out", required=True, type=click.Path(dir_okay=False), help="Result file (netCDF4/HDF5).")
+@click.option("--method", type=click.Choice(METHODS), default=METHODS[0], show_default=True, help="Solver.")
+@click.option("--integrator", type=click.Choice(list(INTEGRATORS)), default="DOP853", show_default=True, help="Integrator of the ivp solver.")
+@click.option("--rtol", type=float, default=1e-10, show_default=True, help="Relative tolerance.")
+@click.option("--atol", type=float, default=1e-12, show_default=True, help="Absolute tolerance (m, m/s).")
+def simulate(scene_file: str, out: str, method: str, integrator: str, rtol: float, atol: float) -> None:
+    """Simulate SCENE_FILE and write the result dataset to --out."""
+    try:
+        scene = load_scene(scene_file)
+        result = run_simulation(scene, method, integrator=integrator, rtol=rtol, atol=atol)
+    except (StochpoundError, ValueError) as error:
+        raise click.ClickException(str(error)) from None
+    write_dataset(result, out)
+    n_impacts = result.sizes.get("impact", 0)
+    click.echo(
+        f"{scene_file}: {len(result.time)} samples, {n_impacts} impacts, "
+        f"energy residual {float(abs(result.energy_residual).max()):.3g} J -> {out}"
+    )

@@ -1,0 +1,19 @@
+"""Exception types raised by stochpound.
+
+Every error caused by user input names the offending field (or file and line)
+and the allowed range, so that it can be fixed without reading the source.
+"""
+
+
+class StochpoundError(Exception):
+    """Base class of every error raised on purpose by stochpound."""
+
+
+class SceneError(StochpoundError, ValueError):
+    """A scene definition is invalid; the message names the field, e.g.
+    ``building[1].base.mu: must be >= 0, got -0.2``."""
+
+
+class RecordError(StochpoundError, ValueError):
+    """A ground-motion record cannot be read or is unusable; the message names
+    the file (and line, where there is one)."""

@@ -1,0 +1,181 @@
+"""What a run records while a solver advances: samples, impacts and the energy balance.
+
+The solver hands over every accepted (possibly truncated) step together with
+a dense representation of the state inside it, every event, and the state at
+every output time. From those the recorder keeps
+
+* the state, contact forces, base friction forces and base states at the
+  motion's sample times;
+* one row per impact: contact, start, end, peak force (located on the dense
+  state, not sampled), impulse, relative velocity at onset, in-phase flag;
+* the cumulative energy terms, integrated step by step with 5-point
+  Gauss–Legendre quadrature of the power of every force (relative-motion
+  energy balance, see docs/model.md).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.optimize import brentq
+
+from stochpound.events import TIME_TOLERANCE, Dense
+from stochpound.modes import FREE, Guard, Mode, ModeDynamics
+from stochpound.motion import GroundMotion
+from stochpound.system import System
+
+_NODES, _WEIGHTS = np.polynomial.legendre.leggauss(5)
+ENERGY_TERMS = ("input", "damping", "friction", "impact")
+
+
+@dataclass
+class Impact:
+    """One impact (a closed phase of one contact)."""
+
+    contact: int
+    start: float
+    onset_velocity: float
+    in_phase: bool
+    peak_force: float = 0.0
+    peak_time: float = float("nan")
+    impulse: float = 0.0
+    end: float = float("nan")
+    complete: bool = False
+
+
+@dataclass
+class Recorder:
+    """Collects the outputs of one run (see module docstring)."""
+
+    system: System
+    motion: GroundMotion
+    states: np.ndarray = field(init=False)
+    forces: np.ndarray = field(init=False)
+    friction: np.ndarray = field(init=False)
+    base_states: np.ndarray = field(init=False)
+    energy: dict[str, np.ndarray] = field(init=False)
+    impacts: list[Impact] = field(default_factory=list)
+    _running: dict[str, float] = field(init=False)
+    _open_impacts: dict[int, Impact] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        n_times, n = len(self.motion.times), self.system.n_dof
+        self.states = np.zeros((n_times, 2 * n))
+        self.forces = np.zeros((n_times, self.system.n_contacts))
+        self.friction = np.zeros((n_times, len(self.system.base_dofs)))
+        self.base_states = np.zeros((n_times, len(self.system.base_dofs)), dtype=np.int8)
+        self.energy = {term: np.zeros(n_times) for term in ENERGY_TERMS}
+        self._running = {term: 0.0 for term in ENERGY_TERMS}
+
+    # ------------------------------------------------------------ samples
+
+    def sample(self, index: int, x: np.ndarray, dynamics: ModeDynamics) -> None:
+        """Store the state and read-outs at output time ``motion.times[index]``."""
+        t = self.motion.times[index]
+        ground = self.motion.acceleration(t, min(index, len(self.motion.times) - 2))
+        self.states[index] = x
+        self.forces[index] = dynamics.force_matrix @ x + dynamics.force_constant
+        self.friction[index] = dynamics.friction_matrix @ x + dynamics.friction_ground * ground + dynamics.friction_constant
+        self.base_states[index] = [self._base_state(b, s, x) for b, s in enumerate(dynamics.mode.base)]
+        for term in ENERGY_TERMS:
+            self.energy[term][index] = self._running[term]
+
+    def _base_state(self, b: int, state: int, x: np.ndarray) -> int:
+        if state == FREE:
+            return int(np.sign(x[self.system.n_dof + self.system.base_dofs[b]]))
+        return state
+
+    # ------------------------------------------------------------ steps
+
+    def on_step(self, dynamics: ModeDynamics, interval: int, t0: float, t1: float, dense: Dense) -> None:
+        """Integrate energy and impulses over [t0, t1] and track peak impact forces."""
+        if t1 <= t0:
+            return
+        half = 0.5 * (t1 - t0)
+        times = t0 + half * (_NODES + 1.0)
+        weights = half * _WEIGHTS
+        x = np.atleast_2d(dense(times))
+        n = self.system.n_dof
+        q_dot = x[n:]
+        ground = self.motion.acceleration(times, interval)
+        forces = dynamics.force_matrix @ x + dynamics.force_constant[:, None]
+        friction = dynamics.friction_matrix @ x + np.outer(dynamics.friction_ground, ground) + dynamics.friction_constant[:, None]
+        base_velocity = self._base_velocities(q_dot)
+        power = {
+            "input": -ground * (self.system.influence @ q_dot),
+            "damping": np.einsum("it,ij,jt->t", q_dot, self.system.damping, q_dot),
+            "friction": -np.einsum("bt,bt->t", friction, base_velocity),
+            "impact": np.einsum("pt,pt->t", forces, self.system.contact_load @ q_dot),
+        }
+        for term, values in power.items():
+            self._running[term] += float(weights @ values)
+        for p, impact in self._open_impacts.items():
+            impact.impulse += float(weights @ forces[p])
+            self._track_peak(dynamics, interval, p, impact, t0, t1, dense)
+
+    def _base_velocities(self, q_dot: np.ndarray) -> np.ndarray:
+        velocities = np.zeros((len(self.system.base_dofs), q_dot.shape[1]))
+        for b, dof in enumerate(self.system.base_dofs):
+            if dof >= 0:
+                velocities[b] = q_dot[dof]
+        return velocities
+
+    def _track_peak(self, dynamics: ModeDynamics, interval: int, p: int, impact: Impact, t0: float, t1: float, dense: Dense) -> None:
+        row, constant = dynamics.force_matrix[p], dynamics.force_constant[p]
+
+        def force(t: float) -> float:
+            return float(row @ dense(t) + constant)
+
+        def force_rate(t: float) -> float:
+            return float(row @ dynamics.rate(dense(t), float(self.motion.acceleration(t, interval))))
+
+        for t in (t0, t1):
+            self._offer_peak(impact, t, force(t))
+        if force_rate(t0) > 0.0 > force_rate(t1):  # a maximum inside the step
+            t_peak = brentq(force_rate, t0, t1, xtol=TIME_TOLERANCE)
+            self._offer_peak(impact, t_peak, force(t_peak))
+
+    @staticmethod
+    def _offer_peak(impact: Impact, t: float, value: float) -> None:
+        if value > impact.peak_force:
+            impact.peak_force, impact.peak_time = value, t
+
+    # ------------------------------------------------------------ events
+
+    def on_transitions(self, t: float, x: np.ndarray, transitions: list[tuple[int, int, int]], mode: Mode) -> None:
+        """Open or close impact records for the contact transitions applied at time t."""
+        n = self.system.n_dof
+        for kind, target, _ in transitions:
+            if kind in (Guard.CLOSE, Guard.RECLOSE) and target not in self._open_impacts and mode.closed[target]:
+                velocities = self.system.contact_floor_velocity @ x
+                left, right = velocities[2 * target], velocities[2 * target + 1]
+                onset = float(self.system.contact_geometry[target] @ x[n:])
+                self._open_impacts[target] = Impact(target, t, onset, bool(left * right > 0.0))
+            elif kind == Guard.OPEN and target in self._open_impacts and not mode.closed[target]:
+                impact = self._open_impacts.pop(target)
+                impact.end, impact.complete = t, True
+                self.impacts.append(impact)
+
+    def on_contact_force(self, t: float, mode: Mode, dynamics: ModeDynamics, x: np.ndarray) -> None:
+        """Offer the (possibly jumping) contact forces at an event time as peaks."""
+        forces = dynamics.force_matrix @ x + dynamics.force_constant
+        for p, impact in self._open_impacts.items():
+            self._offer_peak(impact, t, float(forces[p]))
+
+    def finish(self, t_end: float) -> None:
+        """Close the impacts still running at the end of the motion (``complete`` stays False)."""
+        for impact in self._open_impacts.values():
+            impact.end = t_end
+            self.impacts.append(impact)
+        self._open_impacts.clear()
+        self.impacts.sort(key=lambda impact: (impact.start, impact.contact))
+
+    def kinetic_and_strain(self) -> tuple[np.ndarray, np.ndarray]:
+        """Kinetic energy ½ vᵀMv and storey/restoring strain energy ½ qᵀKq at the samples, J."""
+        n = self.system.n_dof
+        q, v = self.states[:, :n], self.states[:, n:]
+        kinetic = 0.5 * np.einsum("ti,ij,tj->t", v, self.system.mass, v)
+        strain = 0.5 * np.einsum("ti,ij,tj->t", q, self.system.stiffness, q)
+        return kinetic, strain
+

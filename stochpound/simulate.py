@@ -1,0 +1,52 @@
+"""The ``simulate`` entry point: one scene, one solver, one result dataset."""
+
+from __future__ import annotations
+
+import xarray as xr
+
+from stochpound.result import build_dataset
+from stochpound.scene import Scene
+from stochpound.solvers.ivp import INTEGRATORS, run_ivp
+
+METHODS = ("ivp",)
+"""Available solvers: ``ivp`` (scipy integrators with exact event location)."""
+
+
+def simulate(
+    scene: Scene,
+    method: str = "ivp",
+    *,
+    integrator: str = "DOP853",
+    rtol: float = 1e-10,
+    atol: float = 1e-12,
+) -> xr.Dataset:
+    """Simulate a scene and return the result dataset (CONTRACT.md names).
+
+    Parameters
+    ----------
+    scene : Scene
+        From :func:`stochpound.load_scene` or built in Python.
+    method : {"ivp"}
+        The solver. ``ivp``: the event-driven path on scipy's ``solve_ivp``
+        integrators.
+    integrator : str
+        For ``ivp``: ``DOP853`` (default), ``RK45``, ``RK23``, ``Radau``, ``BDF`` or ``LSODA``.
+    rtol, atol : float
+        Integrator tolerances (``atol`` in m and m/s).
+
+    Returns
+    -------
+    xarray.Dataset
+        Time histories at the motion's samples, the impact table, the energy
+        balance, and attributes naming the solver and its settings.
+    """
+    if method not in METHODS:
+        raise ValueError(f"method must be one of {', '.join(METHODS)}, got {method!r}")
+    if integrator not in INTEGRATORS:
+        raise ValueError(f"integrator must be one of {', '.join(INTEGRATORS)}, got {integrator!r}")
+    for name, value in (("rtol", rtol), ("atol", atol)):
+        if not (value > 0.0):
+            raise ValueError(f"{name} must be > 0, got {value}")
+    recorder, counters, library = run_ivp(scene, integrator, rtol, atol)
+    attrs = {"solver": method, "integrator": integrator, "rtol": rtol, "atol": atol, "modes_visited": len(library)}
+    return build_dataset(scene, library.system, recorder, counters, attrs)

@@ -1,0 +1,1 @@
+"""Solvers of the hybrid pounding model (each advances the same modes and events)."""

@@ -1,0 +1,189 @@
+"""The scene as one linear mechanical system: degrees of freedom and global matrices.
+
+Degrees of freedom (DOFs) are, building by building, the floor displacements
+u_{b,i} relative to the building's base, followed by the base's sliding
+displacement s_b when the building is isolated (a fixed base has no s_b). With
+q the DOF vector and v = q̇, the equations of motion of MODEL.md §3 read
+
+    M q̈ + C q̇ + K q = −r a_g(t) + f_impact + f_friction
+
+where M couples each floor with its base (the floor equation contains s̈_b,
+the base equation contains Σ m_i ü_i), r holds the inertia of each DOF
+(m_i for a floor, M_b + Σ m_i for a base), and K includes an optional restoring
+stiffness of the base. Contact p has penetration δ_p = g_p·q − d_p and acts on
+the structure with the generalised force −F_p h_p, where h_p = g_p in the
+momentum-consistent model and h_p is g_p without its base entries in
+``study_compat`` mode (the study's base equation lacks Σ f).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from stochpound.scene import Scene, storey_matrix
+
+
+@dataclass(frozen=True)
+class System:
+    """Global DOF layout and constant matrices of a scene.
+
+    Attributes
+    ----------
+    n_dof : int
+        Number of DOFs N; the state is x = [q, v] of length 2N.
+    floor_dofs : list of np.ndarray
+        For each building, the DOF indices of its floors (floor 1 first).
+    base_dofs : list of int
+        For each building, the DOF index of its sliding base, or -1 (fixed base).
+    mass, stiffness, damping : np.ndarray
+        M, K, C (N × N), kg, N/m, N·s/m.
+    influence : np.ndarray
+        r (N), kg: the ground-acceleration load is −r a_g.
+    contact_gap, contact_stiffness, contact_damping : np.ndarray
+        d_p (m), k_p (N/m), c_p (N·s/m) of each contact.
+    contact_geometry : np.ndarray
+        g_p as rows (n_contacts × N): δ_p = g_p·q − d_p.
+    contact_load : np.ndarray
+        h_p as rows (n_contacts × N): generalised load −F_p h_p.
+    contact_tensile : np.ndarray of bool
+        Which contacts separate at δ = 0 (True) or at F = 0 (False).
+    base_weight, base_mu, base_mu_static : np.ndarray
+        Per building: W_b = g·total mass (N), kinetic and static μ (0 for fixed bases).
+    frictionless : np.ndarray of bool
+        Per building: isolated with μ = μ_s = 0 (a free DOF, no stick state).
+    total_displacement : np.ndarray
+        Y (n_floors_total × N): total displacements y = s + u of every floor, in DOF order.
+    initial_state : np.ndarray
+        x(0) = [q(0), v(0)] from the buildings' initial conditions.
+    contact_rows : np.ndarray of int
+        (n_contacts × 2): rows of ``total_displacement`` of each contact's left and right floor.
+    """
+
+    n_dof: int
+    floor_dofs: list[np.ndarray]
+    base_dofs: list[int]
+    mass: np.ndarray
+    stiffness: np.ndarray
+    damping: np.ndarray
+    influence: np.ndarray
+    contact_gap: np.ndarray
+    contact_stiffness: np.ndarray
+    contact_damping: np.ndarray
+    contact_geometry: np.ndarray
+    contact_load: np.ndarray
+    contact_tensile: np.ndarray
+    base_weight: np.ndarray
+    base_mu: np.ndarray
+    base_mu_static: np.ndarray
+    frictionless: np.ndarray
+    total_displacement: np.ndarray
+    initial_state: np.ndarray
+    contact_rows: np.ndarray
+
+    @property
+    def n_contacts(self) -> int:
+        """Number of contact elements."""
+        return len(self.contact_gap)
+
+    @property
+    def isolated(self) -> list[int]:
+        """Indices of the buildings with a sliding base."""
+        return [b for b, dof in enumerate(self.base_dofs) if dof >= 0]
+
+    @property
+    def contact_floor_velocity(self) -> np.ndarray:
+        """Rows (2·n_contacts × 2N) giving ẏ of the left, then the right floor of each contact."""
+        rows = self.total_displacement[self.contact_rows.ravel()]
+        return np.hstack([np.zeros_like(rows), rows])
+
+
+def build_system(scene: Scene) -> System:
+    """Assemble the DOF layout and the global matrices of ``scene``."""
+    floor_dofs, base_dofs, n_dof = _layout(scene)
+    mass = np.zeros((n_dof, n_dof))
+    stiffness = np.zeros((n_dof, n_dof))
+    damping = np.zeros((n_dof, n_dof))
+    influence = np.zeros(n_dof)
+    total = np.zeros((sum(b.n_floors for b in scene.buildings), n_dof))
+    initial = np.zeros(2 * n_dof)
+    row = 0
+    for b, building in enumerate(scene.buildings):
+        floors, base = floor_dofs[b], base_dofs[b]
+        m = np.asarray(building.mass, float)
+        block = np.ix_(floors, floors)
+        mass[block] = np.diag(m)
+        stiffness[block] = storey_matrix(np.asarray(building.stiffness, float))
+        damping[block] = storey_matrix(np.asarray(building.damping, float))
+        influence[floors] = m
+        for i, dof in enumerate(floors):
+            total[row + i, dof] = 1.0
+        initial[floors] = building.initial.displacement
+        initial[n_dof + floors] = building.initial.velocity
+        if base >= 0:
+            mass[floors, base] = m
+            mass[base, floors] = m
+            mass[base, base] = building.total_mass
+            stiffness[base, base] = building.base.restoring_stiffness
+            influence[base] = building.total_mass
+            total[row : row + building.n_floors, base] = 1.0
+            initial[base] = building.initial.base_displacement
+            initial[n_dof + base] = building.initial.base_velocity
+        row += building.n_floors
+    geometry, load = _contact_vectors(scene, floor_dofs, base_dofs, n_dof)
+    return System(
+        n_dof=n_dof,
+        floor_dofs=floor_dofs,
+        base_dofs=base_dofs,
+        mass=mass,
+        stiffness=stiffness,
+        damping=damping,
+        influence=influence,
+        contact_gap=np.array([c.gap for c in scene.contacts], float),
+        contact_stiffness=np.array([c.stiffness for c in scene.contacts], float),
+        contact_damping=np.array([c.damping for c in scene.contacts], float),
+        contact_geometry=geometry,
+        contact_load=load,
+        contact_tensile=np.array([c.tensile for c in scene.contacts], bool),
+        base_weight=np.array([scene.g * b.total_mass if b.base else 0.0 for b in scene.buildings]),
+        base_mu=np.array([b.base.mu if b.base else 0.0 for b in scene.buildings]),
+        base_mu_static=np.array([b.base.mu_static if b.base else 0.0 for b in scene.buildings]),
+        frictionless=np.array([bool(b.base and b.base.frictionless) for b in scene.buildings]),
+        total_displacement=total,
+        initial_state=initial,
+        contact_rows=_contact_rows(scene),
+    )
+
+
+def _layout(scene: Scene) -> tuple[list[np.ndarray], list[int], int]:
+    floor_dofs, base_dofs, n_dof = [], [], 0
+    for building in scene.buildings:
+        floor_dofs.append(np.arange(n_dof, n_dof + building.n_floors))
+        n_dof += building.n_floors
+        if building.base is not None:
+            base_dofs.append(n_dof)
+            n_dof += 1
+        else:
+            base_dofs.append(-1)
+    return floor_dofs, base_dofs, n_dof
+
+
+def _contact_vectors(scene: Scene, floor_dofs: list[np.ndarray], base_dofs: list[int], n_dof: int) -> tuple[np.ndarray, np.ndarray]:
+    geometry = np.zeros((len(scene.contacts), n_dof))
+    load = np.zeros((len(scene.contacts), n_dof))
+    for p, contact in enumerate(scene.contacts):
+        for building, floor, sign in ((contact.left, contact.left_floor, 1.0), (contact.right, contact.right_floor, -1.0)):
+            geometry[p, floor_dofs[building][floor - 1]] += sign
+            load[p, floor_dofs[building][floor - 1]] += sign
+            if base_dofs[building] >= 0:
+                geometry[p, base_dofs[building]] += sign
+                if not scene.study_compat:
+                    load[p, base_dofs[building]] += sign
+    return geometry, load
+
+
+def _contact_rows(scene: Scene) -> np.ndarray:
+    first_row = np.cumsum([0] + [b.n_floors for b in scene.buildings])
+    rows = [(first_row[c.left] + c.left_floor - 1, first_row[c.right] + c.right_floor - 1) for c in scene.contacts]
+    return np.array(rows, dtype=int).reshape(-1, 2)
