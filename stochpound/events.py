@@ -47,13 +47,22 @@ Dense = Callable[[np.ndarray | float], np.ndarray]
 
 @dataclass
 class EventCounters:
-    """Counts of what the event logic did, stored in the result's attributes."""
+    """Counts of what the event logic did, stored in the result's attributes.
 
-    events: int = 0
+    Attributes
+    ----------
+    total : int
+        Guard crossings located and settled.
+    chatter_cycles : int
+        Instants at which settling found a cycle of modes (chattering) and
+        kept the last mode, disarming the guards that still wanted to fire.
+    grazing_checks : int
+        Near-grazing guard maxima that were checked on the dense state.
+    """
+
+    total: int = 0
     chatter_cycles: int = 0
-    forced_events: int = 0
     grazing_checks: int = 0
-    ignored_recloses: int = 0
 
     def as_attrs(self) -> dict[str, int]:
         """The counters as netCDF attributes (``events_*``)."""
@@ -65,11 +74,15 @@ class GuardStates:
     """Per-guard arming state for the current mode span.
 
     ``threshold[j]`` is 0 for an armed guard, a small positive value for a
-    disarmed one, and +inf for a guard disabled until the next mode change.
+    disarmed one, and +inf for a guard that may not fire at all for now.
+    A disarmed guard is armed again once its value goes below −tolerance,
+    unless it is not ``rearmable`` (a RECLOSE guard of a contact that is not
+    penetrated stays off until the next mode change).
     """
 
     threshold: np.ndarray
     tolerance: np.ndarray
+    rearmable: np.ndarray
     disarmed: np.ndarray = field(init=False)
 
     def __post_init__(self) -> None:
@@ -77,7 +90,7 @@ class GuardStates:
 
     def arm_where_negative(self, values: np.ndarray) -> None:
         """Arm the disarmed guards whose value has gone clearly below zero."""
-        rearm = self.disarmed & np.isfinite(self.threshold) & (values < -self.tolerance)
+        rearm = self.disarmed & self.rearmable & (values < -self.tolerance)
         self.threshold[rearm] = 0.0
         self.disarmed[rearm] = False
 
@@ -196,7 +209,7 @@ def settle(
     for _ in range(MAX_SETTLE_ITERATIONS):
         dynamics = library[mode]
         values, tolerance, heading = guard_leaving_sign(dynamics, x, ground)
-        candidates = _wanting_to_fire(system, dynamics, x, heading)
+        candidates = _wanting_to_fire(system, dynamics, x, values, tolerance, heading)
         if len(candidates) == 0:
             return mode, x, _initial_guard_states(system, dynamics, x, values, tolerance), transitions
         j = candidates[0]
@@ -213,10 +226,19 @@ def settle(
     return mode, x, _initial_guard_states(system, dynamics, x, values, tolerance), transitions
 
 
-def _wanting_to_fire(system: System, dynamics: ModeDynamics, x: np.ndarray, heading: np.ndarray) -> np.ndarray:
+def _wanting_to_fire(system: System, dynamics: ModeDynamics, x: np.ndarray, values: np.ndarray, tolerance: np.ndarray, heading: np.ndarray) -> np.ndarray:
+    """Guards that fire at this instant, in index order.
+
+    A non-tensile contact that separated with residual penetration (δ > 0,
+    F = 0) recloses only through its RECLOSE guard (trial force > 0 while
+    δ > 0), never because δ is positive.
+    """
     wanting = heading > 0
-    for j in np.flatnonzero(wanting & (dynamics.guard_kind == Guard.RECLOSE)):
-        if _penetration(system, dynamics.guard_target[j], x) <= 0.0:
+    for j in np.flatnonzero(wanting):
+        kind, p = dynamics.guard_kind[j], dynamics.guard_target[j]
+        if kind == Guard.RECLOSE and _penetration(system, p, x) <= 0.0:
+            wanting[j] = False
+        elif kind == Guard.CLOSE and not system.contact_tensile[p] and values[j] > tolerance[j]:
             wanting[j] = False
     return np.flatnonzero(wanting)
 
@@ -227,22 +249,27 @@ def _penetration(system: System, p: int, x: np.ndarray) -> float:
 
 def _apply(system: System, mode: Mode, x: np.ndarray, transition: tuple[int, int, int]) -> Mode:
     kind, target, direction = transition
-    if kind in (Guard.CLOSE, Guard.RECLOSE):
+    if kind == Guard.CLOSE or (kind == Guard.RECLOSE and _penetration(system, target, x) > 0.0):
         return mode.with_contact(target, True)
     if kind == Guard.OPEN:
         return mode.with_contact(target, False)
     if kind == Guard.SLIP:
         return mode.with_base(target, direction)
-    x[system.n_dof + system.base_dofs[target]] = 0.0  # STOP: the sliding velocity has reached zero
-    return mode.with_base(target, STUCK)
+    if kind == Guard.STOP:
+        x[system.n_dof + system.base_dofs[target]] = 0.0  # the sliding velocity has reached zero
+        return mode.with_base(target, STUCK)
+    return mode  # a RECLOSE crossing while not penetrated changes nothing
 
 
 def _initial_guard_states(system: System, dynamics: ModeDynamics, x: np.ndarray, values: np.ndarray, tolerance: np.ndarray) -> GuardStates:
     threshold = np.where(values < -tolerance, 0.0, FIRE_THRESHOLD / ROUND_OFF * tolerance)
-    for j in np.flatnonzero(dynamics.guard_kind == Guard.RECLOSE):
-        if _penetration(system, dynamics.guard_target[j], x) <= 0.0:
-            threshold[j] = np.inf
-    return GuardStates(threshold, tolerance)
+    rearmable = np.ones(len(values), dtype=bool)
+    for j, (kind, p) in enumerate(zip(dynamics.guard_kind, dynamics.guard_target)):
+        if kind == Guard.RECLOSE and _penetration(system, p, x) <= 0.0:
+            threshold[j], rearmable[j] = np.inf, False
+        elif kind == Guard.CLOSE and not system.contact_tensile[p] and values[j] > tolerance[j]:
+            threshold[j] = np.inf  # residual penetration: wait until δ < 0 again
+    return GuardStates(threshold, tolerance, rearmable)
 
 
 def initial_mode(system: System) -> Mode:

@@ -104,7 +104,7 @@ class _Run:
 
     def _event(self, k: int, t: float, x: np.ndarray, mode: Mode, dynamics: ModeDynamics, guard: int):
         fired = (int(dynamics.guard_kind[guard]), int(dynamics.guard_target[guard]), int(dynamics.guard_direction[guard]))
-        self.counters.events += 1
+        self.counters.total += 1
         new_mode, x, states, transitions = settle(self.library, self.motion, k, t, x, mode, self.counters, fired)
         self.recorder.on_transitions(t, x, transitions, new_mode)
         self.recorder.on_contact_force(t, new_mode, self.library[new_mode], x)

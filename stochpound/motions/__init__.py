@@ -1,0 +1,72 @@
+"""Synthetic ground motions: Kanai–Tajimi and Clough–Penzien PSDs, envelopes, generators.
+
+>>> from stochpound import motions
+>>> a = motions.kanai_tajimi(100, 20.0, 0.01, omega_g=15.0, zeta_g=0.6, pga=3.0,
+...                          envelope="jennings", seed=1)          # doctest: +SKIP
+>>> a.sizes                                                         # doctest: +SKIP
+{'realization': 100, 'time': 2001}
+
+Conventions (PSD two-sided in ω, σ² = ∫ S dω; SI units) are in ``docs/motions.md``.
+"""
+
+from stochpound.motions.baseline import baseline_correct, final_velocity_displacement
+from stochpound.motions.envelopes import (
+    ENVELOPES,
+    AminAng,
+    CallableEnvelope,
+    Envelope,
+    Jennings,
+    SaragoniHart,
+    Trapezoidal,
+    make_envelope,
+)
+from stochpound.motions.generators import filter_samples, spectral_samples, stationary_samples
+from stochpound.motions.intensity import poisson_peak_factor, s0_from_pga, s0_from_rms, simulated_peak_factor
+from stochpound.motions.presets import SOIL_PRESETS, SoilPreset, soil_preset
+from stochpound.motions.psd import (
+    FilteredWhiteNoise,
+    clough_penzien_model,
+    clough_penzien_psd,
+    high_pass_gain,
+    kanai_tajimi_model,
+    kanai_tajimi_psd,
+    kanai_tajimi_variance,
+)
+from stochpound.motions.seeding import realization_rng, realization_rngs
+from stochpound.motions.synthetic import PSD_CONVENTION, clough_penzien, kanai_tajimi, synthetic_ground_motion
+
+__all__ = [
+    "ENVELOPES",
+    "PSD_CONVENTION",
+    "SOIL_PRESETS",
+    "AminAng",
+    "CallableEnvelope",
+    "Envelope",
+    "FilteredWhiteNoise",
+    "Jennings",
+    "SaragoniHart",
+    "SoilPreset",
+    "Trapezoidal",
+    "baseline_correct",
+    "clough_penzien",
+    "clough_penzien_model",
+    "clough_penzien_psd",
+    "filter_samples",
+    "final_velocity_displacement",
+    "high_pass_gain",
+    "kanai_tajimi",
+    "kanai_tajimi_model",
+    "kanai_tajimi_psd",
+    "kanai_tajimi_variance",
+    "make_envelope",
+    "poisson_peak_factor",
+    "realization_rng",
+    "realization_rngs",
+    "s0_from_pga",
+    "s0_from_rms",
+    "soil_preset",
+    "simulated_peak_factor",
+    "spectral_samples",
+    "stationary_samples",
+    "synthetic_ground_motion",
+]
