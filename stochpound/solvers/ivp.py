@@ -112,10 +112,20 @@ class _Run:
 
     def _solver(self, dynamics: ModeDynamics, k: int, t: float, x: np.ndarray, t_end: float):
         A, B, c = dynamics.A, dynamics.B, dynamics.c
-        acceleration = self.motion.acceleration
+        polynomial = self.motion.polynomial(k)
+        if polynomial is None:
+            acceleration = self.motion.acceleration
 
-        def rate(time, state):
-            return A @ state + B * acceleration(time, k) + c
+            def rate(time, state):
+                return A @ state + B * acceleration(time, k) + c
+
+        else:
+            c0, c1, c2, c3 = (float(value) for value in polynomial)
+            start = float(self.motion.times[k])
+
+            def rate(time, state):
+                tau = time - start
+                return A @ state + B * (c0 + tau * (c1 + tau * (c2 + tau * c3))) + c
 
         options = {"rtol": self.rtol, "atol": self.atol}
         if self.step_guess is not None:

@@ -1,0 +1,25 @@
+"""Statistics of simulated responses, dask-friendly (lazy on chunked data).
+
+Every function takes and returns xarray objects and reduces only the
+dimensions it is told to, so it applies equally to one run (reduce over
+``time``), to an experiment store (the grid's dimensions are carried along)
+and to ensembles (reduce over ``realization``).
+"""
+
+from stochpound.analysis.moments import moments
+from stochpound.analysis.correlation import correlation
+from stochpound.analysis.histogram import normal_histogram
+from stochpound.analysis.impacts import impact_statistics
+from stochpound.analysis.peaks import peak_response
+from stochpound.analysis.pounding import pounding_probability
+from stochpound.analysis.summary import run_summary
+
+__all__ = [
+    "moments",
+    "correlation",
+    "normal_histogram",
+    "impact_statistics",
+    "peak_response",
+    "pounding_probability",
+    "run_summary",
+]
