@@ -8,6 +8,8 @@ from decimal import Decimal
 
 import numpy as np
 import pytest
+
+from stochpound.data_files import bundled_data_dir
 import scipy.stats
 
 from stochpound.errors import RecordError
@@ -141,11 +143,11 @@ def test_packaged_copy_is_preferred(tmp_path, monkeypatch):
     package = tmp_path / "stochpound"
     shutil.copytree(records_dir(), package / "_data" / "records")
     monkeypatch.setattr(importlib.resources, "files", lambda name: package)
-    registry_module._records_dir.cache_clear()
+    bundled_data_dir.cache_clear()
     try:
         assert records_dir() == package / "_data" / "records"
     finally:
-        registry_module._records_dir.cache_clear()
+        bundled_data_dir.cache_clear()
     assert (records_dir() / "registry.toml").is_file()
 
 

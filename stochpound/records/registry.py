@@ -7,7 +7,6 @@ repository's ``data/records`` next to the package (editable installs).
 
 from __future__ import annotations
 
-import importlib.resources
 import math
 import tomllib
 from dataclasses import dataclass
@@ -15,6 +14,7 @@ from functools import lru_cache
 from pathlib import Path
 from typing import Any, Mapping
 
+from stochpound.data_files import bundled_data_dir
 from stochpound.errors import RecordError
 from stochpound.records.readers import RawSeries, read_record_file
 from stochpound.records.record import Record, normalize_units
@@ -72,21 +72,14 @@ def records_dir() -> Path:
     return _records_dir()
 
 
-@lru_cache(maxsize=1)
 def _records_dir() -> Path:
-    try:
-        packaged = importlib.resources.files("stochpound").joinpath("_data", "records")
-        if packaged.is_dir() and packaged.joinpath(REGISTRY_FILE).is_file():
-            return Path(str(packaged))
-    except (ModuleNotFoundError, TypeError, NotADirectoryError, FileNotFoundError):
-        pass
-    repository = Path(__file__).resolve().parents[2] / "data" / "records"
-    if (repository / REGISTRY_FILE).is_file():
-        return repository
-    raise RecordError(
-        "the bundled records are missing: neither stochpound/_data/records (installed package) "
-        "nor data/records (source tree) holds registry.toml"
-    )
+    folder = bundled_data_dir("records", REGISTRY_FILE)
+    if folder is None:
+        raise RecordError(
+            "the bundled records are missing: neither stochpound/_data/records (installed package) "
+            "nor data/records (source tree) holds registry.toml"
+        )
+    return folder
 
 
 @lru_cache(maxsize=1)

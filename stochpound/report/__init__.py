@@ -1,0 +1,1 @@
+"""Reports: the reference study's tables and figures regenerated from experiment stores."""
