@@ -341,10 +341,8 @@ def first_crossing(
     rates1 = G @ dynamics.rate(step.x1, ground1[0]) + gh * ground1[1]
     a0, a1, a2, a3 = _hermite(values0, values1, rates0, rates1, h)
     margin = 1e-3 * (np.abs(values0) + np.abs(values1) + np.abs(a1) + np.abs(rates1 * h)) + states.tolerance
-    level = np.where(states.disarmed, 0.0, states.threshold)  # a disarmed guard may fire at 0 after a dip
-    suspects = np.isfinite(states.threshold) & (
-        (values1 >= level) | (_interior_maximum(a0, a1, a2, a3) >= level - margin)
-    )
+    # screen at level 0 for every guard: an armed guard fires at 0, and a disarmed one may too after a dip
+    suspects = np.isfinite(states.threshold) & ((values1 >= 0.0) | (_interior_maximum(a0, a1, a2, a3) >= -margin))
     best: tuple[float, int] | None = None
     for j in np.flatnonzero(suspects):
 

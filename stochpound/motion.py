@@ -40,6 +40,10 @@ class GroundMotion:
         """Coefficients c0..c3 of a_g = Σ c_j τ^j, τ = t − times[k], or None if not polynomial."""
         return None
 
+    def at_times(self) -> np.ndarray:
+        """a_g at every output time, m/s²."""
+        raise NotImplementedError
+
 
 @dataclass
 class SampledMotion(GroundMotion):
@@ -71,6 +75,9 @@ class SampledMotion(GroundMotion):
 
     def polynomial(self, k: int) -> np.ndarray:
         return self.coefficients[k]
+
+    def at_times(self) -> np.ndarray:
+        return self.values
 
     def derivatives(self, t: float, k: int) -> np.ndarray:
         c0, c1, c2, c3 = self.coefficients[k]
@@ -146,3 +153,6 @@ class HarmonicMotion(GroundMotion):
 
     def acceleration(self, t, k):
         return self.amplitude * np.sin(self.omega * np.asarray(t) + self.phase)
+
+    def at_times(self) -> np.ndarray:
+        return self.acceleration(self.times, 0)

@@ -50,7 +50,7 @@ def build_dataset(scene: Scene, system: System, recorder: Recorder, counters: Ev
         "total_displacement": _var(("building", "floor", "time"), total, "m", "floor displacement relative to the ground (y = s + u)"),
         "relative_displacement": _var(("building", "floor", "time"), relative, "m", "floor displacement relative to the building's base (u)"),
         "sliding_displacement": _var(("building", "time"), sliding, "m", "sliding displacement of the base relative to the ground (s)"),
-        "ground_acceleration": _var(("time",), _ground(scene), "m s-2", "ground acceleration a_g"),
+        "ground_acceleration": _var(("time",), scene.motion.at_times(), "m s-2", "ground acceleration a_g"),
         "impact_force": _var(("contact", "time"), recorder.forces.T, "N", "contact force, positive in compression (0 while open)"),
         "base_friction_force": _var(
             ("building", "time"), recorder.friction.T, "N", "force of the foundation on the base, positive to the right (0 for a fixed base)"
@@ -81,12 +81,6 @@ def build_dataset(scene: Scene, system: System, recorder: Recorder, counters: Ev
         **counters.as_attrs(),
     }
     return xr.Dataset(data_vars, coords=coords, attrs=attrs)
-
-
-def _ground(scene: Scene) -> np.ndarray:
-    times = scene.motion.times
-    last = len(times) - 2
-    return np.array([scene.motion.acceleration(t, min(k, last)) for k, t in enumerate(times)], dtype=float)
 
 
 def _contact_variables(scene: Scene) -> dict[str, xr.Variable]:

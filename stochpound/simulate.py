@@ -6,15 +6,17 @@ import xarray as xr
 
 from stochpound.result import build_dataset
 from stochpound.scene import Scene
+from stochpound.solvers.exact import run_exact
 from stochpound.solvers.ivp import INTEGRATORS, run_ivp
 
-METHODS = ("ivp",)
-"""Available solvers: ``ivp`` (scipy integrators with exact event location)."""
+METHODS = ("exact", "ivp")
+"""Available solvers: ``exact`` (matrix-exponential propagation, the default) and
+``ivp`` (scipy integrators with exact event location)."""
 
 
 def simulate(
     scene: Scene,
-    method: str = "ivp",
+    method: str = "exact",
     *,
     integrator: str = "DOP853",
     rtol: float = 1e-10,
@@ -26,13 +28,15 @@ def simulate(
     ----------
     scene : Scene
         From :func:`stochpound.load_scene` or built in Python.
-    method : {"ivp"}
-        The solver. ``ivp``: the event-driven path on scipy's ``solve_ivp``
-        integrators.
+    method : {"exact", "ivp"}
+        The solver. ``exact`` (default): every mode advanced exactly by
+        matrix exponentials (sampled motions with linear or spline
+        interpolation, and harmonic motions). ``ivp``: the event-driven path
+        on scipy's ``solve_ivp`` integrators.
     integrator : str
         For ``ivp``: ``DOP853`` (default), ``RK45``, ``RK23``, ``Radau``, ``BDF`` or ``LSODA``.
     rtol, atol : float
-        Integrator tolerances (``atol`` in m and m/s).
+        For ``ivp``: integrator tolerances (``atol`` in m and m/s).
 
     Returns
     -------
@@ -47,6 +51,10 @@ def simulate(
     for name, value in (("rtol", rtol), ("atol", atol)):
         if not (value > 0.0):
             raise ValueError(f"{name} must be > 0, got {value}")
-    recorder, counters, library = run_ivp(scene, integrator, rtol, atol)
-    attrs = {"solver": method, "integrator": integrator, "rtol": rtol, "atol": atol, "modes_visited": len(library)}
+    if method == "exact":
+        recorder, counters, library = run_exact(scene)
+        attrs = {"solver": method, "modes_visited": len(library)}
+    else:
+        recorder, counters, library = run_ivp(scene, integrator, rtol, atol)
+        attrs = {"solver": method, "integrator": integrator, "rtol": rtol, "atol": atol, "modes_visited": len(library)}
     return build_dataset(scene, library.system, recorder, counters, attrs)

@@ -1,0 +1,220 @@
+"""Many ground motions, one scene: batched simulation of an ensemble of realizations.
+
+:func:`simulate_ensemble` runs one scene under every realization of an
+ensemble of ground accelerations (e.g. from :func:`stochpound.motions.kanai_tajimi`)
+and returns one :class:`xarray.Dataset` with a ``realization`` dimension.
+Realizations are simulated in batches, optionally in worker processes; each
+realization is computed on its own, so the result does not depend on the
+batch size or the number of workers. Only what ``keep`` asks for is held in
+memory: a summaries-only ensemble holds one batch of histories at a time.
+
+Summaries per realization (see :mod:`stochpound.analysis`):
+
+* per building: ``peak_total_displacement``, ``peak_relative_displacement``,
+  ``peak_sliding_displacement``, ``residual_sliding`` (m), and the moments
+  ``top_floor_mean``, ``top_floor_variance``, ``top_floor_std`` (m, m²),
+  ``top_floor_skewness`` and ``top_floor_excess`` of the top floor's total
+  displacement over time;
+* impacts: ``impacts``, ``impacts_in_phase``, ``impacts_out_of_phase``,
+  ``peak_impact_force`` (N), ``longest_impact`` (s), ``total_impulse`` (N·s);
+* energy: the final ``energy_input``, ``energy_damping``, ``energy_friction``
+  and ``energy_impact`` (J);
+* ``events_total`` and ``events_chatter_cycles`` of the event logic.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import multiprocessing
+import os
+from concurrent.futures import ProcessPoolExecutor
+from typing import Any
+
+import numpy as np
+import xarray as xr
+from threadpoolctl import threadpool_limits
+
+from stochpound import __version__
+from stochpound.analysis import impact_statistics, moments, peak_response
+from stochpound.events import EventCounters
+from stochpound.motion import SampledMotion
+from stochpound.recorder import ENERGY_TERMS, Recorder
+from stochpound.scene import Scene
+from stochpound.solvers.exact import run_exact
+from stochpound.solvers.ivp import run_ivp
+
+KEEP = ("summary", "histories")
+"""What an ensemble keeps: summaries only, or also the displacement and impact force histories."""
+METHODS = ("exact", "ivp")
+
+
+def simulate_ensemble(
+    scene: Scene,
+    motions: xr.DataArray,
+    keep: str = "summary",
+    method: str = "exact",
+    *,
+    workers: int | None = 1,
+    batch_size: int = 64,
+) -> xr.Dataset:
+    """Simulate ``scene`` under every realization of ``motions``.
+
+    Parameters
+    ----------
+    scene : Scene
+        The buildings and contacts; its motion is replaced by each realization
+        (with the scene's interpolation if its motion is sampled, else linear).
+    motions : xarray.DataArray
+        Ground acceleration, m/s², dims ``(realization, time)``, uniformly
+        sampled from t = 0 (the ``time`` coordinate in s, or ``attrs["dt"]``).
+        May be dask-backed: one batch is loaded at a time.
+    keep : {"summary", "histories"}
+        ``summary``: per-realization scalars only. ``histories``: also
+        ``total_displacement``, ``relative_displacement`` (realization,
+        building, floor, time), ``sliding_displacement`` (realization,
+        building, time) and ``impact_force`` (realization, contact, time).
+    method : {"exact", "ivp"}
+        The solver (``ivp`` with DOP853 at its default tolerances).
+    workers : int or None
+        Worker processes (``None``: one per CPU). 1 runs in this process.
+    batch_size : int
+        Realizations per batch (the unit of work of a worker).
+
+    Returns
+    -------
+    xarray.Dataset
+        The summaries (and histories) with a ``realization`` dimension, in
+        the order of ``motions``.
+    """
+    if keep not in KEEP:
+        raise ValueError(f"keep must be one of {', '.join(KEEP)}, got {keep!r}")
+    if method not in METHODS:
+        raise ValueError(f"method must be one of {', '.join(METHODS)}, got {method!r}")
+    if batch_size < 1:
+        raise ValueError(f"batch_size must be >= 1, got {batch_size}")
+    motions = motions.transpose("realization", "time")
+    dt = _sample_spacing(motions)
+    n_realizations = motions.sizes["realization"]
+    starts = range(0, n_realizations, batch_size)
+    tasks = ((scene, motions.isel(realization=slice(a, a + batch_size)), dt, keep, method) for a in starts)
+    workers = (os.cpu_count() or 1) if workers is None else workers
+    if workers <= 1 or len(starts) <= 1:
+        batches = [_simulate_batch(*task) for task in tasks]
+    else:
+        with ProcessPoolExecutor(max_workers=min(workers, len(starts)), mp_context=_context()) as pool:
+            batches = list(pool.map(_simulate_batch, *zip(*tasks)))
+    result = xr.concat(batches, dim="realization", data_vars="all", coords="minimal", compat="override", join="override")
+    result.attrs.update(
+        title="stochpound ensemble", stochpound_version=__version__, solver=method, keep=keep,
+        scene_source=scene.source, g=scene.g, study_compat=int(scene.study_compat), dt=dt,
+        **{f"motion_{name}": value for name, value in motions.attrs.items() if isinstance(value, (int, float, str))},
+    )
+    return result
+
+
+def _context() -> multiprocessing.context.BaseContext:
+    """Fork where available (workers inherit compiled kernels and caches), else spawn."""
+    methods = multiprocessing.get_all_start_methods()
+    return multiprocessing.get_context("fork" if "fork" in methods else "spawn")
+
+
+def _sample_spacing(motions: xr.DataArray) -> float:
+    """dt (s) of the ensemble's uniformly spaced samples."""
+    if "time" in motions.coords:
+        times = np.asarray(motions["time"].values, float)
+        dt = float(times[1] - times[0])
+        if abs(times[0]) > 1e-9 * dt or not np.allclose(np.diff(times), dt, rtol=1e-9, atol=0.0):
+            raise ValueError("motions: the time coordinate must start at 0 and be uniformly spaced")
+        return dt
+    if "dt" in motions.attrs:
+        return float(motions.attrs["dt"])
+    raise ValueError("motions: give a time coordinate (s) or attrs['dt']")
+
+
+# ---------------------------------------------------------------- one batch
+
+
+def _simulate_batch(scene: Scene, motions: xr.DataArray, dt: float, keep: str, method: str) -> xr.Dataset:
+    """Simulate and summarise one batch of realizations."""
+    interpolation = scene.motion.interpolation if isinstance(scene.motion, SampledMotion) else "linear"
+    values = np.asarray(motions.values, float)
+    runs = []
+    with threadpool_limits(limits=1):
+        for i, samples in enumerate(values):
+            motion = SampledMotion(dt, samples, interpolation, f"realization {motions['realization'].values[i]}")
+            runs.append(_run(dataclasses.replace(scene, motion=motion), method))
+    histories = _histories(scene, runs, motions)
+    summary = xr.merge([peak_response(histories), _top_floor_moments(scene, histories), _impacts(runs), _energies(runs)])
+    if keep == "histories":
+        summary = summary.merge(histories)
+    return summary.assign_coords(realization=motions["realization"].values)
+
+
+def _run(scene: Scene, method: str) -> tuple[Recorder, EventCounters, Any]:
+    if method == "exact":
+        return run_exact(scene, limit_threads=False)
+    return run_ivp(scene)
+
+
+def _histories(scene: Scene, runs: list, motions: xr.DataArray) -> xr.Dataset:
+    """Displacement and impact force histories of a batch (realization, ...)."""
+    system = runs[0][2].system
+    n, n_floors = system.n_dof, scene.max_floors
+    shape = (len(runs), len(scene.buildings), n_floors, motions.sizes["time"])
+    relative, sliding = np.full(shape, np.nan), np.zeros(shape[:2] + shape[3:])
+    for r, (recorder, _, _) in enumerate(runs):
+        q = recorder.states[:, :n]
+        for b, building in enumerate(scene.buildings):
+            relative[r, b, : building.n_floors] = q[:, system.floor_dofs[b]].T
+            if system.base_dofs[b] >= 0:
+                sliding[r, b] = q[:, system.base_dofs[b]]
+    forces = np.array([recorder.forces.T for recorder, _, _ in runs])
+    dims = ("realization", "building", "floor", "time")
+    coords = {"building": scene.building_names, "floor": np.arange(1, n_floors + 1), "time": np.arange(shape[-1]) * _spacing(runs)}
+    return xr.Dataset(
+        {
+            "total_displacement": (dims, relative + sliding[:, :, None, :], {"units": "m"}),
+            "relative_displacement": (dims, relative, {"units": "m"}),
+            "sliding_displacement": (("realization", "building", "time"), sliding, {"units": "m"}),
+            "impact_force": (("realization", "contact", "time"), forces, {"units": "N"}),
+        },
+        coords=coords,
+    )
+
+
+def _spacing(runs: list) -> float:
+    times = runs[0][0].motion.times
+    return float(times[1] - times[0])
+
+
+def _top_floor_moments(scene: Scene, histories: xr.Dataset) -> xr.Dataset:
+    """Moments over time of every building's top-floor total displacement."""
+    tops = xr.DataArray([b.n_floors for b in scene.buildings], dims="building", coords={"building": scene.building_names})
+    top_floor = histories["total_displacement"].sel(floor=tops).drop_vars("floor")
+    statistics = moments(top_floor.assign_attrs(units="m"), "time")
+    return statistics.rename({name: f"top_floor_{name}" for name in statistics.data_vars})
+
+
+def _impacts(runs: list) -> xr.Dataset:
+    """Impact statistics of each realization (from its impact table)."""
+    tables = []
+    for recorder, _, _ in runs:
+        impacts = recorder.impacts
+        tables.append(xr.Dataset({
+            "impact_in_phase": ("impact", np.array([i.in_phase for i in impacts], bool)),
+            "impact_peak_force": ("impact", np.array([i.peak_force for i in impacts], float)),
+            "impact_duration": ("impact", np.array([i.end - i.start for i in impacts], float)),
+            "impact_impulse": ("impact", np.array([i.impulse for i in impacts], float)),
+        }))
+    return xr.concat([impact_statistics(table) for table in tables], dim="realization")
+
+
+def _energies(runs: list) -> xr.Dataset:
+    """Final energy terms and event counts of each realization."""
+    variables: dict[str, tuple] = {}
+    for term in ENERGY_TERMS:
+        variables[f"energy_{term}"] = ("realization", [rec.energy[term][-1] for rec, _, _ in runs], {"units": "J"})
+    variables["events_total"] = ("realization", [counters.total for _, counters, _ in runs])
+    variables["events_chatter_cycles"] = ("realization", [counters.chatter_cycles for _, counters, _ in runs])
+    return xr.Dataset(variables)
+

@@ -1,0 +1,231 @@
+"""The exact solver against the ivp path (rtol 1e-12), closed forms and the traps of MODEL.md §6."""
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+import stochpound
+from stochpound.motion import GroundMotion, HarmonicMotion, SampledMotion
+from stochpound.propagators import UnsupportedMotionError, exosystem, interval_forcing, propagator_library, sample_ground
+from stochpound.system import build_system
+from tests.conftest import reference_building, study_contacts, study_scene
+from tests.test_modal import AMPLITUDE, modal_solution
+
+TOLERANCE = 1e-9  # m, on every floor's total displacement over the whole record
+
+
+def both(scene: dict) -> tuple:
+    """The same scene run by the exact solver and by ivp (DOP853, rtol 1e-12)."""
+    parsed = stochpound.scene_from_dict(scene)
+    exact = stochpound.simulate(parsed, method="exact")
+    reference = stochpound.simulate(parsed, method="ivp", rtol=1e-12, atol=1e-14)
+    return exact, reference
+
+
+def assert_same_run(exact, reference, tolerance: float = TOLERANCE) -> None:
+    """Displacements within ``tolerance``, identical impacts, same base states, a closed energy balance."""
+    for name in ("total_displacement", "sliding_displacement"):
+        difference = np.nan_to_num(exact[name].values - reference[name].values)
+        assert np.max(np.abs(difference), initial=0.0) <= tolerance, name
+    assert exact.sizes["impact"] == reference.sizes["impact"]
+    np.testing.assert_array_equal(exact.impact_contact.values, reference.impact_contact.values)
+    np.testing.assert_array_equal(exact.impact_in_phase.values, reference.impact_in_phase.values)
+    np.testing.assert_allclose(exact.impact_start.values, reference.impact_start.values, rtol=0, atol=1e-8)
+    np.testing.assert_allclose(exact.impact_end.values, reference.impact_end.values, rtol=0, atol=1e-8)
+    force_scale = max(float(reference.impact_peak_force.max()) if reference.sizes["impact"] else 0.0, 1.0)
+    np.testing.assert_allclose(exact.impact_peak_force.values, reference.impact_peak_force.values, rtol=0, atol=1e-6 * force_scale)
+    np.testing.assert_array_equal(exact.base_state.values, reference.base_state.values)
+    energy_scale = float(np.abs(reference.energy_input).max()) or 1.0
+    assert float(np.abs(exact.energy_residual).max()) <= 1e-6 * energy_scale
+    for term in ("input", "damping", "friction", "impact"):
+        np.testing.assert_allclose(exact[f"energy_{term}"].values, reference[f"energy_{term}"].values, rtol=0, atol=1e-6 * energy_scale)
+    assert exact.attrs["solver"] == "exact"
+
+
+STUDY_SCENES = {
+    "fixed-fixed, B2 flexible, gap 2 cm": study_scene(None, None, 2.0),
+    "fixed-fixed, B2 stiff, gap 1 cm": study_scene(None, None, 0.5, gap=0.01),
+    "B1 isolated mu=0.2, B2 flexible fixed, gap 2 cm": study_scene(0.2, None, 2.0),
+    "B1 isolated mu=0.2, B2 stiff fixed, gap 1 cm": study_scene(0.2, None, 0.5, gap=0.01),
+    "both isolated mu=0.1, B2 stiff, gap 1 cm": study_scene(0.1, 0.1, 0.5, gap=0.01),
+}
+
+
+@pytest.mark.parametrize("name", list(STUDY_SCENES))
+def test_study_scenes_match_ivp(name):
+    exact, reference = both(STUDY_SCENES[name])
+    assert reference.sizes["impact"] > 0
+    assert_same_run(exact, reference)
+
+
+@pytest.mark.parametrize("omega_ground", [2.0, 10.0])
+def test_fixed_base_building_matches_modal_solution(omega_ground):
+    scene = stochpound.scene_from_dict({
+        "building": [reference_building()],
+        "motion": {"type": "harmonic", "amplitude": AMPLITUDE, "omega": omega_ground, "duration": 15.0, "dt": 0.01},
+    })
+    run = stochpound.simulate(scene, method="exact")
+    computed = run.relative_displacement.sel(building="B1").values
+    assert np.max(np.abs(computed - modal_solution(run.time.values, omega_ground))) <= 1e-9
+
+
+def test_zero_gap_fixed_buildings():
+    exact, reference = both(study_scene(None, None, 0.5, gap=0.0, motion={"record": "el_centro_1940_study", "duration": 20.0}))
+    assert reference.sizes["impact"] > 10
+    assert_same_run(exact, reference)
+
+
+def test_zero_gap_isolated_building_settles_against_its_neighbour():
+    """Chattering contact of a frictionless building pushed against a fixed one: progress, and the same impacts."""
+    scene = {
+        "building": [reference_building("B1", mu=0.0), reference_building("B2", 2.0)],
+        "contact": study_contacts(0.0, mass_factor=2.0),
+        "motion": {"type": "constant", "acceleration": -0.5, "duration": 20.0, "dt": 0.02},
+    }
+    exact, reference = both(scene)
+    assert reference.sizes["impact"] > 50
+    assert_same_run(exact, reference)
+
+
+def test_frictionless_base():
+    exact, reference = both(study_scene(0.0, None, 2.0, motion={"record": "el_centro_1940_study", "duration": 20.0}))
+    assert float(exact.energy_friction[-1]) == 0.0
+    assert_same_run(exact, reference)
+
+
+def test_very_stiff_contacts():
+    """Contacts 10× shorter than a sample interval (stiffness × 100): sub-steps and the Hermite screen find them all."""
+    scene = study_scene(None, None, 2.0, motion={"record": "el_centro_1940_study", "duration": 10.0})
+    for contact in scene["contact"]:
+        contact["stiffness"] *= 100.0
+    exact, reference = both(scene)
+    assert float(reference.impact_duration.max()) < 0.01
+    assert_same_run(exact, reference)
+
+
+@pytest.mark.parametrize("excess", [1e-6, 1e-3])
+def test_block_slips_just_above_mu_g_under_harmonic_input(excess):
+    mu, g = 0.2, 9.81
+    scene = {
+        "g": g,
+        "building": [{"name": "block", "mass": [], "stiffness": [], "base": {"mass": 1000.0, "mu": mu}}],
+        "motion": {"type": "harmonic", "amplitude": mu * g * (1 + excess), "omega": 2 * np.pi, "duration": 5.0, "dt": 0.01},
+    }
+    exact, reference = both(scene)
+    assert exact.attrs["events_total"] >= 10
+    assert_same_run(exact, reference, tolerance=1e-12)
+
+
+def test_block_under_constant_acceleration_just_above_mu_g():
+    """Constant a_g = μg(1 + 1e-6): the block slips from t = 0 with relative acceleration 1e-6 μg."""
+    mu, g = 0.2, 9.81
+    scene = {
+        "g": g,
+        "building": [{"name": "block", "mass": [], "stiffness": [], "base": {"mass": 1000.0, "mu": mu}}],
+        "motion": {"type": "constant", "acceleration": mu * g * (1 + 1e-6), "duration": 2.0, "dt": 0.01},
+    }
+    exact, reference = both(scene)
+    s = exact.sliding_displacement.values[0]
+    np.testing.assert_allclose(s, -0.5 * 1e-6 * mu * g * exact.time.values**2, rtol=1e-9, atol=1e-15)
+    assert_same_run(exact, reference, tolerance=1e-12)
+
+
+def test_near_threshold_stick_slip_of_a_building():
+    scene = {
+        "g": 9.81,
+        "building": [reference_building("B1", mu=0.05)],
+        "motion": {"type": "harmonic", "amplitude": 0.35, "omega": 8.0, "duration": 10.0, "dt": 0.01},
+    }
+    exact, reference = both(scene)
+    states = exact.base_state.values
+    assert np.any(states != 0) and np.any(states == 0)
+    assert_same_run(exact, reference)
+
+
+def test_spline_interpolated_record_is_exact_too():
+    motion = {"record": "el_centro_1940_study", "duration": 10.0, "interpolation": "spline"}
+    exact, reference = both(study_scene(0.2, None, 2.0, motion=motion))
+    assert_same_run(exact, reference)
+
+
+# ---------------------------------------------------------------- propagators
+
+
+def test_exosystem_reproduces_the_motion_inside_an_interval():
+    """exp(S τ) w(t_k) is the interpolating polynomial (or the sine) at t_k + τ."""
+    from scipy.linalg import expm
+
+    sampled = SampledMotion(0.02, np.sin(np.arange(30) * 0.7), interpolation="spline")
+    harmonic = HarmonicMotion(3.0, 7.0, 1.0, 0.02, phase=0.3)
+    for motion in (sampled, harmonic):
+        w = interval_forcing(motion)
+        for k, tau in ((3, 0.013), (17, 0.02)):
+            expected = motion.derivatives(motion.times[k] + tau, k)
+            np.testing.assert_allclose(expm(exosystem(motion) * tau) @ w[k], expected, rtol=1e-12, atol=1e-12)
+        ground = [motion.acceleration(t, min(k, len(motion.times) - 2)) for k, t in enumerate(motion.times)]
+        np.testing.assert_array_equal(sample_ground(motion), ground)
+
+
+def test_unsupported_motion_names_the_other_method():
+    class Other(GroundMotion):
+        times = np.arange(5) * 0.1
+
+    scene = stochpound.scene_from_dict(study_scene())
+    with pytest.raises(UnsupportedMotionError, match="method='ivp'"):
+        stochpound.simulate(dataclasses.replace(scene, motion=Other()), method="exact")
+
+
+def test_propagators_are_cached_across_runs_and_hold_stuck_bases_exactly():
+    scene = stochpound.scene_from_dict(study_scene(0.2, None, 2.0, motion={"record": "el_centro_1940_study", "duration": 5.0}))
+    first = stochpound.simulate(scene, method="exact")
+    library = propagator_library(build_system(scene), scene.motion)
+    built = len(library)
+    assert built == first.attrs["modes_visited"]
+    again = stochpound.simulate(scene, method="exact")
+    assert len(library) == built
+    np.testing.assert_array_equal(first.total_displacement.values, again.total_displacement.values)
+    stuck = scene.motion.dt * 0 + first.base_state.sel(building="B1").values == 0
+    velocity_free = np.diff(first.sliding_displacement.sel(building="B1").values)
+    assert np.all(velocity_free[stuck[:-1] & stuck[1:]] == 0.0)  # s constant to the last bit while stuck
+
+
+# ---------------------------------------------------------------- compiled engine against the shared Python event code
+
+
+HARD_CASES = {
+    "B1 isolated, El Centro 20 s": study_scene(0.2, None, 2.0, motion={"record": "el_centro_1940_study", "duration": 20.0}),
+    "zero gap, stiff B2": study_scene(None, None, 0.5, gap=0.0, motion={"record": "el_centro_1940_study", "duration": 10.0}),
+    "stiff contacts x100": study_scene(None, None, 2.0, motion={"record": "el_centro_1940_study", "duration": 10.0}),
+    "non-tensile contacts, both isolated": study_scene(0.1, 0.1, 0.5, gap=0.01, motion={"record": "el_centro_1940_study", "duration": 20.0}),
+    "frictionless against a neighbour": {
+        "building": [reference_building("B1", mu=0.0), reference_building("B2", 2.0)],
+        "contact": study_contacts(0.0, mass_factor=2.0),
+        "motion": {"type": "constant", "acceleration": -0.5, "duration": 10.0, "dt": 0.02},
+    },
+}
+for contact in HARD_CASES["stiff contacts x100"]["contact"]:
+    contact["stiffness"] *= 100.0
+for contact in HARD_CASES["non-tensile contacts, both isolated"]["contact"]:
+    contact["tensile"] = False
+
+
+@pytest.mark.parametrize("name", list(HARD_CASES))
+def test_compiled_engine_matches_the_shared_python_event_code(name):
+    """The numba port of events/recorder gives the events and outputs of the shared Python functions."""
+    from stochpound.solvers.exact import run_exact
+
+    scene = stochpound.scene_from_dict(HARD_CASES[name])
+    compiled, counters, _ = run_exact(scene, events="compiled")
+    python, python_counters, _ = run_exact(scene, events="python")
+    assert counters.total == python_counters.total
+    assert counters.chatter_cycles == python_counters.chatter_cycles
+    np.testing.assert_allclose(compiled.states, python.states, rtol=0, atol=1e-11)
+    np.testing.assert_array_equal(compiled.base_states, python.base_states)
+    assert len(compiled.impacts) == len(python.impacts)
+    for a, b in zip(compiled.impacts, python.impacts):
+        assert (a.contact, a.in_phase, a.complete) == (b.contact, b.in_phase, b.complete)
+        np.testing.assert_allclose([a.start, a.end, a.peak_time], [b.start, b.end, b.peak_time], rtol=0, atol=1e-11)
+        np.testing.assert_allclose([a.peak_force, a.impulse], [b.peak_force, b.impulse], rtol=1e-9)
+    for term in compiled.energy:
+        np.testing.assert_allclose(compiled.energy[term], python.energy[term], rtol=1e-9, atol=1e-6)
