@@ -17,6 +17,8 @@ def _register() -> None:
     main.add_command(simulate)
     from stochpound.cli.records import records
     main.add_command(records)
+    from stochpound.cli.experiment import experiment
+    main.add_command(experiment)
 
 
 _register()

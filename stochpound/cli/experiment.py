@@ -1,0 +1,116 @@
+"""``stochpound experiment``: run an experiment into its store, check it, show a store's status."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import click
+
+from stochpound.errors import StochpoundError
+
+
+@click.group("experiment")
+def experiment() -> None:
+    """Grids and ensembles of scenes, run on dask into a crash-safe store (docs/experiments.md)."""
+
+
+@experiment.command("run")
+@click.argument("experiment_file", type=click.Path(dir_okay=False))
+@click.option("--store", "store", type=click.Path(dir_okay=False), default=None, help="Store file (default: beside EXPERIMENT_FILE, suffix .nc).")
+@click.option("--workers", type=click.IntRange(min=0), default=None, help="Local dask worker processes (default: the machine's cores; 0: run in this process).")
+@click.option("--scheduler", default=None, metavar="ADDRESS", help="Run on an existing dask.distributed cluster, e.g. tcp://host:8786.")
+@click.option("--restart", is_flag=True, help="Discard the existing store and its finished cases (also one of another definition).")
+@click.option("--batch", "batch_size", type=click.IntRange(min=1), default=None, help="Cases per dask task (default: automatic).")
+@click.option("--checkpoint", type=click.FloatRange(min=0.0), default=30.0, show_default=True, help="Seconds between rebuilds of the store file during the run.")
+@click.option("--quiet", is_flag=True, help="No progress bar.")
+def run_command(experiment_file: str, store: str | None, workers: int | None, scheduler: str | None, restart: bool, batch_size: int | None, checkpoint: float, quiet: bool) -> None:
+    """Run the missing cases of EXPERIMENT_FILE into its store.
+
+    Finished cases are kept one file each in STORE.parts/; rerunning the
+    same command completes only the missing ones. Ctrl-C stops cleanly.
+    """
+    from stochpound.experiment import load_experiment, run_experiment
+
+    if workers is not None and scheduler is not None:
+        raise click.BadParameter("give --workers or --scheduler, not both", param_hint="--workers")
+    try:
+        loaded = load_experiment(experiment_file)
+        report = run_experiment(
+            loaded, store, workers=workers, scheduler=scheduler, restart=restart, progress=not quiet, checkpoint=checkpoint, batch_size=batch_size
+        )
+    except (StochpoundError, ValueError) as error:
+        raise click.ClickException(str(error)) from None
+    _summary(report)
+    if report.interrupted:
+        sys.exit(130)
+    if report.failed:
+        sys.exit(1)
+
+
+def _summary(report) -> None:
+    rate = report.done_now / report.elapsed if report.elapsed > 0 else 0.0
+    state = "interrupted" if report.interrupted else ("complete" if report.complete else "incomplete")
+    click.echo(
+        f"{state}: {report.done}/{report.total} cases done ({report.done_now} this run, {report.done_before} before) "
+        f"in {report.elapsed:.1f} s, {rate:.2f} cases/s on {report.executor}"
+    )
+    for described, error in report.failed[:5]:
+        click.echo(f"FAILED {described}\n{error}", err=True)
+    if len(report.failed) > 5:
+        click.echo(f"... and {len(report.failed) - 5} more failed cases", err=True)
+    size = report.store.stat().st_size if report.store.exists() else 0
+    click.echo(f"store: {report.store} ({size / 1e6:.2f} MB); open it with stochpound.open_store({str(report.store)!r})")
+    if not report.complete:
+        click.echo("rerun the same command to complete the missing cases")
+
+
+@experiment.command("check")
+@click.argument("experiment_file", type=click.Path(dir_okay=False))
+def check_command(experiment_file: str) -> None:
+    """Validate EXPERIMENT_FILE and list its dimensions (runs nothing)."""
+    from stochpound.experiment import load_experiment
+    from stochpound.experiment.sources import resolve_motions
+
+    try:
+        loaded = load_experiment(experiment_file)
+        resolve_motions(loaded)
+    except (StochpoundError, ValueError) as error:
+        raise click.ClickException(str(error)) from None
+    click.echo(f"{experiment_file}: valid; definition sha256 {loaded.sha256}")
+    for dim in loaded.dims:
+        click.echo(f"  {dim.name:14s} {len(dim.values):5d}  {', '.join(_fmt(v) for v in dim.values[:8])}{' ...' if len(dim.values) > 8 else ''}")
+    n_reference = sum(1 for c in loaded.cases if c.kind == "reference")
+    click.echo(f"  {len(loaded.cases) - n_reference} cases + {n_reference} fixed-base reference cases")
+
+
+def _fmt(value) -> str:
+    return f"{value:g}" if isinstance(value, float) else str(value)
+
+
+@experiment.command("status")
+@click.argument("store", type=click.Path(dir_okay=False))
+@click.option("--all", "show_all", is_flag=True, help="List every missing case (default: the first 20).")
+@click.option("--done", "show_done", is_flag=True, help="Also list the done cases.")
+@click.option("--no-rebuild", is_flag=True, help="Do not rewrite the store file from the finished cases.")
+def status_command(store: str, show_all: bool, show_done: bool, no_rebuild: bool) -> None:
+    """List the done and missing cases of STORE (and refresh the file from the finished cases)."""
+    from stochpound.experiment import store_status
+
+    try:
+        report = store_status(Path(store), rebuild=not no_rebuild)
+    except (StochpoundError, ValueError, OSError) as error:
+        raise click.ClickException(str(error)) from None
+    total = len(report.done) + len(report.missing)
+    click.echo(f"experiment {report.experiment.name} (definition sha256 {report.experiment.sha256[:12]}…)")
+    click.echo(f"{len(report.done)}/{total} cases done, {len(report.missing)} missing" + ("; a run is writing this store now" if report.running else ""))
+    if show_done:
+        for case in report.done:
+            click.echo(f"done     {case.case_id}  {case.describe()}")
+    shown = report.missing if show_all else report.missing[:20]
+    for case in shown:
+        click.echo(f"missing  {case.case_id}  {case.describe()}")
+    if len(shown) < len(report.missing):
+        click.echo(f"... {len(report.missing) - len(shown)} more (--all lists them)")
+    if report.rebuilt:
+        click.echo(f"store rebuilt from the finished cases: {report.store}")

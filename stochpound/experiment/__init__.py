@@ -1,0 +1,29 @@
+"""Experiments: grids and ensembles of scenes run on dask into a crash-safe store.
+
+>>> from stochpound import experiment                               # doctest: +SKIP
+>>> exp = experiment.load_experiment("experiments/quickstart.toml")  # doctest: +SKIP
+>>> report = experiment.run_experiment(exp, workers=2)               # doctest: +SKIP
+>>> ds = experiment.open_store(report.store)                         # doctest: +SKIP
+
+File format, store layout, resumption and clusters: ``docs/experiments.md``.
+"""
+
+from stochpound.experiment.model import Case, Dim, Experiment
+from stochpound.experiment.runner import RunReport, default_store, load_experiment, run_experiment
+from stochpound.experiment.spec import ExperimentError
+from stochpound.experiment.status import StatusReport, store_status
+from stochpound.experiment.store import open_store
+
+__all__ = [
+    "Case",
+    "Dim",
+    "Experiment",
+    "ExperimentError",
+    "RunReport",
+    "StatusReport",
+    "default_store",
+    "load_experiment",
+    "open_store",
+    "run_experiment",
+    "store_status",
+]

@@ -1,0 +1,220 @@
+"""A store and its parts folder: identity checks, loading the finished cases, rebuilding the file.
+
+Used by ``experiment run`` (with the folder's lock held) and by
+``experiment status``.
+"""
+
+from __future__ import annotations
+
+import datetime as _dt
+import hashlib
+import json
+import os
+import platform
+import shutil
+import subprocess
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from stochpound import __version__
+from stochpound.experiment.model import Experiment
+from stochpound.experiment.parts import (
+    DEFINITION_FILE,
+    iter_parts,
+    part_ids,
+    parts_folder,
+    read_definition,
+    read_runs,
+    write_definition,
+)
+from stochpound.experiment.spec import ExperimentError, canonical_json
+from stochpound.experiment.store import build_store, write_store
+
+
+def now() -> str:
+    """Current UTC time, ISO 8601."""
+    return _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")
+
+
+def store_identity(store: Path) -> str:
+    """The ``definition_sha256`` attribute of an existing store file.
+
+    Raises
+    ------
+    ExperimentError
+        If the file is not a readable experiment store.
+    """
+    import h5py
+
+    try:
+        with h5py.File(store, "r") as handle:
+            value = handle.attrs["definition_sha256"]
+    except KeyError:
+        raise ExperimentError(f"{store}: not a stochpound experiment store (no definition_sha256 attribute)") from None
+    except OSError as error:
+        raise ExperimentError(f"{store}: not a readable netCDF4/HDF5 file ({error})") from None
+    return value.decode() if isinstance(value, bytes) else str(value)
+
+
+def check_store(store: Path, sha256: str) -> None:
+    """Refuse a store (or parts folder) that belongs to another experiment definition.
+
+    Raises
+    ------
+    ExperimentError
+        The store is a folder, is unreadable, or was made from a different definition.
+    """
+    hint = "use --restart to discard it and start again, or --store to write elsewhere"
+    if store.is_dir():
+        raise ExperimentError(f"{store}: is a folder; --store must name a file")
+    if store.exists():
+        try:
+            found = store_identity(store)
+        except ExperimentError as error:
+            raise ExperimentError(f"{error}; {hint}") from None
+        if found != sha256:
+            raise ExperimentError(f"{store}: made from a different experiment definition (sha256 {found[:12]}…, this one {sha256[:12]}…); {hint}")
+    folder = parts_folder(store)
+    if folder.exists() and ((folder / DEFINITION_FILE).exists() or part_ids(folder)):
+        try:
+            found = read_definition(folder)["definition_sha256"]
+        except (ExperimentError, KeyError, TypeError) as error:
+            raise ExperimentError(f"{folder}: unreadable parts folder ({error}); {hint}") from None
+        if found != sha256:
+            raise ExperimentError(f"{folder}: holds cases of a different experiment definition (sha256 {found[:12]}…, this one {sha256[:12]}…); {hint}")
+
+
+def clear_store(store: Path) -> None:
+    """Delete a store file and its parts (``--restart``; call with the folder's lock held)."""
+    folder = parts_folder(store)
+    for path in folder.iterdir():
+        if path.name != ".lock":
+            shutil.rmtree(path) if path.is_dir() else path.unlink()
+    store.unlink(missing_ok=True)
+
+
+def git_commit() -> str:
+    """Commit of the stochpound source tree ("+dirty" if modified), or "none"."""
+    source = Path(__file__).resolve().parents[2]
+    try:
+        tracked = subprocess.run(["git", "-C", str(source), "ls-files", "--error-unmatch", "stochpound/__init__.py"], capture_output=True, timeout=10)
+        commit = subprocess.run(["git", "-C", str(source), "rev-parse", "HEAD"], capture_output=True, text=True, timeout=10)
+        if tracked.returncode != 0 or commit.returncode != 0:
+            return "none"
+        dirty = subprocess.run(["git", "-C", str(source), "status", "--porcelain", "--", "stochpound"], capture_output=True, text=True, timeout=10)
+    except (OSError, subprocess.SubprocessError):
+        return "none"
+    return commit.stdout.strip() + ("+dirty" if dirty.stdout.strip() else "")
+
+
+def machine() -> str:
+    """Host, platform, Python and CPU count of this process."""
+    return f"{platform.node()}; {platform.platform()}; Python {platform.python_version()}; {os.cpu_count()} CPUs"
+
+
+class StoreSession:
+    """A store file, its parts folder and the experiment they belong to.
+
+    Parameters
+    ----------
+    store : Path
+        The store file.
+    experiment : Experiment
+    record : dict
+        Contents of ``experiment.json``.
+    """
+
+    def __init__(self, store: Path, experiment: Experiment, record: dict[str, Any]) -> None:
+        self.store = Path(store)
+        self.folder = parts_folder(self.store)
+        self.experiment = experiment
+        self.record = record
+        self.results: dict[str, dict[str, np.ndarray]] = {}
+
+    @classmethod
+    def create(cls, store: Path, experiment: Experiment, motion_grids: dict[str, tuple[float, int]]) -> "StoreSession":
+        """Open the parts folder for a run, writing ``experiment.json`` if it is new."""
+        folder = parts_folder(store)
+        folder.mkdir(parents=True, exist_ok=True)
+        if (folder / DEFINITION_FILE).exists():
+            record = read_definition(folder)
+        else:
+            record = {
+                "definition_sha256": experiment.sha256,
+                "definition": json.loads(canonical_json(experiment.definition)),
+                "text": experiment.text,
+                "text_sha256": hashlib.sha256(experiment.text.encode()).hexdigest(),
+                "file": experiment.path,
+                "base_dir": str(experiment.base_dir.resolve()),
+                "motion_grids": {k: list(v) for k, v in motion_grids.items()},
+                "created": now(),
+            }
+            write_definition(folder, record)
+        return cls(store, experiment, record)
+
+    @classmethod
+    def open(cls, store: Path) -> "StoreSession":
+        """Open an existing store's parts folder (for ``status``).
+
+        Raises
+        ------
+        ExperimentError
+            If there is no parts folder or it is unreadable.
+        """
+        folder = parts_folder(store)
+        record = read_definition(folder)
+        experiment = Experiment(record["definition"], record.get("text", ""), record.get("base_dir", "."), record.get("file", ""))
+        return cls(store, experiment, record)
+
+    @property
+    def motion_grids(self) -> dict[str, tuple[float, int]]:
+        """(dt, samples) of each motion."""
+        return {k: (float(v[0]), int(v[1])) for k, v in self.record["motion_grids"].items()}
+
+    def done_ids(self) -> set[str]:
+        """Ids of the cases with a part file."""
+        return part_ids(self.folder) & set(self.experiment.case_index)
+
+    def load(self, remove_unreadable: bool = False) -> None:
+        """Read every finished case's part into memory (unreadable parts count as missing)."""
+        ids = self.done_ids()
+        self.results = {case_id: arrays for case_id, _, arrays in iter_parts(self.folder, ids)}
+        if remove_unreadable:
+            for case_id in ids - set(self.results):
+                (self.folder / f"{case_id}.npz").unlink(missing_ok=True)
+
+    def attrs(self) -> dict[str, Any]:
+        """Provenance attributes of the store."""
+        experiment = self.experiment
+        solver = experiment.solver
+        runs = read_runs(self.folder)
+        last = runs[-1] if runs else {}
+        return {
+            "experiment_name": experiment.name,
+            "experiment_description": experiment.definition.get("description", ""),
+            "experiment_file": self.record.get("file", ""),
+            "experiment_text": self.record.get("text", ""),
+            "experiment_sha256": self.record.get("text_sha256", ""),
+            "definition_sha256": experiment.sha256,
+            "definition": canonical_json(experiment.definition),
+            "studied_building": experiment.studied,
+            "stochpound_version": __version__,
+            "git_commit": last.get("git_commit", "none"),
+            "solver": solver["method"],
+            "solver_integrator": solver["integrator"],
+            "solver_rtol": solver["rtol"],
+            "solver_atol": solver["atol"],
+            "solver_note": "integrator, rtol and atol apply to the ivp solver only",
+            "seeds": json.dumps(experiment.seeds()),
+            "created": self.record.get("created", ""),
+            "updated": now(),
+            "machine": last.get("machine", machine()),
+            "runs": json.dumps(runs),
+        }
+
+    def rebuild(self) -> Path:
+        """(Re)write the store file atomically from the finished cases in memory."""
+        dataset = build_store(self.experiment, self.results, self.motion_grids, self.attrs())
+        return write_store(dataset, self.store)

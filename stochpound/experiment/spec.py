@@ -1,0 +1,485 @@
+"""Experiment files (TOML): parsing and validation into a canonical definition.
+
+An experiment file names a base scene, named variants of it, grid axes (gap,
+μ, variants), the ground motions (records and synthetic ensembles), the
+outputs to keep and the solver settings (docs/experiments.md, field by
+field). :func:`parse_experiment` checks every field and returns the
+*canonical definition*: a JSON-able dict with every default filled in and the
+base scene inlined. Its sha256 identifies the experiment: a store made from a
+different definition is refused. :class:`stochpound.experiment.model.Experiment`
+is built from it.
+
+Errors raise :class:`ExperimentError` whose message starts with the field's
+path, e.g. ``grid.mu[2]: must be >= 0 or inf, got -0.1``.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import copy
+import hashlib
+import json
+import math
+import re
+import tomllib
+from pathlib import Path
+from typing import Any, Iterator, Mapping
+
+from stochpound.errors import SceneError
+from stochpound.scene_file import _is_number, _number, _reject_unknown, _string, _table
+from stochpound.simulate import METHODS
+from stochpound.solvers.ivp import INTEGRATORS
+
+#: Format version of the canonical definition (stored with every store).
+FORMAT_VERSION = 1
+
+_TOP_KEYS = {"experiment", "scene", "variants", "grid", "records", "synthetic", "output", "solver"}
+_EXPERIMENT_KEYS = {"name", "description", "scene", "studied"}
+_BUILDING_OVERRIDES = {"mass_factor", "mass", "stiffness", "damping", "damping_ratio", "base", "initial"}
+_SCENE_OVERRIDES = {"study_compat"}
+_RECORD_KEYS = {"name", "record", "scale", "dt", "duration", "units", "interpolation"}
+_SYNTHETIC_TYPES = ("kanai_tajimi", "clough_penzien")
+_GAP_AXIS = re.compile(r"^gap(_[A-Za-z0-9_]+)?$")
+_DIM_NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
+_RESERVED_DIMS = {
+    "mu", "record", "realization", "time", "building", "floor", "contact", "impact",
+    # suffixes of the impact table's columns (impact_<dim> labels the table)
+    "start", "end", "duration", "peak_force", "peak_time", "impulse", "onset_velocity", "in_phase", "complete", "case_id",
+}
+
+#: Time-history variables of a result that an experiment can keep.
+TIME_HISTORY_VARIABLES = (
+    "total_displacement",
+    "relative_displacement",
+    "sliding_displacement",
+    "ground_acceleration",
+    "impact_force",
+    "base_friction_force",
+    "base_state",
+    "energy_input",
+    "energy_kinetic",
+    "energy_strain",
+    "energy_damping",
+    "energy_friction",
+    "energy_impact",
+    "energy_residual",
+)
+
+
+class ExperimentError(SceneError):
+    """An experiment definition or store is invalid; the message names the field
+    (e.g. ``grid.gap[1]: must be >= 0, got -0.01``) or the file."""
+
+
+@contextlib.contextmanager
+def field_errors(prefix: str = "", scene_prefix: str | None = None) -> Iterator[None]:
+    """Re-raise :class:`SceneError` (and ``ValueError``) as :class:`ExperimentError`.
+
+    Parameters
+    ----------
+    prefix : str
+        Prepended to the message (``"variants.neighbour.stiff: "``).
+    scene_prefix : str, optional
+        Replaces a leading ``motion.`` / ``motion:`` of scene messages, so that a
+        record's errors name the experiment's field (``records[0].duration``).
+    """
+    try:
+        yield
+    except ExperimentError:
+        raise
+    except (SceneError, ValueError) as error:
+        message = str(error)
+        if scene_prefix is not None:
+            message = re.sub(r"^motion([.:])", lambda m: scene_prefix + ("." if m.group(1) == "." else ":"), message)
+        raise ExperimentError(prefix + message) from None
+
+
+def load_definition(path: str | Path) -> tuple[dict[str, Any], str]:
+    """Read an experiment file and return its canonical definition and its text.
+
+    Parameters
+    ----------
+    path : str or Path
+        The TOML experiment file. A base scene given as a path is resolved
+        against the file's folder, and so are record files.
+
+    Raises
+    ------
+    ExperimentError
+        If the file is missing, not TOML, or any field is invalid.
+    """
+    path = Path(path)
+    try:
+        text = path.read_text()
+    except (FileNotFoundError, IsADirectoryError):
+        raise ExperimentError(f"{path}: experiment file not found") from None
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as error:
+        raise ExperimentError(f"{path}: not valid TOML: {error}") from None
+    return parse_experiment(data, base_dir=path.parent, default_name=path.stem), text
+
+
+def definition_sha256(definition: Mapping[str, Any]) -> str:
+    """sha256 of the canonical definition (sorted-key JSON): the experiment's identity."""
+    return hashlib.sha256(canonical_json(definition).encode()).hexdigest()
+
+
+def canonical_json(value: Any) -> str:
+    """Deterministic JSON (sorted keys, inf as the string "inf")."""
+    return json.dumps(_jsonable(value), sort_keys=True, separators=(",", ":"))
+
+
+def _jsonable(value: Any) -> Any:
+    if isinstance(value, float) and math.isinf(value):
+        return "inf" if value > 0 else "-inf"
+    if isinstance(value, Mapping):
+        return {str(k): _jsonable(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_jsonable(v) for v in value]
+    return value
+
+
+def parse_experiment(data: Mapping[str, Any], base_dir: str | Path = ".", default_name: str = "experiment") -> dict[str, Any]:
+    """Validate a parsed experiment file and return its canonical definition.
+
+    Parameters
+    ----------
+    data : mapping
+        The parsed TOML.
+    base_dir : str or Path
+        Folder of the experiment file (for a scene path and record files).
+    default_name : str
+        Name when ``experiment.name`` is not given.
+
+    Returns
+    -------
+    dict
+        Canonical definition: ``format``, ``name``, ``description``,
+        ``scene`` (the base scene's dict, its ``[motion]`` included when it has one),
+        ``studied``, ``variants``, ``gaps``, ``mu``, ``motions``, ``output``, ``solver``.
+    """
+    base_dir = Path(base_dir)
+    with field_errors():
+        _reject_unknown(data, _TOP_KEYS, "")
+        header = _table(data, "experiment", "") or {}
+        _reject_unknown(header, _EXPERIMENT_KEYS, "experiment")
+        name = _string(header, "name", "experiment", default=default_name)
+        description = header.get("description", "")
+        if not isinstance(description, str):
+            raise ExperimentError(f"experiment.description: must be a string, got {description!r}")
+    scene = _base_scene(data, header, base_dir)
+    buildings = [b.get("name", f"B{i + 1}") for i, b in enumerate(scene.get("building", []))]
+    studied = header.get("studied", buildings[0] if buildings else "B1")
+    if studied not in buildings:
+        raise ExperimentError(f"experiment.studied: must be one of the scene's buildings ({', '.join(buildings)}), got {studied!r}")
+    variants = _variants(data, buildings)
+    grid = _table_or_error(data, "grid", "")
+    known_axes = {v["name"] for v in variants}
+    for key in grid:
+        if not (_GAP_AXIS.match(key) or key == "mu" or key in known_axes):
+            allowed = ["gap", "gap_<name>", "mu", *sorted(known_axes)]
+            raise ExperimentError(f"grid.{key}: unknown axis (allowed: {', '.join(allowed)}; variant axes are declared in [variants.<axis>])")
+    for variant in variants:
+        variant["values"] = _variant_selection(grid, variant)
+    n_contacts = len(scene.get("contact", []))
+    contact_floors = [c.get("between", [[None, None]])[0][1] for c in scene.get("contact", [])]
+    gaps = [_gap_axis(key, grid[key], n_contacts, contact_floors) for key in grid if _GAP_AXIS.match(key)]
+    mu = _mu_axis(grid["mu"], buildings) if "mu" in grid else None
+    return {
+        "format": FORMAT_VERSION,
+        "name": name,
+        "description": description,
+        "scene": scene,
+        "studied": studied,
+        "variants": variants,
+        "gaps": gaps,
+        "mu": mu,
+        "motions": _motions(data, scene, base_dir),
+        "output": _output(data, buildings),
+        "solver": _solver(data),
+    }
+
+
+def _table_or_error(data: Mapping[str, Any], key: str, prefix: str) -> dict[str, Any]:
+    with field_errors():
+        return dict(_table(data, key, prefix) or {})
+
+
+def _base_scene(data: Mapping[str, Any], header: Mapping[str, Any], base_dir: Path) -> dict[str, Any]:
+    inline = data.get("scene")
+    path = header.get("scene")
+    if inline is not None and path is not None:
+        raise ExperimentError("experiment.scene: give either a scene path here or an inline [scene] table, not both")
+    if inline is None and path is None:
+        raise ExperimentError("scene: missing (an inline [scene] table, or experiment.scene = \"path/to/scene.toml\")")
+    if inline is not None:
+        if not isinstance(inline, dict):
+            raise ExperimentError(f"scene: must be a table (the scene, as in a scene file), got {type(inline).__name__}")
+        return copy.deepcopy(inline)
+    if not isinstance(path, str) or not path:
+        raise ExperimentError(f"experiment.scene: must be a path to a scene file, got {path!r}")
+    file = base_dir / path
+    try:
+        return tomllib.loads(file.read_text())
+    except (FileNotFoundError, IsADirectoryError):
+        raise ExperimentError(f"experiment.scene: scene file {str(file)!r} not found") from None
+    except tomllib.TOMLDecodeError as error:
+        raise ExperimentError(f"experiment.scene: {str(file)!r} is not valid TOML: {error}") from None
+
+
+# ---------------------------------------------------------------- variants
+
+
+def _variants(data: Mapping[str, Any], buildings: list[str]) -> list[dict[str, Any]]:
+    table = _table_or_error(data, "variants", "")
+    axes = []
+    for axis, values in table.items():
+        where = f"variants.{axis}"
+        _check_dim_name(axis, where)
+        if not isinstance(values, dict) or not values:
+            raise ExperimentError(f"{where}: must be a table of named variants, e.g. [{where}.stiff] (at least one)")
+        overrides = {}
+        for value, override in values.items():
+            overrides[value] = _override(override, f"{where}.{value}", buildings)
+        axes.append({"name": axis, "values": list(values), "overrides": overrides})
+    return axes
+
+
+def _check_dim_name(name: str, where: str) -> None:
+    if not _DIM_NAME.match(name) or name in _RESERVED_DIMS or _GAP_AXIS.match(name):
+        raise ExperimentError(
+            f"{where}: axis name must be a letter followed by letters, digits or _, and none of "
+            f"{', '.join(sorted(_RESERVED_DIMS))}, gap, gap_*; got {name!r}"
+        )
+
+
+def _override(override: Any, where: str, buildings: list[str]) -> dict[str, Any]:
+    if not isinstance(override, dict):
+        raise ExperimentError(f"{where}: must be a table (with building.<name> and/or scene tables)")
+    with field_errors():
+        _reject_unknown(override, {"building", "scene"}, where)
+    scene_part = override.get("scene", {})
+    if not isinstance(scene_part, dict):
+        raise ExperimentError(f"{where}.scene: must be a table")
+    with field_errors():
+        _reject_unknown(scene_part, _SCENE_OVERRIDES, f"{where}.scene")
+    building_part = override.get("building", {})
+    if not isinstance(building_part, dict):
+        raise ExperimentError(f"{where}.building: must be a table of buildings by name, e.g. [{where}.building.B2]")
+    for name, fields in building_part.items():
+        prefix = f"{where}.building.{name}"
+        if name not in buildings:
+            raise ExperimentError(f"{prefix}: unknown building (buildings: {', '.join(buildings)})")
+        if not isinstance(fields, dict):
+            raise ExperimentError(f"{prefix}: must be a table of building fields")
+        with field_errors():
+            _reject_unknown(fields, _BUILDING_OVERRIDES, prefix)
+            if "mass_factor" in fields:
+                _number(fields, "mass_factor", prefix, low=0.0, low_open=True)
+        base = fields.get("base")
+        if base is not None and base is not False and not isinstance(base, dict):
+            raise ExperimentError(f"{prefix}.base: must be a table (merged into the base) or false (a fixed base), got {base!r}")
+    return copy.deepcopy(dict(override))
+
+
+def _variant_selection(grid: Mapping[str, Any], variant: Mapping[str, Any]) -> list[str]:
+    name, declared = variant["name"], variant["values"]
+    if name not in grid:
+        return list(declared)
+    chosen = grid[name]
+    where = f"grid.{name}"
+    if not isinstance(chosen, list) or not chosen:
+        raise ExperimentError(f"{where}: must be a non-empty list of variant names ({', '.join(declared)})")
+    for i, value in enumerate(chosen):
+        if value not in declared:
+            raise ExperimentError(f"{where}[{i}]: unknown variant {value!r} (declared: {', '.join(declared)})")
+    _check_unique(chosen, where)
+    return list(chosen)
+
+
+def _check_unique(values: list[Any], where: str) -> None:
+    for i, value in enumerate(values):
+        if values.index(value) != i:
+            raise ExperimentError(f"{where}[{i}]: repeated value {value!r}")
+
+
+# ---------------------------------------------------------------- axes
+
+
+def _axis_values(spec: Any, where: str, allowed: set[str]) -> tuple[list[Any], dict[str, Any]]:
+    """An axis is a list of values, or a table with ``values`` and options."""
+    if isinstance(spec, list):
+        return spec, {}
+    if isinstance(spec, dict):
+        with field_errors():
+            _reject_unknown(spec, {"values", *allowed}, where)
+        if "values" not in spec:
+            raise ExperimentError(f"{where}.values: missing (a non-empty list)")
+        return spec["values"], spec
+    raise ExperimentError(f"{where}: must be a list of values or a table with values = [...], got {spec!r}")
+
+
+def _numbers(values: Any, where: str, allow_inf: bool) -> list[float]:
+    if not isinstance(values, list) or not values:
+        raise ExperimentError(f"{where}: must be a non-empty list (an empty axis makes an empty grid)")
+    numbers = []
+    for i, value in enumerate(values):
+        item = f"{where}[{i}]"
+        if allow_inf and isinstance(value, str) and value.lower() in ("inf", "infinity"):
+            value = math.inf
+        if not _is_number(value) or math.isnan(value) or (math.isinf(value) and not (allow_inf and value > 0)):
+            allowed = "a number >= 0 or inf (a fixed base)" if allow_inf else "a finite number >= 0"
+            raise ExperimentError(f"{item}: must be {allowed}, got {value!r}")
+        if value < 0:
+            raise ExperimentError(f"{item}: must be >= 0{' or inf' if allow_inf else ''}, got {value!r}")
+        numbers.append(float(value))
+    _check_unique(numbers, where)
+    return numbers
+
+
+def _gap_axis(key: str, spec: Any, n_contacts: int, contact_floors: list[Any]) -> dict[str, Any]:
+    where = f"grid.{key}"
+    values, options = _axis_values(spec, where, {"contacts", "floors"})
+    gaps = _numbers(values, f"{where}.values" if options else where, allow_inf=False)
+    if n_contacts == 0:
+        raise ExperimentError(f"{where}: the scene has no [[contact]] whose gap could vary")
+    contacts = list(range(n_contacts))
+    if "contacts" in options and "floors" in options:
+        raise ExperimentError(f"{where}: give contacts or floors, not both")
+    if "contacts" in options:
+        contacts = options["contacts"]
+        if not isinstance(contacts, list) or not contacts or not all(isinstance(c, int) and not isinstance(c, bool) and 0 <= c < n_contacts for c in contacts):
+            raise ExperimentError(f"{where}.contacts: must be a non-empty list of contact indices in 0..{n_contacts - 1}, got {contacts!r}")
+    if "floors" in options:
+        floors = options["floors"]
+        if not isinstance(floors, list) or not floors:
+            raise ExperimentError(f"{where}.floors: must be a non-empty list of floor levels, got {floors!r}")
+        contacts = [i for i, floor in enumerate(contact_floors) if floor in floors]
+        if not contacts:
+            raise ExperimentError(f"{where}.floors: no contact has its left floor in {floors!r} (contact floors: {contact_floors})")
+    return {"name": key, "values": gaps, "contacts": sorted(set(contacts))}
+
+
+def _mu_axis(spec: Any, buildings: list[str]) -> dict[str, Any]:
+    values, options = _axis_values(spec, "grid.mu", {"buildings"})
+    mus = _numbers(values, "grid.mu.values" if options else "grid.mu", allow_inf=True)
+    chosen = options.get("buildings")
+    if chosen is not None:
+        if not isinstance(chosen, list) or not chosen or not all(b in buildings for b in chosen):
+            raise ExperimentError(f"grid.mu.buildings: must be a non-empty list of building names ({', '.join(buildings)}), got {chosen!r}")
+        _check_unique(chosen, "grid.mu.buildings")
+    return {"values": mus, "buildings": chosen}
+
+
+# ---------------------------------------------------------------- motions
+
+
+def _motions(data: Mapping[str, Any], scene: Mapping[str, Any], base_dir: Path) -> list[dict[str, Any]]:
+    records = data.get("records", [])
+    if not isinstance(records, list) or not all(isinstance(r, dict) for r in records):
+        raise ExperimentError("records: must be an array of tables ([[records]] with record = name or file)")
+    synthetic = _table_or_error(data, "synthetic", "")
+    motions = [_record_source(table, f"records[{i}]", base_dir) for i, table in enumerate(records)]
+    motions += [_synthetic_source(label, table, f"synthetic.{label}") for label, table in synthetic.items()]
+    if not motions:
+        table = scene.get("motion")
+        if not isinstance(table, dict):
+            raise ExperimentError("records: no motion (give [[records]], [synthetic.<name>], or a [motion] in the base scene)")
+        kind = table.get("type", "record")
+        if kind in _SYNTHETIC_TYPES:
+            entry = dict(table)
+            realization = entry.pop("realization", 0)
+            motions.append({"label": kind, "kind": "synthetic", "field": "scene.motion", "motion": entry, "start": realization, "count": 1})
+        else:  # a record (or a harmonic or constant motion), read on the client and shipped
+            motion = dict(table)
+            label = kind
+            if kind == "record":
+                motion["file_sha256"] = _file_sha256(base_dir, table.get("record"))
+                label = Path(str(table.get("record", kind))).stem
+            motions.append({"label": label, "kind": "record", "field": "scene.motion", "motion": motion})
+    labels = [m["label"] for m in motions]
+    for i, label in enumerate(labels):
+        if labels.index(label) != i:
+            raise ExperimentError(f"records: motion label {label!r} is used twice (give each [[records]] a distinct name)")
+    return motions
+
+
+def _file_sha256(base_dir: Path, spec: Any) -> str | None:
+    if not isinstance(spec, str):
+        return None
+    file = base_dir / spec
+    return hashlib.sha256(file.read_bytes()).hexdigest() if file.is_file() else None
+
+
+def _record_source(table: Mapping[str, Any], where: str, base_dir: Path) -> dict[str, Any]:
+    with field_errors():
+        _reject_unknown(table, _RECORD_KEYS, where)
+        record = _string(table, "record", where)
+        label = _string(table, "name", where, default=Path(record).stem if (base_dir / record).is_file() else record)
+    motion = {k: v for k, v in table.items() if k != "name"}
+    motion["type"] = "record"
+    motion["file_sha256"] = _file_sha256(base_dir, record)
+    return {"label": label, "kind": "record", "field": where, "motion": motion}
+
+
+def _synthetic_source(label: str, table: Any, where: str) -> dict[str, Any]:
+    if not isinstance(table, dict):
+        raise ExperimentError(f"{where}: must be a table (type, count, seed and the generator's parameters)")
+    entry = dict(table)
+    kind = entry.get("type", "kanai_tajimi")
+    if kind not in _SYNTHETIC_TYPES:
+        raise ExperimentError(f"{where}.type: must be one of {', '.join(_SYNTHETIC_TYPES)}, got {kind!r}")
+    entry["type"] = kind
+    counts = {}
+    for key, low in (("count", 1), ("start", 0)):
+        value = entry.pop(key, None if key == "count" else 0)
+        if value is None:
+            raise ExperimentError(f"{where}.count: missing (the number of realizations, an integer >= 1)")
+        if not isinstance(value, int) or isinstance(value, bool) or value < low:
+            raise ExperimentError(f"{where}.{key}: must be an integer >= {low}, got {value!r}")
+        counts[key] = value
+    if "realization" in entry:
+        raise ExperimentError(f"{where}.realization: not used here (realizations start .. start + count - 1 are run)")
+    if "seed" not in entry:
+        raise ExperimentError(f"{where}.seed: missing (an integer >= 0; realization i depends on (seed, i) only)")
+    return {"label": label, "kind": "synthetic", "field": where, "motion": entry, **counts}
+
+
+# ---------------------------------------------------------------- output and solver
+
+
+def _output(data: Mapping[str, Any], buildings: list[str]) -> dict[str, Any]:
+    table = _table_or_error(data, "output", "")
+    with field_errors():
+        _reject_unknown(table, {"time_histories", "buildings", "impacts"}, "output")
+    histories = table.get("time_histories", [])
+    if not isinstance(histories, list):
+        raise ExperimentError(f"output.time_histories: must be a list of variable names, got {histories!r}")
+    for i, name in enumerate(histories):
+        if name not in TIME_HISTORY_VARIABLES:
+            raise ExperimentError(f"output.time_histories[{i}]: unknown variable {name!r} (allowed: {', '.join(TIME_HISTORY_VARIABLES)})")
+    _check_unique(histories, "output.time_histories")
+    chosen = table.get("buildings", buildings)
+    if not isinstance(chosen, list) or not chosen or not all(b in buildings for b in chosen):
+        raise ExperimentError(f"output.buildings: must be a non-empty list of building names ({', '.join(buildings)}), got {chosen!r}")
+    _check_unique(chosen, "output.buildings")
+    impacts = table.get("impacts", True)
+    if not isinstance(impacts, bool):
+        raise ExperimentError(f"output.impacts: must be true or false, got {impacts!r}")
+    return {"time_histories": list(histories), "buildings": [b for b in buildings if b in chosen], "impacts": impacts}
+
+
+def _solver(data: Mapping[str, Any]) -> dict[str, Any]:
+    table = _table_or_error(data, "solver", "")
+    with field_errors():
+        _reject_unknown(table, {"method", "integrator", "rtol", "atol"}, "solver")
+        method = _string(table, "method", "solver", default=METHODS[0])
+        integrator = _string(table, "integrator", "solver", default="DOP853")
+        rtol = _number(table, "rtol", "solver", default=1e-10, low=0.0, low_open=True)
+        atol = _number(table, "atol", "solver", default=1e-12, low=0.0, low_open=True)
+    if method not in METHODS:
+        raise ExperimentError(f"solver.method: must be one of {', '.join(METHODS)}, got {method!r}")
+    if integrator not in INTEGRATORS:
+        raise ExperimentError(f"solver.integrator: must be one of {', '.join(INTEGRATORS)}, got {integrator!r}")
+    return {"method": method, "integrator": integrator, "rtol": rtol, "atol": atol}

@@ -1,0 +1,161 @@
+"""Applying an experiment's overrides to a scene dict: variants, gaps and μ.
+
+Every function takes a scene dict (the structure of a scene file) and returns
+a modified deep copy; validation of the result is left to
+:func:`stochpound.scene_from_dict`.
+
+The *mass factor* rule (docs/experiments.md): multiplying a building's
+masses by f (floors and base) keeps its dynamics consistent:
+
+* storey dashpots given as ``damping`` are multiplied by sqrt(f), which keeps
+  every modal damping ratio (M → fM, K fixed, C → sqrt(f) C); a
+  ``damping_ratio`` is kept as it is;
+* every contact touching the building keeps its impact frequency
+  sqrt(k_imp / m_eff), m_eff = m1 m2 / (m1 + m2): k_imp is multiplied by
+  m_eff,new / m_eff,old; c_imp follows from the restitution (or, when given as
+  ``damping``, is multiplied by the same ratio, which keeps its damping ratio).
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+from typing import Any, Iterable, Mapping
+
+#: Motion used while validating a scene's structure (the real motion is set per case).
+PLACEHOLDER_MOTION = {"type": "constant", "acceleration": 0.0, "duration": 1.0, "dt": 1.0}
+
+
+def building_table(scene: Mapping[str, Any], name: str) -> dict[str, Any]:
+    """The ``[[building]]`` table named ``name`` (default names B1, B2, ... included)."""
+    for i, building in enumerate(scene["building"]):
+        if building.get("name", f"B{i + 1}") == name:
+            return building
+    raise KeyError(name)
+
+
+def apply_overrides(scene: Mapping[str, Any], overrides: Iterable[Mapping[str, Any]]) -> dict[str, Any]:
+    """Apply variant overrides: explicit fields first (in order), then all mass factors.
+
+    Parameters
+    ----------
+    scene : mapping
+        Base scene dict.
+    overrides : iterable of mapping
+        One override table per variant axis (``building.<name>`` and ``scene`` tables).
+
+    Returns
+    -------
+    dict
+        The new scene dict. The two phases make the result independent of the
+        order of the variant axes.
+    """
+    scene = copy.deepcopy(dict(scene))
+    factors: dict[str, float] = {}
+    for override in overrides:
+        scene.update(copy.deepcopy(override.get("scene", {})))
+        for name, fields in override.get("building", {}).items():
+            building = building_table(scene, name)
+            for key, value in fields.items():
+                if key == "mass_factor":
+                    factors[name] = factors.get(name, 1.0) * float(value)
+                elif key == "base":
+                    _set_base(building, value)
+                elif key in ("damping", "damping_ratio"):
+                    building.pop("damping", None)
+                    building.pop("damping_ratio", None)
+                    building[key] = copy.deepcopy(value)
+                else:
+                    building[key] = copy.deepcopy(value)
+    for name, factor in factors.items():
+        scale_masses(scene, name, factor)
+    return scene
+
+
+def _set_base(building: dict[str, Any], value: Any) -> None:
+    if value is False:
+        building.pop("base", None)
+    else:
+        building["base"] = {**building.get("base", {}), **copy.deepcopy(value)}
+
+
+def scale_masses(scene: dict[str, Any], name: str, factor: float) -> None:
+    """Multiply building ``name``'s masses by ``factor`` in place, with its derived constants.
+
+    See the module docstring for the rule (dashpots × sqrt(factor); impact
+    stiffness × m_eff,new / m_eff,old so that sqrt(k/m_eff) is kept).
+    """
+    building = building_table(scene, name)
+    old_mass = [float(m) for m in building["mass"]]
+    building["mass"] = [m * factor for m in old_mass]
+    if isinstance(building.get("base"), dict) and "mass" in building["base"]:
+        building["base"]["mass"] = float(building["base"]["mass"]) * factor
+    if "damping" in building:
+        building["damping"] = [float(c) * math.sqrt(factor) for c in building["damping"]]
+    for contact in scene.get("contact", []):
+        try:
+            ends = [(str(end_name), int(floor)) for end_name, floor in contact["between"]]
+            if name not in [end[0] for end in ends]:
+                continue
+            masses_new = [float(building_table(scene, end_name)["mass"][floor - 1]) for end_name, floor in ends]
+            masses_old = [old_mass[floor - 1] if end_name == name else new for (end_name, floor), new in zip(ends, masses_new)]
+        except (KeyError, IndexError, TypeError, ValueError):
+            continue  # a malformed contact: scene validation names it
+        ratio = _effective_mass(*masses_new) / _effective_mass(*masses_old)
+        contact["stiffness"] = float(contact["stiffness"]) * ratio
+        if "damping" in contact:
+            contact["damping"] = float(contact["damping"]) * ratio
+
+
+def _effective_mass(m1: float, m2: float) -> float:
+    return m1 * m2 / (m1 + m2)
+
+
+def set_gaps(scene: dict[str, Any], contacts: Iterable[int], gap: float) -> None:
+    """Set the gap (m) of the given contacts (0-based indices) in place."""
+    for index in contacts:
+        scene["contact"][index]["gap"] = float(gap)
+
+
+def set_mu(scene: dict[str, Any], buildings: Iterable[str] | None, mu: float) -> list[str]:
+    """Set the friction coefficient μ of buildings in place; μ = inf removes their base.
+
+    Parameters
+    ----------
+    scene : dict
+        Scene dict.
+    buildings : iterable of str or None
+        Buildings to change; None: every building that has a ``[building.base]``.
+    mu : float
+        Kinetic and static coefficient (``mu`` and ``mu_static``), >= 0, or inf
+        for a fixed base.
+
+    Returns
+    -------
+    list of str
+        The chosen buildings that have no base (an error unless μ is inf).
+    """
+    names = [b.get("name", f"B{i + 1}") for i, b in enumerate(scene["building"])]
+    chosen = list(buildings) if buildings is not None else [n for n in names if isinstance(building_table(scene, n).get("base"), dict)]
+    missing = []
+    for name in chosen:
+        building = building_table(scene, name)
+        if math.isinf(mu):
+            building.pop("base", None)
+        elif isinstance(building.get("base"), dict):
+            building["base"]["mu"] = float(mu)
+            building["base"]["mu_static"] = float(mu)
+        else:
+            missing.append(name)
+    if buildings is None and not chosen and not math.isinf(mu):
+        missing.append("(no building has a [building.base])")
+    return missing
+
+
+def reference_scene(scene: Mapping[str, Any], studied: str) -> dict[str, Any]:
+    """The studied building alone on a fixed base (no contacts), same g."""
+    building = copy.deepcopy(building_table(scene, studied))
+    building.pop("base", None)
+    building.pop("initial", None)
+    building["name"] = studied
+    return {"g": scene.get("g", 9.81), "building": [building], "contact": []}

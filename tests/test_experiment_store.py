@@ -1,0 +1,164 @@
+"""The experiment store: layout, CF metadata, provenance, summaries against direct runs, refusals."""
+
+from __future__ import annotations
+
+import hashlib
+
+import dask.array
+import numpy as np
+import pytest
+import xarray as xr
+
+import stochpound
+from stochpound.analysis.summary import top_floor_total_displacement
+from stochpound.experiment import ExperimentError, load_experiment, open_store, run_experiment, store_status
+from stochpound.experiment.parts import FolderLock, parts_folder
+from tests.test_experiment_helpers import N_CASES, SMALL_EXPERIMENT, cli, write_experiment
+
+
+@pytest.fixture(scope="module")
+def small_store(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("store")
+    path = write_experiment(folder)
+    report = run_experiment(load_experiment(path), workers=0, progress=False)
+    assert report.complete and report.done_now == N_CASES and not report.failed
+    return path, report.store
+
+
+def test_layout_and_metadata(small_store):
+    path, store = small_store
+    assert store == path.with_suffix(".nc")
+    with xr.open_dataset(store) as ds:
+        for dim, size in {"neighbour": 2, "gap": 2, "mu": 2, "record": 2, "realization": 2, "building": 2, "floor": 2, "time": 401}.items():
+            assert ds.sizes[dim] == size, dim
+        assert ds["mu"].values[-1] == np.inf
+        assert list(ds["record"].values) == ["el_centro", "kt"]
+        assert ds["impacts"].dims == ("neighbour", "gap", "mu", "record", "realization")
+        assert ds["peak_total_displacement"].dims == ("neighbour", "gap", "mu", "record", "realization", "building")
+        assert ds["total_displacement"].dims == ("neighbour", "gap", "mu", "record", "realization", "building", "floor", "time")
+        assert ds["reference_response_std"].dims == ("record", "realization")
+        assert ds["impact_start"].dims == ("impact",) and ds.sizes["impact"] > 0
+        for name, variable in ds.variables.items():
+            assert "units" in variable.attrs and "long_name" in variable.attrs, name
+        # a record has one realization: the others are not in the grid
+        status = ds["case_status"].sel(record="el_centro")
+        assert (status.sel(realization=0) == 1).all() and (status.sel(realization=1) == -1).all()
+        assert int(ds.attrs["cases_done"]) == N_CASES and ds.attrs["complete"] == 1
+        assert ds.attrs["experiment_text"] == SMALL_EXPERIMENT
+        assert ds.attrs["experiment_sha256"] == hashlib.sha256(SMALL_EXPERIMENT.encode()).hexdigest()
+        for key in ("definition_sha256", "stochpound_version", "git_commit", "solver", "seeds", "created", "updated", "machine", "runs"):
+            assert ds.attrs[key] != "", key
+        assert '"kt": 7' in ds.attrs["seeds"]
+        # the B2 time histories were not kept
+        assert np.isnan(ds["total_displacement"].sel(building="B2")).all()
+        assert not np.isnan(ds["total_displacement"].sel(building="B1", record="el_centro", realization=0)).any()
+    with xr.open_datatree(store) as tree:
+        assert "impacts" in tree.dataset
+
+
+def test_summaries_match_a_direct_run(small_store):
+    path, store = small_store
+    experiment = load_experiment(path)
+    case = next(c for c in experiment.cases if c.kind == "case" and c.label_dict == {"neighbour": "flexible", "gap": 0.02, "mu": np.inf, "record": "el_centro", "realization": 0})
+    run = stochpound.simulate(stochpound.scene_from_dict({**experiment.structure(case), "motion": {"record": "el_centro_1940_study", "duration": 8.0}}))
+    alone = stochpound.simulate(stochpound.scene_from_dict({**experiment.reference_structure(case), "motion": {"record": "el_centro_1940_study", "duration": 8.0}}))
+    y = top_floor_total_displacement(run, "B1").values
+    y0 = top_floor_total_displacement(alone, "B1").values
+    with open_store(store) as ds:
+        assert isinstance(ds["impacts"].data, dask.array.Array)
+        point = ds.sel(neighbour="flexible", gap=0.02, mu=np.inf, record="el_centro", realization=0).compute()
+        assert point["impacts"] == run.sizes["impact"] > 0
+        assert point["impacts_in_phase"] + point["impacts_out_of_phase"] == point["impacts"]
+        assert point["peak_impact_force"] == run["impact_peak_force"].max()
+        assert point["response_mean"] == pytest.approx(y.mean(), rel=1e-12, abs=1e-15)
+        assert point["response_std"] == pytest.approx(y.std(), rel=1e-12)
+        centred = y - y.mean()
+        assert point["response_excess"] == pytest.approx(np.mean(centred**4) / np.mean(centred**2) ** 2 - 3, rel=1e-10)
+        assert point["fixed_base_correlation"] == pytest.approx(np.corrcoef(y, y0)[0, 1], rel=1e-10)
+        assert point["reference_response_std"] == pytest.approx(y0.std(), rel=1e-12)
+        assert point["peak_total_displacement"].sel(building="B1") == np.abs(run["total_displacement"].sel(building="B1")).max()
+        np.testing.assert_array_equal(point["total_displacement"].sel(building="B1").values, run["total_displacement"].sel(building="B1").values)
+        table = ds[["impact_start", "impact_peak_force"]].compute()
+        table = table.where(
+            (table.impact_neighbour == "flexible") & (table.impact_gap == 0.02) & (table.impact_mu == np.inf) & (table.impact_record == "el_centro"), drop=True
+        )
+        np.testing.assert_array_equal(table["impact_start"].values, run["impact_start"].values)
+
+
+def test_rerun_is_a_no_op_and_status_is_complete(small_store):
+    path, store = small_store
+    report = run_experiment(load_experiment(path), workers=0, progress=False)
+    assert report.done_now == 0 and report.done_before == N_CASES and report.complete
+    status = store_status(store)
+    assert len(status.done) == N_CASES and not status.missing and status.rebuilt
+
+
+def _snapshot(store):
+    folder = parts_folder(store)
+    return store.read_bytes(), sorted(p.name for p in folder.iterdir())
+
+
+def test_changed_definition_is_refused_without_restart(small_store, tmp_path):
+    path, store = small_store
+    before = _snapshot(store)
+    changed = tmp_path / "small.toml"
+    changed.write_text(SMALL_EXPERIMENT.replace("gap = [0.01, 0.02]", "gap = [0.01, 0.03]"))
+    result = cli("experiment", "run", str(changed), "--store", str(store), "--workers", "0", check=False)
+    assert result.returncode != 0
+    assert "made from a different experiment definition" in result.stderr and "--restart" in result.stderr
+    assert _snapshot(store) == before
+
+
+def test_restart_replaces_a_store(tmp_path):
+    path = write_experiment(tmp_path, SMALL_EXPERIMENT.replace("count = 2", "count = 1").replace("gap = [0.01, 0.02]", "gap = [0.02]"))
+    store = tmp_path / "other.nc"
+    store.write_bytes(b"not a store")
+    with pytest.raises(ExperimentError, match=r"other\.nc: not a readable netCDF4/HDF5 file .*--restart"):
+        run_experiment(load_experiment(path), store, workers=0, progress=False)
+    assert store.read_bytes() == b"not a store"
+    report = run_experiment(load_experiment(path), store, workers=0, progress=False, restart=True)
+    assert report.complete and report.total == 2 * 2 * 2 + 2
+    with open_store(store) as ds:
+        assert ds.sizes["gap"] == 1
+
+
+def test_a_store_being_written_is_refused(small_store):
+    path, store = small_store
+    lock = FolderLock(parts_folder(store))
+    assert lock.acquire()
+    try:
+        with pytest.raises(ExperimentError, match="another run is writing this store"):
+            run_experiment(load_experiment(path), workers=0, progress=False)
+        assert store_status(store).running
+    finally:
+        lock.release()
+
+
+def test_open_store_errors(tmp_path):
+    with pytest.raises(ExperimentError, match="store not found"):
+        open_store(tmp_path / "missing.nc")
+    bad = tmp_path / "bad.nc"
+    bad.write_bytes(b"garbage")
+    with pytest.raises(ExperimentError, match="not a readable"):
+        open_store(bad)
+    with pytest.raises(ExperimentError, match=r"bad\.nc: not a readable"):
+        store_status(bad)
+
+
+@pytest.mark.parametrize("mu1, mu2", [(0.2, None), (None, None), (0.1, 0.1)])
+def test_numpy_summaries_equal_the_analysis_definitions(mu1, mu2):
+    from stochpound.experiment.summary import case_summary, case_values, reference_summary, reference_values, top_floor
+    from tests.conftest import reference_building, study_scene
+
+    motion = {"record": "el_centro_1940_study", "duration": 10.0}
+    run = stochpound.simulate(stochpound.scene_from_dict(study_scene(mu1=mu1, mu2=mu2, motion=motion)))
+    alone = stochpound.simulate(stochpound.scene_from_dict({"g": 9.814, "building": [reference_building("B1")], "motion": motion}))
+    fast = case_values(run, "B1", top_floor(alone, "B1"))
+    slow = case_summary(run, "B1", top_floor_total_displacement(alone, "B1"))
+    assert set(fast) == set(slow.data_vars)
+    for name, value in fast.items():
+        np.testing.assert_allclose(value, slow[name].values, rtol=1e-12, atol=1e-15, err_msg=name)
+    fast, slow = reference_values(alone, "B1"), reference_summary(alone, "B1")
+    assert set(fast) == set(slow.data_vars)
+    for name, value in fast.items():
+        np.testing.assert_allclose(value, slow[name].values, rtol=1e-12, atol=1e-15, err_msg=name)
