@@ -1,0 +1,65 @@
+"""Command line of the benchmark suite: ``python -m benchmarks`` or ``python benchmarks/run.py``.
+
+The thread pools of BLAS, OpenMP and numba are set to one thread here,
+before numpy is imported, so that every in-process measurement runs on one core.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+
+if __package__ in (None, ""):  # run as a script: make the repository importable
+    sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+
+from benchmarks.timing import single_thread_environment  # noqa: E402  (numpy-free module)
+
+single_thread_environment()
+
+import argparse  # noqa: E402
+import tempfile  # noqa: E402
+import time  # noqa: E402
+from pathlib import Path  # noqa: E402
+
+from benchmarks import report, suite  # noqa: E402
+from benchmarks.timing import REPOSITORY  # noqa: E402
+
+
+def parse_arguments(argv: list[str] | None = None) -> argparse.Namespace:
+    """Options of the command line."""
+    parser = argparse.ArgumentParser(prog="python -m benchmarks", description="Benchmark stochpound's solvers; write benchmarks.md and the work-precision figure.")
+    parser.add_argument("--quick", action="store_true", help="smoke run (< 1 min): scene (a), 10 s of El Centro, one setting per solver")
+    parser.add_argument("--out", type=Path, default=None, help="output folder (default: docs/ for a full run, a temporary folder for --quick)")
+    parser.add_argument("--no-opensees", action="store_true", help="leave OpenSeesPy out even when it is installed")
+    return parser.parse_args(argv)
+
+
+def output_folder(arguments: argparse.Namespace) -> Path:
+    """Where benchmarks.md and figures/ go."""
+    if arguments.out is not None:
+        return arguments.out
+    if arguments.quick:
+        return Path(tempfile.gettempdir()) / "stochpound-benchmarks-quick"
+    return REPOSITORY / "docs"
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run the suite and write its outputs; return the exit status."""
+    arguments = parse_arguments(argv)
+    config = suite.Config.quick_preset() if arguments.quick else suite.Config.full()
+    if arguments.no_opensees:
+        config = suite.dataclasses.replace(config, opensees_steps=())
+    folder = output_folder(arguments)
+    info = report.machine()
+    start = time.perf_counter()
+    results = suite.run_all(config, log=lambda message: print(f"[{time.perf_counter() - start:7.1f} s] {message}", flush=True))
+    elapsed = time.perf_counter() - start
+    figure = report.figure(results, folder / "figures" / report.FIGURE_NAME)
+    markdown = folder / "benchmarks.md"
+    markdown.write_text(report.document(results, info, elapsed))
+    print(f"wrote {markdown} and {figure} in {elapsed:.1f} s")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,117 @@
+"""The benchmark suite's emulation of the study's scheme and its OpenSees model build, run and behave as expected.
+
+Nothing is timed here: the timings belong to ``python -m benchmarks``. These
+tests check, on short records, that the emulation of the study's fixed-restart
+scheme is a correct integrator where the study's rules do not act, and that it
+reproduces the study's known artefacts; and that the OpenSees model agrees
+with the exact solver to the accuracy its regularised elements allow.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+import stochpound
+from benchmarks.opensees_model import OpenSeesUnavailable, load_opensees, run_opensees
+from benchmarks.outcome import compare, outcome_from_dataset
+from benchmarks.scenes import MAIN_SCENE, STUDY_SCENES, with_motion
+from benchmarks.study_scheme import StudyScheme, run_study_scheme
+from tests.conftest import reference_building
+
+FIXED_PAIR = STUDY_SCENES[1]
+
+
+def exact_outcome(scene):
+    return outcome_from_dataset(stochpound.simulate(scene))
+
+
+def test_study_scheme_runs_on_a_short_record():
+    scene = MAIN_SCENE.scene(2.0, interpolation="spline")
+    run = run_study_scheme(scene, 0.02)
+    assert run.states.shape == (len(scene.motion.times), 2 * run.system.n_dof)
+    assert np.all(np.isfinite(run.states))
+    outcome = run.outcome()
+    assert np.array_equal(outcome.times, scene.motion.times)
+    assert outcome.top_displacement[0] == 0.0
+
+
+def test_study_scheme_is_an_accurate_integrator_without_contact_or_sliding():
+    scene = dataclasses.replace(FIXED_PAIR, gap=1.0).scene(4.0, interpolation="spline")
+    errors = compare(run_study_scheme(scene, 0.02).outcome(), exact_outcome(scene))
+    assert errors.displacement < 1e-5  # RK45 at atol = rtol = 1e-3 on a response of ~1 cm
+    assert errors.impacts == 0
+
+
+def test_study_scheme_converges_with_h_when_no_base_slides():
+    scene = FIXED_PAIR.scene(4.0, interpolation="spline")
+    reference = exact_outcome(scene)
+    coarse, fine = (compare(run_study_scheme(scene, h).outcome(), reference).displacement for h in (0.02, 0.005))
+    assert reference.impacts > 0
+    assert fine < coarse / 2
+
+
+def sliding_pulse_scene():
+    """An isolated reference building (μ = 0.1) under 3 m/s² for 1 s, then at rest for 3 s."""
+    data = {"g": 9.814, "building": [reference_building("B1", 1.0, 0.1)], "motion": {"type": "constant", "acceleration": 0.0, "duration": 4.0, "dt": 0.02}}
+    values = np.zeros(201)
+    values[:51] = 3.0
+    return with_motion(stochpound.scene_from_dict(data), values, 0.02)
+
+
+def last_sliding_time(times, sliding):
+    moving = np.flatnonzero(np.abs(np.diff(sliding)) > 1e-12)
+    return times[moving[-1] + 1]
+
+
+def test_study_scheme_zeroes_the_sliding_velocity_once_the_base_decelerates():
+    """The study's artefact: a decelerating base fails its sliding test and its velocity is reset to zero."""
+    scene = sliding_pulse_scene()
+    exact = stochpound.simulate(scene)
+    emulated = run_study_scheme(scene, 0.02)
+    exact_sliding = exact.sliding_displacement.values[0]
+    assert last_sliding_time(exact.time.values, exact_sliding) > 2.5  # slides on, decelerating at about μg
+    assert last_sliding_time(emulated.times, emulated.sliding_displacement()) <= 1.0 + 2 * 0.02
+    assert abs(emulated.sliding_displacement()[-1]) < 0.5 * abs(exact_sliding[-1])
+
+
+def test_study_scheme_starts_stuck_and_decides_sliding_only_at_restarts():
+    scene = sliding_pulse_scene()
+    run = StudyScheme(scene, 0.02).run()
+    steps = len(scene.motion.times) - 1
+    assert 0 < run.sliding_steps[0] < steps
+    assert run.sliding_displacement()[1] == 0.0  # the first step sticks: the study starts from zero accelerations
+
+
+def test_study_scheme_rejects_a_restart_interval_that_does_not_divide_the_samples():
+    with pytest.raises(ValueError, match="divide"):
+        StudyScheme(MAIN_SCENE.scene(1.0), 0.015)
+
+
+def opensees_or_skip():
+    try:
+        return load_opensees()
+    except OpenSeesUnavailable as error:
+        pytest.skip(str(error))
+
+
+@pytest.mark.parametrize("spec", STUDY_SCENES, ids=lambda spec: spec.key)
+def test_opensees_model_agrees_with_the_exact_solver_on_a_short_record(spec):
+    opensees_or_skip()
+    scene = spec.scene(5.0)
+    reference = exact_outcome(scene)
+    errors = compare(run_opensees(scene, 0.001), reference)
+    assert errors.displacement < 2e-3  # regularised friction (1e-5 m) and Newmark at 1 ms
+    assert errors.impacts == 0
+    assert errors.peak_force < 0.05
+    assert errors.final_sliding < 1e-3
+
+
+def test_opensees_model_rejects_what_its_elements_cannot_represent():
+    opensees_or_skip()
+    with pytest.raises(ValueError, match="study_compat"):
+        run_opensees(MAIN_SCENE.scene(1.0, study_compat=True), 0.001)
+    with pytest.raises(ValueError, match="gap"):
+        run_opensees(dataclasses.replace(FIXED_PAIR, gap=0.0).scene(1.0), 0.001)
