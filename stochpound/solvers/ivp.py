@@ -131,5 +131,5 @@ class _Run:
         if self.step_guess is not None:
             options["first_step"] = min(self.step_guess, t_end - t)
         if self.implicit:
-            options["jac"] = A
+            options["jac"] = lambda time, state: A  # LSODA accepts only a callable
         return self.integrator(rate, t, x, t_end, **options)
