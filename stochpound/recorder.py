@@ -20,6 +20,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.optimize import brentq
 
+from stochpound.analysis.impacts import in_phase
 from stochpound.events import TIME_TOLERANCE, Dense
 from stochpound.modes import FREE, Guard, Mode, ModeDynamics
 from stochpound.motion import GroundMotion
@@ -151,7 +152,7 @@ class Recorder:
                 velocities = self.system.contact_floor_velocity @ x
                 left, right = velocities[2 * target], velocities[2 * target + 1]
                 onset = float(self.system.contact_geometry[target] @ x[n:])
-                self._open_impacts[target] = Impact(target, t, onset, bool(left * right > 0.0))
+                self._open_impacts[target] = Impact(target, t, onset, bool(in_phase(left, right)))
             elif kind == Guard.OPEN and target in self._open_impacts and not mode.closed[target]:
                 impact = self._open_impacts.pop(target)
                 impact.end, impact.complete = t, True
