@@ -10,6 +10,7 @@ import pytest
 
 import stochpound
 from stochpound.experiment import Experiment, ExperimentError, load_experiment, run_experiment
+from stochpound.experiment.sources import resolve_motions
 from stochpound.experiment.spec import parse_experiment
 from tests.test_experiment_helpers import N_CASES, SMALL_EXPERIMENT, cli, write_experiment
 
@@ -49,6 +50,9 @@ def experiment(data: dict) -> Experiment:
         ({"variants__neighbour__stiff__building__B3": {"mass_factor": 2.0}}, r"^variants\.neighbour\.stiff\.building\.B3: unknown building \(buildings: B1, B2\)"),
         ({"variants__neighbour__stiff__building__B2__colour": "red"}, r"^variants\.neighbour\.stiff\.building\.B2\.colour: unknown field \(allowed: base, damping"),
         ({"variants__neighbour__stiff__building__B2__damping_ratio": 1.5}, r"^case neighbour=stiff, gap=0.01, mu=0.2: building\[1\]\.damping_ratio: must be < 1, got 1.5"),
+        ({"motions": [{"name": "h", "type": "kanai_tajimi"}]}, r"^motions\[0\]\.type: must be one of harmonic, constant \(records go in \[\[records\]\]\), got 'kanai_tajimi'"),
+        ({"motions": [{"type": "harmonic"}]}, r"^motions\[0\]\.name: "),
+        ({"motions": {"name": "h"}}, r"^motions: must be an array of tables"),
         ({"synthetic__kt__count": 0}, r"^synthetic\.kt\.count: must be an integer >= 1, got 0"),
         ({"synthetic__kt__seed": None}, r"^synthetic\.kt\.seed: missing"),
         ({"output__time_histories": ["velocity"]}, r"^output\.time_histories\[0\]: unknown variable 'velocity' \(allowed: total_displacement"),
@@ -56,7 +60,7 @@ def experiment(data: dict) -> Experiment:
         ({"solver": {"rtol": -1.0}}, r"^solver\.rtol: must be > 0, got -1"),
         ({"experiment__studied": "B7"}, r"^experiment\.studied: must be one of the scene's buildings \(B1, B2\), got 'B7'"),
         ({"scene__building": []}, r"^case neighbour=stiff.*building: at least one \[\[building\]\] is required|experiment\.studied"),
-        ({"bogus": 1}, r"^bogus: unknown field \(allowed: experiment, grid, output, records, scene, solver, synthetic, variants\)"),
+        ({"bogus": 1}, r"^bogus: unknown field \(allowed: experiment, grid, motions, output, records, scene, solver, synthetic, variants\)"),
     ],
 )
 def test_bad_fields_are_named(changes, message):
@@ -144,3 +148,26 @@ def test_check_command_and_load(tmp_path):
     assert len(load_experiment(path).cases) == N_CASES
     out = cli("experiment", "check", str(path)).stdout
     assert "24 cases + 3 fixed-base reference cases" in out and "neighbour" in out
+
+
+def test_analytic_motions_are_labelled_and_run(tmp_path):
+    data = small(records=None, synthetic=None)
+    data["motions"] = [
+        {"name": "slow", "type": "harmonic", "amplitude": 1.0, "omega": 2.0, "duration": 2.0, "dt": 0.01},
+        {"name": "push", "type": "constant", "acceleration": 0.5, "duration": 2.0, "dt": 0.01},
+    ]
+    exp = experiment(data)
+    assert {case.label_dict["record"] for case in exp.cases} == {"slow", "push"}
+    with pytest.raises(ExperimentError, match=r"^motions\[1\]\.amplitude: unknown field"):
+        bad = small(records=None, synthetic=None)
+        bad["motions"] = [data["motions"][0], {**data["motions"][1], "amplitude": 1.0}]
+        resolve_motions(experiment(bad))
+
+
+def test_run_takes_several_files_but_one_store(tmp_path):
+    first = write_experiment(tmp_path)
+    second = write_experiment(tmp_path, name="other.toml")
+    result = cli("experiment", "run", str(first), str(second), "--store", str(tmp_path / "x.nc"), check=False)
+    assert result.returncode != 0 and "--store names one store" in result.stderr
+    result = cli("experiment", "run", str(first), str(tmp_path / "missing.toml"), check=False)
+    assert result.returncode != 0 and not (tmp_path / "small.nc").exists()

@@ -19,6 +19,8 @@ def _register() -> None:
     main.add_command(records)
     from stochpound.cli.experiment import experiment
     main.add_command(experiment)
+    from stochpound.cli.report import report
+    main.add_command(report)
 
 
 _register()

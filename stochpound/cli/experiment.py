@@ -16,35 +16,46 @@ def experiment() -> None:
 
 
 @experiment.command("run")
-@click.argument("experiment_file", type=click.Path(dir_okay=False))
-@click.option("--store", "store", type=click.Path(dir_okay=False), default=None, help="Store file (default: beside EXPERIMENT_FILE, suffix .nc).")
+@click.argument("experiment_files", metavar="EXPERIMENT_FILE...", nargs=-1, required=True, type=click.Path(dir_okay=False))
+@click.option("--store", "store", type=click.Path(dir_okay=False), default=None, help="Store file (default: beside EXPERIMENT_FILE, suffix .nc; only with one file).")
 @click.option("--workers", type=click.IntRange(min=0), default=None, help="Local dask worker processes (default: the machine's cores; 0: run in this process).")
 @click.option("--scheduler", default=None, metavar="ADDRESS", help="Run on an existing dask.distributed cluster, e.g. tcp://host:8786.")
 @click.option("--restart", is_flag=True, help="Discard the existing store and its finished cases (also one of another definition).")
 @click.option("--batch", "batch_size", type=click.IntRange(min=1), default=None, help="Cases per dask task (default: automatic).")
 @click.option("--checkpoint", type=click.FloatRange(min=0.0), default=30.0, show_default=True, help="Seconds between rebuilds of the store file during the run.")
 @click.option("--quiet", is_flag=True, help="No progress bar.")
-def run_command(experiment_file: str, store: str | None, workers: int | None, scheduler: str | None, restart: bool, batch_size: int | None, checkpoint: float, quiet: bool) -> None:
-    """Run the missing cases of EXPERIMENT_FILE into its store.
+def run_command(experiment_files: tuple[str, ...], store: str | None, workers: int | None, scheduler: str | None, restart: bool, batch_size: int | None, checkpoint: float, quiet: bool) -> None:
+    """Run the missing cases of each EXPERIMENT_FILE into its store, one after the other.
 
     Finished cases are kept one file each in STORE.parts/; rerunning the
     same command completes only the missing ones. Ctrl-C stops cleanly.
+    Every file is checked before any runs.
     """
     from stochpound.experiment import load_experiment, run_experiment
 
     if workers is not None and scheduler is not None:
         raise click.BadParameter("give --workers or --scheduler, not both", param_hint="--workers")
+    if store is not None and len(experiment_files) > 1:
+        raise click.BadParameter("--store names one store: give one EXPERIMENT_FILE with it", param_hint="--store")
     try:
-        loaded = load_experiment(experiment_file)
-        report = run_experiment(
-            loaded, store, workers=workers, scheduler=scheduler, restart=restart, progress=not quiet, checkpoint=checkpoint, batch_size=batch_size
-        )
+        loaded = [load_experiment(path) for path in experiment_files]
     except (StochpoundError, ValueError) as error:
         raise click.ClickException(str(error)) from None
-    _summary(report)
-    if report.interrupted:
-        sys.exit(130)
-    if report.failed:
+    failed = False
+    for experiment_file, definition in zip(experiment_files, loaded):
+        if len(loaded) > 1:
+            click.echo(f"{experiment_file}:")
+        try:
+            report = run_experiment(
+                definition, store, workers=workers, scheduler=scheduler, restart=restart, progress=not quiet, checkpoint=checkpoint, batch_size=batch_size
+            )
+        except (StochpoundError, ValueError) as error:
+            raise click.ClickException(str(error)) from None
+        _summary(report)
+        if report.interrupted:
+            sys.exit(130)
+        failed |= bool(report.failed)
+    if failed:
         sys.exit(1)
 
 

@@ -33,12 +33,13 @@ from stochpound.solvers.ivp import INTEGRATORS
 #: Format version of the canonical definition (stored with every store).
 FORMAT_VERSION = 1
 
-_TOP_KEYS = {"experiment", "scene", "variants", "grid", "records", "synthetic", "output", "solver"}
+_TOP_KEYS = {"experiment", "scene", "variants", "grid", "records", "motions", "synthetic", "output", "solver"}
 _EXPERIMENT_KEYS = {"name", "description", "scene", "studied"}
 _BUILDING_OVERRIDES = {"mass_factor", "mass", "stiffness", "damping", "damping_ratio", "base", "initial"}
 _SCENE_OVERRIDES = {"study_compat"}
 _RECORD_KEYS = {"name", "record", "scale", "dt", "duration", "units", "interpolation"}
 _SYNTHETIC_TYPES = ("kanai_tajimi", "clough_penzien")
+_ANALYTIC_TYPES = ("harmonic", "constant")
 _GAP_AXIS = re.compile(r"^gap(_[A-Za-z0-9_]+)?$")
 _DIM_NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
 _RESERVED_DIMS = {
@@ -376,16 +377,15 @@ def _mu_axis(spec: Any, buildings: list[str]) -> dict[str, Any]:
 
 
 def _motions(data: Mapping[str, Any], scene: Mapping[str, Any], base_dir: Path) -> list[dict[str, Any]]:
-    records = data.get("records", [])
-    if not isinstance(records, list) or not all(isinstance(r, dict) for r in records):
-        raise ExperimentError("records: must be an array of tables ([[records]] with record = name or file)")
+    records = _array_of_tables(data, "records")
     synthetic = _table_or_error(data, "synthetic", "")
     motions = [_record_source(table, f"records[{i}]", base_dir) for i, table in enumerate(records)]
+    motions += [_analytic_source(table, f"motions[{i}]") for i, table in enumerate(_array_of_tables(data, "motions"))]
     motions += [_synthetic_source(label, table, f"synthetic.{label}") for label, table in synthetic.items()]
     if not motions:
         table = scene.get("motion")
         if not isinstance(table, dict):
-            raise ExperimentError("records: no motion (give [[records]], [synthetic.<name>], or a [motion] in the base scene)")
+            raise ExperimentError("records: no motion (give [[records]], [[motions]], [synthetic.<name>], or a [motion] in the base scene)")
         kind = table.get("type", "record")
         if kind in _SYNTHETIC_TYPES:
             entry = dict(table)
@@ -403,6 +403,25 @@ def _motions(data: Mapping[str, Any], scene: Mapping[str, Any], base_dir: Path) 
         if labels.index(label) != i:
             raise ExperimentError(f"records: motion label {label!r} is used twice (give each [[records]] a distinct name)")
     return motions
+
+
+def _array_of_tables(data: Mapping[str, Any], key: str) -> list[dict[str, Any]]:
+    tables = data.get(key, [])
+    if not isinstance(tables, list) or not all(isinstance(t, dict) for t in tables):
+        what = "record = name or file" if key == "records" else "name, type = harmonic | constant and its parameters"
+        raise ExperimentError(f"{key}: must be an array of tables ([[{key}]] with {what})")
+    return tables
+
+
+def _analytic_source(table: Mapping[str, Any], where: str) -> dict[str, Any]:
+    """A ``[[motions]]`` entry: a named analytic motion (a scene ``[motion]`` table of type harmonic or constant)."""
+    with field_errors():
+        label = _string(table, "name", where)
+    motion = {k: v for k, v in table.items() if k != "name"}
+    kind = motion.get("type")
+    if kind not in _ANALYTIC_TYPES:
+        raise ExperimentError(f"{where}.type: must be one of {', '.join(_ANALYTIC_TYPES)} (records go in [[records]]), got {kind!r}")
+    return {"label": label, "kind": "record", "field": where, "motion": motion}
 
 
 def _file_sha256(base_dir: Path, spec: Any) -> str | None:

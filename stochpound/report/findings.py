@@ -1,0 +1,187 @@
+"""Findings written from the numbers: each of the study's conclusions checked against the stores.
+
+Every function reads the stores, decides whether the conclusion holds under
+the corrected model, and returns a :class:`Paragraph` that says so with the
+numbers behind the verdict (or None when the store it needs is missing).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import xarray as xr
+
+from stochpound.report.document import Paragraph
+from stochpound.report.published import published_tables
+from stochpound.report.stores import select, value
+
+CM = 100.0
+NEIGHBOURS = ("stiff", "flexible")
+
+
+def _verdict(holds: bool) -> str:
+    return "Holds" if holds else "Does not hold"
+
+
+def fixed_columns(pair_mu: xr.Dataset) -> Paragraph:
+    """The single building and the μ = ∞ columns: how closely the corrected model reproduces them."""
+    tables = published_tables()["table"]
+    worst = 0.0
+    for number in ("4.1", "4.3"):
+        for position, column in ((0, "single"), (1, "inf")):
+            for statistic in ("std", "skewness", "excess"):
+                study = float(tables[number][statistic][position])
+                prefix = "reference_" if column == "single" else ""
+                labels = {} if column == "single" else {"isolation": tables[number]["configuration"], "neighbour": tables[number]["neighbour"], "gap": 0.02, "mu": math.inf, "model": "corrected"}
+                ours = value(pair_mu, f"{prefix}response_{statistic}", CM if statistic == "std" else 1.0, record="el_centro_spline" if "el_centro_spline" in pair_mu["record"].values else "el_centro", **labels)
+                if abs(study) > 0.1:
+                    worst = max(worst, abs(ours - study) / abs(study))
+    impacts = {n: value(pair_mu, "impacts", isolation="b1_isolated", neighbour=n, gap=0.02, mu=math.inf, model="corrected", record="el_centro") for n in NEIGHBOURS}
+    return Paragraph(
+        f"The single fixed-base building and the fixed–fixed (μ = ∞) columns of Tables 4.1 and 4.3 are reproduced: std, "
+        f"skewness and excess within {worst * 100:.0f} % with the study's spline input (skewness near zero compared in absolute "
+        f"terms). The corrected model resolves more impacts ({impacts['stiff']:.0f} stiff, {impacts['flexible']:.0f} flexible, "
+        "against the study's 8 and 38): the study decided contact only at its 0.02 s restarts, so contacts that open and "
+        "close between two restarts were merged or missed."
+    )
+
+
+def gap_effect(gap_study: xr.Dataset) -> Paragraph:
+    """Impacts fall with the gap, faster for a stiff neighbour; forces are larger with a flexible neighbour."""
+    gaps = gap_study["gap"].values
+    impacts = {n: select(gap_study, neighbour=n, mu=math.inf, record="el_centro")["impacts"].values for n in NEIGHBOURS}
+    forces = {n: select(gap_study, neighbour=n, mu=math.inf, record="el_centro")["peak_impact_force"].values for n in NEIGHBOURS}
+    last = {n: _last_gap_with_impacts(gaps, impacts[n]) for n in NEIGHBOURS}
+    falling = all(impacts[n][0] >= impacts[n][-1] for n in NEIGHBOURS)
+    faster = last["stiff"] < last["flexible"]
+    both = (impacts["stiff"] > 0) & (impacts["flexible"] > 0)
+    larger = bool(both.any()) and float(np.mean(forces["flexible"][both])) > float(np.mean(forces["stiff"][both]))
+    return Paragraph(
+        f"Impacts fall as the gap widens, faster for a stiff neighbour: {_verdict(falling and faster)}. With both buildings "
+        f"fixed under El Centro the stiff pair stops pounding beyond {last['stiff'] * CM:g} cm and the flexible pair beyond "
+        f"{last['flexible'] * CM:g} cm (impacts at zero gap: {impacts['stiff'][0]:.0f} stiff, {impacts['flexible'][0]:.0f} "
+        f"flexible). Impact forces are larger with a flexible neighbour: {_verdict(larger)} (mean peak force over the gaps "
+        f"where both pound: {np.mean(forces['stiff'][both]) / 1e3 if both.any() else float('nan'):.0f} kN stiff, "
+        f"{np.mean(forces['flexible'][both]) / 1e3 if both.any() else float('nan'):.0f} kN flexible)."
+    )
+
+
+def _last_gap_with_impacts(gaps: np.ndarray, impacts: np.ndarray) -> float:
+    pounding = np.flatnonzero(impacts > 0)
+    return float(gaps[pounding[-1]]) if pounding.size else 0.0
+
+
+def phase(gap_study: xr.Dataset, pair_mu: xr.Dataset | None) -> Paragraph:
+    """Out-of-phase impacts outnumber in-phase ones."""
+    counts = []
+    for store, labels in ((gap_study, {"record": "el_centro"}), (pair_mu, {"record": "el_centro", "model": "corrected"})):
+        if store is not None:
+            data = select(store, **labels)
+            counts.append((float(data["impacts_in_phase"].sum()), float(data["impacts_out_of_phase"].sum())))
+    in_phase, out_of_phase = (sum(c[i] for c in counts) for i in (0, 1))
+    return Paragraph(
+        f"Out-of-phase impacts outnumber in-phase ones: {_verdict(out_of_phase > in_phase)} ({out_of_phase:.0f} out-of-phase "
+        f"against {in_phase:.0f} in-phase over every El Centro case of the gap and μ studies, corrected model)."
+    )
+
+
+def small_gaps(gap_study: xr.Dataset) -> Paragraph:
+    """Very small gaps raise the peak displacement."""
+    sentences = []
+    raised = True
+    for neighbour in NEIGHBOURS:
+        data = select(gap_study, neighbour=neighbour, mu=math.inf, record="el_centro")
+        peaks = data["peak_total_displacement"].sel(building="B1").values * CM
+        free = float(data["reference_peak_total_displacement"].values) * CM
+        smallest = float(peaks[:3].max())
+        raised &= smallest > free
+        sentences.append(f"{neighbour} neighbour: up to {smallest:.2f} cm at gaps ≤ {data['gap'].values[2] * CM:g} cm against {free:.2f} cm alone")
+    return Paragraph(f"Very small gaps raise Building 1's peak displacement: {_verdict(raised)} ({'; '.join(sentences)}).")
+
+
+def worst_case(pair_mu: xr.Dataset) -> Paragraph:
+    """One isolated building next to a fixed one is the worst case; both isolated pound least."""
+    finite = [float(mu) for mu in pair_mu["mu"].values if np.isfinite(mu)]
+    totals = {}
+    for isolation in ("b1_isolated", "both_isolated"):
+        data = select(pair_mu, isolation=isolation, model="corrected", gap=0.02, mu=finite, record="el_centro")
+        totals[isolation] = (float(data["impacts"].sum()), float(data["peak_total_displacement"].sel(building="B1").max()) * CM)
+    worse = totals["b1_isolated"][0] > totals["both_isolated"][0] and totals["b1_isolated"][1] >= totals["both_isolated"][1]
+    return Paragraph(
+        f"One isolated building next to a fixed one is the worst case, and both isolated pound least: {_verdict(worse)}. Over "
+        f"μ = {', '.join(f'{m:g}' for m in finite)} and both neighbours (El Centro, gap 2 cm) Building 1 isolated next to a "
+        f"fixed Building 2 has {totals['b1_isolated'][0]:.0f} impacts in all and a largest top-floor displacement of "
+        f"{totals['b1_isolated'][1]:.1f} cm; with both isolated, {totals['both_isolated'][0]:.0f} impacts and "
+        f"{totals['both_isolated'][1]:.1f} cm."
+    )
+
+
+def correlation_collapse(pair_mu: xr.Dataset) -> Paragraph:
+    """Correlation with the fixed-base response collapses once sliding and pounding act."""
+    published = published_tables()["correlation"]
+    ours = {
+        mu: [value(pair_mu, "fixed_base_correlation", isolation=i, neighbour=n, gap=0.02, mu=mu, model="corrected", record="el_centro") for n in NEIGHBOURS for i in ("b1_isolated", "both_isolated")]
+        for mu in (0.3, 0.2, 0.1)
+    }
+    study = {float(mu): [published[f"{n}_{i}"][k] for n in NEIGHBOURS for i in ("b1_isolated", "both_isolated")] for k, mu in enumerate(published["mu"]) if mu != "inf"}
+    collapsed = max(abs(c) for c in ours[0.1]) < 0.1
+    later = max(abs(c) for c in study[0.2]) < 0.1 and max(abs(c) for c in ours[0.2]) >= 0.1
+    return Paragraph(
+        f"Correlation with the fixed-base response collapses once sliding acts: {_verdict(collapsed)} at μ = 0.1 (ours "
+        f"{_span(ours[0.1])}, the study's {_span(study[0.1])}). At μ = 0.3 and 0.2 the corrected model keeps "
+        f"{_span(ours[0.3])} and {_span(ours[0.2])}, the study {_span(study[0.3])} and {_span(study[0.2])}"
+        + (": under the corrected model the collapse needs a lower μ than the study reports." if later else ".")
+    )
+
+
+def _span(values: list[float]) -> str:
+    return f"{min(values):.2f} to {max(values):.2f}"
+
+
+def isolated_columns(pair_mu: xr.Dataset) -> Paragraph:
+    """Why the study's isolated columns differ: its equations (study_compat) and its fixed-step decisions."""
+    finite = [float(mu) for mu in pair_mu["mu"].values if np.isfinite(mu)]
+    common = {"gap": 0.02, "mu": finite, "record": "el_centro"}
+    corrected = select(pair_mu, model="corrected", **common)
+    compat = select(pair_mu, model="study_compat", **common) if "model" in pair_mu.dims and "study_compat" in pair_mu["model"].values else None
+    flipped, cells = _sign_changes(pair_mu)
+    lines = [
+        f"The study's isolated columns (μ ≤ 0.5) are not reproduced and should not be: across Tables 4.1, 4.3, 4.5 and 4.7 the "
+        f"corrected model gives {float(corrected['impacts'].sum()):.0f} impacts in all where the study counted "
+        f"{_published_isolated_impacts():.0f}, and the mean or the skewness changes sign in {flipped} of the {cells} columns."
+    ]
+    if compat is not None:
+        jams = float((compat["longest_impact"] > 1.0).sum())
+        lines.append(
+            f"With the study's own equations (no impact forces in the base equation, no friction at slip onset) the same "
+            f"cases give {float(compat['impacts'].sum()):.0f} impacts, and in {jams:.0f} of them Building 1 jams against its "
+            f"neighbour for more than 1 s (longest {float(compat['longest_impact'].max()):.1f} s, corrected model: "
+            f"{float(corrected['longest_impact'].max()) * 1e3:.0f} ms): the missing impact term drives the base into the "
+            "neighbour. The rest of the difference is consistent with the study's method (contact and slip decided only "
+            "every 0.02 s, sliding velocity reset to zero): the emulation of its scheme in benchmarks/ stays centimetres "
+            "away from the exact solution however small that step (docs/benchmarks.md)."
+        )
+    return Paragraph(" ".join(lines))
+
+
+def _sign_changes(pair_mu: xr.Dataset) -> tuple[int, int]:
+    """Isolated columns (μ < ∞) of Tables 4.1/4.3/4.5/4.7 whose mean or skewness has the other sign under the corrected model."""
+    tables = published_tables()
+    flipped = cells = 0
+    for number in ("4.1", "4.3", "4.5", "4.7"):
+        spec = tables["table"][number]
+        for position, mu in enumerate(tables["columns"]["mu"]):
+            if mu in ("single", "inf"):
+                continue
+            labels = {"isolation": spec["configuration"], "neighbour": spec["neighbour"], "gap": 0.02, "mu": float(mu), "model": "corrected", "record": "el_centro"}
+            ours = [value(pair_mu, f"response_{name}", **labels) for name in ("mean", "skewness")]
+            study = [float(spec[name][position]) for name in ("mean", "skewness")]
+            cells += 1
+            flipped += any(np.sign(a) != np.sign(b) for a, b in zip(ours, study))
+    return flipped, cells
+
+
+def _published_isolated_impacts() -> float:
+    tables = published_tables()["table"]
+    return float(sum(sum(float(v) for v in tables[n]["impacts"][2:]) for n in ("4.1", "4.3", "4.5", "4.7")))

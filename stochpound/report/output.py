@@ -1,0 +1,141 @@
+"""Write a :class:`~stochpound.report.document.Report` to a folder: figures, tables, HTML page, PDF.
+
+Layout of the folder::
+
+    figures/<key>.png   every figure (the same bytes are embedded in index.html)
+    tables/<key>.csv    every table's numbers (not rounded)
+    index.html          the self-contained page (stochpound.report.html)
+    report.pdf          the A4 document (stochpound.report.pdf)
+
+Every file is written to a temporary name and then renamed, so an
+interrupted build never leaves a half-written file.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import datetime
+import io
+import os
+import re
+import secrets
+from pathlib import Path
+from typing import Callable, Iterator, Sequence
+
+import matplotlib.pyplot as plt
+
+from stochpound.report.document import Report
+from stochpound.report.html import render_html
+from stochpound.report.pdf import render_pdf
+
+FORMATS = ("html", "pdf")
+FILE_NAMES = {"html": "index.html", "pdf": "report.pdf"}
+FIGURE_DPI = 130
+KEY = re.compile(r"[A-Za-z0-9][A-Za-z0-9._-]*")
+
+Progress = Callable[[str], None]
+
+
+def write_report(
+    report: Report, out: Path, formats: Sequence[str] = FORMATS, progress: Progress | None = None
+) -> dict[str, Path]:
+    """Write ``report`` into the folder ``out`` (created if needed).
+
+    Parameters
+    ----------
+    report : Report
+        The report; its figures are closed afterwards.
+    out : pathlib.Path
+        The output folder.
+    formats : sequence of str
+        Any of ``"html"`` (``index.html``) and ``"pdf"`` (``report.pdf``).
+    progress : callable, optional
+        Called with a short message at each step (e.g. ``"figures 3/25"``).
+
+    Returns
+    -------
+    dict of str to pathlib.Path
+        The written document by format, and the ``"figures"`` and ``"tables"`` folders.
+
+    Raises
+    ------
+    ValueError
+        For an unknown format (the message names ``--format`` and the allowed
+        values), or table/figure keys that are duplicated or unusable as file names.
+    """
+    formats = _check_formats(formats)
+    _check_keys(report)
+    say = progress or (lambda message: None)
+    out = Path(out)
+    date = datetime.date.today()
+    written = {"figures": out / "figures", "tables": out / "tables"}
+    try:
+        figure_png = _write_figures(report, written["figures"], say)
+        _write_tables(report, written["tables"], say)
+        if "html" in formats:
+            say(FILE_NAMES["html"])
+            written["html"] = _replace(out / FILE_NAMES["html"], render_html(report, figure_png, date).encode("utf-8"))
+        if "pdf" in formats:
+            say(f"{FILE_NAMES['pdf']} (drawing pages)")
+            with _replacing(out / FILE_NAMES["pdf"]) as temporary:
+                pages = render_pdf(report, temporary, date)
+            say(f"{FILE_NAMES['pdf']}: {pages} pages")
+            written["pdf"] = out / FILE_NAMES["pdf"]
+    finally:
+        for item in report.figures():
+            plt.close(item.figure)
+    return written
+
+
+def _check_formats(formats: Sequence[str]) -> list[str]:
+    unknown = [name for name in formats if name not in FORMATS]
+    if unknown:
+        raise ValueError(f"--format: unknown format {unknown[0]!r}; allowed values: {', '.join(FORMATS)}")
+    return list(dict.fromkeys(formats))
+
+
+def _check_keys(report: Report) -> None:
+    for kind, keys in (("table", [t.key for t in report.tables()]), ("figure", [f.key for f in report.figures()])):
+        for key in keys:
+            if not KEY.fullmatch(key):
+                raise ValueError(f"{kind} key {key!r} is not usable as a file name (letters, digits, '.', '_', '-')")
+            if keys.count(key) > 1:
+                raise ValueError(f"{kind} key {key!r} is used more than once")
+
+
+def _write_figures(report: Report, folder: Path, say: Progress) -> dict[str, bytes]:
+    figures = report.figures()
+    png = {}
+    for number, item in enumerate(figures, start=1):
+        say(f"figures {number}/{len(figures)}")
+        buffer = io.BytesIO()
+        item.figure.savefig(buffer, format="png", dpi=FIGURE_DPI)
+        png[item.key] = buffer.getvalue()
+        _replace(folder / f"{item.key}.png", png[item.key])
+    return png
+
+
+def _write_tables(report: Report, folder: Path, say: Progress) -> None:
+    tables = report.tables()
+    for number, table in enumerate(tables, start=1):
+        say(f"tables {number}/{len(tables)}")
+        _replace(folder / f"{table.key}.csv", table.frame.to_csv().encode("utf-8"))
+
+
+def _replace(path: Path, data: bytes) -> Path:
+    """Write ``data`` to ``path`` atomically; return ``path``."""
+    with _replacing(path) as temporary:
+        temporary.write_bytes(data)
+    return path
+
+
+@contextlib.contextmanager
+def _replacing(path: Path) -> Iterator[Path]:
+    """A fresh temporary name beside ``path`` that replaces it when the block succeeds (removed otherwise)."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    temporary = path.with_name(f".{path.name}.{os.getpid()}.{secrets.token_hex(4)}.part")
+    try:
+        yield temporary
+        os.replace(temporary, path)
+    finally:
+        temporary.unlink(missing_ok=True)

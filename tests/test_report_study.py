@@ -1,0 +1,150 @@
+"""The study report built from small versions of the study's experiments (experiments/study/, shortened).
+
+The experiments are the committed definitions with shorter motions and a
+coarser gap grid, run in-process; the report must carry every study table
+with the study's rows and columns, our numbers taken from the stores, every
+figure, the findings and the methods, in HTML and PDF.
+"""
+
+import re
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+import xarray as xr
+
+from stochpound.experiment import load_experiment, open_store, run_experiment
+from stochpound.report.assemble import assemble_report
+from stochpound.report.output import write_report
+from stochpound.report.published import published_tables
+from stochpound.report.study_tables import CORRECTED, DIFFERENCE, SPLINE, STUDY, STUDY_EQUATIONS
+from tests.chromium import render_in_chromium, require_chromium
+
+STUDY_DIR = Path(__file__).resolve().parents[1] / "experiments" / "study"
+DURATION = 6.0  # s of every record
+STATISTICS = ["mean (cm)", "variance (cm²)", "std (cm)", "skewness", "excess", "impacts"]
+MU_COLUMNS = ["single building", "μ = ∞", "μ = 0.5", "μ = 0.4", "μ = 0.3", "μ = 0.2", "μ = 0.1"]
+
+
+def _shorten(text: str) -> str:
+    text = re.sub(r'^(record = "[^"]+")$', rf"\1\nduration = {DURATION}", text, flags=re.MULTILINE)
+    text = re.sub(r"^duration = 15\.0.*$", "duration = 3.0", text, flags=re.MULTILINE)
+    return re.sub(r"^gap = \[0\.0, 0\.005.*\]$", "gap = [0.0, 0.01, 0.02, 0.08]", text, flags=re.MULTILINE)
+
+
+@pytest.fixture(scope="module")
+def study_stores(tmp_path_factory) -> list[Path]:
+    folder = tmp_path_factory.mktemp("study")
+    shutil.copytree(STUDY_DIR / "scenes", folder / "scenes")
+    stores = []
+    for source in sorted(STUDY_DIR.glob("*.toml")):
+        (folder / source.name).write_text(_shorten(source.read_text()))
+        report = run_experiment(load_experiment(folder / source.name), workers=0, progress=False)
+        assert report.complete and not report.failed
+        stores.append(report.store)
+    return stores
+
+
+@pytest.fixture(scope="module")
+def built(study_stores, tmp_path_factory):
+    report = assemble_report(study_stores)
+    tables = {table.key: table for table in report.tables()}
+    figures = {item.key: item.caption for item in report.figures()}
+    sections = [section.title for section in report.sections]
+    findings = [block.text for section in report.sections if section.key == "findings" for block in section.blocks]
+    out = tmp_path_factory.mktemp("report")
+    written = write_report(report, out)
+    return {"tables": tables, "figures": figures, "sections": sections, "findings": findings, "written": written, "out": out}
+
+
+def test_every_study_experiment_is_shortened_and_complete(study_stores):
+    names = {str(open_store(path).attrs["experiment_name"]) for path in study_stores}
+    assert names == {"study_harmonic", "study_gap", "study_single", "study_pair_mu", "study_pair_records"}
+    gap = open_store(next(p for p in study_stores if p.stem == "gap_study"))
+    assert gap["time"].values[-1] <= DURATION
+
+
+def test_every_table_is_there_in_the_study_layout(built):
+    tables = built["tables"]
+    expected = {"table-3.2", "table-records", "table-4.9-4.10", *(f"table-4.{n}" for n in range(1, 9))}
+    assert set(tables) == expected
+    for number in ("4.1", "4.3", "4.5", "4.7"):
+        frame = tables[f"table-{number}"].frame
+        assert list(frame.columns) == MU_COLUMNS
+        assert list(frame.index.get_level_values(0).unique()) == STATISTICS
+        assert list(frame.loc["std (cm)"].index) == [STUDY, CORRECTED, DIFFERENCE, SPLINE, STUDY_EQUATIONS]
+    for number in ("4.2", "4.4", "4.6", "4.8"):
+        frame = tables[f"table-{number}"].frame
+        assert frame.shape == (16, 6)
+        assert [label.split(",")[0] for label in frame.index.get_level_values(0).unique()] == [
+            "Mexico City 1985", "El Centro 1940", "Loma Prieta 1989 (substitute)", "Northridge 1994 (substitute)"]
+    correlation = tables["table-4.9-4.10"].frame
+    assert correlation.shape == (20, 4)
+    assert tables["table-3.2"].frame.shape == (8, 7)
+
+
+def test_tables_carry_the_study_and_the_stores_numbers(built, study_stores):
+    frame = built["tables"]["table-4.3"].frame
+    published = published_tables()["table"]["4.3"]
+    np.testing.assert_allclose(frame.loc[("std (cm)", STUDY)].values, published["std"])
+    pair = open_store(next(p for p in study_stores if p.stem == "pair_mu"))
+    case = {"isolation": "b1_isolated", "neighbour": "flexible", "model": "corrected", "gap": 0.02, "record": "el_centro", "realization": 0}
+    ours = pair["response_std"].sel(case).sel(mu=[0.5, 0.4, 0.3, 0.2, 0.1]).values * 100
+    np.testing.assert_allclose(frame.loc[("std (cm)", CORRECTED)].values[2:], ours)
+    assert frame.loc[("std (cm)", CORRECTED), "single building"] == pytest.approx(float(pair["reference_response_std"].sel(record="el_centro", realization=0)) * 100)
+    np.testing.assert_allclose(frame.loc[("std (cm)", DIFFERENCE)].values, frame.loc[("std (cm)", CORRECTED)].values - np.asarray(published["std"]))
+    assert np.isnan(frame.loc[("impacts", CORRECTED), "single building"])
+    compat = pair["impacts"].sel(case | {"model": "study_compat", "record": "el_centro_spline"}).sel(mu=0.4)
+    assert frame.loc[("impacts", STUDY_EQUATIONS), "μ = 0.4"] == float(compat)
+
+
+def test_every_figure_is_written_and_named(built):
+    expected = {"3.2", "3.3", "3.4", "3.6", "3.7", "3.8", "3.9", "4.1", "4.2", "4.3", "4.4", "4.5", "4.6", "4.8-4.15-b1_isolated", "4.8-4.15-both_isolated", "4.16-4.17", "4.18", "4.19", "4.20"}
+    assert set(built["figures"]) == {f"figure-{n}" for n in expected}
+    for key in built["figures"]:
+        png = built["out"] / "figures" / f"{key}.png"
+        assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and png.stat().st_size > 5000
+    substitute_captions = [c for c in built["figures"].values() if "Loma Prieta" in c or "four records" in c]
+    assert substitute_captions and all("substitute" in c for c in substitute_captions)
+
+
+def test_findings_and_methods_are_written_from_the_numbers(built):
+    assert built["sections"][:2] == ["About this report", "Findings"]
+    assert built["sections"][-1] == "Methods"
+    assert len(built["findings"]) == 7
+    assert all(("Holds" in text or "Does not hold" in text or "not reproduced" in text or "reproduced" in text) for text in built["findings"])
+    html = built["written"]["html"].read_text()
+    assert "closed-form modal solution" in html and "DOP853" in html and "energy input" in html
+
+
+def test_documents_are_written(built):
+    pdf = built["written"]["pdf"].read_bytes()
+    assert pdf.startswith(b"%PDF")
+    pages = len(re.findall(rb"/Type\s*/Page[^s]", pdf))
+    assert pages >= 1 + len(built["figures"]) + len(built["tables"])
+    html = built["written"]["html"].read_text()
+    assert html.count("<table") == len(built["tables"])
+    assert html.count("data:image/png;base64,") == len(built["figures"])
+
+
+def test_a_store_that_is_not_the_study_gets_a_section_of_its_own(study_stores, tmp_path):
+    single = next(p for p in study_stores if p.stem == "single_isolated")
+    data = xr.open_dataset(single).load()
+    data.attrs["experiment_name"] = "my_grid"
+    other = tmp_path / "my_grid.nc"
+    data.to_netcdf(other, engine="h5netcdf")
+    report = assemble_report([other])
+    assert [s.title for s in report.sections] == ["Experiment my_grid", "Methods"]
+    table = report.tables()[0]
+    assert table.frame.shape[0] == data.sizes["mu"] * data.sizes["record"]
+    assert [f.key for f in report.figures()] == ["figure-my_grid-mu"]
+
+
+def test_the_study_report_renders_in_headless_chromium(built, tmp_path):
+    executable = require_chromium()
+    verdict, problems = render_in_chromium(built["written"]["html"], tmp_path / "screenshot.png", executable)
+    assert verdict["readyState"] == "complete"
+    assert verdict["tables"] == len(built["tables"])
+    assert len(verdict["images"]) == len(built["figures"]) and all(width > 0 for width in verdict["images"])
+    assert problems == []
