@@ -27,7 +27,7 @@ def _verdict(holds: bool) -> str:
 def fixed_columns(pair_mu: xr.Dataset) -> Paragraph:
     """The single building and the μ = ∞ columns: how closely the corrected model reproduces them."""
     tables = published_tables()["table"]
-    worst = 0.0
+    worst = worst_small = 0.0
     for number in ("4.1", "4.3"):
         for position, column in ((0, "single"), (1, "inf")):
             for statistic in ("std", "skewness", "excess"):
@@ -37,13 +37,18 @@ def fixed_columns(pair_mu: xr.Dataset) -> Paragraph:
                 ours = value(pair_mu, f"{prefix}response_{statistic}", CM if statistic == "std" else 1.0, record="el_centro_spline" if "el_centro_spline" in pair_mu["record"].values else "el_centro", **labels)
                 if abs(study) > 0.1:
                     worst = max(worst, abs(ours - study) / abs(study))
-    impacts = {n: value(pair_mu, "impacts", isolation="b1_isolated", neighbour=n, gap=0.02, mu=math.inf, model="corrected", record="el_centro") for n in NEIGHBOURS}
+                else:
+                    worst_small = max(worst_small, abs(ours - study))
+    record = "el_centro_spline" if "el_centro_spline" in pair_mu["record"].values else "el_centro"
+    impacts = {n: value(pair_mu, "impacts", isolation="b1_isolated", neighbour=n, gap=0.02, mu=math.inf, model="corrected", record=record) for n in NEIGHBOURS}
+    study = {tables[number]["neighbour"]: float(tables[number]["impacts"][1]) for number in ("4.1", "4.3")}
     return Paragraph(
         f"The single fixed-base building and the fixed–fixed (μ = ∞) columns of Tables 4.1 and 4.3 are reproduced: std, "
-        f"skewness and excess within {worst * 100:.0f} % with the study's spline input (skewness near zero compared in absolute "
-        f"terms). The corrected model resolves more impacts ({impacts['stiff']:.0f} stiff, {impacts['flexible']:.0f} flexible, "
-        "against the study's 8 and 38): the study decided contact only at its 0.02 s restarts, so contacts that open and "
-        "close between two restarts were merged or missed."
+        f"skewness and excess within {worst * 100:.0f} % with the study's spline input (values below 0.1 in magnitude within "
+        f"{worst_small:.3f}). The corrected model resolves {'more' if sum(impacts.values()) > sum(study.values()) else 'as many or fewer'} "
+        f"impacts ({impacts['stiff']:.0f} stiff, {impacts['flexible']:.0f} flexible, against the study's {study['stiff']:.0f} and "
+        f"{study['flexible']:.0f}): the study decided contact only at its 0.02 s restarts, so contacts that open and close "
+        "between two restarts were merged or missed."
     )
 
 
@@ -87,17 +92,18 @@ def phase(gap_study: xr.Dataset, pair_mu: xr.Dataset | None) -> Paragraph:
 
 
 def small_gaps(gap_study: xr.Dataset) -> Paragraph:
-    """Very small gaps raise the peak displacement."""
-    sentences = []
-    raised = True
+    """Very small gaps raise the peak displacement (checked per neighbour, gaps up to 1 cm against the building alone)."""
+    sentences, raised = [], {}
     for neighbour in NEIGHBOURS:
         data = select(gap_study, neighbour=neighbour, mu=math.inf, record="el_centro")
-        peaks = data["peak_total_displacement"].sel(building="B1").values * CM
-        free = float(data["reference_peak_total_displacement"].values) * CM
-        smallest = float(peaks[:3].max())
-        raised &= smallest > free
-        sentences.append(f"{neighbour} neighbour: up to {smallest:.2f} cm at gaps ≤ {data['gap'].values[2] * CM:g} cm against {free:.2f} cm alone")
-    return Paragraph(f"Very small gaps raise Building 1's peak displacement: {_verdict(raised)} ({'; '.join(sentences)}).")
+        small = data["gap"].values <= 0.01
+        peak = float(data["peak_total_displacement"].sel(building="B1").values[small].max()) * CM
+        alone = float(data["reference_peak_total_displacement"].values) * CM
+        raised[neighbour] = peak > alone
+        sentences.append(f"{neighbour} neighbour: at most {peak:.2f} cm at gaps ≤ 1 cm against {alone:.2f} cm alone")
+    holding = [n for n, up in raised.items() if up]
+    verdict = _verdict(len(holding) == len(raised)) if len(holding) in (0, len(raised)) else f"Holds for the {holding[0]} neighbour only"
+    return Paragraph(f"Very small gaps raise Building 1's peak displacement: {verdict} ({'; '.join(sentences)}).")
 
 
 def worst_case(pair_mu: xr.Dataset) -> Paragraph:
