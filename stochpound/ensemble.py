@@ -27,6 +27,8 @@ from __future__ import annotations
 import dataclasses
 import multiprocessing
 import os
+from collections import deque
+from collections.abc import Iterator
 from concurrent.futures import ProcessPoolExecutor
 from typing import Any
 
@@ -67,7 +69,9 @@ def simulate_ensemble(
     motions : xarray.DataArray
         Ground acceleration, m/s², dims ``(realization, time)``, uniformly
         sampled from t = 0 (the ``time`` coordinate in s, or ``attrs["dt"]``).
-        May be dask-backed: one batch is loaded at a time.
+        May be dask-backed: batches are computed in this process (dask's
+        synchronous scheduler) as they are handed out, at most two per
+        worker ahead.
     keep : {"summary", "histories"}
         ``summary``: per-realization scalars only. ``histories``: also
         ``total_displacement``, ``relative_displacement`` (realization,
@@ -94,15 +98,14 @@ def simulate_ensemble(
         raise ValueError(f"batch_size must be >= 1, got {batch_size}")
     motions = motions.transpose("realization", "time")
     dt = _sample_spacing(motions)
-    n_realizations = motions.sizes["realization"]
-    starts = range(0, n_realizations, batch_size)
-    tasks = ((scene, motions.isel(realization=slice(a, a + batch_size)), dt, keep, method) for a in starts)
+    labels = motions["realization"].values
+    starts = range(0, len(labels), batch_size)
+    tasks = ((scene, _load(motions, a, batch_size), labels[a : a + batch_size], dt, keep, method) for a in starts)
     workers = (os.cpu_count() or 1) if workers is None else workers
     if workers <= 1 or len(starts) <= 1:
         batches = [_simulate_batch(*task) for task in tasks]
     else:
-        with ProcessPoolExecutor(max_workers=min(workers, len(starts)), mp_context=_context()) as pool:
-            batches = list(pool.map(_simulate_batch, *zip(*tasks)))
+        batches = _in_workers(tasks, min(workers, len(starts)))
     result = xr.concat(batches, dim="realization", data_vars="all", coords="minimal", compat="override", join="override")
     result.attrs.update(
         title="stochpound ensemble", stochpound_version=__version__, solver=method, keep=keep,
@@ -110,6 +113,33 @@ def simulate_ensemble(
         **{f"motion_{name}": value for name, value in motions.attrs.items() if isinstance(value, (int, float, str))},
     )
     return result
+
+
+def _load(motions: xr.DataArray, start: int, size: int) -> np.ndarray:
+    """Samples (m/s²) of realizations ``start`` to ``start + size``, computed in this process.
+
+    Dask-backed motions are computed with the synchronous scheduler: workers
+    get plain arrays and never run dask (a forked worker would block on the
+    locks of the parent's scheduler threads), and the parent starts no threads.
+    """
+    batch = motions.isel(realization=slice(start, start + size))
+    return np.asarray(batch.compute(scheduler="synchronous").values, float)
+
+
+def _in_workers(tasks: Iterator[tuple], workers: int) -> list[xr.Dataset]:
+    """Batch results of ``tasks`` computed by ``workers`` processes, in order.
+
+    At most two batches per worker are loaded and queued at a time, so a lazy
+    ensemble is generated batch by batch while the workers simulate.
+    """
+    results, queued = [], deque()
+    with ProcessPoolExecutor(max_workers=workers, mp_context=_context()) as pool:
+        for task in tasks:
+            queued.append(pool.submit(_simulate_batch, *task))
+            if len(queued) >= 2 * workers:
+                results.append(queued.popleft().result())
+        results.extend(future.result() for future in queued)
+    return results
 
 
 def _context() -> multiprocessing.context.BaseContext:
@@ -134,20 +164,19 @@ def _sample_spacing(motions: xr.DataArray) -> float:
 # ---------------------------------------------------------------- one batch
 
 
-def _simulate_batch(scene: Scene, motions: xr.DataArray, dt: float, keep: str, method: str) -> xr.Dataset:
-    """Simulate and summarise one batch of realizations."""
+def _simulate_batch(scene: Scene, values: np.ndarray, labels: np.ndarray, dt: float, keep: str, method: str) -> xr.Dataset:
+    """Simulate and summarise one batch of realizations (``values``: realization × time, m/s²)."""
     interpolation = scene.motion.interpolation if isinstance(scene.motion, SampledMotion) else "linear"
-    values = np.asarray(motions.values, float)
     runs = []
     with threadpool_limits(limits=1):
-        for i, samples in enumerate(values):
-            motion = SampledMotion(dt, samples, interpolation, f"realization {motions['realization'].values[i]}")
+        for label, samples in zip(labels, values):
+            motion = SampledMotion(dt, samples, interpolation, f"realization {label}")
             runs.append(_run(dataclasses.replace(scene, motion=motion), method))
-    histories = _histories(scene, runs, motions)
+    histories = _histories(scene, runs)
     summary = xr.merge([peak_response(histories), _top_floor_moments(scene, histories), _impacts(runs), _energies(runs)])
     if keep == "histories":
         summary = summary.merge(histories)
-    return summary.assign_coords(realization=motions["realization"].values)
+    return summary.assign_coords(realization=labels)
 
 
 def _run(scene: Scene, method: str) -> tuple[Recorder, EventCounters, Any]:
@@ -156,11 +185,11 @@ def _run(scene: Scene, method: str) -> tuple[Recorder, EventCounters, Any]:
     return run_ivp(scene)
 
 
-def _histories(scene: Scene, runs: list, motions: xr.DataArray) -> xr.Dataset:
+def _histories(scene: Scene, runs: list) -> xr.Dataset:
     """Displacement and impact force histories of a batch (realization, ...)."""
     system = runs[0][2].system
     n, n_floors = system.n_dof, scene.max_floors
-    shape = (len(runs), len(scene.buildings), n_floors, motions.sizes["time"])
+    shape = (len(runs), len(scene.buildings), n_floors, len(runs[0][0].motion.times))
     relative, sliding = np.full(shape, np.nan), np.zeros(shape[:2] + shape[3:])
     for r, (recorder, _, _) in enumerate(runs):
         q = recorder.states[:, :n]
@@ -196,17 +225,13 @@ def _top_floor_moments(scene: Scene, histories: xr.Dataset) -> xr.Dataset:
 
 
 def _impacts(runs: list) -> xr.Dataset:
-    """Impact statistics of each realization (from its impact table)."""
-    tables = []
-    for recorder, _, _ in runs:
-        impacts = recorder.impacts
-        tables.append(xr.Dataset({
-            "impact_in_phase": ("impact", np.array([i.in_phase for i in impacts], bool)),
-            "impact_peak_force": ("impact", np.array([i.peak_force for i in impacts], float)),
-            "impact_duration": ("impact", np.array([i.end - i.start for i in impacts], float)),
-            "impact_impulse": ("impact", np.array([i.impulse for i in impacts], float)),
-        }))
-    return xr.concat([impact_statistics(table) for table in tables], dim="realization")
+    """Impact statistics of each realization, from the batch's impact tables padded with NaN to (realization, impact)."""
+    rows = [[(i.in_phase, i.peak_force, i.end - i.start, i.impulse) for i in recorder.impacts] for recorder, _, _ in runs]
+    table = np.full((len(rows), max(map(len, rows)), 4), np.nan)
+    for r, impacts in enumerate(rows):
+        table[r, : len(impacts)] = np.reshape(impacts, (-1, 4))
+    names = ("impact_in_phase", "impact_peak_force", "impact_duration", "impact_impulse")
+    return impact_statistics(xr.Dataset({name: (("realization", "impact"), table[..., j]) for j, name in enumerate(names)}))
 
 
 def _energies(runs: list) -> xr.Dataset:

@@ -12,13 +12,17 @@ affine in x and a_g:
     guard_j(t) = G_j · x + h_j a_g(t) + g0_j      (fires when it becomes > 0)
 
 Matrices are built lazily, only for the modes a run visits, and cached per
-system, so a contact that never closes or a base that never slips costs nothing.
+system within a memory budget (:class:`ModeLibrary`), so a contact that never
+closes or a base that never slips costs nothing.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from collections import OrderedDict
+from collections.abc import Callable
+from dataclasses import dataclass, fields
 from enum import IntEnum
+from typing import Generic, TypeVar
 
 import numpy as np
 
@@ -29,6 +33,11 @@ STUCK = 0
 FREE = 2
 """Base state: frictionless base, a free degree of freedom."""
 SLIP_RIGHT, SLIP_LEFT = 1, -1
+MODE_BUDGET = 256 * 2**20
+"""Largest size of the cached :class:`ModeDynamics` of one system, bytes (large scenes visit thousands of modes)."""
+
+Key = TypeVar("Key")
+Value = TypeVar("Value")
 
 
 class Guard(IntEnum):
@@ -110,37 +119,112 @@ class ModeDynamics:
         return self.guard_matrix @ x + self.guard_ground * ground + self.guard_constant
 
 
+class BoundedCache(Generic[Key, Value]):
+    """Least recently used cache holding at most ``budget`` bytes of values (and at least one value).
+
+    Parameters
+    ----------
+    budget : int
+        Largest total size of the cached values, bytes.
+    size : callable
+        Size of a value, bytes.
+    """
+
+    def __init__(self, budget: int, size: Callable[[Value], int]) -> None:
+        self._budget = budget
+        self._size = size
+        self._items: OrderedDict[Key, tuple[Value, int]] = OrderedDict()
+        self._bytes = 0
+
+    def get(self, key: Key) -> Value | None:
+        """The cached value of ``key`` (now the most recently used), or None."""
+        item = self._items.get(key)
+        if item is None:
+            return None
+        self._items.move_to_end(key)
+        return item[0]
+
+    def put(self, key: Key, value: Value) -> None:
+        """Cache ``value``, dropping the least recently used values beyond the budget."""
+        size = self._size(value)
+        self._items[key] = (value, size)
+        self._bytes += size
+        while self._bytes > self._budget and len(self._items) > 1:
+            _, (_, dropped) = self._items.popitem(last=False)
+            self._bytes -= dropped
+
+
+def array_bytes(value: object) -> int:
+    """Total size of the numpy arrays among the fields of a dataclass instance, bytes."""
+    return sum(getattr(value, f.name).nbytes for f in fields(value) if isinstance(getattr(value, f.name), np.ndarray))
+
+
 class ModeLibrary:
-    """Lazily built, cached :class:`ModeDynamics` of one :class:`System`."""
+    """Lazily built :class:`ModeDynamics` of one :class:`System`, cached within :data:`MODE_BUDGET`.
+
+    Dynamics dropped from the cache are rebuilt when asked for again;
+    ``len`` counts the distinct modes built.
+    """
 
     def __init__(self, system: System) -> None:
         self.system = system
-        self._cache: dict[Mode, ModeDynamics] = {}
+        self._cache: BoundedCache[Mode, ModeDynamics] = BoundedCache(MODE_BUDGET, array_bytes)
+        self._built: set[Mode] = set()
+        self._inverse_mass: dict[tuple[int, ...], np.ndarray] = {}
+        self._contact_rows = _contact_guard_rows(system)
 
     def __getitem__(self, mode: Mode) -> ModeDynamics:
         dynamics = self._cache.get(mode)
         if dynamics is None:
-            dynamics = self._cache[mode] = _build(self.system, mode)
+            dynamics = _build(self.system, mode, self._free_inverse_mass(mode), self._contact_rows)
+            self._cache.put(mode, dynamics)
+            self._built.add(mode)
         return dynamics
 
     def __len__(self) -> int:
-        return len(self._cache)
+        return len(self._built)
+
+    def _free_inverse_mass(self, mode: Mode) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Stuck DOFs, free DOFs and the inverse of the free DOFs' mass matrix of ``mode``."""
+        system = self.system
+        stuck = np.array([system.base_dofs[b] for b in system.isolated if mode.base[b] == STUCK], dtype=int)
+        free = np.setdiff1d(np.arange(system.n_dof), stuck)
+        key = tuple(stuck)
+        inverse = self._inverse_mass.get(key)
+        if inverse is None:
+            inverse = self._inverse_mass[key] = np.linalg.inv(system.mass[np.ix_(free, free)])
+        return stuck, free, inverse
 
 
-def _build(system: System, mode: Mode) -> ModeDynamics:
+@dataclass(frozen=True)
+class _ContactRows:
+    """Every contact's penetration row [g, 0] and force row [k g, c g] over the state (n_contacts × 2N)."""
+
+    penetration: np.ndarray
+    force: np.ndarray
+
+
+def _contact_guard_rows(system: System) -> _ContactRows:
+    """The guard rows of every contact, shared by all modes."""
+    g = system.contact_geometry
+    zeros = np.zeros_like(g)
+    k, c = system.contact_stiffness[:, None], system.contact_damping[:, None]
+    return _ContactRows(np.hstack([g, zeros]), np.hstack([k * g, c * g]))
+
+
+def _build(system: System, mode: Mode, masses: tuple[np.ndarray, np.ndarray, np.ndarray], rows: _ContactRows) -> ModeDynamics:
+    """The dynamics of ``mode`` from its stuck and free DOFs and free mass inverse (``masses``)."""
     n = system.n_dof
+    stuck, free, inverse_mass = masses
     closed = np.flatnonzero(mode.closed)
     g, h = system.contact_geometry, system.contact_load
     k, c_imp, d = system.contact_stiffness, system.contact_damping, system.contact_gap
     stiffness = system.stiffness + (h[closed].T * k[closed]) @ g[closed]
     damping = system.damping + (h[closed].T * c_imp[closed]) @ g[closed]
     load = h[closed].T @ (k[closed] * d[closed])
-    stuck = np.array([system.base_dofs[b] for b in system.isolated if mode.base[b] == STUCK], dtype=int)
     for b in system.isolated:
         if mode.base[b] in (SLIP_RIGHT, SLIP_LEFT):
             load[system.base_dofs[b]] -= mode.base[b] * system.base_mu[b] * system.base_weight[b]
-    free = np.setdiff1d(np.arange(n), stuck)
-    inverse_mass = np.linalg.inv(system.mass[np.ix_(free, free)])
     A = np.zeros((2 * n, 2 * n))
     A[free, n + free] = 1.0
     A[n + free, :n] = -inverse_mass @ stiffness[free]
@@ -150,7 +234,7 @@ def _build(system: System, mode: Mode) -> ModeDynamics:
     c = np.zeros(2 * n)
     c[n + free] = inverse_mass @ load[free]
     friction = _friction(system, mode, stiffness, damping, load, A, B, c, free)
-    guards = _guards(system, mode, friction)
+    guards = _guards(system, mode, friction, rows)
     force_matrix = np.zeros((system.n_contacts, 2 * n))
     force_matrix[closed, :n] = g[closed] * k[closed, None]
     force_matrix[closed, n:] = g[closed] * c_imp[closed, None]
@@ -177,7 +261,31 @@ def _friction(system, mode, stiffness, damping, load, A, B, c, free):
     return matrix, ground, constant
 
 
-def _guards(system, mode, friction):
+def _guards(system: System, mode: Mode, friction: tuple, rows: _ContactRows) -> tuple[np.ndarray, ...]:
+    """Guard rows of ``mode``: every contact's guards in contact order, then every base's."""
+    contact = _contact_guards(system, np.array(mode.closed, bool), rows)
+    base = _base_guards(system, mode, friction)
+    return tuple(np.concatenate([a, b]) for a, b in zip(contact, base))
+
+
+def _contact_guards(system: System, closed: np.ndarray, rows: _ContactRows) -> tuple[np.ndarray, ...]:
+    """CLOSE (and RECLOSE for non-tensile contacts) of open contacts, OPEN of closed ones, in contact order."""
+    k, d, tensile = system.contact_stiffness, system.contact_gap, system.contact_tensile
+    # first guard of each contact: CLOSE when open; OPEN (on δ when tensile, on F when not) when closed
+    first = np.where(closed[:, None], -np.where(tensile[:, None], rows.penetration, rows.force), rows.penetration)
+    first_constant = np.where(closed, np.where(tensile, d, k * d), -d)
+    first_kind = np.where(closed, Guard.OPEN, Guard.CLOSE)
+    reclose = np.flatnonzero(~closed & ~tensile)
+    order = np.argsort(np.concatenate([2 * np.arange(system.n_contacts), 2 * reclose + 1]), kind="stable")
+    matrix = np.concatenate([first, rows.force[reclose]])[order]
+    constant = np.concatenate([first_constant, -k[reclose] * d[reclose]])[order]
+    kind = np.concatenate([first_kind, np.full(len(reclose), Guard.RECLOSE)])[order]
+    target = np.concatenate([np.arange(system.n_contacts), reclose])[order]
+    return matrix, np.zeros(len(order)), constant, kind.astype(int), target, np.zeros(len(order), int)
+
+
+def _base_guards(system: System, mode: Mode, friction: tuple) -> tuple[np.ndarray, ...]:
+    """SLIP guards (both ways) of stuck bases and STOP guards of slipping ones."""
     n = system.n_dof
     rows, ground, constant, kind, target, direction = [], [], [], [], [], []
 
@@ -189,20 +297,6 @@ def _guards(system, mode, friction):
         target.append(index)
         direction.append(sense)
 
-    zeros = np.zeros(n)
-    for p in range(system.n_contacts):
-        geometry = system.contact_geometry[p]
-        k, c, d = system.contact_stiffness[p], system.contact_damping[p], system.contact_gap[p]
-        penetration = np.concatenate([geometry, zeros])
-        force = np.concatenate([k * geometry, c * geometry])
-        if not mode.closed[p]:
-            add(penetration, -d, Guard.CLOSE, p)
-            if not system.contact_tensile[p]:
-                add(force, -k * d, Guard.RECLOSE, p)
-        elif system.contact_tensile[p]:
-            add(-penetration, d, Guard.OPEN, p)
-        else:
-            add(-force, k * d, Guard.OPEN, p)
     friction_matrix, friction_ground, friction_constant = friction
     for b in system.isolated:
         state = mode.base[b]

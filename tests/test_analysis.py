@@ -94,6 +94,38 @@ def test_no_impacts_gives_zeros():
     assert int(result["impacts"]) == 0 and float(result["peak_impact_force"]) == 0.0 and float(result["longest_impact"]) == 0.0
 
 
+def padded_impacts() -> tuple[xr.Dataset, list[xr.Dataset]]:
+    """Three realizations' tables (3, 0 and 2 impacts) and their (realization, impact) table padded with NaN."""
+    table = constructed_impacts()
+    tables = [table, table.isel(impact=slice(0, 0)), table.isel(impact=[2, 0])]
+    tables = [t.assign_coords(impact=np.arange(t.sizes["impact"])) for t in tables]
+    padded = xr.concat(tables, dim="realization", join="outer")
+    return padded, tables
+
+
+def test_padded_table_gives_each_realizations_statistics():
+    padded, tables = padded_impacts()
+    assert padded["impact_in_phase"].dtype != bool and padded["impact_in_phase"].isnull().any()  # NaN padding
+    result = impact_statistics(padded)
+    explicit = impact_statistics(padded, valid=padded["impact_duration"].notnull())
+    for r, table in enumerate(tables):
+        single = impact_statistics(table)
+        for name in single.data_vars:
+            assert result[name].values[r] == single[name].values, name
+            assert explicit[name].values[r] == single[name].values, name
+    np.testing.assert_array_equal(result["impacts"], [3, 0, 2])
+    np.testing.assert_array_equal(result["impacts_in_phase"], [2, 0, 2])
+
+
+def test_padded_table_statistics_are_lazy_on_dask_chunks():
+    padded, _ = padded_impacts()
+    lazy = impact_statistics(padded.chunk({"realization": 1}))
+    eager = impact_statistics(padded)
+    for name in eager.data_vars:
+        assert lazy[name].chunks is not None, name  # still lazy
+        np.testing.assert_array_equal(lazy[name].compute(), eager[name], err_msg=name)
+
+
 def test_pounding_probability_matches_the_exact_binomial_interval():
     rng = np.random.default_rng(3)
     counts = xr.DataArray(rng.poisson([[0.2], [1.5], [0.0]], size=(3, 200)), dims=("gap", "realization"), coords={"gap": [0.08, 0.02, 0.5]})

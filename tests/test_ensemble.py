@@ -1,6 +1,11 @@
 """Batched ensembles: one dataset with a realization dimension, independent of batching and workers."""
 
 import dataclasses
+import os
+import signal
+import subprocess
+import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -61,6 +66,38 @@ def test_result_does_not_depend_on_batching_or_workers(scene, motions, ensemble)
         np.testing.assert_array_equal(summary[name].values, ensemble[name].values, err_msg=name)
     assert "total_displacement" not in summary  # summaries only: no histories kept
     assert summary.realization.values.tolist() == motions.realization.values.tolist()
+
+
+DASK_AFTER_PARENT_COMPUTE = """
+import sys
+import numpy as np
+import stochpound
+from stochpound import motions as synthetic
+from stochpound.ensemble import simulate_ensemble
+from tests.conftest import study_scene
+
+scene = stochpound.scene_from_dict(study_scene(0.1, 0.1, 0.5, gap=0.01))
+motions = synthetic.kanai_tajimi({n}, 6.0, 0.01, omega_g=15.0, zeta_g=0.6, pga=3.4, envelope="jennings", seed=3)
+motions = motions.chunk(realization=2)
+motions.isel(realization=0).values  # the parent computes a chunk first (dask's threaded scheduler)
+result = simulate_ensemble(scene, motions, workers=2, batch_size=1)
+np.savez(sys.argv[1], **{{name: result[name].values for name in result.data_vars}})
+"""
+
+
+def test_dask_motions_in_worker_processes_after_the_parent_computed_a_chunk(ensemble, tmp_path):
+    """Forked workers used to block on the lock of the parent's dask scheduler: the run must finish, unchanged."""
+    output = tmp_path / "result.npz"
+    script = DASK_AFTER_PARENT_COMPUTE.format(n=N_REALIZATIONS)
+    process = subprocess.Popen([sys.executable, "-c", script, str(output)], cwd=Path(__file__).parents[1], start_new_session=True)
+    try:
+        assert process.wait(timeout=300) == 0
+    finally:
+        if process.poll() is None:  # hung: stop it and its workers
+            os.killpg(process.pid, signal.SIGKILL)
+    with np.load(output) as result:
+        for name in result.files:
+            np.testing.assert_array_equal(result[name], ensemble[name].values, err_msg=name)
 
 
 def test_ivp_method_gives_the_same_summaries(scene, motions, ensemble):

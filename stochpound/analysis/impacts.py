@@ -6,8 +6,12 @@ import numpy as np
 import xarray as xr
 
 
-def impact_statistics(run: xr.Dataset, dim: str = "impact") -> xr.Dataset:
+def impact_statistics(run: xr.Dataset, dim: str = "impact", valid: xr.DataArray | None = None) -> xr.Dataset:
     """Counts and extremes of the impacts listed along ``dim``.
+
+    Works on a run's table and on padded tables, e.g. (realization, impact)
+    with each realization's impacts followed by NaN rows; lazy on dask-backed
+    tables.
 
     Parameters
     ----------
@@ -18,6 +22,9 @@ def impact_statistics(run: xr.Dataset, dim: str = "impact") -> xr.Dataset:
         table. Use ``run.groupby(...)`` to get statistics per case or contact.
     dim : str
         The table's dimension.
+    valid : xarray.DataArray of bool, optional
+        Which rows are impacts (False for padding). Default: the rows with a
+        peak force (padding is NaN there).
 
     Returns
     -------
@@ -26,25 +33,37 @@ def impact_statistics(run: xr.Dataset, dim: str = "impact") -> xr.Dataset:
         way at onset), ``impacts_out_of_phase``, ``peak_impact_force`` (N),
         ``longest_impact`` (s) and ``total_impulse`` (N·s); extremes are 0
         when there is no impact.
+
+    Notes
+    -----
+    ``total_impulse`` is summed in table order, so a realization's statistics
+    do not depend on how far its table is padded.
     """
-    in_phase = run["impact_in_phase"].astype(bool)
-    count = in_phase.count(dim)
-    n_in_phase = in_phase.sum(dim)
+    valid = run["impact_peak_force"].notnull() if valid is None else valid.astype(bool)
+    count = valid.sum(dim)
+    n_in_phase = run["impact_in_phase"].where(valid, False).astype(bool).sum(dim)
 
     def largest(name: str) -> xr.DataArray:
-        values = run[name]
-        return values.max(dim) if values.sizes[dim] else xr.zeros_like(count, dtype=float)
+        values = run[name].where(valid)
+        return values.max(dim).fillna(0.0) if values.sizes[dim] else xr.zeros_like(count, dtype=float)
 
     return xr.Dataset(
         {
             "impacts": count.assign_attrs(units="1", long_name="number of impacts"),
             "impacts_in_phase": n_in_phase.assign_attrs(units="1", long_name="impacts with both floors moving the same way at onset"),
             "impacts_out_of_phase": (count - n_in_phase).assign_attrs(units="1", long_name="impacts with the floors moving towards each other at onset"),
-            "peak_impact_force": largest("impact_peak_force").fillna(0.0).assign_attrs(units="N", long_name="largest impact force"),
-            "longest_impact": largest("impact_duration").fillna(0.0).assign_attrs(units="s", long_name="longest impact duration"),
-            "total_impulse": run["impact_impulse"].sum(dim).assign_attrs(units="N s", long_name="sum of impact impulses"),
+            "peak_impact_force": largest("impact_peak_force").assign_attrs(units="N", long_name="largest impact force"),
+            "longest_impact": largest("impact_duration").assign_attrs(units="s", long_name="longest impact duration"),
+            "total_impulse": _running_total(run["impact_impulse"].where(valid, 0.0), dim).assign_attrs(units="N s", long_name="sum of impact impulses"),
         }
     )
+
+
+def _running_total(values: xr.DataArray, dim: str) -> xr.DataArray:
+    """Sum along ``dim`` in table order (a cumulative sum): trailing padding zeros cannot change its last bit."""
+    if not values.sizes[dim]:
+        return values.sum(dim)
+    return values.cumsum(dim).isel({dim: -1}, drop=True)
 
 
 def in_phase(left_velocity: np.ndarray, right_velocity: np.ndarray) -> np.ndarray:
