@@ -10,7 +10,6 @@ from stochpound.motion import GroundMotion, HarmonicMotion, SampledMotion
 from stochpound.propagators import UnsupportedMotionError, exosystem, interval_forcing, propagator_library, sample_ground
 from stochpound.system import build_system
 from tests.conftest import reference_building, study_contacts, study_scene
-from tests.test_modal import AMPLITUDE, modal_solution
 
 TOLERANCE = 1e-9  # m, on every floor's total displacement over the whole record
 
@@ -57,17 +56,6 @@ def test_study_scenes_match_ivp(name):
     exact, reference = both(STUDY_SCENES[name])
     assert reference.sizes["impact"] > 0
     assert_same_run(exact, reference)
-
-
-@pytest.mark.parametrize("omega_ground", [2.0, 10.0])
-def test_fixed_base_building_matches_modal_solution(omega_ground):
-    scene = stochpound.scene_from_dict({
-        "building": [reference_building()],
-        "motion": {"type": "harmonic", "amplitude": AMPLITUDE, "omega": omega_ground, "duration": 15.0, "dt": 0.01},
-    })
-    run = stochpound.simulate(scene, method="exact")
-    computed = run.relative_displacement.sel(building="B1").values
-    assert np.max(np.abs(computed - modal_solution(run.time.values, omega_ground))) <= 1e-9
 
 
 def test_zero_gap_fixed_buildings():
