@@ -28,9 +28,10 @@ import weakref
 import numpy as np
 from threadpoolctl import ThreadpoolController
 
-from stochpound.events import EventCounters, GuardStates, Step, first_crossing, initial_mode, settle
+from stochpound.events import MAX_SETTLE_ITERATIONS, EventCounters, GuardStates, Step, first_crossing, initial_mode, settle
 from stochpound.modes import FREE, Mode, ModeDynamics, ModeLibrary
 from stochpound.propagators import (
+    CHEBYSHEV_DEGREE,
     GAUSS_NODES,
     GAUSS_WEIGHTS,
     ModePropagator,
@@ -266,28 +267,27 @@ class _CompiledRun:
         state.pending_x[:] = system.initial_state
         state.clock[0] = self.motion.times[0]
         state.ints[engine.PENDING] = engine.INITIAL
+        slots = _slots(self.propagators)
         while True:
-            tables = _tables(self.propagators)
-            if len(state.visited) < len(self.propagators):
-                state = self.state = state._replace(visited=np.resize(state.visited, 2 * len(self.propagators)))
-            status = engine.run_engine(tables, self.plant, state, *self.work)
+            if len(state.visited) < len(slots.modes):
+                state = self.state = state._replace(visited=np.resize(state.visited, 2 * len(slots.modes)))
+            status = engine.run_engine(slots.tables, self.plant, state, *self.work)
             if status == engine.FINISHED:
                 break
             if status == engine.NEED_MODE:
-                self.propagators[vector_mode(state.missing_mode, system.n_contacts)]
+                slots.load(vector_mode(state.missing_mode, system.n_contacts))
             else:  # NEED_SPACE
                 state = self.state = state._replace(impacts=np.concatenate([state.impacts, np.zeros_like(state.impacts)]))
-        return self._recorder(), self._counters(), self._visited()
+        return self._recorder(slots), self._counters(), self._visited(slots)
 
-    def _recorder(self) -> Recorder:
+    def _recorder(self, slots: "_Slots") -> Recorder:
         state = self.state
         recorder = KernelRecorder(self.system, self.motion)
         recorder.states[:] = state.states
         recorder.energy_block[:] = state.energy
         ground = sample_ground(self.motion)
-        built = self.propagators.built()
-        for m in np.unique(state.sample_modes):
-            recorder.sample_at(np.flatnonzero(state.sample_modes == m), built[m][1].dynamics, ground)
+        for i in np.unique(state.sample_modes):
+            recorder.sample_at(np.flatnonzero(state.sample_modes == i), self.propagators.modes[slots.modes[i]], ground)
         recorder.load_impacts(state.impacts[: state.ints[engine.N_IMPACTS]], _open_impacts(state), float(self.motion.times[-1]))
         return recorder
 
@@ -295,9 +295,8 @@ class _CompiledRun:
         ints = self.state.ints
         return EventCounters(total=int(ints[engine.TOTAL]), chatter_cycles=int(ints[engine.CHATTER]), grazing_checks=int(ints[engine.GRAZING]))
 
-    def _visited(self) -> "_VisitedModes":
-        built = self.propagators.built()
-        modes = {built[m][0] for m in np.flatnonzero(self.state.visited[: len(built)])}
+    def _visited(self, slots: "_Slots") -> "_VisitedModes":
+        modes = {slots.modes[i] for i in np.flatnonzero(self.state.visited[: len(slots.modes)])}
         return _VisitedModes(self.propagators.modes, modes)
 
 
@@ -369,28 +368,79 @@ def _run_state(system: System, n_times: int) -> engine.RunState:
     )
 
 
-_TABLES: "weakref.WeakKeyDictionary[PropagatorLibrary, tuple[int, engine.Tables]]" = weakref.WeakKeyDictionary()
+TABLE_BUDGET = 256 * 2**20
+"""Largest size of the engine tables of one library, bytes: beyond it modes take turns in the slots."""
+
+_SLOTS: "weakref.WeakKeyDictionary[PropagatorLibrary, _Slots]" = weakref.WeakKeyDictionary()
 
 
-def _tables(library: PropagatorLibrary) -> engine.Tables:
-    """The engine's stacked arrays of every built mode of ``library`` (rebuilt when modes were added)."""
-    cached = _TABLES.get(library)
-    if cached is not None and cached[0] == len(library):
-        return cached[1]
-    built = library.built()
-    system = library.system
-    n_guards, size = _max_guards(system), 2 * system.n_dof
-    degree = max((propagator.chebyshev.shape[0] for _, propagator in built), default=1)
-    rows = [_mode_rows(mode, propagator, n_guards, degree) for mode, propagator in built]
-    if not rows:
-        rows = [_empty_rows(system, n_guards, degree)]
-    stacked = {name: np.ascontiguousarray(np.stack([row[name] for row in rows])) for name in engine.Tables._fields}
-    if not built:
-        stacked["hashes"][:] = 0
-        stacked["modes"][:] = -9
-    tables = engine.Tables(**stacked)
-    _TABLES[library] = (len(library), tables)
-    return tables
+def _slots(library: PropagatorLibrary) -> "_Slots":
+    """The engine tables of ``library``, shared by its runs."""
+    slots = _SLOTS.get(library)
+    if slots is None:
+        slots = _SLOTS[library] = _Slots(library)
+    return slots
+
+
+class _Slots:
+    """The engine's tables (:class:`engine.Tables`) of a library's modes, one mode per slot.
+
+    The tables grow to :data:`TABLE_BUDGET` bytes (and at least to a settling
+    chain's length); beyond that a new mode takes the slot filled longest ago,
+    and the mode it held is loaded again if the engine asks for it. Every
+    mode keeps one id (``modes[id]``): the engine records ids per sample.
+    """
+
+    def __init__(self, library: PropagatorLibrary) -> None:
+        self.library = library
+        self.modes: list[Mode] = []
+        self._ids: dict[Mode, int] = {}
+        self._resident: list[Mode] = []
+        self._oldest = 0
+        self._n_guards = _max_guards(library.system)
+        self.tables = self._empty(1, 1)
+        row_bytes = sum(np.asarray(value).nbytes for value in _empty_rows(library.system, self._n_guards, CHEBYSHEV_DEGREE + 1).values())
+        self._capacity = max(MAX_SETTLE_ITERATIONS + 2, TABLE_BUDGET // row_bytes)
+
+    def load(self, mode: Mode) -> None:
+        """Put ``mode`` into a slot."""
+        propagator = self.library[mode]
+        mode_id = self._ids.setdefault(mode, len(self._ids))
+        if mode_id == len(self.modes):
+            self.modes.append(mode)
+        filled = len(self._resident)
+        if filled < self._capacity:
+            slot = filled
+            self._resident.append(mode)
+        else:
+            slot, self._oldest = self._oldest, (self._oldest + 1) % filled
+            self._resident[slot] = mode
+        degree = max(self.tables.chebyshev.shape[1], len(propagator.chebyshev))
+        self._grow(slot + 1, degree)
+        rows = _mode_rows(mode, propagator, self._n_guards, degree)
+        rows["ids"] = np.int64(mode_id)
+        for name in engine.Tables._fields:
+            getattr(self.tables, name)[slot] = rows[name]
+
+    def _grow(self, slots: int, degree: int) -> None:
+        """Make room for ``slots`` slots and ``degree`` Chebyshev terms, keeping the filled slots."""
+        tables = self.tables
+        if slots <= len(tables.hashes) and degree <= tables.chebyshev.shape[1]:
+            return
+        grown = self._empty(max(len(tables.hashes), min(self._capacity, 2 * slots)), degree)
+        for old, new in zip(tables, grown):
+            if old.ndim > 1:
+                new[: len(old), : old.shape[1]] = old
+            else:
+                new[: len(old)] = old
+        self.tables = grown
+
+    def _empty(self, size: int, degree: int) -> engine.Tables:
+        """Tables of ``size`` empty slots (never matched: invalid mode vectors)."""
+        rows = _empty_rows(self.library.system, self._n_guards, degree)
+        tables = engine.Tables(**{name: np.zeros((size,) + np.shape(rows[name]), np.asarray(rows[name]).dtype) for name in engine.Tables._fields})
+        tables.modes[:] = -9
+        return tables
 
 
 def _mode_rows(mode: Mode, propagator: ModePropagator, n_guards: int, degree: int) -> dict[str, np.ndarray]:
@@ -417,10 +467,10 @@ def _mode_rows(mode: Mode, propagator: ModePropagator, n_guards: int, degree: in
 
 
 def _empty_rows(system: System, n_guards: int, degree: int) -> dict[str, np.ndarray]:
-    """Placeholder row of a library with no mode built yet (never matched: its hash and mode are invalid)."""
+    """An empty slot's row (never matched: its hash and mode are invalid)."""
     size, width, n_contacts, n_buildings = 2 * system.n_dof, 2 * system.n_dof + 5, system.n_contacts, len(system.base_dofs)
     return {
-        "hashes": np.int64(0), "modes": np.full(n_contacts + n_buildings, -9, dtype=np.int64), "A": np.zeros((size, size)),
+        "hashes": np.int64(0), "modes": np.full(n_contacts + n_buildings, -9, dtype=np.int64), "ids": np.int64(0), "A": np.zeros((size, size)),
         "B": np.zeros(size), "c": np.zeros(size), "G": np.zeros((n_guards, size)), "gh": np.zeros(n_guards),
         "g0": np.zeros(n_guards), "kind": np.zeros(n_guards, np.int64), "target": np.zeros(n_guards, np.int64),
         "direction": np.zeros(n_guards, np.int64), "n_guards": np.int64(0), "F": np.zeros((n_contacts, size)),

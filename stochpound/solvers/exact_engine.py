@@ -54,7 +54,7 @@ from stochpound.solvers.exact_kernel import (
 
 Tables = namedtuple(
     "Tables",
-    "hashes modes A B c G gh g0 kind target direction n_guards F f0 Fr frg frc transition nodes chebyshev substeps step",
+    "hashes modes ids A B c G gh g0 kind target direction n_guards F f0 Fr frg frc transition nodes chebyshev substeps step",
 )
 Plant = namedtuple(
     "Plant",
@@ -724,9 +724,9 @@ def run_engine(tables, plant, run, scratch, saved):
             _on_transitions(tables, plant, run, m, run.clock[0], x, transitions, n_transitions)
             run.x[:] = x
             run.ints[MODE] = m
-            run.visited[m] = True
+            run.visited[tables.ids[m]] = True
             if run.ints[PENDING] == INITIAL:
-                run.states[0], run.energy[:, 0], run.sample_modes[0] = run.x, run.running, m
+                run.states[0], run.energy[:, 0], run.sample_modes[0] = run.x, run.running, tables.ids[m]
             run.ints[PENDING] = NONE
         k = run.ints[K]
         if k < times.shape[0] - 1 and run.clock[0] == times[k]:  # the fast path over quiet intervals
@@ -742,7 +742,7 @@ def run_engine(tables, plant, run, scratch, saved):
                 run.is_open, run.impact_impulse, run.impact_peak, run.impact_peak_time, run.running,
                 run.states, run.energy, scratch, saved,
             )
-            run.sample_modes[run.ints[K] + 1 : k + 1] = m
+            run.sample_modes[run.ints[K] + 1 : k + 1] = tables.ids[m]
             run.ints[K] = k
             run.clock[0] = times[k]
         if k >= times.shape[0] - 1:
@@ -758,4 +758,4 @@ def run_engine(tables, plant, run, scratch, saved):
             continue
         run.clock[0] = t_end
         run.ints[K] = k + 1
-        run.states[k + 1], run.energy[:, k + 1], run.sample_modes[k + 1] = run.x, run.running, run.ints[MODE]
+        run.states[k + 1], run.energy[:, k + 1], run.sample_modes[k + 1] = run.x, run.running, tables.ids[run.ints[MODE]]
