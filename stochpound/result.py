@@ -2,6 +2,10 @@
 
 Outputs are given at the motion's sample times, t = 0 included. Every
 variable carries ``units`` and ``long_name`` (CF conventions).
+
+Every array is built with numpy first and the dataset is assembled directly
+from its variables (:func:`_assemble`): xarray's usual construction converts,
+aligns and merges every variable, which would cost more than a whole exact run.
 """
 
 from __future__ import annotations
@@ -12,7 +16,9 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import pandas as pd
 import xarray as xr
+from xarray.indexes import PandasIndex
 
 from stochpound import __version__
 from stochpound.events import EventCounters
@@ -20,9 +26,16 @@ from stochpound.recorder import ENERGY_TERMS, Recorder
 from stochpound.scene import Scene
 from stochpound.system import System
 
+_ENERGY_NAMES = {
+    "input": "work of the ground-acceleration load (relative-motion input energy)",
+    "damping": "energy dissipated by the storey dashpots",
+    "friction": "energy dissipated by base friction",
+    "impact": "work absorbed by the impact elements (dissipated, plus stored while closed)",
+}
 
-def _var(dims, data, units: str, long_name: str, **attrs: Any) -> xr.Variable:
-    return xr.Variable(dims, data, attrs={"units": units, "long_name": long_name, **attrs})
+
+def _var(dims: tuple[str, ...], data: np.ndarray, units: str, long_name: str, **attrs: Any) -> xr.Variable:
+    return xr.Variable(dims, data, {"units": units, "long_name": long_name, **attrs}, fastpath=True)
 
 
 def build_dataset(scene: Scene, system: System, recorder: Recorder, counters: EventCounters, solver_attrs: dict[str, Any]) -> xr.Dataset:
@@ -36,38 +49,17 @@ def build_dataset(scene: Scene, system: System, recorder: Recorder, counters: Ev
     solver_attrs : dict
         Solver name and settings, stored as attributes.
     """
-    n = system.n_dof
-    q = recorder.states[:, :n]
-    n_times, n_buildings, n_floors = len(scene.motion.times), len(scene.buildings), scene.max_floors
-    relative = np.full((n_buildings, n_floors, n_times), np.nan)
-    sliding = np.zeros((n_buildings, n_times))
-    for b, building in enumerate(scene.buildings):
-        relative[b, : building.n_floors] = q[:, system.floor_dofs[b]].T
-        if system.base_dofs[b] >= 0:
-            sliding[b] = q[:, system.base_dofs[b]]
-    total = relative + sliding[:, None, :]
-    data_vars = {
-        "total_displacement": _var(("building", "floor", "time"), total, "m", "floor displacement relative to the ground (y = s + u)"),
-        "relative_displacement": _var(("building", "floor", "time"), relative, "m", "floor displacement relative to the building's base (u)"),
-        "sliding_displacement": _var(("building", "time"), sliding, "m", "sliding displacement of the base relative to the ground (s)"),
-        "ground_acceleration": _var(("time",), scene.motion.at_times(), "m s-2", "ground acceleration a_g"),
-        "impact_force": _var(("contact", "time"), recorder.forces.T, "N", "contact force, positive in compression (0 while open)"),
-        "base_friction_force": _var(
-            ("building", "time"), recorder.friction.T, "N", "force of the foundation on the base, positive to the right (0 for a fixed base)"
-        ),
-        "base_state": _var(
-            ("building", "time"), recorder.base_states.T, "1", "base state",
-            flag_values=np.array([-1, 0, 1], dtype=np.int8), flag_meanings="slipping_left stuck_or_fixed slipping_right",
-        ),
-        **_contact_variables(scene),
-        **_impact_variables(recorder),
-        **_energy_variables(recorder),
-    }
     coords = {
         "time": _var(("time",), scene.motion.times, "s", "time"),
         "building": _var(("building",), np.array(scene.building_names, dtype=object), "1", "building name, left to right"),
-        "floor": _var(("floor",), np.arange(1, n_floors + 1), "1", "floor number, 1 = lowest"),
+        "floor": _var(("floor",), np.arange(1, scene.max_floors + 1), "1", "floor number, 1 = lowest"),
         "contact": _var(("contact",), np.arange(len(scene.contacts)), "1", "contact index"),
+    }
+    data_vars = {
+        **_response_variables(scene, system, recorder),
+        **_contact_variables(scene),
+        **_impact_variables(recorder),
+        **_energy_variables(recorder),
     }
     attrs = {
         "title": "stochpound simulation",
@@ -80,7 +72,51 @@ def build_dataset(scene: Scene, system: System, recorder: Recorder, counters: Ev
         **solver_attrs,
         **counters.as_attrs(),
     }
-    return xr.Dataset(data_vars, coords=coords, attrs=attrs)
+    return _assemble(coords, data_vars, attrs)
+
+
+def _assemble(coords: dict[str, xr.Variable], data_vars: dict[str, xr.Variable], attrs: dict[str, Any]) -> xr.Dataset:
+    """The dataset of dimension coordinates ``coords`` (with default indexes) and ``data_vars``, consistent by construction.
+
+    The same dataset as ``xr.Dataset(data_vars, coords=coords, attrs=attrs)``
+    (checked by the tests), without the conversion, alignment and merge of
+    every variable (the indexes are built from :class:`pandas.Index` objects,
+    which also spares xarray's check for dask arrays, and its import of dask).
+    """
+    indexes = {name: PandasIndex(pd.Index(variable.values, dtype=variable.dtype), name, coord_dtype=variable.dtype) for name, variable in coords.items()}
+    variables = {name: indexes[name].create_variables({name: variable})[name] for name, variable in coords.items()}
+    variables.update(data_vars)
+    dims: dict[str, int] = {}
+    for variable in variables.values():
+        dims.update(zip(variable.dims, variable.shape))
+    return xr.Dataset._construct_direct(variables, set(coords), dims, attrs, indexes)
+
+
+def _response_variables(scene: Scene, system: System, recorder: Recorder) -> dict[str, xr.Variable]:
+    """Displacements, ground acceleration, contact and friction forces and base states at the samples."""
+    q = recorder.states[:, : system.n_dof]
+    n_times, n_buildings, n_floors = len(scene.motion.times), len(scene.buildings), scene.max_floors
+    relative = np.full((n_buildings, n_floors, n_times), np.nan)
+    sliding = np.zeros((n_buildings, n_times))
+    for b, building in enumerate(scene.buildings):
+        relative[b, : building.n_floors] = q[:, system.floor_dofs[b]].T
+        if system.base_dofs[b] >= 0:
+            sliding[b] = q[:, system.base_dofs[b]]
+    return {
+        "total_displacement": _var(("building", "floor", "time"), relative + sliding[:, None, :], "m",
+                                   "floor displacement relative to the ground (y = s + u)"),
+        "relative_displacement": _var(("building", "floor", "time"), relative, "m", "floor displacement relative to the building's base (u)"),
+        "sliding_displacement": _var(("building", "time"), sliding, "m", "sliding displacement of the base relative to the ground (s)"),
+        "ground_acceleration": _var(("time",), np.asarray(scene.motion.at_times(), float), "m s-2", "ground acceleration a_g"),
+        "impact_force": _var(("contact", "time"), recorder.forces.T, "N", "contact force, positive in compression (0 while open)"),
+        "base_friction_force": _var(
+            ("building", "time"), recorder.friction.T, "N", "force of the foundation on the base, positive to the right (0 for a fixed base)"
+        ),
+        "base_state": _var(
+            ("building", "time"), recorder.base_states.T, "1", "base state",
+            flag_values=np.array([-1, 0, 1], dtype=np.int8), flag_meanings="slipping_left stuck_or_fixed slipping_right",
+        ),
+    }
 
 
 def _contact_variables(scene: Scene) -> dict[str, xr.Variable]:
@@ -122,13 +158,7 @@ def _impact_variables(recorder: Recorder) -> dict[str, xr.Variable]:
 def _energy_variables(recorder: Recorder) -> dict[str, xr.Variable]:
     kinetic, strain = recorder.kinetic_and_strain()
     energy = recorder.energy
-    names = {
-        "input": "work of the ground-acceleration load (relative-motion input energy)",
-        "damping": "energy dissipated by the storey dashpots",
-        "friction": "energy dissipated by base friction",
-        "impact": "work absorbed by the impact elements (dissipated, plus stored while closed)",
-    }
-    variables = {f"energy_{term}": _var(("time",), energy[term], "J", names[term]) for term in ENERGY_TERMS}
+    variables = {f"energy_{term}": _var(("time",), energy[term], "J", _ENERGY_NAMES[term]) for term in ENERGY_TERMS}
     variables["energy_kinetic"] = _var(("time",), kinetic, "J", "kinetic energy of the motion relative to the ground")
     variables["energy_strain"] = _var(("time",), strain, "J", "strain energy of storeys and base restoring springs")
     residual = energy["input"] - (kinetic - kinetic[0]) - (strain - strain[0]) - energy["damping"] - energy["friction"] - energy["impact"]

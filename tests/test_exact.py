@@ -217,3 +217,31 @@ def test_compiled_engine_matches_the_shared_python_event_code(name):
         np.testing.assert_allclose([a.peak_force, a.impulse], [b.peak_force, b.impulse], rtol=1e-9)
     for term in compiled.energy:
         np.testing.assert_allclose(compiled.energy[term], python.energy[term], rtol=1e-9, atol=1e-6)
+
+
+def test_engine_compiles_every_function_once():
+    """Each jitted function of the engine has one specialisation (two for _copy: float and int arrays).
+
+    A compile-time constant passed to a helper, or arrays of another layout,
+    would compile it again (numba's first-call compile time). Vacuous when
+    the engine was loaded from numba's cache.
+    """
+    from numba.core.registry import CPUDispatcher
+
+    from stochpound.solvers import exact_engine
+
+    stochpound.simulate(stochpound.scene_from_dict(HARD_CASES["non-tensile contacts, both isolated"]))
+    for name, function in vars(exact_engine).items():
+        if isinstance(function, CPUDispatcher):
+            assert len(function.signatures) <= (2 if name == "_copy" else 1), name
+
+
+def test_result_dataset_is_the_one_xarray_would_build():
+    """The dataset assembled directly from its variables equals xarray's own construction (indexes included)."""
+    import xarray as xr
+
+    result = stochpound.simulate(stochpound.scene_from_dict(study_scene(0.2, None, 2.0, motion={"record": "el_centro_1940_study", "duration": 5.0})))
+    coords = {name: result.variables[name].to_base_variable() for name in result.coords}
+    rebuilt = xr.Dataset({name: result.variables[name] for name in result.data_vars}, coords=coords, attrs=result.attrs)
+    xr.testing.assert_identical(result, rebuilt)
+    assert {name: type(index) for name, index in result.xindexes.items()} == {name: type(index) for name, index in rebuilt.xindexes.items()}

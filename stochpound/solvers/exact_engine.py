@@ -16,18 +16,45 @@ logic, which stays the specification:
   5-point Gauss–Legendre quadrature, impulses, located peak forces),
   ``on_transitions`` and ``on_contact_force``.
 
-``tests/test_exact.py`` checks that this path and the Python event path
-(``run_exact(..., events="python")``, which calls the shared code itself)
-give the same events and the same answer on the hard cases.
+Most sample intervals have no event: :func:`_advance_quiet` advances them
+with the exact sub-step propagator, screening every sub-step exactly as
+``first_crossing`` would, and stops (rolled back to the start of the
+interval) at the first interval in which a guard is suspected to cross or an
+impact force has an interior maximum. Only the event code judges events; the
+quiet loop decides nothing it would decide differently.
 
-Modes are int64 vectors [closed flags of every contact, state of every base]
-and are found in the table of built modes by hash. All arrays are grouped in
-three named tuples: :class:`Tables` (one row per built mode),
-:class:`Plant` (system and motion) and :class:`RunState` (everything the run
-changes, so that a call can stop for a missing mode and resume). Only the
-top-level functions take them; helpers take the few arrays they use, or a
-:class:`Flow` (one mode's dense flow inside one step), which keeps numba's
-compile time down (a named tuple of arrays is flattened into every signature).
+``tests/test_exact.py`` checks that this engine and the Python event path
+(``run_exact(..., events="python")``, which runs only the quiet loop here and
+calls the shared code for every other interval) give the same events and the
+same answer on the hard cases.
+
+Data. Modes are int64 vectors [closed flags of every contact, state of every
+base]. Every linear read-out of a mode is an *affine map*, an array whose
+row i gives ``row[:S] · x + row[S] a_g + row[S + 1]`` (S = 2N): ``rate``
+(ẋ = A x + B a_g + c), ``guard`` (G x + h a_g + g0) and ``force`` (contact
+forces, no a_g term), summed in the order of the Python code. The powers of
+the energy balance are quadratic forms of the augmented state z = [x, w, 1]
+(``exact._power_forms``), and their 5-point Gauss–Legendre integrals over a
+whole sub-step are quadratic forms of z(t0) (``exact._sub_step_forms``).
+The arrays are grouped in small named tuples: :class:`ModeTable`,
+:class:`Dynamics` and :class:`Propagators` (one row per slot of modes),
+:class:`Motion` and :class:`Layout` (the plant), :class:`Run`,
+:class:`Arming`, :class:`Impacts` and :class:`Outputs` (everything a run
+changes, so that a call can stop for a missing mode and resume).
+
+Compile time (``cache=True``: once per machine). numba compiles every jitted
+function on its own and then again inside each caller, spends about as much
+on each source line as on each optimised LLVM line, copies every field of a
+named tuple wherever one is bound or passed, and inlines (``inline="always"``)
+at a high cost per call site. So :func:`run_engine` is the only entry point:
+it unpacks the named tuples once and inlines its three phases
+(:func:`_settle_pending`, :func:`_advance_quiet`, :func:`_advance_span`),
+which take arrays; the helpers take the few arrays they use, are compiled
+once without Python wrappers (:data:`INTERNAL`) and are inlined by LLVM; no
+compile-time constant is passed to a helper (it would compile a second
+specialisation), and no array is assigned to an array slice (its error
+message alone compiles string formatting). All jitted code lives in this one
+module, whose source stamp is what invalidates numba's cache.
 """
 
 from __future__ import annotations
@@ -40,89 +67,344 @@ from numba import njit
 
 from stochpound.events import FIRE_THRESHOLD, MAX_SETTLE_ITERATIONS, ROUND_OFF, TIME_TOLERANCE
 from stochpound.modes import STUCK, Guard
-from stochpound.solvers.exact_kernel import (
-    _force_rate,
-    _guards_and_rates,
-    _interior_maximum,
-    _matvec,
-    _quadrature,
-    _suspect,
-    add_power,
-    advance_quiet,
-    arm_where_negative,
-)
+from stochpound.propagators import GAUSS_NODES, GAUSS_WEIGHTS
 
-Tables = namedtuple(
-    "Tables",
-    "hashes modes ids A B c G gh g0 kind target direction n_guards F f0 Fr frg frc transition nodes chebyshev substeps step",
-)
-Plant = namedtuple(
-    "Plant",
-    "n_dof geometry gap load tensile damping influence base_dofs left_rows right_rows times forcing coefficients harmonic "
-    "gauss_nodes gauss_weights",
-)
-RunState = namedtuple(
-    "RunState",
-    "clock ints x pending_x pending_mode missing_mode threshold tolerance rearmable disarmed "
-    "is_open impact_start impact_onset impact_in_phase impact_peak impact_peak_time impact_impulse "
-    "impacts running states energy sample_modes visited",
-)
+INTERNAL = {"no_cpython_wrapper": True, "no_cfunc_wrapper": True, "error_model": "numpy"}
+"""Options of the jitted helpers, called only from compiled code."""
 
-Flow = namedtuple("Flow", "A B c G gh g0 F f0 coefficients t0 scale k times motion harmonic")
+ModeTable = namedtuple("ModeTable", "modes ids codes n_guards substeps")
+ModeTable.__doc__ = """The modes in the table's slots: mode vector (invalid in an empty slot), the mode's id (kept
+when it changes slot, recorded per sample), guard codes (rows KIND, TARGET, DIRECTION; padded), number of guards
+and of sub-steps per sample interval."""
+Dynamics = namedtuple("Dynamics", "rate guard force power")
+Dynamics.__doc__ = """The slots' modes' affine maps of ẋ, the guards (padded) and the contact forces, and its power forms.
 
-# ints of RunState
+``power[m]`` stacks the quadratic forms P of the input, damping, friction and
+impact powers, zᵀ P z at z = [x, a_g, 0, 0, 0, 1], transposed (Z × 4Z)
+(``exact._power_forms``).
+"""
+Propagators = namedtuple("Propagators", "propagate chebyshev step")
+Propagators.__doc__ = """Exact sub-step propagators of the slots' modes.
+
+``propagate[m]`` is [exp(𝒜h); Q_input; Q_damping; Q_friction; Q_impact; R]
+transposed (Z × (5Z + n_contacts)): one product of z(t0) gives z(t0 + h),
+Q z(t0) of every energy term (whose gain over the sub-step is z(t0) · Q z(t0))
+and the impulses R z(t0) (``exact._sub_step_forms``). ``chebyshev[m]`` is the
+Chebyshev expansion of the flow on a sub-step of length ``step[m]``,
+transposed (Z × D·2N).
+"""
+Motion = namedtuple("Motion", "times forcing coefficients harmonic")
+Motion.__doc__ = """Output times, exosystem state per interval, cubic per interval (sampled) or [A, ω, φ] (harmonic)."""
+Layout = namedtuple("Layout", "geometry gap tensile left_rows right_rows base_dofs")
+Layout.__doc__ = """Contacts (penetration rows, gaps, tensile flags, rows of the left and right floors) and the base DOFs."""
+Run = namedtuple("Run", "clock ints x pending_x pending_mode missing_mode visited")
+Run.__doc__ = """Time, counters (``ints``; ``ints[MODE]`` is a slot), state, the pending event and the ids of the modes visited."""
+Arming = namedtuple("Arming", "threshold tolerance rearmable disarmed")
+Arming.__doc__ = """Arming of the current mode's guards (:class:`stochpound.events.GuardStates`)."""
+Impacts = namedtuple("Impacts", "is_open impact table")
+Impacts.__doc__ = """Open impacts (``impact[row, contact]``, rows START … IMPULSE) and the table of finished ones."""
+Outputs = namedtuple("Outputs", "running states energy sample_modes")
+Outputs.__doc__ = """Running energy terms, and the state, energy terms and mode id at every output time."""
+Flow = namedtuple("Flow", "rate guard force coefficients ground origin harmonic t0 scale")
+Flow.__doc__ = """One mode's flow inside one step: its affine maps and the Chebyshev coefficients of x(t).
+
+``ground`` is the interval's cubic of a_g(t − origin) (sampled motions) or
+[amplitude, ω, phase] (``harmonic``); the step starts at t0 and
+``scale`` = 2 / h maps it onto [−1, 1].
+"""
+
+# entries of Run.ints
 K, MODE, PENDING, FIRED_KIND, FIRED_TARGET, FIRED_DIRECTION, N_IMPACTS, TOTAL, CHATTER, GRAZING = range(10)
 N_INTS = 10
+# rows of ModeTable.codes
+KIND, TARGET, DIRECTION = range(3)
+# rows of Impacts.impact
+START, ONSET, IN_PHASE, PEAK, PEAK_TIME, IMPULSE = range(6)
 # pending settles
 NONE, INITIAL, EVENT = 0, 1, 2
 # statuses returned to Python
-FINISHED, NEED_MODE, NEED_SPACE = 0, 1, 2
-# impact table columns
-IMPACT_COLUMNS = ("contact", "start", "end", "onset_velocity", "in_phase", "peak_force", "peak_time", "impulse", "complete")
+FINISHED, NEED_MODE, NEED_SPACE, NEEDS_EVENTS = 0, 1, 2, 3
+# columns of Impacts.table (finished impacts): contact, end, then the rows of Impacts.impact
+IMPACT_COLUMNS = ("contact", "end", "start", "onset_velocity", "in_phase", "peak_force", "peak_time", "impulse")
+N_NODES = 5
+"""Gauss–Legendre nodes of the energy quadrature."""
 
 _CLOSE, _RECLOSE, _OPEN, _SLIP, _STOP = int(Guard.CLOSE), int(Guard.RECLOSE), int(Guard.OPEN), int(Guard.SLIP), int(Guard.STOP)
 _STUCK = STUCK
 _ROUND_OFF, _FIRE_RATIO, _XTOL, _MAX_SETTLE = ROUND_OFF, FIRE_THRESHOLD / ROUND_OFF, TIME_TOLERANCE, MAX_SETTLE_ITERATIONS
 _RTOL = 4 * np.finfo(float).eps
-_INPUT, _DAMPING, _FRICTION, _IMPACT = 0, 1, 2, 3
-_GUARD, _FORCE_RATE = 0, 1
+_EPS = 2 * np.finfo(float).eps
 
 
-# ---------------------------------------------------------------- modes
+def work_arrays(size: int, n_guards: int, n_contacts: int) -> tuple[np.ndarray, np.ndarray]:
+    """``scratch`` and ``saved`` work arrays of :func:`run_engine` for state size ``size`` (2N)."""
+    width = size + 5
+    return np.zeros((7, max(5 * width + n_contacts, n_guards))), np.zeros((6, max(4, n_contacts, n_guards)))
 
 
-@njit(cache=True)
-def mode_hash(mode):
-    """64-bit FNV-1a hash of a mode vector."""
-    value = np.uint64(14695981039346656037)
-    for entry in mode:
-        value = (value ^ np.uint64(entry + 3)) * np.uint64(1099511628211)
-    return np.int64(value)
+# ---------------------------------------------------------------- linear algebra and read-outs
 
 
-@njit(cache=True)
-def _lookup(hashes, modes, mode):
-    """Index of ``mode`` among the built modes, or −1."""
-    key = mode_hash(mode)
-    for i in range(hashes.shape[0]):
-        if hashes[i] == key and _same(modes[i], mode):
-            return i
-    return -1
+@njit(**INTERNAL)
+def _copy(source, target):
+    """target[i] = source[i] for every i of target."""
+    for i in range(target.shape[0]):
+        target[i] = source[i]
 
 
-@njit(cache=True, inline="always")
-def _same(a, b):
-    """Element-wise equality of two mode vectors."""
-    for i in range(a.shape[0]):
-        if a[i] != b[i]:
-            return False
-    return True
+@njit(**INTERNAL)
+def _product(transposed, vector, out):
+    """out = Mᵀ vector for M = ``transposed``: a column at a time (vectorised; the sums of row dot products)."""
+    for i in range(out.shape[0]):
+        out[i] = 0.0
+    for j in range(vector.shape[0]):
+        value = vector[j]
+        for i in range(out.shape[0]):
+            out[i] += transposed[j, i] * value
+
+
+@njit(**INTERNAL)
+def _affine(M, i, x, ground):
+    """Row i of the affine map M at (x, a_g): M[i, S] a_g + M[i, S + 1] + M[i, :S] · x."""
+    size = M.shape[1] - 2
+    total = M[i, size] * ground + M[i, size + 1]
+    for j in range(size):
+        total += M[i, j] * x[j]
+    return total
+
+
+@njit(**INTERNAL)
+def _force(force, p, x):
+    """Contact force p (no a_g term): force[p, S + 1] + force[p, :S] · x."""
+    size = force.shape[1] - 2
+    total = force[p, size + 1]
+    for j in range(size):
+        total += force[p, j] * x[j]
+    return total
+
+
+@njit(**INTERNAL)
+def _force_rate(force, p, rate, x, ground):
+    """Rate of contact force p: force[p, :S] · ẋ."""
+    total = 0.0
+    for i in range(rate.shape[0]):
+        total += force[p, i] * _affine(rate, i, x, ground)
+    return total
+
+
+@njit(**INTERNAL)
+def _guards_and_rates(rate, guard, x, ground, ground_rate, values, rates, work):
+    """Values of the first len(values) guards and their rates G ẋ + h ȧ_g (ẋ into ``work``)."""
+    size = rate.shape[0]
+    for i in range(size):
+        work[i] = _affine(rate, i, x, ground)
+    for g in range(values.shape[0]):
+        value = guard[g, size] * ground + guard[g, size + 1]
+        slope = guard[g, size] * ground_rate
+        for j in range(size):
+            value += guard[g, j] * x[j]
+            slope += guard[g, j] * work[j]
+        values[g] = value
+        rates[g] = slope
+
+
+@njit(**INTERNAL)
+def _add_forms(z, products, weight, running):
+    """running[term] += weight × zᵀ Pₜ z for the four power forms, from products = [P₀ z, P₁ z, P₂ z, P₃ z]."""
+    width = z.shape[0]
+    for term in range(running.shape[0]):
+        value = 0.0
+        for j in range(width):
+            value += z[j] * products[term * width + j]
+        running[term] += weight * value
+
+
+@njit(**INTERNAL)
+def _sub_step_energy(z0, propagated, is_open, impulse, running):
+    """Add a full sub-step's energy terms and impulses from ``propagated`` = ``propagate[m]`` z(t0) (see :class:`Propagators`).
+
+    The energy gains are z(t0) · Q z(t0), as :func:`_add_forms` (written out: this is the quiet loop's hot path).
+    """
+    width = z0.shape[0]
+    for term in range(running.shape[0]):
+        start = (term + 1) * width
+        gain = 0.0
+        for j in range(width):
+            gain += z0[j] * propagated[start + j]
+        running[term] += gain
+    for p in range(is_open.shape[0]):
+        if is_open[p]:
+            impulse[p] += propagated[5 * width + p]
+
+
+@njit(**INTERNAL)
+def _any(flags):
+    """True if some flag is set."""
+    for flag in flags:
+        if flag:
+            return True
+    return False
+
+
+@njit(**INTERNAL)
+def _offer_peaks(force, is_open, impact, t, x):
+    """Offer the contact forces at (t, x) as peaks of the open impacts."""
+    for p in range(is_open.shape[0]):
+        if is_open[p]:
+            value = _force(force, p, x)
+            if value > impact[PEAK, p]:
+                impact[PEAK, p], impact[PEAK_TIME, p] = value, t
+
+
+@njit(**INTERNAL)
+def _record_sample(x, running, mode_id, states, energy, sample_modes, k):
+    """Store the state, the energy terms and the mode's id at output time k."""
+    _copy(x, states[k])
+    for term in range(running.shape[0]):
+        energy[term, k] = running[term]
+    sample_modes[k] = mode_id
+
+
+# ---------------------------------------------------------------- guard screen
+
+
+@njit(**INTERNAL)
+def _interior_maximum(a0, a1, a2, a3):
+    """Largest value of the cubic a0 + a1 τ + a2 τ² + a3 τ³ at its critical points inside (0, 1), −inf if none."""
+    best = -math.inf
+    if a3 != 0.0:
+        discriminant = 4.0 * a2 * a2 - 12.0 * a3 * a1
+        if discriminant >= 0.0:
+            root = math.sqrt(discriminant)
+            tau = (-2.0 * a2 + root) / (6.0 * a3)
+            if 0.0 < tau < 1.0:
+                best = max(best, a0 + tau * (a1 + tau * (a2 + tau * a3)))
+            tau = (-2.0 * a2 - root) / (6.0 * a3)
+            if 0.0 < tau < 1.0:
+                best = max(best, a0 + tau * (a1 + tau * (a2 + tau * a3)))
+    elif a2 != 0.0:
+        tau = -a1 / (2.0 * a2)
+        if 0.0 < tau < 1.0:
+            best = max(best, a0 + tau * (a1 + tau * (a2 + tau * a3)))
+    return best
+
+
+@njit(**INTERNAL)
+def _suspect(values0, values1, rates0, rates1, h, threshold, tolerance):
+    """True when first_crossing would examine some guard of this sub-step."""
+    for g in range(values0.shape[0]):
+        if not abs(threshold[g]) < math.inf:
+            continue
+        if values1[g] >= 0.0:
+            return True
+        a0, a1 = values0[g], rates0[g] * h
+        a2 = 3.0 * (values1[g] - values0[g]) - (2.0 * rates0[g] + rates1[g]) * h
+        a3 = 2.0 * (values0[g] - values1[g]) + (rates0[g] + rates1[g]) * h
+        margin = 1e-3 * (abs(values0[g]) + abs(values1[g]) + abs(a1) + abs(rates1[g] * h)) + tolerance[g]
+        if _interior_maximum(a0, a1, a2, a3) >= -margin:
+            return True
+    return False
+
+
+@njit(**INTERNAL)
+def _arm_where_negative(values, threshold, tolerance, rearmable, disarmed):
+    """``GuardStates.arm_where_negative``: arm the disarmed guards that went below −tolerance."""
+    for g in range(values.shape[0]):
+        if disarmed[g] and rearmable[g] and values[g] < -tolerance[g]:
+            threshold[g] = 0.0
+            disarmed[g] = False
+
+
+@njit(**INTERNAL)
+def _peaks(rate, force, is_open, impact, x0, a0, t0, x1, a1, t1):
+    """Offer the end-point forces as peaks; True if some open impact has a force maximum inside."""
+    _offer_peaks(force, is_open, impact, t0, x0)
+    _offer_peaks(force, is_open, impact, t1, x1)
+    for p in range(is_open.shape[0]):
+        if is_open[p] and _force_rate(force, p, rate, x0, a0) > 0.0 > _force_rate(force, p, rate, x1, a1):
+            return True
+    return False
+
+
+# ---------------------------------------------------------------- the quiet loop
+
+
+@njit(**INTERNAL)
+def _save(saved, running, impact, threshold, disarmed):
+    """Copy the running totals, the open impacts' peaks and impulses and the guard arming into the rows of ``saved``."""
+    for i in range(running.shape[0]):
+        saved[0, i] = running[i]
+    for p in range(impact.shape[1]):
+        saved[1, p], saved[2, p], saved[3, p] = impact[PEAK, p], impact[PEAK_TIME, p], impact[IMPULSE, p]
+    for g in range(threshold.shape[0]):
+        saved[4, g], saved[5, g] = threshold[g], 1.0 if disarmed[g] else 0.0
+
+
+@njit(**INTERNAL)
+def _restore(saved, running, impact, threshold, disarmed):
+    """Undo everything since :func:`_save`."""
+    for i in range(running.shape[0]):
+        running[i] = saved[0, i]
+    for p in range(impact.shape[1]):
+        impact[PEAK, p], impact[PEAK_TIME, p], impact[IMPULSE, p] = saved[1, p], saved[2, p], saved[3, p]
+    for g in range(threshold.shape[0]):
+        threshold[g], disarmed[g] = saved[4, g], saved[5, g] != 0.0
+
+
+@njit(inline="always", error_model="numpy")
+def _advance_quiet(mode_id, n, substeps, propagate, rate, guard, force, times, forcing, ints, clock, x, arming, is_open, impact,
+                   outputs, scratch, saved):
+    """Advance the current mode (its id, n guards and arrays) from interval ``ints[K]`` until an interval needs the event code.
+
+    Does for every sub-step what the event code does for a step without event:
+    the guard screen of ``first_crossing`` and the re-arming of guards, the
+    energy terms, impulses and end-point peak forces of ``Recorder.on_step``.
+    Every completed interval k is recorded at output time k + 1;
+    ``ints[K]``, ``clock`` and ``x`` are left at the start of the interval
+    where the loop stopped (or at the end of the motion).
+    """
+    threshold, tolerance, rearmable, disarmed = arming
+    running, states, energy, sample_modes = outputs
+    size = x.shape[0]
+    width = size + 5
+    z0, propagated, work = scratch[0, :width], scratch[1, : propagate.shape[1]], scratch[2, :size]
+    z1, x0, x1 = propagated[:width], z0[:size], propagated[:size]
+    values0, values1, rates0, rates1 = scratch[3, :n], scratch[4, :n], scratch[5, :n], scratch[6, :n]
+    any_open = _any(is_open)
+    for k in range(ints[K], forcing.shape[0]):
+        h = (times[k + 1] - times[k]) / substeps
+        _save(saved, running, impact, threshold, disarmed)
+        _copy(x, x0)
+        _copy(forcing[k], z0[size : size + 4])
+        z0[width - 1] = 1.0
+        _guards_and_rates(rate, guard, x0, z0[size], z0[size + 1], values0, rates0, work)
+        for j in range(substeps):
+            _product(propagate, z0, propagated)
+            t0 = times[k] + j * h
+            t1 = times[k + 1] if j == substeps - 1 else t0 + h
+            _guards_and_rates(rate, guard, x1, z1[size], z1[size + 1], values1, rates1, work)
+            if _suspect(values0, values1, rates0, rates1, h, threshold, tolerance) or (
+                any_open and _peaks(rate, force, is_open, impact, x0, z0[size], t0, x1, z1[size], t1)
+            ):
+                _restore(saved, running, impact, threshold, disarmed)
+                ints[K] = k
+                clock[0] = times[k]
+                return
+            _sub_step_energy(z0, propagated, is_open, impact[IMPULSE], running)
+            _arm_where_negative(values1, threshold, tolerance, rearmable, disarmed)
+            _copy(values1, values0)
+            _copy(rates1, rates0)
+            _copy(z1, z0)
+        _copy(x0, x)
+        ints[K] = k + 1
+        _record_sample(x, running, mode_id, states, energy, sample_modes, k + 1)
+    clock[0] = times[ints[K]]
 
 
 # ---------------------------------------------------------------- ground and dense state
 
 
-@njit(cache=True, inline="always")
+@njit(**INTERNAL)
 def _ground(times, motion, harmonic, t, k, out):
     """[a_g, ȧ_g, ä_g, a⃛_g] at t in interval k (as ``GroundMotion.derivatives``)."""
     if harmonic.shape[0] == 0:
@@ -135,67 +417,57 @@ def _ground(times, motion, harmonic, t, k, out):
     else:
         a, w, phase = harmonic[0], harmonic[1], harmonic[2]
         angle = w * t + phase
-        out[0] = a * np.sin(angle)
-        out[1] = a * w * np.cos(angle)
-        out[2] = -a * w * w * np.sin(angle)
-        out[3] = -a * w * w * w * np.cos(angle)
+        out[0] = a * math.sin(angle)
+        out[1] = a * w * math.cos(angle)
+        out[2] = -a * w * w * math.sin(angle)
+        out[3] = -a * w * w * w * math.cos(angle)
 
 
-@njit(cache=True, inline="always")
+@njit(**INTERNAL)
 def _ground_value(flow, t):
     """a_g at t in the flow's interval (as ``GroundMotion.acceleration``)."""
-    if flow.harmonic.shape[0] == 0:
-        tau = t - flow.times[flow.k]
-        c = flow.motion[flow.k]
-        return c[0] + tau * (c[1] + tau * (c[2] + tau * c[3]))
-    return flow.harmonic[0] * np.sin(flow.harmonic[1] * t + flow.harmonic[2])
+    c = flow.ground
+    if flow.harmonic:
+        return c[0] * math.sin(c[1] * t + c[2])
+    tau = t - flow.origin
+    return c[0] + tau * (c[1] + tau * (c[2] + tau * c[3]))
 
 
-@njit(cache=True, inline="always")
+@njit(**INTERNAL)
 def _dense(flow, t, out):
-    """x(t) from the step's Chebyshev coefficients (as ``ModePropagator.dense``)."""
+    """x(t) from the step's Chebyshev coefficients (``ModePropagator.dense``; Tₙ by the recurrence Tₙ₊₁ = 2s Tₙ − Tₙ₋₁)."""
     s = min(max((t - flow.t0) * flow.scale - 1.0, -1.0), 1.0)
-    theta = np.arccos(s)
-    out[:] = 0.0
+    size = out.shape[0]
     coefficients = flow.coefficients
-    for n in range(coefficients.shape[0]):
-        weight = np.cos(n * theta)
-        for i in range(out.shape[0]):
-            out[i] += weight * coefficients[n, i]
+    previous, current = 1.0, s
+    for i in range(size):
+        out[i] = coefficients[i]
+    for n in range(1, coefficients.shape[0] // size):
+        for i in range(size):
+            out[i] += current * coefficients[n * size + i]
+        previous, current = current, 2.0 * s * current - previous
 
 
-@njit(cache=True)
-def _evaluate(flow, what, index, level, t, work):
-    """Guard ``index`` minus ``level`` (what = _GUARD), or the rate of contact force ``index``, at t."""
+@njit(**INTERNAL)
+def _evaluate(flow, index, level, t, work):
+    """Guard ``index`` minus ``level`` at t, or (index < 0) the rate of contact force −1 − index."""
     _dense(flow, t, work)
     ground = _ground_value(flow, t)
-    if what == _GUARD:
-        row = flow.G[index]
-        value = flow.gh[index] * ground + flow.g0[index]
-        for j in range(work.shape[0]):
-            value += row[j] * work[j]
-        return value - level
-    return _force_rate(flow.F[index], flow.A, flow.B, flow.c, work, ground)
-
-
-@njit(cache=True, inline="always")
-def _force(F, f0, p, x):
-    value = f0[p]
-    for j in range(x.shape[0]):
-        value += F[p, j] * x[j]
-    return value
+    if index < 0:
+        return _force_rate(flow.force, -1 - index, flow.rate, work, ground)
+    return _affine(flow.guard, index, work, ground) - level
 
 
 # ---------------------------------------------------------------- scipy's brentq and bounded Brent, ported
 
 
-@njit(cache=True)
-def _brentq(flow, what, index, level, xa, xb, work):
+@njit(**INTERNAL)
+def _brentq(flow, index, level, xa, xb, work):
     """Root of _evaluate in [xa, xb] (scipy.optimize.brentq, xtol = TIME_TOLERANCE, rtol = 4 eps)."""
     xpre, xcur = xa, xb
     xblk, fblk, spre, scur = 0.0, 0.0, 0.0, 0.0
-    fpre = _evaluate(flow, what, index, level, xpre, work)
-    fcur = _evaluate(flow, what, index, level, xcur, work)
+    fpre = _evaluate(flow, index, level, xpre, work)
+    fcur = _evaluate(flow, index, level, xcur, work)
     if fpre == 0.0:
         return xpre
     if fcur == 0.0:
@@ -231,18 +503,18 @@ def _brentq(flow, what, index, level, xa, xb, work):
             xcur += scur
         else:
             xcur += delta if sbis > 0.0 else -delta
-        fcur = _evaluate(flow, what, index, level, xcur, work)
+        fcur = _evaluate(flow, index, level, xcur, work)
     return xcur
 
 
-@njit(cache=True)
+@njit(**INTERNAL)
 def _maximise_guard(flow, j, level, a, b, work):
     """(t, level − guard(t)) minimising level − guard on [a, b] (scipy's bounded Brent, xatol = 1e-12)."""
-    xatol, sqrt_eps, golden_mean = 1e-12, np.sqrt(2.2e-16), 0.5 * (3.0 - np.sqrt(5.0))
+    xatol, sqrt_eps, golden_mean = 1e-12, math.sqrt(2.2e-16), 0.5 * (3.0 - math.sqrt(5.0))
     fulc = a + golden_mean * (b - a)
     nfc, xf = fulc, fulc
     rat = e = 0.0
-    fx = -_evaluate(flow, _GUARD, j, level, xf, work)
+    fx = -_evaluate(flow, j, level, xf, work)
     num = 1
     ffulc = fnfc = fx
     xm = 0.5 * (a + b)
@@ -272,7 +544,7 @@ def _maximise_guard(flow, j, level, a, b, work):
             e = a - xf if xf >= xm else b - xf
             rat = golden_mean * e
         x = xf + (1.0 if rat >= 0.0 else -1.0) * max(abs(rat), tol1)
-        fu = -_evaluate(flow, _GUARD, j, level, x, work)
+        fu = -_evaluate(flow, j, level, x, work)
         num += 1
         if fu <= fx:
             if x >= xf:
@@ -303,7 +575,7 @@ def _maximise_guard(flow, j, level, a, b, work):
 # ---------------------------------------------------------------- first_crossing
 
 
-@njit(cache=True)
+@njit(**INTERNAL)
 def _critical_points(a1, a2, a3, out):
     """Zeros of a1 + 2 a2 τ + 3 a3 τ² inside (0, 1), sorted, into out; returns their number."""
     count = 0
@@ -318,13 +590,13 @@ def _critical_points(a1, a2, a3, out):
     qa, qb, qc = 3.0 * a3, 2.0 * a2, a1
     discriminant = qb * qb - 4.0 * qa * qc
     if discriminant >= 0.0:
-        half = -0.5 * (qb + np.sqrt(discriminant)) if qb >= 0.0 else -0.5 * (qb - np.sqrt(discriminant))
+        half = -0.5 * (qb + math.sqrt(discriminant)) if qb >= 0.0 else -0.5 * (qb - math.sqrt(discriminant))
         r1 = half / qa
         r2 = qc / half if half != 0.0 else r1
         low, high = min(r1, r2), max(r1, r2)
     else:
         low = high = -qb / (2.0 * qa)
-        if np.sqrt(-discriminant) / (2.0 * abs(qa)) > 1e-12 * max(1.0, abs(low)):
+        if math.sqrt(-discriminant) / (2.0 * abs(qa)) > 1e-12 * max(1.0, abs(low)):
             return 0
     if 0.0 < low < 1.0:
         out[count] = low
@@ -335,75 +607,81 @@ def _critical_points(a1, a2, a3, out):
     return count
 
 
-@njit(cache=True)
-def _locate(flow, j, armed, threshold, tolerance, counters, a0, a1, a2, a3, margin, t1, work):
-    """First time guard j crosses its firing level upwards in [t0, t1], or NaN (``events._locate``)."""
+@njit(**INTERNAL)
+def _first_crossing(flow, threshold, tolerance, rearmable, disarmed, counters, t1, values0, values1, rates0, rates1, work):
+    """(time, guard) of the earliest crossing in [t0, t1], or (NaN, −1) (``events.first_crossing``).
+
+    Every guard whose cubic Hermite interpolant may reach zero is located on
+    the dense flow (``events._locate``): the step is cut at the cubic's
+    critical points; an armed guard fires at 0, a disarmed one at its
+    threshold until it has dipped below −tolerance; a cubic maximum close to
+    the level is checked by maximising the true guard (``events._grazing``).
+    """
     t0 = flow.t0
     h = t1 - t0
-    taus = np.zeros(4)
-    n = _critical_points(a1, a2, a3, taus[1:3]) + 2
-    taus[n - 1] = 1.0
-    times = t0 + taus[:n] * h
-    raw = np.empty(n)
-    raw[0] = a0
-    for i in range(1, n):
-        raw[i] = _evaluate(flow, _GUARD, j, 0.0, times[i], work)
-    level = 0.0 if armed else threshold
-    previous = min(raw[0], -tolerance) if armed else raw[0] - level
-    for i in range(1, n):
-        current = raw[i] - level
-        if previous < 0.0 <= current:
-            return _brentq(flow, _GUARD, j, level, times[i - 1], times[i], work)
-        tau = taus[i]
-        cubic_here = a0 + tau * (a1 + tau * (a2 + tau * a3)) - level
-        if 0 < i < n - 1 and current < 0.0 and cubic_here >= -margin:
-            found = _grazing(flow, j, level, counters, times[i - 1], times[min(i + 1, n - 1)], work)
-            if found == found:  # not NaN
-                return found
-        if not armed and raw[i] < -tolerance:
-            armed, level = True, 0.0
-            current = raw[i]
-        previous = current
-    return np.nan
-
-
-@njit(cache=True)
-def _grazing(flow, j, level, counters, start, end, work):
-    """``events._grazing``: maximise the true guard; its first crossing if the maximum reaches the level."""
-    counters[GRAZING] += 1
-    t_max, value = _maximise_guard(flow, j, level, start, end, work)
-    if -value >= 0.0 and _evaluate(flow, _GUARD, j, level, start, work) < 0.0:
-        return _brentq(flow, _GUARD, j, level, start, t_max, work)
-    return np.nan
-
-
-@njit(cache=True)
-def _first_crossing(flow, threshold, tolerance, rearmable, disarmed, counters, t1, values0, values1, rates0, rates1, work):
-    """(time, guard) of the earliest crossing in [t0, t1], or (NaN, −1) (``events.first_crossing``)."""
-    h = t1 - flow.t0
-    best_time, best_guard = np.nan, -1
+    taus, times, raw = np.empty(4), np.empty(4), np.empty(4)
+    best_time, best_guard = math.nan, -1
     for j in range(values0.shape[0]):
-        if not abs(threshold[j]) < np.inf:
+        if not abs(threshold[j]) < math.inf:
             continue
         a0, a1 = values0[j], rates0[j] * h
         a2 = 3.0 * (values1[j] - values0[j]) - (2.0 * rates0[j] + rates1[j]) * h
         a3 = 2.0 * (values0[j] - values1[j]) + (rates0[j] + rates1[j]) * h
         margin = 1e-3 * (abs(values0[j]) + abs(values1[j]) + abs(a1) + abs(rates1[j] * h)) + tolerance[j]
-        level = 0.0 if disarmed[j] else threshold[j]
-        if not (values1[j] >= level or _interior_maximum(a0, a1, a2, a3) >= level - margin):
+        screen = 0.0 if disarmed[j] else threshold[j]
+        if not (values1[j] >= screen or _interior_maximum(a0, a1, a2, a3) >= screen - margin):
             continue
-        time = _locate(flow, j, not disarmed[j], threshold[j], tolerance[j], counters, a0, a1, a2, a3, margin, t1, work)
+        n = _critical_points(a1, a2, a3, taus[1:3]) + 2
+        taus[0], taus[n - 1] = 0.0, 1.0
+        raw[0] = a0
+        for i in range(n):
+            times[i] = t0 + taus[i] * h
+            if i > 0:
+                raw[i] = _evaluate(flow, j, 0.0, times[i], work)
+        armed = not disarmed[j]
+        level = 0.0 if armed else threshold[j]
+        previous = min(raw[0], -tolerance[j]) if armed else raw[0] - level
+        time = math.nan
+        for i in range(1, n):
+            current = raw[i] - level
+            if previous < 0.0 <= current:
+                time = _brentq(flow, j, level, times[i - 1], times[i], work)
+                break
+            tau = taus[i]
+            if 0 < i < n - 1 and current < 0.0 and a0 + tau * (a1 + tau * (a2 + tau * a3)) - level >= -margin:  # grazing
+                counters[GRAZING] += 1
+                start = times[i - 1]
+                t_max, value = _maximise_guard(flow, j, level, start, times[min(i + 1, n - 1)], work)
+                if -value >= 0.0 and _evaluate(flow, j, level, start, work) < 0.0:
+                    time = _brentq(flow, j, level, start, t_max, work)
+                    break
+            if not armed and raw[i] < -tolerance[j]:
+                armed, level = True, 0.0
+                current = raw[i]
+            previous = current
         if time == time and (best_guard < 0 or time < best_time):
             best_time, best_guard = time, j
     if best_guard < 0:
-        arm_where_negative(values1, threshold, tolerance, rearmable, disarmed)
+        _arm_where_negative(values1, threshold, tolerance, rearmable, disarmed)
     return best_time, best_guard
 
 
 # ---------------------------------------------------------------- settle
 
 
-@njit(cache=True, inline="always")
+@njit(**INTERNAL)
+def _lookup(modes, mode):
+    """Index of the first row of ``modes`` equal to ``mode``, or −1."""
+    for i in range(modes.shape[0]):
+        j = 0
+        while j < mode.shape[0] and modes[i, j] == mode[j]:
+            j += 1
+        if j == mode.shape[0]:
+            return i
+    return -1
+
+
+@njit(**INTERNAL)
 def _penetration(geometry, gap, p, x):
     value = -gap[p]
     for j in range(geometry.shape[1]):
@@ -411,7 +689,7 @@ def _penetration(geometry, gap, p, x):
     return value
 
 
-@njit(cache=True)
+@njit(**INTERNAL)
 def _apply(geometry, gap, base_dofs, mode, x, kind, target, direction):
     """``events._apply`` on a mode vector (changed in place); a STOP zeroes the base velocity in x."""
     n_contacts = gap.shape[0]
@@ -426,336 +704,340 @@ def _apply(geometry, gap, base_dofs, mode, x, kind, target, direction):
         mode[n_contacts + target] = _STUCK
 
 
-@njit(cache=True)
-def _leaving_sign(A, B, c, G, gh, g0, x, ground, values, tolerance, heading):
-    """``events.guard_leaving_sign``: values, tolerances and heading of the guards G, gh, g0."""
-    n_guards = G.shape[0]
+@njit(**INTERNAL)
+def _with_bound(M, i, x, magnitude, ground, constant):
+    """Row i of the affine map M at (x, a_g), with its constant or not, its round-off scale and Σ|M[i, :S + 1]|.
+
+    The scale is the same sum with every term taken absolute and x replaced
+    by ``magnitude`` (``events._guard_scales``).
+    """
+    size = M.shape[1] - 2
+    slope, offset = M[i, size], M[i, size + 1] if constant else 0.0
+    value, scale, floor = slope * ground + offset, abs(slope) * abs(ground) + abs(offset), abs(slope)
+    for j in range(size):
+        value += M[i, j] * x[j]
+        scale += abs(M[i, j]) * magnitude[j]
+        floor += abs(M[i, j])
+    return value, scale, floor
+
+
+@njit(**INTERNAL)
+def _leaving_sign(rate, guard, n_guards, x, ground, values, tolerance, heading):
+    """``events.guard_leaving_sign``: values, tolerances and heading of the first n_guards guards.
+
+    The heading of a guard is the sign of its first time derivative (up to the
+    third) that is clearly non-zero: 0 while undecided.
+    """
     size = x.shape[0]
-    derivative = x.copy()
-    magnitude = np.empty(size)
+    derivative, magnitude, next_derivative, next_magnitude = np.empty(size), np.empty(size), np.empty(size), np.empty(size)
     for i in range(size):
-        magnitude[i] = abs(x[i])
-    heading[:n_guards] = 0
-    undecided = np.empty(n_guards, dtype=np.bool_)
-    undecided[:] = True
+        derivative[i], magnitude[i] = x[i], abs(x[i])
+    for g in range(n_guards):
+        heading[g] = 0
     for order in range(4):
         for g in range(n_guards):
-            value = gh[g] * ground[order] + (g0[g] if order == 0 else 0.0)
-            scale = abs(gh[g]) * abs(ground[order]) + (abs(g0[g]) if order == 0 else 0.0)
-            floor = abs(gh[g])
-            for j in range(size):
-                value += G[g, j] * derivative[j]
-                scale += abs(G[g, j]) * magnitude[j]
-                floor += abs(G[g, j])
+            value, scale, floor = _with_bound(guard, g, derivative, magnitude, ground[order], order == 0)
             limit = _ROUND_OFF * (scale + 1e-4 * floor)
             if order == 0:
                 values[g], tolerance[g] = value, limit
-            if undecided[g] and abs(value) > limit:
+            if heading[g] == 0 and abs(value) > limit:
                 heading[g] = 1 if value > 0.0 else -1
-                undecided[g] = False
-        next_derivative = np.empty(size)
-        next_magnitude = np.empty(size)
         for i in range(size):
-            rate = B[i] * ground[order] + (c[i] if order == 0 else 0.0)
-            bound = abs(B[i]) * abs(ground[order]) + (abs(c[i]) if order == 0 else 0.0)
-            for j in range(size):
-                rate += A[i, j] * derivative[j]
-                bound += abs(A[i, j]) * magnitude[j]
-            next_derivative[i], next_magnitude[i] = rate, bound
-        derivative, magnitude = next_derivative, next_magnitude
+            next_derivative[i], next_magnitude[i], _ = _with_bound(rate, i, derivative, magnitude, ground[order], order == 0)
+        derivative, next_derivative = next_derivative, derivative
+        magnitude, next_magnitude = next_magnitude, magnitude
 
 
-@njit(cache=True, inline="always")
-def _ignored(kind, p, geometry, gap, tensile, x, value, tolerance):
-    """A guard that may not fire now: RECLOSE while not penetrated, CLOSE of a non-tensile contact still penetrated."""
-    if kind == _RECLOSE and _penetration(geometry, gap, p, x) <= 0.0:
-        return True
-    return kind == _CLOSE and not tensile[p] and value > tolerance
+@njit(**INTERNAL)
+def _first_wanting(codes, n_guards, geometry, gap, tensile, x, values, tolerance, heading):
+    """Index of the first guard that fires at this instant (``events._wanting_to_fire``), or −1.
 
-
-@njit(cache=True)
-def _first_wanting(kinds, targets, geometry, gap, tensile, x, values, tolerance, heading):
-    """Index of the first guard that fires at this instant (``events._wanting_to_fire``), or −1."""
-    for j in range(kinds.shape[0]):
-        if heading[j] > 0 and not _ignored(kinds[j], targets[j], geometry, gap, tensile, x, values[j], tolerance[j]):
-            return j
+    A RECLOSE guard does not fire while its contact is not penetrated, nor the
+    CLOSE guard of a non-tensile contact still penetrated.
+    """
+    for j in range(n_guards):
+        kind, p = codes[KIND, j], codes[TARGET, j]
+        if heading[j] <= 0:
+            continue
+        if kind == _RECLOSE and _penetration(geometry, gap, p, x) <= 0.0:
+            continue
+        if kind == _CLOSE and not tensile[p] and values[j] > tolerance[j]:
+            continue
+        return j
     return -1
 
 
-@njit(cache=True)
-def _initial_guard_states(kinds, targets, geometry, gap, tensile, x, values, tolerance, threshold_out, tolerance_out, rearmable, disarmed):
+@njit(**INTERNAL)
+def _initial_guard_states(codes, n_guards, geometry, gap, tensile, x, values, tolerance, threshold_out, tolerance_out, rearmable, disarmed):
     """``events._initial_guard_states`` into the run's guard arrays."""
-    for j in range(kinds.shape[0]):
+    for j in range(n_guards):
         tolerance_out[j] = tolerance[j]
         threshold_out[j] = 0.0 if values[j] < -tolerance[j] else _FIRE_RATIO * tolerance[j]
         rearmable[j] = True
-        kind, p = kinds[j], targets[j]
+        kind, p = codes[KIND, j], codes[TARGET, j]
         if kind == _RECLOSE and _penetration(geometry, gap, p, x) <= 0.0:
-            threshold_out[j], rearmable[j] = np.inf, False
+            threshold_out[j], rearmable[j] = math.inf, False
         elif kind == _CLOSE and not tensile[p] and values[j] > tolerance[j]:
-            threshold_out[j] = np.inf
+            threshold_out[j] = math.inf
         disarmed[j] = threshold_out[j] != 0.0
 
 
-@njit(cache=True)
-def _settle(tables, plant, run, transitions):
-    """``events.settle`` of the pending (t, x, mode, fired); returns (mode index, x, number of transitions).
+@njit(**INTERNAL)
+def _settle(modes, codes, n_guards, rate, guard, geometry, gap, tensile, base_dofs, ground, ints, x, mode, transitions,
+            threshold, tolerance, rearmable, disarmed):
+    """``events.settle`` of the pending event: returns (mode index, number of transitions); x and mode are updated.
 
-    Returns mode index −1 (and the missing mode in ``run.missing_mode``) when a
-    mode is not built yet: nothing in ``run`` has changed then.
+    ``codes``, ``rate`` and ``guard`` are the :class:`ModeTable` and
+    :class:`Dynamics` arrays of the slots. Returns mode index −1 when the
+    settled mode is in no slot (``mode`` is that mode; nothing else has
+    changed then).
     """
-    t, k = run.clock[0], run.ints[K]
-    x = run.pending_x.copy()
-    mode = run.pending_mode.copy()
-    ground = np.empty(4)
-    _ground(plant.times, plant.coefficients, plant.harmonic, t, k, ground)
-    n_guards_max = tables.G.shape[1]
-    values, tolerance = np.empty(n_guards_max), np.empty(n_guards_max)
-    heading = np.zeros(n_guards_max, dtype=np.int64)
-    geometry, gap, tensile = plant.geometry, plant.gap, plant.tensile
+    n_guards_max = guard.shape[1]
+    values, limits = np.empty(n_guards_max), np.empty(n_guards_max)
+    heading = np.empty(n_guards_max, dtype=np.int64)
     n_transitions = 0
-    if run.ints[PENDING] == EVENT:
-        kind, target, direction = run.ints[FIRED_KIND], run.ints[FIRED_TARGET], run.ints[FIRED_DIRECTION]
-        _apply(geometry, gap, plant.base_dofs, mode, x, kind, target, direction)
+    if ints[PENDING] == EVENT:
+        kind, target, direction = ints[FIRED_KIND], ints[FIRED_TARGET], ints[FIRED_DIRECTION]
+        _apply(geometry, gap, base_dofs, mode, x, kind, target, direction)
         transitions[0, 0], transitions[0, 1], transitions[0, 2] = kind, target, direction
         n_transitions = 1
-    visited = np.empty((_MAX_SETTLE + 1, mode.shape[0]), dtype=np.int64)
-    visited[0] = mode
+    visited, following = np.empty((_MAX_SETTLE + 1, mode.shape[0]), dtype=np.int64), np.empty(mode.shape[0], dtype=np.int64)
+    _copy(mode, visited[0])
     n_visited = 1
     settled = False
     for _ in range(_MAX_SETTLE):
-        m = _lookup(tables.hashes, tables.modes, mode)
+        m = _lookup(modes, mode)
         if m < 0:
-            run.missing_mode[:] = mode
-            return -1, x, 0
-        n = tables.n_guards[m]
-        _leaving_sign(tables.A[m], tables.B[m], tables.c[m], tables.G[m, :n], tables.gh[m, :n], tables.g0[m, :n], x, ground, values, tolerance, heading)
-        j = _first_wanting(tables.kind[m, :n], tables.target[m, :n], geometry, gap, tensile, x, values, tolerance, heading)
+            break
+        _leaving_sign(rate[m], guard[m], n_guards[m], x, ground, values, limits, heading)
+        j = _first_wanting(codes[m], n_guards[m], geometry, gap, tensile, x, values, limits, heading)
         if j < 0:
             settled = True
             break
-        kind, target, direction = tables.kind[m, j], tables.target[m, j], tables.direction[m, j]
-        following = mode.copy()
-        _apply(geometry, gap, plant.base_dofs, following, x, kind, target, direction)
-        cycle = False
-        for v in range(n_visited):
-            if _same(visited[v], following):
-                cycle = True
-        if cycle:
+        kind, target, direction = codes[m, KIND, j], codes[m, TARGET, j], codes[m, DIRECTION, j]
+        _copy(mode, following)
+        _apply(geometry, gap, base_dofs, following, x, kind, target, direction)
+        if _lookup(visited[:n_visited], following) >= 0:
             break
         transitions[n_transitions, 0], transitions[n_transitions, 1], transitions[n_transitions, 2] = kind, target, direction
         n_transitions += 1
-        visited[n_visited] = following
+        _copy(following, visited[n_visited])
         n_visited += 1
-        mode = following
-    m = _lookup(tables.hashes, tables.modes, mode)
+        _copy(following, mode)
+    m = _lookup(modes, mode)
     if m < 0:
-        run.missing_mode[:] = mode
-        return -1, x, 0
-    n = tables.n_guards[m]
+        return -1, 0
     if not settled:
-        run.ints[CHATTER] += 1
-        _leaving_sign(tables.A[m], tables.B[m], tables.c[m], tables.G[m, :n], tables.gh[m, :n], tables.g0[m, :n], x, ground, values, tolerance, heading)
-    _initial_guard_states(tables.kind[m, :n], tables.target[m, :n], geometry, gap, tensile, x, values, tolerance,
-                          run.threshold, run.tolerance, run.rearmable, run.disarmed)
-    return m, x, n_transitions
+        ints[CHATTER] += 1
+        _leaving_sign(rate[m], guard[m], n_guards[m], x, ground, values, limits, heading)
+    _initial_guard_states(codes[m], n_guards[m], geometry, gap, tensile, x, values, limits, threshold, tolerance, rearmable, disarmed)
+    return m, n_transitions
 
 
-# ---------------------------------------------------------------- recording
+# ---------------------------------------------------------------- recording events
 
 
-@njit(cache=True, inline="always")
-def _offer_peak(peak, peak_time, p, t, value):
-    if value > peak[p]:
-        peak[p], peak_time[p] = value, t
-
-
-@njit(cache=True)
-def _on_transitions(tables, plant, run, m, t, x, transitions, n_transitions):
-    """``Recorder.on_transitions`` and ``on_contact_force`` at an event."""
-    n = plant.n_dof
+@njit(**INTERNAL)
+def _on_transitions(mode, force, left_rows, right_rows, geometry, is_open, impact, table, ints, t, x, transitions, n_transitions):
+    """``Recorder.on_transitions`` and ``on_contact_force`` at an event (``impact``: rows of ``Impacts.impact``)."""
+    n = geometry.shape[1]
     for i in range(n_transitions):
         kind, p = transitions[i, 0], transitions[i, 1]
-        if (kind == _CLOSE or kind == _RECLOSE) and not run.is_open[p] and tables.modes[m, p] == 1:
+        if (kind == _CLOSE or kind == _RECLOSE) and not is_open[p] and mode[p] == 1:
             left, right, onset = 0.0, 0.0, 0.0
             for j in range(n):
-                left += plant.left_rows[p, j] * x[n + j]
-                right += plant.right_rows[p, j] * x[n + j]
-                onset += plant.geometry[p, j] * x[n + j]
-            run.is_open[p] = True
-            run.impact_start[p], run.impact_onset[p], run.impact_in_phase[p] = t, onset, left * right > 0.0
-            run.impact_peak[p], run.impact_peak_time[p], run.impact_impulse[p] = 0.0, np.nan, 0.0
-        elif kind == _OPEN and run.is_open[p] and tables.modes[m, p] == 0:
-            row = run.impacts[run.ints[N_IMPACTS]]
-            row[0], row[1], row[2], row[3] = p, run.impact_start[p], t, run.impact_onset[p]
-            row[4], row[5], row[6], row[7], row[8] = run.impact_in_phase[p], run.impact_peak[p], run.impact_peak_time[p], run.impact_impulse[p], 1.0
-            run.ints[N_IMPACTS] += 1
-            run.is_open[p] = False
-    for p in range(plant.gap.shape[0]):
-        if run.is_open[p]:
-            _offer_peak(run.impact_peak, run.impact_peak_time, p, t, _force(tables.F[m], tables.f0[m], p, x))
+                left += left_rows[p, j] * x[n + j]
+                right += right_rows[p, j] * x[n + j]
+                onset += geometry[p, j] * x[n + j]
+            is_open[p] = True
+            impact[START, p], impact[ONSET, p], impact[IN_PHASE, p] = t, onset, 1.0 if left * right > 0.0 else 0.0
+            impact[PEAK, p], impact[PEAK_TIME, p], impact[IMPULSE, p] = 0.0, math.nan, 0.0
+        elif kind == _OPEN and is_open[p] and mode[p] == 0:
+            row = table[ints[N_IMPACTS]]
+            row[0], row[1] = p, t
+            for r in range(impact.shape[0]):
+                row[2 + r] = impact[r, p]
+            ints[N_IMPACTS] += 1
+            is_open[p] = False
+    _offer_peaks(force, is_open, impact, t, x)
 
 
-@njit(cache=True)
-def _track_peaks(flow, is_open, peak, peak_time, t1, x0, x1, work):
-    """``Recorder._track_peak`` for every open impact (ends, and an interior maximum located by brentq)."""
-    t0 = flow.t0
-    for p in range(is_open.shape[0]):
-        if not is_open[p]:
+@njit(inline="always", error_model="numpy")
+def _settle_pending(modes, codes, n_guards, rate, guard, force, motion, layout, arming, ints, clock, pending_x, pending_mode,
+                    missing_mode, is_open, impact, table, x):
+    """Settle the pending event (or the start) and record it (``settle_and_record``): returns the mode index.
+
+    The settled state goes into ``x``. Returns −1 (with the mode to build in
+    ``missing_mode``, and nothing else changed) when a mode is missing.
+    """
+    settled, mode = np.empty(x.shape[0]), np.empty(pending_mode.shape[0], dtype=np.int64)
+    _copy(pending_x, settled)
+    _copy(pending_mode, mode)
+    transitions = np.empty((_MAX_SETTLE + 1, 3), dtype=np.int64)
+    ground = np.empty(4)
+    _ground(motion.times, motion.coefficients, motion.harmonic, clock[0], ints[K], ground)
+    geometry, gap, tensile, left_rows, right_rows, base_dofs = layout
+    threshold, tolerance, rearmable, disarmed = arming
+    m, n_transitions = _settle(modes, codes, n_guards, rate, guard, geometry, gap, tensile, base_dofs, ground, ints, settled, mode,
+                               transitions, threshold, tolerance, rearmable, disarmed)
+    if m < 0:
+        _copy(mode, missing_mode)
+        return m
+    _on_transitions(modes[m], force[m], left_rows, right_rows, geometry, is_open, impact, table, ints, clock[0], settled, transitions,
+                    n_transitions)
+    _copy(settled, x)
+    return m
+
+
+# ---------------------------------------------------------------- event steps
+
+
+@njit(inline="always", error_model="numpy")
+def _advance_span(m, n, modes, codes, substeps, step, propagate, chebyshev, rate, guard, force, power, motion, ints, clock, x,
+                  pending_x, pending_mode, arming, is_open, impact, running, k, t, t_end):
+    """Sub-steps of mode m (n guards, its arrays) from t to t_end (``_until_event`` of exact.py).
+
+    Returns True when it stopped at an event (now pending), False at t_end.
+    """
+    times, coefficients_k, harmonic = motion.times, motion.coefficients, motion.harmonic
+    threshold, tolerance, rearmable, disarmed = arming
+    full = t == times[k] and t_end == times[k + 1]
+    n_steps = substeps if full else max(1, math.ceil((t_end - t) / step - 1e-9))
+    spacing = (t_end - t) / n_steps
+    size = x.shape[0]
+    width = size + 5
+    values0, values1, rates0, rates1 = np.empty(n), np.empty(n), np.empty(n), np.empty(n)
+    z0, propagated, work, rate_work, ground1 = np.empty(width), np.empty(propagate.shape[1]), np.empty(size), np.empty(size), np.empty(4)
+    node, products = np.empty(width), np.empty(power.shape[1])  # node: z = [x, a_g, 0, 0, 0, 1] at a Gauss node
+    node[size + 1], node[size + 2], node[size + 3], node[width - 1] = 0.0, 0.0, 0.0, 1.0
+    x1 = propagated[:size]
+    coefficients = np.empty(chebyshev.shape[1])
+    is_harmonic = harmonic.shape[0] > 0
+    ground = harmonic if is_harmonic else coefficients_k[k]
+    any_open = _any(is_open)
+    for i in range(n_steps):
+        t0 = t + i * spacing  # as np.linspace(t, t_end, n_steps + 1)
+        t1 = t_end if i == n_steps - 1 else t + (i + 1) * spacing
+        _copy(x, z0)
+        _ground(times, coefficients_k, harmonic, t0, k, z0[size : size + 4])
+        z0[width - 1] = 1.0
+        flow = Flow(rate, guard, force, coefficients, ground, times[k], is_harmonic, t0, 2.0 / step)
+        _guards_and_rates(rate, guard, x, z0[size], z0[size + 1], values0, rates0, rate_work)
+        if full:
+            _product(propagate, z0, propagated)
+        else:
+            _product(chebyshev, z0, coefficients)
+            _dense(flow, t1, x1)
+        _ground(times, coefficients_k, harmonic, t1, k, ground1)
+        _guards_and_rates(rate, guard, x1, ground1[0], ground1[1], values1, rates1, rate_work)
+        if full and not _suspect(values0, values1, rates0, rates1, t1 - t0, threshold, tolerance) and not any_open:
+            _sub_step_energy(z0, propagated, is_open, impact[IMPULSE], running)
+            _arm_where_negative(values1, threshold, tolerance, rearmable, disarmed)
+            _copy(x1, x)
             continue
-        _offer_peak(peak, peak_time, p, t0, _force(flow.F, flow.f0, p, x0))
-        _offer_peak(peak, peak_time, p, t1, _force(flow.F, flow.f0, p, x1))
-        rate0 = _evaluate(flow, _FORCE_RATE, p, 0.0, t0, work)
-        rate1 = _evaluate(flow, _FORCE_RATE, p, 0.0, t1, work)
-        if rate0 > 0.0 > rate1:
-            t_peak = _brentq(flow, _FORCE_RATE, p, 0.0, t0, t1, work)
-            _dense(flow, t_peak, work)
-            _offer_peak(peak, peak_time, p, t_peak, _force(flow.F, flow.f0, p, work))
+        if full:
+            _product(chebyshev, z0, coefficients)
+        t_event, fired = _first_crossing(flow, threshold, tolerance, rearmable, disarmed, ints, t1, values0, values1, rates0, rates1, work)
+        t_stop, x_stop = t1, x1
+        if fired >= 0:
+            t_stop, x_stop = t_event, np.empty(size)
+            _dense(flow, t_event, x_stop)
+        if t_stop > t0:  # Recorder.on_step: energy terms and impulses at the Gauss nodes, then peak forces
+            half = 0.5 * (t_stop - t0)
+            for g in range(N_NODES):
+                t_node, weight = t0 + half * (GAUSS_NODES[g] + 1.0), half * GAUSS_WEIGHTS[g]
+                _dense(flow, t_node, node[:size])
+                node[size] = _ground_value(flow, t_node)
+                _product(power, node, products)
+                _add_forms(node, products, weight, running)
+                for p in range(is_open.shape[0]):
+                    if is_open[p]:
+                        impact[IMPULSE, p] += weight * _force(force, p, node)
+            _offer_peaks(force, is_open, impact, t0, x)
+            _offer_peaks(force, is_open, impact, t_stop, x_stop)
+            for p in range(is_open.shape[0]):  # a force maximum inside the step
+                if is_open[p] and _evaluate(flow, -1 - p, 0.0, t0, work) > 0.0 > _evaluate(flow, -1 - p, 0.0, t_stop, work):
+                    t_peak = _brentq(flow, -1 - p, 0.0, t0, t_stop, work)
+                    _dense(flow, t_peak, work)
+                    value = _force(force, p, work)
+                    if value > impact[PEAK, p]:
+                        impact[PEAK, p], impact[PEAK_TIME, p] = value, t_peak
+        if fired < 0:
+            _copy(x1, x)
+            continue
+        clock[0] = t_event
+        _copy(x_stop, pending_x)
+        _copy(modes[m], pending_mode)
+        ints[FIRED_KIND], ints[FIRED_TARGET], ints[FIRED_DIRECTION] = codes[m, KIND, fired], codes[m, TARGET, fired], codes[m, DIRECTION, fired]
+        ints[PENDING] = EVENT
+        ints[TOTAL] += 1
+        return True
+    return False
 
 
 # ---------------------------------------------------------------- the run
 
 
-@njit(cache=True)
-def _advance_span(tables, plant, run, k, t, t_end):
-    """Sub-steps of the current mode from t to t_end (``_until_event`` of exact.py).
+@njit(cache=True, nogil=True, no_cfunc_wrapper=True, error_model="numpy")
+def run_engine(table, dynamics, propagators, motion, layout, run, arming, impacts, outputs, scratch, saved, events):
+    """Run (or resume) the simulation; returns FINISHED, NEED_MODE, NEED_SPACE or NEEDS_EVENTS.
 
-    Returns True when it stopped at an event (now pending), False at t_end.
+    Parameters
+    ----------
+    table, dynamics, propagators : ModeTable, Dynamics, Propagators
+        The modes in the slots.
+    motion, layout : Motion, Layout
+        The motion and the system.
+    run, arming, impacts, outputs : Run, Arming, Impacts, Outputs
+        Everything the run changes, updated in place.
+    scratch, saved : np.ndarray
+        Work arrays (:func:`work_arrays`).
+    events : bool
+        False for the Python event path: only the quiet loop runs, and
+        NEEDS_EVENTS means interval ``run.ints[K]`` has events.
+
+    Returns
+    -------
+    int
+        On NEED_MODE, ``run.missing_mode`` is the mode to build; on NEED_SPACE
+        the impact table is full. Either way the caller fixes it and calls again.
     """
-    m = run.ints[MODE]
-    size = run.x.shape[0]
-    width = size + 5
-    full = t == plant.times[k] and t_end == plant.times[k + 1]
-    n_steps = tables.substeps[m] if full else max(1, int(math.ceil((t_end - t) / tables.step[m] - 1e-9)))
-    spacing = (t_end - t) / n_steps
-    n = tables.n_guards[m]
-    values0, values1, rates0, rates1 = np.empty(n), np.empty(n), np.empty(n), np.empty(n)
-    z0, z1, node, work, rate_work, ground1 = np.empty(width), np.empty(width), np.empty(width), np.empty(size), np.empty(size), np.empty(4)
-    coefficients = np.empty((tables.chebyshev.shape[1], size))
-    A, B, c, G, gh, g0 = tables.A[m], tables.B[m], tables.c[m], tables.G[m, :n], tables.gh[m, :n], tables.g0[m, :n]
-    F, f0, Fr, frg, frc = tables.F[m], tables.f0[m], tables.Fr[m], tables.frg[m], tables.frc[m]
-    threshold, tolerance, rearmable, disarmed = run.threshold[:n], run.tolerance[:n], run.rearmable[:n], run.disarmed[:n]
-    weights = 0.5 * tables.step[m] * plant.gauss_weights
-    for i in range(n_steps):
-        t0 = t + i * spacing  # as np.linspace(t, t_end, n_steps + 1)
-        t1 = t_end if i == n_steps - 1 else t + (i + 1) * spacing
-        z0[:size] = run.x
-        _ground(plant.times, plant.coefficients, plant.harmonic, t0, k, z0[size : size + 4])
-        z0[width - 1] = 1.0
-        flow = Flow(A, B, c, G, gh, g0, F, f0, coefficients, t0, 2.0 / tables.step[m], k, plant.times, plant.coefficients, plant.harmonic)
-        _guards_and_rates(G, gh, g0, A, B, c, run.x, z0[size], z0[size + 1], values0, rates0, rate_work)
-        x1 = z1[:size]
-        dense = not full
-        if full:
-            _matvec(tables.transition[m], z0, z1)
-        else:
-            _chebyshev_state(tables.chebyshev[m], z0, coefficients)
-            _dense(flow, t1, x1)
-        _ground(plant.times, plant.coefficients, plant.harmonic, t1, k, ground1)
-        _guards_and_rates(G, gh, g0, A, B, c, x1, ground1[0], ground1[1], values1, rates1, rate_work)
-        if full and (_suspect(values0, values1, rates0, rates1, t1 - t0, threshold, tolerance) or _any(run.is_open)):
-            _chebyshev_state(tables.chebyshev[m], z0, coefficients)
-            dense = True
-        if not dense:
-            _quadrature(tables.nodes[m], weights, z0, node, F, f0, Fr, frg, frc, plant.load, plant.damping,
-                        plant.influence, plant.base_dofs, run.is_open, run.impact_impulse, run.running)
-            arm_where_negative(values1, threshold, tolerance, rearmable, disarmed)
-            run.x[:] = x1
-            continue
-        t_event, guard = _first_crossing(flow, threshold, tolerance, rearmable, disarmed, run.ints, t1, values0, values1, rates0, rates1, work)
-        t_stop = t1 if guard < 0 else t_event
-        x_stop = x1 if guard < 0 else np.empty(size)
-        if guard >= 0:
-            _dense(flow, t_event, x_stop)
-        if t_stop > t0:  # Recorder.on_step
-            half = 0.5 * (t_stop - t0)
-            for g in range(plant.gauss_nodes.shape[0]):
-                t_node = t0 + half * (plant.gauss_nodes[g] + 1.0)
-                _dense(flow, t_node, work)
-                add_power(work, _ground_value(flow, t_node), half * plant.gauss_weights[g], F, f0, Fr, frg, frc, plant.load,
-                          plant.damping, plant.influence, plant.base_dofs, run.is_open, run.impact_impulse, run.running)
-            _track_peaks(flow, run.is_open, run.impact_peak, run.impact_peak_time, t_stop, run.x, x_stop, work)
-        if guard < 0:
-            run.x[:] = x1
-            continue
-        run.clock[0] = t_event
-        run.pending_x[:] = x_stop
-        run.pending_mode[:] = tables.modes[m]
-        run.ints[FIRED_KIND], run.ints[FIRED_TARGET], run.ints[FIRED_DIRECTION] = tables.kind[m, guard], tables.target[m, guard], tables.direction[m, guard]
-        run.ints[PENDING] = EVENT
-        run.ints[TOTAL] += 1
-        return True
-    return False
-
-
-@njit(cache=True, inline="always")
-def _any(flags):
-    for flag in flags:
-        if flag:
-            return True
-    return False
-
-
-@njit(cache=True)
-def _chebyshev_state(chebyshev, z, coefficients):
-    """Chebyshev coefficients (D × 2N) of x(t0 + τ) from z(t0)."""
-    for n in range(chebyshev.shape[0]):
-        _matvec(chebyshev[n], z, coefficients[n])
-
-
-@njit(cache=True, nogil=True)
-def run_engine(tables, plant, run, scratch, saved):
-    """Run (or resume) the simulation; returns FINISHED, NEED_MODE or NEED_SPACE.
-
-    On NEED_MODE, ``run.missing_mode`` is the mode to build; on NEED_SPACE the
-    impact table is full. Either way the caller fixes it and calls again.
-    ``scratch`` and ``saved`` are work arrays (:func:`exact_kernel.work_arrays`).
-    """
-    eps = 2.0 * np.finfo(np.float64).eps
-    times = plant.times
-    transitions = np.empty((_MAX_SETTLE + 1, 3), dtype=np.int64)
+    modes, ids, codes, n_guards, substeps = table
+    rate, guard, force, power = dynamics
+    propagate, chebyshev, step = propagators
+    clock, ints, x, pending_x, pending_mode, missing_mode, visited = run
+    is_open, impact, impact_table = impacts
+    running, states, energy, sample_modes = outputs
+    times = motion.times
+    last = times.shape[0] - 1
     while True:
-        if run.ints[PENDING] != NONE:  # settle and record the pending event (Run._event)
-            if run.ints[N_IMPACTS] + plant.gap.shape[0] > run.impacts.shape[0]:
+        if ints[PENDING] != NONE:
+            if ints[N_IMPACTS] + is_open.shape[0] > impact_table.shape[0]:
                 return NEED_SPACE
-            m, x, n_transitions = _settle(tables, plant, run, transitions)
+            m = _settle_pending(modes, codes, n_guards, rate, guard, force, motion, layout, arming, ints, clock, pending_x,
+                                pending_mode, missing_mode, is_open, impact, impact_table, x)
             if m < 0:
                 return NEED_MODE
-            _on_transitions(tables, plant, run, m, run.clock[0], x, transitions, n_transitions)
-            run.x[:] = x
-            run.ints[MODE] = m
-            run.visited[tables.ids[m]] = True
-            if run.ints[PENDING] == INITIAL:
-                run.states[0], run.energy[:, 0], run.sample_modes[0] = run.x, run.running, tables.ids[m]
-            run.ints[PENDING] = NONE
-        k = run.ints[K]
-        if k < times.shape[0] - 1 and run.clock[0] == times[k]:  # the fast path over quiet intervals
-            m = run.ints[MODE]
-            n = tables.n_guards[m]
-            k, _ = advance_quiet(
-                k, run.x, plant.forcing, times, tables.substeps[m], tables.transition[m], tables.nodes[m],
-                0.5 * tables.step[m] * plant.gauss_weights, tables.A[m], tables.B[m], tables.c[m],
-                tables.G[m, :n], tables.gh[m, :n], tables.g0[m, :n],
-                run.threshold[:n], run.tolerance[:n], run.rearmable[:n], run.disarmed[:n],
-                tables.F[m], tables.f0[m], tables.Fr[m], tables.frg[m], tables.frc[m],
-                plant.load, plant.damping, plant.influence, plant.base_dofs,
-                run.is_open, run.impact_impulse, run.impact_peak, run.impact_peak_time, run.running,
-                run.states, run.energy, scratch, saved,
-            )
-            run.sample_modes[run.ints[K] + 1 : k + 1] = tables.ids[m]
-            run.ints[K] = k
-            run.clock[0] = times[k]
-        if k >= times.shape[0] - 1:
+            ints[MODE] = m
+            visited[ids[m]] = True
+            if ints[PENDING] == INITIAL:
+                _record_sample(x, running, ids[m], states, energy, sample_modes, ints[K])
+            ints[PENDING] = NONE
+        k, m = ints[K], ints[MODE]
+        if k < last and clock[0] == times[k]:
+            _advance_quiet(ids[m], n_guards[m], substeps[m], propagate[m], rate[m], guard[m], force[m], times, motion.forcing, ints,
+                           clock, x, arming, is_open, impact, outputs, scratch, saved)
+            k = ints[K]
+        if k >= last:
             return FINISHED
-        t, t_end = run.clock[0], times[k + 1]
-        stopped = False
-        while t_end - t > eps * max(1.0, abs(t_end)):
-            if _advance_span(tables, plant, run, k, t, t_end):
-                stopped = True
-                break
-            t = t_end
-        if stopped:
+        if not events:
+            return NEEDS_EVENTS
+        t, t_end = clock[0], times[k + 1]
+        if t_end - t > _EPS * max(1.0, abs(t_end)) and _advance_span(
+            m, n_guards[m], modes, codes, substeps[m], step[m], propagate[m], chebyshev[m], rate[m], guard[m], force[m], power[m],
+            motion, ints, clock, x, pending_x, pending_mode, arming, is_open, impact, running, k, t, t_end
+        ):
             continue
-        run.clock[0] = t_end
-        run.ints[K] = k + 1
-        run.states[k + 1], run.energy[:, k + 1], run.sample_modes[k + 1] = run.x, run.running, tables.ids[run.ints[MODE]]
+        clock[0] = t_end
+        ints[K] = k + 1
+        _record_sample(x, running, ids[m], states, energy, sample_modes, k + 1)

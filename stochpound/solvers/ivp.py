@@ -17,9 +17,9 @@ from scipy.integrate import BDF, DOP853, LSODA, RK23, RK45, Radau
 from threadpoolctl import threadpool_limits
 
 from stochpound.errors import StochpoundError
-from stochpound.events import EventCounters, GuardStates, Step, first_crossing, initial_mode, settle
+from stochpound.events import EventCounters, GuardStates, Step, first_crossing, initial_mode
 from stochpound.modes import Mode, ModeDynamics, ModeLibrary
-from stochpound.recorder import Recorder
+from stochpound.recorder import Recorder, settle_and_record
 from stochpound.scene import Scene
 from stochpound.system import build_system
 
@@ -68,9 +68,7 @@ class _Run:
     def execute(self) -> tuple[Recorder, EventCounters, ModeLibrary]:
         times = self.motion.times
         t, x = float(times[0]), self.system.initial_state.copy()
-        mode, x, states, transitions = settle(self.library, self.motion, 0, t, x, initial_mode(self.system), self.counters)
-        self.recorder.on_transitions(t, x, transitions, mode)
-        self.recorder.on_contact_force(t, mode, self.library[mode], x)
+        mode, x, states = settle_and_record(self.library, self.motion, self.recorder, self.counters, 0, t, x, initial_mode(self.system))
         self.recorder.sample(0, x, self.library[mode])
         for k in range(len(times) - 1):
             t_end = float(times[k + 1])
@@ -99,16 +97,9 @@ class _Run:
                 continue
             t_event, guard = crossing
             self.recorder.on_step(dynamics, k, t_old, t_event, dense)
-            return self._event(k, t_event, dense(t_event), mode, dynamics, guard)
+            mode, x, states = settle_and_record(self.library, self.motion, self.recorder, self.counters, k, t_event, dense(t_event), mode, guard)
+            return t_event, x, mode, states
         return t_end, solver.y.copy(), mode, states
-
-    def _event(self, k: int, t: float, x: np.ndarray, mode: Mode, dynamics: ModeDynamics, guard: int):
-        fired = (int(dynamics.guard_kind[guard]), int(dynamics.guard_target[guard]), int(dynamics.guard_direction[guard]))
-        self.counters.total += 1
-        new_mode, x, states, transitions = settle(self.library, self.motion, k, t, x, mode, self.counters, fired)
-        self.recorder.on_transitions(t, x, transitions, new_mode)
-        self.recorder.on_contact_force(t, new_mode, self.library[new_mode], x)
-        return t, x, new_mode, states
 
     def _solver(self, dynamics: ModeDynamics, k: int, t: float, x: np.ndarray, t_end: float):
         A, B, c = dynamics.A, dynamics.B, dynamics.c
