@@ -52,7 +52,7 @@ from __future__ import annotations
 import hashlib
 import math
 from collections import OrderedDict
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, fields
 from functools import cache, partial
 
@@ -77,8 +77,12 @@ SERIES_TOLERANCE = np.finfo(float).eps / 16
 """Size (∞-norm, balanced) of the last Taylor term of exp(𝒜 τ) kept."""
 GAUSS_NODES, GAUSS_WEIGHTS = np.polynomial.legendre.leggauss(5)
 _CACHE_SIZE = 16
-PROPAGATOR_BUDGET = 512 * 2**20
-"""Largest size of the cached :class:`ModePropagator` of one library, bytes."""
+PROPAGATOR_BUDGET = 128 * 2**20
+"""Largest size of the cached :class:`ModePropagator` of one library, bytes.
+
+The exact engine keeps its own copies of the modes it runs in (its slots,
+``solvers.exact.TABLE_BUDGET``), so this cache only spares rebuilding a mode
+evicted from the slots; dropped propagators are rebuilt from the block cache."""
 BLOCK_BUDGET = 64 * 2**20
 """Largest size of the cached block flows of one library, bytes."""
 
@@ -403,7 +407,8 @@ class PropagatorLibrary:
 
     Propagators are cached within :data:`PROPAGATOR_BUDGET`; one dropped from
     the cache is rebuilt when asked for again (from the cached blocks, see
-    :class:`BlockCache`). ``len`` counts the distinct modes built.
+    :class:`BlockCache`). ``len`` counts the distinct modes built, and
+    iterating gives them in the order they were first built.
 
     Parameters
     ----------
@@ -434,9 +439,8 @@ class PropagatorLibrary:
     def __len__(self) -> int:
         return len(self._order)
 
-    def built(self) -> list[tuple[Mode, ModePropagator]]:
-        """Every built mode and its propagator, in the order they were first built (rebuilding dropped ones)."""
-        return [(mode, self[mode]) for mode in self._order]
+    def __iter__(self) -> Iterator[Mode]:
+        return iter(self._order)
 
 
 _LIBRARIES: OrderedDict[bytes, PropagatorLibrary] = OrderedDict()

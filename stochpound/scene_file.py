@@ -7,6 +7,7 @@ path (0-based indices), e.g. ``building[0].base.mu: must be >= 0, got -0.2``.
 
 from __future__ import annotations
 
+import inspect
 import math
 import tomllib
 from pathlib import Path
@@ -385,17 +386,28 @@ def _record_motion(table: Mapping[str, Any], base_dir: Path, g: float) -> Sample
     return SampledMotion(record.dt, values, interpolation, description)
 
 
+def _check_generator_fields(table: Mapping[str, Any], generator: Any, kind: str) -> None:
+    """Reject fields the generator does not take, and name the required ones that are missing."""
+    signature = inspect.signature(generator).parameters
+    own = {name for name in signature if name not in ("n_realizations", "start")}
+    _reject_unknown(table, own | {"type", "realization", "interpolation"}, "motion")
+    for name, parameter in signature.items():
+        if name in own and parameter.default is inspect.Parameter.empty and name not in table:
+            raise SceneError(f"motion.{name}: required for type = {kind!r} (see docs/motions.md)")
+
+
 def _synthetic_motion(table: Mapping[str, Any], kind: str) -> SampledMotion:
     """One realization of a synthetic ensemble, fixed by (seed, realization) alone."""
     from stochpound import motions
 
+    generator = getattr(motions, kind)
+    _check_generator_fields(table, generator, kind)
     parameters = {key: value for key, value in table.items() if key not in ("type", "realization", "interpolation")}
     realization = table.get("realization", 0)
     if not isinstance(realization, int) or isinstance(realization, bool) or realization < 0:
         raise SceneError(f"motion.realization: must be an integer >= 0, got {realization!r}")
     duration, dt = _timing(table, required=True)
     parameters.update(duration=duration, dt=dt)
-    generator = getattr(motions, kind)
     try:
         ensemble = generator(1, start=realization, **parameters)
     except (TypeError, ValueError) as error:

@@ -112,7 +112,7 @@ def test_dropped_propagators_and_dynamics_are_rebuilt_identically(monkeypatch):
             np.testing.assert_array_equal(getattr(a, name), getattr(b, name), err_msg=name)
         np.testing.assert_array_equal(a.dynamics.A, b.dynamics.A)
     assert len(bounded) == len(bounded.modes) == len(set(visits))
-    assert [mode for mode, _ in bounded.built()] == [mode for mode, _ in unbounded.built()]
+    assert list(bounded) == list(unbounded) == list(dict.fromkeys(visits))
 
 
 def test_identical_buildings_share_their_blocks(monkeypatch):

@@ -119,6 +119,25 @@ def test_missing_record_is_rejected():
     assert "motion.record" in rejected(lambda s: s.update(motion={"record": "no_such_record"}))
 
 
+SYNTHETIC = {"type": "kanai_tajimi", "omega_g": 15.0, "zeta_g": 0.6, "pga": 3.0, "seed": 1, "duration": 2.0, "dt": 0.01}
+
+
+@pytest.mark.parametrize(
+    "change, message",
+    [
+        ({"omega_g": None}, "motion.omega_g: required for type = 'kanai_tajimi'"),
+        ({"type": "clough_penzien"}, "motion.omega_f: required for type = 'clough_penzien'"),
+        ({"soil": "firm"}, "motion.soil: unknown field (allowed: S0, band_limit"),
+        ({"zeta_g": -0.1}, "motion: zeta_g"),
+        ({"realization": -1}, "motion.realization: must be an integer >= 0"),
+    ],
+    ids=["missing omega_g", "missing filter of clough_penzien", "unknown field", "bad value", "bad realization"],
+)
+def test_bad_synthetic_motions_are_rejected(change, message):
+    motion = {key: value for key, value in {**SYNTHETIC, **change}.items() if value is not None}
+    assert message in rejected(lambda s: s.update(motion=motion))
+
+
 def test_cli_reports_the_field_and_writes_nothing(tmp_path):
     scene_file = tmp_path / "bad.toml"
     scene_file.write_text(
