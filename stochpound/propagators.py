@@ -58,8 +58,6 @@ from functools import cache, partial
 
 import numpy as np
 from scipy.linalg import matrix_balance
-from scipy.sparse import csr_matrix
-from scipy.sparse.csgraph import connected_components
 
 from stochpound.errors import StochpoundError
 from stochpound.events import Dense
@@ -298,9 +296,15 @@ def coupled_blocks(A: np.ndarray, n_dof: int) -> list[np.ndarray]:
     """
     n = n_dof
     coupling = (A[:n, :n] != 0) | (A[:n, n:] != 0) | (A[n:, :n] != 0) | (A[n:, n:] != 0)
-    count, labels = connected_components(csr_matrix(coupling), directed=False)
-    order = np.argsort(labels, kind="stable")
-    return np.split(order, np.cumsum(np.bincount(labels, minlength=count))[:-1])
+    coupling |= coupling.T
+    labels = np.arange(n)  # each DOF's block is named by its lowest DOF: label propagation with pointer jumping
+    while True:
+        lowered = np.minimum(labels, np.where(coupling, labels, n).min(axis=1, initial=n))
+        lowered = lowered[lowered]
+        if np.array_equal(lowered, labels):
+            break
+        labels = lowered
+    return [np.flatnonzero(labels == label) for label in np.unique(labels)]
 
 
 class BlockCache:

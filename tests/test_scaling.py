@@ -55,6 +55,26 @@ def test_blocks_are_the_buildings_joined_by_closed_contacts():
     assert sorted(joined, key=min) == [b1, b2 | b3]
 
 
+def test_blocks_are_the_connected_components_of_the_coupling():
+    """Random sparse couplings: the blocks are scipy's connected components, each sorted, ordered by lowest DOF."""
+    from scipy.sparse import csr_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    rng = np.random.default_rng(7)
+    for _ in range(300):
+        n = int(rng.integers(1, 40))
+        A = np.zeros((2 * n, 2 * n))
+        entries = int(rng.integers(0, 3 * n))
+        A[rng.integers(0, 2 * n, entries), rng.integers(0, 2 * n, entries)] = 1.0
+        coupling = sum(A[i * n : (i + 1) * n, j * n : (j + 1) * n] != 0 for i in (0, 1) for j in (0, 1)) > 0
+        count, labels = connected_components(csr_matrix(coupling), directed=False)
+        expected = sorted((np.flatnonzero(labels == label) for label in range(count)), key=min)
+        blocks = coupled_blocks(A, n)
+        assert len(blocks) == count
+        for block, component in zip(blocks, expected):
+            np.testing.assert_array_equal(block, component)
+
+
 @pytest.mark.parametrize("motion", [None, "harmonic"])
 def test_propagators_equal_the_exponential_of_the_whole_mode(motion):
     """exp(𝒜 τ) of the full augmented matrix (scipy) at h, at the Gauss nodes and anywhere in the sub-step."""
