@@ -16,6 +16,8 @@ peak on seed 2).
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 import pytest
 
@@ -31,7 +33,7 @@ def random_scene(seed: int, duration: float = 6.0) -> dict:
     buildings = [_random_building(rng, f"B{b + 1}") for b in range(int(rng.integers(1, 5)))]
     contacts = [
         _random_contact(rng, left, right, floor)
-        for left, right in zip(buildings[:-1], buildings[1:])
+        for left, right in itertools.pairwise(buildings)
         for floor in range(1, min(len(left["mass"]), len(right["mass"])) + 1)
         if rng.random() < 0.8
     ]
