@@ -24,6 +24,7 @@ This module also lays out the engine's arrays (:class:`_Slots`, :func:`_plant`,
 
 from __future__ import annotations
 
+import itertools
 import math
 import weakref
 from collections import namedtuple
@@ -120,7 +121,7 @@ class _PythonRun:
         state = _state(self.system, len(self.motion.times))
         outputs = state.outputs._replace(running=self.recorder.running, states=self.recorder.states, energy=self.recorder.energy_history)
         self.state = state._replace(outputs=outputs)
-        self.work = engine.work_arrays(2 * self.system.n_dof, _max_guards(self.system), self.system.n_contacts)
+        self.work = _work_arrays(self.system, _slots(self.propagators))  # the quiet loop uses no Chebyshev rows: never too narrow
 
     def execute(self) -> tuple[Recorder, EventCounters, ModeLibrary]:
         times = self.motion.times
@@ -174,7 +175,7 @@ class _PythonRun:
         dynamics = propagator.dynamics
         n_steps = max(1, math.ceil((t_end - t) / propagator.step - 1e-9))
         edges = np.linspace(t, t_end, n_steps + 1)
-        for t0, t1 in zip(edges[:-1], edges[1:]):
+        for t0, t1 in itertools.pairwise(edges):
             dense = propagator.dense(t0, x, self.motion.derivatives(t0, k))
             x1 = dense(t1)
             crossing = first_crossing(dynamics, self.motion, k, Step(t0, t1, x, x1, dense), states, self.counters)
@@ -215,7 +216,6 @@ class _CompiledRun:
         self.system = self.propagators.system
         self.plant = _plant(self.system, self.motion)
         self.state = _state(self.system, len(self.motion.times))
-        self.work = engine.work_arrays(2 * self.system.n_dof, _max_guards(self.system), self.system.n_contacts)
 
     def execute(self) -> tuple[Recorder, EventCounters, ModeLibrary]:
         run, system = self.state.run, self.system
@@ -228,7 +228,7 @@ class _CompiledRun:
             if len(self.state.run.visited) < len(slots.modes):
                 visited = np.resize(self.state.run.visited, 2 * len(slots.modes))
                 self.state = self.state._replace(run=self.state.run._replace(visited=visited))
-            status = engine.run_engine(*slots.tables, *self.plant, *self.state, *self.work, True)
+            status = engine.run_engine(*slots.tables, *self.plant, *self.state, *_work_arrays(system, slots), True)
             if status == engine.FINISHED:
                 break
             if status == engine.NEED_MODE:
@@ -304,6 +304,12 @@ def _plant(system: System, motion: GroundMotion) -> Plant:
 
 def _max_guards(system: System) -> int:
     return 2 * system.n_contacts + 2 * len(system.base_dofs)
+
+
+def _work_arrays(system: System, slots: "_Slots") -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The engine's work arrays for ``system`` and the current Chebyshev width of ``slots`` (:func:`exact_engine.work_arrays`)."""
+    mode_size = system.n_contacts + len(system.base_dofs)
+    return engine.work_arrays(2 * system.n_dof, _max_guards(system), system.n_contacts, mode_size, slots.arrays["chebyshev"].shape[2])
 
 
 def _state(system: System, n_times: int) -> State:

@@ -53,8 +53,14 @@ which take arrays; the helpers take the few arrays they use, are compiled
 once without Python wrappers (:data:`INTERNAL`) and are inlined by LLVM; no
 compile-time constant is passed to a helper (it would compile a second
 specialisation), and no array is assigned to an array slice (its error
-message alone compiles string formatting). All jitted code lives in this one
-module, whose source stamp is what invalidates numba's cache.
+message alone compiles string formatting). Reference counting would make up
+half of the unoptimised IR (every incref or decref of an array extracts all
+its fields), so everything is compiled without numba's runtime
+(``_nrt=False``): the engine allocates nothing (every work vector is a row of
+the arrays of :func:`work_arrays`), and it calls no builtin ``min`` or
+``max`` (each compiles an overload; the comparisons written out give the same
+results). All jitted code lives in this one module, whose source stamp is
+what invalidates numba's cache.
 """
 
 from __future__ import annotations
@@ -69,8 +75,8 @@ from stochpound.events import FIRE_THRESHOLD, MAX_SETTLE_ITERATIONS, ROUND_OFF, 
 from stochpound.modes import STUCK, Guard
 from stochpound.propagators import GAUSS_NODES, GAUSS_WEIGHTS
 
-INTERNAL = {"no_cpython_wrapper": True, "no_cfunc_wrapper": True, "error_model": "numpy"}
-"""Options of the jitted helpers, called only from compiled code."""
+INTERNAL = {"no_cpython_wrapper": True, "no_cfunc_wrapper": True, "error_model": "numpy", "_nrt": False}
+"""Options of the jitted helpers, called only from compiled code (no runtime: they allocate nothing)."""
 
 ModeTable = namedtuple("ModeTable", "modes ids codes n_guards substeps")
 ModeTable.__doc__ = """The modes in the table's slots: mode vector (invalid in an empty slot), the mode's id (kept
@@ -136,10 +142,21 @@ _RTOL = 4 * np.finfo(float).eps
 _EPS = 2 * np.finfo(float).eps
 
 
-def work_arrays(size: int, n_guards: int, n_contacts: int) -> tuple[np.ndarray, np.ndarray]:
-    """``scratch`` and ``saved`` work arrays of :func:`run_engine` for state size ``size`` (2N)."""
+def work_arrays(size: int, n_guards: int, n_contacts: int, mode_size: int, chebyshev_width: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``scratch``, ``saved`` and ``marks`` work arrays of :func:`run_engine`.
+
+    For state size ``size`` (2N), mode vectors of ``mode_size`` and Chebyshev
+    rows of ``chebyshev_width`` (``Propagators.chebyshev.shape[2]``). The
+    engine allocates nothing: every work vector is a row of these.
+    ``scratch`` rows: 0–6 the quiet loop's (:func:`_advance_quiet`), 0–15
+    an event step's (:func:`_advance_span`, :func:`_first_crossing`), 16–23
+    settling's. ``marks`` rows: the settling chain's modes, its transitions,
+    then the guard headings and two mode vectors.
+    """
     width = size + 5
-    return np.zeros((7, max(5 * width + n_contacts, n_guards))), np.zeros((6, max(4, n_contacts, n_guards)))
+    scratch = np.zeros((24, max(5 * width + n_contacts, n_guards, chebyshev_width)))
+    marks = np.zeros((2 * (_MAX_SETTLE + 1) + 3, max(mode_size, 3, n_guards)), dtype=np.int64)
+    return scratch, np.zeros((6, max(4, n_contacts, n_guards))), marks
 
 
 # ---------------------------------------------------------------- linear algebra and read-outs
@@ -277,15 +294,18 @@ def _interior_maximum(a0, a1, a2, a3):
         if discriminant >= 0.0:
             root = math.sqrt(discriminant)
             tau = (-2.0 * a2 + root) / (6.0 * a3)
-            if 0.0 < tau < 1.0:
-                best = max(best, a0 + tau * (a1 + tau * (a2 + tau * a3)))
+            value = a0 + tau * (a1 + tau * (a2 + tau * a3))
+            if 0.0 < tau < 1.0 and value > best:
+                best = value
             tau = (-2.0 * a2 - root) / (6.0 * a3)
-            if 0.0 < tau < 1.0:
-                best = max(best, a0 + tau * (a1 + tau * (a2 + tau * a3)))
+            value = a0 + tau * (a1 + tau * (a2 + tau * a3))
+            if 0.0 < tau < 1.0 and value > best:
+                best = value
     elif a2 != 0.0:
         tau = -a1 / (2.0 * a2)
-        if 0.0 < tau < 1.0:
-            best = max(best, a0 + tau * (a1 + tau * (a2 + tau * a3)))
+        value = a0 + tau * (a1 + tau * (a2 + tau * a3))
+        if 0.0 < tau < 1.0 and value > best:
+            best = value
     return best
 
 
@@ -436,7 +456,8 @@ def _ground_value(flow, t):
 @njit(**INTERNAL)
 def _dense(flow, t, out):
     """x(t) from the step's Chebyshev coefficients (``ModePropagator.dense``; Tₙ by the recurrence Tₙ₊₁ = 2s Tₙ − Tₙ₋₁)."""
-    s = min(max((t - flow.t0) * flow.scale - 1.0, -1.0), 1.0)
+    s = (t - flow.t0) * flow.scale - 1.0
+    s = -1.0 if s < -1.0 else (1.0 if s > 1.0 else s)  # clipped to [−1, 1]
     size = out.shape[0]
     coefficients = flow.coefficients
     previous, current = 1.0, s
@@ -492,7 +513,8 @@ def _brentq(flow, index, level, xa, xb, work):
                 dpre = (fpre - fcur) / (xpre - xcur)
                 dblk = (fblk - fcur) / (xblk - xcur)
                 stry = -fcur * (fblk * dblk - fpre * dpre) / (dblk * dpre * (fblk - fpre))
-            if 2.0 * abs(stry) < min(abs(spre), 3.0 * abs(sbis) - delta):
+            limit = 3.0 * abs(sbis) - delta
+            if 2.0 * abs(stry) < (limit if limit < abs(spre) else abs(spre)):  # min(abs(spre), limit)
                 spre, scur = scur, stry
             else:
                 spre, scur = sbis, sbis
@@ -543,7 +565,7 @@ def _maximise_guard(flow, j, level, a, b, work):
         if golden:
             e = a - xf if xf >= xm else b - xf
             rat = golden_mean * e
-        x = xf + (1.0 if rat >= 0.0 else -1.0) * max(abs(rat), tol1)
+        x = xf + (1.0 if rat >= 0.0 else -1.0) * (tol1 if tol1 > abs(rat) else abs(rat))
         fu = -_evaluate(flow, j, level, x, work)
         num += 1
         if fu <= fx:
@@ -593,10 +615,10 @@ def _critical_points(a1, a2, a3, out):
         half = -0.5 * (qb + math.sqrt(discriminant)) if qb >= 0.0 else -0.5 * (qb - math.sqrt(discriminant))
         r1 = half / qa
         r2 = qc / half if half != 0.0 else r1
-        low, high = min(r1, r2), max(r1, r2)
+        low, high = (r2 if r2 < r1 else r1), (r2 if r2 > r1 else r1)
     else:
         low = high = -qb / (2.0 * qa)
-        if math.sqrt(-discriminant) / (2.0 * abs(qa)) > 1e-12 * max(1.0, abs(low)):
+        if math.sqrt(-discriminant) / (2.0 * abs(qa)) > 1e-12 * (abs(low) if abs(low) > 1.0 else 1.0):
             return 0
     if 0.0 < low < 1.0:
         out[count] = low
@@ -608,7 +630,8 @@ def _critical_points(a1, a2, a3, out):
 
 
 @njit(**INTERNAL)
-def _first_crossing(flow, threshold, tolerance, rearmable, disarmed, counters, t1, values0, values1, rates0, rates1, work):
+def _first_crossing(flow, threshold, tolerance, rearmable, disarmed, counters, t1, values0, values1, rates0, rates1, work, taus, times,
+                    raw):
     """(time, guard) of the earliest crossing in [t0, t1], or (NaN, −1) (``events.first_crossing``).
 
     Every guard whose cubic Hermite interpolant may reach zero is located on
@@ -616,10 +639,10 @@ def _first_crossing(flow, threshold, tolerance, rearmable, disarmed, counters, t
     critical points; an armed guard fires at 0, a disarmed one at its
     threshold until it has dipped below −tolerance; a cubic maximum close to
     the level is checked by maximising the true guard (``events._grazing``).
+    ``taus``, ``times`` and ``raw`` are work vectors (4 entries).
     """
     t0 = flow.t0
     h = t1 - t0
-    taus, times, raw = np.empty(4), np.empty(4), np.empty(4)
     best_time, best_guard = math.nan, -1
     for j in range(values0.shape[0]):
         if not abs(threshold[j]) < math.inf:
@@ -640,7 +663,7 @@ def _first_crossing(flow, threshold, tolerance, rearmable, disarmed, counters, t
                 raw[i] = _evaluate(flow, j, 0.0, times[i], work)
         armed = not disarmed[j]
         level = 0.0 if armed else threshold[j]
-        previous = min(raw[0], -tolerance[j]) if armed else raw[0] - level
+        previous = (-tolerance[j] if -tolerance[j] < raw[0] else raw[0]) if armed else raw[0] - level
         time = math.nan
         for i in range(1, n):
             current = raw[i] - level
@@ -651,7 +674,7 @@ def _first_crossing(flow, threshold, tolerance, rearmable, disarmed, counters, t
             if 0 < i < n - 1 and current < 0.0 and a0 + tau * (a1 + tau * (a2 + tau * a3)) - level >= -margin:  # grazing
                 counters[GRAZING] += 1
                 start = times[i - 1]
-                t_max, value = _maximise_guard(flow, j, level, start, times[min(i + 1, n - 1)], work)
+                t_max, value = _maximise_guard(flow, j, level, start, times[i + 1], work)  # i + 1 < n here
                 if -value >= 0.0 and _evaluate(flow, j, level, start, work) < 0.0:
                     time = _brentq(flow, j, level, start, t_max, work)
                     break
@@ -722,14 +745,15 @@ def _with_bound(M, i, x, magnitude, ground, constant):
 
 
 @njit(**INTERNAL)
-def _leaving_sign(rate, guard, n_guards, x, ground, values, tolerance, heading):
+def _leaving_sign(rate, guard, n_guards, x, ground, values, tolerance, heading, scratch):
     """``events.guard_leaving_sign``: values, tolerances and heading of the first n_guards guards.
 
     The heading of a guard is the sign of its first time derivative (up to the
-    third) that is clearly non-zero: 0 while undecided.
+    third) that is clearly non-zero: 0 while undecided. ``scratch``: the
+    engine's work array (:func:`work_arrays`).
     """
     size = x.shape[0]
-    derivative, magnitude, next_derivative, next_magnitude = np.empty(size), np.empty(size), np.empty(size), np.empty(size)
+    derivative, magnitude, next_derivative, next_magnitude = scratch[20, :size], scratch[21, :size], scratch[22, :size], scratch[23, :size]
     for i in range(size):
         derivative[i], magnitude[i] = x[i], abs(x[i])
     for g in range(n_guards):
@@ -784,32 +808,31 @@ def _initial_guard_states(codes, n_guards, geometry, gap, tensile, x, values, to
 
 @njit(**INTERNAL)
 def _settle(modes, codes, n_guards, rate, guard, geometry, gap, tensile, base_dofs, ground, ints, x, mode, transitions,
-            threshold, tolerance, rearmable, disarmed):
+            threshold, tolerance, rearmable, disarmed, scratch, marks):
     """``events.settle`` of the pending event: returns (mode index, number of transitions); x and mode are updated.
 
     ``codes``, ``rate`` and ``guard`` are the :class:`ModeTable` and
     :class:`Dynamics` arrays of the slots. Returns mode index −1 when the
     settled mode is in no slot (``mode`` is that mode; nothing else has
-    changed then).
+    changed then). ``scratch`` and ``marks``: the work arrays (:func:`work_arrays`).
     """
     n_guards_max = guard.shape[1]
-    values, limits = np.empty(n_guards_max), np.empty(n_guards_max)
-    heading = np.empty(n_guards_max, dtype=np.int64)
+    values, limits, heading = scratch[18, :n_guards_max], scratch[19, :n_guards_max], marks[-3, :n_guards_max]
     n_transitions = 0
     if ints[PENDING] == EVENT:
         kind, target, direction = ints[FIRED_KIND], ints[FIRED_TARGET], ints[FIRED_DIRECTION]
         _apply(geometry, gap, base_dofs, mode, x, kind, target, direction)
         transitions[0, 0], transitions[0, 1], transitions[0, 2] = kind, target, direction
         n_transitions = 1
-    visited, following = np.empty((_MAX_SETTLE + 1, mode.shape[0]), dtype=np.int64), np.empty(mode.shape[0], dtype=np.int64)
-    _copy(mode, visited[0])
+    visited, following = marks[: _MAX_SETTLE + 1], marks[-2, : mode.shape[0]]
+    _copy(mode, visited[0, : mode.shape[0]])
     n_visited = 1
     settled = False
     for _ in range(_MAX_SETTLE):
         m = _lookup(modes, mode)
         if m < 0:
             break
-        _leaving_sign(rate[m], guard[m], n_guards[m], x, ground, values, limits, heading)
+        _leaving_sign(rate[m], guard[m], n_guards[m], x, ground, values, limits, heading, scratch)
         j = _first_wanting(codes[m], n_guards[m], geometry, gap, tensile, x, values, limits, heading)
         if j < 0:
             settled = True
@@ -821,7 +844,7 @@ def _settle(modes, codes, n_guards, rate, guard, geometry, gap, tensile, base_do
             break
         transitions[n_transitions, 0], transitions[n_transitions, 1], transitions[n_transitions, 2] = kind, target, direction
         n_transitions += 1
-        _copy(following, visited[n_visited])
+        _copy(following, visited[n_visited, : mode.shape[0]])
         n_visited += 1
         _copy(following, mode)
     m = _lookup(modes, mode)
@@ -829,7 +852,7 @@ def _settle(modes, codes, n_guards, rate, guard, geometry, gap, tensile, base_do
         return -1, 0
     if not settled:
         ints[CHATTER] += 1
-        _leaving_sign(rate[m], guard[m], n_guards[m], x, ground, values, limits, heading)
+        _leaving_sign(rate[m], guard[m], n_guards[m], x, ground, values, limits, heading, scratch)
     _initial_guard_states(codes[m], n_guards[m], geometry, gap, tensile, x, values, limits, threshold, tolerance, rearmable, disarmed)
     return m, n_transitions
 
@@ -864,22 +887,22 @@ def _on_transitions(mode, force, left_rows, right_rows, geometry, is_open, impac
 
 @njit(inline="always", error_model="numpy")
 def _settle_pending(modes, codes, n_guards, rate, guard, force, motion, layout, arming, ints, clock, pending_x, pending_mode,
-                    missing_mode, is_open, impact, table, x):
+                    missing_mode, is_open, impact, table, x, scratch, marks):
     """Settle the pending event (or the start) and record it (``settle_and_record``): returns the mode index.
 
     The settled state goes into ``x``. Returns −1 (with the mode to build in
     ``missing_mode``, and nothing else changed) when a mode is missing.
+    ``scratch`` and ``marks``: the work arrays (:func:`work_arrays`).
     """
-    settled, mode = np.empty(x.shape[0]), np.empty(pending_mode.shape[0], dtype=np.int64)
+    settled, mode = scratch[16, : x.shape[0]], marks[-1, : pending_mode.shape[0]]
     _copy(pending_x, settled)
     _copy(pending_mode, mode)
-    transitions = np.empty((_MAX_SETTLE + 1, 3), dtype=np.int64)
-    ground = np.empty(4)
+    transitions, ground = marks[_MAX_SETTLE + 1 : 2 * (_MAX_SETTLE + 1)], scratch[17, :4]
     _ground(motion.times, motion.coefficients, motion.harmonic, clock[0], ints[K], ground)
     geometry, gap, tensile, left_rows, right_rows, base_dofs = layout
     threshold, tolerance, rearmable, disarmed = arming
     m, n_transitions = _settle(modes, codes, n_guards, rate, guard, geometry, gap, tensile, base_dofs, ground, ints, settled, mode,
-                               transitions, threshold, tolerance, rearmable, disarmed)
+                               transitions, threshold, tolerance, rearmable, disarmed, scratch, marks)
     if m < 0:
         _copy(mode, missing_mode)
         return m
@@ -894,24 +917,27 @@ def _settle_pending(modes, codes, n_guards, rate, guard, force, motion, layout, 
 
 @njit(inline="always", error_model="numpy")
 def _advance_span(m, n, modes, codes, substeps, step, propagate, chebyshev, rate, guard, force, power, motion, ints, clock, x,
-                  pending_x, pending_mode, arming, is_open, impact, running, k, t, t_end):
+                  pending_x, pending_mode, arming, is_open, impact, running, k, t, t_end, scratch):
     """Sub-steps of mode m (n guards, its arrays) from t to t_end (``_until_event`` of exact.py).
 
     Returns True when it stopped at an event (now pending), False at t_end.
+    ``scratch``: the work array (:func:`work_arrays`).
     """
     times, coefficients_k, harmonic = motion.times, motion.coefficients, motion.harmonic
     threshold, tolerance, rearmable, disarmed = arming
     full = t == times[k] and t_end == times[k + 1]
-    n_steps = substeps if full else max(1, math.ceil((t_end - t) / step - 1e-9))
+    n_steps = substeps if full else math.ceil((t_end - t) / step - 1e-9)
+    if not full and n_steps < 1:
+        n_steps = 1
     spacing = (t_end - t) / n_steps
     size = x.shape[0]
     width = size + 5
-    values0, values1, rates0, rates1 = np.empty(n), np.empty(n), np.empty(n), np.empty(n)
-    z0, propagated, work, rate_work, ground1 = np.empty(width), np.empty(propagate.shape[1]), np.empty(size), np.empty(size), np.empty(4)
-    node, products = np.empty(width), np.empty(power.shape[1])  # node: z = [x, a_g, 0, 0, 0, 1] at a Gauss node
+    z0, propagated, work = scratch[0, :width], scratch[1, : propagate.shape[1]], scratch[2, :size]
+    values0, values1, rates0, rates1 = scratch[3, :n], scratch[4, :n], scratch[5, :n], scratch[6, :n]
+    rate_work, ground1, coefficients = scratch[7, :size], scratch[8, :4], scratch[9, : chebyshev.shape[1]]
+    node, products = scratch[10, :width], scratch[11, : power.shape[1]]  # node: z = [x, a_g, 0, 0, 0, 1] at a Gauss node
     node[size + 1], node[size + 2], node[size + 3], node[width - 1] = 0.0, 0.0, 0.0, 1.0
     x1 = propagated[:size]
-    coefficients = np.empty(chebyshev.shape[1])
     is_harmonic = harmonic.shape[0] > 0
     ground = harmonic if is_harmonic else coefficients_k[k]
     any_open = _any(is_open)
@@ -937,10 +963,11 @@ def _advance_span(m, n, modes, codes, substeps, step, propagate, chebyshev, rate
             continue
         if full:
             _product(chebyshev, z0, coefficients)
-        t_event, fired = _first_crossing(flow, threshold, tolerance, rearmable, disarmed, ints, t1, values0, values1, rates0, rates1, work)
+        t_event, fired = _first_crossing(flow, threshold, tolerance, rearmable, disarmed, ints, t1, values0, values1, rates0, rates1, work,
+                                         scratch[13], scratch[14], scratch[15])
         t_stop, x_stop = t1, x1
         if fired >= 0:
-            t_stop, x_stop = t_event, np.empty(size)
+            t_stop, x_stop = t_event, scratch[12, :size]
             _dense(flow, t_event, x_stop)
         if t_stop > t0:  # Recorder.on_step: energy terms and impulses at the Gauss nodes, then peak forces
             half = 0.5 * (t_stop - t0)
@@ -978,8 +1005,8 @@ def _advance_span(m, n, modes, codes, substeps, step, propagate, chebyshev, rate
 # ---------------------------------------------------------------- the run
 
 
-@njit(cache=True, nogil=True, no_cfunc_wrapper=True, error_model="numpy")
-def run_engine(table, dynamics, propagators, motion, layout, run, arming, impacts, outputs, scratch, saved, events):
+@njit(cache=True, nogil=True, no_cfunc_wrapper=True, error_model="numpy", _nrt=False)
+def run_engine(table, dynamics, propagators, motion, layout, run, arming, impacts, outputs, scratch, saved, marks, events):
     """Run (or resume) the simulation; returns FINISHED, NEED_MODE, NEED_SPACE or NEEDS_EVENTS.
 
     Parameters
@@ -990,7 +1017,7 @@ def run_engine(table, dynamics, propagators, motion, layout, run, arming, impact
         The motion and the system.
     run, arming, impacts, outputs : Run, Arming, Impacts, Outputs
         Everything the run changes, updated in place.
-    scratch, saved : np.ndarray
+    scratch, saved, marks : np.ndarray
         Work arrays (:func:`work_arrays`).
     events : bool
         False for the Python event path: only the quiet loop runs, and
@@ -1015,7 +1042,7 @@ def run_engine(table, dynamics, propagators, motion, layout, run, arming, impact
             if ints[N_IMPACTS] + is_open.shape[0] > impact_table.shape[0]:
                 return NEED_SPACE
             m = _settle_pending(modes, codes, n_guards, rate, guard, force, motion, layout, arming, ints, clock, pending_x,
-                                pending_mode, missing_mode, is_open, impact, impact_table, x)
+                                pending_mode, missing_mode, is_open, impact, impact_table, x, scratch, marks)
             if m < 0:
                 return NEED_MODE
             ints[MODE] = m
@@ -1033,9 +1060,9 @@ def run_engine(table, dynamics, propagators, motion, layout, run, arming, impact
         if not events:
             return NEEDS_EVENTS
         t, t_end = clock[0], times[k + 1]
-        if t_end - t > _EPS * max(1.0, abs(t_end)) and _advance_span(
+        if t_end - t > _EPS * (abs(t_end) if abs(t_end) > 1.0 else 1.0) and _advance_span(
             m, n_guards[m], modes, codes, substeps[m], step[m], propagate[m], chebyshev[m], rate[m], guard[m], force[m], power[m],
-            motion, ints, clock, x, pending_x, pending_mode, arming, is_open, impact, running, k, t, t_end
+            motion, ints, clock, x, pending_x, pending_mode, arming, is_open, impact, running, k, t, t_end, scratch
         ):
             continue
         clock[0] = t_end
