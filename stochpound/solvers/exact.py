@@ -32,7 +32,14 @@ from collections import namedtuple
 import numpy as np
 from threadpoolctl import ThreadpoolController
 
-from stochpound.events import MAX_SETTLE_ITERATIONS, EventCounters, GuardStates, Step, first_crossing, initial_mode
+from stochpound.events import (
+    MAX_SETTLE_ITERATIONS,
+    EventCounters,
+    GuardStates,
+    Step,
+    first_crossing,
+    initial_mode,
+)
 from stochpound.modes import BoundedCache, Mode, ModeDynamics, ModeLibrary
 from stochpound.motion import GroundMotion, HarmonicMotion
 from stochpound.propagators import (
