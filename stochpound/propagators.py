@@ -79,7 +79,7 @@ PROPAGATOR_BUDGET = 128 * 2**20
 """Largest size of the cached :class:`ModePropagator` of one library, bytes.
 
 The exact engine keeps its own copies of the modes it runs in (its slots,
-``solvers.exact.TABLE_BUDGET``), so this cache only spares rebuilding a mode
+``solvers.exact_tables.TABLE_BUDGET``), so this cache only spares rebuilding a mode
 evicted from the slots; dropped propagators are rebuilt from the block cache."""
 BLOCK_BUDGET = 64 * 2**20
 """Largest size of the cached block flows of one library, bytes."""

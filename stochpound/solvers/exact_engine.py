@@ -34,8 +34,8 @@ row i gives ``row[:S] · x + row[S] a_g + row[S + 1]`` (S = 2N): ``rate``
 (ẋ = A x + B a_g + c), ``guard`` (G x + h a_g + g0) and ``force`` (contact
 forces, no a_g term), summed in the order of the Python code. The powers of
 the energy balance are quadratic forms of the augmented state z = [x, w, 1]
-(``exact._power_forms``), and their 5-point Gauss–Legendre integrals over a
-whole sub-step are quadratic forms of z(t0) (``exact._sub_step_forms``).
+(``exact_tables._power_forms``), and their 5-point Gauss–Legendre integrals over a
+whole sub-step are quadratic forms of z(t0) (``exact_tables._sub_step_forms``).
 The arrays are grouped in small named tuples: :class:`ModeTable`,
 :class:`Dynamics` and :class:`Propagators` (one row per slot of modes),
 :class:`Motion` and :class:`Layout` (the plant), :class:`Run`,
@@ -87,7 +87,7 @@ Dynamics.__doc__ = """The slots' modes' affine maps of ẋ, the guards (padded) 
 
 ``power[m]`` stacks the quadratic forms P of the input, damping, friction and
 impact powers, zᵀ P z at z = [x, a_g, 0, 0, 0, 1], transposed (Z × 4Z)
-(``exact._power_forms``).
+(``exact_tables._power_forms``).
 """
 Propagators = namedtuple("Propagators", "propagate chebyshev step")
 Propagators.__doc__ = """Exact sub-step propagators of the slots' modes.
@@ -95,7 +95,7 @@ Propagators.__doc__ = """Exact sub-step propagators of the slots' modes.
 ``propagate[m]`` is [exp(𝒜h); Q_input; Q_damping; Q_friction; Q_impact; R]
 transposed (Z × (5Z + n_contacts)): one product of z(t0) gives z(t0 + h),
 Q z(t0) of every energy term (whose gain over the sub-step is z(t0) · Q z(t0))
-and the impulses R z(t0) (``exact._sub_step_forms``). ``chebyshev[m]`` is the
+and the impulses R z(t0) (``exact_tables._sub_step_forms``). ``chebyshev[m]`` is the
 Chebyshev expansion of the flow on a sub-step of length ``step[m]``,
 transposed (Z × D·2N).
 """

@@ -1,0 +1,314 @@
+"""The exact engine's arrays: the modes a run reaches, the plant, the run state and the work arrays.
+
+:mod:`stochpound.solvers.exact_engine` takes only arrays, grouped in small
+named tuples. This module lays them out from the library's objects:
+
+* :class:`Slots`: every mode the runs of one propagator library reach, one per
+  slot of fixed-size arrays (mode vector and guard codes, affine maps of ẋ, the
+  guards and the contact forces, the power forms, the sub-step propagator with
+  the energy and impulse forms stacked beside it, the Chebyshev expansion of
+  the flow). Slots are shared by the library's runs; within a memory budget
+  new modes take free slots, beyond it the slot filled longest ago.
+* :func:`plant_arrays` (system and motion), :func:`run_state` (everything one
+  run changes) and :func:`work_arrays_for` (the engine's scratch rows).
+
+The energy terms are integrated exactly over a sub-step as quadratic forms of
+the augmented state z = [x, w, 1] at its start (:func:`_power_forms`,
+:func:`_sub_step_forms`), so the engine adds them with one matrix product per
+sub-step.
+"""
+
+from __future__ import annotations
+
+import weakref
+from collections import namedtuple
+
+import numpy as np
+
+from stochpound.events import MAX_SETTLE_ITERATIONS
+from stochpound.modes import BoundedCache, Mode
+from stochpound.motion import GroundMotion, HarmonicMotion
+from stochpound.propagators import (
+    CHEBYSHEV_DEGREE,
+    GAUSS_WEIGHTS,
+    ModePropagator,
+    PropagatorLibrary,
+    interval_forcing,
+)
+from stochpound.recorder import ENERGY_TERMS
+from stochpound.solvers import exact_engine as engine
+from stochpound.system import System
+
+Built = namedtuple("Built", "table dynamics propagators")
+"""The engine's arrays of the modes in a library's slots (:class:`Slots`)."""
+Plant = namedtuple("Plant", "motion layout")
+"""The engine's arrays of a system and motion (:func:`_plant`)."""
+State = namedtuple("State", "run arming impacts outputs")
+"""The engine's arrays of one run (:func:`_state`)."""
+
+
+def mode_vector(mode: Mode) -> np.ndarray:
+    """The engine's int64 vector of a mode: closed flags, then base states."""
+    return np.array([int(flag) for flag in mode.closed] + list(mode.base), dtype=np.int64)
+
+
+def vector_mode(vector: np.ndarray, n_contacts: int) -> Mode:
+    """The :class:`Mode` of an engine mode vector."""
+    return Mode(tuple(bool(v) for v in vector[:n_contacts]), tuple(int(v) for v in vector[n_contacts:]))
+
+
+def plant_arrays(system: System, motion: GroundMotion) -> Plant:
+    """System and motion arrays of the engine."""
+    rows = system.total_displacement
+    if isinstance(motion, HarmonicMotion):
+        coefficients, harmonic = np.zeros((1, 4)), np.array([motion.amplitude, motion.omega, motion.phase], float)
+    else:
+        coefficients, harmonic = np.ascontiguousarray(motion.coefficients, float), np.zeros(0)
+    floor_rows = [np.ascontiguousarray(rows[system.contact_rows[:, side]]).reshape(system.n_contacts, system.n_dof) for side in (0, 1)]
+    return Plant(
+        engine.Motion(np.asarray(motion.times, float), np.ascontiguousarray(interval_forcing(motion)), coefficients, harmonic),
+        engine.Layout(system.contact_geometry, system.contact_gap, system.contact_tensile.astype(np.bool_), *floor_rows,
+                      np.asarray(system.base_dofs, dtype=np.int64)),
+    )
+
+
+def max_guards(system: System) -> int:
+    return 2 * system.n_contacts + 2 * len(system.base_dofs)
+
+
+def work_arrays_for(system: System, slots: "Slots") -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The engine's work arrays for ``system`` and the current Chebyshev width of ``slots`` (:func:`exact_engine.work_arrays`)."""
+    mode_size = system.n_contacts + len(system.base_dofs)
+    return engine.work_arrays(2 * system.n_dof, max_guards(system), system.n_contacts, mode_size, slots.arrays["chebyshev"].shape[2])
+
+
+def run_state(system: System, n_times: int) -> State:
+    """Fresh arrays of everything a run changes."""
+    size, n_contacts, n_guards = 2 * system.n_dof, system.n_contacts, max_guards(system)
+    length = n_contacts + len(system.base_dofs)
+    return State(
+        engine.Run(np.zeros(1), np.zeros(engine.N_INTS, dtype=np.int64), np.zeros(size), np.zeros(size),
+                   np.zeros(length, dtype=np.int64), np.zeros(length, dtype=np.int64), np.zeros(64, dtype=np.bool_)),
+        engine.Arming(np.zeros(n_guards), np.zeros(n_guards), np.zeros(n_guards, dtype=np.bool_), np.zeros(n_guards, dtype=np.bool_)),
+        engine.Impacts(np.zeros(n_contacts, dtype=np.bool_), np.zeros((6, n_contacts)),
+                       np.zeros((max(64, 4 * n_contacts), len(engine.IMPACT_COLUMNS)))),
+        engine.Outputs(np.zeros(len(ENERGY_TERMS)), np.zeros((n_times, size)), np.zeros((len(ENERGY_TERMS), n_times)),
+                       np.zeros(n_times, dtype=np.int64)),
+    )
+
+
+TABLE_BUDGET = 256 * 2**20
+"""Largest size of the engine arrays of one library, bytes: beyond it modes take turns in the slots."""
+
+ENERGY_BUDGET = 256 * 2**20
+"""Largest size of the cached :func:`_energy_rows` of one library's modes, bytes (they outlive their slots)."""
+
+INITIAL_SLOTS = 128
+"""Slots allocated at first (doubled when full, up to the budget)."""
+
+_SLOTS: "weakref.WeakKeyDictionary[PropagatorLibrary, Slots]" = weakref.WeakKeyDictionary()
+
+
+def slots_of(library: PropagatorLibrary) -> "Slots":
+    """The engine arrays of ``library``'s modes, shared by its runs."""
+    slots = _SLOTS.get(library)
+    if slots is None:
+        slots = _SLOTS[library] = Slots(library)
+    return slots
+
+
+class Slots:
+    """The engine's arrays (:class:`Built`) of a library's modes, one mode per slot.
+
+    The arrays grow to :data:`TABLE_BUDGET` bytes (and at least to a settling
+    chain's length); beyond that a new mode takes the slot filled longest ago,
+    and the mode it held is loaded again when the engine asks for it. Every
+    mode keeps one id (``modes[id]``), which the engine records per sample.
+    Empty slots never match a mode (their mode vector is invalid).
+    """
+
+    def __init__(self, library: PropagatorLibrary) -> None:
+        self.library = library
+        self.modes: list[Mode] = []
+        self._ids: dict[Mode, int] = {}
+        self._slot: dict[Mode, int] = {}
+        self._held: list[Mode] = []
+        self._oldest = 0
+        self._energy: BoundedCache[Mode, tuple[np.ndarray, np.ndarray]] = BoundedCache(ENERGY_BUDGET, _total_bytes)
+        self.arrays: dict[str, np.ndarray] = {}
+        width = (CHEBYSHEV_DEGREE + 1) * 2 * library.system.n_dof  # the usual Chebyshev rows (grown if a mode's are wider)
+        self._grow(1, width)
+        self._capacity = max(MAX_SETTLE_ITERATIONS + 2, TABLE_BUDGET // sum(array[0].nbytes for array in self.arrays.values()))
+        self._grow(min(self._capacity, INITIAL_SLOTS), width)
+
+    @property
+    def tables(self) -> Built:
+        """The arrays, grouped as the engine takes them."""
+        return Built(*(group(**{name: self.arrays[name] for name in group._fields}) for group in (engine.ModeTable, engine.Dynamics, engine.Propagators)))
+
+    def slot(self, mode: Mode) -> int:
+        """The slot of ``mode`` (loaded if it holds none)."""
+        slot = self._slot.get(mode)
+        return self.load(mode) if slot is None else slot
+
+    def load(self, mode: Mode) -> int:
+        """Put ``mode`` into a free slot, or else the one filled longest ago; return the slot."""
+        propagator = self.library[mode]
+        energy = self._energy.get(mode)
+        if energy is None:  # worth keeping: their products cost more than building the propagator
+            energy = _energy_rows(self.library.system, propagator)
+            self._energy.put(mode, energy)
+        row = _mode_rows(self.library.system, mode, propagator, energy)
+        row["ids"] = np.int64(self._ids.setdefault(mode, len(self._ids)))
+        if row["ids"] == len(self.modes):
+            self.modes.append(mode)
+        slot, size = self._take_slot(mode), len(self.arrays["modes"])
+        if slot == size or row["chebyshev"].shape[1] > self.arrays["chebyshev"].shape[2]:
+            self._grow(min(self._capacity, 2 * size) if slot == size else size, row["chebyshev"].shape[1])
+        if row["chebyshev"].shape[1] < self.arrays["chebyshev"].shape[2]:
+            self.arrays["chebyshev"][slot] = 0  # zero padded
+        for name, value in row.items():
+            self.arrays[name][(slot, ...) + tuple(slice(0, n) for n in np.shape(value))] = value
+        return slot
+
+    def _take_slot(self, mode: Mode) -> int:
+        """The next free slot, or else the one filled longest ago, now held by ``mode``."""
+        slot = len(self._held)
+        if slot < self._capacity:
+            self._held.append(mode)
+        else:
+            slot, self._oldest = self._oldest, (self._oldest + 1) % self._capacity
+            del self._slot[self._held[slot]]
+            self._held[slot] = mode
+        self._slot[mode] = slot
+        return slot
+
+    def _grow(self, capacity: int, width: int) -> None:
+        """Reallocate for ``capacity`` slots and Chebyshev rows of ``width`` (at least the current), keeping the filled slots."""
+        old = self.arrays
+        width = max(width, old["chebyshev"].shape[2]) if old else width
+        self.arrays = {}
+        for name, value in _placeholder(self.library.system, width).items():
+            self.arrays[name] = np.zeros((capacity,) + np.shape(value), np.asarray(value).dtype)  # untouched pages stay unallocated
+            if np.any(value):
+                self.arrays[name][:] = value
+        for name, array in old.items():
+            self.arrays[name][(slice(0, len(array)), ...) + tuple(slice(0, n) for n in array.shape[1:])] = array
+
+
+def _mode_rows(system: System, mode: Mode, propagator: ModePropagator, energy: tuple[np.ndarray, np.ndarray]) -> dict[str, np.ndarray]:
+    """One mode's entries of the :class:`Built` arrays but its id (guards padded to the system's largest count).
+
+    ``energy`` is the mode's :func:`_energy_rows`.
+    """
+    d = propagator.dynamics
+    count, n_guards = len(d.guard_kind), max_guards(system)
+    codes = np.zeros((3, n_guards), dtype=np.int64)
+    codes[:, :count] = d.guard_kind, d.guard_target, d.guard_direction
+    guard = np.zeros((n_guards, d.A.shape[1] + 2))
+    guard[:count] = _affine(d.guard_matrix, d.guard_ground, d.guard_constant)
+    power, forms = energy
+    return {
+        "modes": mode_vector(mode), "codes": codes, "n_guards": np.int64(count), "substeps": np.int64(propagator.substeps),
+        "rate": _affine(d.A, d.B, d.c), "guard": guard, "force": _affine(d.force_matrix, 0.0, d.force_constant), "power": power,
+        "propagate": np.concatenate([propagator.transition.T, forms], axis=1), "step": np.float64(propagator.step),
+        "chebyshev": propagator.chebyshev.reshape(-1, propagator.transition.shape[0]).T,
+    }
+
+
+def _energy_rows(system: System, propagator: ModePropagator) -> tuple[np.ndarray, np.ndarray]:
+    """A mode's power forms and its sub-step forms and impulses (:func:`_sub_step_forms`), stacked and transposed (Z × 4Z, Z × (4Z + n_contacts))."""
+    d, width = propagator.dynamics, propagator.transition.shape[0]
+    force = _in_z(_affine(d.force_matrix, 0.0, d.force_constant), width)
+    friction = _in_z(_affine(d.friction_matrix, d.friction_ground, d.friction_constant), width)
+    power = _power_forms(system, force, friction).reshape(-1, width).T
+    return np.ascontiguousarray(power), np.concatenate([form.T for form in _sub_step_forms(system, propagator, force, friction)], axis=1)
+
+
+def _total_bytes(arrays: tuple[np.ndarray, ...]) -> int:
+    return sum(array.nbytes for array in arrays)
+
+
+def _affine(matrix: np.ndarray, ground: np.ndarray | float, constant: np.ndarray) -> np.ndarray:
+    """The engine's affine map [matrix | ground | constant] of ``matrix · x + ground a_g + constant``."""
+    return np.column_stack([matrix, np.broadcast_to(ground, len(matrix)), constant])
+
+
+def _power_forms(system: System, force: np.ndarray, friction: np.ndarray) -> np.ndarray:
+    """Quadratic forms P (4 × Z × Z) of the input, damping, friction and impact powers (``Recorder.on_step``).
+
+    The power of each force is zᵀ P z for the augmented state z = [x, w, 1]
+    (only a_g = w[0] and the constant 1 enter), W: −a_g (ι · v), vᵀ C v,
+    −Σ (friction force) ṡ over sliding bases, Σ F (load · v) over contacts.
+    ``force`` and ``friction`` are the mode's contact and friction forces
+    (rows acting on z).
+    """
+    n, size = system.n_dof, 2 * system.n_dof
+    velocity = slice(n, size)
+    power = np.zeros((4,) + (force.shape[1],) * 2)
+    power[0, size, velocity] = -system.influence
+    power[1, velocity, velocity] = system.damping
+    sliding_rows, sliding_bases = _sliding(system)
+    power[2, sliding_rows] = -friction[sliding_bases]
+    power[3, velocity] = system.contact_load.T @ force
+    return power
+
+
+def _sub_step_forms(system: System, propagator: ModePropagator, force: np.ndarray, friction: np.ndarray) -> list[np.ndarray]:
+    """Energy terms and impulses of one sub-step as functions of z(t0) (``Recorder.on_step``'s quadrature, combined).
+
+    The 5-point Gauss–Legendre integral of a power zᵀ P z (:func:`_power_forms`)
+    over a sub-step is z(t0)ᵀ Q z(t0) with Q = Σᵢ wᵢ Nᵢᵀ P Nᵢ (Nᵢ the node
+    propagators, wᵢ the weights), computed from the factors P = Lᵀ R of each
+    power as Σᵢ (wᵢ L Nᵢ)ᵀ (R Nᵢ); the impulses are linear, r · z(t0).
+
+    Returns
+    -------
+    list of np.ndarray
+        Q of the four powers (Z × Z each, J) and the impulse rows of every
+        contact (n_contacts × Z, N·s).
+    """
+    n, size, width = system.n_dof, 2 * system.n_dof, force.shape[1]
+    weights = 0.5 * propagator.step * GAUSS_WEIGHTS
+    nodes = propagator.nodes
+    velocity = nodes[:, n:size]
+    weighted_velocity = weights[:, None, None] * velocity
+    sliding_rows, sliding_bases = _sliding(system)
+    loaded = np.flatnonzero(np.any(force, axis=1))  # the rows of open contacts are zero
+    factors = [
+        (weights[:, None] * nodes[:, size], -system.influence @ velocity),
+        (weighted_velocity, system.damping @ velocity),
+        (weights[:, None, None] * nodes[:, sliding_rows], -friction[sliding_bases] @ nodes),
+        (system.contact_load[loaded] @ weighted_velocity, force[loaded] @ nodes),
+    ]
+    forms = [left.reshape(-1, width).T @ right.reshape(-1, width) for left, right in factors]
+    impulses = np.zeros((len(force), width))
+    impulses[loaded] = force[loaded] @ np.tensordot(weights, nodes, 1)
+    return [*forms, impulses]
+
+
+def _sliding(system: System) -> tuple[np.ndarray, np.ndarray]:
+    """The state rows of the sliding bases' velocities, and those bases' indices."""
+    bases = np.array([b for b, dof in enumerate(system.base_dofs) if dof >= 0], dtype=np.int64)
+    return system.n_dof + np.asarray(system.base_dofs, dtype=np.int64)[bases], bases
+
+
+def _in_z(rows: np.ndarray, width: int) -> np.ndarray:
+    """Affine rows [x-coefficients | a_g coefficient | constant] as rows acting on z = [x, w, 1]."""
+    size = rows.shape[1] - 2
+    out = np.zeros((len(rows), width))
+    out[:, :size], out[:, size], out[:, width - 1] = rows[:, :size], rows[:, size], rows[:, size + 1]
+    return out
+
+
+def _placeholder(system: System, chebyshev_width: int) -> dict[str, np.ndarray]:
+    """An empty slot of the :class:`Built` arrays (it matches no mode: its mode vector is invalid)."""
+    size, n_contacts, n_guards = 2 * system.n_dof, system.n_contacts, max_guards(system)
+    width = size + 5
+    return {
+        "modes": np.full(n_contacts + len(system.base_dofs), -9, dtype=np.int64), "ids": np.int64(0), "codes": np.zeros((3, n_guards), np.int64),
+        "n_guards": np.int64(0), "substeps": np.int64(1), "rate": np.zeros((size, size + 2)),
+        "guard": np.zeros((n_guards, size + 2)), "force": np.zeros((n_contacts, size + 2)), "power": np.zeros((width, 4 * width)),
+        "propagate": np.zeros((width, 5 * width + n_contacts)), "chebyshev": np.zeros((width, chebyshev_width)),
+        "step": np.float64(1.0),
+    }
