@@ -1,6 +1,10 @@
 """The exact solver against the ivp path (rtol 1e-12), closed forms and the traps of MODEL.md §6."""
 
 import dataclasses
+import os
+import subprocess
+import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -245,3 +249,31 @@ def test_result_dataset_is_the_one_xarray_would_build():
     rebuilt = xr.Dataset({name: result.variables[name] for name in result.data_vars}, coords=coords, attrs=result.attrs)
     xr.testing.assert_identical(result, rebuilt)
     assert {name: type(index) for name, index in result.xindexes.items()} == {name: type(index) for name, index in rebuilt.xindexes.items()}
+
+
+BOUNDS_PROBE = """
+import stochpound
+from stochpound.solvers.exact import run_exact
+from tests.test_exact import HARD_CASES
+from tests.test_random_scenes import random_scene
+
+scenes = [stochpound.scene_from_dict(data) for data in HARD_CASES.values()]
+scenes += [stochpound.scene_from_dict(random_scene(seed)) for seed in range(8)]
+for scene in scenes:
+    run_exact(scene)
+run_exact(scenes[0], events="python")
+print("in bounds", len(scenes))
+"""
+
+
+def test_engine_never_indexes_out_of_bounds(tmp_path):
+    """The compiled engine with numba's bounds checking on (a fresh process and cache): hard cases and random scenes.
+
+    Compiled code reads and writes unchecked otherwise: an index past an array's
+    end would go unnoticed as long as the values read are overwritten.
+    """
+    environment = {**os.environ, "NUMBA_BOUNDSCHECK": "1", "NUMBA_CACHE_DIR": str(tmp_path)}
+    result = subprocess.run([sys.executable, "-c", BOUNDS_PROBE], cwd=Path(__file__).parents[1], env=environment,
+                            capture_output=True, text=True, timeout=600, check=False)
+    assert result.returncode == 0, result.stderr[-2000:]
+    assert "in bounds" in result.stdout

@@ -944,7 +944,7 @@ def _advance_span(m, n, modes, codes, substeps, step, propagate, chebyshev, rate
     for i in range(n_steps):
         t0 = t + i * spacing  # as np.linspace(t, t_end, n_steps + 1)
         t1 = t_end if i == n_steps - 1 else t + (i + 1) * spacing
-        _copy(x, z0)
+        _copy(x, z0[:size])
         _ground(times, coefficients_k, harmonic, t0, k, z0[size : size + 4])
         z0[width - 1] = 1.0
         flow = Flow(rate, guard, force, coefficients, ground, times[k], is_harmonic, t0, 2.0 / step)
