@@ -236,8 +236,7 @@ def _build(system: System, mode: Mode, masses: tuple[np.ndarray, np.ndarray, np.
     friction = _friction(system, mode, stiffness, damping, load, A, B, c, free)
     guards = _guards(system, mode, friction, rows)
     force_matrix = np.zeros((system.n_contacts, 2 * n))
-    force_matrix[closed, :n] = g[closed] * k[closed, None]
-    force_matrix[closed, n:] = g[closed] * c_imp[closed, None]
+    force_matrix[closed] = rows.force[closed]
     force_constant = np.zeros(system.n_contacts)
     force_constant[closed] = -k[closed] * d[closed]
     return ModeDynamics(mode, A, B, c, *guards, force_matrix, force_constant, *friction, stuck)
@@ -265,7 +264,7 @@ def _guards(system: System, mode: Mode, friction: tuple, rows: _ContactRows) -> 
     """Guard rows of ``mode``: every contact's guards in contact order, then every base's."""
     contact = _contact_guards(system, np.array(mode.closed, bool), rows)
     base = _base_guards(system, mode, friction)
-    return tuple(np.concatenate([a, b]) for a, b in zip(contact, base))
+    return tuple(np.concatenate([a, b]) for a, b in zip(contact, base, strict=True))
 
 
 def _contact_guards(system: System, closed: np.ndarray, rows: _ContactRows) -> tuple[np.ndarray, ...]:

@@ -191,16 +191,6 @@ def _affine(M, i, x, ground):
 
 
 @njit(**INTERNAL)
-def _force(force, p, x):
-    """Contact force p (no a_g term): force[p, S + 1] + force[p, :S] · x."""
-    size = force.shape[1] - 2
-    total = force[p, size + 1]
-    for j in range(size):
-        total += force[p, j] * x[j]
-    return total
-
-
-@njit(**INTERNAL)
 def _force_rate(force, p, rate, x, ground):
     """Rate of contact force p: force[p, :S] · ẋ."""
     total = 0.0
@@ -268,7 +258,7 @@ def _offer_peaks(force, is_open, impact, t, x):
     """Offer the contact forces at (t, x) as peaks of the open impacts."""
     for p in range(is_open.shape[0]):
         if is_open[p]:
-            value = _force(force, p, x)
+            value = _affine(force, p, x, 0.0)
             if value > impact[PEAK, p]:
                 impact[PEAK, p], impact[PEAK_TIME, p] = value, t
 
@@ -979,14 +969,14 @@ def _advance_span(m, n, modes, codes, substeps, step, propagate, chebyshev, rate
                 _add_forms(node, products, weight, running)
                 for p in range(is_open.shape[0]):
                     if is_open[p]:
-                        impact[IMPULSE, p] += weight * _force(force, p, node)
+                        impact[IMPULSE, p] += weight * _affine(force, p, node, 0.0)
             _offer_peaks(force, is_open, impact, t0, x)
             _offer_peaks(force, is_open, impact, t_stop, x_stop)
             for p in range(is_open.shape[0]):  # a force maximum inside the step
                 if is_open[p] and _evaluate(flow, -1 - p, 0.0, t0, work) > 0.0 > _evaluate(flow, -1 - p, 0.0, t_stop, work):
                     t_peak = _brentq(flow, -1 - p, 0.0, t0, t_stop, work)
                     _dense(flow, t_peak, work)
-                    value = _force(force, p, work)
+                    value = _affine(force, p, work, 0.0)
                     if value > impact[PEAK, p]:
                         impact[PEAK, p], impact[PEAK_TIME, p] = value, t_peak
         if fired < 0:

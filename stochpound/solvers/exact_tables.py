@@ -42,9 +42,9 @@ from stochpound.system import System
 Built = namedtuple("Built", "table dynamics propagators")
 """The engine's arrays of the modes in a library's slots (:class:`Slots`)."""
 Plant = namedtuple("Plant", "motion layout")
-"""The engine's arrays of a system and motion (:func:`_plant`)."""
+"""The engine's arrays of a system and motion (:func:`plant_arrays`)."""
 State = namedtuple("State", "run arming impacts outputs")
-"""The engine's arrays of one run (:func:`_state`)."""
+"""The engine's arrays of one run (:func:`run_state`)."""
 
 
 def mode_vector(mode: Mode) -> np.ndarray:
@@ -73,6 +73,7 @@ def plant_arrays(system: System, motion: GroundMotion) -> Plant:
 
 
 def max_guards(system: System) -> int:
+    """The largest number of guards of a mode: two per contact (CLOSE and RECLOSE) and two per base (SLIP both ways)."""
     return 2 * system.n_contacts + 2 * len(system.base_dofs)
 
 
