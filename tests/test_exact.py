@@ -223,6 +223,34 @@ def test_compiled_engine_matches_the_shared_python_event_code(name):
         np.testing.assert_allclose(compiled.energy[term], python.energy[term], rtol=1e-9, atol=1e-6)
 
 
+def test_a_sub_step_product_gives_the_next_state_and_its_guards():
+    """One product of z(t0) with a mode's ``propagate`` rows: z(t0 + h), then (past the forms) the guards' values and rates there."""
+    from stochpound.solvers import exact_engine, exact_tables
+
+    scene = stochpound.scene_from_dict(study_scene(0.2, 0.1, 2.0, motion={"record": "el_centro_1940_study", "duration": 5.0}))
+    stochpound.simulate(scene)
+    library = propagator_library(build_system(scene), scene.motion)
+    slots = exact_tables.slots_of(library)
+    size, n_contacts = 2 * library.system.n_dof, library.system.n_contacts
+    padded = slots.arrays["guard"].shape[1]
+    rng = np.random.default_rng(5)
+    for mode in library:
+        propagator = library[mode]
+        dynamics = propagator.dynamics
+        z0 = np.concatenate([rng.normal(scale=0.05, size=size), rng.normal(size=4), [1.0]])
+        out = z0 @ slots.arrays["propagate"][slots.slot(mode)]
+        z1 = propagator.transition @ z0
+        x1, ground, ground_rate = z1[:size], z1[size], z1[size + 1]
+        n = len(dynamics.guard_kind)
+        values_at = 5 * len(z0) + n_contacts
+        values, rates = out[values_at : values_at + n], out[values_at + padded : values_at + padded + n]
+        np.testing.assert_allclose(out[: len(z0)], z1, rtol=1e-13, atol=1e-15)
+        np.testing.assert_allclose(values, dynamics.guards(x1, ground), rtol=1e-12, atol=1e-12)
+        expected = dynamics.guard_matrix @ dynamics.rate(x1, ground) + dynamics.guard_ground * ground_rate
+        np.testing.assert_allclose(rates, expected, rtol=1e-12, atol=1e-12)
+        assert out.shape[0] % exact_engine.LANES == 0 and not np.any(out[values_at + 2 * padded :])
+
+
 def test_engine_compiles_every_function_once():
     """Each jitted function of the engine has one specialisation (two for _copy: float and int arrays).
 

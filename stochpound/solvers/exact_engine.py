@@ -92,10 +92,12 @@ impact powers, zᵀ P z at z = [x, a_g, 0, 0, 0, 1], transposed (Z × 4Z)
 Propagators = namedtuple("Propagators", "propagate chebyshev step")
 Propagators.__doc__ = """Exact sub-step propagators of the slots' modes.
 
-``propagate[m]`` is [exp(𝒜h); Q_input; Q_damping; Q_friction; Q_impact; R]
-transposed (Z × (5Z + n_contacts)): one product of z(t0) gives z(t0 + h),
-Q z(t0) of every energy term (whose gain over the sub-step is z(t0) · Q z(t0))
-and the impulses R z(t0) (``exact_tables._sub_step_forms``). ``chebyshev[m]`` is the
+``propagate[m]`` is [exp(𝒜h); Q_input; Q_damping; Q_friction; Q_impact; R;
+V; W] transposed (Z × (5Z + n_contacts + 2 n_guards), guards padded): one
+product of z(t0) gives z(t0 + h), Q z(t0) of every energy term (whose gain
+over the sub-step is z(t0) · Q z(t0)), the impulses R z(t0)
+(``exact_tables._sub_step_forms``), and the guards' values V z(t0) and rates
+W z(t0) at t0 + h (``exact_tables._guard_rows``). ``chebyshev[m]`` is the
 Chebyshev expansion of the flow on a sub-step of length ``step[m]``,
 transposed (Z × D·2N).
 """
@@ -142,6 +144,16 @@ _RTOL = 4 * np.finfo(float).eps
 _EPS = 2 * np.finfo(float).eps
 
 
+LANES = 16
+"""The columns of ``Propagators.propagate`` are padded to a multiple of this, so that its products vectorise whole."""
+
+
+def propagate_columns(size: int, n_guards: int, n_contacts: int) -> int:
+    """Columns of ``Propagators.propagate`` (padded to :data:`LANES`) for state size ``size`` (2N)."""
+    used = 5 * (size + 5) + n_contacts + 2 * n_guards
+    return -(-used // LANES) * LANES
+
+
 def work_arrays(size: int, n_guards: int, n_contacts: int, mode_size: int, chebyshev_width: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``scratch``, ``saved`` and ``marks`` work arrays of :func:`run_engine`.
 
@@ -153,8 +165,7 @@ def work_arrays(size: int, n_guards: int, n_contacts: int, mode_size: int, cheby
     settling's. ``marks`` rows: the settling chain's modes, its transitions,
     then the guard headings and two mode vectors.
     """
-    width = size + 5
-    scratch = np.zeros((24, max(5 * width + n_contacts, n_guards, chebyshev_width)))
+    scratch = np.zeros((24, max(propagate_columns(size, n_guards, n_contacts), chebyshev_width)))
     marks = np.zeros((2 * (_MAX_SETTLE + 1) + 3, max(mode_size, 3, n_guards)), dtype=np.int64)
     return scratch, np.zeros((6, max(4, n_contacts, n_guards))), marks
 
@@ -379,7 +390,8 @@ def _advance_quiet(mode_id, n, substeps, propagate, rate, guard, force, times, f
     width = size + 5
     z0, propagated, work = scratch[0, :width], scratch[1, : propagate.shape[1]], scratch[2, :size]
     z1, x0, x1 = propagated[:width], z0[:size], propagated[:size]
-    values0, values1, rates0, rates1 = scratch[3, :n], scratch[4, :n], scratch[5, :n], scratch[6, :n]
+    values_at, rates_at = 5 * width + is_open.shape[0], 5 * width + is_open.shape[0] + guard.shape[0]
+    values0, values1, rates0, rates1 = scratch[3, :n], propagated[values_at : values_at + n], scratch[5, :n], propagated[rates_at : rates_at + n]
     any_open = _any(is_open)
     for k in range(ints[K], forcing.shape[0]):
         h = (times[k + 1] - times[k]) / substeps
@@ -392,7 +404,6 @@ def _advance_quiet(mode_id, n, substeps, propagate, rate, guard, force, times, f
             _product(propagate, z0, propagated)
             t0 = times[k] + j * h
             t1 = times[k + 1] if j == substeps - 1 else t0 + h
-            _guards_and_rates(rate, guard, x1, z1[size], z1[size + 1], values1, rates1, work)
             if _suspect(values0, values1, rates0, rates1, h, threshold, tolerance) or (
                 any_open and _peaks(rate, force, is_open, impact, x0, z0[size], t0, x1, z1[size], t1)
             ):

@@ -209,10 +209,12 @@ def _mode_rows(system: System, mode: Mode, propagator: ModePropagator, energy: t
     guard = np.zeros((n_guards, d.A.shape[1] + 2))
     guard[:count] = _affine(d.guard_matrix, d.guard_ground, d.guard_constant)
     power, forms = energy
+    guard_rows = _guard_rows(guard, _affine(d.A, d.B, d.c), width=len(propagator.transition))
     return {
         "modes": mode_vector(mode), "codes": codes, "n_guards": np.int64(count), "substeps": np.int64(propagator.substeps),
         "rate": _affine(d.A, d.B, d.c), "guard": guard, "force": _affine(d.force_matrix, 0.0, d.force_constant), "power": power,
-        "propagate": np.concatenate([propagator.transition.T, forms], axis=1), "step": np.float64(propagator.step),
+        "propagate": np.concatenate([propagator.transition.T, forms, (guard_rows @ propagator.transition).T], axis=1),  # padded by load
+        "step": np.float64(propagator.step),
         "chebyshev": propagator.chebyshev.reshape(-1, propagator.transition.shape[0]).T,
     }
 
@@ -224,6 +226,18 @@ def _energy_rows(system: System, propagator: ModePropagator) -> tuple[np.ndarray
     friction = _in_z(_affine(d.friction_matrix, d.friction_ground, d.friction_constant), width)
     power = _power_forms(system, force, friction).reshape(-1, width).T
     return np.ascontiguousarray(power), np.concatenate([form.T for form in _sub_step_forms(system, propagator, force, friction)], axis=1)
+
+
+def _guard_rows(guard: np.ndarray, rate: np.ndarray, width: int) -> np.ndarray:
+    """Rows V and W acting on z = [x, w, 1] that give the guards' values and rates (2 n_guards × Z).
+
+    For the affine maps ``guard`` (G x + h a_g + g0) and ``rate`` (ẋ = A x + B a_g + c):
+    values V z = G x + h a_g + g0, rates W z = G A x + (G B) a_g + h ȧ_g + G c.
+    """
+    size = guard.shape[1] - 2
+    rates = _in_z(guard[:, :size] @ rate, width)
+    rates[:, size + 1] = guard[:, size]
+    return np.vstack([_in_z(guard, width), rates])
 
 
 def _total_bytes(arrays: tuple[np.ndarray, ...]) -> int:
@@ -310,6 +324,6 @@ def _placeholder(system: System, chebyshev_width: int) -> dict[str, np.ndarray]:
         "modes": np.full(n_contacts + len(system.base_dofs), -9, dtype=np.int64), "ids": np.int64(0), "codes": np.zeros((3, n_guards), np.int64),
         "n_guards": np.int64(0), "substeps": np.int64(1), "rate": np.zeros((size, size + 2)),
         "guard": np.zeros((n_guards, size + 2)), "force": np.zeros((n_contacts, size + 2)), "power": np.zeros((width, 4 * width)),
-        "propagate": np.zeros((width, 5 * width + n_contacts)), "chebyshev": np.zeros((width, chebyshev_width)),
+        "propagate": np.zeros((width, engine.propagate_columns(size, n_guards, n_contacts))), "chebyshev": np.zeros((width, chebyshev_width)),
         "step": np.float64(1.0),
     }
