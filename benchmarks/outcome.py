@@ -64,18 +64,27 @@ class Errors:
 
 
 def outcome_from_dataset(run: xr.Dataset) -> Outcome:
-    """Reduce a stochpound result dataset to an :class:`Outcome`."""
-    first = run.building.values[0]
-    floors = run.total_displacement.sel(building=first)
-    top = floors.dropna("floor", how="all").isel(floor=-1)
-    peak = float(run.impact_peak_force.max()) if run.sizes.get("impact", 0) else 0.0
+    """Reduce a stochpound result dataset to an :class:`Outcome`.
+
+    Plain numpy on the variables' arrays (xarray's label selection would add
+    about half a millisecond to every timed run of the fast solvers).
+    """
+    floors = _first_building(run["total_displacement"], ("floor", "time"))
+    top = floors[~np.all(np.isnan(floors), axis=1)][-1]
+    impacts = int(run.sizes.get("impact", 0))
     return Outcome(
-        times=np.asarray(run.time.values, float),
-        top_displacement=np.asarray(top.values, float),
-        impacts=int(run.sizes.get("impact", 0)),
-        peak_force=peak,
-        final_sliding=float(run.sliding_displacement.sel(building=first).values[-1]),
+        times=np.asarray(run["time"].values, float),
+        top_displacement=np.asarray(top, float),
+        impacts=impacts,
+        peak_force=float(np.max(run["impact_peak_force"].values)) if impacts else 0.0,
+        final_sliding=float(_first_building(run["sliding_displacement"], ("time",))[-1]),
     )
+
+
+def _first_building(variable: xr.DataArray, dims: tuple[str, ...]) -> np.ndarray:
+    """The values of ``variable`` for the scene's first building, with axes ``dims``."""
+    axes = [variable.get_axis_num(name) for name in ("building", *dims)]
+    return np.moveaxis(variable.values, axes, range(len(axes)))[0]
 
 
 def compare(outcome: Outcome, reference: Outcome) -> Errors:

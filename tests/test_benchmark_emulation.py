@@ -115,3 +115,22 @@ def test_opensees_model_rejects_what_its_elements_cannot_represent():
         run_opensees(MAIN_SCENE.scene(1.0, study_compat=True), 0.001)
     with pytest.raises(ValueError, match="gap"):
         run_opensees(dataclasses.replace(FIXED_PAIR, gap=0.0).scene(1.0), 0.001)
+
+
+def test_outcome_reads_the_first_buildings_top_floor_as_label_selection_would():
+    """The numpy reduction of a result equals xarray's selection, with the first building the shorter (NaN-padded floors)."""
+    short = reference_building("B1", mu=0.2) | {"mass": [2.0e5], "stiffness": [4.0e7], "damping": [1.0e5]}
+    tall = reference_building("B2") | {"mass": [2.0e5] * 3, "stiffness": [4.0e7] * 3, "damping": [1.0e5] * 3}
+    scene = stochpound.scene_from_dict({
+        "building": [short, tall],
+        "contact": [{"between": [["B1", 1], ["B2", 1]], "gap": 0.0, "stiffness": 1e8, "restitution": 0.5}],
+        "motion": {"type": "harmonic", "amplitude": 3.0, "omega": 9.0, "duration": 4.0, "dt": 0.01},
+    })
+    run = stochpound.simulate(scene)
+    outcome = outcome_from_dataset(run)
+    floors = run.total_displacement.sel(building="B1").dropna("floor", how="all")
+    assert floors.sizes["floor"] == 1 and run.sizes["floor"] == 3 and run.sizes.get("impact", 0) > 0
+    np.testing.assert_array_equal(outcome.top_displacement, floors.isel(floor=-1).values)
+    assert outcome.final_sliding == float(run.sliding_displacement.sel(building="B1").values[-1]) != 0.0
+    assert outcome.impacts == run.sizes["impact"]
+    assert outcome.peak_force == float(run.impact_peak_force.max())
