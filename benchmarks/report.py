@@ -9,6 +9,7 @@ from __future__ import annotations
 import datetime as dt
 import os
 import platform
+import statistics
 import subprocess
 from collections.abc import Iterable
 from dataclasses import dataclass
@@ -165,11 +166,14 @@ def _memory_target(results: Results) -> Target:
 
 
 def _compile_target(data: dict[str, Any]) -> Target:
-    cold = data["cold"]
-    if "error" in cold:
-        return Target("first call of exact, empty numba cache", "< 10 s", cold["error"], None)
-    compiled = cold["first"] - cold["second"]
-    return Target("first call of exact, empty numba cache (minus a warm call)", "< 10 s", f"{compiled:.3g} s", compiled < 10.0)
+    """Judged on the median of the fresh-cache runs (each a first call minus a warm call)."""
+    failed = [run["error"] for run in data["cold"] if "error" in run]
+    if failed:
+        return Target("first call of exact, empty numba cache", "< 10 s", failed[0], None)
+    compiled = [run["first"] - run["second"] for run in data["cold"]]
+    median = statistics.median(compiled)
+    measured = f"{median:.3g} s (median of {len(compiled)} fresh processes: {', '.join(f'{c:.3g}' for c in compiled)} s)"
+    return Target("first call of exact, empty numba cache (minus a warm call)", "< 10 s", measured, median < 10.0)
 
 
 def _length_target(rows: list[dict[str, Any]]) -> Target:
@@ -314,14 +318,16 @@ def _compile_section(results: Results) -> str:
     if results.compile is None:
         return ""
     rows = []
-    for label, data in (("empty numba cache", results.compile["cold"]), ("filled numba cache", results.compile["cached"])):
+    runs = [("empty numba cache", run) for run in results.compile["cold"]] + [("filled numba cache", results.compile["cached"])]
+    for label, data in runs:
         if "error" in data:
             rows.append([label, data["error"], "–", "–", "–"])
         else:
             rows.append([label, f"{data['import']:.3g}", f"{data['first']:.3g}", f"{data['second'] * 1e3:.4g}", "yes" if data["numba"] else "no"])
     return (
         "## First call\n\nScene (a) in a fresh process: import and scene building, the first `simulate` "
-        "(compiles or loads the numba kernels and builds the mode propagators) and a second call.\n\n"
+        "(compiles or loads the numba kernels and builds the mode propagators) and a second call; "
+        "one row per process, each with its own empty numba cache, then one that finds the last one's cache filled.\n\n"
         + _table(["numba cache", "import + scene (s)", "first call (s)", "second call (ms)", "numba loaded"], rows)
     )
 

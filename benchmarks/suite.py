@@ -59,6 +59,8 @@ class Config:
         Record length (s), gap (m) and timeout (s) of each scene-size run.
     compile_time : bool
         Measure the first-call time with an empty numba cache.
+    compile_runs : int
+        Fresh processes (each with its own empty cache) of that measurement.
     """
 
     quick: bool
@@ -83,6 +85,7 @@ class Config:
     size_gap: float
     size_timeout: float
     compile_time: bool
+    compile_runs: int
 
     @classmethod
     def full(cls) -> Config:
@@ -91,11 +94,11 @@ class Config:
             quick=False, scenes=STUDY_SCENES, duration=None,
             integrators=("DOP853", "RK45", "LSODA", "Radau"), rtols=(1e-4, 1e-6, 1e-8, 1e-10, 1e-12),
             extra_rtols={"DOP853": (1e-11,)}, scheme_steps=(0.02, 0.01, 0.005), opensees_steps=(0.001, 0.0005),
-            repeats=3, exact_repeats=20, budget=20.0, slow_cap=120.0,
+            repeats=3, exact_repeats=200, budget=20.0, slow_cap=120.0,
             ensemble_runs=1000, ensemble_workers=2, memory_runs=10_000,
             lengths=(10.0, 25.0, 50.0, 100.0, 200.0), gaps=(0.08, 0.04, 0.02, 0.01, 0.005, 0.0025),
             sizes=((2, 2), (2, 6), (2, 10), (6, 2), (10, 2), (4, 4), (6, 6), (10, 10)),
-            size_duration=10.0, size_gap=0.05, size_timeout=240.0, compile_time=True,
+            size_duration=10.0, size_gap=0.05, size_timeout=240.0, compile_time=True, compile_runs=3,
         )
 
     @classmethod
@@ -305,14 +308,16 @@ def ensemble_available() -> bool:
     return True
 
 
-def compile_time() -> dict[str, Any]:
-    """First-call time of the exact solver in fresh processes: numba cache empty, then filled."""
+def compile_time(config: Config) -> dict[str, Any]:
+    """First-call time of the exact solver in fresh processes: ``compile_runs`` with an empty numba cache, then one filled."""
     import tempfile
 
-    with tempfile.TemporaryDirectory(prefix="stochpound-numba-") as cache:
-        environment = {"NUMBA_CACHE_DIR": cache}
-        cold = probe("first_call", timeout=600, extra_env=environment)
-        cached = probe("first_call", timeout=600, extra_env=environment)
+    cold = []
+    for _ in range(config.compile_runs):
+        with tempfile.TemporaryDirectory(prefix="stochpound-numba-") as cache:
+            environment = {"NUMBA_CACHE_DIR": cache}
+            cold.append(probe("first_call", timeout=600, extra_env=environment))
+            cached = probe("first_call", timeout=600, extra_env=environment)
     return {"cold": cold, "cached": cached}
 
 
@@ -386,7 +391,7 @@ def run_all(config: Config, log: Callable[[str], None] = print) -> Results:
     """Run every section of the suite."""
     scenes = [scene_benchmark(spec, config, log) for spec in config.scenes]
     log("first-call compile time")
-    compiled = compile_time() if config.compile_time else None
+    compiled = compile_time(config) if config.compile_time else None
     has_ensemble = ensemble_available()
     missing = {"error": "stochpound.ensemble.simulate_ensemble is not available in this tree"}
     log("ensemble throughput")
