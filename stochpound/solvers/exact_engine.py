@@ -47,11 +47,9 @@ function on its own and then again inside each caller, spends about as much
 on each source line as on each optimised LLVM line, copies every field of a
 named tuple wherever one is bound or passed, and inlines (``inline="always"``)
 at a high cost per call site. So :func:`run_engine` is the only entry point:
-it unpacks the named tuples once and inlines two of its three phases
-(:func:`_settle_pending`, :func:`_advance_quiet`), which take arrays; the
-third, :func:`_advance_span`, is a helper (measured: inlined, it made
-:func:`run_engine` large enough to cost 0.4 s more to optimise than it
-saves). The helpers take the few arrays they use, are compiled
+it unpacks the named tuples once and inlines its three phases
+(:func:`_settle_pending`, :func:`_advance_quiet`, :func:`_advance_span`),
+which take arrays; the helpers take the few arrays they use, are compiled
 once without Python wrappers (:data:`INTERNAL`) and are inlined by LLVM; no
 compile-time constant is passed to a helper (it would compile a second
 specialisation), and no array is assigned to an array slice (its error
@@ -919,7 +917,7 @@ def _settle_pending(modes, codes, n_guards, rate, guard, force, motion, layout, 
 # ---------------------------------------------------------------- event steps
 
 
-@njit(**INTERNAL)
+@njit(inline="always", error_model="numpy")
 def _advance_span(m, n, modes, codes, substeps, step, propagate, chebyshev, rate, guard, force, power, motion, ints, clock, x,
                   pending_x, pending_mode, arming, is_open, impact, running, k, t, t_end, scratch):
     """Sub-steps of mode m (n guards, its arrays) from t to t_end (``_until_event`` of exact.py).
