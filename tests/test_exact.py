@@ -215,7 +215,7 @@ def test_compiled_engine_matches_the_shared_python_event_code(name):
     np.testing.assert_allclose(compiled.states, python.states, rtol=0, atol=1e-11)
     np.testing.assert_array_equal(compiled.base_states, python.base_states)
     assert len(compiled.impacts) == len(python.impacts)
-    for a, b in zip(compiled.impacts, python.impacts):
+    for a, b in zip(compiled.impacts, python.impacts, strict=True):
         assert (a.contact, a.in_phase, a.complete) == (b.contact, b.in_phase, b.complete)
         np.testing.assert_allclose([a.start, a.end, a.peak_time], [b.start, b.end, b.peak_time], rtol=0, atol=1e-11)
         np.testing.assert_allclose([a.peak_force, a.impulse], [b.peak_force, b.impulse], rtol=1e-9)
@@ -281,16 +281,18 @@ def test_result_dataset_is_the_one_xarray_would_build():
 
 BOUNDS_PROBE = """
 import stochpound
-from stochpound.solvers.exact import run_exact
+from stochpound.solvers import exact_engine
+from stochpound.solvers.exact import compile_engine, run_exact
 from tests.test_exact import HARD_CASES
 from tests.test_random_scenes import random_scene
 
+compile_engine()
 scenes = [stochpound.scene_from_dict(data) for data in HARD_CASES.values()]
 scenes += [stochpound.scene_from_dict(random_scene(seed)) for seed in range(8)]
 for scene in scenes:
     run_exact(scene)
 run_exact(scenes[0], events="python")
-print("in bounds", len(scenes))
+print("in bounds", len(scenes), "engine specialisations", len(exact_engine.run_engine.signatures))
 """
 
 
@@ -298,10 +300,14 @@ def test_engine_never_indexes_out_of_bounds(tmp_path):
     """The compiled engine with numba's bounds checking on (a fresh process and cache): hard cases and random scenes.
 
     Compiled code reads and writes unchecked otherwise: an index past an array's
-    end would go unnoticed as long as the values read are overwritten.
+    end would go unnoticed as long as the values read are overwritten. The
+    process first runs ``compile_engine`` (the experiment runner's warm-up),
+    which must compile the specialisation the later runs use.
     """
     environment = {**os.environ, "NUMBA_BOUNDSCHECK": "1", "NUMBA_CACHE_DIR": str(tmp_path)}
     result = subprocess.run([sys.executable, "-c", BOUNDS_PROBE], cwd=Path(__file__).parents[1], env=environment,
                             capture_output=True, text=True, timeout=600, check=False)
     assert result.returncode == 0, result.stderr[-2000:]
     assert "in bounds" in result.stdout
+    # compile_engine's tiny scene compiled the one specialisation every later run used
+    assert "engine specialisations 1" in result.stdout

@@ -307,10 +307,9 @@ def _compile_solver_once() -> None:
     every local worker loads them in about a second instead of compiling them
     concurrently.
     """
-    from stochpound.solvers.exact import run_exact
-    from stochpound.solvers.exact_timing import study_scene
+    from stochpound.solvers.exact import compile_engine
 
-    run_exact(study_scene())
+    compile_engine()
 
 
 def _describe_executor(workers: int | None, scheduler: str | None) -> str:

@@ -88,6 +88,30 @@ def run_exact(scene: Scene, limit_threads: bool = True, events: str = "compiled"
         return _PythonRun(scene).execute()
 
 
+WARM_UP_SCENE = {
+    "building": [
+        {"name": "B1", "mass": [2.0e5], "stiffness": [4.0e7], "damping": [1.0e5], "base": {"mass": 1.0e5, "mu": 0.1}},
+        {"name": "B2", "mass": [2.0e5], "stiffness": [4.0e7], "damping": [1.0e5]},
+    ],
+    "contact": [{"between": [["B1", 1], ["B2", 1]], "gap": 0.0, "stiffness": 1.0e8, "restitution": 0.5}],
+    "motion": {"type": "harmonic", "amplitude": 3.0, "omega": 9.0, "duration": 0.2, "dt": 0.01},
+}
+"""A tiny scene (an isolated and a fixed one-storey building in contact, 0.2 s) for :func:`compile_engine`."""
+
+
+def compile_engine() -> None:
+    """Compile the compiled event engine, or load it from numba's cache, by running :data:`WARM_UP_SCENE`.
+
+    numba compiles the whole engine on its first call (seconds, once per
+    machine: ``cache=True``); processes that start afterwards load it from
+    the cache. The experiment runner calls this before its local workers
+    start, so that they do not all compile it at once.
+    """
+    from stochpound.scene_file import scene_from_dict
+
+    run_exact(scene_from_dict(WARM_UP_SCENE, source="compile_engine"))
+
+
 def _one_thread(limit_threads: bool) -> contextlib.AbstractContextManager:
     """One BLAS thread inside the block if ``limit_threads`` (setting it costs ~0.2 ms), else no change."""
     return _thread_controller().limit(limits=1) if limit_threads else contextlib.nullcontext()
