@@ -378,7 +378,7 @@ def build_propagator(
     stuck = np.zeros(n_dof, bool)
     stuck[dynamics.stuck_dofs] = True
     blocks = [_Block.of(dynamics, dofs, stuck) for dofs in coupled_blocks(dynamics.A, n_dof)]
-    radius = max([cache.radius(b.key, b.A) for b in blocks] + [float(np.abs(np.linalg.eigvals(exo)).max())])
+    radius = max([cache.radius(b.key, b.A) for b in blocks] + [cache.radius(exo.tobytes(), exo)])
     substeps = max(1, math.ceil(radius * dt / SCREEN_ANGLE - 1e-9))
     step = dt / substeps
     exo_matrix = _augmented(np.zeros((0, 0)), np.zeros(0), np.zeros(0), exo)
