@@ -363,9 +363,10 @@ def _locate(guard, step: Step, coefficients, states: GuardStates, j: int, margin
     The step is cut at the critical points of the guard's Hermite cubic, so a
     crossing hidden between two end points of the same sign is bracketed. An
     armed guard fires at 0. A disarmed guard fires at 0 once it has dipped
-    below −tolerance, else at its positive threshold. Cubic maxima that come
-    close to the level without confirming are checked by maximising the true
-    guard (grazing contacts).
+    below −tolerance (seen at a cut point, or found by :func:`_after_dip`
+    before the time it reached its threshold), else at its positive
+    threshold. Cubic maxima that come close to the level without confirming
+    are checked by maximising the true guard (grazing contacts).
     """
     a0, a1, a2, a3 = coefficients
     h = step.t1 - step.t0
@@ -376,19 +377,35 @@ def _locate(guard, step: Step, coefficients, states: GuardStates, j: int, margin
     level = 0.0 if armed else states.threshold[j]
     previous = min(raw[0], -states.tolerance[j]) if armed else raw[0] - level
     for i in range(1, len(times)):
+        if not armed and raw[i] < -states.tolerance[j]:  # a dip: armed from here on, fires at 0
+            armed, level, previous = True, 0.0, raw[i]
+            continue
         current = raw[i] - level
         if previous < 0.0 <= current:
-            return brentq(lambda t: guard(t) - level, times[i - 1], times[i], xtol=TIME_TOLERANCE, rtol=4 * np.finfo(float).eps)
+            crossing = brentq(lambda t: guard(t) - level, times[i - 1], times[i], xtol=TIME_TOLERANCE, rtol=4 * np.finfo(float).eps)
+            return crossing if armed else _after_dip(guard, states.tolerance[j], step.t0, crossing)
         cubic_here = a0 + taus[i] * (a1 + taus[i] * (a2 + taus[i] * a3)) - level
         if 0 < i < len(times) - 1 and current < 0.0 and cubic_here >= -margin:
             found = _grazing(guard, level, times[i - 1], times[min(i + 1, len(times) - 1)], counters)
             if found is not None:
-                return found
-        if not armed and raw[i] < -states.tolerance[j]:
-            armed, level = True, 0.0
-            current = raw[i]
+                return found if armed else _after_dip(guard, states.tolerance[j], step.t0, found)
         previous = current
     return None
+
+
+def _after_dip(guard, tolerance: float, start: float, crossing: float) -> float:
+    """Where a disarmed guard that reached its threshold at ``crossing`` really fires.
+
+    If the guard went below −``tolerance`` between ``start`` and ``crossing``
+    (a dip between the points ``_locate`` samples, e.g. a contact that opens
+    and closes again within one step), it was armed again there and fires at
+    its first zero after the dip; otherwise at ``crossing``. The dip is found
+    by minimising the true guard (bounded Brent, as ``_grazing``).
+    """
+    found = minimize_scalar(guard, bounds=(start, crossing), method="bounded", options={"xatol": 1e-12})
+    if found.fun < -tolerance:
+        return brentq(guard, found.x, crossing, xtol=TIME_TOLERANCE, rtol=4 * np.finfo(float).eps)
+    return crossing
 
 
 def _grazing(guard, level: float, start: float, end: float, counters: EventCounters) -> float | None:

@@ -1,4 +1,4 @@
-"""Random scenes: the exact solver against the ivp path (DOP853 at rtol 1e-12), two independent integrations.
+"""Random scenes: the exact solver against the ivp path (DOP853 at rtol 1e-13), two independent integrations.
 
 Every scene is drawn from a seeded generator covering what a scene file can
 hold: one to four buildings of one to four floors, fixed or on sliding bases
@@ -11,7 +11,18 @@ the same events and impacts, and the same displacements to 1e-9 of the
 largest displacement (1e-9 m below 1 m): harmonic inputs slide some bases by
 metres, and there the problem itself is that sensitive (exact runs with
 different sub-steps, DOP853 and Radau differ from each other by ~5e-10 of the
-peak on seed 2).
+peak on seed 2; at rtol 1e-12 DOP853 itself is off by 2e-9 m on seed 151).
+Impact starts agree to 1e-8 s, plus 1e-12 m over the onset velocity for the
+slow, barely touching impacts of zero-gap contacts (seed 21: 4e-9 m/s), whose
+start times are that ill-conditioned.
+
+Seeds 16 and 25 found disarmed guards that dipped below zero and came back
+within one exact sub-step (a contact closing again 56 µs after it opened; a
+non-tensile contact's force passing through zero just after the start): the
+exact solver fired them at their small positive threshold, 2.7 µs and 0.9 ms
+late, instead of at zero after the dip. ``events._locate`` now arms a guard
+at a sampled dip before anything else and looks for a dip between samples
+before firing at the threshold (``events._after_dip``).
 """
 
 from __future__ import annotations
@@ -24,7 +35,7 @@ import pytest
 import stochpound
 
 TOLERANCE = 1e-9  # of max(1 m, largest |y|), every floor's total displacement over the whole record
-SEEDS = range(12)
+SEEDS = range(60)
 
 
 def random_scene(seed: int, duration: float = 6.0) -> dict:
@@ -94,9 +105,11 @@ def test_random_scenes_are_reproducible():
 def test_exact_matches_ivp_on_a_random_scene(seed):
     scene = stochpound.scene_from_dict(random_scene(seed))
     exact = stochpound.simulate(scene)
-    reference = stochpound.simulate(scene, method="ivp", rtol=1e-12, atol=1e-14)
+    reference = stochpound.simulate(scene, method="ivp", rtol=1e-13, atol=1e-16)
     assert exact.sizes.get("impact", 0) == reference.sizes.get("impact", 0)
     assert exact.attrs["events_total"] == reference.attrs["events_total"]
     scale = max(1.0, float(np.nanmax(np.abs(reference.total_displacement.values))))
     np.testing.assert_allclose(exact.total_displacement.values, reference.total_displacement.values, rtol=0, atol=TOLERANCE * scale)
-    np.testing.assert_allclose(exact.impact_start.values, reference.impact_start.values, rtol=0, atol=1e-8)
+    # a start is as sharp as the approach is fast: 1e-12 m of state difference moves it by 1e-12 m / |onset velocity|
+    start_tolerance = 1e-8 + 1e-12 * scale / np.maximum(np.abs(reference.impact_onset_velocity.values), 1e-300)
+    np.testing.assert_array_less(np.abs(exact.impact_start.values - reference.impact_start.values), start_tolerance)

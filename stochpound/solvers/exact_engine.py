@@ -532,13 +532,16 @@ def _brentq(flow, index, level, xa, xb, work):
 
 
 @njit(**INTERNAL)
-def _maximise_guard(flow, j, level, a, b, work):
-    """(t, level − guard(t)) minimising level − guard on [a, b] (scipy's bounded Brent, xatol = 1e-12)."""
+def _bounded_brent(flow, j, level, a, b, sign, work):
+    """(t, f(t)) minimising f = −sign (guard − level) on [a, b] (scipy's bounded Brent, xatol = 1e-12).
+
+    ``sign`` = 1 maximises the guard (``events._grazing``), −1 minimises it (``events._after_dip``).
+    """
     xatol, sqrt_eps, golden_mean = 1e-12, math.sqrt(2.2e-16), 0.5 * (3.0 - math.sqrt(5.0))
     fulc = a + golden_mean * (b - a)
     nfc, xf = fulc, fulc
     rat = e = 0.0
-    fx = -_evaluate(flow, j, level, xf, work)
+    fx = -sign * _evaluate(flow, j, level, xf, work)
     num = 1
     ffulc = fnfc = fx
     xm = 0.5 * (a + b)
@@ -568,7 +571,7 @@ def _maximise_guard(flow, j, level, a, b, work):
             e = a - xf if xf >= xm else b - xf
             rat = golden_mean * e
         x = xf + (1.0 if rat >= 0.0 else -1.0) * (tol1 if tol1 > abs(rat) else abs(rat))
-        fu = -_evaluate(flow, j, level, x, work)
+        fu = -sign * _evaluate(flow, j, level, x, work)
         num += 1
         if fu <= fx:
             if x >= xf:
@@ -597,6 +600,19 @@ def _maximise_guard(flow, j, level, a, b, work):
 
 
 # ---------------------------------------------------------------- first_crossing
+
+
+@njit(**INTERNAL)
+def _after_dip(flow, j, tolerance, start, crossing, work):
+    """Where disarmed guard j, at its threshold at ``crossing``, fires (``events._after_dip``).
+
+    At its first zero after a dip below −``tolerance`` in [start, crossing],
+    found by minimising the guard; at ``crossing`` if it did not dip.
+    """
+    t_min, value = _bounded_brent(flow, j, 0.0, start, crossing, -1.0, work)
+    if value < -tolerance:
+        return _brentq(flow, j, 0.0, t_min, crossing, work)
+    return crossing
 
 
 @njit(**INTERNAL)
@@ -639,7 +655,8 @@ def _first_crossing(flow, threshold, tolerance, rearmable, disarmed, counters, t
     Every guard whose cubic Hermite interpolant may reach zero is located on
     the dense flow (``events._locate``): the step is cut at the cubic's
     critical points; an armed guard fires at 0, a disarmed one at its
-    threshold until it has dipped below −tolerance; a cubic maximum close to
+    threshold until it has dipped below −tolerance (at a cut point, or found
+    by :func:`_after_dip`); a cubic maximum close to
     the level is checked by maximising the true guard (``events._grazing``).
     ``taus``, ``times`` and ``raw`` are work vectors (4 entries).
     """
@@ -668,6 +685,9 @@ def _first_crossing(flow, threshold, tolerance, rearmable, disarmed, counters, t
         previous = (-tolerance[j] if -tolerance[j] < raw[0] else raw[0]) if armed else raw[0] - level
         time = math.nan
         for i in range(1, n):
+            if not armed and raw[i] < -tolerance[j]:  # a dip: armed from here on, fires at 0
+                armed, level, previous = True, 0.0, raw[i]
+                continue
             current = raw[i] - level
             if previous < 0.0 <= current:
                 time = _brentq(flow, j, level, times[i - 1], times[i], work)
@@ -676,14 +696,13 @@ def _first_crossing(flow, threshold, tolerance, rearmable, disarmed, counters, t
             if 0 < i < n - 1 and current < 0.0 and a0 + tau * (a1 + tau * (a2 + tau * a3)) - level >= -margin:  # grazing
                 counters[GRAZING] += 1
                 start = times[i - 1]
-                t_max, value = _maximise_guard(flow, j, level, start, times[i + 1], work)  # i + 1 < n here
+                t_max, value = _bounded_brent(flow, j, level, start, times[i + 1], 1.0, work)  # i + 1 < n here
                 if -value >= 0.0 and _evaluate(flow, j, level, start, work) < 0.0:
                     time = _brentq(flow, j, level, start, t_max, work)
                     break
-            if not armed and raw[i] < -tolerance[j]:
-                armed, level = True, 0.0
-                current = raw[i]
             previous = current
+        if time == time and not armed:
+            time = _after_dip(flow, j, tolerance[j], t0, time, work)
         if time == time and (best_guard < 0 or time < best_time):
             best_time, best_guard = time, j
     if best_guard < 0:
