@@ -310,14 +310,13 @@ def ensemble_available() -> bool:
 
 def compile_time(config: Config) -> dict[str, Any]:
     """First-call time of the exact solver in fresh processes: ``compile_runs`` with an empty numba cache, then one filled."""
+    import os
     import tempfile
 
-    cold = []
-    for _ in range(config.compile_runs):
-        with tempfile.TemporaryDirectory(prefix="stochpound-numba-") as cache:
-            environment = {"NUMBA_CACHE_DIR": cache}
-            cold.append(probe("first_call", timeout=600, extra_env=environment))
-            cached = probe("first_call", timeout=600, extra_env=environment)
+    with tempfile.TemporaryDirectory(prefix="stochpound-numba-") as root:
+        caches = [{"NUMBA_CACHE_DIR": os.path.join(root, f"run{run}")} for run in range(config.compile_runs)]
+        cold = [probe("first_call", timeout=600, extra_env=cache) for cache in caches]
+        cached = probe("first_call", timeout=600, extra_env=caches[-1])
     return {"cold": cold, "cached": cached}
 
 

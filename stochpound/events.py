@@ -376,6 +376,7 @@ def _locate(guard, step: Step, coefficients, states: GuardStates, j: int, margin
     armed = not states.disarmed[j]
     level = 0.0 if armed else states.threshold[j]
     previous = min(raw[0], -states.tolerance[j]) if armed else raw[0] - level
+    crossing = None
     for i in range(1, len(times)):
         if not armed and raw[i] < -states.tolerance[j]:  # a dip: armed from here on, fires at 0
             armed, level, previous = True, 0.0, raw[i]
@@ -383,14 +384,16 @@ def _locate(guard, step: Step, coefficients, states: GuardStates, j: int, margin
         current = raw[i] - level
         if previous < 0.0 <= current:
             crossing = brentq(lambda t: guard(t) - level, times[i - 1], times[i], xtol=TIME_TOLERANCE, rtol=4 * np.finfo(float).eps)
-            return crossing if armed else _after_dip(guard, states.tolerance[j], step.t0, crossing)
+            break
         cubic_here = a0 + taus[i] * (a1 + taus[i] * (a2 + taus[i] * a3)) - level
         if 0 < i < len(times) - 1 and current < 0.0 and cubic_here >= -margin:
-            found = _grazing(guard, level, times[i - 1], times[min(i + 1, len(times) - 1)], counters)
-            if found is not None:
-                return found if armed else _after_dip(guard, states.tolerance[j], step.t0, found)
+            crossing = _grazing(guard, level, times[i - 1], times[min(i + 1, len(times) - 1)], counters)
+            if crossing is not None:
+                break
         previous = current
-    return None
+    if crossing is None or armed:
+        return crossing
+    return _after_dip(guard, states.tolerance[j], step.t0, crossing)
 
 
 def _after_dip(guard, tolerance: float, start: float, crossing: float) -> float:

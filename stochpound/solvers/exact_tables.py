@@ -209,11 +209,13 @@ def _mode_rows(system: System, mode: Mode, propagator: ModePropagator, energy: t
     guard = np.zeros((n_guards, d.A.shape[1] + 2))
     guard[:count] = _affine(d.guard_matrix, d.guard_ground, d.guard_constant)
     power, forms = energy
-    guard_rows = _guard_rows(guard, _affine(d.A, d.B, d.c), width=len(propagator.transition))
+    rate = _affine(d.A, d.B, d.c)
+    guard_rows = _guard_rows(guard, rate, width=len(propagator.transition))
     return {
         "modes": mode_vector(mode), "codes": codes, "n_guards": np.int64(count), "substeps": np.int64(propagator.substeps),
-        "rate": _affine(d.A, d.B, d.c), "guard": guard, "force": _affine(d.force_matrix, 0.0, d.force_constant), "power": power,
-        "propagate": np.concatenate([propagator.transition.T, forms, (guard_rows @ propagator.transition).T], axis=1),  # padded by load
+        "rate": rate, "guard": guard, "force": _affine(d.force_matrix, 0.0, d.force_constant), "power": power,
+        # the slot's columns beyond these stay zero: the padding to exact_engine.propagate_columns
+        "propagate": np.concatenate([propagator.transition.T, forms, (guard_rows @ propagator.transition).T], axis=1),
         "step": np.float64(propagator.step),
         "chebyshev": propagator.chebyshev.reshape(-1, propagator.transition.shape[0]).T,
     }
