@@ -309,15 +309,24 @@ def ensemble_available() -> bool:
 
 
 def compile_time(config: Config) -> dict[str, Any]:
-    """First-call time of the exact solver in fresh processes: ``compile_runs`` with an empty numba cache, then one filled."""
+    """First-call time of the exact solver in fresh processes: ``compile_runs`` with an empty numba cache, then one filled.
+
+    Each empty-cache run is followed by one at numba's default optimisation
+    level (``NUMBA_OPT=3``, ``cold_default_level``), which the engine lowers
+    (:data:`stochpound.solvers.exact_engine.OPTIMISATION_LEVEL`): the pairs
+    show what that saves and that it costs no speed.
+    """
     import os
     import tempfile
 
+    cold, cold_default_level = [], []
     with tempfile.TemporaryDirectory(prefix="stochpound-numba-") as root:
-        caches = [{"NUMBA_CACHE_DIR": os.path.join(root, f"run{run}")} for run in range(config.compile_runs)]
-        cold = [probe("first_call", timeout=600, extra_env=cache) for cache in caches]
-        cached = probe("first_call", timeout=600, extra_env=caches[-1])
-    return {"cold": cold, "cached": cached}
+        for run in range(config.compile_runs):
+            cache = os.path.join(root, f"run{run}")
+            cold.append(probe("first_call", timeout=600, extra_env={"NUMBA_CACHE_DIR": cache}))
+            cold_default_level.append(probe("first_call", timeout=600, extra_env={"NUMBA_CACHE_DIR": cache + "-default", "NUMBA_OPT": "3"}))
+        cached = probe("first_call", timeout=600, extra_env={"NUMBA_CACHE_DIR": cache})
+    return {"cold": cold, "cold_default_level": cold_default_level, "cached": cached}
 
 
 def ensemble_throughput(config: Config) -> dict[str, Any]:

@@ -280,13 +280,30 @@ def test_result_dataset_is_the_one_xarray_would_build():
 
 
 BOUNDS_PROBE = """
+import numba
+from numba.core import event
+
 import stochpound
 from stochpound.solvers import exact_engine
 from stochpound.solvers.exact import compile_engine, run_exact
 from tests.test_exact import HARD_CASES
 from tests.test_random_scenes import random_scene
 
+levels = []
+
+
+class EngineCompileLevel(event.Listener):
+    def on_start(self, compile_event):
+        if compile_event.data["dispatcher"] is exact_engine.run_engine:
+            levels.append(int(numba.config.OPT))
+
+    def on_end(self, compile_event):
+        pass
+
+
+event.register("numba:compile", EngineCompileLevel())
 compile_engine()
+print("compiled at", levels, "then", int(numba.config.OPT))
 scenes = [stochpound.scene_from_dict(data) for data in HARD_CASES.values()]
 scenes += [stochpound.scene_from_dict(random_scene(seed)) for seed in range(8)]
 for scene in scenes:
@@ -304,10 +321,28 @@ def test_engine_never_indexes_out_of_bounds(tmp_path):
     process first runs ``compile_engine`` (the experiment runner's warm-up),
     which must compile the specialisation the later runs use.
     """
-    environment = {**os.environ, "NUMBA_BOUNDSCHECK": "1", "NUMBA_CACHE_DIR": str(tmp_path)}
+    from stochpound.solvers import exact_engine
+
+    environment = {name: value for name, value in os.environ.items() if name != "NUMBA_OPT"}
+    environment.update(NUMBA_BOUNDSCHECK="1", NUMBA_CACHE_DIR=str(tmp_path))
     result = subprocess.run([sys.executable, "-c", BOUNDS_PROBE], cwd=Path(__file__).parents[1], env=environment,
                             capture_output=True, text=True, timeout=600, check=False)
     assert result.returncode == 0, result.stderr[-2000:]
     assert "in bounds" in result.stdout
     # compile_engine's tiny scene compiled the one specialisation every later run used
     assert "engine specialisations 1" in result.stdout
+    # at the engine's optimisation level, numba's default restored afterwards
+    assert f"compiled at [{exact_engine.OPTIMISATION_LEVEL}] then 3" in result.stdout
+
+
+def test_optimisation_level_is_set_inside_the_block_only():
+    """numba's optimisation level (its own type kept) inside the block, restored after it, also when the block raises."""
+    import numba
+
+    from stochpound.solvers import exact_engine
+
+    default = numba.config.OPT
+    with pytest.raises(RuntimeError), exact_engine._optimisation_level(1):
+        assert numba.config.OPT == 1 and type(numba.config.OPT) is type(default)
+        raise RuntimeError
+    assert numba.config.OPT is default

@@ -177,7 +177,7 @@ class _PythonRun:
             states.threshold, states.tolerance, states.rearmable, states.disarmed
         )
         _put_open_impacts(self.recorder.open_impacts, impacts)
-        status = engine.run_engine(*slots.tables, *self.plant, *self.state, *self.work, False)
+        status = engine.run(*slots.tables, *self.plant, *self.state, *self.work, False)
         states.threshold[:], states.disarmed[:] = arming.threshold[:n], arming.disarmed[:n]
         _take_open_impacts(impacts, self.recorder.open_impacts)
         stop = int(run.ints[engine.K])
@@ -251,7 +251,7 @@ class _CompiledRun:
             if len(self.state.run.visited) < len(slots.modes):
                 visited = np.resize(self.state.run.visited, 2 * len(slots.modes))
                 self.state = self.state._replace(run=self.state.run._replace(visited=visited))
-            status = engine.run_engine(*slots.tables, *self.plant, *self.state, *exact_tables.work_arrays_for(system, slots), True)
+            status = engine.run(*slots.tables, *self.plant, *self.state, *exact_tables.work_arrays_for(system, slots), True)
             if status == engine.FINISHED:
                 break
             if status == engine.NEED_MODE:  # the only step that builds propagators (matrix exponentials)
