@@ -1109,7 +1109,7 @@ A ``NUMBA_OPT`` set in the environment is left in force.
 """
 
 
-def run(*arguments) -> int:
+def run(*arguments: object) -> int:
     """Call :func:`run_engine`: a process's first call compiles it (or loads it from numba's cache) at :data:`OPTIMISATION_LEVEL`."""
     if run_engine.signatures or "NUMBA_OPT" in os.environ:
         return run_engine(*arguments)
