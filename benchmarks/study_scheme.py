@@ -19,7 +19,7 @@ step, and a sliding base never stops inside a step. The ground motion is the
 scene's own (the study used a cubic spline through the samples).
 
 The equations inside a step are stochpound's mode equations
-(:class:`stochpound.modes.ModeLibrary`): a sliding base is a free degree of
+(:class:`stochpound.model.modes.ModeLibrary`): a sliding base is a free degree of
 freedom plus the friction term above, a stuck base keeps s and ṡ. Whether
 the impact forces act on the base as a whole follows the scene:
 ``study_compat = true`` gives the study's equations (they do not), otherwise
@@ -39,10 +39,10 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from benchmarks.outcome import Outcome
-from stochpound.modes import FREE, STUCK, Mode, ModeDynamics, ModeLibrary
-from stochpound.motion import SampledMotion
-from stochpound.scene import Scene
-from stochpound.system import System, build_system
+from stochpound.model.modes import FREE, STUCK, Mode, ModeDynamics, ModeLibrary
+from stochpound.motions.ground import SampledMotion
+from stochpound.model.scene import Scene
+from stochpound.model.system import System, build_system
 
 STUDY_RK45 = {"max_step": 0.01, "first_step": 0.01, "atol": 1e-3, "rtol": 1e-3}
 """Settings of the RK45 integration inside each step (the study's ode45 options; the
@@ -97,7 +97,7 @@ class StudyScheme:
     Parameters
     ----------
     scene : Scene
-        Its motion must be sampled (:class:`~stochpound.motion.SampledMotion`).
+        Its motion must be sampled (:class:`~stochpound.motions.ground.SampledMotion`).
     h : float
         Restart interval, s. The motion's sample spacing must be a whole
         multiple of it (the study: h = dt = 0.02 s).

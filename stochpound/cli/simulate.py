@@ -5,9 +5,9 @@ from __future__ import annotations
 import click
 
 from stochpound.errors import StochpoundError
-from stochpound.result import write_dataset
-from stochpound.scene_file import load_scene
-from stochpound.simulate import METHODS, simulate as run_simulation
+from stochpound.results.dataset import write_dataset
+from stochpound.model.scene_file import load_scene
+from stochpound.solvers.simulate import METHODS, simulate as run_simulation
 from stochpound.solvers.ivp import INTEGRATORS
 
 

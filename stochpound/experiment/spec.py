@@ -26,8 +26,8 @@ from pathlib import Path
 from typing import Any, Iterator, Mapping
 
 from stochpound.errors import SceneError
-from stochpound.scene_file import _is_number, _number, _reject_unknown, _string, _table
-from stochpound.simulate import METHODS
+from stochpound.model.scene_file import _is_number, _number, _reject_unknown, _string, _table
+from stochpound.solvers.simulate import METHODS
 from stochpound.solvers.ivp import INTEGRATORS
 
 #: Format version of the canonical definition (stored with every store).

@@ -28,7 +28,7 @@ import xarray as xr
 
 from stochpound.analysis import moments, peak_response
 from stochpound.analysis.summary import run_summary, top_floor_total_displacement
-from stochpound.records.statistics import moments as sample_moments
+from stochpound.motions.records.statistics import moments as sample_moments
 
 #: Summary names of :func:`stochpound.analysis.run_summary` renamed in the store
 #: (``mean``/``std`` would shadow Dataset methods).
@@ -214,8 +214,8 @@ def reference_arrays(summary: Mapping[str, np.ndarray], run: xr.Dataset, keep_hi
 @cache
 def templates() -> tuple[xr.Dataset, xr.Dataset, xr.Dataset]:
     """A tiny real run and its case and reference summaries (metadata: dims, dtypes, units, long names)."""
-    from stochpound.scene_file import scene_from_dict
-    from stochpound.simulate import simulate
+    from stochpound.model.scene_file import scene_from_dict
+    from stochpound.solvers.simulate import simulate
 
     building = {"mass": [1.0], "stiffness": [1.0]}
     scene = scene_from_dict(

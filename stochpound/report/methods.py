@@ -19,8 +19,8 @@ import pandas as pd
 import xarray as xr
 
 import stochpound
-from stochpound.modal_solution import harmonic_response
-from stochpound.records import registry_entries
+from stochpound.model.modal_solution import harmonic_response
+from stochpound.motions.records import registry_entries
 from stochpound.report.document import Paragraph, Section, Table
 from stochpound.report.stores import case_scene, select
 

@@ -18,7 +18,7 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
-from stochpound.records import load_record, record_statistics, registry_entries, study_table_3_2
+from stochpound.motions.records import load_record, record_statistics, registry_entries, study_table_3_2
 from stochpound.report.document import Table
 from stochpound.report.published import published_tables, study_number
 from stochpound.report.stores import value

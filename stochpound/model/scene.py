@@ -2,7 +2,7 @@
 
 A :class:`Scene` is a validated, immutable description of one physical
 situation (MODEL.md §1–4). It is built from a scene file by
-:func:`stochpound.scene_file.load_scene`, or directly in Python. All
+:func:`stochpound.model.scene_file.load_scene`, or directly in Python. All
 quantities are SI (kg, N/m, N·s/m, m, s).
 """
 
@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from stochpound.motion import GroundMotion
+from stochpound.motions.ground import GroundMotion
 
 
 @dataclass(frozen=True)

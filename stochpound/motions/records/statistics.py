@@ -14,7 +14,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from stochpound.records.record import Record
+from stochpound.motions.records.record import Record
 
 #: The reference study's g, m/s².
 STUDY_G = 9.814

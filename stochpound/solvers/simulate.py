@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import xarray as xr
 
-from stochpound.result import build_dataset
-from stochpound.scene import Scene
+from stochpound.results.dataset import build_dataset
+from stochpound.model.scene import Scene
 from stochpound.solvers.exact import run_exact
 from stochpound.solvers.ivp import INTEGRATORS, run_ivp
 

@@ -38,10 +38,9 @@ from threadpoolctl import threadpool_limits
 
 from stochpound import __version__
 from stochpound.analysis import impact_statistics, moments, peak_response
-from stochpound.events import EventCounters
-from stochpound.motion import SampledMotion
-from stochpound.recorder import ENERGY_TERMS, Recorder
-from stochpound.scene import Scene
+from stochpound.motions.ground import SampledMotion
+from stochpound.results.record import ENERGY_TERMS, EventCounters, Recorder
+from stochpound.model.scene import Scene
 from stochpound.solvers.exact import run_exact
 from stochpound.solvers.ivp import run_ivp
 

@@ -18,7 +18,7 @@ autonomous linear system ż = 𝒜 z,
 so z(t₀ + τ) = exp(𝒜 τ) z(t₀) exactly. For every visited mode a
 :class:`ModePropagator` holds exp(𝒜 h) for the sub-step h used inside a
 sample interval, exp(𝒜 τᵢ) at the 5 Gauss–Legendre nodes of a sub-step (the
-energy quadrature of :class:`stochpound.recorder.Recorder`), and a Chebyshev
+energy quadrature of :class:`stochpound.results.record.Recorder`), and a Chebyshev
 expansion of exp(𝒜 τ) on [0, h] that evaluates the exact flow anywhere inside
 a sub-step (event location, peak forces). The rows of a stuck base are set to
 exactly s(τ) = s(0), ṡ(τ) = 0 (MODEL.md §6).
@@ -60,10 +60,9 @@ import numpy as np
 from scipy.linalg import matrix_balance
 
 from stochpound.errors import StochpoundError
-from stochpound.events import Dense
-from stochpound.modes import BoundedCache, Mode, ModeDynamics, ModeLibrary, array_bytes
-from stochpound.motion import GroundMotion, HarmonicMotion, SampledMotion
-from stochpound.system import System
+from stochpound.model.modes import BoundedCache, Mode, ModeDynamics, ModeLibrary, array_bytes
+from stochpound.motions.ground import GroundMotion, HarmonicMotion, SampledMotion
+from stochpound.model.system import System
 
 SCREEN_ANGLE = 0.5
 """Largest phase ρ·h (rad) swept by any mode frequency in one sub-step."""
@@ -172,23 +171,6 @@ class ModePropagator:
     transition: np.ndarray
     nodes: np.ndarray
     chebyshev: np.ndarray
-
-    def dense(self, t0: float, x0: np.ndarray, ground0: np.ndarray) -> Dense:
-        """Exact state x(t) for t ∈ [t0, t0 + h] from x(t0) and w(t0) = ``ground0``.
-
-        Returns a callable: scalar t → (2N,), array of times → (2N, n_times).
-        """
-        z0 = np.concatenate([x0, ground0, [1.0]])
-        coefficients = self.chebyshev @ z0  # (d+1, 2N)
-        orders = np.arange(len(coefficients))
-        scale = 2.0 / self.step
-
-        def evaluate(t: np.ndarray | float) -> np.ndarray:
-            s = np.clip((np.asarray(t, float) - t0) * scale - 1.0, -1.0, 1.0)
-            basis = np.cos(np.multiply.outer(np.arccos(s), orders))
-            return (basis @ coefficients).T
-
-        return evaluate
 
 
 def _augmented(A: np.ndarray, B: np.ndarray, c: np.ndarray, exo: np.ndarray) -> np.ndarray:

@@ -22,7 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from stochpound.scene import Scene, storey_matrix
+from stochpound.model.scene import Scene, storey_matrix
 
 
 @dataclass(frozen=True)

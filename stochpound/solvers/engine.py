@@ -12,7 +12,7 @@ logic, which stays the specification:
 * settling: :func:`stochpound.events.settle` (``guard_leaving_sign``,
   ``_wanting_to_fire``, ``_apply``, ``_initial_guard_states``) with the same
   constants (imported from :mod:`stochpound.events`);
-* recording: :meth:`stochpound.recorder.Recorder.on_step` (energy terms by
+* recording: :meth:`stochpound.results.record.Recorder.on_step` (energy terms by
   5-point Gauss–Legendre quadrature, impulses, located peak forces),
   ``on_transitions`` and ``on_contact_force``.
 
@@ -78,9 +78,17 @@ from numba import njit
 from numba.core.compiler_lock import global_compiler_lock
 from numba.core.registry import cpu_target
 
-from stochpound.events import FIRE_THRESHOLD, MAX_SETTLE_ITERATIONS, ROUND_OFF, TIME_TOLERANCE
-from stochpound.modes import STUCK, Guard
-from stochpound.propagators import GAUSS_NODES, GAUSS_WEIGHTS
+from stochpound.model.modes import STUCK, Guard
+from stochpound.solvers.propagators import GAUSS_NODES, GAUSS_WEIGHTS
+
+ROUND_OFF = 1e-10
+"""Relative size under which a guard value or derivative counts as zero."""
+FIRE_THRESHOLD = 1e-7
+"""Relative level at which a disarmed guard fires anyway (progress guarantee)."""
+TIME_TOLERANCE = 1e-13
+"""Absolute tolerance of event times, s."""
+MAX_SETTLE_ITERATIONS = 64
+"""Most mode transitions applied at one instant before settling declares a cycle (chattering)."""
 
 INTERNAL = {"no_cpython_wrapper": True, "no_cfunc_wrapper": True, "error_model": "numpy", "_nrt": False}
 """Options of the jitted helpers, called only from compiled code (no runtime: they allocate nothing)."""
@@ -116,11 +124,25 @@ Layout.__doc__ = """Contacts (penetration rows, gaps, tensile flags, rows of the
 Run = namedtuple("Run", "clock ints x pending_x pending_mode missing_mode visited")
 Run.__doc__ = """Time, counters (``ints``; ``ints[MODE]`` is a slot), state, the pending event and the ids of the modes visited."""
 Arming = namedtuple("Arming", "threshold tolerance rearmable disarmed")
-Arming.__doc__ = """Arming of the current mode's guards (:class:`stochpound.events.GuardStates`)."""
+Arming.__doc__ = """Arming of the current mode's guards.
+
+``threshold[j]`` is 0 for an armed guard (it fires at 0), a small positive
+level for a disarmed one (it fires there, or at 0 once it has gone below
+−``tolerance[j]``) and +inf for a guard that may not fire for now;
+``rearmable[j]`` is False for a guard that stays off until the next mode
+change (the RECLOSE guard of a contact that is not penetrated).
+"""
 Impacts = namedtuple("Impacts", "is_open impact table")
 Impacts.__doc__ = """Open impacts (``impact[row, contact]``, rows START … IMPULSE) and the table of finished ones."""
 Outputs = namedtuple("Outputs", "running states energy sample_modes")
 Outputs.__doc__ = """Running energy terms, and the state, energy terms and mode id at every output time."""
+Supplied = namedtuple("Supplied", "bounds x coefficients")
+Supplied.__doc__ = """A step of the flow supplied by the caller (``external`` runs: an integrator's step).
+
+``bounds`` = [t0, t1] (s), ``x`` the state at t1 and ``coefficients`` the
+Chebyshev coefficients of x(t) on [t0, t1], (D + 1) × 2N flattened by order
+(the dense output of :class:`Flow`).
+"""
 Flow = namedtuple("Flow", "rate guard force coefficients ground origin harmonic t0 scale")
 Flow.__doc__ = """One mode's flow inside one step: its affine maps and the Chebyshev coefficients of x(t).
 
@@ -130,8 +152,8 @@ Flow.__doc__ = """One mode's flow inside one step: its affine maps and the Cheby
 """
 
 # entries of Run.ints
-K, MODE, PENDING, FIRED_KIND, FIRED_TARGET, FIRED_DIRECTION, N_IMPACTS, TOTAL, CHATTER, GRAZING = range(10)
-N_INTS = 10
+K, MODE, PENDING, FIRED_KIND, FIRED_TARGET, FIRED_DIRECTION, N_IMPACTS, TOTAL, CHATTER, GRAZING, READY = range(11)
+N_INTS = 11
 # rows of ModeTable.codes
 KIND, TARGET, DIRECTION = range(3)
 # rows of Impacts.impact
@@ -139,7 +161,7 @@ START, ONSET, IN_PHASE, PEAK, PEAK_TIME, IMPULSE = range(6)
 # pending settles
 NONE, INITIAL, EVENT = 0, 1, 2
 # statuses returned to Python
-FINISHED, NEED_MODE, NEED_SPACE, NEEDS_EVENTS = 0, 1, 2, 3
+FINISHED, NEED_MODE, NEED_SPACE, NEED_STEP = 0, 1, 2, 3
 # columns of Impacts.table (finished impacts): contact, end, then the rows of Impacts.impact
 IMPACT_COLUMNS = ("contact", "end", "start", "onset_velocity", "in_phase", "peak_force", "peak_time", "impulse")
 N_NODES = 5
@@ -319,18 +341,31 @@ def _interior_maximum(a0, a1, a2, a3):
 
 
 @njit(**INTERNAL)
+def _hermite(value0, value1, rate0, rate1, h):
+    """Coefficients (a0, a1, a2, a3) in τ ∈ [0, 1] of the cubic Hermite interpolant of a guard over a step of h seconds."""
+    return value0, rate0 * h, 3.0 * (value1 - value0) - (2.0 * rate0 + rate1) * h, 2.0 * (value0 - value1) + (rate0 + rate1) * h
+
+
+@njit(**INTERNAL)
+def _screen_margin(value0, value1, rate0, rate1, h, tolerance):
+    """How close below zero a guard's Hermite cubic may come before the guard is examined on the flow itself."""
+    return 1e-3 * (abs(value0) + abs(value1) + abs(rate0 * h) + abs(rate1 * h)) + tolerance
+
+
+@njit(**INTERNAL)
+def _may_cross(value0, value1, rate0, rate1, h, tolerance):
+    """The guard screen: True when a guard ends the step at or above zero, or its Hermite cubic peaks within the margin of zero."""
+    if value1 >= 0.0:
+        return True
+    a0, a1, a2, a3 = _hermite(value0, value1, rate0, rate1, h)
+    return _interior_maximum(a0, a1, a2, a3) >= -_screen_margin(value0, value1, rate0, rate1, h, tolerance)
+
+
+@njit(**INTERNAL)
 def _suspect(values0, values1, rates0, rates1, h, threshold, tolerance):
-    """True when first_crossing would examine some guard of this sub-step."""
+    """True when some guard that may fire passes the screen (:func:`_may_cross`) over this step."""
     for g in range(values0.shape[0]):
-        if not abs(threshold[g]) < math.inf:
-            continue
-        if values1[g] >= 0.0:
-            return True
-        a0, a1 = values0[g], rates0[g] * h
-        a2 = 3.0 * (values1[g] - values0[g]) - (2.0 * rates0[g] + rates1[g]) * h
-        a3 = 2.0 * (values0[g] - values1[g]) + (rates0[g] + rates1[g]) * h
-        margin = 1e-3 * (abs(values0[g]) + abs(values1[g]) + abs(a1) + abs(rates1[g] * h)) + tolerance[g]
-        if _interior_maximum(a0, a1, a2, a3) >= -margin:
+        if abs(threshold[g]) < math.inf and _may_cross(values0[g], values1[g], rates0[g], rates1[g], h, tolerance[g]):
             return True
     return False
 
@@ -671,15 +706,11 @@ def _first_crossing(flow, threshold, tolerance, rearmable, disarmed, counters, t
     h = t1 - t0
     best_time, best_guard = math.nan, -1
     for j in range(values0.shape[0]):
-        if not abs(threshold[j]) < math.inf:
+        # every guard is screened at 0: an armed guard fires there, and a disarmed one may, after a dip
+        if not (abs(threshold[j]) < math.inf and _may_cross(values0[j], values1[j], rates0[j], rates1[j], h, tolerance[j])):
             continue
-        a0, a1 = values0[j], rates0[j] * h
-        a2 = 3.0 * (values1[j] - values0[j]) - (2.0 * rates0[j] + rates1[j]) * h
-        a3 = 2.0 * (values0[j] - values1[j]) + (rates0[j] + rates1[j]) * h
-        margin = 1e-3 * (abs(values0[j]) + abs(values1[j]) + abs(a1) + abs(rates1[j] * h)) + tolerance[j]
-        screen = 0.0 if disarmed[j] else threshold[j]
-        if not (values1[j] >= screen or _interior_maximum(a0, a1, a2, a3) >= screen - margin):
-            continue
+        a0, a1, a2, a3 = _hermite(values0[j], values1[j], rates0[j], rates1[j], h)
+        margin = _screen_margin(values0[j], values1[j], rates0[j], rates1[j], h, tolerance[j])
         n = _critical_points(a1, a2, a3, taus[1:3]) + 2
         taus[0], taus[n - 1] = 0.0, 1.0
         raw[0] = a0
@@ -943,12 +974,70 @@ def _settle_pending(modes, codes, n_guards, rate, guard, force, motion, layout, 
 # ---------------------------------------------------------------- event steps
 
 
+@njit(**INTERNAL)
+def _locate_and_record(flow, m, modes, codes, force, power, ints, clock, x0, x1, pending_x, pending_mode, arming, is_open, impact,
+                       running, t1, values0, values1, rates0, rates1, scratch):
+    """The event code of one step [flow.t0, t1] of mode m on its dense flow: returns True when it stopped at an event (now pending).
+
+    The earliest guard crossing is located (:func:`_first_crossing`); the
+    energy terms and impulses are integrated (5-point Gauss–Legendre on the
+    flow) and the impact forces' peaks located up to the event or t1; the
+    fired guard becomes the pending event at ``clock[0]`` with the state in
+    ``pending_x``. ``values*``/``rates*`` are the guards' values and rates
+    at the step's ends; ``scratch``: the work array (:func:`work_arrays`).
+    """
+    threshold, tolerance, rearmable, disarmed = arming
+    t0, size = flow.t0, x0.shape[0]
+    width = size + 5
+    work, x_stop = scratch[2, :size], scratch[12, :size]
+    node, products = scratch[10, :width], scratch[11, : power.shape[1]]  # node: z = [x, a_g, 0, 0, 0, 1] at a Gauss node
+    node[size + 1], node[size + 2], node[size + 3], node[width - 1] = 0.0, 0.0, 0.0, 1.0
+    t_event, fired = _first_crossing(flow, threshold, tolerance, rearmable, disarmed, ints, t1, values0, values1, rates0, rates1, work,
+                                     scratch[13], scratch[14], scratch[15])
+    t_stop = t1
+    _copy(x1, x_stop)
+    if fired >= 0:
+        t_stop = t_event
+        _dense(flow, t_event, x_stop)
+    if t_stop > t0:  # energy terms and impulses at the Gauss nodes, then peak forces
+        half = 0.5 * (t_stop - t0)
+        for g in range(N_NODES):
+            t_node, weight = t0 + half * (GAUSS_NODES[g] + 1.0), half * GAUSS_WEIGHTS[g]
+            _dense(flow, t_node, node[:size])
+            node[size] = _ground_value(flow, t_node)
+            _product(power, node, products)
+            _add_forms(node, products, weight, running)
+            for p in range(is_open.shape[0]):
+                if is_open[p]:
+                    impact[IMPULSE, p] += weight * _affine(force, p, node, 0.0)
+        _offer_peaks(force, is_open, impact, t0, x0)
+        _offer_peaks(force, is_open, impact, t_stop, x_stop)
+        for p in range(is_open.shape[0]):  # a force maximum inside the step
+            if is_open[p] and _evaluate(flow, -1 - p, 0.0, t0, work) > 0.0 > _evaluate(flow, -1 - p, 0.0, t_stop, work):
+                t_peak = _brentq(flow, -1 - p, 0.0, t0, t_stop, work)
+                _dense(flow, t_peak, work)
+                value = _affine(force, p, work, 0.0)
+                if value > impact[PEAK, p]:
+                    impact[PEAK, p], impact[PEAK_TIME, p] = value, t_peak
+    if fired < 0:
+        return False
+    clock[0] = t_event
+    _copy(x_stop, pending_x)
+    _copy(modes[m], pending_mode)
+    ints[FIRED_KIND], ints[FIRED_TARGET], ints[FIRED_DIRECTION] = codes[m, KIND, fired], codes[m, TARGET, fired], codes[m, DIRECTION, fired]
+    ints[PENDING] = EVENT
+    ints[TOTAL] += 1
+    return True
+
+
 @njit(inline="always", error_model="numpy")
 def _advance_span(m, n, modes, codes, substeps, step, propagate, chebyshev, rate, guard, force, power, motion, ints, clock, x,
                   pending_x, pending_mode, arming, is_open, impact, running, k, t, t_end, scratch):
-    """Sub-steps of mode m (n guards, its arrays) from t to t_end (``_until_event`` of exact.py).
+    """Exact sub-steps of mode m (n guards, its arrays) from t to t_end, each through :func:`_locate_and_record`.
 
-    Returns True when it stopped at an event (now pending), False at t_end.
+    A full sub-step in which no guard passes the screen and no impact is
+    open takes the quiet loop's shortcut (its energy forms). Returns True
+    when it stopped at an event (now pending), False at t_end.
     ``scratch``: the work array (:func:`work_arrays`).
     """
     times, coefficients_k, harmonic = motion.times, motion.coefficients, motion.harmonic
@@ -960,11 +1049,9 @@ def _advance_span(m, n, modes, codes, substeps, step, propagate, chebyshev, rate
     spacing = (t_end - t) / n_steps
     size = x.shape[0]
     width = size + 5
-    z0, propagated, work = scratch[0, :width], scratch[1, : propagate.shape[1]], scratch[2, :size]
+    z0, propagated = scratch[0, :width], scratch[1, : propagate.shape[1]]
     values0, values1, rates0, rates1 = scratch[3, :n], scratch[4, :n], scratch[5, :n], scratch[6, :n]
     rate_work, ground1, coefficients = scratch[7, :size], scratch[8, :4], scratch[9, : chebyshev.shape[1]]
-    node, products = scratch[10, :width], scratch[11, : power.shape[1]]  # node: z = [x, a_g, 0, 0, 0, 1] at a Gauss node
-    node[size + 1], node[size + 2], node[size + 3], node[width - 1] = 0.0, 0.0, 0.0, 1.0
     x1 = propagated[:size]
     is_harmonic = harmonic.shape[0] > 0
     ground = harmonic if is_harmonic else coefficients_k[k]
@@ -991,42 +1078,37 @@ def _advance_span(m, n, modes, codes, substeps, step, propagate, chebyshev, rate
             continue
         if full:
             _product(chebyshev, z0, coefficients)
-        t_event, fired = _first_crossing(flow, threshold, tolerance, rearmable, disarmed, ints, t1, values0, values1, rates0, rates1, work,
-                                         scratch[13], scratch[14], scratch[15])
-        t_stop, x_stop = t1, x1
-        if fired >= 0:
-            t_stop, x_stop = t_event, scratch[12, :size]
-            _dense(flow, t_event, x_stop)
-        if t_stop > t0:  # Recorder.on_step: energy terms and impulses at the Gauss nodes, then peak forces
-            half = 0.5 * (t_stop - t0)
-            for g in range(N_NODES):
-                t_node, weight = t0 + half * (GAUSS_NODES[g] + 1.0), half * GAUSS_WEIGHTS[g]
-                _dense(flow, t_node, node[:size])
-                node[size] = _ground_value(flow, t_node)
-                _product(power, node, products)
-                _add_forms(node, products, weight, running)
-                for p in range(is_open.shape[0]):
-                    if is_open[p]:
-                        impact[IMPULSE, p] += weight * _affine(force, p, node, 0.0)
-            _offer_peaks(force, is_open, impact, t0, x)
-            _offer_peaks(force, is_open, impact, t_stop, x_stop)
-            for p in range(is_open.shape[0]):  # a force maximum inside the step
-                if is_open[p] and _evaluate(flow, -1 - p, 0.0, t0, work) > 0.0 > _evaluate(flow, -1 - p, 0.0, t_stop, work):
-                    t_peak = _brentq(flow, -1 - p, 0.0, t0, t_stop, work)
-                    _dense(flow, t_peak, work)
-                    value = _affine(force, p, work, 0.0)
-                    if value > impact[PEAK, p]:
-                        impact[PEAK, p], impact[PEAK_TIME, p] = value, t_peak
-        if fired < 0:
-            _copy(x1, x)
-            continue
-        clock[0] = t_event
-        _copy(x_stop, pending_x)
-        _copy(modes[m], pending_mode)
-        ints[FIRED_KIND], ints[FIRED_TARGET], ints[FIRED_DIRECTION] = codes[m, KIND, fired], codes[m, TARGET, fired], codes[m, DIRECTION, fired]
-        ints[PENDING] = EVENT
-        ints[TOTAL] += 1
+        if _locate_and_record(flow, m, modes, codes, force, power, ints, clock, x, x1, pending_x, pending_mode, arming, is_open, impact,
+                              running, t1, values0, values1, rates0, rates1, scratch):
+            return True
+        _copy(x1, x)
+    return False
+
+
+@njit(inline="always", error_model="numpy")
+def _supplied_step(m, n, modes, codes, rate, guard, force, power, motion, ints, clock, x, pending_x, pending_mode, arming, is_open, impact,
+                   running, k, supplied, scratch):
+    """The supplied step of mode m (n guards, its arrays) through :func:`_locate_and_record`; x moves to its end if no event.
+
+    Returns True when it stopped at an event (now pending).
+    """
+    times, harmonic = motion.times, motion.harmonic
+    t0, t1 = supplied.bounds[0], supplied.bounds[1]
+    size = x.shape[0]
+    values0, values1, rates0, rates1 = scratch[3, :n], scratch[4, :n], scratch[5, :n], scratch[6, :n]
+    rate_work, ground0, ground1 = scratch[7, :size], scratch[8, :4], scratch[9, :4]
+    is_harmonic = harmonic.shape[0] > 0
+    ground = harmonic if is_harmonic else motion.coefficients[k]
+    flow = Flow(rate, guard, force, supplied.coefficients, ground, times[k], is_harmonic, t0, 2.0 / (t1 - t0))
+    _ground(times, motion.coefficients, harmonic, t0, k, ground0)
+    _guards_and_rates(rate, guard, x, ground0[0], ground0[1], values0, rates0, rate_work)
+    _ground(times, motion.coefficients, harmonic, t1, k, ground1)
+    _guards_and_rates(rate, guard, supplied.x, ground1[0], ground1[1], values1, rates1, rate_work)
+    if _locate_and_record(flow, m, modes, codes, force, power, ints, clock, x, supplied.x, pending_x, pending_mode, arming, is_open, impact,
+                          running, t1, values0, values1, rates0, rates1, scratch):
         return True
+    _copy(supplied.x, x)
+    clock[0] = t1
     return False
 
 
@@ -1034,22 +1116,28 @@ def _advance_span(m, n, modes, codes, substeps, step, propagate, chebyshev, rate
 
 
 @njit(cache=True, nogil=True, no_cfunc_wrapper=True, error_model="numpy", _nrt=False)
-def run_engine(table, dynamics, propagators, motion, layout, run, arming, impacts, outputs, scratch, saved, marks, events):
-    """Run (or resume) the simulation; returns FINISHED, NEED_MODE, NEED_SPACE or NEEDS_EVENTS.
+def run_engine(table, dynamics, propagators, motion, layout, run, arming, impacts, outputs, supplied, scratch, saved, marks, external):
+    """Run (or resume) the simulation; returns FINISHED, NEED_MODE, NEED_SPACE or NEED_STEP.
 
     Parameters
     ----------
     table, dynamics, propagators : ModeTable, Dynamics, Propagators
-        The modes in the slots.
+        The modes in the slots (``propagators`` unused when ``external``).
     motion, layout : Motion, Layout
         The motion and the system.
     run, arming, impacts, outputs : Run, Arming, Impacts, Outputs
         Everything the run changes, updated in place.
+    supplied : Supplied
+        The caller's next step of the flow (``external`` runs).
     scratch, saved, marks : np.ndarray
         Work arrays (:func:`work_arrays`).
-    events : bool
-        False for the Python event path: only the quiet loop runs, and
-        NEEDS_EVENTS means interval ``run.ints[K]`` has events.
+    external : bool
+        False: the flow is the exact propagators' (the quiet loop and the
+        exact sub-steps). True: the caller supplies the flow step by step
+        (an integrator's steps, ``method="ivp"``): NEED_STEP asks for the
+        step from ``run.clock[0]``, state ``run.x``, in the mode of slot
+        ``run.ints[MODE]`` inside interval ``run.ints[K]``; the caller fills
+        ``supplied``, sets ``run.ints[READY]`` and calls again.
 
     Returns
     -------
@@ -1079,20 +1167,25 @@ def run_engine(table, dynamics, propagators, motion, layout, run, arming, impact
                 _record_sample(x, running, ids[m], states, energy, sample_modes, ints[K])
             ints[PENDING] = NONE
         k, m = ints[K], ints[MODE]
-        if k < last and clock[0] == times[k]:
+        if not external and k < last and clock[0] == times[k]:
             _advance_quiet(ids[m], n_guards[m], substeps[m], propagate[m], rate[m], guard[m], force[m], times, motion.forcing, ints,
                            clock, x, arming, is_open, impact, outputs, scratch, saved)
             k = ints[K]
         if k >= last:
             return FINISHED
-        if not events:
-            return NEEDS_EVENTS
         t, t_end = clock[0], times[k + 1]
-        if t_end - t > _EPS * (abs(t_end) if abs(t_end) > 1.0 else 1.0) and _advance_span(
-            m, n_guards[m], modes, codes, substeps[m], step[m], propagate[m], chebyshev[m], rate[m], guard[m], force[m], power[m],
-            motion, ints, clock, x, pending_x, pending_mode, arming, is_open, impact, running, k, t, t_end, scratch
-        ):
-            continue
+        if t_end - t > _EPS * (abs(t_end) if abs(t_end) > 1.0 else 1.0):
+            if external:
+                if ints[READY] == 0:
+                    return NEED_STEP
+                ints[READY] = 0
+                if _supplied_step(m, n_guards[m], modes, codes, rate[m], guard[m], force[m], power[m], motion, ints, clock, x, pending_x,
+                                  pending_mode, arming, is_open, impact, running, k, supplied, scratch) or clock[0] < t_end:
+                    continue
+            elif _advance_span(m, n_guards[m], modes, codes, substeps[m], step[m], propagate[m], chebyshev[m], rate[m], guard[m], force[m],
+                               power[m], motion, ints, clock, x, pending_x, pending_mode, arming, is_open, impact, running, k, t, t_end,
+                               scratch):
+                continue
         clock[0] = t_end
         ints[K] = k + 1
         _record_sample(x, running, ids[m], states, energy, sample_modes, k + 1)
@@ -1111,7 +1204,7 @@ A ``NUMBA_OPT`` set in the environment is left in force.
 
 def run(*arguments: object) -> int:
     """Call :func:`run_engine`: a process's first call compiles it (or loads it from numba's cache) at :data:`OPTIMISATION_LEVEL`."""
-    if run_engine.signatures or "NUMBA_OPT" in os.environ:
+    if numba.config.DISABLE_JIT or run_engine.signatures or "NUMBA_OPT" in os.environ:
         return run_engine(*arguments)
     with _optimisation_level(OPTIMISATION_LEVEL):
         return run_engine(*arguments)

@@ -1,21 +1,23 @@
-"""The exact engine's arrays: the modes a run reaches, the plant, the run state and the work arrays.
+"""The event engine's arrays: the modes a run reaches, the plant, the run state and the work arrays.
 
-:mod:`stochpound.solvers.exact_engine` takes only arrays, grouped in small
-named tuples. This module lays them out from the library's objects:
+:mod:`stochpound.solvers.engine` takes only arrays, grouped in small
+named tuples. This module lays them out from the model's objects:
 
-* :class:`Slots`: every mode the runs of one propagator library reach, one per
-  slot of fixed-size arrays (mode vector and guard codes, affine maps of ẋ, the
-  guards and the contact forces, the power forms, the sub-step propagator with
-  the energy and impulse forms stacked beside it, the Chebyshev expansion of
-  the flow). Slots are shared by the library's runs; within a memory budget
-  new modes take free slots, beyond it the slot filled longest ago.
+* :class:`Slots`: every mode the runs of one library reach, one per slot of
+  fixed-size arrays (mode vector and guard codes, affine maps of ẋ, the
+  guards and the contact forces, the power forms and, for the exact solver,
+  the sub-step propagator with the energy and impulse forms stacked beside
+  it and the Chebyshev expansion of the flow). Slots are shared by the
+  library's runs; within a memory budget new modes take free slots, beyond
+  it the slot filled longest ago.
 * :func:`plant_arrays` (system and motion), :func:`run_state` (everything one
   run changes) and :func:`work_arrays_for` (the engine's scratch rows).
 
-The energy terms are integrated exactly over a sub-step as quadratic forms of
-the augmented state z = [x, w, 1] at its start (:func:`_power_forms`,
-:func:`_sub_step_forms`), so the engine adds them with one matrix product per
-sub-step.
+The powers of the energy balance are defined once, as bilinear forms of the
+augmented state z = [x, w, 1] (:func:`_power_factors`); the engine integrates
+them on the dense flow at Gauss–Legendre nodes (:func:`_power_forms`), and
+over a whole exact sub-step as quadratic forms of z at its start
+(:func:`_sub_step_forms`), added with one matrix product per sub-step.
 """
 
 from __future__ import annotations
@@ -25,25 +27,24 @@ from collections import namedtuple
 
 import numpy as np
 
-from stochpound.events import MAX_SETTLE_ITERATIONS
-from stochpound.modes import BoundedCache, Mode
-from stochpound.motion import GroundMotion, HarmonicMotion
-from stochpound.propagators import (
+from stochpound.model.modes import BoundedCache, Mode, ModeDynamics, ModeLibrary
+from stochpound.model.system import System
+from stochpound.motions.ground import GroundMotion, HarmonicMotion
+from stochpound.results.record import ENERGY_TERMS
+from stochpound.solvers import engine
+from stochpound.solvers.propagators import (
     CHEBYSHEV_DEGREE,
     GAUSS_WEIGHTS,
     ModePropagator,
     PropagatorLibrary,
     interval_forcing,
 )
-from stochpound.recorder import ENERGY_TERMS
-from stochpound.solvers import exact_engine as engine
-from stochpound.system import System
 
 Built = namedtuple("Built", "table dynamics propagators")
 """The engine's arrays of the modes in a library's slots (:class:`Slots`)."""
 Plant = namedtuple("Plant", "motion layout")
 """The engine's arrays of a system and motion (:func:`plant_arrays`)."""
-State = namedtuple("State", "run arming impacts outputs")
+State = namedtuple("State", "run arming impacts outputs supplied")
 """The engine's arrays of one run (:func:`run_state`)."""
 
 
@@ -83,8 +84,8 @@ def work_arrays_for(system: System, slots: "Slots") -> tuple[np.ndarray, np.ndar
     return engine.work_arrays(2 * system.n_dof, max_guards(system), system.n_contacts, mode_size, slots.arrays["chebyshev"].shape[2])
 
 
-def run_state(system: System, n_times: int) -> State:
-    """Fresh arrays of everything a run changes."""
+def run_state(system: System, n_times: int, supplied_degree: int = 0) -> State:
+    """Fresh arrays of everything a run changes (supplied steps of Chebyshev degree ``supplied_degree``)."""
     size, n_contacts, n_guards = 2 * system.n_dof, system.n_contacts, max_guards(system)
     length = n_contacts + len(system.base_dofs)
     return State(
@@ -95,6 +96,7 @@ def run_state(system: System, n_times: int) -> State:
                        np.zeros((max(64, 4 * n_contacts), len(engine.IMPACT_COLUMNS)))),
         engine.Outputs(np.zeros(len(ENERGY_TERMS)), np.zeros((n_times, size)), np.zeros((len(ENERGY_TERMS), n_times)),
                        np.zeros(n_times, dtype=np.int64)),
+        engine.Supplied(np.zeros(2), np.zeros(size), np.zeros((supplied_degree + 1) * size)),
     )
 
 
@@ -107,11 +109,16 @@ ENERGY_BUDGET = 256 * 2**20
 INITIAL_SLOTS = 128
 """Slots allocated at first (doubled when full, up to the budget)."""
 
-_SLOTS: "weakref.WeakKeyDictionary[PropagatorLibrary, Slots]" = weakref.WeakKeyDictionary()
+_SLOTS: "weakref.WeakKeyDictionary[PropagatorLibrary | ModeLibrary, Slots]" = weakref.WeakKeyDictionary()
 
 
-def slots_of(library: PropagatorLibrary) -> "Slots":
-    """The engine arrays of ``library``'s modes, shared by its runs."""
+def slots_of(library: PropagatorLibrary | ModeLibrary) -> "Slots":
+    """The engine arrays of ``library``'s modes, shared by its runs.
+
+    With a :class:`PropagatorLibrary` (the exact solver) the slots hold the
+    modes' propagators too; with a :class:`ModeLibrary` (supplied flows) only
+    their dynamics.
+    """
     slots = _SLOTS.get(library)
     if slots is None:
         slots = _SLOTS[library] = Slots(library)
@@ -126,26 +133,38 @@ class Slots:
     and the mode it held is loaded again when the engine asks for it. Every
     mode keeps one id (``modes[id]``), which the engine records per sample.
     Empty slots never match a mode (their mode vector is invalid).
+
+    Parameters
+    ----------
+    library : PropagatorLibrary or ModeLibrary
+        The exact solver's propagators of the modes, or their dynamics only
+        (flows supplied by the caller: the ``Propagators`` arrays stay empty).
     """
 
-    def __init__(self, library: PropagatorLibrary) -> None:
+    def __init__(self, library: PropagatorLibrary | ModeLibrary) -> None:
         self.library = library
+        self.exact = isinstance(library, PropagatorLibrary)
+        self.system = library.system
         self.modes: list[Mode] = []
         self._ids: dict[Mode, int] = {}
         self._slot: dict[Mode, int] = {}
         self._held: list[Mode] = []
         self._oldest = 0
-        self._energy: BoundedCache[Mode, tuple[np.ndarray, np.ndarray]] = BoundedCache(ENERGY_BUDGET, _total_bytes)
+        self._energy: BoundedCache[Mode, tuple[np.ndarray, ...]] = BoundedCache(ENERGY_BUDGET, _total_bytes)
         self.arrays: dict[str, np.ndarray] = {}
-        width = (CHEBYSHEV_DEGREE + 1) * 2 * library.system.n_dof  # the usual Chebyshev rows (grown if a mode's are wider)
+        width = (CHEBYSHEV_DEGREE + 1) * 2 * self.system.n_dof  # the usual Chebyshev rows (grown if a mode's are wider)
         self._grow(1, width)
-        self._capacity = max(MAX_SETTLE_ITERATIONS + 2, TABLE_BUDGET // sum(array[0].nbytes for array in self.arrays.values()))
+        self._capacity = max(engine.MAX_SETTLE_ITERATIONS + 2, TABLE_BUDGET // sum(array[0].nbytes for array in self.arrays.values()))
         self._grow(min(self._capacity, INITIAL_SLOTS), width)
 
     @property
     def tables(self) -> Built:
         """The arrays, grouped as the engine takes them."""
         return Built(*(group(**{name: self.arrays[name] for name in group._fields}) for group in (engine.ModeTable, engine.Dynamics, engine.Propagators)))
+
+    def dynamics(self, mode: Mode) -> ModeDynamics:
+        """The dynamics of ``mode`` (from the library's cache)."""
+        return self.library[mode].dynamics if self.exact else self.library[mode]
 
     def slot(self, mode: Mode) -> int:
         """The slot of ``mode`` (loaded if it holds none)."""
@@ -154,19 +173,23 @@ class Slots:
 
     def load(self, mode: Mode) -> int:
         """Put ``mode`` into a free slot, or else the one filled longest ago; return the slot."""
-        propagator = self.library[mode]
+        propagator = self.library[mode] if self.exact else None
+        dynamics = self.dynamics(mode)
         energy = self._energy.get(mode)
         if energy is None:  # worth keeping: their products cost more than building the propagator
-            energy = _energy_rows(self.library.system, propagator)
+            energy = _energy_rows(self.system, dynamics, propagator)
             self._energy.put(mode, energy)
-        row = _mode_rows(self.library.system, mode, propagator, energy)
+        row = _mode_rows(self.system, mode, dynamics, energy)
+        if propagator is not None:
+            row.update(_propagator_rows(propagator, row["guard"], row["rate"], energy[1]))
         row["ids"] = np.int64(self._ids.setdefault(mode, len(self._ids)))
         if row["ids"] == len(self.modes):
             self.modes.append(mode)
         slot, size = self._take_slot(mode), len(self.arrays["modes"])
-        if slot == size or row["chebyshev"].shape[1] > self.arrays["chebyshev"].shape[2]:
-            self._grow(min(self._capacity, 2 * size) if slot == size else size, row["chebyshev"].shape[1])
-        if row["chebyshev"].shape[1] < self.arrays["chebyshev"].shape[2]:
+        chebyshev_width = row["chebyshev"].shape[1] if "chebyshev" in row else 0
+        if slot == size or chebyshev_width > self.arrays["chebyshev"].shape[2]:
+            self._grow(min(self._capacity, 2 * size) if slot == size else size, chebyshev_width)
+        if "chebyshev" in row and chebyshev_width < self.arrays["chebyshev"].shape[2]:
             self.arrays["chebyshev"][slot] = 0  # zero padded
         for name, value in row.items():
             self.arrays[name][(slot, ...) + tuple(slice(0, n) for n in np.shape(value))] = value
@@ -189,7 +212,7 @@ class Slots:
         old = self.arrays
         width = max(width, old["chebyshev"].shape[2]) if old else width
         self.arrays = {}
-        for name, value in _placeholder(self.library.system, width).items():
+        for name, value in _placeholder(self.system, width, self.exact).items():
             self.arrays[name] = np.zeros((capacity,) + np.shape(value), np.asarray(value).dtype)  # untouched pages stay unallocated
             if np.any(value):
                 self.arrays[name][:] = value
@@ -197,37 +220,49 @@ class Slots:
             self.arrays[name][(slice(0, len(array)), ...) + tuple(slice(0, n) for n in array.shape[1:])] = array
 
 
-def _mode_rows(system: System, mode: Mode, propagator: ModePropagator, energy: tuple[np.ndarray, np.ndarray]) -> dict[str, np.ndarray]:
-    """One mode's entries of the :class:`Built` arrays but its id (guards padded to the system's largest count).
+def _mode_rows(system: System, mode: Mode, dynamics: ModeDynamics, energy: tuple[np.ndarray, ...]) -> dict[str, np.ndarray]:
+    """One mode's entries of the :class:`Built` arrays but its id and propagators (guards padded to the system's largest count).
 
     ``energy`` is the mode's :func:`_energy_rows`.
     """
-    d = propagator.dynamics
+    d = dynamics
     count, n_guards = len(d.guard_kind), max_guards(system)
     codes = np.zeros((3, n_guards), dtype=np.int64)
     codes[:, :count] = d.guard_kind, d.guard_target, d.guard_direction
     guard = np.zeros((n_guards, d.A.shape[1] + 2))
     guard[:count] = _affine(d.guard_matrix, d.guard_ground, d.guard_constant)
-    power, forms = energy
-    rate = _affine(d.A, d.B, d.c)
+    return {
+        "modes": mode_vector(mode), "codes": codes, "n_guards": np.int64(count), "rate": _affine(d.A, d.B, d.c), "guard": guard,
+        "force": _affine(d.force_matrix, 0.0, d.force_constant), "power": energy[0],
+    }
+
+
+def _propagator_rows(propagator: ModePropagator, guard: np.ndarray, rate: np.ndarray, forms: np.ndarray) -> dict[str, np.ndarray]:
+    """One mode's entries of the ``Propagators`` arrays (and its sub-steps per interval).
+
+    ``guard`` and ``rate`` are the mode's padded affine maps, ``forms`` its
+    sub-step energy forms and impulses (:func:`_energy_rows`).
+    """
     guard_rows = _guard_rows(guard, rate, width=len(propagator.transition))
     return {
-        "modes": mode_vector(mode), "codes": codes, "n_guards": np.int64(count), "substeps": np.int64(propagator.substeps),
-        "rate": rate, "guard": guard, "force": _affine(d.force_matrix, 0.0, d.force_constant), "power": power,
-        # the slot's columns beyond these stay zero: the padding to exact_engine.propagate_columns
+        "substeps": np.int64(propagator.substeps),
+        # the slot's columns beyond these stay zero: the padding to engine.propagate_columns
         "propagate": np.concatenate([propagator.transition.T, forms, (guard_rows @ propagator.transition).T], axis=1),
         "step": np.float64(propagator.step),
         "chebyshev": propagator.chebyshev.reshape(-1, propagator.transition.shape[0]).T,
     }
 
 
-def _energy_rows(system: System, propagator: ModePropagator) -> tuple[np.ndarray, np.ndarray]:
-    """A mode's power forms and its sub-step forms and impulses (:func:`_sub_step_forms`), stacked and transposed (Z × 4Z, Z × (4Z + n_contacts))."""
-    d, width = propagator.dynamics, propagator.transition.shape[0]
+def _energy_rows(system: System, dynamics: ModeDynamics, propagator: ModePropagator | None) -> tuple[np.ndarray, ...]:
+    """A mode's power forms (Z × 4Z, :func:`_power_forms`) and, with a propagator, its sub-step forms and impulses (Z × (4Z + n_contacts))."""
+    d, width = dynamics, 2 * system.n_dof + 5
     force = _in_z(_affine(d.force_matrix, 0.0, d.force_constant), width)
     friction = _in_z(_affine(d.friction_matrix, d.friction_ground, d.friction_constant), width)
-    power = _power_forms(system, force, friction).reshape(-1, width).T
-    return np.ascontiguousarray(power), np.concatenate([form.T for form in _sub_step_forms(system, propagator, force, friction)], axis=1)
+    factors = _power_factors(system, force, friction)
+    power = np.ascontiguousarray(_power_forms(factors))
+    if propagator is None:
+        return (power,)
+    return power, np.concatenate([form.T for form in _sub_step_forms(factors, force, propagator)], axis=1)
 
 
 def _guard_rows(guard: np.ndarray, rate: np.ndarray, width: int) -> np.ndarray:
@@ -251,33 +286,41 @@ def _affine(matrix: np.ndarray, ground: np.ndarray | float, constant: np.ndarray
     return np.column_stack([matrix, np.broadcast_to(ground, len(matrix)), constant])
 
 
-def _power_forms(system: System, force: np.ndarray, friction: np.ndarray) -> np.ndarray:
-    """Quadratic forms P (4 × Z × Z) of the input, damping, friction and impact powers (``Recorder.on_step``).
+def _power_factors(system: System, force: np.ndarray, friction: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
+    """The powers of the energy balance as bilinear forms (L z) · (R z) of z = [x, w, 1]: their factors (L, R).
 
-    The power of each force is zᵀ P z for the augmented state z = [x, w, 1]
-    (only a_g = w[0] and the constant 1 enter), W: −a_g (ι · v), vᵀ C v,
-    −Σ (friction force) ṡ over sliding bases, Σ F (load · v) over contacts.
-    ``force`` and ``friction`` are the mode's contact and friction forces
-    (rows acting on z).
+    In :data:`ENERGY_TERMS` order, W: the input power −a_g (ι · v), the
+    damping power vᵀ C v, the friction power −Σ F_b ṡ_b over sliding bases
+    (F_b the foundation's force on base b) and the impact power
+    Σ F_p (h_p · v) over contacts. ``force`` and ``friction`` are the mode's
+    contact and friction forces (rows acting on z).
     """
-    n, size = system.n_dof, 2 * system.n_dof
-    velocity = slice(n, size)
-    power = np.zeros((4,) + (force.shape[1],) * 2)
-    power[0, size, velocity] = -system.influence
-    power[1, velocity, velocity] = system.damping
+    n, size, width = system.n_dof, 2 * system.n_dof, force.shape[1]
+    velocity = np.zeros((n, width))
+    velocity[:, n:size] = np.eye(n)
+    ground = np.zeros((1, width))
+    ground[0, size] = 1.0
     sliding_rows, sliding_bases = _sliding(system)
-    power[2, sliding_rows] = -friction[sliding_bases]
-    power[3, velocity] = system.contact_load.T @ force
-    return power
+    return [
+        (ground, (-system.influence @ velocity)[None]),
+        (velocity, system.damping @ velocity),
+        (velocity[sliding_rows - n], -friction[sliding_bases]),
+        (system.contact_load @ velocity, force),
+    ]
 
 
-def _sub_step_forms(system: System, propagator: ModePropagator, force: np.ndarray, friction: np.ndarray) -> list[np.ndarray]:
-    """Energy terms and impulses of one sub-step as functions of z(t0) (``Recorder.on_step``'s quadrature, combined).
+def _power_forms(factors: list[tuple[np.ndarray, np.ndarray]]) -> np.ndarray:
+    """The quadratic forms P = Lᵀ R of the powers (:func:`_power_factors`), zᵀ P z, stacked and transposed (Z × 4Z)."""
+    return np.concatenate([left.T @ right for left, right in factors]).T
 
-    The 5-point Gauss–Legendre integral of a power zᵀ P z (:func:`_power_forms`)
-    over a sub-step is z(t0)ᵀ Q z(t0) with Q = Σᵢ wᵢ Nᵢᵀ P Nᵢ (Nᵢ the node
-    propagators, wᵢ the weights), computed from the factors P = Lᵀ R of each
-    power as Σᵢ (wᵢ L Nᵢ)ᵀ (R Nᵢ); the impulses are linear, r · z(t0).
+
+def _sub_step_forms(factors: list[tuple[np.ndarray, np.ndarray]], force: np.ndarray, propagator: ModePropagator) -> list[np.ndarray]:
+    """Energy terms and impulses of one exact sub-step as functions of z(t0).
+
+    The 5-point Gauss–Legendre integral of a power (L z)·(R z) over a
+    sub-step is z(t0)ᵀ Q z(t0) with Q = Σᵢ wᵢ (L Nᵢ)ᵀ (R Nᵢ) (Nᵢ the node
+    propagators, wᵢ the weights): the quadrature of the dense flow, summed
+    in closed form. The impulses are linear, r · z(t0).
 
     Returns
     -------
@@ -285,23 +328,11 @@ def _sub_step_forms(system: System, propagator: ModePropagator, force: np.ndarra
         Q of the four powers (Z × Z each, J) and the impulse rows of every
         contact (n_contacts × Z, N·s).
     """
-    n, size, width = system.n_dof, 2 * system.n_dof, force.shape[1]
     weights = 0.5 * propagator.step * GAUSS_WEIGHTS
     nodes = propagator.nodes
-    velocity = nodes[:, n:size]
-    weighted_velocity = weights[:, None, None] * velocity
-    sliding_rows, sliding_bases = _sliding(system)
-    loaded = np.flatnonzero(np.any(force, axis=1))  # the rows of open contacts are zero
-    factors = [
-        (weights[:, None] * nodes[:, size], -system.influence @ velocity),
-        (weighted_velocity, system.damping @ velocity),
-        (weights[:, None, None] * nodes[:, sliding_rows], -friction[sliding_bases] @ nodes),
-        (system.contact_load[loaded] @ weighted_velocity, force[loaded] @ nodes),
-    ]
-    forms = [left.reshape(-1, width).T @ right.reshape(-1, width) for left, right in factors]
-    impulses = np.zeros((len(force), width))
-    impulses[loaded] = force[loaded] @ np.tensordot(weights, nodes, 1)
-    return [*forms, impulses]
+    width = nodes.shape[-1]
+    forms = [(weights[:, None, None] * (left @ nodes)).reshape(-1, width).T @ (right @ nodes).reshape(-1, width) for left, right in factors]
+    return [*forms, force @ np.tensordot(weights, nodes, 1)]
 
 
 def _sliding(system: System) -> tuple[np.ndarray, np.ndarray]:
@@ -318,14 +349,18 @@ def _in_z(rows: np.ndarray, width: int) -> np.ndarray:
     return out
 
 
-def _placeholder(system: System, chebyshev_width: int) -> dict[str, np.ndarray]:
-    """An empty slot of the :class:`Built` arrays (it matches no mode: its mode vector is invalid)."""
+def _placeholder(system: System, chebyshev_width: int, exact: bool) -> dict[str, np.ndarray]:
+    """An empty slot of the :class:`Built` arrays (it matches no mode: its mode vector is invalid).
+
+    Without ``exact`` the ``Propagators`` arrays are one column wide (the engine does not read them).
+    """
     size, n_contacts, n_guards = 2 * system.n_dof, system.n_contacts, max_guards(system)
     width = size + 5
+    propagate = (width, engine.propagate_columns(size, n_guards, n_contacts)) if exact else (1, 1)
     return {
         "modes": np.full(n_contacts + len(system.base_dofs), -9, dtype=np.int64), "ids": np.int64(0), "codes": np.zeros((3, n_guards), np.int64),
         "n_guards": np.int64(0), "substeps": np.int64(1), "rate": np.zeros((size, size + 2)),
         "guard": np.zeros((n_guards, size + 2)), "force": np.zeros((n_contacts, size + 2)), "power": np.zeros((width, 4 * width)),
-        "propagate": np.zeros((width, engine.propagate_columns(size, n_guards, n_contacts))), "chebyshev": np.zeros((width, chebyshev_width)),
+        "propagate": np.zeros(propagate), "chebyshev": np.zeros((width, chebyshev_width) if exact else (1, 1)),
         "step": np.float64(1.0),
     }

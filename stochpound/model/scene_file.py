@@ -1,4 +1,4 @@
-"""Scene files (TOML, CONTRACT.md): parsing and validation into a :class:`~stochpound.scene.Scene`.
+"""Scene files (TOML, CONTRACT.md): parsing and validation into a :class:`~stochpound.model.scene.Scene`.
 
 Every field is checked before anything is computed. A bad field raises
 :class:`~stochpound.errors.SceneError` whose message starts with the field's
@@ -16,8 +16,8 @@ from typing import Any, Mapping
 import numpy as np
 
 from stochpound.errors import RecordError, SceneError
-from stochpound.motion import GroundMotion, HarmonicMotion, SampledMotion
-from stochpound.scene import (
+from stochpound.motions.ground import GroundMotion, HarmonicMotion, SampledMotion
+from stochpound.model.scene import (
     Base,
     Building,
     Contact,
@@ -360,7 +360,7 @@ def _constant_motion(table: Mapping[str, Any]) -> SampledMotion:
 
 
 def _record_motion(table: Mapping[str, Any], base_dir: Path, g: float) -> SampledMotion:
-    from stochpound.records import load_record
+    from stochpound.motions.records import load_record
 
     spec = _string(table, "record", "motion")
     scale = _number(table, "scale", "motion", default=1.0)

@@ -26,7 +26,7 @@ from typing import Generic, TypeVar
 
 import numpy as np
 
-from stochpound.system import System
+from stochpound.model.system import System
 
 STUCK = 0
 """Base state: stuck to its foundation (also used for fixed bases)."""
@@ -317,3 +317,16 @@ def _base_guards(system: System, mode: Mode, friction: tuple) -> tuple[np.ndarra
         np.array(target, int),
         np.array(direction, int),
     )
+
+
+def initial_mode(system: System) -> Mode:
+    """Mode before settling at t = 0: contacts open, bases stuck, free or sliding as x(0) says."""
+    states = []
+    for b, dof in enumerate(system.base_dofs):
+        if dof < 0:
+            states.append(STUCK)
+        elif system.frictionless[b]:
+            states.append(FREE)
+        else:
+            states.append(int(np.sign(system.initial_state[system.n_dof + dof])))
+    return Mode(tuple(False for _ in range(system.n_contacts)), tuple(states))

@@ -21,10 +21,9 @@ import xarray as xr
 from xarray.indexes import PandasIndex
 
 from stochpound import __version__
-from stochpound.events import EventCounters
-from stochpound.recorder import ENERGY_TERMS, Recorder
-from stochpound.scene import Scene
-from stochpound.system import System
+from stochpound.results.record import ENERGY_TERMS, EventCounters, Recorder
+from stochpound.model.scene import Scene
+from stochpound.model.system import System
 
 _ENERGY_NAMES = {
     "input": "work of the ground-acceleration load (relative-motion input energy)",

@@ -1,0 +1,151 @@
+"""What one run recorded: samples, impacts, the energy terms and the event counts.
+
+The event engine (:mod:`stochpound.solvers.engine`) writes the state and the
+running energy terms at every output time, the mode in force there and one
+row per finished impact; :func:`stochpound.solvers.driver.EngineRun.record`
+turns its arrays into a :class:`Recorder`, which adds what follows from the
+samples and their modes: contact forces, base friction forces and base states.
+
+Energy terms (J, relative-motion energy balance, docs/model.md):
+``input`` (work of the ground-acceleration load), ``damping`` (storey
+dashpots), ``friction`` (base friction) and ``impact`` (work absorbed by the
+impact elements), each the integral of a power over the run.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from stochpound.model.modes import FREE, ModeDynamics
+from stochpound.model.system import System
+from stochpound.motions.ground import GroundMotion
+
+ENERGY_TERMS = ("input", "damping", "friction", "impact")
+
+
+@dataclass
+class Impact:
+    """One impact (a closed phase of one contact).
+
+    Attributes
+    ----------
+    contact : int
+        The contact's index.
+    start, end : float
+        When it began and ended, s (``end`` is the end of the motion if it was still closed).
+    onset_velocity : float
+        Rate of penetration at onset, m/s.
+    in_phase : bool
+        Both floors moving the same way at onset.
+    peak_force, peak_time : float
+        Largest contact force (N) and when it happened (s), located on the solution.
+    impulse : float
+        Time integral of the contact force, N·s.
+    complete : bool
+        The impact ended before the end of the motion.
+    """
+
+    contact: int
+    start: float
+    onset_velocity: float
+    in_phase: bool
+    peak_force: float = 0.0
+    peak_time: float = float("nan")
+    impulse: float = 0.0
+    end: float = float("nan")
+    complete: bool = False
+
+
+@dataclass
+class EventCounters:
+    """Counts of what the event logic did, stored in the result's attributes.
+
+    Attributes
+    ----------
+    total : int
+        Guard crossings located and settled.
+    chatter_cycles : int
+        Instants at which settling found a cycle of modes (chattering) and
+        kept the last mode, disarming the guards that still wanted to fire.
+    grazing_checks : int
+        Near-grazing guard maxima that were checked on the dense state.
+    """
+
+    total: int = 0
+    chatter_cycles: int = 0
+    grazing_checks: int = 0
+
+    def as_attrs(self) -> dict[str, int]:
+        """The counters as netCDF attributes (``events_*``)."""
+        return {f"events_{name}": value for name, value in self.__dict__.items()}
+
+
+@dataclass
+class Recorder:
+    """The outputs of one run at the motion's sample times.
+
+    Attributes
+    ----------
+    system : System
+    motion : GroundMotion
+    states : np.ndarray
+        x = [q, v] at every output time (n_times × 2N), m and m/s.
+    forces, friction, base_states : np.ndarray
+        Contact forces (N), force of the foundation on each base (N, positive
+        to the right) and base states (:mod:`stochpound.model.modes`) at every
+        output time, filled by :meth:`sample_at`.
+    energy_history : np.ndarray
+        The energy terms (rows in :data:`ENERGY_TERMS` order, J) at every
+        output time; ``energy`` maps each term's name to its row.
+    impacts : list of Impact
+        Every impact, in order of start (then contact).
+    """
+
+    system: System
+    motion: GroundMotion
+    states: np.ndarray = field(init=False)
+    forces: np.ndarray = field(init=False)
+    friction: np.ndarray = field(init=False)
+    base_states: np.ndarray = field(init=False)
+    energy: dict[str, np.ndarray] = field(init=False)
+    energy_history: np.ndarray = field(init=False)
+    impacts: list[Impact] = field(default_factory=list)
+
+    def __post_init__(self) -> None:
+        n_times, n = len(self.motion.times), self.system.n_dof
+        self.states = np.zeros((n_times, 2 * n))
+        self.forces = np.zeros((n_times, self.system.n_contacts))
+        self.friction = np.zeros((n_times, len(self.system.base_dofs)))
+        self.base_states = np.zeros((n_times, len(self.system.base_dofs)), dtype=np.int8)
+        self.energy_history = np.zeros((len(ENERGY_TERMS), n_times))
+        self.energy = dict(zip(ENERGY_TERMS, self.energy_history))
+
+    def sample_at(self, indices: np.ndarray, dynamics: ModeDynamics, ground: np.ndarray) -> None:
+        """Contact forces, friction forces and base states at samples ``indices`` from their stored states.
+
+        Parameters
+        ----------
+        indices : np.ndarray of int
+            Sample indices, all in the mode of ``dynamics``.
+        dynamics : ModeDynamics
+            The mode at those samples.
+        ground : np.ndarray
+            a_g at those samples, m/s².
+        """
+        x = self.states[indices]
+        self.forces[indices] = x @ dynamics.force_matrix.T + dynamics.force_constant
+        self.friction[indices] = x @ dynamics.friction_matrix.T + np.outer(ground, dynamics.friction_ground) + dynamics.friction_constant
+        for b, state in enumerate(dynamics.mode.base):
+            if state == FREE:
+                state = np.sign(x[:, self.system.n_dof + self.system.base_dofs[b]])
+            self.base_states[indices, b] = state
+
+    def kinetic_and_strain(self) -> tuple[np.ndarray, np.ndarray]:
+        """Kinetic energy ½ vᵀMv and storey/restoring strain energy ½ qᵀKq at the samples, J."""
+        n = self.system.n_dof
+        q, v = self.states[:, :n], self.states[:, n:]
+        kinetic = 0.5 * np.einsum("ti,ti->t", v @ self.system.mass, v)
+        strain = 0.5 * np.einsum("ti,ti->t", q @ self.system.stiffness, q)
+        return kinetic, strain
