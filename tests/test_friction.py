@@ -67,7 +67,7 @@ def building_in_static_equilibrium(acceleration: float) -> dict:
     """The reference building on its base, floors pre-deflected by the constant inertial load."""
     from scipy.linalg import solve
 
-    from stochpound.model.scene import storey_matrix
+    from stochpound.model.building import storey_matrix
     from tests.conftest import REFERENCE_STIFFNESS
 
     deflection = solve(storey_matrix(np.array(REFERENCE_STIFFNESS)), -np.array(REFERENCE_MASS) * acceleration)

@@ -17,7 +17,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.linalg import eigh
 
-from stochpound.model.scene import Building, storey_matrix
+from stochpound.model.building import Building, storey_matrix
 
 #: Largest off-diagonal modal damping, relative to the diagonal, still treated as
 #: classical (and neglected): the study's dashpots are a1·K rounded to 6 digits.

@@ -1,4 +1,4 @@
-"""Scene files (TOML, CONTRACT.md): parsing and validation into a :class:`~stochpound.model.scene.Scene`.
+"""Scene files (TOML, docs/scene-files.md): parsing and validation into a :class:`~stochpound.model.scene.Scene`.
 
 Every field is checked before anything is computed. A bad field raises
 :class:`~stochpound.errors.SceneError` whose message starts with the field's
@@ -16,22 +16,13 @@ from typing import Any, Mapping
 import numpy as np
 
 from stochpound.errors import RecordError, SceneError
+from stochpound.model import fields
+from stochpound.model.building import buildings_from_tables
+from stochpound.model.contact import contact_from_table
+from stochpound.model.scene import Scene
 from stochpound.motions.ground import GroundMotion, HarmonicMotion, SampledMotion
-from stochpound.model.scene import (
-    Base,
-    Building,
-    Contact,
-    InitialState,
-    Scene,
-    impact_damping,
-    stiffness_proportional_damping,
-)
 
 _TOP_KEYS = {"g", "study_compat", "building", "contact", "motion"}
-_BUILDING_KEYS = {"name", "mass", "stiffness", "damping", "damping_ratio", "base", "initial"}
-_BASE_KEYS = {"mass", "mu", "mu_static", "restoring_stiffness"}
-_INITIAL_KEYS = {"displacement", "velocity", "base_displacement", "base_velocity"}
-_CONTACT_KEYS = {"between", "gap", "stiffness", "restitution", "damping", "tensile"}
 _SYNTHETIC_TYPES = {"kanai_tajimi", "clough_penzien"}
 
 
@@ -41,7 +32,7 @@ def load_scene(path: str | Path) -> Scene:
     Parameters
     ----------
     path : str or Path
-        A TOML scene file (CONTRACT.md). Relative record paths inside it are
+        A TOML scene file (docs/scene-files.md). Relative record paths inside it are
         resolved against the file's folder.
 
     Returns
@@ -76,237 +67,13 @@ def scene_from_dict(data: Mapping[str, Any], base_dir: str | Path = ".", source:
     source : str
         Provenance label stored with the scene.
     """
-    _reject_unknown(data, _TOP_KEYS, "")
-    g = _number(data, "g", "", default=9.81, low=0.0, low_open=True)
-    study_compat = _boolean(data, "study_compat", "", default=False)
-    buildings = _buildings(data)
-    contacts = _contacts(data, buildings)
+    fields.reject_unknown(data, _TOP_KEYS, "")
+    g = fields.number(data, "g", "", default=9.81, low=0.0, low_open=True)
+    study_compat = fields.boolean(data, "study_compat", "", default=False)
+    buildings = buildings_from_tables(fields.array_of_tables(data, "building"))
+    contacts = [contact_from_table(table, f"contact[{i}]", buildings) for i, table in enumerate(fields.array_of_tables(data, "contact"))]
     motion = _motion(data, Path(base_dir), g)
     return Scene(tuple(buildings), tuple(contacts), motion, g=g, study_compat=study_compat, source=source)
-
-
-# ---------------------------------------------------------------- field helpers
-
-
-def _where(prefix: str, key: str) -> str:
-    return f"{prefix}.{key}" if prefix else key
-
-
-def _reject_unknown(table: Mapping[str, Any], allowed: set[str], prefix: str) -> None:
-    for key in table:
-        if key not in allowed:
-            raise SceneError(f"{_where(prefix, key)}: unknown field (allowed: {', '.join(sorted(allowed))})")
-
-
-def _is_number(value: Any) -> bool:
-    return isinstance(value, (int, float)) and not isinstance(value, bool)
-
-
-def _check_range(value: float, where: str, low: float | None, low_open: bool, high: float | None, high_open: bool) -> None:
-    if math.isnan(value):
-        raise SceneError(f"{where}: must be a number, got nan")
-    if low is not None and (value < low or (low_open and value == low)):
-        raise SceneError(f"{where}: must be {'>' if low_open else '>='} {low:g}, got {value:g}")
-    if high is not None and (value > high or (high_open and value == high)):
-        raise SceneError(f"{where}: must be {'<' if high_open else '<='} {high:g}, got {value:g}")
-
-
-def _number(
-    table: Mapping[str, Any],
-    key: str,
-    prefix: str,
-    *,
-    default: float | None = None,
-    required: bool = False,
-    low: float | None = None,
-    low_open: bool = False,
-    high: float | None = None,
-    high_open: bool = False,
-    allow_inf: bool = False,
-) -> float | None:
-    where = _where(prefix, key)
-    if key not in table:
-        if required:
-            raise SceneError(f"{where}: missing (a number is required)")
-        return default
-    value = table[key]
-    if not _is_number(value):
-        raise SceneError(f"{where}: must be a number, got {type(value).__name__} {value!r}")
-    value = float(value)
-    if math.isinf(value) and not allow_inf:
-        raise SceneError(f"{where}: must be finite, got {value}")
-    _check_range(value, where, low, low_open, high, high_open)
-    return value
-
-
-def _boolean(table: Mapping[str, Any], key: str, prefix: str, default: bool) -> bool:
-    value = table.get(key, default)
-    if not isinstance(value, bool):
-        raise SceneError(f"{_where(prefix, key)}: must be true or false, got {value!r}")
-    return value
-
-
-def _string(table: Mapping[str, Any], key: str, prefix: str, default: str | None = None) -> str:
-    where = _where(prefix, key)
-    if key not in table:
-        if default is None:
-            raise SceneError(f"{where}: missing (a string is required)")
-        return default
-    value = table[key]
-    if not isinstance(value, str) or not value:
-        raise SceneError(f"{where}: must be a non-empty string, got {value!r}")
-    return value
-
-
-def _number_list(table: Mapping[str, Any], key: str, prefix: str, *, low: float, low_open: bool, length: int | None = None) -> tuple[float, ...]:
-    where = _where(prefix, key)
-    if key not in table:
-        raise SceneError(f"{where}: missing (a list of numbers is required)")
-    values = table[key]
-    if not isinstance(values, list):
-        raise SceneError(f"{where}: must be a list of numbers, got {type(values).__name__} {values!r}")
-    if length is not None and len(values) != length:
-        raise SceneError(f"{where}: must have {length} values (one per floor), got {len(values)}")
-    for i, value in enumerate(values):
-        item = f"{where}[{i}]"
-        if not _is_number(value):
-            raise SceneError(f"{item}: must be a number, got {type(value).__name__} {value!r}")
-        if math.isinf(value):
-            raise SceneError(f"{item}: must be finite, got {value}")
-        _check_range(float(value), item, low, low_open, None, False)
-    return tuple(float(v) for v in values)
-
-
-def _table(table: Mapping[str, Any], key: str, prefix: str) -> Mapping[str, Any] | None:
-    value = table.get(key)
-    if value is not None and not isinstance(value, dict):
-        raise SceneError(f"{_where(prefix, key)}: must be a table, got {type(value).__name__}")
-    return value
-
-
-def _array_of_tables(table: Mapping[str, Any], key: str) -> list[Mapping[str, Any]]:
-    value = table.get(key, [])
-    if not isinstance(value, list) or not all(isinstance(v, dict) for v in value):
-        raise SceneError(f"{key}: must be an array of tables ([[{key}]])")
-    return value
-
-
-# ---------------------------------------------------------------- buildings
-
-
-def _buildings(data: Mapping[str, Any]) -> list[Building]:
-    tables = _array_of_tables(data, "building")
-    if not tables:
-        raise SceneError("building: at least one [[building]] is required")
-    buildings = [_building(table, f"building[{i}]", i) for i, table in enumerate(tables)]
-    names = [b.name for b in buildings]
-    for i, name in enumerate(names):
-        if names.index(name) != i:
-            raise SceneError(f"building[{i}].name: must be unique, {name!r} is used twice")
-    return buildings
-
-
-def _building(table: Mapping[str, Any], prefix: str, index: int) -> Building:
-    _reject_unknown(table, _BUILDING_KEYS, prefix)
-    name = _string(table, "name", prefix, default=f"B{index + 1}")
-    base = _base(_table(table, "base", prefix), f"{prefix}.base")
-    mass = _number_list(table, "mass", prefix, low=0.0, low_open=True)
-    if not mass and base is None:
-        raise SceneError(f"{prefix}.mass: must have at least one floor (only a sliding base may carry no floors)")
-    stiffness = _number_list(table, "stiffness", prefix, low=0.0, low_open=False, length=len(mass))
-    damping, ratio = _storey_damping(table, prefix, np.array(mass), np.array(stiffness))
-    initial = _initial(_table(table, "initial", prefix), f"{prefix}.initial", len(mass), base is not None)
-    return Building(name, mass, stiffness, damping, ratio, base, initial)
-
-
-def _storey_damping(table: Mapping[str, Any], prefix: str, mass: np.ndarray, stiffness: np.ndarray) -> tuple[tuple[float, ...], float | None]:
-    if "damping" in table and "damping_ratio" in table:
-        raise SceneError(f"{prefix}.damping: give either damping (N·s/m per storey) or damping_ratio, not both")
-    if "damping_ratio" in table:
-        ratio = _number(table, "damping_ratio", prefix, low=0.0, high=1.0, high_open=True)
-        if len(mass) == 0 or np.any(stiffness <= 0.0):
-            raise SceneError(f"{prefix}.damping_ratio: needs every storey stiffness > 0 (mode 1 must have a frequency); give damping instead")
-        return tuple(stiffness_proportional_damping(mass, stiffness, ratio)), ratio
-    if "damping" in table:
-        return _number_list(table, "damping", prefix, low=0.0, low_open=False, length=len(mass)), None
-    return tuple(0.0 for _ in mass), None
-
-
-def _base(table: Mapping[str, Any] | None, prefix: str) -> Base | None:
-    if table is None:
-        return None
-    _reject_unknown(table, _BASE_KEYS, prefix)
-    mass = _number(table, "mass", prefix, required=True, low=0.0, low_open=True)
-    mu = _number(table, "mu", prefix, required=True, low=0.0)
-    mu_static = _number(table, "mu_static", prefix, default=mu, low=mu)
-    restoring = _number(table, "restoring_stiffness", prefix, default=0.0, low=0.0)
-    return Base(mass, mu, mu_static, restoring)
-
-
-def _initial(table: Mapping[str, Any] | None, prefix: str, n_floors: int, has_base: bool) -> InitialState:
-    zeros = tuple(0.0 for _ in range(n_floors))
-    if table is None:
-        return InitialState(zeros, zeros)
-    _reject_unknown(table, _INITIAL_KEYS, prefix)
-    for key in ("base_displacement", "base_velocity"):
-        if key in table and not has_base:
-            raise SceneError(f"{prefix}.{key}: only a building with a sliding [building.base] can have it")
-    displacement = _number_list(table, "displacement", prefix, low=-math.inf, low_open=False, length=n_floors) if "displacement" in table else zeros
-    velocity = _number_list(table, "velocity", prefix, low=-math.inf, low_open=False, length=n_floors) if "velocity" in table else zeros
-    return InitialState(
-        displacement,
-        velocity,
-        _number(table, "base_displacement", prefix, default=0.0),
-        _number(table, "base_velocity", prefix, default=0.0),
-    )
-
-
-# ---------------------------------------------------------------- contacts
-
-
-def _contacts(data: Mapping[str, Any], buildings: list[Building]) -> list[Contact]:
-    return [_contact(table, f"contact[{i}]", buildings) for i, table in enumerate(_array_of_tables(data, "contact"))]
-
-
-def _contact_end(value: Any, where: str, buildings: list[Building]) -> tuple[int, int]:
-    names = [b.name for b in buildings]
-    if not (isinstance(value, list) and len(value) == 2 and isinstance(value[0], str) and isinstance(value[1], int) and not isinstance(value[1], bool)):
-        raise SceneError(f"{where}: must be [building name, floor number], got {value!r}")
-    name, floor = value
-    if name not in names:
-        raise SceneError(f"{where}: unknown building {name!r} (buildings: {', '.join(names)})")
-    index = names.index(name)
-    n_floors = buildings[index].n_floors
-    if not 1 <= floor <= n_floors:
-        raise SceneError(f"{where}: floor must be in 1..{n_floors} for building {name!r}, got {floor}")
-    return index, floor
-
-
-def _contact(table: Mapping[str, Any], prefix: str, buildings: list[Building]) -> Contact:
-    _reject_unknown(table, _CONTACT_KEYS, prefix)
-    between = table.get("between")
-    if not isinstance(between, list) or len(between) != 2:
-        raise SceneError(f"{prefix}.between: must be [[left building, floor], [right building, floor]], got {between!r}")
-    left, left_floor = _contact_end(between[0], f"{prefix}.between[0]", buildings)
-    right, right_floor = _contact_end(between[1], f"{prefix}.between[1]", buildings)
-    if right != left + 1:
-        raise SceneError(
-            f"{prefix}.between: contacts join neighbours, left building first; "
-            f"{buildings[left].name!r} and {buildings[right].name!r} are not left/right neighbours"
-        )
-    gap = _number(table, "gap", prefix, required=True, low=0.0)
-    stiffness = _number(table, "stiffness", prefix, required=True, low=0.0, low_open=True)
-    restitution = None
-    if "restitution" in table and "damping" in table:
-        raise SceneError(f"{prefix}.damping: give either restitution or damping, not both")
-    if "damping" in table:
-        damping = _number(table, "damping", prefix, low=0.0)
-    else:
-        restitution = _number(table, "restitution", prefix, required=True, low=0.0, low_open=True, high=1.0)
-        masses = buildings[left].mass[left_floor - 1], buildings[right].mass[right_floor - 1]
-        damping = impact_damping(stiffness, restitution, *masses)
-    tensile = _boolean(table, "tensile", prefix, default=True)
-    return Contact(left, left_floor, right, right_floor, gap, stiffness, damping, restitution, tensile)
 
 
 # ---------------------------------------------------------------- motion
@@ -320,15 +87,15 @@ _MOTION_KEYS = {
 
 
 def _motion(data: Mapping[str, Any], base_dir: Path, g: float) -> GroundMotion:
-    table = _table(data, "motion", "")
+    table = fields.table(data, "motion", "")
     if table is None:
         raise SceneError("motion: missing ([motion] with a record, or type = harmonic | constant | kanai_tajimi | clough_penzien)")
-    kind = _string(table, "type", "motion", default="record")
+    kind = fields.string(table, "type", "motion", default="record")
     if kind in _SYNTHETIC_TYPES:
         return _synthetic_motion(table, kind)
     if kind not in _MOTION_KEYS:
         raise SceneError(f"motion.type: must be one of record, harmonic, constant, kanai_tajimi, clough_penzien; got {kind!r}")
-    _reject_unknown(table, _MOTION_KEYS[kind], "motion")
+    fields.reject_unknown(table, _MOTION_KEYS[kind], "motion")
     if kind == "harmonic":
         return _harmonic_motion(table)
     if kind == "constant":
@@ -337,23 +104,23 @@ def _motion(data: Mapping[str, Any], base_dir: Path, g: float) -> GroundMotion:
 
 
 def _timing(table: Mapping[str, Any], required: bool) -> tuple[float | None, float | None]:
-    duration = _number(table, "duration", "motion", required=required, low=0.0, low_open=True)
-    dt = _number(table, "dt", "motion", required=required, low=0.0, low_open=True)
+    duration = fields.number(table, "duration", "motion", required=required, low=0.0, low_open=True)
+    dt = fields.number(table, "dt", "motion", required=required, low=0.0, low_open=True)
     if duration is not None and dt is not None and dt > duration:
         raise SceneError(f"motion.dt: must be <= motion.duration ({duration:g} s), got {dt:g}")
     return duration, dt
 
 
 def _harmonic_motion(table: Mapping[str, Any]) -> HarmonicMotion:
-    amplitude = _number(table, "amplitude", "motion", required=True)
-    omega = _number(table, "omega", "motion", required=True, low=0.0)
-    phase = _number(table, "phase", "motion", default=0.0)
+    amplitude = fields.number(table, "amplitude", "motion", required=True)
+    omega = fields.number(table, "omega", "motion", required=True, low=0.0)
+    phase = fields.number(table, "phase", "motion", default=0.0)
     duration, dt = _timing(table, required=True)
     return HarmonicMotion(amplitude, omega, duration, dt, phase)
 
 
 def _constant_motion(table: Mapping[str, Any]) -> SampledMotion:
-    acceleration = _number(table, "acceleration", "motion", required=True)
+    acceleration = fields.number(table, "acceleration", "motion", required=True)
     duration, dt = _timing(table, required=True)
     n_samples = int(round(duration / dt)) + 1
     return SampledMotion(dt, np.full(n_samples, acceleration), description=f"constant {acceleration:g} m/s²")
@@ -362,13 +129,13 @@ def _constant_motion(table: Mapping[str, Any]) -> SampledMotion:
 def _record_motion(table: Mapping[str, Any], base_dir: Path, g: float) -> SampledMotion:
     from stochpound.motions.records import load_record
 
-    spec = _string(table, "record", "motion")
-    scale = _number(table, "scale", "motion", default=1.0)
+    spec = fields.string(table, "record", "motion")
+    scale = fields.number(table, "scale", "motion", default=1.0)
     duration, dt = _timing(table, required=False)
-    units = _string(table, "units", "motion", default="") or None
+    units = fields.string(table, "units", "motion", default="") or None
     if units not in (None, "g", "m/s2", "cm/s2"):
         raise SceneError(f"motion.units: must be one of g, m/s2, cm/s2; got {units!r}")
-    interpolation = _string(table, "interpolation", "motion", default="linear")
+    interpolation = fields.string(table, "interpolation", "motion", default="linear")
     if interpolation not in ("linear", "spline"):
         raise SceneError(f"motion.interpolation: must be 'linear' or 'spline', got {interpolation!r}")
     candidate = base_dir / spec
@@ -390,7 +157,7 @@ def _check_generator_fields(table: Mapping[str, Any], generator: Any, kind: str)
     """Reject fields the generator does not take, and name the required ones that are missing."""
     signature = inspect.signature(generator).parameters
     own = {name for name in signature if name not in ("n_realizations", "start")}
-    _reject_unknown(table, own | {"type", "realization", "interpolation"}, "motion")
+    fields.reject_unknown(table, own | {"type", "realization", "interpolation"}, "motion")
     for name, parameter in signature.items():
         if name in own and parameter.default is inspect.Parameter.empty and name not in table:
             raise SceneError(f"motion.{name}: required for type = {kind!r} (see docs/motions.md)")

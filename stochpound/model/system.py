@@ -3,7 +3,7 @@
 Degrees of freedom (DOFs) are, building by building, the floor displacements
 u_{b,i} relative to the building's base, followed by the base's sliding
 displacement s_b when the building is isolated (a fixed base has no s_b). With
-q the DOF vector and v = q̇, the equations of motion of MODEL.md §3 read
+q the DOF vector and v = q̇, the equations of motion (docs/model.md) read
 
     M q̈ + C q̇ + K q = −r a_g(t) + f_impact + f_friction
 
@@ -22,7 +22,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from stochpound.model.scene import Scene, storey_matrix
+from stochpound.model.building import storey_matrix
+from stochpound.model.friction import SlidingBase
+from stochpound.model.scene import Scene
 
 
 @dataclass(frozen=True)
@@ -35,8 +37,8 @@ class System:
         Number of DOFs N; the state is x = [q, v] of length 2N.
     floor_dofs : list of np.ndarray
         For each building, the DOF indices of its floors (floor 1 first).
-    base_dofs : list of int
-        For each building, the DOF index of its sliding base, or -1 (fixed base).
+    bases : tuple of SlidingBase
+        The sliding bases, left to right (fixed bases have none).
     mass, stiffness, damping : np.ndarray
         M, K, C (N × N), kg, N/m, N·s/m.
     influence : np.ndarray
@@ -49,10 +51,6 @@ class System:
         h_p as rows (n_contacts × N): generalised load −F_p h_p.
     contact_tensile : np.ndarray of bool
         Which contacts separate at δ = 0 (True) or at F = 0 (False).
-    base_weight, base_mu, base_mu_static : np.ndarray
-        Per building: W_b = g·total mass (N), kinetic and static μ (0 for fixed bases).
-    frictionless : np.ndarray of bool
-        Per building: isolated with μ = μ_s = 0 (a free DOF, no stick state).
     total_displacement : np.ndarray
         Y (n_floors_total × N): total displacements y = s + u of every floor, in DOF order.
     initial_state : np.ndarray
@@ -63,7 +61,7 @@ class System:
 
     n_dof: int
     floor_dofs: list[np.ndarray]
-    base_dofs: list[int]
+    bases: tuple[SlidingBase, ...]
     mass: np.ndarray
     stiffness: np.ndarray
     damping: np.ndarray
@@ -74,10 +72,6 @@ class System:
     contact_geometry: np.ndarray
     contact_load: np.ndarray
     contact_tensile: np.ndarray
-    base_weight: np.ndarray
-    base_mu: np.ndarray
-    base_mu_static: np.ndarray
-    frictionless: np.ndarray
     total_displacement: np.ndarray
     initial_state: np.ndarray
     contact_rows: np.ndarray
@@ -88,9 +82,9 @@ class System:
         return len(self.contact_gap)
 
     @property
-    def isolated(self) -> list[int]:
-        """Indices of the buildings with a sliding base."""
-        return [b for b, dof in enumerate(self.base_dofs) if dof >= 0]
+    def base_dofs(self) -> np.ndarray:
+        """The DOF of every sliding base (int64, in base order)."""
+        return np.array([base.dof for base in self.bases], dtype=np.int64)
 
     @property
     def contact_floor_velocity(self) -> np.ndarray:
@@ -108,6 +102,7 @@ def build_system(scene: Scene) -> System:
     influence = np.zeros(n_dof)
     total = np.zeros((sum(b.n_floors for b in scene.buildings), n_dof))
     initial = np.zeros(2 * n_dof)
+    bases = []
     row = 0
     for b, building in enumerate(scene.buildings):
         floors, base = floor_dofs[b], base_dofs[b]
@@ -121,7 +116,7 @@ def build_system(scene: Scene) -> System:
             total[row + i, dof] = 1.0
         initial[floors] = building.initial.displacement
         initial[n_dof + floors] = building.initial.velocity
-        if base >= 0:
+        if base is not None:
             mass[floors, base] = m
             mass[base, floors] = m
             mass[base, base] = building.total_mass
@@ -130,12 +125,13 @@ def build_system(scene: Scene) -> System:
             total[row : row + building.n_floors, base] = 1.0
             initial[base] = building.initial.base_displacement
             initial[n_dof + base] = building.initial.base_velocity
+            bases.append(SlidingBase(b, base, scene.g * building.total_mass, building.base.mu, building.base.mu_static))
         row += building.n_floors
     geometry, load = _contact_vectors(scene, floor_dofs, base_dofs, n_dof)
     return System(
         n_dof=n_dof,
         floor_dofs=floor_dofs,
-        base_dofs=base_dofs,
+        bases=tuple(bases),
         mass=mass,
         stiffness=stiffness,
         damping=damping,
@@ -146,37 +142,31 @@ def build_system(scene: Scene) -> System:
         contact_geometry=geometry,
         contact_load=load,
         contact_tensile=np.array([c.tensile for c in scene.contacts], bool),
-        base_weight=np.array([scene.g * b.total_mass if b.base else 0.0 for b in scene.buildings]),
-        base_mu=np.array([b.base.mu if b.base else 0.0 for b in scene.buildings]),
-        base_mu_static=np.array([b.base.mu_static if b.base else 0.0 for b in scene.buildings]),
-        frictionless=np.array([bool(b.base and b.base.frictionless) for b in scene.buildings]),
         total_displacement=total,
         initial_state=initial,
         contact_rows=_contact_rows(scene),
     )
 
 
-def _layout(scene: Scene) -> tuple[list[np.ndarray], list[int], int]:
+def _layout(scene: Scene) -> tuple[list[np.ndarray], list[int | None], int]:
+    """Each building's floor DOFs and base DOF (None for a fixed base), and the number of DOFs."""
     floor_dofs, base_dofs, n_dof = [], [], 0
     for building in scene.buildings:
         floor_dofs.append(np.arange(n_dof, n_dof + building.n_floors))
         n_dof += building.n_floors
-        if building.base is not None:
-            base_dofs.append(n_dof)
-            n_dof += 1
-        else:
-            base_dofs.append(-1)
+        base_dofs.append(n_dof if building.base is not None else None)
+        n_dof += building.base is not None
     return floor_dofs, base_dofs, n_dof
 
 
-def _contact_vectors(scene: Scene, floor_dofs: list[np.ndarray], base_dofs: list[int], n_dof: int) -> tuple[np.ndarray, np.ndarray]:
+def _contact_vectors(scene: Scene, floor_dofs: list[np.ndarray], base_dofs: list[int | None], n_dof: int) -> tuple[np.ndarray, np.ndarray]:
     geometry = np.zeros((len(scene.contacts), n_dof))
     load = np.zeros((len(scene.contacts), n_dof))
     for p, contact in enumerate(scene.contacts):
         for building, floor, sign in ((contact.left, contact.left_floor, 1.0), (contact.right, contact.right_floor, -1.0)):
             geometry[p, floor_dofs[building][floor - 1]] += sign
             load[p, floor_dofs[building][floor - 1]] += sign
-            if base_dofs[building] >= 0:
+            if base_dofs[building] is not None:
                 geometry[p, base_dofs[building]] += sign
                 if not scene.study_compat:
                     load[p, base_dofs[building]] += sign

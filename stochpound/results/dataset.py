@@ -93,14 +93,7 @@ def _assemble(coords: dict[str, xr.Variable], data_vars: dict[str, xr.Variable],
 
 def _response_variables(scene: Scene, system: System, recorder: Recorder) -> dict[str, xr.Variable]:
     """Displacements, ground acceleration, contact and friction forces and base states at the samples."""
-    q = recorder.states[:, : system.n_dof]
-    n_times, n_buildings, n_floors = len(scene.motion.times), len(scene.buildings), scene.max_floors
-    relative = np.full((n_buildings, n_floors, n_times), np.nan)
-    sliding = np.zeros((n_buildings, n_times))
-    for b, building in enumerate(scene.buildings):
-        relative[b, : building.n_floors] = q[:, system.floor_dofs[b]].T
-        if system.base_dofs[b] >= 0:
-            sliding[b] = q[:, system.base_dofs[b]]
+    relative, sliding = recorder.displacements()
     return {
         "total_displacement": _var(("building", "floor", "time"), relative + sliding[:, None, :], "m",
                                    "floor displacement relative to the ground (y = s + u)"),
@@ -109,10 +102,10 @@ def _response_variables(scene: Scene, system: System, recorder: Recorder) -> dic
         "ground_acceleration": _var(("time",), np.asarray(scene.motion.at_times(), float), "m s-2", "ground acceleration a_g"),
         "impact_force": _var(("contact", "time"), recorder.forces.T, "N", "contact force, positive in compression (0 while open)"),
         "base_friction_force": _var(
-            ("building", "time"), recorder.friction.T, "N", "force of the foundation on the base, positive to the right (0 for a fixed base)"
+            ("building", "time"), recorder.by_building(recorder.friction), "N", "force of the foundation on the base, positive to the right (0 for a fixed base)"
         ),
         "base_state": _var(
-            ("building", "time"), recorder.base_states.T, "1", "base state",
+            ("building", "time"), recorder.by_building(recorder.base_states), "1", "base state",
             flag_values=np.array([-1, 0, 1], dtype=np.int8), flag_meanings="slipping_left stuck_or_fixed slipping_right",
         ),
     }

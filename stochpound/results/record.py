@@ -18,7 +18,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from stochpound.model.modes import FREE, ModeDynamics
+from stochpound.model.friction import FREE
+from stochpound.model.modes import ModeDynamics
 from stochpound.model.system import System
 from stochpound.motions.ground import GroundMotion
 
@@ -93,9 +94,11 @@ class Recorder:
     states : np.ndarray
         x = [q, v] at every output time (n_times × 2N), m and m/s.
     forces, friction, base_states : np.ndarray
-        Contact forces (N), force of the foundation on each base (N, positive
-        to the right) and base states (:mod:`stochpound.model.modes`) at every
-        output time, filled by :meth:`sample_at`.
+        Contact forces (N), force of the foundation on each sliding base (N,
+        positive to the right) and base states
+        (:mod:`stochpound.model.friction`; a free base's is the sign of its
+        velocity) at every output time (time × contact or base), filled by
+        :meth:`sample_at`.
     energy_history : np.ndarray
         The energy terms (rows in :data:`ENERGY_TERMS` order, J) at every
         output time; ``energy`` maps each term's name to its row.
@@ -137,10 +140,23 @@ class Recorder:
         x = self.states[indices]
         self.forces[indices] = x @ dynamics.force_matrix.T + dynamics.force_constant
         self.friction[indices] = x @ dynamics.friction_matrix.T + np.outer(ground, dynamics.friction_ground) + dynamics.friction_constant
-        for b, state in enumerate(dynamics.mode.base):
-            if state == FREE:
-                state = np.sign(x[:, self.system.n_dof + self.system.base_dofs[b]])
-            self.base_states[indices, b] = state
+        for b, (base, state) in enumerate(zip(self.system.bases, dynamics.mode.base)):
+            self.base_states[indices, b] = np.sign(x[:, self.system.n_dof + base.dof]) if state == FREE else state
+
+    def displacements(self) -> tuple[np.ndarray, np.ndarray]:
+        """Floor displacements u relative to their base (building × floor × time, NaN above a building's top floor) and sliding displacements s (building × time, 0 for a fixed base), m."""
+        floors = self.system.floor_dofs
+        q = self.states[:, : self.system.n_dof]
+        relative = np.full((len(floors), max(len(dofs) for dofs in floors), len(q)), np.nan)
+        for b, dofs in enumerate(floors):
+            relative[b, : len(dofs)] = q[:, dofs].T
+        return relative, self.by_building(q[:, self.system.base_dofs])
+
+    def by_building(self, per_base: np.ndarray) -> np.ndarray:
+        """Values of the sliding bases over time (time × base) as building × time, 0 for fixed bases."""
+        values = np.zeros((len(self.system.floor_dofs), len(per_base)), dtype=per_base.dtype)
+        values[[base.building for base in self.system.bases]] = per_base.T
+        return values
 
     def kinetic_and_strain(self) -> tuple[np.ndarray, np.ndarray]:
         """Kinetic energy ½ vᵀMv and storey/restoring strain energy ½ qᵀKq at the samples, J."""

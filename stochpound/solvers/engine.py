@@ -78,7 +78,8 @@ from numba import njit
 from numba.core.compiler_lock import global_compiler_lock
 from numba.core.registry import cpu_target
 
-from stochpound.model.modes import STUCK, Guard
+from stochpound.model.friction import STUCK
+from stochpound.model.guards import Guard
 from stochpound.solvers.propagators import GAUSS_NODES, GAUSS_WEIGHTS
 
 ROUND_OFF = 1e-10

@@ -437,6 +437,9 @@ def system_fingerprint(system: System) -> bytes:
     digest = hashlib.blake2b(digest_size=20)
     for item in fields(system):
         value = getattr(system, item.name)
+        if isinstance(value, tuple):  # the sliding bases: frozen dataclasses of numbers
+            digest.update(repr(value).encode())
+            continue
         arrays = value if isinstance(value, list) else [value]
         for array in arrays:
             array = np.ascontiguousarray(array)

@@ -49,13 +49,18 @@ State = namedtuple("State", "run arming impacts outputs supplied")
 
 
 def mode_vector(mode: Mode) -> np.ndarray:
-    """The engine's int64 vector of a mode: closed flags, then base states."""
-    return np.array([int(flag) for flag in mode.closed] + list(mode.base), dtype=np.int64)
+    """The engine's int64 vector of a mode: closed flags, then base states, then 1 (an empty slot's vector ends in -9 instead)."""
+    return np.array([int(flag) for flag in mode.closed] + list(mode.base) + [1], dtype=np.int64)
 
 
 def vector_mode(vector: np.ndarray, n_contacts: int) -> Mode:
     """The :class:`Mode` of an engine mode vector."""
-    return Mode(tuple(bool(v) for v in vector[:n_contacts]), tuple(int(v) for v in vector[n_contacts:]))
+    return Mode(tuple(bool(v) for v in vector[:n_contacts]), tuple(int(v) for v in vector[n_contacts:-1]))
+
+
+def mode_length(system: System) -> int:
+    """Length of the engine's mode vectors of ``system`` (:func:`mode_vector`)."""
+    return system.n_contacts + len(system.bases) + 1
 
 
 def plant_arrays(system: System, motion: GroundMotion) -> Plant:
@@ -68,26 +73,24 @@ def plant_arrays(system: System, motion: GroundMotion) -> Plant:
     floor_rows = [np.ascontiguousarray(rows[system.contact_rows[:, side]]).reshape(system.n_contacts, system.n_dof) for side in (0, 1)]
     return Plant(
         engine.Motion(np.asarray(motion.times, float), np.ascontiguousarray(interval_forcing(motion)), coefficients, harmonic),
-        engine.Layout(system.contact_geometry, system.contact_gap, system.contact_tensile.astype(np.bool_), *floor_rows,
-                      np.asarray(system.base_dofs, dtype=np.int64)),
+        engine.Layout(system.contact_geometry, system.contact_gap, system.contact_tensile.astype(np.bool_), *floor_rows, system.base_dofs),
     )
 
 
 def max_guards(system: System) -> int:
     """The largest number of guards of a mode: two per contact (CLOSE and RECLOSE) and two per base (SLIP both ways)."""
-    return 2 * system.n_contacts + 2 * len(system.base_dofs)
+    return 2 * system.n_contacts + 2 * len(system.bases)
 
 
 def work_arrays_for(system: System, slots: "Slots") -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The engine's work arrays for ``system`` and the current Chebyshev width of ``slots`` (:func:`exact_engine.work_arrays`)."""
-    mode_size = system.n_contacts + len(system.base_dofs)
-    return engine.work_arrays(2 * system.n_dof, max_guards(system), system.n_contacts, mode_size, slots.arrays["chebyshev"].shape[2])
+    return engine.work_arrays(2 * system.n_dof, max_guards(system), system.n_contacts, mode_length(system), slots.arrays["chebyshev"].shape[2])
 
 
 def run_state(system: System, n_times: int, supplied_degree: int = 0) -> State:
     """Fresh arrays of everything a run changes (supplied steps of Chebyshev degree ``supplied_degree``)."""
     size, n_contacts, n_guards = 2 * system.n_dof, system.n_contacts, max_guards(system)
-    length = n_contacts + len(system.base_dofs)
+    length = mode_length(system)
     return State(
         engine.Run(np.zeros(1), np.zeros(engine.N_INTS, dtype=np.int64), np.zeros(size), np.zeros(size),
                    np.zeros(length, dtype=np.int64), np.zeros(length, dtype=np.int64), np.zeros(64, dtype=np.bool_)),
@@ -300,11 +303,10 @@ def _power_factors(system: System, force: np.ndarray, friction: np.ndarray) -> l
     velocity[:, n:size] = np.eye(n)
     ground = np.zeros((1, width))
     ground[0, size] = 1.0
-    sliding_rows, sliding_bases = _sliding(system)
     return [
         (ground, (-system.influence @ velocity)[None]),
         (velocity, system.damping @ velocity),
-        (velocity[sliding_rows - n], -friction[sliding_bases]),
+        (velocity[system.base_dofs], -friction),
         (system.contact_load @ velocity, force),
     ]
 
@@ -335,12 +337,6 @@ def _sub_step_forms(factors: list[tuple[np.ndarray, np.ndarray]], force: np.ndar
     return [*forms, force @ np.tensordot(weights, nodes, 1)]
 
 
-def _sliding(system: System) -> tuple[np.ndarray, np.ndarray]:
-    """The state rows of the sliding bases' velocities, and those bases' indices."""
-    bases = np.array([b for b, dof in enumerate(system.base_dofs) if dof >= 0], dtype=np.int64)
-    return system.n_dof + np.asarray(system.base_dofs, dtype=np.int64)[bases], bases
-
-
 def _in_z(rows: np.ndarray, width: int) -> np.ndarray:
     """Affine rows [x-coefficients | a_g coefficient | constant] as rows acting on z = [x, w, 1]."""
     size = rows.shape[1] - 2
@@ -358,7 +354,7 @@ def _placeholder(system: System, chebyshev_width: int, exact: bool) -> dict[str,
     width = size + 5
     propagate = (width, engine.propagate_columns(size, n_guards, n_contacts)) if exact else (1, 1)
     return {
-        "modes": np.full(n_contacts + len(system.base_dofs), -9, dtype=np.int64), "ids": np.int64(0), "codes": np.zeros((3, n_guards), np.int64),
+        "modes": np.full(mode_length(system), -9, dtype=np.int64), "ids": np.int64(0), "codes": np.zeros((3, n_guards), np.int64),
         "n_guards": np.int64(0), "substeps": np.int64(1), "rate": np.zeros((size, size + 2)),
         "guard": np.zeros((n_guards, size + 2)), "force": np.zeros((n_contacts, size + 2)), "power": np.zeros((width, 4 * width)),
         "propagate": np.zeros(propagate), "chebyshev": np.zeros((width, chebyshev_width) if exact else (1, 1)),
