@@ -250,7 +250,7 @@ def test_interpreted_engine_gives_the_compiled_results():
 
 
 def test_a_sub_step_product_gives_the_next_state_and_its_guards():
-    """One product of z(t0) with a mode's ``propagate`` rows: z(t0 + h), then (past the forms) the guards' values and rates there."""
+    """One product of z(t0) with a mode's ``propagate`` rows: z(t0 + h), then (past the forms) the guards' and monitors' values and rates there."""
     from stochpound.solvers import engine, tables
 
     scene = stochpound.scene_from_dict(study_scene(0.2, 0.1, 2.0, motion={"record": "el_centro_1940_study", "duration": 5.0}))
@@ -274,7 +274,12 @@ def test_a_sub_step_product_gives_the_next_state_and_its_guards():
         np.testing.assert_allclose(values, dynamics.guards(x1, ground), rtol=1e-12, atol=1e-12)
         expected = dynamics.guard_matrix @ dynamics.rate(x1, ground) + dynamics.guard_ground * ground_rate
         np.testing.assert_allclose(rates, expected, rtol=1e-12, atol=1e-12)
-        assert out.shape[0] % engine.LANES == 0 and not np.any(out[values_at + 2 * padded :])
+        monitors_at, m = values_at + 2 * padded, len(dynamics.monitor_constant)
+        closure = dynamics.monitor_matrix @ x1 + dynamics.monitor_ground * ground + dynamics.monitor_constant
+        np.testing.assert_allclose(out[monitors_at : monitors_at + m], closure, rtol=1e-12, atol=1e-14)
+        expected = dynamics.monitor_matrix @ dynamics.rate(x1, ground) + dynamics.monitor_ground * ground_rate
+        np.testing.assert_allclose(out[monitors_at + m : monitors_at + 2 * m], expected, rtol=1e-12, atol=1e-14)
+        assert out.shape[0] % engine.LANES == 0 and not np.any(out[monitors_at + 2 * m :])
 
 
 def test_engine_compiles_every_function_once():

@@ -1,7 +1,8 @@
 """The linear Kelvin–Voigt impact element between neighbouring floors (the reference study's contact law).
 
 Scene keys (``[[contact]]``): ``between`` ([[left building, floor], [right
-building, floor]], neighbours, the left one first), ``gap`` (m, ≥ 0),
+building, floor]], neighbours, the left one first), ``gap`` (m, ≥ 0; ``inf``:
+the contact never closes, and a run still records its closure),
 ``stiffness`` (k, N/m), ``restitution`` (r ∈ (0, 1]) or ``damping`` (c,
 N·s/m), ``tensile`` (default true).
 
@@ -59,7 +60,7 @@ class Contact:
     left_floor, right_floor : int
         Floors (1-based) that can collide.
     gap : float
-        At-rest gap d, m (>= 0). Penetration is δ = y_left − y_right − d.
+        At-rest gap d, m (>= 0; inf: the contact never closes). Penetration is δ = y_left − y_right − d.
     stiffness : float
         Impact spring k_imp, N/m (> 0).
     damping : float
@@ -118,7 +119,7 @@ def contact_from_table(table: Mapping[str, Any], prefix: str, buildings: Sequenc
             f"{prefix}.between: contacts join neighbours, left building first; "
             f"{buildings[left].name!r} and {buildings[right].name!r} are not left/right neighbours"
         )
-    gap = fields.number(table, "gap", prefix, required=True, low=0.0)
+    gap = fields.number(table, "gap", prefix, required=True, low=0.0, allow_inf=True)
     stiffness = fields.number(table, "stiffness", prefix, required=True, low=0.0, low_open=True)
     restitution = None
     if "restitution" in table and "damping" in table:
@@ -202,15 +203,18 @@ def guards(rows: ContactRows, stiffness: np.ndarray, gap: np.ndarray, tensile: n
         Guard rows over x (none depends on a_g), their constants, kinds
         (:class:`~stochpound.model.guards.Guard`), contacts, and 0 directions.
     """
-    n_contacts = len(gap)
+    # a contact with an infinite gap never closes: it has no guard (its closure is still monitored)
+    guarded = np.flatnonzero(closed | np.isfinite(gap))
+    closed, tensile, gap, stiffness = closed[guarded], tensile[guarded], gap[guarded], stiffness[guarded]
+    penetration, force = rows.penetration[guarded], rows.force[guarded]
     # first guard of each contact: CLOSE when open; OPEN (on δ when tensile, on F when not) when closed
-    first = np.where(closed[:, None], -np.where(tensile[:, None], rows.penetration, rows.force), rows.penetration)
+    first = np.where(closed[:, None], -np.where(tensile[:, None], penetration, force), penetration)
     first_constant = np.where(closed, np.where(tensile, gap, stiffness * gap), -gap)
     first_kind = np.where(closed, Guard.OPEN, Guard.CLOSE)
     reclose = np.flatnonzero(~closed & ~tensile)
-    order = np.argsort(np.concatenate([2 * np.arange(n_contacts), 2 * reclose + 1]), kind="stable")
-    matrix = np.concatenate([first, rows.force[reclose]])[order]
+    order = np.argsort(np.concatenate([2 * np.arange(len(guarded)), 2 * reclose + 1]), kind="stable")
+    matrix = np.concatenate([first, force[reclose]])[order]
     constant = np.concatenate([first_constant, -stiffness[reclose] * gap[reclose]])[order]
     kind = np.concatenate([first_kind, np.full(len(reclose), Guard.RECLOSE)])[order]
-    target = np.concatenate([np.arange(n_contacts), reclose])[order]
-    return matrix, np.zeros(len(order)), constant, kind.astype(int), target, np.zeros(len(order), int)
+    target = np.concatenate([guarded, guarded[reclose]])[order]
+    return matrix.reshape(len(order), rows.penetration.shape[1]), np.zeros(len(order)), constant, kind.astype(int), target, np.zeros(len(order), int)

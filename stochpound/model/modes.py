@@ -78,6 +78,9 @@ class ModeDynamics:
     friction_matrix, friction_ground, friction_constant : np.ndarray
         Force of the foundation on each sliding base, N, positive to the right
         (−F_req when stuck, −σ μ W when slipping, 0 for a free base).
+    monitor_matrix, monitor_ground, monitor_constant : np.ndarray
+        The monitors (:func:`monitor_rows`): read-outs whose largest value over
+        a run is located on the solution.
     stuck_dofs : np.ndarray of int
         DOFs held fixed in this mode (stuck bases); s and ṡ are re-imposed on them.
     """
@@ -97,6 +100,9 @@ class ModeDynamics:
     friction_matrix: np.ndarray
     friction_ground: np.ndarray
     friction_constant: np.ndarray
+    monitor_matrix: np.ndarray
+    monitor_ground: np.ndarray
+    monitor_constant: np.ndarray
     stuck_dofs: np.ndarray
 
     def rate(self, x: np.ndarray, ground: float) -> np.ndarray:
@@ -213,7 +219,18 @@ def _build(system: System, mode: Mode, masses: tuple[np.ndarray, np.ndarray, np.
                    for guard in friction.guards(base, i, state, foundation[i], n)]
     force_matrix, force_constant = contact.force_rows(rows, k, d, closed)
     return ModeDynamics(mode, A, B, c, *_stack_guards(contact_guards, base_guards, 2 * n), force_matrix, force_constant,
-                        *_stack_foundation(foundation, 2 * n), stuck)
+                        *_stack_foundation(foundation, 2 * n), *monitor_rows(rows), stuck)
+
+
+def monitor_rows(rows: contact.ContactRows) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The monitors of a mode as an affine map (matrix over x, a_g coefficients, constants): each contact's closure.
+
+    The closure of contact p is y_left − y_right = g_p · q (m, the penetration
+    plus the gap): its largest value over a run, located on the solution, is
+    the separation the run needed (``peak_contact_closure``).
+    """
+    n_monitors = len(rows.penetration)
+    return rows.penetration, np.zeros(n_monitors), np.zeros(n_monitors)
 
 
 def _stack_guards(contact_guards: tuple[np.ndarray, ...], base_guards: list[tuple], size: int) -> tuple[np.ndarray, ...]:

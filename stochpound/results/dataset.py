@@ -57,6 +57,7 @@ def build_dataset(scene: Scene, system: System, recorder: Recorder, counters: Ev
     data_vars = {
         **_response_variables(scene, system, recorder),
         **_contact_variables(scene),
+        **_closure_variables(recorder),
         **_impact_variables(recorder),
         **_energy_variables(recorder),
     }
@@ -108,6 +109,16 @@ def _response_variables(scene: Scene, system: System, recorder: Recorder) -> dic
             ("building", "time"), recorder.by_building(recorder.base_states), "1", "base state",
             flag_values=np.array([-1, 0, 1], dtype=np.int8), flag_meanings="slipping_left stuck_or_fixed slipping_right",
         ),
+    }
+
+
+def _closure_variables(recorder: Recorder) -> dict[str, xr.Variable]:
+    """Each contact's closure over time and its peak over the run, located on the solution."""
+    return {
+        "contact_closure": _var(("contact", "time"), recorder.contact_closure(), "m",
+                                "closure y_left - y_right of the contact's floors (the gap is closed where it reaches the gap)"),
+        "peak_contact_closure": _var(("contact",), recorder.peaks[0], "m", "largest closure over the run: the separation this run needed"),
+        "peak_contact_closure_time": _var(("contact",), recorder.peaks[1], "s", "time of the largest closure"),
     }
 
 

@@ -104,6 +104,10 @@ class Recorder:
         output time; ``energy`` maps each term's name to its row.
     impacts : list of Impact
         Every impact, in order of start (then contact).
+    peaks : np.ndarray
+        The monitors' largest values over the run and when they happened
+        (rows: value, time in s), located on the solution: each contact's
+        closure y_left − y_right (m) (:func:`stochpound.model.modes.monitor_rows`).
     """
 
     system: System
@@ -115,6 +119,7 @@ class Recorder:
     energy: dict[str, np.ndarray] = field(init=False)
     energy_history: np.ndarray = field(init=False)
     impacts: list[Impact] = field(default_factory=list)
+    peaks: np.ndarray = field(init=False)
 
     def __post_init__(self) -> None:
         n_times, n = len(self.motion.times), self.system.n_dof
@@ -124,6 +129,7 @@ class Recorder:
         self.base_states = np.zeros((n_times, len(self.system.base_dofs)), dtype=np.int8)
         self.energy_history = np.zeros((len(ENERGY_TERMS), n_times))
         self.energy = dict(zip(ENERGY_TERMS, self.energy_history))
+        self.peaks = np.full((2, self.system.n_contacts), np.nan)
 
     def sample_at(self, indices: np.ndarray, dynamics: ModeDynamics, ground: np.ndarray) -> None:
         """Contact forces, friction forces and base states at samples ``indices`` from their stored states.
@@ -151,6 +157,10 @@ class Recorder:
         for b, dofs in enumerate(floors):
             relative[b, : len(dofs)] = q[:, dofs].T
         return relative, self.by_building(q[:, self.system.base_dofs])
+
+    def contact_closure(self) -> np.ndarray:
+        """Each contact's closure y_left − y_right at the samples (contact × time), m."""
+        return self.system.contact_geometry @ self.states[:, : self.system.n_dof].T
 
     def by_building(self, per_base: np.ndarray) -> np.ndarray:
         """Values of the sliding bases over time (time × base) as building × time, 0 for fixed bases."""

@@ -102,6 +102,7 @@ class EngineRun:
         recorder = Recorder(self.system, self.motion)
         recorder.states[:] = outputs.states
         recorder.energy_history[:] = outputs.energy
+        recorder.peaks[:] = outputs.peaks
         ground = sample_ground(self.motion)
         for i in np.flatnonzero(run.visited[: len(self.slots.modes)]):
             indices = np.flatnonzero(outputs.sample_modes == i)

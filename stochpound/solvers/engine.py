@@ -98,23 +98,25 @@ ModeTable = namedtuple("ModeTable", "modes ids codes n_guards substeps")
 ModeTable.__doc__ = """The modes in the table's slots: mode vector (invalid in an empty slot), the mode's id (kept
 when it changes slot, recorded per sample), guard codes (rows KIND, TARGET, DIRECTION; padded), number of guards
 and of sub-steps per sample interval."""
-Dynamics = namedtuple("Dynamics", "rate guard force power")
-Dynamics.__doc__ = """The slots' modes' affine maps of ẋ, the guards (padded) and the contact forces, and its power forms.
+Dynamics = namedtuple("Dynamics", "rate guard force monitor power")
+Dynamics.__doc__ = """The slots' modes' affine maps of ẋ, the guards (padded), the contact forces and the monitors, and their power forms.
 
-``power[m]`` stacks the quadratic forms P of the input, damping, friction and
-impact powers, zᵀ P z at z = [x, a_g, 0, 0, 0, 1], transposed (Z × 4Z)
-(``exact_tables._power_forms``).
+A *monitor* is a read-out whose largest value over the run is located on
+the solution (e.g. a contact's closure, whose peak is the separation the run
+needed). ``power[m]`` stacks the quadratic forms P of the input, damping,
+friction and impact powers, zᵀ P z at z = [x, a_g, 0, 0, 0, 1], transposed
+(Z × 4Z) (``tables._power_forms``).
 """
 Propagators = namedtuple("Propagators", "propagate chebyshev step")
 Propagators.__doc__ = """Exact sub-step propagators of the slots' modes.
 
 ``propagate[m]`` is [exp(𝒜h); Q_input; Q_damping; Q_friction; Q_impact; R;
-V; W] transposed (Z × (5Z + n_contacts + 2 n_guards), guards padded, then
-zero columns up to :func:`propagate_columns`): one
+V; W; V_m; W_m] transposed (Z × (5Z + n_contacts + 2 n_guards + 2 n_monitors),
+guards padded, then zero columns up to :func:`propagate_columns`): one
 product of z(t0) gives z(t0 + h), Q z(t0) of every energy term (whose gain
 over the sub-step is z(t0) · Q z(t0)), the impulses R z(t0)
-(``exact_tables._sub_step_forms``), and the guards' values V z(t0) and rates
-W z(t0) at t0 + h (``exact_tables._guard_rows``). ``chebyshev[m]`` is the
+(``tables._sub_step_forms``), and the guards' and monitors' values V z(t0)
+and rates W z(t0) at t0 + h (``tables._read_out_rows``). ``chebyshev[m]`` is the
 Chebyshev expansion of the flow on a sub-step of length ``step[m]``,
 transposed (Z × D·2N).
 """
@@ -135,8 +137,8 @@ change (the RECLOSE guard of a contact that is not penetrated).
 """
 Impacts = namedtuple("Impacts", "is_open impact table")
 Impacts.__doc__ = """Open impacts (``impact[row, contact]``, rows START … IMPULSE) and the table of finished ones."""
-Outputs = namedtuple("Outputs", "running states energy sample_modes")
-Outputs.__doc__ = """Running energy terms, and the state, energy terms and mode id at every output time."""
+Outputs = namedtuple("Outputs", "running states energy sample_modes peaks")
+Outputs.__doc__ = """Running energy terms, the state, energy terms and mode id at every output time, and the monitors' peaks (rows PEAK_VALUE, PEAK_AT)."""
 Supplied = namedtuple("Supplied", "bounds x coefficients")
 Supplied.__doc__ = """A step of the flow supplied by the caller (``external`` runs: an integrator's step).
 
@@ -144,7 +146,7 @@ Supplied.__doc__ = """A step of the flow supplied by the caller (``external`` ru
 Chebyshev coefficients of x(t) on [t0, t1], (D + 1) × 2N flattened by order
 (the dense output of :class:`Flow`).
 """
-Flow = namedtuple("Flow", "rate guard force coefficients ground origin harmonic t0 scale")
+Flow = namedtuple("Flow", "rate guard force monitor coefficients ground origin harmonic t0 scale")
 Flow.__doc__ = """One mode's flow inside one step: its affine maps and the Chebyshev coefficients of x(t).
 
 ``ground`` is the interval's cubic of a_g(t − origin) (sampled motions) or
@@ -159,6 +161,8 @@ N_INTS = 11
 KIND, TARGET, DIRECTION = range(3)
 # rows of Impacts.impact
 START, ONSET, IN_PHASE, PEAK, PEAK_TIME, IMPULSE = range(6)
+# rows of Outputs.peaks
+PEAK_VALUE, PEAK_AT = range(2)
 # pending settles
 NONE, INITIAL, EVENT = 0, 1, 2
 # statuses returned to Python
@@ -179,26 +183,28 @@ LANES = 16
 """The columns of ``Propagators.propagate`` are padded to a multiple of this, so that its products vectorise whole."""
 
 
-def propagate_columns(size: int, n_guards: int, n_contacts: int) -> int:
+def propagate_columns(size: int, n_guards: int, n_contacts: int, n_monitors: int) -> int:
     """Columns of ``Propagators.propagate`` (padded to :data:`LANES`) for state size ``size`` (2N)."""
-    used = 5 * (size + 5) + n_contacts + 2 * n_guards
+    used = 5 * (size + 5) + n_contacts + 2 * n_guards + 2 * n_monitors
     return -(-used // LANES) * LANES
 
 
-def work_arrays(size: int, n_guards: int, n_contacts: int, mode_size: int, chebyshev_width: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def work_arrays(size: int, n_guards: int, n_contacts: int, n_monitors: int, mode_size: int,
+                chebyshev_width: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``scratch``, ``saved`` and ``marks`` work arrays of :func:`run_engine`.
 
     For state size ``size`` (2N), mode vectors of ``mode_size`` and Chebyshev
     rows of ``chebyshev_width`` (``Propagators.chebyshev.shape[2]``). The
     engine allocates nothing: every work vector is a row of these.
-    ``scratch`` rows: 0–6 the quiet loop's (:func:`_advance_quiet`), 0–15
-    an event step's (:func:`_advance_span`, :func:`_first_crossing`), 16–23
-    settling's. ``marks`` rows: the settling chain's modes, its transitions,
-    then the guard headings and two mode vectors.
+    ``scratch`` rows: 0–6 and 9 the quiet loop's (:func:`_advance_quiet`),
+    0–15 an event step's (:func:`_advance_span`, :func:`_first_crossing`),
+    16–23 settling's, 24–27 the monitors' values and rates at a step's ends.
+    ``marks`` rows: the settling chain's modes, its transitions, then the
+    guard headings and two mode vectors.
     """
-    scratch = np.zeros((24, max(propagate_columns(size, n_guards, n_contacts), chebyshev_width)))
+    scratch = np.zeros((28, max(propagate_columns(size, n_guards, n_contacts, n_monitors), chebyshev_width)))
     marks = np.zeros((2 * (_MAX_SETTLE + 1) + 3, max(mode_size, 3, n_guards)), dtype=np.int64)
-    return scratch, np.zeros((6, max(4, n_contacts, n_guards))), marks
+    return scratch, np.zeros((8, max(4, n_contacts, n_guards, n_monitors))), marks
 
 
 # ---------------------------------------------------------------- linear algebra and read-outs
@@ -233,11 +239,11 @@ def _affine(M, i, x, ground):
 
 
 @njit(**INTERNAL)
-def _force_rate(force, p, rate, x, ground):
-    """Rate of contact force p: force[p, :S] · ẋ."""
-    total = 0.0
-    for i in range(rate.shape[0]):
-        total += force[p, i] * _affine(rate, i, x, ground)
+def _rate_of(M, i, rate, x, ground, ground_rate):
+    """Rate of row i of the affine map M along the flow: M[i, :S] · ẋ + M[i, S] ȧ_g."""
+    total = M[i, rate.shape[0]] * ground_rate
+    for j in range(rate.shape[0]):
+        total += M[i, j] * _affine(rate, j, x, ground)
     return total
 
 
@@ -386,7 +392,7 @@ def _peaks(rate, force, is_open, impact, x0, a0, t0, x1, a1, t1):
     _offer_peaks(force, is_open, impact, t0, x0)
     _offer_peaks(force, is_open, impact, t1, x1)
     for p in range(is_open.shape[0]):
-        if is_open[p] and _force_rate(force, p, rate, x0, a0) > 0.0 > _force_rate(force, p, rate, x1, a1):
+        if is_open[p] and _rate_of(force, p, rate, x0, a0, 0.0) > 0.0 > _rate_of(force, p, rate, x1, a1, 0.0):
             return True
     return False
 
@@ -395,18 +401,20 @@ def _peaks(rate, force, is_open, impact, x0, a0, t0, x1, a1, t1):
 
 
 @njit(**INTERNAL)
-def _save(saved, running, impact, threshold, disarmed):
-    """Copy the running totals, the open impacts' peaks and impulses and the guard arming into the rows of ``saved``."""
+def _save(saved, running, impact, threshold, disarmed, peaks):
+    """Copy the running totals, the open impacts' peaks and impulses, the guard arming and the monitors' peaks into the rows of ``saved``."""
     for i in range(running.shape[0]):
         saved[0, i] = running[i]
     for p in range(impact.shape[1]):
         saved[1, p], saved[2, p], saved[3, p] = impact[PEAK, p], impact[PEAK_TIME, p], impact[IMPULSE, p]
     for g in range(threshold.shape[0]):
         saved[4, g], saved[5, g] = threshold[g], 1.0 if disarmed[g] else 0.0
+    for i in range(peaks.shape[1]):
+        saved[6, i], saved[7, i] = peaks[PEAK_VALUE, i], peaks[PEAK_AT, i]
 
 
 @njit(**INTERNAL)
-def _restore(saved, running, impact, threshold, disarmed):
+def _restore(saved, running, impact, threshold, disarmed, peaks):
     """Undo everything since :func:`_save`."""
     for i in range(running.shape[0]):
         running[i] = saved[0, i]
@@ -414,36 +422,96 @@ def _restore(saved, running, impact, threshold, disarmed):
         impact[PEAK, p], impact[PEAK_TIME, p], impact[IMPULSE, p] = saved[1, p], saved[2, p], saved[3, p]
     for g in range(threshold.shape[0]):
         threshold[g], disarmed[g] = saved[4, g], saved[5, g] != 0.0
+    for i in range(peaks.shape[1]):
+        peaks[PEAK_VALUE, i], peaks[PEAK_AT, i] = saved[6, i], saved[7, i]
+
+
+# ---------------------------------------------------------------- monitors
+
+
+@njit(**INTERNAL)
+def _offer_monitors(values, t, peaks):
+    """Offer the monitors' ``values`` at time t as their peaks."""
+    for i in range(values.shape[0]):
+        if values[i] > peaks[PEAK_VALUE, i]:
+            peaks[PEAK_VALUE, i], peaks[PEAK_AT, i] = values[i], t
+
+
+@njit(**INTERNAL)
+def _maximum_may_beat(value0, value1, rate0, rate1, h, peak):
+    """True when a monitor has a maximum inside a step of h seconds (rate from + to −) whose Hermite cubic comes near its ``peak``."""
+    if not rate0 > 0.0 > rate1:
+        return False
+    a0, a1, a2, a3 = _hermite(value0, value1, rate0, rate1, h)
+    return _interior_maximum(a0, a1, a2, a3) >= peak - _screen_margin(value0, value1, rate0, rate1, h, 0.0)
+
+
+@njit(**INTERNAL)
+def _any_maximum_may_beat(values0, values1, rates0, rates1, h, peaks):
+    """True when some monitor's maximum inside the step may beat its peak (:func:`_maximum_may_beat`)."""
+    for i in range(values0.shape[0]):
+        if _maximum_may_beat(values0[i], values1[i], rates0[i], rates1[i], h, peaks[PEAK_VALUE, i]):
+            return True
+    return False
+
+
+@njit(**INTERNAL)
+def _monitor_peaks(flow, t1, values0, values1, rates0, rates1, peaks, work):
+    """Offer the monitors' values at t1 and their maxima inside [flow.t0, t1], located on the flow, as their peaks.
+
+    ``values*``/``rates*``: the monitors' values and rates at the step's ends.
+    A maximum is located (Brent on the monitor's rate) when the rate goes from
+    + to − on the flow and the Hermite cubic says it may beat the peak.
+    """
+    t0, n_contacts = flow.t0, flow.force.shape[0]
+    for i in range(values1.shape[0]):
+        if _maximum_may_beat(values0[i], values1[i], rates0[i], rates1[i], t1 - t0, peaks[PEAK_VALUE, i]):
+            index = -1 - n_contacts - i
+            if _evaluate(flow, index, 0.0, t0, work) > 0.0 > _evaluate(flow, index, 0.0, t1, work):
+                t_peak = _brentq(flow, index, 0.0, t0, t1, work)
+                _dense(flow, t_peak, work)
+                value = _affine(flow.monitor, i, work, _ground_value(flow, t_peak))
+                if value > peaks[PEAK_VALUE, i]:
+                    peaks[PEAK_VALUE, i], peaks[PEAK_AT, i] = value, t_peak
+    _offer_monitors(values1, t1, peaks)
 
 
 @njit(inline="always", error_model="numpy")
-def _advance_quiet(mode_id, n, substeps, propagate, rate, guard, force, times, forcing, ints, clock, x, arming, is_open, impact,
-                   outputs, scratch, saved):
+def _advance_quiet(mode_id, n, substeps, step, propagate, chebyshev, rate, guard, force, monitor, motion, ints, clock, x, arming, is_open,
+                   impact, outputs, scratch, saved):
     """Advance the current mode (its id, n guards and arrays) from interval ``ints[K]`` until an interval needs the event code.
 
     Does for every sub-step what the event code does for a step without event:
     the guard screen of ``first_crossing`` and the re-arming of guards, the
-    energy terms, impulses and end-point peak forces of ``Recorder.on_step``.
-    Every completed interval k is recorded at output time k + 1;
-    ``ints[K]``, ``clock`` and ``x`` are left at the start of the interval
-    where the loop stopped (or at the end of the motion).
+    energy terms, impulses and end-point peak forces of ``Recorder.on_step``,
+    and the monitors' peaks (located on the flow when a maximum inside a
+    sub-step may beat one). Every completed interval k is recorded at output
+    time k + 1; ``ints[K]``, ``clock`` and ``x`` are left at the start of the
+    interval where the loop stopped (or at the end of the motion).
     """
     threshold, tolerance, rearmable, disarmed = arming
-    running, states, energy, sample_modes = outputs
+    running, states, energy, sample_modes, peaks = outputs
+    times, forcing, harmonic = motion.times, motion.forcing, motion.harmonic
+    is_harmonic = harmonic.shape[0] > 0
     size = x.shape[0]
     width = size + 5
-    z0, propagated, work = scratch[0, :width], scratch[1, : propagate.shape[1]], scratch[2, :size]
+    z0, propagated, work, coefficients = scratch[0, :width], scratch[1, : propagate.shape[1]], scratch[2, :size], scratch[9, : chebyshev.shape[1]]
     z1, x0, x1 = propagated[:width], z0[:size], propagated[:size]
-    values_at, rates_at = 5 * width + is_open.shape[0], 5 * width + is_open.shape[0] + guard.shape[0]
+    values_at = 5 * width + is_open.shape[0]
+    rates_at, monitors_at = values_at + guard.shape[0], values_at + 2 * guard.shape[0]
+    n_monitors = monitor.shape[0]
     values0, values1, rates0, rates1 = scratch[3, :n], propagated[values_at : values_at + n], scratch[5, :n], propagated[rates_at : rates_at + n]
+    monitors0, monitors1 = scratch[24, :n_monitors], propagated[monitors_at : monitors_at + n_monitors]
+    monitor_rates0, monitor_rates1 = scratch[26, :n_monitors], propagated[monitors_at + n_monitors : monitors_at + 2 * n_monitors]
     any_open = _any(is_open)
     for k in range(ints[K], forcing.shape[0]):
         h = (times[k + 1] - times[k]) / substeps
-        _save(saved, running, impact, threshold, disarmed)
+        _save(saved, running, impact, threshold, disarmed, peaks)
         _copy(x, x0)
         _copy(forcing[k], z0[size : size + 4])
         z0[width - 1] = 1.0
         _guards_and_rates(rate, guard, x0, z0[size], z0[size + 1], values0, rates0, work)
+        _guards_and_rates(rate, monitor, x0, z0[size], z0[size + 1], monitors0, monitor_rates0, work)
         for j in range(substeps):
             _product(propagate, z0, propagated)
             t0 = times[k] + j * h
@@ -451,14 +519,23 @@ def _advance_quiet(mode_id, n, substeps, propagate, rate, guard, force, times, f
             if _suspect(values0, values1, rates0, rates1, h, threshold, tolerance) or (
                 any_open and _peaks(rate, force, is_open, impact, x0, z0[size], t0, x1, z1[size], t1)
             ):
-                _restore(saved, running, impact, threshold, disarmed)
+                _restore(saved, running, impact, threshold, disarmed, peaks)
                 ints[K] = k
                 clock[0] = times[k]
                 return
             _sub_step_energy(z0, propagated, is_open, impact[IMPULSE], running)
             _arm_where_negative(values1, threshold, tolerance, rearmable, disarmed)
+            if _any_maximum_may_beat(monitors0, monitors1, monitor_rates0, monitor_rates1, h, peaks):
+                _product(chebyshev, z0, coefficients)
+                flow = Flow(rate, guard, force, monitor, coefficients, harmonic if is_harmonic else motion.coefficients[k], times[k], is_harmonic,
+                            t0, 2.0 / step)
+                _monitor_peaks(flow, t1, monitors0, monitors1, monitor_rates0, monitor_rates1, peaks, work)
+            else:
+                _offer_monitors(monitors1, t1, peaks)
             _copy(values1, values0)
             _copy(rates1, rates0)
+            _copy(monitors1, monitors0)
+            _copy(monitor_rates1, monitor_rates0)
             _copy(z1, z0)
         _copy(x0, x)
         ints[K] = k + 1
@@ -515,13 +592,29 @@ def _dense(flow, t, out):
 
 
 @njit(**INTERNAL)
+def _ground_rate(flow, t):
+    """ȧ_g at t in the flow's interval."""
+    c = flow.ground
+    if flow.harmonic:
+        return c[0] * c[1] * math.cos(c[1] * t + c[2])
+    tau = t - flow.origin
+    return c[1] + tau * (2.0 * c[2] + 3.0 * tau * c[3])
+
+
+@njit(**INTERNAL)
 def _evaluate(flow, index, level, t, work):
-    """Guard ``index`` minus ``level`` at t, or (index < 0) the rate of contact force −1 − index."""
+    """Guard ``index`` minus ``level`` at t; for index < 0, the rate of read-out r = −1 − index.
+
+    Read-out r < n_contacts is contact force r, else monitor r − n_contacts.
+    """
     _dense(flow, t, work)
     ground = _ground_value(flow, t)
-    if index < 0:
-        return _force_rate(flow.force, -1 - index, flow.rate, work, ground)
-    return _affine(flow.guard, index, work, ground) - level
+    if index >= 0:
+        return _affine(flow.guard, index, work, ground) - level
+    r, n_contacts = -1 - index, flow.force.shape[0]
+    if r < n_contacts:
+        return _rate_of(flow.force, r, flow.rate, work, ground, 0.0)
+    return _rate_of(flow.monitor, r - n_contacts, flow.rate, work, ground, _ground_rate(flow, t))
 
 
 # ---------------------------------------------------------------- scipy's brentq and bounded Brent, ported
@@ -946,8 +1039,8 @@ def _on_transitions(mode, force, left_rows, right_rows, geometry, is_open, impac
 
 
 @njit(inline="always", error_model="numpy")
-def _settle_pending(modes, codes, n_guards, rate, guard, force, motion, layout, arming, ints, clock, pending_x, pending_mode,
-                    missing_mode, is_open, impact, table, x, scratch, marks):
+def _settle_pending(modes, codes, n_guards, rate, guard, force, monitor, motion, layout, arming, ints, clock, pending_x, pending_mode,
+                    missing_mode, is_open, impact, table, peaks, x, scratch, marks):
     """Settle the pending event (or the start) and record it (``settle_and_record``): returns the mode index.
 
     The settled state goes into ``x``. Returns −1 (with the mode to build in
@@ -968,6 +1061,10 @@ def _settle_pending(modes, codes, n_guards, rate, guard, force, motion, layout, 
         return m
     _on_transitions(modes[m], force[m], left_rows, right_rows, geometry, is_open, impact, table, ints, clock[0], settled, transitions,
                     n_transitions)
+    n_monitors = monitor.shape[1]
+    monitors, monitor_rates = scratch[24, :n_monitors], scratch[26, :n_monitors]
+    _guards_and_rates(rate[m], monitor[m], settled, ground[0], ground[1], monitors, monitor_rates, scratch[2, : x.shape[0]])
+    _offer_monitors(monitors, clock[0], peaks)  # a monitor may jump with the mode (e.g. an acceleration at impact)
     _copy(settled, x)
     return m
 
@@ -977,12 +1074,13 @@ def _settle_pending(modes, codes, n_guards, rate, guard, force, motion, layout, 
 
 @njit(**INTERNAL)
 def _locate_and_record(flow, m, modes, codes, force, power, ints, clock, x0, x1, pending_x, pending_mode, arming, is_open, impact,
-                       running, t1, values0, values1, rates0, rates1, scratch):
+                       running, peaks, t1, values0, values1, rates0, rates1, scratch):
     """The event code of one step [flow.t0, t1] of mode m on its dense flow: returns True when it stopped at an event (now pending).
 
     The earliest guard crossing is located (:func:`_first_crossing`); the
     energy terms and impulses are integrated (5-point Gauss–Legendre on the
-    flow) and the impact forces' peaks located up to the event or t1; the
+    flow) and the impact forces' and monitors' peaks located up to the event
+    or t1; the
     fired guard becomes the pending event at ``clock[0]`` with the state in
     ``pending_x``. ``values*``/``rates*`` are the guards' values and rates
     at the step's ends; ``scratch``: the work array (:func:`work_arrays`).
@@ -1020,6 +1118,11 @@ def _locate_and_record(flow, m, modes, codes, force, power, ints, clock, x0, x1,
                 value = _affine(force, p, work, 0.0)
                 if value > impact[PEAK, p]:
                     impact[PEAK, p], impact[PEAK_TIME, p] = value, t_peak
+        n_monitors = flow.monitor.shape[0]
+        monitors0, monitors1, monitor_rates0, monitor_rates1 = scratch[24, :n_monitors], scratch[25, :n_monitors], scratch[26, :n_monitors], scratch[27, :n_monitors]
+        _guards_and_rates(flow.rate, flow.monitor, x0, _ground_value(flow, t0), _ground_rate(flow, t0), monitors0, monitor_rates0, work)
+        _guards_and_rates(flow.rate, flow.monitor, x_stop, _ground_value(flow, t_stop), _ground_rate(flow, t_stop), monitors1, monitor_rates1, work)
+        _monitor_peaks(flow, t_stop, monitors0, monitors1, monitor_rates0, monitor_rates1, peaks, work)
     if fired < 0:
         return False
     clock[0] = t_event
@@ -1031,9 +1134,19 @@ def _locate_and_record(flow, m, modes, codes, force, power, ints, clock, x0, x1,
     return True
 
 
+@njit(**INTERNAL)
+def _sub_step_monitors(flow, t1, x0, x1, peaks, scratch):
+    """The monitors' peaks over a sub-step [flow.t0, t1] from x0 to x1 that needs no event code (:func:`_monitor_peaks`)."""
+    n_monitors, work = flow.monitor.shape[0], scratch[2, : x0.shape[0]]
+    monitors0, monitors1, monitor_rates0, monitor_rates1 = scratch[24, :n_monitors], scratch[25, :n_monitors], scratch[26, :n_monitors], scratch[27, :n_monitors]
+    _guards_and_rates(flow.rate, flow.monitor, x0, _ground_value(flow, flow.t0), _ground_rate(flow, flow.t0), monitors0, monitor_rates0, work)
+    _guards_and_rates(flow.rate, flow.monitor, x1, _ground_value(flow, t1), _ground_rate(flow, t1), monitors1, monitor_rates1, work)
+    _monitor_peaks(flow, t1, monitors0, monitors1, monitor_rates0, monitor_rates1, peaks, work)
+
+
 @njit(inline="always", error_model="numpy")
-def _advance_span(m, n, modes, codes, substeps, step, propagate, chebyshev, rate, guard, force, power, motion, ints, clock, x,
-                  pending_x, pending_mode, arming, is_open, impact, running, k, t, t_end, scratch):
+def _advance_span(m, n, modes, codes, substeps, step, propagate, chebyshev, rate, guard, force, monitor, power, motion, ints, clock, x,
+                  pending_x, pending_mode, arming, is_open, impact, running, peaks, k, t, t_end, scratch):
     """Exact sub-steps of mode m (n guards, its arrays) from t to t_end, each through :func:`_locate_and_record`.
 
     A full sub-step in which no guard passes the screen and no impact is
@@ -1063,7 +1176,7 @@ def _advance_span(m, n, modes, codes, substeps, step, propagate, chebyshev, rate
         _copy(x, z0[:size])
         _ground(times, coefficients_k, harmonic, t0, k, z0[size : size + 4])
         z0[width - 1] = 1.0
-        flow = Flow(rate, guard, force, coefficients, ground, times[k], is_harmonic, t0, 2.0 / step)
+        flow = Flow(rate, guard, force, monitor, coefficients, ground, times[k], is_harmonic, t0, 2.0 / step)
         _guards_and_rates(rate, guard, x, z0[size], z0[size + 1], values0, rates0, rate_work)
         if full:
             _product(propagate, z0, propagated)
@@ -1075,20 +1188,22 @@ def _advance_span(m, n, modes, codes, substeps, step, propagate, chebyshev, rate
         if full and not _suspect(values0, values1, rates0, rates1, t1 - t0, threshold, tolerance) and not any_open:
             _sub_step_energy(z0, propagated, is_open, impact[IMPULSE], running)
             _arm_where_negative(values1, threshold, tolerance, rearmable, disarmed)
+            _product(chebyshev, z0, coefficients)
+            _sub_step_monitors(flow, t1, x, x1, peaks, scratch)
             _copy(x1, x)
             continue
         if full:
             _product(chebyshev, z0, coefficients)
         if _locate_and_record(flow, m, modes, codes, force, power, ints, clock, x, x1, pending_x, pending_mode, arming, is_open, impact,
-                              running, t1, values0, values1, rates0, rates1, scratch):
+                              running, peaks, t1, values0, values1, rates0, rates1, scratch):
             return True
         _copy(x1, x)
     return False
 
 
 @njit(inline="always", error_model="numpy")
-def _supplied_step(m, n, modes, codes, rate, guard, force, power, motion, ints, clock, x, pending_x, pending_mode, arming, is_open, impact,
-                   running, k, supplied, scratch):
+def _supplied_step(m, n, modes, codes, rate, guard, force, monitor, power, motion, ints, clock, x, pending_x, pending_mode, arming, is_open,
+                   impact, running, peaks, k, supplied, scratch):
     """The supplied step of mode m (n guards, its arrays) through :func:`_locate_and_record`; x moves to its end if no event.
 
     Returns True when it stopped at an event (now pending).
@@ -1100,13 +1215,13 @@ def _supplied_step(m, n, modes, codes, rate, guard, force, power, motion, ints, 
     rate_work, ground0, ground1 = scratch[7, :size], scratch[8, :4], scratch[9, :4]
     is_harmonic = harmonic.shape[0] > 0
     ground = harmonic if is_harmonic else motion.coefficients[k]
-    flow = Flow(rate, guard, force, supplied.coefficients, ground, times[k], is_harmonic, t0, 2.0 / (t1 - t0))
+    flow = Flow(rate, guard, force, monitor, supplied.coefficients, ground, times[k], is_harmonic, t0, 2.0 / (t1 - t0))
     _ground(times, motion.coefficients, harmonic, t0, k, ground0)
     _guards_and_rates(rate, guard, x, ground0[0], ground0[1], values0, rates0, rate_work)
     _ground(times, motion.coefficients, harmonic, t1, k, ground1)
     _guards_and_rates(rate, guard, supplied.x, ground1[0], ground1[1], values1, rates1, rate_work)
     if _locate_and_record(flow, m, modes, codes, force, power, ints, clock, x, supplied.x, pending_x, pending_mode, arming, is_open, impact,
-                          running, t1, values0, values1, rates0, rates1, scratch):
+                          running, peaks, t1, values0, values1, rates0, rates1, scratch):
         return True
     _copy(supplied.x, x)
     clock[0] = t1
@@ -1147,19 +1262,19 @@ def run_engine(table, dynamics, propagators, motion, layout, run, arming, impact
         the impact table is full. Either way the caller fixes it and calls again.
     """
     modes, ids, codes, n_guards, substeps = table
-    rate, guard, force, power = dynamics
+    rate, guard, force, monitor, power = dynamics
     propagate, chebyshev, step = propagators
     clock, ints, x, pending_x, pending_mode, missing_mode, visited = run
     is_open, impact, impact_table = impacts
-    running, states, energy, sample_modes = outputs
+    running, states, energy, sample_modes, peaks = outputs
     times = motion.times
     last = times.shape[0] - 1
     while True:
         if ints[PENDING] != NONE:
             if ints[N_IMPACTS] + is_open.shape[0] > impact_table.shape[0]:
                 return NEED_SPACE
-            m = _settle_pending(modes, codes, n_guards, rate, guard, force, motion, layout, arming, ints, clock, pending_x,
-                                pending_mode, missing_mode, is_open, impact, impact_table, x, scratch, marks)
+            m = _settle_pending(modes, codes, n_guards, rate, guard, force, monitor, motion, layout, arming, ints, clock, pending_x,
+                                pending_mode, missing_mode, is_open, impact, impact_table, peaks, x, scratch, marks)
             if m < 0:
                 return NEED_MODE
             ints[MODE] = m
@@ -1169,8 +1284,8 @@ def run_engine(table, dynamics, propagators, motion, layout, run, arming, impact
             ints[PENDING] = NONE
         k, m = ints[K], ints[MODE]
         if not external and k < last and clock[0] == times[k]:
-            _advance_quiet(ids[m], n_guards[m], substeps[m], propagate[m], rate[m], guard[m], force[m], times, motion.forcing, ints,
-                           clock, x, arming, is_open, impact, outputs, scratch, saved)
+            _advance_quiet(ids[m], n_guards[m], substeps[m], step[m], propagate[m], chebyshev[m], rate[m], guard[m], force[m], monitor[m], motion,
+                           ints, clock, x, arming, is_open, impact, outputs, scratch, saved)
             k = ints[K]
         if k >= last:
             return FINISHED
@@ -1180,12 +1295,12 @@ def run_engine(table, dynamics, propagators, motion, layout, run, arming, impact
                 if ints[READY] == 0:
                     return NEED_STEP
                 ints[READY] = 0
-                if _supplied_step(m, n_guards[m], modes, codes, rate[m], guard[m], force[m], power[m], motion, ints, clock, x, pending_x,
-                                  pending_mode, arming, is_open, impact, running, k, supplied, scratch) or clock[0] < t_end:
+                if _supplied_step(m, n_guards[m], modes, codes, rate[m], guard[m], force[m], monitor[m], power[m], motion, ints, clock, x,
+                                  pending_x, pending_mode, arming, is_open, impact, running, peaks, k, supplied, scratch) or clock[0] < t_end:
                     continue
             elif _advance_span(m, n_guards[m], modes, codes, substeps[m], step[m], propagate[m], chebyshev[m], rate[m], guard[m], force[m],
-                               power[m], motion, ints, clock, x, pending_x, pending_mode, arming, is_open, impact, running, k, t, t_end,
-                               scratch):
+                               monitor[m], power[m], motion, ints, clock, x, pending_x, pending_mode, arming, is_open, impact, running, peaks,
+                               k, t, t_end, scratch):
                 continue
         clock[0] = t_end
         ints[K] = k + 1

@@ -77,6 +77,11 @@ def plant_arrays(system: System, motion: GroundMotion) -> Plant:
     )
 
 
+def n_monitors(system: System) -> int:
+    """Number of monitors of every mode of ``system`` (:func:`stochpound.model.modes.monitor_rows`)."""
+    return system.n_contacts
+
+
 def max_guards(system: System) -> int:
     """The largest number of guards of a mode: two per contact (CLOSE and RECLOSE) and two per base (SLIP both ways)."""
     return 2 * system.n_contacts + 2 * len(system.bases)
@@ -84,7 +89,8 @@ def max_guards(system: System) -> int:
 
 def work_arrays_for(system: System, slots: "Slots") -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The engine's work arrays for ``system`` and the current Chebyshev width of ``slots`` (:func:`exact_engine.work_arrays`)."""
-    return engine.work_arrays(2 * system.n_dof, max_guards(system), system.n_contacts, mode_length(system), slots.arrays["chebyshev"].shape[2])
+    return engine.work_arrays(2 * system.n_dof, max_guards(system), system.n_contacts, n_monitors(system), mode_length(system),
+                              slots.arrays["chebyshev"].shape[2])
 
 
 def run_state(system: System, n_times: int, supplied_degree: int = 0) -> State:
@@ -98,7 +104,7 @@ def run_state(system: System, n_times: int, supplied_degree: int = 0) -> State:
         engine.Impacts(np.zeros(n_contacts, dtype=np.bool_), np.zeros((6, n_contacts)),
                        np.zeros((max(64, 4 * n_contacts), len(engine.IMPACT_COLUMNS)))),
         engine.Outputs(np.zeros(len(ENERGY_TERMS)), np.zeros((n_times, size)), np.zeros((len(ENERGY_TERMS), n_times)),
-                       np.zeros(n_times, dtype=np.int64)),
+                       np.zeros(n_times, dtype=np.int64), np.array([[-np.inf], [np.nan]]).repeat(n_monitors(system), axis=1)),
         engine.Supplied(np.zeros(2), np.zeros(size), np.zeros((supplied_degree + 1) * size)),
     )
 
@@ -184,7 +190,7 @@ class Slots:
             self._energy.put(mode, energy)
         row = _mode_rows(self.system, mode, dynamics, energy)
         if propagator is not None:
-            row.update(_propagator_rows(propagator, row["guard"], row["rate"], energy[1]))
+            row.update(_propagator_rows(propagator, row["guard"], row["monitor"], row["rate"], energy[1]))
         row["ids"] = np.int64(self._ids.setdefault(mode, len(self._ids)))
         if row["ids"] == len(self.modes):
             self.modes.append(mode)
@@ -236,21 +242,23 @@ def _mode_rows(system: System, mode: Mode, dynamics: ModeDynamics, energy: tuple
     guard[:count] = _affine(d.guard_matrix, d.guard_ground, d.guard_constant)
     return {
         "modes": mode_vector(mode), "codes": codes, "n_guards": np.int64(count), "rate": _affine(d.A, d.B, d.c), "guard": guard,
-        "force": _affine(d.force_matrix, 0.0, d.force_constant), "power": energy[0],
+        "force": _affine(d.force_matrix, 0.0, d.force_constant), "monitor": _affine(d.monitor_matrix, d.monitor_ground, d.monitor_constant),
+        "power": energy[0],
     }
 
 
-def _propagator_rows(propagator: ModePropagator, guard: np.ndarray, rate: np.ndarray, forms: np.ndarray) -> dict[str, np.ndarray]:
+def _propagator_rows(propagator: ModePropagator, guard: np.ndarray, monitor: np.ndarray, rate: np.ndarray, forms: np.ndarray) -> dict[str, np.ndarray]:
     """One mode's entries of the ``Propagators`` arrays (and its sub-steps per interval).
 
-    ``guard`` and ``rate`` are the mode's padded affine maps, ``forms`` its
-    sub-step energy forms and impulses (:func:`_energy_rows`).
+    ``guard``, ``monitor`` and ``rate`` are the mode's affine maps (guards
+    padded), ``forms`` its sub-step energy forms and impulses (:func:`_energy_rows`).
     """
-    guard_rows = _guard_rows(guard, rate, width=len(propagator.transition))
+    width = len(propagator.transition)
+    read_outs = np.vstack([_read_out_rows(guard, rate, width), _read_out_rows(monitor, rate, width)])
     return {
         "substeps": np.int64(propagator.substeps),
         # the slot's columns beyond these stay zero: the padding to engine.propagate_columns
-        "propagate": np.concatenate([propagator.transition.T, forms, (guard_rows @ propagator.transition).T], axis=1),
+        "propagate": np.concatenate([propagator.transition.T, forms, (read_outs @ propagator.transition).T], axis=1),
         "step": np.float64(propagator.step),
         "chebyshev": propagator.chebyshev.reshape(-1, propagator.transition.shape[0]).T,
     }
@@ -268,16 +276,17 @@ def _energy_rows(system: System, dynamics: ModeDynamics, propagator: ModePropaga
     return power, np.concatenate([form.T for form in _sub_step_forms(factors, force, propagator)], axis=1)
 
 
-def _guard_rows(guard: np.ndarray, rate: np.ndarray, width: int) -> np.ndarray:
-    """Rows V and W acting on z = [x, w, 1] that give the guards' values and rates (2 n_guards × Z).
+def _read_out_rows(read_out: np.ndarray, rate: np.ndarray, width: int) -> np.ndarray:
+    """Rows V and W acting on z = [x, w, 1] that give an affine read-out's values and rates (2 n × Z).
 
-    For the affine maps ``guard`` (G x + h a_g + g0) and ``rate`` (ẋ = A x + B a_g + c):
-    values V z = G x + h a_g + g0, rates W z = G A x + (G B) a_g + h ȧ_g + G c.
+    For the affine maps ``read_out`` (G x + h a_g + g0: guards, monitors) and
+    ``rate`` (ẋ = A x + B a_g + c): values V z = G x + h a_g + g0, rates
+    W z = G A x + (G B) a_g + h ȧ_g + G c.
     """
-    size = guard.shape[1] - 2
-    rates = _in_z(guard[:, :size] @ rate, width)
-    rates[:, size + 1] = guard[:, size]
-    return np.vstack([_in_z(guard, width), rates])
+    size = read_out.shape[1] - 2
+    rates = _in_z(read_out[:, :size] @ rate, width)
+    rates[:, size + 1] = read_out[:, size]
+    return np.vstack([_in_z(read_out, width), rates])
 
 
 def _total_bytes(arrays: tuple[np.ndarray, ...]) -> int:
@@ -352,11 +361,12 @@ def _placeholder(system: System, chebyshev_width: int, exact: bool) -> dict[str,
     """
     size, n_contacts, n_guards = 2 * system.n_dof, system.n_contacts, max_guards(system)
     width = size + 5
-    propagate = (width, engine.propagate_columns(size, n_guards, n_contacts)) if exact else (1, 1)
+    propagate = (width, engine.propagate_columns(size, n_guards, n_contacts, n_monitors(system))) if exact else (1, 1)
     return {
         "modes": np.full(mode_length(system), -9, dtype=np.int64), "ids": np.int64(0), "codes": np.zeros((3, n_guards), np.int64),
         "n_guards": np.int64(0), "substeps": np.int64(1), "rate": np.zeros((size, size + 2)),
-        "guard": np.zeros((n_guards, size + 2)), "force": np.zeros((n_contacts, size + 2)), "power": np.zeros((width, 4 * width)),
+        "guard": np.zeros((n_guards, size + 2)), "force": np.zeros((n_contacts, size + 2)), "monitor": np.zeros((n_monitors(system), size + 2)),
+        "power": np.zeros((width, 4 * width)),
         "propagate": np.zeros(propagate), "chebyshev": np.zeros((width, chebyshev_width) if exact else (1, 1)),
         "step": np.float64(1.0),
     }
