@@ -1,4 +1,4 @@
-"""An emulation of the reference study's own solution scheme (REFERENCE_STUDY.md, its Appendix 4).
+"""An emulation of the reference study's own solution scheme (Agarwal 2004, its Appendix 4).
 
 The study did not locate events. It restarted MATLAB's ``ode45`` every h
 seconds (h = 0.02 s), and only at those restarts decided
@@ -24,7 +24,7 @@ freedom plus the friction term above, a stuck base keeps s and ṡ. Whether
 the impact forces act on the base as a whole follows the scene:
 ``study_compat = true`` gives the study's equations (they do not), otherwise
 the momentum-consistent ones; the sliding test includes them in the second
-case, as the required friction force F_req of MODEL.md does.
+case, as the required friction force F_req of docs/model.md does.
 
 This module lives in ``benchmarks/``, not in the library: it exists to show
 what the study's scheme does, not to be used.

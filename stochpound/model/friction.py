@@ -9,7 +9,7 @@ The law (docs/model.md, "Sliding bases"). W = g × (base + floor masses).
 A base is in one of four states:
 
 * ``STUCK``: its sliding displacement s is held; the foundation supplies the
-  force F_req the stuck equations need, while |F_req| ≤ μ_s W;
+  force F_req the stuck equations need, while abs(F_req) ≤ μ_s W;
 * ``SLIP_RIGHT`` (+1) / ``SLIP_LEFT`` (−1): the foundation's force on the
   base is −σ μ W for sliding direction σ;
 * ``FREE``: a frictionless base (μ = μ_s = 0) is a free degree of freedom

@@ -18,11 +18,14 @@ momentum-consistent model and h_p is g_p without its base entries in
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import hashlib
+from dataclasses import dataclass, fields
+from functools import cached_property, lru_cache
 
 import numpy as np
 
-from stochpound.model.building import storey_matrix
+from stochpound.model.building import Building, storey_matrix
+from stochpound.model.contact import Contact
 from stochpound.model.friction import SlidingBase
 from stochpound.model.scene import Scene
 
@@ -86,6 +89,21 @@ class System:
         """The DOF of every sliding base (int64, in base order)."""
         return np.array([base.dof for base in self.bases], dtype=np.int64)
 
+    @cached_property
+    def fingerprint(self) -> bytes:
+        """Digest of every matrix and layout entry (equal systems share propagators)."""
+        digest = hashlib.blake2b(digest_size=20)
+        for item in fields(self):
+            value = getattr(self, item.name)
+            if isinstance(value, tuple):  # the sliding bases: frozen dataclasses of numbers
+                digest.update(repr(value).encode())
+                continue
+            for array in value if isinstance(value, list) else [value]:
+                array = np.ascontiguousarray(array)
+                digest.update(f"{item.name}{array.dtype}{array.shape}".encode())
+                digest.update(array.tobytes())
+        return digest.digest()
+
     @property
     def contact_floor_velocity(self) -> np.ndarray:
         """Rows (2·n_contacts × 2N) giving ẏ of the left, then the right floor of each contact."""
@@ -94,17 +112,26 @@ class System:
 
 
 def build_system(scene: Scene) -> System:
-    """Assemble the DOF layout and the global matrices of ``scene``."""
-    floor_dofs, base_dofs, n_dof = _layout(scene)
+    """Assemble the DOF layout and the global matrices of ``scene`` (cached: runs of one structure share its system).
+
+    The system depends on the buildings, contacts, g and ``study_compat``
+    only, not on the motion; its arrays are shared and must not be changed.
+    """
+    return _build_system(scene.buildings, scene.contacts, scene.g, scene.study_compat)
+
+
+@lru_cache(maxsize=16)
+def _build_system(buildings: tuple[Building, ...], contacts: tuple[Contact, ...], g: float, study_compat: bool) -> System:
+    floor_dofs, base_dofs, n_dof = _layout(buildings)
     mass = np.zeros((n_dof, n_dof))
     stiffness = np.zeros((n_dof, n_dof))
     damping = np.zeros((n_dof, n_dof))
     influence = np.zeros(n_dof)
-    total = np.zeros((sum(b.n_floors for b in scene.buildings), n_dof))
+    total = np.zeros((sum(b.n_floors for b in buildings), n_dof))
     initial = np.zeros(2 * n_dof)
     bases = []
     row = 0
-    for b, building in enumerate(scene.buildings):
+    for b, building in enumerate(buildings):
         floors, base = floor_dofs[b], base_dofs[b]
         m = np.asarray(building.mass, float)
         block = np.ix_(floors, floors)
@@ -125,9 +152,9 @@ def build_system(scene: Scene) -> System:
             total[row : row + building.n_floors, base] = 1.0
             initial[base] = building.initial.base_displacement
             initial[n_dof + base] = building.initial.base_velocity
-            bases.append(SlidingBase(b, base, scene.g * building.total_mass, building.base.mu, building.base.mu_static))
+            bases.append(SlidingBase(b, base, g * building.total_mass, building.base.mu, building.base.mu_static))
         row += building.n_floors
-    geometry, load = _contact_vectors(scene, floor_dofs, base_dofs, n_dof)
+    geometry, load = _contact_vectors(contacts, study_compat, floor_dofs, base_dofs, n_dof)
     return System(
         n_dof=n_dof,
         floor_dofs=floor_dofs,
@@ -136,22 +163,22 @@ def build_system(scene: Scene) -> System:
         stiffness=stiffness,
         damping=damping,
         influence=influence,
-        contact_gap=np.array([c.gap for c in scene.contacts], float),
-        contact_stiffness=np.array([c.stiffness for c in scene.contacts], float),
-        contact_damping=np.array([c.damping for c in scene.contacts], float),
+        contact_gap=np.array([c.gap for c in contacts], float),
+        contact_stiffness=np.array([c.stiffness for c in contacts], float),
+        contact_damping=np.array([c.damping for c in contacts], float),
         contact_geometry=geometry,
         contact_load=load,
-        contact_tensile=np.array([c.tensile for c in scene.contacts], bool),
+        contact_tensile=np.array([c.tensile for c in contacts], bool),
         total_displacement=total,
         initial_state=initial,
-        contact_rows=_contact_rows(scene),
+        contact_rows=_contact_rows(buildings, contacts),
     )
 
 
-def _layout(scene: Scene) -> tuple[list[np.ndarray], list[int | None], int]:
+def _layout(buildings: tuple[Building, ...]) -> tuple[list[np.ndarray], list[int | None], int]:
     """Each building's floor DOFs and base DOF (None for a fixed base), and the number of DOFs."""
     floor_dofs, base_dofs, n_dof = [], [], 0
-    for building in scene.buildings:
+    for building in buildings:
         floor_dofs.append(np.arange(n_dof, n_dof + building.n_floors))
         n_dof += building.n_floors
         base_dofs.append(n_dof if building.base is not None else None)
@@ -159,21 +186,24 @@ def _layout(scene: Scene) -> tuple[list[np.ndarray], list[int | None], int]:
     return floor_dofs, base_dofs, n_dof
 
 
-def _contact_vectors(scene: Scene, floor_dofs: list[np.ndarray], base_dofs: list[int | None], n_dof: int) -> tuple[np.ndarray, np.ndarray]:
-    geometry = np.zeros((len(scene.contacts), n_dof))
-    load = np.zeros((len(scene.contacts), n_dof))
-    for p, contact in enumerate(scene.contacts):
+def _contact_vectors(contacts: tuple[Contact, ...], study_compat: bool, floor_dofs: list[np.ndarray], base_dofs: list[int | None],
+                     n_dof: int) -> tuple[np.ndarray, np.ndarray]:
+    """Each contact's geometry row g and load row h (h without base entries when ``study_compat``)."""
+    geometry = np.zeros((len(contacts), n_dof))
+    load = np.zeros((len(contacts), n_dof))
+    for p, contact in enumerate(contacts):
         for building, floor, sign in ((contact.left, contact.left_floor, 1.0), (contact.right, contact.right_floor, -1.0)):
             geometry[p, floor_dofs[building][floor - 1]] += sign
             load[p, floor_dofs[building][floor - 1]] += sign
             if base_dofs[building] is not None:
                 geometry[p, base_dofs[building]] += sign
-                if not scene.study_compat:
+                if not study_compat:
                     load[p, base_dofs[building]] += sign
     return geometry, load
 
 
-def _contact_rows(scene: Scene) -> np.ndarray:
-    first_row = np.cumsum([0] + [b.n_floors for b in scene.buildings])
-    rows = [(first_row[c.left] + c.left_floor - 1, first_row[c.right] + c.right_floor - 1) for c in scene.contacts]
+def _contact_rows(buildings: tuple[Building, ...], contacts: tuple[Contact, ...]) -> np.ndarray:
+    """Rows of the total-displacement map of each contact's left and right floors."""
+    first_row = np.cumsum([0] + [b.n_floors for b in buildings])
+    rows = [(first_row[c.left] + c.left_floor - 1, first_row[c.right] + c.right_floor - 1) for c in contacts]
     return np.array(rows, dtype=int).reshape(-1, 2)

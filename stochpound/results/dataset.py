@@ -1,11 +1,7 @@
-"""The result of one simulation as an :class:`xarray.Dataset` (names of CONTRACT.md).
+"""The result of one simulation as an :class:`xarray.Dataset` (the names of docs/scene-files.md).
 
 Outputs are given at the motion's sample times, t = 0 included. Every
 variable carries ``units`` and ``long_name`` (CF conventions).
-
-Every array is built with numpy first and the dataset is assembled directly
-from its variables (:func:`_assemble`): xarray's usual construction converts,
-aligns and merges every variable, which would cost more than a whole exact run.
 """
 
 from __future__ import annotations
@@ -16,9 +12,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import pandas as pd
 import xarray as xr
-from xarray.indexes import PandasIndex
 
 from stochpound import __version__
 from stochpound.results.record import ENERGY_TERMS, EventCounters, Recorder
@@ -33,8 +27,9 @@ _ENERGY_NAMES = {
 }
 
 
-def _var(dims: tuple[str, ...], data: np.ndarray, units: str, long_name: str, **attrs: Any) -> xr.Variable:
-    return xr.Variable(dims, data, {"units": units, "long_name": long_name, **attrs}, fastpath=True)
+def _var(dims: tuple[str, ...], data: np.ndarray, units: str, long_name: str, **attrs: Any) -> tuple:
+    """A variable (dims, data, attrs) with its CF ``units`` and ``long_name``."""
+    return dims, data, {"units": units, "long_name": long_name, **attrs}
 
 
 def build_dataset(scene: Scene, system: System, recorder: Recorder, counters: EventCounters, solver_attrs: dict[str, Any]) -> xr.Dataset:
@@ -50,7 +45,7 @@ def build_dataset(scene: Scene, system: System, recorder: Recorder, counters: Ev
     """
     coords = {
         "time": _var(("time",), scene.motion.times, "s", "time"),
-        "building": _var(("building",), np.array(scene.building_names, dtype=object), "1", "building name, left to right"),
+        "building": _var(("building",), np.array(scene.building_names, dtype=str), "1", "building name, left to right"),
         "floor": _var(("floor",), np.arange(1, scene.max_floors + 1), "1", "floor number, 1 = lowest"),
         "contact": _var(("contact",), np.arange(len(scene.contacts)), "1", "contact index"),
     }
@@ -72,27 +67,10 @@ def build_dataset(scene: Scene, system: System, recorder: Recorder, counters: Ev
         **solver_attrs,
         **counters.as_attrs(),
     }
-    return _assemble(coords, data_vars, attrs)
+    return xr.Dataset(data_vars, coords=coords, attrs=attrs)
 
 
-def _assemble(coords: dict[str, xr.Variable], data_vars: dict[str, xr.Variable], attrs: dict[str, Any]) -> xr.Dataset:
-    """The dataset of dimension coordinates ``coords`` (with default indexes) and ``data_vars``, consistent by construction.
-
-    The same dataset as ``xr.Dataset(data_vars, coords=coords, attrs=attrs)``
-    (checked by the tests), without the conversion, alignment and merge of
-    every variable (the indexes are built from :class:`pandas.Index` objects,
-    which also spares xarray's check for dask arrays, and its import of dask).
-    """
-    indexes = {name: PandasIndex(pd.Index(variable.values, dtype=variable.dtype), name, coord_dtype=variable.dtype) for name, variable in coords.items()}
-    variables = {name: indexes[name].create_variables({name: variable})[name] for name, variable in coords.items()}
-    variables.update(data_vars)
-    dims: dict[str, int] = {}
-    for variable in variables.values():
-        dims.update(zip(variable.dims, variable.shape))
-    return xr.Dataset._construct_direct(variables, set(coords), dims, attrs, indexes)
-
-
-def _response_variables(scene: Scene, system: System, recorder: Recorder) -> dict[str, xr.Variable]:
+def _response_variables(scene: Scene, system: System, recorder: Recorder) -> dict[str, tuple]:
     """Displacements, ground acceleration, contact and friction forces and base states at the samples."""
     relative, sliding = recorder.displacements()
     return {
@@ -112,7 +90,7 @@ def _response_variables(scene: Scene, system: System, recorder: Recorder) -> dic
     }
 
 
-def _closure_variables(recorder: Recorder) -> dict[str, xr.Variable]:
+def _closure_variables(recorder: Recorder) -> dict[str, tuple]:
     """Each contact's closure over time and its peak over the run, located on the solution."""
     return {
         "contact_closure": _var(("contact", "time"), recorder.contact_closure(), "m",
@@ -122,13 +100,13 @@ def _closure_variables(recorder: Recorder) -> dict[str, xr.Variable]:
     }
 
 
-def _contact_variables(scene: Scene) -> dict[str, xr.Variable]:
+def _contact_variables(scene: Scene) -> dict[str, tuple]:
     names = scene.building_names
     contacts = scene.contacts
     return {
-        "contact_left": _var(("contact",), np.array([names[c.left] for c in contacts], dtype=object), "1", "left building of the contact"),
+        "contact_left": _var(("contact",), np.array([names[c.left] for c in contacts], dtype=str), "1", "left building of the contact"),
         "contact_left_floor": _var(("contact",), np.array([c.left_floor for c in contacts], dtype=int), "1", "floor of the left building"),
-        "contact_right": _var(("contact",), np.array([names[c.right] for c in contacts], dtype=object), "1", "right building of the contact"),
+        "contact_right": _var(("contact",), np.array([names[c.right] for c in contacts], dtype=str), "1", "right building of the contact"),
         "contact_right_floor": _var(("contact",), np.array([c.right_floor for c in contacts], dtype=int), "1", "floor of the right building"),
         "contact_gap": _var(("contact",), np.array([c.gap for c in contacts], float), "m", "at-rest gap"),
         "contact_stiffness": _var(("contact",), np.array([c.stiffness for c in contacts], float), "N m-1", "impact spring stiffness"),
@@ -136,7 +114,7 @@ def _contact_variables(scene: Scene) -> dict[str, xr.Variable]:
     }
 
 
-def _impact_variables(recorder: Recorder) -> dict[str, xr.Variable]:
+def _impact_variables(recorder: Recorder) -> dict[str, tuple]:
     impacts = recorder.impacts
 
     def column(name, dtype=float):
@@ -158,7 +136,7 @@ def _impact_variables(recorder: Recorder) -> dict[str, xr.Variable]:
     }
 
 
-def _energy_variables(recorder: Recorder) -> dict[str, xr.Variable]:
+def _energy_variables(recorder: Recorder) -> dict[str, tuple]:
     kinetic, strain = recorder.kinetic_and_strain()
     energy = recorder.energy
     variables = {f"energy_{term}": _var(("time",), energy[term], "J", _ENERGY_NAMES[term]) for term in ENERGY_TERMS}

@@ -882,7 +882,7 @@ def _apply(geometry, gap, base_dofs, mode, x, kind, target, direction):
 
 @njit(**INTERNAL)
 def _with_bound(M, i, x, magnitude, ground, constant):
-    """Row i of the affine map M at (x, a_g), with its constant or not, its round-off scale and Σ|M[i, :S + 1]|.
+    """Row i of the affine map M at (x, a_g), with its constant or not, its round-off scale and Σabs(M[i, :S + 1]).
 
     The scale is the same sum with every term taken absolute and x replaced
     by ``magnitude`` (``events._guard_scales``).
@@ -1318,12 +1318,17 @@ A ``NUMBA_OPT`` set in the environment is left in force.
 """
 
 
+_COMPILED: list[bool] = []
+
+
 def run(*arguments: object) -> int:
     """Call :func:`run_engine`: a process's first call compiles it (or loads it from numba's cache) at :data:`OPTIMISATION_LEVEL`."""
-    if numba.config.DISABLE_JIT or run_engine.signatures or "NUMBA_OPT" in os.environ:
+    if _COMPILED or numba.config.DISABLE_JIT or "NUMBA_OPT" in os.environ:
         return run_engine(*arguments)
     with _optimisation_level(OPTIMISATION_LEVEL):
-        return run_engine(*arguments)
+        status = run_engine(*arguments)
+    _COMPILED.append(True)
+    return status
 
 
 @contextlib.contextmanager
