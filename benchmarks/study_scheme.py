@@ -124,7 +124,7 @@ class StudyScheme:
         states = np.empty((len(self.motion.times), 2 * system.n_dof))
         states[0] = x
         check = np.zeros(n_bases)  # the study starts from zero accelerations
-        closed_before = np.zeros(system.n_contacts, dtype=bool)
+        closed_before = np.zeros(system.n_elements, dtype=bool)
         impacts, peak, sliding_steps = 0, 0.0, np.zeros(n_bases, dtype=int)
         for k in range(len(self.motion.times) - 1):
             edges = np.linspace(self.motion.times[k], self.motion.times[k + 1], self.steps_per_sample + 1)
@@ -149,7 +149,7 @@ class StudyScheme:
 
     def _penetration(self, x: np.ndarray) -> np.ndarray:
         """δ of every contact at state x, m."""
-        return self.system.contact_geometry @ x[: self.system.n_dof] - self.system.contact_gap
+        return self.system.element_geometry @ x[: self.system.n_dof] - self.system.element_gap
 
     def _friction(self, mode: Mode) -> np.ndarray:
         """Columns: the state rate of each sliding base's friction force −μ W (times sgn ṡ)."""
@@ -208,7 +208,7 @@ class StudyScheme:
             check[b] = (
                 floor_mass @ (acceleration[floors] + acceleration[base])
                 + system.influence[base] * ground
-                + forces @ system.contact_load[:, base]
+                + forces @ system.element_load[:, base]
                 + system.stiffness[base, base] * x[base]
             )
         return check

@@ -258,7 +258,7 @@ def test_a_sub_step_product_gives_the_next_state_and_its_guards():
     stochpound.simulate(scene)
     library = propagator_library(build_system(scene), scene.motion)
     slots = tables.slots_of(library)
-    size, n_contacts = 2 * library.system.n_dof, library.system.n_contacts
+    size, n_contacts = 2 * library.system.n_dof, library.system.n_elements
     padded = slots.arrays["guard"].shape[1]
     rng = np.random.default_rng(5)
     for mode in library:

@@ -48,12 +48,15 @@ def build_dataset(scene: Scene, system: System, recorder: Recorder, counters: Ev
         "building": _var(("building",), np.array(scene.building_names, dtype=str), "1", "building name, left to right"),
         "floor": _var(("floor",), np.arange(1, scene.max_floors + 1), "1", "floor number, 1 = lowest"),
         "contact": _var(("contact",), np.arange(len(scene.contacts)), "1", "contact index"),
+        **({"wall": _var(("wall",), np.arange(len(scene.walls)), "1", "wall index")} if scene.walls else {}),
     }
     data_vars = {
         **_response_variables(scene, system, recorder),
         **_contact_variables(scene),
-        **_closure_variables(recorder),
-        **_impact_variables(recorder),
+        **(_wall_variables(scene, recorder) if scene.walls else {}),
+        **_closure_variables(recorder, system.n_contacts, "contact"),
+        **(_closure_variables(recorder, system.n_contacts, "wall") if scene.walls else {}),
+        **_impact_variables(recorder, system.n_contacts, bool(scene.walls)),
         **_energy_variables(recorder),
     }
     attrs = {
@@ -79,7 +82,7 @@ def _response_variables(scene: Scene, system: System, recorder: Recorder) -> dic
         "relative_displacement": _var(("building", "floor", "time"), relative, "m", "floor displacement relative to the building's base (u)"),
         "sliding_displacement": _var(("building", "time"), sliding, "m", "sliding displacement of the base relative to the ground (s)"),
         "ground_acceleration": _var(("time",), np.asarray(scene.motion.at_times(), float), "m s-2", "ground acceleration a_g"),
-        "impact_force": _var(("contact", "time"), recorder.forces.T, "N", "contact force, positive in compression (0 while open)"),
+        "impact_force": _var(("contact", "time"), recorder.forces[:, : system.n_contacts].T, "N", "contact force, positive in compression (0 while open)"),
         "base_friction_force": _var(
             ("building", "time"), recorder.by_building(recorder.friction), "N", "force of the foundation on the base, positive to the right (0 for a fixed base)"
         ),
@@ -90,13 +93,28 @@ def _response_variables(scene: Scene, system: System, recorder: Recorder) -> dic
     }
 
 
-def _closure_variables(recorder: Recorder) -> dict[str, tuple]:
-    """Each contact's closure over time and its peak over the run, located on the solution."""
+def _closure_variables(recorder: Recorder, n_contacts: int, kind: str) -> dict[str, tuple]:
+    """The closure over time of each contact (``kind`` "contact", the first ``n_contacts`` elements) or wall, and its peak over the run, located on the solution."""
+    rows = slice(0, n_contacts) if kind == "contact" else slice(n_contacts, None)
+    toward = "y_left - y_right of the contact's floors" if kind == "contact" else "the level's displacement toward the wall"
     return {
-        "contact_closure": _var(("contact", "time"), recorder.contact_closure(), "m",
-                                "closure y_left - y_right of the contact's floors (the gap is closed where it reaches the gap)"),
-        "peak_contact_closure": _var(("contact",), recorder.peaks[0], "m", "largest closure over the run: the separation this run needed"),
-        "peak_contact_closure_time": _var(("contact",), recorder.peaks[1], "s", "time of the largest closure"),
+        f"{kind}_closure": _var((kind, "time"), recorder.closure()[rows], "m", f"closure {toward} (the gap is closed where it reaches the gap)"),
+        f"peak_{kind}_closure": _var((kind,), recorder.peaks[0, rows], "m", "largest closure over the run: the separation this run needed"),
+        f"peak_{kind}_closure_time": _var((kind,), recorder.peaks[1, rows], "s", "time of the largest closure"),
+    }
+
+
+def _wall_variables(scene: Scene, recorder: Recorder) -> dict[str, tuple]:
+    """What each wall is, and its force over time."""
+    names, walls, n_contacts = scene.building_names, scene.walls, len(scene.contacts)
+    return {
+        "wall_building": _var(("wall",), np.array([names[w.building] for w in walls], dtype=str), "1", "building beside the wall"),
+        "wall_side": _var(("wall",), np.array([w.side_name for w in walls], dtype=str), "1", "side of the building the wall is on"),
+        "wall_level": _var(("wall",), np.array([w.level for w in walls], dtype=int), "1", "level the wall faces: 0 the base, else the floor"),
+        "wall_gap": _var(("wall",), np.array([w.gap for w in walls], float), "m", "at-rest gap"),
+        "wall_stiffness": _var(("wall",), np.array([w.stiffness for w in walls], float), "N m-1", "impact spring stiffness"),
+        "wall_damping": _var(("wall",), np.array([w.damping for w in walls], float), "N s m-1", "impact dashpot"),
+        "wall_force": _var(("wall", "time"), recorder.forces[:, n_contacts:].T, "N", "force of the wall's impact element, positive in compression (0 while open)"),
     }
 
 
@@ -114,16 +132,19 @@ def _contact_variables(scene: Scene) -> dict[str, tuple]:
     }
 
 
-def _impact_variables(recorder: Recorder) -> dict[str, tuple]:
+def _impact_variables(recorder: Recorder, n_contacts: int, walls: bool) -> dict[str, tuple]:
+    """One row per impact; with ``walls``, ``impact_wall`` names the wall of a wall impact (``impact_contact`` is then −1)."""
     impacts = recorder.impacts
 
     def column(name, dtype=float):
         return np.array([getattr(impact, name) for impact in impacts], dtype=dtype)
 
-    start, end = column("start"), column("end")
+    start, end, element = column("start"), column("end"), column("contact", int)
     dims = ("impact",)
+    wall = {"impact_wall": _var(dims, np.where(element >= n_contacts, element - n_contacts, -1), "1", "wall index of the impact (-1: a contact)")}
     return {
-        "impact_contact": _var(dims, column("contact", int), "1", "contact index of the impact"),
+        "impact_contact": _var(dims, np.where(element < n_contacts, element, -1), "1", "contact index of the impact (-1: a wall)"),
+        **(wall if walls else {}),
         "impact_start": _var(dims, start, "s", "time the impact began"),
         "impact_end": _var(dims, end, "s", "time the impact ended (end of the motion if still closed)"),
         "impact_duration": _var(dims, end - start, "s", "impact duration"),
@@ -131,7 +152,7 @@ def _impact_variables(recorder: Recorder) -> dict[str, tuple]:
         "impact_peak_time": _var(dims, column("peak_time"), "s", "time of the largest contact force"),
         "impact_impulse": _var(dims, column("impulse"), "N s", "time integral of the contact force"),
         "impact_onset_velocity": _var(dims, column("onset_velocity"), "m s-1", "approach velocity (rate of penetration) at onset"),
-        "impact_in_phase": _var(dims, column("in_phase", bool), "1", "both floors moving the same way at onset"),
+        "impact_in_phase": _var(dims, column("in_phase", bool), "1", "both floors moving the same way at onset (false at a wall, which moves with the ground)"),
         "impact_complete": _var(dims, column("complete", bool), "1", "the impact ended before the end of the motion"),
     }
 

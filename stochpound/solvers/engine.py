@@ -123,7 +123,7 @@ transposed (Z × D·2N).
 Motion = namedtuple("Motion", "times forcing coefficients harmonic")
 Motion.__doc__ = """Output times, exosystem state per interval, cubic per interval (sampled) or [A, ω, φ] (harmonic)."""
 Layout = namedtuple("Layout", "geometry gap tensile left_rows right_rows base_dofs")
-Layout.__doc__ = """Contacts (penetration rows, gaps, tensile flags, rows of the left and right floors) and the base DOFs."""
+Layout.__doc__ = """Impact elements (penetration rows, gaps, tensile flags, displacement rows of their left and right sides) and the base DOFs."""
 Run = namedtuple("Run", "clock ints x pending_x pending_mode missing_mode visited")
 Run.__doc__ = """Time, counters (``ints``; ``ints[MODE]`` is a slot), state, the pending event and the ids of the modes visited."""
 Arming = namedtuple("Arming", "threshold tolerance rearmable disarmed")
