@@ -4,7 +4,8 @@ Scene keys (``[[building]]``): ``name``, ``mass`` (kg per floor, floor 1
 upwards), ``stiffness`` (N/m per storey), ``damping`` (N·s/m per storey) or
 ``damping_ratio`` (stiffness-proportional damping C = a₁K with that ratio
 in mode 1), ``base`` (a sliding base, :mod:`stochpound.model.friction`;
-none: a fixed base) and ``initial`` (initial conditions). Storey i joins
+none: a fixed base), ``initial`` (initial conditions) and ``storey_height``
+(m per storey, optional: storey drift ratios). Storey i joins
 floor i − 1 (floor 0 is the base) to floor i.
 """
 
@@ -21,7 +22,7 @@ from stochpound.errors import SceneError
 from stochpound.model import fields
 from stochpound.model.friction import Base, base_from_table
 
-BUILDING_KEYS = {"name", "mass", "stiffness", "damping", "damping_ratio", "base", "initial"}
+BUILDING_KEYS = {"name", "mass", "stiffness", "damping", "damping_ratio", "base", "initial", "storey_height"}
 INITIAL_KEYS = {"displacement", "velocity", "base_displacement", "base_velocity"}
 
 
@@ -65,6 +66,8 @@ class Building:
         The sliding base; ``None`` for a fixed base (the one encoding of a fixed base).
     initial : InitialState
         Initial conditions.
+    storey_height : tuple of float or None
+        Storey heights h_i, m (for storey drift ratios), when given.
     """
 
     name: str
@@ -74,6 +77,7 @@ class Building:
     damping_ratio: float | None = None
     base: Base | None = None
     initial: InitialState | None = None
+    storey_height: tuple[float, ...] | None = None
 
     @property
     def n_floors(self) -> int:
@@ -145,7 +149,8 @@ def building_from_table(table: Mapping[str, Any], prefix: str, index: int) -> Bu
     stiffness = fields.number_list(table, "stiffness", prefix, low=0.0, low_open=False, length=len(mass))
     damping, ratio = _storey_damping(table, prefix, np.array(mass), np.array(stiffness))
     initial = _initial(fields.table(table, "initial", prefix), f"{prefix}.initial", len(mass), base is not None)
-    return Building(name, mass, stiffness, damping, ratio, base, initial)
+    height = fields.number_list(table, "storey_height", prefix, low=0.0, low_open=True, length=len(mass)) if "storey_height" in table else None
+    return Building(name, mass, stiffness, damping, ratio, base, initial, height)
 
 
 def _storey_damping(table: Mapping[str, Any], prefix: str, mass: np.ndarray, stiffness: np.ndarray) -> tuple[tuple[float, ...], float | None]:

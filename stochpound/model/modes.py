@@ -29,6 +29,7 @@ from typing import Generic, TypeVar
 import numpy as np
 
 from stochpound.model import contact, friction
+from stochpound.model.demands import DEMANDS, demand_rows
 from stochpound.model.friction import STUCK
 from stochpound.model.system import System
 
@@ -219,18 +220,31 @@ def _build(system: System, mode: Mode, masses: tuple[np.ndarray, np.ndarray, np.
                    for guard in friction.guards(base, i, state, foundation[i], n)]
     force_matrix, force_constant = contact.force_rows(rows, k, d, closed)
     return ModeDynamics(mode, A, B, c, *_stack_guards(contact_guards, base_guards, 2 * n), force_matrix, force_constant,
-                        *_stack_foundation(foundation, 2 * n), *monitor_rows(rows), stuck)
+                        *_stack_foundation(foundation, 2 * n), *monitor_rows(system, rows, (A, B, c)), stuck)
 
 
-def monitor_rows(rows: contact.ContactRows) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The monitors of a mode as an affine map (matrix over x, a_g coefficients, constants): each contact's closure.
+def monitor_count(system: System) -> int:
+    """Number of monitors of every mode of ``system`` (:func:`monitor_rows`)."""
+    return system.n_elements + (2 * len(DEMANDS) * len(system.total_displacement) if system.demands else 0)
 
-    The closure of contact p is y_left − y_right = g_p · q (m, the penetration
-    plus the gap): its largest value over a run, located on the solution, is
-    the separation the run needed (``peak_contact_closure``).
+
+def monitor_rows(system: System, rows: contact.ContactRows, rate: tuple[np.ndarray, np.ndarray, np.ndarray]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The monitors of a mode as an affine map (matrix over x, a_g coefficients, constants).
+
+    First each impact element's closure y_left − y_right = g_p · q (m, the
+    penetration plus the gap): its largest value over a run, located on the
+    solution, is the separation the run needed (``peak_contact_closure``).
+    Then, when the system monitors demands, + and − every demand parameter of
+    :func:`stochpound.model.demands.demand_rows` (whose peaks give the peak
+    absolute values). ``rate`` is the mode's (A, B, c).
     """
-    n_monitors = len(rows.penetration)
-    return rows.penetration, np.zeros(n_monitors), np.zeros(n_monitors)
+    n_closures = len(rows.penetration)
+    matrix, ground, constant = rows.penetration, np.zeros(n_closures), np.zeros(n_closures)
+    if not system.demands:
+        return matrix, ground, constant
+    demand = demand_rows(system.floor_dofs, system.building_base_dofs, system.storey_stiffness, system.storey_damping, rate)
+    return (np.vstack([matrix, demand[0], -demand[0]]), np.concatenate([ground, demand[1], -demand[1]]),
+            np.concatenate([constant, demand[2], -demand[2]]))
 
 
 def _stack_guards(contact_guards: tuple[np.ndarray, ...], base_guards: list[tuple], size: int) -> tuple[np.ndarray, ...]:

@@ -68,6 +68,10 @@ class System:
         Y (n_floors_total × N): total displacements y = s + u of every floor, in DOF order.
     initial_state : np.ndarray
         x(0) = [q(0), v(0)] from the buildings' initial conditions.
+    storey_stiffness, storey_damping : list of np.ndarray
+        Each building's storey k_i (N/m) and c_i (N·s/m).
+    demands : bool
+        Whether runs monitor the demand parameters (:mod:`stochpound.model.demands`).
     """
 
     n_dof: int
@@ -88,11 +92,22 @@ class System:
     element_right: np.ndarray
     total_displacement: np.ndarray
     initial_state: np.ndarray
+    storey_stiffness: list[np.ndarray]
+    storey_damping: list[np.ndarray]
+    demands: bool
 
     @property
     def n_elements(self) -> int:
         """Number of impact elements (contacts, then walls)."""
         return len(self.element_gap)
+
+    @property
+    def building_base_dofs(self) -> list[int | None]:
+        """For each building, the DOF of its sliding base, or None for a fixed base."""
+        dofs: list[int | None] = [None] * len(self.floor_dofs)
+        for base in self.bases:
+            dofs[base.building] = base.dof
+        return dofs
 
     @property
     def base_dofs(self) -> np.ndarray:
@@ -105,7 +120,7 @@ class System:
         digest = hashlib.blake2b(digest_size=20)
         for item in fields(self):
             value = getattr(self, item.name)
-            if isinstance(value, (tuple, int)):  # the sliding bases (frozen dataclasses of numbers), the number of contacts
+            if isinstance(value, (tuple, int, bool)):  # the sliding bases (frozen dataclasses of numbers), the number of contacts, a flag
                 digest.update(f"{item.name}{value!r}".encode())
                 continue
             for array in value if isinstance(value, list) else [value]:
@@ -115,17 +130,20 @@ class System:
         return digest.digest()
 
 
-def build_system(scene: Scene) -> System:
+def build_system(scene: Scene, demands: bool = False) -> System:
     """Assemble the DOF layout and the global matrices of ``scene`` (cached: runs of one structure share its system).
 
-    The system depends on the buildings, contacts, g and ``study_compat``
-    only, not on the motion; its arrays are shared and must not be changed.
+    The system depends on the buildings, contacts, walls, g and
+    ``study_compat`` only, not on the motion; its arrays are shared and must
+    not be changed. With ``demands`` its runs also monitor the demand
+    parameters (floor accelerations, storey drifts and shears).
     """
-    return _build_system(scene.buildings, scene.contacts, scene.walls, scene.g, scene.study_compat)
+    return _build_system(scene.buildings, scene.contacts, scene.walls, scene.g, scene.study_compat, demands)
 
 
 @lru_cache(maxsize=16)
-def _build_system(buildings: tuple[Building, ...], contacts: tuple[Contact, ...], walls: tuple[Wall, ...], g: float, study_compat: bool) -> System:
+def _build_system(buildings: tuple[Building, ...], contacts: tuple[Contact, ...], walls: tuple[Wall, ...], g: float, study_compat: bool,
+                  demands: bool) -> System:
     floor_dofs, base_dofs, n_dof = _layout(buildings)
     mass = np.zeros((n_dof, n_dof))
     stiffness = np.zeros((n_dof, n_dof))
@@ -180,6 +198,9 @@ def _build_system(buildings: tuple[Building, ...], contacts: tuple[Contact, ...]
         element_right=right,
         total_displacement=total,
         initial_state=initial,
+        storey_stiffness=[np.asarray(b.stiffness, float) for b in buildings],
+        storey_damping=[np.asarray(b.damping, float) for b in buildings],
+        demands=demands,
     )
 
 

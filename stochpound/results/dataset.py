@@ -57,6 +57,7 @@ def build_dataset(scene: Scene, system: System, recorder: Recorder, counters: Ev
         **_closure_variables(recorder, system.n_contacts, "contact"),
         **(_closure_variables(recorder, system.n_contacts, "wall") if scene.walls else {}),
         **_impact_variables(recorder, system.n_contacts, bool(scene.walls)),
+        **(_demand_variables(scene, recorder) if recorder.demands else {}),
         **_energy_variables(recorder),
     }
     attrs = {
@@ -102,6 +103,39 @@ def _closure_variables(recorder: Recorder, n_contacts: int, kind: str) -> dict[s
         f"peak_{kind}_closure": _var((kind,), recorder.peaks[0, rows], "m", "largest closure over the run: the separation this run needed"),
         f"peak_{kind}_closure_time": _var((kind,), recorder.peaks[1, rows], "s", "time of the largest closure"),
     }
+
+
+_DEMAND_NAMES = {
+    "total_acceleration": ("m s-2", "total floor acceleration (relative acceleration of the floor and its base, plus the ground's)"),
+    "storey_drift": ("m", "storey drift u_i - u_(i-1) (u_0 = 0, the base)"),
+    "storey_shear": ("N", "storey shear k_i d_i + c_i d'_i of the storey below the floor"),
+}
+
+
+def _demand_variables(scene: Scene, recorder: Recorder) -> dict[str, tuple]:
+    """The demand parameters at the samples and their peaks (absolute values) over the run, located on the solution."""
+    variables = {}
+    peaks = recorder.demand_peaks()
+    for name, (units, long_name) in _DEMAND_NAMES.items():
+        variables[name] = _var(("building", "floor", "time"), recorder.by_floor(recorder.demands[name]), units, long_name)
+        peak, when = peaks[name]
+        variables[f"peak_{name}"] = _var(("building", "floor"), recorder.by_floor(peak), units, f"largest absolute {name.replace('_', ' ')} over the run")
+        variables[f"peak_{name}_time"] = _var(("building", "floor"), recorder.by_floor(when), "s", f"time of the largest absolute {name.replace('_', ' ')}")
+    shear, peak_shear, when = variables["storey_shear"][1], variables["peak_storey_shear"][1], variables["peak_storey_shear_time"][1]
+    variables["base_shear"] = _var(("building", "time"), shear[:, 0], "N", "base shear: the shear of the first storey")
+    variables["peak_base_shear"] = _var(("building",), peak_shear[:, 0], "N", "largest absolute base shear over the run")
+    variables["peak_base_shear_time"] = _var(("building",), when[:, 0], "s", "time of the largest absolute base shear")
+    heights = [b.storey_height for b in scene.buildings]
+    if any(h is not None for h in heights):
+        height = np.full(peak_shear.shape, np.nan)
+        for b, h in enumerate(heights):
+            if h is not None:
+                height[b, : len(h)] = h
+        drift = variables["storey_drift"][1]
+        variables["storey_drift_ratio"] = _var(("building", "floor", "time"), drift / height[:, :, None], "1", "storey drift over the storey height")
+        variables["peak_storey_drift_ratio"] = _var(("building", "floor"), variables["peak_storey_drift"][1] / height, "1",
+                                                    "largest absolute storey drift ratio over the run")
+    return variables
 
 
 def _wall_variables(scene: Scene, recorder: Recorder) -> dict[str, tuple]:

@@ -18,8 +18,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from stochpound.model.demands import DEMANDS
 from stochpound.model.friction import FREE
-from stochpound.model.modes import ModeDynamics
+from stochpound.model.modes import ModeDynamics, monitor_count
 from stochpound.model.system import System
 from stochpound.motions.ground import GroundMotion
 
@@ -106,8 +107,14 @@ class Recorder:
         Every impact, in order of start (then contact).
     peaks : np.ndarray
         The monitors' largest values over the run and when they happened
-        (rows: value, time in s), located on the solution: each contact's
-        closure y_left − y_right (m) per impact element (:func:`stochpound.model.modes.monitor_rows`).
+        (rows: value, time in s), located on the solution: each impact
+        element's closure y_left − y_right (m), then ± the demand parameters
+        when the system monitors them (:func:`stochpound.model.modes.monitor_rows`).
+    demands : dict of str to np.ndarray
+        When the system monitors demands: each parameter of
+        :data:`stochpound.model.demands.DEMANDS` at every floor and output
+        time (floor, in the order of the system's floors × time), filled by
+        :meth:`sample_at`.
     """
 
     system: System
@@ -120,6 +127,7 @@ class Recorder:
     energy_history: np.ndarray = field(init=False)
     impacts: list[Impact] = field(default_factory=list)
     peaks: np.ndarray = field(init=False)
+    demands: dict[str, np.ndarray] = field(init=False)
 
     def __post_init__(self) -> None:
         n_times, n = len(self.motion.times), self.system.n_dof
@@ -129,7 +137,9 @@ class Recorder:
         self.base_states = np.zeros((n_times, len(self.system.base_dofs)), dtype=np.int8)
         self.energy_history = np.zeros((len(ENERGY_TERMS), n_times))
         self.energy = dict(zip(ENERGY_TERMS, self.energy_history))
-        self.peaks = np.full((2, self.system.n_elements), np.nan)
+        self.peaks = np.full((2, monitor_count(self.system)), np.nan)
+        floors = len(self.system.total_displacement)
+        self.demands = {name: np.zeros((floors, n_times)) for name in DEMANDS} if self.system.demands else {}
 
     def sample_at(self, indices: np.ndarray, dynamics: ModeDynamics, ground: np.ndarray) -> None:
         """Contact forces, friction forces and base states at samples ``indices`` from their stored states.
@@ -148,6 +158,12 @@ class Recorder:
         self.friction[indices] = x @ dynamics.friction_matrix.T + np.outer(ground, dynamics.friction_ground) + dynamics.friction_constant
         for b, (base, state) in enumerate(zip(self.system.bases, dynamics.mode.base)):
             self.base_states[indices, b] = np.sign(x[:, self.system.n_dof + base.dof]) if state == FREE else state
+        if self.demands:  # the demand monitors' + rows (stochpound.model.modes.monitor_rows)
+            floors = len(self.system.total_displacement)
+            rows = slice(self.system.n_elements, self.system.n_elements + len(DEMANDS) * floors)
+            values = x @ dynamics.monitor_matrix[rows].T + np.outer(ground, dynamics.monitor_ground[rows]) + dynamics.monitor_constant[rows]
+            for name, value in zip(DEMANDS, values.T.reshape(len(DEMANDS), floors, len(indices))):
+                self.demands[name][:, indices] = value
 
     def displacements(self) -> tuple[np.ndarray, np.ndarray]:
         """Floor displacements u relative to their base (building × floor × time, NaN above a building's top floor) and sliding displacements s (building × time, 0 for a fixed base), m."""
@@ -161,6 +177,23 @@ class Recorder:
     def closure(self) -> np.ndarray:
         """Each impact element's closure y_left − y_right at the samples (element × time), m (a wall's side is 0)."""
         return self.system.element_geometry @ self.states[:, : self.system.n_dof].T
+
+    def by_floor(self, per_floor: np.ndarray) -> np.ndarray:
+        """Values of every floor (floor in system order × ...) as building × floor × ..., NaN above a building's top floor."""
+        floors = self.system.floor_dofs
+        values = np.full((len(floors), max(len(dofs) for dofs in floors)) + per_floor.shape[1:], np.nan)
+        first = 0
+        for b, dofs in enumerate(floors):
+            values[b, : len(dofs)] = per_floor[first : first + len(dofs)]
+            first += len(dofs)
+        return values
+
+    def demand_peaks(self) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+        """Each demand parameter's largest absolute value over the run and when (floor in system order), located on the solution."""
+        floors, n = len(self.system.total_displacement), len(DEMANDS) * len(self.system.total_displacement)
+        plus, minus = self.peaks[:, self.system.n_elements : self.system.n_elements + n], self.peaks[:, self.system.n_elements + n :]
+        larger = np.where(plus[0] >= minus[0], plus, minus)
+        return {name: (larger[0, i * floors : (i + 1) * floors], larger[1, i * floors : (i + 1) * floors]) for i, name in enumerate(DEMANDS)}
 
     def by_building(self, per_base: np.ndarray) -> np.ndarray:
         """Values of the sliding bases over time (time × base) as building × time, 0 for fixed bases."""

@@ -21,7 +21,7 @@ from stochpound.solvers.driver import EngineRun, VisitedModes
 from stochpound.solvers.propagators import propagator_library
 
 
-def run_exact(scene: Scene, limit_threads: bool = True) -> tuple[Recorder, EventCounters, VisitedModes]:
+def run_exact(scene: Scene, limit_threads: bool = True, demands: bool = False) -> tuple[Recorder, EventCounters, VisitedModes]:
     """Simulate ``scene`` with exact propagation between events.
 
     Parameters
@@ -35,6 +35,8 @@ def run_exact(scene: Scene, limit_threads: bool = True) -> tuple[Recorder, Event
         Build propagators with one BLAS thread (small-matrix kernels are much
         slower threaded); batch callers may limit threads once themselves
         instead. A run that builds no new mode leaves them alone.
+    demands : bool
+        Also record the demand parameters and locate their peaks (:mod:`stochpound.model.demands`).
 
     Returns
     -------
@@ -47,7 +49,7 @@ def run_exact(scene: Scene, limit_threads: bool = True) -> tuple[Recorder, Event
     stochpound.solvers.propagators.UnsupportedMotionError
         For other ground motions (use ``method="ivp"``).
     """
-    library = propagator_library(build_system(scene), scene.motion)
+    library = propagator_library(build_system(scene, demands), scene.motion)
     return EngineRun(library.system, scene.motion, library, building=lambda: _one_thread(limit_threads)).execute()
 
 

@@ -40,7 +40,8 @@ class IntegrationError(StochpoundError, RuntimeError):
     """The underlying integrator failed (e.g. step size underflow)."""
 
 
-def run_ivp(scene: Scene, integrator: str = "DOP853", rtol: float = 1e-10, atol: float = 1e-12) -> tuple[Recorder, EventCounters, VisitedModes]:
+def run_ivp(scene: Scene, integrator: str = "DOP853", rtol: float = 1e-10, atol: float = 1e-12,
+            demands: bool = False) -> tuple[Recorder, EventCounters, VisitedModes]:
     """Simulate ``scene`` with a scipy integrator and the event engine.
 
     Parameters
@@ -50,6 +51,8 @@ def run_ivp(scene: Scene, integrator: str = "DOP853", rtol: float = 1e-10, atol:
         One of :data:`INTEGRATORS`.
     rtol, atol : float
         Relative and absolute tolerances of the integrator (absolute in m and m/s).
+    demands : bool
+        Also record the demand parameters and locate their peaks (:mod:`stochpound.model.demands`).
 
     Returns
     -------
@@ -58,7 +61,7 @@ def run_ivp(scene: Scene, integrator: str = "DOP853", rtol: float = 1e-10, atol:
     """
     if integrator not in INTEGRATORS:
         raise ValueError(f"integrator must be one of {', '.join(INTEGRATORS)}, got {integrator!r}")
-    system = build_system(scene)
+    system = build_system(scene, demands)
     stepper = IntegratorSteps(scene.motion, integrator, rtol, atol)
     with threadpool_limits(limits=1):
         return EngineRun(system, scene.motion, ModeLibrary(system), stepper=stepper).execute()

@@ -27,7 +27,7 @@ from collections import namedtuple
 
 import numpy as np
 
-from stochpound.model.modes import BoundedCache, Mode, ModeDynamics, ModeLibrary
+from stochpound.model.modes import BoundedCache, Mode, ModeDynamics, ModeLibrary, monitor_count
 from stochpound.model.system import System
 from stochpound.motions.ground import GroundMotion, HarmonicMotion
 from stochpound.results.record import ENERGY_TERMS
@@ -77,11 +77,6 @@ def plant_arrays(system: System, motion: GroundMotion) -> Plant:
     )
 
 
-def n_monitors(system: System) -> int:
-    """Number of monitors of every mode of ``system`` (:func:`stochpound.model.modes.monitor_rows`)."""
-    return system.n_elements
-
-
 def max_guards(system: System) -> int:
     """The largest number of guards of a mode: two per contact (CLOSE and RECLOSE) and two per base (SLIP both ways)."""
     return 2 * system.n_elements + 2 * len(system.bases)
@@ -89,7 +84,7 @@ def max_guards(system: System) -> int:
 
 def work_arrays_for(system: System, slots: "Slots") -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The engine's work arrays for ``system`` and the current Chebyshev width of ``slots`` (:func:`exact_engine.work_arrays`)."""
-    return engine.work_arrays(2 * system.n_dof, max_guards(system), system.n_elements, n_monitors(system), mode_length(system),
+    return engine.work_arrays(2 * system.n_dof, max_guards(system), system.n_elements, monitor_count(system), mode_length(system),
                               slots.arrays["chebyshev"].shape[2])
 
 
@@ -104,7 +99,7 @@ def run_state(system: System, n_times: int, supplied_degree: int = 0) -> State:
         engine.Impacts(np.zeros(n_contacts, dtype=np.bool_), np.zeros((6, n_contacts)),
                        np.zeros((max(64, 4 * n_contacts), len(engine.IMPACT_COLUMNS)))),
         engine.Outputs(np.zeros(len(ENERGY_TERMS)), np.zeros((n_times, size)), np.zeros((len(ENERGY_TERMS), n_times)),
-                       np.zeros(n_times, dtype=np.int64), np.array([[-np.inf], [np.nan]]).repeat(n_monitors(system), axis=1)),
+                       np.zeros(n_times, dtype=np.int64), np.array([[-np.inf], [np.nan]]).repeat(monitor_count(system), axis=1)),
         engine.Supplied(np.zeros(2), np.zeros(size), np.zeros((supplied_degree + 1) * size)),
     )
 
@@ -361,11 +356,11 @@ def _placeholder(system: System, chebyshev_width: int, exact: bool) -> dict[str,
     """
     size, n_contacts, n_guards = 2 * system.n_dof, system.n_elements, max_guards(system)
     width = size + 5
-    propagate = (width, engine.propagate_columns(size, n_guards, n_contacts, n_monitors(system))) if exact else (1, 1)
+    propagate = (width, engine.propagate_columns(size, n_guards, n_contacts, monitor_count(system))) if exact else (1, 1)
     return {
         "modes": np.full(mode_length(system), -9, dtype=np.int64), "ids": np.int64(0), "codes": np.zeros((3, n_guards), np.int64),
         "n_guards": np.int64(0), "substeps": np.int64(1), "rate": np.zeros((size, size + 2)),
-        "guard": np.zeros((n_guards, size + 2)), "force": np.zeros((n_contacts, size + 2)), "monitor": np.zeros((n_monitors(system), size + 2)),
+        "guard": np.zeros((n_guards, size + 2)), "force": np.zeros((n_contacts, size + 2)), "monitor": np.zeros((monitor_count(system), size + 2)),
         "power": np.zeros((width, 4 * width)),
         "propagate": np.zeros(propagate), "chebyshev": np.zeros((width, chebyshev_width) if exact else (1, 1)),
         "step": np.float64(1.0),
