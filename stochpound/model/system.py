@@ -72,6 +72,10 @@ class System:
         Each building's storey k_i (N/m) and c_i (N·s/m).
     demands : bool
         Whether runs monitor the demand parameters (:mod:`stochpound.model.demands`).
+    n_readouts : int
+        Number n_f of read-outs f: the forces of nonlinear laws, which enter a
+        mode's equations as inputs (ẋ = A x + E f + B a_g + c); the engine's
+        state is ξ = [x, f].
     """
 
     n_dof: int
@@ -95,11 +99,17 @@ class System:
     storey_stiffness: list[np.ndarray]
     storey_damping: list[np.ndarray]
     demands: bool
+    n_readouts: int
 
     @property
     def n_elements(self) -> int:
         """Number of impact elements (contacts, then walls)."""
         return len(self.element_gap)
+
+    @property
+    def xi_size(self) -> int:
+        """Length S' of ξ = [x, f]: 2N + n_f."""
+        return 2 * self.n_dof + self.n_readouts
 
     @property
     def building_base_dofs(self) -> list[int | None]:
@@ -201,6 +211,7 @@ def _build_system(buildings: tuple[Building, ...], contacts: tuple[Contact, ...]
         storey_stiffness=[np.asarray(b.stiffness, float) for b in buildings],
         storey_damping=[np.asarray(b.damping, float) for b in buildings],
         demands=demands,
+        n_readouts=0,
     )
 
 

@@ -84,8 +84,10 @@ class EngineRun:
             elif status == engine.NEED_SPACE:
                 table = self.state.impacts.table
                 self.state = self.state._replace(impacts=self.state.impacts._replace(table=np.concatenate([table, np.zeros_like(table)])))
-            else:  # NEED_STEP
+            elif status == engine.NEED_STEP:
                 self._supply_step()
+            else:  # NEED_READOUTS
+                self._supply_readouts()
         return self.record(), self.counters(), self.visited()
 
     def _supply_step(self) -> None:
@@ -95,6 +97,17 @@ class EngineRun:
         mode = self.slots.modes[int(self.slots.arrays["ids"][run.ints[engine.MODE]])]
         self.stepper.step(self.slots.dynamics(mode), k, float(run.clock[0]), run.x, float(self.motion.times[k + 1]), self.state.supplied)
         run.ints[engine.READY] = 1
+
+    def _supply_readouts(self) -> None:
+        """Append the read-outs (f, ḟ) the engine asked for while settling: a mode's slot, at ``readouts.x``."""
+        run, readouts = self.state.run, self.state.readouts
+        slot, row = int(run.ints[engine.READOUT_SLOT]), int(run.ints[engine.N_READOUTS])
+        mode = self.slots.modes[int(self.slots.arrays["ids"][slot])]
+        k, t = int(run.ints[engine.K]), float(run.clock[0])
+        readouts.values[row] = self.readouts.at_instant(self.slots.dynamics(mode), readouts.x[: 2 * self.system.n_dof], self.motion.derivatives(t, k)[:2],
+                                                        self.state.impacts.impact[engine.ONSET])
+        readouts.slots[row] = slot
+        run.ints[engine.N_READOUTS] = row + 1
 
     def record(self) -> Recorder:
         """The run's :class:`Recorder` from the engine's outputs (after :meth:`execute`)."""

@@ -142,12 +142,24 @@ Outputs.__doc__ = """Running energy terms, the state, energy terms and mode id a
 Supplied = namedtuple("Supplied", "bounds x coefficients")
 Supplied.__doc__ = """A step of the flow supplied by the caller (``external`` runs: an integrator's step).
 
-``bounds`` = [t0, t1] (s), ``x`` the state at t1 and ``coefficients`` the
-Chebyshev coefficients of x(t) on [t0, t1], (D + 1) × 2N flattened by order
-(the dense output of :class:`Flow`).
+``bounds`` = [t0, t1] (s), ``x`` the state ξ = [x, f] at t1 (f: the mode's
+read-outs, the forces of nonlinear laws) and ``coefficients`` the Chebyshev
+coefficients of ξ(t) on [t0, t1], (D + 1) × S' flattened by order (the dense
+output of :class:`Flow`). The step starts at the engine's own ξ.
+"""
+Readouts = namedtuple("Readouts", "slots values x")
+Readouts.__doc__ = """The read-outs f of the modes met while settling one event (systems with nonlinear laws only).
+
+Row r holds slot ``slots[r]``'s f and ḟ (``values[r]``, 2 × n_f) at the
+settling instant; ``ints[N_READOUTS]`` rows are filled. When a mode's row is
+missing the engine returns NEED_READOUTS with the mode's slot in
+``ints[READOUT_SLOT]`` and the state in ``x``; the caller appends the row.
 """
 Flow = namedtuple("Flow", "rate guard force monitor coefficients ground origin harmonic t0 scale")
-Flow.__doc__ = """One mode's flow inside one step: its affine maps and the Chebyshev coefficients of x(t).
+Flow.__doc__ = """One mode's flow inside one step: its affine maps and the Chebyshev coefficients of ξ(t) = [x(t), f(t)].
+
+An exact flow has no read-outs (ξ = x); a supplied flow has those of the
+mode's nonlinear laws (:func:`_flow_rate`).
 
 ``ground`` is the interval's cubic of a_g(t − origin) (sampled motions) or
 [amplitude, ω, phase] (``harmonic``); the step starts at t0 and
@@ -155,8 +167,8 @@ Flow.__doc__ = """One mode's flow inside one step: its affine maps and the Cheby
 """
 
 # entries of Run.ints
-K, MODE, PENDING, FIRED_KIND, FIRED_TARGET, FIRED_DIRECTION, N_IMPACTS, TOTAL, CHATTER, GRAZING, READY = range(11)
-N_INTS = 11
+K, MODE, PENDING, FIRED_KIND, FIRED_TARGET, FIRED_DIRECTION, N_IMPACTS, TOTAL, CHATTER, GRAZING, READY, N_READOUTS, READOUT_SLOT = range(13)
+N_INTS = 13
 # rows of ModeTable.codes
 KIND, TARGET, DIRECTION = range(3)
 # rows of Impacts.impact
@@ -166,7 +178,7 @@ PEAK_VALUE, PEAK_AT = range(2)
 # pending settles
 NONE, INITIAL, EVENT = 0, 1, 2
 # statuses returned to Python
-FINISHED, NEED_MODE, NEED_SPACE, NEED_STEP = 0, 1, 2, 3
+FINISHED, NEED_MODE, NEED_SPACE, NEED_STEP, NEED_READOUTS = 0, 1, 2, 3, 4
 # columns of Impacts.table (finished impacts): contact, end, then the rows of Impacts.impact
 IMPACT_COLUMNS = ("contact", "end", "start", "onset_velocity", "in_phase", "peak_force", "peak_time", "impulse")
 N_NODES = 5
@@ -229,18 +241,18 @@ def _product(transposed, vector, out):
 
 
 @njit(**INTERNAL)
-def _affine(M, i, x, ground):
-    """Row i of the affine map M at (x, a_g): M[i, S] a_g + M[i, S + 1] + M[i, :S] · x."""
+def _affine(M, i, xi, ground):
+    """Row i of the affine map M at (ξ, a_g): M[i, S'] a_g + M[i, S' + 1] + M[i, :S'] · ξ (ξ = [x, f], S' = M.shape[1] − 2)."""
     size = M.shape[1] - 2
     total = M[i, size] * ground + M[i, size + 1]
     for j in range(size):
-        total += M[i, j] * x[j]
+        total += M[i, j] * xi[j]
     return total
 
 
 @njit(**INTERNAL)
 def _rate_of(M, i, rate, x, ground, ground_rate):
-    """Rate of row i of the affine map M along the flow: M[i, :S] · ẋ + M[i, S] ȧ_g."""
+    """Rate of row i of the affine map M along an exact flow (no read-outs): M[i, :S] · ẋ + M[i, S] ȧ_g."""
     total = M[i, rate.shape[0]] * ground_rate
     for j in range(rate.shape[0]):
         total += M[i, j] * _affine(rate, j, x, ground)
@@ -248,19 +260,25 @@ def _rate_of(M, i, rate, x, ground, ground_rate):
 
 
 @njit(**INTERNAL)
-def _guards_and_rates(rate, guard, x, ground, ground_rate, values, rates, work):
-    """Values of the first len(values) guards and their rates G ẋ + h ȧ_g (ẋ into ``work``)."""
-    size = rate.shape[0]
-    for i in range(size):
-        work[i] = _affine(rate, i, x, ground)
+def _read_outs(M, xi, xi_rate, ground, ground_rate, values, rates):
+    """The first len(values) rows of the affine map M at (ξ, a_g) and their rates M ξ̇ + h ȧ_g."""
+    size = M.shape[1] - 2
     for g in range(values.shape[0]):
-        value = guard[g, size] * ground + guard[g, size + 1]
-        slope = guard[g, size] * ground_rate
+        value = M[g, size] * ground + M[g, size + 1]
+        slope = M[g, size] * ground_rate
         for j in range(size):
-            value += guard[g, j] * x[j]
-            slope += guard[g, j] * work[j]
+            value += M[g, j] * xi[j]
+            slope += M[g, j] * xi_rate[j]
         values[g] = value
         rates[g] = slope
+
+
+@njit(**INTERNAL)
+def _guards_and_rates(rate, guard, x, ground, ground_rate, values, rates, work):
+    """Values of the first len(values) rows of ``guard`` (guards or monitors) and their rates on an exact flow (ẋ into ``work``)."""
+    for i in range(rate.shape[0]):
+        work[i] = _affine(rate, i, x, ground)
+    _read_outs(guard, x, work, ground, ground_rate, values, rates)
 
 
 @njit(**INTERNAL)
@@ -463,14 +481,14 @@ def _monitor_peaks(flow, t1, values0, values1, rates0, rates1, peaks, work):
     A maximum is located (Brent on the monitor's rate) when the rate goes from
     + to − on the flow and the Hermite cubic says it may beat the peak.
     """
-    t0, n_contacts = flow.t0, flow.force.shape[0]
+    t0, n_contacts, xi = flow.t0, flow.force.shape[0], work[: flow.rate.shape[1] - 2]
     for i in range(values1.shape[0]):
         if _maximum_may_beat(values0[i], values1[i], rates0[i], rates1[i], t1 - t0, peaks[PEAK_VALUE, i]):
             index = -1 - n_contacts - i
             if _evaluate(flow, index, 0.0, t0, work) > 0.0 > _evaluate(flow, index, 0.0, t1, work):
                 t_peak = _brentq(flow, index, 0.0, t0, t1, work)
-                _dense(flow, t_peak, work)
-                value = _affine(flow.monitor, i, work, _ground_value(flow, t_peak))
+                _dense(flow, t_peak, xi)
+                value = _affine(flow.monitor, i, xi, _ground_value(flow, t_peak))
                 if value > peaks[PEAK_VALUE, i]:
                     peaks[PEAK_VALUE, i], peaks[PEAK_AT, i] = value, t_peak
     _offer_monitors(values1, t1, peaks)
@@ -495,7 +513,7 @@ def _advance_quiet(mode_id, n, substeps, step, propagate, chebyshev, rate, guard
     is_harmonic = harmonic.shape[0] > 0
     size = x.shape[0]
     width = size + 5
-    z0, propagated, work, coefficients = scratch[0, :width], scratch[1, : propagate.shape[1]], scratch[2, :size], scratch[9, : chebyshev.shape[1]]
+    z0, propagated, work, coefficients = scratch[0, :width], scratch[1, : propagate.shape[1]], scratch[2], scratch[9, : chebyshev.shape[1]]
     z1, x0, x1 = propagated[:width], z0[:size], propagated[:size]
     values_at = 5 * width + is_open.shape[0]
     rates_at, monitors_at = values_at + guard.shape[0], values_at + 2 * guard.shape[0]
@@ -576,6 +594,45 @@ def _ground_value(flow, t):
 
 
 @njit(**INTERNAL)
+def _dense_derivative(flow, t, out):
+    """dξ/dt from the step's Chebyshev coefficients: Σ cₙ n Uₙ₋₁(s) ds/dt (Uₙ₊₁ = 2s Uₙ − Uₙ₋₁)."""
+    s = (t - flow.t0) * flow.scale - 1.0
+    s = -1.0 if s < -1.0 else (1.0 if s > 1.0 else s)
+    size = out.shape[0]
+    coefficients = flow.coefficients
+    for i in range(size):
+        out[i] = 0.0
+    previous, current = 0.0, 1.0  # U₋₁, U₀
+    for n in range(1, coefficients.shape[0] // size):
+        for i in range(size):
+            out[i] += n * current * coefficients[n * size + i] * flow.scale
+        previous, current = current, 2.0 * s * current - previous
+
+
+@njit(**INTERNAL)
+def _flow_rate(flow, t, xi, ground, out):
+    """ξ̇ at t on the flow, given ξ(t) and a_g(t) (``out``: S' entries).
+
+    ẋ is the rate map's at ξ (exact, read-outs included); the read-outs'
+    rates ḟ (nonlinear laws, supplied flows only) are the derivative of the
+    flow's expansion.
+    """
+    rows = flow.rate.shape[0]
+    if out.shape[0] > rows:
+        _dense_derivative(flow, t, out)
+    for j in range(rows):
+        out[j] = _affine(flow.rate, j, xi, ground)
+
+
+@njit(**INTERNAL)
+def _flow_read_outs(flow, M, t, xi, values, rates, work):
+    """The first len(values) rows of M (guards or monitors) and their rates at t, ξ(t) given (ξ̇ into ``work``)."""
+    ground = _ground_value(flow, t)
+    _flow_rate(flow, t, xi, ground, work[: xi.shape[0]])
+    _read_outs(M, xi, work, ground, _ground_rate(flow, t), values, rates)
+
+
+@njit(**INTERNAL)
 def _dense(flow, t, out):
     """x(t) from the step's Chebyshev coefficients (``ModePropagator.dense``; Tₙ by the recurrence Tₙ₊₁ = 2s Tₙ − Tₙ₋₁)."""
     s = (t - flow.t0) * flow.scale - 1.0
@@ -605,16 +662,22 @@ def _ground_rate(flow, t):
 def _evaluate(flow, index, level, t, work):
     """Guard ``index`` minus ``level`` at t; for index < 0, the rate of read-out r = −1 − index.
 
-    Read-out r < n_contacts is contact force r, else monitor r − n_contacts.
+    Read-out r < n_elements is element force r, else monitor r − n_elements.
+    ``work`` holds ξ(t) then ξ̇(t) (at least 2 S' entries).
     """
-    _dense(flow, t, work)
+    size = flow.rate.shape[1] - 2
+    xi, xi_rate = work[:size], work[size : 2 * size]
+    _dense(flow, t, xi)
     ground = _ground_value(flow, t)
     if index >= 0:
-        return _affine(flow.guard, index, work, ground) - level
-    r, n_contacts = -1 - index, flow.force.shape[0]
-    if r < n_contacts:
-        return _rate_of(flow.force, r, flow.rate, work, ground, 0.0)
-    return _rate_of(flow.monitor, r - n_contacts, flow.rate, work, ground, _ground_rate(flow, t))
+        return _affine(flow.guard, index, xi, ground) - level
+    _flow_rate(flow, t, xi, ground, xi_rate)
+    r, n_elements = -1 - index, flow.force.shape[0]
+    M, row = (flow.force, r) if r < n_elements else (flow.monitor, r - n_elements)
+    total = M[row, size] * _ground_rate(flow, t)
+    for j in range(size):
+        total += M[row, j] * xi_rate[j]
+    return total
 
 
 # ---------------------------------------------------------------- scipy's brentq and bounded Brent, ported
@@ -898,17 +961,21 @@ def _with_bound(M, i, x, magnitude, ground, constant):
 
 
 @njit(**INTERNAL)
-def _leaving_sign(rate, guard, n_guards, x, ground, values, tolerance, heading, scratch):
-    """``events.guard_leaving_sign``: values, tolerances and heading of the first n_guards guards.
+def _leaving_sign(rate, guard, n_guards, x, ground, readout, values, tolerance, heading, scratch):
+    """Values, tolerances and heading of the first n_guards guards at state x (its first S entries) and a_g derivatives ``ground``.
 
     The heading of a guard is the sign of its first time derivative (up to the
-    third) that is clearly non-zero: 0 while undecided. ``scratch``: the
-    engine's work array (:func:`work_arrays`).
+    third) that is clearly non-zero: 0 while undecided. The derivatives of ξ
+    come from the rate map, with the read-outs' value and rate from
+    ``readout`` (2 × n_f: f, ḟ; their higher derivatives taken as 0).
+    ``scratch``: the engine's work array (:func:`work_arrays`).
     """
-    size = x.shape[0]
+    size, rows = rate.shape[1] - 2, rate.shape[0]
     derivative, magnitude, next_derivative, next_magnitude = scratch[20, :size], scratch[21, :size], scratch[22, :size], scratch[23, :size]
-    for i in range(size):
+    for i in range(rows):
         derivative[i], magnitude[i] = x[i], abs(x[i])
+    for j in range(size - rows):
+        derivative[rows + j], magnitude[rows + j] = readout[0, j], abs(readout[0, j])
     for g in range(n_guards):
         heading[g] = 0
     for order in range(4):
@@ -919,8 +986,11 @@ def _leaving_sign(rate, guard, n_guards, x, ground, values, tolerance, heading, 
                 values[g], tolerance[g] = value, limit
             if heading[g] == 0 and abs(value) > limit:
                 heading[g] = 1 if value > 0.0 else -1
-        for i in range(size):
+        for i in range(rows):
             next_derivative[i], next_magnitude[i], _ = _with_bound(rate, i, derivative, magnitude, ground[order], order == 0)
+        for j in range(size - rows):
+            next_derivative[rows + j] = readout[1, j] if order == 0 else 0.0
+            next_magnitude[rows + j] = abs(next_derivative[rows + j])
         derivative, next_derivative = next_derivative, derivative
         magnitude, next_magnitude = next_magnitude, magnitude
 
@@ -961,13 +1031,19 @@ def _initial_guard_states(codes, n_guards, geometry, gap, tensile, x, values, to
 
 @njit(**INTERNAL)
 def _settle(modes, codes, n_guards, rate, guard, geometry, gap, tensile, base_dofs, ground, ints, x, mode, transitions,
-            threshold, tolerance, rearmable, disarmed, scratch, marks):
-    """``events.settle`` of the pending event: returns (mode index, number of transitions); x and mode are updated.
+            threshold, tolerance, rearmable, disarmed, readouts, scratch, marks):
+    """Settle the pending event: returns (mode index, number of transitions); x (ξ) and mode are updated.
 
+    The fired transition is applied, then every guard of the new mode is
+    judged at the same instant (:func:`_leaving_sign`), and transitions are
+    applied until no guard wants to fire; meeting a mode twice (a chattering
+    cycle) keeps the last mode and disarms the guards that still want to fire.
     ``codes``, ``rate`` and ``guard`` are the :class:`ModeTable` and
-    :class:`Dynamics` arrays of the slots. Returns mode index −1 when the
-    settled mode is in no slot (``mode`` is that mode; nothing else has
-    changed then). ``scratch`` and ``marks``: the work arrays (:func:`work_arrays`).
+    :class:`Dynamics` arrays of the slots. Returns mode index −1 when a mode
+    is in no slot (``mode`` is that mode; nothing else has changed then), −2
+    when a mode's read-outs are needed (:class:`Readouts`: ``readouts.x`` and
+    ``ints[READOUT_SLOT]`` say which). ``scratch`` and ``marks``: the work
+    arrays (:func:`work_arrays`).
     """
     n_guards_max = guard.shape[1]
     values, limits, heading = scratch[18, :n_guards_max], scratch[19, :n_guards_max], marks[-3, :n_guards_max]
@@ -985,7 +1061,10 @@ def _settle(modes, codes, n_guards, rate, guard, geometry, gap, tensile, base_do
         m = _lookup(modes, mode)
         if m < 0:
             break
-        _leaving_sign(rate[m], guard[m], n_guards[m], x, ground, values, limits, heading, scratch)
+        r = _readout_of(readouts, ints, m, x)
+        if r < 0:
+            return -2, 0
+        _leaving_sign(rate[m], guard[m], n_guards[m], x, ground, readouts.values[r], values, limits, heading, scratch)
         j = _first_wanting(codes[m], n_guards[m], geometry, gap, tensile, x, values, limits, heading)
         if j < 0:
             settled = True
@@ -1003,11 +1082,34 @@ def _settle(modes, codes, n_guards, rate, guard, geometry, gap, tensile, base_do
     m = _lookup(modes, mode)
     if m < 0:
         return -1, 0
+    r = _readout_of(readouts, ints, m, x)
+    if r < 0:
+        return -2, 0
     if not settled:
         ints[CHATTER] += 1
-        _leaving_sign(rate[m], guard[m], n_guards[m], x, ground, values, limits, heading, scratch)
+        _leaving_sign(rate[m], guard[m], n_guards[m], x, ground, readouts.values[r], values, limits, heading, scratch)
     _initial_guard_states(codes[m], n_guards[m], geometry, gap, tensile, x, values, limits, threshold, tolerance, rearmable, disarmed)
+    rows = rate.shape[1]
+    for j in range(readouts.values.shape[2]):  # ξ's read-outs: the settled mode's
+        x[rows + j] = readouts.values[r, 0, j]
+    ints[N_READOUTS] = 0
     return m, n_transitions
+
+
+@njit(**INTERNAL)
+def _readout_of(readouts, ints, m, x):
+    """The row of ``readouts`` holding slot m's read-outs at this instant, or −1 after asking for them (state x into ``readouts.x``).
+
+    With no read-outs (n_f = 0) every slot has its (empty) row 0.
+    """
+    if readouts.values.shape[2] == 0:
+        return 0
+    for r in range(ints[N_READOUTS]):
+        if readouts.slots[r] == m:
+            return r
+    _copy(x, readouts.x)
+    ints[READOUT_SLOT] = m
+    return -1
 
 
 # ---------------------------------------------------------------- recording events
@@ -1040,11 +1142,12 @@ def _on_transitions(mode, force, left_rows, right_rows, geometry, is_open, impac
 
 @njit(inline="always", error_model="numpy")
 def _settle_pending(modes, codes, n_guards, rate, guard, force, monitor, motion, layout, arming, ints, clock, pending_x, pending_mode,
-                    missing_mode, is_open, impact, table, peaks, x, scratch, marks):
-    """Settle the pending event (or the start) and record it (``settle_and_record``): returns the mode index.
+                    missing_mode, is_open, impact, table, peaks, readouts, x, scratch, marks):
+    """Settle the pending event (or the start) and record it (:func:`_settle`, :func:`_on_transitions`): returns the mode index.
 
-    The settled state goes into ``x``. Returns −1 (with the mode to build in
-    ``missing_mode``, and nothing else changed) when a mode is missing.
+    The settled ξ goes into ``x``. Returns −1 (with the mode to build in
+    ``missing_mode``) when a mode is missing, −2 when read-outs are
+    (:func:`_readout_of`); nothing else has changed then.
     ``scratch`` and ``marks``: the work arrays (:func:`work_arrays`).
     """
     settled, mode = scratch[16, : x.shape[0]], marks[-1, : pending_mode.shape[0]]
@@ -1055,15 +1158,16 @@ def _settle_pending(modes, codes, n_guards, rate, guard, force, monitor, motion,
     geometry, gap, tensile, left_rows, right_rows, base_dofs = layout
     threshold, tolerance, rearmable, disarmed = arming
     m, n_transitions = _settle(modes, codes, n_guards, rate, guard, geometry, gap, tensile, base_dofs, ground, ints, settled, mode,
-                               transitions, threshold, tolerance, rearmable, disarmed, scratch, marks)
-    if m < 0:
+                               transitions, threshold, tolerance, rearmable, disarmed, readouts, scratch, marks)
+    if m == -1:
         _copy(mode, missing_mode)
+    if m < 0:
         return m
     _on_transitions(modes[m], force[m], left_rows, right_rows, geometry, is_open, impact, table, ints, clock[0], settled, transitions,
                     n_transitions)
     n_monitors = monitor.shape[1]
     monitors, monitor_rates = scratch[24, :n_monitors], scratch[26, :n_monitors]
-    _guards_and_rates(rate[m], monitor[m], settled, ground[0], ground[1], monitors, monitor_rates, scratch[2, : x.shape[0]])
+    _guards_and_rates(rate[m], monitor[m], settled, ground[0], ground[1], monitors, monitor_rates, scratch[2])
     _offer_monitors(monitors, clock[0], peaks)  # a monitor may jump with the mode (e.g. an acceleration at impact)
     _copy(settled, x)
     return m
@@ -1086,9 +1190,9 @@ def _locate_and_record(flow, m, modes, codes, force, power, ints, clock, x0, x1,
     at the step's ends; ``scratch``: the work array (:func:`work_arrays`).
     """
     threshold, tolerance, rearmable, disarmed = arming
-    t0, size = flow.t0, x0.shape[0]
+    t0, size = flow.t0, flow.rate.shape[1] - 2
     width = size + 5
-    work, x_stop = scratch[2, :size], scratch[12, :size]
+    work, x_stop = scratch[2], scratch[12, :size]
     node, products = scratch[10, :width], scratch[11, : power.shape[1]]  # node: z = [x, a_g, 0, 0, 0, 1] at a Gauss node
     node[size + 1], node[size + 2], node[size + 3], node[width - 1] = 0.0, 0.0, 0.0, 1.0
     t_event, fired = _first_crossing(flow, threshold, tolerance, rearmable, disarmed, ints, t1, values0, values1, rates0, rates1, work,
@@ -1114,14 +1218,14 @@ def _locate_and_record(flow, m, modes, codes, force, power, ints, clock, x0, x1,
         for p in range(is_open.shape[0]):  # a force maximum inside the step
             if is_open[p] and _evaluate(flow, -1 - p, 0.0, t0, work) > 0.0 > _evaluate(flow, -1 - p, 0.0, t_stop, work):
                 t_peak = _brentq(flow, -1 - p, 0.0, t0, t_stop, work)
-                _dense(flow, t_peak, work)
+                _dense(flow, t_peak, work[:size])
                 value = _affine(force, p, work, 0.0)
                 if value > impact[PEAK, p]:
                     impact[PEAK, p], impact[PEAK_TIME, p] = value, t_peak
         n_monitors = flow.monitor.shape[0]
         monitors0, monitors1, monitor_rates0, monitor_rates1 = scratch[24, :n_monitors], scratch[25, :n_monitors], scratch[26, :n_monitors], scratch[27, :n_monitors]
-        _guards_and_rates(flow.rate, flow.monitor, x0, _ground_value(flow, t0), _ground_rate(flow, t0), monitors0, monitor_rates0, work)
-        _guards_and_rates(flow.rate, flow.monitor, x_stop, _ground_value(flow, t_stop), _ground_rate(flow, t_stop), monitors1, monitor_rates1, work)
+        _flow_read_outs(flow, flow.monitor, t0, x0, monitors0, monitor_rates0, work)
+        _flow_read_outs(flow, flow.monitor, t_stop, x_stop, monitors1, monitor_rates1, work)
         _monitor_peaks(flow, t_stop, monitors0, monitors1, monitor_rates0, monitor_rates1, peaks, work)
     if fired < 0:
         return False
@@ -1137,10 +1241,10 @@ def _locate_and_record(flow, m, modes, codes, force, power, ints, clock, x0, x1,
 @njit(**INTERNAL)
 def _sub_step_monitors(flow, t1, x0, x1, peaks, scratch):
     """The monitors' peaks over a sub-step [flow.t0, t1] from x0 to x1 that needs no event code (:func:`_monitor_peaks`)."""
-    n_monitors, work = flow.monitor.shape[0], scratch[2, : x0.shape[0]]
+    n_monitors, work = flow.monitor.shape[0], scratch[2]
     monitors0, monitors1, monitor_rates0, monitor_rates1 = scratch[24, :n_monitors], scratch[25, :n_monitors], scratch[26, :n_monitors], scratch[27, :n_monitors]
-    _guards_and_rates(flow.rate, flow.monitor, x0, _ground_value(flow, flow.t0), _ground_rate(flow, flow.t0), monitors0, monitor_rates0, work)
-    _guards_and_rates(flow.rate, flow.monitor, x1, _ground_value(flow, t1), _ground_rate(flow, t1), monitors1, monitor_rates1, work)
+    _flow_read_outs(flow, flow.monitor, flow.t0, x0, monitors0, monitor_rates0, work)
+    _flow_read_outs(flow, flow.monitor, t1, x1, monitors1, monitor_rates1, work)
     _monitor_peaks(flow, t1, monitors0, monitors1, monitor_rates0, monitor_rates1, peaks, work)
 
 
@@ -1204,22 +1308,20 @@ def _advance_span(m, n, modes, codes, substeps, step, propagate, chebyshev, rate
 @njit(inline="always", error_model="numpy")
 def _supplied_step(m, n, modes, codes, rate, guard, force, monitor, power, motion, ints, clock, x, pending_x, pending_mode, arming, is_open,
                    impact, running, peaks, k, supplied, scratch):
-    """The supplied step of mode m (n guards, its arrays) through :func:`_locate_and_record`; x moves to its end if no event.
+    """The supplied step of mode m (n guards, its arrays) through :func:`_locate_and_record`; ξ moves to its end if no event.
 
-    Returns True when it stopped at an event (now pending).
+    The step starts at the engine's ξ = x (its read-outs included) and its
+    rates are the derivative of the supplied expansion. Returns True when it
+    stopped at an event (now pending).
     """
     times, harmonic = motion.times, motion.harmonic
     t0, t1 = supplied.bounds[0], supplied.bounds[1]
-    size = x.shape[0]
     values0, values1, rates0, rates1 = scratch[3, :n], scratch[4, :n], scratch[5, :n], scratch[6, :n]
-    rate_work, ground0, ground1 = scratch[7, :size], scratch[8, :4], scratch[9, :4]
     is_harmonic = harmonic.shape[0] > 0
     ground = harmonic if is_harmonic else motion.coefficients[k]
     flow = Flow(rate, guard, force, monitor, supplied.coefficients, ground, times[k], is_harmonic, t0, 2.0 / (t1 - t0))
-    _ground(times, motion.coefficients, harmonic, t0, k, ground0)
-    _guards_and_rates(rate, guard, x, ground0[0], ground0[1], values0, rates0, rate_work)
-    _ground(times, motion.coefficients, harmonic, t1, k, ground1)
-    _guards_and_rates(rate, guard, supplied.x, ground1[0], ground1[1], values1, rates1, rate_work)
+    _flow_read_outs(flow, guard, t0, x, values0, rates0, scratch[2])
+    _flow_read_outs(flow, guard, t1, supplied.x, values1, rates1, scratch[2])
     if _locate_and_record(flow, m, modes, codes, force, power, ints, clock, x, supplied.x, pending_x, pending_mode, arming, is_open, impact,
                           running, peaks, t1, values0, values1, rates0, rates1, scratch):
         return True
@@ -1232,8 +1334,8 @@ def _supplied_step(m, n, modes, codes, rate, guard, force, monitor, power, motio
 
 
 @njit(cache=True, nogil=True, no_cfunc_wrapper=True, error_model="numpy", _nrt=False)
-def run_engine(table, dynamics, propagators, motion, layout, run, arming, impacts, outputs, supplied, scratch, saved, marks, external):
-    """Run (or resume) the simulation; returns FINISHED, NEED_MODE, NEED_SPACE or NEED_STEP.
+def run_engine(table, dynamics, propagators, motion, layout, run, arming, impacts, outputs, supplied, readouts, scratch, saved, marks, external):
+    """Run (or resume) the simulation; returns FINISHED, NEED_MODE, NEED_SPACE, NEED_STEP or NEED_READOUTS.
 
     Parameters
     ----------
@@ -1245,6 +1347,8 @@ def run_engine(table, dynamics, propagators, motion, layout, run, arming, impact
         Everything the run changes, updated in place.
     supplied : Supplied
         The caller's next step of the flow (``external`` runs).
+    readouts : Readouts
+        The read-outs of the modes met while settling (systems with nonlinear laws).
     scratch, saved, marks : np.ndarray
         Work arrays (:func:`work_arrays`).
     external : bool
@@ -1259,7 +1363,8 @@ def run_engine(table, dynamics, propagators, motion, layout, run, arming, impact
     -------
     int
         On NEED_MODE, ``run.missing_mode`` is the mode to build; on NEED_SPACE
-        the impact table is full. Either way the caller fixes it and calls again.
+        the impact table is full; on NEED_READOUTS a mode's read-outs are
+        missing (:class:`Readouts`). The caller fixes it and calls again.
     """
     modes, ids, codes, n_guards, substeps = table
     rate, guard, force, monitor, power = dynamics
@@ -1274,9 +1379,9 @@ def run_engine(table, dynamics, propagators, motion, layout, run, arming, impact
             if ints[N_IMPACTS] + is_open.shape[0] > impact_table.shape[0]:
                 return NEED_SPACE
             m = _settle_pending(modes, codes, n_guards, rate, guard, force, monitor, motion, layout, arming, ints, clock, pending_x,
-                                pending_mode, missing_mode, is_open, impact, impact_table, peaks, x, scratch, marks)
+                                pending_mode, missing_mode, is_open, impact, impact_table, peaks, readouts, x, scratch, marks)
             if m < 0:
-                return NEED_MODE
+                return NEED_MODE if m == -1 else NEED_READOUTS
             ints[MODE] = m
             visited[ids[m]] = True
             if ints[PENDING] == INITIAL:

@@ -44,7 +44,7 @@ Built = namedtuple("Built", "table dynamics propagators")
 """The engine's arrays of the modes in a library's slots (:class:`Slots`)."""
 Plant = namedtuple("Plant", "motion layout")
 """The engine's arrays of a system and motion (:func:`plant_arrays`)."""
-State = namedtuple("State", "run arming impacts outputs supplied")
+State = namedtuple("State", "run arming impacts outputs supplied readouts")
 """The engine's arrays of one run (:func:`run_state`)."""
 
 
@@ -84,13 +84,13 @@ def max_guards(system: System) -> int:
 
 def work_arrays_for(system: System, slots: "Slots") -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The engine's work arrays for ``system`` and the current Chebyshev width of ``slots`` (:func:`exact_engine.work_arrays`)."""
-    return engine.work_arrays(2 * system.n_dof, max_guards(system), system.n_elements, monitor_count(system), mode_length(system),
+    return engine.work_arrays(system.xi_size, max_guards(system), system.n_elements, monitor_count(system), mode_length(system),
                               slots.arrays["chebyshev"].shape[2])
 
 
 def run_state(system: System, n_times: int, supplied_degree: int = 0) -> State:
     """Fresh arrays of everything a run changes (supplied steps of Chebyshev degree ``supplied_degree``)."""
-    size, n_contacts, n_guards = 2 * system.n_dof, system.n_elements, max_guards(system)
+    size, n_contacts, n_guards = system.xi_size, system.n_elements, max_guards(system)
     length = mode_length(system)
     return State(
         engine.Run(np.zeros(1), np.zeros(engine.N_INTS, dtype=np.int64), np.zeros(size), np.zeros(size),
@@ -101,6 +101,8 @@ def run_state(system: System, n_times: int, supplied_degree: int = 0) -> State:
         engine.Outputs(np.zeros(len(ENERGY_TERMS)), np.zeros((n_times, size)), np.zeros((len(ENERGY_TERMS), n_times)),
                        np.zeros(n_times, dtype=np.int64), np.array([[-np.inf], [np.nan]]).repeat(monitor_count(system), axis=1)),
         engine.Supplied(np.zeros(2), np.zeros(size), np.zeros((supplied_degree + 1) * size)),
+        engine.Readouts(np.zeros(engine.MAX_SETTLE_ITERATIONS + 2, dtype=np.int64), np.zeros((engine.MAX_SETTLE_ITERATIONS + 2, 2, system.n_readouts)),
+                        np.zeros(size)),
     )
 
 
@@ -261,7 +263,7 @@ def _propagator_rows(propagator: ModePropagator, guard: np.ndarray, monitor: np.
 
 def _energy_rows(system: System, dynamics: ModeDynamics, propagator: ModePropagator | None) -> tuple[np.ndarray, ...]:
     """A mode's power forms (Z × 4Z, :func:`_power_forms`) and, with a propagator, its sub-step forms and impulses (Z × (4Z + n_contacts))."""
-    d, width = dynamics, 2 * system.n_dof + 5
+    d, width = dynamics, system.xi_size + 5
     force = _in_z(_affine(d.force_matrix, 0.0, d.force_constant), width)
     friction = _in_z(_affine(d.friction_matrix, d.friction_ground, d.friction_constant), width)
     factors = _power_factors(system, force, friction)
@@ -302,11 +304,11 @@ def _power_factors(system: System, force: np.ndarray, friction: np.ndarray) -> l
     Σ F_p (h_p · v) over contacts. ``force`` and ``friction`` are the mode's
     contact and friction forces (rows acting on z).
     """
-    n, size, width = system.n_dof, 2 * system.n_dof, force.shape[1]
+    n, width = system.n_dof, force.shape[1]
     velocity = np.zeros((n, width))
-    velocity[:, n:size] = np.eye(n)
+    velocity[:, n : 2 * n] = np.eye(n)
     ground = np.zeros((1, width))
-    ground[0, size] = 1.0
+    ground[0, width - 5] = 1.0  # z = [ξ, a_g, ȧ_g, ä_g, a⃛_g, 1]
     return [
         (ground, (-system.influence @ velocity)[None]),
         (velocity, system.damping @ velocity),
@@ -354,12 +356,12 @@ def _placeholder(system: System, chebyshev_width: int, exact: bool) -> dict[str,
 
     Without ``exact`` the ``Propagators`` arrays are one column wide (the engine does not read them).
     """
-    size, n_contacts, n_guards = 2 * system.n_dof, system.n_elements, max_guards(system)
+    size, n_contacts, n_guards = system.xi_size, system.n_elements, max_guards(system)
     width = size + 5
     propagate = (width, engine.propagate_columns(size, n_guards, n_contacts, monitor_count(system))) if exact else (1, 1)
     return {
         "modes": np.full(mode_length(system), -9, dtype=np.int64), "ids": np.int64(0), "codes": np.zeros((3, n_guards), np.int64),
-        "n_guards": np.int64(0), "substeps": np.int64(1), "rate": np.zeros((size, size + 2)),
+        "n_guards": np.int64(0), "substeps": np.int64(1), "rate": np.zeros((2 * system.n_dof, size + 2)),
         "guard": np.zeros((n_guards, size + 2)), "force": np.zeros((n_contacts, size + 2)), "monitor": np.zeros((monitor_count(system), size + 2)),
         "power": np.zeros((width, 4 * width)),
         "propagate": np.zeros(propagate), "chebyshev": np.zeros((width, chebyshev_width) if exact else (1, 1)),
