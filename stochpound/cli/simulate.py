@@ -14,12 +14,13 @@ from stochpound.solvers.ivp import INTEGRATORS
 @click.command()
 @click.argument("scene_file", type=click.Path(dir_okay=False))
 @click.option("--out", "out", required=True, type=click.Path(dir_okay=False), help="Result file (netCDF4/HDF5).")
-@click.option("--method", type=click.Choice(METHODS), default=METHODS[0], show_default=True, help="Solver: exact (matrix exponentials) or ivp (scipy integrators).")
+@click.option("--method", type=click.Choice(METHODS), default=None,
+              help="Solver: exact (matrix exponentials) or ivp (scipy integrators); default: exact when every law is piecewise linear, else ivp.")
 @click.option("--integrator", type=click.Choice(list(INTEGRATORS)), default="DOP853", show_default=True, help="Integrator of the ivp solver.")
 @click.option("--rtol", type=float, default=1e-10, show_default=True, help="Relative tolerance of the ivp solver.")
 @click.option("--atol", type=float, default=1e-12, show_default=True, help="Absolute tolerance of the ivp solver (m, m/s).")
 @click.option("--demands", is_flag=True, help="Also record floor accelerations, storey drifts and shears, and their peaks.")
-def simulate(scene_file: str, out: str, method: str, integrator: str, rtol: float, atol: float, demands: bool) -> None:
+def simulate(scene_file: str, out: str, method: str | None, integrator: str, rtol: float, atol: float, demands: bool) -> None:
     """Simulate SCENE_FILE and write the result dataset to --out."""
     try:
         scene = load_scene(scene_file)

@@ -39,12 +39,14 @@ from typing import Any, Mapping, Sequence
 import numpy as np
 
 from stochpound.errors import SceneError
-from stochpound.model import fields
+from stochpound.model import fields, hertz, jankowski
 from stochpound.model.building import Building
 from stochpound.model.guards import Guard
 
-ELEMENT_KEYS = {"stiffness", "restitution", "damping", "tensile"}
-"""The keys of the Kelvin–Voigt element itself, in a ``[[contact]]`` or a ``[[wall]]`` table."""
+ELEMENT_KEYS = {"law", "stiffness", "restitution", "damping", "tensile"}
+"""The keys of the impact element itself, in a ``[[contact]]`` or a ``[[wall]]`` table."""
+LAWS = ("kelvin", *hertz.LAWS, *jankowski.LAWS)
+"""The contact laws: ``kelvin`` (this module, the default), the Hertz family (:mod:`stochpound.model.hertz`) and :mod:`stochpound.model.jankowski`."""
 CONTACT_KEYS = {"between", "gap"} | ELEMENT_KEYS
 PIECEWISE_LINEAR = True
 """The Kelvin–Voigt element keeps every mode linear (the exact solver applies)."""
@@ -72,7 +74,10 @@ class Contact:
     tensile : bool
         True: the element separates when δ returns to 0 and may pull just
         before (the study's choice). False: it separates when its force
-        returns to 0 and never pulls.
+        returns to 0 and never pulls. The nonlinear laws separate at δ = 0
+        and never pull (True).
+    law : str
+        The contact law (:data:`LAWS`); the Hertz family's ``stiffness`` is in N/m^1.5.
     """
 
     left: int
@@ -84,6 +89,7 @@ class Contact:
     damping: float
     restitution: float | None = None
     tensile: bool = True
+    law: str = "kelvin"
 
 
 def restitution_damping_ratio(restitution: float) -> float:
@@ -121,12 +127,19 @@ def contact_from_table(table: Mapping[str, Any], prefix: str, buildings: Sequenc
     return Contact(left, left_floor, right, right_floor, gap, *element_from_table(table, prefix, mass))
 
 
-def element_from_table(table: Mapping[str, Any], prefix: str, mass: float) -> tuple[float, float, float | None, bool]:
-    """The Kelvin–Voigt element of a ``[[contact]]`` or ``[[wall]]`` table: (stiffness N/m, damping N·s/m, restitution or None, tensile).
+def element_from_table(table: Mapping[str, Any], prefix: str, mass: float) -> tuple[float, float, float | None, bool, str]:
+    """The impact element of a ``[[contact]]`` or ``[[wall]]`` table: (stiffness, damping N·s/m, restitution or None, tensile, law).
 
     ``mass`` is the effective mass m_eff of the collision (kg) that turns a
-    restitution into a dashpot.
+    restitution into a Kelvin–Voigt dashpot. The stiffness is in N/m for
+    ``kelvin``, N/m^1.5 for the nonlinear laws (which have no dashpot and
+    never pull: damping 0, tensile).
     """
+    law = fields.string(table, "law", prefix, default="kelvin")
+    if law not in LAWS:
+        raise SceneError(f"{prefix}.law: must be one of {', '.join(LAWS)}; got {law!r}")
+    if law != "kelvin":
+        return _nonlinear_element(table, prefix, law)
     stiffness = fields.number(table, "stiffness", prefix, required=True, low=0.0, low_open=True)
     restitution = None
     if "restitution" in table and "damping" in table:
@@ -137,7 +150,20 @@ def element_from_table(table: Mapping[str, Any], prefix: str, mass: float) -> tu
         restitution = fields.number(table, "restitution", prefix, required=True, low=0.0, low_open=True, high=1.0)
         damping = 2.0 * restitution_damping_ratio(restitution) * math.sqrt(stiffness * mass)
     tensile = fields.boolean(table, "tensile", prefix, default=True)
-    return stiffness, damping, restitution, tensile
+    return stiffness, damping, restitution, tensile, law
+
+
+def _nonlinear_element(table: Mapping[str, Any], prefix: str, law: str) -> tuple[float, float, float | None, bool, str]:
+    for key in ("damping", "tensile"):
+        if key in table:
+            raise SceneError(f"{prefix}.{key}: not a field of law {law!r} (its damping follows from restitution; it never pulls)")
+    stiffness = fields.number(table, "stiffness", prefix, required=True, low=0.0, low_open=True)
+    if law == "hertz":
+        if "restitution" in table:
+            raise SceneError(f"{prefix}.restitution: law 'hertz' is elastic; use law = 'hertz_damp' or 'jankowski' for a restitution")
+        return stiffness, 0.0, None, True, law
+    restitution = fields.number(table, "restitution", prefix, required=True, low=0.0, low_open=True, high=1.0, high_open=law == "jankowski")
+    return stiffness, 0.0, restitution, True, law
 
 
 def _contact_end(value: Any, path: str, buildings: Sequence[Building]) -> tuple[int, int]:

@@ -38,12 +38,12 @@ def demand_rows(floor_dofs: list[np.ndarray], base_dofs: list[int | None], store
     storey_stiffness, storey_damping : list of np.ndarray
         Each building's storey k_i (N/m) and c_i (N·s/m).
     rate : (A, B, c)
-        The mode's ẋ = A x + B a_g + c.
+        The mode's ẋ = A ξ + B a_g + c (A over ξ = [x, f]: the rows are over ξ too).
     """
     A, B, c = rate
     n = A.shape[0] // 2
     floors = sum(len(dofs) for dofs in floor_dofs)
-    matrix, ground, constant = np.zeros((3 * floors, 2 * n)), np.zeros(3 * floors), np.zeros(3 * floors)
+    matrix, ground, constant = np.zeros((3 * floors, A.shape[1])), np.zeros(3 * floors), np.zeros(3 * floors)
     row = 0
     for dofs, base, k, damping in zip(floor_dofs, base_dofs, storey_stiffness, storey_damping):
         for i, dof in enumerate(dofs):

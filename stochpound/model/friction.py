@@ -32,7 +32,7 @@ from typing import Any, Mapping
 import numpy as np
 
 from stochpound.errors import SceneError
-from stochpound.model import fields
+from stochpound.model import fields, velocity_friction
 from stochpound.model.guards import Guard
 
 STUCK = 0
@@ -64,6 +64,10 @@ class Base:
         Optional restoring stiffness k_r, N/m (0 with a ``radius``).
     radius : float or None
         Radius R of a friction pendulum, m: k_r = W/R (see :meth:`restoring`).
+    mu_fast, mu_rate : float or None
+        Velocity-dependent friction (:mod:`stochpound.model.velocity_friction`):
+        the coefficient at high velocity and the rate a (s/m); ``mu`` is then
+        the coefficient at vanishing velocity. None: Coulomb friction.
     """
 
     mass: float
@@ -71,6 +75,8 @@ class Base:
     mu_static: float
     restoring_stiffness: float = 0.0
     radius: float | None = None
+    mu_fast: float | None = None
+    mu_rate: float | None = None
 
     def restoring(self, weight: float) -> float:
         """The restoring stiffness k_r (N/m) of the base under the building's weight W (N): W/R for a friction pendulum."""
@@ -88,13 +94,17 @@ def base_from_table(table: Mapping[str, Any] | None, prefix: str) -> Base | None
         return None
     fields.reject_unknown(table, BASE_KEYS, prefix)
     mass = fields.number(table, "mass", prefix, required=True, low=0.0, low_open=True)
-    mu = fields.number(table, "mu", prefix, required=True, low=0.0)
+    mu_fast = mu_rate = None
+    if isinstance(table.get("mu"), dict):
+        mu, mu_fast, mu_rate = velocity_friction.mu_from_table(table["mu"], f"{prefix}.mu")
+    else:
+        mu = fields.number(table, "mu", prefix, required=True, low=0.0)
     mu_static = fields.number(table, "mu_static", prefix, default=mu, low=mu)
     if "radius" in table and "restoring_stiffness" in table:
         raise SceneError(f"{prefix}.radius: give either radius (a friction pendulum, k_r = W/R) or restoring_stiffness, not both")
     restoring = fields.number(table, "restoring_stiffness", prefix, default=0.0, low=0.0)
     radius = fields.number(table, "radius", prefix, low=0.0, low_open=True)
-    return Base(mass, mu, mu_static, restoring, radius)
+    return Base(mass, mu, mu_static, restoring, radius, mu_fast, mu_rate)
 
 
 @dataclass(frozen=True)
@@ -110,7 +120,9 @@ class SlidingBase:
     weight : float
         W = g × (base + floor masses), N.
     mu, mu_static : float
-        Kinetic and static friction coefficients.
+        Kinetic (at vanishing velocity, for velocity-dependent friction) and static friction coefficients.
+    mu_fast, mu_rate : float or None
+        Velocity-dependent friction's coefficient at high velocity and rate (s/m); None: Coulomb.
     """
 
     building: int
@@ -118,6 +130,13 @@ class SlidingBase:
     weight: float
     mu: float
     mu_static: float
+    mu_fast: float | None = None
+    mu_rate: float | None = None
+
+    @property
+    def velocity_dependent(self) -> bool:
+        """True for velocity-dependent friction (a nonlinear law: its slip force is a read-out)."""
+        return self.mu_fast is not None
 
     @property
     def frictionless(self) -> bool:
@@ -136,13 +155,13 @@ def slipping(state: int) -> bool:
 
 
 def slip_force(base: SlidingBase, state: int) -> float:
-    """The foundation's force on a slipping base, −σ μ W (N, positive to the right); 0 in other states."""
-    return -state * base.mu * base.weight if slipping(state) else 0.0
+    """The foundation's force on a slipping Coulomb base, −σ μ W (N, positive to the right); 0 in other states and with velocity-dependent friction (a read-out)."""
+    return -state * base.mu * base.weight if slipping(state) and not base.velocity_dependent else 0.0
 
 
-def stuck_foundation_force(dof: int, mass: np.ndarray, stiffness: np.ndarray, damping: np.ndarray, load: np.ndarray, influence: np.ndarray,
-                           rate: tuple[np.ndarray, np.ndarray, np.ndarray], free: np.ndarray) -> tuple[np.ndarray, float, float]:
-    """The foundation's force −F_req on a stuck base as an affine map (row over x = [q, v], a_g coefficient, constant).
+def stuck_foundation_force(dof: int, mass: np.ndarray, stiffness: np.ndarray, damping: np.ndarray, load: np.ndarray, inputs: np.ndarray,
+                           influence: np.ndarray, rate: tuple[np.ndarray, np.ndarray, np.ndarray], free: np.ndarray) -> tuple[np.ndarray, float, float]:
+    """The foundation's force −F_req on a stuck base as an affine map (row over ξ = [q, v, f], a_g coefficient, constant).
 
     From the base's equation with s̈ = 0: F_req is what the base needs to
     stay put, given the free DOFs' accelerations of the stuck mode.
@@ -155,6 +174,8 @@ def stuck_foundation_force(dof: int, mass: np.ndarray, stiffness: np.ndarray, da
         The mode's M, K, C (N × N).
     load : np.ndarray
         The mode's constant generalised load (N).
+    inputs : np.ndarray
+        The generalised load of each read-out f per unit (N × n_f).
     influence : np.ndarray
         r: the ground-acceleration load is −r a_g (kg).
     rate : (A, B, c)
@@ -165,7 +186,7 @@ def stuck_foundation_force(dof: int, mass: np.ndarray, stiffness: np.ndarray, da
     A, B, c = rate
     n = len(mass)
     coupling = mass[dof, free]
-    required = -np.concatenate([stiffness[dof], damping[dof]]) - coupling @ A[n + free]
+    required = -np.concatenate([stiffness[dof], damping[dof], -inputs[dof]]) - coupling @ A[n + free]
     return -required, float(influence[dof] + coupling @ B[n + free]), float(-(load[dof] - coupling @ c[n + free]))
 
 
@@ -180,7 +201,7 @@ def guards(base: SlidingBase, index: int, state: int, foundation: tuple[np.ndarr
         # F_req = −(foundation force); slip in direction σ when σ F_req > μ_s W
         return [(-sense * row, -sense * ground, -sense * constant - limit, Guard.SLIP, index, sense) for sense in (SLIP_RIGHT, SLIP_LEFT)]
     if slipping(state):
-        row = np.zeros(2 * n_dof)
+        row = np.zeros(len(foundation[0]))
         row[n_dof + base.dof] = -state
         return [(row, 0.0, 0.0, Guard.STOP, index, 0)]
     return []

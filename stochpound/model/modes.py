@@ -193,34 +193,78 @@ class ModeLibrary:
 
 
 def _build(system: System, mode: Mode, masses: tuple[np.ndarray, np.ndarray, np.ndarray], rows: contact.ContactRows) -> ModeDynamics:
-    """The dynamics of ``mode`` from its stuck and free DOFs and free mass inverse (``masses``)."""
-    n = system.n_dof
+    """The dynamics of ``mode`` from its stuck and free DOFs and free mass inverse (``masses``).
+
+    Every map acts on ξ = [x, f] (the read-outs f of the nonlinear laws enter
+    as inputs: their columns of A are E, :func:`_readout_loads`).
+    """
+    n, size = system.n_dof, system.xi_size
     stuck, free, inverse_mass = masses
     closed = np.array(mode.closed, bool)
     k, c_imp, d = system.element_stiffness, system.element_damping, system.element_gap
-    extra_stiffness, extra_damping, load = contact.closed_terms(system.element_geometry, system.element_load, k, c_imp, d, closed)
+    linear = closed & ~system.nonlinear  # the closed Kelvin–Voigt elements, folded into K, C and the load
+    extra_stiffness, extra_damping, load = contact.closed_terms(system.element_geometry, system.element_load, k, c_imp, d, linear)
     stiffness, damping = system.stiffness + extra_stiffness, system.damping + extra_damping
     for base, state in zip(system.bases, mode.base):
         load[base.dof] += friction.slip_force(base, state)
-    A = np.zeros((2 * n, 2 * n))
+    inputs = _readout_loads(system, mode)
+    A = np.zeros((2 * n, size))
     A[free, n + free] = 1.0
     A[n + free, :n] = -inverse_mass @ stiffness[free]
-    A[n + free, n:] = -inverse_mass @ damping[free]
+    A[n + free, n : 2 * n] = -inverse_mass @ damping[free]
+    A[n + free, 2 * n :] = inverse_mass @ inputs[free]
     B = np.zeros(2 * n)
     B[n + free] = -inverse_mass @ system.influence[free]
     c = np.zeros(2 * n)
     c[n + free] = inverse_mass @ load[free]
-    foundation = [
-        friction.stuck_foundation_force(base.dof, system.mass, stiffness, damping, load, system.influence, (A, B, c), free)
-        if state == STUCK else (np.zeros(2 * n), 0.0, friction.slip_force(base, state))
-        for base, state in zip(system.bases, mode.base)
-    ]
-    contact_guards = contact.guards(rows, k, d, system.element_tensile, closed)
+    foundation = [_foundation_force(system, i, state, (stiffness, damping, load, inputs), (A, B, c), free) for i, state in enumerate(mode.base)]
+    matrix, *rest = contact.guards(rows, k, d, system.element_tensile, closed)
+    contact_guards = (_over_xi(matrix, size), *rest)
     base_guards = [guard for i, (base, state) in enumerate(zip(system.bases, mode.base))
                    for guard in friction.guards(base, i, state, foundation[i], n)]
-    force_matrix, force_constant = contact.force_rows(rows, k, d, closed)
-    return ModeDynamics(mode, A, B, c, *_stack_guards(contact_guards, base_guards, 2 * n), force_matrix, force_constant,
-                        *_stack_foundation(foundation, 2 * n), *monitor_rows(system, rows, (A, B, c)), stuck)
+    force_matrix, force_constant = contact.force_rows(rows, k, d, linear)
+    force_matrix = _over_xi(force_matrix, size)
+    readout = 2 * n + np.arange(len(system.readout_elements))
+    force_matrix[system.readout_elements, readout] = closed[system.readout_elements]  # a nonlinear element's force is its read-out
+    return ModeDynamics(mode, A, B, c, *_stack_guards(contact_guards, base_guards, size), force_matrix, force_constant,
+                        *_stack_foundation(foundation, size), *monitor_rows(system, rows, (A, B, c)), stuck)
+
+
+def _over_xi(matrix: np.ndarray, size: int) -> np.ndarray:
+    """Rows over x (… × 2N) as rows over ξ = [x, f] (… × ``size``), zero on the read-outs."""
+    out = np.zeros(matrix.shape[:-1] + (size,))
+    out[..., : matrix.shape[-1]] = matrix
+    return out
+
+
+def _readout_loads(system: System, mode: Mode) -> np.ndarray:
+    """The generalised load of each read-out per unit (N × n_f): −h_p for a closed nonlinear element p, the base DOF for a slipping velocity-dependent base."""
+    inputs = np.zeros((system.n_dof, system.n_readouts))
+    for j, p in enumerate(system.readout_elements):
+        if mode.closed[p]:
+            inputs[:, j] = -system.element_load[p]
+    for j, b in enumerate(system.readout_bases, start=len(system.readout_elements)):
+        if friction.slipping(mode.base[b]):
+            inputs[system.bases[b].dof, j] = 1.0
+    return inputs
+
+
+def _foundation_force(system: System, b: int, state: int, terms: tuple[np.ndarray, ...], rate: tuple[np.ndarray, ...],
+                      free: np.ndarray) -> tuple[np.ndarray, float, float]:
+    """The foundation's force on sliding base b in ``state`` as a map over ξ: (row, a_g coefficient, constant).
+
+    Stuck: −F_req (:func:`stochpound.model.friction.stuck_foundation_force`);
+    slipping: −σ μ W, or its read-out with velocity-dependent friction; free: 0.
+    ``terms``: the mode's K, C, constant load and read-out loads.
+    """
+    base, size = system.bases[b], system.xi_size
+    if state == STUCK:
+        stiffness, damping, load, inputs = terms
+        return friction.stuck_foundation_force(base.dof, system.mass, stiffness, damping, load, inputs, system.influence, rate, free)
+    row = np.zeros(size)
+    if base.velocity_dependent and friction.slipping(state):
+        row[2 * system.n_dof + len(system.readout_elements) + list(system.readout_bases).index(b)] = 1.0
+    return row, 0.0, friction.slip_force(base, state)
 
 
 def monitor_count(system: System) -> int:
@@ -239,7 +283,7 @@ def monitor_rows(system: System, rows: contact.ContactRows, rate: tuple[np.ndarr
     absolute values). ``rate`` is the mode's (A, B, c).
     """
     n_closures = len(rows.penetration)
-    matrix, ground, constant = rows.penetration, np.zeros(n_closures), np.zeros(n_closures)
+    matrix, ground, constant = _over_xi(rows.penetration, system.xi_size), np.zeros(n_closures), np.zeros(n_closures)
     if not system.demands:
         return matrix, ground, constant
     demand = demand_rows(system.floor_dofs, system.building_base_dofs, system.storey_stiffness, system.storey_damping, rate)

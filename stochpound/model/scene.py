@@ -58,3 +58,14 @@ class Scene:
     def max_floors(self) -> int:
         """Largest number of floors of any building."""
         return max(b.n_floors for b in self.buildings)
+
+    def nonlinear_laws(self) -> list[str]:
+        """The laws of the scene that are not piecewise linear (the exact solver cannot take them), each named by its field.
+
+        E.g. ``contact[0].law = 'hertz'``, ``building[0].base.mu`` (velocity-dependent friction).
+        """
+        laws = [f"contact[{p}].law = {c.law!r}" for p, c in enumerate(self.contacts) if c.law != "kelvin"]
+        laws += [f"wall[{p}].law = {w.law!r}" for p, w in enumerate(self.walls) if w.law != "kelvin"]
+        laws += [f"building[{b}].base.mu (velocity-dependent friction)" for b, building in enumerate(self.buildings)
+                 if building.base is not None and building.base.mu_fast is not None]
+        return laws

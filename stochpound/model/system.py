@@ -28,7 +28,7 @@ from functools import cached_property, lru_cache
 import numpy as np
 
 from stochpound.model.building import Building, storey_matrix
-from stochpound.model.contact import Contact
+from stochpound.model.contact import Contact, effective_mass
 from stochpound.model.wall import Wall
 from stochpound.model.friction import SlidingBase
 from stochpound.model.scene import Scene
@@ -64,6 +64,10 @@ class System:
         Rows (n_elements × N) giving the displacement relative to the ground
         of each element's left and right side (a wall's side is 0: it moves
         with the ground); g_p = left − right.
+    element_law : tuple of str
+        Each element's contact law (:data:`stochpound.model.contact.LAWS`).
+    element_restitution, element_mass : np.ndarray
+        Each element's coefficient of restitution (NaN if none) and effective mass m_eff (kg).
     total_displacement : np.ndarray
         Y (n_floors_total × N): total displacements y = s + u of every floor, in DOF order.
     initial_state : np.ndarray
@@ -72,10 +76,11 @@ class System:
         Each building's storey k_i (N/m) and c_i (N·s/m).
     demands : bool
         Whether runs monitor the demand parameters (:mod:`stochpound.model.demands`).
-    n_readouts : int
-        Number n_f of read-outs f: the forces of nonlinear laws, which enter a
-        mode's equations as inputs (ẋ = A x + E f + B a_g + c); the engine's
-        state is ξ = [x, f].
+    readout_elements, readout_bases : np.ndarray of int
+        The read-outs f: the forces of nonlinear laws, which enter a mode's
+        equations as inputs (ẋ = A x + E f + B a_g + c; the engine's state is
+        ξ = [x, f]): first the elements with a nonlinear contact law, then the
+        sliding bases with velocity-dependent friction (their indices).
     """
 
     n_dof: int
@@ -94,17 +99,31 @@ class System:
     element_tensile: np.ndarray
     element_left: np.ndarray
     element_right: np.ndarray
+    element_law: tuple[str, ...]
+    element_restitution: np.ndarray
+    element_mass: np.ndarray
     total_displacement: np.ndarray
     initial_state: np.ndarray
     storey_stiffness: list[np.ndarray]
     storey_damping: list[np.ndarray]
     demands: bool
-    n_readouts: int
+    readout_elements: np.ndarray
+    readout_bases: np.ndarray
 
     @property
     def n_elements(self) -> int:
         """Number of impact elements (contacts, then walls)."""
         return len(self.element_gap)
+
+    @property
+    def n_readouts(self) -> int:
+        """Number n_f of read-outs (nonlinear elements, then velocity-dependent bases)."""
+        return len(self.readout_elements) + len(self.readout_bases)
+
+    @property
+    def nonlinear(self) -> np.ndarray:
+        """Which elements have a nonlinear contact law (bool per element)."""
+        return np.array([law != "kelvin" for law in self.element_law], dtype=bool)
 
     @property
     def xi_size(self) -> int:
@@ -130,7 +149,7 @@ class System:
         digest = hashlib.blake2b(digest_size=20)
         for item in fields(self):
             value = getattr(self, item.name)
-            if isinstance(value, (tuple, int, bool)):  # the sliding bases (frozen dataclasses of numbers), the number of contacts, a flag
+            if isinstance(value, (tuple, int, bool)):  # the sliding bases (frozen dataclasses of numbers), the laws, counts and flags
                 digest.update(f"{item.name}{value!r}".encode())
                 continue
             for array in value if isinstance(value, list) else [value]:
@@ -184,7 +203,8 @@ def _build_system(buildings: tuple[Building, ...], contacts: tuple[Contact, ...]
             total[row : row + building.n_floors, base] = 1.0
             initial[base] = building.initial.base_displacement
             initial[n_dof + base] = building.initial.base_velocity
-            bases.append(SlidingBase(b, base, g * building.total_mass, building.base.mu, building.base.mu_static))
+            bases.append(SlidingBase(b, base, g * building.total_mass, building.base.mu, building.base.mu_static, building.base.mu_fast,
+                                     building.base.mu_rate))
         row += building.n_floors
     levels = _level_rows(buildings, floor_dofs, base_dofs, n_dof)
     left, right, load = _element_rows(contacts, walls, study_compat, levels, base_dofs)
@@ -206,13 +226,24 @@ def _build_system(buildings: tuple[Building, ...], contacts: tuple[Contact, ...]
         element_tensile=np.array([e.tensile for e in elements], bool),
         element_left=left,
         element_right=right,
+        element_law=tuple(e.law for e in elements),
+        element_restitution=np.array([np.nan if e.restitution is None else e.restitution for e in elements], float),
+        element_mass=_element_masses(buildings, contacts, walls),
         total_displacement=total,
         initial_state=initial,
         storey_stiffness=[np.asarray(b.stiffness, float) for b in buildings],
         storey_damping=[np.asarray(b.damping, float) for b in buildings],
         demands=demands,
-        n_readouts=0,
+        readout_elements=np.array([p for p, e in enumerate(elements) if e.law != "kelvin"], dtype=np.int64),
+        readout_bases=np.array([i for i, base in enumerate(bases) if base.velocity_dependent], dtype=np.int64),
     )
+
+
+def _element_masses(buildings: tuple[Building, ...], contacts: tuple[Contact, ...], walls: tuple[Wall, ...]) -> np.ndarray:
+    """Each impact element's effective mass m_eff (kg): m1 m2/(m1 + m2) for a contact, the level's mass for a wall."""
+    masses = [effective_mass(buildings[c.left].mass[c.left_floor - 1], buildings[c.right].mass[c.right_floor - 1]) for c in contacts]
+    masses += [buildings[w.building].base.mass if w.level == 0 else buildings[w.building].mass[w.level - 1] for w in walls]
+    return np.array(masses, float)
 
 
 def _layout(buildings: tuple[Building, ...]) -> tuple[list[np.ndarray], list[int | None], int]:

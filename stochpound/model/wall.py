@@ -56,6 +56,8 @@ class Wall:
         Coefficient of restitution the damping was derived from.
     tensile : bool
         False: the element separates when its force returns to 0.
+    law : str
+        The contact law of the element (:data:`stochpound.model.contact.LAWS`).
     """
 
     building: int
@@ -66,6 +68,7 @@ class Wall:
     damping: float
     restitution: float | None = None
     tensile: bool = True
+    law: str = "kelvin"
 
     @property
     def side_name(self) -> str:

@@ -93,7 +93,8 @@ class Recorder:
     system : System
     motion : GroundMotion
     states : np.ndarray
-        x = [q, v] at every output time (n_times × 2N), m and m/s.
+        ξ = [q, v, f] at every output time (n_times × S'), m, m/s and N (the
+        read-outs f of nonlinear laws, :mod:`stochpound.model.readouts`).
     forces, friction, base_states : np.ndarray
         Impact element forces (N: contacts, then walls), force of the foundation on each sliding base (N,
         positive to the right) and base states
@@ -131,7 +132,7 @@ class Recorder:
 
     def __post_init__(self) -> None:
         n_times, n = len(self.motion.times), self.system.n_dof
-        self.states = np.zeros((n_times, 2 * n))
+        self.states = np.zeros((n_times, self.system.xi_size))
         self.forces = np.zeros((n_times, self.system.n_elements))
         self.friction = np.zeros((n_times, len(self.system.base_dofs)))
         self.base_states = np.zeros((n_times, len(self.system.base_dofs)), dtype=np.int8)
@@ -204,7 +205,7 @@ class Recorder:
     def kinetic_and_strain(self) -> tuple[np.ndarray, np.ndarray]:
         """Kinetic energy ½ vᵀMv and storey/restoring strain energy ½ qᵀKq at the samples, J."""
         n = self.system.n_dof
-        q, v = self.states[:, :n], self.states[:, n:]
+        q, v = self.states[:, :n], self.states[:, n : 2 * n]
         kinetic = 0.5 * np.einsum("ti,ti->t", v @ self.system.mass, v)
         strain = 0.5 * np.einsum("ti,ti->t", q @ self.system.stiffness, q)
         return kinetic, strain

@@ -24,6 +24,7 @@ from typing import Protocol
 import numpy as np
 
 from stochpound.model.modes import Mode, ModeDynamics, ModeLibrary, initial_mode
+from stochpound.model.readouts import Readouts
 from stochpound.model.system import System
 from stochpound.motions.ground import GroundMotion
 from stochpound.results.record import EventCounters, Impact, Recorder
@@ -37,8 +38,11 @@ class Stepper(Protocol):
     degree: int
     """Chebyshev degree of the supplied dense output."""
 
-    def step(self, dynamics: ModeDynamics, k: int, t: float, x: np.ndarray, t_end: float, supplied: engine.Supplied) -> None:
-        """Fill ``supplied`` with the next step from (t, x) in mode ``dynamics`` inside motion interval k, ending by ``t_end``."""
+    def step(self, dynamics: ModeDynamics, k: int, t: float, x: np.ndarray, t_end: float, supplied: engine.Supplied, onsets: np.ndarray) -> None:
+        """Fill ``supplied`` with the next step from (t, ξ = x) in mode ``dynamics`` inside motion interval k, ending by ``t_end``.
+
+        ``onsets``: each impact element's current impact approach velocity (m/s).
+        """
 
 
 class EngineRun:
@@ -61,6 +65,7 @@ class EngineRun:
                  building: Callable[[], contextlib.AbstractContextManager] = contextlib.nullcontext) -> None:
         self.system, self.motion = system, motion
         self.stepper, self.building = stepper, building
+        self.readouts = Readouts(system)
         self.slots = tables.slots_of(library)
         self.plant = tables.plant_arrays(system, motion)
         self.state = tables.run_state(system, len(motion.times), stepper.degree if stepper else 0)
@@ -69,7 +74,7 @@ class EngineRun:
         """Run the simulation; return what it recorded, its event counts and the modes it visited."""
         run, system, slots = self.state.run, self.system, self.slots
         run.pending_mode[:] = tables.mode_vector(initial_mode(system))
-        run.pending_x[:] = system.initial_state
+        run.pending_x[: 2 * system.n_dof] = system.initial_state
         run.clock[0] = self.motion.times[0]
         run.ints[engine.PENDING] = engine.INITIAL
         while True:
@@ -95,7 +100,8 @@ class EngineRun:
         run = self.state.run
         k = int(run.ints[engine.K])
         mode = self.slots.modes[int(self.slots.arrays["ids"][run.ints[engine.MODE]])]
-        self.stepper.step(self.slots.dynamics(mode), k, float(run.clock[0]), run.x, float(self.motion.times[k + 1]), self.state.supplied)
+        self.stepper.step(self.slots.dynamics(mode), k, float(run.clock[0]), run.x, float(self.motion.times[k + 1]), self.state.supplied,
+                          self.state.impacts.impact[engine.ONSET])
         run.ints[engine.READY] = 1
 
     def _supply_readouts(self) -> None:

@@ -23,8 +23,9 @@ from threadpoolctl import threadpool_limits
 
 from stochpound.errors import StochpoundError
 from stochpound.model.modes import Mode, ModeDynamics, ModeLibrary
+from stochpound.model.readouts import Readouts
 from stochpound.model.scene import Scene
-from stochpound.model.system import build_system
+from stochpound.model.system import System, build_system
 from stochpound.motions.ground import GroundMotion
 from stochpound.results.record import EventCounters, Recorder
 from stochpound.solvers import engine
@@ -62,7 +63,7 @@ def run_ivp(scene: Scene, integrator: str = "DOP853", rtol: float = 1e-10, atol:
     if integrator not in INTEGRATORS:
         raise ValueError(f"integrator must be one of {', '.join(INTEGRATORS)}, got {integrator!r}")
     system = build_system(scene, demands)
-    stepper = IntegratorSteps(scene.motion, integrator, rtol, atol)
+    stepper = IntegratorSteps(system, scene.motion, integrator, rtol, atol)
     with threadpool_limits(limits=1):
         return EngineRun(system, scene.motion, ModeLibrary(system), stepper=stepper).execute()
 
@@ -72,12 +73,16 @@ class IntegratorSteps:
 
     The integrator is kept while the engine asks for the next step from where
     the last one ended, in the same mode and interval, and started afresh
-    otherwise (after an event, or in a new interval).
+    otherwise (after an event, or in a new interval). With nonlinear laws the
+    rate function and the supplied steps evaluate their read-outs f
+    (:class:`stochpound.model.readouts.Readouts`): ξ = [x, f].
     """
 
     degree = SUPPLIED_DEGREE
 
-    def __init__(self, motion: GroundMotion, integrator: str, rtol: float, atol: float) -> None:
+    def __init__(self, system: System, motion: GroundMotion, integrator: str, rtol: float, atol: float) -> None:
+        self.readouts = Readouts(system)
+        self.size = 2 * system.n_dof
         self.motion = motion
         self.name, self.integrator, self.implicit = integrator, INTEGRATORS[integrator], integrator in _IMPLICIT
         self.rtol, self.atol = rtol, atol
@@ -85,10 +90,13 @@ class IntegratorSteps:
         self.span: tuple[Mode, int] | None = None
         self.step_guess: float | None = None
 
-    def step(self, dynamics: ModeDynamics, k: int, t: float, x: np.ndarray, t_end: float, supplied: engine.Supplied) -> None:
-        """Take one step from (t, x) in ``dynamics``' mode inside interval k (ending by t_end) into ``supplied``."""
+    def step(self, dynamics: ModeDynamics, k: int, t: float, x: np.ndarray, t_end: float, supplied: engine.Supplied, onsets: np.ndarray) -> None:
+        """Take one step from (t, ξ = x) in ``dynamics``' mode inside interval k (ending by t_end) into ``supplied``.
+
+        ``onsets``: each element's current impact approach velocity (m/s), for laws that need it.
+        """
         if self.solver is None or self.span != (dynamics.mode, k) or self.solver.t != t:
-            self.solver, self.span = self._solver(dynamics, k, t, x, t_end), (dynamics.mode, k)
+            self.solver, self.span = self._solver(dynamics, k, t, x[: self.size], t_end, onsets), (dynamics.mode, k)
         solver = self.solver
         t_old = solver.t
         solver.step()
@@ -97,19 +105,34 @@ class IntegratorSteps:
         self.step_guess = solver.t - t_old
         dense = solver.dense_output()
         half = 0.5 * (solver.t - t_old)
-        coefficients = chebyshev.chebinterpolate(lambda s: dense(t_old + half * (s + 1.0)).T, self.degree)
-        supplied.bounds[:] = t_old, solver.t
-        supplied.x[:] = solver.y
-        supplied.coefficients[:] = coefficients.ravel()
 
-    def _solver(self, dynamics: ModeDynamics, k: int, t: float, x: np.ndarray, t_end: float):
+        def xi(s: np.ndarray) -> np.ndarray:
+            states = dense(t_old + half * (s + 1.0)).T
+            return np.concatenate([states, self.readouts.values(dynamics.mode, states, onsets)], axis=-1)
+
+        supplied.bounds[:] = t_old, solver.t
+        supplied.x[:] = xi(np.array([1.0]))[0]
+        supplied.x[: self.size] = solver.y
+        supplied.coefficients[:] = chebyshev.chebinterpolate(xi, self.degree).ravel()
+
+    def _solver(self, dynamics: ModeDynamics, k: int, t: float, x: np.ndarray, t_end: float, onsets: np.ndarray):
         A, B, c = dynamics.A, dynamics.B, dynamics.c
+        if A.shape[1] > self.size:  # read-outs: ẋ = A_x x + E f(x) + B a_g + c
+            mode, A, E, readouts = dynamics.mode, A[:, : self.size], A[:, self.size :], self.readouts
+
+            def inputs(state):
+                return c + E @ readouts.values(mode, state, onsets)
+        else:
+
+            def inputs(state):
+                return c
+
         polynomial = self.motion.polynomial(k)
         if polynomial is None:
             acceleration = self.motion.acceleration
 
             def rate(time, state):
-                return A @ state + B * acceleration(time, k) + c
+                return A @ state + B * acceleration(time, k) + inputs(state)
 
         else:
             c0, c1, c2, c3 = (float(value) for value in polynomial)
@@ -117,11 +140,11 @@ class IntegratorSteps:
 
             def rate(time, state):
                 tau = time - start
-                return A @ state + B * (c0 + tau * (c1 + tau * (c2 + tau * c3))) + c
+                return A @ state + B * (c0 + tau * (c1 + tau * (c2 + tau * c3))) + inputs(state)
 
         options = {"rtol": self.rtol, "atol": self.atol}
         if self.step_guess is not None:
             options["first_step"] = min(self.step_guess, t_end - t)
-        if self.implicit:
+        if self.implicit and dynamics.A.shape[1] == self.size:  # with read-outs the integrator estimates the Jacobian
             options["jac"] = lambda time, state: A  # LSODA accepts only a callable
         return self.integrator(rate, t, np.array(x), t_end, **options)

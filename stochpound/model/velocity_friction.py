@@ -1,0 +1,48 @@
+"""Velocity-dependent friction of a sliding base (PTFE on steel; Constantinou, Mokha & Reinhorn 1990).
+
+Scene keys: ``[building.base]`` ``mu = { slow = ..., fast = ..., rate = ... }``
+instead of a number: the coefficient at vanishing and at high sliding
+velocity and the rate a (s/m); ``mu_static`` defaults to ``slow``.
+
+The law (docs/model.md, "Friction laws"): while the base slips at velocity ṡ,
+
+    μ(ṡ) = μ_fast − (μ_fast − μ_slow) exp(−a |ṡ|),
+
+and the foundation's force on the base is −sgn(ṡ) μ(ṡ) W; the base sticks
+and slips as with Coulomb friction (stick while the force it needs stays
+within μ_s W). With μ_fast = μ_slow it is Coulomb friction. Not piecewise
+linear: a scene that asks for it runs on the ivp path.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Mapping
+
+import numpy as np
+
+from stochpound.errors import SceneError
+from stochpound.model import fields
+
+MU_KEYS = {"slow", "fast", "rate"}
+PIECEWISE_LINEAR = False
+
+
+def mu_from_table(table: Mapping[str, Any], prefix: str) -> tuple[float, float, float]:
+    """The ``mu = { slow, fast, rate }`` table (at ``prefix``): (μ_slow, μ_fast, a in s/m), validated."""
+    fields.reject_unknown(table, MU_KEYS, prefix)
+    slow = fields.number(table, "slow", prefix, required=True, low=0.0)
+    fast = fields.number(table, "fast", prefix, required=True, low=slow)
+    rate = fields.number(table, "rate", prefix, required=True, low=0.0, low_open=True)
+    if fast == 0.0:
+        raise SceneError(f"{prefix}.fast: must be > 0 (a frictionless base is mu = 0)")
+    return slow, fast, rate
+
+
+def coefficient(slow: float, fast: float, rate: float, speed: np.ndarray) -> np.ndarray:
+    """μ at sliding speed |ṡ| (m/s)."""
+    return fast - (fast - slow) * np.exp(-rate * speed)
+
+
+def coefficient_slope(slow: float, fast: float, rate: float, speed: np.ndarray) -> np.ndarray:
+    """dμ/d|ṡ| (s/m) at sliding speed |ṡ|."""
+    return rate * (fast - slow) * np.exp(-rate * speed)
