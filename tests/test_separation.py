@@ -3,8 +3,8 @@
 The same Kanai–Tajimi realizations are run contact-free (gap = inf) and with
 gaps, for the study's pair (Building 1 next to the flexible Building 2, both
 floors in contact) on fixed and on sliding bases. Gaps 10 nm either side of
-each run's D check that D is located on the solution (a peak taken on the
-0.01 s output grid falls short of it by up to about 0.1 mm).
+each run's D check that D is located on the solution (in these runs the
+largest closure at the 0.01 s output samples falls short of it by up to 0.16 mm).
 """
 
 import dataclasses
