@@ -64,12 +64,14 @@ def test_rule_exceedance_judges_each_rules_gap_per_run():
             [[0.04, 0.05], [0.07, 0.02], [0.03, 0.03], [0.02, 0.05]],  # reached in run 0 only (contact 1, a tie)
             [[0.01, 0.10], [0.10, 0.10], [0.10, 0.10], [0.10, 0.03]],  # reached in runs 0 (contact 0) and 3 (contact 1)
             [[np.nan, 0.1], [0.1, 0.1], [0.1, 0.1], [0.1, 0.1]],  # run 0 left out: not reached in 3 runs
+            np.full((4, 2), np.nan),  # no gap: no run counted
         ],
-        dims=("rule", "realization", "contact"), coords={"rule": ["a", "b", "c"]},
+        dims=("rule", "realization", "contact"), coords={"rule": ["a", "b", "c", "d"]},
     )
     result = rule_exceedance(peak, rule_gap)
-    np.testing.assert_array_equal(result["probability"], [1 / 4, 2 / 4, 0 / 3])
-    np.testing.assert_array_equal(result["realizations"], [4, 4, 3])
+    np.testing.assert_array_equal(result["probability"], [1 / 4, 2 / 4, 0 / 3, np.nan])
+    np.testing.assert_array_equal(result["realizations"], [4, 4, 3, 0])
+    assert result[["lower", "upper"]].sel(rule="d").isnull().all()
     interval = stats.binomtest(2, 4).proportion_ci(confidence_level=0.95, method="exact")
     assert float(result["lower"].sel(rule="b")) == pytest.approx(interval.low, abs=1e-10)
     assert float(result["upper"].sel(rule="b")) == pytest.approx(interval.high, abs=1e-10)

@@ -27,6 +27,7 @@ import xarray as xr  # noqa: E402
 import stochpound  # noqa: E402
 from stochpound import motions  # noqa: E402
 from stochpound.analysis import contact_demands, fixed_base_cqc, pounding_curve, required_separation, rule_exceedance, separation_rules  # noqa: E402
+from stochpound.model.scene import Scene  # noqa: E402
 from stochpound.motions.ground import SampledMotion  # noqa: E402
 
 HERE = Path(__file__).resolve().parent
@@ -36,7 +37,7 @@ TARGETS = (0.5, 0.16, 0.05)
 RULE_STYLES = {"abs": "tab:red", "srss": "tab:blue", "srss_reduced": "tab:cyan", "ddc": "tab:green", "ddc_cqc": "tab:olive"}
 
 
-def pairs() -> dict[str, stochpound.model.scene.Scene]:
+def pairs() -> dict[str, Scene]:
     """The pair with Building 1 isolated (μ = 0.2) and fixed, contact-free."""
     isolated = stochpound.load_scene(SCENE)
     isolated = dataclasses.replace(isolated, contacts=tuple(dataclasses.replace(c, gap=math.inf) for c in isolated.contacts))
@@ -45,7 +46,7 @@ def pairs() -> dict[str, stochpound.model.scene.Scene]:
     return {"both fixed": fixed, "B1 isolated, μ = 0.2": isolated}
 
 
-def ensemble_demands(scene, accelerations: xr.DataArray) -> xr.Dataset:
+def ensemble_demands(scene: Scene, accelerations: xr.DataArray) -> xr.Dataset:
     """contact_demands of the contact-free runs of ``scene`` under every realization."""
     demands = []
     for samples in accelerations.values:
@@ -54,7 +55,7 @@ def ensemble_demands(scene, accelerations: xr.DataArray) -> xr.Dataset:
     return xr.concat(demands, dim="realization")
 
 
-def panel(ax, name: str, scene, demands: xr.Dataset) -> None:
+def panel(ax: plt.Axes, name: str, scene: Scene, demands: xr.Dataset) -> None:
     """Pounding curve with its band, required separations, and each rule's exceedance at its median gap."""
     cqc = fixed_base_cqc(scene)
     rules = separation_rules(demands, cqc=cqc if cqc.notnull().all() else None)

@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import numpy as np
 import xarray as xr
+from numpy.typing import ArrayLike
 from scipy.linalg import eigh
 
 from stochpound.analysis.correlation import correlation
@@ -117,7 +118,7 @@ def ddc_rule(u1: xr.DataArray, u2: xr.DataArray, rho: xr.DataArray) -> xr.DataAr
     return np.sqrt(np.maximum(u1**2 + u2**2 - 2.0 * rho * u1 * u2, 0.0))
 
 
-def cqc_coefficient(omega_i, zeta_i, omega_j, zeta_j):
+def cqc_coefficient(omega_i: ArrayLike, zeta_i: ArrayLike, omega_j: ArrayLike, zeta_j: ArrayLike) -> np.ndarray:
     """CQC correlation coefficient of two linear oscillators (Der Kiureghian 1981).
 
     ρ_ij = 8 sqrt(ζ_i ζ_j ω_i ω_j) (ζ_i ω_i + ζ_j ω_j) ω_i ω_j
@@ -136,7 +137,13 @@ def cqc_coefficient(omega_i, zeta_i, omega_j, zeta_j):
         Natural circular frequencies, rad/s (≥ 0).
     zeta_i, zeta_j : array_like
         Damping ratios (≥ 0, not both 0). Broadcast like numpy arrays.
+
+    Returns
+    -------
+    numpy.ndarray
+        ρ_ij, in [0, 1].
     """
+    omega_i, zeta_i, omega_j, zeta_j = (np.asarray(value, dtype=float) for value in (omega_i, zeta_i, omega_j, zeta_j))
     product = omega_i * omega_j
     numerator = 8.0 * np.sqrt(zeta_i * zeta_j * product) * (zeta_i * omega_i + zeta_j * omega_j) * product
     denominator = (omega_i**2 - omega_j**2) ** 2 + 4.0 * zeta_i * zeta_j * product * (omega_i**2 + omega_j**2) + 4.0 * (zeta_i**2 + zeta_j**2) * product**2
@@ -146,12 +153,12 @@ def cqc_coefficient(omega_i, zeta_i, omega_j, zeta_j):
 def fixed_base_cqc(scene: Scene) -> xr.DataArray:
     """CQC coefficient of the fundamental modes of every contact's two fixed-base buildings.
 
-    Only mode 1 of each building is used: in a shear building it moves every
-    floor the same way, so ρ does not depend on the contact's floors (the
-    higher modes, neglected, matter little for the few-storey buildings of a
-    scene). Each mode's damping ratio is φᵀCφ / (2ω) with the mass-normalised
-    shape φ of the undamped fixed-base building (exact for classical damping
-    such as C = a₁K; the diagonal term otherwise).
+    Only mode 1 of each building is used, as in the DDC of two single-mode
+    buildings: in a shear building it moves every floor the same way, so ρ
+    does not depend on the contact's floors; the higher modes are neglected.
+    Each mode's damping ratio is φᵀCφ / (2ω) with the mass-normalised shape
+    φ of the undamped fixed-base building (exact for classical damping such
+    as C = a₁K; the diagonal term otherwise).
 
     Parameters
     ----------
