@@ -1,4 +1,4 @@
-"""An emulation of the reference study's own solution scheme (REFERENCE_STUDY.md, its Appendix 4).
+"""An emulation of the reference study's own solution scheme (Agarwal 2004, its Appendix 4).
 
 The study did not locate events. It restarted MATLAB's ``ode45`` every h
 seconds (h = 0.02 s), and only at those restarts decided
@@ -24,7 +24,7 @@ freedom plus the friction term above, a stuck base keeps s and ṡ. Whether
 the impact forces act on the base as a whole follows the scene:
 ``study_compat = true`` gives the study's equations (they do not), otherwise
 the momentum-consistent ones; the sliding test includes them in the second
-case, as the required friction force F_req of MODEL.md does.
+case, as the required friction force F_req of docs/model.md does.
 
 This module lives in ``benchmarks/``, not in the library: it exists to show
 what the study's scheme does, not to be used.
@@ -124,7 +124,7 @@ class StudyScheme:
         states = np.empty((len(self.motion.times), 2 * system.n_dof))
         states[0] = x
         check = np.zeros(n_bases)  # the study starts from zero accelerations
-        closed_before = np.zeros(system.n_contacts, dtype=bool)
+        closed_before = np.zeros(system.n_elements, dtype=bool)
         impacts, peak, sliding_steps = 0, 0.0, np.zeros(n_bases, dtype=int)
         for k in range(len(self.motion.times) - 1):
             edges = np.linspace(self.motion.times[k], self.motion.times[k + 1], self.steps_per_sample + 1)
@@ -149,7 +149,7 @@ class StudyScheme:
 
     def _penetration(self, x: np.ndarray) -> np.ndarray:
         """δ of every contact at state x, m."""
-        return self.system.contact_geometry @ x[: self.system.n_dof] - self.system.contact_gap
+        return self.system.element_geometry @ x[: self.system.n_dof] - self.system.element_gap
 
     def _friction(self, mode: Mode) -> np.ndarray:
         """Columns: the state rate of each sliding base's friction force −μ W (times sgn ṡ)."""
@@ -208,7 +208,7 @@ class StudyScheme:
             check[b] = (
                 floor_mass @ (acceleration[floors] + acceleration[base])
                 + system.influence[base] * ground
-                + forces @ system.contact_load[:, base]
+                + forces @ system.element_load[:, base]
                 + system.stiffness[base, base] * x[base]
             )
         return check

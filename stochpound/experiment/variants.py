@@ -87,9 +87,10 @@ def scale_masses(scene: dict[str, Any], name: str, factor: float) -> None:
     """Multiply building ``name``'s masses by ``factor`` in place, with what the laws derive from them.
 
     The building's own rule (:func:`stochpound.model.building.scale_masses`:
-    dashpots × √factor), then every contact touching it by its law's rule
-    (:func:`stochpound.model.contact.rescale_table`, with the ratio of the
-    contact's effective masses, new over old).
+    dashpots × √factor), then every contact touching it and every wall beside
+    it by their element's rule (:func:`stochpound.model.contact.rescale_table`,
+    with the ratio of the effective masses, new over old: the factor itself
+    for a wall).
     """
     building = building_table(scene, name)
     old_mass = [float(m) for m in building["mass"]]
@@ -104,6 +105,9 @@ def scale_masses(scene: dict[str, Any], name: str, factor: float) -> None:
         except (KeyError, IndexError, TypeError, ValueError):
             continue  # a malformed contact: scene validation names it
         contact_law.rescale_table(contact, effective_mass(*masses_new) / effective_mass(*masses_old))
+    for wall in scene.get("wall", []):
+        if wall.get("building") == name:  # a wall's effective mass is its level's mass, scaled by the factor
+            contact_law.rescale_table(wall, factor)
 
 
 def set_gaps(scene: dict[str, Any], contacts: Iterable[int], gap: float) -> None:

@@ -43,7 +43,9 @@ from stochpound.model import fields
 from stochpound.model.building import Building
 from stochpound.model.guards import Guard
 
-CONTACT_KEYS = {"between", "gap", "stiffness", "restitution", "damping", "tensile"}
+ELEMENT_KEYS = {"stiffness", "restitution", "damping", "tensile"}
+"""The keys of the Kelvin–Voigt element itself, in a ``[[contact]]`` or a ``[[wall]]`` table."""
+CONTACT_KEYS = {"between", "gap"} | ELEMENT_KEYS
 PIECEWISE_LINEAR = True
 """The Kelvin–Voigt element keeps every mode linear (the exact solver applies)."""
 
@@ -98,11 +100,6 @@ def effective_mass(mass_1: float, mass_2: float) -> float:
     return mass_1 * mass_2 / (mass_1 + mass_2)
 
 
-def impact_damping(stiffness: float, restitution: float, mass_1: float, mass_2: float) -> float:
-    """Impact dashpot c_imp = 2 ξ sqrt(k_imp m1 m2 / (m1 + m2)), N·s/m."""
-    return 2.0 * restitution_damping_ratio(restitution) * math.sqrt(stiffness * effective_mass(mass_1, mass_2))
-
-
 # ---------------------------------------------------------------- scene file
 
 
@@ -120,6 +117,16 @@ def contact_from_table(table: Mapping[str, Any], prefix: str, buildings: Sequenc
             f"{buildings[left].name!r} and {buildings[right].name!r} are not left/right neighbours"
         )
     gap = fields.number(table, "gap", prefix, required=True, low=0.0, allow_inf=True)
+    mass = effective_mass(buildings[left].mass[left_floor - 1], buildings[right].mass[right_floor - 1])
+    return Contact(left, left_floor, right, right_floor, gap, *element_from_table(table, prefix, mass))
+
+
+def element_from_table(table: Mapping[str, Any], prefix: str, mass: float) -> tuple[float, float, float | None, bool]:
+    """The Kelvin–Voigt element of a ``[[contact]]`` or ``[[wall]]`` table: (stiffness N/m, damping N·s/m, restitution or None, tensile).
+
+    ``mass`` is the effective mass m_eff of the collision (kg) that turns a
+    restitution into a dashpot.
+    """
     stiffness = fields.number(table, "stiffness", prefix, required=True, low=0.0, low_open=True)
     restitution = None
     if "restitution" in table and "damping" in table:
@@ -128,9 +135,9 @@ def contact_from_table(table: Mapping[str, Any], prefix: str, buildings: Sequenc
         damping = fields.number(table, "damping", prefix, low=0.0)
     else:
         restitution = fields.number(table, "restitution", prefix, required=True, low=0.0, low_open=True, high=1.0)
-        damping = impact_damping(stiffness, restitution, buildings[left].mass[left_floor - 1], buildings[right].mass[right_floor - 1])
+        damping = 2.0 * restitution_damping_ratio(restitution) * math.sqrt(stiffness * mass)
     tensile = fields.boolean(table, "tensile", prefix, default=True)
-    return Contact(left, left_floor, right, right_floor, gap, stiffness, damping, restitution, tensile)
+    return stiffness, damping, restitution, tensile
 
 
 def _contact_end(value: Any, path: str, buildings: Sequence[Building]) -> tuple[int, int]:

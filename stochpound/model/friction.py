@@ -1,15 +1,16 @@
-"""Coulomb friction of a flat sliding base (the reference study's isolator), with an optional restoring spring.
+"""Coulomb friction of a sliding base (the reference study's isolator), flat or a friction pendulum.
 
 Scene keys (``[building.base]``): ``mass`` (kg), ``mu`` (kinetic coefficient),
-``mu_static`` (≥ mu, default mu) and ``restoring_stiffness`` (N/m, e.g. a
-friction pendulum's W/R). A building without the table stands on a fixed
-base.
+``mu_static`` (≥ mu, default mu), and either ``restoring_stiffness`` (N/m)
+or ``radius`` (m: a friction pendulum of radius R, whose restoring stiffness
+is k_r = W/R, so that the isolated rigid mass swings with period
+2π √(R/g)). A building without the table stands on a fixed base.
 
 The law (docs/model.md, "Sliding bases"). W = g × (base + floor masses).
 A base is in one of four states:
 
 * ``STUCK``: its sliding displacement s is held; the foundation supplies the
-  force F_req the stuck equations need, while |F_req| ≤ μ_s W;
+  force F_req the stuck equations need, while abs(F_req) ≤ μ_s W;
 * ``SLIP_RIGHT`` (+1) / ``SLIP_LEFT`` (−1): the foundation's force on the
   base is −σ μ W for sliding direction σ;
 * ``FREE``: a frictionless base (μ = μ_s = 0) is a free degree of freedom
@@ -30,6 +31,7 @@ from typing import Any, Mapping
 
 import numpy as np
 
+from stochpound.errors import SceneError
 from stochpound.model import fields
 from stochpound.model.guards import Guard
 
@@ -39,7 +41,7 @@ SLIP_RIGHT, SLIP_LEFT = 1, -1
 """Base states: slipping right or left."""
 FREE = 2
 """Base state: frictionless base, a free degree of freedom."""
-BASE_KEYS = {"mass", "mu", "mu_static", "restoring_stiffness"}
+BASE_KEYS = {"mass", "mu", "mu_static", "restoring_stiffness", "radius"}
 PIECEWISE_LINEAR = True
 """Coulomb friction keeps every mode linear (the exact solver applies)."""
 
@@ -59,13 +61,20 @@ class Base:
         Static friction coefficient (>= mu); the base sticks while the
         friction force it needs stays within ``mu_static * W``.
     restoring_stiffness : float
-        Optional restoring stiffness k_r, N/m (a friction pendulum has W/R).
+        Optional restoring stiffness k_r, N/m (0 with a ``radius``).
+    radius : float or None
+        Radius R of a friction pendulum, m: k_r = W/R (see :meth:`restoring`).
     """
 
     mass: float
     mu: float
     mu_static: float
     restoring_stiffness: float = 0.0
+    radius: float | None = None
+
+    def restoring(self, weight: float) -> float:
+        """The restoring stiffness k_r (N/m) of the base under the building's weight W (N): W/R for a friction pendulum."""
+        return weight / self.radius if self.radius is not None else self.restoring_stiffness
 
     @property
     def frictionless(self) -> bool:
@@ -81,8 +90,11 @@ def base_from_table(table: Mapping[str, Any] | None, prefix: str) -> Base | None
     mass = fields.number(table, "mass", prefix, required=True, low=0.0, low_open=True)
     mu = fields.number(table, "mu", prefix, required=True, low=0.0)
     mu_static = fields.number(table, "mu_static", prefix, default=mu, low=mu)
+    if "radius" in table and "restoring_stiffness" in table:
+        raise SceneError(f"{prefix}.radius: give either radius (a friction pendulum, k_r = W/R) or restoring_stiffness, not both")
     restoring = fields.number(table, "restoring_stiffness", prefix, default=0.0, low=0.0)
-    return Base(mass, mu, mu_static, restoring)
+    radius = fields.number(table, "radius", prefix, low=0.0, low_open=True)
+    return Base(mass, mu, mu_static, restoring, radius)
 
 
 @dataclass(frozen=True)

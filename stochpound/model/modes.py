@@ -166,7 +166,7 @@ class ModeLibrary:
         self._cache: BoundedCache[Mode, ModeDynamics] = BoundedCache(MODE_BUDGET, array_bytes)
         self._built: set[Mode] = set()
         self._inverse_mass: dict[tuple[int, ...], np.ndarray] = {}
-        self._contact_rows = contact.contact_rows(system.contact_geometry, system.contact_stiffness, system.contact_damping)
+        self._contact_rows = contact.contact_rows(system.element_geometry, system.element_stiffness, system.element_damping)
 
     def __getitem__(self, mode: Mode) -> ModeDynamics:
         dynamics = self._cache.get(mode)
@@ -196,8 +196,8 @@ def _build(system: System, mode: Mode, masses: tuple[np.ndarray, np.ndarray, np.
     n = system.n_dof
     stuck, free, inverse_mass = masses
     closed = np.array(mode.closed, bool)
-    k, c_imp, d = system.contact_stiffness, system.contact_damping, system.contact_gap
-    extra_stiffness, extra_damping, load = contact.closed_terms(system.contact_geometry, system.contact_load, k, c_imp, d, closed)
+    k, c_imp, d = system.element_stiffness, system.element_damping, system.element_gap
+    extra_stiffness, extra_damping, load = contact.closed_terms(system.element_geometry, system.element_load, k, c_imp, d, closed)
     stiffness, damping = system.stiffness + extra_stiffness, system.damping + extra_damping
     for base, state in zip(system.bases, mode.base):
         load[base.dof] += friction.slip_force(base, state)
@@ -214,7 +214,7 @@ def _build(system: System, mode: Mode, masses: tuple[np.ndarray, np.ndarray, np.
         if state == STUCK else (np.zeros(2 * n), 0.0, friction.slip_force(base, state))
         for base, state in zip(system.bases, mode.base)
     ]
-    contact_guards = contact.guards(rows, k, d, system.contact_tensile, closed)
+    contact_guards = contact.guards(rows, k, d, system.element_tensile, closed)
     base_guards = [guard for i, (base, state) in enumerate(zip(system.bases, mode.base))
                    for guard in friction.guards(base, i, state, foundation[i], n)]
     force_matrix, force_constant = contact.force_rows(rows, k, d, closed)
@@ -252,4 +252,4 @@ def _stack_foundation(foundation: list[tuple[np.ndarray, float, float]], size: i
 def initial_mode(system: System) -> Mode:
     """Mode before settling at t = 0: contacts open, bases stuck, free or sliding as x(0) says."""
     states = tuple(friction.initial_state(base, system.initial_state[system.n_dof + base.dof]) for base in system.bases)
-    return Mode(tuple(False for _ in range(system.n_contacts)), states)
+    return Mode(tuple(False for _ in range(system.n_elements)), states)

@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 
 from stochpound.model.building import Building
 from stochpound.model.contact import Contact
+from stochpound.model.wall import Wall
 from stochpound.motions.ground import GroundMotion
 
 
@@ -34,6 +35,8 @@ class Scene:
         Gravitational acceleration, m/s² (weights of sliding buildings).
     study_compat : bool
         Drop the impact forces from the base equation, as the reference study did.
+    walls : tuple of Wall
+        Rigid walls moving with the ground.
     source : str
         Where the scene came from (file name or "python"), for provenance.
     """
@@ -43,6 +46,7 @@ class Scene:
     motion: GroundMotion
     g: float = 9.81
     study_compat: bool = False
+    walls: tuple[Wall, ...] = ()
     source: str = field(default="python", compare=False)
 
     @property

@@ -20,9 +20,10 @@ from stochpound.model import fields
 from stochpound.model.building import buildings_from_tables
 from stochpound.model.contact import contact_from_table
 from stochpound.model.scene import Scene
+from stochpound.model.wall import walls_from_tables
 from stochpound.motions.ground import GroundMotion, HarmonicMotion, SampledMotion
 
-_TOP_KEYS = {"g", "study_compat", "building", "contact", "motion"}
+_TOP_KEYS = {"g", "study_compat", "building", "contact", "wall", "motion"}
 _SYNTHETIC_TYPES = {"kanai_tajimi", "clough_penzien"}
 
 
@@ -72,8 +73,9 @@ def scene_from_dict(data: Mapping[str, Any], base_dir: str | Path = ".", source:
     study_compat = fields.boolean(data, "study_compat", "", default=False)
     buildings = buildings_from_tables(fields.array_of_tables(data, "building"))
     contacts = [contact_from_table(table, f"contact[{i}]", buildings) for i, table in enumerate(fields.array_of_tables(data, "contact"))]
+    walls = walls_from_tables(fields.array_of_tables(data, "wall"), buildings)
     motion = _motion(data, Path(base_dir), g)
-    return Scene(tuple(buildings), tuple(contacts), motion, g=g, study_compat=study_compat, source=source)
+    return Scene(tuple(buildings), tuple(contacts), motion, g=g, study_compat=study_compat, walls=tuple(walls), source=source)
 
 
 # ---------------------------------------------------------------- motion

@@ -10,19 +10,26 @@ q the DOF vector and v = q̇, the equations of motion (docs/model.md) read
 where M couples each floor with its base (the floor equation contains s̈_b,
 the base equation contains Σ m_i ü_i), r holds the inertia of each DOF
 (m_i for a floor, M_b + Σ m_i for a base), and K includes an optional restoring
-stiffness of the base. Contact p has penetration δ_p = g_p·q − d_p and acts on
-the structure with the generalised force −F_p h_p, where h_p = g_p in the
-momentum-consistent model and h_p is g_p without its base entries in
+stiffness of the base.
+
+The *impact elements* are the contacts between buildings, then the walls.
+Element p has penetration δ_p = g_p·q − d_p and acts on the structure with
+the generalised force −F_p h_p, where h_p = g_p in the momentum-consistent
+model and, for a contact, h_p is g_p without its base entries in
 ``study_compat`` mode (the study's base equation lacks Σ f).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import hashlib
+from dataclasses import dataclass, fields
+from functools import cached_property, lru_cache
 
 import numpy as np
 
-from stochpound.model.building import storey_matrix
+from stochpound.model.building import Building, storey_matrix
+from stochpound.model.contact import Contact
+from stochpound.model.wall import Wall
 from stochpound.model.friction import SlidingBase
 from stochpound.model.scene import Scene
 
@@ -43,20 +50,24 @@ class System:
         M, K, C (N × N), kg, N/m, N·s/m.
     influence : np.ndarray
         r (N), kg: the ground-acceleration load is −r a_g.
-    contact_gap, contact_stiffness, contact_damping : np.ndarray
-        d_p (m), k_p (N/m), c_p (N·s/m) of each contact.
-    contact_geometry : np.ndarray
-        g_p as rows (n_contacts × N): δ_p = g_p·q − d_p.
-    contact_load : np.ndarray
-        h_p as rows (n_contacts × N): generalised load −F_p h_p.
-    contact_tensile : np.ndarray of bool
-        Which contacts separate at δ = 0 (True) or at F = 0 (False).
+    n_contacts : int
+        Number of contacts between buildings: the first impact elements; the walls follow.
+    element_gap, element_stiffness, element_damping : np.ndarray
+        d_p (m), k_p (N/m), c_p (N·s/m) of each impact element.
+    element_geometry : np.ndarray
+        g_p as rows (n_elements × N): δ_p = g_p·q − d_p.
+    element_load : np.ndarray
+        h_p as rows (n_elements × N): generalised load −F_p h_p.
+    element_tensile : np.ndarray of bool
+        Which elements separate at δ = 0 (True) or at F = 0 (False).
+    element_left, element_right : np.ndarray
+        Rows (n_elements × N) giving the displacement relative to the ground
+        of each element's left and right side (a wall's side is 0: it moves
+        with the ground); g_p = left − right.
     total_displacement : np.ndarray
         Y (n_floors_total × N): total displacements y = s + u of every floor, in DOF order.
     initial_state : np.ndarray
         x(0) = [q(0), v(0)] from the buildings' initial conditions.
-    contact_rows : np.ndarray of int
-        (n_contacts × 2): rows of ``total_displacement`` of each contact's left and right floor.
     """
 
     n_dof: int
@@ -66,45 +77,65 @@ class System:
     stiffness: np.ndarray
     damping: np.ndarray
     influence: np.ndarray
-    contact_gap: np.ndarray
-    contact_stiffness: np.ndarray
-    contact_damping: np.ndarray
-    contact_geometry: np.ndarray
-    contact_load: np.ndarray
-    contact_tensile: np.ndarray
+    n_contacts: int
+    element_gap: np.ndarray
+    element_stiffness: np.ndarray
+    element_damping: np.ndarray
+    element_geometry: np.ndarray
+    element_load: np.ndarray
+    element_tensile: np.ndarray
+    element_left: np.ndarray
+    element_right: np.ndarray
     total_displacement: np.ndarray
     initial_state: np.ndarray
-    contact_rows: np.ndarray
 
     @property
-    def n_contacts(self) -> int:
-        """Number of contact elements."""
-        return len(self.contact_gap)
+    def n_elements(self) -> int:
+        """Number of impact elements (contacts, then walls)."""
+        return len(self.element_gap)
 
     @property
     def base_dofs(self) -> np.ndarray:
         """The DOF of every sliding base (int64, in base order)."""
         return np.array([base.dof for base in self.bases], dtype=np.int64)
 
-    @property
-    def contact_floor_velocity(self) -> np.ndarray:
-        """Rows (2·n_contacts × 2N) giving ẏ of the left, then the right floor of each contact."""
-        rows = self.total_displacement[self.contact_rows.ravel()]
-        return np.hstack([np.zeros_like(rows), rows])
+    @cached_property
+    def fingerprint(self) -> bytes:
+        """Digest of every matrix and layout entry (equal systems share propagators)."""
+        digest = hashlib.blake2b(digest_size=20)
+        for item in fields(self):
+            value = getattr(self, item.name)
+            if isinstance(value, (tuple, int)):  # the sliding bases (frozen dataclasses of numbers), the number of contacts
+                digest.update(f"{item.name}{value!r}".encode())
+                continue
+            for array in value if isinstance(value, list) else [value]:
+                array = np.ascontiguousarray(array)
+                digest.update(f"{item.name}{array.dtype}{array.shape}".encode())
+                digest.update(array.tobytes())
+        return digest.digest()
 
 
 def build_system(scene: Scene) -> System:
-    """Assemble the DOF layout and the global matrices of ``scene``."""
-    floor_dofs, base_dofs, n_dof = _layout(scene)
+    """Assemble the DOF layout and the global matrices of ``scene`` (cached: runs of one structure share its system).
+
+    The system depends on the buildings, contacts, g and ``study_compat``
+    only, not on the motion; its arrays are shared and must not be changed.
+    """
+    return _build_system(scene.buildings, scene.contacts, scene.walls, scene.g, scene.study_compat)
+
+
+@lru_cache(maxsize=16)
+def _build_system(buildings: tuple[Building, ...], contacts: tuple[Contact, ...], walls: tuple[Wall, ...], g: float, study_compat: bool) -> System:
+    floor_dofs, base_dofs, n_dof = _layout(buildings)
     mass = np.zeros((n_dof, n_dof))
     stiffness = np.zeros((n_dof, n_dof))
     damping = np.zeros((n_dof, n_dof))
     influence = np.zeros(n_dof)
-    total = np.zeros((sum(b.n_floors for b in scene.buildings), n_dof))
+    total = np.zeros((sum(b.n_floors for b in buildings), n_dof))
     initial = np.zeros(2 * n_dof)
     bases = []
     row = 0
-    for b, building in enumerate(scene.buildings):
+    for b, building in enumerate(buildings):
         floors, base = floor_dofs[b], base_dofs[b]
         m = np.asarray(building.mass, float)
         block = np.ix_(floors, floors)
@@ -120,14 +151,16 @@ def build_system(scene: Scene) -> System:
             mass[floors, base] = m
             mass[base, floors] = m
             mass[base, base] = building.total_mass
-            stiffness[base, base] = building.base.restoring_stiffness
+            stiffness[base, base] = building.base.restoring(g * building.total_mass)
             influence[base] = building.total_mass
             total[row : row + building.n_floors, base] = 1.0
             initial[base] = building.initial.base_displacement
             initial[n_dof + base] = building.initial.base_velocity
-            bases.append(SlidingBase(b, base, scene.g * building.total_mass, building.base.mu, building.base.mu_static))
+            bases.append(SlidingBase(b, base, g * building.total_mass, building.base.mu, building.base.mu_static))
         row += building.n_floors
-    geometry, load = _contact_vectors(scene, floor_dofs, base_dofs, n_dof)
+    levels = _level_rows(buildings, floor_dofs, base_dofs, n_dof)
+    left, right, load = _element_rows(contacts, walls, study_compat, levels, base_dofs)
+    elements = (*contacts, *walls)
     return System(
         n_dof=n_dof,
         floor_dofs=floor_dofs,
@@ -136,22 +169,24 @@ def build_system(scene: Scene) -> System:
         stiffness=stiffness,
         damping=damping,
         influence=influence,
-        contact_gap=np.array([c.gap for c in scene.contacts], float),
-        contact_stiffness=np.array([c.stiffness for c in scene.contacts], float),
-        contact_damping=np.array([c.damping for c in scene.contacts], float),
-        contact_geometry=geometry,
-        contact_load=load,
-        contact_tensile=np.array([c.tensile for c in scene.contacts], bool),
+        n_contacts=len(contacts),
+        element_gap=np.array([e.gap for e in elements], float),
+        element_stiffness=np.array([e.stiffness for e in elements], float),
+        element_damping=np.array([e.damping for e in elements], float),
+        element_geometry=left - right,
+        element_load=load,
+        element_tensile=np.array([e.tensile for e in elements], bool),
+        element_left=left,
+        element_right=right,
         total_displacement=total,
         initial_state=initial,
-        contact_rows=_contact_rows(scene),
     )
 
 
-def _layout(scene: Scene) -> tuple[list[np.ndarray], list[int | None], int]:
+def _layout(buildings: tuple[Building, ...]) -> tuple[list[np.ndarray], list[int | None], int]:
     """Each building's floor DOFs and base DOF (None for a fixed base), and the number of DOFs."""
     floor_dofs, base_dofs, n_dof = [], [], 0
-    for building in scene.buildings:
+    for building in buildings:
         floor_dofs.append(np.arange(n_dof, n_dof + building.n_floors))
         n_dof += building.n_floors
         base_dofs.append(n_dof if building.base is not None else None)
@@ -159,21 +194,29 @@ def _layout(scene: Scene) -> tuple[list[np.ndarray], list[int | None], int]:
     return floor_dofs, base_dofs, n_dof
 
 
-def _contact_vectors(scene: Scene, floor_dofs: list[np.ndarray], base_dofs: list[int | None], n_dof: int) -> tuple[np.ndarray, np.ndarray]:
-    geometry = np.zeros((len(scene.contacts), n_dof))
-    load = np.zeros((len(scene.contacts), n_dof))
-    for p, contact in enumerate(scene.contacts):
-        for building, floor, sign in ((contact.left, contact.left_floor, 1.0), (contact.right, contact.right_floor, -1.0)):
-            geometry[p, floor_dofs[building][floor - 1]] += sign
-            load[p, floor_dofs[building][floor - 1]] += sign
-            if base_dofs[building] is not None:
-                geometry[p, base_dofs[building]] += sign
-                if not scene.study_compat:
-                    load[p, base_dofs[building]] += sign
-    return geometry, load
+def _level_rows(buildings: tuple[Building, ...], floor_dofs: list[np.ndarray], base_dofs: list[int | None], n_dof: int) -> list[np.ndarray]:
+    """For each building, rows (levels × N) giving the displacement relative to the ground of its base (level 0: s, or 0 if fixed) and floors (s + u_i)."""
+    levels = []
+    for building, floors, base in zip(buildings, floor_dofs, base_dofs):
+        rows = np.zeros((building.n_floors + 1, n_dof))
+        rows[np.arange(1, building.n_floors + 1), floors] = 1.0
+        if base is not None:
+            rows[:, base] = 1.0
+        levels.append(rows)
+    return levels
 
 
-def _contact_rows(scene: Scene) -> np.ndarray:
-    first_row = np.cumsum([0] + [b.n_floors for b in scene.buildings])
-    rows = [(first_row[c.left] + c.left_floor - 1, first_row[c.right] + c.right_floor - 1) for c in scene.contacts]
-    return np.array(rows, dtype=int).reshape(-1, 2)
+def _element_rows(contacts: tuple[Contact, ...], walls: tuple[Wall, ...], study_compat: bool, levels: list[np.ndarray],
+                  base_dofs: list[int | None]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Each impact element's left-side and right-side displacement rows and its load row h (n_elements × N each)."""
+    n_dof = levels[0].shape[1]
+    left, right = np.zeros((len(contacts) + len(walls), n_dof)), np.zeros((len(contacts) + len(walls), n_dof))
+    for p, contact in enumerate(contacts):
+        left[p], right[p] = levels[contact.left][contact.left_floor], levels[contact.right][contact.right_floor]
+    for p, wall in enumerate(walls, start=len(contacts)):
+        (left if wall.side > 0 else right)[p] = levels[wall.building][wall.level]
+    load = left - right
+    if study_compat:  # the study's base equation lacks the contacts' forces (walls are not the study's)
+        bases = [dof for dof in base_dofs if dof is not None]
+        load[: len(contacts), bases] = 0.0
+    return left, right, load

@@ -1,11 +1,7 @@
-"""The result of one simulation as an :class:`xarray.Dataset` (names of CONTRACT.md).
+"""The result of one simulation as an :class:`xarray.Dataset` (the names of docs/scene-files.md).
 
 Outputs are given at the motion's sample times, t = 0 included. Every
 variable carries ``units`` and ``long_name`` (CF conventions).
-
-Every array is built with numpy first and the dataset is assembled directly
-from its variables (:func:`_assemble`): xarray's usual construction converts,
-aligns and merges every variable, which would cost more than a whole exact run.
 """
 
 from __future__ import annotations
@@ -16,9 +12,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import pandas as pd
 import xarray as xr
-from xarray.indexes import PandasIndex
 
 from stochpound import __version__
 from stochpound.results.record import ENERGY_TERMS, EventCounters, Recorder
@@ -33,8 +27,9 @@ _ENERGY_NAMES = {
 }
 
 
-def _var(dims: tuple[str, ...], data: np.ndarray, units: str, long_name: str, **attrs: Any) -> xr.Variable:
-    return xr.Variable(dims, data, {"units": units, "long_name": long_name, **attrs}, fastpath=True)
+def _var(dims: tuple[str, ...], data: np.ndarray, units: str, long_name: str, **attrs: Any) -> tuple:
+    """A variable (dims, data, attrs) with its CF ``units`` and ``long_name``."""
+    return dims, data, {"units": units, "long_name": long_name, **attrs}
 
 
 def build_dataset(scene: Scene, system: System, recorder: Recorder, counters: EventCounters, solver_attrs: dict[str, Any]) -> xr.Dataset:
@@ -50,15 +45,18 @@ def build_dataset(scene: Scene, system: System, recorder: Recorder, counters: Ev
     """
     coords = {
         "time": _var(("time",), scene.motion.times, "s", "time"),
-        "building": _var(("building",), np.array(scene.building_names, dtype=object), "1", "building name, left to right"),
+        "building": _var(("building",), np.array(scene.building_names, dtype=str), "1", "building name, left to right"),
         "floor": _var(("floor",), np.arange(1, scene.max_floors + 1), "1", "floor number, 1 = lowest"),
         "contact": _var(("contact",), np.arange(len(scene.contacts)), "1", "contact index"),
+        **({"wall": _var(("wall",), np.arange(len(scene.walls)), "1", "wall index")} if scene.walls else {}),
     }
     data_vars = {
         **_response_variables(scene, system, recorder),
         **_contact_variables(scene),
-        **_closure_variables(recorder),
-        **_impact_variables(recorder),
+        **(_wall_variables(scene, recorder) if scene.walls else {}),
+        **_closure_variables(recorder, system.n_contacts, "contact"),
+        **(_closure_variables(recorder, system.n_contacts, "wall") if scene.walls else {}),
+        **_impact_variables(recorder, system.n_contacts, bool(scene.walls)),
         **_energy_variables(recorder),
     }
     attrs = {
@@ -72,27 +70,10 @@ def build_dataset(scene: Scene, system: System, recorder: Recorder, counters: Ev
         **solver_attrs,
         **counters.as_attrs(),
     }
-    return _assemble(coords, data_vars, attrs)
+    return xr.Dataset(data_vars, coords=coords, attrs=attrs)
 
 
-def _assemble(coords: dict[str, xr.Variable], data_vars: dict[str, xr.Variable], attrs: dict[str, Any]) -> xr.Dataset:
-    """The dataset of dimension coordinates ``coords`` (with default indexes) and ``data_vars``, consistent by construction.
-
-    The same dataset as ``xr.Dataset(data_vars, coords=coords, attrs=attrs)``
-    (checked by the tests), without the conversion, alignment and merge of
-    every variable (the indexes are built from :class:`pandas.Index` objects,
-    which also spares xarray's check for dask arrays, and its import of dask).
-    """
-    indexes = {name: PandasIndex(pd.Index(variable.values, dtype=variable.dtype), name, coord_dtype=variable.dtype) for name, variable in coords.items()}
-    variables = {name: indexes[name].create_variables({name: variable})[name] for name, variable in coords.items()}
-    variables.update(data_vars)
-    dims: dict[str, int] = {}
-    for variable in variables.values():
-        dims.update(zip(variable.dims, variable.shape))
-    return xr.Dataset._construct_direct(variables, set(coords), dims, attrs, indexes)
-
-
-def _response_variables(scene: Scene, system: System, recorder: Recorder) -> dict[str, xr.Variable]:
+def _response_variables(scene: Scene, system: System, recorder: Recorder) -> dict[str, tuple]:
     """Displacements, ground acceleration, contact and friction forces and base states at the samples."""
     relative, sliding = recorder.displacements()
     return {
@@ -101,7 +82,7 @@ def _response_variables(scene: Scene, system: System, recorder: Recorder) -> dic
         "relative_displacement": _var(("building", "floor", "time"), relative, "m", "floor displacement relative to the building's base (u)"),
         "sliding_displacement": _var(("building", "time"), sliding, "m", "sliding displacement of the base relative to the ground (s)"),
         "ground_acceleration": _var(("time",), np.asarray(scene.motion.at_times(), float), "m s-2", "ground acceleration a_g"),
-        "impact_force": _var(("contact", "time"), recorder.forces.T, "N", "contact force, positive in compression (0 while open)"),
+        "impact_force": _var(("contact", "time"), recorder.forces[:, : system.n_contacts].T, "N", "contact force, positive in compression (0 while open)"),
         "base_friction_force": _var(
             ("building", "time"), recorder.by_building(recorder.friction), "N", "force of the foundation on the base, positive to the right (0 for a fixed base)"
         ),
@@ -112,23 +93,38 @@ def _response_variables(scene: Scene, system: System, recorder: Recorder) -> dic
     }
 
 
-def _closure_variables(recorder: Recorder) -> dict[str, xr.Variable]:
-    """Each contact's closure over time and its peak over the run, located on the solution."""
+def _closure_variables(recorder: Recorder, n_contacts: int, kind: str) -> dict[str, tuple]:
+    """The closure over time of each contact (``kind`` "contact", the first ``n_contacts`` elements) or wall, and its peak over the run, located on the solution."""
+    rows = slice(0, n_contacts) if kind == "contact" else slice(n_contacts, None)
+    toward = "y_left - y_right of the contact's floors" if kind == "contact" else "the level's displacement toward the wall"
     return {
-        "contact_closure": _var(("contact", "time"), recorder.contact_closure(), "m",
-                                "closure y_left - y_right of the contact's floors (the gap is closed where it reaches the gap)"),
-        "peak_contact_closure": _var(("contact",), recorder.peaks[0], "m", "largest closure over the run: the separation this run needed"),
-        "peak_contact_closure_time": _var(("contact",), recorder.peaks[1], "s", "time of the largest closure"),
+        f"{kind}_closure": _var((kind, "time"), recorder.closure()[rows], "m", f"closure {toward} (the gap is closed where it reaches the gap)"),
+        f"peak_{kind}_closure": _var((kind,), recorder.peaks[0, rows], "m", "largest closure over the run: the separation this run needed"),
+        f"peak_{kind}_closure_time": _var((kind,), recorder.peaks[1, rows], "s", "time of the largest closure"),
     }
 
 
-def _contact_variables(scene: Scene) -> dict[str, xr.Variable]:
+def _wall_variables(scene: Scene, recorder: Recorder) -> dict[str, tuple]:
+    """What each wall is, and its force over time."""
+    names, walls, n_contacts = scene.building_names, scene.walls, len(scene.contacts)
+    return {
+        "wall_building": _var(("wall",), np.array([names[w.building] for w in walls], dtype=str), "1", "building beside the wall"),
+        "wall_side": _var(("wall",), np.array([w.side_name for w in walls], dtype=str), "1", "side of the building the wall is on"),
+        "wall_level": _var(("wall",), np.array([w.level for w in walls], dtype=int), "1", "level the wall faces: 0 the base, else the floor"),
+        "wall_gap": _var(("wall",), np.array([w.gap for w in walls], float), "m", "at-rest gap"),
+        "wall_stiffness": _var(("wall",), np.array([w.stiffness for w in walls], float), "N m-1", "impact spring stiffness"),
+        "wall_damping": _var(("wall",), np.array([w.damping for w in walls], float), "N s m-1", "impact dashpot"),
+        "wall_force": _var(("wall", "time"), recorder.forces[:, n_contacts:].T, "N", "force of the wall's impact element, positive in compression (0 while open)"),
+    }
+
+
+def _contact_variables(scene: Scene) -> dict[str, tuple]:
     names = scene.building_names
     contacts = scene.contacts
     return {
-        "contact_left": _var(("contact",), np.array([names[c.left] for c in contacts], dtype=object), "1", "left building of the contact"),
+        "contact_left": _var(("contact",), np.array([names[c.left] for c in contacts], dtype=str), "1", "left building of the contact"),
         "contact_left_floor": _var(("contact",), np.array([c.left_floor for c in contacts], dtype=int), "1", "floor of the left building"),
-        "contact_right": _var(("contact",), np.array([names[c.right] for c in contacts], dtype=object), "1", "right building of the contact"),
+        "contact_right": _var(("contact",), np.array([names[c.right] for c in contacts], dtype=str), "1", "right building of the contact"),
         "contact_right_floor": _var(("contact",), np.array([c.right_floor for c in contacts], dtype=int), "1", "floor of the right building"),
         "contact_gap": _var(("contact",), np.array([c.gap for c in contacts], float), "m", "at-rest gap"),
         "contact_stiffness": _var(("contact",), np.array([c.stiffness for c in contacts], float), "N m-1", "impact spring stiffness"),
@@ -136,16 +132,19 @@ def _contact_variables(scene: Scene) -> dict[str, xr.Variable]:
     }
 
 
-def _impact_variables(recorder: Recorder) -> dict[str, xr.Variable]:
+def _impact_variables(recorder: Recorder, n_contacts: int, walls: bool) -> dict[str, tuple]:
+    """One row per impact; with ``walls``, ``impact_wall`` names the wall of a wall impact (``impact_contact`` is then −1)."""
     impacts = recorder.impacts
 
     def column(name, dtype=float):
         return np.array([getattr(impact, name) for impact in impacts], dtype=dtype)
 
-    start, end = column("start"), column("end")
+    start, end, element = column("start"), column("end"), column("contact", int)
     dims = ("impact",)
+    wall = {"impact_wall": _var(dims, np.where(element >= n_contacts, element - n_contacts, -1), "1", "wall index of the impact (-1: a contact)")}
     return {
-        "impact_contact": _var(dims, column("contact", int), "1", "contact index of the impact"),
+        "impact_contact": _var(dims, np.where(element < n_contacts, element, -1), "1", "contact index of the impact (-1: a wall)"),
+        **(wall if walls else {}),
         "impact_start": _var(dims, start, "s", "time the impact began"),
         "impact_end": _var(dims, end, "s", "time the impact ended (end of the motion if still closed)"),
         "impact_duration": _var(dims, end - start, "s", "impact duration"),
@@ -153,12 +152,12 @@ def _impact_variables(recorder: Recorder) -> dict[str, xr.Variable]:
         "impact_peak_time": _var(dims, column("peak_time"), "s", "time of the largest contact force"),
         "impact_impulse": _var(dims, column("impulse"), "N s", "time integral of the contact force"),
         "impact_onset_velocity": _var(dims, column("onset_velocity"), "m s-1", "approach velocity (rate of penetration) at onset"),
-        "impact_in_phase": _var(dims, column("in_phase", bool), "1", "both floors moving the same way at onset"),
+        "impact_in_phase": _var(dims, column("in_phase", bool), "1", "both floors moving the same way at onset (false at a wall, which moves with the ground)"),
         "impact_complete": _var(dims, column("complete", bool), "1", "the impact ended before the end of the motion"),
     }
 
 
-def _energy_variables(recorder: Recorder) -> dict[str, xr.Variable]:
+def _energy_variables(recorder: Recorder) -> dict[str, tuple]:
     kinetic, strain = recorder.kinetic_and_strain()
     energy = recorder.energy
     variables = {f"energy_{term}": _var(("time",), energy[term], "J", _ENERGY_NAMES[term]) for term in ENERGY_TERMS}

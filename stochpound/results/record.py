@@ -94,7 +94,7 @@ class Recorder:
     states : np.ndarray
         x = [q, v] at every output time (n_times × 2N), m and m/s.
     forces, friction, base_states : np.ndarray
-        Contact forces (N), force of the foundation on each sliding base (N,
+        Impact element forces (N: contacts, then walls), force of the foundation on each sliding base (N,
         positive to the right) and base states
         (:mod:`stochpound.model.friction`; a free base's is the sign of its
         velocity) at every output time (time × contact or base), filled by
@@ -107,7 +107,7 @@ class Recorder:
     peaks : np.ndarray
         The monitors' largest values over the run and when they happened
         (rows: value, time in s), located on the solution: each contact's
-        closure y_left − y_right (m) (:func:`stochpound.model.modes.monitor_rows`).
+        closure y_left − y_right (m) per impact element (:func:`stochpound.model.modes.monitor_rows`).
     """
 
     system: System
@@ -124,12 +124,12 @@ class Recorder:
     def __post_init__(self) -> None:
         n_times, n = len(self.motion.times), self.system.n_dof
         self.states = np.zeros((n_times, 2 * n))
-        self.forces = np.zeros((n_times, self.system.n_contacts))
+        self.forces = np.zeros((n_times, self.system.n_elements))
         self.friction = np.zeros((n_times, len(self.system.base_dofs)))
         self.base_states = np.zeros((n_times, len(self.system.base_dofs)), dtype=np.int8)
         self.energy_history = np.zeros((len(ENERGY_TERMS), n_times))
         self.energy = dict(zip(ENERGY_TERMS, self.energy_history))
-        self.peaks = np.full((2, self.system.n_contacts), np.nan)
+        self.peaks = np.full((2, self.system.n_elements), np.nan)
 
     def sample_at(self, indices: np.ndarray, dynamics: ModeDynamics, ground: np.ndarray) -> None:
         """Contact forces, friction forces and base states at samples ``indices`` from their stored states.
@@ -158,9 +158,9 @@ class Recorder:
             relative[b, : len(dofs)] = q[:, dofs].T
         return relative, self.by_building(q[:, self.system.base_dofs])
 
-    def contact_closure(self) -> np.ndarray:
-        """Each contact's closure y_left − y_right at the samples (contact × time), m."""
-        return self.system.contact_geometry @ self.states[:, : self.system.n_dof].T
+    def closure(self) -> np.ndarray:
+        """Each impact element's closure y_left − y_right at the samples (element × time), m (a wall's side is 0)."""
+        return self.system.element_geometry @ self.states[:, : self.system.n_dof].T
 
     def by_building(self, per_base: np.ndarray) -> np.ndarray:
         """Values of the sliding bases over time (time × base) as building × time, 0 for fixed bases."""

@@ -123,7 +123,7 @@ transposed (Z × D·2N).
 Motion = namedtuple("Motion", "times forcing coefficients harmonic")
 Motion.__doc__ = """Output times, exosystem state per interval, cubic per interval (sampled) or [A, ω, φ] (harmonic)."""
 Layout = namedtuple("Layout", "geometry gap tensile left_rows right_rows base_dofs")
-Layout.__doc__ = """Contacts (penetration rows, gaps, tensile flags, rows of the left and right floors) and the base DOFs."""
+Layout.__doc__ = """Impact elements (penetration rows, gaps, tensile flags, displacement rows of their left and right sides) and the base DOFs."""
 Run = namedtuple("Run", "clock ints x pending_x pending_mode missing_mode visited")
 Run.__doc__ = """Time, counters (``ints``; ``ints[MODE]`` is a slot), state, the pending event and the ids of the modes visited."""
 Arming = namedtuple("Arming", "threshold tolerance rearmable disarmed")
@@ -882,7 +882,7 @@ def _apply(geometry, gap, base_dofs, mode, x, kind, target, direction):
 
 @njit(**INTERNAL)
 def _with_bound(M, i, x, magnitude, ground, constant):
-    """Row i of the affine map M at (x, a_g), with its constant or not, its round-off scale and Σ|M[i, :S + 1]|.
+    """Row i of the affine map M at (x, a_g), with its constant or not, its round-off scale and Σabs(M[i, :S + 1]).
 
     The scale is the same sum with every term taken absolute and x replaced
     by ``magnitude`` (``events._guard_scales``).
@@ -1318,12 +1318,17 @@ A ``NUMBA_OPT`` set in the environment is left in force.
 """
 
 
+_COMPILED: list[bool] = []
+
+
 def run(*arguments: object) -> int:
     """Call :func:`run_engine`: a process's first call compiles it (or loads it from numba's cache) at :data:`OPTIMISATION_LEVEL`."""
-    if numba.config.DISABLE_JIT or run_engine.signatures or "NUMBA_OPT" in os.environ:
+    if _COMPILED or numba.config.DISABLE_JIT or "NUMBA_OPT" in os.environ:
         return run_engine(*arguments)
     with _optimisation_level(OPTIMISATION_LEVEL):
-        return run_engine(*arguments)
+        status = run_engine(*arguments)
+    _COMPILED.append(True)
+    return status
 
 
 @contextlib.contextmanager

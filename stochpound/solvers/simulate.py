@@ -22,7 +22,7 @@ def simulate(
     rtol: float = 1e-10,
     atol: float = 1e-12,
 ) -> xr.Dataset:
-    """Simulate a scene and return the result dataset (CONTRACT.md names).
+    """Simulate a scene and return the result dataset (the names of docs/scene-files.md).
 
     Parameters
     ----------

@@ -60,42 +60,42 @@ def vector_mode(vector: np.ndarray, n_contacts: int) -> Mode:
 
 def mode_length(system: System) -> int:
     """Length of the engine's mode vectors of ``system`` (:func:`mode_vector`)."""
-    return system.n_contacts + len(system.bases) + 1
+    return system.n_elements + len(system.bases) + 1
 
 
 def plant_arrays(system: System, motion: GroundMotion) -> Plant:
-    """System and motion arrays of the engine."""
-    rows = system.total_displacement
+    """System and motion arrays of the engine (raises :class:`~stochpound.solvers.propagators.UnsupportedMotionError` for other motions)."""
+    forcing = np.ascontiguousarray(interval_forcing(motion))
     if isinstance(motion, HarmonicMotion):
         coefficients, harmonic = np.zeros((1, 4)), np.array([motion.amplitude, motion.omega, motion.phase], float)
     else:
         coefficients, harmonic = np.ascontiguousarray(motion.coefficients, float), np.zeros(0)
-    floor_rows = [np.ascontiguousarray(rows[system.contact_rows[:, side]]).reshape(system.n_contacts, system.n_dof) for side in (0, 1)]
     return Plant(
-        engine.Motion(np.asarray(motion.times, float), np.ascontiguousarray(interval_forcing(motion)), coefficients, harmonic),
-        engine.Layout(system.contact_geometry, system.contact_gap, system.contact_tensile.astype(np.bool_), *floor_rows, system.base_dofs),
+        engine.Motion(np.asarray(motion.times, float), forcing, coefficients, harmonic),
+        engine.Layout(system.element_geometry, system.element_gap, system.element_tensile.astype(np.bool_), system.element_left, system.element_right,
+                      system.base_dofs),
     )
 
 
 def n_monitors(system: System) -> int:
     """Number of monitors of every mode of ``system`` (:func:`stochpound.model.modes.monitor_rows`)."""
-    return system.n_contacts
+    return system.n_elements
 
 
 def max_guards(system: System) -> int:
     """The largest number of guards of a mode: two per contact (CLOSE and RECLOSE) and two per base (SLIP both ways)."""
-    return 2 * system.n_contacts + 2 * len(system.bases)
+    return 2 * system.n_elements + 2 * len(system.bases)
 
 
 def work_arrays_for(system: System, slots: "Slots") -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The engine's work arrays for ``system`` and the current Chebyshev width of ``slots`` (:func:`exact_engine.work_arrays`)."""
-    return engine.work_arrays(2 * system.n_dof, max_guards(system), system.n_contacts, n_monitors(system), mode_length(system),
+    return engine.work_arrays(2 * system.n_dof, max_guards(system), system.n_elements, n_monitors(system), mode_length(system),
                               slots.arrays["chebyshev"].shape[2])
 
 
 def run_state(system: System, n_times: int, supplied_degree: int = 0) -> State:
     """Fresh arrays of everything a run changes (supplied steps of Chebyshev degree ``supplied_degree``)."""
-    size, n_contacts, n_guards = 2 * system.n_dof, system.n_contacts, max_guards(system)
+    size, n_contacts, n_guards = 2 * system.n_dof, system.n_elements, max_guards(system)
     length = mode_length(system)
     return State(
         engine.Run(np.zeros(1), np.zeros(engine.N_INTS, dtype=np.int64), np.zeros(size), np.zeros(size),
@@ -316,7 +316,7 @@ def _power_factors(system: System, force: np.ndarray, friction: np.ndarray) -> l
         (ground, (-system.influence @ velocity)[None]),
         (velocity, system.damping @ velocity),
         (velocity[system.base_dofs], -friction),
-        (system.contact_load @ velocity, force),
+        (system.element_load @ velocity, force),
     ]
 
 
@@ -359,7 +359,7 @@ def _placeholder(system: System, chebyshev_width: int, exact: bool) -> dict[str,
 
     Without ``exact`` the ``Propagators`` arrays are one column wide (the engine does not read them).
     """
-    size, n_contacts, n_guards = 2 * system.n_dof, system.n_contacts, max_guards(system)
+    size, n_contacts, n_guards = 2 * system.n_dof, system.n_elements, max_guards(system)
     width = size + 5
     propagate = (width, engine.propagate_columns(size, n_guards, n_contacts, n_monitors(system))) if exact else (1, 1)
     return {
