@@ -49,8 +49,8 @@ def contact_demands(run: xr.Dataset, dim: str = "time") -> xr.Dataset:
     -------
     xarray.Dataset
         Per contact: ``peak_displacement_left`` and ``peak_displacement_right``
-        (u1, u2: peak |y| of the contact's floors relative to the ground over
-        the output samples, m), ``correlation`` (ρ, Pearson correlation of the
+        (u1, u2: the largest absolute displacement y of the contact's floors
+        relative to the ground over the output samples, m), ``correlation`` (ρ, Pearson correlation of the
         two floors' y over time) and ``peak_closure`` (D, the largest
         y_left − y_right, located on the solution, m).
     """
