@@ -12,6 +12,8 @@ from stochpound.analysis.histogram import normal_histogram
 from stochpound.analysis.impacts import impact_statistics
 from stochpound.analysis.peaks import peak_response
 from stochpound.analysis.pounding import pounding_probability
+from stochpound.analysis.separation import pounding_curve, required_separation, rule_exceedance
+from stochpound.analysis.separation_rules import contact_demands, fixed_base_cqc, separation_rules
 from stochpound.analysis.summary import run_summary
 
 __all__ = [
@@ -21,5 +23,11 @@ __all__ = [
     "impact_statistics",
     "peak_response",
     "pounding_probability",
+    "pounding_curve",
+    "required_separation",
+    "rule_exceedance",
+    "contact_demands",
+    "separation_rules",
+    "fixed_base_cqc",
     "run_summary",
 ]
