@@ -16,6 +16,7 @@ import xarray as xr
 
 from stochpound.experiment import load_experiment, open_store, run_experiment
 from stochpound.report.assemble import assemble_report
+from stochpound.report.generic import AGAINST
 from stochpound.report.output import write_report
 from stochpound.report.published import published_tables
 from stochpound.report.study_tables import CORRECTED, DIFFERENCE, SPLINE, STUDY, STUDY_EQUATIONS
@@ -67,7 +68,7 @@ def test_every_study_experiment_is_shortened_and_complete(study_stores):
 
 def test_every_table_is_there_in_the_study_layout(built):
     tables = built["tables"]
-    expected = {"table-3.2", "table-records", "table-4.9-4.10", *(f"table-4.{n}" for n in range(1, 9))}
+    expected = {"table-3.2", "table-records", "table-4.9-4.10", *(f"table-4.{n}" for n in range(1, 9)), "table-buildings", "table-contacts", "table-motions"}
     assert set(tables) == expected
     for number in ("4.1", "4.3", "4.5", "4.7"):
         frame = tables[f"table-{number}"].frame
@@ -138,7 +139,7 @@ def test_a_store_that_is_not_the_study_gets_a_section_of_its_own(study_stores, t
     assert [s.title for s in report.sections] == ["Experiment my_grid", "Methods"]
     table = report.tables()[0]
     assert table.frame.shape[0] == data.sizes["mu"] * data.sizes["record"]
-    assert [f.key for f in report.figures()] == ["figure-my_grid-mu"]
+    assert [f.key for f in report.figures()] == [f"figure-my_grid-{variable}-mu" for variable in AGAINST]
 
 
 def test_the_study_report_renders_in_headless_chromium(built, tmp_path):

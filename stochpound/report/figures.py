@@ -9,7 +9,9 @@ substitutes as such.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import xarray as xr
@@ -125,6 +127,120 @@ def histograms_with_normal(samples: Mapping[str, xr.DataArray], title: str, bins
         ax.set_visible(False)
     figure.suptitle(title, fontsize=9)
     return figure
+
+
+@dataclass(frozen=True)
+class Curve:
+    """One line of a panel of :func:`panel_grid`.
+
+    Attributes
+    ----------
+    label : str
+        Its legend entry (curves with the same label share one entry).
+    x : numpy.ndarray
+        Abscissae; with ``y`` None, a sample drawn as its empirical CDF (NaN left out).
+    y, lower, upper : numpy.ndarray, optional
+        Ordinates and a band between ``lower`` and ``upper`` (e.g. a 95 % interval).
+    color : Any
+        A matplotlib colour.
+    style : str
+        Line style.
+    marker : str
+        Marker at each point ("" for none).
+    gid : str
+        Set on every artist of the curve (:func:`stochpound.report.facets.cell_gid`).
+    """
+
+    label: str
+    x: np.ndarray
+    y: np.ndarray | None = None
+    lower: np.ndarray | None = None
+    upper: np.ndarray | None = None
+    color: Any = "C0"
+    style: str = "-"
+    marker: str = ""
+    gid: str = ""
+
+
+def panel_grid(
+    panels: Mapping[str, Sequence[Curve]],
+    title: str,
+    x_label: str,
+    y_label: str,
+    *,
+    x_ticks: Mapping[float, str] | None = None,
+    log_x: bool = False,
+    y_limits: tuple[float, float] | None = None,
+    legend_title: str = "",
+) -> Figure:
+    """Panels of curves (with bands, or empirical CDFs) in a grid sharing axes and one legend.
+
+    Parameters
+    ----------
+    panels : mapping
+        Panel title -> its curves.
+    title : str
+        The figure's title.
+    x_label, y_label : str
+        Axis labels with units (shown once per row and column).
+    x_ticks : mapping, optional
+        Tick positions and labels (e.g. a categorical μ axis with "fixed").
+    log_x : bool
+        A logarithmic x axis (positive values only are drawn).
+    y_limits : tuple, optional
+        Limits of every y axis.
+    legend_title : str
+        Title of the figure's legend.
+    """
+    columns = 4 if len(panels) > 9 else min(len(panels), 3)
+    rows = -(-len(panels) // columns)
+    # a fixed layout (inches): constrained layout costs seconds on a grid of panels
+    legend, top, bottom, left = 0.55, 0.45, 0.5, 0.65
+    height = top + bottom + legend + 1.75 * rows
+    figure = Figure(figsize=(7.5, height))
+    axes = figure.subplots(
+        rows, columns, squeeze=False, sharex=True, sharey=True,
+        gridspec_kw={"left": left / 7.5, "right": 1 - 0.15 / 7.5, "top": 1 - top / height, "bottom": (bottom + legend) / height, "hspace": 0.45, "wspace": 0.12},
+    )
+    entries: dict[str, Any] = {}
+    for ax, (panel, curves) in zip(axes.ravel(), panels.items()):
+        for curve in curves:
+            entries.setdefault(curve.label, _draw(ax, curve))
+        ax.set_title(panel, fontsize=7.5)
+        ax.tick_params(labelsize=7)
+        ax.grid(True, lw=0.3, alpha=0.5)
+        if log_x:
+            ax.set_xscale("log")
+        if x_ticks is not None:
+            ax.set_xticks(list(x_ticks), list(x_ticks.values()))
+        if y_limits is not None:
+            ax.set_ylim(*y_limits)
+    for ax in axes.ravel()[len(panels):]:
+        ax.set_visible(False)
+    for ax in axes[:, 0]:
+        ax.set_ylabel(y_label, fontsize=8)
+    for column in range(columns):
+        last = max(r for r in range(rows) if r * columns + column < len(panels))
+        axes[last, column].set_xlabel(x_label, fontsize=8)
+        axes[last, column].xaxis.set_tick_params(labelbottom=True)
+    figure.suptitle(title, fontsize=9, y=1 - 0.12 / height)
+    if len(entries) > 1:
+        figure.legend(list(entries.values()), list(entries), loc="lower center", bbox_to_anchor=(0.5, 0.02 / height), ncols=min(len(entries), 6), fontsize=7, title=legend_title or None, title_fontsize=7)
+    return figure
+
+
+def _draw(ax: Any, curve: Curve) -> Any:
+    """Draw one curve (and its band) on ``ax``; return the artist for the legend."""
+    if curve.y is None:
+        sample = np.asarray(curve.x, dtype=float)
+        line = ax.ecdf(sample[np.isfinite(sample)], color=curve.color, linestyle=curve.style, lw=1.0)
+    else:
+        (line,) = ax.plot(curve.x, curve.y, color=curve.color, linestyle=curve.style, marker=curve.marker or None, ms=3, lw=1.0)
+        if curve.lower is not None:
+            band = ax.fill_between(curve.x, curve.lower, curve.upper, color=curve.color, alpha=0.15, linewidth=0)
+            band.set_gid(curve.gid)
+    line.set_gid(curve.gid)
+    return line
 
 
 def _cycle(count: int) -> list[str]:

@@ -15,7 +15,7 @@ import xarray as xr
 from stochpound.records import load_record
 from stochpound.report import figures
 from stochpound.report.document import FigureItem
-from stochpound.report.methods import harmonic_comparisons
+from stochpound.report.accuracy import harmonic_comparisons
 from stochpound.report.stores import case_impacts, select
 from stochpound.report.study_tables import RECORD_ENTRIES, record_label
 
