@@ -15,7 +15,7 @@ from pathlib import Path
 
 import xarray as xr
 
-from stochpound.report import findings, study_figures, study_tables
+from stochpound.report import findings, study_figures, study_notes, study_tables
 from stochpound.report.document import Block, Paragraph, Report, Section
 from stochpound.report.generic import store_section
 from stochpound.report.methods import methods_section
@@ -78,22 +78,22 @@ def _study_sections(stores: dict[str, xr.Dataset]) -> list[tuple[str, str, Calla
     gap, single, pair_mu, pair_records, harmonic = (stores.get(name) for name in ("study_gap", "study_single", "study_pair_mu", "study_pair_records", "study_harmonic"))
     sections = []
     if pair_mu is not None or gap is not None:
-        sections.append(("Findings", "findings", lambda: _findings(gap, pair_mu)))
+        sections.append(("Findings", "findings", lambda: _findings(gap, pair_mu, pair_records)))
     sections.append(("The records", "records", lambda: [study_tables.records_table(), study_figures.accelerograms()]))
     if harmonic is not None:
         sections.append(("Harmonic check", "harmonic", lambda: study_figures.harmonic_check(harmonic)))
     if gap is not None:
-        sections.append(("Both fixed: pounding against the gap", "gap", lambda: [study_figures.gap_time_history(gap), *study_figures.against_gap(gap)]))
+        sections.append(("Both fixed: pounding against the gap", "gap", lambda: [study_tables.building_2_table(gap), study_figures.gap_time_history(gap), *study_figures.against_gap(gap)]))
     if single is not None:
         sections.append(("Single isolated building against μ", "single", lambda: [*study_figures.single_against_mu(single), study_figures.single_histograms(single)]))
     if pair_mu is not None:
         sections.append(("The pair against μ (El Centro, gap 2 cm)", "pair-mu", lambda: _pair_mu(pair_mu)))
     if pair_records is not None:
-        sections.append(("The pair by record (μ = 0.2)", "pair-records", lambda: _pair_records(pair_records, pair_mu)))
+        sections.append(("The pair by record (μ = 0.2)", "pair-records", lambda: _pair_records(pair_records, pair_mu, single)))
     return sections
 
 
-def _findings(gap: xr.Dataset | None, pair_mu: xr.Dataset | None) -> list[Block]:
+def _findings(gap: xr.Dataset | None, pair_mu: xr.Dataset | None, pair_records: xr.Dataset | None) -> list[Block]:
     blocks: list[Block] = []
     if pair_mu is not None:
         blocks += [findings.fixed_columns(pair_mu), findings.isolated_columns(pair_mu)]
@@ -101,17 +101,18 @@ def _findings(gap: xr.Dataset | None, pair_mu: xr.Dataset | None) -> list[Block]
         blocks += [findings.gap_effect(gap), findings.small_gaps(gap)]
         blocks.append(findings.phase(gap, pair_mu))
     if pair_mu is not None:
-        blocks += [findings.worst_case(pair_mu), findings.correlation_collapse(pair_mu)]
+        blocks += [findings.worst_case(pair_mu, pair_records), findings.correlation_collapse(pair_mu)]
     return blocks
 
 
 def _pair_mu(store: xr.Dataset) -> list[Block]:
     tables = [study_tables.mu_table(number, store) for number in ("4.1", "4.3", "4.5", "4.7")]
-    return [*tables, *study_figures.pair_against_mu(store), study_tables.correlation_table(store)]
+    return [*tables, *study_figures.pair_against_mu(store), study_tables.correlation_table(store), *study_notes.scaling_sensitivity(store)]
 
 
-def _pair_records(store: xr.Dataset, pair_mu: xr.Dataset | None) -> list[Block]:
+def _pair_records(store: xr.Dataset, pair_mu: xr.Dataset | None, single: xr.Dataset | None) -> list[Block]:
     blocks: list[Block] = [study_tables.by_record_table(number, store) for number in ("4.2", "4.4", "4.6", "4.8")]
+    blocks += study_notes.northridge_means(store, single)
     blocks += study_figures.by_record_histograms(store)
     if pair_mu is not None:
         blocks.append(study_figures.configurations_time_history(pair_mu))
