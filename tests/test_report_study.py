@@ -138,7 +138,7 @@ def test_a_store_that_is_not_the_study_gets_a_section_of_its_own(study_stores, t
     other = tmp_path / "my_grid.nc"
     data.to_netcdf(other, engine="h5netcdf")
     report = assemble_report([other])
-    assert [s.title for s in report.sections] == ["Experiment my_grid", "Methods"]
+    assert [s.title for s in report.sections] == ["About this report", "Experiment my_grid", "Methods"]
     table = report.tables()[0]
     assert table.frame.shape[0] == data.sizes["mu"] * data.sizes["record"]
     assert [f.key for f in report.figures()] == [f"figure-my_grid-{variable}-mu" for variable in AGAINST]

@@ -56,7 +56,7 @@ def assemble_report(paths: Sequence[str | Path], progress: Callable[[str], None]
     study = {name: store for name, store in stores.items() if name in STUDY_EXPERIMENTS}
     others = {name: store for name, store in stores.items() if name not in STUDY_EXPERIMENTS}
     report = Report(
-        title="Pounding of base-isolated buildings: the reference study regenerated" if study else "stochpound experiment report",
+        title="Pounding of base-isolated buildings: the reference study regenerated" if study else f"Pounding experiments: {', '.join(others)}",
         subtitle=f"stochpound report of {', '.join(stores)}, built {date.today().isoformat()}",
         sources=[f"{name}: {store.attrs.get('experiment_file', '')}, definition sha256 {store.attrs.get('definition_sha256', '')}" for name, store in stores.items()],
     )
@@ -65,12 +65,29 @@ def assemble_report(paths: Sequence[str | Path], progress: Callable[[str], None]
         for title, key, build in _study_sections(study):
             say(title)
             report.sections.append(Section(title, build(), key=key))
+    if others and not study:
+        report.sections.append(Section("About this report", [Paragraph(_about(others))], key="about"))
     for name, store in others.items():
         say(f"experiment {name}")
         report.sections.append(store_section(name, store))
     say("methods")
     report.sections.append(methods_section(stores))
     return report
+
+
+def _about(stores: dict[str, xr.Dataset]) -> str:
+    """What the report of stores that are not the study's holds, and how to read it."""
+    described = "; ".join(f"{name}: {store.attrs.get('experiment_description', '')}" for name, store in stores.items())
+    return (
+        f"This report describes the experiment stores {described}. Each experiment has a section: the cases run under "
+        "records one by one, and each synthetic ensemble by the statistics of its realizations in every cell of the grid "
+        "(every combination of the grid's axes): means with 95 % Student-t confidence intervals, quantiles of the peaks, and "
+        "the probability of pounding (at least one impact) with its 95 % Clopper–Pearson interval, followed by findings "
+        "computed from them, tables (also written as CSV files) and figures in which every cell is drawn. An ECDF gives, for "
+        "each value, the fraction of realizations at or below it; a convergence figure shows an estimate over the first n "
+        "realizations, so that one sees whether the ensemble is large enough. The Methods section describes every building, "
+        "contact and motion from the stores' own definitions and checks the solver while the report is built."
+    )
 
 
 def _study_sections(stores: dict[str, xr.Dataset]) -> list[tuple[str, str, Callable[[], list[Block]]]]:
