@@ -32,8 +32,8 @@ from types import ModuleType
 import numpy as np
 
 from benchmarks.outcome import Outcome
-from stochpound.motion import SampledMotion
-from stochpound.scene import Scene
+from stochpound.motions.ground import SampledMotion
+from stochpound.model.scene import Scene
 
 FRICTION_YIELD_DISPLACEMENT = 1e-5
 """Yield displacement of the ElasticPP friction element, m."""

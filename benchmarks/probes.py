@@ -36,7 +36,7 @@ def first_call() -> None:
 
     imported, scene = _timed(_main_scene)
     import stochpound
-    from stochpound.solvers.exact_engine import OPTIMISATION_LEVEL
+    from stochpound.solvers.engine import OPTIMISATION_LEVEL
 
     first, _ = _timed(lambda: stochpound.simulate(scene))
     second, _ = _timed(lambda: stochpound.simulate(scene))
@@ -54,7 +54,7 @@ def _main_scene():
 def _ensemble_setup(runs: int, lazy: bool):
     """Scene (c), ``runs`` Kanai–Tajimi motions of 30 s at dt 0.01 s, and a 2-realization warm-up run."""
     from benchmarks.scenes import STUDY_SCENES, kanai_tajimi_motions, lazy_kanai_tajimi_motions
-    from stochpound.ensemble import simulate_ensemble
+    from stochpound.experiment.ensemble import simulate_ensemble
 
     scene = STUDY_SCENES[2].scene()
     make = lazy_kanai_tajimi_motions if lazy else kanai_tajimi_motions

@@ -272,7 +272,7 @@ def _work_precision_section(results: Results) -> str:
         "Error: largest |y − y_ref| of Building 1's top-floor total displacement over the record's samples; "
         "Δ impacts: impacts counted minus the reference's; peak force and final sliding displacement of Building 1's base "
         "against the reference. `ivp` runs use atol = rtol · 1e-2. The study scheme runs on spline input and is compared "
-        "with the exact solution of the same spline-interpolated scene; OpenSeesPy runs the scene of MODEL.md with the "
+        "with the exact solution of the same spline-interpolated scene; OpenSeesPy runs the same scene (docs/model.md) with the "
         "regularised friction and gap elements of `benchmarks/opensees_model.py`.\n",
     ]
     for bench in results.scenes:

@@ -22,8 +22,8 @@ import xarray as xr
 
 import stochpound
 from stochpound import motions
-from stochpound.motion import SampledMotion
-from stochpound.scene import Scene
+from stochpound.motions.ground import SampledMotion
+from stochpound.model.scene import Scene
 from tests.conftest import REFERENCE_MASS, REFERENCE_STIFFNESS, study_scene
 
 STUDY_RECORD = "el_centro_1940_study"

@@ -1,4 +1,4 @@
-"""An emulation of the reference study's own solution scheme (REFERENCE_STUDY.md, its Appendix 4).
+"""An emulation of the reference study's own solution scheme (Agarwal 2004, its Appendix 4).
 
 The study did not locate events. It restarted MATLAB's ``ode45`` every h
 seconds (h = 0.02 s), and only at those restarts decided
@@ -19,12 +19,12 @@ step, and a sliding base never stops inside a step. The ground motion is the
 scene's own (the study used a cubic spline through the samples).
 
 The equations inside a step are stochpound's mode equations
-(:class:`stochpound.modes.ModeLibrary`): a sliding base is a free degree of
+(:class:`stochpound.model.modes.ModeLibrary`): a sliding base is a free degree of
 freedom plus the friction term above, a stuck base keeps s and ṡ. Whether
 the impact forces act on the base as a whole follows the scene:
 ``study_compat = true`` gives the study's equations (they do not), otherwise
 the momentum-consistent ones; the sliding test includes them in the second
-case, as the required friction force F_req of MODEL.md does.
+case, as the required friction force F_req of docs/model.md does.
 
 This module lives in ``benchmarks/``, not in the library: it exists to show
 what the study's scheme does, not to be used.
@@ -39,10 +39,11 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from benchmarks.outcome import Outcome
-from stochpound.modes import FREE, STUCK, Mode, ModeDynamics, ModeLibrary
-from stochpound.motion import SampledMotion
-from stochpound.scene import Scene
-from stochpound.system import System, build_system
+from stochpound.model.friction import FREE, STUCK
+from stochpound.model.modes import Mode, ModeDynamics, ModeLibrary
+from stochpound.motions.ground import SampledMotion
+from stochpound.model.scene import Scene
+from stochpound.model.system import System, build_system
 
 STUDY_RK45 = {"max_step": 0.01, "first_step": 0.01, "atol": 1e-3, "rtol": 1e-3}
 """Settings of the RK45 integration inside each step (the study's ode45 options; the
@@ -66,7 +67,7 @@ class SchemeRun:
     peak_force : float
         Largest contact force over the integrator's steps, N.
     sliding_steps : np.ndarray
-        Per building, the number of steps in which its base slid.
+        Per sliding base, the number of steps in which it slid.
     """
 
     system: System = field(repr=False)
@@ -78,8 +79,8 @@ class SchemeRun:
 
     def sliding_displacement(self, building: int = 0) -> np.ndarray:
         """Sliding displacement s of a building's base at the sample times, m (0 if fixed)."""
-        dof = self.system.base_dofs[building]
-        return self.states[:, dof] if dof >= 0 else np.zeros(len(self.times))
+        dofs = [base.dof for base in self.system.bases if base.building == building]
+        return self.states[:, dofs[0]] if dofs else np.zeros(len(self.times))
 
     def total_displacement(self, building: int = 0, floor: int = -1) -> np.ndarray:
         """Total displacement y = s + u of one floor (default: the top) at the sample times, m."""
@@ -97,7 +98,7 @@ class StudyScheme:
     Parameters
     ----------
     scene : Scene
-        Its motion must be sampled (:class:`~stochpound.motion.SampledMotion`).
+        Its motion must be sampled (:class:`~stochpound.motions.ground.SampledMotion`).
     h : float
         Restart interval, s. The motion's sample spacing must be a whole
         multiple of it (the study: h = dt = 0.02 s).
@@ -118,13 +119,13 @@ class StudyScheme:
 
     def run(self) -> SchemeRun:
         """Emulate the whole motion; see the module docstring for the rules."""
-        system, n_buildings = self.system, len(self.system.base_dofs)
+        system, n_bases = self.system, len(self.system.bases)
         x = system.initial_state.copy()
         states = np.empty((len(self.motion.times), 2 * system.n_dof))
         states[0] = x
-        check = np.zeros(n_buildings)  # the study starts from zero accelerations
-        closed_before = np.zeros(system.n_contacts, dtype=bool)
-        impacts, peak, sliding_steps = 0, 0.0, np.zeros(n_buildings, dtype=int)
+        check = np.zeros(n_bases)  # the study starts from zero accelerations
+        closed_before = np.zeros(system.n_elements, dtype=bool)
+        impacts, peak, sliding_steps = 0, 0.0, np.zeros(n_bases, dtype=int)
         for k in range(len(self.motion.times) - 1):
             edges = np.linspace(self.motion.times[k], self.motion.times[k + 1], self.steps_per_sample + 1)
             for t0, t1 in zip(edges[:-1], edges[1:]):
@@ -143,12 +144,12 @@ class StudyScheme:
         """The mode of the next step: contacts penetrated at the restart, bases whose test quantity reaches μ W."""
         system = self.system
         closed = tuple(bool(c) for c in self._penetration(x) > 0.0)
-        sliding = [b in system.isolated and not (system.base_mu[b] * system.base_weight[b] > abs(check[b])) for b in range(len(check))]
+        sliding = [not (base.mu * base.weight > abs(check[b])) for b, base in enumerate(system.bases)]
         return Mode(closed, tuple(FREE if slides else STUCK for slides in sliding))
 
     def _penetration(self, x: np.ndarray) -> np.ndarray:
         """δ of every contact at state x, m."""
-        return self.system.contact_geometry @ x[: self.system.n_dof] - self.system.contact_gap
+        return self.system.element_geometry @ x[: self.system.n_dof] - self.system.element_gap
 
     def _friction(self, mode: Mode) -> np.ndarray:
         """Columns: the state rate of each sliding base's friction force −μ W (times sgn ṡ)."""
@@ -156,13 +157,13 @@ class StudyScheme:
         if cached is not None:
             return cached
         system, n = self.system, self.system.n_dof
-        stuck = [system.base_dofs[b] for b in system.isolated if mode.base[b] == STUCK]
+        stuck = [base.dof for base, state in zip(system.bases, mode.base) if state == STUCK]
         free = np.setdiff1d(np.arange(n), stuck)
-        columns = np.zeros((2 * n, len(system.base_dofs)))
-        for b in system.isolated:
+        columns = np.zeros((2 * n, len(system.bases)))
+        for b, base in enumerate(system.bases):
             if mode.base[b] == FREE:
                 load = np.zeros(len(free))
-                load[np.searchsorted(free, system.base_dofs[b])] = -system.base_mu[b] * system.base_weight[b]
+                load[np.searchsorted(free, base.dof)] = -base.mu * base.weight
                 columns[n + free, b] = np.linalg.solve(system.mass[np.ix_(free, free)], load)
         self._friction_cache[mode.base] = columns
         return columns
@@ -172,7 +173,7 @@ class StudyScheme:
         dynamics = self.library[mode]
         A, B, c = dynamics.A, dynamics.B, dynamics.c
         friction = self._friction(mode)
-        velocity_rows = self.system.n_dof + np.array([max(dof, 0) for dof in self.system.base_dofs])
+        velocity_rows = self.system.n_dof + self.system.base_dofs
         acceleration = self.motion.acceleration
 
         def rate(t: float, x: np.ndarray) -> np.ndarray:
@@ -188,26 +189,26 @@ class StudyScheme:
         if not solution.success:
             raise RuntimeError(f"RK45 failed at t = {t0:.4f} s: {solution.message}")
         x_end = solution.y[:, -1].copy()
-        for b in self.system.isolated:
-            if mode.base[b] == STUCK:
-                x_end[self.system.n_dof + self.system.base_dofs[b]] = 0.0  # the study's "no sliding" reset
+        for base, state in zip(self.system.bases, mode.base):
+            if state == STUCK:
+                x_end[self.system.n_dof + base.dof] = 0.0  # the study's "no sliding" reset
         return x_end, _peak_force(dynamics, solution.y)
 
     def _sliding_check(self, k: int, t: float, x: np.ndarray, mode: Mode) -> np.ndarray:
-        """The study's sliding test quantity per building, N, at the end of a step (0 for fixed bases)."""
+        """The study's sliding test quantity per sliding base, N, at the end of a step."""
         system, n = self.system, self.system.n_dof
         rate, dynamics = self._rate_function(k, mode)
         acceleration = rate(t, x)[n:]
         forces = dynamics.force_matrix @ x + dynamics.force_constant
         ground = self.motion.acceleration(t, k)
-        check = np.zeros(len(system.base_dofs))
-        for b in system.isolated:
-            base, floors = system.base_dofs[b], system.floor_dofs[b]
+        check = np.zeros(len(system.bases))
+        for b, sliding_base in enumerate(system.bases):
+            base, floors = sliding_base.dof, system.floor_dofs[sliding_base.building]
             floor_mass = np.diag(system.mass)[floors]
             check[b] = (
                 floor_mass @ (acceleration[floors] + acceleration[base])
                 + system.influence[base] * ground
-                + forces @ system.contact_load[:, base]
+                + forces @ system.element_load[:, base]
                 + system.stiffness[base, base] * x[base]
             )
         return check

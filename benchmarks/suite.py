@@ -19,7 +19,7 @@ from benchmarks.outcome import Errors, Outcome, compare, outcome_from_dataset
 from benchmarks.scenes import MAIN_SCENE, STUDY_SCENES, StudyScene, kanai_tajimi_motions, with_motion
 from benchmarks.study_scheme import run_study_scheme
 from benchmarks.timing import Timing, best_of, run_subprocess
-from stochpound.scene import Scene
+from stochpound.model.scene import Scene
 
 REFERENCE_RTOL = 1e-12
 """rtol of the ``ivp`` DOP853 run that cross-checks the exact solver (atol = rtol · 1e-2)."""
@@ -300,9 +300,9 @@ def guarded(call: Callable[[], dict[str, Any]]) -> dict[str, Any]:
 
 
 def ensemble_available() -> bool:
-    """Whether ``stochpound.ensemble.simulate_ensemble`` exists in this tree."""
+    """Whether ``stochpound.experiment.ensemble.simulate_ensemble`` exists in this tree."""
     try:
-        from stochpound.ensemble import simulate_ensemble  # noqa: F401
+        from stochpound.experiment.ensemble import simulate_ensemble  # noqa: F401
     except ImportError:
         return False
     return True
@@ -313,7 +313,7 @@ def compile_time(config: Config) -> dict[str, Any]:
 
     Each empty-cache run is followed by one at numba's default optimisation
     level (``NUMBA_OPT=3``, ``cold_default_level``), which the engine lowers
-    (:data:`stochpound.solvers.exact_engine.OPTIMISATION_LEVEL`): the pairs
+    (:data:`stochpound.solvers.engine.OPTIMISATION_LEVEL`): the pairs
     show what that saves and that it costs no speed.
     """
     import os
@@ -401,7 +401,7 @@ def run_all(config: Config, log: Callable[[str], None] = print) -> Results:
     log("first-call compile time")
     compiled = compile_time(config) if config.compile_time else None
     has_ensemble = ensemble_available()
-    missing = {"error": "stochpound.ensemble.simulate_ensemble is not available in this tree"}
+    missing = {"error": "stochpound.experiment.ensemble.simulate_ensemble is not available in this tree"}
     log("ensemble throughput")
     ensemble = ensemble_throughput(config) if has_ensemble else missing
     log("ensemble memory")

@@ -7,8 +7,8 @@ and :func:`simulate` (run one scene and return an :class:`xarray.Dataset`).
 __version__ = "0.1.0"
 
 from stochpound.errors import RecordError, SceneError, StochpoundError  # noqa: E402
-from stochpound.scene_file import load_scene, scene_from_dict  # noqa: E402
-from stochpound.simulate import simulate  # noqa: E402
+from stochpound.model.scene_file import load_scene, scene_from_dict  # noqa: E402
+from stochpound.solvers.simulate import simulate  # noqa: E402
 from stochpound.experiment.store import open_store  # noqa: E402
 
 __all__ = ["__version__", "load_scene", "scene_from_dict", "simulate", "open_store", "SceneError", "RecordError", "StochpoundError"]

@@ -1,4 +1,4 @@
-"""Shared scene builders for the tests (the reference study's buildings, MODEL.md / REFERENCE_STUDY.md)."""
+"""Shared scene builders for the tests (the reference study's buildings, docs/model.md)."""
 
 from __future__ import annotations
 

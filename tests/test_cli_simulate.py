@@ -1,4 +1,4 @@
-"""``stochpound simulate SCENE.toml --out RUN.nc`` writes the CONTRACT.md dataset."""
+"""``stochpound simulate SCENE.toml --out RUN.nc`` writes the result dataset of docs/scene-files.md."""
 
 import subprocess
 import sys

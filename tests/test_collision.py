@@ -1,4 +1,4 @@
-"""A single collision of two free masses through the Kelvin–Voigt element (MODEL.md §4)."""
+"""A single collision of two free masses through the Kelvin–Voigt element (docs/model.md §3)."""
 
 import math
 

@@ -1,4 +1,4 @@
-"""Energy balance on the study scenes and the numerical traps of MODEL.md §6."""
+"""Energy balance on the study scenes and the numerical traps of docs/model.md."""
 
 import numpy as np
 import pytest

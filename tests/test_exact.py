@@ -1,4 +1,4 @@
-"""The exact solver against the ivp path (rtol 1e-12), closed forms and the traps of MODEL.md §6."""
+"""The exact solver against the ivp path (rtol 1e-12), closed forms and the numerical traps of docs/model.md."""
 
 import dataclasses
 import os
@@ -10,9 +10,9 @@ import numpy as np
 import pytest
 
 import stochpound
-from stochpound.motion import GroundMotion, HarmonicMotion, SampledMotion
-from stochpound.propagators import UnsupportedMotionError, exosystem, interval_forcing, propagator_library, sample_ground
-from stochpound.system import build_system
+from stochpound.motions.ground import GroundMotion, HarmonicMotion, SampledMotion
+from stochpound.solvers.propagators import UnsupportedMotionError, exosystem, interval_forcing, propagator_library, sample_ground
+from stochpound.model.system import build_system
 from tests.conftest import reference_building, study_contacts, study_scene
 
 TOLERANCE = 1e-9  # m, on every floor's total displacement over the whole record
@@ -159,13 +159,14 @@ def test_exosystem_reproduces_the_motion_inside_an_interval():
         np.testing.assert_array_equal(sample_ground(motion), ground)
 
 
-def test_unsupported_motion_names_the_other_method():
+@pytest.mark.parametrize("method", ["exact", "ivp"])
+def test_unsupported_motion_is_named(method):
     class Other(GroundMotion):
         times = np.arange(5) * 0.1
 
     scene = stochpound.scene_from_dict(study_scene())
-    with pytest.raises(UnsupportedMotionError, match="method='ivp'"):
-        stochpound.simulate(dataclasses.replace(scene, motion=Other()), method="exact")
+    with pytest.raises(UnsupportedMotionError, match="sampled .* and harmonic ground motions, not Other"):
+        stochpound.simulate(dataclasses.replace(scene, motion=Other()), method=method)
 
 
 def test_propagators_are_cached_across_runs_and_hold_stuck_bases_exactly():
@@ -182,14 +183,14 @@ def test_propagators_are_cached_across_runs_and_hold_stuck_bases_exactly():
     assert np.all(velocity_free[stuck[:-1] & stuck[1:]] == 0.0)  # s constant to the last bit while stuck
 
 
-# ---------------------------------------------------------------- compiled engine against the shared Python event code
+# ---------------------------------------------------------------- hard cases, and the engine run by Python
 
 
 HARD_CASES = {
     "B1 isolated, El Centro 20 s": study_scene(0.2, None, 2.0, motion={"record": "el_centro_1940_study", "duration": 20.0}),
     "zero gap, stiff B2": study_scene(None, None, 0.5, gap=0.0, motion={"record": "el_centro_1940_study", "duration": 10.0}),
     "stiff contacts x100": study_scene(None, None, 2.0, motion={"record": "el_centro_1940_study", "duration": 10.0}),
-    "non-tensile contacts, both isolated": study_scene(0.1, 0.1, 0.5, gap=0.01, motion={"record": "el_centro_1940_study", "duration": 20.0}),
+    "non-tensile contacts, both isolated": study_scene(0.1, 0.1, 0.5, gap=0.002, motion={"record": "el_centro_1940_study", "duration": 20.0}),
     "frictionless against a neighbour": {
         "building": [reference_building("B1", mu=0.0), reference_building("B2", 2.0)],
         "contact": study_contacts(0.0, mass_factor=2.0),
@@ -203,35 +204,61 @@ for contact in HARD_CASES["non-tensile contacts, both isolated"]["contact"]:
 
 
 @pytest.mark.parametrize("name", list(HARD_CASES))
-def test_compiled_engine_matches_the_shared_python_event_code(name):
-    """The numba port of events/recorder gives the events and outputs of the shared Python functions."""
-    from stochpound.solvers.exact import run_exact
+def test_hard_cases_match_ivp(name):
+    """The exact flow and DOP853's (rtol 1e-12) through the one event engine: the same events, impacts and outputs."""
+    exact, reference = both(HARD_CASES[name])
+    assert exact.attrs["events_total"] == reference.attrs["events_total"]
+    assert exact.attrs["events_chatter_cycles"] == reference.attrs["events_chatter_cycles"]
+    assert_same_run(exact, reference)
 
-    scene = stochpound.scene_from_dict(HARD_CASES[name])
-    compiled, counters, _ = run_exact(scene, events="compiled")
-    python, python_counters, _ = run_exact(scene, events="python")
-    assert counters.total == python_counters.total
-    assert counters.chatter_cycles == python_counters.chatter_cycles
-    np.testing.assert_allclose(compiled.states, python.states, rtol=0, atol=1e-11)
-    np.testing.assert_array_equal(compiled.base_states, python.base_states)
-    assert len(compiled.impacts) == len(python.impacts)
-    for a, b in zip(compiled.impacts, python.impacts, strict=True):
-        assert (a.contact, a.in_phase, a.complete) == (b.contact, b.in_phase, b.complete)
-        np.testing.assert_allclose([a.start, a.end, a.peak_time], [b.start, b.end, b.peak_time], rtol=0, atol=1e-11)
-        np.testing.assert_allclose([a.peak_force, a.impulse], [b.peak_force, b.impulse], rtol=1e-9)
-    for term in compiled.energy:
-        np.testing.assert_allclose(compiled.energy[term], python.energy[term], rtol=1e-9, atol=1e-6)
+
+INTERPRETED_PROBE = """
+import json
+import stochpound
+from tests.test_exact import interpreted_scene
+
+scene = interpreted_scene()
+runs = {method: stochpound.simulate(stochpound.scene_from_dict(scene), method=method) for method in ("exact", "ivp")}
+print(json.dumps({method: {"y": run.total_displacement.values[:, :, ::10].ravel().tolist(), "starts": run.impact_start.values.tolist(),
+                           "events": run.attrs["events_total"]} for method, run in runs.items()}))
+"""
+
+
+def interpreted_scene() -> dict:
+    """B1 isolated (μ = 0.1) against a stiff fixed B2 at zero gap, non-tensile contacts, 2 s of El Centro: 13 impacts."""
+    scene = study_scene(0.1, None, 0.5, gap=0.0, motion={"record": "el_centro_1940_study", "duration": 2.0})
+    for contact in scene["contact"]:
+        contact["tensile"] = False
+    return scene
+
+
+def test_interpreted_engine_gives_the_compiled_results():
+    """NUMBA_DISABLE_JIT (the debugging path: the engine's code run by Python) reproduces the compiled engine, exact and ivp."""
+    import json
+
+    scene = interpreted_scene()
+    environment = dict(os.environ, NUMBA_DISABLE_JIT="1")
+    result = subprocess.run([sys.executable, "-c", INTERPRETED_PROBE], cwd=Path(__file__).parents[1], env=environment,
+                            capture_output=True, text=True, timeout=600, check=False)
+    assert result.returncode == 0, result.stderr[-2000:]
+    interpreted = json.loads(result.stdout.splitlines()[-1])
+    for method in ("exact", "ivp"):
+        compiled = stochpound.simulate(stochpound.scene_from_dict(scene), method=method)
+        assert compiled.sizes["impact"] > 0
+        assert interpreted[method]["events"] == compiled.attrs["events_total"]
+        np.testing.assert_allclose(interpreted[method]["starts"], compiled.impact_start.values, rtol=0, atol=1e-12)
+        np.testing.assert_allclose(interpreted[method]["y"], compiled.total_displacement.values[:, :, ::10].ravel(), rtol=0, atol=1e-13)
 
 
 def test_a_sub_step_product_gives_the_next_state_and_its_guards():
-    """One product of z(t0) with a mode's ``propagate`` rows: z(t0 + h), then (past the forms) the guards' values and rates there."""
-    from stochpound.solvers import exact_engine, exact_tables
+    """One product of z(t0) with a mode's ``propagate`` rows: z(t0 + h), then (past the forms) the guards' and monitors' values and rates there."""
+    from stochpound.solvers import engine, tables
 
     scene = stochpound.scene_from_dict(study_scene(0.2, 0.1, 2.0, motion={"record": "el_centro_1940_study", "duration": 5.0}))
     stochpound.simulate(scene)
     library = propagator_library(build_system(scene), scene.motion)
-    slots = exact_tables.slots_of(library)
-    size, n_contacts = 2 * library.system.n_dof, library.system.n_contacts
+    slots = tables.slots_of(library)
+    size, n_contacts = 2 * library.system.n_dof, library.system.n_elements
     padded = slots.arrays["guard"].shape[1]
     rng = np.random.default_rng(5)
     for mode in library:
@@ -248,7 +275,12 @@ def test_a_sub_step_product_gives_the_next_state_and_its_guards():
         np.testing.assert_allclose(values, dynamics.guards(x1, ground), rtol=1e-12, atol=1e-12)
         expected = dynamics.guard_matrix @ dynamics.rate(x1, ground) + dynamics.guard_ground * ground_rate
         np.testing.assert_allclose(rates, expected, rtol=1e-12, atol=1e-12)
-        assert out.shape[0] % exact_engine.LANES == 0 and not np.any(out[values_at + 2 * padded :])
+        monitors_at, m = values_at + 2 * padded, len(dynamics.monitor_constant)
+        closure = dynamics.monitor_matrix @ x1 + dynamics.monitor_ground * ground + dynamics.monitor_constant
+        np.testing.assert_allclose(out[monitors_at : monitors_at + m], closure, rtol=1e-12, atol=1e-14)
+        expected = dynamics.monitor_matrix @ dynamics.rate(x1, ground) + dynamics.monitor_ground * ground_rate
+        np.testing.assert_allclose(out[monitors_at + m : monitors_at + 2 * m], expected, rtol=1e-12, atol=1e-14)
+        assert out.shape[0] % engine.LANES == 0 and not np.any(out[monitors_at + 2 * m :])
 
 
 def test_engine_compiles_every_function_once():
@@ -260,23 +292,12 @@ def test_engine_compiles_every_function_once():
     """
     from numba.core.registry import CPUDispatcher
 
-    from stochpound.solvers import exact_engine
+    from stochpound.solvers import engine
 
     stochpound.simulate(stochpound.scene_from_dict(HARD_CASES["non-tensile contacts, both isolated"]))
-    for name, function in vars(exact_engine).items():
+    for name, function in vars(engine).items():
         if isinstance(function, CPUDispatcher):
             assert len(function.signatures) <= (2 if name == "_copy" else 1), name
-
-
-def test_result_dataset_is_the_one_xarray_would_build():
-    """The dataset assembled directly from its variables equals xarray's own construction (indexes included)."""
-    import xarray as xr
-
-    result = stochpound.simulate(stochpound.scene_from_dict(study_scene(0.2, None, 2.0, motion={"record": "el_centro_1940_study", "duration": 5.0})))
-    coords = {name: result.variables[name].to_base_variable() for name in result.coords}
-    rebuilt = xr.Dataset({name: result.variables[name] for name in result.data_vars}, coords=coords, attrs=result.attrs)
-    xr.testing.assert_identical(result, rebuilt)
-    assert {name: type(index) for name, index in result.xindexes.items()} == {name: type(index) for name, index in rebuilt.xindexes.items()}
 
 
 BOUNDS_PROBE = """
@@ -284,7 +305,7 @@ import numba
 from numba.core import event
 
 import stochpound
-from stochpound.solvers import exact_engine
+from stochpound.solvers import engine
 from stochpound.solvers.exact import compile_engine, run_exact
 from tests.test_exact import HARD_CASES
 from tests.test_random_scenes import random_scene
@@ -294,7 +315,7 @@ levels = []
 
 class EngineCompileLevel(event.Listener):
     def on_start(self, compile_event):
-        if compile_event.data["dispatcher"] is exact_engine.run_engine:
+        if compile_event.data["dispatcher"] is engine.run_engine:
             levels.append(int(numba.config.OPT))
 
     def on_end(self, compile_event):
@@ -308,8 +329,8 @@ scenes = [stochpound.scene_from_dict(data) for data in HARD_CASES.values()]
 scenes += [stochpound.scene_from_dict(random_scene(seed)) for seed in range(8)]
 for scene in scenes:
     run_exact(scene)
-run_exact(scenes[0], events="python")
-print("in bounds", len(scenes), "engine specialisations", len(exact_engine.run_engine.signatures))
+stochpound.simulate(scenes[0], method="ivp")
+print("in bounds", len(scenes), "engine specialisations", len(engine.run_engine.signatures))
 """
 
 
@@ -321,7 +342,7 @@ def test_engine_never_indexes_out_of_bounds(tmp_path):
     process first runs ``compile_engine`` (the experiment runner's warm-up),
     which must compile the specialisation the later runs use.
     """
-    from stochpound.solvers import exact_engine
+    from stochpound.solvers import engine
 
     environment = {name: value for name, value in os.environ.items() if name != "NUMBA_OPT"}
     environment.update(NUMBA_BOUNDSCHECK="1", NUMBA_CACHE_DIR=str(tmp_path))
@@ -332,17 +353,17 @@ def test_engine_never_indexes_out_of_bounds(tmp_path):
     # compile_engine's tiny scene compiled the one specialisation every later run used
     assert "engine specialisations 1" in result.stdout
     # at the engine's optimisation level, numba's default restored afterwards
-    assert f"compiled at [{exact_engine.OPTIMISATION_LEVEL}] then 3" in result.stdout
+    assert f"compiled at [{engine.OPTIMISATION_LEVEL}] then 3" in result.stdout
 
 
 def test_optimisation_level_is_set_inside_the_block_only():
     """numba's optimisation level (its own type kept) inside the block, restored after it, also when the block raises."""
     import numba
 
-    from stochpound.solvers import exact_engine
+    from stochpound.solvers import engine
 
     default = numba.config.OPT
-    with pytest.raises(RuntimeError), exact_engine._optimisation_level(1):
+    with pytest.raises(RuntimeError), engine._optimisation_level(1):
         assert numba.config.OPT == 1 and type(numba.config.OPT) is type(default)
         raise RuntimeError
     assert numba.config.OPT is default

@@ -98,7 +98,7 @@ def test_mass_factor_keeps_damping_ratio_and_impact_frequency():
             assert contact.gap == case.label_dict["gap"]
         mu = case.label_dict["mu"]
         assert (b1.base is None) if math.isinf(mu) else (b1.base.mu == mu and b1.base.mu_static == mu)
-    # the flexible pair of the study: k_imp = 56 993 585 N/m at floor 1 (REFERENCE_STUDY.md)
+    # the flexible pair of the study: k_imp = 56 993 585 N/m at floor 1 (the reference study's Table 3.3)
     flexible = next(c for c in exp.cases if c.kind == "case" and c.label_dict["neighbour"] == "flexible")
     assert stochpound.scene_from_dict(exp.structure(flexible)).contacts[0].stiffness == pytest.approx(56993585.0, rel=1e-4)
     assert base.buildings[0].name == "B1"

@@ -67,7 +67,7 @@ def building_in_static_equilibrium(acceleration: float) -> dict:
     """The reference building on its base, floors pre-deflected by the constant inertial load."""
     from scipy.linalg import solve
 
-    from stochpound.scene import storey_matrix
+    from stochpound.model.building import storey_matrix
     from tests.conftest import REFERENCE_STIFFNESS
 
     deflection = solve(storey_matrix(np.array(REFERENCE_STIFFNESS)), -np.array(REFERENCE_MASS) * acceleration)
@@ -94,3 +94,36 @@ def test_building_above_mu_g_centre_of_mass_slides_at_the_exact_rate():
     t = run.time.values
     assert np.all(run.base_state.values[0, 1:] == -1)  # slipping left all along
     assert np.max(np.abs(centre + 0.5 * (acceleration - MU * G) * t**2)) <= 1e-9
+
+
+def test_frictionless_pendulum_swings_with_period_two_pi_root_r_over_g():
+    """A rigid block on a friction pendulum (radius R, μ = 0) released from s0: s = s0 cos(√(g/R) t), period 2π √(R/g)."""
+    radius, s0 = 2.24, 0.1
+    scene = block(duration=6.0, dt=0.01)
+    scene["building"][0]["base"].update(mu=0.0, radius=radius)
+    scene["building"][0]["initial"] = {"base_displacement": s0}
+    for method in ("exact", "ivp"):
+        run = stochpound.simulate(stochpound.scene_from_dict(scene), method=method)
+        t, s = run.time.values, run.sliding_displacement.sel(building="block").values
+        np.testing.assert_allclose(s, s0 * np.cos(np.sqrt(G / radius) * t), rtol=0, atol=1e-9)
+
+
+def test_radius_is_the_restoring_stiffness_w_over_r():
+    """radius = R runs exactly as restoring_stiffness = W/R (W the weight of the base and its floors)."""
+    radius, mu = 2.24, 0.05
+    motion = {"record": "el_centro_1940_study", "duration": 10.0}
+    pendulum = {"g": G, "building": [reference_building("B1", mu=mu)], "motion": motion}
+    pendulum["building"][0]["base"]["radius"] = radius
+    weight = G * (pendulum["building"][0]["base"]["mass"] + sum(REFERENCE_MASS))
+    spring = {"g": G, "building": [reference_building("B1", mu=mu)], "motion": motion}
+    spring["building"][0]["base"]["restoring_stiffness"] = weight / radius
+    runs = [stochpound.simulate(stochpound.scene_from_dict(scene)) for scene in (pendulum, spring)]
+    assert np.abs(runs[0].sliding_displacement).max() > 1e-3  # it slides
+    np.testing.assert_allclose(runs[0].total_displacement.values, runs[1].total_displacement.values, rtol=0, atol=1e-10)
+
+
+def test_radius_and_restoring_stiffness_together_are_refused():
+    scene = block()
+    scene["building"][0]["base"].update(radius=2.0, restoring_stiffness=1e5)
+    with pytest.raises(stochpound.SceneError, match=r"building\[0\]\.base\.radius: give either radius"):
+        stochpound.scene_from_dict(scene)

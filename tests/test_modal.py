@@ -5,7 +5,7 @@ import pytest
 from scipy.integrate import solve_ivp
 
 import stochpound
-from stochpound.modal_solution import harmonic_response, modal_coordinate
+from stochpound.model.modal_solution import harmonic_response, modal_coordinate
 from tests.conftest import reference_building
 
 AMPLITUDE = 10.0  # m/s²

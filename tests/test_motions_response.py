@@ -30,7 +30,7 @@ DT = 0.005
 # name: (masses kg, storey stiffnesses N/m, storey dashpots N s/m)
 STRUCTURES = {
     "sdof": ([1000.0], [1.0e5], [1000.0]),  # ω = 10 rad/s, ζ = 5 %
-    "reference_building": ([26268.0, 17512.0], [24516800.0, 17512000.0], [23634.2, 16881.57]),  # REFERENCE_STUDY.md, fixed base
+    "reference_building": ([26268.0, 17512.0], [24516800.0, 17512000.0], [23634.2, 16881.57]),  # the reference study's Building 1, fixed base
 }
 
 

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from stochpound.errors import RecordError
-from stochpound.records import load_record, read_at2, read_record_file, read_text, records_dir, registry_entries
+from stochpound.motions.records import load_record, read_at2, read_record_file, read_text, records_dir, registry_entries
 
 
 def _write_at2(path: Path, values: np.ndarray, dt: float, style: str, per_line: int = 5, units: str = "G") -> Path:

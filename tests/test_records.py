@@ -13,7 +13,7 @@ from stochpound.data_files import bundled_data_dir
 import scipy.stats
 
 from stochpound.errors import RecordError
-from stochpound.records import (
+from stochpound.motions.records import (
     Record,
     arias_intensity,
     list_records,
@@ -24,8 +24,8 @@ from stochpound.records import (
     registry_entries,
     study_table_3_2,
 )
-from stochpound.records import registry as registry_module
-from stochpound.records.readers import sha256_of
+from stochpound.motions.records import registry as registry_module
+from stochpound.motions.records.readers import sha256_of
 
 STUDY_G = 9.814
 

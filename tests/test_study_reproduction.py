@@ -18,7 +18,7 @@ from stochpound.analysis.summary import top_floor_total_displacement
 from tests.conftest import reference_building, study_scene
 
 STUDY_MOTION = {"record": "el_centro_1940_study", "interpolation": "spline"}
-# REFERENCE_STUDY.md, Tables 4.1 and 4.3 (cm), 4.9 and 4.10
+# the reference study's Tables 4.1 and 4.3 (cm), 4.9 and 4.10 (data/study/reference_tables.toml)
 SINGLE = {"mean": 0.0, "variance": 0.49, "std": 0.7, "skewness": 0.0246, "excess": 1.8417}
 FIXED_FIXED = {
     "stiff": {"factor": 0.5, "mean": -0.0021, "std": 0.66, "skewness": -0.0107, "excess": 0.9556, "impacts": 8, "correlation": 0.9529},

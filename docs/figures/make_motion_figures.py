@@ -22,7 +22,7 @@ import numpy as np  # noqa: E402
 from scipy import signal  # noqa: E402
 
 from stochpound import motions  # noqa: E402
-from stochpound.records import STUDY_G, load_record  # noqa: E402
+from stochpound.motions.records import STUDY_G, load_record  # noqa: E402
 
 HERE = Path(__file__).resolve().parent
 

@@ -126,14 +126,14 @@ def pearson(response: np.ndarray, reference: np.ndarray, axis: int = -1) -> np.n
 
 
 def abs_peak(values: np.ndarray, axis: Axis = -1) -> np.ndarray:
-    """max |values| along ``axis``, ignoring NaN (NaN where every value is NaN)."""
+    """The largest absolute value along ``axis``, ignoring NaN (NaN where every value is NaN)."""
     magnitude = np.abs(np.asarray(values, dtype=np.float64))
     peak = np.max(np.where(np.isnan(magnitude), -np.inf, magnitude), axis=axis)
     return np.where(np.isneginf(peak), np.nan, peak)
 
 
 def energy_residual_ratio(residual: np.ndarray, energy_input: np.ndarray) -> np.ndarray:
-    """max |energy residual| / max |energy input| along the trailing axis (J/J): the energy balance's error."""
+    """The largest absolute energy residual over the largest absolute energy input along the trailing axis (J/J): the energy balance's error."""
     return abs_peak(residual) / abs_peak(energy_input)
 
 

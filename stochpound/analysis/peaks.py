@@ -9,7 +9,7 @@ from stochpound.analysis.ufunc import reduce
 
 
 def peak_response(run: xr.Dataset, dim: str = "time") -> xr.Dataset:
-    """Peak |y|, |u|, |s| per building and the residual sliding at the end of the motion.
+    """Peak absolute total (y), relative (u) and sliding (s) displacement per building and the residual sliding at the end of the motion.
 
     Parameters
     ----------

@@ -47,7 +47,7 @@ def run_summary(run: xr.Dataset, building: str, fixed_base: xr.DataArray | None 
         statistics of the whole run, moments of the top-floor total
         displacement (``response_mean``, ``response_variance``,
         ``response_std``, ``response_skewness``, ``response_excess``),
-        ``energy_residual_ratio`` (max |residual| / max |input|) and, if
+        ``energy_residual_ratio`` (largest absolute residual over largest absolute input) and, if
         given a reference, ``fixed_base_correlation``; the earlier names
         ``mean`` … ``excess`` and ``correlation`` as aliases
         (:mod:`stochpound.analysis.names`).

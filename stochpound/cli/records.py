@@ -15,7 +15,7 @@ def records() -> None:
 @records.command("list")
 def list_command() -> None:
     """List the bundled records and their named variants."""
-    from stochpound.records import registry_entries
+    from stochpound.motions.records import registry_entries
 
     for name, entry in registry_entries().items():
         fields = entry.fields
@@ -33,9 +33,9 @@ def list_command() -> None:
 @click.option("--units", type=click.Choice(["g", "m/s2", "cm/s2"]), default=None, help="Units of a text file's values.")
 def show_command(name: str, plot_path: str | None, g: float, dt: float | None, units: str | None) -> None:
     """Statistics of NAME (a bundled record or a file), with the study's Table 3.2 beside ours."""
-    from stochpound.records import load_record
-    from stochpound.records.plot import plot_record
-    from stochpound.records.report import record_report
+    from stochpound.motions.records import load_record
+    from stochpound.motions.records.plot import plot_record
+    from stochpound.motions.records.report import record_report
 
     if not g > 0:
         raise click.BadParameter(f"must be > 0, got {g}", param_hint="--g")

@@ -5,9 +5,9 @@ from __future__ import annotations
 import click
 
 from stochpound.errors import StochpoundError
-from stochpound.result import write_dataset
-from stochpound.scene_file import load_scene
-from stochpound.simulate import METHODS, simulate as run_simulation
+from stochpound.results.dataset import write_dataset
+from stochpound.model.scene_file import load_scene
+from stochpound.solvers.simulate import METHODS, simulate as run_simulation
 from stochpound.solvers.ivp import INTEGRATORS
 
 
@@ -18,11 +18,12 @@ from stochpound.solvers.ivp import INTEGRATORS
 @click.option("--integrator", type=click.Choice(list(INTEGRATORS)), default="DOP853", show_default=True, help="Integrator of the ivp solver.")
 @click.option("--rtol", type=float, default=1e-10, show_default=True, help="Relative tolerance of the ivp solver.")
 @click.option("--atol", type=float, default=1e-12, show_default=True, help="Absolute tolerance of the ivp solver (m, m/s).")
-def simulate(scene_file: str, out: str, method: str, integrator: str, rtol: float, atol: float) -> None:
+@click.option("--demands", is_flag=True, help="Also record floor accelerations, storey drifts and shears, and their peaks.")
+def simulate(scene_file: str, out: str, method: str, integrator: str, rtol: float, atol: float, demands: bool) -> None:
     """Simulate SCENE_FILE and write the result dataset to --out."""
     try:
         scene = load_scene(scene_file)
-        result = run_simulation(scene, method, integrator=integrator, rtol=rtol, atol=atol)
+        result = run_simulation(scene, method, integrator=integrator, rtol=rtol, atol=atol, demands=demands)
     except (StochpoundError, ValueError) as error:
         raise click.ClickException(str(error)) from None
     write_dataset(result, out)

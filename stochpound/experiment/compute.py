@@ -24,10 +24,10 @@ import xarray as xr
 from stochpound.experiment.spec import canonical_json
 from stochpound.experiment.summary import case_arrays, case_values, reference_arrays, reference_values, top_floor
 from stochpound import motions as synthetic_motions
-from stochpound.motion import GroundMotion, SampledMotion
-from stochpound.scene import Scene
-from stochpound.scene_file import scene_from_dict
-from stochpound.simulate import simulate
+from stochpound.motions.ground import GroundMotion, SampledMotion
+from stochpound.model.scene import Scene
+from stochpound.model.scene_file import scene_from_dict
+from stochpound.solvers.simulate import simulate
 
 
 @dataclass(frozen=True)

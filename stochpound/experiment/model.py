@@ -29,7 +29,7 @@ from stochpound.experiment.variants import (
     set_gaps,
     set_mu,
 )
-from stochpound.scene_file import scene_from_dict
+from stochpound.model.scene_file import scene_from_dict
 
 CASE = "case"
 REFERENCE = "reference"

@@ -18,8 +18,8 @@ import numpy as np
 from stochpound import motions as synthetic_motions
 from stochpound.experiment.model import REFERENCE, Experiment
 from stochpound.experiment.spec import field_errors
-from stochpound.motion import GroundMotion
-from stochpound.scene_file import scene_from_dict
+from stochpound.motions.ground import GroundMotion
+from stochpound.model.scene_file import scene_from_dict
 
 _INTENSITY_KEYS = ("pga", "rms", "peak_factor", "S0")
 

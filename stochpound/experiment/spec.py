@@ -26,8 +26,8 @@ from pathlib import Path
 from typing import Any, Iterator, Mapping
 
 from stochpound.errors import SceneError
-from stochpound.scene_file import _is_number, _number, _reject_unknown, _string, _table
-from stochpound.simulate import METHODS
+from stochpound.model import fields as toml_fields
+from stochpound.solvers.simulate import METHODS
 from stochpound.solvers.ivp import INTEGRATORS
 
 #: Format version of the canonical definition (stored with every store).
@@ -162,10 +162,10 @@ def parse_experiment(data: Mapping[str, Any], base_dir: str | Path = ".", defaul
     """
     base_dir = Path(base_dir)
     with field_errors():
-        _reject_unknown(data, _TOP_KEYS, "")
-        header = _table(data, "experiment", "") or {}
-        _reject_unknown(header, _EXPERIMENT_KEYS, "experiment")
-        name = _string(header, "name", "experiment", default=default_name)
+        toml_fields.reject_unknown(data, _TOP_KEYS, "")
+        header = toml_fields.table(data, "experiment", "") or {}
+        toml_fields.reject_unknown(header, _EXPERIMENT_KEYS, "experiment")
+        name = toml_fields.string(header, "name", "experiment", default=default_name)
         description = header.get("description", "")
         if not isinstance(description, str):
             raise ExperimentError(f"experiment.description: must be a string, got {description!r}")
@@ -204,7 +204,7 @@ def parse_experiment(data: Mapping[str, Any], base_dir: str | Path = ".", defaul
 
 def _table_or_error(data: Mapping[str, Any], key: str, prefix: str) -> dict[str, Any]:
     with field_errors():
-        return dict(_table(data, key, prefix) or {})
+        return dict(toml_fields.table(data, key, prefix) or {})
 
 
 def _base_scene(data: Mapping[str, Any], header: Mapping[str, Any], base_dir: Path) -> dict[str, Any]:
@@ -259,12 +259,12 @@ def _override(override: Any, where: str, buildings: list[str]) -> dict[str, Any]
     if not isinstance(override, dict):
         raise ExperimentError(f"{where}: must be a table (with building.<name> and/or scene tables)")
     with field_errors():
-        _reject_unknown(override, {"building", "scene"}, where)
+        toml_fields.reject_unknown(override, {"building", "scene"}, where)
     scene_part = override.get("scene", {})
     if not isinstance(scene_part, dict):
         raise ExperimentError(f"{where}.scene: must be a table")
     with field_errors():
-        _reject_unknown(scene_part, _SCENE_OVERRIDES, f"{where}.scene")
+        toml_fields.reject_unknown(scene_part, _SCENE_OVERRIDES, f"{where}.scene")
     building_part = override.get("building", {})
     if not isinstance(building_part, dict):
         raise ExperimentError(f"{where}.building: must be a table of buildings by name, e.g. [{where}.building.B2]")
@@ -275,9 +275,9 @@ def _override(override: Any, where: str, buildings: list[str]) -> dict[str, Any]
         if not isinstance(fields, dict):
             raise ExperimentError(f"{prefix}: must be a table of building fields")
         with field_errors():
-            _reject_unknown(fields, _BUILDING_OVERRIDES, prefix)
+            toml_fields.reject_unknown(fields, _BUILDING_OVERRIDES, prefix)
             if "mass_factor" in fields:
-                _number(fields, "mass_factor", prefix, low=0.0, low_open=True)
+                toml_fields.number(fields, "mass_factor", prefix, low=0.0, low_open=True)
         base = fields.get("base")
         if base is not None and base is not False and not isinstance(base, dict):
             raise ExperimentError(f"{prefix}.base: must be a table (merged into the base) or false (a fixed base), got {base!r}")
@@ -314,7 +314,7 @@ def _axis_values(spec: Any, where: str, allowed: set[str]) -> tuple[list[Any], d
         return spec, {}
     if isinstance(spec, dict):
         with field_errors():
-            _reject_unknown(spec, {"values", *allowed}, where)
+            toml_fields.reject_unknown(spec, {"values", *allowed}, where)
         if "values" not in spec:
             raise ExperimentError(f"{where}.values: missing (a non-empty list)")
         return spec["values"], spec
@@ -329,7 +329,7 @@ def _numbers(values: Any, where: str, allow_inf: bool) -> list[float]:
         item = f"{where}[{i}]"
         if allow_inf and isinstance(value, str) and value.lower() in ("inf", "infinity"):
             value = math.inf
-        if not _is_number(value) or math.isnan(value) or (math.isinf(value) and not (allow_inf and value > 0)):
+        if not toml_fields.is_number(value) or math.isnan(value) or (math.isinf(value) and not (allow_inf and value > 0)):
             allowed = "a number >= 0 or inf (a fixed base)" if allow_inf else "a finite number >= 0"
             raise ExperimentError(f"{item}: must be {allowed}, got {value!r}")
         if value < 0:
@@ -416,7 +416,7 @@ def _array_of_tables(data: Mapping[str, Any], key: str) -> list[dict[str, Any]]:
 def _analytic_source(table: Mapping[str, Any], where: str) -> dict[str, Any]:
     """A ``[[motions]]`` entry: a named analytic motion (a scene ``[motion]`` table of type harmonic or constant)."""
     with field_errors():
-        label = _string(table, "name", where)
+        label = toml_fields.string(table, "name", where)
     motion = {k: v for k, v in table.items() if k != "name"}
     kind = motion.get("type")
     if kind not in _ANALYTIC_TYPES:
@@ -433,9 +433,9 @@ def _file_sha256(base_dir: Path, spec: Any) -> str | None:
 
 def _record_source(table: Mapping[str, Any], where: str, base_dir: Path) -> dict[str, Any]:
     with field_errors():
-        _reject_unknown(table, _RECORD_KEYS, where)
-        record = _string(table, "record", where)
-        label = _string(table, "name", where, default=Path(record).stem if (base_dir / record).is_file() else record)
+        toml_fields.reject_unknown(table, _RECORD_KEYS, where)
+        record = toml_fields.string(table, "record", where)
+        label = toml_fields.string(table, "name", where, default=Path(record).stem if (base_dir / record).is_file() else record)
     motion = {k: v for k, v in table.items() if k != "name"}
     motion["type"] = "record"
     motion["file_sha256"] = _file_sha256(base_dir, record)
@@ -471,7 +471,7 @@ def _synthetic_source(label: str, table: Any, where: str) -> dict[str, Any]:
 def _output(data: Mapping[str, Any], buildings: list[str]) -> dict[str, Any]:
     table = _table_or_error(data, "output", "")
     with field_errors():
-        _reject_unknown(table, {"time_histories", "buildings", "impacts"}, "output")
+        toml_fields.reject_unknown(table, {"time_histories", "buildings", "impacts"}, "output")
     histories = table.get("time_histories", [])
     if not isinstance(histories, list):
         raise ExperimentError(f"output.time_histories: must be a list of variable names, got {histories!r}")
@@ -492,11 +492,11 @@ def _output(data: Mapping[str, Any], buildings: list[str]) -> dict[str, Any]:
 def _solver(data: Mapping[str, Any]) -> dict[str, Any]:
     table = _table_or_error(data, "solver", "")
     with field_errors():
-        _reject_unknown(table, {"method", "integrator", "rtol", "atol"}, "solver")
-        method = _string(table, "method", "solver", default=METHODS[0])
-        integrator = _string(table, "integrator", "solver", default="DOP853")
-        rtol = _number(table, "rtol", "solver", default=1e-10, low=0.0, low_open=True)
-        atol = _number(table, "atol", "solver", default=1e-12, low=0.0, low_open=True)
+        toml_fields.reject_unknown(table, {"method", "integrator", "rtol", "atol"}, "solver")
+        method = toml_fields.string(table, "method", "solver", default=METHODS[0])
+        integrator = toml_fields.string(table, "integrator", "solver", default="DOP853")
+        rtol = toml_fields.number(table, "rtol", "solver", default=1e-10, low=0.0, low_open=True)
+        atol = toml_fields.number(table, "atol", "solver", default=1e-12, low=0.0, low_open=True)
     if method not in METHODS:
         raise ExperimentError(f"solver.method: must be one of {', '.join(METHODS)}, got {method!r}")
     if integrator not in INTEGRATORS:

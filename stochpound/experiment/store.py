@@ -29,7 +29,7 @@ import xarray as xr
 from stochpound.experiment.model import CASE, REFERENCE, Case, Dim, Experiment
 from stochpound.experiment.spec import ExperimentError
 from stochpound.experiment.summary import IMPACT_COLUMNS, templates, variable_attrs
-from stochpound.result import write_dataset
+from stochpound.results.dataset import write_dataset
 
 #: Version of the store layout.
 STORE_FORMAT = 1

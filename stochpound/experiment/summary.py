@@ -180,8 +180,8 @@ def reference_arrays(summary: Mapping[str, np.ndarray], run: xr.Dataset, keep_hi
 @cache
 def templates() -> tuple[xr.Dataset, xr.Dataset, xr.Dataset]:
     """A tiny real run and its case and reference summaries (metadata: dims, dtypes, units, long names)."""
-    from stochpound.scene_file import scene_from_dict
-    from stochpound.simulate import simulate
+    from stochpound.model.scene_file import scene_from_dict
+    from stochpound.solvers.simulate import simulate
 
     building = {"mass": [1.0], "stiffness": [1.0]}
     scene = scene_from_dict(

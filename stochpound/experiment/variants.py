@@ -22,6 +22,10 @@ import copy
 import math
 from typing import Any, Iterable, Mapping
 
+from stochpound.model import building as building_law
+from stochpound.model import contact as contact_law
+from stochpound.model.contact import effective_mass
+
 #: Motion used while validating a scene's structure (the real motion is set per case).
 PLACEHOLDER_MOTION = {"type": "constant", "acceleration": 0.0, "duration": 1.0, "dt": 1.0}
 
@@ -80,18 +84,17 @@ def _set_base(building: dict[str, Any], value: Any) -> None:
 
 
 def scale_masses(scene: dict[str, Any], name: str, factor: float) -> None:
-    """Multiply building ``name``'s masses by ``factor`` in place, with its derived constants.
+    """Multiply building ``name``'s masses by ``factor`` in place, with what the laws derive from them.
 
-    See the module docstring for the rule (dashpots × sqrt(factor); impact
-    stiffness × m_eff,new / m_eff,old so that sqrt(k/m_eff) is kept).
+    The building's own rule (:func:`stochpound.model.building.scale_masses`:
+    dashpots × √factor), then every contact touching it and every wall beside
+    it by their element's rule (:func:`stochpound.model.contact.rescale_table`,
+    with the ratio of the effective masses, new over old: the factor itself
+    for a wall).
     """
     building = building_table(scene, name)
     old_mass = [float(m) for m in building["mass"]]
-    building["mass"] = [m * factor for m in old_mass]
-    if isinstance(building.get("base"), dict) and "mass" in building["base"]:
-        building["base"]["mass"] = float(building["base"]["mass"]) * factor
-    if "damping" in building:
-        building["damping"] = [float(c) * math.sqrt(factor) for c in building["damping"]]
+    building_law.scale_masses(building, factor)
     for contact in scene.get("contact", []):
         try:
             ends = [(str(end_name), int(floor)) for end_name, floor in contact["between"]]
@@ -101,14 +104,10 @@ def scale_masses(scene: dict[str, Any], name: str, factor: float) -> None:
             masses_old = [old_mass[floor - 1] if end_name == name else new for (end_name, floor), new in zip(ends, masses_new)]
         except (KeyError, IndexError, TypeError, ValueError):
             continue  # a malformed contact: scene validation names it
-        ratio = _effective_mass(*masses_new) / _effective_mass(*masses_old)
-        contact["stiffness"] = float(contact["stiffness"]) * ratio
-        if "damping" in contact:
-            contact["damping"] = float(contact["damping"]) * ratio
-
-
-def _effective_mass(m1: float, m2: float) -> float:
-    return m1 * m2 / (m1 + m2)
+        contact_law.rescale_table(contact, effective_mass(*masses_new) / effective_mass(*masses_old))
+    for wall in scene.get("wall", []):
+        if wall.get("building") == name:  # a wall's effective mass is its level's mass, scaled by the factor
+            contact_law.rescale_table(wall, factor)
 
 
 def set_gaps(scene: dict[str, Any], contacts: Iterable[int], gap: float) -> None:

@@ -3,7 +3,7 @@
 Both methods produce samples a_k = a(k·dt) whose second-order statistics are
 those of the continuous process at the sample times: variance σ² = ∫ S dω and
 autocovariance R(k·dt). Their PSD as a sequence is therefore the *aliased*
-PSD S_d(ω) = Σ_m S(ω + 2πm/dt) on |ω| ≤ π/dt (see
+PSD S_d(ω) = Σ_m S(ω + 2πm/dt) on abs(ω) ≤ π/dt (see
 :meth:`FilteredWhiteNoise.sampled_psd`), not S truncated at the Nyquist
 frequency, which would lose the variance above π/dt.
 
@@ -18,7 +18,7 @@ filter) fits in one period, which makes the wrap-around correlation below
 e^{−20}. Each realization has (asymptotically) Gaussian values and, over a
 full period, exactly the target mean square.
 
-With ``band_limit=True`` the spectral method uses S itself on |ω| ≤ π/dt
+With ``band_limit=True`` the spectral method uses S itself on abs(ω) ≤ π/dt
 instead: no aliasing (a Clough–Penzien sequence keeps S(0) = 0, which the
 aliased high-frequency tail of the Kanai–Tajimi factor otherwise fills with a
 small white floor), at the cost of the variance above π/dt.
@@ -69,7 +69,7 @@ def spectral_samples(
 ) -> np.ndarray:
     """Stationary samples (len(rngs), n_time) by the spectral representation.
 
-    ``band_limit=True`` uses S(ω) on |ω| ≤ π/dt instead of the aliased S_d:
+    ``band_limit=True`` uses S(ω) on abs(ω) ≤ π/dt instead of the aliased S_d:
     the spectral shape below the Nyquist frequency is exact (e.g. a
     Clough–Penzien process keeps S(0) = 0) but the variance above π/dt is lost.
     Each realization is synthesised on its own (one inverse FFT per row), so

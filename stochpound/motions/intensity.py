@@ -1,8 +1,8 @@
 """Setting the white-noise level S0 from a target RMS or a target PGA.
 
 * ``rms``: the stationary standard deviation σ = sqrt(∫ S dω), so
-  S0 = σ² / ∫ |H|² dω (the integral is exact, from the Lyapunov equation).
-* ``pga``: PGA = p · σ with a peak factor p = E[max_k |a_k|] / σ, the
+  S0 = σ² / ∫ abs(H)² dω (the integral is exact, from the Lyapunov equation).
+* ``pga``: PGA = p · σ with a peak factor p = E[max_k abs(a_k)] / σ, the
   expected largest sample of the (modulated) motion in units of σ. Two
   estimates of p are offered:
 
@@ -10,7 +10,7 @@
   Davenport 1964), with the envelope e(t) (peak 1) making the level relative
   to the local standard deviation σ e(t)::
 
-      P(max |a| ≤ b σ) = exp(−ν ∫ exp(−b² / (2 e(t)²)) dt),
+      P(max abs(a) ≤ b σ) = exp(−ν ∫ exp(−b² / (2 e(t)²)) dt),
       ν = arccos(ρ1) / (π dt),   ρ1 = R(dt) / R(0),
 
   where ν is the exact mean rate of sign changes of the *sampled* sequence
@@ -20,7 +20,7 @@
   1–4 % for firm and medium soil over 20–30 s, by up to about 13 % for soft
   soil and short (10 s) enveloped motions, where crossings cluster.
 
-  ``"simulated"`` — the mean of max |a|/σ over a pilot ensemble of
+  ``"simulated"`` — the mean of max abs(a)/σ over a pilot ensemble of
   :data:`PILOT_REALIZATIONS` realizations drawn from a fixed pilot seed (not
   the user's), by the same method and envelope: accurate to about 1 %.
 
@@ -47,7 +47,7 @@ PEAK_FACTORS = ("poisson", "simulated")
 def s0_from_rms(model: FilteredWhiteNoise, rms: float, omega_max: float | None = None) -> float:
     """S0 (m²/s³) that gives the stationary process the standard deviation ``rms`` (m/s²).
 
-    ``omega_max`` (rad/s): for a process band-limited to |ω| ≤ omega_max.
+    ``omega_max`` (rad/s): for a process band-limited to abs(ω) ≤ omega_max.
     """
     if not (math.isfinite(rms) and rms > 0.0):
         raise ValueError(f"rms: must be > 0 m/s², got {rms!r}")
@@ -98,7 +98,7 @@ def poisson_peak_factor(model: FilteredWhiteNoise, dt: float, envelope: np.ndarr
 def simulated_peak_factor(
     model: FilteredWhiteNoise, dt: float, envelope: np.ndarray, method: str, band_limit: bool = False
 ) -> float:
-    """Mean of max |a|/σ over a pilot ensemble (module docstring)."""
+    """Mean of max abs(a)/σ over a pilot ensemble (module docstring)."""
     from stochpound.motions.generators import stationary_samples
     from stochpound.motions.seeding import realization_rngs
 

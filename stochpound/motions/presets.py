@@ -4,13 +4,13 @@ Values of Der Kiureghian & Neuenhofer (1992), "Response spectrum method for
 multi-support seismic excitations", Earthquake Engineering and Structural
 Dynamics 21(8), 713–740, widely reused for firm, medium and soft soil:
 
-======  ========  ======  ========  ======
-soil    ω_g rad/s  ζ_g    ω_f rad/s  ζ_f
-======  ========  ======  ========  ======
-firm    15.0      0.6     1.5       0.6
-medium  10.0      0.4     1.0       0.6
-soft     5.0      0.2     0.5       0.6
-======  ========  ======  ========  ======
+======  =========  ======  =========  ======
+soil    ω_g rad/s  ζ_g     ω_f rad/s  ζ_f
+======  =========  ======  =========  ======
+firm    15.0       0.6     1.5        0.6
+medium  10.0       0.4     1.0        0.6
+soft    5.0        0.2     0.5        0.6
+======  =========  ======  =========  ======
 
 (ω_f = ω_g / 10 and ζ_f = 0.6 throughout.)
 """

@@ -19,7 +19,7 @@ Clough–Penzien (Clough & Penzien 1975) adds a second-order high-pass filter::
 
     S_CP(ω) = S_KT(ω) · ω⁴ / ((ω_f² − ω²)² + 4 ζ_f² ω_f² ω²)
 
-Both are |H(iω)|² S0 for a rational transfer function H(s) = N(s)/D(s),
+Both are abs(H(iω))² S0 for a rational transfer function H(s) = N(s)/D(s),
 strictly proper, so the process has a finite variance and a state-space
 realisation (A, B, C). :class:`FilteredWhiteNoise` holds H and computes the
 variance exactly (Lyapunov equation), the exact discretisation at a step dt,
@@ -62,7 +62,7 @@ def kanai_tajimi_psd(omega: np.ndarray | float, omega_g: float, zeta_g: float, S
 
 
 def high_pass_gain(omega: np.ndarray | float, omega_f: float, zeta_f: float) -> np.ndarray:
-    """|H_f(iω)|² = ω⁴ / ((ω_f² − ω²)² + 4 ζ_f² ω_f² ω²), the Clough–Penzien high-pass filter."""
+    """abs(H_f(iω))² = ω⁴ / ((ω_f² − ω²)² + 4 ζ_f² ω_f² ω²), the Clough–Penzien high-pass filter."""
     w2 = np.asarray(omega, dtype=float) ** 2
     f2 = omega_f**2
     return w2**2 / ((f2 - w2) ** 2 + 4.0 * zeta_f**2 * f2 * w2)
@@ -118,7 +118,7 @@ class FilteredWhiteNoise:
         return FilteredWhiteNoise(self.numerator, self.denominator, float(S0), self.name, dict(self.parameters))
 
     def psd(self, omega: np.ndarray | float) -> np.ndarray:
-        """S(ω) = S0 |H(iω)|², two-sided, m²/s³."""
+        """S(ω) = S0 abs(H(iω))², two-sided, m²/s³."""
         s = 1j * np.asarray(omega, dtype=float)
         return self.S0 * np.abs(np.polyval(self.numerator, s) / np.polyval(self.denominator, s)) ** 2
 
@@ -144,7 +144,7 @@ class FilteredWhiteNoise:
     def variance(self, omega_max: float | None = None) -> float:
         """σ² = ∫ S dω, (m/s²)².
 
-        Over (−∞, ∞) exactly (Lyapunov equation), or over |ω| ≤ ``omega_max``
+        Over (−∞, ∞) exactly (Lyapunov equation), or over abs(ω) ≤ ``omega_max``
         (rad/s) by adaptive quadrature.
         """
         if omega_max is None:
@@ -183,7 +183,7 @@ class FilteredWhiteNoise:
         return Phi, _psd_factor(Qd), C, _psd_factor(P)
 
     def sampled_psd(self, omega: np.ndarray | float, dt: float) -> np.ndarray:
-        """PSD of the sampled sequence a_k = a(k dt), on |ω| ≤ π/dt (aliased PSD).
+        """PSD of the sampled sequence a_k = a(k dt), on abs(ω) ≤ π/dt (aliased PSD).
 
         S_d(ω) = Σ_m S(ω + 2πm/dt) = (dt/2π) Σ_k R(k dt) e^{−iωk dt}, computed
         exactly from R(k dt) = C Φ^k P Cᵀ. Its integral over (−π/dt, π/dt) is σ².
@@ -201,7 +201,7 @@ class FilteredWhiteNoise:
         return (dt / (2.0 * np.pi) * (2.0 * one_sided.real - r0)).reshape(omega.shape)
 
     def spectral_moment(self, order: int, dt: float, n_points: int = 20001) -> float:
-        """λ_k = ∫ |ω|^k S_d(ω) dω over |ω| ≤ π/dt (the sampled process), (m/s²)² (rad/s)^k."""
+        """λ_k = ∫ abs(ω)^k S_d(ω) dω over abs(ω) ≤ π/dt (the sampled process), (m/s²)² (rad/s)^k."""
         omega = np.linspace(0.0, np.pi / dt, n_points)
         return 2.0 * float(np.trapezoid(omega**order * self.sampled_psd(omega, dt), omega))
 

@@ -69,7 +69,7 @@ def kanai_tajimi(
     rms : float, optional
         Target stationary standard deviation σ, m/s².
     peak_factor : float or {"poisson", "simulated"}, optional
-        Peak factor p = E[max |a|]/σ used with ``pga``: a number, or how to
+        Peak factor p = E[max abs(a)]/σ used with ``pga``: a number, or how to
         estimate it: ``"poisson"`` (default; level crossings of the sampled,
         enveloped process) or ``"simulated"`` (pilot ensemble); see
         :mod:`stochpound.motions.intensity`.
@@ -77,9 +77,9 @@ def kanai_tajimi(
         Correct each realization to end with zero velocity and displacement
         (:mod:`stochpound.motions.baseline`).
     band_limit : bool
-        Spectral method only: synthesise from S on |ω| ≤ π/dt instead of the
+        Spectral method only: synthesise from S on abs(ω) ≤ π/dt instead of the
         aliased PSD of the sampled process (see :mod:`stochpound.motions.generators`).
-        The variance is then ∫_{|ω|<π/dt} S dω, not ∫ S dω.
+        The variance is then ∫_{abs(ω)<π/dt} S dω, not ∫ S dω.
 
     Returns
     -------

@@ -23,11 +23,11 @@ import numpy as np
 import xarray as xr
 
 import stochpound
-from stochpound.modal_solution import harmonic_response, modal_properties
+from stochpound.model.modal_solution import harmonic_response, modal_properties
 from stochpound.report.description import StoreDefinition, number
 from stochpound.report.document import Paragraph
 from stochpound.report.stores import case_scene, select
-from stochpound.scene import Building, Contact, Scene
+from stochpound.model.scene import Building, Contact, Scene
 
 #: Closing velocity of the single-collision check, m/s.
 COLLISION_VELOCITY = 0.5
@@ -137,7 +137,7 @@ class HarmonicComparison:
 
     @property
     def error(self) -> float:
-        """Largest |computed − exact|, m."""
+        """The largest absolute difference between computed and exact, m."""
         return float(np.max(np.abs(self.computed - self.exact)))
 
 

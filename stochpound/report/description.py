@@ -22,12 +22,12 @@ import xarray as xr
 from stochpound import motions as synthetic_motions
 from stochpound.experiment import Case
 from stochpound.experiment.model import CASE
-from stochpound.modal_solution import modal_properties
-from stochpound.records import load_record, registry_entries
+from stochpound.model.modal_solution import modal_properties
+from stochpound.motions.records import load_record, registry_entries
 from stochpound.report.document import Paragraph, Table
 from stochpound.report.stores import store_experiment
-from stochpound.scene import Building, Contact, Scene
-from stochpound.scene_file import scene_from_dict
+from stochpound.model.scene import Building, Contact, Scene
+from stochpound.model.scene_file import scene_from_dict
 
 
 def number(value: float, digits: int = 6) -> str:

@@ -14,7 +14,7 @@ import pandas as pd
 import xarray as xr
 
 import stochpound
-from stochpound.records import registry_entries
+from stochpound.motions.records import registry_entries
 from stochpound.report.accuracy import accuracy_paragraphs
 from stochpound.report.description import StoreDefinition, buildings_table, contacts_table, grid_paragraph, model_paragraph, motions_table, records_used
 from stochpound.report.document import Paragraph, Section, Table

@@ -12,8 +12,8 @@ import xarray as xr
 
 from stochpound.errors import StochpoundError
 from stochpound.experiment import Experiment, open_store
-from stochpound.scene import Scene
-from stochpound.scene_file import scene_from_dict
+from stochpound.model.scene import Scene
+from stochpound.model.scene_file import scene_from_dict
 
 
 def open_stores(paths: Sequence[str | Path]) -> dict[str, xr.Dataset]:

@@ -12,7 +12,7 @@ import math
 import numpy as np
 import xarray as xr
 
-from stochpound.records import load_record
+from stochpound.motions.records import load_record
 from stochpound.report import figures
 from stochpound.report.document import FigureItem
 from stochpound.report.accuracy import harmonic_comparisons

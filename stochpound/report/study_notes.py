@@ -20,7 +20,7 @@ import pandas as pd
 import xarray as xr
 
 import stochpound
-from stochpound.motion import SampledMotion
+from stochpound.motions.ground import SampledMotion
 from stochpound.report import figures
 from stochpound.report.document import Block, FigureItem, Paragraph, Table
 from stochpound.report.stores import case_scene, select

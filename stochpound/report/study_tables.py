@@ -1,7 +1,7 @@
 """The study's Tables 3.2 and 4.1–4.10: its published values beside ours, in its layout.
 
 Each table's rows group a statistic (or a record, or a μ) with its sources:
-``study`` (the published value), ``corrected model`` (ours: MODEL.md, the
+``study`` (the published value), ``corrected model`` (ours: docs/model.md, the
 record interpolated linearly between samples), ``difference`` (corrected −
 study) and, where the store has them, the sensitivity rows ``corrected,
 spline input`` (the study's cubic-spline interpolation of the record) and
@@ -21,8 +21,8 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
-from stochpound.modal_solution import modal_properties
-from stochpound.records import load_record, record_statistics, registry_entries, study_table_3_2
+from stochpound.model.modal_solution import modal_properties
+from stochpound.motions.records import load_record, record_statistics, registry_entries, study_table_3_2
 from stochpound.report.description import StoreDefinition
 from stochpound.report.document import Table
 from stochpound.report.published import published_tables, study_number
@@ -44,7 +44,7 @@ STATISTICS = (
     ("excess", "response_excess", 1.0),
     ("impacts", "impacts", 1.0),
 )
-#: Stores' record labels of the study's records (experiments/study/*.toml).
+#: Stores' record labels of the study's records (``experiments/study/*.toml``).
 RECORDS = {"mexico_city": "Mexico City 1985", "el_centro": "El Centro 1940", "loma_prieta": "Loma Prieta 1989", "northridge": "Northridge 1994"}
 #: The registry entries behind them (Table 3.2).
 RECORD_ENTRIES = {

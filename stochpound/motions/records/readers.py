@@ -41,7 +41,7 @@ from pathlib import Path
 import numpy as np
 
 from stochpound.errors import RecordError
-from stochpound.records.record import normalize_units
+from stochpound.motions.records.record import normalize_units
 
 #: Relative tolerance on the uniformity of a time column (fraction of a step).
 TIME_STEP_TOLERANCE = 0.01

@@ -16,8 +16,8 @@ from typing import Any, Mapping
 
 from stochpound.data_files import bundled_data_dir
 from stochpound.errors import RecordError
-from stochpound.records.readers import RawSeries, read_record_file
-from stochpound.records.record import Record, normalize_units
+from stochpound.motions.records.readers import RawSeries, read_record_file
+from stochpound.motions.records.record import Record, normalize_units
 
 REGISTRY_FILE = "registry.toml"
 _VARIANT_KEYS = {"base", "first", "scale", "divide_by"}

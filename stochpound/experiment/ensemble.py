@@ -42,10 +42,9 @@ from stochpound import __version__
 from stochpound.analysis import impact_statistics, peak_response
 from stochpound.analysis.names import ENSEMBLE_ALIASES, with_aliases
 from stochpound.analysis.summary import response_moments
-from stochpound.events import EventCounters
-from stochpound.motion import SampledMotion
-from stochpound.recorder import ENERGY_TERMS, Recorder
-from stochpound.scene import Scene
+from stochpound.motions.ground import SampledMotion
+from stochpound.results.record import ENERGY_TERMS, EventCounters, Recorder
+from stochpound.model.scene import Scene
 from stochpound.solvers.exact import run_exact
 from stochpound.solvers.ivp import run_ivp
 
@@ -192,16 +191,9 @@ def _run(scene: Scene, method: str) -> tuple[Recorder, EventCounters, Any]:
 
 def _histories(scene: Scene, runs: list) -> xr.Dataset:
     """Displacement and impact force histories of a batch (realization, ...)."""
-    system = runs[0][2].system
-    n, n_floors = system.n_dof, scene.max_floors
-    shape = (len(runs), len(scene.buildings), n_floors, len(runs[0][0].motion.times))
-    relative, sliding = np.full(shape, np.nan), np.zeros(shape[:2] + shape[3:])
-    for r, (recorder, _, _) in enumerate(runs):
-        q = recorder.states[:, :n]
-        for b, building in enumerate(scene.buildings):
-            relative[r, b, : building.n_floors] = q[:, system.floor_dofs[b]].T
-            if system.base_dofs[b] >= 0:
-                sliding[r, b] = q[:, system.base_dofs[b]]
+    n_floors = scene.max_floors
+    relative, sliding = (np.array(arrays) for arrays in zip(*(recorder.displacements() for recorder, _, _ in runs)))
+    shape = relative.shape
     forces = np.array([recorder.forces.T for recorder, _, _ in runs])
     dims = ("realization", "building", "floor", "time")
     coords = {"building": scene.building_names, "floor": np.arange(1, n_floors + 1), "time": np.arange(shape[-1]) * _spacing(runs)}

@@ -2,9 +2,9 @@
 
 from __future__ import annotations
 
-from stochpound.records.record import Record
-from stochpound.records.registry import study_table_3_2
-from stochpound.records.statistics import STUDY_G, record_statistics
+from stochpound.motions.records.record import Record
+from stochpound.motions.records.registry import study_table_3_2
+from stochpound.motions.records.statistics import STUDY_G, record_statistics
 
 _ROWS = (
     ("npts", "points", "{:d}"),

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import xarray as xr
 
-from stochpound.result import build_dataset
-from stochpound.scene import Scene
+from stochpound.results.dataset import build_dataset
+from stochpound.model.scene import Scene
 from stochpound.solvers.exact import run_exact
 from stochpound.solvers.ivp import INTEGRATORS, run_ivp
 
@@ -21,8 +21,9 @@ def simulate(
     integrator: str = "DOP853",
     rtol: float = 1e-10,
     atol: float = 1e-12,
+    demands: bool = False,
 ) -> xr.Dataset:
-    """Simulate a scene and return the result dataset (CONTRACT.md names).
+    """Simulate a scene and return the result dataset (the names of docs/scene-files.md).
 
     Parameters
     ----------
@@ -37,6 +38,10 @@ def simulate(
         For ``ivp``: ``DOP853`` (default), ``RK45``, ``RK23``, ``Radau``, ``BDF`` or ``LSODA``.
     rtol, atol : float
         For ``ivp``: integrator tolerances (``atol`` in m and m/s).
+    demands : bool
+        Also give the demand parameters (``total_acceleration``,
+        ``storey_drift``, ``storey_shear``, ``base_shear``) and their peaks over
+        the run, located on the solution (monitoring them makes a run slower).
 
     Returns
     -------
@@ -52,9 +57,9 @@ def simulate(
         if not (value > 0.0):
             raise ValueError(f"{name} must be > 0, got {value}")
     if method == "exact":
-        recorder, counters, library = run_exact(scene)
+        recorder, counters, library = run_exact(scene, demands=demands)
         attrs = {"solver": method, "modes_visited": len(library)}
     else:
-        recorder, counters, library = run_ivp(scene, integrator, rtol, atol)
+        recorder, counters, library = run_ivp(scene, integrator, rtol, atol, demands)
         attrs = {"solver": method, "integrator": integrator, "rtol": rtol, "atol": atol, "modes_visited": len(library)}
     return build_dataset(scene, library.system, recorder, counters, attrs)

@@ -1,15 +1,15 @@
 """Ground-motion records: the bundled registry, file readers and statistics.
 
->>> from stochpound.records import load_record
+>>> from stochpound.motions.records import load_record
 >>> rec = load_record("el_centro_1940_study")      # a registry name or a file path
 >>> rec.dt, rec.units, rec.acceleration(g=9.814)[:3]  # doctest: +SKIP
 
 See ``docs/records.md`` for the names, the formats and the conventions.
 """
 
-from stochpound.records.readers import RawSeries, read_at2, read_record_file, read_text
-from stochpound.records.record import Record, normalize_units
-from stochpound.records.registry import (
+from stochpound.motions.records.readers import RawSeries, read_at2, read_record_file, read_text
+from stochpound.motions.records.record import Record, normalize_units
+from stochpound.motions.records.registry import (
     RegistryEntry,
     list_records,
     load_record,
@@ -17,7 +17,7 @@ from stochpound.records.registry import (
     registry_entries,
     study_table_3_2,
 )
-from stochpound.records.statistics import (
+from stochpound.motions.records.statistics import (
     STUDY_G,
     RecordStatistics,
     arias_intensity,

@@ -19,7 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.linalg import eigh
 
-from stochpound.scene import Building, storey_matrix
+from stochpound.model.building import Building, storey_matrix
 
 #: Largest off-diagonal modal damping, relative to the diagonal, still treated as
 #: classical (and neglected): the study's dashpots are a1·K rounded to 6 digits.

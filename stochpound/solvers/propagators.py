@@ -18,10 +18,10 @@ autonomous linear system ż = 𝒜 z,
 so z(t₀ + τ) = exp(𝒜 τ) z(t₀) exactly. For every visited mode a
 :class:`ModePropagator` holds exp(𝒜 h) for the sub-step h used inside a
 sample interval, exp(𝒜 τᵢ) at the 5 Gauss–Legendre nodes of a sub-step (the
-energy quadrature of :class:`stochpound.recorder.Recorder`), and a Chebyshev
+energy quadrature of :class:`stochpound.results.record.Recorder`), and a Chebyshev
 expansion of exp(𝒜 τ) on [0, h] that evaluates the exact flow anywhere inside
 a sub-step (event location, peak forces). The rows of a stuck base are set to
-exactly s(τ) = s(0), ṡ(τ) = 0 (MODEL.md §6).
+exactly s(τ) = s(0), ṡ(τ) = 0 (docs/model.md, numerical traps).
 
 The sub-step h = dt / m is the largest with ρ h ≤ :data:`SCREEN_ANGLE`, where
 ρ bounds the mode's frequencies (spectral radius of A, and Ω of a harmonic
@@ -60,10 +60,9 @@ import numpy as np
 from scipy.linalg import matrix_balance
 
 from stochpound.errors import StochpoundError
-from stochpound.events import Dense
-from stochpound.modes import BoundedCache, Mode, ModeDynamics, ModeLibrary, array_bytes
-from stochpound.motion import GroundMotion, HarmonicMotion, SampledMotion
-from stochpound.system import System
+from stochpound.model.modes import BoundedCache, Mode, ModeDynamics, ModeLibrary, array_bytes
+from stochpound.motions.ground import GroundMotion, HarmonicMotion, SampledMotion
+from stochpound.model.system import System
 
 SCREEN_ANGLE = 0.5
 """Largest phase ρ·h (rad) swept by any mode frequency in one sub-step."""
@@ -86,7 +85,7 @@ BLOCK_BUDGET = 64 * 2**20
 
 
 class UnsupportedMotionError(StochpoundError, ValueError):
-    """The exact solver cannot generate this ground motion exactly."""
+    """The solvers cannot run this ground motion (they take sampled and harmonic motions)."""
 
 
 # ---------------------------------------------------------------- exosystem
@@ -99,7 +98,8 @@ def exosystem(motion: GroundMotion) -> np.ndarray:
     ------
     UnsupportedMotionError
         For motions other than :class:`SampledMotion` (linear or spline) and
-        :class:`HarmonicMotion`; simulate those with ``method="ivp"``.
+        :class:`HarmonicMotion`: the event engine of both solvers evaluates
+        a_g interval by interval as a cubic or a sine.
     """
     if isinstance(motion, HarmonicMotion):
         rotation = np.array([[0.0, 1.0], [-motion.omega**2, 0.0]])
@@ -107,8 +107,7 @@ def exosystem(motion: GroundMotion) -> np.ndarray:
     if isinstance(motion, SampledMotion):
         return np.eye(EXO_SIZE, k=1)
     raise UnsupportedMotionError(
-        f"method='exact' supports sampled (linear or spline) and harmonic ground motions, "
-        f"not {type(motion).__name__}; use method='ivp'"
+        f"the solvers run sampled (linear or spline) and harmonic ground motions, not {type(motion).__name__}"
     )
 
 
@@ -138,7 +137,7 @@ def uniform_step(motion: GroundMotion) -> float:
     """The motion's sample spacing dt (s); raises if the output times are not uniform."""
     steps = np.diff(motion.times)
     dt = float(steps[0])
-    if not np.allclose(steps, dt, rtol=1e-9, atol=0.0):
+    if np.abs(steps - dt).max() > 1e-9 * abs(dt):  # np.allclose(steps, dt, rtol=1e-9, atol=0), cheaper
         raise UnsupportedMotionError("method='exact' needs uniformly spaced motion samples; use method='ivp'")
     return dt
 
@@ -172,23 +171,6 @@ class ModePropagator:
     transition: np.ndarray
     nodes: np.ndarray
     chebyshev: np.ndarray
-
-    def dense(self, t0: float, x0: np.ndarray, ground0: np.ndarray) -> Dense:
-        """Exact state x(t) for t ∈ [t0, t0 + h] from x(t0) and w(t0) = ``ground0``.
-
-        Returns a callable: scalar t → (2N,), array of times → (2N, n_times).
-        """
-        z0 = np.concatenate([x0, ground0, [1.0]])
-        coefficients = self.chebyshev @ z0  # (d+1, 2N)
-        orders = np.arange(len(coefficients))
-        scale = 2.0 / self.step
-
-        def evaluate(t: np.ndarray | float) -> np.ndarray:
-            s = np.clip((np.asarray(t, float) - t0) * scale - 1.0, -1.0, 1.0)
-            basis = np.cos(np.multiply.outer(np.arccos(s), orders))
-            return (basis @ coefficients).T
-
-        return evaluate
 
 
 def _augmented(A: np.ndarray, B: np.ndarray, c: np.ndarray, exo: np.ndarray) -> np.ndarray:
@@ -238,7 +220,7 @@ def _series_weights(order: int) -> np.ndarray:
     Rows: u^m at u = 1 (the sub-step), at the Gauss–Legendre nodes
     u = (1 + ξᵢ)/2, then the Chebyshev coefficients of u^m = ((1 + s)/2)^m in
     s ∈ [−1, 1] up to degree max(:data:`CHEBYSHEV_DEGREE`, ``order``), exact
-    (dyadic rationals): u Tⱼ = Tⱼ/2 + (Tⱼ₊₁ + T|ⱼ₋₁|)/4, u T₀ = (T₀ + T₁)/2.
+    (dyadic rationals): u Tⱼ = Tⱼ/2 + (Tⱼ₊₁ + T_abs(j−1))/4, u T₀ = (T₀ + T₁)/2.
     """
     degree = max(CHEBYSHEV_DEGREE, order)
     times_u = 0.5 * np.eye(degree + 1) + 0.25 * (np.eye(degree + 1, k=-1) + np.eye(degree + 1, k=1))
@@ -320,7 +302,7 @@ class BlockCache:
         self._flows: BoundedCache[tuple[bytes, float], _Flows] = BoundedCache(BLOCK_BUDGET, array_bytes)
 
     def radius(self, key: bytes, A: np.ndarray) -> float:
-        """Largest |eigenvalue| of the block matrix ``A`` (rad/s)."""
+        """Largest abs(eigenvalue) of the block matrix ``A`` (rad/s)."""
         radius = self._radius.get(key)
         if radius is None:
             radius = self._radius[key] = float(np.abs(np.linalg.eigvals(A)).max(initial=0.0))
@@ -450,19 +432,6 @@ class PropagatorLibrary:
 _LIBRARIES: OrderedDict[bytes, PropagatorLibrary] = OrderedDict()
 
 
-def system_fingerprint(system: System) -> bytes:
-    """Digest of every matrix and layout entry of ``system`` (equal systems share propagators)."""
-    digest = hashlib.blake2b(digest_size=20)
-    for item in fields(system):
-        value = getattr(system, item.name)
-        arrays = value if isinstance(value, list) else [value]
-        for array in arrays:
-            array = np.ascontiguousarray(array)
-            digest.update(f"{item.name}{array.dtype}{array.shape}".encode())
-            digest.update(array.tobytes())
-    return digest.digest()
-
-
 def propagator_library(system: System, motion: GroundMotion) -> PropagatorLibrary:
     """The cached :class:`PropagatorLibrary` of ``system`` driven by ``motion`` (built on first use).
 
@@ -472,7 +441,7 @@ def propagator_library(system: System, motion: GroundMotion) -> PropagatorLibrar
     """
     exo = exosystem(motion)
     dt = uniform_step(motion)
-    key = system_fingerprint(system) + exo.tobytes() + np.float64(dt).tobytes()
+    key = system.fingerprint + exo.tobytes() + np.float64(dt).tobytes()
     library = _LIBRARIES.get(key)
     if library is None:
         library = _LIBRARIES[key] = PropagatorLibrary(system, exo, dt)

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from stochpound.records.record import Record
-from stochpound.records.statistics import STUDY_G
+from stochpound.motions.records.record import Record
+from stochpound.motions.records.statistics import STUDY_G
 
 
 def plot_record(record: Record, path: str | Path, g: float = STUDY_G) -> Path:

@@ -12,7 +12,7 @@ logic, which stays the specification:
 * settling: :func:`stochpound.events.settle` (``guard_leaving_sign``,
   ``_wanting_to_fire``, ``_apply``, ``_initial_guard_states``) with the same
   constants (imported from :mod:`stochpound.events`);
-* recording: :meth:`stochpound.recorder.Recorder.on_step` (energy terms by
+* recording: :meth:`stochpound.results.record.Recorder.on_step` (energy terms by
   5-point Gauss–Legendre quadrature, impulses, located peak forces),
   ``on_transitions`` and ``on_contact_force``.
 
@@ -78,9 +78,18 @@ from numba import njit
 from numba.core.compiler_lock import global_compiler_lock
 from numba.core.registry import cpu_target
 
-from stochpound.events import FIRE_THRESHOLD, MAX_SETTLE_ITERATIONS, ROUND_OFF, TIME_TOLERANCE
-from stochpound.modes import STUCK, Guard
-from stochpound.propagators import GAUSS_NODES, GAUSS_WEIGHTS
+from stochpound.model.friction import STUCK
+from stochpound.model.guards import Guard
+from stochpound.solvers.propagators import GAUSS_NODES, GAUSS_WEIGHTS
+
+ROUND_OFF = 1e-10
+"""Relative size under which a guard value or derivative counts as zero."""
+FIRE_THRESHOLD = 1e-7
+"""Relative level at which a disarmed guard fires anyway (progress guarantee)."""
+TIME_TOLERANCE = 1e-13
+"""Absolute tolerance of event times, s."""
+MAX_SETTLE_ITERATIONS = 64
+"""Most mode transitions applied at one instant before settling declares a cycle (chattering)."""
 
 INTERNAL = {"no_cpython_wrapper": True, "no_cfunc_wrapper": True, "error_model": "numpy", "_nrt": False}
 """Options of the jitted helpers, called only from compiled code (no runtime: they allocate nothing)."""
@@ -89,39 +98,55 @@ ModeTable = namedtuple("ModeTable", "modes ids codes n_guards substeps")
 ModeTable.__doc__ = """The modes in the table's slots: mode vector (invalid in an empty slot), the mode's id (kept
 when it changes slot, recorded per sample), guard codes (rows KIND, TARGET, DIRECTION; padded), number of guards
 and of sub-steps per sample interval."""
-Dynamics = namedtuple("Dynamics", "rate guard force power")
-Dynamics.__doc__ = """The slots' modes' affine maps of ẋ, the guards (padded) and the contact forces, and its power forms.
+Dynamics = namedtuple("Dynamics", "rate guard force monitor power")
+Dynamics.__doc__ = """The slots' modes' affine maps of ẋ, the guards (padded), the contact forces and the monitors, and their power forms.
 
-``power[m]`` stacks the quadratic forms P of the input, damping, friction and
-impact powers, zᵀ P z at z = [x, a_g, 0, 0, 0, 1], transposed (Z × 4Z)
-(``exact_tables._power_forms``).
+A *monitor* is a read-out whose largest value over the run is located on
+the solution (e.g. a contact's closure, whose peak is the separation the run
+needed). ``power[m]`` stacks the quadratic forms P of the input, damping,
+friction and impact powers, zᵀ P z at z = [x, a_g, 0, 0, 0, 1], transposed
+(Z × 4Z) (``tables._power_forms``).
 """
 Propagators = namedtuple("Propagators", "propagate chebyshev step")
 Propagators.__doc__ = """Exact sub-step propagators of the slots' modes.
 
 ``propagate[m]`` is [exp(𝒜h); Q_input; Q_damping; Q_friction; Q_impact; R;
-V; W] transposed (Z × (5Z + n_contacts + 2 n_guards), guards padded, then
-zero columns up to :func:`propagate_columns`): one
+V; W; V_m; W_m] transposed (Z × (5Z + n_contacts + 2 n_guards + 2 n_monitors),
+guards padded, then zero columns up to :func:`propagate_columns`): one
 product of z(t0) gives z(t0 + h), Q z(t0) of every energy term (whose gain
 over the sub-step is z(t0) · Q z(t0)), the impulses R z(t0)
-(``exact_tables._sub_step_forms``), and the guards' values V z(t0) and rates
-W z(t0) at t0 + h (``exact_tables._guard_rows``). ``chebyshev[m]`` is the
+(``tables._sub_step_forms``), and the guards' and monitors' values V z(t0)
+and rates W z(t0) at t0 + h (``tables._read_out_rows``). ``chebyshev[m]`` is the
 Chebyshev expansion of the flow on a sub-step of length ``step[m]``,
 transposed (Z × D·2N).
 """
 Motion = namedtuple("Motion", "times forcing coefficients harmonic")
 Motion.__doc__ = """Output times, exosystem state per interval, cubic per interval (sampled) or [A, ω, φ] (harmonic)."""
 Layout = namedtuple("Layout", "geometry gap tensile left_rows right_rows base_dofs")
-Layout.__doc__ = """Contacts (penetration rows, gaps, tensile flags, rows of the left and right floors) and the base DOFs."""
+Layout.__doc__ = """Impact elements (penetration rows, gaps, tensile flags, displacement rows of their left and right sides) and the base DOFs."""
 Run = namedtuple("Run", "clock ints x pending_x pending_mode missing_mode visited")
 Run.__doc__ = """Time, counters (``ints``; ``ints[MODE]`` is a slot), state, the pending event and the ids of the modes visited."""
 Arming = namedtuple("Arming", "threshold tolerance rearmable disarmed")
-Arming.__doc__ = """Arming of the current mode's guards (:class:`stochpound.events.GuardStates`)."""
+Arming.__doc__ = """Arming of the current mode's guards.
+
+``threshold[j]`` is 0 for an armed guard (it fires at 0), a small positive
+level for a disarmed one (it fires there, or at 0 once it has gone below
+−``tolerance[j]``) and +inf for a guard that may not fire for now;
+``rearmable[j]`` is False for a guard that stays off until the next mode
+change (the RECLOSE guard of a contact that is not penetrated).
+"""
 Impacts = namedtuple("Impacts", "is_open impact table")
 Impacts.__doc__ = """Open impacts (``impact[row, contact]``, rows START … IMPULSE) and the table of finished ones."""
-Outputs = namedtuple("Outputs", "running states energy sample_modes")
-Outputs.__doc__ = """Running energy terms, and the state, energy terms and mode id at every output time."""
-Flow = namedtuple("Flow", "rate guard force coefficients ground origin harmonic t0 scale")
+Outputs = namedtuple("Outputs", "running states energy sample_modes peaks")
+Outputs.__doc__ = """Running energy terms, the state, energy terms and mode id at every output time, and the monitors' peaks (rows PEAK_VALUE, PEAK_AT)."""
+Supplied = namedtuple("Supplied", "bounds x coefficients")
+Supplied.__doc__ = """A step of the flow supplied by the caller (``external`` runs: an integrator's step).
+
+``bounds`` = [t0, t1] (s), ``x`` the state at t1 and ``coefficients`` the
+Chebyshev coefficients of x(t) on [t0, t1], (D + 1) × 2N flattened by order
+(the dense output of :class:`Flow`).
+"""
+Flow = namedtuple("Flow", "rate guard force monitor coefficients ground origin harmonic t0 scale")
 Flow.__doc__ = """One mode's flow inside one step: its affine maps and the Chebyshev coefficients of x(t).
 
 ``ground`` is the interval's cubic of a_g(t − origin) (sampled motions) or
@@ -130,16 +155,18 @@ Flow.__doc__ = """One mode's flow inside one step: its affine maps and the Cheby
 """
 
 # entries of Run.ints
-K, MODE, PENDING, FIRED_KIND, FIRED_TARGET, FIRED_DIRECTION, N_IMPACTS, TOTAL, CHATTER, GRAZING = range(10)
-N_INTS = 10
+K, MODE, PENDING, FIRED_KIND, FIRED_TARGET, FIRED_DIRECTION, N_IMPACTS, TOTAL, CHATTER, GRAZING, READY = range(11)
+N_INTS = 11
 # rows of ModeTable.codes
 KIND, TARGET, DIRECTION = range(3)
 # rows of Impacts.impact
 START, ONSET, IN_PHASE, PEAK, PEAK_TIME, IMPULSE = range(6)
+# rows of Outputs.peaks
+PEAK_VALUE, PEAK_AT = range(2)
 # pending settles
 NONE, INITIAL, EVENT = 0, 1, 2
 # statuses returned to Python
-FINISHED, NEED_MODE, NEED_SPACE, NEEDS_EVENTS = 0, 1, 2, 3
+FINISHED, NEED_MODE, NEED_SPACE, NEED_STEP = 0, 1, 2, 3
 # columns of Impacts.table (finished impacts): contact, end, then the rows of Impacts.impact
 IMPACT_COLUMNS = ("contact", "end", "start", "onset_velocity", "in_phase", "peak_force", "peak_time", "impulse")
 N_NODES = 5
@@ -156,26 +183,28 @@ LANES = 16
 """The columns of ``Propagators.propagate`` are padded to a multiple of this, so that its products vectorise whole."""
 
 
-def propagate_columns(size: int, n_guards: int, n_contacts: int) -> int:
+def propagate_columns(size: int, n_guards: int, n_contacts: int, n_monitors: int) -> int:
     """Columns of ``Propagators.propagate`` (padded to :data:`LANES`) for state size ``size`` (2N)."""
-    used = 5 * (size + 5) + n_contacts + 2 * n_guards
+    used = 5 * (size + 5) + n_contacts + 2 * n_guards + 2 * n_monitors
     return -(-used // LANES) * LANES
 
 
-def work_arrays(size: int, n_guards: int, n_contacts: int, mode_size: int, chebyshev_width: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def work_arrays(size: int, n_guards: int, n_contacts: int, n_monitors: int, mode_size: int,
+                chebyshev_width: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``scratch``, ``saved`` and ``marks`` work arrays of :func:`run_engine`.
 
     For state size ``size`` (2N), mode vectors of ``mode_size`` and Chebyshev
     rows of ``chebyshev_width`` (``Propagators.chebyshev.shape[2]``). The
     engine allocates nothing: every work vector is a row of these.
-    ``scratch`` rows: 0–6 the quiet loop's (:func:`_advance_quiet`), 0–15
-    an event step's (:func:`_advance_span`, :func:`_first_crossing`), 16–23
-    settling's. ``marks`` rows: the settling chain's modes, its transitions,
-    then the guard headings and two mode vectors.
+    ``scratch`` rows: 0–6 and 9 the quiet loop's (:func:`_advance_quiet`),
+    0–15 an event step's (:func:`_advance_span`, :func:`_first_crossing`),
+    16–23 settling's, 24–27 the monitors' values and rates at a step's ends.
+    ``marks`` rows: the settling chain's modes, its transitions, then the
+    guard headings and two mode vectors.
     """
-    scratch = np.zeros((24, max(propagate_columns(size, n_guards, n_contacts), chebyshev_width)))
+    scratch = np.zeros((28, max(propagate_columns(size, n_guards, n_contacts, n_monitors), chebyshev_width)))
     marks = np.zeros((2 * (_MAX_SETTLE + 1) + 3, max(mode_size, 3, n_guards)), dtype=np.int64)
-    return scratch, np.zeros((6, max(4, n_contacts, n_guards))), marks
+    return scratch, np.zeros((8, max(4, n_contacts, n_guards, n_monitors))), marks
 
 
 # ---------------------------------------------------------------- linear algebra and read-outs
@@ -210,11 +239,11 @@ def _affine(M, i, x, ground):
 
 
 @njit(**INTERNAL)
-def _force_rate(force, p, rate, x, ground):
-    """Rate of contact force p: force[p, :S] · ẋ."""
-    total = 0.0
-    for i in range(rate.shape[0]):
-        total += force[p, i] * _affine(rate, i, x, ground)
+def _rate_of(M, i, rate, x, ground, ground_rate):
+    """Rate of row i of the affine map M along the flow: M[i, :S] · ẋ + M[i, S] ȧ_g."""
+    total = M[i, rate.shape[0]] * ground_rate
+    for j in range(rate.shape[0]):
+        total += M[i, j] * _affine(rate, j, x, ground)
     return total
 
 
@@ -319,18 +348,31 @@ def _interior_maximum(a0, a1, a2, a3):
 
 
 @njit(**INTERNAL)
+def _hermite(value0, value1, rate0, rate1, h):
+    """Coefficients (a0, a1, a2, a3) in τ ∈ [0, 1] of the cubic Hermite interpolant of a guard over a step of h seconds."""
+    return value0, rate0 * h, 3.0 * (value1 - value0) - (2.0 * rate0 + rate1) * h, 2.0 * (value0 - value1) + (rate0 + rate1) * h
+
+
+@njit(**INTERNAL)
+def _screen_margin(value0, value1, rate0, rate1, h, tolerance):
+    """How close below zero a guard's Hermite cubic may come before the guard is examined on the flow itself."""
+    return 1e-3 * (abs(value0) + abs(value1) + abs(rate0 * h) + abs(rate1 * h)) + tolerance
+
+
+@njit(**INTERNAL)
+def _may_cross(value0, value1, rate0, rate1, h, tolerance):
+    """The guard screen: True when a guard ends the step at or above zero, or its Hermite cubic peaks within the margin of zero."""
+    if value1 >= 0.0:
+        return True
+    a0, a1, a2, a3 = _hermite(value0, value1, rate0, rate1, h)
+    return _interior_maximum(a0, a1, a2, a3) >= -_screen_margin(value0, value1, rate0, rate1, h, tolerance)
+
+
+@njit(**INTERNAL)
 def _suspect(values0, values1, rates0, rates1, h, threshold, tolerance):
-    """True when first_crossing would examine some guard of this sub-step."""
+    """True when some guard that may fire passes the screen (:func:`_may_cross`) over this step."""
     for g in range(values0.shape[0]):
-        if not abs(threshold[g]) < math.inf:
-            continue
-        if values1[g] >= 0.0:
-            return True
-        a0, a1 = values0[g], rates0[g] * h
-        a2 = 3.0 * (values1[g] - values0[g]) - (2.0 * rates0[g] + rates1[g]) * h
-        a3 = 2.0 * (values0[g] - values1[g]) + (rates0[g] + rates1[g]) * h
-        margin = 1e-3 * (abs(values0[g]) + abs(values1[g]) + abs(a1) + abs(rates1[g] * h)) + tolerance[g]
-        if _interior_maximum(a0, a1, a2, a3) >= -margin:
+        if abs(threshold[g]) < math.inf and _may_cross(values0[g], values1[g], rates0[g], rates1[g], h, tolerance[g]):
             return True
     return False
 
@@ -350,7 +392,7 @@ def _peaks(rate, force, is_open, impact, x0, a0, t0, x1, a1, t1):
     _offer_peaks(force, is_open, impact, t0, x0)
     _offer_peaks(force, is_open, impact, t1, x1)
     for p in range(is_open.shape[0]):
-        if is_open[p] and _force_rate(force, p, rate, x0, a0) > 0.0 > _force_rate(force, p, rate, x1, a1):
+        if is_open[p] and _rate_of(force, p, rate, x0, a0, 0.0) > 0.0 > _rate_of(force, p, rate, x1, a1, 0.0):
             return True
     return False
 
@@ -359,18 +401,20 @@ def _peaks(rate, force, is_open, impact, x0, a0, t0, x1, a1, t1):
 
 
 @njit(**INTERNAL)
-def _save(saved, running, impact, threshold, disarmed):
-    """Copy the running totals, the open impacts' peaks and impulses and the guard arming into the rows of ``saved``."""
+def _save(saved, running, impact, threshold, disarmed, peaks):
+    """Copy the running totals, the open impacts' peaks and impulses, the guard arming and the monitors' peaks into the rows of ``saved``."""
     for i in range(running.shape[0]):
         saved[0, i] = running[i]
     for p in range(impact.shape[1]):
         saved[1, p], saved[2, p], saved[3, p] = impact[PEAK, p], impact[PEAK_TIME, p], impact[IMPULSE, p]
     for g in range(threshold.shape[0]):
         saved[4, g], saved[5, g] = threshold[g], 1.0 if disarmed[g] else 0.0
+    for i in range(peaks.shape[1]):
+        saved[6, i], saved[7, i] = peaks[PEAK_VALUE, i], peaks[PEAK_AT, i]
 
 
 @njit(**INTERNAL)
-def _restore(saved, running, impact, threshold, disarmed):
+def _restore(saved, running, impact, threshold, disarmed, peaks):
     """Undo everything since :func:`_save`."""
     for i in range(running.shape[0]):
         running[i] = saved[0, i]
@@ -378,36 +422,96 @@ def _restore(saved, running, impact, threshold, disarmed):
         impact[PEAK, p], impact[PEAK_TIME, p], impact[IMPULSE, p] = saved[1, p], saved[2, p], saved[3, p]
     for g in range(threshold.shape[0]):
         threshold[g], disarmed[g] = saved[4, g], saved[5, g] != 0.0
+    for i in range(peaks.shape[1]):
+        peaks[PEAK_VALUE, i], peaks[PEAK_AT, i] = saved[6, i], saved[7, i]
+
+
+# ---------------------------------------------------------------- monitors
+
+
+@njit(**INTERNAL)
+def _offer_monitors(values, t, peaks):
+    """Offer the monitors' ``values`` at time t as their peaks."""
+    for i in range(values.shape[0]):
+        if values[i] > peaks[PEAK_VALUE, i]:
+            peaks[PEAK_VALUE, i], peaks[PEAK_AT, i] = values[i], t
+
+
+@njit(**INTERNAL)
+def _maximum_may_beat(value0, value1, rate0, rate1, h, peak):
+    """True when a monitor has a maximum inside a step of h seconds (rate from + to −) whose Hermite cubic comes near its ``peak``."""
+    if not rate0 > 0.0 > rate1:
+        return False
+    a0, a1, a2, a3 = _hermite(value0, value1, rate0, rate1, h)
+    return _interior_maximum(a0, a1, a2, a3) >= peak - _screen_margin(value0, value1, rate0, rate1, h, 0.0)
+
+
+@njit(**INTERNAL)
+def _any_maximum_may_beat(values0, values1, rates0, rates1, h, peaks):
+    """True when some monitor's maximum inside the step may beat its peak (:func:`_maximum_may_beat`)."""
+    for i in range(values0.shape[0]):
+        if _maximum_may_beat(values0[i], values1[i], rates0[i], rates1[i], h, peaks[PEAK_VALUE, i]):
+            return True
+    return False
+
+
+@njit(**INTERNAL)
+def _monitor_peaks(flow, t1, values0, values1, rates0, rates1, peaks, work):
+    """Offer the monitors' values at t1 and their maxima inside [flow.t0, t1], located on the flow, as their peaks.
+
+    ``values*``/``rates*``: the monitors' values and rates at the step's ends.
+    A maximum is located (Brent on the monitor's rate) when the rate goes from
+    + to − on the flow and the Hermite cubic says it may beat the peak.
+    """
+    t0, n_contacts = flow.t0, flow.force.shape[0]
+    for i in range(values1.shape[0]):
+        if _maximum_may_beat(values0[i], values1[i], rates0[i], rates1[i], t1 - t0, peaks[PEAK_VALUE, i]):
+            index = -1 - n_contacts - i
+            if _evaluate(flow, index, 0.0, t0, work) > 0.0 > _evaluate(flow, index, 0.0, t1, work):
+                t_peak = _brentq(flow, index, 0.0, t0, t1, work)
+                _dense(flow, t_peak, work)
+                value = _affine(flow.monitor, i, work, _ground_value(flow, t_peak))
+                if value > peaks[PEAK_VALUE, i]:
+                    peaks[PEAK_VALUE, i], peaks[PEAK_AT, i] = value, t_peak
+    _offer_monitors(values1, t1, peaks)
 
 
 @njit(inline="always", error_model="numpy")
-def _advance_quiet(mode_id, n, substeps, propagate, rate, guard, force, times, forcing, ints, clock, x, arming, is_open, impact,
-                   outputs, scratch, saved):
+def _advance_quiet(mode_id, n, substeps, step, propagate, chebyshev, rate, guard, force, monitor, motion, ints, clock, x, arming, is_open,
+                   impact, outputs, scratch, saved):
     """Advance the current mode (its id, n guards and arrays) from interval ``ints[K]`` until an interval needs the event code.
 
     Does for every sub-step what the event code does for a step without event:
     the guard screen of ``first_crossing`` and the re-arming of guards, the
-    energy terms, impulses and end-point peak forces of ``Recorder.on_step``.
-    Every completed interval k is recorded at output time k + 1;
-    ``ints[K]``, ``clock`` and ``x`` are left at the start of the interval
-    where the loop stopped (or at the end of the motion).
+    energy terms, impulses and end-point peak forces of ``Recorder.on_step``,
+    and the monitors' peaks (located on the flow when a maximum inside a
+    sub-step may beat one). Every completed interval k is recorded at output
+    time k + 1; ``ints[K]``, ``clock`` and ``x`` are left at the start of the
+    interval where the loop stopped (or at the end of the motion).
     """
     threshold, tolerance, rearmable, disarmed = arming
-    running, states, energy, sample_modes = outputs
+    running, states, energy, sample_modes, peaks = outputs
+    times, forcing, harmonic = motion.times, motion.forcing, motion.harmonic
+    is_harmonic = harmonic.shape[0] > 0
     size = x.shape[0]
     width = size + 5
-    z0, propagated, work = scratch[0, :width], scratch[1, : propagate.shape[1]], scratch[2, :size]
+    z0, propagated, work, coefficients = scratch[0, :width], scratch[1, : propagate.shape[1]], scratch[2, :size], scratch[9, : chebyshev.shape[1]]
     z1, x0, x1 = propagated[:width], z0[:size], propagated[:size]
-    values_at, rates_at = 5 * width + is_open.shape[0], 5 * width + is_open.shape[0] + guard.shape[0]
+    values_at = 5 * width + is_open.shape[0]
+    rates_at, monitors_at = values_at + guard.shape[0], values_at + 2 * guard.shape[0]
+    n_monitors = monitor.shape[0]
     values0, values1, rates0, rates1 = scratch[3, :n], propagated[values_at : values_at + n], scratch[5, :n], propagated[rates_at : rates_at + n]
+    monitors0, monitors1 = scratch[24, :n_monitors], propagated[monitors_at : monitors_at + n_monitors]
+    monitor_rates0, monitor_rates1 = scratch[26, :n_monitors], propagated[monitors_at + n_monitors : monitors_at + 2 * n_monitors]
     any_open = _any(is_open)
     for k in range(ints[K], forcing.shape[0]):
         h = (times[k + 1] - times[k]) / substeps
-        _save(saved, running, impact, threshold, disarmed)
+        _save(saved, running, impact, threshold, disarmed, peaks)
         _copy(x, x0)
         _copy(forcing[k], z0[size : size + 4])
         z0[width - 1] = 1.0
         _guards_and_rates(rate, guard, x0, z0[size], z0[size + 1], values0, rates0, work)
+        _guards_and_rates(rate, monitor, x0, z0[size], z0[size + 1], monitors0, monitor_rates0, work)
         for j in range(substeps):
             _product(propagate, z0, propagated)
             t0 = times[k] + j * h
@@ -415,14 +519,23 @@ def _advance_quiet(mode_id, n, substeps, propagate, rate, guard, force, times, f
             if _suspect(values0, values1, rates0, rates1, h, threshold, tolerance) or (
                 any_open and _peaks(rate, force, is_open, impact, x0, z0[size], t0, x1, z1[size], t1)
             ):
-                _restore(saved, running, impact, threshold, disarmed)
+                _restore(saved, running, impact, threshold, disarmed, peaks)
                 ints[K] = k
                 clock[0] = times[k]
                 return
             _sub_step_energy(z0, propagated, is_open, impact[IMPULSE], running)
             _arm_where_negative(values1, threshold, tolerance, rearmable, disarmed)
+            if _any_maximum_may_beat(monitors0, monitors1, monitor_rates0, monitor_rates1, h, peaks):
+                _product(chebyshev, z0, coefficients)
+                flow = Flow(rate, guard, force, monitor, coefficients, harmonic if is_harmonic else motion.coefficients[k], times[k], is_harmonic,
+                            t0, 2.0 / step)
+                _monitor_peaks(flow, t1, monitors0, monitors1, monitor_rates0, monitor_rates1, peaks, work)
+            else:
+                _offer_monitors(monitors1, t1, peaks)
             _copy(values1, values0)
             _copy(rates1, rates0)
+            _copy(monitors1, monitors0)
+            _copy(monitor_rates1, monitor_rates0)
             _copy(z1, z0)
         _copy(x0, x)
         ints[K] = k + 1
@@ -479,13 +592,29 @@ def _dense(flow, t, out):
 
 
 @njit(**INTERNAL)
+def _ground_rate(flow, t):
+    """ȧ_g at t in the flow's interval."""
+    c = flow.ground
+    if flow.harmonic:
+        return c[0] * c[1] * math.cos(c[1] * t + c[2])
+    tau = t - flow.origin
+    return c[1] + tau * (2.0 * c[2] + 3.0 * tau * c[3])
+
+
+@njit(**INTERNAL)
 def _evaluate(flow, index, level, t, work):
-    """Guard ``index`` minus ``level`` at t, or (index < 0) the rate of contact force −1 − index."""
+    """Guard ``index`` minus ``level`` at t; for index < 0, the rate of read-out r = −1 − index.
+
+    Read-out r < n_contacts is contact force r, else monitor r − n_contacts.
+    """
     _dense(flow, t, work)
     ground = _ground_value(flow, t)
-    if index < 0:
-        return _force_rate(flow.force, -1 - index, flow.rate, work, ground)
-    return _affine(flow.guard, index, work, ground) - level
+    if index >= 0:
+        return _affine(flow.guard, index, work, ground) - level
+    r, n_contacts = -1 - index, flow.force.shape[0]
+    if r < n_contacts:
+        return _rate_of(flow.force, r, flow.rate, work, ground, 0.0)
+    return _rate_of(flow.monitor, r - n_contacts, flow.rate, work, ground, _ground_rate(flow, t))
 
 
 # ---------------------------------------------------------------- scipy's brentq and bounded Brent, ported
@@ -671,15 +800,11 @@ def _first_crossing(flow, threshold, tolerance, rearmable, disarmed, counters, t
     h = t1 - t0
     best_time, best_guard = math.nan, -1
     for j in range(values0.shape[0]):
-        if not abs(threshold[j]) < math.inf:
+        # every guard is screened at 0: an armed guard fires there, and a disarmed one may, after a dip
+        if not (abs(threshold[j]) < math.inf and _may_cross(values0[j], values1[j], rates0[j], rates1[j], h, tolerance[j])):
             continue
-        a0, a1 = values0[j], rates0[j] * h
-        a2 = 3.0 * (values1[j] - values0[j]) - (2.0 * rates0[j] + rates1[j]) * h
-        a3 = 2.0 * (values0[j] - values1[j]) + (rates0[j] + rates1[j]) * h
-        margin = 1e-3 * (abs(values0[j]) + abs(values1[j]) + abs(a1) + abs(rates1[j] * h)) + tolerance[j]
-        screen = 0.0 if disarmed[j] else threshold[j]
-        if not (values1[j] >= screen or _interior_maximum(a0, a1, a2, a3) >= screen - margin):
-            continue
+        a0, a1, a2, a3 = _hermite(values0[j], values1[j], rates0[j], rates1[j], h)
+        margin = _screen_margin(values0[j], values1[j], rates0[j], rates1[j], h, tolerance[j])
         n = _critical_points(a1, a2, a3, taus[1:3]) + 2
         taus[0], taus[n - 1] = 0.0, 1.0
         raw[0] = a0
@@ -757,7 +882,7 @@ def _apply(geometry, gap, base_dofs, mode, x, kind, target, direction):
 
 @njit(**INTERNAL)
 def _with_bound(M, i, x, magnitude, ground, constant):
-    """Row i of the affine map M at (x, a_g), with its constant or not, its round-off scale and Σ|M[i, :S + 1]|.
+    """Row i of the affine map M at (x, a_g), with its constant or not, its round-off scale and Σabs(M[i, :S + 1]).
 
     The scale is the same sum with every term taken absolute and x replaced
     by ``magnitude`` (``events._guard_scales``).
@@ -914,8 +1039,8 @@ def _on_transitions(mode, force, left_rows, right_rows, geometry, is_open, impac
 
 
 @njit(inline="always", error_model="numpy")
-def _settle_pending(modes, codes, n_guards, rate, guard, force, motion, layout, arming, ints, clock, pending_x, pending_mode,
-                    missing_mode, is_open, impact, table, x, scratch, marks):
+def _settle_pending(modes, codes, n_guards, rate, guard, force, monitor, motion, layout, arming, ints, clock, pending_x, pending_mode,
+                    missing_mode, is_open, impact, table, peaks, x, scratch, marks):
     """Settle the pending event (or the start) and record it (``settle_and_record``): returns the mode index.
 
     The settled state goes into ``x``. Returns −1 (with the mode to build in
@@ -936,6 +1061,10 @@ def _settle_pending(modes, codes, n_guards, rate, guard, force, motion, layout, 
         return m
     _on_transitions(modes[m], force[m], left_rows, right_rows, geometry, is_open, impact, table, ints, clock[0], settled, transitions,
                     n_transitions)
+    n_monitors = monitor.shape[1]
+    monitors, monitor_rates = scratch[24, :n_monitors], scratch[26, :n_monitors]
+    _guards_and_rates(rate[m], monitor[m], settled, ground[0], ground[1], monitors, monitor_rates, scratch[2, : x.shape[0]])
+    _offer_monitors(monitors, clock[0], peaks)  # a monitor may jump with the mode (e.g. an acceleration at impact)
     _copy(settled, x)
     return m
 
@@ -943,12 +1072,86 @@ def _settle_pending(modes, codes, n_guards, rate, guard, force, motion, layout, 
 # ---------------------------------------------------------------- event steps
 
 
-@njit(inline="always", error_model="numpy")
-def _advance_span(m, n, modes, codes, substeps, step, propagate, chebyshev, rate, guard, force, power, motion, ints, clock, x,
-                  pending_x, pending_mode, arming, is_open, impact, running, k, t, t_end, scratch):
-    """Sub-steps of mode m (n guards, its arrays) from t to t_end (``_until_event`` of exact.py).
+@njit(**INTERNAL)
+def _locate_and_record(flow, m, modes, codes, force, power, ints, clock, x0, x1, pending_x, pending_mode, arming, is_open, impact,
+                       running, peaks, t1, values0, values1, rates0, rates1, scratch):
+    """The event code of one step [flow.t0, t1] of mode m on its dense flow: returns True when it stopped at an event (now pending).
 
-    Returns True when it stopped at an event (now pending), False at t_end.
+    The earliest guard crossing is located (:func:`_first_crossing`); the
+    energy terms and impulses are integrated (5-point Gauss–Legendre on the
+    flow) and the impact forces' and monitors' peaks located up to the event
+    or t1; the
+    fired guard becomes the pending event at ``clock[0]`` with the state in
+    ``pending_x``. ``values*``/``rates*`` are the guards' values and rates
+    at the step's ends; ``scratch``: the work array (:func:`work_arrays`).
+    """
+    threshold, tolerance, rearmable, disarmed = arming
+    t0, size = flow.t0, x0.shape[0]
+    width = size + 5
+    work, x_stop = scratch[2, :size], scratch[12, :size]
+    node, products = scratch[10, :width], scratch[11, : power.shape[1]]  # node: z = [x, a_g, 0, 0, 0, 1] at a Gauss node
+    node[size + 1], node[size + 2], node[size + 3], node[width - 1] = 0.0, 0.0, 0.0, 1.0
+    t_event, fired = _first_crossing(flow, threshold, tolerance, rearmable, disarmed, ints, t1, values0, values1, rates0, rates1, work,
+                                     scratch[13], scratch[14], scratch[15])
+    t_stop = t1
+    _copy(x1, x_stop)
+    if fired >= 0:
+        t_stop = t_event
+        _dense(flow, t_event, x_stop)
+    if t_stop > t0:  # energy terms and impulses at the Gauss nodes, then peak forces
+        half = 0.5 * (t_stop - t0)
+        for g in range(N_NODES):
+            t_node, weight = t0 + half * (GAUSS_NODES[g] + 1.0), half * GAUSS_WEIGHTS[g]
+            _dense(flow, t_node, node[:size])
+            node[size] = _ground_value(flow, t_node)
+            _product(power, node, products)
+            _add_forms(node, products, weight, running)
+            for p in range(is_open.shape[0]):
+                if is_open[p]:
+                    impact[IMPULSE, p] += weight * _affine(force, p, node, 0.0)
+        _offer_peaks(force, is_open, impact, t0, x0)
+        _offer_peaks(force, is_open, impact, t_stop, x_stop)
+        for p in range(is_open.shape[0]):  # a force maximum inside the step
+            if is_open[p] and _evaluate(flow, -1 - p, 0.0, t0, work) > 0.0 > _evaluate(flow, -1 - p, 0.0, t_stop, work):
+                t_peak = _brentq(flow, -1 - p, 0.0, t0, t_stop, work)
+                _dense(flow, t_peak, work)
+                value = _affine(force, p, work, 0.0)
+                if value > impact[PEAK, p]:
+                    impact[PEAK, p], impact[PEAK_TIME, p] = value, t_peak
+        n_monitors = flow.monitor.shape[0]
+        monitors0, monitors1, monitor_rates0, monitor_rates1 = scratch[24, :n_monitors], scratch[25, :n_monitors], scratch[26, :n_monitors], scratch[27, :n_monitors]
+        _guards_and_rates(flow.rate, flow.monitor, x0, _ground_value(flow, t0), _ground_rate(flow, t0), monitors0, monitor_rates0, work)
+        _guards_and_rates(flow.rate, flow.monitor, x_stop, _ground_value(flow, t_stop), _ground_rate(flow, t_stop), monitors1, monitor_rates1, work)
+        _monitor_peaks(flow, t_stop, monitors0, monitors1, monitor_rates0, monitor_rates1, peaks, work)
+    if fired < 0:
+        return False
+    clock[0] = t_event
+    _copy(x_stop, pending_x)
+    _copy(modes[m], pending_mode)
+    ints[FIRED_KIND], ints[FIRED_TARGET], ints[FIRED_DIRECTION] = codes[m, KIND, fired], codes[m, TARGET, fired], codes[m, DIRECTION, fired]
+    ints[PENDING] = EVENT
+    ints[TOTAL] += 1
+    return True
+
+
+@njit(**INTERNAL)
+def _sub_step_monitors(flow, t1, x0, x1, peaks, scratch):
+    """The monitors' peaks over a sub-step [flow.t0, t1] from x0 to x1 that needs no event code (:func:`_monitor_peaks`)."""
+    n_monitors, work = flow.monitor.shape[0], scratch[2, : x0.shape[0]]
+    monitors0, monitors1, monitor_rates0, monitor_rates1 = scratch[24, :n_monitors], scratch[25, :n_monitors], scratch[26, :n_monitors], scratch[27, :n_monitors]
+    _guards_and_rates(flow.rate, flow.monitor, x0, _ground_value(flow, flow.t0), _ground_rate(flow, flow.t0), monitors0, monitor_rates0, work)
+    _guards_and_rates(flow.rate, flow.monitor, x1, _ground_value(flow, t1), _ground_rate(flow, t1), monitors1, monitor_rates1, work)
+    _monitor_peaks(flow, t1, monitors0, monitors1, monitor_rates0, monitor_rates1, peaks, work)
+
+
+@njit(inline="always", error_model="numpy")
+def _advance_span(m, n, modes, codes, substeps, step, propagate, chebyshev, rate, guard, force, monitor, power, motion, ints, clock, x,
+                  pending_x, pending_mode, arming, is_open, impact, running, peaks, k, t, t_end, scratch):
+    """Exact sub-steps of mode m (n guards, its arrays) from t to t_end, each through :func:`_locate_and_record`.
+
+    A full sub-step in which no guard passes the screen and no impact is
+    open takes the quiet loop's shortcut (its energy forms). Returns True
+    when it stopped at an event (now pending), False at t_end.
     ``scratch``: the work array (:func:`work_arrays`).
     """
     times, coefficients_k, harmonic = motion.times, motion.coefficients, motion.harmonic
@@ -960,11 +1163,9 @@ def _advance_span(m, n, modes, codes, substeps, step, propagate, chebyshev, rate
     spacing = (t_end - t) / n_steps
     size = x.shape[0]
     width = size + 5
-    z0, propagated, work = scratch[0, :width], scratch[1, : propagate.shape[1]], scratch[2, :size]
+    z0, propagated = scratch[0, :width], scratch[1, : propagate.shape[1]]
     values0, values1, rates0, rates1 = scratch[3, :n], scratch[4, :n], scratch[5, :n], scratch[6, :n]
     rate_work, ground1, coefficients = scratch[7, :size], scratch[8, :4], scratch[9, : chebyshev.shape[1]]
-    node, products = scratch[10, :width], scratch[11, : power.shape[1]]  # node: z = [x, a_g, 0, 0, 0, 1] at a Gauss node
-    node[size + 1], node[size + 2], node[size + 3], node[width - 1] = 0.0, 0.0, 0.0, 1.0
     x1 = propagated[:size]
     is_harmonic = harmonic.shape[0] > 0
     ground = harmonic if is_harmonic else coefficients_k[k]
@@ -975,7 +1176,7 @@ def _advance_span(m, n, modes, codes, substeps, step, propagate, chebyshev, rate
         _copy(x, z0[:size])
         _ground(times, coefficients_k, harmonic, t0, k, z0[size : size + 4])
         z0[width - 1] = 1.0
-        flow = Flow(rate, guard, force, coefficients, ground, times[k], is_harmonic, t0, 2.0 / step)
+        flow = Flow(rate, guard, force, monitor, coefficients, ground, times[k], is_harmonic, t0, 2.0 / step)
         _guards_and_rates(rate, guard, x, z0[size], z0[size + 1], values0, rates0, rate_work)
         if full:
             _product(propagate, z0, propagated)
@@ -987,46 +1188,43 @@ def _advance_span(m, n, modes, codes, substeps, step, propagate, chebyshev, rate
         if full and not _suspect(values0, values1, rates0, rates1, t1 - t0, threshold, tolerance) and not any_open:
             _sub_step_energy(z0, propagated, is_open, impact[IMPULSE], running)
             _arm_where_negative(values1, threshold, tolerance, rearmable, disarmed)
+            _product(chebyshev, z0, coefficients)
+            _sub_step_monitors(flow, t1, x, x1, peaks, scratch)
             _copy(x1, x)
             continue
         if full:
             _product(chebyshev, z0, coefficients)
-        t_event, fired = _first_crossing(flow, threshold, tolerance, rearmable, disarmed, ints, t1, values0, values1, rates0, rates1, work,
-                                         scratch[13], scratch[14], scratch[15])
-        t_stop, x_stop = t1, x1
-        if fired >= 0:
-            t_stop, x_stop = t_event, scratch[12, :size]
-            _dense(flow, t_event, x_stop)
-        if t_stop > t0:  # Recorder.on_step: energy terms and impulses at the Gauss nodes, then peak forces
-            half = 0.5 * (t_stop - t0)
-            for g in range(N_NODES):
-                t_node, weight = t0 + half * (GAUSS_NODES[g] + 1.0), half * GAUSS_WEIGHTS[g]
-                _dense(flow, t_node, node[:size])
-                node[size] = _ground_value(flow, t_node)
-                _product(power, node, products)
-                _add_forms(node, products, weight, running)
-                for p in range(is_open.shape[0]):
-                    if is_open[p]:
-                        impact[IMPULSE, p] += weight * _affine(force, p, node, 0.0)
-            _offer_peaks(force, is_open, impact, t0, x)
-            _offer_peaks(force, is_open, impact, t_stop, x_stop)
-            for p in range(is_open.shape[0]):  # a force maximum inside the step
-                if is_open[p] and _evaluate(flow, -1 - p, 0.0, t0, work) > 0.0 > _evaluate(flow, -1 - p, 0.0, t_stop, work):
-                    t_peak = _brentq(flow, -1 - p, 0.0, t0, t_stop, work)
-                    _dense(flow, t_peak, work)
-                    value = _affine(force, p, work, 0.0)
-                    if value > impact[PEAK, p]:
-                        impact[PEAK, p], impact[PEAK_TIME, p] = value, t_peak
-        if fired < 0:
-            _copy(x1, x)
-            continue
-        clock[0] = t_event
-        _copy(x_stop, pending_x)
-        _copy(modes[m], pending_mode)
-        ints[FIRED_KIND], ints[FIRED_TARGET], ints[FIRED_DIRECTION] = codes[m, KIND, fired], codes[m, TARGET, fired], codes[m, DIRECTION, fired]
-        ints[PENDING] = EVENT
-        ints[TOTAL] += 1
+        if _locate_and_record(flow, m, modes, codes, force, power, ints, clock, x, x1, pending_x, pending_mode, arming, is_open, impact,
+                              running, peaks, t1, values0, values1, rates0, rates1, scratch):
+            return True
+        _copy(x1, x)
+    return False
+
+
+@njit(inline="always", error_model="numpy")
+def _supplied_step(m, n, modes, codes, rate, guard, force, monitor, power, motion, ints, clock, x, pending_x, pending_mode, arming, is_open,
+                   impact, running, peaks, k, supplied, scratch):
+    """The supplied step of mode m (n guards, its arrays) through :func:`_locate_and_record`; x moves to its end if no event.
+
+    Returns True when it stopped at an event (now pending).
+    """
+    times, harmonic = motion.times, motion.harmonic
+    t0, t1 = supplied.bounds[0], supplied.bounds[1]
+    size = x.shape[0]
+    values0, values1, rates0, rates1 = scratch[3, :n], scratch[4, :n], scratch[5, :n], scratch[6, :n]
+    rate_work, ground0, ground1 = scratch[7, :size], scratch[8, :4], scratch[9, :4]
+    is_harmonic = harmonic.shape[0] > 0
+    ground = harmonic if is_harmonic else motion.coefficients[k]
+    flow = Flow(rate, guard, force, monitor, supplied.coefficients, ground, times[k], is_harmonic, t0, 2.0 / (t1 - t0))
+    _ground(times, motion.coefficients, harmonic, t0, k, ground0)
+    _guards_and_rates(rate, guard, x, ground0[0], ground0[1], values0, rates0, rate_work)
+    _ground(times, motion.coefficients, harmonic, t1, k, ground1)
+    _guards_and_rates(rate, guard, supplied.x, ground1[0], ground1[1], values1, rates1, rate_work)
+    if _locate_and_record(flow, m, modes, codes, force, power, ints, clock, x, supplied.x, pending_x, pending_mode, arming, is_open, impact,
+                          running, peaks, t1, values0, values1, rates0, rates1, scratch):
         return True
+    _copy(supplied.x, x)
+    clock[0] = t1
     return False
 
 
@@ -1034,22 +1232,28 @@ def _advance_span(m, n, modes, codes, substeps, step, propagate, chebyshev, rate
 
 
 @njit(cache=True, nogil=True, no_cfunc_wrapper=True, error_model="numpy", _nrt=False)
-def run_engine(table, dynamics, propagators, motion, layout, run, arming, impacts, outputs, scratch, saved, marks, events):
-    """Run (or resume) the simulation; returns FINISHED, NEED_MODE, NEED_SPACE or NEEDS_EVENTS.
+def run_engine(table, dynamics, propagators, motion, layout, run, arming, impacts, outputs, supplied, scratch, saved, marks, external):
+    """Run (or resume) the simulation; returns FINISHED, NEED_MODE, NEED_SPACE or NEED_STEP.
 
     Parameters
     ----------
     table, dynamics, propagators : ModeTable, Dynamics, Propagators
-        The modes in the slots.
+        The modes in the slots (``propagators`` unused when ``external``).
     motion, layout : Motion, Layout
         The motion and the system.
     run, arming, impacts, outputs : Run, Arming, Impacts, Outputs
         Everything the run changes, updated in place.
+    supplied : Supplied
+        The caller's next step of the flow (``external`` runs).
     scratch, saved, marks : np.ndarray
         Work arrays (:func:`work_arrays`).
-    events : bool
-        False for the Python event path: only the quiet loop runs, and
-        NEEDS_EVENTS means interval ``run.ints[K]`` has events.
+    external : bool
+        False: the flow is the exact propagators' (the quiet loop and the
+        exact sub-steps). True: the caller supplies the flow step by step
+        (an integrator's steps, ``method="ivp"``): NEED_STEP asks for the
+        step from ``run.clock[0]``, state ``run.x``, in the mode of slot
+        ``run.ints[MODE]`` inside interval ``run.ints[K]``; the caller fills
+        ``supplied``, sets ``run.ints[READY]`` and calls again.
 
     Returns
     -------
@@ -1058,19 +1262,19 @@ def run_engine(table, dynamics, propagators, motion, layout, run, arming, impact
         the impact table is full. Either way the caller fixes it and calls again.
     """
     modes, ids, codes, n_guards, substeps = table
-    rate, guard, force, power = dynamics
+    rate, guard, force, monitor, power = dynamics
     propagate, chebyshev, step = propagators
     clock, ints, x, pending_x, pending_mode, missing_mode, visited = run
     is_open, impact, impact_table = impacts
-    running, states, energy, sample_modes = outputs
+    running, states, energy, sample_modes, peaks = outputs
     times = motion.times
     last = times.shape[0] - 1
     while True:
         if ints[PENDING] != NONE:
             if ints[N_IMPACTS] + is_open.shape[0] > impact_table.shape[0]:
                 return NEED_SPACE
-            m = _settle_pending(modes, codes, n_guards, rate, guard, force, motion, layout, arming, ints, clock, pending_x,
-                                pending_mode, missing_mode, is_open, impact, impact_table, x, scratch, marks)
+            m = _settle_pending(modes, codes, n_guards, rate, guard, force, monitor, motion, layout, arming, ints, clock, pending_x,
+                                pending_mode, missing_mode, is_open, impact, impact_table, peaks, x, scratch, marks)
             if m < 0:
                 return NEED_MODE
             ints[MODE] = m
@@ -1079,20 +1283,25 @@ def run_engine(table, dynamics, propagators, motion, layout, run, arming, impact
                 _record_sample(x, running, ids[m], states, energy, sample_modes, ints[K])
             ints[PENDING] = NONE
         k, m = ints[K], ints[MODE]
-        if k < last and clock[0] == times[k]:
-            _advance_quiet(ids[m], n_guards[m], substeps[m], propagate[m], rate[m], guard[m], force[m], times, motion.forcing, ints,
-                           clock, x, arming, is_open, impact, outputs, scratch, saved)
+        if not external and k < last and clock[0] == times[k]:
+            _advance_quiet(ids[m], n_guards[m], substeps[m], step[m], propagate[m], chebyshev[m], rate[m], guard[m], force[m], monitor[m], motion,
+                           ints, clock, x, arming, is_open, impact, outputs, scratch, saved)
             k = ints[K]
         if k >= last:
             return FINISHED
-        if not events:
-            return NEEDS_EVENTS
         t, t_end = clock[0], times[k + 1]
-        if t_end - t > _EPS * (abs(t_end) if abs(t_end) > 1.0 else 1.0) and _advance_span(
-            m, n_guards[m], modes, codes, substeps[m], step[m], propagate[m], chebyshev[m], rate[m], guard[m], force[m], power[m],
-            motion, ints, clock, x, pending_x, pending_mode, arming, is_open, impact, running, k, t, t_end, scratch
-        ):
-            continue
+        if t_end - t > _EPS * (abs(t_end) if abs(t_end) > 1.0 else 1.0):
+            if external:
+                if ints[READY] == 0:
+                    return NEED_STEP
+                ints[READY] = 0
+                if _supplied_step(m, n_guards[m], modes, codes, rate[m], guard[m], force[m], monitor[m], power[m], motion, ints, clock, x,
+                                  pending_x, pending_mode, arming, is_open, impact, running, peaks, k, supplied, scratch) or clock[0] < t_end:
+                    continue
+            elif _advance_span(m, n_guards[m], modes, codes, substeps[m], step[m], propagate[m], chebyshev[m], rate[m], guard[m], force[m],
+                               monitor[m], power[m], motion, ints, clock, x, pending_x, pending_mode, arming, is_open, impact, running, peaks,
+                               k, t, t_end, scratch):
+                continue
         clock[0] = t_end
         ints[K] = k + 1
         _record_sample(x, running, ids[m], states, energy, sample_modes, k + 1)
@@ -1109,12 +1318,17 @@ A ``NUMBA_OPT`` set in the environment is left in force.
 """
 
 
+_COMPILED: list[bool] = []
+
+
 def run(*arguments: object) -> int:
     """Call :func:`run_engine`: a process's first call compiles it (or loads it from numba's cache) at :data:`OPTIMISATION_LEVEL`."""
-    if run_engine.signatures or "NUMBA_OPT" in os.environ:
+    if _COMPILED or numba.config.DISABLE_JIT or "NUMBA_OPT" in os.environ:
         return run_engine(*arguments)
     with _optimisation_level(OPTIMISATION_LEVEL):
-        return run_engine(*arguments)
+        status = run_engine(*arguments)
+    _COMPILED.append(True)
+    return status
 
 
 @contextlib.contextmanager

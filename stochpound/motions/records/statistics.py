@@ -2,7 +2,7 @@
 
 * population moments (ddof = 0);
 * skewness = m3 / m2^1.5, excess = m4 / m2² − 3 (the study's "coefficient of excess");
-* peak = max |a|, in g;
+* peak = max abs(a), in g;
 * Arias intensity I_A = π / (2 g) ∫ a(t)² dt, with a(t) interpolated linearly
   between samples (the first-order hold the solvers use), so that the integral
   over each step is dt (a_k² + a_k a_{k+1} + a_{k+1}²) / 3.
@@ -15,7 +15,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from stochpound.analysis import kernels
-from stochpound.records.record import Record
+from stochpound.motions.records.record import Record
 
 #: The reference study's g, m/s².
 STUDY_G = 9.814
@@ -34,7 +34,7 @@ class RecordStatistics:
     duration : float
         Time of the last sample, (npts − 1)·dt, s.
     peak_g : float
-        max |a| / g.
+        max abs(a) / g.
     mean, std : float
         Population mean and standard deviation, m/s².
     skewness, excess : float

@@ -1,0 +1,11 @@
+"""The physical model: buildings, the laws of their bases and contacts, the scene, and the system and modes they make.
+
+One module per concept: :mod:`~stochpound.model.building` (shear buildings),
+:mod:`~stochpound.model.friction` (sliding bases), :mod:`~stochpound.model.contact`
+(impact elements), :mod:`~stochpound.model.scene` and
+:mod:`~stochpound.model.scene_file` (a scene and its TOML file),
+:mod:`~stochpound.model.system` (global matrices), :mod:`~stochpound.model.modes`
+(the linear modes of the hybrid system and their guards),
+:mod:`~stochpound.model.guards` (event kinds) and
+:mod:`~stochpound.model.modal_solution` (a closed-form reference).
+"""

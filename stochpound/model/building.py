@@ -1,0 +1,198 @@
+"""Shear buildings: lumped floor masses joined by storey springs and dashpots.
+
+Scene keys (``[[building]]``): ``name``, ``mass`` (kg per floor, floor 1
+upwards), ``stiffness`` (N/m per storey), ``damping`` (N·s/m per storey) or
+``damping_ratio`` (stiffness-proportional damping C = a₁K with that ratio
+in mode 1), ``base`` (a sliding base, :mod:`stochpound.model.friction`;
+none: a fixed base), ``initial`` (initial conditions) and ``storey_height``
+(m per storey, optional: storey drift ratios). Storey i joins
+floor i − 1 (floor 0 is the base) to floor i.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any, Mapping
+
+import numpy as np
+from scipy.linalg import eigh
+
+from stochpound.errors import SceneError
+from stochpound.model import fields
+from stochpound.model.friction import Base, base_from_table
+
+BUILDING_KEYS = {"name", "mass", "stiffness", "damping", "damping_ratio", "base", "initial", "storey_height"}
+INITIAL_KEYS = {"displacement", "velocity", "base_displacement", "base_velocity"}
+
+
+@dataclass(frozen=True)
+class InitialState:
+    """Initial conditions of one building (all zero by default).
+
+    Attributes
+    ----------
+    displacement, velocity : tuple of float
+        Floor displacements u (m) and velocities (m/s) relative to the base.
+    base_displacement, base_velocity : float
+        Sliding displacement s (m) and velocity (m/s) of the base; only for
+        a sliding base.
+    """
+
+    displacement: tuple[float, ...]
+    velocity: tuple[float, ...]
+    base_displacement: float = 0.0
+    base_velocity: float = 0.0
+
+
+@dataclass(frozen=True)
+class Building:
+    """A shear building: lumped floor masses joined by storey springs and dashpots.
+
+    Attributes
+    ----------
+    name : str
+        Unique name of the building in its scene.
+    mass : tuple of float
+        Floor masses m_i, kg, floor 1 (lowest) upwards.
+    stiffness : tuple of float
+        Storey stiffnesses k_i, N/m; storey i joins floor i-1 (the base) to floor i.
+    damping : tuple of float
+        Storey dashpots c_i, N·s/m (derived from ``damping_ratio`` when that is given).
+    damping_ratio : float or None
+        Mode-1 damping ratio of a stiffness-proportional damping C = a1·K,
+        when the damping was specified that way.
+    base : Base or None
+        The sliding base; ``None`` for a fixed base (the one encoding of a fixed base).
+    initial : InitialState
+        Initial conditions.
+    storey_height : tuple of float or None
+        Storey heights h_i, m (for storey drift ratios), when given.
+    """
+
+    name: str
+    mass: tuple[float, ...]
+    stiffness: tuple[float, ...]
+    damping: tuple[float, ...]
+    damping_ratio: float | None = None
+    base: Base | None = None
+    initial: InitialState | None = None
+    storey_height: tuple[float, ...] | None = None
+
+    @property
+    def n_floors(self) -> int:
+        """Number of floors (storeys)."""
+        return len(self.mass)
+
+    @property
+    def isolated(self) -> bool:
+        """True when the building stands on a sliding base."""
+        return self.base is not None
+
+    @property
+    def total_mass(self) -> float:
+        """Mass of the floors plus the base, kg."""
+        return float(sum(self.mass)) + (self.base.mass if self.base else 0.0)
+
+
+def storey_matrix(storey_values: np.ndarray) -> np.ndarray:
+    """Tridiagonal shear-building matrix (stiffness or damping) from storey values.
+
+    Storey i joins floor i-1 to floor i; floor 0 is the base.
+    """
+    n = len(storey_values)
+    matrix = np.zeros((n, n))
+    for i, value in enumerate(storey_values):
+        matrix[i, i] += value
+        if i > 0:
+            matrix[i - 1, i - 1] += value
+            matrix[i - 1, i] -= value
+            matrix[i, i - 1] -= value
+    return matrix
+
+
+def fixed_base_frequencies(mass: np.ndarray, stiffness: np.ndarray) -> np.ndarray:
+    """Natural circular frequencies (rad/s, ascending) of the fixed-base building."""
+    eigenvalues = eigh(storey_matrix(np.asarray(stiffness, float)), np.diag(mass), eigvals_only=True)
+    return np.sqrt(np.clip(eigenvalues, 0.0, None))
+
+
+def stiffness_proportional_damping(mass: np.ndarray, stiffness: np.ndarray, ratio: float) -> np.ndarray:
+    """Storey dashpots of C = a1·K with damping ``ratio`` in mode 1 (a1 = 2ζ1/ω1), N·s/m."""
+    omega_1 = fixed_base_frequencies(mass, stiffness)[0]
+    return 2.0 * ratio / omega_1 * np.asarray(stiffness, float)
+
+
+# ---------------------------------------------------------------- scene file
+
+
+def buildings_from_tables(tables: list[Mapping[str, Any]]) -> list[Building]:
+    """The ``[[building]]`` tables of a scene file, validated (names unique)."""
+    if not tables:
+        raise SceneError("building: at least one [[building]] is required")
+    buildings = [building_from_table(table, f"building[{i}]", i) for i, table in enumerate(tables)]
+    names = [b.name for b in buildings]
+    for i, name in enumerate(names):
+        if names.index(name) != i:
+            raise SceneError(f"building[{i}].name: must be unique, {name!r} is used twice")
+    return buildings
+
+
+def building_from_table(table: Mapping[str, Any], prefix: str, index: int) -> Building:
+    """One ``[[building]]`` table (at ``prefix``, the ``index``-th: default name B{index + 1}), validated."""
+    fields.reject_unknown(table, BUILDING_KEYS, prefix)
+    name = fields.string(table, "name", prefix, default=f"B{index + 1}")
+    base = base_from_table(fields.table(table, "base", prefix), f"{prefix}.base")
+    mass = fields.number_list(table, "mass", prefix, low=0.0, low_open=True)
+    if not mass and base is None:
+        raise SceneError(f"{prefix}.mass: must have at least one floor (only a sliding base may carry no floors)")
+    stiffness = fields.number_list(table, "stiffness", prefix, low=0.0, low_open=False, length=len(mass))
+    damping, ratio = _storey_damping(table, prefix, np.array(mass), np.array(stiffness))
+    initial = _initial(fields.table(table, "initial", prefix), f"{prefix}.initial", len(mass), base is not None)
+    height = fields.number_list(table, "storey_height", prefix, low=0.0, low_open=True, length=len(mass)) if "storey_height" in table else None
+    return Building(name, mass, stiffness, damping, ratio, base, initial, height)
+
+
+def _storey_damping(table: Mapping[str, Any], prefix: str, mass: np.ndarray, stiffness: np.ndarray) -> tuple[tuple[float, ...], float | None]:
+    if "damping" in table and "damping_ratio" in table:
+        raise SceneError(f"{prefix}.damping: give either damping (N·s/m per storey) or damping_ratio, not both")
+    if "damping_ratio" in table:
+        ratio = fields.number(table, "damping_ratio", prefix, low=0.0, high=1.0, high_open=True)
+        if len(mass) == 0 or np.any(stiffness <= 0.0):
+            raise SceneError(f"{prefix}.damping_ratio: needs every storey stiffness > 0 (mode 1 must have a frequency); give damping instead")
+        return tuple(stiffness_proportional_damping(mass, stiffness, ratio)), ratio
+    if "damping" in table:
+        return fields.number_list(table, "damping", prefix, low=0.0, low_open=False, length=len(mass)), None
+    return tuple(0.0 for _ in mass), None
+
+
+def _initial(table: Mapping[str, Any] | None, prefix: str, n_floors: int, has_base: bool) -> InitialState:
+    zeros = tuple(0.0 for _ in range(n_floors))
+    if table is None:
+        return InitialState(zeros, zeros)
+    fields.reject_unknown(table, INITIAL_KEYS, prefix)
+    for key in ("base_displacement", "base_velocity"):
+        if key in table and not has_base:
+            raise SceneError(f"{prefix}.{key}: only a building with a sliding [building.base] can have it")
+    displacement = fields.number_list(table, "displacement", prefix, low=-math.inf, low_open=False, length=n_floors) if "displacement" in table else zeros
+    velocity = fields.number_list(table, "velocity", prefix, low=-math.inf, low_open=False, length=n_floors) if "velocity" in table else zeros
+    return InitialState(
+        displacement,
+        velocity,
+        fields.number(table, "base_displacement", prefix, default=0.0),
+        fields.number(table, "base_velocity", prefix, default=0.0),
+    )
+
+
+def scale_masses(table: dict[str, Any], factor: float) -> None:
+    """Multiply a ``[[building]]`` table's floor and base masses by ``factor`` in place, keeping its modal damping ratios.
+
+    Storey dashpots given as ``damping`` are multiplied by √factor (M → fM
+    with K fixed scales every frequency by 1/√f, so C → √f C keeps every
+    modal damping ratio); a ``damping_ratio`` is kept as it is.
+    """
+    table["mass"] = [float(m) * factor for m in table["mass"]]
+    if isinstance(table.get("base"), dict) and "mass" in table["base"]:
+        table["base"]["mass"] = float(table["base"]["mass"]) * factor
+    if "damping" in table:
+        table["damping"] = [float(c) * math.sqrt(factor) for c in table["damping"]]

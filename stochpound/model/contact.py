@@ -1,0 +1,227 @@
+"""The linear Kelvin–Voigt impact element between neighbouring floors (the reference study's contact law).
+
+Scene keys (``[[contact]]``): ``between`` ([[left building, floor], [right
+building, floor]], neighbours, the left one first), ``gap`` (m, ≥ 0; ``inf``:
+the contact never closes, and a run still records its closure),
+``stiffness`` (k, N/m), ``restitution`` (r ∈ (0, 1]) or ``damping`` (c,
+N·s/m), ``tensile`` (default true).
+
+The law (docs/model.md, "Impact elements"). With the penetration
+δ = y_left − y_right − d (d the gap), the element's force while closed is
+
+    F = k δ + c δ̇,    c = 2 ξ √(k m_eff),  ξ = −ln r / √(π² + ln² r),
+
+m_eff = m₁m₂/(m₁ + m₂) of the two floor masses; F pushes the left floor
+left and the right floor right. A tensile element separates when δ returns
+to 0 (it may pull just before); a non-tensile one when F returns to 0, and
+then closes again only when its trial force k δ + c δ̇ turns positive while
+it is still penetrated.
+
+In a mode in which the contact is closed it adds h k gᵀ to the stiffness,
+h c gᵀ to the damping and h k d to the constant load, where δ = g·q − d and
+the generalised load of F is −F h (h = g without base entries in the
+study's ``study_compat`` model). Guards: ``CLOSE`` (δ crosses 0 upwards),
+``RECLOSE`` (non-tensile: trial force crosses 0 upwards while δ > 0) and
+``OPEN`` (δ or F crosses 0 downwards). Power: F (h · v). The law is
+piecewise linear (the exact solver takes it).
+
+Mass scaling (experiment variants): k is multiplied by m_eff,new/m_eff,old,
+which keeps the contact's frequency √(k/m_eff); c follows from r, or (given
+as ``damping``) is multiplied by the same ratio, which keeps its damping ratio.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any, Mapping, Sequence
+
+import numpy as np
+
+from stochpound.errors import SceneError
+from stochpound.model import fields
+from stochpound.model.building import Building
+from stochpound.model.guards import Guard
+
+ELEMENT_KEYS = {"stiffness", "restitution", "damping", "tensile"}
+"""The keys of the Kelvin–Voigt element itself, in a ``[[contact]]`` or a ``[[wall]]`` table."""
+CONTACT_KEYS = {"between", "gap"} | ELEMENT_KEYS
+PIECEWISE_LINEAR = True
+"""The Kelvin–Voigt element keeps every mode linear (the exact solver applies)."""
+
+
+@dataclass(frozen=True)
+class Contact:
+    """A linear Kelvin–Voigt impact element between neighbouring floors.
+
+    Attributes
+    ----------
+    left, right : int
+        Indices (0-based, in the scene's building list) of the left building
+        and its right-hand neighbour (``right == left + 1``).
+    left_floor, right_floor : int
+        Floors (1-based) that can collide.
+    gap : float
+        At-rest gap d, m (>= 0; inf: the contact never closes). Penetration is δ = y_left − y_right − d.
+    stiffness : float
+        Impact spring k_imp, N/m (> 0).
+    damping : float
+        Impact dashpot c_imp, N·s/m (>= 0); derived from ``restitution`` when given.
+    restitution : float or None
+        Coefficient of restitution r in (0, 1] the damping was derived from.
+    tensile : bool
+        True: the element separates when δ returns to 0 and may pull just
+        before (the study's choice). False: it separates when its force
+        returns to 0 and never pulls.
+    """
+
+    left: int
+    left_floor: int
+    right: int
+    right_floor: int
+    gap: float
+    stiffness: float
+    damping: float
+    restitution: float | None = None
+    tensile: bool = True
+
+
+def restitution_damping_ratio(restitution: float) -> float:
+    """Damping ratio ξ of a Kelvin–Voigt element with coefficient of restitution r.
+
+    ξ = −ln r / sqrt(π² + (ln r)²) (Anagnostopoulos 1988); ξ = 0 for r = 1.
+    """
+    log_r = math.log(restitution)
+    return -log_r / math.sqrt(math.pi**2 + log_r**2)
+
+
+def effective_mass(mass_1: float, mass_2: float) -> float:
+    """m_eff = m1 m2 / (m1 + m2), kg."""
+    return mass_1 * mass_2 / (mass_1 + mass_2)
+
+
+# ---------------------------------------------------------------- scene file
+
+
+def contact_from_table(table: Mapping[str, Any], prefix: str, buildings: Sequence[Building]) -> Contact:
+    """One ``[[contact]]`` table (at ``prefix``) between ``buildings``, validated."""
+    fields.reject_unknown(table, CONTACT_KEYS, prefix)
+    between = table.get("between")
+    if not isinstance(between, list) or len(between) != 2:
+        raise SceneError(f"{prefix}.between: must be [[left building, floor], [right building, floor]], got {between!r}")
+    left, left_floor = _contact_end(between[0], f"{prefix}.between[0]", buildings)
+    right, right_floor = _contact_end(between[1], f"{prefix}.between[1]", buildings)
+    if right != left + 1:
+        raise SceneError(
+            f"{prefix}.between: contacts join neighbours, left building first; "
+            f"{buildings[left].name!r} and {buildings[right].name!r} are not left/right neighbours"
+        )
+    gap = fields.number(table, "gap", prefix, required=True, low=0.0, allow_inf=True)
+    mass = effective_mass(buildings[left].mass[left_floor - 1], buildings[right].mass[right_floor - 1])
+    return Contact(left, left_floor, right, right_floor, gap, *element_from_table(table, prefix, mass))
+
+
+def element_from_table(table: Mapping[str, Any], prefix: str, mass: float) -> tuple[float, float, float | None, bool]:
+    """The Kelvin–Voigt element of a ``[[contact]]`` or ``[[wall]]`` table: (stiffness N/m, damping N·s/m, restitution or None, tensile).
+
+    ``mass`` is the effective mass m_eff of the collision (kg) that turns a
+    restitution into a dashpot.
+    """
+    stiffness = fields.number(table, "stiffness", prefix, required=True, low=0.0, low_open=True)
+    restitution = None
+    if "restitution" in table and "damping" in table:
+        raise SceneError(f"{prefix}.damping: give either restitution or damping, not both")
+    if "damping" in table:
+        damping = fields.number(table, "damping", prefix, low=0.0)
+    else:
+        restitution = fields.number(table, "restitution", prefix, required=True, low=0.0, low_open=True, high=1.0)
+        damping = 2.0 * restitution_damping_ratio(restitution) * math.sqrt(stiffness * mass)
+    tensile = fields.boolean(table, "tensile", prefix, default=True)
+    return stiffness, damping, restitution, tensile
+
+
+def _contact_end(value: Any, path: str, buildings: Sequence[Building]) -> tuple[int, int]:
+    names = [b.name for b in buildings]
+    if not (isinstance(value, list) and len(value) == 2 and isinstance(value[0], str) and isinstance(value[1], int) and not isinstance(value[1], bool)):
+        raise SceneError(f"{path}: must be [building name, floor number], got {value!r}")
+    name, floor = value
+    if name not in names:
+        raise SceneError(f"{path}: unknown building {name!r} (buildings: {', '.join(names)})")
+    index = names.index(name)
+    n_floors = buildings[index].n_floors
+    if not 1 <= floor <= n_floors:
+        raise SceneError(f"{path}: floor must be in 1..{n_floors} for building {name!r}, got {floor}")
+    return index, floor
+
+
+def rescale_table(table: dict[str, Any], mass_ratio: float) -> None:
+    """Rescale a ``[[contact]]`` table in place after its floors' m_eff changed by ``mass_ratio`` (new/old).
+
+    k × ratio keeps √(k/m_eff); a given ``damping`` × ratio keeps its damping
+    ratio (a ``restitution`` recomputes c by itself).
+    """
+    table["stiffness"] = float(table["stiffness"]) * mass_ratio
+    if "damping" in table:
+        table["damping"] = float(table["damping"]) * mass_ratio
+
+
+# ---------------------------------------------------------------- modes
+
+
+@dataclass(frozen=True)
+class ContactRows:
+    """Every contact's penetration row [g, 0] and force row [k g, c g] over the state x = [q, v] (n_contacts × 2N)."""
+
+    penetration: np.ndarray
+    force: np.ndarray
+
+
+def contact_rows(geometry: np.ndarray, stiffness: np.ndarray, damping: np.ndarray) -> ContactRows:
+    """The rows of every contact (``geometry``: g as rows; ``stiffness``, ``damping``: k, c per contact), shared by all modes."""
+    zeros = np.zeros_like(geometry)
+    return ContactRows(np.hstack([geometry, zeros]), np.hstack([stiffness[:, None] * geometry, damping[:, None] * geometry]))
+
+
+def closed_terms(geometry: np.ndarray, load: np.ndarray, stiffness: np.ndarray, damping: np.ndarray, gap: np.ndarray,
+                 closed: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """What the ``closed`` contacts add to a mode: stiffness h k gᵀ (N/m), damping h c gᵀ (N·s/m) and constant load h k d (N).
+
+    ``geometry`` and ``load`` hold g and h as rows (n_contacts × N).
+    """
+    g, h = geometry[closed], load[closed]
+    return (h.T * stiffness[closed]) @ g, (h.T * damping[closed]) @ g, h.T @ (stiffness[closed] * gap[closed])
+
+
+def force_rows(rows: ContactRows, stiffness: np.ndarray, gap: np.ndarray, closed: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Contact forces F = matrix · x + constant (N) in a mode: k δ + c δ̇ for closed contacts, 0 for open ones."""
+    matrix = np.zeros_like(rows.force)
+    matrix[closed] = rows.force[closed]
+    constant = np.zeros(len(gap))
+    constant[closed] = -stiffness[closed] * gap[closed]
+    return matrix, constant
+
+
+def guards(rows: ContactRows, stiffness: np.ndarray, gap: np.ndarray, tensile: np.ndarray, closed: np.ndarray) -> tuple[np.ndarray, ...]:
+    """Every contact's guards in a mode, in contact order: CLOSE (and RECLOSE if non-tensile) of open contacts, OPEN of closed ones.
+
+    Returns
+    -------
+    matrix, ground, constant, kind, target, direction : np.ndarray
+        Guard rows over x (none depends on a_g), their constants, kinds
+        (:class:`~stochpound.model.guards.Guard`), contacts, and 0 directions.
+    """
+    # a contact with an infinite gap never closes: it has no guard (its closure is still monitored)
+    guarded = np.flatnonzero(closed | np.isfinite(gap))
+    closed, tensile, gap, stiffness = closed[guarded], tensile[guarded], gap[guarded], stiffness[guarded]
+    penetration, force = rows.penetration[guarded], rows.force[guarded]
+    # first guard of each contact: CLOSE when open; OPEN (on δ when tensile, on F when not) when closed
+    first = np.where(closed[:, None], -np.where(tensile[:, None], penetration, force), penetration)
+    first_constant = np.where(closed, np.where(tensile, gap, stiffness * gap), -gap)
+    first_kind = np.where(closed, Guard.OPEN, Guard.CLOSE)
+    reclose = np.flatnonzero(~closed & ~tensile)
+    order = np.argsort(np.concatenate([2 * np.arange(len(guarded)), 2 * reclose + 1]), kind="stable")
+    matrix = np.concatenate([first, force[reclose]])[order]
+    constant = np.concatenate([first_constant, -stiffness[reclose] * gap[reclose]])[order]
+    kind = np.concatenate([first_kind, np.full(len(reclose), Guard.RECLOSE)])[order]
+    target = np.concatenate([guarded, guarded[reclose]])[order]
+    return matrix.reshape(len(order), rows.penetration.shape[1]), np.zeros(len(order)), constant, kind.astype(int), target, np.zeros(len(order), int)

@@ -1,0 +1,269 @@
+"""Modes of the hybrid system and their linear dynamics and guards (docs/model.md, "Modes and events").
+
+A mode fixes which contacts are closed and, for every sliding base, whether it
+sticks, slips right, slips left or is free (frictionless). Inside a mode the
+state x = [q, v] obeys the linear time-invariant equation
+
+    ẋ = A x + B a_g(t) + c
+
+and every event is the upward zero crossing of a guard that is affine in x
+and a_g:
+
+    guard_j(t) = G_j · x + h_j a_g(t) + g0_j      (fires when it becomes > 0)
+
+A mode is assembled from the system's linear part and the contributions of
+the laws (:mod:`stochpound.model.contact`, :mod:`stochpound.model.friction`):
+their terms of the mode's matrices, their guards and their force read-outs.
+Matrices are built lazily, only for the modes a run visits, and cached per
+system within a memory budget (:class:`ModeLibrary`), so a contact that never
+closes or a base that never slips costs nothing.
+"""
+
+from __future__ import annotations
+
+from collections import OrderedDict
+from collections.abc import Callable
+from dataclasses import dataclass, fields
+from typing import Generic, TypeVar
+
+import numpy as np
+
+from stochpound.model import contact, friction
+from stochpound.model.demands import DEMANDS, demand_rows
+from stochpound.model.friction import STUCK
+from stochpound.model.system import System
+
+MODE_BUDGET = 256 * 2**20
+"""Largest size of the cached :class:`ModeDynamics` of one system, bytes (large scenes visit thousands of modes)."""
+
+Key = TypeVar("Key")
+Value = TypeVar("Value")
+
+
+@dataclass(frozen=True)
+class Mode:
+    """Discrete state: ``closed[p]`` per contact, ``base[i]`` (STUCK, ±1 or FREE) per sliding base (``System.bases``)."""
+
+    closed: tuple[bool, ...]
+    base: tuple[int, ...]
+
+    def with_contact(self, p: int, closed: bool) -> "Mode":
+        """The same mode with contact p opened or closed."""
+        flags = list(self.closed)
+        flags[p] = closed
+        return Mode(tuple(flags), self.base)
+
+    def with_base(self, b: int, state: int) -> "Mode":
+        """The same mode with sliding base b in ``state``."""
+        states = list(self.base)
+        states[b] = state
+        return Mode(self.closed, tuple(states))
+
+
+@dataclass(frozen=True)
+class ModeDynamics:
+    """Linear dynamics, guards and force read-outs of one mode.
+
+    Attributes
+    ----------
+    mode : Mode
+    A, B, c : np.ndarray
+        ẋ = A x + B a_g + c.
+    guard_matrix, guard_ground, guard_constant : np.ndarray
+        G (n_guards × 2N), h, g0 of every guard of this mode.
+    guard_kind, guard_target, guard_direction : np.ndarray of int
+        Guard kind (:class:`~stochpound.model.guards.Guard`), its contact or
+        sliding base, and the slip direction of a SLIP guard (0 otherwise).
+    force_matrix, force_constant : np.ndarray
+        Contact forces F = force_matrix · x + force_constant, N (rows of open contacts are 0).
+    friction_matrix, friction_ground, friction_constant : np.ndarray
+        Force of the foundation on each sliding base, N, positive to the right
+        (−F_req when stuck, −σ μ W when slipping, 0 for a free base).
+    monitor_matrix, monitor_ground, monitor_constant : np.ndarray
+        The monitors (:func:`monitor_rows`): read-outs whose largest value over
+        a run is located on the solution.
+    stuck_dofs : np.ndarray of int
+        DOFs held fixed in this mode (stuck bases); s and ṡ are re-imposed on them.
+    """
+
+    mode: Mode
+    A: np.ndarray
+    B: np.ndarray
+    c: np.ndarray
+    guard_matrix: np.ndarray
+    guard_ground: np.ndarray
+    guard_constant: np.ndarray
+    guard_kind: np.ndarray
+    guard_target: np.ndarray
+    guard_direction: np.ndarray
+    force_matrix: np.ndarray
+    force_constant: np.ndarray
+    friction_matrix: np.ndarray
+    friction_ground: np.ndarray
+    friction_constant: np.ndarray
+    monitor_matrix: np.ndarray
+    monitor_ground: np.ndarray
+    monitor_constant: np.ndarray
+    stuck_dofs: np.ndarray
+
+    def rate(self, x: np.ndarray, ground: float) -> np.ndarray:
+        """ẋ at state x and ground acceleration ``ground`` (m/s²)."""
+        return self.A @ x + self.B * ground + self.c
+
+    def guards(self, x: np.ndarray, ground: float) -> np.ndarray:
+        """Guard values at state x and ground acceleration."""
+        return self.guard_matrix @ x + self.guard_ground * ground + self.guard_constant
+
+
+class BoundedCache(Generic[Key, Value]):
+    """Least recently used cache holding at most ``budget`` bytes of values (and at least one value).
+
+    Parameters
+    ----------
+    budget : int
+        Largest total size of the cached values, bytes.
+    size : callable
+        Size of a value, bytes.
+    """
+
+    def __init__(self, budget: int, size: Callable[[Value], int]) -> None:
+        self._budget = budget
+        self._size = size
+        self._items: OrderedDict[Key, tuple[Value, int]] = OrderedDict()
+        self._bytes = 0
+
+    def get(self, key: Key) -> Value | None:
+        """The cached value of ``key`` (now the most recently used), or None."""
+        item = self._items.get(key)
+        if item is None:
+            return None
+        self._items.move_to_end(key)
+        return item[0]
+
+    def put(self, key: Key, value: Value) -> None:
+        """Cache ``value``, dropping the least recently used values beyond the budget."""
+        size = self._size(value)
+        self._items[key] = (value, size)
+        self._bytes += size
+        while self._bytes > self._budget and len(self._items) > 1:
+            _, (_, dropped) = self._items.popitem(last=False)
+            self._bytes -= dropped
+
+
+def array_bytes(value: object) -> int:
+    """Total size of the numpy arrays among the fields of a dataclass instance, bytes."""
+    return sum(getattr(value, f.name).nbytes for f in fields(value) if isinstance(getattr(value, f.name), np.ndarray))
+
+
+class ModeLibrary:
+    """Lazily built :class:`ModeDynamics` of one :class:`System`, cached within :data:`MODE_BUDGET`.
+
+    Dynamics dropped from the cache are rebuilt when asked for again;
+    ``len`` counts the distinct modes built.
+    """
+
+    def __init__(self, system: System) -> None:
+        self.system = system
+        self._cache: BoundedCache[Mode, ModeDynamics] = BoundedCache(MODE_BUDGET, array_bytes)
+        self._built: set[Mode] = set()
+        self._inverse_mass: dict[tuple[int, ...], np.ndarray] = {}
+        self._contact_rows = contact.contact_rows(system.element_geometry, system.element_stiffness, system.element_damping)
+
+    def __getitem__(self, mode: Mode) -> ModeDynamics:
+        dynamics = self._cache.get(mode)
+        if dynamics is None:
+            dynamics = _build(self.system, mode, self._free_inverse_mass(mode), self._contact_rows)
+            self._cache.put(mode, dynamics)
+            self._built.add(mode)
+        return dynamics
+
+    def __len__(self) -> int:
+        return len(self._built)
+
+    def _free_inverse_mass(self, mode: Mode) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Stuck DOFs, free DOFs and the inverse of the free DOFs' mass matrix of ``mode``."""
+        system = self.system
+        stuck = np.array([base.dof for base, state in zip(system.bases, mode.base) if state == STUCK], dtype=int)
+        free = np.setdiff1d(np.arange(system.n_dof), stuck)
+        key = tuple(stuck)
+        inverse = self._inverse_mass.get(key)
+        if inverse is None:
+            inverse = self._inverse_mass[key] = np.linalg.inv(system.mass[np.ix_(free, free)])
+        return stuck, free, inverse
+
+
+def _build(system: System, mode: Mode, masses: tuple[np.ndarray, np.ndarray, np.ndarray], rows: contact.ContactRows) -> ModeDynamics:
+    """The dynamics of ``mode`` from its stuck and free DOFs and free mass inverse (``masses``)."""
+    n = system.n_dof
+    stuck, free, inverse_mass = masses
+    closed = np.array(mode.closed, bool)
+    k, c_imp, d = system.element_stiffness, system.element_damping, system.element_gap
+    extra_stiffness, extra_damping, load = contact.closed_terms(system.element_geometry, system.element_load, k, c_imp, d, closed)
+    stiffness, damping = system.stiffness + extra_stiffness, system.damping + extra_damping
+    for base, state in zip(system.bases, mode.base):
+        load[base.dof] += friction.slip_force(base, state)
+    A = np.zeros((2 * n, 2 * n))
+    A[free, n + free] = 1.0
+    A[n + free, :n] = -inverse_mass @ stiffness[free]
+    A[n + free, n:] = -inverse_mass @ damping[free]
+    B = np.zeros(2 * n)
+    B[n + free] = -inverse_mass @ system.influence[free]
+    c = np.zeros(2 * n)
+    c[n + free] = inverse_mass @ load[free]
+    foundation = [
+        friction.stuck_foundation_force(base.dof, system.mass, stiffness, damping, load, system.influence, (A, B, c), free)
+        if state == STUCK else (np.zeros(2 * n), 0.0, friction.slip_force(base, state))
+        for base, state in zip(system.bases, mode.base)
+    ]
+    contact_guards = contact.guards(rows, k, d, system.element_tensile, closed)
+    base_guards = [guard for i, (base, state) in enumerate(zip(system.bases, mode.base))
+                   for guard in friction.guards(base, i, state, foundation[i], n)]
+    force_matrix, force_constant = contact.force_rows(rows, k, d, closed)
+    return ModeDynamics(mode, A, B, c, *_stack_guards(contact_guards, base_guards, 2 * n), force_matrix, force_constant,
+                        *_stack_foundation(foundation, 2 * n), *monitor_rows(system, rows, (A, B, c)), stuck)
+
+
+def monitor_count(system: System) -> int:
+    """Number of monitors of every mode of ``system`` (:func:`monitor_rows`)."""
+    return system.n_elements + (2 * len(DEMANDS) * len(system.total_displacement) if system.demands else 0)
+
+
+def monitor_rows(system: System, rows: contact.ContactRows, rate: tuple[np.ndarray, np.ndarray, np.ndarray]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The monitors of a mode as an affine map (matrix over x, a_g coefficients, constants).
+
+    First each impact element's closure y_left − y_right = g_p · q (m, the
+    penetration plus the gap): its largest value over a run, located on the
+    solution, is the separation the run needed (``peak_contact_closure``).
+    Then, when the system monitors demands, + and − every demand parameter of
+    :func:`stochpound.model.demands.demand_rows` (whose peaks give the peak
+    absolute values). ``rate`` is the mode's (A, B, c).
+    """
+    n_closures = len(rows.penetration)
+    matrix, ground, constant = rows.penetration, np.zeros(n_closures), np.zeros(n_closures)
+    if not system.demands:
+        return matrix, ground, constant
+    demand = demand_rows(system.floor_dofs, system.building_base_dofs, system.storey_stiffness, system.storey_damping, rate)
+    return (np.vstack([matrix, demand[0], -demand[0]]), np.concatenate([ground, demand[1], -demand[1]]),
+            np.concatenate([constant, demand[2], -demand[2]]))
+
+
+def _stack_guards(contact_guards: tuple[np.ndarray, ...], base_guards: list[tuple], size: int) -> tuple[np.ndarray, ...]:
+    """The guard arrays of a mode: the contacts' (in contact order), then the bases' rows (row, a_g, constant, kind, target, direction)."""
+    columns = list(zip(*base_guards)) if base_guards else [[] for _ in range(6)]
+    base_arrays = (np.array(columns[0], float).reshape(len(base_guards), size), *(np.array(column, dtype) for column, dtype in
+                                                                                  zip(columns[1:], (float, float, int, int, int))))
+    return tuple(np.concatenate([a, b]) for a, b in zip(contact_guards, base_arrays, strict=True))
+
+
+def _stack_foundation(foundation: list[tuple[np.ndarray, float, float]], size: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The foundation-force maps of the sliding bases as (matrix, a_g coefficients, constants)."""
+    if not foundation:
+        return np.zeros((0, size)), np.zeros(0), np.zeros(0)
+    rows, ground, constant = zip(*foundation)
+    return np.array(rows), np.array(ground, float), np.array(constant, float)
+
+
+def initial_mode(system: System) -> Mode:
+    """Mode before settling at t = 0: contacts open, bases stuck, free or sliding as x(0) says."""
+    states = tuple(friction.initial_state(base, system.initial_state[system.n_dof + base.dof]) for base in system.bases)
+    return Mode(tuple(False for _ in range(system.n_elements)), states)

@@ -1,0 +1,185 @@
+"""Scene files (TOML, docs/scene-files.md): parsing and validation into a :class:`~stochpound.model.scene.Scene`.
+
+Every field is checked before anything is computed. A bad field raises
+:class:`~stochpound.errors.SceneError` whose message starts with the field's
+path (0-based indices), e.g. ``building[0].base.mu: must be >= 0, got -0.2``.
+"""
+
+from __future__ import annotations
+
+import inspect
+import math
+import tomllib
+from pathlib import Path
+from typing import Any, Mapping
+
+import numpy as np
+
+from stochpound.errors import RecordError, SceneError
+from stochpound.model import fields
+from stochpound.model.building import buildings_from_tables
+from stochpound.model.contact import contact_from_table
+from stochpound.model.scene import Scene
+from stochpound.model.wall import walls_from_tables
+from stochpound.motions.ground import GroundMotion, HarmonicMotion, SampledMotion
+
+_TOP_KEYS = {"g", "study_compat", "building", "contact", "wall", "motion"}
+_SYNTHETIC_TYPES = {"kanai_tajimi", "clough_penzien"}
+
+
+def load_scene(path: str | Path) -> Scene:
+    """Read and validate a scene file.
+
+    Parameters
+    ----------
+    path : str or Path
+        A TOML scene file (docs/scene-files.md). Relative record paths inside it are
+        resolved against the file's folder.
+
+    Returns
+    -------
+    Scene
+
+    Raises
+    ------
+    SceneError
+        If the file is not valid TOML or any field is missing, of the wrong
+        type or out of range.
+    """
+    path = Path(path)
+    try:
+        data = tomllib.loads(path.read_text())
+    except FileNotFoundError:
+        raise SceneError(f"{path}: scene file not found") from None
+    except tomllib.TOMLDecodeError as error:
+        raise SceneError(f"{path}: not valid TOML: {error}") from None
+    return scene_from_dict(data, base_dir=path.parent, source=path.name)
+
+
+def scene_from_dict(data: Mapping[str, Any], base_dir: str | Path = ".", source: str = "python") -> Scene:
+    """Validate a scene given as a dictionary (the parsed TOML) and build it.
+
+    Parameters
+    ----------
+    data : mapping
+        The scene, with the structure of a scene file.
+    base_dir : str or Path
+        Folder against which relative record paths are resolved.
+    source : str
+        Provenance label stored with the scene.
+    """
+    fields.reject_unknown(data, _TOP_KEYS, "")
+    g = fields.number(data, "g", "", default=9.81, low=0.0, low_open=True)
+    study_compat = fields.boolean(data, "study_compat", "", default=False)
+    buildings = buildings_from_tables(fields.array_of_tables(data, "building"))
+    contacts = [contact_from_table(table, f"contact[{i}]", buildings) for i, table in enumerate(fields.array_of_tables(data, "contact"))]
+    walls = walls_from_tables(fields.array_of_tables(data, "wall"), buildings)
+    motion = _motion(data, Path(base_dir), g)
+    return Scene(tuple(buildings), tuple(contacts), motion, g=g, study_compat=study_compat, walls=tuple(walls), source=source)
+
+
+# ---------------------------------------------------------------- motion
+
+
+_MOTION_KEYS = {
+    "record": {"type", "record", "scale", "dt", "duration", "units", "interpolation"},
+    "harmonic": {"type", "amplitude", "omega", "phase", "duration", "dt"},
+    "constant": {"type", "acceleration", "duration", "dt"},
+}
+
+
+def _motion(data: Mapping[str, Any], base_dir: Path, g: float) -> GroundMotion:
+    table = fields.table(data, "motion", "")
+    if table is None:
+        raise SceneError("motion: missing ([motion] with a record, or type = harmonic | constant | kanai_tajimi | clough_penzien)")
+    kind = fields.string(table, "type", "motion", default="record")
+    if kind in _SYNTHETIC_TYPES:
+        return _synthetic_motion(table, kind)
+    if kind not in _MOTION_KEYS:
+        raise SceneError(f"motion.type: must be one of record, harmonic, constant, kanai_tajimi, clough_penzien; got {kind!r}")
+    fields.reject_unknown(table, _MOTION_KEYS[kind], "motion")
+    if kind == "harmonic":
+        return _harmonic_motion(table)
+    if kind == "constant":
+        return _constant_motion(table)
+    return _record_motion(table, base_dir, g)
+
+
+def _timing(table: Mapping[str, Any], required: bool) -> tuple[float | None, float | None]:
+    duration = fields.number(table, "duration", "motion", required=required, low=0.0, low_open=True)
+    dt = fields.number(table, "dt", "motion", required=required, low=0.0, low_open=True)
+    if duration is not None and dt is not None and dt > duration:
+        raise SceneError(f"motion.dt: must be <= motion.duration ({duration:g} s), got {dt:g}")
+    return duration, dt
+
+
+def _harmonic_motion(table: Mapping[str, Any]) -> HarmonicMotion:
+    amplitude = fields.number(table, "amplitude", "motion", required=True)
+    omega = fields.number(table, "omega", "motion", required=True, low=0.0)
+    phase = fields.number(table, "phase", "motion", default=0.0)
+    duration, dt = _timing(table, required=True)
+    return HarmonicMotion(amplitude, omega, duration, dt, phase)
+
+
+def _constant_motion(table: Mapping[str, Any]) -> SampledMotion:
+    acceleration = fields.number(table, "acceleration", "motion", required=True)
+    duration, dt = _timing(table, required=True)
+    n_samples = int(round(duration / dt)) + 1
+    return SampledMotion(dt, np.full(n_samples, acceleration), description=f"constant {acceleration:g} m/s²")
+
+
+def _record_motion(table: Mapping[str, Any], base_dir: Path, g: float) -> SampledMotion:
+    from stochpound.motions.records import load_record
+
+    spec = fields.string(table, "record", "motion")
+    scale = fields.number(table, "scale", "motion", default=1.0)
+    duration, dt = _timing(table, required=False)
+    units = fields.string(table, "units", "motion", default="") or None
+    if units not in (None, "g", "m/s2", "cm/s2"):
+        raise SceneError(f"motion.units: must be one of g, m/s2, cm/s2; got {units!r}")
+    interpolation = fields.string(table, "interpolation", "motion", default="linear")
+    if interpolation not in ("linear", "spline"):
+        raise SceneError(f"motion.interpolation: must be 'linear' or 'spline', got {interpolation!r}")
+    candidate = base_dir / spec
+    try:
+        record = load_record(str(candidate) if candidate.exists() else spec, dt=dt, units=units)
+    except RecordError as error:
+        raise SceneError(f"motion.record: {error}") from None
+    values = np.asarray(record.acceleration(g=g), dtype=float) * scale
+    if duration is not None:
+        n_keep = int(math.floor(duration / record.dt + 1e-9)) + 1
+        values = values[:n_keep]
+    if len(values) < 2:
+        raise SceneError(f"motion.record: {spec!r} has {len(values)} sample(s) in the requested duration; at least 2 are needed")
+    description = f"{record.name} x {scale:g}" + (f", first {duration:g} s" if duration is not None else "")
+    return SampledMotion(record.dt, values, interpolation, description)
+
+
+def _check_generator_fields(table: Mapping[str, Any], generator: Any, kind: str) -> None:
+    """Reject fields the generator does not take, and name the required ones that are missing."""
+    signature = inspect.signature(generator).parameters
+    own = {name for name in signature if name not in ("n_realizations", "start")}
+    fields.reject_unknown(table, own | {"type", "realization", "interpolation"}, "motion")
+    for name, parameter in signature.items():
+        if name in own and parameter.default is inspect.Parameter.empty and name not in table:
+            raise SceneError(f"motion.{name}: required for type = {kind!r} (see docs/motions.md)")
+
+
+def _synthetic_motion(table: Mapping[str, Any], kind: str) -> SampledMotion:
+    """One realization of a synthetic ensemble, fixed by (seed, realization) alone."""
+    from stochpound import motions
+
+    generator = getattr(motions, kind)
+    _check_generator_fields(table, generator, kind)
+    parameters = {key: value for key, value in table.items() if key not in ("type", "realization", "interpolation")}
+    realization = table.get("realization", 0)
+    if not isinstance(realization, int) or isinstance(realization, bool) or realization < 0:
+        raise SceneError(f"motion.realization: must be an integer >= 0, got {realization!r}")
+    duration, dt = _timing(table, required=True)
+    parameters.update(duration=duration, dt=dt)
+    try:
+        ensemble = generator(1, start=realization, **parameters)
+    except (TypeError, ValueError) as error:
+        raise SceneError(f"motion: {error}") from None
+    description = f"{kind} realization {realization} (seed {parameters.get('seed', 0)})"
+    return SampledMotion(dt, np.asarray(ensemble.values[0], dtype=float), "linear", description)

@@ -1,0 +1,99 @@
+"""Rigid walls that move with the ground: a moat's retaining wall around an isolated building, or a neighbour treated as rigid.
+
+Scene keys (``[[wall]]``): ``building`` (its name), ``side`` (``"left"`` or
+``"right"`` of the building), ``level`` (0: the base, a moat wall, under a
+sliding base only; or a floor number), ``gap`` (m, ≥ 0; ``inf``: never
+reached, the run still records the closure), and the impact element's
+fields as for a contact (:mod:`stochpound.model.contact`): ``stiffness``,
+``restitution`` or ``damping``, ``tensile``.
+
+The law (docs/model.md, "Walls"). With y the level's displacement relative
+to the ground (s for the base, s + u_i for floor i), the penetration is
+δ = y − d for a wall on the right and δ = −y − d on the left; while δ > 0 the
+Kelvin–Voigt element pushes the level away from the wall with
+F = k δ + c δ̇. The wall is infinitely massive, so a restitution r gives
+c = 2 ξ(r) √(k m), m the level's mass (the floor's, or the base's at level
+0). The force acts on that level only (at the base through the base
+equation; the study's ``study_compat`` switch concerns building contacts,
+not walls). A wall is an impact element like a contact: the same guards,
+impact table rows (``impact_wall``), energy term and closure monitor. With
+the Kelvin–Voigt element it is piecewise linear (the exact solver takes it).
+
+Mass scaling (experiment variants): as a contact's, with m_eff = m.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, Mapping, Sequence
+
+from stochpound.errors import SceneError
+from stochpound.model import fields
+from stochpound.model.building import Building
+from stochpound.model.contact import ELEMENT_KEYS, element_from_table
+
+WALL_KEYS = {"building", "side", "level", "gap"} | ELEMENT_KEYS
+SIDES = {"left": -1, "right": 1}
+
+
+@dataclass(frozen=True)
+class Wall:
+    """A rigid wall moving with the ground, beside one level of a building.
+
+    Attributes
+    ----------
+    building : int
+        Index (0-based) of the building in the scene.
+    side : int
+        +1: the wall is on the building's right; −1: on its left.
+    level : int
+        0: the base (a moat wall); i ≥ 1: floor i.
+    gap : float
+        At-rest gap d, m (>= 0; inf: never reached).
+    stiffness, damping : float
+        The impact element: k (N/m) and c (N·s/m).
+    restitution : float or None
+        Coefficient of restitution the damping was derived from.
+    tensile : bool
+        False: the element separates when its force returns to 0.
+    """
+
+    building: int
+    side: int
+    level: int
+    gap: float
+    stiffness: float
+    damping: float
+    restitution: float | None = None
+    tensile: bool = True
+
+    @property
+    def side_name(self) -> str:
+        """``"left"`` or ``"right"``."""
+        return "right" if self.side > 0 else "left"
+
+
+def walls_from_tables(tables: list[Mapping[str, Any]], buildings: Sequence[Building]) -> list[Wall]:
+    """The ``[[wall]]`` tables of a scene, validated."""
+    return [wall_from_table(table, f"wall[{i}]", buildings) for i, table in enumerate(tables)]
+
+
+def wall_from_table(table: Mapping[str, Any], prefix: str, buildings: Sequence[Building]) -> Wall:
+    """One ``[[wall]]`` table (at ``prefix``) beside one of ``buildings``, validated."""
+    fields.reject_unknown(table, WALL_KEYS, prefix)
+    names = [b.name for b in buildings]
+    name = fields.string(table, "building", prefix)
+    if name not in names:
+        raise SceneError(f"{prefix}.building: unknown building {name!r} (buildings: {', '.join(names)})")
+    building = buildings[names.index(name)]
+    side = fields.string(table, "side", prefix)
+    if side not in SIDES:
+        raise SceneError(f"{prefix}.side: must be 'left' or 'right', got {side!r}")
+    level = table.get("level")
+    if not isinstance(level, int) or isinstance(level, bool) or not 0 <= level <= building.n_floors:
+        raise SceneError(f"{prefix}.level: must be 0 (the base) or a floor number in 1..{building.n_floors} for building {name!r}, got {level!r}")
+    if level == 0 and building.base is None:
+        raise SceneError(f"{prefix}.level: 0 is the base, and building {name!r} has a fixed base (a moat wall needs a [building.base])")
+    gap = fields.number(table, "gap", prefix, required=True, low=0.0, allow_inf=True)
+    mass = building.base.mass if level == 0 else building.mass[level - 1]
+    return Wall(names.index(name), SIDES[side], level, gap, *element_from_table(table, prefix, mass))

@@ -1,0 +1,220 @@
+"""The result of one simulation as an :class:`xarray.Dataset` (the names of docs/scene-files.md).
+
+Outputs are given at the motion's sample times, t = 0 included. Every
+variable carries ``units`` and ``long_name`` (CF conventions).
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import xarray as xr
+
+from stochpound import __version__
+from stochpound.results.record import ENERGY_TERMS, EventCounters, Recorder
+from stochpound.model.scene import Scene
+from stochpound.model.system import System
+
+_ENERGY_NAMES = {
+    "input": "work of the ground-acceleration load (relative-motion input energy)",
+    "damping": "energy dissipated by the storey dashpots",
+    "friction": "energy dissipated by base friction",
+    "impact": "work absorbed by the impact elements (dissipated, plus stored while closed)",
+}
+
+
+def _var(dims: tuple[str, ...], data: np.ndarray, units: str, long_name: str, **attrs: Any) -> tuple:
+    """A variable (dims, data, attrs) with its CF ``units`` and ``long_name``."""
+    return dims, data, {"units": units, "long_name": long_name, **attrs}
+
+
+def build_dataset(scene: Scene, system: System, recorder: Recorder, counters: EventCounters, solver_attrs: dict[str, Any]) -> xr.Dataset:
+    """Assemble the result dataset of one run.
+
+    Parameters
+    ----------
+    scene, system : the simulated scene and its assembled system.
+    recorder : Recorder with the recorded outputs.
+    counters : EventCounters of the run.
+    solver_attrs : dict
+        Solver name and settings, stored as attributes.
+    """
+    coords = {
+        "time": _var(("time",), scene.motion.times, "s", "time"),
+        "building": _var(("building",), np.array(scene.building_names, dtype=str), "1", "building name, left to right"),
+        "floor": _var(("floor",), np.arange(1, scene.max_floors + 1), "1", "floor number, 1 = lowest"),
+        "contact": _var(("contact",), np.arange(len(scene.contacts)), "1", "contact index"),
+        **({"wall": _var(("wall",), np.arange(len(scene.walls)), "1", "wall index")} if scene.walls else {}),
+    }
+    data_vars = {
+        **_response_variables(scene, system, recorder),
+        **_contact_variables(scene),
+        **(_wall_variables(scene, recorder) if scene.walls else {}),
+        **_closure_variables(recorder, system.n_contacts, "contact"),
+        **(_closure_variables(recorder, system.n_contacts, "wall") if scene.walls else {}),
+        **_impact_variables(recorder, system.n_contacts, bool(scene.walls)),
+        **(_demand_variables(scene, recorder) if recorder.demands else {}),
+        **_energy_variables(recorder),
+    }
+    attrs = {
+        "title": "stochpound simulation",
+        "Conventions": "CF-1.10",
+        "stochpound_version": __version__,
+        "scene_source": scene.source,
+        "motion": scene.motion.description,
+        "g": scene.g,
+        "study_compat": int(scene.study_compat),
+        **solver_attrs,
+        **counters.as_attrs(),
+    }
+    return xr.Dataset(data_vars, coords=coords, attrs=attrs)
+
+
+def _response_variables(scene: Scene, system: System, recorder: Recorder) -> dict[str, tuple]:
+    """Displacements, ground acceleration, contact and friction forces and base states at the samples."""
+    relative, sliding = recorder.displacements()
+    return {
+        "total_displacement": _var(("building", "floor", "time"), relative + sliding[:, None, :], "m",
+                                   "floor displacement relative to the ground (y = s + u)"),
+        "relative_displacement": _var(("building", "floor", "time"), relative, "m", "floor displacement relative to the building's base (u)"),
+        "sliding_displacement": _var(("building", "time"), sliding, "m", "sliding displacement of the base relative to the ground (s)"),
+        "ground_acceleration": _var(("time",), np.asarray(scene.motion.at_times(), float), "m s-2", "ground acceleration a_g"),
+        "impact_force": _var(("contact", "time"), recorder.forces[:, : system.n_contacts].T, "N", "contact force, positive in compression (0 while open)"),
+        "base_friction_force": _var(
+            ("building", "time"), recorder.by_building(recorder.friction), "N", "force of the foundation on the base, positive to the right (0 for a fixed base)"
+        ),
+        "base_state": _var(
+            ("building", "time"), recorder.by_building(recorder.base_states), "1", "base state",
+            flag_values=np.array([-1, 0, 1], dtype=np.int8), flag_meanings="slipping_left stuck_or_fixed slipping_right",
+        ),
+    }
+
+
+def _closure_variables(recorder: Recorder, n_contacts: int, kind: str) -> dict[str, tuple]:
+    """The closure over time of each contact (``kind`` "contact", the first ``n_contacts`` elements) or wall, and its peak over the run, located on the solution."""
+    rows = slice(0, n_contacts) if kind == "contact" else slice(n_contacts, None)
+    toward = "y_left - y_right of the contact's floors" if kind == "contact" else "the level's displacement toward the wall"
+    return {
+        f"{kind}_closure": _var((kind, "time"), recorder.closure()[rows], "m", f"closure {toward} (the gap is closed where it reaches the gap)"),
+        f"peak_{kind}_closure": _var((kind,), recorder.peaks[0, rows], "m", "largest closure over the run: the separation this run needed"),
+        f"peak_{kind}_closure_time": _var((kind,), recorder.peaks[1, rows], "s", "time of the largest closure"),
+    }
+
+
+_DEMAND_NAMES = {
+    "total_acceleration": ("m s-2", "total floor acceleration (relative acceleration of the floor and its base, plus the ground's)"),
+    "storey_drift": ("m", "storey drift u_i - u_(i-1) (u_0 = 0, the base)"),
+    "storey_shear": ("N", "storey shear k_i d_i + c_i d'_i of the storey below the floor"),
+}
+
+
+def _demand_variables(scene: Scene, recorder: Recorder) -> dict[str, tuple]:
+    """The demand parameters at the samples and their peaks (absolute values) over the run, located on the solution."""
+    variables = {}
+    peaks = recorder.demand_peaks()
+    for name, (units, long_name) in _DEMAND_NAMES.items():
+        variables[name] = _var(("building", "floor", "time"), recorder.by_floor(recorder.demands[name]), units, long_name)
+        peak, when = peaks[name]
+        variables[f"peak_{name}"] = _var(("building", "floor"), recorder.by_floor(peak), units, f"largest absolute {name.replace('_', ' ')} over the run")
+        variables[f"peak_{name}_time"] = _var(("building", "floor"), recorder.by_floor(when), "s", f"time of the largest absolute {name.replace('_', ' ')}")
+    shear, peak_shear, when = variables["storey_shear"][1], variables["peak_storey_shear"][1], variables["peak_storey_shear_time"][1]
+    variables["base_shear"] = _var(("building", "time"), shear[:, 0], "N", "base shear: the shear of the first storey")
+    variables["peak_base_shear"] = _var(("building",), peak_shear[:, 0], "N", "largest absolute base shear over the run")
+    variables["peak_base_shear_time"] = _var(("building",), when[:, 0], "s", "time of the largest absolute base shear")
+    heights = [b.storey_height for b in scene.buildings]
+    if any(h is not None for h in heights):
+        height = np.full(peak_shear.shape, np.nan)
+        for b, h in enumerate(heights):
+            if h is not None:
+                height[b, : len(h)] = h
+        drift = variables["storey_drift"][1]
+        variables["storey_drift_ratio"] = _var(("building", "floor", "time"), drift / height[:, :, None], "1", "storey drift over the storey height")
+        variables["peak_storey_drift_ratio"] = _var(("building", "floor"), variables["peak_storey_drift"][1] / height, "1",
+                                                    "largest absolute storey drift ratio over the run")
+    return variables
+
+
+def _wall_variables(scene: Scene, recorder: Recorder) -> dict[str, tuple]:
+    """What each wall is, and its force over time."""
+    names, walls, n_contacts = scene.building_names, scene.walls, len(scene.contacts)
+    return {
+        "wall_building": _var(("wall",), np.array([names[w.building] for w in walls], dtype=str), "1", "building beside the wall"),
+        "wall_side": _var(("wall",), np.array([w.side_name for w in walls], dtype=str), "1", "side of the building the wall is on"),
+        "wall_level": _var(("wall",), np.array([w.level for w in walls], dtype=int), "1", "level the wall faces: 0 the base, else the floor"),
+        "wall_gap": _var(("wall",), np.array([w.gap for w in walls], float), "m", "at-rest gap"),
+        "wall_stiffness": _var(("wall",), np.array([w.stiffness for w in walls], float), "N m-1", "impact spring stiffness"),
+        "wall_damping": _var(("wall",), np.array([w.damping for w in walls], float), "N s m-1", "impact dashpot"),
+        "wall_force": _var(("wall", "time"), recorder.forces[:, n_contacts:].T, "N", "force of the wall's impact element, positive in compression (0 while open)"),
+    }
+
+
+def _contact_variables(scene: Scene) -> dict[str, tuple]:
+    names = scene.building_names
+    contacts = scene.contacts
+    return {
+        "contact_left": _var(("contact",), np.array([names[c.left] for c in contacts], dtype=str), "1", "left building of the contact"),
+        "contact_left_floor": _var(("contact",), np.array([c.left_floor for c in contacts], dtype=int), "1", "floor of the left building"),
+        "contact_right": _var(("contact",), np.array([names[c.right] for c in contacts], dtype=str), "1", "right building of the contact"),
+        "contact_right_floor": _var(("contact",), np.array([c.right_floor for c in contacts], dtype=int), "1", "floor of the right building"),
+        "contact_gap": _var(("contact",), np.array([c.gap for c in contacts], float), "m", "at-rest gap"),
+        "contact_stiffness": _var(("contact",), np.array([c.stiffness for c in contacts], float), "N m-1", "impact spring stiffness"),
+        "contact_damping": _var(("contact",), np.array([c.damping for c in contacts], float), "N s m-1", "impact dashpot"),
+    }
+
+
+def _impact_variables(recorder: Recorder, n_contacts: int, walls: bool) -> dict[str, tuple]:
+    """One row per impact; with ``walls``, ``impact_wall`` names the wall of a wall impact (``impact_contact`` is then −1)."""
+    impacts = recorder.impacts
+
+    def column(name, dtype=float):
+        return np.array([getattr(impact, name) for impact in impacts], dtype=dtype)
+
+    start, end, element = column("start"), column("end"), column("contact", int)
+    dims = ("impact",)
+    wall = {"impact_wall": _var(dims, np.where(element >= n_contacts, element - n_contacts, -1), "1", "wall index of the impact (-1: a contact)")}
+    return {
+        "impact_contact": _var(dims, np.where(element < n_contacts, element, -1), "1", "contact index of the impact (-1: a wall)"),
+        **(wall if walls else {}),
+        "impact_start": _var(dims, start, "s", "time the impact began"),
+        "impact_end": _var(dims, end, "s", "time the impact ended (end of the motion if still closed)"),
+        "impact_duration": _var(dims, end - start, "s", "impact duration"),
+        "impact_peak_force": _var(dims, column("peak_force"), "N", "largest contact force of the impact"),
+        "impact_peak_time": _var(dims, column("peak_time"), "s", "time of the largest contact force"),
+        "impact_impulse": _var(dims, column("impulse"), "N s", "time integral of the contact force"),
+        "impact_onset_velocity": _var(dims, column("onset_velocity"), "m s-1", "approach velocity (rate of penetration) at onset"),
+        "impact_in_phase": _var(dims, column("in_phase", bool), "1", "both floors moving the same way at onset (false at a wall, which moves with the ground)"),
+        "impact_complete": _var(dims, column("complete", bool), "1", "the impact ended before the end of the motion"),
+    }
+
+
+def _energy_variables(recorder: Recorder) -> dict[str, tuple]:
+    kinetic, strain = recorder.kinetic_and_strain()
+    energy = recorder.energy
+    variables = {f"energy_{term}": _var(("time",), energy[term], "J", _ENERGY_NAMES[term]) for term in ENERGY_TERMS}
+    variables["energy_kinetic"] = _var(("time",), kinetic, "J", "kinetic energy of the motion relative to the ground")
+    variables["energy_strain"] = _var(("time",), strain, "J", "strain energy of storeys and base restoring springs")
+    residual = energy["input"] - (kinetic - kinetic[0]) - (strain - strain[0]) - energy["damping"] - energy["friction"] - energy["impact"]
+    variables["energy_residual"] = _var(("time",), residual, "J", "input minus every other term (0 for an exact solution)")
+    return variables
+
+
+def write_dataset(dataset: xr.Dataset, path: str | Path) -> Path:
+    """Write ``dataset`` as netCDF4/HDF5 atomically (a temporary file renamed into place).
+
+    An interrupted write never leaves a partial file at ``path``.
+    """
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    os.close(handle)
+    try:
+        dataset.to_netcdf(temporary, engine="h5netcdf", invalid_netcdf=False)
+        os.replace(temporary, path)
+    except BaseException:
+        Path(temporary).unlink(missing_ok=True)
+        raise
+    return path

@@ -1,0 +1,81 @@
+"""Rigid walls moving with the ground: moat walls at the base, walls at a floor, in both solvers."""
+
+import copy
+
+import numpy as np
+import pytest
+
+import stochpound
+from tests.conftest import reference_building, study_contacts
+from tests.test_exact import assert_same_run
+
+MOTION = {"record": "el_centro_1940_study", "duration": 20.0}
+
+
+def moat(gap: float = 0.02, level: int = 0, mu: float = 0.1) -> dict:
+    """The study's Building 1 on a sliding base between two walls (a moat) at ``level``."""
+    walls = [{"building": "B1", "side": side, "level": level, "gap": gap, "stiffness": 5.0e8, "restitution": 0.5} for side in ("left", "right")]
+    return {"g": 9.814, "building": [reference_building("B1", mu=mu)], "wall": walls, "motion": MOTION}
+
+
+def run(scene: dict, method: str = "exact"):
+    return stochpound.simulate(stochpound.scene_from_dict(scene), method=method)
+
+
+@pytest.mark.parametrize("level", [0, 2])
+def test_walls_match_between_the_exact_and_ivp_flows(level):
+    exact, reference = run(moat(level=level)), run(moat(level=level), "ivp")
+    assert reference.sizes["impact"] > 2 and set(reference.impact_wall.values) == {0, 1}
+    assert np.all(reference.impact_contact.values == -1)
+    assert_same_run(exact, reference)
+    np.testing.assert_array_equal(exact.impact_wall.values, reference.impact_wall.values)
+
+
+def test_an_unreachable_wall_changes_nothing():
+    """Walls beyond the largest excursion leave the run as it was without them (to 1e-10 m), and record their closure."""
+    alone = moat()
+    del alone["wall"]
+    far = moat(gap=1.0)
+    without, with_walls = run(alone), run(far)
+    assert with_walls.sizes["impact"] == 0
+    np.testing.assert_allclose(with_walls.total_displacement.values, without.total_displacement.values, rtol=0, atol=1e-10)
+    s = without.sliding_displacement.sel(building="B1")
+    # the closure toward a wall is the base's displacement toward it; its peak is located on the solution (at least the sampled peak)
+    np.testing.assert_allclose(with_walls.wall_closure.sel(wall=1).values, s.values, rtol=0, atol=1e-15)
+    np.testing.assert_allclose(with_walls.wall_closure.sel(wall=0).values, -s.values, rtol=0, atol=1e-15)
+    assert float(with_walls.peak_wall_closure.sel(wall=1)) >= float(s.max()) > 0.0
+    assert float(with_walls.peak_wall_closure.sel(wall=0)) >= float(-s.min()) > 0.0
+
+
+def test_a_wall_is_hit_exactly_when_the_wall_free_run_reaches_its_gap():
+    free = moat(gap=np.inf)
+    reach = float(run(free).peak_wall_closure.max())
+    assert run(moat(gap=0.999 * reach)).sizes["impact"] > 0
+    assert run(moat(gap=1.001 * reach)).sizes["impact"] == 0
+
+
+def test_a_frictionless_block_bounces_off_a_moat_wall_with_its_restitution():
+    """A rigid block launched at a wall: exit velocity −r times the entry velocity (the wall is infinitely massive)."""
+    r, v0 = 0.6, 0.5
+    scene = {"building": [{"name": "block", "mass": [], "stiffness": [], "base": {"mass": 1.0e4, "mu": 0.0}, "initial": {"base_velocity": v0}}],
+             "wall": [{"building": "block", "side": "right", "level": 0, "gap": 0.1, "stiffness": 1.0e7, "restitution": r}],
+             "motion": {"type": "constant", "acceleration": 0.0, "duration": 1.0, "dt": 0.001}}
+    result = run(scene, "ivp")
+    assert result.sizes["impact"] == 1 and bool(result.impact_complete[0])
+    t, s = result.time.values, result.sliding_displacement.sel(building="block").values
+    after = t > float(result.impact_end[0]) + 0.01
+    velocity = np.polyfit(t[after], s[after], 1)[0]
+    assert velocity == pytest.approx(-r * v0, rel=1e-6)
+
+
+def test_walls_are_validated_with_the_field_named():
+    bad = [({"level": 0}, "wall[0].level: 0 is the base, and building 'B2' has a fixed base"),
+           ({"side": "up"}, "wall[0].side: must be 'left' or 'right'"),
+           ({"level": 3}, r"wall\[0\].level: must be 0 \(the base\) or a floor number in 1..2"),
+           ({"building": "B9"}, "wall[0].building: unknown building 'B9'")]
+    for change, message in bad:
+        scene = {"building": [reference_building("B1", mu=0.1), reference_building("B2")], "contact": study_contacts(0.02),
+                 "wall": [{"building": "B2", "side": "right", "level": 1, "gap": 0.1, "stiffness": 1e8, "restitution": 0.5, **change}],
+                 "motion": MOTION}
+        with pytest.raises(stochpound.SceneError, match=message.replace("[", r"\[").replace("]", r"\]") if "\\" not in message else message):
+            stochpound.scene_from_dict(copy.deepcopy(scene))
