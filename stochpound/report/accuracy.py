@@ -279,7 +279,7 @@ def _collision_paragraphs(definitions: list[StoreDefinition]) -> list[Paragraph]
     ]
     worst = max(abs(c.measured - c.expected) for c in checked.values())
     return [Paragraph(
-        f"Every contact element as a single collision of its two floor masses, free, closing at {number(COLLISION_VELOCITY)} m/s, run now "
+        f"Every contact element between buildings as a single collision of its two floor masses, free, closing at {number(COLLISION_VELOCITY)} m/s, run now "
         "with the exact solver; the coefficient of restitution measured from the velocities after separation against its closed "
         f"form for the element's separation rule (largest difference {worst:.1e}): " + "; ".join(rows) + "."
     )]

@@ -27,6 +27,7 @@ from stochpound.motions.records import load_record, registry_entries
 from stochpound.report.document import Paragraph, Table
 from stochpound.report.stores import store_experiment
 from stochpound.model.scene import Building, Contact, Scene
+from stochpound.model.wall import Wall
 from stochpound.model.scene_file import scene_from_dict
 
 
@@ -201,13 +202,31 @@ def _contact_row(definition: StoreDefinition, scene: Scene, index: int, contact:
     )
 
 
+def _wall_row(scene: Scene, wall: Wall) -> tuple[str, ...]:
+    building = scene.buildings[wall.building]
+    mass = building.base.mass if wall.level == 0 and building.base is not None else building.mass[max(wall.level, 1) - 1]
+    level = "base" if wall.level == 0 else f"floor {wall.level}"
+    return (
+        f"{building.name} {level} – rigid wall on its {'right' if wall.side > 0 else 'left'}",
+        "linear Kelvin–Voigt",
+        number(wall.gap),
+        number(wall.stiffness),
+        number(wall.damping),
+        number(wall.restitution) if wall.restitution is not None else "– (dashpot given)",
+        "tensile (separates when the penetration returns to 0)" if wall.tensile else "non-tensile (separates when the force returns to 0)",
+        number(math.sqrt(wall.stiffness / mass), 4),
+    )
+
+
 def contacts_table(definitions: Iterable[StoreDefinition]) -> Table | None:
-    """Every contact element the stores ran (None when no store has one)."""
+    """Every contact element the stores ran, between buildings and against walls (None when no store has one)."""
     rows: dict[tuple, list[str]] = {}
     for definition in definitions:
         for configuration in definition.configurations:
             for index, contact in enumerate(configuration.scene.contacts):
                 rows.setdefault(_contact_row(definition, configuration.scene, index, contact), []).append((definition, configuration))
+            for wall in configuration.scene.walls:
+                rows.setdefault(_wall_row(configuration.scene, wall), []).append((definition, configuration))
     if not rows:
         return None
     return _merged_table(
@@ -215,7 +234,7 @@ def contacts_table(definitions: Iterable[StoreDefinition]) -> Table | None:
         "The contact (impact) elements as run: floors joined, law, at-rest gap, stiffness k, dashpot c, restitution and separation rule.",
         ["between", "law", "gap (m)", "k (N/m)", "c (N·s/m)", "restitution", "separation", "√(k/m_eff) (rad/s)"],
         rows,
-        "m_eff = m1 m2 / (m1 + m2) of the two floor masses; with a restitution r, c = 2 ξ √(k m_eff), ξ = −ln r / √(π² + ln² r).",
+        "m_eff = m1 m2 / (m1 + m2) of the two floor masses (against a wall, the level's own mass); with a restitution r, c = 2 ξ √(k m_eff), ξ = −ln r / √(π² + ln² r).",
     )
 
 
@@ -354,6 +373,9 @@ def model_paragraph(definitions: list[StoreDefinition]) -> Paragraph:
             "Adjacent floors are joined by linear Kelvin–Voigt impact elements, F = k δ + c δ̇, which act only while the gap "
             f"is closed and are {' or '.join(rules)} (values in the table of contacts)."
         )
+    walls = [w for s in scenes for w in s.walls]
+    if walls:
+        sentences.append("Rigid walls moving with the ground stand beside some levels, with the same kind of impact element (table of contacts).")
     if isolated and contacts:
         sentences.append(
             "The impact forces act on an isolated building as a whole (they enter its base equation), and friction at the onset "
