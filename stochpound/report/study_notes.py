@@ -5,7 +5,7 @@
   under the Northridge substitute, traced to its few impacts and the
   sliding they start (the cases are rerun to get the sliding history);
 * :func:`scaling_sensitivity`: the μ = 0.2, El Centro cases rerun with the
-  record scaled by 0.98 … 1.02, to show how much a count of impacts from one
+  record scaled by 0.98, 1 and 1.02, to show how much a count of impacts from one
   record depends on its amplitude.
 
 Every number is computed from the stores or from those reruns.
@@ -30,7 +30,7 @@ CM = 100.0
 NEIGHBOURS = ("stiff", "flexible")
 CONFIGURATIONS = {"b1_isolated": "Building 1 isolated", "both_isolated": "both isolated"}
 #: Record scale factors of the sensitivity check.
-SCALES = (0.98, 0.99, 1.0, 1.01, 1.02)
+SCALES = (0.98, 1.0, 1.02)
 
 
 def northridge_means(pair_records: xr.Dataset, single: xr.Dataset | None, record: str = "northridge", gap: float = 0.08, mu: float = 0.2) -> list[Block]:
