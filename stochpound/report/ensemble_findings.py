@@ -121,6 +121,22 @@ def gap_effect(ensemble: Ensemble, dim: str) -> list[Block]:
     return blocks
 
 
+def _most(stats: xr.Dataset, fixed: xr.Dataset, candidates: list[tuple[float, xr.DataArray]], verb: str) -> str:
+    """"It hurts (helps) most at ...": the cell with the largest clear change of P(pounding), "" if none."""
+    found = [(float(change.max()), mu, change) for mu, change in candidates if bool(change.notnull().any())]
+    if not found:
+        return ""
+    _, mu, change = max(found, key=lambda item: item[0])
+    where = change.where(change == change.max(), drop=True)
+    labels = {d: where[d].values[0].item() for d in where.dims}
+    cell = {**labels, "mu": mu}
+
+    def estimate(data: xr.Dataset, at: dict) -> str:
+        return f"{float(data['pounding_probability'].sel(at)):.2f} [{float(data['pounding_probability_lower'].sel(at)):.2f}, {float(data['pounding_probability_upper'].sel(at)):.2f}]"
+
+    return f"It {verb} most at {labels_text(cell)}: P(pounding) {estimate(stats, cell)} against {estimate(fixed, labels)} on a fixed base."
+
+
 def _range(values: xr.DataArray) -> str:
     low, high = float(values.min()), float(values.max())
     return f"{low:.2f}" if f"{low:.2f}" == f"{high:.2f}" else f"{low:.2f}–{high:.2f}"
@@ -166,7 +182,7 @@ def isolation_effect(ensemble: Ensemble) -> list[Block]:
     mus = ensemble.grid["mu"]
     fixed = stats.sel(mu=math.inf)
     rows = {}
-    extremes = []
+    extremes: dict[str, list[tuple[float, xr.DataArray]]] = {"hurts": [], "helps": []}
     for mu in (m for m in mus if not math.isinf(m)):
         isolated = stats.sel(mu=mu)
         row = []
@@ -175,9 +191,9 @@ def isolation_effect(ensemble: Ensemble) -> list[Block]:
             higher = isolated[f"{name}_lower"] > fixed[f"{name}_upper"]
             row += [int(lower.sum()), int(higher.sum()), int((~lower & ~higher).sum())]
         rows[value_text("mu", mu)] = row
-        difference = (isolated["pounding_probability"] - fixed["pounding_probability"]).where(isolated["pounding_probability_lower"] > fixed["pounding_probability_upper"])
-        if bool(difference.notnull().any()):
-            extremes.append((float(difference.max()), mu, difference))
+        difference = isolated["pounding_probability"] - fixed["pounding_probability"]
+        extremes["hurts"].append((mu, difference.where(isolated["pounding_probability_lower"] > fixed["pounding_probability_upper"])))
+        extremes["helps"].append((mu, -difference.where(isolated["pounding_probability_upper"] < fixed["pounding_probability_lower"])))
     columns = pd.MultiIndex.from_product([[f"mean {label}" if name != "pounding_probability" else label for name, label in COMPARED.items()], ["lower", "higher", "no clear difference"]])
     frame = pd.DataFrame.from_dict(rows, orient="index", columns=columns)
     frame.index.name = "μ"
@@ -191,19 +207,13 @@ def isolation_effect(ensemble: Ensemble) -> list[Block]:
     sentences.append(
         f"Of {cells * len(rows)} isolated cells, isolation lowers the probability of pounding in {counts[0][0]} and raises it in "
         f"{counts[0][1]}; it lowers {ensemble.studied}'s mean peak relative displacement (its deformation) in {counts[1][0]} and "
-        f"raises it in {counts[1][1]}, and its mean peak total displacement (deformation plus sliding) in {counts[2][0]} and {counts[2][1]}."
+        f"raises it in {counts[1][1]}; it lowers its mean peak total displacement (deformation plus sliding) in {counts[2][0]} and "
+        f"raises it in {counts[2][1]}."
     )
-    if extremes:
-        worst, mu, difference = max(extremes, key=lambda e: e[0])
-        where = difference.where(difference == worst, drop=True)
-        labels = {d: where[d].values[0].item() for d in where.dims}
-        cell = {**labels, "mu": mu}
-        sentences.append(
-            f"It hurts most at {labels_text(cell)}: P(pounding) {float(stats['pounding_probability'].sel(cell)):.2f} "
-            f"[{float(stats['pounding_probability_lower'].sel(cell)):.2f}, {float(stats['pounding_probability_upper'].sel(cell)):.2f}] "
-            f"against {float(fixed['pounding_probability'].sel(labels)):.2f} [{float(fixed['pounding_probability_lower'].sel(labels)):.2f}, "
-            f"{float(fixed['pounding_probability_upper'].sel(labels)):.2f}] on a fixed base."
-        )
+    for verb, candidates in extremes.items():
+        sentence = _most(stats, fixed, candidates, verb)
+        if sentence:
+            sentences.append(sentence)
     return [
         Paragraph(" ".join(sentences)),
         Table(
@@ -214,3 +224,18 @@ def isolation_effect(ensemble: Ensemble) -> list[Block]:
             formats={},
         ),
     ]
+
+
+def compare_ensembles(first: Ensemble, second: Ensemble) -> Paragraph:
+    """Cell by cell, where the second ensemble's P(pounding) and peak displacements are higher or lower than the first's."""
+    a, b = first.statistics, second.statistics
+    parts = []
+    for name, label in COMPARED.items():
+        lower = int((b[f"{name}_upper"] < a[f"{name}_lower"]).sum())
+        higher = int((b[f"{name}_lower"] > a[f"{name}_upper"]).sum())
+        parts.append(f"{label if name == 'pounding_probability' else 'the mean ' + label} higher in {higher} and lower in {lower}")
+    cells = int(a["pounding_probability"].size)
+    return Paragraph(
+        f"Ensemble {second.label} against ensemble {first.label}, cell by cell over the {cells} cells of the grid (non-overlapping "
+        f"{first.confidence:.0%} intervals): " + "; ".join(parts) + "."
+    )

@@ -19,7 +19,7 @@ import xarray as xr
 
 from stochpound.report import figures
 from stochpound.report.document import Block, FigureItem, Paragraph, Section, Table
-from stochpound.report.ensemble_findings import ensemble_findings
+from stochpound.report.ensemble_findings import compare_ensembles, ensemble_findings
 from stochpound.report.ensembles import Ensemble
 from stochpound.report.facets import dim_text, is_gap, labels_text, layouts, line_colours, plain, value_text, cell_gid
 
@@ -60,8 +60,10 @@ def store_section(name: str, store: xr.Dataset) -> Section:
     if records:
         for block in record_blocks(name, store.sel(record=records).isel(realization=[0])):
             section.add(block)
-    for label in (label for label, kind in kinds.items() if kind == "synthetic"):
-        ensemble = Ensemble(name, store, label)
+    ensembles = [Ensemble(name, store, label) for label, kind in kinds.items() if kind == "synthetic"]
+    for ensemble in ensembles[1:]:
+        section.add(compare_ensembles(ensembles[0], ensemble))
+    for ensemble in ensembles:
         for block in [*ensemble_findings(ensemble), *ensemble.blocks()]:
             section.add(block)
     return section
