@@ -52,11 +52,11 @@ def test_summaries_match_single_runs(scene, motions, ensemble):
             assert float(one.peak_impact_force) == float(run.impact_peak_force.max())
             assert float(one.longest_impact) == float(run.impact_duration.max())
         top = run.total_displacement.sel(building="B1", floor=2).values
-        assert float(one.top_floor_mean.sel(building="B1")) == pytest.approx(top.mean(), rel=1e-12)
-        assert float(one.top_floor_std.sel(building="B1")) == pytest.approx(top.std(), rel=1e-12)
+        assert float(one.response_mean.sel(building="B1")) == pytest.approx(top.mean(), rel=1e-12)
+        assert float(one.response_std.sel(building="B1")) == pytest.approx(top.std(), rel=1e-12)
         deviation = top - top.mean()
         excess = np.mean(deviation**4) / np.mean(deviation**2) ** 2 - 3.0
-        assert float(one.top_floor_excess.sel(building="B1")) == pytest.approx(excess, rel=1e-9)
+        assert float(one.response_excess.sel(building="B1")) == pytest.approx(excess, rel=1e-9)
         assert float(one.energy_friction) == float(run.energy_friction[-1])
 
 

@@ -16,6 +16,7 @@ import xarray as xr
 
 from stochpound.experiment import load_experiment, open_store, run_experiment
 from stochpound.report.assemble import assemble_report
+from stochpound.report.generic import AGAINST
 from stochpound.report.output import write_report
 from stochpound.report.published import published_tables
 from stochpound.report.study_tables import CORRECTED, DIFFERENCE, SPLINE, STUDY, STUDY_EQUATIONS
@@ -51,11 +52,13 @@ def built(study_stores, tmp_path_factory):
     report = assemble_report(study_stores)
     tables = {table.key: table for table in report.tables()}
     figures = {item.key: item.caption for item in report.figures()}
+    figure_items = {item.key: item for item in report.figures()}
+    paragraphs = [block.text for section in report.sections for block in section.blocks if hasattr(block, "text")]
     sections = [section.title for section in report.sections]
     findings = [block.text for section in report.sections if section.key == "findings" for block in section.blocks]
     out = tmp_path_factory.mktemp("report")
     written = write_report(report, out)
-    return {"tables": tables, "figures": figures, "sections": sections, "findings": findings, "written": written, "out": out}
+    return {"tables": tables, "figures": figures, "figure_items": figure_items, "paragraphs": paragraphs, "sections": sections, "findings": findings, "written": written, "out": out}
 
 
 def test_every_study_experiment_is_shortened_and_complete(study_stores):
@@ -67,7 +70,7 @@ def test_every_study_experiment_is_shortened_and_complete(study_stores):
 
 def test_every_table_is_there_in_the_study_layout(built):
     tables = built["tables"]
-    expected = {"table-3.2", "table-records", "table-4.9-4.10", *(f"table-4.{n}" for n in range(1, 9))}
+    expected = {"table-3.2", "table-3.3", "table-scaling", "table-records", "table-4.9-4.10", *(f"table-4.{n}" for n in range(1, 9)), "table-buildings", "table-contacts", "table-motions"}
     assert set(tables) == expected
     for number in ("4.1", "4.3", "4.5", "4.7"):
         frame = tables[f"table-{number}"].frame
@@ -95,12 +98,12 @@ def test_tables_carry_the_study_and_the_stores_numbers(built, study_stores):
     assert frame.loc[("std (cm)", CORRECTED), "single building"] == pytest.approx(float(pair["reference_response_std"].sel(record="el_centro", realization=0)) * 100)
     np.testing.assert_allclose(frame.loc[("std (cm)", DIFFERENCE)].values, frame.loc[("std (cm)", CORRECTED)].values - np.asarray(published["std"]))
     assert np.isnan(frame.loc[("impacts", CORRECTED), "single building"])
-    compat = pair["impacts"].sel(case | {"model": "study_compat", "record": "el_centro_spline"}).sel(mu=0.4)
+    compat = pair["impacts"].sel(case | {"model": "study_compat", "record": "el_centro"}).sel(mu=0.4)  # the same (linear) input as "corrected model"
     assert frame.loc[("impacts", STUDY_EQUATIONS), "μ = 0.4"] == float(compat)
 
 
 def test_every_figure_is_written_and_named(built):
-    expected = {"3.2", "3.3", "3.4", "3.6", "3.7", "3.8", "3.9", "4.1", "4.2", "4.3", "4.4", "4.5", "4.6", "4.8-4.15-b1_isolated", "4.8-4.15-both_isolated", "4.16-4.17", "4.18", "4.19", "4.20"}
+    expected = {"northridge-sliding", "3.2", "3.3", "3.4", "3.6", "3.7", "3.8", "3.9", "4.1", "4.2", "4.3", "4.4", "4.5", "4.6", "4.8-4.15-b1_isolated", "4.8-4.15-both_isolated", "4.16-4.17", "4.18", "4.19", "4.20"}
     assert set(built["figures"]) == {f"figure-{n}" for n in expected}
     for key in built["figures"]:
         png = built["out"] / "figures" / f"{key}.png"
@@ -135,10 +138,10 @@ def test_a_store_that_is_not_the_study_gets_a_section_of_its_own(study_stores, t
     other = tmp_path / "my_grid.nc"
     data.to_netcdf(other, engine="h5netcdf")
     report = assemble_report([other])
-    assert [s.title for s in report.sections] == ["Experiment my_grid", "Methods"]
+    assert [s.title for s in report.sections] == ["About this report", "Experiment my_grid", "Methods"]
     table = report.tables()[0]
     assert table.frame.shape[0] == data.sizes["mu"] * data.sizes["record"]
-    assert [f.key for f in report.figures()] == ["figure-my_grid-mu"]
+    assert [f.key for f in report.figures()] == [f"figure-my_grid-{variable}-mu" for variable in AGAINST]
 
 
 def test_the_study_report_renders_in_headless_chromium(built, tmp_path):
@@ -148,3 +151,43 @@ def test_the_study_report_renders_in_headless_chromium(built, tmp_path):
     assert verdict["tables"] == len(built["tables"])
     assert len(verdict["images"]) == len(built["figures"]) and all(width > 0 for width in verdict["images"])
     assert problems == []
+
+
+def test_figure_3_6_draws_every_located_peak_its_caption_quotes(built, study_stores):
+    gap = open_store(next(p for p in study_stores if p.stem == "gap_study"))
+    case = {"neighbour": "flexible", "gap": 0.02, "mu": np.inf, "record": "el_centro", "realization": 0}
+    from stochpound.report.stores import case_impacts
+
+    impacts = case_impacts(gap, **case)
+    item = built["figure_items"]["figure-3.6"]
+    peaks = [line for ax in item.figure.axes for line in ax.lines if line.get_label().startswith("located peaks")]
+    assert sum(len(line.get_xdata()) for line in peaks) == impacts.sizes["impact"]
+    drawn = max(max(line.get_ydata()) for line in peaks)
+    assert drawn == pytest.approx(float(impacts["impact_peak_force"].max()) / 1e3)
+    assert f"Largest located peak {drawn:.0f} kN" in item.caption
+
+
+def test_impact_extremes_are_not_drawn_where_there_is_no_impact(built, study_stores):
+    pair = open_store(next(p for p in study_stores if p.stem == "pair_mu"))
+    item = built["figure_items"]["figure-4.8-4.15-b1_isolated"]
+    force_axes = next(ax for ax in item.figure.axes if ax.get_title() == "peak impact force")
+    line = next(line for line in force_axes.lines if line.get_label() == "B2 stiff")
+    case = {"isolation": "b1_isolated", "neighbour": "stiff", "model": "corrected", "gap": 0.02, "record": "el_centro", "realization": 0}
+    impacts = pair["impacts"].sel(case).sel(mu=[0.1, 0.2, 0.3, 0.4, 0.5]).values
+    np.testing.assert_array_equal(np.isnan(line.get_ydata()), impacts == 0)
+    assert next(ax for ax in item.figure.axes if ax.get_title() == "longest impact").get_yscale() == "log"
+
+
+def test_the_northridge_means_and_the_scaling_sensitivity_are_explained_from_the_stores(built, study_stores):
+    records = open_store(next(p for p in study_stores if p.stem == "pair_records"))
+    case = {"isolation": "b1_isolated", "model": "corrected", "gap": 0.08, "mu": 0.2, "record": "northridge", "realization": 0}
+    text = next(t for t in built["paragraphs"] if t.startswith("The largest effect in Tables 4.2–4.4"))
+    for neighbour in ("stiff", "flexible"):
+        mean = float(records["response_mean"].sel(case | {"neighbour": neighbour})) * 100
+        assert f"over the record is {mean:.1f} cm" in text
+    scaling = built["tables"]["table-scaling"].frame
+    pair = open_store(next(p for p in study_stores if p.stem == "pair_mu"))
+    stored = pair["impacts"].sel(isolation="b1_isolated", neighbour="flexible", model="corrected", gap=0.02, mu=0.2, record="el_centro", realization=0)
+    assert scaling.loc[("Building 1 isolated", "B2 flexible"), ("× 1", "impacts")] == float(stored)
+    worst = next(t for t in built["findings"] if t.startswith("One isolated building"))
+    assert all(name in worst for name in ("Mexico City 1985, gap 2 cm", "Northridge 1994 (substitute), gap 8 cm"))

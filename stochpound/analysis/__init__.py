@@ -3,13 +3,17 @@
 Every function takes and returns xarray objects and reduces only the
 dimensions it is told to, so it applies equally to one run (reduce over
 ``time``), to an experiment store (the grid's dimensions are carried along)
-and to ensembles (reduce over ``realization``).
+and to ensembles (reduce over ``realization``). Each statistic has one
+implementation, a numpy kernel of :mod:`stochpound.analysis.kernels`, which
+these functions apply with :func:`xarray.apply_ufunc`.
 """
 
 from stochpound.analysis.moments import moments
 from stochpound.analysis.correlation import correlation
+from stochpound.analysis.ensemble_statistics import ensemble_statistics
 from stochpound.analysis.histogram import normal_histogram
 from stochpound.analysis.impacts import impact_statistics
+from stochpound.analysis.intervals import mean_interval, quantiles, running_mean, running_pounding_probability
 from stochpound.analysis.peaks import peak_response
 from stochpound.analysis.pounding import pounding_probability
 from stochpound.analysis.separation import pounding_curve, required_separation, rule_exceedance
@@ -19,8 +23,13 @@ from stochpound.analysis.summary import run_summary
 __all__ = [
     "moments",
     "correlation",
+    "ensemble_statistics",
     "normal_histogram",
     "impact_statistics",
+    "mean_interval",
+    "quantiles",
+    "running_mean",
+    "running_pounding_probability",
     "peak_response",
     "pounding_probability",
     "pounding_curve",

@@ -6,6 +6,8 @@ import numpy as np
 import xarray as xr
 from scipy import stats
 
+from stochpound.analysis import kernels
+
 
 def normal_histogram(data: xr.DataArray, bins: int = 40) -> xr.Dataset:
     """Density histogram of all values of ``data`` and the normal density with its mean and std.
@@ -28,7 +30,8 @@ def normal_histogram(data: xr.DataArray, bins: int = 40) -> xr.Dataset:
     values = values[np.isfinite(values)]
     density, edges = np.histogram(values, bins=bins, density=True)
     centres = 0.5 * (edges[:-1] + edges[1:])
-    mean, std = float(values.mean()), float(values.std())
+    sample = kernels.moments(values)
+    mean, std = float(sample.mean), float(sample.std)
     units = data.attrs.get("units", "")
     return xr.Dataset(
         {

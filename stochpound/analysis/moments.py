@@ -4,7 +4,10 @@ from __future__ import annotations
 
 import xarray as xr
 
-MOMENT_NAMES = ("mean", "variance", "std", "skewness", "excess")
+from stochpound.analysis import kernels
+from stochpound.analysis.ufunc import reduce
+
+MOMENT_NAMES = kernels.Moments._fields
 
 
 def moments(data: xr.DataArray, dim: str | list[str] = "time") -> xr.Dataset:
@@ -14,6 +17,7 @@ def moments(data: xr.DataArray, dim: str | list[str] = "time") -> xr.Dataset:
     ----------
     data : xarray.DataArray
         Any response (e.g. a total displacement in m); may be dask-backed.
+        NaN (padding, missing cases) is ignored.
     dim : str or list of str
         Dimension(s) to reduce: ``time`` for one record, ``realization`` for
         an ensemble at each time, or both.
@@ -23,21 +27,19 @@ def moments(data: xr.DataArray, dim: str | list[str] = "time") -> xr.Dataset:
     xarray.Dataset
         ``mean`` and ``std`` in the units of ``data``, ``variance`` in its
         square, ``skewness`` = m3/m2^1.5 and ``excess`` = m4/m2² − 3
-        (population moments, ddof = 0). Lazy if ``data`` is.
+        (population moments, ddof = 0; :func:`stochpound.analysis.kernels.moments`).
+        Lazy if ``data`` is.
     """
-    mean = data.mean(dim)
-    deviation = data - mean
-    m2 = (deviation**2).mean(dim)
-    m3 = (deviation**3).mean(dim)
-    m4 = (deviation**4).mean(dim)
+    dims = [dim] if isinstance(dim, str) else list(dim)
+    axes = tuple(range(-len(dims), 0))
+    values = reduce(lambda x: tuple(kernels.moments(x, axes)), [data], dims, len(MOMENT_NAMES))
     units = data.attrs.get("units", "")
     squared = f"({units})2" if units else ""
-    return xr.Dataset(
-        {
-            "mean": mean.assign_attrs(units=units, long_name="mean"),
-            "variance": m2.assign_attrs(units=squared, long_name="variance (population)"),
-            "std": (m2**0.5).assign_attrs(units=units, long_name="standard deviation (population)"),
-            "skewness": (m3 / m2**1.5).assign_attrs(units="1", long_name="skewness m3/m2^1.5"),
-            "excess": (m4 / m2**2 - 3.0).assign_attrs(units="1", long_name="coefficient of excess (kurtosis - 3)"),
-        }
-    )
+    attrs = {
+        "mean": {"units": units, "long_name": "mean"},
+        "variance": {"units": squared, "long_name": "variance (population)"},
+        "std": {"units": units, "long_name": "standard deviation (population)"},
+        "skewness": {"units": "1", "long_name": "skewness m3/m2^1.5"},
+        "excess": {"units": "1", "long_name": "coefficient of excess (kurtosis - 3)"},
+    }
+    return xr.Dataset({name: value.assign_attrs(attrs[name]) for name, value in zip(MOMENT_NAMES, values)})

@@ -3,7 +3,14 @@
 from __future__ import annotations
 
 import xarray as xr
-from scipy import stats
+
+from stochpound.analysis import kernels
+from stochpound.analysis.ufunc import reduce
+
+
+def pounded(impacts: xr.DataArray) -> xr.DataArray:
+    """1 where a case has at least one impact, 0 where it has none, NaN where it is missing."""
+    return (impacts > 0).astype(float).where(impacts.notnull())
 
 
 def pounding_probability(impacts: xr.DataArray, dim: str = "realization", confidence: float = 0.95) -> xr.Dataset:
@@ -12,7 +19,8 @@ def pounding_probability(impacts: xr.DataArray, dim: str = "realization", confid
     Parameters
     ----------
     impacts : xarray.DataArray
-        Number of impacts per realization (other dimensions, e.g. ``gap``, broadcast).
+        Number of impacts per realization (other dimensions, e.g. ``gap``,
+        broadcast); NaN (a missing case) is left out.
     dim : str
         The ensemble dimension.
     confidence : float
@@ -21,26 +29,17 @@ def pounding_probability(impacts: xr.DataArray, dim: str = "realization", confid
     Returns
     -------
     xarray.Dataset
-        ``probability``, ``lower`` and ``upper`` (all in [0, 1]) and ``realizations``.
+        ``probability``, ``lower`` and ``upper`` (all in [0, 1]) and
+        ``realizations`` (:func:`stochpound.analysis.kernels.proportion_interval`).
+        Lazy on dask-backed inputs.
     """
-    if not 0.0 < confidence < 1.0:
-        raise ValueError(f"confidence must be in (0, 1), got {confidence}")
-    pounded = (impacts > 0).sum(dim)
-    total = impacts.count(dim)
-    alpha = 1.0 - confidence
-
-    def lower(k, n):
-        return xr.where(k > 0, stats.beta.ppf(alpha / 2, k, n - k + 1), 0.0)
-
-    def upper(k, n):
-        return xr.where(k < n, stats.beta.ppf(1 - alpha / 2, k + 1, n - k), 1.0)
-
+    kernels.check_confidence(confidence)
+    values = reduce(lambda events: tuple(kernels.proportion_interval(events, confidence)), [pounded(impacts)], [dim], 4)
     attrs = {"units": "1", "confidence": confidence}
-    return xr.Dataset(
-        {
-            "probability": (pounded / total).assign_attrs(long_name="probability of pounding", **attrs),
-            "lower": xr.apply_ufunc(lower, pounded, total, dask="allowed").assign_attrs(long_name="lower confidence bound", **attrs),
-            "upper": xr.apply_ufunc(upper, pounded, total, dask="allowed").assign_attrs(long_name="upper confidence bound", **attrs),
-            "realizations": total.assign_attrs(units="1", long_name="number of realizations"),
-        }
-    )
+    names = {
+        "probability": {"long_name": "probability of pounding", **attrs},
+        "lower": {"long_name": "lower confidence bound (Clopper-Pearson)", **attrs},
+        "upper": {"long_name": "upper confidence bound (Clopper-Pearson)", **attrs},
+        "realizations": {"units": "1", "long_name": "number of realizations"},
+    }
+    return xr.Dataset({name: value.assign_attrs(names[name]) for name, value in zip(names, values)})

@@ -1,13 +1,16 @@
-"""The per-run scalars of MODEL.md §7, from one result dataset."""
+"""The per-run scalars of the model's outputs (one result dataset, one studied building)."""
 
 from __future__ import annotations
 
 import xarray as xr
 
+from stochpound.analysis import kernels
 from stochpound.analysis.correlation import correlation
 from stochpound.analysis.impacts import impact_statistics
 from stochpound.analysis.moments import moments
+from stochpound.analysis.names import RESPONSE_MOMENTS, RUN_SUMMARY_ALIASES, with_aliases
 from stochpound.analysis.peaks import peak_response
+from stochpound.analysis.ufunc import reduce
 
 
 def top_floor_total_displacement(run: xr.Dataset, building: str) -> xr.DataArray:
@@ -15,6 +18,11 @@ def top_floor_total_displacement(run: xr.Dataset, building: str) -> xr.DataArray
     y = run["total_displacement"].sel(building=building)
     top = int(y.notnull().any("time").sum("floor"))
     return y.sel(floor=top, drop=True)
+
+
+def response_moments(response: xr.DataArray) -> xr.Dataset:
+    """The moments of a response over time under their quantity names (``response_mean`` … ``response_excess``)."""
+    return moments(response, "time").rename(RESPONSE_MOMENTS)
 
 
 def run_summary(run: xr.Dataset, building: str, fixed_base: xr.DataArray | None = None) -> xr.Dataset:
@@ -29,28 +37,26 @@ def run_summary(run: xr.Dataset, building: str, fixed_base: xr.DataArray | None 
         response whose moments are reported).
     fixed_base : xarray.DataArray, optional
         The same building's top-floor total displacement when alone on a
-        fixed base under the same motion (same ``time``); gives ``correlation``.
+        fixed base under the same motion (same ``time``); gives
+        ``fixed_base_correlation``.
 
     Returns
     -------
     xarray.Dataset
         Peaks and residual sliding of the studied building (m), impact
         statistics of the whole run, moments of the top-floor total
-        displacement (``mean``, ``variance``, ``std``, ``skewness``,
-        ``excess``), ``energy_residual_ratio`` (max |residual| / max |input|)
-        and, if given a reference, ``correlation``.
+        displacement (``response_mean``, ``response_variance``,
+        ``response_std``, ``response_skewness``, ``response_excess``),
+        ``energy_residual_ratio`` (largest absolute residual over largest absolute input) and, if
+        given a reference, ``fixed_base_correlation``; the earlier names
+        ``mean`` … ``excess`` and ``correlation`` as aliases
+        (:mod:`stochpound.analysis.names`).
     """
     response = top_floor_total_displacement(run, building)
-    summary = xr.merge(
-        [
-            peak_response(run).sel(building=building, drop=True),
-            impact_statistics(run),
-            moments(response, "time"),
-        ]
-    )
-    summary["energy_residual_ratio"] = (abs(run["energy_residual"]).max() / abs(run["energy_input"]).max()).assign_attrs(
+    summary = xr.merge([peak_response(run).sel(building=building, drop=True), impact_statistics(run), response_moments(response)])
+    summary["energy_residual_ratio"] = reduce(kernels.energy_residual_ratio, [run["energy_residual"], run["energy_input"]], ["time"]).assign_attrs(
         units="1", long_name="largest energy residual relative to the largest input energy"
     )
     if fixed_base is not None:
-        summary["correlation"] = correlation(response, fixed_base)
-    return summary
+        summary["fixed_base_correlation"] = correlation(response, fixed_base)
+    return with_aliases(summary, RUN_SUMMARY_ALIASES)

@@ -12,9 +12,11 @@ Summaries per realization (see :mod:`stochpound.analysis`):
 
 * per building: ``peak_total_displacement``, ``peak_relative_displacement``,
   ``peak_sliding_displacement``, ``residual_sliding`` (m), and the moments
-  ``top_floor_mean``, ``top_floor_variance``, ``top_floor_std`` (m, m²),
-  ``top_floor_skewness`` and ``top_floor_excess`` of the top floor's total
-  displacement over time;
+  ``response_mean``, ``response_variance``, ``response_std`` (m, m²),
+  ``response_skewness`` and ``response_excess`` of the top floor's total
+  displacement over time (the names of the experiment store; the earlier
+  ``top_floor_mean`` … ``top_floor_excess`` remain as aliases,
+  :mod:`stochpound.analysis.names`);
 * impacts: ``impacts``, ``impacts_in_phase``, ``impacts_out_of_phase``,
   ``peak_impact_force`` (N), ``longest_impact`` (s), ``total_impulse`` (N·s);
 * energy: the final ``energy_input``, ``energy_damping``, ``energy_friction``
@@ -37,7 +39,9 @@ import xarray as xr
 from threadpoolctl import threadpool_limits
 
 from stochpound import __version__
-from stochpound.analysis import impact_statistics, moments, peak_response
+from stochpound.analysis import impact_statistics, peak_response
+from stochpound.analysis.names import ENSEMBLE_ALIASES, with_aliases
+from stochpound.analysis.summary import response_moments
 from stochpound.motions.ground import SampledMotion
 from stochpound.results.record import ENERGY_TERMS, EventCounters, Recorder
 from stochpound.model.scene import Scene
@@ -106,6 +110,7 @@ def simulate_ensemble(
     else:
         batches = _in_workers(tasks, min(workers, len(starts)))
     result = xr.concat(batches, dim="realization", data_vars="all", coords="minimal", compat="override", join="override")
+    result = with_aliases(result, ENSEMBLE_ALIASES)
     result.attrs.update(
         title="stochpound ensemble", stochpound_version=__version__, solver=method, keep=keep,
         scene_source=scene.source, g=scene.g, study_compat=int(scene.study_compat), dt=dt,
@@ -212,8 +217,7 @@ def _top_floor_moments(scene: Scene, histories: xr.Dataset) -> xr.Dataset:
     """Moments over time of every building's top-floor total displacement."""
     tops = xr.DataArray([b.n_floors for b in scene.buildings], dims="building", coords={"building": scene.building_names})
     top_floor = histories["total_displacement"].sel(floor=tops).drop_vars("floor")
-    statistics = moments(top_floor.assign_attrs(units="m"), "time")
-    return statistics.rename({name: f"top_floor_{name}" for name in statistics.data_vars})
+    return response_moments(top_floor.assign_attrs(units="m"))
 
 
 def _impacts(runs: list) -> xr.Dataset:

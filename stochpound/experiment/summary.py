@@ -11,11 +11,13 @@ keeps. A case's result is flattened into named numpy arrays (a *part*):
 Units and long names are taken from a tiny real run (:func:`templates`), so
 they always match :func:`stochpound.simulate` and :mod:`stochpound.analysis`.
 
-:func:`case_summary` and :func:`reference_summary` define the summaries with
-:mod:`stochpound.analysis`. Per case, the experiment evaluates the same
-quantities with plain numpy (:func:`case_values`, :func:`reference_values`):
-xarray's per-call overhead would cost several times the solver's time. The
-tests check that both agree.
+:func:`case_summary` and :func:`reference_summary` give the summaries as
+xarray datasets (their metadata names and describes the store's variables);
+per case, the experiment takes the same values from :func:`case_values` and
+:func:`reference_values`, which call the numpy kernels of
+:mod:`stochpound.analysis.kernels` directly (xarray's per-call overhead would
+cost several times the solver's time). Both go through the same kernels; the
+tests check that they agree.
 """
 
 from __future__ import annotations
@@ -26,21 +28,11 @@ from typing import Any, Mapping, Sequence
 import numpy as np
 import xarray as xr
 
-from stochpound.analysis import moments, peak_response
-from stochpound.analysis.summary import run_summary, top_floor_total_displacement
-from stochpound.motions.records.statistics import moments as sample_moments
+from stochpound.analysis import kernels, peak_response
+from stochpound.analysis.names import RESPONSE_MOMENTS, without_aliases
+from stochpound.analysis.summary import response_moments, run_summary, top_floor_total_displacement
 
-#: Summary names of :func:`stochpound.analysis.run_summary` renamed in the store
-#: (``mean``/``std`` would shadow Dataset methods).
-RENAMES = {
-    "mean": "response_mean",
-    "variance": "response_variance",
-    "std": "response_std",
-    "skewness": "response_skewness",
-    "excess": "response_excess",
-    "correlation": "fixed_base_correlation",
-}
-_MOMENTS = ("response_mean", "response_variance", "response_std", "response_skewness", "response_excess")
+_MOMENTS = tuple(RESPONSE_MOMENTS.values())
 _PEAKS = ("peak_total_displacement", "peak_relative_displacement", "peak_sliding_displacement", "residual_sliding")
 #: Summaries of the fixed-base reference (prefixed ``reference_`` in the store).
 REFERENCE_SUMMARIES = (*_MOMENTS, "peak_total_displacement", "peak_relative_displacement")
@@ -78,8 +70,8 @@ def case_summary(run: xr.Dataset, studied: str, fixed_base: xr.DataArray) -> xr.
         moments of the response, ``fixed_base_correlation``,
         ``energy_residual_ratio`` and ``events_total``.
     """
-    summary = run_summary(run, studied, fixed_base).drop_vars(list(_PEAKS))
-    summary = xr.merge([summary, peak_response(run)]).rename(RENAMES)
+    summary = without_aliases(run_summary(run, studied, fixed_base)).drop_vars(list(_PEAKS))
+    summary = xr.merge([summary, peak_response(run)])
     _describe_moments(summary, "")
     summary["fixed_base_correlation"].attrs["long_name"] = (
         "correlation of the studied building's top-floor total displacement with the same building alone on a fixed base"
@@ -91,8 +83,7 @@ def case_summary(run: xr.Dataset, studied: str, fixed_base: xr.DataArray) -> xr.
 def reference_summary(run: xr.Dataset, studied: str) -> xr.Dataset:
     """Summaries of the fixed-base reference run (``reference_*``, no building dimension)."""
     peaks = peak_response(run)[["peak_total_displacement", "peak_relative_displacement"]].sel(building=studied, drop=True)
-    response = moments(top_floor_total_displacement(run, studied), "time")
-    summary = xr.merge([response.rename({name: RENAMES[name] for name in response.data_vars}), peaks])
+    summary = xr.merge([response_moments(top_floor_total_displacement(run, studied)), peaks])
     _describe_moments(summary, "")
     renamed = summary[list(REFERENCE_SUMMARIES)].rename({name: f"reference_{name}" for name in REFERENCE_SUMMARIES})
     for variable in renamed.data_vars.values():
@@ -106,13 +97,6 @@ def _describe_moments(summary: xr.Dataset, suffix: str) -> None:
     summary["response_variance"].attrs["units"] = "m2"  # CF spelling of (m)2
 
 
-def _nan_abs_max(values: np.ndarray, axis: tuple[int, ...]) -> np.ndarray:
-    """max |values| over ``axis`` ignoring NaN (NaN where everything is NaN)."""
-    magnitude = np.abs(values)
-    result = np.max(np.where(np.isnan(magnitude), -np.inf, magnitude), axis=axis)
-    return np.where(np.isneginf(result), np.nan, result)
-
-
 def top_floor(run: xr.Dataset, studied: str) -> np.ndarray:
     """The studied building's top-floor total displacement over time, m (numpy)."""
     index = list(run["building"].values).index(studied)
@@ -122,53 +106,35 @@ def top_floor(run: xr.Dataset, studied: str) -> np.ndarray:
 
 
 def _moment_values(response: np.ndarray) -> dict[str, np.ndarray]:
-    mean, std, skewness, excess = sample_moments(response)
-    return {
-        "response_mean": np.float64(mean),
-        "response_variance": np.float64(std * std),
-        "response_std": np.float64(std),
-        "response_skewness": np.float64(skewness),
-        "response_excess": np.float64(excess),
-    }
+    return dict(zip(_MOMENTS, kernels.moments(response)))
 
 
 def case_values(run: xr.Dataset, studied: str, fixed_base: np.ndarray) -> dict[str, np.ndarray]:
-    """The values of :func:`case_summary`, computed with numpy (names of the store)."""
+    """The values of :func:`case_summary`, computed with the numpy kernels (names of the store)."""
     y, u, s = (run[name].values for name in ("total_displacement", "relative_displacement", "sliding_displacement"))
-    in_phase = run["impact_in_phase"].values.astype(bool)
-    count = np.int64(in_phase.size)
-
-    def largest(name: str) -> np.float64:
-        values = run[name].values
-        return np.float64(values.max()) if values.size else np.float64(0.0)
-
+    columns = [run[name].values for name in ("impact_in_phase", "impact_peak_force", "impact_duration", "impact_impulse")]
+    impacts = kernels.impact_counts(*columns, np.ones(columns[0].shape, dtype=bool))
     response = top_floor(run, studied)
-    residual, energy_input = np.abs(run["energy_residual"].values), np.abs(run["energy_input"].values)
     return {
-        "impacts": count,
-        "impacts_in_phase": np.int64(in_phase.sum()),
-        "impacts_out_of_phase": np.int64(count - in_phase.sum()),
-        "peak_impact_force": largest("impact_peak_force"),
-        "longest_impact": largest("impact_duration"),
-        "total_impulse": np.float64(run["impact_impulse"].values.sum()),
+        **{name: np.int64(value) if name.startswith("impacts") else np.float64(value) for name, value in impacts._asdict().items()},
         **_moment_values(response),
-        "energy_residual_ratio": np.float64(residual.max() / energy_input.max()),
-        "fixed_base_correlation": np.float64(np.corrcoef(response, fixed_base)[0, 1]),
-        "peak_total_displacement": _nan_abs_max(y, (1, 2)),
-        "peak_relative_displacement": _nan_abs_max(u, (1, 2)),
-        "peak_sliding_displacement": np.abs(s).max(axis=1),
-        "residual_sliding": s[:, -1].copy(),
+        "energy_residual_ratio": kernels.energy_residual_ratio(run["energy_residual"].values, run["energy_input"].values),
+        "fixed_base_correlation": kernels.pearson(response, fixed_base),
+        "peak_total_displacement": kernels.abs_peak(y, (1, 2)),
+        "peak_relative_displacement": kernels.abs_peak(u, (1, 2)),
+        "peak_sliding_displacement": kernels.abs_peak(s),
+        "residual_sliding": kernels.final_value(s),
         "events_total": np.int64(run.attrs.get("events_total", 0)),
     }
 
 
 def reference_values(run: xr.Dataset, studied: str) -> dict[str, np.ndarray]:
-    """The values of :func:`reference_summary`, computed with numpy (names of the store)."""
+    """The values of :func:`reference_summary`, computed with the numpy kernels (names of the store)."""
     index = list(run["building"].values).index(studied)
     values = {
         **_moment_values(top_floor(run, studied)),
-        "peak_total_displacement": _nan_abs_max(run["total_displacement"].values[index], (0, 1)),
-        "peak_relative_displacement": _nan_abs_max(run["relative_displacement"].values[index], (0, 1)),
+        "peak_total_displacement": kernels.abs_peak(run["total_displacement"].values[index], (0, 1)),
+        "peak_relative_displacement": kernels.abs_peak(run["relative_displacement"].values[index], (0, 1)),
     }
     return {f"reference_{name}": values[name] for name in REFERENCE_SUMMARIES}
 

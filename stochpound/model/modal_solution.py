@@ -14,6 +14,8 @@ satisfies the zero initial conditions.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 from scipy.linalg import eigh
 
@@ -22,6 +24,51 @@ from stochpound.model.building import Building, storey_matrix
 #: Largest off-diagonal modal damping, relative to the diagonal, still treated as
 #: classical (and neglected): the study's dashpots are a1·K rounded to 6 digits.
 CLASSICAL_TOLERANCE = 1e-4
+
+
+@dataclass(frozen=True)
+class Modes:
+    """The undamped modes of a fixed-base shear building and their damping.
+
+    Attributes
+    ----------
+    omega : numpy.ndarray
+        Natural circular frequencies ω_n, rad/s, ascending.
+    damping_ratio : numpy.ndarray
+        Modal damping ratios ζ_n = φ_nᵀ C φ_n / (2 ω_n) (mass-normalised φ_n).
+    shapes : numpy.ndarray
+        Mass-normalised mode shapes, one per column.
+    participation : numpy.ndarray
+        Γ_n = φ_nᵀ M 1.
+    classical : bool
+        Whether φᵀ C φ is diagonal (to :data:`CLASSICAL_TOLERANCE`): only then
+        do the modes decouple and ζ_n describe the damping exactly.
+    """
+
+    omega: np.ndarray
+    damping_ratio: np.ndarray
+    shapes: np.ndarray
+    participation: np.ndarray
+    classical: bool
+
+    @property
+    def periods(self) -> np.ndarray:
+        """Natural periods 2π/ω_n, s."""
+        return 2.0 * np.pi / self.omega
+
+
+def modal_properties(building: Building) -> Modes:
+    """The modes of ``building`` on a fixed base (its base, if any, is ignored)."""
+    mass = np.diag(building.mass)
+    stiffness = storey_matrix(np.asarray(building.stiffness, dtype=float))
+    damping = storey_matrix(np.asarray(building.damping, dtype=float))
+    eigenvalues, shapes = eigh(stiffness, mass)  # mass-normalised shapes
+    modal_damping = shapes.T @ damping @ shapes
+    off_diagonal = modal_damping - np.diag(np.diag(modal_damping))
+    classical = bool(np.max(np.abs(off_diagonal), initial=0.0) <= CLASSICAL_TOLERANCE * np.max(np.abs(np.diag(modal_damping))))
+    omega = np.sqrt(eigenvalues)
+    participation = shapes.T @ mass @ np.ones(len(building.mass))
+    return Modes(omega, np.diag(modal_damping) / (2.0 * omega), shapes, participation, classical)
 
 
 def harmonic_response(building: Building, amplitude: float, omega: float, times: np.ndarray) -> np.ndarray:
@@ -49,21 +96,13 @@ def harmonic_response(building: Building, amplitude: float, omega: float, times:
         If the damping is not classical (the modes would not decouple), or
         a mode is in exact resonance with undamped forcing.
     """
-    mass = np.diag(building.mass)
-    stiffness = storey_matrix(np.asarray(building.stiffness, dtype=float))
-    damping = storey_matrix(np.asarray(building.damping, dtype=float))
-    eigenvalues, shapes = eigh(stiffness, mass)  # mass-normalised shapes
-    modal_damping = shapes.T @ damping @ shapes
-    off_diagonal = modal_damping - np.diag(np.diag(modal_damping))
-    if np.max(np.abs(off_diagonal), initial=0.0) > CLASSICAL_TOLERANCE * np.max(np.abs(np.diag(modal_damping))):
+    modes = modal_properties(building)
+    if not modes.classical:
         raise ValueError(f"building {building.name!r}: damping is not classical (not diagonal in the mode shapes)")
-    participation = shapes.T @ mass @ np.ones(len(building.mass))
     response = np.zeros((len(building.mass), len(times)))
-    for n in range(len(eigenvalues)):
-        natural = float(np.sqrt(eigenvalues[n]))
-        ratio = float(modal_damping[n, n] / (2.0 * natural))
-        eta = modal_coordinate(natural, ratio, -participation[n] * amplitude, omega, times)
-        response += np.outer(shapes[:, n], eta)
+    for n, (natural, ratio) in enumerate(zip(modes.omega, modes.damping_ratio)):
+        eta = modal_coordinate(float(natural), float(ratio), -modes.participation[n] * amplitude, omega, times)
+        response += np.outer(modes.shapes[:, n], eta)
     return response
 
 

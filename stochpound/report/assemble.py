@@ -15,7 +15,7 @@ from pathlib import Path
 
 import xarray as xr
 
-from stochpound.report import findings, study_figures, study_tables
+from stochpound.report import findings, study_figures, study_notes, study_tables
 from stochpound.report.document import Block, Paragraph, Report, Section
 from stochpound.report.generic import store_section
 from stochpound.report.methods import methods_section
@@ -56,7 +56,7 @@ def assemble_report(paths: Sequence[str | Path], progress: Callable[[str], None]
     study = {name: store for name, store in stores.items() if name in STUDY_EXPERIMENTS}
     others = {name: store for name, store in stores.items() if name not in STUDY_EXPERIMENTS}
     report = Report(
-        title="Pounding of base-isolated buildings: the reference study regenerated" if study else "stochpound experiment report",
+        title="Pounding of base-isolated buildings: the reference study regenerated" if study else f"Pounding experiments: {', '.join(others)}",
         subtitle=f"stochpound report of {', '.join(stores)}, built {date.today().isoformat()}",
         sources=[f"{name}: {store.attrs.get('experiment_file', '')}, definition sha256 {store.attrs.get('definition_sha256', '')}" for name, store in stores.items()],
     )
@@ -65,6 +65,8 @@ def assemble_report(paths: Sequence[str | Path], progress: Callable[[str], None]
         for title, key, build in _study_sections(study):
             say(title)
             report.sections.append(Section(title, build(), key=key))
+    if others and not study:
+        report.sections.append(Section("About this report", [Paragraph(_about(others))], key="about"))
     for name, store in others.items():
         say(f"experiment {name}")
         report.sections.append(store_section(name, store))
@@ -73,27 +75,42 @@ def assemble_report(paths: Sequence[str | Path], progress: Callable[[str], None]
     return report
 
 
+def _about(stores: dict[str, xr.Dataset]) -> str:
+    """What the report of stores that are not the study's holds, and how to read it."""
+    described = "; ".join(f"{name}: {store.attrs.get('experiment_description', '')}" for name, store in stores.items())
+    return (
+        f"This report describes the experiment stores {described}. Each experiment has a section: the cases run under "
+        "records one by one, and each synthetic ensemble by the statistics of its realizations in every cell of the grid "
+        "(every combination of the grid's axes): means with 95 % Student-t confidence intervals, quantiles of the peaks, and "
+        "the probability of pounding (at least one impact) with its 95 % Clopper–Pearson interval, followed by findings "
+        "computed from them, tables (also written as CSV files) and figures in which every cell is drawn. An ECDF gives, for "
+        "each value, the fraction of realizations at or below it; a convergence figure shows an estimate over the first n "
+        "realizations, so that one sees whether the ensemble is large enough. The Methods section describes every building, "
+        "contact and motion from the stores' own definitions and checks the solver while the report is built."
+    )
+
+
 def _study_sections(stores: dict[str, xr.Dataset]) -> list[tuple[str, str, Callable[[], list[Block]]]]:
     """(title, key, builder) of each study section whose stores are present."""
     gap, single, pair_mu, pair_records, harmonic = (stores.get(name) for name in ("study_gap", "study_single", "study_pair_mu", "study_pair_records", "study_harmonic"))
     sections = []
     if pair_mu is not None or gap is not None:
-        sections.append(("Findings", "findings", lambda: _findings(gap, pair_mu)))
+        sections.append(("Findings", "findings", lambda: _findings(gap, pair_mu, pair_records)))
     sections.append(("The records", "records", lambda: [study_tables.records_table(), study_figures.accelerograms()]))
     if harmonic is not None:
         sections.append(("Harmonic check", "harmonic", lambda: study_figures.harmonic_check(harmonic)))
     if gap is not None:
-        sections.append(("Both fixed: pounding against the gap", "gap", lambda: [study_figures.gap_time_history(gap), *study_figures.against_gap(gap)]))
+        sections.append(("Both fixed: pounding against the gap", "gap", lambda: [study_tables.building_2_table(gap), study_figures.gap_time_history(gap), *study_figures.against_gap(gap)]))
     if single is not None:
         sections.append(("Single isolated building against μ", "single", lambda: [*study_figures.single_against_mu(single), study_figures.single_histograms(single)]))
     if pair_mu is not None:
         sections.append(("The pair against μ (El Centro, gap 2 cm)", "pair-mu", lambda: _pair_mu(pair_mu)))
     if pair_records is not None:
-        sections.append(("The pair by record (μ = 0.2)", "pair-records", lambda: _pair_records(pair_records, pair_mu)))
+        sections.append(("The pair by record (μ = 0.2)", "pair-records", lambda: _pair_records(pair_records, pair_mu, single)))
     return sections
 
 
-def _findings(gap: xr.Dataset | None, pair_mu: xr.Dataset | None) -> list[Block]:
+def _findings(gap: xr.Dataset | None, pair_mu: xr.Dataset | None, pair_records: xr.Dataset | None) -> list[Block]:
     blocks: list[Block] = []
     if pair_mu is not None:
         blocks += [findings.fixed_columns(pair_mu), findings.isolated_columns(pair_mu)]
@@ -101,17 +118,18 @@ def _findings(gap: xr.Dataset | None, pair_mu: xr.Dataset | None) -> list[Block]
         blocks += [findings.gap_effect(gap), findings.small_gaps(gap)]
         blocks.append(findings.phase(gap, pair_mu))
     if pair_mu is not None:
-        blocks += [findings.worst_case(pair_mu), findings.correlation_collapse(pair_mu)]
+        blocks += [findings.worst_case(pair_mu, pair_records), findings.correlation_collapse(pair_mu)]
     return blocks
 
 
 def _pair_mu(store: xr.Dataset) -> list[Block]:
     tables = [study_tables.mu_table(number, store) for number in ("4.1", "4.3", "4.5", "4.7")]
-    return [*tables, *study_figures.pair_against_mu(store), study_tables.correlation_table(store)]
+    return [*tables, *study_figures.pair_against_mu(store), study_tables.correlation_table(store), *study_notes.scaling_sensitivity(store)]
 
 
-def _pair_records(store: xr.Dataset, pair_mu: xr.Dataset | None) -> list[Block]:
+def _pair_records(store: xr.Dataset, pair_mu: xr.Dataset | None, single: xr.Dataset | None) -> list[Block]:
     blocks: list[Block] = [study_tables.by_record_table(number, store) for number in ("4.2", "4.4", "4.6", "4.8")]
+    blocks += study_notes.northridge_means(store, single)
     blocks += study_figures.by_record_histograms(store)
     if pair_mu is not None:
         blocks.append(study_figures.configurations_time_history(pair_mu))

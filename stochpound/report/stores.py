@@ -103,6 +103,19 @@ def case_impacts(store: xr.Dataset, **labels: Any) -> xr.Dataset:
     return table.isel(impact=np.flatnonzero(keep)).load()
 
 
+def store_experiment(store: xr.Dataset) -> Experiment:
+    """The store's experiment, from its canonical definition (JSON, which spells infinity "inf").
+
+    The grid's values are numbers again (μ = ∞ is a float), as when the
+    experiment file was read; case ids are unchanged.
+    """
+    definition = json.loads(store.attrs["definition"])
+    for axis in [definition["mu"], *definition["gaps"]]:
+        if axis is not None:
+            axis["values"] = [float(v) for v in axis["values"]]
+    return Experiment(definition)
+
+
 def case_scene(store: xr.Dataset, **labels: Any) -> Scene:
     """The scene (structure and motion) of one stored case, rebuilt from the store's definition.
 
@@ -113,7 +126,7 @@ def case_scene(store: xr.Dataset, **labels: Any) -> Scene:
     **labels
         The case's label on every grid dimension of the store.
     """
-    experiment = Experiment(json.loads(store.attrs["definition"]))
+    experiment = store_experiment(store)
     case = experiment.case_index[str(select(store, **labels)["case_id"].values)]
     where = case.label_dict
     return scene_from_dict({**experiment.structure(case), "motion": experiment.motion_table(where["record"], where.get("realization"))})

@@ -15,7 +15,7 @@ import xarray as xr
 from stochpound.motions.records import load_record
 from stochpound.report import figures
 from stochpound.report.document import FigureItem
-from stochpound.report.methods import harmonic_comparisons
+from stochpound.report.accuracy import harmonic_comparisons
 from stochpound.report.stores import case_impacts, select
 from stochpound.report.study_tables import RECORD_ENTRIES, record_label
 
@@ -54,28 +54,36 @@ def accelerograms() -> FigureItem:
         longest = max(longest, loaded.duration)
     time = np.arange(0.0, longest + 0.005, 0.005)
     for record, (t, a) in series.items():
-        padded = np.interp(time, t, a, left=np.nan, right=np.nan)
-        panels[f"{record_label(record)} (m/s²)"] = {record_label(record): padded}
+        panels[record_label(record)] = {record_label(record): np.interp(time, t, a, left=np.nan, right=np.nan)}
     caption = (
         "Figure 3.4: ground accelerations of the four records (the study's El Centro and Mexico City; substitutes "
         "for Loma Prieta and Northridge, whose study files were not found)."
     )
-    return FigureItem("figure-3.4", caption, figures.traces(time, panels, "The four records", height=1.6))
+    return FigureItem("figure-3.4", caption, figures.traces(time, panels, "The four records", height=1.7, y_label="a_g (m/s²)"))
 
 
 def gap_time_history(store: xr.Dataset, gap: float = 0.02, neighbour: str = "flexible") -> FigureItem:
-    """Figure 3.6: Building 1's top floor with impact onsets, and the impact forces (both fixed)."""
+    """Figure 3.6: Building 1's top floor with impact onsets, and each contact's force with its impacts' located peaks (both fixed)."""
     case = {"neighbour": neighbour, "gap": gap, "mu": math.inf, "record": "el_centro"}
     run = select(store, **case)
     top = run["total_displacement"].sel(building="B1").isel(floor=-1).values
     impacts = case_impacts(store, **case, realization=0)
-    forces = {f"contact at floor {c + 1}": run["impact_force"].sel(contact=c).values for c in run["contact"].values}
+    forces = {}
+    for contact in run["contact"].values:
+        mine = impacts.isel(impact=np.flatnonzero(impacts["impact_contact"].values == contact))
+        forces[f"contact at floor {contact + 1}"] = (run["impact_force"].sel(contact=contact).values, mine["impact_peak_time"].values, mine["impact_peak_force"].values)
     title = f"Both fixed, {NEIGHBOURS[neighbour]}, gap {gap * CM:g} cm, El Centro 1940"
     figure = figures.time_history_with_impacts(run["time"].values, top, impacts["impact_start"].values, forces, "Building 1, floor 2", title)
+    step = float(run["time"].values[1] - run["time"].values[0])
+    largest = int(np.argmax(impacts["impact_peak_force"].values))
+    sampled = float(run["impact_force"].max())
     caption = (
-        f"Figure 3.6: Building 1's top-floor total displacement with impact onsets, and the contact forces; both buildings "
-        f"fixed, Building 2 {neighbour}, gap {gap * CM:g} cm, El Centro 1940 (the study's record). Largest impact force "
-        f"{float(impacts['impact_peak_force'].max()) / 1e3:.0f} kN."
+        f"Figure 3.6: Building 1's top-floor total displacement with impact onsets, and the force of each contact: sampled every "
+        f"{step:g} s (grey) and the peak of every impact located on the solution (dots); both buildings fixed, Building 2 "
+        f"{neighbour}, gap {gap * CM:g} cm, El Centro 1940 (the study's record). Largest located peak "
+        f"{float(impacts['impact_peak_force'][largest]) / 1e3:.0f} kN (contact at floor {int(impacts['impact_contact'][largest]) + 1}, "
+        f"t = {float(impacts['impact_peak_time'][largest]):.2f} s); the largest sampled value is {sampled / 1e3:.0f} kN, because the "
+        f"peaks fall between samples."
     )
     return FigureItem("figure-3.6", caption, figure)
 
@@ -95,35 +103,49 @@ def against_gap(store: xr.Dataset) -> list[FigureItem]:
         f"{building} peak total displacement (cm)": {NEIGHBOURS[n]: data[n]["peak_total_displacement"].sel(building=building).values * CM for n in NEIGHBOURS}
         for building in ("B1", "B2")
     }
-    force = {"peak impact force (kN)": {NEIGHBOURS[n]: data[n]["peak_impact_force"].values / 1e3 for n in NEIGHBOURS}}
+    force = {"peak impact force (kN)": {NEIGHBOURS[n]: _where_impacts(data[n], "peak_impact_force") / 1e3 for n in NEIGHBOURS}}
     where = "both buildings fixed, El Centro 1940 (the study's record)"
     specs = (
         ("3.7", impacts, f"Figure 3.7: number of impacts (total, in-phase, out-of-phase) against the gap; {where}; total also with the study's spline input."),
         ("3.8", peaks, f"Figure 3.8: peak total displacement of each building against the gap; {where}."),
-        ("3.9", force, f"Figure 3.9: peak impact force against the gap; {where}."),
+        ("3.9", force, f"Figure 3.9: peak impact force against the gap (not drawn at gaps without impacts); {where}."),
     )
     return [FigureItem(f"figure-{number}", caption, figures.against(gaps, panels, caption.split(":")[0], "gap (cm)")) for number, panels, caption in specs]
 
 
 def single_against_mu(store: xr.Dataset) -> list[FigureItem]:
-    """Figures 4.1–4.5: the single isolated building against μ, four records."""
+    """Figures 4.1–4.5: the single isolated building against μ, four records.
+
+    A frictionless base (μ = 0) drifts with the ground's displacement: its
+    sliding and total displacements (Figures 4.4–4.5) are an order of
+    magnitude beyond the others, so they are given in the caption instead.
+    """
     finite = store["mu"].values[np.isfinite(store["mu"].values)]
     records = list(store["record"].values)
     specs = (
-        ("4.1", "skewness", "response_skewness", 1.0, None),
-        ("4.2", "excess", "response_excess", 1.0, None),
-        ("4.3", "peak relative displacement (cm)", "peak_relative_displacement", CM, "B1"),
-        ("4.4", "peak sliding displacement (cm)", "peak_sliding_displacement", CM, "B1"),
-        ("4.5", "peak total displacement (cm)", "peak_total_displacement", CM, "B1"),
+        ("4.1", "skewness", "response_skewness", 1.0, None, False),
+        ("4.2", "excess", "response_excess", 1.0, None, False),
+        ("4.3", "peak relative displacement (cm)", "peak_relative_displacement", CM, "B1", False),
+        ("4.4", "peak sliding displacement (cm)", "peak_sliding_displacement", CM, "B1", True),
+        ("4.5", "peak total displacement (cm)", "peak_total_displacement", CM, "B1", True),
     )
     items = []
-    for number, label, variable, factor, building in specs:
-        lines = {}
+    for number, label, variable, factor, building, without_frictionless in specs:
+        mus = finite[finite > 0] if without_frictionless else finite
+        lines, frictionless = {}, []
         for record in records:
             data = select(store, record=record, mu=finite)[variable]
-            lines[record_label(record)] = (data.sel(building=building) if building else data).values * factor
+            values = (data.sel(building=building) if building else data) * factor
+            lines[record_label(record)] = values.sel(mu=mus).values
+            if without_frictionless and 0.0 in finite:
+                frictionless.append(f"{record_label(record)} {float(values.sel(mu=0.0)):.0f} cm")
         caption = f"Figure {number}: {label} of the single isolated building's top floor against μ, four records (substitutes labelled)."
-        items.append(FigureItem(f"figure-{number}", caption, figures.against(finite, {label: lines}, caption.split(":")[0], "friction coefficient μ")))
+        if frictionless:
+            caption = caption[:-1] + (
+                f", μ > 0. A frictionless base (μ = 0) has no friction to hold it and drifts with the ground's displacement: "
+                f"{'; '.join(frictionless)} at μ = 0, left out of the plot."
+            )
+        items.append(FigureItem(f"figure-{number}", caption, figures.against(mus, {label: lines}, caption.split(":")[0], "friction coefficient μ")))
     return items
 
 
@@ -147,15 +169,16 @@ def pair_against_mu(store: xr.Dataset) -> list[FigureItem]:
         "peak total displacement (cm)": ("peak_total_displacement", CM, "B1"),
     }
     finite = store["mu"].values[np.isfinite(store["mu"].values)]
-    common = "gap 2 cm, El Centro 1940; corrected model and the study's equations (study_compat)"
+    common = "gap 2 cm, El Centro 1940 interpolated linearly; corrected model and the study's equations (study_compat)"
     items = []
     for isolation, description in CONFIGURATIONS.items():
         panels = {label: _lines_against_mu(store, isolation, *spec) for label, spec in quantities.items()}
         caption = (
-            f"Figures 4.8–4.15 ({description}): impacts, peak impact force, longest impact and Building 1's peak total "
-            f"displacement against μ, Building 2 stiff and flexible; {common}."
+            f"Figures 4.8–4.15 ({description}): impacts, peak impact force, longest impact (logarithmic axis) and Building 1's "
+            f"peak total displacement against μ, Building 2 stiff and flexible; {common}. Force and duration are not drawn "
+            "where a case has no impact."
         )
-        figure = figures.against(finite, panels, f"Figures 4.8–4.15: {description}", "friction coefficient μ")
+        figure = figures.against(finite, panels, f"Figures 4.8–4.15: {description}", "friction coefficient μ", log_panels=["longest impact (ms)"])
         items.append(FigureItem(f"figure-4.8-4.15-{isolation}", caption, figure))
     panels = {f"{description}: peak relative displacement (cm)": _lines_against_mu(store, isolation, "peak_relative_displacement", CM, "B1") for isolation, description in CONFIGURATIONS.items()}
     caption = f"Figures 4.16–4.17: Building 1's peak relative displacement against μ, Building 1 isolated and both isolated; {common}."
@@ -170,10 +193,18 @@ def _lines_against_mu(store: xr.Dataset, isolation: str, variable: str, factor: 
     lines = {}
     for neighbour in NEIGHBOURS:
         for model in models:
-            data = select(store, isolation=isolation, neighbour=neighbour, gap=0.02, mu=finite, model=model, record="el_centro")[variable]
+            case = select(store, isolation=isolation, neighbour=neighbour, gap=0.02, mu=finite, model=model, record="el_centro")
             name = NEIGHBOURS[neighbour] + ("" if model == "corrected" else ", study's equations")
-            lines[name] = (data.sel(building=building) if building else data).values * factor
+            if variable in ("peak_impact_force", "longest_impact"):
+                lines[name] = _where_impacts(case, variable) * factor
+            else:
+                lines[name] = (case[variable].sel(building=building) if building else case[variable]).values * factor
     return lines
+
+
+def _where_impacts(case: xr.Dataset, variable: str) -> np.ndarray:
+    """An impact extreme where the case has impacts, NaN where it has none (the store holds 0 there)."""
+    return np.where(case["impacts"].values > 0, case[variable].values, np.nan)
 
 
 def by_record_histograms(store: xr.Dataset) -> list[FigureItem]:

@@ -14,6 +14,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
+from stochpound.analysis import kernels
 from stochpound.motions.records.record import Record
 
 #: The reference study's g, m/s².
@@ -74,15 +75,8 @@ def moments(values: np.ndarray) -> tuple[float, float, float, float]:
         ``std`` with ddof = 0; ``skewness = m3/m2**1.5``; ``excess = m4/m2**2 − 3``
         (NaN skewness and excess for a constant sample).
     """
-    x = np.asarray(values, dtype=np.float64)
-    mean = float(x.mean())
-    centred = x - mean
-    m2 = float(np.mean(centred**2))
-    if m2 == 0.0:
-        return mean, 0.0, float("nan"), float("nan")
-    m3 = float(np.mean(centred**3))
-    m4 = float(np.mean(centred**4))
-    return mean, m2**0.5, m3 / m2**1.5, m4 / m2**2 - 3.0
+    result = kernels.moments(np.asarray(values, dtype=np.float64))
+    return float(result.mean), float(result.std), float(result.skewness), float(result.excess)
 
 
 def arias_intensity(acceleration: np.ndarray, dt: float, g: float = STUDY_G) -> float:
