@@ -10,8 +10,6 @@ aligns and merges every variable, which would cost more than a whole exact run.
 
 from __future__ import annotations
 
-import os
-import tempfile
 from pathlib import Path
 from typing import Any
 
@@ -21,6 +19,7 @@ import xarray as xr
 from xarray.indexes import PandasIndex
 
 from stochpound import __version__
+from stochpound.atomic import replacing
 from stochpound.events import EventCounters
 from stochpound.recorder import ENERGY_TERMS, Recorder
 from stochpound.scene import Scene
@@ -169,16 +168,10 @@ def _energy_variables(recorder: Recorder) -> dict[str, xr.Variable]:
 def write_dataset(dataset: xr.Dataset, path: str | Path) -> Path:
     """Write ``dataset`` as netCDF4/HDF5 atomically (a temporary file renamed into place).
 
-    An interrupted write never leaves a partial file at ``path``.
+    An interrupted write never leaves a partial file at ``path``; the file's
+    permissions follow the umask (:mod:`stochpound.atomic`).
     """
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    os.close(handle)
-    try:
+    with replacing(path) as temporary:
         dataset.to_netcdf(temporary, engine="h5netcdf", invalid_netcdf=False)
-        os.replace(temporary, path)
-    except BaseException:
-        Path(temporary).unlink(missing_ok=True)
-        raise
     return path

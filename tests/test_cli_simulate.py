@@ -1,10 +1,13 @@
-"""``stochpound simulate SCENE.toml --out RUN.nc`` writes the CONTRACT.md dataset."""
+"""``stochpound simulate SCENE.toml --out RUN.nc`` writes the CONTRACT.md dataset (refusing to overwrite, following the umask)."""
 
+import os
+import stat
 import subprocess
 import sys
 from pathlib import Path
 
 import numpy as np
+import pytest
 import xarray as xr
 
 import stochpound
@@ -43,3 +46,55 @@ def test_simulate_writes_the_contract_dataset(tmp_path):
         np.testing.assert_array_equal(run.sliding_displacement.sel(building="B2"), 0.0)
         in_memory = stochpound.simulate(stochpound.load_scene(EXAMPLE), method="ivp")
         np.testing.assert_array_equal(run.total_displacement.values, in_memory.total_displacement.values)
+
+
+SMALL_SCENE = """
+[[building]]
+mass = [1.0e5]
+stiffness = [4.0e7]
+damping = [1.0e5]
+
+[motion]
+type = "harmonic"
+amplitude = 3.0
+omega = 9.0
+duration = 2.0
+dt = 0.01
+"""
+
+
+def _simulate(folder, *args: str, umask: int | None = None) -> subprocess.CompletedProcess:
+    scene = folder / "scene.toml"
+    scene.write_text(SMALL_SCENE)
+
+    def set_umask() -> None:
+        if umask is not None:
+            os.umask(umask)
+
+    return subprocess.run([sys.executable, "-m", "stochpound", "simulate", str(scene), *args], capture_output=True, text=True, preexec_fn=set_umask)
+
+
+def test_an_existing_output_is_refused_without_overwrite(tmp_path):
+    out = tmp_path / "run.nc"
+    out.write_bytes(b"keep me")
+    refused = _simulate(tmp_path, "--out", str(out))
+    assert refused.returncode == 2 and f"{out} exists; give --overwrite to replace it" in refused.stderr
+    assert out.read_bytes() == b"keep me"
+    replaced = _simulate(tmp_path, "--out", str(out), "--overwrite")
+    assert replaced.returncode == 0, replaced.stderr
+    with xr.open_dataset(out) as run:
+        assert run.sizes["time"] == 201
+
+
+def test_an_output_suffix_other_than_nc_is_warned_about(tmp_path):
+    result = _simulate(tmp_path, "--out", str(tmp_path / "run.h5"))
+    assert result.returncode == 0
+    assert "warning: --out" in result.stderr and "usual suffix is .nc (got .h5)" in result.stderr
+    assert "warning" not in _simulate(tmp_path, "--out", str(tmp_path / "run.nc")).stderr
+
+
+@pytest.mark.parametrize("umask, mode", [(0o022, 0o644), (0o027, 0o640)])
+def test_the_output_follows_the_umask(tmp_path, umask, mode):
+    out = tmp_path / "run.nc"
+    assert _simulate(tmp_path, "--out", str(out), umask=umask).returncode == 0
+    assert stat.S_IMODE(out.stat().st_mode) == mode
