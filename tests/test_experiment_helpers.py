@@ -103,6 +103,18 @@ def cli_process(*args: str, env: dict | None = None) -> subprocess.Popen:
     )
 
 
+def done_cases(store: Path) -> int:
+    """Finished cases in a store's parts folder."""
+    from stochpound.experiment.parts import read_definition, parts_folder
+    from stochpound.experiment.model import Experiment
+    from stochpound.experiment.store_writer import PartsIndex
+
+    folder = parts_folder(store)
+    if not (folder / "experiment.json").is_file():
+        return 0
+    return PartsIndex.scan(Experiment(read_definition(folder)["definition"]), folder).n_done
+
+
 def assert_same_results(first: Path, second: Path) -> None:
     """Every variable and coordinate of two stores is bitwise identical (attributes aside)."""
     with xr.open_dataset(first) as a, xr.open_dataset(second) as b:

@@ -13,9 +13,10 @@ they always match :func:`stochpound.simulate` and :mod:`stochpound.analysis`.
 
 :func:`case_summary` and :func:`reference_summary` define the summaries with
 :mod:`stochpound.analysis`. Per case, the experiment evaluates the same
-quantities with plain numpy (:func:`case_values`, :func:`reference_values`):
-xarray's per-call overhead would cost several times the solver's time. The
-tests check that both agree.
+quantities with plain numpy (:func:`case_values`, :func:`reference_values`),
+reading the run's variables directly (``run.variables``): xarray's per-call
+overhead would cost several times the solver's time. The tests check that
+both agree.
 """
 
 from __future__ import annotations
@@ -115,8 +116,8 @@ def _nan_abs_max(values: np.ndarray, axis: tuple[int, ...]) -> np.ndarray:
 
 def top_floor(run: xr.Dataset, studied: str) -> np.ndarray:
     """The studied building's top-floor total displacement over time, m (numpy)."""
-    index = list(run["building"].values).index(studied)
-    y = run["total_displacement"].values[index]
+    index = list(run.variables["building"].values).index(studied)
+    y = run.variables["total_displacement"].values[index]
     top = int(np.sum(~np.all(np.isnan(y), axis=-1)))
     return y[top - 1]
 
@@ -134,23 +135,24 @@ def _moment_values(response: np.ndarray) -> dict[str, np.ndarray]:
 
 def case_values(run: xr.Dataset, studied: str, fixed_base: np.ndarray) -> dict[str, np.ndarray]:
     """The values of :func:`case_summary`, computed with numpy (names of the store)."""
-    y, u, s = (run[name].values for name in ("total_displacement", "relative_displacement", "sliding_displacement"))
-    in_phase = run["impact_in_phase"].values.astype(bool)
+    variables = run.variables
+    y, u, s = (variables[name].values for name in ("total_displacement", "relative_displacement", "sliding_displacement"))
+    in_phase = variables["impact_in_phase"].values.astype(bool)
     count = np.int64(in_phase.size)
 
     def largest(name: str) -> np.float64:
-        values = run[name].values
+        values = variables[name].values
         return np.float64(values.max()) if values.size else np.float64(0.0)
 
     response = top_floor(run, studied)
-    residual, energy_input = np.abs(run["energy_residual"].values), np.abs(run["energy_input"].values)
+    residual, energy_input = np.abs(variables["energy_residual"].values), np.abs(variables["energy_input"].values)
     return {
         "impacts": count,
         "impacts_in_phase": np.int64(in_phase.sum()),
         "impacts_out_of_phase": np.int64(count - in_phase.sum()),
         "peak_impact_force": largest("impact_peak_force"),
         "longest_impact": largest("impact_duration"),
-        "total_impulse": np.float64(run["impact_impulse"].values.sum()),
+        "total_impulse": np.float64(variables["impact_impulse"].values.sum()),
         **_moment_values(response),
         "energy_residual_ratio": np.float64(residual.max() / energy_input.max()),
         "fixed_base_correlation": np.float64(np.corrcoef(response, fixed_base)[0, 1]),
@@ -162,14 +164,14 @@ def case_values(run: xr.Dataset, studied: str, fixed_base: np.ndarray) -> dict[s
     }
 
 
-def reference_values(run: xr.Dataset, studied: str) -> dict[str, np.ndarray]:
-    """The values of :func:`reference_summary`, computed with numpy (names of the store)."""
-    index = list(run["building"].values).index(studied)
-    values = {
-        **_moment_values(top_floor(run, studied)),
-        "peak_total_displacement": _nan_abs_max(run["total_displacement"].values[index], (0, 1)),
-        "peak_relative_displacement": _nan_abs_max(run["relative_displacement"].values[index], (0, 1)),
-    }
+def reference_values(displacement: np.ndarray) -> dict[str, np.ndarray]:
+    """The values of :func:`reference_summary`, computed with numpy (names of the store).
+
+    ``displacement`` (floors × time, m) is the fixed-base building's floor
+    displacements, its total and relative displacement alike.
+    """
+    peak = _nan_abs_max(displacement, (0, 1))
+    values = {**_moment_values(displacement[-1]), "peak_total_displacement": peak, "peak_relative_displacement": peak}
     return {f"reference_{name}": values[name] for name in REFERENCE_SUMMARIES}
 
 
@@ -191,23 +193,21 @@ def case_arrays(summary: Mapping[str, np.ndarray], run: xr.Dataset, histories: S
     """
     arrays = {f"s:{name}": np.asarray(value) for name, value in summary.items()}
     if histories:
-        arrays["t:time"] = np.asarray(run["time"].values)
+        names = list(run.variables["building"].values)
+        kept = [names.index(b) for b in buildings if b in names]
         for name in histories:
-            variable = run[name]
-            if "building" in variable.dims:
-                variable = variable.sel(building=[b for b in buildings if b in run["building"].values])
-            arrays[f"t:{name}"] = np.asarray(variable.values)
+            variable = run.variables[name]
+            arrays[f"t:{name}"] = variable.values[kept] if variable.dims[0] == "building" else variable.values
     if impacts:
-        arrays.update({f"i:{name}": np.asarray(run[name].values) for name in IMPACT_COLUMNS})
+        arrays.update({f"i:{name}": run.variables[name].values for name in IMPACT_COLUMNS})
     return arrays
 
 
-def reference_arrays(summary: Mapping[str, np.ndarray], run: xr.Dataset, keep_history: bool) -> dict[str, np.ndarray]:
-    """Part arrays of a reference case: its summaries and, if asked, its total displacement."""
+def reference_arrays(summary: Mapping[str, np.ndarray], displacement: np.ndarray, keep_history: bool) -> dict[str, np.ndarray]:
+    """Part arrays of a reference case: its summaries and, if asked, its floors' total displacement (floors × time, m)."""
     arrays = {f"s:{name}": np.asarray(value) for name, value in summary.items()}
     if keep_history:
-        arrays["t:time"] = np.asarray(run["time"].values)
-        arrays["t:reference_total_displacement"] = np.asarray(run["total_displacement"].values[0])
+        arrays["t:reference_total_displacement"] = displacement
     return arrays
 
 
