@@ -77,11 +77,12 @@ def _errors_of(path: str, name_it: bool) -> Iterator[None]:
 
 
 def _summary(report) -> None:
-    rate = report.done_now / report.elapsed if report.elapsed > 0 else 0.0
+    running = report.elapsed - report.setup
+    rate = report.done_now / running if running > 0 else 0.0
     state = "interrupted" if report.interrupted else ("complete" if report.complete else "incomplete")
     click.echo(
         f"{state}: {report.done}/{report.total} cases done ({report.done_now} this run, {report.done_before} before) "
-        f"in {report.elapsed:.1f} s, {rate:.2f} cases/s on {report.executor}"
+        f"in {report.elapsed:.1f} s ({report.setup:.1f} s start-up), {rate:.2f} cases/s on {report.executor}"
     )
     for described, error in report.failed[:5]:
         click.echo(f"FAILED {described}\n{error}", err=True)

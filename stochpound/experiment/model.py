@@ -180,8 +180,8 @@ class Experiment:
     @cached_property
     def motion_dims(self) -> list[Dim]:
         """``record`` (motion labels) and ``realization`` (union of realization indices)."""
-        realizations = sorted({r for label in self.motions for r in self.realizations(label)})
-        return [Dim("record", "record", tuple(self.motions)), Dim("realization", "realization", tuple(realizations))]
+        realizations = np.unique(np.concatenate([np.asarray(self.realizations(label)) for label in self.motions]))
+        return [Dim("record", "record", tuple(self.motions)), Dim("realization", "realization", tuple(realizations.tolist()))]
 
     @cached_property
     def grid_dims(self) -> list[Dim]:
@@ -210,12 +210,12 @@ class Experiment:
                 return True
         return False
 
-    def realizations(self, label: str) -> list[int]:
-        """Realization indices of a motion: ``[0]`` for a record, start .. start+count−1 for an ensemble."""
+    def realizations(self, label: str) -> range:
+        """Realization indices of a motion: 0 for a record, start .. start+count−1 for an ensemble."""
         motion = self.motions[label]
         if motion["kind"] == "record":
-            return [0]
-        return list(range(motion["start"], motion["start"] + motion["count"]))
+            return range(1)
+        return range(motion["start"], motion["start"] + motion["count"])
 
     # ------------------------------------------------------------ grids and cases
 
@@ -341,11 +341,6 @@ class Experiment:
         structural = self.reference_dims[:-2]
         position = tuple(d.values.index(labels[d.name]) for d in structural)
         return Point(REFERENCE, position, tuple((d.name, labels[d.name]) for d in structural))
-
-    def reference_of(self, case: Case) -> Case:
-        """The fixed-base reference case under the same motion as ``case``."""
-        point = self.reference_point(self._point_of(case))
-        return self.case_at(REFERENCE, (*point.position, *case.position[-2:]))
 
     @cached_property
     def scene_field(self) -> str:

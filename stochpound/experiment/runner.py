@@ -22,7 +22,7 @@ import time
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Iterable, Iterator
+from typing import Any, Callable, Iterable, Iterator
 
 from stochpound import __version__
 from stochpound.experiment.batches import automatic_size, make_batches
@@ -57,6 +57,9 @@ class RunReport:
         Cases that raised, described, with their tracebacks.
     elapsed : float
         Wall time of the run, s.
+    setup : float
+        Of which before the first batch was submitted (store checks and first
+        write, the local cluster's start, loading the compiled solver), s.
     executor : str
         Where the cases ran.
     interrupted : bool
@@ -69,6 +72,7 @@ class RunReport:
     done_now: int = 0
     failed: list[tuple[str, str]] = field(default_factory=list)
     elapsed: float = 0.0
+    setup: float = 0.0
     executor: str = ""
     interrupted: bool = False
 
@@ -176,7 +180,10 @@ def run_experiment(
         try:
             size = batch_size or automatic_size(experiment.n_cases - report.done_before, workers)
             batches = make_batches(experiment, missing, motions, size)
-            with contextlib.closing(execute(batches, experiment, motions, workers, scheduler)) as results:
+            def ready() -> None:
+                report.setup = time.monotonic() - started
+
+            with contextlib.closing(execute(batches, experiment, motions, workers, scheduler, ready)) as results:
                 for task, result in results:
                     _record(experiment, report, buffer, task, result)
                     if stop.requested:
@@ -223,9 +230,14 @@ class _Checkpoints:
 
 
 def execute(
-    batches: Iterable[BatchTask], experiment: Experiment, motions: dict[str, ResolvedMotion], workers: int | None, scheduler: str | None
+    batches: Iterable[BatchTask],
+    experiment: Experiment,
+    motions: dict[str, ResolvedMotion],
+    workers: int | None,
+    scheduler: str | None,
+    ready: Callable[[], None] = lambda: None,
 ) -> Iterator[tuple[BatchTask, BatchResult]]:
-    """Run batches and yield (task, result) as they finish (in any order).
+    """Run batches and yield (task, result) as they finish (in any order); call ``ready()`` before the first is submitted.
 
     ``workers=0`` (and no scheduler) runs them in this process; otherwise on a
     local dask cluster of ``workers`` processes or on the given scheduler,
@@ -236,6 +248,7 @@ def execute(
     """
     labels = list(experiment.motions)
     if workers == 0 and scheduler is None:
+        ready()
         for task in batches:
             yield task, run_batch(task, motions[labels[task.record]].motion)
         return
@@ -247,6 +260,7 @@ def execute(
         pending = iter(batches)
         tasks: dict[Any, BatchTask] = {}
         running = as_completed()
+        ready()
 
         def submit() -> None:
             task = next(pending, None)

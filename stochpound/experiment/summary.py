@@ -2,10 +2,11 @@
 
 The statistics come from :mod:`stochpound.analysis` (one definition for the
 whole toolkit); this module only chooses and names what an experiment store
-keeps. A case's result is flattened into named numpy arrays (a *part*):
+keeps. A case's result is flattened into named numpy arrays (stacked with
+other cases' into a part, :mod:`stochpound.experiment.parts`):
 
 * ``s:<name>``: summaries (dimensions ``building`` or none);
-* ``t:<name>``: kept time histories, ``t:time`` their sample times (s);
+* ``t:<name>``: kept time histories (at the motion's samples);
 * ``i:<name>``: the impact table's columns.
 
 Units and long names are taken from a tiny real run (:func:`templates`), so
