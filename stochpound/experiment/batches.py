@@ -61,7 +61,7 @@ def make_batches(experiment: Experiment, missing: Mapping[str, np.ndarray], moti
     """
     points = [_Point(p, experiment.structure(p), experiment.reference_structure(p)) for kind in KINDS for p in experiment.points(kind)]
     for record, label in enumerate(experiment.motions):
-        realizations = np.asarray(experiment.realizations(label))
+        realizations = experiment.realization_numbers(label)
         columns = experiment.realization_positions(label)
         wanted = np.array([missing[p.point.kind][p.point.position + (record,)][columns] for p in points]).reshape(len(points), len(columns))
         active = np.flatnonzero(wanted.any(axis=1))

@@ -160,6 +160,7 @@ class Experiment:
         self.motions: dict[str, dict[str, Any]] = {m["label"]: m for m in self.definition["motions"]}
         self.output: dict[str, Any] = self.definition["output"]
         self.solver: dict[str, Any] = self.definition["solver"]
+        self._grid_case_ids: dict[str, np.ndarray] = {}
 
     # ------------------------------------------------------------ dimensions
 
@@ -180,7 +181,8 @@ class Experiment:
     @cached_property
     def motion_dims(self) -> list[Dim]:
         """``record`` (motion labels) and ``realization`` (union of realization indices)."""
-        realizations = np.unique(np.concatenate([np.asarray(self.realizations(label)) for label in self.motions]))
+        realizations = np.sort(np.concatenate([self.realization_numbers(label) for label in self.motions]))
+        realizations = realizations[np.concatenate([[True], realizations[1:] != realizations[:-1]])]  # unique (np.unique hashes: slower)
         return [Dim("record", "record", tuple(self.motions)), Dim("realization", "realization", tuple(realizations.tolist()))]
 
     @cached_property
@@ -217,6 +219,11 @@ class Experiment:
             return range(1)
         return range(motion["start"], motion["start"] + motion["count"])
 
+    def realization_numbers(self, label: str) -> np.ndarray:
+        """:meth:`realizations` as an array."""
+        numbers = self.realizations(label)
+        return np.arange(numbers.start, numbers.stop)
+
     # ------------------------------------------------------------ grids and cases
 
     def kind_dims(self, kind: str) -> list[Dim]:
@@ -249,7 +256,7 @@ class Experiment:
     @cached_property
     def _realization_positions(self) -> dict[str, np.ndarray]:
         values = np.asarray(self.motion_dims[1].values)
-        return {label: np.searchsorted(values, self.realizations(label)) for label in self.motions}
+        return {label: np.searchsorted(values, self.realization_numbers(label)) for label in self.motions}
 
     def in_grid(self, kind: str) -> np.ndarray:
         """Which positions of the grid of ``kind`` hold a case (bool, :meth:`grid_shape`): a record has realization 0 only."""
@@ -273,6 +280,17 @@ class Experiment:
         """Ids of the cases at ``point`` under motion number ``record``, one per realization of the motion."""
         label = self.motion_dims[0].values[record]
         return case_ids(point.kind, {**dict(point.labels), "record": label}, self.realizations(label))
+
+    def grid_case_ids(self, kind: str) -> np.ndarray:
+        """Ids of the cases of ``kind`` on its grid (``S16``, empty where no case is), computed once (16 bytes a case)."""
+        if kind not in self._grid_case_ids:
+            ids = np.zeros(self.grid_shape(kind), dtype="S16")
+            for point in self.points(kind):
+                for m in range(len(self.motion_dims[0].values)):
+                    label = self.motion_dims[0].values[m]
+                    ids[point.position + (m,)][self.realization_positions(label)] = self.point_case_ids(point, m)
+            self._grid_case_ids[kind] = ids
+        return self._grid_case_ids[kind]
 
     def iter_cases(self) -> Iterator[Case]:
         """Every case, lazily: the references first, then the grid, realization varying fastest."""

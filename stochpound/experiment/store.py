@@ -109,7 +109,8 @@ class Layout:
 
         variables = {}
         for spec in self.specs:
-            placeholder = da.empty(tuple(self.sizes[d] for d in spec.dims), dtype=spec.dtype, chunks=spec.chunks)
+            shape = tuple(self.sizes[d] for d in spec.dims)
+            placeholder = da.empty(shape, dtype=spec.dtype, chunks=spec.chunks, name=f"placeholder-{spec.name}")  # named: no tokenizing
             variable = xr.Variable(spec.dims, placeholder, dict(spec.attrs))
             variable.encoding = {"chunksizes": spec.chunks, **spec.encoding}
             variables[spec.name] = variable

@@ -16,7 +16,6 @@ The file is written to a temporary name and renamed over the store
 
 from __future__ import annotations
 
-import itertools
 from collections import OrderedDict
 from dataclasses import dataclass
 from pathlib import Path
@@ -27,7 +26,7 @@ import numpy as np
 from xarray.backends import H5NetCDFStore
 
 from stochpound.atomic import replacing
-from stochpound.experiment.model import CASE, KINDS, Experiment, case_ids
+from stochpound.experiment.model import CASE, KINDS, Experiment
 from stochpound.experiment.parts import part_paths, read_part, split_key
 from stochpound.experiment.store import INT_FILL, Layout, Spec, blocks, layout, union_times
 
@@ -216,9 +215,10 @@ class _Writer:
                     buffers[spec.name][local] = arrays[f"{prefix}/s:{spec.name}"][section]
                 if rows is not None:
                     self._fill_impacts(rows, block, local, section, arrays, prefix, ids)
-            for spec in specs:
-                self.handle[spec.name][block] = buffers[spec.name]
-            if rows is not None:
+            if (source >= 0).any():  # a block without finished cases stays unwritten: the file's fill values
+                for spec in specs:
+                    self.handle[spec.name][block] = buffers[spec.name]
+            if rows is not None and len(rows["columns"]["impact_case_id"]):
                 for name, values in rows["columns"].items():
                     self.handle[name][rows["first"] : rows["first"] + len(values)] = values
 
@@ -236,20 +236,8 @@ class _Writer:
             yield inside[mine], tuple(local[mine].T), arrays, prefix
 
     def _ids(self, kind: str, block: tuple[slice, ...]) -> np.ndarray:
-        """Case ids of the block ('' where no case is in the grid)."""
-        experiment = self.experiment
-        ids = np.full(tuple(s.stop - s.start for s in block), "", dtype=object)
-        points = {p.position: p for p in experiment.points(kind)}
-        realizations = block[-1]
-        for index in itertools.product(*(range(s.start, s.stop) for s in block[:-1])):
-            point, record = points[index[:-1]], index[-1]
-            label = experiment.motion_dims[0].values[record]
-            columns = experiment.realization_positions(label)
-            chosen = (columns >= realizations.start) & (columns < realizations.stop)
-            numbers = np.asarray(experiment.realizations(label))[chosen]
-            local = tuple(i - s.start for i, s in zip(index, block[:-1]))
-            ids[local + (columns[chosen] - realizations.start,)] = case_ids(kind, {**dict(point.labels), "record": label}, numbers)
-        return ids
+        """Case ids of the block as strings ('' where no case is in the grid)."""
+        return self.experiment.grid_case_ids(kind)[block].astype("U16").astype(object)
 
     # ------------------------------------------------------------ impact table
 
@@ -292,6 +280,8 @@ class _Writer:
         trailing = spec.chunks[len(shape):]
         for block in blocks(shape, spec.chunks[: len(shape)]):
             source = self.index.source[kind][block]
+            if not (source >= 0).any():
+                continue
             buffer = np.full(source.shape + trailing, np.nan)
             flat_buffer = buffer.reshape((-1,) + trailing)
             for section, local, arrays, prefix in self._contributions(kind, block, source):
