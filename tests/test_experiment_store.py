@@ -200,3 +200,19 @@ def test_a_large_ensemble_is_chunked_along_realization(tmp_path):
     with xr.open_dataset(report.store) as ds:
         assert ds["impacts"].encoding["chunksizes"] == (1, 1, 1, 1, 128)
         xr.testing.assert_identical(ds.load(), whole)
+
+
+def test_kept_histories_of_a_later_building_land_on_its_row(tmp_path):
+    """Only B2's histories kept: they are B2's (not written on B1's row), and B1's are NaN."""
+    from tests.test_experiment_cli import TINY_EXPERIMENT
+
+    text = TINY_EXPERIMENT.replace('[solver]\nmethod = "ivp"', '[output]\ntime_histories = ["total_displacement", "sliding_displacement"]\nbuildings = ["B2"]')
+    path = write_experiment(tmp_path, text, "tiny.toml")
+    report = run_experiment(load_experiment(path), workers=0, progress=False)
+    experiment = load_experiment(path)
+    run = stochpound.simulate(stochpound.scene_from_dict({**experiment.structure(experiment.points("case")[0]), "motion": experiment.motion_table("push")}))
+    with open_store(report.store) as ds:
+        point = ds.sel(record="push", realization=0).compute()
+    np.testing.assert_array_equal(point["total_displacement"].sel(building="B2").values, run["total_displacement"].sel(building="B2").values)
+    np.testing.assert_array_equal(point["sliding_displacement"].sel(building="B2").values, run["sliding_displacement"].sel(building="B2").values)
+    assert np.isnan(point["total_displacement"].sel(building="B1")).all() and np.isnan(point["sliding_displacement"].sel(building="B1")).all()

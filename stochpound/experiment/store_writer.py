@@ -278,6 +278,8 @@ class _Writer:
         kind = spec.kind
         shape = self.experiment.grid_shape(kind)
         trailing = spec.chunks[len(shape):]
+        kept = [self.experiment.building_names.index(b) for b in self.experiment.output["buildings"]]
+        own_dims = spec.dims[len(shape) : -1]  # a part keeps the output buildings only: their rows of ``building``
         for block in blocks(shape, spec.chunks[: len(shape)]):
             source = self.index.source[kind][block]
             if not (source >= 0).any():
@@ -291,7 +293,8 @@ class _Writer:
                 values = arrays[key][section]
                 columns = np.searchsorted(self.union, np.round(arrays[f"{prefix}/t:time"], 9))
                 where = np.ravel_multi_index(local, source.shape)
-                flat_buffer[np.ix_(where, *[np.arange(n) for n in values.shape[1:-1]], columns)] = values
+                rows = [np.asarray(kept) if dim == "building" else np.arange(n) for dim, n in zip(own_dims, values.shape[1:-1])]
+                flat_buffer[np.ix_(where, *rows, columns)] = values
             self.handle[spec.name][block] = buffer
 
 
