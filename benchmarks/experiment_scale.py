@@ -33,44 +33,12 @@ from typing import Any, Callable
 
 from benchmarks import report
 from benchmarks.timing import REPOSITORY, run_subprocess, single_thread_environment
+from tests.test_experiment_helpers import quickstart_cell
 
 START = "<!-- experiments at scale: start -->"
 END = "<!-- experiments at scale: end -->"
 SIZES = (1_000, 10_000, 100_000, 1_000_000)
-CELL = """
-[experiment]
-name = "cell"
-description = "the quick-start pair, one cell: B1 isolated (mu = 0.2) next to the flexible B2, gap 2 cm"
-studied = "B1"
-
-[scene]
-g = 9.814
-
-[[scene.building]]
-name = "B1"
-mass = [26268.0, 17512.0]
-stiffness = [24516800.0, 17512000.0]
-damping = [23634.2, 16881.57]
-base = {{ mass = 13134.0, mu = 0.2 }}
-
-[[scene.building]]
-name = "B2"
-mass = [52536.0, 35024.0]
-stiffness = [24516800.0, 17512000.0]
-damping_ratio = 0.01
-
-[[scene.contact]]
-between = [["B1", 1], ["B2", 1]]
-gap = 0.02
-stiffness = 56993585.0
-restitution = 0.5
-
-[[scene.contact]]
-between = [["B1", 2], ["B2", 2]]
-gap = 0.02
-stiffness = 37997566.8
-restitution = 0.5
-
+MOTIONS = """
 [synthetic.kt_firm]
 type = "kanai_tajimi"
 count = {count}
@@ -85,7 +53,7 @@ dt = 0.02
 [output]
 impacts = true
 """
-"""The benchmark's experiment (the quick-start file's flexible neighbour, gap 0.02 and μ = 0.2), ``count`` realizations."""
+"""The benchmark's motions: the quick-start file's Kanai–Tajimi ensemble with ``count`` realizations, summaries and impacts only."""
 
 
 def parse_arguments(argv: list[str] | None) -> argparse.Namespace:
@@ -139,9 +107,9 @@ def measure(folder: Path, arguments: argparse.Namespace, log: Callable[[str], No
 
 
 def experiment_file(folder: Path, count: int, name: str) -> Path:
-    """Write the benchmark's experiment with ``count`` realizations."""
+    """Write the benchmark's experiment: one cell of the quick-start file (flexible neighbour, gap 2 cm, μ = 0.2), ``count`` realizations."""
     path = folder / f"{name}.toml"
-    path.write_text(CELL.format(count=count))
+    path.write_text(quickstart_cell(MOTIONS.format(count=count), gap=0.02, mu=0.2, neighbour="flexible"))
     return path
 
 

@@ -15,35 +15,10 @@ import xarray as xr
 
 from stochpound.experiment.parts import part_paths, parts_folder
 from stochpound.experiment.session import PACKAGE, git_commit, sources_sha256
-from tests.test_experiment_helpers import REPO, SMALL_EXPERIMENT, cli, write_experiment
+from tests.test_experiment_helpers import REPO, SMALL_EXPERIMENT, cli, quickstart_cell, write_experiment
 
-#: One grid point (B1 next to B2, gap 2 cm, mu 0.2) under a short harmonic motion, solved by ivp: a small, quick experiment.
-TINY_EXPERIMENT = """
-[experiment]
-name = "tiny"
-
-[scene]
-g = 9.814
-
-[[scene.building]]
-name = "B1"
-mass = [26268.0, 17512.0]
-stiffness = [24516800.0, 17512000.0]
-damping = [23634.2, 16881.57]
-base = { mass = 13134.0, mu = 0.2 }
-
-[[scene.building]]
-name = "B2"
-mass = [26268.0, 17512.0]
-stiffness = [24516800.0, 17512000.0]
-damping_ratio = 0.01
-
-[[scene.contact]]
-between = [["B1", 2], ["B2", 2]]
-gap = 0.02
-stiffness = 28498175.1
-restitution = 0.5
-
+#: One cell of the quick-start grid under a short harmonic motion, solved by ivp: a small, quick experiment.
+TINY_EXPERIMENT = quickstart_cell("""
 [[motions]]
 name = "push"
 type = "harmonic"
@@ -54,7 +29,7 @@ dt = 0.02
 
 [solver]
 method = "ivp"
-"""
+""")
 
 
 def test_ctrl_c_prints_only_the_message(tmp_path):

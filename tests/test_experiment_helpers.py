@@ -78,6 +78,18 @@ buildings = ["B1"]
 """
 
 N_CASES = 27
+QUICKSTART = REPO / "experiments" / "quickstart.toml"
+
+
+def quickstart_cell(motions: str, gap: float = 0.02, mu: float = 0.2, neighbour: str = "flexible") -> str:
+    """An experiment file: the quick-start file's scene and variants, one cell of its grid, under ``motions``.
+
+    ``motions`` is the rest of the file: ``[[records]]``, ``[[motions]]``,
+    ``[synthetic.<name>]``, ``[output]`` and ``[solver]`` tables.
+    """
+    text = QUICKSTART.read_text()
+    grid = f'[grid]\ngap = [{gap}]\nmu = {{ values = [{mu}], buildings = ["B1"] }}\nneighbour = ["{neighbour}"]\n\n'
+    return text[: text.index("[grid]")] + grid + motions
 
 
 def write_experiment(folder: Path, text: str = SMALL_EXPERIMENT, name: str = "small.toml") -> Path:

@@ -18,7 +18,7 @@ import xarray as xr
 from stochpound.atomic import temporaries
 from stochpound.experiment import load_experiment, run_experiment
 from stochpound.experiment.parts import part_paths, parts_folder
-from tests.test_experiment_helpers import N_CASES, assert_same_results, cli, cli_process, done_cases, write_experiment
+from tests.test_experiment_helpers import N_CASES, assert_same_results, cli, cli_process, done_cases, quickstart_cell, write_experiment
 
 
 @pytest.fixture(scope="module")
@@ -122,39 +122,8 @@ def test_local_cluster_matches_one_process(tmp_path, baseline):
     assert_same_results(baseline, tmp_path / "small.nc")
 
 
-#: One grid point of the quick-start pair under many short Kanai-Tajimi realizations: the batched path.
-MANY_REALIZATIONS = """
-[experiment]
-name = "many"
-
-[scene]
-g = 9.814
-
-[[scene.building]]
-name = "B1"
-mass = [26268.0, 17512.0]
-stiffness = [24516800.0, 17512000.0]
-damping = [23634.2, 16881.57]
-base = { mass = 13134.0, mu = 0.2 }
-
-[[scene.building]]
-name = "B2"
-mass = [52536.0, 35024.0]
-stiffness = [24516800.0, 17512000.0]
-damping_ratio = 0.01
-
-[[scene.contact]]
-between = [["B1", 1], ["B2", 1]]
-gap = 0.005
-stiffness = 56993585.0
-restitution = 0.5
-
-[[scene.contact]]
-between = [["B1", 2], ["B2", 2]]
-gap = 0.005
-stiffness = 37997566.8
-restitution = 0.5
-
+#: One cell of the quick-start grid (gap 5 mm: impacts) under many short Kanai-Tajimi realizations: the batched path.
+MANY_REALIZATIONS = quickstart_cell("""
 [synthetic.kt]
 count = 800
 seed = 11
@@ -164,7 +133,7 @@ pga = 3.0
 envelope = "jennings"
 duration = 2.0
 dt = 0.02
-"""
+""", gap=0.005)
 
 
 def test_a_large_run_killed_twice_resumes_to_the_same_store(tmp_path):

@@ -212,7 +212,7 @@ def test_kept_histories_of_a_later_building_land_on_its_row(tmp_path):
     experiment = load_experiment(path)
     run = stochpound.simulate(stochpound.scene_from_dict({**experiment.structure(experiment.points("case")[0]), "motion": experiment.motion_table("push")}))
     with open_store(report.store) as ds:
-        point = ds.sel(record="push", realization=0).compute()
+        point = ds.sel(record="push", realization=0).squeeze().compute()
     np.testing.assert_array_equal(point["total_displacement"].sel(building="B2").values, run["total_displacement"].sel(building="B2").values)
     np.testing.assert_array_equal(point["sliding_displacement"].sel(building="B2").values, run["sliding_displacement"].sel(building="B2").values)
     assert np.isnan(point["total_displacement"].sel(building="B1")).all() and np.isnan(point["sliding_displacement"].sel(building="B1")).all()
