@@ -135,21 +135,33 @@ def run_batch(task: BatchTask, motion: GroundMotion | None = None) -> BatchResul
         return BatchResult(failures=[(g.kind, tuple(int(i) for i in p), error) for g in task.groups for p in g.positions])
     result, sections = BatchResult(), []
     for group in task.groups:
-        finished, positions = [], []
-        group_twins = twins[canonical_json(group.reference)]
-        scene = _scene(group.structure) if group.kind != REFERENCE else None
-        for realization, position in zip(group.realizations, group.positions):
-            try:
-                finished.append(_case(task, scene, grounds[realization], group_twins[realization]))
-            except Exception:  # noqa: BLE001 - reported per case, the batch goes on
-                result.failures.append((group.kind, tuple(int(i) for i in position), traceback.format_exc(limit=8)))
-                continue
-            positions.append(position)
-        if finished:
-            sections.append(_section(group.kind, task.record, finished, positions, grounds[group.realizations[0]].times))
-            result.done += len(finished)
+        section = _group(task, group, grounds, twins[canonical_json(group.reference)], result.failures)
+        if section:
+            sections.append(section)
+            result.done += len(section[section_key(group.kind, task.record, "position")])
     result.arrays = concatenate(sections)
     return result
+
+
+def _group(task: BatchTask, group: Group, grounds: dict[int, GroundMotion], twins: dict[int, np.ndarray], failures: list) -> dict[str, np.ndarray]:
+    """The section of a group's finished cases (empty if none finished); failures are appended to ``failures``."""
+    try:
+        scene = _scene(group.structure) if group.kind != REFERENCE else None
+    except Exception:  # noqa: BLE001 - reported for every case of the group
+        failures.extend((group.kind, tuple(int(i) for i in position), traceback.format_exc(limit=8)) for position in group.positions)
+        return {}
+    finished, positions = [], []
+    for realization, position in zip(group.realizations, group.positions):
+        try:
+            finished.append(_case(task, scene, grounds[realization], twins[realization]))
+        except Exception:  # noqa: BLE001 - reported per case, the batch goes on
+            failures.append((group.kind, tuple(int(i) for i in position), traceback.format_exc(limit=8)))
+            continue
+        positions.append(position)
+    if not finished:
+        return {}
+    stacked = stack_cases(finished, np.array(positions, dtype=np.int64), grounds[group.realizations[0]].times)
+    return {section_key(group.kind, task.record, name): values for name, values in stacked.items()}
 
 
 def _case(task: BatchTask, scene: Scene | None, ground: GroundMotion, twin: np.ndarray) -> dict[str, np.ndarray]:
@@ -160,12 +172,6 @@ def _case(task: BatchTask, scene: Scene | None, ground: GroundMotion, twin: np.n
     run = simulate(dataclasses.replace(scene, motion=ground), solver["method"], integrator=solver["integrator"], rtol=solver["rtol"], atol=solver["atol"])
     summary = case_values(run, task.studied, twin[-1])
     return case_arrays(summary, run, task.output["time_histories"], task.output["buildings"], task.output["impacts"])
-
-
-def _section(kind: str, record: int, cases: list[dict[str, np.ndarray]], positions: list[np.ndarray], times: np.ndarray) -> dict[str, np.ndarray]:
-    """Finished cases of one group as part arrays of their section."""
-    stacked = stack_cases(cases, np.array(positions, dtype=np.int64), times)
-    return {section_key(kind, record, name): values for name, values in stacked.items()}
 
 
 _SCENES: dict[str, Scene] = {}

@@ -30,7 +30,7 @@ from stochpound.experiment.model import CASE, KINDS, Experiment
 from stochpound.experiment.parts import part_paths, read_part, split_key
 from stochpound.experiment.store import INT_FILL, Layout, Spec, blocks, layout, union_times
 
-PART_CACHE_BYTES = 256 * 2**20
+PART_CACHE_BYTES = 64 * 2**20
 """Parts kept in memory while the blocks that need them are written, bytes."""
 _CHUNK_CACHE_BYTES = 16 * 2**20
 
