@@ -7,7 +7,6 @@ import sys
 from pathlib import Path
 
 import numpy as np
-import pytest
 import xarray as xr
 
 import stochpound
@@ -74,27 +73,26 @@ def _simulate(folder, *args: str, umask: int | None = None) -> subprocess.Comple
     return subprocess.run([sys.executable, "-m", "stochpound", "simulate", str(scene), *args], capture_output=True, text=True, preexec_fn=set_umask)
 
 
-def test_an_existing_output_is_refused_without_overwrite(tmp_path):
-    out = tmp_path / "run.nc"
+def test_an_existing_output_is_refused_without_overwrite_and_other_suffixes_are_warned_about(tmp_path):
+    from tests.test_experiment_helpers import invoke
+
+    scene = tmp_path / "scene.toml"
+    scene.write_text(SMALL_SCENE)
+    out = tmp_path / "run.h5"
+    written = invoke("simulate", str(scene), "--out", str(out))
+    assert written.exit_code == 0 and "warning: --out" in written.stderr and "usual suffix is .nc (got .h5)" in written.stderr
     out.write_bytes(b"keep me")
-    refused = _simulate(tmp_path, "--out", str(out))
-    assert refused.returncode == 2 and f"{out} exists; give --overwrite to replace it" in refused.stderr
+    refused = invoke("simulate", str(scene), "--out", str(out))
+    assert refused.exit_code == 2 and f"{out} exists; give --overwrite to replace it" in refused.stderr
     assert out.read_bytes() == b"keep me"
-    replaced = _simulate(tmp_path, "--out", str(out), "--overwrite")
-    assert replaced.returncode == 0, replaced.stderr
+    replaced = invoke("simulate", str(scene), "--out", str(out), "--overwrite")
+    assert replaced.exit_code == 0, replaced.stderr
     with xr.open_dataset(out) as run:
         assert run.sizes["time"] == 201
+    assert "warning" not in invoke("simulate", str(scene), "--out", str(tmp_path / "run.nc")).stderr
 
 
-def test_an_output_suffix_other_than_nc_is_warned_about(tmp_path):
-    result = _simulate(tmp_path, "--out", str(tmp_path / "run.h5"))
-    assert result.returncode == 0
-    assert "warning: --out" in result.stderr and "usual suffix is .nc (got .h5)" in result.stderr
-    assert "warning" not in _simulate(tmp_path, "--out", str(tmp_path / "run.nc")).stderr
-
-
-@pytest.mark.parametrize("umask, mode", [(0o022, 0o644), (0o027, 0o640)])
-def test_the_output_follows_the_umask(tmp_path, umask, mode):
+def test_the_output_follows_the_umask(tmp_path):
     out = tmp_path / "run.nc"
-    assert _simulate(tmp_path, "--out", str(out), umask=umask).returncode == 0
-    assert stat.S_IMODE(out.stat().st_mode) == mode
+    assert _simulate(tmp_path, "--out", str(out), umask=0o027).returncode == 0
+    assert stat.S_IMODE(out.stat().st_mode) == 0o640  # neither mkstemp's 0600 nor the usual 0644

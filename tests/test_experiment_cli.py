@@ -15,7 +15,7 @@ import xarray as xr
 
 from stochpound.experiment.parts import part_paths, parts_folder
 from stochpound.experiment.session import PACKAGE, git_commit, sources_sha256
-from tests.test_experiment_helpers import REPO, SMALL_EXPERIMENT, cli, quickstart_cell, write_experiment
+from tests.test_experiment_helpers import REPO, SMALL_EXPERIMENT, invoke, quickstart_cell, write_experiment
 
 #: One cell of the quick-start grid under a short harmonic motion, solved by ivp: a small, quick experiment.
 TINY_EXPERIMENT = quickstart_cell("""
@@ -49,8 +49,8 @@ def test_ctrl_c_prints_only_the_message(tmp_path):
     assert out.startswith("interrupted: ") and "rerun the same command to complete the missing cases" in out, out
 
 
-@pytest.mark.parametrize("umask, mode", [(0o022, 0o644), (0o027, 0o640)])
-def test_the_store_and_its_parts_follow_the_umask(tmp_path, umask, mode):
+def test_the_store_and_its_parts_follow_the_umask(tmp_path):
+    umask, mode = 0o027, 0o640  # neither mkstemp's 0600 nor the usual 0644
     experiment = write_experiment(tmp_path, TINY_EXPERIMENT, "tiny.toml")
     subprocess.run(
         [sys.executable, "-m", "stochpound", "experiment", "run", str(experiment), "--workers", "0", "--quiet"],
@@ -65,8 +65,8 @@ def test_the_store_and_its_parts_follow_the_umask(tmp_path, umask, mode):
 
 def test_errors_of_the_base_scene_name_the_scene(tmp_path):
     broken = SMALL_EXPERIMENT.replace("damping_ratio = 0.01", "damping_ratio = 1.5")
-    result = cli("experiment", "check", str(write_experiment(tmp_path, broken)), check=False)
-    assert result.returncode == 1
+    result = invoke("experiment", "check", str(write_experiment(tmp_path, broken)))
+    assert result.exit_code == 1
     assert result.stderr.strip() == "Error: scene.building[1].damping_ratio: must be < 1, got 1.5"
     scene_file = tmp_path / "scenes" / "pair.toml"
     scene_file.parent.mkdir()
@@ -74,15 +74,15 @@ def test_errors_of_the_base_scene_name_the_scene(tmp_path):
     scene_file.write_text(broken[start:end].replace("[scene]", "").replace("scene.building", "building").replace("scene.contact", "contact"))
     from_file = broken[:start] + broken[end:]
     from_file = from_file.replace('studied = "B1"', 'studied = "B1"\nscene = "scenes/pair.toml"')
-    result = cli("experiment", "check", str(write_experiment(tmp_path, from_file, "from_file.toml")), check=False)
+    result = invoke("experiment", "check", str(write_experiment(tmp_path, from_file, "from_file.toml")))
     assert result.stderr.strip() == f"Error: {tmp_path / 'scenes' / 'pair.toml'}: building[1].damping_ratio: must be < 1, got 1.5"
 
 
 def test_with_several_files_every_error_names_its_file(tmp_path):
     good = write_experiment(tmp_path, TINY_EXPERIMENT, "good.toml")
     bad = write_experiment(tmp_path, SMALL_EXPERIMENT.replace("gap = [0.01, 0.02]", "gap = [0.01, -0.02]"), "bad.toml")
-    result = cli("experiment", "run", str(good), str(bad), "--workers", "0", check=False)
-    assert result.returncode == 1
+    result = invoke("experiment", "run", str(good), str(bad), "--workers", "0")
+    assert result.exit_code == 1
     assert result.stderr.strip() == f"Error: {bad}: grid.gap[1]: must be >= 0, got -0.02"
     assert not (tmp_path / "good.nc").exists(), "every file is checked before any runs"
 

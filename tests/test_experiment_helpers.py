@@ -108,6 +108,15 @@ def cli(*args: str, env: dict | None = None, check: bool = True, timeout: float 
     return result
 
 
+def invoke(*args: str, env: dict | None = None):
+    """Run ``stochpound ARGS`` in this process (click's test runner): ``exit_code``, ``stdout``, ``stderr``."""
+    from click.testing import CliRunner
+
+    from stochpound.cli import main
+
+    return CliRunner().invoke(main, list(args), env=env)
+
+
 def cli_process(*args: str, env: dict | None = None) -> subprocess.Popen:
     """Start ``python -m stochpound ARGS`` in the background."""
     return subprocess.Popen(

@@ -125,7 +125,7 @@ def test_local_cluster_matches_one_process(tmp_path, baseline):
 #: One cell of the quick-start grid (gap 5 mm: impacts) under many short Kanai-Tajimi realizations: the batched path.
 MANY_REALIZATIONS = quickstart_cell("""
 [synthetic.kt]
-count = 800
+count = 400
 seed = 11
 omega_g = 15.0
 zeta_g = 0.6
@@ -137,28 +137,28 @@ dt = 0.02
 
 
 def test_a_large_run_killed_twice_resumes_to_the_same_store(tmp_path):
-    """800 realizations, SIGKILLed twice mid-run (in one process, then on two local workers: the whole process
+    """400 realizations, SIGKILLed twice mid-run (in one process, then on two local workers: the whole process
     group), then completed with other batches: the store equals an uninterrupted run's, and there is at most
-    one part per 100 cases (the part size, lowered from 500 for a small run) plus one per run.
+    one part per 50 cases (the part size, lowered from 500 for a small run) plus one per run.
 
     The benchmark (``python -m benchmarks scaling``) does the same with 100 000 realizations."""
     whole = tmp_path / "whole"
     whole.mkdir()
     reference = run_experiment(load_experiment(write_experiment(whole, MANY_REALIZATIONS, "many.toml")), workers=0, progress=False, batch_size=50)
-    assert reference.complete and reference.total == 1600
+    assert reference.complete and reference.total == 800
     experiment = write_experiment(tmp_path, MANY_REALIZATIONS, "many.toml")
     store = tmp_path / "many.nc"
     run = [sys.executable, "-m", "stochpound", "experiment", "run", str(experiment), "--quiet"]
-    env = {**os.environ, "STOCHPOUND_EXPERIMENT_PART_CASES": "100"}
+    env = {**os.environ, "STOCHPOUND_EXPERIMENT_PART_CASES": "50"}
     done = [0]
     for workers in ("0", "2"):
         process = subprocess.Popen([*run, "--workers", workers], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True, env=env)
-        _wait_for(lambda: done_cases(store) > done[-1] + 100, process, "more parts", timeout=600)
+        _wait_for(lambda: done_cases(store) > done[-1] + 50, process, "more parts", timeout=600)
         os.killpg(process.pid, signal.SIGKILL)
         process.wait(timeout=60)
         done.append(done_cases(store))
-    assert 100 < done[1] < done[2] < 1600
+    assert 50 < done[1] < done[2] < 800
     result = cli(*run[3:], "--workers", "0", "--batch", "7", env=env)
-    assert f"({1600 - done[2]} this run, {done[2]} before)" in result.stdout, result.stdout
-    assert len(part_paths(parts_folder(store))) <= 1600 // 100 + 3
+    assert f"({800 - done[2]} this run, {done[2]} before)" in result.stdout, result.stdout
+    assert len(part_paths(parts_folder(store))) <= 800 // 50 + 3
     assert_same_results(reference.store, store)
