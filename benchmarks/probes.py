@@ -139,22 +139,34 @@ def single_cell(path: str, runs: int) -> None:
     motion_single, _ = _timed(lambda: [SampledMotion(table["dt"], generate(1, start=i, **parameters).values[0], "linear") for i in range(min(runs, 100))])
     for motion in motions[:20]:
         stochpound.simulate(dataclasses.replace(scene, motion=motion))
+    cpu = time.process_time()
     elapsed, results = _timed(lambda: [stochpound.simulate(dataclasses.replace(scene, motion=motion)) for motion in motions])
+    cpu = time.process_time() - cpu
     _emit({
-        "runs": runs, "simulate": elapsed / runs, "motion_batched": motion_batched / runs, "motion_single": motion_single / min(runs, 100),
+        "runs": runs, "simulate": elapsed / runs, "simulate_cpu": cpu / runs, "motion_batched": motion_batched / runs, "motion_single": motion_single / min(runs, 100),
         "mean_impacts": float(np.mean([r.sizes.get("impact", 0) for r in results])),
     })
 
 
 def experiment_run(path: str, workers: int, store: str) -> None:
-    """``stochpound experiment run PATH --store STORE --workers N`` in this process (the command's own function)."""
+    """``stochpound experiment run PATH --store STORE --workers N`` in this process (the command's own function).
+
+    Also the CPU time of this process (the client, with the local cluster's
+    scheduler and nannies; imports included) and of its children (the
+    workers, reaped when the cluster closes).
+    """
     from stochpound.experiment import load_experiment, run_experiment
+
+    import resource
 
     started = time.perf_counter()
     report = run_experiment(load_experiment(path), store, workers=workers, progress=False)
+    usage = {who: resource.getrusage(who) for who in (resource.RUSAGE_SELF, resource.RUSAGE_CHILDREN)}
+    cpu = {who: u.ru_utime + u.ru_stime for who, u in usage.items()}
     _emit({
         "wall": time.perf_counter() - started, "elapsed": report.elapsed, "setup": report.setup, "done": report.done_now,
         "total": report.total, "failed": len(report.failed), "complete": report.complete,
+        "cpu_client": cpu[resource.RUSAGE_SELF], "cpu_workers": cpu[resource.RUSAGE_CHILDREN],
     })
 
 
