@@ -18,6 +18,7 @@ import logging
 import os
 import signal
 import sys
+import threading
 import time
 from contextlib import contextmanager
 from dataclasses import dataclass, field
@@ -180,30 +181,32 @@ def run_experiment(
         identity = code_identity()
         append_run(session.folder, {"started": now(), "machine": machine(), "executor": report.executor, **identity})
         missing = session.missing()
-        rebuilds = _Checkpoints(checkpoint, session)
-        rebuilds.rebuild()
+        session.rebuild()
+        checkpoints = _Checkpoints(checkpoint, session)
         bar = _progress_bar(report, experiment.name, progress)
         buffer = PartBuffer(session.folder, {"stochpound_version": __version__, "sources_sha256": identity["sources_sha256"]})
+
+        def ready() -> None:
+            report.setup = time.monotonic() - started
+
         try:
             size = batch_size or automatic_size(experiment.n_cases - report.done_before, workers)
             batches = make_batches(experiment, missing, motions, size)
-            def ready() -> None:
-                report.setup = time.monotonic() - started
-
             with contextlib.closing(execute(batches, experiment, motions, workers, scheduler, ready)) as results:
                 for task, result in results:
                     _record(experiment, report, buffer, task, result)
                     if stop.requested:
                         raise KeyboardInterrupt
                     bar.update(result.done)
-                    if rebuilds.due():
+                    if checkpoints.due():
                         buffer.flush()
-                        rebuilds.rebuild()
+                        checkpoints.start()
         except KeyboardInterrupt:
             report.interrupted = True
         finally:
             buffer.flush()
             bar.close()
+            checkpoints.wait()
             session.rebuild()
             report.elapsed = time.monotonic() - started
     return report
@@ -218,22 +221,50 @@ def _record(experiment: Experiment, report: RunReport, buffer: PartBuffer, task:
 
 
 class _Checkpoints:
-    """When to rebuild the store during a run: every ``interval`` s, and at least
-    :data:`CHECKPOINT_FACTOR` times the last rebuild's duration after it."""
+    """Rebuilds of the store during a run, in a background thread (batches go on being submitted meanwhile):
+    ``interval`` s after the previous one ended, and at least :data:`CHECKPOINT_FACTOR` times its duration.
+
+    The rebuild reads only complete parts (written atomically), so parts may
+    be written while it runs. An error in it is raised in the run at the next
+    :meth:`due` or :meth:`wait`.
+    """
 
     def __init__(self, interval: float, session: StoreSession) -> None:
         self.interval = interval
         self.session = session
-        self.next = 0.0
+        self.next = time.monotonic() + interval
+        self.thread: threading.Thread | None = None
+        self.error: BaseException | None = None
 
     def due(self) -> bool:
-        return time.monotonic() >= self.next
+        """No rebuild running and its time has come (raises a failed rebuild's error)."""
+        self._raise()
+        return (self.thread is None or not self.thread.is_alive()) and time.monotonic() >= self.next
 
-    def rebuild(self) -> None:
+    def start(self) -> None:
+        """Start a rebuild."""
+        self.thread = threading.Thread(target=self._rebuild, name="stochpound-checkpoint", daemon=True)
+        self.thread.start()
+
+    def wait(self) -> None:
+        """Wait for a running rebuild to end (raises its error)."""
+        if self.thread is not None:
+            self.thread.join()
+        self._raise()
+
+    def _rebuild(self) -> None:
         started = time.monotonic()
-        self.session.rebuild()
+        try:
+            self.session.rebuild()
+        except BaseException as error:  # noqa: BLE001 - handed to the run's thread
+            self.error = error
         finished = time.monotonic()
         self.next = finished + max(self.interval, CHECKPOINT_FACTOR * (finished - started))
+
+    def _raise(self) -> None:
+        if self.error is not None:
+            error, self.error = self.error, None
+            raise error
 
 
 def execute(
