@@ -25,7 +25,7 @@ from stochpound.experiment.sources import ResolvedMotion
 from stochpound.memory import sample_bytes
 from stochpound.scene_file import scene_from_dict
 
-MAX_BATCH = 128
+MAX_BATCH = 256
 """Largest automatic number of cases per batch."""
 BATCH_BYTES = 256 * 2**20
 """Memory a batch's realizations may take on a worker (motions, twins, one run at a time), bytes."""
