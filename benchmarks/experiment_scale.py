@@ -239,7 +239,7 @@ def _introduction(results: dict[str, Any], info: dict[str, str]) -> str:
         f"(one at a time it costs {one['motion_single'] * 1e3:.3g} ms instead of {one['motion_batched'] * 1e3:.3g} ms in the last "
         f"measurement): {min(costs):.3g}–{max(costs):.3g} ms per realization; {one['mean_impacts']:.2f} impacts per realization on average.\n\n"
         "Per realization below: the run's wall time after its start-up (the store's first write, the local cluster's start, "
-        "loading the compiled solver) divided by the realizations; the whole command's time is given too. The CPU time of "
+        "loading the compiled solver in every worker) divided by the realizations; the whole command's time is given too. The CPU time of "
         "all the command's processes per realization (start-up included) shows the work itself, independent of how much of "
         "the shared machine the run got: with the two cores to itself, the run's wall time per realization would be about "
         "half of it. "

@@ -6,8 +6,9 @@ Layout::
         experiment.json        the canonical definition, its sha256, the file text, motion grids
         runs.jsonl             one line per run: start time, host, workers, version, code identity
         .lock                  held (flock) by the run writing this folder
-        part-<run>-<n>.npz     finished cases (numpy .npz, no pickles): at least
-                               :data:`PART_CASES` cases or a few seconds of work each
+        part-<run>-<n>.npz     finished cases (numpy .npz, no pickles): the cases of at
+                               least :data:`PART_REALIZATIONS` realizations, or a few
+                               seconds of work, each
 
 A part holds *sections*, one per kind of case and motion (``case.1`` is the
 grid's cases under the motion at index 1 on ``record``). A section's arrays
@@ -49,9 +50,11 @@ RUNS_FILE = "runs.jsonl"
 LOCK_FILE = ".lock"
 PART_PREFIX = "part-"
 PART_SUFFIX = ".npz"
-PART_CASES = int(os.environ.get("STOCHPOUND_EXPERIMENT_PART_CASES", "500"))
-"""A part is written once this many cases wait in the buffer (:class:`PartBuffer`); 500 (the
-variable, a testing aid, sets it lower to make a small run write several parts)."""
+PART_REALIZATIONS = 500
+"""A part is written once the cases of this many realizations wait in the buffer (:class:`PartBuffer`): 500 times
+the experiment's cases per realization (2 for one grid point and its fixed-base reference)."""
+_PART_CASES = int(os.environ.get("STOCHPOUND_EXPERIMENT_PART_CASES", "0") or 0)
+"""Testing aid: a number of cases that replaces that threshold, to make a small run write several parts."""
 PART_SECONDS = 5.0
 """... or once the oldest waiting case finished this many seconds ago."""
 PART_BYTES = 64 * 2**20
@@ -186,9 +189,9 @@ def part_paths(folder: Path) -> list[Path]:
 class PartBuffer:
     """Finished cases waiting to be written as one part file.
 
-    A part is written when :data:`PART_CASES` cases wait, when the oldest has
-    waited :data:`PART_SECONDS`, or when they hold :data:`PART_BYTES`
-    (:meth:`due`), and on :meth:`flush`.
+    A part is written when ``cases`` cases wait, when the oldest has waited
+    :data:`PART_SECONDS`, or when they hold :data:`PART_BYTES` (:meth:`due`),
+    and on :meth:`flush`.
 
     Parameters
     ----------
@@ -196,11 +199,15 @@ class PartBuffer:
         The parts folder.
     meta : dict
         Kept in every part (version, run).
+    cases_per_realization : float
+        The experiment's cases per realization of its motions: a part holds
+        the cases of :data:`PART_REALIZATIONS` realizations.
     """
 
-    def __init__(self, folder: Path, meta: dict[str, Any]) -> None:
+    def __init__(self, folder: Path, meta: dict[str, Any], cases_per_realization: float) -> None:
         self.folder = folder
         self.meta = meta
+        self.cases = _PART_CASES or max(1, round(PART_REALIZATIONS * cases_per_realization))
         self.run = secrets.token_hex(4)
         self.written = 0
         self.waiting: list[dict[str, np.ndarray]] = []
@@ -223,7 +230,7 @@ class PartBuffer:
     def due(self) -> bool:
         """Enough cases, bytes or waiting time for a part."""
         return bool(self.waiting) and (
-            self.count >= PART_CASES or self.bytes >= PART_BYTES or time.monotonic() - self.oldest >= PART_SECONDS
+            self.count >= self.cases or self.bytes >= PART_BYTES or time.monotonic() - self.oldest >= PART_SECONDS
         )
 
     def flush(self) -> None:

@@ -4,7 +4,7 @@ The client (this process) validates everything, checks the store, writes the
 store file once before the first case, submits batches of cases
 (:mod:`stochpound.experiment.batches`) with a bounded number in flight,
 writes finished cases to part files as results arrive (one per
-:data:`~stochpound.experiment.parts.PART_CASES` cases or a few seconds),
+:data:`~stochpound.experiment.parts.PART_REALIZATIONS` realizations or a few seconds),
 rebuilds the store at checkpoints and at the end. Workers only compute
 (:mod:`stochpound.experiment.compute`): they need the package, not the
 store's file system. The client's memory does not grow with the number of
@@ -67,7 +67,7 @@ class RunReport:
         Wall time of the run, s.
     setup : float
         Of which before the first batch was submitted (store checks and first
-        write, the local cluster's start, loading the compiled solver), s.
+        write, the cluster's start, loading the compiled solver in every worker), s.
     executor : str
         Where the cases ran.
     interrupted : bool
@@ -184,7 +184,9 @@ def run_experiment(
         session.rebuild()
         checkpoints = _Checkpoints(checkpoint, session)
         bar = _progress_bar(report, experiment.name, progress)
-        buffer = PartBuffer(session.folder, {"stochpound_version": __version__, "sources_sha256": identity["sources_sha256"]})
+        realizations = sum(len(experiment.realizations(label)) for label in experiment.motions)
+        meta = {"stochpound_version": __version__, "sources_sha256": identity["sources_sha256"]}
+        buffer = PartBuffer(session.folder, meta, experiment.n_cases / realizations)
 
         def ready() -> None:
             report.setup = time.monotonic() - started
@@ -277,6 +279,8 @@ def execute(
 ) -> Iterator[tuple[BatchTask, BatchResult]]:
     """Run batches and yield (task, result) as they finish (in any order); call ``ready()`` before the first is submitted.
 
+    On dask, every worker first loads the compiled solver (:func:`~stochpound.experiment.compute.warm_up`).
+
     ``workers=0`` (and no scheduler) runs them in this process; otherwise on a
     local dask cluster of ``workers`` processes or on the given scheduler,
     with at most :data:`IN_FLIGHT_PER_WORKER` batches per worker thread
@@ -290,9 +294,10 @@ def execute(
         for task in batches:
             yield task, run_batch(task, motions[labels[task.record]].motion)
         return
-    from distributed import as_completed
+    from distributed import as_completed, wait
 
     with _dask_client(workers, scheduler) as client:
+        wait([client.submit(warm_up, pure=False, workers=[worker]) for worker in client.scheduler_info()["workers"]])
         shipped = {m: client.scatter(motions[label].motion, broadcast=True, hash=False) for m, label in enumerate(labels) if motions[label].motion is not None}
         ahead = IN_FLIGHT_PER_WORKER * max(1, sum(client.nthreads().values()))
         pending = iter(batches)
