@@ -102,3 +102,91 @@ def scene_size(buildings: int, floors: int, gap: float, duration: float) -> None
         "first": first, "warm": warm, "impacts": run.sizes.get("impact", 0), "events": run.attrs["events_total"],
         "modes": run.attrs["modes_visited"], "dofs": state,
     })
+
+
+def single_cell(path: str, runs: int) -> None:
+    """The experiment's one case run alone: ``runs`` warm ``simulate`` calls, and the cost of their motions.
+
+    The case's scene and its Kanai–Tajimi table (intensity resolved to S0)
+    come from the experiment file at ``path``. Mean wall times per
+    realization: ``simulate`` (motion made beforehand), the motion generated
+    ``BATCH`` at a time, and generated one at a time.
+    """
+    import dataclasses
+
+    import numpy as np
+
+    import stochpound
+    from stochpound import motions as generators
+    from stochpound.experiment import load_experiment
+    from stochpound.experiment.model import CASE
+    from stochpound.experiment.sources import resolve_motions
+    from stochpound.motions.ground import SampledMotion
+
+    batch = 64
+    experiment = load_experiment(path)
+    scene = stochpound.scene_from_dict(experiment.structure(experiment.points(CASE)[0]))
+    table = next(iter(resolve_motions(experiment).values())).table
+    parameters = {k: v for k, v in table.items() if k not in ("type", "interpolation", "realization")}
+    generate = getattr(generators, table["type"])
+
+    def batched() -> list:
+        values = [generate(batch, start=start, **parameters).values for start in range(0, runs, batch)]
+        return [SampledMotion(table["dt"], row, "linear") for row in np.concatenate(values)[:runs]]
+
+    batched()
+    motion_batched, motions = _timed(batched)
+    motion_single, _ = _timed(lambda: [SampledMotion(table["dt"], generate(1, start=i, **parameters).values[0], "linear") for i in range(min(runs, 100))])
+    for motion in motions[:20]:
+        stochpound.simulate(dataclasses.replace(scene, motion=motion))
+    cpu = time.process_time()
+    elapsed, results = _timed(lambda: [stochpound.simulate(dataclasses.replace(scene, motion=motion)) for motion in motions])
+    cpu = time.process_time() - cpu
+    _emit({
+        "runs": runs, "simulate": elapsed / runs, "simulate_cpu": cpu / runs, "motion_batched": motion_batched / runs, "motion_single": motion_single / min(runs, 100),
+        "mean_impacts": float(np.mean([r.sizes.get("impact", 0) for r in results])),
+    })
+
+
+def experiment_run(path: str, workers: int, store: str) -> None:
+    """``stochpound experiment run PATH --store STORE --workers N`` in this process (the command's own function).
+
+    Also the CPU time of this process (the client, with the local cluster's
+    scheduler and nannies; imports included) and of its children (the
+    workers, reaped when the cluster closes).
+    """
+    from stochpound.experiment import load_experiment, run_experiment
+
+    import resource
+
+    started = time.perf_counter()
+    report = run_experiment(load_experiment(path), store, workers=workers, progress=False)
+    usage = {who: resource.getrusage(who) for who in (resource.RUSAGE_SELF, resource.RUSAGE_CHILDREN)}
+    cpu = {who: u.ru_utime + u.ru_stime for who, u in usage.items()}
+    _emit({
+        "wall": time.perf_counter() - started, "elapsed": report.elapsed, "setup": report.setup, "done": report.done_now,
+        "total": report.total, "failed": len(report.failed), "complete": report.complete,
+        "cpu_client": cpu[resource.RUSAGE_SELF], "cpu_workers": cpu[resource.RUSAGE_CHILDREN],
+    })
+
+
+def store_analysis(store: str) -> None:
+    """Questions answered on a store with dask (lazily, chunk by chunk): pounding probability, mean response, impact table."""
+    import dask
+
+    import stochpound
+    from stochpound.analysis import pounding_probability
+
+    dask.config.set(scheduler="synchronous")
+    ds = stochpound.open_store(store)
+    record = str(ds["record"].values[0])
+    started = time.perf_counter()
+    probability = pounding_probability(ds["impacts"].sel(record=record), "realization").compute()
+    mean_std = float(ds["response_std"].sel(record=record).mean("realization").compute().values.ravel()[0])
+    largest = float(ds["impact_peak_force"].max().compute())
+    in_phase = int(ds["impact_in_phase"].sum().compute())
+    _emit({
+        "elapsed": time.perf_counter() - started, "realizations": int(probability["realizations"].values.ravel()[0]),
+        "probability": float(probability["probability"].values.ravel()[0]), "mean_response_std": mean_std,
+        "impacts": int(ds.sizes["impact"]), "largest_impact_force": largest, "impacts_in_phase": in_phase,
+    })

@@ -1,5 +1,8 @@
 """Command line of the benchmark suite: ``python -m benchmarks`` or ``python benchmarks/run.py``.
 
+``python -m benchmarks scaling`` runs the experiment-scaling benchmark instead
+(:mod:`benchmarks.experiment_scale`).
+
 The thread pools of BLAS, OpenMP and numba are set to one thread here,
 before numpy is imported, so that every in-process measurement runs on one core.
 """
@@ -21,7 +24,7 @@ import tempfile  # noqa: E402
 import time  # noqa: E402
 from pathlib import Path  # noqa: E402
 
-from benchmarks import report, suite  # noqa: E402
+from benchmarks import experiment_scale, report, suite  # noqa: E402
 from benchmarks.timing import REPOSITORY  # noqa: E402
 
 
@@ -45,6 +48,9 @@ def output_folder(arguments: argparse.Namespace) -> Path:
 
 def main(argv: list[str] | None = None) -> int:
     """Run the suite and write its outputs; return the exit status."""
+    argv = sys.argv[1:] if argv is None else argv
+    if argv[:1] == ["scaling"]:
+        return experiment_scale.main(argv[1:])
     arguments = parse_arguments(argv)
     config = suite.Config.quick_preset() if arguments.quick else suite.Config.full()
     if arguments.no_opensees:
@@ -56,7 +62,7 @@ def main(argv: list[str] | None = None) -> int:
     elapsed = time.perf_counter() - start
     figure = report.figure(results, folder / "figures" / report.FIGURE_NAME)
     markdown = folder / "benchmarks.md"
-    markdown.write_text(report.document(results, info, elapsed))
+    markdown.write_text(experiment_scale.keep_section(markdown.read_text() if markdown.exists() else "", report.document(results, info, elapsed)))
     print(f"wrote {markdown} and {figure} in {elapsed:.1f} s")
     return 0
 

@@ -1,5 +1,7 @@
-"""``stochpound simulate SCENE.toml --out RUN.nc`` writes the result dataset of docs/scene-files.md."""
+"""``stochpound simulate SCENE.toml --out RUN.nc`` writes the result dataset of docs/scene-files.md (refusing to overwrite, following the umask)."""
 
+import os
+import stat
 import subprocess
 import sys
 from pathlib import Path
@@ -43,3 +45,54 @@ def test_simulate_writes_the_contract_dataset(tmp_path):
         np.testing.assert_array_equal(run.sliding_displacement.sel(building="B2"), 0.0)
         in_memory = stochpound.simulate(stochpound.load_scene(EXAMPLE), method="ivp")
         np.testing.assert_array_equal(run.total_displacement.values, in_memory.total_displacement.values)
+
+
+SMALL_SCENE = """
+[[building]]
+mass = [1.0e5]
+stiffness = [4.0e7]
+damping = [1.0e5]
+
+[motion]
+type = "harmonic"
+amplitude = 3.0
+omega = 9.0
+duration = 2.0
+dt = 0.01
+"""
+
+
+def _simulate(folder, *args: str, umask: int | None = None) -> subprocess.CompletedProcess:
+    scene = folder / "scene.toml"
+    scene.write_text(SMALL_SCENE)
+
+    def set_umask() -> None:
+        if umask is not None:
+            os.umask(umask)
+
+    return subprocess.run([sys.executable, "-m", "stochpound", "simulate", str(scene), *args], capture_output=True, text=True, preexec_fn=set_umask)
+
+
+def test_an_existing_output_is_refused_without_overwrite_and_other_suffixes_are_warned_about(tmp_path):
+    from tests.test_experiment_helpers import invoke
+
+    scene = tmp_path / "scene.toml"
+    scene.write_text(SMALL_SCENE)
+    out = tmp_path / "run.h5"
+    written = invoke("simulate", str(scene), "--out", str(out))
+    assert written.exit_code == 0 and "warning: --out" in written.stderr and "usual suffix is .nc (got .h5)" in written.stderr
+    out.write_bytes(b"keep me")
+    refused = invoke("simulate", str(scene), "--out", str(out))
+    assert refused.exit_code == 2 and f"{out} exists; give --overwrite to replace it" in refused.stderr
+    assert out.read_bytes() == b"keep me"
+    replaced = invoke("simulate", str(scene), "--out", str(out), "--overwrite")
+    assert replaced.exit_code == 0, replaced.stderr
+    with xr.open_dataset(out) as run:
+        assert run.sizes["time"] == 201
+    assert "warning" not in invoke("simulate", str(scene), "--out", str(tmp_path / "run.nc")).stderr
+
+
+def test_the_output_follows_the_umask(tmp_path):
+    out = tmp_path / "run.nc"
+    assert _simulate(tmp_path, "--out", str(out), umask=0o027).returncode == 0
+    assert stat.S_IMODE(out.stat().st_mode) == 0o640  # neither mkstemp's 0600 nor the usual 0644

@@ -78,6 +78,18 @@ buildings = ["B1"]
 """
 
 N_CASES = 27
+QUICKSTART = REPO / "experiments" / "quickstart.toml"
+
+
+def quickstart_cell(motions: str, gap: float = 0.02, mu: float = 0.2, neighbour: str = "flexible") -> str:
+    """An experiment file: the quick-start file's scene and variants, one cell of its grid, under ``motions``.
+
+    ``motions`` is the rest of the file: ``[[records]]``, ``[[motions]]``,
+    ``[synthetic.<name>]``, ``[output]`` and ``[solver]`` tables.
+    """
+    text = QUICKSTART.read_text()
+    grid = f'[grid]\ngap = [{gap}]\nmu = {{ values = [{mu}], buildings = ["B1"] }}\nneighbour = ["{neighbour}"]\n\n'
+    return text[: text.index("[grid]")] + grid + motions
 
 
 def write_experiment(folder: Path, text: str = SMALL_EXPERIMENT, name: str = "small.toml") -> Path:
@@ -96,11 +108,32 @@ def cli(*args: str, env: dict | None = None, check: bool = True, timeout: float 
     return result
 
 
+def invoke(*args: str, env: dict | None = None):
+    """Run ``stochpound ARGS`` in this process (click's test runner): ``exit_code``, ``stdout``, ``stderr``."""
+    from click.testing import CliRunner
+
+    from stochpound.cli import main
+
+    return CliRunner().invoke(main, list(args), env=env)
+
+
 def cli_process(*args: str, env: dict | None = None) -> subprocess.Popen:
     """Start ``python -m stochpound ARGS`` in the background."""
     return subprocess.Popen(
         [sys.executable, "-m", "stochpound", *args], env={**os.environ, **(env or {})}, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
     )
+
+
+def done_cases(store: Path) -> int:
+    """Finished cases in a store's parts folder."""
+    from stochpound.experiment.parts import read_definition, parts_folder
+    from stochpound.experiment.model import Experiment
+    from stochpound.experiment.store_writer import PartsIndex
+
+    folder = parts_folder(store)
+    if not (folder / "experiment.json").is_file():
+        return 0
+    return PartsIndex.scan(Experiment(read_definition(folder)["definition"]), folder).n_done
 
 
 def assert_same_results(first: Path, second: Path) -> None:

@@ -17,7 +17,7 @@ from stochpound.analysis.intervals import mean_interval, quantiles, running_mean
 from stochpound.analysis.peaks import peak_response
 from stochpound.analysis.pounding import pounding_probability
 from stochpound.analysis.separation import pounding_curve, required_separation, rule_exceedance
-from stochpound.analysis.separation_rules import contact_demands, fixed_base_cqc, separation_rules
+from stochpound.analysis.separation_rules import contact_demands, fixed_base_cqc, separation_rules, store_contact_demands
 from stochpound.analysis.summary import run_summary
 
 __all__ = [
@@ -37,6 +37,7 @@ __all__ = [
     "rule_exceedance",
     "contact_demands",
     "separation_rules",
+    "store_contact_demands",
     "fixed_base_cqc",
     "run_summary",
 ]

@@ -197,6 +197,8 @@ def _demand(peak_closure: xr.DataArray, dim: str, contact_dim: str | None, gap_o
     demand = peak_closure if gap_offsets is None else peak_closure - gap_offsets
     if contact_dim is not None and contact_dim in demand.dims:
         demand = demand.max(contact_dim, skipna=False)
+    if "gap" in demand.coords and "gap" not in demand.dims:  # a store's contact-free selection (gap = inf) labels its runs
+        demand = demand.drop_vars("gap")
     return demand
 
 

@@ -33,6 +33,20 @@ RULES = ("abs", "srss", "srss_reduced", "ddc", "ddc_cqc")
 """Names of the rules on the ``rule`` dimension of :func:`separation_rules` (``ddc_cqc`` only when given a CQC ρ)."""
 
 
+STORE_NAMES = {
+    "peak_closure": "peak_contact_closure",
+    "peak_displacement_left": "contact_peak_displacement_left",
+    "peak_displacement_right": "contact_peak_displacement_right",
+    "correlation": "contact_correlation",
+}
+"""Name of each variable of :func:`contact_demands` in an experiment store (its per-case summaries)."""
+
+
+def store_contact_demands(store: xr.Dataset) -> xr.Dataset:
+    """The :func:`contact_demands` of every case of an experiment store (its names; lazy on a dask-backed store)."""
+    return store[list(STORE_NAMES.values())].rename({stored: name for name, stored in STORE_NAMES.items()})
+
+
 def contact_demands(run: xr.Dataset, dim: str = "time") -> xr.Dataset:
     """The inputs of the separation rules at every contact of a run.
 

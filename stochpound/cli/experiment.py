@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import sys
+from contextlib import contextmanager
 from pathlib import Path
+from typing import Iterator
 
 import click
 
@@ -37,20 +39,23 @@ def run_command(experiment_files: tuple[str, ...], store: str | None, workers: i
         raise click.BadParameter("give --workers or --scheduler, not both", param_hint="--workers")
     if store is not None and len(experiment_files) > 1:
         raise click.BadParameter("--store names one store: give one EXPERIMENT_FILE with it", param_hint="--store")
-    try:
-        loaded = [load_experiment(path) for path in experiment_files]
-    except (StochpoundError, ValueError) as error:
-        raise click.ClickException(str(error)) from None
+    several = len(experiment_files) > 1
+    loaded = []
+    for path in experiment_files:
+        with _errors_of(path, several):
+            loaded.append(load_experiment(path))
     failed = False
     for experiment_file, definition in zip(experiment_files, loaded):
-        if len(loaded) > 1:
+        if several:
             click.echo(f"{experiment_file}:")
-        try:
-            report = run_experiment(
-                definition, store, workers=workers, scheduler=scheduler, restart=restart, progress=not quiet, checkpoint=checkpoint, batch_size=batch_size
-            )
-        except (StochpoundError, ValueError) as error:
-            raise click.ClickException(str(error)) from None
+        with _errors_of(experiment_file, several):
+            try:
+                report = run_experiment(
+                    definition, store, workers=workers, scheduler=scheduler, restart=restart, progress=not quiet, checkpoint=checkpoint, batch_size=batch_size
+                )
+            except KeyboardInterrupt:  # a second Ctrl-C while the first one's clean-up ran
+                click.echo("interrupted; rerun the same command to complete the missing cases")
+                sys.exit(130)
         _summary(report)
         if report.interrupted:
             sys.exit(130)
@@ -59,12 +64,25 @@ def run_command(experiment_files: tuple[str, ...], store: str | None, workers: i
         sys.exit(1)
 
 
+@contextmanager
+def _errors_of(path: str, name_it: bool) -> Iterator[None]:
+    """Turn a stochpound error into a one-line command error; prefix it with ``path`` if ``name_it`` and it does not name it already."""
+    try:
+        yield
+    except (StochpoundError, ValueError) as error:
+        message = str(error)
+        if name_it and not message.startswith(path):
+            message = f"{path}: {message}"
+        raise click.ClickException(message) from None
+
+
 def _summary(report) -> None:
-    rate = report.done_now / report.elapsed if report.elapsed > 0 else 0.0
+    running = report.elapsed - report.setup
+    rate = report.done_now / running if running > 0 else 0.0
     state = "interrupted" if report.interrupted else ("complete" if report.complete else "incomplete")
     click.echo(
         f"{state}: {report.done}/{report.total} cases done ({report.done_now} this run, {report.done_before} before) "
-        f"in {report.elapsed:.1f} s, {rate:.2f} cases/s on {report.executor}"
+        f"in {report.elapsed:.1f} s ({report.setup:.1f} s start-up), {rate:.2f} cases/s on {report.executor}"
     )
     for described, error in report.failed[:5]:
         click.echo(f"FAILED {described}\n{error}", err=True)
@@ -91,8 +109,8 @@ def check_command(experiment_file: str) -> None:
     click.echo(f"{experiment_file}: valid; definition sha256 {loaded.sha256}")
     for dim in loaded.dims:
         click.echo(f"  {dim.name:14s} {len(dim.values):5d}  {', '.join(_fmt(v) for v in dim.values[:8])}{' ...' if len(dim.values) > 8 else ''}")
-    n_reference = sum(1 for c in loaded.cases if c.kind == "reference")
-    click.echo(f"  {len(loaded.cases) - n_reference} cases + {n_reference} fixed-base reference cases")
+    n_reference = int(loaded.in_grid("reference").sum())
+    click.echo(f"  {loaded.n_cases - n_reference} cases + {n_reference} fixed-base reference cases")
 
 
 def _fmt(value) -> str:
@@ -112,16 +130,15 @@ def status_command(store: str, show_all: bool, show_done: bool, no_rebuild: bool
         report = store_status(Path(store), rebuild=not no_rebuild)
     except (StochpoundError, ValueError, OSError) as error:
         raise click.ClickException(str(error)) from None
-    total = len(report.done) + len(report.missing)
     click.echo(f"experiment {report.experiment.name} (definition sha256 {report.experiment.sha256[:12]}…)")
-    click.echo(f"{len(report.done)}/{total} cases done, {len(report.missing)} missing" + ("; a run is writing this store now" if report.running else ""))
+    click.echo(f"{report.n_done}/{report.experiment.n_cases} cases done, {report.n_missing} missing" + ("; a run is writing this store now" if report.running else ""))
     if show_done:
-        for case in report.done:
+        for case in report.cases(done=True):
             click.echo(f"done     {case.case_id}  {case.describe()}")
-    shown = report.missing if show_all else report.missing[:20]
+    shown = report.cases(done=False, limit=None if show_all else 20)
     for case in shown:
         click.echo(f"missing  {case.case_id}  {case.describe()}")
-    if len(shown) < len(report.missing):
-        click.echo(f"... {len(report.missing) - len(shown)} more (--all lists them)")
+    if len(shown) < report.n_missing:
+        click.echo(f"... {report.n_missing - len(shown)} more (--all lists them)")
     if report.rebuilt:
         click.echo(f"store rebuilt from the finished cases: {report.store}")

@@ -1,54 +1,76 @@
-"""Running cases: what a worker does with a batch of case tasks.
+"""Running cases: what a worker does with a batch.
 
-A :class:`CaseTask` is self-contained and picklable (scene dicts, the motion's
-table or the motion itself, the output and solver settings), so a batch runs
-unchanged in this process, on local dask workers or on a remote cluster.
-Every result depends only on the task: the solvers limit BLAS to one thread,
-and a synthetic realization depends only on (seed, realization).
+A :class:`BatchTask` is self-contained and picklable (scene dicts, the motion's
+table, the output and solver settings), so a batch runs unchanged in this
+process, on local dask workers or on a remote cluster. A batch is a set of
+realizations of one motion and the grid points that run under them
+(:class:`Group`): the realizations are generated once (an ensemble's in one
+call), the fixed-base twins of all of them are computed at once
+(:mod:`stochpound.experiment.twin`), and each case is simulated and
+summarised (:mod:`stochpound.experiment.summary`).
 
-To run synthetic ensembles through a batched solver, only :func:`run_batch`
-needs to change (see the note there).
+Every result depends only on its case: the solvers limit BLAS to one thread,
+a synthetic realization depends only on (seed, realization), and the twin's
+recursion computes each realization on its own.
 """
 
 from __future__ import annotations
 
 import dataclasses
 import traceback
-from collections import OrderedDict
-from dataclasses import dataclass
-from typing import Any, Callable, Hashable, Sequence
+from dataclasses import dataclass, field
 
 import numpy as np
-import xarray as xr
 
-from stochpound.experiment.spec import canonical_json
-from stochpound.experiment.summary import case_arrays, case_values, reference_arrays, reference_values, top_floor
 from stochpound import motions as synthetic_motions
-from stochpound.motions.ground import GroundMotion, SampledMotion
+from stochpound.experiment.model import REFERENCE
+from stochpound.experiment.parts import concatenate, section_key, stack_cases
+from stochpound.experiment.spec import canonical_json
+from stochpound.experiment.summary import case_arrays, case_values, reference_arrays, reference_values
+from stochpound.experiment.twin import fixed_base_displacements
 from stochpound.model.scene import Scene
 from stochpound.model.scene_file import scene_from_dict
+from stochpound.motions.ground import GroundMotion, SampledMotion
 from stochpound.solvers.simulate import simulate
 
 
 @dataclass(frozen=True)
-class CaseTask:
-    """Everything a worker needs to run one case.
+class Group:
+    """The cases of one kind at one grid point, under some realizations of the batch's motion.
 
     Attributes
     ----------
-    case_id : str
-        The case's id.
     kind : str
         ``case`` or ``reference``.
     structure : dict
-        Scene dict of the case (placeholder motion).
+        Scene dict of the grid point (placeholder motion).
     reference : dict
-        Scene dict of the studied building alone on a fixed base (placeholder motion).
-    motion_key : tuple
-        (motion label, realization): identifies the motion for caching.
+        Scene dict of its fixed-base twin (placeholder motion).
+    realizations : tuple of int
+        Realization numbers (0 for a record).
+    positions : np.ndarray
+        (len(realizations), n_dims) int: the cases' positions in the grid of their kind.
+    """
+
+    kind: str
+    structure: dict
+    reference: dict
+    realizations: tuple[int, ...]
+    positions: np.ndarray
+
+
+@dataclass(frozen=True)
+class BatchTask:
+    """Everything a worker needs to run a batch.
+
+    Attributes
+    ----------
+    record : int
+        Index of the motion on the store's ``record`` dimension.
     motion_table : dict or None
-        Scene ``[motion]`` table for a synthetic realization (generated on the
-        worker); None when the batch's motion is shipped with it.
+        An ensemble's scene ``[motion]`` table (realizations are generated
+        from it on the worker); None when the motion is shipped with the batch.
+    groups : tuple of Group
     studied : str
         The studied building.
     output : dict
@@ -57,123 +79,152 @@ class CaseTask:
         ``method``, ``integrator``, ``rtol``, ``atol``.
     """
 
-    case_id: str
-    kind: str
-    structure: dict
-    reference: dict
-    motion_key: tuple
+    record: int
     motion_table: dict | None
+    groups: tuple[Group, ...]
     studied: str
     output: dict
     solver: dict
 
+    @property
+    def n_cases(self) -> int:
+        """Number of cases in the batch."""
+        return sum(len(g.realizations) for g in self.groups)
+
 
 @dataclass
-class CaseOutcome:
-    """The result of one case: its part arrays, or the error that stopped it."""
+class BatchResult:
+    """What a batch produced.
 
-    case_id: str
-    arrays: dict[str, np.ndarray] | None = None
-    error: str | None = None
+    Attributes
+    ----------
+    arrays : dict
+        Part arrays of the finished cases, by section (:func:`stochpound.experiment.parts.section_key`).
+    done : int
+        Number of finished cases.
+    failures : list of (str, tuple, str)
+        (kind, position, traceback) of each case that raised.
+    """
 
-
-class _LRU:
-    """A small least-recently-used cache (per worker process)."""
-
-    def __init__(self, size: int) -> None:
-        self.size = size
-        self.items: OrderedDict[Hashable, Any] = OrderedDict()
-
-    def get(self, key: Hashable, make: Callable[[], Any]) -> Any:
-        if key in self.items:
-            self.items.move_to_end(key)
-            return self.items[key]
-        value = make()
-        self.put(key, value)
-        return value
-
-    def put(self, key: Hashable, value: Any) -> None:
-        self.items[key] = value
-        self.items.move_to_end(key)
-        if len(self.items) > self.size:
-            self.items.popitem(last=False)
+    arrays: dict[str, np.ndarray] = field(default_factory=dict)
+    done: int = 0
+    failures: list[tuple[str, tuple[int, ...], str]] = field(default_factory=list)
 
 
-_MOTIONS = _LRU(64)          # ground motions by (label, realization)
-_REFERENCES = _LRU(1024)     # fixed-base top-floor responses (a few kB each)
-
-
-def run_batch(tasks: Sequence[CaseTask], motion: GroundMotion | None = None) -> list[CaseOutcome]:
-    """Run a batch of cases that share one motion source.
+def run_batch(task: BatchTask, motion: GroundMotion | None = None) -> BatchResult:
+    """Run a batch: generate its motions, compute the twins, simulate and summarise every case.
 
     Parameters
     ----------
-    tasks : sequence of CaseTask
+    task : BatchTask
     motion : GroundMotion, optional
-        The batch's recorded motion (None for synthetic realizations, which
-        are generated here from their tables).
+        The batch's recorded (or analytic) motion; None for an ensemble,
+        whose realizations are generated here from the task's table.
 
     Returns
     -------
-    list of CaseOutcome
-        One per task, in order; a failing case carries its traceback.
-
-    Notes
-    -----
-    Synthetic batches are realizations of one grid point; a batched
-    ensemble solver would replace the loop below for them (one call for the
-    whole batch), keeping :func:`compute_case`'s summaries.
+    BatchResult
+        A case that raises is reported with its traceback and the batch goes
+        on; an error shared by all cases (the motion, a twin) fails them all.
     """
-    _generate_ensemble(tasks)
-    outcomes = []
-    for task in tasks:
+    try:
+        grounds = _motions(task, motion)
+        twins = _twins(task, grounds)
+    except Exception:  # noqa: BLE001 - reported for every case of the batch
+        error = traceback.format_exc(limit=8)
+        return BatchResult(failures=[(g.kind, tuple(int(i) for i in p), error) for g in task.groups for p in g.positions])
+    result, sections = BatchResult(), []
+    for group in task.groups:
+        section = _group(task, group, grounds, twins[canonical_json(group.reference)], result.failures)
+        if section:
+            sections.append(section)
+            result.done += len(section[section_key(group.kind, task.record, "position")])
+    result.arrays = concatenate(sections)
+    return result
+
+
+def _group(task: BatchTask, group: Group, grounds: dict[int, GroundMotion], twins: dict[int, np.ndarray], failures: list) -> dict[str, np.ndarray]:
+    """The section of a group's finished cases (empty if none finished); failures are appended to ``failures``."""
+    try:
+        scene = _scene(group.structure) if group.kind != REFERENCE else None
+    except Exception:  # noqa: BLE001 - reported for every case of the group
+        failures.extend((group.kind, tuple(int(i) for i in position), traceback.format_exc(limit=8)) for position in group.positions)
+        return {}
+    finished, positions = [], []
+    for realization, position in zip(group.realizations, group.positions):
         try:
-            outcomes.append(CaseOutcome(task.case_id, compute_case(task, motion)))
+            finished.append(_case(task, scene, grounds[realization], twins[realization]))
         except Exception:  # noqa: BLE001 - reported per case, the batch goes on
-            outcomes.append(CaseOutcome(task.case_id, error=traceback.format_exc(limit=8)))
-    return outcomes
+            failures.append((group.kind, tuple(int(i) for i in position), traceback.format_exc(limit=8)))
+            continue
+        positions.append(position)
+    if not finished:
+        return {}
+    stacked = stack_cases(finished, np.array(positions, dtype=np.int64), grounds[group.realizations[0]].times)
+    return {section_key(group.kind, task.record, name): values for name, values in stacked.items()}
 
 
-def _generate_ensemble(tasks: Sequence[CaseTask]) -> None:
-    """Generate a synthetic batch's realizations in one call (bit for bit those of one-by-one calls)."""
-    synthetic = [t for t in tasks if t.motion_table is not None and t.motion_key not in _MOTIONS.items]
-    if len(synthetic) < 2:
-        return
-    table = {k: v for k, v in synthetic[0].motion_table.items() if k != "realization"}
-    if any({k: v for k, v in t.motion_table.items() if k != "realization"} != table for t in synthetic):
-        return
-    indices = sorted({t.motion_table["realization"] for t in synthetic})
-    parameters = {k: v for k, v in table.items() if k not in ("type", "interpolation")}
-    ensemble = getattr(synthetic_motions, table["type"])(indices[-1] - indices[0] + 1, start=indices[0], **parameters)
-    dt = float(table["dt"])
-    for task in synthetic:
-        row = ensemble.sel(realization=task.motion_table["realization"]).values
-        _MOTIONS.put(task.motion_key, SampledMotion(dt, np.asarray(row, dtype=float), "linear", f"{table['type']} realization {task.motion_key[1]}"))
+def _case(task: BatchTask, scene: Scene | None, ground: GroundMotion, twin: np.ndarray) -> dict[str, np.ndarray]:
+    """Part arrays of one case: ``scene`` (placeholder motion) under ``ground``, or, without a scene, a reference case (its twin's response)."""
+    if scene is None:
+        return reference_arrays(reference_values(twin), twin, "total_displacement" in task.output["time_histories"])
+    solver = task.solver
+    run = simulate(dataclasses.replace(scene, motion=ground), solver["method"], integrator=solver["integrator"], rtol=solver["rtol"], atol=solver["atol"])
+    summary = case_values(run, task.studied, twin[-1])
+    return case_arrays(summary, run, task.output["time_histories"], task.output["buildings"], task.output["impacts"])
 
 
-def compute_case(task: CaseTask, motion: GroundMotion | None = None) -> dict[str, np.ndarray]:
-    """Simulate one case and return its part arrays (:mod:`stochpound.experiment.summary`)."""
-    ground = motion if motion is not None else _MOTIONS.get(task.motion_key, lambda: _generated_motion(task))
-    histories = task.output["time_histories"]
-    key = (canonical_json(task.reference), task.motion_key, canonical_json(task.solver))
-    if task.kind == "reference":
-        run = _simulate(task.reference, ground, task.solver)
-        _REFERENCES.put(key, top_floor(run, task.studied))
-        return reference_arrays(reference_values(run, task.studied), run, "total_displacement" in histories)
-    run = _simulate(task.structure, ground, task.solver)
-    fixed_base = _REFERENCES.get(key, lambda: top_floor(_simulate(task.reference, ground, task.solver), task.studied))
-    summary = case_values(run, task.studied, fixed_base)
-    return case_arrays(summary, run, histories, task.output["buildings"], task.output["impacts"])
+_SCENES: dict[str, Scene] = {}
 
 
-def _generated_motion(task: CaseTask) -> GroundMotion:
-    return scene_from_dict({**task.reference, "motion": task.motion_table}).motion
+def _scene(structure: dict) -> Scene:
+    """The scene of a structure dict (placeholder motion), cached per worker by its canonical JSON."""
+    key = canonical_json(structure)
+    scene = _SCENES.get(key)
+    if scene is None:
+        if len(_SCENES) >= 256:
+            _SCENES.clear()
+        scene = _SCENES[key] = scene_from_dict(structure, source="experiment")
+    return scene
 
 
-def build_scene(structure: dict, motion: GroundMotion) -> Scene:
-    """The scene of a structure dict (placeholder motion) under ``motion``."""
-    return dataclasses.replace(scene_from_dict(structure, source="experiment"), motion=motion)
+def _motions(task: BatchTask, motion: GroundMotion | None) -> dict[int, GroundMotion]:
+    """The batch's ground motion of each realization: the shipped motion, or an ensemble's realizations generated in one call."""
+    realizations = sorted({r for group in task.groups for r in group.realizations})
+    if task.motion_table is None:
+        return {r: motion for r in realizations}
+    table = task.motion_table
+    parameters = {k: v for k, v in table.items() if k not in ("type", "interpolation", "realization")}
+    first = realizations[0]
+    generated = getattr(synthetic_motions, table["type"])(realizations[-1] - first + 1, start=first, **parameters)
+    values, dt = np.asarray(generated.values, dtype=float), float(table["dt"])
+    return {r: SampledMotion(dt, values[r - first], "linear", f"{table['type']} realization {r}") for r in realizations}
 
 
-def _simulate(structure: dict, motion: GroundMotion, solver: dict) -> xr.Dataset:
-    return simulate(build_scene(structure, motion), solver["method"], integrator=solver["integrator"], rtol=solver["rtol"], atol=solver["atol"])
+def _twins(task: BatchTask, grounds: dict[int, GroundMotion]) -> dict[str, dict[int, np.ndarray]]:
+    """Fixed-base twins' floor displacements (floors × time, m) by reference structure and realization."""
+    wanted: dict[str, tuple[dict, set[int]]] = {}
+    for group in task.groups:
+        key = canonical_json(group.reference)
+        wanted.setdefault(key, (group.reference, set()))[1].update(group.realizations)
+    twins = {}
+    for key, (reference, realizations) in wanted.items():
+        order = sorted(realizations)
+        displacements = fixed_base_displacements(_scene(reference), [grounds[r] for r in order])
+        twins[key] = dict(zip(order, displacements))
+    return twins
+
+
+def warm_up() -> None:
+    """Compile the exact solver's engine and the twin's recursion (or load them from numba's cache).
+
+    numba caches compiled kernels on disk (``cache=True``): compiled once
+    here, before local workers start, every worker loads them in about a
+    second instead of compiling them concurrently.
+    """
+    from stochpound.solvers.exact import WARM_UP_SCENE, compile_engine
+
+    compile_engine()
+    building = WARM_UP_SCENE["building"][1]
+    twin = scene_from_dict({"building": [building], "motion": WARM_UP_SCENE["motion"]}, source="warm_up")
+    fixed_base_displacements(twin, [twin.motion])

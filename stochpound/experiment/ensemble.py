@@ -42,6 +42,7 @@ from stochpound import __version__
 from stochpound.analysis import impact_statistics, peak_response
 from stochpound.analysis.names import ENSEMBLE_ALIASES, with_aliases
 from stochpound.analysis.summary import response_moments
+from stochpound.memory import check_memory, sample_bytes
 from stochpound.motions.ground import SampledMotion
 from stochpound.results.record import ENERGY_TERMS, EventCounters, Recorder
 from stochpound.model.scene import Scene
@@ -103,8 +104,9 @@ def simulate_ensemble(
     dt = _sample_spacing(motions)
     labels = motions["realization"].values
     starts = range(0, len(labels), batch_size)
-    tasks = ((scene, _load(motions, a, batch_size), labels[a : a + batch_size], dt, keep, method) for a in starts)
     workers = (os.cpu_count() or 1) if workers is None else workers
+    _check_memory(scene, motions.shape, keep, min(max(workers, 1), len(starts)), batch_size)
+    tasks = ((scene, _load(motions, a, batch_size), labels[a : a + batch_size], dt, keep, method) for a in starts)
     if workers <= 1 or len(starts) <= 1:
         batches = [_simulate_batch(*task) for task in tasks]
     else:
@@ -117,6 +119,18 @@ def simulate_ensemble(
         **{f"motion_{name}": value for name, value in motions.attrs.items() if isinstance(value, (int, float, str))},
     )
     return result
+
+
+def _check_memory(scene: Scene, shape: tuple[int, int], keep: str, parallel: int, batch_size: int) -> None:
+    """Refuse an ensemble whose batches in flight (two per worker) or kept histories would exceed the memory limit."""
+    n_realizations, n_times = shape
+    n_dof = sum(b.n_floors + (b.base is not None) for b in scene.buildings)
+    sizes = (n_dof, len(scene.buildings), scene.max_floors, len(scene.contacts))
+    in_flight = 2 * parallel * min(batch_size, n_realizations)
+    check_memory(in_flight * n_times * sample_bytes(*sizes), f"batch_size: {in_flight} runs of {n_times} samples at a time ({parallel} workers)")
+    if keep == "histories":
+        per_sample = 8 * (2 * len(scene.buildings) * scene.max_floors + len(scene.buildings) + len(scene.contacts))
+        check_memory(n_realizations * n_times * per_sample, f"motions: {n_realizations} realizations of {n_times} samples kept as histories")
 
 
 def _load(motions: xr.DataArray, start: int, size: int) -> np.ndarray:

@@ -1,17 +1,32 @@
-"""The store's sidecar folder ``STORE.parts/``: one small file per finished case.
+"""The store's sidecar folder ``STORE.parts/``: finished cases, persisted in batches.
 
 Layout::
 
     STORE.parts/
         experiment.json        the canonical definition, its sha256, the file text, motion grids
-        runs.jsonl             one line per run: start time, host, workers, version, git commit
+        runs.jsonl             one line per run: start time, host, workers, version, code identity
         .lock                  held (flock) by the run writing this folder
-        <case_id>.npz          one finished case (numpy .npz, no pickles)
+        part-<run>-<n>.npz     finished cases (numpy .npz, no pickles): the cases of at
+                               least :data:`PART_REALIZATIONS` realizations, or a few
+                               seconds of work, each
 
-Every file is written to a temporary name in the folder, flushed to disk
-(fsync) and renamed into place, so a part that exists is complete: a run
-killed at any moment leaves finished parts and, at worst, a stray temporary
-file, which the next run deletes. HDF5 is never appended in place.
+A part holds *sections*, one per kind of case and motion (``case.1`` is the
+grid's cases under the motion at index 1 on ``record``). A section's arrays
+are named ``<kind>.<record>/<name>``:
+
+* ``position``: (n, n_dims) positions of its cases in the grid of their kind;
+* ``s:<name>``: summaries, stacked (n, ...);
+* ``t:<name>``: kept time histories, stacked (n, ..., n_samples) and padded
+  with NaN to the section's largest shape; ``t:time`` their sample times, s;
+* ``i:count``: impacts of each case, ``i:<name>``: the impact table's columns,
+  the cases' rows one after the other.
+
+Every file is written to a temporary name in the folder
+(``.<name>.<random>.tmp``), flushed to disk (fsync) and renamed into place,
+so a part that exists is complete: a run killed at any moment loses only the
+cases not yet in a part (those in flight, and at most one part's worth
+waiting to be written) and leaves, at worst, a stray temporary file, which
+the next run deletes. HDF5 is never appended in place.
 """
 
 from __future__ import annotations
@@ -19,21 +34,31 @@ from __future__ import annotations
 import fcntl
 import json
 import os
-import tempfile
+import secrets
 import time
 import zipfile
 from pathlib import Path
-from typing import Any, Iterator
+from typing import Any, Iterable, Sequence
 
 import numpy as np
 
+from stochpound.atomic import replacing, temporaries
 from stochpound.experiment.spec import ExperimentError
 
 DEFINITION_FILE = "experiment.json"
 RUNS_FILE = "runs.jsonl"
 LOCK_FILE = ".lock"
+PART_PREFIX = "part-"
 PART_SUFFIX = ".npz"
-_TEMP_PREFIX = ".tmp-"
+PART_REALIZATIONS = 500
+"""A part is written once the cases of this many realizations wait in the buffer (:class:`PartBuffer`): 500 times
+the experiment's cases per realization (2 for one grid point and its fixed-base reference)."""
+_PART_CASES = int(os.environ.get("STOCHPOUND_EXPERIMENT_PART_CASES", "0") or 0)
+"""Testing aid: a number of cases that replaces that threshold, to make a small run write several parts."""
+PART_SECONDS = 5.0
+"""... or once the oldest waiting case finished this many seconds ago."""
+PART_BYTES = 64 * 2**20
+"""... or once the waiting cases' arrays hold this many bytes (time histories)."""
 #: Testing aid: seconds to wait between writing a file and renaming it into place,
 #: which widens the window in which a test can kill a run during a write.
 _WRITE_DELAY = float(os.environ.get("STOCHPOUND_EXPERIMENT_WRITE_DELAY", "0") or 0)
@@ -46,52 +71,183 @@ def parts_folder(store: str | Path) -> Path:
 
 
 def atomic_write(path: Path, write: Any) -> None:
-    """Write a file atomically: ``write(file_object)`` into a temporary file, fsync, rename."""
-    handle, temporary = tempfile.mkstemp(prefix=_TEMP_PREFIX + path.name + ".", dir=path.parent)
-    try:
-        with os.fdopen(handle, "wb") as stream:
+    """Write a file atomically: ``write(file_object)`` into a temporary file, fsync, rename (:mod:`stochpound.atomic`)."""
+    with replacing(path) as temporary:
+        with open(temporary, "wb") as stream:
             write(stream)
             stream.flush()
             os.fsync(stream.fileno())
         if _WRITE_DELAY:
             time.sleep(_WRITE_DELAY)
-        os.replace(temporary, path)
-    except BaseException:
-        Path(temporary).unlink(missing_ok=True)
-        raise
 
 
-def write_part(folder: Path, case_id: str, meta: dict[str, Any], arrays: dict[str, np.ndarray]) -> Path:
-    """Write one finished case atomically as ``<case_id>.npz``."""
-    path = folder / f"{case_id}{PART_SUFFIX}"
+# ---------------------------------------------------------------- sections
+
+
+def section_key(kind: str, record: int, name: str) -> str:
+    """Name of a part array: ``<kind>.<record>/<name>``."""
+    return f"{kind}.{record}/{name}"
+
+
+def split_key(key: str) -> tuple[str, int, str]:
+    """(kind, record, name) of a part array's name."""
+    section, name = key.split("/", 1)
+    kind, record = section.rsplit(".", 1)
+    return kind, int(record), name
+
+
+def stack_cases(cases: Sequence[dict[str, np.ndarray]], positions: np.ndarray, times: np.ndarray) -> dict[str, np.ndarray]:
+    """One section's arrays (module docstring) from the part arrays of its cases.
+
+    Parameters
+    ----------
+    cases : sequence of dict
+        Each case's ``s:``, ``t:`` and ``i:`` arrays (:mod:`stochpound.experiment.summary`).
+    positions : np.ndarray
+        (n, n_dims) their grid positions.
+    times : np.ndarray
+        Sample times of their motion, s.
+    """
+    stacked: dict[str, np.ndarray] = {"position": np.asarray(positions, dtype=np.int64)}
+    for name in cases[0]:
+        values = [case[name] for case in cases]
+        if name.startswith("s:"):
+            stacked[name] = np.stack(values)
+        elif name.startswith("t:"):
+            stacked[name] = _stack_padded([np.asarray(v, dtype=float) for v in values])
+            stacked["t:time"] = np.asarray(times, dtype=float)
+        else:
+            stacked[name] = np.concatenate(values)
+            stacked["i:count"] = np.array([len(v) for v in values], dtype=np.int64)
+    return stacked
+
+
+def _stack_padded(values: Sequence[np.ndarray]) -> np.ndarray:
+    shape = np.max([v.shape for v in values], axis=0)
+    out = np.full((len(values), *shape), np.nan)
+    for row, value in zip(out, values):
+        row[tuple(slice(0, n) for n in value.shape)] = value
+    return out
+
+
+def concatenate(parts: Iterable[dict[str, np.ndarray]]) -> dict[str, np.ndarray]:
+    """Merge the arrays of several results or parts, section by section (cases one after the other)."""
+    grouped: dict[str, list[np.ndarray]] = {}
+    for arrays in parts:
+        for key, values in arrays.items():
+            grouped.setdefault(key, []).append(values)
+    merged = {}
+    for key, values in grouped.items():
+        name = split_key(key)[2]
+        if name == "t:time" or len(values) == 1:
+            merged[key] = values[0]
+        elif name.startswith("t:"):
+            merged[key] = np.concatenate([_pad_to(v, np.max([w.shape for w in values], axis=0)) for v in values])
+        else:
+            merged[key] = np.concatenate(values)
+    return merged
+
+
+def _pad_to(values: np.ndarray, shape: np.ndarray) -> np.ndarray:
+    widths = [(0, 0)] + [(0, int(n - m)) for n, m in zip(shape[1:], values.shape[1:])]
+    return np.pad(values, widths, constant_values=np.nan) if any(w[1] for w in widths) else values
+
+
+def section_count(arrays: dict[str, np.ndarray]) -> int:
+    """Number of cases in a result's or part's arrays."""
+    return sum(len(values) for key, values in arrays.items() if key.endswith("/position"))
+
+
+# ---------------------------------------------------------------- part files
+
+
+def write_part(folder: Path, name: str, arrays: dict[str, np.ndarray], meta: dict[str, Any]) -> Path:
+    """Write a part atomically as ``<name>.npz`` (``meta`` is kept as JSON)."""
+    path = folder / f"{name}{PART_SUFFIX}"
     payload = {"meta": np.array(json.dumps(meta)), **arrays}
     atomic_write(path, lambda stream: np.savez(stream, **payload))
     return path
 
 
-def read_part(path: Path) -> tuple[dict[str, Any], dict[str, np.ndarray]] | None:
-    """Read a part; None if it cannot be read (it is then treated as missing)."""
+def read_part(path: Path, names: Sequence[str] | None = None) -> dict[str, np.ndarray] | None:
+    """A part's arrays (only the sections' arrays whose name is in ``names``, if given); None if unreadable."""
     try:
         with np.load(path, allow_pickle=False) as data:
-            arrays = {key: data[key] for key in data.files}
-        meta = json.loads(str(arrays.pop("meta")))
+            keys = [k for k in data.files if k != "meta" and (names is None or split_key(k)[2] in names)]
+            return {key: data[key] for key in keys}
     except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile):
         return None
-    return meta, arrays
 
 
-def part_ids(folder: Path) -> set[str]:
-    """Case ids of the part files present in the folder."""
+def part_paths(folder: Path) -> list[Path]:
+    """The part files of a folder, by name."""
     if not folder.is_dir():
-        return set()
-    return {p.name[: -len(PART_SUFFIX)] for p in folder.iterdir() if p.name.endswith(PART_SUFFIX) and not p.name.startswith(".")}
+        return []
+    return sorted(p for p in folder.iterdir() if p.name.startswith(PART_PREFIX) and p.name.endswith(PART_SUFFIX))
+
+
+class PartBuffer:
+    """Finished cases waiting to be written as one part file.
+
+    A part is written when ``cases`` cases wait, when the oldest has waited
+    :data:`PART_SECONDS`, or when they hold :data:`PART_BYTES` (:meth:`due`),
+    and on :meth:`flush`.
+
+    Parameters
+    ----------
+    folder : Path
+        The parts folder.
+    meta : dict
+        Kept in every part (version, run).
+    cases_per_realization : float
+        The experiment's cases per realization of its motions: a part holds
+        the cases of :data:`PART_REALIZATIONS` realizations.
+    """
+
+    def __init__(self, folder: Path, meta: dict[str, Any], cases_per_realization: float) -> None:
+        self.folder = folder
+        self.meta = meta
+        self.cases = _PART_CASES or max(1, round(PART_REALIZATIONS * cases_per_realization))
+        self.run = secrets.token_hex(4)
+        self.written = 0
+        self.waiting: list[dict[str, np.ndarray]] = []
+        self.count = 0
+        self.bytes = 0
+        self.oldest = 0.0
+
+    def add(self, arrays: dict[str, np.ndarray]) -> None:
+        """Queue the arrays of finished cases; write a part if one is due."""
+        if not arrays:
+            return
+        if not self.waiting:
+            self.oldest = time.monotonic()
+        self.waiting.append(arrays)
+        self.count += section_count(arrays)
+        self.bytes += sum(values.nbytes for values in arrays.values())
+        if self.due():
+            self.flush()
+
+    def due(self) -> bool:
+        """Enough cases, bytes or waiting time for a part."""
+        return bool(self.waiting) and (
+            self.count >= self.cases or self.bytes >= PART_BYTES or time.monotonic() - self.oldest >= PART_SECONDS
+        )
+
+    def flush(self) -> None:
+        """Write the waiting cases as one part (nothing if none wait)."""
+        if not self.waiting:
+            return
+        self.written += 1
+        write_part(self.folder, f"{PART_PREFIX}{self.run}-{self.written:06d}", concatenate(self.waiting), self.meta)
+        self.waiting, self.count, self.bytes = [], 0, 0
+
+
+# ---------------------------------------------------------------- folder
 
 
 def remove_temporaries(folder: Path) -> None:
-    """Delete temporary files left by an interrupted write (call with the lock held)."""
-    for path in folder.glob(_TEMP_PREFIX + "*"):
-        path.unlink(missing_ok=True)
-    for path in folder.parent.glob(f".{folder.name[: -len('.parts')]}.*.tmp"):
+    """Delete temporary files left by interrupted writes of the parts and the store (call with the lock held)."""
+    for path in temporaries(folder) + temporaries(folder.parent, folder.name[: -len(".parts")]):
         path.unlink(missing_ok=True)
 
 
@@ -164,11 +320,3 @@ class FolderLock:
 
     def __exit__(self, *exc: Any) -> None:
         self.release()
-
-
-def iter_parts(folder: Path, ids: set[str]) -> Iterator[tuple[str, dict[str, Any], dict[str, np.ndarray]]]:
-    """Read the parts of the given case ids; unreadable ones are skipped."""
-    for case_id in sorted(ids):
-        content = read_part(folder / f"{case_id}{PART_SUFFIX}")
-        if content is not None:
-            yield case_id, *content

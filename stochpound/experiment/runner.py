@@ -1,32 +1,50 @@
 """``experiment run``: the missing cases of an experiment, on dask, into its store.
 
 The client (this process) validates everything, checks the store, writes the
-store file once before the first case, submits batches of cases, writes one
-part per finished case as results arrive, rebuilds the store at checkpoints
-and at the end. Workers only compute (:mod:`stochpound.experiment.compute`):
-they need the package, not the store's file system.
+store file once before the first case, submits batches of cases
+(:mod:`stochpound.experiment.batches`) with a bounded number in flight,
+writes finished cases to part files as results arrive (one per
+:data:`~stochpound.experiment.parts.PART_REALIZATIONS` realizations or a few seconds),
+rebuilds the store at checkpoints and at the end. Workers only compute
+(:mod:`stochpound.experiment.compute`): they need the package, not the
+store's file system. The client's memory does not grow with the number of
+cases (beyond a few bytes per case for the grid's masks).
 """
 
 from __future__ import annotations
 
-import json
+import contextlib
 import logging
 import os
 import signal
 import sys
+import threading
 import time
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Iterator, Sequence
+from typing import Any, Callable, Iterable, Iterator
 
 from stochpound import __version__
-from stochpound.experiment.compute import CaseOutcome, CaseTask, run_batch
-from stochpound.experiment.model import REFERENCE, Case, Experiment
-from stochpound.experiment.parts import FolderLock, append_run, parts_folder, remove_temporaries, write_part
-from stochpound.experiment.session import StoreSession, check_store, clear_store, git_commit, machine, now
+from stochpound.experiment.batches import automatic_size, make_batches
+from stochpound.experiment.compute import BatchResult, BatchTask, run_batch, warm_up
+from stochpound.experiment.model import Experiment
+from stochpound.experiment.parts import FolderLock, PartBuffer, append_run, parts_folder, remove_temporaries
+from stochpound.experiment.session import StoreSession, check_store, clear_store, code_identity, machine, now
 from stochpound.experiment.sources import ResolvedMotion, resolve_motions
-from stochpound.experiment.spec import ExperimentError, canonical_json, load_definition
+from stochpound.experiment.spec import ExperimentError, load_definition
+
+CHECKPOINT_FACTOR = 20.0
+"""A checkpoint waits at least this many times the last rebuild's duration (rebuilds cost at most ~5 % of a run)."""
+IN_FLIGHT_PER_WORKER = 2
+"""Batches submitted ahead per worker thread."""
+LOCAL_CLUSTER_CONFIG = {
+    "distributed.worker.profile.enabled": False,
+    "distributed.admin.system-monitor.interval": "2s",
+    "distributed.admin.tick.interval": "500ms",
+}
+"""dask settings of the local cluster: no statistical profiler in the workers (it samples their threads every
+10 ms), slower system monitors and event-loop ticks: idle, the cluster takes about 3 % of a core instead of 13 %."""
 
 
 @dataclass
@@ -47,6 +65,9 @@ class RunReport:
         Cases that raised, described, with their tracebacks.
     elapsed : float
         Wall time of the run, s.
+    setup : float
+        Of which before the first batch was submitted (store checks and first
+        write, the cluster's start, loading the compiled solver in every worker), s.
     executor : str
         Where the cases ran.
     interrupted : bool
@@ -59,6 +80,7 @@ class RunReport:
     done_now: int = 0
     failed: list[tuple[str, str]] = field(default_factory=list)
     elapsed: float = 0.0
+    setup: float = 0.0
     executor: str = ""
     interrupted: bool = False
 
@@ -121,9 +143,10 @@ def run_experiment(
     progress : bool
         Show a progress bar on stderr.
     checkpoint : float
-        Seconds between rebuilds of the store file during the run.
+        Least number of seconds between rebuilds of the store file during the
+        run (and at least :data:`CHECKPOINT_FACTOR` times the last rebuild's duration).
     batch_size : int, optional
-        Cases per dask task (default: chosen from the number of cases and workers).
+        Cases per dask task (default: :func:`~stochpound.experiment.batches.automatic_size`).
 
     Returns
     -------
@@ -152,131 +175,163 @@ def run_experiment(
             clear_store(store)
         remove_temporaries(parts_folder(store))
         session = StoreSession.create(store, experiment, {label: m.grid for label, m in motions.items()})
-        session.load(remove_unreadable=True)
-        missing = [c for c in experiment.cases if c.case_id not in session.results]
-        report = RunReport(store, len(experiment.cases), len(experiment.cases) - len(missing))
+        session.scan(remove_unreadable=True)
+        report = RunReport(store, experiment.n_cases, session.index.n_done)
         report.executor = _describe_executor(workers, scheduler)
-        append_run(session.folder, {"started": now(), "machine": machine(), "executor": report.executor, "stochpound_version": __version__, "git_commit": git_commit()})
+        identity = code_identity()
+        append_run(session.folder, {"started": now(), "machine": machine(), "executor": report.executor, **identity})
+        missing = session.missing()
         session.rebuild()
+        checkpoints = _Checkpoints(checkpoint, session)
         bar = _progress_bar(report, experiment.name, progress)
-        last_checkpoint = time.monotonic()
+        realizations = sum(len(experiment.realizations(label)) for label in experiment.motions)
+        meta = {"stochpound_version": __version__, "sources_sha256": identity["sources_sha256"]}
+        buffer = PartBuffer(session.folder, meta, experiment.n_cases / realizations)
+
+        def ready() -> None:
+            report.setup = time.monotonic() - started
+
         try:
-            batches = make_batches(experiment, missing, motions, batch_size or _auto_batch(len(missing), workers))
-            for outcomes in execute(batches, motions, workers, scheduler):
-                for outcome in outcomes:
-                    if outcome.arrays is not None or not stop.requested:
-                        _record(session, report, outcome)
-                if stop.requested:
-                    raise KeyboardInterrupt
-                bar.update(sum(1 for o in outcomes if o.arrays is not None))
-                if time.monotonic() - last_checkpoint > checkpoint:
-                    session.rebuild()
-                    last_checkpoint = time.monotonic()
+            size = batch_size or automatic_size(experiment.n_cases - report.done_before, workers)
+            batches = make_batches(experiment, missing, motions, size)
+            with contextlib.closing(execute(batches, experiment, motions, workers, scheduler, ready)) as results:
+                for task, result in results:
+                    _record(experiment, report, buffer, task, result)
+                    if stop.requested:
+                        raise KeyboardInterrupt
+                    bar.update(result.done)
+                    if checkpoints.due():
+                        buffer.flush()
+                        checkpoints.start()
         except KeyboardInterrupt:
             report.interrupted = True
         finally:
+            buffer.flush()
             bar.close()
+            checkpoints.wait()
             session.rebuild()
             report.elapsed = time.monotonic() - started
     return report
 
 
-def _record(session: StoreSession, report: RunReport, outcome: CaseOutcome) -> None:
-    case = session.experiment.case_index[outcome.case_id]
-    if outcome.arrays is None:
-        report.failed.append((case.describe(), outcome.error or ""))
-        return
-    meta = {"case_id": case.case_id, "kind": case.kind, "labels": json.loads(canonical_json(dict(case.labels))), "stochpound_version": __version__}
-    write_part(session.folder, case.case_id, meta, outcome.arrays)
-    session.results[case.case_id] = outcome.arrays
-    report.done_now += 1
+def _record(experiment: Experiment, report: RunReport, buffer: PartBuffer, task: BatchTask, result: BatchResult) -> None:
+    """Queue a batch's finished cases for the next part; note its failures."""
+    buffer.add(result.arrays)
+    report.done_now += result.done
+    for kind, position, error in result.failures:
+        report.failed.append((experiment.case_at(kind, position).describe(), error))
 
 
-@dataclass(frozen=True)
-class Batch:
-    """Cases that run together in one task: one motion source, and for an ensemble one grid point."""
+class _Checkpoints:
+    """Rebuilds of the store during a run, in a background thread (batches go on being submitted meanwhile):
+    ``interval`` s after the previous one ended, and at least :data:`CHECKPOINT_FACTOR` times its duration.
 
-    label: str
-    tasks: tuple[CaseTask, ...]
-
-
-def make_batches(experiment: Experiment, cases: Sequence[Case], motions: dict[str, ResolvedMotion], size: int) -> list[Batch]:
-    """Group cases into batches of at most ``size`` that share their motion source.
-
-    Records batch consecutive grid points; an ensemble batches consecutive
-    realizations of one grid point (the shape a batched ensemble solver wants).
+    The rebuild reads only complete parts (written atomically), so parts may
+    be written while it runs. An error in it is raised in the run at the next
+    :meth:`due` or :meth:`wait`.
     """
-    order = list(experiment.motions)
 
-    def key(case: Case) -> tuple:
-        labels = case.label_dict
-        return (order.index(labels["record"]), case.kind != REFERENCE, case.position)
+    def __init__(self, interval: float, session: StoreSession) -> None:
+        self.interval = interval
+        self.session = session
+        self.next = time.monotonic() + interval
+        self.thread: threading.Thread | None = None
+        self.error: BaseException | None = None
 
-    batches: list[Batch] = []
-    current: list[CaseTask] = []
-    current_key: tuple | None = None
-    for case in sorted(cases, key=key):
-        labels = case.label_dict
-        synthetic = motions[labels["record"]].table is not None
-        group = (labels["record"], case.kind, case.position[:-2] if synthetic else None)
-        if current and (group != current_key or len(current) >= size):
-            batches.append(Batch(current_key[0], tuple(current)))
-            current = []
-        current_key = group
-        current.append(_task(experiment, case, motions[labels["record"]]))
-    if current:
-        batches.append(Batch(current_key[0], tuple(current)))
-    return batches
+    def due(self) -> bool:
+        """No rebuild running and its time has come (raises a failed rebuild's error)."""
+        self._raise()
+        return (self.thread is None or not self.thread.is_alive()) and time.monotonic() >= self.next
+
+    def start(self) -> None:
+        """Start a rebuild."""
+        self.thread = threading.Thread(target=self._rebuild, name="stochpound-checkpoint", daemon=True)
+        self.thread.start()
+
+    def wait(self) -> None:
+        """Wait for a running rebuild to end (raises its error)."""
+        if self.thread is not None:
+            self.thread.join()
+        self._raise()
+
+    def _rebuild(self) -> None:
+        started = time.monotonic()
+        try:
+            self.session.rebuild()
+        except BaseException as error:  # noqa: BLE001 - handed to the run's thread
+            self.error = error
+        finished = time.monotonic()
+        self.next = finished + max(self.interval, CHECKPOINT_FACTOR * (finished - started))
+
+    def _raise(self) -> None:
+        if self.error is not None:
+            error, self.error = self.error, None
+            raise error
 
 
-def _task(experiment: Experiment, case: Case, motion: ResolvedMotion) -> CaseTask:
-    labels = case.label_dict
-    table = None if motion.table is None else {**motion.table, "realization": labels["realization"]}
-    structure = experiment.structure(case)
-    reference = structure if case.kind == REFERENCE else experiment.reference_structure(case)
-    return CaseTask(
-        case.case_id, case.kind, structure, reference, (labels["record"], labels["realization"]), table,
-        experiment.studied, experiment.output, experiment.solver,
-    )
+def execute(
+    batches: Iterable[BatchTask],
+    experiment: Experiment,
+    motions: dict[str, ResolvedMotion],
+    workers: int | None,
+    scheduler: str | None,
+    ready: Callable[[], None] = lambda: None,
+) -> Iterator[tuple[BatchTask, BatchResult]]:
+    """Run batches and yield (task, result) as they finish (in any order); call ``ready()`` before the first is submitted.
 
-
-def _auto_batch(n_cases: int, workers: int | None) -> int:
-    slots = max(1, workers if workers else (os.cpu_count() or 1))
-    return max(1, min(16, n_cases // (slots * 16)))
-
-
-def execute(batches: Sequence[Batch], motions: dict[str, ResolvedMotion], workers: int | None, scheduler: str | None) -> Iterator[list[CaseOutcome]]:
-    """Run batches and yield their outcomes as they finish (in any order).
+    On dask, every worker first loads the compiled solver (:func:`~stochpound.experiment.compute.warm_up`).
 
     ``workers=0`` (and no scheduler) runs them in this process; otherwise on a
-    local dask cluster of ``workers`` processes or on the given scheduler.
+    local dask cluster of ``workers`` processes or on the given scheduler,
+    with at most :data:`IN_FLIGHT_PER_WORKER` batches per worker thread
+    submitted ahead (the batches are made as they are submitted). A batch
+    whose task fails as a whole (e.g. its worker died) is reported as failed
+    for each of its cases.
     """
-    if not batches:
-        return
+    labels = list(experiment.motions)
     if workers == 0 and scheduler is None:
-        for batch in batches:
-            yield run_batch(batch.tasks, motions[batch.label].motion)
+        ready()
+        for task in batches:
+            yield task, run_batch(task, motions[labels[task.record]].motion)
         return
-    from distributed import as_completed
+    from distributed import as_completed, wait
 
     with _dask_client(workers, scheduler) as client:
-        shipped = {label: client.scatter(m.motion, broadcast=True, hash=False) for label, m in motions.items() if m.motion is not None}
-        futures = {client.submit(run_batch, batch.tasks, shipped.get(batch.label), pure=False): batch for batch in batches}
+        wait([client.submit(warm_up, pure=False, workers=[worker]) for worker in client.scheduler_info()["workers"]])
+        shipped = {m: client.scatter(motions[label].motion, broadcast=True, hash=False) for m, label in enumerate(labels) if motions[label].motion is not None}
+        ahead = IN_FLIGHT_PER_WORKER * max(1, sum(client.nthreads().values()))
+        pending = iter(batches)
+        tasks: dict[Any, BatchTask] = {}
+        running = as_completed()
+        ready()
+
+        def submit() -> None:
+            task = next(pending, None)
+            if task is not None:
+                future = client.submit(run_batch, task, shipped.get(task.record), pure=False)
+                tasks[future] = task
+                running.add(future)
+
         try:
-            for future in as_completed(futures):
-                batch = futures[future]
+            for _ in range(ahead):
+                submit()
+            for future in running:
+                task = tasks.pop(future)
                 try:
-                    outcomes = future.result()
-                except Exception as error:  # noqa: BLE001 - e.g. KilledWorker: report the batch's cases as failed
-                    outcomes = [CaseOutcome(task.case_id, error=f"{type(error).__name__}: {error}") for task in batch.tasks]
+                    result = future.result()
+                except Exception as error:  # noqa: BLE001 - e.g. KilledWorker: the batch's cases are reported as failed
+                    message = f"{type(error).__name__}: {error}"
+                    result = BatchResult(failures=[(g.kind, tuple(int(i) for i in p), message) for g in task.groups for p in g.positions])
                 future.release()
-                yield outcomes
+                submit()
+                yield task, result
         finally:
-            client.cancel(list(futures))
+            client.cancel(list(tasks))
 
 
 @contextmanager
 def _dask_client(workers: int | None, scheduler: str | None) -> Iterator[Any]:
+    import dask
     from distributed import Client, LocalCluster
 
     for name in ("distributed", "distributed.nanny", "distributed.worker", "distributed.scheduler", "distributed.core"):
@@ -288,10 +343,11 @@ def _dask_client(workers: int | None, scheduler: str | None) -> Iterator[Any]:
         finally:
             client.close(timeout=10)
         return
-    _compile_solver_once()
-    cluster = LocalCluster(
-        n_workers=workers or os.cpu_count() or 1, threads_per_worker=1, processes=True, dashboard_address=None, silence_logs=logging.ERROR
-    )
+    warm_up()
+    with dask.config.set(LOCAL_CLUSTER_CONFIG), _ignoring_sigint():  # the worker processes inherit both
+        cluster = LocalCluster(  # its HTTP server on a free port (the default, 8787, may be taken: a warning)
+            n_workers=workers or os.cpu_count() or 1, threads_per_worker=1, processes=True, dashboard_address=":0", silence_logs=logging.ERROR
+        )
     client = Client(cluster)
     try:
         yield client
@@ -300,16 +356,23 @@ def _dask_client(workers: int | None, scheduler: str | None) -> Iterator[Any]:
         cluster.close(timeout=10)
 
 
-def _compile_solver_once() -> None:
-    """Compile the exact solver's kernels in this process before the local workers start.
+@contextmanager
+def _ignoring_sigint() -> Iterator[None]:
+    """Ignore SIGINT while local workers start: processes started meanwhile keep ignoring it.
 
-    numba caches compiled kernels on disk (``cache=True``): compiled once here,
-    every local worker loads them in about a second instead of compiling them
-    concurrently.
+    A Ctrl-C in a terminal reaches every process of the foreground group; the
+    workers then stop with the cluster instead of printing their own
+    tracebacks. (A Ctrl-C during the cluster's start, a second or two, is lost.)
     """
-    from stochpound.solvers.exact import compile_engine
-
-    compile_engine()
+    try:
+        previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    except ValueError:  # not the main thread
+        yield
+        return
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
 
 
 def _describe_executor(workers: int | None, scheduler: str | None) -> str:

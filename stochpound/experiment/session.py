@@ -13,24 +13,17 @@ import os
 import platform
 import shutil
 import subprocess
+from functools import lru_cache
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from stochpound import __version__
-from stochpound.experiment.model import Experiment
-from stochpound.experiment.parts import (
-    DEFINITION_FILE,
-    iter_parts,
-    part_ids,
-    parts_folder,
-    read_definition,
-    read_runs,
-    write_definition,
-)
+from stochpound.experiment.model import KINDS, Experiment
+from stochpound.experiment.parts import DEFINITION_FILE, part_paths, parts_folder, read_definition, read_runs, write_definition
 from stochpound.experiment.spec import ExperimentError, canonical_json
-from stochpound.experiment.store import build_store, write_store
+from stochpound.experiment.store_writer import PartsIndex, write_store
 
 
 def now() -> str:
@@ -77,7 +70,7 @@ def check_store(store: Path, sha256: str) -> None:
         if found != sha256:
             raise ExperimentError(f"{store}: made from a different experiment definition (sha256 {found[:12]}…, this one {sha256[:12]}…); {hint}")
     folder = parts_folder(store)
-    if folder.exists() and ((folder / DEFINITION_FILE).exists() or part_ids(folder)):
+    if folder.exists() and ((folder / DEFINITION_FILE).exists() or part_paths(folder)):
         try:
             found = read_definition(folder)["definition_sha256"]
         except (ExperimentError, KeyError, TypeError) as error:
@@ -95,18 +88,44 @@ def clear_store(store: Path) -> None:
     store.unlink(missing_ok=True)
 
 
-def git_commit() -> str:
-    """Commit of the stochpound source tree ("+dirty" if modified), or "none"."""
-    source = Path(__file__).resolve().parents[2]
+PACKAGE = Path(__file__).resolve().parents[1]
+"""The stochpound package's folder."""
+
+
+def git_commit(package: Path = PACKAGE) -> str:
+    """Commit of the git checkout the package is in ("+dirty" if modified), or "none" (an installed copy).
+
+    An installed copy is identified by the version and :func:`sources_sha256`.
+    """
+    source = package.parent
     try:
-        tracked = subprocess.run(["git", "-C", str(source), "ls-files", "--error-unmatch", "stochpound/__init__.py"], capture_output=True, timeout=10)
+        tracked = subprocess.run(["git", "-C", str(source), "ls-files", "--error-unmatch", f"{package.name}/__init__.py"], capture_output=True, timeout=10)
         commit = subprocess.run(["git", "-C", str(source), "rev-parse", "HEAD"], capture_output=True, text=True, timeout=10)
         if tracked.returncode != 0 or commit.returncode != 0:
             return "none"
-        dirty = subprocess.run(["git", "-C", str(source), "status", "--porcelain", "--", "stochpound"], capture_output=True, text=True, timeout=10)
+        dirty = subprocess.run(["git", "-C", str(source), "status", "--porcelain", "--", package.name], capture_output=True, text=True, timeout=10)
     except (OSError, subprocess.SubprocessError):
         return "none"
     return commit.stdout.strip() + ("+dirty" if dirty.stdout.strip() else "")
+
+
+@lru_cache(maxsize=None)
+def sources_sha256(package: Path = PACKAGE) -> str:
+    """sha256 of the package's Python sources: every ``.py`` file's path (relative, sorted) and contents.
+
+    With the version, it identifies the code of a copy that is not a git
+    checkout (``pip install .``), where :func:`git_commit` gives "none".
+    """
+    digest = hashlib.sha256()
+    for path in sorted(package.rglob("*.py")):
+        digest.update(path.relative_to(package).as_posix().encode() + b"\0")
+        digest.update(path.read_bytes() + b"\0")
+    return digest.hexdigest()
+
+
+def code_identity() -> dict[str, str]:
+    """What identifies the running code: version, git commit (or "none") and sources' sha256."""
+    return {"stochpound_version": __version__, "git_commit": git_commit(), "sources_sha256": sources_sha256()}
 
 
 def machine() -> str:
@@ -131,7 +150,7 @@ class StoreSession:
         self.folder = parts_folder(self.store)
         self.experiment = experiment
         self.record = record
-        self.results: dict[str, dict[str, np.ndarray]] = {}
+        self.index: PartsIndex | None = None
 
     @classmethod
     def create(cls, store: Path, experiment: Experiment, motion_grids: dict[str, tuple[float, int]]) -> "StoreSession":
@@ -173,17 +192,17 @@ class StoreSession:
         """(dt, samples) of each motion."""
         return {k: (float(v[0]), int(v[1])) for k, v in self.record["motion_grids"].items()}
 
-    def done_ids(self) -> set[str]:
-        """Ids of the cases with a part file."""
-        return part_ids(self.folder) & set(self.experiment.case_index)
-
-    def load(self, remove_unreadable: bool = False) -> None:
-        """Read every finished case's part into memory (unreadable parts count as missing)."""
-        ids = self.done_ids()
-        self.results = {case_id: arrays for case_id, _, arrays in iter_parts(self.folder, ids)}
+    def scan(self, remove_unreadable: bool = False) -> PartsIndex:
+        """Find the finished cases in the parts (unreadable parts count as missing, and are deleted if asked)."""
+        self.index = PartsIndex.scan(self.experiment, self.folder)
         if remove_unreadable:
-            for case_id in ids - set(self.results):
-                (self.folder / f"{case_id}.npz").unlink(missing_ok=True)
+            for path in self.index.unreadable:
+                path.unlink(missing_ok=True)
+        return self.index
+
+    def missing(self) -> dict[str, np.ndarray]:
+        """For each kind, which cases of its grid are still to run (bool, from the last :meth:`scan`)."""
+        return {kind: self.experiment.in_grid(kind) & ~self.index.done(kind) for kind in KINDS}
 
     def attrs(self) -> dict[str, Any]:
         """Provenance attributes of the store."""
@@ -202,6 +221,7 @@ class StoreSession:
             "studied_building": experiment.studied,
             "stochpound_version": __version__,
             "git_commit": last.get("git_commit", "none"),
+            "stochpound_sources_sha256": last.get("sources_sha256", ""),
             "solver": solver["method"],
             "solver_integrator": solver["integrator"],
             "solver_rtol": solver["rtol"],
@@ -215,6 +235,5 @@ class StoreSession:
         }
 
     def rebuild(self) -> Path:
-        """(Re)write the store file atomically from the finished cases in memory."""
-        dataset = build_store(self.experiment, self.results, self.motion_grids, self.attrs())
-        return write_store(dataset, self.store)
+        """(Re)write the store file atomically from the parts (scanned again: parts written since count)."""
+        return write_store(self.experiment, self.scan(), self.motion_grids, self.attrs(), self.store)

@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 
 from stochpound import motions as synthetic_motions
-from stochpound.experiment.model import REFERENCE, Experiment
+from stochpound.experiment.model import CASE, Experiment
 from stochpound.experiment.spec import field_errors
 from stochpound.motions.ground import GroundMotion
 from stochpound.model.scene_file import scene_from_dict
@@ -54,8 +54,7 @@ def resolve_motions(experiment: Experiment) -> dict[str, ResolvedMotion]:
     ExperimentError
         Naming the field (``records[1].record: ...``, ``synthetic.firm.pga: ...``).
     """
-    first_reference = next(c for c in experiment.cases if c.kind == REFERENCE)
-    structure = experiment.structure(first_reference)
+    structure = experiment.structure(experiment.points(CASE)[0])  # every building: the memory check counts them all
     resolved = {}
     for label, source in experiment.motions.items():
         table = experiment.motion_table(label)

@@ -321,7 +321,7 @@ def _axis_values(spec: Any, where: str, allowed: set[str]) -> tuple[list[Any], d
     raise ExperimentError(f"{where}: must be a list of values or a table with values = [...], got {spec!r}")
 
 
-def _numbers(values: Any, where: str, allow_inf: bool) -> list[float]:
+def _numbers(values: Any, where: str, allow_inf: bool, inf_meaning: str = "a fixed base") -> list[float]:
     if not isinstance(values, list) or not values:
         raise ExperimentError(f"{where}: must be a non-empty list (an empty axis makes an empty grid)")
     numbers = []
@@ -330,7 +330,7 @@ def _numbers(values: Any, where: str, allow_inf: bool) -> list[float]:
         if allow_inf and isinstance(value, str) and value.lower() in ("inf", "infinity"):
             value = math.inf
         if not toml_fields.is_number(value) or math.isnan(value) or (math.isinf(value) and not (allow_inf and value > 0)):
-            allowed = "a number >= 0 or inf (a fixed base)" if allow_inf else "a finite number >= 0"
+            allowed = f"a number >= 0 or inf ({inf_meaning})" if allow_inf else "a finite number >= 0"
             raise ExperimentError(f"{item}: must be {allowed}, got {value!r}")
         if value < 0:
             raise ExperimentError(f"{item}: must be >= 0{' or inf' if allow_inf else ''}, got {value!r}")
@@ -342,7 +342,7 @@ def _numbers(values: Any, where: str, allow_inf: bool) -> list[float]:
 def _gap_axis(key: str, spec: Any, n_contacts: int, contact_floors: list[Any]) -> dict[str, Any]:
     where = f"grid.{key}"
     values, options = _axis_values(spec, where, {"contacts", "floors"})
-    gaps = _numbers(values, f"{where}.values" if options else where, allow_inf=False)
+    gaps = _numbers(values, f"{where}.values" if options else where, allow_inf=True, inf_meaning="contact-free: the peak closure answers every gap")
     if n_contacts == 0:
         raise ExperimentError(f"{where}: the scene has no [[contact]] whose gap could vary")
     contacts = list(range(n_contacts))

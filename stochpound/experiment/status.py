@@ -2,15 +2,19 @@
 
 from __future__ import annotations
 
+import itertools
 import json
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Iterator
 
-from stochpound.experiment.model import Case, Experiment
+import numpy as np
+
+from stochpound.experiment.model import KINDS, Case, Experiment
 from stochpound.experiment.parts import DEFINITION_FILE, FolderLock, parts_folder
 from stochpound.experiment.session import StoreSession
 from stochpound.experiment.spec import ExperimentError
-from stochpound.experiment.store import open_store
+from stochpound.experiment.store import PREFIX, open_store
 
 
 @dataclass
@@ -21,8 +25,8 @@ class StatusReport:
     ----------
     store : Path
     experiment : Experiment
-    done, missing : list of Case
-        Finished and missing cases, in grid order.
+    done_mask : dict of np.ndarray
+        For each kind, which cases of its grid are finished (bool).
     running : bool
         A run holds the parts folder's lock (it is being written now).
     rebuilt : bool
@@ -31,10 +35,29 @@ class StatusReport:
 
     store: Path
     experiment: Experiment
-    done: list[Case]
-    missing: list[Case]
+    done_mask: dict[str, np.ndarray]
     running: bool = False
     rebuilt: bool = False
+
+    @property
+    def n_done(self) -> int:
+        """Finished cases."""
+        return sum(int(mask.sum()) for mask in self.done_mask.values())
+
+    @property
+    def n_missing(self) -> int:
+        """Cases still to run."""
+        return self.experiment.n_cases - self.n_done
+
+    def cases(self, done: bool, limit: int | None = None) -> list[Case]:
+        """The first ``limit`` (default all) finished (``done``) or missing cases, in grid order."""
+        return list(itertools.islice(self._cases(done), limit))
+
+    def _cases(self, done: bool) -> Iterator[Case]:
+        for kind in KINDS:
+            chosen = self.experiment.in_grid(kind) & (self.done_mask[kind] == done)
+            for position in zip(*np.nonzero(chosen)):
+                yield self.experiment.case_at(kind, position)
 
 
 def store_status(store: str | Path, rebuild: bool = True) -> StatusReport:
@@ -58,18 +81,15 @@ def store_status(store: str | Path, rebuild: bool = True) -> StatusReport:
     session = StoreSession.open(store)
     lock = FolderLock(session.folder)
     running = not lock.acquire()
-    rebuilt = False
     try:
         if rebuild and not running:
-            session.load()
             session.rebuild()
-            rebuilt = True
-            done_ids = set(session.results)
         else:
-            done_ids = session.done_ids()
+            session.scan()
     finally:
         lock.release()
-    return _report(store, session.experiment, done_ids, running, rebuilt)
+    done = {kind: session.index.done(kind) for kind in KINDS}
+    return StatusReport(store, session.experiment, done, running, rebuild and not running)
 
 
 def _from_file(store: Path) -> StatusReport:
@@ -77,19 +97,9 @@ def _from_file(store: Path) -> StatusReport:
     dataset = open_store(store)
     try:
         experiment = Experiment(json.loads(dataset.attrs["definition"]), str(dataset.attrs.get("experiment_text", "")))
-        done_ids = set()
-        for prefix in ("case", "reference"):
-            ids = dataset[f"{prefix}_id"].values.ravel()
-            status = dataset[f"{prefix}_status"].values.ravel()
-            done_ids |= {str(i) for i, s in zip(ids, status) if s == 1}
+        done = {kind: dataset[f"{PREFIX[kind]}_status"].values == 1 for kind in KINDS}
     except (KeyError, ValueError) as error:
         raise ExperimentError(f"{store}: not a stochpound experiment store ({error})") from None
     finally:
         dataset.close()
-    return _report(store, experiment, done_ids, False, False)
-
-
-def _report(store: Path, experiment: Experiment, done_ids: set[str], running: bool, rebuilt: bool) -> StatusReport:
-    done = [c for c in experiment.cases if c.case_id in done_ids]
-    missing = [c for c in experiment.cases if c.case_id not in done_ids]
-    return StatusReport(store, experiment, done, missing, running, rebuilt)
+    return StatusReport(store, experiment, done)

@@ -1,98 +1,199 @@
-"""The experiment store: one netCDF4/HDF5 file assembled from the finished cases.
+"""The experiment store's layout: one netCDF4/HDF5 file, its dimensions, variables and chunks.
 
-The store is rebuilt from the parts (:mod:`stochpound.experiment.parts`) and
-written atomically (temporary file renamed into place) at the start and end of
-a run, at checkpoints, on ``status`` and on resume: it is always a complete,
-readable file, whatever happens to the run. Its layout (docs/experiments.md):
+Layout (docs/experiments.md):
 
 * coordinates: the grid's dimensions (variant axes, ``gap``…, ``mu``), the
   motion's (``record``, ``realization``), ``building``, ``floor``, ``contact``
   and, with time histories, ``time`` (the union of the motions' sample times);
 * ``case_status`` (−1 not in the grid, 0 missing, 1 done) and ``case_id`` on
-  the case dimensions, ``reference_status``/``reference_case_id`` likewise;
+  the case dimensions, ``reference_status``/``reference_id`` likewise;
 * per-case summaries on the case dimensions (plus ``building``), the
   fixed-base reference's ``reference_*`` summaries on the reference dimensions;
 * kept time histories on the case dimensions plus their own and ``time``;
 * the impact table on dimension ``impact``, with the case's coordinates
   (``impact_case_id``, ``impact_<dim>``);
 * provenance attributes.
+
+Every variable on the case dimensions is chunked in *blocks* of consecutive
+grid positions (:func:`blocks`): along ``realization`` for an ensemble, so
+that the file opens lazily chunked along realization and is written, block by
+block, in time and memory independent of the number of cases
+(:mod:`stochpound.experiment.store_writer`).
 """
 
 from __future__ import annotations
 
+import itertools
+import math
+from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Any, Iterator, Mapping
 
 import numpy as np
 import xarray as xr
 
-from stochpound.experiment.model import CASE, REFERENCE, Case, Dim, Experiment
-from stochpound.experiment.spec import ExperimentError
+from stochpound.experiment.model import CASE, REFERENCE, Dim, Experiment
+from stochpound.experiment.spec import ExperimentError, canonical_json
 from stochpound.experiment.summary import IMPACT_COLUMNS, templates, variable_attrs
-from stochpound.results.dataset import write_dataset
 
 #: Version of the store layout.
 STORE_FORMAT = 1
-_INT_FILL = -1
+INT_FILL = -1
+"""On-disk fill value of integer variables (decoded to NaN by xarray)."""
+SUMMARY_BLOCK = 65536
+"""Largest number of grid positions in a block of the summaries (and chunk of the file)."""
+HISTORY_BLOCK_BYTES = 4 * 2**20
+"""Largest size of a block (and chunk) of a time-history variable, bytes."""
+IMPACT_CHUNK = 262144
+"""Rows per chunk of the impact table."""
 _STATUS_ATTRS = {
     "units": "1",
     "flag_values": np.array([-1, 0, 1], dtype=np.int8),
     "flag_meanings": "not_in_grid missing done",
 }
+PREFIX = {CASE: "case", REFERENCE: "reference"}
+"""Name prefix of the status and id variables of each kind."""
 
 
-def build_store(
-    experiment: Experiment,
-    results: Mapping[str, Mapping[str, np.ndarray]],
-    motion_grids: Mapping[str, tuple[float, int]],
-    attrs: Mapping[str, Any],
-) -> xr.Dataset:
-    """Assemble the store dataset from the finished cases.
+@dataclass(frozen=True)
+class Spec:
+    """One variable of the store.
 
-    Parameters
+    Attributes
     ----------
-    experiment : Experiment
-    results : mapping
-        Part arrays of the finished cases, by case id (unknown ids are ignored).
-    motion_grids : mapping
-        (dt in s, number of samples) of each motion, by label (for ``time``).
-    attrs : mapping
-        Provenance attributes.
-
-    Returns
-    -------
-    xarray.Dataset
+    name : str
+    kind : str or None
+        The kind of case of a grid variable (None for the impact table).
+    family : str
+        ``status``, ``id``, ``summary``, ``history`` or ``impact`` (the table's
+        columns, their case id and labels).
+    dims : tuple of str
+    dtype : numpy dtype
+        In memory (bool is stored as int8 with ``dtype = "bool"``, ``<U1``
+        stands for variable-length strings).
+    attrs : dict
+    chunks : tuple of int
+        Chunk shape in the file (a block of the grid, whole trailing dimensions).
+    encoding : dict
+        Further encoding (``_FillValue`` of integers, compression).
+    coordinate : bool
+        A coordinate (the impact table's case id and labels).
     """
+
+    name: str
+    kind: str | None
+    family: str
+    dims: tuple[str, ...]
+    dtype: np.dtype
+    attrs: dict[str, Any]
+    chunks: tuple[int, ...]
+    encoding: dict[str, Any] = field(default_factory=dict)
+    coordinate: bool = False
+
+
+@dataclass(frozen=True)
+class Layout:
+    """Coordinates, dimension sizes and variables of an experiment's store."""
+
+    coords: dict[str, xr.Variable]
+    sizes: dict[str, int]
+    specs: list[Spec]
+
+    def of(self, family: str, kind: str | None = None) -> list[Spec]:
+        """The variables of a family (and kind)."""
+        return [s for s in self.specs if s.family == family and (kind is None or s.kind == kind)]
+
+    def template(self, attrs: Mapping[str, Any]) -> xr.Dataset:
+        """The store as a dataset whose variables are lazy placeholders (dask), the file's encoding in ``encoding``."""
+        import dask.array as da
+
+        variables = {}
+        for spec in self.specs:
+            shape = tuple(self.sizes[d] for d in spec.dims)
+            placeholder = da.empty(shape, dtype=spec.dtype, chunks=spec.chunks, name=f"placeholder-{spec.name}")  # named: no tokenizing
+            variable = xr.Variable(spec.dims, placeholder, dict(spec.attrs))
+            variable.encoding = {"chunksizes": spec.chunks, **spec.encoding}
+            variables[spec.name] = variable
+        dataset = xr.Dataset(variables, coords=self.coords, attrs=dict(attrs))
+        return dataset.set_coords([s.name for s in self.specs if s.coordinate])
+
+
+def layout(experiment: Experiment, motion_grids: Mapping[str, tuple[float, int]], n_impacts: int) -> Layout:
+    """The layout of an experiment's store holding ``n_impacts`` impact rows."""
     coords = _coordinates(experiment, motion_grids)
-    case_dims = [d.name for d in experiment.dims]
-    reference_dims = [d.name for d in experiment.reference_dims]
-    _, summary_template, reference_template = templates()
-    cases = {CASE: [c for c in experiment.cases if c.kind == CASE], REFERENCE: [c for c in experiment.cases if c.kind == REFERENCE]}
-    variables: dict[str, xr.Variable] = {}
-    for kind, dims, template, prefix in ((CASE, case_dims, summary_template, "case"), (REFERENCE, reference_dims, reference_template, "reference")):
-        done = [c for c in cases[kind] if c.case_id in results]
-        variables.update(_status(prefix, dims, coords, cases[kind], results))
+    sizes = {name: v.size for name, v in coords.items() if v.dims == (name,)}
+    run, summary_template, reference_template = templates()
+    specs: list[Spec] = []
+    for kind, template in ((REFERENCE, reference_template), (CASE, summary_template)):
+        dims = tuple(d.name for d in experiment.kind_dims(kind))
+        grid = tuple(sizes[d] for d in dims)
+        chunks = block_shape(grid, SUMMARY_BLOCK)
+        prefix = PREFIX[kind]
+        long = "case" if kind == CASE else "fixed-base reference case"
+        specs.append(Spec(f"{prefix}_status", kind, "status", dims, np.dtype(np.int8), {**_STATUS_ATTRS, "long_name": f"{long} status"}, chunks))
+        specs.append(Spec(f"{prefix}_id", kind, "id", dims, np.dtype("<U1"), {"units": "1", "long_name": f"{long} id"}, chunks))
         for name, variable in template.data_vars.items():
-            variables[name] = _grid_variable(name, dims + list(variable.dims), coords, done, results, f"s:{name}", variable.dtype)
-    variables.update(_time_histories(experiment, case_dims, reference_dims, coords, cases, results))
+            extra = tuple(variable.dims)
+            dtype = _store_dtype(variable.dtype)
+            encoding = {} if dtype.kind == "f" else {"_FillValue": INT_FILL}
+            specs.append(Spec(name, kind, "summary", dims + extra, dtype, dict(variable_attrs(name)), chunks + tuple(sizes[d] for d in extra), encoding))
+    specs += _history_specs(experiment, sizes, run)
     if experiment.output["impacts"]:
-        variables.update(_impact_table(experiment, cases[CASE], results))
-    n_total = len(experiment.cases)
-    n_done = sum(1 for c in experiment.cases if c.case_id in results)
-    dataset = xr.Dataset(variables, coords=coords)
-    dataset = dataset.set_coords([name for name in variables if name == "impact_case_id" or name.startswith("impact_") and name[7:] in case_dims])
-    dataset.attrs.update(
-        {
-            "title": f"stochpound experiment {experiment.name}",
-            "Conventions": "CF-1.10",
-            "stochpound_store_format": STORE_FORMAT,
-            **attrs,
-            "cases_total": n_total,
-            "cases_done": n_done,
-            "complete": int(n_done == n_total),
-        }
-    )
-    return dataset
+        specs += _impact_specs(experiment, run, max(n_impacts, 0))
+    return Layout(coords, {**sizes, "impact": n_impacts}, specs)
+
+
+def _history_specs(experiment: Experiment, sizes: Mapping[str, int], run: xr.Dataset) -> list[Spec]:
+    names = experiment.output["time_histories"]
+    jobs = [(name, CASE, tuple(d for d in run[name].dims if d != "time")) for name in names]
+    if "total_displacement" in names:
+        jobs.append(("reference_total_displacement", REFERENCE, ("floor",)))
+    specs = []
+    for name, kind, extra in jobs:
+        dims = tuple(d.name for d in experiment.kind_dims(kind))
+        trailing = tuple(sizes[d] for d in extra) + (sizes["time"],)
+        per_case = 8 * math.prod(trailing)
+        grid = block_shape(tuple(sizes[d] for d in dims), max(1, HISTORY_BLOCK_BYTES // per_case))
+        encoding = {"zlib": True, "complevel": 1}
+        specs.append(Spec(name, kind, "history", dims + extra + ("time",), np.dtype(float), dict(variable_attrs(name)), grid + trailing, encoding))
+    return specs
+
+
+def _impact_specs(experiment: Experiment, run: xr.Dataset, n_impacts: int) -> list[Spec]:
+    chunks = (max(1, min(IMPACT_CHUNK, n_impacts)),)
+    specs = [Spec(name, None, "impact", ("impact",), run[name].dtype, dict(variable_attrs(name)), chunks) for name in IMPACT_COLUMNS]
+    specs.append(Spec("impact_case_id", None, "impact", ("impact",), np.dtype("<U1"), {"units": "1", "long_name": "id of the case of the impact"}, chunks, coordinate=True))
+    for dim in experiment.dims:
+        units = _dim_coordinate(experiment, dim).attrs["units"]
+        dtype = np.dtype("<U1") if dim.kind in ("variant", "record") else np.dtype(np.int64) if dim.kind == "realization" else np.dtype(float)
+        specs.append(Spec(f"impact_{dim.name}", None, "impact", ("impact",), dtype, {"units": units, "long_name": f"{dim.name} of the case of the impact"}, chunks, coordinate=True))
+    return specs
+
+
+def block_shape(shape: tuple[int, ...], target: int) -> tuple[int, ...]:
+    """Shape of the blocks (and chunks) of a grid: whole trailing dimensions, at most ``target`` positions.
+
+    The trailing dimensions that fit whole are kept whole; the dimension
+    before them is split in runs of consecutive indices; the leading ones
+    have length 1. A block is a hyperslab of consecutive positions in C order.
+    """
+    block = [1] * len(shape)
+    room = max(1, target)
+    for axis in range(len(shape) - 1, -1, -1):
+        if shape[axis] <= room:
+            block[axis] = shape[axis]
+            room //= max(1, shape[axis])
+        else:
+            block[axis] = room
+            break
+    return tuple(max(1, b) for b in block)
+
+
+def blocks(shape: tuple[int, ...], block: tuple[int, ...]) -> Iterator[tuple[slice, ...]]:
+    """The blocks of a grid, in C order, as tuples of slices."""
+    ranges = [range(0, n, b) for n, b in zip(shape, block)]
+    for starts in itertools.product(*ranges):
+        yield tuple(slice(s, min(s + b, n)) for s, b, n in zip(starts, block, shape))
 
 
 def _coordinates(experiment: Experiment, motion_grids: Mapping[str, tuple[float, int]]) -> dict[str, xr.Variable]:
@@ -102,7 +203,7 @@ def _coordinates(experiment: Experiment, motion_grids: Mapping[str, tuple[float,
     motions = experiment.motions
     coords["record_kind"] = xr.Variable(("record",), np.array([motions[m]["kind"] for m in motions], dtype=object), {"units": "1", "long_name": "record or synthetic ensemble"})
     coords["record_motion"] = xr.Variable(
-        ("record",), np.array([_describe_motion(motions[m]["motion"]) for m in motions], dtype=object), {"units": "1", "long_name": "the motion's scene table (JSON)"}
+        ("record",), np.array([canonical_json(motions[m]["motion"]) for m in motions], dtype=object), {"units": "1", "long_name": "the motion's scene table (JSON)"}
     )
     scene = experiment.definition["scene"]
     coords["building"] = xr.Variable(("building",), np.array(experiment.building_names, dtype=object), {"units": "1", "long_name": "building name, left to right"})
@@ -128,38 +229,10 @@ def _dim_coordinate(experiment: Experiment, dim: Dim) -> xr.Variable:
     return xr.Variable(("realization",), np.array(dim.values, dtype=np.int64), {"units": "1", "long_name": "realization index (0 for a record)"})
 
 
-def _describe_motion(table: Mapping[str, Any]) -> str:
-    from stochpound.experiment.spec import canonical_json
-
-    return canonical_json(table)
-
-
 def union_times(motion_grids: Mapping[str, tuple[float, int]]) -> np.ndarray:
     """Sorted union of every motion's sample times k·dt (rounded to 1e-9 s)."""
     times = [np.round(np.arange(int(n)) * float(dt), 9) for dt, n in motion_grids.values()]
     return np.unique(np.concatenate(times)) if times else np.zeros(0)
-
-
-def _shape(dims: list[str], coords: Mapping[str, xr.Variable]) -> tuple[int, ...]:
-    return tuple(coords[d].size for d in dims)
-
-
-def _status(prefix: str, dims: list[str], coords: Mapping[str, xr.Variable], cases: list[Case], results: Mapping[str, Any]) -> dict[str, xr.Variable]:
-    shape = _shape(dims, coords)
-    status = np.full(shape, -1, dtype=np.int8)
-    ids = np.full(shape, "", dtype=object)
-    for case in cases:
-        status[case.position] = 1 if case.case_id in results else 0
-        ids[case.position] = case.case_id
-    long = "case" if prefix == "case" else "fixed-base reference case"
-    return {
-        f"{prefix}_status": xr.Variable(dims, status, {**_STATUS_ATTRS, "long_name": f"{long} status"}),
-        f"{prefix}_id": xr.Variable(dims, ids, {"units": "1", "long_name": f"{long} id (parts file name)"}),
-    }
-
-
-def _fill_value(dtype: np.dtype) -> Any:
-    return np.nan if np.issubdtype(dtype, np.floating) else _INT_FILL
 
 
 def _store_dtype(dtype: np.dtype) -> np.dtype:
@@ -170,86 +243,6 @@ def _store_dtype(dtype: np.dtype) -> np.dtype:
     return np.dtype(np.float64)
 
 
-def _grid_variable(name: str, dims: list[str], coords: Mapping[str, xr.Variable], cases: list[Case], results: Mapping[str, Any], key: str, dtype: np.dtype) -> xr.Variable:
-    dtype = _store_dtype(dtype)
-    data = np.full(_shape(dims, coords), _fill_value(dtype), dtype=dtype)
-    for case in cases:
-        value = results[case.case_id].get(key)
-        if value is not None:
-            data[case.position + tuple(slice(0, n) for n in np.shape(value))] = value
-    encoding = {} if np.issubdtype(dtype, np.floating) else {"_FillValue": _INT_FILL}
-    variable = xr.Variable(dims, data, dict(variable_attrs(name)))
-    variable.encoding.update(encoding)
-    return variable
-
-
-def _time_histories(
-    experiment: Experiment, case_dims: list[str], reference_dims: list[str], coords: Mapping[str, xr.Variable], cases: Mapping[str, list[Case]], results: Mapping[str, Any]
-) -> dict[str, xr.Variable]:
-    names = experiment.output["time_histories"]
-    if not names:
-        return {}
-    run, _, _ = templates()
-    union = coords["time"].values
-    kept = [experiment.building_names.index(b) for b in experiment.output["buildings"]]
-    variables = {}
-    jobs = [(name, case_dims, [d for d in run[name].dims if d != "time"], cases[CASE]) for name in names]
-    if "total_displacement" in names:
-        jobs.append(("reference_total_displacement", reference_dims, ["floor"], cases[REFERENCE]))
-    for name, dims, extra, kind_cases in jobs:
-        all_dims = dims + extra + ["time"]
-        data = np.full(_shape(all_dims, coords), np.nan)
-        for case in kind_cases:
-            arrays = results.get(case.case_id)
-            if arrays is None or f"t:{name}" not in arrays:
-                continue
-            columns = np.searchsorted(union, np.round(arrays["t:time"], 9))
-            values, view = arrays[f"t:{name}"], data[case.position]
-            rows = list(enumerate(kept)) if "building" in extra else [(None, None)]
-            for j, row in rows:
-                source = values if j is None else values[j]
-                target = view if row is None else view[row]
-                target[tuple(slice(0, n) for n in source.shape[:-1]) + (columns,)] = source
-        variable = xr.Variable(all_dims, data, dict(variable_attrs(name)))
-        variable.encoding.update({"zlib": True, "complevel": 1})
-        variables[name] = variable
-    return variables
-
-
-def _impact_table(experiment: Experiment, cases: list[Case], results: Mapping[str, Any]) -> dict[str, xr.Variable]:
-    run, _, _ = templates()
-    columns: dict[str, list[np.ndarray]] = {name: [] for name in IMPACT_COLUMNS}
-    owners: list[Case] = []
-    for case in cases:
-        arrays = results.get(case.case_id)
-        if arrays is None or "i:impact_start" not in arrays:
-            continue
-        count = len(arrays["i:impact_start"])
-        owners.extend([case] * count)
-        for name in IMPACT_COLUMNS:
-            columns[name].append(arrays[f"i:{name}"])
-    variables = {}
-    for name in IMPACT_COLUMNS:
-        dtype = run[name].dtype
-        data = np.concatenate(columns[name]).astype(dtype) if columns[name] else np.zeros(0, dtype)
-        variables[name] = xr.Variable(("impact",), data, dict(variable_attrs(name)))
-    variables["impact_case_id"] = xr.Variable(("impact",), np.array([c.case_id for c in owners], dtype=object), {"units": "1", "long_name": "id of the case of the impact"})
-    for position, dim in enumerate(experiment.dims):
-        values = np.array([c.labels[position][1] for c in owners], dtype=_coordinate_dtype(dim))
-        units = _dim_coordinate(experiment, dim).attrs["units"]
-        variables[f"impact_{dim.name}"] = xr.Variable(("impact",), values, {"units": units, "long_name": f"{dim.name} of the case of the impact"})
-    return variables
-
-
-def _coordinate_dtype(dim: Dim) -> Any:
-    return {"variant": object, "record": object, "realization": np.int64}.get(dim.kind, float)
-
-
-def write_store(dataset: xr.Dataset, path: str | Path) -> Path:
-    """Write the store atomically (temporary file renamed into place)."""
-    return write_dataset(dataset, path)
-
-
 def open_store(path: str | Path, chunks: Any = None) -> xr.Dataset:
     """Open an experiment store lazily (dask-chunked).
 
@@ -258,7 +251,8 @@ def open_store(path: str | Path, chunks: Any = None) -> xr.Dataset:
     path : str or Path
         The store file written by ``stochpound experiment run``.
     chunks : optional
-        Dask chunks (default ``{}``: the file's own chunking).
+        Dask chunks (default ``{}``: the file's own chunking, blocks of
+        consecutive realizations).
 
     Returns
     -------
@@ -282,3 +276,4 @@ def open_store(path: str | Path, chunks: Any = None) -> xr.Dataset:
         dataset.close()
         raise ExperimentError(f"{path}: not a stochpound experiment store (no definition_sha256 attribute)")
     return dataset
+

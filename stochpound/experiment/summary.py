@@ -2,10 +2,11 @@
 
 The statistics come from :mod:`stochpound.analysis` (one definition for the
 whole toolkit); this module only chooses and names what an experiment store
-keeps. A case's result is flattened into named numpy arrays (a *part*):
+keeps. A case's result is flattened into named numpy arrays (stacked with
+other cases' into a part, :mod:`stochpound.experiment.parts`):
 
 * ``s:<name>``: summaries (dimensions ``building`` or none);
-* ``t:<name>``: kept time histories, ``t:time`` their sample times (s);
+* ``t:<name>``: kept time histories (at the motion's samples);
 * ``i:<name>``: the impact table's columns.
 
 Units and long names are taken from a tiny real run (:func:`templates`), so
@@ -14,9 +15,10 @@ they always match :func:`stochpound.simulate` and :mod:`stochpound.analysis`.
 :func:`case_summary` and :func:`reference_summary` give the summaries as
 xarray datasets (their metadata names and describes the store's variables);
 per case, the experiment takes the same values from :func:`case_values` and
-:func:`reference_values`, which call the numpy kernels of
-:mod:`stochpound.analysis.kernels` directly (xarray's per-call overhead would
-cost several times the solver's time). Both go through the same kernels; the
+:func:`reference_values`, which read the run's variables directly
+(``run.variables``) and call the numpy kernels of
+:mod:`stochpound.analysis.kernels` (xarray's per-call overhead would cost
+several times the solver's time). Both go through the same kernels; the
 tests check that they agree.
 """
 
@@ -30,6 +32,7 @@ import xarray as xr
 
 from stochpound.analysis import kernels, peak_response
 from stochpound.analysis.names import RESPONSE_MOMENTS, without_aliases
+from stochpound.analysis.separation_rules import STORE_NAMES, contact_demands
 from stochpound.analysis.summary import response_moments, run_summary, top_floor_total_displacement
 
 _MOMENTS = tuple(RESPONSE_MOMENTS.values())
@@ -77,7 +80,13 @@ def case_summary(run: xr.Dataset, studied: str, fixed_base: xr.DataArray) -> xr.
         "correlation of the studied building's top-floor total displacement with the same building alone on a fixed base"
     )
     summary["events_total"] = xr.DataArray(np.int64(run.attrs.get("events_total", 0)), attrs={"units": "1", "long_name": "events located by the solver"})
-    return summary
+    return summary.merge(_contact_summary(run))
+
+
+def _contact_summary(run: xr.Dataset) -> xr.Dataset:
+    """Per contact: the peak closure and the inputs of the separation rules (:func:`stochpound.analysis.separation_rules.contact_demands`)."""
+    demands = contact_demands(run)
+    return demands.rename(STORE_NAMES).drop_vars("contact")
 
 
 def reference_summary(run: xr.Dataset, studied: str) -> xr.Dataset:
@@ -99,8 +108,8 @@ def _describe_moments(summary: xr.Dataset, suffix: str) -> None:
 
 def top_floor(run: xr.Dataset, studied: str) -> np.ndarray:
     """The studied building's top-floor total displacement over time, m (numpy)."""
-    index = list(run["building"].values).index(studied)
-    y = run["total_displacement"].values[index]
+    index = list(run.variables["building"].values).index(studied)
+    y = run.variables["total_displacement"].values[index]
     top = int(np.sum(~np.all(np.isnan(y), axis=-1)))
     return y[top - 1]
 
@@ -111,31 +120,52 @@ def _moment_values(response: np.ndarray) -> dict[str, np.ndarray]:
 
 def case_values(run: xr.Dataset, studied: str, fixed_base: np.ndarray) -> dict[str, np.ndarray]:
     """The values of :func:`case_summary`, computed with the numpy kernels (names of the store)."""
-    y, u, s = (run[name].values for name in ("total_displacement", "relative_displacement", "sliding_displacement"))
-    columns = [run[name].values for name in ("impact_in_phase", "impact_peak_force", "impact_duration", "impact_impulse")]
+    variables = run.variables
+    y, u, s = (variables[name].values for name in ("total_displacement", "relative_displacement", "sliding_displacement"))
+    columns = [variables[name].values for name in ("impact_in_phase", "impact_peak_force", "impact_duration", "impact_impulse")]
     impacts = kernels.impact_counts(*columns, np.ones(columns[0].shape, dtype=bool))
     response = top_floor(run, studied)
     return {
         **{name: np.int64(value) if name.startswith("impacts") else np.float64(value) for name, value in impacts._asdict().items()},
         **_moment_values(response),
-        "energy_residual_ratio": kernels.energy_residual_ratio(run["energy_residual"].values, run["energy_input"].values),
+        "energy_residual_ratio": kernels.energy_residual_ratio(variables["energy_residual"].values, variables["energy_input"].values),
         "fixed_base_correlation": kernels.pearson(response, fixed_base),
         "peak_total_displacement": kernels.abs_peak(y, (1, 2)),
         "peak_relative_displacement": kernels.abs_peak(u, (1, 2)),
         "peak_sliding_displacement": kernels.abs_peak(s),
         "residual_sliding": kernels.final_value(s),
         "events_total": np.int64(run.attrs.get("events_total", 0)),
+        **_contact_values(run),
     }
 
 
-def reference_values(run: xr.Dataset, studied: str) -> dict[str, np.ndarray]:
-    """The values of :func:`reference_summary`, computed with the numpy kernels (names of the store)."""
-    index = list(run["building"].values).index(studied)
-    values = {
-        **_moment_values(top_floor(run, studied)),
-        "peak_total_displacement": kernels.abs_peak(run["total_displacement"].values[index], (0, 1)),
-        "peak_relative_displacement": kernels.abs_peak(run["relative_displacement"].values[index], (0, 1)),
+def _contact_values(run: xr.Dataset) -> dict[str, np.ndarray]:
+    """The values of :func:`_contact_summary` with the numpy kernels."""
+    variables = run.variables
+    names = list(variables["building"].values)
+    y = variables["total_displacement"].values
+
+    def floors(side: str) -> np.ndarray:
+        buildings = [names.index(b) for b in variables[f"contact_{side}"].values]
+        return y[buildings, variables[f"contact_{side}_floor"].values.astype(int) - 1]
+
+    left, right = floors("left"), floors("right")
+    return {
+        "peak_contact_closure": variables["peak_contact_closure"].values.astype(float),
+        "contact_peak_displacement_left": kernels.abs_peak(left),
+        "contact_peak_displacement_right": kernels.abs_peak(right),
+        "contact_correlation": kernels.pearson(left, right),
     }
+
+
+def reference_values(displacement: np.ndarray) -> dict[str, np.ndarray]:
+    """The values of :func:`reference_summary`, computed with the numpy kernels (names of the store).
+
+    ``displacement`` (floors × time, m) is the fixed-base building's floor
+    displacements, its total and relative displacement alike.
+    """
+    peak = kernels.abs_peak(displacement, (0, 1))
+    values = {**_moment_values(displacement[-1]), "peak_total_displacement": peak, "peak_relative_displacement": peak}
     return {f"reference_{name}": values[name] for name in REFERENCE_SUMMARIES}
 
 
@@ -157,23 +187,21 @@ def case_arrays(summary: Mapping[str, np.ndarray], run: xr.Dataset, histories: S
     """
     arrays = {f"s:{name}": np.asarray(value) for name, value in summary.items()}
     if histories:
-        arrays["t:time"] = np.asarray(run["time"].values)
+        names = list(run.variables["building"].values)
+        kept = [names.index(b) for b in buildings if b in names]
         for name in histories:
-            variable = run[name]
-            if "building" in variable.dims:
-                variable = variable.sel(building=[b for b in buildings if b in run["building"].values])
-            arrays[f"t:{name}"] = np.asarray(variable.values)
+            variable = run.variables[name]
+            arrays[f"t:{name}"] = variable.values[kept] if variable.dims[0] == "building" else variable.values
     if impacts:
-        arrays.update({f"i:{name}": np.asarray(run[name].values) for name in IMPACT_COLUMNS})
+        arrays.update({f"i:{name}": run.variables[name].values for name in IMPACT_COLUMNS})
     return arrays
 
 
-def reference_arrays(summary: Mapping[str, np.ndarray], run: xr.Dataset, keep_history: bool) -> dict[str, np.ndarray]:
-    """Part arrays of a reference case: its summaries and, if asked, its total displacement."""
+def reference_arrays(summary: Mapping[str, np.ndarray], displacement: np.ndarray, keep_history: bool) -> dict[str, np.ndarray]:
+    """Part arrays of a reference case: its summaries and, if asked, its floors' total displacement (floors × time, m)."""
     arrays = {f"s:{name}": np.asarray(value) for name, value in summary.items()}
     if keep_history:
-        arrays["t:time"] = np.asarray(run["time"].values)
-        arrays["t:reference_total_displacement"] = np.asarray(run["total_displacement"].values[0])
+        arrays["t:reference_total_displacement"] = displacement
     return arrays
 
 

@@ -16,6 +16,7 @@ from typing import Any, Mapping
 import numpy as np
 
 from stochpound.errors import RecordError, SceneError
+from stochpound.memory import check_memory, sample_bytes
 from stochpound.model import fields
 from stochpound.model.building import buildings_from_tables
 from stochpound.model.contact import contact_from_table
@@ -74,7 +75,9 @@ def scene_from_dict(data: Mapping[str, Any], base_dir: str | Path = ".", source:
     buildings = buildings_from_tables(fields.array_of_tables(data, "building"))
     contacts = [contact_from_table(table, f"contact[{i}]", buildings) for i, table in enumerate(fields.array_of_tables(data, "contact"))]
     walls = walls_from_tables(fields.array_of_tables(data, "wall"), buildings)
-    motion = _motion(data, Path(base_dir), g)
+    n_dof = sum(b.n_floors + (b.base is not None) for b in buildings)
+    per_sample = sample_bytes(n_dof, len(buildings), max((b.n_floors for b in buildings), default=1), len(contacts) + len(walls))
+    motion = _motion(data, Path(base_dir), g, per_sample)
     return Scene(tuple(buildings), tuple(contacts), motion, g=g, study_compat=study_compat, walls=tuple(walls), source=source)
 
 
@@ -88,52 +91,56 @@ _MOTION_KEYS = {
 }
 
 
-def _motion(data: Mapping[str, Any], base_dir: Path, g: float) -> GroundMotion:
+def _motion(data: Mapping[str, Any], base_dir: Path, g: float, per_sample: int) -> GroundMotion:
+    """The scene's ground motion; a run needing more than the memory limit (``per_sample`` bytes a sample) is refused first."""
     table = fields.table(data, "motion", "")
     if table is None:
         raise SceneError("motion: missing ([motion] with a record, or type = harmonic | constant | kanai_tajimi | clough_penzien)")
     kind = fields.string(table, "type", "motion", default="record")
     if kind in _SYNTHETIC_TYPES:
-        return _synthetic_motion(table, kind)
+        return _synthetic_motion(table, kind, per_sample)
     if kind not in _MOTION_KEYS:
         raise SceneError(f"motion.type: must be one of record, harmonic, constant, kanai_tajimi, clough_penzien; got {kind!r}")
     fields.reject_unknown(table, _MOTION_KEYS[kind], "motion")
     if kind == "harmonic":
-        return _harmonic_motion(table)
+        return _harmonic_motion(table, per_sample)
     if kind == "constant":
-        return _constant_motion(table)
-    return _record_motion(table, base_dir, g)
+        return _constant_motion(table, per_sample)
+    return _record_motion(table, base_dir, g, per_sample)
 
 
-def _timing(table: Mapping[str, Any], required: bool) -> tuple[float | None, float | None]:
+def _timing(table: Mapping[str, Any], required: bool, per_sample: int) -> tuple[float | None, float | None]:
     duration = fields.number(table, "duration", "motion", required=required, low=0.0, low_open=True)
     dt = fields.number(table, "dt", "motion", required=required, low=0.0, low_open=True)
     if duration is not None and dt is not None and dt > duration:
         raise SceneError(f"motion.dt: must be <= motion.duration ({duration:g} s), got {dt:g}")
+    if required:  # a record's own length bounds its samples: checked once read
+        n_samples = duration / dt + 1
+        check_memory(n_samples * per_sample, f"motion: duration {duration:g} s at dt {dt:g} s is {n_samples:.3g} samples; a run")
     return duration, dt
 
 
-def _harmonic_motion(table: Mapping[str, Any]) -> HarmonicMotion:
+def _harmonic_motion(table: Mapping[str, Any], per_sample: int) -> HarmonicMotion:
     amplitude = fields.number(table, "amplitude", "motion", required=True)
     omega = fields.number(table, "omega", "motion", required=True, low=0.0)
     phase = fields.number(table, "phase", "motion", default=0.0)
-    duration, dt = _timing(table, required=True)
+    duration, dt = _timing(table, required=True, per_sample=per_sample)
     return HarmonicMotion(amplitude, omega, duration, dt, phase)
 
 
-def _constant_motion(table: Mapping[str, Any]) -> SampledMotion:
+def _constant_motion(table: Mapping[str, Any], per_sample: int) -> SampledMotion:
     acceleration = fields.number(table, "acceleration", "motion", required=True)
-    duration, dt = _timing(table, required=True)
+    duration, dt = _timing(table, required=True, per_sample=per_sample)
     n_samples = int(round(duration / dt)) + 1
     return SampledMotion(dt, np.full(n_samples, acceleration), description=f"constant {acceleration:g} m/s²")
 
 
-def _record_motion(table: Mapping[str, Any], base_dir: Path, g: float) -> SampledMotion:
+def _record_motion(table: Mapping[str, Any], base_dir: Path, g: float, per_sample: int) -> SampledMotion:
     from stochpound.motions.records import load_record
 
     spec = fields.string(table, "record", "motion")
     scale = fields.number(table, "scale", "motion", default=1.0)
-    duration, dt = _timing(table, required=False)
+    duration, dt = _timing(table, required=False, per_sample=per_sample)
     units = fields.string(table, "units", "motion", default="") or None
     if units not in (None, "g", "m/s2", "cm/s2"):
         raise SceneError(f"motion.units: must be one of g, m/s2, cm/s2; got {units!r}")
@@ -151,6 +158,7 @@ def _record_motion(table: Mapping[str, Any], base_dir: Path, g: float) -> Sample
         values = values[:n_keep]
     if len(values) < 2:
         raise SceneError(f"motion.record: {spec!r} has {len(values)} sample(s) in the requested duration; at least 2 are needed")
+    check_memory(len(values) * per_sample, f"motion.record: {len(values)} samples; a run")
     description = f"{record.name} x {scale:g}" + (f", first {duration:g} s" if duration is not None else "")
     return SampledMotion(record.dt, values, interpolation, description)
 
@@ -165,7 +173,7 @@ def _check_generator_fields(table: Mapping[str, Any], generator: Any, kind: str)
             raise SceneError(f"motion.{name}: required for type = {kind!r} (see docs/motions.md)")
 
 
-def _synthetic_motion(table: Mapping[str, Any], kind: str) -> SampledMotion:
+def _synthetic_motion(table: Mapping[str, Any], kind: str, per_sample: int) -> SampledMotion:
     """One realization of a synthetic ensemble, fixed by (seed, realization) alone."""
     from stochpound import motions
 
@@ -175,7 +183,7 @@ def _synthetic_motion(table: Mapping[str, Any], kind: str) -> SampledMotion:
     realization = table.get("realization", 0)
     if not isinstance(realization, int) or isinstance(realization, bool) or realization < 0:
         raise SceneError(f"motion.realization: must be an integer >= 0, got {realization!r}")
-    duration, dt = _timing(table, required=True)
+    duration, dt = _timing(table, required=True, per_sample=per_sample)
     parameters.update(duration=duration, dt=dt)
     try:
         ensemble = generator(1, start=realization, **parameters)

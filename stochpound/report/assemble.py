@@ -18,6 +18,7 @@ import xarray as xr
 from stochpound.report import findings, study_figures, study_notes, study_tables
 from stochpound.report.document import Block, Paragraph, Report, Section
 from stochpound.report.generic import store_section
+from stochpound.report.separation import has_contact_free, separation_section, with_contacts
 from stochpound.report.methods import methods_section
 from stochpound.report.stores import open_stores
 
@@ -69,7 +70,13 @@ def assemble_report(paths: Sequence[str | Path], progress: Callable[[str], None]
         report.sections.append(Section("About this report", [Paragraph(_about(others))], key="about"))
     for name, store in others.items():
         say(f"experiment {name}")
-        report.sections.append(store_section(name, store))
+        contact_free = has_contact_free(store)
+        finite = with_contacts(store) if contact_free else store
+        if all(finite.sizes[d] for d in finite["case_status"].dims):
+            report.sections.append(store_section(name, finite))
+        if contact_free:
+            say(f"experiment {name}: separation")
+            report.sections.append(separation_section(name, store))
     say("methods")
     report.sections.append(methods_section(stores))
     return report

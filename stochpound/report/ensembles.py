@@ -138,7 +138,7 @@ class Ensemble:
         return Table(
             key=f"table-{self.name}-{self.label}-{kind}",
             caption=f"Experiment {self.name}, ensemble {self.label} ({self.size} realizations per cell): {TABLE_CAPTIONS[kind]}.",
-            frame=_frame(columns, list(self.grid)),
+            frame=table_frame(columns, list(self.grid)),
             note=(
                 f"mean: the ensemble mean over the realizations, with the lower and upper bounds of its {self.confidence:.0%} "
                 f"Student-t confidence interval; P(pounding): fraction of realizations with at least one impact, with its "
@@ -173,7 +173,7 @@ class Ensemble:
         return Table(
             key=f"table-{self.name}-{self.label}-fixed-base",
             caption=f"Experiment {self.name}, ensemble {self.label}: the fixed-base twin, {self.studied} alone on a fixed base under the same {self.size} realizations.",
-            frame=_frame(columns, dims),
+            frame=table_frame(columns, dims),
             note=f"Means with their {self.confidence:.0%} Student-t intervals, and sample quantiles.",
         )
 
@@ -196,19 +196,19 @@ class Ensemble:
 
         def curves(panel: dict[str, Any]) -> list[figures.Curve]:
             result = []
-            for value, colour in _lines(self.grid, line_dim):
+            for value, colour in lines(self.grid, line_dim):
                 where = {**panel, **({line_dim: value} if line_dim else {})}
                 cell = stats.sel({d: v for d, v in where.items()})
                 p = cell["pounding_probability"].sel({x_dim: x_values})
                 result.append(figures.Curve(
-                    _line_label(line_dim, value), positions, p.values,
+                    line_label(line_dim, value), positions, p.values,
                     cell["pounding_probability_lower"].sel({x_dim: x_values}).values, cell["pounding_probability_upper"].sel({x_dim: x_values}).values,
                     colour, marker="o", gid="|".join(self.gid({**where, x_dim: x}) for x in x_values),
                 ))
             return result
 
         x_label = f"{dim_text(x_dim)}" + (" (cm)" if is_gap(x_dim) else "")
-        return self._figures(
+        return self.facet_figures(
             f"pounding-{x_dim}", [x_dim, line_dim], curves, x_label, "P(pounding)",
             f"the probability of pounding against {dim_text(x_dim)}, with its {self.confidence:.0%} Clopper–Pearson band",
             x_ticks=ticks, y_limits=(-0.03, 1.03), legend_title=dim_text(line_dim) if line_dim else "",
@@ -222,9 +222,9 @@ class Ensemble:
 
         def curves(panel: dict[str, Any]) -> list[figures.Curve]:
             result = []
-            for value, colour in _lines(self.grid, line_dim):
+            for value, colour in lines(self.grid, line_dim):
                 where = {**panel, **({line_dim: value} if line_dim else {})}
-                result.append(figures.Curve(_line_label(line_dim, value), sample.sel(where).values * quantity.factor, color=colour, gid=self.gid(where)))
+                result.append(figures.Curve(line_label(line_dim, value), sample.sel(where).values * quantity.factor, color=colour, gid=self.gid(where)))
             if reference is not None:
                 twin_sample = reference.sel({d: v for d, v in panel.items() if d in reference.dims})
                 result.append(figures.Curve(f"{self.studied} alone, fixed base", twin_sample.values * quantity.factor, color="grey", style="--", gid="fixed-base twin"))
@@ -235,7 +235,7 @@ class Ensemble:
             what += "; its jump at zero is the probability of not pounding"
         if reference is not None:
             what += f", with the fixed-base twin's ({self.studied} alone on a fixed base under the same realizations, dashed)"
-        return self._figures(
+        return self.facet_figures(
             f"ecdf-{quantity.variable}", [line_dim], curves, _with_unit(quantity), "fraction of realizations", what,
             title=f"ECDF of the {quantity.label}", y_limits=(-0.02, 1.02), log_x=log_x, legend_title=dim_text(line_dim) if line_dim else "",
         )
@@ -254,23 +254,23 @@ class Ensemble:
 
             def curves(panel: dict[str, Any], estimate: xr.Dataset = estimate, field: str = field, factor: float = factor) -> list[figures.Curve]:
                 result = []
-                for value, colour in _lines(self.grid, line_dim):
+                for value, colour in lines(self.grid, line_dim):
                     where = {**panel, **({line_dim: value} if line_dim else {})}
                     cell = estimate.sel(where)
                     result.append(figures.Curve(
-                        _line_label(line_dim, value), n, cell[field].values * factor, cell["lower"].values * factor, cell["upper"].values * factor,
+                        line_label(line_dim, value), n, cell[field].values * factor, cell["lower"].values * factor, cell["upper"].values * factor,
                         colour, gid=self.gid(where),
                     ))
                 return result
 
-            items += self._figures(
+            items += self.facet_figures(
                 f"convergence-{key}", [line_dim], curves, "realizations", y_label,
                 f"convergence: the running estimate of the {y_label.split(' (')[0]} over the first n realizations, with its {self.confidence:.0%} band",
                 title=f"running {y_label.split(' (')[0]}", log_x=True, legend_title=dim_text(line_dim) if line_dim else "",
             )
         return items
 
-    def _figures(
+    def facet_figures(
         self, kind: str, drawn: Sequence[str | None], curves: Callable[[dict[str, Any]], list[figures.Curve]], x_label: str, y_label: str, what: str, title: str = "", **options: Any
     ) -> list[FigureItem]:
         """One figure per layout of the dimensions not ``drawn`` (each combination a panel)."""
@@ -309,7 +309,7 @@ class Ensemble:
         return blocks + self.figures()
 
 
-def _frame(columns: dict[tuple[str, str], xr.DataArray], dims: list[str]) -> pd.DataFrame:
+def table_frame(columns: dict[tuple[str, str], xr.DataArray], dims: list[str]) -> pd.DataFrame:
     """A table with one row per combination of ``dims`` (labelled as in the figures) and (quantity, estimate) columns."""
     if not dims:
         frame = pd.DataFrame({key: [float(value)] for key, value in columns.items()}, index=pd.Index(["all"], name="cell"))
@@ -321,13 +321,13 @@ def _frame(columns: dict[tuple[str, str], xr.DataArray], dims: list[str]) -> pd.
     return frame
 
 
-def _lines(grid: dict[str, list[Any]], line_dim: str | None) -> list[tuple[Any, Any]]:
+def lines(grid: dict[str, list[Any]], line_dim: str | None) -> list[tuple[Any, Any]]:
     if line_dim is None:
         return [(None, "C0")]
     return list(zip(grid[line_dim], line_colours(line_dim, grid[line_dim])))
 
 
-def _line_label(line_dim: str | None, value: Any) -> str:
+def line_label(line_dim: str | None, value: Any) -> str:
     return value_text(line_dim, value) if line_dim else "all realizations"
 
 

@@ -6,8 +6,6 @@ variable carries ``units`` and ``long_name`` (CF conventions).
 
 from __future__ import annotations
 
-import os
-import tempfile
 from pathlib import Path
 from typing import Any
 
@@ -15,6 +13,7 @@ import numpy as np
 import xarray as xr
 
 from stochpound import __version__
+from stochpound.atomic import replacing
 from stochpound.results.record import ENERGY_TERMS, EventCounters, Recorder
 from stochpound.model.scene import Scene
 from stochpound.model.system import System
@@ -205,16 +204,10 @@ def _energy_variables(recorder: Recorder) -> dict[str, tuple]:
 def write_dataset(dataset: xr.Dataset, path: str | Path) -> Path:
     """Write ``dataset`` as netCDF4/HDF5 atomically (a temporary file renamed into place).
 
-    An interrupted write never leaves a partial file at ``path``.
+    An interrupted write never leaves a partial file at ``path``; the file's
+    permissions follow the umask (:mod:`stochpound.atomic`).
     """
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    os.close(handle)
-    try:
+    with replacing(path) as temporary:
         dataset.to_netcdf(temporary, engine="h5netcdf", invalid_netcdf=False)
-        os.replace(temporary, path)
-    except BaseException:
-        Path(temporary).unlink(missing_ok=True)
-        raise
     return path

@@ -1,41 +1,35 @@
-"""Compiled (numba) event-driven run of the exact solver.
+"""The event engine: the one implementation of the discrete event logic (numba).
 
-This is the fast path of ``method="exact"``: the whole run, events included,
-happens in compiled code, and Python is called back only to build the
-matrices and propagators of a mode the run reaches for the first time (and
-to grow the impact table). It is a line-by-line port of the shared Python
-logic, which stays the specification:
+Every solver runs through this module (:mod:`stochpound.solvers.driver`):
+``method="exact"`` lets it advance each mode with exact propagators,
+``method="ivp"`` supplies an integrator's steps as Chebyshev expansions of
+its dense output. Either way the engine alone
 
-* guard crossings: :func:`stochpound.events.first_crossing` (Hermite screen,
-  ``_locate``, ``_grazing``), with scipy's ``brentq`` and bounded Brent
-  minimiser ported below;
-* settling: :func:`stochpound.events.settle` (``guard_leaving_sign``,
-  ``_wanting_to_fire``, ``_apply``, ``_initial_guard_states``) with the same
-  constants (imported from :mod:`stochpound.events`);
-* recording: :meth:`stochpound.results.record.Recorder.on_step` (energy terms by
-  5-point Gauss–Legendre quadrature, impulses, located peak forces),
-  ``on_transitions`` and ``on_contact_force``.
+* screens and locates guard crossings (:func:`_may_cross`, the cubic
+  Hermite screen; :func:`_first_crossing`, with a Brent root finder and a
+  bounded Brent minimiser for grazing guards and dips, :func:`_brentq`,
+  :func:`_bounded_brent`);
+* settles an instant (:func:`_settle_pending`: which guard fires first, mode
+  transitions, re-arming);
+* records the run: energy terms by 5-point Gauss–Legendre quadrature,
+  impulses, located peak forces and monitored peaks, the impact table.
 
 Most sample intervals have no event: :func:`_advance_quiet` advances them
-with the exact sub-step propagator, screening every sub-step exactly as
-``first_crossing`` would, and stops (rolled back to the start of the
+sub-step by sub-step, screening every sub-step exactly as
+:func:`_first_crossing` would, and stops (rolled back to the start of the
 interval) at the first interval in which a guard is suspected to cross or an
-impact force has an interior maximum. Only the event code judges events; the
-quiet loop decides nothing it would decide differently.
-
-``tests/test_exact.py`` checks that this engine and the Python event path
-(``run_exact(..., events="python")``, which runs only the quiet loop here and
-calls the shared code for every other interval) give the same events and the
-same answer on the hard cases.
+impact force has an interior maximum; :func:`_advance_span` then takes the
+interval event by event. With ``NUMBA_DISABLE_JIT=1`` the same functions run
+as plain Python (the debugging path, tested).
 
 Data. Modes are int64 vectors [closed flags of every contact, state of every
 base]. Every linear read-out of a mode is an *affine map*, an array whose
 row i gives ``row[:S] · x + row[S] a_g + row[S + 1]`` (S = 2N): ``rate``
 (ẋ = A x + B a_g + c), ``guard`` (G x + h a_g + g0) and ``force`` (contact
-forces, no a_g term), summed in the order of the Python code. The powers of
+forces, no a_g term). The powers of
 the energy balance are quadratic forms of the augmented state z = [x, w, 1]
-(``exact_tables._power_forms``), and their 5-point Gauss–Legendre integrals over a
-whole sub-step are quadratic forms of z(t0) (``exact_tables._sub_step_forms``).
+(``tables._power_forms``), and their 5-point Gauss–Legendre integrals over a
+whole sub-step are quadratic forms of z(t0) (``tables._sub_step_forms``).
 The arrays are grouped in small named tuples: :class:`ModeTable`,
 :class:`Dynamics` and :class:`Propagators` (one row per slot of modes),
 :class:`Motion` and :class:`Layout` (the plant), :class:`Run`,
@@ -734,7 +728,7 @@ def _brentq(flow, index, level, xa, xb, work):
 def _bounded_brent(flow, j, level, a, b, sign, work):
     """(t, f(t)) minimising f = −sign (guard − level) on [a, b] (scipy's bounded Brent, xatol = 1e-12).
 
-    ``sign`` = 1 maximises the guard (``events._grazing``), −1 minimises it (``events._after_dip``).
+    ``sign`` = 1 maximises the guard (a grazing guard), −1 minimises it (:func:`_after_dip`).
     """
     xatol, sqrt_eps, golden_mean = 1e-12, math.sqrt(2.2e-16), 0.5 * (3.0 - math.sqrt(5.0))
     fulc = a + golden_mean * (b - a)
@@ -803,7 +797,7 @@ def _bounded_brent(flow, j, level, a, b, sign, work):
 
 @njit(**INTERNAL)
 def _after_dip(flow, j, tolerance, start, crossing, work):
-    """Where disarmed guard j, at its threshold at ``crossing``, fires (``events._after_dip``).
+    """Where disarmed guard j, at its threshold at ``crossing``, fires after dipping below it.
 
     At its first zero after a dip below −``tolerance`` in [start, crossing],
     found by minimising the guard; at ``crossing`` if it did not dip.
@@ -849,14 +843,14 @@ def _critical_points(a1, a2, a3, out):
 @njit(**INTERNAL)
 def _first_crossing(flow, threshold, tolerance, rearmable, disarmed, counters, t1, values0, values1, rates0, rates1, work, taus, times,
                     raw):
-    """(time, guard) of the earliest crossing in [t0, t1], or (NaN, −1) (``events.first_crossing``).
+    """(time, guard) of the earliest crossing in [t0, t1], or (NaN, −1).
 
     Every guard whose cubic Hermite interpolant may reach zero is located on
-    the dense flow (``events._locate``): the step is cut at the cubic's
+    the dense flow: the step is cut at the cubic's
     critical points; an armed guard fires at 0, a disarmed one at its
     threshold until it has dipped below −tolerance (at a cut point, or found
     by :func:`_after_dip`); a cubic maximum close to
-    the level is checked by maximising the true guard (``events._grazing``).
+    the level is checked by maximising the true guard (grazing).
     ``taus``, ``times`` and ``raw`` are work vectors (4 entries).
     """
     t0 = flow.t0
@@ -930,7 +924,7 @@ def _penetration(geometry, gap, p, x):
 
 @njit(**INTERNAL)
 def _apply(geometry, gap, base_dofs, mode, x, kind, target, direction):
-    """``events._apply`` on a mode vector (changed in place); a STOP zeroes the base velocity in x."""
+    """Apply a transition to a mode vector (changed in place); a STOP zeroes the base velocity in x."""
     n_contacts = gap.shape[0]
     if kind == _CLOSE or (kind == _RECLOSE and _penetration(geometry, gap, target, x) > 0.0):
         mode[target] = 1
@@ -948,7 +942,7 @@ def _with_bound(M, i, x, magnitude, ground, constant):
     """Row i of the affine map M at (x, a_g), with its constant or not, its round-off scale and Σabs(M[i, :S + 1]).
 
     The scale is the same sum with every term taken absolute and x replaced
-    by ``magnitude`` (``events._guard_scales``).
+    by ``magnitude``.
     """
     size = M.shape[1] - 2
     slope, offset = M[i, size], M[i, size + 1] if constant else 0.0
@@ -997,7 +991,7 @@ def _leaving_sign(rate, guard, n_guards, x, ground, readout, values, tolerance, 
 
 @njit(**INTERNAL)
 def _first_wanting(codes, n_guards, geometry, gap, tensile, x, values, tolerance, heading):
-    """Index of the first guard that fires at this instant (``events._wanting_to_fire``), or −1.
+    """Index of the first guard that fires at this instant, or −1.
 
     A RECLOSE guard does not fire while its contact is not penetrated, nor the
     CLOSE guard of a non-tensile contact still penetrated.
@@ -1016,7 +1010,7 @@ def _first_wanting(codes, n_guards, geometry, gap, tensile, x, values, tolerance
 
 @njit(**INTERNAL)
 def _initial_guard_states(codes, n_guards, geometry, gap, tensile, x, values, tolerance, threshold_out, tolerance_out, rearmable, disarmed):
-    """``events._initial_guard_states`` into the run's guard arrays."""
+    """The initial guard states (armed or not) into the run's guard arrays."""
     for j in range(n_guards):
         tolerance_out[j] = tolerance[j]
         threshold_out[j] = 0.0 if values[j] < -tolerance[j] else _FIRE_RATIO * tolerance[j]

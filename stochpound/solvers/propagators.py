@@ -25,7 +25,7 @@ exactly s(τ) = s(0), ṡ(τ) = 0 (docs/model.md, numerical traps).
 
 The sub-step h = dt / m is the largest with ρ h ≤ :data:`SCREEN_ANGLE`, where
 ρ bounds the mode's frequencies (spectral radius of A, and Ω of a harmonic
-input): the cubic Hermite screen of :func:`stochpound.events.first_crossing`
+input): the cubic Hermite screen of :func:`stochpound.solvers.engine._first_crossing`
 then resolves any guard excursion, including contacts shorter than a sample
 interval.
 
@@ -78,7 +78,7 @@ PROPAGATOR_BUDGET = 128 * 2**20
 """Largest size of the cached :class:`ModePropagator` of one library, bytes.
 
 The exact engine keeps its own copies of the modes it runs in (its slots,
-``solvers.exact_tables.TABLE_BUDGET``), so this cache only spares rebuilding a mode
+``solvers.tables.TABLE_BUDGET``), so this cache only spares rebuilding a mode
 evicted from the slots; dropped propagators are rebuilt from the block cache."""
 BLOCK_BUDGET = 64 * 2**20
 """Largest size of the cached block flows of one library, bytes."""

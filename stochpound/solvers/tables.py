@@ -83,7 +83,7 @@ def max_guards(system: System) -> int:
 
 
 def work_arrays_for(system: System, slots: "Slots") -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The engine's work arrays for ``system`` and the current Chebyshev width of ``slots`` (:func:`exact_engine.work_arrays`)."""
+    """The engine's work arrays for ``system`` and the current Chebyshev width of ``slots`` (:func:`stochpound.solvers.engine.work_arrays`)."""
     return engine.work_arrays(system.xi_size, max_guards(system), system.n_elements, monitor_count(system), mode_length(system),
                               slots.arrays["chebyshev"].shape[2])
 

@@ -1,0 +1,52 @@
+"""Atomic file writes: a temporary file beside the target, renamed over it once complete.
+
+A reader never sees a partial file, and an interrupted write leaves the old
+file as it was (plus, at worst, a stray temporary, ``.<name>.<random>.tmp``,
+which :func:`temporaries` finds). Temporaries are created with mode 0666
+filtered by the umask, as the target itself would be (``tempfile.mkstemp``
+would make every result private to its owner, 0600).
+"""
+
+from __future__ import annotations
+
+import os
+import secrets
+from contextlib import contextmanager
+from pathlib import Path
+from typing import Iterator
+
+TEMPORARY_SUFFIX = ".tmp"
+
+
+@contextmanager
+def replacing(path: str | Path) -> Iterator[Path]:
+    """Yield the path of a new, empty temporary file beside ``path``; rename it over ``path`` when the block ends.
+
+    If the block raises (or is interrupted), the temporary is deleted and
+    ``path`` is left unchanged. The caller writes the temporary (it may
+    reopen and truncate it) and flushes it to disk if it needs to.
+    """
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    temporary = _create_temporary(path)
+    try:
+        yield temporary
+        os.replace(temporary, path)
+    except BaseException:
+        temporary.unlink(missing_ok=True)
+        raise
+
+
+def _create_temporary(path: Path) -> Path:
+    while True:
+        temporary = path.with_name(f".{path.name}.{secrets.token_hex(6)}{TEMPORARY_SUFFIX}")
+        try:
+            os.close(os.open(temporary, os.O_CREAT | os.O_EXCL | os.O_WRONLY, 0o666))
+        except FileExistsError:
+            continue
+        return temporary
+
+
+def temporaries(folder: str | Path, name: str = "*") -> list[Path]:
+    """Temporaries left in ``folder`` by interrupted writes of ``name`` (default: of any file)."""
+    return sorted(Path(folder).glob(f".{name}.*{TEMPORARY_SUFFIX}"))
