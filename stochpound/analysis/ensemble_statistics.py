@@ -32,6 +32,9 @@ SUMMARIES = (
     "reference_response_std",
     "reference_peak_total_displacement",
     "reference_peak_relative_displacement",
+    "peak_floor_acceleration",
+    "peak_interstorey_drift",
+    "peak_base_shear",
 )
 #: Summaries whose quantiles are given too.
 PEAKS = (
@@ -41,6 +44,9 @@ PEAKS = (
     "peak_impact_force",
     "reference_peak_total_displacement",
     "reference_peak_relative_displacement",
+    "peak_floor_acceleration",
+    "peak_interstorey_drift",
+    "peak_base_shear",
 )
 #: Summaries estimated over the realizations that pound only (their value is 0 without an impact).
 GIVEN_POUNDING = ("peak_impact_force",)

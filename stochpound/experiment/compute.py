@@ -25,7 +25,7 @@ import numpy as np
 from stochpound import motions as synthetic_motions
 from stochpound.experiment.model import REFERENCE
 from stochpound.experiment.parts import concatenate, section_key, stack_cases
-from stochpound.experiment.spec import canonical_json
+from stochpound.experiment.spec import AUTO, canonical_json
 from stochpound.experiment.summary import case_arrays, case_values, reference_arrays, reference_values
 from stochpound.experiment.twin import fixed_base_displacements
 from stochpound.model.scene import Scene
@@ -169,7 +169,11 @@ def _case(task: BatchTask, scene: Scene | None, ground: GroundMotion, twin: np.n
     if scene is None:
         return reference_arrays(reference_values(twin), twin, "total_displacement" in task.output["time_histories"])
     solver = task.solver
-    run = simulate(dataclasses.replace(scene, motion=ground), solver["method"], integrator=solver["integrator"], rtol=solver["rtol"], atol=solver["atol"])
+    method = None if solver["method"] == AUTO else solver["method"]
+    run = simulate(
+        dataclasses.replace(scene, motion=ground), method, integrator=solver["integrator"], rtol=solver["rtol"], atol=solver["atol"],
+        demands=task.output.get("demands", False),
+    )
     summary = case_values(run, task.studied, twin[-1])
     return case_arrays(summary, run, task.output["time_histories"], task.output["buildings"], task.output["impacts"])
 

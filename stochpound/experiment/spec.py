@@ -27,6 +27,7 @@ from typing import Any, Iterator, Mapping
 
 from stochpound.errors import SceneError
 from stochpound.model import fields as toml_fields
+from stochpound.model.contact import ELEMENT_KEYS
 from stochpound.solvers.simulate import METHODS
 from stochpound.solvers.ivp import INTEGRATORS
 
@@ -36,7 +37,9 @@ FORMAT_VERSION = 1
 _TOP_KEYS = {"experiment", "scene", "variants", "grid", "records", "motions", "synthetic", "output", "solver"}
 _EXPERIMENT_KEYS = {"name", "description", "scene", "studied"}
 _BUILDING_OVERRIDES = {"mass_factor", "mass", "stiffness", "damping", "damping_ratio", "base", "initial"}
-_SCENE_OVERRIDES = {"study_compat"}
+_SCENE_OVERRIDES = {"study_compat", "wall"}
+AUTO = "auto"
+"""``solver.method`` default: each case's solver chosen by :func:`stochpound.simulate` (exact unless a law is nonlinear)."""
 _RECORD_KEYS = {"name", "record", "scale", "dt", "duration", "units", "interpolation"}
 _SYNTHETIC_TYPES = ("kanai_tajimi", "clough_penzien")
 _ANALYTIC_TYPES = ("harmonic", "constant")
@@ -174,7 +177,7 @@ def parse_experiment(data: Mapping[str, Any], base_dir: str | Path = ".", defaul
     studied = header.get("studied", buildings[0] if buildings else "B1")
     if studied not in buildings:
         raise ExperimentError(f"experiment.studied: must be one of the scene's buildings ({', '.join(buildings)}), got {studied!r}")
-    variants = _variants(data, buildings)
+    variants = _variants(data, buildings, len(scene.get("contact", [])))
     grid = _table_or_error(data, "grid", "")
     known_axes = {v["name"] for v in variants}
     for key in grid:
@@ -232,7 +235,7 @@ def _base_scene(data: Mapping[str, Any], header: Mapping[str, Any], base_dir: Pa
 # ---------------------------------------------------------------- variants
 
 
-def _variants(data: Mapping[str, Any], buildings: list[str]) -> list[dict[str, Any]]:
+def _variants(data: Mapping[str, Any], buildings: list[str], n_contacts: int) -> list[dict[str, Any]]:
     table = _table_or_error(data, "variants", "")
     axes = []
     for axis, values in table.items():
@@ -242,7 +245,7 @@ def _variants(data: Mapping[str, Any], buildings: list[str]) -> list[dict[str, A
             raise ExperimentError(f"{where}: must be a table of named variants, e.g. [{where}.stiff] (at least one)")
         overrides = {}
         for value, override in values.items():
-            overrides[value] = _override(override, f"{where}.{value}", buildings)
+            overrides[value] = _override(override, f"{where}.{value}", buildings, n_contacts)
         axes.append({"name": axis, "values": list(values), "overrides": overrides})
     return axes
 
@@ -255,16 +258,31 @@ def _check_dim_name(name: str, where: str) -> None:
         )
 
 
-def _override(override: Any, where: str, buildings: list[str]) -> dict[str, Any]:
+def _contact_override(part: Any, where: str, n_contacts: int) -> None:
+    """A variant's ``contact``: one table of impact-element fields for every contact, or one table per contact."""
+    if part is None:
+        return
+    tables = part if isinstance(part, list) else [part]
+    if not all(isinstance(t, dict) for t in tables) or not tables:
+        raise ExperimentError(f"{where}: must be a table of contact fields ({', '.join(sorted(ELEMENT_KEYS))}) or a list of one table per contact")
+    if isinstance(part, list) and len(part) != n_contacts:
+        raise ExperimentError(f"{where}: a list must have one table per contact of the scene ({n_contacts}), got {len(part)}")
+    for i, table in enumerate(tables):
+        with field_errors():
+            toml_fields.reject_unknown(table, ELEMENT_KEYS, f"{where}[{i}]" if isinstance(part, list) else where)
+
+
+def _override(override: Any, where: str, buildings: list[str], n_contacts: int) -> dict[str, Any]:
     if not isinstance(override, dict):
         raise ExperimentError(f"{where}: must be a table (with building.<name> and/or scene tables)")
     with field_errors():
-        toml_fields.reject_unknown(override, {"building", "scene"}, where)
+        toml_fields.reject_unknown(override, {"building", "scene", "contact"}, where)
     scene_part = override.get("scene", {})
     if not isinstance(scene_part, dict):
         raise ExperimentError(f"{where}.scene: must be a table")
     with field_errors():
         toml_fields.reject_unknown(scene_part, _SCENE_OVERRIDES, f"{where}.scene")
+    _contact_override(override.get("contact"), f"{where}.contact", n_contacts)
     building_part = override.get("building", {})
     if not isinstance(building_part, dict):
         raise ExperimentError(f"{where}.building: must be a table of buildings by name, e.g. [{where}.building.B2]")
@@ -471,7 +489,7 @@ def _synthetic_source(label: str, table: Any, where: str) -> dict[str, Any]:
 def _output(data: Mapping[str, Any], buildings: list[str]) -> dict[str, Any]:
     table = _table_or_error(data, "output", "")
     with field_errors():
-        toml_fields.reject_unknown(table, {"time_histories", "buildings", "impacts"}, "output")
+        toml_fields.reject_unknown(table, {"time_histories", "buildings", "impacts", "demands"}, "output")
     histories = table.get("time_histories", [])
     if not isinstance(histories, list):
         raise ExperimentError(f"output.time_histories: must be a list of variable names, got {histories!r}")
@@ -486,19 +504,25 @@ def _output(data: Mapping[str, Any], buildings: list[str]) -> dict[str, Any]:
     impacts = table.get("impacts", True)
     if not isinstance(impacts, bool):
         raise ExperimentError(f"output.impacts: must be true or false, got {impacts!r}")
-    return {"time_histories": list(histories), "buildings": [b for b in buildings if b in chosen], "impacts": impacts}
+    demands = table.get("demands", False)
+    if not isinstance(demands, bool):
+        raise ExperimentError(f"output.demands: must be true or false, got {demands!r}")
+    output = {"time_histories": list(histories), "buildings": [b for b in buildings if b in chosen], "impacts": impacts}
+    if demands:  # absent when false: the definitions (and hashes) of stores without demands are unchanged
+        output["demands"] = True
+    return output
 
 
 def _solver(data: Mapping[str, Any]) -> dict[str, Any]:
     table = _table_or_error(data, "solver", "")
     with field_errors():
         toml_fields.reject_unknown(table, {"method", "integrator", "rtol", "atol"}, "solver")
-        method = toml_fields.string(table, "method", "solver", default=METHODS[0])
+        method = toml_fields.string(table, "method", "solver", default=AUTO)
         integrator = toml_fields.string(table, "integrator", "solver", default="DOP853")
         rtol = toml_fields.number(table, "rtol", "solver", default=1e-10, low=0.0, low_open=True)
         atol = toml_fields.number(table, "atol", "solver", default=1e-12, low=0.0, low_open=True)
-    if method not in METHODS:
-        raise ExperimentError(f"solver.method: must be one of {', '.join(METHODS)}, got {method!r}")
+    if method not in (AUTO, *METHODS):
+        raise ExperimentError(f"solver.method: must be one of {AUTO}, {', '.join(METHODS)}, got {method!r}")
     if integrator not in INTEGRATORS:
         raise ExperimentError(f"solver.integrator: must be one of {', '.join(INTEGRATORS)}, got {integrator!r}")
     return {"method": method, "integrator": integrator, "rtol": rtol, "atol": atol}

@@ -34,7 +34,7 @@ import xarray as xr
 
 from stochpound.experiment.model import CASE, REFERENCE, Dim, Experiment
 from stochpound.experiment.spec import ExperimentError, canonical_json
-from stochpound.experiment.summary import IMPACT_COLUMNS, templates, variable_attrs
+from stochpound.experiment.summary import DEMAND_SUMMARIES, IMPACT_COLUMNS, templates, variable_attrs
 
 #: Version of the store layout.
 STORE_FORMAT = 1
@@ -133,6 +133,8 @@ def layout(experiment: Experiment, motion_grids: Mapping[str, tuple[float, int]]
         specs.append(Spec(f"{prefix}_status", kind, "status", dims, np.dtype(np.int8), {**_STATUS_ATTRS, "long_name": f"{long} status"}, chunks))
         specs.append(Spec(f"{prefix}_id", kind, "id", dims, np.dtype("<U1"), {"units": "1", "long_name": f"{long} id"}, chunks))
         for name, variable in template.data_vars.items():
+            if name in DEMAND_SUMMARIES and not experiment.output.get("demands", False):
+                continue
             extra = tuple(variable.dims)
             dtype = _store_dtype(variable.dtype)
             encoding = {} if dtype.kind == "f" else {"_FillValue": INT_FILL}

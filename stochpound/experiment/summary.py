@@ -39,6 +39,12 @@ _MOMENTS = tuple(RESPONSE_MOMENTS.values())
 _PEAKS = ("peak_total_displacement", "peak_relative_displacement", "peak_sliding_displacement", "residual_sliding")
 #: Summaries of the fixed-base reference (prefixed ``reference_`` in the store).
 REFERENCE_SUMMARIES = (*_MOMENTS, "peak_total_displacement", "peak_relative_displacement")
+#: Demand summaries kept with ``[output] demands = true``: name -> (result peak it reduces, long name).
+DEMAND_SUMMARIES = {
+    "peak_floor_acceleration": ("peak_total_acceleration", "largest peak total (absolute) floor acceleration over the building's floors"),
+    "peak_interstorey_drift": ("peak_storey_drift", "largest peak storey drift over the building's storeys"),
+    "peak_base_shear": ("peak_base_shear", "largest absolute base shear over the run"),
+}
 IMPACT_COLUMNS = (
     "impact_contact",
     "impact_start",
@@ -80,7 +86,17 @@ def case_summary(run: xr.Dataset, studied: str, fixed_base: xr.DataArray) -> xr.
         "correlation of the studied building's top-floor total displacement with the same building alone on a fixed base"
     )
     summary["events_total"] = xr.DataArray(np.int64(run.attrs.get("events_total", 0)), attrs={"units": "1", "long_name": "events located by the solver"})
-    return summary.merge(_contact_summary(run))
+    summary = summary.merge(_contact_summary(run))
+    return summary.merge(_demand_summary(run)) if "peak_total_acceleration" in run else summary
+
+
+def _demand_summary(run: xr.Dataset) -> xr.Dataset:
+    """Per building, the largest over its floors (storeys) of each demand peak (:data:`DEMAND_SUMMARIES`)."""
+    summary = xr.Dataset()
+    for name, (source, long_name) in DEMAND_SUMMARIES.items():
+        peak = run[source].max("floor") if "floor" in run[source].dims else run[source]
+        summary[name] = peak.assign_attrs(units=run[source].attrs["units"], long_name=long_name)
+    return summary
 
 
 def _contact_summary(run: xr.Dataset) -> xr.Dataset:
@@ -136,6 +152,18 @@ def case_values(run: xr.Dataset, studied: str, fixed_base: np.ndarray) -> dict[s
         "residual_sliding": kernels.final_value(s),
         "events_total": np.int64(run.attrs.get("events_total", 0)),
         **_contact_values(run),
+        **_demand_values(run),
+    }
+
+
+def _demand_values(run: xr.Dataset) -> dict[str, np.ndarray]:
+    """The values of :func:`_demand_summary` with the numpy kernels (none for a run without demands)."""
+    variables = run.variables
+    if "peak_total_acceleration" not in variables:
+        return {}
+    return {
+        name: kernels.abs_peak(variables[source].values, 1) if variables[source].ndim == 2 else variables[source].values.astype(float)
+        for name, (source, _) in DEMAND_SUMMARIES.items()
     }
 
 
@@ -220,7 +248,7 @@ def templates() -> tuple[xr.Dataset, xr.Dataset, xr.Dataset]:
         },
         source="template",
     )
-    run = simulate(scene, "ivp")  # the reference path: the tiny run only provides metadata
+    run = simulate(scene, "ivp", demands=True)  # the reference path: the tiny run only provides metadata
     response = top_floor_total_displacement(run, "A")
     return run, case_summary(run, "A", response), reference_summary(run.isel(building=[0]), "A")
 

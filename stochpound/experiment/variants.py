@@ -24,7 +24,7 @@ from typing import Any, Iterable, Mapping
 
 from stochpound.model import building as building_law
 from stochpound.model import contact as contact_law
-from stochpound.model.contact import effective_mass
+from stochpound.model.contact import ELEMENT_KEYS, effective_mass
 
 #: Motion used while validating a scene's structure (the real motion is set per case).
 PLACEHOLDER_MOTION = {"type": "constant", "acceleration": 0.0, "duration": 1.0, "dt": 1.0}
@@ -58,6 +58,7 @@ def apply_overrides(scene: Mapping[str, Any], overrides: Iterable[Mapping[str, A
     factors: dict[str, float] = {}
     for override in overrides:
         scene.update(copy.deepcopy(override.get("scene", {})))
+        _override_contacts(scene, override.get("contact"))
         for name, fields in override.get("building", {}).items():
             building = building_table(scene, name)
             for key, value in fields.items():
@@ -74,6 +75,24 @@ def apply_overrides(scene: Mapping[str, Any], overrides: Iterable[Mapping[str, A
     for name, factor in factors.items():
         scale_masses(scene, name, factor)
     return scene
+
+
+def _override_contacts(scene: dict[str, Any], part: Mapping[str, Any] | list | None) -> None:
+    """Replace impact-element fields of every contact (one table) or of each contact (a list, one table per contact).
+
+    A table that gives ``law`` replaces the element (the old law's
+    ``stiffness``, ``restitution``, ``damping`` and ``tensile`` go); one
+    without ``law`` replaces only the fields it gives.
+    """
+    if part is None:
+        return
+    contacts = scene.get("contact", [])
+    tables = part if isinstance(part, list) else [part] * len(contacts)
+    for contact, fields in zip(contacts, tables):
+        if "law" in fields:
+            for key in ELEMENT_KEYS:
+                contact.pop(key, None)
+        contact.update(copy.deepcopy(dict(fields)))
 
 
 def _set_base(building: dict[str, Any], value: Any) -> None:

@@ -189,7 +189,7 @@ def _contact_row(definition: StoreDefinition, scene: Scene, index: int, contact:
     m1, m2 = left.mass[contact.left_floor - 1], right.mass[contact.right_floor - 1]
     effective = m1 * m2 / (m1 + m2)
     axis = definition.gap_axis(index)
-    law = definition.definition["scene"]["contact"][index].get("law", "kelvin")
+    law = contact.law
     return (
         f"{left.name} floor {contact.left_floor} – {right.name} floor {contact.right_floor}",
         "linear Kelvin–Voigt" if law == "kelvin" else str(law),

@@ -53,6 +53,11 @@ QUANTITIES = {
         Quantity("peak_sliding_displacement", "peak sliding", "cm", CM),
         Quantity("residual_sliding", "residual sliding", "cm", CM),
     ),
+    "demands": (
+        Quantity("peak_floor_acceleration", "peak floor acceleration", "m/s²", 1.0),
+        Quantity("peak_interstorey_drift", "peak storey drift", "cm", CM),
+        Quantity("peak_base_shear", "peak base shear", "kN", KN),
+    ),
     "response": (
         Quantity("response_std", "std of the response", "cm", CM),
         Quantity("response_skewness", "skewness", "", 1.0),
@@ -63,6 +68,7 @@ QUANTITIES = {
 TABLE_CAPTIONS = {
     "pounding": "the probability of pounding with its Clopper–Pearson interval, the mean numbers of impacts in and out of phase, and the peak impact force over the realizations that pound",
     "displacements": "the studied building's peak displacements and residual sliding",
+    "demands": "the studied building's demands: the largest peak total floor acceleration and storey drift over its floors, and its peak base shear",
     "response": "moments of the studied building's top-floor total displacement over time, and its correlation with the same building alone on a fixed base",
 }
 
@@ -124,7 +130,7 @@ class Ensemble:
 
     def tables(self) -> list[Table]:
         """The pounding, displacement and response tables of every cell."""
-        return [self._table(kind) for kind in QUANTITIES]
+        return [self._table(kind) for kind in QUANTITIES if kind == "pounding" or any(f"{q.variable}_mean" in self.statistics for q in QUANTITIES[kind])]
 
     def _table(self, kind: str) -> Table:
         stats = self.statistics
@@ -297,6 +303,8 @@ class Ensemble:
             items += self.distributions(Quantity("peak_sliding_displacement", "peak sliding", "cm", CM))
         items += self.distributions(Quantity("peak_impact_force", "peak impact force", "kN", KN))
         items += self.distributions(Quantity("fixed_base_correlation", "correlation with the fixed-base twin", "", 1.0))
+        if "peak_floor_acceleration" in self.data:
+            items += self.distributions(QUANTITIES["demands"][0])
         items += self.convergence()
         return items
 

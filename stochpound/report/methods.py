@@ -58,12 +58,27 @@ def solver_paragraph(definitions: list[StoreDefinition]) -> Paragraph:
     by_solver: dict[str, list[str]] = {}
     for definition in definitions:
         solver = definition.definition["solver"]
+        integrated = f"scipy's {solver['integrator']} with event location (rtol {solver['rtol']:g}, atol {solver['atol']:g})"
         if solver["method"] == "exact":
             text = EXACT_TEXT
+        elif solver["method"] == "ivp":
+            text = integrated
         else:
-            text = f"scipy's {solver['integrator']} with event location (rtol {solver['rtol']:g}, atol {solver['atol']:g})"
+            text = _automatic_solver(definition, integrated)
         by_solver.setdefault(text, []).append(definition.name)
     return Paragraph(" ".join(f"{', '.join(names)}: every case is solved with {text}." for text, names in by_solver.items()))
+
+
+def _automatic_solver(definition: StoreDefinition, integrated: str) -> str:
+    """The solvers an ``auto`` store ran: exact where a configuration's laws are piecewise linear, the integrator elsewhere."""
+    nonlinear = {c.name: c.scene.nonlinear_laws() for c in definition.configurations}
+    linear = [name for name, laws in nonlinear.items() if not laws]
+    other = {name: laws for name, laws in nonlinear.items() if laws}
+    if not other:
+        return EXACT_TEXT
+    laws = sorted({law for found in other.values() for law in found})
+    text = f"{integrated} where a case has a nonlinear law ({'; '.join(laws)}: configurations {', '.join(other)})"
+    return text + (f", and {EXACT_TEXT} elsewhere ({', '.join(linear)})" if linear else "")
 
 
 def records_provenance(definitions: list[StoreDefinition]) -> Table:

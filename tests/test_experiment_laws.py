@@ -1,0 +1,132 @@
+"""Experiments over laws: variants that replace contacts' laws or add walls, the automatic solver, demand summaries."""
+
+from __future__ import annotations
+
+import copy
+
+import numpy as np
+import pytest
+
+import stochpound
+from stochpound.experiment import ExperimentError, load_experiment, open_store, run_experiment
+from stochpound.experiment.model import CASE
+from tests.conftest import reference_building, study_contacts
+from tests.test_experiment_helpers import write_experiment
+
+PAIR = """
+[experiment]
+name = "laws"
+studied = "B1"
+
+[scene]
+g = 9.814
+{buildings}
+{contacts}
+
+[variants.law.kelvin]
+[variants.law.hertz_damp.contact]
+law = "hertz_damp"
+stiffness = 2.75e9
+restitution = 0.5
+
+[variants.moat.none]
+[[variants.moat.near.scene.wall]]
+building = "B1"
+side = "left"
+level = 0
+gap = 0.002
+stiffness = 5.0e8
+restitution = 0.5
+
+[grid]
+gap = [0.005]
+mu = {{ values = [0.1], buildings = ["B1"] }}
+
+[[motions]]
+name = "pulse"
+type = "harmonic"
+amplitude = 3.0
+omega = 6.0
+duration = 3.0
+dt = 0.01
+
+[output]
+demands = true
+"""
+
+
+def _toml_tables(name: str, tables: list[dict]) -> str:
+    lines = []
+    for table in tables:
+        lines.append(f"[[scene.{name}]]")
+        nested = []
+        for key, value in table.items():
+            if isinstance(value, dict):
+                nested.append((key, value))
+            else:
+                lines.append(f"{key} = {value!r}".replace("'", '"').replace("True", "true").replace("False", "false"))
+        for key, value in nested:
+            lines.append(f"{key} = {{ {', '.join(f'{k} = {v!r}' for k, v in value.items())} }}")
+    return "\n".join(lines)
+
+
+def _pair_text() -> str:
+    buildings = [reference_building("B1", 1.0, 0.1), reference_building("B2", 2.0)]
+    return PAIR.format(buildings=_toml_tables("building", buildings), contacts=_toml_tables("contact", study_contacts(0.02)))
+
+
+@pytest.fixture(scope="module")
+def laws_store(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("laws")
+    report = run_experiment(load_experiment(write_experiment(folder, _pair_text(), "laws.toml")), workers=0, progress=False)
+    assert report.complete and not report.failed
+    return folder / "laws.toml", report.store
+
+
+def test_variants_replace_the_contact_law_and_add_a_wall(laws_store):
+    path, _ = laws_store
+    experiment = load_experiment(path)
+    structures = {(dict(c.labels)["law"], dict(c.labels)["moat"]): experiment.structure(c) for c in experiment.points(CASE)}
+    by_law = {law: s for (law, moat), s in structures.items() if moat == "none"}
+    kelvin, hertz = by_law["kelvin"]["contact"], by_law["hertz_damp"]["contact"]
+    assert [c["gap"] for c in hertz] == [0.005, 0.005] and all("law" not in c for c in kelvin)
+    for before, after in zip(kelvin, hertz):  # the law replaces the element; the flexible B2 keeps its contacts' ends and gap
+        assert after["between"] == before["between"] and after["law"] == "hertz_damp" and after["restitution"] == 0.5
+        assert after["stiffness"] == pytest.approx(2.75e9)
+    assert all(s["wall"][0]["gap"] == 0.002 for (_, moat), s in structures.items() if moat == "near")
+    assert all("wall" not in s for (_, moat), s in structures.items() if moat == "none")
+
+
+def test_store_equals_direct_runs_with_the_automatic_solver_and_demands(laws_store):
+    path, store = laws_store
+    experiment = load_experiment(path)
+    with open_store(store) as ds:
+        assert ds.attrs["solver"] == "auto"
+        for case in experiment.points(CASE):
+            labels = dict(case.labels)
+            scene_dict = copy.deepcopy(experiment.structure(case))
+            scene_dict["motion"] = {"type": "harmonic", "amplitude": 3.0, "omega": 6.0, "duration": 3.0, "dt": 0.01}
+            run = stochpound.simulate(stochpound.scene_from_dict(scene_dict), demands=True)
+            assert run.attrs["solver_choice"] == ("ivp" if labels["law"] == "hertz_damp" else "exact")
+            cell = ds.sel({k: v for k, v in labels.items() if k in ds.dims}, record="pulse", realization=0).sel(building="B1")
+            assert int(cell.impacts) == run.sizes["impact"] > 0
+            np.testing.assert_allclose(float(cell.peak_floor_acceleration), float(run.peak_total_acceleration.sel(building="B1").max()), rtol=1e-12)
+            np.testing.assert_allclose(float(cell.peak_interstorey_drift), float(run.peak_storey_drift.sel(building="B1").max()), rtol=1e-12)
+            np.testing.assert_allclose(float(cell.peak_base_shear), float(run.peak_base_shear.sel(building="B1")), rtol=1e-12)
+            walls = int((run.impact_wall >= 0).sum()) if "impact_wall" in run else 0
+            assert (walls > 0) == (labels["moat"] == "near")
+
+
+def test_bad_contact_overrides_name_the_field(tmp_path):
+    text = _pair_text()
+    for bad, message in (
+        ('[variants.law.hertz_damp.contact]\nlaw = "hertz_damp"\nstiffnes = 1.0', "variants.law.hertz_damp.contact.stiffnes"),
+        ('[[variants.law.hertz_damp.contact]]\nlaw = "hertz"\nstiffness = 1.0', "variants.law.hertz_damp.contact: a list must have one table per contact of the scene (2), got 1"),
+    ):
+        broken = text.replace('[variants.law.hertz_damp.contact]\nlaw = "hertz_damp"\nstiffness = 2.75e9\nrestitution = 0.5', bad)
+        with pytest.raises(ExperimentError, match=message.replace("(", r"\(").replace(")", r"\)").replace(".", r"\.")):
+            load_experiment(write_experiment(tmp_path, broken, "bad.toml"))
+    with pytest.raises(ExperimentError, match=r"output\.demands: must be true or false"):
+        load_experiment(write_experiment(tmp_path, text.replace("demands = true", 'demands = "yes"'), "bad.toml"))
+    with pytest.raises(ExperimentError, match=r"solver\.method: must be one of auto, exact, ivp"):
+        load_experiment(write_experiment(tmp_path, text + '\n[solver]\nmethod = "fast"\n', "bad.toml"))
