@@ -92,3 +92,22 @@ def test_storey_heights_are_validated():
     scene["building"][0]["storey_height"] = [3.5]
     with pytest.raises(stochpound.SceneError, match=r"building\[0\]\.storey_height: must have 2 values"):
         stochpound.scene_from_dict(scene)
+
+
+@pytest.mark.parametrize("law", ["hertz_damp", "jankowski"])
+def test_demands_of_a_nonlinear_law_follow_their_definitions(law):
+    """A nonlinear contact law runs on the read-out state ξ = [x, f]: drift, shear and the floors' equation of motion still hold."""
+    scene = pair(dt=0.01, duration=4.0)
+    for contact in scene["contact"]:
+        contact.update(law=law, stiffness=2.75e9, restitution=0.5)
+    result = stochpound.simulate(stochpound.scene_from_dict(scene), demands=True)
+    assert result.attrs["solver_choice"].startswith("nonlinear laws") and result.sizes["impact"] > 0
+    u = result.relative_displacement.values
+    drift = np.diff(np.concatenate([np.zeros_like(u[:, :1]), u], axis=1), axis=1)
+    np.testing.assert_allclose(result.storey_drift.values, drift, rtol=0, atol=1e-15)
+    # B2 (fixed, top floor): m a_total = -(shear of its top storey) - the contact force pushing it right
+    b2 = result.sel(building="B2")
+    mass = scene["building"][1]["mass"][1]
+    force = result.impact_force.isel(contact=1).values
+    np.testing.assert_allclose(mass * b2.total_acceleration.sel(floor=2).values, -b2.storey_shear.sel(floor=2).values + force,
+                               rtol=0, atol=1e-8 * np.abs(mass * b2.total_acceleration.sel(floor=2).values).max())

@@ -40,7 +40,7 @@ def experiment(data: dict) -> Experiment:
     [
         ({"grid__speed": [1.0]}, r"^grid\.speed: unknown axis \(allowed: gap, gap_<name>, mu, neighbour"),
         ({"grid__gap": []}, r"^grid\.gap: must be a non-empty list \(an empty axis makes an empty grid\)"),
-        ({"grid__gap": [0.01, -0.02]}, r"^grid\.gap\[1\]: must be >= 0, got -0.02"),
+        ({"grid__gap": [0.01, -0.02]}, r"^grid\.gap\[1\]: must be >= 0 or inf, got -0.02"),
         ({"grid__gap": [0.01, 0.01]}, r"^grid\.gap\[1\]: repeated value"),
         ({"grid__mu": {"values": [0.1, -0.1]}}, r"^grid\.mu\.values\[1\]: must be >= 0 or inf, got -0.1"),
         ({"grid__mu": {"values": [0.1], "buildings": ["B9"]}}, r"^grid\.mu\.buildings: must be a non-empty list of building names \(B1, B2\)"),
@@ -56,7 +56,7 @@ def experiment(data: dict) -> Experiment:
         ({"synthetic__kt__count": 0}, r"^synthetic\.kt\.count: must be an integer >= 1, got 0"),
         ({"synthetic__kt__seed": None}, r"^synthetic\.kt\.seed: missing"),
         ({"output__time_histories": ["velocity"]}, r"^output\.time_histories\[0\]: unknown variable 'velocity' \(allowed: total_displacement"),
-        ({"solver": {"method": "euler"}}, r"^solver\.method: must be one of exact, ivp, got 'euler'"),
+        ({"solver": {"method": "euler"}}, r"^solver\.method: must be one of auto, exact, ivp, got 'euler'"),
         ({"solver": {"rtol": -1.0}}, r"^solver\.rtol: must be > 0, got -1"),
         ({"experiment__studied": "B7"}, r"^experiment\.studied: must be one of the scene's buildings \(B1, B2\), got 'B7'"),
         ({"scene__building": []}, r"^case neighbour=stiff.*building: at least one \[\[building\]\] is required|experiment\.studied"),

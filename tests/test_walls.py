@@ -79,3 +79,12 @@ def test_walls_are_validated_with_the_field_named():
                  "motion": MOTION}
         with pytest.raises(stochpound.SceneError, match=message.replace("[", r"\[").replace("]", r"\]") if "\\" not in message else message):
             stochpound.scene_from_dict(copy.deepcopy(scene))
+
+
+def test_demands_leave_the_walls_peak_closures_and_impacts_as_they_are():
+    """With demands the run also monitors floor accelerations, drifts and shears; the walls' located peaks are still theirs."""
+    scene = stochpound.scene_from_dict(moat())
+    plain, with_demands = stochpound.simulate(scene), stochpound.simulate(scene, demands=True)
+    assert with_demands.sizes["wall"] == 2 and with_demands.sizes["impact"] == plain.sizes["impact"] > 0
+    for name in ("peak_wall_closure", "peak_wall_closure_time", "peak_contact_closure"):
+        np.testing.assert_allclose(with_demands[name].values, plain[name].values, rtol=0, atol=1e-12, err_msg=name)

@@ -57,6 +57,6 @@ def demand_rows(floor_dofs: list[np.ndarray], base_dofs: list[int | None], store
             if below is not None:
                 matrix[drift, below] = -1.0
             matrix[drift + floors, :n] = k[i] * matrix[drift, :n]
-            matrix[drift + floors, n:] = damping[i] * matrix[drift, :n]
+            matrix[drift + floors, n : 2 * n] = damping[i] * matrix[drift, :n]  # columns beyond 2N: read-outs (none in a shear)
             row += 1
     return matrix, ground, constant

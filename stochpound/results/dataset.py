@@ -95,7 +95,7 @@ def _response_variables(scene: Scene, system: System, recorder: Recorder) -> dic
 
 def _closure_variables(recorder: Recorder, n_contacts: int, kind: str) -> dict[str, tuple]:
     """The closure over time of each contact (``kind`` "contact", the first ``n_contacts`` elements) or wall, and its peak over the run, located on the solution."""
-    rows = slice(0, n_contacts) if kind == "contact" else slice(n_contacts, None)
+    rows = slice(0, n_contacts) if kind == "contact" else slice(n_contacts, recorder.system.n_elements)  # the demand monitors follow the elements
     toward = "y_left - y_right of the contact's floors" if kind == "contact" else "the level's displacement toward the wall"
     return {
         f"{kind}_closure": _var((kind, "time"), recorder.closure()[rows], "m", f"closure {toward} (the gap is closed where it reaches the gap)"),
