@@ -136,6 +136,8 @@ def layout(experiment: Experiment, motion_grids: Mapping[str, tuple[float, int]]
             if name in DEMAND_SUMMARIES and not experiment.output.get("demands", False):
                 continue
             extra = tuple(variable.dims)
+            if any(sizes[d] == 0 for d in extra):  # e.g. per-contact summaries of a scene without contacts
+                continue
             dtype = _store_dtype(variable.dtype)
             encoding = {} if dtype.kind == "f" else {"_FillValue": INT_FILL}
             specs.append(Spec(name, kind, "summary", dims + extra, dtype, dict(variable_attrs(name)), chunks + tuple(sizes[d] for d in extra), encoding))
