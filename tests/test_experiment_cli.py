@@ -83,7 +83,7 @@ def test_with_several_files_every_error_names_its_file(tmp_path):
     bad = write_experiment(tmp_path, SMALL_EXPERIMENT.replace("gap = [0.01, 0.02]", "gap = [0.01, -0.02]"), "bad.toml")
     result = invoke("experiment", "run", str(good), str(bad), "--workers", "0")
     assert result.exit_code == 1
-    assert result.stderr.strip() == f"Error: {bad}: grid.gap[1]: must be >= 0, got -0.02"
+    assert result.stderr.strip() == f"Error: {bad}: grid.gap[1]: must be >= 0 or inf, got -0.02"
     assert not (tmp_path / "good.nc").exists(), "every file is checked before any runs"
 
 
