@@ -10,6 +10,7 @@ with the exact solver to the accuracy its regularised elements allow.
 from __future__ import annotations
 
 import dataclasses
+import os
 
 import numpy as np
 import pytest
@@ -91,9 +92,12 @@ def test_study_scheme_rejects_a_restart_interval_that_does_not_divide_the_sample
 
 
 def opensees_or_skip():
+    """OpenSeesPy (the test extra installs it); skip without it, except under CI, where the cross-check must run."""
     try:
         return load_opensees()
     except OpenSeesUnavailable as error:
+        if os.environ.get("CI"):
+            raise
         pytest.skip(str(error))
 
 
