@@ -27,7 +27,7 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from stochpound.analysis import pounding_curve, required_separation, rule_exceedance, separation_rules, store_contact_demands
+from stochpound.analysis import pounding_curve, pounding_probability, required_separation, rule_exceedance, separation_rules, store_contact_demands
 from stochpound.analysis.separation import TARGET_PROBABILITIES
 from stochpound.report import figures
 from stochpound.report.document import Block, FigureItem, Paragraph, Section, Table
@@ -56,6 +56,11 @@ def has_contact_free(store: xr.Dataset) -> bool:
     return bool(dims) and all(np.isinf(store[d].values).any() for d in dims)
 
 
+def contact_free(store: xr.Dataset) -> xr.Dataset:
+    """The store's contact-free cases (``inf`` on every gap axis; the gap coordinates dropped)."""
+    return store.sel({d: np.inf for d in gap_dims(store)}, drop=True)
+
+
 def with_contacts(store: xr.Dataset) -> xr.Dataset:
     """The store without its contact-free cases (the finite values of every gap axis)."""
     return store.sel({d: store[d].values[np.isfinite(store[d].values)] for d in gap_dims(store)})
@@ -63,10 +68,9 @@ def with_contacts(store: xr.Dataset) -> xr.Dataset:
 
 def separation_section(name: str, store: xr.Dataset) -> Section:
     """The "Separation" section of one store (call when :func:`has_contact_free`)."""
-    free = store.sel({d: np.inf for d in gap_dims(store)}, drop=True)
+    free = contact_free(store)
     section = Section(f"Separation: experiment {name}", key=f"separation-{name}")
-    for block in _method_blocks(store, free):
-        section.add(block)
+    section.add(_method_paragraph(store))
     kinds = dict(zip(store["record"].values.tolist(), store["record_kind"].values.tolist()))
     records = [label for label, kind in kinds.items() if kind != "synthetic"]
     if records:
@@ -77,7 +81,7 @@ def separation_section(name: str, store: xr.Dataset) -> Section:
     return section
 
 
-def _method_blocks(store: xr.Dataset, free: xr.Dataset) -> list[Block]:
+def _method_paragraph(store: xr.Dataset) -> Paragraph:
     contacts = store.sizes.get("contact", 0)
     axes = ", ".join(gap_dims(store))
     sliding = "mu" in store.dims and bool(np.isfinite(store["mu"].values).any())
@@ -95,7 +99,7 @@ def _method_blocks(store: xr.Dataset, free: xr.Dataset) -> list[Block]:
             " The store has sliding bases: the rules come from the linear theory of fixed-base buildings, and no such theory "
             "covers a sliding building, so their comparison with the probability of pounding is new for the isolated cases."
         )
-    return [Paragraph(text)]
+    return Paragraph(text)
 
 
 def _rule_gaps(free: xr.Dataset) -> xr.DataArray:
@@ -122,11 +126,14 @@ class SeparationEnsemble:
     """The contact-free cells of one synthetic ensemble and the separation they call for."""
 
     def __init__(self, name: str, store: xr.Dataset, label: str, confidence: float = 0.95) -> None:
-        self.ensemble = Ensemble(name, store.sel({d: np.inf for d in gap_dims(store)}, drop=True), label, confidence)
-        self.with_contacts = Ensemble(name, with_contacts(store), label, confidence) if any(np.isfinite(store[d].values).any() for d in gap_dims(store)) else None
+        self.ensemble = Ensemble(name, contact_free(store), label, confidence)
         self.name, self.label, self.confidence = name, label, confidence
-        self.closure = self.ensemble.data["peak_contact_closure"].load()
-        self.demand = self.closure.max("contact", skipna=False)
+        self.demand = self.ensemble.data["peak_contact_closure"].load().max("contact", skipna=False)
+        # the runs at the grid's finite gaps, compared with D when one gap axis sets every gap
+        axes = gap_dims(store)
+        finite = store[axes[0]].values[np.isfinite(store[axes[0]].values)] if len(axes) == 1 else []
+        self.gap_axis = axes[0] if len(finite) else None
+        self.impacts = Ensemble(name, with_contacts(store), label, confidence).data["impacts"].load() if self.gap_axis else None
 
     def blocks(self) -> list[Block]:
         """Findings, tables and figures, in reading order."""
@@ -146,12 +153,11 @@ class SeparationEnsemble:
 
     def _identity_check(self) -> list[Block]:
         """Runs at the store's finite gaps against the contact-free closures of the same realizations."""
-        if self.with_contacts is None:
+        if self.gap_axis is None:
             return []
-        axis = gap_dims(self.with_contacts.data)[0]
-        impacts = self.with_contacts.data["impacts"].load()
+        axis, impacts = self.gap_axis, self.impacts
         pounded = (impacts > 0).where(impacts.notnull())
-        gaps = xr.DataArray(self.with_contacts.data[axis].values, dims=axis)
+        gaps = xr.DataArray(impacts[axis].values, dims=axis)
         reached = (self.demand >= gaps).where(self.demand.notnull())
         both = pounded.notnull() & reached.notnull()
         ties = both & (abs(self.demand - gaps) <= 1e-9)
@@ -234,8 +240,8 @@ class SeparationEnsemble:
         top = float(np.quantile(finite, 0.995)) if finite.size else 0.1  # the far tail of one cell would squeeze the others
         gaps = np.linspace(0.0, 1.05 * top, 211)
         curve = pounding_curve(self.demand, gaps, confidence=self.confidence, contact_dim=None).compute()
-        direct = self.with_contacts.statistics if self.with_contacts is not None else None
-        axis = gap_dims(self.with_contacts.data)[0] if self.with_contacts is not None else None
+        axis = self.gap_axis
+        direct = pounding_probability(self.impacts, confidence=self.confidence)["probability"].compute() if axis else None
         line_dim = ensemble.line_dim()
 
         def curves(panel: dict[str, Any]) -> list[figures.Curve]:
@@ -248,7 +254,7 @@ class SeparationEnsemble:
                     runs = direct.sel(where)
                     result.append(figures.Curve(
                         "runs at the grid's gaps (squares)",
-                        runs[axis].values * CM, runs["pounding_probability"].values, color=colour, style="none", marker="s", gid=ensemble.gid(where),
+                        runs[axis].values * CM, runs.values, color=colour, style="none", marker="s", gid=ensemble.gid(where),
                     ))
             return result
 
