@@ -5,8 +5,10 @@ ensemble of ground accelerations (e.g. from :func:`stochpound.motions.kanai_taji
 and returns one :class:`xarray.Dataset` with a ``realization`` dimension.
 Realizations are simulated in batches, optionally in worker processes; each
 realization is computed on its own, so the result does not depend on the
-batch size or the number of workers. Only what ``keep`` asks for is held in
-memory: a summaries-only ensemble holds one batch of histories at a time.
+batch size or the number of workers. Each realization's result is the
+dataset of :func:`stochpound.simulate` (names, units and long names as
+there); only what ``keep`` asks for is held in memory: a summaries-only
+ensemble holds one batch of results at a time.
 
 Summaries per realization (see :mod:`stochpound.analysis`):
 
@@ -32,7 +34,6 @@ import os
 from collections import deque
 from collections.abc import Iterator
 from concurrent.futures import ProcessPoolExecutor
-from typing import Any
 
 import numpy as np
 import xarray as xr
@@ -44,14 +45,18 @@ from stochpound.analysis.names import ENSEMBLE_ALIASES, with_aliases
 from stochpound.analysis.summary import response_moments
 from stochpound.memory import check_memory, sample_bytes
 from stochpound.motions.ground import SampledMotion
-from stochpound.results.record import ENERGY_TERMS, EventCounters, Recorder
 from stochpound.model.scene import Scene
-from stochpound.solvers.exact import run_exact
-from stochpound.solvers.ivp import run_ivp
+from stochpound.results.record import ENERGY_TERMS
+from stochpound.solvers.simulate import simulate
 
 KEEP = ("summary", "histories")
 """What an ensemble keeps: summaries only, or also the displacement and impact force histories."""
 METHODS = ("exact", "ivp")
+HISTORIES = ("total_displacement", "relative_displacement", "sliding_displacement", "impact_force")
+"""The time histories an ensemble keeps with ``keep="histories"`` (the names of :func:`stochpound.simulate`)."""
+IMPACT_COLUMNS = ("impact_in_phase", "impact_peak_force", "impact_duration", "impact_impulse")
+FINAL_ENERGIES = tuple(f"energy_{term}" for term in ENERGY_TERMS)
+EVENT_COUNTS = ("events_total", "events_chatter_cycles")
 
 
 def simulate_ensemble(
@@ -183,48 +188,20 @@ def _sample_spacing(motions: xr.DataArray) -> float:
 
 
 def _simulate_batch(scene: Scene, values: np.ndarray, labels: np.ndarray, dt: float, keep: str, method: str) -> xr.Dataset:
-    """Simulate and summarise one batch of realizations (``values``: realization × time, m/s²)."""
+    """Simulate and summarise one batch of realizations (``values``: realization × time, m/s²).
+
+    Each realization's result is the dataset of :func:`stochpound.simulate`
+    (the toolkit's one result builder); the batch stacks what it needs of them.
+    """
     interpolation = scene.motion.interpolation if isinstance(scene.motion, SampledMotion) else "linear"
-    runs = []
     with threadpool_limits(limits=1):
-        for label, samples in zip(labels, values):
-            motion = SampledMotion(dt, samples, interpolation, f"realization {label}")
-            runs.append(_run(dataclasses.replace(scene, motion=motion), method))
-    histories = _histories(scene, runs)
-    summary = xr.merge([peak_response(histories), _top_floor_moments(scene, histories), _impacts(runs), _energies(runs)])
+        runs = [simulate(dataclasses.replace(scene, motion=SampledMotion(dt, samples, interpolation, f"realization {label}")), method)
+                for label, samples in zip(labels, values)]
+    histories = xr.concat([run[list(HISTORIES)] for run in runs], "realization", coords="minimal", compat="override", join="override")
+    summary = xr.merge([peak_response(histories), _top_floor_moments(scene, histories), impact_statistics(_impact_tables(runs)), _final_values(runs)])
     if keep == "histories":
         summary = summary.merge(histories)
     return summary.assign_coords(realization=labels)
-
-
-def _run(scene: Scene, method: str) -> tuple[Recorder, EventCounters, Any]:
-    if method == "exact":
-        return run_exact(scene, limit_threads=False)
-    return run_ivp(scene)
-
-
-def _histories(scene: Scene, runs: list) -> xr.Dataset:
-    """Displacement and impact force histories of a batch (realization, ...)."""
-    n_floors = scene.max_floors
-    relative, sliding = (np.array(arrays) for arrays in zip(*(recorder.displacements() for recorder, _, _ in runs)))
-    shape = relative.shape
-    forces = np.array([recorder.forces.T for recorder, _, _ in runs])
-    dims = ("realization", "building", "floor", "time")
-    coords = {"building": scene.building_names, "floor": np.arange(1, n_floors + 1), "time": np.arange(shape[-1]) * _spacing(runs)}
-    return xr.Dataset(
-        {
-            "total_displacement": (dims, relative + sliding[:, :, None, :], {"units": "m"}),
-            "relative_displacement": (dims, relative, {"units": "m"}),
-            "sliding_displacement": (("realization", "building", "time"), sliding, {"units": "m"}),
-            "impact_force": (("realization", "contact", "time"), forces, {"units": "N"}),
-        },
-        coords=coords,
-    )
-
-
-def _spacing(runs: list) -> float:
-    times = runs[0][0].motion.times
-    return float(times[1] - times[0])
 
 
 def _top_floor_moments(scene: Scene, histories: xr.Dataset) -> xr.Dataset:
@@ -234,22 +211,21 @@ def _top_floor_moments(scene: Scene, histories: xr.Dataset) -> xr.Dataset:
     return response_moments(top_floor.assign_attrs(units="m"))
 
 
-def _impacts(runs: list) -> xr.Dataset:
-    """Impact statistics of each realization, from the batch's impact tables padded with NaN to (realization, impact)."""
-    rows = [[(i.in_phase, i.peak_force, i.end - i.start, i.impulse) for i in recorder.impacts] for recorder, _, _ in runs]
-    table = np.full((len(rows), max(map(len, rows)), 4), np.nan)
-    for r, impacts in enumerate(rows):
-        table[r, : len(impacts)] = np.reshape(impacts, (-1, 4))
-    names = ("impact_in_phase", "impact_peak_force", "impact_duration", "impact_impulse")
-    return impact_statistics(xr.Dataset({name: (("realization", "impact"), table[..., j]) for j, name in enumerate(names)}))
+def _impact_tables(runs: list[xr.Dataset]) -> xr.Dataset:
+    """The batch's impact tables, padded with NaN to (realization, impact)."""
+    longest = max(run.sizes.get("impact", 0) for run in runs)
+    tables = {}
+    for name in IMPACT_COLUMNS:
+        table = np.full((len(runs), longest), np.nan)
+        for row, run in zip(table, runs):
+            row[: run.sizes.get("impact", 0)] = run[name].values
+        tables[name] = (("realization", "impact"), table)
+    return xr.Dataset(tables)
 
 
-def _energies(runs: list) -> xr.Dataset:
-    """Final energy terms and event counts of each realization."""
-    variables: dict[str, tuple] = {}
-    for term in ENERGY_TERMS:
-        variables[f"energy_{term}"] = ("realization", [rec.energy[term][-1] for rec, _, _ in runs], {"units": "J"})
-    variables["events_total"] = ("realization", [counters.total for _, counters, _ in runs])
-    variables["events_chatter_cycles"] = ("realization", [counters.chatter_cycles for _, counters, _ in runs])
+def _final_values(runs: list[xr.Dataset]) -> xr.Dataset:
+    """The final energy terms (J) and the event counts of each realization."""
+    variables = {name: ("realization", [run[name].values[-1] for run in runs], runs[0][name].attrs) for name in FINAL_ENERGIES}
+    for name in EVENT_COUNTS:
+        variables[name] = ("realization", [run.attrs[name] for run in runs])
     return xr.Dataset(variables)
-

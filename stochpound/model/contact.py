@@ -33,7 +33,7 @@ as ``damping``) is multiplied by the same ratio, which keeps its damping ratio.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass
 from typing import Any, Mapping, Sequence
 
 import numpy as np
@@ -53,22 +53,18 @@ PIECEWISE_LINEAR = True
 
 
 @dataclass(frozen=True)
-class Contact:
-    """A linear Kelvin–Voigt impact element between neighbouring floors.
+class ImpactElement:
+    """The impact element itself, the same for a contact between floors and a wall (:mod:`stochpound.model.wall`).
 
     Attributes
     ----------
-    left, right : int
-        Indices (0-based, in the scene's building list) of the left building
-        and its right-hand neighbour (``right == left + 1``).
-    left_floor, right_floor : int
-        Floors (1-based) that can collide.
     gap : float
-        At-rest gap d, m (>= 0; inf: the contact never closes). Penetration is δ = y_left − y_right − d.
+        At-rest gap d, m (>= 0; inf: the element never closes, and a run
+        still records its closure).
     stiffness : float
-        Impact spring k_imp, N/m (> 0).
+        Impact spring k, N/m (> 0); N/m^1.5 for the Hertz family.
     damping : float
-        Impact dashpot c_imp, N·s/m (>= 0); derived from ``restitution`` when given.
+        Impact dashpot c, N·s/m (>= 0); derived from ``restitution`` when given.
     restitution : float or None
         Coefficient of restitution r in (0, 1] the damping was derived from.
     tensile : bool
@@ -77,19 +73,35 @@ class Contact:
         returns to 0 and never pulls. The nonlinear laws separate at δ = 0
         and never pull (True).
     law : str
-        The contact law (:data:`LAWS`); the Hertz family's ``stiffness`` is in N/m^1.5.
+        The contact law (:data:`LAWS`).
     """
 
-    left: int
-    left_floor: int
-    right: int
-    right_floor: int
     gap: float
     stiffness: float
     damping: float
     restitution: float | None = None
     tensile: bool = True
     law: str = "kelvin"
+
+
+@dataclass(frozen=True, kw_only=True)
+class Contact(ImpactElement):
+    """An impact element between neighbouring floors (the element's fields: :class:`ImpactElement`).
+
+    Attributes
+    ----------
+    left, right : int
+        Indices (0-based, in the scene's building list) of the left building
+        and its right-hand neighbour (``right == left + 1``).
+    left_floor, right_floor : int
+        Floors (1-based) that can collide. The penetration is
+        δ = y_left − y_right − d.
+    """
+
+    left: int
+    left_floor: int
+    right: int
+    right_floor: int
 
 
 def restitution_damping_ratio(restitution: float) -> float:
@@ -122,24 +134,24 @@ def contact_from_table(table: Mapping[str, Any], prefix: str, buildings: Sequenc
             f"{prefix}.between: contacts join neighbours, left building first; "
             f"{buildings[left].name!r} and {buildings[right].name!r} are not left/right neighbours"
         )
-    gap = fields.number(table, "gap", prefix, required=True, low=0.0, allow_inf=True)
     mass = effective_mass(buildings[left].mass[left_floor - 1], buildings[right].mass[right_floor - 1])
-    return Contact(left, left_floor, right, right_floor, gap, *element_from_table(table, prefix, mass))
+    return Contact(left=left, left_floor=left_floor, right=right, right_floor=right_floor, **asdict(element_from_table(table, prefix, mass)))
 
 
-def element_from_table(table: Mapping[str, Any], prefix: str, mass: float) -> tuple[float, float, float | None, bool, str]:
-    """The impact element of a ``[[contact]]`` or ``[[wall]]`` table: (stiffness, damping N·s/m, restitution or None, tensile, law).
+def element_from_table(table: Mapping[str, Any], prefix: str, mass: float) -> ImpactElement:
+    """The impact element of a ``[[contact]]`` or ``[[wall]]`` table, validated.
 
     ``mass`` is the effective mass m_eff of the collision (kg) that turns a
     restitution into a Kelvin–Voigt dashpot. The stiffness is in N/m for
     ``kelvin``, N/m^1.5 for the nonlinear laws (which have no dashpot and
     never pull: damping 0, tensile).
     """
+    gap = fields.number(table, "gap", prefix, required=True, low=0.0, allow_inf=True)
     law = fields.string(table, "law", prefix, default="kelvin")
     if law not in LAWS:
         raise SceneError(f"{prefix}.law: must be one of {', '.join(LAWS)}; got {law!r}")
     if law != "kelvin":
-        return _nonlinear_element(table, prefix, law)
+        return _nonlinear_element(table, prefix, gap, law)
     stiffness = fields.number(table, "stiffness", prefix, required=True, low=0.0, low_open=True)
     restitution = None
     if "restitution" in table and "damping" in table:
@@ -150,10 +162,10 @@ def element_from_table(table: Mapping[str, Any], prefix: str, mass: float) -> tu
         restitution = fields.number(table, "restitution", prefix, required=True, low=0.0, low_open=True, high=1.0)
         damping = 2.0 * restitution_damping_ratio(restitution) * math.sqrt(stiffness * mass)
     tensile = fields.boolean(table, "tensile", prefix, default=True)
-    return stiffness, damping, restitution, tensile, law
+    return ImpactElement(gap, stiffness, damping, restitution, tensile, law)
 
 
-def _nonlinear_element(table: Mapping[str, Any], prefix: str, law: str) -> tuple[float, float, float | None, bool, str]:
+def _nonlinear_element(table: Mapping[str, Any], prefix: str, gap: float, law: str) -> ImpactElement:
     for key in ("damping", "tensile"):
         if key in table:
             raise SceneError(f"{prefix}.{key}: not a field of law {law!r} (its damping follows from restitution; it never pulls)")
@@ -161,9 +173,9 @@ def _nonlinear_element(table: Mapping[str, Any], prefix: str, law: str) -> tuple
     if law == "hertz":
         if "restitution" in table:
             raise SceneError(f"{prefix}.restitution: law 'hertz' is elastic; use law = 'hertz_damp' or 'jankowski' for a restitution")
-        return stiffness, 0.0, None, True, law
+        return ImpactElement(gap, stiffness, 0.0, None, True, law)
     restitution = fields.number(table, "restitution", prefix, required=True, low=0.0, low_open=True, high=1.0, high_open=law == "jankowski")
-    return stiffness, 0.0, restitution, True, law
+    return ImpactElement(gap, stiffness, 0.0, restitution, True, law)
 
 
 def _contact_end(value: Any, path: str, buildings: Sequence[Building]) -> tuple[int, int]:

@@ -24,21 +24,21 @@ Mass scaling (experiment variants): as a contact's, with m_eff = m.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass
 from typing import Any, Mapping, Sequence
 
 from stochpound.errors import SceneError
 from stochpound.model import fields
 from stochpound.model.building import Building
-from stochpound.model.contact import ELEMENT_KEYS, element_from_table
+from stochpound.model.contact import ELEMENT_KEYS, ImpactElement, element_from_table
 
 WALL_KEYS = {"building", "side", "level", "gap"} | ELEMENT_KEYS
 SIDES = {"left": -1, "right": 1}
 
 
-@dataclass(frozen=True)
-class Wall:
-    """A rigid wall moving with the ground, beside one level of a building.
+@dataclass(frozen=True, kw_only=True)
+class Wall(ImpactElement):
+    """A rigid wall moving with the ground, beside one level of a building (the element's fields: :class:`~stochpound.model.contact.ImpactElement`).
 
     Attributes
     ----------
@@ -48,27 +48,11 @@ class Wall:
         +1: the wall is on the building's right; −1: on its left.
     level : int
         0: the base (a moat wall); i ≥ 1: floor i.
-    gap : float
-        At-rest gap d, m (>= 0; inf: never reached).
-    stiffness, damping : float
-        The impact element: k (N/m) and c (N·s/m).
-    restitution : float or None
-        Coefficient of restitution the damping was derived from.
-    tensile : bool
-        False: the element separates when its force returns to 0.
-    law : str
-        The contact law of the element (:data:`stochpound.model.contact.LAWS`).
     """
 
     building: int
     side: int
     level: int
-    gap: float
-    stiffness: float
-    damping: float
-    restitution: float | None = None
-    tensile: bool = True
-    law: str = "kelvin"
 
     @property
     def side_name(self) -> str:
@@ -97,6 +81,5 @@ def wall_from_table(table: Mapping[str, Any], prefix: str, buildings: Sequence[B
         raise SceneError(f"{prefix}.level: must be 0 (the base) or a floor number in 1..{building.n_floors} for building {name!r}, got {level!r}")
     if level == 0 and building.base is None:
         raise SceneError(f"{prefix}.level: 0 is the base, and building {name!r} has a fixed base (a moat wall needs a [building.base])")
-    gap = fields.number(table, "gap", prefix, required=True, low=0.0, allow_inf=True)
     mass = building.base.mass if level == 0 else building.mass[level - 1]
-    return Wall(names.index(name), SIDES[side], level, gap, *element_from_table(table, prefix, mass))
+    return Wall(building=names.index(name), side=SIDES[side], level=level, **asdict(element_from_table(table, prefix, mass)))
