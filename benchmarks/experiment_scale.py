@@ -32,11 +32,14 @@ from pathlib import Path
 from typing import Any, Callable
 
 from benchmarks import report
+from benchmarks.sections import Section
 from benchmarks.timing import REPOSITORY, run_subprocess, single_thread_environment
 from tests.test_experiment_helpers import quickstart_cell
 
 START = "<!-- experiments at scale: start -->"
 END = "<!-- experiments at scale: end -->"
+SECTION = Section(START, END)
+"""This benchmark's section of docs/benchmarks.md."""
 SIZES = (1_000, 10_000, 100_000, 1_000_000)
 MOTIONS = """
 [synthetic.kt_firm]
@@ -80,7 +83,7 @@ def main(argv: list[str] | None = None) -> int:
         results = measure(Path(folder), arguments, log)
     results["elapsed"] = time.perf_counter() - started
     info["load average (1 min) at end"] = f"{os.getloadavg()[0]:.2f}"
-    write_section(arguments.out, section(results, info))
+    SECTION.write(arguments.out, section(results, info))
     log(f"wrote the section 'Experiments at scale' of {arguments.out}")
     return 0
 
@@ -313,22 +316,3 @@ def _analysis_paragraph(results: dict[str, Any]) -> str:
         f"largest force and the in-phase count over the {analysis['impacts']:,} rows of the impact table took {analysis['elapsed']:.1f} s, "
         f"peak memory {analysis['peak_total'] / 2**20:.0f} MiB (probability of pounding {analysis['probability']:.4f})."
     )
-
-
-def write_section(path: Path, text: str) -> None:
-    """Replace the section between :data:`START` and :data:`END` of ``path`` (appended if it has none)."""
-    document = path.read_text() if path.exists() else ""
-    if START in document and END in document:
-        head, rest = document.split(START, 1)
-        document = head + text.strip() + rest.split(END, 1)[1]
-    else:
-        document = document.rstrip() + "\n\n" + text
-    path.write_text(document if document.endswith("\n") else document + "\n")
-
-
-def keep_section(old: str, new: str) -> str:
-    """The main suite's new document ``new`` with the section of ``old`` (its previous version) kept at the end."""
-    if START not in old or END not in old:
-        return new
-    kept = START + old.split(START, 1)[1].split(END, 1)[0] + END
-    return new.rstrip() + "\n\n" + kept + "\n"

@@ -1,7 +1,8 @@
 """Command line of the benchmark suite: ``python -m benchmarks`` or ``python benchmarks/run.py``.
 
 ``python -m benchmarks scaling`` runs the experiment-scaling benchmark instead
-(:mod:`benchmarks.experiment_scale`).
+(:mod:`benchmarks.experiment_scale`), ``python -m benchmarks compare REV`` the
+comparison with an earlier revision (:mod:`benchmarks.compare`).
 
 The thread pools of BLAS, OpenMP and numba are set to one thread here,
 before numpy is imported, so that every in-process measurement runs on one core.
@@ -24,7 +25,8 @@ import tempfile  # noqa: E402
 import time  # noqa: E402
 from pathlib import Path  # noqa: E402
 
-from benchmarks import experiment_scale, report, suite  # noqa: E402
+from benchmarks import compare, experiment_scale, report, suite  # noqa: E402
+from benchmarks.sections import keep_sections  # noqa: E402
 from benchmarks.timing import REPOSITORY  # noqa: E402
 
 
@@ -51,6 +53,8 @@ def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else argv
     if argv[:1] == ["scaling"]:
         return experiment_scale.main(argv[1:])
+    if argv[:1] == ["compare"]:
+        return compare.main(argv[1:])
     arguments = parse_arguments(argv)
     config = suite.Config.quick_preset() if arguments.quick else suite.Config.full()
     if arguments.no_opensees:
@@ -62,7 +66,8 @@ def main(argv: list[str] | None = None) -> int:
     elapsed = time.perf_counter() - start
     figure = report.figure(results, folder / "figures" / report.FIGURE_NAME)
     markdown = folder / "benchmarks.md"
-    markdown.write_text(experiment_scale.keep_section(markdown.read_text() if markdown.exists() else "", report.document(results, info, elapsed)))
+    old = markdown.read_text() if markdown.exists() else ""
+    markdown.write_text(keep_sections(old, report.document(results, info, elapsed), (experiment_scale.SECTION, compare.SECTION)))
     print(f"wrote {markdown} and {figure} in {elapsed:.1f} s")
     return 0
 

@@ -225,11 +225,17 @@ def _copy(source, target):
 
 @njit(**INTERNAL)
 def _product(transposed, vector, out):
-    """out = Mᵀ vector for M = ``transposed``: a column at a time (vectorised; the sums of row dot products)."""
+    """out = Mᵀ vector for M = ``transposed``: a column at a time (vectorised; the sums of row dot products).
+
+    Zero entries of ``vector`` are skipped (they add nothing to a finite M):
+    the ground's higher coefficients under linear interpolation, a stuck base.
+    """
     for i in range(out.shape[0]):
         out[i] = 0.0
     for j in range(vector.shape[0]):
         value = vector[j]
+        if value == 0.0:
+            continue
         for i in range(out.shape[0]):
             out[i] += transposed[j, i] * value
 
@@ -268,11 +274,12 @@ def _read_outs(M, xi, xi_rate, ground, ground_rate, values, rates):
 
 
 @njit(**INTERNAL)
-def _guards_and_rates(rate, guard, x, ground, ground_rate, values, rates, work):
-    """Values of the first len(values) rows of ``guard`` (guards or monitors) and their rates on an exact flow (ẋ into ``work``)."""
+def _guards_and_rates(rate, guard, monitor, x, ground, ground_rate, values, rates, monitor_values, monitor_rates, work):
+    """The first len(values) guards and len(monitor_values) monitors and their rates at (x, a_g) on an exact flow (ẋ, computed once, into ``work``)."""
     for i in range(rate.shape[0]):
         work[i] = _affine(rate, i, x, ground)
     _read_outs(guard, x, work, ground, ground_rate, values, rates)
+    _read_outs(monitor, x, work, ground, ground_rate, monitor_values, monitor_rates)
 
 
 @njit(**INTERNAL)
@@ -468,6 +475,20 @@ def _any_maximum_may_beat(values0, values1, rates0, rates1, h, peaks):
 
 
 @njit(**INTERNAL)
+def _sub_step_monitors(flow, chebyshev, z0, t1, values0, values1, rates0, rates1, peaks, work):
+    """The monitors' peaks over an exact sub-step [flow.t0, t1] from z0 (:func:`_monitor_peaks`).
+
+    The sub-step's Chebyshev coefficients (``chebyshev`` z0, into
+    ``flow.coefficients``) are computed only when a maximum inside may beat a peak.
+    """
+    if _any_maximum_may_beat(values0, values1, rates0, rates1, t1 - flow.t0, peaks):
+        _product(chebyshev, z0, flow.coefficients)
+        _monitor_peaks(flow, t1, values0, values1, rates0, rates1, peaks, work)
+    else:
+        _offer_monitors(values1, t1, peaks)
+
+
+@njit(**INTERNAL)
 def _monitor_peaks(flow, t1, values0, values1, rates0, rates1, peaks, work):
     """Offer the monitors' values at t1 and their maxima inside [flow.t0, t1], located on the flow, as their peaks.
 
@@ -522,8 +543,7 @@ def _advance_quiet(mode_id, n, substeps, step, propagate, chebyshev, rate, guard
         _copy(x, x0)
         _copy(forcing[k], z0[size : size + 4])
         z0[width - 1] = 1.0
-        _guards_and_rates(rate, guard, x0, z0[size], z0[size + 1], values0, rates0, work)
-        _guards_and_rates(rate, monitor, x0, z0[size], z0[size + 1], monitors0, monitor_rates0, work)
+        _guards_and_rates(rate, guard, monitor, x0, z0[size], z0[size + 1], values0, rates0, monitors0, monitor_rates0, work)
         for j in range(substeps):
             _product(propagate, z0, propagated)
             t0 = times[k] + j * h
@@ -537,13 +557,9 @@ def _advance_quiet(mode_id, n, substeps, step, propagate, chebyshev, rate, guard
                 return
             _sub_step_energy(z0, propagated, is_open, impact[IMPULSE], running)
             _arm_where_negative(values1, threshold, tolerance, rearmable, disarmed)
-            if _any_maximum_may_beat(monitors0, monitors1, monitor_rates0, monitor_rates1, h, peaks):
-                _product(chebyshev, z0, coefficients)
-                flow = Flow(rate, guard, force, monitor, coefficients, harmonic if is_harmonic else motion.coefficients[k], times[k], is_harmonic,
-                            t0, 2.0 / step)
-                _monitor_peaks(flow, t1, monitors0, monitors1, monitor_rates0, monitor_rates1, peaks, work)
-            else:
-                _offer_monitors(monitors1, t1, peaks)
+            flow = Flow(rate, guard, force, monitor, coefficients, harmonic if is_harmonic else motion.coefficients[k], times[k], is_harmonic, t0,
+                        2.0 / step)
+            _sub_step_monitors(flow, chebyshev, z0, t1, monitors0, monitors1, monitor_rates0, monitor_rates1, peaks, work)
             _copy(values1, values0)
             _copy(rates1, rates0)
             _copy(monitors1, monitors0)
@@ -619,11 +635,12 @@ def _flow_rate(flow, t, xi, ground, out):
 
 
 @njit(**INTERNAL)
-def _flow_read_outs(flow, M, t, xi, values, rates, work):
-    """The first len(values) rows of M (guards or monitors) and their rates at t, ξ(t) given (ξ̇ into ``work``)."""
-    ground = _ground_value(flow, t)
+def _flow_read_outs(flow, t, xi, values, rates, monitor_values, monitor_rates, work):
+    """The first len(values) guards and len(monitor_values) monitors and their rates at t on the flow, ξ(t) given (ξ̇, computed once, into ``work``)."""
+    ground, ground_rate = _ground_value(flow, t), _ground_rate(flow, t)
     _flow_rate(flow, t, xi, ground, work[: xi.shape[0]])
-    _read_outs(M, xi, work, ground, _ground_rate(flow, t), values, rates)
+    _read_outs(flow.guard, xi, work, ground, ground_rate, values, rates)
+    _read_outs(flow.monitor, xi, work, ground, ground_rate, monitor_values, monitor_rates)
 
 
 @njit(**INTERNAL)
@@ -1161,7 +1178,8 @@ def _settle_pending(modes, codes, n_guards, rate, guard, force, monitor, motion,
                     n_transitions)
     n_monitors = monitor.shape[1]
     monitors, monitor_rates = scratch[24, :n_monitors], scratch[26, :n_monitors]
-    _guards_and_rates(rate[m], monitor[m], settled, ground[0], ground[1], monitors, monitor_rates, scratch[2])
+    _guards_and_rates(rate[m], guard[m], monitor[m], settled, ground[0], ground[1], monitors[:0], monitor_rates[:0], monitors, monitor_rates,
+                      scratch[2])
     _offer_monitors(monitors, clock[0], peaks)  # a monitor may jump with the mode (e.g. an acceleration at impact)
     _copy(settled, x)
     return m
@@ -1218,8 +1236,8 @@ def _locate_and_record(flow, m, modes, codes, force, power, ints, clock, x0, x1,
                     impact[PEAK, p], impact[PEAK_TIME, p] = value, t_peak
         n_monitors = flow.monitor.shape[0]
         monitors0, monitors1, monitor_rates0, monitor_rates1 = scratch[24, :n_monitors], scratch[25, :n_monitors], scratch[26, :n_monitors], scratch[27, :n_monitors]
-        _flow_read_outs(flow, flow.monitor, t0, x0, monitors0, monitor_rates0, work)
-        _flow_read_outs(flow, flow.monitor, t_stop, x_stop, monitors1, monitor_rates1, work)
+        if fired >= 0:  # the caller gave the monitors at t1
+            _flow_read_outs(flow, t_stop, x_stop, values1[:0], rates1[:0], monitors1, monitor_rates1, work)
         _monitor_peaks(flow, t_stop, monitors0, monitors1, monitor_rates0, monitor_rates1, peaks, work)
     if fired < 0:
         return False
@@ -1230,16 +1248,6 @@ def _locate_and_record(flow, m, modes, codes, force, power, ints, clock, x0, x1,
     ints[PENDING] = EVENT
     ints[TOTAL] += 1
     return True
-
-
-@njit(**INTERNAL)
-def _sub_step_monitors(flow, t1, x0, x1, peaks, scratch):
-    """The monitors' peaks over a sub-step [flow.t0, t1] from x0 to x1 that needs no event code (:func:`_monitor_peaks`)."""
-    n_monitors, work = flow.monitor.shape[0], scratch[2]
-    monitors0, monitors1, monitor_rates0, monitor_rates1 = scratch[24, :n_monitors], scratch[25, :n_monitors], scratch[26, :n_monitors], scratch[27, :n_monitors]
-    _flow_read_outs(flow, flow.monitor, flow.t0, x0, monitors0, monitor_rates0, work)
-    _flow_read_outs(flow, flow.monitor, t1, x1, monitors1, monitor_rates1, work)
-    _monitor_peaks(flow, t1, monitors0, monitors1, monitor_rates0, monitor_rates1, peaks, work)
 
 
 @njit(inline="always", error_model="numpy")
@@ -1263,6 +1271,8 @@ def _advance_span(m, n, modes, codes, substeps, step, propagate, chebyshev, rate
     width = size + 5
     z0, propagated = scratch[0, :width], scratch[1, : propagate.shape[1]]
     values0, values1, rates0, rates1 = scratch[3, :n], scratch[4, :n], scratch[5, :n], scratch[6, :n]
+    n_monitors = monitor.shape[0]
+    monitors0, monitors1, monitor_rates0, monitor_rates1 = scratch[24, :n_monitors], scratch[25, :n_monitors], scratch[26, :n_monitors], scratch[27, :n_monitors]
     rate_work, ground1, coefficients = scratch[7, :size], scratch[8, :4], scratch[9, : chebyshev.shape[1]]
     x1 = propagated[:size]
     is_harmonic = harmonic.shape[0] > 0
@@ -1275,19 +1285,18 @@ def _advance_span(m, n, modes, codes, substeps, step, propagate, chebyshev, rate
         _ground(times, coefficients_k, harmonic, t0, k, z0[size : size + 4])
         z0[width - 1] = 1.0
         flow = Flow(rate, guard, force, monitor, coefficients, ground, times[k], is_harmonic, t0, 2.0 / step)
-        _guards_and_rates(rate, guard, x, z0[size], z0[size + 1], values0, rates0, rate_work)
+        _guards_and_rates(rate, guard, monitor, x, z0[size], z0[size + 1], values0, rates0, monitors0, monitor_rates0, rate_work)
         if full:
             _product(propagate, z0, propagated)
         else:
             _product(chebyshev, z0, coefficients)
             _dense(flow, t1, x1)
         _ground(times, coefficients_k, harmonic, t1, k, ground1)
-        _guards_and_rates(rate, guard, x1, ground1[0], ground1[1], values1, rates1, rate_work)
+        _guards_and_rates(rate, guard, monitor, x1, ground1[0], ground1[1], values1, rates1, monitors1, monitor_rates1, rate_work)
         if full and not _suspect(values0, values1, rates0, rates1, t1 - t0, threshold, tolerance) and not any_open:
             _sub_step_energy(z0, propagated, is_open, impact[IMPULSE], running)
             _arm_where_negative(values1, threshold, tolerance, rearmable, disarmed)
-            _product(chebyshev, z0, coefficients)
-            _sub_step_monitors(flow, t1, x, x1, peaks, scratch)
+            _sub_step_monitors(flow, chebyshev, z0, t1, monitors0, monitors1, monitor_rates0, monitor_rates1, peaks, scratch[2])
             _copy(x1, x)
             continue
         if full:
@@ -1314,8 +1323,10 @@ def _supplied_step(m, n, modes, codes, rate, guard, force, monitor, power, motio
     is_harmonic = harmonic.shape[0] > 0
     ground = harmonic if is_harmonic else motion.coefficients[k]
     flow = Flow(rate, guard, force, monitor, supplied.coefficients, ground, times[k], is_harmonic, t0, 2.0 / (t1 - t0))
-    _flow_read_outs(flow, guard, t0, x, values0, rates0, scratch[2])
-    _flow_read_outs(flow, guard, t1, supplied.x, values1, rates1, scratch[2])
+    n_monitors = monitor.shape[0]
+    monitors0, monitors1, monitor_rates0, monitor_rates1 = scratch[24, :n_monitors], scratch[25, :n_monitors], scratch[26, :n_monitors], scratch[27, :n_monitors]
+    _flow_read_outs(flow, t0, x, values0, rates0, monitors0, monitor_rates0, scratch[2])
+    _flow_read_outs(flow, t1, supplied.x, values1, rates1, monitors1, monitor_rates1, scratch[2])
     if _locate_and_record(flow, m, modes, codes, force, power, ints, clock, x, supplied.x, pending_x, pending_mode, arming, is_open, impact,
                           running, peaks, t1, values0, values1, rates0, rates1, scratch):
         return True

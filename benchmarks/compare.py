@@ -1,0 +1,174 @@
+"""The exact solver against an earlier revision of the project, measured in one session: ``python -m benchmarks compare REV``.
+
+Warm-speed figures measured on different days are not comparable (the
+machine's speed varies by 2x from one day to the next, docs/benchmarks.md).
+This benchmark checks out ``REV`` (``git archive``) beside the working tree
+and times both in alternating rounds, each round in fresh single-threaded
+processes, on the study scenes (a), (b) and (c) under El Centro:
+
+* ``simulate`` warm (the result dataset included) and the engine alone
+  (``run_exact``: the recorded outputs, no dataset), best of the repeats of
+  each round, then the best and the median over the rounds;
+* the first call, with numba's cache in an empty folder (compile time), in
+  the first round;
+* the outputs compared: number of impacts and peak top-floor displacement of
+  Building 1 (m).
+
+It rewrites the section "Against an earlier revision" of
+``docs/benchmarks.md`` (between :data:`SECTION`'s markers; the main suite
+keeps it when it rewrites the file).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import statistics
+import subprocess
+import tempfile
+import time
+from pathlib import Path
+from typing import Any
+
+from benchmarks import report
+from benchmarks.sections import Section
+from benchmarks.timing import REPOSITORY, run_subprocess
+
+SECTION = Section("<!-- against an earlier revision: start -->", "<!-- against an earlier revision: end -->")
+"""This benchmark's section of docs/benchmarks.md."""
+SCENES = {"a": (0.2, None, 2.0, 0.02), "b": (None, None, 2.0, 0.02), "c": (0.1, 0.1, 0.5, 0.01)}
+"""The study scenes (μ1, μ2, mass factor of Building 2, gap in m), as in :mod:`benchmarks.scenes`."""
+
+PROBE = """
+import json, sys, time
+sys.path.insert(0, {tree!r})
+import stochpound
+assert stochpound.__file__.startswith({tree!r}), stochpound.__file__
+from tests.conftest import study_scene
+try:
+    from stochpound.solvers.exact import run_exact
+except ImportError:  # the layout before issue 16
+    from stochpound.exact import run_exact
+
+def best(call, repeats):
+    times = []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        call()
+        times.append(time.perf_counter() - start)
+    return min(times)
+
+out = {{}}
+for key, arguments in {scenes!r}.items():
+    scene = stochpound.scene_from_dict(study_scene(*arguments))
+    start = time.perf_counter()
+    result = stochpound.simulate(scene, method="exact")
+    first = time.perf_counter() - start
+    top = result.total_displacement.sel(building="B1").isel(floor=-1)
+    out[key] = {{
+        "first_call": first,
+        "simulate": best(lambda: stochpound.simulate(scene, method="exact"), {repeats}),
+        "engine": best(lambda: run_exact(scene), {repeats}),
+        "impacts": int(result.sizes["impact"]),
+        "peak": float(abs(top).max()),
+    }}
+print(json.dumps(out))
+"""
+
+
+def parse_arguments(argv: list[str] | None) -> argparse.Namespace:
+    """Options of ``python -m benchmarks compare``."""
+    parser = argparse.ArgumentParser(prog="python -m benchmarks compare", description=__doc__.splitlines()[0])
+    parser.add_argument("revision", help="the earlier revision (a commit, tag or branch of this repository)")
+    parser.add_argument("--rounds", type=int, default=5, help="alternating rounds (default 5)")
+    parser.add_argument("--repeats", type=int, default=30, help="timed calls per scene and round (default 30)")
+    parser.add_argument("--out", type=Path, default=REPOSITORY / "docs" / "benchmarks.md", help="the Markdown file whose section is rewritten")
+    return parser.parse_args(argv)
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Measure both trees and rewrite the section of ``--out``."""
+    arguments = parse_arguments(argv)
+    info = report.machine()
+    started = time.perf_counter()
+    with tempfile.TemporaryDirectory(prefix="stochpound-compare-") as folder:
+        earlier = Path(folder) / "earlier"
+        checkout(arguments.revision, earlier)
+        trees = {"this tree": REPOSITORY, arguments.revision: earlier}
+        rounds = measure(trees, arguments.rounds, arguments.repeats, Path(folder))
+    results = {"revision": arguments.revision, "head": _head(), "rounds": rounds, "repeats": arguments.repeats,
+               "elapsed": time.perf_counter() - started}
+    SECTION.write(arguments.out, section(results, info))
+    print(f"wrote the section 'Against an earlier revision' of {arguments.out} in {results['elapsed']:.0f} s")
+    return 0
+
+
+def checkout(revision: str, folder: Path) -> None:
+    """The files of ``revision`` in ``folder`` (``git archive``; the working tree is left alone)."""
+    folder.mkdir(parents=True)
+    archive = subprocess.run(["git", "archive", "--format=tar", revision], cwd=REPOSITORY, capture_output=True, check=True).stdout
+    subprocess.run(["tar", "-x", "-C", str(folder)], input=archive, check=True)
+
+
+def measure(trees: dict[str, Path], rounds: int, repeats: int, folder: Path) -> dict[str, list[dict[str, Any]]]:
+    """Every tree's probe, in alternating rounds; the first round of each tree with numba's cache in an empty folder."""
+    measured: dict[str, list[dict[str, Any]]] = {name: [] for name in trees}
+    for round_ in range(rounds):
+        for index, (name, tree) in enumerate(trees.items()):
+            cache = folder / f"numba-cache-{index}"
+            code = PROBE.format(tree=str(tree), scenes=SCENES, repeats=repeats)
+            measured[name].append(run_subprocess(code, extra_env={"NUMBA_CACHE_DIR": str(cache)}))
+            print(f"round {round_ + 1}: {name} {json.dumps(measured[name][-1])}", flush=True)
+    return measured
+
+
+def _head() -> str:
+    """The working tree's commit (short hash), with ``+`` when it has uncommitted changes."""
+    commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=REPOSITORY, capture_output=True, text=True).stdout.strip()
+    dirty = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no"], cwd=REPOSITORY, capture_output=True, text=True).stdout.strip()
+    return commit + ("+" if dirty else "")
+
+
+def section(results: dict[str, Any], info: dict[str, str]) -> str:
+    """The Markdown section, markers included."""
+    names = list(results["rounds"])
+    this, earlier = names
+    lines = [
+        SECTION.start,
+        "## Against an earlier revision",
+        "",
+        f"`python -m benchmarks compare {results['revision']}` ({results['elapsed'] / 60:.0f} min): this tree ({results['head']}) and "
+        f"revision {results['revision']} timed in {len(results['rounds'][this])} alternating rounds in one session, each round in fresh "
+        f"single-threaded processes, {results['repeats']} calls per scene and round; the study scenes under El Centro. Times in ms: best "
+        "over the rounds (median of the rounds' bests). *simulate* is the warm call with its result dataset; *engine* is `run_exact` "
+        "alone (the recorded outputs, no dataset). The first call compiles the engine into an empty numba cache.",
+        "",
+        f"| scene | quantity | {this} | {earlier} | ratio (best) |",
+        "|---|---|---:|---:|---:|",
+    ]
+    for key in SCENES:
+        for quantity in ("simulate", "engine"):
+            ours, theirs = (_times(results["rounds"][name], key, quantity) for name in (this, earlier))
+            lines.append(f"| ({key}) | {quantity} | {_cell(ours)} | {_cell(theirs)} | {min(ours) / min(theirs):.3f} |")
+    first = {name: results["rounds"][name][0]["a"]["first_call"] for name in names}
+    lines.append(f"| (a) | first call (s) | {first[this]:.1f} | {first[earlier]:.1f} | {first[this] / first[earlier]:.2f} |")
+    lines += ["", _outputs_sentence(results, this, earlier), "", "Machine: " + "; ".join(f"{k} {v}" for k, v in info.items()) + ".", SECTION.end]
+    return "\n".join(lines) + "\n"
+
+
+def _times(rounds: list[dict[str, Any]], key: str, quantity: str) -> list[float]:
+    """The rounds' best times (ms) of one scene and quantity."""
+    return [1e3 * measured[key][quantity] for measured in rounds]
+
+
+def _cell(times: list[float]) -> str:
+    return f"{min(times):.2f} ({statistics.median(times):.2f})"
+
+
+def _outputs_sentence(results: dict[str, Any], this: str, earlier: str) -> str:
+    """Whether both trees gave the same impacts and peak displacements."""
+    parts = []
+    for key in SCENES:
+        ours, theirs = results["rounds"][this][0][key], results["rounds"][earlier][0][key]
+        parts.append(f"({key}) {ours['impacts']} and {theirs['impacts']} impacts, peaks differ by {abs(ours['peak'] - theirs['peak']):.1e} m")
+    return "Outputs of the two trees: " + "; ".join(parts) + "."
