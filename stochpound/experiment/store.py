@@ -262,7 +262,10 @@ def open_store(path: str | Path, chunks: Any = None) -> xr.Dataset:
     -------
     xarray.Dataset
         Summaries on the grid's dimensions, time histories, the impact table
-        and the provenance attributes; nothing is loaded until computed.
+        and the provenance attributes, loaded when computed; only the impact
+        table's string coordinates (``impact_case_id`` and the string labels
+        of the grid's dimensions) are read on opening, as xarray decodes
+        variable-length strings eagerly (0.2–0.3 KB per impact row).
 
     Raises
     ------
