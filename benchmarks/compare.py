@@ -96,7 +96,7 @@ def main(argv: list[str] | None = None) -> int:
         checkout(arguments.revision, earlier)
         trees = {"this tree": REPOSITORY, arguments.revision: earlier}
         rounds = measure(trees, arguments.rounds, arguments.repeats, Path(folder))
-    results = {"revision": arguments.revision, "head": _head(), "rounds": rounds, "repeats": arguments.repeats,
+    results = {"revision": arguments.revision, "head": info["commit"], "rounds": rounds, "repeats": arguments.repeats,
                "elapsed": time.perf_counter() - started}
     SECTION.write(arguments.out, section(results, info))
     print(f"wrote the section 'Against an earlier revision' of {arguments.out} in {results['elapsed']:.0f} s")
@@ -120,13 +120,6 @@ def measure(trees: dict[str, Path], rounds: int, repeats: int, folder: Path) -> 
             measured[name].append(run_subprocess(code, extra_env={"NUMBA_CACHE_DIR": str(cache)}))
             print(f"round {round_ + 1}: {name} {json.dumps(measured[name][-1])}", flush=True)
     return measured
-
-
-def _head() -> str:
-    """The working tree's commit (short hash), with ``+`` when it has uncommitted changes."""
-    commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=REPOSITORY, capture_output=True, text=True).stdout.strip()
-    dirty = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no"], cwd=REPOSITORY, capture_output=True, text=True).stdout.strip()
-    return commit + ("+" if dirty else "")
 
 
 def section(results: dict[str, Any], info: dict[str, str]) -> str:

@@ -8,6 +8,8 @@ import xarray as xr
 from stochpound.analysis import kernels
 from stochpound.analysis.ufunc import reduce
 
+TABLE_COLUMNS = ("impact_in_phase", "impact_peak_force", "impact_duration", "impact_impulse")
+"""The impact-table columns :func:`impact_statistics` reads."""
 _ATTRS = {
     "impacts": {"units": "1", "long_name": "number of impacts"},
     "impacts_in_phase": {"units": "1", "long_name": "impacts with both floors moving the same way at onset"},
@@ -47,7 +49,7 @@ def impact_statistics(run: xr.Dataset, dim: str = "impact", valid: xr.DataArray 
         when there is no impact.
     """
     valid = run["impact_peak_force"].notnull() if valid is None else valid.astype(bool)
-    columns = [run[name] for name in ("impact_in_phase", "impact_peak_force", "impact_duration", "impact_impulse")]
+    columns = [run[name] for name in TABLE_COLUMNS]
     names = kernels.ImpactCounts._fields
     values = reduce(lambda *arrays: tuple(kernels.impact_counts(*arrays)), [*columns, valid], [dim], len(names), [np.int64] * 3 + [float] * 3)
     return xr.Dataset({name: value.assign_attrs(_ATTRS[name]) for name, value in zip(names, values)})

@@ -41,6 +41,7 @@ from threadpoolctl import threadpool_limits
 
 from stochpound import __version__
 from stochpound.analysis import impact_statistics, peak_response
+from stochpound.analysis.impacts import TABLE_COLUMNS
 from stochpound.analysis.names import ENSEMBLE_ALIASES, with_aliases
 from stochpound.analysis.summary import response_moments
 from stochpound.memory import check_memory, sample_bytes
@@ -54,7 +55,6 @@ KEEP = ("summary", "histories")
 METHODS = ("exact", "ivp")
 HISTORIES = ("total_displacement", "relative_displacement", "sliding_displacement", "impact_force")
 """The time histories an ensemble keeps with ``keep="histories"`` (the names of :func:`stochpound.simulate`)."""
-IMPACT_COLUMNS = ("impact_in_phase", "impact_peak_force", "impact_duration", "impact_impulse")
 FINAL_ENERGIES = tuple(f"energy_{term}" for term in ENERGY_TERMS)
 EVENT_COUNTS = ("events_total", "events_chatter_cycles")
 
@@ -212,10 +212,10 @@ def _top_floor_moments(scene: Scene, histories: xr.Dataset) -> xr.Dataset:
 
 
 def _impact_tables(runs: list[xr.Dataset]) -> xr.Dataset:
-    """The batch's impact tables, padded with NaN to (realization, impact)."""
+    """The batch's impact tables (the columns :func:`~stochpound.analysis.impact_statistics` reads), padded with NaN to (realization, impact)."""
     longest = max(run.sizes.get("impact", 0) for run in runs)
     tables = {}
-    for name in IMPACT_COLUMNS:
+    for name in TABLE_COLUMNS:
         table = np.full((len(runs), longest), np.nan)
         for row, run in zip(table, runs):
             row[: run.sizes.get("impact", 0)] = run[name].values
