@@ -28,20 +28,20 @@ def _timed(call: Callable[[], Any]) -> tuple[float, Any]:
 def first_call() -> None:
     """Import, scene (a), then exact runs: the first compiles or loads the numba kernels; the best of 100 warm ones.
 
-    Also reports the LLVM optimisation level the engine was compiled at
-    (``NUMBA_OPT`` if set, else the engine's own).
+    Also reports the compile settings: numba's default when ``NUMBA_OPT`` is
+    set, else the engine's own (:mod:`stochpound.solvers.compiling`).
     """
     import os
     import sys
 
     imported, scene = _timed(_main_scene)
     import stochpound
-    from stochpound.solvers.engine import OPTIMISATION_LEVEL
+    from stochpound.solvers.compiling import OPTIMISATION_LEVEL
 
     first, _ = _timed(lambda: stochpound.simulate(scene))
     second, _ = _timed(lambda: stochpound.simulate(scene))
     warm = min(_timed(lambda: stochpound.simulate(scene))[0] for _ in range(100))
-    level = os.environ.get("NUMBA_OPT", str(OPTIMISATION_LEVEL))
+    level = f"numba's default (LLVM {os.environ['NUMBA_OPT']})" if "NUMBA_OPT" in os.environ else f"stochpound's (LLVM {OPTIMISATION_LEVEL})"
     _emit({"import": imported, "first": first, "second": second, "warm": warm, "level": level, "numba": "numba" in sys.modules})
 
 

@@ -336,15 +336,16 @@ def _compile_section(results: Results) -> str:
     return (
         "## First call\n\nScene (a) in a fresh process: import and scene building, the first `simulate` "
         "(compiles or loads the numba kernels and builds the mode propagators), a second call and the best of 100 warm calls; "
-        "one row per process, each with its own empty numba cache (the engine's LLVM optimisation level, then numba's default, "
-        "alternating), then one that finds the first level's last cache filled.\n\n"
-        + _table(["numba cache", "LLVM level", "import + scene (s)", "first call (s)", "second call (ms)", "best warm call (ms)", "numba loaded"], rows)
+        "one row per process, each with its own empty numba cache (the engine's compile settings, "
+        "`stochpound.solvers.compiling`: LLVM level 1 and no machine code for the helpers of their own; then numba's default, "
+        "alternating), then one that finds the first settings' last cache filled.\n\n"
+        + _table(["numba cache", "compile settings", "import + scene (s)", "first call (s)", "second call (ms)", "best warm call (ms)", "numba loaded"], rows)
         + _level_comparison(data)
     )
 
 
 def _level_comparison(data: dict[str, Any]) -> str:
-    """Medians of compile time and warm time at the engine's optimisation level and at numba's default."""
+    """Medians of compile time and warm time under the engine's compile settings and numba's default."""
     pairs = [(run, other) for run, other in zip(data["cold"], data.get("cold_default_level", []), strict=False)
              if "error" not in run and "error" not in other and "warm" in run and "warm" in other]
     if not pairs:
@@ -352,7 +353,7 @@ def _level_comparison(data: dict[str, Any]) -> str:
     compiled = [statistics.median(_compile_seconds(one) for one in side) for side in zip(*pairs, strict=True)]
     warm = [statistics.median(one["warm"] for one in side) * 1e3 for side in zip(*pairs, strict=True)]
     return (
-        f"\n\nMedians over these runs, the engine's level {pairs[0][0]['level']} against numba's default {pairs[0][1]['level']}: "
+        f"\n\nMedians over these runs, {pairs[0][0]['level']} settings against {pairs[0][1]['level']}: "
         f"compile (first call minus second) {compiled[0]:.3g} s against {compiled[1]:.3g} s ({compiled[0] / compiled[1]:.2f}×), "
         f"best warm call {warm[0]:.3g} ms against {warm[1]:.3g} ms ({warm[0] / warm[1]:.2f}×).\n"
     )

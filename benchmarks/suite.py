@@ -311,10 +311,10 @@ def ensemble_available() -> bool:
 def compile_time(config: Config) -> dict[str, Any]:
     """First-call time of the exact solver in fresh processes: ``compile_runs`` with an empty numba cache, then one filled.
 
-    Each empty-cache run is followed by one at numba's default optimisation
-    level (``NUMBA_OPT=3``, ``cold_default_level``), which the engine lowers
-    (:data:`stochpound.solvers.engine.OPTIMISATION_LEVEL`): the pairs
-    show what that saves and that it costs no speed.
+    Each empty-cache run is followed by one under numba's default compile
+    settings (``NUMBA_OPT=3``, ``cold_default_level``), which the engine's
+    own replace (:mod:`stochpound.solvers.compiling`): the pairs show what
+    they save and that they cost no speed.
     """
     import os
     import tempfile

@@ -53,27 +53,25 @@ its fields), so everything is compiled without numba's runtime
 (``_nrt=False``): the engine allocates nothing (every work vector is a row of
 the arrays of :func:`work_arrays`), and it calls no builtin ``min`` or
 ``max`` (each compiles an overload; the comparisons written out give the same
-results). LLVM optimises it at level 1 (:data:`OPTIMISATION_LEVEL`, set by
-:func:`run` around the first call). All jitted code lives in this one module,
-whose source stamp is what invalidates numba's cache.
+results). :func:`run` compiles it inside
+:func:`~stochpound.solvers.compiling.engine_compile`: LLVM level 1, and no
+machine code for the helpers of their own (they are optimised and turned
+into machine code once, inside :func:`run_engine`). All jitted code lives in
+this one module, whose source stamp is what invalidates numba's cache (the
+compile settings change no result, so they need not).
 """
 
 from __future__ import annotations
 
-import contextlib
 import math
-import os
 from collections import namedtuple
-from collections.abc import Iterator
 
-import numba
 import numpy as np
 from numba import njit
-from numba.core.compiler_lock import global_compiler_lock
-from numba.core.registry import cpu_target
 
 from stochpound.model.friction import STUCK
 from stochpound.model.guards import Guard
+from stochpound.solvers.compiling import engine_compile, numba_default_requested
 from stochpound.solvers.propagators import GAUSS_NODES, GAUSS_WEIGHTS
 
 ROUND_OFF = 1e-10
@@ -1417,43 +1415,14 @@ def run_engine(table, dynamics, propagators, motion, layout, run, arming, impact
         _record_sample(x, running, ids[m], states, energy, sample_modes, k + 1)
 
 
-OPTIMISATION_LEVEL = 1
-"""LLVM optimisation level of the engine's compile (numba's default, ``NUMBA_OPT``, is 3).
-
-Level 1 compiles the engine about a fifth faster with the same speed: its hot
-loops are vectorised at either level (``LOOP_VECTORIZE`` stays on), and the
-passes level 3 adds find nothing more to gain in it (docs/benchmarks.md). It
-changes no result: LLVM keeps IEEE semantics at every level (no fast-math).
-A ``NUMBA_OPT`` set in the environment is left in force.
-"""
-
-
 _COMPILED: list[bool] = []
 
 
 def run(*arguments: object) -> int:
-    """Call :func:`run_engine`: a process's first call compiles it (or loads it from numba's cache) at :data:`OPTIMISATION_LEVEL`."""
-    if _COMPILED or numba.config.DISABLE_JIT or "NUMBA_OPT" in os.environ:
+    """Call :func:`run_engine`: a process's first call compiles it (or loads it from numba's cache) in :func:`~stochpound.solvers.compiling.engine_compile`."""
+    if _COMPILED or numba_default_requested():
         return run_engine(*arguments)
-    with _optimisation_level(OPTIMISATION_LEVEL):
+    with engine_compile():
         status = run_engine(*arguments)
     _COMPILED.append(True)
     return status
-
-
-@contextlib.contextmanager
-def _optimisation_level(level: int) -> Iterator[None]:
-    """numba's LLVM optimisation passes at ``level`` inside the block (the compiler lock held: no other thread compiles).
-
-    numba reads ``numba.config.OPT`` whenever it builds a pass pipeline. The
-    code generator, which reads it once per process, is created first at the
-    default level so that it stays there for every later compile.
-    """
-    with global_compiler_lock:
-        cpu_target.target_context  # noqa: B018 (creates the code generator)
-        default = numba.config.OPT
-        numba.config.OPT = type(default)(level)
-        try:
-            yield
-        finally:
-            numba.config.OPT = default

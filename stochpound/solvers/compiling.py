@@ -1,0 +1,160 @@
+"""How the event engine is compiled: two numba settings beyond its public options.
+
+The engine (:mod:`stochpound.solvers.engine`) is one jitted entry point,
+``run_engine``, and about fifty jitted helpers without Python wrappers that
+only it calls. numba compiles it on a process's first call unless its cache
+(``cache=True``) holds it; :func:`engine_compile` is the block that first
+call runs in. Inside it:
+
+* **LLVM optimisation level** :data:`OPTIMISATION_LEVEL` (numba's default,
+  ``NUMBA_OPT``, is 3): the engine's hot loops are vectorised at either
+  level and the passes level 3 adds find nothing more to gain in it, so it
+  compiles faster and runs as fast (docs/benchmarks.md, "First call").
+* **No machine code for the helpers.** numba finalises every function it
+  compiles, wrapper or not: it optimises the function's module and
+  generates its machine code, although a helper without a Python wrapper is
+  only ever linked, as LLVM IR, into its callers, which optimise and
+  generate code for it again (numba pull request 9566 proposes to skip this
+  upstream). Inside the block a library whose function has no Python
+  wrapper stays unfinalised: it is linked into its callers as its
+  function-optimised IR, and only ``run_engine``'s library, with every
+  helper linked in, is optimised as a module and turned into machine code.
+
+Neither setting changes a result: LLVM keeps IEEE semantics at every level
+(no fast-math), and the same IR is optimised, only once instead of once per
+function (the outputs are compared bitwise with numba's default compile in
+``tests/test_exact.py``). A ``NUMBA_OPT`` set in the environment turns both
+off: the engine then compiles exactly as numba would by default.
+
+Both reach into numba's internals (its compiler lock, configuration, CPU
+target context and code libraries); ``pyproject.toml`` bounds numba's
+version to the releases they were checked with.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+from collections.abc import Iterator
+from typing import Any
+
+import llvmlite.binding as llvm
+import numba
+from numba import _dynfunc
+from numba.core.codegen import JITCodeLibrary
+from numba.core.compiler_lock import global_compiler_lock
+from numba.core.registry import cpu_target
+
+OPTIMISATION_LEVEL = 1
+"""LLVM optimisation level of the engine's compile (numba's default, ``NUMBA_OPT``, is 3)."""
+
+
+def numba_default_requested() -> bool:
+    """True when the environment asks for numba's own compile settings (``NUMBA_OPT`` set) or for no compile (``NUMBA_DISABLE_JIT``)."""
+    return "NUMBA_OPT" in os.environ or bool(numba.config.DISABLE_JIT)
+
+
+@contextlib.contextmanager
+def engine_compile() -> Iterator[None]:
+    """The block in which the engine is compiled: :data:`OPTIMISATION_LEVEL` and no machine code for wrapper-less helpers.
+
+    numba's compiler lock is held throughout, so no other thread compiles
+    under these settings; everything is restored on leaving the block, also
+    when it raises.
+    """
+    with global_compiler_lock, optimisation_level(OPTIMISATION_LEVEL), _helpers_without_machine_code():
+        yield
+
+
+@contextlib.contextmanager
+def optimisation_level(level: int) -> Iterator[None]:
+    """numba's LLVM optimisation passes at ``level`` inside the block (numba's compiler lock held).
+
+    Parameters
+    ----------
+    level : int
+        LLVM optimisation level, 0 to 3 (numba's ``NUMBA_OPT``).
+
+    Notes
+    -----
+    numba reads ``numba.config.OPT`` whenever it builds a pass pipeline. The
+    code generator, which reads it once per process, is created first at the
+    default level so that it stays there for every later compile.
+    """
+    with global_compiler_lock:
+        cpu_target.target_context  # noqa: B018 (creates the code generator)
+        default = numba.config.OPT
+        numba.config.OPT = type(default)(level)
+        try:
+            yield
+        finally:
+            numba.config.OPT = default
+
+
+class _LinkedOnlyLibrary(JITCodeLibrary):
+    """A code library that links wrapper-less functions into its callers unfinalised (see the module docstring).
+
+    A library is marked ``linked_only`` by :func:`_executable` when its
+    function has no Python wrapper. Such a library is never finalised while
+    it is only linked: its callers link its function-optimised module with
+    its own callees' linked in (as numba's finalised module would hold them).
+    Anything else (inspection, a caller compiled outside the block) finalises
+    it as numba always does.
+    """
+
+    linked_only = False
+
+    def add_linking_library(self, library: Any) -> None:
+        """Link ``library`` into this one when this one is finalised (a linked-only library stays unfinalised until then)."""
+        if not getattr(library, "linked_only", False):
+            library._ensure_finalized()
+        self._linking_libraries.append(library)
+
+    def _get_module_for_linking(self) -> Any:
+        """The module its callers link: the function-optimised IR with its callees', functions made ``linkonce_odr`` (as numba's)."""
+        if not self.linked_only or self._finalized:
+            return super()._get_module_for_linking()
+        if self._shared_module is None:
+            module = self._final_module.clone()
+            for library in dict.fromkeys(self._linking_libraries):
+                self._reload_init.update(library._reload_init)
+                module.link_in(library._get_module_for_linking(), preserve=True)
+            for function in module.functions:
+                if not function.is_declaration and function.linkage == llvm.Linkage.external:
+                    function.linkage = "linkonce_odr"
+            self._shared_module = module
+        return self._shared_module
+
+
+def _executable(context: Any, library: Any, fndesc: Any, env: Any) -> Any:
+    """``CPUContext.get_executable`` that leaves a wrapper-less function's library unfinalised (no machine code).
+
+    numba's own asks the finalised library for the Python wrapper's address,
+    which is null for such a function anyway; the function object it makes
+    from that null address is what callers look the function up by.
+    """
+    if not isinstance(library, _LinkedOnlyLibrary) or library._finalized or _defines(library, fndesc.llvm_cpython_wrapper_name):
+        return type(context).get_executable(context, library, fndesc, env)  # loaded from numba's cache, or wrapped
+    library.linked_only = True
+    name = fndesc.qualname.split(".")[-1]
+    return _dynfunc.make_function(fndesc.lookup_module(), name, f"compiled wrapper for {fndesc.qualname!r}", 0, env, (library,))
+
+
+def _defines(library: Any, name: str) -> bool:
+    """True if the unfinalised ``library`` defines a function named ``name``."""
+    return any(function.name == name and not function.is_declaration for function in library._final_module.functions)
+
+
+@contextlib.contextmanager
+def _helpers_without_machine_code() -> Iterator[None]:
+    """Inside the block, libraries are :class:`_LinkedOnlyLibrary` and wrapper-less functions get no machine code (numba's compiler lock held)."""
+    with global_compiler_lock:
+        context = cpu_target.target_context
+        codegen = context.codegen()
+        codegen._library_class = _LinkedOnlyLibrary
+        context.get_executable = _executable.__get__(context)
+        try:
+            yield
+        finally:
+            del codegen._library_class
+            del context.get_executable
