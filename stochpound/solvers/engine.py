@@ -36,8 +36,9 @@ The arrays are grouped in small named tuples: :class:`ModeTable`,
 :class:`Arming`, :class:`Impacts` and :class:`Outputs` (everything a run
 changes, so that a call can stop for a missing mode and resume).
 
-Compile time (``cache=True``: once per machine). numba compiles every jitted
-function on its own and then again inside each caller, spends about as much
+Compile time (``cache=True``: once per machine). numba type-infers and lowers
+every jitted function on its own, optimises it again inside each caller
+(into which it is linked as LLVM IR), spends about as much
 on each source line as on each optimised LLVM line, copies every field of a
 named tuple wherever one is bound or passed, and inlines (``inline="always"``)
 at a high cost per call site. So :func:`run_engine` is the only entry point:
