@@ -41,8 +41,8 @@ def first_call() -> None:
     first, _ = _timed(lambda: stochpound.simulate(scene))
     second, _ = _timed(lambda: stochpound.simulate(scene))
     warm = min(_timed(lambda: stochpound.simulate(scene))[0] for _ in range(100))
-    level = f"numba's default (LLVM {os.environ['NUMBA_OPT']})" if "NUMBA_OPT" in os.environ else f"stochpound's (LLVM {OPTIMISATION_LEVEL})"
-    _emit({"import": imported, "first": first, "second": second, "warm": warm, "level": level, "numba": "numba" in sys.modules})
+    settings = f"numba's default (LLVM {os.environ['NUMBA_OPT']})" if "NUMBA_OPT" in os.environ else f"stochpound's (LLVM {OPTIMISATION_LEVEL})"
+    _emit({"import": imported, "first": first, "second": second, "warm": warm, "settings": settings, "numba": "numba" in sys.modules})
 
 
 def _main_scene():

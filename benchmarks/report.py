@@ -331,13 +331,13 @@ def _compile_section(results: Results) -> str:
             rows.append([label, run["error"], "–", "–", "–", "–", "–"])
         else:
             warm = f"{run['warm'] * 1e3:.3g}" if "warm" in run else "–"
-            rows.append([label, run.get("level", "–"), f"{run['import']:.3g}", f"{run['first']:.3g}", f"{run['second'] * 1e3:.4g}", warm,
+            rows.append([label, run.get("settings", "–"), f"{run['import']:.3g}", f"{run['first']:.3g}", f"{run['second'] * 1e3:.4g}", warm,
                          "yes" if run["numba"] else "no"])
     return (
         "## First call\n\nScene (a) in a fresh process: import and scene building, the first `simulate` "
         "(compiles or loads the numba kernels and builds the mode propagators), a second call and the best of 100 warm calls; "
         "one row per process, each with its own empty numba cache (the engine's compile settings, "
-        "`stochpound.solvers.compiling`: LLVM level 1 and no machine code for the helpers of their own; then numba's default, "
+        "`stochpound.solvers.compiling`: an LLVM level of its own and no machine code for the helpers of their own; then numba's default, "
         "alternating), then one that finds the first settings' last cache filled.\n\n"
         + _table(["numba cache", "compile settings", "import + scene (s)", "first call (s)", "second call (ms)", "best warm call (ms)", "numba loaded"], rows)
         + _level_comparison(data)
@@ -353,7 +353,7 @@ def _level_comparison(data: dict[str, Any]) -> str:
     compiled = [statistics.median(_compile_seconds(one) for one in side) for side in zip(*pairs, strict=True)]
     warm = [statistics.median(one["warm"] for one in side) * 1e3 for side in zip(*pairs, strict=True)]
     return (
-        f"\n\nMedians over these runs, {pairs[0][0]['level']} settings against {pairs[0][1]['level']}: "
+        f"\n\nMedians over these runs, {pairs[0][0]['settings']} settings against {pairs[0][1]['settings']}: "
         f"compile (first call minus second) {compiled[0]:.3g} s against {compiled[1]:.3g} s ({compiled[0] / compiled[1]:.2f}×), "
         f"best warm call {warm[0]:.3g} ms against {warm[1]:.3g} ms ({warm[0] / warm[1]:.2f}×).\n"
     )

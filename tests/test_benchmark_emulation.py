@@ -146,8 +146,8 @@ def test_compile_report_judges_the_engines_settings_and_compares_them_with_numba
 
     OURS, DEFAULT = "stochpound's (LLVM 1)", "numba's default (LLVM 3)"  # as benchmarks.probes.first_call labels them
 
-    def run(level, first, warm):
-        return {"import": 1.0, "first": first, "second": 0.004, "warm": warm, "level": level, "numba": True}
+    def run(settings, first, warm):
+        return {"import": 1.0, "first": first, "second": 0.004, "warm": warm, "settings": settings, "numba": True}
 
     data = {
         "cold": [run(OURS, 8.004, 0.003), run(OURS, 9.004, 0.0031), run(OURS, 20.004, 0.0029)],

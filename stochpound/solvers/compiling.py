@@ -23,7 +23,7 @@ call runs in. Inside it:
 Neither setting changes a result: LLVM keeps IEEE semantics at every level
 (no fast-math), and the same IR is optimised, only once instead of once per
 function (the outputs are compared bitwise with numba's default compile in
-``tests/test_exact.py``). A ``NUMBA_OPT`` set in the environment turns both
+``tests/test_engine_compile.py``). A ``NUMBA_OPT`` set in the environment turns both
 off: the engine then compiles exactly as numba would by default.
 
 Both reach into numba's internals (its compiler lock, configuration, CPU
@@ -58,11 +58,11 @@ def numba_default_requested() -> bool:
 def engine_compile() -> Iterator[None]:
     """The block in which the engine is compiled: :data:`OPTIMISATION_LEVEL` and no machine code for wrapper-less helpers.
 
-    numba's compiler lock is held throughout, so no other thread compiles
-    under these settings; everything is restored on leaving the block, also
-    when it raises.
+    numba's compiler lock is held throughout (both settings take it), so no
+    other thread compiles under them; everything is restored on leaving the
+    block, also when it raises.
     """
-    with global_compiler_lock, optimisation_level(OPTIMISATION_LEVEL), _helpers_without_machine_code():
+    with optimisation_level(OPTIMISATION_LEVEL), _helpers_without_machine_code():
         yield
 
 

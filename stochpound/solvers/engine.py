@@ -55,7 +55,7 @@ its fields), so everything is compiled without numba's runtime
 the arrays of :func:`work_arrays`), and it calls no builtin ``min`` or
 ``max`` (each compiles an overload; the comparisons written out give the same
 results). :func:`run` compiles it inside
-:func:`~stochpound.solvers.compiling.engine_compile`: LLVM level 1, and no
+:func:`~stochpound.solvers.compiling.engine_compile`: its own LLVM level, and no
 machine code for the helpers of their own (they are optimised and turned
 into machine code once, inside :func:`run_engine`). All jitted code lives in
 this one module, whose source stamp is what invalidates numba's cache (the
