@@ -72,7 +72,7 @@ def ensemble_statistics(
     Returns
     -------
     xarray.Dataset
-        For each summary ``s`` of :data:`SUMMARIES` in the store:
+        For each summary ``s`` of ``SUMMARIES`` in the store:
         ``s_mean``, ``s_lower``, ``s_upper`` (Student-t interval of the
         mean); for the peaks ``s_quantile`` (dimension ``quantile``);
         ``peak_impact_force_*`` over the realizations with at least one

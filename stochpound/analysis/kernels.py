@@ -2,7 +2,7 @@
 
 The xarray functions of :mod:`stochpound.analysis` wrap these kernels with
 :func:`xarray.apply_ufunc` (lazily on dask); the experiment store's per-case
-summaries (:mod:`stochpound.experiment.summary`) and
+summaries (``stochpound.experiment.summary``) and
 :func:`stochpound.simulate_ensemble` call them, directly or through those
 wrappers. Nothing else computes these quantities.
 

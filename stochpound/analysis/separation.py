@@ -169,7 +169,7 @@ def rule_exceedance(
         As in :func:`pounding_curve`.
     rule_gap : xarray.DataArray
         Each contact's gap (m), which may vary per realization and along
-        other dimensions, e.g. ``rule`` from :func:`~stochpound.analysis.separation_rules.separation_rules`.
+        other dimensions, e.g. ``rule`` from :func:`~stochpound.analysis.separation_rules`.
         A NaN gap leaves its run out.
     dim, confidence, contact_dim
         As in :func:`pounding_curve`.

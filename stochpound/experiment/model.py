@@ -139,7 +139,7 @@ class Experiment:
     Parameters
     ----------
     definition : mapping
-        Canonical definition (:func:`stochpound.experiment.spec.parse_experiment`).
+        Canonical definition (``stochpound.experiment.spec.parse_experiment``).
     text : str
         The experiment file's text (provenance).
     base_dir : str or Path

@@ -144,9 +144,9 @@ def run_experiment(
         Show a progress bar on stderr.
     checkpoint : float
         Least number of seconds between rebuilds of the store file during the
-        run (and at least :data:`CHECKPOINT_FACTOR` times the last rebuild's duration).
+        run (and at least ``CHECKPOINT_FACTOR`` times the last rebuild's duration).
     batch_size : int, optional
-        Cases per dask task (default: :func:`~stochpound.experiment.batches.automatic_size`).
+        Cases per dask task (default: ``stochpound.experiment.batches.automatic_size``).
 
     Returns
     -------

@@ -9,3 +9,11 @@ One module per concept: :mod:`~stochpound.model.building` (shear buildings),
 :mod:`~stochpound.model.guards` (event kinds) and
 :mod:`~stochpound.model.modal_solution` (a closed-form reference).
 """
+
+from stochpound.model.building import Building, InitialState
+from stochpound.model.contact import Contact, ImpactElement
+from stochpound.model.friction import Base
+from stochpound.model.scene import Scene
+from stochpound.model.wall import Wall
+
+__all__ = ["Scene", "Building", "InitialState", "Base", "Contact", "Wall", "ImpactElement"]

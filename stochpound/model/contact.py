@@ -73,7 +73,7 @@ class ImpactElement:
         returns to 0 and never pulls. The nonlinear laws separate at δ = 0
         and never pull (True).
     law : str
-        The contact law (:data:`LAWS`).
+        The contact law (``LAWS``).
     """
 
     gap: float

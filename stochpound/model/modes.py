@@ -156,7 +156,7 @@ def array_bytes(value: object) -> int:
 
 
 class ModeLibrary:
-    """Lazily built :class:`ModeDynamics` of one :class:`System`, cached within :data:`MODE_BUDGET`.
+    """Lazily built :class:`ModeDynamics` of one :class:`~stochpound.model.system.System`, cached within :data:`MODE_BUDGET`.
 
     Dynamics dropped from the cache are rebuilt when asked for again;
     ``len`` counts the distinct modes built.

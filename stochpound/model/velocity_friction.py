@@ -6,7 +6,7 @@ velocity and the rate a (s/m); ``mu_static`` defaults to ``slow``.
 
 The law (docs/model.md, "Friction laws"): while the base slips at velocity ṡ,
 
-    μ(ṡ) = μ_fast − (μ_fast − μ_slow) exp(−a |ṡ|),
+    μ(ṡ) = μ_fast − (μ_fast − μ_slow) exp(−a abs(ṡ)),
 
 and the foundation's force on the base is −sgn(ṡ) μ(ṡ) W; the base sticks
 and slips as with Coulomb friction (stick while the force it needs stays
@@ -39,10 +39,10 @@ def mu_from_table(table: Mapping[str, Any], prefix: str) -> tuple[float, float, 
 
 
 def coefficient(slow: float, fast: float, rate: float, speed: np.ndarray) -> np.ndarray:
-    """μ at sliding speed |ṡ| (m/s)."""
+    """μ at sliding speed abs(ṡ) (m/s)."""
     return fast - (fast - slow) * np.exp(-rate * speed)
 
 
 def coefficient_slope(slow: float, fast: float, rate: float, speed: np.ndarray) -> np.ndarray:
-    """dμ/d|ṡ| (s/m) at sliding speed |ṡ|."""
+    """dμ/dabs(ṡ) (s/m) at sliding speed abs(ṡ)."""
     return rate * (fast - slow) * np.exp(-rate * speed)

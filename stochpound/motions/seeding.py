@@ -24,5 +24,5 @@ def realization_rng(seed: int, index: int) -> np.random.Generator:
 
 
 def realization_rngs(seed: int, start: int, count: int) -> list[np.random.Generator]:
-    """Generators of realizations ``start .. start + count − 1``."""
+    """Generators of the realizations ``start`` to ``start + count − 1``."""
     return [realization_rng(seed, index) for index in range(start, start + count)]

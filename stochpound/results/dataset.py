@@ -221,7 +221,7 @@ def write_dataset(dataset: xr.Dataset, path: str | Path) -> Path:
     """Write ``dataset`` as netCDF4/HDF5 atomically (a temporary file renamed into place).
 
     An interrupted write never leaves a partial file at ``path``; the file's
-    permissions follow the umask (:mod:`stochpound.atomic`).
+    permissions follow the umask (``stochpound.atomic``).
     """
     path = Path(path)
     with replacing(path) as temporary:

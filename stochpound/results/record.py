@@ -102,7 +102,7 @@ class Recorder:
         velocity) at every output time (time × contact or base), filled by
         :meth:`sample_at`.
     energy_history : np.ndarray
-        The energy terms (rows in :data:`ENERGY_TERMS` order, J) at every
+        The energy terms (rows in ``ENERGY_TERMS`` order, J) at every
         output time; ``energy`` maps each term's name to its row.
     impacts : list of Impact
         Every impact, in order of start (then contact).

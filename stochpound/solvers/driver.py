@@ -56,7 +56,7 @@ class EngineRun:
         The exact propagators of the modes (exact flow) or their dynamics
         only (flow supplied by ``stepper``).
     stepper : Stepper, optional
-        Supplies the flow; required with a :class:`ModeLibrary`.
+        Supplies the flow; required with a :class:`~stochpound.model.modes.ModeLibrary`.
     building : callable, optional
         Context manager entered while a mode is built (e.g. one BLAS thread).
     """
@@ -116,7 +116,7 @@ class EngineRun:
         run.ints[engine.N_READOUTS] = row + 1
 
     def record(self) -> Recorder:
-        """The run's :class:`Recorder` from the engine's outputs (after :meth:`execute`)."""
+        """The run's :class:`~stochpound.results.record.Recorder` from the engine's outputs (after :meth:`execute`)."""
         outputs, impacts, run = self.state.outputs, self.state.impacts, self.state.run
         recorder = Recorder(self.system, self.motion)
         recorder.states[:] = outputs.states

@@ -49,7 +49,7 @@ def run_ivp(scene: Scene, integrator: str = "DOP853", rtol: float = 1e-10, atol:
     ----------
     scene : Scene
     integrator : str
-        One of :data:`INTEGRATORS`.
+        One of ``INTEGRATORS``.
     rtol, atol : float
         Relative and absolute tolerances of the integrator (absolute in m and m/s).
     demands : bool

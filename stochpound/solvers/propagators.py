@@ -97,8 +97,8 @@ def exosystem(motion: GroundMotion) -> np.ndarray:
     Raises
     ------
     UnsupportedMotionError
-        For motions other than :class:`SampledMotion` (linear or spline) and
-        :class:`HarmonicMotion`: the event engine of both solvers evaluates
+        For motions other than :class:`~stochpound.motions.ground.SampledMotion` (linear or spline) and
+        :class:`~stochpound.motions.ground.HarmonicMotion`: the event engine of both solvers evaluates
         a_g interval by interval as a cubic or a sine.
     """
     if isinstance(motion, HarmonicMotion):
@@ -123,7 +123,7 @@ def interval_forcing(motion: GroundMotion) -> np.ndarray:
 
 
 def sample_ground(motion: GroundMotion) -> np.ndarray:
-    """a_g at every output time, as :meth:`Recorder.sample` evaluates it (m/s²)."""
+    """a_g at every output time, as :meth:`Recorder.sample_at <stochpound.results.record.Recorder.sample_at>` evaluates it (m/s²)."""
     if isinstance(motion, HarmonicMotion):
         return np.asarray(motion.acceleration(motion.times, 0), float)
     if isinstance(motion, SampledMotion):

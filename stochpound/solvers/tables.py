@@ -54,7 +54,7 @@ def mode_vector(mode: Mode) -> np.ndarray:
 
 
 def vector_mode(vector: np.ndarray, n_contacts: int) -> Mode:
-    """The :class:`Mode` of an engine mode vector."""
+    """The :class:`~stochpound.model.modes.Mode` of an engine mode vector."""
     return Mode(tuple(bool(v) for v in vector[:n_contacts]), tuple(int(v) for v in vector[n_contacts:-1]))
 
 
@@ -121,8 +121,8 @@ _SLOTS: "weakref.WeakKeyDictionary[PropagatorLibrary | ModeLibrary, Slots]" = we
 def slots_of(library: PropagatorLibrary | ModeLibrary) -> "Slots":
     """The engine arrays of ``library``'s modes, shared by its runs.
 
-    With a :class:`PropagatorLibrary` (the exact solver) the slots hold the
-    modes' propagators too; with a :class:`ModeLibrary` (supplied flows) only
+    With a :class:`~stochpound.solvers.propagators.PropagatorLibrary` (the exact solver) the slots hold the
+    modes' propagators too; with a :class:`~stochpound.model.modes.ModeLibrary` (supplied flows) only
     their dynamics.
     """
     slots = _SLOTS.get(library)
@@ -298,7 +298,7 @@ def _affine(matrix: np.ndarray, ground: np.ndarray | float, constant: np.ndarray
 def _power_factors(system: System, force: np.ndarray, friction: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
     """The powers of the energy balance as bilinear forms (L z) · (R z) of z = [x, w, 1]: their factors (L, R).
 
-    In :data:`ENERGY_TERMS` order, W: the input power −a_g (ι · v), the
+    In ``ENERGY_TERMS`` order, W: the input power −a_g (ι · v), the
     damping power vᵀ C v, the friction power −Σ F_b ṡ_b over sliding bases
     (F_b the foundation's force on base b) and the impact power
     Σ F_p (h_p · v) over contacts. ``force`` and ``friction`` are the mode's

@@ -33,7 +33,7 @@ def normalize_units(units: str) -> str:
     Raises
     ------
     ValueError
-        If the spelling is not one of :data:`UNIT_ALIASES`.
+        If the spelling is not one of ``UNIT_ALIASES``.
     """
     key = str(units).strip().lower()
     if key not in UNIT_ALIASES:
