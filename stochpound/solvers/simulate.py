@@ -10,7 +10,7 @@ from stochpound.solvers.exact import run_exact
 from stochpound.solvers.ivp import INTEGRATORS, run_ivp
 
 METHODS = ("exact", "ivp")
-"""Available solvers: ``exact`` (matrix-exponential propagation, the default) and
+"""Available solvers: ``exact`` (matrix-exponential propagation; the default for piecewise-linear laws) and
 ``ivp`` (scipy integrators with exact event location)."""
 
 
