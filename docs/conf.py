@@ -60,6 +60,9 @@ sphinx_gallery_conf = {
     "image_scrapers": ("matplotlib",),
     "matplotlib_animations": False,
     "min_reported_time": 1,
+    # "Examples using X" at the foot of each API page (docs/_templates/autosummary)
+    "doc_module": ("stochpound",),
+    "backreferences_dir": "generated/backreferences",
 }
 
 html_theme = "pydata_sphinx_theme"

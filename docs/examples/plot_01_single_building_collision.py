@@ -30,7 +30,9 @@ scene = stochpound.scene_from_dict(
             }
         ],
         "wall": [
-            {"building": "B1", "side": "right", "level": 1, "gap": 0.01, "stiffness": 4.0e8, "restitution": 0.5}
+            # tensile = false: the wall pushes but never pulls the floor back
+            {"building": "B1", "side": "right", "level": 1, "gap": 0.01, "stiffness": 4.0e8, "restitution": 0.5,
+             "tensile": False}
         ],
         "motion": {"type": "constant", "acceleration": 0.0, "duration": 2.0, "dt": 0.005},
     }

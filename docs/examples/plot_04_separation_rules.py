@@ -76,8 +76,8 @@ print(exceedance[["probability", "lower", "upper"]].to_pandas().round(3))
 top = dict(contact=1)
 fig, ax = plt.subplots(figsize=(5.5, 5))
 needed = 100 * demands.peak_closure.isel(top)
-for rule in rules.rule.values:
-    ax.plot(needed, 100 * rules.sel(rule=rule).isel(top), ".", label=rule)
+for rule, marker in zip(rules.rule.values, "os^vx"):
+    ax.plot(needed, 100 * rules.sel(rule=rule).isel(top), marker, ms=4, fillstyle="none", label=rule)
 limit = float(needed.max()) * 1.1
 ax.plot([0, limit], [0, limit], "k--", lw=1, label="gap = D")
 ax.set_xlabel("peak closure D of the contact-free run (cm)")
