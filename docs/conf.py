@@ -35,7 +35,21 @@ autodoc_typehints = "none"  # the numpydoc sections give the types (and units)
 autosummary_generate = True  # one page per documented object, under api/ (see api.md)
 autosummary_imported_members = False
 numpydoc_show_class_members = False
-numpydoc_xref_param_type = False
+# parameter and return types link to the public classes they name; other words
+# (builtins, other projects' types, "optional", ...) stay plain text
+numpydoc_xref_param_type = True
+numpydoc_xref_ignore = "all"
+numpydoc_xref_aliases = {
+    name: f"stochpound.{module}.{name}" if module else f"stochpound.{name}"
+    for module, names in {
+        "model": ["Scene", "Building", "InitialState", "Base", "Contact", "Wall", "ImpactElement"],
+        "experiment": ["Experiment", "Dim", "Case", "RunReport", "StatusReport", "ExperimentError"],
+        "motions": ["Envelope", "FilteredWhiteNoise", "SoilPreset"],
+        "motions.records": ["Record", "RegistryEntry", "RawSeries", "RecordStatistics"],
+        "": ["SceneError", "RecordError", "StochpoundError"],
+    }.items()
+    for name in names
+}
 
 # Every cross-reference must resolve. The build needs no network, so other
 # projects' inventories (intersphinx) are not loaded: references to their
@@ -43,6 +57,9 @@ numpydoc_xref_param_type = False
 nitpicky = True
 nitpick_ignore_regex = [
     (r"py:.*", r"(numpy|scipy|xarray|pandas|matplotlib|dask|numba|click)(\..+)?"),
+    # numpydoc's built-in type aliases (float, int, None, sequence, array_like, ...) point into
+    # Python's and numpy's inventories
+    (r"py:.*|std:term|std:ref", r"(python|numpy):.+"),
     # private helpers (a leading underscore) are named in docstrings for
     # contributors but are not documented
     (r"py:.*", r"(.+\.)?_[A-Za-z]\w*"),
