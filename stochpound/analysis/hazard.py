@@ -190,10 +190,11 @@ class HazardCurve:
                 self.extrapolated = True
         with np.errstate(divide="ignore"):
             u = np.log(values)
-        return np.exp(self._log_rate_at(u))
+        return np.exp(self.log_rate(u))
 
-    def _log_rate_at(self, u: np.ndarray) -> np.ndarray:
-        """ln λ at ln x = ``u``, extending the end segments linearly (callers check the range)."""
+    def log_rate(self, log_im: ArrayLike) -> np.ndarray:
+        """ln λ at ln x = ``log_im``, the end segments extended as straight lines (no range check: the caller's)."""
+        u = np.asarray(log_im, dtype=float)
         lx, ly = self._log_im, self._log_rate
         inside = np.interp(u, lx, ly)
         below = ly[0] + (u - lx[0]) * (ly[1] - ly[0]) / (lx[1] - lx[0])
