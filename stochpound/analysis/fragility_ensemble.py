@@ -15,21 +15,22 @@ own fit. The results are computed (not lazy).
 
 Bootstrap: the motions (records), not the runs, are resampled with
 replacement, the same resample for every stripe, threshold and
-configuration, and everything is refitted; the intervals are percentiles of
-the refits. The resamples are drawn from ``numpy.random.default_rng(seed)``,
-so a seed reproduces them.
+configuration, and everything is refitted; the intervals are BCa
+percentiles of the refits (:mod:`stochpound.analysis.bootstrap`). The
+resamples are drawn from ``numpy.random.default_rng(seed)``, so a seed
+reproduces them.
 """
 
 from __future__ import annotations
 
-import warnings
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 import numpy as np
 import xarray as xr
 from numpy.typing import ArrayLike
 
 from stochpound.analysis import kernels
+from stochpound.analysis.bootstrap import bootstrap_weights, interval, jackknife_weights
 from stochpound.analysis.fragility import STATUS, ida_mle, lognormal_cdf, stripe_mle
 
 BOOTSTRAP = 1000
@@ -94,8 +95,10 @@ def stripe_fragility(events: xr.DataArray, intensity_dim: str = "intensity", rec
         Over the other dimensions: ``theta`` (IM units), ``beta``,
         ``status`` (:data:`~stochpound.analysis.fragility.STATUS`),
         ``theta_lower``/``theta_upper`` and ``beta_lower``/``beta_upper``
-        (bootstrap percentiles), ``theta_bootstrap`` and ``beta_bootstrap``
-        (dimension ``bootstrap``, for the risk chain); per stripe, the
+        (BCa bootstrap intervals), ``theta_bootstrap`` and ``beta_bootstrap``
+        (dimension ``bootstrap``) and ``theta_jackknife`` and
+        ``beta_jackknife`` (dimension ``jackknife``, one per motion left
+        out), for the risk chain; per stripe, the
         empirical points ``exceeded``, ``runs``, ``probability`` and their
         Clopper–Pearson ``probability_lower``/``probability_upper``.
     """
@@ -124,11 +127,12 @@ def stripe_fragility(events: xr.DataArray, intensity_dim: str = "intensity", rec
         probability_upper=(per_stripe, upper, {"units": "1", "long_name": "upper Clopper-Pearson bound", "confidence": confidence}),
     ).assign_coords({intensity_dim: data[intensity_dim]})
     if bootstrap:
-        weights = bootstrap_weights(values.shape[-1], bootstrap, seed)
-        k_b = np.einsum("...jr,br->...bj", np.where(valid, values, 0.0), weights)
-        n_b = np.einsum("...jr,br->...bj", valid.astype(float), weights)
-        theta_b, beta_b, _ = stripe_mle(levels, k_b, n_b)
-        result = _with_bootstrap(result, theta_b, beta_b, other, confidence, seed)
+        def refit(weights: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+            k_w = np.einsum("...jr,br->...bj", np.where(valid, values, 0.0), weights)
+            n_w = np.einsum("...jr,br->...bj", valid.astype(float), weights)
+            return stripe_mle(levels, k_w, n_w)[:2]
+
+        result = _with_bootstrap(result, refit, values.shape[-1], other, confidence, bootstrap, seed)
     return result
 
 
@@ -166,9 +170,10 @@ def ida_fragility(capacities: xr.DataArray, record_dim: str = "record", censored
     coords = {name: coord for name, coord in data.coords.items() if set(coord.dims) <= set(other)}
     result = _fit_dataset(theta, beta, status, other, coords, "ida")
     if bootstrap:
-        weights = bootstrap_weights(values.shape[-1], bootstrap, seed)
-        theta_b, beta_b, _ = ida_mle(values[..., None, :], None if bound is None else bound[..., None, :], weights)
-        result = _with_bootstrap(result, theta_b, beta_b, other, confidence, seed)
+        def refit(weights: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+            return ida_mle(values[..., None, :], None if bound is None else bound[..., None, :], weights)[:2]
+
+        result = _with_bootstrap(result, refit, values.shape[-1], other, confidence, bootstrap, seed)
     return result
 
 
@@ -220,25 +225,6 @@ def fragility_surface(fragility: xr.Dataset, im: Sequence[float] | np.ndarray | 
     return surface.assign_attrs(units="1", long_name="fitted probability of exceedance")
 
 
-def bootstrap_weights(motions: int, resamples: int, seed: int) -> np.ndarray:
-    """How many times each motion appears in each resample with replacement: an integer array (resamples, motions)."""
-    if not (isinstance(resamples, (int, np.integer)) and resamples > 0):
-        raise ValueError(f"bootstrap: must be a positive number of resamples, got {resamples!r}")
-    if motions < 2:
-        raise ValueError(f"record: the bootstrap needs at least 2 motions, got {motions}")
-    rng = np.random.default_rng(seed)
-    return rng.multinomial(motions, np.full(motions, 1.0 / motions), size=resamples).astype(float)
-
-
-def percentile_interval(samples: np.ndarray, confidence: float, axis: int = -1) -> tuple[np.ndarray, np.ndarray]:
-    """The (1 ∓ confidence)/2 percentiles of bootstrap ``samples`` along ``axis`` (NaN samples left out; inf kept)."""
-    tail = (1.0 - confidence) / 2.0
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", RuntimeWarning)  # all-NaN samples give NaN
-        bounds = np.nanquantile(samples, [tail, 1.0 - tail], axis=axis, method="inverted_cdf")
-    return bounds[0], bounds[1]
-
-
 # ---------------------------------------------------------------- helpers
 
 
@@ -260,16 +246,19 @@ def _fit_dataset(theta: np.ndarray, beta: np.ndarray, status: np.ndarray, dims: 
     )
 
 
-def _with_bootstrap(result: xr.Dataset, theta_b: np.ndarray, beta_b: np.ndarray, dims: tuple, confidence: float, seed: int) -> xr.Dataset:
-    sampled = (*dims, "bootstrap")
-    t_lower, t_upper = percentile_interval(theta_b, confidence)
-    b_lower, b_upper = percentile_interval(beta_b, confidence)
-    attrs = {"confidence": confidence, "method": "percentile bootstrap over motions", "seed": seed}
-    return result.assign(
-        theta_lower=(dims, t_lower, {"long_name": "lower bound of theta", **attrs}),
-        theta_upper=(dims, t_upper, {"long_name": "upper bound of theta", **attrs}),
-        beta_lower=(dims, b_lower, {"units": "1", "long_name": "lower bound of beta", **attrs}),
-        beta_upper=(dims, b_upper, {"units": "1", "long_name": "upper bound of beta", **attrs}),
-        theta_bootstrap=(sampled, theta_b, {"long_name": "theta refitted to each resample of the motions"}),
-        beta_bootstrap=(sampled, beta_b, {"units": "1", "long_name": "beta refitted to each resample of the motions"}),
-    )
+def _with_bootstrap(result: xr.Dataset, refit: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]], motions: int, dims: tuple,
+                    confidence: float, resamples: int, seed: int) -> xr.Dataset:
+    """``result`` with θ, β refitted to bootstrap and jackknife resamples of the motions, and their BCa intervals."""
+    theta_b, beta_b = refit(bootstrap_weights(motions, resamples, seed))
+    theta_j, beta_j = refit(jackknife_weights(motions))
+    attrs = {"confidence": confidence, "method": "BCa bootstrap over motions", "seed": seed}
+    variables = {}
+    for name, sampled, left_out, units in (("theta", theta_b, theta_j, {}), ("beta", beta_b, beta_j, {"units": "1"})):
+        lower, upper = interval(sampled, result[name].values, left_out, confidence)
+        variables.update({
+            f"{name}_lower": (dims, lower, {"long_name": f"lower bound of {name}", **units, **attrs}),
+            f"{name}_upper": (dims, upper, {"long_name": f"upper bound of {name}", **units, **attrs}),
+            f"{name}_bootstrap": ((*dims, "bootstrap"), sampled, {"long_name": f"{name} refitted to each resample of the motions", **units}),
+            f"{name}_jackknife": ((*dims, "jackknife"), left_out, {"long_name": f"{name} refitted without each motion", **units}),
+        })
+    return result.assign(variables)

@@ -29,7 +29,8 @@ from numpy.typing import ArrayLike
 from scipy import special
 
 from stochpound.analysis import kernels
-from stochpound.analysis.fragility_ensemble import BOOTSTRAP, limit_state_events, percentile_interval, stripe_fragility
+from stochpound.analysis.bootstrap import interval
+from stochpound.analysis.fragility_ensemble import BOOTSTRAP, limit_state_events, stripe_fragility
 from stochpound.analysis.hazard import HazardCurve, probability_from_rate, rate_from_probability, return_period
 
 TARGETS = (0.10, 0.02)
@@ -124,13 +125,14 @@ def risk_curve(fragility: xr.Dataset, hz: HazardCurve, years: float = 50.0, conf
     )
     if "theta_bootstrap" in fragility:
         sampled = mean_annual_frequency(xr.Dataset({"theta": fragility["theta_bootstrap"], "beta": fragility["beta_bootstrap"]}), hz)
-        lower, upper = percentile_interval(sampled.transpose(..., "bootstrap").values, confidence)
+        left_out = mean_annual_frequency(xr.Dataset({"theta": fragility["theta_jackknife"], "beta": fragility["beta_jackknife"]}), hz)
+        lower, upper = _interval(sampled, maf, left_out, confidence)
         attrs = {"units": "1/yr", "confidence": confidence}
-        dims = sampled.transpose(..., "bootstrap").dims[:-1]
         result = result.assign(
-            maf_lower=(dims, lower, {"long_name": "lower bound of the MAF (bootstrap over motions)", **attrs}),
-            maf_upper=(dims, upper, {"long_name": "upper bound of the MAF (bootstrap over motions)", **attrs}),
+            maf_lower=lower.assign_attrs(long_name="lower bound of the MAF (BCa bootstrap over motions)", **attrs),
+            maf_upper=upper.assign_attrs(long_name="upper bound of the MAF (BCa bootstrap over motions)", **attrs),
             maf_bootstrap=sampled.assign_attrs(units="1/yr", long_name="MAF of each resample of the motions"),
+            maf_jackknife=left_out.assign_attrs(units="1/yr", long_name="MAF without each motion"),
         )
     result.attrs["hazard_extrapolated"] = int(hz.extrapolated)
     return result
@@ -180,13 +182,13 @@ def risk_targeted_separation(curve: xr.Dataset, targets: Sequence[float] = TARGE
         return xr.apply_ufunc(_separation_kernel, maf, kwargs={"gaps": gaps, "rates": rates},
                               input_core_dims=[[dim]], output_core_dims=[["target"]])
 
-    result = xr.Dataset({"separation": solve(curve["maf"]).assign_attrs(units="m", long_name="risk-targeted separation g*")})
+    separation = solve(curve["maf"])
+    result = xr.Dataset({"separation": separation.assign_attrs(units="m", long_name="risk-targeted separation g*")})
     if "maf_bootstrap" in curve:
-        sampled = solve(curve["maf_bootstrap"]).transpose(..., "bootstrap")
-        lower, upper = percentile_interval(sampled.values, confidence)
+        lower, upper = _interval(solve(curve["maf_bootstrap"]), separation, solve(curve["maf_jackknife"]), confidence)
         attrs = {"units": "m", "confidence": confidence}
-        result = result.assign(lower=(sampled.dims[:-1], lower, {"long_name": "lower bound of g* (bootstrap over motions)", **attrs}),
-                               upper=(sampled.dims[:-1], upper, {"long_name": "upper bound of g* (bootstrap over motions)", **attrs}))
+        result = result.assign(lower=lower.assign_attrs(long_name="lower bound of g* (BCa bootstrap over motions)", **attrs),
+                               upper=upper.assign_attrs(long_name="upper bound of g* (BCa bootstrap over motions)", **attrs))
     return result.assign_coords(
         target=("target", np.atleast_1d(np.asarray(targets, dtype=float)), {"units": "1", "long_name": f"target probability of pounding in {years:g} years"}),
         target_rate=("target", rates, {"units": "1/yr", "long_name": "target mean annual frequency"}),
@@ -219,6 +221,12 @@ def demand_hazard_curve(demand: xr.DataArray, levels: Sequence[float] | np.ndarr
 
 
 # ---------------------------------------------------------------- kernels
+
+
+def _interval(sampled: xr.DataArray, estimate: xr.DataArray, left_out: xr.DataArray, confidence: float) -> tuple[xr.DataArray, xr.DataArray]:
+    """BCa bounds of ``estimate`` from its resamples (dim ``bootstrap``) and jackknife values (dim ``jackknife``)."""
+    return xr.apply_ufunc(lambda s, e, j: interval(s, e, j, confidence), sampled, estimate, left_out,
+                          input_core_dims=[["bootstrap"], [], ["jackknife"]], output_core_dims=[[], []])
 
 
 def _lognormal_integral(theta: np.ndarray, beta: np.ndarray, hz: HazardCurve, lo: float, hi: float) -> np.ndarray:
