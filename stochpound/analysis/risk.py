@@ -144,8 +144,9 @@ def risk_targeted_separation(curve: xr.Dataset, targets: Sequence[float] = TARGE
 
     λ_P(g) is made non-increasing along the gap grid (its running minimum:
     a wider gap cannot pound more often, so a rise is fitting noise) and
-    g* is interpolated linearly in ln λ between the two grid gaps that
-    bracket the target.
+    g* is interpolated between the two grid gaps that bracket the target,
+    linearly in ln λ against ln g (exact where λ_P is a power law of g, as
+    for a linear pair under a power-law hazard; against g from a zero gap).
 
     Parameters
     ----------
@@ -257,7 +258,7 @@ def _lognormal_integral(theta: np.ndarray, beta: np.ndarray, hz: HazardCurve, lo
 
 
 def _separation_kernel(maf: np.ndarray, gaps: np.ndarray, rates: np.ndarray) -> np.ndarray:
-    """g* per target rate along the last axis of ``maf`` (running minimum, interpolation in ln λ)."""
+    """g* per target rate along the last axis of ``maf`` (running minimum, interpolation of ln λ in ln g)."""
     envelope = np.fmin.accumulate(np.where(np.isnan(maf), np.inf, maf), axis=-1)
     below = envelope[..., None, :] <= rates[:, None]  # (..., target, gap)
     found = below.any(-1)
@@ -272,6 +273,9 @@ def _separation_kernel(maf: np.ndarray, gaps: np.ndarray, rates: np.ndarray) -> 
         linear = (lam_hi - target) / (lam_hi - lam_lo)
         fraction = np.where(lam_lo > 0.0, in_log, linear)
         fraction = np.where(np.isfinite(lam_hi), fraction, 1.0)
-    separation = g_hi + np.clip(fraction, 0.0, 1.0) * (g_lo - g_hi)
-    separation = np.where(index == 0, gaps[0], np.where(found, separation, np.inf))
+    fraction = np.clip(fraction, 0.0, 1.0)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        in_log_gap = np.exp(np.log(g_hi) + fraction * (np.log(g_lo) - np.log(g_hi)))
+    separation = np.where(g_hi > 0.0, in_log_gap, g_hi + fraction * (g_lo - g_hi))
+    separation = np.where(~found, np.inf, np.where(index == 0, gaps[0], separation))
     return np.where(np.isnan(maf).all(-1)[..., None], np.nan, separation)
