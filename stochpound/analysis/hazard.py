@@ -120,7 +120,7 @@ class HazardCurve:
 
         >>> hz = HazardCurve.power_law_through((0.4, rate_from_probability(0.10)), (0.8, rate_from_probability(0.02)))
         >>> round(float(hz.power[1]), 3)  # slope k
-        2.355
+        2.383
         """
         (x1, y1), (x2, y2) = first, second
         for name, value in (("first im", x1), ("first rate", y1), ("second im", x2), ("second rate", y2)):

@@ -1,7 +1,7 @@
 """Risk at a site: mean annual frequency of a limit state, the pounding risk curve and the risk-targeted separation.
 
 The mean annual frequency (MAF) of exceeding a limit state with fragility F
-at a site with hazard curve λ(x) is λ_LS = ∫ F(x) |dλ(x)| (Cornell &
+at a site with hazard curve λ(x) is λ_LS = ∫ F(x) ``|dλ(x)|`` (Cornell &
 Krawinkler 2000). Integrated by parts over the hazard's range [lo, hi],
 
     λ_LS = F(lo) λ(lo) + ∫_lo^hi λ(x) dF(x),
@@ -42,7 +42,7 @@ _EXTRAPOLATED_SHARE = 1e-4
 
 
 def mean_annual_frequency(frag: object, hz: HazardCurve) -> float | np.ndarray | xr.DataArray:
-    """λ = ∫ F(x) |dλ(x)|: the mean annual frequency (1/yr) of exceeding a limit state with lognormal fragility ``frag``.
+    """λ = ∫ F(x) ``|dλ(x)|``: the mean annual frequency (1/yr) of exceeding a limit state with lognormal fragility ``frag``.
 
     Parameters
     ----------
