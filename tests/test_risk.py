@@ -158,6 +158,8 @@ def test_code_rules_in_risk_terms_apply_the_rules_to_the_suite_means_at_the_code
     assert float(mce.maf.sel(rule="srss")) == pytest.approx(float(expected))
     assert float(mce.maf.sel(rule="abs")) < float(mce.maf.sel(rule="srss")) < float(mce.maf.sel(rule="srss_reduced"))
     assert np.all(result.maf_lower <= result.maf) and np.all(result.maf <= result.maf_upper)
+    assert np.all(result.gap_lower <= result.gap) and np.all(result.gap <= result.gap_upper)
+    assert np.all(result.gap_lower < result.gap_upper)  # the rule's gap is recomputed from each resample
     assert result.return_period.values == pytest.approx(1 / result.maf.values)
     table = result[["gap", "maf"]].to_dataframe()
     assert len(table) == 2 * 5 * 2
