@@ -172,3 +172,26 @@ def test_code_rules_need_seven_motions_and_the_demands():
         code_rules_risk(demands, hz)
     with pytest.raises(ValueError, match="^demands: missing 'correlation'"):
         code_rules_risk(demands.drop_vars("correlation"), hz)
+
+
+def synthetic_store(seed=4):
+    """A store-shaped Dataset: (gap with inf, mu, record, intensity, contact) peak closures; only gap = inf is contact-free."""
+    rng = np.random.default_rng(seed)
+    gaps, mu, levels = [0.02, 0.05, np.inf], [0.05, 0.1], [0.2, 0.4, 0.6, 0.8]
+    values = rng.lognormal(np.log(0.04), 0.5, (3, 2, 10, 4, 2)) * np.array(levels)[:, None]
+    dims = ("gap", "mu", "record", "intensity", "contact")
+    return xr.Dataset({"peak_contact_closure": (dims, values)}, coords={"gap": gaps, "mu": mu, "intensity": levels})
+
+
+def test_the_store_selection_takes_the_contact_free_cases_for_every_gap_and_configuration():
+    from stochpound.analysis.store_risk import contact_free_closure, pounding_fragility
+
+    store = synthetic_store()
+    fragility = pounding_fragility(store, [0.01, 0.03, 0.06], bootstrap=20)
+    assert set(fragility.theta.dims) == {"gap", "mu"}
+    manual = store.peak_contact_closure.sel(gap=np.inf).max("contact")
+    expected = stripe_fragility(limit_state_events(manual, [0.01, 0.03, 0.06]), bootstrap=0)
+    assert fragility.theta.transpose(*expected.theta.dims).values == pytest.approx(expected.theta.values, nan_ok=True)
+    assert contact_free_closure(store).dims == ("mu", "record", "intensity")
+    with pytest.raises(ValueError, match="^store: no contact-free cases"):
+        contact_free_closure(store.sel(gap=[0.02, 0.05]))
