@@ -242,49 +242,58 @@ def _degenerate(theta: np.ndarray, beta: np.ndarray, status: np.ndarray, step: n
 
 
 def _probit_loglik(u: np.ndarray, k: np.ndarray, n: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Σ k ln Φ(a + b u) + (n − k) ln Φ(−(a + b u)) along the last axis."""
     eta = a[..., None] + b[..., None] * u
     return (k * special.log_ndtr(eta) + (n - k) * special.log_ndtr(-eta)).sum(-1)
 
 
 def _probit_fisher_scoring(u: np.ndarray, k: np.ndarray, n: np.ndarray, active: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Maximum-likelihood (a, b) of P = Φ(a + b u) for binomial counts, by Fisher scoring with step halving."""
+    """Maximum-likelihood (a, b) of P = Φ(a + b u) for binomial counts, by Fisher scoring with step halving.
+
+    Each iteration works on the fits still moving only (flattened), so a
+    few slow fits (nearly separated data) do not hold up the others.
+    """
+    shape = u.shape[:-1]
+    u, k, n = (value.reshape(-1, value.shape[-1]) for value in (u, k, n))
+    a, b = (value.ravel() for value in _probit_start(u, k, n))
+    running = np.flatnonzero(active.ravel())
+    a, b = np.where(active.ravel(), a, 0.0), np.where(active.ravel(), b, 1.0)
     with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
-        return _fisher_scoring_steps(u, k, n, active)
-
-
-def _fisher_scoring_steps(u: np.ndarray, k: np.ndarray, n: np.ndarray, active: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    a, b = _probit_start(u, k, n)
-    a, b = np.where(active, a, 0.0), np.where(active, b, 1.0)
-    u_a, k_a, n_a = (np.where(active[..., None], value, 0.0) for value in (u, k, n))
-    loglik = _probit_loglik(u_a, k_a, n_a, a, b)
-    running = active.copy()
-    for _ in range(_ITERATIONS):
-        running &= b > 0.0  # a decreasing fit: stop (reported as such)
-        if not running.any():
-            break
-        eta = a[..., None] + b[..., None] * u_a
-        log_phi = -0.5 * eta**2 - 0.5 * np.log(2.0 * np.pi)
-        lower, upper = special.log_ndtr(eta), special.log_ndtr(-eta)
-        score = k_a * np.exp(log_phi - lower) - (n_a - k_a) * np.exp(log_phi - upper)
-        weight = n_a * np.exp(2.0 * log_phi - lower - upper)
-        g0, g1 = score.sum(-1), (score * u_a).sum(-1)
-        i00, i01, i11 = weight.sum(-1), (weight * u_a).sum(-1), (weight * u_a**2).sum(-1)
-        det = i00 * i11 - i01**2
-        with np.errstate(divide="ignore", invalid="ignore"):
-            da = np.where(running, (i11 * g0 - i01 * g1) / det, 0.0)
-            db = np.where(running, (i00 * g1 - i01 * g0) / det, 0.0)
-        da, db = np.nan_to_num(da), np.nan_to_num(db)
-        step = np.ones_like(a)
-        for _ in range(40):
-            trial = _probit_loglik(u_a, k_a, n_a, a + step * da, b + step * db)
-            better = (trial >= loglik - 1e-12 * np.abs(loglik)) | ~running
-            if better.all():
+        for _ in range(_ITERATIONS):
+            if running.size == 0:
                 break
-            step = np.where(better, step, 0.5 * step)
-        a, b = a + step * da, b + step * db
-        loglik = _probit_loglik(u_a, k_a, n_a, a, b)
-        running &= np.abs(step * da) + np.abs(step * db) * (1.0 + np.abs(u_a).max(-1)) > _TOLERANCE
-    return a, b
+            da, db, moved = _scoring_step(u[running], k[running], n[running], a[running], b[running])
+            a[running] += da
+            b[running] += db
+            running = running[moved & (b[running] > 0.0)]  # a fit whose slope turns non-positive is decreasing
+    return a.reshape(shape), b.reshape(shape)
+
+
+def _scoring_step(u: np.ndarray, k: np.ndarray, n: np.ndarray, a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """One Fisher-scoring step (halved until the likelihood does not fall) and whether each fit still moves."""
+    eta = a[:, None] + b[:, None] * u
+    log_phi = -0.5 * eta**2 - 0.5 * np.log(2.0 * np.pi)
+    lower, upper = special.log_ndtr(eta), special.log_ndtr(-eta)
+    score = k * np.exp(log_phi - lower) - (n - k) * np.exp(log_phi - upper)
+    weight = n * np.exp(2.0 * log_phi - lower - upper)
+    g0, g1 = score.sum(-1), (score * u).sum(-1)
+    i00, i01, i11 = weight.sum(-1), (weight * u).sum(-1), (weight * u**2).sum(-1)
+    det = i00 * i11 - i01**2
+    da = np.nan_to_num((i11 * g0 - i01 * g1) / det)
+    db = np.nan_to_num((i00 * g1 - i01 * g0) / det)
+    loglik = (k * lower + (n - k) * upper).sum(-1)
+    step = np.ones_like(a)
+    pending = np.arange(a.size)
+    for _ in range(40):
+        trial = _probit_loglik(u[pending], k[pending], n[pending], a[pending] + step[pending] * da[pending], b[pending] + step[pending] * db[pending])
+        worse = ~(trial >= loglik[pending] - 1e-12 * np.abs(loglik[pending]))
+        pending = pending[worse]
+        if pending.size == 0:
+            break
+        step[pending] *= 0.5
+    da, db = step * da, step * db
+    moved = np.abs(da) + np.abs(db) * (1.0 + np.abs(u).max(-1)) > _TOLERANCE
+    return da, db, moved
 
 
 def _probit_start(u: np.ndarray, k: np.ndarray, n: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -36,7 +36,7 @@ from stochpound.analysis.hazard import HazardCurve, probability_from_rate, rate_
 TARGETS = (0.10, 0.02)
 """Default target probabilities of exceedance in ``years`` (50) of :func:`risk_targeted_separation`."""
 _Z_RANGE = (-16.0, 10.0)
-_PANELS, _NODES = 48, 8
+_PANELS, _NODES = 24, 8
 _CHUNK = 4096
 _EXTRAPOLATED_SHARE = 1e-4
 
