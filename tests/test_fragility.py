@@ -5,9 +5,9 @@ import pytest
 import xarray as xr
 from scipy import optimize, special, stats
 
-from stochpound.analysis import Fragility, fit_fragility, fragility_surface, homogeneous_capacities, ida_fragility, limit_state_events, stripe_fragility
-from stochpound.analysis.fragility import ALWAYS, DECREASING, FIT, NEVER, SEPARATED, stripe_mle
+from stochpound.analysis import Fragility, fit_fragility, fragility_band, fragility_surface, homogeneous_capacities, ida_fragility, limit_state_events, stripe_fragility
 from stochpound.analysis.bootstrap import bootstrap_weights
+from stochpound.analysis.fragility import ALWAYS, DECREASING, FIT, NEVER, SEPARATED, stripe_mle
 
 
 def independent_stripe_mle(levels, k, n):
@@ -176,3 +176,14 @@ def test_ida_fragility_with_censoring_matches_the_single_fit():
     single = fit_fragility(capacities=capacity, censored_at=0.8)
     assert (float(result.theta), float(result.beta)) == pytest.approx((single.theta, single.beta))
     assert float(result.theta_lower) < single.theta < float(result.theta_upper)
+
+
+def test_the_fitted_curve_has_a_band_around_it_at_every_intensity():
+    events, _ = synthetic_stripes(np.random.default_rng(8))
+    fitted = stripe_fragility(events, bootstrap=200)
+    band = fragility_band(fitted, [0.2, 0.5, 1.0])
+    assert band.probability.values == pytest.approx(Fragility(float(fitted.theta), float(fitted.beta))([0.2, 0.5, 1.0]))
+    assert np.all(band.lower <= band.probability) and np.all(band.probability <= band.upper)
+    assert np.all(band.lower < band.upper)
+    with pytest.raises(ValueError, match="^fragility"):
+        fragility_band(stripe_fragility(events, bootstrap=0), [0.5])

@@ -9,10 +9,12 @@ from stochpound.analysis import (
     Fragility,
     HazardCurve,
     code_rules_risk,
+    contact_free_closure,
     demand_hazard_curve,
     fit_fragility,
     limit_state_events,
     mean_annual_frequency,
+    pounding_fragility,
     rate_from_probability,
     risk_curve,
     risk_targeted_separation,
@@ -184,8 +186,6 @@ def synthetic_store(seed=4):
 
 
 def test_the_store_selection_takes_the_contact_free_cases_for_every_gap_and_configuration():
-    from stochpound.analysis.store_risk import contact_free_closure, pounding_fragility
-
     store = synthetic_store()
     fragility = pounding_fragility(store, [0.01, 0.03, 0.06], bootstrap=20)
     assert set(fragility.theta.dims) == {"gap", "mu"}

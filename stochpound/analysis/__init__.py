@@ -21,6 +21,7 @@ from stochpound.analysis.separation_rules import contact_demands, fixed_base_cqc
 from stochpound.analysis.summary import run_summary
 from stochpound.analysis.fragility import Fragility, fit_fragility
 from stochpound.analysis.fragility_ensemble import (
+    fragility_band,
     fragility_surface,
     homogeneous_capacities,
     ida_fragility,
@@ -54,6 +55,7 @@ __all__ = [
     "run_summary",
     "Fragility",
     "fit_fragility",
+    "fragility_band",
     "fragility_surface",
     "homogeneous_capacities",
     "ida_fragility",

@@ -225,6 +225,39 @@ def fragility_surface(fragility: xr.Dataset, im: Sequence[float] | np.ndarray | 
     return surface.assign_attrs(units="1", long_name="fitted probability of exceedance")
 
 
+def fragility_band(fragility: xr.Dataset, im: Sequence[float] | np.ndarray, confidence: float = 0.95, dim: str = "im") -> xr.Dataset:
+    """The fitted F(x) at intensities ``im`` with its bootstrap band, for every fit (e.g. curves at a few gaps).
+
+    Parameters
+    ----------
+    fragility : xarray.Dataset
+        From :func:`stripe_fragility` or :func:`ida_fragility` with a bootstrap.
+    im : sequence of float
+        Intensities (IM units, > 0).
+    confidence : float
+        Level of the band (BCa over the resamples of the motions), in (0, 1).
+    dim : str
+        Name of the intensities' dimension.
+
+    Returns
+    -------
+    xarray.Dataset
+        ``probability`` (the fit), ``lower`` and ``upper`` over the fits' dimensions and ``dim``.
+    """
+    kernels.check_confidence(confidence)
+    if "theta_bootstrap" not in fragility:
+        raise ValueError("fragility: has no bootstrap samples (fit it with bootstrap > 0)")
+    x = xr.DataArray(np.asarray(im, dtype=float), dims=dim, coords={dim: np.asarray(im, dtype=float)})
+    fit = fragility_surface(fragility, x, dim)
+    sampled = xr.apply_ufunc(lognormal_cdf, x, fragility["theta_bootstrap"], fragility["beta_bootstrap"])
+    left_out = xr.apply_ufunc(lognormal_cdf, x, fragility["theta_jackknife"], fragility["beta_jackknife"])
+    lower, upper = xr.apply_ufunc(lambda b, e, j: interval(b, e, j, confidence), sampled, fit, left_out,
+                                  input_core_dims=[["bootstrap"], [], ["jackknife"]], output_core_dims=[[], []])
+    attrs = {"units": "1", "confidence": confidence}
+    return xr.Dataset({"probability": fit, "lower": lower.assign_attrs(long_name="lower bound of the fitted probability", **attrs),
+                       "upper": upper.assign_attrs(long_name="upper bound of the fitted probability", **attrs)})
+
+
 # ---------------------------------------------------------------- helpers
 
 
