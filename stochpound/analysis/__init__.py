@@ -19,6 +19,19 @@ from stochpound.analysis.pounding import pounding_probability
 from stochpound.analysis.separation import pounding_curve, required_separation, rule_exceedance
 from stochpound.analysis.separation_rules import contact_demands, fixed_base_cqc, separation_rules, store_contact_demands
 from stochpound.analysis.summary import run_summary
+from stochpound.analysis.fragility import Fragility, fit_fragility
+from stochpound.analysis.fragility_ensemble import (
+    fragility_band,
+    fragility_surface,
+    homogeneous_capacities,
+    ida_fragility,
+    limit_state_events,
+    stripe_fragility,
+)
+from stochpound.analysis.hazard import HazardCurve, probability_from_rate, rate_from_probability, return_period
+from stochpound.analysis.risk import demand_hazard_curve, mean_annual_frequency, risk_curve, risk_targeted_separation
+from stochpound.analysis.code_rules_risk import code_rules_risk
+from stochpound.analysis.store_risk import contact_free_closure, pounding_fragility
 
 __all__ = [
     "moments",
@@ -40,4 +53,23 @@ __all__ = [
     "store_contact_demands",
     "fixed_base_cqc",
     "run_summary",
+    "Fragility",
+    "fit_fragility",
+    "fragility_band",
+    "fragility_surface",
+    "homogeneous_capacities",
+    "ida_fragility",
+    "limit_state_events",
+    "stripe_fragility",
+    "HazardCurve",
+    "probability_from_rate",
+    "rate_from_probability",
+    "return_period",
+    "demand_hazard_curve",
+    "mean_annual_frequency",
+    "risk_curve",
+    "risk_targeted_separation",
+    "code_rules_risk",
+    "contact_free_closure",
+    "pounding_fragility",
 ]
