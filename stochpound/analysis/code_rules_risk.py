@@ -8,7 +8,7 @@ coincide). Here the intensity is read off the site's hazard curve, the
 stripe nearest to it (in ln IM) is taken, and each rule is applied to the
 *suite means* of that stripe's displacements (as a code's response-history
 analysis does: the mean over at least 7 motions), using
-:func:`stochpound.analysis.separation_rules.separation_rules`:
+:func:`~stochpound.analysis.separation_rules`:
 
 * u1, u2: the mean over the motions of the peak displacements of the two
   floors at each contact; ρ (for DDC): the mean of their correlations;
@@ -56,7 +56,7 @@ def code_rules_risk(demands: xr.Dataset, hz: HazardCurve, design_levels: Sequenc
     demands : xarray.Dataset
         Contact-free runs' ``peak_displacement_left``, ``peak_displacement_right``,
         ``correlation`` and ``peak_closure`` (m;
-        :func:`~stochpound.analysis.separation_rules.store_contact_demands`
+        :func:`~stochpound.analysis.store_contact_demands`
         of a store's ``gap = inf`` cases), with dims ``intensity_dim``
         (coordinate: the stripe levels, in the hazard's IM units),
         ``record_dim`` and ``contact_dim``; other dims are carried along.
@@ -70,9 +70,9 @@ def code_rules_risk(demands: xr.Dataset, hz: HazardCurve, design_levels: Sequenc
         Peak base displacement max|s| (m) of the isolated building per run
         (dims ``intensity_dim``, ``record_dim``): adds the rule ``dtm``.
     cqc, reduction
-        As in :func:`~stochpound.analysis.separation_rules.separation_rules`.
+        As in :func:`~stochpound.analysis.separation_rules`.
     confidence, bootstrap, seed
-        As in :func:`~stochpound.analysis.fragility_ensemble.stripe_fragility`.
+        As in :func:`~stochpound.analysis.stripe_fragility`.
 
     Returns
     -------

@@ -15,7 +15,7 @@ first exceeds the limit state) give θ = exp(mean ln c), β = std(ln c)
 are right-censored observations of the same lognormal likelihood.
 
 When the data cannot identify a lognormal, the fit is *degenerate* and says
-so in its ``status`` (:data:`STATUS`), with a step (β = 0) at θ:
+so in its ``status`` (``STATUS``), with a step (β = 0) at θ:
 
 * ``never``: no run exceeded (θ = inf, F ≡ 0);
 * ``always``: every run exceeded (θ = 0, F ≡ 1);
@@ -54,7 +54,7 @@ class Fragility:
     beta : float or numpy.ndarray
         Log-standard deviation β (> 0; 0 for a degenerate step).
     status : int or numpy.ndarray
-        Index into :data:`STATUS`.
+        Index into ``STATUS``.
     method : str
         ``"stripes"`` or ``"ida"``.
     """
@@ -70,7 +70,7 @@ class Fragility:
 
     @property
     def status_name(self) -> str | np.ndarray:
-        """The status as text (:data:`STATUS`)."""
+        """The status as text (``STATUS``)."""
         names = np.asarray(STATUS, dtype=object)[np.asarray(self.status)]
         return str(names) if np.ndim(names) == 0 else names
 
@@ -107,7 +107,7 @@ def fit_fragility(levels: ArrayLike | None = None, pounded: ArrayLike | None = N
     Returns
     -------
     Fragility
-        θ, β and the fit's status (:data:`STATUS`). Leading axes of the
+        θ, β and the fit's status (``STATUS``). Leading axes of the
         inputs (before the stripes' or motions' last axis) give a batch of fits.
 
     Examples

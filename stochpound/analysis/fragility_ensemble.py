@@ -93,7 +93,7 @@ def stripe_fragility(events: xr.DataArray, intensity_dim: str = "intensity", rec
     -------
     xarray.Dataset
         Over the other dimensions: ``theta`` (IM units), ``beta``,
-        ``status`` (:data:`~stochpound.analysis.fragility.STATUS`),
+        ``status`` (``stochpound.analysis.fragility.STATUS``),
         ``theta_lower``/``theta_upper`` and ``beta_lower``/``beta_upper``
         (BCa bootstrap intervals), ``theta_bootstrap`` and ``beta_bootstrap``
         (dimension ``bootstrap``) and ``theta_jackknife`` and

@@ -135,7 +135,7 @@ class HazardCurve:
         """A table read from a CSV file of rows ``im, rate`` (annual rate of exceedance, 1/yr).
 
         Lines starting with ``#`` are comments (keep the provenance there)
-        and are stored in :attr:`source`; a first row that is not numeric
+        and are stored in ``source``; a first row that is not numeric
         (column names) is skipped. Any further columns are ignored.
         """
         path = Path(path)
@@ -162,7 +162,7 @@ class HazardCurve:
 
     @classmethod
     def bundled(cls, name: str, *, extrapolate: bool = False) -> HazardCurve:
-        """A hazard curve shipped with stochpound (``data/hazard/<name>.csv``; :func:`bundled_curves` lists them)."""
+        """A hazard curve shipped with stochpound (``data/hazard/<name>.csv``; ``bundled_curves()`` lists them)."""
         folder = _bundled_folder()
         path = folder / f"{name}.csv"
         if not path.is_file():

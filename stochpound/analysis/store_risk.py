@@ -43,7 +43,7 @@ def pounding_fragility(store: xr.Dataset, gaps: Sequence[float] | np.ndarray, in
     Returns
     -------
     xarray.Dataset
-        :func:`~stochpound.analysis.fragility_ensemble.stripe_fragility` over
+        :func:`~stochpound.analysis.stripe_fragility` over
         ``gap`` (the given gaps) and the store's other grid dimensions.
     """
     events = limit_state_events(contact_free_closure(store), gaps, "gap")
