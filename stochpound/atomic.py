@@ -40,11 +40,15 @@ def replacing(path: str | Path) -> Iterator[Path]:
 def check_writable(path: str | Path) -> None:
     """Raise the ``OSError`` that writing ``path`` would raise, before any work: create (and remove) a temporary beside it.
 
-    Its folder is created if needed (as :func:`replacing` would).
+    Its folder is created if needed (as :func:`replacing` would). The error
+    names that folder (not the temporary's name).
     """
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    os.unlink(_create_temporary(path))
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        os.unlink(_create_temporary(path))
+    except OSError as error:
+        raise OSError(error.errno, error.strerror, str(path.parent)) from None
 
 
 def _create_temporary(path: Path) -> Path:

@@ -211,7 +211,8 @@ def run_experiment(
         report.executor = _describe_executor(workers, scheduler)
         if repair:
             say(f"{store}: damaged; rebuilding it from the {report.done_before} finished cases in {session.folder.name}/")
-        say(estimate_run(experiment, grids, experiment.n_cases - report.done_before).describe(_cores(workers, scheduler)))
+        if report.done_before < report.total:
+            say(estimate_run(experiment, grids, report.total - report.done_before).describe(_cores(workers, scheduler)))
         identity = code_identity()
         append_run(session.folder, {"started": now(), "machine": machine(), "executor": report.executor, **identity})
         missing = session.missing()
