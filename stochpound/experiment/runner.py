@@ -195,6 +195,8 @@ def run_experiment(
     if not restart:
         repair = check_store(store, experiment.sha256)
         if store.is_file() and not repair and store_complete(store):
+            if FolderLock(parts_folder(store)).held():
+                raise _busy(store)
             return RunReport(store, experiment.n_cases, experiment.n_cases, elapsed=time.monotonic() - started, nothing_to_run=True)
     elif store.is_dir():
         raise ExperimentError(f"{store}: is a folder; --store must name a file")
@@ -203,7 +205,7 @@ def run_experiment(
     parts_folder(store).mkdir(parents=True, exist_ok=True)
     lock = FolderLock(parts_folder(store))
     if not lock.acquire():
-        raise ExperimentError(f"{store}: another run is writing this store (its parts folder is locked)")
+        raise _busy(store)
     with lock, _interrupts() as stop:
         if restart:
             clear_store(store)
@@ -252,6 +254,10 @@ def run_experiment(
             session.rebuild()
             report.elapsed = time.monotonic() - started
     return report
+
+
+def _busy(store: Path) -> ExperimentError:
+    return ExperimentError(f"{store}: another run is writing this store (its parts folder is locked)")
 
 
 def _check_size(experiment: Experiment, grids: dict[str, tuple[float, int]], store: Path, restart: bool, large_ok: bool, cores: int) -> None:

@@ -72,6 +72,17 @@ def check_store(store: Path, sha256: str) -> bool:
         raise ExperimentError(f"{store}: is a folder; --store must name a file")
     folder = parts_folder(store)
     parts = folder.exists() and ((folder / DEFINITION_FILE).exists() or bool(part_paths(folder)))
+    damaged = False
+    if store.exists():
+        try:
+            found = store_identity(store)
+        except ExperimentError as error:
+            if not parts:
+                raise ExperimentError(f"{error}; {hint}") from None
+            damaged = True  # rebuilt from the parts, if they hold this definition's cases (checked below)
+        else:
+            if found != sha256:
+                raise ExperimentError(f"{store}: made from a different experiment definition (sha256 {found[:12]}…, this one {sha256[:12]}…); {hint}")
     if parts:
         try:
             found = read_definition(folder)["definition_sha256"]
@@ -79,17 +90,7 @@ def check_store(store: Path, sha256: str) -> bool:
             raise ExperimentError(f"{folder}: unreadable parts folder ({error}); {hint}") from None
         if found != sha256:
             raise ExperimentError(f"{folder}: holds cases of a different experiment definition (sha256 {found[:12]}…, this one {sha256[:12]}…); {hint}")
-    if not store.exists():
-        return False
-    try:
-        found = store_identity(store)
-    except ExperimentError as error:
-        if parts:
-            return True
-        raise ExperimentError(f"{error}; {hint}") from None
-    if found != sha256:
-        raise ExperimentError(f"{store}: made from a different experiment definition (sha256 {found[:12]}…, this one {sha256[:12]}…); {hint}")
-    return False
+    return damaged
 
 
 def store_complete(store: Path) -> bool:

@@ -83,8 +83,8 @@ def store_status(store: str | Path, rebuild: bool = True) -> StatusReport:
     lock = FolderLock(session.folder)
     try:
         running, writable = not lock.acquire(), True
-    except OSError:  # the lock file cannot be made (a read-only disk): no run can be writing the folder either
-        running, writable = False, False
+    except OSError:  # the lock file cannot be made or opened for writing (a read-only disk): only read
+        running, writable = lock.held(), False
     rebuilt = rebuild and writable and not running
     try:
         if rebuilt:
