@@ -11,17 +11,19 @@ import math
 from dataclasses import dataclass
 from typing import Mapping
 
-from stochpound.experiment.model import KINDS, Experiment
+from stochpound.experiment.model import KINDS, Experiment, Point
+from stochpound.experiment.spec import AUTO
 from stochpound.experiment.store import layout
 from stochpound.memory import format_bytes
+from stochpound.model.scene_file import scene_from_dict
 
 LARGE_RUN_CASES = 1_000_000
 """Above this many cases to run, ``experiment run`` asks for ``--yes``."""
 LARGE_RUN_BYTES = 10 * 2**30
 """... or above this estimated size of the store file (10 GiB)."""
 CPU_SECONDS_PER_SIMULATED_SECOND = {"exact": 2e-4, "ivp": 0.1}
-"""CPU time of a case per second of motion, by solver: the exact solver's is measured on the
-study's scenes (docs/benchmarks.md: 0.09–0.2 ms), the ivp solver's is a rough order of magnitude."""
+"""CPU time of a case per second of motion, by solver (``auto``: the one each grid point's scene gets): the exact
+solver's is measured on the study's scenes (docs/benchmarks.md: 0.09–0.2 ms), the ivp solver's is a rough order of magnitude."""
 _ID_BYTES = 24
 """Bytes per case id in the file (16 characters and the variable-length string's overhead)."""
 
@@ -70,14 +72,12 @@ def estimate_run(experiment: Experiment, motion_grids: Mapping[str, tuple[float,
     cases : int
         Cases to run (their share of the experiment's simulated time is counted).
     """
-    simulated = 0.0
+    per_point = sum(len(experiment.realizations(label)) * dt * max(samples - 1, 0) for label, (dt, samples) in motion_grids.items())
+    cpu = 0.0
     for kind in KINDS:
-        points = len(experiment.points(kind))
-        for label in experiment.motions:
-            dt, samples = motion_grids[label]
-            simulated += points * len(experiment.realizations(label)) * dt * max(samples - 1, 0)
+        for point in experiment.points(kind):
+            cpu += per_point * CPU_SECONDS_PER_SIMULATED_SECOND[_method(experiment, point)]
     share = cases / experiment.n_cases if experiment.n_cases else 0.0
-    per_second = CPU_SECONDS_PER_SIMULATED_SECOND.get(experiment.solver["method"], max(CPU_SECONDS_PER_SIMULATED_SECOND.values()))
     store = layout(experiment, motion_grids, 0)
     size = 0
     for spec in store.specs:
@@ -86,7 +86,16 @@ def estimate_run(experiment: Experiment, motion_grids: Mapping[str, tuple[float,
         grid = len(experiment.kind_dims(spec.kind))
         per_position = _ID_BYTES if spec.family == "id" else spec.dtype.itemsize * math.prod(store.sizes[d] for d in spec.dims[grid:])
         size += per_position * math.prod(experiment.grid_shape(spec.kind))
-    return RunEstimate(cases, simulated * share * per_second, size)
+    return RunEstimate(cases, cpu * share, size)
+
+
+def _method(experiment: Experiment, point: Point) -> str:
+    """The solver of a grid point's cases: the experiment's, or with ``auto`` the one :func:`stochpound.simulate` picks."""
+    method = experiment.solver["method"]
+    if method != AUTO:
+        return method
+    scene = scene_from_dict(experiment.structure(point), base_dir=experiment.base_dir)
+    return "ivp" if scene.nonlinear_laws() else "exact"
 
 
 def _duration(seconds: float) -> str:

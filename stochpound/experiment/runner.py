@@ -16,13 +16,13 @@ from __future__ import annotations
 import contextlib
 import logging
 import os
-from multiprocessing import forkserver
 import signal
 import sys
 import threading
 import time
 from contextlib import contextmanager
 from dataclasses import dataclass, field
+from multiprocessing import forkserver
 from pathlib import Path
 from typing import Any, Callable, Iterable, Iterator
 
@@ -50,7 +50,7 @@ LOCAL_CLUSTER_CONFIG = {
 }
 """dask settings of the local cluster: no statistical profiler in the workers (it samples their threads every
 10 ms), slower system monitors and event-loop ticks: idle, the cluster takes about 3 % of a core instead of 13 %;
-worker processes forked by multiprocessing's fork server (which ignores SIGINT: :func:`_ignoring_sigint`)."""
+worker processes forked by multiprocessing's fork server (which ignores SIGINT: :func:`_handling_sigint`)."""
 
 
 @dataclass
@@ -253,6 +253,7 @@ def run_experiment(
             checkpoints.wait()
             session.rebuild()
             report.elapsed = time.monotonic() - started
+            report.setup = report.setup or report.elapsed  # stopped before the first batch: all of it was start-up
     return report
 
 
@@ -411,14 +412,18 @@ def _dask_client(workers: int | None, scheduler: str | None, say: Callable[[str]
     warm_up()
     n_workers = workers or os.cpu_count() or 1
     say(f"starting a local dask cluster ({n_workers} worker{'s' if n_workers > 1 else ''})…")
-    with _ignoring_sigint():  # the fork server, and every worker process it forks, ignore SIGINT
+    with _handling_sigint(signal.SIG_IGN):  # the fork server, and every worker process it forks, ignore SIGINT
         forkserver.ensure_running()
     cluster = client = None
+    requested: list[int] = []
     try:
-        with dask.config.set(LOCAL_CLUSTER_CONFIG), _deferring_sigint():
+        # a SIGINT during the cluster's start (which an exception would leave half made) is raised once it can be closed
+        with dask.config.set(LOCAL_CLUSTER_CONFIG), _handling_sigint(lambda signum, frame: requested.append(signum)):
             cluster = LocalCluster(  # its HTTP server on a free port (the default, 8787, may be taken: a warning)
                 n_workers=n_workers, threads_per_worker=1, processes=True, dashboard_address=":0", silence_logs=logging.ERROR
             )
+        if requested:
+            raise KeyboardInterrupt
         client = Client(cluster)
         yield client
     finally:
@@ -429,18 +434,18 @@ def _dask_client(workers: int | None, scheduler: str | None, say: Callable[[str]
 
 
 @contextmanager
-def _ignoring_sigint() -> Iterator[None]:
-    """Ignore SIGINT inside the block: processes started meanwhile keep ignoring it.
+def _handling_sigint(handler: Any) -> Iterator[None]:
+    """SIGINT goes to ``handler`` inside the block (``signal.SIG_IGN``: ignored); nothing changes outside the main thread.
 
     The local workers are forked by multiprocessing's fork server
-    (:data:`LOCAL_CLUSTER_CONFIG`), started in this block: they inherit its
-    ignored SIGINT. A Ctrl-C in a terminal reaches every process of the
-    foreground group; the workers then stop with the cluster instead of
-    printing their own tracebacks. The block lasts as long as the fork
-    server's fork and exec (milliseconds, once per process): a Ctrl-C then is lost.
+    (:data:`LOCAL_CLUSTER_CONFIG`), started while SIGINT is ignored: they
+    inherit the ignored SIGINT. A Ctrl-C in a terminal reaches every process
+    of the foreground group; the workers then stop with the cluster instead of
+    printing their own tracebacks. Ignoring lasts as long as the fork server's
+    fork and exec (milliseconds, once per process): a Ctrl-C then is lost.
     """
     try:
-        previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+        previous = signal.signal(signal.SIGINT, handler)
     except ValueError:  # not the main thread
         yield
         return
@@ -448,24 +453,6 @@ def _ignoring_sigint() -> Iterator[None]:
         yield
     finally:
         signal.signal(signal.SIGINT, previous)
-
-
-@contextmanager
-def _deferring_sigint() -> Iterator[None]:
-    """Note a SIGINT inside the block (the cluster's start, which an exception would leave half made) and raise
-    KeyboardInterrupt when the block ends, once the cluster exists and can be closed."""
-    requested = []
-    try:
-        previous = signal.signal(signal.SIGINT, lambda signum, frame: requested.append(signum))
-    except ValueError:  # not the main thread
-        yield
-        return
-    try:
-        yield
-    finally:
-        signal.signal(signal.SIGINT, previous)
-    if requested:
-        raise KeyboardInterrupt
 
 
 def _cores(workers: int | None, scheduler: str | None) -> int:
