@@ -11,5 +11,6 @@ from stochpound.model.scene_file import load_scene, scene_from_dict  # noqa: E40
 from stochpound.solvers.simulate import simulate  # noqa: E402
 from stochpound.experiment.store import open_store  # noqa: E402
 from stochpound.experiment.ensemble import simulate_ensemble  # noqa: E402
+from stochpound.experiment.spec import ExperimentError  # noqa: E402
 
-__all__ = ["__version__", "load_scene", "scene_from_dict", "simulate", "simulate_ensemble", "open_store", "SceneError", "RecordError", "StochpoundError"]
+__all__ = ["__version__", "load_scene", "scene_from_dict", "simulate", "simulate_ensemble", "open_store", "ExperimentError", "SceneError", "RecordError", "StochpoundError"]

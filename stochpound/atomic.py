@@ -37,6 +37,20 @@ def replacing(path: str | Path) -> Iterator[Path]:
         raise
 
 
+def check_writable(path: str | Path) -> None:
+    """Raise the ``OSError`` that writing ``path`` would raise, before any work: create (and remove) a temporary beside it.
+
+    Its folder is created if needed (as :func:`replacing` would). The error
+    names that folder (not the temporary's name).
+    """
+    path = Path(path)
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        os.unlink(_create_temporary(path))
+    except OSError as error:
+        raise OSError(error.errno, error.strerror, str(path.parent)) from None
+
+
 def _create_temporary(path: Path) -> Path:
     while True:
         temporary = path.with_name(f".{path.name}.{secrets.token_hex(6)}{TEMPORARY_SUFFIX}")

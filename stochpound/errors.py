@@ -4,6 +4,8 @@ Every error caused by user input names the offending field (or file and line)
 and the allowed range, so that it can be fixed without reading the source.
 """
 
+import errno
+
 
 class StochpoundError(Exception):
     """Base class of every error raised on purpose by stochpound."""
@@ -17,3 +19,17 @@ class SceneError(StochpoundError, ValueError):
 class RecordError(StochpoundError, ValueError):
     """A ground-motion record cannot be read or is unusable; the message names
     the file (and line, where there is one)."""
+
+
+def os_error_message(error: OSError) -> str:
+    """One line for a file-system error, naming the path: ``PATH: cannot write here (Read-only file system)``.
+
+    Without a path in ``error``, its message as it is.
+    """
+    if error.filename is None:
+        return str(error)
+    action = "cannot write here" if error.errno in _WRITE_ERRORS else "cannot access"
+    return f"{error.filename}: {action} ({error.strerror or error})"
+
+
+_WRITE_ERRORS = {errno.EROFS, errno.EACCES, errno.EPERM, errno.ENOSPC, errno.EDQUOT}

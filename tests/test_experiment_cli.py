@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import json
 import os
+import re
 import shutil
 import signal
 import stat
@@ -13,9 +15,10 @@ import time
 import pytest
 import xarray as xr
 
+from stochpound import open_store
 from stochpound.experiment.parts import part_paths, parts_folder
 from stochpound.experiment.session import PACKAGE, git_commit, sources_sha256
-from tests.test_experiment_helpers import REPO, SMALL_EXPERIMENT, invoke, quickstart_cell, write_experiment
+from tests.test_experiment_helpers import REPO, SMALL_EXPERIMENT, invoke, quickstart_cell, read_only, write_experiment
 
 #: One cell of the quick-start grid under a short harmonic motion, solved by ivp: a small, quick experiment.
 TINY_EXPERIMENT = quickstart_cell("""
@@ -110,3 +113,216 @@ def test_a_git_checkout_records_its_commit():
     if not (REPO / ".git").exists():
         pytest.skip("not a git checkout")
     assert len(commit.split("+")[0]) == 40
+
+
+# ---------------------------------------------------------------- issue 27: what a new user trips over
+
+#: The tiny cell under a stationary Kanai-Tajimi ensemble (no envelope, as docs/experiments.md allows): 2 cases + 2 references.
+STATIONARY_EXPERIMENT = quickstart_cell("""
+[synthetic.still]
+type = "kanai_tajimi"
+count = 2
+seed = 5
+omega_g = 15.0
+zeta_g = 0.6
+pga = 3.0
+duration = 2.0
+dt = 0.02
+
+[solver]
+method = "ivp"
+""")
+
+
+@pytest.fixture(scope="module")
+def stationary(tmp_path_factory):
+    """A complete store of :data:`STATIONARY_EXPERIMENT` (its experiment file beside it); tests copy it before changing it."""
+    folder = tmp_path_factory.mktemp("stationary")
+    experiment = write_experiment(folder, STATIONARY_EXPERIMENT, "still.toml")
+    result = invoke("experiment", "run", str(experiment), "--workers", "0", "--quiet")
+    assert result.exit_code == 0, result.output
+    return folder
+
+
+def _copy(stationary, tmp_path):
+    """A copy of the stationary store's folder; its experiment file and store."""
+    folder = tmp_path / "copy"
+    shutil.copytree(stationary, folder)
+    return folder / "still.toml", folder / "still.nc"
+
+
+def test_a_stationary_ensemble_stores_a_json_envelope_and_builds_its_report(stationary, tmp_path):
+    from stochpound.motions import kanai_tajimi
+
+    assert json.loads(kanai_tajimi(1, 1.0, 0.02, omega_g=15.0, zeta_g=0.6, pga=3.0, seed=1).attrs["envelope"]) is None
+    out = tmp_path / "report"
+    result = invoke("report", "build", str(stationary / "still.nc"), "--out", str(out), "--format", "html")
+    assert result.exit_code == 0, result.output
+    assert "; stationary;" in (out / "index.html").read_text()
+
+
+def test_report_out_not_writable_fails_before_the_work(stationary, tmp_path, monkeypatch):
+    locked = tmp_path / "locked"
+    locked.mkdir()
+    with read_only(locked, monkeypatch):
+        result = invoke("report", "build", str(stationary / "still.nc"), "--out", str(locked / "report"), "--format", "html")
+    assert result.exit_code == 1
+    assert result.stderr.strip().startswith(f"Error: {locked / 'report'}: cannot write here ("), result.stderr
+    assert "reading stores" not in result.stderr and len(result.stderr.strip().splitlines()) == 1, "no work before the check"
+
+
+def test_a_reused_out_loses_only_its_own_stale_figures(stationary, tmp_path):
+    out = tmp_path / "report"
+    build = ("report", "build", str(stationary / "still.nc"), "--out", str(out), "--format", "html")
+    assert invoke(*build).exit_code == 0
+    manifest = out / ".stochpound-report.json"
+    owned = json.loads(manifest.read_text())
+    assert owned and all(name.startswith(("figures/", "tables/")) for name in owned)
+    # as if an earlier build (another store) had written figure-old.png and tables/old.csv
+    (out / "figures" / "figure-old.png").write_bytes(b"old")
+    (out / "tables" / "old.csv").write_text("old")
+    manifest.write_text(json.dumps([*owned, "figures/figure-old.png", "tables/old.csv", "../outside.png", "notes.txt"]))
+    user_files = [out / "figures" / "mine.png", out / "notes.txt", tmp_path / "outside.png"]
+    for path in user_files:
+        path.write_text("the user's")
+    assert invoke(*build).exit_code == 0
+    assert not (out / "figures" / "figure-old.png").exists() and not (out / "tables" / "old.csv").exists()
+    assert all(path.read_text() == "the user's" for path in user_files), "only files an earlier build listed are removed"
+    assert json.loads(manifest.read_text()) == owned
+    assert all((out / name).is_file() for name in owned)
+
+
+def test_a_damaged_store_with_intact_parts_is_repaired_by_run(stationary, tmp_path):
+    experiment, store = _copy(stationary, tmp_path)
+    store.write_bytes(b"not a store")
+    result = invoke("experiment", "run", str(experiment), "--workers", "0")
+    assert result.exit_code == 0, result.output
+    assert "rebuilt from the finished cases in still.nc.parts/" in result.stdout and "--restart" not in result.output
+    assert "damaged; rebuilding it from the 4 finished cases" in result.stderr
+    with open_store(store) as dataset:
+        assert int((dataset.case_status == 1).sum()) == 2 and int((dataset.reference_status == 1).sum()) == 2
+    # without parts there is nothing to repair from: then, and only then, the advice is --restart
+    shutil.rmtree(parts_folder(store))
+    store.write_bytes(b"not a store")
+    result = invoke("experiment", "run", str(experiment), "--workers", "0")
+    assert result.exit_code == 1 and "use --restart to discard it" in result.stderr, result.stderr
+
+
+def test_a_complete_store_is_not_run_again(stationary, tmp_path):
+    experiment, store = _copy(stationary, tmp_path)
+    before = (store.stat().st_mtime_ns, (parts_folder(store) / "runs.jsonl").read_text())
+    result = invoke("experiment", "run", str(experiment))  # default workers: a cluster would start if anything ran
+    assert result.exit_code == 0, result.output
+    assert result.stdout.startswith("nothing to run: store complete (4/4 cases)"), result.stdout
+    assert "cluster" not in result.output and "solver" not in result.output
+    assert (store.stat().st_mtime_ns, (parts_folder(store) / "runs.jsonl").read_text()) == before
+    assert f"next: stochpound report build {store} --out " in result.stdout
+
+
+def test_a_store_on_a_read_only_disk_can_be_read(stationary, tmp_path, monkeypatch):
+    experiment, store = _copy(stationary, tmp_path)
+    (parts_folder(store) / ".lock").unlink(missing_ok=True)  # a store copied without its lock file
+    with read_only(store.parent, monkeypatch):
+        status = invoke("experiment", "status", str(store))
+        with open_store(store) as dataset:
+            assert dataset.attrs["experiment_name"] == "quickstart"
+        report = invoke("report", "build", str(store), "--out", str(tmp_path / "report"), "--format", "html")
+        rerun = invoke("experiment", "run", str(experiment), "--workers", "0")
+    assert status.exit_code == 0, status.output
+    assert "4/4 cases done, 0 missing" in status.stdout and "rebuilt" not in status.stdout
+    assert report.exit_code == 0, report.output
+    assert rerun.exit_code == 0 and rerun.stdout.startswith("nothing to run"), rerun.output
+
+
+def test_writing_onto_a_read_only_disk_is_a_one_line_error(stationary, tmp_path, monkeypatch):
+    experiment, store = _copy(stationary, tmp_path)
+    store.unlink()  # a resume: the store file must be rebuilt from the parts
+    scene = REPO / "experiments" / "scenes" / "study_b1_isolated_flexible.toml"
+    with read_only(store.parent, monkeypatch):
+        resume = invoke("experiment", "run", str(experiment), "--workers", "0")
+        fresh = invoke("experiment", "run", str(experiment), "--workers", "0", "--store", str(store.parent / "new" / "fresh.nc"))
+        simulated = invoke("simulate", str(scene), "--out", str(store.parent / "run.nc"), "--method", "ivp")
+    for result, path in ((resume, parts_folder(store) / ".lock"), (fresh, store.parent / "new"), (simulated, store.parent)):
+        assert result.exit_code == 1, result.output
+        assert result.stderr.strip().startswith(f"Error: {path}: cannot write here ("), result.stderr
+        assert len(result.stderr.strip().splitlines()) == 1, result.stderr
+
+
+def test_a_large_experiment_shows_its_estimate_and_asks_for_yes(tmp_path, monkeypatch):
+    """2·10⁶ cases: refused before anything is written, with the time and size; with --yes it goes past the check
+    (and here stops at the read-only folder, so that nothing runs)."""
+    experiment = write_experiment(tmp_path, STATIONARY_EXPERIMENT.replace("count = 2", "count = 1000000"), "large.toml")
+    result = invoke("experiment", "run", str(experiment), "--workers", "0")
+    assert result.exit_code == 1
+    message = result.stderr.strip()
+    assert re.fullmatch(
+        rf"Error: {re.escape(str(experiment))}: 2,000,000 cases to run: roughly [0-9.]+ \w+ on 1 core, store about [0-9.]+ MiB "
+        r"\(and as much again in its \.parts folder\); above 1,000,000 cases or 10 GiB of store: give --yes to run it",
+        message,
+    ), message
+    assert sorted(path.name for path in tmp_path.iterdir()) == ["large.toml"]
+    with read_only(tmp_path, monkeypatch):
+        result = invoke("experiment", "run", str(experiment), "--workers", "0", "--yes")
+    assert result.exit_code == 1 and "cannot write here" in result.stderr and "--yes" not in result.stderr, result.stderr
+
+
+def test_a_first_run_says_what_it_does_and_ctrl_c_during_the_cluster_start_stops_it(tmp_path):
+    """The start-up messages as they happen; SIGINT to the process group while the local cluster starts: exit 130, a readable store."""
+    experiment = write_experiment(tmp_path, STATIONARY_EXPERIMENT, "still.toml")
+    command = [sys.executable, "-m", "stochpound", "experiment", "run", str(experiment), "--workers", "2"]
+    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
+    lines = []
+    for line in process.stderr:
+        lines.append(line)
+        if line.startswith("starting a local dask cluster"):
+            break
+    assert lines[0].startswith("4 cases to run: roughly "), lines
+    assert lines[1] in ("compiling the solver (first run only, ~10 s)…\n", "loading the compiled solver…\n"), lines
+    assert lines[2] == "starting a local dask cluster (2 workers)…\n", lines
+    time.sleep(0.5)  # inside LocalCluster(...): its workers take seconds to start
+    os.killpg(process.pid, signal.SIGINT)
+    out, err = process.communicate(timeout=120)
+    assert process.returncode == 130, (out, err)
+    assert "Traceback" not in err, err
+    assert out.startswith("interrupted: 0/4 cases done"), out
+    assert "rerun the same command to complete the missing cases" in out
+    with open_store(tmp_path / "still.nc") as dataset:
+        assert int((dataset.case_status == 0).sum()) == 2
+
+
+def test_a_finished_run_names_the_next_command_and_its_times(tmp_path):
+    experiment = write_experiment(tmp_path, STATIONARY_EXPERIMENT, "still.toml")
+    result = invoke("experiment", "run", str(experiment), "--workers", "0")
+    assert result.exit_code == 0, result.output
+    first = result.stdout.splitlines()[0]
+    assert re.fullmatch(
+        r"complete: 4/4 cases done \(4 this run, 0 before\) on this process \(no dask\); "
+        r"(?P<all>[0-9.]+) s in all: (?P<setup>[0-9.]+) s start-up, (?P<run>[0-9.]+) s running, [0-9.]+ cases/s", first
+    ), first
+    assert result.stdout.splitlines()[-1] == f"next: stochpound report build {tmp_path / 'still.nc'} --out {tmp_path / 'still'}-report"
+
+
+def test_the_help_is_whole_and_the_bare_command_prints_it():
+    bare = invoke()
+    assert bare.exit_code == 0 and bare.stdout.startswith("Usage: ") and "Commands:" in bare.stdout
+    listed = " ".join(invoke("experiment", "--help").stdout.split())
+    assert "run Run the missing cases of each EXPERIMENT_FILE into its store, one after the other." in listed
+    for group in ((), ("experiment",), ("records",), ("report",)):
+        commands = invoke(*group, "--help").stdout.split("Commands:")[1]
+        assert "..." not in commands, commands
+    report = " ".join(invoke("report", "--help").stdout.split())
+    assert "built from experiment stores: any experiment's" in report
+
+
+def test_experiment_error_is_importable_from_the_package():
+    import stochpound
+    from stochpound.experiment.spec import ExperimentError
+
+    assert stochpound.ExperimentError is ExperimentError and "ExperimentError" in stochpound.__all__
+
+
+def test_the_readme_plot_example_shows_or_saves_its_figure():
+    text = (REPO / "README.md").read_text()
+    block = text[text.index("```python\nimport matplotlib.pyplot as plt\nimport stochpound") :]
+    block = block[: block.index("```", 3)]
+    assert ".plot()" in block and ("plt.savefig(" in block or "plt.show()" in block)

@@ -2,10 +2,16 @@
 
 from __future__ import annotations
 
+import builtins
+import errno
+import io
 import os
+import stat
 import subprocess
 import sys
+from contextlib import contextmanager
 from pathlib import Path
+from typing import Any, Iterator
 
 import numpy as np
 import xarray as xr
@@ -147,3 +153,62 @@ def assert_same_results(first: Path, second: Path) -> None:
                 assert np.array_equal(x.view(np.uint8), y.view(np.uint8)), name
             else:
                 assert np.array_equal(x, y), name
+
+
+
+@contextmanager
+def read_only(folder: Path, monkeypatch) -> Iterator[None]:
+    """Inside the block, ``folder`` (and everything in it) cannot be written, as on a read-only disk.
+
+    As another user than root, by ``chmod`` (restored afterwards). Root writes
+    through any mode and a test cannot mount a read-only file system, so for
+    root every way stochpound creates or writes a file (``open`` and
+    ``os.open`` for writing, ``os.mkdir``) raises ``OSError(EROFS)`` for paths
+    inside ``folder``, as the kernel would; reading is untouched. Only this
+    process is affected: use it with click's test runner, not a subprocess.
+    """
+    folder = Path(folder).resolve()
+    if os.geteuid() != 0:
+        modes = {path: stat.S_IMODE(path.stat().st_mode) for path in [folder, *folder.rglob("*")]}
+        for path, mode in modes.items():
+            path.chmod(mode & ~0o222)
+        try:
+            yield
+        finally:
+            for path, mode in modes.items():
+                path.chmod(mode)
+        return
+
+    def inside(path: Any) -> bool:
+        return isinstance(path, (str, os.PathLike)) and Path(os.path.abspath(os.fspath(path))).is_relative_to(folder)
+
+    def refuse(path: Any) -> None:
+        raise OSError(errno.EROFS, os.strerror(errno.EROFS), os.fspath(path))
+
+    real_open, real_os_open, real_mkdir = builtins.open, os.open, os.mkdir
+
+    def fake_open(file: Any, mode: str = "r", *args: Any, **kwargs: Any) -> Any:
+        if inside(file) and any(c in mode for c in "wax+"):
+            refuse(file)
+        return real_open(file, mode, *args, **kwargs)
+
+    def fake_os_open(path: Any, flags: int, *args: Any, **kwargs: Any) -> int:
+        if inside(path) and flags & (os.O_WRONLY | os.O_RDWR | os.O_CREAT | os.O_APPEND | os.O_TRUNC):
+            refuse(path)
+        return real_os_open(path, flags, *args, **kwargs)
+
+    def fake_mkdir(path: Any, *args: Any, **kwargs: Any) -> None:
+        if inside(path):
+            if os.path.isdir(path):
+                raise FileExistsError(errno.EEXIST, os.strerror(errno.EEXIST), os.fspath(path))
+            if not os.path.isdir(os.path.dirname(os.path.abspath(path))):
+                raise FileNotFoundError(errno.ENOENT, os.strerror(errno.ENOENT), os.fspath(path))
+            refuse(path)
+        real_mkdir(path, *args, **kwargs)
+
+    with monkeypatch.context() as patch:
+        patch.setattr(builtins, "open", fake_open)
+        patch.setattr(io, "open", fake_open)  # pathlib's
+        patch.setattr(os, "open", fake_os_open)
+        patch.setattr(os, "mkdir", fake_mkdir)
+        yield

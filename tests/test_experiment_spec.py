@@ -53,7 +53,8 @@ def experiment(data: dict) -> Experiment:
         ({"motions": [{"name": "h", "type": "kanai_tajimi"}]}, r"^motions\[0\]\.type: must be one of harmonic, constant \(records go in \[\[records\]\]\), got 'kanai_tajimi'"),
         ({"motions": [{"type": "harmonic"}]}, r"^motions\[0\]\.name: "),
         ({"motions": {"name": "h"}}, r"^motions: must be an array of tables"),
-        ({"synthetic__kt__count": 0}, r"^synthetic\.kt\.count: must be an integer >= 1, got 0"),
+        ({"synthetic__kt__count": 0}, r"^synthetic\.kt\.count: must be an integer in \[1, 100000000\], got 0"),
+        ({"synthetic__kt__count": 10**12}, r"^synthetic\.kt\.count: must be an integer in \[1, 100000000\], got 1000000000000$"),
         ({"synthetic__kt__seed": None}, r"^synthetic\.kt\.seed: missing"),
         ({"output__time_histories": ["velocity"]}, r"^output\.time_histories\[0\]: unknown variable 'velocity' \(allowed: total_displacement"),
         ({"solver": {"method": "euler"}}, r"^solver\.method: must be one of auto, exact, ivp, got 'euler'"),
@@ -66,6 +67,18 @@ def experiment(data: dict) -> Experiment:
 def test_bad_fields_are_named(changes, message):
     with pytest.raises(ExperimentError, match=message):
         experiment(small(**changes))
+
+
+def test_a_misspelt_count_is_an_unknown_field_listing_count_and_start():
+    """``cont = 2`` for ``count = 2``: named as the unknown field, the allowed list has count and start, not the rejected realization."""
+    with pytest.raises(ExperimentError) as raised:
+        experiment(small(synthetic__kt__count=None, synthetic__kt__cont=2))
+    message = str(raised.value)
+    assert message.startswith("synthetic.kt.cont: unknown field (allowed: "), message
+    allowed = message.split("(allowed: ")[1].rstrip(")").split(", ")
+    assert {"count", "start", "seed", "omega_g", "envelope"} <= set(allowed) and "realization" not in allowed, allowed
+    with pytest.raises(ExperimentError, match=r"^synthetic\.kt\.realization: not used here"):
+        experiment(small(synthetic__kt__realization=3))
 
 
 def test_bad_motions_are_named(tmp_path):

@@ -3,9 +3,10 @@
 import click
 
 from stochpound import __version__
+from stochpound.cli.group import HelpGroup
 
 
-@click.group(context_settings={"help_option_names": ["-h", "--help"]})
+@click.group(cls=HelpGroup, context_settings={"help_option_names": ["-h", "--help"]})
 @click.version_option(__version__, prog_name="stochpound")
 def main() -> None:
     """Stochastic analysis of earthquake pounding between adjacent buildings."""

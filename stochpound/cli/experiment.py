@@ -5,14 +5,21 @@ from __future__ import annotations
 import sys
 from contextlib import contextmanager
 from pathlib import Path
-from typing import Iterator
+from typing import TYPE_CHECKING, Iterator
 
 import click
 
-from stochpound.errors import StochpoundError
+from stochpound.cli.group import HelpGroup
+from stochpound.errors import StochpoundError, os_error_message
+from stochpound.experiment.estimate import LARGE_RUN_BYTES, LARGE_RUN_CASES
+from stochpound.experiment.parts import parts_folder
+from stochpound.memory import format_bytes
+
+if TYPE_CHECKING:
+    from stochpound.experiment.runner import RunReport
 
 
-@click.group("experiment")
+@click.group("experiment", cls=HelpGroup)
 def experiment() -> None:
     """Grids and ensembles of scenes, run on dask into a crash-safe store (docs/experiments.md)."""
 
@@ -25,13 +32,17 @@ def experiment() -> None:
 @click.option("--restart", is_flag=True, help="Discard the existing store and its finished cases (also one of another definition).")
 @click.option("--batch", "batch_size", type=click.IntRange(min=1), default=None, help="Cases per dask task (default: automatic).")
 @click.option("--checkpoint", type=click.FloatRange(min=0.0), default=30.0, show_default=True, help="Seconds between rebuilds of the store file during the run.")
-@click.option("--quiet", is_flag=True, help="No progress bar.")
-def run_command(experiment_files: tuple[str, ...], store: str | None, workers: int | None, scheduler: str | None, restart: bool, batch_size: int | None, checkpoint: float, quiet: bool) -> None:
+@click.option("--yes", "large_ok", is_flag=True, help=f"Run a large experiment (over {LARGE_RUN_CASES:,} cases or {format_bytes(LARGE_RUN_BYTES)} of store to write) without asking.")
+@click.option("--quiet", is_flag=True, help="No progress bar and no start-up messages.")
+def run_command(
+    experiment_files: tuple[str, ...], store: str | None, workers: int | None, scheduler: str | None, restart: bool, batch_size: int | None, checkpoint: float, large_ok: bool, quiet: bool
+) -> None:
     """Run the missing cases of each EXPERIMENT_FILE into its store, one after the other.
 
-    Finished cases are kept one file each in STORE.parts/; rerunning the
-    same command completes only the missing ones. Ctrl-C stops cleanly.
-    Every file is checked before any runs.
+    Finished cases are kept in STORE.parts/; rerunning the same command
+    completes only the missing ones, and rebuilds a damaged store file from
+    them. Ctrl-C stops cleanly. Every file is checked before any runs; the
+    time and size of each run are estimated before it starts.
     """
     from stochpound.experiment import load_experiment, run_experiment
 
@@ -51,7 +62,8 @@ def run_command(experiment_files: tuple[str, ...], store: str | None, workers: i
         with _errors_of(experiment_file, several):
             try:
                 report = run_experiment(
-                    definition, store, workers=workers, scheduler=scheduler, restart=restart, progress=not quiet, checkpoint=checkpoint, batch_size=batch_size
+                    definition, store, workers=workers, scheduler=scheduler, restart=restart, progress=not quiet, checkpoint=checkpoint,
+                    batch_size=batch_size, large_ok=large_ok, say=None if quiet else _say,
                 )
             except KeyboardInterrupt:  # a second Ctrl-C while the first one's clean-up ran
                 click.echo("interrupted; rerun the same command to complete the missing cases")
@@ -66,24 +78,33 @@ def run_command(experiment_files: tuple[str, ...], store: str | None, workers: i
 
 @contextmanager
 def _errors_of(path: str, name_it: bool) -> Iterator[None]:
-    """Turn a stochpound error into a one-line command error; prefix it with ``path`` if ``name_it`` and it does not name it already."""
+    """Turn a stochpound or file-system error into a one-line command error; prefix it with ``path`` if ``name_it`` and it does not name it already."""
     try:
         yield
-    except (StochpoundError, ValueError) as error:
-        message = str(error)
+    except (StochpoundError, ValueError, OSError) as error:
+        message = os_error_message(error) if isinstance(error, OSError) else str(error)
         if name_it and not message.startswith(path):
             message = f"{path}: {message}"
         raise click.ClickException(message) from None
 
 
-def _summary(report) -> None:
-    running = report.elapsed - report.setup
-    rate = report.done_now / running if running > 0 else 0.0
-    state = "interrupted" if report.interrupted else ("complete" if report.complete else "incomplete")
-    click.echo(
-        f"{state}: {report.done}/{report.total} cases done ({report.done_now} this run, {report.done_before} before) "
-        f"in {report.elapsed:.1f} s ({report.setup:.1f} s start-up), {rate:.2f} cases/s on {report.executor}"
-    )
+def _say(message: str) -> None:
+    click.echo(message, err=True)
+
+
+def _summary(report: RunReport) -> None:
+    if report.nothing_to_run:
+        click.echo(f"nothing to run: store complete ({report.done}/{report.total} cases)")
+    else:
+        running = report.elapsed - report.setup
+        rate = f", {report.done_now / running:.2f} cases/s" if running > 0 and report.done_now else ""
+        state = "interrupted" if report.interrupted else ("complete" if report.complete else "incomplete")
+        click.echo(
+            f"{state}: {report.done}/{report.total} cases done ({report.done_now} this run, {report.done_before} before) on {report.executor}; "
+            f"{report.elapsed:.1f} s in all: {report.setup:.1f} s start-up, {running:.1f} s running{rate}"
+        )
+    if report.repaired:
+        click.echo(f"the store file was damaged: rebuilt from the finished cases in {parts_folder(report.store).name}/")
     for described, error in report.failed[:5]:
         click.echo(f"FAILED {described}\n{error}", err=True)
     if len(report.failed) > 5:
@@ -92,6 +113,8 @@ def _summary(report) -> None:
     click.echo(f"store: {report.store} ({size / 1e6:.2f} MB); open it with stochpound.open_store({str(report.store)!r})")
     if not report.complete:
         click.echo("rerun the same command to complete the missing cases")
+    else:
+        click.echo(f"next: stochpound report build {report.store} --out {report.store.with_suffix('')}-report")
 
 
 @experiment.command("check")
@@ -126,10 +149,8 @@ def status_command(store: str, show_all: bool, show_done: bool, no_rebuild: bool
     """List the done and missing cases of STORE (and refresh the file from the finished cases)."""
     from stochpound.experiment import store_status
 
-    try:
+    with _errors_of(store, False):
         report = store_status(Path(store), rebuild=not no_rebuild)
-    except (StochpoundError, ValueError, OSError) as error:
-        raise click.ClickException(str(error)) from None
     click.echo(f"experiment {report.experiment.name} (definition sha256 {report.experiment.sha256[:12]}…)")
     click.echo(f"{report.n_done}/{report.experiment.n_cases} cases done, {report.n_missing} missing" + ("; a run is writing this store now" if report.running else ""))
     if show_done:

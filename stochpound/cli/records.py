@@ -4,10 +4,11 @@ from __future__ import annotations
 
 import click
 
+from stochpound.cli.group import HelpGroup
 from stochpound.errors import RecordError
 
 
-@click.group("records")
+@click.group("records", cls=HelpGroup)
 def records() -> None:
     """Bundled ground-motion records (and record files)."""
 

@@ -6,14 +6,15 @@ from pathlib import Path
 
 import click
 
-from stochpound.errors import StochpoundError
+from stochpound.cli.group import HelpGroup
+from stochpound.errors import StochpoundError, os_error_message
 
 FORMAT_CHOICES = ("html", "pdf")
 
 
-@click.group("report")
+@click.group("report", cls=HelpGroup)
 def report() -> None:
-    """Tables and figures of the reference study regenerated from experiment stores."""
+    """Reports (HTML page, PDF, figures, tables) built from experiment stores: any experiment's, the reference study's among them."""
 
 
 @report.command("build")
@@ -33,15 +34,22 @@ def build_command(stores: tuple[Path, ...], out: Path, formats: tuple[str, ...])
 
     Writes OUT/index.html (self-contained page), OUT/report.pdf, and every
     figure and table as OUT/figures/<key>.png and OUT/tables/<key>.csv.
+    Figures and tables of an earlier build into OUT that this one does not
+    write again are removed (only those: OUT/.stochpound-report.json lists them).
+    The stores are only read (they may be on a read-only disk); OUT is
+    checked to be writable before any work.
     """
     from stochpound.report.assemble import assemble_report
-    from stochpound.report.output import write_report
+    from stochpound.report.output import check_output_folder, write_report
 
     try:
+        check_output_folder(out)
         document = assemble_report(list(stores), progress=_progress)
         written = write_report(document, out, formats, progress=_progress)
-    except (StochpoundError, ValueError, OSError) as error:
+    except (StochpoundError, ValueError) as error:
         raise click.ClickException(str(error)) from None
+    except OSError as error:
+        raise click.ClickException(os_error_message(error)) from None
     counts = {"figures": f" ({len(document.figures())} PNG files)", "tables": f" ({len(document.tables())} CSV files)"}
     for name, path in written.items():
         click.echo(f"{name}: {_shown(path, out)}{counts.get(name, '')}")

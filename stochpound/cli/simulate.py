@@ -6,7 +6,8 @@ from pathlib import Path
 
 import click
 
-from stochpound.errors import StochpoundError
+from stochpound.atomic import check_writable
+from stochpound.errors import StochpoundError, os_error_message
 from stochpound.results.dataset import write_dataset
 from stochpound.model.scene_file import load_scene
 from stochpound.solvers.simulate import METHODS, simulate as run_simulation
@@ -29,9 +30,11 @@ def simulate(scene_file: str, out: str, overwrite: bool, method: str | None, int
     try:
         scene = load_scene(scene_file)
         result = run_simulation(scene, method, integrator=integrator, rtol=rtol, atol=atol, demands=demands)
+        write_dataset(result, out)
     except (StochpoundError, ValueError) as error:
         raise click.ClickException(str(error)) from None
-    write_dataset(result, out)
+    except OSError as error:
+        raise click.ClickException(os_error_message(error)) from None
     n_impacts = result.sizes.get("impact", 0)
     click.echo(
         f"{scene_file}: {len(result.time)} samples, {n_impacts} impacts, "
@@ -40,8 +43,12 @@ def simulate(scene_file: str, out: str, overwrite: bool, method: str | None, int
 
 
 def _check_output(out: Path, overwrite: bool) -> None:
-    """Refuse an existing --out without --overwrite (before anything runs); warn on a suffix other than .nc."""
+    """Refuse an existing --out without --overwrite, or one that cannot be written (before anything runs); warn on a suffix other than .nc."""
     if out.exists() and not overwrite:
         raise click.BadParameter(f"{out} exists; give --overwrite to replace it", param_hint="--out")
+    try:
+        check_writable(out)
+    except OSError as error:
+        raise click.ClickException(os_error_message(error)) from None
     if out.suffix != ".nc":
         click.echo(f"warning: --out {out}: the file is netCDF4/HDF5, whose usual suffix is .nc (got {out.suffix or 'none'})", err=True)

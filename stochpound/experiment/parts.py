@@ -308,6 +308,20 @@ class FolderLock:
             return False
         return True
 
+    def held(self) -> bool:
+        """True if another process holds the lock (probed through a read-only handle: nothing is created or written)."""
+        try:
+            handle = open(self.path)
+        except FileNotFoundError:
+            return False
+        with handle:
+            try:
+                fcntl.flock(handle, fcntl.LOCK_SH | fcntl.LOCK_NB)
+            except BlockingIOError:
+                return True
+            fcntl.flock(handle, fcntl.LOCK_UN)
+        return False
+
     def release(self) -> None:
         """Release the lock."""
         if self.handle is not None:

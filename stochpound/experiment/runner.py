@@ -22,17 +22,21 @@ import threading
 import time
 from contextlib import contextmanager
 from dataclasses import dataclass, field
+from multiprocessing import forkserver
 from pathlib import Path
 from typing import Any, Callable, Iterable, Iterator
 
 from stochpound import __version__
 from stochpound.experiment.batches import automatic_size, make_batches
-from stochpound.experiment.compute import BatchResult, BatchTask, run_batch, warm_up
+from stochpound.experiment.compute import BatchResult, BatchTask, run_batch, solver_cached, warm_up
+from stochpound.experiment.estimate import LARGE_RUN_BYTES, LARGE_RUN_CASES, estimate_run
 from stochpound.experiment.model import Experiment
 from stochpound.experiment.parts import FolderLock, PartBuffer, append_run, parts_folder, remove_temporaries
-from stochpound.experiment.session import StoreSession, check_store, clear_store, code_identity, machine, now
+from stochpound.experiment.session import StoreSession, check_store, clear_store, code_identity, machine, now, store_complete
 from stochpound.experiment.sources import ResolvedMotion, resolve_motions
 from stochpound.experiment.spec import ExperimentError, load_definition
+from stochpound.experiment.store_writer import PartsIndex
+from stochpound.memory import format_bytes
 
 CHECKPOINT_FACTOR = 20.0
 """A checkpoint waits at least this many times the last rebuild's duration (rebuilds cost at most ~5 % of a run)."""
@@ -42,9 +46,11 @@ LOCAL_CLUSTER_CONFIG = {
     "distributed.worker.profile.enabled": False,
     "distributed.admin.system-monitor.interval": "2s",
     "distributed.admin.tick.interval": "500ms",
+    "distributed.worker.multiprocessing-method": "forkserver",
 }
 """dask settings of the local cluster: no statistical profiler in the workers (it samples their threads every
-10 ms), slower system monitors and event-loop ticks: idle, the cluster takes about 3 % of a core instead of 13 %."""
+10 ms), slower system monitors and event-loop ticks: idle, the cluster takes about 3 % of a core instead of 13 %;
+worker processes forked by multiprocessing's fork server (which ignores SIGINT: :func:`_handling_sigint`)."""
 
 
 @dataclass
@@ -72,6 +78,10 @@ class RunReport:
         Where the cases ran.
     interrupted : bool
         True if the run was stopped (Ctrl-C, SIGTERM).
+    repaired : bool
+        The store file was damaged and was rebuilt from the finished cases in its parts folder.
+    nothing_to_run : bool
+        The store was complete: nothing ran and nothing was written.
     """
 
     store: Path
@@ -83,6 +93,8 @@ class RunReport:
     setup: float = 0.0
     executor: str = ""
     interrupted: bool = False
+    repaired: bool = False
+    nothing_to_run: bool = False
 
     @property
     def done(self) -> int:
@@ -124,6 +136,8 @@ def run_experiment(
     progress: bool = True,
     checkpoint: float = 30.0,
     batch_size: int | None = None,
+    large_ok: bool = True,
+    say: Callable[[str], None] | None = None,
 ) -> RunReport:
     """Run the missing cases of an experiment into its store.
 
@@ -147,6 +161,12 @@ def run_experiment(
         run (and at least ``CHECKPOINT_FACTOR`` times the last rebuild's duration).
     batch_size : int, optional
         Cases per dask task (default: ``stochpound.experiment.batches.automatic_size``).
+    large_ok : bool
+        Run a large experiment (:attr:`~stochpound.experiment.estimate.RunEstimate.large`);
+        if False, one is refused before anything is written (``experiment run`` without ``--yes``).
+    say : callable, optional
+        Called with a line about each step of the start-up (the estimate, the
+        cluster's start, the solver's compilation), as it begins.
 
     Returns
     -------
@@ -155,46 +175,68 @@ def run_experiment(
     Raises
     ------
     ExperimentError
-        Before any case runs: a bad motion, an unreadable store, a store of
-        another definition (without ``restart``), or a store being written by
-        another run. The existing store is then left unchanged.
+        Before any case runs: a bad motion, an unreadable store without
+        parts to rebuild it from, a store of another definition (without
+        ``restart``), a store being written by another run, or a large
+        experiment without ``large_ok``. The existing store is then left unchanged.
+    OSError
+        If the store's folder cannot be written.
+
+    Notes
+    -----
+    A store whose file says every case is done is left as it is: no cluster
+    starts and nothing is written (``nothing_to_run``).
     """
     started = time.monotonic()
+    say = say or (lambda message: None)
     store = Path(store) if store is not None else default_store(experiment.path or f"{experiment.name}.toml")
     motions = resolve_motions(experiment)
+    repair = False
     if not restart:
-        check_store(store, experiment.sha256)
+        repair = check_store(store, experiment.sha256)
+        if store.is_file() and not repair and store_complete(store):
+            if FolderLock(parts_folder(store)).held():
+                raise _busy(store)
+            return RunReport(store, experiment.n_cases, experiment.n_cases, elapsed=time.monotonic() - started, nothing_to_run=True)
     elif store.is_dir():
         raise ExperimentError(f"{store}: is a folder; --store must name a file")
+    grids = {label: m.grid for label, m in motions.items()}
+    _check_size(experiment, grids, store, restart, large_ok, _cores(workers, scheduler))
     parts_folder(store).mkdir(parents=True, exist_ok=True)
     lock = FolderLock(parts_folder(store))
     if not lock.acquire():
-        raise ExperimentError(f"{store}: another run is writing this store (its parts folder is locked)")
+        raise _busy(store)
     with lock, _interrupts() as stop:
         if restart:
             clear_store(store)
         remove_temporaries(parts_folder(store))
-        session = StoreSession.create(store, experiment, {label: m.grid for label, m in motions.items()})
+        session = StoreSession.create(store, experiment, grids)
         session.scan(remove_unreadable=True)
-        report = RunReport(store, experiment.n_cases, session.index.n_done)
+        report = RunReport(store, experiment.n_cases, session.index.n_done, repaired=repair)
         report.executor = _describe_executor(workers, scheduler)
+        if repair:
+            say(f"{store}: damaged; rebuilding it from the {report.done_before} finished cases in {session.folder.name}/")
+        if report.done_before < report.total:
+            say(estimate_run(experiment, grids, report.total - report.done_before).describe(_cores(workers, scheduler)))
         identity = code_identity()
         append_run(session.folder, {"started": now(), "machine": machine(), "executor": report.executor, **identity})
         missing = session.missing()
         session.rebuild()
         checkpoints = _Checkpoints(checkpoint, session)
-        bar = _progress_bar(report, experiment.name, progress)
+        bar: Any = _NoBar()
         realizations = sum(len(experiment.realizations(label)) for label in experiment.motions)
         meta = {"stochpound_version": __version__, "sources_sha256": identity["sources_sha256"]}
         buffer = PartBuffer(session.folder, meta, experiment.n_cases / realizations)
 
         def ready() -> None:
+            nonlocal bar
             report.setup = time.monotonic() - started
+            bar = _progress_bar(report, experiment.name, progress)  # after the start-up's messages
 
         try:
             size = batch_size or automatic_size(experiment.n_cases - report.done_before, workers)
             batches = make_batches(experiment, missing, motions, size)
-            with contextlib.closing(execute(batches, experiment, motions, workers, scheduler, ready)) as results:
+            with contextlib.closing(execute(batches, experiment, motions, workers, scheduler, ready, say)) as results:
                 for task, result in results:
                     _record(experiment, report, buffer, task, result)
                     if stop.requested:
@@ -211,7 +253,26 @@ def run_experiment(
             checkpoints.wait()
             session.rebuild()
             report.elapsed = time.monotonic() - started
+            report.setup = report.setup or report.elapsed  # stopped before the first batch: all of it was start-up
     return report
+
+
+def _busy(store: Path) -> ExperimentError:
+    return ExperimentError(f"{store}: another run is writing this store (its parts folder is locked)")
+
+
+def _check_size(experiment: Experiment, grids: dict[str, tuple[float, int]], store: Path, restart: bool, large_ok: bool, cores: int) -> None:
+    """Refuse a large run (:attr:`RunEstimate.large`, its finished cases not counted) unless ``large_ok``."""
+    if large_ok:
+        return
+    estimate = estimate_run(experiment, grids, experiment.n_cases)
+    if estimate.large and not restart and parts_folder(store).is_dir():
+        estimate = estimate_run(experiment, grids, experiment.n_cases - PartsIndex.scan(experiment, parts_folder(store)).n_done)
+    if estimate.large:
+        raise ExperimentError(
+            f"{experiment.path or experiment.name}: {estimate.describe(cores)}; "
+            f"above {LARGE_RUN_CASES:,} cases or {format_bytes(LARGE_RUN_BYTES)} of store: give --yes to run it"
+        )
 
 
 def _record(experiment: Experiment, report: RunReport, buffer: PartBuffer, task: BatchTask, result: BatchResult) -> None:
@@ -276,8 +337,11 @@ def execute(
     workers: int | None,
     scheduler: str | None,
     ready: Callable[[], None] = lambda: None,
+    say: Callable[[str], None] = lambda message: None,
 ) -> Iterator[tuple[BatchTask, BatchResult]]:
     """Run batches and yield (task, result) as they finish (in any order); call ``ready()`` before the first is submitted.
+
+    ``say`` is called with a line as each step of the start-up begins.
 
     On dask, every worker first loads the compiled solver (:func:`~stochpound.experiment.compute.warm_up`).
 
@@ -296,7 +360,7 @@ def execute(
         return
     from distributed import as_completed, wait
 
-    with _dask_client(workers, scheduler) as client:
+    with _dask_client(workers, scheduler, say) as client:
         wait([client.submit(warm_up, pure=False, workers=[worker]) for worker in client.scheduler_info()["workers"]])
         shipped = {m: client.scatter(motions[label].motion, broadcast=True, hash=False) for m, label in enumerate(labels) if motions[label].motion is not None}
         ahead = IN_FLIGHT_PER_WORKER * max(1, sum(client.nthreads().values()))
@@ -330,42 +394,58 @@ def execute(
 
 
 @contextmanager
-def _dask_client(workers: int | None, scheduler: str | None) -> Iterator[Any]:
+def _dask_client(workers: int | None, scheduler: str | None, say: Callable[[str], None]) -> Iterator[Any]:
     import dask
     from distributed import Client, LocalCluster
 
     for name in ("distributed", "distributed.nanny", "distributed.worker", "distributed.scheduler", "distributed.core"):
         logging.getLogger(name).setLevel(logging.ERROR)
     if scheduler is not None:
+        say(f"connecting to the dask scheduler {scheduler}…")
         client = Client(scheduler, timeout="30s")
         try:
             yield client
         finally:
             client.close(timeout=10)
         return
+    say("compiling the solver (first run only, ~10 s)…" if not solver_cached() else "loading the compiled solver…")
     warm_up()
-    with dask.config.set(LOCAL_CLUSTER_CONFIG), _ignoring_sigint():  # the worker processes inherit both
-        cluster = LocalCluster(  # its HTTP server on a free port (the default, 8787, may be taken: a warning)
-            n_workers=workers or os.cpu_count() or 1, threads_per_worker=1, processes=True, dashboard_address=":0", silence_logs=logging.ERROR
-        )
-    client = Client(cluster)
+    n_workers = workers or os.cpu_count() or 1
+    say(f"starting a local dask cluster ({n_workers} worker{'s' if n_workers > 1 else ''})…")
+    with _handling_sigint(signal.SIG_IGN):  # the fork server, and every worker process it forks, ignore SIGINT
+        forkserver.ensure_running()
+    cluster = client = None
+    requested: list[int] = []
     try:
+        # a SIGINT during the cluster's start (which an exception would leave half made) is raised once it can be closed
+        with dask.config.set(LOCAL_CLUSTER_CONFIG), _handling_sigint(lambda signum, frame: requested.append(signum)):
+            cluster = LocalCluster(  # its HTTP server on a free port (the default, 8787, may be taken: a warning)
+                n_workers=n_workers, threads_per_worker=1, processes=True, dashboard_address=":0", silence_logs=logging.ERROR
+            )
+        if requested:
+            raise KeyboardInterrupt
+        client = Client(cluster)
         yield client
     finally:
-        client.close(timeout=10)
-        cluster.close(timeout=10)
+        if client is not None:
+            client.close(timeout=10)
+        if cluster is not None:
+            cluster.close(timeout=10)
 
 
 @contextmanager
-def _ignoring_sigint() -> Iterator[None]:
-    """Ignore SIGINT while local workers start: processes started meanwhile keep ignoring it.
+def _handling_sigint(handler: Any) -> Iterator[None]:
+    """SIGINT goes to ``handler`` inside the block (``signal.SIG_IGN``: ignored); nothing changes outside the main thread.
 
-    A Ctrl-C in a terminal reaches every process of the foreground group; the
-    workers then stop with the cluster instead of printing their own
-    tracebacks. (A Ctrl-C during the cluster's start, a second or two, is lost.)
+    The local workers are forked by multiprocessing's fork server
+    (:data:`LOCAL_CLUSTER_CONFIG`), started while SIGINT is ignored: they
+    inherit the ignored SIGINT. A Ctrl-C in a terminal reaches every process
+    of the foreground group; the workers then stop with the cluster instead of
+    printing their own tracebacks. Ignoring lasts as long as the fork server's
+    fork and exec (milliseconds, once per process): a Ctrl-C then is lost.
     """
     try:
-        previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+        previous = signal.signal(signal.SIGINT, handler)
     except ValueError:  # not the main thread
         yield
         return
@@ -375,12 +455,19 @@ def _ignoring_sigint() -> Iterator[None]:
         signal.signal(signal.SIGINT, previous)
 
 
+def _cores(workers: int | None, scheduler: str | None) -> int:
+    """Cores the cases run on: the local workers (this machine's cores for a scheduler's unknown cluster)."""
+    if workers == 0 and scheduler is None:
+        return 1
+    return workers or os.cpu_count() or 1
+
+
 def _describe_executor(workers: int | None, scheduler: str | None) -> str:
     if scheduler is not None:
         return f"dask scheduler {scheduler}"
     if workers == 0:
         return "this process (no dask)"
-    return f"local dask cluster, {workers or os.cpu_count() or 1} worker processes"
+    return f"local dask cluster, {_cores(workers, scheduler)} worker processes"
 
 
 class _StopFlag:

@@ -23,6 +23,7 @@ from stochpound import __version__
 from stochpound.experiment.model import KINDS, Experiment
 from stochpound.experiment.parts import DEFINITION_FILE, part_paths, parts_folder, read_definition, read_runs, write_definition
 from stochpound.experiment.spec import ExperimentError, canonical_json
+from stochpound.experiment.store import PREFIX
 from stochpound.experiment.store_writer import PartsIndex, write_store
 
 
@@ -51,32 +52,53 @@ def store_identity(store: Path) -> str:
     return value.decode() if isinstance(value, bytes) else str(value)
 
 
-def check_store(store: Path, sha256: str) -> None:
+def check_store(store: Path, sha256: str) -> bool:
     """Refuse a store (or parts folder) that belongs to another experiment definition.
+
+    Returns
+    -------
+    bool
+        True if the store file is damaged (unreadable) but its parts folder
+        holds this definition's finished cases: the run rebuilds the file from them.
 
     Raises
     ------
     ExperimentError
-        The store is a folder, is unreadable, or was made from a different definition.
+        The store is a folder, is unreadable without parts to rebuild it from,
+        or was made from a different definition.
     """
     hint = "use --restart to discard it and start again, or --store to write elsewhere"
     if store.is_dir():
         raise ExperimentError(f"{store}: is a folder; --store must name a file")
+    folder = parts_folder(store)
+    parts = folder.exists() and ((folder / DEFINITION_FILE).exists() or bool(part_paths(folder)))
+    damaged = False
     if store.exists():
         try:
             found = store_identity(store)
         except ExperimentError as error:
-            raise ExperimentError(f"{error}; {hint}") from None
-        if found != sha256:
-            raise ExperimentError(f"{store}: made from a different experiment definition (sha256 {found[:12]}…, this one {sha256[:12]}…); {hint}")
-    folder = parts_folder(store)
-    if folder.exists() and ((folder / DEFINITION_FILE).exists() or part_paths(folder)):
+            if not parts:
+                raise ExperimentError(f"{error}; {hint}") from None
+            damaged = True  # rebuilt from the parts, if they hold this definition's cases (checked below)
+        else:
+            if found != sha256:
+                raise ExperimentError(f"{store}: made from a different experiment definition (sha256 {found[:12]}…, this one {sha256[:12]}…); {hint}")
+    if parts:
         try:
             found = read_definition(folder)["definition_sha256"]
         except (ExperimentError, KeyError, TypeError) as error:
             raise ExperimentError(f"{folder}: unreadable parts folder ({error}); {hint}") from None
         if found != sha256:
             raise ExperimentError(f"{folder}: holds cases of a different experiment definition (sha256 {found[:12]}…, this one {sha256[:12]}…); {hint}")
+    return damaged
+
+
+def store_complete(store: Path) -> bool:
+    """True if the store file (readable, checked by :func:`check_store`) has no missing case."""
+    import h5py
+
+    with h5py.File(store, "r") as handle:
+        return all(not (handle[f"{prefix}_status"][()] == 0).any() for prefix in PREFIX.values())
 
 
 def clear_store(store: Path) -> None:

@@ -28,6 +28,7 @@ from typing import Any, Iterator, Mapping
 from stochpound.errors import SceneError
 from stochpound.model import fields as toml_fields
 from stochpound.model.contact import ELEMENT_KEYS
+from stochpound.model.scene_file import generator_fields
 from stochpound.solvers.simulate import METHODS
 from stochpound.solvers.ivp import INTEGRATORS
 
@@ -42,6 +43,10 @@ AUTO = "auto"
 """``solver.method`` default: each case's solver chosen by :func:`stochpound.simulate` (exact unless a law is nonlinear)."""
 _RECORD_KEYS = {"name", "record", "scale", "dt", "duration", "units", "interpolation"}
 _SYNTHETIC_TYPES = ("kanai_tajimi", "clough_penzien")
+MAX_REALIZATIONS = 10**8
+"""Largest ``count`` of a synthetic ensemble: the run's client holds a few hundred bytes per case
+(a larger count is refused before anything is allocated; runs above
+:data:`~stochpound.experiment.estimate.LARGE_RUN_CASES` cases ask for ``--yes``)."""
 _ANALYTIC_TYPES = ("harmonic", "constant")
 _GAP_AXIS = re.compile(r"^gap(_[A-Za-z0-9_]+)?$")
 _DIM_NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
@@ -468,16 +473,21 @@ def _synthetic_source(label: str, table: Any, where: str) -> dict[str, Any]:
     if kind not in _SYNTHETIC_TYPES:
         raise ExperimentError(f"{where}.type: must be one of {', '.join(_SYNTHETIC_TYPES)}, got {kind!r}")
     entry["type"] = kind
-    counts = {}
-    for key, low in (("count", 1), ("start", 0)):
-        value = entry.pop(key, None if key == "count" else 0)
-        if value is None:
-            raise ExperimentError(f"{where}.count: missing (the number of realizations, an integer >= 1)")
-        if not isinstance(value, int) or isinstance(value, bool) or value < low:
-            raise ExperimentError(f"{where}.{key}: must be an integer >= {low}, got {value!r}")
-        counts[key] = value
+    from stochpound import motions
+
     if "realization" in entry:
         raise ExperimentError(f"{where}.realization: not used here (realizations start .. start + count - 1 are run)")
+    with field_errors():  # before the checks below: a misspelt count is an unknown field, not a missing count
+        toml_fields.reject_unknown(entry, generator_fields(getattr(motions, kind)) | {"count", "start"}, where)
+    counts = {}
+    for key, low, high in (("count", 1, MAX_REALIZATIONS), ("start", 0, None)):
+        value = entry.pop(key, None if key == "count" else 0)
+        if value is None:
+            raise ExperimentError(f"{where}.count: missing (the number of realizations, an integer in [1, {MAX_REALIZATIONS}])")
+        if not isinstance(value, int) or isinstance(value, bool) or value < low or (high is not None and value > high):
+            allowed = f">= {low}" if high is None else f"in [{low}, {high}]"
+            raise ExperimentError(f"{where}.{key}: must be an integer {allowed}, got {value!r}")
+        counts[key] = value
     if "seed" not in entry:
         raise ExperimentError(f"{where}.seed: missing (an integer >= 0; realization i depends on (seed, i) only)")
     return {"label": label, "kind": "synthetic", "field": where, "motion": entry, **counts}

@@ -68,7 +68,8 @@ def store_status(store: str | Path, rebuild: bool = True) -> StatusReport:
     store : str or Path
         The store file (its parts folder ``STORE.parts`` is read if present).
     rebuild : bool
-        Rewrite the store file from the parts (atomically) if no run holds the lock.
+        Rewrite the store file from the parts (atomically) if no run holds the
+        lock and the folder can be written (a store on a read-only disk is only read).
 
     Raises
     ------
@@ -80,16 +81,20 @@ def store_status(store: str | Path, rebuild: bool = True) -> StatusReport:
         return _from_file(store)
     session = StoreSession.open(store)
     lock = FolderLock(session.folder)
-    running = not lock.acquire()
     try:
-        if rebuild and not running:
+        running, writable = not lock.acquire(), True
+    except OSError:  # the lock file cannot be made or opened for writing (a read-only disk): only read
+        running, writable = lock.held(), False
+    rebuilt = rebuild and writable and not running
+    try:
+        if rebuilt:
             session.rebuild()
         else:
             session.scan()
     finally:
         lock.release()
     done = {kind: session.index.done(kind) for kind in KINDS}
-    return StatusReport(store, session.experiment, done, running, rebuild and not running)
+    return StatusReport(store, session.experiment, done, running, rebuilt)
 
 
 def _from_file(store: Path) -> StatusReport:

@@ -163,11 +163,16 @@ def _record_motion(table: Mapping[str, Any], base_dir: Path, g: float, per_sampl
     return SampledMotion(record.dt, values, interpolation, description)
 
 
+def generator_fields(generator: Any) -> set[str]:
+    """The fields of a synthetic motion table other than ``realization``: the generator's own parameters, ``type`` and ``interpolation``."""
+    return {name for name in inspect.signature(generator).parameters if name not in ("n_realizations", "start")} | {"type", "interpolation"}
+
+
 def _check_generator_fields(table: Mapping[str, Any], generator: Any, kind: str) -> None:
     """Reject fields the generator does not take, and name the required ones that are missing."""
     signature = inspect.signature(generator).parameters
     own = {name for name in signature if name not in ("n_realizations", "start")}
-    fields.reject_unknown(table, own | {"type", "realization", "interpolation"}, "motion")
+    fields.reject_unknown(table, generator_fields(generator) | {"realization"}, "motion")
     for name, parameter in signature.items():
         if name in own and parameter.default is inspect.Parameter.empty and name not in table:
             raise SceneError(f"motion.{name}: required for type = {kind!r} (see docs/motions.md)")

@@ -85,7 +85,8 @@ def kanai_tajimi(
     -------
     xarray.DataArray
         Ground acceleration, m/s², dims ``(realization, time)``; the
-        parameters (ω_g, ζ_g, S0, σ, envelope, seed, method, ...) in ``attrs``.
+        parameters (ω_g, ζ_g, S0, σ, envelope, seed, method, ...) in ``attrs``
+        (``envelope`` as JSON text: ``{"type": name, ...}``, or ``null`` if stationary).
     """
     model = kanai_tajimi_model(omega_g, zeta_g)
     return synthetic_ground_motion(
@@ -197,7 +198,7 @@ def synthetic_ground_motion(
         "band_limited": int(bool(band_limit)),
         "psd_convention": PSD_CONVENTION,
         **attrs,
-        "envelope": "none" if shape is None else shape.describe(),
+        "envelope": "null" if shape is None else shape.describe(),  # JSON text either way: null is the stationary specification
         "seed": seed,
         "method": method,
         "baseline_corrected": int(bool(baseline)),

@@ -271,7 +271,7 @@ def _synthetic_parameters(table: Mapping[str, Any], start: int) -> tuple[str, di
         intensity = f"RMS {number(attrs['rms_target'])} m/s²"
     else:
         intensity = "S0 given"
-    envelope = json.loads(attrs["envelope"]) if attrs.get("envelope") not in (None, "", "null") else None
+    envelope = json.loads(attrs["envelope"])
     shape = "stationary" if envelope is None else f"{envelope.pop('type')} envelope ({', '.join(f'{k} = {number(v, 4)}' for k, v in envelope.items())})"
     text = (
         f"{table['type'].replace('_', '–').title()}: {filters}; {intensity}, S0 = {number(attrs['S0'], 4)} m²/s³ "

@@ -6,9 +6,12 @@ Layout of the folder::
     tables/<key>.csv    every table's numbers (not rounded)
     index.html          the self-contained page (stochpound.report.html)
     report.pdf          the A4 document (stochpound.report.pdf)
+    .stochpound-report.json   the figure and table files this build wrote
 
 Every file is written to a temporary name and then renamed, so an
-interrupted build never leaves a half-written file.
+interrupted build never leaves a half-written file. A build into a folder
+that holds an earlier one removes the earlier figures and tables it does not
+write again: only files the earlier build's list names, never another file.
 """
 
 from __future__ import annotations
@@ -16,6 +19,7 @@ from __future__ import annotations
 import contextlib
 import datetime
 import io
+import json
 import os
 import re
 import secrets
@@ -24,6 +28,7 @@ from typing import Callable, Iterator, Sequence
 
 import matplotlib.pyplot as plt
 
+from stochpound.atomic import check_writable
 from stochpound.report.document import Report
 from stochpound.report.html import render_html
 from stochpound.report.pdf import render_pdf
@@ -32,6 +37,10 @@ FORMATS = ("html", "pdf")
 FILE_NAMES = {"html": "index.html", "pdf": "report.pdf"}
 FIGURE_DPI = 130
 KEY = re.compile(r"[A-Za-z0-9][A-Za-z0-9._-]*")
+MANIFEST = ".stochpound-report.json"
+"""The list of figure and table files (relative paths) the last build wrote into its folder."""
+_OWNED = re.compile(r"(figures/[A-Za-z0-9][A-Za-z0-9._-]*\.png|tables/[A-Za-z0-9][A-Za-z0-9._-]*\.csv)")
+"""The only paths a list may name for removal (no other folder, no other kind of file)."""
 
 Progress = Callable[[str], None]
 
@@ -72,6 +81,7 @@ def write_report(
     try:
         figure_png = _write_figures(report, written["figures"], say)
         _write_tables(report, written["tables"], say)
+        _replace_owned(out, [f"figures/{item.key}.png" for item in report.figures()] + [f"tables/{table.key}.csv" for table in report.tables()])
         if "html" in formats:
             say(FILE_NAMES["html"])
             written["html"] = _replace(out / FILE_NAMES["html"], render_html(report, figure_png, date).encode("utf-8"))
@@ -85,6 +95,24 @@ def write_report(
         for item in report.figures():
             plt.close(item.figure)
     return written
+
+
+def check_output_folder(out: Path) -> None:
+    """Raise the ``OSError`` that writing into the folder ``out`` would raise (it is created if needed), before any work."""
+    check_writable(Path(out) / MANIFEST)
+
+
+def _replace_owned(out: Path, owned: list[str]) -> None:
+    """Remove the files the previous build's list names and this build did not write; list this build's files."""
+    try:
+        previous = json.loads((out / MANIFEST).read_text())
+    except (OSError, ValueError):
+        previous = []
+    kept = set(owned)
+    for name in previous if isinstance(previous, list) else []:
+        if isinstance(name, str) and name not in kept and _OWNED.fullmatch(name):
+            (out / name).unlink(missing_ok=True)
+    _replace(out / MANIFEST, json.dumps(owned, indent=0).encode("utf-8"))
 
 
 def _check_formats(formats: Sequence[str]) -> list[str]:

@@ -1,0 +1,35 @@
+"""The command groups' class: whole first sentences in the command lists, help (exit 0) when called without a command."""
+
+from __future__ import annotations
+
+import sys
+
+import click
+
+
+class HelpGroup(click.Group):
+    """A click group that lists each command with the whole first sentence of its help.
+
+    click cuts the sentence at the terminal's width (``run     Run the missing
+    cases of each EXPERIMENT_FILE into its store,...``); here it is wrapped
+    instead. Called without a command, it prints its help and exits with 0
+    (click's default is 2, an error).
+    """
+
+    def parse_args(self, ctx: click.Context, args: list[str]) -> list[str]:
+        """Print the help and exit 0 if no argument is given."""
+        if not args and self.no_args_is_help and not ctx.resilient_parsing:
+            click.echo(ctx.get_help(), color=ctx.color)
+            ctx.exit(0)
+        return super().parse_args(ctx, args)
+
+    def format_commands(self, ctx: click.Context, formatter: click.HelpFormatter) -> None:
+        """The ``Commands:`` section, each command's first sentence whole."""
+        rows = []
+        for name in self.list_commands(ctx):
+            command = self.get_command(ctx, name)
+            if command is not None and not command.hidden:
+                rows.append((name, command.get_short_help_str(limit=sys.maxsize)))
+        if rows:
+            with formatter.section("Commands"):
+                formatter.write_dl(rows)
