@@ -162,7 +162,7 @@ def run_experiment(
     batch_size : int, optional
         Cases per dask task (default: ``stochpound.experiment.batches.automatic_size``).
     large_ok : bool
-        Run a large experiment (:attr:`~stochpound.experiment.estimate.RunEstimate.large`);
+        Run a large experiment (``RunEstimate.large`` of ``stochpound.experiment.estimate``);
         if False, one is refused before anything is written (``experiment run`` without ``--yes``).
     say : callable, optional
         Called with a line about each step of the start-up (the estimate, the
