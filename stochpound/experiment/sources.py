@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 
 from stochpound import motions as synthetic_motions
+from stochpound.experiment.intensity import check_resolution
 from stochpound.experiment.model import CASE, Experiment
 from stochpound.experiment.spec import field_errors
 from stochpound.motions.ground import GroundMotion
@@ -61,6 +62,9 @@ def resolve_motions(experiment: Experiment) -> dict[str, ResolvedMotion]:
         with field_errors(scene_prefix=source["field"]):
             motion = scene_from_dict({**structure, "motion": table}, base_dir=experiment.base_dir).motion
         grid = (float(motion.times[1] - motion.times[0]), len(motion.times))
+        if experiment.intensity is not None:
+            with field_errors():
+                check_resolution(experiment.intensity, grid[0], f"{source['field']} ({label})")
         if source["kind"] == "record":
             resolved[label] = ResolvedMotion(label, motion, None, grid)
         else:
