@@ -239,20 +239,20 @@ def _coordinates(experiment: Experiment, motion_grids: Mapping[str, tuple[float,
 
 
 def _suite_coordinates(experiment: Experiment) -> dict[str, xr.Variable]:
-    """Metadata of the motions of suites on ``record`` (event, station, component, magnitude, distance...; none without suites)."""
-    from stochpound.motions.records.suites import SUITES, load_suite_member
+    """Metadata of the motions from suites on ``record`` (event, station, component, magnitude, distance...; none without such motions)."""
+    from stochpound.motions.records.suites import is_suite_member, load_suite_member
 
-    motions = experiment.motions
-    if not any("suite" in m for m in motions.values()):
-        return {}
-    rows = []
-    for label, source in motions.items():
-        meta: Mapping[str, Any] = {}
-        if source.get("suite") in SUITES:
-            meta = load_suite_member(source["motion"]["record"]).metadata
+    rows: list[Mapping[str, Any]] = []
+    for source in experiment.motions.values():
+        record = str(source["motion"].get("record", ""))
+        if is_suite_member(record):
+            rows.append(load_suite_member(record).metadata)
         elif "suite" in source:  # a folder: the file name is all that is known
-            meta = {"suite": source["suite"], "component": Path(source["motion"]["record"]).name}
-        rows.append(meta)
+            rows.append({"suite": source["suite"], "component": Path(record).name})
+        else:
+            rows.append({})
+    if not any(rows):
+        return {}
     coords = {"record_suite": xr.Variable(("record",), np.array([str(m.get("suite", "")) for m in rows], dtype=object), {"units": "1", "long_name": "suite of the motion"})}
     for name, units in METADATA_FIELDS.items():
         values = [m.get(name, "" if name in _TEXT_FIELDS else np.nan) for m in rows]

