@@ -14,12 +14,15 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from scipy.stats import binomtest
 
 from stochpound import open_store
 from stochpound.experiment.runner import load_experiment, run_experiment
 from stochpound.experiment.sources import resolve_motions
 from stochpound.experiment.spec import ExperimentError, load_definition, parse_experiment
 from stochpound.model.scene_file import scene_from_dict
+from stochpound.report.document import FigureItem, Table
+from stochpound.report.intensity import intensity_section
 from stochpound.solvers.simulate import simulate
 from tests.test_experiment_helpers import write_experiment
 
@@ -74,6 +77,11 @@ def test_stripes_scale_exactly_with_the_level(tmp_path):
     assert float(im.sel(record=MOTIONS[1]).isel(intensity=2)) == pytest.approx(psa, rel=1e-14)
     assert list(store.record_event.values[:1]) == ["Northridge 1994"] and store.record_magnitude.values[1] == 7.1
     assert store.motion_psa.dims[-1] == "spectrum_period" and store.reference_status.dims[0] == "intensity"
+    # the report's stripe table: counts of runs that pounded and their Clopper-Pearson interval
+    section = intensity_section("im", store)
+    table = next(block for block in section.blocks if isinstance(block, Table)).frame
+    assert list(table["runs"]) == [3, 3, 3] and list(table["pounded"]) == [0, 0, 0]  # contact-free: nobody pounds
+    assert table["upper"].iloc[0] == pytest.approx(binomtest(0, 3).proportion_ci(0.95, method="exact").high, rel=1e-12)
 
 
 def test_ida_capacities_agree_with_brute_force(tmp_path):
@@ -98,6 +106,7 @@ def test_ida_capacities_agree_with_brute_force(tmp_path):
                 scene["motion"] = {"record": record, "duration": 4.0, "scale": threshold * factor}
                 run = simulate(scene_from_dict(scene), "exact")
                 assert (run.sizes["impact"] > 0) == pounds, (record, gap, factor)
+    assert any(isinstance(block, FigureItem) and block.key == "intensity-ida-im" for block in intensity_section("im", store).blocks)
 
 
 def test_ida_falls_back_to_stripes_on_a_sliding_base(tmp_path):
