@@ -138,19 +138,10 @@ def intensity_measures(
 ) -> xr.Dataset:
     """Intensity measures of a ground motion (module docstring).
 
-    Parameters
-    ----------
-    acceleration : array_like, Record or str
-        Samples in m/s² at ``dt`` from t = 0, linear between them; or a
-        :class:`~stochpound.motions.records.Record` or a bundled record's name.
-    dt : float, optional
-        Step, s (required for an array).
-    periods : array_like, optional
-        Periods (s) of the ``psa`` (and ``sd``, ``sa``) added over ``period``.
-    damping : float
-        Damping ratio of the spectrum.
-    g : float
-        m/s², of the Arias intensity and of a record stored in g.
+    ``acceleration``, ``dt`` and ``damping`` are as in
+    :func:`~stochpound.motions.spectrum.response_spectrum`; ``periods`` (s,
+    optional) adds ``psa``, ``sd`` and ``sa`` over ``period``; ``g`` (m/s²) is
+    that of the Arias intensity and of a record stored in g.
 
     Returns
     -------

@@ -119,10 +119,25 @@ def _pounding_counts(store: xr.Dataset) -> tuple[xr.DataArray, xr.DataArray]:
     return done.sum(("record", "realization")), pounded.sum(("record", "realization"))
 
 
+def _proportion(k: np.ndarray, n: np.ndarray) -> np.ndarray:
+    """k / n, NaN where n = 0."""
+    return np.where(n > 0, k / np.maximum(n, 1), np.nan)
+
+
+def _probability_axes(ax: Any, setting: dict[str, Any], label: str, legend: bool) -> None:
+    """Axes of a probability against the intensity measure."""
+    ax.set_xlabel(f"{describe_measure(setting)} ({setting['units']})")
+    ax.set_ylabel(label)
+    ax.set_ylim(-0.02, 1.02)
+    ax.grid(True, lw=0.3, color="0.85")
+    if legend:
+        ax.legend(fontsize=7)
+
+
 def _stripe_table(name: str, store: xr.Dataset, setting: dict[str, Any]) -> Table:
     runs, pounded = _pounding_counts(store)
     lower, upper = clopper_pearson(pounded.values, runs.values, CONFIDENCE)
-    probability = xr.DataArray(np.where(runs.values > 0, pounded.values / np.maximum(runs.values, 1), np.nan), runs.coords, runs.dims)
+    probability = xr.DataArray(_proportion(pounded.values, runs.values), runs.coords, runs.dims)
     frame = xr.Dataset(
         {
             "runs": runs,
@@ -160,15 +175,10 @@ def _stripe_figure(name: str, store: xr.Dataset, setting: dict[str, Any]) -> Fig
     for label, cell in cells:
         n, k = cell.sel(what="runs").values, cell.sel(what="pounded").values
         lower, upper = clopper_pearson(k, n, CONFIDENCE)
-        p = np.where(n > 0, k / np.maximum(n, 1), np.nan)
+        p = _proportion(k, n)
         (line,) = ax.plot(levels, p, "o-", label=label or None)
         ax.fill_between(levels, lower, upper, color=line.get_color(), alpha=0.15)
-    ax.set_xlabel(f"{describe_measure(setting)} ({setting['units']})")
-    ax.set_ylabel("P(pounding)")
-    ax.set_ylim(-0.02, 1.02)
-    ax.grid(True, lw=0.3, color="0.85")
-    if any(label for label, _ in cells):
-        ax.legend(fontsize=7)
+    _probability_axes(ax, setting, "P(pounding)", any(label for label, _ in cells))
     per = " per " + ", ".join(gaps) if gaps else ""
     return FigureItem(
         f"intensity-pounding-{name}",
@@ -192,12 +202,7 @@ def _ida_figure(name: str, store: xr.Dataset, setting: dict[str, Any]) -> Figure
         lower, upper = clopper_pearson(k, np.full(grid.shape, values.size), CONFIDENCE)
         (line,) = ax.step(grid, k / max(values.size, 1), where="post", label=label or None)
         ax.fill_between(grid, lower, upper, step="post", color=line.get_color(), alpha=0.15)
-    ax.set_xlabel(f"{describe_measure(setting)} ({setting['units']})")
-    ax.set_ylabel("P(pounding) (fraction of motions)")
-    ax.set_ylim(-0.02, 1.02)
-    ax.grid(True, lw=0.3, color="0.85")
-    if any(label for label, _ in cells):
-        ax.legend(fontsize=7)
+    _probability_axes(ax, setting, "P(pounding) (fraction of motions)", any(label for label, _ in cells))
     return FigureItem(
         f"intensity-ida-{name}",
         f"Experiment {name}: fraction of motions whose IDA capacity is at most x (they pound when scaled to x), per gap, with "
