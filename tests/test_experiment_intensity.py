@@ -152,3 +152,18 @@ def test_files_without_the_new_tables_keep_their_definitions():
     definition, _ = load_definition(REPOSITORY / "experiments" / "quickstart.toml")
     assert "intensity" not in definition and all("suite" not in m for m in definition["motions"])
     assert math.isfinite(definition["mu"]["values"][0])
+
+
+@pytest.mark.parametrize("synthetic", ["each", "expected"])
+def test_synthetic_ensembles_scaled_each_or_by_their_mean(synthetic, tmp_path):
+    ensemble = '\n[synthetic.kt]\ntype = "kanai_tajimi"\ncount = 4\nseed = 5\nomega_g = 15.0\nzeta_g = 0.6\npga = 3.0\nenvelope = "jennings"\nduration = 4.0\ndt = 0.01\n'
+    text = _experiment('gap = ["inf"]', f'measure = "pga"\nlevels = [0.1, 0.3]\nsynthetic = "{synthetic}"', records=ensemble)
+    report = run_experiment(load_experiment(write_experiment(tmp_path, text, f"{synthetic}.toml")), workers=0, progress=False)
+    store = open_store(report.store).load().isel(gap=0, record=0)
+    im, scale = store.motion_intensity, store.scale_factor
+    np.testing.assert_allclose(im.isel(intensity=0), store.motion_pga.isel(intensity=0) / 9.81, rtol=1e-15)
+    for j, level in enumerate(store.intensity.values):
+        if synthetic == "each":
+            np.testing.assert_allclose(scale.isel(intensity=j) * im.isel(intensity=j), level, rtol=1e-14)
+        else:
+            np.testing.assert_allclose(scale.isel(intensity=j), level / float(im.isel(intensity=j).mean()), rtol=1e-13)

@@ -61,7 +61,7 @@ def make_batches(experiment: Experiment, missing: Mapping[str, np.ndarray], moti
         Cases per batch (about).
     """
     points = [_Point(p, experiment.structure(p), experiment.reference_structure(p)) for kind in KINDS for p in experiment.points(kind)]
-    settings = task_settings(experiment)
+    settings = task_settings(experiment, motions)
     for record, label in enumerate(experiment.motions):
         realizations = experiment.realization_numbers(label)
         columns = experiment.realization_positions(label)

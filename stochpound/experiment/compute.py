@@ -168,7 +168,7 @@ def _group(
         try:
             ground, twin, extra = grounds[realization], twins[realization], {}
             if task.intensity is not None:
-                ground, twin, extra = intensity.scaled_case(task.intensity, dict(group.labels), ground, twin, measures[realization])
+                ground, twin, extra = intensity.scaled_case(task.intensity, task.record, dict(group.labels), ground, twin, measures[realization])
             ida = task.intensity is not None and task.intensity["ran"] == "ida" and scene is not None
             key = (canonical_json(group.structure), realization) if ida else None
             finished.append(_case(task, scene, ground, twin, extra, dict(group.labels), runs, key))

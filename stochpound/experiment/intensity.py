@@ -7,9 +7,11 @@ levels of an intensity measure (``pga``, ``pgv``, ``psa`` at a period,
 * **stripes** (multi-stripe analysis): the levels are a grid dimension,
   ``intensity``; the case at level x runs the motion scaled by
   x / IM, IM the motion's own (unscaled) measure. A synthetic ensemble is
-  scaled realization by realization, each realization exactly to the level
-  (``synthetic = "each"``, the only choice so far: the ensemble's PGA
-  parameter sets the shape of the realizations, the level their intensity).
+  scaled realization by realization, each exactly to the level
+  (``synthetic = "each"``, the default), or every realization by x / E[IM],
+  E[IM] the mean measure of the ensemble's realizations in the experiment
+  (``synthetic = "expected"``: the realizations keep their scatter of
+  intensity around the level).
 * **ida**: where the scene's contact-free response is homogeneous in the
   input (fixed bases, no initial displacement or velocity, no walls), a
   motion scaled by λ closes every contact by λ D, D its closure at scale 1;
@@ -38,7 +40,10 @@ MEASURES = ("pga", "pgv", "psa", "sa_avg")
 METHODS = ("stripes", "ida")
 UNITS = {"pga": ("g", "m/s2"), "psa": ("g", "m/s2"), "sa_avg": ("g", "m/s2"), "pgv": ("m/s", "cm/s")}
 """Units of ``levels`` allowed for each measure (the first is the default)."""
-SYNTHETIC_SCALING = ("each",)
+SYNTHETIC_SCALING = ("each", "expected")
+"""How a synthetic ensemble is scaled: each realization exactly to the level, or all by the level over the ensemble's mean measure."""
+ENSEMBLE_CHUNK = 256
+"""Realizations generated at once for an ensemble's mean measure."""
 PERIOD_SAMPLES = 2.0
 """Shortest period of a spectral measure, in steps of the motion: T ≥ 2·dt, the Nyquist period.
 
@@ -118,7 +123,10 @@ def parse_intensity(data: Mapping[str, Any], scene: Mapping[str, Any], variants:
     entry["method"] = method
     synthetic = table.get("synthetic", SYNTHETIC_SCALING[0])
     if synthetic not in SYNTHETIC_SCALING:
-        raise IntensityError(f"intensity.synthetic: must be {' or '.join(SYNTHETIC_SCALING)} (each realization scaled to the level), got {synthetic!r}")
+        raise IntensityError(
+            f"intensity.synthetic: must be {' or '.join(SYNTHETIC_SCALING)} (each realization scaled to the level, or all by the level over the "
+            f"ensemble's mean measure), got {synthetic!r}"
+        )
     entry["synthetic"] = synthetic
     entry["ran"], entry["note"] = _method_run(method, scene, variants, gaps, mu)
     return entry
@@ -173,10 +181,10 @@ def check_resolution(intensity: Mapping[str, Any], dt: float, where: str) -> Non
             )
 
 
-def motion_measures(values: np.ndarray, dt: float, intensity: Mapping[str, Any], g: float) -> dict[str, Any]:
+def motion_measures(values: np.ndarray, dt: float, intensity: Mapping[str, Any], g: float, spectrum: bool = True) -> dict[str, Any]:
     """The unscaled measures of a motion (samples in m/s², linear between them), by store name.
 
-    ``motion_intensity`` is in the units of ``levels``.
+    ``motion_intensity`` is in the units of ``levels``; ``spectrum=False`` leaves out ``motion_psa``.
     """
     pga, pgv, pgd = peak_ground_motion(values, dt)
     measure = intensity["measure"]
@@ -188,15 +196,17 @@ def motion_measures(values: np.ndarray, dt: float, intensity: Mapping[str, Any],
         periods = [intensity["period"]] if measure == "psa" else intensity["periods"]
         psa = response_spectrum(values, dt, periods, intensity["damping"]).psa.values
         value = float(np.exp(np.mean(np.log(psa))))
-    return {
+    measures = {
         "motion_intensity": value / level_to_si(intensity, 1.0, g),
         "motion_pga": pga,
         "motion_pgv": pgv,
         "motion_pgd": pgd,
         "motion_arias_intensity": arias_intensity(values, dt, g),
         "motion_significant_duration": significant_duration(values, dt),
-        "motion_psa": response_spectrum(values, dt, SPECTRUM_PERIODS, SPECTRUM_DAMPING).psa.values,
     }
+    if spectrum:
+        measures["motion_psa"] = response_spectrum(values, dt, SPECTRUM_PERIODS, SPECTRUM_DAMPING).psa.values
+    return measures
 
 
 def ida_capacity(closure: np.ndarray, im: float, gap_axes: list[tuple[float, list[int]]]) -> float:
@@ -243,12 +253,31 @@ def store_names(intensity: Mapping[str, Any] | None) -> list[str]:
     return names + (["ida_capacity"] if intensity["ran"] == "ida" else [])
 
 
-def task_settings(experiment: Any) -> dict[str, Any] | None:
-    """What a worker needs to scale an experiment's cases: the ``intensity`` entry, g and the gap axes (None without intensity)."""
+def task_settings(experiment: Any, motions: Mapping[str, Any]) -> dict[str, Any] | None:
+    """What a worker needs to scale an experiment's cases (None without intensity).
+
+    The ``intensity`` entry, g, the gap axes and, by motion number, the
+    ensembles' mean measures (``expected``; ``[intensity] synthetic = "expected"``).
+    """
     if experiment.intensity is None:
         return None
     gap_axes = [(gap["name"], list(gap["contacts"])) for gap in experiment.definition["gaps"]]
-    return {**experiment.intensity, "g": float(experiment.definition["scene"].get("g", 9.81)), "gap_axes": gap_axes}
+    expected = {index: motions[label].expected_intensity for index, label in enumerate(experiment.motions) if motions[label].expected_intensity is not None}
+    return {**experiment.intensity, "g": float(experiment.definition["scene"].get("g", 9.81)), "gap_axes": gap_axes, "expected": expected}
+
+
+def ensemble_intensity(intensity: Mapping[str, Any], table: Mapping[str, Any], realizations: range, g: float) -> float:
+    """Mean measure (units of ``levels``) of an ensemble's realizations, generated from its worker table in chunks."""
+    from stochpound import motions as synthetic_motions
+
+    parameters = {k: v for k, v in table.items() if k not in ("type", "interpolation", "realization")}
+    generator = getattr(synthetic_motions, table["type"])
+    total = 0.0
+    for start in range(realizations.start, realizations.stop, ENSEMBLE_CHUNK):
+        count = min(ENSEMBLE_CHUNK, realizations.stop - start)
+        values = np.asarray(generator(count, start=start, **parameters).values, dtype=float)
+        total += sum(motion_measures(row, float(table["dt"]), intensity, g, spectrum=False)["motion_intensity"] for row in values)
+    return total / len(realizations)
 
 
 def measures_of(settings: Mapping[str, Any], ground: Any) -> dict[str, Any]:
@@ -260,15 +289,20 @@ def measures_of(settings: Mapping[str, Any], ground: Any) -> dict[str, Any]:
     return motion_measures(ground.values, ground.dt, settings, settings["g"])
 
 
-def scaled_case(settings: Mapping[str, Any], labels: Mapping[str, Any], ground: Any, twin: np.ndarray, measures: Mapping[str, Any]) -> tuple[Any, np.ndarray, dict[str, Any]]:
+def scaled_case(
+    settings: Mapping[str, Any], record: int, labels: Mapping[str, Any], ground: Any, twin: np.ndarray, measures: Mapping[str, Any]
+) -> tuple[Any, np.ndarray, dict[str, Any]]:
     """The case's motion and fixed-base twin scaled to its ``intensity`` level (unchanged for IDA), and its intensity variables.
 
-    The twin is linear and starts at rest, so scaling its response equals running it on the scaled motion.
+    ``record`` is the motion's number (an ensemble scaled by its mean measure
+    uses it). The twin is linear and starts at rest, so scaling its response
+    equals running it on the scaled motion.
     """
     import dataclasses
 
     level = labels.get("intensity")
-    scale = 1.0 if level is None else float(level) / measures["motion_intensity"]
+    reference = settings["expected"].get(record, measures["motion_intensity"])
+    scale = 1.0 if level is None else float(level) / reference
     extra = {**measures, "scale_factor": scale}
     if scale == 1.0:
         return ground, twin, extra

@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 
 from stochpound import motions as synthetic_motions
-from stochpound.experiment.intensity import check_resolution
+from stochpound.experiment.intensity import check_resolution, ensemble_intensity
 from stochpound.experiment.model import CASE, Experiment
 from stochpound.experiment.spec import field_errors
 from stochpound.motions.ground import GroundMotion
@@ -39,12 +39,16 @@ class ResolvedMotion:
         An ensemble's ``[motion]`` table for the workers (``realization`` set per case).
     grid : tuple of (float, int)
         Sample spacing (s) and number of samples.
+    expected_intensity : float or None
+        An ensemble's mean intensity measure over its realizations, units of
+        ``levels`` (``[intensity] synthetic = "expected"`` only).
     """
 
     label: str
     motion: GroundMotion | None
     table: dict[str, Any] | None
     grid: tuple[float, int]
+    expected_intensity: float | None = None
 
 
 def resolve_motions(experiment: Experiment) -> dict[str, ResolvedMotion]:
@@ -68,7 +72,12 @@ def resolve_motions(experiment: Experiment) -> dict[str, ResolvedMotion]:
         if source["kind"] == "record":
             resolved[label] = ResolvedMotion(label, motion, None, grid)
         else:
-            resolved[label] = ResolvedMotion(label, None, _worker_table(table, motion, structure), grid)
+            worker_table = _worker_table(table, motion, structure)
+            expected = None
+            if experiment.intensity is not None and experiment.intensity["synthetic"] == "expected":
+                g = float(experiment.definition["scene"].get("g", 9.81))
+                expected = ensemble_intensity(experiment.intensity, worker_table, experiment.realizations(label), g)
+            resolved[label] = ResolvedMotion(label, None, worker_table, grid, expected)
     return resolved
 
 
