@@ -167,3 +167,10 @@ def test_synthetic_ensembles_scaled_each_or_by_their_mean(synthetic, tmp_path):
             np.testing.assert_allclose(scale.isel(intensity=j) * im.isel(intensity=j), level, rtol=1e-14)
         else:
             np.testing.assert_allclose(scale.isel(intensity=j), level / float(im.isel(intensity=j).mean()), rtol=1e-13)
+
+
+def test_analytic_motions_cannot_be_scaled(tmp_path):
+    motions = '\n[[motions]]\nname = "sine"\ntype = "harmonic"\namplitude = 1.0\nomega = 6.0\nduration = 2.0\ndt = 0.01\n'
+    path = write_experiment(tmp_path, _experiment("gap = [0.01]", 'measure = "pga"\nlevels = [0.1]', records=motions), "sine.toml")
+    with pytest.raises(ExperimentError, match=r"^motions\[0\]: a HarmonicMotion cannot be scaled"):
+        resolve_motions(load_experiment(path))

@@ -18,8 +18,8 @@ import numpy as np
 from stochpound import motions as synthetic_motions
 from stochpound.experiment.intensity import check_resolution, ensemble_intensity
 from stochpound.experiment.model import CASE, Experiment
-from stochpound.experiment.spec import field_errors
-from stochpound.motions.ground import GroundMotion
+from stochpound.experiment.spec import ExperimentError, field_errors
+from stochpound.motions.ground import GroundMotion, SampledMotion
 from stochpound.model.scene_file import scene_from_dict
 
 _INTENSITY_KEYS = ("pga", "rms", "peak_factor", "S0")
@@ -69,6 +69,8 @@ def resolve_motions(experiment: Experiment) -> dict[str, ResolvedMotion]:
         if experiment.intensity is not None:
             with field_errors():
                 check_resolution(experiment.intensity, grid[0], f"{source['field']} ({label})")
+                if not isinstance(motion, SampledMotion):
+                    raise ExperimentError(f"{source['field']}: a {type(motion).__name__} cannot be scaled to an intensity level; [intensity] takes records, suites and synthetic ensembles")
         if source["kind"] == "record":
             resolved[label] = ResolvedMotion(label, motion, None, grid)
         else:
