@@ -43,7 +43,7 @@ def intensity_section(name: str, store: xr.Dataset) -> Section:
     """The "Intensity" section of one store (call when :func:`intensity_setting` is not None)."""
     setting = intensity_setting(store)
     section = Section(f"Intensity: experiment {name}", key=f"intensity-{name}")
-    section.add(Paragraph(_method_text(store, setting)))
+    section.add(Paragraph(method_text(store, setting)))
     section.add(_spectra(name, store, setting))
     if "intensity" in store.dims:
         section.add(_stripe_table(name, store, setting))
@@ -53,7 +53,8 @@ def intensity_section(name: str, store: xr.Dataset) -> Section:
     return section
 
 
-def _method_text(store: xr.Dataset, setting: dict[str, Any]) -> str:
+def method_text(store: xr.Dataset, setting: dict[str, Any]) -> str:
+    """What ran (stripes or IDA, and why), the measure and the levels: one paragraph of the section and of the methods."""
     levels = ", ".join(f"{level:g}" for level in setting["levels"])
     text = (
         f"Intensity measure {describe_measure(setting)}, in {setting['units']}. Method requested: {setting['method']}; ran: "
