@@ -180,18 +180,20 @@ def _step_peak(l0: float, l1: float, E: float, F: float, sigma: float, wd: float
                 ex = math.exp(-sigma * tau)
                 c, s = math.cos(wd * tau), math.sin(wd * tau)
                 d1 = l1 + ex * (E1 * c + F1 * s)
+                if d1 == 0.0:
+                    break
                 if (d1 < 0.0) == (d_lo < 0.0):
                     lo, d_lo = tau, d1
                 else:
                     hi = tau
                 d2 = ex * (E2 * c + F2 * s)
-                step = d1 / d2 if d2 != 0.0 else 0.0
-                candidate = tau - step
+                candidate = tau - d1 / d2 if d2 != 0.0 else lo  # lo: not inside, so bisect
                 if not (lo < candidate < hi):
                     candidate = 0.5 * (lo + hi)
-                if candidate == tau or hi - lo <= 4e-16 * h:
-                    break
+                converged = abs(candidate - tau) <= 1e-15 * h or hi - lo <= 4e-16 * h
                 tau = candidate
+                if converged:
+                    break
             value = abs(_value(l0, l1, E, F, sigma, wd, tau))
             if value > peak:
                 peak = value
