@@ -249,7 +249,7 @@ def _twins(task: BatchTask, grounds: dict[int, GroundMotion]) -> dict[str, dict[
 
 
 def warm_up() -> None:
-    """Compile the exact solver's engine and the twin's recursion (or load them from numba's cache).
+    """Compile the exact solver's engine, the twin's recursion and the response spectrum's kernel (or load them from numba's cache).
 
     numba caches compiled kernels on disk (``cache=True``): compiled once
     here, before local workers start, every worker loads them in about a
@@ -258,6 +258,7 @@ def warm_up() -> None:
     from stochpound.solvers.exact import WARM_UP_SCENE, compile_engine
 
     compile_engine()
+    intensity.warm_up()
     building = WARM_UP_SCENE["building"][1]
     twin = scene_from_dict({"building": [building], "motion": WARM_UP_SCENE["motion"]}, source="warm_up")
     fixed_base_displacements(twin, [twin.motion])

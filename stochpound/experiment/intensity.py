@@ -314,3 +314,8 @@ def capacity_of(settings: Mapping[str, Any], summary: Mapping[str, Any], labels:
     """:func:`ida_capacity` of a contact-free case from its summary and grid labels."""
     axes = [(float(labels[name]), contacts) for name, contacts in settings["gap_axes"]]
     return ida_capacity(np.asarray(summary["peak_contact_closure"], dtype=float), float(summary["motion_intensity"]), axes)
+
+
+def warm_up() -> None:
+    """Compile the response spectrum's kernel (or load it from numba's cache) before workers start."""
+    response_spectrum(np.zeros(3), 0.01, [1.0])
