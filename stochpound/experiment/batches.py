@@ -20,6 +20,7 @@ from typing import Iterator, Mapping
 import numpy as np
 
 from stochpound.experiment.compute import BatchTask, Group
+from stochpound.experiment.intensity import task_settings
 from stochpound.experiment.model import CASE, KINDS, Experiment, Point
 from stochpound.experiment.sources import ResolvedMotion
 from stochpound.memory import sample_bytes
@@ -60,6 +61,7 @@ def make_batches(experiment: Experiment, missing: Mapping[str, np.ndarray], moti
         Cases per batch (about).
     """
     points = [_Point(p, experiment.structure(p), experiment.reference_structure(p)) for kind in KINDS for p in experiment.points(kind)]
+    settings = task_settings(experiment, motions)
     for record, label in enumerate(experiment.motions):
         realizations = experiment.realization_numbers(label)
         columns = experiment.realization_positions(label)
@@ -74,14 +76,14 @@ def make_batches(experiment: Experiment, missing: Mapping[str, np.ndarray], moti
             rows = [i for i in active if wanted[i, block].any()]
             for first in range(0, len(rows), per_batch):
                 groups = tuple(_group(points[i], record, realizations[block], columns[block], wanted[i, block]) for i in rows[first : first + per_batch])
-                yield BatchTask(record, motions[label].table, groups, experiment.studied, experiment.output, experiment.solver)
+                yield BatchTask(record, motions[label].table, groups, experiment.studied, experiment.output, experiment.solver, settings)
 
 
 def _group(entry: _Point, record: int, realizations: np.ndarray, columns: np.ndarray, wanted: np.ndarray) -> Group:
     chosen = np.flatnonzero(wanted)
     point = entry.point
     positions = np.array([(*point.position, record, int(c)) for c in columns[chosen]], dtype=np.int64)
-    return Group(point.kind, entry.structure, entry.reference, tuple(int(r) for r in realizations[chosen]), positions)
+    return Group(point.kind, entry.structure, entry.reference, tuple(int(r) for r in realizations[chosen]), positions, point.labels)
 
 
 def _realizations_per_batch(experiment: Experiment, motion: ResolvedMotion, size: int, n_points: int, n_realizations: int) -> int:

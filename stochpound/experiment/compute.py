@@ -23,6 +23,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from stochpound import motions as synthetic_motions
+from stochpound.experiment import intensity
 from stochpound.experiment.model import REFERENCE
 from stochpound.experiment.parts import concatenate, section_key, stack_cases
 from stochpound.experiment.spec import AUTO, canonical_json
@@ -50,6 +51,8 @@ class Group:
         Realization numbers (0 for a record).
     positions : np.ndarray
         (len(realizations), n_dims) int: the cases' positions in the grid of their kind.
+    labels : tuple of (str, value)
+        The grid point's labels (its ``intensity`` level and gaps scale the motion and give the IDA capacities).
     """
 
     kind: str
@@ -57,6 +60,7 @@ class Group:
     reference: dict
     realizations: tuple[int, ...]
     positions: np.ndarray
+    labels: tuple = ()
 
 
 @dataclass(frozen=True)
@@ -77,6 +81,8 @@ class BatchTask:
         ``time_histories``, ``buildings`` and ``impacts`` of the definition.
     solver : dict
         ``method``, ``integrator``, ``rtol``, ``atol``.
+    intensity : dict or None
+        :func:`stochpound.experiment.intensity.task_settings` of an intensity-conditioned experiment.
     """
 
     record: int
@@ -85,6 +91,7 @@ class BatchTask:
     studied: str
     output: dict
     solver: dict
+    intensity: dict | None = None
 
     @property
     def n_cases(self) -> int:
@@ -130,12 +137,13 @@ def run_batch(task: BatchTask, motion: GroundMotion | None = None) -> BatchResul
     try:
         grounds = _motions(task, motion)
         twins = _twins(task, grounds)
+        measures = {r: intensity.measures_of(task.intensity, ground) for r, ground in grounds.items()} if task.intensity else {}
     except Exception:  # noqa: BLE001 - reported for every case of the batch
         error = traceback.format_exc(limit=8)
         return BatchResult(failures=[(g.kind, tuple(int(i) for i in p), error) for g in task.groups for p in g.positions])
-    result, sections = BatchResult(), []
+    result, sections, runs = BatchResult(), [], {}
     for group in task.groups:
-        section = _group(task, group, grounds, twins[canonical_json(group.reference)], result.failures)
+        section = _group(task, group, grounds, twins[canonical_json(group.reference)], measures, runs, result.failures)
         if section:
             sections.append(section)
             result.done += len(section[section_key(group.kind, task.record, "position")])
@@ -143,8 +151,13 @@ def run_batch(task: BatchTask, motion: GroundMotion | None = None) -> BatchResul
     return result
 
 
-def _group(task: BatchTask, group: Group, grounds: dict[int, GroundMotion], twins: dict[int, np.ndarray], failures: list) -> dict[str, np.ndarray]:
-    """The section of a group's finished cases (empty if none finished); failures are appended to ``failures``."""
+def _group(
+    task: BatchTask, group: Group, grounds: dict[int, GroundMotion], twins: dict[int, np.ndarray], measures: dict[int, dict], runs: dict, failures: list
+) -> dict[str, np.ndarray]:
+    """The section of a group's finished cases (empty if none finished); failures are appended to ``failures``.
+
+    ``runs`` keeps the batch's IDA runs: their grid points differ only in gaps that are all infinite, so each motion runs once.
+    """
     try:
         scene = _scene(group.structure) if group.kind != REFERENCE else None
     except Exception:  # noqa: BLE001 - reported for every case of the group
@@ -153,7 +166,12 @@ def _group(task: BatchTask, group: Group, grounds: dict[int, GroundMotion], twin
     finished, positions = [], []
     for realization, position in zip(group.realizations, group.positions):
         try:
-            finished.append(_case(task, scene, grounds[realization], twins[realization]))
+            ground, twin, extra = grounds[realization], twins[realization], {}
+            if task.intensity is not None:
+                ground, twin, extra = intensity.scaled_case(task.intensity, task.record, dict(group.labels), ground, twin, measures[realization])
+            ida = task.intensity is not None and task.intensity["ran"] == "ida" and scene is not None
+            key = (canonical_json(group.structure), realization) if ida else None
+            finished.append(_case(task, scene, ground, twin, extra, dict(group.labels), runs, key))
         except Exception:  # noqa: BLE001 - reported per case, the batch goes on
             failures.append((group.kind, tuple(int(i) for i in position), traceback.format_exc(limit=8)))
             continue
@@ -164,17 +182,28 @@ def _group(task: BatchTask, group: Group, grounds: dict[int, GroundMotion], twin
     return {section_key(group.kind, task.record, name): values for name, values in stacked.items()}
 
 
-def _case(task: BatchTask, scene: Scene | None, ground: GroundMotion, twin: np.ndarray) -> dict[str, np.ndarray]:
-    """Part arrays of one case: ``scene`` (placeholder motion) under ``ground``, or, without a scene, a reference case (its twin's response)."""
+def _case(
+    task: BatchTask, scene: Scene | None, ground: GroundMotion, twin: np.ndarray, extra: dict, labels: dict, runs: dict, key: tuple | None
+) -> dict[str, np.ndarray]:
+    """Part arrays of one case: ``scene`` (placeholder motion) under ``ground``, or, without a scene, a reference case (its twin's response).
+
+    ``extra``: the intensity variables of the case (none without ``[intensity]``); a run with a ``key`` is kept in ``runs`` and reused.
+    """
     if scene is None:
-        return reference_arrays(reference_values(twin), twin, "total_displacement" in task.output["time_histories"])
+        return reference_arrays({**reference_values(twin), **extra}, twin, "total_displacement" in task.output["time_histories"])
     solver = task.solver
     method = None if solver["method"] == AUTO else solver["method"]
-    run = simulate(
-        dataclasses.replace(scene, motion=ground), method, integrator=solver["integrator"], rtol=solver["rtol"], atol=solver["atol"],
-        demands=task.output.get("demands", False),
-    )
-    summary = case_values(run, task.studied, twin[-1])
+    run = runs.get(key) if key is not None else None
+    if run is None:
+        run = simulate(
+            dataclasses.replace(scene, motion=ground), method, integrator=solver["integrator"], rtol=solver["rtol"], atol=solver["atol"],
+            demands=task.output.get("demands", False),
+        )
+        if key is not None:
+            runs[key] = run
+    summary = {**case_values(run, task.studied, twin[-1]), **extra}
+    if task.intensity is not None and task.intensity["ran"] == "ida":
+        summary["ida_capacity"] = intensity.capacity_of(task.intensity, summary, labels)
     return case_arrays(summary, run, task.output["time_histories"], task.output["buildings"], task.output["impacts"])
 
 
@@ -231,7 +260,7 @@ def solver_cached() -> bool:
 
 
 def warm_up() -> None:
-    """Compile the exact solver's engine and the twin's recursion (or load them from numba's cache).
+    """Compile the exact solver's engine, the twin's recursion and the response spectrum's kernel (or load them from numba's cache).
 
     numba caches compiled kernels on disk (``cache=True``): compiled once
     here, before local workers start, every worker loads them in about a
@@ -240,6 +269,7 @@ def warm_up() -> None:
     from stochpound.solvers.exact import WARM_UP_SCENE, compile_engine
 
     compile_engine()
+    intensity.warm_up()
     building = WARM_UP_SCENE["building"][1]
     twin = scene_from_dict({"building": [building], "motion": WARM_UP_SCENE["motion"]}, source="warm_up")
     fixed_base_displacements(twin, [twin.motion])

@@ -2,11 +2,11 @@
 
 Two kinds of case exist:
 
-* ``case``: one point of the grid (variant axes × gap axes × μ) under one
+* ``case``: one point of the grid (variant axes × gap axes × μ × intensity) under one
   motion (``record``, ``realization``);
 * ``reference``: the studied building alone on a fixed base under the same
   motion, on the dimensions ``record`` and ``realization`` (plus the variant
-  axes that change the studied building itself).
+  axes that change the studied building itself, and ``intensity``).
 
 A case id is the first 16 hex digits of the sha256 of its kind and labels, so
 it does not depend on the order of the grid or on how the run is split.
@@ -48,9 +48,9 @@ class Dim:
     Attributes
     ----------
     name : str
-        Dimension name (``gap``, ``mu``, a variant axis, ``record``, ``realization``).
+        Dimension name (``gap``, ``mu``, a variant axis, ``intensity``, ``record``, ``realization``).
     kind : str
-        ``variant``, ``gap``, ``mu``, ``record`` or ``realization``.
+        ``variant``, ``gap``, ``mu``, ``intensity``, ``record`` or ``realization``.
     values : tuple
         Coordinate values, in grid order.
     """
@@ -160,6 +160,7 @@ class Experiment:
         self.motions: dict[str, dict[str, Any]] = {m["label"]: m for m in self.definition["motions"]}
         self.output: dict[str, Any] = self.definition["output"]
         self.solver: dict[str, Any] = self.definition["solver"]
+        self.intensity: dict[str, Any] | None = self.definition.get("intensity")
         self._grid_case_ids: dict[str, np.ndarray] = {}
 
     # ------------------------------------------------------------ dimensions
@@ -192,7 +193,14 @@ class Experiment:
         dims += [Dim(g["name"], "gap", tuple(g["values"])) for g in self.definition["gaps"]]
         if self.definition["mu"] is not None:
             dims.append(Dim("mu", "mu", tuple(self.definition["mu"]["values"])))
-        return dims
+        return dims + self.intensity_dims
+
+    @cached_property
+    def intensity_dims(self) -> list[Dim]:
+        """``intensity`` (the target levels) when stripes run; none otherwise."""
+        if self.intensity is None or self.intensity["ran"] != "stripes":
+            return []
+        return [Dim("intensity", "intensity", tuple(self.intensity["levels"]))]
 
     @cached_property
     def dims(self) -> list[Dim]:
@@ -202,7 +210,8 @@ class Experiment:
     @cached_property
     def reference_dims(self) -> list[Dim]:
         """Dimensions of the fixed-base reference: variant axes that change the studied building, then the motion."""
-        return [d for d in self.grid_dims if d.kind == "variant" and self._touches_studied(d.name)] + self.motion_dims
+        touched = [d for d in self.grid_dims if d.kind == "variant" and self._touches_studied(d.name)]
+        return touched + self.intensity_dims + self.motion_dims
 
     def _touches_studied(self, axis: str) -> bool:
         variant = next(v for v in self.variants if v["name"] == axis)
@@ -330,6 +339,8 @@ class Experiment:
         else:
             for gap in self.definition["gaps"]:
                 set_gaps(scene, gap["contacts"], labels[gap["name"]])
+            if self.intensity is not None and self.intensity["ran"] == "ida":  # contact-free: capacities come from the closures
+                set_gaps(scene, range(len(scene.get("contact", []))), float("inf"))
             mu = self.definition["mu"]
             if mu is not None:
                 missing = set_mu(scene, mu["buildings"], labels["mu"])

@@ -16,9 +16,10 @@ from typing import Any
 import numpy as np
 
 from stochpound import motions as synthetic_motions
+from stochpound.experiment.intensity import check_resolution, ensemble_intensity
 from stochpound.experiment.model import CASE, Experiment
-from stochpound.experiment.spec import field_errors
-from stochpound.motions.ground import GroundMotion
+from stochpound.experiment.spec import ExperimentError, field_errors
+from stochpound.motions.ground import GroundMotion, SampledMotion
 from stochpound.model.scene_file import scene_from_dict
 
 _INTENSITY_KEYS = ("pga", "rms", "peak_factor", "S0")
@@ -38,12 +39,16 @@ class ResolvedMotion:
         An ensemble's ``[motion]`` table for the workers (``realization`` set per case).
     grid : tuple of (float, int)
         Sample spacing (s) and number of samples.
+    expected_intensity : float or None
+        An ensemble's mean intensity measure over its realizations, units of
+        ``levels`` (``[intensity] synthetic = "expected"`` only).
     """
 
     label: str
     motion: GroundMotion | None
     table: dict[str, Any] | None
     grid: tuple[float, int]
+    expected_intensity: float | None = None
 
 
 def resolve_motions(experiment: Experiment) -> dict[str, ResolvedMotion]:
@@ -61,10 +66,20 @@ def resolve_motions(experiment: Experiment) -> dict[str, ResolvedMotion]:
         with field_errors(scene_prefix=source["field"]):
             motion = scene_from_dict({**structure, "motion": table}, base_dir=experiment.base_dir).motion
         grid = (float(motion.times[1] - motion.times[0]), len(motion.times))
+        if experiment.intensity is not None:
+            with field_errors():
+                check_resolution(experiment.intensity, grid[0], f"{source['field']} ({label})")
+                if not isinstance(motion, SampledMotion):
+                    raise ExperimentError(f"{source['field']}: a {type(motion).__name__} cannot be scaled to an intensity level; [intensity] takes records, suites and synthetic ensembles")
         if source["kind"] == "record":
             resolved[label] = ResolvedMotion(label, motion, None, grid)
         else:
-            resolved[label] = ResolvedMotion(label, None, _worker_table(table, motion, structure), grid)
+            worker_table = _worker_table(table, motion, structure)
+            expected = None
+            if experiment.intensity is not None and experiment.intensity["synthetic"] == "expected":
+                g = float(experiment.definition["scene"].get("g", 9.81))
+                expected = ensemble_intensity(experiment.intensity, worker_table, experiment.realizations(label), g)
+            resolved[label] = ResolvedMotion(label, None, worker_table, grid, expected)
     return resolved
 
 

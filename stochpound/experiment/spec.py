@@ -26,6 +26,7 @@ from pathlib import Path
 from typing import Any, Iterator, Mapping
 
 from stochpound.errors import SceneError
+from stochpound.experiment.intensity import parse_intensity
 from stochpound.model import fields as toml_fields
 from stochpound.model.contact import ELEMENT_KEYS
 from stochpound.model.scene_file import generator_fields
@@ -35,13 +36,14 @@ from stochpound.solvers.ivp import INTEGRATORS
 #: Format version of the canonical definition (stored with every store).
 FORMAT_VERSION = 1
 
-_TOP_KEYS = {"experiment", "scene", "variants", "grid", "records", "motions", "synthetic", "output", "solver"}
+_TOP_KEYS = {"experiment", "scene", "variants", "grid", "records", "motions", "synthetic", "output", "solver", "intensity"}
 _EXPERIMENT_KEYS = {"name", "description", "scene", "studied"}
 _BUILDING_OVERRIDES = {"mass_factor", "mass", "stiffness", "damping", "damping_ratio", "base", "initial"}
 _SCENE_OVERRIDES = {"study_compat", "wall"}
 AUTO = "auto"
 """``solver.method`` default: each case's solver chosen by :func:`stochpound.simulate` (exact unless a law is nonlinear)."""
 _RECORD_KEYS = {"name", "record", "scale", "dt", "duration", "units", "interpolation"}
+_SUITE_KEYS = {"name", "suite", "scale", "duration", "interpolation"}
 _SYNTHETIC_TYPES = ("kanai_tajimi", "clough_penzien")
 MAX_REALIZATIONS = 10**8
 """Largest ``count`` of a synthetic ensemble: the run's client holds a few hundred bytes per case
@@ -51,7 +53,7 @@ _ANALYTIC_TYPES = ("harmonic", "constant")
 _GAP_AXIS = re.compile(r"^gap(_[A-Za-z0-9_]+)?$")
 _DIM_NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
 _RESERVED_DIMS = {
-    "mu", "record", "realization", "time", "building", "floor", "contact", "impact",
+    "mu", "record", "realization", "time", "building", "floor", "contact", "impact", "intensity", "spectrum_period",
     # suffixes of the impact table's columns (impact_<dim> labels the table)
     "start", "end", "duration", "peak_force", "peak_time", "impulse", "onset_velocity", "in_phase", "complete", "case_id",
 }
@@ -195,7 +197,9 @@ def parse_experiment(data: Mapping[str, Any], base_dir: str | Path = ".", defaul
     contact_floors = [c.get("between", [[None, None]])[0][1] for c in scene.get("contact", [])]
     gaps = [_gap_axis(key, grid[key], n_contacts, contact_floors) for key in grid if _GAP_AXIS.match(key)]
     mu = _mu_axis(grid["mu"], buildings) if "mu" in grid else None
-    return {
+    with field_errors():
+        intensity = parse_intensity(data, scene, variants, gaps, mu)
+    definition = {
         "format": FORMAT_VERSION,
         "name": name,
         "description": description,
@@ -208,6 +212,9 @@ def parse_experiment(data: Mapping[str, Any], base_dir: str | Path = ".", defaul
         "output": _output(data, buildings),
         "solver": _solver(data),
     }
+    if intensity is not None:  # absent without [intensity]: the definitions (and hashes) of other files are unchanged
+        definition["intensity"] = intensity
+    return definition
 
 
 def _table_or_error(data: Mapping[str, Any], key: str, prefix: str) -> dict[str, Any]:
@@ -402,7 +409,7 @@ def _mu_axis(spec: Any, buildings: list[str]) -> dict[str, Any]:
 def _motions(data: Mapping[str, Any], scene: Mapping[str, Any], base_dir: Path) -> list[dict[str, Any]]:
     records = _array_of_tables(data, "records")
     synthetic = _table_or_error(data, "synthetic", "")
-    motions = [_record_source(table, f"records[{i}]", base_dir) for i, table in enumerate(records)]
+    motions = [source for i, table in enumerate(records) for source in _record_sources(table, f"records[{i}]", base_dir)]
     motions += [_analytic_source(table, f"motions[{i}]") for i, table in enumerate(_array_of_tables(data, "motions"))]
     motions += [_synthetic_source(label, table, f"synthetic.{label}") for label, table in synthetic.items()]
     if not motions:
@@ -452,6 +459,31 @@ def _file_sha256(base_dir: Path, spec: Any) -> str | None:
         return None
     file = base_dir / spec
     return hashlib.sha256(file.read_bytes()).hexdigest() if file.is_file() else None
+
+
+def _record_sources(table: Mapping[str, Any], where: str, base_dir: Path) -> list[dict[str, Any]]:
+    """A ``[[records]]`` entry: one record, or every motion of a suite (``suite = "fema_p695_far_field"`` or a folder)."""
+    if "suite" not in table:
+        return [_record_source(table, where, base_dir)]
+    from stochpound.motions.records.suites import SUITES, suite_members
+
+    with field_errors():
+        toml_fields.reject_unknown(table, _SUITE_KEYS, where)
+        suite = toml_fields.string(table, "suite", where)
+        prefix = toml_fields.string(table, "name", where, default="")
+    folder = base_dir / suite
+    if suite not in SUITES and not folder.is_dir():
+        raise ExperimentError(f"{where}.suite: unknown suite {suite!r} and no such folder (suites: {', '.join(SUITES)}, or a folder of .AT2/.txt files)")
+    with field_errors(f"{where}."):
+        members = suite_members(suite if suite in SUITES else folder)
+    sources = []
+    for member in members:
+        record = member if suite in SUITES else str(Path(member).relative_to(base_dir))
+        label = member if suite in SUITES else Path(member).stem
+        motion = {k: v for k, v in table.items() if k not in ("name", "suite")}
+        motion.update(type="record", record=record, file_sha256=_file_sha256(base_dir, record))
+        sources.append({"label": f"{prefix}/{label}" if prefix else label, "kind": "record", "field": where, "motion": motion, "suite": suite})
+    return sources
 
 
 def _record_source(table: Mapping[str, Any], where: str, base_dir: Path) -> dict[str, Any]:

@@ -32,9 +32,11 @@ from typing import Any, Iterator, Mapping
 import numpy as np
 import xarray as xr
 
+from stochpound.experiment import intensity
 from stochpound.experiment.model import CASE, REFERENCE, Dim, Experiment
 from stochpound.experiment.spec import ExperimentError, canonical_json
 from stochpound.experiment.summary import DEMAND_SUMMARIES, IMPACT_COLUMNS, templates, variable_attrs
+from stochpound.motions.records.suites import METADATA_FIELDS
 
 #: Version of the store layout.
 STORE_FORMAT = 1
@@ -141,10 +143,23 @@ def layout(experiment: Experiment, motion_grids: Mapping[str, tuple[float, int]]
             dtype = _store_dtype(variable.dtype)
             encoding = {} if dtype.kind == "f" else {"_FillValue": INT_FILL}
             specs.append(Spec(name, kind, "summary", dims + extra, dtype, dict(variable_attrs(name)), chunks + tuple(sizes[d] for d in extra), encoding))
+    specs += _intensity_specs(experiment, sizes)
     specs += _history_specs(experiment, sizes, run)
     if experiment.output["impacts"]:
         specs += _impact_specs(experiment, run, max(n_impacts, 0))
     return Layout(coords, {**sizes, "impact": n_impacts}, specs)
+
+
+def _intensity_specs(experiment: Experiment, sizes: Mapping[str, int]) -> list[Spec]:
+    """The per-case intensity variables (:mod:`stochpound.experiment.intensity`), on the case dimensions."""
+    dims = tuple(d.name for d in experiment.kind_dims(CASE))
+    chunks = block_shape(tuple(sizes[d] for d in dims), SUMMARY_BLOCK)
+    specs = []
+    for name in intensity.store_names(experiment.intensity):
+        extra = ("spectrum_period",) if name == "motion_psa" else ()
+        attrs = intensity.summary_attrs(experiment.intensity, name)
+        specs.append(Spec(name, CASE, "summary", dims + extra, np.dtype(float), attrs, chunks + tuple(sizes[d] for d in extra)))
+    return specs
 
 
 def _history_specs(experiment: Experiment, sizes: Mapping[str, int], run: xr.Dataset) -> list[Spec]:
@@ -209,6 +224,11 @@ def _coordinates(experiment: Experiment, motion_grids: Mapping[str, tuple[float,
     coords["record_motion"] = xr.Variable(
         ("record",), np.array([canonical_json(motions[m]["motion"]) for m in motions], dtype=object), {"units": "1", "long_name": "the motion's scene table (JSON)"}
     )
+    coords.update(_suite_coordinates(experiment))
+    if experiment.intensity is not None:
+        coords["spectrum_period"] = xr.Variable(
+            ("spectrum_period",), intensity.SPECTRUM_PERIODS, {"units": "s", "long_name": "period of the stored spectra (5 % damping)"}
+        )
     scene = experiment.definition["scene"]
     coords["building"] = xr.Variable(("building",), np.array(experiment.building_names, dtype=object), {"units": "1", "long_name": "building name, left to right"})
     coords["floor"] = xr.Variable(("floor",), np.arange(1, experiment.max_floors + 1), {"units": "1", "long_name": "floor number, 1 = lowest"})
@@ -216,6 +236,34 @@ def _coordinates(experiment: Experiment, motion_grids: Mapping[str, tuple[float,
     if experiment.output["time_histories"]:
         coords["time"] = xr.Variable(("time",), union_times(motion_grids), {"units": "s", "long_name": "time (union of the motions' sample times)"})
     return coords
+
+
+def _suite_coordinates(experiment: Experiment) -> dict[str, xr.Variable]:
+    """Metadata of the motions from suites on ``record`` (event, station, component, magnitude, distance...; none without such motions)."""
+    from stochpound.motions.records.suites import is_suite_member, load_suite_member
+
+    rows: list[Mapping[str, Any]] = []
+    for source in experiment.motions.values():
+        record = str(source["motion"].get("record", ""))
+        if is_suite_member(record):
+            rows.append(load_suite_member(record).metadata)
+        elif "suite" in source:  # a folder: the file name is all that is known
+            rows.append({"suite": source["suite"], "component": Path(record).name})
+        else:
+            rows.append({})
+    if not any(rows):
+        return {}
+    coords = {"record_suite": xr.Variable(("record",), np.array([str(m.get("suite", "")) for m in rows], dtype=object), {"units": "1", "long_name": "suite of the motion"})}
+    for name, units in METADATA_FIELDS.items():
+        values = [m.get(name, "" if name in _TEXT_FIELDS else np.nan) for m in rows]
+        if name in _TEXT_FIELDS:
+            coords[f"record_{name}"] = xr.Variable(("record",), np.array([str(v) for v in values], dtype=object), {"units": "1", "long_name": f"{name} of the motion"})
+        else:
+            coords[f"record_{name}"] = xr.Variable(("record",), np.array(values, dtype=float), {"units": units or "1", "long_name": f"{name} of the motion"})
+    return coords
+
+
+_TEXT_FIELDS = ("event", "station", "component")
 
 
 def _dim_coordinate(experiment: Experiment, dim: Dim) -> xr.Variable:
@@ -230,6 +278,9 @@ def _dim_coordinate(experiment: Experiment, dim: Dim) -> xr.Variable:
         return xr.Variable(("mu",), np.array(dim.values, float), {"units": "1", "long_name": f"friction coefficient of {which} (inf: fixed base)"})
     if dim.kind == "record":
         return xr.Variable(("record",), np.array(dim.values, dtype=object), {"units": "1", "long_name": "ground motion (record or synthetic ensemble)"})
+    if dim.kind == "intensity":
+        setting = experiment.intensity
+        return xr.Variable(("intensity",), np.array(dim.values, float), {"units": setting["units"], "long_name": f"target intensity level, {intensity.describe_measure(setting)}"})
     return xr.Variable(("realization",), np.array(dim.values, dtype=np.int64), {"units": "1", "long_name": "realization index (0 for a record)"})
 
 

@@ -6,6 +6,9 @@
 >>> a.sizes                                                         # doctest: +SKIP
 {'realization': 100, 'time': 2001}
 
+Intensity measures and the response spectrum (exact for accelerations linear
+between samples): :func:`intensity_measures`, :func:`response_spectrum`.
+
 Conventions (PSD two-sided in ω, σ² = ∫ S dω; SI units) are in ``docs/motions.md``.
 """
 
@@ -21,6 +24,7 @@ from stochpound.motions.envelopes import (
     make_envelope,
 )
 from stochpound.motions.generators import filter_samples, spectral_samples, stationary_samples
+from stochpound.motions.measures import intensity_measures, peak_ground_motion, sa_avg, significant_duration
 from stochpound.motions.intensity import poisson_peak_factor, s0_from_pga, s0_from_rms, simulated_peak_factor
 from stochpound.motions.presets import SOIL_PRESETS, SoilPreset, soil_preset
 from stochpound.motions.psd import (
@@ -33,6 +37,7 @@ from stochpound.motions.psd import (
     kanai_tajimi_variance,
 )
 from stochpound.motions.seeding import realization_rng, realization_rngs
+from stochpound.motions.spectrum import response_spectrum
 from stochpound.motions.synthetic import PSD_CONVENTION, clough_penzien, kanai_tajimi, synthetic_ground_motion
 
 __all__ = [
@@ -54,16 +59,21 @@ __all__ = [
     "filter_samples",
     "final_velocity_displacement",
     "high_pass_gain",
+    "intensity_measures",
     "kanai_tajimi",
     "kanai_tajimi_model",
     "kanai_tajimi_psd",
     "kanai_tajimi_variance",
     "make_envelope",
+    "peak_ground_motion",
     "poisson_peak_factor",
     "realization_rng",
     "realization_rngs",
+    "response_spectrum",
     "s0_from_pga",
     "s0_from_rms",
+    "sa_avg",
+    "significant_duration",
     "soil_preset",
     "simulated_peak_factor",
     "spectral_samples",

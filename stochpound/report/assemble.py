@@ -18,6 +18,7 @@ import xarray as xr
 from stochpound.report import findings, study_figures, study_notes, study_tables
 from stochpound.report.document import Block, Paragraph, Report, Section
 from stochpound.report.generic import store_section
+from stochpound.report.intensity import intensity_section, intensity_setting
 from stochpound.report.separation import has_contact_free, separation_section, with_contacts
 from stochpound.report.methods import methods_section
 from stochpound.report.stores import open_stores
@@ -77,6 +78,9 @@ def assemble_report(paths: Sequence[str | Path], progress: Callable[[str], None]
         if contact_free:
             say(f"experiment {name}: separation")
             report.sections.append(separation_section(name, store))
+        if intensity_setting(store) is not None:
+            say(f"experiment {name}: intensity")
+            report.sections.append(intensity_section(name, store))
     say("methods")
     report.sections.append(methods_section(stores))
     return report

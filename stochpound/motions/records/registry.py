@@ -18,6 +18,7 @@ from stochpound.data_files import bundled_data_dir
 from stochpound.errors import RecordError
 from stochpound.motions.records.readers import RawSeries, read_record_file
 from stochpound.motions.records.record import Record, normalize_units
+from stochpound.motions.records.suites import is_suite_member, load_suite_member
 
 REGISTRY_FILE = "registry.toml"
 _VARIANT_KEYS = {"base", "first", "scale", "divide_by"}
@@ -129,8 +130,10 @@ def load_record(
     Parameters
     ----------
     source : str or Path
-        A registry name (see :func:`list_records`; named variants included) or
-        the path of a PEER ``.AT2`` or text file.
+        A registry name (see :func:`list_records`; named variants included), a
+        suite's motion (``fema_p695_far_field/01a``, see
+        :mod:`stochpound.motions.records.suites`) or the path of a PEER
+        ``.AT2`` or text file.
     dt : float, optional
         Sample step, s. Required for one-column text files; for other files and
         bundled records it must agree with the file.
@@ -158,8 +161,8 @@ def load_record(
     """
     entries = registry_entries()
     key = str(source)
-    if key in entries:
-        record = _load_entry(entries, key)
+    if key in entries or is_suite_member(key):
+        record = _load_entry(entries, key) if key in entries else load_suite_member(key)
         _check_override(record, dt, units)
         return record
     path = Path(source)

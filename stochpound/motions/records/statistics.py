@@ -5,7 +5,8 @@
 * peak = max abs(a), in g;
 * Arias intensity I_A = π / (2 g) ∫ a(t)² dt, with a(t) interpolated linearly
   between samples (the first-order hold the solvers use), so that the integral
-  over each step is dt (a_k² + a_k a_{k+1} + a_{k+1}²) / 3.
+  over each step is dt (a_k² + a_k a_{k+1} + a_{k+1}²) / 3
+  (:func:`stochpound.motions.measures.arias_intensity`).
 """
 
 from __future__ import annotations
@@ -15,6 +16,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from stochpound.analysis import kernels
+from stochpound.motions.measures import arias_intensity
 from stochpound.motions.records.record import Record
 
 #: The reference study's g, m/s².
@@ -77,31 +79,6 @@ def moments(values: np.ndarray) -> tuple[float, float, float, float]:
     """
     result = kernels.moments(np.asarray(values, dtype=np.float64))
     return float(result.mean), float(result.std), float(result.skewness), float(result.excess)
-
-
-def arias_intensity(acceleration: np.ndarray, dt: float, g: float = STUDY_G) -> float:
-    """Arias intensity π/(2g) ∫ a² dt of a linearly interpolated accelerogram.
-
-    Parameters
-    ----------
-    acceleration : np.ndarray
-        Samples, m/s².
-    dt : float
-        Step, s.
-    g : float
-        m/s².
-
-    Returns
-    -------
-    float
-        Arias intensity, m/s.
-    """
-    a = np.asarray(acceleration, dtype=np.float64)
-    if a.size < 2:
-        return 0.0
-    left, right = a[:-1], a[1:]
-    integral = dt * float(np.sum(left * left + left * right + right * right)) / 3.0
-    return np.pi / (2.0 * g) * integral
 
 
 def record_statistics(record: Record, g: float = STUDY_G) -> RecordStatistics:
