@@ -12,7 +12,7 @@ With a_g linear in every step (a_k + s τ, 0 ≤ τ ≤ h), from rest:
 * significant duration D5–95: the time between the instants the cumulative
   integral ∫ a_g² reaches 5 % and 95 % of its total; the integral is cubic
   in every step, a_k² τ + a_k s τ² + s² τ³/3, and is inverted to round-off;
-* PSA at given periods (:func:`stochpound.motions.spectrum.response_spectrum`)
+* PSA at given periods (:func:`~stochpound.motions.response_spectrum`)
   and Sa_avg, the geometric mean of PSA over a set of periods.
 
 A motion scaled by λ has every measure scaled by abs(λ), I_a by λ², D5–95 unchanged.
@@ -139,7 +139,7 @@ def intensity_measures(
     """Intensity measures of a ground motion (module docstring).
 
     ``acceleration``, ``dt`` and ``damping`` are as in
-    :func:`~stochpound.motions.spectrum.response_spectrum`; ``periods`` (s,
+    :func:`~stochpound.motions.response_spectrum`; ``periods`` (s,
     optional) adds ``psa``, ``sd`` and ``sa`` over ``period``; ``g`` (m/s²) is
     that of the Arias intensity and of a record stored in g.
 

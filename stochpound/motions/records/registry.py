@@ -132,7 +132,7 @@ def load_record(
     source : str or Path
         A registry name (see :func:`list_records`; named variants included), a
         suite's motion (``fema_p695_far_field/01a``, see
-        :mod:`stochpound.motions.records.suites`) or the path of a PEER
+        :func:`~stochpound.motions.records.load_suite`) or the path of a PEER
         ``.AT2`` or text file.
     dt : float, optional
         Sample step, s. Required for one-column text files; for other files and
