@@ -5,9 +5,12 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 ROOT = Path(__file__).parents[1]
 
 
+@pytest.mark.slow
 def test_sphinx_builds_the_docs_and_the_api_reference_without_warnings(tmp_path):
     result = subprocess.run([sys.executable, "-m", "sphinx", "-W", "--keep-going", "-q", "-b", "html", "docs", str(tmp_path)],
                             cwd=ROOT, capture_output=True, text=True, timeout=900, check=False)

@@ -21,6 +21,7 @@ import hashlib, json
 import numba
 import numpy as np
 from numba.core import event
+from numba.core.registry import CPUDispatcher
 
 import stochpound
 from stochpound.solvers import engine
@@ -58,6 +59,7 @@ runs.update({f"seed {seed}": stochpound.simulate(stochpound.scene_from_dict(rand
 runs["hard case 1, ivp"] = stochpound.simulate(stochpound.scene_from_dict(next(iter(HARD_CASES.values()))), method="ivp")
 runs["hertz_damp, ivp"] = stochpound.simulate(stochpound.scene_from_dict(free_masses("hertz_damp", 0.6)), method="ivp")
 print(json.dumps({"levels": levels, "after": after, "specialisations": len(engine.run_engine.signatures),
+                  "signatures": {name: len(f.signatures) for name, f in vars(engine).items() if isinstance(f, CPUDispatcher)},
                   "digests": {name: digest(run) for name, run in runs.items()}}))
 """
 
@@ -72,6 +74,7 @@ def _probe(cache: Path, **environment: str) -> dict:
     return json.loads(result.stdout.splitlines()[-1])
 
 
+@pytest.mark.slow
 def test_engine_stays_in_bounds_and_its_compile_settings_change_no_result(tmp_path):
     """The engine compiled as stochpound compiles it, with numba's bounds checking on, and as numba would by default (NUMBA_OPT=3).
 
@@ -82,13 +85,20 @@ def test_engine_stays_in_bounds_and_its_compile_settings_change_no_result(tmp_pa
     and two ivp runs (one with a nonlinear law): every variable of every
     result dataset and the event counters must be bitwise the same. Each
     process first runs ``compile_engine`` (the experiment runner's warm-up),
-    which must compile the one specialisation every later run uses.
+    which must compile the one specialisation every later run uses, and
+    every jitted function of the engine once (twice for ``_copy``: float and
+    int arrays): a compile-time constant passed to a helper, or arrays of
+    another layout, would compile it again. The cache is empty, so every
+    function the runs reach is compiled in the probe and counted.
     """
     ours = _probe(tmp_path / "ours", NUMBA_BOUNDSCHECK="1")
     default = _probe(tmp_path / "default", NUMBA_OPT="3")
     assert ours["levels"] == [compiling.OPTIMISATION_LEVEL] and ours["after"] == 3  # numba's default level restored afterwards
     assert default["levels"] == [3]
     assert ours["specialisations"] == default["specialisations"] == 1
+    for probe in (ours, default):
+        assert probe["signatures"]["run_engine"] == 1 and sum(count > 0 for count in probe["signatures"].values()) > 20
+        assert {name: count for name, count in probe["signatures"].items() if count > (2 if name == "_copy" else 1)} == {}
     assert len(ours["digests"]) == 19
     assert ours["digests"] == default["digests"]
 

@@ -213,6 +213,7 @@ def test_findings_are_computed_from_the_statistics(built, store):
     assert any(text.startswith("A sliding base against the fixed base") for text in texts)
 
 
+@pytest.mark.slow
 def test_the_report_renders_in_headless_chromium(built, tmp_path):
     executable = require_chromium()
     report, written = built
