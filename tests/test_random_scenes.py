@@ -126,16 +126,9 @@ def test_exact_matches_ivp_on_a_random_scene(seed):
 
 
 def _storey(values: list[float]) -> np.ndarray:
-    """The matrix of storey springs (or dashpots) k_i between floor i − 1 (the ground for i = 1) and floor i."""
-    n = len(values)
-    matrix = np.zeros((n, n))
-    for i, k in enumerate(values):
-        matrix[i, i] += k
-        if i > 0:
-            matrix[i - 1, i - 1] += k
-            matrix[i - 1, i] -= k
-            matrix[i, i - 1] -= k
-    return matrix
+    """Dᵀ diag(k) D: storey springs (or dashpots) k_i acting on the storey drifts D u = u_i − u_{i−1} (u_0 = 0, the ground)."""
+    drifts = np.eye(len(values)) - np.eye(len(values), k=-1)
+    return drifts.T @ np.diag(values) @ drifts
 
 
 def _fixed_base_scene(seed: int) -> dict:
