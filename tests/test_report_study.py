@@ -22,6 +22,8 @@ from stochpound.report.published import published_tables
 from stochpound.report.study_tables import CORRECTED, DIFFERENCE, SPLINE, STUDY, STUDY_EQUATIONS
 from tests.chromium import render_in_chromium, require_chromium
 
+pytestmark = pytest.mark.slow  # builds the study report from every study experiment (about two minutes)
+
 STUDY_DIR = Path(__file__).resolve().parents[1] / "experiments" / "study"
 DURATION = 6.0  # s of every record
 STATISTICS = ["mean (cm)", "variance (cm²)", "std (cm)", "skewness", "excess", "impacts"]
@@ -194,7 +196,6 @@ def test_a_store_that_is_not_the_study_gets_a_section_of_its_own(study_stores, t
     assert [f.key for f in report.figures()] == [f"figure-my_grid-{variable}-mu" for variable in AGAINST]
 
 
-@pytest.mark.slow
 def test_the_study_report_renders_in_headless_chromium(built, tmp_path):
     executable = require_chromium()
     verdict, problems = render_in_chromium(built["written"]["html"], tmp_path / "screenshot.png", executable)
