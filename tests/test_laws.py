@@ -8,7 +8,7 @@ import pytest
 
 import stochpound
 from stochpound.model import laws
-from stochpound.model.friction import Base
+from stochpound.model.friction import Base, SlidingBase
 from stochpound.model.law import ElementParameters
 from tests.conftest import reference_building
 
@@ -62,6 +62,17 @@ def test_the_friction_laws_and_the_friction_pendulum_describe_themselves():
     law = laws.friction_law(velocity.friction_law)
     assert not law.piecewise_linear and laws.friction_law("coulomb").piecewise_linear
     assert "μ_slow = 0.06, μ_fast = 0.12, a = 20 s/m" in law.describe(velocity)
+    sliding = SlidingBase(building=0, dof=3, weight=1.0e6, mu=0.06, mu_static=0.06, mu_fast=0.12, mu_rate=20.0)
+    speed = np.array([0.0, 0.05, 1.0])
+    for state in (1, -1):  # the force opposes the sliding, its work is negative, its slope matches a central difference
+        force = law.force(sliding, state, speed)
+        np.testing.assert_allclose(-state * force / sliding.weight, [0.06, 0.12 - 0.06 * np.exp(-1.0), 0.12 - 0.06 * np.exp(-20.0)], rtol=1e-14)
+        assert np.all(law.power(sliding, state, speed)[1:] < 0.0)
+        h = 1e-7
+        np.testing.assert_allclose(law.partial(sliding, speed[1:]), state * (law.force(sliding, state, speed[1:] + h) - law.force(sliding, state, speed[1:] - h)) / (2 * h), rtol=1e-6, atol=1e-2)
+    coulomb = laws.friction_law("coulomb")
+    np.testing.assert_array_equal(coulomb.force(sliding, -1, speed), 0.06 * 1.0e6)
+    assert not coulomb.partial(sliding, speed).any() and coulomb.energy_term == law.energy_term == "friction"
 
 
 def test_a_scenes_nonlinear_laws_come_from_the_registry():
