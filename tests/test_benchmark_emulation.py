@@ -102,6 +102,7 @@ def opensees_or_skip():
 
 
 @pytest.mark.parametrize("spec", STUDY_SCENES, ids=lambda spec: spec.key)
+@pytest.mark.slow
 def test_opensees_model_agrees_with_the_exact_solver_on_a_short_record(spec):
     opensees_or_skip()
     scene = spec.scene(5.0)
@@ -113,6 +114,7 @@ def test_opensees_model_agrees_with_the_exact_solver_on_a_short_record(spec):
     assert errors.final_sliding < 1e-3
 
 
+@pytest.mark.slow
 def test_opensees_model_rejects_what_its_elements_cannot_represent():
     opensees_or_skip()
     with pytest.raises(ValueError, match="study_compat"):

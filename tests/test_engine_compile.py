@@ -16,14 +16,21 @@ from numba.core.registry import cpu_target
 from stochpound.solvers import compiling, engine
 
 PROBE = """
-import hashlib, json
+import hashlib, json, os
+
+if os.environ.get("PROBE_CHANGE_NUMBA_INTERNALS"):  # numba still works; one method it has is not the one compiling.py was written against
+    from numba.core.cpu import CPUContext
+
+    numbas_own = CPUContext.get_executable
+    CPUContext.get_executable = lambda self, *arguments: numbas_own(self, *arguments)
 
 import numba
 import numpy as np
 from numba.core import event
+from numba.core.registry import CPUDispatcher
 
 import stochpound
-from stochpound.solvers import engine
+from stochpound.solvers import compiling, engine
 from stochpound.solvers.exact import compile_engine
 from tests.test_contact_laws import free_masses
 from tests.test_exact import HARD_CASES
@@ -57,9 +64,16 @@ runs = {name: stochpound.simulate(stochpound.scene_from_dict(scene), demands=Tru
 runs.update({f"seed {seed}": stochpound.simulate(stochpound.scene_from_dict(random_scene(seed))) for seed in range(12)})
 runs["hard case 1, ivp"] = stochpound.simulate(stochpound.scene_from_dict(next(iter(HARD_CASES.values()))), method="ivp")
 runs["hertz_damp, ivp"] = stochpound.simulate(stochpound.scene_from_dict(free_masses("hertz_damp", 0.6)), method="ivp")
-print(json.dumps({"levels": levels, "after": after, "specialisations": len(engine.run_engine.signatures),
+print(json.dumps({"levels": levels, "after": after, "specialisations": len(engine.run_engine.signatures), "mismatch": compiling.internals_mismatch(),
+                  "signatures": {name: len(f.signatures) for name, f in vars(engine).items() if isinstance(f, CPUDispatcher)},
                   "digests": {name: digest(run) for name, run in runs.items()}}))
 """
+
+
+@pytest.fixture(scope="module")
+def numbas_default(tmp_path_factory) -> dict:
+    """:data:`PROBE`'s output with the engine compiled as numba would by default (NUMBA_OPT=3)."""
+    return _probe(tmp_path_factory.mktemp("default"), NUMBA_OPT="3")
 
 
 def _probe(cache: Path, **environment: str) -> dict:
@@ -72,7 +86,8 @@ def _probe(cache: Path, **environment: str) -> dict:
     return json.loads(result.stdout.splitlines()[-1])
 
 
-def test_engine_stays_in_bounds_and_its_compile_settings_change_no_result(tmp_path):
+@pytest.mark.slow
+def test_engine_stays_in_bounds_and_its_compile_settings_change_no_result(tmp_path, numbas_default):
     """The engine compiled as stochpound compiles it, with numba's bounds checking on, and as numba would by default (NUMBA_OPT=3).
 
     Compiled code reads and writes unchecked otherwise: an index past an
@@ -82,15 +97,58 @@ def test_engine_stays_in_bounds_and_its_compile_settings_change_no_result(tmp_pa
     and two ivp runs (one with a nonlinear law): every variable of every
     result dataset and the event counters must be bitwise the same. Each
     process first runs ``compile_engine`` (the experiment runner's warm-up),
-    which must compile the one specialisation every later run uses.
+    which must compile the one specialisation every later run uses, and
+    every jitted function of the engine once (twice for ``_copy``: float and
+    int arrays): a compile-time constant passed to a helper, or arrays of
+    another layout, would compile it again. The cache is empty, so every
+    function the runs reach is compiled in the probe and counted.
     """
-    ours = _probe(tmp_path / "ours", NUMBA_BOUNDSCHECK="1")
-    default = _probe(tmp_path / "default", NUMBA_OPT="3")
+    ours, default = _probe(tmp_path / "ours", NUMBA_BOUNDSCHECK="1"), numbas_default
+    assert ours["mismatch"] is None
     assert ours["levels"] == [compiling.OPTIMISATION_LEVEL] and ours["after"] == 3  # numba's default level restored afterwards
     assert default["levels"] == [3]
     assert ours["specialisations"] == default["specialisations"] == 1
+    for probe in (ours, default):
+        assert probe["signatures"]["run_engine"] == 1 and sum(count > 0 for count in probe["signatures"].values()) > 20
+        assert {name: count for name, count in probe["signatures"].items() if count > (2 if name == "_copy" else 1)} == {}
     assert len(ours["digests"]) == 19
     assert ours["digests"] == default["digests"]
+
+
+@pytest.mark.slow
+def test_engine_compiles_as_numba_does_by_default_when_numbas_internals_differ(tmp_path, numbas_default):
+    """A numba whose internals differ from those compiling.py touches: the engine still compiles (numba's default level) and gives the same results."""
+    changed = _probe(tmp_path / "changed", PROBE_CHANGE_NUMBA_INTERNALS="1")
+    assert changed["mismatch"] == "CPUContext.get_executable takes ['self', 'arguments'], expected ['self', 'library', 'fndesc', 'env']"
+    assert changed["levels"] == [3] and changed["specialisations"] == 1
+    assert changed["digests"] == numbas_default["digests"]
+
+
+@pytest.mark.parametrize("change", ["missing attribute", "other parameters", "no library class"])
+def test_a_difference_in_numbas_internals_is_detected_and_leaves_the_compile_to_numba(monkeypatch, change):
+    """internals_mismatch names the difference; engine_compile then changes nothing (numba's optimisation level, no library class of ours)."""
+    from numba.core.codegen import JITCodeLibrary
+
+    context = cpu_target.target_context
+    if change == "missing attribute":
+        monkeypatch.delattr(compiling.FunctionDescriptor, "lookup_module")
+        expected = "numba has no lookup_module"
+    elif change == "other parameters":
+        monkeypatch.setattr(JITCodeLibrary, "add_linking_library", lambda self, library, extra=None: None)
+        expected = "JITCodeLibrary.add_linking_library takes ['self', 'library', 'extra'], expected ['self', 'library']"
+    else:
+        monkeypatch.setattr(type(context.codegen()), "_library_class", object)
+        expected = "numba's code libraries are <class 'object'>, not JITCodeLibrary"
+    compiling.internals_mismatch.cache_clear()
+    try:
+        assert compiling.internals_mismatch() == expected and compiling.numba_default_requested()
+        default = numba.config.OPT
+        with compiling.engine_compile():
+            assert numba.config.OPT is default and "_library_class" not in vars(context.codegen())
+    finally:
+        monkeypatch.undo()
+        compiling.internals_mismatch.cache_clear()
+    assert compiling.internals_mismatch() is None
 
 
 def test_optimisation_level_is_set_inside_the_block_only():

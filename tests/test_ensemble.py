@@ -85,6 +85,7 @@ np.savez(sys.argv[1], **{{name: result[name].values for name in result.data_vars
 """
 
 
+@pytest.mark.slow
 def test_dask_motions_in_worker_processes_after_the_parent_computed_a_chunk(ensemble, tmp_path):
     """Forked workers used to block on the lock of the parent's dask scheduler: the run must finish, unchanged."""
     output = tmp_path / "result.npz"

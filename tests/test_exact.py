@@ -232,6 +232,7 @@ def interpreted_scene() -> dict:
     return scene
 
 
+@pytest.mark.slow
 def test_interpreted_engine_gives_the_compiled_results():
     """NUMBA_DISABLE_JIT (the debugging path: the engine's code run by Python) reproduces the compiled engine, exact and ivp."""
     import json
@@ -281,20 +282,3 @@ def test_a_sub_step_product_gives_the_next_state_and_its_guards():
         expected = dynamics.monitor_matrix @ dynamics.rate(x1, ground) + dynamics.monitor_ground * ground_rate
         np.testing.assert_allclose(out[monitors_at + m : monitors_at + 2 * m], expected, rtol=1e-12, atol=1e-14)
         assert out.shape[0] % engine.LANES == 0 and not np.any(out[monitors_at + 2 * m :])
-
-
-def test_engine_compiles_every_function_once():
-    """Each jitted function of the engine has one specialisation (two for _copy: float and int arrays).
-
-    A compile-time constant passed to a helper, or arrays of another layout,
-    would compile it again (numba's first-call compile time). Vacuous when
-    the engine was loaded from numba's cache.
-    """
-    from numba.core.registry import CPUDispatcher
-
-    from stochpound.solvers import engine
-
-    stochpound.simulate(stochpound.scene_from_dict(HARD_CASES["non-tensile contacts, both isolated"]))
-    for name, function in vars(engine).items():
-        if isinstance(function, CPUDispatcher):
-            assert len(function.signatures) <= (2 if name == "_copy" else 1), name

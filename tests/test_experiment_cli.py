@@ -35,6 +35,7 @@ method = "ivp"
 """)
 
 
+@pytest.mark.slow
 def test_ctrl_c_prints_only_the_message(tmp_path):
     """SIGINT to the whole process group, as a terminal's Ctrl-C: no worker traceback, exit status 130."""
     experiment = write_experiment(tmp_path, SMALL_EXPERIMENT.replace("count = 2", "count = 400"))
@@ -90,6 +91,7 @@ def test_with_several_files_every_error_names_its_file(tmp_path):
     assert not (tmp_path / "good.nc").exists(), "every file is checked before any runs"
 
 
+@pytest.mark.slow
 def test_an_installed_copy_records_its_version_and_sources(tmp_path):
     """The package copied out of the git checkout (as ``pip install .`` does): git_commit "none", and the sources' sha256."""
     copy = tmp_path / "site" / "stochpound"

@@ -15,6 +15,8 @@ import pytest
 from stochpound.experiment import load_experiment, run_experiment
 from tests.test_experiment_helpers import assert_same_results, cli, write_experiment
 
+pytestmark = pytest.mark.slow
+
 DASK = str(Path(sys.executable).with_name("dask"))
 
 

@@ -69,6 +69,7 @@ def _check_after_kill(store: Path) -> int:
     return done
 
 
+@pytest.mark.slow
 def test_sigkill_at_several_points_then_resume(tmp_path, baseline):
     experiment = write_experiment(tmp_path)
     store = tmp_path / "small.nc"
@@ -115,6 +116,7 @@ def test_sigkill_at_several_points_then_resume(tmp_path, baseline):
     assert_same_results(baseline, store)
 
 
+@pytest.mark.slow
 def test_local_cluster_matches_one_process(tmp_path, baseline):
     experiment = write_experiment(tmp_path)
     result = cli("experiment", "run", str(experiment), "--workers", "2", "--batch", "2")
@@ -136,6 +138,7 @@ dt = 0.02
 """, gap=0.005)
 
 
+@pytest.mark.slow
 def test_a_large_run_killed_twice_resumes_to_the_same_store(tmp_path):
     """400 realizations, SIGKILLed twice mid-run (in one process, then on two local workers: the whole process
     group), then completed with other batches: the store equals an uninterrupted run's, and there is at most

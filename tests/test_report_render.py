@@ -326,6 +326,7 @@ def test_cli_build_reports_store_errors(tmp_path: Path, fake_assemble: types.Mod
     assert "Error: store.nc: not an experiment store" in result.stderr
 
 
+@pytest.mark.slow
 def test_html_renders_in_headless_chromium(built: tuple[Report, dict[str, Path]], tmp_path: Path) -> None:
     executable = require_chromium()
     report, written = built

@@ -183,6 +183,7 @@ print(json.dumps({{"impacts": run.sizes["impact"], "modes": run.attrs["modes_vis
 """
 
 
+@pytest.mark.slow
 def test_a_row_of_ten_ten_storey_buildings_runs():
     """10 buildings × 10 floors, contacts at every floor: hundreds of modes in the first 3 s of El Centro."""
     script = LARGE_ROW.format(n=10, floors=10, duration=3.0)

@@ -152,7 +152,19 @@ class _MetadataOnly:
 
 
 def _create(store_layout: Layout, attrs: Mapping[str, Any], path: Path) -> None:
-    """Create the store file: dimensions, coordinates, attributes and every variable (chunked, no data)."""
+    """Create the store file: dimensions, coordinates, attributes and every variable (chunked, no data).
+
+    Not ``to_netcdf(compute=False)``: it leaves the file open until the
+    delayed write it returns is computed, and that write stores every lazy
+    variable's placeholder data (the whole store, before any block of it is
+    known); left uncomputed, the file closes whenever the delayed object is
+    collected, after :func:`write_store` has renamed it over the store. Here
+    ``Dataset.dump_to_store`` (what ``to_netcdf`` itself calls) writes the
+    same metadata through a writer that creates the lazy variables empty
+    (:class:`_MetadataOnly`, the ``add`` of xarray's ``ArrayWriter``: a change
+    to that call raises, it cannot write another file), and the file is
+    closed before the blocks are written.
+    """
     store = H5NetCDFStore.open(path, mode="w")
     try:
         store_layout.template(attrs).dump_to_store(store, writer=_MetadataOnly())

@@ -10,10 +10,12 @@ masses by f (floors and base) keeps its dynamics consistent:
 * storey dashpots given as ``damping`` are multiplied by sqrt(f), which keeps
   every modal damping ratio (M → fM, K fixed, C → sqrt(f) C); a
   ``damping_ratio`` is kept as it is;
-* every contact touching the building keeps its impact frequency
-  sqrt(k_imp / m_eff), m_eff = m1 m2 / (m1 + m2): k_imp is multiplied by
-  m_eff,new / m_eff,old; c_imp follows from the restitution (or, when given as
-  ``damping``, is multiplied by the same ratio, which keeps its damping ratio).
+* every contact touching the building and every wall beside it is rescaled
+  by its law's rule (:meth:`stochpound.model.law.ContactLaw.rescale_table`)
+  with the ratio m_eff,new / m_eff,old, m_eff = m1 m2 / (m1 + m2): for a
+  Kelvin–Voigt element k_imp × ratio keeps its impact frequency
+  sqrt(k_imp / m_eff), and c_imp follows from the restitution (or, when given
+  as ``damping``, × the same ratio, which keeps its damping ratio).
 """
 
 from __future__ import annotations
@@ -22,8 +24,9 @@ import copy
 import math
 from typing import Any, Iterable, Mapping
 
+from stochpound.errors import SceneError
 from stochpound.model import building as building_law
-from stochpound.model import contact as contact_law
+from stochpound.model import laws
 from stochpound.model.contact import ELEMENT_KEYS, effective_mass
 
 #: Motion used while validating a scene's structure (the real motion is set per case).
@@ -107,7 +110,7 @@ def scale_masses(scene: dict[str, Any], name: str, factor: float) -> None:
 
     The building's own rule (:func:`stochpound.model.building.scale_masses`:
     dashpots × √factor), then every contact touching it and every wall beside
-    it by their element's rule (:func:`stochpound.model.contact.rescale_table`,
+    it by their law's rule (:meth:`stochpound.model.law.ContactLaw.rescale_table`,
     with the ratio of the effective masses, new over old: the factor itself
     for a wall).
     """
@@ -123,10 +126,19 @@ def scale_masses(scene: dict[str, Any], name: str, factor: float) -> None:
             masses_old = [old_mass[floor - 1] if end_name == name else new for (end_name, floor), new in zip(ends, masses_new)]
         except (KeyError, IndexError, TypeError, ValueError):
             continue  # a malformed contact: scene validation names it
-        contact_law.rescale_table(contact, effective_mass(*masses_new) / effective_mass(*masses_old))
+        _rescale_element(contact, effective_mass(*masses_new) / effective_mass(*masses_old))
     for wall in scene.get("wall", []):
         if wall.get("building") == name:  # a wall's effective mass is its level's mass, scaled by the factor
-            contact_law.rescale_table(wall, factor)
+            _rescale_element(wall, factor)
+
+
+def _rescale_element(table: dict[str, Any], mass_ratio: float) -> None:
+    """Rescale an impact element's table by its law's rule (a table naming no known law is left for scene validation to name)."""
+    try:
+        law = laws.contact_law(str(table.get("law", laws.DEFAULT_CONTACT_LAW)))
+    except SceneError:
+        return
+    law.rescale_table(table, mass_ratio)
 
 
 def set_gaps(scene: dict[str, Any], contacts: Iterable[int], gap: float) -> None:

@@ -1,55 +1,41 @@
-"""The linear Kelvin–Voigt impact element between neighbouring floors (the reference study's contact law).
+"""Impact elements between neighbouring floors: the element every contact law acts through, its rows, guards and mode terms.
 
 Scene keys (``[[contact]]``): ``between`` ([[left building, floor], [right
 building, floor]], neighbours, the left one first), ``gap`` (m, ≥ 0; ``inf``:
-the contact never closes, and a run still records its closure),
-``stiffness`` (k, N/m), ``restitution`` (r ∈ (0, 1]) or ``damping`` (c,
-N·s/m), ``tensile`` (default true).
+the contact never closes, and a run still records its closure), ``law``
+(default ``kelvin``; :mod:`stochpound.model.laws`) and the law's own keys
+(``stiffness``, and ``restitution``, ``damping`` or ``tensile`` as the law
+takes them).
 
-The law (docs/model.md, "Impact elements"). With the penetration
-δ = y_left − y_right − d (d the gap), the element's force while closed is
-
-    F = k δ + c δ̇,    c = 2 ξ √(k m_eff),  ξ = −ln r / √(π² + ln² r),
-
-m_eff = m₁m₂/(m₁ + m₂) of the two floor masses; F pushes the left floor
-left and the right floor right. A tensile element separates when δ returns
-to 0 (it may pull just before); a non-tensile one when F returns to 0, and
-then closes again only when its trial force k δ + c δ̇ turns positive while
-it is still penetrated.
-
-In a mode in which the contact is closed it adds h k gᵀ to the stiffness,
+With the penetration δ = y_left − y_right − d (d the gap), the element's
+force F pushes the left floor left and the right floor right while closed;
+m_eff = m₁m₂/(m₁ + m₂) of the two floor masses. A law that is piecewise
+linear (the Kelvin–Voigt element, :mod:`stochpound.model.kelvin`: F = k δ + c δ̇)
+adds to a mode in which the contact is closed h k gᵀ to the stiffness,
 h c gᵀ to the damping and h k d to the constant load, where δ = g·q − d and
 the generalised load of F is −F h (h = g without base entries in the
-study's ``study_compat`` model). Guards: ``CLOSE`` (δ crosses 0 upwards),
-``RECLOSE`` (non-tensile: trial force crosses 0 upwards while δ > 0) and
-``OPEN`` (δ or F crosses 0 downwards). Power: F (h · v). The law is
-piecewise linear (the exact solver takes it).
-
-Mass scaling (experiment variants): k is multiplied by m_eff,new/m_eff,old,
-which keeps the contact's frequency √(k/m_eff); c follows from r, or (given
-as ``damping``) is multiplied by the same ratio, which keeps its damping ratio.
+study's ``study_compat`` model); a nonlinear law's force is a read-out
+(:mod:`stochpound.model.readouts`). Guards: ``CLOSE`` (δ crosses 0 upwards),
+``RECLOSE`` (non-tensile: trial force k δ + c δ̇ crosses 0 upwards while
+δ > 0) and ``OPEN`` (δ or F crosses 0 downwards). Power: F (h · v).
 """
 
 from __future__ import annotations
 
-import math
 from dataclasses import asdict, dataclass
 from typing import Any, Mapping, Sequence
 
 import numpy as np
 
 from stochpound.errors import SceneError
-from stochpound.model import fields, hertz, jankowski
+from stochpound.model import fields, laws
 from stochpound.model.building import Building
 from stochpound.model.guards import Guard
+from stochpound.model.law import ElementParameters
 
-ELEMENT_KEYS = {"law", "stiffness", "restitution", "damping", "tensile"}
-"""The keys of the impact element itself, in a ``[[contact]]`` or a ``[[wall]]`` table."""
-LAWS = ("kelvin", *hertz.LAWS, *jankowski.LAWS)
-"""The contact laws: ``kelvin`` (this module, the default), the Hertz family (:mod:`stochpound.model.hertz`) and :mod:`stochpound.model.jankowski`."""
+ELEMENT_KEYS = {"law"}.union(*(law.keys for law in laws.CONTACT_LAWS.values()))
+"""The keys of the impact element itself, in a ``[[contact]]`` or a ``[[wall]]`` table (each law takes some of them)."""
 CONTACT_KEYS = {"between", "gap"} | ELEMENT_KEYS
-PIECEWISE_LINEAR = True
-"""The Kelvin–Voigt element keeps every mode linear (the exact solver applies)."""
 
 
 @dataclass(frozen=True)
@@ -73,7 +59,7 @@ class ImpactElement:
         returns to 0 and never pulls. The nonlinear laws separate at δ = 0
         and never pull (True).
     law : str
-        The contact law (``LAWS``).
+        The contact law (a name of ``stochpound.model.laws.CONTACT_LAWS``).
     """
 
     gap: float
@@ -81,7 +67,11 @@ class ImpactElement:
     damping: float
     restitution: float | None = None
     tensile: bool = True
-    law: str = "kelvin"
+    law: str = laws.DEFAULT_CONTACT_LAW
+
+    def parameters(self, mass: float) -> ElementParameters:
+        """The law's parameters of this element, whose collision has effective mass ``mass`` (kg)."""
+        return ElementParameters(self.stiffness, self.damping, self.restitution, self.tensile, mass)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -102,15 +92,6 @@ class Contact(ImpactElement):
     left_floor: int
     right: int
     right_floor: int
-
-
-def restitution_damping_ratio(restitution: float) -> float:
-    """Damping ratio ξ of a Kelvin–Voigt element with coefficient of restitution r.
-
-    ξ = −ln r / sqrt(π² + (ln r)²) (Anagnostopoulos 1988); ξ = 0 for r = 1.
-    """
-    log_r = math.log(restitution)
-    return -log_r / math.sqrt(math.pi**2 + log_r**2)
 
 
 def effective_mass(mass_1: float, mass_2: float) -> float:
@@ -139,43 +120,18 @@ def contact_from_table(table: Mapping[str, Any], prefix: str, buildings: Sequenc
 
 
 def element_from_table(table: Mapping[str, Any], prefix: str, mass: float) -> ImpactElement:
-    """The impact element of a ``[[contact]]`` or ``[[wall]]`` table, validated.
+    """The impact element of a ``[[contact]]`` or ``[[wall]]`` table, validated by its law (:mod:`stochpound.model.laws`).
 
-    ``mass`` is the effective mass m_eff of the collision (kg) that turns a
-    restitution into a Kelvin–Voigt dashpot. The stiffness is in N/m for
-    ``kelvin``, N/m^1.5 for the nonlinear laws (which have no dashpot and
-    never pull: damping 0, tensile).
+    ``mass`` is the effective mass m_eff of the collision (kg), from which a
+    Kelvin–Voigt element derives its dashpot from a restitution.
     """
     gap = fields.number(table, "gap", prefix, required=True, low=0.0, allow_inf=True)
-    law = fields.string(table, "law", prefix, default="kelvin")
-    if law not in LAWS:
-        raise SceneError(f"{prefix}.law: must be one of {', '.join(LAWS)}; got {law!r}")
-    if law != "kelvin":
-        return _nonlinear_element(table, prefix, gap, law)
-    stiffness = fields.number(table, "stiffness", prefix, required=True, low=0.0, low_open=True)
-    restitution = None
-    if "restitution" in table and "damping" in table:
-        raise SceneError(f"{prefix}.damping: give either restitution or damping, not both")
-    if "damping" in table:
-        damping = fields.number(table, "damping", prefix, low=0.0)
-    else:
-        restitution = fields.number(table, "restitution", prefix, required=True, low=0.0, low_open=True, high=1.0)
-        damping = 2.0 * restitution_damping_ratio(restitution) * math.sqrt(stiffness * mass)
-    tensile = fields.boolean(table, "tensile", prefix, default=True)
-    return ImpactElement(gap, stiffness, damping, restitution, tensile, law)
-
-
-def _nonlinear_element(table: Mapping[str, Any], prefix: str, gap: float, law: str) -> ImpactElement:
-    for key in ("damping", "tensile"):
+    law = laws.contact_law(fields.string(table, "law", prefix, default=laws.DEFAULT_CONTACT_LAW), f"{prefix}.law")
+    for key in sorted(ELEMENT_KEYS - law.keys - {"law"}):
         if key in table:
-            raise SceneError(f"{prefix}.{key}: not a field of law {law!r} (its damping follows from restitution; it never pulls)")
-    stiffness = fields.number(table, "stiffness", prefix, required=True, low=0.0, low_open=True)
-    if law == "hertz":
-        if "restitution" in table:
-            raise SceneError(f"{prefix}.restitution: law 'hertz' is elastic; use law = 'hertz_damp' or 'jankowski' for a restitution")
-        return ImpactElement(gap, stiffness, 0.0, None, True, law)
-    restitution = fields.number(table, "restitution", prefix, required=True, low=0.0, low_open=True, high=1.0, high_open=law == "jankowski")
-    return ImpactElement(gap, stiffness, 0.0, restitution, True, law)
+            raise SceneError(f"{prefix}.{key}: {law.refuse(key)}")
+    stiffness, damping, restitution, tensile, _ = law.read(table, prefix, mass)
+    return ImpactElement(gap, stiffness, damping, restitution, tensile, law.name)
 
 
 def _contact_end(value: Any, path: str, buildings: Sequence[Building]) -> tuple[int, int]:
@@ -190,17 +146,6 @@ def _contact_end(value: Any, path: str, buildings: Sequence[Building]) -> tuple[
     if not 1 <= floor <= n_floors:
         raise SceneError(f"{path}: floor must be in 1..{n_floors} for building {name!r}, got {floor}")
     return index, floor
-
-
-def rescale_table(table: dict[str, Any], mass_ratio: float) -> None:
-    """Rescale a ``[[contact]]`` table in place after its floors' m_eff changed by ``mass_ratio`` (new/old).
-
-    k × ratio keeps √(k/m_eff); a given ``damping`` × ratio keeps its damping
-    ratio (a ``restitution`` recomputes c by itself).
-    """
-    table["stiffness"] = float(table["stiffness"]) * mass_ratio
-    if "damping" in table:
-        table["damping"] = float(table["damping"]) * mass_ratio
 
 
 # ---------------------------------------------------------------- modes

@@ -26,13 +26,14 @@ Mass scaling (experiment variants): W follows the masses; μ is kept.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Any, Mapping
 
 import numpy as np
 
 from stochpound.errors import SceneError
-from stochpound.model import fields, velocity_friction
+from stochpound.model import coulomb, fields, laws, velocity_friction
 from stochpound.model.guards import Guard
 
 STUCK = 0
@@ -42,8 +43,11 @@ SLIP_RIGHT, SLIP_LEFT = 1, -1
 FREE = 2
 """Base state: frictionless base, a free degree of freedom."""
 BASE_KEYS = {"mass", "mu", "mu_static", "restoring_stiffness", "radius"}
-PIECEWISE_LINEAR = True
-"""Coulomb friction keeps every mode linear (the exact solver applies)."""
+
+
+def friction_law_name(mu_fast: float | None) -> str:
+    """The name of a base's friction law (:data:`stochpound.model.laws.FRICTION_LAWS`): velocity-dependent when it has a μ_fast."""
+    return coulomb.COULOMB.name if mu_fast is None else velocity_friction.VELOCITY_DEPENDENT.name
 
 
 @dataclass(frozen=True)
@@ -81,6 +85,19 @@ class Base:
     def restoring(self, weight: float) -> float:
         """The restoring stiffness k_r (N/m) of the base under the building's weight W (N): W/R for a friction pendulum."""
         return weight / self.radius if self.radius is not None else self.restoring_stiffness
+
+    @property
+    def friction_law(self) -> str:
+        """The name of its friction law (:data:`stochpound.model.laws.FRICTION_LAWS`)."""
+        return friction_law_name(self.mu_fast)
+
+    def describe_restoring(self, g: float) -> str:
+        """Its restoring force with its parameters and units, for methods text (``g`` in m/s²); its friction: the law's ``describe``."""
+        if self.radius is not None:
+            return f"friction pendulum, R = {self.radius:.4g} m (k_r = W/R, T_b = 2π √(R/g) = {2.0 * math.pi * math.sqrt(self.radius / g):.4g} s)"
+        if self.restoring_stiffness:
+            return f"restoring stiffness k_r = {self.restoring_stiffness:.4g} N/m"
+        return "flat slider (no restoring force)"
 
     @property
     def frictionless(self) -> bool:
@@ -134,9 +151,9 @@ class SlidingBase:
     mu_rate: float | None = None
 
     @property
-    def velocity_dependent(self) -> bool:
-        """True for velocity-dependent friction (a nonlinear law: its slip force is a read-out)."""
-        return self.mu_fast is not None
+    def friction_law(self) -> str:
+        """The name of its friction law (:data:`stochpound.model.laws.FRICTION_LAWS`)."""
+        return friction_law_name(self.mu_fast)
 
     @property
     def frictionless(self) -> bool:
@@ -155,8 +172,9 @@ def slipping(state: int) -> bool:
 
 
 def slip_force(base: SlidingBase, state: int) -> float:
-    """The foundation's force on a slipping Coulomb base, −σ μ W (N, positive to the right); 0 in other states and with velocity-dependent friction (a read-out)."""
-    return -state * base.mu * base.weight if slipping(state) and not base.velocity_dependent else 0.0
+    """The foundation's force on a slipping base with a piecewise-linear friction law (N, positive to the right: Coulomb's −σ μ W), a constant of its mode; 0 in other states and with a nonlinear law (a read-out)."""
+    law = laws.friction_law(base.friction_law)
+    return float(law.force(base, state, 0.0)) if slipping(state) and law.piecewise_linear else 0.0
 
 
 def stuck_foundation_force(dof: int, mass: np.ndarray, stiffness: np.ndarray, damping: np.ndarray, load: np.ndarray, inputs: np.ndarray,

@@ -24,30 +24,81 @@ velocity).
 
 from __future__ import annotations
 
+from typing import Any, Mapping
+
 import numpy as np
 
-LAWS = ("hertz", "hertz_damp")
-PIECEWISE_LINEAR = False
+from stochpound.model import fields
+from stochpound.model.law import ContactLaw, ElementParameters, quantity
+
+ONSET_FLOOR = 1e-9
+"""Smallest approach velocity (m/s) taken for an impact's δ̇₀ (the damped laws' c_h ∝ 1/δ̇₀)."""
 
 
-def damping_coefficient(stiffness: float, restitution: float, onset: np.ndarray) -> np.ndarray:
-    """c_h = 3 k_h (1 − e²) / (4 δ̇₀), N·s/m^{5/2}, for approach velocities δ̇₀ (m/s, > 0)."""
-    return 3.0 * stiffness * (1.0 - restitution**2) / (4.0 * onset)
+class Hertz(ContactLaw):
+    """``hertz``: F = k_h δ^{3/2}, elastic."""
+
+    name = "hertz"
+    title = "Hertz"
+    formula = "F = k_h δ^{3/2}"
+    keys = frozenset({"stiffness"})
+    piecewise_linear = False
+
+    def read(self, table: Mapping[str, Any], prefix: str, mass: float) -> ElementParameters:
+        stiffness = fields.number(table, "stiffness", prefix, required=True, low=0.0, low_open=True)
+        return ElementParameters(stiffness, 0.0, None, True, mass)
+
+    def force(self, element: ElementParameters, delta: np.ndarray, rate: np.ndarray, onset: float) -> np.ndarray:
+        return element.stiffness * np.clip(delta, 0.0, None) ** 1.5
+
+    def partials(self, element: ElementParameters, delta: np.ndarray, rate: np.ndarray, onset: float) -> tuple[np.ndarray, np.ndarray]:
+        delta = np.clip(delta, 0.0, None)
+        return 1.5 * element.stiffness * np.sqrt(delta), np.zeros_like(delta)
+
+    def describe(self, element: ElementParameters) -> str:
+        return f"{self.title}, k_h = {quantity(element.stiffness, self.stiffness_unit)}, elastic"
+
+    def refuse(self, key: str) -> str:
+        if key == "restitution":
+            return f"law {self.name!r} is elastic; use a damped law (hertz_damp, hertz_damp_ye, jankowski) for a restitution"
+        return super().refuse(key)
 
 
-def force(law: str, stiffness: float, restitution: float | None, delta: np.ndarray, rate: np.ndarray, onset: np.ndarray) -> np.ndarray:
-    """The element's force F (N) at penetration δ (m, clipped at 0), rate δ̇ (m/s) and onset velocity δ̇₀ (m/s)."""
-    power = np.clip(delta, 0.0, None) ** 1.5
-    if law == "hertz":
-        return stiffness * power
-    return power * (stiffness + damping_coefficient(stiffness, restitution, onset) * rate)
+class HertzDamp(ContactLaw):
+    """``hertz_damp``: F = k_h δ^{3/2} + c_h δ^{3/2} δ̇ with Muthukumar & DesRoches's c_h = 3 k_h (1 − e²) / (4 δ̇₀).
+
+    The damped Hertz laws differ only in c_h(e, δ̇₀) (:meth:`damping_coefficient`).
+    """
+
+    name = "hertz_damp"
+    title = "Hertz-damp (Muthukumar & DesRoches 2006)"
+    formula = "F = k_h δ^{3/2} + c_h δ^{3/2} δ̇, c_h = 3 k_h (1 − e²) / (4 δ̇₀)"
+    keys = frozenset({"stiffness", "restitution"})
+    piecewise_linear = False
+
+    def damping_coefficient(self, stiffness: float, restitution: float, onset: float) -> float:
+        """c_h (N·s/m^{5/2}) for k_h (N/m^1.5), e and the approach velocity δ̇₀ (m/s, > 0)."""
+        return 3.0 * stiffness * (1.0 - restitution**2) / (4.0 * onset)
+
+    def read(self, table: Mapping[str, Any], prefix: str, mass: float) -> ElementParameters:
+        stiffness = fields.number(table, "stiffness", prefix, required=True, low=0.0, low_open=True)
+        restitution = fields.number(table, "restitution", prefix, required=True, low=0.0, low_open=True, high=1.0)
+        return ElementParameters(stiffness, 0.0, restitution, True, mass)
+
+    def force(self, element: ElementParameters, delta: np.ndarray, rate: np.ndarray, onset: float) -> np.ndarray:
+        c = self.damping_coefficient(element.stiffness, element.restitution, max(onset, ONSET_FLOOR))
+        return np.clip(delta, 0.0, None) ** 1.5 * (element.stiffness + c * rate)
+
+    def partials(self, element: ElementParameters, delta: np.ndarray, rate: np.ndarray, onset: float) -> tuple[np.ndarray, np.ndarray]:
+        delta = np.clip(delta, 0.0, None)
+        c = self.damping_coefficient(element.stiffness, element.restitution, max(onset, ONSET_FLOOR))
+        return 1.5 * np.sqrt(delta) * (element.stiffness + c * rate), c * delta**1.5
+
+    def describe(self, element: ElementParameters) -> str:
+        return f"{self.title}, k_h = {quantity(element.stiffness, self.stiffness_unit)}, c_h from e = {element.restitution:.4g} per impact"
 
 
-def partials(law: str, stiffness: float, restitution: float | None, delta: np.ndarray, rate: np.ndarray,
-             onset: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """∂F/∂δ (N/m) and ∂F/∂δ̇ (N·s/m) at (δ, δ̇, δ̇₀)."""
-    delta = np.clip(delta, 0.0, None)
-    if law == "hertz":
-        return 1.5 * stiffness * np.sqrt(delta), np.zeros_like(delta)
-    c = damping_coefficient(stiffness, restitution, onset)
-    return 1.5 * np.sqrt(delta) * (stiffness + c * rate), c * delta**1.5
+HERTZ = Hertz()
+"""The elastic Hertz law."""
+HERTZ_DAMP = HertzDamp()
+"""The Hertz law with Muthukumar & DesRoches's damping."""

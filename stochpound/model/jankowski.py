@@ -25,11 +25,12 @@ ivp path. Mass scaling (experiment variants): β × m_eff,new/m_eff,old.
 from __future__ import annotations
 
 import math
+from typing import Any, Mapping
 
 import numpy as np
 
-LAWS = ("jankowski",)
-PIECEWISE_LINEAR = False
+from stochpound.model import fields
+from stochpound.model.law import ContactLaw, ElementParameters, quantity
 
 
 def damping_ratio(restitution: float) -> float:
@@ -38,19 +39,38 @@ def damping_ratio(restitution: float) -> float:
     return 9.0 * math.sqrt(5.0) * (1.0 - e**2) / (2.0 * e * (e * (9.0 * math.pi - 16.0) + 16.0))
 
 
-def force(stiffness: float, restitution: float, mass: float, delta: np.ndarray, rate: np.ndarray) -> np.ndarray:
-    """The element's force F (N) at penetration δ (m, clipped at 0) and rate δ̇ (m/s); ``mass`` is m_eff (kg)."""
-    delta = np.clip(delta, 0.0, None)
-    c = 2.0 * damping_ratio(restitution) * np.sqrt(stiffness * np.sqrt(delta) * mass)
-    return stiffness * delta**1.5 + np.where(rate > 0.0, c * rate, 0.0)
+class Jankowski(ContactLaw):
+    """``jankowski``: F = β δ^{3/2} + c(t) δ̇ while approaching, β δ^{3/2} while restoring."""
+
+    name = "jankowski"
+    title = "Jankowski (2005, 2006)"
+    formula = "F = β δ^{3/2} + c(t) δ̇ while δ̇ > 0, β δ^{3/2} while δ̇ ≤ 0, c(t) = 2 ξ √(β √δ m_eff)"
+    keys = frozenset({"stiffness", "restitution"})
+    piecewise_linear = False
+
+    def read(self, table: Mapping[str, Any], prefix: str, mass: float) -> ElementParameters:
+        stiffness = fields.number(table, "stiffness", prefix, required=True, low=0.0, low_open=True)
+        restitution = fields.number(table, "restitution", prefix, required=True, low=0.0, low_open=True, high=1.0, high_open=True)
+        return ElementParameters(stiffness, 0.0, restitution, True, mass)
+
+    def force(self, element: ElementParameters, delta: np.ndarray, rate: np.ndarray, onset: float) -> np.ndarray:
+        delta = np.clip(delta, 0.0, None)
+        c = 2.0 * damping_ratio(element.restitution) * np.sqrt(element.stiffness * np.sqrt(delta) * element.mass)
+        return element.stiffness * delta**1.5 + np.where(rate > 0.0, c * rate, 0.0)
+
+    def partials(self, element: ElementParameters, delta: np.ndarray, rate: np.ndarray, onset: float) -> tuple[np.ndarray, np.ndarray]:
+        delta = np.clip(delta, 0.0, None)
+        xi = damping_ratio(element.restitution)
+        c = 2.0 * xi * np.sqrt(element.stiffness * np.sqrt(delta) * element.mass)
+        approaching = rate > 0.0
+        with np.errstate(divide="ignore", invalid="ignore"):
+            dc = np.where(delta > 0.0, 0.25 * c / delta, 0.0)  # d c/dδ = c / (4 δ)
+        return 1.5 * element.stiffness * np.sqrt(delta) + np.where(approaching, dc * rate, 0.0), np.where(approaching, c, 0.0)
+
+    def describe(self, element: ElementParameters) -> str:
+        return (f"{self.title}, β = {quantity(element.stiffness, self.stiffness_unit)}, "
+                f"ξ = {damping_ratio(element.restitution):.4g} from e = {element.restitution:.4g} while approaching")
 
 
-def partials(stiffness: float, restitution: float, mass: float, delta: np.ndarray, rate: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """∂F/∂δ (N/m) and ∂F/∂δ̇ (N·s/m) at (δ, δ̇)."""
-    delta = np.clip(delta, 0.0, None)
-    xi = damping_ratio(restitution)
-    c = 2.0 * xi * np.sqrt(stiffness * np.sqrt(delta) * mass)
-    approaching = rate > 0.0
-    with np.errstate(divide="ignore", invalid="ignore"):
-        dc = np.where(delta > 0.0, 0.25 * c / delta, 0.0)  # d c/dδ = c / (4 δ)
-    return 1.5 * stiffness * np.sqrt(delta) + np.where(approaching, dc * rate, 0.0), np.where(approaching, c, 0.0)
+JANKOWSKI = Jankowski()
+"""Jankowski's law."""

@@ -262,7 +262,7 @@ def _foundation_force(system: System, b: int, state: int, terms: tuple[np.ndarra
         stiffness, damping, load, inputs = terms
         return friction.stuck_foundation_force(base.dof, system.mass, stiffness, damping, load, inputs, system.influence, rate, free)
     row = np.zeros(size)
-    if base.velocity_dependent and friction.slipping(state):
+    if b in system.readout_bases and friction.slipping(state):
         row[2 * system.n_dof + len(system.readout_elements) + list(system.readout_bases).index(b)] = 1.0
     return row, 0.0, friction.slip_force(base, state)
 

@@ -10,22 +10,19 @@ and is evaluated here, by the law's own module, wherever it is needed:
   settling meets (:class:`stochpound.solvers.driver.EngineRun`).
 
 The read-outs are, in order, the forces of the impact elements with a
-nonlinear contact law (:mod:`stochpound.model.hertz`,
-:mod:`stochpound.model.jankowski`; 0 while open) and the foundation's force on
-the sliding bases with velocity-dependent friction
-(:mod:`stochpound.model.velocity_friction`; 0 unless slipping).
+nonlinear contact law (0 while open) and the foundation's force on the
+sliding bases with a nonlinear friction law (0 unless slipping), each
+evaluated by its law's object (:mod:`stochpound.model.laws`).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from stochpound.model import friction, hertz, jankowski, velocity_friction
+from stochpound.model import friction, laws
+from stochpound.model.law import ElementParameters
 from stochpound.model.modes import Mode, ModeDynamics
 from stochpound.model.system import System
-
-ONSET_FLOOR = 1e-9
-"""Smallest approach velocity (m/s) taken for an impact's δ̇₀ (hertz_damp's damping is c_h ∝ 1/δ̇₀)."""
 
 
 class Readouts:
@@ -40,6 +37,10 @@ class Readouts:
         self.system = system
         self.elements = system.readout_elements
         self.bases = [system.bases[b] for b in system.readout_bases]
+        self.element_laws = [laws.contact_law(system.element_law[p]) for p in self.elements]
+        self.parameters = [ElementParameters(system.element_stiffness[p], system.element_damping[p], system.element_restitution[p],
+                                             system.element_tensile[p], system.element_mass[p]) for p in self.elements]
+        self.base_laws = [laws.friction_law(base.friction_law) for base in self.bases]
 
     def values(self, mode: Mode, x: np.ndarray, onsets: np.ndarray) -> np.ndarray:
         """f (N) at states ``x`` (… × 2N) in ``mode``; ``onsets``: each element's impact approach velocity δ̇₀ (m/s)."""
@@ -48,12 +49,11 @@ class Readouts:
         for j, p in enumerate(self.elements):
             if mode.closed[p]:
                 delta, rate = self._penetration(p, x)
-                f[..., j] = self._element(p, "force", delta, rate, onsets[p])
-        for j, (b, base) in enumerate(zip(self.system.readout_bases, self.bases), start=len(self.elements)):
+                f[..., j] = self.element_laws[j].force(self.parameters[j], delta, rate, onsets[p])
+        for j, (b, base, law) in enumerate(zip(self.system.readout_bases, self.bases, self.base_laws), start=len(self.elements)):
             state = mode.base[b]
             if friction.slipping(state):
-                speed = np.abs(x[..., self.system.n_dof + base.dof])
-                f[..., j] = -state * base.weight * velocity_friction.coefficient(base.mu, base.mu_fast, base.mu_rate, speed)
+                f[..., j] = law.force(base, state, np.abs(x[..., self.system.n_dof + base.dof]))
         return f
 
     def at_instant(self, dynamics: ModeDynamics, x: np.ndarray, ground: np.ndarray, onsets: np.ndarray) -> np.ndarray:
@@ -65,23 +65,14 @@ class Readouts:
         for j, p in enumerate(self.elements):
             if dynamics.mode.closed[p]:
                 delta, rate = self._penetration(p, x)
-                along, across = self._element(p, "partials", delta, rate, onsets[p])
+                along, across = self.element_laws[j].partials(self.parameters[j], delta, rate, onsets[p])
                 rates[j] = along * rate + across * (self.system.element_geometry[p] @ acceleration)
-        for j, (b, base) in enumerate(zip(self.system.readout_bases, self.bases), start=len(self.elements)):
+        for j, (b, base, law) in enumerate(zip(self.system.readout_bases, self.bases, self.base_laws), start=len(self.elements)):
             if friction.slipping(dynamics.mode.base[b]):
-                speed = abs(x[n + base.dof])
-                rates[j] = -base.weight * velocity_friction.coefficient_slope(base.mu, base.mu_fast, base.mu_rate, speed) * acceleration[base.dof]
+                rates[j] = law.partial(base, abs(x[n + base.dof])) * acceleration[base.dof]
         return np.vstack([f, rates])
 
     def _penetration(self, p: int, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """δ (m) and δ̇ (m/s) of element p at states x."""
         geometry, n = self.system.element_geometry[p], self.system.n_dof
         return x[..., :n] @ geometry - self.system.element_gap[p], x[..., n : 2 * n] @ geometry
-
-    def _element(self, p: int, what: str, delta: np.ndarray, rate: np.ndarray, onset: float):
-        """The ``force`` or its ``partials`` of element p's law."""
-        system = self.system
-        law, stiffness, restitution = system.element_law[p], system.element_stiffness[p], system.element_restitution[p]
-        if law in hertz.LAWS:
-            return getattr(hertz, what)(law, stiffness, restitution, delta, rate, max(onset, ONSET_FLOOR))
-        return getattr(jankowski, what)(stiffness, restitution, system.element_mass[p], delta, rate)

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+from stochpound.model import laws
 from stochpound.model.building import Building
 from stochpound.model.contact import Contact
 from stochpound.model.wall import Wall
@@ -64,8 +65,8 @@ class Scene:
 
         E.g. ``contact[0].law = 'hertz'``, ``building[0].base.mu`` (velocity-dependent friction).
         """
-        laws = [f"contact[{p}].law = {c.law!r}" for p, c in enumerate(self.contacts) if c.law != "kelvin"]
-        laws += [f"wall[{p}].law = {w.law!r}" for p, w in enumerate(self.walls) if w.law != "kelvin"]
-        laws += [f"building[{b}].base.mu (velocity-dependent friction)" for b, building in enumerate(self.buildings)
-                 if building.base is not None and building.base.mu_fast is not None]
-        return laws
+        found = [f"contact[{p}].law = {c.law!r}" for p, c in enumerate(self.contacts) if not laws.contact_law(c.law).piecewise_linear]
+        found += [f"wall[{p}].law = {w.law!r}" for p, w in enumerate(self.walls) if not laws.contact_law(w.law).piecewise_linear]
+        found += [f"building[{b}].base.mu ({laws.friction_law(building.base.friction_law).title})" for b, building in enumerate(self.buildings)
+                  if building.base is not None and not laws.friction_law(building.base.friction_law).piecewise_linear]
+        return found

@@ -27,6 +27,7 @@ from functools import cached_property, lru_cache
 
 import numpy as np
 
+from stochpound.model import laws
 from stochpound.model.building import Building, storey_matrix
 from stochpound.model.contact import Contact, effective_mass
 from stochpound.model.wall import Wall
@@ -65,7 +66,7 @@ class System:
         of each element's left and right side (a wall's side is 0: it moves
         with the ground); g_p = left − right.
     element_law : tuple of str
-        Each element's contact law (:data:`stochpound.model.contact.LAWS`).
+        Each element's contact law (a name of :data:`stochpound.model.laws.CONTACT_LAWS`).
     element_restitution, element_mass : np.ndarray
         Each element's coefficient of restitution (NaN if none) and effective mass m_eff (kg).
     total_displacement : np.ndarray
@@ -123,7 +124,7 @@ class System:
     @property
     def nonlinear(self) -> np.ndarray:
         """Which elements have a nonlinear contact law (bool per element)."""
-        return np.array([law != "kelvin" for law in self.element_law], dtype=bool)
+        return np.array([not laws.contact_law(law).piecewise_linear for law in self.element_law], dtype=bool)
 
     @property
     def xi_size(self) -> int:
@@ -234,8 +235,8 @@ def _build_system(buildings: tuple[Building, ...], contacts: tuple[Contact, ...]
         storey_stiffness=[np.asarray(b.stiffness, float) for b in buildings],
         storey_damping=[np.asarray(b.damping, float) for b in buildings],
         demands=demands,
-        readout_elements=np.array([p for p, e in enumerate(elements) if e.law != "kelvin"], dtype=np.int64),
-        readout_bases=np.array([i for i, base in enumerate(bases) if base.velocity_dependent], dtype=np.int64),
+        readout_elements=np.array([p for p, e in enumerate(elements) if not laws.contact_law(e.law).piecewise_linear], dtype=np.int64),
+        readout_bases=np.array([i for i, base in enumerate(bases) if not laws.friction_law(base.friction_law).piecewise_linear], dtype=np.int64),
     )
 
 

@@ -22,9 +22,9 @@ import numpy as np
 
 from stochpound.errors import SceneError
 from stochpound.model import fields
+from stochpound.model.law import FrictionLaw
 
 MU_KEYS = {"slow", "fast", "rate"}
-PIECEWISE_LINEAR = False
 
 
 def mu_from_table(table: Mapping[str, Any], prefix: str) -> tuple[float, float, float]:
@@ -36,6 +36,29 @@ def mu_from_table(table: Mapping[str, Any], prefix: str) -> tuple[float, float, 
     if fast == 0.0:
         raise SceneError(f"{prefix}.fast: must be > 0 (a frictionless base is mu = 0)")
     return slow, fast, rate
+
+
+class VelocityDependent(FrictionLaw):
+    """``velocity``: F = −sgn(ṡ) μ(|ṡ|) W while slipping (``base.mu`` is μ_slow, ``base.mu_fast`` μ_fast, ``base.mu_rate`` a)."""
+
+    name = "velocity"
+    title = "velocity-dependent friction"
+    piecewise_linear = False
+
+    def force(self, base: Any, state: int, speed: np.ndarray) -> np.ndarray:
+        return -state * base.weight * coefficient(base.mu, base.mu_fast, base.mu_rate, speed)
+
+    def partial(self, base: Any, speed: np.ndarray) -> np.ndarray:
+        # d(−σ μ(|ṡ|) W)/dṡ = −σ W μ'(|ṡ|) σ: the same in both directions
+        return -base.weight * coefficient_slope(base.mu, base.mu_fast, base.mu_rate, speed)
+
+    def describe(self, base: Any) -> str:
+        return (f"{self.title} (Constantinou, Mokha & Reinhorn 1990), μ(v) = μ_fast − (μ_fast − μ_slow) exp(−a |v|), μ_slow = {base.mu:.4g}, "
+                f"μ_fast = {base.mu_fast:.4g}, a = {base.mu_rate:.4g} s/m, μ_s = {base.mu_static:.4g}")
+
+
+VELOCITY_DEPENDENT = VelocityDependent()
+"""Velocity-dependent friction."""
 
 
 def coefficient(slow: float, fast: float, rate: float, speed: np.ndarray) -> np.ndarray:

@@ -4,22 +4,22 @@ Scene keys (``[[wall]]``): ``building`` (its name), ``side`` (``"left"`` or
 ``"right"`` of the building), ``level`` (0: the base, a moat wall, under a
 sliding base only; or a floor number), ``gap`` (m, ≥ 0; ``inf``: never
 reached, the run still records the closure), and the impact element's
-fields as for a contact (:mod:`stochpound.model.contact`): ``stiffness``,
-``restitution`` or ``damping``, ``tensile``.
+fields as for a contact (:mod:`stochpound.model.contact`): ``law`` and the
+law's keys (:mod:`stochpound.model.laws`).
 
 The law (docs/model.md, "Walls"). With y the level's displacement relative
 to the ground (s for the base, s + u_i for floor i), the penetration is
 δ = y − d for a wall on the right and δ = −y − d on the left; while δ > 0 the
-Kelvin–Voigt element pushes the level away from the wall with
-F = k δ + c δ̇. The wall is infinitely massive, so a restitution r gives
-c = 2 ξ(r) √(k m), m the level's mass (the floor's, or the base's at level
-0). The force acts on that level only (at the base through the base
+element pushes the level away from the wall with its law's force (Kelvin–Voigt
+by default, F = k δ + c δ̇). The wall is infinitely massive, so its effective
+mass is the level's mass m (the floor's, or the base's at level 0): a
+restitution r gives a Kelvin–Voigt element c = 2 ξ(r) √(k m). The force acts on that level only (at the base through the base
 equation; the study's ``study_compat`` switch concerns building contacts,
 not walls). A wall is an impact element like a contact: the same guards,
 impact table rows (``impact_wall``), energy term and closure monitor. With
-the Kelvin–Voigt element it is piecewise linear (the exact solver takes it).
+a piecewise-linear law it is piecewise linear (the exact solver takes it).
 
-Mass scaling (experiment variants): as a contact's, with m_eff = m.
+Mass scaling (experiment variants): its law's, with m_eff = m.
 """
 
 from __future__ import annotations

@@ -23,6 +23,7 @@ import numpy as np
 import xarray as xr
 
 import stochpound
+from stochpound.model import laws
 from stochpound.model.modal_solution import harmonic_response, modal_properties
 from stochpound.report.description import StoreDefinition, number
 from stochpound.report.document import Paragraph
@@ -266,7 +267,7 @@ def _collision_paragraphs(definitions: list[StoreDefinition]) -> list[Paragraph]
     for definition in definitions:
         for configuration in definition.configurations:
             scene = configuration.scene
-            for contact in (c for c in scene.contacts if c.law == "kelvin"):  # the closed form is the linear element's
+            for contact in (c for c in scene.contacts if laws.contact_law(c.law).piecewise_linear):  # the closed form is the linear element's
                 masses = (scene.buildings[contact.left].mass[contact.left_floor - 1], scene.buildings[contact.right].mass[contact.right_floor - 1])
                 key = (masses, contact.stiffness, contact.damping, contact.tensile)
                 if key not in checked:

@@ -23,6 +23,8 @@ from stochpound import motions as synthetic_motions
 from stochpound.experiment import Case
 from stochpound.experiment.intensity import describe_measure
 from stochpound.experiment.model import CASE
+from stochpound.model import laws
+from stochpound.model.contact import effective_mass
 from stochpound.model.modal_solution import modal_properties
 from stochpound.motions.records import load_record, registry_entries
 from stochpound.report.document import Paragraph, Table
@@ -140,20 +142,18 @@ def _damping(building: Building) -> str:
     return f"storey dashpots {numbers(building.damping)} N·s/m"
 
 
-def _base(definition: StoreDefinition, building: Building) -> str:
+def _base(definition: StoreDefinition, building: Building, g: float) -> str:
     base = building.base
     if base is None:
         return "fixed"
+    law = laws.friction_law(base.friction_law)
     if definition.takes_grid_mu(building):
         finite = [m for m in definition.mu_values if not math.isinf(m)]
-        parts = [f"sliding, μ = μ_s ∈ {{{numbers(finite)}}}" + (" or fixed (μ = ∞)" if len(finite) < len(definition.mu_values) else "")]
+        parts = [f"sliding, {law.title}, μ = μ_s ∈ {{{numbers(finite)}}}" + (" or fixed (μ = ∞)" if len(finite) < len(definition.mu_values) else "")]
     else:
-        parts = [f"sliding, μ = {number(base.mu)}, μ_s = {number(base.mu_static)}"]
+        parts = [f"sliding, {law.describe(base)}"]
     parts.append(f"base mass {number(base.mass)} kg")
-    if base.restoring_stiffness:
-        parts.append(f"restoring stiffness {number(base.restoring_stiffness)} N/m")
-    else:
-        parts.append("no restoring stiffness (flat slider)")
+    parts.append(base.describe_restoring(g))
     return "; ".join(parts)
 
 
@@ -173,7 +173,7 @@ def buildings_table(definitions: Iterable[StoreDefinition]) -> Table:
                     _damping(building),
                     numbers(modes.periods, 4),
                     percent(modes.damping_ratio) + damping_note,
-                    _base(definition, building),
+                    _base(definition, building, configuration.scene.g),
                 )
                 rows.setdefault(row, []).append((definition, configuration))
     return _merged_table(
@@ -187,35 +187,27 @@ def buildings_table(definitions: Iterable[StoreDefinition]) -> Table:
 
 def _contact_row(definition: StoreDefinition, scene: Scene, index: int, contact: Contact) -> tuple[str, ...]:
     left, right = scene.buildings[contact.left], scene.buildings[contact.right]
-    m1, m2 = left.mass[contact.left_floor - 1], right.mass[contact.right_floor - 1]
-    effective = m1 * m2 / (m1 + m2)
+    parameters = contact.parameters(effective_mass(left.mass[contact.left_floor - 1], right.mass[contact.right_floor - 1]))
     axis = definition.gap_axis(index)
-    law = contact.law
+    law = laws.contact_law(contact.law)
     return (
         f"{left.name} floor {contact.left_floor} – {right.name} floor {contact.right_floor}",
-        "linear Kelvin–Voigt" if law == "kelvin" else str(law),
+        law.describe(parameters),
         f"{{{numbers(axis['values'])}}} (axis {axis['name']})" if axis else number(contact.gap),
-        number(contact.stiffness),
-        number(contact.damping),
-        number(contact.restitution) if contact.restitution is not None else "– (dashpot given)",
-        "tensile (separates when the penetration returns to 0)" if contact.tensile else "non-tensile (separates when the force returns to 0)",
-        number(math.sqrt(contact.stiffness / effective), 4),
+        law.separation(parameters),
     )
 
 
 def _wall_row(scene: Scene, wall: Wall) -> tuple[str, ...]:
     building = scene.buildings[wall.building]
-    mass = building.base.mass if wall.level == 0 and building.base is not None else building.mass[max(wall.level, 1) - 1]
+    parameters = wall.parameters(building.base.mass if wall.level == 0 and building.base is not None else building.mass[max(wall.level, 1) - 1])
     level = "base" if wall.level == 0 else f"floor {wall.level}"
+    law = laws.contact_law(wall.law)
     return (
-        f"{building.name} {level} – rigid wall on its {'right' if wall.side > 0 else 'left'}",
-        "linear Kelvin–Voigt",
+        f"{building.name} {level} – wall on its {wall.side_name} (moves with the ground)",
+        law.describe(parameters),
         number(wall.gap),
-        number(wall.stiffness),
-        number(wall.damping),
-        number(wall.restitution) if wall.restitution is not None else "– (dashpot given)",
-        "tensile (separates when the penetration returns to 0)" if wall.tensile else "non-tensile (separates when the force returns to 0)",
-        number(math.sqrt(wall.stiffness / mass), 4),
+        law.separation(parameters),
     )
 
 
@@ -232,10 +224,12 @@ def contacts_table(definitions: Iterable[StoreDefinition]) -> Table | None:
         return None
     return _merged_table(
         "table-contacts",
-        "The contact (impact) elements as run: floors joined, law, at-rest gap, stiffness k, dashpot c, restitution and separation rule.",
-        ["between", "law", "gap (m)", "k (N/m)", "c (N·s/m)", "restitution", "separation", "√(k/m_eff) (rad/s)"],
+        "The contact (impact) elements as run: floors joined, law with its parameters, at-rest gap and separation rule.",
+        ["between", "law", "gap (m)", "separation"],
         rows,
-        "m_eff = m1 m2 / (m1 + m2) of the two floor masses (against a wall, the level's own mass); with a restitution r, c = 2 ξ √(k m_eff), ξ = −ln r / √(π² + ln² r).",
+        "m_eff = m1 m2 / (m1 + m2) of the two floor masses (against a wall, the level's own mass); a Kelvin–Voigt element's dashpot from "
+        "a restitution e is c = 2 ξ √(k m_eff), ξ = −ln e / √(π² + ln² e). A wall is rigid in that it moves with the ground and has no "
+        "mass of its own; it is reached through its contact element, which it penetrates as that element's stiffness allows.",
     )
 
 
@@ -367,19 +361,21 @@ def model_paragraph(definitions: list[StoreDefinition]) -> Paragraph:
     isolated = any(b.base is not None for b in buildings)
     sentences = ["Buildings are shear buildings: lumped floor masses joined by storey springs and dashpots, standing in a row on the same ground."]
     if isolated:
+        friction = sorted({laws.friction_law(b.base.friction_law).title for b in buildings if b.base is not None})
         sentences.append(
-            "A building on a flat friction slider has one more degree of freedom, its sliding displacement s; Coulomb friction "
-            "μW opposes the sliding, and the base sticks while the friction force it needs stays below μ_s W (W its weight)."
-        )
-    if contacts:
-        rules = sorted({"tensile (until the penetration returns to zero)" if c.tensile else "non-tensile (until the force returns to zero)" for c in contacts})
-        sentences.append(
-            "Adjacent floors are joined by linear Kelvin–Voigt impact elements, F = k δ + c δ̇, which act only while the gap "
-            f"is closed and are {' or '.join(rules)} (values in the table of contacts)."
+            f"A building on a sliding base has one more degree of freedom, its sliding displacement s; {' or '.join(friction)} "
+            "opposes the sliding, and the base sticks while the friction force it needs stays below μ_s W (W its weight); "
+            "the restoring force, if any, is given in the table of buildings."
         )
     walls = [w for s in scenes for w in s.walls]
+    if contacts or walls:
+        used = [laws.contact_law(name) for name in dict.fromkeys(e.law for e in (*contacts, *walls))]
+        sentences.append(
+            "Impact elements act only while their gap is closed: " + "; ".join(f"{law.title}, {law.formula}" for law in used)
+            + " (δ the penetration, δ̇ its rate, δ̇₀ its rate at the onset of the impact; parameters in the table of contacts)."
+        )
     if walls:
-        sentences.append("Rigid walls moving with the ground stand beside some levels, with the same kind of impact element (table of contacts).")
+        sentences.append("Walls that move with the ground stand beside some levels, reached through such an impact element (table of contacts).")
     if isolated and contacts:
         sentences.append(
             "The impact forces act on an isolated building as a whole (they enter its base equation), and friction at the onset "

@@ -27,31 +27,118 @@ function (the outputs are compared bitwise with numba's default compile in
 off: the engine then compiles exactly as numba would by default.
 
 Both reach into numba's internals (its compiler lock, configuration, CPU
-target context and code libraries); ``pyproject.toml`` bounds numba's
-version to the releases they were checked with.
+target context and code libraries), and they fail safe: before the first
+compile :func:`internals_mismatch` checks that every internal they touch is
+there with the signature they were written against (numba 0.63 to 0.68), and
+on any difference the engine compiles as numba does by default (a
+debug-level log message, once, names the difference). So does
+:data:`NO_RUNTIME`, the engine's ``_nrt=False``.
 """
 
 from __future__ import annotations
 
 import contextlib
+import functools
+import inspect
+import logging
 import os
 from collections.abc import Iterator
 from typing import Any
 
-import llvmlite.binding as llvm
 import numba
-from numba import _dynfunc
-from numba.core.codegen import JITCodeLibrary
-from numba.core.compiler_lock import global_compiler_lock
-from numba.core.registry import cpu_target
+
+try:
+    import llvmlite.binding as llvm
+    from numba import _dynfunc
+    from numba.core.codegen import JITCodeLibrary
+    from numba.core.compiler_lock import global_compiler_lock
+    from numba.core.cpu import CPUTargetOptions
+    from numba.core.funcdesc import FunctionDescriptor
+    from numba.core.registry import cpu_target
+except ImportError as error:  # numba moved its internals: numba's default compile (see internals_mismatch)
+    _IMPORT_ERROR: ImportError | None = error
+    JITCodeLibrary = object  # the base of _LinkedOnlyLibrary, which is then never used
+    CPUTargetOptions = object
+else:
+    _IMPORT_ERROR = None
+
+_LOG = logging.getLogger(__name__)
 
 OPTIMISATION_LEVEL = 1
 """LLVM optimisation level of the engine's compile (numba's default, ``NUMBA_OPT``, is 3)."""
+NO_RUNTIME = {"_nrt": False} if hasattr(CPUTargetOptions, "_nrt") else {}
+"""The jit option that compiles without numba's runtime (reference counting), where numba offers it.
+
+``_nrt`` is a target option of numba's CPU target (``numba.core.cpu.CPUTargetOptions``)
+without a public spelling. The engine allocates nothing, so the runtime only
+adds reference counting (half of its unoptimised IR); without the option
+it compiles slower, with the same results.
+"""
 
 
 def numba_default_requested() -> bool:
-    """True when the environment asks for numba's own compile settings (``NUMBA_OPT`` set) or for no compile (``NUMBA_DISABLE_JIT``)."""
-    return "NUMBA_OPT" in os.environ or bool(numba.config.DISABLE_JIT)
+    """True when the engine must compile as numba does by default.
+
+    The environment asks for numba's own compile settings (``NUMBA_OPT``
+    set) or for no compile (``NUMBA_DISABLE_JIT``), or numba's internals
+    differ from those :func:`engine_compile` was written against
+    (:func:`internals_mismatch`).
+    """
+    return "NUMBA_OPT" in os.environ or bool(numba.config.DISABLE_JIT) or internals_mismatch() is not None
+
+
+_SIGNATURES = {
+    "JITCodeLibrary.add_linking_library": ["self", "library"],
+    "JITCodeLibrary._get_module_for_linking": ["self"],
+    "JITCodeLibrary._ensure_finalized": ["self"],
+    "CPUContext.get_executable": ["self", "library", "fndesc", "env"],
+}
+"""The numba methods :func:`engine_compile` overrides or calls, with the parameters it was written against."""
+_LIBRARY_ATTRIBUTES = ("_linking_libraries", "_shared_module", "_final_module", "_reload_init", "_finalized")
+"""The attributes of a numba code library :class:`_LinkedOnlyLibrary` reads and sets."""
+
+
+@functools.cache
+def internals_mismatch() -> str | None:
+    """How numba's internals differ from those :func:`engine_compile` touches (None: they are as expected).
+
+    Checks that every module, class, method and attribute it uses exists, and
+    the parameters of the methods it overrides or calls. On a difference it
+    logs it once, at debug level, and the engine compiles as numba does by
+    default.
+    """
+    reason = _mismatch()
+    if reason is not None:
+        _LOG.debug("compiling the engine as numba does by default: %s", reason)
+    return reason
+
+
+def _mismatch() -> str | None:
+    if _IMPORT_ERROR is not None:
+        return f"numba's internals cannot be imported ({_IMPORT_ERROR})"
+    context = cpu_target.target_context
+    codegen = context.codegen()
+    owners = {"JITCodeLibrary": JITCodeLibrary, "CPUContext": type(context)}
+    for name, expected in _SIGNATURES.items():
+        owner, method = name.split(".")
+        function = getattr(owners[owner], method, None)
+        try:
+            parameters = list(inspect.signature(function).parameters) if callable(function) else None
+        except (TypeError, ValueError):
+            parameters = None
+        if parameters != expected:
+            return f"{name} takes {parameters}, expected {expected}"
+    missing = [name for owner, name in ((numba.config, "OPT"), (_dynfunc, "make_function"), (llvm, "Linkage"), (FunctionDescriptor, "lookup_module"),
+                                        (FunctionDescriptor, "llvm_cpython_wrapper_name"), (type(codegen), "_library_class"))
+               if not hasattr(owner, name)]
+    if missing:
+        return f"numba has no {', '.join(missing)}"
+    if not (isinstance(type(codegen)._library_class, type) and issubclass(type(codegen)._library_class, JITCodeLibrary)):
+        return f"numba's code libraries are {type(codegen)._library_class!r}, not JITCodeLibrary"
+    with global_compiler_lock:
+        library = codegen.create_library("stochpound.solvers.compiling probe")
+    missing = [name for name in _LIBRARY_ATTRIBUTES if not hasattr(library, name)]
+    return f"numba's code libraries have no {', '.join(missing)}" if missing else None
 
 
 @contextlib.contextmanager
@@ -60,8 +147,12 @@ def engine_compile() -> Iterator[None]:
 
     numba's compiler lock is held throughout (both settings take it), so no
     other thread compiles under them; everything is restored on leaving the
-    block, also when it raises.
+    block, also when it raises. When numba's internals differ from those
+    the settings touch (:func:`internals_mismatch`), the block changes nothing.
     """
+    if internals_mismatch() is not None:  # numba's default compile (logged once)
+        yield
+        return
     with optimisation_level(OPTIMISATION_LEVEL), _helpers_without_machine_code():
         yield
 

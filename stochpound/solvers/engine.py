@@ -51,7 +51,8 @@ specialisation), and no array is assigned to an array slice (its error
 message alone compiles string formatting). Reference counting would make up
 half of the unoptimised IR (every incref or decref of an array extracts all
 its fields), so everything is compiled without numba's runtime
-(``_nrt=False``): the engine allocates nothing (every work vector is a row of
+(``_nrt=False``, numba's private option, given only where numba offers it:
+:data:`~stochpound.solvers.compiling.NO_RUNTIME`): the engine allocates nothing (every work vector is a row of
 the arrays of :func:`work_arrays`), and it calls no builtin ``min`` or
 ``max`` (each compiles an overload; the comparisons written out give the same
 results). :func:`run` compiles it inside
@@ -72,7 +73,7 @@ from numba import njit
 
 from stochpound.model.friction import STUCK
 from stochpound.model.guards import Guard
-from stochpound.solvers.compiling import engine_compile, numba_default_requested
+from stochpound.solvers.compiling import NO_RUNTIME, engine_compile, numba_default_requested
 from stochpound.solvers.propagators import GAUSS_NODES, GAUSS_WEIGHTS
 
 ROUND_OFF = 1e-10
@@ -84,7 +85,7 @@ TIME_TOLERANCE = 1e-13
 MAX_SETTLE_ITERATIONS = 64
 """Most mode transitions applied at one instant before settling declares a cycle (chattering)."""
 
-INTERNAL = {"no_cpython_wrapper": True, "no_cfunc_wrapper": True, "error_model": "numpy", "_nrt": False}
+INTERNAL = {"no_cpython_wrapper": True, "no_cfunc_wrapper": True, "error_model": "numpy", **NO_RUNTIME}
 """Options of the jitted helpers, called only from compiled code (no runtime: they allocate nothing)."""
 
 ModeTable = namedtuple("ModeTable", "modes ids codes n_guards substeps")
@@ -1337,7 +1338,7 @@ def _supplied_step(m, n, modes, codes, rate, guard, force, monitor, power, motio
 # ---------------------------------------------------------------- the run
 
 
-@njit(cache=True, nogil=True, no_cfunc_wrapper=True, error_model="numpy", _nrt=False)
+@njit(cache=True, nogil=True, no_cfunc_wrapper=True, error_model="numpy", **NO_RUNTIME)
 def run_engine(table, dynamics, propagators, motion, layout, run, arming, impacts, outputs, supplied, readouts, scratch, saved, marks, external):
     """Run (or resume) the simulation; returns FINISHED, NEED_MODE, NEED_SPACE, NEED_STEP or NEED_READOUTS.
 

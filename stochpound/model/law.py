@@ -1,0 +1,161 @@
+"""What every law declares: the contract the law registry (:mod:`stochpound.model.laws`) holds laws to.
+
+A *contact law* (of an impact element, between floors or against a wall) is
+one :class:`ContactLaw` object in its own module; a *friction law* (of a
+sliding base) one :class:`FrictionLaw`. Each object holds, behind one
+signature per kind of law:
+
+* its name (the scene file's ``law``), its scene keys and their validation
+  (:meth:`ContactLaw.read`);
+* whether it is piecewise linear (only then does every mode stay linear, which
+  the exact solver needs; a nonlinear law's force is a read-out of the mode,
+  evaluated by :mod:`stochpound.model.readouts`);
+* its force and partial derivatives: the element's force F(δ, δ̇, δ̇₀) and
+  ∂F/∂δ, ∂F/∂δ̇ (for a piecewise-linear law, k δ + c δ̇ and (k, c): the terms
+  it adds to a closed mode, :func:`stochpound.model.contact.closed_terms`);
+* its power (the rate of work of its force, the energy term it enters);
+* its mass rescaling for experiment variants (:meth:`ContactLaw.rescale_table`);
+* ``describe()``: its name, parameters and units, for methods text.
+"""
+
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+from typing import Any, Mapping, NamedTuple
+
+import numpy as np
+
+
+class ElementParameters(NamedTuple):
+    """An impact element's law parameters, as a law reads them from its table (SI units).
+
+    Attributes
+    ----------
+    stiffness : float
+        k (N/m) of a Kelvin–Voigt element; k_h (N/m^1.5) of the Hertz family.
+    damping : float
+        Dashpot c (N·s/m) of a Kelvin–Voigt element; 0 for laws without one.
+    restitution : float or None
+        The coefficient of restitution e the law was given (None: none given).
+    tensile : bool
+        Whether the element separates at δ = 0 (True) or when its force returns to 0.
+    mass : float
+        The collision's effective mass m_eff (kg): m1 m2/(m1 + m2), or the level's mass against a wall.
+    """
+
+    stiffness: float
+    damping: float
+    restitution: float | None
+    tensile: bool
+    mass: float
+
+
+def quantity(value: float, unit: str = "") -> str:
+    """``value`` to 4 significant digits with its unit, e.g. ``2.75e+09 N/m^1.5``."""
+    return f"{value:.4g}" + (f" {unit}" if unit else "")
+
+
+class ContactLaw(ABC):
+    """A contact law of an impact element (class attributes and methods every law defines).
+
+    Attributes
+    ----------
+    name : str
+        The scene file's ``law``.
+    title : str
+        Its name in text, with its reference, e.g. ``Hertz-damp (Muthukumar & DesRoches 2006)``.
+    formula : str
+        Its force while δ > 0, e.g. ``F = k_h δ^{3/2}``.
+    keys : frozenset of str
+        The element keys it accepts (besides ``law`` and ``gap``).
+    piecewise_linear : bool
+        True: a closed element adds linear terms to its mode (the exact solver applies).
+    stiffness_unit : str
+        The unit of its ``stiffness``.
+    energy_term : str
+        The energy-balance term its power enters (:data:`stochpound.results.record.ENERGY_TERMS`).
+    """
+
+    name: str
+    title: str
+    formula: str
+    keys: frozenset[str]
+    piecewise_linear: bool
+    stiffness_unit: str = "N/m^1.5"
+    energy_term: str = "impact"
+
+    @abstractmethod
+    def read(self, table: Mapping[str, Any], prefix: str, mass: float) -> ElementParameters:
+        """The element's parameters from its table (at ``prefix``; unknown keys already rejected), validated; ``mass``: m_eff (kg)."""
+
+    @abstractmethod
+    def force(self, element: ElementParameters, delta: np.ndarray, rate: np.ndarray, onset: float) -> np.ndarray:
+        """The element's force F (N) at penetration δ (m), its rate δ̇ (m/s) and the impact's approach velocity δ̇₀ (m/s)."""
+
+    @abstractmethod
+    def partials(self, element: ElementParameters, delta: np.ndarray, rate: np.ndarray, onset: float) -> tuple[np.ndarray, np.ndarray]:
+        """∂F/∂δ (N/m) and ∂F/∂δ̇ (N·s/m) at (δ, δ̇, δ̇₀)."""
+
+    @abstractmethod
+    def describe(self, element: ElementParameters) -> str:
+        """The law with its parameters and units, for methods text."""
+
+    def power(self, element: ElementParameters, delta: np.ndarray, rate: np.ndarray, onset: float) -> np.ndarray:
+        """The rate of work F δ̇ (W) the element takes from the structure (its :attr:`energy_term`)."""
+        return self.force(element, delta, rate, onset) * rate
+
+    def refuse(self, key: str) -> str:
+        """Why ``key`` (an impact element's key this law does not take) is refused, for the error message."""
+        return f"not a field of law {self.name!r} (its fields: {', '.join(sorted(self.keys))})"
+
+    def separation(self, element: ElementParameters) -> str:
+        """When a closed element opens, in words (the nonlinear laws' force vanishes with δ: they never pull)."""
+        return "at δ = 0, where its force vanishes (never pulls)"
+
+    def rescale_table(self, table: dict[str, Any], mass_ratio: float) -> None:
+        """Rescale the element's table in place after its m_eff changed by ``mass_ratio`` (new/old).
+
+        The stiffness × ratio keeps the impact's time scale for a given
+        approach velocity (√(k/m_eff) for Kelvin–Voigt); a given ``damping``
+        × ratio keeps its damping ratio (a ``restitution`` is kept).
+        """
+        table["stiffness"] = float(table["stiffness"]) * mass_ratio
+        if "damping" in table:
+            table["damping"] = float(table["damping"]) * mass_ratio
+
+
+class FrictionLaw(ABC):
+    """A friction law of a sliding base: the foundation's force on the base while it slips.
+
+    Attributes
+    ----------
+    name : str
+        The law's name (a base's :attr:`~stochpound.model.friction.Base.friction_law`).
+    title : str
+        Its name in text, with its reference.
+    piecewise_linear : bool
+        True: the slip force is a constant of each slip mode (the exact solver applies).
+    energy_term : str
+        The energy-balance term its power enters.
+    """
+
+    name: str
+    title: str
+    piecewise_linear: bool
+    energy_term: str = "friction"
+
+    @abstractmethod
+    def force(self, base: Any, state: int, speed: np.ndarray) -> np.ndarray:
+        """The foundation's force (N, positive to the right) on ``base`` (a :class:`~stochpound.model.friction.SlidingBase`) slipping in direction ``state`` (±1) at speed |ṡ| (m/s)."""
+
+    @abstractmethod
+    def partial(self, base: Any, speed: np.ndarray) -> np.ndarray:
+        """∂F/∂ṡ (N·s/m) of :meth:`force` at speed |ṡ| (m/s), in either slip direction."""
+
+    @abstractmethod
+    def describe(self, base: Any) -> str:
+        """The law with its parameters, for methods text (``base``: a :class:`~stochpound.model.friction.Base`)."""
+
+    def power(self, base: Any, state: int, speed: np.ndarray) -> np.ndarray:
+        """The rate of work F ṡ (W, ≤ 0) of the foundation's force on the slipping base."""
+        return self.force(base, state, speed) * state * speed

@@ -1,0 +1,34 @@
+"""The law registry: every contact law and friction law by name (the contract: :mod:`stochpound.model.law`).
+
+Code asks the registry, never a law's name: ``contact_law(element.law).piecewise_linear``,
+``.read(...)``, ``.force(...)``, ``.describe(...)``. A new law is one module
+defining its law object, one line here, its tests and its docs entry
+(docs/contributing.md, "Adding a physical law").
+"""
+
+from __future__ import annotations
+
+from stochpound.errors import SceneError
+from stochpound.model import coulomb, hertz, hertz_damp_ye, jankowski, kelvin, velocity_friction
+from stochpound.model.law import ContactLaw, FrictionLaw
+
+CONTACT_LAWS: dict[str, ContactLaw] = {law.name: law for law in (kelvin.KELVIN, hertz.HERTZ, hertz.HERTZ_DAMP, jankowski.JANKOWSKI,
+                                                                 hertz_damp_ye.HERTZ_DAMP_YE)}
+"""The contact laws of impact elements (contacts and walls), by the scene file's ``law``."""
+DEFAULT_CONTACT_LAW = kelvin.KELVIN.name
+"""The law of an element whose table gives none."""
+FRICTION_LAWS: dict[str, FrictionLaw] = {law.name: law for law in (coulomb.COULOMB, velocity_friction.VELOCITY_DEPENDENT)}
+"""The friction laws of sliding bases, by name (a base's ``friction_law``)."""
+
+
+def contact_law(name: str, prefix: str = "law") -> ContactLaw:
+    """The contact law called ``name``; a :class:`~stochpound.errors.SceneError` at ``prefix`` naming the laws if there is none."""
+    law = CONTACT_LAWS.get(name)
+    if law is None:
+        raise SceneError(f"{prefix}: must be one of {', '.join(CONTACT_LAWS)}; got {name!r}")
+    return law
+
+
+def friction_law(name: str) -> FrictionLaw:
+    """The friction law called ``name`` (:data:`FRICTION_LAWS`)."""
+    return FRICTION_LAWS[name]
