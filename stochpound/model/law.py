@@ -73,7 +73,7 @@ class ContactLaw(ABC):
     stiffness_unit : str
         The unit of its ``stiffness``.
     energy_term : str
-        The energy-balance term its power enters (:data:`stochpound.results.record.ENERGY_TERMS`).
+        The energy-balance term its power enters (``stochpound.results.record.ENERGY_TERMS``).
     """
 
     name: str
@@ -101,7 +101,7 @@ class ContactLaw(ABC):
         """The law with its parameters and units, for methods text."""
 
     def power(self, element: ElementParameters, delta: np.ndarray, rate: np.ndarray, onset: float) -> np.ndarray:
-        """The rate of work F δ̇ (W) the element takes from the structure (its :attr:`energy_term`)."""
+        """The rate of work F δ̇ (W) the element takes from the structure (its ``energy_term``)."""
         return self.force(element, delta, rate, onset) * rate
 
     def refuse(self, key: str) -> str:
@@ -146,11 +146,11 @@ class FrictionLaw(ABC):
 
     @abstractmethod
     def force(self, base: Any, state: int, speed: np.ndarray) -> np.ndarray:
-        """The foundation's force (N, positive to the right) on ``base`` (a :class:`~stochpound.model.friction.SlidingBase`) slipping in direction ``state`` (±1) at speed |ṡ| (m/s)."""
+        """The foundation's force (N, positive to the right) on ``base`` (a :class:`~stochpound.model.friction.SlidingBase`) slipping in direction ``state`` (±1) at speed abs(ṡ) (m/s)."""
 
     @abstractmethod
     def partial(self, base: Any, speed: np.ndarray) -> np.ndarray:
-        """∂F/∂ṡ (N·s/m) of :meth:`force` at speed |ṡ| (m/s), in either slip direction."""
+        """∂F/∂ṡ (N·s/m) of :meth:`force` at speed abs(ṡ) (m/s), in either slip direction."""
 
     @abstractmethod
     def describe(self, base: Any) -> str:

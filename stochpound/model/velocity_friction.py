@@ -39,7 +39,7 @@ def mu_from_table(table: Mapping[str, Any], prefix: str) -> tuple[float, float, 
 
 
 class VelocityDependent(FrictionLaw):
-    """``velocity``: F = −sgn(ṡ) μ(|ṡ|) W while slipping (``base.mu`` is μ_slow, ``base.mu_fast`` μ_fast, ``base.mu_rate`` a)."""
+    """``velocity``: F = −sgn(ṡ) μ(abs(ṡ)) W while slipping (``base.mu`` is μ_slow, ``base.mu_fast`` μ_fast, ``base.mu_rate`` a)."""
 
     name = "velocity"
     title = "velocity-dependent friction"
