@@ -54,6 +54,21 @@ def test_store_pounds_at_a_gap_exactly_when_the_contact_free_closure_reaches_it(
         assert set(rules.rule.values) >= {"abs", "srss", "ddc"} and rule_exceedance(free.peak_contact_closure, rules).probability.notnull().all()
 
 
+def test_abs_bounds_the_peak_closure_on_every_contact_free_run_of_a_store(contact_free_store):
+    """u1, u2 and D are located the same way (on the solution), so ABS = u1 + u2 ≥ D on every contact-free case: fixed and sliding, record and ensemble."""
+    with open_store(contact_free_store) as ds:
+        free = ds.sel(gap=np.inf)
+        done = (free.case_status == 1).broadcast_like(free.peak_contact_closure)
+        assert int(done.sum()) >= 2 * 2 * (1 + 4)
+        rules = separation_rules(store_contact_demands(free))
+        closure = free.peak_contact_closure
+        assert bool(((rules.sel(rule="abs") >= closure) | ~done).all())
+        assert bool(((rules.sel(rule="abs") - closure).where(done) > 0).any())  # a bound, not an identity
+        ensemble = free.sel(record="kt")
+        exceeded = rule_exceedance(ensemble.peak_contact_closure, separation_rules(store_contact_demands(ensemble)).sel(rule="abs"))
+        assert float(exceeded.probability.max()) == 0.0
+
+
 def test_gap_axis_accepts_inf_and_refuses_negative_and_nan(tmp_path):
     gap = next(d for d in _experiment(tmp_path, '[0.01, "inf"]').dims if d.name == "gap")
     assert gap.values[-1] == np.inf
