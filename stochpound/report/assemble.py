@@ -17,6 +17,7 @@ import xarray as xr
 
 from stochpound.report import findings, study_figures, study_notes, study_tables
 from stochpound.report.document import Block, Paragraph, Report, Section
+from stochpound.report.ensembles import INTERVAL_NOTE
 from stochpound.report.generic import store_section
 from stochpound.report.separation import has_contact_free, separation_section, with_contacts
 from stochpound.report.methods import methods_section
@@ -88,7 +89,7 @@ def _about(stores: dict[str, xr.Dataset]) -> str:
     return (
         f"This report describes the experiment stores {described}. Each experiment has a section: the cases run under "
         "records one by one, and each synthetic ensemble by the statistics of its realizations in every cell of the grid "
-        "(every combination of the grid's axes): means with 95 % Student-t confidence intervals, quantiles of the peaks, and "
+        f"(every combination of the grid's axes): means with 95 % confidence intervals ({INTERVAL_NOTE}), quantiles of the peaks, and "
         "the probability of pounding (at least one impact) with its 95 % Clopper–Pearson interval, followed by findings "
         "computed from them, tables (also written as CSV files) and figures in which every cell is drawn. An ECDF gives, for "
         "each value, the fraction of realizations at or below it; a convergence figure shows an estimate over the first n "
