@@ -98,6 +98,10 @@ def test_report_has_a_separation_section_built_from_the_store(contact_free_store
         needed = float(closure.max("realization").max()) * 100  # 4 realizations: a cell's 5 % gap is its largest D
     assert f"{compared} runs with contacts were compared" in text and "every one pounds exactly when D ≥ g" in text
     assert "sliding bases" in text and f"{needed:.1f} cm" in text
+    assert "ASCE 7 (§17.2.5.2)" in text and "no such theory" not in text and "ABS is never reached" in text
+    assert "the grid's own gaps" in text.lower()  # the two answers to the gap question, related
+    dimensions = next(block.text for block in experiment.blocks if isinstance(block, Paragraph) and "Dimensions:" in block.text)
+    assert f"gap ({len(GAPS) + 1}: {len(GAPS)} gaps here and the contact-free one" in dimensions
     tables = {block.key for block in section.blocks if isinstance(block, Table)}
     assert tables == {"table-small-separation-records", "table-small-kt-separation", "table-small-kt-separation-rules"}
     figures = [block for block in section.blocks if isinstance(block, FigureItem)]

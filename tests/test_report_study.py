@@ -117,6 +117,12 @@ def test_findings_and_methods_are_written_from_the_numbers(built):
     assert built["sections"][-1] == "Methods"
     assert len(built["findings"]) == 7
     assert all(("Holds" in text or "Does not hold" in text or "not reproduced" in text or "reproduced" in text) for text in built["findings"])
+    worst = next(text for text in built["findings"] if text.startswith("One isolated building"))
+    assert not re.search(r"holds \((\d+) against \1 impacts", worst)  # a tie is "no difference", not support
+    for verdict in re.findall(r"(holds|does not hold) \(\d+ against \d+ impacts; ([^)]*)\)", worst):
+        assert "× 0.98" in verdict[1] and "× 1.02" in verdict[1]  # a verdict survives the record-scaling check
+    collapse = next(text for text in built["findings"] if text.startswith("Correlation with the fixed-base response collapses"))
+    assert re.search(r"(Holds only at μ = [\d. and]+|Holds at every μ|Does not hold at any μ) \(", collapse)
     html = built["written"]["html"].read_text()
     assert "closed-form modal solution" in html and "DOP853" in html and "energy input" in html
 

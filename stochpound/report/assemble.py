@@ -74,7 +74,7 @@ def assemble_report(paths: Sequence[str | Path], progress: Callable[[str], None]
         contact_free = has_contact_free(store)
         finite = with_contacts(store) if contact_free else store
         if all(finite.sizes[d] for d in finite["case_status"].dims):
-            report.sections.append(store_section(name, finite))
+            report.sections.append(store_section(name, finite, contact_free))
         if contact_free:
             say(f"experiment {name}: separation")
             report.sections.append(separation_section(name, store))

@@ -1,0 +1,59 @@
+"""Findings qualified by their data: no ratio from too few runs, and where the sign of an effect flips, said where."""
+
+from __future__ import annotations
+
+import math
+from types import SimpleNamespace
+
+import numpy as np
+import xarray as xr
+
+from stochpound.report.ensemble_findings import isolation_across, isolation_effect, spread
+from stochpound.report.ensembles import MIN_RUNS
+
+
+def _ensemble(label: str, p_isolated: dict[str, float], size: int = 200, forces: int = 0) -> SimpleNamespace:
+    """An ensemble-like object whose statistics give P(pounding) per neighbour: 0.5 on a fixed base, ``p_isolated`` at μ = 0.1 (intervals ±0.05)."""
+    neighbours, mus, gaps = list(p_isolated), [0.1, math.inf], [0.02, 0.06]
+    p = np.array([[[p_isolated[n]] * len(gaps), [0.5] * len(gaps)] for n in neighbours])
+    dims = ("neighbour", "mu", "gap")
+    coords = {"neighbour": neighbours, "mu": mus, "gap": gaps}
+    quantile = xr.DataArray(np.stack([np.ones(p.shape), 2 * np.ones(p.shape)], -1), dims=(*dims, "quantile"), coords={**coords, "quantile": [0.5, 0.95]})
+    statistics = xr.Dataset(
+        {
+            "pounding_probability": (dims, p), "pounding_probability_lower": (dims, p - 0.05), "pounding_probability_upper": (dims, p + 0.05),
+            "peak_total_displacement_quantile": quantile, "peak_impact_force_quantile": quantile * 1e5,
+            "peak_impact_force_count": (dims, np.full(p.shape, forces)),
+            **{f"peak_{kind}_displacement_{part}": (dims, np.full(p.shape, 0.1 + (0.01 if part == "upper" else -0.01 if part == "lower" else 0.0)))
+               for kind in ("total", "relative") for part in ("mean", "lower", "upper")},
+        },
+        coords=coords,
+    )
+    return SimpleNamespace(statistics=statistics, grid=coords, label=label, name="x", size=size, confidence=0.95, studied="B1")
+
+
+def test_the_sign_flip_of_isolation_is_located_by_condition():
+    """Isolation lowers P(pounding) next to a flexible neighbour and raises it next to a stiff one: the finding says so, by neighbour."""
+    paragraph = isolation_effect(_ensemble("kt_firm", {"stiff": 0.8, "flexible": 0.2}))[0]
+    assert "lowers the probability of pounding in 2 and raises it in 2" in paragraph.text
+    assert "flips with neighbour" in paragraph.text and "stiff: 0 lower, 2 higher; flexible: 2 lower, 0 higher" in paragraph.text
+    same = isolation_effect(_ensemble("kt_firm", {"stiff": 0.2, "flexible": 0.2}))[0]
+    assert "flips" not in same.text
+
+
+def test_a_sign_flip_between_ensembles_is_named():
+    firm, soft = _ensemble("kt_firm", {"stiff": 0.2, "flexible": 0.2}), _ensemble("kt_soft", {"stiff": 0.8, "flexible": 0.8})
+    text = isolation_across([firm, soft]).text
+    assert "changes sign between the ensembles" in text and "than it raises it in kt_firm" in text and "raises it in more in kt_soft" in text
+    assert "the same way in every ensemble" in isolation_across([firm, _ensemble("kt_rock", {"stiff": 0.1, "flexible": 0.3})]).text
+    assert isolation_across([firm]) is None
+
+
+def test_no_ratio_from_cells_with_too_few_runs():
+    """Below MIN_RUNS realizations (pounding realizations for the force) the spread is not estimated, and the count is stated."""
+    few = spread(_ensemble("kt", {"stiff": 0.8, "flexible": 0.2}, size=MIN_RUNS - 1, forces=4)).text
+    assert f"With {MIN_RUNS - 1} realizations per cell (fewer than {MIN_RUNS})" in few and "times its median" not in few
+    assert f"No cell has {MIN_RUNS} pounding realizations (at most 4)" in few
+    enough = spread(_ensemble("kt", {"stiff": 0.8, "flexible": 0.2}, size=200, forces=MIN_RUNS)).text
+    assert "2.00 to 2.00 times its median (n = 200 per cell)" in enough
+    assert f"In the 8 cells with at least {MIN_RUNS} pounding realizations (n = {MIN_RUNS}–{MIN_RUNS})" in enough
