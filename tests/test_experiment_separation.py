@@ -102,8 +102,12 @@ def test_report_has_a_separation_section_built_from_the_store(contact_free_store
     assert "the grid's own gaps" in text.lower()  # the two answers to the gap question, related
     dimensions = next(block.text for block in experiment.blocks if isinstance(block, Paragraph) and "Dimensions:" in block.text)
     assert f"gap ({len(GAPS) + 1}: {len(GAPS)} gaps here and the contact-free one" in dimensions
-    tables = {block.key for block in section.blocks if isinstance(block, Table)}
-    assert tables == {"table-small-separation-records", "table-small-kt-separation", "table-small-kt-separation-rules"}
+    assert not any(isinstance(block, Table) for block in section.blocks)  # its per-cell tables are in the appendix
+    appendix = report.sections[-1]
+    assert appendix.key == "appendix" and all(isinstance(block, Table) and block.per_cell for block in appendix.blocks)
+    assert {"table-small-separation-records", "table-small-kt-separation", "table-small-kt-separation-rules"} <= {block.key for block in appendix.blocks}
+    summary = report.sections[0]
+    assert summary.key == "summary" and "How wide must the gap be?" in " ".join(b.text for b in summary.blocks if isinstance(b, Paragraph))
     figures = [block for block in section.blocks if isinstance(block, FigureItem)]
     drawn = {artist.get_gid() for item in figures for ax in item.figure.axes for artist in ax.get_children() if artist.get_gid()}
     for neighbour in ("stiff", "flexible"):

@@ -113,7 +113,7 @@ def test_every_figure_is_written_and_named(built):
 
 
 def test_findings_and_methods_are_written_from_the_numbers(built):
-    assert built["sections"][:2] == ["About this report", "Findings"]
+    assert built["sections"][:3] == ["Summary", "About this report", "Findings"]
     assert built["sections"][-1] == "Methods"
     assert len(built["findings"]) == 7
     assert all(("Holds" in text or "Does not hold" in text or "not reproduced" in text or "reproduced" in text) for text in built["findings"])

@@ -5,6 +5,9 @@ experiment names) give the study's tables and figures, with the findings
 and the methods; any other store gets a section of its own
 (:mod:`stochpound.report.generic`). Sections whose store is missing are left
 out, so a report can be built from any subset of the study's stores.
+Every report opens with a summary, the answers first
+(:mod:`stochpound.report.summary`); the report of experiments ends with an
+appendix of its per-cell tables.
 """
 
 from __future__ import annotations
@@ -22,6 +25,7 @@ from stochpound.report.generic import store_section
 from stochpound.report.separation import has_contact_free, separation_section, with_contacts
 from stochpound.report.methods import methods_section
 from stochpound.report.stores import open_stores
+from stochpound.report.summary import experiment_summary, move_per_cell_tables, study_summary
 
 #: Experiment names of the study's stores (``experiments/study/``).
 STUDY_EXPERIMENTS = ("study_harmonic", "study_gap", "study_single", "study_pair_mu", "study_pair_records")
@@ -67,6 +71,9 @@ def assemble_report(paths: Sequence[str | Path], progress: Callable[[str], None]
         for title, key, build in _study_sections(study):
             say(title)
             report.sections.append(Section(title, build(), key=key))
+        findings_section = next((section for section in report.sections if section.key == "findings"), None)
+        if findings_section is not None:
+            report.sections.insert(0, study_summary(findings_section, report.sections))
     if others and not study:
         report.sections.append(Section("About this report", [Paragraph(_about(others))], key="about"))
     for name, store in others.items():
@@ -80,6 +87,12 @@ def assemble_report(paths: Sequence[str | Path], progress: Callable[[str], None]
             report.sections.append(separation_section(name, store))
     say("methods")
     report.sections.append(methods_section(stores))
+    if others and not study:
+        appendix = move_per_cell_tables(report.sections)
+        if appendix is not None:
+            report.sections.append(appendix)
+        say("summary")
+        report.sections.insert(0, experiment_summary(others, report.sections))
     return report
 
 

@@ -166,6 +166,7 @@ class Ensemble:
                 f"quantiles. Peaks are the studied building's ({self.studied}); μ fixed: a fixed base."
             ),
             formats={"n": "{:.0f}"},
+            per_cell=True,
         )
 
     def _columns(self, quantity: Quantity) -> dict[tuple[str, str], xr.DataArray]:
@@ -195,6 +196,7 @@ class Ensemble:
             caption=f"Experiment {self.name}, ensemble {self.label}: the fixed-base twin, {self.studied} alone on a fixed base under the same {self.size} realizations.",
             frame=table_frame(columns, dims),
             note=f"Means with their {self.confidence:.0%} percentile-bootstrap intervals, and sample quantiles.",
+            per_cell=True,
         )
 
     # ------------------------------------------------------------ figures

@@ -108,6 +108,7 @@ def summary_table(name: str, data: xr.Dataset) -> Table:
         note="std, skewness and excess (kurtosis − 3) of the studied building's top-floor total displacement over time; peak "
         "impact force 0 where a case has no impact; μ fixed: a fixed base.",
         formats={"impacts": "{:.0f}", "in-phase": "{:.0f}", "out-of-phase": "{:.0f}"},
+        per_cell=True,
     )
 
 

@@ -123,6 +123,7 @@ def _record_table(name: str, free: xr.Dataset) -> Table:
         caption=f"Experiment {name}, records: the separation each record needed (D of its contact-free run) and the gap each rule asks for.",
         frame=table_frame(columns, dims),
         note="A record pounds at any gap up to D; a rule's gap below D would have let it pound.",
+        per_cell=True,
     )
 
 
@@ -222,11 +223,11 @@ class SeparationEnsemble:
         above_bound = int((known & (grid >= bound)).sum())
         return (
             f"The experiment's section answers the same question on the grid's own gaps: the smallest gap of the grid from which "
-            f"on the upper {self.confidence:.0%} bound of P(pounding) is below {RARE:.0%}, {_span_cm(grid)} in {int(known.sum())} of "
+            f"on the upper {self.confidence:.0%} bound of P(pounding) is below {RARE:.0%}, {span_cm(grid)} in {int(known.sum())} of "
             f"{cells} cells. That answer can only name a gap of the grid, and asks the bound, not the estimate, to be below "
             f"{RARE:.0%}: it is at or above the estimate here in {above} of those cells and at or above its upper bound in "
-            f"{above_bound}; the quantile of D gives the gap between the grid's gaps (estimate {_span_cm(estimate)}, upper "
-            f"bound {_span_cm(bound)}). "
+            f"{above_bound}; the quantile of D gives the gap between the grid's gaps (estimate {span_cm(estimate)}, upper "
+            f"bound {span_cm(bound)}). "
         )
 
     # ------------------------------------------------------------ tables
@@ -245,6 +246,7 @@ class SeparationEnsemble:
                 f"Distribution-free {self.confidence:.0%} intervals from order statistics; a bound is empty when the sample "
                 f"is too small to give it (the lower bound of p needs pⁿ < {(1 - self.confidence) / 2:g})."
             ),
+            per_cell=True,
         )
 
     def _rule_table(self, rules: xr.DataArray, exceedance: xr.Dataset) -> Table:
@@ -262,6 +264,7 @@ class SeparationEnsemble:
             ),
             frame=table_frame(columns, list(self.ensemble.grid)),
             note="; ".join(f"{k}: {v}" for k, v in RULE_TEXT.items() if k in rules["rule"].values) + ". A rule's gap is the largest over the contacts.",
+            per_cell=True,
         )
 
     # ------------------------------------------------------------ figures
@@ -328,7 +331,7 @@ def _extreme_cells(values: xr.DataArray) -> tuple[dict[str, Any], dict[str, Any]
     return labels(finite[0]), labels(finite[-1])
 
 
-def _span_cm(values: xr.DataArray) -> str:
+def span_cm(values: xr.DataArray) -> str:
     """The range of ``values`` (m) in cm, NaN ignored ("—" if none)."""
     finite = values.values[np.isfinite(values.values)]
     if not finite.size:
