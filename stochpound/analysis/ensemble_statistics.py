@@ -84,7 +84,7 @@ def ensemble_statistics(
         For each summary ``s`` of ``SUMMARIES`` in the store:
         ``s_mean``, ``s_lower``, ``s_upper`` (interval of the mean: Student t
         for a summary of either sign, the percentile bootstrap for one that
-        cannot be negative, :func:`interval_method`); for the peaks ``s_quantile`` (dimension ``quantile``);
+        cannot be negative, ``interval_method``); for the peaks ``s_quantile`` (dimension ``quantile``);
         ``peak_impact_force_*`` over the realizations with at least one
         impact (``peak_impact_force_count`` of them); and
         ``pounding_probability`` with its Clopper–Pearson bounds

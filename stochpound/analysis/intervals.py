@@ -96,7 +96,7 @@ def running_mean(data: xr.DataArray, dim: str = "realization", confidence: float
 
 
 def of_first(estimate: Callable[[xr.DataArray], xr.Dataset], data: xr.DataArray, counts: Sequence[int], dim: str = "realization") -> xr.Dataset:
-    """``estimate`` (e.g. :func:`mean_interval`) of the first n entries of ``data`` along ``dim``, for each n of ``counts``.
+    """``estimate`` (e.g. :func:`~stochpound.analysis.mean_interval`) of the first n entries of ``data`` along ``dim``, for each n of ``counts``.
 
     Convergence at chosen sample sizes, for an estimate without a running
     kernel (the percentile bootstrap): on a new dimension ``first`` (the n of

@@ -21,8 +21,7 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
-from stochpound.analysis import ensemble_statistics, mean_interval, pounding_probability
-from stochpound.analysis.intervals import of_first
+from stochpound.analysis import ensemble_statistics, mean_interval, of_first, pounding_probability
 from stochpound.report import figures
 from stochpound.report.document import Block, FigureItem, Table
 from stochpound.report.facets import cell_gid, dim_text, is_gap, labels_text, layouts, line_colours, plain, value_text

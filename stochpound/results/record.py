@@ -198,7 +198,7 @@ class Recorder:
         return {name: (larger[0, i * floors : (i + 1) * floors], larger[1, i * floors : (i + 1) * floors]) for i, name in enumerate(DEMANDS)}
 
     def contact_displacement_peaks(self) -> tuple[np.ndarray, np.ndarray]:
-        """The largest |y| over the run of each contact's left and right floor (y = s + u relative to the ground), located on the solution.
+        """The largest abs(y) over the run of each contact's left and right floor (y = s + u relative to the ground), located on the solution.
 
         Returns
         -------
