@@ -18,10 +18,11 @@ import pandas as pd
 import pytest
 
 from stochpound.analysis import separation_rules, store_contact_demands
-from stochpound.experiment import load_experiment, open_store, run_experiment
+from stochpound.experiment import open_store
 from stochpound.report.assemble import assemble_report
 from stochpound.report.document import Paragraph, Table
 from stochpound.report.output import write_report
+from tests.test_experiment_helpers import run_in_process
 
 EXPERIMENT = """
 [experiment]
@@ -31,23 +32,16 @@ studied = "A"
 
 [[scene.building]]
 name = "A"
-mass = [30000.0, 25000.0, 20000.0]
-stiffness = [3.0e7, 2.5e7, 2.0e7]
-damping_ratio = 0.05
-base = { mass = 15000.0, mu = 0.06, radius = 2.2 }
+mass = [28000.0, 24000.0, 21000.0]
+stiffness = [3.4e7, 2.9e7, 2.2e7]
+damping_ratio = 0.04
+base = { mass = 16000.0, mu = 0.06, radius = 2.2 }
 
 [[scene.building]]
 name = "C"
-mass = [40000.0, 30000.0]
-stiffness = [2.0e7, 1.5e7]
-damping_ratio = 0.05
-
-[[scene.contact]]
-between = [["A", 1], ["C", 1]]
-gap = 0.01
-law = "hertz_damp"
-stiffness = 2.75e9
-restitution = 0.7
+mass = [45000.0, 35000.0]
+stiffness = [2.2e7, 1.6e7]
+damping_ratio = 0.03
 
 [[scene.contact]]
 between = [["A", 2], ["C", 2]]
@@ -77,11 +71,7 @@ SIGNED = ("skewness", "excess", "correlation", "residual sliding")
 
 @pytest.fixture(scope="module")
 def store(tmp_path_factory) -> Path:
-    folder = tmp_path_factory.mktemp("pendulum")
-    (folder / "pendulum.toml").write_text(EXPERIMENT)
-    report = run_experiment(load_experiment(folder / "pendulum.toml"), workers=0, progress=False)
-    assert report.complete and not report.failed
-    return report.store
+    return run_in_process(tmp_path_factory.mktemp("pendulum"), "pendulum", EXPERIMENT)
 
 
 @pytest.fixture(scope="module")
@@ -112,7 +102,7 @@ def test_abs_bounds_the_peak_closure_on_every_contact_free_run(store):
     with open_store(store) as ds:
         free = ds.sel(gap=np.inf)
         done = (free.case_status == 1).broadcast_like(free.peak_contact_closure)
-        assert int(done.sum()) == 2 * 6 * 2  # mu x realizations x contacts
+        assert int(done.sum()) == 2 * 6  # mu x realizations
         gaps = separation_rules(store_contact_demands(free)).sel(rule="abs")
         assert bool(((gaps >= free.peak_contact_closure) | ~done).all())
 

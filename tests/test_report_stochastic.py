@@ -14,12 +14,13 @@ import pytest
 from scipy import stats
 
 from stochpound.analysis import ensemble_statistics
-from stochpound.experiment import load_experiment, open_store, run_experiment
+from stochpound.experiment import open_store
 from stochpound.report.assemble import assemble_report
 from stochpound.report.document import FigureItem, Paragraph, Table
 from stochpound.report.facets import cell_gid
 from stochpound.report.output import write_report
 from tests.chromium import render_in_chromium, require_chromium
+from tests.test_experiment_helpers import run_in_process
 
 REALIZATIONS = 6
 EXPERIMENT = f"""
@@ -84,11 +85,7 @@ STUDY_DEFAULTS = ("57.05", "ζ1 = 1 %", "restitution 0.5", "study_compat", "tens
 
 @pytest.fixture(scope="module")
 def store(tmp_path_factory) -> Path:
-    folder = tmp_path_factory.mktemp("unusual")
-    (folder / "unusual.toml").write_text(EXPERIMENT)
-    report = run_experiment(load_experiment(folder / "unusual.toml"), workers=0, progress=False)
-    assert report.complete and not report.failed
-    return report.store
+    return run_in_process(tmp_path_factory.mktemp("unusual"), "unusual", EXPERIMENT)
 
 
 @pytest.fixture(scope="module")
