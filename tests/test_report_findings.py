@@ -57,3 +57,34 @@ def test_no_ratio_from_cells_with_too_few_runs():
     enough = spread(_ensemble("kt", {"stiff": 0.8, "flexible": 0.2}, size=200, forces=MIN_RUNS)).text
     assert "2.00 to 2.00 times its median (n = 200 per cell)" in enough
     assert f"In the 8 cells with at least {MIN_RUNS} pounding realizations (n = {MIN_RUNS}–{MIN_RUNS})" in enough
+
+
+def test_convergence_starts_at_min_runs_in_a_handful_of_panels():
+    """40 realizations on a 5 gaps × 3 μ grid: estimates at n = 30 … 40, in CONVERGENCE_PANELS panels, those nearest P = 0.5."""
+    from stochpound.report.ensembles import CONVERGENCE_PANELS, Ensemble
+
+    rng = np.random.default_rng(4)
+    gaps, mus, n = [0.0, 0.01, 0.02, 0.04, 0.08], [0.1, 0.2, math.inf], 40
+    shape = (1, n, len(gaps), len(mus))
+    rate = np.array([2.0, 0.7, 0.3, 0.05, 0.0])[None, None, :, None]
+    dims = ("record", "realization", "gap", "mu")
+    store = xr.Dataset(
+        {
+            "case_status": (dims, np.ones(shape, int)),
+            "impacts": (dims, rng.poisson(np.broadcast_to(rate, shape)).astype(float)),
+            "peak_total_displacement": ((*dims, "building"), rng.lognormal(-3.0, 0.4, shape + (1,)), {"units": "m"}),
+            "record_kind": ("record", ["synthetic"]),
+        },
+        coords={"record": ["kt"], "realization": np.arange(n), "gap": gaps, "mu": mus, "building": ["B1"]},
+        attrs={"studied_building": "B1"},
+    )
+    ensemble = Ensemble("x", store, "kt")
+    items = ensemble.convergence()
+    assert [item.key for item in items] == ["figure-x-kt-convergence-pounding", "figure-x-kt-convergence-peak"]
+    for item in items:
+        assert len([ax for ax in item.figure.axes if ax.lines]) == CONVERGENCE_PANELS
+        for ax in item.figure.axes:
+            for line in ax.lines:
+                assert min(line.get_xdata()) >= MIN_RUNS
+    # μ is drawn as lines; of the 5 gaps the 4 with P(pounding) nearest 0.5 are panels (never pounding at 8 cm, the farthest, is left out)
+    assert items[0].caption.endswith("nearest 0.5, the slowest to settle: gap 0 cm, 1 cm, 2 cm, 4 cm.")

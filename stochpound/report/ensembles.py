@@ -12,6 +12,7 @@ realizations. Every cell is in every figure family (:mod:`stochpound.report.face
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from functools import cached_property
@@ -34,6 +35,8 @@ values neither the t nor the bootstrap interval of a mean of skewed peaks covers
 interval is wider than most differences it would be compared with (±0.18 at P = 0.5 with 30 runs)."""
 CONVERGENCE_POINTS = 8
 """Sample sizes, from :data:`MIN_RUNS` to the ensemble's size (geometrically spaced), at which a convergence figure draws the estimates."""
+CONVERGENCE_PANELS = 4
+"""Most panels of a convergence figure: the cells slowest to settle (P(pounding) nearest 0.5), not every cell."""
 
 
 @dataclass(frozen=True)
@@ -267,6 +270,10 @@ class Ensemble:
             return []
         line_dim = self.line_dim()
         counts = np.unique(np.round(np.geomspace(MIN_RUNS, self.size, CONVERGENCE_POINTS)).astype(int))
+        panels = self._slowest_panels(line_dim)
+        cut = {d: v for d, v in panels.items() if len(v) < len(self.grid[d])}
+        which = ("; only the panels whose P(pounding) is nearest 0.5, the slowest to settle: "
+                 + "; ".join(f"{dim_text(d)} {', '.join(value_text(d, x) for x in v)}" for d, v in cut.items())) if cut else ""
         items = []
         running = {
             "pounding": (of_first(lambda first: pounding_probability(first, confidence=self.confidence), self.sample("impacts"), counts),
@@ -292,16 +299,33 @@ class Ensemble:
             items += self.facet_figures(
                 f"convergence-{key}", [line_dim], curves, "realizations", y_label,
                 f"convergence: the {what} estimated from the first n realizations (n = {', '.join(map(str, counts))}), with its "
-                f"{self.confidence:.0%} {method} band",
+                f"{self.confidence:.0%} {method} band{which}",
                 title=f"{what} against the number of realizations", log_x=True, legend_title=dim_text(line_dim) if line_dim else "",
+                panel_grid=panels,
             )
         return items
 
+    def _slowest_panels(self, line_dim: str | None) -> dict[str, list[Any]]:
+        """The panel axes of a convergence figure, the longest cut (repeatedly) to its values with P(pounding) nearest 0.5, to at most :data:`CONVERGENCE_PANELS` panels."""
+        panels = {d: list(v) for d, v in self.grid.items() if d != line_dim}
+        probability = self.statistics["pounding_probability"]
+        while math.prod(len(v) for v in panels.values()) > CONVERGENCE_PANELS:
+            dim = max(panels, key=lambda d: len(panels[d]))
+            if len(panels[dim]) == 1:
+                break
+            others = math.prod(len(v) for d, v in panels.items() if d != dim)
+            keep = max(1, min(len(panels[dim]) - 1, CONVERGENCE_PANELS // others))
+            distance = abs(probability.mean([d for d in probability.dims if d != dim]).sel({dim: panels[dim]}).values - 0.5)
+            kept = sorted(np.argsort(distance, kind="stable")[:keep])
+            panels[dim] = [panels[dim][i] for i in kept]
+        return panels
+
     def facet_figures(
-        self, kind: str, drawn: Sequence[str | None], curves: Callable[[dict[str, Any]], list[figures.Curve]], x_label: str, y_label: str, what: str, title: str = "", **options: Any
+        self, kind: str, drawn: Sequence[str | None], curves: Callable[[dict[str, Any]], list[figures.Curve]], x_label: str, y_label: str, what: str, title: str = "",
+        panel_grid: dict[str, list[Any]] | None = None, **options: Any
     ) -> list[FigureItem]:
-        """One figure per layout of the dimensions not ``drawn`` (each combination a panel)."""
-        panel_grid = {d: v for d, v in self.grid.items() if d not in drawn}
+        """One figure per layout of the dimensions not ``drawn`` (each combination a panel; ``panel_grid``: only those values of them)."""
+        panel_grid = panel_grid if panel_grid is not None else {d: v for d, v in self.grid.items() if d not in drawn}
         plans = layouts(panel_grid)
         items = []
         for number, layout in enumerate(plans, start=1):
