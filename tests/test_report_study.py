@@ -122,7 +122,7 @@ def test_findings_and_methods_are_written_from_the_numbers(built):
     for verdict in re.findall(r"(holds|does not hold) \(\d+ against \d+ impacts; ([^)]*)\)", worst):
         assert "× 0.98" in verdict[1] and "× 1.02" in verdict[1]  # a verdict survives the record-scaling check
     collapse = next(text for text in built["findings"] if text.startswith("Correlation with the fixed-base response collapses"))
-    assert re.search(r"(Holds only at μ = [\d. and]+|Holds at every μ|Does not hold at any μ) \(", collapse)
+    assert re.search(r"It collapses \(every \|correlation\| below 0\.1; [^)]*\) (at every μ|only at μ = [\d. and]+|at none of these μ)", collapse)
     html = built["written"]["html"].read_text()
     assert "closed-form modal solution" in html and "DOP853" in html and "energy input" in html
 
@@ -144,7 +144,7 @@ def test_a_store_that_is_not_the_study_gets_a_section_of_its_own(study_stores, t
     other = tmp_path / "my_grid.nc"
     data.to_netcdf(other, engine="h5netcdf")
     report = assemble_report([other])
-    assert [s.title for s in report.sections] == ["About this report", "Experiment my_grid", "Methods"]
+    assert [s.title for s in report.sections] == ["Summary", "About this report", "Experiment my_grid", "Methods", "Appendix: per-cell tables"]
     table = report.tables()[0]
     assert table.frame.shape[0] == data.sizes["mu"] * data.sizes["record"]
     assert [f.key for f in report.figures()] == [f"figure-my_grid-{variable}-mu" for variable in AGAINST]

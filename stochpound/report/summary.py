@@ -8,6 +8,7 @@ each with its number and interval, computed from the stores:
   (:func:`stochpound.analysis.required_separation`);
 * how likely pounding is at the grid's gaps: P(pounding) with its
   Clopper–Pearson bounds, over the cells of each synthetic ensemble;
+* under records (one realization each), in how many cases each pounded;
 * the risk-targeted gap, when a builder of :data:`RISK_ANSWERS` finds a
   hazard in the store;
 
@@ -59,6 +60,9 @@ def experiment_summary(stores: dict[str, xr.Dataset], sections: list[Section], c
                 f"cells of each ensemble (the lowest and the highest cell) with the highest upper {confidence:.0%} Clopper–Pearson bound."
             ))
             summary.add(_probability_table(name, finite, ensembles, axes[0], confidence))
+        records = [label for label, kind in kinds.items() if kind != "synthetic"]
+        if records:
+            summary.add(Paragraph(_records_answer(store, records)))
         for answer in RISK_ANSWERS:
             for block in answer(name, store):
                 summary.add(block)
@@ -87,6 +91,17 @@ def _separation_answer(name: str, store: xr.Dataset, ensembles: list[str], confi
         few = f"; fewer than {MIN_RUNS}, so indicative only" if n < MIN_RUNS else ""
         parts.append(f"ensemble {label} ({n} contact-free realizations in each of {cells} cells{few}): " + "; ".join(answers))
     return "How wide must the gap be? The separation needed, the 1 − p quantile of the contact-free peak closure D: " + "; ".join(parts) + "."
+
+
+def _records_answer(store: xr.Dataset, records: list[str]) -> str:
+    """What the records' cases answer: in how many cases each record pounded (one realization each: no probability)."""
+    finite = with_contacts(store) if has_contact_free(store) else store
+    impacts = finite["impacts"].sel(record=records).isel(realization=0)
+    done = (finite["case_status"].sel(record=records).isel(realization=0) == 1)
+    counts = "; ".join(f"{label}: {int(((impacts.sel(record=label) > 0) & done.sel(record=label)).sum())} of {int(done.sel(record=label).sum())}"
+                       for label in records)
+    return (f"Does a record make the buildings pound? Cases with at least one impact, per record: {counts}. A record is one "
+            "realization: it answers yes or no per case, not with a probability.")
 
 
 def _extremes(values: xr.DataArray) -> str:
