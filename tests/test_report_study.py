@@ -145,8 +145,8 @@ def test_a_store_that_is_not_the_study_gets_a_section_of_its_own(study_stores, t
     data.to_netcdf(other, engine="h5netcdf")
     report = assemble_report([other])
     assert [s.title for s in report.sections] == ["Summary", "About this report", "Experiment my_grid", "Methods", "Appendix: per-cell tables"]
-    table = report.tables()[0]
-    assert table.frame.shape[0] == data.sizes["mu"] * data.sizes["record"]
+    table = report.sections[-1].blocks[0]  # the per-cell table of the records' cases, in the appendix
+    assert table.key == "table-my_grid-records" and table.frame.shape[0] == data.sizes["mu"] * data.sizes["record"]
     assert [f.key for f in report.figures()] == [f"figure-my_grid-{variable}-mu" for variable in AGAINST]
 
 

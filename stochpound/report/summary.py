@@ -163,8 +163,8 @@ def study_summary(findings: Section, sections: list[Section]) -> Section:
 
 
 def _first_sentence(text: str) -> str:
-    """The text up to its first full stop followed by a capital (a decimal point does not end it)."""
-    return re.split(r"(?<=[^\d\s.]\)|[^\d\s.])\. (?=[A-Z])", text, maxsplit=1)[0].rstrip(".") + "."
+    """The text up to its first full stop followed by a space and a capital (a decimal point is followed by a digit)."""
+    return re.split(r"\. (?=[A-Z])", text, maxsplit=1)[0].rstrip(".") + "."
 
 
 def move_per_cell_tables(sections: list[Section]) -> Section | None:
