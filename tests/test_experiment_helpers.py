@@ -105,6 +105,16 @@ def write_experiment(folder: Path, text: str = SMALL_EXPERIMENT, name: str = "sm
     return path
 
 
+def run_in_process(folder: Path, name: str, text: str) -> Path:
+    """Write experiment ``text`` as ``folder/<name>.toml``, run it in this process and return its store (every case done)."""
+    from stochpound.experiment import load_experiment, run_experiment
+
+    (folder / f"{name}.toml").write_text(text)
+    report = run_experiment(load_experiment(folder / f"{name}.toml"), workers=0, progress=False)
+    assert report.complete and not report.failed
+    return report.store
+
+
 def cli(*args: str, env: dict | None = None, check: bool = True, timeout: float = 600) -> subprocess.CompletedProcess:
     """Run ``python -m stochpound ARGS`` and return the completed process."""
     environment = {**os.environ, **(env or {})}

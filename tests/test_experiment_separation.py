@@ -54,6 +54,21 @@ def test_store_pounds_at_a_gap_exactly_when_the_contact_free_closure_reaches_it(
         assert set(rules.rule.values) >= {"abs", "srss", "ddc"} and rule_exceedance(free.peak_contact_closure, rules).probability.notnull().all()
 
 
+def test_abs_bounds_the_peak_closure_on_every_contact_free_run_of_a_store(contact_free_store):
+    """u1, u2 and D are located the same way (on the solution), so ABS = u1 + u2 ≥ D on every contact-free case: fixed and sliding, record and ensemble."""
+    with open_store(contact_free_store) as ds:
+        free = ds.sel(gap=np.inf)
+        done = (free.case_status == 1).broadcast_like(free.peak_contact_closure)
+        assert int(done.sum()) >= 2 * 2 * (1 + 4)
+        rules = separation_rules(store_contact_demands(free))
+        closure = free.peak_contact_closure
+        assert bool(((rules.sel(rule="abs") >= closure) | ~done).all())
+        assert bool(((rules.sel(rule="abs") - closure).where(done) > 0).any())  # a bound, not an identity
+        ensemble = free.sel(record="kt")
+        exceeded = rule_exceedance(ensemble.peak_contact_closure, separation_rules(store_contact_demands(ensemble)).sel(rule="abs"))
+        assert float(exceeded.probability.max()) == 0.0
+
+
 def test_gap_axis_accepts_inf_and_refuses_negative_and_nan(tmp_path):
     gap = next(d for d in _experiment(tmp_path, '[0.01, "inf"]').dims if d.name == "gap")
     assert gap.values[-1] == np.inf
@@ -83,8 +98,16 @@ def test_report_has_a_separation_section_built_from_the_store(contact_free_store
         needed = float(closure.max("realization").max()) * 100  # 4 realizations: a cell's 5 % gap is its largest D
     assert f"{compared} runs with contacts were compared" in text and "every one pounds exactly when D ≥ g" in text
     assert "sliding bases" in text and f"{needed:.1f} cm" in text
-    tables = {block.key for block in section.blocks if isinstance(block, Table)}
-    assert tables == {"table-small-separation-records", "table-small-kt-separation", "table-small-kt-separation-rules"}
+    assert "ASCE 7 (§17.2.5.2)" in text and "no such theory" not in text and "ABS is never reached" in text
+    assert "the grid's own gaps" in text.lower()  # the two answers to the gap question, related
+    dimensions = next(block.text for block in experiment.blocks if isinstance(block, Paragraph) and "Dimensions:" in block.text)
+    assert f"gap ({len(GAPS) + 1}: {len(GAPS)} gaps here and the contact-free one" in dimensions
+    assert not any(isinstance(block, Table) for block in section.blocks)  # its per-cell tables are in the appendix
+    appendix = report.sections[-1]
+    assert appendix.key == "appendix" and all(isinstance(block, Table) and block.per_cell for block in appendix.blocks)
+    assert {"table-small-separation-records", "table-small-kt-separation", "table-small-kt-separation-rules"} <= {block.key for block in appendix.blocks}
+    summary = report.sections[0]
+    assert summary.key == "summary" and "How wide must the gap be?" in " ".join(b.text for b in summary.blocks if isinstance(b, Paragraph))
     figures = [block for block in section.blocks if isinstance(block, FigureItem)]
     drawn = {artist.get_gid() for item in figures for ax in item.figure.axes for artist in ax.get_children() if artist.get_gid()}
     for neighbour in ("stiff", "flexible"):

@@ -172,7 +172,7 @@ HARMONICS = {  # contact: left (building, floor, amplitude m, phase rad), right 
 
 
 def contact_demands_of_harmonics() -> xr.Dataset:
-    """contact_demands of a constructed run: floors moving as y = a sin(ωt + phase), 1200 samples a period (every peak sampled), 2 periods."""
+    """contact_demands of a constructed run: floors moving as y = a sin(ωt + phase), 1200 samples a period, 2 periods (the located peaks |y| are the amplitudes)."""
     omega, time = 2.0 * math.pi, np.arange(2400) / 1200.0
     floors = {(left[:2]): left[2:] for left, _ in HARMONICS.values()} | {right[:2]: right[2:] for _, right in HARMONICS.values()}
     total = np.full((2, 2, time.size), np.nan)
@@ -187,6 +187,9 @@ def contact_demands_of_harmonics() -> xr.Dataset:
             "contact_right": ("contact", [right[0] for _, right in contacts]),
             "contact_right_floor": ("contact", [right[1] for _, right in contacts]),
             "peak_contact_closure": ("contact", [0.036, 0.054, 0.05], {"units": "m"}),
+            # the located peaks of |y| of a harmonic floor motion: its amplitude
+            "peak_contact_displacement_left": ("contact", [left[2] for left, _ in contacts], {"units": "m"}),
+            "peak_contact_displacement_right": ("contact", [right[2] for _, right in contacts], {"units": "m"}),
         },
         coords={"building": ["B1", "B2"], "floor": [1, 2], "time": time, "contact": [0, 1, 2]},
     )

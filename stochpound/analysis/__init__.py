@@ -13,7 +13,7 @@ from stochpound.analysis.correlation import correlation
 from stochpound.analysis.ensemble_statistics import ensemble_statistics
 from stochpound.analysis.histogram import normal_histogram
 from stochpound.analysis.impacts import impact_statistics
-from stochpound.analysis.intervals import mean_interval, quantiles, running_mean, running_pounding_probability
+from stochpound.analysis.intervals import mean_interval, of_first, quantiles, running_mean, running_pounding_probability
 from stochpound.analysis.peaks import peak_response
 from stochpound.analysis.pounding import pounding_probability
 from stochpound.analysis.separation import pounding_curve, required_separation, rule_exceedance
@@ -40,6 +40,7 @@ __all__ = [
     "normal_histogram",
     "impact_statistics",
     "mean_interval",
+    "of_first",
     "quantiles",
     "running_mean",
     "running_pounding_probability",

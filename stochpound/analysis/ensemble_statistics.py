@@ -50,6 +50,15 @@ PEAKS = (
 )
 #: Summaries estimated over the realizations that pound only (their value is 0 without an impact).
 GIVEN_POUNDING = ("peak_impact_force",)
+#: Summaries that can be of either sign: their means get a Student-t interval. Every other summary (counts, forces,
+#: peaks, standard deviations) cannot be negative and gets the percentile bootstrap, whose bounds stay within the
+#: sample's range (:func:`stochpound.analysis.kernels.bootstrap_mean_interval`).
+SIGNED = ("response_skewness", "response_excess", "fixed_base_correlation", "residual_sliding")
+
+
+def interval_method(name: str) -> str:
+    """The interval method of a summary's mean: ``t`` for a signed one (:data:`SIGNED`), else ``bootstrap``."""
+    return "t" if name in SIGNED else "bootstrap"
 
 
 def ensemble_statistics(
@@ -73,8 +82,9 @@ def ensemble_statistics(
     -------
     xarray.Dataset
         For each summary ``s`` of ``SUMMARIES`` in the store:
-        ``s_mean``, ``s_lower``, ``s_upper`` (Student-t interval of the
-        mean); for the peaks ``s_quantile`` (dimension ``quantile``);
+        ``s_mean``, ``s_lower``, ``s_upper`` (interval of the mean: Student t
+        for a summary of either sign, the percentile bootstrap for one that
+        cannot be negative, ``interval_method``); for the peaks ``s_quantile`` (dimension ``quantile``);
         ``peak_impact_force_*`` over the realizations with at least one
         impact (``peak_impact_force_count`` of them); and
         ``pounding_probability`` with its Clopper–Pearson bounds
@@ -86,7 +96,7 @@ def ensemble_statistics(
         data = store[name]
         if name in GIVEN_POUNDING:
             data = data.where(store["impacts"] > 0).assign_attrs(data.attrs, long_name=f"{data.attrs.get('long_name', name)}, given pounding")
-        interval = mean_interval(data, dim, confidence)
+        interval = mean_interval(data, dim, confidence, interval_method(name))
         for part in ("mean", "lower", "upper"):
             variables[f"{name}_{part}"] = interval[part]
         if name in GIVEN_POUNDING:

@@ -7,7 +7,8 @@ NaN (a missing case) is left out.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
+from typing import Literal
 
 import xarray as xr
 
@@ -17,6 +18,17 @@ from stochpound.analysis.ufunc import reduce
 
 #: Quantiles reported for peaks (median, ~mean + 1 sigma of a normal, 95 %).
 QUANTILES = (0.5, 0.84, 0.95)
+#: Interval of a mean: ``t`` (Student t, for a quantity of either sign) or ``bootstrap`` (percentile bootstrap, for a
+#: quantity that cannot be negative: its bounds stay within the sample's range).
+Method = Literal["t", "bootstrap"]
+_MEAN_KERNELS = {"t": (kernels.mean_interval, "Student t"), "bootstrap": (kernels.bootstrap_mean_interval, "percentile bootstrap")}
+
+
+def _mean_kernel(method: Method) -> tuple:
+    """The interval kernel of ``method`` and its name."""
+    if method not in _MEAN_KERNELS:
+        raise ValueError(f"method: must be one of {', '.join(_MEAN_KERNELS)}, got {method!r}")
+    return _MEAN_KERNELS[method]
 
 
 def _interval_dataset(values: tuple, estimate: str, data: xr.DataArray, confidence: float, method: str) -> xr.Dataset:
@@ -32,8 +44,8 @@ def _interval_dataset(values: tuple, estimate: str, data: xr.DataArray, confiden
     )
 
 
-def mean_interval(data: xr.DataArray, dim: str = "realization", confidence: float = 0.95) -> xr.Dataset:
-    """Mean of ``data`` along ``dim`` with its Student-t confidence interval.
+def mean_interval(data: xr.DataArray, dim: str = "realization", confidence: float = 0.95, method: Method = "t") -> xr.Dataset:
+    """Mean of ``data`` along ``dim`` with its confidence interval (Student t, or a percentile bootstrap for a non-negative quantity).
 
     Parameters
     ----------
@@ -44,17 +56,23 @@ def mean_interval(data: xr.DataArray, dim: str = "realization", confidence: floa
         The ensemble dimension.
     confidence : float
         Two-sided confidence level, in (0, 1).
+    method : {"t", "bootstrap"}
+        ``t``: Student t (:func:`stochpound.analysis.kernels.mean_interval`),
+        for a quantity of either sign; ``bootstrap``: the percentile bootstrap
+        of the mean (:func:`stochpound.analysis.kernels.bootstrap_mean_interval`),
+        for a quantity that cannot be negative (counts, forces, peaks): never a
+        negative bound.
 
     Returns
     -------
     xarray.Dataset
         ``mean``, ``lower``, ``upper`` (units of ``data``; NaN bounds for
-        fewer than two values) and ``count``
-        (:func:`stochpound.analysis.kernels.mean_interval`).
+        fewer than two values) and ``count``; the bounds' ``long_name`` names the method.
     """
     kernels.check_confidence(confidence)
-    values = reduce(lambda x: tuple(kernels.mean_interval(x, confidence)), [data], [dim], 4)
-    return _interval_dataset(values, "mean", data, confidence, "Student t")
+    kernel, name = _mean_kernel(method)
+    values = reduce(lambda x: tuple(kernel(x, confidence)), [data], [dim], 4)
+    return _interval_dataset(values, "mean", data, confidence, name)
 
 
 def quantiles(data: xr.DataArray, q: Sequence[float] = QUANTILES, dim: str = "realization") -> xr.DataArray:
@@ -75,6 +93,16 @@ def running_mean(data: xr.DataArray, dim: str = "realization", confidence: float
     kernels.check_confidence(confidence)
     values = reduce(lambda x: tuple(kernels.running_mean_interval(x, confidence)), [data], [dim], 4, new_dims={dim: data.sizes[dim]})
     return _interval_dataset(values, "mean", data, confidence, "Student t").assign_coords({dim: data[dim]} if dim in data.coords else {})
+
+
+def of_first(estimate: Callable[[xr.DataArray], xr.Dataset], data: xr.DataArray, counts: Sequence[int], dim: str = "realization") -> xr.Dataset:
+    """``estimate`` (e.g. :func:`~stochpound.analysis.mean_interval`) of the first n entries of ``data`` along ``dim``, for each n of ``counts``.
+
+    Convergence at chosen sample sizes, for an estimate without a running
+    kernel (the percentile bootstrap): on a new dimension ``first`` (the n of
+    ``counts``; missing entries among the first n are left out by ``estimate``).
+    """
+    return xr.concat([estimate(data.isel({dim: slice(0, int(n))})) for n in counts], dim="first").assign_coords(first=[int(n) for n in counts])
 
 
 def running_pounding_probability(impacts: xr.DataArray, dim: str = "realization", confidence: float = 0.95) -> xr.Dataset:

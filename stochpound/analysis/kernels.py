@@ -21,12 +21,19 @@ Conventions:
 from __future__ import annotations
 
 import warnings
+from functools import lru_cache
 from typing import NamedTuple
 
 import numpy as np
 from scipy import stats
 
 Axis = int | tuple[int, ...]
+
+BOOTSTRAP_RESAMPLES = 9999
+"""Resamples of :func:`bootstrap_mean_interval` (scipy's default): the Monte Carlo error of its 2.5 % and 97.5 %
+bounds is then about 2 % of the interval's width."""
+BOOTSTRAP_SEED = 20240528
+"""Seed of the resampling of :func:`bootstrap_mean_interval` (with the sample size): the same data always give the same interval."""
 
 
 class Moments(NamedTuple):
@@ -231,6 +238,61 @@ def mean_interval(values: np.ndarray, confidence: float = 0.95) -> Interval:
         std = sample.std * np.sqrt(count / (count - 1.0))
     lower, upper = t_interval(sample.mean, std, count, confidence)
     return Interval(sample.mean, lower, upper, count)
+
+
+def bootstrap_mean_interval(values: np.ndarray, confidence: float = 0.95, resamples: int = BOOTSTRAP_RESAMPLES) -> Interval:
+    """Sample mean along the trailing axis with its percentile-bootstrap confidence interval (NaN ignored).
+
+    For a quantity that cannot be negative (counts, forces, peaks) a Student-t
+    interval from a few skewed values reaches below zero (a mean impact force
+    of 74.5 kN from 4 runs with bounds −11.1 and 160.2 kN). The percentile
+    bootstrap of the mean (Efron & Tibshirani 1993, ch. 13) takes its bounds
+    from means of resamples of the data, so they lie within the sample's range:
+    never below zero for non-negative data, and asymmetric where the data are
+    skewed. Its coverage, like the t interval's, approaches the nominal level
+    as the sample grows (it is too narrow for a handful of values: state n).
+
+    Parameters
+    ----------
+    values : numpy.ndarray
+        The sample(s), along the trailing axis; NaN is ignored.
+    confidence : float
+        Two-sided level in (0, 1).
+    resamples : int
+        Bootstrap resamples (:data:`BOOTSTRAP_RESAMPLES`).
+
+    Returns
+    -------
+    Interval
+        The mean, the (1 − c)/2 and (1 + c)/2 quantiles (type 7) of the
+        resampled means, and the count; NaN bounds for fewer than two values.
+        Deterministic: the resampling depends only on :data:`BOOTSTRAP_SEED`
+        and the sample size, and the values are sorted first, so the interval
+        is a function of the sample's values, not of their order.
+    """
+    check_confidence(confidence)
+    x = np.asarray(values, dtype=np.float64)
+    flat = np.sort(x.reshape(-1, x.shape[-1]), axis=-1)  # NaN last
+    count = np.sum(~np.isnan(flat), axis=-1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        mean = np.nansum(flat, axis=-1) / count
+    lower, upper = np.full(len(flat), np.nan), np.full(len(flat), np.nan)
+    alpha = 1.0 - confidence
+    for n in np.unique(count[count >= 2]):
+        rows = count == n
+        resampled = flat[rows, :n] @ _resample_weights(int(n), resamples).T / n  # rows x resamples
+        lower[rows], upper[rows] = np.quantile(resampled, [alpha / 2, 1 - alpha / 2], axis=-1)
+    shape = x.shape[:-1]
+    return Interval(mean.reshape(shape), lower.reshape(shape), upper.reshape(shape), count.reshape(shape))
+
+
+@lru_cache(maxsize=64)
+def _resample_weights(n: int, resamples: int) -> np.ndarray:
+    """How often each of n values is drawn in each of ``resamples`` resamples with replacement (resamples × n), from :data:`BOOTSTRAP_SEED` and n."""
+    drawn = np.random.default_rng([BOOTSTRAP_SEED, n]).integers(0, n, size=(resamples, n))
+    weights = np.bincount((drawn + n * np.arange(resamples)[:, None]).ravel(), minlength=resamples * n).reshape(resamples, n).astype(np.float64)
+    weights.flags.writeable = False
+    return weights
 
 
 def proportion_interval(events: np.ndarray, confidence: float = 0.95) -> Interval:

@@ -3,7 +3,8 @@
 Each rule combines u1, u2, the peak displacements relative to the ground of
 the two floors at a contact (m), into the gap it asks for:
 
-- ABS: u1 + u2, an upper bound of the peak closure;
+- ABS: u1 + u2, an upper bound of the peak closure (u1, u2 and the closure
+  all located on the solution);
 - SRSS: sqrt(u1² + u2²) (ASCE 7's δ_MT; Eurocode 8, which allows 0.7 of it
   where the floor levels of the two buildings coincide);
 - DDC, the double difference combination (Jeng et al. 1992; Penzien 1997):
@@ -54,8 +55,9 @@ def contact_demands(run: xr.Dataset, dim: str = "time") -> xr.Dataset:
     ----------
     run : xarray.Dataset
         A result of :func:`stochpound.simulate` (``total_displacement``, the
-        ``contact_*`` description and ``peak_contact_closure``); run it
-        contact-free (every gap ``inf``) for the rules of an ensemble.
+        ``contact_*`` description, ``peak_contact_closure`` and
+        ``peak_contact_displacement_left``/``_right``); run it contact-free
+        (every gap ``inf``) for the rules of an ensemble.
     dim : str
         The time dimension.
 
@@ -64,17 +66,18 @@ def contact_demands(run: xr.Dataset, dim: str = "time") -> xr.Dataset:
     xarray.Dataset
         Per contact: ``peak_displacement_left`` and ``peak_displacement_right``
         (u1, u2: the largest absolute displacement y of the contact's floors
-        relative to the ground over the output samples, m), ``correlation`` (ρ, Pearson correlation of the
-        two floors' y over time) and ``peak_closure`` (D, the largest
-        y_left − y_right, located on the solution, m).
+        relative to the ground, m), ``correlation`` (ρ, Pearson correlation of the
+        two floors' y over the output samples) and ``peak_closure`` (D, the largest
+        y_left − y_right, m). u1, u2 and D are all located on the solution
+        (the engine's monitors), so ABS = u1 + u2 ≥ D holds by construction.
     """
     displacement = run["total_displacement"]
     left = _floor_history(displacement, run["contact_left"], run["contact_left_floor"])
     right = _floor_history(displacement, run["contact_right"], run["contact_right_floor"])
     return xr.Dataset(
         {
-            "peak_displacement_left": abs(left).max(dim).assign_attrs(units="m", long_name="peak |y| of the contact's left floor (u1)"),
-            "peak_displacement_right": abs(right).max(dim).assign_attrs(units="m", long_name="peak |y| of the contact's right floor (u2)"),
+            "peak_displacement_left": run["peak_contact_displacement_left"].assign_attrs(units="m", long_name="peak |y| of the contact's left floor (u1)"),
+            "peak_displacement_right": run["peak_contact_displacement_right"].assign_attrs(units="m", long_name="peak |y| of the contact's right floor (u2)"),
             "correlation": correlation(left, right, dim).assign_attrs(long_name="correlation of the two floors' displacement histories (rho)"),
             "peak_closure": run["peak_contact_closure"],
         }

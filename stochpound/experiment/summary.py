@@ -180,8 +180,8 @@ def _contact_values(run: xr.Dataset) -> dict[str, np.ndarray]:
     left, right = floors("left"), floors("right")
     return {
         "peak_contact_closure": variables["peak_contact_closure"].values.astype(float),
-        "contact_peak_displacement_left": kernels.abs_peak(left),
-        "contact_peak_displacement_right": kernels.abs_peak(right),
+        "contact_peak_displacement_left": variables["peak_contact_displacement_left"].values.astype(float),
+        "contact_peak_displacement_right": variables["peak_contact_displacement_right"].values.astype(float),
         "contact_correlation": kernels.pearson(left, right),
     }
 

@@ -269,7 +269,17 @@ def _foundation_force(system: System, b: int, state: int, terms: tuple[np.ndarra
 
 def monitor_count(system: System) -> int:
     """Number of monitors of every mode of ``system`` (:func:`monitor_rows`)."""
-    return system.n_elements + (2 * len(DEMANDS) * len(system.total_displacement) if system.demands else 0)
+    return demand_monitors_start(system) + (2 * len(DEMANDS) * len(system.total_displacement) if system.demands else 0)
+
+
+def contact_displacement_monitors(system: System) -> slice:
+    """The monitor rows of ± each contact's left and right floor displacement (:func:`monitor_rows`): 4 per contact, in the order +left, −left, +right, −right."""
+    return slice(system.n_elements, system.n_elements + 4 * system.n_contacts)
+
+
+def demand_monitors_start(system: System) -> int:
+    """Index of the first demand monitor (:func:`monitor_rows`): they follow the closures and the contacts' floor displacements."""
+    return system.n_elements + 4 * system.n_contacts
 
 
 def monitor_rows(system: System, rows: contact.ContactRows, rate: tuple[np.ndarray, np.ndarray, np.ndarray]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -278,12 +288,21 @@ def monitor_rows(system: System, rows: contact.ContactRows, rate: tuple[np.ndarr
     First each impact element's closure y_left − y_right = g_p · q (m, the
     penetration plus the gap): its largest value over a run, located on the
     solution, is the separation the run needed (``peak_contact_closure``).
-    Then, when the system monitors demands, + and − every demand parameter of
+    Then, per contact, + and − the displacement relative to the ground
+    y = s + u of its left floor, then of its right floor
+    (:func:`contact_displacement_monitors`): their peaks are the separation
+    rules' u1 and u2 located the same way as the closure, so that
+    u1 + u2 ≥ D holds on the solution. Then, when the system monitors
+    demands, + and − every demand parameter of
     :func:`stochpound.model.demands.demand_rows` (whose peaks give the peak
     absolute values). ``rate`` is the mode's (A, B, c).
     """
-    n_closures = len(rows.penetration)
-    matrix, ground, constant = _over_xi(rows.penetration, system.xi_size), np.zeros(n_closures), np.zeros(n_closures)
+    n_contacts = system.n_contacts
+    sides = np.stack([system.element_left[:n_contacts], -system.element_left[:n_contacts],
+                      system.element_right[:n_contacts], -system.element_right[:n_contacts]], axis=1).reshape(4 * n_contacts, system.n_dof)
+    displacements = np.vstack([rows.penetration, np.hstack([sides, np.zeros((4 * n_contacts, system.n_dof))])])
+    n_rows = len(displacements)
+    matrix, ground, constant = _over_xi(displacements, system.xi_size), np.zeros(n_rows), np.zeros(n_rows)
     if not system.demands:
         return matrix, ground, constant
     demand = demand_rows(system.floor_dofs, system.building_base_dofs, system.storey_stiffness, system.storey_damping, rate)

@@ -5,6 +5,9 @@ experiment names) give the study's tables and figures, with the findings
 and the methods; any other store gets a section of its own
 (:mod:`stochpound.report.generic`). Sections whose store is missing are left
 out, so a report can be built from any subset of the study's stores.
+Every report opens with a summary, the answers first
+(:mod:`stochpound.report.summary`); the report of experiments ends with an
+appendix of its per-cell tables.
 """
 
 from __future__ import annotations
@@ -17,11 +20,13 @@ import xarray as xr
 
 from stochpound.report import findings, study_figures, study_notes, study_tables
 from stochpound.report.document import Block, Paragraph, Report, Section
+from stochpound.report.ensembles import INTERVAL_NOTE
 from stochpound.report.generic import store_section
 from stochpound.report.intensity import intensity_section, intensity_setting
 from stochpound.report.separation import has_contact_free, separation_section, with_contacts
 from stochpound.report.methods import methods_section
 from stochpound.report.stores import open_stores
+from stochpound.report.summary import experiment_summary, move_per_cell_tables, study_summary
 
 #: Experiment names of the study's stores (``experiments/study/``).
 STUDY_EXPERIMENTS = ("study_harmonic", "study_gap", "study_single", "study_pair_mu", "study_pair_records")
@@ -67,6 +72,9 @@ def assemble_report(paths: Sequence[str | Path], progress: Callable[[str], None]
         for title, key, build in _study_sections(study):
             say(title)
             report.sections.append(Section(title, build(), key=key))
+        findings_section = next((section for section in report.sections if section.key == "findings"), None)
+        if findings_section is not None:
+            report.sections.insert(0, study_summary(findings_section, report.sections))
     if others and not study:
         report.sections.append(Section("About this report", [Paragraph(_about(others))], key="about"))
     for name, store in others.items():
@@ -74,7 +82,7 @@ def assemble_report(paths: Sequence[str | Path], progress: Callable[[str], None]
         contact_free = has_contact_free(store)
         finite = with_contacts(store) if contact_free else store
         if all(finite.sizes[d] for d in finite["case_status"].dims):
-            report.sections.append(store_section(name, finite))
+            report.sections.append(store_section(name, finite, contact_free))
         if contact_free:
             say(f"experiment {name}: separation")
             report.sections.append(separation_section(name, store))
@@ -83,6 +91,12 @@ def assemble_report(paths: Sequence[str | Path], progress: Callable[[str], None]
             report.sections.append(intensity_section(name, store))
     say("methods")
     report.sections.append(methods_section(stores))
+    if others and not study:
+        appendix = move_per_cell_tables(report.sections)
+        if appendix is not None:
+            report.sections.append(appendix)
+        say("summary")
+        report.sections.insert(0, experiment_summary(others, report.sections))
     return report
 
 
@@ -92,7 +106,7 @@ def _about(stores: dict[str, xr.Dataset]) -> str:
     return (
         f"This report describes the experiment stores {described}. Each experiment has a section: the cases run under "
         "records one by one, and each synthetic ensemble by the statistics of its realizations in every cell of the grid "
-        "(every combination of the grid's axes): means with 95 % Student-t confidence intervals, quantiles of the peaks, and "
+        f"(every combination of the grid's axes): means with 95 % confidence intervals ({INTERVAL_NOTE}), quantiles of the peaks, and "
         "the probability of pounding (at least one impact) with its 95 % Clopper–Pearson interval, followed by findings "
         "computed from them, tables (also written as CSV files) and figures in which every cell is drawn. An ECDF gives, for "
         "each value, the fraction of realizations at or below it; a convergence figure shows an estimate over the first n "

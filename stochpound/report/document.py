@@ -47,6 +47,9 @@ class Table:
         The table's own name (e.g. the study's ``"Table 4.1"``); empty: the
         renderers number it ("Table 3"). A caption that starts with its
         own name and a colon (``"Table 4.1: ..."``) gives the label.
+    per_cell : bool
+        One row per cell (case) of an experiment's grid: a reference table,
+        which the report of an experiment moves to its appendix.
     """
 
     key: str
@@ -55,6 +58,7 @@ class Table:
     note: str = ""
     formats: dict[str, str] = field(default_factory=dict)
     label: str = ""
+    per_cell: bool = False
 
     def __post_init__(self) -> None:
         self.label, self.caption = _own_label(self.label, self.caption)

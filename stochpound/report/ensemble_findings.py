@@ -19,7 +19,7 @@ import xarray as xr
 
 from stochpound.analysis import kernels
 from stochpound.report.document import Block, Paragraph, Table
-from stochpound.report.ensembles import CM, Ensemble
+from stochpound.report.ensembles import CM, MIN_RUNS, Ensemble
 from stochpound.report.facets import dim_text, is_gap, labels_text, value_text
 
 #: Estimates compared between a sliding and a fixed base: statistic -> label.
@@ -60,37 +60,62 @@ def precision(ensemble: Ensemble) -> Paragraph:
         f"interval of the probability of pounding is at most ±{np.nanmax(p):.3f} wide (median ±{np.nanmedian(p):.3f}; widest "
         f"where P is near 0.5, narrowest where it is 0 or 1), and the mean peak total displacement of {ensemble.studied} is "
         f"known to ±{np.nanmedian(relative) * 100:.1f} % (median over cells; at most ±{np.nanmax(relative) * 100:.1f} %). "
-        f"The convergence figures show how these estimates settle as realizations are added."
+        + (f"The convergence figures show these estimates from the first {MIN_RUNS} realizations to all {ensemble.size}."
+           if ensemble.size >= MIN_RUNS else f"With fewer than {MIN_RUNS} realizations per cell no convergence figure is drawn.")
     )
 
 
 def spread(ensemble: Ensemble) -> Paragraph:
-    """How far the peaks spread between realizations of the same cell, which one record cannot show."""
+    """How far the peaks spread between realizations of the same cell, which one record cannot show (only from cells with :data:`MIN_RUNS` runs)."""
     stats = ensemble.statistics
     quantile = stats["peak_total_displacement_quantile"]
-    ratio = (quantile.sel(quantile=quantile["quantile"].max()) / quantile.sel(quantile=0.5)).values.ravel()
+    top = float(quantile["quantile"].max())
     between = ((stats["pounding_probability_lower"] > 0) & (stats["pounding_probability_upper"] < 1)).values
-    sentence = (
-        f"Within one cell the realizations differ widely: the {float(quantile['quantile'].max()) * 100:g} % quantile of "
-        f"{ensemble.studied}'s peak total displacement is {np.nanmin(ratio):.2f} to {np.nanmax(ratio):.2f} times its median. "
+    if ensemble.size >= MIN_RUNS:
+        ratio = (quantile.sel(quantile=top) / quantile.sel(quantile=0.5)).values.ravel()
+        sentence = (
+            f"Within one cell the realizations differ widely: the {top * 100:g} % quantile of {ensemble.studied}'s peak total "
+            f"displacement is {np.nanmin(ratio):.2f} to {np.nanmax(ratio):.2f} times its median (n = {ensemble.size} per cell). "
+        )
+    else:
+        sentence = (
+            f"With {ensemble.size} realizations per cell (fewer than {MIN_RUNS}) the spread of the peaks within a cell is not "
+            "estimated. "
+        )
+    sentence += (
         f"In {int(between.sum())} of {between.size} cells the probability of pounding lies strictly between 0 and 1 with "
         f"{ensemble.confidence:.0%} confidence: there a single record answers yes or no where the ensemble gives a probability."
     )
     if "peak_impact_force_quantile" in stats:
-        force = stats["peak_impact_force_quantile"]
-        force_ratio = (force.sel(quantile=force["quantile"].max()) / force.sel(quantile=0.5)).values.ravel()
-        if np.isfinite(force_ratio).any():
-            sentence += f" The peak impact force, over the realizations that pound, reaches {np.nanmin(force_ratio):.2f} to {np.nanmax(force_ratio):.2f} times its median at that quantile."
+        sentence += " " + _force_spread(stats, top)
     return Paragraph(sentence)
 
 
-def _rare_gap(ensemble: Ensemble, dim: str) -> xr.DataArray:
-    """The smallest value of gap axis ``dim`` from which on every larger gap of the grid has P(pounding)'s upper bound below :data:`RARE` (NaN if none)."""
-    upper = ensemble.statistics["pounding_probability_upper"]
+def _force_spread(stats: xr.Dataset, top: float) -> str:
+    """The spread of the peak impact force over the pounding realizations, from the cells with at least :data:`MIN_RUNS` of them."""
+    force, count = stats["peak_impact_force_quantile"], stats["peak_impact_force_count"]
+    enough = (count >= MIN_RUNS).values.ravel()
+    if not enough.any():
+        return (
+            f"No cell has {MIN_RUNS} pounding realizations (at most {int(count.max())}): the spread of the peak impact force is "
+            "not estimated."
+        )
+    ratio = (force.sel(quantile=top) / force.sel(quantile=0.5)).values.ravel()[enough]
+    counts = count.values.ravel()[enough]
+    text = (
+        f"In the {int(enough.sum())} cells with at least {MIN_RUNS} pounding realizations (n = {int(counts.min())}–{int(counts.max())}), "
+        f"the {top * 100:g} % quantile of the peak impact force is {np.nanmin(ratio):.2f} to {np.nanmax(ratio):.2f} times its median"
+    )
+    rest = int((~enough).sum())
+    return text + (f"; the other {rest} cells have fewer pounding realizations and give no ratio." if rest else ".")
+
+
+def rare_gap(upper: xr.DataArray, dim: str) -> xr.DataArray:
+    """The smallest value of gap axis ``dim`` from which on every larger gap has P(pounding)'s upper bound ``upper`` below :data:`RARE` (m, NaN if none)."""
     rare = (upper < RARE).transpose(dim, ...)
     # rare from this gap on: a reversed cumulative "all"
     from_here = rare.isel({dim: slice(None, None, -1)}).cumprod(dim).isel({dim: slice(None, None, -1)}).astype(bool)
-    gaps = xr.DataArray(np.asarray(ensemble.grid[dim], dtype=float), dims=dim, coords={dim: upper[dim]})
+    gaps = xr.DataArray(np.asarray(upper[dim].values, dtype=float), dims=dim, coords={dim: upper[dim]})
     return gaps.where(from_here).min(dim)
 
 
@@ -101,7 +126,7 @@ def gap_effect(ensemble: Ensemble, dim: str) -> list[Block]:
     first, last = p.isel({dim: 0}), p.isel({dim: -1})
     lines = int(first.size)
     lower_at_end = int((last < first).sum())
-    needed = _rare_gap(ensemble, dim)
+    needed = rare_gap(stats["pounding_probability_upper"], dim)
     reached = needed.notnull()
     others = [d for d in ensemble.grid if d != dim]
     text = (
@@ -187,8 +212,7 @@ def isolation_effect(ensemble: Ensemble) -> list[Block]:
         isolated = stats.sel(mu=mu)
         row = []
         for name in COMPARED:
-            lower = isolated[f"{name}_upper"] < fixed[f"{name}_lower"]
-            higher = isolated[f"{name}_lower"] > fixed[f"{name}_upper"]
+            lower, higher = _clearly(isolated, fixed, name)
             row += [int(lower.sum()), int(higher.sum()), int((~lower & ~higher).sum())]
         rows[value_text("mu", mu)] = row
         difference = isolated["pounding_probability"] - fixed["pounding_probability"]
@@ -210,6 +234,9 @@ def isolation_effect(ensemble: Ensemble) -> list[Block]:
         f"raises it in {counts[1][1]}; it lowers its mean peak total displacement (deformation plus sliding) in {counts[2][0]} and "
         f"raises it in {counts[2][1]}."
     )
+    flip = _where_sign_flips(ensemble)
+    if flip:
+        sentences.append(flip)
     for verb, candidates in extremes.items():
         sentence = _most(stats, fixed, candidates, verb)
         if sentence:
@@ -224,6 +251,63 @@ def isolation_effect(ensemble: Ensemble) -> list[Block]:
             formats={},
         ),
     ]
+
+
+def _clearly(isolated: xr.Dataset, fixed: xr.Dataset, name: str) -> tuple[xr.DataArray, xr.DataArray]:
+    """Cells where the isolated estimate of ``name`` is lower, and where it is higher, than the fixed base's with non-overlapping intervals."""
+    return isolated[f"{name}_upper"] < fixed[f"{name}_lower"], isolated[f"{name}_lower"] > fixed[f"{name}_upper"]
+
+
+def isolation_changes(ensemble: Ensemble) -> tuple[xr.DataArray, xr.DataArray]:
+    """Per isolated cell (μ finite, every other label): where isolation clearly lowers and where it clearly raises P(pounding) against the fixed base."""
+    stats = ensemble.statistics
+    finite = [m for m in ensemble.grid["mu"] if not math.isinf(m)]
+    return _clearly(stats.sel(mu=finite), stats.sel(mu=math.inf, drop=True), "pounding_probability")
+
+
+def _where_sign_flips(ensemble: Ensemble) -> str:
+    """Where isolation lowers and where it raises P(pounding), by the axis that separates the two best ("" when the sign does not flip)."""
+    lower, higher = isolation_changes(ensemble)
+    if not (bool(lower.any()) and bool(higher.any())):
+        return ""
+    best, purity = None, -1.0
+    for dim in (d for d in lower.dims if lower.sizes[d] > 1):
+        lowered, raised = lower.sum([d for d in lower.dims if d != dim]), higher.sum([d for d in higher.dims if d != dim])
+        score = float(np.maximum(lowered, raised).sum() / (lowered + raised).sum())
+        if score > purity:
+            best, purity = (dim, lowered, raised), score
+    if best is None:
+        return ""
+    dim, lowered, raised = best
+    parts = [f"{value_text(dim, v)}: {int(lo)} lower, {int(hi)} higher" for v, lo, hi in zip(lowered[dim].values, lowered.values, raised.values) if lo + hi]
+    return (
+        f"The sign of the change of P(pounding) flips with {dim_text(dim)} (cells with a clear difference, by {dim_text(dim)}: "
+        + "; ".join(parts) + ")."
+    )
+
+
+def isolation_across(ensembles: list[Ensemble]) -> Paragraph | None:
+    """Whether isolation's effect on P(pounding) has the same sign in every ensemble (e.g. soils), or where it flips; None without a fixed and a sliding base."""
+    counts = {}
+    for ensemble in ensembles:
+        mus = ensemble.grid.get("mu", [])
+        if any(math.isinf(m) for m in mus) and any(not math.isinf(m) for m in mus):
+            lower, higher = isolation_changes(ensemble)
+            counts[ensemble.label] = (int(lower.sum()), int(higher.sum()), int(lower.size))
+    if len(counts) < 2:
+        return None
+    signs = {label: np.sign(raised - lowered) for label, (lowered, raised, _) in counts.items()}
+    described = "; ".join(f"ensemble {label}: lower in {lo}, higher in {hi} of {n} isolated cells" for label, (lo, hi, n) in counts.items())
+    if len(set(signs.values())) == 1:
+        verdict = "Isolation changes the probability of pounding the same way in every ensemble"
+    else:
+        lowers = [label for label, sign in signs.items() if sign < 0]
+        raises = [label for label, sign in signs.items() if sign > 0]
+        verdict = (
+            "The effect of isolation on the probability of pounding changes sign between the ensembles: it lowers it in more "
+            f"cells than it raises it in {', '.join(lowers) or 'none'}, and raises it in more in {', '.join(raises) or 'none'}"
+        )
+    return Paragraph(f"{verdict} ({described}; non-overlapping {ensembles[0].confidence:.0%} intervals).")
 
 
 def compare_ensembles(first: Ensemble, second: Ensemble) -> Paragraph:

@@ -12,6 +12,7 @@ realizations. Every cell is in every figure family (:mod:`stochpound.report.face
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from functools import cached_property
@@ -21,13 +22,21 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
-from stochpound.analysis import ensemble_statistics, running_mean, running_pounding_probability
+from stochpound.analysis import ensemble_statistics, mean_interval, of_first, pounding_probability
 from stochpound.report import figures
 from stochpound.report.document import Block, FigureItem, Table
 from stochpound.report.facets import cell_gid, dim_text, is_gap, labels_text, layouts, line_colours, plain, value_text
 
 CM = 100.0
 KN = 1e-3
+MIN_RUNS = 30
+"""Fewest runs behind an estimate the report draws a conclusion from, or draws as a running estimate: below about 30
+values neither the t nor the bootstrap interval of a mean of skewed peaks covers at its level, and a proportion's
+interval is wider than most differences it would be compared with (±0.18 at P = 0.5 with 30 runs)."""
+CONVERGENCE_POINTS = 8
+"""Sample sizes, from :data:`MIN_RUNS` to the ensemble's size (geometrically spaced), at which a convergence figure draws the estimates."""
+CONVERGENCE_PANELS = 4
+"""Most panels of a convergence figure: the cells slowest to settle (P(pounding) nearest 0.5), not every cell."""
 
 
 @dataclass(frozen=True)
@@ -71,6 +80,13 @@ TABLE_CAPTIONS = {
     "demands": "the studied building's demands: the largest peak total floor acceleration and storey drift over its floors, and its peak base shear",
     "response": "moments of the studied building's top-floor total displacement over time, and its correlation with the same building alone on a fixed base",
 }
+
+
+INTERVAL_NOTE = (
+    "a percentile bootstrap of the mean for quantities that cannot be negative — counts, forces, peaks, standard "
+    "deviations — whose bounds stay within the realizations' range, a Student t interval for those of either sign"
+)
+"""How the report's intervals of means are taken (:func:`stochpound.analysis.ensemble_statistics.interval_method`)."""
 
 
 def _with_unit(quantity: Quantity) -> str:
@@ -147,11 +163,12 @@ class Ensemble:
             frame=table_frame(columns, list(self.grid)),
             note=(
                 f"mean: the ensemble mean over the realizations, with the lower and upper bounds of its {self.confidence:.0%} "
-                f"Student-t confidence interval; P(pounding): fraction of realizations with at least one impact, with its "
+                f"confidence interval ({INTERVAL_NOTE}); P(pounding): fraction of realizations with at least one impact, with its "
                 f"{self.confidence:.0%} Clopper–Pearson (exact binomial) interval; n: realizations used; percentages: sample "
                 f"quantiles. Peaks are the studied building's ({self.studied}); μ fixed: a fixed base."
             ),
             formats={"n": "{:.0f}"},
+            per_cell=True,
         )
 
     def _columns(self, quantity: Quantity) -> dict[tuple[str, str], xr.DataArray]:
@@ -180,7 +197,8 @@ class Ensemble:
             key=f"table-{self.name}-{self.label}-fixed-base",
             caption=f"Experiment {self.name}, ensemble {self.label}: the fixed-base twin, {self.studied} alone on a fixed base under the same {self.size} realizations.",
             frame=table_frame(columns, dims),
-            note=f"Means with their {self.confidence:.0%} Student-t intervals, and sample quantiles.",
+            note=f"Means with their {self.confidence:.0%} percentile-bootstrap intervals, and sample quantiles.",
+            per_cell=True,
         )
 
     # ------------------------------------------------------------ figures
@@ -247,16 +265,24 @@ class Ensemble:
         )
 
     def convergence(self) -> list[FigureItem]:
-        """Running P(pounding) and running mean peak displacement against the number of realizations, with bands."""
+        """P(pounding) and the mean peak displacement over the first n realizations, n from :data:`MIN_RUNS` to all, with bands (none below :data:`MIN_RUNS` realizations)."""
+        if self.size < MIN_RUNS:
+            return []
         line_dim = self.line_dim()
+        counts = np.unique(np.round(np.geomspace(MIN_RUNS, self.size, CONVERGENCE_POINTS)).astype(int))
+        panels = self._slowest_panels(line_dim)
+        cut = {d: v for d, v in panels.items() if len(v) < len(self.grid[d])}
+        which = ("; only the panels whose P(pounding) is nearest 0.5, the slowest to settle: "
+                 + "; ".join(f"{dim_text(d)} {', '.join(value_text(d, x) for x in v)}" for d, v in cut.items())) if cut else ""
         items = []
         running = {
-            "pounding": (running_pounding_probability(self.sample("impacts"), confidence=self.confidence), "probability", 1.0, "P(pounding)"),
-            "peak": (running_mean(self.sample(PEAK_DISPLACEMENT.variable), confidence=self.confidence), "mean", CM, "mean peak total displacement (cm)"),
+            "pounding": (of_first(lambda first: pounding_probability(first, confidence=self.confidence), self.sample("impacts"), counts),
+                         "probability", 1.0, "P(pounding)", "Clopper–Pearson"),
+            "peak": (of_first(lambda first: mean_interval(first, confidence=self.confidence, method="bootstrap"), self.sample(PEAK_DISPLACEMENT.variable), counts),
+                     "mean", CM, "mean peak total displacement (cm)", "percentile-bootstrap"),
         }
-        for key, (estimate, field, factor, y_label) in running.items():
+        for key, (estimate, field, factor, y_label, method) in running.items():
             estimate = estimate.compute()
-            n = np.arange(1, self.size + 1)
 
             def curves(panel: dict[str, Any], estimate: xr.Dataset = estimate, field: str = field, factor: float = factor) -> list[figures.Curve]:
                 result = []
@@ -264,23 +290,42 @@ class Ensemble:
                     where = {**panel, **({line_dim: value} if line_dim else {})}
                     cell = estimate.sel(where)
                     result.append(figures.Curve(
-                        line_label(line_dim, value), n, cell[field].values * factor, cell["lower"].values * factor, cell["upper"].values * factor,
-                        colour, gid=self.gid(where),
+                        line_label(line_dim, value), counts, cell[field].values * factor, cell["lower"].values * factor, cell["upper"].values * factor,
+                        colour, marker="o", gid=self.gid(where),
                     ))
                 return result
 
+            what = y_label.split(" (")[0]
             items += self.facet_figures(
                 f"convergence-{key}", [line_dim], curves, "realizations", y_label,
-                f"convergence: the running estimate of the {y_label.split(' (')[0]} over the first n realizations, with its {self.confidence:.0%} band",
-                title=f"running {y_label.split(' (')[0]}", log_x=True, legend_title=dim_text(line_dim) if line_dim else "",
+                f"convergence: the {what} estimated from the first n realizations (n = {', '.join(map(str, counts))}), with its "
+                f"{self.confidence:.0%} {method} band{which}",
+                title=f"{what} against the number of realizations", log_x=True, legend_title=dim_text(line_dim) if line_dim else "",
+                panel_grid=panels,
             )
         return items
 
+    def _slowest_panels(self, line_dim: str | None) -> dict[str, list[Any]]:
+        """The panel axes of a convergence figure, the longest cut (repeatedly) to its values with P(pounding) nearest 0.5, to at most :data:`CONVERGENCE_PANELS` panels."""
+        panels = {d: list(v) for d, v in self.grid.items() if d != line_dim}
+        probability = self.statistics["pounding_probability"]
+        while math.prod(len(v) for v in panels.values()) > CONVERGENCE_PANELS:
+            dim = max(panels, key=lambda d: len(panels[d]))
+            if len(panels[dim]) == 1:
+                break
+            others = math.prod(len(v) for d, v in panels.items() if d != dim)
+            keep = max(1, min(len(panels[dim]) - 1, CONVERGENCE_PANELS // others))
+            distance = abs(probability.mean([d for d in probability.dims if d != dim]).sel({dim: panels[dim]}).values - 0.5)
+            kept = sorted(np.argsort(distance, kind="stable")[:keep])
+            panels[dim] = [panels[dim][i] for i in kept]
+        return panels
+
     def facet_figures(
-        self, kind: str, drawn: Sequence[str | None], curves: Callable[[dict[str, Any]], list[figures.Curve]], x_label: str, y_label: str, what: str, title: str = "", **options: Any
+        self, kind: str, drawn: Sequence[str | None], curves: Callable[[dict[str, Any]], list[figures.Curve]], x_label: str, y_label: str, what: str, title: str = "",
+        panel_grid: dict[str, list[Any]] | None = None, **options: Any
     ) -> list[FigureItem]:
-        """One figure per layout of the dimensions not ``drawn`` (each combination a panel)."""
-        panel_grid = {d: v for d, v in self.grid.items() if d not in drawn}
+        """One figure per layout of the dimensions not ``drawn`` (each combination a panel; ``panel_grid``: only those values of them)."""
+        panel_grid = panel_grid if panel_grid is not None else {d: v for d, v in self.grid.items() if d not in drawn}
         plans = layouts(panel_grid)
         items = []
         for number, layout in enumerate(plans, start=1):

@@ -19,7 +19,7 @@ import xarray as xr
 
 from stochpound.report import figures
 from stochpound.report.document import Block, FigureItem, Paragraph, Section, Table
-from stochpound.report.ensemble_findings import compare_ensembles, ensemble_findings
+from stochpound.report.ensemble_findings import compare_ensembles, ensemble_findings, isolation_across
 from stochpound.report.ensembles import Ensemble
 from stochpound.report.facets import dim_text, is_gap, labels_text, layouts, line_colours, plain, value_text, cell_gid
 
@@ -45,14 +45,20 @@ AGAINST = {
 }
 
 
-def store_section(name: str, store: xr.Dataset) -> Section:
-    """A section for one store: description, its records' cases, its ensembles."""
+def store_section(name: str, store: xr.Dataset, contact_free: bool = False) -> Section:
+    """A section for one store: description, its records' cases, its ensembles.
+
+    ``contact_free``: ``store`` is a store's cases with contacts, its
+    contact-free (``inf``) gap values left for the Separation section; the
+    dimensions then count them, and say so.
+    """
     section = Section(f"Experiment {name}", key=f"experiment-{name}")
-    dims = {dim: store.sizes[dim] for dim in store["case_status"].dims}
+    dims = [f"{d} ({store.sizes[d] + 1}: {store.sizes[d]} gaps here and the contact-free one of the Separation section)" if contact_free and is_gap(d)
+            else f"{d} ({store.sizes[d]})" for d in store["case_status"].dims]
     section.add(Paragraph(
         f"{store.attrs.get('experiment_description', '')} Studied building: {store.attrs.get('studied_building', '')}; its "
         f"top-floor total displacement is the response, and its peaks are those shown. Dimensions: "
-        f"{', '.join(f'{d} ({n})' for d, n in dims.items())}; {int(store.attrs.get('cases_done', 0))} of "
+        f"{', '.join(dims)}; {int(store.attrs.get('cases_done', 0))} of "
         f"{int(store.attrs.get('cases_total', 0))} runs done (Methods describes every building, contact and motion)."
     ))
     kinds = dict(zip(store["record"].values.tolist(), store["record_kind"].values.tolist()))
@@ -63,6 +69,9 @@ def store_section(name: str, store: xr.Dataset) -> Section:
     ensembles = [Ensemble(name, store, label) for label, kind in kinds.items() if kind == "synthetic"]
     for ensemble in ensembles[1:]:
         section.add(compare_ensembles(ensembles[0], ensemble))
+    across = isolation_across(ensembles)
+    if across is not None:
+        section.add(across)
     for ensemble in ensembles:
         for block in [*ensemble_findings(ensemble), *ensemble.blocks()]:
             section.add(block)
@@ -99,6 +108,7 @@ def summary_table(name: str, data: xr.Dataset) -> Table:
         note="std, skewness and excess (kurtosis − 3) of the studied building's top-floor total displacement over time; peak "
         "impact force 0 where a case has no impact; μ fixed: a fixed base.",
         formats={"impacts": "{:.0f}", "in-phase": "{:.0f}", "out-of-phase": "{:.0f}"},
+        per_cell=True,
     )
 
 

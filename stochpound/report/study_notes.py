@@ -92,17 +92,22 @@ def _zoom(runs: dict) -> tuple[float, float]:
     return (max(float(starts.min()) - 1.0, 0.0), float(starts.max()) + 2.0)
 
 
+def scaled_runs(store: xr.Dataset, scales: tuple[float, ...] = SCALES, **labels: object) -> list[xr.Dataset]:
+    """The case of ``store`` at ``labels`` rerun with its record scaled by each of ``scales`` (the record-scaling noise of a single-record answer)."""
+    scene = case_scene(store, **labels)
+    motion = scene.motion
+    return [stochpound.simulate(dataclasses.replace(scene, motion=SampledMotion(motion.dt, motion.values * scale, motion.interpolation,
+                                                                                   f"{motion.description} x {scale:g}")))
+            for scale in scales]
+
+
 def scaling_sensitivity(pair_mu: xr.Dataset, mu: float = 0.2, gap: float = 0.02, record: str = "el_centro") -> list[Block]:
     """The μ = ``mu`` cases of Tables 4.1–4.7 rerun with the record scaled by :data:`SCALES`: impacts and mean."""
     rows = {}
     for isolation in ("b1_isolated", "both_isolated"):
         for neighbour in NEIGHBOURS:
-            scene = case_scene(pair_mu, isolation=isolation, neighbour=neighbour, model="corrected", gap=gap, mu=mu, record=record)
-            motion = scene.motion
             cells = []
-            for scale in SCALES:
-                scaled = SampledMotion(motion.dt, motion.values * scale, motion.interpolation, f"{motion.description} x {scale:g}")
-                run = stochpound.simulate(dataclasses.replace(scene, motion=scaled))
+            for run in scaled_runs(pair_mu, isolation=isolation, neighbour=neighbour, model="corrected", gap=gap, mu=mu, record=record):
                 top = run["total_displacement"].sel(building="B1").isel(floor=-1).values
                 cells += [run.sizes["impact"], float(np.mean(top)) * CM]
             rows[(CONFIGURATIONS[isolation], f"B2 {neighbour}")] = cells

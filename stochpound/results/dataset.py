@@ -48,6 +48,7 @@ def build_dataset(scene: Scene, system: System, recorder: Recorder, counters: Ev
         **_contact_variables(scene),
         **(_wall_variables(scene, recorder) if scene.walls else {}),
         **_closure_variables(recorder, system.n_contacts, "contact"),
+        **_contact_displacement_variables(recorder),
         **(_closure_variables(recorder, system.n_contacts, "wall") if scene.walls else {}),
         **_impact_variables(recorder, system.n_contacts, bool(scene.walls)),
         **(_demand_variables(scene, recorder) if recorder.demands else {}),
@@ -111,13 +112,23 @@ def _response_variables(scene: Scene, system: System, recorder: Recorder) -> dic
 
 def _closure_variables(recorder: Recorder, n_contacts: int, kind: str) -> dict[str, tuple]:
     """The closure over time of each contact (``kind`` "contact", the first ``n_contacts`` elements) or wall, and its peak over the run, located on the solution."""
-    rows = slice(0, n_contacts) if kind == "contact" else slice(n_contacts, recorder.system.n_elements)  # the demand monitors follow the elements
+    rows = slice(0, n_contacts) if kind == "contact" else slice(n_contacts, recorder.system.n_elements)  # the other monitors follow the elements
     toward = "y_left - y_right of the contact's floors" if kind == "contact" else "the level's displacement toward the wall"
     return {
         f"{kind}_closure": _var((kind, "time"), recorder.closure()[rows], "m", f"closure {toward} (the gap is closed where it reaches the gap)"),
         f"peak_{kind}_closure": _var((kind,), recorder.peaks[0, rows], "m", "largest closure over the run: the separation this run needed"),
         f"peak_{kind}_closure_time": _var((kind,), recorder.peaks[1, rows], "s", "time of the largest closure"),
     }
+
+
+def _contact_displacement_variables(recorder: Recorder) -> dict[str, tuple]:
+    """The largest abs(y) of each contact's two floors over the run and when, located on the solution (the separation rules' u1, u2)."""
+    variables = {}
+    for side, (value, when) in zip(("left", "right"), recorder.contact_displacement_peaks()):
+        variables[f"peak_contact_displacement_{side}"] = _var(("contact",), value, "m",
+                                                              f"largest |y| of the contact's {side} floor over the run (y = s + u)")
+        variables[f"peak_contact_displacement_{side}_time"] = _var(("contact",), when, "s", f"time of the largest |y| of the contact's {side} floor")
+    return variables
 
 
 _DEMAND_NAMES = {
