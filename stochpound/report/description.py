@@ -227,10 +227,22 @@ def contacts_table(definitions: Iterable[StoreDefinition]) -> Table | None:
         "The contact (impact) elements as run: floors joined, law with its parameters, at-rest gap and separation rule.",
         ["between", "law", "gap (m)", "separation"],
         rows,
-        "m_eff = m1 m2 / (m1 + m2) of the two floor masses (against a wall, the level's own mass); a Kelvin–Voigt element's dashpot from "
-        "a restitution e is c = 2 ξ √(k m_eff), ξ = −ln e / √(π² + ln² e). A wall is rigid in that it moves with the ground and has no "
-        "mass of its own; it is reached through its contact element, which it penetrates as that element's stiffness allows.",
+        _contacts_note(definitions),
     )
+
+
+def _contacts_note(definitions: Iterable[StoreDefinition]) -> str:
+    """The contacts table's note: m_eff, then what only the laws and walls that ran need said."""
+    scenes = [configuration.scene for definition in definitions for configuration in definition.configurations]
+    walls = any(scene.walls for scene in scenes)
+    ran = {element.law for scene in scenes for element in (*scene.contacts, *scene.walls)}
+    note = "m_eff = m1 m2 / (m1 + m2) of the two floor masses" + (" (against a wall, the level's own mass)." if walls else ".")
+    if laws.DEFAULT_CONTACT_LAW in ran:
+        note += (" A Kelvin–Voigt element's dashpot from a restitution e is c = 2 ξ √(k m_eff), ξ = −ln e / √(π² + ln² e).")
+    if walls:
+        note += (" A wall is rigid in that it moves with the ground and has no mass of its own; it is reached through its contact "
+                 "element, which it penetrates as that element's stiffness allows.")
+    return note
 
 
 def _where(uses: list[tuple[StoreDefinition, Configuration]]) -> str:
