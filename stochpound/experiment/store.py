@@ -270,10 +270,11 @@ def _dim_coordinate(experiment: Experiment, dim: Dim) -> xr.Variable:
     if dim.kind == "variant":
         return xr.Variable((dim.name,), np.array(dim.values, dtype=object), {"units": "1", "long_name": f"variant of axis {dim.name}"})
     if dim.kind == "gap":
-        gap = next(g for g in experiment.definition["gaps"] if g["name"] == dim.name)
-        return xr.Variable((dim.name,), np.array(dim.values, float), {"units": "m", "long_name": f"at-rest gap of contacts {gap['contacts']}"})
+        gap = experiment.contract.gap_axis(dim.name)
+        walls = f" and walls {list(gap.walls)}" if gap.walls else ""
+        return xr.Variable((dim.name,), np.array(dim.values, float), {"units": "m", "long_name": f"at-rest gap of contacts {list(gap.contacts)}{walls}"})
     if dim.kind == "mu":
-        chosen = experiment.definition["mu"]["buildings"]
+        chosen = experiment.contract.mu.buildings
         which = ", ".join(chosen) if chosen else "every isolated building"
         return xr.Variable(("mu",), np.array(dim.values, float), {"units": "1", "long_name": f"friction coefficient of {which} (inf: fixed base)"})
     if dim.kind == "record":

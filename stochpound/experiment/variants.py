@@ -129,10 +129,12 @@ def scale_masses(scene: dict[str, Any], name: str, factor: float) -> None:
             contact_law.rescale_table(wall, factor)
 
 
-def set_gaps(scene: dict[str, Any], contacts: Iterable[int], gap: float) -> None:
-    """Set the gap (m) of the given contacts (0-based indices) in place."""
+def set_gaps(scene: dict[str, Any], contacts: Iterable[int], gap: float, walls: Iterable[int] = ()) -> None:
+    """Set the gap (m) of the given contacts and walls (0-based indices into ``contact`` and ``wall``) in place."""
     for index in contacts:
         scene["contact"][index]["gap"] = float(gap)
+    for index in walls:
+        scene["wall"][index]["gap"] = float(gap)
 
 
 def set_mu(scene: dict[str, Any], buildings: Iterable[str] | None, mu: float) -> list[str]:

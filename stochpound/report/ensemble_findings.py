@@ -20,7 +20,8 @@ import xarray as xr
 from stochpound.analysis import kernels
 from stochpound.report.document import Block, Paragraph, Table
 from stochpound.report.ensembles import CM, Ensemble
-from stochpound.report.facets import dim_text, is_gap, labels_text, value_text
+from stochpound.experiment.definition import is_gap_axis
+from stochpound.report.facets import dim_text, labels_text, value_text
 
 #: Estimates compared between a sliding and a fixed base: statistic -> label.
 COMPARED = {
@@ -36,7 +37,7 @@ def ensemble_findings(ensemble: Ensemble) -> list[Block]:
     """Every finding that applies to the ensemble's grid."""
     blocks: list[Block] = [precision(ensemble), spread(ensemble)]
     for dim in ensemble.grid:
-        if is_gap(dim) and len(ensemble.grid[dim]) > 1:
+        if is_gap_axis(dim) and len(ensemble.grid[dim]) > 1:
             blocks += gap_effect(ensemble, dim)
     mus = ensemble.grid.get("mu", [])
     if any(math.isinf(m) for m in mus) and any(not math.isinf(m) for m in mus):

@@ -32,7 +32,8 @@ from stochpound.analysis.separation import TARGET_PROBABILITIES
 from stochpound.report import figures
 from stochpound.report.document import Block, FigureItem, Paragraph, Section, Table
 from stochpound.report.ensembles import Ensemble, line_label, lines, table_frame
-from stochpound.report.facets import dim_text, is_gap, labels_text, value_text
+from stochpound.experiment.definition import is_gap_axis
+from stochpound.report.facets import dim_text, labels_text, value_text
 
 CM = 100.0
 RULE_TEXT = {
@@ -47,7 +48,7 @@ CURVE_PROBABILITIES = tuple(np.round(np.geomspace(0.005, 0.9, 31), 5))
 
 def gap_dims(store: xr.Dataset) -> list[str]:
     """The store's gap axes."""
-    return [d for d in store["case_status"].dims if is_gap(d)]
+    return [d for d in store["case_status"].dims if is_gap_axis(d)]
 
 
 def has_contact_free(store: xr.Dataset) -> bool:
