@@ -26,6 +26,7 @@ from pathlib import Path
 from typing import Any, Iterator, Mapping
 
 from stochpound.errors import SceneError
+from stochpound.experiment.catalogue import TIME_HISTORIES
 from stochpound.experiment.definition import is_gap_axis, read_definition
 from stochpound.experiment.intensity import parse_intensity
 from stochpound.model import fields as toml_fields
@@ -58,23 +59,8 @@ _RESERVED_DIMS = {
     "start", "end", "duration", "peak_force", "peak_time", "impulse", "onset_velocity", "in_phase", "complete", "case_id",
 }
 
-#: Time-history variables of a result that an experiment can keep.
-TIME_HISTORY_VARIABLES = (
-    "total_displacement",
-    "relative_displacement",
-    "sliding_displacement",
-    "ground_acceleration",
-    "impact_force",
-    "base_friction_force",
-    "base_state",
-    "energy_input",
-    "energy_kinetic",
-    "energy_strain",
-    "energy_damping",
-    "energy_friction",
-    "energy_impact",
-    "energy_residual",
-)
+#: Time-history variables of a result that an experiment can keep (declared in :mod:`stochpound.experiment.catalogue`).
+TIME_HISTORY_VARIABLES = tuple(TIME_HISTORIES)
 
 
 class ExperimentError(SceneError):
