@@ -11,34 +11,36 @@ attribute, a dict — goes through :func:`read_definition`, which returns a
 dict stays the stored form; :meth:`Definition.to_dict` gives it back unchanged.
 
 The rules that name parts of a grid live here once: a gap axis is ``gap`` or
-``gap_<name>`` (:func:`is_gap_axis`), and μ = ∞ is a fixed base
-(:data:`FIXED_BASE`, :func:`is_fixed_base`).
+``gap_<name>`` (:func:`is_gap_axis`); that μ = ∞ is a fixed base
+(:data:`FIXED_BASE`, :func:`is_fixed_base`) is the model's rule
+(:mod:`stochpound.model.friction`), given here too.
 """
 
 from __future__ import annotations
 
 import copy
 import json
-import math
 import re
 from dataclasses import dataclass
 from typing import Any, Mapping
 
-#: The value of μ that stands for a fixed base (no sliding base at all): ∞.
-FIXED_BASE = math.inf
+from stochpound.model.friction import FIXED_BASE, is_fixed_base
+
+__all__ = [
+    "FIXED_BASE",
+    "Definition",
+    "GapAxis",
+    "MotionSource",
+    "MuAxis",
+    "Output",
+    "Solver",
+    "VariantAxis",
+    "is_fixed_base",
+    "is_gap_axis",
+    "read_definition",
+]
 
 _GAP_AXIS = re.compile(r"^gap(_[A-Za-z0-9_]+)?$")
-
-
-def is_fixed_base(mu: float | str) -> bool:
-    """Whether a friction coefficient stands for a fixed base (μ = ∞, :data:`FIXED_BASE`).
-
-    Parameters
-    ----------
-    mu : float or str
-        Friction coefficient (dimensionless); a store's JSON spells ∞ ``"inf"``.
-    """
-    return math.isinf(float(mu))
 
 
 def is_gap_axis(name: str) -> bool:

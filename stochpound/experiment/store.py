@@ -37,7 +37,9 @@ from stochpound.experiment.model import CASE, REFERENCE, Dim, Experiment
 from stochpound.experiment.spec import ExperimentError, canonical_json
 from stochpound.experiment.catalogue import CASE_SUMMARIES, IMPACT_TABLE, REFERENCE_HISTORY, REFERENCE_SUMMARIES, TIME_HISTORIES, StoreVariable
 from stochpound.experiment.summary import DEMAND_SUMMARIES
+from stochpound.model.scene_file import scene_from_dict
 from stochpound.motions.records.suites import METADATA_FIELDS
+from stochpound.results.dataset import scene_parameters
 
 #: Version of the store layout.
 STORE_FORMAT = 1
@@ -232,8 +234,34 @@ def _coordinates(experiment: Experiment, motion_grids: Mapping[str, tuple[float,
     coords["building"] = xr.Variable(("building",), np.array(experiment.building_names, dtype=object), {"units": "1", "long_name": "building name, left to right"})
     coords["floor"] = xr.Variable(("floor",), np.arange(1, experiment.max_floors + 1), {"units": "1", "long_name": "floor number, 1 = lowest"})
     coords["contact"] = xr.Variable(("contact",), np.arange(len(scene.get("contact", []))), {"units": "1", "long_name": "contact index"})
+    coords.update(_scene_coordinates(experiment))
     if experiment.output["time_histories"]:
         coords["time"] = xr.Variable(("time",), union_times(motion_grids), {"units": "s", "long_name": "time (union of the motions' sample times)"})
+    return coords
+
+
+def _scene_coordinates(experiment: Experiment) -> dict[str, xr.Variable]:
+    """What each grid point ran, as a result names it (:func:`stochpound.results.dataset.scene_parameters`): the bases and the contacts' laws.
+
+    On the case dimensions without ``record`` and ``realization``, then ``building`` or ``contact``
+    (walls, whose number a variant may change, are left out: the definition gives them).
+    """
+    points = experiment.points(CASE)
+    dims = tuple(d.name for d in experiment.kind_dims(CASE)[:-2])
+    shape = experiment.grid_shape(CASE)[:-2]
+    columns: dict[str, list[np.ndarray]] = {}
+    attrs: dict[str, tuple[tuple[str, ...], dict[str, Any]]] = {}
+    for point in points:
+        scene = scene_from_dict(experiment.structure(point), base_dir=experiment.base_dir)
+        for name, (variable_dims, values, variable_attrs) in scene_parameters(scene).items():
+            if variable_dims in (("building",), ("contact",)):
+                columns.setdefault(name, []).append(np.asarray(values))
+                attrs[name] = (variable_dims, variable_attrs)
+    coords = {}
+    for name, values in columns.items():
+        variable_dims, variable_attrs = attrs[name]
+        data = np.stack(values).reshape(shape + values[0].shape)
+        coords[name] = xr.Variable(dims + variable_dims, data.astype(object) if data.dtype.kind == "U" else data, variable_attrs)
     return coords
 
 

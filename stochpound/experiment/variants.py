@@ -19,12 +19,12 @@ masses by f (floors and base) keeps its dynamics consistent:
 from __future__ import annotations
 
 import copy
-import math
 from typing import Any, Iterable, Mapping
 
 from stochpound.model import building as building_law
 from stochpound.model import contact as contact_law
 from stochpound.model.contact import ELEMENT_KEYS, effective_mass
+from stochpound.model.friction import is_fixed_base
 
 #: Motion used while validating a scene's structure (the real motion is set per case).
 PLACEHOLDER_MOTION = {"type": "constant", "acceleration": 0.0, "duration": 1.0, "dt": 1.0}
@@ -160,14 +160,14 @@ def set_mu(scene: dict[str, Any], buildings: Iterable[str] | None, mu: float) ->
     missing = []
     for name in chosen:
         building = building_table(scene, name)
-        if math.isinf(mu):
+        if is_fixed_base(mu):
             building.pop("base", None)
         elif isinstance(building.get("base"), dict):
             building["base"]["mu"] = float(mu)
             building["base"]["mu_static"] = float(mu)
         else:
             missing.append(name)
-    if buildings is None and not chosen and not math.isinf(mu):
+    if buildings is None and not chosen and not is_fixed_base(mu):
         missing.append("(no building has a [building.base])")
     return missing
 
