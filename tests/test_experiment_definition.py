@@ -141,3 +141,15 @@ def test_gap_axis_wall_errors() -> None:
     assert n_contacts > 0
     with pytest.raises(ExperimentError, match="grid.gap_w.walls: the base scene has no wall"):
         parse_experiment({**pair, "grid": {"gap_w": {"values": [0.1], "walls": [0]}}}, base_dir=ROOT / "experiments")
+
+
+def test_report_names_the_gap_axis_of_walls() -> None:
+    """The report's table of contacts gives a wall's gap as the axis that sets it, read from the store's definition alone."""
+    from stochpound.report.description import StoreDefinition, contacts_table
+
+    definition = parse_experiment(_moat({"mu": {"values": [0.05, 0.1], "buildings": ["B1"]}, "gap_wall": {"values": [0.05, 0.1, "inf"], "walls": [0, 1]}}))
+    store = xr.Dataset(attrs={"definition": canonical_json(definition)})
+    table = contacts_table([StoreDefinition("moat", store)])
+    assert table is not None
+    cells = set(table.frame.astype(str).values.ravel())
+    assert "{0.05, 0.1, ∞} (axis gap_wall)" in cells

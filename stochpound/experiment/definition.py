@@ -274,6 +274,10 @@ class Definition:
         """The gap axis that sets a contact's gap, if any."""
         return next((g for g in self.gaps if contact in g.contacts), None)
 
+    def wall_gap_axis(self, wall: int) -> GapAxis | None:
+        """The gap axis that sets a wall's gap, if any."""
+        return next((g for g in self.gaps if wall in g.walls), None)
+
     def motion(self, label: str) -> MotionSource:
         """The motion labelled ``label`` (KeyError if none)."""
         for motion in self.motions:

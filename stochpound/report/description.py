@@ -202,14 +202,15 @@ def _contact_row(definition: StoreDefinition, scene: Scene, index: int, contact:
     )
 
 
-def _wall_row(scene: Scene, wall: Wall) -> tuple[str, ...]:
+def _wall_row(definition: StoreDefinition, scene: Scene, index: int, wall: Wall) -> tuple[str, ...]:
     building = scene.buildings[wall.building]
+    axis = definition.definition.wall_gap_axis(index)
     mass = building.base.mass if wall.level == 0 and building.base is not None else building.mass[max(wall.level, 1) - 1]
     level = "base" if wall.level == 0 else f"floor {wall.level}"
     return (
         f"{building.name} {level} – rigid wall on its {'right' if wall.side > 0 else 'left'}",
         "linear Kelvin–Voigt",
-        number(wall.gap),
+        f"{{{numbers(axis.values)}}} (axis {axis.name})" if axis else number(wall.gap),
         number(wall.stiffness),
         number(wall.damping),
         number(wall.restitution) if wall.restitution is not None else "– (dashpot given)",
@@ -225,8 +226,8 @@ def contacts_table(definitions: Iterable[StoreDefinition]) -> Table | None:
         for configuration in definition.configurations:
             for index, contact in enumerate(configuration.scene.contacts):
                 rows.setdefault(_contact_row(definition, configuration.scene, index, contact), []).append((definition, configuration))
-            for wall in configuration.scene.walls:
-                rows.setdefault(_wall_row(configuration.scene, wall), []).append((definition, configuration))
+            for index, wall in enumerate(configuration.scene.walls):
+                rows.setdefault(_wall_row(definition, configuration.scene, index, wall), []).append((definition, configuration))
     if not rows:
         return None
     return _merged_table(
