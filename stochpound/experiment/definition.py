@@ -92,7 +92,7 @@ class MuAxis:
     buildings: tuple[str, ...] | None
 
     def sets(self, building: str, has_base: bool) -> bool:
-        """Whether the axis sets this building's friction (a building in :attr:`buildings`, or any building on a base)."""
+        """Whether the axis sets this building's friction (a building in ``buildings``, or any building on a base)."""
         return building in self.buildings if self.buildings is not None else has_base
 
     @property
