@@ -43,7 +43,8 @@ numpydoc_xref_aliases = {
     name: f"stochpound.{module}.{name}" if module else f"stochpound.{name}"
     for module, names in {
         "model": ["Scene", "Building", "InitialState", "Base", "Contact", "Wall", "ImpactElement"],
-        "experiment": ["Experiment", "Dim", "Case", "RunReport", "StatusReport", "ExperimentError"],
+        "experiment": ["Experiment", "Dim", "Case", "RunReport", "StatusReport", "ExperimentError", "Definition", "GapAxis", "MuAxis",
+                       "VariantAxis", "MotionSource", "Output", "Solver"],
         "motions": ["Envelope", "FilteredWhiteNoise", "SoilPreset"],
         "motions.records": ["Record", "RegistryEntry", "RawSeries", "RecordStatistics"],
         "": ["SceneError", "RecordError", "StochpoundError"],

@@ -142,14 +142,14 @@ def cli_process(*args: str, env: dict | None = None) -> subprocess.Popen:
 
 def done_cases(store: Path) -> int:
     """Finished cases in a store's parts folder."""
-    from stochpound.experiment.parts import read_definition, parts_folder
+    from stochpound.experiment.parts import parts_folder, read_experiment_json
     from stochpound.experiment.model import Experiment
     from stochpound.experiment.store_writer import PartsIndex
 
     folder = parts_folder(store)
     if not (folder / "experiment.json").is_file():
         return 0
-    return PartsIndex.scan(Experiment(read_definition(folder)["definition"]), folder).n_done
+    return PartsIndex.scan(Experiment(read_experiment_json(folder)["definition"]), folder).n_done
 
 
 def assert_same_results(first: Path, second: Path) -> None:

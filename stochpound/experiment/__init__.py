@@ -8,6 +8,19 @@
 File format, store layout, resumption and clusters: ``docs/experiments.md``.
 """
 
+from stochpound.experiment.definition import (
+    FIXED_BASE,
+    Definition,
+    GapAxis,
+    MotionSource,
+    MuAxis,
+    Output,
+    Solver,
+    VariantAxis,
+    is_fixed_base,
+    is_gap_axis,
+    read_definition,
+)
 from stochpound.experiment.model import Case, Dim, Experiment
 from stochpound.experiment.runner import RunReport, default_store, load_experiment, run_experiment
 from stochpound.experiment.spec import ExperimentError
@@ -15,15 +28,26 @@ from stochpound.experiment.status import StatusReport, store_status
 from stochpound.experiment.store import open_store
 
 __all__ = [
+    "FIXED_BASE",
     "Case",
+    "Definition",
     "Dim",
     "Experiment",
     "ExperimentError",
+    "GapAxis",
+    "MotionSource",
+    "MuAxis",
+    "Output",
     "RunReport",
+    "Solver",
     "StatusReport",
+    "VariantAxis",
     "default_store",
+    "is_fixed_base",
+    "is_gap_axis",
     "load_experiment",
     "open_store",
+    "read_definition",
     "run_experiment",
     "store_status",
 ]

@@ -33,6 +33,7 @@ from typing import Any, Mapping
 import numpy as np
 
 from stochpound.model import fields as toml_fields
+from stochpound.model.friction import is_fixed_base
 from stochpound.motions.measures import arias_intensity, peak_ground_motion, significant_duration
 from stochpound.motions.spectrum import response_spectrum
 
@@ -148,14 +149,14 @@ def inhomogeneity(scene: Mapping[str, Any], variants: list[dict[str, Any]], mu: 
     """Why a scene's contact-free response is not homogeneous in the input ("" if it is)."""
     if scene.get("wall"):
         return "the scene has walls"
-    if mu is not None and any(math.isfinite(value) for value in mu["values"]):
+    if mu is not None and any(not is_fixed_base(value) for value in mu["values"]):
         return "grid.mu has finite friction coefficients (sliding bases)"
     tables = [("scene", b) for b in scene.get("building", [])]
     for variant in variants:
         for value, override in variant["overrides"].items():
             tables += [(f"variants.{variant['name']}.{value}", b) for b in override.get("building", {}).values()]
     for where, building in tables:
-        if isinstance(building.get("base"), dict) and (mu is None or any(math.isfinite(v) for v in mu["values"])):
+        if isinstance(building.get("base"), dict) and (mu is None or any(not is_fixed_base(v) for v in mu["values"])):
             return f"{where}: a building on a sliding base"
         if building.get("initial"):
             return f"{where}: a building not at rest at t = 0"

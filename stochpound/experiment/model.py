@@ -25,7 +25,8 @@ from typing import Any, Iterator, Mapping, Sequence
 import numpy as np
 
 from stochpound.errors import SceneError
-from stochpound.experiment.spec import ExperimentError, canonical_json, definition_sha256
+from stochpound.experiment.definition import Definition, read_definition
+from stochpound.experiment.spec import ExperimentError, canonical_json
 from stochpound.experiment.variants import (
     PLACEHOLDER_MOTION,
     apply_overrides,
@@ -138,8 +139,9 @@ class Experiment:
 
     Parameters
     ----------
-    definition : mapping
-        Canonical definition (``stochpound.experiment.spec.parse_experiment``).
+    definition : mapping or Definition
+        Canonical definition (``stochpound.experiment.spec.parse_experiment``), or
+        its typed form (:func:`~stochpound.experiment.read_definition`).
     text : str
         The experiment file's text (provenance).
     base_dir : str or Path
@@ -148,12 +150,13 @@ class Experiment:
         The experiment file, for provenance.
     """
 
-    def __init__(self, definition: Mapping[str, Any], text: str = "", base_dir: str | Path = ".", path: str = "") -> None:
-        self.definition = dict(definition)
+    def __init__(self, definition: Mapping[str, Any] | Definition, text: str = "", base_dir: str | Path = ".", path: str = "") -> None:
+        self.contract: Definition = read_definition(definition)
+        self.definition = self.contract.to_dict()
         self.text = text
         self.base_dir = Path(base_dir)
         self.path = path
-        self.sha256 = definition_sha256(self.definition)
+        self.sha256 = self.contract.sha256
         self.name: str = self.definition["name"]
         self.studied: str = self.definition["studied"]
         self.variants: list[dict[str, Any]] = self.definition["variants"]
@@ -190,9 +193,9 @@ class Experiment:
     def grid_dims(self) -> list[Dim]:
         """Variant axes, gap axes and μ, in that order (the structural dimensions)."""
         dims = [Dim(v["name"], "variant", tuple(v["values"])) for v in self.variants]
-        dims += [Dim(g["name"], "gap", tuple(g["values"])) for g in self.definition["gaps"]]
-        if self.definition["mu"] is not None:
-            dims.append(Dim("mu", "mu", tuple(self.definition["mu"]["values"])))
+        dims += [Dim(g.name, "gap", g.values) for g in self.contract.gaps]
+        if self.contract.mu is not None:
+            dims.append(Dim("mu", "mu", self.contract.mu.values))
         return dims + self.intensity_dims
 
     @cached_property
@@ -337,13 +340,13 @@ class Experiment:
         if point.kind == REFERENCE:
             scene = reference_scene(scene, self.studied)
         else:
-            for gap in self.definition["gaps"]:
-                set_gaps(scene, gap["contacts"], labels[gap["name"]])
+            for gap in self.contract.gaps:
+                set_gaps(scene, gap.contacts, labels[gap.name], gap.walls)
             if self.intensity is not None and self.intensity["ran"] == "ida":  # contact-free: capacities come from the closures
                 set_gaps(scene, range(len(scene.get("contact", []))), float("inf"))
-            mu = self.definition["mu"]
+            mu = self.contract.mu
             if mu is not None:
-                missing = set_mu(scene, mu["buildings"], labels["mu"])
+                missing = set_mu(scene, mu.buildings, labels["mu"])
                 if missing:
                     raise ExperimentError(
                         f"grid.mu: building(s) {', '.join(missing)} have no [building.base] in {point.describe()}; "

@@ -251,7 +251,7 @@ def remove_temporaries(folder: Path) -> None:
         path.unlink(missing_ok=True)
 
 
-def read_definition(folder: Path) -> dict[str, Any]:
+def read_experiment_json(folder: Path) -> dict[str, Any]:
     """The contents of ``experiment.json`` (definition, sha256, text, motion grids, created)."""
     path = folder / DEFINITION_FILE
     try:
@@ -262,7 +262,7 @@ def read_definition(folder: Path) -> dict[str, Any]:
         raise ExperimentError(f"{path}: unreadable ({error}); use --restart to start the store again") from None
 
 
-def write_definition(folder: Path, record: dict[str, Any]) -> None:
+def write_experiment_json(folder: Path, record: dict[str, Any]) -> None:
     """Write ``experiment.json`` atomically."""
     atomic_write(folder / DEFINITION_FILE, lambda stream: stream.write(json.dumps(record, indent=1).encode()))
 

@@ -21,7 +21,7 @@ import numpy as np
 
 from stochpound import __version__
 from stochpound.experiment.model import KINDS, Experiment
-from stochpound.experiment.parts import DEFINITION_FILE, part_paths, parts_folder, read_definition, read_runs, write_definition
+from stochpound.experiment.parts import DEFINITION_FILE, part_paths, parts_folder, read_experiment_json, read_runs, write_experiment_json
 from stochpound.experiment.spec import ExperimentError, canonical_json
 from stochpound.experiment.store import PREFIX
 from stochpound.experiment.store_writer import PartsIndex, write_store
@@ -85,7 +85,7 @@ def check_store(store: Path, sha256: str) -> bool:
                 raise ExperimentError(f"{store}: made from a different experiment definition (sha256 {found[:12]}…, this one {sha256[:12]}…); {hint}")
     if parts:
         try:
-            found = read_definition(folder)["definition_sha256"]
+            found = read_experiment_json(folder)["definition_sha256"]
         except (ExperimentError, KeyError, TypeError) as error:
             raise ExperimentError(f"{folder}: unreadable parts folder ({error}); {hint}") from None
         if found != sha256:
@@ -180,7 +180,7 @@ class StoreSession:
         folder = parts_folder(store)
         folder.mkdir(parents=True, exist_ok=True)
         if (folder / DEFINITION_FILE).exists():
-            record = read_definition(folder)
+            record = read_experiment_json(folder)
         else:
             record = {
                 "definition_sha256": experiment.sha256,
@@ -192,7 +192,7 @@ class StoreSession:
                 "motion_grids": {k: list(v) for k, v in motion_grids.items()},
                 "created": now(),
             }
-            write_definition(folder, record)
+            write_experiment_json(folder, record)
         return cls(store, experiment, record)
 
     @classmethod
@@ -205,7 +205,7 @@ class StoreSession:
             If there is no parts folder or it is unreadable.
         """
         folder = parts_folder(store)
-        record = read_definition(folder)
+        record = read_experiment_json(folder)
         experiment = Experiment(record["definition"], record.get("text", ""), record.get("base_dir", "."), record.get("file", ""))
         return cls(store, experiment, record)
 

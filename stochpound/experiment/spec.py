@@ -26,6 +26,8 @@ from pathlib import Path
 from typing import Any, Iterator, Mapping
 
 from stochpound.errors import SceneError
+from stochpound.experiment.catalogue import TIME_HISTORIES
+from stochpound.experiment.definition import is_gap_axis, read_definition
 from stochpound.experiment.intensity import parse_intensity
 from stochpound.model import fields as toml_fields
 from stochpound.model.contact import ELEMENT_KEYS
@@ -50,7 +52,6 @@ MAX_REALIZATIONS = 10**8
 (a larger count is refused before anything is allocated; runs above
 :data:`~stochpound.experiment.estimate.LARGE_RUN_CASES` cases ask for ``--yes``)."""
 _ANALYTIC_TYPES = ("harmonic", "constant")
-_GAP_AXIS = re.compile(r"^gap(_[A-Za-z0-9_]+)?$")
 _DIM_NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
 _RESERVED_DIMS = {
     "mu", "record", "realization", "time", "building", "floor", "contact", "impact", "intensity", "spectrum_period",
@@ -58,23 +59,8 @@ _RESERVED_DIMS = {
     "start", "end", "duration", "peak_force", "peak_time", "impulse", "onset_velocity", "in_phase", "complete", "case_id",
 }
 
-#: Time-history variables of a result that an experiment can keep.
-TIME_HISTORY_VARIABLES = (
-    "total_displacement",
-    "relative_displacement",
-    "sliding_displacement",
-    "ground_acceleration",
-    "impact_force",
-    "base_friction_force",
-    "base_state",
-    "energy_input",
-    "energy_kinetic",
-    "energy_strain",
-    "energy_damping",
-    "energy_friction",
-    "energy_impact",
-    "energy_residual",
-)
+#: Time-history variables of a result that an experiment can keep (declared in :mod:`stochpound.experiment.catalogue`).
+TIME_HISTORY_VARIABLES = tuple(TIME_HISTORIES)
 
 
 class ExperimentError(SceneError):
@@ -188,14 +174,15 @@ def parse_experiment(data: Mapping[str, Any], base_dir: str | Path = ".", defaul
     grid = _table_or_error(data, "grid", "")
     known_axes = {v["name"] for v in variants}
     for key in grid:
-        if not (_GAP_AXIS.match(key) or key == "mu" or key in known_axes):
+        if not (is_gap_axis(key) or key == "mu" or key in known_axes):
             allowed = ["gap", "gap_<name>", "mu", *sorted(known_axes)]
             raise ExperimentError(f"grid.{key}: unknown axis (allowed: {', '.join(allowed)}; variant axes are declared in [variants.<axis>])")
     for variant in variants:
         variant["values"] = _variant_selection(grid, variant)
     n_contacts = len(scene.get("contact", []))
     contact_floors = [c.get("between", [[None, None]])[0][1] for c in scene.get("contact", [])]
-    gaps = [_gap_axis(key, grid[key], n_contacts, contact_floors) for key in grid if _GAP_AXIS.match(key)]
+    n_walls = len(scene.get("wall", []))
+    gaps = [_gap_axis(key, grid[key], n_contacts, contact_floors, n_walls) for key in grid if is_gap_axis(key)]
     mu = _mu_axis(grid["mu"], buildings) if "mu" in grid else None
     with field_errors():
         intensity = parse_intensity(data, scene, variants, gaps, mu)
@@ -214,6 +201,7 @@ def parse_experiment(data: Mapping[str, Any], base_dir: str | Path = ".", defaul
     }
     if intensity is not None:  # absent without [intensity]: the definitions (and hashes) of other files are unchanged
         definition["intensity"] = intensity
+    read_definition(definition)  # the typed definition reads every field parsed here
     return definition
 
 
@@ -263,7 +251,7 @@ def _variants(data: Mapping[str, Any], buildings: list[str], n_contacts: int) ->
 
 
 def _check_dim_name(name: str, where: str) -> None:
-    if not _DIM_NAME.match(name) or name in _RESERVED_DIMS or _GAP_AXIS.match(name):
+    if not _DIM_NAME.match(name) or name in _RESERVED_DIMS or is_gap_axis(name):
         raise ExperimentError(
             f"{where}: axis name must be a letter followed by letters, digits or _, and none of "
             f"{', '.join(sorted(_RESERVED_DIMS))}, gap, gap_*; got {name!r}"
@@ -369,19 +357,19 @@ def _numbers(values: Any, where: str, allow_inf: bool, inf_meaning: str = "a fix
     return numbers
 
 
-def _gap_axis(key: str, spec: Any, n_contacts: int, contact_floors: list[Any]) -> dict[str, Any]:
+def _gap_axis(key: str, spec: Any, n_contacts: int, contact_floors: list[Any], n_walls: int) -> dict[str, Any]:
+    """A gap axis: its contacts (every contact, or ``contacts`` / ``floors``) and, with ``walls``, the scene's walls it sets."""
     where = f"grid.{key}"
-    values, options = _axis_values(spec, where, {"contacts", "floors"})
+    values, options = _axis_values(spec, where, {"contacts", "floors", "walls"})
     gaps = _numbers(values, f"{where}.values" if options else where, allow_inf=True, inf_meaning="contact-free: the peak closure answers every gap")
-    if n_contacts == 0:
-        raise ExperimentError(f"{where}: the scene has no [[contact]] whose gap could vary")
-    contacts = list(range(n_contacts))
+    walls = _indices(options, "walls", where, n_walls, "wall") if "walls" in options else None
+    if n_contacts == 0 and walls is None:
+        raise ExperimentError(f"{where}: the scene has no [[contact]] whose gap could vary (give walls = [...] to vary the gap of walls)")
+    contacts = list(range(n_contacts)) if walls is None else []  # with walls only: the contacts keep their gaps
     if "contacts" in options and "floors" in options:
         raise ExperimentError(f"{where}: give contacts or floors, not both")
     if "contacts" in options:
-        contacts = options["contacts"]
-        if not isinstance(contacts, list) or not contacts or not all(isinstance(c, int) and not isinstance(c, bool) and 0 <= c < n_contacts for c in contacts):
-            raise ExperimentError(f"{where}.contacts: must be a non-empty list of contact indices in 0..{n_contacts - 1}, got {contacts!r}")
+        contacts = _indices(options, "contacts", where, n_contacts, "contact")
     if "floors" in options:
         floors = options["floors"]
         if not isinstance(floors, list) or not floors:
@@ -389,7 +377,20 @@ def _gap_axis(key: str, spec: Any, n_contacts: int, contact_floors: list[Any]) -
         contacts = [i for i, floor in enumerate(contact_floors) if floor in floors]
         if not contacts:
             raise ExperimentError(f"{where}.floors: no contact has its left floor in {floors!r} (contact floors: {contact_floors})")
-    return {"name": key, "values": gaps, "contacts": sorted(set(contacts))}
+    axis = {"name": key, "values": gaps, "contacts": sorted(set(contacts))}
+    if walls is not None:  # absent without walls: the definitions (and hashes) of other files are unchanged
+        axis["walls"] = walls
+    return axis
+
+
+def _indices(options: Mapping[str, Any], key: str, where: str, count: int, what: str) -> list[int]:
+    """``options[key]``: a non-empty list of indices in 0..count-1, sorted and without repeats."""
+    chosen = options[key]
+    if count == 0:
+        raise ExperimentError(f"{where}.{key}: the base scene has no {what}")
+    if not isinstance(chosen, list) or not chosen or not all(isinstance(c, int) and not isinstance(c, bool) and 0 <= c < count for c in chosen):
+        raise ExperimentError(f"{where}.{key}: must be a non-empty list of {what} indices in 0..{count - 1}, got {chosen!r}")
+    return sorted(set(chosen))
 
 
 def _mu_axis(spec: Any, buildings: list[str]) -> dict[str, Any]:

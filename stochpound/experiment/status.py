@@ -3,13 +3,13 @@
 from __future__ import annotations
 
 import itertools
-import json
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Iterator
 
 import numpy as np
 
+from stochpound.experiment.definition import read_definition
 from stochpound.experiment.model import KINDS, Case, Experiment
 from stochpound.experiment.parts import DEFINITION_FILE, FolderLock, parts_folder
 from stochpound.experiment.session import StoreSession
@@ -101,7 +101,7 @@ def _from_file(store: Path) -> StatusReport:
     """Status from the store file alone (its parts folder was removed)."""
     dataset = open_store(store)
     try:
-        experiment = Experiment(json.loads(dataset.attrs["definition"]), str(dataset.attrs.get("experiment_text", "")))
+        experiment = Experiment(read_definition(dataset), str(dataset.attrs.get("experiment_text", "")))
         done = {kind: dataset[f"{PREFIX[kind]}_status"].values == 1 for kind in KINDS}
     except (KeyError, ValueError) as error:
         raise ExperimentError(f"{store}: not a stochpound experiment store ({error})") from None

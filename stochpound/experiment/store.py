@@ -35,8 +35,11 @@ import xarray as xr
 from stochpound.experiment import intensity
 from stochpound.experiment.model import CASE, REFERENCE, Dim, Experiment
 from stochpound.experiment.spec import ExperimentError, canonical_json
-from stochpound.experiment.summary import DEMAND_SUMMARIES, IMPACT_COLUMNS, templates, variable_attrs
+from stochpound.experiment.catalogue import CASE_SUMMARIES, IMPACT_TABLE, REFERENCE_HISTORY, REFERENCE_SUMMARIES, TIME_HISTORIES, StoreVariable
+from stochpound.experiment.summary import DEMAND_SUMMARIES
+from stochpound.model.scene_file import scene_from_dict
 from stochpound.motions.records.suites import METADATA_FIELDS
+from stochpound.results.dataset import scene_parameters
 
 #: Version of the store layout.
 STORE_FORMAT = 1
@@ -124,9 +127,8 @@ def layout(experiment: Experiment, motion_grids: Mapping[str, tuple[float, int]]
     """The layout of an experiment's store holding ``n_impacts`` impact rows."""
     coords = _coordinates(experiment, motion_grids)
     sizes = {name: v.size for name, v in coords.items() if v.dims == (name,)}
-    run, summary_template, reference_template = templates()
     specs: list[Spec] = []
-    for kind, template in ((REFERENCE, reference_template), (CASE, summary_template)):
+    for kind, variables in ((REFERENCE, REFERENCE_SUMMARIES), (CASE, CASE_SUMMARIES)):
         dims = tuple(d.name for d in experiment.kind_dims(kind))
         grid = tuple(sizes[d] for d in dims)
         chunks = block_shape(grid, SUMMARY_BLOCK)
@@ -134,19 +136,18 @@ def layout(experiment: Experiment, motion_grids: Mapping[str, tuple[float, int]]
         long = "case" if kind == CASE else "fixed-base reference case"
         specs.append(Spec(f"{prefix}_status", kind, "status", dims, np.dtype(np.int8), {**_STATUS_ATTRS, "long_name": f"{long} status"}, chunks))
         specs.append(Spec(f"{prefix}_id", kind, "id", dims, np.dtype("<U1"), {"units": "1", "long_name": f"{long} id"}, chunks))
-        for name, variable in template.data_vars.items():
-            if name in DEMAND_SUMMARIES and not experiment.output.get("demands", False):
+        for variable in variables:
+            if variable.name in DEMAND_SUMMARIES and not experiment.output.get("demands", False):
                 continue
-            extra = tuple(variable.dims)
-            if any(sizes[d] == 0 for d in extra):  # e.g. per-contact summaries of a scene without contacts
+            if any(sizes[d] == 0 for d in variable.dims):  # e.g. per-contact summaries of a scene without contacts
                 continue
-            dtype = _store_dtype(variable.dtype)
+            dtype = _store_dtype(np.dtype(variable.dtype))
             encoding = {} if dtype.kind == "f" else {"_FillValue": INT_FILL}
-            specs.append(Spec(name, kind, "summary", dims + extra, dtype, dict(variable_attrs(name)), chunks + tuple(sizes[d] for d in extra), encoding))
+            specs.append(Spec(variable.name, kind, "summary", dims + variable.dims, dtype, variable.attrs, chunks + tuple(sizes[d] for d in variable.dims), encoding))
     specs += _intensity_specs(experiment, sizes)
-    specs += _history_specs(experiment, sizes, run)
+    specs += _history_specs(experiment, sizes)
     if experiment.output["impacts"]:
-        specs += _impact_specs(experiment, run, max(n_impacts, 0))
+        specs += _impact_specs(experiment, max(n_impacts, 0))
     return Layout(coords, {**sizes, "impact": n_impacts}, specs)
 
 
@@ -162,25 +163,25 @@ def _intensity_specs(experiment: Experiment, sizes: Mapping[str, int]) -> list[S
     return specs
 
 
-def _history_specs(experiment: Experiment, sizes: Mapping[str, int], run: xr.Dataset) -> list[Spec]:
+def _history_specs(experiment: Experiment, sizes: Mapping[str, int]) -> list[Spec]:
     names = experiment.output["time_histories"]
-    jobs = [(name, CASE, tuple(d for d in run[name].dims if d != "time")) for name in names]
+    jobs: list[tuple[StoreVariable, str]] = [(TIME_HISTORIES[name], CASE) for name in names]
     if "total_displacement" in names:
-        jobs.append(("reference_total_displacement", REFERENCE, ("floor",)))
+        jobs.append((REFERENCE_HISTORY, REFERENCE))
     specs = []
-    for name, kind, extra in jobs:
+    for variable, kind in jobs:
         dims = tuple(d.name for d in experiment.kind_dims(kind))
-        trailing = tuple(sizes[d] for d in extra) + (sizes["time"],)
+        trailing = tuple(sizes[d] for d in variable.dims) + (sizes["time"],)
         per_case = 8 * math.prod(trailing)
         grid = block_shape(tuple(sizes[d] for d in dims), max(1, HISTORY_BLOCK_BYTES // per_case))
         encoding = {"zlib": True, "complevel": 1}
-        specs.append(Spec(name, kind, "history", dims + extra + ("time",), np.dtype(float), dict(variable_attrs(name)), grid + trailing, encoding))
+        specs.append(Spec(variable.name, kind, "history", dims + variable.dims + ("time",), np.dtype(float), variable.attrs, grid + trailing, encoding))
     return specs
 
 
-def _impact_specs(experiment: Experiment, run: xr.Dataset, n_impacts: int) -> list[Spec]:
+def _impact_specs(experiment: Experiment, n_impacts: int) -> list[Spec]:
     chunks = (max(1, min(IMPACT_CHUNK, n_impacts)),)
-    specs = [Spec(name, None, "impact", ("impact",), run[name].dtype, dict(variable_attrs(name)), chunks) for name in IMPACT_COLUMNS]
+    specs = [Spec(v.name, None, "impact", v.dims, np.dtype(v.dtype), v.attrs, chunks) for v in IMPACT_TABLE]
     specs.append(Spec("impact_case_id", None, "impact", ("impact",), np.dtype("<U1"), {"units": "1", "long_name": "id of the case of the impact"}, chunks, coordinate=True))
     for dim in experiment.dims:
         units = _dim_coordinate(experiment, dim).attrs["units"]
@@ -233,8 +234,34 @@ def _coordinates(experiment: Experiment, motion_grids: Mapping[str, tuple[float,
     coords["building"] = xr.Variable(("building",), np.array(experiment.building_names, dtype=object), {"units": "1", "long_name": "building name, left to right"})
     coords["floor"] = xr.Variable(("floor",), np.arange(1, experiment.max_floors + 1), {"units": "1", "long_name": "floor number, 1 = lowest"})
     coords["contact"] = xr.Variable(("contact",), np.arange(len(scene.get("contact", []))), {"units": "1", "long_name": "contact index"})
+    coords.update(_scene_coordinates(experiment))
     if experiment.output["time_histories"]:
         coords["time"] = xr.Variable(("time",), union_times(motion_grids), {"units": "s", "long_name": "time (union of the motions' sample times)"})
+    return coords
+
+
+def _scene_coordinates(experiment: Experiment) -> dict[str, xr.Variable]:
+    """What each grid point ran, as a result names it (:func:`stochpound.results.dataset.scene_parameters`): the bases and the contacts' laws.
+
+    On the case dimensions without ``record`` and ``realization``, then ``building`` or ``contact``
+    (walls, whose number a variant may change, are left out: the definition gives them).
+    """
+    points = experiment.points(CASE)
+    dims = tuple(d.name for d in experiment.kind_dims(CASE)[:-2])
+    shape = experiment.grid_shape(CASE)[:-2]
+    columns: dict[str, list[np.ndarray]] = {}
+    attrs: dict[str, tuple[tuple[str, ...], dict[str, Any]]] = {}
+    for point in points:
+        scene = scene_from_dict(experiment.structure(point), base_dir=experiment.base_dir)
+        for name, (variable_dims, values, variable_attrs) in scene_parameters(scene).items():
+            if variable_dims in (("building",), ("contact",)):
+                columns.setdefault(name, []).append(np.asarray(values))
+                attrs[name] = (variable_dims, variable_attrs)
+    coords = {}
+    for name, values in columns.items():
+        variable_dims, variable_attrs = attrs[name]
+        data = np.stack(values).reshape(shape + values[0].shape)
+        coords[name] = xr.Variable(dims + variable_dims, data.astype(object) if data.dtype.kind == "U" else data, variable_attrs)
     return coords
 
 
@@ -270,10 +297,11 @@ def _dim_coordinate(experiment: Experiment, dim: Dim) -> xr.Variable:
     if dim.kind == "variant":
         return xr.Variable((dim.name,), np.array(dim.values, dtype=object), {"units": "1", "long_name": f"variant of axis {dim.name}"})
     if dim.kind == "gap":
-        gap = next(g for g in experiment.definition["gaps"] if g["name"] == dim.name)
-        return xr.Variable((dim.name,), np.array(dim.values, float), {"units": "m", "long_name": f"at-rest gap of contacts {gap['contacts']}"})
+        gap = experiment.contract.gap_axis(dim.name)
+        walls = f" and walls {list(gap.walls)}" if gap.walls else ""
+        return xr.Variable((dim.name,), np.array(dim.values, float), {"units": "m", "long_name": f"at-rest gap of contacts {list(gap.contacts)}{walls}"})
     if dim.kind == "mu":
-        chosen = experiment.definition["mu"]["buildings"]
+        chosen = experiment.contract.mu.buildings
         which = ", ".join(chosen) if chosen else "every isolated building"
         return xr.Variable(("mu",), np.array(dim.values, float), {"units": "1", "long_name": f"friction coefficient of {which} (inf: fixed base)"})
     if dim.kind == "record":

@@ -9,8 +9,8 @@ other cases' into a part, :mod:`stochpound.experiment.parts`):
 * ``t:<name>``: kept time histories (at the motion's samples);
 * ``i:<name>``: the impact table's columns.
 
-Units and long names are taken from a tiny real run (:func:`templates`), so
-they always match :func:`stochpound.simulate` and :mod:`stochpound.analysis`.
+The store's units and long names are declared in
+:mod:`stochpound.experiment.catalogue`; the tests hold them against a real run.
 
 :func:`case_summary` and :func:`reference_summary` give the summaries as
 xarray datasets (their metadata names and describes the store's variables);
@@ -24,7 +24,6 @@ tests check that they agree.
 
 from __future__ import annotations
 
-from functools import cache
 from typing import Any, Mapping, Sequence
 
 import numpy as np
@@ -34,6 +33,7 @@ from stochpound.analysis import kernels, peak_response
 from stochpound.analysis.names import RESPONSE_MOMENTS, without_aliases
 from stochpound.analysis.separation_rules import STORE_NAMES, contact_demands
 from stochpound.analysis.summary import response_moments, run_summary, top_floor_total_displacement
+from stochpound.experiment.catalogue import IMPACT_TABLE
 
 _MOMENTS = tuple(RESPONSE_MOMENTS.values())
 _PEAKS = ("peak_total_displacement", "peak_relative_displacement", "peak_sliding_displacement", "residual_sliding")
@@ -45,18 +45,8 @@ DEMAND_SUMMARIES = {
     "peak_interstorey_drift": ("peak_storey_drift", "largest peak storey drift over the building's storeys"),
     "peak_base_shear": ("peak_base_shear", "largest absolute base shear over the run"),
 }
-IMPACT_COLUMNS = (
-    "impact_contact",
-    "impact_start",
-    "impact_end",
-    "impact_duration",
-    "impact_peak_force",
-    "impact_peak_time",
-    "impact_impulse",
-    "impact_onset_velocity",
-    "impact_in_phase",
-    "impact_complete",
-)
+#: Columns of the impact table a store keeps (:data:`stochpound.experiment.catalogue.IMPACT_TABLE`).
+IMPACT_COLUMNS = tuple(v.name for v in IMPACT_TABLE)
 
 
 def case_summary(run: xr.Dataset, studied: str, fixed_base: xr.DataArray) -> xr.Dataset:
@@ -231,34 +221,3 @@ def reference_arrays(summary: Mapping[str, np.ndarray], displacement: np.ndarray
     if keep_history:
         arrays["t:reference_total_displacement"] = displacement
     return arrays
-
-
-@cache
-def templates() -> tuple[xr.Dataset, xr.Dataset, xr.Dataset]:
-    """A tiny real run and its case and reference summaries (metadata: dims, dtypes, units, long names)."""
-    from stochpound.model.scene_file import scene_from_dict
-    from stochpound.solvers.simulate import simulate
-
-    building = {"mass": [1.0], "stiffness": [1.0]}
-    scene = scene_from_dict(
-        {
-            "building": [{"name": "A", **building}, {"name": "B", **building}],
-            "contact": [{"between": [["A", 1], ["B", 1]], "gap": 1.0, "stiffness": 1.0, "restitution": 0.5}],
-            "motion": {"type": "constant", "acceleration": 1.0, "duration": 2.0, "dt": 1.0},
-        },
-        source="template",
-    )
-    run = simulate(scene, "ivp", demands=True)  # the reference path: the tiny run only provides metadata
-    response = top_floor_total_displacement(run, "A")
-    return run, case_summary(run, "A", response), reference_summary(run.isel(building=[0]), "A")
-
-
-def variable_attrs(name: str) -> dict[str, Any]:
-    """Units and long name of a result, summary or reference variable."""
-    run, summary, reference = templates()
-    for dataset in (summary, reference, run):
-        if name in dataset.variables:
-            return {k: dataset[name].attrs[k] for k in ("units", "long_name") if k in dataset[name].attrs}
-    if name == "reference_total_displacement":
-        return {"units": "m", "long_name": "total displacement of the studied building alone on a fixed base"}
-    raise KeyError(name)

@@ -21,13 +21,13 @@ masses by f (floors and base) keeps its dynamics consistent:
 from __future__ import annotations
 
 import copy
-import math
 from typing import Any, Iterable, Mapping
 
 from stochpound.errors import SceneError
 from stochpound.model import building as building_law
 from stochpound.model import laws
 from stochpound.model.contact import ELEMENT_KEYS, effective_mass
+from stochpound.model.friction import is_fixed_base
 
 #: Motion used while validating a scene's structure (the real motion is set per case).
 PLACEHOLDER_MOTION = {"type": "constant", "acceleration": 0.0, "duration": 1.0, "dt": 1.0}
@@ -141,10 +141,12 @@ def _rescale_element(table: dict[str, Any], mass_ratio: float) -> None:
     law.rescale_table(table, mass_ratio)
 
 
-def set_gaps(scene: dict[str, Any], contacts: Iterable[int], gap: float) -> None:
-    """Set the gap (m) of the given contacts (0-based indices) in place."""
+def set_gaps(scene: dict[str, Any], contacts: Iterable[int], gap: float, walls: Iterable[int] = ()) -> None:
+    """Set the gap (m) of the given contacts and walls (0-based indices into ``contact`` and ``wall``) in place."""
     for index in contacts:
         scene["contact"][index]["gap"] = float(gap)
+    for index in walls:
+        scene["wall"][index]["gap"] = float(gap)
 
 
 def set_mu(scene: dict[str, Any], buildings: Iterable[str] | None, mu: float) -> list[str]:
@@ -170,14 +172,14 @@ def set_mu(scene: dict[str, Any], buildings: Iterable[str] | None, mu: float) ->
     missing = []
     for name in chosen:
         building = building_table(scene, name)
-        if math.isinf(mu):
+        if is_fixed_base(mu):
             building.pop("base", None)
         elif isinstance(building.get("base"), dict):
             building["base"]["mu"] = float(mu)
             building["base"]["mu_static"] = float(mu)
         else:
             missing.append(name)
-    if buildings is None and not chosen and not math.isinf(mu):
+    if buildings is None and not chosen and not is_fixed_base(mu):
         missing.append("(no building has a [building.base])")
     return missing
 

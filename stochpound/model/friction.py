@@ -42,6 +42,11 @@ SLIP_RIGHT, SLIP_LEFT = 1, -1
 """Base states: slipping right or left."""
 FREE = 2
 """Base state: frictionless base, a free degree of freedom."""
+FIXED_BASE = math.inf
+"""The friction coefficient that stands for a fixed base (no sliding base at all): ∞.
+
+An experiment's μ axis removes the base of a building at this value, and a
+result gives it as the ``base_mu`` of a building without a base."""
 BASE_KEYS = {"mass", "mu", "mu_static", "restoring_stiffness", "radius"}
 
 
@@ -103,6 +108,17 @@ class Base:
     def frictionless(self) -> bool:
         """True when the base has no friction (a free degree of freedom)."""
         return self.mu == 0.0 and self.mu_static == 0.0
+
+
+def is_fixed_base(mu: float | str) -> bool:
+    """Whether a friction coefficient stands for a fixed base (μ = ∞, :data:`FIXED_BASE`).
+
+    Parameters
+    ----------
+    mu : float or str
+        Friction coefficient (dimensionless); a store's JSON spells ∞ ``"inf"``.
+    """
+    return math.isinf(float(mu))
 
 
 def base_from_table(table: Mapping[str, Any] | None, prefix: str) -> Base | None:

@@ -15,7 +15,6 @@ Four checks, each against something known exactly or computed independently:
 
 from __future__ import annotations
 
-import json
 import math
 from dataclasses import dataclass
 
@@ -24,6 +23,7 @@ import xarray as xr
 
 import stochpound
 from stochpound.model import laws
+from stochpound.experiment.definition import read_definition
 from stochpound.model.modal_solution import harmonic_response, modal_properties
 from stochpound.report.description import StoreDefinition, number
 from stochpound.report.document import Paragraph
@@ -144,17 +144,16 @@ class HarmonicComparison:
 
 def harmonic_comparisons(store: xr.Dataset) -> list[HarmonicComparison]:
     """A store's harmonic motions (``[[motions]]`` of type harmonic) beside the closed-form modal solution."""
-    definition = json.loads(store.attrs["definition"])
     comparisons = []
-    for motion in definition["motions"]:
-        if motion["motion"].get("type") != "harmonic":
+    for motion in read_definition(store).motions:
+        if motion.motion.get("type") != "harmonic":
             continue
-        building = case_scene(store, record=motion["label"]).buildings[0]
-        run = select(store, record=motion["label"])
+        building = case_scene(store, record=motion.label).buildings[0]
+        run = select(store, record=motion.label)
         computed = run["relative_displacement"].sel(building=building.name).values
         valid = np.isfinite(computed[0])
         time = run["time"].values[valid]
-        amplitude, omega = float(motion["motion"]["amplitude"]), float(motion["motion"]["omega"])
+        amplitude, omega = float(motion.motion["amplitude"]), float(motion.motion["omega"])
         comparisons.append(HarmonicComparison(amplitude, omega, time, computed[:, valid], harmonic_response(building, amplitude, omega, time)))
     return comparisons
 

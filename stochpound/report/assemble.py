@@ -23,7 +23,8 @@ from stochpound.report.document import Block, Paragraph, Report, Section
 from stochpound.report.ensembles import INTERVAL_NOTE
 from stochpound.report.generic import store_section
 from stochpound.report.intensity import intensity_section, intensity_setting
-from stochpound.report.separation import has_contact_free, separation_section, with_contacts
+from stochpound.experiment.selections import has_contact_free, with_contacts
+from stochpound.report.separation import separation_section
 from stochpound.report.methods import methods_section
 from stochpound.report.stores import open_stores
 from stochpound.report.summary import experiment_summary, move_per_cell_tables, study_summary

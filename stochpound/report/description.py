@@ -21,6 +21,7 @@ import xarray as xr
 
 from stochpound import motions as synthetic_motions
 from stochpound.experiment import Case
+from stochpound.experiment.definition import GapAxis, is_fixed_base
 from stochpound.experiment.intensity import describe_measure
 from stochpound.experiment.model import CASE
 from stochpound.model import laws
@@ -87,7 +88,7 @@ class StoreDefinition:
         self.name = name
         self.store = store
         self.experiment = store_experiment(store)
-        self.definition = self.experiment.definition
+        self.definition = self.experiment.contract
 
     @cached_property
     def configurations(self) -> list[Configuration]:
@@ -98,32 +99,30 @@ class StoreDefinition:
         for case in cases:
             labels = case.label_dict
             key = tuple(labels[axis] for axis in variant_axes)
-            finite = not math.isinf(float(labels.get("mu", 0.0)))
-            if key not in chosen or (finite and math.isinf(float(chosen[key].label_dict.get("mu", 0.0)))):
+            finite = not is_fixed_base(labels.get("mu", 0.0))
+            if key not in chosen or (finite and is_fixed_base(chosen[key].label_dict.get("mu", 0.0))):
                 chosen[key] = case
         return [Configuration(dict(zip(variant_axes, key)), scene_from_dict(self.experiment.structure(case))) for key, case in chosen.items()]
 
     def takes_grid_mu(self, building: Building) -> bool:
         """Whether the grid's ``mu`` axis sets this building's friction (it must then stand on a base)."""
-        mu = self.definition["mu"]
-        if mu is None or building.base is None:
-            return False
-        return mu["buildings"] is None or building.name in mu["buildings"]
+        mu = self.definition.mu
+        return mu is not None and building.base is not None and mu.sets(building.name, has_base=True)
 
     @property
     def mu_buildings_text(self) -> str:
         """The buildings the ``mu`` axis applies to, in words."""
-        chosen = self.definition["mu"]["buildings"]
+        chosen = self.definition.mu.buildings
         return ", ".join(chosen) if chosen else "every building on a sliding base"
 
     @property
     def mu_values(self) -> list[float]:
         """The ``mu`` axis's values (empty without one)."""
-        return list(self.definition["mu"]["values"]) if self.definition["mu"] is not None else []
+        return list(self.definition.mu.values) if self.definition.mu is not None else []
 
-    def gap_axis(self, contact: int) -> dict[str, Any] | None:
+    def gap_axis(self, contact: int) -> GapAxis | None:
         """The grid's gap axis that sets this contact's gap, if any."""
-        return next((g for g in self.definition["gaps"] if contact in g["contacts"]), None)
+        return self.definition.contact_gap_axis(contact)
 
     @property
     def study_compat_cases(self) -> int:
@@ -148,7 +147,7 @@ def _base(definition: StoreDefinition, building: Building, g: float) -> str:
         return "fixed"
     law = laws.friction_law(base.friction_law)
     if definition.takes_grid_mu(building):
-        finite = [m for m in definition.mu_values if not math.isinf(m)]
+        finite = [m for m in definition.mu_values if not is_fixed_base(m)]
         parts = [f"sliding, {law.title}, μ = μ_s ∈ {{{numbers(finite)}}}" + (" or fixed (μ = ∞)" if len(finite) < len(definition.mu_values) else "")]
     else:
         parts = [f"sliding, {law.describe(base)}"]
@@ -193,20 +192,21 @@ def _contact_row(definition: StoreDefinition, scene: Scene, index: int, contact:
     return (
         f"{left.name} floor {contact.left_floor} – {right.name} floor {contact.right_floor}",
         law.describe(parameters),
-        f"{{{numbers(axis['values'])}}} (axis {axis['name']})" if axis else number(contact.gap),
+        f"{{{numbers(axis.values)}}} (axis {axis.name})" if axis else number(contact.gap),
         law.separation(parameters),
     )
 
 
-def _wall_row(scene: Scene, wall: Wall) -> tuple[str, ...]:
+def _wall_row(definition: StoreDefinition, scene: Scene, index: int, wall: Wall) -> tuple[str, ...]:
     building = scene.buildings[wall.building]
+    axis = definition.definition.wall_gap_axis(index)
     parameters = wall.parameters(building.base.mass if wall.level == 0 and building.base is not None else building.mass[max(wall.level, 1) - 1])
     level = "base" if wall.level == 0 else f"floor {wall.level}"
     law = laws.contact_law(wall.law)
     return (
         f"{building.name} {level} – wall on its {wall.side_name} (moves with the ground)",
         law.describe(parameters),
-        number(wall.gap),
+        f"{{{numbers(axis.values)}}} (axis {axis.name})" if axis else number(wall.gap),
         law.separation(parameters),
     )
 
@@ -218,8 +218,8 @@ def contacts_table(definitions: Iterable[StoreDefinition]) -> Table | None:
         for configuration in definition.configurations:
             for index, contact in enumerate(configuration.scene.contacts):
                 rows.setdefault(_contact_row(definition, configuration.scene, index, contact), []).append((definition, configuration))
-            for wall in configuration.scene.walls:
-                rows.setdefault(_wall_row(configuration.scene, wall), []).append((definition, configuration))
+            for index, wall in enumerate(configuration.scene.walls):
+                rows.setdefault(_wall_row(definition, configuration.scene, index, wall), []).append((definition, configuration))
     if not rows:
         return None
     return _merged_table(
@@ -316,11 +316,11 @@ def motions_table(definitions: Iterable[StoreDefinition]) -> Table:
     """Every ground motion the stores ran: records with their treatment, ensembles with their generator and seed."""
     rows = []
     for definition in definitions:
-        for motion in definition.definition["motions"]:
-            table = motion["motion"]
-            if motion["kind"] == "synthetic":
-                text, attrs = _synthetic_parameters(table, motion["start"])
-                realizations = f"{motion['count']} (indices {motion['start']}–{motion['start'] + motion['count'] - 1}), seed {table['seed']}"
+        for motion in definition.definition.motions:
+            table = motion.motion
+            if motion.kind == "synthetic":
+                text, attrs = _synthetic_parameters(table, motion.start)
+                realizations = f"{motion.count} (indices {motion.start}–{motion.start + motion.count - 1}), seed {table['seed']}"
                 grid = f"{number(attrs['dt'])} s, {number(attrs['duration'])} s"
             elif table.get("type", "record") == "record":
                 text, grid = _record_parameters(table)
@@ -328,7 +328,7 @@ def motions_table(definitions: Iterable[StoreDefinition]) -> Table:
             else:
                 text, realizations = _analytic_parameters(table), "1"
                 grid = f"{number(float(table['dt']))} s, {number(float(table['duration']))} s"
-            rows.append([definition.name, motion["label"], text, grid, realizations])
+            rows.append([definition.name, motion.label, text, grid, realizations])
     frame = pd.DataFrame(rows, columns=["experiment", "motion", "definition", "step, duration", "realizations"])
     frame.index = pd.RangeIndex(1, len(frame) + 1, name="#")
     return Table(
@@ -346,10 +346,9 @@ def grid_paragraph(definition: StoreDefinition) -> Paragraph:
         if dim.kind == "variant":
             axes.append(f"{dim.name} ∈ {{{', '.join(map(str, dim.values))}}}")
         elif dim.kind == "gap":
-            axis = next(g for g in definition.definition["gaps"] if g["name"] == dim.name)
-            axes.append(f"{dim.name} ∈ {{{numbers(dim.values)}}} m (contacts {', '.join(map(str, axis['contacts']))})")
+            axes.append(f"{dim.name} ∈ {{{numbers(dim.values)}}} m ({definition.definition.gap_axis(dim.name).targets})")
         elif dim.kind == "intensity":
-            setting = definition.definition["intensity"]
+            setting = definition.definition.intensity
             axes.append(f"intensity ∈ {{{numbers(dim.values)}}} {setting['units']} ({describe_measure(setting)}, every motion scaled to every level)")
         else:
             axes.append(f"μ ∈ {{{numbers(dim.values)}}} for {definition.mu_buildings_text} (∞: fixed base)")
@@ -358,7 +357,7 @@ def grid_paragraph(definition: StoreDefinition) -> Paragraph:
     references = sum(1 for c in definition.experiment.cases if c.kind != CASE)
     return Paragraph(
         f"Experiment {definition.name}: {', '.join(axes) or 'a single configuration'}, under "
-        f"{len(definition.definition['motions'])} motion(s) (Table of motions); g = {number(scene.g)} m/s². The studied building is "
+        f"{len(definition.definition.motions)} motion(s) (Table of motions); g = {number(scene.g)} m/s². The studied building is "
         f"{definition.experiment.studied}: the response whose moments are reported is its top-floor total displacement, and "
         f"it is also run alone on a fixed base under every motion ({references} reference runs). "
         f"{int(store.attrs.get('cases_done', 0))} of {int(store.attrs.get('cases_total', 0))} runs done."
@@ -404,5 +403,5 @@ def model_paragraph(definitions: list[StoreDefinition]) -> Paragraph:
 
 def records_used(definitions: Iterable[StoreDefinition]) -> list[str]:
     """Bundled records run by the stores, sorted."""
-    used = {str(m["motion"]["record"]) for d in definitions for m in d.definition["motions"] if m["motion"].get("type", "record") == "record" and "record" in m["motion"]}
+    used = {str(m.motion["record"]) for d in definitions for m in d.definition.motions if m.motion.get("type", "record") == "record" and "record" in m.motion}
     return sorted(used & set(registry_entries()))

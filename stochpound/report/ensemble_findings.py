@@ -10,7 +10,6 @@ out.
 
 from __future__ import annotations
 
-import math
 from typing import Any
 
 import numpy as np
@@ -20,7 +19,9 @@ import xarray as xr
 from stochpound.analysis import kernels
 from stochpound.report.document import Block, Paragraph, Table
 from stochpound.report.ensembles import CM, MIN_RUNS, Ensemble
-from stochpound.report.facets import dim_text, is_gap, labels_text, value_text
+from stochpound.experiment.definition import is_gap_axis
+from stochpound.experiment.selections import fixed_base, has_fixed_base_twins, isolated_mus
+from stochpound.report.facets import dim_text, labels_text, value_text
 
 #: Estimates compared between a sliding and a fixed base: statistic -> label.
 COMPARED = {
@@ -36,10 +37,10 @@ def ensemble_findings(ensemble: Ensemble) -> list[Block]:
     """Every finding that applies to the ensemble's grid."""
     blocks: list[Block] = [precision(ensemble), spread(ensemble)]
     for dim in ensemble.grid:
-        if is_gap(dim) and len(ensemble.grid[dim]) > 1:
+        if is_gap_axis(dim) and len(ensemble.grid[dim]) > 1:
             blocks += gap_effect(ensemble, dim)
     mus = ensemble.grid.get("mu", [])
-    if any(math.isinf(m) for m in mus) and any(not math.isinf(m) for m in mus):
+    if has_fixed_base_twins(mus):
         blocks += isolation_effect(ensemble)
     return blocks
 
@@ -205,10 +206,10 @@ def isolation_effect(ensemble: Ensemble) -> list[Block]:
     """Where a sliding base lowers or raises P(pounding) and the peak displacement, against the fixed base, cell by cell."""
     stats = ensemble.statistics
     mus = ensemble.grid["mu"]
-    fixed = stats.sel(mu=math.inf)
+    fixed = fixed_base(stats)
     rows = {}
     extremes: dict[str, list[tuple[float, xr.DataArray]]] = {"hurts": [], "helps": []}
-    for mu in (m for m in mus if not math.isinf(m)):
+    for mu in isolated_mus(mus):
         isolated = stats.sel(mu=mu)
         row = []
         for name in COMPARED:

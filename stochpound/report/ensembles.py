@@ -25,7 +25,8 @@ import xarray as xr
 from stochpound.analysis import ensemble_statistics, mean_interval, of_first, pounding_probability
 from stochpound.report import figures
 from stochpound.report.document import Block, FigureItem, Table
-from stochpound.report.facets import cell_gid, dim_text, is_gap, labels_text, layouts, line_colours, plain, value_text
+from stochpound.experiment.definition import is_gap_axis
+from stochpound.report.facets import cell_gid, dim_text, labels_text, layouts, line_colours, plain, value_text
 
 CM = 100.0
 KN = 1e-3
@@ -206,7 +207,7 @@ class Ensemble:
     def line_dim(self, exclude: Sequence[str] = ()) -> str | None:
         """The dimension drawn as lines: μ, else a gap axis, else the first other axis."""
         candidates = [d for d in self.grid if d not in exclude and len(self.grid[d]) > 1]
-        for wanted in ("mu", *[d for d in candidates if is_gap(d)], *candidates):
+        for wanted in ("mu", *[d for d in candidates if is_gap_axis(d)], *candidates):
             if wanted in candidates:
                 return wanted
         return None
@@ -231,7 +232,7 @@ class Ensemble:
                 ))
             return result
 
-        x_label = f"{dim_text(x_dim)}" + (" (cm)" if is_gap(x_dim) else "")
+        x_label = f"{dim_text(x_dim)}" + (" (cm)" if is_gap_axis(x_dim) else "")
         return self.facet_figures(
             f"pounding-{x_dim}", [x_dim, line_dim], curves, x_label, "P(pounding)",
             f"the probability of pounding against {dim_text(x_dim)}, with its {self.confidence:.0%} Clopper–Pearson band",
@@ -341,7 +342,7 @@ class Ensemble:
         """Every figure of the ensemble."""
         items: list[FigureItem] = []
         for dim in self.grid:
-            if (is_gap(dim) or dim == "mu") and len(self.grid[dim]) > 1:
+            if (is_gap_axis(dim) or dim == "mu") and len(self.grid[dim]) > 1:
                 items += self.pounding_against(dim)
         items += self.distributions(PEAK_DISPLACEMENT, twin="reference_peak_total_displacement", log_x=True)
         if self.sliding:
@@ -386,7 +387,7 @@ def line_label(line_dim: str | None, value: Any) -> str:
 
 def _axis_positions(dim: str, values: Sequence[Any]) -> tuple[np.ndarray, dict[float, str] | None]:
     """x positions of an axis's values: gaps in cm; μ by rank, labelled, so that a fixed base (∞) has a place."""
-    if is_gap(dim):
+    if is_gap_axis(dim):
         return np.asarray(values, dtype=float) * CM, None
     positions = np.arange(len(values), dtype=float)
     return positions, {float(p): value_text(dim, v) for p, v in zip(positions, values)}

@@ -23,15 +23,12 @@ from typing import Any
 
 import numpy as np
 
+from stochpound.experiment.definition import is_fixed_base, is_gap_axis
+
 #: Most panels in one figure.
 MAX_PANELS = 16
 #: Dimensions whose values are lengths in m, shown in cm.
 CM = 100.0
-
-
-def is_gap(dim: str) -> bool:
-    """Whether a dimension is a gap axis (``gap`` or ``gap_<name>``)."""
-    return dim == "gap" or dim.startswith("gap_")
 
 
 def plain(value: Any) -> Any:
@@ -43,10 +40,10 @@ def plain(value: Any) -> Any:
 def value_text(dim: str, value: Any) -> str:
     """A coordinate value for a label: gaps in cm, μ = ∞ as "fixed"."""
     value = plain(value)
-    if is_gap(dim):
+    if is_gap_axis(dim):
         return f"{value * CM:g} cm"
     if dim == "mu":
-        return "fixed" if math.isinf(value) else f"{value:g}"
+        return "fixed" if is_fixed_base(value) else f"{value:g}"
     return f"{value:g}" if isinstance(value, float) else str(value)
 
 

@@ -7,11 +7,11 @@ numbers behind the verdict (or None when the store it needs is missing).
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 import xarray as xr
 
+from stochpound.experiment.definition import FIXED_BASE
+from stochpound.experiment.selections import isolated_mus
 from stochpound.report.document import Paragraph
 from stochpound.report.description import StoreDefinition
 from stochpound.report.published import published_tables
@@ -67,14 +67,14 @@ def _column_variable(column: str, statistic: str) -> str:
 def _column_labels(spec: dict, column: str) -> dict:
     if column == "single":
         return {}
-    return {"isolation": spec["configuration"], "neighbour": spec["neighbour"], "gap": 0.02, "mu": math.inf, "model": "corrected"}
+    return {"isolation": spec["configuration"], "neighbour": spec["neighbour"], "gap": 0.02, "mu": FIXED_BASE, "model": "corrected"}
 
 
 def gap_effect(gap_study: xr.Dataset) -> Paragraph:
     """Impacts fall with the gap, faster for a stiff neighbour; forces are larger with a flexible neighbour."""
     gaps = gap_study["gap"].values
-    impacts = {n: select(gap_study, neighbour=n, mu=math.inf, record="el_centro")["impacts"].values for n in NEIGHBOURS}
-    forces = {n: select(gap_study, neighbour=n, mu=math.inf, record="el_centro")["peak_impact_force"].values for n in NEIGHBOURS}
+    impacts = {n: select(gap_study, neighbour=n, mu=FIXED_BASE, record="el_centro")["impacts"].values for n in NEIGHBOURS}
+    forces = {n: select(gap_study, neighbour=n, mu=FIXED_BASE, record="el_centro")["peak_impact_force"].values for n in NEIGHBOURS}
     last = {n: _last_gap_with_impacts(gaps, impacts[n]) for n in NEIGHBOURS}
     falling = all(impacts[n][0] >= impacts[n][-1] for n in NEIGHBOURS)
     faster = last["stiff"] < last["flexible"]
@@ -124,7 +124,7 @@ def small_gaps(gap_study: xr.Dataset) -> Paragraph:
     """Very small gaps raise the peak displacement (checked per neighbour, gaps up to 1 cm against the building alone)."""
     sentences, raised = [], {}
     for neighbour in NEIGHBOURS:
-        data = select(gap_study, neighbour=neighbour, mu=math.inf, record="el_centro")
+        data = select(gap_study, neighbour=neighbour, mu=FIXED_BASE, record="el_centro")
         small = data["gap"].values <= 0.01
         peak = float(data["peak_total_displacement"].sel(building="B1").values[small].max()) * CM
         alone = float(data["reference_peak_total_displacement"].values) * CM
@@ -137,7 +137,7 @@ def small_gaps(gap_study: xr.Dataset) -> Paragraph:
 
 def worst_case(pair_mu: xr.Dataset, pair_records: xr.Dataset | None) -> Paragraph:
     """One isolated building next to a fixed one is the worst case; both isolated pound least: El Centro over μ, then every record at μ = 0.2."""
-    finite = [float(mu) for mu in pair_mu["mu"].values if np.isfinite(mu)]
+    finite = isolated_mus(pair_mu["mu"].values)
     totals = {}
     for isolation in ("b1_isolated", "both_isolated"):
         data = select(pair_mu, isolation=isolation, model="corrected", gap=0.02, mu=finite, record="el_centro")
@@ -209,7 +209,7 @@ def _span(values: list[float]) -> str:
 
 def isolated_columns(pair_mu: xr.Dataset) -> Paragraph:
     """Why the study's isolated columns differ: its equations (study_compat) and its fixed-step decisions."""
-    finite = [float(mu) for mu in pair_mu["mu"].values if np.isfinite(mu)]
+    finite = isolated_mus(pair_mu["mu"].values)
     common = {"gap": 0.02, "mu": finite, "record": "el_centro"}  # linear input, as in every row of the tables but "spline input"
     corrected = select(pair_mu, model="corrected", **common)
     compat = select(pair_mu, model="study_compat", **common) if "model" in pair_mu.dims and "study_compat" in pair_mu["model"].values else None

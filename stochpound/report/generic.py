@@ -21,7 +21,8 @@ from stochpound.report import figures
 from stochpound.report.document import Block, FigureItem, Paragraph, Section, Table
 from stochpound.report.ensemble_findings import compare_ensembles, ensemble_findings, isolation_across
 from stochpound.report.ensembles import Ensemble
-from stochpound.report.facets import dim_text, is_gap, labels_text, layouts, line_colours, plain, value_text, cell_gid
+from stochpound.experiment.definition import is_gap_axis
+from stochpound.report.facets import dim_text, labels_text, layouts, line_colours, plain, value_text, cell_gid
 
 CM = 100.0
 #: Summaries of a record's case: store variable -> (label, factor to the shown unit).
@@ -83,7 +84,7 @@ def record_blocks(name: str, store: xr.Dataset) -> list[Block]:
     data = store.squeeze("realization", drop=True)
     blocks: list[Block] = [summary_table(name, data)]
     grid = {d: [plain(v) for v in data[d].values] for d in data["case_status"].dims}
-    for axis in (d for d in grid if (is_gap(d) or d == "mu") and len(grid[d]) > 1):
+    for axis in (d for d in grid if (is_gap_axis(d) or d == "mu") and len(grid[d]) > 1):
         blocks += against_axis(name, data, grid, axis)
     return blocks
 
@@ -118,7 +119,7 @@ def against_axis(name: str, data: xr.Dataset, grid: dict[str, list], axis: str) 
     x_values = grid[axis]
     others = [d for d in grid if d != axis]
     line_dim = next((d for d in ("mu", *others) if d in others and len(grid[d]) > 1), None)
-    if is_gap(axis):
+    if is_gap_axis(axis):
         positions, ticks = np.asarray(x_values, dtype=float) * CM, None
     else:
         positions = np.arange(len(x_values), dtype=float)
@@ -146,7 +147,7 @@ def against_axis(name: str, data: xr.Dataset, grid: dict[str, list], axis: str) 
                 panels[labels_text(panel) or "all cases"] = curves
             part = f" ({layout.title})" if layout.title else ""
             suffix = f"-{number}" if len(plans) > 1 else ""
-            x_label = dim_text(axis) + (" (cm)" if is_gap(axis) else "")
+            x_label = dim_text(axis) + (" (cm)" if is_gap_axis(axis) else "")
             figure = figures.panel_grid(panels, f"{name}{part}: {label}", x_label, label, x_ticks=ticks, legend_title=dim_text(line_dim) if line_dim else "")
             note = " (not drawn where a case has no impact)" if variable == "peak_impact_force" else ""
             caption = f"Experiment {name}{part}, the records' cases: {label}{note} against {dim_text(axis)}, every case drawn."

@@ -17,7 +17,6 @@ Other structural axes (μ, variants) give one line per combination.
 
 from __future__ import annotations
 
-import json
 from typing import Any
 
 import numpy as np
@@ -28,7 +27,7 @@ from matplotlib.figure import Figure
 from stochpound.analysis.kernels import clopper_pearson
 from stochpound.experiment.intensity import describe_measure
 from stochpound.report.document import Block, FigureItem, Paragraph, Section, Table
-from stochpound.report.facets import is_gap
+from stochpound.experiment.definition import is_gap_axis, read_definition
 
 CONFIDENCE = 0.95
 G = 9.81
@@ -36,7 +35,7 @@ G = 9.81
 
 def intensity_setting(store: xr.Dataset) -> dict[str, Any] | None:
     """The definition's ``intensity`` entry of a store (None if it has none)."""
-    return json.loads(store.attrs.get("definition", "{}")).get("intensity")
+    return read_definition(store).intensity
 
 
 def intensity_section(name: str, store: xr.Dataset) -> Section:
@@ -168,7 +167,7 @@ def _stripe_table(name: str, store: xr.Dataset, setting: dict[str, Any]) -> Tabl
 
 def _stripe_figure(name: str, store: xr.Dataset, setting: dict[str, Any]) -> FigureItem:
     runs, pounded = _pounding_counts(store)
-    gaps = [d for d in runs.dims if is_gap(d)]
+    gaps = [d for d in runs.dims if is_gap_axis(d)]
     figure = Figure(figsize=(7.5, 3.4), layout="constrained")
     ax = figure.subplots()
     levels = store["intensity"].values

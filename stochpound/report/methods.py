@@ -64,11 +64,11 @@ def solver_paragraph(definitions: list[StoreDefinition]) -> Paragraph:
     """Which solver ran each store, with its settings."""
     by_solver: dict[str, list[str]] = {}
     for definition in definitions:
-        solver = definition.definition["solver"]
-        integrated = f"scipy's {solver['integrator']} with event location (rtol {solver['rtol']:g}, atol {solver['atol']:g})"
-        if solver["method"] == "exact":
+        solver = definition.definition.solver
+        integrated = f"scipy's {solver.integrator} with event location (rtol {solver.rtol:g}, atol {solver.atol:g})"
+        if solver.method == "exact":
             text = EXACT_TEXT
-        elif solver["method"] == "ivp":
+        elif solver.method == "ivp":
             text = integrated
         else:
             text = _automatic_solver(definition, integrated)
@@ -115,9 +115,9 @@ def suites_paragraph(definitions: list[StoreDefinition]) -> Paragraph | None:
 
     used: dict[str, set[str]] = {}
     for definition in definitions:
-        for motion in definition.definition["motions"]:
-            record = str(motion["motion"].get("record", ""))
-            suite = motion.get("suite") or (record.partition("/")[0] if is_suite_member(record) else None)
+        for motion in definition.definition.motions:
+            record = str(motion.motion.get("record", ""))
+            suite = motion.suite or (record.partition("/")[0] if is_suite_member(record) else None)
             if suite:
                 used.setdefault(suite, set()).add(record)
     if not used:

@@ -33,7 +33,8 @@ from stochpound.report import figures
 from stochpound.report.document import Block, FigureItem, Paragraph, Section, Table
 from stochpound.report.ensemble_findings import RARE, rare_gap
 from stochpound.report.ensembles import Ensemble, line_label, lines, table_frame
-from stochpound.report.facets import dim_text, is_gap, labels_text, value_text
+from stochpound.experiment.selections import contact_free, gap_dims, has_contact_free, isolated_mus, with_contacts
+from stochpound.report.facets import dim_text, labels_text, value_text
 
 CM = 100.0
 RULE_TEXT = {
@@ -44,27 +45,6 @@ RULE_TEXT = {
 }
 #: Target probabilities of the separation-against-probability figure.
 CURVE_PROBABILITIES = tuple(np.round(np.geomspace(0.005, 0.9, 31), 5))
-
-
-def gap_dims(store: xr.Dataset) -> list[str]:
-    """The store's gap axes."""
-    return [d for d in store["case_status"].dims if is_gap(d)]
-
-
-def has_contact_free(store: xr.Dataset) -> bool:
-    """Whether every gap axis of the store holds ``inf`` (its contact-free cases)."""
-    dims = gap_dims(store)
-    return bool(dims) and all(np.isinf(store[d].values).any() for d in dims)
-
-
-def contact_free(store: xr.Dataset) -> xr.Dataset:
-    """The store's contact-free cases (``inf`` on every gap axis; the gap coordinates dropped)."""
-    return store.sel({d: np.inf for d in gap_dims(store)}, drop=True)
-
-
-def with_contacts(store: xr.Dataset) -> xr.Dataset:
-    """The store without its contact-free cases (the finite values of every gap axis)."""
-    return store.sel({d: store[d].values[np.isfinite(store[d].values)] for d in gap_dims(store)})
 
 
 def separation_section(name: str, store: xr.Dataset) -> Section:
@@ -85,7 +65,7 @@ def separation_section(name: str, store: xr.Dataset) -> Section:
 def _method_paragraph(store: xr.Dataset) -> Paragraph:
     contacts = store.sizes.get("contact", 0)
     axes = ", ".join(gap_dims(store))
-    sliding = "mu" in store.dims and bool(np.isfinite(store["mu"].values).any())
+    sliding = "mu" in store.dims and bool(isolated_mus(store["mu"].values))
     text = (
         f"The grid's gap axis ({axes}) holds ∞: those cases ran contact-free, every contact open throughout. Before its first "
         f"impact a run with gap g is the contact-free run, so it pounds at gap g exactly when the contact-free run's peak "

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
@@ -12,6 +11,7 @@ import xarray as xr
 
 from stochpound.errors import StochpoundError
 from stochpound.experiment import Experiment, open_store
+from stochpound.experiment.definition import read_definition
 from stochpound.model.scene import Scene
 from stochpound.model.scene_file import scene_from_dict
 
@@ -104,16 +104,12 @@ def case_impacts(store: xr.Dataset, **labels: Any) -> xr.Dataset:
 
 
 def store_experiment(store: xr.Dataset) -> Experiment:
-    """The store's experiment, from its canonical definition (JSON, which spells infinity "inf").
+    """The store's experiment, from its definition (:func:`~stochpound.experiment.read_definition`).
 
     The grid's values are numbers again (μ = ∞ is a float), as when the
     experiment file was read; case ids are unchanged.
     """
-    definition = json.loads(store.attrs["definition"])
-    for axis in [definition["mu"], *definition["gaps"]]:
-        if axis is not None:
-            axis["values"] = [float(v) for v in axis["values"]]
-    return Experiment(definition)
+    return Experiment(read_definition(store))
 
 
 def case_scene(store: xr.Dataset, **labels: Any) -> Scene:

@@ -7,11 +7,11 @@ substitutes are labelled as such.
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 import xarray as xr
 
+from stochpound.experiment.definition import FIXED_BASE, is_fixed_base
+from stochpound.experiment.selections import isolated_mus
 from stochpound.motions.records import load_record
 from stochpound.report import figures
 from stochpound.report.document import FigureItem
@@ -64,7 +64,7 @@ def accelerograms() -> FigureItem:
 
 def gap_time_history(store: xr.Dataset, gap: float = 0.02, neighbour: str = "flexible") -> FigureItem:
     """Figure 3.6: Building 1's top floor with impact onsets, and each contact's force with its impacts' located peaks (both fixed)."""
-    case = {"neighbour": neighbour, "gap": gap, "mu": math.inf, "record": "el_centro"}
+    case = {"neighbour": neighbour, "gap": gap, "mu": FIXED_BASE, "record": "el_centro"}
     run = select(store, **case)
     top = run["total_displacement"].sel(building="B1").isel(floor=-1).values
     impacts = case_impacts(store, **case, realization=0)
@@ -91,8 +91,8 @@ def gap_time_history(store: xr.Dataset, gap: float = 0.02, neighbour: str = "fle
 def against_gap(store: xr.Dataset) -> list[FigureItem]:
     """Figures 3.7–3.9: impacts, peak displacements and peak impact force against the gap (both fixed)."""
     gaps = store["gap"].values * CM
-    data = {n: select(store, neighbour=n, mu=math.inf, record="el_centro").load() for n in NEIGHBOURS}
-    spline = {n: select(store, neighbour=n, mu=math.inf, record="el_centro_spline").load() for n in NEIGHBOURS} if "el_centro_spline" in store["record"].values else {}
+    data = {n: select(store, neighbour=n, mu=FIXED_BASE, record="el_centro").load() for n in NEIGHBOURS}
+    spline = {n: select(store, neighbour=n, mu=FIXED_BASE, record="el_centro_spline").load() for n in NEIGHBOURS} if "el_centro_spline" in store["record"].values else {}
     impacts = {
         "impacts": {f"{NEIGHBOURS[n]}": data[n]["impacts"].values for n in NEIGHBOURS}
         | {f"{NEIGHBOURS[n]}, spline input": spline[n]["impacts"].values for n in spline},
@@ -120,7 +120,7 @@ def single_against_mu(store: xr.Dataset) -> list[FigureItem]:
     sliding and total displacements (Figures 4.4–4.5) are an order of
     magnitude beyond the others, so they are given in the caption instead.
     """
-    finite = store["mu"].values[np.isfinite(store["mu"].values)]
+    finite = np.array(isolated_mus(store["mu"].values))
     records = list(store["record"].values)
     specs = (
         ("4.1", "skewness", "response_skewness", 1.0, None, False),
@@ -149,12 +149,12 @@ def single_against_mu(store: xr.Dataset) -> list[FigureItem]:
     return items
 
 
-def single_histograms(store: xr.Dataset, mus: tuple[float, ...] = (math.inf, 0.2, 0.1, 0.05)) -> FigureItem:
+def single_histograms(store: xr.Dataset, mus: tuple[float, ...] = (FIXED_BASE, 0.2, 0.1, 0.05)) -> FigureItem:
     """Figure 4.6: histograms of the single building's top-floor total displacement with fitted normals, El Centro."""
     samples = {}
     for mu in mus:
         run = select(store, record="el_centro", mu=mu)
-        label = "fixed base" if math.isinf(mu) else f"isolated, μ = {mu:g}"
+        label = "fixed base" if is_fixed_base(mu) else f"isolated, μ = {mu:g}"
         samples[label] = run["total_displacement"].sel(building="B1").isel(floor=-1)
     caption = "Figure 4.6: histograms of the single building's top-floor total displacement with the fitted normal density, El Centro 1940."
     return FigureItem("figure-4.6", caption, figures.histograms_with_normal(samples, "Single building, El Centro 1940"))
@@ -168,7 +168,7 @@ def pair_against_mu(store: xr.Dataset) -> list[FigureItem]:
         "longest impact (ms)": ("longest_impact", 1e3, None),
         "peak total displacement (cm)": ("peak_total_displacement", CM, "B1"),
     }
-    finite = store["mu"].values[np.isfinite(store["mu"].values)]
+    finite = np.array(isolated_mus(store["mu"].values))
     common = "gap 2 cm, El Centro 1940 interpolated linearly; corrected model and the study's equations (study_compat)"
     items = []
     for isolation, description in CONFIGURATIONS.items():
@@ -188,7 +188,7 @@ def pair_against_mu(store: xr.Dataset) -> list[FigureItem]:
 
 def _lines_against_mu(store: xr.Dataset, isolation: str, variable: str, factor: float, building: str | None) -> dict[str, np.ndarray]:
     """One line per neighbour and model: ``variable`` (× ``factor``) against the finite μ of the store."""
-    finite = store["mu"].values[np.isfinite(store["mu"].values)]
+    finite = np.array(isolated_mus(store["mu"].values))
     models = list(store["model"].values) if "model" in store.dims else ["corrected"]
     lines = {}
     for neighbour in NEIGHBOURS:

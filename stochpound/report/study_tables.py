@@ -14,13 +14,13 @@ equations alone.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping
 
 import numpy as np
 import pandas as pd
 import xarray as xr
 
+from stochpound.experiment.definition import is_fixed_base
 from stochpound.model.modal_solution import modal_properties
 from stochpound.motions.records import load_record, record_statistics, registry_entries, study_table_3_2
 from stochpound.report.description import StoreDefinition
@@ -67,7 +67,7 @@ def mu_label(mu: float | str) -> str:
     """Column label of a friction coefficient: "μ = ∞" for the fixed base."""
     if mu == "single":
         return "single building"
-    return "μ = ∞" if math.isinf(float(mu)) else f"μ = {float(mu):g}"
+    return "μ = ∞" if is_fixed_base(mu) else f"μ = {float(mu):g}"
 
 
 def _variants(store: xr.Dataset | None) -> dict[str, dict[str, str]]:

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import functools
 from pathlib import Path
-from typing import Any
+from typing import Any, Sequence
 
 import numpy as np
 import xarray as xr
@@ -16,6 +16,8 @@ import xarray as xr
 from stochpound import __version__
 from stochpound.atomic import replacing
 from stochpound.results.record import ENERGY_TERMS, EventCounters, Recorder
+from stochpound.model.contact import ImpactElement
+from stochpound.model.friction import FIXED_BASE
 from stochpound.model.scene import Scene
 from stochpound.model.system import System
 
@@ -45,7 +47,7 @@ def build_dataset(scene: Scene, system: System, recorder: Recorder, counters: Ev
     """
     data_vars = {
         **_response_variables(scene, system, recorder),
-        **_contact_variables(scene),
+        **scene_parameters(scene),
         **(_wall_variables(scene, recorder) if scene.walls else {}),
         **_closure_variables(recorder, system.n_contacts, "contact"),
         **_contact_displacement_variables(recorder),
@@ -165,8 +167,14 @@ def _demand_variables(scene: Scene, recorder: Recorder) -> dict[str, tuple]:
 
 
 def _wall_variables(scene: Scene, recorder: Recorder) -> dict[str, tuple]:
-    """What each wall is, and its force over time."""
-    names, walls, n_contacts = scene.building_names, scene.walls, len(scene.contacts)
+    """Each wall's force over time."""
+    n_contacts = len(scene.contacts)
+    return {"wall_force": _var(("wall", "time"), recorder.forces[:, n_contacts:].T, "N", "force of the wall's impact element, positive in compression (0 while open)")}
+
+
+def _wall_parameters(scene: Scene) -> dict[str, tuple]:
+    """What each wall is: its building, side, level, gap, stiffness and damping."""
+    names, walls = scene.building_names, scene.walls
     return {
         "wall_building": _var(("wall",), np.array([names[w.building] for w in walls], dtype=str), "1", "building beside the wall"),
         "wall_side": _var(("wall",), np.array([w.side_name for w in walls], dtype=str), "1", "side of the building the wall is on"),
@@ -174,7 +182,56 @@ def _wall_variables(scene: Scene, recorder: Recorder) -> dict[str, tuple]:
         "wall_gap": _var(("wall",), np.array([w.gap for w in walls], float), "m", "at-rest gap"),
         "wall_stiffness": _var(("wall",), np.array([w.stiffness for w in walls], float), "N m-1", "impact spring stiffness"),
         "wall_damping": _var(("wall",), np.array([w.damping for w in walls], float), "N s m-1", "impact dashpot"),
-        "wall_force": _var(("wall", "time"), recorder.forces[:, n_contacts:].T, "N", "force of the wall's impact element, positive in compression (0 while open)"),
+    }
+
+
+def scene_parameters(scene: Scene) -> dict[str, tuple]:
+    """What a scene runs with: each building's base, each contact and wall with its law's parameters.
+
+    Returns
+    -------
+    dict
+        ``base_*`` (dimension ``building``), ``contact_*`` (``contact``) and
+        ``wall_*`` (``wall``, with walls): name -> (dims, values, attrs), as
+        the variables of a result (and the coordinates of an experiment store).
+    """
+    return {
+        **_base_variables(scene),
+        **_contact_variables(scene),
+        **_element_variables("contact", scene.contacts),
+        **(_wall_parameters(scene) if scene.walls else {}),
+        **(_element_variables("wall", scene.walls) if scene.walls else {}),
+    }
+
+
+def _base_variables(scene: Scene) -> dict[str, tuple]:
+    """Each building's base as run: its friction law's parameters (μ = ∞, :data:`~stochpound.model.friction.FIXED_BASE`, for a fixed base)."""
+    bases = [b.base for b in scene.buildings]
+
+    def column(field: str, fixed: float = np.nan) -> np.ndarray:
+        return np.array([fixed if base is None else np.nan if getattr(base, field) is None else getattr(base, field) for base in bases], float)
+
+    restoring = [np.nan if b.base is None else b.base.restoring(scene.g * (b.base.mass + sum(b.mass))) for b in scene.buildings]
+    return {
+        "base_mu": _var(("building",), column("mu", FIXED_BASE), "1", "kinetic friction coefficient of the base (inf: a fixed base)"),
+        "base_mu_static": _var(("building",), column("mu_static", FIXED_BASE), "1", "static friction coefficient of the base (inf: a fixed base)"),
+        "base_mass": _var(("building",), column("mass"), "kg", "base mass (nan: a fixed base)"),
+        "base_restoring_stiffness": _var(("building",), np.array(restoring, float), "N m-1",
+                                         "restoring stiffness of the base (W/R for a friction pendulum; nan: a fixed base)"),
+        "base_radius": _var(("building",), column("radius"), "m", "radius of the friction pendulum (nan: a flat slider or a fixed base)"),
+        "base_mu_fast": _var(("building",), column("mu_fast"), "1", "friction coefficient at high sliding velocity (nan: Coulomb friction)"),
+        "base_mu_rate": _var(("building",), column("mu_rate"), "s m-1", "rate of the velocity-dependent friction (nan: Coulomb friction)"),
+    }
+
+
+def _element_variables(kind: str, elements: Sequence[ImpactElement]) -> dict[str, tuple]:
+    """The law of each impact element of ``kind`` (``contact`` or ``wall``) as run, beside its gap, stiffness and damping."""
+    return {
+        f"{kind}_law": _var((kind,), np.array([e.law for e in elements], dtype=str), "1", "contact law of the impact element"),
+        f"{kind}_restitution": _var((kind,), np.array([np.nan if e.restitution is None else e.restitution for e in elements], float), "1",
+                                    "coefficient of restitution the damping was derived from (nan: damping given)"),
+        f"{kind}_tensile": _var((kind,), np.array([e.tensile for e in elements], dtype=bool), "1",
+                                "the element separates when the penetration returns to 0 (false: when its force does)"),
     }
 
 

@@ -1,0 +1,66 @@
+"""The store's declared catalogue of variables against what a real run and its summaries return."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import xarray as xr
+
+from stochpound.analysis.summary import top_floor_total_displacement
+from stochpound.experiment.catalogue import CASE_SUMMARIES, IMPACT_TABLE, REFERENCE_HISTORY, REFERENCE_SUMMARIES, TIME_HISTORIES, StoreVariable
+from stochpound.experiment.spec import TIME_HISTORY_VARIABLES
+from stochpound.experiment.summary import DEMAND_SUMMARIES, REFERENCE_SUMMARIES as REFERENCE_NAMES, case_summary, reference_summary
+from stochpound.model.scene_file import scene_from_dict
+from stochpound.solvers.simulate import simulate
+
+
+@pytest.fixture(scope="module")
+def run() -> xr.Dataset:
+    """Two two-storey buildings (the right one stiffer), the left one on a sliding base, one contact that closes; demands kept."""
+    building = {"mass": [1.0, 1.0], "stiffness": [40.0, 40.0], "damping_ratio": 0.05}
+    scene = scene_from_dict(
+        {
+            "building": [{"name": "A", **building, "base": {"mass": 1.0, "mu": 0.3}}, {"name": "B", **building, "stiffness": [400.0, 400.0]}],
+            "contact": [{"between": [["A", 2], ["B", 2]], "gap": 0.01, "stiffness": 400.0, "restitution": 0.5}],
+            "motion": {"type": "harmonic", "amplitude": 3.0, "omega": 5.0, "duration": 3.0, "dt": 0.01},
+        },
+        source="catalogue test",
+    )
+    result = simulate(scene, "ivp", demands=True)
+    assert int(result["impact_contact"].size) > 0  # the impact table has rows
+    return result
+
+
+def _check(variable: StoreVariable, data: xr.DataArray) -> None:
+    assert tuple(d for d in data.dims if d != "time") == variable.dims, variable.name
+    assert data.dtype.kind == np.dtype(variable.dtype).kind, variable.name
+    assert {k: data.attrs.get(k) for k in ("units", "long_name")} == variable.attrs, variable.name
+
+
+def test_case_summaries_are_declared(run: xr.Dataset) -> None:
+    """Every summary of a case, in order, with its dimensions, dtype, units and long name."""
+    summary = case_summary(run, "A", top_floor_total_displacement(run, "A"))
+    assert list(summary.data_vars) == [v.name for v in CASE_SUMMARIES]
+    for variable in CASE_SUMMARIES:
+        _check(variable, summary[variable.name])
+    assert set(DEMAND_SUMMARIES) <= {v.name for v in CASE_SUMMARIES}
+
+
+def test_reference_summaries_are_declared(run: xr.Dataset) -> None:
+    """The fixed-base reference's summaries (the studied building alone)."""
+    summary = reference_summary(run.isel(building=[0]), "A")
+    assert list(summary.data_vars) == [v.name for v in REFERENCE_SUMMARIES] == [f"reference_{n}" for n in REFERENCE_NAMES]
+    for variable in REFERENCE_SUMMARIES:
+        _check(variable, summary[variable.name])
+
+
+def test_time_histories_and_impacts_are_declared(run: xr.Dataset) -> None:
+    """Every history an experiment can keep and every impact column, as simulate() returns them."""
+    assert tuple(TIME_HISTORIES) == TIME_HISTORY_VARIABLES
+    for variable in TIME_HISTORIES.values():
+        assert run[variable.name].dims[-1] == "time"
+        _check(variable, run[variable.name])
+    for variable in IMPACT_TABLE:
+        _check(variable, run[variable.name])
+    assert REFERENCE_HISTORY.dims == TIME_HISTORIES["total_displacement"].dims[1:]
+    assert REFERENCE_HISTORY.units == TIME_HISTORIES["total_displacement"].units

@@ -1,0 +1,155 @@
+"""The typed experiment definition: identities of the experiment files, read_definition, gap axes on walls, the shared rules."""
+
+from __future__ import annotations
+
+import copy
+import hashlib
+import math
+import tomllib
+from pathlib import Path
+
+import numpy as np
+import pytest
+import xarray as xr
+
+from stochpound.experiment import Experiment
+from stochpound.experiment.definition import FIXED_BASE, Definition, GapAxis, is_fixed_base, is_gap_axis, read_definition
+from stochpound.experiment.spec import ExperimentError, canonical_json, definition_sha256, load_definition, parse_experiment
+from stochpound.report.facets import value_text
+
+ROOT = Path(__file__).resolve().parents[1]
+EXPERIMENTS = sorted(p for p in (ROOT / "experiments").glob("**/*.toml") if "scenes" not in p.parts)
+
+#: sha256 of an experiment file's bytes -> sha256 of its canonical definition, as the code gave before the
+#: typed definition. A change of the code that changes one of these refuses every store made from that file.
+#: (A new version of a file adds its own pair.)
+IDENTITIES = {
+    "dff3909976ebae73dbef4b1c7e398b3c66732d61c178e1debb73a80981f01404": "a63f03d1e1476471d116da9995f03d845c9e79e14062bb72ce23591ed55bdbe9",
+    "638a33ff8b952e185ac07f1fa238740ac38b104a19a0645200932dff86f82be1": "55b4b4b082fba4063464e07d892cf47f9fe52647e8aaf4da1dc51387b674d13f",
+    "7ad709e4bbe91a9f92e0c12f96f960fce5174cd54a3a1cf0906d78795a2e9945": "f336d6034b32d583b0db8f048c848c45712cd573d4674dd9f0ccdea44ade869b",
+    "6697914613a0683968394c9f99293c9aa78bf484a40e8a37114efa5d1f1ecd75": "0c7e1bb0cb9003917d5cacf7873dcc867307b4a31f88d0c9f90a620b49be6ae6",
+    "eb5a30003676e0a4788bdc77278c680db1928cefaa2e3184526ffb4ff2cd149e": "128add143f75d2a6807a3bdadd1a10eccb86101908995348243d55d4932ab1bb",
+    "4904d40c5d2d0af316c9c36b4504f7cfee312861107e92629aed74be5de1066e": "77712e2d264128c8a3ecf4a696d879d37508b4eb254212b076dc9de9f45a36d9",
+    "6daeb16f63151e60b79f56d62baf423fe9dc5422dd7830c10c372c48ccf19b93": "6a1f389f07a4ddb74a22fbafd5d9eaf12cfb7b010b75506e2a1437e07f1be195",
+    "309e927fcc92995558f608b63070f7e34c624ad733de05db2ef3dd846f46cb13": "d7bad4356301529901f3028369bf45d6dce7588b965a51be782d38c89476ebc1",
+    "3a44b36605ea72c0c043259c19a87db1bc5a8500725c7284713e6ff3cfa64452": "913155073613e472c6ef121b0554fa0de7279f648eae93ad48e7312bd1006f1a",
+    "93e84ab50ebb80c062ec7a177215421571fafb21faf708e8305b434fedf77a5d": "9ccb32b6d15111c2d0345cd74ac84e5e347b7c48011b942840a44a14ea11a14b",
+    "a8d3ad001bdadc3e1c3396bd7a9b21732bc1417c58b9421ed2653e00825f3eb2": "d55d0ae2cae2a3641780d936ed0fa9a61320d035ec519634a8d5a6aacb8d882c",
+    "0891f60b747a8f36d97e968b18eca6f258bb1e9f6782da805f763b739f5ba482": "17ac371fe5e1bedc1ee453a2548339086beffba24ce2aaf729d893eb2a9513a5",
+}
+
+
+def test_experiment_files_keep_their_identity() -> None:
+    """Every experiment file whose version is pinned gives the same canonical definition (sha256) as before."""
+    checked = 0
+    for path in EXPERIMENTS:
+        pinned = IDENTITIES.get(hashlib.sha256(path.read_bytes()).hexdigest())
+        if pinned is None:
+            continue
+        definition, _ = load_definition(path)
+        assert definition_sha256(definition) == pinned, path
+        checked += 1
+    assert checked >= len(EXPERIMENTS) - 2, "most experiment files are pinned: pin the new versions"
+
+
+@pytest.mark.parametrize("path", EXPERIMENTS, ids=lambda p: str(p.relative_to(ROOT)))
+def test_read_definition_keeps_the_canonical_definition(path: Path) -> None:
+    """From the parsed dict, from a store's JSON attribute, and from its text: the same dict and sha256; axes are floats."""
+    definition, _ = load_definition(path)
+    store = xr.Dataset(attrs={"definition": canonical_json(definition)})
+    for source in (definition, store, canonical_json(definition)):
+        typed = read_definition(source)
+        assert typed.sha256 == definition_sha256(definition)
+        assert canonical_json(typed.to_dict()) == canonical_json(definition)
+        for axis in [*typed.gaps, *([typed.mu] if typed.mu else [])]:
+            assert all(isinstance(v, float) for v in axis.values)
+    typed = read_definition(store)
+    assert [m.label for m in typed.motions] == [m["label"] for m in definition["motions"]]
+    assert typed.output.buildings == tuple(definition["output"]["buildings"])
+    assert typed.solver.rtol == definition["solver"]["rtol"]
+    assert Experiment(typed).sha256 == Experiment(definition).sha256
+
+
+def test_read_definition_types_and_errors() -> None:
+    """Gap and μ axes, motions and the errors of a store without a definition."""
+    definition, _ = load_definition(ROOT / "experiments" / "study" / "pair_mu.toml")
+    typed = read_definition(definition)
+    assert isinstance(typed, Definition) and read_definition(typed) is typed
+    assert typed.mu is not None and typed.mu.has_fixed_base and FIXED_BASE in typed.mu.values
+    assert not any(is_fixed_base(m) for m in typed.mu.finite_values)
+    with pytest.raises(ExperimentError, match="no definition attribute"):
+        read_definition(xr.Dataset())
+    broken = copy.deepcopy(definition)
+    del broken["solver"]
+    with pytest.raises(ExperimentError, match="solver"):
+        read_definition(broken)
+
+
+def test_fixed_base_rule() -> None:
+    """μ = ∞ (a float or JSON's "inf") is a fixed base, and only that."""
+    assert is_fixed_base(math.inf) and is_fixed_base("inf") and is_fixed_base(np.float64(np.inf))
+    assert not is_fixed_base(0.0) and not is_fixed_base(0.1) and not is_fixed_base(1e300)
+    assert value_text("mu", math.inf) == "fixed" and value_text("mu", 0.1) == "0.1"
+
+
+@pytest.mark.parametrize(("name", "gap"), [("gap", True), ("gap_top", True), ("gap_wall_1", True), ("gap_", False), ("gaps", False), ("mu", False), ("gap-x", False)])
+def test_gap_axis_rule(name: str, gap: bool) -> None:
+    """One rule names gap axes for the parser and the report (cm labels)."""
+    assert is_gap_axis(name) is gap
+    assert (value_text(name, 0.02) == "2 cm") is gap
+
+
+def _moat(grid: dict, walls: list[dict] | None = None) -> dict:
+    """The moat-wall experiment with ``grid`` and, instead of its ``moat`` variants, ``walls`` in the base scene."""
+    data = tomllib.loads((ROOT / "experiments" / "laws" / "moat_wall.toml").read_text())
+    del data["variants"]
+    data["scene"]["wall"] = walls if walls is not None else copy.deepcopy(tomllib.loads((ROOT / "experiments" / "laws" / "moat_wall.toml").read_text())["variants"]["moat"]["w05"]["scene"]["wall"])
+    data["grid"] = grid
+    return data
+
+
+def test_gap_axis_sets_walls() -> None:
+    """``gap_wall = { values, walls }`` gives each grid point the scene that a variant repeating the wall tables gives."""
+    original = Experiment(load_definition(ROOT / "experiments" / "laws" / "moat_wall.toml")[0])
+    compact = Experiment(parse_experiment(_moat({"mu": {"values": [0.05, 0.1], "buildings": ["B1"]}, "gap_wall": {"values": [0.05, 0.1, 0.15, 0.2, 0.3, "inf"], "walls": [0, 1]}})))
+    assert compact.contract.gaps == (GapAxis("gap_wall", (0.05, 0.1, 0.15, 0.2, 0.3, math.inf), (), (0, 1)),)
+    variant = {0.05: "w05", 0.1: "w10", 0.15: "w15", 0.2: "w20", 0.3: "w30"}
+    compared = 0
+    for point in compact.points("case"):
+        labels = dict(point.labels)
+        scene = compact.structure(point)
+        if math.isinf(labels["gap_wall"]):
+            assert all(math.isinf(w["gap"]) for w in scene["wall"])  # a wall that is never reached: the moat "none"
+            continue
+        twin = next(p for p in original.points("case") if dict(p.labels) == {"moat": variant[labels["gap_wall"]], "mu": labels["mu"]})
+        assert scene == original.structure(twin)
+        compared += 1
+    assert compared == 10
+    compact.validate()
+
+
+def test_gap_axis_wall_errors() -> None:
+    """Walls out of range, a scene without walls, and a wall-only axis leave the contacts alone."""
+    with pytest.raises(ExperimentError, match=r"grid.gap_wall.walls: must be a non-empty list of wall indices in 0..1, got \[2\]"):
+        parse_experiment(_moat({"gap_wall": {"values": [0.1], "walls": [2]}}))
+    with pytest.raises(ExperimentError, match="grid.gap_wall.walls: the base scene has no wall"):
+        parse_experiment(_moat({"gap_wall": {"values": [0.1], "walls": [0]}}, walls=[]))
+    with pytest.raises(ExperimentError, match="give walls"):
+        parse_experiment(_moat({"gap": [0.1]}))
+    pair = tomllib.loads((ROOT / "experiments" / "quickstart.toml").read_text())
+    n_contacts = len(parse_experiment(pair, base_dir=ROOT / "experiments")["scene"]["contact"])
+    assert n_contacts > 0
+    with pytest.raises(ExperimentError, match="grid.gap_w.walls: the base scene has no wall"):
+        parse_experiment({**pair, "grid": {"gap_w": {"values": [0.1], "walls": [0]}}}, base_dir=ROOT / "experiments")
+
+
+def test_report_names_the_gap_axis_of_walls() -> None:
+    """The report's table of contacts gives a wall's gap as the axis that sets it, read from the store's definition alone."""
+    from stochpound.report.description import StoreDefinition, contacts_table
+
+    definition = parse_experiment(_moat({"mu": {"values": [0.05, 0.1], "buildings": ["B1"]}, "gap_wall": {"values": [0.05, 0.1, "inf"], "walls": [0, 1]}}))
+    store = xr.Dataset(attrs={"definition": canonical_json(definition)})
+    table = contacts_table([StoreDefinition("moat", store)])
+    assert table is not None
+    cells = set(table.frame.astype(str).values.ravel())
+    assert "{0.05, 0.1, ∞} (axis gap_wall)" in cells
