@@ -19,7 +19,7 @@ import xarray as xr
 from stochpound.analysis import kernels
 from stochpound.report.document import Block, Paragraph, Table
 from stochpound.report.ensembles import CM, MIN_RUNS, Ensemble
-from stochpound.experiment.definition import is_gap_axis
+from stochpound.experiment.definition import FIXED_BASE, is_fixed_base, is_gap_axis
 from stochpound.experiment.selections import fixed_base, has_fixed_base_twins, isolated_mus
 from stochpound.report.facets import dim_text, labels_text, value_text
 
@@ -262,8 +262,8 @@ def _clearly(isolated: xr.Dataset, fixed: xr.Dataset, name: str) -> tuple[xr.Dat
 def isolation_changes(ensemble: Ensemble) -> tuple[xr.DataArray, xr.DataArray]:
     """Per isolated cell (μ finite, every other label): where isolation clearly lowers and where it clearly raises P(pounding) against the fixed base."""
     stats = ensemble.statistics
-    finite = [m for m in ensemble.grid["mu"] if not math.isinf(m)]
-    return _clearly(stats.sel(mu=finite), stats.sel(mu=math.inf, drop=True), "pounding_probability")
+    finite = [m for m in ensemble.grid["mu"] if not is_fixed_base(m)]
+    return _clearly(stats.sel(mu=finite), stats.sel(mu=FIXED_BASE, drop=True), "pounding_probability")
 
 
 def _where_sign_flips(ensemble: Ensemble) -> str:
@@ -292,7 +292,7 @@ def isolation_across(ensembles: list[Ensemble]) -> Paragraph | None:
     counts = {}
     for ensemble in ensembles:
         mus = ensemble.grid.get("mu", [])
-        if any(math.isinf(m) for m in mus) and any(not math.isinf(m) for m in mus):
+        if any(is_fixed_base(m) for m in mus) and any(not is_fixed_base(m) for m in mus):
             lower, higher = isolation_changes(ensemble)
             counts[ensemble.label] = (int(lower.sum()), int(higher.sum()), int(lower.size))
     if len(counts) < 2:

@@ -54,7 +54,7 @@ def store_section(name: str, store: xr.Dataset, contact_free: bool = False) -> S
     dimensions then count them, and say so.
     """
     section = Section(f"Experiment {name}", key=f"experiment-{name}")
-    dims = [f"{d} ({store.sizes[d] + 1}: {store.sizes[d]} gaps here and the contact-free one of the Separation section)" if contact_free and is_gap(d)
+    dims = [f"{d} ({store.sizes[d] + 1}: {store.sizes[d]} gaps here and the contact-free one of the Separation section)" if contact_free and is_gap_axis(d)
             else f"{d} ({store.sizes[d]})" for d in store["case_status"].dims]
     section.add(Paragraph(
         f"{store.attrs.get('experiment_description', '')} Studied building: {store.attrs.get('studied_building', '')}; its "

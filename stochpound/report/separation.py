@@ -21,19 +21,17 @@ cell. Every sentence is computed from the store.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
 import xarray as xr
 
 from stochpound.analysis import pounding_curve, pounding_probability, required_separation, rule_exceedance, separation_rules, store_contact_demands
-from stochpound.analysis.separation import TARGET_PROBABILITIES
 from stochpound.report import figures
 from stochpound.report.document import Block, FigureItem, Paragraph, Section, Table
 from stochpound.report.ensemble_findings import RARE, rare_gap
 from stochpound.report.ensembles import Ensemble, line_label, lines, table_frame
-from stochpound.experiment.selections import contact_free, gap_dims, has_contact_free, isolated_mus, with_contacts
+from stochpound.experiment.selections import contact_free, gap_dims, isolated_mus, with_contacts
 from stochpound.report.facets import dim_text, labels_text, value_text
 
 CM = 100.0
@@ -48,7 +46,7 @@ CURVE_PROBABILITIES = tuple(np.round(np.geomspace(0.005, 0.9, 31), 5))
 
 
 def separation_section(name: str, store: xr.Dataset) -> Section:
-    """The "Separation" section of one store (call when :func:`has_contact_free`)."""
+    """The "Separation" section of one store (call when :func:`stochpound.experiment.selections.has_contact_free`)."""
     free = contact_free(store)
     section = Section(f"Separation: experiment {name}", key=f"separation-{name}")
     section.add(_method_paragraph(store))

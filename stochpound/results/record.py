@@ -133,7 +133,7 @@ class Recorder:
     demands: dict[str, np.ndarray] = field(init=False)
 
     def __post_init__(self) -> None:
-        n_times, n = len(self.motion.times), self.system.n_dof
+        n_times = len(self.motion.times)
         self.states = np.zeros((n_times, self.system.xi_size))
         self.forces = np.zeros((n_times, self.system.n_elements))
         self.friction = np.zeros((n_times, len(self.system.base_dofs)))
