@@ -31,7 +31,8 @@ from stochpound.analysis import pounding_probability, required_separation
 from stochpound.report.document import Block, Paragraph, Section, Table
 from stochpound.report.ensembles import MIN_RUNS, Ensemble
 from stochpound.report.facets import dim_text, labels_text, value_text
-from stochpound.report.separation import SeparationEnsemble, gap_dims, has_contact_free, span_cm, with_contacts
+from stochpound.experiment.selections import gap_dims, has_contact_free, with_contacts
+from stochpound.report.separation import SeparationEnsemble, span_cm
 
 CM = 100.0
 SEPARATION_TARGETS = (0.05, 0.01)
