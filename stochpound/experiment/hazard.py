@@ -27,6 +27,7 @@ carries everything needed to redo the risk chain without the file.
 from __future__ import annotations
 
 import hashlib
+import json
 import math
 from pathlib import Path
 from typing import Any, Mapping
@@ -157,3 +158,33 @@ def _power_law(table: Any) -> dict[str, float]:
         raise IntensityError(f"hazard.power_law: must be a table {{ k0 = ..., k = ... }} (rate = k0 x^-k, 1/yr), got {table!r}")
     toml_fields.reject_unknown(table, {"k0", "k"}, "hazard.power_law")
     return {key: toml_fields.number(table, key, "hazard.power_law", required=True, low=0.0, low_open=True) for key in ("k0", "k")}
+
+
+def stored_hazard(store: Any) -> HazardCurve | None:
+    """The hazard an experiment store carries (its definition's ``hazard`` entry), or None."""
+    entry = json.loads(store.attrs.get("definition", "{}")).get("hazard")
+    return None if entry is None else hazard_curve(entry)
+
+
+def hazard_option(value: str, intensity: Mapping[str, Any], option: str = "--hazard") -> HazardCurve:
+    """A hazard named on the command line: a bundled curve's name (its measure checked against ``intensity``) or a CSV file.
+
+    A file is taken to be in ``intensity``'s measure and the units of its
+    levels (it cannot say otherwise); a bundled curve must match them.
+
+    Raises
+    ------
+    IntensityError
+        Neither a bundled name nor a file, an invalid file, or a bundled curve of another measure.
+    """
+    if value in bundled_curves():
+        _check_measure(option, bundled_measure(value), intensity, bundled=value)
+        return HazardCurve.bundled(value)
+    path = Path(value)
+    if not path.is_file():
+        raise IntensityError(f"{option}: {value!r} is neither a file nor a bundled hazard curve (bundled: {', '.join(bundled_curves())})")
+    try:
+        curve = HazardCurve.from_file(path, measure=describe_measure(intensity), units=intensity["units"])
+    except ValueError as error:
+        raise IntensityError(f"{option}: {error}") from None
+    return curve

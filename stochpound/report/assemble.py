@@ -19,6 +19,7 @@ from stochpound.report import findings, study_figures, study_notes, study_tables
 from stochpound.report.document import Block, Paragraph, Report, Section
 from stochpound.report.generic import store_section
 from stochpound.report.intensity import intensity_section, intensity_setting
+from stochpound.report.risk import has_risk, risk_section
 from stochpound.report.separation import has_contact_free, separation_section, with_contacts
 from stochpound.report.methods import methods_section
 from stochpound.report.stores import open_stores
@@ -81,6 +82,9 @@ def assemble_report(paths: Sequence[str | Path], progress: Callable[[str], None]
         if intensity_setting(store) is not None:
             say(f"experiment {name}: intensity")
             report.sections.append(intensity_section(name, store))
+        if has_risk(store):
+            say(f"experiment {name}: risk")
+            report.sections.append(risk_section(name, store))
     say("methods")
     report.sections.append(methods_section(stores))
     return report
