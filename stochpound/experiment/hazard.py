@@ -69,11 +69,9 @@ def parse_hazard(data: Mapping[str, Any], intensity: Mapping[str, Any] | None, b
         Naming the field: no ``[intensity]``, not exactly one source, an
         unreadable or invalid table, a measure other than ``[intensity]``'s.
     """
-    table = data.get("hazard")
+    table = toml_fields.table(data, "hazard", "")
     if table is None:
         return None
-    if not isinstance(table, dict):
-        raise IntensityError("hazard: must be a table (file, bundled or power_law)")
     toml_fields.reject_unknown(table, _KEYS, "hazard")
     if intensity is None:
         raise IntensityError("hazard: needs an [intensity] table (the hazard is a curve of its measure, in the units of its levels)")

@@ -70,21 +70,22 @@ def assemble_report(paths: Sequence[str | Path], progress: Callable[[str], None]
             report.sections.append(Section(title, build(), key=key))
     if others and not study:
         report.sections.append(Section("About this report", [Paragraph(_about(others))], key="about"))
+    for name, store in others.items():  # the answer first: each store's risk at its site, right after the introduction
+        if has_risk(store):
+            say(f"experiment {name}: risk")
+            report.sections.append(risk_section(name, store))
     for name, store in others.items():
         say(f"experiment {name}")
         contact_free = has_contact_free(store)
         finite = with_contacts(store) if contact_free else store
         if all(finite.sizes[d] for d in finite["case_status"].dims):
             report.sections.append(store_section(name, finite))
-        if contact_free:
+        if contact_free and not has_risk(store):  # with a hazard, the Risk section gives the separation at every intensity
             say(f"experiment {name}: separation")
             report.sections.append(separation_section(name, store))
         if intensity_setting(store) is not None:
             say(f"experiment {name}: intensity")
             report.sections.append(intensity_section(name, store))
-        if has_risk(store):
-            say(f"experiment {name}: risk")
-            report.sections.append(risk_section(name, store))
     say("methods")
     report.sections.append(methods_section(stores))
     return report

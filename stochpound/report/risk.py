@@ -210,7 +210,7 @@ def risk_section(name: str, store: xr.Dataset) -> Section:
     setting = intensity_of(store)
     section = Section(f"Risk: experiment {name}", key=f"risk-{name}")
     section.add(Paragraph(headline_text(name, store, risk)))
-    section.add(Paragraph(_hazard_text(store, risk.hazard, setting)))
+    section.add(Paragraph(_hazard_text(risk.hazard, setting, risk.method)))
     section.add(Table(f"risk-separation-{name}", f"Experiment {name}: risk-targeted separation g* per configuration and target, with its "
                       f"{int(100 * CONFIDENCE)} % BCa bootstrap interval over the {risk.motions} motions", separation_frame(risk),
                       note=_grid_note(risk), formats={"g* (m)": "{:.3f}", "lower (m)": "{:.3f}", "upper (m)": "{:.3f}"}))
@@ -224,15 +224,16 @@ def risk_section(name: str, store: xr.Dataset) -> Section:
     return section
 
 
-def _hazard_text(store: xr.Dataset, hz: HazardCurve, setting: dict[str, Any]) -> str:
+def _hazard_text(hz: HazardCurve, setting: dict[str, Any], method: str) -> str:
     levels = {p: float(hz.intensity_at(rate_from_probability(p, YEARS))) for p in (0.10, 0.02)}
     source = hz.source.splitlines()[0] if hz.source else ""
+    fitted = ("fitted to the stripes' counts by maximum likelihood, from the contact-free runs by the gap identity" if method == "stripes"
+              else "of the motions' IDA capacities IM·g/D (log-moments), from one contact-free run per motion")
     extrapolated = " The hazard was extrapolated beyond its table (as a power law) for some integrals." if hz.extrapolated else ""
     return (
         f"Hazard curve {repr(hz)} of {describe_measure(setting)} in {setting['units']} ({source}); its 10 %/50 yr intensity is "
         f"{levels[0.10]:.3g} and its 2 %/50 yr intensity {levels[0.02]:.3g} {setting['units']}. The fragility of every gap is the "
-        "lognormal fitted to the stripes' counts by maximum likelihood (IDA: to the capacities), from the contact-free runs by the "
-        "gap identity; λ_P(g) = ∫ F(x; g) |dλ(x)|; the intervals resample the motions and refit the whole chain. Assumptions: Poisson "
+        f"lognormal {fitted}; λ_P(g) = ∫ F(x; g) |dλ(x)|; the intervals resample the motions and refit the whole chain. Assumptions: Poisson "
         "occurrence, record-to-record variability only (not the hazard's or the model's uncertainty), and a suite scaled to each "
         f"intensity standing for the site's motions of that intensity.{extrapolated}"
     )
@@ -418,7 +419,8 @@ def _demand_blocks(name: str, store: xr.Dataset, risk: StoreRisk, setting: dict[
         ax.grid(True, which="both", lw=0.3, color="0.85")
     for ax in axes[len(demands):]:
         ax.set_visible(False)
-    axes[0].legend(fontsize=5)
+    if axes[0].get_legend_handles_labels()[1]:
+        axes[0].legend(fontsize=5)
     blocks: list[Block] = [FigureItem(f"risk-demands-{name}", f"Experiment {name}: demand hazard curves (mean annual frequency of "
                                       "exceeding each level, the lognormal fragility of every level fitted over the stripes' "
                                       "contact-free runs and integrated with the hazard, made non-increasing along the level), per "
