@@ -35,32 +35,10 @@ from tests.test_experiment_helpers import write_experiment
 REPOSITORY = Path(__file__).resolve().parent.parent
 MOTIONS = ["01a", "03b", "05a", "07b", "10a", "12a", "14b", "19a"]
 RECORDS = "".join(f'\n[[records]]\nrecord = "fema_p695_far_field/{name}"\nduration = 5.0\n' for name in MOTIONS)
-ISOLATED = """
-[scene]
-g = 9.81
-[[scene.building]]
-name = "B1"
-mass = [26268.0, 17512.0]
-stiffness = [24516800.0, 17512000.0]
-damping_ratio = 0.05
-base = { mass = 13134.0, mu = 0.05, radius = 2.24 }
-[[scene.building]]
-name = "B2"
-mass = [13134.0, 8756.0]
-stiffness = [24516800.0, 17512000.0]
-damping_ratio = 0.05
-[[scene.contact]]
-between = [["B1", 1], ["B2", 1]]
-gap = 0.02
-stiffness = 42747262.6
-restitution = 0.5
-[[scene.contact]]
-between = [["B1", 2], ["B2", 2]]
-gap = 0.02
-stiffness = 28498175.1
-restitution = 0.5
-"""
-FIXED = ISOLATED.replace("base = { mass = 13134.0, mu = 0.05, radius = 2.24 }\n", "")
+FLAGSHIP = (REPOSITORY / "experiments" / "risk" / "isolated.toml").read_text()
+ISOLATED = FLAGSHIP[FLAGSHIP.index("[scene]"):FLAGSHIP.index("[variants")]  # the flagship's scene, without its variants
+_B2 = ISOLATED.rindex("mass = [26268.0, 17512.0]")  # the neighbour: the stiff variant (masses x 0.5), else the pair moves as one
+FIXED = re.sub(r"^base = .*\n", "", ISOLATED[:_B2] + "mass = [13134.0, 8756.0]" + ISOLATED[_B2 + len("mass = [26268.0, 17512.0]"):], flags=re.MULTILINE)
 BUNDLED = "fox_plaza_los_angeles_sa1p0s"
 PINNED = {  # canonical definitions of files without [hazard]: unchanged by it
     "quickstart.toml": "128add143f75d2a6807a3bdadd1a10eccb86101908995348243d55d4932ab1bb",
