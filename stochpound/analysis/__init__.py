@@ -31,7 +31,7 @@ from stochpound.analysis.fragility_ensemble import (
 from stochpound.analysis.hazard import HazardCurve, probability_from_rate, rate_from_probability, return_period
 from stochpound.analysis.risk import demand_hazard_curve, mean_annual_frequency, risk_curve, risk_targeted_separation
 from stochpound.analysis.code_rules_risk import code_rules_risk
-from stochpound.analysis.store_risk import contact_free_closure, pounding_fragility
+from stochpound.analysis.store_risk import StoreRisk, contact_free_closure, pounding_fragility, risk_gaps, store_risk
 
 __all__ = [
     "moments",
@@ -73,4 +73,7 @@ __all__ = [
     "code_rules_risk",
     "contact_free_closure",
     "pounding_fragility",
+    "risk_gaps",
+    "store_risk",
+    "StoreRisk",
 ]

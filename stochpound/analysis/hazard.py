@@ -14,6 +14,7 @@ years is P = 1 − exp(−λ t), so 2 % in 50 years is λ = −ln(0.98)/50 =
 from __future__ import annotations
 
 import csv
+import re
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -24,6 +25,9 @@ from stochpound.data_files import bundled_data_dir
 
 BUNDLED_FOLDER = "hazard"
 """Name of the bundled hazard folder (``data/hazard/`` in the repository, with its ``SOURCES.md``)."""
+BUNDLED_DAMPING = 0.05
+"""Damping ratio of the bundled spectral-acceleration curves."""
+_BUNDLED_MEASURE = re.compile(r"_(?:(pga)|sa(\d+)p(\d+)s)$")
 
 
 def rate_from_probability(probability: ArrayLike, years: float = 50.0) -> np.ndarray:
@@ -242,6 +246,24 @@ class HazardCurve:
 def bundled_curves() -> list[str]:
     """Names of the bundled hazard curves (``HazardCurve.bundled(name)``); provenance in ``data/hazard/SOURCES.md``."""
     return sorted(path.stem for path in _bundled_folder().glob("*.csv"))
+
+
+def bundled_measure(name: str) -> dict[str, float | str]:
+    """The intensity measure of a bundled curve, from the end of its name (``_pga``, or ``_sa<T>s`` with ``p`` for the point).
+
+    Returns
+    -------
+    dict
+        ``measure`` (``"pga"`` or ``"psa"``), for ``psa`` its ``period`` (s)
+        and ``damping`` (:data:`BUNDLED_DAMPING`), and ``units`` (``"g"``):
+        the keys of an experiment's ``[intensity]`` they must match.
+    """
+    match = _BUNDLED_MEASURE.search(name)
+    if match is None or name not in bundled_curves():
+        raise ValueError(f"name: no bundled hazard curve {name!r}; bundled: {', '.join(bundled_curves())}")
+    if match.group(1):
+        return {"measure": "pga", "units": "g"}
+    return {"measure": "psa", "period": float(f"{match.group(2)}.{match.group(3)}"), "damping": BUNDLED_DAMPING, "units": "g"}
 
 
 def _bundled_folder() -> Path:

@@ -22,6 +22,8 @@ def _register() -> None:
     main.add_command(experiment)
     from stochpound.cli.report import report
     main.add_command(report)
+    from stochpound.cli.risk import risk
+    main.add_command(risk)
 
 
 _register()

@@ -28,6 +28,7 @@ from typing import Any, Iterator, Mapping
 from stochpound.errors import SceneError
 from stochpound.experiment.catalogue import TIME_HISTORIES
 from stochpound.experiment.definition import is_gap_axis, read_definition
+from stochpound.experiment.hazard import parse_hazard
 from stochpound.experiment.intensity import parse_intensity
 from stochpound.model import fields as toml_fields
 from stochpound.model.contact import ELEMENT_KEYS
@@ -38,7 +39,7 @@ from stochpound.solvers.ivp import INTEGRATORS
 #: Format version of the canonical definition (stored with every store).
 FORMAT_VERSION = 1
 
-_TOP_KEYS = {"experiment", "scene", "variants", "grid", "records", "motions", "synthetic", "output", "solver", "intensity"}
+_TOP_KEYS = {"experiment", "scene", "variants", "grid", "records", "motions", "synthetic", "output", "solver", "intensity", "hazard"}
 _EXPERIMENT_KEYS = {"name", "description", "scene", "studied"}
 _BUILDING_OVERRIDES = {"mass_factor", "mass", "stiffness", "damping", "damping_ratio", "base", "initial"}
 _SCENE_OVERRIDES = {"study_compat", "wall"}
@@ -154,7 +155,8 @@ def parse_experiment(data: Mapping[str, Any], base_dir: str | Path = ".", defaul
     dict
         Canonical definition: ``format``, ``name``, ``description``,
         ``scene`` (the base scene's dict, its ``[motion]`` included when it has one),
-        ``studied``, ``variants``, ``gaps``, ``mu``, ``motions``, ``output``, ``solver``.
+        ``studied``, ``variants``, ``gaps``, ``mu``, ``motions``, ``output``, ``solver``;
+        ``intensity`` and ``hazard`` only when the file has those tables.
     """
     base_dir = Path(base_dir)
     with field_errors():
@@ -186,6 +188,7 @@ def parse_experiment(data: Mapping[str, Any], base_dir: str | Path = ".", defaul
     mu = _mu_axis(grid["mu"], buildings) if "mu" in grid else None
     with field_errors():
         intensity = parse_intensity(data, scene, variants, gaps, mu)
+        hazard = parse_hazard(data, intensity, base_dir)
     definition = {
         "format": FORMAT_VERSION,
         "name": name,
@@ -201,6 +204,8 @@ def parse_experiment(data: Mapping[str, Any], base_dir: str | Path = ".", defaul
     }
     if intensity is not None:  # absent without [intensity]: the definitions (and hashes) of other files are unchanged
         definition["intensity"] = intensity
+    if hazard is not None:  # likewise absent without [hazard]
+        definition["hazard"] = hazard
     read_definition(definition)  # the typed definition reads every field parsed here
     return definition
 

@@ -25,6 +25,7 @@ from stochpound.report.generic import store_section
 from stochpound.report.intensity import intensity_section, intensity_setting
 from stochpound.experiment.selections import has_contact_free, with_contacts
 from stochpound.report.separation import separation_section
+from stochpound.report.risk import has_risk, risk_section
 from stochpound.report.methods import methods_section
 from stochpound.report.stores import open_stores
 from stochpound.report.summary import experiment_summary, move_per_cell_tables, study_summary
@@ -78,13 +79,17 @@ def assemble_report(paths: Sequence[str | Path], progress: Callable[[str], None]
             report.sections.insert(0, study_summary(findings_section, report.sections))
     if others and not study:
         report.sections.append(Section("About this report", [Paragraph(_about(others))], key="about"))
+    for name, store in others.items():  # the answer first: each store's risk at its site, right after the introduction
+        if has_risk(store):
+            say(f"experiment {name}: risk")
+            report.sections.append(risk_section(name, store))
     for name, store in others.items():
         say(f"experiment {name}")
         contact_free = has_contact_free(store)
         finite = with_contacts(store) if contact_free else store
         if all(finite.sizes[d] for d in finite["case_status"].dims):
             report.sections.append(store_section(name, finite, contact_free))
-        if contact_free:
+        if contact_free and not has_risk(store):  # with a hazard, the Risk section gives the separation at every intensity
             say(f"experiment {name}: separation")
             report.sections.append(separation_section(name, store))
         if intensity_setting(store) is not None:

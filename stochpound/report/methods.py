@@ -19,6 +19,7 @@ from stochpound.report.accuracy import accuracy_paragraphs
 from stochpound.report.description import StoreDefinition, buildings_table, contacts_table, grid_paragraph, model_paragraph, motions_table, records_used
 from stochpound.report.document import Paragraph, Section, Table
 from stochpound.report.intensity import intensity_setting, method_text
+from stochpound.report.risk import hazard_provenance
 
 #: Packages whose versions the report lists.
 PACKAGES = ("numpy", "scipy", "xarray", "numba", "dask", "pandas", "matplotlib", "h5netcdf", "jinja2")
@@ -41,6 +42,9 @@ def methods_section(stores: Mapping[str, xr.Dataset]) -> Section:
         setting = intensity_setting(definition.store)
         if setting is not None:
             section.add(Paragraph(f"Experiment {definition.name}: {method_text(definition.store, setting)}"))
+        hazard = hazard_provenance(definition.store)
+        if hazard:
+            section.add(Paragraph(f"Experiment {definition.name}: {hazard}"))
     section.add(buildings_table(definitions))
     contacts = contacts_table(definitions)
     if contacts is not None:

@@ -1,0 +1,253 @@
+"""Pounding risk from experiment files to the CLI and the report (docs/risk.md).
+
+* ``[hazard]``: parsed into the canonical definition with its table and
+  provenance; errors name the field; its measure must be ``[intensity]``'s;
+  definitions of files without it are byte-identical (pinned sha256);
+* the store layer on small real stores: the fragility's per-gap counts are
+  a direct count of the contact-free closures; the gap identity holds on a
+  friction-pendulum store; for a fixed-base scene, stripes and IDA give the
+  same counts and consistent fits;
+* ``stochpound risk`` prints g* and the rules, and fails in one line;
+* the report's Risk section states g* first.
+"""
+
+from __future__ import annotations
+
+import re
+import tomllib
+from pathlib import Path
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+from stochpound import open_store
+from stochpound.analysis import HazardCurve, pounding_fragility
+from stochpound.analysis.store_risk import contact_free_closure, risk_gaps
+from stochpound.cli import main
+from stochpound.experiment.hazard import hazard_curve, stored_hazard
+from stochpound.experiment.runner import load_experiment, run_experiment
+from stochpound.experiment.spec import ExperimentError, definition_sha256, load_definition, parse_experiment
+from stochpound.report.document import Paragraph, Table
+from stochpound.report.risk import risk_headline, risk_of, risk_section
+from tests.test_experiment_helpers import write_experiment
+
+REPOSITORY = Path(__file__).resolve().parent.parent
+MOTIONS = ["01a", "03b", "05a", "07b", "10a", "12a", "14b", "19a"]
+RECORDS = "".join(f'\n[[records]]\nrecord = "fema_p695_far_field/{name}"\nduration = 5.0\n' for name in MOTIONS)
+FLAGSHIP = (REPOSITORY / "experiments" / "risk" / "isolated.toml").read_text()
+ISOLATED = FLAGSHIP[FLAGSHIP.index("[scene]"):FLAGSHIP.index("[variants")]  # the flagship's scene, without its variants
+_B2 = ISOLATED.rindex("mass = [26268.0, 17512.0]")  # the neighbour: the stiff variant (masses x 0.5), else the pair moves as one
+FIXED = re.sub(r"^base = .*\n", "", ISOLATED[:_B2] + "mass = [13134.0, 8756.0]" + ISOLATED[_B2 + len("mass = [26268.0, 17512.0]"):], flags=re.MULTILINE)
+BUNDLED = "fox_plaza_los_angeles_sa1p0s"
+PINNED = {  # canonical definitions of files without [hazard]: unchanged by it
+    "quickstart.toml": "128add143f75d2a6807a3bdadd1a10eccb86101908995348243d55d4932ab1bb",
+    "intensity/far_field_stripes.toml": "55b4b4b082fba4063464e07d892cf47f9fe52647e8aaf4da1dc51387b674d13f",
+    "intensity/far_field_ida.toml": "a63f03d1e1476471d116da9995f03d845c9e79e14062bb72ce23591ed55bdbe9",
+    "laws/moat_wall.toml": "0c7e1bb0cb9003917d5cacf7873dcc867307b4a31f88d0c9f90a620b49be6ae6",
+    "study/pair_mu.toml": "9ccb32b6d15111c2d0345cd74ac84e5e347b7c48011b942840a44a14ea11a14b",
+}
+
+
+def _text(scene: str, grid: str, intensity: str, hazard: str = f'bundled = "{BUNDLED}"') -> str:
+    hazard_table = f"\n[hazard]\n{hazard}\n" if hazard else ""
+    return (f'[experiment]\nname = "risk"\nstudied = "B1"\n{scene}\n[grid]\n{grid}\n{RECORDS}\n[intensity]\n{intensity}\n{hazard_table}'
+            '[output]\nimpacts = true\n')
+
+
+def _run(folder: Path, text: str, name: str) -> Path:
+    report = run_experiment(load_experiment(write_experiment(folder, text, name)), workers=0, progress=False)
+    assert report.complete
+    return report.store
+
+
+STRIPES = 'measure = "psa"\nperiod = 1.0\nlevels = [0.3, 0.8, 1.5]'
+
+
+@pytest.fixture(scope="module")
+def isolated_store(tmp_path_factory) -> Path:
+    """B1 on a friction pendulum beside a fixed B2: 8 motions x 3 stripes, gaps 5 cm and contact-free."""
+    return _run(tmp_path_factory.mktemp("isolated"), _text(ISOLATED, "gap = [0.05, inf]", STRIPES), "isolated.toml")
+
+
+@pytest.fixture(scope="module")
+def fixed_stores(tmp_path_factory) -> tuple[Path, Path]:
+    """The fixed-base pair: stripes (contact-free) and IDA, the same motions."""
+    folder = tmp_path_factory.mktemp("fixed")
+    levels = "levels = [0.1, 0.2, 0.4, 0.8, 1.6]"
+    stripes = _run(folder, _text(FIXED, "gap = [inf]", f'measure = "psa"\nperiod = 1.0\n{levels}'), "stripes.toml")
+    ida = _run(folder, _text(FIXED, "gap = [0.01, 0.02]", f'measure = "psa"\nperiod = 1.0\n{levels}\nmethod = "ida"', hazard=""), "ida.toml")
+    return stripes, ida
+
+
+# ---------------------------------------------------------------- [hazard]
+
+
+def _parse(hazard: str, intensity: str = STRIPES, base_dir: Path = REPOSITORY) -> dict:
+    return parse_experiment(tomllib.loads(_text(ISOLATED, "gap = [inf]", intensity, hazard)), base_dir=base_dir)
+
+
+def test_hazard_is_carried_in_the_definition(tmp_path):
+    entry = _parse(f'bundled = "{BUNDLED}"')["hazard"]
+    bundled = HazardCurve.bundled(BUNDLED)
+    assert entry["source"] == "bundled" and entry["measure"] == "psa" and entry["period"] == 1.0 and entry["units"] == "g"
+    assert entry["im"] == list(bundled.im) and entry["rate"] == list(bundled.rate) and "Fox Plaza" in entry["provenance"]
+    x = np.geomspace(0.02, 1.9, 25)
+    np.testing.assert_array_equal(hazard_curve(entry)(x), bundled(x))
+    (tmp_path / "site.csv").write_text("# my site, PSA(1 s)\nim,rate\n0.1,0.02\n0.5,0.002\n1.0,0.0004\n")
+    entry = _parse('file = "site.csv"', base_dir=tmp_path)["hazard"]
+    assert entry["file"] == "site.csv" and entry["rate"] == [0.02, 0.002, 0.0004] and entry["provenance"] == "my site, PSA(1 s)"
+    assert len(entry["file_sha256"]) == 64
+    entry = _parse("power_law = { k0 = 2.0e-4, k = 2.2 }\nmeasure = \"psa\"\nperiod = 1.0")["hazard"]
+    assert hazard_curve(entry)(0.5) == pytest.approx(2.0e-4 * 0.5**-2.2, rel=1e-12) and "im" not in entry
+
+
+@pytest.mark.parametrize(
+    ("hazard", "intensity", "message"),
+    [
+        ('bundled = "fox_plaza_los_angeles_sa2p0s"', STRIPES, r"^hazard\.bundled: the hazard's measure must be \[intensity\]'s, PSA\(T = 1 s"),
+        ('bundled = "fox_plaza_los_angeles_pga"', STRIPES, r"^hazard\.bundled: .*'fox_plaza_los_angeles_pga' is PGA in g"),
+        (f'bundled = "{BUNDLED}"', 'measure = "psa"\nperiod = 1.0\nlevels = [0.5]\nunits = "m/s2"', r"^hazard\.bundled: .*intensity\.units = 'm/s2'"),
+        ('power_law = { k0 = 2.0e-4, k = 2.2 }\nmeasure = "pga"', STRIPES, r"^hazard\.measure: the hazard's measure must be \[intensity\]'s"),
+        ('power_law = { k0 = 2.0e-4, k = 2.2 }\nperiod = 2.0', STRIPES, r"^hazard\.period: .*got 2\.0"),
+        ('power_law = { k0 = 2.0e-4, k = -1.0 }', STRIPES, r"^hazard\.power_law\.k: must be > 0"),
+        ('power_law = 3', STRIPES, r"^hazard\.power_law: must be a table"),
+        ('file = "missing.csv"', STRIPES, r"^hazard\.file: 'missing\.csv' not found"),
+        ('file = "a.csv"\nbundled = "b"', STRIPES, r"^hazard: give exactly one of file, bundled, power_law, got file, bundled"),
+        ('extrapolate = true', STRIPES, r"^hazard: give exactly one of file, bundled, power_law, got none"),
+        ('bundled = "nowhere"', STRIPES, r"^hazard\.bundled: no bundled hazard curve 'nowhere'"),
+        ('bundled = "x"\nsite = "y"', STRIPES, r"^hazard\.site: unknown field"),
+    ],
+)
+def test_hazard_errors_name_the_field(hazard, intensity, message):
+    with pytest.raises(ExperimentError, match=message):
+        _parse(hazard, intensity)
+
+
+def test_hazard_needs_intensity():
+    data = tomllib.loads(f'[experiment]\nname = "x"\n{ISOLATED}\n[grid]\ngap = [inf]\n{RECORDS}\n[hazard]\nbundled = "{BUNDLED}"\n')
+    with pytest.raises(ExperimentError, match=r"^hazard: needs an \[intensity\] table"):
+        parse_experiment(data, base_dir=REPOSITORY)
+
+
+@pytest.mark.parametrize("name", sorted(PINNED))
+def test_definitions_without_hazard_are_unchanged(name):
+    definition, _ = load_definition(REPOSITORY / "experiments" / name)
+    assert "hazard" not in definition
+    assert definition_sha256(definition) == PINNED[name]
+
+
+def test_the_flagship_experiments_use_the_bundled_hazard_in_their_measure():
+    for path in sorted((REPOSITORY / "experiments" / "risk").glob("*.toml")):
+        definition, _ = load_definition(path)
+        assert definition["hazard"]["bundled"] == "fox_plaza_los_angeles_sa2p0s"
+        assert (definition["intensity"]["measure"], definition["intensity"]["period"]) == ("psa", 2.0)
+        levels = definition["intensity"]["levels"]
+        hz = hazard_curve(definition["hazard"])
+        two_percent = float(hz.intensity_at(-np.log(0.98) / 50))
+        assert len(levels) >= 8 and max(levels) >= 1.5 * two_percent * 0.999
+        assert min(abs(np.log(np.array(levels) / two_percent))) < 1e-3 and min(abs(np.log(np.array(levels) / hz.intensity_at(-np.log(0.9) / 50)))) < 1e-3
+
+
+# ---------------------------------------------------------------- the store layer
+
+
+def test_fragility_counts_are_a_direct_count_of_the_closures(isolated_store):
+    store = open_store(isolated_store).load()
+    gaps = risk_gaps(contact_free_closure(store), 12)
+    fit = pounding_fragility(store, gaps, bootstrap=0)
+    closure = store["peak_contact_closure"].sel(gap=np.inf).max("contact").isel(realization=0)
+    for g in gaps:
+        for j, level in enumerate(store["intensity"].values):
+            runs = closure.isel(intensity=j).values
+            assert fit["exceeded"].sel(gap=g, intensity=level).item() == np.sum(runs >= g)
+            assert fit["runs"].sel(gap=g, intensity=level).item() == len(MOTIONS)
+
+
+def test_the_gap_identity_holds_with_a_friction_pendulum(isolated_store):
+    store = open_store(isolated_store).load()
+    assert float(store["peak_sliding_displacement"].sel(building="B1").max()) > 0.0
+    free = store["peak_contact_closure"].sel(gap=np.inf).max("contact")
+    pounded = store["impacts"].sel(gap=0.05) > 0
+    assert bool(pounded.any()) and not bool(pounded.all())
+    assert bool(((free >= 0.05) == pounded).all())
+
+
+def test_fixed_base_stripes_and_ida_agree(fixed_stores):
+    stripes, ida = (open_store(path).load() for path in fixed_stores)
+    closure = contact_free_closure(stripes)
+    gaps = np.geomspace(float(closure.quantile(0.2)), float(closure.quantile(0.8)), 5)
+    from_stripes = pounding_fragility(stripes, gaps, bootstrap=200)
+    from_ida = pounding_fragility(ida, gaps, bootstrap=0)
+    levels = stripes["intensity"].values
+    capacities = (ida["motion_intensity"].isel(gap=0, realization=0) * from_ida["gap"]
+                  / ida["peak_contact_closure"].isel(gap=0, realization=0).max("contact"))
+    for g in gaps:
+        counted = [(capacities.sel(gap=g).values <= level * (1 + 1e-9)).sum() for level in levels]
+        np.testing.assert_array_equal(from_stripes["exceeded"].sel(gap=g).values, counted)
+    fitted = from_stripes["status"].values == 0
+    assert fitted.sum() >= 3
+    lower, upper = from_stripes["theta_lower"].values[fitted], from_stripes["theta_upper"].values[fitted]
+    theta = from_ida["theta"].values[fitted]
+    assert np.all((theta >= lower) & (theta <= upper))
+
+
+# ---------------------------------------------------------------- CLI
+
+
+def test_cli_prints_separation_and_rules(isolated_store, tmp_path):
+    result = CliRunner().invoke(main, ["risk", str(isolated_store), "--bootstrap", "100", "--target", "0.1,0.02", "--csv", str(tmp_path / "risk.csv")])
+    assert result.exit_code == 0, result.output
+    risk = risk_of(open_store(isolated_store), bootstrap=100)
+    headline = risk_headline(risk)
+    for value in headline["separation"]:
+        assert f"{value:.3f}" in result.output
+    for text in ("10 % in 50 yr", "2 % in 50 yr", "SRSS (ASCE 7 δ_MT)", "0.7 SRSS (Eurocode 8)", "DDC", "D_TM", "once in (yr)"):
+        assert text in result.output
+    written = (tmp_path / "risk.csv").read_text()
+    assert written.startswith("target,separation") and "rules" in written
+
+
+def test_cli_errors_are_one_line(isolated_store, fixed_stores, tmp_path):
+    runner = CliRunner()
+    cases = [
+        (["risk", str(isolated_store), "--hazard", "fox_plaza_los_angeles_pga"], r"--hazard: the hazard's measure must be \[intensity\]'s"),
+        (["risk", str(fixed_stores[1])], r"--hazard: the store carries no hazard"),
+        (["risk", str(isolated_store), "--hazard", str(tmp_path / "none.csv")], r"--hazard: .* is neither a file nor a bundled hazard curve"),
+        (["risk", str(isolated_store), "--target", "0.1,2"], r"must be probabilities in \(0, 1\)"),
+    ]
+    for args, message in cases:
+        result = runner.invoke(main, args)
+        assert result.exit_code != 0 and re.search(message, result.output), result.output
+        assert len([line for line in result.output.splitlines() if line.startswith("Error")]) == 1
+    plain = _run(tmp_path, f'[experiment]\nname = "plain"\n{FIXED}\n[grid]\ngap = [inf]\n[[records]]\nrecord = "fema_p695_far_field/01a"\nduration = 2.0\n', "plain.toml")
+    result = runner.invoke(main, ["risk", str(plain)])
+    assert result.exit_code == 1 and "store: has no intensity stripes or IDA capacities" in result.output
+
+
+def test_cli_takes_a_hazard_file_and_ida_stores(fixed_stores, tmp_path):
+    csv = tmp_path / "site.csv"
+    hz = HazardCurve.bundled(BUNDLED)
+    csv.write_text("im,rate\n" + "".join(f"{float(x)!r},{float(y)!r}\n" for x, y in zip(hz.im, hz.rate)))
+    result = CliRunner().invoke(main, ["risk", str(fixed_stores[1]), "--hazard", str(csv), "--bootstrap", "0"])
+    assert result.exit_code == 0, result.output
+    assert "8 motions, IDA capacities" in result.output and "not evaluated: IDA runs hold no stripe" in result.output
+
+
+# ---------------------------------------------------------------- report
+
+
+def test_report_section_states_the_separation_first(isolated_store):
+    store = open_store(isolated_store)
+    section = risk_section("risk", store)
+    first = section.blocks[0]
+    assert isinstance(first, Paragraph) and first.text.startswith("Risk-targeted separation g*")
+    for value in risk_headline(risk_of(store))["separation"]:
+        assert f"{value:.3f} m" in first.text
+    assert f"from {len(MOTIONS)} motions (3 stripes of PSA(T = 1 s, 5 % damping) in g)" in first.text
+    keys = [block.key for block in section.blocks if not isinstance(block, Paragraph)]
+    assert keys[:2] == ["risk-separation-risk", "risk-curve-risk"]
+    assert {"risk-surface-risk", "risk-fragility-risk", "risk-rules-risk", "risk-demands-risk"} <= set(keys)
+    rules = next(block for block in section.blocks if isinstance(block, Table) and block.key == "risk-rules-risk")
+    assert "D_TM (ASCE 7 §17.2.5.2)" in rules.frame.index.get_level_values("rule")
+    assert stored_hazard(store).source.startswith("Site: Fox Plaza")
