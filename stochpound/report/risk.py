@@ -39,6 +39,7 @@ from stochpound.experiment.hazard import stored_hazard
 from stochpound.experiment.intensity import describe_measure
 from stochpound.report.document import Block, FigureItem, Paragraph, Section, Table
 from stochpound.report.facets import labels_text
+from stochpound.report.summary import RISK_ANSWERS
 
 CONFIDENCE = 0.95
 YEARS = 50.0
@@ -199,6 +200,14 @@ def headline_text(name: str, store: xr.Dataset, risk: StoreRisk) -> str:
         f"{name}, from {risk.motions} motions ({stripes}{describe_measure(setting)} in {setting['units']}) at the site of its hazard curve, "
         f"with {int(100 * CONFIDENCE)} % BCa bootstrap intervals over the motions: " + ". ".join(per) + "."
     )
+
+
+def summary_answer(name: str, store: xr.Dataset) -> list[Block]:
+    """The summary's answer to "which gap meets a target risk?" (a builder of :data:`stochpound.report.summary.RISK_ANSWERS`)."""
+    return [Paragraph(headline_text(name, store, risk_of(store)))] if has_risk(store) else []
+
+
+RISK_ANSWERS.append(summary_answer)
 
 
 # ---------------------------------------------------------------- the section
