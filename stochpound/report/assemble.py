@@ -19,6 +19,7 @@ from stochpound.report import findings, study_figures, study_notes, study_tables
 from stochpound.report.document import Block, Paragraph, Report, Section
 from stochpound.report.generic import store_section
 from stochpound.report.intensity import intensity_section, intensity_setting
+from stochpound.report.laws import law_axis, laws_section
 from stochpound.report.separation import has_contact_free, separation_section, with_contacts
 from stochpound.report.methods import methods_section
 from stochpound.report.stores import open_stores
@@ -73,6 +74,8 @@ def assemble_report(paths: Sequence[str | Path], progress: Callable[[str], None]
         say(f"experiment {name}")
         contact_free = has_contact_free(store)
         finite = with_contacts(store) if contact_free else store
+        if law_axis(store) is not None:
+            report.sections.append(laws_section(name, finite))
         if all(finite.sizes[d] for d in finite["case_status"].dims):
             report.sections.append(store_section(name, finite))
         if contact_free:
