@@ -104,11 +104,19 @@ def laws_section(name: str, store: xr.Dataset) -> Section:
     axis = law_axis(store)
     assert axis is not None
     section = Section(f"Contact laws compared: experiment {name}", key=f"laws-{name}")
-    named = variant_laws(json.loads(store.attrs["definition"]), axis)
+    definition = json.loads(store.attrs["definition"])
+    named = variant_laws(definition, axis)
+    overrides = next(v for v in definition["variants"] if v["name"] == axis)["overrides"]
+    same_until_contact = (
+        "A law acts only once the floors touch, and this axis changes nothing else: up to its first impact a run is the "
+        "same under every law, so the laws can differ in P(pounding) only within the solvers' tolerances, and they differ "
+        "in what follows the first impact. " if all(set(o) <= {"contact"} for o in overrides.values()) else "")
     section.add(Paragraph(
         f"The {dim_text(axis)} axis gives the contacts different laws: "
-        + "; ".join(f"{value}: {laws.contact_law(law.split('/')[0]).title if '/' not in law else law}" for value, law in named.items())
-        + ". Methods gives each element's parameters and units. Below, every law is drawn in the same panel; means are "
+        + "; ".join(f"{value}: {' / '.join(laws.contact_law(law).title for law in named[value].split('/'))}"
+                    for value in map(plain, store[axis].values))
+        + f". Methods gives each element's parameters and units. {same_until_contact}Below, every law is drawn in the same "
+        "panel; means are "
         f"shown and compared only from at least {MIN_RUNS} runs, with 95 % bootstrap intervals over the realizations "
         "(BCa), and P(pounding) with its 95 % Clopper–Pearson interval."
     ))
