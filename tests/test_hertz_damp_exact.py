@@ -8,6 +8,7 @@ integrated numerically for its peak force.
 """
 
 import math
+import re
 
 import numpy as np
 import pytest
@@ -16,7 +17,7 @@ from scipy.integrate import solve_ivp
 import stochpound
 from stochpound.model import hertz, kelvin, laws
 from stochpound.model.hertz_damp_exact import damping_ratio
-from tests.test_contact_laws import K_HERTZ, M_EFF, V0, free_masses, realised_restitution, run
+from tests.test_contact_laws import K_HERTZ, M_EFF, V0, docs_restitution_column, free_masses, realised_restitution, run
 
 
 def collision(xi: float, mass: float, stiffness: float, approach: float) -> tuple[float, float]:
@@ -50,6 +51,14 @@ def test_the_solver_realises_the_target_in_a_single_collision(target):
     assert realised_restitution(result) == pytest.approx(target, abs=1e-6)
     residual = float(np.abs(result.energy_residual).max() / np.abs(result.energy_kinetic).max())
     assert residual < 1e-8
+
+
+def test_the_docs_table_gives_the_target_and_the_solved_damping():
+    rows = docs_restitution_column("hertz_damp_exact")
+    assert len(rows) >= 7
+    for target, cell in rows.items():
+        realised, xi = re.fullmatch(r"([0-9.]+) \(([0-9.]+)\)", cell).groups()
+        assert float(realised) == target and float(xi) == pytest.approx(damping_ratio(target), rel=5e-4)
 
 
 def test_the_solved_damping_lies_between_the_published_ones():
