@@ -200,19 +200,20 @@ def _comparison(ensemble: Ensemble, axis: str, gap: str | None, panels: list[dic
             rows = {v: c for v, c in rows.items() if np.isfinite(float(c["estimate"]))}
             context = labels_text(where) or ensemble.label
             if len(rows) < 2:
-                sentences.append(f"At {context} fewer than two {dim_text(axis)} values have {MIN_RUNS} runs to compare.")
+                sentences.append(f"At {context}, fewer than two {dim_text(axis)} values have {MIN_RUNS} runs to compare.")
                 continue
             ranked = sorted(rows, key=lambda v: float(rows[v]["estimate"]), reverse=True)
             top, bottom = ranked[0], ranked[-1]
             largest, smallest = float(rows[top]["estimate"]), float(rows[bottom]["estimate"])
             if largest == smallest:
-                sentences.append(f"At {context} every {dim_text(axis)} gives the same {text}, {_value(rows[top], unit)}.")
+                sentences.append(f"At {context}, every {dim_text(axis)} gives the same {text}, {_value(rows[top], unit)}.")
                 continue
             by = f"{largest / smallest:.2f} times that of {bottom}" if smallest > 0 else f"against none for {bottom}"
             below = [str(v) for v in ranked[1:] if float(rows[v]["upper"]) < float(rows[top]["lower"])]
             sentences.append(
                 f"At {context}, {top} gives the largest {text}, {_value(rows[top], unit)}, {by}, {_value(rows[bottom], unit)}; "
-                + (f"the intervals of {', '.join(below)} lie below that of {top}." if below else
+                + (f"the intervals of {', '.join(below)} lie below that of {top}"
+                   + ("." if len(below) == len(ranked) - 1 else ", the others' overlap it.") if below else
                    "every interval overlaps the largest one: the laws agree within their intervals.")
             )
     return " ".join(sentences)
