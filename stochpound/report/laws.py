@@ -53,7 +53,9 @@ class LawQuantity:
     variable : str
         The store variable.
     text : str
-        Its name in prose and on the y axis.
+        Its name in prose and in titles.
+    axis : str
+        Its short name on the y axis.
     unit : str
         The unit shown.
     factor : float
@@ -64,15 +66,16 @@ class LawQuantity:
 
     variable: str
     text: str
+    axis: str
     unit: str
     factor: float
     pounding_only: bool = False
 
 
 QUANTITIES = (
-    LawQuantity("peak_impact_force", "mean peak impact force of the runs that pounded", "kN", 1e-3, pounding_only=True),
-    LawQuantity("impacts", "mean number of impacts", "", 1.0),
-    LawQuantity("peak_floor_acceleration", "mean peak floor acceleration of the studied building", "m/s²", 1.0),
+    LawQuantity("peak_impact_force", "mean peak impact force of the runs that pounded", "peak impact force", "kN", 1e-3, pounding_only=True),
+    LawQuantity("impacts", "mean number of impacts", "impacts", "", 1.0),
+    LawQuantity("peak_floor_acceleration", "mean peak floor acceleration of the studied building", "peak floor acceleration", "m/s²", 1.0),
 )
 
 
@@ -137,7 +140,8 @@ def _ensemble_blocks(ensemble: Ensemble, axis: str) -> list[Block]:
         quantity = next((q for q in QUANTITIES if q.variable == key), None)
         text = "P(pounding)" if quantity is None else quantity.text
         unit = "" if quantity is None or not quantity.unit else f" ({quantity.unit})"
-        blocks.append(_figure(ensemble, axis, gap, panels, table, f"{text}{unit}", key))
+        y_label = "P(pounding)" if quantity is None else quantity.axis
+        blocks.append(_figure(ensemble, axis, gap, panels, table, f"{text}{unit}", f"{y_label}{unit}", key))
         blocks.append(Paragraph(_comparison(ensemble, axis, gap, panels, table, text, "" if quantity is None else quantity.unit)))
     return blocks
 
@@ -169,7 +173,8 @@ def _mean_interval(sample: np.ndarray) -> np.ndarray:
     return np.array([x.mean(), lower[0], upper[0], x.size])
 
 
-def _figure(ensemble: Ensemble, axis: str, gap: str | None, panels: list[dict[str, Any]], table: xr.Dataset, y_label: str, key: str) -> FigureItem:
+def _figure(ensemble: Ensemble, axis: str, gap: str | None, panels: list[dict[str, Any]], table: xr.Dataset, text: str, y_label: str,
+            key: str) -> FigureItem:
     values = ensemble.grid[axis]
     colours = line_colours(axis, values)
     x_values = np.asarray(ensemble.grid[gap], dtype=float) * 100.0 if gap else np.zeros(1)
@@ -182,9 +187,10 @@ def _figure(ensemble: Ensemble, axis: str, gap: str | None, panels: list[dict[st
                                         np.atleast_1d(cell["upper"].values), color=colour, marker="o",
                                         gid=ensemble.gid({**panel, axis: value})))
         drawn[labels_text(panel) or ensemble.label] = curves
-    title = f"{y_label}, every {dim_text(axis)} in each panel ({ensemble.label}, {ensemble.size} realizations)"
-    figure = figures.panel_grid(drawn, title, "gap (cm)" if gap else "", y_label, legend_title=dim_text(axis))
-    caption = (f"{y_label} of ensemble {ensemble.label} against the gap, one line per {dim_text(axis)} ({', '.join(map(str, values))}) "
+    title = f"{text}, every {dim_text(axis)} in each panel ({ensemble.label}, {ensemble.size} realizations)"
+    figure = figures.panel_grid(drawn, title, "gap (cm)" if gap else "", y_label, legend_title=dim_text(axis),
+                                x_ticks={x: f"{x:g}" for x in x_values} if gap else None)
+    caption = (f"{text} of ensemble {ensemble.label} against the gap, one line per {dim_text(axis)} ({', '.join(map(str, values))}) "
                "with its 95 % interval as a band; " + ("one panel per " + ", ".join(map(dim_text, [d for d in panels[0]])) if panels[0] else "one panel") + ".")
     return FigureItem(f"laws-{ensemble.name}-{ensemble.label}-{key}", caption, figure)
 
