@@ -11,7 +11,7 @@ from scipy.integrate import solve_ivp
 
 import stochpound
 from stochpound.model import laws
-from tests.test_contact_laws import GAP, K_HERTZ, M_EFF, V0, free_masses, realised_restitution, run
+from tests.test_contact_laws import GAP, K_HERTZ, M_EFF, V0, docs_restitution_column, free_masses, realised_restitution, run
 
 
 def ye_restitution(target: float, approach: float = V0) -> float:
@@ -42,18 +42,11 @@ def test_a_single_collision_realises_the_restitution_of_the_independent_integrat
 
 def test_the_realised_restitution_is_scale_invariant_and_tabulated_in_the_docs():
     """The realised e depends on the target only (not on δ̇₀); docs/model.md's column is reproduced."""
-    from pathlib import Path
-
     assert ye_restitution(0.5, 0.1) == pytest.approx(ye_restitution(0.5, 1.0), rel=1e-8)
-    text = (Path(__file__).parents[1] / "docs" / "model.md").read_text()
-    header = next(line for line in text.splitlines() if line.startswith("| target e |"))
-    column = [c.strip() for c in header.split("|")].index("hertz_damp_ye")
-    rows = {float(cells[1]): float(cells[column]) for line in text.splitlines()
-            if line.startswith("| ") and len(cells := [c.strip() for c in line.split("|")]) == len(header.split("|"))
-            and cells[1].replace(".", "").isdigit()}
+    rows = docs_restitution_column("hertz_damp_ye")
     assert len(rows) >= 7
     for target, realised in rows.items():
-        assert ye_restitution(target) == pytest.approx(realised, abs=5e-4)
+        assert ye_restitution(target) == pytest.approx(float(realised), abs=5e-4)
 
 
 def test_the_law_is_registered_validated_and_described():

@@ -35,6 +35,21 @@ ONSET_FLOOR = 1e-9
 """Smallest approach velocity (m/s) taken for an impact's δ̇₀ (the damped laws' c_h ∝ 1/δ̇₀)."""
 
 
+def peak_force(stiffness: float, mass: float, approach: float) -> float:
+    """The peak force (N) of an elastic Hertz impact of two free masses: k_h δ_max^{3/2}, δ_max = (5 m_eff δ̇₀² / (4 k_h))^{2/5}.
+
+    Parameters
+    ----------
+    stiffness : float
+        k_h (N/m^1.5).
+    mass : float
+        The effective mass m_eff = m1 m2 / (m1 + m2) (kg).
+    approach : float
+        The approach velocity δ̇₀ (m/s).
+    """
+    return stiffness * (5.0 * mass * approach**2 / (4.0 * stiffness)) ** 0.6
+
+
 class Hertz(ContactLaw):
     """``hertz``: F = k_h δ^{3/2}, elastic."""
 

@@ -41,6 +41,66 @@ def restitution_damping_ratio(restitution: float) -> float:
     return -log_r / math.sqrt(math.pi**2 + log_r**2)
 
 
+def peak_force_factor(damping_ratio: float) -> float:
+    """φ(ξ): the peak force of a Kelvin–Voigt impact of two free masses over √(k m_eff) δ̇₀.
+
+    The relative motion δ = (δ̇₀/ω_d) e^{−ξωt} sin(ω_d t), ω = √(k/m_eff),
+    ω_d = ω √(1 − ξ²), carries the force F = k δ + c δ̇ = −m_eff δ̈. For
+    ξ < 1/2 it peaks where δ̇/δ = 2ξω/(1 − 4ξ²), i.e. at
+    ω_d t* = atan2(√(1 − ξ²)(1 − 4ξ²), ξ(3 − 4ξ²)); for ξ ≥ 1/2 it peaks at
+    onset, F = c δ̇₀ (φ = 2ξ).
+
+    Parameters
+    ----------
+    damping_ratio : float
+        ξ of the element (in [0, 1)).
+
+    Returns
+    -------
+    float
+        φ = F_max / (√(k m_eff) δ̇₀), dimensionless.
+    """
+    xi = damping_ratio
+    if xi >= 0.5:
+        return 2.0 * xi
+    root = math.sqrt(1.0 - xi**2)
+    phase = math.atan2(root * (1.0 - 4.0 * xi**2), xi * (3.0 - 4.0 * xi**2))  # ω_d t*
+    decay = math.exp(-xi * phase / root)
+    # with ω = 1 and δ̇₀ = 1: δ = e^{−ξt} sin(ω_d t)/ω_d, δ̇ = e^{−ξt} (cos(ω_d t) − ξ sin(ω_d t)/ω_d)
+    delta = decay * math.sin(phase) / root
+    rate = decay * (math.cos(phase) - xi * math.sin(phase) / root)
+    return delta + 2.0 * xi * rate
+
+
+def stiffness_for_peak_force(force: float, mass: float, approach: float, restitution: float) -> float:
+    """The stiffness k (N/m) of a Kelvin–Voigt element of restitution e whose free two-mass impact peaks at ``force``.
+
+    The element's peak force is φ(ξ) √(k m_eff) δ̇₀ (:func:`peak_force_factor`,
+    ξ from e by :func:`restitution_damping_ratio`), so
+    k = (F / (φ(ξ) δ̇₀))² / m_eff. With F the elastic Hertz peak force
+    (:func:`stochpound.model.hertz.peak_force`) at a reference approach
+    velocity, the element matches a Hertz element's peak force there.
+
+    Parameters
+    ----------
+    force : float
+        The peak force to match (N).
+    mass : float
+        The impact's effective mass m_eff (kg).
+    approach : float
+        The reference approach velocity δ̇₀ (m/s).
+    restitution : float
+        The element's coefficient of restitution e (in (0, 1]).
+
+    Returns
+    -------
+    float
+        k (N/m).
+    """
+    factor = peak_force_factor(restitution_damping_ratio(restitution))
+    return (force / (factor * approach)) ** 2 / mass
+
+
 class KelvinVoigt(ContactLaw):
     """``kelvin``: F = k δ + c δ̇ while closed."""
 

@@ -9,11 +9,11 @@ defining its law object, one line here, its tests and its docs entry
 from __future__ import annotations
 
 from stochpound.errors import SceneError
-from stochpound.model import coulomb, hertz, hertz_damp_ye, jankowski, kelvin, velocity_friction
+from stochpound.model import coulomb, hertz, hertz_damp_exact, hertz_damp_ye, jankowski, kelvin, velocity_friction
 from stochpound.model.law import ContactLaw, FrictionLaw
 
 CONTACT_LAWS: dict[str, ContactLaw] = {law.name: law for law in (kelvin.KELVIN, hertz.HERTZ, hertz.HERTZ_DAMP, jankowski.JANKOWSKI,
-                                                                 hertz_damp_ye.HERTZ_DAMP_YE)}
+                                                                 hertz_damp_ye.HERTZ_DAMP_YE, hertz_damp_exact.HERTZ_DAMP_EXACT)}
 """The contact laws of impact elements (contacts and walls), by the scene file's ``law``."""
 DEFAULT_CONTACT_LAW = kelvin.KELVIN.name
 """The law of an element whose table gives none."""

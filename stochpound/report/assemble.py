@@ -26,6 +26,7 @@ from stochpound.report.intensity import intensity_section, intensity_setting
 from stochpound.experiment.selections import has_contact_free, with_contacts
 from stochpound.report.separation import separation_section
 from stochpound.report.risk import has_risk, risk_section
+from stochpound.report.laws import law_axis, laws_section
 from stochpound.report.methods import methods_section
 from stochpound.report.stores import open_stores
 from stochpound.report.summary import experiment_summary, move_per_cell_tables, study_summary
@@ -87,6 +88,8 @@ def assemble_report(paths: Sequence[str | Path], progress: Callable[[str], None]
         say(f"experiment {name}")
         contact_free = has_contact_free(store)
         finite = with_contacts(store) if contact_free else store
+        if law_axis(store) is not None:
+            report.sections.append(laws_section(name, finite))
         if all(finite.sizes[d] for d in finite["case_status"].dims):
             report.sections.append(store_section(name, finite, contact_free))
         if contact_free and not has_risk(store):  # with a hazard, the Risk section gives the separation at every intensity
