@@ -9,7 +9,7 @@ same panel against the gap (one panel per combination of the other axes):
 * the probability of pounding with its Clopper–Pearson band;
 * the mean peak impact force of the runs that pounded, the mean number of
   impacts and, when the store keeps demands, the mean peak floor
-  acceleration of the studied building, each with a bootstrap (BCa) interval
+  acceleration of the studied building, each with a percentile-bootstrap interval
   over the realizations, which stays within the quantity's support (≥ 0);
 
 and states, at every gap of every panel, which law gives the largest value,
@@ -21,27 +21,22 @@ runs, and whether the laws' intervals overlap. A mean from fewer than
 from __future__ import annotations
 
 import itertools
-import json
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 import xarray as xr
 
-from stochpound.analysis import pounding_probability
-from stochpound.analysis.bootstrap import bootstrap_weights, interval, jackknife_weights
+from stochpound.analysis import mean_interval, pounding_probability
+from stochpound.experiment.definition import is_gap_axis, read_definition
 from stochpound.model import laws
 from stochpound.report import figures
 from stochpound.report.document import Block, FigureItem, Paragraph, Section
 from stochpound.report.ensembles import Ensemble
-from stochpound.report.facets import dim_text, is_gap, labels_text, line_colours, plain
+from stochpound.report.facets import dim_text, labels_text, line_colours, plain
 
 #: Fewest runs behind a mean that is drawn and compared.
 MIN_RUNS = 10
-#: Bootstrap resamples of every interval of a mean.
-RESAMPLES = 2000
-#: Seed of the bootstrap resamples (the report is reproducible).
-SEED = 20241
 
 
 @dataclass(frozen=True)
@@ -81,7 +76,7 @@ QUANTITIES = (
 
 def law_axis(store: xr.Dataset) -> str | None:
     """The variant axis whose values give the contacts different laws (from the stored definition), or None."""
-    definition = json.loads(store.attrs.get("definition", "{}"))
+    definition = read_definition(store).to_dict()
     for axis in definition.get("variants", []):
         named = variant_laws(definition, axis["name"]) if axis["name"] in store.dims else {}
         if len({named[plain(v)] for v in store[axis["name"]].values}) > 1:
@@ -107,7 +102,7 @@ def laws_section(name: str, store: xr.Dataset) -> Section:
     axis = law_axis(store)
     assert axis is not None
     section = Section(f"Contact laws compared: experiment {name}", key=f"laws-{name}")
-    definition = json.loads(store.attrs["definition"])
+    definition = read_definition(store).to_dict()
     named = variant_laws(definition, axis)
     overrides = next(v for v in definition["variants"] if v["name"] == axis)["overrides"]
     same_until_contact = (
@@ -121,7 +116,7 @@ def laws_section(name: str, store: xr.Dataset) -> Section:
         + f". Methods gives each element's parameters and units. {same_until_contact}Below, every law is drawn in the same "
         "panel; means are "
         f"shown and compared only from at least {MIN_RUNS} runs, with 95 % bootstrap intervals over the realizations "
-        "(BCa), and P(pounding) with its 95 % Clopper–Pearson interval."
+        "(percentile), and P(pounding) with its 95 % Clopper–Pearson interval."
     ))
     kinds = dict(zip(store["record"].values.tolist(), store["record_kind"].values.tolist()))
     for label in [label for label, kind in kinds.items() if kind == "synthetic"]:
@@ -130,7 +125,7 @@ def laws_section(name: str, store: xr.Dataset) -> Section:
 
 
 def _ensemble_blocks(ensemble: Ensemble, axis: str) -> list[Block]:
-    gap = next((d for d in ensemble.grid if is_gap(d)), None)
+    gap = next((d for d in ensemble.grid if is_gap_axis(d)), None)
     others = [d for d in ensemble.grid if d not in (axis, gap)]
     panels = [dict(zip(others, values)) for values in itertools.product(*(ensemble.grid[d] for d in others))]
     estimates = {"pounding": _pounding(ensemble)}
@@ -153,24 +148,15 @@ def _pounding(ensemble: Ensemble) -> xr.Dataset:
 
 
 def _means(ensemble: Ensemble, quantity: LawQuantity) -> xr.Dataset:
-    """The mean of ``quantity`` in every cell with its BCa bootstrap interval over the runs (NaN from fewer than MIN_RUNS)."""
+    """The mean of ``quantity`` in every cell with its percentile-bootstrap interval over the runs
+    (:func:`stochpound.analysis.mean_interval`; NaN from fewer than MIN_RUNS)."""
     values = ensemble.sample(quantity.variable) * quantity.factor
     if quantity.pounding_only:
         values = values.where(ensemble.sample("impacts") > 0)
-    return xr.apply_ufunc(_mean_interval, values, input_core_dims=[["realization"]], output_core_dims=[["part"]], vectorize=True) \
-        .assign_coords(part=["estimate", "lower", "upper", "count"]).to_dataset("part")
-
-
-def _mean_interval(sample: np.ndarray) -> np.ndarray:
-    """[mean, lower, upper, n] of the finite values of ``sample`` (BCa over the runs; NaN below MIN_RUNS)."""
-    x = sample[np.isfinite(sample)]
-    if x.size < MIN_RUNS:
-        return np.array([np.nan, np.nan, np.nan, x.size])
-    estimate = np.array([x.mean()])
-    boot = bootstrap_weights(x.size, RESAMPLES, SEED) @ x / x.size
-    jack = jackknife_weights(x.size) @ x / (x.size - 1)
-    lower, upper = interval(boot[None, :], estimate, jack[None, :], 0.95)
-    return np.array([x.mean(), lower[0], upper[0], x.size])
+    result = mean_interval(values, "realization", method="bootstrap").compute()
+    enough = result["count"] >= MIN_RUNS
+    return xr.Dataset({"estimate": result["mean"].where(enough), "lower": result["lower"].where(enough),
+                       "upper": result["upper"].where(enough), "count": result["count"]})
 
 
 def _figure(ensemble: Ensemble, axis: str, gap: str | None, panels: list[dict[str, Any]], table: xr.Dataset, text: str, y_label: str,

@@ -62,7 +62,8 @@ def experiment_summary(stores: dict[str, xr.Dataset], sections: list[Section], c
             ))
             summary.add(_probability_table(name, finite, ensembles, axes[0], confidence))
         records = [label for label, kind in kinds.items() if kind != "synthetic"]
-        if records:
+        if records and len(axes) == len(gap_dims(store)) and "intensity" not in store.dims:
+            # with no finite gap there is nothing to count; over intensity stripes the Intensity and Risk sections answer
             summary.add(Paragraph(_records_answer(store, records)))
         for answer in RISK_ANSWERS:
             for block in answer(name, store):
