@@ -121,3 +121,33 @@ def test_every_integrator_runs_and_agrees(integrator):
     difference = np.abs(run.total_displacement - reference.total_displacement).max()
     assert float(difference) < 1e-4
     assert relative_residual(run) <= 1e-4
+
+
+@pytest.mark.parametrize("stiffness", [3.3e8, 3.5e8, 3.525e8])
+def test_a_zero_gap_collision_whose_guard_starts_within_tolerance_is_located(stiffness):
+    """Two free 26.3 t masses through a stiff tensile Kelvin element at zero gap (c fixed, so ζ varies with k).
+
+    At k = 3.5e8 N/m the closing guard started a step within its tolerance above zero, and the event
+    search stopped on "f(a) and f(b) must have different signs"; the realised restitution must be
+    the closed form of the free collision, e^(−ζπ/√(1−ζ²)), at every stiffness.
+    """
+    import math
+
+    mass, damping, velocity = 26268.0, 923882.2117691986, 1.0
+    effective = mass / 2.0
+    zeta = damping / (2.0 * math.sqrt(stiffness * effective))
+    omega = math.sqrt(stiffness / effective)
+    duration = 3.0 * math.pi / (omega * math.sqrt(1.0 - zeta**2))
+
+    def body(name, speed):
+        return {"name": name, "mass": [mass], "stiffness": [0.0], "damping": [0.0], "initial": {"velocity": [speed]}}
+
+    scene = stochpound.scene_from_dict({
+        "building": [body("A", velocity), body("B", 0.0)],
+        "contact": [{"between": [["A", 1], ["B", 1]], "gap": 0.0, "stiffness": stiffness, "damping": damping, "tensile": True}],
+        "motion": {"type": "constant", "acceleration": 0.0, "duration": duration, "dt": duration / 300},
+    })
+    run = stochpound.simulate(scene, method="exact")
+    y, t = run["total_displacement"].sel(floor=1).values, run["time"].values
+    v_a, v_b = (y[:, -1] - y[:, -2]) / (t[-1] - t[-2])
+    assert (v_b - v_a) / velocity == pytest.approx(math.exp(-zeta * math.pi / math.sqrt(1.0 - zeta**2)), abs=1e-9)

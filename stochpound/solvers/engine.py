@@ -896,7 +896,9 @@ def _first_crossing(flow, threshold, tolerance, rearmable, disarmed, counters, t
                 continue
             current = raw[i] - level
             if previous < 0.0 <= current:
-                time = _brentq(flow, j, level, times[i - 1], times[i], work)
+                # an armed guard within its tolerance above zero at the step's start (clamped to −tolerance above) crosses there
+                start = times[i - 1]
+                time = start if _evaluate(flow, j, level, start, work) >= 0.0 else _brentq(flow, j, level, start, times[i], work)
                 break
             tau = taus[i]
             if 0 < i < n - 1 and current < 0.0 and a0 + tau * (a1 + tau * (a2 + tau * a3)) - level >= -margin:  # grazing
