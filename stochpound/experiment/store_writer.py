@@ -16,6 +16,7 @@ The file is written to a temporary name and renamed over the store
 
 from __future__ import annotations
 
+import threading
 from collections import OrderedDict
 from dataclasses import dataclass
 from pathlib import Path
@@ -165,7 +166,9 @@ def _create(store_layout: Layout, attrs: Mapping[str, Any], path: Path) -> None:
     to that call raises, it cannot write another file), and the file is
     closed before the blocks are written.
     """
-    store = H5NetCDFStore.open(path, mode="w")
+    # A lock of this process: xarray's default write lock is a dask.distributed Lock while a client is active, and the
+    # last checkpoint's rebuild may run as the run's cluster closes ("IOLoop is closed"); only this process writes here.
+    store = H5NetCDFStore.open(path, mode="w", lock=threading.Lock())
     try:
         store_layout.template(attrs).dump_to_store(store, writer=_MetadataOnly())
     finally:
