@@ -50,12 +50,13 @@ def risk(store: Path, hazard: str | None, target: str, years: float, bootstrap: 
     from stochpound.experiment import open_store
     from stochpound.experiment.hazard import hazard_option, stored_hazard
     from stochpound.experiment.intensity import describe_measure
-    from stochpound.report.risk import intensity_of, risk_headline, rules_frame, separation_frame
+    from stochpound.report.intensity import intensity_setting
+    from stochpound.report.risk import risk_headline, rules_frame, separation_frame
 
     targets = _targets(target)
     try:
         data = open_store(store)
-        setting = intensity_of(data)
+        setting = intensity_setting(data)
         if setting is None:
             raise click.ClickException("store: has no intensity stripes or IDA capacities (run an experiment with an [intensity] table)")
         hz = hazard_option(hazard, setting) if hazard is not None else stored_hazard(data)

@@ -27,12 +27,12 @@ carries everything needed to redo the risk chain without the file.
 from __future__ import annotations
 
 import hashlib
-import json
 import math
 from pathlib import Path
 from typing import Any, Mapping
 
 from stochpound.analysis.hazard import HazardCurve, bundled_curves, bundled_measure
+from stochpound.experiment.definition import read_definition
 from stochpound.experiment.intensity import IntensityError, describe_measure
 from stochpound.model import fields as toml_fields
 
@@ -158,9 +158,14 @@ def _power_law(table: Any) -> dict[str, float]:
     return {key: toml_fields.number(table, key, "hazard.power_law", required=True, low=0.0, low_open=True) for key in ("k0", "k")}
 
 
+def stored_hazard_entry(store: Any) -> dict[str, Any] | None:
+    """An experiment store's definition's ``hazard`` entry (its table and provenance), or None."""
+    return read_definition(store).to_dict().get("hazard")
+
+
 def stored_hazard(store: Any) -> HazardCurve | None:
     """The hazard an experiment store carries (its definition's ``hazard`` entry), or None."""
-    entry = json.loads(store.attrs.get("definition", "{}")).get("hazard")
+    entry = stored_hazard_entry(store)
     return None if entry is None else hazard_curve(entry)
 
 

@@ -22,7 +22,6 @@ and target, with the interval and the number of motions), for a summary.
 
 from __future__ import annotations
 
-import json
 import math
 from typing import Any
 
@@ -35,10 +34,12 @@ from stochpound.analysis import HazardCurve, demand_hazard_curve, fragility_band
 from stochpound.analysis.fragility_ensemble import BOOTSTRAP
 from stochpound.analysis.risk import TARGETS
 from stochpound.analysis.store_risk import StoreRisk, base_displacement, contact_free_cases, store_motions, store_risk
-from stochpound.experiment.hazard import stored_hazard
+from stochpound.experiment.definition import read_definition
+from stochpound.experiment.hazard import stored_hazard, stored_hazard_entry
 from stochpound.experiment.intensity import describe_measure
 from stochpound.report.document import Block, FigureItem, Paragraph, Section, Table
 from stochpound.report.facets import labels_text
+from stochpound.report.intensity import intensity_setting
 from stochpound.report.summary import RISK_ANSWERS
 
 CONFIDENCE = 0.95
@@ -63,19 +64,14 @@ DEMANDS = {
 _CACHE: dict[tuple[str, str, int], StoreRisk] = {}
 
 
-def intensity_of(store: xr.Dataset) -> dict[str, Any] | None:
-    """The definition's ``intensity`` entry of a store (None without one)."""
-    return json.loads(store.attrs.get("definition", "{}")).get("intensity")
-
-
 def has_risk(store: xr.Dataset) -> bool:
     """Whether a store gets a Risk section: intensity levels (stripes or IDA) and a stored hazard."""
-    return intensity_of(store) is not None and stored_hazard(store) is not None and ("intensity" in store.dims or "ida_capacity" in store)
+    return intensity_setting(store) is not None and stored_hazard(store) is not None and ("intensity" in store.dims or "ida_capacity" in store)
 
 
 def hazard_provenance(store: xr.Dataset) -> str:
     """Where a store's hazard curve comes from, in a sentence ("" without one): its source, range and provenance lines."""
-    entry = json.loads(store.attrs.get("definition", "{}")).get("hazard")
+    entry = stored_hazard_entry(store)
     if entry is None:
         return ""
     given = {"file": lambda: f"the file {entry['file']} (sha256 {entry['file_sha256']})", "bundled": lambda: f"the bundled curve {entry['bundled']}",
@@ -184,7 +180,7 @@ def _gap_text(value: float) -> str:
 
 def headline_text(name: str, store: xr.Dataset, risk: StoreRisk) -> str:
     """The section's first paragraph: g* for each target, per configuration, with its interval and the number of motions."""
-    setting = intensity_of(store)
+    setting = intensity_setting(store)
     frame = risk_headline(risk)
     config = [c for c in frame.columns if c not in ("target", "separation", "lower", "upper", "confidence", "motions")]
     targets = " and ".join(_target_text(p) for p in risk.separation["target"].values)
@@ -216,7 +212,7 @@ RISK_ANSWERS.append(summary_answer)
 def risk_section(name: str, store: xr.Dataset) -> Section:
     """The "Risk" section of one store (call when :func:`has_risk` is true)."""
     risk = risk_of(store)
-    setting = intensity_of(store)
+    setting = intensity_setting(store)
     section = Section(f"Risk: experiment {name}", key=f"risk-{name}")
     section.add(Paragraph(headline_text(name, store, risk)))
     section.add(Paragraph(_hazard_text(risk.hazard, setting, risk.method)))
@@ -443,7 +439,7 @@ def _demand_blocks(name: str, store: xr.Dataset, risk: StoreRisk, setting: dict[
 
 def _moat_clearances(store: xr.Dataset, studied: str | None) -> list[float]:
     """The distinct gaps of the walls at the studied building's base in the definition (its scene and its variants)."""
-    definition = json.loads(store.attrs.get("definition", "{}"))
+    definition = read_definition(store).to_dict()
     walls = list(definition.get("scene", {}).get("wall", []))
     for variant in definition.get("variants", []):
         for override in variant.get("overrides", {}).values():
