@@ -6,6 +6,7 @@ import xarray as xr
 from scipy import optimize, special, stats
 
 from stochpound.analysis import Fragility, fit_fragility, fragility_band, fragility_surface, homogeneous_capacities, ida_fragility, limit_state_events, stripe_fragility
+from stochpound.analysis import kernels
 from stochpound.analysis.bootstrap import bootstrap_weights
 from stochpound.analysis.fragility import ALWAYS, DECREASING, FIT, NEVER, SEPARATED, stripe_mle
 
@@ -154,6 +155,24 @@ def test_the_bootstrap_resamples_motions_reproducibly():
     assert not np.array_equal(first.theta_bootstrap.values, stripe_fragility(events, bootstrap=50, seed=10).theta_bootstrap.values)
     weights = bootstrap_weights(40, 50, 9)
     assert weights.shape == (50, 40) and np.all(weights.sum(1) == 40)
+
+
+def test_the_fragility_bootstrap_and_the_mean_interval_draw_from_the_one_resampler():
+    """Both callers reproduced from ``bootstrap_weights``: a fragility resample is the fit to the motions repeated as often
+    as the weights say, and the percentile bootstrap of the mean is the quantiles of the weighted means."""
+    events, _ = synthetic_stripes(np.random.default_rng(4), records=20)
+    fitted = stripe_fragility(events, bootstrap=6, seed=9)
+    weights = bootstrap_weights(20, 6, 9)
+    for resample, counts in enumerate(weights.astype(int)):
+        repeated = stripe_fragility(events.isel(record=np.repeat(np.arange(20), counts)), bootstrap=0)
+        assert fitted.theta_bootstrap.values[resample] == pytest.approx(float(repeated.theta), rel=1e-9)
+        assert fitted.beta_bootstrap.values[resample] == pytest.approx(float(repeated.beta), rel=1e-9)
+    values = np.sort(np.random.default_rng(5).lognormal(0.0, 1.0, 30))
+    resampled_means = bootstrap_weights(30, kernels.BOOTSTRAP_RESAMPLES, (kernels.BOOTSTRAP_SEED, 30)) @ values / 30
+    _, lower, upper, _ = kernels.bootstrap_mean_interval(values)
+    assert [lower, upper] == pytest.approx(np.quantile(resampled_means, [0.025, 0.975]), rel=1e-12)
+    counts = bootstrap_weights(50, 4000, 1)  # each count is Binomial(50, 1/50): mean 1, variance 0.98
+    assert counts.mean() == pytest.approx(1.0, abs=0.01) and counts.var() == pytest.approx(0.98, abs=0.03)
 
 
 def test_bootstrap_intervals_cover_the_true_median_about_95_percent_of_the_time():

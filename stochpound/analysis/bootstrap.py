@@ -18,19 +18,41 @@ plain percentile interval is used.
 from __future__ import annotations
 
 import warnings
+from collections.abc import Sequence
 
 import numpy as np
 from scipy import special
 
 
-def bootstrap_weights(motions: int, resamples: int, seed: int) -> np.ndarray:
-    """How many times each motion appears in each resample with replacement: an array (resamples, motions) from ``default_rng(seed)``."""
+def bootstrap_weights(motions: int, resamples: int, seed: int | Sequence[int]) -> np.ndarray:
+    """How many times each motion appears in each resample with replacement: the one resampler of the toolkit.
+
+    Each resample draws ``motions`` indices uniformly with replacement from
+    ``numpy.random.default_rng(seed)`` and counts them; the fragility and risk
+    bootstraps and the percentile bootstrap of the mean
+    (:func:`stochpound.analysis.kernels.bootstrap_mean_interval`) all use it.
+
+    Parameters
+    ----------
+    motions : int
+        Number of motions (values) resampled, at least 2.
+    resamples : int
+        Number of resamples, positive.
+    seed : int or sequence of int
+        Seed of :func:`numpy.random.default_rng`: the same seed gives the same weights.
+
+    Returns
+    -------
+    numpy.ndarray
+        Counts, float, shape (resamples, motions); each row sums to ``motions``.
+    """
     if not (isinstance(resamples, (int, np.integer)) and resamples > 0):
         raise ValueError(f"bootstrap: must be a positive number of resamples, got {resamples!r}")
     if motions < 2:
         raise ValueError(f"record: the bootstrap needs at least 2 motions, got {motions}")
-    rng = np.random.default_rng(seed)
-    return rng.multinomial(motions, np.full(motions, 1.0 / motions), size=resamples).astype(float)
+    drawn = np.random.default_rng(seed).integers(0, motions, size=(resamples, motions))
+    counts = np.bincount((drawn + motions * np.arange(resamples)[:, None]).ravel(), minlength=resamples * motions)
+    return counts.reshape(resamples, motions).astype(np.float64)
 
 
 def jackknife_weights(motions: int) -> np.ndarray:

@@ -27,6 +27,8 @@ from typing import NamedTuple
 import numpy as np
 from scipy import stats
 
+from stochpound.analysis.bootstrap import bootstrap_weights
+
 Axis = int | tuple[int, ...]
 
 BOOTSTRAP_RESAMPLES = 9999
@@ -288,9 +290,8 @@ def bootstrap_mean_interval(values: np.ndarray, confidence: float = 0.95, resamp
 
 @lru_cache(maxsize=64)
 def _resample_weights(n: int, resamples: int) -> np.ndarray:
-    """How often each of n values is drawn in each of ``resamples`` resamples with replacement (resamples × n), from :data:`BOOTSTRAP_SEED` and n."""
-    drawn = np.random.default_rng([BOOTSTRAP_SEED, n]).integers(0, n, size=(resamples, n))
-    weights = np.bincount((drawn + n * np.arange(resamples)[:, None]).ravel(), minlength=resamples * n).reshape(resamples, n).astype(np.float64)
+    """:func:`~stochpound.analysis.bootstrap.bootstrap_weights` of n values seeded with (:data:`BOOTSTRAP_SEED`, n), cached read-only."""
+    weights = bootstrap_weights(n, resamples, (BOOTSTRAP_SEED, n))
     weights.flags.writeable = False
     return weights
 
