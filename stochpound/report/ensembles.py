@@ -23,6 +23,7 @@ import pandas as pd
 import xarray as xr
 
 from stochpound.analysis import ensemble_statistics, mean_interval, of_first, pounding_probability
+from stochpound.analysis.intervals import MIN_RUNS
 from stochpound.report import figures
 from stochpound.report.document import Block, FigureItem, Table
 from stochpound.experiment.definition import is_gap_axis
@@ -30,10 +31,6 @@ from stochpound.report.facets import cell_gid, dim_text, labels_text, layouts, l
 
 CM = 100.0
 KN = 1e-3
-MIN_RUNS = 30
-"""Fewest runs behind an estimate the report draws a conclusion from, or draws as a running estimate: below about 30
-values neither the t nor the bootstrap interval of a mean of skewed peaks covers at its level, and a proportion's
-interval is wider than most differences it would be compared with (±0.18 at P = 0.5 with 30 runs)."""
 CONVERGENCE_POINTS = 8
 """Sample sizes, from :data:`MIN_RUNS` to the ensemble's size (geometrically spaced), at which a convergence figure draws the estimates."""
 CONVERGENCE_PANELS = 4

@@ -15,7 +15,7 @@ same panel against the gap (one panel per combination of the other axes):
 and states, at every gap of every panel, which law gives the largest value,
 by how much it exceeds the smallest, with the intervals and the number of
 runs, and whether the laws' intervals overlap. A mean from fewer than
-:data:`MIN_RUNS` runs is neither drawn nor compared.
+:data:`~stochpound.analysis.intervals.MIN_RUNS` runs is neither drawn nor compared.
 """
 
 from __future__ import annotations
@@ -28,15 +28,13 @@ import numpy as np
 import xarray as xr
 
 from stochpound.analysis import mean_interval, pounding_probability
+from stochpound.analysis.intervals import MIN_RUNS
 from stochpound.experiment.definition import is_gap_axis, read_definition
 from stochpound.model import laws
 from stochpound.report import figures
 from stochpound.report.document import Block, FigureItem, Paragraph, Section
 from stochpound.report.ensembles import Ensemble
 from stochpound.report.facets import dim_text, labels_text, line_colours, plain
-
-#: Fewest runs behind a mean that is drawn and compared.
-MIN_RUNS = 10
 
 
 @dataclass(frozen=True)
