@@ -3,7 +3,7 @@
 A store with intensity stripes holds, per case, ``peak_contact_closure``
 over the grid's dimensions (``gap``, ``mu``, variants, ``intensity``,
 ``record``, ``realization``) and ``contact``; its contact-free cases are
-those at ``gap = inf``. By the gap identity, their largest closure over the
+those at ``inf`` on every gap axis. By the gap identity, their largest closure over the
 contacts decides pounding at every gap, so the pounding fragility of every
 gap and configuration comes from that one selection. A store of IDA runs
 (homogeneous scenes: ``ida_capacity``, no ``intensity`` dimension) holds one
@@ -26,6 +26,7 @@ import xarray as xr
 
 from stochpound.analysis.code_rules_risk import MINIMUM_MOTIONS, code_rules_risk
 from stochpound.analysis.fragility_ensemble import BOOTSTRAP, homogeneous_capacities, ida_fragility, limit_state_events, stripe_fragility
+from stochpound.analysis.gap_axes import contact_free, gap_dims, has_contact_free
 from stochpound.analysis.hazard import HazardCurve
 from stochpound.analysis.risk import TARGETS, risk_curve, risk_targeted_separation
 from stochpound.analysis.separation_rules import store_contact_demands
@@ -69,28 +70,23 @@ def store_motions(data: xr.DataArray, record_dim: str = "record", realization_di
     return stacked.assign_coords({record_dim: labels})
 
 
-def contact_free_cases(store: xr.Dataset, gap_dim: str = "gap") -> xr.Dataset:
-    """The store's cases at ``gap = inf`` (the whole store when it has no gap axis)."""
-    return store.sel({gap_dim: np.inf}) if gap_dim in store.dims else store
-
-
-def contact_free_closure(store: xr.Dataset, contact_dim: str = "contact", gap_dim: str = "gap") -> xr.DataArray:
+def contact_free_closure(store: xr.Dataset, contact_dim: str = "contact") -> xr.DataArray:
     """The largest peak closure over the contacts of every contact-free case of a store (m), one motion dimension ``record``.
 
-    The contact-free cases are those at ``gap = inf``; in an IDA store
-    every case runs contact-free, and the first gap's are taken.
+    The contact-free cases are those at ``inf`` on every gap axis
+    (``stochpound.analysis.gap_axes.contact_free``); in an IDA store every
+    case runs contact-free, and the first gap's are taken.
     """
     if CLOSURE not in store:
         raise RiskInputError(f"store: has no {CLOSURE!r}")
     closure = store[CLOSURE]
-    if gap_dim in closure.dims:
-        gaps = np.asarray(closure[gap_dim].values, dtype=float)
-        if CAPACITY in store and "intensity" not in store.dims:
-            closure = closure.isel({gap_dim: 0}, drop=True)
-        elif not np.isinf(gaps).any():
-            raise RiskInputError(f"store: no contact-free cases ({gap_dim} = inf) on its {gap_dim!r} axis: add inf to the gaps")
-        else:
-            closure = closure.sel({gap_dim: np.inf})
+    gaps = gap_dims(closure)
+    if gaps and CAPACITY in store and "intensity" not in store.dims:
+        closure = closure.isel({dim: 0 for dim in gaps}, drop=True)
+    elif gaps and not has_contact_free(closure):
+        raise RiskInputError(f"store: no contact-free cases (inf on every gap axis: {', '.join(gaps)}): add inf to the gaps")
+    else:
+        closure = contact_free(closure)
     if contact_dim in closure.dims:
         closure = closure.max(contact_dim, skipna=False)
     return store_motions(closure).load().assign_attrs(units="m", long_name="largest contact-free peak closure over the contacts")
@@ -211,7 +207,7 @@ def store_risk(store: xr.Dataset, hz: HazardCurve, targets: Sequence[float] = TA
     elif motions < MINIMUM_MOTIONS:
         note = f"the codes take the mean over at least {MINIMUM_MOTIONS} motions; the store has {motions}"
     else:
-        free = contact_free_cases(store)
+        free = contact_free(store)
         demands = xr.Dataset({name: store_motions(value) for name, value in store_contact_demands(free).items()}).load()
         rules = code_rules_risk(demands, hz, years=years, isolator_displacement=base_displacement(free, studied), confidence=confidence,
                                 bootstrap=bootstrap, seed=seed)

@@ -10,20 +10,21 @@ attribute, a dict — goes through :func:`read_definition`, which returns a
 (:class:`Output`) and the solver settings (:class:`Solver`). The canonical
 dict stays the stored form; :meth:`Definition.to_dict` gives it back unchanged.
 
-The rules that name parts of a grid live here once: a gap axis is ``gap`` or
-``gap_<name>`` (:func:`is_gap_axis`); that μ = ∞ is a fixed base
-(:data:`FIXED_BASE`, :func:`is_fixed_base`) is the model's rule
-(:mod:`stochpound.model.friction`), given here too.
+The rules that name parts of a grid are given here: that a gap axis is ``gap``
+or ``gap_<name>`` (:func:`is_gap_axis`) is the analysis layer's rule
+(``stochpound.analysis.gap_axes``, which selects contact-free cases for
+the risk chain too); that μ = ∞ is a fixed base (:data:`FIXED_BASE`,
+:func:`is_fixed_base`) is the model's rule (:mod:`stochpound.model.friction`).
 """
 
 from __future__ import annotations
 
 import copy
 import json
-import re
 from dataclasses import dataclass
 from typing import Any, Mapping
 
+from stochpound.analysis.gap_axes import is_gap_axis
 from stochpound.model.friction import FIXED_BASE, is_fixed_base
 
 __all__ = [
@@ -39,14 +40,6 @@ __all__ = [
     "is_gap_axis",
     "read_definition",
 ]
-
-_GAP_AXIS = re.compile(r"^gap(_[A-Za-z0-9_]+)?$")
-
-
-def is_gap_axis(name: str) -> bool:
-    """Whether a grid axis (a store dimension) is a gap axis: ``gap`` or ``gap_<name>`` (letters, digits, _)."""
-    return _GAP_AXIS.match(name) is not None
-
 
 @dataclass(frozen=True)
 class GapAxis:

@@ -33,7 +33,8 @@ from matplotlib.figure import Figure
 from stochpound.analysis import HazardCurve, demand_hazard_curve, fragility_band, fragility_surface, rate_from_probability
 from stochpound.analysis.fragility_ensemble import BOOTSTRAP
 from stochpound.analysis.risk import TARGETS
-from stochpound.analysis.store_risk import StoreRisk, base_displacement, contact_free_cases, store_motions, store_risk
+from stochpound.analysis.gap_axes import contact_free
+from stochpound.analysis.store_risk import StoreRisk, base_displacement, store_motions, store_risk
 from stochpound.experiment.definition import read_definition
 from stochpound.experiment.hazard import stored_hazard, stored_hazard_entry
 from stochpound.experiment.intensity import describe_measure
@@ -395,7 +396,7 @@ def _demand_blocks(name: str, store: xr.Dataset, risk: StoreRisk, setting: dict[
     """Demand hazard curves of a stripes store: base displacement (and the moat walls' clearance), drift, floor acceleration."""
     if "intensity" not in store.dims:
         return []
-    free = contact_free_cases(store)
+    free = contact_free(store)
     studied = store.attrs.get("studied_building")
     demands: dict[str, tuple[xr.DataArray, str]] = {}
     sliding = base_displacement(free, studied)
