@@ -216,3 +216,38 @@ def test_kept_histories_of_a_later_building_land_on_its_row(tmp_path):
     np.testing.assert_array_equal(point["total_displacement"].sel(building="B2").values, run["total_displacement"].sel(building="B2").values)
     np.testing.assert_array_equal(point["sliding_displacement"].sel(building="B2").values, run["sliding_displacement"].sel(building="B2").values)
     assert np.isnan(point["total_displacement"].sel(building="B1")).all() and np.isnan(point["sliding_displacement"].sel(building="B1")).all()
+
+
+def test_the_store_is_written_under_a_lock_of_this_process_while_a_dask_client_is_active(small_store, tmp_path, monkeypatch):
+    """xarray's default write lock is a dask.distributed Lock while a client is active; a last checkpoint rebuilt as the run's
+    cluster closed failed on it ("IOLoop is closed"). The store writer must take no distributed lock, and the rebuilt
+    store must hold the same data."""
+    from distributed import Client, LocalCluster
+    from distributed import Lock as DistributedLock
+    from xarray.backends import H5NetCDFStore
+
+    from stochpound.experiment import store_writer
+    from stochpound.experiment.session import StoreSession
+
+    opened = []
+
+    class RecordingStore(H5NetCDFStore):
+        @classmethod
+        def open(cls, *args, **kwargs):
+            store = H5NetCDFStore.open(*args, **kwargs)
+            opened.append(store)
+            return store
+
+    def locks(lock):  # the locks inside xarray's CombinedLock
+        return [inner for part in lock.locks for inner in locks(part)] if hasattr(lock, "locks") else [lock]
+
+    monkeypatch.setattr(store_writer, "H5NetCDFStore", RecordingStore)
+    _, store = small_store
+    session = StoreSession.open(store)
+    rebuilt = tmp_path / "rebuilt.nc"
+    with LocalCluster(processes=False, n_workers=1, threads_per_worker=1, dashboard_address=None) as cluster, Client(cluster):
+        assert any(isinstance(lock, DistributedLock) for lock in locks(xr.backends.locks.get_write_lock("probe")))  # the default
+        store_writer.write_store(session.experiment, session.scan(), session.motion_grids, session.attrs(), rebuilt)
+    assert opened and not any(isinstance(lock, DistributedLock) for store in opened for lock in locks(store.lock))
+    with xr.open_dataset(store) as expected, xr.open_dataset(rebuilt) as actual:
+        xr.testing.assert_identical(actual.drop_attrs(), expected.drop_attrs())
