@@ -23,13 +23,14 @@ from stochpound.errors import StochpoundError
 from stochpound.report import output
 from stochpound.report.document import FigureItem, Paragraph, Report, Section, Table
 from stochpound.report.html import render_html
+from stochpound.report import pdf as pdf_layout
 from stochpound.report.pdf import render_pdf
 from tests.chromium import render_in_chromium, require_chromium
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 TRICKY = "Friction μ < 0.2 & gap → ∞ – see <b>not bold</b>"
-# title page, section 1 (text, table, figure), section 2 (table under its heading, figure, text), sources
-EXPECTED_PAGES = 8
+# title page, section 1 (text, table, figure), section 2 (table under its heading, figure and the text after it), sources
+EXPECTED_PAGES = 7
 
 
 def _peaks() -> pd.DataFrame:
@@ -275,6 +276,44 @@ def test_pdf_splits_long_and_wide_tables(tmp_path: Path) -> None:
     pages = render_pdf(report, tmp_path / "long.pdf")
     assert pages == _pdf_pages((tmp_path / "long.pdf").read_bytes())
     assert pages >= 1 + 2 * 3  # title page; at least two column slices of at least three pages each
+
+
+def _page_texts(page: pdf_layout._Page) -> list[str]:
+    """The texts a planned PDF page draws, in order."""
+    return [op.keywords["text"] for op in page.ops if getattr(op, "func", None) is pdf_layout._put]
+
+
+def _page_has_rows(page: pdf_layout._Page) -> bool:
+    """True when the page draws a body row of the tests' tables (labelled "row i")."""
+    return any(text.startswith("row ") for text in _page_texts(page))
+
+
+@pytest.mark.parametrize("rows", range(20, 61, 2))
+def test_pdf_table_note_stays_with_its_rows(rows: int) -> None:
+    note = "A note long enough to wrap onto several lines of the page. " * 6
+    frame = pd.DataFrame({"value": np.arange(rows, dtype=float)}, index=pd.Index([f"row {i}" for i in range(rows)], name="row"))
+    flow = pdf_layout._plan(Report("Notes", sections=[Section("Only", [Table("table-note", "Rows", frame, note=note)])]), "2024-01-02")
+    pages_with_note = [page for page in flow.pages if any(text in note for text in _page_texts(page) if text.strip())]
+    assert len(pages_with_note) == 1
+    assert _page_has_rows(pages_with_note[0])
+
+
+def test_pdf_text_after_a_table_continues_on_its_page() -> None:
+    frame = pd.DataFrame({"value": [1.0, 2.0]}, index=pd.Index(["a", "b"], name="row"))
+    report = Report("After", sections=[Section("Only", [Table("table-short", "Short", frame), Paragraph("The words after the table.")])])
+    flow = pdf_layout._plan(report, "2024-01-02")
+    assert len(flow.pages) == 2  # the title page; the section's heading, the table and the paragraph
+    assert "The words after the table." in _page_texts(flow.pages[1])
+
+
+@pytest.mark.parametrize("filler", range(24, 48))
+def test_pdf_paragraphs_leave_no_orphan_or_widow_lines(filler: int) -> None:
+    words = " ".join(f"word{i}" for i in range(120))  # about ten lines
+    blocks = [Paragraph("Filler line.") for _ in range(filler)] + [Paragraph(words)]
+    flow = pdf_layout._plan(Report("Lines", sections=[Section("Only", blocks)]), "2024-01-02")
+    for page in flow.pages[1:]:
+        mine = [text for text in _page_texts(page) if "word" in text]
+        assert not mine or len(mine) >= pdf_layout.MIN_LINES
 
 
 # --- CLI --------------------------------------------------------------------

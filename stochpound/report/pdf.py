@@ -2,11 +2,15 @@
 
 Layout: a title page with the contents (sections, tables and figures with
 their pages); each section starts on a new page and its text flows onto
-portrait pages; each table gets its own page(s) (landscape, a smaller font or
-column slices when it is wide; long tables continue with repeated headers);
-each figure gets its own page with its caption. The pages are first planned
-as lists of drawing operations, so the contents can give page numbers, then
-drawn one by one.
+portrait pages; each table starts a page (landscape, a smaller font or
+column slices when it is wide; long tables continue with repeated headers,
+and a table's last page keeps room for its note, so a note never stands
+alone); each figure starts a page with its caption. Text after a table or a
+figure continues on its page when it has room for the whole paragraph or
+at least ``MIN_LINES`` of it; a paragraph is never split so that fewer
+than ``MIN_LINES`` lines stand alone at the bottom or the top of a page.
+The pages are first planned as lists of drawing operations, so the
+contents can give page numbers, then drawn one by one.
 """
 
 from __future__ import annotations
@@ -49,6 +53,8 @@ HEADER_CAP = 1.1
 FIGURE_DPI = 200
 GREY = "#555555"
 DIFFERENCE_FILL = "#fff1c9"
+MIN_LINES = 3
+"""The fewest lines of a paragraph at the bottom of a page (fewer move to the next page with the rest)."""
 
 Op = Callable[[Figure], None]
 
@@ -215,12 +221,22 @@ def _contents_line(figure: Figure, y: float, label: str, key: str, starts: dict[
 
 
 def _paragraph(flow: _Flow, text: str) -> None:
+    """A paragraph at the cursor; on a new page when the section has none yet or when fewer than ``MIN_LINES`` of it would fit."""
+    lines = _wrap(text, _width(flow.page.size) if flow.open else _width(PORTRAIT), BODY)
+    if flow.open and not _fits(len(lines), int((flow.room() - 0.35 * _line(BODY)) // _line(BODY))):
+        flow.open = False
     if not flow.open:
         flow.new_page()
+        lines = _wrap(text, _width(flow.page.size), BODY)
     else:
         flow.y += 0.35 * _line(BODY)
-    flow.text(_wrap(text, _width(flow.page.size), BODY), BODY)
+    flow.text(lines, BODY)
     flow.open = True
+
+
+def _fits(lines: int, room: int) -> bool:
+    """True when a paragraph of ``lines`` lines may start with ``room`` lines left on the page: whole, or split with at least ``MIN_LINES`` lines on each side."""
+    return lines <= room or (room >= MIN_LINES and lines - room >= MIN_LINES)
 
 
 def _figure(flow: _Flow, item: FigureItem, number: int) -> None:
@@ -238,6 +254,7 @@ def _figure(flow: _Flow, item: FigureItem, number: int) -> None:
     flow.draw(partial(_image, x=MARGIN + (box_width - width) / 2, y=flow.y, width=width, height=height, png=png))
     flow.y += height + 0.15
     flow.text(caption, BODY)
+    flow.open = True
 
 
 def _image(figure: Figure, x: float, y: float, width: float, height: float, png: bytes) -> None:
@@ -288,10 +305,13 @@ class _TableLayout:
 
 
 def _table(flow: _Flow, table: Table, number: int) -> None:
+    """The table from a new page, continued over as many pages as it needs, then its note (kept with its last rows)."""
     layout = _table_layout(table_grid(table))
     rows = len(layout.grid.cells)
+    note = _wrap(table.note, _width(layout.page), NOTE) if table.note else []
+    slices = layout.slices()
     first = True
-    for columns in layout.slices():
+    for slice_number, columns in enumerate(slices, start=1):
         start = 0
         while first or start < rows:
             flow.new_page(layout.page)
@@ -301,10 +321,12 @@ def _table(flow: _Flow, table: Table, number: int) -> None:
             flow.text(_wrap(title, _width(layout.page), BODY), BODY)
             flow.y += 0.08
             first = False
-            start = _table_page(flow, layout, columns, start)
-    if table.note:
+            reserve = 0.1 + len(note) * _line(NOTE) if slice_number == len(slices) else 0.0
+            start = _table_page(flow, layout, columns, start, reserve)
+    if note:
         flow.y += 0.1
-        flow.text(_wrap(table.note, _width(layout.page), NOTE), NOTE, style="italic", color=GREY)
+        flow.text(note, NOTE, style="italic", color=GREY)
+    flow.open = True
 
 
 def _table_layout(grid: Grid) -> _TableLayout:
@@ -343,8 +365,13 @@ def _widen_groups(widths: list[float], groups: list[tuple[int, int]], needed: li
             widths[column] += max(missing, 0.0) / length
 
 
-def _table_page(flow: _Flow, layout: _TableLayout, columns: list[int], start: int) -> int:
-    """Draw the header and as many rows from ``start`` as fit; return the next row."""
+def _table_page(flow: _Flow, layout: _TableLayout, columns: list[int], start: int, reserve: float = 0.0) -> int:
+    """Draw the header and as many rows from ``start`` as fit; return the next row.
+
+    ``reserve`` (inches) is kept free below the table's last row (for its
+    note): when every remaining row fits but the reserve does not, the last
+    row moves to a continuation page.
+    """
     x_labels = np.cumsum([MARGIN] + layout.label_widths)
     x_columns = np.cumsum([x_labels[-1]] + [layout.column_widths[c] for c in columns])
     right = x_columns[-1]
@@ -356,6 +383,8 @@ def _table_page(flow: _Flow, layout: _TableLayout, columns: list[int], start: in
     while stop < rows and (stop == start or used + layout.row_height(stop) <= flow.room()):
         used += layout.row_height(stop)
         stop += 1
+    if stop == rows and stop - start > 1 and used + reserve > flow.room():
+        stop -= 1
     stop = _group_break(layout.grid, start, stop)
     labels = layout.grid.row_labels[start:stop]
     spans = [dict(runs(labels, level)) for level in range(len(layout.grid.index_names))]
