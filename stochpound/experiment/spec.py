@@ -6,7 +6,7 @@ outputs to keep and the solver settings (docs/experiments.md, field by
 field). :func:`parse_experiment` checks every field and returns the
 *canonical definition*: a JSON-able dict with every default filled in and the
 base scene inlined. Its sha256 identifies the experiment: a store made from a
-different definition is refused. :class:`stochpound.experiment.model.Experiment`
+different definition is refused. :class:`stochpound.experiment.grid.Experiment`
 is built from it.
 
 Errors raise :class:`ExperimentError` whose message starts with the field's

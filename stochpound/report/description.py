@@ -23,7 +23,7 @@ from stochpound import motions as synthetic_motions
 from stochpound.experiment import Case
 from stochpound.experiment.definition import GapAxis, is_fixed_base
 from stochpound.experiment.intensity import describe_measure
-from stochpound.experiment.model import CASE
+from stochpound.experiment.grid import CASE
 from stochpound.model import laws
 from stochpound.model.contact import effective_mass
 from stochpound.model.modal_solution import modal_properties
