@@ -28,8 +28,8 @@ from stochpound.cli import main
 from stochpound.experiment.hazard import hazard_curve, stored_hazard
 from stochpound.experiment.runner import load_experiment, run_experiment
 from stochpound.experiment.spec import ExperimentError, definition_sha256, load_definition, parse_experiment
-from stochpound.report.document import Paragraph, Table
-from stochpound.report.risk import risk_headline, risk_of, risk_section
+from stochpound.report.render.document import Paragraph, Table
+from stochpound.report.sections.risk import risk_headline, risk_of, risk_section
 from tests.test_experiment_helpers import write_experiment
 
 REPOSITORY = Path(__file__).resolve().parent.parent

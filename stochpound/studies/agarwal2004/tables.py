@@ -23,10 +23,10 @@ import xarray as xr
 from stochpound.experiment.definition import is_fixed_base
 from stochpound.model.modal_solution import modal_properties
 from stochpound.motions.records import load_record, record_statistics, registry_entries, study_table_3_2
-from stochpound.report.description import StoreDefinition
-from stochpound.report.document import Table
-from stochpound.report.published import published_tables, study_number
-from stochpound.report.stores import value
+from stochpound.report.sections.description import StoreDefinition
+from stochpound.report.render.document import Table
+from stochpound.studies.agarwal2004.published import published_tables, study_number
+from stochpound.report.sections.stores import value
 
 CM = 100.0
 STUDY = "study"

@@ -25,9 +25,9 @@ import stochpound
 from stochpound.model import laws
 from stochpound.experiment.definition import read_definition
 from stochpound.model.modal_solution import harmonic_response, modal_properties
-from stochpound.report.description import StoreDefinition, number
-from stochpound.report.document import Paragraph
-from stochpound.report.stores import case_scene, select
+from stochpound.report.sections.description import StoreDefinition, number
+from stochpound.report.render.document import Paragraph
+from stochpound.report.sections.stores import case_scene, select
 from stochpound.model.scene import Building, Contact, Scene
 
 #: Closing velocity of the single-collision check, m/s.
