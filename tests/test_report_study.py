@@ -6,6 +6,7 @@ with the study's rows and columns, our numbers taken from the stores, every
 figure, the findings and the methods, in HTML and PDF.
 """
 
+import json
 import re
 import shutil
 from pathlib import Path
@@ -15,6 +16,7 @@ import pytest
 import xarray as xr
 
 from stochpound.experiment import load_experiment, open_store, run_experiment
+from stochpound.experiment.spec import canonical_json
 from stochpound.report.assemble import assemble_report
 from stochpound.report.sections.generic import AGAINST
 from stochpound.report.render.output import write_report
@@ -199,9 +201,17 @@ def test_documents_are_written(built):
 
 
 def test_a_store_that_is_not_the_study_gets_a_section_of_its_own(study_stores, tmp_path):
+    """The study claims a store by its declaration (``reproduces``), not by its name: renamed, it is still the study's;
+    without the declaration (a user's grid, or a store written before the field) it gets the generic sections."""
     single = next(p for p in study_stores if p.stem == "single_isolated")
     data = xr.open_dataset(single).load()
     data.attrs["experiment_name"] = "my_grid"
+    renamed = tmp_path / "renamed.nc"
+    data.to_netcdf(renamed, engine="h5netcdf")
+    assert "Single isolated building against μ" in [s.title for s in assemble_report([renamed]).sections]
+    definition = json.loads(data.attrs["definition"])
+    assert definition.pop("reproduces") == "agarwal2004:single"
+    data.attrs["definition"] = canonical_json(definition)
     other = tmp_path / "my_grid.nc"
     data.to_netcdf(other, engine="h5netcdf")
     report = assemble_report([other])

@@ -4,7 +4,7 @@ Four checks, each against something known exactly or computed independently:
 
 * every studied building on a fixed base under a_g = A sin(Ωt), against the
   closed-form modal solution (:func:`stochpound.modal_solution.harmonic_response`);
-  the study's harmonic experiment, when present, is checked on its stored runs;
+  a store's harmonic motions (``[[motions]]`` of type harmonic), when present, are checked on its stored runs;
 * every contact element as a single collision of its two floor masses, free,
   against the restitution the Kelvin–Voigt law gives in closed form
   (:func:`free_collision_restitution`);

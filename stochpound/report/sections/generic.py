@@ -1,7 +1,7 @@
 """Report sections for any experiment store: its records' cases and its ensembles' distributions.
 
-Used for stores that are not the study's (``experiments/study/``), e.g. the
-quick-start experiment, the stochastic study or a user's grid. The motions
+Used for stores that no study claims (:mod:`stochpound.studies`), e.g. a
+user's grid or a stochastic study. The motions
 of a store are of two kinds:
 
 * records (one realization each): a table of every case's summaries and

@@ -273,8 +273,8 @@ def building_2_table(store: xr.Dataset) -> Table:
             study["mass_factor"], study["T1"], study["T2"], study["omega1"], study["omega2"], study["zeta1"] * 100,
             *study.get("k_imp", [np.nan] * 2), *study.get("c_imp", [np.nan] * 2),
         ]
-        for label, value, theirs in zip(ours, ours.values(), study_values):
-            rows.setdefault(label, []).extend([theirs, value])
+        for label, computed, theirs in zip(ours, ours.values(), study_values):
+            rows.setdefault(label, []).extend([theirs, computed])
     columns = pd.MultiIndex.from_product([["B2 stiff", "B2 flexible"], [STUDY, CORRECTED]], names=["neighbour", "source"])
     frame = pd.DataFrame.from_dict(rows, orient="index", columns=columns)
     frame.index.name = "property"
