@@ -44,26 +44,20 @@ class Study:
     ----------
     key : str
         Its id, the package name under ``stochpound.studies`` and the part
-        of ``reproduces`` before the colon.
-    reference : str
-        The publication.
+        of ``reproduces`` before the colon (the package's docstring cites the publication).
     parts : tuple of str
         The parts an experiment may reproduce (after the colon), one store each.
     """
 
     key: str
-    reference: str
     parts: tuple[str, ...]
 
 
 STUDIES: dict[str, Study] = {
     study.key: study
     for study in (
-        Study(
-            "agarwal2004",
-            'V. K. Agarwal, "Pounding and impact of base isolated buildings due to earthquakes", M.S. thesis, Texas A&M University, 2004',
-            ("harmonic", "gap", "single", "pair_mu", "pair_records"),
-        ),
+        # V. K. Agarwal, "Pounding and impact of base isolated buildings due to earthquakes", M.S. thesis, Texas A&M University, 2004
+        Study("agarwal2004", ("harmonic", "gap", "single", "pair_mu", "pair_records")),
     )
 }
 """The registered studies, by key."""
