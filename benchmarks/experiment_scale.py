@@ -168,7 +168,7 @@ def _environment() -> dict[str, str]:
 
 def _done(store: Path) -> int:
     """Finished cases in a store's parts."""
-    from stochpound.experiment.model import Experiment
+    from stochpound.experiment.grid import Experiment
     from stochpound.experiment.parts import parts_folder, read_definition
     from stochpound.experiment.store_writer import PartsIndex
 

@@ -119,7 +119,7 @@ def single_cell(path: str, runs: int) -> None:
     import stochpound
     from stochpound import motions as generators
     from stochpound.experiment import load_experiment
-    from stochpound.experiment.model import CASE
+    from stochpound.experiment.grid import CASE
     from stochpound.experiment.sources import resolve_motions
     from stochpound.motions.ground import SampledMotion
 

@@ -15,7 +15,7 @@ import xarray as xr
 from stochpound.experiment import Experiment
 from stochpound.experiment.definition import FIXED_BASE, Definition, GapAxis, is_fixed_base, is_gap_axis, read_definition
 from stochpound.experiment.spec import ExperimentError, canonical_json, definition_sha256, load_definition, parse_experiment
-from stochpound.report.facets import value_text
+from stochpound.report.sections.facets import value_text
 
 ROOT = Path(__file__).resolve().parents[1]
 EXPERIMENTS = sorted(p for p in (ROOT / "experiments").glob("**/*.toml") if "scenes" not in p.parts)
@@ -39,6 +39,11 @@ IDENTITIES = {
     "bd9b53093d44e3e4acc85e308510add994bdf7abef03df62e1f2f88028935856": "4baf14717bf47188d5761c7a878b1636513e2d3c3992b75e15e25c72041021ae",  # experiments/laws/contact_laws.toml
     "30f757d6a000b675d5a77664f7ebaac77f5f8fe2bdaaa81c5a883ef996a93fda": "8587d2f9de1b97fd57b3799a668aa67bd90c2019b1ba238e1c664b982fc3c61a",  # experiments/risk/fixed_pair.toml
     "2ac35eca7fc1effebf5cc3dea300b01aadfa0cc86abb47b348e411247cb9c803": "40f7acef22ebc787ae56e0d0b2a347f5bd6eed6c553e7fbc0902cd26d1a814df",  # experiments/risk/isolated.toml
+    "6721b840847f3c887a64063a94280b5d169110c60ef231755da91b89a8300078": "d63aa13f0c17c62515a7f33d09c8af15f2d12f6063f66110f23227a68f70937f",  # experiments/study/gap_study.toml (declares reproduces)
+    "2991b119a5949c2c82f9b2fe3c5ea23ba8308484f5adbaf6202633df2547e55f": "0fee6ef18974eda7fe49d0fa885cd06ca430f684281d7e09d9aa13ae02729a4e",  # experiments/study/harmonic.toml (declares reproduces)
+    "b7cb8955ddf0e1110227ccc8d346f24b89c5f33cd69da9d0bcda4bfe1400fd19": "dc1f1332c3bbb0688ce5cc07bf78b719f5f9f549de5f0725493b705c41748dec",  # experiments/study/pair_mu.toml (declares reproduces)
+    "9eb3e480c894b5bc34df43b5b9a8de0d7f73faa83a3f65cbeb7e49152b4225f2": "82e15f9008cd583a3af79c9689770e8de7646b09322d1ecfd1d153b940b451e2",  # experiments/study/pair_records.toml (declares reproduces)
+    "9a9e8639340c6742f144c3a5eee10f4e5d01d648a5ae3fe097441832f7061a34": "740a608956d013e4f9f9a57339b973a7409ce0f1f55a9322ee58b8ba12740eec",  # experiments/study/single_isolated.toml (declares reproduces)
 }
 
 
@@ -86,6 +91,21 @@ def test_read_definition_types_and_errors() -> None:
     del broken["solver"]
     with pytest.raises(ExperimentError, match="solver"):
         read_definition(broken)
+
+
+def test_reproduces_declares_a_study_part() -> None:
+    """The study's files declare the part they reproduce; a definition without the field (a store written before it) reads None;
+    a value that is not a registered study's part is refused, naming the field and the allowed values."""
+    definition, _ = load_definition(ROOT / "experiments" / "study" / "pair_mu.toml")
+    assert read_definition(definition).reproduces == "agarwal2004:pair_mu"
+    older = {key: value for key, value in definition.items() if key != "reproduces"}
+    assert read_definition(xr.Dataset(attrs={"definition": canonical_json(older)})).reproduces is None
+    assert read_definition(load_definition(ROOT / "experiments" / "quickstart.toml")[0]).reproduces is None
+    data = tomllib.loads((ROOT / "experiments" / "study" / "harmonic.toml").read_text())
+    for wrong in ("agarwal2004", "agarwal2004:pair", "thesis:gap", 3):
+        data["experiment"]["reproduces"] = wrong
+        with pytest.raises(ExperimentError, match=r"experiment\.reproduces: must be one of agarwal2004:harmonic, .*agarwal2004:pair_records, got"):
+            parse_experiment(data, base_dir=ROOT / "experiments" / "study")
 
 
 def test_fixed_base_rule() -> None:
@@ -148,7 +168,7 @@ def test_gap_axis_wall_errors() -> None:
 
 def test_report_names_the_gap_axis_of_walls() -> None:
     """The report's table of contacts gives a wall's gap as the axis that sets it, read from the store's definition alone."""
-    from stochpound.report.description import StoreDefinition, contacts_table
+    from stochpound.report.sections.description import StoreDefinition, contacts_table
 
     definition = parse_experiment(_moat({"mu": {"values": [0.05, 0.1], "buildings": ["B1"]}, "gap_wall": {"values": [0.05, 0.1, "inf"], "walls": [0, 1]}}))
     store = xr.Dataset(attrs={"definition": canonical_json(definition)})

@@ -143,7 +143,7 @@ def cli_process(*args: str, env: dict | None = None) -> subprocess.Popen:
 def done_cases(store: Path) -> int:
     """Finished cases in a store's parts folder."""
     from stochpound.experiment.parts import parts_folder, read_experiment_json
-    from stochpound.experiment.model import Experiment
+    from stochpound.experiment.grid import Experiment
     from stochpound.experiment.store_writer import PartsIndex
 
     folder = parts_folder(store)

@@ -21,8 +21,8 @@ from stochpound.experiment.runner import load_experiment, run_experiment
 from stochpound.experiment.sources import resolve_motions
 from stochpound.experiment.spec import ExperimentError, load_definition, parse_experiment
 from stochpound.model.scene_file import scene_from_dict
-from stochpound.report.document import FigureItem, Table
-from stochpound.report.intensity import intensity_section
+from stochpound.report.render.document import FigureItem, Table
+from stochpound.report.sections.intensity import intensity_section
 from stochpound.solvers.simulate import simulate
 from tests.test_experiment_helpers import write_experiment
 

@@ -20,11 +20,11 @@ from matplotlib.figure import Figure
 from stochpound.cli import main
 from stochpound.cli import report as cli_report
 from stochpound.errors import StochpoundError
-from stochpound.report import output
-from stochpound.report.document import FigureItem, Paragraph, Report, Section, Table
-from stochpound.report.html import render_html
-from stochpound.report import pdf as pdf_layout
-from stochpound.report.pdf import render_pdf
+from stochpound.report.render import output
+from stochpound.report.render import pdf as pdf_layout
+from stochpound.report.render.document import FigureItem, Paragraph, Report, Section, Table
+from stochpound.report.render.html import render_html
+from stochpound.report.render.pdf import render_pdf
 from tests.chromium import render_in_chromium, require_chromium
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"

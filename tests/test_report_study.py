@@ -6,6 +6,7 @@ with the study's rows and columns, our numbers taken from the stores, every
 figure, the findings and the methods, in HTML and PDF.
 """
 
+import json
 import re
 import shutil
 from pathlib import Path
@@ -15,11 +16,12 @@ import pytest
 import xarray as xr
 
 from stochpound.experiment import load_experiment, open_store, run_experiment
+from stochpound.experiment.spec import canonical_json
 from stochpound.report.assemble import assemble_report
-from stochpound.report.generic import AGAINST
-from stochpound.report.output import write_report
-from stochpound.report.published import published_tables
-from stochpound.report.study_tables import CORRECTED, DIFFERENCE, SPLINE, STUDY, STUDY_EQUATIONS
+from stochpound.report.sections.generic import AGAINST
+from stochpound.report.render.output import write_report
+from stochpound.studies.agarwal2004.published import published_tables
+from stochpound.studies.agarwal2004.tables import CORRECTED, DIFFERENCE, SPLINE, STUDY, STUDY_EQUATIONS
 from tests.chromium import render_in_chromium, require_chromium
 
 pytestmark = pytest.mark.slow  # builds the study report from every study experiment (about two minutes)
@@ -199,9 +201,17 @@ def test_documents_are_written(built):
 
 
 def test_a_store_that_is_not_the_study_gets_a_section_of_its_own(study_stores, tmp_path):
+    """The study claims a store by its declaration (``reproduces``), not by its name: renamed, it is still the study's;
+    without the declaration (a user's grid, or a store written before the field) it gets the generic sections."""
     single = next(p for p in study_stores if p.stem == "single_isolated")
     data = xr.open_dataset(single).load()
     data.attrs["experiment_name"] = "my_grid"
+    renamed = tmp_path / "renamed.nc"
+    data.to_netcdf(renamed, engine="h5netcdf")
+    assert "Single isolated building against μ" in [s.title for s in assemble_report([renamed]).sections]
+    definition = json.loads(data.attrs["definition"])
+    assert definition.pop("reproduces") == "agarwal2004:single"
+    data.attrs["definition"] = canonical_json(definition)
     other = tmp_path / "my_grid.nc"
     data.to_netcdf(other, engine="h5netcdf")
     report = assemble_report([other])
@@ -223,7 +233,7 @@ def test_the_study_report_renders_in_headless_chromium(built, tmp_path):
 def test_figure_3_6_draws_every_located_peak_its_caption_quotes(built, study_stores):
     gap = open_store(next(p for p in study_stores if p.stem == "gap_study"))
     case = {"neighbour": "flexible", "gap": 0.02, "mu": np.inf, "record": "el_centro", "realization": 0}
-    from stochpound.report.stores import case_impacts
+    from stochpound.report.sections.stores import case_impacts
 
     impacts = case_impacts(gap, **case)
     item = built["figure_items"]["figure-3.6"]

@@ -40,7 +40,7 @@ def build_command(stores: tuple[Path, ...], out: Path, formats: tuple[str, ...])
     checked to be writable before any work.
     """
     from stochpound.report.assemble import assemble_report
-    from stochpound.report.output import check_output_folder, write_report
+    from stochpound.report.render.output import check_output_folder, write_report
 
     try:
         check_output_folder(out)

@@ -50,8 +50,8 @@ def risk(store: Path, hazard: str | None, target: str, years: float, bootstrap: 
     from stochpound.experiment import open_store
     from stochpound.experiment.hazard import hazard_option, stored_hazard
     from stochpound.experiment.intensity import describe_measure
-    from stochpound.report.intensity import intensity_setting
-    from stochpound.report.risk import risk_headline, rules_frame, separation_frame
+    from stochpound.report.sections.intensity import intensity_setting
+    from stochpound.report.sections.risk import risk_headline, rules_frame, separation_frame
 
     targets = _targets(target)
     try:

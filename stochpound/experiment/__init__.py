@@ -21,7 +21,7 @@ from stochpound.experiment.definition import (
     is_gap_axis,
     read_definition,
 )
-from stochpound.experiment.model import Case, Dim, Experiment
+from stochpound.experiment.grid import Case, Dim, Experiment
 from stochpound.experiment.runner import RunReport, default_store, load_experiment, run_experiment
 from stochpound.experiment.spec import ExperimentError
 from stochpound.experiment.status import StatusReport, store_status

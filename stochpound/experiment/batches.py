@@ -21,7 +21,7 @@ import numpy as np
 
 from stochpound.experiment.compute import BatchTask, Group
 from stochpound.experiment.intensity import task_settings
-from stochpound.experiment.model import CASE, KINDS, Experiment, Point
+from stochpound.experiment.grid import CASE, KINDS, Experiment, Point
 from stochpound.experiment.sources import ResolvedMotion
 from stochpound.memory import sample_bytes
 from stochpound.model.scene_file import scene_from_dict

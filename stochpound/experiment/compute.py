@@ -6,7 +6,7 @@ process, on local dask workers or on a remote cluster. A batch is a set of
 realizations of one motion and the grid points that run under them
 (:class:`Group`): the realizations are generated once (an ensemble's in one
 call), the fixed-base twins of all of them are computed at once
-(:mod:`stochpound.experiment.twin`), and each case is simulated and
+(:mod:`stochpound.solvers.twin`), and each case is simulated and
 summarised (:mod:`stochpound.experiment.summary`).
 
 Every result depends only on its case: the solvers limit BLAS to one thread,
@@ -24,11 +24,11 @@ import numpy as np
 
 from stochpound import motions as synthetic_motions
 from stochpound.experiment import intensity
-from stochpound.experiment.model import REFERENCE
+from stochpound.experiment.grid import REFERENCE
 from stochpound.experiment.parts import concatenate, section_key, stack_cases
 from stochpound.experiment.spec import AUTO, canonical_json
 from stochpound.experiment.summary import case_arrays, case_values, reference_arrays, reference_values
-from stochpound.experiment.twin import fixed_base_displacements
+from stochpound.solvers.twin import fixed_base_displacements
 from stochpound.model.scene import Scene
 from stochpound.model.scene_file import scene_from_dict
 from stochpound.motions.ground import GroundMotion, SampledMotion

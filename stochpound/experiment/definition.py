@@ -224,6 +224,9 @@ class Definition:
         Format version of the canonical definition.
     canonical : mapping
         The canonical dict itself (every field, later ones included): :meth:`Definition.to_dict`.
+    reproduces : str or None
+        The part of a published study the experiment reproduces, ``"<study>:<part>"``
+        (``stochpound.studies.STUDIES``); None: none (and for definitions stored before the field).
     """
 
     name: str
@@ -239,6 +242,7 @@ class Definition:
     intensity: Mapping[str, Any] | None
     format: int
     canonical: Mapping[str, Any]
+    reproduces: str | None = None
 
     def to_dict(self) -> dict[str, Any]:
         """The canonical definition (a copy): what ``parse_experiment`` returned (``stochpound.experiment.spec``)."""
@@ -336,4 +340,5 @@ def _from_dict(data: dict[str, Any]) -> Definition:
         intensity=data.get("intensity"),
         format=data["format"],
         canonical=data,
+        reproduces=data.get("reproduces"),
     )

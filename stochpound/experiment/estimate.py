@@ -11,7 +11,7 @@ import math
 from dataclasses import dataclass
 from typing import Mapping
 
-from stochpound.experiment.model import KINDS, Experiment, Point
+from stochpound.experiment.grid import KINDS, Experiment, Point
 from stochpound.experiment.spec import AUTO
 from stochpound.experiment.store import layout
 from stochpound.memory import format_bytes

@@ -30,7 +30,7 @@ from stochpound import __version__
 from stochpound.experiment.batches import automatic_size, make_batches
 from stochpound.experiment.compute import BatchResult, BatchTask, run_batch, solver_cached, warm_up
 from stochpound.experiment.estimate import LARGE_RUN_BYTES, LARGE_RUN_CASES, estimate_run
-from stochpound.experiment.model import Experiment
+from stochpound.experiment.grid import Experiment
 from stochpound.experiment.parts import FolderLock, PartBuffer, append_run, parts_folder, remove_temporaries
 from stochpound.experiment.session import StoreSession, check_store, clear_store, code_identity, machine, now, store_complete
 from stochpound.experiment.sources import ResolvedMotion, resolve_motions

@@ -20,7 +20,7 @@ from typing import Any
 import numpy as np
 
 from stochpound import __version__
-from stochpound.experiment.model import KINDS, Experiment
+from stochpound.experiment.grid import KINDS, Experiment
 from stochpound.experiment.parts import DEFINITION_FILE, part_paths, parts_folder, read_experiment_json, read_runs, write_experiment_json
 from stochpound.experiment.spec import ExperimentError, canonical_json
 from stochpound.experiment.store import PREFIX

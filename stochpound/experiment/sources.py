@@ -17,7 +17,7 @@ import numpy as np
 
 from stochpound import motions as synthetic_motions
 from stochpound.experiment.intensity import check_resolution, ensemble_intensity
-from stochpound.experiment.model import CASE, Experiment
+from stochpound.experiment.grid import CASE, Experiment
 from stochpound.experiment.spec import ExperimentError, field_errors
 from stochpound.motions.ground import GroundMotion, SampledMotion
 from stochpound.model.scene_file import scene_from_dict

@@ -6,7 +6,7 @@ outputs to keep and the solver settings (docs/experiments.md, field by
 field). :func:`parse_experiment` checks every field and returns the
 *canonical definition*: a JSON-able dict with every default filled in and the
 base scene inlined. Its sha256 identifies the experiment: a store made from a
-different definition is refused. :class:`stochpound.experiment.model.Experiment`
+different definition is refused. :class:`stochpound.experiment.grid.Experiment`
 is built from it.
 
 Errors raise :class:`ExperimentError` whose message starts with the field's
@@ -35,12 +35,13 @@ from stochpound.model.contact import ELEMENT_KEYS
 from stochpound.model.scene_file import generator_fields
 from stochpound.solvers.simulate import METHODS
 from stochpound.solvers.ivp import INTEGRATORS
+from stochpound.studies import parse_reproduces
 
 #: Format version of the canonical definition (stored with every store).
 FORMAT_VERSION = 1
 
 _TOP_KEYS = {"experiment", "scene", "variants", "grid", "records", "motions", "synthetic", "output", "solver", "intensity", "hazard"}
-_EXPERIMENT_KEYS = {"name", "description", "scene", "studied"}
+_EXPERIMENT_KEYS = {"name", "description", "scene", "studied", "reproduces"}
 _BUILDING_OVERRIDES = {"mass_factor", "mass", "stiffness", "damping", "damping_ratio", "base", "initial"}
 _SCENE_OVERRIDES = {"study_compat", "wall"}
 AUTO = "auto"
@@ -156,7 +157,8 @@ def parse_experiment(data: Mapping[str, Any], base_dir: str | Path = ".", defaul
         Canonical definition: ``format``, ``name``, ``description``,
         ``scene`` (the base scene's dict, its ``[motion]`` included when it has one),
         ``studied``, ``variants``, ``gaps``, ``mu``, ``motions``, ``output``, ``solver``;
-        ``intensity`` and ``hazard`` only when the file has those tables.
+        ``intensity`` and ``hazard`` only when the file has those tables;
+        ``reproduces`` only when the file declares it.
     """
     base_dir = Path(base_dir)
     with field_errors():
@@ -167,6 +169,12 @@ def parse_experiment(data: Mapping[str, Any], base_dir: str | Path = ".", defaul
         description = header.get("description", "")
         if not isinstance(description, str):
             raise ExperimentError(f"experiment.description: must be a string, got {description!r}")
+        reproduces = header.get("reproduces")
+        if reproduces is not None:
+            try:
+                parse_reproduces(reproduces)
+            except ValueError as error:
+                raise ExperimentError(f"experiment.reproduces: {error} (a published study's part, \"<study>:<part>\")") from None
     scene = _base_scene(data, header, base_dir)
     buildings = [b.get("name", f"B{i + 1}") for i, b in enumerate(scene.get("building", []))]
     studied = header.get("studied", buildings[0] if buildings else "B1")
@@ -202,6 +210,8 @@ def parse_experiment(data: Mapping[str, Any], base_dir: str | Path = ".", defaul
         "output": _output(data, buildings),
         "solver": _solver(data),
     }
+    if reproduces is not None:  # absent unless declared: the definitions (and hashes) of other files are unchanged
+        definition["reproduces"] = reproduces
     if intensity is not None:  # absent without [intensity]: the definitions (and hashes) of other files are unchanged
         definition["intensity"] = intensity
     if hazard is not None:  # likewise absent without [hazard]

@@ -10,7 +10,7 @@ from typing import Iterator
 import numpy as np
 
 from stochpound.experiment.definition import read_definition
-from stochpound.experiment.model import KINDS, Case, Experiment
+from stochpound.experiment.grid import KINDS, Case, Experiment
 from stochpound.experiment.parts import DEFINITION_FILE, FolderLock, parts_folder
 from stochpound.experiment.session import StoreSession
 from stochpound.experiment.spec import ExperimentError

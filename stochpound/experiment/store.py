@@ -33,7 +33,7 @@ import numpy as np
 import xarray as xr
 
 from stochpound.experiment import intensity
-from stochpound.experiment.model import CASE, REFERENCE, Dim, Experiment
+from stochpound.experiment.grid import CASE, REFERENCE, Dim, Experiment
 from stochpound.experiment.spec import ExperimentError, canonical_json
 from stochpound.experiment.catalogue import CASE_SUMMARIES, IMPACT_TABLE, REFERENCE_HISTORY, REFERENCE_SUMMARIES, TIME_HISTORIES, StoreVariable
 from stochpound.experiment.summary import DEMAND_SUMMARIES

@@ -27,7 +27,7 @@ import numpy as np
 from xarray.backends import H5NetCDFStore
 
 from stochpound.atomic import replacing
-from stochpound.experiment.model import CASE, KINDS, Experiment
+from stochpound.experiment.grid import CASE, KINDS, Experiment
 from stochpound.experiment.parts import part_paths, read_part, split_key
 from stochpound.experiment.store import INT_FILL, Layout, Spec, blocks, layout, union_times
 

@@ -10,7 +10,7 @@ import pytest
 import stochpound
 from stochpound import motions
 from stochpound.motions.ground import HarmonicMotion, SampledMotion
-from stochpound.experiment.twin import fixed_base_displacements
+from stochpound.solvers.twin import fixed_base_displacements
 from tests.conftest import reference_building
 
 PLACEHOLDER = {"type": "constant", "acceleration": 0.0, "duration": 1.0, "dt": 1.0}

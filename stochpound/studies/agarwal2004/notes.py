@@ -21,10 +21,10 @@ import xarray as xr
 
 import stochpound
 from stochpound.motions.ground import SampledMotion
-from stochpound.report import figures
-from stochpound.report.document import Block, FigureItem, Paragraph, Table
-from stochpound.report.stores import case_scene, select
-from stochpound.report.study_tables import record_label
+from stochpound.report.render import figures
+from stochpound.report.render.document import Block, FigureItem, Paragraph, Table
+from stochpound.report.sections.stores import case_scene, select
+from stochpound.studies.agarwal2004.tables import record_label
 
 CM = 100.0
 NEIGHBOURS = ("stiff", "flexible")

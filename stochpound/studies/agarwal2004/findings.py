@@ -12,12 +12,12 @@ import xarray as xr
 
 from stochpound.experiment.definition import FIXED_BASE
 from stochpound.experiment.selections import isolated_mus
-from stochpound.report.document import Paragraph
-from stochpound.report.description import StoreDefinition
-from stochpound.report.published import published_tables
-from stochpound.report.stores import select, value
-from stochpound.report.study_notes import SCALES, scaled_runs
-from stochpound.report.study_tables import record_label
+from stochpound.report.render.document import Paragraph
+from stochpound.report.sections.description import StoreDefinition
+from stochpound.studies.agarwal2004.published import published_tables
+from stochpound.report.sections.stores import select, value
+from stochpound.studies.agarwal2004.notes import SCALES, scaled_runs
+from stochpound.studies.agarwal2004.tables import record_label
 
 CM = 100.0
 NEIGHBOURS = ("stiff", "flexible")

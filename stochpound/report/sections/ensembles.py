@@ -7,7 +7,7 @@ quantiles of the peaks, the probability of pounding with its exact
 interval) and drawn: the probability of pounding against each gap axis and
 against μ, the empirical distributions of the peaks and of the correlation
 with the fixed-base twin, and the running estimates against the number of
-realizations. Every cell is in every figure family (:mod:`stochpound.report.facets`).
+realizations. Every cell is in every figure family (:mod:`stochpound.report.sections.facets`).
 """
 
 from __future__ import annotations
@@ -24,10 +24,10 @@ import xarray as xr
 
 from stochpound.analysis import ensemble_statistics, mean_interval, of_first, pounding_probability
 from stochpound.analysis.intervals import MIN_RUNS
-from stochpound.report import figures
-from stochpound.report.document import Block, FigureItem, Table
+from stochpound.report.render import figures
+from stochpound.report.render.document import Block, FigureItem, Table
 from stochpound.experiment.definition import is_gap_axis
-from stochpound.report.facets import cell_gid, dim_text, labels_text, layouts, line_colours, plain, value_text
+from stochpound.report.sections.facets import cell_gid, dim_text, labels_text, layouts, line_colours, plain, value_text
 
 CM = 100.0
 KN = 1e-3

@@ -31,10 +31,10 @@ from stochpound.analysis import mean_interval, pounding_probability
 from stochpound.analysis.intervals import MIN_RUNS
 from stochpound.experiment.definition import is_gap_axis, read_definition
 from stochpound.model import laws
-from stochpound.report import figures
-from stochpound.report.document import Block, FigureItem, Paragraph, Section
-from stochpound.report.ensembles import Ensemble
-from stochpound.report.facets import dim_text, labels_text, line_colours, plain
+from stochpound.report.render import figures
+from stochpound.report.render.document import Block, FigureItem, Paragraph, Section
+from stochpound.report.sections.ensembles import Ensemble
+from stochpound.report.sections.facets import dim_text, labels_text, line_colours, plain
 
 
 @dataclass(frozen=True)

@@ -23,13 +23,13 @@ from stochpound import motions as synthetic_motions
 from stochpound.experiment import Case
 from stochpound.experiment.definition import GapAxis, is_fixed_base
 from stochpound.experiment.intensity import describe_measure
-from stochpound.experiment.model import CASE
+from stochpound.experiment.grid import CASE
 from stochpound.model import laws
 from stochpound.model.contact import effective_mass
 from stochpound.model.modal_solution import modal_properties
 from stochpound.motions.records import load_record, registry_entries
-from stochpound.report.document import Paragraph, Table
-from stochpound.report.stores import store_experiment
+from stochpound.report.render.document import Paragraph, Table
+from stochpound.report.sections.stores import store_experiment
 from stochpound.model.scene import Building, Contact, Scene
 from stochpound.model.wall import Wall
 from stochpound.model.scene_file import scene_from_dict
@@ -246,7 +246,7 @@ def _contacts_note(definitions: Iterable[StoreDefinition]) -> str:
 
 
 def _where(uses: list[tuple[StoreDefinition, Configuration]]) -> str:
-    """The experiments and configurations a row was run in, e.g. ``pair_mu (neighbour = stiff)``."""
+    """The experiments and configurations a row was run in, e.g. ``<experiment> (neighbour = stiff)``."""
     texts = []
     for definition in dict.fromkeys(d for d, _ in uses):
         chosen = [c for d, c in uses if d is definition]

@@ -1,14 +1,14 @@
 """Report sections for any experiment store: its records' cases and its ensembles' distributions.
 
-Used for stores that are not the study's (``experiments/study/``), e.g. the
-quick-start experiment, the stochastic study or a user's grid. The motions
+Used for stores that no study claims (:mod:`stochpound.studies`), e.g. a
+user's grid or a stochastic study. The motions
 of a store are of two kinds:
 
 * records (one realization each): a table of every case's summaries and
   the summaries against the numeric grid axes, every case drawn;
 * synthetic ensembles: per grid cell, the ensemble statistics, their
-  findings and the distributions (:mod:`stochpound.report.ensembles`,
-  :mod:`stochpound.report.ensemble_findings`).
+  findings and the distributions (:mod:`stochpound.report.sections.ensembles`,
+  :mod:`stochpound.report.sections.ensemble_findings`).
 """
 
 from __future__ import annotations
@@ -17,12 +17,12 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
-from stochpound.report import figures
-from stochpound.report.document import Block, FigureItem, Paragraph, Section, Table
-from stochpound.report.ensemble_findings import compare_ensembles, ensemble_findings, isolation_across
-from stochpound.report.ensembles import Ensemble
+from stochpound.report.render import figures
+from stochpound.report.render.document import Block, FigureItem, Paragraph, Section, Table
+from stochpound.report.sections.ensemble_findings import compare_ensembles, ensemble_findings, isolation_across
+from stochpound.report.sections.ensembles import Ensemble
 from stochpound.experiment.definition import is_gap_axis
-from stochpound.report.facets import dim_text, labels_text, layouts, line_colours, plain, value_text, cell_gid
+from stochpound.report.sections.facets import dim_text, labels_text, layouts, line_colours, plain, value_text, cell_gid
 
 CM = 100.0
 #: Summaries of a record's case: store variable -> (label, factor to the shown unit).

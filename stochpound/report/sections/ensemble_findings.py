@@ -1,6 +1,6 @@
 """Findings written from an ensemble's statistics: what its realizations show that one record cannot.
 
-Every sentence is computed from :attr:`stochpound.report.ensembles.Ensemble.statistics`:
+Every sentence is computed from :attr:`stochpound.report.sections.ensembles.Ensemble.statistics`:
 how wide the intervals are, how the probability of pounding falls with each
 gap axis (and the gap it takes to make pounding unlikely with 95 %
 confidence), where a sliding base helps or hurts against the fixed base,
@@ -17,11 +17,11 @@ import pandas as pd
 import xarray as xr
 
 from stochpound.analysis import kernels
-from stochpound.report.document import Block, Paragraph, Table
-from stochpound.report.ensembles import CM, MIN_RUNS, Ensemble
+from stochpound.report.render.document import Block, Paragraph, Table
+from stochpound.report.sections.ensembles import CM, MIN_RUNS, Ensemble
 from stochpound.experiment.definition import FIXED_BASE, is_fixed_base, is_gap_axis
 from stochpound.experiment.selections import fixed_base, has_fixed_base_twins, isolated_mus
-from stochpound.report.facets import dim_text, labels_text, value_text
+from stochpound.report.sections.facets import dim_text, labels_text, value_text
 
 #: Estimates compared between a sliding and a fixed base: statistic -> label.
 COMPARED = {

@@ -1,8 +1,8 @@
 """The report as data: sections of paragraphs, tables and figures, rendered to HTML and PDF.
 
-The builders (:mod:`stochpound.report.study`, :mod:`stochpound.report.generic`)
-produce a :class:`Report`; the renderers (:mod:`stochpound.report.html`,
-:mod:`stochpound.report.pdf`) turn the same object into each format, so the
+The builders (the sections of :mod:`stochpound.report.sections`, and the studies'
+sections, :mod:`stochpound.studies`) produce a :class:`Report`; the renderers (:mod:`stochpound.report.render.html`,
+:mod:`stochpound.report.render.pdf`) turn the same object into each format, so the
 two formats always carry the same tables, figures and text.
 """
 

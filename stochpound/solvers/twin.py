@@ -9,7 +9,7 @@ hold gives [a_k, (a_{k+1} − a_k)/dt, 0, 0]),
     x_{k+1} = Φ x_k + Γ w_k + γ,
 
 where [Φ, Γ, γ] are the state rows of exp(𝒜 dt), the solver's own
-transition over one sub-step (:attr:`stochpound.solvers.propagators.ModePropagator.transition`)
+transition over one sub-step (``stochpound.solvers.propagators.ModePropagator.transition``)
 raised to the number of sub-steps in a sample interval. No second matrix
 exponential is computed: the propagator is the one the exact solver uses for
 the same mode.

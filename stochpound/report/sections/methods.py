@@ -1,7 +1,7 @@
 """The methods section: what was run, from the stores' own definitions, and the solver's accuracy measured now.
 
-Every sentence and table is derived from the stores (:mod:`stochpound.report.description`)
-or measured while the report is built (:mod:`stochpound.report.accuracy`).
+Every sentence and table is derived from the stores (:mod:`stochpound.report.sections.description`)
+or measured while the report is built (:mod:`stochpound.report.sections.accuracy`).
 """
 
 from __future__ import annotations
@@ -15,11 +15,11 @@ import xarray as xr
 
 import stochpound
 from stochpound.motions.records import registry_entries
-from stochpound.report.accuracy import accuracy_paragraphs
-from stochpound.report.description import StoreDefinition, buildings_table, contacts_table, grid_paragraph, model_paragraph, motions_table, records_used
-from stochpound.report.document import Paragraph, Section, Table
-from stochpound.report.intensity import intensity_setting, method_text
-from stochpound.report.risk import hazard_provenance
+from stochpound.report.sections.accuracy import accuracy_paragraphs
+from stochpound.report.sections.description import StoreDefinition, buildings_table, contacts_table, grid_paragraph, model_paragraph, motions_table, records_used
+from stochpound.report.render.document import Paragraph, Section, Table
+from stochpound.report.sections.intensity import intensity_setting, method_text
+from stochpound.report.sections.risk import hazard_provenance
 
 #: Packages whose versions the report lists.
 PACKAGES = ("numpy", "scipy", "xarray", "numba", "dask", "pandas", "matplotlib", "h5netcdf", "jinja2")

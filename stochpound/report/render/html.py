@@ -3,7 +3,7 @@
 The page makes no request of its own: the style sheet is inline, figures are
 embedded as base64 PNG and a Content-Security-Policy forbids anything else.
 Tables are real ``<table>`` elements: the column levels become grouped header
-rows, the index levels row headers (:mod:`stochpound.report.layout`).
+rows, the index levels row headers (:mod:`stochpound.report.render.layout`).
 """
 
 from __future__ import annotations
@@ -18,8 +18,8 @@ import jinja2
 
 from stochpound import __version__
 from stochpound.data_files import bundled_data_dir
-from stochpound.report.document import FigureItem, Paragraph, Report, Section, Table
-from stochpound.report.layout import Grid, runs, table_grid
+from stochpound.report.render.document import FigureItem, Paragraph, Report, Section, Table
+from stochpound.report.render.layout import Grid, runs, table_grid
 
 TEMPLATE = "report.html.j2"
 

@@ -35,8 +35,8 @@ from matplotlib.patches import Rectangle
 from matplotlib.textpath import text_to_path
 
 from stochpound import __version__
-from stochpound.report.document import FigureItem, Paragraph, Report, Table
-from stochpound.report.layout import Grid, runs, table_grid
+from stochpound.report.render.document import FigureItem, Paragraph, Report, Table
+from stochpound.report.render.layout import Grid, runs, table_grid
 
 PORTRAIT = (8.27, 11.69)
 LANDSCAPE = (11.69, 8.27)

@@ -4,7 +4,7 @@ Four checks, each against something known exactly or computed independently:
 
 * every studied building on a fixed base under a_g = A sin(Ωt), against the
   closed-form modal solution (:func:`stochpound.modal_solution.harmonic_response`);
-  the study's harmonic experiment, when present, is checked on its stored runs;
+  a store's harmonic motions (``[[motions]]`` of type harmonic), when present, are checked on its stored runs;
 * every contact element as a single collision of its two floor masses, free,
   against the restitution the Kelvin–Voigt law gives in closed form
   (:func:`free_collision_restitution`);
@@ -25,9 +25,9 @@ import stochpound
 from stochpound.model import laws
 from stochpound.experiment.definition import read_definition
 from stochpound.model.modal_solution import harmonic_response, modal_properties
-from stochpound.report.description import StoreDefinition, number
-from stochpound.report.document import Paragraph
-from stochpound.report.stores import case_scene, select
+from stochpound.report.sections.description import StoreDefinition, number
+from stochpound.report.render.document import Paragraph
+from stochpound.report.sections.stores import case_scene, select
 from stochpound.model.scene import Building, Contact, Scene
 
 #: Closing velocity of the single-collision check, m/s.

@@ -38,10 +38,10 @@ from stochpound.analysis.store_risk import StoreRisk, base_displacement, store_m
 from stochpound.experiment.definition import read_definition
 from stochpound.experiment.hazard import stored_hazard, stored_hazard_entry
 from stochpound.experiment.intensity import describe_measure
-from stochpound.report.document import Block, FigureItem, Paragraph, Section, Table
-from stochpound.report.facets import labels_text
-from stochpound.report.intensity import intensity_setting
-from stochpound.report.summary import RISK_ANSWERS
+from stochpound.report.render.document import Block, FigureItem, Paragraph, Section, Table
+from stochpound.report.sections.facets import labels_text
+from stochpound.report.sections.intensity import intensity_setting
+from stochpound.report.sections.summary import RISK_ANSWERS
 
 CONFIDENCE = 0.95
 YEARS = 50.0
@@ -200,7 +200,7 @@ def headline_text(name: str, store: xr.Dataset, risk: StoreRisk) -> str:
 
 
 def summary_answer(name: str, store: xr.Dataset) -> list[Block]:
-    """The summary's answer to "which gap meets a target risk?" (a builder of :data:`stochpound.report.summary.RISK_ANSWERS`)."""
+    """The summary's answer to "which gap meets a target risk?" (a builder of :data:`stochpound.report.sections.summary.RISK_ANSWERS`)."""
     return [Paragraph(headline_text(name, store, risk_of(store)))] if has_risk(store) else []
 
 

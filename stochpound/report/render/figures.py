@@ -3,7 +3,7 @@
 Every function returns a :class:`matplotlib.figure.Figure` (not attached to
 pyplot, so building many figures keeps no global state) with labelled axes
 (units), a legend where there is more than one line, and a title. The callers
-(:mod:`stochpound.report.study_figures`) name the record and label
+(the report's sections and the studies' figures) name the record and label
 substitutes as such.
 """
 
@@ -204,7 +204,7 @@ class Curve:
     marker : str
         Marker at each point ("" for none).
     gid : str
-        Set on every artist of the curve (:func:`stochpound.report.facets.cell_gid`).
+        Set on every artist of the curve (:func:`stochpound.report.sections.facets.cell_gid`).
     """
 
     label: str

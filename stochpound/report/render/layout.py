@@ -1,6 +1,6 @@
 """A table as a grid of text cells with grouped labels, shared by the HTML and PDF renderers.
 
-Both renderers show a :class:`~stochpound.report.document.Table` the same way:
+Both renderers show a :class:`~stochpound.report.render.document.Table` the same way:
 the index levels become leading label columns, the column levels become
 stacked header rows, and a label repeated on consecutive rows (or columns)
 is shown once over its group (:func:`runs`).
@@ -13,7 +13,7 @@ import numbers
 from dataclasses import dataclass
 from typing import Sequence
 
-from stochpound.report.document import Table
+from stochpound.report.render.document import Table
 
 DIFFERENCE = "difference"
 

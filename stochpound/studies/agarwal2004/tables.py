@@ -23,10 +23,10 @@ import xarray as xr
 from stochpound.experiment.definition import is_fixed_base
 from stochpound.model.modal_solution import modal_properties
 from stochpound.motions.records import load_record, record_statistics, registry_entries, study_table_3_2
-from stochpound.report.description import StoreDefinition
-from stochpound.report.document import Table
-from stochpound.report.published import published_tables, study_number
-from stochpound.report.stores import value
+from stochpound.report.sections.description import StoreDefinition
+from stochpound.report.render.document import Table
+from stochpound.studies.agarwal2004.published import published_tables, study_number
+from stochpound.report.sections.stores import value
 
 CM = 100.0
 STUDY = "study"
@@ -273,8 +273,8 @@ def building_2_table(store: xr.Dataset) -> Table:
             study["mass_factor"], study["T1"], study["T2"], study["omega1"], study["omega2"], study["zeta1"] * 100,
             *study.get("k_imp", [np.nan] * 2), *study.get("c_imp", [np.nan] * 2),
         ]
-        for label, value, theirs in zip(ours, ours.values(), study_values):
-            rows.setdefault(label, []).extend([theirs, value])
+        for label, computed, theirs in zip(ours, ours.values(), study_values):
+            rows.setdefault(label, []).extend([theirs, computed])
     columns = pd.MultiIndex.from_product([["B2 stiff", "B2 flexible"], [STUDY, CORRECTED]], names=["neighbour", "source"])
     frame = pd.DataFrame.from_dict(rows, orient="index", columns=columns)
     frame.index.name = "property"

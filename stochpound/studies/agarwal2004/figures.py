@@ -13,11 +13,11 @@ import xarray as xr
 from stochpound.experiment.definition import FIXED_BASE, is_fixed_base
 from stochpound.experiment.selections import isolated_mus
 from stochpound.motions.records import load_record
-from stochpound.report import figures
-from stochpound.report.document import FigureItem
-from stochpound.report.accuracy import harmonic_comparisons
-from stochpound.report.stores import case_impacts, select
-from stochpound.report.study_tables import RECORD_ENTRIES, record_label
+from stochpound.report.render import figures
+from stochpound.report.render.document import FigureItem
+from stochpound.report.sections.accuracy import harmonic_comparisons
+from stochpound.report.sections.stores import case_impacts, select
+from stochpound.studies.agarwal2004.tables import RECORD_ENTRIES, record_label
 
 CM = 100.0
 NEIGHBOURS = {"stiff": "B2 stiff", "flexible": "B2 flexible"}

@@ -27,12 +27,12 @@ import numpy as np
 import xarray as xr
 
 from stochpound.analysis import pounding_curve, pounding_probability, required_separation, rule_exceedance, separation_rules, store_contact_demands
-from stochpound.report import figures
-from stochpound.report.document import Block, FigureItem, Paragraph, Section, Table
-from stochpound.report.ensemble_findings import RARE, rare_gap
-from stochpound.report.ensembles import Ensemble, line_label, lines, table_frame
+from stochpound.report.render import figures
+from stochpound.report.render.document import Block, FigureItem, Paragraph, Section, Table
+from stochpound.report.sections.ensemble_findings import RARE, rare_gap
+from stochpound.report.sections.ensembles import Ensemble, line_label, lines, table_frame
 from stochpound.experiment.selections import contact_free, gap_dims, isolated_mus, with_contacts
-from stochpound.report.facets import dim_text, labels_text, value_text
+from stochpound.report.sections.facets import dim_text, labels_text, value_text
 
 CM = 100.0
 RULE_TEXT = {

@@ -12,15 +12,13 @@ each with its number and interval, computed from the stores:
 * the risk-targeted gap, when a builder of :data:`RISK_ANSWERS` finds a
   hazard in the store;
 
-and where the details are (the sections by number and title). For the
-study's stores it states each of the study's conclusions with its verdict.
+and where the details are (the sections by number and title).
 Tables with one row per cell of a grid (``Table.per_cell``) move to an
 appendix at the end (:func:`move_per_cell_tables`).
 """
 
 from __future__ import annotations
 
-import re
 from collections.abc import Callable
 
 import numpy as np
@@ -28,11 +26,11 @@ import pandas as pd
 import xarray as xr
 
 from stochpound.analysis import pounding_probability, required_separation
-from stochpound.report.document import Block, Paragraph, Section, Table
-from stochpound.report.ensembles import MIN_RUNS, Ensemble
-from stochpound.report.facets import dim_text, labels_text, value_text
+from stochpound.report.render.document import Block, Paragraph, Section, Table
+from stochpound.report.sections.ensembles import MIN_RUNS, Ensemble
+from stochpound.report.sections.facets import dim_text, labels_text, value_text
 from stochpound.experiment.selections import gap_dims, has_contact_free, with_contacts
-from stochpound.report.separation import SeparationEnsemble, span_cm
+from stochpound.report.sections.separation import SeparationEnsemble, span_cm
 
 CM = 100.0
 SEPARATION_TARGETS = (0.05, 0.01)
@@ -44,7 +42,7 @@ APPENDIX_TITLE = "Appendix: per-cell tables"
 
 
 def experiment_summary(stores: dict[str, xr.Dataset], sections: list[Section], confidence: float = 0.95) -> Section:
-    """The summary of the stores of experiments (not the study's), given the report's other sections in their final order (after the summary)."""
+    """The summary of the stores of experiments (those no study claims), given the report's other sections in their final order (after the summary)."""
     summary = Section("Summary", key="summary")
     for name, store in stores.items():
         description = str(store.attrs.get("experiment_description", "")).strip()
@@ -148,25 +146,6 @@ def _where(name: str, sections: list[Section]) -> str:
     wanted = {f"experiment-{name}", f"separation-{name}", "appendix", "methods"}
     found = [f"section {number} ({section.title})" for number, section in enumerate(sections, start=2) if section.key in wanted]
     return "Details: " + ", ".join(found) + "."
-
-
-def study_summary(findings: Section, sections: list[Section]) -> Section:
-    """The summary of the study's report: each conclusion of the study with its verdict (the first sentence of each finding)."""
-    number = next((n for n, section in enumerate(sections, start=2) if section is findings), None)
-    summary = Section("Summary", key="summary")
-    summary.add(Paragraph(
-        f"The study's conclusions, each checked against the corrected model; section {number} ({findings.title}) gives the numbers "
-        "behind each verdict, the later sections every table and figure of the study regenerated:"
-    ))
-    for block in findings.blocks:
-        if isinstance(block, Paragraph):
-            summary.add(Paragraph(_first_sentence(block.text)))
-    return summary
-
-
-def _first_sentence(text: str) -> str:
-    """The text up to its first full stop followed by a space and a capital (a decimal point is followed by a digit)."""
-    return re.split(r"\. (?=[A-Z])", text, maxsplit=1)[0].rstrip(".") + "."
 
 
 def move_per_cell_tables(sections: list[Section]) -> Section | None:
