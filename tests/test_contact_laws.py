@@ -5,7 +5,6 @@ integration of its relative motion, m_eff δ̈ = −F(δ, δ̇) (scipy's DOP853 
 rtol 1e-12, with its own event at δ = 0), and the Hertz closed form.
 """
 
-import math
 
 import numpy as np
 import pytest

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 import stochpound
-from tests.conftest import reference_building, study_contacts, study_scene
+from tests.conftest import study_scene
 from tests.test_exact import assert_same_run
 
 

@@ -7,7 +7,6 @@ import shlex
 import shutil
 
 import matplotlib
-import pytest
 from click.testing import CliRunner
 
 from stochpound.cli import main

@@ -5,7 +5,6 @@ the study's report used to state as fixed text: three storeys next to two,
 5 % damping, restitution 0.8, non-tensile contacts, g = 9.81.
 """
 
-import json
 import re
 from pathlib import Path
 
