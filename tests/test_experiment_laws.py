@@ -117,6 +117,11 @@ def test_store_equals_direct_runs_with_the_automatic_solver_and_demands(laws_sto
             np.testing.assert_allclose(float(cell.peak_base_shear), float(run.peak_base_shear.sel(building="B1")), rtol=1e-12)
             walls = int((run.impact_wall >= 0).sum()) if "impact_wall" in run else 0
             assert (walls > 0) == (labels["moat"] == "near")
+            if labels["moat"] == "near":  # the scene has walls: the store keeps each case's largest penetration
+                np.testing.assert_allclose(float(cell.peak_wall_penetration), float((run.peak_wall_closure - run.wall_gap).max()), rtol=1e-12)
+                assert float(cell.peak_wall_penetration) > 0.0
+            else:
+                assert np.isnan(float(cell.peak_wall_penetration))
     assert pounded["kelvin"] > 0 and pounded["hertz_damp"] > 0
 
 
