@@ -8,7 +8,7 @@ import xarray as xr
 
 from stochpound.experiment import open_store
 from stochpound.report.ensembles import MIN_RUNS
-from stochpound.report.mechanism_findings import amplification_text, mechanism_findings, ratcheting_text, wall_axis
+from stochpound.report.mechanism_findings import amplification_text, mechanism_answer, mechanism_findings, ratcheting_text, wall_axis
 from tests.test_experiment_helpers import run_in_process
 
 N = 40
@@ -117,6 +117,7 @@ def test_a_moat_store_states_the_wall_s_amplification_and_its_largest_penetratio
     with open_store(moat_store) as store:
         assert wall_axis(store) == ("moat", "none")
         texts = [block.text for block in mechanism_findings("moat_test", store, "kt_soft")]
+        answer = mechanism_answer("moat_test", store)
         penetration = store["peak_wall_penetration"].sel(moat="w02")
         largest = float(penetration.max())
         assert np.isnan(store["peak_wall_penetration"].sel(moat="none")).all() and largest > 0
@@ -125,6 +126,9 @@ def test_a_moat_store_states_the_wall_s_amplification_and_its_largest_penetratio
     assert acceleration.startswith("Amplification of the peak floor acceleration by a wall (kt_soft, B1)") and "It raises it in 1 of the 1 cells" in acceleration
     assert drift.startswith("Amplification of the peak storey drift by a wall") and "raises it in 1 of the 1" in drift
     assert f"the largest penetration is {largest * 100:.3g} cm" in wall and "at moat w02, realization" in wall
+    assert "(k = 42.75 MN/m)" in wall
+    assert "ensemble kt_soft: a wall raises the peak floor acceleration in 1 of 1 cells" in answer
+    assert f"the walls were penetrated by up to {largest * 100:.3g} cm" in answer and "ratchets" not in answer
 
 
 def test_a_pair_with_contact_free_twins_gets_the_ratcheting_and_pounding_findings_in_its_section(tmp_path):
@@ -170,3 +174,6 @@ demands = true
     assert "cells with contacts that have at least" in ratchet and "(to the left)" in ratchet
     assert any(t.startswith("Amplification of the peak floor acceleration by pounding (kt, B1)") for t in texts)
     assert not any(t.startswith("Wall penetration") for t in texts)
+    with open_store(tmp_path / "pair_test.nc") as store:
+        answer = mechanism_answer("pair_test", store)
+    assert "pounding ratchets B1's sliding base in" in answer and "pounding raises the peak floor acceleration in" in answer
