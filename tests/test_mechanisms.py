@@ -69,3 +69,11 @@ def test_amplification_is_the_paired_ratio_with_its_interval():
     assert float(wall["ratio_lower"]) < float(np.mean(factor)) < float(wall["ratio_upper"])
     same = found.sel(moat="w10")
     assert not bool(same["raises"]) and not bool(same["lowers"]) and float(same["ratio_mean"]) == 1.0
+
+
+def test_runs_equal_to_their_twins_but_for_rounding_show_no_mechanism(free):
+    """A cell whose runs never touch equals its twin to the last bits: neither ratcheting nor a change of demand."""
+    rounded = free * (1.0 - 1e-15)
+    assert not ratcheting(rounded, free, away=-1, min_runs=30)[["ratchets", "lowers"]].to_array().any()
+    twin = _runs(np.random.default_rng(8).uniform(2.0, 4.0, N))
+    assert not amplification(twin * (1.0 - 1e-15), twin, min_runs=30)[["raises", "lowers"]].to_array().any()

@@ -177,3 +177,48 @@ demands = true
     with open_store(tmp_path / "pair_test.nc") as store:
         answer = mechanism_answer("pair_test", store)
     assert "pounding ratchets B1's sliding base in" in answer and "pounding raises the peak floor acceleration in" in answer
+
+
+def test_walls_of_the_base_scene_state_their_largest_penetration(tmp_path):
+    """Without a wall axis (walls in the base scene) the penetration is still stated, over every run, and no amplification claimed."""
+    text = f"""
+[experiment]
+name = "walled"
+studied = "B1"
+
+[scene]
+g = 9.814
+
+[[scene.building]]
+name = "B1"
+mass = [26268.0, 17512.0]
+stiffness = [24516800.0, 17512000.0]
+damping = [23634.2, 16881.57]
+base = {{ mass = 13134.0, mu = 0.05 }}
+
+[[scene.wall]]
+building = "B1"
+side = "right"
+level = 0
+gap = 0.01
+stiffness = 42747262.6
+restitution = 0.5
+
+[synthetic.kt]
+type = "kanai_tajimi"
+count = {MIN_RUNS}
+seed = 20042
+omega_g = 5.0
+zeta_g = 0.2
+pga = 3.0
+envelope = "jennings"
+duration = 5.0
+dt = 0.02
+"""
+    with open_store(run_in_process(tmp_path, "walled", text)) as store:
+        assert wall_axis(store) is None
+        largest = float(store["peak_wall_penetration"].max())
+        texts = [block.text for block in mechanism_findings("walled", store, "kt")]
+    assert largest > 0 and len(texts) == 1
+    assert texts[0].startswith("Wall penetration (kt, B1)") and f"Over the {MIN_RUNS} runs with a wall the largest penetration is {largest * 100:.3g} cm" in texts[0]
+    assert "per value of" not in texts[0]

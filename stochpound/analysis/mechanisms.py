@@ -40,6 +40,10 @@ import xarray as xr
 
 from stochpound.analysis.intervals import mean_interval
 
+ROUNDOFF = 1e-9
+"""Changes within this of none are the rounding of runs that are the same, not a mechanism: m for a residual's paired
+increase, relative for a ratio (a bound must exceed 0, or differ from 1, by more)."""
+
 
 def _paired(data: xr.DataArray, reference: xr.DataArray) -> tuple[xr.DataArray, xr.DataArray]:
     """``data`` and ``reference`` aligned on their common coordinates, NaN where either is missing (pairs only); other coordinates dropped."""
@@ -94,7 +98,8 @@ def ratcheting(residual: xr.DataArray, contact_free: xr.DataArray, away: float, 
         and its paired increase over the twin's), and the booleans
         ``ratchets`` (both paired increases have intervals above 0),
         ``lowers`` (the paired change of abs(residual) has an interval below
-        0) and ``enough`` (at least ``min_runs`` pairs).
+        0), each by more than :data:`ROUNDOFF`, and ``enough`` (at least
+        ``min_runs`` pairs).
     """
     if away not in (-1, 1, -1.0, 1.0):
         raise ValueError(f"away: must be -1 (the building is left of its neighbour) or +1 (right of it), got {away!r}")
@@ -110,8 +115,8 @@ def ratcheting(residual: xr.DataArray, contact_free: xr.DataArray, away: float, 
         _interval(away * with_contacts, "away", dim, confidence, enough),
         _interval(away * (with_contacts - free), "away_change", dim, confidence, enough),
     ])
-    result["ratchets"] = enough & (result["abs_change_lower"] > 0) & (result["away_change_lower"] > 0)
-    result["lowers"] = enough & (result["abs_change_upper"] < 0)
+    result["ratchets"] = enough & (result["abs_change_lower"] > ROUNDOFF) & (result["away_change_lower"] > ROUNDOFF)
+    result["lowers"] = enough & (result["abs_change_upper"] < -ROUNDOFF)
     result["enough"] = enough
     return result
 
@@ -142,7 +147,8 @@ def amplification(demand: xr.DataArray, twin: xr.DataArray, min_runs: int, dim: 
         count; units of ``demand``), ``ratio_of_means`` (1), ``ratio_*`` (the
         mean of the per-run ratios demand / twin with its interval and count)
         and the booleans ``raises`` (ratio interval above 1), ``lowers``
-        (below 1) and ``enough`` (at least ``min_runs`` pairs).
+        (below 1), each by more than :data:`ROUNDOFF`, and ``enough`` (at
+        least ``min_runs`` pairs).
     """
     if int(min_runs) < 2:
         raise ValueError(f"min_runs: must be at least 2, got {min_runs!r}")
@@ -155,7 +161,7 @@ def amplification(demand: xr.DataArray, twin: xr.DataArray, min_runs: int, dim: 
         _interval(with_impacts / without.where(without > 0), "ratio", dim, confidence, enough),
     ])
     result["ratio_of_means"] = result["with_mean"] / result["twin_mean"]
-    result["raises"] = enough & (result["ratio_lower"] > 1)
-    result["lowers"] = enough & (result["ratio_upper"] < 1)
+    result["raises"] = enough & (result["ratio_lower"] > 1 + ROUNDOFF)
+    result["lowers"] = enough & (result["ratio_upper"] < 1 - ROUNDOFF)
     result["enough"] = enough
     return result

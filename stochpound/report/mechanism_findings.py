@@ -26,10 +26,10 @@ import xarray as xr
 
 from stochpound.analysis.mechanisms import amplification, ratcheting
 from stochpound.experiment.definition import read_definition
-from stochpound.experiment.selections import contact_free, has_contact_free, with_contacts
+from stochpound.experiment.selections import contact_free, gap_dims, has_contact_free, isolated_mus, with_contacts
 from stochpound.report.document import Block, Paragraph
 from stochpound.report.ensembles import CM, MIN_RUNS, Ensemble
-from stochpound.report.facets import labels_text, plain
+from stochpound.report.facets import dim_text, labels_text, plain, value_text
 
 #: Demands compared with their twins without impacts: store variable -> (words, unit shown, factor to it).
 DEMANDS = {
@@ -43,7 +43,7 @@ LISTED = 6
 def mechanism_findings(name: str, store: xr.Dataset, label: str) -> list[Block]:
     """Every mechanism finding that applies to ensemble ``label`` of ``store`` (the whole store: its contact-free cases included)."""
     blocks: list[Block] = []
-    if has_contact_free(store):
+    if has_twins(store):
         pounding, free = Ensemble(name, with_contacts(store), label), Ensemble(name, contact_free(store), label)
         blocks.append(Paragraph(ratcheting_text(pounding, free, away_from_neighbour(store, pounding.studied))))
         blocks += [Paragraph(amplification_text(pounding, free, variable, "pounding", "its contact-free twin (gap = ∞)"))
@@ -54,14 +54,29 @@ def mechanism_findings(name: str, store: xr.Dataset, label: str) -> list[Block]:
         walled, bare = Ensemble(name, store.drop_sel({walls: reference}), label), Ensemble(name, store.sel({walls: reference}, drop=True), label)
         blocks += [Paragraph(amplification_text(walled, bare, variable, "a wall", f"the same motion without a wall ({walls} {reference})"))
                    for variable in DEMANDS if variable in store]
-        if "peak_wall_penetration" in store:
-            blocks.append(Paragraph(penetration_text(walled, walls)))
+    if "peak_wall_penetration" in store:
+        blocks.append(Paragraph(penetration_text(_walled(name, store, label, axis), axis[0] if axis else None)))
     return blocks
 
 
+def _walled(name: str, store: xr.Dataset, label: str, axis: tuple[str, str] | None) -> Ensemble:
+    """Ensemble ``label`` of the store's cells with walls (without the wall axis's value without walls, if any)."""
+    return Ensemble(name, store if axis is None else store.drop_sel({axis[0]: axis[1]}), label)
+
+
+def has_twins(store: xr.Dataset) -> bool:
+    """Whether ``store`` has cells with contacts and their contact-free twins (a gap axis holding ``inf`` and finite gaps)."""
+    return has_contact_free(store) and all(with_contacts(store).sizes[d] for d in gap_dims(store))
+
+
 def ratcheting_of(pounding: Ensemble, free: Ensemble, away: int) -> xr.Dataset:
-    """:func:`stochpound.analysis.ratcheting` of the studied building's residual sliding in ``pounding``'s cells against ``free``, computed."""
-    return ratcheting(pounding.sample("residual_sliding"), free.sample("residual_sliding"), away, MIN_RUNS, confidence=pounding.confidence).compute()
+    """:func:`stochpound.analysis.ratcheting` of the studied building's residual sliding in ``pounding``'s cells on a sliding base
+    (a μ axis's fixed-base cells left out) against ``free``, computed."""
+    residual, twin = pounding.sample("residual_sliding"), free.sample("residual_sliding")
+    if "mu" in residual.dims:
+        sliding = isolated_mus(residual["mu"].values)
+        residual, twin = residual.sel(mu=sliding), twin.sel(mu=sliding)
+    return ratcheting(residual, twin, away, MIN_RUNS, confidence=pounding.confidence).compute()
 
 
 def amplification_of(impacts: Ensemble, twins: Ensemble, variable: str) -> xr.Dataset:
@@ -76,7 +91,7 @@ def mechanism_answer(name: str, store: xr.Dataset) -> str | None:
     parts = []
     for label in (label for label, kind in kinds.items() if kind == "synthetic"):
         found = []
-        if has_contact_free(store):
+        if has_twins(store):
             pounding, free = Ensemble(name, with_contacts(store), label), Ensemble(name, contact_free(store), label)
             away = away_from_neighbour(store, pounding.studied)
             if away is not None and pounding.sliding:
@@ -88,8 +103,9 @@ def mechanism_answer(name: str, store: xr.Dataset) -> str | None:
             walls, reference = axis
             walled, bare = Ensemble(name, store.drop_sel({walls: reference}), label), Ensemble(name, store.sel({walls: reference}, drop=True), label)
             found += [_raised(amplification_of(walled, bare, v), "a wall", DEMANDS[v][0]) for v in DEMANDS if v in store]
-            if "peak_wall_penetration" in store:
-                found.append(f"the walls were penetrated by up to {float(walled.sample('peak_wall_penetration').max()) * CM:.3g} cm")
+        if "peak_wall_penetration" in store:
+            deepest = float(_walled(name, store, label, axis).sample("peak_wall_penetration").max())
+            found.append(f"the walls were penetrated by up to {deepest * CM:.3g} cm" if np.isfinite(deepest) else "no run with a wall")
         if found:
             parts.append(f"ensemble {label}: " + "; ".join(found))
     if not parts:
@@ -158,7 +174,7 @@ def ratcheting_text(pounding: Ensemble, free: Ensemble, away: int | None) -> str
     """Where pounding ratchets the studied building's sliding base against its contact-free twins, and where it does not."""
     building, opening = pounding.studied, f"Ratcheting ({pounding.label}, {pounding.studied}): "
     if away is None:
-        return opening + "not assessed: the studied building has no neighbour on one side only, so 'away from the neighbour' is undefined."
+        return opening + "not assessed: the studied building has neighbours on both sides or none, so 'away from the neighbour' is undefined."
     if not pounding.sliding:
         return opening + "none possible: the studied building's base does not slide in any cell."
     found = ratcheting_of(pounding, free, away)
@@ -187,6 +203,8 @@ def ratcheting_text(pounding: Ensemble, free: Ensemble, away: int | None) -> str
         f"of the {len(enough)} cells with contacts that have at least {MIN_RUNS} paired runs"
     )
     text += (": " + _listed([describe(c) for c in ratchets]) + "." if ratchets else "; it does not ratchet it in any of them.")
+    if ratchets and len(enough) > LISTED:
+        text += " " + _by_axis(found["ratchets"], found["enough"], "ratcheting")
     if pushed:
         text += (f" In {len(pushed)} cells the impacts push the residual away from the neighbour without a resolved increase of its size: "
                  + _listed([describe(c) for c in pushed]) + ".")
@@ -198,6 +216,17 @@ def ratcheting_text(pounding: Ensemble, free: Ensemble, away: int | None) -> str
     if short:
         text += f" Fewer than {MIN_RUNS} paired runs, not assessed: {_listed([labels_text(c) for c in short])}."
     return text
+
+
+def _by_axis(flags: xr.DataArray, enough: xr.DataArray, what: str) -> str:
+    """Where ``flags`` hold, counted along each axis of more than one value: "Cells with ratcheting, by gap: 2 cm 3 of 4; ..."."""
+    parts = []
+    for dim in (d for d in flags.dims if flags.sizes[d] > 1):
+        others = [d for d in flags.dims if d != dim]
+        held, assessed = (flags & enough).sum(others), enough.sum(others)
+        parts.append(f"by {dim_text(dim)}: " + ", ".join(f"{value_text(dim, plain(v))} {int(h)} of {int(a)}"
+                                                        for v, h, a in zip(flags[dim].values, held.values, assessed.values)))
+    return f"Cells with {what}, " + "; ".join(parts) + "." if parts else ""
 
 
 def amplification_text(impacts: Ensemble, twins: Ensemble, variable: str, cause: str, twin: str) -> str:
@@ -227,6 +256,8 @@ def amplification_text(impacts: Ensemble, twins: Ensemble, variable: str, cause:
     text += (": " + _listed([describe(c) for c in raises]) + "." if raises else ".")
     if lowers:
         text += f" It lowers it in {len(lowers)}: " + _listed([describe(c) for c in lowers]) + "."
+    if raises and len(enough) > LISTED:
+        text += " " + _by_axis(found["raises"], found["enough"], f"a resolved rise of the {words}")
     if rest:
         text += f" No resolved change at {_listed([labels_text(c) for c in rest])}."
     short = [c for c in cells if c not in enough]
@@ -235,24 +266,27 @@ def amplification_text(impacts: Ensemble, twins: Ensemble, variable: str, cause:
     return text
 
 
-def penetration_text(ensemble: Ensemble, walls: str) -> str:
-    """The largest penetration of the walls over the runs of ``ensemble`` (its cells with walls, on variant axis ``walls``), and where: what a 'rigid' wall is here."""
+def penetration_text(ensemble: Ensemble, walls: str | None) -> str:
+    """The largest penetration of the walls over the runs of ``ensemble`` (its cells with walls), and where, also per value of the
+    variant axis ``walls`` that adds them (if any): what a 'rigid' wall is here."""
     penetration = ensemble.sample("peak_wall_penetration")
     definition = read_definition(ensemble.data)
-    axis = next(a for a in definition.variants if a.name == walls)
-    stiffness = sorted({float(w["stiffness"]) for value in axis.values for w in axis.overrides[value].get("scene", {}).get("wall", []) if "stiffness" in w})
+    tables = list(definition.scene.get("wall", [])) + [w for axis in definition.variants for override in axis.overrides.values()
+                                                       for w in override.get("scene", {}).get("wall", [])]
+    stiffness = sorted({float(w["stiffness"]) for w in tables if "stiffness" in w})
     runs = int(penetration.notnull().sum())
     if runs == 0:
         return f"Wall penetration ({ensemble.label}): no run with a wall is in the store."
     where = penetration.where(penetration == penetration.max(), drop=True)
     at = {d: plain(where[d].values[0]) for d in where.dims}
     largest = float(penetration.max())
-    per_wall = "; ".join(f"{plain(value)}: {float(penetration.sel({walls: value}).max()) * CM:.3g} cm" for value in penetration[walls].values)
+    per_wall = "" if walls is None else (f"; the largest per value of {walls}: "
+                                         + "; ".join(f"{plain(v)}: {float(penetration.sel({walls: v}).max()) * CM:.3g} cm" for v in penetration[walls].values))
     return (
         f"Wall penetration ({ensemble.label}, {ensemble.studied}): a 'rigid' wall is here a stiff impact element"
         + (f" (k = {', '.join(f'{k / 1e6:.4g}' for k in stiffness)} MN/m)" if stiffness else "")
         + f" that the level it faces penetrates while in contact. Over the {runs} runs with a wall the largest penetration is "
         f"{largest * CM:.3g} cm ({largest * 1000:.3g} mm), at {labels_text({k: v for k, v in at.items() if k != 'realization'})}, realization "
-        f"{at.get('realization')}; the largest per value of {walls}: {per_wall}. It is the located peak of the level's displacement toward each "
+        f"{at.get('realization')}{per_wall}. It is the located peak of the level's displacement toward each "
         "wall beyond its gap (store variable peak_wall_penetration), not a sampled value."
     )
