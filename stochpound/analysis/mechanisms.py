@@ -15,7 +15,7 @@ non-negative quantity, and of either sign for a difference).
 Ratcheting
     Under repeated impacts from one side a sliding base is pushed the same
     way again and again and keeps a one-sided residual displacement. A cell
-    *ratchets* (:func:`ratcheting`) when, over at least ``min_runs`` paired
+    *ratchets* (:func:`~stochpound.analysis.ratcheting`) when, over at least ``min_runs`` paired
     runs, both
 
     * the mean increase of abs(residual sliding) over the contact-free twin,
@@ -29,7 +29,7 @@ Ratcheting
 Amplification
     The mean of a peak demand (peak floor acceleration, peak storey drift)
     with impacts over its mean in the twins without impacts
-    (:func:`amplification`): the ratio of the two means, and the mean of the
+    (:func:`~stochpound.analysis.amplification`): the ratio of the two means, and the mean of the
     per-run ratios with its interval; the impacts *raise* the demand where
     that interval lies above 1, and *lower* it where it lies below 1.
 """
@@ -98,7 +98,7 @@ def ratcheting(residual: xr.DataArray, contact_free: xr.DataArray, away: float, 
         and its paired increase over the twin's), and the booleans
         ``ratchets`` (both paired increases have intervals above 0),
         ``lowers`` (the paired change of abs(residual) has an interval below
-        0), each by more than :data:`ROUNDOFF`, and ``enough`` (at least
+        0), each by more than :data:`~stochpound.analysis.mechanisms.ROUNDOFF`, and ``enough`` (at least
         ``min_runs`` pairs).
     """
     if away not in (-1, 1, -1.0, 1.0):
@@ -147,7 +147,7 @@ def amplification(demand: xr.DataArray, twin: xr.DataArray, min_runs: int, dim: 
         count; units of ``demand``), ``ratio_of_means`` (1), ``ratio_*`` (the
         mean of the per-run ratios demand / twin with its interval and count)
         and the booleans ``raises`` (ratio interval above 1), ``lowers``
-        (below 1), each by more than :data:`ROUNDOFF`, and ``enough`` (at
+        (below 1), each by more than :data:`~stochpound.analysis.mechanisms.ROUNDOFF`, and ``enough`` (at
         least ``min_runs`` pairs).
     """
     if int(min_runs) < 2:

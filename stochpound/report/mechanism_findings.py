@@ -1,7 +1,7 @@
 """Findings on the mechanisms of pounding in an ensemble: ratcheting of a sliding base, amplification by impacts, wall penetration.
 
 Each sentence is computed by :mod:`stochpound.analysis.mechanisms` from the
-store, run against twin run (the same motion without the impact elements):
+store, each run against its twin (the same motion without the impact elements):
 
 * with contact-free twins (a gap axis holding ``inf``): where pounding
   ratchets the studied building's sliding base, where it does not, and
@@ -43,20 +43,29 @@ LISTED = 6
 def mechanism_findings(name: str, store: xr.Dataset, label: str) -> list[Block]:
     """Every mechanism finding that applies to ensemble ``label`` of ``store`` (the whole store: its contact-free cases included)."""
     blocks: list[Block] = []
-    if has_twins(store):
-        pounding, free = Ensemble(name, with_contacts(store), label), Ensemble(name, contact_free(store), label)
-        blocks.append(Paragraph(ratcheting_text(pounding, free, away_from_neighbour(store, pounding.studied))))
-        blocks += [Paragraph(amplification_text(pounding, free, variable, "pounding", "its contact-free twin (gap = ∞)"))
-                   for variable in DEMANDS if variable in store]
+    for impacts, twins, cause, twin in _comparisons(name, store, label):
+        if cause == "pounding":
+            blocks.append(Paragraph(ratcheting_text(impacts, twins, away_from_neighbour(store, impacts.studied))))
+        blocks += [Paragraph(amplification_text(impacts, twins, variable, cause, twin)) for variable in DEMANDS if variable in store]
     axis = wall_axis(store)
-    if axis is not None:
-        walls, reference = axis
-        walled, bare = Ensemble(name, store.drop_sel({walls: reference}), label), Ensemble(name, store.sel({walls: reference}, drop=True), label)
-        blocks += [Paragraph(amplification_text(walled, bare, variable, "a wall", f"the same motion without a wall ({walls} {reference})"))
-                   for variable in DEMANDS if variable in store]
     if "peak_wall_penetration" in store:
         blocks.append(Paragraph(penetration_text(_walled(name, store, label, axis), axis[0] if axis else None)))
     return blocks
+
+
+def _comparisons(name: str, store: xr.Dataset, label: str) -> list[tuple[Ensemble, Ensemble, str, str]]:
+    """(cells with impacts, their twins without, the cause in words, the twins in words) of ensemble ``label``: pounding against
+    the contact-free twins, a wall against the variant without walls (those the store has)."""
+    comparisons = []
+    if has_twins(store):
+        comparisons.append((Ensemble(name, with_contacts(store), label), Ensemble(name, contact_free(store), label), "pounding",
+                            "its contact-free twin (gap = ∞)"))
+    axis = wall_axis(store)
+    if axis is not None:
+        walls, reference = axis
+        comparisons.append((_walled(name, store, label, axis), Ensemble(name, store.sel({walls: reference}, drop=True), label), "a wall",
+                            f"the same motion without a wall ({walls} {reference})"))
+    return comparisons
 
 
 def _walled(name: str, store: xr.Dataset, label: str, axis: tuple[str, str] | None) -> Ensemble:
@@ -91,18 +100,13 @@ def mechanism_answer(name: str, store: xr.Dataset) -> str | None:
     parts = []
     for label in (label for label, kind in kinds.items() if kind == "synthetic"):
         found = []
-        if has_twins(store):
-            pounding, free = Ensemble(name, with_contacts(store), label), Ensemble(name, contact_free(store), label)
-            away = away_from_neighbour(store, pounding.studied)
-            if away is not None and pounding.sliding:
-                result = ratcheting_of(pounding, free, away)
-                found.append(f"pounding ratchets {pounding.studied}'s sliding base in {int(result['ratchets'].sum())} of "
+        for impacts, twins, cause, _ in _comparisons(name, store, label):
+            away = away_from_neighbour(store, impacts.studied)
+            if cause == "pounding" and away is not None and impacts.sliding:
+                result = ratcheting_of(impacts, twins, away)
+                found.append(f"pounding ratchets {impacts.studied}'s sliding base in {int(result['ratchets'].sum())} of "
                              f"{int(result['enough'].sum())} cells")
-            found += [_raised(amplification_of(pounding, free, v), "pounding", DEMANDS[v][0]) for v in DEMANDS if v in store]
-        if axis is not None:
-            walls, reference = axis
-            walled, bare = Ensemble(name, store.drop_sel({walls: reference}), label), Ensemble(name, store.sel({walls: reference}, drop=True), label)
-            found += [_raised(amplification_of(walled, bare, v), "a wall", DEMANDS[v][0]) for v in DEMANDS if v in store]
+            found += [_raised(amplification_of(impacts, twins, v), cause, DEMANDS[v][0]) for v in DEMANDS if v in store]
         if "peak_wall_penetration" in store:
             deepest = float(_walled(name, store, label, axis).sample("peak_wall_penetration").max())
             found.append(f"the walls were penetrated by up to {deepest * CM:.3g} cm" if np.isfinite(deepest) else "no run with a wall")
