@@ -219,6 +219,8 @@ dt = 0.02
         assert wall_axis(store) is None
         largest = float(store["peak_wall_penetration"].max())
         texts = [block.text for block in mechanism_findings("walled", store, "kt")]
+        answer = mechanism_answer("walled", store)
     assert largest > 0 and len(texts) == 1
+    assert answer == f"Which mechanisms do the runs show? ensemble kt: the walls were penetrated by up to {largest * 100:.3g} cm."
     assert texts[0].startswith("Wall penetration (kt, B1)") and f"Over the {MIN_RUNS} runs with a wall the largest penetration is {largest * 100:.3g} cm" in texts[0]
     assert "per value of" not in texts[0]

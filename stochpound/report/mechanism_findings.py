@@ -97,10 +97,11 @@ def mechanism_answer(name: str, store: xr.Dataset) -> str | None:
     """The summary's answer "Which mechanisms do the runs show?", per synthetic ensemble in one sentence (None when the store can show none)."""
     kinds = dict(zip(store["record"].values.tolist(), store["record_kind"].values.tolist()))
     axis = wall_axis(store)
-    parts = []
+    parts, compared = [], False
     for label in (label for label, kind in kinds.items() if kind == "synthetic"):
         found = []
         for impacts, twins, cause, _ in _comparisons(name, store, label):
+            compared = True
             away = away_from_neighbour(store, impacts.studied)
             if cause == "pounding" and away is not None and impacts.sliding:
                 result = ratcheting_of(impacts, twins, away)
@@ -114,8 +115,9 @@ def mechanism_answer(name: str, store: xr.Dataset) -> str | None:
             parts.append(f"ensemble {label}: " + "; ".join(found))
     if not parts:
         return None
-    return (f"Which mechanisms do the runs show (each run against the same motion without impacts, cells with at least {MIN_RUNS} "
-            "paired runs; details and intervals in the findings)? " + "; ".join(parts) + ".")
+    how = (f" (each run against the same motion without impacts, cells with at least {MIN_RUNS} paired runs; details and intervals in "
+           "the findings)" if compared else "")
+    return f"Which mechanisms do the runs show{how}? " + "; ".join(parts) + "."
 
 
 def _raised(found: xr.Dataset, cause: str, words: str) -> str:
