@@ -7,7 +7,7 @@ import pytest
 import xarray as xr
 
 from stochpound.analysis.summary import top_floor_total_displacement
-from stochpound.experiment.catalogue import CASE_SUMMARIES, IMPACT_TABLE, REFERENCE_HISTORY, REFERENCE_SUMMARIES, TIME_HISTORIES, StoreVariable
+from stochpound.experiment.catalogue import CASE_SUMMARIES, IMPACT_TABLE, WALL_SUMMARIES, REFERENCE_HISTORY, REFERENCE_SUMMARIES, TIME_HISTORIES, StoreVariable
 from stochpound.experiment.spec import TIME_HISTORY_VARIABLES
 from stochpound.experiment.summary import DEMAND_SUMMARIES, REFERENCE_SUMMARIES as REFERENCE_NAMES, case_summary, reference_summary
 from stochpound.model.scene_file import scene_from_dict
@@ -40,8 +40,8 @@ def _check(variable: StoreVariable, data: xr.DataArray) -> None:
 def test_case_summaries_are_declared(run: xr.Dataset) -> None:
     """Every summary of a case, in order, with its dimensions, dtype, units and long name."""
     summary = case_summary(run, "A", top_floor_total_displacement(run, "A"))
-    assert list(summary.data_vars) == [v.name for v in CASE_SUMMARIES]
-    for variable in CASE_SUMMARIES:
+    assert list(summary.data_vars) == [v.name for v in CASE_SUMMARIES + WALL_SUMMARIES]
+    for variable in CASE_SUMMARIES + WALL_SUMMARIES:
         _check(variable, summary[variable.name])
     assert set(DEMAND_SUMMARIES) <= {v.name for v in CASE_SUMMARIES}
 

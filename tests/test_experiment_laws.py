@@ -117,6 +117,11 @@ def test_store_equals_direct_runs_with_the_automatic_solver_and_demands(laws_sto
             np.testing.assert_allclose(float(cell.peak_base_shear), float(run.peak_base_shear.sel(building="B1")), rtol=1e-12)
             walls = int((run.impact_wall >= 0).sum()) if "impact_wall" in run else 0
             assert (walls > 0) == (labels["moat"] == "near")
+            if labels["moat"] == "near":  # the scene has walls: the store keeps each case's largest penetration
+                np.testing.assert_allclose(float(cell.peak_wall_penetration), float((run.peak_wall_closure - run.wall_gap).max()), rtol=1e-12)
+                assert float(cell.peak_wall_penetration) > 0.0
+            else:
+                assert np.isnan(float(cell.peak_wall_penetration))
     assert pounded["kelvin"] > 0 and pounded["hertz_damp"] > 0
 
 
@@ -133,3 +138,27 @@ def test_bad_contact_overrides_name_the_field(tmp_path):
         load_experiment(write_experiment(tmp_path, text.replace("demands = true", 'demands = "yes"'), "bad.toml"))
     with pytest.raises(ExperimentError, match=r"solver\.method: must be one of auto, exact, ivp"):
         load_experiment(write_experiment(tmp_path, text + '\n[solver]\nmethod = "fast"\n', "bad.toml"))
+
+
+def test_a_walled_store_from_before_the_wall_summary_asks_for_a_restart(tmp_path):
+    """Cases computed without ``peak_wall_penetration`` (an earlier stochpound) are not silently kept: the store file and its
+    parts each name the summary and --restart, which recomputes them."""
+    import h5py
+
+    text = _pair_text().replace('name = "laws"', 'name = "walled"')
+    path = write_experiment(tmp_path, text, "walled.toml")
+    report = run_experiment(load_experiment(path), workers=0, progress=False)
+    with h5py.File(report.store, "a") as handle:  # the store file as an earlier version wrote it
+        del handle["peak_wall_penetration"]
+    with pytest.raises(ExperimentError, match="written by an earlier stochpound without peak_wall_penetration.*--restart"):
+        run_experiment(load_experiment(path), workers=0, progress=False)
+    for part in (tmp_path / "walled.nc.parts").glob("part-*.npz"):  # and its parts
+        with np.load(part) as data:
+            kept = {key: data[key] for key in data.files if not key.endswith("s:peak_wall_penetration")}
+        np.savez(part, **kept)
+    report.store.unlink()
+    with pytest.raises(ExperimentError, match="peak_wall_penetration: the finished cases in the store's parts folder .* --restart"):
+        run_experiment(load_experiment(path), workers=0, progress=False)
+    restarted = run_experiment(load_experiment(path), workers=0, progress=False, restart=True)
+    with open_store(restarted.store) as ds:
+        assert float(ds["peak_wall_penetration"].sel(moat="near").max()) > 0.0

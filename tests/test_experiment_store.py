@@ -38,6 +38,7 @@ def test_layout_and_metadata(small_store):
         assert ds["total_displacement"].dims == ("neighbour", "gap", "mu", "record", "realization", "building", "floor", "time")
         assert ds["reference_response_std"].dims == ("record", "realization")
         assert ds["impact_start"].dims == ("impact",) and ds.sizes["impact"] > 0
+        assert "peak_wall_penetration" not in ds  # a scene without walls: no wall summary
         for name, variable in ds.variables.items():
             assert "units" in variable.attrs and "long_name" in variable.attrs, name
         # a record has one realization: the others are not in the grid

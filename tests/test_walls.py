@@ -88,3 +88,42 @@ def test_demands_leave_the_walls_peak_closures_and_impacts_as_they_are():
     assert with_demands.sizes["wall"] == 2 and with_demands.sizes["impact"] == plain.sizes["impact"] > 0
     for name in ("peak_wall_closure", "peak_wall_closure_time", "peak_contact_closure"):
         np.testing.assert_allclose(with_demands[name].values, plain[name].values, rtol=0, atol=1e-12, err_msg=name)
+
+
+@pytest.mark.parametrize("method, rel", [("exact", 1e-9), ("ivp", 1e-6)])
+def test_the_largest_wall_penetration_is_the_closed_form_of_one_kelvin_collision(method, rel):
+    """A frictionless block at v0 into a Kelvin wall: δ(t) = v0/ω_d e^(−ζωt) sin(ω_d t) while closed, whose peak is
+    (v0/ω) exp(−ζ arccos(ζ)/√(1−ζ²)); the summary takes it from the located peak closure, not from the coarse samples."""
+    from stochpound.analysis.kernels import wall_penetration
+
+    m, k, gap, v0 = 1.0e4, 1.0e7, 0.115, 0.5
+    scene = {"building": [{"name": "block", "mass": [], "stiffness": [], "base": {"mass": m, "mu": 0.0}, "initial": {"base_velocity": v0}}],
+             "wall": [{"building": "block", "side": "right", "level": 0, "gap": gap, "stiffness": k, "restitution": 0.5},
+                      {"building": "block", "side": "left", "level": 0, "gap": 0.5, "stiffness": k, "restitution": 0.5}],
+             "motion": {"type": "constant", "acceleration": 0.0, "duration": 0.6, "dt": 0.05}}
+    result = run(scene, method)
+    assert result.sizes["impact"] == 1
+    omega = np.sqrt(k / m)
+    zeta = float(result.wall_damping[0]) / (2.0 * np.sqrt(k * m))
+    expected = v0 / omega * np.exp(-zeta * np.arccos(zeta) / np.sqrt(1.0 - zeta**2))
+    penetration = float(wall_penetration(result.peak_wall_closure.values, result.wall_gap.values))
+    assert penetration == pytest.approx(expected, rel=rel)
+    sampled = float(result.sliding_displacement.max()) - gap
+    assert sampled < 0.9 * expected  # the samples (dt 0.05 s against a 0.1 s impact) miss the peak the monitor locates
+
+
+def test_a_case_s_wall_penetration_is_its_walls_located_peak_beyond_the_gap():
+    """Hit walls: the peak closure beyond the gap; unreached walls: 0; no walls: NaN (the summary of a case, both ways)."""
+    from stochpound.experiment.summary import case_summary, case_values
+
+    hit, far = run(moat(gap=0.02)), run(moat(gap=1.0))
+    alone = moat()
+    del alone["wall"]
+    twin = np.zeros(hit.sizes["time"])
+    assert hit.sizes["impact"] > 0
+    expected = float((hit.peak_wall_closure - hit.wall_gap).max())
+    assert expected > 0.0
+    assert case_values(hit, "B1", twin)["peak_wall_penetration"] == pytest.approx(expected, rel=1e-12)
+    assert float(case_summary(hit, "B1", hit.total_displacement.sel(building="B1").isel(floor=-1) * 0.0)["peak_wall_penetration"]) == pytest.approx(expected, rel=1e-12)
+    assert case_values(far, "B1", twin)["peak_wall_penetration"] == 0.0
+    assert np.isnan(case_values(run(alone), "B1", twin)["peak_wall_penetration"])

@@ -14,6 +14,7 @@ from stochpound.analysis.ensemble_statistics import ensemble_statistics
 from stochpound.analysis.histogram import normal_histogram
 from stochpound.analysis.impacts import impact_statistics
 from stochpound.analysis.intervals import mean_interval, of_first, quantiles, running_mean, running_pounding_probability
+from stochpound.analysis.mechanisms import amplification, ratcheting
 from stochpound.analysis.peaks import peak_response
 from stochpound.analysis.pounding import pounding_probability
 from stochpound.analysis.separation import pounding_curve, required_separation, rule_exceedance
@@ -44,6 +45,8 @@ __all__ = [
     "quantiles",
     "running_mean",
     "running_pounding_probability",
+    "ratcheting",
+    "amplification",
     "peak_response",
     "pounding_probability",
     "pounding_curve",

@@ -35,6 +35,7 @@ SUMMARIES = (
     "peak_floor_acceleration",
     "peak_interstorey_drift",
     "peak_base_shear",
+    "peak_wall_penetration",
 )
 #: Summaries whose quantiles are given too.
 PEAKS = (
@@ -47,6 +48,7 @@ PEAKS = (
     "peak_floor_acceleration",
     "peak_interstorey_drift",
     "peak_base_shear",
+    "peak_wall_penetration",
 )
 #: Summaries estimated over the realizations that pound only (their value is 0 without an impact).
 GIVEN_POUNDING = ("peak_impact_force",)

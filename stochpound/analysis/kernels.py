@@ -141,6 +141,21 @@ def abs_peak(values: np.ndarray, axis: Axis = -1) -> np.ndarray:
     return np.where(np.isneginf(peak), np.nan, peak)
 
 
+def wall_penetration(peak_closure: np.ndarray, gap: np.ndarray) -> np.ndarray:
+    """The largest penetration of a wall over the run and over the walls, m (the walls along the trailing axis).
+
+    A wall's penetration is its level's displacement toward it beyond its
+    at-rest gap; its largest over the run is the wall's located peak closure
+    minus its gap (``peak_wall_closure`` − ``wall_gap`` of
+    :func:`stochpound.simulate`), and 0 for a wall never reached (an ``inf``
+    gap included). NaN without walls (an empty trailing axis).
+    """
+    closure, at_rest = np.asarray(peak_closure, dtype=np.float64), np.asarray(gap, dtype=np.float64)
+    if closure.shape[-1] == 0:
+        return np.full(closure.shape[:-1], np.nan)
+    return np.maximum(np.max(closure - at_rest, axis=-1), 0.0)
+
+
 def energy_residual_ratio(residual: np.ndarray, energy_input: np.ndarray) -> np.ndarray:
     """The largest absolute energy residual over the largest absolute energy input along the trailing axis (J/J): the energy balance's error."""
     return abs_peak(residual) / abs_peak(energy_input)

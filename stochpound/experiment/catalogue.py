@@ -81,6 +81,12 @@ CASE_SUMMARIES = (
     StoreVariable("peak_base_shear", ("building",), "f8", "N", "largest absolute base shear over the run"),
 )
 
+#: Summaries of every case of an experiment whose scene has walls (in the base scene or a variant), after :data:`CASE_SUMMARIES`;
+#: NaN for a case without walls (a variant without them).
+WALL_SUMMARIES = (
+    StoreVariable("peak_wall_penetration", (), "f8", "m", "largest penetration of a wall over the run and over the walls (0: no wall reached)"),
+)
+
 #: Summaries of every fixed-base reference (the studied building alone): those of a case, named ``reference_<name>``, per building no more.
 REFERENCE_SUMMARIES = tuple(
     replace(v, name=f"reference_{v.name}", dims=(), long_name=v.long_name + _ALONE)

@@ -183,6 +183,12 @@ class Experiment:
         return max(counts + [1])
 
     @cached_property
+    def has_walls(self) -> bool:
+        """Whether a case's scene can have walls: the base scene's or a variant's ``[[wall]]``."""
+        overrides = [o for variant in self.variants for o in variant["overrides"].values()]
+        return bool(self.definition["scene"].get("wall")) or any(o.get("scene", {}).get("wall") for o in overrides)
+
+    @cached_property
     def motion_dims(self) -> list[Dim]:
         """``record`` (motion labels) and ``realization`` (union of realization indices)."""
         realizations = np.sort(np.concatenate([self.realization_numbers(label) for label in self.motions]))

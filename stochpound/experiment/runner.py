@@ -32,7 +32,7 @@ from stochpound.experiment.compute import BatchResult, BatchTask, run_batch, sol
 from stochpound.experiment.estimate import LARGE_RUN_BYTES, LARGE_RUN_CASES, estimate_run
 from stochpound.experiment.grid import Experiment
 from stochpound.experiment.parts import FolderLock, PartBuffer, append_run, parts_folder, remove_temporaries
-from stochpound.experiment.session import StoreSession, check_store, clear_store, code_identity, machine, now, store_complete
+from stochpound.experiment.session import StoreSession, check_store, clear_store, code_identity, machine, missing_summaries, now, store_complete
 from stochpound.experiment.sources import ResolvedMotion, resolve_motions
 from stochpound.experiment.spec import ExperimentError, load_definition
 from stochpound.experiment.store_writer import PartsIndex
@@ -197,6 +197,10 @@ def run_experiment(
         if store.is_file() and not repair and store_complete(store):
             if FolderLock(parts_folder(store)).held():
                 raise _busy(store)
+            missing = missing_summaries(store, experiment, {label: m.grid for label, m in motions.items()})
+            if missing:
+                raise ExperimentError(f"{store}: written by an earlier stochpound without {', '.join(missing)}, which it keeps now: "
+                                      "run the experiment again with --restart to recompute its cases")
             return RunReport(store, experiment.n_cases, experiment.n_cases, elapsed=time.monotonic() - started, nothing_to_run=True)
     elif store.is_dir():
         raise ExperimentError(f"{store}: is a folder; --store must name a file")

@@ -23,7 +23,7 @@ from stochpound import __version__
 from stochpound.experiment.grid import KINDS, Experiment
 from stochpound.experiment.parts import DEFINITION_FILE, part_paths, parts_folder, read_experiment_json, read_runs, write_experiment_json
 from stochpound.experiment.spec import ExperimentError, canonical_json
-from stochpound.experiment.store import PREFIX
+from stochpound.experiment.store import PREFIX, layout
 from stochpound.experiment.store_writer import PartsIndex, write_store
 
 
@@ -99,6 +99,15 @@ def store_complete(store: Path) -> bool:
 
     with h5py.File(store, "r") as handle:
         return all(not (handle[f"{prefix}_status"][()] == 0).any() for prefix in PREFIX.values())
+
+
+def missing_summaries(store: Path, experiment: Experiment, motion_grids: dict[str, tuple[float, int]]) -> list[str]:
+    """The summaries the experiment's store keeps today (:func:`stochpound.experiment.store.layout`) that the store file lacks: one written
+    by an earlier stochpound (e.g. ``peak_wall_penetration``, kept since for a scene with walls)."""
+    import h5py
+
+    with h5py.File(store, "r") as handle:
+        return [spec.name for spec in layout(experiment, motion_grids, 0).of("summary") if spec.name not in handle]
 
 
 def clear_store(store: Path) -> None:

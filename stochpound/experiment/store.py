@@ -35,7 +35,7 @@ import xarray as xr
 from stochpound.experiment import intensity
 from stochpound.experiment.grid import CASE, REFERENCE, Dim, Experiment
 from stochpound.experiment.spec import ExperimentError, canonical_json
-from stochpound.experiment.catalogue import CASE_SUMMARIES, IMPACT_TABLE, REFERENCE_HISTORY, REFERENCE_SUMMARIES, TIME_HISTORIES, StoreVariable
+from stochpound.experiment.catalogue import CASE_SUMMARIES, IMPACT_TABLE, WALL_SUMMARIES, REFERENCE_HISTORY, REFERENCE_SUMMARIES, TIME_HISTORIES, StoreVariable
 from stochpound.experiment.summary import DEMAND_SUMMARIES
 from stochpound.model.scene_file import scene_from_dict
 from stochpound.motions.records.suites import METADATA_FIELDS
@@ -128,7 +128,8 @@ def layout(experiment: Experiment, motion_grids: Mapping[str, tuple[float, int]]
     coords = _coordinates(experiment, motion_grids)
     sizes = {name: v.size for name, v in coords.items() if v.dims == (name,)}
     specs: list[Spec] = []
-    for kind, variables in ((REFERENCE, REFERENCE_SUMMARIES), (CASE, CASE_SUMMARIES)):
+    case_summaries = CASE_SUMMARIES + (WALL_SUMMARIES if experiment.has_walls else ())
+    for kind, variables in ((REFERENCE, REFERENCE_SUMMARIES), (CASE, case_summaries)):
         dims = tuple(d.name for d in experiment.kind_dims(kind))
         grid = tuple(sizes[d] for d in dims)
         chunks = block_shape(grid, SUMMARY_BLOCK)

@@ -29,6 +29,7 @@ from xarray.backends import H5NetCDFStore
 from stochpound.atomic import replacing
 from stochpound.experiment.grid import CASE, KINDS, Experiment
 from stochpound.experiment.parts import part_paths, read_part, split_key
+from stochpound.experiment.spec import ExperimentError
 from stochpound.experiment.store import INT_FILL, Layout, Spec, blocks, layout, union_times
 
 PART_CACHE_BYTES = 64 * 2**20
@@ -227,6 +228,9 @@ class _Writer:
             rows = self._impact_rows(block) if impacts else None
             for section, local, arrays, prefix in self._contributions(kind, block, source):
                 for spec in specs:
+                    if f"{prefix}/s:{spec.name}" not in arrays:
+                        raise ExperimentError(f"{spec.name}: the finished cases in the store's parts folder were computed by an earlier "
+                                              "stochpound without it: run the experiment again with --restart to recompute them")
                     buffers[spec.name][local] = arrays[f"{prefix}/s:{spec.name}"][section]
                 if rows is not None:
                     self._fill_impacts(rows, block, local, section, arrays, prefix, ids)

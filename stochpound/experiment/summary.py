@@ -33,7 +33,7 @@ from stochpound.analysis import kernels, peak_response
 from stochpound.analysis.names import RESPONSE_MOMENTS, without_aliases
 from stochpound.analysis.separation_rules import STORE_NAMES, contact_demands
 from stochpound.analysis.summary import response_moments, run_summary, top_floor_total_displacement
-from stochpound.experiment.catalogue import IMPACT_TABLE
+from stochpound.experiment.catalogue import IMPACT_TABLE, WALL_SUMMARIES
 
 _MOMENTS = tuple(RESPONSE_MOMENTS.values())
 _PEAKS = ("peak_total_displacement", "peak_relative_displacement", "peak_sliding_displacement", "residual_sliding")
@@ -45,6 +45,8 @@ DEMAND_SUMMARIES = {
     "peak_interstorey_drift": ("peak_storey_drift", "largest peak storey drift over the building's storeys"),
     "peak_base_shear": ("peak_base_shear", "largest absolute base shear over the run"),
 }
+#: The wall summary (:data:`stochpound.experiment.catalogue.WALL_SUMMARIES`): every case computes it (NaN without walls); a store keeps it when its scene has walls.
+WALL_PENETRATION = WALL_SUMMARIES[0]
 #: Columns of the impact table a store keeps (:data:`stochpound.experiment.catalogue.IMPACT_TABLE`).
 IMPACT_COLUMNS = tuple(v.name for v in IMPACT_TABLE)
 
@@ -67,7 +69,8 @@ def case_summary(run: xr.Dataset, studied: str, fixed_base: xr.DataArray) -> xr.
     xarray.Dataset
         Peaks and residual sliding per building (m), impact statistics,
         moments of the response, ``fixed_base_correlation``,
-        ``energy_residual_ratio`` and ``events_total``.
+        ``energy_residual_ratio``, ``events_total`` and ``peak_wall_penetration``
+        (m; NaN without walls).
     """
     summary = without_aliases(run_summary(run, studied, fixed_base)).drop_vars(list(_PEAKS))
     summary = xr.merge([summary, peak_response(run)])
@@ -77,7 +80,10 @@ def case_summary(run: xr.Dataset, studied: str, fixed_base: xr.DataArray) -> xr.
     )
     summary["events_total"] = xr.DataArray(np.int64(run.attrs.get("events_total", 0)), attrs={"units": "1", "long_name": "events located by the solver"})
     summary = summary.merge(_contact_summary(run))
-    return summary.merge(_demand_summary(run)) if "peak_total_acceleration" in run else summary
+    if "peak_total_acceleration" in run:
+        summary = summary.merge(_demand_summary(run))
+    summary[WALL_PENETRATION.name] = xr.DataArray(_wall_penetration(run), attrs=WALL_PENETRATION.attrs)
+    return summary
 
 
 def _demand_summary(run: xr.Dataset) -> xr.Dataset:
@@ -143,7 +149,16 @@ def case_values(run: xr.Dataset, studied: str, fixed_base: np.ndarray) -> dict[s
         "events_total": np.int64(run.attrs.get("events_total", 0)),
         **_contact_values(run),
         **_demand_values(run),
+        WALL_PENETRATION.name: _wall_penetration(run),
     }
+
+
+def _wall_penetration(run: xr.Dataset) -> np.float64:
+    """The largest wall penetration of the run, m, from its walls' located peak closures (:func:`stochpound.analysis.kernels.wall_penetration`; NaN without walls)."""
+    variables = run.variables
+    if "peak_wall_closure" not in variables:
+        return np.float64(np.nan)
+    return np.float64(kernels.wall_penetration(variables["peak_wall_closure"].values, variables["wall_gap"].values))
 
 
 def _demand_values(run: xr.Dataset) -> dict[str, np.ndarray]:

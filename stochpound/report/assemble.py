@@ -79,7 +79,7 @@ def assemble_report(paths: Sequence[str | Path], progress: Callable[[str], None]
         if law_axis(store) is not None:
             report.sections.append(laws_section(name, finite))
         if all(finite.sizes[d] for d in finite["case_status"].dims):
-            report.sections.append(store_section(name, finite, contact_free))
+            report.sections.append(store_section(name, finite, contact_free, store))
         if contact_free and not has_risk(store):  # with a hazard, the Risk section gives the separation at every intensity
             say(f"experiment {name}: separation")
             report.sections.append(separation_section(name, store))

@@ -59,6 +59,7 @@ QUANTITIES = {
         Quantity("peak_relative_displacement", "peak relative displacement", "cm", CM),
         Quantity("peak_sliding_displacement", "peak sliding", "cm", CM),
         Quantity("residual_sliding", "residual sliding", "cm", CM),
+        Quantity("peak_wall_penetration", "peak wall penetration", "cm", CM),
     ),
     "demands": (
         Quantity("peak_floor_acceleration", "peak floor acceleration", "m/s²", 1.0),
@@ -74,7 +75,7 @@ QUANTITIES = {
 }
 TABLE_CAPTIONS = {
     "pounding": "the probability of pounding with its Clopper–Pearson interval, the mean numbers of impacts in and out of phase, and the peak impact force over the realizations that pound",
-    "displacements": "the studied building's peak displacements and residual sliding",
+    "displacements": "the studied building's peak displacements and residual sliding (and, with walls, the largest penetration of a wall per run)",
     "demands": "the studied building's demands: the largest peak total floor acceleration and storey drift over its floors, and its peak base shear",
     "response": "moments of the studied building's top-floor total displacement over time, and its correlation with the same building alone on a fixed base",
 }

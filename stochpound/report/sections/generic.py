@@ -21,6 +21,7 @@ from stochpound.report.render import figures
 from stochpound.report.render.document import Block, FigureItem, Paragraph, Section, Table
 from stochpound.report.sections.ensemble_findings import compare_ensembles, ensemble_findings, isolation_across
 from stochpound.report.sections.ensembles import Ensemble
+from stochpound.report.sections.mechanism_findings import mechanism_findings
 from stochpound.experiment.definition import is_gap_axis
 from stochpound.report.sections.facets import dim_text, labels_text, layouts, line_colours, plain, value_text, cell_gid
 
@@ -46,12 +47,15 @@ AGAINST = {
 }
 
 
-def store_section(name: str, store: xr.Dataset, contact_free: bool = False) -> Section:
+def store_section(name: str, store: xr.Dataset, contact_free: bool = False, whole: xr.Dataset | None = None) -> Section:
     """A section for one store: description, its records' cases, its ensembles.
 
     ``contact_free``: ``store`` is a store's cases with contacts, its
     contact-free (``inf``) gap values left for the Separation section; the
-    dimensions then count them, and say so.
+    dimensions then count them, and say so. ``whole``: the whole store (its
+    contact-free cases included), whose mechanism findings compare the cases
+    with their twins without impacts (:mod:`stochpound.report.sections.mechanism_findings`);
+    ``store`` itself if not given.
     """
     section = Section(f"Experiment {name}", key=f"experiment-{name}")
     dims = [f"{d} ({store.sizes[d] + 1}: {store.sizes[d]} gaps here and the contact-free one of the Separation section)" if contact_free and is_gap_axis(d)
@@ -74,7 +78,8 @@ def store_section(name: str, store: xr.Dataset, contact_free: bool = False) -> S
     if across is not None:
         section.add(across)
     for ensemble in ensembles:
-        for block in [*ensemble_findings(ensemble), *ensemble.blocks()]:
+        mechanisms = mechanism_findings(name, store if whole is None else whole, ensemble.label)
+        for block in [*ensemble_findings(ensemble), *mechanisms, *ensemble.blocks()]:
             section.add(block)
     return section
 

@@ -9,6 +9,9 @@ each with its number and interval, computed from the stores:
 * how likely pounding is at the grid's gaps: P(pounding) with its
   Clopper–Pearson bounds, over the cells of each synthetic ensemble;
 * under records (one realization each), in how many cases each pounded;
+* which mechanisms the runs show: ratcheting of a sliding base, the
+  amplification of demands by pounding and by a moat wall, the walls'
+  largest penetration (``stochpound.report.sections.mechanism_findings``);
 * the risk-targeted gap, when a builder of :data:`RISK_ANSWERS` finds a
   hazard in the store;
 
@@ -29,6 +32,7 @@ from stochpound.analysis import pounding_probability, required_separation
 from stochpound.report.render.document import Block, Paragraph, Section, Table
 from stochpound.report.sections.ensembles import MIN_RUNS, Ensemble
 from stochpound.report.sections.facets import dim_text, labels_text, value_text
+from stochpound.report.sections.mechanism_findings import mechanism_answer
 from stochpound.experiment.selections import gap_dims, has_contact_free, with_contacts
 from stochpound.report.sections.separation import SeparationEnsemble, span_cm
 
@@ -63,6 +67,9 @@ def experiment_summary(stores: dict[str, xr.Dataset], sections: list[Section], c
         if records and len(axes) == len(gap_dims(store)) and "intensity" not in store.dims:
             # with no finite gap there is nothing to count; over intensity stripes the Intensity and Risk sections answer
             summary.add(Paragraph(_records_answer(store, records)))
+        mechanisms = mechanism_answer(name, store)
+        if mechanisms is not None:
+            summary.add(Paragraph(mechanisms))
         for answer in RISK_ANSWERS:
             for block in answer(name, store):
                 summary.add(block)
