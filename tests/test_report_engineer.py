@@ -132,3 +132,10 @@ def test_methods_name_the_law_that_ran_with_its_units_and_no_other(built):
     methods = _text(next(s for s in report.sections if s.key == "methods"))
     assert "Hertz" in methods and "N/m^1.5" in methods
     assert "Kelvin" not in methods
+
+
+def test_no_wall_wording_without_walls(built):
+    """A store without walls has no penetration column, and no caption or sentence speaks of walls' penetration."""
+    report, written = built
+    text = "\n".join(_text(section) for section in report.sections)
+    assert not re.search(r"penetration of a wall|wall penetration|walls were penetrated|peak_wall_penetration", text, re.IGNORECASE)

@@ -7,7 +7,7 @@ import pytest
 import xarray as xr
 
 from stochpound.experiment import open_store
-from stochpound.report.sections.ensembles import MIN_RUNS
+from stochpound.report.sections.ensembles import MIN_RUNS, Ensemble
 from stochpound.report.sections.mechanism_findings import amplification_text, mechanism_answer, mechanism_findings, ratcheting_text, wall_axis
 from tests.test_experiment_helpers import run_in_process
 
@@ -129,6 +129,10 @@ def test_a_moat_store_states_the_wall_s_amplification_and_its_largest_penetratio
     assert "(k = 42.75 MN/m)" in wall
     assert "ensemble kt_soft: a wall raises the peak floor acceleration in 1 of 1 cells" in answer
     assert f"the walls were penetrated by up to {largest * 100:.3g} cm" in answer and "ratchets" not in answer
+    with open_store(moat_store) as store:
+        tables = Ensemble("moat_test", store, "kt_soft").tables()
+    displacements = next(table for table in tables if table.key.endswith("-displacements"))
+    assert displacements.caption.endswith("and the largest penetration of a wall per run.")
 
 
 def test_a_pair_with_contact_free_twins_gets_the_ratcheting_and_pounding_findings_in_its_section(tmp_path):

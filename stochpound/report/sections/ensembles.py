@@ -75,7 +75,7 @@ QUANTITIES = {
 }
 TABLE_CAPTIONS = {
     "pounding": "the probability of pounding with its Clopper–Pearson interval, the mean numbers of impacts in and out of phase, and the peak impact force over the realizations that pound",
-    "displacements": "the studied building's peak displacements and residual sliding (and, with walls, the largest penetration of a wall per run)",
+    "displacements": "the studied building's peak displacements and residual sliding",
     "demands": "the studied building's demands: the largest peak total floor acceleration and storey drift over its floors, and its peak base shear",
     "response": "moments of the studied building's top-floor total displacement over time, and its correlation with the same building alone on a fixed base",
 }
@@ -147,6 +147,12 @@ class Ensemble:
         """The pounding, displacement and response tables of every cell."""
         return [self._table(kind) for kind in QUANTITIES if kind == "pounding" or any(f"{q.variable}_mean" in self.statistics for q in QUANTITIES[kind])]
 
+    def _caption(self, kind: str) -> str:
+        """What table ``kind`` holds, naming the wall penetration only when the store has it."""
+        if kind == "displacements" and "peak_wall_penetration_mean" in self.statistics:
+            return f"{TABLE_CAPTIONS[kind]} and the largest penetration of a wall per run"
+        return TABLE_CAPTIONS[kind]
+
     def _table(self, kind: str) -> Table:
         stats = self.statistics
         columns: dict[tuple[str, str], xr.DataArray] = {}
@@ -158,7 +164,7 @@ class Ensemble:
             columns.update(self._columns(quantity))
         return Table(
             key=f"table-{self.name}-{self.label}-{kind}",
-            caption=f"Experiment {self.name}, ensemble {self.label} ({self.size} realizations per cell): {TABLE_CAPTIONS[kind]}.",
+            caption=f"Experiment {self.name}, ensemble {self.label} ({self.size} realizations per cell): {self._caption(kind)}.",
             frame=table_frame(columns, list(self.grid)),
             note=(
                 f"mean: the ensemble mean over the realizations, with the lower and upper bounds of its {self.confidence:.0%} "
