@@ -18,6 +18,7 @@ import tomllib
 from pathlib import Path
 
 import numpy as np
+import xarray as xr
 import pytest
 from click.testing import CliRunner
 
@@ -250,4 +251,27 @@ def test_report_section_states_the_separation_first(isolated_store):
     assert {"risk-surface-risk", "risk-fragility-risk", "risk-rules-risk", "risk-demands-risk"} <= set(keys)
     rules = next(block for block in section.blocks if isinstance(block, Table) and block.key == "risk-rules-risk")
     assert "D_TM (ASCE 7 §17.2.5.2)" in rules.frame.index.get_level_values("rule")
+    grid = {"design_level", "rule", *(d for d in store["case_status"].dims if d not in ("record", "realization", "intensity", "gap"))}
+    assert set(rules.frame.index.names) <= grid, rules.frame.index.names  # the grid's axes, not what each point ran (base_mu, base_radius, ...)
+    separation = next(block for block in section.blocks if isinstance(block, Table) and block.key == "risk-separation-risk")
+    assert not any(str(name).startswith("base_") for name in separation.frame.index.names)
     assert stored_hazard(store).source.startswith("Site: Fox Plaza")
+
+
+def test_rules_table_is_indexed_by_the_grid_not_by_what_each_point_ran():
+    """Coordinates that say what a grid point ran (base_mu, base_radius, contact_law ...) stay out of the table's index."""
+    from types import SimpleNamespace
+
+    from stochpound.report.sections.risk import rules_frame
+
+    shape = (1, 1, 2, 1)
+    dims = ("design_level", "rule", "mu", "contact")
+    rules = xr.Dataset(
+        {"gap": (dims, np.full(shape, 0.3)), **{name: (dims[:3], np.full(shape[:3], 1e-3)) for name in ("maf", "maf_lower", "maf_upper")}},
+        coords={"design_level": [0.02], "rule": ["abs"], "mu": [0.05, 0.08], "contact": [0], "stripe_intensity": ("design_level", [0.76]),
+                "code_intensity": ("design_level", [0.76]), "base_mu": ("mu", [0.05, 0.08]), "base_radius": ("mu", [2.24, 2.24]),
+                "contact_law": (("mu", "contact"), [["kelvin"], ["kelvin"]])},
+        attrs={"years": 50.0},
+    )
+    frame = rules_frame(SimpleNamespace(rules=rules))
+    assert list(frame.index.names) == ["design_level", "rule", "mu"] and len(frame) == 2

@@ -122,7 +122,7 @@ def risk_headline(risk: StoreRisk) -> pd.DataFrame:
     for bound in ("lower", "upper"):  # absent without a bootstrap
         if bound not in separation:
             separation = separation.assign({bound: xr.full_like(separation["separation"], np.nan)})
-    frame = separation[["separation", "lower", "upper"]].to_dataframe().reset_index()
+    frame = _grid_only(separation[["separation", "lower", "upper"]]).to_dataframe().reset_index()
     frame = frame.drop(columns=[c for c in ("target_rate",) if c in frame])
     return frame.assign(confidence=CONFIDENCE, motions=risk.motions)
 
@@ -152,6 +152,7 @@ def rules_frame(risk: StoreRisk) -> pd.DataFrame:
     rules = risk.rules
     if rules is None:
         return pd.DataFrame()
+    rules = _grid_only(rules, keep=("code_intensity", "stripe_intensity"))
     years = float(rules.attrs.get("years", YEARS))
     gaps = rules["gap"].to_dataframe()["gap"].unstack("contact")
     gaps.columns = [f"gap, contact {c} (m)" for c in gaps.columns]
@@ -165,6 +166,11 @@ def rules_frame(risk: StoreRisk) -> pd.DataFrame:
     frame = frame.drop(columns=[c for c in ("code_intensity", "stripe_intensity") if c in frame])
     index = [c for c in frame.columns if not c.startswith("gap, ") and c not in ("λ_P (1/yr)", "λ_P lower", "λ_P upper", "once in (yr)", f"P in {years:g} yr")]
     return frame.set_index(index).dropna(how="all")
+
+
+def _grid_only(data: xr.Dataset, keep: tuple[str, ...] = ()) -> xr.Dataset:
+    """``data`` without its coordinates that are not dimensions (what each grid point ran: friction and law parameters), but ``keep``."""
+    return data.drop_vars([name for name in data.coords if name not in data.dims and name not in keep])
 
 
 def _target_text(probability: float, years: float = YEARS) -> str:
