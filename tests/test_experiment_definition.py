@@ -13,7 +13,7 @@ import pytest
 import xarray as xr
 
 from stochpound.experiment import Experiment
-from stochpound.experiment.definition import FIXED_BASE, Definition, GapAxis, is_fixed_base, is_gap_axis, read_definition
+from stochpound.experiment.definition import FIXED_BASE, Definition, is_fixed_base, is_gap_axis, read_definition
 from stochpound.experiment.spec import ExperimentError, canonical_json, definition_sha256, load_definition, parse_experiment
 from stochpound.report.sections.facets import value_text
 

@@ -95,7 +95,8 @@ def test_the_clearance_section_and_its_figure_against_the_clearance(report):
     experiment = next(s for s in report.sections if s.key == "experiment-moat_wall")
     assert "gap_wall (5: 4 clearances here and the wall-free one of the Separation section)" in _text(experiment)
     figure = next(b for b in experiment.blocks if isinstance(b, FigureItem) and b.key.endswith("gap_wall"))
-    assert figure.figure.axes[0].get_xlabel() == "gap_wall (cm)"
+    assert figure.figure.axes[0].get_xlabel() == "gap_wall (cm)" and figure.figure.axes[0].get_ylabel() == "P(wall hit)"
+    assert "The probability of a wall hit falls as gap_wall widens" in _text(experiment) and "A wall hit becomes rare" in _text(experiment)
 
 
 def test_the_mechanisms_speak_of_a_wall_not_of_pounding(report, moat):

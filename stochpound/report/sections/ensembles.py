@@ -133,6 +133,11 @@ class Ensemble:
         return self._studied(self.data[variable]).load()
 
     @property
+    def event(self) -> str:
+        """What an impact is in this ensemble's words: "pounding", or "a wall hit" in a store whose only impact elements are walls."""
+        return "a wall hit" if self.data.sizes.get("contact", 0) == 0 and "peak_wall_penetration" in self.data else "pounding"
+
+    @property
     def sliding(self) -> bool:
         """Whether any case of the ensemble slides."""
         return "peak_sliding_displacement" in self.data and bool((self.sample("peak_sliding_displacement") > 0).any())
@@ -231,9 +236,10 @@ class Ensemble:
             return result
 
         x_label = f"{dim_text(x_dim)}" + (" (cm)" if is_gap_axis(x_dim) else "")
+        event = self.event
         return self.facet_figures(
-            f"pounding-{x_dim}", [x_dim, line_dim], curves, x_label, "P(pounding)",
-            f"the probability of pounding against {dim_text(x_dim)}, with its {self.confidence:.0%} Clopper–Pearson band",
+            f"pounding-{x_dim}", [x_dim, line_dim], curves, x_label, f"P({event.removeprefix('a ')})",
+            f"the probability of {event} against {dim_text(x_dim)}, with its {self.confidence:.0%} Clopper–Pearson band",
             x_ticks=ticks, y_limits=(-0.03, 1.03), legend_title=dim_text(line_dim) if line_dim else "",
         )
 
