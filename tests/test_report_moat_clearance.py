@@ -93,7 +93,8 @@ def test_the_clearance_section_and_its_figure_against_the_clearance(report):
     assert axes.get_xlabel() == "clearance c (cm)" and axes.get_ylabel() == "P(wall hit)"
     assert max(float(line.get_xdata().max()) for line in axes.get_lines() if len(line.get_xdata())) > 40.0  # in cm, beyond the grid's 40 cm
     experiment = next(s for s in report.sections if s.key == "experiment-moat_wall")
-    assert "gap_wall (5: 4 clearances here and the wall-free one of the Separation section)" in _text(experiment)
+    assert "gap_wall (5: 4 clearances here and the wall-free one of the Moat clearance section)" in _text(experiment)
+    assert "pounding" not in _text(experiment)
     figure = next(b for b in experiment.blocks if isinstance(b, FigureItem) and b.key.endswith("gap_wall"))
     assert figure.figure.axes[0].get_xlabel() == "gap_wall (cm)" and figure.figure.axes[0].get_ylabel() == "P(wall hit)"
     assert "The probability of a wall hit falls as gap_wall widens" in _text(experiment) and "A wall hit becomes rare" in _text(experiment)

@@ -84,31 +84,31 @@ def spread(ensemble: Ensemble) -> Paragraph:
             "estimated. "
         )
     sentence += (
-        f"In {int(between.sum())} of {between.size} cells the probability of pounding lies strictly between 0 and 1 with "
+        f"In {int(between.sum())} of {between.size} cells the probability of {ensemble.event} lies strictly between 0 and 1 with "
         f"{ensemble.confidence:.0%} confidence: there a single record answers yes or no where the ensemble gives a probability."
     )
     if "peak_impact_force_quantile" in stats:
-        sentence += " " + _force_spread(stats, top)
+        sentence += " " + _force_spread(stats, top, "pounding realizations" if ensemble.event == "pounding" else "realizations that hit a wall")
     return Paragraph(sentence)
 
 
-def _force_spread(stats: xr.Dataset, top: float) -> str:
-    """The spread of the peak impact force over the pounding realizations, from the cells with at least :data:`MIN_RUNS` of them."""
+def _force_spread(stats: xr.Dataset, top: float, impacting: str) -> str:
+    """The spread of the peak impact force over the realizations with impacts (``impacting``, in words), from the cells with at least :data:`MIN_RUNS` of them."""
     force, count = stats["peak_impact_force_quantile"], stats["peak_impact_force_count"]
     enough = (count >= MIN_RUNS).values.ravel()
     if not enough.any():
         return (
-            f"No cell has {MIN_RUNS} pounding realizations (at most {int(count.max())}): the spread of the peak impact force is "
+            f"No cell has {MIN_RUNS} {impacting} (at most {int(count.max())}): the spread of the peak impact force is "
             "not estimated."
         )
     ratio = (force.sel(quantile=top) / force.sel(quantile=0.5)).values.ravel()[enough]
     counts = count.values.ravel()[enough]
     text = (
-        f"In the {int(enough.sum())} cells with at least {MIN_RUNS} pounding realizations (n = {int(counts.min())}–{int(counts.max())}), "
+        f"In the {int(enough.sum())} cells with at least {MIN_RUNS} {impacting} (n = {int(counts.min())}–{int(counts.max())}), "
         f"the {top * 100:g} % quantile of the peak impact force is {np.nanmin(ratio):.2f} to {np.nanmax(ratio):.2f} times its median"
     )
     rest = int((~enough).sum())
-    return text + (f"; the other {rest} cells have fewer pounding realizations and give no ratio." if rest else ".")
+    return text + (f"; the other {rest} cells have fewer {impacting} and give no ratio." if rest else ".")
 
 
 def rare_gap(upper: xr.DataArray, dim: str) -> xr.DataArray:
@@ -196,7 +196,7 @@ def _needed_table(ensemble: Ensemble, dim: str, needed: xr.DataArray, others: li
         frame=frame,
         note=(
             f"– : not reached within the grid (largest {dim_text(dim)} {value_text(dim, ensemble.grid[dim][-1])}). With "
-            f"{ensemble.size} realizations and none pounding the upper bound is {float(kernels.clopper_pearson(0, ensemble.size, ensemble.confidence)[1]):.4f}: "
+            f"{ensemble.size} realizations and none {'pounding' if ensemble.event == 'pounding' else 'hitting a wall'} the upper bound is {float(kernels.clopper_pearson(0, ensemble.size, ensemble.confidence)[1]):.4f}: "
             "a smaller threshold needs more realizations."
         ),
         formats={},

@@ -61,7 +61,7 @@ def store_section(name: str, store: xr.Dataset, contact_free: bool = False, whol
     section = Section(f"Experiment {name}", key=f"experiment-{name}")
     walls = wall_gap_dims(store)
     dims = [f"{d} ({store.sizes[d] + 1}: {store.sizes[d]} {'clearances' if d in walls else 'gaps'} here and the "
-            f"{'wall-free' if d in walls else 'contact-free'} one of the Separation section)" if contact_free and is_gap_axis(d)
+            f"{'wall-free one of the Moat clearance' if d in walls else 'contact-free one of the Separation'} section)" if contact_free and is_gap_axis(d)
             else f"{d} ({store.sizes[d]})" for d in store["case_status"].dims]
     section.add(Paragraph(
         f"{store.attrs.get('experiment_description', '')} Studied building: {store.attrs.get('studied_building', '')}; its "
