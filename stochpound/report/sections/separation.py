@@ -48,6 +48,8 @@ RULE_TEXT = {
 }
 #: Target probabilities of the separation-against-probability figure.
 CURVE_PROBABILITIES = tuple(np.round(np.geomspace(0.005, 0.9, 31), 5))
+#: Target probabilities of a wall hit whose clearance the findings state (among the table's).
+WALL_TARGETS = (0.05, 0.01)
 
 
 @dataclass(frozen=True)
@@ -56,6 +58,8 @@ class Closure:
 
     Attributes
     ----------
+    kind : str
+        ``contacts`` (between buildings: the separation rules apply) or ``walls``.
     variable : str
         The store's peak closure D of a run (m), per ``contact`` (the largest is taken) or one per run.
     events : str
@@ -71,6 +75,7 @@ class Closure:
         (:mod:`stochpound.analysis.gap_axes`).
     """
 
+    kind: str
     variable: str
     events: str
     event: str
@@ -84,12 +89,12 @@ class Closure:
     @property
     def walls(self) -> bool:
         """Whether the gap separates a building from walls (no separation rules then)."""
-        return self is WALLS
+        return self.kind == "walls"
 
 
-CONTACTS = Closure("peak_contact_closure", "impacts", "pounding", "gap", "g", "contact-free", contact_free, with_contacts, contact_gap_dims)
+CONTACTS = Closure("contacts", "peak_contact_closure", "impacts", "pounding", "gap", "g", "contact-free", contact_free, with_contacts, contact_gap_dims)
 """The gap between buildings: gap axes that set contacts, their contact-free runs."""
-WALLS = Closure("largest_wall_closure", "peak_wall_penetration", "wall hit", "clearance", "c", "wall-free", wall_free, with_walls, wall_gap_dims)
+WALLS = Closure("walls", "largest_wall_closure", "peak_wall_penetration", "wall hit", "clearance", "c", "wall-free", wall_free, with_walls, wall_gap_dims)
 """A moat's clearance: gap axes that set walls only, their wall-free runs (walls never reached, the closure toward them located)."""
 
 
@@ -214,6 +219,13 @@ class SeparationEnsemble:
         """The fraction of the store's runs at its finite gaps that closed one (P(pounding), P(wall hit)) with its interval, computed."""
         return pounding_probability(self.impacts, confidence=self.confidence).compute()
 
+    def curve_at_grid(self) -> xr.Dataset:
+        """P(D ≥ g) from the contact-free (wall-free) runs at the grid's finite gaps, on the gap axis, with its interval, computed
+        (call when :attr:`gap_axis` is not None)."""
+        axis = self.gap_axis
+        curve = pounding_curve(self.demand, self.impacts[axis].values, confidence=self.confidence, contact_dim=None).compute()
+        return curve.rename(gap=axis) if axis != "gap" else curve
+
     # ------------------------------------------------------------ text
 
     def _identity_check(self) -> list[Block]:
@@ -274,18 +286,14 @@ class SeparationEnsemble:
         text = f"With {n} wall-free realizations per cell: "
         if self.gap_axis is not None:
             clearances = self.impacts[self.gap_axis].values
-            curve = pounding_curve(self.demand, clearances, confidence=self.confidence, contact_dim=None).compute()
-            curve = curve.rename(gap=self.gap_axis) if self.gap_axis != "gap" else curve
-            direct = self.hit_probability()
+            curve, direct = self.curve_at_grid(), self.hit_probability()
             inside = ((direct["probability"] >= curve["lower"]) & (direct["probability"] <= curve["upper"])) | direct["probability"].isnull()
             text += (
                 f"P(wall hit | c) = P(D ≥ c) is {'; '.join(f'{value_text(self.gap_axis, c)}: {span(curve.probability.sel({self.gap_axis: c}))}' for c in clearances)} "
                 f"over the cells; the runs at those clearances hit a wall in a fraction within its {self.confidence:.0%} Clopper–Pearson "
                 f"interval in {int(inside.sum())} of {int(inside.size)} cells. "
             )
-        for p in needed["probability"].values:
-            if p not in (0.05, 0.01):
-                continue
+        for p in WALL_TARGETS:
             separation = needed["separation"].sel(probability=p)
             low, high = _extreme_cells(separation)
             text += f"P(wall hit) = {p:.0%} needs a clearance of {_cm(separation.sel(low))} ({labels_text(low) or 'the one cell'})"

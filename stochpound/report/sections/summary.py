@@ -28,7 +28,7 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
-from stochpound.analysis import pounding_curve, pounding_probability, required_separation
+from stochpound.analysis import pounding_probability, required_separation
 from stochpound.report.render.document import Block, Paragraph, Section, Table
 from stochpound.report.sections.ensembles import MIN_RUNS, Ensemble
 from stochpound.report.sections.facets import dim_text, labels_text, value_text
@@ -99,12 +99,10 @@ def _clearance_answer(name: str, store: xr.Dataset, ensembles: list[str], confid
         text = f"ensemble {label} ({n} wall-free realizations in each of {cells} cells{few}): "
         axis = separation.gap_axis
         if axis is not None:
-            clearances = separation.impacts[axis].values
-            curve = pounding_curve(separation.demand, clearances, confidence=confidence, contact_dim=None).compute()
-            direct = separation.hit_probability()
+            curve, direct = separation.curve_at_grid(), separation.hit_probability()
             at = []
-            for index, c in enumerate(clearances):
-                cell = curve.isel(gap=index)
+            for c in curve[axis].values:
+                cell = curve.sel({axis: c})
                 at.append(f"{value_text(axis, c)}: {span(cell['probability'])} (upper bound {span(cell['upper'])}; runs there {span(direct['probability'].sel({axis: c}))})")
             text += "P(wall hit | c) = P(D ≥ c) at " + "; ".join(at) + ". "
         answers = []
