@@ -13,7 +13,7 @@ import pytest
 import xarray as xr
 
 from stochpound.experiment import Experiment
-from stochpound.experiment.definition import FIXED_BASE, Definition, GapAxis, is_fixed_base, is_gap_axis, read_definition
+from stochpound.experiment.definition import FIXED_BASE, Definition, is_fixed_base, is_gap_axis, read_definition
 from stochpound.experiment.spec import ExperimentError, canonical_json, definition_sha256, load_definition, parse_experiment
 from stochpound.report.sections.facets import value_text
 
@@ -27,7 +27,7 @@ IDENTITIES = {
     "dff3909976ebae73dbef4b1c7e398b3c66732d61c178e1debb73a80981f01404": "a63f03d1e1476471d116da9995f03d845c9e79e14062bb72ce23591ed55bdbe9",
     "638a33ff8b952e185ac07f1fa238740ac38b104a19a0645200932dff86f82be1": "55b4b4b082fba4063464e07d892cf47f9fe52647e8aaf4da1dc51387b674d13f",
     "7ad709e4bbe91a9f92e0c12f96f960fce5174cd54a3a1cf0906d78795a2e9945": "f336d6034b32d583b0db8f048c848c45712cd573d4674dd9f0ccdea44ade869b",
-    "97435fb40cd297e05a2d9d7af38be45f497fbac3c7c57d7d0d4d5d354a4d96c5": "f90a928501350528f7389c2a4426092d7f05836a94fa8087b0d590d6a4f5bb0c",
+    "7aa99d11cd33c58e32019efbeea980bd3013b663da9288bf85a5e352838fd602": "a288cd8a711ce8d1a0604666aabd69bb434b978fe8fbbecd45a12309dd49defa",  # experiments/laws/moat_wall.toml (the clearance a gap axis over its walls)
     "eb5a30003676e0a4788bdc77278c680db1928cefaa2e3184526ffb4ff2cd149e": "128add143f75d2a6807a3bdadd1a10eccb86101908995348243d55d4932ab1bb",
     "4904d40c5d2d0af316c9c36b4504f7cfee312861107e92629aed74be5de1066e": "77712e2d264128c8a3ecf4a696d879d37508b4eb254212b076dc9de9f45a36d9",
     "6daeb16f63151e60b79f56d62baf423fe9dc5422dd7830c10c372c48ccf19b93": "6a1f389f07a4ddb74a22fbafd5d9eaf12cfb7b010b75506e2a1437e07f1be195",
@@ -122,30 +122,45 @@ def test_gap_axis_rule(name: str, gap: bool) -> None:
     assert (value_text(name, 0.02) == "2 cm") is gap
 
 
+MOAT = ROOT / "experiments" / "laws" / "moat_wall.toml"
+
+
 def _moat(grid: dict, walls: list[dict] | None = None) -> dict:
-    """The moat-wall experiment with ``grid`` and, instead of its ``moat`` variants, ``walls`` in the base scene."""
-    data = tomllib.loads((ROOT / "experiments" / "laws" / "moat_wall.toml").read_text())
-    del data["variants"]
-    data["scene"]["wall"] = walls if walls is not None else copy.deepcopy(tomllib.loads((ROOT / "experiments" / "laws" / "moat_wall.toml").read_text())["variants"]["moat"]["w10"]["scene"]["wall"])
+    """The moat-wall experiment with ``grid`` and, if given, ``walls`` instead of its base scene's walls."""
+    data = tomllib.loads(MOAT.read_text())
+    if walls is not None:
+        data["scene"]["wall"] = walls
     data["grid"] = grid
     return data
 
 
 def test_gap_axis_sets_walls() -> None:
-    """``gap_wall = { values, walls }`` gives each grid point the scene that a variant repeating the wall tables gives."""
-    original = Experiment(load_definition(ROOT / "experiments" / "laws" / "moat_wall.toml")[0])
-    compact = Experiment(parse_experiment(_moat({"mu": {"values": [0.05, 0.12], "buildings": ["B1"]}, "gap_wall": {"values": [0.1, 0.2, 0.3, 0.4, "inf"], "walls": [0, 1]}})))
-    assert compact.contract.gaps == (GapAxis("gap_wall", (0.1, 0.2, 0.3, 0.4, math.inf), (), (0, 1)),)
-    variant = {0.1: "w10", 0.2: "w20", 0.3: "w30", 0.4: "w40"}
+    """The file's ``gap_wall`` axis gives each grid point the scene that a variant repeating its wall tables at that gap gives
+    (and, at inf, walls that are never reached)."""
+    compact = Experiment(load_definition(MOAT)[0])
+    gap_axis = compact.contract.gaps[0]
+    assert gap_axis.name == "gap_wall" and gap_axis.walls == (0, 1) and gap_axis.contacts == ()
+    data = tomllib.loads(MOAT.read_text())
+    walls = data["scene"].pop("wall")
+    assert [w["side"] for w in walls] == ["left", "right"]
+    variants: dict[str, dict] = {"none": {}}
+    for gap in (g for g in gap_axis.values if math.isfinite(g)):
+        variants[f"w{round(gap * 100)}"] = {"scene": {"wall": [{**wall, "gap": gap} for wall in walls]}}
+    data["variants"] = {"moat": variants}
+    data["grid"] = {"mu": data["grid"]["mu"]}
+    variant_form = Experiment(parse_experiment(data))
+    assert len(list(variant_form.points("case"))) == len(list(compact.points("case")))
     compared = 0
     for point in compact.points("case"):
         labels = dict(point.labels)
         scene = compact.structure(point)
         if math.isinf(labels["gap_wall"]):
-            assert all(math.isinf(w["gap"]) for w in scene["wall"])  # a wall that is never reached: the moat "none"
+            assert [w["gap"] for w in scene["wall"]] == [math.inf, math.inf]  # walls never reached: the variant without walls
+            twin = next(p for p in variant_form.points("case") if dict(p.labels) == {"moat": "none", "mu": labels["mu"]})
+            assert "wall" not in variant_form.structure(twin) or not variant_form.structure(twin)["wall"]
             continue
-        twin = next(p for p in original.points("case") if dict(p.labels) == {"moat": variant[labels["gap_wall"]], "mu": labels["mu"]})
-        assert scene == original.structure(twin)
+        twin = next(p for p in variant_form.points("case") if dict(p.labels) == {"moat": f"w{round(labels['gap_wall'] * 100)}", "mu": labels["mu"]})
+        assert scene == variant_form.structure(twin)
         compared += 1
     assert compared == 8
     compact.validate()

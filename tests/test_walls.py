@@ -127,3 +127,22 @@ def test_a_case_s_wall_penetration_is_its_walls_located_peak_beyond_the_gap():
     assert float(case_summary(hit, "B1", hit.total_displacement.sel(building="B1").isel(floor=-1) * 0.0)["peak_wall_penetration"]) == pytest.approx(expected, rel=1e-12)
     assert case_values(far, "B1", twin)["peak_wall_penetration"] == 0.0
     assert np.isnan(case_values(run(alone), "B1", twin)["peak_wall_penetration"])
+
+
+def test_a_case_s_largest_wall_closure_is_the_clearance_it_needed():
+    """The largest located closure toward a wall over the walls, whatever their gap (inf included): a wall at a clearance
+    below it is hit, one above it is not (the same motion); NaN without walls."""
+    from stochpound.experiment.summary import case_summary, case_values
+
+    free = run(moat(gap=np.inf))
+    twin = np.zeros(free.sizes["time"])
+    for wall in moat(gap=np.inf)["wall"]:
+        assert np.isinf(wall["gap"])
+    needed = float(free.peak_wall_closure.max())
+    assert free.sizes["impact"] == 0 and needed > 0.0
+    assert case_values(free, "B1", twin)["largest_wall_closure"] == pytest.approx(needed, rel=1e-12)
+    assert float(case_summary(free, "B1", free.total_displacement.sel(building="B1").isel(floor=-1) * 0.0)["largest_wall_closure"]) == pytest.approx(needed, rel=1e-12)
+    assert run(moat(gap=0.98 * needed)).sizes["impact"] > 0 and run(moat(gap=1.02 * needed)).sizes["impact"] == 0
+    alone = moat()
+    del alone["wall"]
+    assert np.isnan(case_values(run(alone), "B1", twin)["largest_wall_closure"])

@@ -156,6 +156,21 @@ def wall_penetration(peak_closure: np.ndarray, gap: np.ndarray) -> np.ndarray:
     return np.maximum(np.max(closure - at_rest, axis=-1), 0.0)
 
 
+def largest_wall_closure(peak_closure: np.ndarray) -> np.ndarray:
+    """The largest peak closure toward a wall over the walls (trailing axis), m: the clearance the run needed.
+
+    A wall's closure is its level's displacement toward it (``peak_wall_closure``
+    of :func:`stochpound.simulate`, located on the solution, whatever its gap,
+    ``inf`` included); a run with every wall at clearance c reaches one exactly
+    when this value is at least c (before the first impact the run equals the
+    run whose walls are never reached). NaN without walls (an empty trailing axis).
+    """
+    closure = np.asarray(peak_closure, dtype=np.float64)
+    if closure.shape[-1] == 0:
+        return np.full(closure.shape[:-1], np.nan)
+    return np.max(closure, axis=-1)
+
+
 def energy_residual_ratio(residual: np.ndarray, energy_input: np.ndarray) -> np.ndarray:
     """The largest absolute energy residual over the largest absolute energy input along the trailing axis (J/J): the energy balance's error."""
     return abs_peak(residual) / abs_peak(energy_input)

@@ -85,6 +85,7 @@ CASE_SUMMARIES = (
 #: NaN for a case without walls (a variant without them).
 WALL_SUMMARIES = (
     StoreVariable("peak_wall_penetration", (), "f8", "m", "largest penetration of a wall over the run and over the walls (0: no wall reached)"),
+    StoreVariable("largest_wall_closure", (), "f8", "m", "largest closure toward a wall over the run and over the walls: the clearance this run needed"),
 )
 
 #: Summaries of every fixed-base reference (the studied building alone): those of a case, named ``reference_<name>``, per building no more.

@@ -1,8 +1,9 @@
-"""Selections of an experiment store by what its grid's values mean: contact-free cases, fixed-base twins.
+"""Selections of an experiment store by what its grid's values mean: contact-free and wall-free cases, fixed-base twins.
 
-A gap axis that holds ``inf`` makes *contact-free* cases: their gaps never
-close, and by the gap identity their peak closure answers every gap at once
-(docs/separation.md). That rule is the analysis layer's
+A gap axis that holds ``inf`` makes *contact-free* cases (an axis setting
+contacts) or *wall-free* cases (an axis setting walls only): their gaps
+never close, and by the gap identity their peak closure answers every gap at
+once (docs/separation.md). That rule is the analysis layer's
 (``stochpound.analysis.gap_axes``, which the risk chain uses too), given
 here too. A μ axis that holds :data:`~stochpound.experiment.FIXED_BASE`
 makes, for each isolated case, its *fixed-base twin*: the same case with the
@@ -17,10 +18,13 @@ from typing import TypeVar
 
 import xarray as xr
 
-from stochpound.analysis.gap_axes import contact_free, gap_dims, has_contact_free, with_contacts
+from stochpound.analysis.gap_axes import contact_free, contact_gap_dims, gap_dims, has_contact_free, has_wall_free, wall_free, wall_gap_dims, with_contacts, with_walls
 from stochpound.experiment.definition import FIXED_BASE, is_fixed_base
 
-__all__ = ["contact_free", "fixed_base", "gap_dims", "has_contact_free", "has_fixed_base_twins", "isolated_mus", "with_contacts"]
+__all__ = [
+    "contact_free", "contact_gap_dims", "fixed_base", "gap_dims", "has_contact_free", "has_fixed_base_twins", "has_wall_free",
+    "isolated_mus", "wall_free", "wall_gap_dims", "with_contacts", "with_walls",
+]
 
 Data = TypeVar("Data", xr.Dataset, xr.DataArray)
 

@@ -32,6 +32,7 @@ from typing import Any, Iterator, Mapping
 import numpy as np
 import xarray as xr
 
+from stochpound.analysis.gap_axes import SETS
 from stochpound.experiment import intensity
 from stochpound.experiment.grid import CASE, REFERENCE, Dim, Experiment
 from stochpound.experiment.spec import ExperimentError, canonical_json
@@ -300,7 +301,8 @@ def _dim_coordinate(experiment: Experiment, dim: Dim) -> xr.Variable:
     if dim.kind == "gap":
         gap = experiment.contract.gap_axis(dim.name)
         walls = f" and walls {list(gap.walls)}" if gap.walls else ""
-        return xr.Variable((dim.name,), np.array(dim.values, float), {"units": "m", "long_name": f"at-rest gap of contacts {list(gap.contacts)}{walls}"})
+        sets = " and ".join(what for what, indices in (("contacts", gap.contacts), ("walls", gap.walls)) if indices)
+        return xr.Variable((dim.name,), np.array(dim.values, float), {"units": "m", "long_name": f"at-rest gap of contacts {list(gap.contacts)}{walls}", SETS: sets})
     if dim.kind == "mu":
         chosen = experiment.contract.mu.buildings
         which = ", ".join(chosen) if chosen else "every isolated building"

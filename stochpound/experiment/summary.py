@@ -45,8 +45,8 @@ DEMAND_SUMMARIES = {
     "peak_interstorey_drift": ("peak_storey_drift", "largest peak storey drift over the building's storeys"),
     "peak_base_shear": ("peak_base_shear", "largest absolute base shear over the run"),
 }
-#: The wall summary (:data:`stochpound.experiment.catalogue.WALL_SUMMARIES`): every case computes it (NaN without walls); a store keeps it when its scene has walls.
-WALL_PENETRATION = WALL_SUMMARIES[0]
+#: The wall summaries (:data:`stochpound.experiment.catalogue.WALL_SUMMARIES`): every case computes them (NaN without walls); a store keeps them when its scene has walls.
+WALL_PENETRATION, WALL_CLOSURE = WALL_SUMMARIES
 #: Columns of the impact table a store keeps (:data:`stochpound.experiment.catalogue.IMPACT_TABLE`).
 IMPACT_COLUMNS = tuple(v.name for v in IMPACT_TABLE)
 
@@ -69,8 +69,8 @@ def case_summary(run: xr.Dataset, studied: str, fixed_base: xr.DataArray) -> xr.
     xarray.Dataset
         Peaks and residual sliding per building (m), impact statistics,
         moments of the response, ``fixed_base_correlation``,
-        ``energy_residual_ratio``, ``events_total`` and ``peak_wall_penetration``
-        (m; NaN without walls).
+        ``energy_residual_ratio``, ``events_total``, ``peak_wall_penetration``
+        and ``largest_wall_closure`` (m; NaN without walls).
     """
     summary = without_aliases(run_summary(run, studied, fixed_base)).drop_vars(list(_PEAKS))
     summary = xr.merge([summary, peak_response(run)])
@@ -83,6 +83,7 @@ def case_summary(run: xr.Dataset, studied: str, fixed_base: xr.DataArray) -> xr.
     if "peak_total_acceleration" in run:
         summary = summary.merge(_demand_summary(run))
     summary[WALL_PENETRATION.name] = xr.DataArray(_wall_penetration(run), attrs=WALL_PENETRATION.attrs)
+    summary[WALL_CLOSURE.name] = xr.DataArray(_wall_closure(run), attrs=WALL_CLOSURE.attrs)
     return summary
 
 
@@ -150,6 +151,7 @@ def case_values(run: xr.Dataset, studied: str, fixed_base: np.ndarray) -> dict[s
         **_contact_values(run),
         **_demand_values(run),
         WALL_PENETRATION.name: _wall_penetration(run),
+        WALL_CLOSURE.name: _wall_closure(run),
     }
 
 
@@ -159,6 +161,14 @@ def _wall_penetration(run: xr.Dataset) -> np.float64:
     if "peak_wall_closure" not in variables:
         return np.float64(np.nan)
     return np.float64(kernels.wall_penetration(variables["peak_wall_closure"].values, variables["wall_gap"].values))
+
+
+def _wall_closure(run: xr.Dataset) -> np.float64:
+    """The largest peak closure toward a wall over the run and its walls, m (:func:`stochpound.analysis.kernels.largest_wall_closure`; NaN without walls)."""
+    variables = run.variables
+    if "peak_wall_closure" not in variables:
+        return np.float64(np.nan)
+    return np.float64(kernels.largest_wall_closure(variables["peak_wall_closure"].values))
 
 
 def _demand_values(run: xr.Dataset) -> dict[str, np.ndarray]:

@@ -19,7 +19,7 @@ from pathlib import Path
 import xarray as xr
 
 from stochpound.experiment.definition import read_definition
-from stochpound.experiment.selections import has_contact_free, with_contacts
+from stochpound.experiment.selections import has_contact_free, has_wall_free, with_contacts, with_walls
 from stochpound.report.render.document import Paragraph, Report, Section
 from stochpound.report.sections.ensembles import INTERVAL_NOTE
 from stochpound.report.sections.generic import store_section
@@ -27,7 +27,7 @@ from stochpound.report.sections.intensity import intensity_section, intensity_se
 from stochpound.report.sections.laws import law_axis, laws_section
 from stochpound.report.sections.methods import methods_section
 from stochpound.report.sections.risk import has_risk, risk_section
-from stochpound.report.sections.separation import separation_section
+from stochpound.report.sections.separation import WALLS, separation_section
 from stochpound.report.sections.stores import open_stores
 from stochpound.report.sections.summary import experiment_summary, move_per_cell_tables
 from stochpound.studies import claims, load_study
@@ -74,12 +74,16 @@ def assemble_report(paths: Sequence[str | Path], progress: Callable[[str], None]
             report.sections.append(risk_section(name, store))
     for name, store in others.items():
         say(f"experiment {name}")
-        contact_free = has_contact_free(store)
+        contact_free, wall_free = has_contact_free(store), has_wall_free(store)
         finite = with_contacts(store) if contact_free else store
+        finite = with_walls(finite) if wall_free else finite
         if law_axis(store) is not None:
             report.sections.append(laws_section(name, finite))
         if all(finite.sizes[d] for d in finite["case_status"].dims):
-            report.sections.append(store_section(name, finite, contact_free, store))
+            report.sections.append(store_section(name, finite, contact_free or wall_free, store))
+        if wall_free and not has_risk(store):
+            say(f"experiment {name}: moat clearance")
+            report.sections.append(separation_section(name, store, WALLS))
         if contact_free and not has_risk(store):  # with a hazard, the Risk section gives the separation at every intensity
             say(f"experiment {name}: separation")
             report.sections.append(separation_section(name, store))

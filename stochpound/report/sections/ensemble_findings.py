@@ -58,7 +58,7 @@ def precision(ensemble: Ensemble) -> Paragraph:
     cells = int(stats["pounding_probability"].size)
     return Paragraph(
         f"Ensemble {ensemble.label}: {ensemble.size} realizations in each of {cells} cells. The {ensemble.confidence:.0%} "
-        f"interval of the probability of pounding is at most ±{np.nanmax(p):.3f} wide (median ±{np.nanmedian(p):.3f}; widest "
+        f"interval of the probability of {ensemble.event} is at most ±{np.nanmax(p):.3f} wide (median ±{np.nanmedian(p):.3f}; widest "
         f"where P is near 0.5, narrowest where it is 0 or 1), and the mean peak total displacement of {ensemble.studied} is "
         f"known to ±{np.nanmedian(relative) * 100:.1f} % (median over cells; at most ±{np.nanmax(relative) * 100:.1f} %). "
         + (f"The convergence figures show these estimates from the first {MIN_RUNS} realizations to all {ensemble.size}."
@@ -84,31 +84,31 @@ def spread(ensemble: Ensemble) -> Paragraph:
             "estimated. "
         )
     sentence += (
-        f"In {int(between.sum())} of {between.size} cells the probability of pounding lies strictly between 0 and 1 with "
+        f"In {int(between.sum())} of {between.size} cells the probability of {ensemble.event} lies strictly between 0 and 1 with "
         f"{ensemble.confidence:.0%} confidence: there a single record answers yes or no where the ensemble gives a probability."
     )
     if "peak_impact_force_quantile" in stats:
-        sentence += " " + _force_spread(stats, top)
+        sentence += " " + _force_spread(stats, top, "pounding realizations" if ensemble.event == "pounding" else "realizations that hit a wall")
     return Paragraph(sentence)
 
 
-def _force_spread(stats: xr.Dataset, top: float) -> str:
-    """The spread of the peak impact force over the pounding realizations, from the cells with at least :data:`MIN_RUNS` of them."""
+def _force_spread(stats: xr.Dataset, top: float, impacting: str) -> str:
+    """The spread of the peak impact force over the realizations with impacts (``impacting``, in words), from the cells with at least :data:`MIN_RUNS` of them."""
     force, count = stats["peak_impact_force_quantile"], stats["peak_impact_force_count"]
     enough = (count >= MIN_RUNS).values.ravel()
     if not enough.any():
         return (
-            f"No cell has {MIN_RUNS} pounding realizations (at most {int(count.max())}): the spread of the peak impact force is "
+            f"No cell has {MIN_RUNS} {impacting} (at most {int(count.max())}): the spread of the peak impact force is "
             "not estimated."
         )
     ratio = (force.sel(quantile=top) / force.sel(quantile=0.5)).values.ravel()[enough]
     counts = count.values.ravel()[enough]
     text = (
-        f"In the {int(enough.sum())} cells with at least {MIN_RUNS} pounding realizations (n = {int(counts.min())}–{int(counts.max())}), "
+        f"In the {int(enough.sum())} cells with at least {MIN_RUNS} {impacting} (n = {int(counts.min())}–{int(counts.max())}), "
         f"the {top * 100:g} % quantile of the peak impact force is {np.nanmin(ratio):.2f} to {np.nanmax(ratio):.2f} times its median"
     )
     rest = int((~enough).sum())
-    return text + (f"; the other {rest} cells have fewer pounding realizations and give no ratio." if rest else ".")
+    return text + (f"; the other {rest} cells have fewer {impacting} and give no ratio." if rest else ".")
 
 
 def rare_gap(upper: xr.DataArray, dim: str) -> xr.DataArray:
@@ -128,13 +128,14 @@ def gap_effect(ensemble: Ensemble, dim: str) -> list[Block]:
     lines = int(first.size)
     lower_at_end = int((last < first).sum())
     needed = rare_gap(stats["pounding_probability_upper"], dim)
+    event, gap = ensemble.event, ("clearance" if ensemble.event != "pounding" else "gap")
     reached = needed.notnull()
     others = [d for d in ensemble.grid if d != dim]
     text = (
-        f"The probability of pounding falls as {dim_text(dim)} widens: over the {lines} combinations of "
+        f"The probability of {event} falls as {dim_text(dim)} widens: over the {lines} combinations of "
         f"{', '.join(dim_text(d) for d in others) or 'the grid'} it is lower at {value_text(dim, ensemble.grid[dim][-1])} than at "
-        f"{value_text(dim, ensemble.grid[dim][0])} in {lower_at_end} (P from {_range(first)} to {_range(last)}). Pounding becomes rare (upper {ensemble.confidence:.0%} bound below "
-        f"{RARE:.0%} at that gap and every larger one of the grid) within the grid in {int(reached.sum())} of them"
+        f"{value_text(dim, ensemble.grid[dim][0])} in {lower_at_end} (P from {_range(first)} to {_range(last)}). {event.capitalize()} becomes rare (upper {ensemble.confidence:.0%} bound below "
+        f"{RARE:.0%} at that {gap} and every larger one of the grid) within the grid in {int(reached.sum())} of them"
     )
     if bool(reached.any()):
         text += f", at {needed.min().item() * CM:g} to {needed.max().item() * CM:g} cm"
@@ -189,13 +190,13 @@ def _needed_table(ensemble: Ensemble, dim: str, needed: xr.DataArray, others: li
         key=f"table-{ensemble.name}-{ensemble.label}-rare-{dim}",
         caption=(
             f"Experiment {ensemble.name}, ensemble {ensemble.label}: the smallest {dim_text(dim)} (cm) of the grid from which on "
-            f"pounding is rare, i.e. the upper {ensemble.confidence:.0%} Clopper–Pearson bound of P(pounding) is below {RARE:.0%} "
-            "there and at every larger gap of the grid."
+            f"{ensemble.event} is rare, i.e. the upper {ensemble.confidence:.0%} Clopper–Pearson bound of its probability is below {RARE:.0%} "
+            f"there and at every larger {'gap' if ensemble.event == 'pounding' else 'clearance'} of the grid."
         ),
         frame=frame,
         note=(
             f"– : not reached within the grid (largest {dim_text(dim)} {value_text(dim, ensemble.grid[dim][-1])}). With "
-            f"{ensemble.size} realizations and none pounding the upper bound is {float(kernels.clopper_pearson(0, ensemble.size, ensemble.confidence)[1]):.4f}: "
+            f"{ensemble.size} realizations and none {'pounding' if ensemble.event == 'pounding' else 'hitting a wall'} the upper bound is {float(kernels.clopper_pearson(0, ensemble.size, ensemble.confidence)[1]):.4f}: "
             "a smaller threshold needs more realizations."
         ),
         formats={},

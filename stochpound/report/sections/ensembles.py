@@ -133,6 +133,16 @@ class Ensemble:
         return self._studied(self.data[variable]).load()
 
     @property
+    def event(self) -> str:
+        """What an impact is in this ensemble's words: "pounding", or "a wall hit" in a store whose only impact elements are walls."""
+        return "a wall hit" if self.data.sizes.get("contact", 0) == 0 and "peak_wall_penetration" in self.data else "pounding"
+
+    @property
+    def probability_label(self) -> str:
+        """Its probability as a label: "P(pounding)" or "P(wall hit)"."""
+        return f"P({self.event.removeprefix('a ')})"
+
+    @property
     def sliding(self) -> bool:
         """Whether any case of the ensemble slides."""
         return "peak_sliding_displacement" in self.data and bool((self.sample("peak_sliding_displacement") > 0).any())
@@ -237,9 +247,10 @@ class Ensemble:
             return result
 
         x_label = f"{dim_text(x_dim)}" + (" (cm)" if is_gap_axis(x_dim) else "")
+        event = self.event
         return self.facet_figures(
-            f"pounding-{x_dim}", [x_dim, line_dim], curves, x_label, "P(pounding)",
-            f"the probability of pounding against {dim_text(x_dim)}, with its {self.confidence:.0%} Clopper–Pearson band",
+            f"pounding-{x_dim}", [x_dim, line_dim], curves, x_label, self.probability_label,
+            f"the probability of {event} against {dim_text(x_dim)}, with its {self.confidence:.0%} Clopper–Pearson band",
             x_ticks=ticks, y_limits=(-0.03, 1.03), legend_title=dim_text(line_dim) if line_dim else "",
         )
 
@@ -261,7 +272,7 @@ class Ensemble:
 
         what = f"the empirical distribution (ECDF) of the {quantity.label} over the realizations of each cell"
         if quantity.variable == "peak_impact_force":
-            what += "; its jump at zero is the probability of not pounding"
+            what += f"; its jump at zero is the probability of {'not pounding' if self.event == 'pounding' else 'no wall hit'}"
         if reference is not None:
             what += f", with the fixed-base twin's ({self.studied} alone on a fixed base under the same realizations, dashed)"
         return self.facet_figures(
@@ -277,12 +288,13 @@ class Ensemble:
         counts = np.unique(np.round(np.geomspace(MIN_RUNS, self.size, CONVERGENCE_POINTS)).astype(int))
         panels = self._slowest_panels(line_dim)
         cut = {d: v for d, v in panels.items() if len(v) < len(self.grid[d])}
-        which = ("; only the panels whose P(pounding) is nearest 0.5, the slowest to settle: "
+        hit = self.probability_label
+        which = (f"; only the panels whose {hit} is nearest 0.5, the slowest to settle: "
                  + "; ".join(f"{dim_text(d)} {', '.join(value_text(d, x) for x in v)}" for d, v in cut.items())) if cut else ""
         items = []
         running = {
             "pounding": (of_first(lambda first: pounding_probability(first, confidence=self.confidence), self.sample("impacts"), counts),
-                         "probability", 1.0, "P(pounding)", "Clopper–Pearson"),
+                         "probability", 1.0, hit, "Clopper–Pearson"),
             "peak": (of_first(lambda first: mean_interval(first, confidence=self.confidence, method="bootstrap"), self.sample(PEAK_DISPLACEMENT.variable), counts),
                      "mean", CM, "mean peak total displacement (cm)", "percentile-bootstrap"),
         }

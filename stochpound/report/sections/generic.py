@@ -23,6 +23,7 @@ from stochpound.report.sections.ensemble_findings import compare_ensembles, ense
 from stochpound.report.sections.ensembles import Ensemble
 from stochpound.report.sections.mechanism_findings import mechanism_findings
 from stochpound.experiment.definition import is_gap_axis
+from stochpound.experiment.selections import wall_gap_dims
 from stochpound.report.sections.facets import dim_text, labels_text, layouts, line_colours, plain, value_text, cell_gid
 
 CM = 100.0
@@ -50,15 +51,17 @@ AGAINST = {
 def store_section(name: str, store: xr.Dataset, contact_free: bool = False, whole: xr.Dataset | None = None) -> Section:
     """A section for one store: description, its records' cases, its ensembles.
 
-    ``contact_free``: ``store`` is a store's cases with contacts, its
-    contact-free (``inf``) gap values left for the Separation section; the
-    dimensions then count them, and say so. ``whole``: the whole store (its
-    contact-free cases included), whose mechanism findings compare the cases
+    ``contact_free``: ``store`` is a store's cases with contacts (or walls
+    reached), its contact-free (wall-free) ``inf`` gap values left for the
+    Separation section; the dimensions then count them, and say so.
+    ``whole``: the whole store (its contact-free and wall-free cases included), whose mechanism findings compare the cases
     with their twins without impacts (:mod:`stochpound.report.sections.mechanism_findings`);
     ``store`` itself if not given.
     """
     section = Section(f"Experiment {name}", key=f"experiment-{name}")
-    dims = [f"{d} ({store.sizes[d] + 1}: {store.sizes[d]} gaps here and the contact-free one of the Separation section)" if contact_free and is_gap_axis(d)
+    walls = wall_gap_dims(store)
+    dims = [f"{d} ({store.sizes[d] + 1}: {store.sizes[d]} {'clearances' if d in walls else 'gaps'} here and the "
+            f"{'wall-free one of the Moat clearance' if d in walls else 'contact-free one of the Separation'} section)" if contact_free and is_gap_axis(d)
             else f"{d} ({store.sizes[d]})" for d in store["case_status"].dims]
     section.add(Paragraph(
         f"{store.attrs.get('experiment_description', '')} Studied building: {store.attrs.get('studied_building', '')}; its "

@@ -7,10 +7,12 @@ store, each run against its twin (the same motion without the impact elements):
   ratchets the studied building's sliding base, where it does not, and
   how much it raises its peak floor acceleration and storey drift (when
   the store keeps demands);
-* with a variant axis whose values add walls beside a variant without
-  walls (a moat): how much each wall raises those demands over the same
-  motions without a wall, and how deep the stiff wall elements were
-  penetrated (``peak_wall_penetration``, the largest over the runs, and where).
+* with walls (a moat) and runs without them, either a gap axis over the
+  walls holding ``inf`` (walls never reached) or a variant axis whose
+  values add walls beside a variant without walls: how much a wall raises
+  those demands over the same motions without a wall, and how deep the
+  stiff wall elements were penetrated (``peak_wall_penetration``, the
+  largest over the runs, and where).
 
 A cell is stated only from at least :data:`~stochpound.analysis.intervals.MIN_RUNS`
 paired runs; a finding whose data the store lacks is left out, and a
@@ -25,8 +27,8 @@ import numpy as np
 import xarray as xr
 
 from stochpound.analysis.mechanisms import amplification, ratcheting
-from stochpound.experiment.definition import read_definition
-from stochpound.experiment.selections import contact_free, gap_dims, has_contact_free, isolated_mus, with_contacts
+from stochpound.experiment.definition import is_gap_axis, read_definition
+from stochpound.experiment.selections import contact_free, contact_gap_dims, has_contact_free, isolated_mus, wall_gap_dims, with_contacts
 from stochpound.report.render.document import Block, Paragraph
 from stochpound.report.sections.ensembles import CM, MIN_RUNS, Ensemble
 from stochpound.report.sections.facets import dim_text, labels_text, plain, value_text
@@ -53,6 +55,14 @@ def mechanism_findings(name: str, store: xr.Dataset, label: str) -> list[Block]:
     return blocks
 
 
+def _without_walls(axis: str, reference: Any) -> str:
+    """The runs without a wall in words: the variant without walls, or the walls never reached (clearance ∞)."""
+    if is_gap_axis(axis):
+        return f"the same motion with the walls never reached ({axis} = ∞)"
+    return f"the same motion without a wall ({axis} {reference})"
+
+
+
 def _comparisons(name: str, store: xr.Dataset, label: str) -> list[tuple[Ensemble, Ensemble, str, str]]:
     """(cells with impacts, their twins without, the cause in words, the twins in words) of ensemble ``label``: pounding against
     the contact-free twins, a wall against the variant without walls (those the store has)."""
@@ -64,18 +74,18 @@ def _comparisons(name: str, store: xr.Dataset, label: str) -> list[tuple[Ensembl
     if axis is not None:
         walls, reference = axis
         comparisons.append((_walled(name, store, label, axis), Ensemble(name, store.sel({walls: reference}, drop=True), label), "a wall",
-                            f"the same motion without a wall ({walls} {reference})"))
+                            _without_walls(walls, reference)))
     return comparisons
 
 
-def _walled(name: str, store: xr.Dataset, label: str, axis: tuple[str, str] | None) -> Ensemble:
+def _walled(name: str, store: xr.Dataset, label: str, axis: tuple[str, Any] | None) -> Ensemble:
     """Ensemble ``label`` of the store's cells with walls (without the wall axis's value without walls, if any)."""
     return Ensemble(name, store if axis is None else store.drop_sel({axis[0]: axis[1]}), label)
 
 
 def has_twins(store: xr.Dataset) -> bool:
     """Whether ``store`` has cells with contacts and their contact-free twins (a gap axis holding ``inf`` and finite gaps)."""
-    return has_contact_free(store) and all(with_contacts(store).sizes[d] for d in gap_dims(store))
+    return has_contact_free(store) and all(with_contacts(store).sizes[d] for d in contact_gap_dims(store))
 
 
 def ratcheting_of(pounding: Ensemble, free: Ensemble, away: int) -> xr.Dataset:
@@ -143,8 +153,14 @@ def away_from_neighbour(store: xr.Dataset, building: str) -> int | None:
     return None
 
 
-def wall_axis(store: xr.Dataset) -> tuple[str, str] | None:
-    """(variant axis, its first value without walls) when the base scene has no wall and the axis's other values add some; else None."""
+def wall_axis(store: xr.Dataset) -> tuple[str, Any] | None:
+    """The axis that sets walls and its value without a wall reached: a gap axis over the walls only holding ``inf`` and
+    finite clearances (``(axis, inf)``), or a variant axis whose first value without walls is the reference when the base
+    scene has no wall and the axis's other values add some; else None."""
+    for axis in wall_gap_dims(store):
+        values = store[axis].values
+        if np.isinf(values).any() and np.isfinite(values).any():
+            return axis, float(np.inf)
     definition = read_definition(store)
     if definition.scene.get("wall"):
         return None
@@ -274,7 +290,7 @@ def amplification_text(impacts: Ensemble, twins: Ensemble, variable: str, cause:
 
 def penetration_text(ensemble: Ensemble, walls: str | None) -> str:
     """The largest penetration of the walls over the runs of ``ensemble`` (its cells with walls), and where, also per value of the
-    variant axis ``walls`` that adds them (if any): what a 'rigid' wall is here."""
+    axis ``walls`` that adds them or sets their clearance (if any): what a 'rigid' wall is here."""
     penetration = ensemble.sample("peak_wall_penetration")
     definition = read_definition(ensemble.data)
     tables = list(definition.scene.get("wall", [])) + [w for axis in definition.variants for override in axis.overrides.values()
@@ -287,7 +303,7 @@ def penetration_text(ensemble: Ensemble, walls: str | None) -> str:
     at = {d: plain(where[d].values[0]) for d in where.dims}
     largest = float(penetration.max())
     per_wall = "" if walls is None else (f"; the largest per value of {walls}: "
-                                         + "; ".join(f"{plain(v)}: {float(penetration.sel({walls: v}).max()) * CM:.3g} cm" for v in penetration[walls].values))
+                                         + "; ".join(f"{value_text(walls, plain(v))}: {float(penetration.sel({walls: v}).max()) * CM:.3g} cm" for v in penetration[walls].values))
     return (
         f"Wall penetration ({ensemble.label}, {ensemble.studied}): a 'rigid' wall is here a stiff impact element"
         + (f" (k = {', '.join(f'{k / 1e6:.4g}' for k in stiffness)} MN/m)" if stiffness else "")

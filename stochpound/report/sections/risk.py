@@ -33,7 +33,7 @@ from matplotlib.figure import Figure
 from stochpound.analysis import HazardCurve, demand_hazard_curve, fragility_band, fragility_surface, rate_from_probability
 from stochpound.analysis.fragility_ensemble import BOOTSTRAP
 from stochpound.analysis.risk import TARGETS
-from stochpound.analysis.gap_axes import contact_free
+from stochpound.analysis.gap_axes import contact_free, wall_free
 from stochpound.analysis.store_risk import StoreRisk, base_displacement, store_motions, store_risk
 from stochpound.experiment.definition import read_definition
 from stochpound.experiment.hazard import stored_hazard, stored_hazard_entry
@@ -402,7 +402,7 @@ def _demand_blocks(name: str, store: xr.Dataset, risk: StoreRisk, setting: dict[
     """Demand hazard curves of a stripes store: base displacement (and the moat walls' clearance), drift, floor acceleration."""
     if "intensity" not in store.dims:
         return []
-    free = contact_free(store)
+    free = wall_free(contact_free(store))  # the runs without impacts: contacts open, walls never reached
     studied = store.attrs.get("studied_building")
     demands: dict[str, tuple[xr.DataArray, str]] = {}
     sliding = base_displacement(free, studied)
@@ -445,13 +445,16 @@ def _demand_blocks(name: str, store: xr.Dataset, risk: StoreRisk, setting: dict[
 
 
 def _moat_clearances(store: xr.Dataset, studied: str | None) -> list[float]:
-    """The distinct gaps of the walls at the studied building's base in the definition (its scene and its variants)."""
-    definition = read_definition(store).to_dict()
-    walls = list(definition.get("scene", {}).get("wall", []))
-    for variant in definition.get("variants", []):
-        for override in variant.get("overrides", {}).values():
-            walls += override.get("scene", {}).get("wall", []) or []
-    return sorted({float(w["gap"]) for w in walls if w.get("building") == studied and w.get("level", 0) == 0 and math.isfinite(float(w["gap"]))})
+    """The distinct gaps of the walls at the studied building's base in the definition (its scene, with the values of a gap axis
+    that sets a wall instead of its own gap, and its variants), finite ones only."""
+    definition = read_definition(store)
+    walls = [(w, axis.values if axis is not None else (w["gap"],)) for w, axis in
+             ((w, definition.wall_gap_axis(index)) for index, w in enumerate(definition.scene.get("wall", [])))]
+    for variant in definition.variants:
+        for override in variant.overrides.values():
+            walls += [(w, (w["gap"],)) for w in override.get("scene", {}).get("wall", []) or []]
+    return sorted({float(gap) for w, gaps in walls for gap in gaps
+                   if w.get("building") == studied and w.get("level", 0) == 0 and math.isfinite(float(gap))})
 
 
 def _moat_table(name: str, sliding: xr.DataArray, clearances: list[float], hz: HazardCurve) -> Table:

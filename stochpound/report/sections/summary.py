@@ -33,8 +33,8 @@ from stochpound.report.render.document import Block, Paragraph, Section, Table
 from stochpound.report.sections.ensembles import MIN_RUNS, Ensemble
 from stochpound.report.sections.facets import dim_text, labels_text, value_text
 from stochpound.report.sections.mechanism_findings import mechanism_answer
-from stochpound.experiment.selections import gap_dims, has_contact_free, with_contacts
-from stochpound.report.sections.separation import SeparationEnsemble, span_cm
+from stochpound.experiment.selections import gap_dims, has_contact_free, has_wall_free, wall_gap_dims, with_contacts, with_walls
+from stochpound.report.sections.separation import CONTACTS, WALLS, Closure, SeparationEnsemble, span, span_cm
 
 CM = 100.0
 SEPARATION_TARGETS = (0.05, 0.01)
@@ -53,16 +53,20 @@ def experiment_summary(stores: dict[str, xr.Dataset], sections: list[Section], c
         summary.add(Paragraph(f"Experiment {name}{': ' + description if description else ''}. The questions its runs answer:".replace(".. ", ". ")))
         kinds = dict(zip(store["record"].values.tolist(), store["record_kind"].values.tolist()))
         ensembles = [label for label, kind in kinds.items() if kind == "synthetic"]
+        if has_wall_free(store) and ensembles:
+            summary.add(Paragraph(_clearance_answer(name, store, ensembles, confidence)))
         if has_contact_free(store) and ensembles:
             summary.add(Paragraph(_separation_answer(name, store, ensembles, confidence)))
-        finite = with_contacts(store) if has_contact_free(store) else store
+        finite = _finite(store)
         axes = [d for d in gap_dims(store) if finite.sizes[d]]
         if ensembles and axes:
+            closure = WALLS if axes[0] in wall_gap_dims(store) else CONTACTS
             summary.add(Paragraph(
-                f"How likely is pounding at the grid's gaps? The table below gives, at each gap of the grid, P(pounding) over the "
-                f"cells of each ensemble (the lowest and the highest cell) with the highest upper {confidence:.0%} Clopper–Pearson bound."
+                f"How likely is {'a wall hit' if closure.walls else 'pounding'} at the grid's {closure.gap}s? The table below gives, at each "
+                f"{closure.gap} of the grid, the fraction of its runs with {'a wall hit' if closure.walls else 'pounding'}, P({closure.event}), "
+                f"over the cells of each ensemble (the lowest and the highest cell) with the highest upper {confidence:.0%} Clopper–Pearson bound."
             ))
-            summary.add(_probability_table(name, finite, ensembles, axes[0], confidence))
+            summary.add(_probability_table(name, finite, ensembles, axes[0], confidence, closure))
         records = [label for label, kind in kinds.items() if kind != "synthetic"]
         if records and len(axes) == len(gap_dims(store)) and "intensity" not in store.dims:
             # with no finite gap there is nothing to count; over intensity stripes the Intensity and Risk sections answer
@@ -75,6 +79,46 @@ def experiment_summary(stores: dict[str, xr.Dataset], sections: list[Section], c
                 summary.add(block)
         summary.add(Paragraph(_where(name, sections)))
     return summary
+
+
+def _finite(store: xr.Dataset) -> xr.Dataset:
+    """The store's runs at finite gaps and clearances: its contact-free and wall-free runs left out (those it has)."""
+    finite = with_contacts(store) if has_contact_free(store) else store
+    return with_walls(finite) if has_wall_free(store) else finite
+
+
+def _clearance_answer(name: str, store: xr.Dataset, ensembles: list[str], confidence: float) -> str:
+    """How likely a wall hit is at each clearance of the grid, from the wall-free runs (against the runs there), and the clearance
+    for each target probability with its upper bound, per ensemble over its cells."""
+    parts = []
+    for label in ensembles:
+        separation = SeparationEnsemble(name, store, label, confidence, closure=WALLS)
+        needed = required_separation(separation.demand, SEPARATION_TARGETS, confidence=confidence, contact_dim=None).compute()
+        n, cells = int(needed["realizations"].min()), int(needed["separation"].isel(probability=0).size)
+        few = f"; fewer than {MIN_RUNS}, so indicative only" if n < MIN_RUNS else ""
+        text = f"ensemble {label} ({n} wall-free realizations in each of {cells} cells{few}): "
+        axis = separation.gap_axis
+        if axis is not None:
+            curve, direct = separation.curve_at_grid(), separation.hit_probability()
+            at = []
+            for c in curve[axis].values:
+                cell = curve.sel({axis: c})
+                at.append(f"{value_text(axis, c)}: {span(cell['probability'])} (upper bound {span(cell['upper'])}; runs there {span(direct['probability'].sel({axis: c}))})")
+            text += "P(wall hit | c) = P(D ≥ c) at " + "; ".join(at) + ". "
+        answers = []
+        for p in SEPARATION_TARGETS:
+            estimate, upper = needed["separation"].sel(probability=p), needed["upper"].sel(probability=p)
+            answer = f"P(wall hit) ≤ {p:.0%} needs a clearance of {span_cm(estimate)}{_extremes(estimate)}"
+            missing = int(upper.isnull().sum())
+            if missing < upper.size:
+                answer += f", upper {confidence:.0%} bound {span_cm(upper)}"
+            if missing:
+                answer += (f" (no upper bound in {missing} of {cells} cells: {n} realizations are too few, it needs "
+                           f"(1 − p)ⁿ ≤ {(1 - confidence) / 2:g})")
+            answers.append(answer)
+        parts.append(text + "; ".join(answers))
+    return ("How likely is the moat wall hit at each clearance c, and what clearance keeps it rare? From the wall-free runs "
+            "(clearance ∞, the closure toward the walls located), D the largest closure toward a wall: " + "; ".join(parts) + ".")
 
 
 def _separation_answer(name: str, store: xr.Dataset, ensembles: list[str], confidence: float) -> str:
@@ -102,7 +146,7 @@ def _separation_answer(name: str, store: xr.Dataset, ensembles: list[str], confi
 
 def _records_answer(store: xr.Dataset, records: list[str]) -> str:
     """What the records' cases answer: in how many cases each record pounded (one realization each: no probability)."""
-    finite = with_contacts(store) if has_contact_free(store) else store
+    finite = _finite(store)
     impacts = finite["impacts"].sel(record=records).isel(realization=0)
     done = (finite["case_status"].sel(record=records).isel(realization=0) == 1)
     counts = "; ".join(f"{label}: {int(((impacts.sel(record=label) > 0) & done.sel(record=label)).sum())} of {int(done.sel(record=label).sum())}"
@@ -125,11 +169,11 @@ def _extremes(values: xr.DataArray) -> str:
     return f" (smallest at {labels(low)}, largest at {labels(high)})"
 
 
-def _probability_table(name: str, store: xr.Dataset, ensembles: list[str], axis: str, confidence: float) -> Table:
-    """P(pounding) at each gap of the grid, per ensemble: its range over the other cells and the highest upper bound."""
+def _probability_table(name: str, store: xr.Dataset, ensembles: list[str], axis: str, confidence: float, closure: Closure) -> Table:
+    """P(pounding) (P(wall hit)) at each gap (clearance) of the grid, per ensemble: its range over the other cells and the highest upper bound."""
     rows = {}
     for label in ensembles:
-        impacts = Ensemble(name, store, label, confidence).data["impacts"]
+        impacts = Ensemble(name, store, label, confidence).data[closure.events]
         probability = pounding_probability(impacts, confidence=confidence).compute()
         others = [d for d in probability["probability"].dims if d != axis]
         for gap in probability[axis].values:
@@ -140,8 +184,9 @@ def _probability_table(name: str, store: xr.Dataset, ensembles: list[str], axis:
     frame = pd.DataFrame.from_dict(rows, orient="index", columns=["cells", "n", "P lowest", "P highest", "highest upper bound"])
     frame.index = pd.MultiIndex.from_tuples(list(rows), names=["ensemble", dim_text(axis)])
     return Table(
-        key=f"table-{name}-summary-pounding",
-        caption=f"Experiment {name}: the probability of pounding at each gap of the grid, over the cells ({cells}) of each ensemble.",
+        key=f"table-{name}-summary-{'wall-hit' if closure.walls else 'pounding'}",
+        caption=(f"Experiment {name}: the probability of {'a wall hit' if closure.walls else 'pounding'} at each {closure.gap} of the grid, "
+                 f"over the cells ({cells}) of each ensemble."),
         frame=frame,
         note=f"n: realizations per cell (the fewest); bounds: {confidence:.0%} Clopper–Pearson (exact binomial). Per-cell values: the appendix.",
         formats={"cells": "{:.0f}", "n": "{:.0f}", "P lowest": "{:.3f}", "P highest": "{:.3f}", "highest upper bound": "{:.3f}"},
@@ -150,7 +195,7 @@ def _probability_table(name: str, store: xr.Dataset, ensembles: list[str], axis:
 
 def _where(name: str, sections: list[Section]) -> str:
     """Where the details of experiment ``name`` are: its sections by number (the summary is section 1) and title."""
-    wanted = {f"experiment-{name}", f"separation-{name}", "appendix", "methods"}
+    wanted = {f"experiment-{name}", f"clearance-{name}", f"separation-{name}", "appendix", "methods"}
     found = [f"section {number} ({section.title})" for number, section in enumerate(sections, start=2) if section.key in wanted]
     return "Details: " + ", ".join(found) + "."
 
