@@ -114,7 +114,7 @@ def test_the_largest_wall_penetration_is_the_closed_form_of_one_kelvin_collision
 
 def test_a_case_s_wall_penetration_is_its_walls_located_peak_beyond_the_gap():
     """Hit walls: the peak closure beyond the gap; unreached walls: 0; no walls: NaN (the summary of a case, both ways)."""
-    from stochpound.experiment.summary import case_summary, case_values
+    from stochpound.experiment._summary import case_summary, case_values
 
     hit, far = run(moat(gap=0.02)), run(moat(gap=1.0))
     alone = moat()
