@@ -168,9 +168,9 @@ def _environment() -> dict[str, str]:
 
 def _done(store: Path) -> int:
     """Finished cases in a store's parts."""
-    from stochpound.experiment.grid import Experiment
-    from stochpound.experiment.parts import parts_folder, read_definition
-    from stochpound.experiment.store_writer import PartsIndex
+    from stochpound.experiment._grid import Experiment
+    from stochpound.experiment._parts import parts_folder, read_definition
+    from stochpound.experiment._store_writer import PartsIndex
 
     folder = parts_folder(store)
     try:

@@ -300,9 +300,9 @@ def guarded(call: Callable[[], dict[str, Any]]) -> dict[str, Any]:
 
 
 def ensemble_available() -> bool:
-    """Whether ``stochpound.experiment.ensemble.simulate_ensemble`` exists in this tree."""
+    """Whether ``stochpound.experiment._ensemble.simulate_ensemble`` exists in this tree."""
     try:
-        from stochpound.experiment.ensemble import simulate_ensemble  # noqa: F401
+        from stochpound.experiment._ensemble import simulate_ensemble  # noqa: F401
     except ImportError:
         return False
     return True
@@ -401,7 +401,7 @@ def run_all(config: Config, log: Callable[[str], None] = print) -> Results:
     log("first-call compile time")
     compiled = compile_time(config) if config.compile_time else None
     has_ensemble = ensemble_available()
-    missing = {"error": "stochpound.experiment.ensemble.simulate_ensemble is not available in this tree"}
+    missing = {"error": "stochpound.experiment._ensemble.simulate_ensemble is not available in this tree"}
     log("ensemble throughput")
     ensemble = ensemble_throughput(config) if has_ensemble else missing
     log("ensemble memory")

@@ -64,7 +64,7 @@ def constructed_impacts() -> xr.Dataset:
     right_velocity = np.array([0.10, -0.15, -0.25])  # same way, towards each other, same way (both left)
     start = np.array([1.0, 2.0, 3.0])
     end = np.array([1.05, 2.02, 3.08])
-    from stochpound.analysis.impacts import in_phase
+    from stochpound.analysis._impacts import in_phase
 
     return xr.Dataset(
         {

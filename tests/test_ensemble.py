@@ -13,7 +13,7 @@ import xarray as xr
 
 import stochpound
 from stochpound import motions as synthetic
-from stochpound.experiment.ensemble import simulate_ensemble
+from stochpound.experiment._ensemble import simulate_ensemble
 from stochpound.motions.ground import SampledMotion
 from tests.conftest import study_scene
 
@@ -73,7 +73,7 @@ import sys
 import numpy as np
 import stochpound
 from stochpound import motions as synthetic
-from stochpound.experiment.ensemble import simulate_ensemble
+from stochpound.experiment._ensemble import simulate_ensemble
 from tests.conftest import study_scene
 
 scene = stochpound.scene_from_dict(study_scene(0.1, 0.1, 0.5, gap=0.01))

@@ -16,8 +16,8 @@ import pytest
 import xarray as xr
 
 from stochpound import open_store
-from stochpound.experiment.parts import part_paths, parts_folder
-from stochpound.experiment.session import PACKAGE, git_commit, sources_sha256
+from stochpound.experiment._parts import part_paths, parts_folder
+from stochpound.experiment._session import PACKAGE, git_commit, sources_sha256
 from tests.test_experiment_helpers import REPO, SMALL_EXPERIMENT, invoke, quickstart_cell, read_only, write_experiment
 
 #: One cell of the quick-start grid under a short harmonic motion, solved by ivp: a small, quick experiment.
@@ -105,7 +105,7 @@ def test_an_installed_copy_records_its_version_and_sources(tmp_path):
     with xr.open_dataset(tmp_path / "tiny.nc") as store:
         assert store.attrs["git_commit"] == "none"
         assert store.attrs["stochpound_sources_sha256"] == sources_sha256(copy)
-    (copy / "memory.py").write_text((copy / "memory.py").read_text() + "\n# changed\n")
+    (copy / "_memory.py").write_text((copy / "_memory.py").read_text() + "\n# changed\n")
     sources_sha256.cache_clear()
     assert sources_sha256(copy) != sources_sha256(PACKAGE)
 
@@ -318,7 +318,7 @@ def test_the_help_is_whole_and_the_bare_command_prints_it():
 
 def test_experiment_error_is_importable_from_the_package():
     import stochpound
-    from stochpound.experiment.spec import ExperimentError
+    from stochpound.experiment._spec import ExperimentError
 
     assert stochpound.ExperimentError is ExperimentError and "ExperimentError" in stochpound.__all__
 

@@ -13,9 +13,9 @@ import pytest
 import xarray as xr
 
 from stochpound.experiment import Experiment
-from stochpound.experiment.definition import FIXED_BASE, Definition, is_fixed_base, is_gap_axis, read_definition
-from stochpound.experiment.spec import ExperimentError, canonical_json, definition_sha256, load_definition, parse_experiment
-from stochpound.report.sections.facets import value_text
+from stochpound.experiment._definition import FIXED_BASE, Definition, is_fixed_base, is_gap_axis, read_definition
+from stochpound.experiment._spec import ExperimentError, canonical_json, definition_sha256, load_definition, parse_experiment
+from stochpound.report.sections._facets import value_text
 
 ROOT = Path(__file__).resolve().parents[1]
 EXPERIMENTS = sorted(p for p in (ROOT / "experiments").glob("**/*.toml") if "scenes" not in p.parts)
@@ -183,7 +183,7 @@ def test_gap_axis_wall_errors() -> None:
 
 def test_report_names_the_gap_axis_of_walls() -> None:
     """The report's table of contacts gives a wall's gap as the axis that sets it, read from the store's definition alone."""
-    from stochpound.report.sections.description import StoreDefinition, contacts_table
+    from stochpound.report.sections._description import StoreDefinition, contacts_table
 
     definition = parse_experiment(_moat({"mu": {"values": [0.05, 0.1], "buildings": ["B1"]}, "gap_wall": {"values": [0.05, 0.1, "inf"], "walls": [0, 1]}}))
     store = xr.Dataset(attrs={"definition": canonical_json(definition)})

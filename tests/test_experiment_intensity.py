@@ -17,12 +17,12 @@ import pytest
 from scipy.stats import binomtest
 
 from stochpound import open_store
-from stochpound.experiment.runner import load_experiment, run_experiment
-from stochpound.experiment.sources import resolve_motions
-from stochpound.experiment.spec import ExperimentError, load_definition, parse_experiment
+from stochpound.experiment._runner import load_experiment, run_experiment
+from stochpound.experiment._sources import resolve_motions
+from stochpound.experiment._spec import ExperimentError, load_definition, parse_experiment
 from stochpound.model.scene_file import scene_from_dict
-from stochpound.report.render.document import FigureItem, Table
-from stochpound.report.sections.intensity import intensity_section
+from stochpound.report.render._document import FigureItem, Table
+from stochpound.report.sections._intensity import intensity_section
 from stochpound.solvers.simulate import simulate
 from tests.test_experiment_helpers import write_experiment
 

@@ -9,7 +9,7 @@ import pytest
 
 import stochpound
 from stochpound.experiment import ExperimentError, load_experiment, open_store, run_experiment
-from stochpound.experiment.grid import CASE
+from stochpound.experiment._grid import CASE
 from tests.conftest import reference_building, study_contacts
 from tests.test_experiment_helpers import write_experiment
 

@@ -15,9 +15,9 @@ from pathlib import Path
 import pytest
 import xarray as xr
 
-from stochpound.atomic import temporaries
+from stochpound._atomic import temporaries
 from stochpound.experiment import load_experiment, run_experiment
-from stochpound.experiment.parts import part_paths, parts_folder
+from stochpound.experiment._parts import part_paths, parts_folder
 from tests.test_experiment_helpers import N_CASES, assert_same_results, cli, cli_process, done_cases, quickstart_cell, write_experiment
 
 

@@ -83,7 +83,7 @@ def test_gap_axis_accepts_inf_and_refuses_negative_and_nan(tmp_path):
 
 def test_report_has_a_separation_section_built_from_the_store(contact_free_store):
     from stochpound.report.assemble import assemble_report
-    from stochpound.report.render.document import FigureItem, Paragraph, Table
+    from stochpound.report.render._document import FigureItem, Paragraph, Table
 
     report = assemble_report([contact_free_store])
     keys = [section.key for section in report.sections]

@@ -10,8 +10,8 @@ import pytest
 
 import stochpound
 from stochpound.experiment import Experiment, ExperimentError, load_experiment, run_experiment
-from stochpound.experiment.sources import resolve_motions
-from stochpound.experiment.spec import parse_experiment
+from stochpound.experiment._sources import resolve_motions
+from stochpound.experiment._spec import parse_experiment
 from tests.test_experiment_helpers import N_CASES, SMALL_EXPERIMENT, cli, write_experiment
 
 

@@ -10,9 +10,9 @@ import pytest
 import xarray as xr
 
 import stochpound
-from stochpound.analysis.summary import top_floor_total_displacement
+from stochpound.analysis._summary import top_floor_total_displacement
 from stochpound.experiment import ExperimentError, load_experiment, open_store, run_experiment, store_status
-from stochpound.experiment.parts import FolderLock, parts_folder
+from stochpound.experiment._parts import FolderLock, parts_folder
 from tests.test_experiment_helpers import N_CASES, SMALL_EXPERIMENT, cli, write_experiment
 
 
@@ -148,7 +148,7 @@ def test_open_store_errors(tmp_path):
 
 @pytest.mark.parametrize("mu1, mu2", [(0.2, None), (None, None), (0.1, 0.1)])
 def test_numpy_summaries_equal_the_analysis_definitions(mu1, mu2):
-    from stochpound.experiment.summary import case_summary, case_values, reference_summary, reference_values, top_floor
+    from stochpound.experiment._summary import case_summary, case_values, reference_summary, reference_values, top_floor
     from tests.conftest import reference_building, study_scene
 
     motion = {"record": "el_centro_1940_study", "duration": 10.0}
@@ -178,7 +178,7 @@ def test_both_netcdf_engines_read_the_same_store(small_store):
 
 def test_a_large_ensemble_is_chunked_along_realization(tmp_path):
     """Blocks (and the file's chunks) of consecutive realizations; open_store keeps them as dask chunks."""
-    from stochpound.experiment.store import SUMMARY_BLOCK, block_shape, blocks
+    from stochpound.experiment._store import SUMMARY_BLOCK, block_shape, blocks
 
     assert block_shape((1, 1000000), SUMMARY_BLOCK) == (1, SUMMARY_BLOCK)
     assert block_shape((2, 3, 4, 1, 10), 50) == (1, 1, 4, 1, 10)
@@ -187,7 +187,7 @@ def test_a_large_ensemble_is_chunked_along_realization(tmp_path):
     text = SMALL_EXPERIMENT.replace("count = 2", "count = 300").replace("duration = 8.0\ndt = 0.02", "duration = 1.0\ndt = 0.02")
     text = text.replace("gap = [0.01, 0.02]", "gap = [0.01]\nneighbour = [\"stiff\"]").replace("values = [0.2, inf]", "values = [0.2]")
     path = write_experiment(tmp_path, text.replace('time_histories = ["total_displacement", "impact_force"]', ""))
-    import stochpound.experiment.store as layout
+    import stochpound.experiment._store as layout
 
     original = layout.SUMMARY_BLOCK
     layout.SUMMARY_BLOCK = 128
@@ -227,8 +227,8 @@ def test_the_store_is_written_under_a_lock_of_this_process_while_a_dask_client_i
     from distributed import Lock as DistributedLock
     from xarray.backends import H5NetCDFStore
 
-    from stochpound.experiment import store_writer
-    from stochpound.experiment.session import StoreSession
+    from stochpound.experiment import _store_writer as store_writer
+    from stochpound.experiment._session import StoreSession
 
     opened = []
 

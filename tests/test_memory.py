@@ -10,8 +10,8 @@ import pytest
 import xarray as xr
 
 import stochpound
-from stochpound.experiment.ensemble import simulate_ensemble
-from stochpound.memory import LIMIT_VARIABLE, MemoryLimitError, memory_limit, parse_size, physical_memory, sample_bytes
+from stochpound.experiment._ensemble import simulate_ensemble
+from stochpound._memory import LIMIT_VARIABLE, MemoryLimitError, memory_limit, parse_size, physical_memory, sample_bytes
 from tests.conftest import study_scene
 from tests.test_experiment_helpers import SMALL_EXPERIMENT, invoke, write_experiment
 

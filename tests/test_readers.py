@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from stochpound.errors import RecordError
+from stochpound._errors import RecordError
 from stochpound.motions.records import load_record, read_at2, read_record_file, read_text, records_dir, registry_entries
 
 

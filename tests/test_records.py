@@ -9,10 +9,10 @@ from decimal import Decimal
 import numpy as np
 import pytest
 
-from stochpound.data_files import bundled_data_dir
+from stochpound._data_files import bundled_data_dir
 import scipy.stats
 
-from stochpound.errors import RecordError
+from stochpound._errors import RecordError
 from stochpound.motions.records import (
     Record,
     arias_intensity,
@@ -24,8 +24,8 @@ from stochpound.motions.records import (
     registry_entries,
     study_table_3_2,
 )
-from stochpound.motions.records import registry as registry_module
-from stochpound.motions.records.readers import sha256_of
+from stochpound.motions.records import _registry as registry_module
+from stochpound.motions.records._readers import sha256_of
 
 STUDY_G = 9.814
 
@@ -202,7 +202,7 @@ def test_arias_intensity_of_a_sine():
 def _cli(*args):
     from click.testing import CliRunner
 
-    from stochpound.cli.records import records
+    from stochpound.cli._records import records
 
     return CliRunner().invoke(records, list(args))
 

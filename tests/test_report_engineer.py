@@ -20,7 +20,7 @@ import pytest
 from stochpound.analysis import separation_rules, store_contact_demands
 from stochpound.experiment import open_store
 from stochpound.report.assemble import assemble_report
-from stochpound.report.render.document import Paragraph, Table
+from stochpound.report.render._document import Paragraph, Table
 from stochpound.report.render.output import write_report
 from tests.test_experiment_helpers import run_in_process
 

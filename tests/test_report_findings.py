@@ -8,8 +8,8 @@ from types import SimpleNamespace
 import numpy as np
 import xarray as xr
 
-from stochpound.report.sections.ensemble_findings import isolation_across, isolation_effect, spread
-from stochpound.report.sections.ensembles import MIN_RUNS
+from stochpound.report.sections._ensemble_findings import isolation_across, isolation_effect, spread
+from stochpound.report.sections._ensembles import MIN_RUNS
 
 
 def _ensemble(label: str, p_isolated: dict[str, float], size: int = 200, forces: int = 0) -> SimpleNamespace:
@@ -61,7 +61,7 @@ def test_no_ratio_from_cells_with_too_few_runs():
 
 def test_convergence_starts_at_min_runs_in_a_handful_of_panels():
     """40 realizations on a 5 gaps × 3 μ grid: estimates at n = 30 … 40, in CONVERGENCE_PANELS panels, those nearest P = 0.5."""
-    from stochpound.report.sections.ensembles import CONVERGENCE_PANELS, Ensemble
+    from stochpound.report.sections._ensembles import CONVERGENCE_PANELS, Ensemble
 
     rng = np.random.default_rng(4)
     gaps, mus, n = [0.0, 0.01, 0.02, 0.04, 0.08], [0.1, 0.2, math.inf], 40

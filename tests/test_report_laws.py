@@ -8,9 +8,9 @@ import re
 import pytest
 
 from stochpound.experiment import load_experiment, open_store, run_experiment
-from stochpound.report.sections import laws as laws_report
+from stochpound.report.sections import _laws as laws_report
 from stochpound.report.assemble import assemble_report
-from stochpound.report.render.document import FigureItem, Paragraph
+from stochpound.report.render._document import FigureItem, Paragraph
 from tests.test_experiment_helpers import write_experiment
 
 REALIZATIONS = 5

@@ -15,7 +15,7 @@ from pathlib import Path
 
 import pytest
 
-from stochpound.errors import StochpoundError
+from stochpound._errors import StochpoundError
 from stochpound.studies import STUDIES, claims, parse_reproduces
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -18,13 +18,13 @@ from click.testing import CliRunner
 from matplotlib.figure import Figure
 
 from stochpound.cli import main
-from stochpound.cli import report as cli_report
-from stochpound.errors import StochpoundError
+from stochpound.cli import _report as cli_report
+from stochpound._errors import StochpoundError
 from stochpound.report.render import output
-from stochpound.report.render import pdf as pdf_layout
-from stochpound.report.render.document import FigureItem, Paragraph, Report, Section, Table
-from stochpound.report.render.html import render_html
-from stochpound.report.render.pdf import render_pdf
+from stochpound.report.render import _pdf as pdf_layout
+from stochpound.report.render._document import FigureItem, Paragraph, Report, Section, Table
+from stochpound.report.render._html import render_html
+from stochpound.report.render._pdf import render_pdf
 from tests.chromium import render_in_chromium, require_chromium
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"

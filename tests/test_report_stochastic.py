@@ -15,8 +15,8 @@ from scipy import stats
 from stochpound.analysis import ensemble_statistics
 from stochpound.experiment import open_store
 from stochpound.report.assemble import assemble_report
-from stochpound.report.render.document import FigureItem, Paragraph, Table
-from stochpound.report.sections.facets import cell_gid
+from stochpound.report.render._document import FigureItem, Paragraph, Table
+from stochpound.report.sections._facets import cell_gid
 from stochpound.report.render.output import write_report
 from tests.chromium import render_in_chromium, require_chromium
 from tests.test_experiment_helpers import run_in_process

@@ -16,12 +16,12 @@ import pytest
 import xarray as xr
 
 from stochpound.experiment import load_experiment, open_store, run_experiment
-from stochpound.experiment.spec import canonical_json
+from stochpound.experiment._spec import canonical_json
 from stochpound.report.assemble import assemble_report
-from stochpound.report.sections.generic import AGAINST
+from stochpound.report.sections._generic import AGAINST
 from stochpound.report.render.output import write_report
-from stochpound.studies.agarwal2004.published import published_tables
-from stochpound.studies.agarwal2004.tables import CORRECTED, DIFFERENCE, SPLINE, STUDY, STUDY_EQUATIONS
+from stochpound.studies.agarwal2004._published import published_tables
+from stochpound.studies.agarwal2004._tables import CORRECTED, DIFFERENCE, SPLINE, STUDY, STUDY_EQUATIONS
 from tests.chromium import render_in_chromium, require_chromium
 
 pytestmark = pytest.mark.slow  # builds the study report from every study experiment (about two minutes)
@@ -233,7 +233,7 @@ def test_the_study_report_renders_in_headless_chromium(built, tmp_path):
 def test_figure_3_6_draws_every_located_peak_its_caption_quotes(built, study_stores):
     gap = open_store(next(p for p in study_stores if p.stem == "gap_study"))
     case = {"neighbour": "flexible", "gap": 0.02, "mu": np.inf, "record": "el_centro", "realization": 0}
-    from stochpound.report.sections.stores import case_impacts
+    from stochpound.report.sections._stores import case_impacts
 
     impacts = case_impacts(gap, **case)
     item = built["figure_items"]["figure-3.6"]

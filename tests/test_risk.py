@@ -21,8 +21,8 @@ from stochpound.analysis import (
     separation_rules,
     stripe_fragility,
 )
-from stochpound.analysis import gap_axes
-from stochpound.experiment import selections
+from stochpound.analysis import _gap_axes as gap_axes
+from stochpound.experiment import _selections as selections
 
 
 def closed_form(k0, k, theta, beta):

@@ -24,13 +24,13 @@ from click.testing import CliRunner
 
 from stochpound import open_store
 from stochpound.analysis import HazardCurve, pounding_fragility
-from stochpound.analysis.store_risk import contact_free_closure, risk_gaps
+from stochpound.analysis._store_risk import contact_free_closure, risk_gaps
 from stochpound.cli import main
-from stochpound.experiment.hazard import hazard_curve, stored_hazard
-from stochpound.experiment.runner import load_experiment, run_experiment
-from stochpound.experiment.spec import ExperimentError, definition_sha256, load_definition, parse_experiment
-from stochpound.report.render.document import Paragraph, Table
-from stochpound.report.sections.risk import risk_headline, risk_of, risk_section
+from stochpound.experiment._hazard import hazard_curve, stored_hazard
+from stochpound.experiment._runner import load_experiment, run_experiment
+from stochpound.experiment._spec import ExperimentError, definition_sha256, load_definition, parse_experiment
+from stochpound.report.render._document import Paragraph, Table
+from stochpound.report.sections._risk import risk_headline, risk_of, risk_section
 from tests.test_experiment_helpers import write_experiment
 
 REPOSITORY = Path(__file__).resolve().parent.parent
@@ -262,7 +262,7 @@ def test_rules_table_is_indexed_by_the_grid_not_by_what_each_point_ran():
     """Coordinates that say what a grid point ran (base_mu, base_radius, contact_law ...) stay out of the table's index."""
     from types import SimpleNamespace
 
-    from stochpound.report.sections.risk import rules_frame
+    from stochpound.report.sections._risk import rules_frame
 
     shape = (1, 1, 2, 1)
     dims = ("design_level", "rule", "mu", "contact")

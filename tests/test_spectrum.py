@@ -18,7 +18,7 @@ from scipy.integrate import solve_ivp
 from scipy.optimize import minimize_scalar
 
 from stochpound.motions import intensity_measures, peak_ground_motion, response_spectrum, sa_avg, significant_duration
-from stochpound.motions.measures import arias_intensity
+from stochpound.motions._measures import arias_intensity
 from stochpound.motions.records import load_record
 
 RECORD = "el_centro_1940_ngaw2_rsn6"
@@ -185,7 +185,7 @@ def test_bad_input_names_the_field(kwargs, field):
 def test_cli_spectrum(tmp_path):
     from click.testing import CliRunner
 
-    from stochpound.cli.records import records
+    from stochpound.cli._records import records
 
     plot = tmp_path / "spectrum.png"
     result = CliRunner().invoke(records, ["spectrum", RECORD, "--periods", "0.1,1.0", "--plot", str(plot)])

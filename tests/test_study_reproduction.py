@@ -14,7 +14,7 @@ import pytest
 
 import stochpound
 from stochpound.analysis import moments, run_summary
-from stochpound.analysis.summary import top_floor_total_displacement
+from stochpound.analysis._summary import top_floor_total_displacement
 from tests.conftest import reference_building, study_scene
 
 STUDY_MOTION = {"record": "el_centro_1940_study", "interpolation": "spline"}

@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
-from stochpound.cli.records import records as records_cli
-from stochpound.errors import RecordError
+from stochpound.cli._records import records as records_cli
+from stochpound._errors import RecordError
 from stochpound.motions import intensity_measures
 from stochpound.motions.records import SUITES, load_record, load_suite, records_dir, suite_members
 

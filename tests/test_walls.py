@@ -114,7 +114,7 @@ def test_the_largest_wall_penetration_is_the_closed_form_of_one_kelvin_collision
 
 def test_a_case_s_wall_penetration_is_its_walls_located_peak_beyond_the_gap():
     """Hit walls: the peak closure beyond the gap; unreached walls: 0; no walls: NaN (the summary of a case, both ways)."""
-    from stochpound.experiment.summary import case_summary, case_values
+    from stochpound.experiment._summary import case_summary, case_values
 
     hit, far = run(moat(gap=0.02)), run(moat(gap=1.0))
     alone = moat()
@@ -132,7 +132,7 @@ def test_a_case_s_wall_penetration_is_its_walls_located_peak_beyond_the_gap():
 def test_a_case_s_largest_wall_closure_is_the_clearance_it_needed():
     """The largest located closure toward a wall over the walls, whatever their gap (inf included): a wall at a clearance
     below it is hit, one above it is not (the same motion); NaN without walls."""
-    from stochpound.experiment.summary import case_summary, case_values
+    from stochpound.experiment._summary import case_summary, case_values
 
     free = run(moat(gap=np.inf))
     twin = np.zeros(free.sizes["time"])

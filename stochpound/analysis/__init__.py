@@ -8,20 +8,20 @@ implementation, a numpy kernel of :mod:`stochpound.analysis.kernels`, which
 these functions apply with :func:`xarray.apply_ufunc`.
 """
 
-from stochpound.analysis.moments import moments
-from stochpound.analysis.correlation import correlation
-from stochpound.analysis.ensemble_statistics import ensemble_statistics
-from stochpound.analysis.histogram import normal_histogram
-from stochpound.analysis.impacts import impact_statistics
-from stochpound.analysis.intervals import mean_interval, of_first, quantiles, running_mean, running_pounding_probability
+from stochpound.analysis._moments import moments
+from stochpound.analysis._correlation import correlation
+from stochpound.analysis._ensemble_statistics import ensemble_statistics
+from stochpound.analysis._histogram import normal_histogram
+from stochpound.analysis._impacts import impact_statistics
+from stochpound.analysis._intervals import mean_interval, of_first, quantiles, running_mean, running_pounding_probability
 from stochpound.analysis.mechanisms import amplification, ratcheting
-from stochpound.analysis.peaks import peak_response
-from stochpound.analysis.pounding import pounding_probability
-from stochpound.analysis.separation import pounding_curve, required_separation, rule_exceedance
-from stochpound.analysis.separation_rules import contact_demands, fixed_base_cqc, separation_rules, store_contact_demands
-from stochpound.analysis.summary import run_summary
-from stochpound.analysis.fragility import Fragility, fit_fragility
-from stochpound.analysis.fragility_ensemble import (
+from stochpound.analysis._peaks import peak_response
+from stochpound.analysis._pounding import pounding_probability
+from stochpound.analysis._separation import pounding_curve, required_separation, rule_exceedance
+from stochpound.analysis._separation_rules import contact_demands, fixed_base_cqc, separation_rules, store_contact_demands
+from stochpound.analysis._summary import run_summary
+from stochpound.analysis._fragility import Fragility, fit_fragility
+from stochpound.analysis._fragility_ensemble import (
     fragility_band,
     fragility_surface,
     homogeneous_capacities,
@@ -29,10 +29,10 @@ from stochpound.analysis.fragility_ensemble import (
     limit_state_events,
     stripe_fragility,
 )
-from stochpound.analysis.hazard import HazardCurve, probability_from_rate, rate_from_probability, return_period
-from stochpound.analysis.risk import demand_hazard_curve, mean_annual_frequency, risk_curve, risk_targeted_separation
-from stochpound.analysis.code_rules_risk import code_rules_risk
-from stochpound.analysis.store_risk import StoreRisk, contact_free_closure, pounding_fragility, risk_gaps, store_risk
+from stochpound.analysis._hazard import HazardCurve, probability_from_rate, rate_from_probability, return_period
+from stochpound.analysis._risk import demand_hazard_curve, mean_annual_frequency, risk_curve, risk_targeted_separation
+from stochpound.analysis._code_rules_risk import code_rules_risk
+from stochpound.analysis._store_risk import StoreRisk, contact_free_closure, pounding_fragility, risk_gaps, store_risk
 
 __all__ = [
     "moments",

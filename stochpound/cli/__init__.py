@@ -3,7 +3,7 @@
 import click
 
 from stochpound import __version__
-from stochpound.cli.group import HelpGroup
+from stochpound.cli._group import HelpGroup
 
 
 @click.group(cls=HelpGroup, context_settings={"help_option_names": ["-h", "--help"]})
@@ -13,16 +13,16 @@ def main() -> None:
 
 
 def _register() -> None:
-    from stochpound.cli.simulate import simulate
+    from stochpound.cli._simulate import simulate
 
     main.add_command(simulate)
-    from stochpound.cli.records import records
+    from stochpound.cli._records import records
     main.add_command(records)
-    from stochpound.cli.experiment import experiment
+    from stochpound.cli._experiment import experiment
     main.add_command(experiment)
-    from stochpound.cli.report import report
+    from stochpound.cli._report import report
     main.add_command(report)
-    from stochpound.cli.risk import risk
+    from stochpound.cli._risk import risk
     main.add_command(risk)
 
 

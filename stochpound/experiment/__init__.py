@@ -8,7 +8,7 @@
 File format, store layout, resumption and clusters: ``docs/experiments.md``.
 """
 
-from stochpound.experiment.definition import (
+from stochpound.experiment._definition import (
     FIXED_BASE,
     Definition,
     GapAxis,
@@ -21,11 +21,11 @@ from stochpound.experiment.definition import (
     is_gap_axis,
     read_definition,
 )
-from stochpound.experiment.grid import Case, Dim, Experiment
-from stochpound.experiment.runner import RunReport, default_store, load_experiment, run_experiment
-from stochpound.experiment.spec import ExperimentError
-from stochpound.experiment.status import StatusReport, store_status
-from stochpound.experiment.store import open_store
+from stochpound.experiment._grid import Case, Dim, Experiment
+from stochpound.experiment._runner import RunReport, default_store, load_experiment, run_experiment
+from stochpound.experiment._spec import ExperimentError
+from stochpound.experiment._status import StatusReport, store_status
+from stochpound.experiment._store import open_store
 
 __all__ = [
     "FIXED_BASE",

@@ -18,7 +18,7 @@ from typing import Any, Mapping
 import numpy as np
 from scipy.linalg import eigh
 
-from stochpound.errors import SceneError
+from stochpound._errors import SceneError
 from stochpound.model import fields
 from stochpound.model.friction import Base, base_from_table
 

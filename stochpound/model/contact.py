@@ -27,7 +27,7 @@ from typing import Any, Mapping, Sequence
 
 import numpy as np
 
-from stochpound.errors import SceneError
+from stochpound._errors import SceneError
 from stochpound.model import fields, laws
 from stochpound.model.building import Building
 from stochpound.model.guards import Guard

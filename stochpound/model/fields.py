@@ -1,7 +1,7 @@
 """Reading fields of scene and experiment files (parsed TOML), with errors that name the field.
 
 Every reader takes the table, the key and the path of the table (``prefix``,
-e.g. ``building[0].base``) and raises :class:`~stochpound.errors.SceneError`
+e.g. ``building[0].base``) and raises :class:`~stochpound._errors.SceneError`
 whose message starts with the field's full path and says what is allowed,
 e.g. ``building[0].base.mu: must be >= 0, got -0.2``.
 """
@@ -11,7 +11,7 @@ from __future__ import annotations
 import math
 from typing import Any, Mapping
 
-from stochpound.errors import SceneError
+from stochpound._errors import SceneError
 
 
 def field_path(prefix: str, key: str) -> str:

@@ -32,7 +32,7 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from stochpound.errors import SceneError
+from stochpound._errors import SceneError
 from stochpound.model import coulomb, fields, laws, velocity_friction
 from stochpound.model.guards import Guard
 

@@ -8,7 +8,7 @@ defining its law object, one line here, its tests and its docs entry
 
 from __future__ import annotations
 
-from stochpound.errors import SceneError
+from stochpound._errors import SceneError
 from stochpound.model import coulomb, hertz, hertz_damp_exact, hertz_damp_ye, jankowski, kelvin, velocity_friction
 from stochpound.model.law import ContactLaw, FrictionLaw
 
@@ -22,7 +22,7 @@ FRICTION_LAWS: dict[str, FrictionLaw] = {law.name: law for law in (coulomb.COULO
 
 
 def contact_law(name: str, prefix: str = "law") -> ContactLaw:
-    """The contact law called ``name``; a :class:`~stochpound.errors.SceneError` at ``prefix`` naming the laws if there is none."""
+    """The contact law called ``name``; a :class:`~stochpound._errors.SceneError` at ``prefix`` naming the laws if there is none."""
     law = CONTACT_LAWS.get(name)
     if law is None:
         raise SceneError(f"{prefix}: must be one of {', '.join(CONTACT_LAWS)}; got {name!r}")

@@ -1,7 +1,7 @@
 """Scene files (TOML, docs/scene-files.md): parsing and validation into a :class:`~stochpound.model.scene.Scene`.
 
 Every field is checked before anything is computed. A bad field raises
-:class:`~stochpound.errors.SceneError` whose message starts with the field's
+:class:`~stochpound._errors.SceneError` whose message starts with the field's
 path (0-based indices), e.g. ``building[0].base.mu: must be >= 0, got -0.2``.
 """
 
@@ -15,8 +15,8 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from stochpound.errors import RecordError, SceneError
-from stochpound.memory import check_memory, sample_bytes
+from stochpound._errors import RecordError, SceneError
+from stochpound._memory import check_memory, sample_bytes
 from stochpound.model import fields
 from stochpound.model.building import buildings_from_tables
 from stochpound.model.contact import contact_from_table

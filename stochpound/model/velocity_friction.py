@@ -20,7 +20,7 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from stochpound.errors import SceneError
+from stochpound._errors import SceneError
 from stochpound.model import fields
 from stochpound.model.law import FrictionLaw
 

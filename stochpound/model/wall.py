@@ -27,7 +27,7 @@ from __future__ import annotations
 from dataclasses import asdict, dataclass
 from typing import Any, Mapping, Sequence
 
-from stochpound.errors import SceneError
+from stochpound._errors import SceneError
 from stochpound.model import fields
 from stochpound.model.building import Building
 from stochpound.model.contact import ELEMENT_KEYS, ImpactElement, element_from_table

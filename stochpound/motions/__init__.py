@@ -24,9 +24,9 @@ from stochpound.motions.envelopes import (
     make_envelope,
 )
 from stochpound.motions.generators import filter_samples, spectral_samples, stationary_samples
-from stochpound.motions.measures import intensity_measures, peak_ground_motion, sa_avg, significant_duration
+from stochpound.motions._measures import intensity_measures, peak_ground_motion, sa_avg, significant_duration
 from stochpound.motions.intensity import poisson_peak_factor, s0_from_pga, s0_from_rms, simulated_peak_factor
-from stochpound.motions.presets import SOIL_PRESETS, SoilPreset, soil_preset
+from stochpound.motions._presets import SOIL_PRESETS, SoilPreset, soil_preset
 from stochpound.motions.psd import (
     FilteredWhiteNoise,
     clough_penzien_model,
@@ -36,9 +36,9 @@ from stochpound.motions.psd import (
     kanai_tajimi_psd,
     kanai_tajimi_variance,
 )
-from stochpound.motions.seeding import realization_rng, realization_rngs
-from stochpound.motions.spectrum import response_spectrum
-from stochpound.motions.synthetic import PSD_CONVENTION, clough_penzien, kanai_tajimi, synthetic_ground_motion
+from stochpound.motions._seeding import realization_rng, realization_rngs
+from stochpound.motions._spectrum import response_spectrum
+from stochpound.motions._synthetic import PSD_CONVENTION, clough_penzien, kanai_tajimi, synthetic_ground_motion
 
 __all__ = [
     "ENVELOPES",

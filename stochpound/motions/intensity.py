@@ -100,7 +100,7 @@ def simulated_peak_factor(
 ) -> float:
     """Mean of max abs(a)/σ over a pilot ensemble (module docstring)."""
     from stochpound.motions.generators import stationary_samples
-    from stochpound.motions.seeding import realization_rngs
+    from stochpound.motions._seeding import realization_rngs
 
     unit = model.with_S0(1.0)
     e = np.asarray(envelope, dtype=float)

@@ -1,7 +1,7 @@
 """Reports of experiment stores, in HTML and PDF.
 
 * :mod:`stochpound.report.assemble`: the entry point (``stochpound report
-  build``), which builds a :class:`~stochpound.report.render.document.Report`
+  build``), which builds a :class:`~stochpound.report.render._document.Report`
   from stores;
 * :mod:`stochpound.report.render`: the document model and its formats (HTML,
   PDF, their layout, the figure kinds, writing the output folder);

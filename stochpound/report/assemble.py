@@ -5,7 +5,7 @@ study (``[experiment] reproduces = "<study>:<part>"``) is claimed by that
 study (:func:`stochpound.studies.claims`), which builds the study's sections
 (:mod:`stochpound.studies`); any other store gets sections of its own
 (:mod:`stochpound.report.sections`). Every report opens with a summary, the
-answers first (the study's, or :mod:`stochpound.report.sections.summary`);
+answers first (the study's, or :mod:`stochpound.report.sections._summary`);
 the report of experiments no study claims ends with an appendix of its
 per-cell tables.
 """
@@ -18,18 +18,18 @@ from pathlib import Path
 
 import xarray as xr
 
-from stochpound.experiment.definition import read_definition
-from stochpound.experiment.selections import has_contact_free, has_wall_free, with_contacts, with_walls
-from stochpound.report.render.document import Paragraph, Report, Section
-from stochpound.report.sections.ensembles import INTERVAL_NOTE
-from stochpound.report.sections.generic import store_section
-from stochpound.report.sections.intensity import intensity_section, intensity_setting
-from stochpound.report.sections.laws import law_axis, laws_section
-from stochpound.report.sections.methods import methods_section
-from stochpound.report.sections.risk import has_risk, risk_section
-from stochpound.report.sections.separation import WALLS, separation_section
-from stochpound.report.sections.stores import open_stores
-from stochpound.report.sections.summary import experiment_summary, move_per_cell_tables
+from stochpound.experiment._definition import read_definition
+from stochpound.experiment._selections import has_contact_free, has_wall_free, with_contacts, with_walls
+from stochpound.report.render._document import Paragraph, Report, Section
+from stochpound.report.sections._ensembles import INTERVAL_NOTE
+from stochpound.report.sections._generic import store_section
+from stochpound.report.sections._intensity import intensity_section, intensity_setting
+from stochpound.report.sections._laws import law_axis, laws_section
+from stochpound.report.sections._methods import methods_section
+from stochpound.report.sections._risk import has_risk, risk_section
+from stochpound.report.sections._separation import WALLS, separation_section
+from stochpound.report.sections._stores import open_stores
+from stochpound.report.sections._summary import experiment_summary, move_per_cell_tables
 from stochpound.studies import claims, load_study
 
 

@@ -14,7 +14,7 @@ import numpy as np
 import xarray as xr
 
 from stochpound import __version__
-from stochpound.atomic import replacing
+from stochpound._atomic import replacing
 from stochpound.results.record import ENERGY_TERMS, EventCounters, Recorder
 from stochpound.model.contact import ImpactElement
 from stochpound.model.friction import FIXED_BASE
@@ -289,7 +289,7 @@ def write_dataset(dataset: xr.Dataset, path: str | Path) -> Path:
     """Write ``dataset`` as netCDF4/HDF5 atomically (a temporary file renamed into place).
 
     An interrupted write never leaves a partial file at ``path``; the file's
-    permissions follow the umask (``stochpound.atomic``).
+    permissions follow the umask (``stochpound._atomic``).
     """
     path = Path(path)
     with replacing(path) as temporary:

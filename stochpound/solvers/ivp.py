@@ -21,7 +21,7 @@ from numpy.polynomial import chebyshev
 from scipy.integrate import BDF, DOP853, LSODA, RK23, RK45, Radau
 from threadpoolctl import threadpool_limits
 
-from stochpound.errors import StochpoundError
+from stochpound._errors import StochpoundError
 from stochpound.model.modes import Mode, ModeDynamics, ModeLibrary
 from stochpound.model.readouts import Readouts
 from stochpound.model.scene import Scene

@@ -59,7 +59,7 @@ from functools import cache, partial
 import numpy as np
 from scipy.linalg import matrix_balance
 
-from stochpound.errors import StochpoundError
+from stochpound._errors import StochpoundError
 from stochpound.model.modes import BoundedCache, Mode, ModeDynamics, ModeLibrary, array_bytes
 from stochpound.motions.ground import GroundMotion, HarmonicMotion, SampledMotion
 from stochpound.model.system import System

@@ -26,12 +26,12 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, Protocol
 
-from stochpound.errors import StochpoundError
+from stochpound._errors import StochpoundError
 
 if TYPE_CHECKING:
     import xarray as xr
 
-    from stochpound.report.render.document import Block, Section
+    from stochpound.report.render._document import Block, Section
 
 __all__ = ["STUDIES", "Study", "StudyReport", "claims", "parse_reproduces", "load_study"]
 

@@ -7,9 +7,9 @@
 See ``docs/records.md`` for the names, the formats and the conventions.
 """
 
-from stochpound.motions.records.readers import RawSeries, read_at2, read_record_file, read_text
-from stochpound.motions.records.record import Record, normalize_units
-from stochpound.motions.records.registry import (
+from stochpound.motions.records._readers import RawSeries, read_at2, read_record_file, read_text
+from stochpound.motions.records._record import Record, normalize_units
+from stochpound.motions.records._registry import (
     RegistryEntry,
     list_records,
     load_record,
@@ -17,8 +17,8 @@ from stochpound.motions.records.registry import (
     registry_entries,
     study_table_3_2,
 )
-from stochpound.motions.records.suites import SUITES, list_suites, load_suite, load_suite_member, suite_members
-from stochpound.motions.records.statistics import (
+from stochpound.motions.records._suites import SUITES, list_suites, load_suite, load_suite_member, suite_members
+from stochpound.motions.records._statistics import (
     STUDY_G,
     RecordStatistics,
     arias_intensity,

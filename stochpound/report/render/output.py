@@ -1,11 +1,11 @@
-"""Write a :class:`~stochpound.report.render.document.Report` to a folder: figures, tables, HTML page, PDF.
+"""Write a :class:`~stochpound.report.render._document.Report` to a folder: figures, tables, HTML page, PDF.
 
 Layout of the folder::
 
     figures/<key>.png   every figure (the same bytes are embedded in index.html)
     tables/<key>.csv    every table's numbers (not rounded)
-    index.html          the self-contained page (stochpound.report.render.html)
-    report.pdf          the A4 document (stochpound.report.render.pdf)
+    index.html          the self-contained page (stochpound.report.render._html)
+    report.pdf          the A4 document (stochpound.report.render._pdf)
     .stochpound-report.json   the figure and table files this build wrote
 
 Every file is written to a temporary name and then renamed, so an
@@ -28,10 +28,10 @@ from typing import Callable, Iterator, Sequence
 
 import matplotlib.pyplot as plt
 
-from stochpound.atomic import check_writable
-from stochpound.report.render.document import Report
-from stochpound.report.render.html import render_html
-from stochpound.report.render.pdf import render_pdf
+from stochpound._atomic import check_writable
+from stochpound.report.render._document import Report
+from stochpound.report.render._html import render_html
+from stochpound.report.render._pdf import render_pdf
 
 FORMATS = ("html", "pdf")
 FILE_NAMES = {"html": "index.html", "pdf": "report.pdf"}

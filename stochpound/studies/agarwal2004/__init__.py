@@ -3,12 +3,12 @@
 The stores of ``experiments/study/*.toml`` declare the part of the study each
 reproduces (``[experiment] reproduces = "agarwal2004:<part>"``, the parts of
 :data:`stochpound.studies.STUDIES`); the report hands them here by part. The
-study's tables and figures (:mod:`~stochpound.studies.agarwal2004.tables`,
-:mod:`~stochpound.studies.agarwal2004.figures`), beside its published values
-(:mod:`~stochpound.studies.agarwal2004.published`), with its conclusions
-checked (:mod:`~stochpound.studies.agarwal2004.findings`) and the
+study's tables and figures (:mod:`~stochpound.studies.agarwal2004._tables`,
+:mod:`~stochpound.studies.agarwal2004._figures`), beside its published values
+(:mod:`~stochpound.studies.agarwal2004._published`), with its conclusions
+checked (:mod:`~stochpound.studies.agarwal2004._findings`) and the
 explanations the report owes its reader
-(:mod:`~stochpound.studies.agarwal2004.notes`). Sections whose store is
+(:mod:`~stochpound.studies.agarwal2004._notes`). Sections whose store is
 missing are left out, so a report can be built from any subset of the
 study's stores.
 """
@@ -20,8 +20,8 @@ from collections.abc import Callable, Mapping
 
 import xarray as xr
 
-from stochpound.report.render.document import Block, Paragraph, Section
-from stochpound.studies.agarwal2004 import figures, findings, notes, tables
+from stochpound.report.render._document import Block, Paragraph, Section
+from stochpound.studies.agarwal2004 import _figures as figures, _findings as findings, _notes as notes, _tables as tables
 
 TITLE = "Pounding of base-isolated buildings: the reference study regenerated"
 """The title of the study's report."""

@@ -1,0 +1,281 @@
+"""Risk at a site: mean annual frequency of a limit state, the pounding risk curve and the risk-targeted separation.
+
+The mean annual frequency (MAF) of exceeding a limit state with fragility F
+at a site with hazard curve λ(x) is λ_LS = ∫ F(x) ``|dλ(x)|`` (Cornell &
+Krawinkler 2000). Integrated by parts over the hazard's range [lo, hi],
+
+    λ_LS = F(lo) λ(lo) + ∫_lo^hi λ(x) dF(x),
+
+which counts the rate above a table's last intensity as if it were at that
+intensity (a table says nothing beyond it; ask the table to extrapolate to
+go further). For a lognormal F the integral is taken in z = ln(x/θ)/β,
+∫ λ(θ e^{βz}) φ(z) dz, by composite Gauss–Legendre quadrature over
+z ∈ [−16, 10] clipped to the hazard's range (the integrand of a power law
+k0 x^(−k) peaks at z = −kβ, well inside for kβ < 6). For a power law the
+result is k0 θ^(−k) exp(k²β²/2).
+
+Since every gap's fragility comes from the same runs, λ_P(g) over the gap
+grid is one curve, Tubaldi et al.'s (2012) pounding risk curve; the
+risk-targeted separation g* solves λ_P(g*) = λ_target.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+import xarray as xr
+from numpy.typing import ArrayLike
+from scipy import special
+
+from stochpound.analysis import kernels
+from stochpound.analysis._bootstrap import interval
+from stochpound.analysis._fragility_ensemble import BOOTSTRAP, limit_state_events, stripe_fragility
+from stochpound.analysis._hazard import HazardCurve, probability_from_rate, rate_from_probability, return_period
+
+TARGETS = (0.10, 0.02)
+"""Default target probabilities of exceedance in ``years`` (50) of :func:`risk_targeted_separation`."""
+_Z_RANGE = (-16.0, 10.0)
+_PANELS, _NODES = 24, 8
+_CHUNK = 4096
+_EXTRAPOLATED_SHARE = 1e-4
+
+
+def mean_annual_frequency(frag: object, hz: HazardCurve) -> float | np.ndarray | xr.DataArray:
+    """λ = ∫ F(x) ``|dλ(x)|``: the mean annual frequency (1/yr) of exceeding a limit state with lognormal fragility ``frag``.
+
+    Parameters
+    ----------
+    frag : Fragility or xarray.Dataset
+        Anything with ``theta`` (IM units, the hazard's) and ``beta``
+        (floats, arrays or DataArrays, broadcast): a
+        :class:`~stochpound.analysis._fragility.Fragility` or a fit Dataset
+        of :func:`~stochpound.analysis.stripe_fragility`. A step (β = 0)
+        at θ gives λ(θ); θ = inf gives 0.
+    hz : HazardCurve
+        The site's hazard, in the same intensity measure and units.
+
+    Returns
+    -------
+    float, numpy.ndarray or xarray.DataArray
+        Annual rate (1/yr), shaped like θ and β.
+    """
+    theta, beta = frag.theta, frag.beta
+    if isinstance(theta, xr.DataArray) or isinstance(beta, xr.DataArray):
+        rate = xr.apply_ufunc(lambda t, b: lognormal_maf(t, b, hz), theta, beta)
+        return rate.assign_attrs(units="1/yr", long_name="mean annual frequency of exceedance")
+    rate = lognormal_maf(theta, beta, hz)
+    return rate.item() if rate.ndim == 0 else rate
+
+
+def lognormal_maf(theta: ArrayLike, beta: ArrayLike, hz: HazardCurve) -> np.ndarray:
+    """The numpy kernel of :func:`mean_annual_frequency` (θ, β broadcast; NaN where either is NaN)."""
+    t, b = (np.asarray(value, dtype=float) for value in np.broadcast_arrays(np.asarray(theta, dtype=float), np.asarray(beta, dtype=float)))
+    shape = t.shape
+    t, b = t.ravel(), b.ravel()
+    out = np.full(t.shape, np.nan)
+    lo, hi = hz.support
+    known = ~(np.isnan(t) | np.isnan(b))
+    step = known & ((b == 0.0) | (t == 0.0) | np.isinf(t))
+    on_step = step & (t <= hi)
+    out[step] = 0.0
+    if on_step.any():
+        out[on_step] = hz(np.maximum(t[on_step], lo))
+    regular = np.flatnonzero(known & ~step)
+    for start in range(0, regular.size, _CHUNK):
+        index = regular[start:start + _CHUNK]
+        out[index] = _lognormal_integral(t[index], b[index], hz, lo, hi)
+    return out.reshape(shape)
+
+
+def risk_curve(fragility: xr.Dataset, hz: HazardCurve, years: float = 50.0, confidence: float = 0.95) -> xr.Dataset:
+    """λ(g) for every fit of ``fragility`` (e.g. every gap: the pounding risk curve), with its bootstrap band.
+
+    Parameters
+    ----------
+    fragility : xarray.Dataset
+        From :func:`~stochpound.analysis.stripe_fragility`
+        or :func:`~stochpound.analysis.ida_fragility`;
+        with ``theta_bootstrap``/``beta_bootstrap`` the band is the
+        percentiles of λ over the resamples of the motions (the whole chain refitted).
+    hz : HazardCurve
+        The site's hazard in the fragility's intensity measure.
+    years : float
+        The exposure time of ``probability``.
+    confidence : float
+        Level of the band, in (0, 1).
+
+    Returns
+    -------
+    xarray.Dataset
+        ``maf`` (1/yr), ``probability`` (of at least one exceedance in
+        ``years``, Poisson), ``return_period`` (yr), and with a bootstrap
+        ``maf_lower``, ``maf_upper`` and ``maf_bootstrap``.
+    """
+    kernels.check_confidence(confidence)
+    maf = mean_annual_frequency(fragility, hz)
+    result = xr.Dataset(
+        {
+            "maf": maf.assign_attrs(units="1/yr", long_name="mean annual frequency of exceedance"),
+            "probability": xr.apply_ufunc(probability_from_rate, maf, kwargs={"years": years}).assign_attrs(
+                units="1", long_name=f"probability of at least one exceedance in {years:g} years (Poisson)"),
+            "return_period": xr.apply_ufunc(return_period, maf).assign_attrs(units="yr", long_name="mean return period"),
+        },
+        attrs={"years": years, "hazard": repr(hz), "hazard_source": hz.source},
+    )
+    if "theta_bootstrap" in fragility:
+        sampled = mean_annual_frequency(xr.Dataset({"theta": fragility["theta_bootstrap"], "beta": fragility["beta_bootstrap"]}), hz)
+        left_out = mean_annual_frequency(xr.Dataset({"theta": fragility["theta_jackknife"], "beta": fragility["beta_jackknife"]}), hz)
+        lower, upper = _interval(sampled, maf, left_out, confidence)
+        attrs = {"units": "1/yr", "confidence": confidence}
+        result = result.assign(
+            maf_lower=lower.assign_attrs(long_name="lower bound of the MAF (BCa bootstrap over motions)", **attrs),
+            maf_upper=upper.assign_attrs(long_name="upper bound of the MAF (BCa bootstrap over motions)", **attrs),
+            maf_bootstrap=sampled.assign_attrs(units="1/yr", long_name="MAF of each resample of the motions"),
+            maf_jackknife=left_out.assign_attrs(units="1/yr", long_name="MAF without each motion"),
+        )
+    result.attrs["hazard_extrapolated"] = int(hz.extrapolated)
+    return result
+
+
+def risk_targeted_separation(curve: xr.Dataset, targets: Sequence[float] = TARGETS, years: float = 50.0, dim: str = "gap",
+                             confidence: float = 0.95) -> xr.Dataset:
+    """The gap g* with λ_P(g*) = λ_target for each target probability in ``years``, with its bootstrap interval.
+
+    λ_P(g) is made non-increasing along the gap grid (its running minimum:
+    a wider gap cannot pound more often, so a rise is fitting noise) and
+    g* is interpolated between the two grid gaps that bracket the target,
+    linearly in ln λ against ln g (exact where λ_P is a power law of g, as
+    for a linear pair under a power-law hazard; against g from a zero gap).
+
+    Parameters
+    ----------
+    curve : xarray.Dataset
+        From :func:`risk_curve`, with dimension ``dim`` (ascending gaps, m).
+    targets : sequence of float
+        Probabilities of pounding in ``years`` (each in (0, 1)): rate −ln(1 − p)/years.
+    years : float
+        Their exposure time.
+    dim : str
+        The gap dimension.
+    confidence : float
+        Level of the interval (percentiles of g* over the bootstrap resamples).
+
+    Returns
+    -------
+    xarray.Dataset
+        Over ``target`` (the probabilities) and the curve's other
+        dimensions: ``separation`` (m; ``inf`` when even the widest gap of
+        the grid is too risky, the grid's first gap when that one already
+        meets the target), ``target_rate`` (1/yr) and, with a bootstrap,
+        ``lower`` and ``upper``.
+    """
+    kernels.check_confidence(confidence)
+    if dim not in curve.dims:
+        raise ValueError(f"dim: {dim!r} is not a dimension of the risk curve (its dimensions: {', '.join(map(str, curve.dims))})")
+    gaps = np.asarray(curve[dim].values, dtype=float)
+    if gaps.size < 2 or not np.all(np.diff(gaps) > 0.0):
+        raise ValueError(f"{dim}: the gap grid must hold at least two strictly increasing gaps")
+    rates = rate_from_probability(np.asarray(targets, dtype=float), years)
+    rates = np.atleast_1d(rates)
+
+    def solve(maf: xr.DataArray) -> xr.DataArray:
+        return xr.apply_ufunc(_separation_kernel, maf, kwargs={"gaps": gaps, "rates": rates},
+                              input_core_dims=[[dim]], output_core_dims=[["target"]])
+
+    separation = solve(curve["maf"])
+    result = xr.Dataset({"separation": separation.assign_attrs(units="m", long_name="risk-targeted separation g*")})
+    if "maf_bootstrap" in curve:
+        lower, upper = _interval(solve(curve["maf_bootstrap"]), separation, solve(curve["maf_jackknife"]), confidence)
+        attrs = {"units": "m", "confidence": confidence}
+        result = result.assign(lower=lower.assign_attrs(long_name="lower bound of g* (BCa bootstrap over motions)", **attrs),
+                               upper=upper.assign_attrs(long_name="upper bound of g* (BCa bootstrap over motions)", **attrs))
+    return result.assign_coords(
+        target=("target", np.atleast_1d(np.asarray(targets, dtype=float)), {"units": "1", "long_name": f"target probability of pounding in {years:g} years"}),
+        target_rate=("target", rates, {"units": "1/yr", "long_name": "target mean annual frequency"}),
+    ).assign_attrs(years=years)
+
+
+def demand_hazard_curve(demand: xr.DataArray, levels: Sequence[float] | np.ndarray, hz: HazardCurve, dim: str = "level",
+                        intensity_dim: str = "intensity", record_dim: str = "record", confidence: float = 0.95,
+                        bootstrap: int = BOOTSTRAP, seed: int = 0) -> xr.Dataset:
+    """The annual rate at which a demand exceeds each of ``levels`` (e.g. drift, floor acceleration, isolator displacement).
+
+    The fragility of "demand ≥ level" is fitted to the stripes of
+    ``demand`` for every level (:func:`~stochpound.analysis.stripe_fragility`)
+    and integrated with the hazard (:func:`risk_curve`).
+
+    Parameters
+    ----------
+    demand : xarray.DataArray
+        One value per run, dims ``intensity_dim`` (levels in the hazard's IM units) and ``record_dim``.
+    levels : sequence of float
+        Demand levels, in the units of ``demand``.
+
+    Returns
+    -------
+    xarray.Dataset
+        :func:`risk_curve` over ``dim`` (the demand levels).
+    """
+    fragility = stripe_fragility(limit_state_events(demand, levels, dim), intensity_dim, record_dim, confidence, bootstrap, seed)
+    return risk_curve(fragility, hz, confidence=confidence)
+
+
+# ---------------------------------------------------------------- kernels
+
+
+def _interval(sampled: xr.DataArray, estimate: xr.DataArray, left_out: xr.DataArray, confidence: float) -> tuple[xr.DataArray, xr.DataArray]:
+    """BCa bounds of ``estimate`` from its resamples (dim ``bootstrap``) and jackknife values (dim ``jackknife``)."""
+    return xr.apply_ufunc(lambda s, e, j: interval(s, e, j, confidence), sampled, estimate, left_out,
+                          input_core_dims=[["bootstrap"], [], ["jackknife"]], output_core_dims=[[], []])
+
+
+def _lognormal_integral(theta: np.ndarray, beta: np.ndarray, hz: HazardCurve, lo: float, hi: float) -> np.ndarray:
+    """F(lo) λ(lo) + ∫ λ(θ e^{βz}) φ(z) dz over z in the hazard's range (composite Gauss–Legendre), per element."""
+    log_theta = np.log(theta)
+    with np.errstate(divide="ignore"):
+        z_lo = (np.log(lo) - log_theta) / beta
+        z_hi = (np.log(hi) - log_theta) / beta
+    a = np.clip(z_lo, *_Z_RANGE)
+    b = np.clip(z_hi, *_Z_RANGE)
+    nodes, weights = special.roots_legendre(_NODES)
+    panel = (np.arange(_PANELS)[:, None] + 0.5 * (nodes[None, :] + 1.0)).ravel() / _PANELS
+    width = np.maximum(b - a, 0.0)
+    z = a[:, None] + width[:, None] * panel[None, :]
+    w = np.tile(weights, _PANELS)[None, :] * 0.5 * width[:, None] / _PANELS
+    log_x = log_theta[:, None] + beta[:, None] * z
+    if not hz.extrapolate:
+        log_x = np.clip(log_x, np.log(lo), np.log(hi))
+    terms = w * np.exp(hz.log_rate(log_x) - 0.5 * z**2) / np.sqrt(2.0 * np.pi)
+    integral = terms.sum(-1)
+    if hz.extrapolate and hz.power is None:
+        outside = (log_x < np.log(hz.im[0])) | (log_x > np.log(hz.im[-1]))
+        if np.any(np.where(outside, terms, 0.0).sum(-1) > _EXTRAPOLATED_SHARE * integral):
+            hz.extrapolated = True
+    if lo > 0.0:
+        integral = integral + special.ndtr(z_lo) * float(hz(lo))
+    return integral
+
+
+def _separation_kernel(maf: np.ndarray, gaps: np.ndarray, rates: np.ndarray) -> np.ndarray:
+    """g* per target rate along the last axis of ``maf`` (running minimum, interpolation of ln λ in ln g)."""
+    envelope = np.fmin.accumulate(np.where(np.isnan(maf), np.inf, maf), axis=-1)
+    below = envelope[..., None, :] <= rates[:, None]  # (..., target, gap)
+    found = below.any(-1)
+    index = np.argmax(below, axis=-1)
+    previous = np.maximum(index - 1, 0)
+    lam_hi = np.take_along_axis(envelope[..., None, :], previous[..., None], -1)[..., 0]
+    lam_lo = np.take_along_axis(envelope[..., None, :], index[..., None], -1)[..., 0]
+    g_hi, g_lo = gaps[previous], gaps[index]
+    target = np.broadcast_to(rates, index.shape)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        in_log = (np.log(lam_hi) - np.log(target)) / (np.log(lam_hi) - np.log(lam_lo))
+        linear = (lam_hi - target) / (lam_hi - lam_lo)
+        fraction = np.where(lam_lo > 0.0, in_log, linear)
+        fraction = np.where(np.isfinite(lam_hi), fraction, 1.0)
+    fraction = np.clip(fraction, 0.0, 1.0)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        in_log_gap = np.exp(np.log(g_hi) + fraction * (np.log(g_lo) - np.log(g_hi)))
+    separation = np.where(g_hi > 0.0, in_log_gap, g_hi + fraction * (g_lo - g_hi))
+    separation = np.where(~found, np.inf, np.where(index == 0, gaps[0], separation))
+    return np.where(np.isnan(maf).all(-1)[..., None], np.nan, separation)

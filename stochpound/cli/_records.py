@@ -1,0 +1,125 @@
+"""``stochpound records``: list the bundled records and suites, show one, draw its response spectrum."""
+
+from __future__ import annotations
+
+import math
+
+import click
+
+from stochpound.cli._group import HelpGroup
+from stochpound._errors import RecordError
+
+
+@click.group("records", cls=HelpGroup)
+def records() -> None:
+    """Bundled ground-motion records (and record files)."""
+
+
+@records.command("list")
+@click.option("--suite", default=None, help="List the motions of a suite (fema_p695_far_field, ...) or of a folder of record files instead.")
+def list_command(suite: str | None) -> None:
+    """List the bundled records and their named variants, then the suites (or the motions of one suite)."""
+    from stochpound.motions.records import SUITES, registry_entries
+
+    if suite is not None:
+        _list_suite(suite)
+        return
+    for name, entry in registry_entries().items():
+        fields = entry.fields
+        kind = f"variant of {fields['base']}" if entry.is_variant else f"{fields.get('file')}"
+        flag = "  [SUBSTITUTE]" if entry.substitute_for else ""
+        click.echo(f"{name:38s}{kind}{flag}")
+        click.echo(f"{'':38s}{entry.description}")
+    click.echo("\nsuites (stochpound records list --suite NAME):")
+    for name, source in SUITES.items():
+        click.echo(f"{name:38s}{source.description}")
+
+
+def _list_suite(suite: str) -> None:
+    from stochpound.motions.records import load_suite
+
+    try:
+        motions = load_suite(suite)
+    except RecordError as error:
+        raise click.ClickException(str(error)) from None
+    click.echo(f"{'name':34s}{'event':30s}{'station':32s}{'component':18s}{'M':>5s}{'R (km)':>8s}{'Vs30':>7s}{'dt (s)':>8s}{'npts':>7s}")
+    for record in motions:
+        meta = record.metadata
+        click.echo(
+            f"{record.name:34s}{str(meta.get('event', ''))[:29]:30s}{str(meta.get('station', ''))[:31]:32s}{str(meta.get('component', ''))[:17]:18s}"
+            f"{meta.get('magnitude', float('nan')):5.1f}{meta.get('distance', float('nan')):8.1f}{meta.get('vs30', float('nan')):7.0f}{record.dt:8.4f}{record.npts:7d}"
+        )
+
+
+@records.command("show")
+@click.argument("name")
+@click.option("--plot", "plot_path", type=click.Path(dir_okay=False), default=None, help="Write a plot of the accelerogram (PNG, PDF, SVG).")
+@click.option("--g", "g", type=float, default=9.814, show_default=True, help="g (m/s²) for conversions, peak in g and Arias intensity.")
+@click.option("--dt", type=float, default=None, help="Step (s) of a one-column text file.")
+@click.option("--units", type=click.Choice(["g", "m/s2", "cm/s2"]), default=None, help="Units of a text file's values.")
+def show_command(name: str, plot_path: str | None, g: float, dt: float | None, units: str | None) -> None:
+    """Statistics of NAME (a bundled record or a file), with the study's Table 3.2 beside ours."""
+    from stochpound.motions.records import load_record
+    from stochpound.motions.records._plot import plot_record
+    from stochpound.motions.records._report import record_report
+
+    if not g > 0:
+        raise click.BadParameter(f"must be > 0, got {g}", param_hint="--g")
+    try:
+        record = load_record(name, dt=dt, units=units)
+    except RecordError as error:
+        raise click.ClickException(str(error)) from None
+    click.echo(record_report(record, g=g))
+    if plot_path:
+        plot_record(record, plot_path, g=g)
+        click.echo(f"\nplot written to {plot_path}")
+
+
+def parse_periods(text: str) -> list[float]:
+    """Periods (s) from ``"0.1,0.2,1"`` or a log-spaced range ``"0.05:5:30"`` (first:last:count)."""
+    import numpy as np
+
+    try:
+        if ":" in text:
+            first, last, count = text.split(":")
+            return np.geomspace(float(first), float(last), int(count)).tolist()
+        return [float(value) for value in text.split(",") if value.strip()]
+    except ValueError:
+        raise click.BadParameter(f"a list 0.1,0.5,1 or a range first:last:count, got {text!r}", param_hint="--periods") from None
+
+
+@records.command("spectrum")
+@click.argument("name")
+@click.option("--periods", "periods_text", default="0.05:5:30", show_default=True, help="Periods (s): a list 0.1,0.5,1 or a log-spaced range first:last:count.")
+@click.option("--damping", type=float, default=0.05, show_default=True, help="Damping ratio of the oscillators.")
+@click.option("--plot", "plot_path", type=click.Path(dir_okay=False), default=None, help="Write a plot of PSA against period (PNG, PDF, SVG).")
+@click.option("--g", "g", type=float, default=9.81, show_default=True, help="g (m/s²) for records in g, spectra in g and Arias intensity.")
+@click.option("--dt", type=float, default=None, help="Step (s) of a one-column text file.")
+@click.option("--units", type=click.Choice(["g", "m/s2", "cm/s2"]), default=None, help="Units of a text file's values.")
+def spectrum_command(name: str, periods_text: str, damping: float, plot_path: str | None, g: float, dt: float | None, units: str | None) -> None:
+    """Intensity measures and the exact response spectrum of NAME (a bundled record, a suite's motion or a file)."""
+    from stochpound.motions import intensity_measures
+    from stochpound.motions.records import load_record
+    from stochpound.motions.records._plot import plot_spectra
+
+    if not g > 0:
+        raise click.BadParameter(f"must be > 0, got {g}", param_hint="--g")
+    periods = parse_periods(periods_text)
+    try:
+        record = load_record(name, dt=dt, units=units)
+        measures = intensity_measures(record, periods=periods, damping=damping, g=g)
+    except (RecordError, ValueError) as error:
+        raise click.ClickException(str(error)) from None
+    click.echo(f"{record.name}: {record.description}")
+    click.echo(
+        f"PGA {measures.pga.item() / g:.4f} g   PGV {measures.pgv.item():.4f} m/s   PGD {measures.pgd.item():.4f} m   "
+        f"Arias {measures.arias_intensity.item():.4f} m/s   D5-95 {measures.significant_duration.item():.2f} s"
+    )
+    click.echo(f"\nresponse spectrum, damping {damping:g} (maxima located between samples)")
+    click.echo(f"{'T (s)':>10s}{'SD (m)':>14s}{'PSV (m/s)':>14s}{'PSA (g)':>12s}{'SA (g)':>12s}")
+    omega = 2.0 * math.pi / measures.period.values
+    for period, w, sd, sa in zip(measures.period.values, omega, measures.sd.values, measures.sa.values):
+        click.echo(f"{period:10.4g}{sd:14.6g}{w * sd:14.6g}{w * w * sd / g:12.5g}{sa / g:12.5g}")
+    if plot_path:
+        plot_spectra([(f"ζ = {damping:g}", measures.period.values, measures.psa.values)], plot_path, record.name, g=g)
+        click.echo(f"\nplot written to {plot_path}")

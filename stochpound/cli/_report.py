@@ -1,0 +1,64 @@
+"""``stochpound report``: build the report (HTML page, PDF, figures, tables) from experiment stores."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import click
+
+from stochpound.cli._group import HelpGroup
+from stochpound._errors import StochpoundError, os_error_message
+
+FORMAT_CHOICES = ("html", "pdf")
+
+
+@click.group("report", cls=HelpGroup)
+def report() -> None:
+    """Reports (HTML page, PDF, figures, tables) built from experiment stores: any experiment's, the reference study's among them."""
+
+
+@report.command("build")
+@click.argument("stores", metavar="STORE [STORE ...]", nargs=-1, required=True, type=click.Path(exists=True, dir_okay=False, path_type=Path))
+@click.option("--out", "out", required=True, type=click.Path(file_okay=False, path_type=Path), help="Output folder (created if needed).")
+@click.option(
+    "--format",
+    "formats",
+    multiple=True,
+    type=click.Choice(FORMAT_CHOICES),
+    default=FORMAT_CHOICES,
+    show_default=True,
+    help="Document to write; repeat for several.",
+)
+def build_command(stores: tuple[Path, ...], out: Path, formats: tuple[str, ...]) -> None:
+    """Build the report from the experiment STORE files into --out.
+
+    Writes OUT/index.html (self-contained page), OUT/report.pdf, and every
+    figure and table as OUT/figures/<key>.png and OUT/tables/<key>.csv.
+    Figures and tables of an earlier build into OUT that this one does not
+    write again are removed (only those: OUT/.stochpound-report.json lists them).
+    The stores are only read (they may be on a read-only disk); OUT is
+    checked to be writable before any work.
+    """
+    from stochpound.report.assemble import assemble_report
+    from stochpound.report.render.output import check_output_folder, write_report
+
+    try:
+        check_output_folder(out)
+        document = assemble_report(list(stores), progress=_progress)
+        written = write_report(document, out, formats, progress=_progress)
+    except (StochpoundError, ValueError) as error:
+        raise click.ClickException(str(error)) from None
+    except OSError as error:
+        raise click.ClickException(os_error_message(error)) from None
+    counts = {"figures": f" ({len(document.figures())} PNG files)", "tables": f" ({len(document.tables())} CSV files)"}
+    for name, path in written.items():
+        click.echo(f"{name}: {_shown(path, out)}{counts.get(name, '')}")
+
+
+def _progress(message: str) -> None:
+    click.echo(f"  {message}", err=True)
+
+
+def _shown(path: Path, out: Path) -> str:
+    """``path`` as the user named the output folder (no absolute path of this machine)."""
+    return str(out / path.relative_to(out))

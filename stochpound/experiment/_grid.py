@@ -1,0 +1,431 @@
+"""An experiment's grid: dimensions, cases with stable ids, and each case's scene.
+
+Two kinds of case exist:
+
+* ``case``: one point of the grid (variant axes × gap axes × μ × intensity) under one
+  motion (``record``, ``realization``);
+* ``reference``: the studied building alone on a fixed base under the same
+  motion, on the dimensions ``record`` and ``realization`` (plus the variant
+  axes that change the studied building itself, and ``intensity``).
+
+A case id is the first 16 hex digits of the sha256 of its kind and labels, so
+it does not depend on the order of the grid or on how the run is split.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import itertools
+import tomllib
+from dataclasses import dataclass
+from functools import cached_property
+from pathlib import Path
+from typing import Any, Iterator, Mapping, Sequence
+
+import numpy as np
+
+from stochpound._errors import SceneError
+from stochpound.experiment._definition import Definition, read_definition
+from stochpound.experiment._spec import ExperimentError, canonical_json
+from stochpound.experiment._variants import (
+    PLACEHOLDER_MOTION,
+    apply_overrides,
+    reference_scene,
+    set_gaps,
+    set_mu,
+)
+from stochpound.model.scene_file import scene_from_dict
+
+CASE = "case"
+REFERENCE = "reference"
+KINDS = (REFERENCE, CASE)
+"""The kinds of case, in store order."""
+
+
+@dataclass(frozen=True)
+class Dim:
+    """One dimension of the store.
+
+    Attributes
+    ----------
+    name : str
+        Dimension name (``gap``, ``mu``, a variant axis, ``intensity``, ``record``, ``realization``).
+    kind : str
+        ``variant``, ``gap``, ``mu``, ``intensity``, ``record`` or ``realization``.
+    values : tuple
+        Coordinate values, in grid order.
+    """
+
+    name: str
+    kind: str
+    values: tuple[Any, ...]
+
+
+@dataclass(frozen=True)
+class Case:
+    """One simulation of the experiment.
+
+    Attributes
+    ----------
+    case_id : str
+        Stable id (16 hex digits).
+    kind : str
+        ``case`` or ``reference``.
+    labels : tuple of (str, value)
+        Its coordinate on each dimension of its kind, in dimension order.
+    position : tuple of int
+        Index along each of those dimensions.
+    """
+
+    case_id: str
+    kind: str
+    labels: tuple[tuple[str, Any], ...]
+    position: tuple[int, ...]
+
+    @property
+    def label_dict(self) -> dict[str, Any]:
+        """The labels as a dict."""
+        return dict(self.labels)
+
+    def describe(self) -> str:
+        """``kind dim=value ...``, e.g. ``case neighbour=stiff gap=0.02 mu=inf record=el_centro realization=0``."""
+        return " ".join([self.kind] + [f"{name}={_format(value)}" for name, value in self.labels])
+
+
+@dataclass(frozen=True)
+class Point:
+    """One point of a kind's structural grid (its dimensions without ``record`` and ``realization``): one scene.
+
+    Attributes
+    ----------
+    kind : str
+        ``case`` or ``reference``.
+    position : tuple of int
+        Index along each structural dimension of the kind.
+    labels : tuple of (str, value)
+        Its coordinate on each of them.
+    """
+
+    kind: str
+    position: tuple[int, ...]
+    labels: tuple[tuple[str, Any], ...]
+
+    def describe(self) -> str:
+        """``case neighbour=stiff, gap=0.01, mu=0.1`` (``(base scene)`` without structural dimensions)."""
+        return "case " + (", ".join(f"{name}={_format(value)}" for name, value in self.labels) or "(base scene)")
+
+
+def _format(value: Any) -> str:
+    return f"{value:g}" if isinstance(value, float) else str(value)
+
+
+def case_id(kind: str, labels: Mapping[str, Any]) -> str:
+    """Stable id of a case from its kind and labels."""
+    return hashlib.sha256(canonical_json({"kind": kind, "labels": dict(labels)}).encode()).hexdigest()[:16]
+
+
+def case_ids(kind: str, labels: Mapping[str, Any], realizations: Sequence[int]) -> list[str]:
+    """:func:`case_id` of the cases with ``labels`` at each of ``realizations`` (the JSON around the number is built once)."""
+    marker = -7340912358  # a number that no other label renders as
+    text = canonical_json({"kind": kind, "labels": {**labels, "realization": marker}})
+    head, *tail = text.split(str(marker))
+    if len(tail) != 1:
+        return [case_id(kind, {**labels, "realization": r}) for r in realizations]
+    return [hashlib.sha256(f"{head}{int(r)}{tail[0]}".encode()).hexdigest()[:16] for r in realizations]
+
+
+class Experiment:
+    """A validated experiment: its definition, dimensions, cases and their scenes.
+
+    Parameters
+    ----------
+    definition : mapping or Definition
+        Canonical definition (``stochpound.experiment._spec.parse_experiment``), or
+        its typed form (:func:`~stochpound.experiment.read_definition`).
+    text : str
+        The experiment file's text (provenance).
+    base_dir : str or Path
+        Folder of the experiment file (record files are resolved against it).
+    path : str, optional
+        The experiment file, for provenance.
+    """
+
+    def __init__(self, definition: Mapping[str, Any] | Definition, text: str = "", base_dir: str | Path = ".", path: str = "") -> None:
+        self.contract: Definition = read_definition(definition)
+        self.definition = self.contract.to_dict()
+        self.text = text
+        self.base_dir = Path(base_dir)
+        self.path = path
+        self.sha256 = self.contract.sha256
+        self.name: str = self.definition["name"]
+        self.studied: str = self.definition["studied"]
+        self.variants: list[dict[str, Any]] = self.definition["variants"]
+        self.motions: dict[str, dict[str, Any]] = {m["label"]: m for m in self.definition["motions"]}
+        self.output: dict[str, Any] = self.definition["output"]
+        self.solver: dict[str, Any] = self.definition["solver"]
+        self.intensity: dict[str, Any] | None = self.definition.get("intensity")
+        self._grid_case_ids: dict[str, np.ndarray] = {}
+
+    # ------------------------------------------------------------ dimensions
+
+    @cached_property
+    def building_names(self) -> list[str]:
+        """Buildings of the base scene, left to right."""
+        return [b.get("name", f"B{i + 1}") for i, b in enumerate(self.definition["scene"]["building"])]
+
+    @cached_property
+    def max_floors(self) -> int:
+        """Largest number of floors of any building, in the base scene or a variant."""
+        counts = [len(b.get("mass", [])) for b in self.definition["scene"]["building"]]
+        for variant in self.variants:
+            for override in variant["overrides"].values():
+                counts += [len(f["mass"]) for f in override.get("building", {}).values() if isinstance(f.get("mass"), list)]
+        return max(counts + [1])
+
+    @cached_property
+    def has_walls(self) -> bool:
+        """Whether a case's scene can have walls: the base scene's or a variant's ``[[wall]]``."""
+        overrides = [o for variant in self.variants for o in variant["overrides"].values()]
+        return bool(self.definition["scene"].get("wall")) or any(o.get("scene", {}).get("wall") for o in overrides)
+
+    @cached_property
+    def motion_dims(self) -> list[Dim]:
+        """``record`` (motion labels) and ``realization`` (union of realization indices)."""
+        realizations = np.sort(np.concatenate([self.realization_numbers(label) for label in self.motions]))
+        realizations = realizations[np.concatenate([[True], realizations[1:] != realizations[:-1]])]  # unique (np.unique hashes: slower)
+        return [Dim("record", "record", tuple(self.motions)), Dim("realization", "realization", tuple(realizations.tolist()))]
+
+    @cached_property
+    def grid_dims(self) -> list[Dim]:
+        """Variant axes, gap axes and μ, in that order (the structural dimensions)."""
+        dims = [Dim(v["name"], "variant", tuple(v["values"])) for v in self.variants]
+        dims += [Dim(g.name, "gap", g.values) for g in self.contract.gaps]
+        if self.contract.mu is not None:
+            dims.append(Dim("mu", "mu", self.contract.mu.values))
+        return dims + self.intensity_dims
+
+    @cached_property
+    def intensity_dims(self) -> list[Dim]:
+        """``intensity`` (the target levels) when stripes run; none otherwise."""
+        if self.intensity is None or self.intensity["ran"] != "stripes":
+            return []
+        return [Dim("intensity", "intensity", tuple(self.intensity["levels"]))]
+
+    @cached_property
+    def dims(self) -> list[Dim]:
+        """Dimensions of the cases: grid dimensions, then ``record``, ``realization``."""
+        return self.grid_dims + self.motion_dims
+
+    @cached_property
+    def reference_dims(self) -> list[Dim]:
+        """Dimensions of the fixed-base reference: variant axes that change the studied building, then the motion."""
+        touched = [d for d in self.grid_dims if d.kind == "variant" and self._touches_studied(d.name)]
+        return touched + self.intensity_dims + self.motion_dims
+
+    def _touches_studied(self, axis: str) -> bool:
+        variant = next(v for v in self.variants if v["name"] == axis)
+        for override in variant["overrides"].values():
+            fields = override.get("building", {}).get(self.studied, {})
+            if set(fields) - {"base"}:
+                return True
+        return False
+
+    def realizations(self, label: str) -> range:
+        """Realization indices of a motion: 0 for a record, start .. start+count−1 for an ensemble."""
+        motion = self.motions[label]
+        if motion["kind"] == "record":
+            return range(1)
+        return range(motion["start"], motion["start"] + motion["count"])
+
+    def realization_numbers(self, label: str) -> np.ndarray:
+        """:meth:`realizations` as an array."""
+        numbers = self.realizations(label)
+        return np.arange(numbers.start, numbers.stop)
+
+    # ------------------------------------------------------------ grids and cases
+
+    def kind_dims(self, kind: str) -> list[Dim]:
+        """Dimensions of the cases of ``kind``: :attr:`dims` or :attr:`reference_dims`."""
+        return self.reference_dims if kind == REFERENCE else self.dims
+
+    def grid_shape(self, kind: str) -> tuple[int, ...]:
+        """Shape of the grid of ``kind`` (its dimensions' sizes)."""
+        return tuple(len(d.values) for d in self.kind_dims(kind))
+
+    def points(self, kind: str) -> list[Point]:
+        """The structural grid points of ``kind``, in grid order."""
+        return self._points[kind]
+
+    @cached_property
+    def _points(self) -> dict[str, list[Point]]:
+        points = {}
+        for kind in KINDS:
+            structural = self.kind_dims(kind)[:-2]
+            points[kind] = [
+                Point(kind, position, tuple((d.name, d.values[i]) for d, i in zip(structural, position)))
+                for position in itertools.product(*(range(len(d.values)) for d in structural))
+            ]
+        return points
+
+    def realization_positions(self, label: str) -> np.ndarray:
+        """Indices along ``realization`` of a motion's realizations, in order."""
+        return self._realization_positions[label]
+
+    @cached_property
+    def _realization_positions(self) -> dict[str, np.ndarray]:
+        values = np.asarray(self.motion_dims[1].values)
+        return {label: np.searchsorted(values, self.realization_numbers(label)) for label in self.motions}
+
+    def in_grid(self, kind: str) -> np.ndarray:
+        """Which positions of the grid of ``kind`` hold a case (bool, :meth:`grid_shape`): a record has realization 0 only."""
+        mask = np.zeros(self.grid_shape(kind)[-2:], dtype=bool)
+        for m, label in enumerate(self.motions):
+            mask[m, self.realization_positions(label)] = True
+        return np.broadcast_to(mask, self.grid_shape(kind))
+
+    @cached_property
+    def n_cases(self) -> int:
+        """Number of cases, references included."""
+        return sum(int(self.in_grid(kind).sum()) for kind in KINDS)
+
+    def case_at(self, kind: str, position: Sequence[int]) -> Case:
+        """The case of ``kind`` at a (full) grid position."""
+        position = tuple(int(i) for i in position)
+        labels = tuple((d.name, d.values[i]) for d, i in zip(self.kind_dims(kind), position))
+        return Case(case_id(kind, dict(labels)), kind, labels, position)
+
+    def point_case_ids(self, point: Point, record: int) -> list[str]:
+        """Ids of the cases at ``point`` under motion number ``record``, one per realization of the motion."""
+        label = self.motion_dims[0].values[record]
+        return case_ids(point.kind, {**dict(point.labels), "record": label}, self.realizations(label))
+
+    def grid_case_ids(self, kind: str) -> np.ndarray:
+        """Ids of the cases of ``kind`` on its grid (``S16``, empty where no case is), computed once (16 bytes a case)."""
+        if kind not in self._grid_case_ids:
+            ids = np.zeros(self.grid_shape(kind), dtype="S16")
+            for point in self.points(kind):
+                for m in range(len(self.motion_dims[0].values)):
+                    label = self.motion_dims[0].values[m]
+                    ids[point.position + (m,)][self.realization_positions(label)] = self.point_case_ids(point, m)
+            self._grid_case_ids[kind] = ids
+        return self._grid_case_ids[kind]
+
+    def iter_cases(self) -> Iterator[Case]:
+        """Every case, lazily: the references first, then the grid, realization varying fastest."""
+        for kind in KINDS:
+            for point in self.points(kind):
+                for m, label in enumerate(self.motion_dims[0].values):
+                    ids = self.point_case_ids(point, m)
+                    for identifier, realization, r in zip(ids, self.realizations(label), self.realization_positions(label)):
+                        labels = (*point.labels, ("record", label), ("realization", realization))
+                        yield Case(identifier, point.kind, labels, (*point.position, m, int(r)))
+
+    @cached_property
+    def cases(self) -> list[Case]:
+        """Every case, in the order of :meth:`iter_cases` (a list: for small experiments and look-ups)."""
+        return list(self.iter_cases())
+
+    @cached_property
+    def case_index(self) -> dict[str, Case]:
+        """Cases by id (builds :attr:`cases`)."""
+        return {case.case_id: case for case in self.cases}
+
+    def structure(self, case: Case | Point) -> dict[str, Any]:
+        """The scene dict of a case or a grid point without its motion (a placeholder motion is set).
+
+        Raises
+        ------
+        ExperimentError
+            If μ is finite for a building without a sliding base.
+        """
+        point = self._point_of(case)
+        labels = dict(point.labels)
+        scene = {k: v for k, v in self.definition["scene"].items() if k != "motion"}
+        overrides = [v["overrides"][labels[v["name"]]] for v in self.variants if v["name"] in labels]
+        scene = apply_overrides(scene, overrides)
+        if point.kind == REFERENCE:
+            scene = reference_scene(scene, self.studied)
+        else:
+            for gap in self.contract.gaps:
+                set_gaps(scene, gap.contacts, labels[gap.name], gap.walls)
+            if self.intensity is not None and self.intensity["ran"] == "ida":  # contact-free: capacities come from the closures
+                set_gaps(scene, range(len(scene.get("contact", []))), float("inf"))
+            mu = self.contract.mu
+            if mu is not None:
+                missing = set_mu(scene, mu.buildings, labels["mu"])
+                if missing:
+                    raise ExperimentError(
+                        f"grid.mu: building(s) {', '.join(missing)} have no [building.base] in {point.describe()}; "
+                        "give them a base (in the scene or a variant) or leave them out of grid.mu.buildings"
+                    )
+        scene["motion"] = dict(PLACEHOLDER_MOTION)
+        return scene
+
+    def _point_of(self, case: Case | Point) -> Point:
+        if isinstance(case, Point):
+            return case
+        n = len(case.position) - 2
+        return Point(case.kind, case.position[:n], case.labels[:n])
+
+    def reference_structure(self, case: Case | Point) -> dict[str, Any]:
+        """The scene dict of the fixed-base reference of a case or grid point (placeholder motion)."""
+        return self.structure(self.reference_point(self._point_of(case)))
+
+    def reference_point(self, point: Point) -> Point:
+        """The reference grid point of a case grid point (the variant axes that change the studied building)."""
+        if point.kind == REFERENCE:
+            return point
+        labels = dict(point.labels)
+        structural = self.reference_dims[:-2]
+        position = tuple(d.values.index(labels[d.name]) for d in structural)
+        return Point(REFERENCE, position, tuple((d.name, labels[d.name]) for d in structural))
+
+    @cached_property
+    def scene_field(self) -> str:
+        """How errors name the base scene: ``scene`` (inline) or its file (``experiment.scene``)."""
+        try:
+            path = tomllib.loads(self.text).get("experiment", {}).get("scene")
+        except tomllib.TOMLDecodeError:
+            path = None
+        return str(self.base_dir / path) if isinstance(path, str) else "scene"
+
+    def validate(self) -> None:
+        """Validate the scene of every grid point (cases, then references) before anything runs.
+
+        Raises
+        ------
+        ExperimentError
+            Naming the scene field: in the base scene (``scene.building[1].damping_ratio: ...``,
+            or the scene file) when the base scene alone has the same error, else in the grid point.
+        """
+        for point in self.points(CASE) + self.points(REFERENCE):
+            try:
+                scene_from_dict(self.structure(point), base_dir=self.base_dir)
+            except ExperimentError:
+                raise
+            except (SceneError, ValueError) as error:
+                if str(error) == self._base_scene_error():
+                    separator = "." if self.scene_field == "scene" else ": "
+                    raise ExperimentError(f"{self.scene_field}{separator}{error}") from None
+                raise ExperimentError(f"{point.describe()}: {error}") from None
+
+    def _base_scene_error(self) -> str | None:
+        """The error of the base scene on its own (with a placeholder motion), if any."""
+        scene = {k: v for k, v in self.definition["scene"].items() if k != "motion"}
+        try:
+            scene_from_dict({**scene, "motion": dict(PLACEHOLDER_MOTION)}, base_dir=self.base_dir)
+        except (SceneError, ValueError) as error:
+            return str(error)
+        return None
+
+    def motion_table(self, label: str, realization: int | None = None) -> dict[str, Any]:
+        """The scene ``[motion]`` table of a motion (with ``realization`` for an ensemble)."""
+        motion = self.motions[label]
+        table = {k: v for k, v in motion["motion"].items() if k != "file_sha256"}
+        if motion["kind"] == "synthetic":
+            table["realization"] = motion["start"] if realization is None else realization
+        return table
+
+    def seeds(self) -> dict[str, int]:
+        """Seeds of the synthetic ensembles, by label."""
+        return {label: m["motion"]["seed"] for label, m in self.motions.items() if m["kind"] == "synthetic"}

@@ -1,0 +1,322 @@
+"""Experiments conditioned on intensity: the ``[intensity]`` table, scaling, stripes and IDA.
+
+An ``[intensity]`` table (docs/intensity.md) scales every motion to target
+levels of an intensity measure (``pga``, ``pgv``, ``psa`` at a period,
+``sa_avg`` over periods):
+
+* **stripes** (multi-stripe analysis): the levels are a grid dimension,
+  ``intensity``; the case at level x runs the motion scaled by
+  x / IM, IM the motion's own (unscaled) measure. A synthetic ensemble is
+  scaled realization by realization, each exactly to the level
+  (``synthetic = "each"``, the default), or every realization by x / E[IM],
+  E[IM] the mean measure of the ensemble's realizations in the experiment
+  (``synthetic = "expected"``: the realizations keep their scatter of
+  intensity around the level).
+* **ida**: where the scene's contact-free response is homogeneous in the
+  input (fixed bases, no initial displacement or velocity, no walls), a
+  motion scaled by λ closes every contact by λ D, D its closure at scale 1;
+  so motion i first pounds at gap g at the intensity IM_i · g / D_i. Every
+  case then runs once, contact-free (every contact's gap infinite), and the
+  store gets that capacity per motion and gap (``ida_capacity``). When the
+  scene is not homogeneous (a sliding base, say), stripes run instead; the
+  definition's ``intensity.ran`` and ``intensity.note`` say which and why.
+
+Every case also stores its motion's unscaled measures (``motion_*``, the
+response spectrum over ``spectrum_period``) and its ``scale_factor``.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any, Mapping
+
+import numpy as np
+
+from stochpound.model import fields as toml_fields
+from stochpound.model.friction import is_fixed_base
+from stochpound.motions._measures import arias_intensity, peak_ground_motion, significant_duration
+from stochpound.motions._spectrum import response_spectrum
+
+MEASURES = ("pga", "pgv", "psa", "sa_avg")
+METHODS = ("stripes", "ida")
+UNITS = {"pga": ("g", "m/s2"), "psa": ("g", "m/s2"), "sa_avg": ("g", "m/s2"), "pgv": ("m/s", "cm/s")}
+"""Units of ``levels`` allowed for each measure (the first is the default)."""
+SYNTHETIC_SCALING = ("each", "expected")
+"""How a synthetic ensemble is scaled: each realization exactly to the level, or all by the level over the ensemble's mean measure."""
+ENSEMBLE_CHUNK = 256
+"""Realizations generated at once for an ensemble's mean measure."""
+PERIOD_SAMPLES = 2.0
+"""Shortest period of a spectral measure, in steps of the motion: T ≥ 2·dt, the Nyquist period.
+
+A sampled motion carries no information at frequencies above 1/(2 dt); an
+oscillator tuned above it responds to the interpolation between samples,
+not to the recorded ground motion."""
+SPECTRUM_PERIODS = np.geomspace(0.05, 5.0, 25)
+"""Periods (s) of the unscaled spectrum stored for every motion (5 % damping)."""
+SPECTRUM_DAMPING = 0.05
+_KEYS = {"measure", "period", "periods", "damping", "levels", "units", "method", "synthetic"}
+
+#: Per-case variables of an intensity-conditioned store: units and long names (units of levels filled in).
+SUMMARIES: dict[str, tuple[str, str]] = {
+    "scale_factor": ("1", "factor applied to the motion to reach the case's intensity level"),
+    "motion_intensity": ("{units}", "the motion's own (unscaled) intensity measure {measure}"),
+    "motion_pga": ("m/s2", "peak ground acceleration of the unscaled motion"),
+    "motion_pgv": ("m/s", "peak ground velocity of the unscaled motion"),
+    "motion_pgd": ("m", "peak ground displacement of the unscaled motion"),
+    "motion_arias_intensity": ("m/s", "Arias intensity of the unscaled motion"),
+    "motion_significant_duration": ("s", "significant duration D5-95 of the unscaled motion"),
+    "motion_psa": ("m/s2", "pseudo-spectral acceleration (5 % damping) of the unscaled motion"),
+    "ida_capacity": ("{units}", "IDA pounding capacity: intensity at which the motion first closes the gap (contact-free run)"),
+}
+
+
+class IntensityError(ValueError):
+    """An ``[intensity]`` field is invalid (the message starts with the field)."""
+
+
+def parse_intensity(data: Mapping[str, Any], scene: Mapping[str, Any], variants: list[dict[str, Any]], gaps: list[dict[str, Any]], mu: Any) -> dict[str, Any] | None:
+    """The canonical ``intensity`` entry of a definition (None without an ``[intensity]`` table).
+
+    Raises
+    ------
+    IntensityError
+        Naming the field: an unknown measure, method or unit, a period ≤ 0,
+        levels not > 0, ``ida`` without a gap axis.
+    """
+    table = data.get("intensity")
+    if table is None:
+        return None
+    if not isinstance(table, dict):
+        raise IntensityError("intensity: must be a table (measure, levels, ...)")
+    toml_fields.reject_unknown(table, _KEYS, "intensity")
+    measure = table.get("measure")
+    if measure not in MEASURES:
+        raise IntensityError(f"intensity.measure: must be one of {', '.join(MEASURES)}, got {measure!r}")
+    entry: dict[str, Any] = {"measure": measure}
+    if measure == "psa":
+        entry["period"] = toml_fields.number(table, "period", "intensity", required=True, low=0.0, low_open=True)
+    elif measure == "sa_avg":
+        periods = table.get("periods")
+        if not isinstance(periods, list) or len(periods) < 2 or not all(toml_fields.is_number(p) and math.isfinite(p) and p > 0 for p in periods):
+            raise IntensityError(f"intensity.periods: must be a list of at least 2 periods > 0 s (e.g. log-spaced over 0.2-3 T1), got {periods!r}")
+        entry["periods"] = [float(p) for p in periods]
+    for key in ("period", "periods"):
+        if key in table and key not in entry:
+            raise IntensityError(f"intensity.{key}: only for measure = {'psa' if key == 'period' else 'sa_avg'}")
+    if measure in ("psa", "sa_avg"):
+        entry["damping"] = toml_fields.number(table, "damping", "intensity", default=SPECTRUM_DAMPING, low=0.0, high=1.0, high_open=True)
+    levels = table.get("levels")
+    if not isinstance(levels, list) or not levels:
+        raise IntensityError(f"intensity.levels: must be a non-empty list of levels > 0, got {levels!r}")
+    for i, level in enumerate(levels):
+        if not toml_fields.is_number(level) or not math.isfinite(level) or level <= 0:
+            raise IntensityError(f"intensity.levels[{i}]: must be > 0, got {level!r}")
+    if len(set(levels)) != len(levels):
+        raise IntensityError("intensity.levels: repeated level")
+    entry["levels"] = sorted(float(level) for level in levels)
+    units = table.get("units", UNITS[measure][0])
+    if units not in UNITS[measure]:
+        raise IntensityError(f"intensity.units: must be one of {', '.join(UNITS[measure])} for {measure}, got {units!r}")
+    entry["units"] = units
+    method = table.get("method", "stripes")
+    if method not in METHODS:
+        raise IntensityError(f"intensity.method: must be one of {', '.join(METHODS)}, got {method!r}")
+    entry["method"] = method
+    synthetic = table.get("synthetic", SYNTHETIC_SCALING[0])
+    if synthetic not in SYNTHETIC_SCALING:
+        raise IntensityError(
+            f"intensity.synthetic: must be {' or '.join(SYNTHETIC_SCALING)} (each realization scaled to the level, or all by the level over the "
+            f"ensemble's mean measure), got {synthetic!r}"
+        )
+    entry["synthetic"] = synthetic
+    entry["ran"], entry["note"] = _method_run(method, scene, variants, gaps, mu)
+    return entry
+
+
+def _method_run(method: str, scene: Mapping[str, Any], variants: list[dict[str, Any]], gaps: list[dict[str, Any]], mu: Any) -> tuple[str, str]:
+    """The method that runs and why (IDA needs a homogeneous contact-free response and a gap axis)."""
+    if method == "stripes":
+        return "stripes", "every motion scaled to every level"
+    if not gaps:
+        raise IntensityError("intensity.method: ida needs a gap axis (grid.gap = [...]): its capacities are per gap")
+    reason = inhomogeneity(scene, variants, mu)
+    if reason:
+        return "stripes", f"ida requested, stripes run: the contact-free response is not homogeneous in the input ({reason})"
+    return "ida", "one contact-free run per motion; capacity IM·g/D per gap (homogeneous scene: fixed bases, at rest, no walls)"
+
+
+def inhomogeneity(scene: Mapping[str, Any], variants: list[dict[str, Any]], mu: Any) -> str:
+    """Why a scene's contact-free response is not homogeneous in the input ("" if it is)."""
+    if scene.get("wall"):
+        return "the scene has walls"
+    if mu is not None and any(not is_fixed_base(value) for value in mu["values"]):
+        return "grid.mu has finite friction coefficients (sliding bases)"
+    tables = [("scene", b) for b in scene.get("building", [])]
+    for variant in variants:
+        for value, override in variant["overrides"].items():
+            tables += [(f"variants.{variant['name']}.{value}", b) for b in override.get("building", {}).values()]
+    for where, building in tables:
+        if isinstance(building.get("base"), dict) and (mu is None or any(not is_fixed_base(v) for v in mu["values"])):
+            return f"{where}: a building on a sliding base"
+        if building.get("initial"):
+            return f"{where}: a building not at rest at t = 0"
+    return ""
+
+
+def level_to_si(intensity: Mapping[str, Any], level: float, g: float) -> float:
+    """A level in the units of ``levels`` in SI (m/s² or m/s)."""
+    factor = {"g": g, "m/s2": 1.0, "m/s": 1.0, "cm/s": 0.01}[intensity["units"]]
+    return float(level) * factor
+
+
+def check_resolution(intensity: Mapping[str, Any], dt: float, where: str) -> None:
+    """Raise if a spectral measure's period is shorter than :data:`PERIOD_SAMPLES` steps of a motion."""
+    periods = [intensity["period"]] if "period" in intensity else intensity.get("periods", [])
+    shortest = PERIOD_SAMPLES * dt
+    for period in periods:
+        if period < shortest - 1e-12:
+            key = "intensity.period" if "period" in intensity else "intensity.periods"
+            raise IntensityError(
+                f"{key}: {period:g} s is shorter than {PERIOD_SAMPLES:g}·dt = {shortest:g} s of {where}: "
+                "the sampled motion carries nothing above its Nyquist frequency 1/(2 dt)"
+            )
+
+
+def motion_measures(values: np.ndarray, dt: float, intensity: Mapping[str, Any], g: float, spectrum: bool = True) -> dict[str, Any]:
+    """The unscaled measures of a motion (samples in m/s², linear between them), by store name.
+
+    ``motion_intensity`` is in the units of ``levels``; ``spectrum=False`` leaves out ``motion_psa``.
+    """
+    pga, pgv, pgd = peak_ground_motion(values, dt)
+    measure = intensity["measure"]
+    if measure == "pga":
+        value = pga
+    elif measure == "pgv":
+        value = pgv
+    else:
+        periods = [intensity["period"]] if measure == "psa" else intensity["periods"]
+        psa = response_spectrum(values, dt, periods, intensity["damping"]).psa.values
+        value = float(np.exp(np.mean(np.log(psa))))
+    measures = {
+        "motion_intensity": value / level_to_si(intensity, 1.0, g),
+        "motion_pga": pga,
+        "motion_pgv": pgv,
+        "motion_pgd": pgd,
+        "motion_arias_intensity": arias_intensity(values, dt, g),
+        "motion_significant_duration": significant_duration(values, dt),
+    }
+    if spectrum:
+        measures["motion_psa"] = response_spectrum(values, dt, SPECTRUM_PERIODS, SPECTRUM_DAMPING).psa.values
+    return measures
+
+
+def ida_capacity(closure: np.ndarray, im: float, gap_axes: list[tuple[float, list[int]]]) -> float:
+    """Intensity (units of ``levels``) at which a contact-free run first closes a gap: min over axes of IM·g/max D.
+
+    Parameters
+    ----------
+    closure : np.ndarray
+        Peak closure of every contact at scale 1, m.
+    im : float
+        The motion's unscaled measure.
+    gap_axes : list of (gap, contacts)
+        The case's gap on each gap axis (m) and the axis's contacts.
+    """
+    capacities = []
+    for gap, contacts in gap_axes:
+        reach = float(np.max(closure[list(contacts)]))
+        capacities.append(math.inf if not reach > 0 else im * gap / reach)
+    return float(min(capacities))
+
+
+def summary_attrs(intensity: Mapping[str, Any], name: str) -> dict[str, str]:
+    """Units and long name of a per-case intensity variable."""
+    units, long_name = SUMMARIES[name]
+    return {"units": units.format(units=intensity["units"]), "long_name": long_name.format(measure=describe_measure(intensity))}
+
+
+def describe_measure(intensity: Mapping[str, Any]) -> str:
+    """E.g. ``PSA(T = 1 s, 5 % damping)`` or ``PGA``."""
+    measure = intensity["measure"]
+    if measure == "psa":
+        return f"PSA(T = {intensity['period']:g} s, {100 * intensity['damping']:g} % damping)"
+    if measure == "sa_avg":
+        periods = intensity["periods"]
+        return f"Sa_avg({periods[0]:g}-{periods[-1]:g} s, {len(periods)} periods, {100 * intensity['damping']:g} % damping)"
+    return measure.upper()
+
+
+def store_names(intensity: Mapping[str, Any] | None) -> list[str]:
+    """The per-case intensity variables of a store (none without intensity)."""
+    if intensity is None:
+        return []
+    names = [name for name in SUMMARIES if name != "ida_capacity"]
+    return names + (["ida_capacity"] if intensity["ran"] == "ida" else [])
+
+
+def task_settings(experiment: Any, motions: Mapping[str, Any]) -> dict[str, Any] | None:
+    """What a worker needs to scale an experiment's cases (None without intensity).
+
+    The ``intensity`` entry, g, the gap axes and, by motion number, the
+    ensembles' mean measures (``expected``; ``[intensity] synthetic = "expected"``).
+    """
+    if experiment.intensity is None:
+        return None
+    gap_axes = [(gap["name"], list(gap["contacts"])) for gap in experiment.definition["gaps"]]
+    expected = {index: motions[label].expected_intensity for index, label in enumerate(experiment.motions) if motions[label].expected_intensity is not None}
+    return {**experiment.intensity, "g": float(experiment.definition["scene"].get("g", 9.81)), "gap_axes": gap_axes, "expected": expected}
+
+
+def ensemble_intensity(intensity: Mapping[str, Any], table: Mapping[str, Any], realizations: range, g: float) -> float:
+    """Mean measure (units of ``levels``) of an ensemble's realizations, generated from its worker table in chunks."""
+    from stochpound import motions as synthetic_motions
+
+    parameters = {k: v for k, v in table.items() if k not in ("type", "interpolation", "realization")}
+    generator = getattr(synthetic_motions, table["type"])
+    total = 0.0
+    for start in range(realizations.start, realizations.stop, ENSEMBLE_CHUNK):
+        count = min(ENSEMBLE_CHUNK, realizations.stop - start)
+        values = np.asarray(generator(count, start=start, **parameters).values, dtype=float)
+        total += sum(motion_measures(row, float(table["dt"]), intensity, g, spectrum=False)["motion_intensity"] for row in values)
+    return total / len(realizations)
+
+
+def measures_of(settings: Mapping[str, Any], ground: Any) -> dict[str, Any]:
+    """:func:`motion_measures` of a sampled ground motion (a motion given by a formula cannot be scaled to a measure)."""
+    from stochpound.motions.ground import SampledMotion
+
+    if not isinstance(ground, SampledMotion):
+        raise IntensityError(f"intensity: only sampled motions (records, suites, synthetic ensembles) can be scaled, not {type(ground).__name__}")
+    return motion_measures(ground.values, ground.dt, settings, settings["g"])
+
+
+def scaled_case(
+    settings: Mapping[str, Any], record: int, labels: Mapping[str, Any], ground: Any, twin: np.ndarray, measures: Mapping[str, Any]
+) -> tuple[Any, np.ndarray, dict[str, Any]]:
+    """The case's motion and fixed-base twin scaled to its ``intensity`` level (unchanged for IDA), and its intensity variables.
+
+    ``record`` is the motion's number (an ensemble scaled by its mean measure
+    uses it). The twin is linear and starts at rest, so scaling its response
+    equals running it on the scaled motion.
+    """
+    import dataclasses
+
+    level = labels.get("intensity")
+    reference = settings["expected"].get(record, measures["motion_intensity"])
+    scale = 1.0 if level is None else float(level) / reference
+    extra = {**measures, "scale_factor": scale}
+    if scale == 1.0:
+        return ground, twin, extra
+    scaled = dataclasses.replace(ground, values=ground.values * scale, description=f"{ground.description} x {scale:.9g}")
+    return scaled, twin * scale, extra
+
+
+def capacity_of(settings: Mapping[str, Any], summary: Mapping[str, Any], labels: Mapping[str, Any]) -> float:
+    """:func:`ida_capacity` of a contact-free case from its summary and grid labels."""
+    axes = [(float(labels[name]), contacts) for name, contacts in settings["gap_axes"]]
+    return ida_capacity(np.asarray(summary["peak_contact_closure"], dtype=float), float(summary["motion_intensity"]), axes)
+
+
+def warm_up() -> None:
+    """Compile the response spectrum's kernel (or load it from numba's cache) before workers start."""
+    response_spectrum(np.zeros(3), 0.01, [1.0])

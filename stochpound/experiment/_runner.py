@@ -1,0 +1,517 @@
+"""``experiment run``: the missing cases of an experiment, on dask, into its store.
+
+The client (this process) validates everything, checks the store, writes the
+store file once before the first case, submits batches of cases
+(:mod:`stochpound.experiment._batches`) with a bounded number in flight,
+writes finished cases to part files as results arrive (one per
+:data:`~stochpound.experiment._parts.PART_REALIZATIONS` realizations or a few seconds),
+rebuilds the store at checkpoints and at the end. Workers only compute
+(:mod:`stochpound.experiment._compute`): they need the package, not the
+store's file system. The client's memory does not grow with the number of
+cases (beyond a few bytes per case for the grid's masks).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import logging
+import os
+import signal
+import sys
+import threading
+import time
+from contextlib import contextmanager
+from dataclasses import dataclass, field
+from multiprocessing import forkserver
+from pathlib import Path
+from typing import Any, Callable, Iterable, Iterator
+
+from stochpound import __version__
+from stochpound.experiment._batches import automatic_size, make_batches
+from stochpound.experiment._compute import BatchResult, BatchTask, run_batch, solver_cached, warm_up
+from stochpound.experiment._estimate import LARGE_RUN_BYTES, LARGE_RUN_CASES, estimate_run
+from stochpound.experiment._grid import Experiment
+from stochpound.experiment._parts import FolderLock, PartBuffer, append_run, parts_folder, remove_temporaries
+from stochpound.experiment._session import StoreSession, check_store, clear_store, code_identity, machine, missing_summaries, now, store_complete
+from stochpound.experiment._sources import ResolvedMotion, resolve_motions
+from stochpound.experiment._spec import ExperimentError, load_definition
+from stochpound.experiment._store_writer import PartsIndex
+from stochpound._memory import format_bytes
+
+CHECKPOINT_FACTOR = 20.0
+"""A checkpoint waits at least this many times the last rebuild's duration (rebuilds cost at most ~5 % of a run)."""
+IN_FLIGHT_PER_WORKER = 2
+"""Batches submitted ahead per worker thread."""
+LOCAL_CLUSTER_CONFIG = {
+    "distributed.worker.profile.enabled": False,
+    "distributed.admin.system-monitor.interval": "2s",
+    "distributed.admin.tick.interval": "500ms",
+    "distributed.worker.multiprocessing-method": "forkserver",
+}
+"""dask settings of the local cluster: no statistical profiler in the workers (it samples their threads every
+10 ms), slower system monitors and event-loop ticks: idle, the cluster takes about 3 % of a core instead of 13 %;
+worker processes forked by multiprocessing's fork server (which ignores SIGINT: :func:`_handling_sigint`)."""
+
+
+@dataclass
+class RunReport:
+    """What a run did.
+
+    Attributes
+    ----------
+    store : Path
+        The store file.
+    total : int
+        Cases of the experiment (references included).
+    done_before : int
+        Cases already finished when the run started.
+    done_now : int
+        Cases finished by this run.
+    failed : list of (str, str)
+        Cases that raised, described, with their tracebacks.
+    elapsed : float
+        Wall time of the run, s.
+    setup : float
+        Of which before the first batch was submitted (store checks and first
+        write, the cluster's start, loading the compiled solver in every worker), s.
+    executor : str
+        Where the cases ran.
+    interrupted : bool
+        True if the run was stopped (Ctrl-C, SIGTERM).
+    repaired : bool
+        The store file was damaged and was rebuilt from the finished cases in its parts folder.
+    nothing_to_run : bool
+        The store was complete: nothing ran and nothing was written.
+    """
+
+    store: Path
+    total: int
+    done_before: int
+    done_now: int = 0
+    failed: list[tuple[str, str]] = field(default_factory=list)
+    elapsed: float = 0.0
+    setup: float = 0.0
+    executor: str = ""
+    interrupted: bool = False
+    repaired: bool = False
+    nothing_to_run: bool = False
+
+    @property
+    def done(self) -> int:
+        """Cases finished in total."""
+        return self.done_before + self.done_now
+
+    @property
+    def complete(self) -> bool:
+        """Every case finished."""
+        return self.done == self.total
+
+
+def load_experiment(path: str | Path) -> Experiment:
+    """Read, validate and expand an experiment file (every scene of the grid is checked).
+
+    Raises
+    ------
+    ExperimentError
+        Naming the field and the allowed values.
+    """
+    definition, text = load_definition(path)
+    experiment = Experiment(definition, text, Path(path).parent, str(path))
+    experiment.validate()
+    return experiment
+
+
+def default_store(experiment_path: str | Path) -> Path:
+    """The default store of an experiment file: beside it, suffix ``.nc``."""
+    return Path(experiment_path).with_suffix(".nc")
+
+
+def run_experiment(
+    experiment: Experiment,
+    store: str | Path | None = None,
+    *,
+    workers: int | None = None,
+    scheduler: str | None = None,
+    restart: bool = False,
+    progress: bool = True,
+    checkpoint: float = 30.0,
+    batch_size: int | None = None,
+    large_ok: bool = True,
+    say: Callable[[str], None] | None = None,
+) -> RunReport:
+    """Run the missing cases of an experiment into its store.
+
+    Parameters
+    ----------
+    experiment : Experiment
+        From :func:`load_experiment`.
+    store : str or Path, optional
+        Store file (default: beside the experiment file, ``.nc``).
+    workers : int, optional
+        Local dask worker processes (default: the machine's cores); 0 runs
+        every case in this process, without dask.
+    scheduler : str, optional
+        Address of an existing dask.distributed scheduler (``tcp://host:port``).
+    restart : bool
+        Discard an existing store and its parts (also one of another definition).
+    progress : bool
+        Show a progress bar on stderr.
+    checkpoint : float
+        Least number of seconds between rebuilds of the store file during the
+        run (and at least ``CHECKPOINT_FACTOR`` times the last rebuild's duration).
+    batch_size : int, optional
+        Cases per dask task (default: ``stochpound.experiment._batches.automatic_size``).
+    large_ok : bool
+        Run a large experiment (``RunEstimate.large`` of ``stochpound.experiment._estimate``);
+        if False, one is refused before anything is written (``experiment run`` without ``--yes``).
+    say : callable, optional
+        Called with a line about each step of the start-up (the estimate, the
+        cluster's start, the solver's compilation), as it begins.
+
+    Returns
+    -------
+    RunReport
+
+    Raises
+    ------
+    ExperimentError
+        Before any case runs: a bad motion, an unreadable store without
+        parts to rebuild it from, a store of another definition (without
+        ``restart``), a store being written by another run, or a large
+        experiment without ``large_ok``. The existing store is then left unchanged.
+    OSError
+        If the store's folder cannot be written.
+
+    Notes
+    -----
+    A store whose file says every case is done is left as it is: no cluster
+    starts and nothing is written (``nothing_to_run``).
+    """
+    started = time.monotonic()
+    say = say or (lambda message: None)
+    store = Path(store) if store is not None else default_store(experiment.path or f"{experiment.name}.toml")
+    motions = resolve_motions(experiment)
+    repair = False
+    if not restart:
+        repair = check_store(store, experiment.sha256)
+        if store.is_file() and not repair and store_complete(store):
+            if FolderLock(parts_folder(store)).held():
+                raise _busy(store)
+            missing = missing_summaries(store, experiment, {label: m.grid for label, m in motions.items()})
+            if missing:
+                raise ExperimentError(f"{store}: written by an earlier stochpound without {', '.join(missing)}, which it keeps now: "
+                                      "run the experiment again with --restart to recompute its cases")
+            return RunReport(store, experiment.n_cases, experiment.n_cases, elapsed=time.monotonic() - started, nothing_to_run=True)
+    elif store.is_dir():
+        raise ExperimentError(f"{store}: is a folder; --store must name a file")
+    grids = {label: m.grid for label, m in motions.items()}
+    _check_size(experiment, grids, store, restart, large_ok, _cores(workers, scheduler))
+    parts_folder(store).mkdir(parents=True, exist_ok=True)
+    lock = FolderLock(parts_folder(store))
+    if not lock.acquire():
+        raise _busy(store)
+    with lock, _interrupts() as stop:
+        if restart:
+            clear_store(store)
+        remove_temporaries(parts_folder(store))
+        session = StoreSession.create(store, experiment, grids)
+        session.scan(remove_unreadable=True)
+        report = RunReport(store, experiment.n_cases, session.index.n_done, repaired=repair)
+        report.executor = _describe_executor(workers, scheduler)
+        if repair:
+            say(f"{store}: damaged; rebuilding it from the {report.done_before} finished cases in {session.folder.name}/")
+        if report.done_before < report.total:
+            say(estimate_run(experiment, grids, report.total - report.done_before).describe(_cores(workers, scheduler)))
+        identity = code_identity()
+        append_run(session.folder, {"started": now(), "machine": machine(), "executor": report.executor, **identity})
+        missing = session.missing()
+        session.rebuild()
+        checkpoints = _Checkpoints(checkpoint, session)
+        bar: Any = _NoBar()
+        realizations = sum(len(experiment.realizations(label)) for label in experiment.motions)
+        meta = {"stochpound_version": __version__, "sources_sha256": identity["sources_sha256"]}
+        buffer = PartBuffer(session.folder, meta, experiment.n_cases / realizations)
+
+        def ready() -> None:
+            nonlocal bar
+            report.setup = time.monotonic() - started
+            bar = _progress_bar(report, experiment.name, progress)  # after the start-up's messages
+
+        try:
+            size = batch_size or automatic_size(experiment.n_cases - report.done_before, workers)
+            batches = make_batches(experiment, missing, motions, size)
+            with contextlib.closing(execute(batches, experiment, motions, workers, scheduler, ready, say)) as results:
+                for task, result in results:
+                    _record(experiment, report, buffer, task, result)
+                    if stop.requested:
+                        raise KeyboardInterrupt
+                    bar.update(result.done)
+                    if checkpoints.due():
+                        buffer.flush()
+                        checkpoints.start()
+        except KeyboardInterrupt:
+            report.interrupted = True
+        finally:
+            buffer.flush()
+            bar.close()
+            checkpoints.wait()
+            session.rebuild()
+            report.elapsed = time.monotonic() - started
+            report.setup = report.setup or report.elapsed  # stopped before the first batch: all of it was start-up
+    return report
+
+
+def _busy(store: Path) -> ExperimentError:
+    return ExperimentError(f"{store}: another run is writing this store (its parts folder is locked)")
+
+
+def _check_size(experiment: Experiment, grids: dict[str, tuple[float, int]], store: Path, restart: bool, large_ok: bool, cores: int) -> None:
+    """Refuse a large run (:attr:`RunEstimate.large`, its finished cases not counted) unless ``large_ok``."""
+    if large_ok:
+        return
+    estimate = estimate_run(experiment, grids, experiment.n_cases)
+    if estimate.large and not restart and parts_folder(store).is_dir():
+        estimate = estimate_run(experiment, grids, experiment.n_cases - PartsIndex.scan(experiment, parts_folder(store)).n_done)
+    if estimate.large:
+        raise ExperimentError(
+            f"{experiment.path or experiment.name}: {estimate.describe(cores)}; "
+            f"above {LARGE_RUN_CASES:,} cases or {format_bytes(LARGE_RUN_BYTES)} of store: give --yes to run it"
+        )
+
+
+def _record(experiment: Experiment, report: RunReport, buffer: PartBuffer, task: BatchTask, result: BatchResult) -> None:
+    """Queue a batch's finished cases for the next part; note its failures."""
+    buffer.add(result.arrays)
+    report.done_now += result.done
+    for kind, position, error in result.failures:
+        report.failed.append((experiment.case_at(kind, position).describe(), error))
+
+
+class _Checkpoints:
+    """Rebuilds of the store during a run, in a background thread (batches go on being submitted meanwhile):
+    ``interval`` s after the previous one ended, and at least :data:`CHECKPOINT_FACTOR` times its duration.
+
+    The rebuild reads only complete parts (written atomically), so parts may
+    be written while it runs. An error in it is raised in the run at the next
+    :meth:`due` or :meth:`wait`.
+    """
+
+    def __init__(self, interval: float, session: StoreSession) -> None:
+        self.interval = interval
+        self.session = session
+        self.next = time.monotonic() + interval
+        self.thread: threading.Thread | None = None
+        self.error: BaseException | None = None
+
+    def due(self) -> bool:
+        """No rebuild running and its time has come (raises a failed rebuild's error)."""
+        self._raise()
+        return (self.thread is None or not self.thread.is_alive()) and time.monotonic() >= self.next
+
+    def start(self) -> None:
+        """Start a rebuild."""
+        self.thread = threading.Thread(target=self._rebuild, name="stochpound-checkpoint", daemon=True)
+        self.thread.start()
+
+    def wait(self) -> None:
+        """Wait for a running rebuild to end (raises its error)."""
+        if self.thread is not None:
+            self.thread.join()
+        self._raise()
+
+    def _rebuild(self) -> None:
+        started = time.monotonic()
+        try:
+            self.session.rebuild()
+        except BaseException as error:  # noqa: BLE001 - handed to the run's thread
+            self.error = error
+        finished = time.monotonic()
+        self.next = finished + max(self.interval, CHECKPOINT_FACTOR * (finished - started))
+
+    def _raise(self) -> None:
+        if self.error is not None:
+            error, self.error = self.error, None
+            raise error
+
+
+def execute(
+    batches: Iterable[BatchTask],
+    experiment: Experiment,
+    motions: dict[str, ResolvedMotion],
+    workers: int | None,
+    scheduler: str | None,
+    ready: Callable[[], None] = lambda: None,
+    say: Callable[[str], None] = lambda message: None,
+) -> Iterator[tuple[BatchTask, BatchResult]]:
+    """Run batches and yield (task, result) as they finish (in any order); call ``ready()`` before the first is submitted.
+
+    ``say`` is called with a line as each step of the start-up begins.
+
+    On dask, every worker first loads the compiled solver (:func:`~stochpound.experiment._compute.warm_up`).
+
+    ``workers=0`` (and no scheduler) runs them in this process; otherwise on a
+    local dask cluster of ``workers`` processes or on the given scheduler,
+    with at most :data:`IN_FLIGHT_PER_WORKER` batches per worker thread
+    submitted ahead (the batches are made as they are submitted). A batch
+    whose task fails as a whole (e.g. its worker died) is reported as failed
+    for each of its cases.
+    """
+    labels = list(experiment.motions)
+    if workers == 0 and scheduler is None:
+        ready()
+        for task in batches:
+            yield task, run_batch(task, motions[labels[task.record]].motion)
+        return
+    from distributed import as_completed, wait
+
+    with _dask_client(workers, scheduler, say) as client:
+        wait([client.submit(warm_up, pure=False, workers=[worker]) for worker in client.scheduler_info()["workers"]])
+        shipped = {m: client.scatter(motions[label].motion, broadcast=True, hash=False) for m, label in enumerate(labels) if motions[label].motion is not None}
+        ahead = IN_FLIGHT_PER_WORKER * max(1, sum(client.nthreads().values()))
+        pending = iter(batches)
+        tasks: dict[Any, BatchTask] = {}
+        running = as_completed()
+        ready()
+
+        def submit() -> None:
+            task = next(pending, None)
+            if task is not None:
+                future = client.submit(run_batch, task, shipped.get(task.record), pure=False)
+                tasks[future] = task
+                running.add(future)
+
+        try:
+            for _ in range(ahead):
+                submit()
+            for future in running:
+                task = tasks.pop(future)
+                try:
+                    result = future.result()
+                except Exception as error:  # noqa: BLE001 - e.g. KilledWorker: the batch's cases are reported as failed
+                    message = f"{type(error).__name__}: {error}"
+                    result = BatchResult(failures=[(g.kind, tuple(int(i) for i in p), message) for g in task.groups for p in g.positions])
+                future.release()
+                submit()
+                yield task, result
+        finally:
+            client.cancel(list(tasks))
+
+
+@contextmanager
+def _dask_client(workers: int | None, scheduler: str | None, say: Callable[[str], None]) -> Iterator[Any]:
+    import dask
+    from distributed import Client, LocalCluster
+
+    for name in ("distributed", "distributed.nanny", "distributed.worker", "distributed.scheduler", "distributed.core"):
+        logging.getLogger(name).setLevel(logging.ERROR)
+    if scheduler is not None:
+        say(f"connecting to the dask scheduler {scheduler}…")
+        client = Client(scheduler, timeout="30s")
+        try:
+            yield client
+        finally:
+            client.close(timeout=10)
+        return
+    say("compiling the solver (first run only, ~10 s)…" if not solver_cached() else "loading the compiled solver…")
+    warm_up()
+    n_workers = workers or os.cpu_count() or 1
+    say(f"starting a local dask cluster ({n_workers} worker{'s' if n_workers > 1 else ''})…")
+    with _handling_sigint(signal.SIG_IGN):  # the fork server, and every worker process it forks, ignore SIGINT
+        forkserver.ensure_running()
+    cluster = client = None
+    requested: list[int] = []
+    try:
+        # a SIGINT during the cluster's start (which an exception would leave half made) is raised once it can be closed
+        with dask.config.set(LOCAL_CLUSTER_CONFIG), _handling_sigint(lambda signum, frame: requested.append(signum)):
+            cluster = LocalCluster(  # its HTTP server on a free port (the default, 8787, may be taken: a warning)
+                n_workers=n_workers, threads_per_worker=1, processes=True, dashboard_address=":0", silence_logs=logging.ERROR
+            )
+        if requested:
+            raise KeyboardInterrupt
+        client = Client(cluster)
+        yield client
+    finally:
+        if client is not None:
+            client.close(timeout=10)
+        if cluster is not None:
+            cluster.close(timeout=10)
+
+
+@contextmanager
+def _handling_sigint(handler: Any) -> Iterator[None]:
+    """SIGINT goes to ``handler`` inside the block (``signal.SIG_IGN``: ignored); nothing changes outside the main thread.
+
+    The local workers are forked by multiprocessing's fork server
+    (:data:`LOCAL_CLUSTER_CONFIG`), started while SIGINT is ignored: they
+    inherit the ignored SIGINT. A Ctrl-C in a terminal reaches every process
+    of the foreground group; the workers then stop with the cluster instead of
+    printing their own tracebacks. Ignoring lasts as long as the fork server's
+    fork and exec (milliseconds, once per process): a Ctrl-C then is lost.
+    """
+    try:
+        previous = signal.signal(signal.SIGINT, handler)
+    except ValueError:  # not the main thread
+        yield
+        return
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
+def _cores(workers: int | None, scheduler: str | None) -> int:
+    """Cores the cases run on: the local workers (this machine's cores for a scheduler's unknown cluster)."""
+    if workers == 0 and scheduler is None:
+        return 1
+    return workers or os.cpu_count() or 1
+
+
+def _describe_executor(workers: int | None, scheduler: str | None) -> str:
+    if scheduler is not None:
+        return f"dask scheduler {scheduler}"
+    if workers == 0:
+        return "this process (no dask)"
+    return f"local dask cluster, {_cores(workers, scheduler)} worker processes"
+
+
+class _StopFlag:
+    """Set by SIGINT/SIGTERM, in case the KeyboardInterrupt is swallowed (e.g. inside compiled code)."""
+
+    requested = False
+
+
+@contextmanager
+def _interrupts() -> Iterator[_StopFlag]:
+    """Treat SIGINT and SIGTERM as a request to stop: raise KeyboardInterrupt and remember it."""
+    flag = _StopFlag()
+
+    def handler(signum: int, frame: Any) -> None:
+        flag.requested = True
+        raise KeyboardInterrupt
+
+    try:
+        previous = {sig: signal.signal(sig, handler) for sig in (signal.SIGINT, signal.SIGTERM)}
+    except ValueError:  # not the main thread
+        yield flag
+        return
+    try:
+        yield flag
+    finally:
+        for sig, old in previous.items():
+            signal.signal(sig, old)
+
+
+class _NoBar:
+    def update(self, n: int) -> None:
+        pass
+
+    def close(self) -> None:
+        pass
+
+
+def _progress_bar(report: RunReport, name: str, enabled: bool) -> Any:
+    if not enabled:
+        return _NoBar()
+    from tqdm import tqdm
+
+    return tqdm(total=report.total, initial=report.done_before, unit="case", desc=name, file=sys.stderr, smoothing=0.1, dynamic_ncols=True)

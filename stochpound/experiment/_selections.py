@@ -1,0 +1,45 @@
+"""Selections of an experiment store by what its grid's values mean: contact-free and wall-free cases, fixed-base twins.
+
+A gap axis that holds ``inf`` makes *contact-free* cases (an axis setting
+contacts) or *wall-free* cases (an axis setting walls only): their gaps
+never close, and by the gap identity their peak closure answers every gap at
+once (docs/separation.md). That rule is the analysis layer's
+(``stochpound.analysis._gap_axes``, which the risk chain uses too), given
+here too. A μ axis that holds :data:`~stochpound.experiment.FIXED_BASE`
+makes, for each isolated case, its *fixed-base twin*: the same case with the
+sliding base removed. These functions take a store, or any dataset or array
+on its grid dimensions (statistics over realizations, say).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from typing import TypeVar
+
+import xarray as xr
+
+from stochpound.analysis._gap_axes import contact_free, contact_gap_dims, gap_dims, has_contact_free, has_wall_free, wall_free, wall_gap_dims, with_contacts, with_walls
+from stochpound.experiment._definition import FIXED_BASE, is_fixed_base
+
+__all__ = [
+    "contact_free", "contact_gap_dims", "fixed_base", "gap_dims", "has_contact_free", "has_fixed_base_twins", "has_wall_free",
+    "isolated_mus", "wall_free", "wall_gap_dims", "with_contacts", "with_walls",
+]
+
+Data = TypeVar("Data", xr.Dataset, xr.DataArray)
+
+
+def has_fixed_base_twins(mus: Iterable[float]) -> bool:
+    """Whether a μ axis holds both :data:`~stochpound.experiment.FIXED_BASE` and finite values (isolated cases with their twins)."""
+    fixed = [is_fixed_base(m) for m in mus]
+    return any(fixed) and not all(fixed)
+
+
+def isolated_mus(mus: Iterable[float]) -> list[float]:
+    """The finite values of a μ axis (the cases on a sliding base), in order."""
+    return [float(m) for m in mus if not is_fixed_base(m)]
+
+
+def fixed_base(data: Data) -> Data:
+    """The fixed-base cases (μ = :data:`~stochpound.experiment.FIXED_BASE`), the ``mu`` coordinate kept."""
+    return data.sel(mu=FIXED_BASE)

@@ -1,0 +1,270 @@
+"""A store and its parts folder: identity checks, loading the finished cases, rebuilding the file.
+
+Used by ``experiment run`` (with the folder's lock held) and by
+``experiment status``.
+"""
+
+from __future__ import annotations
+
+import datetime as _dt
+import hashlib
+import json
+import os
+import platform
+import shutil
+import subprocess
+from functools import lru_cache
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from stochpound import __version__
+from stochpound.experiment._grid import KINDS, Experiment
+from stochpound.experiment._parts import DEFINITION_FILE, part_paths, parts_folder, read_experiment_json, read_runs, write_experiment_json
+from stochpound.experiment._spec import ExperimentError, canonical_json
+from stochpound.experiment._store import PREFIX, layout
+from stochpound.experiment._store_writer import PartsIndex, write_store
+
+
+def now() -> str:
+    """Current UTC time, ISO 8601."""
+    return _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")
+
+
+def store_identity(store: Path) -> str:
+    """The ``definition_sha256`` attribute of an existing store file.
+
+    Raises
+    ------
+    ExperimentError
+        If the file is not a readable experiment store.
+    """
+    import h5py
+
+    try:
+        with h5py.File(store, "r") as handle:
+            value = handle.attrs["definition_sha256"]
+    except KeyError:
+        raise ExperimentError(f"{store}: not a stochpound experiment store (no definition_sha256 attribute)") from None
+    except OSError as error:
+        raise ExperimentError(f"{store}: not a readable netCDF4/HDF5 file ({error})") from None
+    return value.decode() if isinstance(value, bytes) else str(value)
+
+
+def check_store(store: Path, sha256: str) -> bool:
+    """Refuse a store (or parts folder) that belongs to another experiment definition.
+
+    Returns
+    -------
+    bool
+        True if the store file is damaged (unreadable) but its parts folder
+        holds this definition's finished cases: the run rebuilds the file from them.
+
+    Raises
+    ------
+    ExperimentError
+        The store is a folder, is unreadable without parts to rebuild it from,
+        or was made from a different definition.
+    """
+    hint = "use --restart to discard it and start again, or --store to write elsewhere"
+    if store.is_dir():
+        raise ExperimentError(f"{store}: is a folder; --store must name a file")
+    folder = parts_folder(store)
+    parts = folder.exists() and ((folder / DEFINITION_FILE).exists() or bool(part_paths(folder)))
+    damaged = False
+    if store.exists():
+        try:
+            found = store_identity(store)
+        except ExperimentError as error:
+            if not parts:
+                raise ExperimentError(f"{error}; {hint}") from None
+            damaged = True  # rebuilt from the parts, if they hold this definition's cases (checked below)
+        else:
+            if found != sha256:
+                raise ExperimentError(f"{store}: made from a different experiment definition (sha256 {found[:12]}…, this one {sha256[:12]}…); {hint}")
+    if parts:
+        try:
+            found = read_experiment_json(folder)["definition_sha256"]
+        except (ExperimentError, KeyError, TypeError) as error:
+            raise ExperimentError(f"{folder}: unreadable parts folder ({error}); {hint}") from None
+        if found != sha256:
+            raise ExperimentError(f"{folder}: holds cases of a different experiment definition (sha256 {found[:12]}…, this one {sha256[:12]}…); {hint}")
+    return damaged
+
+
+def store_complete(store: Path) -> bool:
+    """True if the store file (readable, checked by :func:`check_store`) has no missing case."""
+    import h5py
+
+    with h5py.File(store, "r") as handle:
+        return all(not (handle[f"{prefix}_status"][()] == 0).any() for prefix in PREFIX.values())
+
+
+def missing_summaries(store: Path, experiment: Experiment, motion_grids: dict[str, tuple[float, int]]) -> list[str]:
+    """The summaries the experiment's store keeps today (:func:`stochpound.experiment._store.layout`) that the store file lacks: one written
+    by an earlier stochpound (e.g. ``peak_wall_penetration``, kept since for a scene with walls)."""
+    import h5py
+
+    with h5py.File(store, "r") as handle:
+        return [spec.name for spec in layout(experiment, motion_grids, 0).of("summary") if spec.name not in handle]
+
+
+def clear_store(store: Path) -> None:
+    """Delete a store file and its parts (``--restart``; call with the folder's lock held)."""
+    folder = parts_folder(store)
+    for path in folder.iterdir():
+        if path.name != ".lock":
+            shutil.rmtree(path) if path.is_dir() else path.unlink()
+    store.unlink(missing_ok=True)
+
+
+PACKAGE = Path(__file__).resolve().parents[1]
+"""The stochpound package's folder."""
+
+
+def git_commit(package: Path = PACKAGE) -> str:
+    """Commit of the git checkout the package is in ("+dirty" if modified), or "none" (an installed copy).
+
+    An installed copy is identified by the version and :func:`sources_sha256`.
+    """
+    source = package.parent
+    try:
+        tracked = subprocess.run(["git", "-C", str(source), "ls-files", "--error-unmatch", f"{package.name}/__init__.py"], capture_output=True, timeout=10)
+        commit = subprocess.run(["git", "-C", str(source), "rev-parse", "HEAD"], capture_output=True, text=True, timeout=10)
+        if tracked.returncode != 0 or commit.returncode != 0:
+            return "none"
+        dirty = subprocess.run(["git", "-C", str(source), "status", "--porcelain", "--", package.name], capture_output=True, text=True, timeout=10)
+    except (OSError, subprocess.SubprocessError):
+        return "none"
+    return commit.stdout.strip() + ("+dirty" if dirty.stdout.strip() else "")
+
+
+@lru_cache(maxsize=None)
+def sources_sha256(package: Path = PACKAGE) -> str:
+    """sha256 of the package's Python sources: every ``.py`` file's path (relative, sorted) and contents.
+
+    With the version, it identifies the code of a copy that is not a git
+    checkout (``pip install .``), where :func:`git_commit` gives "none".
+    """
+    digest = hashlib.sha256()
+    for path in sorted(package.rglob("*.py")):
+        digest.update(path.relative_to(package).as_posix().encode() + b"\0")
+        digest.update(path.read_bytes() + b"\0")
+    return digest.hexdigest()
+
+
+def code_identity() -> dict[str, str]:
+    """What identifies the running code: version, git commit (or "none") and sources' sha256."""
+    return {"stochpound_version": __version__, "git_commit": git_commit(), "sources_sha256": sources_sha256()}
+
+
+def machine() -> str:
+    """Host, platform, Python and CPU count of this process."""
+    return f"{platform.node()}; {platform.platform()}; Python {platform.python_version()}; {os.cpu_count()} CPUs"
+
+
+class StoreSession:
+    """A store file, its parts folder and the experiment they belong to.
+
+    Parameters
+    ----------
+    store : Path
+        The store file.
+    experiment : Experiment
+    record : dict
+        Contents of ``experiment.json``.
+    """
+
+    def __init__(self, store: Path, experiment: Experiment, record: dict[str, Any]) -> None:
+        self.store = Path(store)
+        self.folder = parts_folder(self.store)
+        self.experiment = experiment
+        self.record = record
+        self.index: PartsIndex | None = None
+
+    @classmethod
+    def create(cls, store: Path, experiment: Experiment, motion_grids: dict[str, tuple[float, int]]) -> "StoreSession":
+        """Open the parts folder for a run, writing ``experiment.json`` if it is new."""
+        folder = parts_folder(store)
+        folder.mkdir(parents=True, exist_ok=True)
+        if (folder / DEFINITION_FILE).exists():
+            record = read_experiment_json(folder)
+        else:
+            record = {
+                "definition_sha256": experiment.sha256,
+                "definition": json.loads(canonical_json(experiment.definition)),
+                "text": experiment.text,
+                "text_sha256": hashlib.sha256(experiment.text.encode()).hexdigest(),
+                "file": experiment.path,
+                "base_dir": str(experiment.base_dir.resolve()),
+                "motion_grids": {k: list(v) for k, v in motion_grids.items()},
+                "created": now(),
+            }
+            write_experiment_json(folder, record)
+        return cls(store, experiment, record)
+
+    @classmethod
+    def open(cls, store: Path) -> "StoreSession":
+        """Open an existing store's parts folder (for ``status``).
+
+        Raises
+        ------
+        ExperimentError
+            If there is no parts folder or it is unreadable.
+        """
+        folder = parts_folder(store)
+        record = read_experiment_json(folder)
+        experiment = Experiment(record["definition"], record.get("text", ""), record.get("base_dir", "."), record.get("file", ""))
+        return cls(store, experiment, record)
+
+    @property
+    def motion_grids(self) -> dict[str, tuple[float, int]]:
+        """(dt, samples) of each motion."""
+        return {k: (float(v[0]), int(v[1])) for k, v in self.record["motion_grids"].items()}
+
+    def scan(self, remove_unreadable: bool = False) -> PartsIndex:
+        """Find the finished cases in the parts (unreadable parts count as missing, and are deleted if asked)."""
+        self.index = PartsIndex.scan(self.experiment, self.folder)
+        if remove_unreadable:
+            for path in self.index.unreadable:
+                path.unlink(missing_ok=True)
+        return self.index
+
+    def missing(self) -> dict[str, np.ndarray]:
+        """For each kind, which cases of its grid are still to run (bool, from the last :meth:`scan`)."""
+        return {kind: self.experiment.in_grid(kind) & ~self.index.done(kind) for kind in KINDS}
+
+    def attrs(self) -> dict[str, Any]:
+        """Provenance attributes of the store."""
+        experiment = self.experiment
+        solver = experiment.solver
+        runs = read_runs(self.folder)
+        last = runs[-1] if runs else {}
+        return {
+            "experiment_name": experiment.name,
+            "experiment_description": experiment.definition.get("description", ""),
+            "experiment_file": self.record.get("file", ""),
+            "experiment_text": self.record.get("text", ""),
+            "experiment_sha256": self.record.get("text_sha256", ""),
+            "definition_sha256": experiment.sha256,
+            "definition": canonical_json(experiment.definition),
+            "studied_building": experiment.studied,
+            "stochpound_version": __version__,
+            "git_commit": last.get("git_commit", "none"),
+            "stochpound_sources_sha256": last.get("sources_sha256", ""),
+            "solver": solver["method"],
+            "solver_integrator": solver["integrator"],
+            "solver_rtol": solver["rtol"],
+            "solver_atol": solver["atol"],
+            "solver_note": "integrator, rtol and atol apply to the ivp solver only",
+            "seeds": json.dumps(experiment.seeds()),
+            "created": self.record.get("created", ""),
+            "updated": now(),
+            "machine": last.get("machine", machine()),
+            "runs": json.dumps(runs),
+        }
+
+    def rebuild(self) -> Path:
+        """(Re)write the store file atomically from the parts (scanned again: parts written since count)."""
+        return write_store(self.experiment, self.scan(), self.motion_grids, self.attrs(), self.store)

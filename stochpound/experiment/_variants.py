@@ -1,0 +1,193 @@
+"""Applying an experiment's overrides to a scene dict: variants, gaps and μ.
+
+Every function takes a scene dict (the structure of a scene file) and returns
+a modified deep copy; validation of the result is left to
+:func:`stochpound.scene_from_dict`.
+
+The *mass factor* rule (docs/experiments.md): multiplying a building's
+masses by f (floors and base) keeps its dynamics consistent:
+
+* storey dashpots given as ``damping`` are multiplied by sqrt(f), which keeps
+  every modal damping ratio (M → fM, K fixed, C → sqrt(f) C); a
+  ``damping_ratio`` is kept as it is;
+* every contact touching the building and every wall beside it is rescaled
+  by its law's rule (:meth:`stochpound.model.law.ContactLaw.rescale_table`)
+  with the ratio m_eff,new / m_eff,old, m_eff = m1 m2 / (m1 + m2): for a
+  Kelvin–Voigt element k_imp × ratio keeps its impact frequency
+  sqrt(k_imp / m_eff), and c_imp follows from the restitution (or, when given
+  as ``damping``, × the same ratio, which keeps its damping ratio).
+"""
+
+from __future__ import annotations
+
+import copy
+from typing import Any, Iterable, Mapping
+
+from stochpound._errors import SceneError
+from stochpound.model import building as building_law
+from stochpound.model import laws
+from stochpound.model.contact import ELEMENT_KEYS, effective_mass
+from stochpound.model.friction import is_fixed_base
+
+#: Motion used while validating a scene's structure (the real motion is set per case).
+PLACEHOLDER_MOTION = {"type": "constant", "acceleration": 0.0, "duration": 1.0, "dt": 1.0}
+
+
+def building_table(scene: Mapping[str, Any], name: str) -> dict[str, Any]:
+    """The ``[[building]]`` table named ``name`` (default names B1, B2, ... included)."""
+    for i, building in enumerate(scene["building"]):
+        if building.get("name", f"B{i + 1}") == name:
+            return building
+    raise KeyError(name)
+
+
+def apply_overrides(scene: Mapping[str, Any], overrides: Iterable[Mapping[str, Any]]) -> dict[str, Any]:
+    """Apply variant overrides: explicit fields first (in order), then all mass factors.
+
+    Parameters
+    ----------
+    scene : mapping
+        Base scene dict.
+    overrides : iterable of mapping
+        One override table per variant axis (``building.<name>`` and ``scene`` tables).
+
+    Returns
+    -------
+    dict
+        The new scene dict. The two phases make the result independent of the
+        order of the variant axes.
+    """
+    scene = copy.deepcopy(dict(scene))
+    factors: dict[str, float] = {}
+    for override in overrides:
+        scene.update(copy.deepcopy(override.get("scene", {})))
+        _override_contacts(scene, override.get("contact"))
+        for name, fields in override.get("building", {}).items():
+            building = building_table(scene, name)
+            for key, value in fields.items():
+                if key == "mass_factor":
+                    factors[name] = factors.get(name, 1.0) * float(value)
+                elif key == "base":
+                    _set_base(building, value)
+                elif key in ("damping", "damping_ratio"):
+                    building.pop("damping", None)
+                    building.pop("damping_ratio", None)
+                    building[key] = copy.deepcopy(value)
+                else:
+                    building[key] = copy.deepcopy(value)
+    for name, factor in factors.items():
+        scale_masses(scene, name, factor)
+    return scene
+
+
+def _override_contacts(scene: dict[str, Any], part: Mapping[str, Any] | list | None) -> None:
+    """Replace impact-element fields of every contact (one table) or of each contact (a list, one table per contact).
+
+    A table that gives ``law`` replaces the element (the old law's
+    ``stiffness``, ``restitution``, ``damping`` and ``tensile`` go); one
+    without ``law`` replaces only the fields it gives.
+    """
+    if part is None:
+        return
+    contacts = scene.get("contact", [])
+    tables = part if isinstance(part, list) else [part] * len(contacts)
+    for contact, fields in zip(contacts, tables):
+        if "law" in fields:
+            for key in ELEMENT_KEYS:
+                contact.pop(key, None)
+        contact.update(copy.deepcopy(dict(fields)))
+
+
+def _set_base(building: dict[str, Any], value: Any) -> None:
+    if value is False:
+        building.pop("base", None)
+    else:
+        building["base"] = {**building.get("base", {}), **copy.deepcopy(value)}
+
+
+def scale_masses(scene: dict[str, Any], name: str, factor: float) -> None:
+    """Multiply building ``name``'s masses by ``factor`` in place, with what the laws derive from them.
+
+    The building's own rule (:func:`stochpound.model.building.scale_masses`:
+    dashpots × √factor), then every contact touching it and every wall beside
+    it by their law's rule (:meth:`stochpound.model.law.ContactLaw.rescale_table`,
+    with the ratio of the effective masses, new over old: the factor itself
+    for a wall).
+    """
+    building = building_table(scene, name)
+    old_mass = [float(m) for m in building["mass"]]
+    building_law.scale_masses(building, factor)
+    for contact in scene.get("contact", []):
+        try:
+            ends = [(str(end_name), int(floor)) for end_name, floor in contact["between"]]
+            if name not in [end[0] for end in ends]:
+                continue
+            masses_new = [float(building_table(scene, end_name)["mass"][floor - 1]) for end_name, floor in ends]
+            masses_old = [old_mass[floor - 1] if end_name == name else new for (end_name, floor), new in zip(ends, masses_new)]
+        except (KeyError, IndexError, TypeError, ValueError):
+            continue  # a malformed contact: scene validation names it
+        _rescale_element(contact, effective_mass(*masses_new) / effective_mass(*masses_old))
+    for wall in scene.get("wall", []):
+        if wall.get("building") == name:  # a wall's effective mass is its level's mass, scaled by the factor
+            _rescale_element(wall, factor)
+
+
+def _rescale_element(table: dict[str, Any], mass_ratio: float) -> None:
+    """Rescale an impact element's table by its law's rule (a table naming no known law is left for scene validation to name)."""
+    try:
+        law = laws.contact_law(str(table.get("law", laws.DEFAULT_CONTACT_LAW)))
+    except SceneError:
+        return
+    law.rescale_table(table, mass_ratio)
+
+
+def set_gaps(scene: dict[str, Any], contacts: Iterable[int], gap: float, walls: Iterable[int] = ()) -> None:
+    """Set the gap (m) of the given contacts and walls (0-based indices into ``contact`` and ``wall``) in place."""
+    for index in contacts:
+        scene["contact"][index]["gap"] = float(gap)
+    for index in walls:
+        scene["wall"][index]["gap"] = float(gap)
+
+
+def set_mu(scene: dict[str, Any], buildings: Iterable[str] | None, mu: float) -> list[str]:
+    """Set the friction coefficient μ of buildings in place; μ = inf removes their base.
+
+    Parameters
+    ----------
+    scene : dict
+        Scene dict.
+    buildings : iterable of str or None
+        Buildings to change; None: every building that has a ``[building.base]``.
+    mu : float
+        Kinetic and static coefficient (``mu`` and ``mu_static``), >= 0, or inf
+        for a fixed base.
+
+    Returns
+    -------
+    list of str
+        The chosen buildings that have no base (an error unless μ is inf).
+    """
+    names = [b.get("name", f"B{i + 1}") for i, b in enumerate(scene["building"])]
+    chosen = list(buildings) if buildings is not None else [n for n in names if isinstance(building_table(scene, n).get("base"), dict)]
+    missing = []
+    for name in chosen:
+        building = building_table(scene, name)
+        if is_fixed_base(mu):
+            building.pop("base", None)
+        elif isinstance(building.get("base"), dict):
+            building["base"]["mu"] = float(mu)
+            building["base"]["mu_static"] = float(mu)
+        else:
+            missing.append(name)
+    if buildings is None and not chosen and not is_fixed_base(mu):
+        missing.append("(no building has a [building.base])")
+    return missing
+
+
+def reference_scene(scene: Mapping[str, Any], studied: str) -> dict[str, Any]:
+    """The studied building alone on a fixed base (no contacts), same g."""
+    building = copy.deepcopy(building_table(scene, studied))
+    building.pop("base", None)
+    building.pop("initial", None)
+    building["name"] = studied
+    return {"g": scene.get("g", 9.81), "building": [building], "contact": []}

@@ -1,0 +1,407 @@
+"""What the stores ran, from their own definitions: buildings, bases, contacts, motions, grids.
+
+Every store keeps its experiment's canonical definition (``definition``, JSON).
+This module rebuilds the scenes of each configuration of the grid from it
+(:class:`stochpound.experiment.Experiment`) and describes them: nothing
+here is fixed text, and a value appears only if a store ran it. Several
+stores that ran the same building or contact share one row.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass
+from functools import cached_property
+from typing import Any
+
+import pandas as pd
+import xarray as xr
+
+from stochpound import motions as synthetic_motions
+from stochpound.experiment import Case
+from stochpound.experiment._definition import GapAxis, is_fixed_base
+from stochpound.experiment._intensity import describe_measure
+from stochpound.experiment._grid import CASE
+from stochpound.model import laws
+from stochpound.model.contact import effective_mass
+from stochpound.model.modal_solution import modal_properties
+from stochpound.motions.records import load_record, registry_entries
+from stochpound.report.render._document import Paragraph, Table
+from stochpound.report.sections._stores import store_experiment
+from stochpound.model.scene import Building, Contact, Scene
+from stochpound.model.wall import Wall
+from stochpound.model.scene_file import scene_from_dict
+
+
+def number(value: float, digits: int = 6) -> str:
+    """A number for a sentence or a table cell: ``digits`` significant digits, ∞ for infinity."""
+    return "∞" if math.isinf(value) else f"{value:.{digits}g}"
+
+
+def numbers(values: Iterable[float], digits: int = 6) -> str:
+    """Numbers separated by commas."""
+    return ", ".join(number(float(v), digits) for v in values)
+
+
+def percent(values: Iterable[float]) -> str:
+    """Ratios as percentages, e.g. ``1 %, 2.24 %``."""
+    return ", ".join(f"{100.0 * float(v):.3g} %" for v in values)
+
+
+@dataclass(frozen=True)
+class Configuration:
+    """One structural configuration of an experiment: a combination of its variant axes' values.
+
+    Attributes
+    ----------
+    labels : dict
+        The variant axes' values (empty without variant axes).
+    scene : Scene
+        The scene of the configuration's first case with a finite μ (its
+        gaps and μ are those of that case; the grid's values are described
+        separately).
+    """
+
+    labels: dict[str, str]
+    scene: Scene
+
+    @property
+    def name(self) -> str:
+        """``neighbour = stiff, model = corrected``, or ``–`` without variant axes."""
+        return ", ".join(f"{axis} = {value}" for axis, value in self.labels.items()) or "–"
+
+
+class StoreDefinition:
+    """An experiment store's definition, with its configurations' scenes.
+
+    Parameters
+    ----------
+    name : str
+        The experiment's name.
+    store : xarray.Dataset
+        The store (its ``definition`` attribute is read).
+    """
+
+    def __init__(self, name: str, store: xr.Dataset) -> None:
+        self.name = name
+        self.store = store
+        self.experiment = store_experiment(store)
+        self.definition = self.experiment.contract
+
+    @cached_property
+    def configurations(self) -> list[Configuration]:
+        """One per combination of the variant axes, in grid order."""
+        cases = [c for c in self.experiment.cases if c.kind == CASE]
+        variant_axes = [v["name"] for v in self.experiment.variants]
+        chosen: dict[tuple, Case] = {}
+        for case in cases:
+            labels = case.label_dict
+            key = tuple(labels[axis] for axis in variant_axes)
+            finite = not is_fixed_base(labels.get("mu", 0.0))
+            if key not in chosen or (finite and is_fixed_base(chosen[key].label_dict.get("mu", 0.0))):
+                chosen[key] = case
+        return [Configuration(dict(zip(variant_axes, key)), scene_from_dict(self.experiment.structure(case))) for key, case in chosen.items()]
+
+    def takes_grid_mu(self, building: Building) -> bool:
+        """Whether the grid's ``mu`` axis sets this building's friction (it must then stand on a base)."""
+        mu = self.definition.mu
+        return mu is not None and building.base is not None and mu.sets(building.name, has_base=True)
+
+    @property
+    def mu_buildings_text(self) -> str:
+        """The buildings the ``mu`` axis applies to, in words."""
+        chosen = self.definition.mu.buildings
+        return ", ".join(chosen) if chosen else "every building on a sliding base"
+
+    @property
+    def mu_values(self) -> list[float]:
+        """The ``mu`` axis's values (empty without one)."""
+        return list(self.definition.mu.values) if self.definition.mu is not None else []
+
+    def gap_axis(self, contact: int) -> GapAxis | None:
+        """The grid's gap axis that sets this contact's gap, if any."""
+        return self.definition.contact_gap_axis(contact)
+
+    @property
+    def study_compat_cases(self) -> int:
+        """How many grid cases run the study's equations (``study_compat``)."""
+        return sum(1 for c in self.configurations if c.scene.study_compat) * self._cases_per_configuration
+
+    @property
+    def _cases_per_configuration(self) -> int:
+        total = sum(1 for c in self.experiment.cases if c.kind == CASE)
+        return total // max(len(self.configurations), 1)
+
+
+def _damping(building: Building) -> str:
+    if building.damping_ratio is not None:
+        return f"stiffness-proportional, C = a1·K with ζ1 = {percent([building.damping_ratio])}"
+    return f"storey dashpots {numbers(building.damping)} N·s/m"
+
+
+def _base(definition: StoreDefinition, building: Building, g: float) -> str:
+    base = building.base
+    if base is None:
+        return "fixed"
+    law = laws.friction_law(base.friction_law)
+    if definition.takes_grid_mu(building):
+        finite = [m for m in definition.mu_values if not is_fixed_base(m)]
+        parts = [f"sliding, {law.title}, μ = μ_s ∈ {{{numbers(finite)}}}" + (" or fixed (μ = ∞)" if len(finite) < len(definition.mu_values) else "")]
+    else:
+        parts = [f"sliding, {law.describe(base)}"]
+    parts.append(f"base mass {number(base.mass)} kg")
+    parts.append(base.describe_restoring(g))
+    return "; ".join(parts)
+
+
+def buildings_table(definitions: Iterable[StoreDefinition]) -> Table:
+    """Every building configuration the stores ran: masses, stiffnesses, damping, modes and base."""
+    rows: dict[tuple, list[str]] = {}
+    for definition in definitions:
+        for configuration in definition.configurations:
+            for building in configuration.scene.buildings:
+                modes = modal_properties(building)
+                damping_note = "" if modes.classical else " (damping not classical: ζ from the diagonal of ΦᵀCΦ)"
+                row = (
+                    building.name,
+                    str(building.n_floors),
+                    numbers(building.mass),
+                    numbers(building.stiffness),
+                    _damping(building),
+                    numbers(modes.periods, 4),
+                    percent(modes.damping_ratio) + damping_note,
+                    _base(definition, building, configuration.scene.g),
+                )
+                rows.setdefault(row, []).append((definition, configuration))
+    return _merged_table(
+        "table-buildings",
+        "The buildings as run: floor masses (floor 1 upwards), storey stiffnesses, damping, the fixed-base modes and the base.",
+        ["building", "floors", "masses (kg)", "storey stiffness (N/m)", "damping", "periods (s)", "modal damping", "base"],
+        rows,
+        "Periods and modal damping ratios are computed from the mass, stiffness and damping matrices of each building on a fixed base.",
+    )
+
+
+def _contact_row(definition: StoreDefinition, scene: Scene, index: int, contact: Contact) -> tuple[str, ...]:
+    left, right = scene.buildings[contact.left], scene.buildings[contact.right]
+    parameters = contact.parameters(effective_mass(left.mass[contact.left_floor - 1], right.mass[contact.right_floor - 1]))
+    axis = definition.gap_axis(index)
+    law = laws.contact_law(contact.law)
+    return (
+        f"{left.name} floor {contact.left_floor} – {right.name} floor {contact.right_floor}",
+        law.describe(parameters),
+        f"{{{numbers(axis.values)}}} (axis {axis.name})" if axis else number(contact.gap),
+        law.separation(parameters),
+    )
+
+
+def _wall_row(definition: StoreDefinition, scene: Scene, index: int, wall: Wall) -> tuple[str, ...]:
+    building = scene.buildings[wall.building]
+    axis = definition.definition.wall_gap_axis(index)
+    parameters = wall.parameters(building.base.mass if wall.level == 0 and building.base is not None else building.mass[max(wall.level, 1) - 1])
+    level = "base" if wall.level == 0 else f"floor {wall.level}"
+    law = laws.contact_law(wall.law)
+    return (
+        f"{building.name} {level} – wall on its {wall.side_name} (moves with the ground)",
+        law.describe(parameters),
+        f"{{{numbers(axis.values)}}} (axis {axis.name})" if axis else number(wall.gap),
+        law.separation(parameters),
+    )
+
+
+def contacts_table(definitions: Iterable[StoreDefinition]) -> Table | None:
+    """Every contact element the stores ran, between buildings and against walls (None when no store has one)."""
+    rows: dict[tuple, list[str]] = {}
+    for definition in definitions:
+        for configuration in definition.configurations:
+            for index, contact in enumerate(configuration.scene.contacts):
+                rows.setdefault(_contact_row(definition, configuration.scene, index, contact), []).append((definition, configuration))
+            for index, wall in enumerate(configuration.scene.walls):
+                rows.setdefault(_wall_row(definition, configuration.scene, index, wall), []).append((definition, configuration))
+    if not rows:
+        return None
+    return _merged_table(
+        "table-contacts",
+        "The contact (impact) elements as run: floors joined, law with its parameters, at-rest gap and separation rule.",
+        ["between", "law", "gap (m)", "separation"],
+        rows,
+        _contacts_note(definitions),
+    )
+
+
+def _contacts_note(definitions: Iterable[StoreDefinition]) -> str:
+    """The contacts table's note: m_eff, then what only the laws and walls that ran need said."""
+    scenes = [configuration.scene for definition in definitions for configuration in definition.configurations]
+    walls = any(scene.walls for scene in scenes)
+    ran = {element.law for scene in scenes for element in (*scene.contacts, *scene.walls)}
+    note = "m_eff = m1 m2 / (m1 + m2) of the two floor masses" + (" (against a wall, the level's own mass)." if walls else ".")
+    if laws.DEFAULT_CONTACT_LAW in ran:
+        note += (" A Kelvin–Voigt element's dashpot from a restitution e is c = 2 ξ √(k m_eff), ξ = −ln e / √(π² + ln² e).")
+    if walls:
+        note += (" A wall is rigid in that it moves with the ground and has no mass of its own; it is reached through its contact "
+                 "element, which it penetrates as that element's stiffness allows.")
+    return note
+
+
+def _where(uses: list[tuple[StoreDefinition, Configuration]]) -> str:
+    """The experiments and configurations a row was run in, e.g. ``<experiment> (neighbour = stiff)``."""
+    texts = []
+    for definition in dict.fromkeys(d for d, _ in uses):
+        chosen = [c for d, c in uses if d is definition]
+        axes = []
+        for axis in definition.experiment.variants:
+            values = list(dict.fromkeys(c.labels[axis["name"]] for c in chosen))
+            if len(values) < len(axis["values"]):
+                axes.append(f"{axis['name']} = {' or '.join(values)}")
+        texts.append(definition.name + (f" ({', '.join(axes)})" if axes else ""))
+    return "; ".join(texts)
+
+
+def _merged_table(key: str, caption: str, columns: list[str], rows: Mapping[tuple, list[tuple[StoreDefinition, Configuration]]], note: str) -> Table:
+    frame = pd.DataFrame([[*row, _where(uses)] for row, uses in rows.items()], columns=[*columns, "where"])
+    frame.index = pd.RangeIndex(1, len(frame) + 1, name="#")
+    return Table(key=key, caption=caption, frame=frame, note=note)
+
+
+def _synthetic_parameters(table: Mapping[str, Any], start: int) -> tuple[str, dict[str, Any]]:
+    """The generator's parameters as run, with the intensity S0 and σ it implies (one realization is generated)."""
+    parameters = {k: v for k, v in table.items() if k not in ("type", "interpolation")}
+    attrs = getattr(synthetic_motions, table["type"])(1, start=start, **parameters).attrs
+    filters = f"ω_g = {number(attrs['omega_g'])} rad/s, ζ_g = {number(attrs['zeta_g'])}"
+    if "omega_f" in attrs:
+        filters += f", ω_f = {number(attrs['omega_f'])} rad/s, ζ_f = {number(attrs['zeta_f'])}"
+    if "pga_target" in attrs:
+        intensity = f"expected PGA {number(attrs['pga_target'])} m/s² (peak factor {number(attrs['peak_factor'], 4)}, {attrs['peak_factor_method']})"
+    elif "rms_target" in attrs:
+        intensity = f"RMS {number(attrs['rms_target'])} m/s²"
+    else:
+        intensity = "S0 given"
+    envelope = json.loads(attrs["envelope"])
+    shape = "stationary" if envelope is None else f"{envelope.pop('type')} envelope ({', '.join(f'{k} = {number(v, 4)}' for k, v in envelope.items())})"
+    text = (
+        f"{table['type'].replace('_', '–').title()}: {filters}; {intensity}, S0 = {number(attrs['S0'], 4)} m²/s³ "
+        f"(two-sided), σ = {number(attrs['sigma'], 4)} m/s²; {shape}; {attrs['method']} method"
+        + ("; baseline-corrected (ends at rest)" if attrs.get("baseline_corrected") else "")
+        + ("; band-limited" if attrs.get("band_limited") else "")
+        + "; linear interpolation between samples"
+    )
+    return text, attrs
+
+
+def _analytic_parameters(table: Mapping[str, Any]) -> str:
+    if table["type"] == "harmonic":
+        phase = f" + {number(float(table['phase']))}" if table.get("phase") else ""
+        return f"harmonic a_g = A sin(Ωt{phase}), A = {number(float(table['amplitude']))} m/s², Ω = {number(float(table['omega']))} rad/s"
+    return f"constant a_g = {number(float(table['acceleration']))} m/s²"
+
+
+def _record_parameters(table: Mapping[str, Any]) -> tuple[str, str]:
+    """A record's description and its (step, duration) as run."""
+    name = str(table["record"])
+    entry = registry_entries().get(name)
+    if entry is None:
+        return f"record file {name} (sha256 {str(table.get('file_sha256'))[:12]}…)", "the file's"
+    record = load_record(name)
+    duration = min(record.duration, float(table.get("duration", math.inf)))
+    parts = [f"record {name} ({entry.description})"]
+    if float(table.get("scale", 1.0)) != 1.0:
+        parts.append(f"scaled by {number(float(table['scale']))}")
+    parts.append(f"{table.get('interpolation', 'linear')} interpolation between samples")
+    return ", ".join(parts), f"{number(record.dt)} s, {number(duration)} s"
+
+
+def motions_table(definitions: Iterable[StoreDefinition]) -> Table:
+    """Every ground motion the stores ran: records with their treatment, ensembles with their generator and seed."""
+    rows = []
+    for definition in definitions:
+        for motion in definition.definition.motions:
+            table = motion.motion
+            if motion.kind == "synthetic":
+                text, attrs = _synthetic_parameters(table, motion.start)
+                realizations = f"{motion.count} (indices {motion.start}–{motion.start + motion.count - 1}), seed {table['seed']}"
+                grid = f"{number(attrs['dt'])} s, {number(attrs['duration'])} s"
+            elif table.get("type", "record") == "record":
+                text, grid = _record_parameters(table)
+                realizations = "1"
+            else:
+                text, realizations = _analytic_parameters(table), "1"
+                grid = f"{number(float(table['dt']))} s, {number(float(table['duration']))} s"
+            rows.append([definition.name, motion.label, text, grid, realizations])
+    frame = pd.DataFrame(rows, columns=["experiment", "motion", "definition", "step, duration", "realizations"])
+    frame.index = pd.RangeIndex(1, len(frame) + 1, name="#")
+    return Table(
+        key="table-motions",
+        caption="The ground motions as run: each record with its treatment, each synthetic ensemble with its generator, intensity, envelope, seed and size.",
+        frame=frame,
+        note="Realization i of an ensemble depends only on (seed, i). The PSD convention: two-sided in ω, σ² = ∫ S dω.",
+    )
+
+
+def grid_paragraph(definition: StoreDefinition) -> Paragraph:
+    """The experiment's axes, studied building and number of cases."""
+    axes = []
+    for dim in definition.experiment.grid_dims:
+        if dim.kind == "variant":
+            axes.append(f"{dim.name} ∈ {{{', '.join(map(str, dim.values))}}}")
+        elif dim.kind == "gap":
+            axes.append(f"{dim.name} ∈ {{{numbers(dim.values)}}} m ({definition.definition.gap_axis(dim.name).targets})")
+        elif dim.kind == "intensity":
+            setting = definition.definition.intensity
+            axes.append(f"intensity ∈ {{{numbers(dim.values)}}} {setting['units']} ({describe_measure(setting)}, every motion scaled to every level)")
+        else:
+            axes.append(f"μ ∈ {{{numbers(dim.values)}}} for {definition.mu_buildings_text} (∞: fixed base)")
+    store = definition.store
+    scene = definition.configurations[0].scene
+    references = sum(1 for c in definition.experiment.cases if c.kind != CASE)
+    return Paragraph(
+        f"Experiment {definition.name}: {', '.join(axes) or 'a single configuration'}, under "
+        f"{len(definition.definition.motions)} motion(s) (Table of motions); g = {number(scene.g)} m/s². The studied building is "
+        f"{definition.experiment.studied}: the response whose moments are reported is its top-floor total displacement, and "
+        f"it is also run alone on a fixed base under every motion ({references} reference runs). "
+        f"{int(store.attrs.get('cases_done', 0))} of {int(store.attrs.get('cases_total', 0))} runs done."
+    )
+
+
+def model_paragraph(definitions: list[StoreDefinition]) -> Paragraph:
+    """The model, saying only what the stores' scenes use."""
+    scenes = [c.scene for d in definitions for c in d.configurations]
+    buildings = [b for s in scenes for b in s.buildings]
+    contacts = [c for s in scenes for c in s.contacts]
+    isolated = any(b.base is not None for b in buildings)
+    sentences = ["Buildings are shear buildings: lumped floor masses joined by storey springs and dashpots, standing in a row on the same ground."]
+    if isolated:
+        friction = sorted({laws.friction_law(b.base.friction_law).title for b in buildings if b.base is not None})
+        sentences.append(
+            f"A building on a sliding base has one more degree of freedom, its sliding displacement s; {' or '.join(friction)} "
+            "opposes the sliding, and the base sticks while the friction force it needs stays below μ_s W (W its weight); "
+            "the restoring force, if any, is given in the table of buildings."
+        )
+    walls = [w for s in scenes for w in s.walls]
+    if contacts or walls:
+        used = [laws.contact_law(name) for name in dict.fromkeys(e.law for e in (*contacts, *walls))]
+        sentences.append(
+            "Impact elements act only while their gap is closed: " + "; ".join(f"{law.title}, {law.formula}" for law in used)
+            + " (δ the penetration, δ̇ its rate, δ̇₀ its rate at the onset of the impact; parameters in the table of contacts)."
+        )
+    if walls:
+        sentences.append("Walls that move with the ground stand beside some levels, reached through such an impact element (table of contacts).")
+    if isolated and contacts:
+        sentences.append(
+            "The impact forces act on an isolated building as a whole (they enter its base equation), and friction at the onset "
+            "of slip opposes the driving force; a slipping base stops only when its velocity reaches zero (docs/model.md)."
+        )
+    compat = [(d.name, d.study_compat_cases) for d in definitions if d.study_compat_cases]
+    if compat:
+        sentences.append(
+            "The reference study's own equations (study_compat: no impact forces in the base equation, no friction at slip onset) "
+            "are run beside them in " + "; ".join(f"{n} cases of {name}" for name, n in compat) + "."
+        )
+    return Paragraph(" ".join(sentences))
+
+
+def records_used(definitions: Iterable[StoreDefinition]) -> list[str]:
+    """Bundled records run by the stores, sorted."""
+    used = {str(m.motion["record"]) for d in definitions for m in d.definition.motions if m.motion.get("type", "record") == "record" and "record" in m.motion}
+    return sorted(used & set(registry_entries()))

@@ -1,0 +1,211 @@
+"""The "Intensity" section of a report: a store whose motions were scaled to intensity levels.
+
+For a store made with an ``[intensity]`` table (docs/intensity.md) it gives:
+
+* what ran (stripes or IDA, and why) and the measure;
+* the response spectra (5 % damping) of the experiment's motions as
+  recorded, and, for stripes, the motions' median and 16/84 % spectra
+  scaled to each level;
+* a table of every stripe: its level, the range of the scale factors and,
+  per gap, the runs, those that pounded (at least one impact) and the
+  probability of pounding with its 95 % Clopper–Pearson interval;
+* per gap, that probability against intensity; for IDA, the fraction of
+  motions whose capacity is at most x, against x, with the same interval.
+
+Other structural axes (μ, variants) give one line per combination.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+import pandas as pd
+import xarray as xr
+from matplotlib.figure import Figure
+
+from stochpound.analysis.kernels import clopper_pearson
+from stochpound.experiment._intensity import describe_measure
+from stochpound.report.render._document import FigureItem, Paragraph, Section, Table
+from stochpound.experiment._definition import is_gap_axis, read_definition
+
+CONFIDENCE = 0.95
+G = 9.81
+
+
+def intensity_setting(store: xr.Dataset) -> dict[str, Any] | None:
+    """The definition's ``intensity`` entry of a store (None if it has none)."""
+    return read_definition(store).intensity
+
+
+def intensity_section(name: str, store: xr.Dataset) -> Section:
+    """The "Intensity" section of one store (call when :func:`intensity_setting` is not None)."""
+    setting = intensity_setting(store)
+    section = Section(f"Intensity: experiment {name}", key=f"intensity-{name}")
+    section.add(Paragraph(method_text(store, setting)))
+    section.add(_spectra(name, store, setting))
+    if "intensity" in store.dims:
+        section.add(_stripe_table(name, store, setting))
+        section.add(_stripe_figure(name, store, setting))
+    elif "ida_capacity" in store:
+        section.add(_ida_figure(name, store, setting))
+    return section
+
+
+def method_text(store: xr.Dataset, setting: dict[str, Any]) -> str:
+    """What ran (stripes or IDA, and why), the measure and the levels: one paragraph of the section and of the methods."""
+    levels = ", ".join(f"{level:g}" for level in setting["levels"])
+    text = (
+        f"Intensity measure {describe_measure(setting)}, in {setting['units']}. Method requested: {setting['method']}; ran: "
+        f"{setting['ran']} ({setting['note']}). {store.sizes['record']} motions"
+    )
+    if setting["ran"] == "stripes":
+        return text + f", each scaled to the levels {levels} {setting['units']} (its scale factor is the level over its own measure)."
+    return text + ": each run once without contacts; a motion whose contacts close by D at scale 1 first pounds at gap g at the intensity IM·g/D."
+
+
+def _cells(data: xr.DataArray, keep: tuple[str, ...]) -> list[tuple[str, xr.DataArray]]:
+    """(label, data) per combination of the structural dimensions other than ``keep`` (and record, realization)."""
+    others = [d for d in data.dims if d not in (*keep, "record", "realization")]
+    if not others:
+        return [("", data)]
+    stacked = data.stack(cell=others)
+    cells = []
+    for i in range(stacked.sizes["cell"]):
+        labels = stacked["cell"].values[i]
+        labels = labels if isinstance(labels, tuple) else (labels,)
+        cells.append((", ".join(f"{d}={v}" for d, v in zip(others, labels)), stacked.isel(cell=i, drop=True)))
+    return cells
+
+
+def _first_cell(data: xr.DataArray) -> xr.DataArray:
+    """The values at the first index of every structural dimension (the motion's measures repeat along them)."""
+    return data.isel({d: 0 for d in data.dims if d not in ("record", "realization", "spectrum_period", "intensity")})
+
+
+def _spectra(name: str, store: xr.Dataset, setting: dict[str, Any]) -> FigureItem:
+    periods = store["spectrum_period"].values
+    psa = _first_cell(store["motion_psa"])
+    done = _first_cell(store["case_status"]) == 1
+    figure = Figure(figsize=(7.5, 4.0), layout="constrained")
+    ax = figure.subplots()
+    unscaled = psa.isel(intensity=0) if "intensity" in psa.dims else psa
+    rows = unscaled.stack(motion=("record", "realization")).transpose("motion", ...).values / G
+    mask = (done.isel(intensity=0) if "intensity" in done.dims else done).stack(motion=("record", "realization")).values
+    for row in rows[mask]:
+        ax.loglog(periods, row, lw=0.4, color="0.8")
+    if "intensity" in store.dims:
+        scale = _first_cell(store["scale_factor"])
+        for j, level in enumerate(store["intensity"].values):
+            scaled = (psa.isel(intensity=j) * scale.isel(intensity=j)).stack(motion=("record", "realization")).transpose("motion", ...).values[mask] / G
+            low, median, high = np.nanpercentile(scaled, [16, 50, 84], axis=0)
+            (line,) = ax.loglog(periods, median, lw=1.6, label=f"{level:g} {setting['units']}: median, 16/84 %")
+            ax.fill_between(periods, low, high, color=line.get_color(), alpha=0.15)
+    ax.set_xlabel("period T (s)")
+    ax.set_ylabel("PSA (g), 5 % damping")
+    ax.grid(True, which="both", lw=0.3, color="0.85")
+    if "intensity" in store.dims:
+        ax.legend(fontsize=7)
+    caption = f"Experiment {name}: response spectra (5 % damping) of the {int(mask.sum())} motions as recorded (grey)"
+    if "intensity" in store.dims:
+        caption += "; at each level, the median and the 16-84 % band of the motions scaled to it"
+    return FigureItem(f"intensity-spectra-{name}", caption + ".", figure)
+
+
+def _pounding_counts(store: xr.Dataset) -> tuple[xr.DataArray, xr.DataArray]:
+    """Runs done and runs with at least one impact, per structural cell (summed over record and realization)."""
+    done = store["case_status"] == 1
+    pounded = (store["impacts"].fillna(0) > 0) & done
+    return done.sum(("record", "realization")), pounded.sum(("record", "realization"))
+
+
+def _proportion(k: np.ndarray, n: np.ndarray) -> np.ndarray:
+    """k / n, NaN where n = 0."""
+    return np.where(n > 0, k / np.maximum(n, 1), np.nan)
+
+
+def _probability_axes(ax: Any, setting: dict[str, Any], label: str, legend: bool) -> None:
+    """Axes of a probability against the intensity measure."""
+    ax.set_xlabel(f"{describe_measure(setting)} ({setting['units']})")
+    ax.set_ylabel(label)
+    ax.set_ylim(-0.02, 1.02)
+    ax.grid(True, lw=0.3, color="0.85")
+    if legend:
+        ax.legend(fontsize=7)
+
+
+def _stripe_table(name: str, store: xr.Dataset, setting: dict[str, Any]) -> Table:
+    runs, pounded = _pounding_counts(store)
+    lower, upper = clopper_pearson(pounded.values, runs.values, CONFIDENCE)
+    probability = xr.DataArray(_proportion(pounded.values, runs.values), runs.coords, runs.dims)
+    frame = xr.Dataset(
+        {
+            "runs": runs,
+            "pounded": pounded,
+            "P(pounding)": probability,
+            "lower": (runs.dims, lower),
+            "upper": (runs.dims, upper),
+        }
+    ).to_dataframe()
+    scale = _first_cell(store["scale_factor"]).where(_first_cell(store["case_status"]) == 1)
+    factors = pd.DataFrame(
+        {
+            "scale min": scale.min(("record", "realization")).to_series(),
+            "scale median": scale.median(("record", "realization")).to_series(),
+            "scale max": scale.max(("record", "realization")).to_series(),
+        }
+    )
+    frame = frame.reset_index().merge(factors.reset_index(), on="intensity").set_index(list(runs.dims))
+    return Table(
+        f"intensity-stripes-{name}",
+        f"Experiment {name}: every stripe ({describe_measure(setting)} in {setting['units']}): scale factors, runs, runs that "
+        f"pounded and the probability of pounding with its {int(100 * CONFIDENCE)} % Clopper–Pearson interval",
+        frame,
+        formats={"runs": "{:.0f}", "pounded": "{:.0f}", "P(pounding)": "{:.3f}", "lower": "{:.3f}", "upper": "{:.3f}"},
+    )
+
+
+def _stripe_figure(name: str, store: xr.Dataset, setting: dict[str, Any]) -> FigureItem:
+    runs, pounded = _pounding_counts(store)
+    gaps = [d for d in runs.dims if is_gap_axis(d)]
+    figure = Figure(figsize=(7.5, 3.4), layout="constrained")
+    ax = figure.subplots()
+    levels = store["intensity"].values
+    cells = _cells(xr.Dataset({"runs": runs, "pounded": pounded}).to_array("what"), ("intensity", "what"))
+    for label, cell in cells:
+        n, k = cell.sel(what="runs").values, cell.sel(what="pounded").values
+        lower, upper = clopper_pearson(k, n, CONFIDENCE)
+        p = _proportion(k, n)
+        (line,) = ax.plot(levels, p, "o-", label=label or None)
+        ax.fill_between(levels, lower, upper, color=line.get_color(), alpha=0.15)
+    _probability_axes(ax, setting, "P(pounding)", any(label for label, _ in cells))
+    per = " per " + ", ".join(gaps) if gaps else ""
+    return FigureItem(
+        f"intensity-pounding-{name}",
+        f"Experiment {name}: probability of pounding against intensity{per}, with the stripes' {int(100 * CONFIDENCE)} % Clopper–Pearson intervals (shaded).",
+        figure,
+    )
+
+
+def _ida_figure(name: str, store: xr.Dataset, setting: dict[str, Any]) -> FigureItem:
+    capacity = store["ida_capacity"].where(store["case_status"] == 1)
+    figure = Figure(figsize=(7.5, 3.4), layout="constrained")
+    ax = figure.subplots()
+    finite = capacity.values[np.isfinite(capacity.values)]
+    top = float(np.max(finite)) * 1.1 if finite.size else 1.0
+    grid = np.linspace(0.0, top, 200)
+    cells = _cells(capacity, ())
+    for label, cell in cells:
+        values = cell.values.ravel()
+        values = values[~np.isnan(values)]
+        k = np.array([(values <= x).sum() for x in grid])
+        lower, upper = clopper_pearson(k, np.full(grid.shape, values.size), CONFIDENCE)
+        (line,) = ax.step(grid, k / max(values.size, 1), where="post", label=label or None)
+        ax.fill_between(grid, lower, upper, step="post", color=line.get_color(), alpha=0.15)
+    _probability_axes(ax, setting, "P(pounding) (fraction of motions)", any(label for label, _ in cells))
+    return FigureItem(
+        f"intensity-ida-{name}",
+        f"Experiment {name}: fraction of motions whose IDA capacity is at most x (they pound when scaled to x), per gap, with "
+        f"{int(100 * CONFIDENCE)} % Clopper–Pearson intervals (shaded).",
+        figure,
+    )
