@@ -103,9 +103,10 @@ when there are more columns than rows, one per *two-sided* row: the last
 in row order, hold the peaks of their negation (so that a peak absolute
 value is located too). A two-sided row is computed once: its negation's
 value and rate are the exact negation of the row's, and its maxima, located
-on the row's rate, are the row's minima (:func:`_row_of`). ``power[m]`` stacks the quadratic forms P of the input, damping,
-friction and impact powers, zᵀ P z at z = [x, a_g, 0, 0, 0, 1], transposed
-(Z × 4Z) (``tables._power_forms``).
+on the row's rate, are the row's minima (``_row_of``). ``power[m]`` stacks
+the quadratic forms P of the input, damping, friction and impact powers,
+zᵀ P z at z = [x, a_g, 0, 0, 0, 1], transposed (Z × 4Z)
+(``tables._power_forms``).
 """
 Propagators = namedtuple("Propagators", "propagate chebyshev step")
 Propagators.__doc__ = """Exact sub-step propagators of the slots' modes.
