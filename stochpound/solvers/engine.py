@@ -469,9 +469,11 @@ def _row_of(peak, n_rows, n_peaks):
 def _offer_monitors(values, t, peaks):
     """Offer the monitors' ``values`` (one per row) at time t as their peaks (:class:`Dynamics`)."""
     n_rows, n_peaks = values.shape[0], peaks.shape[1]
-    for i in range(n_peaks):
-        row, sign = _row_of(i, n_rows, n_peaks)
-        value = sign * values[row]
+    for i in range(n_rows):
+        if values[i] > peaks[PEAK_VALUE, i]:
+            peaks[PEAK_VALUE, i], peaks[PEAK_AT, i] = values[i], t
+    for i in range(n_rows, n_peaks):  # the two-sided rows' negations (the quiet loop's hot path: no _row_of)
+        value = -values[i - (n_peaks - n_rows)]
         if value > peaks[PEAK_VALUE, i]:
             peaks[PEAK_VALUE, i], peaks[PEAK_AT, i] = value, t
 
@@ -489,9 +491,12 @@ def _maximum_may_beat(value0, value1, rate0, rate1, h, peak):
 def _any_maximum_may_beat(values0, values1, rates0, rates1, h, peaks):
     """True when some monitor's maximum inside the step may beat its peak (:func:`_maximum_may_beat`; ``values*``/``rates*`` one per row)."""
     n_rows, n_peaks = values0.shape[0], peaks.shape[1]
-    for i in range(n_peaks):
-        row, sign = _row_of(i, n_rows, n_peaks)
-        if _maximum_may_beat(sign * values0[row], sign * values1[row], sign * rates0[row], sign * rates1[row], h, peaks[PEAK_VALUE, i]):
+    for i in range(n_rows):
+        if _maximum_may_beat(values0[i], values1[i], rates0[i], rates1[i], h, peaks[PEAK_VALUE, i]):
+            return True
+    for i in range(n_rows, n_peaks):  # the two-sided rows' negations (the quiet loop's hot path: no _row_of)
+        row = i - (n_peaks - n_rows)
+        if _maximum_may_beat(-values0[row], -values1[row], -rates0[row], -rates1[row], h, peaks[PEAK_VALUE, i]):
             return True
     return False
 
