@@ -269,13 +269,8 @@ def _foundation_force(system: System, b: int, state: int, terms: tuple[np.ndarra
 
 
 def monitor_count(system: System) -> int:
-    """Number of monitored peaks of every mode of ``system``: one per row of :func:`monitor_rows`, then one per two-sided row (:func:`minimum_peaks`)."""
-    return 2 * monitor_row_count(system) - system.n_elements
-
-
-def monitor_row_count(system: System) -> int:
-    """Number of rows of :func:`monitor_rows` of every mode of ``system``."""
-    return demand_monitors(system).start + (len(DEMANDS) * len(system.total_displacement) if system.demands else 0)
+    """Number of monitors of every mode of ``system`` (:func:`monitor_rows`)."""
+    return demand_monitors_start(system) + (2 * len(DEMANDS) * len(system.total_displacement) if system.demands else 0)
 
 
 def monitored_contacts(system: System) -> np.ndarray:
@@ -283,32 +278,20 @@ def monitored_contacts(system: System) -> np.ndarray:
 
     Their peaks are the separation rules' u1 and u2, which are evaluated on
     contact-free runs; a contact with a finite gap is not monitored (its
-    closure is), which spares every run with contacts their cost.
+    closure is), which spares every run with contacts their cost (the
+    engine's product columns and located maxima).
     """
     return np.array([c for c, gap in enumerate(system.element_gap[: system.n_contacts].tolist()) if gap == math.inf], dtype=np.int64)  # (numpy's calls cost more on every run)
 
 
 def contact_displacement_monitors(system: System) -> slice:
-    """The monitor rows of each monitored contact's left and right floor displacement (:func:`monitor_rows`, :func:`monitored_contacts`): 2 per contact, left then right."""
-    return slice(system.n_elements, system.n_elements + 2 * len(monitored_contacts(system)))
+    """The monitor rows of ± each monitored contact's left and right floor displacement (:func:`monitor_rows`, :func:`monitored_contacts`): 4 per contact, in the order +left, −left, +right, −right."""
+    return slice(system.n_elements, demand_monitors_start(system))
 
 
-def demand_monitors(system: System) -> slice:
-    """The monitor rows of the demand parameters (:func:`monitor_rows`; empty when the system does not monitor demands)."""
-    start = contact_displacement_monitors(system).stop
-    return slice(start, start + (len(DEMANDS) * len(system.total_displacement) if system.demands else 0))
-
-
-def minimum_peaks(system: System, rows: slice) -> slice:
-    """The peaks of the negation of the two-sided monitor ``rows`` (a slice of :func:`contact_displacement_monitors` or :func:`demand_monitors`).
-
-    The peaks of a run hold first every monitor row's largest value, then,
-    for each two-sided row (every row after the closures) in row order, the
-    largest value of its negation, minus its smallest value
-    (:class:`stochpound.solvers.engine.Dynamics`).
-    """
-    shift = monitor_row_count(system) - system.n_elements
-    return slice(rows.start + shift, rows.stop + shift)
+def demand_monitors_start(system: System) -> int:
+    """Index of the first demand monitor (:func:`monitor_rows`): they follow the closures and the monitored contacts' floor displacements."""
+    return system.n_elements + 4 * len(monitored_contacts(system))
 
 
 def monitor_rows(system: System, rows: contact.ContactRows, rate: tuple[np.ndarray, np.ndarray, np.ndarray]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -317,28 +300,27 @@ def monitor_rows(system: System, rows: contact.ContactRows, rate: tuple[np.ndarr
     First each impact element's closure y_left − y_right = g_p · q (m, the
     penetration plus the gap): its largest value over a run, located on the
     solution, is the separation the run needed (``peak_contact_closure``).
-    Then, per contact with an infinite gap (:func:`monitored_contacts`), the
-    displacement relative to the ground y = s + u of its left floor, then of
-    its right floor (:func:`contact_displacement_monitors`): the peaks of their absolute
-    values are the separation rules' u1 and u2, located the same way as the
-    closure, so that u1 + u2 ≥ D holds on the solution. Then, when the system
-    monitors demands, every demand parameter of
+    Then, per contact with an infinite gap (:func:`monitored_contacts`), +
+    and − the displacement relative to the ground y = s + u of its left
+    floor, then of its right floor
+    (:func:`contact_displacement_monitors`): their peaks are the separation
+    rules' u1 and u2 located the same way as the closure, so that
+    u1 + u2 ≥ D holds on the solution. Then, when the system monitors
+    demands, + and − every demand parameter of
     :func:`stochpound.model.demands.demand_rows` (whose peaks give the peak
     absolute values). ``rate`` is the mode's (A, B, c).
-
-    Every row after the closures is two-sided: the engine locates the peaks
-    of the row and of its negation (:func:`minimum_peaks`), computing the row
-    once.
     """
     monitored = monitored_contacts(system)
-    sides = np.stack([system.element_left[monitored], system.element_right[monitored]], axis=1).reshape(2 * len(monitored), system.n_dof)
-    displacements = np.vstack([rows.penetration, np.hstack([sides, np.zeros((2 * len(monitored), system.n_dof))])])
+    left, right = system.element_left[monitored], system.element_right[monitored]
+    sides = np.stack([left, -left, right, -right], axis=1).reshape(4 * len(monitored), system.n_dof)
+    displacements = np.vstack([rows.penetration, np.hstack([sides, np.zeros((4 * len(monitored), system.n_dof))])])
     n_rows = len(displacements)
     matrix, ground, constant = _over_xi(displacements, system.xi_size), np.zeros(n_rows), np.zeros(n_rows)
     if not system.demands:
         return matrix, ground, constant
     demand = demand_rows(system.floor_dofs, system.building_base_dofs, system.storey_stiffness, system.storey_damping, rate)
-    return np.vstack([matrix, demand[0]]), np.concatenate([ground, demand[1]]), np.concatenate([constant, demand[2]])
+    return (np.vstack([matrix, demand[0], -demand[0]]), np.concatenate([ground, demand[1], -demand[1]]),
+            np.concatenate([constant, demand[2], -demand[2]]))
 
 
 def _stack_guards(contact_guards: tuple[np.ndarray, ...], base_guards: list[tuple], size: int) -> tuple[np.ndarray, ...]:

@@ -20,7 +20,7 @@ import numpy as np
 
 from stochpound.model.demands import DEMANDS
 from stochpound.model.friction import FREE
-from stochpound.model.modes import ModeDynamics, contact_displacement_monitors, demand_monitors, minimum_peaks, monitor_count, monitored_contacts
+from stochpound.model.modes import ModeDynamics, contact_displacement_monitors, demand_monitors_start, monitor_count, monitored_contacts
 from stochpound.model.system import System
 from stochpound.motions.ground import GroundMotion
 
@@ -109,12 +109,11 @@ class Recorder:
     peaks : np.ndarray
         The monitors' largest values over the run and when they happened
         (rows: value, time in s), located on the solution: each impact
-        element's closure y_left − y_right (m), then the displacement
+        element's closure y_left − y_right (m), then ± the displacement
         relative to the ground of the two floors of each contact with an
-        infinite gap (m; :func:`stochpound.model.modes.monitored_contacts`), then the
+        infinite gap (m; :func:`stochpound.model.modes.monitored_contacts`), then ± the
         demand parameters when the system monitors them
-        (:func:`stochpound.model.modes.monitor_rows`), then the negation of
-        every row after the closures (:func:`stochpound.model.modes.minimum_peaks`).
+        (:func:`stochpound.model.modes.monitor_rows`).
     demands : dict of str to np.ndarray
         When the system monitors demands: each parameter of
         :data:`stochpound.model.demands.DEMANDS` at every floor and output
@@ -163,8 +162,9 @@ class Recorder:
         self.friction[indices] = x @ dynamics.friction_matrix.T + np.outer(ground, dynamics.friction_ground) + dynamics.friction_constant
         for b, (base, state) in enumerate(zip(self.system.bases, dynamics.mode.base)):
             self.base_states[indices, b] = np.sign(x[:, self.system.n_dof + base.dof]) if state == FREE else state
-        if self.demands:  # the demand monitors (stochpound.model.modes.monitor_rows)
-            floors, rows = len(self.system.total_displacement), demand_monitors(self.system)
+        if self.demands:  # the demand monitors' + rows (stochpound.model.modes.monitor_rows)
+            floors, first = len(self.system.total_displacement), demand_monitors_start(self.system)
+            rows = slice(first, first + len(DEMANDS) * floors)
             values = x @ dynamics.monitor_matrix[rows].T + np.outer(ground, dynamics.monitor_ground[rows]) + dynamics.monitor_constant[rows]
             for name, value in zip(DEMANDS, values.T.reshape(len(DEMANDS), floors, len(indices))):
                 self.demands[name][:, indices] = value
@@ -194,8 +194,8 @@ class Recorder:
 
     def demand_peaks(self) -> dict[str, tuple[np.ndarray, np.ndarray]]:
         """Each demand parameter's largest absolute value over the run and when (floor in system order), located on the solution."""
-        floors = len(self.system.total_displacement)
-        larger = self._absolute_peaks(demand_monitors(self.system))
+        floors, n, first = len(self.system.total_displacement), len(DEMANDS) * len(self.system.total_displacement), demand_monitors_start(self.system)
+        larger = _larger(self.peaks[:, first : first + n], self.peaks[:, first + n :])
         return {name: (larger[0, i * floors : (i + 1) * floors], larger[1, i * floors : (i + 1) * floors]) for i, name in enumerate(DEMANDS)}
 
     def contact_displacement_peaks(self) -> tuple[np.ndarray, np.ndarray]:
@@ -212,15 +212,10 @@ class Recorder:
             Rows value (m) and time (s), one column per contact: the separation rules' u1 and u2.
         """
         monitored = monitored_contacts(self.system)
-        larger = self._absolute_peaks(contact_displacement_monitors(self.system)).reshape(2, len(monitored), 2)
+        signed = self.peaks[:, contact_displacement_monitors(self.system)].reshape(2, len(monitored), 4)
         left, right = np.full((2, self.system.n_contacts), np.nan), np.full((2, self.system.n_contacts), np.nan)
-        left[:, monitored], right[:, monitored] = larger[:, :, 0], larger[:, :, 1]
+        left[:, monitored], right[:, monitored] = _larger(signed[:, :, 0], signed[:, :, 1]), _larger(signed[:, :, 2], signed[:, :, 3])
         return left, right
-
-    def _absolute_peaks(self, rows: slice) -> np.ndarray:
-        """The peaks (rows value, time) of the absolute value of the two-sided monitor ``rows``: the larger of the row's and its negation's."""
-        plus, minus = self.peaks[:, rows], self.peaks[:, minimum_peaks(self.system, rows)]
-        return np.where(plus[0] >= minus[0], plus, minus)
 
     def by_building(self, per_base: np.ndarray) -> np.ndarray:
         """Values of the sliding bases over time (time × base) as building × time, 0 for fixed bases."""
@@ -235,3 +230,8 @@ class Recorder:
         kinetic = 0.5 * np.einsum("ti,ti->t", v @ self.system.mass, v)
         strain = 0.5 * np.einsum("ti,ti->t", q @ self.system.stiffness, q)
         return kinetic, strain
+
+
+def _larger(plus: np.ndarray, minus: np.ndarray) -> np.ndarray:
+    """The peaks (rows value, time) of + and − a read-out combined into the peaks of its absolute value."""
+    return np.where(plus[0] >= minus[0], plus, minus)

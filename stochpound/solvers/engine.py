@@ -97,16 +97,9 @@ Dynamics.__doc__ = """The slots' modes' affine maps of ẋ, the guards (padded),
 
 A *monitor* is a read-out whose largest value over the run is located on
 the solution (e.g. a contact's closure, whose peak is the separation the run
-needed). The peaks (``Outputs.peaks``) hold one column per monitor row, then,
-when there are more columns than rows, one per *two-sided* row: the last
-``peaks.shape[1] − monitor.shape[1]`` rows are two-sided, and their columns,
-in row order, hold the peaks of their negation (so that a peak absolute
-value is located too). A two-sided row is computed once: its negation's
-value and rate are the exact negation of the row's, and its maxima, located
-on the row's rate, are the row's minima (``_row_of``). ``power[m]`` stacks
-the quadratic forms P of the input, damping, friction and impact powers,
-zᵀ P z at z = [x, a_g, 0, 0, 0, 1], transposed (Z × 4Z)
-(``tables._power_forms``).
+needed). ``power[m]`` stacks the quadratic forms P of the input, damping,
+friction and impact powers, zᵀ P z at z = [x, a_g, 0, 0, 0, 1], transposed
+(Z × 4Z) (``tables._power_forms``).
 """
 Propagators = namedtuple("Propagators", "propagate chebyshev step")
 Propagators.__doc__ = """Exact sub-step propagators of the slots' modes.
@@ -197,19 +190,17 @@ LANES = 16
 
 
 def propagate_columns(size: int, n_guards: int, n_contacts: int, n_monitors: int) -> int:
-    """Columns of ``Propagators.propagate`` (padded to :data:`LANES`) for state size ``size`` (2N) and ``n_monitors`` monitor rows."""
+    """Columns of ``Propagators.propagate`` (padded to :data:`LANES`) for state size ``size`` (2N)."""
     used = 5 * (size + 5) + n_contacts + 2 * n_guards + 2 * n_monitors
     return -(-used // LANES) * LANES
 
 
-def work_arrays(size: int, n_guards: int, n_contacts: int, n_monitors: int, n_peaks: int, mode_size: int,
+def work_arrays(size: int, n_guards: int, n_contacts: int, n_monitors: int, mode_size: int,
                 chebyshev_width: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``scratch``, ``saved`` and ``marks`` work arrays of :func:`run_engine`.
 
-    For state size ``size`` (2N), ``n_monitors`` monitor rows and
-    ``n_peaks`` monitored peaks (:class:`Dynamics`), mode vectors of
-    ``mode_size`` and Chebyshev rows of ``chebyshev_width``
-    (``Propagators.chebyshev.shape[2]``). The
+    For state size ``size`` (2N), mode vectors of ``mode_size`` and Chebyshev
+    rows of ``chebyshev_width`` (``Propagators.chebyshev.shape[2]``). The
     engine allocates nothing: every work vector is a row of these.
     ``scratch`` rows: 0–6 and 9 the quiet loop's (:func:`_advance_quiet`),
     0–15 an event step's (:func:`_advance_span`, :func:`_first_crossing`),
@@ -219,7 +210,7 @@ def work_arrays(size: int, n_guards: int, n_contacts: int, n_monitors: int, n_pe
     """
     scratch = np.zeros((28, max(propagate_columns(size, n_guards, n_contacts, n_monitors), chebyshev_width)))
     marks = np.zeros((2 * (_MAX_SETTLE + 1) + 3, max(mode_size, 3, n_guards)), dtype=np.int64)
-    return scratch, np.zeros((8, max(4, n_contacts, n_guards, n_peaks))), marks
+    return scratch, np.zeros((8, max(4, n_contacts, n_guards, n_monitors))), marks
 
 
 # ---------------------------------------------------------------- linear algebra and read-outs
@@ -458,24 +449,11 @@ def _restore(saved, running, impact, threshold, disarmed, peaks):
 
 
 @njit(**INTERNAL)
-def _row_of(peak, n_rows, n_peaks):
-    """The monitor row of column ``peak`` of the peaks and its sign: −1 for a two-sided row's negation (:class:`Dynamics`)."""
-    if peak < n_rows:
-        return peak, 1.0
-    return peak - (n_peaks - n_rows), -1.0
-
-
-@njit(**INTERNAL)
 def _offer_monitors(values, t, peaks):
-    """Offer the monitors' ``values`` (one per row) at time t as their peaks (:class:`Dynamics`)."""
-    n_rows, n_peaks = values.shape[0], peaks.shape[1]
-    for i in range(n_rows):
+    """Offer the monitors' ``values`` at time t as their peaks."""
+    for i in range(values.shape[0]):
         if values[i] > peaks[PEAK_VALUE, i]:
             peaks[PEAK_VALUE, i], peaks[PEAK_AT, i] = values[i], t
-    for i in range(n_rows, n_peaks):  # the two-sided rows' negations (the quiet loop's hot path: no _row_of)
-        value = -values[i - (n_peaks - n_rows)]
-        if value > peaks[PEAK_VALUE, i]:
-            peaks[PEAK_VALUE, i], peaks[PEAK_AT, i] = value, t
 
 
 @njit(**INTERNAL)
@@ -489,14 +467,9 @@ def _maximum_may_beat(value0, value1, rate0, rate1, h, peak):
 
 @njit(**INTERNAL)
 def _any_maximum_may_beat(values0, values1, rates0, rates1, h, peaks):
-    """True when some monitor's maximum inside the step may beat its peak (:func:`_maximum_may_beat`; ``values*``/``rates*`` one per row)."""
-    n_rows, n_peaks = values0.shape[0], peaks.shape[1]
-    for i in range(n_rows):
+    """True when some monitor's maximum inside the step may beat its peak (:func:`_maximum_may_beat`)."""
+    for i in range(values0.shape[0]):
         if _maximum_may_beat(values0[i], values1[i], rates0[i], rates1[i], h, peaks[PEAK_VALUE, i]):
-            return True
-    for i in range(n_rows, n_peaks):  # the two-sided rows' negations (the quiet loop's hot path: no _row_of)
-        row = i - (n_peaks - n_rows)
-        if _maximum_may_beat(-values0[row], -values1[row], -rates0[row], -rates1[row], h, peaks[PEAK_VALUE, i]):
             return True
     return False
 
@@ -519,22 +492,18 @@ def _sub_step_monitors(flow, chebyshev, z0, t1, values0, values1, rates0, rates1
 def _monitor_peaks(flow, t1, values0, values1, rates0, rates1, peaks, work):
     """Offer the monitors' values at t1 and their maxima inside [flow.t0, t1], located on the flow, as their peaks.
 
-    ``values*``/``rates*``: the monitors' values and rates at the step's ends
-    (one per row). A maximum is located (Brent on the monitor's rate) when
-    the rate goes from + to − on the flow and the Hermite cubic says it may
-    beat the peak; a two-sided row's negation is located on the row's own
-    rate (Brent's iterates are the same for f and −f: every step is odd in f).
+    ``values*``/``rates*``: the monitors' values and rates at the step's ends.
+    A maximum is located (Brent on the monitor's rate) when the rate goes from
+    + to − on the flow and the Hermite cubic says it may beat the peak.
     """
     t0, n_contacts, xi = flow.t0, flow.force.shape[0], work[: flow.rate.shape[1] - 2]
-    n_rows, n_peaks = values1.shape[0], peaks.shape[1]
-    for i in range(n_peaks):
-        row, sign = _row_of(i, n_rows, n_peaks)
-        if _maximum_may_beat(sign * values0[row], sign * values1[row], sign * rates0[row], sign * rates1[row], t1 - t0, peaks[PEAK_VALUE, i]):
-            index = -1 - n_contacts - row
-            if sign * _evaluate(flow, index, 0.0, t0, work) > 0.0 > sign * _evaluate(flow, index, 0.0, t1, work):
+    for i in range(values1.shape[0]):
+        if _maximum_may_beat(values0[i], values1[i], rates0[i], rates1[i], t1 - t0, peaks[PEAK_VALUE, i]):
+            index = -1 - n_contacts - i
+            if _evaluate(flow, index, 0.0, t0, work) > 0.0 > _evaluate(flow, index, 0.0, t1, work):
                 t_peak = _brentq(flow, index, 0.0, t0, t1, work)
                 _dense(flow, t_peak, xi)
-                value = sign * _affine(flow.monitor, row, xi, _ground_value(flow, t_peak))
+                value = _affine(flow.monitor, i, xi, _ground_value(flow, t_peak))
                 if value > peaks[PEAK_VALUE, i]:
                     peaks[PEAK_VALUE, i], peaks[PEAK_AT, i] = value, t_peak
     _offer_monitors(values1, t1, peaks)

@@ -27,7 +27,7 @@ from collections import namedtuple
 
 import numpy as np
 
-from stochpound.model.modes import BoundedCache, Mode, ModeDynamics, ModeLibrary, monitor_count, monitor_row_count
+from stochpound.model.modes import BoundedCache, Mode, ModeDynamics, ModeLibrary, monitor_count
 from stochpound.model.system import System
 from stochpound.motions.ground import GroundMotion, HarmonicMotion
 from stochpound.results.record import ENERGY_TERMS
@@ -84,8 +84,8 @@ def max_guards(system: System) -> int:
 
 def work_arrays_for(system: System, slots: "Slots") -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The engine's work arrays for ``system`` and the current Chebyshev width of ``slots`` (:func:`stochpound.solvers.engine.work_arrays`)."""
-    return engine.work_arrays(system.xi_size, max_guards(system), system.n_elements, monitor_row_count(system), monitor_count(system),
-                              mode_length(system), slots.arrays["chebyshev"].shape[2])
+    return engine.work_arrays(system.xi_size, max_guards(system), system.n_elements, monitor_count(system), mode_length(system),
+                              slots.arrays["chebyshev"].shape[2])
 
 
 def run_state(system: System, n_times: int, supplied_degree: int = 0) -> State:
@@ -358,12 +358,11 @@ def _placeholder(system: System, chebyshev_width: int, exact: bool) -> dict[str,
     """
     size, n_contacts, n_guards = system.xi_size, system.n_elements, max_guards(system)
     width = size + 5
-    n_monitors = monitor_row_count(system)
-    propagate = (width, engine.propagate_columns(size, n_guards, n_contacts, n_monitors)) if exact else (1, 1)
+    propagate = (width, engine.propagate_columns(size, n_guards, n_contacts, monitor_count(system))) if exact else (1, 1)
     return {
         "modes": np.full(mode_length(system), -9, dtype=np.int64), "ids": np.int64(0), "codes": np.zeros((3, n_guards), np.int64),
         "n_guards": np.int64(0), "substeps": np.int64(1), "rate": np.zeros((2 * system.n_dof, size + 2)),
-        "guard": np.zeros((n_guards, size + 2)), "force": np.zeros((n_contacts, size + 2)), "monitor": np.zeros((n_monitors, size + 2)),
+        "guard": np.zeros((n_guards, size + 2)), "force": np.zeros((n_contacts, size + 2)), "monitor": np.zeros((monitor_count(system), size + 2)),
         "power": np.zeros((width, 4 * width)),
         "propagate": np.zeros(propagate), "chebyshev": np.zeros((width, chebyshev_width) if exact else (1, 1)),
         "step": np.float64(1.0),
