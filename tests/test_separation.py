@@ -108,3 +108,20 @@ def test_contact_demands_of_a_contact_free_run_are_located_on_the_solution(mu1):
             assert located == pytest.approx(peak, abs=1e-9)
             assert located == pytest.approx(float(dense[f"peak_contact_displacement_{side}"][c]), abs=1e-9)
             assert float(free[f"peak_contact_displacement_{side}_time"][c]) == pytest.approx(when, abs=1e-4)
+
+
+def test_only_contacts_with_an_infinite_gap_locate_their_floors_peaks():
+    """u1, u2 are the contact-free runs' inputs: a contact with a finite gap reports NaN (its floors are not monitored), one with gap inf its located peaks.
+
+    The second contact's gap is finite but never reached (10 m), so the run is
+    the contact-free run: the first contact's u1, u2 and every closure are
+    those of the contact-free run.
+    """
+    free = stochpound.simulate(contact_free_scene(0.2, 0))
+    mixed = stochpound.simulate(with_gaps(contact_free_scene(0.2, 0), (math.inf, 10.0)))
+    assert mixed.sizes["impact"] == 0
+    for side in ("left", "right"):
+        for name in (f"peak_contact_displacement_{side}", f"peak_contact_displacement_{side}_time"):
+            assert math.isnan(float(mixed[name][1])) and not math.isnan(float(free[name][1]))
+            assert float(mixed[name][0]) == pytest.approx(float(free[name][0]), rel=1e-12)
+    np.testing.assert_allclose(mixed["peak_contact_closure"], free["peak_contact_closure"], rtol=1e-12)

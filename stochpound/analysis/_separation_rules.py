@@ -57,7 +57,8 @@ def contact_demands(run: xr.Dataset, dim: str = "time") -> xr.Dataset:
         A result of :func:`stochpound.simulate` (``total_displacement``, the
         ``contact_*`` description, ``peak_contact_closure`` and
         ``peak_contact_displacement_left``/``_right``); run it contact-free
-        (every gap ``inf``) for the rules of an ensemble.
+        (every gap ``inf``) for the rules of an ensemble: a contact with a
+        finite gap has no located u1, u2 (NaN, and so are its rules).
     dim : str
         The time dimension.
 

@@ -21,6 +21,7 @@ closes or a base that never slips costs nothing.
 
 from __future__ import annotations
 
+import math
 from collections import OrderedDict
 from collections.abc import Callable
 from dataclasses import dataclass, fields
@@ -272,14 +273,25 @@ def monitor_count(system: System) -> int:
     return demand_monitors_start(system) + (2 * len(DEMANDS) * len(system.total_displacement) if system.demands else 0)
 
 
+def monitored_contacts(system: System) -> np.ndarray:
+    """The contacts whose floors' displacements are monitored (:func:`monitor_rows`): those with an infinite gap, in contact order.
+
+    Their peaks are the separation rules' u1 and u2, which are evaluated on
+    contact-free runs; a contact with a finite gap is not monitored (its
+    closure is), which spares every run with contacts their cost (the
+    engine's product columns and located maxima).
+    """
+    return np.array([c for c, gap in enumerate(system.element_gap[: system.n_contacts].tolist()) if gap == math.inf], dtype=np.int64)  # (numpy's calls cost more on every run)
+
+
 def contact_displacement_monitors(system: System) -> slice:
-    """The monitor rows of ± each contact's left and right floor displacement (:func:`monitor_rows`): 4 per contact, in the order +left, −left, +right, −right."""
-    return slice(system.n_elements, system.n_elements + 4 * system.n_contacts)
+    """The monitor rows of ± each monitored contact's left and right floor displacement (:func:`monitor_rows`, :func:`monitored_contacts`): 4 per contact, in the order +left, −left, +right, −right."""
+    return slice(system.n_elements, demand_monitors_start(system))
 
 
 def demand_monitors_start(system: System) -> int:
-    """Index of the first demand monitor (:func:`monitor_rows`): they follow the closures and the contacts' floor displacements."""
-    return system.n_elements + 4 * system.n_contacts
+    """Index of the first demand monitor (:func:`monitor_rows`): they follow the closures and the monitored contacts' floor displacements."""
+    return system.n_elements + 4 * len(monitored_contacts(system))
 
 
 def monitor_rows(system: System, rows: contact.ContactRows, rate: tuple[np.ndarray, np.ndarray, np.ndarray]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -288,8 +300,9 @@ def monitor_rows(system: System, rows: contact.ContactRows, rate: tuple[np.ndarr
     First each impact element's closure y_left − y_right = g_p · q (m, the
     penetration plus the gap): its largest value over a run, located on the
     solution, is the separation the run needed (``peak_contact_closure``).
-    Then, per contact, + and − the displacement relative to the ground
-    y = s + u of its left floor, then of its right floor
+    Then, per contact with an infinite gap (:func:`monitored_contacts`), +
+    and − the displacement relative to the ground y = s + u of its left
+    floor, then of its right floor
     (:func:`contact_displacement_monitors`): their peaks are the separation
     rules' u1 and u2 located the same way as the closure, so that
     u1 + u2 ≥ D holds on the solution. Then, when the system monitors
@@ -297,10 +310,10 @@ def monitor_rows(system: System, rows: contact.ContactRows, rate: tuple[np.ndarr
     :func:`stochpound.model.demands.demand_rows` (whose peaks give the peak
     absolute values). ``rate`` is the mode's (A, B, c).
     """
-    n_contacts = system.n_contacts
-    sides = np.stack([system.element_left[:n_contacts], -system.element_left[:n_contacts],
-                      system.element_right[:n_contacts], -system.element_right[:n_contacts]], axis=1).reshape(4 * n_contacts, system.n_dof)
-    displacements = np.vstack([rows.penetration, np.hstack([sides, np.zeros((4 * n_contacts, system.n_dof))])])
+    monitored = monitored_contacts(system)
+    left, right = system.element_left[monitored], system.element_right[monitored]
+    sides = np.stack([left, -left, right, -right], axis=1).reshape(4 * len(monitored), system.n_dof)
+    displacements = np.vstack([rows.penetration, np.hstack([sides, np.zeros((4 * len(monitored), system.n_dof))])])
     n_rows = len(displacements)
     matrix, ground, constant = _over_xi(displacements, system.xi_size), np.zeros(n_rows), np.zeros(n_rows)
     if not system.demands:

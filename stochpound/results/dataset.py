@@ -124,11 +124,11 @@ def _closure_variables(recorder: Recorder, n_contacts: int, kind: str) -> dict[s
 
 
 def _contact_displacement_variables(recorder: Recorder) -> dict[str, tuple]:
-    """The largest abs(y) of each contact's two floors over the run and when, located on the solution (the separation rules' u1, u2)."""
+    """The largest abs(y) of each contact's two floors over the run and when, located on the solution: the separation rules' u1, u2 (NaN for a contact with a finite gap, :meth:`~stochpound.results.record.Recorder.contact_displacement_peaks`)."""
     variables = {}
     for side, (value, when) in zip(("left", "right"), recorder.contact_displacement_peaks()):
         variables[f"peak_contact_displacement_{side}"] = _var(("contact",), value, "m",
-                                                              f"largest |y| of the contact's {side} floor over the run (y = s + u)")
+                                                              f"largest |y| of the contact's {side} floor over the run (y = s + u; NaN for a finite gap)")
         variables[f"peak_contact_displacement_{side}_time"] = _var(("contact",), when, "s", f"time of the largest |y| of the contact's {side} floor")
     return variables
 

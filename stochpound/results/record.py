@@ -20,7 +20,7 @@ import numpy as np
 
 from stochpound.model.demands import DEMANDS
 from stochpound.model.friction import FREE
-from stochpound.model.modes import ModeDynamics, contact_displacement_monitors, demand_monitors_start, monitor_count
+from stochpound.model.modes import ModeDynamics, contact_displacement_monitors, demand_monitors_start, monitor_count, monitored_contacts
 from stochpound.model.system import System
 from stochpound.motions.ground import GroundMotion
 
@@ -110,7 +110,8 @@ class Recorder:
         The monitors' largest values over the run and when they happened
         (rows: value, time in s), located on the solution: each impact
         element's closure y_left − y_right (m), then ± the displacement
-        relative to the ground of each contact's two floors (m), then ± the
+        relative to the ground of the two floors of each contact with an
+        infinite gap (m; :func:`stochpound.model.modes.monitored_contacts`), then ± the
         demand parameters when the system monitors them
         (:func:`stochpound.model.modes.monitor_rows`).
     demands : dict of str to np.ndarray
@@ -200,13 +201,21 @@ class Recorder:
     def contact_displacement_peaks(self) -> tuple[np.ndarray, np.ndarray]:
         """The largest abs(y) over the run of each contact's left and right floor (y = s + u relative to the ground), located on the solution.
 
+        Only a contact with an infinite gap is monitored
+        (:func:`stochpound.model.modes.monitored_contacts`): the separation
+        rules take u1 and u2 from contact-free runs. A contact with a finite
+        gap gets NaN.
+
         Returns
         -------
         left, right : np.ndarray
             Rows value (m) and time (s), one column per contact: the separation rules' u1 and u2.
         """
-        signed = self.peaks[:, contact_displacement_monitors(self.system)].reshape(2, self.system.n_contacts, 4)
-        return _larger(signed[:, :, 0], signed[:, :, 1]), _larger(signed[:, :, 2], signed[:, :, 3])
+        monitored = monitored_contacts(self.system)
+        signed = self.peaks[:, contact_displacement_monitors(self.system)].reshape(2, len(monitored), 4)
+        left, right = np.full((2, self.system.n_contacts), np.nan), np.full((2, self.system.n_contacts), np.nan)
+        left[:, monitored], right[:, monitored] = _larger(signed[:, :, 0], signed[:, :, 1]), _larger(signed[:, :, 2], signed[:, :, 3])
+        return left, right
 
     def by_building(self, per_base: np.ndarray) -> np.ndarray:
         """Values of the sliding bases over time (time × base) as building × time, 0 for fixed bases."""
