@@ -166,7 +166,7 @@ class HazardCurve:
 
     @classmethod
     def bundled(cls, name: str, *, extrapolate: bool = False) -> HazardCurve:
-        """A hazard curve shipped with stochpound (``data/hazard/<name>.csv``; ``bundled_curves()`` lists them)."""
+        """A hazard curve shipped with stochpound (``data/hazard/<name>.csv``; :func:`~stochpound.analysis.bundled_curves` lists them)."""
         folder = _bundled_folder()
         path = folder / f"{name}.csv"
         if not path.is_file():
