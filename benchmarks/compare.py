@@ -14,6 +14,9 @@ processes, on the study scenes (a), (b) and (c) under El Centro:
 * the outputs compared: number of impacts and peak top-floor displacement of
   Building 1 (m).
 
+With ``--demands`` every run also monitors the demand parameters (both
+revisions must take ``demands``).
+
 It rewrites the section "Against an earlier revision" of
 ``docs/benchmarks.md`` (between :data:`SECTION`'s markers; the main suite
 keeps it when it rewrites the file).
@@ -62,13 +65,13 @@ out = {{}}
 for key, arguments in {scenes!r}.items():
     scene = stochpound.scene_from_dict(study_scene(*arguments))
     start = time.perf_counter()
-    result = stochpound.simulate(scene, method="exact")
+    result = stochpound.simulate(scene, method="exact", **{options!r})
     first = time.perf_counter() - start
     top = result.total_displacement.sel(building="B1").isel(floor=-1)
     out[key] = {{
         "first_call": first,
-        "simulate": best(lambda: stochpound.simulate(scene, method="exact"), {repeats}),
-        "engine": best(lambda: run_exact(scene), {repeats}),
+        "simulate": best(lambda: stochpound.simulate(scene, method="exact", **{options!r}), {repeats}),
+        "engine": best(lambda: run_exact(scene, **{options!r}), {repeats}),
         "impacts": int(result.sizes["impact"]),
         "peak": float(abs(top).max()),
     }}
@@ -82,6 +85,7 @@ def parse_arguments(argv: list[str] | None) -> argparse.Namespace:
     parser.add_argument("revision", help="the earlier revision (a commit, tag or branch of this repository)")
     parser.add_argument("--rounds", type=int, default=5, help="alternating rounds (default 5)")
     parser.add_argument("--repeats", type=int, default=30, help="timed calls per scene and round (default 30)")
+    parser.add_argument("--demands", action="store_true", help="runs monitor the demand parameters (both revisions must take demands)")
     parser.add_argument("--out", type=Path, default=REPOSITORY / "docs" / "benchmarks.md", help="the Markdown file whose section is rewritten")
     return parser.parse_args(argv)
 
@@ -95,9 +99,9 @@ def main(argv: list[str] | None = None) -> int:
         earlier = Path(folder) / "earlier"
         checkout(arguments.revision, earlier)
         trees = {"this tree": REPOSITORY, arguments.revision: earlier}
-        rounds = measure(trees, arguments.rounds, arguments.repeats, Path(folder))
+        rounds = measure(trees, arguments.rounds, arguments.repeats, arguments.demands, Path(folder))
     results = {"revision": arguments.revision, "head": info["commit"], "rounds": rounds, "repeats": arguments.repeats,
-               "elapsed": time.perf_counter() - started}
+               "demands": arguments.demands, "elapsed": time.perf_counter() - started}
     SECTION.write(arguments.out, section(results, info))
     print(f"wrote the section 'Against an earlier revision' of {arguments.out} in {results['elapsed']:.0f} s")
     return 0
@@ -110,13 +114,13 @@ def checkout(revision: str, folder: Path) -> None:
     subprocess.run(["tar", "-x", "-C", str(folder)], input=archive, check=True)
 
 
-def measure(trees: dict[str, Path], rounds: int, repeats: int, folder: Path) -> dict[str, list[dict[str, Any]]]:
-    """Every tree's probe, in alternating rounds; the first round of each tree with numba's cache in an empty folder."""
+def measure(trees: dict[str, Path], rounds: int, repeats: int, demands: bool, folder: Path) -> dict[str, list[dict[str, Any]]]:
+    """Every tree's probe, in alternating rounds (runs monitoring the demand parameters when ``demands``); the first round of each tree with numba's cache in an empty folder."""
     measured: dict[str, list[dict[str, Any]]] = {name: [] for name in trees}
     for round_ in range(rounds):
         for index, (name, tree) in enumerate(trees.items()):
             cache = folder / f"numba-cache-{index}"
-            code = PROBE.format(tree=str(tree), scenes=SCENES, repeats=repeats)
+            code = PROBE.format(tree=str(tree), scenes=SCENES, repeats=repeats, options={"demands": True} if demands else {})
             measured[name].append(run_subprocess(code, extra_env={"NUMBA_CACHE_DIR": str(cache)}))
             print(f"round {round_ + 1}: {name} {json.dumps(measured[name][-1])}", flush=True)
     return measured
@@ -132,7 +136,8 @@ def section(results: dict[str, Any], info: dict[str, str]) -> str:
         "",
         f"`python -m benchmarks compare {results['revision']}` ({results['elapsed'] / 60:.0f} min): this tree ({results['head']}) and "
         f"revision {results['revision']} timed in {len(results['rounds'][this])} alternating rounds in one session, each round in fresh "
-        f"single-threaded processes, {results['repeats']} calls per scene and round; the study scenes under El Centro. Times in ms: best "
+        f"single-threaded processes, {results['repeats']} calls per scene and round; the study scenes under El Centro"
+        f"{', every run monitoring the demand parameters (--demands)' if results['demands'] else ''}. Times in ms: best "
         "over the rounds (median of the rounds' bests). *simulate* is the warm call with its result dataset; *engine* is `run_exact` "
         "alone (the recorded outputs, no dataset). The first call compiles the engine into an empty numba cache.",
         "",

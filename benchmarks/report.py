@@ -208,6 +208,7 @@ pip install -e ".[bench]"          # openseespy, for the OpenSees comparison (op
 python -m benchmarks               # full run: rewrites docs/benchmarks.md and docs/figures/{FIGURE_NAME}
 python -m benchmarks --quick       # smoke run (< 1 min), written to a temporary folder
 python -m benchmarks compare REV   # this tree against revision REV in one session (a few minutes): its own section
+python -m benchmarks compare REV --demands   # the same, every run monitoring the demand parameters
 ```
 {quick}
 The benchmark process runs on one thread (OMP, OpenBLAS, MKL and numba thread
