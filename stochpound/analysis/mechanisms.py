@@ -45,11 +45,14 @@ ROUNDOFF = 1e-9
 increase, relative for a ratio (a bound must exceed 0, or differ from 1, by more)."""
 
 
-def _paired(data: xr.DataArray, reference: xr.DataArray) -> tuple[xr.DataArray, xr.DataArray]:
-    """``data`` and ``reference`` aligned on their common coordinates, NaN where either is missing (pairs only); other coordinates dropped."""
-    data, reference = xr.align(data.reset_coords(drop=True), reference.reset_coords(drop=True), join="inner")
+def _paired(data: xr.DataArray, twin: xr.DataArray, min_runs: int, dim: str) -> tuple[xr.DataArray, xr.DataArray, xr.DataArray]:
+    """``data`` and ``twin`` (broadcast against ``data``'s cells) aligned on their common coordinates, NaN where either is missing
+    (pairs only; other coordinates dropped), and where a cell has at least ``min_runs`` pairs along ``dim``."""
+    if int(min_runs) < 2:
+        raise ValueError(f"min_runs: must be at least 2, got {min_runs!r}")
+    data, reference = xr.align(data.reset_coords(drop=True), twin.broadcast_like(data).reset_coords(drop=True), join="inner")
     both = data.notnull() & reference.notnull()
-    return data.where(both), reference.where(both)
+    return data.where(both), reference.where(both), both.sum(dim) >= int(min_runs)
 
 
 def _interval(values: xr.DataArray, prefix: str, dim: str, confidence: float, enough: xr.DataArray) -> xr.Dataset:
@@ -103,11 +106,7 @@ def ratcheting(residual: xr.DataArray, contact_free: xr.DataArray, away: float, 
     """
     if away not in (-1, 1, -1.0, 1.0):
         raise ValueError(f"away: must be -1 (the building is left of its neighbour) or +1 (right of it), got {away!r}")
-    if int(min_runs) < 2:
-        raise ValueError(f"min_runs: must be at least 2, got {min_runs!r}")
-    with_contacts, free = _paired(residual, contact_free.broadcast_like(residual))
-    count = with_contacts.notnull().sum(dim)
-    enough = count >= int(min_runs)
+    with_contacts, free, enough = _paired(residual, contact_free, min_runs, dim)
     result = xr.merge([
         _interval(abs(with_contacts), "abs", dim, confidence, enough),
         _interval(abs(free), "free_abs", dim, confidence, enough),
@@ -150,11 +149,7 @@ def amplification(demand: xr.DataArray, twin: xr.DataArray, min_runs: int, dim: 
         (below 1), each by more than :data:`~stochpound.analysis.mechanisms.ROUNDOFF`, and ``enough`` (at
         least ``min_runs`` pairs).
     """
-    if int(min_runs) < 2:
-        raise ValueError(f"min_runs: must be at least 2, got {min_runs!r}")
-    with_impacts, without = _paired(demand, twin.broadcast_like(demand))
-    count = with_impacts.notnull().sum(dim)
-    enough = count >= int(min_runs)
+    with_impacts, without, enough = _paired(demand, twin, min_runs, dim)
     result = xr.merge([
         _interval(with_impacts, "with", dim, confidence, enough),
         _interval(without, "twin", dim, confidence, enough),
