@@ -105,17 +105,7 @@ def _clearance_answer(name: str, store: xr.Dataset, ensembles: list[str], confid
                 cell = curve.sel({axis: c})
                 at.append(f"{value_text(axis, c)}: {span(cell['probability'])} (upper bound {span(cell['upper'])}; runs there {span(direct['probability'].sel({axis: c}))})")
             text += "P(wall hit | c) = P(D ≥ c) at " + "; ".join(at) + ". "
-        answers = []
-        for p in SEPARATION_TARGETS:
-            estimate, upper = needed["separation"].sel(probability=p), needed["upper"].sel(probability=p)
-            answer = f"P(wall hit) ≤ {p:.0%} needs a clearance of {span_cm(estimate)}{_extremes(estimate)}"
-            missing = int(upper.isnull().sum())
-            if missing < upper.size:
-                answer += f", upper {confidence:.0%} bound {span_cm(upper)}"
-            if missing:
-                answer += (f" (no upper bound in {missing} of {cells} cells: {n} realizations are too few, it needs "
-                           f"(1 − p)ⁿ ≤ {(1 - confidence) / 2:g})")
-            answers.append(answer)
+        answers = _target_answers(needed, lambda p: f"P(wall hit) ≤ {p:.0%} needs a clearance of ", confidence)
         parts.append(text + "; ".join(answers))
     return ("How likely is the moat wall hit at each clearance c, and what clearance keeps it rare? From the wall-free runs "
             "(clearance ∞, the closure toward the walls located), D the largest closure toward a wall: " + "; ".join(parts) + ".")
@@ -128,20 +118,28 @@ def _separation_answer(name: str, store: xr.Dataset, ensembles: list[str], confi
         demand = SeparationEnsemble(name, store, label, confidence).demand
         needed = required_separation(demand, SEPARATION_TARGETS, confidence=confidence, contact_dim=None).compute()
         n, cells = int(needed["realizations"].min()), int(needed["separation"].isel(probability=0).size)
-        answers = []
-        for p in SEPARATION_TARGETS:
-            estimate, upper = needed["separation"].sel(probability=p), needed["upper"].sel(probability=p)
-            text = f"for P(pounding) = {p:.0%}, {span_cm(estimate)}{_extremes(estimate)}"
-            missing = int(upper.isnull().sum())
-            if missing < upper.size:
-                text += f", upper {confidence:.0%} bound {span_cm(upper)}"
-            if missing:
-                text += (f" (no upper bound in {missing} of {cells} cells: {n} realizations are too few, it needs "
-                         f"(1 − p)ⁿ ≤ {(1 - confidence) / 2:g})")
-            answers.append(text)
+        answers = _target_answers(needed, lambda p: f"for P(pounding) = {p:.0%}, ", confidence)
         few = f"; fewer than {MIN_RUNS}, so indicative only" if n < MIN_RUNS else ""
         parts.append(f"ensemble {label} ({n} contact-free realizations in each of {cells} cells{few}): " + "; ".join(answers))
     return "How wide must the gap be? The separation needed, the 1 − p quantile of the contact-free peak closure D: " + "; ".join(parts) + "."
+
+
+def _target_answers(needed: xr.Dataset, lead: Callable[[float], str], confidence: float) -> list[str]:
+    """For each target of ``SEPARATION_TARGETS``: ``lead(p)``, the separation needed over the cells (cm) with its extremes and upper
+    bound, and, where some cells have none, why (``needed``: :func:`~stochpound.analysis.required_separation`'s result)."""
+    n, cells = int(needed["realizations"].min()), int(needed["separation"].isel(probability=0).size)
+    answers = []
+    for p in SEPARATION_TARGETS:
+        estimate, upper = needed["separation"].sel(probability=p), needed["upper"].sel(probability=p)
+        text = f"{lead(p)}{span_cm(estimate)}{_extremes(estimate)}"
+        missing = int(upper.isnull().sum())
+        if missing < upper.size:
+            text += f", upper {confidence:.0%} bound {span_cm(upper)}"
+        if missing:
+            text += (f" (no upper bound in {missing} of {cells} cells: {n} realizations are too few, it needs "
+                     f"(1 − p)ⁿ ≤ {(1 - confidence) / 2:g})")
+        answers.append(text)
+    return answers
 
 
 def _records_answer(store: xr.Dataset, records: list[str]) -> str:
