@@ -222,15 +222,14 @@ def _contents_line(figure: Figure, y: float, label: str, key: str, starts: dict[
 
 def _paragraph(flow: _Flow, text: str) -> None:
     """A paragraph at the cursor; on a new page when the section has none yet or when fewer than ``MIN_LINES`` of it would fit."""
-    lines = _wrap(text, _width(flow.page.size) if flow.open else _width(PORTRAIT), BODY)
-    if flow.open and not _fits(len(lines), int((flow.room() - 0.35 * _line(BODY)) // _line(BODY))):
-        flow.open = False
-    if not flow.open:
-        flow.new_page()
+    if flow.open:
         lines = _wrap(text, _width(flow.page.size), BODY)
-    else:
-        flow.y += 0.35 * _line(BODY)
-    flow.text(lines, BODY)
+        if _fits(len(lines), int((flow.room() - 0.35 * _line(BODY)) // _line(BODY))):
+            flow.y += 0.35 * _line(BODY)
+            flow.text(lines, BODY)
+            return
+    flow.new_page()
+    flow.text(_wrap(text, _width(PORTRAIT), BODY), BODY)
     flow.open = True
 
 
