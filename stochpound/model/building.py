@@ -5,8 +5,10 @@ upwards), ``stiffness`` (N/m per storey), ``damping`` (N·s/m per storey) or
 ``damping_ratio`` (stiffness-proportional damping C = a₁K with that ratio
 in mode 1), ``base`` (a sliding base, :mod:`stochpound.model.friction`;
 none: a fixed base), ``initial`` (initial conditions) and ``storey_height``
-(m per storey, optional: storey drift ratios). Storey i joins
-floor i − 1 (floor 0 is the base) to floor i.
+(m per storey, optional: storey drift ratios), ``yield_force`` (N per
+storey, optional: bilinear yielding storeys, :mod:`stochpound.model.yielding`)
+and ``hardening`` (their post-yield to elastic stiffness ratio α, default 0).
+Storey i joins floor i − 1 (floor 0 is the base) to floor i.
 """
 
 from __future__ import annotations
@@ -22,7 +24,7 @@ from stochpound._errors import SceneError
 from stochpound.model import fields
 from stochpound.model.friction import Base, base_from_table
 
-BUILDING_KEYS = {"name", "mass", "stiffness", "damping", "damping_ratio", "base", "initial", "storey_height"}
+BUILDING_KEYS = {"name", "mass", "stiffness", "damping", "damping_ratio", "base", "initial", "storey_height", "yield_force", "hardening"}
 INITIAL_KEYS = {"displacement", "velocity", "base_displacement", "base_velocity"}
 
 
@@ -68,6 +70,10 @@ class Building:
         Initial conditions.
     storey_height : tuple of float or None
         Storey heights h_i, m (for storey drift ratios), when given.
+    yield_force : tuple of float or None
+        Storey yield shears F_y,i, N (bilinear storeys, :mod:`stochpound.model.yielding`); None: elastic storeys.
+    hardening : float
+        Post-yield to elastic stiffness ratio α of the bilinear storeys (0 ≤ α < 1; 0: elastic–perfectly plastic).
     """
 
     name: str
@@ -78,6 +84,8 @@ class Building:
     base: Base | None = None
     initial: InitialState | None = None
     storey_height: tuple[float, ...] | None = None
+    yield_force: tuple[float, ...] | None = None
+    hardening: float = 0.0
 
     @property
     def n_floors(self) -> int:
@@ -150,7 +158,20 @@ def building_from_table(table: Mapping[str, Any], prefix: str, index: int) -> Bu
     damping, ratio = _storey_damping(table, prefix, np.array(mass), np.array(stiffness))
     initial = _initial(fields.table(table, "initial", prefix), f"{prefix}.initial", len(mass), base is not None)
     height = fields.number_list(table, "storey_height", prefix, low=0.0, low_open=True, length=len(mass)) if "storey_height" in table else None
-    return Building(name, mass, stiffness, damping, ratio, base, initial, height)
+    yield_force, hardening = _yielding(table, prefix, stiffness)
+    return Building(name, mass, stiffness, damping, ratio, base, initial, height, yield_force, hardening)
+
+
+def _yielding(table: Mapping[str, Any], prefix: str, stiffness: tuple[float, ...]) -> tuple[tuple[float, ...] | None, float]:
+    """The bilinear storeys' ``yield_force`` (None: elastic) and ``hardening`` of a ``[[building]]`` table, validated."""
+    if "yield_force" not in table:
+        if "hardening" in table:
+            raise SceneError(f"{prefix}.hardening: only a building with yield_force (bilinear storeys) can have it")
+        return None, 0.0
+    yield_force = fields.number_list(table, "yield_force", prefix, low=0.0, low_open=True, length=len(stiffness))
+    if any(k <= 0.0 for k in stiffness):
+        raise SceneError(f"{prefix}.yield_force: needs every storey stiffness > 0 (the yield drift is F_y / k)")
+    return yield_force, fields.number(table, "hardening", prefix, default=0.0, low=0.0, high=1.0, high_open=True)
 
 
 def _storey_damping(table: Mapping[str, Any], prefix: str, mass: np.ndarray, stiffness: np.ndarray) -> tuple[tuple[float, ...], float | None]:

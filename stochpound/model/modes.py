@@ -29,7 +29,7 @@ from typing import Generic, TypeVar
 
 import numpy as np
 
-from stochpound.model import contact, friction
+from stochpound.model import contact, friction, yielding
 from stochpound.model.demands import DEMANDS, demand_rows
 from stochpound.model.friction import STUCK
 from stochpound.model.system import System
@@ -43,22 +43,23 @@ Value = TypeVar("Value")
 
 @dataclass(frozen=True)
 class Mode:
-    """Discrete state: ``closed[p]`` per contact, ``base[i]`` (STUCK, ±1 or FREE) per sliding base (``System.bases``)."""
+    """Discrete state: ``closed[p]`` per contact, ``base[i]`` (STUCK, ±1 or FREE) per sliding base (``System.bases``), ``storey[j]`` (ELASTIC or ±1) per yielding storey (``System.storeys``)."""
 
     closed: tuple[bool, ...]
     base: tuple[int, ...]
+    storey: tuple[int, ...] = ()
 
     def with_contact(self, p: int, closed: bool) -> "Mode":
         """The same mode with contact p opened or closed."""
         flags = list(self.closed)
         flags[p] = closed
-        return Mode(tuple(flags), self.base)
+        return Mode(tuple(flags), self.base, self.storey)
 
     def with_base(self, b: int, state: int) -> "Mode":
         """The same mode with sliding base b in ``state``."""
         states = list(self.base)
         states[b] = state
-        return Mode(self.closed, tuple(states))
+        return Mode(self.closed, tuple(states), self.storey)
 
 
 @dataclass(frozen=True)
@@ -84,7 +85,8 @@ class ModeDynamics:
         The monitors (:func:`monitor_rows`): read-outs whose largest value over
         a run is located on the solution.
     stuck_dofs : np.ndarray of int
-        DOFs held fixed in this mode (stuck bases); s and ṡ are re-imposed on them.
+        DOFs held fixed in this mode (stuck bases, the plastic DOFs of elastic
+        storeys); s and ṡ are re-imposed on them.
     """
 
     mode: Mode
@@ -182,14 +184,24 @@ class ModeLibrary:
         return len(self._built)
 
     def _free_inverse_mass(self, mode: Mode) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Stuck DOFs, free DOFs and the inverse of the free DOFs' mass matrix of ``mode``."""
+        """Held DOFs, free DOFs (with mass) and the inverse of the free DOFs' mass matrix of ``mode``.
+
+        Held: the stuck bases and the plastic DOFs of elastic storeys; the
+        plastic DOFs have no mass and are never free (their rates are the
+        law's, :func:`stochpound.model.yielding.flow_rates`).
+        """
         system = self.system
         stuck = np.array([base.dof for base, state in zip(system.bases, mode.base) if state == STUCK], dtype=int)
-        free = np.setdiff1d(np.arange(system.n_dof), stuck)
+        plastic = [dof for storey in system.storeys for dof in (storey.plastic_dof, storey.accumulated_dof)]
+        free = np.setdiff1d(np.arange(system.n_dof), np.concatenate([stuck, plastic]).astype(int))
         key = tuple(stuck)
         inverse = self._inverse_mass.get(key)
         if inverse is None:
             inverse = self._inverse_mass[key] = np.linalg.inv(system.mass[np.ix_(free, free)])
+        if system.storeys:
+            held = [dof for storey, state in zip(system.storeys, mode.storey) if state == yielding.ELASTIC
+                    for dof in (storey.plastic_dof, storey.accumulated_dof)]
+            stuck = np.sort(np.concatenate([stuck, held]).astype(int))
         return stuck, free, inverse
 
 
@@ -208,6 +220,10 @@ def _build(system: System, mode: Mode, masses: tuple[np.ndarray, np.ndarray, np.
     stiffness, damping = system.stiffness + extra_stiffness, system.damping + extra_damping
     for base, state in zip(system.bases, mode.base):
         load[base.dof] += friction.slip_force(base, state)
+    for storey, state in zip(system.storeys, mode.storey):
+        if yielding.flowing(state):
+            spring, flow_load = yielding.flow_terms(storey, state, n)
+            stiffness, load = stiffness + spring, load + flow_load
     inputs = _readout_loads(system, mode)
     A = np.zeros((2 * n, size))
     A[free, n + free] = 1.0
@@ -218,11 +234,16 @@ def _build(system: System, mode: Mode, masses: tuple[np.ndarray, np.ndarray, np.
     B[n + free] = -inverse_mass @ system.influence[free]
     c = np.zeros(2 * n)
     c[n + free] = inverse_mass @ load[free]
+    for storey, state in zip(system.storeys, mode.storey):
+        if yielding.flowing(state):
+            yielding.flow_rates(storey, state, A, n)
     foundation = [_foundation_force(system, i, state, (stiffness, damping, load, inputs), (A, B, c), free) for i, state in enumerate(mode.base)]
     matrix, *rest = contact.guards(rows, k, d, system.element_tensile, closed)
     contact_guards = (_over_xi(matrix, size), *rest)
     base_guards = [guard for i, (base, state) in enumerate(zip(system.bases, mode.base))
                    for guard in friction.guards(base, i, state, foundation[i], n)]
+    base_guards += [guard for j, (storey, state) in enumerate(zip(system.storeys, mode.storey))
+                    for guard in yielding.guards(storey, len(system.bases) + j, state, size, n)]
     force_matrix, force_constant = contact.force_rows(rows, k, d, linear)
     force_matrix = _over_xi(force_matrix, size)
     readout = 2 * n + np.arange(len(system.readout_elements))
@@ -342,4 +363,4 @@ def _stack_foundation(foundation: list[tuple[np.ndarray, float, float]], size: i
 def initial_mode(system: System) -> Mode:
     """Mode before settling at t = 0: contacts open, bases stuck, free or sliding as x(0) says."""
     states = tuple(friction.initial_state(base, system.initial_state[system.n_dof + base.dof]) for base in system.bases)
-    return Mode(tuple(False for _ in range(system.n_elements)), states)
+    return Mode(tuple(False for _ in range(system.n_elements)), states, tuple(yielding.ELASTIC for _ in system.storeys))

@@ -32,6 +32,7 @@ from stochpound.model.building import Building, storey_matrix
 from stochpound.model.contact import Contact, effective_mass
 from stochpound.model.wall import Wall
 from stochpound.model.friction import SlidingBase
+from stochpound.model.yielding import YieldingStorey, plastic_spring
 from stochpound.model.scene import Scene
 
 
@@ -82,6 +83,10 @@ class System:
         equations as inputs (ẋ = A x + E f + B a_g + c; the engine's state is
         ξ = [x, f]): first the elements with a nonlinear contact law, then the
         sliding bases with velocity-dependent friction (their indices).
+    storeys : tuple of YieldingStorey
+        The bilinear storeys (:mod:`stochpound.model.yielding`), building by
+        building; their plastic and accumulated plastic drifts are the last
+        DOFs (no mass), and K holds their elastic–perfectly-plastic springs.
     """
 
     n_dof: int
@@ -110,6 +115,7 @@ class System:
     demands: bool
     readout_elements: np.ndarray
     readout_bases: np.ndarray
+    storeys: tuple[YieldingStorey, ...] = ()
 
     @property
     def n_elements(self) -> int:
@@ -150,7 +156,9 @@ class System:
         digest = hashlib.blake2b(digest_size=20)
         for item in fields(self):
             value = getattr(self, item.name)
-            if isinstance(value, (tuple, int, bool)):  # the sliding bases (frozen dataclasses of numbers), the laws, counts and flags
+            if item.name == "storeys" and not value:  # an elastic system's digest is the one it had before yielding storeys
+                continue
+            if isinstance(value, (tuple, int, bool)):  # the sliding bases and storeys (frozen dataclasses of numbers), the laws, counts and flags
                 digest.update(f"{item.name}{value!r}".encode())
                 continue
             for array in value if isinstance(value, list) else [value]:
@@ -175,6 +183,8 @@ def build_system(scene: Scene, demands: bool = False) -> System:
 def _build_system(buildings: tuple[Building, ...], contacts: tuple[Contact, ...], walls: tuple[Wall, ...], g: float, study_compat: bool,
                   demands: bool) -> System:
     floor_dofs, base_dofs, n_dof = _layout(buildings)
+    storeys = _yielding_storeys(buildings, floor_dofs, n_dof)
+    n_dof += 2 * len(storeys)
     mass = np.zeros((n_dof, n_dof))
     stiffness = np.zeros((n_dof, n_dof))
     damping = np.zeros((n_dof, n_dof))
@@ -207,6 +217,9 @@ def _build_system(buildings: tuple[Building, ...], contacts: tuple[Contact, ...]
             bases.append(SlidingBase(b, base, g * building.total_mass, building.base.mu, building.base.mu_static, building.base.mu_fast,
                                      building.base.mu_rate))
         row += building.n_floors
+    for storey in storeys:  # α k of the storey stays in the tridiagonal block, (1 − α) k goes through its plastic element
+        drift = storey.drift_row(n_dof)
+        stiffness += plastic_spring(storey, n_dof) - storey.plastic_stiffness * np.outer(drift, drift)  # exactly 0 on the floors
     levels = _level_rows(buildings, floor_dofs, base_dofs, n_dof)
     left, right, load = _element_rows(contacts, walls, study_compat, levels, base_dofs)
     elements = (*contacts, *walls)
@@ -237,7 +250,21 @@ def _build_system(buildings: tuple[Building, ...], contacts: tuple[Contact, ...]
         demands=demands,
         readout_elements=np.array([p for p, e in enumerate(elements) if not laws.contact_law(e.law).piecewise_linear], dtype=np.int64),
         readout_bases=np.array([i for i, base in enumerate(bases) if not laws.friction_law(base.friction_law).piecewise_linear], dtype=np.int64),
+        storeys=storeys,
     )
+
+
+def _yielding_storeys(buildings: tuple[Building, ...], floor_dofs: list[np.ndarray], n_dof: int) -> tuple[YieldingStorey, ...]:
+    """The bilinear storeys of ``buildings``, their plastic DOFs numbered from ``n_dof`` (z and p of each storey in turn)."""
+    storeys = []
+    for b, building in enumerate(buildings):
+        if building.yield_force is None:
+            continue
+        floors = floor_dofs[b].tolist()
+        for i, (k, force) in enumerate(zip(building.stiffness, building.yield_force)):
+            z = n_dof + 2 * len(storeys)
+            storeys.append(YieldingStorey(b, i, floors[i], floors[i - 1] if i > 0 else -1, z, z + 1, float(k), float(force), float(building.hardening)))
+    return tuple(storeys)
 
 
 def _element_masses(buildings: tuple[Building, ...], contacts: tuple[Contact, ...], walls: tuple[Wall, ...]) -> np.ndarray:

@@ -85,7 +85,7 @@ class EngineRun:
                 break
             if status == engine.NEED_MODE:  # the only step that builds propagators (matrix exponentials)
                 with self.building():
-                    slots.load(tables.vector_mode(run.missing_mode, system.n_elements))
+                    slots.load(tables.vector_mode(run.missing_mode, system.n_elements, len(system.bases)))
             elif status == engine.NEED_SPACE:
                 table = self.state.impacts.table
                 self.state = self.state._replace(impacts=self.state.impacts._replace(table=np.concatenate([table, np.zeros_like(table)])))

@@ -49,18 +49,30 @@ State = namedtuple("State", "run arming impacts outputs supplied readouts")
 
 
 def mode_vector(mode: Mode) -> np.ndarray:
-    """The engine's int64 vector of a mode: closed flags, then base states, then 1 (an empty slot's vector ends in -9 instead)."""
-    return np.array([int(flag) for flag in mode.closed] + list(mode.base) + [1], dtype=np.int64)
+    """The engine's int64 vector of a mode: closed flags, then base states, then yielding storey states, then 1 (an empty slot's vector ends in -9 instead).
+
+    The engine treats a yielding storey's plastic element like a sliding base
+    (:mod:`stochpound.model.yielding`): its sliders are the bases, then the storeys.
+    """
+    return np.array([int(flag) for flag in mode.closed] + list(mode.base) + list(mode.storey) + [1], dtype=np.int64)
 
 
-def vector_mode(vector: np.ndarray, n_contacts: int) -> Mode:
-    """The :class:`~stochpound.model.modes.Mode` of an engine mode vector."""
-    return Mode(tuple(bool(v) for v in vector[:n_contacts]), tuple(int(v) for v in vector[n_contacts:-1]))
+def vector_mode(vector: np.ndarray, n_contacts: int, n_bases: int) -> Mode:
+    """The :class:`~stochpound.model.modes.Mode` of an engine mode vector (``n_contacts`` impact elements, ``n_bases`` sliding bases)."""
+    sliders = n_contacts + n_bases
+    return Mode(tuple(bool(v) for v in vector[:n_contacts]), tuple(int(v) for v in vector[n_contacts:sliders]), tuple(int(v) for v in vector[sliders:-1]))
 
 
 def mode_length(system: System) -> int:
     """Length of the engine's mode vectors of ``system`` (:func:`mode_vector`)."""
-    return system.n_elements + len(system.bases) + 1
+    return system.n_elements + len(system.bases) + len(system.storeys) + 1
+
+
+def slider_dofs(system: System) -> np.ndarray:
+    """The DOF of each of the engine's sliders: the sliding bases', then each yielding storey's plastic drift (int64)."""
+    if not system.storeys:
+        return system.base_dofs
+    return np.concatenate([system.base_dofs, np.array([storey.plastic_dof for storey in system.storeys], dtype=np.int64)])
 
 
 def plant_arrays(system: System, motion: GroundMotion) -> Plant:
@@ -73,13 +85,13 @@ def plant_arrays(system: System, motion: GroundMotion) -> Plant:
     return Plant(
         engine.Motion(np.asarray(motion.times, float), forcing, coefficients, harmonic),
         engine.Layout(system.element_geometry, system.element_gap, system.element_tensile.astype(np.bool_), system.element_left, system.element_right,
-                      system.base_dofs),
+                      slider_dofs(system)),
     )
 
 
 def max_guards(system: System) -> int:
-    """The largest number of guards of a mode: two per contact (CLOSE and RECLOSE) and two per base (SLIP both ways)."""
-    return 2 * system.n_elements + 2 * len(system.bases)
+    """The largest number of guards of a mode: two per contact (CLOSE and RECLOSE), two per base and per yielding storey (SLIP both ways)."""
+    return 2 * system.n_elements + 2 * len(system.bases) + 2 * len(system.storeys)
 
 
 def work_arrays_for(system: System, slots: "Slots") -> tuple[np.ndarray, np.ndarray, np.ndarray]:
