@@ -249,7 +249,7 @@ def _build(system: System, mode: Mode, masses: tuple[np.ndarray, np.ndarray, np.
     readout = 2 * n + np.arange(len(system.readout_elements))
     force_matrix[system.readout_elements, readout] = closed[system.readout_elements]  # a nonlinear element's force is its read-out
     return ModeDynamics(mode, A, B, c, *_stack_guards(contact_guards, base_guards, size), force_matrix, force_constant,
-                        *_stack_foundation(foundation, size), *monitor_rows(system, rows, (A, B, c)), stuck)
+                        *_stack_foundation(foundation, size), *monitor_rows(system, rows, (A, B, c), mode.storey), stuck)
 
 
 def _over_xi(matrix: np.ndarray, size: int) -> np.ndarray:
@@ -291,7 +291,7 @@ def _foundation_force(system: System, b: int, state: int, terms: tuple[np.ndarra
 
 def monitor_count(system: System) -> int:
     """Number of monitors of every mode of ``system`` (:func:`monitor_rows`)."""
-    return demand_monitors_start(system) + (2 * len(DEMANDS) * len(system.total_displacement) if system.demands else 0)
+    return storey_monitors_start(system) + 2 * len(system.storeys)
 
 
 def monitored_contacts(system: System) -> np.ndarray:
@@ -315,7 +315,13 @@ def demand_monitors_start(system: System) -> int:
     return system.n_elements + 4 * len(monitored_contacts(system))
 
 
-def monitor_rows(system: System, rows: contact.ContactRows, rate: tuple[np.ndarray, np.ndarray, np.ndarray]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def storey_monitors_start(system: System) -> int:
+    """Index of the first yielding storey's drift monitor (:func:`monitor_rows`): they follow the demands."""
+    return demand_monitors_start(system) + (2 * len(DEMANDS) * len(system.total_displacement) if system.demands else 0)
+
+
+def monitor_rows(system: System, rows: contact.ContactRows, rate: tuple[np.ndarray, np.ndarray, np.ndarray],
+                 storey_states: tuple[int, ...] = ()) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The monitors of a mode as an affine map (matrix over x, a_g coefficients, constants).
 
     First each impact element's closure y_left − y_right = g_p · q (m, the
@@ -329,19 +335,45 @@ def monitor_rows(system: System, rows: contact.ContactRows, rate: tuple[np.ndarr
     u1 + u2 ≥ D holds on the solution. Then, when the system monitors
     demands, + and − every demand parameter of
     :func:`stochpound.model.demands.demand_rows` (whose peaks give the peak
-    absolute values). ``rate`` is the mode's (A, B, c).
+    absolute values). Last, + and − the drift of every yielding storey
+    (:func:`storey_monitors_start`): their peaks give its peak ductility.
+    ``rate`` is the mode's (A, B, c), ``storey_states`` its yielding storeys' states.
     """
     monitored = monitored_contacts(system)
     left, right = system.element_left[monitored], system.element_right[monitored]
     sides = np.stack([left, -left, right, -right], axis=1).reshape(4 * len(monitored), system.n_dof)
     displacements = np.vstack([rows.penetration, np.hstack([sides, np.zeros((4 * len(monitored), system.n_dof))])])
+    if system.storeys:
+        drifts = np.array([storey.drift_row(system.n_dof) for storey in system.storeys])
+        storey_rows = np.hstack([np.vstack([drifts, -drifts]), np.zeros((2 * len(drifts), system.n_dof))])
     n_rows = len(displacements)
     matrix, ground, constant = _over_xi(displacements, system.xi_size), np.zeros(n_rows), np.zeros(n_rows)
-    if not system.demands:
+    if system.demands:
+        demand = demand_rows(system.floor_dofs, system.building_base_dofs, system.storey_stiffness, system.storey_damping, rate)
+        _yielding_shears(system, storey_states, demand)
+        matrix, ground, constant = (np.vstack([matrix, demand[0], -demand[0]]), np.concatenate([ground, demand[1], -demand[1]]),
+                                    np.concatenate([constant, demand[2], -demand[2]]))
+    if not system.storeys:
         return matrix, ground, constant
-    demand = demand_rows(system.floor_dofs, system.building_base_dofs, system.storey_stiffness, system.storey_damping, rate)
-    return (np.vstack([matrix, demand[0], -demand[0]]), np.concatenate([ground, demand[1], -demand[1]]),
-            np.concatenate([constant, demand[2], -demand[2]]))
+    zeros = np.zeros(len(storey_rows))
+    return np.vstack([matrix, _over_xi(storey_rows, system.xi_size)]), np.concatenate([ground, zeros]), np.concatenate([constant, zeros])
+
+
+def _yielding_shears(system: System, storey_states: tuple[int, ...], demand: tuple[np.ndarray, np.ndarray, np.ndarray]) -> None:
+    """Correct the storey shear rows of :func:`~stochpound.model.demands.demand_rows` (k d + c ḋ) for the yielding storeys, in place.
+
+    Elastic: k d − (1 − α) k z; flowing: α k d + σ (1 − α) F_y (plus c ḋ either way).
+    """
+    matrix, _, constant = demand
+    floors = len(system.total_displacement)
+    first = np.cumsum([0] + [len(dofs) for dofs in system.floor_dofs])
+    for storey, state in zip(system.storeys, storey_states):
+        row = 2 * floors + first[storey.building] + storey.storey
+        if yielding.flowing(state):
+            matrix[row, : system.n_dof] -= storey.plastic_stiffness * storey.drift_row(system.n_dof)
+            constant[row] += state * storey.plastic_strength
+        else:
+            matrix[row, storey.plastic_dof] -= storey.plastic_stiffness
 
 
 def _stack_guards(contact_guards: tuple[np.ndarray, ...], base_guards: list[tuple], size: int) -> tuple[np.ndarray, ...]:

@@ -17,6 +17,7 @@ from stochpound import __version__
 from stochpound._atomic import replacing
 from stochpound.results.record import ENERGY_TERMS, EventCounters, Recorder
 from stochpound.model.contact import ImpactElement
+from stochpound.model import yielding
 from stochpound.model.friction import FIXED_BASE
 from stochpound.model.scene import Scene
 from stochpound.model.system import System
@@ -54,6 +55,7 @@ def build_dataset(scene: Scene, system: System, recorder: Recorder, counters: Ev
         **(_closure_variables(recorder, system.n_contacts, "wall") if scene.walls else {}),
         **_impact_variables(recorder, system.n_contacts, bool(scene.walls)),
         **(_demand_variables(scene, recorder) if recorder.demands else {}),
+        **(_yielding_variables(scene, recorder) if system.storeys else {}),
         **_energy_variables(recorder),
     }
     attrs = {
@@ -163,6 +165,33 @@ def _demand_variables(scene: Scene, recorder: Recorder) -> dict[str, tuple]:
         variables["storey_drift_ratio"] = _var(("building", "floor", "time"), drift / height[:, :, None], "1", "storey drift over the storey height")
         variables["peak_storey_drift_ratio"] = _var(("building", "floor"), variables["peak_storey_drift"][1] / height, "1",
                                                     "largest absolute storey drift ratio over the run")
+    return variables
+
+
+def _yielding_variables(scene: Scene, recorder: Recorder) -> dict[str, tuple]:
+    """The yielding storeys' plastic drifts over time, their peak ductility (located on the solution) and residual drifts (0 or NaN for elastic storeys)."""
+    system = recorder.system
+    shape = (len(scene.buildings), scene.max_floors)
+    plastic_drift, _ = recorder.plastic_drifts()
+    plastic = recorder.by_floor(np.zeros((len(system.total_displacement), len(recorder.motion.times))))
+    ductility, residual = np.full(shape, np.nan), recorder.by_floor(np.zeros(len(system.total_displacement)))
+    peaks = recorder.storey_drift_peaks()
+    for j, storey in enumerate(system.storeys):
+        plastic[storey.building, storey.storey] = plastic_drift[j]
+        ductility[storey.building, storey.storey] = peaks[0, j] / storey.yield_drift
+        residual[storey.building, storey.storey] = yielding.residual_drift(storey, plastic_drift[j, -1])
+    variables = {
+        "storey_plastic_drift": _var(("building", "floor", "time"), plastic, "m", "plastic drift z of the storey below the floor (0 for an elastic storey)"),
+        "peak_storey_ductility": _var(("building", "floor"), ductility, "1", "largest absolute storey drift over its yield drift F_y / k (NaN for an elastic storey)"),
+        "residual_storey_drift": _var(("building", "floor"), residual, "m", "drift the storey keeps at rest after the run: (1 - alpha) z at the end"),
+    }
+    heights = [b.storey_height for b in scene.buildings]
+    if any(h is not None for h in heights):
+        height = np.full(shape, np.nan)
+        for b, h in enumerate(heights):
+            if h is not None:
+                height[b, : len(h)] = h
+        variables["residual_storey_drift_ratio"] = _var(("building", "floor"), residual / height, "1", "residual storey drift over the storey height")
     return variables
 
 
@@ -281,6 +310,11 @@ def _energy_variables(recorder: Recorder) -> dict[str, tuple]:
     variables["energy_kinetic"] = _var(("time",), kinetic, "J", "kinetic energy of the motion relative to the ground")
     variables["energy_strain"] = _var(("time",), strain, "J", "strain energy of storeys and base restoring springs")
     residual = energy["input"] - (kinetic - kinetic[0]) - (strain - strain[0]) - energy["damping"] - energy["friction"] - energy["impact"]
+    if recorder.system.storeys:
+        storeys = recorder.system.storeys
+        hysteretic = np.array([storey.plastic_strength for storey in storeys]) @ recorder.plastic_drifts()[1]
+        variables["energy_hysteretic"] = _var(("time",), hysteretic, "J", "energy dissipated by the yielding storeys ((1 - alpha) F_y times the accumulated plastic drift)")
+        residual = residual - hysteretic
     variables["energy_residual"] = _var(("time",), residual, "J", "input minus every other term (0 for an exact solution)")
     return variables
 

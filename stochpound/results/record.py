@@ -20,7 +20,8 @@ import numpy as np
 
 from stochpound.model.demands import DEMANDS
 from stochpound.model.friction import FREE
-from stochpound.model.modes import ModeDynamics, contact_displacement_monitors, demand_monitors_start, monitor_count, monitored_contacts
+from stochpound.model.modes import (ModeDynamics, contact_displacement_monitors, demand_monitors_start, monitor_count, monitored_contacts,
+                                     storey_monitors_start)
 from stochpound.model.system import System
 from stochpound.motions.ground import GroundMotion
 
@@ -222,6 +223,17 @@ class Recorder:
         values = np.zeros((len(self.system.floor_dofs), len(per_base)), dtype=per_base.dtype)
         values[[base.building for base in self.system.bases]] = per_base.T
         return values
+
+    def storey_drift_peaks(self) -> np.ndarray:
+        """The largest abs(drift) over the run of each yielding storey (``System.storeys`` order) and when: rows value (m), time (s), located on the solution."""
+        first, n = storey_monitors_start(self.system), len(self.system.storeys)
+        return _larger(self.peaks[:, first : first + n], self.peaks[:, first + n : first + 2 * n])
+
+    def plastic_drifts(self) -> tuple[np.ndarray, np.ndarray]:
+        """Each yielding storey's plastic drift z and accumulated plastic drift p = Σ|Δz| at the samples (storey × time, m)."""
+        storeys = self.system.storeys
+        return (self.states[:, [s.plastic_dof for s in storeys]].T.reshape(len(storeys), -1),
+                self.states[:, [s.accumulated_dof for s in storeys]].T.reshape(len(storeys), -1))
 
     def kinetic_and_strain(self) -> tuple[np.ndarray, np.ndarray]:
         """Kinetic energy ½ vᵀMv and storey/restoring strain energy ½ qᵀKq at the samples, J."""

@@ -117,7 +117,12 @@ transposed (Z × D·2N).
 Motion = namedtuple("Motion", "times forcing coefficients harmonic")
 Motion.__doc__ = """Output times, exosystem state per interval, cubic per interval (sampled) or [A, ω, φ] (harmonic)."""
 Layout = namedtuple("Layout", "geometry gap tensile left_rows right_rows base_dofs")
-Layout.__doc__ = """Impact elements (penetration rows, gaps, tensile flags, displacement rows of their left and right sides) and the base DOFs."""
+Layout.__doc__ = """Impact elements (penetration rows, gaps, tensile flags, displacement rows of their left and right sides) and the sliders' DOFs.
+
+``base_dofs`` (2 × sliders: the sliding bases, then the yielding storeys): a
+STOP sets the velocity of DOF ``base_dofs[0, i]`` to that of DOF
+``base_dofs[1, i]`` (0 when it is −1): a base's sliding velocity, a storey's
+drift rate end exactly at 0."""
 Run = namedtuple("Run", "clock ints x pending_x pending_mode missing_mode visited")
 Run.__doc__ = """Time, counters (``ints``; ``ints[MODE]`` is a slot), state, the pending event and the ids of the modes visited."""
 Arming = namedtuple("Arming", "threshold tolerance rearmable disarmed")
@@ -943,7 +948,7 @@ def _penetration(geometry, gap, p, x):
 
 @njit(**INTERNAL)
 def _apply(geometry, gap, base_dofs, mode, x, kind, target, direction):
-    """Apply a transition to a mode vector (changed in place); a STOP zeroes the base velocity in x."""
+    """Apply a transition to a mode vector (changed in place); a STOP zeroes the slider's velocity in x (a base's, a storey's drift rate)."""
     n_contacts = gap.shape[0]
     if kind == _CLOSE or (kind == _RECLOSE and _penetration(geometry, gap, target, x) > 0.0):
         mode[target] = 1
@@ -952,7 +957,8 @@ def _apply(geometry, gap, base_dofs, mode, x, kind, target, direction):
     elif kind == _SLIP:
         mode[n_contacts + target] = direction
     elif kind == _STOP:
-        x[geometry.shape[1] + base_dofs[target]] = 0.0
+        n, lower = geometry.shape[1], base_dofs[1, target]
+        x[n + base_dofs[0, target]] = x[n + lower] if lower >= 0 else 0.0
         mode[n_contacts + target] = _STUCK
 
 

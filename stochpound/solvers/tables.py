@@ -69,10 +69,16 @@ def mode_length(system: System) -> int:
 
 
 def slider_dofs(system: System) -> np.ndarray:
-    """The DOF of each of the engine's sliders: the sliding bases', then each yielding storey's plastic drift (int64)."""
-    if not system.storeys:
-        return system.base_dofs
-    return np.concatenate([system.base_dofs, np.array([storey.plastic_dof for storey in system.storeys], dtype=np.int64)])
+    """The engine's slider DOFs (2 × sliders, int64: :data:`stochpound.solvers.engine.Layout`): the sliding bases, then the yielding storeys.
+
+    A STOP sets the velocity of the first row's DOF to the second's (−1: to
+    0): a base's own, a storey's upper floor's to its lower floor's (its
+    drift rate to 0; u_0 = 0 for the first storey).
+    """
+    bases = system.base_dofs
+    upper = [storey.upper for storey in system.storeys]
+    lower = [storey.lower for storey in system.storeys]
+    return np.array([[*bases.tolist(), *upper], [-1] * len(bases) + lower], dtype=np.int64).reshape(2, len(bases) + len(upper))
 
 
 def plant_arrays(system: System, motion: GroundMotion) -> Plant:
