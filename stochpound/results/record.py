@@ -196,7 +196,7 @@ class Recorder:
     def demand_peaks(self) -> dict[str, tuple[np.ndarray, np.ndarray]]:
         """Each demand parameter's largest absolute value over the run and when (floor in system order), located on the solution."""
         floors, n, first = len(self.system.total_displacement), len(DEMANDS) * len(self.system.total_displacement), demand_monitors_start(self.system)
-        larger = _larger(self.peaks[:, first : first + n], self.peaks[:, first + n :])
+        larger = _larger(self.peaks[:, first : first + n], self.peaks[:, first + n : first + 2 * n])
         return {name: (larger[0, i * floors : (i + 1) * floors], larger[1, i * floors : (i + 1) * floors]) for i, name in enumerate(DEMANDS)}
 
     def contact_displacement_peaks(self) -> tuple[np.ndarray, np.ndarray]:

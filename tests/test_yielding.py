@@ -1,0 +1,136 @@
+"""Bilinear yielding storeys (docs/model.md, "Yielding storeys"): closed forms, energy, elastic limit, exact against ivp."""
+
+import math
+
+import numpy as np
+import pytest
+from scipy.optimize import brentq
+
+import stochpound
+from stochpound._errors import SceneError
+from stochpound.model.building import Building, InitialState
+from stochpound.model.scene import Scene
+from stochpound.model.system import build_system
+from stochpound.motions.ground import SampledMotion
+from tests.conftest import reference_building, study_scene
+
+# an elastic–perfectly-plastic SDOF (ω = 10 rad/s, d_y = 1 cm) thrown upwards under a constant ground acceleration
+MASS, STIFFNESS, YIELD, LOAD, VELOCITY = 1.0, 100.0, 1.0, 0.5, 0.2  # kg, N/m, N, N (= −m a_g), m/s
+DT, DURATION = 0.01, 0.7  # s: the unloading arc lasts less than its half period (no reloading)
+
+
+def epp_closed_form(t: float) -> tuple[float, float]:
+    """Displacement and plastic drift (m) of the SDOF at time t: elastic arc, plastic parabola, elastic unloading about the offset."""
+    omega, d_y, static = math.sqrt(STIFFNESS / MASS), YIELD / STIFFNESS, LOAD / STIFFNESS
+
+    def arc(s):
+        return static * (1.0 - math.cos(omega * s)) + VELOCITY / omega * math.sin(omega * s)
+
+    t1 = brentq(lambda s: arc(s) - d_y, 0.0, 0.5 * math.pi / omega)
+    v1 = static * omega * math.sin(omega * t1) + VELOCITY * math.cos(omega * t1)
+    deceleration = (YIELD - LOAD) / MASS
+    t2 = t1 + v1 / deceleration
+    offset = d_y + 0.5 * v1 * v1 / deceleration - d_y  # plastic drift once the parabola stops
+    if t <= t1:
+        return arc(t), 0.0
+    if t <= t2:
+        tau = t - t1
+        return d_y + v1 * tau - 0.5 * deceleration * tau * tau, v1 * tau - 0.5 * deceleration * tau * tau
+    return offset + static + (d_y - static) * math.cos(omega * (t - t2)), offset
+
+
+def epp_scene() -> Scene:
+    times = np.arange(0.0, DURATION + 0.5 * DT, DT)
+    building = Building("B", (MASS,), (STIFFNESS,), (0.0,), initial=InitialState((0.0,), (VELOCITY,)), yield_force=(YIELD,))
+    return Scene((building,), (), SampledMotion(DT, np.full(len(times), -LOAD / MASS)))
+
+
+@pytest.mark.parametrize("method", ["exact", "ivp"])
+def test_elastic_perfectly_plastic_sdof_under_a_step_matches_its_closed_form(method):
+    run = stochpound.simulate(epp_scene(), method, rtol=1e-12, atol=1e-14)
+    expected = np.array([epp_closed_form(t) for t in run.time.values])
+    assert expected[-1, 1] > 0.03  # it yielded far (the closed form's offset), then unloaded
+    np.testing.assert_allclose(run.relative_displacement.values[0, 0], expected[:, 0], rtol=0, atol=1e-10)
+    np.testing.assert_allclose(run.storey_plastic_drift.values[0, 0], expected[:, 1], rtol=0, atol=1e-10)
+    peak = expected[-1, 1] + YIELD / STIFFNESS  # where the parabola stops
+    assert float(run.peak_storey_ductility[0, 0]) == pytest.approx(peak / (YIELD / STIFFNESS), rel=1e-9)
+    assert float(run.residual_storey_drift[0, 0]) == pytest.approx(expected[-1, 1], abs=1e-10)
+    assert float(run.energy_hysteretic[-1]) == pytest.approx(YIELD * expected[-1, 1], abs=1e-10)  # F_y Σ|Δz|, α = 0
+    assert run.attrs["events_total"] == 2  # yield, unloading
+
+
+def yielding_pair(mu1: float | None, hardening: float = 0.05) -> dict:
+    """The study's pair at a 1 cm gap (El Centro), both buildings yielding at about a fifth of their elastic demand."""
+    scene = study_scene(mu1, None, 2.0, gap=0.01)
+    scene["building"][0].update(yield_force=[1.0e5, 0.7e5], hardening=hardening)
+    scene["building"][1].update(yield_force=[2.0e5, 1.4e5], hardening=hardening)
+    return scene
+
+
+def test_with_hardening_the_energy_balance_closes():
+    run = stochpound.simulate(stochpound.scene_from_dict(yielding_pair(None)), "exact")
+    hysteretic = run.energy_hysteretic.values
+    assert hysteretic[-1] > 0.2 * float(run.energy_input.max())  # yielding dissipates a good share of the input
+    assert np.all(np.diff(hysteretic) >= 0.0)
+    assert float(np.abs(run.energy_residual).max()) <= 1e-9 * float(np.abs(run.energy_input).max())
+
+
+def test_a_yield_force_above_every_demand_gives_the_elastic_result():
+    elastic = study_scene(None, None, 2.0, gap=0.01)
+    strong = yielding_pair(None)
+    for building in strong["building"]:
+        building["yield_force"] = [1e9, 1e9]
+    runs = [stochpound.simulate(stochpound.scene_from_dict(scene), "exact") for scene in (elastic, strong)]
+    assert runs[0].sizes["impact"] == runs[1].sizes["impact"] > 0
+    np.testing.assert_allclose(runs[1].total_displacement.values, runs[0].total_displacement.values, rtol=0, atol=1e-12)
+    assert float(np.abs(runs[1].storey_plastic_drift).max()) == 0.0
+    assert float(runs[1].peak_storey_ductility.max()) < 1e-3
+
+
+@pytest.mark.parametrize("mu1", [None, 0.1], ids=["pounding", "pounding-and-sliding"])
+def test_exact_matches_ivp_on_yielding_scenes(mu1):
+    scene = stochpound.scene_from_dict(yielding_pair(mu1))
+    exact = stochpound.simulate(scene, "exact")
+    reference = stochpound.simulate(scene, "ivp", rtol=1e-12, atol=1e-14)
+    assert exact.sizes["impact"] == reference.sizes["impact"] > 0
+    assert exact.attrs["events_total"] == reference.attrs["events_total"]
+    assert float(exact.peak_storey_ductility.max()) > 2.0  # the scene yields
+    if mu1 is not None:
+        assert float(np.abs(exact.sliding_displacement).max()) > 1e-3  # and slides
+    np.testing.assert_allclose(exact.total_displacement.values, reference.total_displacement.values, rtol=0, atol=1e-8)
+    np.testing.assert_allclose(exact.storey_plastic_drift.values, reference.storey_plastic_drift.values, rtol=0, atol=1e-8)
+    np.testing.assert_allclose(exact.peak_storey_ductility.values, reference.peak_storey_ductility.values, rtol=1e-7)
+
+
+def test_storey_shear_of_a_yielding_storey_is_its_bilinear_force():
+    building = reference_building("B1", 1.0, None, yield_force=[1.0e5, 0.7e5], hardening=0.1, storey_height=[3.5, 3.0])
+    building["damping"] = [0.0, 0.0]
+    run = stochpound.simulate(stochpound.scene_from_dict({"building": [building], "motion": {"record": "el_centro_1940_study"}}), "exact",
+                              demands=True)
+    k = np.array(building["stiffness"])[:, None]
+    drift, plastic = run.storey_drift.values[0], run.storey_plastic_drift.values[0]
+    np.testing.assert_allclose(run.storey_shear.values[0], k * drift - 0.9 * k * plastic, rtol=0, atol=1e-6 * float(np.abs(run.storey_shear).max()))
+    assert float(np.abs(run.storey_shear).max()) <= 1.0e5 * (1 + 1e-9) + 0.1 * 24516800.0 * float(np.abs(drift).max())
+    np.testing.assert_allclose(run.residual_storey_drift_ratio.values[0], run.residual_storey_drift.values[0] / [3.5, 3.0], rtol=1e-15)
+
+
+def test_an_elastic_scene_has_no_plastic_states():
+    system = build_system(stochpound.scene_from_dict(study_scene(0.1, None, 2.0)))
+    assert system.storeys == () and system.n_dof == 5
+    run = stochpound.simulate(stochpound.scene_from_dict(study_scene(None, None, 2.0)), "exact")
+    assert "energy_hysteretic" not in run and "storey_plastic_drift" not in run
+
+
+@pytest.mark.parametrize(
+    "extra, message",
+    [
+        ({"hardening": 0.1}, "building[0].hardening: only a building with yield_force"),
+        ({"yield_force": [1e5]}, "building[0].yield_force"),
+        ({"yield_force": [1e5, -1.0]}, "building[0].yield_force"),
+        ({"yield_force": [1e5, 1e5], "hardening": 1.0}, "building[0].hardening"),
+    ],
+)
+def test_bad_yielding_keys_are_named(extra, message):
+    scene = {"building": [reference_building("B1", 1.0, None, **extra)], "motion": {"record": "el_centro_1940_study"}}
+    with pytest.raises(SceneError, match=message.replace("[", r"\[").replace("]", r"\]")):
+        stochpound.scene_from_dict(scene)
