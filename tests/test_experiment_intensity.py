@@ -115,6 +115,12 @@ def test_ida_falls_back_to_stripes_on_a_sliding_base(tmp_path):
     assert definition["intensity"]["ran"] == "stripes" and "sliding base" in definition["intensity"]["note"]
 
 
+def test_ida_on_a_yielding_scene_is_an_error_that_says_to_run_stripes(tmp_path):
+    scene = SCENE.replace('name = "B1"\n', 'name = "B1"\nyield_force = [4.0e5, 3.0e5]\n')
+    with pytest.raises(ExperimentError, match=r'^intensity.method: ida needs elastic storeys, scene has yield_force .*run method = "stripes"$'):
+        parse_experiment(tomllib.loads(_experiment("gap = [0.01]", 'measure = "pga"\nlevels = [0.2]\nmethod = "ida"', scene=scene)), tmp_path)
+
+
 @pytest.mark.parametrize(
     ("intensity", "message"),
     [

@@ -139,6 +139,10 @@ def _method_run(method: str, scene: Mapping[str, Any], variants: list[dict[str, 
         return "stripes", "every motion scaled to every level"
     if not gaps:
         raise IntensityError("intensity.method: ida needs a gap axis (grid.gap = [...]): its capacities are per gap")
+    for where, building in _building_tables(scene, variants):
+        if "yield_force" in building:
+            raise IntensityError(f'intensity.method: ida needs elastic storeys, {where} has yield_force (yielding is not homogeneous in the input): '
+                                 'run method = "stripes"')
     reason = inhomogeneity(scene, variants, mu)
     if reason:
         return "stripes", f"ida requested, stripes run: the contact-free response is not homogeneous in the input ({reason})"
@@ -151,16 +155,21 @@ def inhomogeneity(scene: Mapping[str, Any], variants: list[dict[str, Any]], mu: 
         return "the scene has walls"
     if mu is not None and any(not is_fixed_base(value) for value in mu["values"]):
         return "grid.mu has finite friction coefficients (sliding bases)"
-    tables = [("scene", b) for b in scene.get("building", [])]
-    for variant in variants:
-        for value, override in variant["overrides"].items():
-            tables += [(f"variants.{variant['name']}.{value}", b) for b in override.get("building", {}).values()]
-    for where, building in tables:
+    for where, building in _building_tables(scene, variants):
         if isinstance(building.get("base"), dict) and (mu is None or any(not is_fixed_base(v) for v in mu["values"])):
             return f"{where}: a building on a sliding base"
         if building.get("initial"):
             return f"{where}: a building not at rest at t = 0"
     return ""
+
+
+def _building_tables(scene: Mapping[str, Any], variants: list[dict[str, Any]]) -> list[tuple[str, Mapping[str, Any]]]:
+    """Every ``[[building]]`` table of a scene and of its variants' overrides, with where it is."""
+    tables = [("scene", b) for b in scene.get("building", [])]
+    for variant in variants:
+        for value, override in variant["overrides"].items():
+            tables += [(f"variants.{variant['name']}.{value}", b) for b in override.get("building", {}).values()]
+    return tables
 
 
 def level_to_si(intensity: Mapping[str, Any], level: float, g: float) -> float:
