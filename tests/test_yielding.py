@@ -8,6 +8,7 @@ from scipy.optimize import brentq
 
 import stochpound
 from stochpound._errors import SceneError
+from stochpound.model import design_yield_shears
 from stochpound.model.building import Building, InitialState
 from stochpound.model.scene import Scene
 from stochpound.model.system import build_system
@@ -134,3 +135,25 @@ def test_bad_yielding_keys_are_named(extra, message):
     scene = {"building": [reference_building("B1", 1.0, None, **extra)], "motion": {"record": "el_centro_1940_study"}}
     with pytest.raises(SceneError, match=message.replace("[", r"\[").replace("]", r"\]")):
         stochpound.scene_from_dict(scene)
+
+
+@pytest.mark.parametrize("period", [0.4, 1.5])
+def test_design_yield_shears_follow_asce7_16_section_12_8_by_hand(period):
+    """Two storeys, S_DS = 1.0 g, S_D1 = 0.6 g, S_1 = 0.6 g, R = 8, I_e = 1.25, Ω0 = 3, T_L = 8 s."""
+    mass, heights, g = [2.0e5, 1.5e5], [3.5, 3.0], 9.81
+    shears = design_yield_shears(mass, heights, period=period, sds=1.0, sd1=0.6, s1=0.6, r=8.0, importance=1.25, overstrength=3.0, g=g)
+    weight = g * 3.5e5
+    cs = min(1.0 / (8.0 / 1.25), 0.6 / (period * 8.0 / 1.25))  # Eq. 12.8-2 capped by Eq. 12.8-3 (T < T_L)
+    cs = max(cs, 0.044 * 1.0 * 1.25, 0.01, 0.5 * 0.6 / (8.0 / 1.25))  # Eqs. 12.8-5 and 12.8-6
+    assert cs == pytest.approx(0.15625 if period == 0.4 else 0.6 / (1.5 * 6.4))
+    k = 1.0 if period <= 0.5 else 1.0 + (period - 0.5) / 2.0  # §12.8.3
+    w1h1, w2h2 = 2.0e5 * 3.5**k, 1.5e5 * 6.5**k
+    top = cs * weight * w2h2 / (w1h1 + w2h2)  # Eqs. 12.8-11, 12.8-12
+    np.testing.assert_allclose(shears, [3.0 * cs * weight, 3.0 * top], rtol=1e-13)
+
+
+@pytest.mark.parametrize(("field", "options"), [("r", {"r": 0.0}), ("overstrength", {"overstrength": 0.5}), ("period", {"period": -1.0})])
+def test_design_yield_shears_name_a_bad_argument(field, options):
+    arguments = {"period": 0.5, "sds": 1.0, "sd1": 0.6, "r": 8.0, "overstrength": 3.0} | options
+    with pytest.raises(ValueError, match=f"^{field}: must be"):
+        design_yield_shears([1e5], [3.0], **arguments)

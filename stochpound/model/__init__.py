@@ -7,13 +7,16 @@ One module per concept: :mod:`~stochpound.model.building` (shear buildings),
 :mod:`~stochpound.model.system` (global matrices), :mod:`~stochpound.model.modes`
 (the linear modes of the hybrid system and their guards),
 :mod:`~stochpound.model.guards` (event kinds) and
-:mod:`~stochpound.model.modal_solution` (a closed-form reference).
+:mod:`~stochpound.model.modal_solution` (a closed-form reference),
+:mod:`~stochpound.model.yielding` (bilinear yielding storeys) and
+:func:`design_yield_shears` (a code-designed building's yield shears).
 """
 
+from stochpound.model._design import design_yield_shears
 from stochpound.model.building import Building, InitialState
 from stochpound.model.contact import Contact, ImpactElement
 from stochpound.model.friction import Base
 from stochpound.model.scene import Scene
 from stochpound.model.wall import Wall
 
-__all__ = ["Scene", "Building", "InitialState", "Base", "Contact", "Wall", "ImpactElement"]
+__all__ = ["Scene", "Building", "InitialState", "Base", "Contact", "Wall", "ImpactElement", "design_yield_shears"]
