@@ -155,12 +155,8 @@ def _demand_variables(scene: Scene, recorder: Recorder) -> dict[str, tuple]:
     variables["base_shear"] = _var(("building", "time"), shear[:, 0], "N", "base shear: the shear of the first storey")
     variables["peak_base_shear"] = _var(("building",), peak_shear[:, 0], "N", "largest absolute base shear over the run")
     variables["peak_base_shear_time"] = _var(("building",), when[:, 0], "s", "time of the largest absolute base shear")
-    heights = [b.storey_height for b in scene.buildings]
-    if any(h is not None for h in heights):
-        height = np.full(peak_shear.shape, np.nan)
-        for b, h in enumerate(heights):
-            if h is not None:
-                height[b, : len(h)] = h
+    height = _storey_heights(scene)
+    if height is not None:
         drift = variables["storey_drift"][1]
         variables["storey_drift_ratio"] = _var(("building", "floor", "time"), drift / height[:, :, None], "1", "storey drift over the storey height")
         variables["peak_storey_drift_ratio"] = _var(("building", "floor"), variables["peak_storey_drift"][1] / height, "1",
@@ -185,14 +181,22 @@ def _yielding_variables(scene: Scene, recorder: Recorder) -> dict[str, tuple]:
         "peak_storey_ductility": _var(("building", "floor"), ductility, "1", "largest absolute storey drift over its yield drift F_y / k (NaN for an elastic storey)"),
         "residual_storey_drift": _var(("building", "floor"), residual, "m", "drift the storey keeps at rest after the run: (1 - alpha) z at the end"),
     }
-    heights = [b.storey_height for b in scene.buildings]
-    if any(h is not None for h in heights):
-        height = np.full(shape, np.nan)
-        for b, h in enumerate(heights):
-            if h is not None:
-                height[b, : len(h)] = h
+    height = _storey_heights(scene)
+    if height is not None:
         variables["residual_storey_drift_ratio"] = _var(("building", "floor"), residual / height, "1", "residual storey drift over the storey height")
     return variables
+
+
+def _storey_heights(scene: Scene) -> np.ndarray | None:
+    """Each storey's height (building × floor, m; NaN where a building gives none or above its top floor), or None when no building gives ``storey_height``."""
+    heights = [b.storey_height for b in scene.buildings]
+    if all(h is None for h in heights):
+        return None
+    height = np.full((len(heights), scene.max_floors), np.nan)
+    for b, h in enumerate(heights):
+        if h is not None:
+            height[b, : len(h)] = h
+    return height
 
 
 def _wall_variables(scene: Scene, recorder: Recorder) -> dict[str, tuple]:
