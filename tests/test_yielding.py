@@ -157,3 +157,33 @@ def test_design_yield_shears_name_a_bad_argument(field, options):
     arguments = {"period": 0.5, "sds": 1.0, "sd1": 0.6, "r": 8.0, "overstrength": 3.0} | options
     with pytest.raises(ValueError, match=f"^{field}: must be"):
         design_yield_shears([1e5], [3.0], **arguments)
+
+
+def test_p_delta_softens_a_storey_by_its_weight_over_its_height():
+    """An SDOF released from u0 with P-Δ vibrates at ω² = (k − m g / h) / m."""
+    mass, stiffness, height, g, u0 = 1000.0, 2.0e5, 0.1, 9.81, 0.01
+    times = np.arange(0.0, 2.0 + 0.5 * DT, DT)
+    building = Building("B", (mass,), (stiffness,), (0.0,), initial=InitialState((u0,), (0.0,)), storey_height=(height,), p_delta=True)
+    run = stochpound.simulate(Scene((building,), (), SampledMotion(DT, np.zeros(len(times))), g=g), "exact")
+    omega = math.sqrt((stiffness - mass * g / height) / mass)
+    np.testing.assert_allclose(run.relative_displacement.values[0, 0], u0 * np.cos(omega * times), rtol=0, atol=1e-12)
+    assert float(np.abs(run.energy_residual).max()) <= 1e-12 * 0.5 * stiffness * u0**2
+
+
+def test_exact_matches_ivp_on_a_yielding_scene_with_p_delta():
+    scene = yielding_pair(None)
+    for building in scene["building"]:
+        building.update(storey_height=[3.5, 3.0], p_delta=True)
+    parsed = stochpound.scene_from_dict(scene)
+    exact, reference = stochpound.simulate(parsed, "exact"), stochpound.simulate(parsed, "ivp", rtol=1e-12, atol=1e-14)
+    assert exact.sizes["impact"] == reference.sizes["impact"] > 0
+    np.testing.assert_allclose(exact.total_displacement.values, reference.total_displacement.values, rtol=0, atol=1e-8)
+    elastic = stochpound.simulate(stochpound.scene_from_dict(yielding_pair(None)), "exact")
+    assert not np.allclose(exact.total_displacement.values, elastic.total_displacement.values, atol=1e-6)  # P-Δ changes the run
+    assert float(np.abs(exact.energy_residual).max()) <= 1e-9 * float(np.abs(exact.energy_input).max())
+
+
+def test_p_delta_needs_storey_heights():
+    scene = {"building": [reference_building("B1", 1.0, None, p_delta=True)], "motion": {"record": "el_centro_1940_study"}}
+    with pytest.raises(SceneError, match=r"^building\[0\].p_delta: needs storey_height"):
+        stochpound.scene_from_dict(scene)

@@ -7,7 +7,9 @@ in mode 1), ``base`` (a sliding base, :mod:`stochpound.model.friction`;
 none: a fixed base), ``initial`` (initial conditions) and ``storey_height``
 (m per storey, optional: storey drift ratios), ``yield_force`` (N per
 storey, optional: bilinear yielding storeys, :mod:`stochpound.model.yielding`)
-and ``hardening`` (their post-yield to elastic stiffness ratio α, default 0).
+and ``hardening`` (their post-yield to elastic stiffness ratio α, default 0),
+``p_delta`` (true: each storey gains the geometric stiffness −W/h of the
+weight W above it, needs ``storey_height``).
 Storey i joins floor i − 1 (floor 0 is the base) to floor i.
 """
 
@@ -24,7 +26,7 @@ from stochpound._errors import SceneError
 from stochpound.model import fields
 from stochpound.model.friction import Base, base_from_table
 
-BUILDING_KEYS = {"name", "mass", "stiffness", "damping", "damping_ratio", "base", "initial", "storey_height", "yield_force", "hardening"}
+BUILDING_KEYS = {"name", "mass", "stiffness", "damping", "damping_ratio", "base", "initial", "storey_height", "yield_force", "hardening", "p_delta"}
 INITIAL_KEYS = {"displacement", "velocity", "base_displacement", "base_velocity"}
 
 
@@ -74,6 +76,9 @@ class Building:
         Storey yield shears F_y,i, N (bilinear storeys, :mod:`stochpound.model.yielding`); None: elastic storeys.
     hardening : float
         Post-yield to elastic stiffness ratio α of the bilinear storeys (0 ≤ α < 1; 0: elastic–perfectly plastic).
+    p_delta : bool
+        Whether each storey i carries the geometric stiffness −W_i / h_i of the
+        weight W_i = g Σ_{j ≥ i} m_j above it (P-Δ; needs ``storey_height``).
     """
 
     name: str
@@ -86,6 +91,14 @@ class Building:
     storey_height: tuple[float, ...] | None = None
     yield_force: tuple[float, ...] | None = None
     hardening: float = 0.0
+    p_delta: bool = False
+
+    def geometric_stiffness(self, g: float) -> np.ndarray:
+        """Each storey's P-Δ stiffness −W_i / h_i (N/m) under gravity ``g`` (m/s²): zeros without ``p_delta``."""
+        if not self.p_delta:
+            return np.zeros(self.n_floors)
+        weight_above = g * np.cumsum(np.asarray(self.mass, float)[::-1])[::-1]
+        return -weight_above / np.asarray(self.storey_height, float)
 
     @property
     def n_floors(self) -> int:
@@ -159,7 +172,10 @@ def building_from_table(table: Mapping[str, Any], prefix: str, index: int) -> Bu
     initial = _initial(fields.table(table, "initial", prefix), f"{prefix}.initial", len(mass), base is not None)
     height = fields.number_list(table, "storey_height", prefix, low=0.0, low_open=True, length=len(mass)) if "storey_height" in table else None
     yield_force, hardening = _yielding(table, prefix, stiffness)
-    return Building(name, mass, stiffness, damping, ratio, base, initial, height, yield_force, hardening)
+    p_delta = fields.boolean(table, "p_delta", prefix, default=False)
+    if p_delta and height is None:
+        raise SceneError(f"{prefix}.p_delta: needs storey_height (the geometric stiffness of a storey is −W/h)")
+    return Building(name, mass, stiffness, damping, ratio, base, initial, height, yield_force, hardening, p_delta)
 
 
 def _yielding(table: Mapping[str, Any], prefix: str, stiffness: tuple[float, ...]) -> tuple[tuple[float, ...] | None, float]:

@@ -199,6 +199,8 @@ def _build_system(buildings: tuple[Building, ...], contacts: tuple[Contact, ...]
         block = np.ix_(floors, floors)
         mass[block] = np.diag(m)
         stiffness[block] = storey_matrix(np.asarray(building.stiffness, float))
+        if building.p_delta:
+            stiffness[block] += storey_matrix(building.geometric_stiffness(g))
         damping[block] = storey_matrix(np.asarray(building.damping, float))
         influence[floors] = m
         for i, dof in enumerate(floors):
