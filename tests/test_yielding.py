@@ -129,6 +129,7 @@ def test_an_elastic_scene_has_no_plastic_states():
         ({"yield_force": [1e5]}, "building[0].yield_force"),
         ({"yield_force": [1e5, -1.0]}, "building[0].yield_force"),
         ({"yield_force": [1e5, 1e5], "hardening": 1.0}, "building[0].hardening"),
+        ({"yield_force": [1e5, 1e5], "initial": {"displacement": [0.001, 0.02]}}, "building[0].initial.displacement: storey 2's drift"),
     ],
 )
 def test_bad_yielding_keys_are_named(extra, message):

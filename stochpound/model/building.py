@@ -172,6 +172,12 @@ def building_from_table(table: Mapping[str, Any], prefix: str, index: int) -> Bu
     initial = _initial(fields.table(table, "initial", prefix), f"{prefix}.initial", len(mass), base is not None)
     height = fields.number_list(table, "storey_height", prefix, low=0.0, low_open=True, length=len(mass)) if "storey_height" in table else None
     yield_force, hardening = _yielding(table, prefix, stiffness)
+    if yield_force is not None:
+        drift = np.diff(np.concatenate([[0.0], initial.displacement]))
+        for i, (d, force, k) in enumerate(zip(drift, yield_force, stiffness)):
+            if abs(d) > force / k:
+                raise SceneError(f"{prefix}.initial.displacement: storey {i + 1}'s drift {d:.6g} m is beyond its yield drift F_y/k = {force / k:.6g} m "
+                                 "(a yielding building starts elastic)")
     p_delta = fields.boolean(table, "p_delta", prefix, default=False)
     if p_delta and height is None:
         raise SceneError(f"{prefix}.p_delta: needs storey_height (the geometric stiffness of a storey is −W/h)")
