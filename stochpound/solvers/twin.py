@@ -18,10 +18,14 @@ Many realizations run at once (:func:`fixed_base_displacements`), one after
 the other in a compiled loop whose arithmetic per realization is fixed: a
 realization's response is bit for bit the same whatever batch it is computed
 in, which keeps the store independent of how a run is split.
+
+A building with yielding storeys is not linear: its twin runs each motion
+through the exact solver's event engine instead (:func:`~stochpound.solvers.exact.run_exact`).
 """
 
 from __future__ import annotations
 
+from dataclasses import replace
 from typing import Sequence
 
 import numba
@@ -32,6 +36,7 @@ from stochpound.motions.ground import GroundMotion
 from stochpound.solvers.propagators import EXO_SIZE, interval_forcing, propagator_library
 from stochpound.model.scene import Scene
 from stochpound.model.system import build_system
+from stochpound.solvers.exact import run_exact
 
 
 def fixed_base_displacements(scene: Scene, motions: Sequence[GroundMotion]) -> np.ndarray:
@@ -61,6 +66,8 @@ def fixed_base_displacements(scene: Scene, motions: Sequence[GroundMotion]) -> n
     if not motions:
         return np.zeros((0, scene.buildings[0].n_floors, 0))
     system = build_system(scene)
+    if system.storeys:  # yield and unloading are events: no recursion without them
+        return np.stack([run_exact(replace(scene, motion=motion))[0].states[:, system.floor_dofs[0]].T for motion in motions])
     propagator = propagator_library(system, motions[0])[initial_mode(system)]
     step = np.linalg.matrix_power(propagator.transition, propagator.substeps)[: 2 * system.n_dof]
     forcing = np.stack([interval_forcing(motion) for motion in motions])
