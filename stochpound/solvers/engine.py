@@ -23,7 +23,8 @@ interval event by event. With ``NUMBA_DISABLE_JIT=1`` the same functions run
 as plain Python (the debugging path, tested).
 
 Data. Modes are int64 vectors [closed flags of every contact, state of every
-base]. Every linear read-out of a mode is an *affine map*, an array whose
+slider: the bases, then the yielding storeys' plastic elements]. Every
+linear read-out of a mode is an *affine map*, an array whose
 row i gives ``row[:S] · x + row[S] a_g + row[S + 1]`` (S = 2N): ``rate``
 (ẋ = A x + B a_g + c), ``guard`` (G x + h a_g + g0) and ``force`` (contact
 forces, no a_g term). The powers of
