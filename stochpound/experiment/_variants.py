@@ -11,7 +11,7 @@ masses by f (floors and base) keeps its dynamics consistent:
   every modal damping ratio (M → fM, K fixed, C → sqrt(f) C); a
   ``damping_ratio`` is kept as it is;
 * every contact touching the building and every wall beside it is rescaled
-  by its law's rule (:meth:`stochpound.model.law.ContactLaw.rescale_table`)
+  by its law's rule (:meth:`stochpound.model.laws.contract.ContactLaw.rescale_table`)
   with the ratio m_eff,new / m_eff,old, m_eff = m1 m2 / (m1 + m2): for a
   Kelvin–Voigt element k_imp × ratio keeps its impact frequency
   sqrt(k_imp / m_eff), and c_imp follows from the restitution (or, when given
@@ -110,7 +110,7 @@ def scale_masses(scene: dict[str, Any], name: str, factor: float) -> None:
 
     The building's own rule (:func:`stochpound.model.building.scale_masses`:
     dashpots × √factor), then every contact touching it and every wall beside
-    it by their law's rule (:meth:`stochpound.model.law.ContactLaw.rescale_table`,
+    it by their law's rule (:meth:`stochpound.model.laws.contract.ContactLaw.rescale_table`,
     with the ratio of the effective masses, new over old: the factor itself
     for a wall).
     """

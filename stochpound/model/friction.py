@@ -33,8 +33,9 @@ from typing import Any, Mapping
 import numpy as np
 
 from stochpound._errors import SceneError
-from stochpound.model import coulomb, fields, laws, velocity_friction
+from stochpound.model import fields, laws
 from stochpound.model.guards import Guard
+from stochpound.model.laws import coulomb, velocity_friction
 
 STUCK = 0
 """Base state: stuck to its foundation."""
@@ -74,7 +75,7 @@ class Base:
     radius : float or None
         Radius R of a friction pendulum, m: k_r = W/R (see :meth:`restoring`).
     mu_fast, mu_rate : float or None
-        Velocity-dependent friction (:mod:`stochpound.model.velocity_friction`):
+        Velocity-dependent friction (:mod:`stochpound.model.laws.velocity_friction`):
         the coefficient at high velocity and the rate a (s/m); ``mu`` is then
         the coefficient at vanishing velocity. None: Coulomb friction.
     """

@@ -16,7 +16,7 @@ from typing import Any
 
 import numpy as np
 
-from stochpound.model.law import FrictionLaw
+from stochpound.model.laws.contract import FrictionLaw
 
 
 class Coulomb(FrictionLaw):

@@ -1,4 +1,4 @@
-"""The law registry: every contact law and friction law by name (the contract: :mod:`stochpound.model.law`).
+"""The law registry: every contact law and friction law by name (the contract: :mod:`stochpound.model.laws.contract`).
 
 Code asks the registry, never a law's name: ``contact_law(element.law).piecewise_linear``,
 ``.read(...)``, ``.force(...)``, ``.describe(...)``. A new law is one module
@@ -9,8 +9,8 @@ defining its law object, one line here, its tests and its docs entry
 from __future__ import annotations
 
 from stochpound._errors import SceneError
-from stochpound.model import coulomb, hertz, hertz_damp_exact, hertz_damp_ye, jankowski, kelvin, velocity_friction
-from stochpound.model.law import ContactLaw, FrictionLaw
+from stochpound.model.laws import coulomb, hertz, hertz_damp_exact, hertz_damp_ye, jankowski, kelvin, velocity_friction
+from stochpound.model.laws.contract import ContactLaw, FrictionLaw
 
 CONTACT_LAWS: dict[str, ContactLaw] = {law.name: law for law in (kelvin.KELVIN, hertz.HERTZ, hertz.HERTZ_DAMP, jankowski.JANKOWSKI,
                                                                  hertz_damp_ye.HERTZ_DAMP_YE, hertz_damp_exact.HERTZ_DAMP_EXACT)}

@@ -22,7 +22,7 @@ import numpy as np
 
 from stochpound._errors import SceneError
 from stochpound.model import fields
-from stochpound.model.law import FrictionLaw
+from stochpound.model.laws.contract import FrictionLaw
 
 MU_KEYS = {"slow", "fast", "rate"}
 
