@@ -8,6 +8,8 @@ defining its law object, one line here, its tests and its docs entry
 
 from __future__ import annotations
 
+from typing import Any, Mapping
+
 from stochpound._errors import SceneError
 from stochpound.model.laws import coulomb, hertz, hertz_damp_exact, hertz_damp_ye, jankowski, kelvin, velocity_friction
 from stochpound.model.laws.contract import ContactLaw, FrictionLaw
@@ -32,3 +34,8 @@ def contact_law(name: str, prefix: str = "law") -> ContactLaw:
 def friction_law(name: str) -> FrictionLaw:
     """The friction law called ``name`` (:data:`FRICTION_LAWS`)."""
     return FRICTION_LAWS[name]
+
+
+def base_friction_law(table: Mapping[str, Any]) -> FrictionLaw:
+    """The friction law of a ``[building.base]`` table: the one whose form its ``mu`` has (:meth:`~stochpound.model.laws.contract.FrictionLaw.spells`)."""
+    return next(law for law in FRICTION_LAWS.values() if law.spells(table.get("mu")))

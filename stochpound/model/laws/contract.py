@@ -6,7 +6,7 @@ sliding base) one :class:`FrictionLaw`. Each object holds, behind one
 signature per kind of law:
 
 * its name (the scene file's ``law``), its scene keys and their validation
-  (:meth:`ContactLaw.read`);
+  (:meth:`ContactLaw.read`, :meth:`FrictionLaw.read`);
 * whether it is piecewise linear (only then does every mode stay linear, which
   the exact solver needs; a nonlinear law's force is a read-out of the mode,
   evaluated by :mod:`stochpound.model.readouts`);
@@ -14,7 +14,10 @@ signature per kind of law:
   ∂F/∂δ, ∂F/∂δ̇ (for a piecewise-linear law, k δ + c δ̇ and (k, c): the terms
   it adds to a closed mode, :func:`stochpound.model.contact.closed_terms`);
 * its power (the rate of work of its force, the energy term it enters);
-* its mass rescaling for experiment variants (:meth:`ContactLaw.rescale_table`);
+* what an experiment's axes do to its parameters: a contact law's mass
+  rescaling for variants (:meth:`ContactLaw.rescale_table`), a friction law's
+  answer to a μ axis (:meth:`FrictionLaw.set_mu`: scale its coefficients or
+  refuse, never replace the law);
 * ``describe()``: its name, parameters and units, for methods text.
 """
 
@@ -24,6 +27,8 @@ from abc import ABC, abstractmethod
 from typing import Any, Mapping, NamedTuple
 
 import numpy as np
+
+from stochpound.model import fields
 
 
 class ElementParameters(NamedTuple):
@@ -124,6 +129,25 @@ class ContactLaw(ABC):
             table["damping"] = float(table["damping"]) * mass_ratio
 
 
+class FrictionParameters(NamedTuple):
+    """A sliding base's friction parameters, as its law reads them from its ``[building.base]`` table.
+
+    Attributes
+    ----------
+    mu : float
+        Kinetic coefficient (at vanishing sliding velocity for velocity-dependent friction), ≥ 0.
+    mu_static : float
+        Static coefficient, ≥ ``mu``.
+    mu_fast, mu_rate : float or None
+        Velocity-dependent friction's coefficient at high velocity and its rate a (s/m); None for Coulomb friction.
+    """
+
+    mu: float
+    mu_static: float
+    mu_fast: float | None = None
+    mu_rate: float | None = None
+
+
 class FrictionLaw(ABC):
     """A friction law of a sliding base: the foundation's force on the base while it slips.
 
@@ -143,6 +167,32 @@ class FrictionLaw(ABC):
     title: str
     piecewise_linear: bool
     energy_term: str = "friction"
+
+    @abstractmethod
+    def spells(self, mu: Any) -> bool:
+        """Whether a base table's ``mu`` value is written in this law's form (a number, a table...)."""
+
+    @abstractmethod
+    def read_mu(self, table: Mapping[str, Any], prefix: str) -> tuple[float, float | None, float | None]:
+        """The law's coefficients from the base table's ``mu`` (at ``prefix``), validated: (μ, μ_fast, a in s/m)."""
+
+    def read(self, table: Mapping[str, Any], prefix: str) -> FrictionParameters:
+        """The base's friction parameters from its ``[building.base]`` table (at ``prefix``), validated.
+
+        ``mu`` as the law spells it (:meth:`read_mu`), then ``mu_static``
+        (≥ μ, default μ: the coefficient at vanishing velocity).
+        """
+        mu, fast, rate = self.read_mu(table, prefix)
+        return FrictionParameters(mu, fields.number(table, "mu_static", prefix, default=mu, low=mu), fast, rate)
+
+    @abstractmethod
+    def set_mu(self, table: dict[str, Any], mu: float, prefix: str) -> None:
+        """Give the base table (at ``prefix``) an experiment's μ-axis value ``mu`` (finite, dimensionless), in place.
+
+        The law scales its coefficients (its rule in its docstring) or
+        refuses with a :class:`~stochpound._errors.SceneError` naming the
+        field; it never replaces itself by another law.
+        """
 
     @abstractmethod
     def force(self, base: Any, state: int, speed: np.ndarray) -> np.ndarray:
