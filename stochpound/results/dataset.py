@@ -17,7 +17,7 @@ from stochpound import __version__
 from stochpound._atomic import replacing
 from stochpound.results.record import ENERGY_TERMS, EventCounters, Recorder
 from stochpound.model.contact import ImpactElement
-from stochpound.model.friction import FIXED_BASE
+from stochpound.model import laws
 from stochpound.model.scene import Scene
 from stochpound.model.system import System
 
@@ -205,22 +205,20 @@ def scene_parameters(scene: Scene) -> dict[str, tuple]:
 
 
 def _base_variables(scene: Scene) -> dict[str, tuple]:
-    """Each building's base as run: its friction law's parameters (μ = ∞, :data:`~stochpound.model.friction.FIXED_BASE`, for a fixed base)."""
+    """Each building's base as run: its friction law's parameters (:data:`~stochpound.model.laws.FRICTION_VARIABLES`; μ = ∞ for a fixed base), its mass and restoring force."""
     bases = [b.base for b in scene.buildings]
 
     def column(field: str, fixed: float = np.nan) -> np.ndarray:
         return np.array([fixed if base is None else np.nan if getattr(base, field) is None else getattr(base, field) for base in bases], float)
 
     restoring = [np.nan if b.base is None else b.base.restoring(scene.g * (b.base.mass + sum(b.mass))) for b in scene.buildings]
+    friction = {v.name: _var(("building",), column(v.field, v.missing), v.units, v.long_name) for v in laws.FRICTION_VARIABLES}
     return {
-        "base_mu": _var(("building",), column("mu", FIXED_BASE), "1", "kinetic friction coefficient of the base (inf: a fixed base)"),
-        "base_mu_static": _var(("building",), column("mu_static", FIXED_BASE), "1", "static friction coefficient of the base (inf: a fixed base)"),
+        **friction,
         "base_mass": _var(("building",), column("mass"), "kg", "base mass (nan: a fixed base)"),
         "base_restoring_stiffness": _var(("building",), np.array(restoring, float), "N m-1",
                                          "restoring stiffness of the base (W/R for a friction pendulum; nan: a fixed base)"),
         "base_radius": _var(("building",), column("radius"), "m", "radius of the friction pendulum (nan: a flat slider or a fixed base)"),
-        "base_mu_fast": _var(("building",), column("mu_fast"), "1", "friction coefficient at high sliding velocity (nan: Coulomb friction)"),
-        "base_mu_rate": _var(("building",), column("mu_rate"), "s m-1", "rate of the velocity-dependent friction (nan: Coulomb friction)"),
     }
 
 

@@ -12,7 +12,7 @@ from typing import Any, Mapping
 
 from stochpound._errors import SceneError
 from stochpound.model.laws import coulomb, hertz, hertz_damp_exact, hertz_damp_ye, jankowski, kelvin, velocity_friction
-from stochpound.model.laws.contract import ContactLaw, FrictionLaw
+from stochpound.model.laws.contract import ContactLaw, FrictionLaw, ResultVariable
 
 CONTACT_LAWS: dict[str, ContactLaw] = {law.name: law for law in (kelvin.KELVIN, hertz.HERTZ, hertz.HERTZ_DAMP, jankowski.JANKOWSKI,
                                                                  hertz_damp_ye.HERTZ_DAMP_YE, hertz_damp_exact.HERTZ_DAMP_EXACT)}
@@ -21,6 +21,8 @@ DEFAULT_CONTACT_LAW = kelvin.KELVIN.name
 """The law of an element whose table gives none."""
 FRICTION_LAWS: dict[str, FrictionLaw] = {law.name: law for law in (coulomb.COULOMB, velocity_friction.VELOCITY_DEPENDENT)}
 """The friction laws of sliding bases, by name (a base's ``friction_law``)."""
+FRICTION_VARIABLES: tuple[ResultVariable, ...] = tuple(variable for law in FRICTION_LAWS.values() for variable in law.variables)
+"""The result variables of every friction law's parameters, in registry order (``base_mu``, ``base_mu_static``, ``base_mu_fast``, ``base_mu_rate``)."""
 
 
 def contact_law(name: str, prefix: str = "law") -> ContactLaw:

@@ -18,11 +18,14 @@ signature per kind of law:
   rescaling for variants (:meth:`ContactLaw.rescale_table`), a friction law's
   answer to a μ axis (:meth:`FrictionLaw.set_mu`: scale its coefficients or
   refuse, never replace the law);
-* ``describe()``: its name, parameters and units, for methods text.
+* ``describe()``: its name, parameters and units, for methods text;
+* a friction law's result variables (:attr:`FrictionLaw.variables`): how a
+  result and a store name its parameters.
 """
 
 from __future__ import annotations
 
+import math
 from abc import ABC, abstractmethod
 from typing import Any, Mapping, NamedTuple
 
@@ -148,6 +151,32 @@ class FrictionParameters(NamedTuple):
     mu_rate: float | None = None
 
 
+class ResultVariable(NamedTuple):
+    """A result variable that reports one parameter of a law, one value per building (a sliding base's law).
+
+    Attributes
+    ----------
+    name : str
+        The variable's name in a result and a store, e.g. ``base_mu_fast``.
+    field : str
+        The :class:`~stochpound.model.friction.Base` attribute it reports.
+    units : str
+        Its ``units`` attribute (CF spelling, ``1`` for a coefficient).
+    long_name : str
+        Its ``long_name`` attribute.
+    missing : float
+        Its value for a building without a base: NaN, or ∞ for the friction
+        coefficients (a fixed base is μ = ∞, :data:`~stochpound.model.friction.FIXED_BASE`).
+        A base whose law lacks the parameter (its attribute None) gives NaN.
+    """
+
+    name: str
+    field: str
+    units: str
+    long_name: str
+    missing: float = math.nan
+
+
 class FrictionLaw(ABC):
     """A friction law of a sliding base: the foundation's force on the base while it slips.
 
@@ -161,11 +190,15 @@ class FrictionLaw(ABC):
         True: the slip force is a constant of each slip mode (the exact solver applies).
     energy_term : str
         The energy-balance term its power enters.
+    variables : tuple of ResultVariable
+        The result variables of the parameters it reads
+        (:meth:`read`), beyond those of a law before it in the registry.
     """
 
     name: str
     title: str
     piecewise_linear: bool
+    variables: tuple[ResultVariable, ...]
     energy_term: str = "friction"
 
     @abstractmethod

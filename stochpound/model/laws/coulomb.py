@@ -17,11 +17,13 @@ from __future__ import annotations
 
 from typing import Any, Mapping
 
+import math
+
 import numpy as np
 
 from stochpound._errors import SceneError
 from stochpound.model import fields
-from stochpound.model.laws.contract import FrictionLaw
+from stochpound.model.laws.contract import FrictionLaw, ResultVariable
 
 
 class Coulomb(FrictionLaw):
@@ -30,6 +32,8 @@ class Coulomb(FrictionLaw):
     name = "coulomb"
     title = "Coulomb friction"
     piecewise_linear = True
+    variables = (ResultVariable("base_mu", "mu", "1", "kinetic friction coefficient of the base (inf: a fixed base)", math.inf),
+                 ResultVariable("base_mu_static", "mu_static", "1", "static friction coefficient of the base (inf: a fixed base)", math.inf))
 
     def spells(self, mu: Any) -> bool:
         """``mu`` is a number (or missing or malformed: :meth:`read_mu` names the error)."""

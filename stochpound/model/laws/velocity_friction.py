@@ -27,7 +27,7 @@ import numpy as np
 
 from stochpound._errors import SceneError
 from stochpound.model import fields
-from stochpound.model.laws.contract import FrictionLaw
+from stochpound.model.laws.contract import FrictionLaw, ResultVariable
 
 MU_KEYS = {"slow", "fast", "rate"}
 
@@ -49,6 +49,8 @@ class VelocityDependent(FrictionLaw):
     name = "velocity"
     title = "velocity-dependent friction"
     piecewise_linear = False
+    variables = (ResultVariable("base_mu_fast", "mu_fast", "1", "friction coefficient at high sliding velocity (nan: Coulomb friction)"),
+                 ResultVariable("base_mu_rate", "mu_rate", "s m-1", "rate of the velocity-dependent friction (nan: Coulomb friction)"))
 
     def spells(self, mu: Any) -> bool:
         """``mu`` is a table ``{ slow, fast, rate }``."""
