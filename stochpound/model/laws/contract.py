@@ -19,7 +19,7 @@ signature per kind of law:
   answer to a μ axis (:meth:`FrictionLaw.set_mu`: scale its coefficients or
   refuse, never replace the law);
 * ``describe()``: its name, parameters and units, for methods text;
-* a friction law's result variables (:attr:`FrictionLaw.variables`): how a
+* a friction law's result variables (``FrictionLaw.variables``): how a
   result and a store name its parameters.
 """
 
