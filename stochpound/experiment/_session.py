@@ -22,7 +22,8 @@ import numpy as np
 from stochpound import __version__
 from stochpound.experiment._grid import KINDS, Experiment
 from stochpound.experiment._parts import DEFINITION_FILE, part_paths, parts_folder, read_experiment_json, read_runs, write_experiment_json
-from stochpound.experiment._spec import ExperimentError, canonical_json
+from stochpound.experiment._spec import ExperimentError
+from stochpound.store import canonical_json
 from stochpound.experiment._store import PREFIX, layout
 from stochpound.experiment._store_writer import PartsIndex, write_store
 

@@ -9,12 +9,12 @@ from typing import Iterator
 
 import numpy as np
 
-from stochpound.experiment._definition import read_definition
+from stochpound.store import open_store, read_definition
 from stochpound.experiment._grid import KINDS, Case, Experiment
 from stochpound.experiment._parts import DEFINITION_FILE, FolderLock, parts_folder
 from stochpound.experiment._session import StoreSession
 from stochpound.experiment._spec import ExperimentError
-from stochpound.experiment._store import PREFIX, open_store
+from stochpound.experiment._store import PREFIX
 
 
 @dataclass

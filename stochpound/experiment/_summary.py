@@ -10,7 +10,7 @@ other cases' into a part, :mod:`stochpound.experiment._parts`):
 * ``i:<name>``: the impact table's columns.
 
 The store's units and long names are declared in
-:mod:`stochpound.experiment._catalogue`; the tests hold them against a real run.
+``stochpound.store._catalogue``; the tests hold them against a real run.
 
 :func:`case_summary` and :func:`reference_summary` give the summaries as
 xarray datasets (their metadata names and describes the store's variables);
@@ -33,7 +33,7 @@ from stochpound.analysis import kernels, peak_response
 from stochpound.analysis.names import RESPONSE_MOMENTS, without_aliases
 from stochpound.analysis._separation_rules import STORE_NAMES, contact_demands
 from stochpound.analysis._summary import response_moments, run_summary, top_floor_total_displacement
-from stochpound.experiment._catalogue import IMPACT_TABLE, WALL_SUMMARIES
+from stochpound.store import IMPACT_TABLE, WALL_SUMMARIES
 
 _MOMENTS = tuple(RESPONSE_MOMENTS.values())
 _PEAKS = ("peak_total_displacement", "peak_relative_displacement", "peak_sliding_displacement", "residual_sliding")
@@ -45,9 +45,9 @@ DEMAND_SUMMARIES = {
     "peak_interstorey_drift": ("peak_storey_drift", "largest peak storey drift over the building's storeys"),
     "peak_base_shear": ("peak_base_shear", "largest absolute base shear over the run"),
 }
-#: The wall summaries (:data:`stochpound.experiment._catalogue.WALL_SUMMARIES`): every case computes them (NaN without walls); a store keeps them when its scene has walls.
+#: The wall summaries (``stochpound.store.WALL_SUMMARIES``): every case computes them (NaN without walls); a store keeps them when its scene has walls.
 WALL_PENETRATION, WALL_CLOSURE = WALL_SUMMARIES
-#: Columns of the impact table a store keeps (:data:`stochpound.experiment._catalogue.IMPACT_TABLE`).
+#: Columns of the impact table a store keeps (``stochpound.store.IMPACT_TABLE``).
 IMPACT_COLUMNS = tuple(v.name for v in IMPACT_TABLE)
 
 

@@ -3,9 +3,8 @@
 A gap axis that holds ``inf`` makes *contact-free* cases (an axis setting
 contacts) or *wall-free* cases (an axis setting walls only): their gaps
 never close, and by the gap identity their peak closure answers every gap at
-once (docs/separation.md). That rule is the analysis layer's
-(``stochpound.analysis._gap_axes``, which the risk chain uses too), given
-here too. A μ axis that holds :data:`~stochpound.experiment.FIXED_BASE`
+once (docs/separation.md). That rule is ``stochpound.store._gap_axes``'s (the risk chain uses it too), given
+here too. A μ axis that holds :data:`~stochpound.store.FIXED_BASE`
 makes, for each isolated case, its *fixed-base twin*: the same case with the
 sliding base removed. These functions take a store, or any dataset or array
 on its grid dimensions (statistics over realizations, say).
@@ -18,8 +17,8 @@ from typing import TypeVar
 
 import xarray as xr
 
-from stochpound.analysis._gap_axes import contact_free, contact_gap_dims, gap_dims, has_contact_free, has_wall_free, wall_free, wall_gap_dims, with_contacts, with_walls
-from stochpound.experiment._definition import FIXED_BASE, is_fixed_base
+from stochpound.model.friction import FIXED_BASE, is_fixed_base
+from stochpound.store._gap_axes import contact_free, contact_gap_dims, gap_dims, has_contact_free, has_wall_free, wall_free, wall_gap_dims, with_contacts, with_walls
 
 __all__ = [
     "contact_free", "contact_gap_dims", "fixed_base", "gap_dims", "has_contact_free", "has_fixed_base_twins", "has_wall_free",
@@ -30,7 +29,7 @@ Data = TypeVar("Data", xr.Dataset, xr.DataArray)
 
 
 def has_fixed_base_twins(mus: Iterable[float]) -> bool:
-    """Whether a μ axis holds both :data:`~stochpound.experiment.FIXED_BASE` and finite values (isolated cases with their twins)."""
+    """Whether a μ axis holds both :data:`~stochpound.store.FIXED_BASE` and finite values (isolated cases with their twins)."""
     fixed = [is_fixed_base(m) for m in mus]
     return any(fixed) and not all(fixed)
 
@@ -41,5 +40,5 @@ def isolated_mus(mus: Iterable[float]) -> list[float]:
 
 
 def fixed_base(data: Data) -> Data:
-    """The fixed-base cases (μ = :data:`~stochpound.experiment.FIXED_BASE`), the ``mu`` coordinate kept."""
+    """The fixed-base cases (μ = :data:`~stochpound.store.FIXED_BASE`), the ``mu`` coordinate kept."""
     return data.sel(mu=FIXED_BASE)

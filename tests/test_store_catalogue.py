@@ -7,7 +7,7 @@ import pytest
 import xarray as xr
 
 from stochpound.analysis._summary import top_floor_total_displacement
-from stochpound.experiment._catalogue import CASE_SUMMARIES, IMPACT_TABLE, WALL_SUMMARIES, REFERENCE_HISTORY, REFERENCE_SUMMARIES, TIME_HISTORIES, StoreVariable
+from stochpound.store import CASE_SUMMARIES, IMPACT_TABLE, WALL_SUMMARIES, REFERENCE_HISTORY, REFERENCE_SUMMARIES, TIME_HISTORIES, StoreVariable
 from stochpound.experiment._spec import TIME_HISTORY_VARIABLES
 from stochpound.experiment._summary import DEMAND_SUMMARIES, REFERENCE_SUMMARIES as REFERENCE_NAMES, case_summary, reference_summary
 from stochpound.model.scene_file import scene_from_dict
