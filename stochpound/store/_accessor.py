@@ -156,6 +156,16 @@ class StoreAccessor:
 
     # ------------------------------------------------------------ cases
 
+    def _at(self, variable: str, **labels: Any) -> Any:
+        """The one value of ``variable`` at ``labels`` (labels of dimensions the store lacks ignored, one realization squeezed)."""
+        present = {dim: value for dim, value in labels.items() if dim in self._dataset.dims}
+        data = self._dataset[variable].sel(present)
+        if "realization" in data.dims and data.sizes["realization"] == 1:
+            data = data.isel(realization=0)
+        if data.size != 1:
+            raise ExperimentError(f"case at {labels}: {data.size} cases, expected one (give every dimension: {dict(data.sizes)})")
+        return data.values.reshape(())
+
     def case_id(self, **labels: Any) -> str:
         """The id of the case at ``labels`` (one label on every grid dimension; a single realization needs none).
 
@@ -166,26 +176,37 @@ class StoreAccessor:
         ExperimentError
             If the labels leave more than one case.
         """
-        present = {dim: value for dim, value in labels.items() if dim in self._dataset.dims}
-        ids = self._dataset["case_id"].sel(present)
-        if "realization" in ids.dims and ids.sizes["realization"] == 1:
-            ids = ids.isel(realization=0)
-        if ids.size != 1:
-            raise ExperimentError(f"case at {labels}: {ids.size} cases, expected one (give every dimension: {dict(ids.sizes)})")
-        return str(ids.values.reshape(()))
+        return str(self._at("case_id", **labels))
 
     def scene(self, **labels: Any) -> Scene:
         """What ran in one case: its scene (structure and motion), rebuilt from the store's definition.
+
+        A case of intensity stripes ran its record scaled to its level: the
+        scene's motion carries that scale (the case's ``scale_factor``, times
+        the record's own ``scale``).
 
         Parameters
         ----------
         **labels
             The case's label on every grid dimension of the store.
+
+        Raises
+        ------
+        ExperimentError
+            If the labels leave more than one case, or the case ran a synthetic
+            motion scaled to a level (a generator's table has no scale).
         """
         grid = self.grid
         case = grid.case_index[self.case_id(**labels)]
         where = case.label_dict
-        return scene_from_dict({**grid.structure(case), "motion": grid.motion_table(where["record"], where.get("realization"))})
+        motion = grid.motion_table(where["record"], where.get("realization"))
+        factor = float(self._at("scale_factor", **labels)) if "scale_factor" in self._dataset else 1.0
+        if factor != 1.0:
+            if motion.get("type", "record") != "record":
+                raise ExperimentError(f"case at {labels}: its {motion['type']} motion ran scaled by {factor:.9g} (scale_factor), "
+                                      "which a generator's [motion] table cannot say; scale the scene's ground motion instead")
+            motion["scale"] = float(motion.get("scale", 1.0)) * factor
+        return scene_from_dict({**grid.structure(case), "motion": motion})
 
     def impacts(self, **labels: Any) -> xr.Dataset:
         """The rows of the impact table of the cases at ``labels`` (the ``impact_*`` variables; all of them without labels), loaded."""
