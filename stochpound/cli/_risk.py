@@ -60,7 +60,7 @@ def risk(store: Path, hazard: str | None, target: str, years: float, bootstrap: 
         hz = hazard_option(hazard, setting) if hazard is not None else stored_hazard(data)
         if hz is None:
             raise click.ClickException("--hazard: the store carries no hazard (its experiment has no [hazard] table): give a hazard file or a bundled curve's name")
-        result = store_risk(data, hz, targets, years, studied=data.attrs.get("studied_building"), bootstrap=bootstrap, seed=seed)
+        result = store_risk(data, hz, targets, years, studied=data.pound.definition.studied, bootstrap=bootstrap, seed=seed)
     except (StochpoundError, ValueError) as error:
         raise click.ClickException(str(error)) from None
     except OSError as error:

@@ -2,7 +2,7 @@
 
 ``ds.pound`` (xarray's own extension point, ``xr.register_dataset_accessor``)
 gives what a store is and holds, read from its attributes once per
-definition: the typed definition (:class:`~stochpound.store.Definition`),
+definition: the typed definition (:class:`~stochpound.experiment.Definition`),
 its intensity setting and hazard (typed), the gap axes and the selections by
 meaning (contact-free, wall-free, fixed-base cases), the experiment's grid,
 what ran in a case (its scene) and its impacts. The report, the command line,
@@ -63,7 +63,7 @@ class StoreAccessor:
     Parameters
     ----------
     dataset : xarray.Dataset
-        An experiment store (:func:`~stochpound.store.open_store`), or a
+        An experiment store (:func:`~stochpound.open_store`), or a
         selection of one (its attributes kept).
 
     Examples

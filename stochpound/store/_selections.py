@@ -4,7 +4,7 @@ A gap axis that holds ``inf`` makes *contact-free* cases (an axis setting
 contacts) or *wall-free* cases (an axis setting walls only): their gaps
 never close, and by the gap identity their peak closure answers every gap at
 once (docs/separation.md). That rule is ``stochpound.store._gap_axes``'s (the risk chain uses it too), given
-here too. A μ axis that holds :data:`~stochpound.store.FIXED_BASE`
+here too. A μ axis that holds :data:`~stochpound.experiment.FIXED_BASE`
 makes, for each isolated case, its *fixed-base twin*: the same case with the
 sliding base removed. These functions take a store, or any dataset or array
 on its grid dimensions (statistics over realizations, say).
@@ -29,7 +29,7 @@ Data = TypeVar("Data", xr.Dataset, xr.DataArray)
 
 
 def has_fixed_base_twins(mus: Iterable[float]) -> bool:
-    """Whether a μ axis holds both :data:`~stochpound.store.FIXED_BASE` and finite values (isolated cases with their twins)."""
+    """Whether a μ axis holds both :data:`~stochpound.experiment.FIXED_BASE` and finite values (isolated cases with their twins)."""
     fixed = [is_fixed_base(m) for m in mus]
     return any(fixed) and not all(fixed)
 
@@ -40,5 +40,5 @@ def isolated_mus(mus: Iterable[float]) -> list[float]:
 
 
 def fixed_base(data: Data) -> Data:
-    """The fixed-base cases (μ = :data:`~stochpound.store.FIXED_BASE`), the ``mu`` coordinate kept."""
+    """The fixed-base cases (μ = :data:`~stochpound.experiment.FIXED_BASE`), the ``mu`` coordinate kept."""
     return data.sel(mu=FIXED_BASE)

@@ -88,7 +88,7 @@ def risk_of(store: xr.Dataset, hz: HazardCurve | None = None, bootstrap: int = B
         raise ValueError("store: has no [hazard]; give a hazard curve")
     key = (str(store.attrs.get("definition_sha256", "")) + str(store.attrs.get("updated", "")), repr(hazard) + hazard.source, bootstrap)
     if key not in _CACHE:
-        _CACHE[key] = store_risk(store, hazard, TARGETS, YEARS, studied=store.attrs.get("studied_building"), confidence=CONFIDENCE,
+        _CACHE[key] = store_risk(store, hazard, TARGETS, YEARS, studied=store.pound.definition.studied, confidence=CONFIDENCE,
                                  bootstrap=bootstrap, seed=seed)
     return _CACHE[key]
 
@@ -400,7 +400,7 @@ def _demand_blocks(name: str, store: xr.Dataset, risk: StoreRisk, setting: dict[
     if "intensity" not in store.dims:
         return []
     free = wall_free(contact_free(store))  # the runs without impacts: contacts open, walls never reached
-    studied = store.attrs.get("studied_building")
+    studied = store.pound.definition.studied
     demands: dict[str, tuple[xr.DataArray, str]] = {}
     sliding = base_displacement(free, studied)
     if sliding is not None:
