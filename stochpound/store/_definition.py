@@ -59,7 +59,7 @@ __all__ = [
 ]
 
 NOT_IN_IDENTITY = ("hazard",)
-"""Entries of a canonical definition that no run depends on, left out of its identity (:func:`definition_sha256`)."""
+"""Entries of a canonical definition that no run depends on, left out of its identity (:func:`~stochpound.store.definition_sha256`)."""
 
 
 def canonical_json(value: Any) -> str:
@@ -78,7 +78,7 @@ def _jsonable(value: Any) -> Any:
 
 
 def definition_sha256(definition: Mapping[str, Any]) -> str:
-    """The experiment's identity: sha256 of the canonical definition's JSON without :data:`NOT_IN_IDENTITY`.
+    """The experiment's identity: sha256 of the canonical definition's JSON without :data:`~stochpound.store.NOT_IN_IDENTITY`.
 
     What the runs depend on, and nothing else: a store is refused by an
     experiment of another identity, and kept (its runs valid) when only its
@@ -136,9 +136,9 @@ class Intensity(_Entry):
     method : str
         The method asked for (``stripes``, ``ida`` or ``auto``).
     ran : str
-        The method that ran (``stripes`` or ``ida``) and :attr:`note`, why.
+        The method that ran (``stripes`` or ``ida``).
     note : str
-        Why :attr:`ran` ran.
+        Why that method ran.
     period : float or None
         Period of ``psa``, s.
     periods : tuple of float
@@ -168,7 +168,7 @@ class Intensity(_Entry):
 
     @property
     def description(self) -> str:
-        """The measure in words (:func:`describe_measure`)."""
+        """The measure in words (:func:`~stochpound.store.describe_measure`)."""
         return describe_measure(self.entry)
 
 
@@ -176,7 +176,7 @@ class Intensity(_Entry):
 class Hazard(_Entry):
     """The site's hazard curve a store carries (the ``[hazard]`` table, docs/risk.md): its values and provenance.
 
-    Not part of the runs' identity (:data:`NOT_IN_IDENTITY`): a new curve
+    Not part of the runs' identity (:data:`~stochpound.store.NOT_IN_IDENTITY`): a new curve
     replaces the stored one without touching the runs.
 
     Attributes
@@ -221,7 +221,7 @@ class Hazard(_Entry):
 
     @property
     def description(self) -> str:
-        """Its measure in words (:func:`describe_measure`)."""
+        """Its measure in words (:func:`~stochpound.store.describe_measure`)."""
         return describe_measure(self.entry)
 
 
@@ -437,7 +437,7 @@ class Definition:
 
     @property
     def sha256(self) -> str:
-        """The experiment's identity (:func:`definition_sha256`: what its runs depend on)."""
+        """The experiment's identity (:func:`~stochpound.store.definition_sha256`: what its runs depend on)."""
         return definition_sha256(self.canonical)
 
     @property
