@@ -21,7 +21,10 @@ units. A mismatch is an error naming the field.
 
 The canonical entry holds the table itself (``im``, ``rate``), its
 provenance (the file's comment lines) and the file's sha256, so a store
-carries everything needed to redo the risk chain without the file.
+carries everything needed to redo the risk chain without the file. No run
+depends on it, so it is not part of the experiment's identity
+(``stochpound.store.NOT_IN_IDENTITY``): a run after the hazard changed keeps
+the store's cases and records the new entry.
 """
 
 from __future__ import annotations

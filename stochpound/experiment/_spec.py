@@ -5,8 +5,9 @@ An experiment file names a base scene, named variants of it, grid axes (gap,
 outputs to keep and the solver settings (docs/experiments.md, field by
 field). :func:`parse_experiment` checks every field and returns the
 *canonical definition*: a JSON-able dict with every default filled in and the
-base scene inlined. Its sha256 identifies the experiment: a store made from a
-different definition is refused. :class:`stochpound.experiment._grid.Experiment`
+base scene inlined. Its sha256, without the hazard that no run depends on
+(``stochpound.store.definition_sha256``), identifies the experiment: a store
+made from a different definition is refused. :class:`stochpound.experiment._grid.Experiment`
 is built from it.
 
 Errors raise :class:`ExperimentError` whose message starts with the field's
