@@ -27,8 +27,8 @@ from stochpound.store._catalogue import (
     WALL_SUMMARIES,
     StoreVariable,
 )
+from stochpound.model.friction import FIXED_BASE, is_fixed_base
 from stochpound.store._definition import (
-    FIXED_BASE,
     NOT_IN_IDENTITY,
     Definition,
     GapAxis,
@@ -42,8 +42,6 @@ from stochpound.store._definition import (
     canonical_json,
     definition_sha256,
     describe_measure,
-    is_fixed_base,
-    is_gap_axis,
     read_definition,
 )
 from stochpound.store._gap_axes import (
@@ -53,6 +51,7 @@ from stochpound.store._gap_axes import (
     gap_dims,
     has_contact_free,
     has_wall_free,
+    is_gap_axis,
     wall_free,
     wall_gap_dims,
     with_contacts,

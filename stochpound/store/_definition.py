@@ -17,11 +17,11 @@ form; :meth:`Definition.to_dict` gives it back unchanged.
 store's runs stay valid when only its hazard changes. A definition without
 those entries hashes exactly as before.
 
-The rules that name parts of a grid are given here: that a gap axis is ``gap``
-or ``gap_<name>`` (:func:`is_gap_axis`, ``stochpound.store._gap_axes``,
-which selects contact-free cases too); that μ = ∞ is a fixed base
-(:data:`FIXED_BASE`, :func:`is_fixed_base`) is the model's rule
-(:mod:`stochpound.model.friction`).
+The rules that name parts of a grid live once, and the store's namespace
+gives them with the definition: that a gap axis is ``gap`` or ``gap_<name>``
+(``is_gap_axis``, ``stochpound.store._gap_axes``, which selects contact-free
+cases too); that μ = ∞ is a fixed base (``FIXED_BASE``, ``is_fixed_base``) is
+the model's rule (:mod:`stochpound.model.friction`).
 """
 
 from __future__ import annotations
@@ -35,28 +35,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from stochpound._errors import ExperimentError
-from stochpound.model.friction import FIXED_BASE, is_fixed_base
-from stochpound.store._gap_axes import is_gap_axis
-
-__all__ = [
-    "FIXED_BASE",
-    "NOT_IN_IDENTITY",
-    "Definition",
-    "GapAxis",
-    "Hazard",
-    "Intensity",
-    "MotionSource",
-    "MuAxis",
-    "Output",
-    "Solver",
-    "VariantAxis",
-    "canonical_json",
-    "definition_sha256",
-    "describe_measure",
-    "is_fixed_base",
-    "is_gap_axis",
-    "read_definition",
-]
+from stochpound.model.friction import is_fixed_base
 
 NOT_IN_IDENTITY = ("hazard",)
 """Entries of a canonical definition that no run depends on, left out of its identity (:func:`~stochpound.store.definition_sha256`)."""
