@@ -27,7 +27,8 @@ from stochpound.experiment import _intensity as intensity
 from stochpound.experiment._grid import REFERENCE
 from stochpound.experiment._parts import concatenate, section_key, stack_cases
 from stochpound.experiment._scene_edits import reference_scene, with_motion
-from stochpound.experiment._spec import AUTO, canonical_json
+from stochpound.experiment._spec import AUTO
+from stochpound.store import canonical_json
 from stochpound.experiment._summary import case_arrays, case_values, reference_arrays, reference_values
 from stochpound.solvers.twin import fixed_base_displacements
 from stochpound.model.scene import Scene

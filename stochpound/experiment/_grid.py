@@ -25,7 +25,7 @@ from typing import Any, Iterator, Mapping, Sequence
 import numpy as np
 
 from stochpound._errors import SceneError
-from stochpound.experiment._definition import Definition, read_definition
+from stochpound.store import Definition, canonical_json, read_definition, register_grid
 from stochpound.experiment._scene_edits import (
     apply_overrides,
     building_names,
@@ -35,7 +35,7 @@ from stochpound.experiment._scene_edits import (
     with_motion,
     without_motion,
 )
-from stochpound.experiment._spec import ExperimentError, canonical_json
+from stochpound.experiment._spec import ExperimentError
 from stochpound.model.scene_file import scene_from_dict
 
 CASE = "case"
@@ -429,3 +429,6 @@ class Experiment:
     def seeds(self) -> dict[str, int]:
         """Seeds of the synthetic ensembles, by label."""
         return {label: m["motion"]["seed"] for label, m in self.motions.items() if m["kind"] == "synthetic"}
+
+
+register_grid(Experiment)  # the store layer's accessor (ds.pound) builds a store's grid with it
