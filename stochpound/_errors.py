@@ -16,6 +16,11 @@ class SceneError(StochpoundError, ValueError):
     ``building[1].base.mu: must be >= 0, got -0.2``."""
 
 
+class ExperimentError(SceneError):
+    """An experiment definition or store is invalid; the message names the field
+    (e.g. ``grid.gap[1]: must be >= 0, got -0.01``) or the file."""
+
+
 class RecordError(StochpoundError, ValueError):
     """A ground-motion record cannot be read or is unusable; the message names
     the file (and line, where there is one)."""

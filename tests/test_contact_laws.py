@@ -14,7 +14,7 @@ from scipy.special import gamma
 
 import stochpound
 from stochpound.model import laws
-from stochpound.model.law import ElementParameters
+from stochpound.model.laws.contract import ElementParameters
 from stochpound.solvers.ivp import run_ivp
 from tests.conftest import reference_building
 

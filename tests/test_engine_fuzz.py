@@ -29,7 +29,7 @@ from scipy.integrate import solve_ivp
 
 import stochpound
 from stochpound.model import laws
-from stochpound.model.law import ElementParameters
+from stochpound.model.laws.contract import ElementParameters
 
 STIFFNESSES = (1e5, 1e6, 1e7, 1e8, 1e9, 1e10)
 GAPS = (0.0, 1e-9, 1e-6, 1e-3, 0.02)

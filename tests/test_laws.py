@@ -1,5 +1,6 @@
 """The law registry (stochpound.model.laws): every law answers the same questions, and no code outside it compares law names."""
 
+import importlib
 import re
 from pathlib import Path
 
@@ -9,7 +10,7 @@ import pytest
 import stochpound
 from stochpound.model import laws
 from stochpound.model.friction import Base, SlidingBase
-from stochpound.model.law import ElementParameters
+from stochpound.model.laws.contract import ElementParameters
 from tests.conftest import reference_building
 
 ELEMENT = ElementParameters(stiffness=2.75e9, damping=0.0, restitution=0.5, tensile=True, mass=1.0e5)
@@ -91,3 +92,16 @@ def test_no_code_outside_the_registry_compares_law_names():
     found = [f"{path.relative_to(package)}:{number}" for path in package.rglob("*.py")
              for number, line in enumerate(path.read_text().splitlines(), 1) if comparison.search(line)]
     assert found == []
+
+
+@pytest.mark.parametrize("old, new", [("law", "contract"), *((name, name) for name in ("kelvin", "hertz", "hertz_damp_ye", "hertz_damp_exact",
+                                                                                      "jankowski", "coulomb", "velocity_friction"))])
+def test_the_law_modules_old_paths_are_the_moved_modules(old, new):
+    """The law modules moved into stochpound.model.laws; code that imports them by their old paths gets the same modules."""
+    assert importlib.import_module(f"stochpound.model.{old}") is importlib.import_module(f"stochpound.model.laws.{new}")
+
+
+@pytest.mark.parametrize("mu, law", [(0.1, "coulomb"), ({"slow": 0.05, "fast": 0.1, "rate": 20.0}, "velocity")])
+def test_a_bases_friction_law_is_the_one_its_mu_is_written_for(mu, law):
+    assert laws.base_friction_law({"mass": 1.0, "mu": mu}) is laws.friction_law(law)
+    assert {name for name, other in laws.FRICTION_LAWS.items() if other.spells(mu)} == {law}

@@ -137,7 +137,7 @@ def test_a_moat_store_states_the_wall_s_amplification_and_its_largest_penetratio
 
 def test_a_pair_with_contact_free_twins_gets_the_ratcheting_and_pounding_findings_in_its_section(tmp_path):
     """The store section, given the whole store, compares the cases with contacts with their contact-free twins."""
-    from stochpound.experiment._selections import with_contacts
+    from stochpound.store import with_contacts
     from stochpound.report.sections._generic import store_section
     from tests.conftest import reference_building, study_contacts
     from tests.test_experiment_laws import _toml_tables

@@ -11,7 +11,7 @@ import xarray as xr
 
 from stochpound.analysis import pounding_curve, pounding_probability
 from stochpound.experiment import open_store
-from stochpound.experiment._selections import contact_free, has_contact_free, has_wall_free, wall_free, wall_gap_dims, with_walls
+from stochpound.store import contact_free, has_contact_free, has_wall_free, wall_free, wall_gap_dims, with_walls
 from stochpound.report.assemble import assemble_report
 from stochpound.report.render._document import FigureItem, Paragraph, Table
 from stochpound.report.sections._mechanism_findings import mechanism_answer, wall_axis
@@ -115,7 +115,8 @@ def test_the_mechanisms_speak_of_a_wall_not_of_pounding(report, moat):
 
 def test_the_risk_section_s_moat_clearances_are_the_gap_axis_s():
     """With a hazard, the moat-wall limit state is judged at the clearances the gap axis sets (not the walls' own placeholder gap)."""
-    from stochpound.experiment._spec import canonical_json, load_definition
+    from stochpound.experiment._spec import load_definition
+    from stochpound.store import canonical_json
     from stochpound.report.sections._risk import _moat_clearances
 
     definition, _ = load_definition(ROOT / "experiments" / "laws" / "moat_wall.toml")

@@ -16,7 +16,7 @@ import pytest
 import xarray as xr
 
 from stochpound.experiment import load_experiment, open_store, run_experiment
-from stochpound.experiment._spec import canonical_json
+from stochpound.store import canonical_json
 from stochpound.report.assemble import assemble_report
 from stochpound.report.sections._generic import AGAINST
 from stochpound.report.render.output import write_report
@@ -233,9 +233,7 @@ def test_the_study_report_renders_in_headless_chromium(built, tmp_path):
 def test_figure_3_6_draws_every_located_peak_its_caption_quotes(built, study_stores):
     gap = open_store(next(p for p in study_stores if p.stem == "gap_study"))
     case = {"neighbour": "flexible", "gap": 0.02, "mu": np.inf, "record": "el_centro", "realization": 0}
-    from stochpound.report.sections._stores import case_impacts
-
-    impacts = case_impacts(gap, **case)
+    impacts = gap.pound.impacts(**case)
     item = built["figure_items"]["figure-3.6"]
     peaks = [line for ax in item.figure.axes for line in ax.lines if line.get_label().startswith("located peaks")]
     assert sum(len(line.get_xdata()) for line in peaks) == impacts.sizes["impact"]

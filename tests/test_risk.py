@@ -21,8 +21,6 @@ from stochpound.analysis import (
     separation_rules,
     stripe_fragility,
 )
-from stochpound.analysis import _gap_axes as gap_axes
-from stochpound.experiment import _selections as selections
 
 
 def closed_form(k0, k, theta, beta):
@@ -200,16 +198,15 @@ def test_the_store_selection_takes_the_contact_free_cases_for_every_gap_and_conf
 
 
 def test_the_risk_chain_and_the_experiment_layer_select_contact_free_cases_by_the_one_rule():
-    """With two gap axes only the cases at inf on both are contact-free, for the risk chain as for the reports' selection."""
+    """With two gap axes only the cases at inf on both are contact-free, for the risk chain as for the store's door (ds.pound)."""
     rng = np.random.default_rng(7)
     dims = ("gap", "gap_top", "record", "intensity", "contact")
     values = rng.lognormal(np.log(0.04), 0.5, (2, 2, 8, 3, 2))
     store = xr.Dataset({"peak_contact_closure": (dims, values)},
                        coords={"gap": [0.02, np.inf], "gap_top": [np.inf, 0.03], "intensity": [0.2, 0.4, 0.6]})
-    assert selections.contact_free is gap_axes.contact_free and selections.has_contact_free is gap_axes.has_contact_free
     closure = contact_free_closure(store)
     assert closure.dims == ("record", "intensity")
     np.testing.assert_array_equal(closure.values, values[1, 0].max(-1))
-    np.testing.assert_array_equal(closure.values, selections.contact_free(store).peak_contact_closure.max("contact").values)
+    np.testing.assert_array_equal(closure.values, store.pound.contact_free().peak_contact_closure.max("contact").values)
     with pytest.raises(ValueError, match="^store: no contact-free cases .*gap, gap_top"):
         contact_free_closure(store.sel(gap_top=[0.03]))

@@ -28,7 +28,8 @@ from stochpound.analysis._store_risk import contact_free_closure, risk_gaps
 from stochpound.cli import main
 from stochpound.experiment._hazard import hazard_curve, stored_hazard
 from stochpound.experiment._runner import load_experiment, run_experiment
-from stochpound.experiment._spec import ExperimentError, definition_sha256, load_definition, parse_experiment
+from stochpound.experiment._spec import ExperimentError, load_definition, parse_experiment
+from stochpound.store import definition_sha256
 from stochpound.report.render._document import Paragraph, Table
 from stochpound.report.sections._risk import risk_headline, risk_of, risk_section
 from tests.test_experiment_helpers import write_experiment

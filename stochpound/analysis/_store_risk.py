@@ -26,7 +26,7 @@ import xarray as xr
 
 from stochpound.analysis._code_rules_risk import MINIMUM_MOTIONS, code_rules_risk
 from stochpound.analysis._fragility_ensemble import BOOTSTRAP, homogeneous_capacities, ida_fragility, limit_state_events, stripe_fragility
-from stochpound.analysis._gap_axes import contact_free, gap_dims, has_contact_free
+from stochpound.store import contact_free, gap_dims, has_contact_free
 from stochpound.analysis._hazard import HazardCurve
 from stochpound.analysis._risk import TARGETS, risk_curve, risk_targeted_separation
 from stochpound.analysis._separation_rules import store_contact_demands
@@ -74,7 +74,7 @@ def contact_free_closure(store: xr.Dataset, contact_dim: str = "contact") -> xr.
     """The largest peak closure over the contacts of every contact-free case of a store (m), one motion dimension ``record``.
 
     The contact-free cases are those at ``inf`` on every gap axis
-    (``stochpound.analysis._gap_axes.contact_free``); in an IDA store every
+    (:func:`stochpound.store.contact_free`); in an IDA store every
     case runs contact-free, and the first gap's are taken.
     """
     if CLOSURE not in store:

@@ -3,7 +3,7 @@
 Each run is compared with its *twin without impacts*: the same motion (the
 same realization of the same ensemble) in the same cell without the impact
 elements, i.e. the contact-free twin of a cell with contacts (gap = ``inf``,
-``stochpound.experiment._selections.contact_free``) or the same building
+:func:`stochpound.store.contact_free`) or the same building
 without its moat wall (a variant without walls). Because a run and its twin
 share the motion, their difference is taken run by run (paired), which
 removes the variability between motions; every interval is the percentile
@@ -78,7 +78,7 @@ def ratcheting(residual: xr.DataArray, contact_free: xr.DataArray, away: float, 
         dimension ``dim`` and the cells' dimensions (finite gaps, μ, ...).
     contact_free : xarray.DataArray
         The same in the contact-free twins (gap = ``inf``, the gap
-        dimensions dropped: ``stochpound.experiment._selections.contact_free``);
+        dimensions dropped: :func:`stochpound.store.contact_free`);
         broadcast against ``residual``'s cells, paired by ``dim``.
     away : float
         −1 for a building left of its neighbour, +1 for one right of it: the

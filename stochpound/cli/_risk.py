@@ -47,22 +47,20 @@ def risk(store: Path, hazard: str | None, target: str, years: float, bootstrap: 
     contact-free cases, gap = inf) or IDA capacities (docs/risk.md).
     """
     from stochpound.analysis._store_risk import store_risk
-    from stochpound.experiment import open_store
     from stochpound.experiment._hazard import hazard_option, stored_hazard
-    from stochpound.experiment._intensity import describe_measure
-    from stochpound.report.sections._intensity import intensity_setting
+    from stochpound.store import describe_measure, open_store
     from stochpound.report.sections._risk import risk_headline, rules_frame, separation_frame
 
     targets = _targets(target)
     try:
         data = open_store(store)
-        setting = intensity_setting(data)
+        setting = data.pound.intensity
         if setting is None:
             raise click.ClickException("store: has no intensity stripes or IDA capacities (run an experiment with an [intensity] table)")
         hz = hazard_option(hazard, setting) if hazard is not None else stored_hazard(data)
         if hz is None:
             raise click.ClickException("--hazard: the store carries no hazard (its experiment has no [hazard] table): give a hazard file or a bundled curve's name")
-        result = store_risk(data, hz, targets, years, studied=data.attrs.get("studied_building"), bootstrap=bootstrap, seed=seed)
+        result = store_risk(data, hz, targets, years, studied=data.pound.definition.studied, bootstrap=bootstrap, seed=seed)
     except (StochpoundError, ValueError) as error:
         raise click.ClickException(str(error)) from None
     except OSError as error:

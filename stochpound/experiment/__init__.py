@@ -8,7 +8,8 @@
 File format, store layout, resumption and clusters: ``docs/experiments.md``.
 """
 
-from stochpound.experiment._definition import (
+from stochpound._errors import ExperimentError
+from stochpound.store import (
     FIXED_BASE,
     Definition,
     GapAxis,
@@ -19,13 +20,12 @@ from stochpound.experiment._definition import (
     VariantAxis,
     is_fixed_base,
     is_gap_axis,
+    open_store,
     read_definition,
 )
 from stochpound.experiment._grid import Case, Dim, Experiment
 from stochpound.experiment._runner import RunReport, default_store, load_experiment, run_experiment
-from stochpound.experiment._spec import ExperimentError
 from stochpound.experiment._status import StatusReport, store_status
-from stochpound.experiment._store import open_store
 
 __all__ = [
     "FIXED_BASE",

@@ -26,7 +26,9 @@ from stochpound import motions as synthetic_motions
 from stochpound.experiment import _intensity as intensity
 from stochpound.experiment._grid import REFERENCE
 from stochpound.experiment._parts import concatenate, section_key, stack_cases
-from stochpound.experiment._spec import AUTO, canonical_json
+from stochpound.experiment._scene_edits import reference_scene, with_motion
+from stochpound.experiment._spec import AUTO
+from stochpound.store import canonical_json
 from stochpound.experiment._summary import case_arrays, case_values, reference_arrays, reference_values
 from stochpound.solvers.twin import fixed_base_displacements
 from stochpound.model.scene import Scene
@@ -270,6 +272,5 @@ def warm_up() -> None:
 
     compile_engine()
     intensity.warm_up()
-    building = WARM_UP_SCENE["building"][1]
-    twin = scene_from_dict({"building": [building], "motion": WARM_UP_SCENE["motion"]}, source="warm_up")
+    twin = scene_from_dict(with_motion(reference_scene(WARM_UP_SCENE, "B2"), WARM_UP_SCENE["motion"]), source="warm_up")
     fixed_base_displacements(twin, [twin.motion])

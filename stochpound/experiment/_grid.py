@@ -25,15 +25,17 @@ from typing import Any, Iterator, Mapping, Sequence
 import numpy as np
 
 from stochpound._errors import SceneError
-from stochpound.experiment._definition import Definition, read_definition
-from stochpound.experiment._spec import ExperimentError, canonical_json
-from stochpound.experiment._variants import (
-    PLACEHOLDER_MOTION,
+from stochpound.store import Definition, canonical_json, read_definition, register_grid
+from stochpound.experiment._scene_edits import (
     apply_overrides,
+    building_names,
     reference_scene,
     set_gaps,
     set_mu,
+    with_motion,
+    without_motion,
 )
+from stochpound.experiment._spec import ExperimentError
 from stochpound.model.scene_file import scene_from_dict
 
 CASE = "case"
@@ -171,7 +173,7 @@ class Experiment:
     @cached_property
     def building_names(self) -> list[str]:
         """Buildings of the base scene, left to right."""
-        return [b.get("name", f"B{i + 1}") for i, b in enumerate(self.definition["scene"]["building"])]
+        return building_names(self.definition["scene"])
 
     @cached_property
     def max_floors(self) -> int:
@@ -340,7 +342,7 @@ class Experiment:
         """
         point = self._point_of(case)
         labels = dict(point.labels)
-        scene = {k: v for k, v in self.definition["scene"].items() if k != "motion"}
+        scene = without_motion(self.definition["scene"])
         overrides = [v["overrides"][labels[v["name"]]] for v in self.variants if v["name"] in labels]
         scene = apply_overrides(scene, overrides)
         if point.kind == REFERENCE:
@@ -358,8 +360,7 @@ class Experiment:
                         f"grid.mu: building(s) {', '.join(missing)} have no [building.base] in {point.describe()}; "
                         "give them a base (in the scene or a variant) or leave them out of grid.mu.buildings"
                     )
-        scene["motion"] = dict(PLACEHOLDER_MOTION)
-        return scene
+        return with_motion(scene)
 
     def _point_of(self, case: Case | Point) -> Point:
         if isinstance(case, Point):
@@ -411,9 +412,8 @@ class Experiment:
 
     def _base_scene_error(self) -> str | None:
         """The error of the base scene on its own (with a placeholder motion), if any."""
-        scene = {k: v for k, v in self.definition["scene"].items() if k != "motion"}
         try:
-            scene_from_dict({**scene, "motion": dict(PLACEHOLDER_MOTION)}, base_dir=self.base_dir)
+            scene_from_dict(with_motion(without_motion(self.definition["scene"])), base_dir=self.base_dir)
         except (SceneError, ValueError) as error:
             return str(error)
         return None
@@ -429,3 +429,6 @@ class Experiment:
     def seeds(self) -> dict[str, int]:
         """Seeds of the synthetic ensembles, by label."""
         return {label: m["motion"]["seed"] for label, m in self.motions.items() if m["kind"] == "synthetic"}
+
+
+register_grid(Experiment)  # the store layer's accessor (ds.pound) builds a store's grid with it

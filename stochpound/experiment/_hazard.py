@@ -21,7 +21,10 @@ units. A mismatch is an error naming the field.
 
 The canonical entry holds the table itself (``im``, ``rate``), its
 provenance (the file's comment lines) and the file's sha256, so a store
-carries everything needed to redo the risk chain without the file.
+carries everything needed to redo the risk chain without the file. No run
+depends on it, so it is not part of the experiment's identity
+(``stochpound.store.NOT_IN_IDENTITY``): a run after the hazard changed keeps
+the store's cases and records the new entry.
 """
 
 from __future__ import annotations
@@ -31,9 +34,11 @@ import math
 from pathlib import Path
 from typing import Any, Mapping
 
+import xarray as xr
+
 from stochpound.analysis._hazard import HazardCurve, bundled_curves, bundled_measure
-from stochpound.experiment._definition import read_definition
-from stochpound.experiment._intensity import IntensityError, describe_measure
+from stochpound.store import describe_measure
+from stochpound.experiment._intensity import IntensityError
 from stochpound.model import fields as toml_fields
 
 SOURCES = ("file", "bundled", "power_law")
@@ -158,14 +163,9 @@ def _power_law(table: Any) -> dict[str, float]:
     return {key: toml_fields.number(table, key, "hazard.power_law", required=True, low=0.0, low_open=True) for key in ("k0", "k")}
 
 
-def stored_hazard_entry(store: Any) -> dict[str, Any] | None:
-    """An experiment store's definition's ``hazard`` entry (its table and provenance), or None."""
-    return read_definition(store).to_dict().get("hazard")
-
-
-def stored_hazard(store: Any) -> HazardCurve | None:
-    """The hazard an experiment store carries (its definition's ``hazard`` entry), or None."""
-    entry = stored_hazard_entry(store)
+def stored_hazard(store: xr.Dataset) -> HazardCurve | None:
+    """The hazard an experiment store carries (``store.pound.hazard``, typed), as a curve; None without one."""
+    entry = store.pound.hazard
     return None if entry is None else hazard_curve(entry)
 
 

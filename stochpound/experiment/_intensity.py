@@ -36,6 +36,7 @@ from stochpound.model import fields as toml_fields
 from stochpound.model.friction import is_fixed_base
 from stochpound.motions._measures import arias_intensity, peak_ground_motion, significant_duration
 from stochpound.motions._spectrum import response_spectrum
+from stochpound.store import describe_measure
 
 MEASURES = ("pga", "pgv", "psa", "sa_avg")
 METHODS = ("stripes", "ida")
@@ -242,17 +243,6 @@ def summary_attrs(intensity: Mapping[str, Any], name: str) -> dict[str, str]:
     """Units and long name of a per-case intensity variable."""
     units, long_name = SUMMARIES[name]
     return {"units": units.format(units=intensity["units"]), "long_name": long_name.format(measure=describe_measure(intensity))}
-
-
-def describe_measure(intensity: Mapping[str, Any]) -> str:
-    """E.g. ``PSA(T = 1 s, 5 % damping)`` or ``PGA``."""
-    measure = intensity["measure"]
-    if measure == "psa":
-        return f"PSA(T = {intensity['period']:g} s, {100 * intensity['damping']:g} % damping)"
-    if measure == "sa_avg":
-        periods = intensity["periods"]
-        return f"Sa_avg({periods[0]:g}-{periods[-1]:g} s, {len(periods)} periods, {100 * intensity['damping']:g} % damping)"
-    return measure.upper()
 
 
 def store_names(intensity: Mapping[str, Any] | None) -> list[str]:

@@ -14,6 +14,7 @@ cases (beyond a few bytes per case for the grid's masks).
 from __future__ import annotations
 
 import contextlib
+import json
 import logging
 import os
 import signal
@@ -32,11 +33,12 @@ from stochpound.experiment._compute import BatchResult, BatchTask, run_batch, so
 from stochpound.experiment._estimate import LARGE_RUN_BYTES, LARGE_RUN_CASES, estimate_run
 from stochpound.experiment._grid import Experiment
 from stochpound.experiment._parts import FolderLock, PartBuffer, append_run, parts_folder, remove_temporaries
-from stochpound.experiment._session import StoreSession, check_store, clear_store, code_identity, machine, missing_summaries, now, store_complete
+from stochpound.experiment._session import StoreSession, check_store, clear_store, code_identity, machine, missing_summaries, now, store_complete, stored_definition
 from stochpound.experiment._sources import ResolvedMotion, resolve_motions
 from stochpound.experiment._spec import ExperimentError, load_definition
 from stochpound.experiment._store_writer import PartsIndex
 from stochpound._memory import format_bytes
+from stochpound.store import canonical_json
 
 CHECKPOINT_FACTOR = 20.0
 """A checkpoint waits at least this many times the last rebuild's duration (rebuilds cost at most ~5 % of a run)."""
@@ -185,7 +187,9 @@ def run_experiment(
     Notes
     -----
     A store whose file says every case is done is left as it is: no cluster
-    starts and nothing is written (``nothing_to_run``).
+    starts and nothing runs (``nothing_to_run``); only when its definition's
+    entries outside the identity (the ``[hazard]``) changed is it rewritten
+    from its parts with the new ones (its runs kept).
     """
     started = time.monotonic()
     say = say or (lambda message: None)
@@ -201,6 +205,8 @@ def run_experiment(
             if missing:
                 raise ExperimentError(f"{store}: written by an earlier stochpound without {', '.join(missing)}, which it keeps now: "
                                       "run the experiment again with --restart to recompute its cases")
+            if stored_definition(store) != json.loads(canonical_json(experiment.definition)):
+                _record_hazard(store, experiment, {label: m.grid for label, m in motions.items()}, say)
             return RunReport(store, experiment.n_cases, experiment.n_cases, elapsed=time.monotonic() - started, nothing_to_run=True)
     elif store.is_dir():
         raise ExperimentError(f"{store}: is a folder; --store must name a file")
@@ -259,6 +265,22 @@ def run_experiment(
             report.elapsed = time.monotonic() - started
             report.setup = report.setup or report.elapsed  # stopped before the first batch: all of it was start-up
     return report
+
+
+def _record_hazard(store: Path, experiment: Experiment, grids: dict[str, tuple[float, int]], say: Callable[[str], None]) -> None:
+    """Rewrite a complete store from its parts with the experiment's hazard (no run depends on it: the runs are kept)."""
+    lock = FolderLock(parts_folder(store))
+    if not lock.acquire():
+        raise _busy(store)
+    with lock:
+        session = StoreSession.create(store, experiment, grids)
+        if session.scan().n_done < experiment.n_cases:  # its parts folder lost cases: rewriting would lose them
+            raise ExperimentError(f"{store}: the hazard changed, but {session.folder.name}/ lacks finished cases to rewrite the store from; "
+                                  "keep the store as it is, or run again with --restart")
+        session.rebuild()
+    hazard = experiment.contract.hazard
+    what = "removed" if hazard is None else f"from {hazard.file or hazard.bundled or 'a power law'}" + (f" (sha256 {hazard.file_sha256[:12]}…)" if hazard.file_sha256 else "")
+    say(f"{store}: the hazard changed ({what}); no run depends on it: the cases are kept and the new curve is recorded in the store")
 
 
 def _busy(store: Path) -> ExperimentError:

@@ -22,7 +22,8 @@ import numpy as np
 from stochpound import __version__
 from stochpound.experiment._grid import KINDS, Experiment
 from stochpound.experiment._parts import DEFINITION_FILE, part_paths, parts_folder, read_experiment_json, read_runs, write_experiment_json
-from stochpound.experiment._spec import ExperimentError, canonical_json
+from stochpound.experiment._spec import ExperimentError
+from stochpound.store import canonical_json, definition_sha256
 from stochpound.experiment._store import PREFIX, layout
 from stochpound.experiment._store_writer import PartsIndex, write_store
 
@@ -33,7 +34,11 @@ def now() -> str:
 
 
 def store_identity(store: Path) -> str:
-    """The ``definition_sha256`` attribute of an existing store file.
+    """The identity of an existing store file's runs, by today's rule (:func:`~stochpound.store.definition_sha256`).
+
+    Computed from the store's ``definition`` attribute, so that a store
+    written while its hazard was part of the identity keeps its runs; its
+    ``definition_sha256`` attribute for a store without that attribute.
 
     Raises
     ------
@@ -44,12 +49,31 @@ def store_identity(store: Path) -> str:
 
     try:
         with h5py.File(store, "r") as handle:
+            if "definition" in handle.attrs:
+                return definition_sha256(json.loads(_text(handle.attrs["definition"])))
             value = handle.attrs["definition_sha256"]
     except KeyError:
         raise ExperimentError(f"{store}: not a stochpound experiment store (no definition_sha256 attribute)") from None
     except OSError as error:
         raise ExperimentError(f"{store}: not a readable netCDF4/HDF5 file ({error})") from None
+    return _text(value)
+
+
+def _text(value: Any) -> str:
     return value.decode() if isinstance(value, bytes) else str(value)
+
+
+def stored_definition(store: Path) -> dict[str, Any]:
+    """The canonical definition an existing store file holds (its ``definition`` attribute, parsed; {} without one)."""
+    import h5py
+
+    with h5py.File(store, "r") as handle:
+        return json.loads(_text(handle.attrs["definition"])) if "definition" in handle.attrs else {}
+
+
+def folder_identity(record: dict[str, Any]) -> str:
+    """The identity of a parts folder's runs (its ``experiment.json``), by today's rule, like :func:`store_identity`."""
+    return definition_sha256(record["definition"]) if "definition" in record else record["definition_sha256"]
 
 
 def check_store(store: Path, sha256: str) -> bool:
@@ -85,7 +109,7 @@ def check_store(store: Path, sha256: str) -> bool:
                 raise ExperimentError(f"{store}: made from a different experiment definition (sha256 {found[:12]}…, this one {sha256[:12]}…); {hint}")
     if parts:
         try:
-            found = read_experiment_json(folder)["definition_sha256"]
+            found = folder_identity(read_experiment_json(folder))
         except (ExperimentError, KeyError, TypeError) as error:
             raise ExperimentError(f"{folder}: unreadable parts folder ({error}); {hint}") from None
         if found != sha256:
@@ -190,6 +214,11 @@ class StoreSession:
         folder.mkdir(parents=True, exist_ok=True)
         if (folder / DEFINITION_FILE).exists():
             record = read_experiment_json(folder)
+            definition = json.loads(canonical_json(experiment.definition))
+            if record["definition"] != definition:  # the same runs (checked by check_store), another hazard: record it
+                record.update(definition=definition, definition_sha256=experiment.sha256, text=experiment.text,
+                              text_sha256=hashlib.sha256(experiment.text.encode()).hexdigest())
+                write_experiment_json(folder, record)
         else:
             record = {
                 "definition_sha256": experiment.sha256,

@@ -16,8 +16,9 @@ from typing import Any
 import numpy as np
 
 from stochpound import motions as synthetic_motions
-from stochpound.experiment._intensity import check_resolution, ensemble_intensity
 from stochpound.experiment._grid import CASE, Experiment
+from stochpound.experiment._intensity import check_resolution, ensemble_intensity
+from stochpound.experiment._scene_edits import with_motion
 from stochpound.experiment._spec import ExperimentError, field_errors
 from stochpound.motions.ground import GroundMotion, SampledMotion
 from stochpound.model.scene_file import scene_from_dict
@@ -64,7 +65,7 @@ def resolve_motions(experiment: Experiment) -> dict[str, ResolvedMotion]:
     for label, source in experiment.motions.items():
         table = experiment.motion_table(label)
         with field_errors(scene_prefix=source["field"]):
-            motion = scene_from_dict({**structure, "motion": table}, base_dir=experiment.base_dir).motion
+            motion = scene_from_dict(with_motion(structure, table), base_dir=experiment.base_dir).motion
         grid = (float(motion.times[1] - motion.times[0]), len(motion.times))
         if experiment.intensity is not None:
             with field_errors():
@@ -90,5 +91,5 @@ def _worker_table(table: dict[str, Any], motion: GroundMotion, structure: dict[s
     level = generator(1, start=table["realization"], **parameters).attrs["S0"]
     fixed = {k: v for k, v in table.items() if k not in _INTENSITY_KEYS}
     fixed["S0"] = float(level)
-    again = scene_from_dict({**structure, "motion": fixed}).motion
+    again = scene_from_dict(with_motion(structure, fixed)).motion
     return fixed if np.array_equal(again.values, motion.values) else table

@@ -5,8 +5,9 @@ An experiment file names a base scene, named variants of it, grid axes (gap,
 outputs to keep and the solver settings (docs/experiments.md, field by
 field). :func:`parse_experiment` checks every field and returns the
 *canonical definition*: a JSON-able dict with every default filled in and the
-base scene inlined. Its sha256 identifies the experiment: a store made from a
-different definition is refused. :class:`stochpound.experiment._grid.Experiment`
+base scene inlined. Its sha256, without the hazard that no run depends on
+(``stochpound.store.definition_sha256``), identifies the experiment: a store
+made from a different definition is refused. :class:`stochpound.experiment._grid.Experiment`
 is built from it.
 
 Errors raise :class:`ExperimentError` whose message starts with the field's
@@ -18,16 +19,14 @@ from __future__ import annotations
 import contextlib
 import copy
 import hashlib
-import json
 import math
 import re
 import tomllib
 from pathlib import Path
 from typing import Any, Iterator, Mapping
 
-from stochpound._errors import SceneError
-from stochpound.experiment._catalogue import TIME_HISTORIES
-from stochpound.experiment._definition import is_gap_axis, read_definition
+from stochpound._errors import ExperimentError, SceneError
+from stochpound._studies import parse_reproduces
 from stochpound.experiment._hazard import parse_hazard
 from stochpound.experiment._intensity import parse_intensity
 from stochpound.model import fields as toml_fields
@@ -35,7 +34,7 @@ from stochpound.model.contact import ELEMENT_KEYS
 from stochpound.model.scene_file import generator_fields
 from stochpound.solvers.simulate import METHODS
 from stochpound.solvers.ivp import INTEGRATORS
-from stochpound.studies import parse_reproduces
+from stochpound.store import TIME_HISTORIES, is_gap_axis, read_definition
 
 #: Format version of the canonical definition (stored with every store).
 FORMAT_VERSION = 1
@@ -61,13 +60,8 @@ _RESERVED_DIMS = {
     "start", "end", "duration", "peak_force", "peak_time", "impulse", "onset_velocity", "in_phase", "complete", "case_id",
 }
 
-#: Time-history variables of a result that an experiment can keep (declared in :mod:`stochpound.experiment._catalogue`).
+#: Time-history variables of a result that an experiment can keep (declared in ``stochpound.store._catalogue``).
 TIME_HISTORY_VARIABLES = tuple(TIME_HISTORIES)
-
-
-class ExperimentError(SceneError):
-    """An experiment definition or store is invalid; the message names the field
-    (e.g. ``grid.gap[1]: must be >= 0, got -0.01``) or the file."""
 
 
 @contextlib.contextmanager
@@ -117,26 +111,6 @@ def load_definition(path: str | Path) -> tuple[dict[str, Any], str]:
     except tomllib.TOMLDecodeError as error:
         raise ExperimentError(f"{path}: not valid TOML: {error}") from None
     return parse_experiment(data, base_dir=path.parent, default_name=path.stem), text
-
-
-def definition_sha256(definition: Mapping[str, Any]) -> str:
-    """sha256 of the canonical definition (sorted-key JSON): the experiment's identity."""
-    return hashlib.sha256(canonical_json(definition).encode()).hexdigest()
-
-
-def canonical_json(value: Any) -> str:
-    """Deterministic JSON (sorted keys, inf as the string "inf")."""
-    return json.dumps(_jsonable(value), sort_keys=True, separators=(",", ":"))
-
-
-def _jsonable(value: Any) -> Any:
-    if isinstance(value, float) and math.isinf(value):
-        return "inf" if value > 0 else "-inf"
-    if isinstance(value, Mapping):
-        return {str(k): _jsonable(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_jsonable(v) for v in value]
-    return value
 
 
 def parse_experiment(data: Mapping[str, Any], base_dir: str | Path = ".", default_name: str = "experiment") -> dict[str, Any]:

@@ -9,12 +9,12 @@ from typing import Iterator
 
 import numpy as np
 
-from stochpound.experiment._definition import read_definition
+from stochpound.store import open_store
 from stochpound.experiment._grid import KINDS, Case, Experiment
 from stochpound.experiment._parts import DEFINITION_FILE, FolderLock, parts_folder
 from stochpound.experiment._session import StoreSession
 from stochpound.experiment._spec import ExperimentError
-from stochpound.experiment._store import PREFIX, open_store
+from stochpound.experiment._store import PREFIX
 
 
 @dataclass
@@ -101,7 +101,7 @@ def _from_file(store: Path) -> StatusReport:
     """Status from the store file alone (its parts folder was removed)."""
     dataset = open_store(store)
     try:
-        experiment = Experiment(read_definition(dataset), str(dataset.attrs.get("experiment_text", "")))
+        experiment = Experiment(dataset.pound.definition, str(dataset.attrs.get("experiment_text", "")))
         done = {kind: dataset[f"{PREFIX[kind]}_status"].values == 1 for kind in KINDS}
     except (KeyError, ValueError) as error:
         raise ExperimentError(f"{store}: not a stochpound experiment store ({error})") from None

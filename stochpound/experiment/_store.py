@@ -32,11 +32,9 @@ from typing import Any, Iterator, Mapping
 import numpy as np
 import xarray as xr
 
-from stochpound.analysis._gap_axes import SETS
+from stochpound.store import CASE_SUMMARIES, IMPACT_TABLE, REFERENCE_HISTORY, REFERENCE_SUMMARIES, SETS, StoreVariable, TIME_HISTORIES, WALL_SUMMARIES, canonical_json
 from stochpound.experiment import _intensity as intensity
 from stochpound.experiment._grid import CASE, REFERENCE, Dim, Experiment
-from stochpound.experiment._spec import ExperimentError, canonical_json
-from stochpound.experiment._catalogue import CASE_SUMMARIES, IMPACT_TABLE, WALL_SUMMARIES, REFERENCE_HISTORY, REFERENCE_SUMMARIES, TIME_HISTORIES, StoreVariable
 from stochpound.experiment._summary import DEMAND_SUMMARIES
 from stochpound.model.scene_file import scene_from_dict
 from stochpound.motions.records._suites import METADATA_FIELDS
@@ -327,42 +325,3 @@ def _store_dtype(dtype: np.dtype) -> np.dtype:
     if np.issubdtype(dtype, np.integer):
         return np.dtype(np.int64)
     return np.dtype(np.float64)
-
-
-def open_store(path: str | Path, chunks: Any = None) -> xr.Dataset:
-    """Open an experiment store lazily (dask-chunked).
-
-    Parameters
-    ----------
-    path : str or Path
-        The store file written by ``stochpound experiment run``.
-    chunks : optional
-        Dask chunks (default ``{}``: the file's own chunking, blocks of
-        consecutive realizations).
-
-    Returns
-    -------
-    xarray.Dataset
-        Summaries on the grid's dimensions, time histories, the impact table
-        and the provenance attributes, loaded when computed; only the impact
-        table's string coordinates (``impact_case_id`` and the string labels
-        of the grid's dimensions) are read on opening, as xarray decodes
-        variable-length strings eagerly (0.2–0.3 KB per impact row).
-
-    Raises
-    ------
-    ExperimentError
-        If the file is missing or not an experiment store.
-    """
-    path = Path(path)
-    if not path.is_file():
-        raise ExperimentError(f"{path}: store not found")
-    try:
-        dataset = xr.open_dataset(path, engine="h5netcdf", chunks={} if chunks is None else chunks)
-    except (OSError, ValueError) as error:
-        raise ExperimentError(f"{path}: not a readable netCDF4/HDF5 file ({error})") from None
-    if "definition_sha256" not in dataset.attrs:
-        dataset.close()
-        raise ExperimentError(f"{path}: not a stochpound experiment store (no definition_sha256 attribute)")
-    return dataset
-

@@ -9,8 +9,9 @@ other cases' into a part, :mod:`stochpound.experiment._parts`):
 * ``t:<name>``: kept time histories (at the motion's samples);
 * ``i:<name>``: the impact table's columns.
 
-The store's units and long names are declared in
-:mod:`stochpound.experiment._catalogue`; the tests hold them against a real run.
+The store's units and long names are declared once, in the store's
+catalogue (``stochpound.store.CATALOGUE``), and the summaries take theirs
+from it; the tests hold the catalogue's names and dimensions against a real run.
 
 :func:`case_summary` and :func:`reference_summary` give the summaries as
 xarray datasets (their metadata names and describes the store's variables);
@@ -33,7 +34,7 @@ from stochpound.analysis import kernels, peak_response
 from stochpound.analysis.names import RESPONSE_MOMENTS, without_aliases
 from stochpound.analysis._separation_rules import STORE_NAMES, contact_demands
 from stochpound.analysis._summary import response_moments, run_summary, top_floor_total_displacement
-from stochpound.experiment._catalogue import IMPACT_TABLE, WALL_SUMMARIES
+from stochpound.store import CATALOGUE, IMPACT_TABLE, WALL_SUMMARIES
 
 _MOMENTS = tuple(RESPONSE_MOMENTS.values())
 _PEAKS = ("peak_total_displacement", "peak_relative_displacement", "peak_sliding_displacement", "residual_sliding")
@@ -45,9 +46,9 @@ DEMAND_SUMMARIES = {
     "peak_interstorey_drift": ("peak_storey_drift", "largest peak storey drift over the building's storeys"),
     "peak_base_shear": ("peak_base_shear", "largest absolute base shear over the run"),
 }
-#: The wall summaries (:data:`stochpound.experiment._catalogue.WALL_SUMMARIES`): every case computes them (NaN without walls); a store keeps them when its scene has walls.
+#: The wall summaries (``stochpound.store.WALL_SUMMARIES``): every case computes them (NaN without walls); a store keeps them when its scene has walls.
 WALL_PENETRATION, WALL_CLOSURE = WALL_SUMMARIES
-#: Columns of the impact table a store keeps (:data:`stochpound.experiment._catalogue.IMPACT_TABLE`).
+#: Columns of the impact table a store keeps (``stochpound.store.IMPACT_TABLE``).
 IMPACT_COLUMNS = tuple(v.name for v in IMPACT_TABLE)
 
 
@@ -74,16 +75,19 @@ def case_summary(run: xr.Dataset, studied: str, fixed_base: xr.DataArray) -> xr.
     """
     summary = without_aliases(run_summary(run, studied, fixed_base)).drop_vars(list(_PEAKS))
     summary = xr.merge([summary, peak_response(run)])
-    _describe_moments(summary, "")
-    summary["fixed_base_correlation"].attrs["long_name"] = (
-        "correlation of the studied building's top-floor total displacement with the same building alone on a fixed base"
-    )
-    summary["events_total"] = xr.DataArray(np.int64(run.attrs.get("events_total", 0)), attrs={"units": "1", "long_name": "events located by the solver"})
+    summary["events_total"] = xr.DataArray(np.int64(run.attrs.get("events_total", 0)))
     summary = summary.merge(_contact_summary(run))
     if "peak_total_acceleration" in run:
         summary = summary.merge(_demand_summary(run))
-    summary[WALL_PENETRATION.name] = xr.DataArray(_wall_penetration(run), attrs=WALL_PENETRATION.attrs)
-    summary[WALL_CLOSURE.name] = xr.DataArray(_wall_closure(run), attrs=WALL_CLOSURE.attrs)
+    summary[WALL_PENETRATION.name] = xr.DataArray(_wall_penetration(run))
+    summary[WALL_CLOSURE.name] = xr.DataArray(_wall_closure(run))
+    return _catalogued(summary)
+
+
+def _catalogued(summary: xr.Dataset) -> xr.Dataset:
+    """``summary`` with each variable's ``units`` and ``long_name`` those of the store's catalogue (``stochpound.store.CATALOGUE``)."""
+    for name, variable in summary.data_vars.items():
+        variable.attrs.update(CATALOGUE[name].attrs)
     return summary
 
 
@@ -106,17 +110,7 @@ def reference_summary(run: xr.Dataset, studied: str) -> xr.Dataset:
     """Summaries of the fixed-base reference run (``reference_*``, no building dimension)."""
     peaks = peak_response(run)[["peak_total_displacement", "peak_relative_displacement"]].sel(building=studied, drop=True)
     summary = xr.merge([response_moments(top_floor_total_displacement(run, studied)), peaks])
-    _describe_moments(summary, "")
-    renamed = summary[list(REFERENCE_SUMMARIES)].rename({name: f"reference_{name}" for name in REFERENCE_SUMMARIES})
-    for variable in renamed.data_vars.values():
-        variable.attrs["long_name"] = f"{variable.attrs['long_name']} (studied building alone on a fixed base)"
-    return renamed
-
-
-def _describe_moments(summary: xr.Dataset, suffix: str) -> None:
-    for name in _MOMENTS:
-        summary[name].attrs["long_name"] = f"{summary[name].attrs['long_name']} of the studied building's top-floor total displacement{suffix}"
-    summary["response_variance"].attrs["units"] = "m2"  # CF spelling of (m)2
+    return _catalogued(summary[list(REFERENCE_SUMMARIES)].rename({name: f"reference_{name}" for name in REFERENCE_SUMMARIES}))
 
 
 def top_floor(run: xr.Dataset, studied: str) -> np.ndarray:

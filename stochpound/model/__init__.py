@@ -2,7 +2,8 @@
 
 One module per concept: :mod:`~stochpound.model.building` (shear buildings),
 :mod:`~stochpound.model.friction` (sliding bases), :mod:`~stochpound.model.contact`
-(impact elements), :mod:`~stochpound.model.scene` and
+(impact elements), :mod:`~stochpound.model.laws` (the law registry: the contract
+and one module per contact or friction law), :mod:`~stochpound.model.scene` and
 :mod:`~stochpound.model.scene_file` (a scene and its TOML file),
 :mod:`~stochpound.model.system` (global matrices), :mod:`~stochpound.model.modes`
 (the linear modes of the hybrid system and their guards),
@@ -12,6 +13,9 @@ One module per concept: :mod:`~stochpound.model.building` (shear buildings),
 :func:`design_yield_shears` (a code-designed building's yield shears).
 """
 
+import importlib
+import sys
+
 from stochpound.model._design import design_yield_shears
 from stochpound.model.building import Building, InitialState
 from stochpound.model.contact import Contact, ImpactElement
@@ -20,3 +24,9 @@ from stochpound.model.scene import Scene
 from stochpound.model.wall import Wall
 
 __all__ = ["Scene", "Building", "InitialState", "Base", "Contact", "Wall", "ImpactElement", "design_yield_shears"]
+
+_MOVED_LAWS = {"law": "contract", **{name: name for name in ("kelvin", "hertz", "hertz_damp_ye", "hertz_damp_exact", "jankowski", "coulomb",
+                                                             "velocity_friction")}}
+"""The law modules' paths before they moved into :mod:`stochpound.model.laws` (old name: new name): each old path is the same module."""
+for _old, _new in _MOVED_LAWS.items():
+    sys.modules[f"{__name__}.{_old}"] = importlib.import_module(f"{__name__}.laws.{_new}")

@@ -10,7 +10,7 @@ takes them).
 With the penetration δ = y_left − y_right − d (d the gap), the element's
 force F pushes the left floor left and the right floor right while closed;
 m_eff = m₁m₂/(m₁ + m₂) of the two floor masses. A law that is piecewise
-linear (the Kelvin–Voigt element, :mod:`stochpound.model.kelvin`: F = k δ + c δ̇)
+linear (the Kelvin–Voigt element, :mod:`stochpound.model.laws.kelvin`: F = k δ + c δ̇)
 adds to a mode in which the contact is closed h k gᵀ to the stiffness,
 h c gᵀ to the damping and h k d to the constant load, where δ = g·q − d and
 the generalised load of F is −F h (h = g without base entries in the
@@ -31,7 +31,7 @@ from stochpound._errors import SceneError
 from stochpound.model import fields, laws
 from stochpound.model.building import Building
 from stochpound.model.guards import Guard
-from stochpound.model.law import ElementParameters
+from stochpound.model.laws.contract import ElementParameters
 
 ELEMENT_KEYS = {"law"}.union(*(law.keys for law in laws.CONTACT_LAWS.values()))
 """The keys of the impact element itself, in a ``[[contact]]`` or a ``[[wall]]`` table (each law takes some of them)."""

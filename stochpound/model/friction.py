@@ -1,7 +1,8 @@
-"""Coulomb friction of a sliding base (the reference study's isolator), flat or a friction pendulum.
+"""A sliding base (the reference study's isolator), flat or a friction pendulum: its states and guards.
 
-Scene keys (``[building.base]``): ``mass`` (kg), ``mu`` (kinetic coefficient),
-``mu_static`` (≥ mu, default mu), and either ``restoring_stiffness`` (N/m)
+Scene keys (``[building.base]``): ``mass`` (kg), the friction law's ``mu``
+and ``mu_static``, read by the law (:mod:`stochpound.model.laws`: Coulomb for
+a number, velocity-dependent for a table), and either ``restoring_stiffness`` (N/m)
 or ``radius`` (m: a friction pendulum of radius R, whose restoring stiffness
 is k_r = W/R, so that the isolated rigid mass swings with period
 2π √(R/g)). A building without the table stands on a fixed base.
@@ -33,8 +34,9 @@ from typing import Any, Mapping
 import numpy as np
 
 from stochpound._errors import SceneError
-from stochpound.model import coulomb, fields, laws, velocity_friction
+from stochpound.model import fields, laws
 from stochpound.model.guards import Guard
+from stochpound.model.laws import coulomb, velocity_friction
 
 STUCK = 0
 """Base state: stuck to its foundation."""
@@ -74,7 +76,7 @@ class Base:
     radius : float or None
         Radius R of a friction pendulum, m: k_r = W/R (see :meth:`restoring`).
     mu_fast, mu_rate : float or None
-        Velocity-dependent friction (:mod:`stochpound.model.velocity_friction`):
+        Velocity-dependent friction (:mod:`stochpound.model.laws.velocity_friction`):
         the coefficient at high velocity and the rate a (s/m); ``mu`` is then
         the coefficient at vanishing velocity. None: Coulomb friction.
     """
@@ -127,12 +129,7 @@ def base_from_table(table: Mapping[str, Any] | None, prefix: str) -> Base | None
         return None
     fields.reject_unknown(table, BASE_KEYS, prefix)
     mass = fields.number(table, "mass", prefix, required=True, low=0.0, low_open=True)
-    mu_fast = mu_rate = None
-    if isinstance(table.get("mu"), dict):
-        mu, mu_fast, mu_rate = velocity_friction.mu_from_table(table["mu"], f"{prefix}.mu")
-    else:
-        mu = fields.number(table, "mu", prefix, required=True, low=0.0)
-    mu_static = fields.number(table, "mu_static", prefix, default=mu, low=mu)
+    mu, mu_static, mu_fast, mu_rate = laws.base_friction_law(table).read(table, prefix)
     if "radius" in table and "restoring_stiffness" in table:
         raise SceneError(f"{prefix}.radius: give either radius (a friction pendulum, k_r = W/R) or restoring_stiffness, not both")
     restoring = fields.number(table, "restoring_stiffness", prefix, default=0.0, low=0.0)

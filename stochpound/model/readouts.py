@@ -20,7 +20,7 @@ from __future__ import annotations
 import numpy as np
 
 from stochpound.model import friction, laws
-from stochpound.model.law import ElementParameters
+from stochpound.model.laws.contract import ElementParameters
 from stochpound.model.modes import Mode, ModeDynamics
 from stochpound.model.system import System
 

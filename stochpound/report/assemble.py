@@ -18,12 +18,11 @@ from pathlib import Path
 
 import xarray as xr
 
-from stochpound.experiment._definition import read_definition
-from stochpound.experiment._selections import has_contact_free, has_wall_free, with_contacts, with_walls
+from stochpound.store import has_contact_free, has_wall_free, with_contacts, with_walls
 from stochpound.report.render._document import Paragraph, Report, Section
 from stochpound.report.sections._ensembles import INTERVAL_NOTE
 from stochpound.report.sections._generic import store_section
-from stochpound.report.sections._intensity import intensity_section, intensity_setting
+from stochpound.report.sections._intensity import intensity_section
 from stochpound.report.sections._laws import law_axis, laws_section
 from stochpound.report.sections._methods import methods_section
 from stochpound.report.sections._risk import has_risk, risk_section
@@ -50,7 +49,7 @@ def assemble_report(paths: Sequence[str | Path], progress: Callable[[str], None]
     say = progress or (lambda message: None)
     say("reading stores")
     stores = open_stores(paths)
-    claimed = claims({name: read_definition(store).reproduces for name, store in stores.items()})
+    claimed = claims({name: store.pound.definition.reproduces for name, store in stores.items()})
     studied = {name for parts in claimed.values() for name in parts.values()}
     others = {name: store for name, store in stores.items() if name not in studied}
     studies = {key: load_study(key) for key in claimed}
@@ -87,7 +86,7 @@ def assemble_report(paths: Sequence[str | Path], progress: Callable[[str], None]
         if contact_free and not has_risk(store):  # with a hazard, the Risk section gives the separation at every intensity
             say(f"experiment {name}: separation")
             report.sections.append(separation_section(name, store))
-        if intensity_setting(store) is not None:
+        if store.pound.intensity is not None:
             say(f"experiment {name}: intensity")
             report.sections.append(intensity_section(name, store))
     say("methods")

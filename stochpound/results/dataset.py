@@ -1,7 +1,9 @@
 """The result of one simulation as an :class:`xarray.Dataset` (the names of docs/scene-files.md).
 
 Outputs are given at the motion's sample times, t = 0 included. Every
-variable carries ``units`` and ``long_name`` (CF conventions).
+variable carries ``units`` and ``long_name`` (CF conventions); those of the
+time histories a store can keep are the store's catalogue's
+(``stochpound.store.TIME_HISTORIES``), declared once there.
 """
 
 from __future__ import annotations
@@ -17,17 +19,16 @@ from stochpound import __version__
 from stochpound._atomic import replacing
 from stochpound.results.record import ENERGY_TERMS, EventCounters, Recorder
 from stochpound.model.contact import ImpactElement
-from stochpound.model import yielding
-from stochpound.model.friction import FIXED_BASE
+from stochpound.model import laws, yielding
 from stochpound.model.scene import Scene
 from stochpound.model.system import System
+from stochpound.store import TIME_HISTORIES
 
-_ENERGY_NAMES = {
-    "input": "work of the ground-acceleration load (relative-motion input energy)",
-    "damping": "energy dissipated by the storey dashpots",
-    "friction": "energy dissipated by base friction",
-    "impact": "work absorbed by the impact elements (dissipated, plus stored while closed)",
-}
+
+def _history(name: str, data: np.ndarray, **attrs: Any) -> tuple:
+    """A time history of the store's catalogue: its dimensions then ``time``, its ``units`` and ``long_name``."""
+    variable = TIME_HISTORIES[name]
+    return (*variable.dims, "time"), data, {**variable.attrs, **attrs}
 
 
 def _var(dims: tuple[str, ...], data: np.ndarray, units: str, long_name: str, **attrs: Any) -> tuple:
@@ -98,17 +99,14 @@ def _response_variables(scene: Scene, system: System, recorder: Recorder) -> dic
     """Displacements, ground acceleration, contact and friction forces and base states at the samples."""
     relative, sliding = recorder.displacements()
     return {
-        "total_displacement": _var(("building", "floor", "time"), relative + sliding[:, None, :], "m",
-                                   "floor displacement relative to the ground (y = s + u)"),
-        "relative_displacement": _var(("building", "floor", "time"), relative, "m", "floor displacement relative to the building's base (u)"),
-        "sliding_displacement": _var(("building", "time"), sliding, "m", "sliding displacement of the base relative to the ground (s)"),
-        "ground_acceleration": _var(("time",), np.asarray(scene.motion.at_times(), float), "m s-2", "ground acceleration a_g"),
-        "impact_force": _var(("contact", "time"), recorder.forces[:, : system.n_contacts].T, "N", "contact force, positive in compression (0 while open)"),
-        "base_friction_force": _var(
-            ("building", "time"), recorder.by_building(recorder.friction), "N", "force of the foundation on the base, positive to the right (0 for a fixed base)"
-        ),
-        "base_state": _var(
-            ("building", "time"), recorder.by_building(recorder.base_states), "1", "base state",
+        "total_displacement": _history("total_displacement", relative + sliding[:, None, :]),
+        "relative_displacement": _history("relative_displacement", relative),
+        "sliding_displacement": _history("sliding_displacement", sliding),
+        "ground_acceleration": _history("ground_acceleration", np.asarray(scene.motion.at_times(), float)),
+        "impact_force": _history("impact_force", recorder.forces[:, : system.n_contacts].T),
+        "base_friction_force": _history("base_friction_force", recorder.by_building(recorder.friction)),
+        "base_state": _history(
+            "base_state", recorder.by_building(recorder.base_states),
             flag_values=np.array([-1, 0, 1], dtype=np.int8), flag_meanings="slipping_left stuck_or_fixed slipping_right",
         ),
     }
@@ -238,22 +236,20 @@ def scene_parameters(scene: Scene) -> dict[str, tuple]:
 
 
 def _base_variables(scene: Scene) -> dict[str, tuple]:
-    """Each building's base as run: its friction law's parameters (μ = ∞, :data:`~stochpound.model.friction.FIXED_BASE`, for a fixed base)."""
+    """Each building's base as run: its friction law's parameters (:data:`~stochpound.model.laws.FRICTION_VARIABLES`; μ = ∞ for a fixed base), its mass and restoring force."""
     bases = [b.base for b in scene.buildings]
 
     def column(field: str, fixed: float = np.nan) -> np.ndarray:
         return np.array([fixed if base is None else np.nan if getattr(base, field) is None else getattr(base, field) for base in bases], float)
 
     restoring = [np.nan if b.base is None else b.base.restoring(scene.g * (b.base.mass + sum(b.mass))) for b in scene.buildings]
+    friction = {v.name: _var(("building",), column(v.field, v.missing), v.units, v.long_name) for v in laws.FRICTION_VARIABLES}
     return {
-        "base_mu": _var(("building",), column("mu", FIXED_BASE), "1", "kinetic friction coefficient of the base (inf: a fixed base)"),
-        "base_mu_static": _var(("building",), column("mu_static", FIXED_BASE), "1", "static friction coefficient of the base (inf: a fixed base)"),
+        **friction,
         "base_mass": _var(("building",), column("mass"), "kg", "base mass (nan: a fixed base)"),
         "base_restoring_stiffness": _var(("building",), np.array(restoring, float), "N m-1",
                                          "restoring stiffness of the base (W/R for a friction pendulum; nan: a fixed base)"),
         "base_radius": _var(("building",), column("radius"), "m", "radius of the friction pendulum (nan: a flat slider or a fixed base)"),
-        "base_mu_fast": _var(("building",), column("mu_fast"), "1", "friction coefficient at high sliding velocity (nan: Coulomb friction)"),
-        "base_mu_rate": _var(("building",), column("mu_rate"), "s m-1", "rate of the velocity-dependent friction (nan: Coulomb friction)"),
     }
 
 
@@ -310,16 +306,16 @@ def _impact_variables(recorder: Recorder, n_contacts: int, walls: bool) -> dict[
 def _energy_variables(recorder: Recorder) -> dict[str, tuple]:
     kinetic, strain = recorder.kinetic_and_strain()
     energy = recorder.energy
-    variables = {f"energy_{term}": _var(("time",), energy[term], "J", _ENERGY_NAMES[term]) for term in ENERGY_TERMS}
-    variables["energy_kinetic"] = _var(("time",), kinetic, "J", "kinetic energy of the motion relative to the ground")
-    variables["energy_strain"] = _var(("time",), strain, "J", "strain energy of storeys and base restoring springs")
+    variables = {f"energy_{term}": _history(f"energy_{term}", energy[term]) for term in ENERGY_TERMS}
+    variables["energy_kinetic"] = _history("energy_kinetic", kinetic)
+    variables["energy_strain"] = _history("energy_strain", strain)
     residual = energy["input"] - (kinetic - kinetic[0]) - (strain - strain[0]) - energy["damping"] - energy["friction"] - energy["impact"]
     if recorder.system.storeys:
         storeys = recorder.system.storeys
         hysteretic = np.array([storey.plastic_strength for storey in storeys]) @ recorder.plastic_drifts()[1]
         variables["energy_hysteretic"] = _var(("time",), hysteretic, "J", "energy dissipated by the yielding storeys ((1 - alpha) F_y times the accumulated plastic drift)")
         residual = residual - hysteretic
-    variables["energy_residual"] = _var(("time",), residual, "J", "input minus every other term (0 for an exact solution)")
+    variables["energy_residual"] = _history("energy_residual", residual)
     return variables
 
 

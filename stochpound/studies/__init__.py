@@ -23,10 +23,10 @@ from __future__ import annotations
 
 import importlib
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, Protocol
+from typing import TYPE_CHECKING, Protocol
 
 from stochpound._errors import StochpoundError
+from stochpound._studies import STUDIES, Study, parse_reproduces
 
 if TYPE_CHECKING:
     import xarray as xr
@@ -34,33 +34,6 @@ if TYPE_CHECKING:
     from stochpound.report.render._document import Block, Section
 
 __all__ = ["STUDIES", "Study", "StudyReport", "claims", "parse_reproduces", "load_study"]
-
-
-@dataclass(frozen=True)
-class Study:
-    """A published study that experiments reproduce.
-
-    Attributes
-    ----------
-    key : str
-        Its id, the package name under ``stochpound.studies`` and the part
-        of ``reproduces`` before the colon (the package's docstring cites the publication).
-    parts : tuple of str
-        The parts an experiment may reproduce (after the colon), one store each.
-    """
-
-    key: str
-    parts: tuple[str, ...]
-
-
-STUDIES: dict[str, Study] = {
-    study.key: study
-    for study in (
-        # V. K. Agarwal, "Pounding and impact of base isolated buildings due to earthquakes", M.S. thesis, Texas A&M University, 2004
-        Study("agarwal2004", ("harmonic", "gap", "single", "pair_mu", "pair_records")),
-    )
-}
-"""The registered studies, by key."""
 
 
 class StudyReport(Protocol):
@@ -73,34 +46,6 @@ class StudyReport(Protocol):
 
     def summary(self, sections: list[Section]) -> Section | None:
         """The summary that opens the report, given its sections; None: no summary."""
-
-
-def _allowed() -> str:
-    return ", ".join(f"{study.key}:{part}" for study in STUDIES.values() for part in study.parts)
-
-
-def parse_reproduces(value: Any) -> tuple[str, str]:
-    """The (study, part) of a ``reproduces`` declaration.
-
-    Parameters
-    ----------
-    value : str
-        ``"<study>:<part>"``, a registered study (:data:`STUDIES`) and one of its parts.
-
-    Returns
-    -------
-    tuple of str
-        The study's key and the part.
-
-    Raises
-    ------
-    ValueError
-        If the value is not one of the registered studies' parts (the message lists them).
-    """
-    study, _, part = value.partition(":") if isinstance(value, str) else ("", "", "")
-    if study not in STUDIES or part not in STUDIES[study].parts:
-        raise ValueError(f"must be one of {_allowed()}, got {value!r}")
-    return study, part
 
 
 def claims(declared: Mapping[str, str | None]) -> dict[str, dict[str, str]]:

@@ -23,11 +23,10 @@ import xarray as xr
 
 import stochpound
 from stochpound.model import laws
-from stochpound.experiment._definition import read_definition
 from stochpound.model.modal_solution import harmonic_response, modal_properties
 from stochpound.report.sections._description import StoreDefinition, number
 from stochpound.report.render._document import Paragraph
-from stochpound.report.sections._stores import case_scene, select
+from stochpound.report.sections._stores import select
 from stochpound.model.scene import Building, Contact, Scene
 
 #: Closing velocity of the single-collision check, m/s.
@@ -145,10 +144,10 @@ class HarmonicComparison:
 def harmonic_comparisons(store: xr.Dataset) -> list[HarmonicComparison]:
     """A store's harmonic motions (``[[motions]]`` of type harmonic) beside the closed-form modal solution."""
     comparisons = []
-    for motion in read_definition(store).motions:
+    for motion in store.pound.definition.motions:
         if motion.motion.get("type") != "harmonic":
             continue
-        building = case_scene(store, record=motion.label).buildings[0]
+        building = store.pound.scene(record=motion.label).buildings[0]
         run = select(store, record=motion.label)
         computed = run["relative_displacement"].sel(building=building.name).values
         valid = np.isfinite(computed[0])
@@ -187,7 +186,7 @@ def cross_check(definitions: list[StoreDefinition]) -> Paragraph | None:
         return None
     definition, (labels, _) = next((c for c in candidates if c[1][1]), candidates[0])
     name, store = definition.name, definition.store
-    scene: Scene = case_scene(store, **labels)
+    scene: Scene = store.pound.scene(**labels)
     nonlinear = scene.nonlinear_laws()
     exact = stochpound.simulate(scene)  # the solver the store used: exact, or the integrator at its defaults for a nonlinear law
     reference = stochpound.simulate(scene, method="ivp", integrator="DOP853", rtol=REFERENCE_RTOL, atol=REFERENCE_ATOL)

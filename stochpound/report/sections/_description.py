@@ -1,8 +1,9 @@
 """What the stores ran, from their own definitions: buildings, bases, contacts, motions, grids.
 
 Every store keeps its experiment's canonical definition (``definition``, JSON).
-This module rebuilds the scenes of each configuration of the grid from it
-(:class:`stochpound.experiment.Experiment`) and describes them: nothing
+This module reads the scenes of each configuration of the grid from it
+(``ds.pound.grid``, the :class:`stochpound.experiment.Experiment` of the
+store) and describes them: nothing
 here is fixed text, and a value appears only if a store ran it. Several
 stores that ran the same building or contact share one row.
 """
@@ -21,15 +22,13 @@ import xarray as xr
 
 from stochpound import motions as synthetic_motions
 from stochpound.experiment import Case
-from stochpound.experiment._definition import GapAxis, is_fixed_base
-from stochpound.experiment._intensity import describe_measure
+from stochpound.store import GapAxis, describe_measure, is_fixed_base
 from stochpound.experiment._grid import CASE
 from stochpound.model import laws
 from stochpound.model.contact import effective_mass
 from stochpound.model.modal_solution import modal_properties
 from stochpound.motions.records import load_record, registry_entries
 from stochpound.report.render._document import Paragraph, Table
-from stochpound.report.sections._stores import store_experiment
 from stochpound.model.scene import Building, Contact, Scene
 from stochpound.model.wall import Wall
 from stochpound.model.scene_file import scene_from_dict
@@ -87,7 +86,7 @@ class StoreDefinition:
     def __init__(self, name: str, store: xr.Dataset) -> None:
         self.name = name
         self.store = store
-        self.experiment = store_experiment(store)
+        self.experiment = store.pound.grid
         self.definition = self.experiment.contract
 
     @cached_property

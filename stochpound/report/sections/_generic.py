@@ -22,8 +22,7 @@ from stochpound.report.render._document import Block, FigureItem, Paragraph, Sec
 from stochpound.report.sections._ensemble_findings import compare_ensembles, ensemble_findings, isolation_across
 from stochpound.report.sections._ensembles import Ensemble
 from stochpound.report.sections._mechanism_findings import mechanism_findings
-from stochpound.experiment._definition import is_gap_axis
-from stochpound.experiment._selections import wall_gap_dims
+from stochpound.store import is_gap_axis, wall_gap_dims
 from stochpound.report.sections._facets import dim_text, labels_text, layouts, line_colours, plain, value_text, cell_gid
 
 CM = 100.0

@@ -25,22 +25,21 @@ import xarray as xr
 from matplotlib.figure import Figure
 
 from stochpound.analysis.kernels import clopper_pearson
-from stochpound.experiment._intensity import describe_measure
+from stochpound.store import Intensity, describe_measure, is_gap_axis
 from stochpound.report.render._document import FigureItem, Paragraph, Section, Table
-from stochpound.experiment._definition import is_gap_axis, read_definition
 
 CONFIDENCE = 0.95
 G = 9.81
 
 
-def intensity_setting(store: xr.Dataset) -> dict[str, Any] | None:
-    """The definition's ``intensity`` entry of a store (None if it has none)."""
-    return read_definition(store).intensity
+def intensity_setting(store: xr.Dataset) -> Intensity | None:
+    """A store's intensity setting (``store.pound.intensity``), or None; kept for the risk chain's move to ``stochpound.risk``."""
+    return store.pound.intensity
 
 
 def intensity_section(name: str, store: xr.Dataset) -> Section:
-    """The "Intensity" section of one store (call when :func:`intensity_setting` is not None)."""
-    setting = intensity_setting(store)
+    """The "Intensity" section of one store (call when ``store.pound.intensity`` is not None)."""
+    setting = store.pound.intensity
     section = Section(f"Intensity: experiment {name}", key=f"intensity-{name}")
     section.add(Paragraph(method_text(store, setting)))
     section.add(_spectra(name, store, setting))

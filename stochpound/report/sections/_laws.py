@@ -29,7 +29,7 @@ import xarray as xr
 
 from stochpound.analysis import mean_interval, pounding_probability
 from stochpound.analysis._intervals import MIN_RUNS
-from stochpound.experiment._definition import is_gap_axis, read_definition
+from stochpound.store import is_gap_axis
 from stochpound.model import laws
 from stochpound.report.render import _figures as figures
 from stochpound.report.render._document import Block, FigureItem, Paragraph, Section
@@ -74,7 +74,7 @@ QUANTITIES = (
 
 def law_axis(store: xr.Dataset) -> str | None:
     """The variant axis whose values give the contacts different laws (from the stored definition), or None."""
-    definition = read_definition(store).to_dict()
+    definition = store.pound.definition.to_dict()
     for axis in definition.get("variants", []):
         named = variant_laws(definition, axis["name"]) if axis["name"] in store.dims else {}
         if len({named[plain(v)] for v in store[axis["name"]].values}) > 1:
@@ -100,7 +100,7 @@ def laws_section(name: str, store: xr.Dataset) -> Section:
     axis = law_axis(store)
     assert axis is not None
     section = Section(f"Contact laws compared: experiment {name}", key=f"laws-{name}")
-    definition = read_definition(store).to_dict()
+    definition = store.pound.definition.to_dict()
     named = variant_laws(definition, axis)
     overrides = next(v for v in definition["variants"] if v["name"] == axis)["overrides"]
     same_until_contact = (

@@ -27,8 +27,7 @@ import numpy as np
 import xarray as xr
 
 from stochpound.analysis.mechanisms import amplification, ratcheting
-from stochpound.experiment._definition import is_gap_axis, read_definition
-from stochpound.experiment._selections import contact_free, contact_gap_dims, has_contact_free, isolated_mus, wall_gap_dims, with_contacts
+from stochpound.store import contact_free, contact_gap_dims, has_contact_free, is_gap_axis, isolated_mus, wall_gap_dims, with_contacts
 from stochpound.report.render._document import Block, Paragraph
 from stochpound.report.sections._ensembles import CM, MIN_RUNS, Ensemble
 from stochpound.report.sections._facets import dim_text, labels_text, plain, value_text
@@ -161,7 +160,7 @@ def wall_axis(store: xr.Dataset) -> tuple[str, Any] | None:
         values = store[axis].values
         if np.isinf(values).any() and np.isfinite(values).any():
             return axis, float(np.inf)
-    definition = read_definition(store)
+    definition = store.pound.definition
     if definition.scene.get("wall"):
         return None
     for axis in definition.variants:
@@ -292,7 +291,7 @@ def penetration_text(ensemble: Ensemble, walls: str | None) -> str:
     """The largest penetration of the walls over the runs of ``ensemble`` (its cells with walls), and where, also per value of the
     axis ``walls`` that adds them or sets their clearance (if any): what a 'rigid' wall is here."""
     penetration = ensemble.sample("peak_wall_penetration")
-    definition = read_definition(ensemble.data)
+    definition = ensemble.data.pound.definition
     tables = list(definition.scene.get("wall", [])) + [w for axis in definition.variants for override in axis.overrides.values()
                                                        for w in override.get("scene", {}).get("wall", [])]
     stiffness = sorted({float(w["stiffness"]) for w in tables if "stiffness" in w})

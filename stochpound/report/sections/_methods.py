@@ -18,7 +18,7 @@ from stochpound.motions.records import registry_entries
 from stochpound.report.sections._accuracy import accuracy_paragraphs
 from stochpound.report.sections._description import StoreDefinition, buildings_table, contacts_table, grid_paragraph, model_paragraph, motions_table, records_used
 from stochpound.report.render._document import Paragraph, Section, Table
-from stochpound.report.sections._intensity import intensity_setting, method_text
+from stochpound.report.sections._intensity import method_text
 from stochpound.report.sections._risk import hazard_provenance
 
 #: Packages whose versions the report lists.
@@ -39,7 +39,7 @@ def methods_section(stores: Mapping[str, xr.Dataset]) -> Section:
     section.add(model_paragraph(definitions))
     for definition in definitions:
         section.add(grid_paragraph(definition))
-        setting = intensity_setting(definition.store)
+        setting = definition.store.pound.intensity
         if setting is not None:
             section.add(Paragraph(f"Experiment {definition.name}: {method_text(definition.store, setting)}"))
         hazard = hazard_provenance(definition.store)

@@ -33,14 +33,11 @@ from matplotlib.figure import Figure
 from stochpound.analysis import HazardCurve, demand_hazard_curve, fragility_band, fragility_surface, rate_from_probability
 from stochpound.analysis._fragility_ensemble import BOOTSTRAP
 from stochpound.analysis._risk import TARGETS
-from stochpound.analysis._gap_axes import contact_free, wall_free
+from stochpound.store import contact_free, describe_measure, wall_free
 from stochpound.analysis._store_risk import StoreRisk, base_displacement, store_motions, store_risk
-from stochpound.experiment._definition import read_definition
-from stochpound.experiment._hazard import stored_hazard, stored_hazard_entry
-from stochpound.experiment._intensity import describe_measure
+from stochpound.experiment._hazard import stored_hazard
 from stochpound.report.render._document import Block, FigureItem, Paragraph, Section, Table
 from stochpound.report.sections._facets import labels_text
-from stochpound.report.sections._intensity import intensity_setting
 from stochpound.report.sections._summary import RISK_ANSWERS
 
 CONFIDENCE = 0.95
@@ -67,12 +64,12 @@ _CACHE: dict[tuple[str, str, int], StoreRisk] = {}
 
 def has_risk(store: xr.Dataset) -> bool:
     """Whether a store gets a Risk section: intensity levels (stripes or IDA) and a stored hazard."""
-    return intensity_setting(store) is not None and stored_hazard(store) is not None and ("intensity" in store.dims or "ida_capacity" in store)
+    return store.pound.intensity is not None and store.pound.hazard is not None and ("intensity" in store.dims or "ida_capacity" in store)
 
 
 def hazard_provenance(store: xr.Dataset) -> str:
     """Where a store's hazard curve comes from, in a sentence ("" without one): its source, range and provenance lines."""
-    entry = stored_hazard_entry(store)
+    entry = store.pound.hazard
     if entry is None:
         return ""
     given = {"file": lambda: f"the file {entry['file']} (sha256 {entry['file_sha256']})", "bundled": lambda: f"the bundled curve {entry['bundled']}",
@@ -91,7 +88,7 @@ def risk_of(store: xr.Dataset, hz: HazardCurve | None = None, bootstrap: int = B
         raise ValueError("store: has no [hazard]; give a hazard curve")
     key = (str(store.attrs.get("definition_sha256", "")) + str(store.attrs.get("updated", "")), repr(hazard) + hazard.source, bootstrap)
     if key not in _CACHE:
-        _CACHE[key] = store_risk(store, hazard, TARGETS, YEARS, studied=store.attrs.get("studied_building"), confidence=CONFIDENCE,
+        _CACHE[key] = store_risk(store, hazard, TARGETS, YEARS, studied=store.pound.definition.studied, confidence=CONFIDENCE,
                                  bootstrap=bootstrap, seed=seed)
     return _CACHE[key]
 
@@ -187,7 +184,7 @@ def _gap_text(value: float) -> str:
 
 def headline_text(name: str, store: xr.Dataset, risk: StoreRisk) -> str:
     """The section's first paragraph: g* for each target, per configuration, with its interval and the number of motions."""
-    setting = intensity_setting(store)
+    setting = store.pound.intensity
     frame = risk_headline(risk)
     config = [c for c in frame.columns if c not in ("target", "separation", "lower", "upper", "confidence", "motions")]
     targets = " and ".join(_target_text(p) for p in risk.separation["target"].values)
@@ -219,7 +216,7 @@ RISK_ANSWERS.append(summary_answer)
 def risk_section(name: str, store: xr.Dataset) -> Section:
     """The "Risk" section of one store (call when :func:`has_risk` is true)."""
     risk = risk_of(store)
-    setting = intensity_setting(store)
+    setting = store.pound.intensity
     section = Section(f"Risk: experiment {name}", key=f"risk-{name}")
     section.add(Paragraph(headline_text(name, store, risk)))
     section.add(Paragraph(_hazard_text(risk.hazard, setting, risk.method)))
@@ -403,7 +400,7 @@ def _demand_blocks(name: str, store: xr.Dataset, risk: StoreRisk, setting: dict[
     if "intensity" not in store.dims:
         return []
     free = wall_free(contact_free(store))  # the runs without impacts: contacts open, walls never reached
-    studied = store.attrs.get("studied_building")
+    studied = store.pound.definition.studied
     demands: dict[str, tuple[xr.DataArray, str]] = {}
     sliding = base_displacement(free, studied)
     if sliding is not None:
@@ -447,7 +444,7 @@ def _demand_blocks(name: str, store: xr.Dataset, risk: StoreRisk, setting: dict[
 def _moat_clearances(store: xr.Dataset, studied: str | None) -> list[float]:
     """The distinct gaps of the walls at the studied building's base in the definition (its scene, with the values of a gap axis
     that sets a wall instead of its own gap, and its variants), finite ones only."""
-    definition = read_definition(store)
+    definition = store.pound.definition
     walls = [(w, axis.values if axis is not None else (w["gap"],)) for w, axis in
              ((w, definition.wall_gap_axis(index)) for index, w in enumerate(definition.scene.get("wall", [])))]
     for variant in definition.variants:

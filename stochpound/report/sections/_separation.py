@@ -36,7 +36,7 @@ from stochpound.report.render import _figures as figures
 from stochpound.report.render._document import Block, FigureItem, Paragraph, Section, Table
 from stochpound.report.sections._ensemble_findings import RARE, rare_gap
 from stochpound.report.sections._ensembles import Ensemble, line_label, lines, table_frame
-from stochpound.experiment._selections import contact_free, contact_gap_dims, isolated_mus, wall_free, wall_gap_dims, with_contacts, with_walls
+from stochpound.store import contact_free, contact_gap_dims, isolated_mus, wall_free, wall_gap_dims, with_contacts, with_walls
 from stochpound.report.sections._facets import dim_text, labels_text, value_text
 
 CM = 100.0
@@ -72,7 +72,7 @@ class Closure:
         The runs whose gaps never close ("contact-free", "wall-free").
     free_cases, finite_cases, axes : callable
         The store's runs at ``inf``, its runs at the finite values, and the gap axes concerned
-        (:mod:`stochpound.analysis._gap_axes`).
+        (``stochpound.store._gap_axes``).
     """
 
     kind: str
@@ -105,8 +105,8 @@ def closure_demand(data: xr.Dataset, closure: Closure) -> xr.DataArray:
 
 
 def separation_section(name: str, store: xr.Dataset, closure: Closure = CONTACTS) -> Section:
-    """The "Separation" section of one store (call when :func:`stochpound.experiment._selections.has_contact_free`, or with
-    :data:`WALLS` when :func:`~stochpound.experiment._selections.has_wall_free`)."""
+    """The "Separation" section of one store (call when :func:`stochpound.store.has_contact_free`, or with
+    :data:`WALLS` when :func:`~stochpound.store.has_wall_free`)."""
     free = closure.free_cases(store)
     title, key = (f"Moat clearance: experiment {name}", f"clearance-{name}") if closure.walls else (f"Separation: experiment {name}", f"separation-{name}")
     section = Section(title, key=key)

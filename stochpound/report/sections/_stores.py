@@ -1,4 +1,4 @@
-"""Reading experiment stores for a report: open them by experiment name, pick cases and their impacts."""
+"""Reading experiment stores for a report: open them by experiment name, pick cases (the rest through ``ds.pound``)."""
 
 from __future__ import annotations
 
@@ -6,14 +6,10 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-import numpy as np
 import xarray as xr
 
 from stochpound._errors import StochpoundError
-from stochpound.experiment import Experiment, open_store
-from stochpound.experiment._definition import read_definition
-from stochpound.model.scene import Scene
-from stochpound.model.scene_file import scene_from_dict
+from stochpound.store import open_store
 
 
 def open_stores(paths: Sequence[str | Path]) -> dict[str, xr.Dataset]:
@@ -75,55 +71,3 @@ def value(store: xr.Dataset | None, variable: str, scale: float = 1.0, **labels:
     if data.size != 1:
         raise StochpoundError(f"{variable} at {labels}: {data.size} values, expected one (give every dimension: {dict(data.sizes)})")
     return float(data.values.reshape(())) * scale
-
-
-def case_impacts(store: xr.Dataset, **labels: Any) -> xr.Dataset:
-    """The rows of the impact table that belong to one case.
-
-    Parameters
-    ----------
-    store : xarray.Dataset
-        An experiment store (impact table on dimension ``impact`` with
-        coordinates ``impact_<dim>``).
-    **labels
-        The case's label on each grid dimension.
-
-    Returns
-    -------
-    xarray.Dataset
-        The ``impact_*`` variables of that case.
-    """
-    table = store[[name for name in store.data_vars if name.startswith("impact_") and store[name].dims == ("impact",)]]
-    keep = np.ones(table.sizes["impact"], dtype=bool)
-    for dim, label in labels.items():
-        coordinate = f"impact_{dim}"
-        if coordinate in table.coords:
-            values = table[coordinate].values
-            keep &= np.isclose(values, label) if np.issubdtype(values.dtype, np.number) else values == label
-    return table.isel(impact=np.flatnonzero(keep)).load()
-
-
-def store_experiment(store: xr.Dataset) -> Experiment:
-    """The store's experiment, from its definition (:func:`~stochpound.experiment.read_definition`).
-
-    The grid's values are numbers again (μ = ∞ is a float), as when the
-    experiment file was read; case ids are unchanged.
-    """
-    return Experiment(read_definition(store))
-
-
-def case_scene(store: xr.Dataset, **labels: Any) -> Scene:
-    """The scene (structure and motion) of one stored case, rebuilt from the store's definition.
-
-    Parameters
-    ----------
-    store : xarray.Dataset
-        An experiment store.
-    **labels
-        The case's label on every grid dimension of the store.
-    """
-    experiment = store_experiment(store)
-    case = experiment.case_index[str(select(store, **labels)["case_id"].values)]
-    where = case.label_dict
-    return scene_from_dict({**experiment.structure(case), "motion": experiment.motion_table(where["record"], where.get("realization"))})
-

@@ -33,7 +33,7 @@ from stochpound.report.render._document import Block, Paragraph, Section, Table
 from stochpound.report.sections._ensembles import MIN_RUNS, Ensemble
 from stochpound.report.sections._facets import dim_text, labels_text, value_text
 from stochpound.report.sections._mechanism_findings import mechanism_answer
-from stochpound.experiment._selections import gap_dims, has_contact_free, has_wall_free, wall_gap_dims, with_contacts, with_walls
+from stochpound.store import gap_dims, has_contact_free, has_wall_free, wall_gap_dims, with_contacts, with_walls
 from stochpound.report.sections._separation import CONTACTS, WALLS, Closure, SeparationEnsemble, span, span_cm
 
 CM = 100.0

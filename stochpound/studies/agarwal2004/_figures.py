@@ -10,13 +10,12 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
-from stochpound.experiment._definition import FIXED_BASE, is_fixed_base
-from stochpound.experiment._selections import isolated_mus
+from stochpound.store import FIXED_BASE, is_fixed_base, isolated_mus
 from stochpound.motions.records import load_record
 from stochpound.report.render import _figures as figures
 from stochpound.report.render._document import FigureItem
 from stochpound.report.sections._accuracy import harmonic_comparisons
-from stochpound.report.sections._stores import case_impacts, select
+from stochpound.report.sections._stores import select
 from stochpound.studies.agarwal2004._tables import RECORD_ENTRIES, record_label
 
 CM = 100.0
@@ -67,7 +66,7 @@ def gap_time_history(store: xr.Dataset, gap: float = 0.02, neighbour: str = "fle
     case = {"neighbour": neighbour, "gap": gap, "mu": FIXED_BASE, "record": "el_centro"}
     run = select(store, **case)
     top = run["total_displacement"].sel(building="B1").isel(floor=-1).values
-    impacts = case_impacts(store, **case, realization=0)
+    impacts = store.pound.impacts(**case, realization=0)
     forces = {}
     for contact in run["contact"].values:
         mine = impacts.isel(impact=np.flatnonzero(impacts["impact_contact"].values == contact))

@@ -10,8 +10,7 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
-from stochpound.experiment._definition import FIXED_BASE
-from stochpound.experiment._selections import isolated_mus
+from stochpound.store import FIXED_BASE, isolated_mus
 from stochpound.report.render._document import Paragraph
 from stochpound.report.sections._description import StoreDefinition
 from stochpound.studies.agarwal2004._published import published_tables

@@ -23,7 +23,7 @@ import stochpound
 from stochpound.motions.ground import SampledMotion
 from stochpound.report.render import _figures as figures
 from stochpound.report.render._document import Block, FigureItem, Paragraph, Table
-from stochpound.report.sections._stores import case_scene, select
+from stochpound.report.sections._stores import select
 from stochpound.studies.agarwal2004._tables import record_label
 
 CM = 100.0
@@ -38,7 +38,7 @@ def northridge_means(pair_records: xr.Dataset, single: xr.Dataset | None, record
     runs = {}
     for neighbour in NEIGHBOURS:
         case = {"isolation": "b1_isolated", "neighbour": neighbour, "model": "corrected", "gap": gap, "mu": mu, "record": record}
-        runs[neighbour] = (stochpound.simulate(case_scene(pair_records, **case)), float(select(pair_records, **case)["response_mean"]) * CM)
+        runs[neighbour] = (stochpound.simulate(pair_records.pound.scene(**case)), float(select(pair_records, **case)["response_mean"]) * CM)
     lines = {}
     alone = None
     if single is not None:
@@ -94,7 +94,7 @@ def _zoom(runs: dict) -> tuple[float, float]:
 
 def scaled_runs(store: xr.Dataset, scales: tuple[float, ...] = SCALES, **labels: object) -> list[xr.Dataset]:
     """The case of ``store`` at ``labels`` rerun with its record scaled by each of ``scales`` (the record-scaling noise of a single-record answer)."""
-    scene = case_scene(store, **labels)
+    scene = store.pound.scene(**labels)
     motion = scene.motion
     return [stochpound.simulate(dataclasses.replace(scene, motion=SampledMotion(motion.dt, motion.values * scale, motion.interpolation,
                                                                                    f"{motion.description} x {scale:g}")))

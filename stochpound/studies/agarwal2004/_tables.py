@@ -20,7 +20,7 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
-from stochpound.experiment._definition import is_fixed_base
+from stochpound.store import is_fixed_base
 from stochpound.model.modal_solution import modal_properties
 from stochpound.motions.records import load_record, record_statistics, registry_entries, study_table_3_2
 from stochpound.report.sections._description import StoreDefinition

@@ -29,7 +29,7 @@ from typing import Any, Mapping
 import numpy as np
 
 from stochpound.model import fields
-from stochpound.model.law import ContactLaw, ElementParameters, quantity
+from stochpound.model.laws.contract import ContactLaw, ElementParameters, quantity
 
 ONSET_FLOOR = 1e-9
 """Smallest approach velocity (m/s) taken for an impact's δ̇₀ (the damped laws' c_h ∝ 1/δ̇₀)."""

@@ -1,7 +1,10 @@
-"""Applying an experiment's overrides to a scene dict: variants, gaps and μ.
+"""The one module that edits an experiment's scene dicts: variants, gaps, μ, the motion.
 
-Every function takes a scene dict (the structure of a scene file) and returns
-a modified deep copy; validation of the result is left to
+A scene dict has the structure of a scene file (docs/scene-files.md); this
+module owns that shape on the experiment side: the buildings by name, their
+bases, the contacts and walls, the ``[motion]``. Every edit of a case's
+scene goes through it, and every edit of a law's parameters asks the law
+(:mod:`stochpound.model.laws`); validation of the result is left to
 :func:`stochpound.scene_from_dict`.
 
 The *mass factor* rule (docs/experiments.md): multiplying a building's
@@ -11,11 +14,17 @@ masses by f (floors and base) keeps its dynamics consistent:
   every modal damping ratio (M → fM, K fixed, C → sqrt(f) C); a
   ``damping_ratio`` is kept as it is;
 * every contact touching the building and every wall beside it is rescaled
-  by its law's rule (:meth:`stochpound.model.law.ContactLaw.rescale_table`)
+  by its law's rule (:meth:`stochpound.model.laws.contract.ContactLaw.rescale_table`)
   with the ratio m_eff,new / m_eff,old, m_eff = m1 m2 / (m1 + m2): for a
   Kelvin–Voigt element k_imp × ratio keeps its impact frequency
   sqrt(k_imp / m_eff), and c_imp follows from the restitution (or, when given
   as ``damping``, × the same ratio, which keeps its damping ratio).
+
+The *μ axis* rule: a finite μ is given to each chosen base by its friction
+law (:meth:`stochpound.model.laws.contract.FrictionLaw.set_mu`), which scales
+its coefficients (Coulomb: ``mu`` = μ, ``mu_static`` keeps its ratio to
+``mu``; velocity-dependent: ``fast`` = μ, ``slow`` and ``mu_static`` keep
+their ratios to ``fast``) or refuses; μ = inf removes the base (a fixed base).
 """
 
 from __future__ import annotations
@@ -33,12 +42,27 @@ from stochpound.model.friction import is_fixed_base
 PLACEHOLDER_MOTION = {"type": "constant", "acceleration": 0.0, "duration": 1.0, "dt": 1.0}
 
 
+def building_names(scene: Mapping[str, Any]) -> list[str]:
+    """The names of the scene's buildings, left to right (default names B1, B2, ...)."""
+    return [building.get("name", f"B{i + 1}") for i, building in enumerate(scene.get("building", []))]
+
+
 def building_table(scene: Mapping[str, Any], name: str) -> dict[str, Any]:
     """The ``[[building]]`` table named ``name`` (default names B1, B2, ... included)."""
-    for i, building in enumerate(scene["building"]):
-        if building.get("name", f"B{i + 1}") == name:
-            return building
-    raise KeyError(name)
+    names = building_names(scene)
+    if name not in names:
+        raise KeyError(name)
+    return scene["building"][names.index(name)]
+
+
+def without_motion(scene: Mapping[str, Any]) -> dict[str, Any]:
+    """The scene's structure: a shallow copy without its ``[motion]``."""
+    return {key: value for key, value in scene.items() if key != "motion"}
+
+
+def with_motion(structure: Mapping[str, Any], motion: Mapping[str, Any] = PLACEHOLDER_MOTION) -> dict[str, Any]:
+    """The scene ``structure`` under the ``[motion]`` table ``motion`` (a shallow copy; default: :data:`PLACEHOLDER_MOTION`)."""
+    return {**structure, "motion": dict(motion)}
 
 
 def apply_overrides(scene: Mapping[str, Any], overrides: Iterable[Mapping[str, Any]]) -> dict[str, Any]:
@@ -110,7 +134,7 @@ def scale_masses(scene: dict[str, Any], name: str, factor: float) -> None:
 
     The building's own rule (:func:`stochpound.model.building.scale_masses`:
     dashpots × √factor), then every contact touching it and every wall beside
-    it by their law's rule (:meth:`stochpound.model.law.ContactLaw.rescale_table`,
+    it by their law's rule (:meth:`stochpound.model.laws.contract.ContactLaw.rescale_table`,
     with the ratio of the effective masses, new over old: the factor itself
     for a wall).
     """
@@ -150,7 +174,7 @@ def set_gaps(scene: dict[str, Any], contacts: Iterable[int], gap: float, walls: 
 
 
 def set_mu(scene: dict[str, Any], buildings: Iterable[str] | None, mu: float) -> list[str]:
-    """Set the friction coefficient μ of buildings in place; μ = inf removes their base.
+    """Set the friction coefficient μ of buildings in place, by each base's friction law; μ = inf removes their base.
 
     Parameters
     ----------
@@ -159,26 +183,40 @@ def set_mu(scene: dict[str, Any], buildings: Iterable[str] | None, mu: float) ->
     buildings : iterable of str or None
         Buildings to change; None: every building that has a ``[building.base]``.
     mu : float
-        Kinetic and static coefficient (``mu`` and ``mu_static``), >= 0, or inf
-        for a fixed base.
+        The μ axis value (dimensionless), >= 0, or inf for a fixed base. A
+        finite μ goes to the base's law
+        (:meth:`stochpound.model.laws.contract.FrictionLaw.set_mu`: it scales
+        its coefficients or refuses); a malformed base is left for scene
+        validation to name.
 
     Returns
     -------
     list of str
         The chosen buildings that have no base (an error unless μ is inf).
+
+    Raises
+    ------
+    SceneError
+        When a base's law refuses μ, naming the field (``building[0].base.mu.fast: ...``).
     """
-    names = [b.get("name", f"B{i + 1}") for i, b in enumerate(scene["building"])]
+    names = building_names(scene)
     chosen = list(buildings) if buildings is not None else [n for n in names if isinstance(building_table(scene, n).get("base"), dict)]
     missing = []
     for name in chosen:
         building = building_table(scene, name)
+        base = building.get("base")
         if is_fixed_base(mu):
             building.pop("base", None)
-        elif isinstance(building.get("base"), dict):
-            building["base"]["mu"] = float(mu)
-            building["base"]["mu_static"] = float(mu)
-        else:
+        elif not isinstance(base, dict):
             missing.append(name)
+        else:
+            prefix = f"building[{names.index(name)}].base"
+            law = laws.base_friction_law(base)
+            try:
+                law.read(base, prefix)
+            except SceneError:
+                continue  # a malformed base: scene validation names it, as without the axis
+            law.set_mu(base, float(mu), prefix)
     if buildings is None and not chosen and not is_fixed_base(mu):
         missing.append("(no building has a [building.base])")
     return missing

@@ -7,7 +7,7 @@ import pytest
 import xarray as xr
 
 from stochpound.analysis._summary import top_floor_total_displacement
-from stochpound.experiment._catalogue import CASE_SUMMARIES, IMPACT_TABLE, WALL_SUMMARIES, REFERENCE_HISTORY, REFERENCE_SUMMARIES, TIME_HISTORIES, StoreVariable
+from stochpound.store import CASE_SUMMARIES, CATALOGUE, IMPACT_TABLE, WALL_SUMMARIES, REFERENCE_HISTORY, REFERENCE_SUMMARIES, TIME_HISTORIES, StoreVariable
 from stochpound.experiment._spec import TIME_HISTORY_VARIABLES
 from stochpound.experiment._summary import DEMAND_SUMMARIES, REFERENCE_SUMMARIES as REFERENCE_NAMES, case_summary, reference_summary
 from stochpound.model.scene_file import scene_from_dict
@@ -64,3 +64,21 @@ def test_time_histories_and_impacts_are_declared(run: xr.Dataset) -> None:
         _check(variable, run[variable.name])
     assert REFERENCE_HISTORY.dims == TIME_HISTORIES["total_displacement"].dims[1:]
     assert REFERENCE_HISTORY.units == TIME_HISTORIES["total_displacement"].units
+
+
+def test_the_catalogue_declares_each_variable_once_and_derived_units_agree():
+    """One declaration per name; a peak, a moment or a reference has the units of the history it is taken from."""
+    declared = [*CASE_SUMMARIES, *WALL_SUMMARIES, *REFERENCE_SUMMARIES, *TIME_HISTORIES.values(), REFERENCE_HISTORY, *IMPACT_TABLE]
+    assert len(CATALOGUE) == len(declared) and all(CATALOGUE[v.name] is v for v in declared)
+    taken_from = {
+        "peak_total_displacement": "total_displacement", "peak_relative_displacement": "relative_displacement",
+        "peak_sliding_displacement": "sliding_displacement", "residual_sliding": "sliding_displacement",
+        "peak_impact_force": "impact_force", "impact_peak_force": "impact_force", "response_mean": "total_displacement",
+        "response_std": "total_displacement", "reference_total_displacement": "total_displacement",
+        "peak_floor_acceleration": "ground_acceleration", "peak_wall_penetration": "peak_contact_closure",
+    }
+    for derived, source in taken_from.items():
+        assert CATALOGUE[derived].units == CATALOGUE[source].units, derived
+    for variable in REFERENCE_SUMMARIES:
+        own = CATALOGUE[variable.name.removeprefix("reference_")]
+        assert (variable.units, variable.long_name) == (own.units, own.long_name + " (studied building alone on a fixed base)")

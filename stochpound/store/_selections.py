@@ -3,8 +3,7 @@
 A gap axis that holds ``inf`` makes *contact-free* cases (an axis setting
 contacts) or *wall-free* cases (an axis setting walls only): their gaps
 never close, and by the gap identity their peak closure answers every gap at
-once (docs/separation.md). That rule is the analysis layer's
-(``stochpound.analysis._gap_axes``, which the risk chain uses too), given
+once (docs/separation.md). That rule is ``stochpound.store._gap_axes``'s (the risk chain uses it too), given
 here too. A μ axis that holds :data:`~stochpound.experiment.FIXED_BASE`
 makes, for each isolated case, its *fixed-base twin*: the same case with the
 sliding base removed. These functions take a store, or any dataset or array
@@ -18,8 +17,8 @@ from typing import TypeVar
 
 import xarray as xr
 
-from stochpound.analysis._gap_axes import contact_free, contact_gap_dims, gap_dims, has_contact_free, has_wall_free, wall_free, wall_gap_dims, with_contacts, with_walls
-from stochpound.experiment._definition import FIXED_BASE, is_fixed_base
+from stochpound.model.friction import FIXED_BASE, is_fixed_base
+from stochpound.store._gap_axes import contact_free, contact_gap_dims, gap_dims, has_contact_free, has_wall_free, wall_free, wall_gap_dims, with_contacts, with_walls
 
 __all__ = [
     "contact_free", "contact_gap_dims", "fixed_base", "gap_dims", "has_contact_free", "has_fixed_base_twins", "has_wall_free",

@@ -129,3 +129,6 @@ IMPACT_TABLE = (
     StoreVariable("impact_in_phase", ("impact",), "b1", "1", "both floors moving the same way at onset (false at a wall, which moves with the ground)"),
     StoreVariable("impact_complete", ("impact",), "b1", "1", "the impact ended before the end of the motion"),
 )
+
+#: Every variable of the catalogue by name (the summaries, the histories, the reference's history, the impact table).
+CATALOGUE = {v.name: v for v in (*CASE_SUMMARIES, *WALL_SUMMARIES, *REFERENCE_SUMMARIES, *_HISTORIES, REFERENCE_HISTORY, *IMPACT_TABLE)}

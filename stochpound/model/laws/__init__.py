@@ -1,4 +1,4 @@
-"""The law registry: every contact law and friction law by name (the contract: :mod:`stochpound.model.law`).
+"""The law registry: every contact law and friction law by name (the contract: :mod:`stochpound.model.laws.contract`).
 
 Code asks the registry, never a law's name: ``contact_law(element.law).piecewise_linear``,
 ``.read(...)``, ``.force(...)``, ``.describe(...)``. A new law is one module
@@ -8,9 +8,11 @@ defining its law object, one line here, its tests and its docs entry
 
 from __future__ import annotations
 
+from typing import Any, Mapping
+
 from stochpound._errors import SceneError
-from stochpound.model import coulomb, hertz, hertz_damp_exact, hertz_damp_ye, jankowski, kelvin, velocity_friction
-from stochpound.model.law import ContactLaw, FrictionLaw
+from stochpound.model.laws import coulomb, hertz, hertz_damp_exact, hertz_damp_ye, jankowski, kelvin, velocity_friction
+from stochpound.model.laws.contract import ContactLaw, FrictionLaw, ResultVariable
 
 CONTACT_LAWS: dict[str, ContactLaw] = {law.name: law for law in (kelvin.KELVIN, hertz.HERTZ, hertz.HERTZ_DAMP, jankowski.JANKOWSKI,
                                                                  hertz_damp_ye.HERTZ_DAMP_YE, hertz_damp_exact.HERTZ_DAMP_EXACT)}
@@ -19,6 +21,8 @@ DEFAULT_CONTACT_LAW = kelvin.KELVIN.name
 """The law of an element whose table gives none."""
 FRICTION_LAWS: dict[str, FrictionLaw] = {law.name: law for law in (coulomb.COULOMB, velocity_friction.VELOCITY_DEPENDENT)}
 """The friction laws of sliding bases, by name (a base's ``friction_law``)."""
+FRICTION_VARIABLES: tuple[ResultVariable, ...] = tuple(variable for law in FRICTION_LAWS.values() for variable in law.variables)
+"""The result variables of every friction law's parameters, in registry order (``base_mu``, ``base_mu_static``, ``base_mu_fast``, ``base_mu_rate``)."""
 
 
 def contact_law(name: str, prefix: str = "law") -> ContactLaw:
@@ -32,3 +36,8 @@ def contact_law(name: str, prefix: str = "law") -> ContactLaw:
 def friction_law(name: str) -> FrictionLaw:
     """The friction law called ``name`` (:data:`FRICTION_LAWS`)."""
     return FRICTION_LAWS[name]
+
+
+def base_friction_law(table: Mapping[str, Any]) -> FrictionLaw:
+    """The friction law of a ``[building.base]`` table: the one whose form its ``mu`` has (:meth:`~stochpound.model.laws.contract.FrictionLaw.spells`)."""
+    return next(law for law in FRICTION_LAWS.values() if law.spells(table.get("mu")))

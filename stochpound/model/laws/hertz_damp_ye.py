@@ -9,7 +9,7 @@ Engng Struct. Dyn. 38 (2009) 1135–1142). With the penetration δ > 0, its rate
 
     F = k_h δ^{3/2} (1 + ξ δ̇ / δ̇₀),   ξ = 8 (1 − e) / (5 e),
 
-that is :mod:`stochpound.model.hertz`'s ``hertz_damp`` with
+that is :mod:`stochpound.model.laws.hertz`'s ``hertz_damp`` with
 c_h = 8 k_h (1 − e) / (5 e δ̇₀) instead of Muthukumar & DesRoches's
 3 k_h (1 − e²) / (4 δ̇₀). Derived for low restitutions, it realises a
 restitution much closer to the target than ``hertz_damp`` does below
@@ -19,7 +19,7 @@ pulls; mass scaling as the Hertz family's (k_h × m_eff,new/m_eff,old).
 
 from __future__ import annotations
 
-from stochpound.model.hertz import HertzDamp
+from stochpound.model.laws.hertz import HertzDamp
 
 
 class HertzDampYe(HertzDamp):

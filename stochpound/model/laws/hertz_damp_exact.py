@@ -8,7 +8,7 @@ The law (docs/model.md, "Contact laws"). With the penetration δ > 0, its rate
 
     F = k_h δ^{3/2} (1 + ξ δ̇ / δ̇₀),   c_h = ξ k_h / δ̇₀,
 
-the force of :mod:`stochpound.model.hertz`'s ``hertz_damp`` with the
+the force of :mod:`stochpound.model.laws.hertz`'s ``hertz_damp`` with the
 dimensionless damping ξ(e) solved so that a free two-mass impact leaves with
 exactly −e times its approach velocity. Scaling δ = δ_s x and
 t = (δ_s / δ̇₀) τ with δ_s = (m_eff δ̇₀² / k_h)^{2/5} turns the impact
@@ -34,8 +34,8 @@ from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
 from stochpound.model import fields
-from stochpound.model.hertz import HertzDamp
-from stochpound.model.law import ElementParameters
+from stochpound.model.laws.contract import ElementParameters
+from stochpound.model.laws.hertz import HertzDamp
 
 LOWEST_RESTITUTION = 0.05
 """The lowest restitution the law accepts (below it ξ grows without bound and the force would pull)."""

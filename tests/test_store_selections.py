@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from stochpound.experiment._selections import contact_free, fixed_base, gap_dims, has_contact_free, has_fixed_base_twins, isolated_mus, with_contacts
+from stochpound.store import contact_free, fixed_base, gap_dims, has_contact_free, has_fixed_base_twins, isolated_mus, with_contacts
 
 
 def _store(gaps: list[float], top: list[float]) -> xr.Dataset:

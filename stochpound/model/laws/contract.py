@@ -6,7 +6,7 @@ sliding base) one :class:`FrictionLaw`. Each object holds, behind one
 signature per kind of law:
 
 * its name (the scene file's ``law``), its scene keys and their validation
-  (:meth:`ContactLaw.read`);
+  (:meth:`ContactLaw.read`, :meth:`FrictionLaw.read`);
 * whether it is piecewise linear (only then does every mode stay linear, which
   the exact solver needs; a nonlinear law's force is a read-out of the mode,
   evaluated by :mod:`stochpound.model.readouts`);
@@ -14,16 +14,24 @@ signature per kind of law:
   ∂F/∂δ, ∂F/∂δ̇ (for a piecewise-linear law, k δ + c δ̇ and (k, c): the terms
   it adds to a closed mode, :func:`stochpound.model.contact.closed_terms`);
 * its power (the rate of work of its force, the energy term it enters);
-* its mass rescaling for experiment variants (:meth:`ContactLaw.rescale_table`);
-* ``describe()``: its name, parameters and units, for methods text.
+* what an experiment's axes do to its parameters: a contact law's mass
+  rescaling for variants (:meth:`ContactLaw.rescale_table`), a friction law's
+  answer to a μ axis (:meth:`FrictionLaw.set_mu`: scale its coefficients or
+  refuse, never replace the law);
+* ``describe()``: its name, parameters and units, for methods text;
+* a friction law's result variables (``FrictionLaw.variables``): how a
+  result and a store name its parameters.
 """
 
 from __future__ import annotations
 
+import math
 from abc import ABC, abstractmethod
 from typing import Any, Mapping, NamedTuple
 
 import numpy as np
+
+from stochpound.model import fields
 
 
 class ElementParameters(NamedTuple):
@@ -124,6 +132,51 @@ class ContactLaw(ABC):
             table["damping"] = float(table["damping"]) * mass_ratio
 
 
+class FrictionParameters(NamedTuple):
+    """A sliding base's friction parameters, as its law reads them from its ``[building.base]`` table.
+
+    Attributes
+    ----------
+    mu : float
+        Kinetic coefficient (at vanishing sliding velocity for velocity-dependent friction), ≥ 0.
+    mu_static : float
+        Static coefficient, ≥ ``mu``.
+    mu_fast, mu_rate : float or None
+        Velocity-dependent friction's coefficient at high velocity and its rate a (s/m); None for Coulomb friction.
+    """
+
+    mu: float
+    mu_static: float
+    mu_fast: float | None = None
+    mu_rate: float | None = None
+
+
+class ResultVariable(NamedTuple):
+    """A result variable that reports one parameter of a law, one value per building (a sliding base's law).
+
+    Attributes
+    ----------
+    name : str
+        The variable's name in a result and a store, e.g. ``base_mu_fast``.
+    field : str
+        The :class:`~stochpound.model.friction.Base` attribute it reports.
+    units : str
+        Its ``units`` attribute (CF spelling, ``1`` for a coefficient).
+    long_name : str
+        Its ``long_name`` attribute.
+    missing : float
+        Its value for a building without a base: NaN, or ∞ for the friction
+        coefficients (a fixed base is μ = ∞, :data:`~stochpound.model.friction.FIXED_BASE`).
+        A base whose law lacks the parameter (its attribute None) gives NaN.
+    """
+
+    name: str
+    field: str
+    units: str
+    long_name: str
+    missing: float = math.nan
+
+
 class FrictionLaw(ABC):
     """A friction law of a sliding base: the foundation's force on the base while it slips.
 
@@ -137,12 +190,42 @@ class FrictionLaw(ABC):
         True: the slip force is a constant of each slip mode (the exact solver applies).
     energy_term : str
         The energy-balance term its power enters.
+    variables : tuple of ResultVariable
+        The result variables of the parameters it reads
+        (:meth:`read`), beyond those of a law before it in the registry.
     """
 
     name: str
     title: str
     piecewise_linear: bool
+    variables: tuple[ResultVariable, ...]
     energy_term: str = "friction"
+
+    @abstractmethod
+    def spells(self, mu: Any) -> bool:
+        """Whether a base table's ``mu`` value is written in this law's form (a number, a table...)."""
+
+    @abstractmethod
+    def read_mu(self, table: Mapping[str, Any], prefix: str) -> tuple[float, float | None, float | None]:
+        """The law's coefficients from the base table's ``mu`` (at ``prefix``), validated: (μ, μ_fast, a in s/m)."""
+
+    def read(self, table: Mapping[str, Any], prefix: str) -> FrictionParameters:
+        """The base's friction parameters from its ``[building.base]`` table (at ``prefix``), validated.
+
+        ``mu`` as the law spells it (:meth:`read_mu`), then ``mu_static``
+        (≥ μ, default μ: the coefficient at vanishing velocity).
+        """
+        mu, fast, rate = self.read_mu(table, prefix)
+        return FrictionParameters(mu, fields.number(table, "mu_static", prefix, default=mu, low=mu), fast, rate)
+
+    @abstractmethod
+    def set_mu(self, table: dict[str, Any], mu: float, prefix: str) -> None:
+        """Give the base table (at ``prefix``) an experiment's μ-axis value ``mu`` (finite, dimensionless), in place.
+
+        The law scales its coefficients (its rule in its docstring) or
+        refuses with a :class:`~stochpound._errors.SceneError` naming the
+        field; it never replaces itself by another law.
+        """
 
     @abstractmethod
     def force(self, base: Any, state: int, speed: np.ndarray) -> np.ndarray:

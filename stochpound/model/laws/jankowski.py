@@ -30,7 +30,7 @@ from typing import Any, Mapping
 import numpy as np
 
 from stochpound.model import fields
-from stochpound.model.law import ContactLaw, ElementParameters, quantity
+from stochpound.model.laws.contract import ContactLaw, ElementParameters, quantity
 
 
 def damping_ratio(restitution: float) -> float:

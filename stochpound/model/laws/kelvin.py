@@ -29,7 +29,7 @@ import numpy as np
 
 from stochpound._errors import SceneError
 from stochpound.model import fields
-from stochpound.model.law import ContactLaw, ElementParameters, quantity
+from stochpound.model.laws.contract import ContactLaw, ElementParameters, quantity
 
 
 def restitution_damping_ratio(restitution: float) -> float:
@@ -78,7 +78,7 @@ def stiffness_for_peak_force(force: float, mass: float, approach: float, restitu
     The element's peak force is φ(ξ) √(k m_eff) δ̇₀ (:func:`peak_force_factor`,
     ξ from e by :func:`restitution_damping_ratio`), so
     k = (F / (φ(ξ) δ̇₀))² / m_eff. With F the elastic Hertz peak force
-    (:func:`stochpound.model.hertz.peak_force`) at a reference approach
+    (:func:`stochpound.model.laws.hertz.peak_force`) at a reference approach
     velocity, the element matches a Hertz element's peak force there.
 
     Parameters

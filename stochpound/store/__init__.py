@@ -1,0 +1,106 @@
+"""Experiment stores: what a store is and holds, read one way, below the analysis.
+
+>>> ds = stochpound.open_store("quickstart.nc")      # doctest: +SKIP
+>>> ds.pound.definition.gaps                        # doctest: +SKIP
+>>> ds.pound.scene(gap=0.02, record="elcentro")     # doctest: +SKIP
+
+The package holds the definition parsed into types
+(:func:`read_definition`, :class:`Definition`, its identity
+:func:`definition_sha256`), the catalogue of the store's variables
+(:data:`CATALOGUE`: units and long name of each, declared once), the gap axes
+and the selections by meaning (contact-free, wall-free, fixed-base cases),
+:func:`open_store`, and the one door to an open store, the ``pound``
+accessor of an xarray dataset (:class:`StoreAccessor`). It imports the model
+and the shared utilities only: the experiment layer writes stores, the
+analysis, the risk chain, the report and the command line read them through
+here.
+"""
+
+from stochpound.store._accessor import ACCESSOR, StoreAccessor, register_grid
+from stochpound.store._catalogue import (
+    CASE_SUMMARIES,
+    CATALOGUE,
+    IMPACT_TABLE,
+    REFERENCE_HISTORY,
+    REFERENCE_SUMMARIES,
+    TIME_HISTORIES,
+    WALL_SUMMARIES,
+    StoreVariable,
+)
+from stochpound.model.friction import FIXED_BASE, is_fixed_base
+from stochpound.store._definition import (
+    NOT_IN_IDENTITY,
+    Definition,
+    GapAxis,
+    Hazard,
+    Intensity,
+    MotionSource,
+    MuAxis,
+    Output,
+    Solver,
+    VariantAxis,
+    canonical_json,
+    definition_sha256,
+    describe_measure,
+    read_definition,
+)
+from stochpound.store._gap_axes import (
+    SETS,
+    contact_free,
+    contact_gap_dims,
+    gap_dims,
+    has_contact_free,
+    has_wall_free,
+    is_gap_axis,
+    wall_free,
+    wall_gap_dims,
+    with_contacts,
+    with_walls,
+)
+from stochpound.store._open import open_store
+from stochpound.store._selections import fixed_base, has_fixed_base_twins, isolated_mus
+
+__all__ = [
+    "ACCESSOR",
+    "CASE_SUMMARIES",
+    "CATALOGUE",
+    "FIXED_BASE",
+    "IMPACT_TABLE",
+    "NOT_IN_IDENTITY",
+    "REFERENCE_HISTORY",
+    "REFERENCE_SUMMARIES",
+    "SETS",
+    "TIME_HISTORIES",
+    "WALL_SUMMARIES",
+    "Definition",
+    "GapAxis",
+    "Hazard",
+    "Intensity",
+    "MotionSource",
+    "MuAxis",
+    "Output",
+    "Solver",
+    "StoreAccessor",
+    "StoreVariable",
+    "VariantAxis",
+    "canonical_json",
+    "contact_free",
+    "contact_gap_dims",
+    "definition_sha256",
+    "describe_measure",
+    "fixed_base",
+    "gap_dims",
+    "has_contact_free",
+    "has_fixed_base_twins",
+    "has_wall_free",
+    "is_fixed_base",
+    "is_gap_axis",
+    "isolated_mus",
+    "open_store",
+    "read_definition",
+    "register_grid",
+    "wall_free",
+    "wall_gap_dims",
+    "with_contacts",
+    "with_walls",
+]
