@@ -24,7 +24,7 @@ from click.testing import CliRunner
 
 from stochpound import open_store
 from stochpound.analysis import HazardCurve, pounding_fragility
-from stochpound.analysis._store_risk import contact_free_closure, risk_gaps
+from stochpound.risk._store_risk import contact_free_closure, risk_gaps
 from stochpound.cli import main
 from stochpound.experiment._hazard import hazard_curve, stored_hazard
 from stochpound.experiment._runner import load_experiment, run_experiment

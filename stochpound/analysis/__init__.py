@@ -20,8 +20,8 @@ from stochpound.analysis._pounding import pounding_probability
 from stochpound.analysis._separation import pounding_curve, required_separation, rule_exceedance
 from stochpound.analysis._separation_rules import contact_demands, fixed_base_cqc, separation_rules, store_contact_demands
 from stochpound.analysis._summary import run_summary
-from stochpound.analysis._fragility import Fragility, fit_fragility
-from stochpound.analysis._fragility_ensemble import (
+from stochpound.risk._fragility import Fragility, fit_fragility
+from stochpound.risk._fragility_ensemble import (
     fragility_band,
     fragility_surface,
     homogeneous_capacities,
@@ -30,9 +30,9 @@ from stochpound.analysis._fragility_ensemble import (
     stripe_fragility,
 )
 from stochpound.analysis._hazard import HazardCurve, bundled_curves, probability_from_rate, rate_from_probability, return_period
-from stochpound.analysis._risk import demand_hazard_curve, mean_annual_frequency, risk_curve, risk_targeted_separation
-from stochpound.analysis._code_rules_risk import code_rules_risk
-from stochpound.analysis._store_risk import StoreRisk, contact_free_closure, pounding_fragility, risk_gaps, store_risk
+from stochpound.risk._maf import demand_hazard_curve, mean_annual_frequency, risk_curve, risk_targeted_separation
+from stochpound.risk._code_rules import code_rules_risk
+from stochpound.risk._store_risk import StoreRisk, contact_free_closure, pounding_fragility, risk_gaps, store_risk
 
 __all__ = [
     "moments",

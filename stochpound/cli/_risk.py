@@ -7,8 +7,8 @@ from pathlib import Path
 import click
 import pandas as pd
 
-from stochpound.analysis._fragility_ensemble import BOOTSTRAP
-from stochpound.analysis._risk import TARGETS
+from stochpound.risk._fragility_ensemble import BOOTSTRAP
+from stochpound.risk._maf import TARGETS
 from stochpound._errors import StochpoundError, os_error_message
 
 
@@ -46,7 +46,7 @@ def risk(store: Path, hazard: str | None, target: str, years: float, bootstrap: 
     a probability in --years. The store needs intensity stripes (with
     contact-free cases, gap = inf) or IDA capacities (docs/risk.md).
     """
-    from stochpound.analysis._store_risk import store_risk
+    from stochpound.risk._store_risk import store_risk
     from stochpound.experiment import open_store
     from stochpound.experiment._hazard import hazard_option, stored_hazard
     from stochpound.experiment._intensity import describe_measure

@@ -31,10 +31,10 @@ import xarray as xr
 from matplotlib.figure import Figure
 
 from stochpound.analysis import HazardCurve, demand_hazard_curve, fragility_band, fragility_surface, rate_from_probability
-from stochpound.analysis._fragility_ensemble import BOOTSTRAP
-from stochpound.analysis._risk import TARGETS
+from stochpound.risk._fragility_ensemble import BOOTSTRAP
+from stochpound.risk._maf import TARGETS
 from stochpound.analysis._gap_axes import contact_free, wall_free
-from stochpound.analysis._store_risk import StoreRisk, base_displacement, store_motions, store_risk
+from stochpound.risk._store_risk import StoreRisk, base_displacement, store_motions, store_risk
 from stochpound.experiment._definition import read_definition
 from stochpound.experiment._hazard import stored_hazard, stored_hazard_entry
 from stochpound.experiment._intensity import describe_measure

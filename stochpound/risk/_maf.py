@@ -30,7 +30,7 @@ from scipy import special
 
 from stochpound.analysis import kernels
 from stochpound.analysis._bootstrap import interval
-from stochpound.analysis._fragility_ensemble import BOOTSTRAP, limit_state_events, stripe_fragility
+from stochpound.risk._fragility_ensemble import BOOTSTRAP, limit_state_events, stripe_fragility
 from stochpound.analysis._hazard import HazardCurve, probability_from_rate, rate_from_probability, return_period
 
 TARGETS = (0.10, 0.02)
@@ -49,7 +49,7 @@ def mean_annual_frequency(frag: object, hz: HazardCurve) -> float | np.ndarray |
     frag : Fragility or xarray.Dataset
         Anything with ``theta`` (IM units, the hazard's) and ``beta``
         (floats, arrays or DataArrays, broadcast): a
-        :class:`~stochpound.analysis._fragility.Fragility` or a fit Dataset
+        :class:`~stochpound.risk._fragility.Fragility` or a fit Dataset
         of :func:`~stochpound.analysis.stripe_fragility`. A step (β = 0)
         at θ gives λ(θ); θ = inf gives 0.
     hz : HazardCurve

@@ -24,11 +24,11 @@ from collections.abc import Sequence
 import numpy as np
 import xarray as xr
 
-from stochpound.analysis._code_rules_risk import MINIMUM_MOTIONS, code_rules_risk
-from stochpound.analysis._fragility_ensemble import BOOTSTRAP, homogeneous_capacities, ida_fragility, limit_state_events, stripe_fragility
+from stochpound.risk._code_rules import MINIMUM_MOTIONS, code_rules_risk
+from stochpound.risk._fragility_ensemble import BOOTSTRAP, homogeneous_capacities, ida_fragility, limit_state_events, stripe_fragility
 from stochpound.analysis._gap_axes import contact_free, gap_dims, has_contact_free
 from stochpound.analysis._hazard import HazardCurve
-from stochpound.analysis._risk import TARGETS, risk_curve, risk_targeted_separation
+from stochpound.risk._maf import TARGETS, risk_curve, risk_targeted_separation
 from stochpound.analysis._separation_rules import store_contact_demands
 
 CLOSURE = "peak_contact_closure"

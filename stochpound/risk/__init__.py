@@ -1,0 +1,1 @@
+"""Pounding risk at a site: fragility, hazard, mean annual frequency, the risk-targeted separation g* and the code rules."""
