@@ -6,6 +6,12 @@ dimensions it is told to, so it applies equally to one run (reduce over
 and to ensembles (reduce over ``realization``). Each statistic has one
 implementation, a numpy kernel of :mod:`stochpound.analysis.kernels`, which
 these functions apply with :func:`xarray.apply_ufunc`.
+
+The hazard curve (:class:`~stochpound.risk.HazardCurve`, which an
+experiment's ``[hazard]`` table is read with) is defined here, below the
+experiment layer; the risk chain built on these statistics is the package
+:mod:`stochpound.risk`, whose names this namespace also gives, as aliases,
+to code written before that package existed.
 """
 
 from stochpound.analysis._moments import moments
@@ -20,19 +26,39 @@ from stochpound.analysis._pounding import pounding_probability
 from stochpound.analysis._separation import pounding_curve, required_separation, rule_exceedance
 from stochpound.analysis._separation_rules import contact_demands, fixed_base_cqc, separation_rules, store_contact_demands
 from stochpound.analysis._summary import run_summary
-from stochpound.risk._fragility import Fragility, fit_fragility
-from stochpound.risk._fragility_ensemble import (
-    fragility_band,
-    fragility_surface,
-    homogeneous_capacities,
-    ida_fragility,
-    limit_state_events,
-    stripe_fragility,
-)
 from stochpound.analysis._hazard import HazardCurve, bundled_curves, probability_from_rate, rate_from_probability, return_period
-from stochpound.risk._maf import demand_hazard_curve, mean_annual_frequency, risk_curve, risk_targeted_separation
-from stochpound.risk._code_rules import code_rules_risk
-from stochpound.risk._store_risk import StoreRisk, contact_free_closure, pounding_fragility, risk_gaps, store_risk
+
+_RISK = (
+    "Fragility",
+    "fit_fragility",
+    "fragility_band",
+    "fragility_surface",
+    "homogeneous_capacities",
+    "ida_fragility",
+    "limit_state_events",
+    "stripe_fragility",
+    "demand_hazard_curve",
+    "mean_annual_frequency",
+    "risk_curve",
+    "risk_targeted_separation",
+    "code_rules_risk",
+    "contact_free_closure",
+    "pounding_fragility",
+    "risk_gaps",
+    "store_risk",
+    "StoreRisk",
+)
+"""The risk chain's names this namespace exported before :mod:`stochpound.risk` existed: aliases of that package's (the canonical
+names), resolved when first used, so that importing the statistics does not import the risk chain (which sits above them)."""
+
+
+def __getattr__(name: str) -> object:
+    if name in _RISK:
+        import stochpound.risk
+
+        return getattr(stochpound.risk, name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
 
 __all__ = [
     "moments",

@@ -257,9 +257,15 @@ def _lognormal_integral(theta: np.ndarray, beta: np.ndarray, hz: HazardCurve, lo
     return integral
 
 
+def non_increasing(maf: np.ndarray) -> np.ndarray:
+    """The running minimum of a rate along its thresholds (last axis; a higher threshold cannot be exceeded more often, so a rise
+    is fitting noise); NaN counts as no bound (``inf``)."""
+    return np.fmin.accumulate(np.where(np.isnan(maf), np.inf, maf), axis=-1)
+
+
 def _separation_kernel(maf: np.ndarray, gaps: np.ndarray, rates: np.ndarray) -> np.ndarray:
     """g* per target rate along the last axis of ``maf`` (running minimum, interpolation of ln λ in ln g)."""
-    envelope = np.fmin.accumulate(np.where(np.isnan(maf), np.inf, maf), axis=-1)
+    envelope = non_increasing(maf)
     below = envelope[..., None, :] <= rates[:, None]  # (..., target, gap)
     found = below.any(-1)
     index = np.argmax(below, axis=-1)
