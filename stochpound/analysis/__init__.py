@@ -28,32 +28,10 @@ from stochpound.analysis._separation_rules import contact_demands, fixed_base_cq
 from stochpound.analysis._summary import run_summary
 from stochpound.analysis._hazard import HazardCurve, bundled_curves, probability_from_rate, rate_from_probability, return_period
 
-_RISK = (
-    "Fragility",
-    "fit_fragility",
-    "fragility_band",
-    "fragility_surface",
-    "homogeneous_capacities",
-    "ida_fragility",
-    "limit_state_events",
-    "stripe_fragility",
-    "demand_hazard_curve",
-    "mean_annual_frequency",
-    "risk_curve",
-    "risk_targeted_separation",
-    "code_rules_risk",
-    "contact_free_closure",
-    "pounding_fragility",
-    "risk_gaps",
-    "store_risk",
-    "StoreRisk",
-)
-"""The risk chain's names this namespace exported before :mod:`stochpound.risk` existed: aliases of that package's (the canonical
-names), resolved when first used, so that importing the statistics does not import the risk chain (which sits above them)."""
-
 
 def __getattr__(name: str) -> object:
-    if name in _RISK:
+    """A risk chain's name, from :mod:`stochpound.risk` (imported on first use)."""
+    if name in _ALIASES:
         import stochpound.risk
 
         return getattr(stochpound.risk, name)
@@ -107,3 +85,7 @@ __all__ = [
     "store_risk",
     "StoreRisk",
 ]
+_ALIASES = frozenset(__all__) - set(globals())
+"""The names ``__all__`` gives that this module does not define: the risk chain's, which it exported before :mod:`stochpound.risk`
+existed. They are aliases of that package's (the canonical names), resolved when first used, so that importing the statistics
+does not import the risk chain (which sits above them)."""

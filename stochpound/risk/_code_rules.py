@@ -72,7 +72,7 @@ def code_rules_risk(demands: xr.Dataset, hz: HazardCurve, design_levels: Sequenc
     cqc, reduction
         As in :func:`~stochpound.analysis.separation_rules`.
     confidence, bootstrap, seed
-        As in :func:`~stochpound.analysis.stripe_fragility`.
+        As in :func:`~stochpound.risk.stripe_fragility`.
 
     Returns
     -------

@@ -50,7 +50,7 @@ def mean_annual_frequency(frag: object, hz: HazardCurve) -> float | np.ndarray |
         Anything with ``theta`` (IM units, the hazard's) and ``beta``
         (floats, arrays or DataArrays, broadcast): a
         :class:`~stochpound.risk._fragility.Fragility` or a fit Dataset
-        of :func:`~stochpound.analysis.stripe_fragility`. A step (β = 0)
+        of :func:`~stochpound.risk.stripe_fragility`. A step (β = 0)
         at θ gives λ(θ); θ = inf gives 0.
     hz : HazardCurve
         The site's hazard, in the same intensity measure and units.
@@ -94,8 +94,8 @@ def risk_curve(fragility: xr.Dataset, hz: HazardCurve, years: float = 50.0, conf
     Parameters
     ----------
     fragility : xarray.Dataset
-        From :func:`~stochpound.analysis.stripe_fragility`
-        or :func:`~stochpound.analysis.ida_fragility`;
+        From :func:`~stochpound.risk.stripe_fragility`
+        or :func:`~stochpound.risk.ida_fragility`;
         with ``theta_bootstrap``/``beta_bootstrap`` the band is the
         percentiles of λ over the resamples of the motions (the whole chain refitted).
     hz : HazardCurve
@@ -202,7 +202,7 @@ def demand_hazard_curve(demand: xr.DataArray, levels: Sequence[float] | np.ndarr
     """The annual rate at which a demand exceeds each of ``levels`` (e.g. drift, floor acceleration, isolator displacement).
 
     The fragility of "demand ≥ level" is fitted to the stripes of
-    ``demand`` for every level (:func:`~stochpound.analysis.stripe_fragility`)
+    ``demand`` for every level (:func:`~stochpound.risk.stripe_fragility`)
     and integrated with the hazard (:func:`risk_curve`).
 
     Parameters

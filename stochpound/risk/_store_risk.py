@@ -8,7 +8,7 @@ contacts decides pounding at every gap, so the pounding fragility of every
 gap and configuration comes from that one selection. A store of IDA runs
 (homogeneous scenes: ``ida_capacity``, no ``intensity`` dimension) holds one
 contact-free run per motion at scale 1, and every gap's capacity follows
-from it (:func:`~stochpound.analysis.homogeneous_capacities`).
+from it (:func:`~stochpound.risk.homogeneous_capacities`).
 
 The motions are the store's ``record`` entries; a synthetic ensemble's
 realizations are motions too (``record`` and ``realization`` are merged
