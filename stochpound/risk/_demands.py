@@ -33,6 +33,10 @@ DEMAND_LEVELS = 40
 class StoreDemands:
     """The demand hazard curves of one store at one site (:func:`store_demands`), with the moat table.
 
+    ``moat_frame()`` is the moat table (per clearance: λ with its interval,
+    the return period, the probability in ``years``);
+    ``non_increasing_maf(label)`` a curve made non-increasing along its levels.
+
     Attributes
     ----------
     curves : dict of str to xarray.Dataset

@@ -66,10 +66,10 @@ def site_hazard(store: xr.Dataset, hazard: str | None = None, option: str = "--h
 
     Raises
     ------
-    RiskInputError
-        The store has no intensity levels, or carries no hazard and none is given.
-    stochpound.experiment.ExperimentError
-        (``IntensityError``) ``hazard`` is neither a file nor a bundled curve, or is of another measure.
+    ValueError
+        (``RiskInputError``) The store has no intensity levels, or carries no
+        hazard and none is given; (``IntensityError``) ``hazard`` is
+        neither a file nor a bundled curve, or is of another measure.
     """
     setting = intensity_setting(store)
     if setting is None:

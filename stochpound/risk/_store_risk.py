@@ -101,6 +101,15 @@ def pounding_fragility(store: xr.Dataset, gaps: Sequence[float] | np.ndarray, in
 class StoreRisk:
     """The risk chain of one store at one site (:func:`store_risk`), with its tables.
 
+    Its tables, those ``stochpound risk`` prints and the report shows:
+    ``to_frame()`` (g* per configuration and target, one row each, with
+    its interval and the number of motions), ``separation_frame()`` (the
+    g* table, the targets side by side) and ``rules_frame()`` (the code
+    rules in risk terms: per configuration, design level and rule, the gap
+    at each contact and λ_P there). For figures: ``non_increasing_maf()``
+    (λ_P(g) as g* reads it), ``surface()`` and ``fragility_curves()``
+    (the fitted fragility over ``im_axis()``), ``hazard_levels()``.
+
     Attributes
     ----------
     fragility : xarray.Dataset
