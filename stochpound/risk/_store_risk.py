@@ -167,7 +167,7 @@ class StoreRisk:
         -------
         pandas.DataFrame
             Columns: the configuration's dimensions, ``target`` (probability in
-            :attr:`years`), ``separation``, ``lower``, ``upper`` (m; ``inf``: wider
+            ``years``), ``separation``, ``lower``, ``upper`` (m; ``inf``: wider
             than every gap of the grid), ``confidence``, ``motions``.
         """
         separation = self.separation
@@ -199,7 +199,7 @@ class StoreRisk:
     def rules_frame(self) -> pd.DataFrame:
         """The code rules in risk terms: per configuration, design level and rule, its gap per contact (m) and the MAF of pounding there.
 
-        Empty when the rules were not evaluated (:attr:`rules_note` says why).
+        Empty when the rules were not evaluated (``rules_note`` says why).
         """
         rules = self.rules
         if rules is None:
@@ -223,11 +223,11 @@ class StoreRisk:
         return non_increasing_along(self.curve["maf"], "gap")
 
     def hazard_levels(self, probabilities: Sequence[float] = (0.10, 0.02)) -> dict[float, float]:
-        """The hazard's intensity (IM units) at each probability of exceedance in :attr:`years`."""
+        """The hazard's intensity (IM units) at each probability of exceedance in ``years``."""
         return {p: float(self.hazard.intensity_at(rate_from_probability(p, self.years))) for p in probabilities}
 
     def im_axis(self, count: int = IM_POINTS) -> np.ndarray:
-        """Intensities (IM units) to draw the fragility over: up to 1.1 × the highest stripe (IDA: the 2 % intensity in :attr:`years`)."""
+        """Intensities (IM units) to draw the fragility over: up to 1.1 × the highest stripe (IDA: the 2 % intensity in ``years``)."""
         top = (float(self.fragility["intensity"].values.max()) if "intensity" in self.fragility.coords
                else self.hazard_levels((0.02,))[0.02])
         return np.linspace(top / 200.0, 1.1 * top, count)
