@@ -116,11 +116,11 @@ def test_the_mechanisms_speak_of_a_wall_not_of_pounding(report, moat):
 def test_the_risk_section_s_moat_clearances_are_the_gap_axis_s():
     """With a hazard, the moat-wall limit state is judged at the clearances the gap axis sets (not the walls' own placeholder gap)."""
     from stochpound.experiment._spec import load_definition
+    from stochpound.risk._store import moat_clearances
     from stochpound.store import canonical_json
-    from stochpound.report.sections._risk import _moat_clearances
 
     definition, _ = load_definition(ROOT / "experiments" / "laws" / "moat_wall.toml")
     assert [w["gap"] for w in definition["scene"]["wall"]] == [0.1, 0.1]
     store = xr.Dataset(attrs={"definition": canonical_json(definition)})
-    assert _moat_clearances(store, "B1") == [0.1, 0.2, 0.3, 0.4]
-    assert _moat_clearances(store, "B2") == []
+    assert moat_clearances(store, "B1") == [0.1, 0.2, 0.3, 0.4]
+    assert moat_clearances(store, "B2") == []

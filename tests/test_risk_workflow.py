@@ -23,15 +23,14 @@ import pytest
 from click.testing import CliRunner
 
 from stochpound import open_store
-from stochpound.analysis import HazardCurve, pounding_fragility
-from stochpound.analysis._store_risk import contact_free_closure, risk_gaps
+from stochpound.risk import HazardCurve, StoreRisk, contact_free_closure, pounding_fragility, risk_gaps, store_demands, store_risk
 from stochpound.cli import main
 from stochpound.experiment._hazard import hazard_curve, stored_hazard
 from stochpound.experiment._runner import load_experiment, run_experiment
 from stochpound.experiment._spec import ExperimentError, load_definition, parse_experiment
 from stochpound.store import definition_sha256
 from stochpound.report.render._document import Paragraph, Table
-from stochpound.report.sections._risk import risk_headline, risk_of, risk_section
+from stochpound.report.sections._risk import risk_section
 from tests.test_experiment_helpers import write_experiment
 
 REPOSITORY = Path(__file__).resolve().parent.parent
@@ -200,8 +199,8 @@ def test_fixed_base_stripes_and_ida_agree(fixed_stores):
 def test_cli_prints_separation_and_rules(isolated_store, tmp_path):
     result = CliRunner().invoke(main, ["risk", str(isolated_store), "--bootstrap", "100", "--target", "0.1,0.02", "--csv", str(tmp_path / "risk.csv")])
     assert result.exit_code == 0, result.output
-    risk = risk_of(open_store(isolated_store), bootstrap=100)
-    headline = risk_headline(risk)
+    risk = store_risk(open_store(isolated_store), bootstrap=100)
+    headline = risk.to_frame()
     for value in headline["separation"]:
         assert f"{value:.3f}" in result.output
     for text in ("10 % in 50 yr", "2 % in 50 yr", "SRSS (ASCE 7 δ_MT)", "0.7 SRSS (Eurocode 8)", "DDC", "D_TM", "once in (yr)"):
@@ -241,10 +240,11 @@ def test_cli_takes_a_hazard_file_and_ida_stores(fixed_stores, tmp_path):
 
 def test_report_section_states_the_separation_first(isolated_store):
     store = open_store(isolated_store)
-    section = risk_section("risk", store)
+    risk = store_risk(store)
+    section = risk_section("risk", risk, store_demands(store))
     first = section.blocks[0]
     assert isinstance(first, Paragraph) and first.text.startswith("Risk-targeted separation g*")
-    for value in risk_headline(risk_of(store))["separation"]:
+    for value in risk.to_frame()["separation"]:
         assert f"{value:.3f} m" in first.text
     assert f"from {len(MOTIONS)} motions (3 stripes of PSA(T = 1 s, 5 % damping) in g)" in first.text
     keys = [block.key for block in section.blocks if not isinstance(block, Paragraph)]
@@ -261,10 +261,6 @@ def test_report_section_states_the_separation_first(isolated_store):
 
 def test_rules_table_is_indexed_by_the_grid_not_by_what_each_point_ran():
     """Coordinates that say what a grid point ran (base_mu, base_radius, contact_law ...) stay out of the table's index."""
-    from types import SimpleNamespace
-
-    from stochpound.report.sections._risk import rules_frame
-
     shape = (1, 1, 2, 1)
     dims = ("design_level", "rule", "mu", "contact")
     rules = xr.Dataset(
@@ -274,5 +270,5 @@ def test_rules_table_is_indexed_by_the_grid_not_by_what_each_point_ran():
                 "contact_law": (("mu", "contact"), [["kelvin"], ["kelvin"]])},
         attrs={"years": 50.0},
     )
-    frame = rules_frame(SimpleNamespace(rules=rules))
+    frame = StoreRisk(xr.Dataset(), xr.Dataset(), xr.Dataset(), rules, "", HazardCurve.bundled(BUNDLED), 8, "stripes").rules_frame()
     assert list(frame.index.names) == ["design_level", "rule", "mu"] and len(frame) == 2

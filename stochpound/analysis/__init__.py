@@ -6,6 +6,12 @@ dimensions it is told to, so it applies equally to one run (reduce over
 and to ensembles (reduce over ``realization``). Each statistic has one
 implementation, a numpy kernel of :mod:`stochpound.analysis.kernels`, which
 these functions apply with :func:`xarray.apply_ufunc`.
+
+The hazard curve (:class:`~stochpound.risk.HazardCurve`, which an
+experiment's ``[hazard]`` table is read with) is defined here, below the
+experiment layer; the risk chain built on these statistics is the package
+:mod:`stochpound.risk`, whose names this namespace also gives, as aliases,
+to code written before that package existed.
 """
 
 from stochpound.analysis._moments import moments
@@ -20,19 +26,17 @@ from stochpound.analysis._pounding import pounding_probability
 from stochpound.analysis._separation import pounding_curve, required_separation, rule_exceedance
 from stochpound.analysis._separation_rules import contact_demands, fixed_base_cqc, separation_rules, store_contact_demands
 from stochpound.analysis._summary import run_summary
-from stochpound.analysis._fragility import Fragility, fit_fragility
-from stochpound.analysis._fragility_ensemble import (
-    fragility_band,
-    fragility_surface,
-    homogeneous_capacities,
-    ida_fragility,
-    limit_state_events,
-    stripe_fragility,
-)
 from stochpound.analysis._hazard import HazardCurve, bundled_curves, probability_from_rate, rate_from_probability, return_period
-from stochpound.analysis._risk import demand_hazard_curve, mean_annual_frequency, risk_curve, risk_targeted_separation
-from stochpound.analysis._code_rules_risk import code_rules_risk
-from stochpound.analysis._store_risk import StoreRisk, contact_free_closure, pounding_fragility, risk_gaps, store_risk
+
+
+def __getattr__(name: str) -> object:
+    """A risk chain's name, from :mod:`stochpound.risk` (imported on first use)."""
+    if name in _ALIASES:
+        import stochpound.risk
+
+        return getattr(stochpound.risk, name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
 
 __all__ = [
     "moments",
@@ -81,3 +85,7 @@ __all__ = [
     "store_risk",
     "StoreRisk",
 ]
+_ALIASES = frozenset(__all__) - set(globals())
+"""The names ``__all__`` gives that this module does not define: the risk chain's, which it exported before :mod:`stochpound.risk`
+existed. They are aliases of that package's (the canonical names), resolved when first used, so that importing the statistics
+does not import the risk chain (which sits above them)."""

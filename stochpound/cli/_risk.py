@@ -7,9 +7,9 @@ from pathlib import Path
 import click
 import pandas as pd
 
-from stochpound.analysis._fragility_ensemble import BOOTSTRAP
-from stochpound.analysis._risk import TARGETS
-from stochpound._errors import StochpoundError, os_error_message
+from stochpound import StochpoundError
+from stochpound._errors import os_error_message
+from stochpound.risk import BOOTSTRAP, TARGETS
 
 
 def _targets(value: str) -> tuple[float, ...]:
@@ -46,34 +46,27 @@ def risk(store: Path, hazard: str | None, target: str, years: float, bootstrap: 
     a probability in --years. The store needs intensity stripes (with
     contact-free cases, gap = inf) or IDA capacities (docs/risk.md).
     """
-    from stochpound.analysis._store_risk import store_risk
-    from stochpound.experiment._hazard import hazard_option, stored_hazard
-    from stochpound.store import describe_measure, open_store
-    from stochpound.report.sections._risk import risk_headline, rules_frame, separation_frame
+    from stochpound.experiment import open_store
+    from stochpound.risk import site_hazard, store_risk
 
     targets = _targets(target)
     try:
         data = open_store(store)
-        setting = data.pound.intensity
-        if setting is None:
-            raise click.ClickException("store: has no intensity stripes or IDA capacities (run an experiment with an [intensity] table)")
-        hz = hazard_option(hazard, setting) if hazard is not None else stored_hazard(data)
-        if hz is None:
-            raise click.ClickException("--hazard: the store carries no hazard (its experiment has no [hazard] table): give a hazard file or a bundled curve's name")
-        result = store_risk(data, hz, targets, years, studied=data.pound.definition.studied, bootstrap=bootstrap, seed=seed)
+        hz = site_hazard(data, hazard)
+        result = store_risk(data, hz, targets, years, bootstrap=bootstrap, seed=seed)
     except (StochpoundError, ValueError) as error:
         raise click.ClickException(str(error)) from None
     except OSError as error:
         raise click.ClickException(os_error_message(error)) from None
-    stripes = f"{data.sizes['intensity']} stripes" if "intensity" in data.dims else "IDA capacities"
+    stripes = f"{result.stripes} stripes" if result.stripes is not None else "IDA capacities"
     source = hz.source.splitlines()[0] if hz.source else repr(hz)
-    click.echo(f"{data.attrs.get('experiment_name', store.stem)}: {result.motions} motions, {stripes} of {describe_measure(setting)} "
-               f"in {setting['units']}; hazard: {source}")
+    click.echo(f"{result.experiment or store.stem}: {result.motions} motions, {stripes} of {result.measure} "
+               f"in {result.setting['units']}; hazard: {source}")
     interval = "95 % BCa bootstrap interval over the motions" if bootstrap else "no bootstrap"
-    separation = separation_frame(result)
+    separation = result.separation_frame()
     click.echo(f"\nRisk-targeted separation g* (m; {interval}; inf: wider than every gap of the grid):")
     click.echo(separation.to_string(float_format=lambda v: f"{v:.3f}"))
-    rules = rules_frame(result)
+    rules = result.rules_frame()
     if result.rules is None:
         click.echo(f"\nCode rules: not evaluated: {result.rules_note}.")
     else:
@@ -81,7 +74,7 @@ def risk(store: Path, hazard: str | None, target: str, years: float, bootstrap: 
                    f"'once in N years'; P in {years:g} years):")
         click.echo(rules.to_string(float_format=lambda v: f"{v:.4g}"))
     if csv_path is not None:
-        frames = [risk_headline(result).assign(table="separation")]
+        frames = [result.to_frame().assign(table="separation")]
         if not rules.empty:
             frames.append(rules.reset_index().assign(table="rules"))
         try:

@@ -25,10 +25,11 @@ from stochpound.report.sections._generic import store_section
 from stochpound.report.sections._intensity import intensity_section
 from stochpound.report.sections._laws import law_axis, laws_section
 from stochpound.report.sections._methods import methods_section
-from stochpound.report.sections._risk import has_risk, risk_section
+from stochpound.report.sections._risk import risk_section
 from stochpound.report.sections._separation import WALLS, separation_section
 from stochpound.report.sections._stores import open_stores
 from stochpound.report.sections._summary import experiment_summary, move_per_cell_tables
+from stochpound.risk import has_risk, store_demands, store_risk
 from stochpound.studies import claims, load_study
 
 
@@ -67,10 +68,12 @@ def assemble_report(paths: Sequence[str | Path], progress: Callable[[str], None]
             report.sections.insert(0, summary)
     if others and not studies:
         report.sections.append(Section("About this report", [Paragraph(_about(others))], key="about"))
+    risks = {}
     for name, store in others.items():  # the answer first: each store's risk at its site, right after the introduction
         if has_risk(store):
             say(f"experiment {name}: risk")
-            report.sections.append(risk_section(name, store))
+            risks[name] = store_risk(store)
+            report.sections.append(risk_section(name, risks[name], store_demands(store)))
     for name, store in others.items():
         say(f"experiment {name}")
         contact_free, wall_free = has_contact_free(store), has_wall_free(store)
@@ -80,10 +83,10 @@ def assemble_report(paths: Sequence[str | Path], progress: Callable[[str], None]
             report.sections.append(laws_section(name, finite))
         if all(finite.sizes[d] for d in finite["case_status"].dims):
             report.sections.append(store_section(name, finite, contact_free or wall_free, store))
-        if wall_free and not has_risk(store):
+        if wall_free and name not in risks:
             say(f"experiment {name}: moat clearance")
             report.sections.append(separation_section(name, store, WALLS))
-        if contact_free and not has_risk(store):  # with a hazard, the Risk section gives the separation at every intensity
+        if contact_free and name not in risks:  # with a hazard, the Risk section gives the separation at every intensity
             say(f"experiment {name}: separation")
             report.sections.append(separation_section(name, store))
         if store.pound.intensity is not None:
@@ -96,7 +99,7 @@ def assemble_report(paths: Sequence[str | Path], progress: Callable[[str], None]
         if appendix is not None:
             report.sections.append(appendix)
         say("summary")
-        report.sections.insert(0, experiment_summary(others, report.sections))
+        report.sections.insert(0, experiment_summary(others, report.sections, risks=risks))
     return report
 
 

@@ -25,16 +25,11 @@ import xarray as xr
 from matplotlib.figure import Figure
 
 from stochpound.analysis.kernels import clopper_pearson
-from stochpound.store import Intensity, describe_measure, is_gap_axis
+from stochpound.store import describe_measure, is_gap_axis
 from stochpound.report.render._document import FigureItem, Paragraph, Section, Table
 
 CONFIDENCE = 0.95
 G = 9.81
-
-
-def intensity_setting(store: xr.Dataset) -> Intensity | None:
-    """A store's intensity setting (``store.pound.intensity``), or None; kept for the risk chain's move to ``stochpound.risk``."""
-    return store.pound.intensity
 
 
 def intensity_section(name: str, store: xr.Dataset) -> Section:

@@ -12,8 +12,8 @@ each with its number and interval, computed from the stores:
 * which mechanisms the runs show: ratcheting of a sliding base, the
   amplification of demands by pounding and by a moat wall, the walls'
   largest penetration (``stochpound.report.sections._mechanism_findings``);
-* the risk-targeted gap, when a builder of :data:`RISK_ANSWERS` finds a
-  hazard in the store;
+* the risk-targeted gap of a store with a hazard, from its risk chain
+  (:class:`~stochpound.risk.StoreRisk`, computed once by the assembler);
 
 and where the details are (the sections by number and title).
 Tables with one row per cell of a grid (``Table.per_cell``) move to an
@@ -22,31 +22,35 @@ appendix at the end (:func:`move_per_cell_tables`).
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 
 import numpy as np
 import pandas as pd
 import xarray as xr
 
 from stochpound.analysis import pounding_probability, required_separation
-from stochpound.report.render._document import Block, Paragraph, Section, Table
+from stochpound.report.render._document import Paragraph, Section, Table
 from stochpound.report.sections._ensembles import MIN_RUNS, Ensemble
 from stochpound.report.sections._facets import dim_text, labels_text, value_text
 from stochpound.report.sections._mechanism_findings import mechanism_answer
 from stochpound.store import gap_dims, has_contact_free, has_wall_free, wall_gap_dims, with_contacts, with_walls
+from stochpound.report.sections._risk import summary_answer
 from stochpound.report.sections._separation import CONTACTS, WALLS, Closure, SeparationEnsemble, span, span_cm
+from stochpound.risk import StoreRisk
 
 CM = 100.0
 SEPARATION_TARGETS = (0.05, 0.01)
 """Probabilities of pounding for which the summary gives the separation needed."""
-RISK_ANSWERS: list[Callable[[str, xr.Dataset], list[Block]]] = []
-"""Builders of the summary's answer to "which gap meets a target risk?": each takes an experiment's name and store and
-returns its blocks, or none for a store without a hazard. The risk section's module registers its builder here."""
 APPENDIX_TITLE = "Appendix: per-cell tables"
 
 
-def experiment_summary(stores: dict[str, xr.Dataset], sections: list[Section], confidence: float = 0.95) -> Section:
-    """The summary of the stores of experiments (those no study claims), given the report's other sections in their final order (after the summary)."""
+def experiment_summary(stores: dict[str, xr.Dataset], sections: list[Section], confidence: float = 0.95,
+                       risks: Mapping[str, StoreRisk] | None = None) -> Section:
+    """The summary of the stores of experiments (those no study claims), given the report's other sections in their final order (after the summary).
+
+    ``risks`` holds the risk chain of each store that has one (by name): its g* answers "which gap meets a target risk?".
+    """
+    risks = risks or {}
     summary = Section("Summary", key="summary")
     for name, store in stores.items():
         description = str(store.attrs.get("experiment_description", "")).strip()
@@ -74,8 +78,8 @@ def experiment_summary(stores: dict[str, xr.Dataset], sections: list[Section], c
         mechanisms = mechanism_answer(name, store)
         if mechanisms is not None:
             summary.add(Paragraph(mechanisms))
-        for answer in RISK_ANSWERS:
-            for block in answer(name, store):
+        if name in risks:
+            for block in summary_answer(name, risks[name]):
                 summary.add(block)
         summary.add(Paragraph(_where(name, sections)))
     return summary

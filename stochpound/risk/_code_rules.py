@@ -33,10 +33,10 @@ import numpy as np
 import xarray as xr
 
 from stochpound.analysis._bootstrap import bootstrap_weights, interval, jackknife_weights
-from stochpound.analysis._fragility import STATUS, stripe_mle
-from stochpound.analysis._fragility_ensemble import BOOTSTRAP
+from stochpound.risk._fragility import STATUS, stripe_mle
+from stochpound.risk._fragility_ensemble import BOOTSTRAP
 from stochpound.analysis._hazard import HazardCurve, probability_from_rate, rate_from_probability, return_period
-from stochpound.analysis._risk import lognormal_maf
+from stochpound.risk._maf import lognormal_maf
 from stochpound.analysis._separation_rules import EC8_REDUCTION, separation_rules
 
 DESIGN_LEVELS = (0.02, 0.10)
@@ -72,7 +72,7 @@ def code_rules_risk(demands: xr.Dataset, hz: HazardCurve, design_levels: Sequenc
     cqc, reduction
         As in :func:`~stochpound.analysis.separation_rules`.
     confidence, bootstrap, seed
-        As in :func:`~stochpound.analysis.stripe_fragility`.
+        As in :func:`~stochpound.risk.stripe_fragility`.
 
     Returns
     -------

@@ -31,7 +31,7 @@ from numpy.typing import ArrayLike
 
 from stochpound.analysis import kernels
 from stochpound.analysis._bootstrap import bootstrap_weights, interval, jackknife_weights
-from stochpound.analysis._fragility import STATUS, ida_mle, lognormal_cdf, stripe_mle
+from stochpound.risk._fragility import STATUS, ida_mle, lognormal_cdf, stripe_mle
 
 BOOTSTRAP = 1000
 """Default number of bootstrap resamples of the motions."""
@@ -93,7 +93,7 @@ def stripe_fragility(events: xr.DataArray, intensity_dim: str = "intensity", rec
     -------
     xarray.Dataset
         Over the other dimensions: ``theta`` (IM units), ``beta``,
-        ``status`` (``stochpound.analysis._fragility.STATUS``),
+        ``status`` (``stochpound.risk._fragility.STATUS``),
         ``theta_lower``/``theta_upper`` and ``beta_lower``/``beta_upper``
         (BCa bootstrap intervals), ``theta_bootstrap`` and ``beta_bootstrap``
         (dimension ``bootstrap``) and ``theta_jackknife`` and

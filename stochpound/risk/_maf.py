@@ -30,7 +30,7 @@ from scipy import special
 
 from stochpound.analysis import kernels
 from stochpound.analysis._bootstrap import interval
-from stochpound.analysis._fragility_ensemble import BOOTSTRAP, limit_state_events, stripe_fragility
+from stochpound.risk._fragility_ensemble import BOOTSTRAP, limit_state_events, stripe_fragility
 from stochpound.analysis._hazard import HazardCurve, probability_from_rate, rate_from_probability, return_period
 
 TARGETS = (0.10, 0.02)
@@ -49,8 +49,8 @@ def mean_annual_frequency(frag: object, hz: HazardCurve) -> float | np.ndarray |
     frag : Fragility or xarray.Dataset
         Anything with ``theta`` (IM units, the hazard's) and ``beta``
         (floats, arrays or DataArrays, broadcast): a
-        :class:`~stochpound.analysis._fragility.Fragility` or a fit Dataset
-        of :func:`~stochpound.analysis.stripe_fragility`. A step (β = 0)
+        :class:`~stochpound.risk._fragility.Fragility` or a fit Dataset
+        of :func:`~stochpound.risk.stripe_fragility`. A step (β = 0)
         at θ gives λ(θ); θ = inf gives 0.
     hz : HazardCurve
         The site's hazard, in the same intensity measure and units.
@@ -94,8 +94,8 @@ def risk_curve(fragility: xr.Dataset, hz: HazardCurve, years: float = 50.0, conf
     Parameters
     ----------
     fragility : xarray.Dataset
-        From :func:`~stochpound.analysis.stripe_fragility`
-        or :func:`~stochpound.analysis.ida_fragility`;
+        From :func:`~stochpound.risk.stripe_fragility`
+        or :func:`~stochpound.risk.ida_fragility`;
         with ``theta_bootstrap``/``beta_bootstrap`` the band is the
         percentiles of λ over the resamples of the motions (the whole chain refitted).
     hz : HazardCurve
@@ -202,7 +202,7 @@ def demand_hazard_curve(demand: xr.DataArray, levels: Sequence[float] | np.ndarr
     """The annual rate at which a demand exceeds each of ``levels`` (e.g. drift, floor acceleration, isolator displacement).
 
     The fragility of "demand ≥ level" is fitted to the stripes of
-    ``demand`` for every level (:func:`~stochpound.analysis.stripe_fragility`)
+    ``demand`` for every level (:func:`~stochpound.risk.stripe_fragility`)
     and integrated with the hazard (:func:`risk_curve`).
 
     Parameters
@@ -257,9 +257,15 @@ def _lognormal_integral(theta: np.ndarray, beta: np.ndarray, hz: HazardCurve, lo
     return integral
 
 
+def non_increasing(maf: np.ndarray) -> np.ndarray:
+    """The running minimum of a rate along its thresholds (last axis; a higher threshold cannot be exceeded more often, so a rise
+    is fitting noise); NaN counts as no bound (``inf``)."""
+    return np.fmin.accumulate(np.where(np.isnan(maf), np.inf, maf), axis=-1)
+
+
 def _separation_kernel(maf: np.ndarray, gaps: np.ndarray, rates: np.ndarray) -> np.ndarray:
     """g* per target rate along the last axis of ``maf`` (running minimum, interpolation of ln λ in ln g)."""
-    envelope = np.fmin.accumulate(np.where(np.isnan(maf), np.inf, maf), axis=-1)
+    envelope = non_increasing(maf)
     below = envelope[..., None, :] <= rates[:, None]  # (..., target, gap)
     found = below.any(-1)
     index = np.argmax(below, axis=-1)

@@ -1,0 +1,70 @@
+"""Pounding risk at a site: fragility, hazard, mean annual frequency, the risk-targeted separation g* and the code rules.
+
+The chain (docs/risk.md): the pounding fragility of every gap from
+intensity stripes or IDA runs (:func:`fit_fragility`,
+:func:`stripe_fragility`, :func:`ida_fragility`), integrated with the
+site's hazard curve (:class:`HazardCurve`) into the mean annual frequency
+of pounding (:func:`mean_annual_frequency`, :func:`risk_curve`), the gap
+that meets a target probability (:func:`risk_targeted_separation`), and
+the code separation rules in risk terms (:func:`code_rules_risk`). For an
+experiment store, :func:`store_risk` runs the whole chain and returns a
+:class:`StoreRisk`, whose tables (:meth:`StoreRisk.to_frame`,
+:meth:`StoreRisk.separation_frame`, :meth:`StoreRisk.rules_frame`) the
+report renders and ``stochpound risk`` prints; :func:`store_demands` gives
+the demand hazard curves and the moat walls' limit state
+(:class:`StoreDemands`).
+
+This package is the canonical home of these names; the ones that
+:mod:`stochpound.analysis` exported before it existed stay importable from
+there as aliases.
+"""
+
+from stochpound.analysis._hazard import HazardCurve, bundled_curves, probability_from_rate, rate_from_probability, return_period
+from stochpound.risk._fragility import Fragility, fit_fragility
+from stochpound.risk._fragility_ensemble import (
+    BOOTSTRAP,
+    fragility_band,
+    fragility_surface,
+    homogeneous_capacities,
+    ida_fragility,
+    limit_state_events,
+    stripe_fragility,
+)
+from stochpound.risk._maf import TARGETS, demand_hazard_curve, mean_annual_frequency, risk_curve, risk_targeted_separation
+from stochpound.risk._code_rules import code_rules_risk
+from stochpound.risk._store import RiskInputError, contact_free_closure, has_risk, site_hazard
+from stochpound.risk._store_risk import StoreRisk, pounding_fragility, risk_gaps, store_risk
+from stochpound.risk._demands import StoreDemands, store_demands
+
+__all__ = [
+    "Fragility",
+    "fit_fragility",
+    "fragility_band",
+    "fragility_surface",
+    "homogeneous_capacities",
+    "ida_fragility",
+    "limit_state_events",
+    "stripe_fragility",
+    "HazardCurve",
+    "bundled_curves",
+    "probability_from_rate",
+    "rate_from_probability",
+    "return_period",
+    "demand_hazard_curve",
+    "mean_annual_frequency",
+    "risk_curve",
+    "risk_targeted_separation",
+    "code_rules_risk",
+    "contact_free_closure",
+    "pounding_fragility",
+    "risk_gaps",
+    "store_risk",
+    "StoreRisk",
+    "store_demands",
+    "StoreDemands",
+    "has_risk",
+    "site_hazard",
+    "RiskInputError",
+    "TARGETS",
+    "BOOTSTRAP",
+]

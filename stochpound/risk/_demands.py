@@ -1,0 +1,111 @@
+"""Demand hazard curves of a store's stripes at its site, and moat-wall contact as a limit state.
+
+From the runs without impacts (contacts open, walls never reached) of a
+store with intensity stripes: the studied building's peak base
+displacement (when it slides) and, with ``[output] demands = true``, every
+building's peak storey drift and floor acceleration, each as a demand
+hazard curve (:func:`~stochpound.risk.demand_hazard_curve`) over
+:data:`DEMAND_LEVELS` levels from the 1 % quantile of its positive values
+to its largest. When the scene has moat walls at the studied building's
+base, the rate with which its base reaches each wall's clearance (before
+the first wall impact a run with the wall equals the run without).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pandas as pd
+import xarray as xr
+
+from stochpound.analysis._hazard import HazardCurve
+from stochpound.risk import _store
+from stochpound.risk._fragility_ensemble import BOOTSTRAP
+from stochpound.risk._maf import demand_hazard_curve
+from stochpound.risk._store_risk import CONFIDENCE, YEARS, non_increasing_along
+
+DEMAND_LEVELS = 40
+"""Levels of each demand hazard curve."""
+
+
+@dataclasses.dataclass
+class StoreDemands:
+    """The demand hazard curves of one store at one site (:func:`store_demands`), with the moat table.
+
+    ``moat_frame()`` is the moat table (per clearance: λ with its interval,
+    the return period, the probability in ``years``);
+    ``non_increasing_maf(label)`` a curve made non-increasing along its levels.
+
+    Attributes
+    ----------
+    curves : dict of str to xarray.Dataset
+        Per demand (e.g. ``"peak base displacement of B1"``), its
+        :func:`~stochpound.risk.demand_hazard_curve` over ``level``.
+    units : dict of str to str
+        The display units of each demand's levels (``m`` or ``g``).
+    moat : xarray.Dataset or None
+        The studied building's base reaching each moat wall's clearance
+        (``level``: the clearances, m), with its bootstrap interval; None
+        without moat walls at its base.
+    years : float
+        The exposure time of the probabilities (yr).
+    """
+
+    curves: dict[str, xr.Dataset]
+    units: dict[str, str]
+    moat: xr.Dataset | None
+    years: float = YEARS
+
+    def non_increasing_maf(self, label: str) -> xr.DataArray:
+        """A demand's exceedance rate made non-increasing along its levels (the running minimum; 1/yr)."""
+        return non_increasing_along(self.curves[label]["maf"], "level")
+
+    def moat_frame(self) -> pd.DataFrame:
+        """The moat table: per clearance (m), the MAF of reaching it with its interval, the return period and the probability."""
+        if self.moat is None:
+            return pd.DataFrame()
+        frame = self.moat[["maf", "maf_lower", "maf_upper", "return_period", "probability"]].reset_coords(drop=True).to_dataframe()
+        frame = frame.rename(columns={"maf": "λ (1/yr)", "maf_lower": "λ lower", "maf_upper": "λ upper", "return_period": "once in (yr)",
+                                      "probability": f"P in {self.years:g} yr"})
+        frame.index = frame.index.set_names({"level": "moat clearance (m)"})
+        return frame
+
+
+def store_demands(store: xr.Dataset, hz: HazardCurve | None = None, confidence: float = CONFIDENCE, bootstrap: int = BOOTSTRAP,
+                  seed: int = 0) -> StoreDemands | None:
+    """The demand hazard curves of a store with intensity stripes at a site (None for IDA runs or a store without demands).
+
+    Parameters
+    ----------
+    store : xarray.Dataset
+        An experiment store with intensity stripes.
+    hz : HazardCurve, optional
+        The site's hazard; default the one the store carries.
+    confidence : float
+        Confidence of the moat table's interval.
+    bootstrap : int
+        Resamples of the motions for the moat table's interval (the curves have none).
+    seed : int
+        Seed of the resamples.
+    """
+    if _store.stripes(store) is None:
+        return None
+    hz = _store.site_hazard(store) if hz is None else hz
+    studied = _store.studied_building(store)
+    demands: dict[str, tuple[xr.DataArray, str]] = {}
+    sliding = _store.base_displacement(store, studied, walls_free=True)
+    if sliding is not None:
+        demands[f"peak base displacement of {studied}"] = (sliding, "m")
+    demands.update(_store.stored_demands(store))
+    if not demands:
+        return None
+    curves = {}
+    for label, (demand, _) in demands.items():
+        values = demand.values[np.isfinite(demand.values) & (demand.values > 0)]
+        levels = np.geomspace(np.quantile(values, 0.01), values.max(), DEMAND_LEVELS)
+        curves[label] = demand_hazard_curve(demand, levels, hz, confidence=confidence, bootstrap=0)
+    clearances = _store.moat_clearances(store, studied)
+    moat = (demand_hazard_curve(sliding, clearances, hz, confidence=confidence, bootstrap=bootstrap, seed=seed)
+            if sliding is not None and clearances else None)
+    return StoreDemands(curves, {label: units for label, (_, units) in demands.items()}, moat)

@@ -1,0 +1,190 @@
+"""Every read of an experiment store by the risk chain, in one module.
+
+The chain needs, from a store: its definition's ``[intensity]`` and
+``[hazard]`` entries, its studied building and the moat walls at that
+building's base; its contact-free (and wall-free) cases, found by the gap
+axes; and, per case, the peak contact closures, the inputs of the code
+separation rules, the peak base displacements and the stored demands, with
+the motions (records, and the realizations of a synthetic ensemble) on one
+``record`` dimension. Nothing else in :mod:`stochpound.risk` opens, selects
+or parses a store, so a new way to read stores is a change of this module
+alone.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+import xarray as xr
+
+from stochpound.analysis import store_contact_demands
+from stochpound.analysis._hazard import HazardCurve
+from stochpound.experiment._hazard import hazard_option, stored_hazard
+from stochpound.store import contact_free, describe_measure, gap_dims, has_contact_free, wall_free
+
+CLOSURE = "peak_contact_closure"
+"""The store's variable of per-case, per-contact peak closures (m)."""
+CAPACITY = "ida_capacity"
+"""The variable of an IDA store (its presence marks one)."""
+SLIDING = "peak_sliding_displacement"
+"""The store's variable of per-case, per-building peak base (sliding) displacements max|s| (m)."""
+DEMANDS = {
+    "peak_interstorey_drift": ("peak storey drift", "m", 1.0),
+    "peak_floor_acceleration": ("peak floor acceleration", "g", 1.0 / 9.81),
+}
+"""Demands of a store with ``[output] demands = true`` given as hazard curves: (name, display units, factor from SI)."""
+NOT_INTENSITY = "store: has no intensity stripes or IDA capacities (run an experiment with an [intensity] table)"
+"""The error of a store without intensity-conditioned runs."""
+
+
+class RiskInputError(ValueError):
+    """A store cannot go through the risk chain (the message says why, in one line)."""
+
+
+def intensity_setting(store: xr.Dataset) -> dict[str, Any] | None:
+    """The definition's ``intensity`` entry of a store (None if it has none), through its ``pound`` accessor."""
+    return store.pound.intensity
+
+
+def measure_text(setting: Mapping[str, Any]) -> str:
+    """The intensity measure of an ``intensity`` entry in words (e.g. ``PSA(2 s, 5 %)``)."""
+    return describe_measure(setting)
+
+
+def has_risk(store: xr.Dataset) -> bool:
+    """Whether a store can go through the risk chain at its own site: intensity levels (stripes or IDA) and a stored hazard."""
+    return intensity_setting(store) is not None and stored_hazard(store) is not None and ("intensity" in store.dims or CAPACITY in store)
+
+
+def site_hazard(store: xr.Dataset, hazard: str | None = None, option: str = "--hazard") -> HazardCurve:
+    """The hazard of a store's site: the one it carries, or ``hazard`` (a bundled curve's name or a CSV file, named by ``option``).
+
+    Raises
+    ------
+    ValueError
+        (``RiskInputError``) The store has no intensity levels, or carries no
+        hazard and none is given; (``IntensityError``) ``hazard`` is
+        neither a file nor a bundled curve, or is of another measure.
+    """
+    setting = intensity_setting(store)
+    if setting is None:
+        raise RiskInputError(NOT_INTENSITY)
+    hz = hazard_option(hazard, setting, option) if hazard is not None else stored_hazard(store)
+    if hz is None:
+        raise RiskInputError(f"{option}: the store carries no hazard (its experiment has no [hazard] table): give a hazard file or a "
+                             "bundled curve's name")
+    return hz
+
+
+def studied_building(store: xr.Dataset) -> str | None:
+    """The store's studied building (its experiment's ``studied``), or None."""
+    return store.pound.definition.studied
+
+
+def experiment_name(store: xr.Dataset) -> str | None:
+    """The store's experiment name, or None."""
+    return store.attrs.get("experiment_name")
+
+
+def stripes(store: xr.Dataset) -> int | None:
+    """The number of intensity stripes of a store (None for IDA runs)."""
+    return store.sizes["intensity"] if "intensity" in store.dims else None
+
+
+def is_ida(store: xr.Dataset) -> bool:
+    """True for a store of IDA runs (``ida_capacity``, no intensity stripes); raises for a store with neither."""
+    if "intensity" in store.dims:
+        return False
+    if CAPACITY in store:
+        return True
+    raise RiskInputError(NOT_INTENSITY)
+
+
+def store_motions(data: xr.DataArray, record_dim: str = "record", realization_dim: str = "realization") -> xr.DataArray:
+    """``data`` with one motion dimension ``record_dim``: a single realization dropped, several merged into the records."""
+    if realization_dim not in data.dims:
+        return data
+    if data.sizes[realization_dim] == 1:
+        return data.isel({realization_dim: 0}, drop=True)
+    per_record = [name for name, coord in data.coords.items() if set(coord.dims) & {record_dim, realization_dim}]
+    stacked = data.drop_vars(per_record).stack(_motion=(record_dim, realization_dim))
+    labels = [f"{record}/{realization}" for record, realization in zip(data[record_dim].values.repeat(data.sizes[realization_dim]),
+                                                                        np.tile(data[realization_dim].values, data.sizes[record_dim]))]
+    stacked = stacked.drop_vars(["_motion", record_dim, realization_dim]).rename(_motion=record_dim)
+    return stacked.assign_coords({record_dim: labels})
+
+
+def contact_free_closure(store: xr.Dataset, contact_dim: str = "contact") -> xr.DataArray:
+    """The largest peak closure over the contacts of every contact-free case of a store (m), one motion dimension ``record``.
+
+    The contact-free cases are those at ``inf`` on every gap axis; in an
+    IDA store every case runs contact-free, and the first gap's are taken.
+    """
+    if CLOSURE not in store:
+        raise RiskInputError(f"store: has no {CLOSURE!r}")
+    closure = store[CLOSURE]
+    gaps = gap_dims(closure)
+    if gaps and CAPACITY in store and "intensity" not in store.dims:
+        closure = closure.isel({dim: 0 for dim in gaps}, drop=True)
+    elif gaps and not has_contact_free(closure):
+        raise RiskInputError(f"store: no contact-free cases (inf on every gap axis: {', '.join(gaps)}): add inf to the gaps")
+    else:
+        closure = contact_free(closure)
+    if contact_dim in closure.dims:
+        closure = closure.max(contact_dim, skipna=False)
+    return store_motions(closure).load().assign_attrs(units="m", long_name="largest contact-free peak closure over the contacts")
+
+
+def motion_intensity(store: xr.Dataset) -> xr.DataArray:
+    """The intensity of every motion of an IDA store at scale 1 (in the units of its levels), one motion dimension ``record``."""
+    intensity = store["motion_intensity"]
+    return store_motions(intensity.isel(gap=0, drop=True) if "gap" in intensity.dims else intensity).load()
+
+
+def contact_free_demands(store: xr.Dataset) -> xr.Dataset:
+    """The inputs of the code separation rules of every contact-free case (:func:`~stochpound.analysis.store_contact_demands`)."""
+    return xr.Dataset({name: store_motions(value) for name, value in store_contact_demands(contact_free(store)).items()}).load()
+
+
+def base_displacement(store: xr.Dataset, studied: str | None, walls_free: bool = False) -> xr.DataArray | None:
+    """A building's peak base displacement max|s| in every contact-free (and, with ``walls_free``, wall-free) case (m, one motion dimension).
+
+    NaN in the configurations where it never slides; None when it slides
+    in none (or the store has no such building or variable).
+    """
+    free = contact_free(store)
+    free = wall_free(free) if walls_free else free
+    if SLIDING not in free or studied is None or studied not in free["building"].values:
+        return None
+    sliding = store_motions(free[SLIDING].sel(building=studied, drop=True)).load()
+    slides = (sliding > 0.0).any(["intensity", "record"])
+    if not bool(slides.any()):
+        return None
+    return sliding.where(slides)
+
+
+def stored_demands(store: xr.Dataset) -> dict[str, tuple[xr.DataArray, str]]:
+    """The stored demands of every case without impacts (contacts open, walls never reached): label → (values, display units).
+
+    Storey drift (m) and floor acceleration (g) of every building, one
+    motion dimension; empty without ``[output] demands = true``.
+    """
+    free = wall_free(contact_free(store))
+    return {f"{label} of {building}": (store_motions(free[variable].sel(building=building, drop=True)) * factor, units)
+            for variable, (label, units, factor) in DEMANDS.items() if variable in free for building in free["building"].values}
+
+
+def moat_clearances(store: xr.Dataset, studied: str | None) -> list[float]:
+    """The distinct gaps of the walls at the studied building's base in the definition (its scene, with the values of a gap axis
+    that sets a wall instead of its own gap, and its variants), finite ones only."""
+    definition = store.pound.definition
+    walls = [(w, axis.values if axis is not None else (w["gap"],)) for w, axis in
+             ((w, definition.wall_gap_axis(index)) for index, w in enumerate(definition.scene.get("wall", [])))]
+    for variant in definition.variants:
+        for override in variant.overrides.values():
+            walls += [(w, (w["gap"],)) for w in override.get("scene", {}).get("wall", []) or []]
+    return sorted({float(gap) for w, gaps in walls for gap in gaps
+                   if w.get("building") == studied and w.get("level", 0) == 0 and math.isfinite(float(gap))})

@@ -1,0 +1,346 @@
+"""An experiment store's intensity-conditioned runs through the risk chain.
+
+A store with intensity stripes holds, per case, ``peak_contact_closure``
+over the grid's dimensions (``gap``, ``mu``, variants, ``intensity``,
+``record``, ``realization``) and ``contact``; its contact-free cases are
+those at ``inf`` on every gap axis. By the gap identity, their largest closure over the
+contacts decides pounding at every gap, so the pounding fragility of every
+gap and configuration comes from that one selection. A store of IDA runs
+(homogeneous scenes: ``ida_capacity``, no ``intensity`` dimension) holds one
+contact-free run per motion at scale 1, and every gap's capacity follows
+from it (:func:`~stochpound.risk.homogeneous_capacities`).
+
+The motions are the store's ``record`` entries; a synthetic ensemble's
+realizations are motions too (``record`` and ``realization`` are merged
+into one ``record`` dimension when there is more than one realization).
+:func:`store_risk` runs the whole chain of a store for a site's hazard and
+returns a :class:`StoreRisk`, which owns the chain's tables
+(:meth:`StoreRisk.to_frame`, :meth:`StoreRisk.separation_frame`,
+:meth:`StoreRisk.rules_frame`): the report renders them and
+``stochpound risk`` prints them. Every read of the store is in
+``stochpound.risk._store``.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+import pandas as pd
+import xarray as xr
+
+from stochpound.analysis._hazard import HazardCurve, rate_from_probability
+from stochpound.risk import _store
+from stochpound.risk._code_rules import MINIMUM_MOTIONS, code_rules_risk
+from stochpound.risk._fragility_ensemble import BOOTSTRAP, fragility_band, fragility_surface, homogeneous_capacities, ida_fragility, limit_state_events, stripe_fragility
+from stochpound.risk._maf import TARGETS, non_increasing, risk_curve, risk_targeted_separation
+
+YEARS = 50.0
+"""The default exposure time of the targets (yr)."""
+CONFIDENCE = 0.95
+"""The default confidence of the intervals."""
+RISK_GAPS = 60
+"""Gaps of the default grid of :func:`risk_gaps`."""
+RULE_NAMES = {
+    "abs": "ABS",
+    "srss": "SRSS (ASCE 7 δ_MT)",
+    "srss_reduced": "0.7 SRSS (Eurocode 8)",
+    "ddc": "DDC",
+    "ddc_cqc": "DDC (CQC ρ)",
+    "dtm": "D_TM (ASCE 7 §17.2.5.2)",
+}
+"""The code rules' names in the tables."""
+CURVE_GAPS = 3
+"""Fragility curves drawn per configuration (at gaps spread over the risk curve's range)."""
+IM_POINTS = 120
+"""Intensities of :meth:`StoreRisk.im_axis`."""
+_SEPARATION = {"separation": "g* (m)", "lower": "lower (m)", "upper": "upper (m)"}
+_RULE_VALUES = ("maf", "maf_lower", "maf_upper", "return_period", "probability")
+
+
+def risk_gaps(closure: xr.DataArray, count: int = RISK_GAPS) -> np.ndarray:
+    """A log-spaced grid of ``count`` gaps (m) spanning the contact-free closures, from half the smallest to 1.5 × the largest.
+
+    Below the grid every run pounds, above it none does, so the risk curve
+    over it reaches both ends of the data.
+    """
+    values = np.asarray(closure.values, dtype=float)
+    positive = values[np.isfinite(values) & (values > 0.0)]
+    if positive.size == 0:
+        raise _store.RiskInputError("store: no contact-free run closes any contact (every peak closure <= 0): no gap can pound")
+    return np.geomspace(0.5 * positive.min(), 1.5 * positive.max(), count)
+
+
+def pounding_fragility(store: xr.Dataset, gaps: Sequence[float] | np.ndarray, intensity_dim: str = "intensity", record_dim: str = "record",
+                       confidence: float = CONFIDENCE, bootstrap: int = BOOTSTRAP, seed: int = 0) -> xr.Dataset:
+    """The pounding fragility at every gap of ``gaps`` (m) and every configuration of a store, from stripes or IDA runs.
+
+    Stripes: the contact-free closures' events at every gap
+    (:func:`~stochpound.risk.limit_state_events`), fitted by
+    :func:`~stochpound.risk.stripe_fragility`. IDA: every motion's
+    capacity IM·g/D at every gap (:func:`~stochpound.risk.homogeneous_capacities`),
+    fitted by :func:`~stochpound.risk.ida_fragility`.
+
+    Returns
+    -------
+    xarray.Dataset
+        The fit over ``gap`` (the given gaps) and the store's other grid dimensions.
+    """
+    closure = _store.contact_free_closure(store)
+    if _store.is_ida(store):
+        capacities = homogeneous_capacities(closure, _store.motion_intensity(store), gaps)
+        return ida_fragility(capacities, record_dim, confidence=confidence, bootstrap=bootstrap, seed=seed)
+    events = limit_state_events(closure, gaps, "gap")
+    return stripe_fragility(events, intensity_dim, record_dim, confidence, bootstrap, seed)
+
+
+@dataclasses.dataclass
+class StoreRisk:
+    """The risk chain of one store at one site (:func:`store_risk`), with its tables.
+
+    Its tables, those ``stochpound risk`` prints and the report shows:
+    ``to_frame()`` (g* per configuration and target, one row each, with
+    its interval and the number of motions), ``separation_frame()`` (the
+    g* table, the targets side by side) and ``rules_frame()`` (the code
+    rules in risk terms: per configuration, design level and rule, the gap
+    at each contact and λ_P there). For figures: ``non_increasing_maf()``
+    (λ_P(g) as g* reads it), ``surface()`` and ``fragility_curves()``
+    (the fitted fragility over ``im_axis()``), ``hazard_levels()``.
+
+    Attributes
+    ----------
+    fragility : xarray.Dataset
+        The pounding fragility over ``gap`` and the configurations (:func:`pounding_fragility`).
+    curve : xarray.Dataset
+        λ_P(g), the pounding risk curve with its band (:func:`~stochpound.risk.risk_curve`).
+    separation : xarray.Dataset
+        g* per target (:func:`~stochpound.risk.risk_targeted_separation`).
+    rules : xarray.Dataset or None
+        The code rules in risk terms (:func:`~stochpound.risk.code_rules_risk`);
+        None for IDA runs (no stripe at the code intensity) or fewer motions than a code accepts.
+    rules_note : str
+        Why ``rules`` is None ("" otherwise).
+    hazard : HazardCurve
+        The site's hazard.
+    motions : int
+        The motions of every stripe (the bootstrap's sample size).
+    method : str
+        ``"stripes"`` or ``"ida"``.
+    setting : dict
+        The store's ``[intensity]`` entry (its measure, units and levels).
+    stripes : int or None
+        The store's intensity stripes (None for IDA runs).
+    experiment : str or None
+        The store's experiment name.
+    years : float
+        The exposure time of the targets (yr).
+    confidence : float
+        The confidence of the intervals.
+    """
+
+    fragility: xr.Dataset
+    curve: xr.Dataset
+    separation: xr.Dataset
+    rules: xr.Dataset | None
+    rules_note: str
+    hazard: HazardCurve
+    motions: int
+    method: str
+    setting: dict[str, Any] = dataclasses.field(default_factory=dict)
+    stripes: int | None = None
+    experiment: str | None = None
+    years: float = YEARS
+    confidence: float = CONFIDENCE
+
+    @property
+    def measure(self) -> str:
+        """The intensity measure in words, e.g. ``PSA(2 s, 5 %)`` ("" without a setting)."""
+        return _store.measure_text(self.setting) if self.setting else ""
+
+    def to_frame(self) -> pd.DataFrame:
+        """The g* numbers: one row per configuration and target.
+
+        Returns
+        -------
+        pandas.DataFrame
+            Columns: the configuration's dimensions, ``target`` (probability in
+            ``years``), ``separation``, ``lower``, ``upper`` (m; ``inf``: wider
+            than every gap of the grid), ``confidence``, ``motions``.
+        """
+        separation = self.separation
+        for bound in ("lower", "upper"):  # absent without a bootstrap
+            if bound not in separation:
+                separation = separation.assign({bound: xr.full_like(separation["separation"], np.nan)})
+        frame = _grid_only(separation[list(_SEPARATION)]).to_dataframe().reset_index()
+        frame = frame.drop(columns=[c for c in ("target_rate",) if c in frame])
+        return frame.assign(confidence=self.confidence, motions=self.motions)
+
+    def configuration_dims(self) -> list[str]:
+        """The dimensions of :meth:`to_frame` that name a configuration (every grid axis but the gap)."""
+        return [c for c in self.to_frame().columns if c not in ("target", *_SEPARATION, "confidence", "motions")]
+
+    def separation_frame(self) -> pd.DataFrame:
+        """The g* table: per configuration, g* and its interval (m) for each target (columns grouped by target)."""
+        frame = self.to_frame()
+        years = float(self.separation.attrs.get("years", self.years))
+        config = self.configuration_dims()
+        frame["target"] = [target_text(p, years) for p in frame["target"]]
+        table = frame.set_index([*config, "target"])[list(_SEPARATION)].rename(columns=_SEPARATION)
+        if config:
+            table = table.unstack("target")
+            table.columns = table.columns.swaplevel(0, 1)
+            order = [target_text(p, years) for p in self.separation["target"].values]
+            table = table.reindex(columns=pd.MultiIndex.from_product([order, list(_SEPARATION.values())]))
+        return table
+
+    def rules_frame(self) -> pd.DataFrame:
+        """The code rules in risk terms: per configuration, design level and rule, its gap per contact (m) and the MAF of pounding there.
+
+        Empty when the rules were not evaluated (``rules_note`` says why).
+        """
+        rules = self.rules
+        if rules is None:
+            return pd.DataFrame()
+        rules = _grid_only(rules, keep=("code_intensity", "stripe_intensity"))
+        years = float(rules.attrs.get("years", self.years))
+        gaps = rules["gap"].to_dataframe()["gap"].unstack("contact")
+        gaps.columns = [f"gap, contact {c} (m)" for c in gaps.columns]
+        values = rules[[name for name in _RULE_VALUES if name in rules]].to_dataframe()
+        frame = gaps.join(values)
+        names = dict(zip(_RULE_VALUES, ("λ_P (1/yr)", "λ_P lower", "λ_P upper", "once in (yr)", f"P in {years:g} yr")))
+        frame = frame.rename(columns=names).reset_index()
+        frame["design_level"] = [design_text(p, float(i), years) for p, i in zip(frame["design_level"], frame["stripe_intensity"])]
+        frame["rule"] = [RULE_NAMES.get(r, r) for r in frame["rule"]]
+        frame = frame.drop(columns=[c for c in ("code_intensity", "stripe_intensity") if c in frame])
+        index = [c for c in frame.columns if not c.startswith("gap, ") and c not in names.values()]
+        return frame.set_index(index).dropna(how="all")
+
+    def non_increasing_maf(self) -> xr.DataArray:
+        """λ_P(g) made non-increasing along the gaps (its running minimum, the curve g* is read from; 1/yr)."""
+        return non_increasing_along(self.curve["maf"], "gap")
+
+    def hazard_levels(self, probabilities: Sequence[float] = (0.10, 0.02)) -> dict[float, float]:
+        """The hazard's intensity (IM units) at each probability of exceedance in ``years``."""
+        return {p: float(self.hazard.intensity_at(rate_from_probability(p, self.years))) for p in probabilities}
+
+    def im_axis(self, count: int = IM_POINTS) -> np.ndarray:
+        """Intensities (IM units) to draw the fragility over: up to 1.1 × the highest stripe (IDA: the 2 % intensity in ``years``)."""
+        top = (float(self.fragility["intensity"].values.max()) if "intensity" in self.fragility.coords
+               else self.hazard_levels((0.02,))[0.02])
+        return np.linspace(top / 200.0, 1.1 * top, count)
+
+    def surface(self) -> xr.DataArray:
+        """The fitted fragility P(pounding | IM, gap) over :meth:`im_axis` (dimension ``im``) and the gaps."""
+        return fragility_surface(self.fragility, self.im_axis())
+
+    def curve_gaps(self, count: int = CURVE_GAPS) -> np.ndarray:
+        """Grid gaps (m) to draw fragility curves at: nearest to the quantiles (in ln g) of the finite g* values, else spread over the grid."""
+        gaps = self.fragility["gap"].values
+        found = self.separation["separation"].values
+        found = found[np.isfinite(found) & (found > gaps[0])]
+        if found.size:
+            wanted = np.exp(np.quantile(np.log(found), np.linspace(0.0, 1.0, count)))
+        else:
+            wanted = np.geomspace(gaps[0], gaps[-1], count + 2)[1:-1]
+        return np.unique(gaps[[int(np.argmin(np.abs(np.log(gaps) - np.log(w)))) for w in wanted]])
+
+    def fragility_curves(self) -> xr.Dataset:
+        """The fitted fragility at :meth:`curve_gaps` over :meth:`im_axis`: ``fit`` and, with a bootstrap, ``lower`` and ``upper``."""
+        shown = self.fragility.sel(gap=self.curve_gaps())
+        levels = self.im_axis()
+        curves = xr.Dataset({"fit": fragility_surface(shown, levels)})
+        if "theta_bootstrap" in shown:
+            band = fragility_band(shown, levels, self.confidence)
+            curves = curves.assign(lower=band["lower"], upper=band["upper"])
+        return curves
+
+    def return_period_range(self) -> tuple[float, float]:
+        """The smallest and largest finite return period (yr) over the rules, levels and configurations (NaN without rules)."""
+        if self.rules is None:
+            return math.nan, math.nan
+        finite = self.rules["return_period"].where(np.isfinite(self.rules["return_period"]))
+        return float(finite.min()), float(finite.max())
+
+    def target_text(self, probability: float) -> str:
+        """A target in words: ``10 % in 50 yr``."""
+        return target_text(probability, self.years)
+
+
+def non_increasing_along(maf: xr.DataArray, dim: str) -> xr.DataArray:
+    """A rate made non-increasing along its thresholds ``dim`` (the running minimum; NaN as no bound)."""
+    return xr.apply_ufunc(non_increasing, maf, input_core_dims=[[dim]], output_core_dims=[[dim]]).transpose(*maf.dims)
+
+
+def store_risk(store: xr.Dataset, hz: HazardCurve | None = None, targets: Sequence[float] = TARGETS, years: float = YEARS,
+               gaps: Sequence[float] | np.ndarray | None = None, studied: str | None = None, confidence: float = CONFIDENCE,
+               bootstrap: int = BOOTSTRAP, seed: int = 0) -> StoreRisk:
+    """Fragility at every gap, the pounding risk curve, g* and the code rules of a store's intensity-conditioned runs.
+
+    Parameters
+    ----------
+    store : xarray.Dataset
+        An experiment store with intensity stripes (contact-free cases at
+        ``gap = inf``) or IDA capacities.
+    hz : HazardCurve, optional
+        The site's hazard, in the store's intensity measure and units;
+        default: the hazard the store carries (its experiment's ``[hazard]``).
+    targets : sequence of float
+        Probabilities of pounding in ``years`` for g*.
+    years : float
+        Exposure time (yr).
+    gaps : sequence of float, optional
+        The gap grid (m); default :func:`risk_gaps` of the closures.
+    studied : str, optional
+        The building whose peak base displacement is ASCE 7's D_TM; default
+        the store's ``studied`` building. The rule is left out where it does not slide.
+    confidence, bootstrap, seed
+        As in :func:`~stochpound.risk.stripe_fragility`.
+
+    Raises
+    ------
+    ValueError
+        (``RiskInputError``) A store without stripes or IDA capacities, or
+        without contact-free runs, or without a hazard when none is given.
+    """
+    hz = _store.site_hazard(store) if hz is None else hz
+    studied = _store.studied_building(store) if studied is None else studied
+    closure = _store.contact_free_closure(store)
+    grid = risk_gaps(closure) if gaps is None else np.asarray(gaps, dtype=float)
+    fragility = pounding_fragility(store, grid, confidence=confidence, bootstrap=bootstrap, seed=seed)
+    curve = risk_curve(fragility, hz, years, confidence)
+    separation = risk_targeted_separation(curve, targets, years, confidence=confidence)
+    motions = closure.sizes["record"]
+    method = "ida" if _store.is_ida(store) else "stripes"
+    rules, note = None, ""
+    if method == "ida":
+        note = "IDA runs hold no stripe at the code intensity to apply the rules to"
+    elif motions < MINIMUM_MOTIONS:
+        note = f"the codes take the mean over at least {MINIMUM_MOTIONS} motions; the store has {motions}"
+    else:
+        rules = code_rules_risk(_store.contact_free_demands(store), hz, years=years, isolator_displacement=_store.base_displacement(store, studied),
+                                confidence=confidence, bootstrap=bootstrap, seed=seed)
+    return StoreRisk(fragility, curve, separation, rules, note, hz, motions, method, setting=_store.intensity_setting(store) or {},
+                     stripes=_store.stripes(store), experiment=_store.experiment_name(store), years=years, confidence=confidence)
+
+
+def target_text(probability: float, years: float = YEARS) -> str:
+    """A target in words: ``10 % in 50 yr``."""
+    return f"{100 * probability:g} % in {years:g} yr"
+
+
+def design_text(probability: float, stripe: float, years: float = YEARS) -> str:
+    """A code's design level in words, with the stripe its rules use: ``2 %/50 yr (stripe 0.508)``."""
+    return f"{100 * probability:g} %/{years:g} yr (stripe {stripe:g})"
+
+
+def gap_text(value: float) -> str:
+    """A gap in words (m), ``inf`` as "wider than every gap of the grid"."""
+    return "wider than every gap of the grid" if math.isinf(value) else f"{value:.3f} m"
+
+
+def _grid_only(data: xr.Dataset, keep: tuple[str, ...] = ()) -> xr.Dataset:
+    """``data`` without its coordinates that are not dimensions (what each grid point ran: friction and law parameters), but ``keep``."""
+    return data.drop_vars([name for name in data.coords if name not in data.dims and name not in keep])

@@ -1,0 +1,92 @@
+"""The risk chain as its own package (docs/risk.md, "Where things live").
+
+* ``stochpound.risk`` is the canonical home of the chain's names; the ones
+  ``stochpound.analysis`` exported before stay importable there as the same
+  objects, and importing the statistics does not import the risk chain;
+* every store read of the chain is in ``stochpound/risk/_store.py``;
+* report sections compute nothing and cache nothing: no process-wide cache;
+* ``stochpound risk`` imports no report section and no private module of
+  another package.
+"""
+
+from __future__ import annotations
+
+import ast
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parent.parent
+RISK = ROOT / "stochpound" / "risk"
+SECTIONS = ROOT / "stochpound" / "report" / "sections"
+
+
+def _imports(path: Path) -> set[str]:
+    """The modules a file imports (``from a.b import c`` gives ``a.b`` and ``a.b.c``: c may be a module)."""
+    found = set()
+    for node in ast.walk(ast.parse(path.read_text())):
+        if isinstance(node, ast.Import):
+            found |= {alias.name for alias in node.names}
+        elif isinstance(node, ast.ImportFrom) and node.module:
+            found.add(node.module)
+            found |= {f"{node.module}.{alias.name}" for alias in node.names}
+    return found
+
+
+@pytest.mark.parametrize("name", ["fit_fragility", "HazardCurve", "mean_annual_frequency", "Fragility", "stripe_fragility", "risk_curve",
+                                  "risk_targeted_separation", "code_rules_risk", "store_risk", "StoreRisk", "contact_free_closure"])
+def test_the_analysis_names_are_the_risk_package_s(name):
+    import stochpound.analysis
+    import stochpound.risk
+
+    assert name in stochpound.analysis.__all__ and name in stochpound.risk.__all__
+    assert getattr(stochpound.analysis, name) is getattr(stochpound.risk, name)
+
+
+def test_an_unknown_analysis_name_is_still_an_attribute_error():
+    import stochpound.analysis
+
+    with pytest.raises(AttributeError, match="no_such_name"):
+        stochpound.analysis.no_such_name  # noqa: B018
+
+
+def test_importing_the_statistics_does_not_import_the_risk_chain():
+    code = "import sys, stochpound.analysis; print(sorted(m for m in sys.modules if m.startswith('stochpound.risk')))"
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, check=True)
+    assert result.stdout.strip() == "[]"
+
+
+def test_every_store_read_of_the_chain_is_in_one_module():
+    """Only ``_store.py`` imports the experiment or store layers (the definition, the store's hazard, the gap axes that
+    select cases), and only it looks into a store (its attributes, variables, dimensions, accessor)."""
+    readers = {path.name for path in RISK.glob("*.py")
+               if any(module.startswith(("stochpound.experiment", "stochpound.store")) for module in _imports(path))}
+    assert readers == {"_store.py"}
+    touching = {path.name for path in RISK.glob("*.py") if re.search(r"\bstore(\.attrs|\[|\.dims|\.sizes|\.sel|\.isel|\.data_vars|\.pound)", path.read_text())}
+    assert touching == {"_store.py"}  # the other modules hand the store to _store's functions, never look into it
+
+
+def test_report_sections_keep_no_cache():
+    for path in SECTIONS.glob("*.py"):
+        text = path.read_text()
+        assert "_CACHE" not in text and "lru_cache" not in text and "functools.cache" not in text, path.name
+    risk = _imports(SECTIONS / "_risk.py")
+    assert not any(module.startswith("stochpound.risk._") for module in risk)
+    assert not {"store_risk", "store_demands"} & {node.id for node in ast.walk(ast.parse((SECTIONS / "_risk.py").read_text()))
+                                                   if isinstance(node, ast.Name)}
+
+
+def test_the_risk_command_imports_only_public_namespaces():
+    """No report section, and no private module of another package (the root package's own ``stochpound._errors`` is the CLI's)."""
+    imported = {module for module in _imports(ROOT / "stochpound" / "cli" / "_risk.py") if module.startswith("stochpound")}
+    assert not any(module.startswith("stochpound.report") for module in imported)
+    private = sorted(module for module in imported if any(part.startswith("_") for part in module.split(".")[1:])
+                     and not module.startswith("stochpound._errors"))
+    assert private == []
+    code = ("import sys, stochpound.cli._risk, stochpound.risk, stochpound.experiment; "
+            "print(sorted(m for m in sys.modules if m.startswith('stochpound.report')))")
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, check=True)
+    assert result.stdout.strip() == "[]"
