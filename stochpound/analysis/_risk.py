@@ -26,7 +26,7 @@ from collections.abc import Sequence
 import numpy as np
 import xarray as xr
 from numpy.typing import ArrayLike
-from scipy import special
+from scipy import optimize, special
 
 from stochpound.analysis import kernels
 from stochpound.analysis._bootstrap import interval
@@ -142,9 +142,13 @@ def risk_targeted_separation(curve: xr.Dataset, targets: Sequence[float] = TARGE
                              confidence: float = 0.95) -> xr.Dataset:
     """The gap g* with λ_P(g*) = λ_target for each target probability in ``years``, with its bootstrap interval.
 
-    λ_P(g) is made non-increasing along the gap grid (its running minimum:
-    a wider gap cannot pound more often, so a rise is fitting noise) and
-    g* is interpolated between the two grid gaps that bracket the target,
+    λ_P(g) is made non-increasing along the gap grid by isotonic
+    regression of ln λ_P on the gap (pool-adjacent-violators,
+    ``_nonincreasing_rate``): a wider gap cannot pound more often, so a
+    rise is estimation noise, and pooling it with its neighbours keeps the
+    upward fluctuations as well as the downward ones (a running minimum
+    would keep only the downward ones: biased low, non-conservative). g* is
+    interpolated between the two grid gaps that bracket the target,
     linearly in ln λ against ln g (exact where λ_P is a power law of g, as
     for a linear pair under a power-law hazard; against g from a zero gap).
 
@@ -257,9 +261,47 @@ def _lognormal_integral(theta: np.ndarray, beta: np.ndarray, hz: HazardCurve, lo
     return integral
 
 
+def _nonincreasing_rate(maf: np.ndarray) -> np.ndarray:
+    """The closest non-increasing curve to a rate curve along its last axis, in ln λ (isotonic regression).
+
+    Each curve (the last axis, ascending gaps) is replaced by the
+    least-squares non-increasing fit of ln λ, computed by the
+    pool-adjacent-violators algorithm (:func:`scipy.optimize.isotonic_regression`):
+    a run of values that rises is replaced by the mean of its logarithms
+    (their geometric mean). A zero rate enters as the smallest positive
+    double. NaN values are left out of the fit and take the fitted value of
+    the gap before them (``inf`` before the first finite one).
+
+    Parameters
+    ----------
+    maf : numpy.ndarray
+        Mean annual frequencies (1/yr), ≥ 0 or NaN, the gaps on the last axis.
+
+    Returns
+    -------
+    numpy.ndarray
+        The non-increasing rates, same shape.
+    """
+    maf = np.asarray(maf, dtype=float)
+    rows = maf.reshape(-1, maf.shape[-1])
+    fitted = np.full_like(rows, np.inf)
+    tiny = np.log(np.finfo(float).tiny)
+    for row, out in zip(rows, fitted, strict=True):
+        known = ~np.isnan(row)
+        if known.sum() > 1:
+            with np.errstate(divide="ignore"):
+                logs = np.maximum(np.log(row[known]), tiny)
+            values = np.exp(optimize.isotonic_regression(logs, increasing=False).x)
+            out[known] = np.where(values > np.finfo(float).tiny, values, 0.0)
+        elif known.any():
+            out[known] = row[known]
+        out[:] = np.fmin.accumulate(out)  # NaN positions take the value before them
+    return fitted.reshape(maf.shape)
+
+
 def _separation_kernel(maf: np.ndarray, gaps: np.ndarray, rates: np.ndarray) -> np.ndarray:
-    """g* per target rate along the last axis of ``maf`` (running minimum, interpolation of ln λ in ln g)."""
-    envelope = np.fmin.accumulate(np.where(np.isnan(maf), np.inf, maf), axis=-1)
+    """g* per target rate along the last axis of ``maf`` (isotonic λ, interpolation of ln λ in ln g)."""
+    envelope = _nonincreasing_rate(maf)
     below = envelope[..., None, :] <= rates[:, None]  # (..., target, gap)
     found = below.any(-1)
     index = np.argmax(below, axis=-1)
