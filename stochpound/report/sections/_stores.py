@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
@@ -123,7 +124,14 @@ def case_scene(store: xr.Dataset, **labels: Any) -> Scene:
         The case's label on every grid dimension of the store.
     """
     experiment = store_experiment(store)
-    case = experiment.case_index[str(select(store, **labels)["case_id"].values)]
+    stored = select(store, **labels)
+    case = experiment.case_index[str(stored["case_id"].values)]
     where = case.label_dict
-    return scene_from_dict({**experiment.structure(case), "motion": experiment.motion_table(where["record"], where.get("realization"))})
+    scene = scene_from_dict({**experiment.structure(case), "motion": experiment.motion_table(where["record"], where.get("realization"))})
+    scale = float(stored["scale_factor"]) if "scale_factor" in stored else 1.0
+    if scale == 1.0:
+        return scene
+    ground = scene.motion  # an intensity stripe: the motion scaled as the run scaled it (experiment.scaled_case)
+    return dataclasses.replace(scene, motion=dataclasses.replace(ground, values=ground.values * scale,
+                                                                 description=f"{ground.description} x {scale:.9g}"))
 
