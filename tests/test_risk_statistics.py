@@ -83,3 +83,22 @@ def test_isotonic_rate_keeps_a_monotone_curve_and_fills_missing_gaps():
     np.testing.assert_allclose(_nonincreasing_rate(curve), [3e-2, 1e-2, 1e-2, 4e-3, 1e-3], rtol=1e-12)
     rising = np.array([1e-2, 1e-3, 4e-3, 1e-4])
     np.testing.assert_allclose(_nonincreasing_rate(rising), [1e-2, 2e-3, 2e-3, 1e-4], rtol=1e-12)  # the pooled pair's geometric mean
+
+
+def test_stripe_fragility_resamples_the_events_of_a_store():
+    import xarray as xr
+
+    from stochpound.analysis import stripe_fragility
+
+    rng = np.random.default_rng(4)
+    levels = np.array([0.2, 0.4, 0.8, 1.6])
+    events = rng.random((4, 12)) < levels[:, None] / 1.2
+    data = xr.DataArray(events.astype(float), dims=("intensity", "record"),
+                        coords={"intensity": levels, "record": [f"m{i}" for i in range(12)],
+                                "record_event": ("record", [f"quake {i // 2}" for i in range(12)]),
+                                "record_station": ("record", [f"station {i // 2}" for i in range(12)])})
+    clustered = stripe_fragility(data, bootstrap=200, seed=1)
+    assert clustered.sizes["jackknife"] == 6 and "cluster bootstrap over events (6 clusters of 12 motions" in clustered["theta_lower"].attrs["method"]
+    plain = stripe_fragility(data.drop_vars(["record_event", "record_station"]), bootstrap=200, seed=1)
+    assert plain.sizes["jackknife"] == 12 and plain["theta_lower"].attrs["method"] == "BCa bootstrap over motions"
+    np.testing.assert_array_equal(clustered["theta"], plain["theta"])  # the estimate itself does not change

@@ -21,6 +21,7 @@ import warnings
 from collections.abc import Sequence
 
 import numpy as np
+import xarray as xr
 from scipy import special
 
 
@@ -102,6 +103,22 @@ def motion_clusters(events: Sequence[object], stations: Sequence[object] | None 
     if all(label.startswith("motion ") for label in labels):
         return None
     return np.array(labels, dtype=object)
+
+
+def record_clusters(data: xr.DataArray | xr.Dataset, record_dim: str = "record") -> np.ndarray | None:
+    """The cluster of each motion along ``record_dim`` from a store's motion metadata: :func:`motion_clusters` of its
+    ``record_event`` (and ``record_station``) coordinates; None where ``data`` has neither (every motion its own cluster)."""
+    if "record_event" not in data.coords or record_dim not in data["record_event"].dims:
+        return None
+    stations = data.coords["record_station"].values if "record_station" in data.coords else None
+    return motion_clusters(data.coords["record_event"].values, stations)
+
+
+def bootstrap_method(clusters: np.ndarray | None) -> str:
+    """How the motions were resampled, in words, for results' ``method`` attributes."""
+    if clusters is None:
+        return "BCa bootstrap over motions"
+    return f"BCa cluster bootstrap over events ({len(set(clusters))} clusters of {len(clusters)} motions; station where the event is unknown)"
 
 
 def _cluster_index(motions: int, clusters: Sequence[object] | None) -> tuple[np.ndarray, int]:

@@ -127,12 +127,12 @@ def risk_curve(fragility: xr.Dataset, hz: HazardCurve, years: float = 50.0, conf
         sampled = mean_annual_frequency(xr.Dataset({"theta": fragility["theta_bootstrap"], "beta": fragility["beta_bootstrap"]}), hz)
         left_out = mean_annual_frequency(xr.Dataset({"theta": fragility["theta_jackknife"], "beta": fragility["beta_jackknife"]}), hz)
         lower, upper = _interval(sampled, maf, left_out, confidence)
-        attrs = {"units": "1/yr", "confidence": confidence}
+        attrs = {"units": "1/yr", "confidence": confidence, "method": fragility["theta_lower"].attrs.get("method", "")}
         result = result.assign(
-            maf_lower=lower.assign_attrs(long_name="lower bound of the MAF (BCa bootstrap over motions)", **attrs),
-            maf_upper=upper.assign_attrs(long_name="upper bound of the MAF (BCa bootstrap over motions)", **attrs),
+            maf_lower=lower.assign_attrs(long_name="lower bound of the MAF", **attrs),
+            maf_upper=upper.assign_attrs(long_name="upper bound of the MAF", **attrs),
             maf_bootstrap=sampled.assign_attrs(units="1/yr", long_name="MAF of each resample of the motions"),
-            maf_jackknife=left_out.assign_attrs(units="1/yr", long_name="MAF without each motion"),
+            maf_jackknife=left_out.assign_attrs(units="1/yr", long_name="MAF without each motion or cluster of motions"),
         )
     result.attrs["hazard_extrapolated"] = int(hz.extrapolated)
     return result
@@ -191,9 +191,9 @@ def risk_targeted_separation(curve: xr.Dataset, targets: Sequence[float] = TARGE
     result = xr.Dataset({"separation": separation.assign_attrs(units="m", long_name="risk-targeted separation g*")})
     if "maf_bootstrap" in curve:
         lower, upper = _interval(solve(curve["maf_bootstrap"]), separation, solve(curve["maf_jackknife"]), confidence)
-        attrs = {"units": "m", "confidence": confidence}
-        result = result.assign(lower=lower.assign_attrs(long_name="lower bound of g* (BCa bootstrap over motions)", **attrs),
-                               upper=upper.assign_attrs(long_name="upper bound of g* (BCa bootstrap over motions)", **attrs))
+        attrs = {"units": "m", "confidence": confidence, "method": curve["maf_lower"].attrs.get("method", "")}
+        result = result.assign(lower=lower.assign_attrs(long_name="lower bound of g*", **attrs),
+                               upper=upper.assign_attrs(long_name="upper bound of g*", **attrs))
     return result.assign_coords(
         target=("target", np.atleast_1d(np.asarray(targets, dtype=float)), {"units": "1", "long_name": f"target probability of pounding in {years:g} years"}),
         target_rate=("target", rates, {"units": "1/yr", "long_name": "target mean annual frequency"}),
