@@ -26,6 +26,10 @@ class RecordError(StochpoundError, ValueError):
     the file (and line, where there is one)."""
 
 
+class VerificationError(StochpoundError):
+    """A self-check of a report disagrees with what it checks (e.g. a stored case re-run does not reproduce the store)."""
+
+
 def os_error_message(error: OSError) -> str:
     """One line for a file-system error, naming the path: ``PATH: cannot write here (Read-only file system)``.
 

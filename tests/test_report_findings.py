@@ -44,7 +44,7 @@ def test_the_sign_flip_of_isolation_is_located_by_condition():
 def test_a_sign_flip_between_ensembles_is_named():
     firm, soft = _ensemble("kt_firm", {"stiff": 0.2, "flexible": 0.2}), _ensemble("kt_soft", {"stiff": 0.8, "flexible": 0.8})
     text = isolation_across([firm, soft]).text
-    assert "changes sign between the ensembles" in text and "than it raises it in kt_firm" in text and "raises it in more in kt_soft" in text
+    assert "changes sign between the ensembles" in text and "than it raises it in kt_firm" in text and "raises it in more cells than it lowers it in kt_soft" in text
     assert "the same way in every ensemble" in isolation_across([firm, _ensemble("kt_rock", {"stiff": 0.1, "flexible": 0.3})]).text
     assert isolation_across([firm]) is None
 
@@ -88,3 +88,14 @@ def test_convergence_starts_at_min_runs_in_a_handful_of_panels():
                 assert min(line.get_xdata()) >= MIN_RUNS
     # μ is drawn as lines; of the 5 gaps the 4 with P(pounding) nearest 0.5 are panels (never pounding at 8 cm, the farthest, is left out)
     assert items[0].caption.endswith("nearest 0.5, the slowest to settle: gap 0 cm, 1 cm, 2 cm, 4 cm.")
+
+
+def test_a_tie_is_not_a_sign_of_isolations_effect():
+    from stochpound.report.sections._ensemble_findings import isolation_verdict
+
+    tie_and_lower = isolation_verdict({"firm": (4, 4, 36), "soft": (9, 2, 36)})
+    assert "changes sign" not in tie_and_lower and "in none" not in tie_and_lower
+    assert "lowers it in more cells than it raises it in soft" in tie_and_lower and "as many cells in firm" in tie_and_lower
+    flipped = isolation_verdict({"firm": (1, 6, 36), "soft": (9, 2, 36)})
+    assert flipped.startswith("The effect of isolation on the probability of pounding changes sign")
+    assert "raises it in more cells than it lowers it in firm" in flipped

@@ -228,3 +228,14 @@ dt = 0.02
     assert answer == f"Which mechanisms do the runs show? ensemble kt: the walls were penetrated by up to {largest * 100:.3g} cm."
     assert texts[0].startswith("Wall penetration (kt, B1)") and f"Over the {MIN_RUNS} runs with a wall the largest penetration is {largest * 100:.3g} cm" in texts[0]
     assert "per value of" not in texts[0]
+
+
+def test_a_residual_pushed_away_without_ratcheting_is_counted_in_the_summary_too():
+    from stochpound.report.sections._mechanism_findings import _pushed_away, ratcheting_of
+
+    free = _runs(np.random.default_rng(8).normal(0.05, 0.005, N))
+    pushed = (free - 0.05 + np.random.default_rng(9).normal(0.0, 0.001, N)).expand_dims(gap=[0.02])  # towards the neighbour's side, smaller
+    pounding, twins = Runs({"residual_sliding": pushed}), Runs({"residual_sliding": free})
+    found = ratcheting_of(pounding, twins, away=-1)
+    assert int(found["ratchets"].sum()) == 0 and int(_pushed_away(found).sum()) == 1
+    assert "In 1 cells the impacts push the residual away from the neighbour" in ratcheting_text(pounding, twins, away=-1)

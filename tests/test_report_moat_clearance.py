@@ -124,3 +124,13 @@ def test_the_risk_section_s_moat_clearances_are_the_gap_axis_s():
     store = xr.Dataset(attrs={"definition": canonical_json(definition)})
     assert moat_clearances(store, "B1") == [0.1, 0.2, 0.3, 0.4]
     assert moat_clearances(store, "B2") == []
+
+
+def test_the_per_cell_tables_of_a_walls_only_store_name_wall_hits(report):
+    tables = [b for s in report.sections for b in s.blocks if isinstance(b, Table) and b.key.startswith("table-moat_wall-") and b.key.endswith("-pounding")]
+    assert tables
+    for table in tables:
+        heads = {str(column[0]) for column in table.frame.columns}
+        assert "P(wall hit)" in heads and "P(pounding)" not in heads
+        assert not any("phase" in head for head in heads) and "peak wall force, given a wall hit (kN)" in heads
+        assert "wall hit" in table.caption and "pounding" not in table.caption and "P(pounding)" not in table.note

@@ -21,16 +21,25 @@ import warnings
 from collections.abc import Sequence
 
 import numpy as np
+import xarray as xr
 from scipy import special
 
 
-def bootstrap_weights(motions: int, resamples: int, seed: int | Sequence[int]) -> np.ndarray:
+def bootstrap_weights(motions: int, resamples: int, seed: int | Sequence[int], clusters: Sequence[object] | None = None) -> np.ndarray:
     """How many times each motion appears in each resample with replacement: the one resampler of the toolkit.
 
-    Each resample draws ``motions`` indices uniformly with replacement from
-    ``numpy.random.default_rng(seed)`` and counts them; the fragility and risk
-    bootstraps and the percentile bootstrap of the mean
-    (:func:`stochpound.analysis.kernels.bootstrap_mean_interval`) all use it.
+    Without ``clusters`` each resample draws ``motions`` indices uniformly
+    with replacement from ``numpy.random.default_rng(seed)`` and counts them.
+    With ``clusters`` (a label per motion, e.g. its earthquake) the clusters
+    are resampled instead: each resample draws as many clusters as there are,
+    with replacement, and every motion of a drawn cluster appears as often as
+    its cluster was drawn (the cluster bootstrap of Davison & Hinkley 1997,
+    §3.8). Motions of one event share its source and path, so their responses
+    are correlated; resampling them as if independent makes intervals too
+    narrow. Singleton clusters in motion order give exactly the plain
+    resampler's weights. The fragility and risk bootstraps and the percentile
+    bootstrap of the mean (:func:`stochpound.analysis.kernels.bootstrap_mean_interval`)
+    all use it.
 
     Parameters
     ----------
@@ -40,24 +49,90 @@ def bootstrap_weights(motions: int, resamples: int, seed: int | Sequence[int]) -
         Number of resamples, positive.
     seed : int or sequence of int
         Seed of :func:`numpy.random.default_rng`: the same seed gives the same weights.
+    clusters : sequence, optional
+        One hashable label per motion; motions with equal labels are resampled together.
 
     Returns
     -------
     numpy.ndarray
-        Counts, float, shape (resamples, motions); each row sums to ``motions``.
+        Counts, float, shape (resamples, motions).
     """
     if not (isinstance(resamples, (int, np.integer)) and resamples > 0):
         raise ValueError(f"bootstrap: must be a positive number of resamples, got {resamples!r}")
     if motions < 2:
         raise ValueError(f"record: the bootstrap needs at least 2 motions, got {motions}")
-    drawn = np.random.default_rng(seed).integers(0, motions, size=(resamples, motions))
-    counts = np.bincount((drawn + motions * np.arange(resamples)[:, None]).ravel(), minlength=resamples * motions)
-    return counts.reshape(resamples, motions).astype(np.float64)
+    index, count = _cluster_index(motions, clusters)
+    drawn = np.random.default_rng(seed).integers(0, count, size=(resamples, count))
+    drawn_counts = np.bincount((drawn + count * np.arange(resamples)[:, None]).ravel(), minlength=resamples * count)
+    return drawn_counts.reshape(resamples, count)[:, index].astype(np.float64)
 
 
-def jackknife_weights(motions: int) -> np.ndarray:
-    """Leave-one-motion-out weights: an array (motions, motions), 0 on the diagonal and 1 elsewhere."""
-    return 1.0 - np.eye(motions)
+def jackknife_weights(motions: int, clusters: Sequence[object] | None = None) -> np.ndarray:
+    """Leave-one-out weights, shape (clusters, motions): 0 for the motions of the cluster left out, 1 elsewhere.
+
+    Without ``clusters`` every motion is its own cluster (an array
+    (motions, motions), 0 on the diagonal).
+    """
+    index, count = _cluster_index(motions, clusters)
+    return (np.arange(count)[:, None] != index[None, :]).astype(np.float64)
+
+
+def motion_clusters(events: Sequence[object], stations: Sequence[object] | None = None) -> np.ndarray | None:
+    """Cluster labels of motions for :func:`bootstrap_weights`: their earthquake, or their station where the event is unknown.
+
+    Parameters
+    ----------
+    events : sequence of str
+        Each motion's earthquake ("" where unknown).
+    stations : sequence of str, optional
+        Each motion's recording station, used where the event is blank.
+
+    Returns
+    -------
+    numpy.ndarray or None
+        One label per motion; None when no motion has an event or station
+        (every motion is then its own cluster).
+    """
+    events = [str(e) for e in events]
+    stations = [str(s) for s in stations] if stations is not None else [""] * len(events)
+    if len(stations) != len(events):
+        raise ValueError(f"stations: must hold one per motion ({len(events)}), got {len(stations)}")
+    labels = []
+    for i, (event, station) in enumerate(zip(events, stations, strict=True)):
+        labels.append(f"event {event}" if event else (f"station {station}" if station else f"motion {i}"))
+    if all(label.startswith("motion ") for label in labels):
+        return None
+    return np.array(labels, dtype=object)
+
+
+def record_clusters(data: xr.DataArray | xr.Dataset, record_dim: str = "record") -> np.ndarray | None:
+    """The cluster of each motion along ``record_dim`` from a store's motion metadata: :func:`motion_clusters` of its
+    ``record_event`` (and ``record_station``) coordinates; None where ``data`` has neither (every motion its own cluster)."""
+    if "record_event" not in data.coords or record_dim not in data["record_event"].dims:
+        return None
+    stations = data.coords["record_station"].values if "record_station" in data.coords else None
+    return motion_clusters(data.coords["record_event"].values, stations)
+
+
+def bootstrap_method(clusters: np.ndarray | None) -> str:
+    """How the motions were resampled, in words, for results' ``method`` attributes."""
+    if clusters is None:
+        return "BCa bootstrap over motions"
+    return f"BCa cluster bootstrap over events ({len(set(clusters))} clusters of {len(clusters)} motions; station where the event is unknown)"
+
+
+def _cluster_index(motions: int, clusters: Sequence[object] | None) -> tuple[np.ndarray, int]:
+    """Each motion's cluster number (in order of first appearance) and the number of clusters."""
+    if clusters is None:
+        return np.arange(motions), motions
+    labels = list(clusters)
+    if len(labels) != motions:
+        raise ValueError(f"clusters: must hold one label per motion ({motions}), got {len(labels)}")
+    numbers: dict[object, int] = {}
+    index = np.array([numbers.setdefault(label, len(numbers)) for label in labels], dtype=np.intp)
+    if len(numbers) < 2:
+        raise ValueError(f"clusters: the bootstrap needs at least 2 clusters (events), got {len(numbers)}")
+    return index, len(numbers)
 
 
 def interval(samples: np.ndarray, estimate: np.ndarray, jackknife: np.ndarray | None, confidence: float) -> tuple[np.ndarray, np.ndarray]:

@@ -19,7 +19,7 @@ from pathlib import Path
 import xarray as xr
 
 from stochpound.store import has_contact_free, has_wall_free, with_contacts, with_walls
-from stochpound.report.render._document import Paragraph, Report, Section
+from stochpound.report.render._document import FigureItem, Paragraph, Report, Section
 from stochpound.report.sections._ensembles import INTERVAL_NOTE
 from stochpound.report.sections._generic import store_section
 from stochpound.report.sections._intensity import intensity_section
@@ -66,8 +66,6 @@ def assemble_report(paths: Sequence[str | Path], progress: Callable[[str], None]
         summary = study.summary(report.sections)
         if summary is not None:
             report.sections.insert(0, summary)
-    if others and not studies:
-        report.sections.append(Section("About this report", [Paragraph(_about(others))], key="about"))
     risks = {}
     for name, store in others.items():  # the answer first: each store's risk at its site, right after the introduction
         if has_risk(store):
@@ -98,21 +96,36 @@ def assemble_report(paths: Sequence[str | Path], progress: Callable[[str], None]
         appendix = move_per_cell_tables(report.sections)
         if appendix is not None:
             report.sections.append(appendix)
+        report.sections.insert(0, Section("About this report", [Paragraph(_about(others, report.sections))], key="about"))
         say("summary")
         report.sections.insert(0, experiment_summary(others, report.sections, risks=risks))
     return report
 
 
-def _about(stores: dict[str, xr.Dataset]) -> str:
-    """What the report of stores no study claims holds, and how to read it."""
+def _about(stores: dict[str, xr.Dataset], sections: list[Section]) -> str:
+    """What the report of stores no study claims holds, and how to read it: only what its ``sections`` contain."""
     described = "; ".join(f"{name}: {store.attrs.get('experiment_description', '')}" for name, store in stores.items())
-    return (
-        f"This report describes the experiment stores {described}. Each experiment has a section: the cases run under "
-        "records one by one, and each synthetic ensemble by the statistics of its realizations in every cell of the grid "
-        f"(every combination of the grid's axes): means with 95 % confidence intervals ({INTERVAL_NOTE}), quantiles of the peaks, and "
-        "the probability of pounding (at least one impact) with its 95 % Clopper–Pearson interval, followed by findings "
-        "computed from them, tables (also written as CSV files) and figures in which every cell is drawn. An ECDF gives, for "
-        "each value, the fraction of realizations at or below it; a convergence figure shows an estimate over the first n "
-        "realizations, so that one sees whether the ensemble is large enough. The Methods section describes every building, "
-        "contact and motion from the stores' own definitions and checks the solver while the report is built."
-    )
+    kinds = {section.key.split("-", 1)[0] for section in sections}
+    figures = [block.key for section in sections for block in section.blocks if isinstance(block, FigureItem)]
+    parts = [f"This report describes the experiment stores {described}."]
+    if "risk" in kinds:
+        parts.append("A Risk section per experiment with a site hazard gives the risk-targeted separation g* first, then the "
+                     "fragility at every gap, the mean annual frequency of pounding and the code rules in risk terms.")
+    if "experiment" in kinds:
+        parts.append("An experiment section gives the cases run under records one by one, and each synthetic ensemble by the "
+                     "statistics of its realizations in every cell of the grid (every combination of the grid's axes): means with "
+                     f"95 % confidence intervals ({INTERVAL_NOTE}), quantiles of the peaks, and the probability of pounding (at least one "
+                     "impact) with its 95 % Clopper–Pearson interval, followed by findings computed from them and tables (also written "
+                     "as CSV files).")
+    if any("-ecdf-" in key for key in figures):
+        parts.append("An ECDF gives, for each value, the fraction of realizations at or below it.")
+    if any("-convergence-" in key for key in figures):
+        parts.append("A convergence figure shows an estimate over the first n realizations, so that one sees whether the ensemble "
+                     "is large enough.")
+    if kinds & {"separation", "clearance"}:
+        parts.append("A separation or moat-clearance section answers the gap question from the contact-free (or wall-free) runs.")
+    if "intensity" in kinds:
+        parts.append("An Intensity section describes the motions' intensity measures, the stripes and their scale factors.")
+    parts.append("The Methods section describes every building, contact and motion from the stores' own definitions and checks "
+                 "the solver while the report is built; the build stops if a check fails.")
+    return " ".join(parts)

@@ -6,7 +6,10 @@ intensity stripes or IDA runs (:func:`fit_fragility`,
 site's hazard curve (:class:`HazardCurve`) into the mean annual frequency
 of pounding (:func:`mean_annual_frequency`, :func:`risk_curve`), the gap
 that meets a target probability (:func:`risk_targeted_separation`), and
-the code separation rules in risk terms (:func:`code_rules_risk`). For an
+the code separation rules in risk terms (:func:`code_rules_risk`), and the
+separations as the codes compute them from a design analysis
+(:func:`asce7_inelastic_displacement`, :func:`ec8_design_displacement`,
+:func:`srss_separation`, :func:`asce7_isolator_displacement`). For an
 experiment store, :func:`store_risk` runs the whole chain and returns a
 :class:`StoreRisk`, whose tables (:meth:`StoreRisk.to_frame`,
 :meth:`StoreRisk.separation_frame`, :meth:`StoreRisk.rules_frame`) the
@@ -32,6 +35,15 @@ from stochpound.risk._fragility_ensemble import (
 )
 from stochpound.risk._maf import TARGETS, demand_hazard_curve, mean_annual_frequency, risk_curve, risk_targeted_separation
 from stochpound.risk._code_rules import code_rules_risk
+from stochpound.risk._code_gaps import (
+    Asce7Design,
+    Ec8Design,
+    asce7_inelastic_displacement,
+    asce7_isolator_displacement,
+    ec8_design_displacement,
+    modal_floor_displacements,
+    srss_separation,
+)
 from stochpound.risk._store import RiskInputError, contact_free_closure, has_risk, site_hazard
 from stochpound.risk._store_risk import StoreRisk, pounding_fragility, risk_gaps, store_risk
 from stochpound.risk._demands import StoreDemands, store_demands
@@ -55,6 +67,13 @@ __all__ = [
     "risk_curve",
     "risk_targeted_separation",
     "code_rules_risk",
+    "Asce7Design",
+    "Ec8Design",
+    "modal_floor_displacements",
+    "asce7_inelastic_displacement",
+    "ec8_design_displacement",
+    "srss_separation",
+    "asce7_isolator_displacement",
     "contact_free_closure",
     "pounding_fragility",
     "risk_gaps",

@@ -32,7 +32,7 @@ from collections.abc import Sequence
 import numpy as np
 import xarray as xr
 
-from stochpound.analysis._bootstrap import bootstrap_weights, interval, jackknife_weights
+from stochpound.analysis._bootstrap import bootstrap_method, bootstrap_weights, interval, jackknife_weights, record_clusters
 from stochpound.risk._fragility import STATUS, stripe_mle
 from stochpound.risk._fragility_ensemble import BOOTSTRAP
 from stochpound.analysis._hazard import HazardCurve, probability_from_rate, rate_from_probability, return_period
@@ -109,9 +109,10 @@ def code_rules_risk(demands: xr.Dataset, hz: HazardCurve, design_levels: Sequenc
             return_period=xr.apply_ufunc(return_period, estimate["maf"]).assign_attrs(units="yr", long_name="mean return period of pounding"),
         )
         if bootstrap:
-            sampled = chain(stripe, xr.DataArray(bootstrap_weights(motions, bootstrap, seed), dims=("sample", record_dim)))
-            left_out = chain(stripe, xr.DataArray(jackknife_weights(motions), dims=("sample", record_dim))).rename(sample="jackknife")
-            attrs = {"confidence": confidence, "method": "BCa bootstrap over motions (rule gap and fragility refitted)", "seed": seed}
+            clusters = record_clusters(demands, record_dim)
+            sampled = chain(stripe, xr.DataArray(bootstrap_weights(motions, bootstrap, seed, clusters), dims=("sample", record_dim)))
+            left_out = chain(stripe, xr.DataArray(jackknife_weights(motions, clusters), dims=("sample", record_dim))).rename(sample="jackknife")
+            attrs = {"confidence": confidence, "method": f"{bootstrap_method(clusters)} (rule gap and fragility refitted)", "seed": seed}
             for name, units in (("maf", "1/yr"), ("gap", "m")):
                 lower, upper = xr.apply_ufunc(lambda b, e, j: interval(b, e, j, confidence), sampled[name], estimate[name], left_out[name],
                                               input_core_dims=[["sample"], [], ["jackknife"]], output_core_dims=[[], []])

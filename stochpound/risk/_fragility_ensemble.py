@@ -30,7 +30,7 @@ import xarray as xr
 from numpy.typing import ArrayLike
 
 from stochpound.analysis import kernels
-from stochpound.analysis._bootstrap import bootstrap_weights, interval, jackknife_weights
+from stochpound.analysis._bootstrap import bootstrap_method, bootstrap_weights, interval, jackknife_weights, record_clusters
 from stochpound.risk._fragility import STATUS, ida_mle, lognormal_cdf, stripe_mle
 
 BOOTSTRAP = 1000
@@ -132,7 +132,7 @@ def stripe_fragility(events: xr.DataArray, intensity_dim: str = "intensity", rec
             n_w = np.einsum("...jr,br->...bj", valid.astype(float), weights)
             return stripe_mle(levels, k_w, n_w)[:2]
 
-        result = _with_bootstrap(result, refit, values.shape[-1], other, confidence, bootstrap, seed)
+        result = _with_bootstrap(result, refit, record_clusters(data, record_dim), values.shape[-1], other, confidence, bootstrap, seed)
     return result
 
 
@@ -173,7 +173,7 @@ def ida_fragility(capacities: xr.DataArray, record_dim: str = "record", censored
         def refit(weights: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
             return ida_mle(values[..., None, :], None if bound is None else bound[..., None, :], weights)[:2]
 
-        result = _with_bootstrap(result, refit, values.shape[-1], other, confidence, bootstrap, seed)
+        result = _with_bootstrap(result, refit, record_clusters(data, record_dim), values.shape[-1], other, confidence, bootstrap, seed)
     return result
 
 
@@ -279,12 +279,12 @@ def _fit_dataset(theta: np.ndarray, beta: np.ndarray, status: np.ndarray, dims: 
     )
 
 
-def _with_bootstrap(result: xr.Dataset, refit: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]], motions: int, dims: tuple,
-                    confidence: float, resamples: int, seed: int) -> xr.Dataset:
-    """``result`` with θ, β refitted to bootstrap and jackknife resamples of the motions, and their BCa intervals."""
-    theta_b, beta_b = refit(bootstrap_weights(motions, resamples, seed))
-    theta_j, beta_j = refit(jackknife_weights(motions))
-    attrs = {"confidence": confidence, "method": "BCa bootstrap over motions", "seed": seed}
+def _with_bootstrap(result: xr.Dataset, refit: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]], clusters: np.ndarray | None,
+                    motions: int, dims: tuple, confidence: float, resamples: int, seed: int) -> xr.Dataset:
+    """``result`` with θ, β refitted to bootstrap and jackknife resamples of the motions (by cluster), and their BCa intervals."""
+    theta_b, beta_b = refit(bootstrap_weights(motions, resamples, seed, clusters))
+    theta_j, beta_j = refit(jackknife_weights(motions, clusters))
+    attrs = {"confidence": confidence, "method": bootstrap_method(clusters), "seed": seed}
     variables = {}
     for name, sampled, left_out, units in (("theta", theta_b, theta_j, {}), ("beta", beta_b, beta_j, {"units": "1"})):
         lower, upper = interval(sampled, result[name].values, left_out, confidence)

@@ -26,7 +26,7 @@ from collections.abc import Sequence
 import numpy as np
 import xarray as xr
 from numpy.typing import ArrayLike
-from scipy import special
+from scipy import optimize, special
 
 from stochpound.analysis import kernels
 from stochpound.analysis._bootstrap import interval
@@ -127,12 +127,12 @@ def risk_curve(fragility: xr.Dataset, hz: HazardCurve, years: float = 50.0, conf
         sampled = mean_annual_frequency(xr.Dataset({"theta": fragility["theta_bootstrap"], "beta": fragility["beta_bootstrap"]}), hz)
         left_out = mean_annual_frequency(xr.Dataset({"theta": fragility["theta_jackknife"], "beta": fragility["beta_jackknife"]}), hz)
         lower, upper = _interval(sampled, maf, left_out, confidence)
-        attrs = {"units": "1/yr", "confidence": confidence}
+        attrs = {"units": "1/yr", "confidence": confidence, "method": fragility["theta_lower"].attrs.get("method", "")}
         result = result.assign(
-            maf_lower=lower.assign_attrs(long_name="lower bound of the MAF (BCa bootstrap over motions)", **attrs),
-            maf_upper=upper.assign_attrs(long_name="upper bound of the MAF (BCa bootstrap over motions)", **attrs),
+            maf_lower=lower.assign_attrs(long_name="lower bound of the MAF", **attrs),
+            maf_upper=upper.assign_attrs(long_name="upper bound of the MAF", **attrs),
             maf_bootstrap=sampled.assign_attrs(units="1/yr", long_name="MAF of each resample of the motions"),
-            maf_jackknife=left_out.assign_attrs(units="1/yr", long_name="MAF without each motion"),
+            maf_jackknife=left_out.assign_attrs(units="1/yr", long_name="MAF without each motion or cluster of motions"),
         )
     result.attrs["hazard_extrapolated"] = int(hz.extrapolated)
     return result
@@ -142,9 +142,13 @@ def risk_targeted_separation(curve: xr.Dataset, targets: Sequence[float] = TARGE
                              confidence: float = 0.95) -> xr.Dataset:
     """The gap g* with λ_P(g*) = λ_target for each target probability in ``years``, with its bootstrap interval.
 
-    λ_P(g) is made non-increasing along the gap grid (its running minimum:
-    a wider gap cannot pound more often, so a rise is fitting noise) and
-    g* is interpolated between the two grid gaps that bracket the target,
+    λ_P(g) is made non-increasing along the gap grid by isotonic
+    regression of ln λ_P on the gap (pool-adjacent-violators,
+    ``non_increasing``): a wider gap cannot pound more often, so a
+    rise is estimation noise, and pooling it with its neighbours keeps the
+    upward fluctuations as well as the downward ones (a running minimum
+    would keep only the downward ones: biased low, non-conservative). g* is
+    interpolated between the two grid gaps that bracket the target,
     linearly in ln λ against ln g (exact where λ_P is a power law of g, as
     for a linear pair under a power-law hazard; against g from a zero gap).
 
@@ -187,9 +191,9 @@ def risk_targeted_separation(curve: xr.Dataset, targets: Sequence[float] = TARGE
     result = xr.Dataset({"separation": separation.assign_attrs(units="m", long_name="risk-targeted separation g*")})
     if "maf_bootstrap" in curve:
         lower, upper = _interval(solve(curve["maf_bootstrap"]), separation, solve(curve["maf_jackknife"]), confidence)
-        attrs = {"units": "m", "confidence": confidence}
-        result = result.assign(lower=lower.assign_attrs(long_name="lower bound of g* (BCa bootstrap over motions)", **attrs),
-                               upper=upper.assign_attrs(long_name="upper bound of g* (BCa bootstrap over motions)", **attrs))
+        attrs = {"units": "m", "confidence": confidence, "method": curve["maf_lower"].attrs.get("method", "")}
+        result = result.assign(lower=lower.assign_attrs(long_name="lower bound of g*", **attrs),
+                               upper=upper.assign_attrs(long_name="upper bound of g*", **attrs))
     return result.assign_coords(
         target=("target", np.atleast_1d(np.asarray(targets, dtype=float)), {"units": "1", "long_name": f"target probability of pounding in {years:g} years"}),
         target_rate=("target", rates, {"units": "1/yr", "long_name": "target mean annual frequency"}),
@@ -258,13 +262,45 @@ def _lognormal_integral(theta: np.ndarray, beta: np.ndarray, hz: HazardCurve, lo
 
 
 def non_increasing(maf: np.ndarray) -> np.ndarray:
-    """The running minimum of a rate along its thresholds (last axis; a higher threshold cannot be exceeded more often, so a rise
-    is fitting noise); NaN counts as no bound (``inf``)."""
-    return np.fmin.accumulate(np.where(np.isnan(maf), np.inf, maf), axis=-1)
+    """The closest non-increasing curve to a rate curve along its last axis, in ln λ (isotonic regression).
+
+    Each curve (the last axis, ascending gaps) is replaced by the
+    least-squares non-increasing fit of ln λ, computed by the
+    pool-adjacent-violators algorithm (:func:`scipy.optimize.isotonic_regression`):
+    a run of values that rises is replaced by the mean of its logarithms
+    (their geometric mean). A zero rate enters as the smallest positive
+    double. NaN values are left out of the fit and take the fitted value of
+    the gap before them (``inf`` before the first finite one).
+
+    Parameters
+    ----------
+    maf : numpy.ndarray
+        Mean annual frequencies (1/yr), ≥ 0 or NaN, the gaps on the last axis.
+
+    Returns
+    -------
+    numpy.ndarray
+        The non-increasing rates, same shape.
+    """
+    maf = np.asarray(maf, dtype=float)
+    rows = maf.reshape(-1, maf.shape[-1])
+    fitted = np.full_like(rows, np.inf)
+    tiny = np.log(np.finfo(float).tiny)
+    for row, out in zip(rows, fitted, strict=True):
+        known = ~np.isnan(row)
+        if known.sum() > 1:
+            with np.errstate(divide="ignore"):
+                logs = np.maximum(np.log(row[known]), tiny)
+            values = np.exp(optimize.isotonic_regression(logs, increasing=False).x)
+            out[known] = np.where(values > np.finfo(float).tiny, values, 0.0)
+        elif known.any():
+            out[known] = row[known]
+        out[:] = np.fmin.accumulate(out)  # NaN positions take the value before them
+    return fitted.reshape(maf.shape)
 
 
 def _separation_kernel(maf: np.ndarray, gaps: np.ndarray, rates: np.ndarray) -> np.ndarray:
-    """g* per target rate along the last axis of ``maf`` (running minimum, interpolation of ln λ in ln g)."""
+    """g* per target rate along the last axis of ``maf`` (isotonic λ, interpolation of ln λ in ln g)."""
     envelope = non_increasing(maf)
     below = envelope[..., None, :] <= rates[:, None]  # (..., target, gap)
     found = below.any(-1)

@@ -22,6 +22,7 @@ import numpy as np
 import xarray as xr
 
 import stochpound
+from stochpound._errors import VerificationError
 from stochpound.model import laws
 from stochpound.model.modal_solution import harmonic_response, modal_properties
 from stochpound.report.sections._description import StoreDefinition, number
@@ -35,6 +36,8 @@ COLLISION_VELOCITY = 0.5
 HARMONIC_AMPLITUDE, HARMONIC_DETUNING = 1.0, 0.9
 #: Tolerances of the DOP853 reference run.
 REFERENCE_RTOL, REFERENCE_ATOL = 1e-12, 1e-14
+CROSS_CHECK_TOLERANCE = 1e-6
+"""Largest difference of the cross-check's two solvers, as a share of the peak displacement, that passes."""
 
 
 def free_collision_restitution(damping_ratio: float, tensile: bool) -> float:
@@ -180,7 +183,15 @@ def cross_check_case(store: xr.Dataset) -> tuple[dict, bool] | None:
 
 
 def cross_check(definitions: list[StoreDefinition]) -> Paragraph | None:
-    """The exact solver against scipy's DOP853 (rtol 1e-12) on one stored case with pounding, with sliding if any store has it."""
+    """The exact solver against scipy's DOP853 (rtol 1e-12) on one stored case with pounding, with sliding if any store has it.
+
+    The case is re-run exactly as it ran (its scene, motion and intensity
+    scale factor). The check can fail: the build stops with a
+    :class:`~stochpound._errors.VerificationError` when the re-run does not
+    count the impacts the store holds, when the two solvers count different
+    impacts, or when they differ by more than :data:`CROSS_CHECK_TOLERANCE`
+    of the peak displacement.
+    """
     candidates = [(d, found) for d in definitions if "impacts" in d.store for found in [cross_check_case(d.store)] if found is not None]
     if not candidates:
         return None
@@ -192,19 +203,36 @@ def cross_check(definitions: list[StoreDefinition]) -> Paragraph | None:
     reference = stochpound.simulate(scene, method="ivp", integrator="DOP853", rtol=REFERENCE_RTOL, atol=REFERENCE_ATOL)
     difference = float(np.nanmax(np.abs(exact["total_displacement"].values - reference["total_displacement"].values)))
     peak = float(np.nanmax(np.abs(reference["total_displacement"].values)))
-    stored = select(store, **labels)
+    held = int(select(store, **labels)["impacts"])
     where = ", ".join(f"{k} = {number(v) if isinstance(v, float) else v}" for k, v in labels.items())
+    counts = (exact.sizes["impact"], reference.sizes["impact"])
+    _verify(name, where, held, counts, difference, peak)
     sliding = float(exact["sliding_displacement"].max() - exact["sliding_displacement"].min())
+    scale = float(select(store, **labels)["scale_factor"]) if "scale_factor" in store else 1.0
     return Paragraph(
-        f"Cross-check on a stored case of {name} ({where}; {exact.sizes['impact']} impacts"
+        f"Cross-check on a stored case of {name} ({where}"
+        + (f", motion scale factor {number(scale, 4)}" if scale != 1.0 else "")
+        + f"; {counts[0]} impacts"
         + (f", sliding over {number(sliding * 100, 3)} cm" if sliding > 0 else "")
-        + f", {number(float(scene.motion.times[-1]))} s): "
+        + f", {number(float(scene.motion.times[-1]))} s), re-run as it was run: "
         + (f"the ivp solver at its defaults (nonlinear laws: {'; '.join(nonlinear)})" if nonlinear else "the exact solver")
         + " and scipy's DOP853 with event location "
         f"(rtol {REFERENCE_RTOL:g}) differ by at most {difference:.1e} m in any floor's total displacement (peak "
-        f"{number(peak * 100, 3)} cm), and count {exact.sizes['impact']} and {reference.sizes['impact']} impacts (the store "
-        f"holds {float(stored['impacts']):.0f})."
+        f"{number(peak * 100, 3)} cm) and both count the {held} impacts the store holds. The report is built only when "
+        f"they agree (impact counts equal, displacements within {CROSS_CHECK_TOLERANCE:g} of the peak)."
     )
+
+
+def _verify(name: str, where: str, held: int, counts: tuple[int, int], difference: float, peak: float) -> None:
+    """Raise :class:`~stochpound._errors.VerificationError` where the re-run disagrees with the store or the reference."""
+    if counts[0] != held:
+        raise VerificationError(f"cross-check: the stored case of {name} ({where}) re-run counts {counts[0]} impacts, the store holds {held}")
+    if counts[1] != counts[0]:
+        raise VerificationError(f"cross-check: on the stored case of {name} ({where}) the solver counts {counts[0]} impacts, "
+                                f"scipy's DOP853 {counts[1]}")
+    if not difference <= CROSS_CHECK_TOLERANCE * peak:
+        raise VerificationError(f"cross-check: on the stored case of {name} ({where}) the solver and scipy's DOP853 differ by "
+                                f"{difference:.1e} m, more than {CROSS_CHECK_TOLERANCE:g} of the peak {peak:.3g} m")
 
 
 def accuracy_paragraphs(definitions: list[StoreDefinition]) -> list[Paragraph]:

@@ -297,18 +297,30 @@ def isolation_across(ensembles: list[Ensemble]) -> Paragraph | None:
             counts[ensemble.label] = (int(lower.sum()), int(higher.sum()), int(lower.size))
     if len(counts) < 2:
         return None
-    signs = {label: np.sign(raised - lowered) for label, (lowered, raised, _) in counts.items()}
     described = "; ".join(f"ensemble {label}: lower in {lo}, higher in {hi} of {n} isolated cells" for label, (lo, hi, n) in counts.items())
+    return Paragraph(f"{isolation_verdict(counts)} ({described}; non-overlapping {ensembles[0].confidence:.0%} intervals).")
+
+
+def isolation_verdict(counts: dict[str, tuple[int, int, int]]) -> str:
+    """How isolation's effect on P(pounding) compares across ensembles, from (cells lowered, cells raised, cells) per ensemble.
+
+    An ensemble where isolation lowers and raises it in as many cells is a
+    tie, not a sign: the effect "changes sign" only where it lowers it in
+    more cells in one ensemble and raises it in more in another.
+    """
+    signs = {label: int(np.sign(raised - lowered)) for label, (lowered, raised, _) in counts.items()}
+    lowers = [label for label, sign in signs.items() if sign < 0]
+    raises = [label for label, sign in signs.items() if sign > 0]
+    ties = [label for label, sign in signs.items() if sign == 0]
     if len(set(signs.values())) == 1:
-        verdict = "Isolation changes the probability of pounding the same way in every ensemble"
-    else:
-        lowers = [label for label, sign in signs.items() if sign < 0]
-        raises = [label for label, sign in signs.items() if sign > 0]
-        verdict = (
-            "The effect of isolation on the probability of pounding changes sign between the ensembles: it lowers it in more "
-            f"cells than it raises it in {', '.join(lowers) or 'none'}, and raises it in more in {', '.join(raises) or 'none'}"
-        )
-    return Paragraph(f"{verdict} ({described}; non-overlapping {ensembles[0].confidence:.0%} intervals).")
+        return ("Isolation lowers and raises the probability of pounding in as many cells in every ensemble" if ties else
+                "Isolation changes the probability of pounding the same way in every ensemble")
+    parts = [f"it lowers it in more cells than it raises it in {', '.join(lowers)}" if lowers else "",
+             f"raises it in more cells than it lowers it in {', '.join(raises)}" if raises else "",
+             f"lowers and raises it in as many cells in {', '.join(ties)}" if ties else ""]
+    opening = ("The effect of isolation on the probability of pounding changes sign between the ensembles: " if lowers and raises else
+               "The effect of isolation on the probability of pounding differs between the ensembles: ")
+    return opening + "; ".join(p for p in parts if p)
 
 
 def compare_ensembles(first: Ensemble, second: Ensemble) -> Paragraph:

@@ -158,7 +158,9 @@ class Ensemble:
         return [self._table(kind) for kind in QUANTITIES if kind == "pounding" or any(f"{q.variable}_mean" in self.statistics for q in QUANTITIES[kind])]
 
     def _caption(self, kind: str) -> str:
-        """What table ``kind`` holds, naming the wall penetration only when the store has it."""
+        """What table ``kind`` holds, naming the wall penetration only when the store has it, and wall hits as such."""
+        if kind == "pounding" and self.event == "a wall hit":
+            return "the probability of a wall hit with its Clopper–Pearson interval and the peak wall force over the realizations that hit a wall"
         if kind == "displacements" and "peak_wall_penetration_mean" in self.statistics:
             return f"{TABLE_CAPTIONS[kind]} and the largest penetration of a wall per run"
         return TABLE_CAPTIONS[kind]
@@ -166,11 +168,16 @@ class Ensemble:
     def _table(self, kind: str) -> Table:
         stats = self.statistics
         columns: dict[tuple[str, str], xr.DataArray] = {}
+        walls = self.event == "a wall hit"
         if kind == "pounding":
             columns[("realizations", "n")] = stats["realizations"]
             for part, suffix in (("P", ""), ("lower", "_lower"), ("upper", "_upper")):
-                columns[("P(pounding)", part)] = stats[f"pounding_probability{suffix}"]
+                columns[(self.probability_label, part)] = stats[f"pounding_probability{suffix}"]
         for quantity in QUANTITIES[kind]:
+            if walls and quantity.variable.startswith("impacts_"):
+                continue  # a wall moves with the ground: its hits have no phase
+            if walls and quantity.variable == "peak_impact_force":
+                quantity = Quantity(quantity.variable, "peak wall force, given a wall hit", quantity.unit, quantity.factor)
             columns.update(self._columns(quantity))
         return Table(
             key=f"table-{self.name}-{self.label}-{kind}",
@@ -178,7 +185,7 @@ class Ensemble:
             frame=table_frame(columns, list(self.grid)),
             note=(
                 f"mean: the ensemble mean over the realizations, with the lower and upper bounds of its {self.confidence:.0%} "
-                f"confidence interval ({INTERVAL_NOTE}); P(pounding): fraction of realizations with at least one impact, with its "
+                f"confidence interval ({INTERVAL_NOTE}); {self.probability_label}: fraction of realizations with at least one impact, with its "
                 f"{self.confidence:.0%} Clopper–Pearson (exact binomial) interval; n: realizations used; percentages: sample "
                 f"quantiles. Peaks are the studied building's ({self.studied}); μ fixed: a fixed base."
             ),

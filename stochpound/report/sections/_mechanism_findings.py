@@ -114,8 +114,11 @@ def mechanism_answer(name: str, store: xr.Dataset) -> str | None:
             away = away_from_neighbour(store, impacts.studied)
             if cause == "pounding" and away is not None and impacts.sliding:
                 result = ratcheting_of(impacts, twins, away)
+                pushed = int(_pushed_away(result).sum())
                 found.append(f"pounding ratchets {impacts.studied}'s sliding base in {int(result['ratchets'].sum())} of "
-                             f"{int(result['enough'].sum())} cells")
+                             f"{int(result['enough'].sum())} cells"
+                             + (f" and pushes its residual away from the neighbour, without a resolved increase of its size, in "
+                                f"{pushed} more" if pushed else ""))
             found += [_raised(amplification_of(impacts, twins, v), cause, DEMANDS[v][0]) for v in DEMANDS if v in store]
         if "peak_wall_penetration" in store:
             deepest = float(_walled(name, store, label, axis).sample("peak_wall_penetration").max())
@@ -191,6 +194,11 @@ def _listed(parts: list[str]) -> str:
     return shown + (f"; and {len(parts) - LISTED} more cells" if len(parts) > LISTED else "")
 
 
+def _pushed_away(found: xr.Dataset) -> xr.DataArray:
+    """Cells where the impacts move the residual away from the neighbour (interval above 0) without ratcheting it."""
+    return found["enough"] & ~found["ratchets"] & (found["away_change_lower"] > 0)
+
+
 def ratcheting_text(pounding: Ensemble, free: Ensemble, away: int | None) -> str:
     """Where pounding ratchets the studied building's sliding base against its contact-free twins, and where it does not."""
     building, opening = pounding.studied, f"Ratcheting ({pounding.label}, {pounding.studied}): "
@@ -216,7 +224,7 @@ def ratcheting_text(pounding: Ensemble, free: Ensemble, away: int | None) -> str
 
     ratchets = sorted((c for c in enough if bool(found["ratchets"].sel(c))), key=lambda c: -float(found["abs_change_mean"].sel(c)))
     lowers = [c for c in enough if bool(found["lowers"].sel(c))]
-    pushed = [c for c in enough if c not in ratchets and float(found["away_change_lower"].sel(c)) > 0]
+    pushed = [c for c in enough if bool(_pushed_away(found).sel(c))]
     rest = [c for c in enough if c not in ratchets and c not in lowers and c not in pushed]
     text = opening + (
         f"pounding ratchets {building}'s sliding base — the paired {pounding.confidence:.0%} bootstrap intervals of the increase of abs(residual sliding) over "

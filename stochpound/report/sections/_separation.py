@@ -148,8 +148,9 @@ def _method_paragraph(store: xr.Dataset) -> Paragraph:
     )
     if sliding:
         text += (
-            " The store has sliding bases. For an isolated building, ASCE 7 (§17.2.5.2) asks for a separation from adjacent "
-            "structures of at least its total maximum displacement D_TM, a bound like ABS rather than a combination of peaks; "
+            " The store has sliding bases. ASCE 7 (§17.2.5.2) asks for a separation of at least the total maximum displacement "
+            "D_TM between an isolated structure and the retaining walls or other fixed obstructions around it; it gives no "
+            "combination rule for a neighbour that moves too, and taking D_TM there is a bound on the isolated side alone; "
             "SRSS and DDC combine the peaks of linear, fixed-base buildings, whose derivation does not hold for a sliding base. "
             "For the isolated cases they are applied here as a designer would, to the total displacements (sliding included), "
             "and judged by the probability of pounding they leave."
@@ -342,7 +343,8 @@ class SeparationEnsemble:
             frame=table_frame(columns, list(self.ensemble.grid)),
             note=(
                 f"Distribution-free {self.confidence:.0%} intervals from order statistics; a bound is empty when the sample "
-                f"is too small to give it (the lower bound of p needs pⁿ < {(1 - self.confidence) / 2:g})."
+                f"of n runs is too small to give it: the upper bound needs (1 − p)ⁿ ≤ {(1 - self.confidence) / 2:g}, the lower "
+                f"bound pⁿ ≤ {(1 - self.confidence) / 2:g}."
             ),
             per_cell=True,
         )
