@@ -30,6 +30,7 @@ from stochpound.analysis._fragility_ensemble import (
     stripe_fragility,
 )
 from stochpound.analysis._hazard import HazardCurve, bundled_curves, probability_from_rate, rate_from_probability, return_period
+from stochpound.analysis._hazard_files import HazardFile, read_hazard_file
 from stochpound.analysis._risk import demand_hazard_curve, mean_annual_frequency, risk_curve, risk_targeted_separation
 from stochpound.analysis._code_rules_risk import code_rules_risk
 from stochpound.analysis._store_risk import StoreRisk, contact_free_closure, pounding_fragility, risk_gaps, store_risk
@@ -66,6 +67,8 @@ __all__ = [
     "limit_state_events",
     "stripe_fragility",
     "HazardCurve",
+    "HazardFile",
+    "read_hazard_file",
     "bundled_curves",
     "probability_from_rate",
     "rate_from_probability",

@@ -5,7 +5,6 @@ from __future__ import annotations
 from pathlib import Path
 
 import click
-import pandas as pd
 
 from stochpound.analysis._fragility_ensemble import BOOTSTRAP
 from stochpound.analysis._risk import TARGETS
@@ -22,19 +21,39 @@ def _targets(value: str) -> tuple[float, ...]:
     return targets
 
 
+def _measure(value: str | None) -> dict[str, object]:
+    from stochpound.analysis._hazard_files import parse_measure
+
+    if value is None:
+        return {}
+    try:
+        return parse_measure(value)
+    except ValueError as error:
+        raise click.BadParameter(str(error).removeprefix("measure: ")) from None
+
+
 @click.command("risk")
 @click.argument("store", type=click.Path(exists=True, dir_okay=False, path_type=Path))
 @click.option("--hazard", "hazard", metavar="FILE|NAME",
-              help="The site's hazard curve: a CSV of rows 'im, rate' (in the store's intensity measure and the units of its levels) "
-                   "or a bundled curve's name. Default: the hazard the store carries (its experiment's [hazard]).")
+              help="The site's hazard curve: a file (stochpound's CSV, OpenQuake's hazard-curve CSV or nshmp-haz's curve output; "
+                   "docs/risk.md) or a bundled curve's name. Default: the hazard the store carries (its experiment's [hazard]).")
+@click.option("--hazard-measure", "hazard_measure", metavar="TEXT",
+              help="What the --hazard file's curve is of, when the file does not say, e.g. 'PSA(1.0 s, 5 %) in g' or 'PGA in m/s2'.")
+@click.option("--hazard-units", "hazard_units", metavar="UNITS", help="Units of the --hazard file's intensities (g, m/s2, cm/s2, m/s, cm/s).")
+@click.option("--investigation-time", "investigation_time", type=click.FloatRange(min=0.0, min_open=True), metavar="YEARS",
+              help="Years of a --hazard file of probabilities of exceedance (a 'poe' column), converted to annual rates.")
+@click.option("--hazard-site", "hazard_site", metavar="ROW|NAME", help="The site of a --hazard file of several (its row, 0-based, or name).")
+@click.option("--extrapolate", is_flag=True, help="Extend the hazard table beyond its intensities as power laws (stated in the output).")
 @click.option("--target", "target", default=",".join(f"{t:g}" for t in TARGETS), show_default=True,
               help="Target probabilities of pounding in --years, separated by commas.")
 @click.option("--years", default=50.0, show_default=True, type=click.FloatRange(min=0.0, min_open=True), help="Exposure time (years).")
 @click.option("--bootstrap", default=BOOTSTRAP, show_default=True, type=click.IntRange(min=0),
               help="Resamples of the motions for the intervals (0: none).")
 @click.option("--seed", default=0, show_default=True, type=click.IntRange(min=0), help="Seed of the resamples.")
-@click.option("--csv", "csv_path", type=click.Path(dir_okay=False, path_type=Path), help="Also write both tables to this CSV file.")
-def risk(store: Path, hazard: str | None, target: str, years: float, bootstrap: int, seed: int, csv_path: Path | None) -> None:
+@click.option("--csv", "csv_dir", type=click.Path(file_okay=False, path_type=Path), metavar="DIR",
+              help="Also write the tables to this folder (created), one CSV file per table: separation.csv, rules.csv.")
+def risk(store: Path, hazard: str | None, hazard_measure: str | None, hazard_units: str | None, investigation_time: float | None,
+         hazard_site: str | None, extrapolate: bool, target: str, years: float, bootstrap: int, seed: int, csv_dir: Path | None) -> None:
     """Print the risk-targeted separation g* and the code rules' risks of the experiment STORE at a site.
 
     For every configuration of the store (each combination of its grid's
@@ -45,32 +64,57 @@ def risk(store: Path, hazard: str | None, target: str, years: float, bootstrap: 
     the mean annual frequency of pounding there, as a return period and
     a probability in --years. The store needs intensity stripes (with
     contact-free cases, gap = inf) or IDA capacities (docs/risk.md).
+    A hazard file must say (or the options state) its measure and units;
+    they are checked against the store's and converted (docs/risk.md).
     """
+    from stochpound.analysis._hazard_files import parse_units
     from stochpound.analysis._store_risk import store_risk
     from stochpound.experiment import open_store
-    from stochpound.experiment._hazard import hazard_option, stored_hazard
+    from stochpound.experiment._definition import read_definition
+    from stochpound.experiment._hazard import DEFAULT_G, check_covers, hazard_curve, hazard_option, stored_hazard_entry
     from stochpound.experiment._intensity import describe_measure
-    from stochpound.report.sections._intensity import intensity_setting
     from stochpound.report.sections._risk import risk_headline, rules_frame, separation_frame
 
     targets = _targets(target)
+    stated = _measure(hazard_measure)
+    if hazard_units is not None:
+        try:
+            stated["units"] = parse_units(hazard_units)
+        except ValueError as error:
+            raise click.BadParameter(str(error).removeprefix("units: "), param_hint="--hazard-units") from None
+    if investigation_time is not None:
+        stated["investigation_time"] = investigation_time
+    if hazard is None and (stated or hazard_site is not None):
+        raise click.UsageError("--hazard-measure, --hazard-units, --investigation-time and --hazard-site describe a --hazard file: give one")
     try:
         data = open_store(store)
-        setting = intensity_setting(data)
+        definition = read_definition(data)
+        setting = definition.intensity
         if setting is None:
             raise click.ClickException("store: has no intensity stripes or IDA capacities (run an experiment with an [intensity] table)")
-        hz = hazard_option(hazard, setting) if hazard is not None else stored_hazard(data)
-        if hz is None:
-            raise click.ClickException("--hazard: the store carries no hazard (its experiment has no [hazard] table): give a hazard file or a bundled curve's name")
+        g = float(definition.to_dict()["scene"].get("g", DEFAULT_G))
+        if hazard is not None:
+            hz = hazard_option(hazard, setting, g, stated=stated, site=hazard_site, extrapolate=extrapolate)
+        else:
+            entry = stored_hazard_entry(data)
+            if entry is None:
+                raise click.ClickException("--hazard: the store carries no hazard (its experiment has no [hazard] table): give a hazard file or a bundled curve's name")
+            hz = hazard_curve(entry, extrapolate=extrapolate or None)
+        if "intensity" in data.dims:
+            check_covers(hz, [float(x) for x in data["intensity"].values], "--hazard", "the store's intensity levels", "pass --extrapolate")
         result = store_risk(data, hz, targets, years, studied=data.attrs.get("studied_building"), bootstrap=bootstrap, seed=seed)
     except (StochpoundError, ValueError) as error:
         raise click.ClickException(str(error)) from None
     except OSError as error:
         raise click.ClickException(os_error_message(error)) from None
     stripes = f"{data.sizes['intensity']} stripes" if "intensity" in data.dims else "IDA capacities"
-    source = hz.source.splitlines()[0] if hz.source else repr(hz)
     click.echo(f"{data.attrs.get('experiment_name', store.stem)}: {result.motions} motions, {stripes} of {describe_measure(setting)} "
-               f"in {setting['units']}; hazard: {source}")
+               f"in {setting['units']}; hazard: {hz.source.splitlines()[0] if hz.source else hz.describe()}")
+    for line in hz.source.splitlines():
+        if line.startswith("stochpound: "):
+            click.echo(f"note: hazard {line.removeprefix('stochpound: ')}")
+    if hz.extrapolated:
+        click.echo(f"note: the hazard table [{hz.im[0]:g}, {hz.im[-1]:g}] {hz.units} was extrapolated beyond its intensities as power laws (--extrapolate)")
     interval = "95 % BCa bootstrap interval over the motions" if bootstrap else "no bootstrap"
     separation = separation_frame(result)
     click.echo(f"\nRisk-targeted separation g* (m; {interval}; inf: wider than every gap of the grid):")
@@ -82,12 +126,15 @@ def risk(store: Path, hazard: str | None, target: str, years: float, bootstrap: 
         click.echo(f"\nCode rules in risk terms (gap at the code intensity's stripe; λ_P: pounding per year at that gap; "
                    f"'once in N years'; P in {years:g} years):")
         click.echo(rules.to_string(float_format=lambda v: f"{v:.4g}"))
-    if csv_path is not None:
-        frames = [risk_headline(result).assign(table="separation")]
+    if csv_dir is not None:
+        tables = {"separation": risk_headline(result)}
         if not rules.empty:
-            frames.append(rules.reset_index().assign(table="rules"))
+            tables["rules"] = rules.reset_index()
         try:
-            pd.concat(frames, ignore_index=True).to_csv(csv_path, index=False)
+            csv_dir.mkdir(parents=True, exist_ok=True)
+            for name, frame in tables.items():
+                frame.to_csv(csv_dir / f"{name}.csv", index=False)
         except OSError as error:
             raise click.ClickException(os_error_message(error)) from None
-        click.echo(f"\ntables: {csv_path}")
+        click.echo(f"\ntables: {', '.join(str(csv_dir / f'{name}.csv') for name in tables)}")
+
