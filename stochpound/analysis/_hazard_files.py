@@ -62,10 +62,10 @@ class HazardFile:
     Attributes
     ----------
     im : numpy.ndarray
-        Intensities, in :attr:`stated` ``units`` (or the caller's).
+        Intensities, in ``stated`` ``units`` (or the caller's).
     values : numpy.ndarray
         Annual rates of exceedance (1/yr) or probabilities of exceedance in
-        :attr:`investigation_time` years, as :attr:`quantity` says.
+        ``investigation_time`` years, as ``quantity`` says.
     quantity : str
         ``"rate"`` or ``"poe"``.
     investigation_time : float or None
@@ -74,7 +74,7 @@ class HazardFile:
         What the file states of its measure: ``measure``, ``period``,
         ``damping``, ``units`` (absent keys: not stated).
     format : str
-        One of :data:`FORMATS`.
+        One of ``FORMATS`` (stochpound, openquake, nshmp-haz).
     provenance : str
         The file's comment lines (or its name), kept with the curve.
     """
@@ -96,7 +96,7 @@ class HazardFile:
         Parameters
         ----------
         units : str
-            Units the intensities must be in (a key of :data:`UNITS`, e.g. the experiment's levels').
+            Units the intensities must be in (a key of ``g``, ``m/s2``, ``cm/s2``, ``m/s``, ``cm/s``, e.g. the experiment's levels').
         g : float
             Standard gravity (m/s²) for a conversion to or from g.
         investigation_time : float, optional
@@ -163,7 +163,7 @@ def unit_factor(source: str, target: str, g: float) -> float:
 
 
 def parse_units(text: str) -> str:
-    """Units as written (``g``, ``m/s²``, ``gal``, ...) in the spelling of :data:`UNITS`."""
+    """Units as written (``g``, ``m/s²``, ``gal``, ...) in the spelling of ``g``, ``m/s2``, ``cm/s2``, ``m/s``, ``cm/s``."""
     key = text.strip().lower().replace(" ", "")
     if key not in _UNIT_ALIASES:
         raise ValueError(f"units: must be one of {', '.join(UNITS)} (or cm/s², gal), got {text!r}")
@@ -214,7 +214,7 @@ def parse_measure(text: str) -> dict[str, Any]:
 
 
 def read_hazard_file(path: str | Path, *, site: int | str | None = None) -> HazardFile:
-    """Read a hazard-curve file in any of :data:`FORMATS` (recognised from its first lines).
+    """Read a hazard-curve file: stochpound's CSV, OpenQuake's or nshmp-haz's (recognised from its first lines).
 
     Parameters
     ----------
