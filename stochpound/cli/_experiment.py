@@ -163,3 +163,5 @@ def status_command(store: str, show_all: bool, show_done: bool, no_rebuild: bool
         click.echo(f"... {report.n_missing - len(shown)} more (--all lists them)")
     if report.rebuilt:
         click.echo(f"store rebuilt from the finished cases: {report.store}")
+    if report.not_rebuilt:
+        click.echo(f"store not rebuilt (its finished cases are kept in its parts): {report.not_rebuilt}", err=True)

@@ -71,8 +71,9 @@ def risk(store: Path, hazard: str | None, hazard_measure: str | None, hazard_uni
     from stochpound.analysis._store_risk import store_risk
     from stochpound.experiment import open_store
     from stochpound.experiment._definition import read_definition
-    from stochpound.experiment._hazard import DEFAULT_G, check_covers, hazard_curve, hazard_option, stored_hazard_entry
+    from stochpound.experiment._hazard import check_covers, hazard_curve, hazard_option, stored_hazard_entry
     from stochpound.experiment._intensity import describe_measure
+    from stochpound.motions._spectrum import DEFAULT_G
     from stochpound.report.sections._risk import risk_headline, rules_frame, separation_frame
 
     targets = _targets(target)

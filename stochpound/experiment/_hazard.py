@@ -43,6 +43,7 @@ from stochpound.analysis._hazard_files import parse_units, read_hazard_file, uni
 from stochpound.experiment._definition import read_definition
 from stochpound.experiment._intensity import MEASURES, IntensityError, describe_measure
 from stochpound.model import fields as toml_fields
+from stochpound.motions._spectrum import DEFAULT_G
 
 SOURCES = ("file", "bundled", "power_law")
 """The keys that name a hazard's source (exactly one per ``[hazard]`` table)."""
@@ -52,8 +53,6 @@ _KEYS = {*SOURCES, *STATED, "site", "extrapolate"}
 _MATCHED = ("measure", "period", "periods", "damping")
 _REQUIRED = {"pga": ("units",), "pgv": ("units",), "psa": ("period", "damping", "units"), "sa_avg": ("periods", "damping", "units")}
 _TOLERANCE = 1e-9
-DEFAULT_G = 9.81
-"""g (m/s²) of a scene that states none: the factor between a hazard's and a store's intensities when one is in g."""
 
 
 def parse_hazard(data: Mapping[str, Any], intensity: Mapping[str, Any] | None, base_dir: Path, g: float = DEFAULT_G) -> dict[str, Any] | None:

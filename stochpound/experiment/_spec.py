@@ -28,7 +28,8 @@ from typing import Any, Iterator, Mapping
 from stochpound._errors import SceneError
 from stochpound.experiment._catalogue import TIME_HISTORIES
 from stochpound.experiment._definition import is_gap_axis, read_definition
-from stochpound.experiment._hazard import DEFAULT_G, parse_hazard
+from stochpound.experiment._hazard import parse_hazard
+from stochpound.motions._spectrum import DEFAULT_G
 from stochpound.experiment._intensity import parse_intensity
 from stochpound.model import fields as toml_fields
 from stochpound.model.contact import ELEMENT_KEYS
@@ -196,7 +197,7 @@ def parse_experiment(data: Mapping[str, Any], base_dir: str | Path = ".", defaul
     mu = _mu_axis(grid["mu"], buildings) if "mu" in grid else None
     with field_errors():
         intensity = parse_intensity(data, scene, variants, gaps, mu)
-        hazard = parse_hazard(data, intensity, base_dir, float(scene.get("g", DEFAULT_G)))
+        hazard = parse_hazard(data, intensity, base_dir, float(scene["g"]) if "g" in scene else DEFAULT_G)
     definition = {
         "format": FORMAT_VERSION,
         "name": name,
