@@ -306,6 +306,16 @@ def test_ctrl_c_at_any_moment_exits_130_without_a_traceback(isolated_store, tmp_
         assert err.decode().strip().splitlines()[-1] == "interrupted" and b"Traceback" not in err, (command, err)
 
 
+def test_the_next_line_of_a_run_with_a_hazard_names_risk(isolated_store, fixed_stores):
+    result = CliRunner().invoke(main, ["experiment", "run", str(isolated_store.with_suffix(".toml")), "--workers", "0", "--quiet"])
+    assert result.exit_code == 0, result.output
+    assert result.stdout.splitlines()[-1].startswith(f"next: stochpound risk {isolated_store} (the risk-targeted separation at its site); "
+                                                     f"stochpound report build {isolated_store}"), result.stdout
+    ida = fixed_stores[1]  # its experiment has no [hazard]
+    result = CliRunner().invoke(main, ["experiment", "run", str(ida.with_suffix(".toml")), "--workers", "0", "--quiet"])
+    assert result.exit_code == 0 and result.stdout.splitlines()[-1].startswith("next: stochpound report build"), result.stdout
+
+
 # ---------------------------------------------------------------- report
 
 

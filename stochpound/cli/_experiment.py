@@ -114,7 +114,18 @@ def _summary(report: RunReport) -> None:
     if not report.complete:
         click.echo("rerun the same command to complete the missing cases")
     else:
-        click.echo(f"next: stochpound report build {report.store} --out {report.store.with_suffix('')}-report")
+        build = f"stochpound report build {report.store} --out {report.store.with_suffix('')}-report"
+        click.echo(f"next: stochpound risk {report.store} (the risk-targeted separation at its site); {build}" if _has_hazard(report.store)
+                   else f"next: {build}")
+
+
+def _has_hazard(store: Path) -> bool:
+    """Whether a store carries a hazard (its experiment has ``[hazard]``): then its answer is ``stochpound risk``'s."""
+    from stochpound.experiment import open_store
+    from stochpound.experiment._hazard import stored_hazard_entry
+
+    with open_store(store) as data:
+        return stored_hazard_entry(data) is not None
 
 
 @experiment.command("check")
