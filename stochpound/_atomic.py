@@ -9,8 +9,10 @@ would make every result private to its owner, 0600).
 
 from __future__ import annotations
 
+import errno
 import os
 import secrets
+import shutil
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Iterator
@@ -23,7 +25,9 @@ def replacing(path: str | Path) -> Iterator[Path]:
     """Yield the path of a new, empty temporary file beside ``path``; rename it over ``path`` when the block ends.
 
     If the block raises (or is interrupted), the temporary is deleted and
-    ``path`` is left unchanged. The caller writes the temporary (it may
+    ``path`` is left unchanged. A file-system error that names no file (a
+    full disk while writing, say) or the temporary is raised naming ``path``,
+    so that its one-line message says which file could not be written. The caller writes the temporary (it may
     reopen and truncate it) and flushes it to disk if it needs to.
     """
     path = Path(path)
@@ -32,6 +36,11 @@ def replacing(path: str | Path) -> Iterator[Path]:
     try:
         yield temporary
         os.replace(temporary, path)
+    except OSError as error:
+        temporary.unlink(missing_ok=True)
+        if error.filename is None or error.filename == str(temporary):
+            raise OSError(error.errno, error.strerror or str(error), str(path)) from error
+        raise
     except BaseException:
         temporary.unlink(missing_ok=True)
         raise
@@ -49,6 +58,21 @@ def check_writable(path: str | Path) -> None:
         os.unlink(_create_temporary(path))
     except OSError as error:
         raise OSError(error.errno, error.strerror, str(path.parent)) from None
+
+
+def check_room(path: str | Path, needed: int) -> None:
+    """Raise ``OSError(ENOSPC)`` naming ``path`` if its disk has less than ``needed`` bytes free.
+
+    Called before a large write, so that a full disk is reported before any
+    byte is written (a library that writes the file may not fail cleanly).
+    """
+    path = Path(path)
+    try:
+        free = shutil.disk_usage(path.parent if path.parent.is_dir() else Path.cwd()).free
+    except OSError:
+        return  # the write itself reports it
+    if free < needed:
+        raise OSError(errno.ENOSPC, f"No space left on device: {free / 1e6:.1f} MB free, about {needed / 1e6:.1f} MB needed", str(path))
 
 
 def _create_temporary(path: Path) -> Path:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import errno
 import json
 import os
 import re
@@ -328,3 +329,45 @@ def test_the_readme_plot_example_shows_or_saves_its_figure():
     block = text[text.index("```python\nimport matplotlib.pyplot as plt\nimport stochpound") :]
     block = block[: block.index("```", 3)]
     assert ".plot()" in block and ("plt.savefig(" in block or "plt.show()" in block)
+
+
+def _disk_full(*args, **kwargs):
+    raise OSError(errno.ENOSPC, "No space left on device")  # as write() raises it: no file named
+
+
+def test_a_full_disk_during_status_names_the_store_and_keeps_everything(stationary, tmp_path, monkeypatch):
+    from stochpound.experiment import _store_writer
+
+    experiment, store = _copy(stationary, tmp_path)
+    before = store.read_bytes()
+    monkeypatch.setattr(_store_writer, "_create", _disk_full)
+    result = invoke("experiment", "status", str(store))
+    assert result.exit_code == 0, result.output
+    assert result.stderr.strip() == f"store not rebuilt (its finished cases are kept in its parts): {store}: cannot write here (No space left on device)"
+    assert re.search(r"^(\d+)/\1 cases done, 0 missing$", result.stdout, re.MULTILINE), result.stdout
+    assert store.read_bytes() == before and not list(store.parent.glob(".still.nc.*"))
+    monkeypatch.undo()
+    assert invoke("experiment", "status", str(store)).exit_code == 0 and open_store(store).attrs["complete"] == 1
+
+
+def test_a_full_disk_is_found_before_the_store_is_written(stationary, tmp_path, monkeypatch):
+    """Less room than the old store file: nothing is written (the library writing it may not fail cleanly); one line naming it."""
+    from stochpound import _atomic
+
+    experiment, store = _copy(stationary, tmp_path)
+    monkeypatch.setattr(_atomic.shutil, "disk_usage", lambda path: shutil._ntuple_diskusage(10**9, 10**9, 0))
+    result = invoke("experiment", "status", str(store))
+    assert f"{store}: cannot write here (No space left on device: 0.0 MB free, about " in result.stderr and result.exit_code == 0
+
+
+def test_a_full_disk_during_a_run_is_one_line_naming_the_store_and_loses_nothing(tmp_path, monkeypatch):
+    from stochpound.experiment import _store_writer
+
+    experiment = write_experiment(tmp_path, TINY_EXPERIMENT, "tiny.toml")
+    monkeypatch.setattr(_store_writer, "_create", _disk_full)
+    result = invoke("experiment", "run", str(experiment), "--workers", "0")
+    assert result.exit_code == 1
+    assert result.stderr.strip().splitlines()[-1] == f"Error: {tmp_path / 'tiny.nc'}: cannot write here (No space left on device)", result.stderr
+    monkeypatch.undo()
+    result = invoke("experiment", "run", str(experiment), "--workers", "0", "--quiet")
+    assert result.exit_code == 0 and open_store(tmp_path / "tiny.nc").attrs["complete"] == 1, result.output

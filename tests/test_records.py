@@ -217,13 +217,23 @@ def test_cli_list():
 
 def test_cli_show_study_record_with_table_3_2(tmp_path):
     plot = tmp_path / "ec.png"
-    result = _cli("show", "el_centro_1940_study", "--plot", str(plot))
+    result = _cli("show", "el_centro_1940_study", "--plot", str(plot), "--g", str(STUDY_G))
     assert result.exit_code == 0, result.output
     stats = record_statistics(load_record("el_centro_1940_study"), g=STUDY_G)
     table = study_table_3_2("el_centro")
     for text in (f"{stats.std:.4f}", f"{stats.excess:.4f}", f"{table['excess']:.4f}", f"{table['skewness']:.4f}", "study Table 3.2", "Arias"):
         assert text in result.output, text
     assert plot.stat().st_size > 10_000 and plot.read_bytes()[:4] == b"\x89PNG"
+
+
+def test_cli_g_defaults_are_one_value():
+    """Every --g of the records commands defaults to the scenes' g (9.81 m/s²), not one 9.814 and another 9.81."""
+    from stochpound.cli._records import records
+    from stochpound.model.scene import Scene
+
+    defaults = {name: next(p.default for p in command.params if p.name == "g") for name, command in records.commands.items()
+                if any(p.name == "g" for p in command.params)}
+    assert len(defaults) >= 2 and set(defaults.values()) == {Scene.__dataclass_fields__["g"].default}, defaults
 
 
 def test_cli_show_substitute_and_file(tmp_path):

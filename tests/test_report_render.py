@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import base64
 import datetime
+import errno
 import re
 import sys
 import types
@@ -224,7 +225,7 @@ def test_figure_and_table_files(built: tuple[Report, dict[str, Path]]) -> None:
             header=list(range(frame.columns.nlevels)),
         )
         pd.testing.assert_frame_equal(back, frame)
-    assert not list(written["html"].parent.rglob("*.part"))
+    assert not list(written["html"].parent.rglob("*.tmp"))
 
 
 def test_unknown_format_names_the_allowed_values(tmp_path: Path) -> None:
@@ -242,7 +243,36 @@ def test_interrupted_pdf_leaves_no_file(tmp_path: Path, monkeypatch: pytest.Monk
     with pytest.raises(KeyboardInterrupt):
         output.write_report(make_report(), tmp_path, ["pdf"])
     assert not (tmp_path / "report.pdf").exists()
-    assert not list(tmp_path.rglob("*.part"))
+    assert not list(tmp_path.rglob("*.tmp"))
+
+
+def test_a_full_disk_names_the_file_and_keeps_the_old_one(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """ENOSPC while the PDF is written (an OSError naming no file, as write() raises it): the error names report.pdf; the old one stays."""
+    output.write_report(make_report(), tmp_path, ["html", "pdf"])
+    before = (tmp_path / "report.pdf").read_bytes()
+
+    def full(report: Report, path: Path, date: datetime.date) -> int:
+        path.write_bytes(b"%PDF-1.4 half")
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    monkeypatch.setattr(output, "render_pdf", full)
+    with pytest.raises(OSError) as caught:
+        output.write_report(make_report(), tmp_path, ["pdf"])
+    assert caught.value.filename == str(tmp_path / "report.pdf") and caught.value.errno == errno.ENOSPC
+    assert (tmp_path / "report.pdf").read_bytes() == before and not list(tmp_path.rglob("*.tmp"))
+
+
+def test_an_html_only_rebuild_removes_the_stale_pdf(tmp_path: Path) -> None:
+    (tmp_path / "report.pdf").write_bytes(b"%PDF the user's")  # a folder without an earlier build: its files are not the build's
+    output.write_report(make_report(), tmp_path, ["html"])
+    assert (tmp_path / "report.pdf").read_bytes() == b"%PDF the user's"
+    output.write_report(make_report(), tmp_path, ["html", "pdf"])
+    assert (tmp_path / "report.pdf").is_file()
+    output.write_report(make_report(), tmp_path, ["html"])
+    assert (tmp_path / "index.html").is_file() and not (tmp_path / "report.pdf").exists()
+    (tmp_path / "mine.pdf").write_bytes(b"%PDF")  # not a document of the build: kept
+    output.write_report(make_report(), tmp_path, ["pdf"])
+    assert (tmp_path / "mine.pdf").is_file() and (tmp_path / "report.pdf").is_file() and not (tmp_path / "index.html").exists()
 
 
 # --- PDF --------------------------------------------------------------------

@@ -65,7 +65,7 @@ units = "g"
 [hazard]
 file = "site.csv"
 """
-HAZARD = "# Site: a made-up curve for the test\nim, rate\n0.05, 0.02\n0.1, 0.008\n0.3, 0.001\n0.6, 0.0002\n1.0, 0.00005\n"
+HAZARD = "# Site: a made-up curve for the test\n# Measure: PGA, in g\nim, rate\n0.05, 0.02\n0.1, 0.008\n0.3, 0.001\n0.6, 0.0002\n1.0, 0.00005\n"
 
 
 @pytest.fixture(scope="module")
@@ -104,7 +104,7 @@ def test_intensity_and_hazard_are_typed(ds, run):
     assert (hazard.source, hazard.file, hazard.units) == ("file", "site.csv", "g")
     assert hazard.file_sha256 == hashlib.sha256((run[0] / "site.csv").read_bytes()).hexdigest()
     assert hazard.im == (0.05, 0.1, 0.3, 0.6, 1.0) and hazard.rate == (0.02, 0.008, 0.001, 0.0002, 0.00005)
-    assert hazard.provenance == "Site: a made-up curve for the test"
+    assert hazard.provenance == "Site: a made-up curve for the test\nMeasure: PGA, in g"
 
 
 def test_gap_axes_and_selections(ds):

@@ -27,6 +27,7 @@ from stochpound.analysis._separation import pounding_curve, required_separation,
 from stochpound.analysis._separation_rules import contact_demands, fixed_base_cqc, separation_rules, store_contact_demands
 from stochpound.analysis._summary import run_summary
 from stochpound.analysis._hazard import HazardCurve, bundled_curves, probability_from_rate, rate_from_probability, return_period
+from stochpound.analysis._hazard_files import HazardFile, read_hazard_file
 
 
 def __getattr__(name: str) -> object:
@@ -70,6 +71,8 @@ __all__ = [
     "limit_state_events",
     "stripe_fragility",
     "HazardCurve",
+    "HazardFile",
+    "read_hazard_file",
     "bundled_curves",
     "probability_from_rate",
     "rate_from_probability",

@@ -167,11 +167,7 @@ class HazardCurve:
     @classmethod
     def bundled(cls, name: str, *, extrapolate: bool = False) -> HazardCurve:
         """A hazard curve shipped with stochpound (``data/hazard/<name>.csv``; :func:`~stochpound.analysis.bundled_curves` lists them)."""
-        folder = _bundled_folder()
-        path = folder / f"{name}.csv"
-        if not path.is_file():
-            raise ValueError(f"name: no bundled hazard curve {name!r}; bundled: {', '.join(bundled_curves())}")
-        return cls.from_file(path, extrapolate=extrapolate, units="g")
+        return cls.from_file(bundled_path(name), extrapolate=extrapolate, units="g")
 
     # ------------------------------------------------------------ evaluation
 
@@ -189,7 +185,8 @@ class HazardCurve:
         if np.any(outside):
             if not self.extrapolate:
                 raise ValueError(f"x: outside the hazard table [{self.im[0]:g}, {self.im[-1]:g}]"
-                                 f"{' ' + self.units if self.units else ''}; pass extrapolate=True to extend it as a power law")
+                                 f"{' ' + self.units if self.units else ''}; extrapolate it (extrapolate=True; "
+                                 "stochpound risk --extrapolate; [hazard] extrapolate = true) to extend it as a power law")
             if self.power is None:
                 self.extrapolated = True
         with np.errstate(divide="ignore"):
@@ -220,7 +217,7 @@ class HazardCurve:
         if np.any(outside):
             if not self.extrapolate:
                 raise ValueError(f"rate: outside the hazard table's rates [{self.rate[-1]:g}, {self.rate[0]:g}] 1/yr; "
-                                 "pass extrapolate=True to extend it as a power law")
+                                 "extrapolate it (extrapolate=True; stochpound risk --extrapolate) to extend it as a power law")
             if self.power is None:
                 self.extrapolated = True
         inside = np.interp(-v, -ly, lx)
@@ -236,6 +233,14 @@ class HazardCurve:
         """Mean return period (yr) of intensities above ``x``."""
         return return_period(self(x))
 
+    def describe(self) -> str:
+        """The curve in words, for prose (a report, a command's output): a power law or a table's size and range."""
+        if self.power is not None:
+            return f"the power law λ(x) = {self.power[0]:g} x^-{self.power[1]:g} per year"
+        units = f" {self.units}" if self.units else ""
+        extended = ", extended beyond them as power laws" if self.extrapolate else ""
+        return f"a table of {self.im.size} intensities from {self.im[0]:g} to {self.im[-1]:g}{units}{extended}"
+
     def __repr__(self) -> str:
         if self.power is not None:
             return f"HazardCurve.power_law(k0={self.power[0]:g}, k={self.power[1]:g})"
@@ -246,6 +251,14 @@ class HazardCurve:
 def bundled_curves() -> list[str]:
     """Names of the bundled hazard curves (``HazardCurve.bundled(name)``); provenance in ``data/hazard/SOURCES.md``."""
     return sorted(path.stem for path in _bundled_folder().glob("*.csv"))
+
+
+def bundled_path(name: str) -> Path:
+    """The file of a bundled hazard curve (``data/hazard/<name>.csv``)."""
+    path = _bundled_folder() / f"{name}.csv"
+    if not path.is_file():
+        raise ValueError(f"name: no bundled hazard curve {name!r}; bundled: {', '.join(bundled_curves())}")
+    return path
 
 
 def bundled_measure(name: str) -> dict[str, float | str]:

@@ -1,9 +1,41 @@
-"""The ``stochpound`` command-line interface (one module per command group)."""
+"""The ``stochpound`` command-line interface (one module per command group).
 
-import click
+A Ctrl-C at any moment ends a command with exit status 130 and one line,
+``interrupted``, on stderr, never a traceback: while the modules load (caught
+here; ``import stochpound`` itself loads almost nothing), and while a command
+runs (:class:`~stochpound.cli._group.HelpGroup`).
+"""
 
-from stochpound import __version__
-from stochpound.cli._group import HelpGroup
+import os
+import sys
+from typing import NoReturn
+
+INTERRUPTED = 130
+"""Exit status of a command stopped by Ctrl-C (128 + SIGINT), as shells report it."""
+
+
+def interrupted(loading: bool = False) -> NoReturn:
+    """End the command as stopped by Ctrl-C: one line on stderr, exit status :data:`INTERRUPTED`.
+
+    ``loading``: the modules were still loading, nothing is written yet; the
+    process ends at once (``os._exit``), because a Ctrl-C that landed in code
+    an extension ran through the interpreter's own runner leaves a flag that
+    turns any later exit into death by SIGINT (status -2), caught or not.
+    """
+    sys.stderr.write("interrupted\n")
+    if loading:
+        sys.stderr.flush()
+        os._exit(INTERRUPTED)
+    raise SystemExit(INTERRUPTED)
+
+
+try:
+    import click
+
+    from stochpound import __version__
+    from stochpound.cli._group import HelpGroup
+except KeyboardInterrupt:
+    interrupted(loading=True)
 
 
 @click.group(cls=HelpGroup, context_settings={"help_option_names": ["-h", "--help"]})
@@ -26,4 +58,7 @@ def _register() -> None:
     main.add_command(risk)
 
 
-_register()
+try:
+    _register()
+except KeyboardInterrupt:
+    interrupted(loading=True)

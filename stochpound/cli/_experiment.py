@@ -114,7 +114,17 @@ def _summary(report: RunReport) -> None:
     if not report.complete:
         click.echo("rerun the same command to complete the missing cases")
     else:
-        click.echo(f"next: stochpound report build {report.store} --out {report.store.with_suffix('')}-report")
+        build = f"stochpound report build {report.store} --out {report.store.with_suffix('')}-report"
+        click.echo(f"next: stochpound risk {report.store} (the risk-targeted separation at its site); {build}" if _has_hazard(report.store)
+                   else f"next: {build}")
+
+
+def _has_hazard(store: Path) -> bool:
+    """Whether a store carries a hazard (its experiment has ``[hazard]``): then its answer is ``stochpound risk``'s."""
+    from stochpound.experiment import open_store
+
+    with open_store(store) as data:
+        return data.pound.hazard is not None
 
 
 @experiment.command("check")
@@ -163,3 +173,5 @@ def status_command(store: str, show_all: bool, show_done: bool, no_rebuild: bool
         click.echo(f"... {report.n_missing - len(shown)} more (--all lists them)")
     if report.rebuilt:
         click.echo(f"store rebuilt from the finished cases: {report.store}")
+    if report.not_rebuilt:
+        click.echo(f"store not rebuilt (its finished cases are kept in its parts): {report.not_rebuilt}", err=True)

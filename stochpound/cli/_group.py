@@ -23,6 +23,15 @@ class HelpGroup(click.Group):
             ctx.exit(0)
         return super().parse_args(ctx, args)
 
+    def invoke(self, ctx: click.Context) -> object:
+        """Run the command; a Ctrl-C anywhere in it ends it with exit status 130 and no traceback (click's is 1, "Aborted!")."""
+        try:
+            return super().invoke(ctx)
+        except KeyboardInterrupt:
+            from stochpound.cli import interrupted
+
+            interrupted()
+
     def format_commands(self, ctx: click.Context, formatter: click.HelpFormatter) -> None:
         """The ``Commands:`` section, each command's first sentence whole."""
         rows = []

@@ -8,6 +8,7 @@ import click
 
 from stochpound.cli._group import HelpGroup
 from stochpound._errors import RecordError
+from stochpound.motions._spectrum import DEFAULT_G
 
 
 @click.group("records", cls=HelpGroup)
@@ -54,7 +55,8 @@ def _list_suite(suite: str) -> None:
 @records.command("show")
 @click.argument("name")
 @click.option("--plot", "plot_path", type=click.Path(dir_okay=False), default=None, help="Write a plot of the accelerogram (PNG, PDF, SVG).")
-@click.option("--g", "g", type=float, default=9.814, show_default=True, help="g (m/s²) for conversions, peak in g and Arias intensity.")
+@click.option("--g", "g", type=float, default=DEFAULT_G, show_default=True,
+              help="g (m/s²) for conversions, peak in g and Arias intensity (the study's Table 3.2 used 9.814).")
 @click.option("--dt", type=float, default=None, help="Step (s) of a one-column text file.")
 @click.option("--units", type=click.Choice(["g", "m/s2", "cm/s2"]), default=None, help="Units of a text file's values.")
 def show_command(name: str, plot_path: str | None, g: float, dt: float | None, units: str | None) -> None:
@@ -93,7 +95,7 @@ def parse_periods(text: str) -> list[float]:
 @click.option("--periods", "periods_text", default="0.05:5:30", show_default=True, help="Periods (s): a list 0.1,0.5,1 or a log-spaced range first:last:count.")
 @click.option("--damping", type=float, default=0.05, show_default=True, help="Damping ratio of the oscillators.")
 @click.option("--plot", "plot_path", type=click.Path(dir_okay=False), default=None, help="Write a plot of PSA against period (PNG, PDF, SVG).")
-@click.option("--g", "g", type=float, default=9.81, show_default=True, help="g (m/s²) for records in g, spectra in g and Arias intensity.")
+@click.option("--g", "g", type=float, default=DEFAULT_G, show_default=True, help="g (m/s²) for records in g, spectra in g and Arias intensity.")
 @click.option("--dt", type=float, default=None, help="Step (s) of a one-column text file.")
 @click.option("--units", type=click.Choice(["g", "m/s2", "cm/s2"]), default=None, help="Units of a text file's values.")
 def spectrum_command(name: str, periods_text: str, damping: float, plot_path: str | None, g: float, dt: float | None, units: str | None) -> None:

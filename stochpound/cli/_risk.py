@@ -5,7 +5,6 @@ from __future__ import annotations
 from pathlib import Path
 
 import click
-import pandas as pd
 
 from stochpound import StochpoundError
 from stochpound._errors import os_error_message
@@ -25,16 +24,25 @@ def _targets(value: str) -> tuple[float, ...]:
 @click.command("risk")
 @click.argument("store", type=click.Path(exists=True, dir_okay=False, path_type=Path))
 @click.option("--hazard", "hazard", metavar="FILE|NAME",
-              help="The site's hazard curve: a CSV of rows 'im, rate' (in the store's intensity measure and the units of its levels) "
-                   "or a bundled curve's name. Default: the hazard the store carries (its experiment's [hazard]).")
+              help="The site's hazard curve: a file (stochpound's CSV, OpenQuake's hazard-curve CSV or nshmp-haz's curve output; "
+                   "docs/risk.md) or a bundled curve's name. Default: the hazard the store carries (its experiment's [hazard]).")
+@click.option("--hazard-measure", "hazard_measure", metavar="TEXT",
+              help="What the --hazard file's curve is of, when the file does not say, e.g. 'PSA(1.0 s, 5 %) in g' or 'PGA in m/s2'.")
+@click.option("--hazard-units", "hazard_units", metavar="UNITS", help="Units of the --hazard file's intensities (g, m/s2, cm/s2, m/s, cm/s).")
+@click.option("--investigation-time", "investigation_time", type=click.FloatRange(min=0.0, min_open=True), metavar="YEARS",
+              help="Years of a --hazard file of probabilities of exceedance (a 'poe' column), converted to annual rates.")
+@click.option("--hazard-site", "hazard_site", metavar="ROW|NAME", help="The site of a --hazard file of several (its row, 0-based, or name).")
+@click.option("--extrapolate", is_flag=True, help="Extend the hazard table beyond its intensities as power laws (stated in the output).")
 @click.option("--target", "target", default=",".join(f"{t:g}" for t in TARGETS), show_default=True,
               help="Target probabilities of pounding in --years, separated by commas.")
 @click.option("--years", default=50.0, show_default=True, type=click.FloatRange(min=0.0, min_open=True), help="Exposure time (years).")
 @click.option("--bootstrap", default=BOOTSTRAP, show_default=True, type=click.IntRange(min=0),
               help="Resamples of the motions for the intervals (0: none).")
 @click.option("--seed", default=0, show_default=True, type=click.IntRange(min=0), help="Seed of the resamples.")
-@click.option("--csv", "csv_path", type=click.Path(dir_okay=False, path_type=Path), help="Also write both tables to this CSV file.")
-def risk(store: Path, hazard: str | None, target: str, years: float, bootstrap: int, seed: int, csv_path: Path | None) -> None:
+@click.option("--csv", "csv_dir", type=click.Path(file_okay=False, path_type=Path), metavar="DIR",
+              help="Also write the tables to this folder (created), one CSV file per table: separation.csv, rules.csv.")
+def risk(store: Path, hazard: str | None, hazard_measure: str | None, hazard_units: str | None, investigation_time: float | None,
+         hazard_site: str | None, extrapolate: bool, target: str, years: float, bootstrap: int, seed: int, csv_dir: Path | None) -> None:
     """Print the risk-targeted separation g* and the code rules' risks of the experiment STORE at a site.
 
     For every configuration of the store (each combination of its grid's
@@ -45,23 +53,33 @@ def risk(store: Path, hazard: str | None, target: str, years: float, bootstrap: 
     the mean annual frequency of pounding there, as a return period and
     a probability in --years. The store needs intensity stripes (with
     contact-free cases, gap = inf) or IDA capacities (docs/risk.md).
+    A hazard file must say (or the options state) its measure and units;
+    they are checked against the store's and converted (docs/risk.md).
     """
     from stochpound.experiment import open_store
     from stochpound.risk import site_hazard, store_risk
 
     targets = _targets(target)
+    if hazard is None and (hazard_measure or hazard_units or investigation_time is not None or hazard_site is not None):
+        raise click.UsageError("--hazard-measure, --hazard-units, --investigation-time and --hazard-site describe a --hazard file: give one")
     try:
         data = open_store(store)
-        hz = site_hazard(data, hazard)
+        hz = site_hazard(data, hazard, measure=hazard_measure, units=hazard_units, investigation_time=investigation_time,
+                         site=hazard_site, extrapolate=extrapolate)
         result = store_risk(data, hz, targets, years, bootstrap=bootstrap, seed=seed)
     except (StochpoundError, ValueError) as error:
         raise click.ClickException(str(error)) from None
     except OSError as error:
         raise click.ClickException(os_error_message(error)) from None
     stripes = f"{result.stripes} stripes" if result.stripes is not None else "IDA capacities"
-    source = hz.source.splitlines()[0] if hz.source else repr(hz)
+    source = hz.source.splitlines()[0] if hz.source else hz.describe()
     click.echo(f"{result.experiment or store.stem}: {result.motions} motions, {stripes} of {result.measure} "
                f"in {result.setting['units']}; hazard: {source}")
+    for line in hz.source.splitlines():
+        if line.startswith("stochpound: "):
+            click.echo(f"note: hazard {line.removeprefix('stochpound: ')}")
+    if hz.extrapolated:
+        click.echo(f"note: the hazard table [{hz.im[0]:g}, {hz.im[-1]:g}] {hz.units} was extrapolated beyond its intensities as power laws (--extrapolate)")
     interval = "95 % BCa bootstrap interval over the motions" if bootstrap else "no bootstrap"
     separation = result.separation_frame()
     click.echo(f"\nRisk-targeted separation g* (m; {interval}; inf: wider than every gap of the grid):")
@@ -73,12 +91,15 @@ def risk(store: Path, hazard: str | None, target: str, years: float, bootstrap: 
         click.echo(f"\nCode rules in risk terms (gap at the code intensity's stripe; λ_P: pounding per year at that gap; "
                    f"'once in N years'; P in {years:g} years):")
         click.echo(rules.to_string(float_format=lambda v: f"{v:.4g}"))
-    if csv_path is not None:
-        frames = [result.to_frame().assign(table="separation")]
+    if csv_dir is not None:
+        tables = {"separation": result.to_frame()}
         if not rules.empty:
-            frames.append(rules.reset_index().assign(table="rules"))
+            tables["rules"] = rules.reset_index()
         try:
-            pd.concat(frames, ignore_index=True).to_csv(csv_path, index=False)
+            csv_dir.mkdir(parents=True, exist_ok=True)
+            for name, frame in tables.items():
+                frame.to_csv(csv_dir / f"{name}.csv", index=False)
         except OSError as error:
             raise click.ClickException(os_error_message(error)) from None
-        click.echo(f"\ntables: {csv_path}")
+        click.echo(f"\ntables: {', '.join(str(csv_dir / f'{name}.csv') for name in tables)}")
+

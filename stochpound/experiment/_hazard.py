@@ -2,29 +2,35 @@
 
 One of three sources (docs/risk.md):
 
-* ``file = "site.csv"``: rows of intensity and annual rate of exceedance
-  (:meth:`~stochpound.analysis.HazardCurve.from_file`), the path relative to
-  the experiment file;
+* ``file = "site.csv"``: a hazard-curve file (stochpound's CSV, OpenQuake's
+  hazard-curve CSV or nshmp-haz's curve output, read by
+  :func:`~stochpound.analysis.read_hazard_file`), the path relative to the
+  experiment file;
 * ``bundled = "fox_plaza_los_angeles_sa2p0s"``: a curve shipped with
   stochpound (:meth:`~stochpound.analysis.HazardCurve.bundled`);
 * ``power_law = { k0 = 2.0e-4, k = 2.2 }``: λ(x) = k0 x^(−k).
 
-**The measure rule.** A hazard curve is only meaningful with the
-fragility's intensity measure, so the hazard's measure must be the
+**A hazard is read, never guessed.** A hazard curve is only meaningful
+with the fragility's intensity measure, so the hazard's measure must be the
 ``[intensity]`` table's: the same ``measure``, the same ``period`` (PSA)
-or ``periods`` (Sa_avg), the same ``damping``, and intensities in the units
-of ``levels``. A bundled curve knows its measure (from its name, in g) and
-is checked against ``[intensity]``; a file or power law may state
-``measure`` (and ``period``/``periods``, ``damping``), which are then
-checked, and is otherwise taken to be in ``[intensity]``'s measure and
-units. A mismatch is an error naming the field.
+or ``periods`` (Sa_avg), the same ``damping``. A file states its measure
+and units (its header, or the format's convention); what it does not state,
+``[hazard]`` must (``measure``, ``period``/``periods``, ``damping``,
+``units``), and a field that contradicts the file is an error naming both.
+Intensities in other units than the levels' (g, m/s², cm/s² for
+accelerations) are converted with the scene's g; probabilities of
+exceedance in an investigation time are converted to annual rates; both
+conversions are recorded in the provenance. A bundled curve knows its
+measure (from its name, in g). A power law is in ``[intensity]``'s
+measure, its x in ``units`` (default: the levels'). A table that does not
+cover the stripes is an error unless ``extrapolate = true``.
 
-The canonical entry holds the table itself (``im``, ``rate``), its
-provenance (the file's comment lines) and the file's sha256, so a store
-carries everything needed to redo the risk chain without the file. No run
-depends on it, so it is not part of the experiment's identity
-(``stochpound.store.NOT_IN_IDENTITY``): a run after the hazard changed keeps
-the store's cases and records the new entry.
+The canonical entry holds the table itself (``im``, ``rate``, in the
+levels' units and annual rates), its provenance (the file's comment lines
+and the conversions) and the file's sha256, so a store carries everything
+needed to redo the risk chain without the file. No run depends on it, so it is not part of the
+experiment's identity (``stochpound.store.NOT_IN_IDENTITY``): a run after
+the hazard changed keeps the store's cases and records the new entry.
 """
 
 from __future__ import annotations
@@ -32,23 +38,28 @@ from __future__ import annotations
 import hashlib
 import math
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Any, Mapping, Sequence
 
 import xarray as xr
 
-from stochpound.analysis._hazard import HazardCurve, bundled_curves, bundled_measure
+from stochpound.analysis._hazard import HazardCurve, bundled_curves, bundled_measure, bundled_path
+from stochpound.analysis._hazard_files import parse_units, read_hazard_file, unit_factor
+from stochpound.experiment._intensity import MEASURES, IntensityError
 from stochpound.store import describe_measure
-from stochpound.experiment._intensity import IntensityError
 from stochpound.model import fields as toml_fields
+from stochpound.motions._spectrum import DEFAULT_G
 
 SOURCES = ("file", "bundled", "power_law")
 """The keys that name a hazard's source (exactly one per ``[hazard]`` table)."""
-_KEYS = {*SOURCES, "measure", "period", "periods", "damping", "extrapolate"}
+STATED = ("measure", "period", "periods", "damping", "units", "investigation_time")
+"""The ``[hazard]`` fields (and ``stochpound risk`` options) that state what a file's curve is of, when the file does not."""
+_KEYS = {*SOURCES, *STATED, "site", "extrapolate"}
 _MATCHED = ("measure", "period", "periods", "damping")
+_REQUIRED = {"pga": ("units",), "pgv": ("units",), "psa": ("period", "damping", "units"), "sa_avg": ("periods", "damping", "units")}
 _TOLERANCE = 1e-9
 
 
-def parse_hazard(data: Mapping[str, Any], intensity: Mapping[str, Any] | None, base_dir: Path) -> dict[str, Any] | None:
+def parse_hazard(data: Mapping[str, Any], intensity: Mapping[str, Any] | None, base_dir: Path, g: float = DEFAULT_G) -> dict[str, Any] | None:
     """The canonical ``hazard`` entry of a definition (None without a ``[hazard]`` table).
 
     Parameters
@@ -59,20 +70,25 @@ def parse_hazard(data: Mapping[str, Any], intensity: Mapping[str, Any] | None, b
         The canonical ``intensity`` entry (a hazard needs one).
     base_dir : Path
         The experiment file's folder (a ``file`` is relative to it).
+    g : float
+        The scene's g (m/s²), to convert a hazard in g to levels in m/s² or back.
 
     Returns
     -------
     dict or None
         ``source`` (one of :data:`SOURCES`), the source's key as given,
         the measure (as ``[intensity]``'s), ``units``, ``extrapolate``,
-        ``im`` and ``rate`` (a table; a power law: ``power_law``),
-        ``provenance`` and, for a file, ``file_sha256``.
+        ``im`` and ``rate`` (a table, in the units of the levels and in
+        annual rates; a power law: ``power_law``), ``provenance`` (with
+        any conversion) and, for a file, ``file_sha256``.
 
     Raises
     ------
     IntensityError
         Naming the field: no ``[intensity]``, not exactly one source, an
-        unreadable or invalid table, a measure other than ``[intensity]``'s.
+        unreadable or invalid table, a measure other than ``[intensity]``'s,
+        a measure or units the file and ``[hazard]`` both leave unstated or
+        state differently, a curve that misses the stripes.
     """
     table = toml_fields.table(data, "hazard", "")
     if table is None:
@@ -86,32 +102,123 @@ def parse_hazard(data: Mapping[str, Any], intensity: Mapping[str, Any] | None, b
     source = given[0]
     extrapolate = toml_fields.boolean(table, "extrapolate", "hazard", default=False)
     entry: dict[str, Any] = {"source": source, **_measure_of(intensity), "units": intensity["units"], "extrapolate": extrapolate}
+    stated = _stated_fields(table)
     if source == "bundled":
         name = toml_fields.string(table, "bundled", "hazard")
-        if name not in bundled_curves():
-            raise IntensityError(f"hazard.bundled: no bundled hazard curve {name!r} (bundled: {', '.join(bundled_curves())})")
-        _check_measure("hazard.bundled", {**bundled_measure(name)}, intensity, bundled=name)
-        curve = HazardCurve.bundled(name)
+        curve = _bundled(name, intensity, g, extrapolate, "hazard.bundled")
         entry["bundled"] = name
+    elif source == "file":
+        name = toml_fields.string(table, "file", "hazard")
+        path = base_dir / name
+        if not path.is_file():
+            raise IntensityError(f"hazard.file: {name!r} not found (a hazard-curve file, relative to the experiment file)")
+        curve = _read(path, stated, table.get("site"), intensity, g, extrapolate, "hazard")
+        entry["file"], entry["file_sha256"] = name, hashlib.sha256(path.read_bytes()).hexdigest()
     else:
-        _check_measure("hazard", {key: table[key] for key in _MATCHED if key in table}, intensity)
-        if source == "file":
-            entry["file"], entry["file_sha256"], curve = _file(table, base_dir)
-        else:
-            entry["power_law"] = _power_law(table["power_law"])
-            curve = HazardCurve.power_law(**entry["power_law"])
+        _check_measure("hazard", {key: stated[key] for key in _MATCHED if key in stated}, intensity)
+        entry["power_law"] = _power_law(table["power_law"], stated.get("units", intensity["units"]), intensity["units"], g)
+        curve = HazardCurve.power_law(**entry["power_law"])
     if curve.power is None:
         entry["im"], entry["rate"] = [float(x) for x in curve.im], [float(y) for y in curve.rate]
+        if intensity.get("ran") == "stripes":
+            check_covers(curve, intensity["levels"], "hazard", "intensity.levels", "extrapolate = true")
     entry["provenance"] = curve.source
     return entry
 
 
-def hazard_curve(entry: Mapping[str, Any]) -> HazardCurve:
-    """The :class:`~stochpound.analysis.HazardCurve` of a canonical ``hazard`` entry (from its stored values, not its file)."""
+def hazard_curve(entry: Mapping[str, Any], extrapolate: bool | None = None) -> HazardCurve:
+    """The :class:`~stochpound.analysis.HazardCurve` of a canonical ``hazard`` entry (from its stored values, not its file).
+
+    ``extrapolate`` overrides the entry's (``stochpound risk --extrapolate``).
+    """
     description = {"measure": describe_measure(entry), "units": entry["units"], "source": entry["provenance"]}
     if "power_law" in entry:
         return HazardCurve.power_law(**entry["power_law"], **description)
-    return HazardCurve(entry["im"], entry["rate"], extrapolate=entry["extrapolate"], **description)
+    return HazardCurve(entry["im"], entry["rate"], extrapolate=entry["extrapolate"] if extrapolate is None else extrapolate, **description)
+
+
+def check_covers(curve: HazardCurve, levels: Sequence[float], where: str, what: str, remedy: str) -> None:
+    """Raise unless the curve's table covers ``levels`` (or extrapolates, as it states).
+
+    A table says nothing outside its intensities: a risk integral over stripes
+    beyond them would silently count nothing (below) or the last rate (above).
+    """
+    low, high = curve.support
+    if min(levels) < low or max(levels) > high:
+        raise IntensityError(f"{where}: the hazard curve covers [{low:g}, {high:g}] {curve.units}, the stripes ({what}) "
+                             f"[{min(levels):g}, {max(levels):g}] {curve.units}: give a curve that covers them, or {remedy} "
+                             "to extend it as power laws (stated in the report)")
+
+
+def _stated_fields(table: Mapping[str, Any]) -> dict[str, Any]:
+    """What ``[hazard]`` states of its curve: measure, period(s), damping, units, investigation time."""
+    stated: dict[str, Any] = {}
+    if "measure" in table:
+        stated["measure"] = toml_fields.string(table, "measure", "hazard")
+        if stated["measure"] not in MEASURES:
+            raise IntensityError(f"hazard.measure: must be one of {', '.join(MEASURES)}, got {stated['measure']!r}")
+    for key in ("period", "investigation_time"):
+        if key in table:
+            stated[key] = toml_fields.number(table, key, "hazard", required=True, low=0.0, low_open=True)
+    if "damping" in table:
+        stated["damping"] = toml_fields.number(table, "damping", "hazard", required=True, low=0.0, high=1.0, high_open=True)
+    if "periods" in table:
+        stated["periods"] = table["periods"]
+    if "units" in table:
+        try:
+            stated["units"] = parse_units(toml_fields.string(table, "units", "hazard"))
+        except ValueError as error:
+            raise IntensityError(f"hazard.{error}") from None
+    return stated
+
+
+def _read(path: Path, given: Mapping[str, Any], site: Any, intensity: Mapping[str, Any], g: float, extrapolate: bool, where: str) -> HazardCurve:
+    """A hazard file's curve, its measure (the file's, completed by ``given``) checked against ``intensity``, converted to its units and to rates."""
+    try:
+        read = read_hazard_file(path, site=site)
+    except (ValueError, UnicodeDecodeError) as error:
+        raise IntensityError(f"{where}.file: {error}") from None
+    stated = dict(read.stated)
+    for key, value in given.items():
+        if key == "investigation_time":
+            if read.investigation_time is not None and not _equal(value, read.investigation_time):
+                raise IntensityError(f"{_field(where, key)}: {value!r} years, but {path.name} states {read.investigation_time:g} years")
+            continue
+        if key in stated and not _equal(value, stated[key]):
+            raise IntensityError(f"{_field(where, key)}: {value!r}, but {path.name} states {key} = {stated[key]!r}")
+        stated[key] = value
+    if "measure" not in stated:
+        raise IntensityError(f"{_field(where, 'measure')}: not stated: {path.name} does not say which measure its curve is of "
+                             "(a '# Measure:' line, e.g. '# Measure: 5 %-damped spectral acceleration at T = 1.0 s, in g'); state it")
+    for key in _REQUIRED.get(stated["measure"], ()):
+        if key not in stated:
+            raise IntensityError(f"{_field(where, key)}: not stated: {path.name} does not give its curve's {key}; state it")
+    _check_measure(where, {key: stated[key] for key in _MATCHED if key in stated}, intensity)
+    read.stated = stated
+    try:
+        return read.curve(intensity["units"], g, investigation_time=given.get("investigation_time"), extrapolate=extrapolate,
+                          description=describe_measure(intensity))
+    except ValueError as error:
+        message = str(error)
+        if message.startswith("investigation_time:"):
+            raise IntensityError(f"{_field(where, 'investigation_time')}{message.removeprefix('investigation_time')}") from None
+        raise IntensityError(f"{where}.file: {path.name}: {message}") from None
+
+
+def _field(where: str, key: str) -> str:
+    """The name of a stated field: ``hazard.units`` in a file, ``--hazard-units`` on the command line."""
+    return f"{where}.{key}" if not where.startswith("--") else f"{where}-{key.replace('_', '-')}"
+
+
+def _bundled(name: str, intensity: Mapping[str, Any], g: float, extrapolate: bool, where: str) -> HazardCurve:
+    """A bundled curve, its measure (from its name) checked against ``intensity``, converted to the levels' units."""
+    if name not in bundled_curves():
+        raise IntensityError(f"{where}: no bundled hazard curve {name!r} (bundled: {', '.join(bundled_curves())})")
+    measure = bundled_measure(name)
+    _check_measure(where, {key: value for key, value in measure.items() if key != "units"}, intensity, bundled=name)
+    read = read_hazard_file(bundled_path(name))
+    read.stated = measure
+    return read.curve(intensity["units"], g, extrapolate=extrapolate, description=describe_measure(intensity))
 
 
 def _measure_of(intensity: Mapping[str, Any]) -> dict[str, Any]:
@@ -120,19 +227,14 @@ def _measure_of(intensity: Mapping[str, Any]) -> dict[str, Any]:
 
 
 def _check_measure(where: str, stated: Mapping[str, Any], intensity: Mapping[str, Any], bundled: str = "") -> None:
-    """Raise unless every stated key of the hazard's measure equals ``[intensity]``'s (``units`` too, for a bundled curve)."""
-    wanted = {**_measure_of(intensity), "units": intensity["units"]}
+    """Raise unless every stated key of the hazard's measure equals ``[intensity]``'s (units are converted, not matched)."""
+    wanted = _measure_of(intensity)
     for key, value in stated.items():
-        if key not in wanted:
-            raise IntensityError(f"{where if bundled else f'hazard.{key}'}: the hazard's measure must be [intensity]'s, "
-                                 f"{describe_measure(intensity)} in {intensity['units']}; "
-                                 f"{f'{bundled!r} has' if bundled else 'got'} {key} = {value!r}")
-        if not _equal(value, wanted[key]):
-            what = (f"{bundled!r} is {describe_measure(stated)} in {stated['units']}" if bundled
-                    else f"got {value!r}")
-            field = where if bundled else f"hazard.{key}"
-            raise IntensityError(f"{field}: the hazard's measure must be [intensity]'s, {describe_measure(intensity)} in "
-                                 f"{intensity['units']} (intensity.{key} = {wanted[key]!r}); {what}")
+        field = where if bundled else _field(where, key)
+        what = f"{bundled!r} is {describe_measure({**wanted, **stated})}" if bundled else f"the hazard's {key} is {value!r}"
+        if key not in wanted or not _equal(value, wanted[key]):
+            detail = f" (intensity.{key} = {wanted[key]!r})" if key in wanted else ""
+            raise IntensityError(f"{field}: the hazard's measure must be [intensity]'s, {describe_measure(intensity)}{detail}; {what}")
 
 
 def _equal(a: Any, b: Any) -> bool:
@@ -143,24 +245,19 @@ def _equal(a: Any, b: Any) -> bool:
     return a == b
 
 
-def _file(table: Mapping[str, Any], base_dir: Path) -> tuple[str, str, HazardCurve]:
-    """The file's path as given, its sha256 and its curve."""
-    name = toml_fields.string(table, "file", "hazard")
-    path = base_dir / name
-    if not path.is_file():
-        raise IntensityError(f"hazard.file: {name!r} not found (a CSV of rows 'im, rate', relative to the experiment file)")
-    try:
-        curve = HazardCurve.from_file(path)
-    except ValueError as error:
-        raise IntensityError(f"hazard.file: {name!r}: {error}") from None
-    return name, hashlib.sha256(path.read_bytes()).hexdigest(), curve
-
-
-def _power_law(table: Any) -> dict[str, float]:
+def _power_law(table: Any, units: str, target: str, g: float) -> dict[str, float]:
+    """``k0`` and ``k`` of λ(x) = k0 x^(−k), k0 converted to x in the levels' units (x in ``units`` → c x in ``target``: k0 c^k)."""
     if not isinstance(table, dict):
         raise IntensityError(f"hazard.power_law: must be a table {{ k0 = ..., k = ... }} (rate = k0 x^-k, 1/yr), got {table!r}")
     toml_fields.reject_unknown(table, {"k0", "k"}, "hazard.power_law")
-    return {key: toml_fields.number(table, key, "hazard.power_law", required=True, low=0.0, low_open=True) for key in ("k0", "k")}
+    law = {key: toml_fields.number(table, key, "hazard.power_law", required=True, low=0.0, low_open=True) for key in ("k0", "k")}
+    try:
+        factor = unit_factor(units, target, g)
+    except ValueError as error:
+        raise IntensityError(f"hazard.{error}") from None
+    if factor != 1.0:
+        law["k0"] = law["k0"] * factor ** law["k"]
+    return law
 
 
 def stored_hazard(store: xr.Dataset) -> HazardCurve | None:
@@ -169,25 +266,35 @@ def stored_hazard(store: xr.Dataset) -> HazardCurve | None:
     return None if entry is None else hazard_curve(entry)
 
 
-def hazard_option(value: str, intensity: Mapping[str, Any], option: str = "--hazard") -> HazardCurve:
-    """A hazard named on the command line: a bundled curve's name (its measure checked against ``intensity``) or a CSV file.
+def hazard_option(value: str, intensity: Mapping[str, Any], g: float = DEFAULT_G, *, stated: Mapping[str, Any] | None = None,
+                  site: Any = None, extrapolate: bool = False, option: str = "--hazard") -> HazardCurve:
+    """A hazard named on the command line: a bundled curve's name or a hazard-curve file, checked against ``intensity``.
 
-    A file is taken to be in ``intensity``'s measure and the units of its
-    levels (it cannot say otherwise); a bundled curve must match them.
+    Parameters
+    ----------
+    value : str
+        A bundled curve's name or a hazard-curve file
+        (:func:`~stochpound.analysis.read_hazard_file`).
+    intensity : mapping
+        The store's ``intensity`` entry.
+    g : float
+        The store's g (m/s²), for a conversion to or from g.
+    stated : mapping, optional
+        What the options state of the file's curve (keys of :data:`STATED`).
+    site : int or str, optional
+        The site of a file of several.
+    extrapolate : bool
+        Extend the table beyond its intensities as power laws.
 
     Raises
     ------
     IntensityError
-        Neither a bundled name nor a file, an invalid file, or a bundled curve of another measure.
+        Neither a bundled name nor a file, an invalid file, a measure other
+        than the store's or one nobody states.
     """
     if value in bundled_curves():
-        _check_measure(option, bundled_measure(value), intensity, bundled=value)
-        return HazardCurve.bundled(value)
+        return _bundled(value, intensity, g, extrapolate, option)
     path = Path(value)
     if not path.is_file():
         raise IntensityError(f"{option}: {value!r} is neither a file nor a bundled hazard curve (bundled: {', '.join(bundled_curves())})")
-    try:
-        curve = HazardCurve.from_file(path, measure=describe_measure(intensity), units=intensity["units"])
-    except ValueError as error:
-        raise IntensityError(f"{option}: {error}") from None
-    return curve
+    return _read(path, stated or {}, site, intensity, g, extrapolate, option)

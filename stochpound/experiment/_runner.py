@@ -258,8 +258,8 @@ def run_experiment(
         except KeyboardInterrupt:
             report.interrupted = True
         finally:
+            bar.close()  # first: an error below is printed on a line of its own, not on the bar's
             buffer.flush()
-            bar.close()
             checkpoints.wait()
             session.rebuild()
             report.elapsed = time.monotonic() - started

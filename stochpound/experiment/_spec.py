@@ -28,6 +28,7 @@ from typing import Any, Iterator, Mapping
 from stochpound._errors import ExperimentError, SceneError
 from stochpound._studies import parse_reproduces
 from stochpound.experiment._hazard import parse_hazard
+from stochpound.motions._spectrum import DEFAULT_G
 from stochpound.experiment._intensity import parse_intensity
 from stochpound.model import fields as toml_fields
 from stochpound.model.contact import ELEMENT_KEYS
@@ -170,7 +171,7 @@ def parse_experiment(data: Mapping[str, Any], base_dir: str | Path = ".", defaul
     mu = _mu_axis(grid["mu"], buildings) if "mu" in grid else None
     with field_errors():
         intensity = parse_intensity(data, scene, variants, gaps, mu)
-        hazard = parse_hazard(data, intensity, base_dir)
+        hazard = parse_hazard(data, intensity, base_dir, float(scene["g"]) if "g" in scene else DEFAULT_G)
     definition = {
         "format": FORMAT_VERSION,
         "name": name,
@@ -455,25 +456,45 @@ def _record_sources(table: Mapping[str, Any], where: str, base_dir: Path) -> lis
     """A ``[[records]]`` entry: one record, or every motion of a suite (``suite = "fema_p695_far_field"`` or a folder)."""
     if "suite" not in table:
         return [_record_source(table, where, base_dir)]
-    from stochpound.motions.records._suites import SUITES, suite_members
+    from stochpound.motions.records._suites import SELECTIONS, SUITES, select_members
 
     with field_errors():
-        toml_fields.reject_unknown(table, _SUITE_KEYS, where)
+        toml_fields.reject_unknown(table, _SUITE_KEYS | set(SELECTIONS), where)
         suite = toml_fields.string(table, "suite", where)
         prefix = toml_fields.string(table, "name", where, default="")
     folder = base_dir / suite
     if suite not in SUITES and not folder.is_dir():
         raise ExperimentError(f"{where}.suite: unknown suite {suite!r} and no such folder (suites: {', '.join(SUITES)}, or a folder of .AT2/.txt files)")
     with field_errors(f"{where}."):
-        members = suite_members(suite if suite in SUITES else folder)
+        members = select_members(suite if suite in SUITES else folder, **_suite_choice(table, where))
     sources = []
     for member in members:
         record = member if suite in SUITES else str(Path(member).relative_to(base_dir))
         label = member if suite in SUITES else Path(member).stem
-        motion = {k: v for k, v in table.items() if k not in ("name", "suite")}
+        motion = {k: v for k, v in table.items() if k not in ("name", "suite", *SELECTIONS)}
         motion.update(type="record", record=record, file_sha256=_file_sha256(base_dir, record))
         sources.append({"label": f"{prefix}/{label}" if prefix else label, "kind": "record", "field": where, "motion": motion, "suite": suite})
     return sources
+
+
+def _suite_choice(table: Mapping[str, Any], where: str) -> dict[str, Any]:
+    """The ``members``, ``event``, ``magnitude`` and ``distance`` choices of a suite entry (lists of names, closed ranges)."""
+    choice: dict[str, Any] = {}
+    for key in ("members", "event"):
+        if key in table:
+            value = table[key]
+            if not isinstance(value, list) or not value or not all(isinstance(item, str) and item for item in value):
+                example = '["01a", "03b"]' if key == "members" else '["Northridge", "Kobe"]'
+                raise ExperimentError(f"{where}.{key}: must be a non-empty list of names, e.g. {key} = {example}; got {value!r}")
+            choice[key] = value
+    for key, unit in (("magnitude", ""), ("distance", " km")):
+        if key in table:
+            value = table[key]
+            if (not isinstance(value, list) or len(value) != 2 or not all(toml_fields.is_number(v) for v in value)
+                    or not value[0] <= value[1]):
+                raise ExperimentError(f"{where}.{key}: must be a range [low, high]{unit} with low <= high, got {value!r}")
+            choice[key] = (float(value[0]), float(value[1]))
+    return choice
 
 
 def _record_source(table: Mapping[str, Any], where: str, base_dir: Path) -> dict[str, Any]:

@@ -9,6 +9,7 @@ from typing import Iterator
 
 import numpy as np
 
+from stochpound._errors import os_error_message
 from stochpound.store import open_store
 from stochpound.experiment._grid import KINDS, Case, Experiment
 from stochpound.experiment._parts import DEFINITION_FILE, FolderLock, parts_folder
@@ -31,6 +32,9 @@ class StatusReport:
         A run holds the parts folder's lock (it is being written now).
     rebuilt : bool
         The store file was rebuilt from the parts.
+    not_rebuilt : str
+        Why a rebuild that was due failed (one line naming the file, e.g. a
+        full disk), or "" (the parts and the old store file are intact).
     """
 
     store: Path
@@ -38,6 +42,7 @@ class StatusReport:
     done_mask: dict[str, np.ndarray]
     running: bool = False
     rebuilt: bool = False
+    not_rebuilt: str = ""
 
     @property
     def n_done(self) -> int:
@@ -86,15 +91,20 @@ def store_status(store: str | Path, rebuild: bool = True) -> StatusReport:
     except OSError:  # the lock file cannot be made or opened for writing (a read-only disk): only read
         running, writable = lock.held(), False
     rebuilt = rebuild and writable and not running
+    not_rebuilt = ""
     try:
         if rebuilt:
-            session.rebuild()
+            try:
+                session.rebuild()
+            except OSError as error:  # a full disk, say: the parts and the old store file are intact; the status is still known
+                rebuilt, not_rebuilt = False, os_error_message(error)
+                session.scan()
         else:
             session.scan()
     finally:
         lock.release()
     done = {kind: session.index.done(kind) for kind in KINDS}
-    return StatusReport(store, session.experiment, done, running, rebuilt)
+    return StatusReport(store, session.experiment, done, running, rebuilt, not_rebuilt)
 
 
 def _from_file(store: Path) -> StatusReport:

@@ -26,7 +26,7 @@ import h5py
 import numpy as np
 from xarray.backends import H5NetCDFStore
 
-from stochpound._atomic import replacing
+from stochpound._atomic import check_room, replacing
 from stochpound.experiment._grid import CASE, KINDS, Experiment
 from stochpound.experiment._parts import part_paths, read_part, split_key
 from stochpound.experiment._spec import ExperimentError
@@ -134,6 +134,7 @@ def write_store(experiment: Experiment, index: PartsIndex, motion_grids: Mapping
         "cases_done": n_done,
         "complete": int(n_done == experiment.n_cases),
     }
+    check_room(path, path.stat().st_size if path.is_file() else 0)  # the new file is at least as large as the old one
     with replacing(path) as temporary:
         _create(store_layout, attrs, temporary)
         with h5py.File(temporary, "r+", rdcc_nbytes=_CHUNK_CACHE_BYTES) as handle:

@@ -22,7 +22,9 @@ import xarray as xr
 
 from stochpound.analysis import store_contact_demands
 from stochpound.analysis._hazard import HazardCurve
-from stochpound.experiment._hazard import hazard_option, stored_hazard
+from stochpound.analysis._hazard_files import parse_measure, parse_units
+from stochpound.experiment._hazard import check_covers, hazard_curve, hazard_option, stored_hazard
+from stochpound.motions._spectrum import DEFAULT_G
 from stochpound.store import contact_free, describe_measure, gap_dims, has_contact_free, wall_free
 
 CLOSURE = "peak_contact_closure"
@@ -59,24 +61,71 @@ def has_risk(store: xr.Dataset) -> bool:
     return intensity_setting(store) is not None and stored_hazard(store) is not None and ("intensity" in store.dims or CAPACITY in store)
 
 
-def site_hazard(store: xr.Dataset, hazard: str | None = None, option: str = "--hazard") -> HazardCurve:
-    """The hazard of a store's site: the one it carries, or ``hazard`` (a bundled curve's name or a CSV file, named by ``option``).
+def site_hazard(store: xr.Dataset, hazard: str | None = None, option: str = "--hazard", *, measure: str | None = None,
+                units: str | None = None, investigation_time: float | None = None, site: str | None = None,
+                extrapolate: bool = False) -> HazardCurve:
+    """The hazard of a store's site: the one it carries, or ``hazard`` (a bundled curve's name or a hazard-curve file, named by ``option``).
+
+    Parameters
+    ----------
+    store : xarray.Dataset
+        An experiment store with intensity levels.
+    hazard : str, optional
+        A bundled curve's name or a hazard-curve file (stochpound's CSV,
+        OpenQuake's hazard-curve CSV, nshmp-haz's curve output); default: the
+        hazard the store carries.
+    option : str
+        The name of ``hazard`` in error messages.
+    measure, units : str, optional
+        What the file's curve is of and its intensities' units, where the file does not say (e.g. ``"PSA(1.0 s, 5 %) in g"``, ``"m/s2"``).
+    investigation_time : float, optional
+        Years of a file of probabilities of exceedance, converted to annual rates.
+    site : str, optional
+        The site (row or name) of a file of several.
+    extrapolate : bool
+        Extend the table beyond its intensities as power laws (stated in its source).
 
     Raises
     ------
     ValueError
         (``RiskInputError``) The store has no intensity levels, or carries no
-        hazard and none is given; (``IntensityError``) ``hazard`` is
-        neither a file nor a bundled curve, or is of another measure.
+        hazard and none is given, or the file's description is given without
+        a file; (``IntensityError``) the hazard is of another measure, misses
+        the stripes without ``extrapolate``, or cannot be read.
     """
     setting = intensity_setting(store)
     if setting is None:
         raise RiskInputError(NOT_INTENSITY)
-    hz = hazard_option(hazard, setting, option) if hazard is not None else stored_hazard(store)
-    if hz is None:
-        raise RiskInputError(f"{option}: the store carries no hazard (its experiment has no [hazard] table): give a hazard file or a "
-                             "bundled curve's name")
+    stated = _stated(measure, units, investigation_time)
+    if hazard is None and (stated or site is not None):
+        raise RiskInputError(f"{option}-measure, {option}-units, --investigation-time and {option}-site describe a {option} file: give one")
+    if hazard is not None:
+        g = float(store.pound.definition.to_dict()["scene"].get("g", DEFAULT_G))
+        hz = hazard_option(hazard, setting, g, stated=stated, site=site, extrapolate=extrapolate, option=option)
+    else:
+        entry = store.pound.hazard
+        if entry is None:
+            raise RiskInputError(f"{option}: the store carries no hazard (its experiment has no [hazard] table): give a hazard file or a "
+                                 "bundled curve's name")
+        hz = hazard_curve(entry, extrapolate=extrapolate or None)
+    if "intensity" in store.dims:
+        check_covers(hz, [float(x) for x in store["intensity"].values], option, "the store's intensity levels", "pass --extrapolate")
     return hz
+
+
+def _stated(measure: str | None, units: str | None, investigation_time: float | None) -> dict[str, Any]:
+    """The hazard file's description given beside it (its measure, units, investigation time), parsed."""
+    stated: dict[str, Any] = {}
+    try:
+        if measure is not None:
+            stated.update(parse_measure(measure))
+        if units is not None:
+            stated["units"] = parse_units(units)
+    except ValueError as error:
+        raise RiskInputError(f"--hazard-{error}") from None
+    if investigation_time is not None:
+        stated["investigation_time"] = investigation_time
+    return stated
 
 
 def studied_building(store: xr.Dataset) -> str | None:

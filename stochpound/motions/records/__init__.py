@@ -17,7 +17,7 @@ from stochpound.motions.records._registry import (
     registry_entries,
     study_table_3_2,
 )
-from stochpound.motions.records._suites import SUITES, list_suites, load_suite, load_suite_member, suite_members
+from stochpound.motions.records._suites import SUITES, is_suite_member, list_suites, load_suite, load_suite_member, select_members, suite_members
 from stochpound.motions.records._statistics import (
     STUDY_G,
     RecordStatistics,
@@ -39,6 +39,8 @@ __all__ = [
     "load_record",
     "load_suite",
     "load_suite_member",
+    "select_members",
+    "is_suite_member",
     "moments",
     "normalize_units",
     "read_at2",

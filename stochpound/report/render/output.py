@@ -16,19 +16,17 @@ write again: only files the earlier build's list names, never another file.
 
 from __future__ import annotations
 
-import contextlib
 import datetime
 import io
 import json
-import os
 import re
-import secrets
 from pathlib import Path
-from typing import Callable, Iterator, Sequence
+from typing import Callable, Sequence
 
 import matplotlib.pyplot as plt
 
 from stochpound._atomic import check_writable
+from stochpound._atomic import replacing as _replacing  # a full disk is reported naming the file
 from stochpound.report.render._document import Report
 from stochpound.report.render._html import render_html
 from stochpound.report.render._pdf import render_pdf
@@ -81,7 +79,8 @@ def write_report(
     try:
         figure_png = _write_figures(report, written["figures"], say)
         _write_tables(report, written["tables"], say)
-        _replace_owned(out, [f"figures/{item.key}.png" for item in report.figures()] + [f"tables/{table.key}.csv" for table in report.tables()])
+        _replace_owned(out, [f"figures/{item.key}.png" for item in report.figures()] + [f"tables/{table.key}.csv" for table in report.tables()],
+                       [FILE_NAMES[name] for name in formats])
         if "html" in formats:
             say(FILE_NAMES["html"])
             written["html"] = _replace(out / FILE_NAMES["html"], render_html(report, figure_png, date).encode("utf-8"))
@@ -102,16 +101,25 @@ def check_output_folder(out: Path) -> None:
     check_writable(Path(out) / MANIFEST)
 
 
-def _replace_owned(out: Path, owned: list[str]) -> None:
-    """Remove the files the previous build's list names and this build did not write; list this build's files."""
+def _replace_owned(out: Path, owned: list[str], documents: list[str]) -> None:
+    """Remove the files the previous build's list names and this build did not write; list this build's files.
+
+    A folder with a list is an earlier build's: its document (``index.html``,
+    ``report.pdf``) that this build does not write (``documents``) is stale
+    and removed too (an HTML-only rebuild leaves no PDF of the old one).
+    """
     try:
         previous = json.loads((out / MANIFEST).read_text())
     except (OSError, ValueError):
-        previous = []
+        previous = None  # no earlier build here
     kept = set(owned)
     for name in previous if isinstance(previous, list) else []:
         if isinstance(name, str) and name not in kept and _OWNED.fullmatch(name):
             (out / name).unlink(missing_ok=True)
+    if isinstance(previous, list):  # a folder of an earlier build: its document not written again is stale (an HTML-only rebuild's PDF)
+        for name in FILE_NAMES.values():
+            if name not in documents:
+                (out / name).unlink(missing_ok=True)
     _replace(out / MANIFEST, json.dumps(owned, indent=0).encode("utf-8"))
 
 
@@ -155,15 +163,3 @@ def _replace(path: Path, data: bytes) -> Path:
     with _replacing(path) as temporary:
         temporary.write_bytes(data)
     return path
-
-
-@contextlib.contextmanager
-def _replacing(path: Path) -> Iterator[Path]:
-    """A fresh temporary name beside ``path`` that replaces it when the block succeeds (removed otherwise)."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    temporary = path.with_name(f".{path.name}.{os.getpid()}.{secrets.token_hex(4)}.part")
-    try:
-        yield temporary
-        os.replace(temporary, path)
-    finally:
-        temporary.unlink(missing_ok=True)

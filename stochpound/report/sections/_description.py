@@ -27,7 +27,7 @@ from stochpound.experiment._grid import CASE
 from stochpound.model import laws
 from stochpound.model.contact import effective_mass
 from stochpound.model.modal_solution import modal_properties
-from stochpound.motions.records import load_record, registry_entries
+from stochpound.motions.records import is_suite_member, load_record, registry_entries
 from stochpound.report.render._document import Paragraph, Table
 from stochpound.model.scene import Building, Contact, Scene
 from stochpound.model.wall import Wall
@@ -299,6 +299,15 @@ def _analytic_parameters(table: Mapping[str, Any]) -> str:
 def _record_parameters(table: Mapping[str, Any]) -> tuple[str, str]:
     """A record's description and its (step, duration) as run."""
     name = str(table["record"])
+    if is_suite_member(name):
+        record = load_record(name)
+        suite, _, member = name.partition("/")
+        duration = min(record.duration, float(table.get("duration", math.inf)))
+        meta = record.metadata
+        return (f"motion {member} of the suite {suite} ({record.description}; {meta['package']}, as recorded; "
+                f"sha256 of the samples {meta['sha256'][:12]}…)"
+                + (f", scaled by {number(float(table['scale']))}" if float(table.get("scale", 1.0)) != 1.0 else ""),
+                f"{number(record.dt)} s, {number(duration)} s")
     entry = registry_entries().get(name)
     if entry is None:
         return f"record file {name} (sha256 {str(table.get('file_sha256'))[:12]}…)", "the file's"

@@ -123,7 +123,7 @@ def _hazard_text(risk: StoreRisk) -> str:
               else "of the motions' IDA capacities IM·g/D (log-moments), from one contact-free run per motion")
     extrapolated = " The hazard was extrapolated beyond its table (as a power law) for some integrals." if hz.extrapolated else ""
     return (
-        f"Hazard curve {repr(hz)} of {risk.measure} in {units} ({source}); its 10 %/50 yr intensity is "
+        f"Hazard curve of {risk.measure} in {units}, {hz.describe()} ({source}); its 10 %/50 yr intensity is "
         f"{levels[0.10]:.3g} and its 2 %/50 yr intensity {levels[0.02]:.3g} {units}. The fragility of every gap is the "
         f"lognormal {fitted}; λ_P(g) = ∫ F(x; g) |dλ(x)|; the intervals resample the motions and refit the whole chain. Assumptions: Poisson "
         "occurrence, record-to-record variability only (not the hazard's or the model's uncertainty), and a suite scaled to each "
