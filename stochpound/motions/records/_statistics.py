@@ -6,7 +6,7 @@
 * Arias intensity I_A = π / (2 g) ∫ a(t)² dt, with a(t) interpolated linearly
   between samples (the first-order hold the solvers use), so that the integral
   over each step is dt (a_k² + a_k a_{k+1} + a_{k+1}²) / 3
-  (:func:`stochpound.motions._measures.arias_intensity`).
+  (``stochpound.motions._arias.arias_intensity``).
 """
 
 from __future__ import annotations
@@ -16,7 +16,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from stochpound.analysis import kernels
-from stochpound.motions._measures import arias_intensity
+from stochpound.motions._arias import arias_intensity
 from stochpound.motions.records._record import Record
 
 #: The reference study's g, m/s².
