@@ -196,7 +196,8 @@ def _needed_table(ensemble: Ensemble, dim: str, needed: xr.DataArray, others: li
         frame=frame,
         note=(
             f"– : not reached within the grid (largest {dim_text(dim)} {value_text(dim, ensemble.grid[dim][-1])}). With "
-            f"{ensemble.size} realizations and none {'pounding' if ensemble.event == 'pounding' else 'hitting a wall'} the upper bound is {float(kernels.clopper_pearson(0, ensemble.size, ensemble.confidence)[1]):.4f}: "
+            f"{ensemble.size} realizations and none {'pounding' if ensemble.event == 'pounding' else 'hitting a wall'} the upper bound is "
+            f"{float(kernels.clopper_pearson(0, ensemble.size, ensemble.confidence)[1]):.4f}: "
             "a smaller threshold needs more realizations."
         ),
         formats={},
@@ -247,7 +248,8 @@ def isolation_effect(ensemble: Ensemble) -> list[Block]:
         Paragraph(" ".join(sentences)),
         Table(
             key=f"table-{ensemble.name}-{ensemble.label}-isolation",
-            caption=f"Experiment {ensemble.name}, ensemble {ensemble.label}: cells where a sliding base of friction μ gives a lower or higher estimate than the fixed base (μ = ∞) at the same other labels.",
+            caption=f"Experiment {ensemble.name}, ensemble {ensemble.label}: cells where a sliding base of friction μ gives a lower or higher estimate "
+            "than the fixed base (μ = ∞) at the same other labels.",
             frame=frame,
             note=f"lower / higher: the {ensemble.confidence:.0%} intervals do not overlap; no clear difference: they do.",
             formats={},

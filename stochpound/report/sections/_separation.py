@@ -414,7 +414,8 @@ class SeparationEnsemble:
             for value, colour in lines(ensemble.grid, line_dim):
                 where = {**panel, **({line_dim: value} if line_dim else {})}
                 cell = needed.sel(where)
-                result.append(figures.Curve(line_label(line_dim, value), np.asarray(usable), cell["separation"].values * CM, cell["lower"].values * CM, cell["upper"].values * CM, colour, gid=ensemble.gid(where)))
+                result.append(figures.Curve(line_label(line_dim, value), np.asarray(usable), cell["separation"].values * CM,
+                                            cell["lower"].values * CM, cell["upper"].values * CM, colour, gid=ensemble.gid(where)))
             return result
 
         c = self.closure

@@ -46,7 +46,8 @@ def fixed_columns(pair_mu: xr.Dataset) -> Paragraph:
                     elif abs(study) <= 0.1:
                         worst_small = max(worst_small, abs(ours - study))
         deviations[name] = (worst, where, worst_small)
-    impacts = {name: {n: value(pair_mu, "impacts", record=record, **_column_labels(tables[number], "inf")) for number in ("4.1", "4.3") for n in [tables[number]["neighbour"]]} for record, name in inputs.items()}
+    impacts = {name: {n: value(pair_mu, "impacts", record=record, **_column_labels(tables[number], "inf"))
+                      for number in ("4.1", "4.3") for n in [tables[number]["neighbour"]]} for record, name in inputs.items()}
     study = {tables[number]["neighbour"]: float(tables[number]["impacts"][1]) for number in ("4.1", "4.3")}
     spread = "; ".join(
         f"with {name} input within {worst * 100:.1f} % (largest: {where}; values below 0.1 in magnitude within {small:.3f})" for name, (worst, where, small) in deviations.items()

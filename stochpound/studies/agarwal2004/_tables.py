@@ -283,7 +283,8 @@ def building_2_table(store: xr.Dataset) -> Table:
         caption="Table 3.3: Building 2, stiff or flexible, on a fixed base, and the impact elements between it and Building 1 at each floor.",
         frame=frame,
         note=(
-            "Building 2 has Building 1's storey stiffnesses and its masses times the factor. k_imp keeps √(k_imp/m_eff) of the equal-mass pair, so it grows with m_eff = m1 m2/(m1 + m2): the flexible pair's "
+            "Building 2 has Building 1's storey stiffnesses and its masses times the factor. "
+            "k_imp keeps √(k_imp/m_eff) of the equal-mass pair, so it grows with m_eff = m1 m2/(m1 + m2): the flexible pair's "
             "elements are stiffer. c_imp = 2ξ√(k_imp m_eff) with ξ from the restitution. The study gives k_imp and c_imp only "
             "for the flexible pair (in its program listing)."
         ),
