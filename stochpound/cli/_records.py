@@ -54,14 +54,14 @@ def _list_suite(suite: str) -> None:
 @records.command("show")
 @click.argument("name")
 @click.option("--plot", "plot_path", type=click.Path(dir_okay=False), default=None, help="Write a plot of the accelerogram (PNG, PDF, SVG).")
-@click.option("--g", "g", type=float, default=9.814, show_default=True, help="g (m/s²) for conversions, peak in g and Arias intensity.")
+@click.option("--g", "g", type=float, default=9.81, show_default=True, help="g (m/s²) for conversions, peak in g and Arias intensity (the reference study's is 9.814).")
 @click.option("--dt", type=float, default=None, help="Step (s) of a one-column text file.")
 @click.option("--units", type=click.Choice(["g", "m/s2", "cm/s2"]), default=None, help="Units of a text file's values.")
 def show_command(name: str, plot_path: str | None, g: float, dt: float | None, units: str | None) -> None:
-    """Statistics of NAME (a bundled record or a file), with the study's Table 3.2 beside ours."""
+    """Statistics of NAME (a bundled record or a file), with the reference study's Table 3.2 beside ours for its records."""
     from stochpound.motions.records import load_record
     from stochpound.motions.records._plot import plot_record
-    from stochpound.motions.records._report import record_report
+    from stochpound.studies.agarwal2004 import record_report
 
     if not g > 0:
         raise click.BadParameter(f"must be > 0, got {g}", param_hint="--g")

@@ -20,7 +20,7 @@ import xarray as xr
 
 from stochpound.experiment._definition import read_definition
 from stochpound.experiment._selections import has_contact_free, has_wall_free, with_contacts, with_walls
-from stochpound.report.render._document import Paragraph, Report, Section
+from stochpound.report.render import Paragraph, Report, Section
 from stochpound.report.sections._ensembles import INTERVAL_NOTE
 from stochpound.report.sections._generic import store_section
 from stochpound.report.sections._intensity import intensity_section, intensity_setting

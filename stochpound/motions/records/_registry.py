@@ -99,24 +99,6 @@ def list_records() -> list[str]:
     return list(registry_entries())
 
 
-def study_table_3_2(row: str | None = None) -> dict[str, Any]:
-    """The reference study's Table 3.2 (acceleration statistics of its four records).
-
-    Parameters
-    ----------
-    row : str, optional
-        ``"mexico_city"``, ``"el_centro"``, ``"loma_prieta"`` or ``"northridge"``;
-        all rows (a dict of dicts) if omitted.
-
-    Returns
-    -------
-    dict
-        ``label, dt (s), npts, peak_g, mean, std (m/s²), skewness, excess``.
-    """
-    table = _registry().get("study_table_3_2", {})
-    return dict(table) if row is None else dict(table[row])
-
-
 def load_record(
     source: str | Path,
     dt: float | None = None,

@@ -28,7 +28,7 @@ from stochpound.model import laws
 from stochpound.model.contact import effective_mass
 from stochpound.model.modal_solution import modal_properties
 from stochpound.motions.records import load_record, registry_entries
-from stochpound.report.render._document import Paragraph, Table
+from stochpound.report.render import Paragraph, Table
 from stochpound.report.sections._stores import store_experiment
 from stochpound.model.scene import Building, Contact, Scene
 from stochpound.model.wall import Wall

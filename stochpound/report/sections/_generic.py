@@ -18,7 +18,7 @@ import pandas as pd
 import xarray as xr
 
 from stochpound.report.render import _figures as figures
-from stochpound.report.render._document import Block, FigureItem, Paragraph, Section, Table
+from stochpound.report.render import Block, FigureItem, Paragraph, Section, Table
 from stochpound.report.sections._ensemble_findings import compare_ensembles, ensemble_findings, isolation_across
 from stochpound.report.sections._ensembles import Ensemble
 from stochpound.report.sections._mechanism_findings import mechanism_findings

@@ -32,7 +32,7 @@ from stochpound.analysis._intervals import MIN_RUNS
 from stochpound.experiment._definition import is_gap_axis, read_definition
 from stochpound.model import laws
 from stochpound.report.render import _figures as figures
-from stochpound.report.render._document import Block, FigureItem, Paragraph, Section
+from stochpound.report.render import Block, FigureItem, Paragraph, Section
 from stochpound.report.sections._ensembles import Ensemble
 from stochpound.report.sections._facets import dim_text, labels_text, line_colours, plain
 

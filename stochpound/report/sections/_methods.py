@@ -17,7 +17,7 @@ import stochpound
 from stochpound.motions.records import registry_entries
 from stochpound.report.sections._accuracy import accuracy_paragraphs
 from stochpound.report.sections._description import StoreDefinition, buildings_table, contacts_table, grid_paragraph, model_paragraph, motions_table, records_used
-from stochpound.report.render._document import Paragraph, Section, Table
+from stochpound.report.render import Paragraph, Section, Table
 from stochpound.report.sections._intensity import intensity_setting, method_text
 from stochpound.report.sections._risk import hazard_provenance
 

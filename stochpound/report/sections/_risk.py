@@ -38,7 +38,7 @@ from stochpound.analysis._store_risk import StoreRisk, base_displacement, store_
 from stochpound.experiment._definition import read_definition
 from stochpound.experiment._hazard import stored_hazard, stored_hazard_entry
 from stochpound.experiment._intensity import describe_measure
-from stochpound.report.render._document import Block, FigureItem, Paragraph, Section, Table
+from stochpound.report.render import Block, FigureItem, Paragraph, Section, Table
 from stochpound.report.sections._facets import labels_text
 from stochpound.report.sections._intensity import intensity_setting
 from stochpound.report.sections._summary import RISK_ANSWERS

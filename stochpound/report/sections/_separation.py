@@ -33,7 +33,7 @@ import xarray as xr
 
 from stochpound.analysis import pounding_curve, pounding_probability, required_separation, rule_exceedance, separation_rules, store_contact_demands
 from stochpound.report.render import _figures as figures
-from stochpound.report.render._document import Block, FigureItem, Paragraph, Section, Table
+from stochpound.report.render import Block, FigureItem, Paragraph, Section, Table
 from stochpound.report.sections._ensemble_findings import RARE, rare_gap
 from stochpound.report.sections._ensembles import Ensemble, line_label, lines, table_frame
 from stochpound.experiment._selections import contact_free, contact_gap_dims, isolated_mus, wall_free, wall_gap_dims, with_contacts, with_walls

@@ -20,8 +20,11 @@ from collections.abc import Callable, Mapping
 
 import xarray as xr
 
-from stochpound.report.render._document import Block, Paragraph, Section
+from stochpound.report import Block, Paragraph, Section
 from stochpound.studies.agarwal2004 import _figures as figures, _findings as findings, _notes as notes, _tables as tables
+from stochpound.studies.agarwal2004._records import STUDY_G, record_report, study_table_3_2
+
+__all__ = ["STUDY_COMMAND", "STUDY_G", "TITLE", "record_report", "sections", "study_table_3_2", "summary"]
 
 TITLE = "Pounding of base-isolated buildings: the reference study regenerated"
 """The title of the study's report."""

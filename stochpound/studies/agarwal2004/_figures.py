@@ -14,7 +14,7 @@ from stochpound.experiment._definition import FIXED_BASE, is_fixed_base
 from stochpound.experiment._selections import isolated_mus
 from stochpound.motions.records import load_record
 from stochpound.report.render import _figures as figures
-from stochpound.report.render._document import FigureItem
+from stochpound.report.render import FigureItem
 from stochpound.report.sections._accuracy import harmonic_comparisons
 from stochpound.report.sections._stores import case_impacts, select
 from stochpound.studies.agarwal2004._tables import RECORD_ENTRIES, record_label

@@ -12,7 +12,7 @@ import xarray as xr
 
 from stochpound.experiment._definition import FIXED_BASE
 from stochpound.experiment._selections import isolated_mus
-from stochpound.report.render._document import Paragraph
+from stochpound.report.render import Paragraph
 from stochpound.report.sections._description import StoreDefinition
 from stochpound.studies.agarwal2004._published import published_tables
 from stochpound.report.sections._stores import select, value

@@ -22,7 +22,7 @@ import xarray as xr
 import stochpound
 from stochpound.motions.ground import SampledMotion
 from stochpound.report.render import _figures as figures
-from stochpound.report.render._document import Block, FigureItem, Paragraph, Table
+from stochpound.report.render import Block, FigureItem, Paragraph, Table
 from stochpound.report.sections._stores import case_scene, select
 from stochpound.studies.agarwal2004._tables import record_label
 

@@ -22,10 +22,11 @@ import xarray as xr
 
 from stochpound.experiment._definition import is_fixed_base
 from stochpound.model.modal_solution import modal_properties
-from stochpound.motions.records import load_record, record_statistics, registry_entries, study_table_3_2
+from stochpound.motions.records import load_record, record_statistics, registry_entries
 from stochpound.report.sections._description import StoreDefinition
-from stochpound.report.render._document import Table
+from stochpound.report.render import Table
 from stochpound.studies.agarwal2004._published import published_tables, study_number
+from stochpound.studies.agarwal2004._records import STUDY_G, study_table_3_2
 from stochpound.report.sections._stores import value
 
 CM = 100.0
@@ -223,7 +224,7 @@ def records_table() -> Table:
     rows: dict[tuple[str, str], list[float]] = {}
     for record, entry in RECORD_ENTRIES.items():
         study = study_table_3_2(record)
-        ours = record_statistics(load_record(entry)).as_dict()
+        ours = record_statistics(load_record(entry), g=STUDY_G).as_dict()
         rows[(record_label(record), STUDY)] = [study[f] for f in fields]
         rows[(record_label(record), f"bundled: {entry}")] = [ours[f] for f in fields]
     frame = pd.DataFrame(list(rows.values()), index=pd.MultiIndex.from_tuples(rows, names=["record", "source"]), columns=columns)
