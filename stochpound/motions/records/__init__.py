@@ -7,7 +7,7 @@
 See ``docs/records.md`` for the names, the formats and the conventions.
 The reference study's ``STUDY_G`` and ``study_table_3_2`` moved to
 :mod:`stochpound.studies.agarwal2004`; their old names here still work and
-emit a :class:`DeprecationWarning`.
+emit a ``DeprecationWarning``.
 """
 
 import warnings
