@@ -168,7 +168,7 @@ def _environment() -> dict[str, str]:
 
 def _done(store: Path) -> int:
     """Finished cases in a store's parts."""
-    from stochpound.experiment._grid import Experiment
+    from stochpound.experiment import Experiment
     from stochpound.experiment._parts import parts_folder, read_definition
     from stochpound.experiment._store_writer import PartsIndex
 

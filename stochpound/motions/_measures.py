@@ -31,7 +31,7 @@ from stochpound.motions._arias import DEFAULT_G, arias_intensity, squared_integr
 from stochpound.motions._spectrum import DEFAULT_DAMPING, as_acceleration, response_spectrum
 
 if TYPE_CHECKING:
-    from stochpound.motions.records._record import Record
+    from stochpound.motions.records import Record
 
 #: Fractions of the Arias intensity that bound the significant duration.
 SIGNIFICANT_FRACTIONS = (0.05, 0.95)

@@ -48,7 +48,7 @@ from numba import njit
 from stochpound.motions._arias import DEFAULT_G
 
 if TYPE_CHECKING:  # the records package imports the analysis kernels, which import the model
-    from stochpound.motions.records._record import Record
+    from stochpound.motions.records import Record
 
 #: Default damping ratio of the spectrum.
 DEFAULT_DAMPING = 0.05

@@ -22,7 +22,8 @@ from stochpound.motions.records._registry import (
     records_dir,
     registry_entries,
 )
-from stochpound.motions.records._suites import SUITES, list_suites, load_suite, load_suite_member, suite_members
+from stochpound.motions.records._suites import SUITES, is_suite_member, list_suites, load_suite, load_suite_member, suite_members
+from stochpound.motions.records._plot import plot_record, plot_spectra
 from stochpound.motions.records._statistics import RecordStatistics, arias_intensity, moments, record_statistics
 
 __all__ = [
@@ -32,6 +33,7 @@ __all__ = [
     "RecordStatistics",
     "RegistryEntry",
     "arias_intensity",
+    "is_suite_member",
     "list_records",
     "list_suites",
     "load_record",
@@ -39,6 +41,8 @@ __all__ = [
     "load_suite_member",
     "moments",
     "normalize_units",
+    "plot_record",
+    "plot_spectra",
     "read_at2",
     "read_record_file",
     "read_text",

@@ -23,7 +23,7 @@ import xarray as xr
 
 import stochpound
 from stochpound.model import laws
-from stochpound.experiment._definition import read_definition
+from stochpound.experiment import read_definition
 from stochpound.model.modal_solution import harmonic_response, modal_properties
 from stochpound.report.sections._description import StoreDefinition, number
 from stochpound.report.render import Paragraph

@@ -21,7 +21,7 @@ import xarray as xr
 
 from stochpound import motions as synthetic_motions
 from stochpound.experiment import Case
-from stochpound.experiment._definition import GapAxis, is_fixed_base
+from stochpound.experiment import GapAxis, is_fixed_base
 from stochpound.experiment._intensity import describe_measure
 from stochpound.experiment._grid import CASE
 from stochpound.model import laws

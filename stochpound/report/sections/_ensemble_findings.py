@@ -19,7 +19,7 @@ import xarray as xr
 from stochpound.analysis import kernels
 from stochpound.report.render import Block, Paragraph, Table
 from stochpound.report.sections._ensembles import CM, MIN_RUNS, Ensemble
-from stochpound.experiment._definition import FIXED_BASE, is_fixed_base, is_gap_axis
+from stochpound.experiment import FIXED_BASE, is_fixed_base, is_gap_axis
 from stochpound.experiment._selections import fixed_base, has_fixed_base_twins, isolated_mus
 from stochpound.report.sections._facets import dim_text, labels_text, value_text
 

@@ -27,7 +27,7 @@ from matplotlib.figure import Figure
 from stochpound.analysis.kernels import clopper_pearson
 from stochpound.experiment._intensity import describe_measure
 from stochpound.report.render import FigureItem, Paragraph, Section, Table
-from stochpound.experiment._definition import is_gap_axis, read_definition
+from stochpound.experiment import is_gap_axis, read_definition
 
 CONFIDENCE = 0.95
 G = 9.81

@@ -27,7 +27,7 @@ import numpy as np
 import xarray as xr
 
 from stochpound.analysis.mechanisms import amplification, ratcheting
-from stochpound.experiment._definition import is_gap_axis, read_definition
+from stochpound.experiment import is_gap_axis, read_definition
 from stochpound.experiment._selections import contact_free, contact_gap_dims, has_contact_free, isolated_mus, wall_gap_dims, with_contacts
 from stochpound.report.render import Block, Paragraph
 from stochpound.report.sections._ensembles import CM, MIN_RUNS, Ensemble

@@ -115,7 +115,7 @@ def suites_paragraph(definitions: list[StoreDefinition]) -> Paragraph | None:
     """The record suites the stores ran, and where they come from (None if none)."""
     from importlib.metadata import version
 
-    from stochpound.motions.records._suites import SUITES, is_suite_member
+    from stochpound.motions.records import SUITES, is_suite_member
 
     used: dict[str, set[str]] = {}
     for definition in definitions:

@@ -32,7 +32,7 @@ import numpy as np
 import xarray as xr
 
 from stochpound.analysis import pounding_curve, pounding_probability, required_separation, rule_exceedance, separation_rules, store_contact_demands
-from stochpound.report.render import _figures as figures
+from stochpound.report.render import figures
 from stochpound.report.render import Block, FigureItem, Paragraph, Section, Table
 from stochpound.report.sections._ensemble_findings import RARE, rare_gap
 from stochpound.report.sections._ensembles import Ensemble, line_label, lines, table_frame

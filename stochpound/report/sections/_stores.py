@@ -11,7 +11,7 @@ import xarray as xr
 
 from stochpound._errors import StochpoundError
 from stochpound.experiment import Experiment, open_store
-from stochpound.experiment._definition import read_definition
+from stochpound.experiment import read_definition
 from stochpound.model.scene import Scene
 from stochpound.model.scene_file import scene_from_dict
 

@@ -10,12 +10,11 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
-from stochpound.experiment._definition import FIXED_BASE
+from stochpound.experiment import FIXED_BASE
 from stochpound.experiment._selections import isolated_mus
 from stochpound.report.render import Paragraph
-from stochpound.report.sections._description import StoreDefinition
+from stochpound.report.sections import StoreDefinition, select, value
 from stochpound.studies.agarwal2004._published import published_tables
-from stochpound.report.sections._stores import select, value
 from stochpound.studies.agarwal2004._notes import SCALES, scaled_runs
 from stochpound.studies.agarwal2004._tables import record_label
 

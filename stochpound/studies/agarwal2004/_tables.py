@@ -20,14 +20,13 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
-from stochpound.experiment._definition import is_fixed_base
+from stochpound.experiment import is_fixed_base
 from stochpound.model.modal_solution import modal_properties
 from stochpound.motions.records import load_record, record_statistics, registry_entries
-from stochpound.report.sections._description import StoreDefinition
+from stochpound.report.sections import StoreDefinition, value
 from stochpound.report.render import Table
 from stochpound.studies.agarwal2004._published import published_tables, study_number
 from stochpound.studies.agarwal2004._records import STUDY_G, study_table_3_2
-from stochpound.report.sections._stores import value
 
 CM = 100.0
 STUDY = "study"
