@@ -231,3 +231,30 @@ def test_the_modules_import_each_other_in_no_cycle_but_the_listed_one():
 def test_cycles_are_found():
     graph = {"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"a"}, "e": {"e"}}
     assert cycles(graph) == [("a", "b", "c")]
+
+
+def test_tests_import_no_test_module_and_benchmarks_no_test():
+    """Shared test code is in tests/helpers.py (and tests/chromium.py); a test imports the benchmarks only to test them."""
+    found = []
+    for path in sorted((ROOT / "tests").glob("*.py")) + sorted((ROOT / "benchmarks").glob("*.py")):
+        for module in imported_top_level(path.read_text()):
+            from_tests = module == "conftest" or module.startswith(("tests.test_", "tests.conftest")) or module == "tests"
+            if path.parent.name == "benchmarks" and (module.startswith("tests") or module == "conftest"):
+                found.append(f"{path.name} imports {module}")
+            elif path.parent.name == "tests" and from_tests:
+                found.append(f"{path.name} imports {module}")
+            elif path.parent.name == "tests" and module.startswith("benchmarks") and not path.name.startswith("test_benchmark_"):
+                found.append(f"{path.name} imports {module}")
+    assert not found
+
+
+def imported_top_level(source: str) -> set[str]:
+    """Every module a source imports (``from a import b``: a, and a.b), by its dotted name."""
+    found = set()
+    for node in ast.walk(ast.parse(source)):
+        if isinstance(node, ast.Import):
+            found.update(alias.name for alias in node.names)
+        elif isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
+            found.add(node.module)
+            found.update(f"{node.module}.{alias.name}" for alias in node.names)
+    return found

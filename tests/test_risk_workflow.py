@@ -31,7 +31,7 @@ from stochpound.experiment._runner import load_experiment, run_experiment
 from stochpound.experiment._spec import ExperimentError, definition_sha256, load_definition, parse_experiment
 from stochpound.report.render._document import Paragraph, Table
 from stochpound.report.sections._risk import risk_headline, risk_of, risk_section
-from tests.test_experiment_helpers import write_experiment
+from tests.helpers import write_experiment
 
 REPOSITORY = Path(__file__).resolve().parent.parent
 MOTIONS = ["01a", "03b", "05a", "07b", "10a", "12a", "14b", "19a"]
