@@ -106,16 +106,21 @@ def scanned_files() -> list[Path]:
     return files
 
 
-def imported_modules(source: str, modules: set[str]) -> set[str]:
-    """The modules of stochpound a source imports, anywhere in it (``from a import b`` names a.b when that is a module)."""
+def imports(source: str) -> set[str]:
+    """Every module a source imports, anywhere in it, by its dotted name; ``from a import b`` gives a and a.b."""
     found = set()
     for node in ast.walk(ast.parse(source)):
         if isinstance(node, ast.Import):
             found.update(alias.name for alias in node.names)
         elif isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
             found.add(node.module)
-            found.update(f"{node.module}.{alias.name}" for alias in node.names if f"{node.module}.{alias.name}" in modules)
-    return {name for name in found if name == "stochpound" or name.startswith("stochpound.")}
+            found.update(f"{node.module}.{alias.name}" for alias in node.names)
+    return found
+
+
+def imported_modules(source: str, modules: set[str]) -> set[str]:
+    """The modules of stochpound a source imports (``from a import b`` names a.b only when that is a module)."""
+    return imports(source) & modules
 
 
 def owner(module: str) -> str | None:
@@ -237,7 +242,7 @@ def test_tests_import_no_test_module_and_benchmarks_no_test():
     """Shared test code is in tests/helpers.py (and tests/chromium.py); a test imports the benchmarks only to test them."""
     found = []
     for path in sorted((ROOT / "tests").glob("*.py")) + sorted((ROOT / "benchmarks").glob("*.py")):
-        for module in imported_top_level(path.read_text()):
+        for module in imports(path.read_text()):
             from_tests = module == "conftest" or module.startswith(("tests.test_", "tests.conftest")) or module == "tests"
             if path.parent.name == "benchmarks" and (module.startswith("tests") or module == "conftest"):
                 found.append(f"{path.name} imports {module}")
@@ -247,14 +252,3 @@ def test_tests_import_no_test_module_and_benchmarks_no_test():
                 found.append(f"{path.name} imports {module}")
     assert not found
 
-
-def imported_top_level(source: str) -> set[str]:
-    """Every module a source imports (``from a import b``: a, and a.b), by its dotted name."""
-    found = set()
-    for node in ast.walk(ast.parse(source)):
-        if isinstance(node, ast.Import):
-            found.update(alias.name for alias in node.names)
-        elif isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
-            found.add(node.module)
-            found.update(f"{node.module}.{alias.name}" for alias in node.names)
-    return found
