@@ -1,6 +1,6 @@
 """Scenes of the benchmarks: the reference study's pairs and synthetic rows for the scaling runs.
 
-The study scenes are built with the test suite's :func:`tests.conftest.study_scene`
+The study scenes are built with :func:`stochpound.studies.agarwal2004.study_scene`
 (the study's buildings and contacts, El Centro as the study used it, g = 9.814):
 
 (a) Building 1 isolated (μ = 0.2) next to the flexible fixed-base Building 2,
@@ -24,11 +24,9 @@ import stochpound
 from stochpound import motions
 from stochpound.motions.ground import SampledMotion
 from stochpound.model.scene import Scene
-from tests.conftest import REFERENCE_MASS, REFERENCE_STIFFNESS, study_scene
+from stochpound.studies.agarwal2004 import IMPACT_FREQUENCY, REFERENCE_MASS, REFERENCE_STIFFNESS, study_scene
 
 STUDY_RECORD = "el_centro_1940_study"
-IMPACT_FREQUENCY = 57.05
-"""Local frequency sqrt(k_imp / m_eff) of the study's impact elements, rad/s."""
 KANAI_TAJIMI = {**motions.soil_preset("firm").kanai_tajimi(), "pga": 0.34 * 9.814, "envelope": "jennings", "seed": 2004}
 """The synthetic motions of the ensemble and scaling runs: firm soil, El Centro's peak (0.34 g), Jennings envelope."""
 

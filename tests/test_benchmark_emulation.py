@@ -20,7 +20,7 @@ from benchmarks.opensees_model import OpenSeesUnavailable, load_opensees, run_op
 from benchmarks.outcome import compare, outcome_from_dataset
 from benchmarks.scenes import MAIN_SCENE, STUDY_SCENES, with_motion
 from benchmarks.study_scheme import StudyScheme, run_study_scheme
-from tests.conftest import reference_building
+from stochpound.studies.agarwal2004 import reference_building
 
 FIXED_PAIR = STUDY_SCENES[1]
 

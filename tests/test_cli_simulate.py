@@ -74,7 +74,7 @@ def _simulate(folder, *args: str, umask: int | None = None) -> subprocess.Comple
 
 
 def test_an_existing_output_is_refused_without_overwrite_and_other_suffixes_are_warned_about(tmp_path):
-    from tests.test_experiment_helpers import invoke
+    from tests.helpers import invoke
 
     scene = tmp_path / "scene.toml"
     scene.write_text(SMALL_SCENE)

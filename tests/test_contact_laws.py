@@ -16,25 +16,8 @@ import stochpound
 from stochpound.model import laws
 from stochpound.model.laws.contract import ElementParameters
 from stochpound.solvers.ivp import run_ivp
-from tests.conftest import reference_building
-
-M1, M2 = 20000.0, 30000.0  # kg
-M_EFF = M1 * M2 / (M1 + M2)
-K_HERTZ = 1.0e10  # N/m^1.5
-V0, GAP = 0.4, 0.01  # m/s, m
-
-
-def free_masses(law: str, restitution: float | None = None, duration: float = 0.1, dt: float = 0.005) -> dict:
-    """Two free one-floor masses on a still ground, the first approaching the second at V0."""
-
-    def mass(name, m, v):
-        return {"name": name, "mass": [m], "stiffness": [0.0], "damping": [0.0], "initial": {"velocity": [v]}}
-
-    contact = {"between": [["A", 1], ["B", 1]], "gap": GAP, "stiffness": K_HERTZ, "law": law}
-    if restitution is not None:
-        contact["restitution"] = restitution
-    return {"building": [mass("A", M1, V0), mass("B", M2, 0.0)], "contact": [contact],
-            "motion": {"type": "constant", "acceleration": 0.0, "duration": duration, "dt": dt}}
+from stochpound.studies.agarwal2004 import reference_building
+from tests.helpers import GAP, K_HERTZ, M_EFF, V0, docs_restitution_column, free_masses, realised_restitution, run
 
 
 def law_force(law: str, restitution: float | None, delta, rate):
@@ -57,18 +40,6 @@ def reference_impact(law: str, restitution: float | None) -> dict:
     peak = minimize_scalar(lambda t: -law_force(law, restitution, *solution.sol(t)), bounds=(0.0, end), method="bounded",
                            options={"xatol": 1e-14})
     return {"duration": end, "peak": -float(peak.fun), "exit": float(solution.y_events[0][-1][1])}
-
-
-def run(scene: dict, **options):
-    return stochpound.simulate(stochpound.scene_from_dict(scene), rtol=1e-12, atol=1e-15, **options)
-
-
-def realised_restitution(result) -> float:
-    """−(relative velocity after) / (relative velocity before) of the two masses, from their final constant velocities."""
-    y = result.total_displacement.sel(floor=1).values
-    t = result.time.values
-    after = (y[:, -1] - y[:, -2]) / (t[-1] - t[-2])
-    return -(after[0] - after[1]) / V0
 
 
 @pytest.mark.parametrize("law, restitution", [("hertz", None), ("hertz_damp", 0.6), ("jankowski", 0.6)])
@@ -94,17 +65,6 @@ def test_hertz_matches_its_closed_form():
     assert float(result.impact_duration[0]) == pytest.approx(factor * delta_max / V0, rel=1e-6)
     assert float(result.impact_peak_force[0]) == pytest.approx(K_HERTZ * delta_max**1.5, rel=1e-6)
     assert realised_restitution(result) == pytest.approx(1.0, abs=1e-7)
-
-
-def docs_restitution_column(law: str) -> dict[float, str]:
-    """docs/model.md's realised-restitution table: target e -> the cell of the column whose header starts with ``law``."""
-    from pathlib import Path
-
-    lines = (Path(__file__).parents[1] / "docs" / "model.md").read_text().splitlines()
-    header = [c.strip() for c in next(line for line in lines if line.startswith("| target e |")).split("|")]
-    column = next(i for i, name in enumerate(header) if name.split(" ")[0] == law)
-    return {float(cells[1]): cells[column] for line in lines
-            if line.startswith("| ") and len(cells := [c.strip() for c in line.split("|")]) == len(header) and cells[1].replace(".", "").isdigit()}
 
 
 def test_the_realised_restitution_table_in_the_docs_is_reproduced():

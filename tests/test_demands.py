@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 
 import stochpound
-from tests.conftest import study_scene
-from tests.test_exact import assert_same_run
+from stochpound.studies.agarwal2004 import study_scene
+from tests.helpers import assert_same_run
 
 
 def pair(dt: float = 0.02, duration: float = 20.0, mu: float | None = 0.2) -> dict:

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 import stochpound
-from tests.conftest import reference_building, study_contacts, study_scene
+from stochpound.studies.agarwal2004 import reference_building, study_contacts, study_scene
 
 
 def simulate(scene: dict, **options):

@@ -32,9 +32,9 @@ from numba.core.registry import CPUDispatcher
 import stochpound
 from stochpound.solvers import compiling, engine
 from stochpound.solvers.exact import compile_engine
-from tests.test_contact_laws import free_masses
-from tests.test_exact import HARD_CASES
-from tests.test_random_scenes import random_scene
+from tests.helpers import free_masses
+from tests.helpers import HARD_CASES
+from tests.helpers import random_scene
 
 levels = []
 

@@ -15,7 +15,7 @@ import stochpound
 from stochpound import motions as synthetic
 from stochpound.experiment._ensemble import simulate_ensemble
 from stochpound.motions.ground import SampledMotion
-from tests.conftest import study_scene
+from stochpound.studies.agarwal2004 import study_scene
 
 N_REALIZATIONS = 6
 
@@ -74,7 +74,7 @@ import numpy as np
 import stochpound
 from stochpound import motions as synthetic
 from stochpound.experiment._ensemble import simulate_ensemble
-from tests.conftest import study_scene
+from stochpound.studies.agarwal2004 import study_scene
 
 scene = stochpound.scene_from_dict(study_scene(0.1, 0.1, 0.5, gap=0.01))
 motions = synthetic.kanai_tajimi({n}, 6.0, 0.01, omega_g=15.0, zeta_g=0.6, pga=3.4, envelope="jennings", seed=3)

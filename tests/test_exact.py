@@ -13,9 +13,8 @@ import stochpound
 from stochpound.motions.ground import GroundMotion, HarmonicMotion, SampledMotion
 from stochpound.solvers.propagators import UnsupportedMotionError, exosystem, interval_forcing, propagator_library, sample_ground
 from stochpound.model.system import build_system
-from tests.conftest import reference_building, study_contacts, study_scene
-
-TOLERANCE = 1e-9  # m, on every floor's total displacement over the whole record
+from stochpound.studies.agarwal2004 import reference_building, study_contacts, study_scene
+from tests.helpers import HARD_CASES, assert_same_run, interpreted_scene
 
 
 def both(scene: dict) -> tuple:
@@ -24,26 +23,6 @@ def both(scene: dict) -> tuple:
     exact = stochpound.simulate(parsed, method="exact")
     reference = stochpound.simulate(parsed, method="ivp", rtol=1e-12, atol=1e-14)
     return exact, reference
-
-
-def assert_same_run(exact, reference, tolerance: float = TOLERANCE) -> None:
-    """Displacements within ``tolerance``, identical impacts, same base states, a closed energy balance."""
-    for name in ("total_displacement", "sliding_displacement"):
-        difference = np.nan_to_num(exact[name].values - reference[name].values)
-        assert np.max(np.abs(difference), initial=0.0) <= tolerance, name
-    assert exact.sizes["impact"] == reference.sizes["impact"]
-    np.testing.assert_array_equal(exact.impact_contact.values, reference.impact_contact.values)
-    np.testing.assert_array_equal(exact.impact_in_phase.values, reference.impact_in_phase.values)
-    np.testing.assert_allclose(exact.impact_start.values, reference.impact_start.values, rtol=0, atol=1e-8)
-    np.testing.assert_allclose(exact.impact_end.values, reference.impact_end.values, rtol=0, atol=1e-8)
-    force_scale = max(float(reference.impact_peak_force.max()) if reference.sizes["impact"] else 0.0, 1.0)
-    np.testing.assert_allclose(exact.impact_peak_force.values, reference.impact_peak_force.values, rtol=0, atol=1e-6 * force_scale)
-    np.testing.assert_array_equal(exact.base_state.values, reference.base_state.values)
-    energy_scale = float(np.abs(reference.energy_input).max()) or 1.0
-    assert float(np.abs(exact.energy_residual).max()) <= 1e-6 * energy_scale
-    for term in ("input", "damping", "friction", "impact"):
-        np.testing.assert_allclose(exact[f"energy_{term}"].values, reference[f"energy_{term}"].values, rtol=0, atol=1e-6 * energy_scale)
-    assert exact.attrs["solver"] == "exact"
 
 
 STUDY_SCENES = {
@@ -186,23 +165,6 @@ def test_propagators_are_cached_across_runs_and_hold_stuck_bases_exactly():
 # ---------------------------------------------------------------- hard cases, and the engine run by Python
 
 
-HARD_CASES = {
-    "B1 isolated, El Centro 20 s": study_scene(0.2, None, 2.0, motion={"record": "el_centro_1940_study", "duration": 20.0}),
-    "zero gap, stiff B2": study_scene(None, None, 0.5, gap=0.0, motion={"record": "el_centro_1940_study", "duration": 10.0}),
-    "stiff contacts x100": study_scene(None, None, 2.0, motion={"record": "el_centro_1940_study", "duration": 10.0}),
-    "non-tensile contacts, both isolated": study_scene(0.1, 0.1, 0.5, gap=0.002, motion={"record": "el_centro_1940_study", "duration": 20.0}),
-    "frictionless against a neighbour": {
-        "building": [reference_building("B1", mu=0.0), reference_building("B2", 2.0)],
-        "contact": study_contacts(0.0, mass_factor=2.0),
-        "motion": {"type": "constant", "acceleration": -0.5, "duration": 10.0, "dt": 0.02},
-    },
-}
-for contact in HARD_CASES["stiff contacts x100"]["contact"]:
-    contact["stiffness"] *= 100.0
-for contact in HARD_CASES["non-tensile contacts, both isolated"]["contact"]:
-    contact["tensile"] = False
-
-
 @pytest.mark.parametrize("name", list(HARD_CASES))
 def test_hard_cases_match_ivp(name):
     """The exact flow and DOP853's (rtol 1e-12) through the one event engine: the same events, impacts and outputs."""
@@ -215,21 +177,13 @@ def test_hard_cases_match_ivp(name):
 INTERPRETED_PROBE = """
 import json
 import stochpound
-from tests.test_exact import interpreted_scene
+from tests.helpers import interpreted_scene
 
 scene = interpreted_scene()
 runs = {method: stochpound.simulate(stochpound.scene_from_dict(scene), method=method) for method in ("exact", "ivp")}
 print(json.dumps({method: {"y": run.total_displacement.values[:, :, ::10].ravel().tolist(), "starts": run.impact_start.values.tolist(),
                            "events": run.attrs["events_total"]} for method, run in runs.items()}))
 """
-
-
-def interpreted_scene() -> dict:
-    """B1 isolated (μ = 0.1) against a stiff fixed B2 at zero gap, non-tensile contacts, 2 s of El Centro: 13 impacts."""
-    scene = study_scene(0.1, None, 0.5, gap=0.0, motion={"record": "el_centro_1940_study", "duration": 2.0})
-    for contact in scene["contact"]:
-        contact["tensile"] = False
-    return scene
 
 
 @pytest.mark.slow

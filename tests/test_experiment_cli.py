@@ -19,21 +19,7 @@ import xarray as xr
 from stochpound import open_store
 from stochpound.experiment._parts import part_paths, parts_folder
 from stochpound.experiment._session import PACKAGE, git_commit, sources_sha256
-from tests.test_experiment_helpers import REPO, SMALL_EXPERIMENT, invoke, quickstart_cell, read_only, write_experiment
-
-#: One cell of the quick-start grid under a short harmonic motion, solved by ivp: a small, quick experiment.
-TINY_EXPERIMENT = quickstart_cell("""
-[[motions]]
-name = "push"
-type = "harmonic"
-amplitude = 3.0
-omega = 9.0
-duration = 2.0
-dt = 0.02
-
-[solver]
-method = "ivp"
-""")
+from tests.helpers import REPO, SMALL_EXPERIMENT, TINY_EXPERIMENT, invoke, quickstart_cell, read_only, write_experiment
 
 
 @pytest.mark.slow

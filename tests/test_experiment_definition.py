@@ -27,7 +27,8 @@ IDENTITIES = {
     "dff3909976ebae73dbef4b1c7e398b3c66732d61c178e1debb73a80981f01404": "a63f03d1e1476471d116da9995f03d845c9e79e14062bb72ce23591ed55bdbe9",
     "638a33ff8b952e185ac07f1fa238740ac38b104a19a0645200932dff86f82be1": "55b4b4b082fba4063464e07d892cf47f9fe52647e8aaf4da1dc51387b674d13f",
     "7ad709e4bbe91a9f92e0c12f96f960fce5174cd54a3a1cf0906d78795a2e9945": "f336d6034b32d583b0db8f048c848c45712cd573d4674dd9f0ccdea44ade869b",
-    "7aa99d11cd33c58e32019efbeea980bd3013b663da9288bf85a5e352838fd602": "a288cd8a711ce8d1a0604666aabd69bb434b978fe8fbbecd45a12309dd49defa",  # experiments/laws/moat_wall.toml (the clearance a gap axis over its walls)
+    # experiments/laws/moat_wall.toml (the clearance a gap axis over its walls)
+    "7aa99d11cd33c58e32019efbeea980bd3013b663da9288bf85a5e352838fd602": "a288cd8a711ce8d1a0604666aabd69bb434b978fe8fbbecd45a12309dd49defa",
     "eb5a30003676e0a4788bdc77278c680db1928cefaa2e3184526ffb4ff2cd149e": "128add143f75d2a6807a3bdadd1a10eccb86101908995348243d55d4932ab1bb",
     "4904d40c5d2d0af316c9c36b4504f7cfee312861107e92629aed74be5de1066e": "77712e2d264128c8a3ecf4a696d879d37508b4eb254212b076dc9de9f45a36d9",
     "6daeb16f63151e60b79f56d62baf423fe9dc5422dd7830c10c372c48ccf19b93": "6a1f389f07a4ddb74a22fbafd5d9eaf12cfb7b010b75506e2a1437e07f1be195",
@@ -43,7 +44,8 @@ IDENTITIES = {
     "2991b119a5949c2c82f9b2fe3c5ea23ba8308484f5adbaf6202633df2547e55f": "0fee6ef18974eda7fe49d0fa885cd06ca430f684281d7e09d9aa13ae02729a4e",  # experiments/study/harmonic.toml (declares reproduces)
     "b7cb8955ddf0e1110227ccc8d346f24b89c5f33cd69da9d0bcda4bfe1400fd19": "dc1f1332c3bbb0688ce5cc07bf78b719f5f9f549de5f0725493b705c41748dec",  # experiments/study/pair_mu.toml (declares reproduces)
     "9eb3e480c894b5bc34df43b5b9a8de0d7f73faa83a3f65cbeb7e49152b4225f2": "82e15f9008cd583a3af79c9689770e8de7646b09322d1ecfd1d153b940b451e2",  # experiments/study/pair_records.toml (declares reproduces)
-    "9a9e8639340c6742f144c3a5eee10f4e5d01d648a5ae3fe097441832f7061a34": "740a608956d013e4f9f9a57339b973a7409ce0f1f55a9322ee58b8ba12740eec",  # experiments/study/single_isolated.toml (declares reproduces)
+    # experiments/study/single_isolated.toml (declares reproduces)
+    "9a9e8639340c6742f144c3a5eee10f4e5d01d648a5ae3fe097441832f7061a34": "740a608956d013e4f9f9a57339b973a7409ce0f1f55a9322ee58b8ba12740eec",
 }
 
 #: The identity of the files with a [hazard], which no run depends on: since the hazard left the identity, their

@@ -13,7 +13,7 @@ from pathlib import Path
 import pytest
 
 from stochpound.experiment import load_experiment, run_experiment
-from tests.test_experiment_helpers import assert_same_results, cli, write_experiment
+from tests.helpers import assert_same_results, cli, write_experiment
 
 pytestmark = pytest.mark.slow
 

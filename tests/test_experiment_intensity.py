@@ -24,7 +24,7 @@ from stochpound.model.scene_file import scene_from_dict
 from stochpound.report.render._document import FigureItem, Table
 from stochpound.report.sections._intensity import intensity_section
 from stochpound.solvers.simulate import simulate
-from tests.test_experiment_helpers import write_experiment
+from tests.helpers import write_experiment
 
 REPOSITORY = Path(__file__).resolve().parent.parent
 MOTIONS = ["fema_p695_far_field/01a", "fema_p695_far_field/03b", "fema_p695_far_field/12a"]

@@ -12,77 +12,8 @@ import stochpound
 from stochpound.experiment import ExperimentError, load_experiment, open_store, run_experiment
 from stochpound.experiment._grid import CASE
 from stochpound.model import laws
-from tests.conftest import reference_building, study_contacts
-from tests.test_experiment_helpers import write_experiment
-
-PAIR = """
-[experiment]
-name = "laws"
-studied = "B1"
-
-[scene]
-g = 9.814
-{buildings}
-{contacts}
-
-[variants.law.kelvin]
-[variants.law.hertz_damp.contact]
-law = "hertz_damp"
-stiffness = 2.75e9
-restitution = 0.5
-
-[variants.moat.none]
-[[variants.moat.near.scene.wall]]
-building = "B1"
-side = "left"
-level = 0
-gap = 0.002
-stiffness = 5.0e8
-restitution = 0.5
-
-[grid]
-gap = [0.005]
-mu = {{ values = [0.1], buildings = ["B1"] }}
-
-[[motions]]
-name = "pulse"
-type = "harmonic"
-amplitude = 3.0
-omega = 6.0
-duration = 3.0
-dt = 0.01
-
-[output]
-demands = true
-"""
-
-
-def _toml_tables(name: str, tables: list[dict]) -> str:
-    lines = []
-    for table in tables:
-        lines.append(f"[[scene.{name}]]")
-        nested = []
-        for key, value in table.items():
-            if isinstance(value, dict):
-                nested.append((key, value))
-            else:
-                lines.append(f"{key} = {value!r}".replace("'", '"').replace("True", "true").replace("False", "false"))
-        for key, value in nested:
-            lines.append(f"{key} = {{ {', '.join(f'{k} = {v!r}' for k, v in value.items())} }}")
-    return "\n".join(lines)
-
-
-def _pair_text() -> str:
-    buildings = [reference_building("B1", 1.0, 0.1), reference_building("B2", 2.0)]
-    return PAIR.format(buildings=_toml_tables("building", buildings), contacts=_toml_tables("contact", study_contacts(0.02)))
-
-
-@pytest.fixture(scope="module")
-def laws_store(tmp_path_factory):
-    folder = tmp_path_factory.mktemp("laws")
-    report = run_experiment(load_experiment(write_experiment(folder, _pair_text(), "laws.toml")), workers=0, progress=False)
-    assert report.complete and not report.failed
-    return folder / "laws.toml", report.store
+from stochpound.studies.agarwal2004 import reference_building
+from tests.helpers import laws_pair_text, write_experiment
 
 
 def test_variants_replace_the_contact_law_and_add_a_wall(laws_store):
@@ -128,7 +59,7 @@ def test_store_equals_direct_runs_with_the_automatic_solver_and_demands(laws_sto
 
 
 def test_bad_contact_overrides_name_the_field(tmp_path):
-    text = _pair_text()
+    text = laws_pair_text()
     for bad, message in (
         ('[variants.law.hertz_damp.contact]\nlaw = "hertz_damp"\nstiffnes = 1.0', "variants.law.hertz_damp.contact.stiffnes"),
         ('[[variants.law.hertz_damp.contact]]\nlaw = "hertz"\nstiffness = 1.0', "variants.law.hertz_damp.contact: a list must have one table per contact of the scene (2), got 1"),
@@ -147,7 +78,7 @@ def test_a_walled_store_from_before_the_wall_summary_asks_for_a_restart(tmp_path
     parts each name the summary and --restart, which recomputes them."""
     import h5py
 
-    text = _pair_text().replace('name = "laws"', 'name = "walled"')
+    text = laws_pair_text().replace('name = "laws"', 'name = "walled"')
     path = write_experiment(tmp_path, text, "walled.toml")
     report = run_experiment(load_experiment(path), workers=0, progress=False)
     with h5py.File(report.store, "a") as handle:  # the store file as an earlier version wrote it

@@ -9,7 +9,7 @@ import pytest
 from nbclient import NotebookClient
 
 from stochpound.experiment import load_experiment, open_store, run_experiment
-from tests.test_experiment_helpers import REPO
+from tests.helpers import REPO
 
 pytestmark = pytest.mark.slow
 

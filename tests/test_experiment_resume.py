@@ -18,7 +18,7 @@ import xarray as xr
 from stochpound._atomic import temporaries
 from stochpound.experiment import load_experiment, run_experiment
 from stochpound.experiment._parts import part_paths, parts_folder
-from tests.test_experiment_helpers import N_CASES, assert_same_results, cli, cli_process, done_cases, quickstart_cell, write_experiment
+from tests.helpers import N_CASES, assert_same_results, cli, cli_process, done_cases, quickstart_cell, write_experiment
 
 
 @pytest.fixture(scope="module")

@@ -8,7 +8,7 @@ import xarray as xr
 
 from stochpound.analysis import pounding_curve, rule_exceedance, separation_rules, store_contact_demands
 from stochpound.experiment import ExperimentError, load_experiment, open_store, run_experiment
-from tests.test_experiment_helpers import SMALL_EXPERIMENT, write_experiment
+from tests.helpers import SMALL_EXPERIMENT, write_experiment
 
 GAPS = (0.0, 0.005, 0.01, 0.02)
 

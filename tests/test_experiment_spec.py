@@ -12,7 +12,7 @@ import stochpound
 from stochpound.experiment import Experiment, ExperimentError, load_experiment, run_experiment
 from stochpound.experiment._sources import resolve_motions
 from stochpound.experiment._spec import parse_experiment
-from tests.test_experiment_helpers import N_CASES, SMALL_EXPERIMENT, cli, write_experiment
+from tests.helpers import N_CASES, SMALL_EXPERIMENT, cli, write_experiment
 
 
 def small(**changes) -> dict:

@@ -13,7 +13,7 @@ import stochpound
 from stochpound.analysis._summary import top_floor_total_displacement
 from stochpound.experiment import ExperimentError, load_experiment, open_store, run_experiment, store_status
 from stochpound.experiment._parts import FolderLock, parts_folder
-from tests.test_experiment_helpers import N_CASES, SMALL_EXPERIMENT, cli, write_experiment
+from tests.helpers import N_CASES, SMALL_EXPERIMENT, cli, write_experiment
 
 
 @pytest.fixture(scope="module")
@@ -149,7 +149,7 @@ def test_open_store_errors(tmp_path):
 @pytest.mark.parametrize("mu1, mu2", [(0.2, None), (None, None), (0.1, 0.1)])
 def test_numpy_summaries_equal_the_analysis_definitions(mu1, mu2):
     from stochpound.experiment._summary import case_summary, case_values, reference_summary, reference_values, top_floor
-    from tests.conftest import reference_building, study_scene
+    from stochpound.studies.agarwal2004 import reference_building, study_scene
 
     motion = {"record": "el_centro_1940_study", "duration": 10.0}
     run = stochpound.simulate(stochpound.scene_from_dict(study_scene(mu1=mu1, mu2=mu2, motion=motion)))
@@ -205,7 +205,7 @@ def test_a_large_ensemble_is_chunked_along_realization(tmp_path):
 
 def test_kept_histories_of_a_later_building_land_on_its_row(tmp_path):
     """Only B2's histories kept: they are B2's (not written on B1's row), and B1's are NaN."""
-    from tests.test_experiment_cli import TINY_EXPERIMENT
+    from tests.helpers import TINY_EXPERIMENT
 
     text = TINY_EXPERIMENT.replace('[solver]\nmethod = "ivp"', '[output]\ntime_histories = ["total_displacement", "sliding_displacement"]\nbuildings = ["B2"]')
     path = write_experiment(tmp_path, text, "tiny.toml")

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 import stochpound
-from tests.conftest import REFERENCE_MASS, reference_building
+from stochpound.studies.agarwal2004 import REFERENCE_MASS, reference_building
 
 G = 9.81
 MU = 0.2
@@ -68,7 +68,7 @@ def building_in_static_equilibrium(acceleration: float) -> dict:
     from scipy.linalg import solve
 
     from stochpound.model.building import storey_matrix
-    from tests.conftest import REFERENCE_STIFFNESS
+    from stochpound.studies.agarwal2004 import REFERENCE_STIFFNESS
 
     deflection = solve(storey_matrix(np.array(REFERENCE_STIFFNESS)), -np.array(REFERENCE_MASS) * acceleration)
     building = reference_building("B1", mu=MU, initial={"displacement": list(deflection)})

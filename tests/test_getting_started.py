@@ -10,7 +10,7 @@ import matplotlib
 from click.testing import CliRunner
 
 from stochpound.cli import main
-from tests.test_experiment_helpers import REPO
+from tests.helpers import REPO
 
 PAGE = REPO / "docs" / "getting-started.md"
 

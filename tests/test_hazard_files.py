@@ -21,7 +21,7 @@ from stochpound.analysis._hazard_files import (
 from stochpound.experiment._hazard import hazard_curve, hazard_option
 from stochpound.experiment._intensity import IntensityError
 from stochpound.experiment._spec import ExperimentError, parse_experiment
-from tests.test_risk_workflow import ISOLATED, _text
+from tests.helpers import ISOLATED, risk_text as _text
 
 DATA = Path(__file__).resolve().parent / "data" / "hazard"
 OPENQUAKE = DATA / "hazard_curve-mean-SA(1.0)_42.csv"

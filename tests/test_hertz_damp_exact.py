@@ -15,18 +15,9 @@ import pytest
 from scipy.integrate import solve_ivp
 
 import stochpound
-from stochpound.model import laws
-from stochpound.model.laws import hertz, kelvin
-from stochpound.model.laws.hertz_damp_exact import damping_ratio
-from tests.test_contact_laws import (
-    K_HERTZ,
-    M_EFF,
-    V0,
-    docs_restitution_column,
-    free_masses,
-    realised_restitution,
-    run,
-)
+from stochpound.model import hertz, kelvin, laws
+from stochpound.model.hertz_damp_exact import damping_ratio
+from tests.helpers import K_HERTZ, M_EFF, V0, docs_restitution_column, free_masses, realised_restitution, run
 
 
 def collision(xi: float, mass: float, stiffness: float, approach: float) -> tuple[float, float]:

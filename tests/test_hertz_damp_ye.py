@@ -11,7 +11,7 @@ from scipy.integrate import solve_ivp
 
 import stochpound
 from stochpound.model import laws
-from tests.test_contact_laws import GAP, K_HERTZ, M_EFF, V0, docs_restitution_column, free_masses, realised_restitution, run
+from tests.helpers import GAP, K_HERTZ, M_EFF, V0, docs_restitution_column, free_masses, realised_restitution, run
 
 
 def ye_restitution(target: float, approach: float = V0) -> float:

@@ -10,8 +10,8 @@ import pytest
 import stochpound
 from stochpound.model import laws
 from stochpound.model.friction import Base, SlidingBase
-from stochpound.model.laws.contract import ElementParameters
-from tests.conftest import reference_building
+from stochpound.model.law import ElementParameters
+from stochpound.studies.agarwal2004 import reference_building
 
 ELEMENT = ElementParameters(stiffness=2.75e9, damping=0.0, restitution=0.5, tensile=True, mass=1.0e5)
 

@@ -12,8 +12,8 @@ import xarray as xr
 import stochpound
 from stochpound.experiment._ensemble import simulate_ensemble
 from stochpound._memory import LIMIT_VARIABLE, MemoryLimitError, memory_limit, parse_size, physical_memory, sample_bytes
-from tests.conftest import study_scene
-from tests.test_experiment_helpers import SMALL_EXPERIMENT, invoke, write_experiment
+from stochpound.studies.agarwal2004 import study_scene
+from tests.helpers import SMALL_EXPERIMENT, invoke, write_experiment
 
 HARMONIC = {"type": "harmonic", "amplitude": 3.0, "omega": 9.0, "duration": 20.0, "dt": 0.02}
 

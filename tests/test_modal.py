@@ -6,7 +6,7 @@ from scipy.integrate import solve_ivp
 
 import stochpound
 from stochpound.model.modal_solution import harmonic_response, modal_coordinate
-from tests.conftest import reference_building
+from stochpound.studies.agarwal2004 import reference_building
 
 AMPLITUDE = 10.0  # m/s²
 

@@ -2,7 +2,7 @@
 
 import numpy as np
 import stochpound
-from tests.conftest import REFERENCE_MASS, reference_building, study_contacts
+from stochpound.studies.agarwal2004 import REFERENCE_MASS, reference_building, study_contacts
 
 V0 = 0.3  # m/s
 GAP = 0.02  # m

@@ -17,7 +17,7 @@ import pytest
 ROOT = Path(__file__).parents[1]
 PACKAGE = ROOT / "stochpound"
 PUBLIC_PACKAGES = ["stochpound", "stochpound.model", "stochpound.motions", "stochpound.motions.records",
-                   "stochpound.experiment", "stochpound.analysis", "stochpound.store", "stochpound.risk"]
+                   "stochpound.experiment", "stochpound.analysis", "stochpound.store", "stochpound.risk", "stochpound.report"]
 """The packages whose ``__all__`` is the public API (docs/api.md)."""
 ENTRY_POINTS = {"stochpound.report.assemble", "stochpound.report.render.output"}
 """Modules users import as the docs show: the report built from Python (docs/reports.md); the command is the ``stochpound.cli`` package."""

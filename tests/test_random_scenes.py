@@ -34,7 +34,6 @@ before firing at the threshold (``events._after_dip``).
 
 from __future__ import annotations
 
-import itertools
 
 import numpy as np
 import pytest
@@ -42,68 +41,12 @@ from scipy.integrate import solve_ivp
 from scipy.linalg import eigh
 
 import stochpound
+from tests.helpers import random_scene
+
 
 TOLERANCE = 1e-9  # of max(1 m, largest |y|), every floor's total displacement over the whole record
 SEEDS = range(60)
 MAX_STEP = 2e-4  # s: the independent integration's largest step, so that no gap closes and opens again unseen within one
-
-
-def random_scene(seed: int, duration: float = 6.0) -> dict:
-    """A random scene dictionary (see the module docstring); the same seed gives the same scene."""
-    rng = np.random.default_rng(seed)
-    buildings = [_random_building(rng, f"B{b + 1}") for b in range(int(rng.integers(1, 5)))]
-    contacts = [
-        _random_contact(rng, left, right, floor)
-        for left, right in itertools.pairwise(buildings)
-        for floor in range(1, min(len(left["mass"]), len(right["mass"])) + 1)
-        if rng.random() < 0.8
-    ]
-    return {"g": 9.81, "building": buildings, "contact": contacts, "motion": _random_motion(rng, duration), "study_compat": bool(rng.random() < 0.15)}
-
-
-def _random_building(rng: np.random.Generator, name: str) -> dict:
-    floors = int(rng.integers(1, 5))
-    building = {"name": name, "mass": rng.uniform(1e4, 5e4, floors).tolist(), "stiffness": rng.uniform(5e6, 5e7, floors).tolist()}
-    if rng.random() < 0.7:
-        building["damping_ratio"] = float(rng.uniform(0.0, 0.08))
-    else:
-        building["damping"] = rng.uniform(0.0, 5e4, floors).tolist()
-    if rng.random() < 0.6:
-        mu = 0.0 if rng.random() < 0.1 else float(rng.uniform(0.02, 0.4))
-        base = {"mass": float(rng.uniform(5e3, 3e4)), "mu": mu}
-        if mu > 0 and rng.random() < 0.3:
-            base["mu_static"] = mu * float(rng.uniform(1.0, 1.5))
-        if rng.random() < 0.2:
-            base["restoring_stiffness"] = float(rng.uniform(1e4, 1e6))
-        building["base"] = base
-    return building
-
-
-def _random_contact(rng: np.random.Generator, left: dict, right: dict, floor: int) -> dict:
-    contact = {
-        "between": [[left["name"], floor], [right["name"], floor]],
-        "gap": 0.0 if rng.random() < 0.25 else float(rng.uniform(0.0, 0.03)),
-        "stiffness": float(10 ** rng.uniform(7.0, 10.0)),
-    }
-    if rng.random() < 0.7:
-        contact["restitution"] = float(rng.uniform(0.3, 0.95))
-    else:
-        contact["damping"] = float(rng.uniform(0.0, 5e5))
-    if rng.random() < 0.3:
-        contact["tensile"] = False
-    return contact
-
-
-def _random_motion(rng: np.random.Generator, duration: float) -> dict:
-    kind = rng.choice(["record", "kanai_tajimi", "harmonic"], p=[0.4, 0.4, 0.2])
-    if kind == "record":
-        interpolation = "spline" if rng.random() < 0.3 else "linear"
-        return {"record": "el_centro_1940_study", "duration": duration, "scale": float(rng.uniform(0.5, 2.5)), "interpolation": interpolation}
-    if kind == "kanai_tajimi":
-        return {"type": "kanai_tajimi", "omega_g": float(rng.uniform(5.0, 20.0)), "zeta_g": float(rng.uniform(0.2, 0.7)),
-                "pga": float(rng.uniform(1.0, 10.0)), "seed": int(rng.integers(0, 1000)), "duration": duration, "dt": 0.01}
-    return {"type": "harmonic", "amplitude": float(rng.uniform(1.0, 8.0)), "omega": float(rng.uniform(2.0, 30.0)),
-            "phase": float(rng.uniform(0.0, 2 * np.pi)), "duration": duration, "dt": 0.02}
 
 
 def test_random_scenes_are_reproducible():

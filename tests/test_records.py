@@ -22,12 +22,10 @@ from stochpound.motions.records import (
     record_statistics,
     records_dir,
     registry_entries,
-    study_table_3_2,
 )
 from stochpound.motions.records import _registry as registry_module
 from stochpound.motions.records._readers import sha256_of
-
-STUDY_G = 9.814
+from stochpound.studies.agarwal2004 import STUDY_G, study_table_3_2
 
 # Values exactly as printed in data/records/SOURCES.md (section in the comment).
 # Each is compared to half a unit of its last printed digit. SOURCES.md computes

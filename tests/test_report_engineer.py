@@ -22,7 +22,7 @@ from stochpound.experiment import open_store
 from stochpound.report.assemble import assemble_report
 from stochpound.report.render._document import Paragraph, Table
 from stochpound.report.render.output import write_report
-from tests.test_experiment_helpers import run_in_process
+from tests.helpers import run_in_process
 
 EXPERIMENT = """
 [experiment]

@@ -11,7 +11,7 @@ from stochpound.experiment import load_experiment, open_store, run_experiment
 from stochpound.report.sections import _laws as laws_report
 from stochpound.report.assemble import assemble_report
 from stochpound.report.render._document import FigureItem, Paragraph
-from tests.test_experiment_helpers import write_experiment
+from tests.helpers import write_experiment
 
 REALIZATIONS = 5
 EXPERIMENT = f"""

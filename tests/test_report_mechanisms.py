@@ -9,7 +9,7 @@ import xarray as xr
 from stochpound.experiment import open_store
 from stochpound.report.sections._ensembles import MIN_RUNS, Ensemble
 from stochpound.report.sections._mechanism_findings import amplification_text, mechanism_answer, mechanism_findings, ratcheting_text, wall_axis
-from tests.test_experiment_helpers import run_in_process
+from tests.helpers import run_in_process
 
 N = 40
 
@@ -139,8 +139,8 @@ def test_a_pair_with_contact_free_twins_gets_the_ratcheting_and_pounding_finding
     """The store section, given the whole store, compares the cases with contacts with their contact-free twins."""
     from stochpound.store import with_contacts
     from stochpound.report.sections._generic import store_section
-    from tests.conftest import reference_building, study_contacts
-    from tests.test_experiment_laws import _toml_tables
+    from stochpound.studies.agarwal2004 import reference_building, study_contacts
+    from tests.helpers import toml_tables
 
     text = f"""
 [experiment]
@@ -149,8 +149,8 @@ studied = "B1"
 
 [scene]
 g = 9.814
-{_toml_tables("building", [reference_building("B1", 1.0, 0.05), reference_building("B2", 1.0)])}
-{_toml_tables("contact", study_contacts(0.01))}
+{toml_tables("building", [reference_building("B1", 1.0, 0.05), reference_building("B2", 1.0)])}
+{toml_tables("contact", study_contacts(0.01))}
 
 [grid]
 gap = [0.01, inf]

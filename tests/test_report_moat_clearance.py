@@ -15,7 +15,7 @@ from stochpound.store import contact_free, has_contact_free, has_wall_free, wall
 from stochpound.report.assemble import assemble_report
 from stochpound.report.render._document import FigureItem, Paragraph, Table
 from stochpound.report.sections._mechanism_findings import mechanism_answer, wall_axis
-from tests.test_experiment_helpers import run_in_process
+from tests.helpers import run_in_process
 
 ROOT = Path(__file__).resolve().parents[1]
 COUNT = 40

@@ -19,7 +19,7 @@ from stochpound.report.render._document import FigureItem, Paragraph, Table
 from stochpound.report.sections._facets import cell_gid
 from stochpound.report.render.output import write_report
 from tests.chromium import render_in_chromium, require_chromium
-from tests.test_experiment_helpers import run_in_process
+from tests.helpers import run_in_process
 
 REALIZATIONS = 6
 EXPERIMENT = f"""

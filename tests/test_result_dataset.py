@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import stochpound
-from tests.conftest import reference_building, study_scene
+from stochpound.studies.agarwal2004 import reference_building, study_scene
 
 
 def run(duration: float = 2.0, **scene_options):

@@ -9,7 +9,6 @@ import pytest
 
 import stochpound
 from stochpound.model.scene_file import scene_from_dict
-from tests.test_experiment_laws import laws_store  # noqa: F401  (the fixture: an experiment over contact laws and walls)
 
 
 @pytest.fixture(scope="module")

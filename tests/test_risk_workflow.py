@@ -36,16 +36,8 @@ from stochpound.experiment._spec import ExperimentError, load_definition, parse_
 from stochpound.store import definition_sha256
 from stochpound.report.render._document import Paragraph, Table
 from stochpound.report.sections._risk import risk_section
-from tests.test_experiment_helpers import write_experiment
+from tests.helpers import BUNDLED, FIXED, ISOLATED, MOTIONS, RECORDS, REPOSITORY, risk_text as _text, write_experiment
 
-REPOSITORY = Path(__file__).resolve().parent.parent
-MOTIONS = ["01a", "03b", "05a", "07b", "10a", "12a", "14b", "19a"]
-RECORDS = "".join(f'\n[[records]]\nrecord = "fema_p695_far_field/{name}"\nduration = 5.0\n' for name in MOTIONS)
-FLAGSHIP = (REPOSITORY / "experiments" / "risk" / "isolated.toml").read_text()
-ISOLATED = FLAGSHIP[FLAGSHIP.index("[scene]"):FLAGSHIP.index("[variants")]  # the flagship's scene, without its variants
-_B2 = ISOLATED.rindex("mass = [26268.0, 17512.0]")  # the neighbour: the stiff variant (masses x 0.5), else the pair moves as one
-FIXED = re.sub(r"^base = .*\n", "", ISOLATED[:_B2] + "mass = [13134.0, 8756.0]" + ISOLATED[_B2 + len("mass = [26268.0, 17512.0]"):], flags=re.MULTILINE)
-BUNDLED = "fox_plaza_los_angeles_sa1p0s"
 PINNED = {  # canonical definitions of files without [hazard]: unchanged by it
     "quickstart.toml": "128add143f75d2a6807a3bdadd1a10eccb86101908995348243d55d4932ab1bb",
     "intensity/far_field_stripes.toml": "55b4b4b082fba4063464e07d892cf47f9fe52647e8aaf4da1dc51387b674d13f",
@@ -53,12 +45,6 @@ PINNED = {  # canonical definitions of files without [hazard]: unchanged by it
     "laws/moat_wall.toml": "a288cd8a711ce8d1a0604666aabd69bb434b978fe8fbbecd45a12309dd49defa",
     "study/pair_mu.toml": "dc1f1332c3bbb0688ce5cc07bf78b719f5f9f549de5f0725493b705c41748dec",  # the version declaring reproduces (without it: 9ccb32b6…)
 }
-
-
-def _text(scene: str, grid: str, intensity: str, hazard: str = f'bundled = "{BUNDLED}"') -> str:
-    hazard_table = f"\n[hazard]\n{hazard}\n" if hazard else ""
-    return (f'[experiment]\nname = "risk"\nstudied = "B1"\n{scene}\n[grid]\n{grid}\n{RECORDS}\n[intensity]\n{intensity}\n{hazard_table}'
-            '[output]\nimpacts = true\n')
 
 
 def _run(folder: Path, text: str, name: str) -> Path:

@@ -21,7 +21,7 @@ from stochpound.motions.ground import HarmonicMotion
 from stochpound.solvers.propagators import GAUSS_NODES, PropagatorLibrary, build_propagator, coupled_blocks, exosystem, uniform_step
 from stochpound.model.scene import Scene
 from stochpound.model.system import build_system
-from tests.conftest import reference_building, study_contacts
+from stochpound.studies.agarwal2004 import reference_building, study_contacts
 
 
 def row_scene(motion: dict | None = None) -> Scene:
@@ -163,7 +163,7 @@ def test_identical_buildings_share_their_blocks(monkeypatch):
 LARGE_ROW = """
 import json
 import stochpound
-from tests.conftest import reference_building, study_contacts
+from stochpound.studies.agarwal2004 import reference_building, study_contacts
 
 buildings = [reference_building(f"B{{j + 1}}", (1.0, 2.0, 0.5)[j % 3], 0.2 if j % 2 == 0 else None) for j in range({n})]
 for building in buildings:  # {floors} floors: the study's lower floor repeated under its top floor

@@ -8,7 +8,7 @@ import pytest
 
 import stochpound
 from stochpound import SceneError
-from tests.conftest import study_scene
+from stochpound.studies.agarwal2004 import study_scene
 
 VALID = study_scene(0.2, None, 2.0, motion={"type": "harmonic", "amplitude": 1.0, "omega": 2.0, "duration": 1.0, "dt": 0.01})
 

@@ -17,7 +17,7 @@ import xarray as xr
 import stochpound
 from stochpound.analysis import contact_demands, pounding_curve
 from stochpound.model.scene import Scene
-from tests.conftest import study_scene
+from stochpound.studies.agarwal2004 import study_scene
 
 KANAI_TAJIMI = {"type": "kanai_tajimi", "omega_g": 15.0, "zeta_g": 0.6, "pga": 3.4, "envelope": "jennings", "seed": 3, "duration": 20.0, "dt": 0.01}
 REALIZATIONS = (0, 1, 2)

@@ -11,7 +11,7 @@ from stochpound.analysis import contact_demands, pounding_curve, required_separa
 from stochpound.analysis._separation_rules import abs_rule, cqc_coefficient, ddc_rule, fixed_base_cqc, fundamental_mode, srss_rule
 from stochpound.model.building import fixed_base_frequencies
 from stochpound.model.scene_file import scene_from_dict
-from tests.conftest import study_scene
+from stochpound.studies.agarwal2004 import study_scene
 
 
 def closures(*rows) -> xr.DataArray:

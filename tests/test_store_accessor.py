@@ -21,7 +21,7 @@ import xarray as xr
 import stochpound
 from stochpound.experiment import ExperimentError, load_experiment, run_experiment
 from stochpound.store import Definition, Hazard, Intensity, canonical_json, definition_sha256, open_store, read_definition
-from tests.test_experiment_helpers import write_experiment
+from tests.helpers import write_experiment
 
 EXPERIMENT = """
 [experiment]

@@ -15,7 +15,7 @@ import pytest
 import stochpound
 from stochpound.analysis import moments, run_summary
 from stochpound.analysis._summary import top_floor_total_displacement
-from tests.conftest import reference_building, study_scene
+from stochpound.studies.agarwal2004 import reference_building, study_scene
 
 STUDY_MOTION = {"record": "el_centro_1940_study", "interpolation": "spline"}
 # the reference study's Tables 4.1 and 4.3 (cm), 4.9 and 4.10 (data/study/reference_tables.toml)

@@ -11,7 +11,7 @@ import pytest
 from stochpound.experiment._spec import ExperimentError, parse_experiment
 from stochpound.motions.records import load_suite_member, select_members, suite_members
 from stochpound.report.sections._description import _record_parameters
-from tests.test_risk_workflow import ISOLATED, REPOSITORY
+from tests.helpers import ISOLATED, REPOSITORY
 
 SUITE = "fema_p695_far_field"
 

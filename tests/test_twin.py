@@ -11,7 +11,7 @@ import stochpound
 from stochpound import motions
 from stochpound.motions.ground import HarmonicMotion, SampledMotion
 from stochpound.solvers.twin import fixed_base_displacements
-from tests.conftest import reference_building
+from stochpound.studies.agarwal2004 import reference_building
 
 PLACEHOLDER = {"type": "constant", "acceleration": 0.0, "duration": 1.0, "dt": 1.0}
 

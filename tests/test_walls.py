@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 import stochpound
-from tests.conftest import reference_building, study_contacts
-from tests.test_exact import assert_same_run
+from stochpound.studies.agarwal2004 import reference_building, study_contacts
+from tests.helpers import assert_same_run
 
 MOTION = {"record": "el_centro_1940_study", "duration": 20.0}
 

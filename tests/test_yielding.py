@@ -13,7 +13,7 @@ from stochpound.model.building import Building, InitialState
 from stochpound.model.scene import Scene
 from stochpound.model.system import build_system
 from stochpound.motions.ground import SampledMotion
-from tests.conftest import reference_building, study_scene
+from stochpound.studies.agarwal2004 import reference_building, study_scene
 
 # an elastic–perfectly-plastic SDOF (ω = 10 rad/s, d_y = 1 cm) thrown upwards under a constant ground acceleration
 MASS, STIFFNESS, YIELD, LOAD, VELOCITY = 1.0, 100.0, 1.0, 0.5, 0.2  # kg, N/m, N, N (= −m a_g), m/s

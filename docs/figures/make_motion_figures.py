@@ -40,7 +40,7 @@ def realization_figure() -> Path:
         ax.plot(t, sign * 3 * sigma * envelope(t), color="tab:red", lw=1.0, ls="--", label="±3σ e(t)" if sign > 0 else None)
     ax.set_xlabel("time (s)")
     ax.set_ylabel("ground acceleration (m/s²)")
-    ax.set_title(f"Kanai–Tajimi, firm soil (ω_g = 15 rad/s, ζ_g = 0.6), Jennings envelope, expected PGA 3 m/s²", fontsize=9)
+    ax.set_title("Kanai–Tajimi, firm soil (ω_g = 15 rad/s, ζ_g = 0.6), Jennings envelope, expected PGA 3 m/s²", fontsize=9)
     ax.legend(fontsize=8, loc="upper right")
     return _save(fig, "motion_realization.png")
 

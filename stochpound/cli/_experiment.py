@@ -16,7 +16,7 @@ from stochpound.experiment._parts import parts_folder
 from stochpound._memory import format_bytes
 
 if TYPE_CHECKING:
-    from stochpound.experiment._runner import RunReport
+    from stochpound.experiment import RunReport
 
 
 @click.group("experiment", cls=HelpGroup)

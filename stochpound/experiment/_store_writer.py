@@ -276,7 +276,7 @@ class _Writer:
         section_starts = np.cumsum(counts) - counts
         chosen = counts[section]
         shape = self.experiment.grid_shape(CASE)
-        positions = tuple(l + s.start for l, s in zip(local, block))
+        positions = tuple(index + s.start for index, s in zip(local, block))
         flat = np.ravel_multi_index(positions, shape)
         within = np.arange(chosen.sum()) - np.repeat(np.cumsum(chosen) - chosen, chosen)
         source_rows = np.repeat(section_starts[section], chosen) + within

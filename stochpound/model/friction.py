@@ -185,7 +185,10 @@ def slipping(state: int) -> bool:
 
 
 def slip_force(base: SlidingBase, state: int) -> float:
-    """The foundation's force on a slipping base with a piecewise-linear friction law (N, positive to the right: Coulomb's −σ μ W), a constant of its mode; 0 in other states and with a nonlinear law (a read-out)."""
+    """The foundation's force on a slipping base with a piecewise-linear friction law (N, positive to the right: Coulomb's −σ μ W).
+
+    A constant of its mode; 0 in other states and with a nonlinear law (a read-out).
+    """
     law = laws.friction_law(base.friction_law)
     return float(law.force(base, state, 0.0)) if slipping(state) and law.piecewise_linear else 0.0
 

@@ -27,10 +27,11 @@ import numpy as np
 import xarray as xr
 from scipy.optimize import brentq
 
-from stochpound.motions._spectrum import DEFAULT_DAMPING, DEFAULT_G, as_acceleration, response_spectrum
+from stochpound.motions._arias import DEFAULT_G, arias_intensity, squared_integrals
+from stochpound.motions._spectrum import DEFAULT_DAMPING, as_acceleration, response_spectrum
 
 if TYPE_CHECKING:
-    from stochpound.motions.records._record import Record
+    from stochpound.motions.records import Record
 
 #: Fractions of the Arias intensity that bound the significant duration.
 SIGNIFICANT_FRACTIONS = (0.05, 0.95)
@@ -76,18 +77,6 @@ def _roots_inside(coefficients: list[np.ndarray], h: float) -> list[np.ndarray]:
             linear = c2 == 0.0
             roots = [np.where(linear, -c0 / c1, q / c2), np.where(linear, np.nan, c0 / q)]
     return [np.where((r > 0.0) & (r < h), r, np.nan) for r in roots]
-
-
-def squared_integrals(acceleration: np.ndarray, dt: float) -> np.ndarray:
-    """∫ a_g² dt over every step, h (a_k² + a_k a_{k+1} + a_{k+1}²)/3 (m²/s³)."""
-    a = np.asarray(acceleration, dtype=np.float64)
-    left, right = a[:-1], a[1:]
-    return float(dt) * (left * left + left * right + right * right) / 3.0
-
-
-def arias_intensity(acceleration: np.ndarray, dt: float, g: float = DEFAULT_G) -> float:
-    """Arias intensity π/(2g) ∫ a_g² dt (m/s) of samples in m/s² linear between them (``dt`` in s, ``g`` in m/s²)."""
-    return np.pi / (2.0 * g) * float(np.sum(squared_integrals(acceleration, dt)))
 
 
 def significant_duration(acceleration: np.ndarray, dt: float, fractions: tuple[float, float] = SIGNIFICANT_FRACTIONS) -> float:

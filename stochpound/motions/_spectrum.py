@@ -45,13 +45,13 @@ import numpy as np
 import xarray as xr
 from numba import njit
 
+from stochpound.motions._arias import DEFAULT_G
+
 if TYPE_CHECKING:  # the records package imports the analysis kernels, which import the model
-    from stochpound.motions.records._record import Record
+    from stochpound.motions.records import Record
 
 #: Default damping ratio of the spectrum.
 DEFAULT_DAMPING = 0.05
-#: The acceleration of gravity used for records stored in g, m/s² (the toolkit's default).
-DEFAULT_G = 9.81
 _NEWTON_ITERATIONS = 60
 
 

@@ -18,18 +18,23 @@ from pathlib import Path
 
 import xarray as xr
 
-from stochpound.store import has_contact_free, has_wall_free, with_contacts, with_walls
-from stochpound.report.render._document import FigureItem, Paragraph, Report, Section
-from stochpound.report.sections._ensembles import INTERVAL_NOTE
-from stochpound.report.sections._generic import store_section
-from stochpound.report.sections._intensity import intensity_section
-from stochpound.report.sections._laws import law_axis, laws_section
-from stochpound.report.sections._methods import methods_section
-from stochpound.report.sections._risk import risk_section
-from stochpound.report.sections._separation import WALLS, separation_section
-from stochpound.report.sections._stores import open_stores
-from stochpound.report.sections._summary import experiment_summary, move_per_cell_tables
+from stochpound.report.render import FigureItem, Paragraph, Report, Section
+from stochpound.report.sections import (
+    INTERVAL_NOTE,
+    WALLS,
+    experiment_summary,
+    intensity_section,
+    law_axis,
+    laws_section,
+    methods_section,
+    move_per_cell_tables,
+    open_stores,
+    risk_section,
+    separation_section,
+    store_section,
+)
 from stochpound.risk import has_risk, store_demands, store_risk
+from stochpound.store import has_contact_free, has_wall_free, with_contacts, with_walls
 from stochpound.studies import claims, load_study
 
 

@@ -124,7 +124,10 @@ def _closure_variables(recorder: Recorder, n_contacts: int, kind: str) -> dict[s
 
 
 def _contact_displacement_variables(recorder: Recorder) -> dict[str, tuple]:
-    """The largest abs(y) of each contact's two floors over the run and when, located on the solution: the separation rules' u1, u2 (NaN for a contact with a finite gap, :meth:`~stochpound.results.record.Recorder.contact_displacement_peaks`)."""
+    """The largest abs(y) of each contact's two floors over the run and when, located on the solution: the separation rules' u1, u2.
+
+    NaN for a contact with a finite gap (:meth:`~stochpound.results.record.Recorder.contact_displacement_peaks`).
+    """
     variables = {}
     for side, (value, when) in zip(("left", "right"), recorder.contact_displacement_peaks()):
         variables[f"peak_contact_displacement_{side}"] = _var(("contact",), value, "m",

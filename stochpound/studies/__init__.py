@@ -31,7 +31,7 @@ from stochpound._studies import STUDIES, Study, parse_reproduces
 if TYPE_CHECKING:
     import xarray as xr
 
-    from stochpound.report.render._document import Block, Section
+    from stochpound.report.render import Block, Section
 
 __all__ = ["STUDIES", "Study", "StudyReport", "claims", "parse_reproduces", "load_study"]
 

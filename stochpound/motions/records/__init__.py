@@ -5,7 +5,13 @@
 >>> rec.dt, rec.units, rec.acceleration(g=9.814)[:3]  # doctest: +SKIP
 
 See ``docs/records.md`` for the names, the formats and the conventions.
+The reference study's ``STUDY_G`` and ``study_table_3_2`` moved to
+:mod:`stochpound.studies.agarwal2004`; their old names here still work and
+emit a ``DeprecationWarning``.
 """
+
+import warnings
+from typing import Any
 
 from stochpound.motions.records._readers import RawSeries, read_at2, read_record_file, read_text
 from stochpound.motions.records._record import Record, normalize_units
@@ -15,40 +21,49 @@ from stochpound.motions.records._registry import (
     load_record,
     records_dir,
     registry_entries,
-    study_table_3_2,
 )
 from stochpound.motions.records._suites import SUITES, is_suite_member, list_suites, load_suite, load_suite_member, select_members, suite_members
-from stochpound.motions.records._statistics import (
-    STUDY_G,
-    RecordStatistics,
-    arias_intensity,
-    moments,
-    record_statistics,
-)
+from stochpound.motions.records._plot import plot_record, plot_spectra
+from stochpound.motions.records._statistics import RecordStatistics, arias_intensity, moments, record_statistics
 
 __all__ = [
-    "STUDY_G",
     "SUITES",
     "RawSeries",
     "Record",
     "RecordStatistics",
     "RegistryEntry",
     "arias_intensity",
+    "is_suite_member",
     "list_records",
     "list_suites",
     "load_record",
     "load_suite",
     "load_suite_member",
     "select_members",
-    "is_suite_member",
     "moments",
     "normalize_units",
+    "plot_record",
+    "plot_spectra",
     "read_at2",
     "read_record_file",
     "read_text",
     "record_statistics",
     "records_dir",
     "registry_entries",
-    "study_table_3_2",
     "suite_members",
 ]
+
+_MOVED = {"STUDY_G": "agarwal2004", "study_table_3_2": "agarwal2004"}
+"""Names that moved to a study's package: the old name here still works, with a warning."""
+
+
+def __getattr__(name: str) -> Any:
+    """The names of :data:`_MOVED`, from their study (loaded through the study registry), with a DeprecationWarning."""
+    if name not in _MOVED:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    from stochpound.studies import load_study
+
+    study = _MOVED[name]
+    warnings.warn(f"stochpound.motions.records.{name} is deprecated: use stochpound.studies.{study}.{name}",
+                  DeprecationWarning, stacklevel=2)
+    return getattr(load_study(study), name)

@@ -7,10 +7,10 @@ from pathlib import Path
 import numpy as np
 
 from stochpound.motions.records._record import Record
-from stochpound.motions.records._statistics import STUDY_G
+from stochpound.motions._arias import DEFAULT_G
 
 
-def plot_record(record: Record, path: str | Path, g: float = STUDY_G) -> Path:
+def plot_record(record: Record, path: str | Path, g: float = DEFAULT_G) -> Path:
     """Save a figure of the record's acceleration (in g) against time.
 
     Parameters
@@ -49,7 +49,7 @@ def plot_record(record: Record, path: str | Path, g: float = STUDY_G) -> Path:
     return out
 
 
-def plot_spectra(spectra: list[tuple[str, np.ndarray, np.ndarray]], path: str | Path, title: str, g: float = STUDY_G) -> Path:
+def plot_spectra(spectra: list[tuple[str, np.ndarray, np.ndarray]], path: str | Path, title: str, g: float = DEFAULT_G) -> Path:
     """Save a figure of response spectra: PSA (in g) against period on log–log axes.
 
     Parameters

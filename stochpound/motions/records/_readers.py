@@ -1,6 +1,7 @@
 """Readers for accelerogram files: PEER ``.AT2`` and plain text columns.
 
-Every reader returns a :class:`RawSeries` and raises :class:`RecordError`
+Every reader returns a :class:`RawSeries` (:func:`record_from_file` makes
+it a :class:`Record`) and raises :class:`RecordError`
 naming the file (as the caller spelled it) and the line for malformed input.
 
 Formats
@@ -41,7 +42,7 @@ from pathlib import Path
 import numpy as np
 
 from stochpound._errors import RecordError
-from stochpound.motions.records._record import normalize_units
+from stochpound.motions.records._record import Record, normalize_units
 
 #: Relative tolerance on the uniformity of a time column (fraction of a step).
 TIME_STEP_TOLERANCE = 0.01
@@ -127,6 +128,32 @@ def read_record_file(
     series.sha256 = hashlib.sha256(raw).hexdigest()
     series.fmt = fmt
     return series
+
+
+def record_from_file(
+    path: str | Path,
+    *,
+    dt: float | None = None,
+    units: str | None = None,
+    column: int | None = None,
+    fmt: str | None = None,
+) -> Record:
+    """A record file (arguments as :func:`read_record_file`) as a :class:`Record` named after the file."""
+    series = read_record_file(path, dt=dt, units=units, column=column, fmt=fmt)
+    return Record(
+        name=Path(path).name,
+        dt=series.dt,
+        values=series.values,
+        units=series.units,
+        description=_header_description(series),
+        provenance=f"file {path} ({series.fmt}), sha256 {series.sha256}",
+        source_start_time=series.source_start_time,
+    )
+
+
+def _header_description(series: RawSeries) -> str:
+    lines = [line.lstrip("#%! ").strip() for line in series.header[:2]]
+    return " / ".join(line for line in lines if line)
 
 
 def read_at2(path: str | Path, *, dt: float | None = None, units: str | None = None) -> RawSeries:

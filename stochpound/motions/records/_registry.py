@@ -16,7 +16,7 @@ from typing import Any, Mapping
 
 from stochpound._data_files import bundled_data_dir
 from stochpound._errors import RecordError
-from stochpound.motions.records._readers import RawSeries, read_record_file
+from stochpound.motions.records._readers import read_record_file, record_from_file
 from stochpound.motions.records._record import Record, normalize_units
 from stochpound.motions.records._suites import is_suite_member, load_suite_member
 
@@ -99,24 +99,6 @@ def list_records() -> list[str]:
     return list(registry_entries())
 
 
-def study_table_3_2(row: str | None = None) -> dict[str, Any]:
-    """The reference study's Table 3.2 (acceleration statistics of its four records).
-
-    Parameters
-    ----------
-    row : str, optional
-        ``"mexico_city"``, ``"el_centro"``, ``"loma_prieta"`` or ``"northridge"``;
-        all rows (a dict of dicts) if omitted.
-
-    Returns
-    -------
-    dict
-        ``label, dt (s), npts, peak_g, mean, std (m/s²), skewness, excess``.
-    """
-    table = _registry().get("study_table_3_2", {})
-    return dict(table) if row is None else dict(table[row])
-
-
 def load_record(
     source: str | Path,
     dt: float | None = None,
@@ -169,16 +151,7 @@ def load_record(
     if not path.exists():
         known = ", ".join(entries)
         raise RecordError(f"{key}: no bundled record of that name and no such file; bundled records: {known}")
-    series = read_record_file(path, dt=dt, units=units, column=column, fmt=fmt)
-    return Record(
-        name=path.name,
-        dt=series.dt,
-        values=series.values,
-        units=series.units,
-        description=_header_description(series),
-        provenance=f"file {key} ({series.fmt}), sha256 {series.sha256}",
-        source_start_time=series.source_start_time,
-    )
+    return record_from_file(path, dt=dt, units=units, column=column, fmt=fmt)
 
 
 def _check_override(record: Record, dt: float | None, units: str | None) -> None:
@@ -191,11 +164,6 @@ def _check_override(record: Record, dt: float | None, units: str | None) -> None
             raise RecordError(f"{record.name}: {error}") from None
         if canonical != record.units:
             raise RecordError(f"{record.name}: units={units!r} was given but the bundled record is in {record.units}")
-
-
-def _header_description(series: RawSeries) -> str:
-    lines = [line.lstrip("#%! ").strip() for line in series.header[:2]]
-    return " / ".join(line for line in lines if line)
 
 
 def _load_entry(entries: dict[str, RegistryEntry], name: str, _depth: int = 0) -> Record:

@@ -1,4 +1,4 @@
-"""Statistics of an accelerogram, in the reference study's convention (its Table 3.2).
+"""Statistics of an accelerogram, in the convention of the reference study's Table 3.2.
 
 * population moments (ddof = 0);
 * skewness = m3 / m2^1.5, excess = m4 / m2² − 3 (the study's "coefficient of excess");
@@ -6,7 +6,7 @@
 * Arias intensity I_A = π / (2 g) ∫ a(t)² dt, with a(t) interpolated linearly
   between samples (the first-order hold the solvers use), so that the integral
   over each step is dt (a_k² + a_k a_{k+1} + a_{k+1}²) / 3
-  (:func:`stochpound.motions._measures.arias_intensity`).
+  (``stochpound.motions._arias.arias_intensity``).
 """
 
 from __future__ import annotations
@@ -16,11 +16,9 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from stochpound.analysis import kernels
-from stochpound.motions._measures import arias_intensity
+from stochpound.motions._arias import DEFAULT_G, arias_intensity
 from stochpound.motions.records._record import Record
 
-#: The reference study's g, m/s².
-STUDY_G = 9.814
 
 
 @dataclass(frozen=True)
@@ -81,7 +79,7 @@ def moments(values: np.ndarray) -> tuple[float, float, float, float]:
     return float(result.mean), float(result.std), float(result.skewness), float(result.excess)
 
 
-def record_statistics(record: Record, g: float = STUDY_G) -> RecordStatistics:
+def record_statistics(record: Record, g: float = DEFAULT_G) -> RecordStatistics:
     """Statistics of a record in the study's convention (module docstring).
 
     Parameters
@@ -90,7 +88,8 @@ def record_statistics(record: Record, g: float = STUDY_G) -> RecordStatistics:
         The record.
     g : float
         g for converting values in g to m/s² and for the peak in g and the
-        Arias intensity, m/s². Default: the study's 9.814.
+        Arias intensity, m/s². Default: 9.81 (the reference study's 9.814
+        is :data:`stochpound.studies.agarwal2004.STUDY_G`).
     """
     a = record.acceleration(g=g)
     mean, std, skewness, excess = moments(a)

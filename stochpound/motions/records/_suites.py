@@ -16,7 +16,7 @@ named ``<suite>/<ID><component>``, e.g. ``fema_p695_far_field/01a``, and
 :func:`stochpound.motions.records.load_record` loads it by that name.
 
 A folder of record files is a suite too: every ``.AT2`` and ``.txt`` file in
-it (sorted by name), read by :func:`~stochpound.motions.records.load_record`.
+it (sorted by name), read as :func:`~stochpound.motions.records.load_record` reads a file.
 """
 
 from __future__ import annotations
@@ -32,6 +32,7 @@ from typing import Any
 import numpy as np
 
 from stochpound._errors import RecordError
+from stochpound.motions.records._readers import record_from_file
 from stochpound.motions.records._record import Record
 
 
@@ -157,13 +158,11 @@ def select_members(suite: str | Path, members: list[str] | None = None, event: l
 
 def load_suite(suite: str | Path) -> list[Record]:
     """Every motion of a named suite or of a folder, as :class:`Record` objects with metadata and provenance."""
-    from stochpound.motions.records._registry import load_record
-
     if str(suite) in SUITES:
         return [load_suite_member(name) for name in suite_members(suite)]
     records = []
     for path in suite_members(suite):
-        record = load_record(path)
+        record = record_from_file(path)
         record.metadata = {**_blank_metadata(), "component": record.name, "suite": str(suite)}
         records.append(record)
     return records

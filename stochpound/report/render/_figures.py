@@ -281,7 +281,8 @@ def panel_grid(
         axes[last, column].xaxis.set_tick_params(labelbottom=True)
     figure.suptitle(title, fontsize=9, y=1 - 0.12 / height)
     if len(entries) > 1:
-        figure.legend(list(entries.values()), list(entries), loc="lower center", bbox_to_anchor=(0.5, 0.02 / height), ncols=min(len(entries), 6), fontsize=7, title=legend_title or None, title_fontsize=7)
+        figure.legend(list(entries.values()), list(entries), loc="lower center", bbox_to_anchor=(0.5, 0.02 / height),
+                      ncols=min(len(entries), 6), fontsize=7, title=legend_title or None, title_fontsize=7)
     return figure
 
 

@@ -1,1 +1,36 @@
-"""The sections of the report of any experiment's stores, and what they read the stores with."""
+"""The sections of the report of any experiment's stores, and what they read the stores with.
+
+Its namespace gives what the report's assembly (``stochpound.report.assemble``)
+and a study's package build with.
+"""
+
+from stochpound.report.sections._accuracy import harmonic_comparisons
+from stochpound.report.sections._description import StoreDefinition
+from stochpound.report.sections._ensembles import INTERVAL_NOTE
+from stochpound.report.sections._generic import store_section
+from stochpound.report.sections._intensity import intensity_section
+from stochpound.report.sections._risk import risk_section
+from stochpound.report.sections._laws import law_axis, laws_section
+from stochpound.report.sections._methods import methods_section
+from stochpound.report.sections._separation import WALLS, separation_section
+from stochpound.report.sections._stores import open_stores, select, value
+from stochpound.report.sections._summary import experiment_summary, move_per_cell_tables
+
+__all__ = [
+    "risk_section",
+    "INTERVAL_NOTE",
+    "WALLS",
+    "StoreDefinition",
+    "experiment_summary",
+    "harmonic_comparisons",
+    "intensity_section",
+    "law_axis",
+    "laws_section",
+    "methods_section",
+    "move_per_cell_tables",
+    "open_stores",
+    "select",
+    "separation_section",
+    "store_section",
+    "value",
+]

@@ -26,7 +26,7 @@ from stochpound._errors import VerificationError
 from stochpound.model import laws
 from stochpound.model.modal_solution import harmonic_response, modal_properties
 from stochpound.report.sections._description import StoreDefinition, number
-from stochpound.report.render._document import Paragraph
+from stochpound.report.render import Paragraph
 from stochpound.report.sections._stores import select
 from stochpound.model.scene import Building, Contact, Scene
 

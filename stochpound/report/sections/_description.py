@@ -22,13 +22,15 @@ import xarray as xr
 
 from stochpound import motions as synthetic_motions
 from stochpound.experiment import Case
-from stochpound.store import GapAxis, describe_measure, is_fixed_base
+from stochpound.experiment import GapAxis, is_fixed_base
+from stochpound.experiment._intensity import describe_measure
 from stochpound.experiment._grid import CASE
 from stochpound.model import laws
 from stochpound.model.contact import effective_mass
 from stochpound.model.modal_solution import modal_properties
-from stochpound.motions.records import is_suite_member, load_record, registry_entries
-from stochpound.report.render._document import Paragraph, Table
+from stochpound.motions.records import load_record, registry_entries
+from stochpound.report.render import Paragraph, Table
+from stochpound.motions.records import is_suite_member
 from stochpound.model.scene import Building, Contact, Scene
 from stochpound.model.wall import Wall
 from stochpound.model.scene_file import scene_from_dict

@@ -17,9 +17,10 @@ import pandas as pd
 import xarray as xr
 
 from stochpound.analysis import kernels
-from stochpound.report.render._document import Block, Paragraph, Table
+from stochpound.report.render import Block, Paragraph, Table
 from stochpound.report.sections._ensembles import CM, MIN_RUNS, Ensemble
-from stochpound.store import FIXED_BASE, fixed_base, has_fixed_base_twins, is_fixed_base, is_gap_axis, isolated_mus
+from stochpound.experiment import FIXED_BASE, is_fixed_base, is_gap_axis
+from stochpound.store import fixed_base, has_fixed_base_twins, isolated_mus
 from stochpound.report.sections._facets import dim_text, labels_text, value_text
 
 #: Estimates compared between a sliding and a fixed base: statistic -> label.
@@ -195,7 +196,8 @@ def _needed_table(ensemble: Ensemble, dim: str, needed: xr.DataArray, others: li
         frame=frame,
         note=(
             f"– : not reached within the grid (largest {dim_text(dim)} {value_text(dim, ensemble.grid[dim][-1])}). With "
-            f"{ensemble.size} realizations and none {'pounding' if ensemble.event == 'pounding' else 'hitting a wall'} the upper bound is {float(kernels.clopper_pearson(0, ensemble.size, ensemble.confidence)[1]):.4f}: "
+            f"{ensemble.size} realizations and none {'pounding' if ensemble.event == 'pounding' else 'hitting a wall'} the upper bound is "
+            f"{float(kernels.clopper_pearson(0, ensemble.size, ensemble.confidence)[1]):.4f}: "
             "a smaller threshold needs more realizations."
         ),
         formats={},
@@ -246,7 +248,8 @@ def isolation_effect(ensemble: Ensemble) -> list[Block]:
         Paragraph(" ".join(sentences)),
         Table(
             key=f"table-{ensemble.name}-{ensemble.label}-isolation",
-            caption=f"Experiment {ensemble.name}, ensemble {ensemble.label}: cells where a sliding base of friction μ gives a lower or higher estimate than the fixed base (μ = ∞) at the same other labels.",
+            caption=f"Experiment {ensemble.name}, ensemble {ensemble.label}: cells where a sliding base of friction μ gives a lower or higher estimate "
+            "than the fixed base (μ = ∞) at the same other labels.",
             frame=frame,
             note=f"lower / higher: the {ensemble.confidence:.0%} intervals do not overlap; no clear difference: they do.",
             formats={},

@@ -24,9 +24,9 @@ import xarray as xr
 
 from stochpound.analysis import ensemble_statistics, mean_interval, of_first, pounding_probability
 from stochpound.analysis._intervals import MIN_RUNS
-from stochpound.report.render import _figures as figures
-from stochpound.report.render._document import Block, FigureItem, Table
-from stochpound.store import is_gap_axis
+from stochpound.report.render import figures
+from stochpound.report.render import Block, FigureItem, Table
+from stochpound.experiment import is_gap_axis
 from stochpound.report.sections._facets import cell_gid, dim_text, labels_text, layouts, line_colours, plain, value_text
 
 CM = 100.0

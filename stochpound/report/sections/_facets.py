@@ -23,7 +23,7 @@ from typing import Any
 
 import numpy as np
 
-from stochpound.store import is_fixed_base, is_gap_axis
+from stochpound.experiment import is_fixed_base, is_gap_axis
 
 #: Most panels in one figure.
 MAX_PANELS = 16

@@ -17,12 +17,13 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
-from stochpound.report.render import _figures as figures
-from stochpound.report.render._document import Block, FigureItem, Paragraph, Section, Table
+from stochpound.report.render import figures
+from stochpound.report.render import Block, FigureItem, Paragraph, Section, Table
 from stochpound.report.sections._ensemble_findings import compare_ensembles, ensemble_findings, isolation_across
 from stochpound.report.sections._ensembles import Ensemble
 from stochpound.report.sections._mechanism_findings import mechanism_findings
-from stochpound.store import is_gap_axis, wall_gap_dims
+from stochpound.experiment import is_gap_axis
+from stochpound.store import wall_gap_dims
 from stochpound.report.sections._facets import dim_text, labels_text, layouts, line_colours, plain, value_text, cell_gid
 
 CM = 100.0

@@ -25,8 +25,9 @@ import xarray as xr
 from matplotlib.figure import Figure
 
 from stochpound.analysis.kernels import clopper_pearson
-from stochpound.store import describe_measure, is_gap_axis
-from stochpound.report.render._document import FigureItem, Paragraph, Section, Table
+from stochpound.experiment._intensity import describe_measure
+from stochpound.report.render import FigureItem, Paragraph, Section, Table
+from stochpound.experiment import is_gap_axis
 
 CONFIDENCE = 0.95
 G = 9.81

@@ -27,8 +27,9 @@ import numpy as np
 import xarray as xr
 
 from stochpound.analysis.mechanisms import amplification, ratcheting
-from stochpound.store import contact_free, contact_gap_dims, has_contact_free, is_gap_axis, isolated_mus, wall_gap_dims, with_contacts
-from stochpound.report.render._document import Block, Paragraph
+from stochpound.experiment import is_gap_axis
+from stochpound.store import contact_free, contact_gap_dims, has_contact_free, isolated_mus, wall_gap_dims, with_contacts
+from stochpound.report.render import Block, Paragraph
 from stochpound.report.sections._ensembles import CM, MIN_RUNS, Ensemble
 from stochpound.report.sections._facets import dim_text, labels_text, plain, value_text
 

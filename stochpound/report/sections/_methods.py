@@ -17,7 +17,7 @@ import stochpound
 from stochpound.motions.records import registry_entries
 from stochpound.report.sections._accuracy import accuracy_paragraphs
 from stochpound.report.sections._description import StoreDefinition, buildings_table, contacts_table, grid_paragraph, model_paragraph, motions_table, records_used
-from stochpound.report.render._document import Paragraph, Section, Table
+from stochpound.report.render import Paragraph, Section, Table
 from stochpound.report.sections._intensity import method_text
 from stochpound.report.sections._risk import hazard_provenance
 
@@ -115,7 +115,7 @@ def suites_paragraph(definitions: list[StoreDefinition]) -> Paragraph | None:
     """The record suites the stores ran, and where they come from (None if none)."""
     from importlib.metadata import version
 
-    from stochpound.motions.records._suites import SUITES, is_suite_member
+    from stochpound.motions.records import SUITES, is_suite_member
 
     used: dict[str, set[str]] = {}
     for definition in definitions:

@@ -32,7 +32,7 @@ import pandas as pd
 import xarray as xr
 from matplotlib.figure import Figure
 
-from stochpound.report.render._document import Block, FigureItem, Paragraph, Section, Table
+from stochpound.report.render import Block, FigureItem, Paragraph, Section, Table
 from stochpound.report.sections._facets import labels_text
 from stochpound.risk import StoreDemands, StoreRisk
 from stochpound.store import describe_measure

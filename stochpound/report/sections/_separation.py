@@ -32,8 +32,8 @@ import numpy as np
 import xarray as xr
 
 from stochpound.analysis import pounding_curve, pounding_probability, required_separation, rule_exceedance, separation_rules, store_contact_demands
-from stochpound.report.render import _figures as figures
-from stochpound.report.render._document import Block, FigureItem, Paragraph, Section, Table
+from stochpound.report.render import figures
+from stochpound.report.render import Block, FigureItem, Paragraph, Section, Table
 from stochpound.report.sections._ensemble_findings import RARE, rare_gap
 from stochpound.report.sections._ensembles import Ensemble, line_label, lines, table_frame
 from stochpound.store import contact_free, contact_gap_dims, isolated_mus, wall_free, wall_gap_dims, with_contacts, with_walls
@@ -416,7 +416,8 @@ class SeparationEnsemble:
             for value, colour in lines(ensemble.grid, line_dim):
                 where = {**panel, **({line_dim: value} if line_dim else {})}
                 cell = needed.sel(where)
-                result.append(figures.Curve(line_label(line_dim, value), np.asarray(usable), cell["separation"].values * CM, cell["lower"].values * CM, cell["upper"].values * CM, colour, gid=ensemble.gid(where)))
+                result.append(figures.Curve(line_label(line_dim, value), np.asarray(usable), cell["separation"].values * CM,
+                                            cell["lower"].values * CM, cell["upper"].values * CM, colour, gid=ensemble.gid(where)))
             return result
 
         c = self.closure

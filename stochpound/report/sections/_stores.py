@@ -9,7 +9,7 @@ from typing import Any
 import xarray as xr
 
 from stochpound._errors import StochpoundError
-from stochpound.store import open_store
+from stochpound.experiment import open_store
 
 
 def open_stores(paths: Sequence[str | Path]) -> dict[str, xr.Dataset]:

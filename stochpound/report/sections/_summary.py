@@ -29,7 +29,7 @@ import pandas as pd
 import xarray as xr
 
 from stochpound.analysis import pounding_probability, required_separation
-from stochpound.report.render._document import Paragraph, Section, Table
+from stochpound.report.render import Paragraph, Section, Table
 from stochpound.report.sections._ensembles import MIN_RUNS, Ensemble
 from stochpound.report.sections._facets import dim_text, labels_text, value_text
 from stochpound.report.sections._mechanism_findings import mechanism_answer

@@ -20,8 +20,35 @@ from collections.abc import Callable, Mapping
 
 import xarray as xr
 
-from stochpound.report.render._document import Block, Paragraph, Section
+from stochpound.report import Block, Paragraph, Section
 from stochpound.studies.agarwal2004 import _figures as figures, _findings as findings, _notes as notes, _tables as tables
+from stochpound.studies.agarwal2004._records import STUDY_G, record_report, study_table_3_2
+from stochpound.studies.agarwal2004._scenes import (
+    IMPACT_FREQUENCY,
+    REFERENCE_DAMPING,
+    REFERENCE_MASS,
+    REFERENCE_STIFFNESS,
+    reference_building,
+    study_contacts,
+    study_scene,
+)
+
+__all__ = [
+    "IMPACT_FREQUENCY",
+    "REFERENCE_DAMPING",
+    "REFERENCE_MASS",
+    "REFERENCE_STIFFNESS",
+    "STUDY_COMMAND",
+    "STUDY_G",
+    "TITLE",
+    "record_report",
+    "reference_building",
+    "sections",
+    "study_contacts",
+    "study_scene",
+    "study_table_3_2",
+    "summary",
+]
 
 TITLE = "Pounding of base-isolated buildings: the reference study regenerated"
 """The title of the study's report."""

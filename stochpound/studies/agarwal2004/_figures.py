@@ -10,12 +10,12 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
-from stochpound.store import FIXED_BASE, is_fixed_base, isolated_mus
+from stochpound.experiment import FIXED_BASE, is_fixed_base
+from stochpound.store import isolated_mus
 from stochpound.motions.records import load_record
-from stochpound.report.render import _figures as figures
-from stochpound.report.render._document import FigureItem
-from stochpound.report.sections._accuracy import harmonic_comparisons
-from stochpound.report.sections._stores import select
+from stochpound.report.render import figures
+from stochpound.report.render import FigureItem
+from stochpound.report.sections import harmonic_comparisons, select
 from stochpound.studies.agarwal2004._tables import RECORD_ENTRIES, record_label
 
 CM = 100.0

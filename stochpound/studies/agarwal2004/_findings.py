@@ -10,11 +10,11 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
-from stochpound.store import FIXED_BASE, isolated_mus
-from stochpound.report.render._document import Paragraph
-from stochpound.report.sections._description import StoreDefinition
+from stochpound.experiment import FIXED_BASE
+from stochpound.store import isolated_mus
+from stochpound.report.render import Paragraph
+from stochpound.report.sections import StoreDefinition, select, value
 from stochpound.studies.agarwal2004._published import published_tables
-from stochpound.report.sections._stores import select, value
 from stochpound.studies.agarwal2004._notes import SCALES, scaled_runs
 from stochpound.studies.agarwal2004._tables import record_label
 
@@ -45,7 +45,8 @@ def fixed_columns(pair_mu: xr.Dataset) -> Paragraph:
                     elif abs(study) <= 0.1:
                         worst_small = max(worst_small, abs(ours - study))
         deviations[name] = (worst, where, worst_small)
-    impacts = {name: {n: value(pair_mu, "impacts", record=record, **_column_labels(tables[number], "inf")) for number in ("4.1", "4.3") for n in [tables[number]["neighbour"]]} for record, name in inputs.items()}
+    impacts = {name: {n: value(pair_mu, "impacts", record=record, **_column_labels(tables[number], "inf"))
+                      for number in ("4.1", "4.3") for n in [tables[number]["neighbour"]]} for record, name in inputs.items()}
     study = {tables[number]["neighbour"]: float(tables[number]["impacts"][1]) for number in ("4.1", "4.3")}
     spread = "; ".join(
         f"with {name} input within {worst * 100:.1f} % (largest: {where}; values below 0.1 in magnitude within {small:.3f})" for name, (worst, where, small) in deviations.items()

@@ -21,9 +21,9 @@ import xarray as xr
 
 import stochpound
 from stochpound.motions.ground import SampledMotion
-from stochpound.report.render import _figures as figures
-from stochpound.report.render._document import Block, FigureItem, Paragraph, Table
-from stochpound.report.sections._stores import select
+from stochpound.report.render import figures
+from stochpound.report.render import Block, FigureItem, Paragraph, Table
+from stochpound.report.sections import select
 from stochpound.studies.agarwal2004._tables import record_label
 
 CM = 100.0

@@ -20,13 +20,13 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
-from stochpound.store import is_fixed_base
+from stochpound.experiment import is_fixed_base
 from stochpound.model.modal_solution import modal_properties
-from stochpound.motions.records import load_record, record_statistics, registry_entries, study_table_3_2
-from stochpound.report.sections._description import StoreDefinition
-from stochpound.report.render._document import Table
+from stochpound.motions.records import load_record, record_statistics, registry_entries
+from stochpound.report.sections import StoreDefinition, value
+from stochpound.report.render import Table
 from stochpound.studies.agarwal2004._published import published_tables, study_number
-from stochpound.report.sections._stores import value
+from stochpound.studies.agarwal2004._records import STUDY_G, study_table_3_2
 
 CM = 100.0
 STUDY = "study"
@@ -223,7 +223,7 @@ def records_table() -> Table:
     rows: dict[tuple[str, str], list[float]] = {}
     for record, entry in RECORD_ENTRIES.items():
         study = study_table_3_2(record)
-        ours = record_statistics(load_record(entry)).as_dict()
+        ours = record_statistics(load_record(entry), g=STUDY_G).as_dict()
         rows[(record_label(record), STUDY)] = [study[f] for f in fields]
         rows[(record_label(record), f"bundled: {entry}")] = [ours[f] for f in fields]
     frame = pd.DataFrame(list(rows.values()), index=pd.MultiIndex.from_tuples(rows, names=["record", "source"]), columns=columns)
@@ -283,7 +283,8 @@ def building_2_table(store: xr.Dataset) -> Table:
         caption="Table 3.3: Building 2, stiff or flexible, on a fixed base, and the impact elements between it and Building 1 at each floor.",
         frame=frame,
         note=(
-            "Building 2 has Building 1's storey stiffnesses and its masses times the factor. k_imp keeps √(k_imp/m_eff) of the equal-mass pair, so it grows with m_eff = m1 m2/(m1 + m2): the flexible pair's "
+            "Building 2 has Building 1's storey stiffnesses and its masses times the factor. "
+            "k_imp keeps √(k_imp/m_eff) of the equal-mass pair, so it grows with m_eff = m1 m2/(m1 + m2): the flexible pair's "
             "elements are stiffer. c_imp = 2ξ√(k_imp m_eff) with ξ from the restitution. The study gives k_imp and c_imp only "
             "for the flexible pair (in its program listing)."
         ),

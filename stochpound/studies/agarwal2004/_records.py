@@ -1,10 +1,45 @@
-"""Text report of a record's statistics, with the study's Table 3.2 beside ours."""
+"""The study's records: its g, its Table 3.2 and a record's statistics with that table beside ours.
+
+These were ``stochpound.motions.records.STUDY_G`` and ``study_table_3_2`` (now
+deprecated there: the records package keeps no study's convention) and the
+text of ``stochpound records show``.
+"""
 
 from __future__ import annotations
 
-from stochpound.motions.records._record import Record
-from stochpound.motions.records._registry import study_table_3_2
-from stochpound.motions.records._statistics import STUDY_G, record_statistics
+import tomllib
+from functools import lru_cache
+from typing import Any
+
+from stochpound.motions.records import Record, record_statistics, records_dir
+
+#: The reference study's g, m/s².
+STUDY_G = 9.814
+
+
+def study_table_3_2(row: str | None = None) -> dict[str, Any]:
+    """The reference study's Table 3.2 (acceleration statistics of its four records).
+
+    Parameters
+    ----------
+    row : str, optional
+        ``"mexico_city"``, ``"el_centro"``, ``"loma_prieta"`` or ``"northridge"``;
+        all rows (a dict of dicts) if omitted.
+
+    Returns
+    -------
+    dict
+        ``label, dt (s), npts, peak_g, mean, std (m/s²), skewness, excess``.
+    """
+    table = _table_3_2()
+    return dict(table) if row is None else dict(table[row])
+
+
+@lru_cache(maxsize=1)
+def _table_3_2() -> dict[str, Any]:
+    """The ``study_table_3_2`` table of the bundled records' ``registry.toml``."""
+    with open(records_dir() / "registry.toml", "rb") as handle:
+        return tomllib.load(handle).get("study_table_3_2", {})
 
 _ROWS = (
     ("npts", "points", "{:d}"),

@@ -1,0 +1,257 @@
+"""Internal interfaces, read from the code's imports (docs/contributing.md, "Public and private modules").
+
+**The rule.** A package's underscore modules (``stochpound.<package>._name``)
+are imported only by the modules of that package (its subpackages included);
+every other module uses the package's namespace (``from stochpound.experiment
+import read_definition``). A subpackage is a package of its own:
+``stochpound.report.render._figures`` is private to ``stochpound.report.render``,
+and ``stochpound.report.sections`` imports ``stochpound.report.render.figures``.
+The rule holds for ``stochpound/``, ``benchmarks/`` and the Python files under
+``docs/``; imports inside functions and under ``TYPE_CHECKING`` count.
+**Tests are exempt**: a test may import a private module to test it (and
+``tests/helpers.py`` with them).
+
+``ALLOWED`` lists today's exceptions. It only shrinks: an import that is
+not listed fails, and so does a listed one that is gone.
+
+The same imports, as a graph of modules, hold no cycle (``ALLOWED_CYCLES``
+lists the one the experiment layer's rewrite removes).
+"""
+
+from __future__ import annotations
+
+import ast
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).parents[1]
+SCANNED = ("stochpound", "benchmarks", "docs")
+GENERATED = ("docs/_build", "docs/generated", "docs/auto_examples")
+
+#: Importer (a path from the repository root) -> the private modules of other packages it imports, to be emptied.
+ALLOWED: dict[str, set[str]] = {
+    "benchmarks/experiment_scale.py": {"stochpound.experiment._parts", "stochpound.experiment._store_writer"},
+    "benchmarks/probes.py": {"stochpound.experiment._ensemble", "stochpound.experiment._grid", "stochpound.experiment._sources"},
+    "benchmarks/suite.py": {"stochpound.experiment._ensemble"},
+    "stochpound/cli/_experiment.py": {"stochpound.experiment._estimate", "stochpound.experiment._parts", "stochpound.experiment._sources"},
+    "stochpound/cli/_records.py": {"stochpound.motions._spectrum"},
+    "stochpound/experiment/_ensemble.py": {"stochpound.analysis._impacts", "stochpound.analysis._summary"},
+    "stochpound/experiment/_hazard.py": {"stochpound.analysis._hazard", "stochpound.analysis._hazard_files", "stochpound.motions._spectrum"},
+    "stochpound/experiment/_intensity.py": {"stochpound.motions._measures", "stochpound.motions._spectrum"},
+    "stochpound/experiment/_spec.py": {"stochpound.motions._spectrum", "stochpound.motions.records._suites"},
+    "stochpound/experiment/_store.py": {"stochpound.motions.records._suites"},
+    "stochpound/experiment/_summary.py": {"stochpound.analysis._separation_rules", "stochpound.analysis._summary"},
+    "stochpound/report/sections/_description.py": {"stochpound.experiment._grid", "stochpound.experiment._intensity"},
+    "stochpound/report/sections/_ensembles.py": {"stochpound.analysis._intervals"},
+    "stochpound/report/sections/_intensity.py": {"stochpound.experiment._intensity"},
+    "stochpound/report/sections/_laws.py": {"stochpound.analysis._intervals"},
+    "stochpound/risk/__init__.py": {"stochpound.analysis._hazard"},
+    "stochpound/risk/_code_rules.py": {"stochpound.analysis._bootstrap", "stochpound.analysis._hazard", "stochpound.analysis._separation_rules"},
+    "stochpound/risk/_demands.py": {"stochpound.analysis._hazard"},
+    "stochpound/risk/_fragility_ensemble.py": {"stochpound.analysis._bootstrap"},
+    "stochpound/risk/_maf.py": {"stochpound.analysis._bootstrap", "stochpound.analysis._hazard"},
+    "stochpound/risk/_store.py": {"stochpound.analysis._hazard", "stochpound.analysis._hazard_files", "stochpound.experiment._hazard", "stochpound.motions._spectrum"},
+    "stochpound/risk/_store_risk.py": {"stochpound.analysis._hazard"},
+}
+
+#: Import cycles among the modules of stochpound, each as the sorted names of its modules, to be emptied. The one left after
+#: the store/risk/newcomer merges runs through lazy imports inside functions (analysis's aliases of the risk chain,
+#: records' deprecated study names, the risk store reader's hazard files): it goes with those aliases.
+ALLOWED_CYCLES = [
+    (
+        "stochpound.analysis",
+        "stochpound.experiment._hazard",
+        "stochpound.experiment._intensity",
+        "stochpound.model.scene_file",
+        "stochpound.motions",
+        "stochpound.motions._measures",
+        "stochpound.motions._spectrum",
+        "stochpound.motions.records",
+        "stochpound.motions.records._statistics",
+        "stochpound.report.render",
+        "stochpound.report.render._figures",
+        "stochpound.risk",
+        "stochpound.risk._code_rules",
+        "stochpound.risk._demands",
+        "stochpound.risk._fragility_ensemble",
+        "stochpound.risk._maf",
+        "stochpound.risk._store",
+        "stochpound.risk._store_risk",
+        "stochpound.store",
+        "stochpound.store._accessor",
+        "stochpound.studies",
+    ),
+]
+
+
+def module_name(path: Path) -> str:
+    """The dotted name of a file under the repository root (a package by its own name)."""
+    parts = list(path.with_suffix("").parts)
+    if parts[-1] == "__init__":
+        parts.pop()
+    return ".".join(parts)
+
+
+def package_modules() -> set[str]:
+    """Every module of stochpound by its dotted name."""
+    return {module_name(path.relative_to(ROOT)) for path in (ROOT / "stochpound").rglob("*.py")}
+
+
+def scanned_files() -> list[Path]:
+    """The Python files the rule holds for, relative to the repository root."""
+    files = []
+    for top in SCANNED:
+        for path in sorted((ROOT / top).rglob("*.py")):
+            relative = path.relative_to(ROOT)
+            if not str(relative).startswith(GENERATED):
+                files.append(relative)
+    return files
+
+
+def imports(source: str) -> set[str]:
+    """Every module a source imports, anywhere in it, by its dotted name; ``from a import b`` gives a and a.b."""
+    found = set()
+    for node in ast.walk(ast.parse(source)):
+        if isinstance(node, ast.Import):
+            found.update(alias.name for alias in node.names)
+        elif isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
+            found.add(node.module)
+            found.update(f"{node.module}.{alias.name}" for alias in node.names)
+    return found
+
+
+def imported_modules(source: str, modules: set[str]) -> set[str]:
+    """The modules of stochpound a source imports (``from a import b`` names a.b only when that is a module)."""
+    return imports(source) & modules
+
+
+def owner(module: str) -> str | None:
+    """The package a private module belongs to (None for a public module)."""
+    parts = module.split(".")
+    for index, part in enumerate(parts[1:], start=1):
+        if part.startswith("_"):
+            return ".".join(parts[:index])
+    return None
+
+
+def crossings(importer: str, imported: set[str]) -> set[str]:
+    """The private modules of other packages among ``imported``, for the module named ``importer``."""
+    result = set()
+    for module in imported:
+        package = owner(module)
+        if package is not None and importer != package and not importer.startswith(package + "."):
+            result.add(module)
+    return result
+
+
+def offenders() -> dict[str, set[str]]:
+    """Every scanned file that imports another package's private modules, with those modules."""
+    modules = package_modules()
+    found = {}
+    for path in scanned_files():
+        crossed = crossings(module_name(path), imported_modules((ROOT / path).read_text(), modules))
+        if crossed:
+            found[path.as_posix()] = crossed
+    return found
+
+
+def test_no_import_crosses_into_another_package_s_private_module_but_the_listed_ones():
+    found = offenders()
+    new = {path: sorted(modules - ALLOWED.get(path, set())) for path, modules in found.items() if modules - ALLOWED.get(path, set())}
+    gone = {path: sorted(modules - found.get(path, set())) for path, modules in ALLOWED.items() if modules - found.get(path, set())}
+    assert not new, f"import from the package's namespace instead (export the name from its __init__): {new}"
+    assert not gone, f"fixed: take these off ALLOWED in {Path(__file__).name}: {gone}"
+
+
+@pytest.mark.parametrize(
+    ("importer", "source", "crossed"),
+    [
+        ("stochpound.report.sections._generic", "from stochpound.experiment._grid import CASE", {"stochpound.experiment._grid"}),
+        ("stochpound.report.sections._generic", "from stochpound.report.render import _figures as figures", {"stochpound.report.render._figures"}),
+        ("stochpound.report.sections._generic", "def f():\n    import stochpound.analysis._summary\n", {"stochpound.analysis._summary"}),
+        ("stochpound.cli._records", "if TYPE_CHECKING:\n    from stochpound.motions.records._record import Record\n", {"stochpound.motions.records._record"}),
+        ("stochpound.motions.records._statistics", "from stochpound.motions._arias import arias_intensity", set()),
+        ("stochpound.experiment._grid", "from stochpound.experiment._spec import parse_experiment", set()),
+        ("stochpound.report.sections._generic", "from stochpound.report.render import figures", set()),
+        ("stochpound.report.assemble", "from stochpound._errors import StochpoundError", set()),
+        ("benchmarks.suite", "from stochpound._errors import StochpoundError", {"stochpound._errors"}),
+    ],
+)
+def test_the_rule_as_read_from_a_source(importer, source, crossed):
+    assert crossings(importer, imported_modules(source, package_modules())) == crossed
+
+
+def import_graph() -> dict[str, set[str]]:
+    """Module -> the modules of stochpound it imports (anywhere in it); a package is its ``__init__``.
+
+    A package the module is in is no arrow: Python runs it before the module
+    (``from stochpound import __version__``).
+    """
+    modules = package_modules()
+    graph = {}
+    for path in (ROOT / "stochpound").rglob("*.py"):
+        name = module_name(path.relative_to(ROOT))
+        imported = imported_modules(path.read_text(), modules)
+        graph[name] = {target for target in imported if target in modules and target != name and not name.startswith(target + ".")}
+    return graph
+
+
+def cycles(graph: dict[str, set[str]]) -> list[tuple[str, ...]]:
+    """The strongly connected components of more than one module (Tarjan's algorithm), each as sorted names."""
+    index: dict[str, int] = {}
+    low: dict[str, int] = {}
+    stack: list[str] = []
+    on_stack: set[str] = set()
+    found = []
+
+    def visit(node: str) -> None:
+        index[node] = low[node] = len(index)
+        stack.append(node)
+        on_stack.add(node)
+        for successor in sorted(graph.get(node, ())):
+            if successor not in index:
+                visit(successor)
+                low[node] = min(low[node], low[successor])
+            elif successor in on_stack:
+                low[node] = min(low[node], index[successor])
+        if low[node] == index[node]:
+            component = []
+            while True:
+                member = stack.pop()
+                on_stack.discard(member)
+                component.append(member)
+                if member == node:
+                    break
+            if len(component) > 1:
+                found.append(tuple(sorted(component)))
+
+    for node in sorted(graph):
+        if node not in index:
+            visit(node)
+    return sorted(found)
+
+
+def test_the_modules_import_each_other_in_no_cycle_but_the_listed_one():
+    assert cycles(import_graph()) == sorted(ALLOWED_CYCLES)
+
+
+def test_cycles_are_found():
+    graph = {"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"a"}, "e": {"e"}}
+    assert cycles(graph) == [("a", "b", "c")]
+
+
+def test_tests_import_no_test_module_and_benchmarks_no_test():
+    """Shared test code is in tests/helpers.py (and tests/chromium.py); a test imports the benchmarks only to test them."""
+    found = []
+    for path in sorted((ROOT / "tests").glob("*.py")) + sorted((ROOT / "benchmarks").glob("*.py")):
+        for module in imports(path.read_text()):
+            from_tests = module == "conftest" or module.startswith(("tests.test_", "tests.conftest")) or module == "tests"
+            if path.parent.name == "benchmarks" and (module.startswith("tests") or module == "conftest"):
+                found.append(f"{path.name} imports {module}")
+            elif path.parent.name == "tests" and from_tests:
+                found.append(f"{path.name} imports {module}")
+            elif path.parent.name == "tests" and module.startswith("benchmarks") and not path.name.startswith("test_benchmark_"):
+                found.append(f"{path.name} imports {module}")
+    assert not found
+
