@@ -22,7 +22,8 @@ import numpy as np  # noqa: E402
 from scipy import signal  # noqa: E402
 
 from stochpound import motions  # noqa: E402
-from stochpound.motions.records import STUDY_G, load_record  # noqa: E402
+from stochpound.motions.records import load_record  # noqa: E402
+from stochpound.studies.agarwal2004 import STUDY_G  # noqa: E402
 
 HERE = Path(__file__).resolve().parent
 
