@@ -21,6 +21,11 @@ class RecordError(StochpoundError, ValueError):
     the file (and line, where there is one)."""
 
 
+class SiteError(StochpoundError, ValueError):
+    """A site scenario, a conditional-spectrum target or a motion selection is invalid;
+    the message names the field, e.g. ``magnitude: must be within 3.5-8.5, got 9``."""
+
+
 def os_error_message(error: OSError) -> str:
     """One line for a file-system error, naming the path: ``PATH: cannot write here (Read-only file system)``.
 

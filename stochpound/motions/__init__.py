@@ -9,9 +9,13 @@
 Intensity measures and the response spectrum (exact for accelerations linear
 between samples): :func:`intensity_measures`, :func:`response_spectrum`.
 
+The conditional spectrum of a site scenario (NGA-West2 models, Baker–Jayaram
+correlation): :func:`conditional_spectrum`.
+
 Conventions (PSD two-sided in ω, σ² = ∫ S dω; SI units) are in ``docs/motions.md``.
 """
 
+from stochpound.motions._conditional import conditional_spectrum
 from stochpound.motions.baseline import baseline_correct, final_velocity_displacement
 from stochpound.motions.envelopes import (
     ENVELOPES,
@@ -56,6 +60,7 @@ __all__ = [
     "clough_penzien",
     "clough_penzien_model",
     "clough_penzien_psd",
+    "conditional_spectrum",
     "filter_samples",
     "final_velocity_displacement",
     "high_pass_gain",
