@@ -125,8 +125,8 @@ def parse_site(site: Any, levels: list[float]) -> list[dict[str, Any]]:
     scenarios = []
     for i in range(len(levels)):
         scenario = {key: columns[key][i] for key in SITE_FIELDS}
-        where = "site." if not any(isinstance(site[k], list) for k in PER_LEVEL) else f"site (level {levels[i]:g}): "
-        check_scenario(scenario["magnitude"], scenario["distance_km"], scenario["vs30"], scenario["mechanism"], where=where)
+        names = {key: f"site.{key}[{i}]" if isinstance(site[key], list) else f"site.{key}" for key in SITE_FIELDS}
+        check_scenario(scenario["magnitude"], scenario["distance_km"], scenario["vs30"], scenario["mechanism"], names)
         scenarios.append({key: (float(v) if key != "mechanism" else v) for key, v in scenario.items()})
     order = sorted(range(len(levels)), key=lambda i: levels[i])
     return [scenarios[i] for i in order]
@@ -207,21 +207,24 @@ def stripe_selections(experiment: Experiment) -> StripeSelections:
         more than the pool has within ``max_scale_factor`` of a level.
     """
     from stochpound._errors import SiteError
-    from stochpound.experiment._spec import ExperimentError
+    from stochpound.experiment._grid import CASE
+    from stochpound.experiment._spec import ExperimentError, field_errors
+    from stochpound.model.scene_file import scene_from_dict
     from stochpound.motions import conditional_spectrum, select_motions, selection_periods, selection_pool
-    from stochpound.motions.records import load_record
+    from stochpound.motions.records import Record
+    from stochpound.motions.records._suites import is_suite_member, load_suite_member
 
     intensity = experiment.intensity
+    scene = experiment.structure(experiment.points(CASE)[0])
     records = []
-    for label, source in experiment.motions.items():
+    for label, source in experiment.motions.items():  # the motions as the cases run them (a duration or a start applied)
         if source["kind"] != "record":
             raise ExperimentError(f"{source['field']}: the conditional-spectrum pool takes records and suites, not synthetic ensembles")
-        table = source["motion"]
-        path = table["record"]
-        local = experiment.base_dir / str(path)
-        record = load_record(local if local.exists() else path, table.get("dt"), table.get("units"))
-        record.name = label
-        records.append(record)
+        with field_errors(scene_prefix=source["field"]):
+            motion = scene_from_dict({**scene, "motion": experiment.motion_table(label)}, base_dir=experiment.base_dir).motion
+        name = str(source["motion"].get("record", ""))
+        metadata = load_suite_member(name).metadata if is_suite_member(name) else {}
+        records.append(Record(label, motion.dt, motion.values, "m/s2", metadata=metadata))
     measure = intensity["measure"]
     period = intensity.get("period", intensity.get("periods"))
     conditioning = [] if period is None else list(np.atleast_1d(period))

@@ -41,7 +41,7 @@ from __future__ import annotations
 
 import warnings
 from dataclasses import dataclass
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 
 import numpy as np
 import xarray as xr
@@ -81,14 +81,18 @@ def scenario_limits() -> dict[str, tuple[float, float]]:
     return limits
 
 
-def check_scenario(magnitude: float, distance_km: float, vs30: float, mechanism: str, where: str = "") -> None:
-    """Raise :class:`SiteError` naming the field of a scenario outside the models' range or of an unknown mechanism."""
+def check_scenario(magnitude: float, distance_km: float, vs30: float, mechanism: str, names: Mapping[str, str] | None = None) -> None:
+    """Raise :class:`SiteError` naming the field of a scenario outside the models' range or of an unknown mechanism.
+
+    ``names`` spells a field in the message (default: its own name).
+    """
+    names = names or {}
     for field, (low, high) in scenario_limits().items():
         value = {"magnitude": magnitude, "distance_km": distance_km, "vs30": vs30}[field]
         if not isinstance(value, (int, float)) or isinstance(value, bool) or not low <= value <= high:
-            raise SiteError(f"{where}{field}: must be within {low:g}-{high:g} (the NGA-West2 models' range), got {value!r}")
+            raise SiteError(f"{names.get(field, field)}: must be within {low:g}-{high:g} (the NGA-West2 models' range), got {value!r}")
     if mechanism not in MECHANISMS:
-        raise SiteError(f"{where}mechanism: must be one of {', '.join(MECHANISMS)}, got {mechanism!r}")
+        raise SiteError(f"{names.get('mechanism', 'mechanism')}: must be one of {', '.join(MECHANISMS)}, got {mechanism!r}")
 
 
 @dataclass(frozen=True)
