@@ -27,7 +27,7 @@ import xarray as xr
 from stochpound.analysis._code_rules_risk import MINIMUM_MOTIONS, code_rules_risk
 from stochpound.analysis._fragility_ensemble import BOOTSTRAP, homogeneous_capacities, ida_fragility, limit_state_events, stripe_fragility
 from stochpound.analysis._gap_axes import contact_free, gap_dims, has_contact_free
-from stochpound.analysis._hazard import HazardCurve
+from stochpound.analysis._hazard import HazardCurve, rate_from_probability
 from stochpound.analysis._risk import TARGETS, risk_curve, risk_targeted_separation
 from stochpound.analysis._separation_rules import store_contact_demands
 
@@ -122,12 +122,24 @@ def pounding_fragility(store: xr.Dataset, gaps: Sequence[float] | np.ndarray, in
     """
     closure = contact_free_closure(store)
     if is_ida(store):
-        intensity = store["motion_intensity"]
-        intensity = store_motions(intensity.isel(gap=0, drop=True) if "gap" in intensity.dims else intensity).load()
-        capacities = homogeneous_capacities(closure, intensity, gaps)
+        capacities = homogeneous_capacities(closure, _ida_intensity(store), gaps)
         return ida_fragility(capacities, record_dim, confidence=confidence, bootstrap=bootstrap, seed=seed)
     events = limit_state_events(closure, gaps, "gap")
     return stripe_fragility(events, intensity_dim, record_dim, confidence, bootstrap, seed)
+
+
+def _ida_intensity(store: xr.Dataset) -> xr.DataArray:
+    """Every motion's unscaled measure in an IDA store (units of its levels), one motion dimension ``record``."""
+    intensity = store["motion_intensity"]
+    return store_motions(intensity.isel(gap=0, drop=True) if "gap" in intensity.dims else intensity).load()
+
+
+def _reach_intensity(hz: HazardCurve, targets: Sequence[float], years: float) -> float:
+    """The intensity up to which a gap grid reaches: where the hazard's rate is a tenth of the smallest target's (within its table)."""
+    rate = rate_from_probability(min(targets), years) / 10.0
+    if not hz.extrapolate:
+        rate = max(float(rate), float(hz.rate[-1]))
+    return float(hz.intensity_at(rate))
 
 
 @dataclasses.dataclass
@@ -182,7 +194,11 @@ def store_risk(store: xr.Dataset, hz: HazardCurve, targets: Sequence[float] = TA
     years : float
         Exposure time (yr).
     gaps : sequence of float, optional
-        The gap grid (m); default :func:`risk_gaps` of the closures.
+        The gap grid (m); default :func:`risk_gaps` of the closures, for IDA
+        runs (closures at scale 1) together with each closure scaled to the
+        intensity where the hazard's rate is a tenth of the rarest target's
+        (within the hazard's table), so that the grid reaches the separations
+        the hazard asks for.
     studied : str, optional
         The building whose peak base displacement is ASCE 7's D_TM (the
         store's ``studied`` building); the rule is left out where it does not slide.
@@ -195,7 +211,12 @@ def store_risk(store: xr.Dataset, hz: HazardCurve, targets: Sequence[float] = TA
         (``RiskInputError``) A store without stripes or IDA capacities, or without contact-free runs.
     """
     closure = contact_free_closure(store)
-    grid = risk_gaps(closure) if gaps is None else np.asarray(gaps, dtype=float)
+    if gaps is not None:
+        grid = np.asarray(gaps, dtype=float)
+    elif is_ida(store):  # the unscaled closures, and each scaled to the hazard's intensities (IDA runs hold scale 1 only)
+        grid = risk_gaps(xr.concat([closure, closure * (_reach_intensity(hz, targets, years) / _ida_intensity(store))], "record"))
+    else:
+        grid = risk_gaps(closure)
     fragility = pounding_fragility(store, grid, confidence=confidence, bootstrap=bootstrap, seed=seed)
     curve = risk_curve(fragility, hz, years, confidence)
     separation = risk_targeted_separation(curve, targets, years, confidence=confidence)
