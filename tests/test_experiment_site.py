@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from stochpound import open_store
+from stochpound.analysis import HazardCurve, store_risk
 from stochpound.experiment._runner import load_experiment, run_experiment
 from stochpound.experiment._spec import ExperimentError, parse_experiment
 from stochpound.motions import conditional_spectrum, select_motions, selection_periods, selection_pool
@@ -79,6 +80,9 @@ def test_each_stripe_runs_its_chosen_motions_and_the_store_keeps_the_selection(t
         np.testing.assert_allclose(store.target_median.isel(intensity=j), target["median"].values, rtol=1e-12)
         np.testing.assert_allclose(store.selection_mean_ln.isel(intensity=j), expected["mean_ln"].values, rtol=1e-12)
         assert store.site_magnitude.values[j] == magnitude and store.site_mechanism.values[j] == "strike_slip"
+    # the risk chain counts the chosen motions of each stripe only
+    risk = store_risk(store, HazardCurve.power_law(1e-4, 2.5), bootstrap=0)
+    assert risk.motions == 4 and np.all(risk.fragility["runs"].values == 4)
 
 
 def test_the_default_selection_adds_nothing_to_the_definition(tmp_path) -> None:

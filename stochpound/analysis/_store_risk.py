@@ -221,6 +221,8 @@ def store_risk(store: xr.Dataset, hz: HazardCurve, targets: Sequence[float] = TA
     curve = risk_curve(fragility, hz, years, confidence)
     separation = risk_targeted_separation(curve, targets, years, confidence=confidence)
     motions = closure.sizes["record"]
+    if "selection_scale_factor" in store:  # stripes of motions chosen for the site: the motions of a stripe
+        motions = int(np.isfinite(store["selection_scale_factor"]).sum("record").min())
     method = "ida" if is_ida(store) else "stripes"
     rules, note = None, ""
     if method == "ida":
