@@ -30,6 +30,7 @@ from stochpound.analysis._fragility_ensemble import (
     stripe_fragility,
 )
 from stochpound.analysis._consistency import hazard_consistency
+from stochpound.analysis._efficiency import measure_efficiency, most_efficient
 from stochpound.analysis._hazard import HazardCurve, bundled_curves, probability_from_rate, rate_from_probability, return_period
 from stochpound.analysis._risk import demand_hazard_curve, mean_annual_frequency, risk_curve, risk_targeted_separation
 from stochpound.analysis._code_rules_risk import code_rules_risk
@@ -79,6 +80,8 @@ __all__ = [
     "contact_free_closure",
     "pounding_fragility",
     "hazard_consistency",
+    "measure_efficiency",
+    "most_efficient",
     "risk_gaps",
     "store_risk",
     "StoreRisk",

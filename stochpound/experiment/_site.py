@@ -132,24 +132,41 @@ def parse_site(site: Any, levels: list[float]) -> list[dict[str, Any]]:
     return [scenarios[i] for i in order]
 
 
-def structure_periods(experiment: Experiment) -> list[float]:
-    """The structure's periods of interest (s): first-mode periods on a fixed base and isolated periods, over every grid point."""
+def periods_of_interest(experiment: Experiment) -> dict[str, float]:
+    """The structure's periods of interest (s), by name: first-mode periods on a fixed base and isolated periods, over every grid point.
+
+    Names: ``"B1 first mode"``, ``"B1 isolated"``, with the grid point's
+    variant labels where a building's period differs between points.
+    """
     from stochpound.experiment._grid import CASE
     from stochpound.model.friction import is_fixed_base
     from stochpound.model.modal_solution import modal_properties
     from stochpound.model.scene_file import scene_from_dict
 
-    periods = set()
+    found: dict[str, set[float]] = {}
+    labels: dict[tuple[str, float], str] = {}
     for point in experiment.points(CASE):
+        variants = ", ".join(f"{name}={value}" for name, value in point.labels if name in {v["name"] for v in experiment.variants})
         scene = scene_from_dict(experiment.structure(point), base_dir=experiment.base_dir)
-        for building in scene.buildings:
-            periods.add(round(float(modal_properties(building).periods[0]), 12))
+        for name, building in zip(experiment.building_names, scene.buildings):
+            periods = {f"{name} first mode": float(modal_properties(building).periods[0])}
             base = building.base
-            if base is not None and not is_fixed_base(base.mu):
-                stiffness = base.restoring(building.total_mass * scene.g)
-                if stiffness > 0:
-                    periods.add(round(2.0 * math.pi * math.sqrt(building.total_mass / stiffness), 12))
-    return sorted(periods)
+            if base is not None and not is_fixed_base(base.mu) and base.restoring(building.total_mass * scene.g) > 0:
+                periods[f"{name} isolated"] = 2.0 * math.pi * math.sqrt(building.total_mass / base.restoring(building.total_mass * scene.g))
+            for key, period in periods.items():
+                period = round(period, 12)
+                found.setdefault(key, set()).add(period)
+                labels.setdefault((key, period), variants)
+    named = {}
+    for key, values in found.items():
+        for period in sorted(values):
+            named[key if len(values) == 1 else f"{key} ({labels[(key, period)]})"] = period
+    return named
+
+
+def structure_periods(experiment: Experiment) -> list[float]:
+    """The distinct periods of :func:`periods_of_interest` (s), ascending."""
+    return sorted(set(periods_of_interest(experiment).values()))
 
 
 @dataclass
