@@ -47,3 +47,21 @@ def test_stripes_of_a_homogeneous_scene_give_the_conditioning_measure_a_zero_spr
     n = ratio.size * stripes.sizes["intensity"]
     assert beta == pytest.approx(np.std(ratio, ddof=0) * np.sqrt(n / (n - 2)), rel=1e-9)  # the store's own measure: exact
     assert float(result["slope"].sel(response="closure", measure=name)) == pytest.approx(1.0, rel=1e-9)
+
+
+def test_risk_cli_names_the_most_efficient_measure_the_sites_hazard_has(fixed_stores) -> None:  # noqa: F811
+    from click.testing import CliRunner
+
+    from stochpound.cli import main
+    from stochpound.cli._measure_choice import hazard_measures
+
+    store = open_store(fixed_stores[0]).load()
+    available = hazard_measures(store, "fox_plaza_los_angeles_sa1p0s")
+    assert available == {"PGA": None, "PSA(1 s)": 1.0, "PSA(2 s)": 2.0, "PSA(3 s)": 3.0}
+    result = CliRunner().invoke(main, ["risk", str(fixed_stores[0]), "--hazard", "fox_plaza_los_angeles_sa1p0s", "--bootstrap", "0"])
+    assert result.exit_code == 0, result.output
+    efficiency = measure_efficiency(store, {f"hazard {k}": v for k, v in available.items() if v is not None})
+    names = ["PGA"] + [f"PSA({v:.3g} s, hazard {k})" for k, v in available.items() if v is not None]
+    best = most_efficient(efficiency, names).item()
+    label = "PGA" if best == "PGA" else best.split(", hazard ")[1].rstrip(")") + ")"
+    assert f"most efficient the site's hazard has: {label} (" in result.output

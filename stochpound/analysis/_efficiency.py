@@ -100,9 +100,9 @@ def measure_efficiency(store: xr.Dataset, periods: Mapping[str, float], structur
 
 def most_efficient(efficiency: xr.Dataset, measures: list[str], response: str = "closure") -> xr.DataArray:
     """The name of the measure of least β among ``measures`` (names of ``efficiency.measure``), per configuration."""
-    beta = efficiency["beta"].sel(response=response, measure=measures)
-    index = beta.fillna(np.inf).argmin("measure")
-    return xr.DataArray(np.asarray(measures, dtype=object)[index.values], dims=index.dims, coords=index.coords)
+    beta = efficiency["beta"].sel(response=response, measure=measures).transpose(..., "measure")
+    index = np.argmin(np.nan_to_num(beta.values, nan=np.inf), axis=-1)
+    return xr.DataArray(np.asarray(measures, dtype=object)[index], dims=beta.dims[:-1], coords={d: beta[d] for d in beta.dims[:-1]})
 
 
 def _conditioning_period(store: xr.Dataset) -> float | None:

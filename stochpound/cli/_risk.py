@@ -47,6 +47,7 @@ def risk(store: Path, hazard: str | None, target: str, years: float, bootstrap: 
     contact-free cases, gap = inf) or IDA capacities (docs/risk.md).
     """
     from stochpound.analysis._store_risk import store_risk
+    from stochpound.cli._measure_choice import efficient_measure_lines
     from stochpound.experiment import open_store
     from stochpound.experiment._hazard import hazard_option, stored_hazard
     from stochpound.experiment._intensity import describe_measure
@@ -82,6 +83,7 @@ def risk(store: Path, hazard: str | None, target: str, years: float, bootstrap: 
         click.echo(f"\nCode rules in risk terms (gap at the code intensity's stripe; λ_P: pounding per year at that gap; "
                    f"'once in N years'; P in {years:g} years):")
         click.echo(rules.to_string(float_format=lambda v: f"{v:.4g}"))
+    click.echo("\n".join(efficient_measure_lines(data, hazard)))
     if csv_path is not None:
         frames = [risk_headline(result).assign(table="separation")]
         if not rules.empty:
