@@ -47,7 +47,7 @@ numpydoc_xref_aliases = {
                        "VariantAxis", "MotionSource", "Output", "Solver"],
         "motions": ["Envelope", "FilteredWhiteNoise", "SoilPreset"],
         "motions.records": ["Record", "RegistryEntry", "RawSeries", "RecordStatistics"],
-        "": ["SceneError", "RecordError", "StochpoundError"],
+        "": ["SceneError", "RecordError", "SiteError", "StochpoundError"],
     }.items()
     for name in names
 }

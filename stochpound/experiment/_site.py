@@ -22,15 +22,16 @@ are unchanged.
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass
 from functools import cached_property
-from typing import TYPE_CHECKING, Any, Mapping
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import xarray as xr
 
 from stochpound.model import fields as toml_fields
-from stochpound.motions._conditional import CONDITIONING_MEASURES, MECHANISMS, MODEL_DAMPING, PERIOD_RANGE, check_scenario
+from stochpound.motions._conditional import CONDITIONING_MEASURES, MODEL_DAMPING, PERIOD_RANGE, check_scenario
 
 if TYPE_CHECKING:
     from stochpound.experiment._grid import Experiment

@@ -40,8 +40,8 @@ estimate in pygmm (from Vs30, M and the dip).
 from __future__ import annotations
 
 import warnings
-from dataclasses import dataclass
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 
 import numpy as np
 import xarray as xr
