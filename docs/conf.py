@@ -48,7 +48,7 @@ numpydoc_xref_aliases = {
         "store": ["StoreAccessor", "Intensity", "Hazard", "StoreVariable"],
         "motions": ["Envelope", "FilteredWhiteNoise", "SoilPreset"],
         "motions.records": ["Record", "RegistryEntry", "RawSeries", "RecordStatistics"],
-        "": ["SceneError", "RecordError", "StochpoundError"],
+        "": ["SceneError", "RecordError", "SiteError", "StochpoundError"],
     }.items()
     for name in names
 }

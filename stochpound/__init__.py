@@ -8,7 +8,7 @@ __version__ = "0.1.0"
 
 import importlib as _importlib
 
-from stochpound._errors import ExperimentError, RecordError, SceneError, StochpoundError
+from stochpound._errors import ExperimentError, RecordError, SceneError, SiteError, StochpoundError
 
 _LAZY = {
     "load_scene": "stochpound.model.scene_file",
@@ -40,4 +40,4 @@ def __dir__() -> list[str]:
     return sorted({*globals(), *_LAZY, *_SUBPACKAGES})
 
 
-__all__ = ["__version__", "load_scene", "scene_from_dict", "simulate", "simulate_ensemble", "open_store", "ExperimentError", "SceneError", "RecordError", "StochpoundError"]
+__all__ = ["__version__", "load_scene", "scene_from_dict", "simulate", "simulate_ensemble", "open_store", "ExperimentError", "SceneError", "RecordError", "SiteError", "StochpoundError"]

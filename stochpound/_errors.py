@@ -30,6 +30,11 @@ class VerificationError(StochpoundError):
     """A self-check of a report disagrees with what it checks (e.g. a stored case re-run does not reproduce the store)."""
 
 
+class SiteError(StochpoundError, ValueError):
+    """A site scenario, a conditional-spectrum target or a motion selection is invalid;
+    the message names the field, e.g. ``magnitude: must be within 3.5-8.5, got 9``."""
+
+
 def os_error_message(error: OSError) -> str:
     """One line for a file-system error, naming the path: ``PATH: cannot write here (Read-only file system)``.
 

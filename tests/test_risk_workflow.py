@@ -339,3 +339,19 @@ def test_rules_table_is_indexed_by_the_grid_not_by_what_each_point_ran():
     )
     frame = StoreRisk(xr.Dataset(), xr.Dataset(), xr.Dataset(), rules, "", HazardCurve.bundled(BUNDLED), 8, "stripes").rules_frame()
     assert list(frame.index.names) == ["design_level", "rule", "mu"] and len(frame) == 2
+
+
+def test_the_ida_gap_grid_reaches_the_separations_of_the_hazards_intensities(fixed_stores):
+    """IDA runs hold the closures at scale 1: the default grid must reach them scaled to the hazard's rare intensities, or g* is "inf"."""
+    from stochpound.analysis import rate_from_probability, store_risk
+
+    ida = open_store(fixed_stores[1]).load()
+    hz = HazardCurve.bundled(BUNDLED)
+    targets = (0.1, 0.02, 0.005)
+    risk = store_risk(ida, hz, targets=targets, bootstrap=0)
+    assert np.all(np.isfinite(risk.separation["separation"].values))
+    reach = hz.intensity_at(max(rate_from_probability(0.005, 50.0) / 10.0, hz.rate[-1]))  # a tenth of the rarest target's rate, within the table
+    closure = contact_free_closure(ida)
+    im = ida["motion_intensity"].isel(gap=0, realization=0)
+    assert float(risk.curve["gap"].max()) >= 1.5 * float((closure * reach / im).max()) * (1 - 1e-12)
+    assert float(risk.separation["separation"].max()) < float(risk.curve["gap"].max())

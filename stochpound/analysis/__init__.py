@@ -26,6 +26,7 @@ from stochpound.analysis._pounding import pounding_probability
 from stochpound.analysis._separation import pounding_curve, required_separation, rule_exceedance
 from stochpound.analysis._separation_rules import contact_demands, fixed_base_cqc, separation_rules, store_contact_demands
 from stochpound.analysis._summary import run_summary
+from stochpound.analysis._consistency import hazard_consistency
 from stochpound.analysis._hazard import HazardCurve, bundled_curves, probability_from_rate, rate_from_probability, return_period
 from stochpound.analysis._hazard_files import HazardFile, read_hazard_file
 
@@ -84,6 +85,7 @@ __all__ = [
     "code_rules_risk",
     "contact_free_closure",
     "pounding_fragility",
+    "hazard_consistency",
     "risk_gaps",
     "store_risk",
     "StoreRisk",

@@ -56,6 +56,7 @@ def risk(store: Path, hazard: str | None, hazard_measure: str | None, hazard_uni
     A hazard file must say (or the options state) its measure and units;
     they are checked against the store's and converted (docs/risk.md).
     """
+    from stochpound.cli._measure_choice import efficient_measure_lines
     from stochpound.experiment import open_store
     from stochpound.risk import site_hazard, store_risk
 
@@ -91,6 +92,7 @@ def risk(store: Path, hazard: str | None, hazard_measure: str | None, hazard_uni
         click.echo(f"\nCode rules in risk terms (gap at the code intensity's stripe; λ_P: pounding per year at that gap; "
                    f"'once in N years'; P in {years:g} years):")
         click.echo(rules.to_string(float_format=lambda v: f"{v:.4g}"))
+    click.echo("\n".join(efficient_measure_lines(data, hazard)))
     if csv_dir is not None:
         tables = {"separation": result.to_frame()}
         if not rules.empty:

@@ -35,6 +35,7 @@ from stochpound.experiment._scene_edits import (
     with_motion,
     without_motion,
 )
+from stochpound.experiment._site import CONDITIONAL_SPECTRUM, StripeSelections, stripe_selections
 from stochpound.experiment._spec import ExperimentError
 from stochpound.model.scene_file import scene_from_dict
 
@@ -279,11 +280,27 @@ class Experiment:
         return {label: np.searchsorted(values, self.realization_numbers(label)) for label in self.motions}
 
     def in_grid(self, kind: str) -> np.ndarray:
-        """Which positions of the grid of ``kind`` hold a case (bool, :meth:`grid_shape`): a record has realization 0 only."""
+        """Which positions of the grid of ``kind`` hold a case (bool, :meth:`grid_shape`): a record has realization 0 only;
+        with a conditional-spectrum selection, a stripe holds its chosen motions only."""
         mask = np.zeros(self.grid_shape(kind)[-2:], dtype=bool)
         for m, label in enumerate(self.motions):
             mask[m, self.realization_positions(label)] = True
+        if self.selection is not None:  # intensity is the dimension before record
+            mask = mask & self.selection.chosen[:, :, None]
         return np.broadcast_to(mask, self.grid_shape(kind))
+
+    @cached_property
+    def selection(self) -> StripeSelections | None:
+        """The motions chosen for every stripe (``[intensity] selection = "conditional_spectrum"``); None otherwise."""
+        if self.intensity is None or self.intensity.get("selection") != CONDITIONAL_SPECTRUM:
+            return None
+        return stripe_selections(self)
+
+    def _runs(self, point: Point, record: int) -> bool:
+        """Whether the motion numbered ``record`` runs at ``point`` (not where a selection left it out of the stripe)."""
+        if self.selection is None:
+            return True
+        return bool(self.selection.chosen[self.intensity["levels"].index(dict(point.labels)["intensity"]), record])
 
     @cached_property
     def n_cases(self) -> int:
@@ -307,6 +324,8 @@ class Experiment:
             ids = np.zeros(self.grid_shape(kind), dtype="S16")
             for point in self.points(kind):
                 for m in range(len(self.motion_dims[0].values)):
+                    if not self._runs(point, m):
+                        continue
                     label = self.motion_dims[0].values[m]
                     ids[point.position + (m,)][self.realization_positions(label)] = self.point_case_ids(point, m)
             self._grid_case_ids[kind] = ids
@@ -317,6 +336,8 @@ class Experiment:
         for kind in KINDS:
             for point in self.points(kind):
                 for m, label in enumerate(self.motion_dims[0].values):
+                    if not self._runs(point, m):
+                        continue
                     ids = self.point_case_ids(point, m)
                     for identifier, realization, r in zip(ids, self.realizations(label), self.realization_positions(label)):
                         labels = (*point.labels, ("record", label), ("realization", realization))

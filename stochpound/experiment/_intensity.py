@@ -33,6 +33,7 @@ from typing import Any, Mapping
 import numpy as np
 
 from stochpound.model import fields as toml_fields
+from stochpound.experiment._site import parse_selection
 from stochpound.model.friction import is_fixed_base
 from stochpound.motions._measures import arias_intensity, peak_ground_motion, significant_duration
 from stochpound.motions._spectrum import response_spectrum
@@ -55,7 +56,7 @@ not to the recorded ground motion."""
 SPECTRUM_PERIODS = np.geomspace(0.05, 5.0, 25)
 """Periods (s) of the unscaled spectrum stored for every motion (5 % damping)."""
 SPECTRUM_DAMPING = 0.05
-_KEYS = {"measure", "period", "periods", "damping", "levels", "units", "method", "synthetic"}
+_KEYS = {"measure", "period", "periods", "damping", "levels", "units", "method", "synthetic", "selection", "motions", "max_scale_factor", "seed"}
 
 #: Per-case variables of an intensity-conditioned store: units and long names (units of levels filled in).
 SUMMARIES: dict[str, tuple[str, str]] = {
@@ -86,6 +87,8 @@ def parse_intensity(data: Mapping[str, Any], scene: Mapping[str, Any], variants:
     """
     table = data.get("intensity")
     if table is None:
+        if data.get("site") is not None:
+            raise IntensityError("site: only with an [intensity] table whose selection is conditional_spectrum")
         return None
     if not isinstance(table, dict):
         raise IntensityError("intensity: must be a table (measure, levels, ...)")
@@ -131,6 +134,7 @@ def parse_intensity(data: Mapping[str, Any], scene: Mapping[str, Any], variants:
         )
     entry["synthetic"] = synthetic
     entry["ran"], entry["note"] = _method_run(method, scene, variants, gaps, mu)
+    entry.update(parse_selection(table, data.get("site"), levels, entry))
     return entry
 
 

@@ -40,7 +40,7 @@ from stochpound.store import TIME_HISTORIES, is_gap_axis, read_definition
 #: Format version of the canonical definition (stored with every store).
 FORMAT_VERSION = 1
 
-_TOP_KEYS = {"experiment", "scene", "variants", "grid", "records", "motions", "synthetic", "output", "solver", "intensity", "hazard"}
+_TOP_KEYS = {"experiment", "scene", "variants", "grid", "records", "motions", "synthetic", "output", "solver", "intensity", "hazard", "site"}
 _EXPERIMENT_KEYS = {"name", "description", "scene", "studied", "reproduces"}
 _BUILDING_OVERRIDES = {"mass_factor", "mass", "stiffness", "damping", "damping_ratio", "base", "initial"}
 _SCENE_OVERRIDES = {"study_compat", "wall"}

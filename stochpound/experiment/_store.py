@@ -226,6 +226,8 @@ def _coordinates(experiment: Experiment, motion_grids: Mapping[str, tuple[float,
         ("record",), np.array([canonical_json(motions[m]["motion"]) for m in motions], dtype=object), {"units": "1", "long_name": "the motion's scene table (JSON)"}
     )
     coords.update(_suite_coordinates(experiment))
+    if experiment.selection is not None:
+        coords.update(experiment.selection.coordinates())
     if experiment.intensity is not None:
         coords["spectrum_period"] = xr.Variable(
             ("spectrum_period",), intensity.SPECTRUM_PERIODS, {"units": "s", "long_name": "period of the stored spectra (5 % damping)"}

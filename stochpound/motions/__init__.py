@@ -9,9 +9,15 @@
 Intensity measures and the response spectrum (exact for accelerations linear
 between samples): :func:`intensity_measures`, :func:`response_spectrum`.
 
+The conditional spectrum of a site scenario (NGA-West2 models, Baker–Jayaram
+correlation): :func:`conditional_spectrum`; records chosen and scaled to it
+(Jayaram, Lin & Baker 2011): :func:`selection_pool`, :func:`selection_periods`,
+:func:`select_motions`.
+
 Conventions (PSD two-sided in ω, σ² = ∫ S dω; SI units) are in ``docs/motions.md``.
 """
 
+from stochpound.motions._conditional import conditional_spectrum
 from stochpound.motions.baseline import baseline_correct, final_velocity_displacement
 from stochpound.motions.envelopes import (
     ENVELOPES,
@@ -36,6 +42,7 @@ from stochpound.motions.psd import (
     kanai_tajimi_psd,
     kanai_tajimi_variance,
 )
+from stochpound.motions._selection import select_motions, selection_periods, selection_pool
 from stochpound.motions._seeding import realization_rng, realization_rngs
 from stochpound.motions._spectrum import response_spectrum
 from stochpound.motions._synthetic import PSD_CONVENTION, clough_penzien, kanai_tajimi, synthetic_ground_motion
@@ -56,6 +63,7 @@ __all__ = [
     "clough_penzien",
     "clough_penzien_model",
     "clough_penzien_psd",
+    "conditional_spectrum",
     "filter_samples",
     "final_velocity_displacement",
     "high_pass_gain",
@@ -73,6 +81,9 @@ __all__ = [
     "s0_from_pga",
     "s0_from_rms",
     "sa_avg",
+    "select_motions",
+    "selection_periods",
+    "selection_pool",
     "significant_duration",
     "soil_preset",
     "simulated_peak_factor",

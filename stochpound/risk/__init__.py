@@ -47,6 +47,8 @@ from stochpound.risk._code_gaps import (
 from stochpound.risk._store import RiskInputError, contact_free_closure, has_risk, site_hazard
 from stochpound.risk._store_risk import StoreRisk, pounding_fragility, risk_gaps, store_risk
 from stochpound.risk._demands import StoreDemands, store_demands
+from stochpound.risk._efficiency import measure_efficiency, most_efficient
+from stochpound.analysis._consistency import hazard_consistency
 
 __all__ = [
     "Fragility",
@@ -81,6 +83,9 @@ __all__ = [
     "StoreRisk",
     "store_demands",
     "StoreDemands",
+    "hazard_consistency",
+    "measure_efficiency",
+    "most_efficient",
     "has_risk",
     "site_hazard",
     "RiskInputError",

@@ -187,6 +187,13 @@ def contact_free_closure(store: xr.Dataset, contact_dim: str = "contact") -> xr.
     return store_motions(closure).load().assign_attrs(units="m", long_name="largest contact-free peak closure over the contacts")
 
 
+def stripe_motions(store: xr.Dataset, motions: int) -> int:
+    """The motions of every stripe: all ``motions`` of the store, or the fewest chosen per stripe by a selection for the site."""
+    if "selection_scale_factor" in store:
+        return int(np.isfinite(store["selection_scale_factor"]).sum("record").min())
+    return motions
+
+
 def motion_intensity(store: xr.Dataset) -> xr.DataArray:
     """The intensity of every motion of an IDA store at scale 1 (in the units of its levels), one motion dimension ``record``."""
     intensity = store["motion_intensity"]

@@ -274,6 +274,14 @@ def non_increasing_along(maf: xr.DataArray, dim: str) -> xr.DataArray:
     return xr.apply_ufunc(non_increasing, maf, input_core_dims=[[dim]], output_core_dims=[[dim]]).transpose(*maf.dims)
 
 
+def _reach_intensity(hz: HazardCurve, targets: Sequence[float], years: float) -> float:
+    """The intensity up to which a gap grid reaches: where the hazard's rate is a tenth of the smallest target's (within its table)."""
+    rate = rate_from_probability(min(targets), years) / 10.0
+    if not hz.extrapolate:
+        rate = max(float(rate), float(hz.rate[-1]))
+    return float(hz.intensity_at(rate))
+
+
 def store_risk(store: xr.Dataset, hz: HazardCurve | None = None, targets: Sequence[float] = TARGETS, years: float = YEARS,
                gaps: Sequence[float] | np.ndarray | None = None, studied: str | None = None, confidence: float = CONFIDENCE,
                bootstrap: int = BOOTSTRAP, seed: int = 0) -> StoreRisk:
@@ -292,7 +300,11 @@ def store_risk(store: xr.Dataset, hz: HazardCurve | None = None, targets: Sequen
     years : float
         Exposure time (yr).
     gaps : sequence of float, optional
-        The gap grid (m); default :func:`risk_gaps` of the closures.
+        The gap grid (m); default :func:`risk_gaps` of the closures, for IDA
+        runs (closures at scale 1) together with each closure scaled to the
+        intensity where the hazard's rate is a tenth of the rarest target's
+        (within the hazard's table), so that the grid reaches the separations
+        the hazard asks for.
     studied : str, optional
         The building whose peak base displacement is ASCE 7's D_TM; default
         the store's ``studied`` building. The rule is left out where it does not slide.
@@ -308,11 +320,16 @@ def store_risk(store: xr.Dataset, hz: HazardCurve | None = None, targets: Sequen
     hz = _store.site_hazard(store) if hz is None else hz
     studied = _store.studied_building(store) if studied is None else studied
     closure = _store.contact_free_closure(store)
-    grid = risk_gaps(closure) if gaps is None else np.asarray(gaps, dtype=float)
+    if gaps is not None:
+        grid = np.asarray(gaps, dtype=float)
+    elif _store.is_ida(store):  # the unscaled closures, and each scaled to the hazard's intensities (IDA runs hold scale 1 only)
+        grid = risk_gaps(xr.concat([closure, closure * (_reach_intensity(hz, targets, years) / _store.motion_intensity(store))], "record"))
+    else:
+        grid = risk_gaps(closure)
     fragility = pounding_fragility(store, grid, confidence=confidence, bootstrap=bootstrap, seed=seed)
     curve = risk_curve(fragility, hz, years, confidence)
     separation = risk_targeted_separation(curve, targets, years, confidence=confidence)
-    motions = closure.sizes["record"]
+    motions = _store.stripe_motions(store, closure.sizes["record"])
     method = "ida" if _store.is_ida(store) else "stripes"
     rules, note = None, ""
     if method == "ida":

@@ -1,0 +1,261 @@
+"""Stripes of motions chosen for the site: ``[intensity] selection = "conditional_spectrum"`` and the ``[site]`` table.
+
+With ``selection = "conditional_spectrum"`` (docs/intensity.md) every stripe
+runs ``motions`` motions chosen from the pool (every ``[[records]]`` entry)
+and scaled to the level within ``max_scale_factor``, so that their spectra
+match the conditional spectrum of the stripe's scenario
+(:func:`stochpound.motions.select_motions`). The ``[site]`` table gives the
+scenario: ``vs30``, and ``magnitude``, ``distance_km`` and ``mechanism``,
+each one value or one per level (in the order ``levels`` lists them).
+
+The period range covers the structure: every building's first-mode period
+on a fixed base and, for a building on a sliding base with a restoring
+force (a friction pendulum), its isolated period 2π √(M/k_r) (M the
+building's and base's mass, k_r the restoring stiffness), over every grid
+point; the range runs from 0.2 times the shortest to 3 times the longest.
+
+The default ``selection = "scale"`` (every motion scaled to every level)
+adds nothing to the definition, so the identities of existing experiments
+are unchanged.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass
+from functools import cached_property
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+import xarray as xr
+
+from stochpound.model import fields as toml_fields
+from stochpound.motions._conditional import CONDITIONING_MEASURES, MODEL_DAMPING, PERIOD_RANGE, check_scenario
+
+if TYPE_CHECKING:
+    from stochpound.experiment._grid import Experiment
+
+SELECTIONS = ("scale", "conditional_spectrum")
+"""``[intensity] selection``: every motion scaled to every level, or motions chosen per stripe."""
+CONDITIONAL_SPECTRUM = SELECTIONS[1]
+DEFAULT_SEED = 1
+"""Seed of the selection when ``[intensity] seed`` is not given."""
+SITE_FIELDS = ("vs30", "magnitude", "distance_km", "mechanism")
+PER_LEVEL = ("magnitude", "distance_km", "mechanism")
+"""``[site]`` fields that take one value per level."""
+
+
+def parse_selection(table: Mapping[str, Any], site: Any, levels: list[float], entry: dict[str, Any]) -> dict[str, Any]:
+    """The selection's entries of the ``intensity`` definition ({} for the default ``scale``).
+
+    Parameters
+    ----------
+    table : mapping
+        The ``[intensity]`` table.
+    site : mapping or None
+        The ``[site]`` table.
+    levels : list of float
+        The levels as the file lists them.
+    entry : mapping
+        The ``intensity`` entry parsed so far (measure, period(s), damping, units, method).
+
+    Raises
+    ------
+    SiteError
+        Naming the field: an unknown selection, a measure or unit the
+        conditional spectrum does not take, a missing or short ``[site]``
+        field, a scenario outside the models' range.
+    """
+    from stochpound._errors import SiteError
+
+    selection = table.get("selection", SELECTIONS[0])
+    if selection not in SELECTIONS:
+        raise SiteError(f"intensity.selection: must be one of {', '.join(SELECTIONS)}, got {selection!r}")
+    if selection == SELECTIONS[0]:
+        for key in ("motions", "max_scale_factor", "seed"):
+            if key in table:
+                raise SiteError(f'intensity.{key}: only with selection = "{CONDITIONAL_SPECTRUM}"')
+        if site is not None:
+            raise SiteError(f'site: only with [intensity] selection = "{CONDITIONAL_SPECTRUM}" (the scenario of its targets)')
+        return {}
+    if entry["measure"] not in CONDITIONING_MEASURES:
+        raise SiteError(f"intensity.measure: the conditional spectrum conditions on {', '.join(CONDITIONING_MEASURES)}, got {entry['measure']!r}")
+    if entry["units"] != "g":
+        raise SiteError(f'intensity.units: the conditional spectrum takes levels in g, got {entry["units"]!r}')
+    if entry["method"] != "stripes":
+        raise SiteError('intensity.method: the conditional spectrum chooses motions per stripe: method = "stripes"')
+    if entry.get("damping", MODEL_DAMPING) != MODEL_DAMPING:
+        raise SiteError(f"intensity.damping: the NGA-West2 models give 5 % damped spectra only (0.05), got {entry['damping']!r}")
+    low, high = PERIOD_RANGE
+    for period in [entry["period"]] if "period" in entry else entry.get("periods", []):
+        if not low <= period <= high:
+            key = "intensity.period" if "period" in entry else "intensity.periods"
+            raise SiteError(f"{key}: must be within {low:g}-{high:g} s for the conditional spectrum (the NGA-West2 models' range), got {period:g}")
+    motions = table.get("motions")
+    if not isinstance(motions, int) or isinstance(motions, bool) or motions < 2:
+        raise SiteError(f"intensity.motions: motions per stripe, an integer >= 2, got {motions!r}")
+    max_scale = toml_fields.number(table, "max_scale_factor", "intensity", required=True, low=1.0)
+    seed = table.get("seed", DEFAULT_SEED)
+    if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0:
+        raise SiteError(f"intensity.seed: must be an integer >= 0, got {seed!r}")
+    note = f"{motions} motions per stripe chosen from the pool and scaled to the conditional spectrum of its scenario"
+    return {"note": note, "selection": selection, "motions": motions, "max_scale_factor": max_scale, "seed": seed, "site": parse_site(site, levels)}
+
+
+def parse_site(site: Any, levels: list[float]) -> list[dict[str, Any]]:
+    """One scenario per level, in the order of the sorted levels, from the ``[site]`` table."""
+    from stochpound._errors import SiteError
+
+    if not isinstance(site, dict):
+        raise SiteError("site: a [site] table is required with the conditional spectrum (vs30, magnitude, distance_km, mechanism)")
+    toml_fields.reject_unknown(site, set(SITE_FIELDS), "site")
+    columns: dict[str, list[Any]] = {}
+    for key in SITE_FIELDS:
+        if key not in site:
+            raise SiteError(f"site.{key}: missing (the scenario of the site's hazard, from its disaggregation)")
+        value = site[key]
+        if isinstance(value, list):
+            if key not in PER_LEVEL:
+                raise SiteError(f"site.{key}: one value for every level, got a list")
+            if len(value) != len(levels):
+                raise SiteError(f"site.{key}: {len(value)} values for {len(levels)} levels (one scenario, or one per level in the order of intensity.levels)")
+            columns[key] = value
+        else:
+            columns[key] = [value] * len(levels)
+    scenarios = []
+    for i in range(len(levels)):
+        scenario = {key: columns[key][i] for key in SITE_FIELDS}
+        names = {key: f"site.{key}[{i}]" if isinstance(site[key], list) else f"site.{key}" for key in SITE_FIELDS}
+        check_scenario(scenario["magnitude"], scenario["distance_km"], scenario["vs30"], scenario["mechanism"], names)
+        scenarios.append({key: (float(v) if key != "mechanism" else v) for key, v in scenario.items()})
+    order = sorted(range(len(levels)), key=lambda i: levels[i])
+    return [scenarios[i] for i in order]
+
+
+def periods_of_interest(experiment: Experiment) -> dict[str, float]:
+    """The structure's periods of interest (s), by name: first-mode periods on a fixed base and isolated periods, over every grid point.
+
+    Names: ``"B1 first mode"``, ``"B1 isolated"``, with the grid point's
+    variant labels where a building's period differs between points.
+    """
+    from stochpound.experiment._grid import CASE
+    from stochpound.model.friction import is_fixed_base
+    from stochpound.model.modal_solution import modal_properties
+    from stochpound.model.scene_file import scene_from_dict
+
+    found: dict[str, set[float]] = {}
+    labels: dict[tuple[str, float], str] = {}
+    for point in experiment.points(CASE):
+        variants = ", ".join(f"{name}={value}" for name, value in point.labels if name in {v["name"] for v in experiment.variants})
+        scene = scene_from_dict(experiment.structure(point), base_dir=experiment.base_dir)
+        for name, building in zip(experiment.building_names, scene.buildings):
+            periods = {f"{name} first mode": float(modal_properties(building).periods[0])}
+            base = building.base
+            if base is not None and not is_fixed_base(base.mu) and base.restoring(building.total_mass * scene.g) > 0:
+                periods[f"{name} isolated"] = 2.0 * math.pi * math.sqrt(building.total_mass / base.restoring(building.total_mass * scene.g))
+            for key, period in periods.items():
+                period = round(period, 12)
+                found.setdefault(key, set()).add(period)
+                labels.setdefault((key, period), variants)
+    named = {}
+    for key, values in found.items():
+        for period in sorted(values):
+            named[key if len(values) == 1 else f"{key} ({labels[(key, period)]})"] = period
+    return named
+
+
+def structure_periods(experiment: Experiment) -> list[float]:
+    """The distinct periods of :func:`periods_of_interest` (s), ascending."""
+    return sorted(set(periods_of_interest(experiment).values()))
+
+
+@dataclass
+class StripeSelections:
+    """The motions chosen for every stripe of an experiment (:func:`stripe_selections`)."""
+
+    experiment_levels: list[float]
+    labels: list[str]
+    periods: np.ndarray
+    structure: list[float]
+    selections: list[xr.Dataset]
+    targets: list[xr.Dataset]
+
+    @cached_property
+    def chosen(self) -> np.ndarray:
+        """Which motions run at every level (bool, level × motion)."""
+        mask = np.zeros((len(self.experiment_levels), len(self.labels)), dtype=bool)
+        for i, selection in enumerate(self.selections):
+            mask[i, [self.labels.index(m) for m in selection["motion"].values]] = True
+        return mask
+
+    def coordinates(self) -> dict[str, xr.Variable]:
+        """The store's record of the selection: per stripe the chosen motions' scale factors, the target and the set's spectra, the scenario."""
+        scale = np.full(self.chosen.shape, np.nan)
+        for i, selection in enumerate(self.selections):
+            scale[i, [self.labels.index(m) for m in selection["motion"].values]] = selection["scale_factor"].values
+        stack = {name: np.stack([s[name].values for s in self.selections]) for name in ("median", "sigma_ln", "mean_ln", "std_ln")}
+        per_stripe = ("intensity", "selection_period")
+        scenario = [t.attrs for t in self.targets]
+        return {
+            "selection_period": xr.Variable(
+                ("selection_period",), self.periods,
+                {"units": "s", "long_name": "period of the conditional-spectrum targets", "structure_periods": " ".join(f"{t:.6g}" for t in self.structure)},
+            ),
+            "selection_scale_factor": xr.Variable(("intensity", "record"), scale, {"units": "1", "long_name": "scale factor of a motion chosen for the stripe (NaN: not chosen)"}),
+            "target_median": xr.Variable(per_stripe, stack["median"], {"units": "g", "long_name": "conditional spectrum: median Sa given the level"}),
+            "target_sigma_ln": xr.Variable(per_stripe, stack["sigma_ln"], {"units": "1", "long_name": "conditional spectrum: standard deviation of ln Sa"}),
+            "selection_mean_ln": xr.Variable(per_stripe, stack["mean_ln"], {"units": "1", "long_name": "mean ln Sa (g) of the chosen, scaled motions"}),
+            "selection_std_ln": xr.Variable(per_stripe, stack["std_ln"], {"units": "1", "long_name": "standard deviation of ln Sa of the chosen, scaled motions"}),
+            "target_epsilon": xr.Variable(("intensity",), np.array([s["epsilon"] for s in scenario]), {"units": "1", "long_name": "epsilon of the level in its scenario"}),
+            "site_magnitude": xr.Variable(("intensity",), np.array([s["magnitude"] for s in scenario]), {"units": "1", "long_name": "scenario moment magnitude"}),
+            "site_distance_km": xr.Variable(("intensity",), np.array([s["distance_km"] for s in scenario]), {"units": "km", "long_name": "scenario rupture distance"}),
+            "site_vs30": xr.Variable(("intensity",), np.array([s["vs30"] for s in scenario]), {"units": "m/s", "long_name": "scenario Vs30"}),
+            "site_mechanism": xr.Variable(("intensity",), np.array([s["mechanism"] for s in scenario], dtype=object), {"units": "1", "long_name": "scenario mechanism"}),
+        }  # fmt: skip
+
+
+def stripe_selections(experiment: Experiment) -> StripeSelections:
+    """Choose and scale the motions of every stripe (module docstring).
+
+    Raises
+    ------
+    ExperimentError
+        Naming the field: a synthetic ensemble in the pool, ``intensity.motions``
+        more than the pool has within ``max_scale_factor`` of a level.
+    """
+    from stochpound._errors import SiteError
+    from stochpound.experiment._grid import CASE
+    from stochpound.experiment._spec import ExperimentError, field_errors
+    from stochpound.model.scene_file import scene_from_dict
+    from stochpound.motions import conditional_spectrum, select_motions, selection_periods, selection_pool
+    from stochpound.motions.records import Record
+    from stochpound.motions.records._suites import is_suite_member, load_suite_member
+
+    intensity = experiment.intensity
+    scene = experiment.structure(experiment.points(CASE)[0])
+    records = []
+    for label, source in experiment.motions.items():  # the motions as the cases run them (a duration or a start applied)
+        if source["kind"] != "record":
+            raise ExperimentError(f"{source['field']}: the conditional-spectrum pool takes records and suites, not synthetic ensembles")
+        with field_errors(scene_prefix=source["field"]):
+            motion = scene_from_dict({**scene, "motion": experiment.motion_table(label)}, base_dir=experiment.base_dir).motion
+        name = str(source["motion"].get("record", ""))
+        metadata = load_suite_member(name).metadata if is_suite_member(name) else {}
+        records.append(Record(label, motion.dt, motion.values, "m/s2", metadata=metadata))
+    measure = intensity["measure"]
+    period = intensity.get("period", intensity.get("periods"))
+    conditioning = [] if period is None else list(np.atleast_1d(period))
+    structure = structure_periods(experiment)
+    periods = selection_periods(structure, conditioning)
+    g = float(experiment.definition["scene"].get("g", 9.81))
+    pool = selection_pool(records, periods, measure, period, MODEL_DAMPING, g)
+    selections, targets = [], []
+    for level, scenario in zip(intensity["levels"], intensity["site"]):
+        target = conditional_spectrum(measure, period, level=level, periods=periods, **scenario)
+        try:
+            selections.append(select_motions(pool, target, intensity["motions"], intensity["max_scale_factor"], intensity["seed"]))
+        except SiteError as error:
+            raise ExperimentError(f"intensity.{error} (stripe {level:g} g)") from None
+        targets.append(target)
+    return StripeSelections(list(intensity["levels"]), list(experiment.motions), periods, structure, selections, targets)

@@ -1,0 +1,274 @@
+"""The conditional spectrum of a site scenario (Baker 2011), from the NGA-West2 models in pygmm.
+
+Given a scenario (magnitude M, rupture distance R, Vs30, mechanism) every
+ground-motion model gives, at every period, the median and the standard
+deviation σ of ln Sa. The four NGA-West2 models ASK14, BSSA14, CB14 and
+CY14 (pygmm) are averaged with equal weights: the mean of their ln medians,
+and σ = √(mean of their σ²) (the aleatory variability of the average model;
+the spread of the four medians is epistemic, which the site's hazard curve
+already integrates, and is left out).
+
+The ε of ln Sa at two periods are correlated by ρ(T1, T2) of Baker & Jayaram
+(2008, pygmm's ``baker_jayaram_2008.calc_correls``), PGA taken as Sa at
+0.01 s, the shortest period of the models and of the correlation. So ln Sa
+over a set of periods is multivariate normal, mean μ and covariance
+C_kl = ρ_kl σ_k σ_l. The conditioning measure is a linear function wᵀ x of
+that vector x of ln Sa: w picks one entry for PGA or PSA(T*); for Sa_avg,
+the geometric mean of Sa over its n periods, ln Sa_avg = (1/n) Σ_k ln Sa(T_k),
+w_k = 1/n. Then ln IM* is normal with mean wᵀμ and variance wᵀCw (for
+Sa_avg: (1/n²) Σ_kl ρ_kl σ_k σ_l), and given ln IM* = ln x,
+
+    ε* = (ln x − wᵀμ) / √(wᵀCw)
+    mean | x = μ + C w ε* / √(wᵀCw)
+    cov | x  = C − C w wᵀ C / (wᵀCw).
+
+For PSA(T*) this is the familiar μ(T) + ρ(T, T*) ε* σ(T) and σ(T) √(1 − ρ²);
+for Sa_avg the correlation of ln Sa(T) with ln Sa_avg is
+(1/n) Σ_k ρ(T, T_k) σ_k / σ_avg. At T* the conditional mean is ln x and the
+σ is 0.
+
+Scenario inputs the magnitude, distance, Vs30 and mechanism do not fix (the
+toolkit's estimates, stated in docs/intensity.md): the rupture reaches the
+surface (Z_tor = 0) and the site is on its footwall side, so R_JB = R_rup
+and R_x = −R_rup (no hanging-wall term); the dip is 90° for strike-slip,
+40° for reverse and 50° for normal faulting (Kaklamanos et al. 2011);
+region California, Vs30 measured; the basin depths Z1.0 and Z2.5, the
+rupture width and the hypocentral depth are each model's own default
+estimate in pygmm (from Vs30, M and the dip).
+"""
+
+from __future__ import annotations
+
+import warnings
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+import xarray as xr
+
+from stochpound._errors import SiteError
+
+#: Mechanisms of a scenario: pygmm's code and the dip (°) assumed.
+MECHANISMS: dict[str, tuple[str, float]] = {"strike_slip": ("SS", 90.0), "reverse": ("RS", 40.0), "normal": ("NS", 50.0)}
+#: Measures a conditional spectrum can be conditioned on.
+CONDITIONING_MEASURES = ("pga", "psa", "sa_avg")
+#: Periods (s) of the models and of the correlation.
+PERIOD_RANGE = (0.01, 10.0)
+#: Period (s) at which PGA enters the correlation.
+PGA_PERIOD = 0.01
+#: Damping ratio of the models' spectra.
+MODEL_DAMPING = 0.05
+_SCENARIO_FIELDS = {"magnitude": "mag", "distance_km": "dist_rup", "vs30": "v_s30"}
+
+
+def _models() -> tuple[type, ...]:
+    import pygmm
+
+    return (pygmm.AbrahamsonSilvaKamai2014, pygmm.BooreStewartSeyhanAtkinson2014, pygmm.CampbellBozorgnia2014, pygmm.ChiouYoungs2014)
+
+
+def scenario_limits() -> dict[str, tuple[float, float]]:
+    """The range of magnitude, distance_km and vs30 every one of the four models is meant for (the intersection of their limits)."""
+    limits = {}
+    for field, name in _SCENARIO_FIELDS.items():
+        low, high = 0.0, np.inf
+        for model in _models():
+            for parameter in model.PARAMS:
+                if parameter.name == name:
+                    low = max(low, parameter.min if parameter.min is not None else low)
+                    high = min(high, parameter.max if parameter.max is not None else high)
+        limits[field] = (low, high)
+    return limits
+
+
+def check_scenario(magnitude: float, distance_km: float, vs30: float, mechanism: str, names: Mapping[str, str] | None = None) -> None:
+    """Raise :class:`SiteError` naming the field of a scenario outside the models' range or of an unknown mechanism.
+
+    ``names`` spells a field in the message (default: its own name).
+    """
+    names = names or {}
+    for field, (low, high) in scenario_limits().items():
+        value = {"magnitude": magnitude, "distance_km": distance_km, "vs30": vs30}[field]
+        if not isinstance(value, (int, float)) or isinstance(value, bool) or not low <= value <= high:
+            raise SiteError(f"{names.get(field, field)}: must be within {low:g}-{high:g} (the NGA-West2 models' range), got {value!r}")
+    if mechanism not in MECHANISMS:
+        raise SiteError(f"{names.get('mechanism', 'mechanism')}: must be one of {', '.join(MECHANISMS)}, got {mechanism!r}")
+
+
+@dataclass(frozen=True)
+class ConditionalDistribution:
+    """ln Sa at ``periods`` given the conditioning measure: mean, covariance and the unconditional moments."""
+
+    periods: np.ndarray
+    mean_ln: np.ndarray
+    covariance: np.ndarray
+    unconditional_mean_ln: np.ndarray
+    unconditional_sigma_ln: np.ndarray
+    epsilon: float
+
+
+def _average_model(nodes: Sequence[float | None], magnitude: float, distance_km: float, vs30: float, mechanism: str) -> tuple[np.ndarray, np.ndarray]:
+    """Mean ln median (g) and σ of the four models at every node (a period in s, or None for PGA)."""
+    import pygmm
+
+    code, dip = MECHANISMS[mechanism]
+    scenario = pygmm.Scenario(
+        mag=float(magnitude), dist_rup=float(distance_km), dist_jb=float(distance_km), dist_x=-float(distance_km),
+        v_s30=float(vs30), mechanism=code, dip=dip, depth_tor=0.0, region="california", vs_source="measured",
+    )  # fmt: skip
+    periods = np.array([PGA_PERIOD if node is None else node for node in nodes], dtype=float)
+    is_pga = np.array([node is None for node in nodes])
+    means, variances = [], []
+    with warnings.catch_warnings():  # the scenario is checked against the models' limits before
+        warnings.simplefilter("ignore", UserWarning)
+        for model_class in _models():
+            model = model_class(scenario)
+            means.append(np.where(is_pga, np.log(model.pga), model.interp_ln_spec_accels(periods)))
+            variances.append(np.where(is_pga, model.ln_std_pga, model.interp_ln_stds(periods)) ** 2)
+    return np.mean(means, axis=0), np.sqrt(np.mean(variances, axis=0))
+
+
+def _check_periods(values: Sequence[float], field: str) -> np.ndarray:
+    """Periods (s) within :data:`PERIOD_RANGE`, or a one-line error naming ``field``."""
+    periods = np.atleast_1d(np.asarray(values, dtype=float))
+    low, high = PERIOD_RANGE
+    if periods.ndim != 1 or not periods.size:
+        raise SiteError(f"{field}: must be one or more periods in s, got {values!r}")
+    for period in periods:
+        if not low <= period <= high:
+            raise SiteError(f"{field}: periods must be within {low:g}-{high:g} s (the NGA-West2 models' range), got {period:g}")
+    return periods
+
+
+def conditional_distribution(
+    measure: str,
+    period: float | Sequence[float] | None,
+    level: float,
+    periods: Sequence[float],
+    magnitude: float,
+    distance_km: float,
+    vs30: float,
+    mechanism: str,
+) -> ConditionalDistribution:
+    """ln Sa (g) at ``periods`` given the measure = ``level`` (module docstring), after checking every input."""
+    if measure not in CONDITIONING_MEASURES:
+        raise SiteError(f"measure: must be one of {', '.join(CONDITIONING_MEASURES)} (no PGV–Sa correlation in the model), got {measure!r}")
+    if measure == "pga":
+        if period is not None:
+            raise SiteError(f"period: pga takes no period, got {period!r}")
+        conditioning: list[float | None] = [None]
+    elif measure == "psa":
+        if period is None or np.ndim(period) != 0:
+            raise SiteError(f"period: psa needs one period T* in s, got {period!r}")
+        conditioning = list(_check_periods([period], "period"))
+    else:
+        if period is None or np.ndim(period) != 1 or len(period) < 2:
+            raise SiteError(f"period: sa_avg needs a list of at least 2 periods in s, got {period!r}")
+        conditioning = list(_check_periods(period, "period"))
+    if not isinstance(level, (int, float)) or isinstance(level, bool) or not np.isfinite(level) or level <= 0:
+        raise SiteError(f"level: must be > 0 (g), got {level!r}")
+    output = _check_periods(periods, "periods")
+    if np.unique(output).size != output.size:
+        raise SiteError("periods: repeated period")
+    check_scenario(magnitude, distance_km, vs30, mechanism)
+    from pygmm.baker_jayaram_2008 import calc_correls
+
+    nodes: list[float | None] = list(output)
+    weights = np.zeros(len(nodes) + len(conditioning))
+    for node in conditioning:
+        index = next((i for i, known in enumerate(nodes) if known == node), None)
+        if index is None:
+            nodes.append(node)
+            index = len(nodes) - 1
+        weights[index] += 1.0 / len(conditioning)
+    weights = weights[: len(nodes)]
+    mean, sigma = _average_model(nodes, magnitude, distance_km, vs30, mechanism)
+    at = np.array([PGA_PERIOD if node is None else node for node in nodes])
+    correlation = np.array([calc_correls(at, t) for t in at])
+    covariance = correlation * np.outer(sigma, sigma)
+    cw = covariance @ weights
+    variance = float(weights @ cw)
+    epsilon = (np.log(level) - float(weights @ mean)) / np.sqrt(variance)
+    n = output.size
+    conditional_mean = (mean + cw * epsilon / np.sqrt(variance))[:n]
+    conditional_cov = (covariance - np.outer(cw, cw) / variance)[:n, :n]
+    return ConditionalDistribution(output, conditional_mean, conditional_cov, mean[:n], sigma[:n], float(epsilon))
+
+
+def conditional_spectrum(
+    measure: str,
+    period: float | Sequence[float] | None = None,
+    *,
+    level: float,
+    periods: Sequence[float],
+    magnitude: float,
+    distance_km: float,
+    vs30: float,
+    mechanism: str,
+    damping: float = MODEL_DAMPING,
+) -> xr.Dataset:
+    """The conditional spectrum: ln Sa given the measure at ``level``, for a scenario (module docstring).
+
+    Parameters
+    ----------
+    measure : {"pga", "psa", "sa_avg"}
+        The conditioning measure.
+    period : float or list of float, optional
+        T* (s) for ``psa``; the averaging periods (s) for ``sa_avg``; none for ``pga``.
+    level : float
+        The measure's value, g.
+    periods : list of float
+        Periods (s) of the spectrum, within 0.01–10 s.
+    magnitude, distance_km, vs30 : float
+        Moment magnitude, rupture distance (km), Vs30 (m/s) of the scenario
+        (the hazard's disaggregation at that level).
+    mechanism : {"strike_slip", "reverse", "normal"}
+        Faulting mechanism.
+    damping : float
+        0.05 only (the models' damping).
+
+    Returns
+    -------
+    xarray.Dataset
+        Over ``period`` (s): ``median`` (g) and ``sigma_ln`` of Sa given the
+        level; ``unconditional_median`` (g) and ``unconditional_sigma_ln`` of
+        the scenario; ``correlation`` (``period``, ``other_period``) of the
+        conditional ln Sa. Attributes: ``epsilon`` (ε* of the level),
+        ``measure``, the scenario and the models.
+
+    Raises
+    ------
+    SiteError
+        Naming the field: an unknown measure or mechanism, a period outside
+        0.01–10 s, a scenario outside the models' range, a damping other than 5 %.
+    """
+    if damping != MODEL_DAMPING:
+        raise SiteError(f"damping: the NGA-West2 models give 5 % damped spectra only (0.05), got {damping!r}")
+    target = conditional_distribution(measure, period, level, periods, magnitude, distance_km, vs30, mechanism)
+    sigma = np.sqrt(np.clip(np.diag(target.covariance), 0.0, None))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        correlation = np.where(np.outer(sigma, sigma) > 0, target.covariance / np.outer(sigma, sigma), 0.0)
+    np.fill_diagonal(correlation, 1.0)
+    coords = {"period": ("period", target.periods, {"units": "s"}), "other_period": ("other_period", target.periods, {"units": "s"})}
+    return xr.Dataset(
+        {
+            "median": ("period", np.exp(target.mean_ln), {"units": "g", "long_name": "median Sa given the level"}),
+            "sigma_ln": ("period", sigma, {"units": "1", "long_name": "standard deviation of ln Sa given the level"}),
+            "unconditional_median": ("period", np.exp(target.unconditional_mean_ln), {"units": "g", "long_name": "median Sa of the scenario"}),
+            "unconditional_sigma_ln": ("period", target.unconditional_sigma_ln, {"units": "1", "long_name": "standard deviation of ln Sa of the scenario"}),
+            "correlation": (("period", "other_period"), correlation, {"units": "1", "long_name": "correlation of ln Sa given the level"}),
+        },
+        coords=coords,
+        attrs={
+            "epsilon": target.epsilon,
+            "measure": measure,
+            "conditioning_period": "" if period is None else " ".join(f"{p:g}" for p in np.atleast_1d(period)),
+            "level": float(level),
+            "magnitude": float(magnitude),
+            "distance_km": float(distance_km),
+            "vs30": float(vs30),
+            "mechanism": mechanism,
+            "damping": MODEL_DAMPING,
+            "models": "ASK14 BSSA14 CB14 CY14 (pygmm), mean of ln medians, sigma = rms of sigmas; Baker-Jayaram 2008 correlation",
+        },
+    )

@@ -1,0 +1,240 @@
+"""Selection and scaling of recorded motions to a conditional spectrum (Jayaram, Lin & Baker 2011).
+
+For one stripe (the conditioning measure IM* at a level x, and the target
+of :func:`~stochpound.motions.conditional_spectrum` over a period range):
+
+1. every motion of the pool is scaled by s = x / IM*, its own measure
+   unscaled; only motions with s ≤ ``max_scale_factor`` are candidates;
+2. a set of ``motions`` target spectra is simulated from the conditional
+   multivariate normal of ln Sa (mean ln median, covariance
+   σ_i σ_j ρ_ij from the target's ``sigma_ln`` and ``correlation``);
+3. to each simulated spectrum, in turn, the nearest unused candidate (sum
+   over periods of the squared difference of ln Sa in units of the target's
+   σ);
+4. greedy swaps: each chosen motion in turn is replaced by the candidate
+   that most lowers the misfit Σ_T (d_m² + d_s²) + 100 Σ_T (d_m⁴ + d_s⁴),
+   d_m and d_s the differences of the set's mean and sample standard
+   deviation (n − 1) of ln Sa from the target's, until a full pass changes
+   nothing (the quartic term, as large as the quadratic one at a difference
+   of 0.1, holds the worst period down);
+5. steps 2–4 are repeated for 20 simulated sets and the set of least misfit kept.
+
+Everything random comes from ``numpy.random.default_rng(seed)``: the same
+pool, target and seed give the same selection.
+
+The period range covers the structure: :func:`selection_periods` spaces
+periods logarithmically from 0.2 times its shortest to 3 times its longest
+period of interest (each building's first-mode period and the isolated
+period), within the models' 0.01–10 s, the conditioning period added.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+import xarray as xr
+
+from stochpound._errors import SiteError
+from stochpound.motions._conditional import PERIOD_RANGE
+from stochpound.motions._measures import peak_ground_motion
+from stochpound.motions._spectrum import DEFAULT_G, response_spectrum
+
+#: Simulated sets of target spectra, each a start of the greedy selection.
+SIMULATED_SETS = 20
+#: Periods of a selection range, log-spaced.
+RANGE_PERIODS = 20
+#: The range of a selection: from this fraction of the shortest period of interest ...
+RANGE_LOW = 0.2
+#: ... to this multiple of the longest.
+RANGE_HIGH = 3.0
+#: Fault types of the FEMA P695 metadata as scenario mechanisms.
+FAULT_TYPES = {"Strike-slip": "strike_slip", "Thrust": "reverse", "Reverse": "reverse", "Reverse-Oblique": "reverse", "Normal": "normal"}
+#: Weight of the quartic term of the misfit.
+QUARTIC_WEIGHT = 100.0
+_MAX_PASSES = 50
+
+
+def selection_periods(structure_periods: Sequence[float], conditioning: Sequence[float] = (), count: int = RANGE_PERIODS) -> np.ndarray:
+    """Periods (s) of a selection: ``count`` log-spaced over 0.2 T_min – 3 T_max of ``structure_periods`` (within 0.01–10 s), ``conditioning`` added.
+
+    Parameters
+    ----------
+    structure_periods : list of float
+        The structure's periods of interest, s (first modes, the isolated period).
+    conditioning : list of float
+        The conditioning measure's period(s), s (none for PGA).
+    count : int
+        Periods in the range.
+    """
+    values = np.asarray(structure_periods, dtype=float)
+    if not values.size or not np.all(values > 0):
+        raise SiteError(f"structure_periods: must be one or more periods > 0 s, got {list(structure_periods)!r}")
+    low = max(PERIOD_RANGE[0], RANGE_LOW * float(values.min()))
+    high = min(PERIOD_RANGE[1], RANGE_HIGH * float(values.max()))
+    return np.unique(np.concatenate([np.geomspace(low, high, count), np.asarray(conditioning, dtype=float)]))
+
+
+def selection_pool(
+    records: Sequence,
+    periods: Sequence[float],
+    measure: str,
+    period: float | Sequence[float] | None = None,
+    damping: float = 0.05,
+    g: float = DEFAULT_G,
+) -> xr.Dataset:
+    """Unscaled spectra and conditioning measures of a pool of records.
+
+    Parameters
+    ----------
+    records : list of Record
+        The pool (:class:`~stochpound.motions.records.Record`, e.g. from
+        :func:`~stochpound.motions.records.load_suite`).
+    periods : list of float
+        Periods of the target, s.
+    measure : {"pga", "psa", "sa_avg"}
+        The conditioning measure; ``period`` its T* (psa) or averaging periods (sa_avg), s.
+    damping : float
+        Damping ratio of the spectra.
+    g : float
+        m/s², to convert records stored in g.
+
+    Returns
+    -------
+    xarray.Dataset
+        Over ``motion`` (the records' names): ``psa`` (``motion``, ``period``; g),
+        ``intensity`` (g), ``magnitude``, ``distance_km``, ``vs30`` (NaN where
+        unknown) and ``mechanism`` ("" where unknown).
+    """
+    psa, intensity = [], []
+    conditioning = [] if measure == "pga" else list(np.atleast_1d(np.asarray(period, dtype=float)))
+    grid = np.asarray(periods, dtype=float)
+    for record in records:
+        a = record.acceleration(g)
+        spectrum = response_spectrum(a, record.dt, np.concatenate([grid, conditioning]), damping).psa.values / g
+        psa.append(spectrum[: grid.size])
+        intensity.append(peak_ground_motion(a, record.dt)[0] / g if measure == "pga" else float(np.exp(np.mean(np.log(spectrum[grid.size :])))))
+    meta = [record.metadata or {} for record in records]
+    return xr.Dataset(
+        {
+            "psa": (("motion", "period"), np.array(psa), {"units": "g", "long_name": "pseudo-spectral acceleration of the unscaled motion"}),
+            "intensity": ("motion", np.array(intensity), {"units": "g", "long_name": f"the unscaled motion's {measure}"}),
+            "magnitude": ("motion", np.array([float(m.get("magnitude", np.nan)) for m in meta])),
+            "distance_km": ("motion", np.array([float(m.get("distance", np.nan)) for m in meta]), {"units": "km"}),
+            "vs30": ("motion", np.array([float(m.get("vs30", np.nan)) for m in meta]), {"units": "m/s"}),
+            "mechanism": ("motion", np.array([FAULT_TYPES.get(str(m.get("fault_type", "")), "") for m in meta], dtype=object)),
+        },
+        coords={"motion": [record.name for record in records], "period": ("period", grid, {"units": "s"})},
+        attrs={"damping": float(damping), "measure": measure},
+    )
+
+
+def select_motions(pool: xr.Dataset, target: xr.Dataset, motions: int, max_scale_factor: float, seed: int = 0) -> xr.Dataset:
+    """Choose and scale ``motions`` motions of ``pool`` to match ``target`` (module docstring).
+
+    Parameters
+    ----------
+    pool : xarray.Dataset
+        From :func:`selection_pool`, over the target's periods.
+    target : xarray.Dataset
+        From :func:`~stochpound.motions.conditional_spectrum`; its ``level`` is the stripe's.
+    motions : int
+        Motions to choose (≥ 2).
+    max_scale_factor : float
+        Largest scale factor allowed (≥ 1).
+    seed : int
+        Seed of the simulated target spectra.
+
+    Returns
+    -------
+    xarray.Dataset
+        Over ``selected``: ``motion`` (names), ``scale_factor``; over
+        ``period``: the set's ``mean_ln`` and ``std_ln`` (sample, n − 1) of
+        the scaled ln Sa, the target's ``median`` and ``sigma_ln``.
+
+    Raises
+    ------
+    SiteError
+        Naming the field: ``motions`` < 2 or more than the pool's motions within
+        ``max_scale_factor`` of the level, ``max_scale_factor`` < 1, periods
+        of pool and target that differ.
+    """
+    if isinstance(motions, bool) or not isinstance(motions, (int, np.integer)) or motions < 2:
+        raise SiteError(f"motions: must be an integer >= 2, got {motions!r}")
+    if isinstance(max_scale_factor, bool) or not isinstance(max_scale_factor, (int, float)) or not max_scale_factor >= 1.0:
+        raise SiteError(f"max_scale_factor: must be >= 1, got {max_scale_factor!r}")
+    if pool.period.size != target.period.size or not np.allclose(pool.period.values, target.period.values, rtol=1e-9):
+        raise SiteError("periods: the pool's spectra and the target are over different periods")
+    level = float(target.attrs["level"])
+    scale = level / pool["intensity"].values
+    eligible = np.flatnonzero(scale <= max_scale_factor * (1 + 1e-12))
+    if eligible.size < motions:
+        raise SiteError(
+            f"motions: only {eligible.size} of the pool's {scale.size} motions reach the level {level:g} g within max_scale_factor = "
+            f"{max_scale_factor:g}, fewer than motions = {motions} (add records or raise max_scale_factor)"
+        )
+    ln_sa = np.log(pool["psa"].values[eligible]) + np.log(scale[eligible])[:, None]
+    mean = np.log(target["median"].values)
+    sigma = target["sigma_ln"].values
+    covariance = target["correlation"].values * np.outer(sigma, sigma)
+    rng = np.random.default_rng(seed)
+    weights = 1.0 / np.where(sigma > 0, sigma, 1.0)
+    best: tuple[float, list[int]] | None = None
+    for _ in range(SIMULATED_SETS):
+        chosen: list[int] = []
+        for spectrum in rng.multivariate_normal(mean, covariance, size=motions, method="eigh"):
+            distance = np.sum(((ln_sa - spectrum) * weights) ** 2, axis=1)
+            distance[chosen] = np.inf
+            chosen.append(int(np.argmin(distance)))
+        chosen = _swap(ln_sa, chosen, mean, sigma)
+        misfit = _set_misfit(ln_sa[chosen], mean, sigma)
+        if best is None or misfit < best[0]:
+            best = (misfit, chosen)
+    chosen = best[1]
+    picked = eligible[chosen]
+    spectra = ln_sa[chosen]
+    return xr.Dataset(
+        {
+            "motion": ("selected", pool["motion"].values[picked]),
+            "scale_factor": ("selected", scale[picked], {"units": "1"}),
+            "mean_ln": ("period", spectra.mean(axis=0), {"units": "1", "long_name": "mean ln Sa (g) of the scaled set"}),
+            "std_ln": ("period", spectra.std(axis=0, ddof=1), {"units": "1", "long_name": "standard deviation of ln Sa of the scaled set"}),
+            "median": target["median"],
+            "sigma_ln": target["sigma_ln"],
+        },
+        coords={"period": target.period},
+        attrs={"level": level, "max_scale_factor": float(max_scale_factor), "seed": int(seed), "pool": int(scale.size), "candidates": int(eligible.size)},
+    )
+
+
+def _misfit(set_mean: np.ndarray, set_std: np.ndarray, mean: np.ndarray, sigma: np.ndarray) -> np.ndarray:
+    """Σ_T (d_m² + d_s²) + w Σ_T (d_m⁴ + d_s⁴) over the last axis (module docstring)."""
+    dm2, ds2 = (set_mean - mean) ** 2, (set_std - sigma) ** 2
+    return np.sum(dm2 + ds2, axis=-1) + QUARTIC_WEIGHT * np.sum(dm2 * dm2 + ds2 * ds2, axis=-1)
+
+
+def _set_misfit(spectra: np.ndarray, mean: np.ndarray, sigma: np.ndarray) -> float:
+    """:func:`_misfit` of a set of ln spectra (rows)."""
+    return float(_misfit(spectra.mean(axis=0), spectra.std(axis=0, ddof=1), mean, sigma))
+
+
+def _swap(ln_sa: np.ndarray, chosen: list[int], mean: np.ndarray, sigma: np.ndarray) -> list[int]:
+    """Greedy swaps of chosen rows of ``ln_sa`` for unused ones while the misfit falls (each slot in turn, best replacement)."""
+    chosen = list(chosen)
+    n = len(chosen)
+    best = _set_misfit(ln_sa[chosen], mean, sigma)
+    for _ in range(_MAX_PASSES):
+        improved = False
+        for slot in range(n):
+            others = ln_sa[[c for k, c in enumerate(chosen) if k != slot]]
+            total, squares = others.sum(axis=0), (others**2).sum(axis=0)
+            set_mean = (total + ln_sa) / n  # every row as the slot's motion
+            variance = np.clip((squares + ln_sa**2 - n * set_mean**2) / (n - 1), 0.0, None)
+            misfit = _misfit(set_mean, np.sqrt(variance), mean, sigma)
+            misfit[[c for k, c in enumerate(chosen) if k != slot]] = np.inf
+            row = int(np.argmin(misfit))
+            if misfit[row] < best - 1e-12:
+                chosen[slot], best, improved = row, float(misfit[row]), True
+        if not improved:
+            break
+    return chosen

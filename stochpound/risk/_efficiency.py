@@ -1,0 +1,149 @@
+"""Which intensity measure predicts the response best: efficiency and sufficiency from a store's contact-free runs.
+
+For every configuration (each combination of the store's grid axes other
+than the gaps and the intensity) and every candidate measure IM, the
+contact-free runs give pairs (IM, D), D the largest peak closure over the
+contacts or the studied building's peak base displacement, IM the measure
+of the motion as it ran (its unscaled measure times the run's scale
+factor). A straight line ln D = a + b ln IM is fitted by least squares over
+every run (every stripe and motion; for an IDA store, the one run per
+motion, whose response is homogeneous in the input); its residual standard
+deviation β (n − 2 degrees of freedom) is the measure's **efficiency**: the
+dispersion a fragility in that measure carries, and so how many motions an
+answer needs (about (β/ε)² for a relative precision ε of the median).
+**Sufficiency**: the residuals' linear trend (slope and its two-sided
+p-value) with ln(scale factor), the motions' magnitude and distance; a
+sufficient measure leaves none.
+
+The candidates: PGA, PGV, PSA at given periods (each building's first-mode
+period, the isolated period, the hazard's periods) and Sa_avg over 10
+log-spaced periods from 0.2 times the shortest to 3 times the longest
+structural period (within the stored spectrum's periods). PSA at a period comes from the spectrum every store keeps
+for every motion (5 % damping, at ``spectrum_period``), interpolated
+linearly in ln PSA against ln T (periods outside the stored range clipped
+to it; the store's own conditioning period is exact, its
+``motion_intensity``). The interpolation moves a motion's PSA by a few per
+cent between the stored periods, and β by about as much.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Mapping
+
+import numpy as np
+import xarray as xr
+from scipy.stats import linregress
+
+from stochpound.risk._store import base_displacement, contact_free, contact_free_closure, gap_dims, is_ida, store_motions
+
+#: Periods of Sa_avg, log-spaced over 0.2 T_min – 3 T_max of the structure.
+SA_AVG_PERIODS = 10
+
+
+def measure_efficiency(store: xr.Dataset, periods: Mapping[str, float], structure: Mapping[str, float] | None = None,
+                       studied: str | None = None) -> xr.Dataset:
+    """Efficiency (β) and sufficiency (residual trends) of candidate measures, per configuration (module docstring).
+
+    Parameters
+    ----------
+    store : xarray.Dataset
+        An experiment store with intensity stripes (contact-free cases) or IDA runs.
+    periods : mapping of str to float
+        Candidate PSA periods (s), by name (e.g. ``{"B1 first mode": 0.30, "hazard": 1.0}``).
+    structure : mapping of str to float, optional
+        The structure's periods (s) over which Sa_avg is taken; default ``periods``.
+    studied : str, optional
+        The building whose peak base displacement is the second response (where it slides).
+
+    Returns
+    -------
+    xarray.Dataset
+        Over ``response`` (``closure``, and ``base_displacement`` for a
+        sliding studied building), ``measure`` and the configurations:
+        ``beta``, ``slope`` (b), ``runs``, and for each of scale_factor,
+        magnitude and distance the residuals' ``trend_<x>`` (per unit of x)
+        and ``p_<x>``. ``measure`` carries ``measure_period`` (s; NaN for PGA, PGV, Sa_avg).
+    """
+    free = store.isel({d: 0 for d in gap_dims(store)}) if is_ida(store) else contact_free(store)
+    responses = {"closure": contact_free_closure(store)}
+    sliding = None if is_ida(store) else base_displacement(free, studied)
+    if sliding is not None:
+        responses["base_displacement"] = sliding
+    scale = store_motions(free["scale_factor"]).load()
+    spectrum_periods = free["spectrum_period"].values
+    psa = store_motions(free["motion_psa"]).load()
+    structural = np.array(list((structure or periods).values()), dtype=float)
+    low, high = max(0.2 * structural.min(), spectrum_periods[0]), min(3.0 * structural.max(), spectrum_periods[-1])
+    average = np.geomspace(low, high, SA_AVG_PERIODS)
+    candidates = {"PGA": store_motions(free["motion_pga"]).load(), "PGV": store_motions(free["motion_pgv"]).load()}
+    measure_periods = [np.nan, np.nan]
+    conditioning = _conditioning_period(store)
+    for name, period in periods.items():
+        if period == conditioning:  # the store's own measure, exact
+            candidates[f"PSA({period:.3g} s, {name})"] = store_motions(free["motion_intensity"]).load()
+        else:
+            candidates[f"PSA({period:.3g} s, {name})"] = _interpolated(psa, spectrum_periods, [period]).isel(period=0, drop=True)
+        measure_periods.append(float(period))
+    candidates[f"Sa_avg({average[0]:.3g}-{average[-1]:.3g} s)"] = np.exp(np.log(_interpolated(psa, spectrum_periods, average)).mean("period"))
+    measure_periods.append(np.nan)
+    covariates = {"scale_factor": np.log(scale)}
+    for key, coordinate in (("magnitude", "record_magnitude"), ("distance", "record_distance")):
+        if coordinate in free.coords:
+            covariates[key] = store_motions(free[coordinate]).broadcast_like(scale)
+    fits = {response: xr.concat([_fit(value, im * scale, covariates) for im in candidates.values()], "measure")
+            for response, value in responses.items()}
+    result = xr.concat(list(fits.values()), "response").assign_coords(response=list(fits), measure=list(candidates))
+    return result.assign_coords(measure_period=("measure", np.array(measure_periods)))
+
+
+def most_efficient(efficiency: xr.Dataset, measures: list[str], response: str = "closure") -> xr.DataArray:
+    """The name of the measure of least β among ``measures`` (names of ``efficiency.measure``), per configuration."""
+    beta = efficiency["beta"].sel(response=response, measure=measures).transpose(..., "measure")
+    index = np.argmin(np.nan_to_num(beta.values, nan=np.inf), axis=-1)
+    return xr.DataArray(np.asarray(measures, dtype=object)[index], dims=beta.dims[:-1], coords={d: beta[d] for d in beta.dims[:-1]})
+
+
+def _conditioning_period(store: xr.Dataset) -> float | None:
+    """T* (s) of a store conditioned on 5 %-damped PSA in g (its ``motion_intensity``), else None."""
+    intensity = json.loads(store.attrs.get("definition", "{}")).get("intensity") or {}
+    if intensity.get("measure") == "psa" and intensity.get("damping") == 0.05 and intensity.get("units") == "g":
+        return float(intensity["period"])
+    return None
+
+
+def _interpolated(psa: xr.DataArray, spectrum_periods: np.ndarray, periods: np.ndarray | list[float]) -> xr.DataArray:
+    """PSA at ``periods`` (s), linear in ln PSA against ln T between the stored periods (clipped to their range)."""
+    log_t = np.log(np.clip(np.asarray(periods, dtype=float), spectrum_periods[0], spectrum_periods[-1]))
+    log_psa = np.log(psa.transpose(..., "spectrum_period"))
+    values = np.apply_along_axis(lambda row: np.interp(log_t, np.log(spectrum_periods), row), -1, log_psa.values)
+    dims = log_psa.dims[:-1] + ("period",)
+    return xr.DataArray(np.exp(values), dims=dims, coords={k: v for k, v in log_psa.coords.items() if "spectrum_period" not in v.dims})
+
+
+def _fit(response: xr.DataArray, im: xr.DataArray, covariates: Mapping[str, xr.DataArray]) -> xr.Dataset:
+    """Least-squares ln D = a + b ln IM per configuration over the runs (the stripes and motions), with the residuals' trends."""
+    runs = [d for d in ("intensity", "record") if d in response.dims]
+    stacked = {name: value.broadcast_like(response).stack(_run=runs) for name, value in {"d": response, "im": im, **covariates}.items()}
+    configurations = [d for d in stacked["d"].dims if d != "_run"]
+    shape = [stacked["d"].sizes[d] for d in configurations]
+    names = ["beta", "slope", "runs"] + [f"{kind}_{key}" for key in covariates for kind in ("trend", "p")]
+    out = {name: np.full(shape, np.nan) for name in names}
+    for index in np.ndindex(*shape):
+        where = dict(zip(configurations, index))
+        d, x = (stacked[k].isel(where).values.astype(float) for k in ("d", "im"))
+        ok = np.isfinite(d) & (d > 0) & np.isfinite(x) & (x > 0)
+        out["runs"][index] = ok.sum()
+        if ok.sum() < 3:
+            continue
+        fit = linregress(np.log(x[ok]), np.log(d[ok]))
+        residual = np.log(d[ok]) - (fit.intercept + fit.slope * np.log(x[ok]))
+        out["beta"][index] = np.sqrt(np.sum(residual**2) / (ok.sum() - 2))
+        out["slope"][index] = fit.slope
+        for key in covariates:
+            c = stacked[key].isel(where).values.astype(float)[ok]
+            if np.all(np.isfinite(c)) and np.ptp(c) > 1e-12 * max(1.0, np.max(np.abs(c))):
+                trend = linregress(c, residual)
+                out[f"trend_{key}"][index], out[f"p_{key}"][index] = trend.slope, trend.pvalue
+    coords = {d: stacked["d"][d] for d in configurations}
+    return xr.Dataset({name: (configurations, value) for name, value in out.items()}, coords=coords)

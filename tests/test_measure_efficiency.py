@@ -1,0 +1,77 @@
+"""measure_efficiency: β and residual trends of candidate measures, checked against a direct computation on an IDA store."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.stats import linregress
+
+from stochpound import open_store
+from stochpound.risk import measure_efficiency, most_efficient
+from tests.helpers import FIXED, risk_text, run_in_process
+
+
+@pytest.fixture(scope="module")
+def fixed_stores(tmp_path_factory):
+    """The fixed-base pair of the flagship: stripes (contact-free) and IDA, the same eight motions."""
+    folder = tmp_path_factory.mktemp("fixed")
+    levels = "levels = [0.1, 0.2, 0.4, 0.8, 1.6]"
+    stripes = run_in_process(folder, "stripes", risk_text(FIXED, "gap = [inf]", f'measure = "psa"\nperiod = 1.0\n{levels}'))
+    ida = run_in_process(folder, "ida", risk_text(FIXED, "gap = [0.01, 0.02]", f'measure = "psa"\nperiod = 1.0\n{levels}\nmethod = "ida"', hazard=""))
+    return stripes, ida
+
+
+def _direct_beta(im: np.ndarray, closure: np.ndarray) -> tuple[float, float]:
+    fit = linregress(np.log(im), np.log(closure))
+    residual = np.log(closure) - fit.intercept - fit.slope * np.log(im)
+    return float(np.sqrt(np.sum(residual**2) / (len(im) - 2))), float(fit.slope)
+
+
+def test_ida_efficiency_is_the_regression_of_the_one_run_per_motion(fixed_stores) -> None:
+    ida = open_store(fixed_stores[1]).load()
+    stored = float(ida["spectrum_period"].values[12])
+    result = measure_efficiency(ida, {"stored": stored, "one second": 1.0})
+    runs = ida.isel(gap=0, realization=0)
+    closure = runs["peak_contact_closure"].max("contact").values
+    for name, im in (("PGA", runs["motion_pga"].values), ("PGV", runs["motion_pgv"].values),
+                     (f"PSA({stored:.3g} s, stored)", runs["motion_psa"].isel(spectrum_period=12).values)):
+        beta, slope = _direct_beta(im, closure)
+        assert float(result["beta"].sel(response="closure", measure=name)) == pytest.approx(beta, rel=1e-10)
+        assert float(result["slope"].sel(response="closure", measure=name)) == pytest.approx(slope, rel=1e-10)
+    assert np.all(result["runs"].values == len(closure))
+    assert np.all(np.isnan(result["trend_scale_factor"].values))  # IDA: every run at scale 1
+    p = result["p_magnitude"].values
+    assert np.all((p >= 0) & (p <= 1))
+    best = most_efficient(result, ["PGA", "PGV"])
+    assert best.item() == ("PGA" if result["beta"].sel(response="closure", measure="PGA") < result["beta"].sel(response="closure", measure="PGV") else "PGV")
+
+
+def test_stripes_of_a_homogeneous_scene_give_the_conditioning_measure_a_zero_spread_per_stripe(fixed_stores) -> None:
+    """Fixed bases: closure = level × D_i / IM_i, so pooled over the stripes β(PSA(1 s)) is the spread of ln(D_i / IM_i)."""
+    stripes = open_store(fixed_stores[0]).load()
+    result = measure_efficiency(stripes, {"one second": 1.0})
+    free = stripes.sel(gap=np.inf).isel(realization=0)
+    ratio = np.log(free["peak_contact_closure"].max("contact").isel(intensity=0) / stripes["intensity"].values[0]).values  # ln(D_i / IM_i) + const
+    name = "PSA(1 s, one second)"
+    beta = float(result["beta"].sel(response="closure", measure=name))
+    n = ratio.size * stripes.sizes["intensity"]
+    assert beta == pytest.approx(np.std(ratio, ddof=0) * np.sqrt(n / (n - 2)), rel=1e-9)  # the store's own measure: exact
+    assert float(result["slope"].sel(response="closure", measure=name)) == pytest.approx(1.0, rel=1e-9)
+
+
+def test_risk_cli_names_the_most_efficient_measure_the_sites_hazard_has(fixed_stores) -> None:
+    from click.testing import CliRunner
+
+    from stochpound.cli import main
+    from stochpound.cli._measure_choice import hazard_measures
+
+    store = open_store(fixed_stores[0]).load()
+    available = hazard_measures(store, "fox_plaza_los_angeles_sa1p0s")
+    assert available == {"PGA": None, "PSA(1 s)": 1.0, "PSA(2 s)": 2.0, "PSA(3 s)": 3.0}
+    result = CliRunner().invoke(main, ["risk", str(fixed_stores[0]), "--hazard", "fox_plaza_los_angeles_sa1p0s", "--bootstrap", "0"])
+    assert result.exit_code == 0, result.output
+    efficiency = measure_efficiency(store, {f"hazard {k}": v for k, v in available.items() if v is not None})
+    names = ["PGA"] + [f"PSA({v:.3g} s, hazard {k})" for k, v in available.items() if v is not None]
+    best = most_efficient(efficiency, names).item()
+    label = "PGA" if best == "PGA" else best.split(", hazard ")[1].rstrip(")") + ")"
+    assert f"most efficient the site's hazard has: {label} (" in result.output
