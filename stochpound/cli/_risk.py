@@ -81,7 +81,7 @@ def risk(store: Path, hazard: str | None, hazard_measure: str | None, hazard_uni
             click.echo(f"note: hazard {line.removeprefix('stochpound: ')}")
     if hz.extrapolated:
         click.echo(f"note: the hazard table [{hz.im[0]:g}, {hz.im[-1]:g}] {hz.units} was extrapolated beyond its intensities as power laws (--extrapolate)")
-    interval = "95 % BCa bootstrap interval over the motions" if bootstrap else "no bootstrap"
+    interval = f"95 % interval, {result.separation['lower'].attrs.get('method', 'BCa bootstrap')}" if bootstrap else "no bootstrap"
     separation = result.separation_frame()
     click.echo(f"\nRisk-targeted separation g* (m; {interval}; inf: wider than every gap of the grid):")
     click.echo(separation.to_string(float_format=lambda v: f"{v:.3f}"))

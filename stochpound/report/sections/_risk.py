@@ -80,12 +80,18 @@ def headline_text(name: str, risk: StoreRisk) -> str:
     return (
         f"Risk-targeted separation g* (the gap whose mean annual frequency of pounding is that of {targets}, Poisson) of experiment "
         f"{name}, from {risk.motions} motions ({stripes}{risk.measure} in {risk.setting['units']}) at the site of its hazard curve, "
-        f"with {_percent(risk.confidence)} BCa bootstrap intervals over the motions: " + ". ".join(per) + "."
+        f"with {_percent(risk.confidence)} intervals ({_resampling(risk)}): " + ". ".join(per) + "."
     )
 
 
 def _gap_text(value: float) -> str:
     return "wider than every gap of the grid" if math.isinf(value) else f"{value:.3f} m"
+
+
+def _resampling(risk: StoreRisk) -> str:
+    """How the intervals resampled the motions, as the chain's results say (by motion, or by event where the store knows them)."""
+    lower = risk.separation["lower"] if "lower" in risk.separation else None
+    return (lower.attrs.get("method") if lower is not None else None) or "BCa bootstrap over motions"
 
 
 def summary_answer(name: str, risk: StoreRisk) -> list[Block]:
