@@ -30,6 +30,15 @@ from stochpound.analysis._consistency import hazard_consistency
 from stochpound.analysis._hazard import HazardCurve, bundled_curves, probability_from_rate, rate_from_probability, return_period
 from stochpound.analysis._hazard_files import HazardFile, read_hazard_file
 
+# For the other packages of stochpound (their interface to this one, not public API: not in __all__).
+from stochpound.analysis._bootstrap import bootstrap_method, bootstrap_weights, interval, jackknife_weights, record_clusters  # noqa: F401
+from stochpound.analysis._hazard import bundled_measure, bundled_path  # noqa: F401
+from stochpound.analysis._hazard_files import parse_measure, parse_units, unit_factor  # noqa: F401
+from stochpound.analysis._impacts import TABLE_COLUMNS  # noqa: F401
+from stochpound.analysis._intervals import MIN_RUNS  # noqa: F401
+from stochpound.analysis._separation_rules import EC8_REDUCTION, STORE_NAMES  # noqa: F401
+from stochpound.analysis._summary import response_moments, top_floor_total_displacement  # noqa: F401
+
 
 def __getattr__(name: str) -> object:
     """A risk chain's name, from :mod:`stochpound.risk` (imported on first use)."""

@@ -16,7 +16,7 @@ def hazard_measures(store: Any, hazard: str | None) -> dict[str, float | None]:
     every bundled curve of the same site; otherwise the store's own measure.
     """
     from stochpound.analysis import bundled_curves
-    from stochpound.analysis._hazard import bundled_measure
+    from stochpound.analysis import bundled_measure
 
     definition = json.loads(store.attrs.get("definition", "{}"))
     name = hazard if hazard in bundled_curves() else (definition.get("hazard") or {}).get("bundled")
@@ -33,7 +33,7 @@ def efficient_measure_lines(store: Any, hazard: str | None) -> list[str]:
     """Lines naming, per configuration, the measure of least β of ln(closure) among those the site's hazard has, and among all candidates."""
     from stochpound.risk import measure_efficiency
     from stochpound.experiment import Experiment
-    from stochpound.experiment._site import periods_of_interest
+    from stochpound.experiment import periods_of_interest
 
     structure = periods_of_interest(Experiment(json.loads(store.attrs["definition"])))
     available = hazard_measures(store, hazard)

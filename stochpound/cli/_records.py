@@ -8,7 +8,7 @@ import click
 
 from stochpound.cli._group import HelpGroup
 from stochpound._errors import RecordError
-from stochpound.motions._spectrum import DEFAULT_G
+from stochpound.motions import DEFAULT_G
 
 
 @click.group("records", cls=HelpGroup)

@@ -21,10 +21,10 @@ import numpy as np
 import xarray as xr
 
 from stochpound.analysis import store_contact_demands
-from stochpound.analysis._hazard import HazardCurve
-from stochpound.analysis._hazard_files import parse_measure, parse_units
-from stochpound.experiment._hazard import check_covers, hazard_curve, hazard_option, stored_hazard
-from stochpound.motions._spectrum import DEFAULT_G
+from stochpound.analysis import HazardCurve
+from stochpound.analysis import parse_measure, parse_units
+from stochpound.experiment import check_covers, hazard_curve, hazard_option, stored_hazard
+from stochpound.motions import DEFAULT_G
 from stochpound.store import contact_free, describe_measure, gap_dims, has_contact_free, wall_free
 
 CLOSURE = "peak_contact_closure"

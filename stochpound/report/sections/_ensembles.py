@@ -23,7 +23,7 @@ import pandas as pd
 import xarray as xr
 
 from stochpound.analysis import ensemble_statistics, mean_interval, of_first, pounding_probability
-from stochpound.analysis._intervals import MIN_RUNS
+from stochpound.analysis import MIN_RUNS
 from stochpound.report.render import figures
 from stochpound.report.render import Block, FigureItem, Table
 from stochpound.experiment import is_gap_axis

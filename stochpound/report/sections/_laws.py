@@ -28,7 +28,7 @@ import numpy as np
 import xarray as xr
 
 from stochpound.analysis import mean_interval, pounding_probability
-from stochpound.analysis._intervals import MIN_RUNS
+from stochpound.analysis import MIN_RUNS
 from stochpound.experiment import is_gap_axis
 from stochpound.model import laws
 from stochpound.report.render import figures
