@@ -179,8 +179,7 @@ def _environment() -> dict[str, str]:
 
 def _done(store: Path) -> int:
     """Finished cases in a store's parts."""
-    from stochpound.experiment import Experiment
-    from stochpound.experiment import PartsIndex, parts_folder, read_experiment_json
+    from stochpound.experiment import Experiment, PartsIndex, parts_folder, read_experiment_json
 
     folder = parts_folder(store)
     try:

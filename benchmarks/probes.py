@@ -118,9 +118,7 @@ def single_cell(path: str, runs: int) -> None:
 
     import stochpound
     from stochpound import motions as generators
-    from stochpound.experiment import load_experiment
-    from stochpound.experiment import CASE
-    from stochpound.experiment import resolve_motions
+    from stochpound.experiment import CASE, load_experiment, resolve_motions
     from stochpound.motions.ground import SampledMotion
 
     batch = 64

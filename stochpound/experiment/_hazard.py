@@ -42,8 +42,7 @@ from typing import Any, Mapping, Sequence
 
 import xarray as xr
 
-from stochpound.analysis import HazardCurve, bundled_curves, bundled_measure, bundled_path
-from stochpound.analysis import parse_units, read_hazard_file, unit_factor
+from stochpound.analysis import HazardCurve, bundled_curves, bundled_measure, bundled_path, parse_units, read_hazard_file, unit_factor
 from stochpound.experiment._intensity import MEASURES, IntensityError
 from stochpound.store import describe_measure
 from stochpound.model import fields as toml_fields

@@ -228,8 +228,7 @@ def stripe_selections(experiment: Experiment) -> StripeSelections:
     from stochpound.experiment._grid import CASE
     from stochpound.model.scene_file import scene_from_dict
     from stochpound.motions import conditional_spectrum, select_motions, selection_periods, selection_pool
-    from stochpound.motions.records import Record
-    from stochpound.motions.records import is_suite_member, load_suite_member
+    from stochpound.motions.records import Record, is_suite_member, load_suite_member
 
     intensity = experiment.intensity
     scene = experiment.structure(experiment.points(CASE)[0])

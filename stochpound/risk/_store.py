@@ -20,9 +20,7 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from stochpound.analysis import store_contact_demands
-from stochpound.analysis import HazardCurve
-from stochpound.analysis import parse_measure, parse_units
+from stochpound.analysis import HazardCurve, parse_measure, parse_units, store_contact_demands
 from stochpound.experiment import check_covers, hazard_curve, hazard_option, stored_hazard
 from stochpound.motions import DEFAULT_G
 from stochpound.store import contact_free, describe_measure, gap_dims, has_contact_free, wall_free
