@@ -40,9 +40,34 @@ from stochpound.analysis._separation_rules import EC8_REDUCTION, STORE_NAMES  # 
 from stochpound.analysis._summary import response_moments, top_floor_total_displacement  # noqa: F401
 
 
+RISK_NAMES = (
+    "Fragility",
+    "fit_fragility",
+    "fragility_band",
+    "fragility_surface",
+    "homogeneous_capacities",
+    "ida_fragility",
+    "limit_state_events",
+    "stripe_fragility",
+    "demand_hazard_curve",
+    "mean_annual_frequency",
+    "risk_curve",
+    "risk_targeted_separation",
+    "code_rules_risk",
+    "contact_free_closure",
+    "pounding_fragility",
+    "risk_gaps",
+    "store_risk",
+    "StoreRisk",
+)
+"""The risk chain's names this namespace exported before :mod:`stochpound.risk` existed (one list: the risk package exports them
+too). Aliases of that package's (the canonical names), resolved when first used, so that importing the statistics does not import
+the risk chain (which sits above them)."""
+
+
 def __getattr__(name: str) -> object:
     """A risk chain's name, from :mod:`stochpound.risk` (imported on first use)."""
-    if name in _ALIASES:
+    if name in RISK_NAMES:
         import stochpound.risk
 
         return getattr(stochpound.risk, name)
@@ -72,14 +97,6 @@ __all__ = [
     "store_contact_demands",
     "fixed_base_cqc",
     "run_summary",
-    "Fragility",
-    "fit_fragility",
-    "fragility_band",
-    "fragility_surface",
-    "homogeneous_capacities",
-    "ida_fragility",
-    "limit_state_events",
-    "stripe_fragility",
     "HazardCurve",
     "HazardFile",
     "read_hazard_file",
@@ -87,19 +104,6 @@ __all__ = [
     "probability_from_rate",
     "rate_from_probability",
     "return_period",
-    "demand_hazard_curve",
-    "mean_annual_frequency",
-    "risk_curve",
-    "risk_targeted_separation",
-    "code_rules_risk",
-    "contact_free_closure",
-    "pounding_fragility",
     "hazard_consistency",
-    "risk_gaps",
-    "store_risk",
-    "StoreRisk",
+    *RISK_NAMES,
 ]
-_ALIASES = frozenset(__all__) - set(globals())
-"""The names ``__all__`` gives that this module does not define: the risk chain's, which it exported before :mod:`stochpound.risk`
-existed. They are aliases of that package's (the canonical names), resolved when first used, so that importing the statistics
-does not import the risk chain (which sits above them)."""
