@@ -219,3 +219,10 @@ def test_tests_import_no_test_module_and_benchmarks_no_test():
                 found.append(f"{path.name} imports {module}")
     assert not found
 
+
+
+def test_the_command_line_imports_no_report_section():
+    """``stochpound risk`` prints the risk chain's own tables: the CLI reads no report section (and, above, no private module)."""
+    found = {path.name: sorted(module for module in imports(path.read_text()) if module.startswith("stochpound.report.sections"))
+             for path in sorted((ROOT / "stochpound" / "cli").glob("*.py"))}
+    assert {name: modules for name, modules in found.items() if modules} == {}
