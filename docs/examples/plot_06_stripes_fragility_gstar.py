@@ -12,7 +12,7 @@ contact-free runs (the gap identity, docs/separation.md):
 1. **stripes**: the experiment's runs, one per motion and stripe;
 2. **fragility**: P(pounding | IM) at every gap of a grid, a lognormal
    fitted to the stripes' counts;
-3. **g***: the gap at which pounding is as rare as the target (10 % and 2 %
+3. **the risk-targeted gap** ``g*``: the gap at which pounding is as rare as the target (10 % and 2 %
    in 50 years), from the fragility and the site's hazard.
 
 Eight motions and four stripes keep this page fast; the flagship
@@ -57,18 +57,18 @@ closure = contact_free_closure(ds)
 print((100 * closure).squeeze(drop=True).round(2).to_pandas())
 
 # %%
-# **2 and 3. Fragility, risk and g*.** ``store_risk`` fits the fragility at
+# **2 and 3. Fragility, risk and the risk-targeted gap.** ``store_risk`` fits the fragility at
 # every gap of a grid over the closures, integrates it with the stored
 # hazard curve into the mean annual frequency of pounding λ_P(g), and reads
-# g* off it, with bootstrap intervals over the motions. With eight motions
-# the intervals are wide: g* is driven by the intensities above the
+# ``g*`` off it, with bootstrap intervals over the motions. With eight motions
+# the intervals are wide: ``g*`` is driven by the intensities above the
 # stripes, where the fitted lognormal extrapolates.
 risk = store_risk(ds, bootstrap=200)
 print(risk.to_frame())
 
 # %%
 # The fragility at three gaps, with the stripes' observed fractions, and
-# the risk curve with the targets' g*.
+# the risk curve with the targets' ``g*``.
 fig, (left, right) = plt.subplots(1, 2, figsize=(9, 3.6))
 im = np.linspace(0.01, 1.5, 200)
 gaps = risk.fragility["gap"].values
