@@ -11,8 +11,7 @@ import click
 
 from stochpound.cli._group import HelpGroup
 from stochpound._errors import StochpoundError, os_error_message
-from stochpound.experiment._estimate import LARGE_RUN_BYTES, LARGE_RUN_CASES
-from stochpound.experiment._parts import parts_folder
+from stochpound.experiment import LARGE_RUN_BYTES, LARGE_RUN_CASES, parts_folder
 from stochpound._memory import format_bytes
 
 if TYPE_CHECKING:
@@ -131,8 +130,7 @@ def _has_hazard(store: Path) -> bool:
 @click.argument("experiment_file", type=click.Path(dir_okay=False))
 def check_command(experiment_file: str) -> None:
     """Validate EXPERIMENT_FILE and list its dimensions (runs nothing)."""
-    from stochpound.experiment import load_experiment
-    from stochpound.experiment._sources import resolve_motions
+    from stochpound.experiment import load_experiment, resolve_motions
 
     try:
         loaded = load_experiment(experiment_file)

@@ -37,7 +37,7 @@ from stochpound.experiment import _intensity as intensity
 from stochpound.experiment._grid import CASE, REFERENCE, Dim, Experiment
 from stochpound.experiment._summary import DEMAND_SUMMARIES
 from stochpound.model.scene_file import scene_from_dict
-from stochpound.motions.records._suites import METADATA_FIELDS
+from stochpound.motions.records import METADATA_FIELDS
 from stochpound.results.dataset import scene_parameters
 
 #: Version of the store layout.
@@ -269,7 +269,7 @@ def _scene_coordinates(experiment: Experiment) -> dict[str, xr.Variable]:
 
 def _suite_coordinates(experiment: Experiment) -> dict[str, xr.Variable]:
     """Metadata of the motions from suites on ``record`` (event, station, component, magnitude, distance...; none without such motions)."""
-    from stochpound.motions.records._suites import is_suite_member, load_suite_member
+    from stochpound.motions.records import is_suite_member, load_suite_member
 
     rows: list[Mapping[str, Any]] = []
     for source in experiment.motions.values():

@@ -32,8 +32,7 @@ import xarray as xr
 
 from stochpound.analysis import kernels, peak_response
 from stochpound.analysis.names import RESPONSE_MOMENTS, without_aliases
-from stochpound.analysis._separation_rules import STORE_NAMES, contact_demands
-from stochpound.analysis._summary import response_moments, run_summary, top_floor_total_displacement
+from stochpound.analysis import STORE_NAMES, contact_demands, response_moments, run_summary, top_floor_total_displacement
 from stochpound.store import CATALOGUE, IMPACT_TABLE, WALL_SUMMARIES
 
 _MOMENTS = tuple(RESPONSE_MOMENTS.values())

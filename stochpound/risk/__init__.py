@@ -22,7 +22,7 @@ This package is the canonical home of these names; the ones that
 there as aliases.
 """
 
-from stochpound.analysis._hazard import HazardCurve, bundled_curves, probability_from_rate, rate_from_probability, return_period
+from stochpound.analysis import HazardCurve, bundled_curves, probability_from_rate, rate_from_probability, return_period
 from stochpound.risk._fragility import Fragility, fit_fragility
 from stochpound.risk._fragility_ensemble import (
     BOOTSTRAP,
@@ -48,7 +48,7 @@ from stochpound.risk._store import RiskInputError, contact_free_closure, has_ris
 from stochpound.risk._store_risk import StoreRisk, pounding_fragility, risk_gaps, store_risk
 from stochpound.risk._demands import StoreDemands, store_demands
 from stochpound.risk._efficiency import measure_efficiency, most_efficient
-from stochpound.analysis._consistency import hazard_consistency
+from stochpound.analysis import hazard_consistency
 
 __all__ = [
     "Fragility",

@@ -20,11 +20,9 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from stochpound.analysis import store_contact_demands
-from stochpound.analysis._hazard import HazardCurve
-from stochpound.analysis._hazard_files import parse_measure, parse_units
-from stochpound.experiment._hazard import check_covers, hazard_curve, hazard_option, stored_hazard
-from stochpound.motions._spectrum import DEFAULT_G
+from stochpound.analysis import HazardCurve, parse_measure, parse_units, store_contact_demands
+from stochpound.experiment import check_covers, hazard_curve, hazard_option, stored_hazard
+from stochpound.motions import DEFAULT_G
 from stochpound.store import contact_free, describe_measure, gap_dims, has_contact_free, wall_free
 
 CLOSURE = "peak_contact_closure"
@@ -244,3 +242,37 @@ def moat_clearances(store: xr.Dataset, studied: str | None) -> list[float]:
             walls += [(w, (w["gap"],)) for w in override.get("scene", {}).get("wall", []) or []]
     return sorted({float(gap) for w, gaps in walls for gap in gaps
                    if w.get("building") == studied and w.get("level", 0) == 0 and math.isfinite(float(gap))})
+
+
+def efficiency_runs(store: xr.Dataset, studied: str | None) -> dict[str, Any]:
+    """What measure efficiency reads of a stripes (contact-free cases) or IDA store, every motion on one dimension ``record``.
+
+    Returns
+    -------
+    dict
+        ``responses`` (``closure``: peak closure, m; ``base_displacement`` of a
+        sliding ``studied`` building, m, stripes only), ``scale_factor``,
+        ``psa`` (over ``spectrum_period``, at scale 1, in g), ``spectrum_periods`` (s),
+        ``pga`` and ``pgv`` (at scale 1), ``intensity`` (the store's own
+        measure at scale 1) and ``conditioning`` (its period T* in s when it is
+        5 %-damped PSA in g, else None), ``covariates`` (``record_magnitude`` and
+        ``record_distance`` where the store has them).
+    """
+    free = store.isel({d: 0 for d in gap_dims(store)}) if is_ida(store) else contact_free(store)
+    responses = {"closure": contact_free_closure(store)}
+    sliding = None if is_ida(store) else base_displacement(free, studied)
+    if sliding is not None:
+        responses["base_displacement"] = sliding
+    setting = intensity_setting(store) or {}
+    psa_in_g = setting.get("measure") == "psa" and setting.get("damping") == 0.05 and setting.get("units") == "g"
+    return {
+        "responses": responses,
+        "scale_factor": store_motions(free["scale_factor"]).load(),
+        "psa": store_motions(free["motion_psa"]).load(),
+        "spectrum_periods": free["spectrum_period"].values,
+        "pga": store_motions(free["motion_pga"]).load(),
+        "pgv": store_motions(free["motion_pgv"]).load(),
+        "intensity": store_motions(free["motion_intensity"]).load(),
+        "conditioning": float(setting["period"]) if psa_in_g else None,
+        "covariates": {name: store_motions(free[name]) for name in ("record_magnitude", "record_distance") if name in free.coords},
+    }

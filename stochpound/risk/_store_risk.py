@@ -32,7 +32,7 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
-from stochpound.analysis._hazard import HazardCurve, rate_from_probability
+from stochpound.analysis import HazardCurve, rate_from_probability
 from stochpound.risk import _store
 from stochpound.risk._code_rules import MINIMUM_MOTIONS, code_rules_risk
 from stochpound.risk._fragility_ensemble import BOOTSTRAP, fragility_band, fragility_surface, homogeneous_capacities, ida_fragility, limit_state_events, stripe_fragility

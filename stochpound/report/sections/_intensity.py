@@ -25,7 +25,7 @@ import xarray as xr
 from matplotlib.figure import Figure
 
 from stochpound.analysis.kernels import clopper_pearson
-from stochpound.experiment._intensity import describe_measure
+from stochpound.experiment import describe_measure
 from stochpound.report.render import FigureItem, Paragraph, Section, Table
 from stochpound.experiment import is_gap_axis
 
