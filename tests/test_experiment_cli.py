@@ -346,6 +346,51 @@ def test_a_full_disk_is_found_before_the_store_is_written(stationary, tmp_path, 
     assert f"{store}: cannot write here (No space left on device: 0.0 MB free, about " in result.stderr and result.exit_code == 0
 
 
+@pytest.fixture
+def small_disk(tmp_path):
+    """A real 4 MB file system (tmpfs) at tmp_path/disk: a full disk as HDF5 meets it (it crashed status with a segfault)."""
+    disk = tmp_path / "disk"
+    disk.mkdir()
+    if subprocess.run(["mount", "-t", "tmpfs", "-o", "size=4m", "tmpfs", str(disk)], capture_output=True).returncode != 0:
+        pytest.skip("mounting a small tmpfs needs root (the monkeypatched tests above cover the messages)")
+    try:
+        yield disk
+    finally:
+        subprocess.run(["umount", str(disk)], check=True)
+
+
+def _fill(disk, leave: int) -> None:
+    """Fill ``disk`` but ``leave`` bytes."""
+    (disk / "filler").write_bytes(b"\0" * max(0, shutil.disk_usage(disk).free - leave))
+
+
+def _stochpound(*args: str, cwd) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "stochpound", *args], capture_output=True, text=True, cwd=cwd, timeout=600,
+                          env={**os.environ, "PYTHONPATH": str(REPO)})
+
+
+def test_a_really_full_disk_crashes_nothing_and_loses_nothing(stationary, small_disk):
+    """status and run on a full tmpfs: exit 0 or 1 (not a segfault's 139), one line naming the store; the parts rebuild it later."""
+    shutil.copytree(stationary, small_disk / "copy")
+    store = small_disk / "copy" / "still.nc"
+    store.unlink()  # status must write it anew from the parts
+    _fill(small_disk, 200_000)  # less than the store needs (about 0.3 MB)
+    result = _stochpound("experiment", "status", str(store), cwd=small_disk)
+    assert result.returncode == 0, (result.returncode, result.stderr[-2000:])
+    assert re.fullmatch(rf"store not rebuilt \(its finished cases are kept in its parts\): {store}: cannot write here "
+                        r"\(No space left on device: 0\.\d MB free, about \d+\.\d MB needed\)\n", result.stderr), result.stderr[-2000:]
+    assert not store.exists() and not list(store.parent.glob(".still.nc.*"))
+    experiment = write_experiment(small_disk, TINY_EXPERIMENT, "tiny.toml")
+    result = _stochpound("experiment", "run", str(experiment), "--workers", "0", cwd=small_disk)
+    assert result.returncode == 1, (result.returncode, result.stderr[-2000:])
+    last = result.stderr.splitlines()[-1]
+    assert re.fullmatch(rf"Error: {small_disk / 'tiny.nc'}: cannot write here \(No space left on device.*\)", last), result.stderr[-2000:]
+    (small_disk / "filler").unlink()
+    assert _stochpound("experiment", "status", str(store), cwd=small_disk).returncode == 0 and open_store(store).attrs["complete"] == 1
+    result = _stochpound("experiment", "run", str(experiment), "--workers", "0", "--quiet", cwd=small_disk)
+    assert result.returncode == 0 and open_store(small_disk / "tiny.nc").attrs["complete"] == 1, result.stderr[-2000:]
+
+
 def test_a_full_disk_during_a_run_is_one_line_naming_the_store_and_loses_nothing(tmp_path, monkeypatch):
     from stochpound.experiment import _store_writer
 

@@ -14,8 +14,10 @@ from typing import Mapping
 from stochpound.experiment._grid import KINDS, Experiment, Point
 from stochpound.experiment._spec import AUTO
 from stochpound.experiment._store import layout
+from stochpound.experiment._store_writer import file_bytes
 from stochpound._memory import format_bytes
 from stochpound.model.scene_file import scene_from_dict
+from stochpound.store import canonical_json
 
 LARGE_RUN_CASES = 1_000_000
 """Above this many cases to run, ``experiment run`` asks for ``--yes``."""
@@ -27,8 +29,6 @@ solver's is measured on a whole experiment, not on the engine alone: the earlier
 cases of 1001 samples in 8.1 min on 2 cores, 12 ms of CPU a case with its summaries, parts and fixed-base twin (the
 engine alone takes 0.09–0.2 ms per second of motion, docs/benchmarks.md). The ivp solver's is a rough order of
 magnitude (0.1 s of CPU per second of motion at 0.02 s)."""
-_ID_BYTES = 24
-"""Bytes per case id in the file (16 characters and the variable-length string's overhead)."""
 
 
 @dataclass(frozen=True)
@@ -42,13 +42,16 @@ class RunEstimate:
     cpu_seconds : float
         Their CPU time (one core), s.
     store_bytes : int
-        Size of the complete store file without its impact table (time histories uncompressed), bytes;
-        the parts folder holds about as much again.
+        Size of the complete store file without its impact table (:func:`~stochpound.experiment._store_writer.file_bytes`:
+        measured on its metadata written in memory, time histories uncompressed), bytes; the parts folder holds about as much again.
+    history_bytes : int
+        The time histories' part of ``store_bytes``, uncompressed (the file holds them compressed: usually less), bytes.
     """
 
     cases: int
     cpu_seconds: float
     store_bytes: int
+    history_bytes: int = 0
 
     @property
     def large(self) -> bool:
@@ -58,9 +61,12 @@ class RunEstimate:
     def describe(self, cores: int) -> str:
         """``1,000 cases to run: roughly 2 min on 2 cores, store about 1.2 MiB (and as much again in STORE.parts/)``."""
         wall = self.cpu_seconds / max(1, cores)
+        size = f"about {format_bytes(self.store_bytes)}"
+        if self.history_bytes:
+            size = f"at most {format_bytes(self.store_bytes)}, {format_bytes(self.history_bytes)} of it time histories before compression"
         return (
             f"{self.cases:,} cases to run: roughly {_duration(wall)} on {cores} core{'s' if cores > 1 else ''}, "
-            f"store about {format_bytes(self.store_bytes)} (and as much again in its .parts folder)"
+            f"store {size} (and as much again in its .parts folder)"
         )
 
 
@@ -82,14 +88,8 @@ def estimate_run(experiment: Experiment, motion_grids: Mapping[str, tuple[float,
             cpu += per_point * CPU_SECONDS_PER_SAMPLE[_method(experiment, point)]
     share = cases / experiment.n_cases if experiment.n_cases else 0.0
     store = layout(experiment, motion_grids, 0)
-    size = 0
-    for spec in store.specs:
-        if spec.kind is None:  # the impact table: its length is not known before the run
-            continue
-        grid = len(experiment.kind_dims(spec.kind))
-        per_position = _ID_BYTES if spec.family == "id" else spec.dtype.itemsize * math.prod(store.sizes[d] for d in spec.dims[grid:])
-        size += per_position * math.prod(experiment.grid_shape(spec.kind))
-    return RunEstimate(cases, cpu * share, size)
+    histories = sum(spec.dtype.itemsize * math.prod(store.sizes[d] for d in spec.dims) for spec in store.of("history"))
+    return RunEstimate(cases, cpu * share, file_bytes(store, {"definition": canonical_json(experiment.definition)}), histories)
 
 
 def _method(experiment: Experiment, point: Point) -> str:

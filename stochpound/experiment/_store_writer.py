@@ -16,6 +16,7 @@ The file is written to a temporary name and renamed over the store
 
 from __future__ import annotations
 
+import math
 import threading
 from collections import OrderedDict
 from dataclasses import dataclass
@@ -35,6 +36,18 @@ from stochpound.experiment._store import INT_FILL, Layout, Spec, blocks, layout,
 PART_CACHE_BYTES = 64 * 2**20
 """Parts kept in memory while the blocks that need them are written, bytes."""
 _CHUNK_CACHE_BYTES = 16 * 2**20
+ROOM_FACTOR = 1.1
+"""Free room checked before a store file is written: this many times its size (:func:`file_bytes`) ..."""
+ROOM_MARGIN = 2**20
+"""... and this many bytes more."""
+_ID_CHARACTERS = 16
+"""Characters of a case id (the strings :func:`file_bytes` writes)."""
+_STRING_BYTES = 64
+"""Bytes of a variable-length string of up to 32 characters: its 16-byte reference and its global-heap object."""
+_INDEX_NODE_CHUNKS = 64
+"""Chunks per node of a variable's chunk index (HDF5's version-1 B-tree, 2K entries, K = 32 by default) ..."""
+_INDEX_NODE_BYTES = 5 * 2**10
+"""... and the size of a node, bytes (4.7 KiB for six dimensions)."""
 
 
 @dataclass
@@ -134,7 +147,8 @@ def write_store(experiment: Experiment, index: PartsIndex, motion_grids: Mapping
         "cases_done": n_done,
         "complete": int(n_done == experiment.n_cases),
     }
-    check_room(path, path.stat().st_size if path.is_file() else 0)  # the new file is at least as large as the old one
+    # HDF5 may crash the process on a full disk (a segfault closing the file): room for the file, with a margin, is checked first
+    check_room(path, max(path.stat().st_size if path.is_file() else 0, int(ROOM_FACTOR * file_bytes(store_layout, attrs)) + ROOM_MARGIN))
     with replacing(path) as temporary:
         _create(store_layout, attrs, temporary)
         with h5py.File(temporary, "r+", rdcc_nbytes=_CHUNK_CACHE_BYTES) as handle:
@@ -144,6 +158,52 @@ def write_store(experiment: Experiment, index: PartsIndex, motion_grids: Mapping
             for spec in store_layout.of("history"):
                 writer.history(spec)
     return path
+
+
+def file_bytes(store_layout: Layout, attrs: Mapping[str, Any]) -> int:
+    """The size of the store file :func:`write_store` writes for ``store_layout``, bytes, measured on an in-memory file.
+
+    The file's metadata is written as :func:`write_store` writes it, in
+    memory (HDF5's core driver, nothing on disk), and one element of every
+    variable, which allocates its chunk index and its first chunk; the
+    other chunks are counted at their uncompressed size (an upper bound
+    for the compressed time histories), variable-length strings at
+    :data:`_STRING_BYTES` each, and a further chunk-index node per
+    :data:`_INDEX_NODE_CHUNKS` chunks.
+
+    Parameters
+    ----------
+    store_layout : Layout
+        The store's layout (its impact table at its length).
+    attrs : mapping
+        The file's global attributes.
+
+    Returns
+    -------
+    int
+        Bytes: within a few per cent of the written file for a store
+        without time histories, an upper bound with them (they are written
+        compressed), tests/test_experiment_store.py.
+    """
+    store = H5NetCDFStore.open("in memory", mode="w", lock=threading.Lock(), driver="core", driver_kwds={"backing_store": False})
+    try:
+        store_layout.template(attrs).dump_to_store(store, writer=_MetadataOnly())
+        handle = store.ds._h5file
+        rest = 0
+        for spec in store_layout.specs:
+            variable = handle[spec.name]
+            if variable.size == 0:
+                continue
+            strings = variable.dtype.kind == "O"
+            variable[(0,) * variable.ndim] = "-" * _ID_CHARACTERS if strings else 0
+            chunks = math.prod(math.ceil(n / c) for n, c in zip(variable.shape, variable.chunks)) if variable.chunks else 1
+            per_chunk = math.prod(variable.chunks or variable.shape) * (_STRING_BYTES if strings else variable.dtype.itemsize)
+            written = 0 if variable.compression else 1  # a compressed chunk of one element takes almost nothing
+            rest += (chunks - written) * per_chunk + (chunks // _INDEX_NODE_CHUNKS) * _INDEX_NODE_BYTES
+        handle.flush()
+        return len(handle.id.get_file_image()) + rest
+    finally:
+        store.close()
 
 
 class _MetadataOnly:
