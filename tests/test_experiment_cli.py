@@ -346,6 +346,32 @@ def test_a_full_disk_is_found_before_the_store_is_written(stationary, tmp_path, 
     assert f"{store}: cannot write here (No space left on device: 0.0 MB free, about " in result.stderr and result.exit_code == 0
 
 
+def test_the_store_size_is_measured_within_a_few_per_cent(tmp_path):
+    """file_bytes (the run's estimate, and the room checked before a write) against the written files: within 5 % without
+    time histories; with them (written compressed) not below 95 % of the file (the estimate's 'or less')."""
+    from stochpound.experiment._estimate import estimate_run
+    from stochpound.experiment._runner import load_experiment
+    from stochpound.experiment._sources import resolve_motions
+    from stochpound.experiment._store import layout
+    from stochpound.experiment._store_writer import file_bytes
+
+    histories = TINY_EXPERIMENT + '\n[output]\ntime_histories = ["total_displacement"]\nbuildings = ["B1"]\nimpacts = true\n'
+    for name, text in (("plain.toml", TINY_EXPERIMENT), ("histories.toml", histories)):
+        experiment = load_experiment(write_experiment(tmp_path, text, name))
+        assert invoke("experiment", "run", str(experiment.path), "--workers", "0", "--quiet").exit_code == 0
+        store = tmp_path / name.replace(".toml", ".nc")
+        grids = {label: m.grid for label, m in resolve_motions(experiment).items()}
+        actual = store.stat().st_size
+        with open_store(store) as data:
+            measured = file_bytes(layout(experiment, grids, data.sizes["impact"]), dict(data.attrs))
+        estimate = estimate_run(experiment, grids, experiment.n_cases)
+        if name == "plain.toml":
+            assert abs(measured / actual - 1) < 0.05 and estimate.history_bytes == 0, (measured, actual)
+        else:
+            assert measured > 0.95 * actual and estimate.history_bytes > 0, (measured, actual)
+            assert " or less (" in estimate.describe(1) and "of it time histories before compression)" in estimate.describe(1)
+
+
 @pytest.fixture
 def small_disk(tmp_path):
     """A real 4 MB file system (tmpfs) at tmp_path/disk: a full disk as HDF5 meets it (it crashed status with a segfault)."""

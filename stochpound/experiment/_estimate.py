@@ -63,7 +63,7 @@ class RunEstimate:
         wall = self.cpu_seconds / max(1, cores)
         size = f"about {format_bytes(self.store_bytes)}"
         if self.history_bytes:
-            size = f"at most {format_bytes(self.store_bytes)}, {format_bytes(self.history_bytes)} of it time histories before compression"
+            size += f" or less ({format_bytes(self.history_bytes)} of it time histories before compression)"
         return (
             f"{self.cases:,} cases to run: roughly {_duration(wall)} on {cores} core{'s' if cores > 1 else ''}, "
             f"store {size} (and as much again in its .parts folder)"
