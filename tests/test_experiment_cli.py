@@ -346,6 +346,59 @@ def test_a_full_disk_is_found_before_the_store_is_written(stationary, tmp_path, 
     assert f"{store}: cannot write here (No space left on device: 0.0 MB free, about " in result.stderr and result.exit_code == 0
 
 
+def test_the_estimate_counts_the_start_up_as_last_timed_on_this_machine(tmp_path, monkeypatch, caplog):
+    """A cold cache: the estimate names the compile and the rest of the start-up, not yet timed; the compile is announced
+    (a log line) and both are timed; the next run's estimate adds them as measured. A warm cache: no compile, no line."""
+    from stochpound.experiment._estimate import COMPILE, _duration
+    from stochpound.solvers import first_call
+
+    timings = tmp_path / "timings.json"
+    monkeypatch.setattr(first_call, "_timings_path", lambda: timings)
+    monkeypatch.setattr(first_call, "engine_cached", lambda: False)
+    experiment = write_experiment(tmp_path, TINY_EXPERIMENT, "tiny.toml")
+    rest = "opening the store and loading the solver"
+    with caplog.at_level("WARNING", logger="stochpound.solvers"):
+        result = invoke("experiment", "run", str(experiment), "--workers", "0")
+    assert result.exit_code == 0, result.output
+    assert (f"on 1 core after a start-up: {COMPILE} (not yet timed on this machine: 8 s on an idle one, up to a minute on a loaded one), "
+            f"{rest} (not yet timed on this machine), store about ") in result.stderr, result.stderr
+    assert [r.getMessage() for r in caplog.records if r.name == "stochpound.solvers"] == [
+        "stochpound: compiling the exact solver's engine (numba's cache of it is empty; not yet timed on this machine: 8 s on an idle "
+        "one, up to a minute on a loaded one); later calls, and later processes, load it from the cache"]
+    measured = json.loads(timings.read_text())
+    assert measured["compile"] > 0 and measured[rest] > 0, measured
+    setup = float(re.search(r"in all: ([\d.]+) s start-up", result.stdout).group(1))
+    assert measured["compile"] + measured[rest] == pytest.approx(setup, abs=0.2)  # the start-up the summary reports, split in two
+    caplog.clear()
+    result = invoke("experiment", "run", str(experiment), "--workers", "0", "--restart")
+    total = _duration(measured["compile"] + measured[rest])
+    assert (f"after a start-up of about {total} ({COMPILE} {_duration(measured['compile'])}, {rest} {_duration(measured[rest])}, "
+            "as last timed on this machine)") in result.stderr, result.stderr
+    monkeypatch.setattr(first_call, "engine_cached", lambda: True)
+    caplog.clear()
+    with caplog.at_level("WARNING", logger="stochpound.solvers"):
+        result = invoke("experiment", "run", str(experiment), "--workers", "0", "--restart")
+    assert COMPILE not in result.stderr and "loading the compiled solver" in result.stderr and not caplog.records, result.stderr
+
+
+@pytest.mark.slow
+def test_a_cold_cache_compile_is_said_once_by_the_python_api_and_timed(tmp_path):
+    """A real empty numba cache: the first simulate() of a process logs one line on stderr (no logging set up), the next
+    process none; the compile's duration is kept beside the cache for the estimates."""
+    from stochpound.solvers.first_call import TIMINGS_FILE
+
+    code = ("import stochpound\nfrom stochpound.model.scene_file import scene_from_dict\nfrom stochpound.solvers.exact import WARM_UP_SCENE\n"
+            "stochpound.simulate(scene_from_dict(WARM_UP_SCENE))\nprint('done')")
+    env = {**os.environ, "PYTHONPATH": str(REPO), "NUMBA_CACHE_DIR": str(tmp_path / "cache")}
+    first, second = (subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=600) for _ in range(2))
+    assert first.returncode == 0 and first.stdout == "done\n", first.stderr
+    assert first.stderr.startswith("stochpound: compiling the exact solver's engine (numba's cache of it is empty; not yet timed")
+    assert len(first.stderr.splitlines()) == 1, first.stderr
+    assert second.returncode == 0 and second.stderr == "", second.stderr
+    (timings,) = (tmp_path / "cache").rglob(TIMINGS_FILE)
+    assert json.loads(timings.read_text())["compile"] > 0
+
+
 def test_the_store_size_is_measured_within_a_few_per_cent(tmp_path):
     """file_bytes (the run's estimate, and the room checked before a write) against the written files: within 5 % without
     time histories; with them (written compressed) not below 95 % of the file (the estimate's 'or less')."""

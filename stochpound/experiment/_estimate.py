@@ -17,8 +17,12 @@ from stochpound.experiment._store import layout
 from stochpound.experiment._store_writer import file_bytes
 from stochpound._memory import format_bytes
 from stochpound.model.scene_file import scene_from_dict
+from stochpound.solvers import first_call
+from stochpound.solvers.first_call import compile_text
 from stochpound.store import canonical_json
 
+COMPILE = "compiling the solver"
+"""The start-up step of compiling the exact solver into numba's empty cache."""
 LARGE_RUN_CASES = 1_000_000
 """Above this many cases to run, ``experiment run`` asks for ``--yes``."""
 LARGE_RUN_BYTES = 10 * 2**30
@@ -46,12 +50,17 @@ class RunEstimate:
         measured on its metadata written in memory, time histories uncompressed), bytes; the parts folder holds about as much again.
     history_bytes : int
         The time histories' part of ``store_bytes``, uncompressed (the file holds them compressed: usually less), bytes.
+    startup : tuple of (str, float or None)
+        The start-up steps before the first case runs, each with its duration last measured on this machine (s; None if never):
+        compiling the solver (when numba's cache of it is empty), then the rest (:func:`startup_step`: loading it, the store,
+        a local cluster), as the runner last timed them (:mod:`stochpound.solvers.first_call`).
     """
 
     cases: int
     cpu_seconds: float
     store_bytes: int
     history_bytes: int = 0
+    startup: tuple[tuple[str, float | None], ...] = ()
 
     @property
     def large(self) -> bool:
@@ -65,12 +74,24 @@ class RunEstimate:
         if self.history_bytes:
             size += f" or less ({format_bytes(self.history_bytes)} of it time histories before compression)"
         return (
-            f"{self.cases:,} cases to run: roughly {_duration(wall)} on {cores} core{'s' if cores > 1 else ''}, "
+            f"{self.cases:,} cases to run: roughly {_duration(wall)} on {cores} core{'s' if cores > 1 else ''}{self._startup_text()}, "
             f"store {size} (and as much again in its .parts folder)"
         )
 
 
-def estimate_run(experiment: Experiment, motion_grids: Mapping[str, tuple[float, int]], cases: int) -> RunEstimate:
+    def _startup_text(self) -> str:
+        """`` after a start-up of about 45 s (compiling the solver 38 s, starting 2 workers 7 s, as last timed here)``, or what is not yet timed."""
+        if not self.startup:
+            return ""
+        if all(seconds is not None for _, seconds in self.startup):
+            steps = ", ".join(f"{step} {_duration(seconds)}" for step, seconds in self.startup)
+            return f" after a start-up of about {_duration(sum(s for _, s in self.startup))} ({steps}, as last timed on this machine)"
+        steps = ", ".join(f"{step} ({_duration(seconds)} when last timed on this machine)" if seconds is not None else
+                          f"{step} ({'not yet timed on this machine' if step != COMPILE else compile_text()})" for step, seconds in self.startup)
+        return f" after a start-up: {steps}"
+
+
+def estimate_run(experiment: Experiment, motion_grids: Mapping[str, tuple[float, int]], cases: int, workers: int = 0) -> RunEstimate:
     """Estimate the cost of running ``cases`` of the experiment's cases (the missing ones).
 
     Parameters
@@ -80,6 +101,8 @@ def estimate_run(experiment: Experiment, motion_grids: Mapping[str, tuple[float,
         Sample spacing (s) and number of samples of each motion.
     cases : int
         Cases to run (their share of the experiment's samples is counted).
+    workers : int
+        Worker processes of the local cluster the run starts (0: none, the cases run in this process or on a scheduler's).
     """
     per_point = sum(len(experiment.realizations(label)) * samples for label, (_, samples) in motion_grids.items())
     cpu = 0.0
@@ -89,7 +112,15 @@ def estimate_run(experiment: Experiment, motion_grids: Mapping[str, tuple[float,
     share = cases / experiment.n_cases if experiment.n_cases else 0.0
     store = layout(experiment, motion_grids, 0)
     histories = sum(spec.dtype.itemsize * math.prod(store.sizes[d] for d in spec.dims) for spec in store.of("history"))
-    return RunEstimate(cases, cpu * share, file_bytes(store, {"definition": canonical_json(experiment.definition)}), histories)
+    startup = [(COMPILE, first_call.measured("compile"))] if cases and not first_call.engine_cached() else []
+    if cases:
+        startup.append((startup_step(workers), first_call.measured(startup_step(workers))))
+    return RunEstimate(cases, cpu * share, file_bytes(store, {"definition": canonical_json(experiment.definition)}), histories, tuple(startup))
+
+
+def startup_step(workers: int) -> str:
+    """The start-up of a run besides a compile (loading the solver, the store, a local cluster of ``workers``), as it is timed and said."""
+    return f"starting {workers} local worker{'s' if workers > 1 else ''} and the store" if workers else "opening the store and loading the solver"
 
 
 def _method(experiment: Experiment, point: Point) -> str:

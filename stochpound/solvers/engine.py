@@ -66,6 +66,7 @@ compile settings change no result, so they need not).
 
 from __future__ import annotations
 
+import contextlib
 import math
 from collections import namedtuple
 
@@ -75,6 +76,7 @@ from numba import njit
 from stochpound.model.friction import STUCK
 from stochpound.model.guards import Guard
 from stochpound.solvers.compiling import NO_RUNTIME, engine_compile, numba_default_requested
+from stochpound.solvers.first_call import announced_compile
 from stochpound.solvers.propagators import GAUSS_NODES, GAUSS_WEIGHTS
 
 ROUND_OFF = 1e-10
@@ -1430,10 +1432,11 @@ _COMPILED: list[bool] = []
 
 
 def run(*arguments: object) -> int:
-    """Call :func:`run_engine`: a process's first call compiles it (or loads it from numba's cache) in :func:`~stochpound.solvers.compiling.engine_compile`."""
-    if _COMPILED or numba_default_requested():
+    """Call :func:`run_engine`: a process's first call compiles it (or loads it from numba's cache) in :func:`~stochpound.solvers.compiling.engine_compile`,
+    announced and timed when the cache is cold (:func:`~stochpound.solvers.first_call.announced_compile`)."""
+    if _COMPILED:
         return run_engine(*arguments)
-    with engine_compile():
+    with announced_compile(), (contextlib.nullcontext() if numba_default_requested() else engine_compile()):
         status = run_engine(*arguments)
     _COMPILED.append(True)
     return status
