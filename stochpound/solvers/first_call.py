@@ -1,4 +1,8 @@
-"""The exact solver's first call in a process: whether it compiles, the line that says so, and start-up times measured here.
+"""The exact solver's engine called: its first call in a process compiles it, said and timed, and start-up times measured here.
+
+:func:`run` is how the engine is called (:mod:`stochpound.solvers.driver`):
+a process's first call compiles it, or loads it from numba's cache, in
+:func:`~stochpound.solvers.compiling.engine_compile`.
 
 numba compiles the event engine on a process's first call unless its
 on-disk cache (``cache=True``) holds it; then the call takes seconds to a
@@ -29,16 +33,31 @@ from pathlib import Path
 
 import numba
 
+from stochpound.solvers.compiling import engine_compile, numba_default_requested
+from stochpound.solvers.engine import run_engine
+
 _LOG = logging.getLogger("stochpound.solvers")
 
 TIMINGS_FILE = "stochpound-startup.json"
 """Name of the file of measured start-up durations, in the folder of numba's cache of the engine."""
 
 
+def run(*arguments: object) -> int:
+    """Call :func:`~stochpound.solvers.engine.run_engine`: a process's first call compiles it (or loads it from numba's cache)
+    in :func:`~stochpound.solvers.compiling.engine_compile`, announced and timed when the cache is cold (:func:`announced_compile`)."""
+    if _COMPILED:
+        return run_engine(*arguments)
+    with announced_compile(), (contextlib.nullcontext() if numba_default_requested() else engine_compile()):
+        status = run_engine(*arguments)
+    _COMPILED.append(True)
+    return status
+
+
+_COMPILED: list[bool] = []
+
+
 def engine_cached() -> bool:
     """True if numba's cache holds the engine compiled from its current source (read from the cache's index, no compilation)."""
-    from stochpound.solvers.engine import run_engine
-
     try:
         return bool(run_engine._cache._cache_file._load_index())  # numba's cache index: empty if absent or stale
     except Exception:  # noqa: BLE001 - numba's private API changed: say the compile may happen
@@ -109,8 +128,6 @@ _OPEN: list[bool] = []
 
 
 def _timings_path() -> Path | None:
-    from stochpound.solvers.engine import run_engine
-
     try:
         return Path(run_engine._cache._cache_path) / TIMINGS_FILE  # numba's cache folder of the engine (private: it may move)
     except Exception:  # noqa: BLE001 - numba's private API changed: nothing is measured across processes
