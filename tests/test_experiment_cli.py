@@ -12,6 +12,7 @@ import stat
 import subprocess
 import sys
 import time
+from collections.abc import Iterator
 
 import pytest
 import xarray as xr
@@ -463,10 +464,13 @@ def test_a_really_full_disk_crashes_nothing_and_loses_nothing(stationary, small_
                         r"\(No space left on device: 0\.\d MB free, about \d+\.\d MB needed\)\n", result.stderr), result.stderr[-2000:]
     assert not store.exists() and not list(store.parent.glob(".still.nc.*"))
     experiment = write_experiment(small_disk, TINY_EXPERIMENT, "tiny.toml")
+    (small_disk / "filler").unlink()
+    _fill(small_disk, 1_500_000)  # room for the run's first store file (0.3 MB) and parts, not for the last one's margin beside it
     result = _stochpound("experiment", "run", str(experiment), "--workers", "0", cwd=small_disk)
     assert result.returncode == 1, (result.returncode, result.stderr[-2000:])
     last = result.stderr.splitlines()[-1]
     assert re.fullmatch(rf"Error: {small_disk / 'tiny.nc'}: cannot write here \(No space left on device.*\)", last), result.stderr[-2000:]
+    assert result.stderr.endswith(f"\n{last}\n") and "%|" in result.stderr, result.stderr[-2000:]  # after the bar, on a line of its own
     (small_disk / "filler").unlink()
     assert _stochpound("experiment", "status", str(store), cwd=small_disk).returncode == 0 and open_store(store).attrs["complete"] == 1
     result = _stochpound("experiment", "run", str(experiment), "--workers", "0", "--quiet", cwd=small_disk)
@@ -484,3 +488,20 @@ def test_a_full_disk_during_a_run_is_one_line_naming_the_store_and_loses_nothing
     monkeypatch.undo()
     result = invoke("experiment", "run", str(experiment), "--workers", "0", "--quiet")
     assert result.exit_code == 0 and open_store(tmp_path / "tiny.nc").attrs["complete"] == 1, result.output
+
+
+def test_every_command_s_g_option_has_the_same_default():
+    """Issue 35: `records show` and `records spectrum` defaulted to 9.814 and 9.81; one g for every command."""
+    import click
+
+    from stochpound.cli import main
+
+    def options(command: click.Command, path: str) -> Iterator[tuple[str, object]]:
+        for param in command.params:
+            if "--g" in getattr(param, "opts", ()):
+                yield path, param.default
+        for name, sub in getattr(command, "commands", {}).items():
+            yield from options(sub, f"{path} {name}")
+
+    found = dict(options(main, "stochpound"))
+    assert len(found) >= 2 and len(set(found.values())) == 1, found

@@ -8,7 +8,7 @@ numba compiles the event engine on a process's first call unless its
 on-disk cache (``cache=True``) holds it; then the call takes seconds to a
 minute (8 s on an idle machine, docs/benchmarks.md; several times that on a
 loaded one) instead of milliseconds. A library should not print, so the
-engine says it through :mod:`logging`: one ``WARNING`` record of the logger
+engine says it through ``logging``: one ``WARNING`` record of the logger
 ``stochpound.solvers`` before a compile (not when it loads from the cache),
 which Python shows on stderr without any logging set up (its "last resort"
 handler) and which ``logging.getLogger("stochpound").setLevel(logging.ERROR)``
