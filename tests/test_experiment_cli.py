@@ -403,13 +403,15 @@ def test_a_cold_cache_compile_is_said_once_by_the_python_api_and_timed(tmp_path)
     assert json.loads(timings.read_text())["compile"] > 0
 
 
-def test_the_store_size_is_measured_within_a_few_per_cent(tmp_path):
+def test_the_store_size_is_measured_within_a_few_per_cent(tmp_path, monkeypatch):
     """file_bytes (the run's estimate, and the room checked before a write) against the written files: within 5 % without
     time histories; with them (written compressed) not below 95 % of the file (the estimate's 'or less')."""
     from stochpound.experiment._estimate import estimate_run
     from stochpound.experiment._runner import load_experiment
     from stochpound.experiment._sources import resolve_motions
     from stochpound.experiment._store import layout
+    from stochpound import _atomic
+    from stochpound.experiment import _store_writer
     from stochpound.experiment._store_writer import file_bytes
 
     histories = TINY_EXPERIMENT + '\n[output]\ntime_histories = ["total_displacement"]\nbuildings = ["B1"]\nimpacts = true\n'
@@ -420,7 +422,14 @@ def test_the_store_size_is_measured_within_a_few_per_cent(tmp_path):
         grids = {label: m.grid for label, m in resolve_motions(experiment).items()}
         actual = store.stat().st_size
         with open_store(store) as data:
-            measured = file_bytes(layout(experiment, grids, data.sizes["impact"]), dict(data.attrs))
+            store_layout, attrs = layout(experiment, grids, data.sizes["impact"]), dict(data.attrs)
+        measured = file_bytes(store_layout, attrs)
+        needed = int(_store_writer.ROOM_FACTOR * measured) + _store_writer.ROOM_MARGIN
+        for module in (_store_writer, _atomic):  # one byte too few: the quick bound must not skip the measure
+            monkeypatch.setattr(module, "free_bytes", lambda path: needed - 1)
+        with pytest.raises(OSError, match=f"about {needed / 1e6:.1f} MB needed"):
+            _store_writer._check_room(store, store_layout, attrs)
+        monkeypatch.undo()
         estimate = estimate_run(experiment, grids, experiment.n_cases)
         if name == "plain.toml":
             assert abs(measured / actual - 1) < 0.05 and estimate.history_bytes == 0, (measured, actual)
