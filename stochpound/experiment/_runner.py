@@ -228,7 +228,7 @@ def run_experiment(
         if repair:
             say(f"{store}: damaged; rebuilding it from the {report.done_before} finished cases in {session.folder.name}/")
         if report.done_before < report.total:
-            say(estimate_run(experiment, grids, report.total - report.done_before, local_workers(workers, scheduler)).describe(_cores(workers, scheduler)))
+            say(estimate_run(experiment, grids, report.total - report.done_before, _local_workers(workers, scheduler)).describe(_cores(workers, scheduler)))
         cold = not first_call.engine_cached()
         identity = code_identity()
         append_run(session.folder, {"started": now(), "machine": machine(), "executor": report.executor, **identity})
@@ -244,7 +244,7 @@ def run_experiment(
             nonlocal bar
             report.setup = time.monotonic() - started
             compiled = first_call.measured("compile") if cold else 0.0  # timed as it happened: the rest is the start-up of any run
-            first_call.record(startup_step(local_workers(workers, scheduler)), report.setup - (compiled or 0.0))
+            first_call.record(startup_step(_local_workers(workers, scheduler)), report.setup - (compiled or 0.0))
             bar = _progress_bar(report, experiment.name, progress)  # after the start-up's messages
 
         try:
@@ -497,7 +497,7 @@ def _handling_sigint(handler: Any) -> Iterator[None]:
         signal.signal(signal.SIGINT, previous)
 
 
-def local_workers(workers: int | None, scheduler: str | None) -> int:
+def _local_workers(workers: int | None, scheduler: str | None) -> int:
     """Worker processes of the local cluster a run starts (0: it runs in this process, or on a scheduler's cluster)."""
     if scheduler is not None or workers == 0:
         return 0

@@ -203,7 +203,7 @@ def _stripe_figure(name: str, store: xr.Dataset, setting: dict[str, Any], gaps: 
     per = " per " + ", ".join(gap_dims) if gap_dims else ""
     caption = f"Experiment {name}: probability of pounding against intensity{per}, with the stripes' {int(100 * CONFIDENCE)} % Clopper–Pearson intervals (shaded)"
     if shown.size:
-        which = "the risk-targeted separations g*" if len(gaps) else "the quartiles of the contact-free closures"
+        which = "the risk-targeted separations g*" if any(np.isfinite(g) and g > 0 for g in gaps) else "the quartiles of the contact-free closures"
         caption += (f"; at {_listed([f'{g:.3g} m' for g in shown])} ({which}), the contact-free runs' fraction whose contacts close by "
                     "that gap (they pound there, the gap identity)")
     return FigureItem(f"intensity-pounding-{name}", caption + ".", figure)
