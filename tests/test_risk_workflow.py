@@ -365,6 +365,10 @@ def test_the_pounding_against_intensity_figure_shows_gaps_near_g_star_not_infini
         assert 0 < max(direct) and min(direct) < 1  # gaps that mean something: some stripes pound there, some do not always
     assert np.allclose(lines["gap=0.05"], [float((store["impacts"].sel(gap=0.05, intensity=level) > 0).mean()) for level in store["intensity"].values])
     assert "the risk-targeted separations g*" in figure.caption
+    alone = next(block for block in intensity_section("risk", store).blocks if isinstance(block, FigureItem) and block.key == "intensity-pounding-risk")
+    quartiles = np.quantile(free.values[free.values > 0], [0.25, 0.5, 0.75])  # without a hazard: where the closures are
+    assert "the quartiles of the contact-free closures" in alone.caption
+    assert [line.get_label() for line in alone.figure.axes[0].get_lines()][1:] == [f"g = {q:.3g} m (contact-free closures)" for q in quartiles]
     plt.close("all")
 
 
