@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import logging
 import sys
 from contextlib import contextmanager
 from pathlib import Path
@@ -58,7 +59,7 @@ def run_command(
     for experiment_file, definition in zip(experiment_files, loaded):
         if several:
             click.echo(f"{experiment_file}:")
-        with _errors_of(experiment_file, several):
+        with _errors_of(experiment_file, several), _silenced(quiet):
             try:
                 report = run_experiment(
                     definition, store, workers=workers, scheduler=scheduler, restart=restart, progress=not quiet, checkpoint=checkpoint,
@@ -85,6 +86,19 @@ def _errors_of(path: str, name_it: bool) -> Iterator[None]:
         if name_it and not message.startswith(path):
             message = f"{path}: {message}"
         raise click.ClickException(message) from None
+
+
+@contextmanager
+def _silenced(quiet: bool) -> Iterator[None]:
+    """With ``quiet``, the library's own start-up line (the solver's compile, a log record of ``stochpound``) is not shown either."""
+    logger = logging.getLogger("stochpound")
+    level = logger.level
+    if quiet:
+        logger.setLevel(logging.ERROR)
+    try:
+        yield
+    finally:
+        logger.setLevel(level)
 
 
 def _say(message: str) -> None:
