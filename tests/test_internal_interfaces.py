@@ -83,6 +83,7 @@ ALLOWED_CYCLES = [
         "stochpound.risk._demands",
         "stochpound.risk._efficiency",
         "stochpound.risk._fragility_ensemble",
+        "stochpound.risk._limit_states",
         "stochpound.risk._maf",
         "stochpound.risk._store",
         "stochpound.risk._store_risk",

@@ -25,7 +25,7 @@ from stochpound.analysis._hazard import HazardCurve
 from stochpound.analysis._hazard_files import parse_measure, parse_units
 from stochpound.experiment._hazard import check_covers, hazard_curve, hazard_option, stored_hazard
 from stochpound.motions._spectrum import DEFAULT_G
-from stochpound.store import contact_free, describe_measure, gap_dims, has_contact_free, wall_free
+from stochpound.store import contact_free, describe_measure, gap_dims, has_contact_free, wall_free, with_contacts
 
 CLOSURE = "peak_contact_closure"
 """The store's variable of per-case, per-contact peak closures (m)."""
@@ -244,3 +244,36 @@ def moat_clearances(store: xr.Dataset, studied: str | None) -> list[float]:
             walls += [(w, (w["gap"],)) for w in override.get("scene", {}).get("wall", []) or []]
     return sorted({float(gap) for w, gaps in walls for gap in gaps
                    if w.get("building") == studied and w.get("level", 0) == 0 and math.isfinite(float(gap))})
+
+
+def scene_g(store: xr.Dataset) -> float:
+    """The acceleration of gravity of the store's scene, m/s²."""
+    return float(store.pound.definition.to_dict()["scene"].get("g", DEFAULT_G))
+
+
+def case_demand(store: xr.Dataset, variable: str, building: str | None, needs: str) -> xr.DataArray:
+    """A per-case summary of every case of a store, its gap axes kept, one motion dimension ``record``.
+
+    With a ``building`` dimension: that ``building``'s value, or (None) the
+    largest over the buildings. ``needs`` says, in the error of a store
+    without ``variable``, what the experiment must have to keep it.
+    """
+    if variable not in store:
+        raise RiskInputError(f"store: has no {variable!r} (it needs {needs})")
+    data = store[variable]
+    if "building" in data.dims:
+        names = [str(b) for b in data["building"].values]
+        if building is not None and building not in names:
+            raise RiskInputError(f"limit_states: building {building!r} is not one of the store's ({', '.join(names)})")
+        data = data.max("building") if building is None else data.sel(building=building, drop=True)
+    return store_motions(data).load().assign_attrs(units=store[variable].attrs.get("units", ""))
+
+
+def at_finite_gaps(data: xr.Dataset) -> xr.Dataset:
+    """The configurations of ``data`` (over a store's grid) at finite gaps: its contact-free ones left out."""
+    return with_contacts(data)
+
+
+def contact_free_twins(data: xr.DataArray) -> xr.DataArray | None:
+    """Each configuration's contact-free twin in ``data`` (``inf`` on every contact axis, broadcast over them), or None without them."""
+    return contact_free(data).broadcast_like(data) if has_contact_free(data) else None
