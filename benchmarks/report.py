@@ -433,6 +433,13 @@ def figure(results: Results, path: Path) -> Path:
         _panel(ax, bench)
     axes[0][0].set_ylabel("max |y − y_ref|, B1 top floor (m)")
     axes[0][-1].legend(loc="best", fontsize=8)
+    return save_figure(fig, path)
+
+
+def save_figure(fig: Any, path: Path) -> Path:
+    """Lay out ``fig``, write it to ``path`` (130 dpi, folders made) and close it."""
+    import matplotlib.pyplot as plt
+
     fig.tight_layout()
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=130)

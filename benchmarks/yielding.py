@@ -123,11 +123,7 @@ def figure(checks: list[dict[str, Any]], path: Path) -> Path:
     ax.set_ylabel("largest |Δy| of B1's top floor (m)")
     ax.set_title(f"Yielding pair, first {CROSS_CHECK_DURATION:g} s of El Centro: Steel01 vs exact")
     ax.legend(fontsize=7)
-    fig.tight_layout()
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=130)
-    plt.close(fig)
-    return path
+    return report.save_figure(fig, path)
 
 
 def _e(value: float | None) -> str:
