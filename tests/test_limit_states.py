@@ -7,7 +7,10 @@ motions at three stripes, contact-free and at a 5 cm gap.
 
 from __future__ import annotations
 
+import tomllib
+
 import numpy as np
+import pandas as pd
 import pytest
 
 import stochpound
@@ -23,11 +26,16 @@ YIELDING_SCENE = ISOLATED.replace("damping_ratio = 0.05\n", YIELDING)
 
 
 @pytest.fixture(scope="module")
-def store(tmp_path_factory):
-    """The yielding pair's store, demands kept (8 motions × 3 stripes × gaps 5 cm and inf)."""
+def store_path(tmp_path_factory):
+    """The yielding pair's store file, demands kept (8 motions × 3 stripes × gaps 5 cm and inf)."""
     assert YIELDING_SCENE.count("yield_force") == 2
     text = risk_text(YIELDING_SCENE, "gap = [0.05, inf]", STRIPES) + "demands = true\n"
-    return open_store(run_in_process(tmp_path_factory.mktemp("yielding"), "yielding", text)).load()
+    return run_in_process(tmp_path_factory.mktemp("yielding"), "yielding", text)
+
+
+@pytest.fixture(scope="module")
+def store(store_path):
+    return open_store(store_path).load()
 
 
 def test_a_store_keeps_each_cases_storey_summaries(store):
@@ -54,8 +62,16 @@ def test_the_gap_identity_holds_in_a_yielding_store(store):
 # ---------------------------------------------------------------- limit states beyond first contact
 
 
-LIMIT_STATES = {"drift_ratio": [0.005, 0.02], "ductility": {"B2": 2.0}, "residual_drift_ratio": [0.001], "floor_acceleration": [1.0],
-                "impact_force": [1.0e5], "isolator_displacement": {"B1": 0.1}}
+LIMIT_STATES_TOML = """
+[limit_states]
+drift_ratio = [0.005, 0.02]
+ductility = { B2 = 2.0 }
+residual_drift_ratio = [0.001]
+floor_acceleration = [1.0]
+impact_force = [1.0e5]
+isolator_displacement = { B1 = 0.1 }
+"""
+LIMIT_STATES = tomllib.loads(LIMIT_STATES_TOML)["limit_states"]
 
 
 @pytest.fixture(scope="module")
@@ -131,3 +147,21 @@ def test_a_store_without_a_limit_states_demand_or_building_is_named(store):
         limit_state_risk(store.drop_vars("peak_floor_acceleration"), [LimitState("floor_acceleration", 1.0)])
     with pytest.raises(RiskInputError, match=r"^limit_states: building 'B3' is not one of the store's \(B1, B2\)$"):
         limit_state_risk(store, [LimitState("ductility", 2.0, "B3")])
+
+
+def test_the_risk_command_prints_and_writes_the_limit_states(store_path, risk, tmp_path):
+    from click.testing import CliRunner
+
+    from stochpound.cli import main
+
+    (tmp_path / "states.toml").write_text(LIMIT_STATES_TOML)
+    result = CliRunner().invoke(main, ["risk", str(store_path), "--bootstrap", "0", "--limit-states", str(tmp_path / "states.toml"),
+                                       "--csv", str(tmp_path / "tables")])
+    assert result.exit_code == 0, result.output
+    assert "Limit states beyond first contact" in result.output and "peak impact force ≥ 100000 N" in result.output
+    written = pd.read_csv(tmp_path / "tables" / "limit_states.csv")
+    assert list(written["limit_state"]) == list(risk["limit_state"].values)
+    np.testing.assert_allclose(written["Δλ (1/yr)"], risk["gap_cost"].sel(gap=0.05).values, rtol=1e-12)
+    (tmp_path / "bad.toml").write_text("[limit_states]\ndrift_ratio = [-1.0]\n")
+    bad = CliRunner().invoke(main, ["risk", str(store_path), "--bootstrap", "0", "--limit-states", str(tmp_path / "bad.toml")])
+    assert bad.exit_code == 1 and "Error: limit_states.drift_ratio: a capacity must be a number > 0 (1), got -1.0" in bad.output
