@@ -62,7 +62,7 @@ class LimitState:
     Attributes
     ----------
     kind : str
-        One of :data:`KINDS`: ``drift_ratio``, ``residual_drift_ratio``,
+        One of ``stochpound.risk.LIMIT_STATE_KINDS``: ``drift_ratio``, ``residual_drift_ratio``,
         ``ductility`` (1), ``floor_acceleration`` (g), ``impact_force`` (N),
         ``isolator_displacement`` (m, the base displacement at which the
         bearing reaches its stop).
@@ -97,7 +97,7 @@ class LimitState:
 def limit_states_from_table(table: Mapping[str, Any]) -> tuple[LimitState, ...]:
     """The limit states of a ``[limit_states]`` table (docs/risk.md, "Limit states beyond first contact").
 
-    Each key is a kind of :data:`KINDS`; its value a capacity or a list of
+    Each key is a kind of ``stochpound.risk.LIMIT_STATE_KINDS``; its value a capacity or a list of
     capacities (any building), or a table of building names to a capacity or
     a list of them.
 
@@ -125,7 +125,7 @@ def limit_state_risk(store: xr.Dataset, limit_states: Sequence[LimitState], hz: 
     ----------
     store : xarray.Dataset
         An experiment store with intensity stripes (a yielding scene runs
-        stripes), holding the variable of every limit state (:data:`KINDS`).
+        stripes), holding the variable of every limit state (``stochpound.risk.LIMIT_STATE_KINDS``).
     limit_states : sequence of LimitState
         The limit states (:func:`limit_states_from_table` reads a table of them).
     hz : HazardCurve, optional
