@@ -209,6 +209,7 @@ python -m benchmarks               # full run: rewrites docs/benchmarks.md and d
 python -m benchmarks --quick       # smoke run (< 1 min), written to a temporary folder
 python -m benchmarks compare REV   # this tree against revision REV in one session (a few minutes): its own section
 python -m benchmarks compare REV --demands   # the same, every run monitoring the demand parameters
+python -m benchmarks yielding     # yielding storeys: OpenSees Steel01 cross-check and speed (1 min): its own section
 ```
 {quick}
 The benchmark process runs on one thread (OMP, OpenBLAS, MKL and numba thread

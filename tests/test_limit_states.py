@@ -134,6 +134,7 @@ def test_a_limit_states_rate_is_its_fragility_integrated_over_the_hazard(store, 
         ({"drift_ratio": [0.0]}, "limit_states.drift_ratio: a capacity must be a number > 0 (1), got 0.0"),
         ({"floor_acceleration": "1 g"}, "limit_states.floor_acceleration: a capacity must be a number > 0 (g), got '1 g'"),
         ({"impact_force": {"B1": 1e5}}, "limit_states.impact_force: has no building"),
+        ({"ductility": True}, "limit_states.ductility: a capacity must be a number > 0 (1), got True"),
         ({}, "limit_states: must be a table of drift_ratio"),
     ],
 )

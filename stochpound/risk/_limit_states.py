@@ -81,7 +81,7 @@ class LimitState:
         where = f"limit_states.{self.kind}"
         if self.kind not in KINDS:
             raise _store.RiskInputError(f"limit_states.{self.kind}: not a limit state; one of {', '.join(KINDS)}")
-        if not (isinstance(self.capacity, (int, float)) and math.isfinite(self.capacity) and self.capacity > 0):
+        if isinstance(self.capacity, bool) or not (isinstance(self.capacity, (int, float)) and math.isfinite(self.capacity) and self.capacity > 0):
             raise _store.RiskInputError(f"{where}: a capacity must be a number > 0 ({KINDS[self.kind].units}), got {self.capacity!r}")
         if self.building is not None and not KINDS[self.kind].per_building:
             raise _store.RiskInputError(f"{where}: has no building (an impact force is a contact's), got {self.building!r}")

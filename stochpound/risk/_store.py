@@ -4,7 +4,8 @@ The chain needs, from a store: its definition's ``[intensity]`` and
 ``[hazard]`` entries, its studied building and the moat walls at that
 building's base; its contact-free (and wall-free) cases, found by the gap
 axes; and, per case, the peak contact closures, the inputs of the code
-separation rules, the peak base displacements and the stored demands, with
+separation rules, the peak base displacements, the stored demands and the
+summaries the limit states beyond first contact read, with
 the motions (records, and the realizations of a synthetic ensemble) on one
 ``record`` dimension. Nothing else in :mod:`stochpound.risk` opens, selects
 or parses a store, so a new way to read stores is a change of this module
