@@ -4,7 +4,8 @@ The chain needs, from a store: its definition's ``[intensity]`` and
 ``[hazard]`` entries, its studied building and the moat walls at that
 building's base; its contact-free (and wall-free) cases, found by the gap
 axes; and, per case, the peak contact closures, the inputs of the code
-separation rules, the peak base displacements and the stored demands, with
+separation rules, the peak base displacements, the stored demands and the
+summaries the limit states beyond first contact read, with
 the motions (records, and the realizations of a synthetic ensemble) on one
 ``record`` dimension. Nothing else in :mod:`stochpound.risk` opens, selects
 or parses a store, so a new way to read stores is a change of this module
@@ -23,7 +24,7 @@ import xarray as xr
 from stochpound.analysis import HazardCurve, parse_measure, parse_units, store_contact_demands
 from stochpound.experiment import check_covers, hazard_curve, hazard_option, stored_hazard
 from stochpound.motions import DEFAULT_G
-from stochpound.store import contact_free, describe_measure, gap_dims, has_contact_free, wall_free
+from stochpound.store import contact_free, describe_measure, gap_dims, has_contact_free, wall_free, with_contacts
 
 CLOSURE = "peak_contact_closure"
 """The store's variable of per-case, per-contact peak closures (m)."""
@@ -276,3 +277,36 @@ def efficiency_runs(store: xr.Dataset, studied: str | None) -> dict[str, Any]:
         "conditioning": float(setting["period"]) if psa_in_g else None,
         "covariates": {name: store_motions(free[name]) for name in ("record_magnitude", "record_distance") if name in free.coords},
     }
+
+
+def scene_g(store: xr.Dataset) -> float:
+    """The acceleration of gravity of the store's scene, m/s²."""
+    return float(store.pound.definition.to_dict()["scene"].get("g", DEFAULT_G))
+
+
+def case_demand(store: xr.Dataset, variable: str, building: str | None, needs: str) -> xr.DataArray:
+    """A per-case summary of every case of a store, its gap axes kept, one motion dimension ``record``.
+
+    With a ``building`` dimension: that ``building``'s value, or (None) the
+    largest over the buildings. ``needs`` says, in the error of a store
+    without ``variable``, what the experiment must have to keep it.
+    """
+    if variable not in store:
+        raise RiskInputError(f"store: has no {variable!r} (it needs {needs})")
+    data = store[variable]
+    if "building" in data.dims:
+        names = [str(b) for b in data["building"].values]
+        if building is not None and building not in names:
+            raise RiskInputError(f"limit_states: building {building!r} is not one of the store's ({', '.join(names)})")
+        data = data.max("building") if building is None else data.sel(building=building, drop=True)
+    return store_motions(data).load().assign_attrs(units=store[variable].attrs.get("units", ""))
+
+
+def at_finite_gaps(data: xr.Dataset) -> xr.Dataset:
+    """The configurations of ``data`` (over a store's grid) at finite gaps: its contact-free ones left out."""
+    return with_contacts(data)
+
+
+def contact_free_twins(data: xr.DataArray) -> xr.DataArray | None:
+    """Each configuration's contact-free twin in ``data`` (``inf`` on every contact axis, broadcast over them), or None without them."""
+    return contact_free(data).broadcast_like(data) if has_contact_free(data) else None
