@@ -65,9 +65,10 @@ class StoreDemands:
         """The moat table: per clearance (m), the MAF of reaching it with its interval, the return period and the probability."""
         if self.moat is None:
             return pd.DataFrame()
-        frame = self.moat[["maf", "maf_lower", "maf_upper", "return_period", "probability"]].reset_coords(drop=True).to_dataframe()
-        frame = frame.rename(columns={"maf": "λ (1/yr)", "maf_lower": "λ lower", "maf_upper": "λ upper", "return_period": "once in (yr)",
-                                      "probability": f"P in {self.years:g} yr"})
+        names = {"maf": "λ (1/yr)", "maf_lower": "λ lower", "maf_upper": "λ upper", "return_period": "once in (yr)",
+                 "return_period_lower": "once in, lower (yr)", "return_period_upper": "once in, upper (yr)",
+                 "probability": f"P in {self.years:g} yr", "probability_lower": "P lower", "probability_upper": "P upper"}
+        frame = self.moat[[name for name in names if name in self.moat]].reset_coords(drop=True).to_dataframe().rename(columns=names)
         frame.index = frame.index.set_names({"level": "moat clearance (m)"})
         return frame
 
