@@ -65,13 +65,16 @@ def test_the_gap_to_design_to_is_the_upper_bound_of_g_star_stated_as_such():
 def test_the_wall_free_d_tm_is_compared_with_the_moat_and_the_wall_governs_a_target_it_is_hit_more_often_than():
     rules = xr.Dataset({"gap": (("design_level", "rule"), [[0.45, 0.1], [0.92, 0.2]])},
                        coords={"design_level": [0.10, 0.02], "rule": ["dtm", "abs"]})
-    moat = xr.Dataset({"maf": ("level", [1 / 918])}, coords={"level": [0.60]})
+    moat = xr.Dataset({"maf": (("mu", "level"), [[1 / 918], [1 / 2000]])}, coords={"level": [0.60], "mu": [0.05, 0.12]})
+    moat = rate_intervals(moat.assign(maf_lower=moat["maf"] / 2, maf_upper=moat["maf"] * 2), 50.0)
     text = moat_text(_risk(rules), StoreDemands({}, {}, moat))
     assert "at 10 %/50 yr is 0.45 m and is within the moat clearance 0.6 m" in text
     assert "at 2 %/50 yr is 0.92 m and exceeds the moat clearance 0.6 m" in text
     # 1/918 /yr against 10 %/50 yr (once in 475 yr) and 2 %/50 yr (once in 2475 yr): governs only the rarer target
-    assert "once in 918 yr (worst configuration), less often than the target allows (once in 475 yr): the wall does not govern" in text
-    assert "once in 918 yr (worst configuration), more often than the target allows (once in 2.47e+03 yr): the wall, not the gap, governs" in text
+    assert "once in 918 [459, 1.84e+03] yr (worst configuration), less often than the target allows (once in 475 yr): the wall does not govern" in text
+    assert "once in 918 [459, 1.84e+03] yr (worst configuration), more often than the target allows (once in 2.47e+03 yr): the wall, not the gap, governs" in text
+    single = StoreDemands({}, {}, moat.isel(mu=0, drop=True)).moat_frame()  # one configuration: a plain index
+    assert single.index.name == "moat clearance (m)" and single["once in, upper (yr)"].iloc[0] == 1836.0
     assert moat_text(_risk(rules), None) == "" and moat_text(_risk(rules.sel(rule=["abs"])), StoreDemands({}, {}, moat)) == ""
 
 

@@ -69,8 +69,7 @@ class StoreDemands:
                  "return_period_lower": "once in, lower (yr)", "return_period_upper": "once in, upper (yr)",
                  "probability": f"P in {self.years:g} yr", "probability_lower": "P lower", "probability_upper": "P upper"}
         frame = self.moat[[name for name in names if name in self.moat]].reset_coords(drop=True).to_dataframe().rename(columns=names)
-        frame.index = frame.index.set_names({"level": "moat clearance (m)"})
-        return frame
+        return frame.rename_axis(index={"level": "moat clearance (m)"})  # a plain index (one configuration) or a MultiIndex
 
 
 def store_demands(store: xr.Dataset, hz: HazardCurve | None = None, confidence: float = CONFIDENCE, bootstrap: int = BOOTSTRAP,

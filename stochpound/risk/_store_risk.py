@@ -213,17 +213,16 @@ class StoreRisk:
         years = float(rules.attrs.get("years", self.years))
         gaps = rules["gap"].to_dataframe()["gap"].unstack("contact")
         gaps.columns = [f"gap, contact {c} (m)" for c in gaps.columns]
-        values = rules[[name for name in _RULE_VALUES if name in rules]].to_dataframe()
+        values = rules[[name for name in (*_RULE_VALUES, "status") if name in rules]].to_dataframe()
         frame = gaps.join(values)
-        names = dict(zip(_RULE_VALUES, (column.format(years=years) for column in _RULE_COLUMNS)))
-        frame = frame.rename(columns=names)
-        if "status" in rules:
-            frame["fit"] = [fit_name(int(s)) for s in rules["status"].to_dataframe()["status"].reindex(frame.index)]
-        frame = frame.reset_index()
+        if "status" in frame:
+            frame["status"] = [fit_name(int(s)) for s in frame["status"]]
+        names = {**dict(zip(_RULE_VALUES, (column.format(years=years) for column in _RULE_COLUMNS))), "status": "fit"}
+        frame = frame.rename(columns=names).reset_index()
         frame["design_level"] = [design_text(p, float(i), years) for p, i in zip(frame["design_level"], frame["stripe_intensity"])]
         frame["rule"] = [RULE_NAMES.get(r, r) for r in frame["rule"]]
         frame = frame.drop(columns=[c for c in ("code_intensity", "stripe_intensity") if c in frame])
-        index = [c for c in frame.columns if not c.startswith("gap, ") and c not in names.values() and c != "fit"]
+        index = [c for c in frame.columns if not c.startswith("gap, ") and c not in names.values()]
         return frame.set_index(index).dropna(how="all")
 
     def design_frame(self) -> pd.DataFrame:
@@ -248,7 +247,10 @@ class StoreRisk:
 
     def degenerate_text(self) -> str:
         """The degenerate fragility fits among the gaps (steps, not lognormals) and what each does to λ_P ("" when there are none)."""
-        return degenerate_text(self.fragility["status"].values, self.hazard) if "status" in self.fragility else ""
+        if "status" not in self.fragility:
+            return ""
+        what = "fits (gaps × configurations)" if self.configuration_dims() else "gaps"
+        return degenerate_text(self.fragility["status"].values, self.hazard, what)
 
     def non_increasing_maf(self) -> xr.DataArray:
         """λ_P(g) made non-increasing along the gaps (its running minimum, the curve g* is read from; 1/yr)."""

@@ -160,10 +160,15 @@ def moat_text(risk: StoreRisk, demands: StoreDemands | None) -> str:
     for target in risk.separation["target"].values:
         rate = rate_from_probability(float(target), risk.years)
         for clearance in clearances:
-            wall = float(maf.sel(level=clearance).max(skipna=True))
+            worst = maf.sel(level=clearance).fillna(-1.0).argmax(...)
+            wall = float(maf.sel(level=clearance)[worst])
+            bounds = demands.moat.sel(level=clearance)[["return_period_lower", "return_period_upper"]].isel(worst) \
+                if "return_period_lower" in demands.moat else None
+            interval = (f" [{float(bounds['return_period_lower']):.3g}, {float(bounds['return_period_upper']):.3g}]"
+                        if bounds is not None else "")
             relation = ("more often than the target allows (once in {:.3g} yr): the wall, not the gap, governs this target"
                         if wall > rate else "less often than the target allows (once in {:.3g} yr): the wall does not govern this target")
-            sentences.append(f"The base reaches the {clearance:.3g} m moat wall once in {1 / wall:.3g} yr (worst configuration), "
+            sentences.append(f"The base reaches the {clearance:.3g} m moat wall once in {1 / wall:.3g}{interval} yr (worst configuration), "
                              + relation.format(1 / rate) + f" ({risk.target_text(float(target))}).")
     return " ".join(sentences)
 
@@ -175,13 +180,12 @@ def _hazard_text(risk: StoreRisk) -> str:
     source = hz.source.splitlines()[0] if hz.source else ""
     fitted = ("fitted to the stripes' counts by maximum likelihood, from the contact-free runs by the gap identity" if risk.method == "stripes"
               else "of the motions' IDA capacities IM·g/D (log-moments), from one contact-free run per motion")
-    degenerate = risk.degenerate_text()
-    degenerate = f" ({degenerate[:-1]})" if degenerate else " (at every gap)"
+    degenerate = risk.degenerate_text() or "Every fit is a lognormal (no degenerate step)."
     extrapolated = " The hazard was extrapolated beyond its table (as a power law) for some integrals." if hz.extrapolated else ""
     return (
         f"Hazard curve of {risk.measure} in {units}, {hz.describe()} ({source}); its 10 %/50 yr intensity is "
         f"{levels[0.10]:.3g} and its 2 %/50 yr intensity {levels[0.02]:.3g} {units}. The fragility at each gap is a "
-        f"lognormal {fitted}, where the data identify one{degenerate}; λ_P(g) = ∫ F(x; g) |dλ(x)|; the intervals resample the motions and "
+        f"lognormal {fitted}, where the data identify one. {degenerate} λ_P(g) = ∫ F(x; g) |dλ(x)|; the intervals resample the motions and "
         "refit the whole chain. Assumptions: Poisson "
         "occurrence, record-to-record variability only (not the hazard's or the model's uncertainty), and a suite scaled to each "
         f"intensity standing for the site's motions of that intensity.{extrapolated}"
