@@ -13,9 +13,8 @@ import pandas as pd
 import xarray as xr
 
 from stochpound.report.sections._risk import design_value_text, moat_text
-from stochpound.risk import HazardCurve, StoreDemands, StoreRisk, mean_annual_frequency
+from stochpound.risk import HazardCurve, StoreDemands, StoreRisk, degenerate_text, mean_annual_frequency, rate_intervals
 from stochpound.risk._fragility import ALWAYS, FIT, NEVER, Fragility
-from stochpound.risk._maf import degenerate_text, rate_intervals
 
 HAZARD = HazardCurve([0.05, 0.2, 0.5, 1.0, 2.0], [0.0333, 8e-3, 2e-3, 5e-4, 8e-5], units="g", measure="PGA")
 
