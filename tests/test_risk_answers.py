@@ -12,7 +12,7 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
-from stochpound.report.sections._risk import design_value_text, moat_text
+from stochpound.report.sections._risk import design_summary_text, design_value_text, moat_text
 from stochpound.risk import HazardCurve, StoreDemands, StoreRisk, degenerate_text, mean_annual_frequency, rate_intervals
 from stochpound.risk._fragility import ALWAYS, FIT, NEVER, Fragility
 
@@ -72,6 +72,11 @@ def test_the_wall_free_d_tm_is_compared_with_the_moat_and_the_wall_governs_a_tar
     # 1/918 /yr against 10 %/50 yr (once in 475 yr) and 2 %/50 yr (once in 2475 yr): governs only the rarer target
     assert "once in 918 [459, 1.84e+03] yr (worst configuration), less often than the target allows (once in 475 yr): the wall does not govern" in text
     assert "once in 918 [459, 1.84e+03] yr (worst configuration), more often than the target allows (once in 2.47e+03 yr): the wall, not the gap, governs" in text
+    summary = design_summary_text(_risk(), StoreDemands({}, {}, moat))
+    assert ("Governing limit state: pounding between the buildings for 10 % in 50 yr; the moat wall (0.6 m clearance, reached once in "
+            "918 yr) for 2 % in 50 yr.") in summary
+    assert "Governing limit state: pounding between the buildings for 10 % in 50 yr; pounding between the buildings for 2 %" in \
+        design_summary_text(_risk(), None)
     single = StoreDemands({}, {}, moat.isel(mu=0, drop=True)).moat_frame()  # one configuration: a plain index
     assert single.index.name == "moat clearance (m)" and math.isclose(single["once in, upper (yr)"].iloc[0], 2 * 918)
     assert moat_text(_risk(rules), None) == "" and moat_text(_risk(rules.sel(rule=["abs"])), StoreDemands({}, {}, moat)) == ""
@@ -99,4 +104,8 @@ def test_the_rules_table_gives_each_return_period_with_its_interval_and_each_fit
     assert (row["once in, lower (yr)"], row["once in (yr)"], row["once in, upper (yr)"]) == (500.0, 1000.0, 2000.0)
     assert row["P lower"] < row["P in 50 yr"] < row["P upper"]
     assert row["fit"] == "step: always"
+    # 2 %/50 yr allows −ln(0.98)/50 = 4.04e-4 /yr; λ_P = 1e-3 does not meet it
+    assert not row["meets its level"] and not row["meets, upper bound"]
+    met = _risk(rules.assign(maf=rules["maf"] / 10, maf_lower=rules["maf_lower"] / 10, maf_upper=rules["maf_upper"] / 10)).rules_frame().iloc[0]
+    assert met["meets its level"] and met["meets, upper bound"]  # 1e-4 and 2e-4 /yr
     assert isinstance(frame, pd.DataFrame) and "SRSS of suite-mean peaks" in frame.index.get_level_values("rule")[0]

@@ -325,6 +325,9 @@ def test_report_section_states_the_separation_first(isolated_store):
     separation = next(block for block in section.blocks if isinstance(block, Table) and block.key == "risk-separation-risk")
     assert not any(str(name).startswith("base_") for name in separation.frame.index.names)
     assert stored_hazard(store).source.startswith("Site: Fox Plaza")
+    assert risk.assumptions["structural model"].startswith("B1: 2-storey shear building, linear elastic storeys, on a sliding base; B2:")
+    summary = section.blocks[1].text
+    assert summary.startswith("Design summary. Governing limit state: pounding between the buildings") and "scaled to every stripe" in summary
 
 
 def test_rules_table_is_indexed_by_the_grid_not_by_what_each_point_ran():

@@ -138,6 +138,29 @@ def experiment_name(store: xr.Dataset) -> str | None:
     return store.attrs.get("experiment_name")
 
 
+def assumptions(store: xr.Dataset) -> dict[str, str]:
+    """What a risk answer from ``store`` rests on, in words, from its definition: the structural model, the suite and its
+    selection, and the scenario."""
+    definition = store.pound.definition
+    models = []
+    for building in definition.scene.get("building", []):
+        storeys = len(building.get("mass", []))
+        storey = "yielding (bilinear) storeys" if "yield_force" in building else "linear elastic storeys"
+        base = "a sliding base" if "base" in building else "a fixed base"
+        models.append(f"{building.get('name', '?')}: {storeys}-storey shear building, {storey}, on {base}")
+    kinds = {"record": "records without a named suite", "synthetic": "synthetic ensembles"}
+    suites = sorted({source.suite or kinds.get(source.kind, source.kind) for source in definition.motions})
+    count = sum(source.count for source in definition.motions)
+    entry = definition.intensity.entry if definition.intensity is not None else {}
+    selection = entry.get("selection")
+    suite = (f"{count} motions ({', '.join(suites)}), "
+             + (f"selected per stripe by {str(selection).replace('_', ' ')}" if selection else "every motion scaled to every stripe (no selection)"))
+    site = entry.get("site")
+    scenario = "; ".join(f"{key} {value}" for key, value in site.items()) if isinstance(site, Mapping) else ""
+    return {"structural model": "; ".join(models), "suite": suite,
+            "scenario": scenario or "none stated (the motions are not selected for a scenario)"}
+
+
 def stripes(store: xr.Dataset) -> int | None:
     """The number of intensity stripes of a store (None for IDA runs)."""
     return store.sizes["intensity"] if "intensity" in store.dims else None

@@ -144,6 +144,10 @@ class StoreRisk:
         The exposure time of the targets (yr).
     confidence : float
         The confidence of the intervals.
+    assumptions : dict of str to str
+        What the answer rests on besides the hazard, in words from the
+        store's definition: ``structural model``, ``suite`` (and its
+        selection), ``scenario``.
     """
 
     fragility: xr.Dataset
@@ -159,6 +163,7 @@ class StoreRisk:
     experiment: str | None = None
     years: float = YEARS
     confidence: float = CONFIDENCE
+    assumptions: dict[str, str] = dataclasses.field(default_factory=dict)
 
     @property
     def measure(self) -> str:
@@ -204,7 +209,12 @@ class StoreRisk:
     def rules_frame(self) -> pd.DataFrame:
         """The code rules in risk terms: per configuration, design level and rule, its gap per contact (m) and the MAF of pounding there.
 
-        Empty when the rules were not evaluated (``rules_note`` says why).
+        With the return period and the probability, each with its interval,
+        the fit's kind (``fit``: ``lognormal`` or the step), and whether the
+        rule meets its own design level as a target (``meets its level``:
+        λ_P ≤ −ln(1 − p)/t for the level's probability p; ``meets, upper
+        bound``: the same for the upper bound of λ_P). Empty when the rules
+        were not evaluated (``rules_note`` says why).
         """
         rules = self.rules
         if rules is None:
@@ -217,12 +227,16 @@ class StoreRisk:
         frame = gaps.join(values)
         if "status" in frame:
             frame["status"] = [fit_name(int(s)) for s in frame["status"]]
+        allowed = rate_from_probability(frame.index.get_level_values("design_level").to_numpy(dtype=float), years)
+        frame["meets its level"] = frame["maf"] <= allowed  # λ_P at the rule's gap within the rate of its own design level
+        if "maf_upper" in frame:
+            frame["meets, upper bound"] = frame["maf_upper"] <= allowed
         names = {**dict(zip(_RULE_VALUES, (column.format(years=years) for column in _RULE_COLUMNS))), "status": "fit"}
         frame = frame.rename(columns=names).reset_index()
         frame["design_level"] = [design_text(p, float(i), years) for p, i in zip(frame["design_level"], frame["stripe_intensity"])]
         frame["rule"] = [RULE_NAMES.get(r, r) for r in frame["rule"]]
         frame = frame.drop(columns=[c for c in ("code_intensity", "stripe_intensity") if c in frame])
-        index = [c for c in frame.columns if not c.startswith("gap, ") and c not in names.values()]
+        index = [c for c in frame.columns if not c.startswith(("gap, ", "meets")) and c not in names.values()]
         return frame.set_index(index).dropna(how="all")
 
     def design_frame(self) -> pd.DataFrame:
@@ -375,7 +389,8 @@ def store_risk(store: xr.Dataset, hz: HazardCurve | None = None, targets: Sequen
         rules = code_rules_risk(_store.contact_free_demands(store), hz, years=years, isolator_displacement=_store.base_displacement(store, studied, walls_free=True),
                                 confidence=confidence, bootstrap=bootstrap, seed=seed)
     return StoreRisk(fragility, curve, separation, rules, note, hz, motions, method, setting=_store.intensity_setting(store) or {},
-                     stripes=_store.stripes(store), experiment=_store.experiment_name(store), years=years, confidence=confidence)
+                     stripes=_store.stripes(store), experiment=_store.experiment_name(store), years=years, confidence=confidence,
+                     assumptions=_store.assumptions(store))
 
 
 def target_text(probability: float, years: float = YEARS) -> str:

@@ -106,7 +106,7 @@ def risk_section(name: str, risk: StoreRisk, demands: StoreDemands | None = None
     """The "Risk" section of one store, from its risk chain and its demand hazard curves (:func:`~stochpound.risk.store_demands`)."""
     section = Section(f"Risk: experiment {name}", key=f"risk-{name}")
     section.add(Paragraph(headline_text(name, risk)))
-    section.add(Paragraph(design_value_text(risk)))
+    section.add(Paragraph(design_summary_text(risk, demands)))
     section.add(Paragraph(_hazard_text(risk)))
     section.add(Table(f"risk-separation-{name}", f"Experiment {name}: risk-targeted separation g* per configuration and target, with its "
                       f"{_percent(risk.confidence)} BCa bootstrap interval over the {risk.motions} motions", risk.separation_frame(),
@@ -122,6 +122,54 @@ def risk_section(name: str, risk: StoreRisk, demands: StoreDemands | None = None
     if moat:
         section.add(Paragraph(moat))
     return section
+
+
+def design_summary_text(risk: StoreRisk, demands: StoreDemands | None = None) -> str:
+    """The design summary: the governing limit state per target, the gap to design to, which code rules meet their level, and
+    what the answer rests on (hazard, scenario, structural model, suite), all from the chain's results and the store."""
+    wall = _wall_governs(risk, demands)
+    governing = "; ".join(
+        (f"the moat wall ({wall[t][0]:.3g} m clearance, reached once in {1 / wall[t][1]:.3g} yr)" if t in wall else "pounding between the buildings")
+        + f" for {risk.target_text(t)}" for t in risk.separation["target"].values)
+    rules = risk.rules_frame()
+    if rules.empty:
+        meets = f"The code rules were not evaluated ({risk.rules_note})."
+    else:
+        column = "meets, upper bound" if "meets, upper bound" in rules else "meets its level"
+        met = rules[column].groupby(level="rule", sort=False).all()
+        meets = (f"Code rules meeting their own design level as a target in every configuration and level ({column.replace('meets, ', '') if 'upper' in column else 'estimate'}): "
+                 f"{', '.join(met.index[met]) or 'none'}; not: {', '.join(met.index[~met]) or 'none'}.")
+    rests = "; ".join(f"{key}: {value}" for key, value in {"hazard": f"{risk.hazard.describe()} ({_source(risk)})", **risk.assumptions}.items())
+    return (f"Design summary. Governing limit state: {governing}. {design_value_text(risk)} {meets} The answer holds only for what it "
+            f"rests on; a change to any of these voids it: {rests}.")
+
+
+def _source(risk: StoreRisk) -> str:
+    return risk.hazard.source.splitlines()[0] if risk.hazard.source else "no provenance stated"
+
+
+def _wall_rates(risk: StoreRisk, demands: StoreDemands) -> list[tuple[float, float, float, float, dict[str, Any]]]:
+    """Per target and moat clearance: (target, clearance m, rate of reaching the wall in its worst configuration 1/yr,
+    the target's rate 1/yr, that configuration's position)."""
+    rows = []
+    for target in risk.separation["target"].values:
+        allowed = float(rate_from_probability(float(target), risk.years))
+        for clearance in demands.moat["level"].values:
+            maf = demands.moat["maf"].sel(level=clearance)
+            worst = maf.fillna(-1.0).argmax(...)
+            rows.append((float(target), float(clearance), float(maf[worst]), allowed, worst))
+    return rows
+
+
+def _wall_governs(risk: StoreRisk, demands: StoreDemands | None) -> dict[float, tuple[float, float]]:
+    """Per target the wall is reached more often than it allows: target → (clearance m, rate of reaching it 1/yr, worst configuration)."""
+    governs: dict[float, tuple[float, float]] = {}
+    if demands is None or demands.moat is None:
+        return governs
+    for target, clearance, wall, allowed, _ in _wall_rates(risk, demands):
+        if wall > allowed and wall > governs.get(target, (0.0, 0.0))[1]:
+            governs[target] = (clearance, wall)
+    return governs
 
 
 def design_value_text(risk: StoreRisk) -> str:
@@ -156,20 +204,14 @@ def moat_text(risk: StoreRisk, demands: StoreDemands | None) -> str:
                    f"{', '.join(f'{c:.3g} m' for c in clearances)}")
         sentences.append(f"The wall-free D_TM (suite-mean peak base displacement without the wall) at {100 * level:g} %/{risk.years:g} yr is "
                          f"{value:.3g} m and {verdict}.")
-    maf = demands.moat["maf"]
-    for target in risk.separation["target"].values:
-        rate = rate_from_probability(float(target), risk.years)
-        for clearance in clearances:
-            worst = maf.sel(level=clearance).fillna(-1.0).argmax(...)
-            wall = float(maf.sel(level=clearance)[worst])
-            bounds = demands.moat.sel(level=clearance)[["return_period_lower", "return_period_upper"]].isel(worst) \
-                if "return_period_lower" in demands.moat else None
-            interval = (f" [{float(bounds['return_period_lower']):.3g}, {float(bounds['return_period_upper']):.3g}]"
-                        if bounds is not None else "")
-            relation = ("more often than the target allows (once in {:.3g} yr): the wall, not the gap, governs this target"
-                        if wall > rate else "less often than the target allows (once in {:.3g} yr): the wall does not govern this target")
-            sentences.append(f"The base reaches the {clearance:.3g} m moat wall once in {1 / wall:.3g}{interval} yr (worst configuration), "
-                             + relation.format(1 / rate) + f" ({risk.target_text(float(target))}).")
+    for target, clearance, wall, allowed, worst in _wall_rates(risk, demands):
+        bounds = demands.moat.sel(level=clearance).isel(worst) if "return_period_lower" in demands.moat else None
+        interval = (f" [{float(bounds['return_period_lower']):.3g}, {float(bounds['return_period_upper']):.3g}]"
+                    if bounds is not None else "")
+        relation = ("more often than the target allows (once in {:.3g} yr): the wall, not the gap, governs this target"
+                    if wall > allowed else "less often than the target allows (once in {:.3g} yr): the wall does not govern this target")
+        sentences.append(f"The base reaches the {clearance:.3g} m moat wall once in {1 / wall:.3g}{interval} yr (worst configuration), "
+                         + relation.format(1 / allowed) + f" ({risk.target_text(target)}).")
     return " ".join(sentences)
 
 
