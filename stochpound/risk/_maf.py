@@ -142,8 +142,9 @@ def risk_curve(fragility: xr.Dataset, hz: HazardCurve, years: float = 50.0, conf
 def degenerate_text(status: ArrayLike, hz: HazardCurve, what: str = "gaps") -> str:
     """What the degenerate fits among ``status`` are and what each does to the MAF ("" when every fit is a lognormal).
 
-    A degenerate fit is a step (β = 0), not a lognormal
-    (:data:`~stochpound.risk._fragility.STATUS`); integrated with the
+    A degenerate fit is a step (β = 0), not a lognormal (its ``status``:
+    ``always``, ``never``, ``separated``; ``decreasing`` and ``empty`` fits
+    have no λ); integrated with the
     hazard it gives λ(θ): for ``always`` (every run exceeded, θ = 0) the
     hazard's rate at the lowest intensity of its table, a plateau set by
     the table, not by the structure; for ``never`` 0; for ``separated``
