@@ -109,3 +109,19 @@ def test_the_rules_table_gives_each_return_period_with_its_interval_and_each_fit
     met = _risk(rules.assign(maf=rules["maf"] / 10, maf_lower=rules["maf_lower"] / 10, maf_upper=rules["maf_upper"] / 10)).rules_frame().iloc[0]
     assert met["meets its level"] and met["meets, upper bound"]  # 1e-4 and 2e-4 /yr
     assert isinstance(frame, pd.DataFrame) and "SRSS of suite-mean peaks" in frame.index.get_level_values("rule")[0]
+
+
+WALLS = "".join(f'\n[[scene.wall]]\nbuilding = "B1"\nside = "{side}"\nlevel = 0\ngap = 0.1\nstiffness = 3283500000.0\nrestitution = 0.5\n'
+                for side in ("left", "right"))
+
+
+def test_d_tm_is_not_taken_from_runs_a_moat_wall_capped(tmp_path):
+    from stochpound import open_store
+    from stochpound.risk import store_demands, store_risk
+    from tests.helpers import ISOLATED, risk_text, run_in_process
+
+    text = risk_text(ISOLATED + WALLS, "gap = [0.05, inf]", 'measure = "psa"\nperiod = 1.0\nlevels = [0.3, 0.8, 1.5]')
+    store = open_store(run_in_process(tmp_path, "capped", text))  # walls in every run: no wall-free case
+    risk = store_risk(store, bootstrap=0)
+    assert "dtm" not in risk.rules["rule"].values and risk.dtm_note.startswith("the store has no wall-free runs")
+    assert moat_text(risk, store_demands(store, bootstrap=0)) == ""

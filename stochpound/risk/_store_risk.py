@@ -32,6 +32,7 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
+from stochpound.store import has_wall_free
 from stochpound.analysis._hazard import HazardCurve, rate_from_probability
 from stochpound.risk import _store
 from stochpound.risk._code_rules import MINIMUM_MOTIONS, code_rules_risk
@@ -144,6 +145,8 @@ class StoreRisk:
         The exposure time of the targets (yr).
     confidence : float
         The confidence of the intervals.
+    dtm_note : str
+        Why the rules hold no D_TM ("" where they do, or where the studied building does not slide).
     assumptions : dict of str to str
         What the answer rests on besides the hazard, in words from the
         store's definition: ``structural model``, ``suite`` (and its
@@ -164,6 +167,7 @@ class StoreRisk:
     years: float = YEARS
     confidence: float = CONFIDENCE
     assumptions: dict[str, str] = dataclasses.field(default_factory=dict)
+    dtm_note: str = ""
 
     @property
     def measure(self) -> str:
@@ -380,17 +384,20 @@ def store_risk(store: xr.Dataset, hz: HazardCurve | None = None, targets: Sequen
     separation = risk_targeted_separation(curve, targets, years, confidence=confidence)
     motions = _store.stripe_motions(store, closure.sizes["record"])
     method = "ida" if _store.is_ida(store) else "stripes"
-    rules, note = None, ""
+    rules, note, dtm_note = None, "", ""
     if method == "ida":
         note = "IDA runs hold no stripe at the code intensity to apply the rules to"
     elif motions < MINIMUM_MOTIONS:
         note = f"the codes take the mean over at least {MINIMUM_MOTIONS} motions; the store has {motions}"
     else:
-        rules = code_rules_risk(_store.contact_free_demands(store), hz, years=years, isolator_displacement=_store.base_displacement(store, studied, walls_free=True),
+        isolator = _store.base_displacement(store, studied, walls_free=True)
+        if isolator is not None and _store.moat_clearances(store, studied) and not has_wall_free(store):
+            isolator, dtm_note = None, "the store has no wall-free runs (a moat wall caps the displacement D_TM is to size): add inf to the wall axis"
+        rules = code_rules_risk(_store.contact_free_demands(store), hz, years=years, isolator_displacement=isolator,
                                 confidence=confidence, bootstrap=bootstrap, seed=seed)
     return StoreRisk(fragility, curve, separation, rules, note, hz, motions, method, setting=_store.intensity_setting(store) or {},
                      stripes=_store.stripes(store), experiment=_store.experiment_name(store), years=years, confidence=confidence,
-                     assumptions=_store.assumptions(store))
+                     assumptions=_store.assumptions(store), dtm_note=dtm_note)
 
 
 def target_text(probability: float, years: float = YEARS) -> str:
