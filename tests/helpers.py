@@ -10,6 +10,7 @@ fixtures only; the reference study's buildings and pairs are
 from __future__ import annotations
 
 import builtins
+import dataclasses
 import errno
 import io
 import itertools
@@ -505,3 +506,6 @@ def risk_text(scene: str, grid: str, intensity: str, hazard: str = f'bundled = "
             '[output]\nimpacts = true\n')
 
 
+def with_gaps(scene, gaps: tuple[float, ...]):
+    """``scene`` (a :class:`stochpound.model.scene.Scene`) with contact c's gap set to ``gaps[c]`` (m)."""
+    return dataclasses.replace(scene, contacts=tuple(dataclasses.replace(c, gap=float(g)) for c, g in zip(scene.contacts, gaps)))

@@ -32,8 +32,7 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
-from stochpound.store import has_wall_free
-from stochpound.analysis._hazard import HazardCurve, rate_from_probability
+from stochpound.analysis import HazardCurve, rate_from_probability
 from stochpound.risk import _store
 from stochpound.risk._code_rules import MINIMUM_MOTIONS, code_rules_risk
 from stochpound.risk._fragility_ensemble import BOOTSTRAP, fragility_band, fragility_surface, homogeneous_capacities, ida_fragility, limit_state_events, stripe_fragility
@@ -390,9 +389,7 @@ def store_risk(store: xr.Dataset, hz: HazardCurve | None = None, targets: Sequen
     elif motions < MINIMUM_MOTIONS:
         note = f"the codes take the mean over at least {MINIMUM_MOTIONS} motions; the store has {motions}"
     else:
-        isolator = _store.base_displacement(store, studied, walls_free=True)
-        if isolator is not None and _store.moat_clearances(store, studied) and not has_wall_free(store):
-            isolator, dtm_note = None, "the store has no wall-free runs (a moat wall caps the displacement D_TM is to size): add inf to the wall axis"
+        isolator, dtm_note = _store.free_base_displacement(store, studied)
         rules = code_rules_risk(_store.contact_free_demands(store), hz, years=years, isolator_displacement=isolator,
                                 confidence=confidence, bootstrap=bootstrap, seed=seed)
     return StoreRisk(fragility, curve, separation, rules, note, hz, motions, method, setting=_store.intensity_setting(store) or {},
