@@ -109,12 +109,19 @@ def risk(store: Path, hazard: str | None, hazard_measure: str | None, hazard_uni
     separation = result.separation_frame()
     click.echo(f"\nRisk-targeted separation g* (m; {interval}; inf: wider than every gap of the grid):")
     click.echo(separation.to_string(float_format=lambda v: f"{v:.3f}"))
+    design = result.design_frame()
+    click.echo(f"\nDesign to (m; the {design['basis'].iloc[0]}, not g* itself):")
+    click.echo(design.drop(columns="basis").assign(target=[result.target_text(p) for p in design["target"]])
+               .to_string(index=False, float_format=lambda v: f"{v:.3f}"))
+    degenerate = result.degenerate_text()
+    if degenerate:
+        click.echo(f"note: {degenerate}")
     rules = result.rules_frame()
     if result.rules is None:
         click.echo(f"\nCode rules: not evaluated: {result.rules_note}.")
     else:
-        click.echo(f"\nCode rules in risk terms (gap at the code intensity's stripe; λ_P: pounding per year at that gap; "
-                   f"'once in N years'; P in {years:g} years):")
+        click.echo(f"\nCode rules in risk terms, applied to the suite-mean peaks of the code intensity's stripe (λ_P: pounding per year "
+                   f"at that gap; 'once in N years'; P in {years:g} years; each with its interval; fit: lognormal or a degenerate step):")
         click.echo(rules.to_string(float_format=lambda v: f"{v:.4g}"))
     if costs is not None:
         click.echo(f"\nLimit states beyond first contact (λ: per year at each finite gap; contact-free: the same motions without "

@@ -36,7 +36,7 @@ from stochpound.risk._fragility_ensemble import (
     limit_state_events,
     stripe_fragility,
 )
-from stochpound.risk._maf import TARGETS, demand_hazard_curve, mean_annual_frequency, risk_curve, risk_targeted_separation
+from stochpound.risk._maf import TARGETS, degenerate_text, demand_hazard_curve, mean_annual_frequency, rate_intervals, risk_curve, risk_targeted_separation
 from stochpound.risk._code_rules import code_rules_risk
 from stochpound.risk._code_gaps import (
     Asce7Design,
@@ -71,6 +71,8 @@ __all__ = [
     "demand_hazard_curve",
     "mean_annual_frequency",
     "risk_curve",
+    "rate_intervals",
+    "degenerate_text",
     "risk_targeted_separation",
     "code_rules_risk",
     "Asce7Design",
