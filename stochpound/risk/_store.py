@@ -132,6 +132,11 @@ def studied_building(store: xr.Dataset) -> str | None:
     return store.pound.definition.studied
 
 
+def design(store: xr.Dataset) -> Mapping[str, Any] | None:
+    """The store's ``[design]`` entry, the buildings' code design (None without one)."""
+    return store.pound.definition.design
+
+
 def experiment_name(store: xr.Dataset) -> str | None:
     """The store's experiment name, or None."""
     return store.attrs.get("experiment_name")
