@@ -118,11 +118,12 @@ def risk(store: Path, hazard: str | None, hazard_measure: str | None, hazard_uni
         click.echo(f"note: {degenerate}")
     rules = result.rules_frame()
     if result.rules is None:
-        click.echo(f"\nCode rules: not evaluated: {result.rules_note}.")
-    else:
-        click.echo(f"\nCode rules in risk terms, applied to the suite-mean peaks of the code intensity's stripe (λ_P: pounding per year "
-                   f"at that gap; 'once in N years'; P in {years:g} years; each with its interval; fit: lognormal or a degenerate step):")
+        click.echo(f"\nCode rules: suite-mean rules not evaluated: {result.rules_note}.")
+    if not rules.empty:
+        click.echo(f"\nCode rules in risk terms, the suite-mean rows applied to the suite-mean peaks of the code intensity's stripe (λ_P: pounding "
+                   f"per year at that gap; 'once in N years'; P in {years:g} years; each with its interval; fit: lognormal or a degenerate step):")
         click.echo(rules.to_string(float_format=lambda v: f"{v:.4g}"))
+    click.echo(result.design_rules_text())
     if costs is not None:
         click.echo(f"\nLimit states beyond first contact (λ: per year at each finite gap; contact-free: the same motions without "
                    f"contact; Δλ: what the gap costs; P in {years:g} years):")
