@@ -26,8 +26,8 @@ from stochpound.analysis._pounding import pounding_probability
 from stochpound.analysis._separation import pounding_curve, required_separation, rule_exceedance
 from stochpound.analysis._separation_rules import contact_demands, fixed_base_cqc, separation_rules, store_contact_demands
 from stochpound.analysis._summary import run_summary
-from stochpound.analysis._consistency import hazard_consistency
-from stochpound.analysis._hazard import HazardCurve, bundled_curves, probability_from_rate, rate_from_probability, return_period
+from stochpound.analysis._consistency import hazard_consistency, stripe_rate_weights
+from stochpound.analysis._hazard import HazardCurve, bundled_curves, bundled_measure, probability_from_rate, rate_from_probability, return_period
 from stochpound.analysis._hazard_files import HazardFile, read_hazard_file
 
 
@@ -75,6 +75,7 @@ __all__ = [
     "HazardFile",
     "read_hazard_file",
     "bundled_curves",
+    "bundled_measure",
     "probability_from_rate",
     "rate_from_probability",
     "return_period",
@@ -86,6 +87,7 @@ __all__ = [
     "contact_free_closure",
     "pounding_fragility",
     "hazard_consistency",
+    "stripe_rate_weights",
     "risk_gaps",
     "store_risk",
     "StoreRisk",

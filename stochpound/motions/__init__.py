@@ -12,12 +12,15 @@ between samples): :func:`intensity_measures`, :func:`response_spectrum`.
 The conditional spectrum of a site scenario (NGA-West2 models, Baker–Jayaram
 correlation): :func:`conditional_spectrum`; records chosen and scaled to it
 (Jayaram, Lin & Baker 2011): :func:`selection_pool`, :func:`selection_periods`,
-:func:`select_motions`.
+:func:`select_motions`; the scenario of every level fitted to the site's own
+hazard curves where no disaggregation is at hand: :func:`fit_scenarios`,
+:func:`fit_levels`, :func:`recomputed_hazard`.
 
 Conventions (PSD two-sided in ω, σ² = ∫ S dω; SI units) are in ``docs/motions.md``.
 """
 
 from stochpound.motions._conditional import conditional_spectrum
+from stochpound.motions._fitted import fit_levels, fit_scenarios, recomputed_hazard
 from stochpound.motions.baseline import baseline_correct, final_velocity_displacement
 from stochpound.motions.envelopes import (
     ENVELOPES,
@@ -65,6 +68,8 @@ __all__ = [
     "clough_penzien_psd",
     "conditional_spectrum",
     "filter_samples",
+    "fit_levels",
+    "fit_scenarios",
     "final_velocity_displacement",
     "high_pass_gain",
     "intensity_measures",
@@ -77,6 +82,7 @@ __all__ = [
     "poisson_peak_factor",
     "realization_rng",
     "realization_rngs",
+    "recomputed_hazard",
     "response_spectrum",
     "s0_from_pga",
     "s0_from_rms",
