@@ -10,7 +10,7 @@ import pytest
 from stochpound._errors import SiteError
 from stochpound.analysis import HazardCurve, stripe_rate_weights
 from stochpound.experiment._spec import ExperimentError, parse_experiment
-from stochpound.motions import conditional_spectrum, fit_levels, fit_scenarios, recomputed_hazard
+from stochpound.motions import TARGET_TOLERANCE, conditional_spectrum, fit_levels, fit_scenarios, misses_target, recomputed_hazard
 
 KNOWN = {"magnitude": 7.0, "distance_km": 10.0, "vs30": 400.0, "mechanism": "reverse"}
 IM_STAR = HazardCurve.power_law(2.0e-4, 2.2)  # PSA(1 s) in g
@@ -38,9 +38,9 @@ def test_the_fit_reproduces_a_synthetic_site_built_from_a_known_scenario() -> No
     levels = IM_STAR.intensity_at(1.0 / np.array([72.0, 224.0, 475.0, 975.0, 2475.0, 5000.0]))
     fitted = _fit(levels, others)
     assert len(fitted) == levels.size and all(s["vs30"] == 400.0 and s["mechanism"] == "reverse" for s in fitted)
-    fine = np.geomspace(0.02, 6.0, 200)  # the fitted scenarios' hazard, integrated as the synthetic site's
-    nearest = np.argmin(np.abs(np.log(fine)[:, None] - np.log(levels)[None, :]), axis=1)
-    recomputed = recomputed_hazard("psa", 1.0, fine, stripe_rate_weights(fine, IM_STAR), [fitted[j] for j in nearest], others)
+    assert all(s == fitted[0] for s in fitted)  # one scenario for every level
+    fine = np.geomspace(0.02, 6.0, 200)  # the fitted scenario's hazard, integrated as the synthetic site's
+    recomputed = recomputed_hazard("psa", 1.0, fine, stripe_rate_weights(fine, IM_STAR), [fitted[0]] * fine.size, others)
     wrong = _synthetic_site({**KNOWN, "magnitude": 5.5, "distance_km": 80.0})
     for (_, im, site), fit, (_, _, bad) in zip(others, recomputed, wrong):
         inside = (site <= IM_STAR(levels[:1])[0]) & (site >= IM_STAR(levels[-1:])[0])  # the rates the stripes represent
@@ -140,3 +140,12 @@ def test_bad_fitted_site_is_one_line_naming_the_field(tmp_path, site: str, field
     with pytest.raises(ExperimentError) as error:
         parse_experiment(tomllib.loads(_text(FITTED_SELECTION, site)), tmp_path)
     assert str(error.value).startswith(field) and "\n" not in str(error.value)
+
+
+def test_a_selection_misses_its_target_where_its_mean_or_std_of_ln_sa_is_off_by_more_than_the_tolerance() -> None:
+    median, sigma = np.array([[0.5, 0.3, 0.1]] * 3), np.array([[0.0, 0.4, 0.5]] * 3)
+    mean_ln, std_ln = np.log(median), sigma.copy()
+    mean_ln[1, 2] += TARGET_TOLERANCE * 1.1  # stripe 1: the mean off at one period
+    std_ln[2, 1] -= TARGET_TOLERANCE * 1.1  # stripe 2: the std off
+    mean_ln[0] += TARGET_TOLERANCE * 0.9  # stripe 0: within
+    assert misses_target(mean_ln, std_ln, median, sigma).tolist() == [False, True, True]

@@ -250,6 +250,8 @@ class StripeSelections:
 
     def coordinates(self) -> dict[str, xr.Variable]:
         """The store's record of the selection: per stripe the chosen motions' scale factors, the target and the set's spectra, the scenario."""
+        from stochpound.motions import TARGET_TOLERANCE, misses_target
+
         scale = np.full(self.chosen.shape, np.nan)
         for i, selection in enumerate(self.selections):
             scale[i, [self.labels.index(m) for m in selection["motion"].values]] = selection["scale_factor"].values
@@ -266,6 +268,10 @@ class StripeSelections:
             "target_sigma_ln": xr.Variable(per_stripe, stack["sigma_ln"], {"units": "1", "long_name": "conditional spectrum: standard deviation of ln Sa"}),
             "selection_mean_ln": xr.Variable(per_stripe, stack["mean_ln"], {"units": "1", "long_name": "mean ln Sa (g) of the chosen, scaled motions"}),
             "selection_std_ln": xr.Variable(per_stripe, stack["std_ln"], {"units": "1", "long_name": "standard deviation of ln Sa of the chosen, scaled motions"}),
+            "selection_misses_target": xr.Variable(
+                ("intensity",), misses_target(stack["mean_ln"], stack["std_ln"], stack["median"], stack["sigma_ln"]).astype(np.int8),
+                {"units": "1", "long_name": f"1 where the stripe's selection misses its target (mean or std of ln Sa off by > {TARGET_TOLERANCE:g} at a period)"},
+            ),
             "target_epsilon": xr.Variable(("intensity",), np.array([s["epsilon"] for s in scenario]), {"units": "1", "long_name": "epsilon of the level in its scenario"}),
             "site_magnitude": xr.Variable(("intensity",), np.array([s["magnitude"] for s in scenario]), {"units": "1", "long_name": "scenario moment magnitude"}),
             "site_distance_km": xr.Variable(("intensity",), np.array([s["distance_km"] for s in scenario]), {"units": "km", "long_name": "scenario rupture distance"}),

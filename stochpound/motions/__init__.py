@@ -45,7 +45,7 @@ from stochpound.motions.psd import (
     kanai_tajimi_psd,
     kanai_tajimi_variance,
 )
-from stochpound.motions._selection import select_motions, selection_periods, selection_pool
+from stochpound.motions._selection import TARGET_TOLERANCE, misses_target, select_motions, selection_periods, selection_pool
 from stochpound.motions._seeding import realization_rng, realization_rngs
 from stochpound.motions._spectrum import response_spectrum
 from stochpound.motions._synthetic import PSD_CONVENTION, clough_penzien, kanai_tajimi, synthetic_ground_motion
@@ -53,6 +53,7 @@ from stochpound.motions._synthetic import PSD_CONVENTION, clough_penzien, kanai_
 __all__ = [
     "ENVELOPES",
     "PSD_CONVENTION",
+    "TARGET_TOLERANCE",
     "SOIL_PRESETS",
     "AminAng",
     "CallableEnvelope",
@@ -78,6 +79,7 @@ __all__ = [
     "kanai_tajimi_psd",
     "kanai_tajimi_variance",
     "make_envelope",
+    "misses_target",
     "peak_ground_motion",
     "poisson_peak_factor",
     "realization_rng",

@@ -13,12 +13,11 @@ with P from the conditional spectrum of the level's scenario (ln Sa(T')
 normal, its conditional mean and σ; :mod:`stochpound.motions._conditional`)
 and Δλ(x_j) the rate of IM* in the bin of x_j
 (:func:`stochpound.analysis.stripe_rate_weights`). The fit integrates on a
-fine grid of :data:`FINE_LEVELS` levels from :data:`SPAN` times below the
-lowest stripe to :data:`SPAN` times above the highest or the end of the
-hazard's table (weaker and stronger shaking add to the rates compared; the
-last takes the whole tail), each fine level taking the scenario of its
-nearest stripe, so that the scenario is fitted to the site's curves and not
-to the coarseness of a few stripes.
+fine grid of :data:`FINE_LEVELS` levels (:func:`fit_levels`) from
+:data:`SPAN` times below the lowest stripe to :data:`SPAN` times above the
+highest or the end of the hazard's table (weaker and stronger shaking add
+to the rates compared; the last takes the whole tail), so that the scenario
+is fitted to the site's curves and not to the coarseness of a few stripes.
 
 The fit: every scenario of a grid (:data:`MAGNITUDES` × :data:`DISTANCES`,
 within the models' range, Vs30 and mechanism given) is a candidate for
@@ -52,7 +51,6 @@ from stochpound.motions._conditional import CONDITIONING_MEASURES, PGA_PERIOD, _
 MAGNITUDES = tuple(np.round(np.arange(5.5, 8.01, 0.1), 2))
 #: Candidate rupture distances of the fit, km.
 DISTANCES = (1.0, 2.0, 4.0, 7.0, 10.0, 15.0, 20.0, 30.0, 50.0, 80.0, 120.0)
-_MAX_PASSES = 20
 #: Levels of the fine grid over the stripes' range on which the fit integrates (each takes its nearest stripe's scenario).
 FINE_LEVELS = 60
 #: The fine grid spans from this factor below the lowest stripe to this factor above the highest (or the hazard table's end).
@@ -84,7 +82,7 @@ def fit_scenarios(
     vs30: float,
     mechanism: str,
 ) -> list[dict[str, float | str]]:
-    """The scenario of every level that makes the stripes reproduce the site's other hazard curves (module docstring).
+    """The scenario that makes the stripes reproduce the site's other hazard curves (module docstring).
 
     Parameters
     ----------
@@ -106,7 +104,8 @@ def fit_scenarios(
     Returns
     -------
     list of dict
-        Per level, in order: ``magnitude``, ``distance_km``, ``vs30``, ``mechanism``.
+        Per level, in order: ``magnitude``, ``distance_km``, ``vs30``,
+        ``mechanism`` (the same scenario for every level: module docstring).
 
     Raises
     ------
@@ -127,7 +126,6 @@ def fit_scenarios(
         raise SiteError("fine_levels: increasing levels, one rate of fine_rates each (fit_levels)")
     if fine[0] > x[0] or fine[-1] < x[-1]:
         raise SiteError(f"fine_levels: must span the levels {x[0]:g}-{x[-1]:g} g, got {fine[0]:g}-{fine[-1]:g} g")
-    owner = np.argmin(np.abs(np.log(fine)[:, None] - np.log(x)[None, :]), axis=1)  # the stripe each fine level belongs to
     model = _SiteModel(measure, period, fine, others, vs30, mechanism)
     high_rate = float(fine_weights[fine >= x[0]].sum())  # the rates of the stripes' range: λ(x_1) to λ(x_top)
     low_rate = float(fine_weights[fine >= x[-1]].sum())
@@ -139,34 +137,16 @@ def fit_scenarios(
             raise SiteError(f"others: the site's {_node_label(node)} curve has no intensity whose rate is within the stripes' {low_rate:.3g}-{high_rate:.3g}/yr")
         targets.append((im[keep], np.log(rate[keep])))
     candidates = [(m, r) for m in MAGNITUDES for r in DISTANCES]
-    # the rates exceed[c][j][k] (over the curve's y) that stripe j contributes with candidate c to other curve k
-    exceed = []
+    scores = []
     for magnitude, distance in candidates:
         probabilities = model.exceedance(magnitude, distance, [y for y, _ in targets])
-        exceed.append([[sum(fine_weights[i] * probabilities[i][k] for i in np.flatnonzero(owner == j)) for k in range(len(targets))]
-                       for j in range(x.size)])
-
-    def misfit(choice: list[int]) -> float:
-        total = 0.0
+        score = 0.0
         for k, (_, ln_site) in enumerate(targets):
-            recomputed = sum(exceed[c][j][k] for j, c in enumerate(choice))
-            total += float(np.sum((np.log(np.maximum(recomputed, 1e-300)) - ln_site) ** 2))
-        return total
-
-    scores = [misfit([c] * x.size) for c in range(len(candidates))]
-    choice = [int(np.argmin(scores))] * x.size
-    best = scores[choice[0]]
-    for _ in range(_MAX_PASSES):
-        improved = False
-        for j in range(x.size):
-            for c in range(len(candidates)):
-                trial = choice[:j] + [c] + choice[j + 1 :]
-                value = misfit(trial)
-                if value < best - 1e-12:
-                    choice, best, improved = trial, value, True
-        if not improved:
-            break
-    return [{"magnitude": float(candidates[c][0]), "distance_km": float(candidates[c][1]), "vs30": float(vs30), "mechanism": mechanism} for c in choice]
+            recomputed = sum(fine_weights[i] * probabilities[i][k] for i in range(fine.size))
+            score += float(np.sum((np.log(np.maximum(recomputed, 1e-300)) - ln_site) ** 2))
+        scores.append(score)
+    magnitude, distance = candidates[int(np.argmin(scores))]
+    return [{"magnitude": float(magnitude), "distance_km": float(distance), "vs30": float(vs30), "mechanism": mechanism} for _ in x]
 
 
 class _SiteModel:
