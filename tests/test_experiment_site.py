@@ -17,28 +17,10 @@ from stochpound.motions.records import Record, load_suite_member
 from stochpound.report.render import FigureItem, Paragraph
 from stochpound.report.sections._intensity import intensity_section
 from stochpound.risk import selection_misses
+from tests.helpers import SITE_SCENE as SCENE
 from tests.helpers import write_experiment
 
 MEMBERS = [f"fema_p695_far_field/{i:02d}{c}" for i in range(1, 7) for c in "ab"]
-SCENE = """
-[scene]
-g = 9.81
-[[scene.building]]
-name = "B1"
-mass = [2.0e5, 1.5e5]
-stiffness = [1.2e8, 0.9e8]
-damping_ratio = 0.05
-[[scene.building]]
-name = "B2"
-mass = [1.0e5]
-stiffness = [1.5e7]
-damping_ratio = 0.02
-[[scene.contact]]
-between = [["B1", 1], ["B2", 1]]
-gap = 0.02
-stiffness = 1.0e8
-restitution = 0.65
-"""
 RECORDS = "".join(f'\n[[records]]\nrecord = "{name}"\nduration = 5.0\n' for name in MEMBERS)
 SELECTION = 'measure = "psa"\nperiod = 0.5\nlevels = [0.4, 0.2]\nselection = "conditional_spectrum"\nmotions = 4\nmax_scale_factor = 5.0\nseed = 2\n'
 SITE = '[site]\nvs30 = 400.0\nmagnitude = [7.0, 6.6]\ndistance_km = 20.0\nmechanism = "strike_slip"\n'

@@ -10,6 +10,7 @@ import pytest
 from stochpound._errors import SiteError
 from stochpound.analysis import HazardCurve, stripe_rate_weights
 from stochpound.experiment._spec import ExperimentError, parse_experiment
+from tests.helpers import SITE_SCENE
 from stochpound.motions import TARGET_TOLERANCE, conditional_spectrum, fit_levels, fit_scenarios, misses_target, recomputed_hazard
 
 KNOWN = {"magnitude": 7.0, "distance_km": 10.0, "vs30": 400.0, "mechanism": "reverse"}
@@ -78,33 +79,10 @@ def test_bad_input_to_the_fit_is_one_line_naming_the_field(change: dict, field: 
     assert str(error.value).startswith(field) and "\n" not in str(error.value)
 
 
-SCENE = """
-[scene]
-g = 9.81
-[[scene.building]]
-name = "B1"
-mass = [2.0e5]
-stiffness = [1.2e8]
-damping_ratio = 0.05
-[[scene.building]]
-name = "B2"
-mass = [1.0e5]
-stiffness = [1.5e7]
-damping_ratio = 0.02
-[[scene.contact]]
-between = [["B1", 1], ["B2", 1]]
-gap = 0.02
-stiffness = 1.0e8
-restitution = 0.65
-[grid]
-gap = ["inf"]
-[[records]]
-suite = "fema_p695_far_field"
-"""
 
 
 def _text(intensity: str, site: str) -> str:
-    return f'[experiment]\nname = "fitted"\n{SCENE}\n[intensity]\n{intensity}\n{site}\n'
+    return f'[experiment]\nname = "fitted"\n{SITE_SCENE}\n[grid]\ngap = ["inf"]\n[[records]]\nsuite = "fema_p695_far_field"\n[intensity]\n{intensity}\n{site}\n'
 
 
 CURVES = '["fox_plaza_los_angeles_pga", "fox_plaza_los_angeles_sa1p0s", "fox_plaza_los_angeles_sa2p0s"]'

@@ -74,7 +74,7 @@ def hazard_consistency(spectra: xr.DataArray, hazard: HazardCurve, other: Hazard
         ``rate_weight`` (``intensity_dim``): Δλ of every stripe.
     """
     levels = np.asarray(spectra[intensity_dim].values, dtype=float)
-    weights = stripe_rate_weights(levels, hazard, f"spectra along {intensity_dim}")
+    weights = stripe_rate_weights(levels, hazard, "spectra")
     values = np.asarray(spectra.transpose(intensity_dim, record_dim).values, dtype=float)
     valid = np.isfinite(values)
     if not valid.any(axis=1).all():
