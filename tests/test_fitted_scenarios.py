@@ -93,6 +93,7 @@ FITTED_SITE = f'[site]\nscenario = "fitted"\ncurves = {CURVES}\nvs30 = 400.0\nme
 def test_a_fitted_site_stores_the_fitted_scenario_of_every_level(tmp_path) -> None:
     definition = parse_experiment(tomllib.loads(_text(FITTED_SELECTION, FITTED_SITE)), tmp_path)
     scenarios = definition["intensity"]["site"]
+    assert "fitted to the site's hazard curves fox_plaza_los_angeles_pga" in definition["intensity"]["note"]
     hazard = HazardCurve.bundled("fox_plaza_los_angeles_sa1p0s")
     others = [(None, HazardCurve.bundled("fox_plaza_los_angeles_pga").im, HazardCurve.bundled("fox_plaza_los_angeles_pga").rate),
               (2.0, HazardCurve.bundled("fox_plaza_los_angeles_sa2p0s").im, HazardCurve.bundled("fox_plaza_los_angeles_sa2p0s").rate)]

@@ -107,6 +107,8 @@ def parse_selection(table: Mapping[str, Any], site: Any, levels: list[float], en
     if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0:
         raise SiteError(f"intensity.seed: must be an integer >= 0, got {seed!r}")
     note = f"{motions} motions per stripe chosen from the pool and scaled to the conditional spectrum of its scenario"
+    if isinstance(site, dict) and site.get("scenario") == "fitted" and isinstance(site.get("curves"), list):
+        note += f" (the scenario fitted to the site's hazard curves {', '.join(map(str, site['curves']))}, standing in for a disaggregation)"
     return {"note": note, "selection": selection, "motions": motions, "max_scale_factor": max_scale, "seed": seed, "site": parse_site(site, levels, entry)}
 
 
