@@ -129,7 +129,8 @@ def main(argv: list[str] | None = None) -> None:
         stacked = values.stack(cell=others) if others else values.expand_dims(cell=[""])
         for ax, j in zip(axes, range(values.sizes["target"])):
             for k in range(stacked.sizes["cell"]):
-                label = configuration + (f", {stacked['cell'].values[k]}" if others else "")
+                cell = stacked["cell"].values[k]
+                label = configuration + (", " + ", ".join(map(str, cell if isinstance(cell, tuple) else (cell,))) + " neighbour" if others else "")
                 ax.plot(args.measures, stacked.isel(target=j, cell=k).values, "o-", label=label)
     axes[0].set_ylabel("g* (m)")
     axes[1].legend(fontsize=7)
