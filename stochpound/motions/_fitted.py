@@ -12,7 +12,7 @@ hazard-consistency check of Lin, Haselton & Baker (2013) used as the fit:
 with P from the conditional spectrum of the level's scenario (ln Sa(T')
 normal, its conditional mean and σ; :mod:`stochpound.motions._conditional`)
 and Δλ(x_j) the rate of IM* in the bin of x_j
-(:func:`stochpound.analysis.stripe_rate_weights`). The fit integrates on a
+(:func:`stochpound.risk.stripe_rate_weights`). The fit integrates on a
 fine grid of :data:`FINE_LEVELS` levels (:func:`fit_levels`) from
 :data:`SPAN` times below the lowest stripe to :data:`SPAN` times above the
 highest or the end of the hazard's table (weaker and stronger shaking add
@@ -58,10 +58,10 @@ SPAN = 5.0
 
 
 def fit_levels(levels: Sequence[float], highest: float = np.inf) -> np.ndarray:
-    """The fine grid (g) on which :func:`fit_scenarios` integrates: :data:`FINE_LEVELS` log-spaced levels (module docstring).
+    """The fine grid (g) on which :func:`fit_scenarios` integrates: 60 log-spaced levels.
 
-    From :data:`SPAN` times below the lowest of ``levels`` (g) to
-    :data:`SPAN` times above the highest, or ``highest`` (g, e.g. the end of
+    From 5 times below the lowest of ``levels`` (g) to
+    5 times above the highest, or ``highest`` (g, e.g. the end of
     the hazard's table) if lower.
     """
     x = np.sort(np.asarray(levels, dtype=float))
@@ -93,7 +93,7 @@ def fit_scenarios(
     fine_levels, fine_rates : list of float
         The site's hazard of IM* on the fine grid of :func:`fit_levels`:
         its levels (g) and the rate of each one's bin (1/yr, e.g.
-        :func:`stochpound.analysis.stripe_rate_weights`).
+        :func:`stochpound.risk.stripe_rate_weights`).
     others : list of (period or None, im, rate)
         The site's hazard curves at other periods: the period in s (None for
         PGA), the tabulated intensities (g) and their annual rates (1/yr).

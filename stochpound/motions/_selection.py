@@ -210,7 +210,7 @@ def select_motions(pool: xr.Dataset, target: xr.Dataset, motions: int, max_scale
 
 
 def misses_target(mean_ln: np.ndarray, std_ln: np.ndarray, median: np.ndarray, sigma_ln: np.ndarray) -> np.ndarray:
-    """Whether a selection misses its target: its mean or standard deviation of ln Sa farther than :data:`TARGET_TOLERANCE` from the target's at any period.
+    """Whether a selection misses its target: its mean or standard deviation of ln Sa farther than ``TARGET_TOLERANCE`` (0.1) from the target's at any period.
 
     Parameters
     ----------
