@@ -12,7 +12,7 @@ experiments/risk/isolated.toml (mu 0.05, no moat wall, stiff neighbour).
 
 It prints the table and draws ``docs/figures/site_consistency.png`` (g*
 against the conditioning measure). About 4 minutes on 2 cores for the four
-measures; ``--measures PGA "PSA(1 s)"`` runs fewer. tests/test_site_consistency.py
+measures; ``--measures PGA "PSA(1 s)"`` runs fewer. tests/test_benchmark_site_consistency.py
 runs the reduced check with the same experiments.
 """
 

@@ -6,7 +6,7 @@ a flexible neighbour, and the isolated Building 1 of experiments/risk/isolated.t
 neighbour; stripes at return periods 72-5000 years, 20 motions per stripe from the 100 FEMA P695 motions, factor <= 5,
 the scenario fitted to the site's four curves), conditioned on PGA, PSA(1 s) and PSA(2 s).
 
-Run: ``pytest -m slow tests/test_site_consistency.py -s`` (prints the g* table; about 1 minute for the fixed pair and 2
+Run: ``pytest -m slow tests/test_benchmark_site_consistency.py -s`` (prints the g* table; about 1 minute for the fixed pair and 2
 for the isolated building on 2 cores).
 """
 
