@@ -179,13 +179,11 @@ def _environment() -> dict[str, str]:
 
 def _done(store: Path) -> int:
     """Finished cases in a store's parts."""
-    from stochpound.experiment import Experiment
-    from stochpound.experiment._parts import parts_folder, read_definition
-    from stochpound.experiment._store_writer import PartsIndex
+    from stochpound.experiment import Experiment, PartsIndex, parts_folder, read_experiment_json
 
     folder = parts_folder(store)
     try:
-        return PartsIndex.scan(Experiment(read_definition(folder)["definition"]), folder).n_done
+        return PartsIndex.scan(Experiment(read_experiment_json(folder)["definition"]), folder).n_done
     except Exception:  # noqa: BLE001 - not there yet
         return 0
 

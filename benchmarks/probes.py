@@ -54,7 +54,7 @@ def _main_scene():
 def _ensemble_setup(runs: int, lazy: bool):
     """Scene (c), ``runs`` Kanai–Tajimi motions of 30 s at dt 0.01 s, and a 2-realization warm-up run."""
     from benchmarks.scenes import STUDY_SCENES, kanai_tajimi_motions, lazy_kanai_tajimi_motions
-    from stochpound.experiment._ensemble import simulate_ensemble
+    from stochpound.experiment import simulate_ensemble
 
     scene = STUDY_SCENES[2].scene()
     make = lazy_kanai_tajimi_motions if lazy else kanai_tajimi_motions
@@ -118,9 +118,7 @@ def single_cell(path: str, runs: int) -> None:
 
     import stochpound
     from stochpound import motions as generators
-    from stochpound.experiment import load_experiment
-    from stochpound.experiment._grid import CASE
-    from stochpound.experiment._sources import resolve_motions
+    from stochpound.experiment import CASE, load_experiment, resolve_motions
     from stochpound.motions.ground import SampledMotion
 
     batch = 64

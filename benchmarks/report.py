@@ -209,6 +209,7 @@ python -m benchmarks               # full run: rewrites docs/benchmarks.md and d
 python -m benchmarks --quick       # smoke run (< 1 min), written to a temporary folder
 python -m benchmarks compare REV   # this tree against revision REV in one session (a few minutes): its own section
 python -m benchmarks compare REV --demands   # the same, every run monitoring the demand parameters
+python -m benchmarks yielding     # yielding storeys: OpenSees Steel01 cross-check and speed (1 min): its own section
 ```
 {quick}
 The benchmark process runs on one thread (OMP, OpenBLAS, MKL and numba thread
@@ -433,6 +434,13 @@ def figure(results: Results, path: Path) -> Path:
         _panel(ax, bench)
     axes[0][0].set_ylabel("max |y − y_ref|, B1 top floor (m)")
     axes[0][-1].legend(loc="best", fontsize=8)
+    return save_figure(fig, path)
+
+
+def save_figure(fig: Any, path: Path) -> Path:
+    """Lay out ``fig``, write it to ``path`` (130 dpi, folders made) and close it."""
+    import matplotlib.pyplot as plt
+
     fig.tight_layout()
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=130)

@@ -85,11 +85,7 @@ def figure(data: dict[str, Any], path: Path) -> Path:
     bottom.set_xlabel("period T (s)")
     bottom.set_ylabel("deviation from exact (%)")
     bottom.legend(fontsize=8)
-    fig.tight_layout()
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=130)
-    plt.close(fig)
-    return path
+    return report.save_figure(fig, path)
 
 
 def section(data: dict[str, Any], info: dict[str, str]) -> str:

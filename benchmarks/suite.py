@@ -302,7 +302,7 @@ def guarded(call: Callable[[], dict[str, Any]]) -> dict[str, Any]:
 def ensemble_available() -> bool:
     """Whether ``stochpound.experiment._ensemble.simulate_ensemble`` exists in this tree."""
     try:
-        from stochpound.experiment._ensemble import simulate_ensemble  # noqa: F401
+        from stochpound.experiment import simulate_ensemble  # noqa: F401
     except ImportError:
         return False
     return True

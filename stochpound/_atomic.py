@@ -66,13 +66,18 @@ def check_room(path: str | Path, needed: int) -> None:
     Called before a large write, so that a full disk is reported before any
     byte is written (a library that writes the file may not fail cleanly).
     """
+    free = free_bytes(path)
+    if free is not None and free < needed:
+        raise OSError(errno.ENOSPC, f"No space left on device: {free / 1e6:.1f} MB free, about {needed / 1e6:.1f} MB needed", str(path))
+
+
+def free_bytes(path: str | Path) -> int | None:
+    """Free bytes on the disk of ``path``'s folder (of the working folder if it does not exist yet); None if unknown."""
     path = Path(path)
     try:
-        free = shutil.disk_usage(path.parent if path.parent.is_dir() else Path.cwd()).free
+        return shutil.disk_usage(path.parent if path.parent.is_dir() else Path.cwd()).free
     except OSError:
-        return  # the write itself reports it
-    if free < needed:
-        raise OSError(errno.ENOSPC, f"No space left on device: {free / 1e6:.1f} MB free, about {needed / 1e6:.1f} MB needed", str(path))
+        return None  # the write itself reports it
 
 
 def _create_temporary(path: Path) -> Path:

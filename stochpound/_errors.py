@@ -4,7 +4,10 @@ Every error caused by user input names the offending field (or file and line)
 and the allowed range, so that it can be fixed without reading the source.
 """
 
+import contextlib
 import errno
+import re
+from typing import Iterator
 
 
 class StochpoundError(Exception):
@@ -47,3 +50,26 @@ def os_error_message(error: OSError) -> str:
 
 
 _WRITE_ERRORS = {errno.EROFS, errno.EACCES, errno.EPERM, errno.ENOSPC, errno.EDQUOT}
+
+
+@contextlib.contextmanager
+def field_errors(prefix: str = "", scene_prefix: str | None = None) -> Iterator[None]:
+    """Re-raise :class:`SceneError` (and ``ValueError``) as :class:`ExperimentError`.
+
+    Parameters
+    ----------
+    prefix : str
+        Prepended to the message (``"variants.neighbour.stiff: "``).
+    scene_prefix : str, optional
+        Replaces a leading ``motion.`` / ``motion:`` of scene messages, so that a
+        record's errors name the experiment's field (``records[0].duration``).
+    """
+    try:
+        yield
+    except ExperimentError:
+        raise
+    except (SceneError, ValueError) as error:
+        message = str(error)
+        if scene_prefix is not None:
+            message = re.sub(r"^motion([.:])", lambda m: scene_prefix + ("." if m.group(1) == "." else ":"), message)
+        raise ExperimentError(prefix + message) from None

@@ -10,6 +10,7 @@ fixtures only; the reference study's buildings and pairs are
 from __future__ import annotations
 
 import builtins
+import dataclasses
 import errno
 import io
 import itertools
@@ -493,7 +494,8 @@ REPOSITORY = Path(__file__).resolve().parent.parent
 MOTIONS = ["01a", "03b", "05a", "07b", "10a", "12a", "14b", "19a"]
 RECORDS = "".join(f'\n[[records]]\nrecord = "fema_p695_far_field/{name}"\nduration = 5.0\n' for name in MOTIONS)
 FLAGSHIP = (REPOSITORY / "experiments" / "risk" / "isolated.toml").read_text()
-ISOLATED = FLAGSHIP[FLAGSHIP.index("[scene]"):FLAGSHIP.index("[variants")]  # the flagship's scene, without its variants
+_YIELDING = r"^(storey_height|yield_force|hardening|p_delta) = .*\n"  # the flagship's yielding storeys: these small experiments stay elastic (IDA)
+ISOLATED = re.sub(_YIELDING, "", FLAGSHIP[FLAGSHIP.index("[scene]"):FLAGSHIP.index("[variants")], flags=re.MULTILINE)  # its scene, no variants
 _B2 = ISOLATED.rindex("mass = [26268.0, 17512.0]")  # the neighbour: the stiff variant (masses x 0.5), else the pair moves as one
 FIXED = re.sub(r"^base = .*\n", "", ISOLATED[:_B2] + "mass = [13134.0, 8756.0]" + ISOLATED[_B2 + len("mass = [26268.0, 17512.0]"):], flags=re.MULTILINE)
 BUNDLED = "fox_plaza_los_angeles_sa1p0s"
@@ -503,6 +505,11 @@ def risk_text(scene: str, grid: str, intensity: str, hazard: str = f'bundled = "
     hazard_table = f"\n[hazard]\n{hazard}\n" if hazard else ""
     return (f'[experiment]\nname = "risk"\nstudied = "B1"\n{scene}\n[grid]\n{grid}\n{RECORDS}\n[intensity]\n{intensity}\n{hazard_table}'
             '[output]\nimpacts = true\n')
+
+
+def with_gaps(scene, gaps: tuple[float, ...]):
+    """``scene`` (a :class:`stochpound.model.scene.Scene`) with contact c's gap set to ``gaps[c]`` (m)."""
+    return dataclasses.replace(scene, contacts=tuple(dataclasses.replace(c, gap=float(g)) for c, g in zip(scene.contacts, gaps)))
 
 
 #: Two buildings (a two-storey and a one-storey) and one contact: the scene of the intensity and site experiments' tests.

@@ -115,12 +115,34 @@ def test_opensees_model_agrees_with_the_exact_solver_on_a_short_record(spec):
 
 
 @pytest.mark.slow
+def test_opensees_steel01_storeys_converge_to_the_exact_yielding_solution_at_second_order():
+    """The yielding pair without contacts, 4 s of El Centro: OpenSees' error against the exact solution falls as dt² and is its own step error."""
+    from benchmarks.yielding import yielding_pair
+
+    opensees_or_skip()
+    scene = yielding_pair(np.inf, 4.0)
+    run = stochpound.simulate(scene)
+    assert float(run["peak_storey_ductility"].max()) > 2.0  # it yields
+    reference = outcome_from_dataset(run)
+    coarse, fine = run_opensees(scene, 0.001), run_opensees(scene, 0.0005)
+    errors = [compare(outcome, reference).displacement for outcome in (coarse, fine)]
+    assert errors[0] < 1e-4 and 3.5 < errors[0] / errors[1] < 4.5  # second order
+    assert compare(coarse, fine).displacement * 4 / 3 == pytest.approx(errors[0], rel=0.1)  # the error is OpenSees' step error
+
+
+@pytest.mark.slow
 def test_opensees_model_rejects_what_its_elements_cannot_represent():
     opensees_or_skip()
     with pytest.raises(ValueError, match="study_compat"):
         run_opensees(MAIN_SCENE.scene(1.0, study_compat=True), 0.001)
     with pytest.raises(ValueError, match="gap"):
         run_opensees(dataclasses.replace(FIXED_PAIR, gap=0.0).scene(1.0), 0.001)
+    from benchmarks.yielding import yielding_pair
+
+    p_delta = yielding_pair(np.inf, 1.0)
+    p_delta = dataclasses.replace(p_delta, buildings=tuple(dataclasses.replace(b, p_delta=True, storey_height=(3.5, 3.0)) for b in p_delta.buildings))
+    with pytest.raises(ValueError, match="p_delta"):
+        run_opensees(p_delta, 0.001)
 
 
 def test_outcome_reads_the_first_buildings_top_floor_as_label_selection_would():

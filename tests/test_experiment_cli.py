@@ -12,6 +12,7 @@ import stat
 import subprocess
 import sys
 import time
+from collections.abc import Iterator
 
 import pytest
 import xarray as xr
@@ -245,7 +246,7 @@ def test_a_large_experiment_shows_its_estimate_and_asks_for_yes(tmp_path, monkey
     assert result.exit_code == 1
     message = result.stderr.strip()
     assert re.fullmatch(
-        rf"Error: {re.escape(str(experiment))}: 2,000,000 cases to run: roughly [0-9.]+ \w+ on 1 core, store about [0-9.]+ MiB "
+        rf"Error: {re.escape(str(experiment))}: 2,000,000 cases to run: roughly [0-9.]+ \w+ on 1 core after a start-up[^;]*, store about [0-9.]+ MiB "
         r"\(and as much again in its \.parts folder\); above 1,000,000 cases or 10 GiB of store: give --yes to run it",
         message,
     ), message
@@ -266,7 +267,7 @@ def test_a_first_run_says_what_it_does_and_ctrl_c_during_the_cluster_start_stops
         if line.startswith("starting a local dask cluster"):
             break
     assert lines[0].startswith("4 cases to run: roughly "), lines
-    assert lines[1] in ("compiling the solver (first run only, ~10 s)…\n", "loading the compiled solver…\n"), lines
+    assert lines[1].startswith("stochpound: compiling the exact solver's engine (") or lines[1] == "loading the compiled solver…\n", lines
     assert lines[2] == "starting a local dask cluster (2 workers)…\n", lines
     time.sleep(0.5)  # inside LocalCluster(...): its workers take seconds to start
     os.killpg(process.pid, signal.SIGINT)
@@ -346,6 +347,145 @@ def test_a_full_disk_is_found_before_the_store_is_written(stationary, tmp_path, 
     assert f"{store}: cannot write here (No space left on device: 0.0 MB free, about " in result.stderr and result.exit_code == 0
 
 
+def test_the_estimate_counts_the_start_up_as_last_timed_on_this_machine(tmp_path, monkeypatch, caplog):
+    """A cold cache: the estimate names the compile and the rest of the start-up, not yet timed; the compile is announced
+    (a log line) and both are timed; the next run's estimate adds them as measured. A warm cache: no compile, no line."""
+    from stochpound.experiment._estimate import COMPILE, _duration
+    from stochpound.solvers import first_call
+
+    timings = tmp_path / "timings.json"
+    monkeypatch.setattr(first_call, "_timings_path", lambda: timings)
+    monkeypatch.setattr(first_call, "engine_cached", lambda: False)
+    experiment = write_experiment(tmp_path, TINY_EXPERIMENT, "tiny.toml")
+    rest = "opening the store and loading the solver"
+    with caplog.at_level("WARNING", logger="stochpound.solvers"):
+        result = invoke("experiment", "run", str(experiment), "--workers", "0")
+    assert result.exit_code == 0, result.output
+    assert (f"on 1 core after a start-up: {COMPILE} (not yet timed on this machine: 8 s on an idle one, up to a minute on a loaded one), "
+            f"{rest} (not yet timed on this machine), store about ") in result.stderr, result.stderr
+    assert [r.getMessage() for r in caplog.records if r.name == "stochpound.solvers"] == [
+        "stochpound: compiling the exact solver's engine (numba's cache of it is empty; not yet timed on this machine: 8 s on an idle "
+        "one, up to a minute on a loaded one); later calls, and later processes, load it from the cache"]
+    measured = json.loads(timings.read_text())
+    assert measured["compile"] >= 0 and measured[rest] > 0, measured  # this process had the engine loaded: the warm-up takes ~0 s
+    setup = float(re.search(r"in all: ([\d.]+) s start-up", result.stdout).group(1))
+    assert measured["compile"] + measured[rest] == pytest.approx(setup, abs=0.2)  # the start-up the summary reports, split in two
+    caplog.clear()
+    result = invoke("experiment", "run", str(experiment), "--workers", "0", "--restart")
+    total = _duration(measured["compile"] + measured[rest])
+    assert (f"after a start-up of about {total} ({COMPILE} {_duration(measured['compile'])}, {rest} {_duration(measured[rest])}, "
+            "as last timed on this machine)") in result.stderr, result.stderr
+    caplog.clear()
+    result = invoke("experiment", "run", str(experiment), "--workers", "0", "--restart", "--quiet")
+    assert result.exit_code == 0 and result.stderr == "" and not caplog.records, (result.stderr, caplog.records)  # --quiet: not even the compile's line
+    monkeypatch.setattr(first_call, "engine_cached", lambda: True)
+    caplog.clear()
+    with caplog.at_level("WARNING", logger="stochpound.solvers"):
+        result = invoke("experiment", "run", str(experiment), "--workers", "0", "--restart")
+    assert COMPILE not in result.stderr and "loading the compiled solver" in result.stderr and not caplog.records, result.stderr
+
+
+@pytest.mark.slow
+def test_a_cold_cache_compile_is_said_once_by_the_python_api_and_timed(tmp_path):
+    """A real empty numba cache: the first simulate() of a process logs one line on stderr (no logging set up), the next
+    process none; the compile's duration is kept beside the cache for the estimates."""
+    from stochpound.solvers.first_call import TIMINGS_FILE
+
+    code = ("import stochpound\nfrom stochpound.model.scene_file import scene_from_dict\nfrom stochpound.solvers.exact import WARM_UP_SCENE\n"
+            "stochpound.simulate(scene_from_dict(WARM_UP_SCENE))\nprint('done')")
+    env = {**os.environ, "PYTHONPATH": str(REPO), "NUMBA_CACHE_DIR": str(tmp_path / "cache")}
+    first, second = (subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=600) for _ in range(2))
+    assert first.returncode == 0 and first.stdout == "done\n", first.stderr
+    assert first.stderr.startswith("stochpound: compiling the exact solver's engine (numba's cache of it is empty; not yet timed")
+    assert len(first.stderr.splitlines()) == 1, first.stderr
+    assert second.returncode == 0 and second.stderr == "", second.stderr
+    (timings,) = (tmp_path / "cache").rglob(TIMINGS_FILE)
+    assert json.loads(timings.read_text())["compile"] > 0
+
+
+def test_the_store_size_is_measured_within_a_few_per_cent(tmp_path, monkeypatch):
+    """file_bytes (the run's estimate, and the room checked before a write) against the written files: within 5 % without
+    time histories; with them (written compressed) not below 95 % of the file (the estimate's 'or less')."""
+    from stochpound.experiment._estimate import estimate_run
+    from stochpound.experiment._runner import load_experiment
+    from stochpound.experiment._sources import resolve_motions
+    from stochpound.experiment._store import layout
+    from stochpound import _atomic
+    from stochpound.experiment import _store_writer
+    from stochpound.experiment._store_writer import file_bytes
+
+    histories = TINY_EXPERIMENT + '\n[output]\ntime_histories = ["total_displacement"]\nbuildings = ["B1"]\nimpacts = true\n'
+    for name, text in (("plain.toml", TINY_EXPERIMENT), ("histories.toml", histories)):
+        experiment = load_experiment(write_experiment(tmp_path, text, name))
+        assert invoke("experiment", "run", str(experiment.path), "--workers", "0", "--quiet").exit_code == 0
+        store = tmp_path / name.replace(".toml", ".nc")
+        grids = {label: m.grid for label, m in resolve_motions(experiment).items()}
+        actual = store.stat().st_size
+        with open_store(store) as data:
+            store_layout, attrs = layout(experiment, grids, data.sizes["impact"]), dict(data.attrs)
+        measured = file_bytes(store_layout, attrs)
+        needed = int(_store_writer.ROOM_FACTOR * measured) + _store_writer.ROOM_MARGIN
+        for module in (_store_writer, _atomic):  # one byte too few: the quick bound must not skip the measure
+            monkeypatch.setattr(module, "free_bytes", lambda path: needed - 1)
+        with pytest.raises(OSError, match=f"about {needed / 1e6:.1f} MB needed"):
+            _store_writer._check_room(store, store_layout, attrs)
+        monkeypatch.undo()
+        estimate = estimate_run(experiment, grids, experiment.n_cases)
+        if name == "plain.toml":
+            assert abs(measured / actual - 1) < 0.05 and estimate.history_bytes == 0, (measured, actual)
+        else:
+            assert measured > 0.95 * actual and estimate.history_bytes > 0, (measured, actual)
+            assert " or less (" in estimate.describe(1) and "of it time histories before compression)" in estimate.describe(1)
+
+
+@pytest.fixture
+def small_disk(tmp_path):
+    """A real 4 MB file system (tmpfs) at tmp_path/disk: a full disk as HDF5 meets it (it crashed status with a segfault)."""
+    disk = tmp_path / "disk"
+    disk.mkdir()
+    if subprocess.run(["mount", "-t", "tmpfs", "-o", "size=4m", "tmpfs", str(disk)], capture_output=True).returncode != 0:
+        pytest.skip("mounting a small tmpfs needs root (the monkeypatched tests above cover the messages)")
+    try:
+        yield disk
+    finally:
+        subprocess.run(["umount", str(disk)], check=True)
+
+
+def _fill(disk, leave: int) -> None:
+    """Fill ``disk`` but ``leave`` bytes."""
+    (disk / "filler").write_bytes(b"\0" * max(0, shutil.disk_usage(disk).free - leave))
+
+
+def _stochpound(*args: str, cwd) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "stochpound", *args], capture_output=True, text=True, cwd=cwd, timeout=600,
+                          env={**os.environ, "PYTHONPATH": str(REPO)})
+
+
+def test_a_really_full_disk_crashes_nothing_and_loses_nothing(stationary, small_disk):
+    """status and run on a full tmpfs: exit 0 or 1 (not a segfault's 139), one line naming the store; the parts rebuild it later."""
+    shutil.copytree(stationary, small_disk / "copy")
+    store = small_disk / "copy" / "still.nc"
+    store.unlink()  # status must write it anew from the parts
+    _fill(small_disk, 200_000)  # less than the store needs (about 0.3 MB)
+    result = _stochpound("experiment", "status", str(store), cwd=small_disk)
+    assert result.returncode == 0, (result.returncode, result.stderr[-2000:])
+    assert re.fullmatch(rf"store not rebuilt \(its finished cases are kept in its parts\): {store}: cannot write here "
+                        r"\(No space left on device: 0\.\d MB free, about \d+\.\d MB needed\)\n", result.stderr), result.stderr[-2000:]
+    assert not store.exists() and not list(store.parent.glob(".still.nc.*"))
+    experiment = write_experiment(small_disk, TINY_EXPERIMENT, "tiny.toml")
+    (small_disk / "filler").unlink()
+    _fill(small_disk, 1_500_000)  # room for the run's first store file (0.3 MB) and parts, not for the last one's margin beside it
+    result = _stochpound("experiment", "run", str(experiment), "--workers", "0", cwd=small_disk)
+    assert result.returncode == 1, (result.returncode, result.stderr[-2000:])
+    last = result.stderr.splitlines()[-1]
+    assert re.fullmatch(rf"Error: {small_disk / 'tiny.nc'}: cannot write here \(No space left on device.*\)", last), result.stderr[-2000:]
+    assert result.stderr.endswith(f"\n{last}\n") and "%|" in result.stderr, result.stderr[-2000:]  # after the bar, on a line of its own
+    (small_disk / "filler").unlink()
+    assert _stochpound("experiment", "status", str(store), cwd=small_disk).returncode == 0 and open_store(store).attrs["complete"] == 1
+    result = _stochpound("experiment", "run", str(experiment), "--workers", "0", "--quiet", cwd=small_disk)
+    assert result.returncode == 0 and open_store(small_disk / "tiny.nc").attrs["complete"] == 1, result.stderr[-2000:]
+
+
 def test_a_full_disk_during_a_run_is_one_line_naming_the_store_and_loses_nothing(tmp_path, monkeypatch):
     from stochpound.experiment import _store_writer
 
@@ -357,3 +497,20 @@ def test_a_full_disk_during_a_run_is_one_line_naming_the_store_and_loses_nothing
     monkeypatch.undo()
     result = invoke("experiment", "run", str(experiment), "--workers", "0", "--quiet")
     assert result.exit_code == 0 and open_store(tmp_path / "tiny.nc").attrs["complete"] == 1, result.output
+
+
+def test_every_command_s_g_option_has_the_same_default():
+    """Issue 35: `records show` and `records spectrum` defaulted to 9.814 and 9.81; one g for every command."""
+    import click
+
+    from stochpound.cli import main
+
+    def options(command: click.Command, path: str) -> Iterator[tuple[str, object]]:
+        for param in command.params:
+            if "--g" in getattr(param, "opts", ()):
+                yield path, param.default
+        for name, sub in getattr(command, "commands", {}).items():
+            yield from options(sub, f"{path} {name}")
+
+    found = dict(options(main, "stochpound"))
+    assert len(found) >= 2 and len(set(found.values())) == 1, found

@@ -39,7 +39,9 @@ IDENTITIES = {
     "0891f60b747a8f36d97e968b18eca6f258bb1e9f6782da805f763b739f5ba482": "17ac371fe5e1bedc1ee453a2548339086beffba24ce2aaf729d893eb2a9513a5",
     "bd9b53093d44e3e4acc85e308510add994bdf7abef03df62e1f2f88028935856": "4baf14717bf47188d5761c7a878b1636513e2d3c3992b75e15e25c72041021ae",  # experiments/laws/contact_laws.toml
     "30f757d6a000b675d5a77664f7ebaac77f5f8fe2bdaaa81c5a883ef996a93fda": "8587d2f9de1b97fd57b3799a668aa67bd90c2019b1ba238e1c664b982fc3c61a",  # experiments/risk/fixed_pair.toml
+    "7ee6d0bbad225fc7ce1b98b350144c895ed0d284696c10d4e0c60c6e1901feaf": "45709c88b8c56c21d821c3429b50c35316a024bc8615d148e8dad43a333a280f",  # experiments/risk/fixed_pair.toml (yielding)
     "2ac35eca7fc1effebf5cc3dea300b01aadfa0cc86abb47b348e411247cb9c803": "40f7acef22ebc787ae56e0d0b2a347f5bd6eed6c553e7fbc0902cd26d1a814df",  # experiments/risk/isolated.toml
+    "8e4b705fc73ef76afaf17a43eb886385aa0233150b9d597de3b98ff0fa68b8cf": "25d025290edee6b600240034af40615bef4faa550ddd7f1e16dc96666a597c3c",  # experiments/risk/isolated.toml (yielding)
     "6721b840847f3c887a64063a94280b5d169110c60ef231755da91b89a8300078": "d63aa13f0c17c62515a7f33d09c8af15f2d12f6063f66110f23227a68f70937f",  # experiments/study/gap_study.toml (declares reproduces)
     "2991b119a5949c2c82f9b2fe3c5ea23ba8308484f5adbaf6202633df2547e55f": "0fee6ef18974eda7fe49d0fa885cd06ca430f684281d7e09d9aa13ae02729a4e",  # experiments/study/harmonic.toml (declares reproduces)
     "b7cb8955ddf0e1110227ccc8d346f24b89c5f33cd69da9d0bcda4bfe1400fd19": "dc1f1332c3bbb0688ce5cc07bf78b719f5f9f549de5f0725493b705c41748dec",  # experiments/study/pair_mu.toml (declares reproduces)
@@ -52,7 +54,9 @@ IDENTITIES = {
 #: sha256 of the canonical definition without its ``hazard`` entry (the pin above is still their canonical JSON's).
 HAZARD_IDENTITIES = {
     "30f757d6a000b675d5a77664f7ebaac77f5f8fe2bdaaa81c5a883ef996a93fda": "3d9262abc04f842b1b695462aae97e3c7c5c028882c6fb38d85a52f450f1b5df",  # experiments/risk/fixed_pair.toml
+    "7ee6d0bbad225fc7ce1b98b350144c895ed0d284696c10d4e0c60c6e1901feaf": "64fc42a22367fe253b24e30fc3e9836a2621b367c692dc9f7be87634a2cdbdfc",  # experiments/risk/fixed_pair.toml (yielding)
     "2ac35eca7fc1effebf5cc3dea300b01aadfa0cc86abb47b348e411247cb9c803": "e36e9c2fdea0577b1f73173500db4effca2a2727e81f6407fcdfa13484bfca68",  # experiments/risk/isolated.toml
+    "8e4b705fc73ef76afaf17a43eb886385aa0233150b9d597de3b98ff0fa68b8cf": "87172a0dd106c497e3d120dd551dfa9f9882ac768b6799754a4df431a76f6d84",  # experiments/risk/isolated.toml (yielding)
 }
 
 

@@ -14,8 +14,8 @@ The rule holds for ``stochpound/``, ``benchmarks/`` and the Python files under
 ``ALLOWED`` lists today's exceptions. It only shrinks: an import that is
 not listed fails, and so does a listed one that is gone.
 
-The same imports, as a graph of modules, hold no cycle (``ALLOWED_CYCLES``
-lists the one the experiment layer's rewrite removes).
+The same imports, as a graph of modules, hold no cycle but the ones that
+the imports in ``ALLOWED_BACK_EDGES`` close.
 """
 
 from __future__ import annotations
@@ -29,70 +29,19 @@ ROOT = Path(__file__).parents[1]
 SCANNED = ("stochpound", "benchmarks", "docs")
 GENERATED = ("docs/_build", "docs/generated", "docs/auto_examples")
 
-#: Importer (a path from the repository root) -> the private modules of other packages it imports, to be emptied.
-ALLOWED: dict[str, set[str]] = {
-    "benchmarks/experiment_scale.py": {"stochpound.experiment._parts", "stochpound.experiment._store_writer"},
-    "benchmarks/probes.py": {"stochpound.experiment._ensemble", "stochpound.experiment._grid", "stochpound.experiment._sources"},
-    "benchmarks/suite.py": {"stochpound.experiment._ensemble"},
-    "stochpound/cli/_experiment.py": {"stochpound.experiment._estimate", "stochpound.experiment._parts", "stochpound.experiment._sources"},
-    "stochpound/cli/_measure_choice.py": {"stochpound.analysis._hazard", "stochpound.experiment._site"},
-    "stochpound/cli/_records.py": {"stochpound.motions._spectrum"},
-    "stochpound/experiment/_ensemble.py": {"stochpound.analysis._impacts", "stochpound.analysis._summary"},
-    "stochpound/experiment/_hazard.py": {"stochpound.analysis._hazard", "stochpound.analysis._hazard_files", "stochpound.motions._spectrum"},
-    "stochpound/experiment/_intensity.py": {"stochpound.motions._measures", "stochpound.motions._spectrum"},
-    "stochpound/experiment/_site.py": {"stochpound.motions._conditional", "stochpound.motions.records._suites"},
-    "stochpound/experiment/_spec.py": {"stochpound.motions._spectrum", "stochpound.motions.records._suites"},
-    "stochpound/experiment/_store.py": {"stochpound.motions.records._suites"},
-    "stochpound/experiment/_summary.py": {"stochpound.analysis._separation_rules", "stochpound.analysis._summary"},
-    "stochpound/report/sections/_description.py": {"stochpound.experiment._grid", "stochpound.experiment._intensity"},
-    "stochpound/report/sections/_ensembles.py": {"stochpound.analysis._intervals"},
-    "stochpound/report/sections/_intensity.py": {"stochpound.experiment._intensity"},
-    "stochpound/report/sections/_laws.py": {"stochpound.analysis._intervals"},
-    "stochpound/risk/__init__.py": {"stochpound.analysis._consistency", "stochpound.analysis._hazard"},
-    "stochpound/risk/_code_rules.py": {"stochpound.analysis._bootstrap", "stochpound.analysis._hazard", "stochpound.analysis._separation_rules"},
-    "stochpound/risk/_demands.py": {"stochpound.analysis._hazard"},
-    "stochpound/risk/_fragility_ensemble.py": {"stochpound.analysis._bootstrap"},
-    "stochpound/risk/_maf.py": {"stochpound.analysis._bootstrap", "stochpound.analysis._hazard"},
-    "stochpound/risk/_store.py": {"stochpound.analysis._hazard", "stochpound.analysis._hazard_files", "stochpound.experiment._hazard", "stochpound.motions._spectrum"},
-    "stochpound/risk/_store_risk.py": {"stochpound.analysis._hazard"},
-}
+#: Importer (a path from the repository root) -> the private modules of other packages it imports. Empty: keep it so.
+ALLOWED: dict[str, set[str]] = {}
 
-#: Import cycles among the modules of stochpound, each as the sorted names of its modules, to be emptied. The one left after
-#: the store/risk/newcomer merges runs through lazy imports inside functions (analysis's aliases of the risk chain,
-#: records' deprecated study names, the risk store reader's hazard files): it goes with those aliases.
-ALLOWED_CYCLES = [
-    (
-        "stochpound.analysis",
-        "stochpound.experiment._grid",
-        "stochpound.experiment._hazard",
-        "stochpound.experiment._intensity",
-        "stochpound.experiment._site",
-        "stochpound.experiment._spec",
-        "stochpound.model.scene_file",
-        "stochpound.motions",
-        "stochpound.motions._measures",
-        "stochpound.motions._selection",
-        "stochpound.motions._spectrum",
-        "stochpound.motions.records",
-        "stochpound.motions.records._statistics",
-        "stochpound.report.render",
-        "stochpound.report.render._figures",
-        "stochpound.results.dataset",
-        "stochpound.risk",
-        "stochpound.risk._code_rules",
-        "stochpound.risk._demands",
-        "stochpound.risk._efficiency",
-        "stochpound.risk._fragility_ensemble",
-        "stochpound.risk._maf",
-        "stochpound.risk._store",
-        "stochpound.risk._store_risk",
-        "stochpound.solvers.exact",
-        "stochpound.solvers.simulate",
-        "stochpound.store",
-        "stochpound.store._accessor",
-        "stochpound.studies",
-    ),
-]
+#: The imports (importer -> imported module) that close the import cycles left, each running back up: without them the
+#: modules import each other in no cycle. Each is an import inside a function: analysis gives the risk chain's names it
+#: exported before stochpound.risk existed (docs/api.md, the names users rely on); records gives the deprecated study names
+#: (``STUDY_G``, ``study_table_3_2``) from stochpound.studies; the conditional-spectrum stripes (``_site``) are chosen for an
+#: ``Experiment`` (``_grid``), which asks for them. Only shrinks.
+ALLOWED_BACK_EDGES = {
+    ("stochpound.analysis", "stochpound.risk"),
+    ("stochpound.motions.records", "stochpound.studies"),
+    ("stochpound.experiment._site", "stochpound.experiment._grid"),
+}
 
 
 def module_name(path: Path) -> str:
@@ -242,8 +191,13 @@ def cycles(graph: dict[str, set[str]]) -> list[tuple[str, ...]]:
     return sorted(found)
 
 
-def test_the_modules_import_each_other_in_no_cycle_but_the_listed_one():
-    assert cycles(import_graph()) == sorted(ALLOWED_CYCLES)
+def test_the_modules_import_each_other_in_no_cycle_but_through_the_listed_imports():
+    graph = import_graph()
+    gone = sorted(edge for edge in ALLOWED_BACK_EDGES if edge[1] not in graph.get(edge[0], set()))
+    assert not gone, f"fixed: take these off ALLOWED_BACK_EDGES in {Path(__file__).name}: {gone}"
+    for importer, imported in ALLOWED_BACK_EDGES:
+        graph[importer].discard(imported)
+    assert cycles(graph) == []
 
 
 def test_cycles_are_found():
@@ -265,3 +219,10 @@ def test_tests_import_no_test_module_and_benchmarks_no_test():
                 found.append(f"{path.name} imports {module}")
     assert not found
 
+
+
+def test_the_command_line_imports_no_report_section():
+    """``stochpound risk`` prints the risk chain's own tables: the CLI reads no report section (and, above, no private module)."""
+    found = {path.name: sorted(module for module in imports(path.read_text()) if module.startswith("stochpound.report.sections"))
+             for path in sorted((ROOT / "stochpound" / "cli").glob("*.py"))}
+    assert {name: modules for name, modules in found.items() if modules} == {}

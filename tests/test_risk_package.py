@@ -90,3 +90,11 @@ def test_the_risk_command_imports_only_public_namespaces():
             "print(sorted(m for m in sys.modules if m.startswith('stochpound.report')))")
     result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, check=True)
     assert result.stdout.strip() == "[]"
+
+
+def test_every_risk_name_analysis_gives_is_the_risk_package_s():
+    import stochpound.analysis
+    import stochpound.risk
+
+    assert set(stochpound.analysis.RISK_NAMES) <= set(stochpound.risk.__all__)
+    assert all(getattr(stochpound.analysis, name) is getattr(stochpound.risk, name) for name in stochpound.analysis.RISK_NAMES)

@@ -22,6 +22,7 @@ import time
 import tomllib
 from pathlib import Path
 
+import matplotlib.pyplot as plt
 import numpy as np
 import xarray as xr
 import pytest
@@ -35,6 +36,9 @@ from stochpound.experiment._runner import load_experiment, run_experiment
 from stochpound.experiment._spec import ExperimentError, load_definition, parse_experiment
 from stochpound.store import definition_sha256
 from stochpound.report.render._document import Paragraph, Table
+from stochpound.report.assemble import assemble_report
+from stochpound.report.render._document import FigureItem
+from stochpound.report.sections._intensity import intensity_section
 from stochpound.report.sections._risk import risk_section
 from tests.helpers import BUNDLED, FIXED, ISOLATED, MOTIONS, RECORDS, REPOSITORY, risk_text as _text, write_experiment
 
@@ -132,12 +136,13 @@ def test_definitions_without_hazard_are_unchanged(name):
 def test_the_flagship_experiments_use_the_bundled_hazard_in_their_measure():
     for path in sorted((REPOSITORY / "experiments" / "risk").glob("*.toml")):
         definition, _ = load_definition(path)
-        assert definition["hazard"]["bundled"] == "fox_plaza_los_angeles_sa2p0s"
-        assert (definition["intensity"]["measure"], definition["intensity"]["period"]) == ("psa", 2.0)
-        levels = definition["intensity"]["levels"]
+        intensity = definition["intensity"]
+        assert intensity["measure"] == "psa" and intensity["period"] in (1.0, 2.0, 3.0)
+        assert definition["hazard"]["bundled"] == f"fox_plaza_los_angeles_sa{intensity['period']:.0f}p0s"  # the curve of its measure
+        levels = intensity["levels"]
         hz = hazard_curve(definition["hazard"])
         two_percent = float(hz.intensity_at(-np.log(0.98) / 50))
-        assert len(levels) >= 8 and max(levels) >= 1.5 * two_percent * 0.999
+        assert len(levels) >= 7 and max(levels) >= 1.5 * two_percent * 0.999
         assert min(abs(np.log(np.array(levels) / two_percent))) < 1e-3 and min(abs(np.log(np.array(levels) / hz.intensity_at(-np.log(0.9) / 50)))) < 1e-3
 
 
@@ -194,7 +199,8 @@ def test_cli_prints_separation_and_rules(isolated_store, tmp_path):
     headline = risk.to_frame()
     for value in headline["separation"]:
         assert f"{value:.3f}" in result.output
-    for text in ("10 % in 50 yr", "2 % in 50 yr", "SRSS (ASCE 7 δ_MT)", "0.7 SRSS (Eurocode 8)", "DDC", "D_TM", "once in (yr)"):
+    for text in ("10 % in 50 yr", "2 % in 50 yr", "SRSS of suite-mean peaks", "0.7 SRSS of suite-mean peaks", "DDC", "D_TM", "once in (yr)",
+                 "once in, lower (yr)", "once in, upper (yr)", "P lower", "P upper", "Design to"):
         assert text in result.output
     written = {path.name: path.read_text() for path in (tmp_path / "tables" / "risk").iterdir()}  # one table per file, in a folder it created
     assert sorted(written) == ["rules.csv", "separation.csv"]
@@ -318,12 +324,57 @@ def test_report_section_states_the_separation_first(isolated_store):
     assert keys[:2] == ["risk-separation-risk", "risk-curve-risk"]
     assert {"risk-surface-risk", "risk-fragility-risk", "risk-rules-risk", "risk-demands-risk"} <= set(keys)
     rules = next(block for block in section.blocks if isinstance(block, Table) and block.key == "risk-rules-risk")
-    assert "D_TM (ASCE 7 §17.2.5.2)" in rules.frame.index.get_level_values("rule")
+    assert "D_TM of the suite-mean base displacement (ASCE 7 §17.2.5.2 form)" in rules.frame.index.get_level_values("rule")
     grid = {"design_level", "rule", *(d for d in store["case_status"].dims if d not in ("record", "realization", "intensity", "gap"))}
     assert set(rules.frame.index.names) <= grid, rules.frame.index.names  # the grid's axes, not what each point ran (base_mu, base_radius, ...)
     separation = next(block for block in section.blocks if isinstance(block, Table) and block.key == "risk-separation-risk")
     assert not any(str(name).startswith("base_") for name in separation.frame.index.names)
     assert stored_hazard(store).source.startswith("Site: Fox Plaza")
+    assert risk.assumptions["structural model"].startswith("B1: 2-storey shear building, linear elastic storeys, on a sliding base; B2:")
+    summary = section.blocks[1].text
+    assert summary.startswith("Design summary. Governing limit state: pounding between the buildings") and "scaled to every stripe" in summary
+
+
+def test_the_report_gives_the_risk_answer_in_its_summary_and_no_repr_in_its_prose(isolated_store):
+    """The summary's first answer is g* for the targets (the Risk section's numbers); no Python repr stands in any text."""
+    report = assemble_report([isolated_store])
+    summary = report.sections[0]
+    texts = [block.text for block in summary.blocks if isinstance(block, Paragraph)]
+    risk = store_risk(open_store(isolated_store))
+    assert any(text.startswith("Risk-targeted separation g*") for text in texts), texts
+    answer = next(text for text in texts if text.startswith("Risk-targeted separation g*"))
+    for row in risk.to_frame().itertuples():
+        assert f"{row.separation:.3f} m for {risk.target_text(row.target)}" in answer, answer
+    prose = [block.text for section in report.sections for block in section.blocks if isinstance(block, Paragraph)]
+    prose += [block.caption for section in report.sections for block in section.blocks if hasattr(block, "caption")]
+    for text in prose:  # e.g. "HazardCurve(16 points, ...)", "<... object at 0x...>", "array([...])", "np.float64(0.2)"
+        assert not re.search(r"\b[A-Z]\w+\(\d+ points|object at 0x|\barray\(|np\.\w+\(|\w+\(\w+=", text), text
+    plt.close("all")
+
+
+def test_the_pounding_against_intensity_figure_shows_gaps_near_g_star_not_infinity(isolated_store):
+    """Contact-free runs (gap = inf) never pound: the figure draws them at g*, from a direct count of their closures."""
+    store = open_store(isolated_store)
+    risk = store_risk(store)
+    near = risk.separation["separation"].values.ravel()
+    section = intensity_section("risk", store, near)
+    figure = next(block for block in section.blocks if isinstance(block, FigureItem) and block.key == "intensity-pounding-risk")
+    lines = {line.get_label(): line.get_ydata() for line in figure.figure.axes[0].get_lines()}
+    assert not any("inf" in label for label in lines), list(lines)
+    free = store["peak_contact_closure"].sel(gap=np.inf).max("contact")
+    for gap in near:
+        label = f"g = {gap:.3g} m (contact-free closures)"
+        assert label in lines, list(lines)
+        direct = [float((free.sel(intensity=level) >= gap).sum() / free.sel(intensity=level).count()) for level in store["intensity"].values]
+        assert np.allclose(lines[label], direct), (label, lines[label], direct)
+        assert 0 < max(direct) and min(direct) < 1  # gaps that mean something: some stripes pound there, some do not always
+    assert np.allclose(lines["gap=0.05"], [float((store["impacts"].sel(gap=0.05, intensity=level) > 0).mean()) for level in store["intensity"].values])
+    assert "the risk-targeted separations g*" in figure.caption
+    alone = next(block for block in intensity_section("risk", store).blocks if isinstance(block, FigureItem) and block.key == "intensity-pounding-risk")
+    quartiles = np.quantile(free.values[free.values > 0], [0.25, 0.5, 0.75])  # without a hazard: where the closures are
+    assert "the quartiles of the contact-free closures" in alone.caption
+    assert [line.get_label() for line in alone.figure.axes[0].get_lines()][1:] == [f"g = {q:.3g} m (contact-free closures)" for q in quartiles]
+    plt.close("all")
 
 
 def test_rules_table_is_indexed_by_the_grid_not_by_what_each_point_ran():

@@ -18,6 +18,7 @@ import stochpound
 from stochpound.analysis import contact_demands, pounding_curve
 from stochpound.model.scene import Scene
 from stochpound.studies.agarwal2004 import study_scene
+from tests.helpers import with_gaps
 
 KANAI_TAJIMI = {"type": "kanai_tajimi", "omega_g": 15.0, "zeta_g": 0.6, "pga": 3.4, "envelope": "jennings", "seed": 3, "duration": 20.0, "dt": 0.01}
 REALIZATIONS = (0, 1, 2)
@@ -28,11 +29,6 @@ TIE = 1e-9  # m: closer than this to D, either outcome is right
 
 def contact_free_scene(mu1: float | None, realization: int) -> Scene:
     return stochpound.scene_from_dict(study_scene(mu1=mu1, gap=math.inf, motion={**KANAI_TAJIMI, "realization": realization}))
-
-
-def with_gaps(scene: Scene, gaps: tuple[float, float]) -> Scene:
-    """``scene`` with contact c's gap set to ``gaps[c]`` (m)."""
-    return dataclasses.replace(scene, contacts=tuple(dataclasses.replace(c, gap=float(g)) for c, g in zip(scene.contacts, gaps)))
 
 
 @pytest.mark.parametrize("mu1", [None, 0.2], ids=["fixed", "sliding"])

@@ -7,9 +7,10 @@ import pytest
 import xarray as xr
 
 from stochpound.analysis._summary import top_floor_total_displacement
-from stochpound.store import CASE_SUMMARIES, CATALOGUE, IMPACT_TABLE, WALL_SUMMARIES, REFERENCE_HISTORY, REFERENCE_SUMMARIES, TIME_HISTORIES, StoreVariable
+from stochpound.store import (CASE_SUMMARIES, CATALOGUE, IMPACT_TABLE, STOREY_SUMMARIES, WALL_SUMMARIES, REFERENCE_HISTORY, REFERENCE_SUMMARIES, TIME_HISTORIES,
+                              StoreVariable)
 from stochpound.experiment._spec import TIME_HISTORY_VARIABLES
-from stochpound.experiment._summary import DEMAND_SUMMARIES, REFERENCE_SUMMARIES as REFERENCE_NAMES, case_summary, reference_summary
+from stochpound.experiment._summary import DEMAND_SUMMARIES, REFERENCE_SUMMARIES as REFERENCE_NAMES, STOREY_SOURCES, case_summary, case_values, reference_summary
 from stochpound.model.scene_file import scene_from_dict
 from stochpound.solvers.simulate import simulate
 
@@ -40,8 +41,8 @@ def _check(variable: StoreVariable, data: xr.DataArray) -> None:
 def test_case_summaries_are_declared(run: xr.Dataset) -> None:
     """Every summary of a case, in order, with its dimensions, dtype, units and long name."""
     summary = case_summary(run, "A", top_floor_total_displacement(run, "A"))
-    assert list(summary.data_vars) == [v.name for v in CASE_SUMMARIES + WALL_SUMMARIES]
-    for variable in CASE_SUMMARIES + WALL_SUMMARIES:
+    assert list(summary.data_vars) == [v.name for v in CASE_SUMMARIES + WALL_SUMMARIES + STOREY_SUMMARIES]
+    for variable in CASE_SUMMARIES + WALL_SUMMARIES + STOREY_SUMMARIES:
         _check(variable, summary[variable.name])
     assert set(DEMAND_SUMMARIES) <= {v.name for v in CASE_SUMMARIES}
 
@@ -68,7 +69,7 @@ def test_time_histories_and_impacts_are_declared(run: xr.Dataset) -> None:
 
 def test_the_catalogue_declares_each_variable_once_and_derived_units_agree():
     """One declaration per name; a peak, a moment or a reference has the units of the history it is taken from."""
-    declared = [*CASE_SUMMARIES, *WALL_SUMMARIES, *REFERENCE_SUMMARIES, *TIME_HISTORIES.values(), REFERENCE_HISTORY, *IMPACT_TABLE]
+    declared = [*CASE_SUMMARIES, *WALL_SUMMARIES, *STOREY_SUMMARIES, *REFERENCE_SUMMARIES, *TIME_HISTORIES.values(), REFERENCE_HISTORY, *IMPACT_TABLE]
     assert len(CATALOGUE) == len(declared) and all(CATALOGUE[v.name] is v for v in declared)
     taken_from = {
         "peak_total_displacement": "total_displacement", "peak_relative_displacement": "relative_displacement",
@@ -76,9 +77,30 @@ def test_the_catalogue_declares_each_variable_once_and_derived_units_agree():
         "peak_impact_force": "impact_force", "impact_peak_force": "impact_force", "response_mean": "total_displacement",
         "response_std": "total_displacement", "reference_total_displacement": "total_displacement",
         "peak_floor_acceleration": "ground_acceleration", "peak_wall_penetration": "peak_contact_closure",
+        "residual_drift": "total_displacement",
     }
     for derived, source in taken_from.items():
         assert CATALOGUE[derived].units == CATALOGUE[source].units, derived
     for variable in REFERENCE_SUMMARIES:
         own = CATALOGUE[variable.name.removeprefix("reference_")]
         assert (variable.units, variable.long_name) == (own.units, own.long_name + " (studied building alone on a fixed base)")
+
+
+def test_storey_summaries_are_the_largest_over_each_buildings_storeys() -> None:
+    """A yielding building with storey heights next to an elastic one: the storey summaries per building, in both paths (xarray and kernels)."""
+    from stochpound.studies.agarwal2004 import study_scene
+
+    scene = study_scene(None, None, 2.0, gap=0.01)
+    scene["building"][0].update(yield_force=[1.0e5, 0.7e5], hardening=0.05, storey_height=[3.5, 3.0])
+    run = simulate(scene_from_dict(scene), "exact", demands=True)
+    summary = case_summary(run, "B1", top_floor_total_displacement(run, "B1"))
+    values = case_values(run, "B1", top_floor_total_displacement(run, "B1").values)
+    assert float(summary["peak_ductility"].sel(building="B1")) > 1.5  # it yields
+    for name, source in STOREY_SOURCES.items():
+        _check(CATALOGUE[name], summary[name])
+        np.testing.assert_array_equal(summary[name].values, values[name])
+        expected = [np.max(np.abs(run[source].sel(building="B1").values)), np.nan]  # B2 is elastic and gives no heights
+        if name == "residual_drift":
+            expected[1] = 0.0  # an elastic storey of a yielding run keeps no drift
+        np.testing.assert_array_equal(summary[name].values, expected, err_msg=name)
+    assert float(summary["residual_drift"].sel(building="B1")) > 0.0

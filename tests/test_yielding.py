@@ -14,6 +14,7 @@ from stochpound.model.scene import Scene
 from stochpound.model.system import build_system
 from stochpound.motions.ground import SampledMotion
 from stochpound.studies.agarwal2004 import reference_building, study_scene
+from tests.helpers import with_gaps
 
 # an elastic–perfectly-plastic SDOF (ω = 10 rad/s, d_y = 1 cm) thrown upwards under a constant ground acceleration
 MASS, STIFFNESS, YIELD, LOAD, VELOCITY = 1.0, 100.0, 1.0, 0.5, 0.2  # kg, N/m, N, N (= −m a_g), m/s
@@ -202,3 +203,44 @@ def test_the_fixed_base_twin_of_a_yielding_building_yields():
         run = stochpound.simulate(Scene(scene.buildings, (), motion), "exact")
         np.testing.assert_array_equal(twin, run.relative_displacement.values[0])
     assert float(run.peak_storey_ductility.max()) > 1.0  # the halved record still yields
+
+
+KANAI_TAJIMI = {"type": "kanai_tajimi", "omega_g": 15.0, "zeta_g": 0.6, "pga": 3.4, "envelope": "jennings", "seed": 3, "duration": 10.0, "dt": 0.01}
+SHARP = 1e-8  # m: gaps this far from the contact-free peak closure D
+
+
+@pytest.mark.parametrize("mu1", [None, 0.2], ids=["fixed", "sliding"])
+def test_the_gap_identity_holds_with_yielding_storeys(mu1):
+    """A yielding pair pounds at gap g exactly when its contact-free twin's located peak closure D reaches g, hit for hit.
+
+    Yielding makes the runs path-dependent but not the identity: the gap-g run
+    is the contact-free run until its first contact, so its first impact is at
+    the contact-free peak's time when only that peak reaches the gap. Gaps 10 nm
+    either side of D, and each contact its own gap, check it realization by
+    realization; the runs yield (ductility > 1), and the grid separates them.
+    """
+    pounded, reached = [], []
+    for realization in range(3):
+        scene = yielding_pair(mu1)
+        scene["contact"] = [dict(contact, gap=math.inf) for contact in scene["contact"]]
+        scene["motion"] = dict(KANAI_TAJIMI, realization=realization)
+        free_scene = stochpound.scene_from_dict(scene)
+        free = stochpound.simulate(free_scene)
+        assert free.sizes["impact"] == 0 and float(free.peak_storey_ductility.max()) > 1.5
+        closure = free["peak_contact_closure"].values
+        assert np.all(closure >= free["contact_closure"].max("time").values)
+        top = int(np.argmax(closure))
+        cases = [((closure.max() - SHARP,) * 2, top), ((closure.max() + SHARP,) * 2, None),
+                 ((closure[0] - SHARP, closure[1] + SHARP), 0), ((closure[0] + SHARP, closure[1] - SHARP), 1)]
+        cases += [((g, g), "grid") for g in (0.01, 0.03, 0.06)]
+        for gaps, touched in cases:
+            run = stochpound.simulate(with_gaps(free_scene, gaps))
+            hit = run.sizes["impact"] > 0
+            assert hit == bool(np.any(closure >= np.array(gaps))), (realization, gaps, closure)
+            if isinstance(touched, int):  # the first impact is at that contact's contact-free peak
+                assert int(run["impact_contact"][0]) == touched
+                assert float(run["impact_start"][0]) == pytest.approx(float(free["peak_contact_closure_time"][touched]), abs=1e-3)
+            if touched == "grid":
+                pounded.append(hit)
+                reached.append(bool(closure.max() >= gaps[0]))
+    assert pounded == reached and 0 < sum(pounded) < len(pounded)

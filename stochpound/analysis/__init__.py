@@ -30,10 +30,44 @@ from stochpound.analysis._consistency import hazard_consistency, stripe_rate_wei
 from stochpound.analysis._hazard import HazardCurve, bundled_curves, bundled_measure, probability_from_rate, rate_from_probability, return_period
 from stochpound.analysis._hazard_files import HazardFile, read_hazard_file
 
+# For the other packages of stochpound (their interface to this one, not public API: not in __all__).
+from stochpound.analysis._bootstrap import bootstrap_method, bootstrap_weights, interval, jackknife_weights, record_clusters  # noqa: F401
+from stochpound.analysis._hazard import bundled_path  # noqa: F401
+from stochpound.analysis._hazard_files import parse_measure, parse_units, unit_factor  # noqa: F401
+from stochpound.analysis._impacts import TABLE_COLUMNS  # noqa: F401
+from stochpound.analysis._intervals import MIN_RUNS  # noqa: F401
+from stochpound.analysis._separation_rules import EC8_REDUCTION, STORE_NAMES  # noqa: F401
+from stochpound.analysis._summary import response_moments, top_floor_total_displacement  # noqa: F401
+
+
+RISK_NAMES = (
+    "Fragility",
+    "fit_fragility",
+    "fragility_band",
+    "fragility_surface",
+    "homogeneous_capacities",
+    "ida_fragility",
+    "limit_state_events",
+    "stripe_fragility",
+    "demand_hazard_curve",
+    "mean_annual_frequency",
+    "risk_curve",
+    "risk_targeted_separation",
+    "code_rules_risk",
+    "contact_free_closure",
+    "pounding_fragility",
+    "risk_gaps",
+    "store_risk",
+    "StoreRisk",
+)
+"""The risk chain's names this namespace exported before :mod:`stochpound.risk` existed (one list: the risk package exports them
+too). Aliases of that package's (the canonical names), resolved when first used, so that importing the statistics does not import
+the risk chain (which sits above them)."""
+
 
 def __getattr__(name: str) -> object:
     """A risk chain's name, from :mod:`stochpound.risk` (imported on first use)."""
-    if name in _ALIASES:
+    if name in RISK_NAMES:
         import stochpound.risk
 
         return getattr(stochpound.risk, name)
@@ -63,14 +97,6 @@ __all__ = [
     "store_contact_demands",
     "fixed_base_cqc",
     "run_summary",
-    "Fragility",
-    "fit_fragility",
-    "fragility_band",
-    "fragility_surface",
-    "homogeneous_capacities",
-    "ida_fragility",
-    "limit_state_events",
-    "stripe_fragility",
     "HazardCurve",
     "HazardFile",
     "read_hazard_file",
@@ -79,20 +105,7 @@ __all__ = [
     "probability_from_rate",
     "rate_from_probability",
     "return_period",
-    "demand_hazard_curve",
-    "mean_annual_frequency",
-    "risk_curve",
-    "risk_targeted_separation",
-    "code_rules_risk",
-    "contact_free_closure",
-    "pounding_fragility",
     "hazard_consistency",
     "stripe_rate_weights",
-    "risk_gaps",
-    "store_risk",
-    "StoreRisk",
+    *RISK_NAMES,
 ]
-_ALIASES = frozenset(__all__) - set(globals())
-"""The names ``__all__`` gives that this module does not define: the risk chain's, which it exported before :mod:`stochpound.risk`
-existed. They are aliases of that package's (the canonical names), resolved when first used, so that importing the statistics
-does not import the risk chain (which sits above them)."""

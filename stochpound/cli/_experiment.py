@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import logging
 import sys
 from contextlib import contextmanager
 from pathlib import Path
@@ -11,8 +12,7 @@ import click
 
 from stochpound.cli._group import HelpGroup
 from stochpound._errors import StochpoundError, os_error_message
-from stochpound.experiment._estimate import LARGE_RUN_BYTES, LARGE_RUN_CASES
-from stochpound.experiment._parts import parts_folder
+from stochpound.experiment import LARGE_RUN_BYTES, LARGE_RUN_CASES, parts_folder
 from stochpound._memory import format_bytes
 
 if TYPE_CHECKING:
@@ -59,7 +59,7 @@ def run_command(
     for experiment_file, definition in zip(experiment_files, loaded):
         if several:
             click.echo(f"{experiment_file}:")
-        with _errors_of(experiment_file, several):
+        with _errors_of(experiment_file, several), _silenced(quiet):
             try:
                 report = run_experiment(
                     definition, store, workers=workers, scheduler=scheduler, restart=restart, progress=not quiet, checkpoint=checkpoint,
@@ -86,6 +86,19 @@ def _errors_of(path: str, name_it: bool) -> Iterator[None]:
         if name_it and not message.startswith(path):
             message = f"{path}: {message}"
         raise click.ClickException(message) from None
+
+
+@contextmanager
+def _silenced(quiet: bool) -> Iterator[None]:
+    """With ``quiet``, the library's own start-up line (the solver's compile, a log record of ``stochpound``) is not shown either."""
+    logger = logging.getLogger("stochpound")
+    level = logger.level
+    if quiet:
+        logger.setLevel(logging.ERROR)
+    try:
+        yield
+    finally:
+        logger.setLevel(level)
 
 
 def _say(message: str) -> None:
@@ -131,8 +144,7 @@ def _has_hazard(store: Path) -> bool:
 @click.argument("experiment_file", type=click.Path(dir_okay=False))
 def check_command(experiment_file: str) -> None:
     """Validate EXPERIMENT_FILE and list its dimensions (runs nothing)."""
-    from stochpound.experiment import load_experiment
-    from stochpound.experiment._sources import resolve_motions
+    from stochpound.experiment import load_experiment, resolve_motions
 
     try:
         loaded = load_experiment(experiment_file)

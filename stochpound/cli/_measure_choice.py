@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 import re
 from typing import Any
 
@@ -15,16 +14,15 @@ def hazard_measures(store: Any, hazard: str | None) -> dict[str, float | None]:
     A bundled curve (``--hazard NAME`` or the store's ``[hazard] bundled``):
     every bundled curve of the same site; otherwise the store's own measure.
     """
-    from stochpound.analysis import bundled_curves
-    from stochpound.analysis._hazard import bundled_measure
+    from stochpound.analysis import bundled_curves, bundled_measure
+    import stochpound.store  # noqa: F401 - registers the store accessor, ds.pound
 
-    definition = json.loads(store.attrs.get("definition", "{}"))
-    name = hazard if hazard in bundled_curves() else (definition.get("hazard") or {}).get("bundled")
+    name = hazard if hazard in bundled_curves() else (store.pound.hazard or {}).get("bundled")
     if name:
         site = re.sub(r"_(pga|sa\d+p\d+s)$", "", name)
         measures = [bundled_measure(curve) for curve in bundled_curves() if curve.startswith(site + "_")]
     else:
-        intensity = definition.get("intensity") or {}
+        intensity = store.pound.intensity or {}
         measures = [intensity] if intensity.get("measure") in ("pga", "psa") else []
     return {("PGA" if m["measure"] == "pga" else f"PSA({m['period']:g} s)"): (None if m["measure"] == "pga" else float(m["period"])) for m in measures}
 
@@ -32,10 +30,10 @@ def hazard_measures(store: Any, hazard: str | None) -> dict[str, float | None]:
 def efficient_measure_lines(store: Any, hazard: str | None) -> list[str]:
     """Lines naming, per configuration, the measure of least β of ln(closure) among those the site's hazard has, and among all candidates."""
     from stochpound.risk import measure_efficiency
-    from stochpound.experiment import Experiment
-    from stochpound.experiment._site import periods_of_interest
+    from stochpound.experiment import Experiment, periods_of_interest
+    import stochpound.store  # noqa: F401 - registers the store accessor, ds.pound
 
-    structure = periods_of_interest(Experiment(json.loads(store.attrs["definition"])))
+    structure = periods_of_interest(Experiment(store.pound.definition))
     available = hazard_measures(store, hazard)
     candidates = {**structure, **{f"hazard {name}": period for name, period in available.items() if period is not None}}
     efficiency = measure_efficiency(store, candidates, structure, studied=store.attrs.get("studied_building"))

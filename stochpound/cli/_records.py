@@ -8,7 +8,7 @@ import click
 
 from stochpound.cli._group import HelpGroup
 from stochpound._errors import RecordError
-from stochpound.motions._spectrum import DEFAULT_G
+from stochpound.motions import DEFAULT_G
 
 
 @click.group("records", cls=HelpGroup)
@@ -61,8 +61,7 @@ def _list_suite(suite: str) -> None:
 @click.option("--units", type=click.Choice(["g", "m/s2", "cm/s2"]), default=None, help="Units of a text file's values.")
 def show_command(name: str, plot_path: str | None, g: float, dt: float | None, units: str | None) -> None:
     """Statistics of NAME (a bundled record or a file), with the reference study's Table 3.2 beside ours for its records."""
-    from stochpound.motions.records import load_record
-    from stochpound.motions.records import plot_record
+    from stochpound.motions.records import load_record, plot_record
     from stochpound.studies.agarwal2004 import record_report
 
     if not g > 0:
@@ -101,8 +100,7 @@ def parse_periods(text: str) -> list[float]:
 def spectrum_command(name: str, periods_text: str, damping: float, plot_path: str | None, g: float, dt: float | None, units: str | None) -> None:
     """Intensity measures and the exact response spectrum of NAME (a bundled record, a suite's motion or a file)."""
     from stochpound.motions import intensity_measures
-    from stochpound.motions.records import load_record
-    from stochpound.motions.records import plot_spectra
+    from stochpound.motions.records import load_record, plot_spectra
 
     if not g > 0:
         raise click.BadParameter(f"must be > 0, got {g}", param_hint="--g")

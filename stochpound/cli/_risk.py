@@ -21,6 +21,21 @@ def _targets(value: str) -> tuple[float, ...]:
     return targets
 
 
+def _limit_states(path: Path) -> tuple:
+    """The limit states of a TOML file's ``[limit_states]`` table (``stochpound.risk.limit_states_from_table``)."""
+    import tomllib
+
+    from stochpound.risk import limit_states_from_table
+
+    try:
+        table = tomllib.loads(path.read_text())
+    except tomllib.TOMLDecodeError as error:
+        raise click.ClickException(f"{path}: not TOML: {error}") from None
+    if "limit_states" not in table:
+        raise click.ClickException(f"{path}: has no [limit_states] table (docs/risk.md)")
+    return limit_states_from_table(table["limit_states"])
+
+
 @click.command("risk")
 @click.argument("store", type=click.Path(exists=True, dir_okay=False, path_type=Path))
 @click.option("--hazard", "hazard", metavar="FILE|NAME",
@@ -39,10 +54,15 @@ def _targets(value: str) -> tuple[float, ...]:
 @click.option("--bootstrap", default=BOOTSTRAP, show_default=True, type=click.IntRange(min=0),
               help="Resamples of the motions for the intervals (0: none).")
 @click.option("--seed", default=0, show_default=True, type=click.IntRange(min=0), help="Seed of the resamples.")
+@click.option("--limit-states", "limit_states", type=click.Path(exists=True, dir_okay=False, path_type=Path), metavar="FILE",
+              help="A TOML file with a [limit_states] table (docs/risk.md): also print each limit state's mean annual frequency "
+                   "at the grid's finite gaps against the contact-free twins (what the gap costs).")
 @click.option("--csv", "csv_dir", type=click.Path(file_okay=False, path_type=Path), metavar="DIR",
-              help="Also write the tables to this folder (created), one CSV file per table: separation.csv, rules.csv.")
+              help="Also write the tables to this folder (created), one CSV file per table: separation.csv, rules.csv "
+                   "(and limit_states.csv with --limit-states).")
 def risk(store: Path, hazard: str | None, hazard_measure: str | None, hazard_units: str | None, investigation_time: float | None,
-         hazard_site: str | None, extrapolate: bool, target: str, years: float, bootstrap: int, seed: int, csv_dir: Path | None) -> None:
+         hazard_site: str | None, extrapolate: bool, target: str, years: float, bootstrap: int, seed: int, limit_states: Path | None,
+         csv_dir: Path | None) -> None:
     """Print the risk-targeted separation g* and the code rules' risks of the experiment STORE at a site.
 
     For every configuration of the store (each combination of its grid's
@@ -55,11 +75,14 @@ def risk(store: Path, hazard: str | None, hazard_measure: str | None, hazard_uni
     contact-free cases, gap = inf) or IDA capacities (docs/risk.md).
     A hazard file must say (or the options state) its measure and units;
     they are checked against the store's and converted (docs/risk.md).
+    With --limit-states, the limit states beyond first contact (storey
+    drift ratio, ductility, floor acceleration, impact force, a bearing's
+    stop) at each finite gap against the contact-free twins.
     """
     from stochpound.cli._measure_choice import efficient_measure_lines
     from stochpound.experiment import open_store
     from stochpound.motions import TARGET_TOLERANCE
-    from stochpound.risk import selection_misses, site_hazard, store_risk
+    from stochpound.risk import gap_cost_frame, limit_state_risk, selection_misses, site_hazard, store_risk
 
     targets = _targets(target)
     if hazard is None and (hazard_measure or hazard_units or investigation_time is not None or hazard_site is not None):
@@ -69,6 +92,7 @@ def risk(store: Path, hazard: str | None, hazard_measure: str | None, hazard_uni
         hz = site_hazard(data, hazard, measure=hazard_measure, units=hazard_units, investigation_time=investigation_time,
                          site=hazard_site, extrapolate=extrapolate)
         result = store_risk(data, hz, targets, years, bootstrap=bootstrap, seed=seed)
+        costs = None if limit_states is None else gap_cost_frame(limit_state_risk(data, _limit_states(limit_states), hz), years)
     except (StochpoundError, ValueError) as error:
         raise click.ClickException(str(error)) from None
     except OSError as error:
@@ -90,18 +114,31 @@ def risk(store: Path, hazard: str | None, hazard_measure: str | None, hazard_uni
     separation = result.separation_frame()
     click.echo(f"\nRisk-targeted separation g* (m; {interval}; inf: wider than every gap of the grid):")
     click.echo(separation.to_string(float_format=lambda v: f"{v:.3f}"))
+    design = result.design_frame()
+    click.echo(f"\nDesign to (m; the {design['basis'].iloc[0]}, not g* itself):")
+    click.echo(design.drop(columns="basis").assign(target=[result.target_text(p) for p in design["target"]])
+               .to_string(index=False, float_format=lambda v: f"{v:.3f}"))
+    degenerate = result.degenerate_text()
+    if degenerate:
+        click.echo(f"note: {degenerate}")
     rules = result.rules_frame()
     if result.rules is None:
         click.echo(f"\nCode rules: not evaluated: {result.rules_note}.")
     else:
-        click.echo(f"\nCode rules in risk terms (gap at the code intensity's stripe; λ_P: pounding per year at that gap; "
-                   f"'once in N years'; P in {years:g} years):")
+        click.echo(f"\nCode rules in risk terms, applied to the suite-mean peaks of the code intensity's stripe (λ_P: pounding per year "
+                   f"at that gap; 'once in N years'; P in {years:g} years; each with its interval; fit: lognormal or a degenerate step):")
         click.echo(rules.to_string(float_format=lambda v: f"{v:.4g}"))
+    if costs is not None:
+        click.echo(f"\nLimit states beyond first contact (λ: per year at each finite gap; contact-free: the same motions without "
+                   f"contact; Δλ: what the gap costs; P in {years:g} years):")
+        click.echo(costs.to_string(float_format=lambda v: f"{v:.4g}"))
     click.echo("\n".join(efficient_measure_lines(data, hazard)))
     if csv_dir is not None:
         tables = {"separation": result.to_frame()}
         if not rules.empty:
             tables["rules"] = rules.reset_index()
+        if costs is not None:
+            tables["limit_states"] = costs.reset_index()
         try:
             csv_dir.mkdir(parents=True, exist_ok=True)
             for name, frame in tables.items():

@@ -27,6 +27,17 @@ from stochpound.experiment._grid import Case, Dim, Experiment
 from stochpound.experiment._runner import RunReport, default_store, load_experiment, run_experiment
 from stochpound.experiment._status import StatusReport, store_status
 
+# For the other packages of stochpound (their interface to this one, not public API: not in __all__).
+from stochpound.experiment._ensemble import simulate_ensemble  # noqa: F401
+from stochpound.experiment._estimate import LARGE_RUN_BYTES, LARGE_RUN_CASES  # noqa: F401
+from stochpound.experiment._grid import CASE  # noqa: F401
+from stochpound.experiment._hazard import check_covers, hazard_curve, hazard_option, stored_hazard  # noqa: F401
+from stochpound.experiment._intensity import describe_measure  # noqa: F401
+from stochpound.experiment._parts import parts_folder, read_experiment_json  # noqa: F401
+from stochpound.experiment._site import periods_of_interest  # noqa: F401
+from stochpound.experiment._sources import resolve_motions  # noqa: F401
+from stochpound.experiment._store_writer import PartsIndex  # noqa: F401
+
 __all__ = [
     "FIXED_BASE",
     "Case",

@@ -250,17 +250,6 @@ def _twins(task: BatchTask, grounds: dict[int, GroundMotion]) -> dict[str, dict[
     return twins
 
 
-def solver_cached() -> bool:
-    """True if numba's cache holds the exact solver's engine compiled from its current source (read from the
-    cache's index, no compilation): :func:`warm_up` then loads it in about a second instead of compiling it."""
-    from stochpound.solvers.engine import run_engine
-
-    try:
-        return bool(run_engine._cache._cache_file._load_index())  # numba's cache index: empty if absent or stale
-    except Exception:  # noqa: BLE001 - numba's private API changed: say the compile may happen
-        return False
-
-
 def warm_up() -> None:
     """Compile the exact solver's engine, the twin's recursion and the response spectrum's kernel (or load them from numba's cache).
 

@@ -40,10 +40,9 @@ import xarray as xr
 from threadpoolctl import threadpool_limits
 
 from stochpound import __version__
-from stochpound.analysis import impact_statistics, peak_response
-from stochpound.analysis._impacts import TABLE_COLUMNS
+from stochpound.analysis import TABLE_COLUMNS, impact_statistics, peak_response
 from stochpound.analysis.names import ENSEMBLE_ALIASES, with_aliases
-from stochpound.analysis._summary import response_moments
+from stochpound.analysis import response_moments
 from stochpound._memory import check_memory, sample_bytes
 from stochpound.motions.ground import SampledMotion
 from stochpound.model.scene import Scene

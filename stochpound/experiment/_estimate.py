@@ -14,9 +14,15 @@ from typing import Mapping
 from stochpound.experiment._grid import KINDS, Experiment, Point
 from stochpound.experiment._spec import AUTO
 from stochpound.experiment._store import layout
+from stochpound.experiment._store_writer import file_bytes
 from stochpound._memory import format_bytes
 from stochpound.model.scene_file import scene_from_dict
+from stochpound.solvers import first_call
+from stochpound.solvers.first_call import compile_text
+from stochpound.store import canonical_json
 
+COMPILE = "compiling the solver"
+"""The start-up step of compiling the exact solver into numba's empty cache."""
 LARGE_RUN_CASES = 1_000_000
 """Above this many cases to run, ``experiment run`` asks for ``--yes``."""
 LARGE_RUN_BYTES = 10 * 2**30
@@ -27,8 +33,6 @@ solver's is measured on a whole experiment, not on the engine alone: the earlier
 cases of 1001 samples in 8.1 min on 2 cores, 12 ms of CPU a case with its summaries, parts and fixed-base twin (the
 engine alone takes 0.09–0.2 ms per second of motion, docs/benchmarks.md). The ivp solver's is a rough order of
 magnitude (0.1 s of CPU per second of motion at 0.02 s)."""
-_ID_BYTES = 24
-"""Bytes per case id in the file (16 characters and the variable-length string's overhead)."""
 
 
 @dataclass(frozen=True)
@@ -42,13 +46,21 @@ class RunEstimate:
     cpu_seconds : float
         Their CPU time (one core), s.
     store_bytes : int
-        Size of the complete store file without its impact table (time histories uncompressed), bytes;
-        the parts folder holds about as much again.
+        Size of the complete store file without its impact table (:func:`~stochpound.experiment._store_writer.file_bytes`:
+        measured on its metadata written in memory, time histories uncompressed), bytes; the parts folder holds about as much again.
+    history_bytes : int
+        The time histories' part of ``store_bytes``, uncompressed (the file holds them compressed: usually less), bytes.
+    startup : tuple of (str, float or None)
+        The start-up steps before the first case runs, each with its duration last measured on this machine (s; None if never):
+        compiling the solver (when numba's cache of it is empty), then the rest (:func:`startup_step`: loading it, the store,
+        a local cluster), as the runner last timed them (:mod:`stochpound.solvers.first_call`).
     """
 
     cases: int
     cpu_seconds: float
     store_bytes: int
+    history_bytes: int = 0
+    startup: tuple[tuple[str, float | None], ...] = ()
 
     @property
     def large(self) -> bool:
@@ -56,15 +68,30 @@ class RunEstimate:
         return self.cases > LARGE_RUN_CASES or self.store_bytes > LARGE_RUN_BYTES
 
     def describe(self, cores: int) -> str:
-        """``1,000 cases to run: roughly 2 min on 2 cores, store about 1.2 MiB (and as much again in STORE.parts/)``."""
+        """``1,000 cases to run: roughly 2 min on 2 cores after a start-up of about 9 s (...), store about 1.2 MiB (and as much again in its .parts folder)``."""
         wall = self.cpu_seconds / max(1, cores)
+        size = f"about {format_bytes(self.store_bytes)}"
+        if self.history_bytes:
+            size += f" or less ({format_bytes(self.history_bytes)} of it time histories before compression)"
         return (
-            f"{self.cases:,} cases to run: roughly {_duration(wall)} on {cores} core{'s' if cores > 1 else ''}, "
-            f"store about {format_bytes(self.store_bytes)} (and as much again in its .parts folder)"
+            f"{self.cases:,} cases to run: roughly {_duration(wall)} on {cores} core{'s' if cores > 1 else ''}{self._startup_text()}, "
+            f"store {size} (and as much again in its .parts folder)"
         )
 
 
-def estimate_run(experiment: Experiment, motion_grids: Mapping[str, tuple[float, int]], cases: int) -> RunEstimate:
+    def _startup_text(self) -> str:
+        """`` after a start-up of about 45 s (compiling the solver 38 s, starting 2 workers 7 s, as last timed here)``, or what is not yet timed."""
+        if not self.startup:
+            return ""
+        if all(seconds is not None for _, seconds in self.startup):
+            steps = ", ".join(f"{step} {_duration(seconds)}" for step, seconds in self.startup)
+            return f" after a start-up of about {_duration(sum(s for _, s in self.startup))} ({steps}, as last timed on this machine)"
+        steps = ", ".join(f"{step} ({_duration(seconds)} when last timed on this machine)" if seconds is not None else
+                          f"{step} ({'not yet timed on this machine' if step != COMPILE else compile_text()})" for step, seconds in self.startup)
+        return f" after a start-up: {steps}"
+
+
+def estimate_run(experiment: Experiment, motion_grids: Mapping[str, tuple[float, int]], cases: int, workers: int = 0) -> RunEstimate:
     """Estimate the cost of running ``cases`` of the experiment's cases (the missing ones).
 
     Parameters
@@ -74,6 +101,8 @@ def estimate_run(experiment: Experiment, motion_grids: Mapping[str, tuple[float,
         Sample spacing (s) and number of samples of each motion.
     cases : int
         Cases to run (their share of the experiment's samples is counted).
+    workers : int
+        Worker processes of the local cluster the run starts (0: none, the cases run in this process or on a scheduler's).
     """
     per_point = sum(len(experiment.realizations(label)) * samples for label, (_, samples) in motion_grids.items())
     cpu = 0.0
@@ -82,14 +111,16 @@ def estimate_run(experiment: Experiment, motion_grids: Mapping[str, tuple[float,
             cpu += per_point * CPU_SECONDS_PER_SAMPLE[_method(experiment, point)]
     share = cases / experiment.n_cases if experiment.n_cases else 0.0
     store = layout(experiment, motion_grids, 0)
-    size = 0
-    for spec in store.specs:
-        if spec.kind is None:  # the impact table: its length is not known before the run
-            continue
-        grid = len(experiment.kind_dims(spec.kind))
-        per_position = _ID_BYTES if spec.family == "id" else spec.dtype.itemsize * math.prod(store.sizes[d] for d in spec.dims[grid:])
-        size += per_position * math.prod(experiment.grid_shape(spec.kind))
-    return RunEstimate(cases, cpu * share, size)
+    histories = sum(spec.dtype.itemsize * math.prod(store.sizes[d] for d in spec.dims) for spec in store.of("history"))
+    startup = [(COMPILE, first_call.measured("compile"))] if cases and not first_call.engine_cached() else []
+    if cases:
+        startup.append((startup_step(workers), first_call.measured(startup_step(workers))))
+    return RunEstimate(cases, cpu * share, file_bytes(store, {"definition": canonical_json(experiment.definition)}), histories, tuple(startup))
+
+
+def startup_step(workers: int) -> str:
+    """The start-up of a run besides a compile (loading the solver, the store, a local cluster of ``workers``), as it is timed and said."""
+    return f"starting {workers} local worker{'s' if workers > 1 else ''} and the store" if workers else "opening the store and loading the solver"
 
 
 def _method(experiment: Experiment, point: Point) -> str:

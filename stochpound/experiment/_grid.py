@@ -192,6 +192,13 @@ class Experiment:
         return bool(self.definition["scene"].get("wall")) or any(o.get("scene", {}).get("wall") for o in overrides)
 
     @cached_property
+    def has_storey_summaries(self) -> bool:
+        """Whether a case's buildings can have yielding storeys or storey heights (``yield_force``, ``storey_height``), in the base scene or a variant."""
+        buildings = list(self.definition["scene"]["building"])
+        buildings += [f for variant in self.variants for o in variant["overrides"].values() for f in o.get("building", {}).values()]
+        return any("yield_force" in b or "storey_height" in b for b in buildings)
+
+    @cached_property
     def motion_dims(self) -> list[Dim]:
         """``record`` (motion labels) and ``realization`` (union of realization indices)."""
         realizations = np.sort(np.concatenate([self.realization_numbers(label) for label in self.motions]))

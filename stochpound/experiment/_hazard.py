@@ -42,12 +42,11 @@ from typing import Any, Mapping, Sequence
 
 import xarray as xr
 
-from stochpound.analysis._hazard import HazardCurve, bundled_curves, bundled_measure, bundled_path
-from stochpound.analysis._hazard_files import parse_units, read_hazard_file, unit_factor
+from stochpound.analysis import HazardCurve, bundled_curves, bundled_measure, bundled_path, parse_units, read_hazard_file, unit_factor
 from stochpound.experiment._intensity import MEASURES, IntensityError
 from stochpound.store import describe_measure
 from stochpound.model import fields as toml_fields
-from stochpound.motions._spectrum import DEFAULT_G
+from stochpound.motions import DEFAULT_G
 
 SOURCES = ("file", "bundled", "power_law")
 """The keys that name a hazard's source (exactly one per ``[hazard]`` table)."""

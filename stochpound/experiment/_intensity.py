@@ -35,8 +35,7 @@ import numpy as np
 from stochpound.model import fields as toml_fields
 from stochpound.experiment._site import parse_selection
 from stochpound.model.friction import is_fixed_base
-from stochpound.motions._measures import arias_intensity, peak_ground_motion, significant_duration
-from stochpound.motions._spectrum import response_spectrum
+from stochpound.motions import arias_intensity, peak_ground_motion, response_spectrum, significant_duration
 from stochpound.store import describe_measure
 
 MEASURES = ("pga", "pgv", "psa", "sa_avg")

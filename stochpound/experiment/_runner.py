@@ -29,8 +29,8 @@ from typing import Any, Callable, Iterable, Iterator
 
 from stochpound import __version__
 from stochpound.experiment._batches import automatic_size, make_batches
-from stochpound.experiment._compute import BatchResult, BatchTask, run_batch, solver_cached, warm_up
-from stochpound.experiment._estimate import LARGE_RUN_BYTES, LARGE_RUN_CASES, estimate_run
+from stochpound.experiment._compute import BatchResult, BatchTask, run_batch, warm_up
+from stochpound.experiment._estimate import LARGE_RUN_BYTES, LARGE_RUN_CASES, estimate_run, startup_step
 from stochpound.experiment._grid import Experiment
 from stochpound.experiment._parts import FolderLock, PartBuffer, append_run, parts_folder, remove_temporaries
 from stochpound.experiment._session import StoreSession, check_store, clear_store, code_identity, machine, missing_summaries, now, store_complete, stored_definition
@@ -38,6 +38,7 @@ from stochpound.experiment._sources import ResolvedMotion, resolve_motions
 from stochpound.experiment._spec import ExperimentError, load_definition
 from stochpound.experiment._store_writer import PartsIndex
 from stochpound._memory import format_bytes
+from stochpound.solvers import first_call
 from stochpound.store import canonical_json
 
 CHECKPOINT_FACTOR = 20.0
@@ -227,7 +228,8 @@ def run_experiment(
         if repair:
             say(f"{store}: damaged; rebuilding it from the {report.done_before} finished cases in {session.folder.name}/")
         if report.done_before < report.total:
-            say(estimate_run(experiment, grids, report.total - report.done_before).describe(_cores(workers, scheduler)))
+            say(estimate_run(experiment, grids, report.total - report.done_before, _local_workers(workers, scheduler)).describe(_cores(workers, scheduler)))
+        cold = not first_call.engine_cached()
         identity = code_identity()
         append_run(session.folder, {"started": now(), "machine": machine(), "executor": report.executor, **identity})
         missing = session.missing()
@@ -241,6 +243,8 @@ def run_experiment(
         def ready() -> None:
             nonlocal bar
             report.setup = time.monotonic() - started
+            compiled = first_call.measured("compile") if cold else 0.0  # timed as it happened: the rest is the start-up of any run
+            first_call.record(startup_step(_local_workers(workers, scheduler)), report.setup - (compiled or 0.0))
             bar = _progress_bar(report, experiment.name, progress)  # after the start-up's messages
 
         try:
@@ -380,14 +384,14 @@ def execute(
     """
     labels = list(experiment.motions)
     if workers == 0 and scheduler is None:
+        _warm_up(say)  # the compile on a cold cache is start-up, not the first batch's time
         ready()
         for task in batches:
             yield task, run_batch(task, motions[labels[task.record]].motion)
         return
-    from distributed import as_completed, wait
+    from distributed import as_completed
 
     with _dask_client(workers, scheduler, say) as client:
-        wait([client.submit(warm_up, pure=False, workers=[worker]) for worker in client.scheduler_info()["workers"]])
         shipped = {m: client.scatter(motions[label].motion, broadcast=True, hash=False) for m, label in enumerate(labels) if motions[label].motion is not None}
         ahead = IN_FLIGHT_PER_WORKER * max(1, sum(client.nthreads().values()))
         pending = iter(batches)
@@ -419,10 +423,23 @@ def execute(
             client.cancel(list(tasks))
 
 
+def _warm_up(say: Callable[[str], None]) -> None:
+    """Compile the solver in this process (a log line says so, and the compile is timed) or load it from numba's cache."""
+    if first_call.engine_cached():
+        say("loading the compiled solver…")
+    with first_call.announced_compile():
+        warm_up()
+
+
 @contextmanager
 def _dask_client(workers: int | None, scheduler: str | None, say: Callable[[str], None]) -> Iterator[Any]:
+    """A client whose workers have loaded the compiled solver: of the scheduler, or of a local cluster."""
     import dask
-    from distributed import Client, LocalCluster
+    from distributed import Client, LocalCluster, wait
+
+    def loaded(client: Any) -> Any:
+        wait([client.submit(warm_up, pure=False, workers=[worker]) for worker in client.scheduler_info()["workers"]])
+        return client
 
     for name in ("distributed", "distributed.nanny", "distributed.worker", "distributed.scheduler", "distributed.core"):
         logging.getLogger(name).setLevel(logging.ERROR)
@@ -430,12 +447,11 @@ def _dask_client(workers: int | None, scheduler: str | None, say: Callable[[str]
         say(f"connecting to the dask scheduler {scheduler}…")
         client = Client(scheduler, timeout="30s")
         try:
-            yield client
+            yield loaded(client)
         finally:
             client.close(timeout=10)
         return
-    say("compiling the solver (first run only, ~10 s)…" if not solver_cached() else "loading the compiled solver…")
-    warm_up()
+    _warm_up(say)
     n_workers = workers or os.cpu_count() or 1
     say(f"starting a local dask cluster ({n_workers} worker{'s' if n_workers > 1 else ''})…")
     with _handling_sigint(signal.SIG_IGN):  # the fork server, and every worker process it forks, ignore SIGINT
@@ -450,7 +466,7 @@ def _dask_client(workers: int | None, scheduler: str | None, say: Callable[[str]
             )
         if requested:
             raise KeyboardInterrupt
-        client = Client(cluster)
+        client = loaded(Client(cluster))
         yield client
     finally:
         if client is not None:
@@ -479,6 +495,13 @@ def _handling_sigint(handler: Any) -> Iterator[None]:
         yield
     finally:
         signal.signal(signal.SIGINT, previous)
+
+
+def _local_workers(workers: int | None, scheduler: str | None) -> int:
+    """Worker processes of the local cluster a run starts (0: it runs in this process, or on a scheduler's cluster)."""
+    if scheduler is not None or workers == 0:
+        return 0
+    return workers or os.cpu_count() or 1
 
 
 def _cores(workers: int | None, scheduler: str | None) -> int:

@@ -36,7 +36,7 @@ import numpy as np
 import xarray as xr
 
 from stochpound.model import fields as toml_fields
-from stochpound.motions._conditional import CONDITIONING_MEASURES, MODEL_DAMPING, PERIOD_RANGE, check_scenario
+from stochpound.motions import CONDITIONING_MEASURES, MODEL_DAMPING, PERIOD_RANGE, check_scenario
 
 if TYPE_CHECKING:
     from stochpound.experiment._grid import Experiment
@@ -291,13 +291,11 @@ def stripe_selections(experiment: Experiment) -> StripeSelections:
         Naming the field: a synthetic ensemble in the pool, ``intensity.motions``
         more than the pool has within ``max_scale_factor`` of a level.
     """
-    from stochpound._errors import SiteError
+    from stochpound._errors import ExperimentError, SiteError, field_errors
     from stochpound.experiment._grid import CASE
-    from stochpound.experiment._spec import ExperimentError, field_errors
     from stochpound.model.scene_file import scene_from_dict
     from stochpound.motions import conditional_spectrum, select_motions, selection_periods, selection_pool
-    from stochpound.motions.records import Record
-    from stochpound.motions.records._suites import is_suite_member, load_suite_member
+    from stochpound.motions.records import Record, is_suite_member, load_suite_member
 
     intensity = experiment.intensity
     scene = experiment.structure(experiment.points(CASE)[0])

@@ -16,19 +16,18 @@ path, e.g. ``grid.mu[2]: must be >= 0 or inf, got -0.1``.
 
 from __future__ import annotations
 
-import contextlib
 import copy
 import hashlib
 import math
 import re
 import tomllib
 from pathlib import Path
-from typing import Any, Iterator, Mapping
+from typing import Any, Mapping
 
-from stochpound._errors import ExperimentError, SceneError
+from stochpound._errors import ExperimentError, field_errors
 from stochpound._studies import parse_reproduces
 from stochpound.experiment._hazard import parse_hazard
-from stochpound.motions._spectrum import DEFAULT_G
+from stochpound.motions import DEFAULT_G
 from stochpound.experiment._intensity import parse_intensity
 from stochpound.model import fields as toml_fields
 from stochpound.model.contact import ELEMENT_KEYS
@@ -63,29 +62,6 @@ _RESERVED_DIMS = {
 
 #: Time-history variables of a result that an experiment can keep (declared in ``stochpound.store._catalogue``).
 TIME_HISTORY_VARIABLES = tuple(TIME_HISTORIES)
-
-
-@contextlib.contextmanager
-def field_errors(prefix: str = "", scene_prefix: str | None = None) -> Iterator[None]:
-    """Re-raise :class:`SceneError` (and ``ValueError``) as :class:`ExperimentError`.
-
-    Parameters
-    ----------
-    prefix : str
-        Prepended to the message (``"variants.neighbour.stiff: "``).
-    scene_prefix : str, optional
-        Replaces a leading ``motion.`` / ``motion:`` of scene messages, so that a
-        record's errors name the experiment's field (``records[0].duration``).
-    """
-    try:
-        yield
-    except ExperimentError:
-        raise
-    except (SceneError, ValueError) as error:
-        message = str(error)
-        if scene_prefix is not None:
-            message = re.sub(r"^motion([.:])", lambda m: scene_prefix + ("." if m.group(1) == "." else ":"), message)
-        raise ExperimentError(prefix + message) from None
 
 
 def load_definition(path: str | Path) -> tuple[dict[str, Any], str]:
@@ -456,7 +432,7 @@ def _record_sources(table: Mapping[str, Any], where: str, base_dir: Path) -> lis
     """A ``[[records]]`` entry: one record, or every motion of a suite (``suite = "fema_p695_far_field"`` or a folder)."""
     if "suite" not in table:
         return [_record_source(table, where, base_dir)]
-    from stochpound.motions.records._suites import SELECTIONS, SUITES, select_members
+    from stochpound.motions.records import SELECTIONS, SUITES, select_members
 
     with field_errors():
         toml_fields.reject_unknown(table, _SUITE_KEYS | set(SELECTIONS), where)

@@ -32,12 +32,12 @@ from typing import Any, Iterator, Mapping
 import numpy as np
 import xarray as xr
 
-from stochpound.store import CASE_SUMMARIES, IMPACT_TABLE, REFERENCE_HISTORY, REFERENCE_SUMMARIES, SETS, StoreVariable, TIME_HISTORIES, WALL_SUMMARIES, canonical_json
+from stochpound.store import CASE_SUMMARIES, IMPACT_TABLE, REFERENCE_HISTORY, REFERENCE_SUMMARIES, SETS, STOREY_SUMMARIES, StoreVariable, TIME_HISTORIES, WALL_SUMMARIES, canonical_json
 from stochpound.experiment import _intensity as intensity
 from stochpound.experiment._grid import CASE, REFERENCE, Dim, Experiment
 from stochpound.experiment._summary import DEMAND_SUMMARIES
 from stochpound.model.scene_file import scene_from_dict
-from stochpound.motions.records._suites import METADATA_FIELDS
+from stochpound.motions.records import METADATA_FIELDS
 from stochpound.results.dataset import scene_parameters
 
 #: Version of the store layout.
@@ -127,7 +127,7 @@ def layout(experiment: Experiment, motion_grids: Mapping[str, tuple[float, int]]
     coords = _coordinates(experiment, motion_grids)
     sizes = {name: v.size for name, v in coords.items() if v.dims == (name,)}
     specs: list[Spec] = []
-    case_summaries = CASE_SUMMARIES + (WALL_SUMMARIES if experiment.has_walls else ())
+    case_summaries = CASE_SUMMARIES + (WALL_SUMMARIES if experiment.has_walls else ()) + (STOREY_SUMMARIES if experiment.has_storey_summaries else ())
     for kind, variables in ((REFERENCE, REFERENCE_SUMMARIES), (CASE, case_summaries)):
         dims = tuple(d.name for d in experiment.kind_dims(kind))
         grid = tuple(sizes[d] for d in dims)
@@ -269,7 +269,7 @@ def _scene_coordinates(experiment: Experiment) -> dict[str, xr.Variable]:
 
 def _suite_coordinates(experiment: Experiment) -> dict[str, xr.Variable]:
     """Metadata of the motions from suites on ``record`` (event, station, component, magnitude, distance...; none without such motions)."""
-    from stochpound.motions.records._suites import is_suite_member, load_suite_member
+    from stochpound.motions.records import is_suite_member, load_suite_member
 
     rows: list[Mapping[str, Any]] = []
     for source in experiment.motions.values():

@@ -16,6 +16,8 @@ The file is written to a temporary name and renamed over the store
 
 from __future__ import annotations
 
+import json
+import math
 import threading
 from collections import OrderedDict
 from dataclasses import dataclass
@@ -26,7 +28,7 @@ import h5py
 import numpy as np
 from xarray.backends import H5NetCDFStore
 
-from stochpound._atomic import check_room, replacing
+from stochpound._atomic import check_room, free_bytes, replacing
 from stochpound.experiment._grid import CASE, KINDS, Experiment
 from stochpound.experiment._parts import part_paths, read_part, split_key
 from stochpound.experiment._spec import ExperimentError
@@ -35,6 +37,22 @@ from stochpound.experiment._store import INT_FILL, Layout, Spec, blocks, layout,
 PART_CACHE_BYTES = 64 * 2**20
 """Parts kept in memory while the blocks that need them are written, bytes."""
 _CHUNK_CACHE_BYTES = 16 * 2**20
+ROOM_FACTOR = 1.1
+"""Free room checked before a store file is written: this many times its size (:func:`file_bytes`) ..."""
+ROOM_MARGIN = 2**20
+"""... and this many bytes more."""
+_ID_CHARACTERS = 16
+"""Characters of a case id (the strings :func:`file_bytes` writes)."""
+_STRING_BYTES = 64
+"""Bytes of a variable-length string of up to 32 characters: its 16-byte reference and its global-heap object."""
+_HEAP_BYTES = 4096
+"""Least size of the global-heap collection HDF5 allocates for the strings of each chunk written, bytes."""
+_OBJECT_BYTES = 16 * 2**10
+"""Bound of a variable's metadata (its header, attributes and first chunk-index node: 1.4 to 2 KiB and 2 to 5 KiB measured), bytes."""
+_INDEX_NODE_CHUNKS = 64
+"""Chunks per node of a variable's chunk index (HDF5's version-1 B-tree, 2K entries, K = 32 by default) ..."""
+_INDEX_NODE_BYTES = 5 * 2**10
+"""... and the size of a node, bytes (4.7 KiB for six dimensions)."""
 
 
 @dataclass
@@ -134,7 +152,7 @@ def write_store(experiment: Experiment, index: PartsIndex, motion_grids: Mapping
         "cases_done": n_done,
         "complete": int(n_done == experiment.n_cases),
     }
-    check_room(path, path.stat().st_size if path.is_file() else 0)  # the new file is at least as large as the old one
+    _check_room(path, store_layout, attrs)
     with replacing(path) as temporary:
         _create(store_layout, attrs, temporary)
         with h5py.File(temporary, "r+", rdcc_nbytes=_CHUNK_CACHE_BYTES) as handle:
@@ -144,6 +162,79 @@ def write_store(experiment: Experiment, index: PartsIndex, motion_grids: Mapping
             for spec in store_layout.of("history"):
                 writer.history(spec)
     return path
+
+
+def _check_room(path: Path, store_layout: Layout, attrs: Mapping[str, Any]) -> None:
+    """Raise ``OSError(ENOSPC)`` naming ``path`` unless its disk has room for the file, with a margin (:data:`ROOM_FACTOR`, :data:`ROOM_MARGIN`).
+
+    HDF5 may crash the process when the disk fills while it writes (a
+    segfault closing the file), so the room is checked before. The file's
+    size is measured (:func:`file_bytes`, half a second) only when the free
+    room is below a quick upper bound of it (:data:`_OBJECT_BYTES` per variable).
+    """
+    free = free_bytes(path)
+    if free is None:
+        return
+    quick = sum(math.prod(count) * per_chunk for count, per_chunk in (_chunks(tuple(store_layout.sizes[d] for d in spec.dims), spec.chunks, spec.dtype)
+                                                                       for spec in store_layout.specs))
+    quick += sum(v.nbytes for v in store_layout.coords.values()) + _OBJECT_BYTES * (len(store_layout.specs) + len(store_layout.coords))
+    quick += 4 * len(json.dumps(dict(attrs), default=str))
+    if free >= ROOM_FACTOR * quick + ROOM_MARGIN:
+        return
+    old = path.stat().st_size if path.is_file() else 0
+    check_room(path, max(old, int(ROOM_FACTOR * file_bytes(store_layout, attrs)) + ROOM_MARGIN))
+
+
+def _chunks(shape: tuple[int, ...], chunks: tuple[int, ...] | None, dtype: np.dtype) -> tuple[tuple[int, ...], int]:
+    """The chunks of a variable along each dimension, and the bytes of one (strings: :data:`_STRING_BYTES` each and a heap)."""
+    strings = dtype.kind in "OU"
+    chunks = chunks or shape
+    per_chunk = math.prod(chunks) * (_STRING_BYTES if strings else dtype.itemsize) + strings * _HEAP_BYTES
+    return tuple(math.ceil(n / c) if c else 0 for n, c in zip(shape, chunks)), per_chunk
+
+
+def file_bytes(store_layout: Layout, attrs: Mapping[str, Any]) -> int:
+    """The size of the store file :func:`write_store` writes for ``store_layout``, bytes, measured on an in-memory file.
+
+    The file's metadata is written as :func:`write_store` writes it, in
+    memory (HDF5's core driver, nothing on disk), and one element of every
+    variable, which allocates its chunk index and its first chunk; the
+    other chunks are counted at their uncompressed size (an upper bound
+    for the compressed time histories), variable-length strings at
+    :data:`_STRING_BYTES` each and a heap of :data:`_HEAP_BYTES` per chunk, and a further chunk-index node per
+    :data:`_INDEX_NODE_CHUNKS` chunks.
+
+    Parameters
+    ----------
+    store_layout : Layout
+        The store's layout (its impact table at its length).
+    attrs : mapping
+        The file's global attributes.
+
+    Returns
+    -------
+    int
+        Bytes: within a few per cent of the written file, or more with time
+        histories (they are written compressed), tests/test_experiment_cli.py.
+    """
+    store = H5NetCDFStore.open("in memory", mode="w", lock=threading.Lock(), driver="core", driver_kwds={"backing_store": False})
+    try:
+        store_layout.template(attrs).dump_to_store(store, writer=_MetadataOnly())
+        handle = store.ds._h5file
+        rest = 0
+        for spec in store_layout.specs:
+            variable = handle[spec.name]
+            if variable.size == 0:
+                continue
+            variable[(0,) * variable.ndim] = "-" * _ID_CHARACTERS if variable.dtype.kind == "O" else 0
+            count, per_chunk = _chunks(variable.shape, variable.chunks, variable.dtype)
+            chunks = math.prod(count)
+            written = 0 if variable.compression else 1  # a compressed chunk of one element takes almost nothing
+            rest += (chunks - written) * per_chunk + (chunks // _INDEX_NODE_CHUNKS) * _INDEX_NODE_BYTES
+        handle.flush()
+        return len(handle.id.get_file_image()) + rest
+    finally:
+        store.close()
 
 
 class _MetadataOnly:

@@ -32,9 +32,8 @@ import xarray as xr
 
 from stochpound.analysis import kernels, peak_response
 from stochpound.analysis.names import RESPONSE_MOMENTS, without_aliases
-from stochpound.analysis._separation_rules import STORE_NAMES, contact_demands
-from stochpound.analysis._summary import response_moments, run_summary, top_floor_total_displacement
-from stochpound.store import CATALOGUE, IMPACT_TABLE, WALL_SUMMARIES
+from stochpound.analysis import STORE_NAMES, contact_demands, response_moments, run_summary, top_floor_total_displacement
+from stochpound.store import CATALOGUE, IMPACT_TABLE, STOREY_SUMMARIES, WALL_SUMMARIES
 
 _MOMENTS = tuple(RESPONSE_MOMENTS.values())
 _PEAKS = ("peak_total_displacement", "peak_relative_displacement", "peak_sliding_displacement", "residual_sliding")
@@ -48,6 +47,11 @@ DEMAND_SUMMARIES = {
 }
 #: The wall summaries (``stochpound.store.WALL_SUMMARIES``): every case computes them (NaN without walls); a store keeps them when its scene has walls.
 WALL_PENETRATION, WALL_CLOSURE = WALL_SUMMARIES
+#: The storey summaries (``stochpound.store.STOREY_SUMMARIES``): name -> the run's per-storey variable whose largest absolute
+#: value over each building's storeys it keeps. Every case computes them (NaN where the run has no such variable); a store
+#: keeps them when its buildings have yielding storeys or storey heights.
+STOREY_SOURCES = dict(zip((v.name for v in STOREY_SUMMARIES),
+                          ("peak_storey_drift_ratio", "peak_storey_ductility", "residual_storey_drift", "residual_storey_drift_ratio")))
 #: Columns of the impact table a store keeps (``stochpound.store.IMPACT_TABLE``).
 IMPACT_COLUMNS = tuple(v.name for v in IMPACT_TABLE)
 
@@ -71,7 +75,9 @@ def case_summary(run: xr.Dataset, studied: str, fixed_base: xr.DataArray) -> xr.
         Peaks and residual sliding per building (m), impact statistics,
         moments of the response, ``fixed_base_correlation``,
         ``energy_residual_ratio``, ``events_total``, ``peak_wall_penetration``
-        and ``largest_wall_closure`` (m; NaN without walls).
+        and ``largest_wall_closure`` (m; NaN without walls), and the storey
+        summaries per building (:data:`STOREY_SOURCES`; NaN where the run
+        lacks their source).
     """
     summary = without_aliases(run_summary(run, studied, fixed_base)).drop_vars(list(_PEAKS))
     summary = xr.merge([summary, peak_response(run)])
@@ -81,6 +87,8 @@ def case_summary(run: xr.Dataset, studied: str, fixed_base: xr.DataArray) -> xr.
         summary = summary.merge(_demand_summary(run))
     summary[WALL_PENETRATION.name] = xr.DataArray(_wall_penetration(run))
     summary[WALL_CLOSURE.name] = xr.DataArray(_wall_closure(run))
+    for name, values in _storey_values(run).items():
+        summary[name] = xr.DataArray(values, dims=("building",), coords={"building": run["building"].values})
     return _catalogued(summary)
 
 
@@ -146,7 +154,15 @@ def case_values(run: xr.Dataset, studied: str, fixed_base: np.ndarray) -> dict[s
         **_demand_values(run),
         WALL_PENETRATION.name: _wall_penetration(run),
         WALL_CLOSURE.name: _wall_closure(run),
+        **_storey_values(run),
     }
+
+
+def _storey_values(run: xr.Dataset) -> dict[str, np.ndarray]:
+    """Per building, the largest absolute value over its storeys of each of :data:`STOREY_SOURCES` (NaN where the run lacks it)."""
+    variables = run.variables
+    missing = np.full(variables["building"].shape, np.nan)
+    return {name: kernels.abs_peak(variables[source].values, 1) if source in variables else missing for name, source in STOREY_SOURCES.items()}
 
 
 def _wall_penetration(run: xr.Dataset) -> np.float64:

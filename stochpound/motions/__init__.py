@@ -50,6 +50,10 @@ from stochpound.motions._seeding import realization_rng, realization_rngs
 from stochpound.motions._spectrum import response_spectrum
 from stochpound.motions._synthetic import PSD_CONVENTION, clough_penzien, kanai_tajimi, synthetic_ground_motion
 
+# For the other packages of stochpound (their interface to this one, not public API: not in __all__).
+from stochpound.motions._arias import DEFAULT_G, arias_intensity  # noqa: F401
+from stochpound.motions._conditional import CONDITIONING_MEASURES, MODEL_DAMPING, PERIOD_RANGE, check_scenario  # noqa: F401
+
 __all__ = [
     "ENVELOPES",
     "PSD_CONVENTION",

@@ -94,7 +94,8 @@ def assemble_report(paths: Sequence[str | Path], progress: Callable[[str], None]
             report.sections.append(separation_section(name, store))
         if store.pound.intensity is not None:
             say(f"experiment {name}: intensity")
-            report.sections.append(intensity_section(name, store))
+            near = risks[name].separation["separation"].values.ravel() if name in risks else ()  # g*: where the contact-free runs pound
+            report.sections.append(intensity_section(name, store, near))
     say("methods")
     report.sections.append(methods_section(stores))
     if others and not studies:

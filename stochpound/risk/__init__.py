@@ -15,14 +15,17 @@ experiment store, :func:`store_risk` runs the whole chain and returns a
 :meth:`StoreRisk.separation_frame`, :meth:`StoreRisk.rules_frame`) the
 report renders and ``stochpound risk`` prints; :func:`store_demands` gives
 the demand hazard curves and the moat walls' limit state
-(:class:`StoreDemands`).
+(:class:`StoreDemands`); :func:`limit_state_risk` the fragility and MAF of
+limit states beyond first contact (:class:`LimitState`: drift ratios,
+ductility, floor acceleration, impact force, a bearing's stop) at every gap
+of a store's grid against its contact-free twins (:func:`gap_cost_frame`).
 
 This package is the canonical home of these names; the ones that
 :mod:`stochpound.analysis` exported before it existed stay importable from
 there as aliases.
 """
 
-from stochpound.analysis._hazard import HazardCurve, bundled_curves, probability_from_rate, rate_from_probability, return_period
+from stochpound.analysis import HazardCurve, bundled_curves, probability_from_rate, rate_from_probability, return_period
 from stochpound.risk._fragility import Fragility, fit_fragility
 from stochpound.risk._fragility_ensemble import (
     BOOTSTRAP,
@@ -33,7 +36,7 @@ from stochpound.risk._fragility_ensemble import (
     limit_state_events,
     stripe_fragility,
 )
-from stochpound.risk._maf import TARGETS, demand_hazard_curve, mean_annual_frequency, risk_curve, risk_targeted_separation
+from stochpound.risk._maf import TARGETS, degenerate_text, demand_hazard_curve, mean_annual_frequency, rate_intervals, risk_curve, risk_targeted_separation
 from stochpound.risk._code_rules import code_rules_risk
 from stochpound.risk._code_gaps import (
     Asce7Design,
@@ -47,8 +50,9 @@ from stochpound.risk._code_gaps import (
 from stochpound.risk._store import RiskInputError, contact_free_closure, has_risk, selection_misses, site_hazard
 from stochpound.risk._store_risk import StoreRisk, pounding_fragility, risk_gaps, store_risk
 from stochpound.risk._demands import StoreDemands, store_demands
+from stochpound.risk._limit_states import KINDS as LIMIT_STATE_KINDS, LimitState, gap_cost_frame, limit_state_risk, limit_states_from_table
 from stochpound.risk._efficiency import measure_efficiency, most_efficient
-from stochpound.analysis._consistency import hazard_consistency, stripe_rate_weights
+from stochpound.analysis import hazard_consistency, stripe_rate_weights
 
 __all__ = [
     "Fragility",
@@ -67,6 +71,8 @@ __all__ = [
     "demand_hazard_curve",
     "mean_annual_frequency",
     "risk_curve",
+    "rate_intervals",
+    "degenerate_text",
     "risk_targeted_separation",
     "code_rules_risk",
     "Asce7Design",
@@ -83,6 +89,11 @@ __all__ = [
     "StoreRisk",
     "store_demands",
     "StoreDemands",
+    "LimitState",
+    "LIMIT_STATE_KINDS",
+    "limit_states_from_table",
+    "limit_state_risk",
+    "gap_cost_frame",
     "hazard_consistency",
     "measure_efficiency",
     "most_efficient",

@@ -28,14 +28,13 @@ cent between the stored periods, and β by about as much.
 
 from __future__ import annotations
 
-import json
 from collections.abc import Mapping
 
 import numpy as np
 import xarray as xr
 from scipy.stats import linregress
 
-from stochpound.risk._store import base_displacement, contact_free, contact_free_closure, gap_dims, is_ida, store_motions
+from stochpound.risk._store import efficiency_runs
 
 #: Periods of Sa_avg, log-spaced over 0.2 T_min – 3 T_max of the structure.
 SA_AVG_PERIODS = 10
@@ -65,23 +64,16 @@ def measure_efficiency(store: xr.Dataset, periods: Mapping[str, float], structur
         magnitude and distance the residuals' ``trend_<x>`` (per unit of x)
         and ``p_<x>``. ``measure`` carries ``measure_period`` (s; NaN for PGA, PGV, Sa_avg).
     """
-    free = store.isel({d: 0 for d in gap_dims(store)}) if is_ida(store) else contact_free(store)
-    responses = {"closure": contact_free_closure(store)}
-    sliding = None if is_ida(store) else base_displacement(free, studied)
-    if sliding is not None:
-        responses["base_displacement"] = sliding
-    scale = store_motions(free["scale_factor"]).load()
-    spectrum_periods = free["spectrum_period"].values
-    psa = store_motions(free["motion_psa"]).load()
+    runs = efficiency_runs(store, studied)
+    scale, spectrum_periods, psa = runs["scale_factor"], runs["spectrum_periods"], runs["psa"]
     structural = np.array(list((structure or periods).values()), dtype=float)
     low, high = max(0.2 * structural.min(), spectrum_periods[0]), min(3.0 * structural.max(), spectrum_periods[-1])
     average = np.geomspace(low, high, SA_AVG_PERIODS)
-    candidates = {"PGA": store_motions(free["motion_pga"]).load(), "PGV": store_motions(free["motion_pgv"]).load()}
+    candidates = {"PGA": runs["pga"], "PGV": runs["pgv"]}
     measure_periods = [np.nan, np.nan]
-    conditioning = _conditioning_period(store)
     for name, period in periods.items():
-        if period == conditioning:  # the store's own measure, exact
-            candidates[f"PSA({period:.3g} s, {name})"] = store_motions(free["motion_intensity"]).load()
+        if period == runs["conditioning"]:  # the store's own measure, exact
+            candidates[f"PSA({period:.3g} s, {name})"] = runs["intensity"]
         else:
             candidates[f"PSA({period:.3g} s, {name})"] = _interpolated(psa, spectrum_periods, [period]).isel(period=0, drop=True)
         measure_periods.append(float(period))
@@ -89,10 +81,10 @@ def measure_efficiency(store: xr.Dataset, periods: Mapping[str, float], structur
     measure_periods.append(np.nan)
     covariates = {"scale_factor": np.log(scale)}
     for key, coordinate in (("magnitude", "record_magnitude"), ("distance", "record_distance")):
-        if coordinate in free.coords:
-            covariates[key] = store_motions(free[coordinate]).broadcast_like(scale)
+        if coordinate in runs["covariates"]:
+            covariates[key] = runs["covariates"][coordinate].broadcast_like(scale)
     fits = {response: xr.concat([_fit(value, im * scale, covariates) for im in candidates.values()], "measure")
-            for response, value in responses.items()}
+            for response, value in runs["responses"].items()}
     result = xr.concat(list(fits.values()), "response").assign_coords(response=list(fits), measure=list(candidates))
     return result.assign_coords(measure_period=("measure", np.array(measure_periods)))
 
@@ -102,14 +94,6 @@ def most_efficient(efficiency: xr.Dataset, measures: list[str], response: str = 
     beta = efficiency["beta"].sel(response=response, measure=measures).transpose(..., "measure")
     index = np.argmin(np.nan_to_num(beta.values, nan=np.inf), axis=-1)
     return xr.DataArray(np.asarray(measures, dtype=object)[index], dims=beta.dims[:-1], coords={d: beta[d] for d in beta.dims[:-1]})
-
-
-def _conditioning_period(store: xr.Dataset) -> float | None:
-    """T* (s) of a store conditioned on 5 %-damped PSA in g (its ``motion_intensity``), else None."""
-    intensity = json.loads(store.attrs.get("definition", "{}")).get("intensity") or {}
-    if intensity.get("measure") == "psa" and intensity.get("damping") == 0.05 and intensity.get("units") == "g":
-        return float(intensity["period"])
-    return None
 
 
 def _interpolated(psa: xr.DataArray, spectrum_periods: np.ndarray, periods: np.ndarray | list[float]) -> xr.DataArray:

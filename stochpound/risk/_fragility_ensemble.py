@@ -29,8 +29,7 @@ import numpy as np
 import xarray as xr
 from numpy.typing import ArrayLike
 
-from stochpound.analysis import kernels
-from stochpound.analysis._bootstrap import bootstrap_method, bootstrap_weights, interval, jackknife_weights, record_clusters
+from stochpound.analysis import bootstrap_method, bootstrap_weights, interval, jackknife_weights, kernels, record_clusters
 from stochpound.risk._fragility import STATUS, ida_mle, lognormal_cdf, stripe_mle
 
 BOOTSTRAP = 1000

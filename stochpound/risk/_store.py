@@ -4,7 +4,8 @@ The chain needs, from a store: its definition's ``[intensity]`` and
 ``[hazard]`` entries, its studied building and the moat walls at that
 building's base; its contact-free (and wall-free) cases, found by the gap
 axes; and, per case, the peak contact closures, the inputs of the code
-separation rules, the peak base displacements and the stored demands, with
+separation rules, the peak base displacements, the stored demands and the
+summaries the limit states beyond first contact read, with
 the motions (records, and the realizations of a synthetic ensemble) on one
 ``record`` dimension. Nothing else in :mod:`stochpound.risk` opens, selects
 or parses a store, so a new way to read stores is a change of this module
@@ -20,12 +21,10 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from stochpound.analysis import store_contact_demands
-from stochpound.analysis._hazard import HazardCurve
-from stochpound.analysis._hazard_files import parse_measure, parse_units
-from stochpound.experiment._hazard import check_covers, hazard_curve, hazard_option, stored_hazard
-from stochpound.motions._spectrum import DEFAULT_G
-from stochpound.store import contact_free, describe_measure, gap_dims, has_contact_free, wall_free
+from stochpound.analysis import HazardCurve, parse_measure, parse_units, store_contact_demands
+from stochpound.experiment import check_covers, hazard_curve, hazard_option, stored_hazard
+from stochpound.motions import DEFAULT_G
+from stochpound.store import contact_free, describe_measure, gap_dims, has_contact_free, has_wall_free, wall_free, with_contacts
 
 CLOSURE = "peak_contact_closure"
 """The store's variable of per-case, per-contact peak closures (m)."""
@@ -138,6 +137,29 @@ def experiment_name(store: xr.Dataset) -> str | None:
     return store.attrs.get("experiment_name")
 
 
+def assumptions(store: xr.Dataset) -> dict[str, str]:
+    """What a risk answer from ``store`` rests on, in words, from its definition: the structural model, the suite and its
+    selection, and the scenario."""
+    definition = store.pound.definition
+    models = []
+    for building in definition.scene.get("building", []):
+        storeys = len(building.get("mass", []))
+        storey = "yielding (bilinear) storeys" if "yield_force" in building else "linear elastic storeys"
+        base = "a sliding base" if "base" in building else "a fixed base"
+        models.append(f"{building.get('name', '?')}: {storeys}-storey shear building, {storey}, on {base}")
+    kinds = {"record": "records without a named suite", "synthetic": "synthetic ensembles"}
+    suites = sorted({source.suite or kinds.get(source.kind, source.kind) for source in definition.motions})
+    count = sum(source.count for source in definition.motions)
+    entry = definition.intensity.entry if definition.intensity is not None else {}
+    selection = entry.get("selection")
+    suite = (f"{count} motions ({', '.join(suites)}), "
+             + (f"selected per stripe by {str(selection).replace('_', ' ')}" if selection else "every motion scaled to every stripe (no selection)"))
+    site = entry.get("site")
+    scenario = "; ".join(f"{key} {value}" for key, value in site.items()) if isinstance(site, Mapping) else ""
+    return {"structural model": "; ".join(models), "suite": suite,
+            "scenario": scenario or "none stated (the motions are not selected for a scenario)"}
+
+
 def stripes(store: xr.Dataset) -> int | None:
     """The number of intensity stripes of a store (None for IDA runs)."""
     return store.sizes["intensity"] if "intensity" in store.dims else None
@@ -230,6 +252,18 @@ def base_displacement(store: xr.Dataset, studied: str | None, walls_free: bool =
     return sliding.where(slides)
 
 
+def free_base_displacement(store: xr.Dataset, studied: str | None) -> tuple[xr.DataArray | None, str]:
+    """The studied building's wall-free peak base displacement for D_TM (:func:`base_displacement`), or None and why not.
+
+    A moat wall caps the displacement D_TM is to size: with walls at its
+    base and no wall-free runs there is none ("" as the reason where the
+    building simply does not slide).
+    """
+    if moat_clearances(store, studied) and not has_wall_free(store):
+        return None, "the store has no wall-free runs (a moat wall caps the displacement D_TM is to size): add inf to the wall axis"
+    return base_displacement(store, studied, walls_free=True), ""
+
+
 def stored_demands(store: xr.Dataset) -> dict[str, tuple[xr.DataArray, str]]:
     """The stored demands of every case without impacts (contacts open, walls never reached): label → (values, display units).
 
@@ -252,3 +286,70 @@ def moat_clearances(store: xr.Dataset, studied: str | None) -> list[float]:
             walls += [(w, (w["gap"],)) for w in override.get("scene", {}).get("wall", []) or []]
     return sorted({float(gap) for w, gaps in walls for gap in gaps
                    if w.get("building") == studied and w.get("level", 0) == 0 and math.isfinite(float(gap))})
+
+
+def efficiency_runs(store: xr.Dataset, studied: str | None) -> dict[str, Any]:
+    """What measure efficiency reads of a stripes (contact-free cases) or IDA store, every motion on one dimension ``record``.
+
+    Returns
+    -------
+    dict
+        ``responses`` (``closure``: peak closure, m; ``base_displacement`` of a
+        sliding ``studied`` building, m, stripes only), ``scale_factor``,
+        ``psa`` (over ``spectrum_period``, at scale 1, in g), ``spectrum_periods`` (s),
+        ``pga`` and ``pgv`` (at scale 1), ``intensity`` (the store's own
+        measure at scale 1) and ``conditioning`` (its period T* in s when it is
+        5 %-damped PSA in g, else None), ``covariates`` (``record_magnitude`` and
+        ``record_distance`` where the store has them).
+    """
+    free = store.isel({d: 0 for d in gap_dims(store)}) if is_ida(store) else contact_free(store)
+    responses = {"closure": contact_free_closure(store)}
+    sliding = None if is_ida(store) else base_displacement(free, studied)
+    if sliding is not None:
+        responses["base_displacement"] = sliding
+    setting = intensity_setting(store) or {}
+    psa_in_g = setting.get("measure") == "psa" and setting.get("damping") == 0.05 and setting.get("units") == "g"
+    return {
+        "responses": responses,
+        "scale_factor": store_motions(free["scale_factor"]).load(),
+        "psa": store_motions(free["motion_psa"]).load(),
+        "spectrum_periods": free["spectrum_period"].values,
+        "pga": store_motions(free["motion_pga"]).load(),
+        "pgv": store_motions(free["motion_pgv"]).load(),
+        "intensity": store_motions(free["motion_intensity"]).load(),
+        "conditioning": float(setting["period"]) if psa_in_g else None,
+        "covariates": {name: store_motions(free[name]) for name in ("record_magnitude", "record_distance") if name in free.coords},
+    }
+
+
+def scene_g(store: xr.Dataset) -> float:
+    """The acceleration of gravity of the store's scene, m/s²."""
+    return float(store.pound.definition.to_dict()["scene"].get("g", DEFAULT_G))
+
+
+def case_demand(store: xr.Dataset, variable: str, building: str | None, needs: str) -> xr.DataArray:
+    """A per-case summary of every case of a store, its gap axes kept, one motion dimension ``record``.
+
+    With a ``building`` dimension: that ``building``'s value, or (None) the
+    largest over the buildings. ``needs`` says, in the error of a store
+    without ``variable``, what the experiment must have to keep it.
+    """
+    if variable not in store:
+        raise RiskInputError(f"store: has no {variable!r} (it needs {needs})")
+    data = store[variable]
+    if "building" in data.dims:
+        names = [str(b) for b in data["building"].values]
+        if building is not None and building not in names:
+            raise RiskInputError(f"limit_states: building {building!r} is not one of the store's ({', '.join(names)})")
+        data = data.max("building") if building is None else data.sel(building=building, drop=True)
+    return store_motions(data).load().assign_attrs(units=store[variable].attrs.get("units", ""))
+
+
+def at_finite_gaps(data: xr.Dataset) -> xr.Dataset:
+    """The configurations of ``data`` (over a store's grid) at finite gaps: its contact-free ones left out."""
+    return with_contacts(data)
+
+
+def contact_free_twins(data: xr.DataArray) -> xr.DataArray | None:
+    """Each configuration's contact-free twin in ``data`` (``inf`` on every contact axis, broadcast over them), or None without them."""
+    return contact_free(data).broadcast_like(data) if has_contact_free(data) else None

@@ -28,7 +28,7 @@ from stochpound.model.readouts import Readouts
 from stochpound.model.system import System
 from stochpound.motions.ground import GroundMotion
 from stochpound.results.record import EventCounters, Impact, Recorder
-from stochpound.solvers import engine, tables
+from stochpound.solvers import engine, first_call, tables
 from stochpound.solvers.propagators import PropagatorLibrary, sample_ground
 
 
@@ -80,7 +80,7 @@ class EngineRun:
         while True:
             if len(self.state.run.visited) < len(slots.modes):
                 self.state = self.state._replace(run=self.state.run._replace(visited=np.resize(self.state.run.visited, 2 * len(slots.modes))))
-            status = engine.run(*slots.tables, *self.plant, *self.state, *tables.work_arrays_for(system, slots), self.stepper is not None)
+            status = first_call.run(*slots.tables, *self.plant, *self.state, *tables.work_arrays_for(system, slots), self.stepper is not None)
             if status == engine.FINISHED:
                 break
             if status == engine.NEED_MODE:  # the only step that builds propagators (matrix exponentials)

@@ -56,7 +56,7 @@ its fields), so everything is compiled without numba's runtime
 :data:`~stochpound.solvers.compiling.NO_RUNTIME`): the engine allocates nothing (every work vector is a row of
 the arrays of :func:`work_arrays`), and it calls no builtin ``min`` or
 ``max`` (each compiles an overload; the comparisons written out give the same
-results). :func:`run` compiles it inside
+results). :func:`stochpound.solvers.first_call.run` compiles it inside
 :func:`~stochpound.solvers.compiling.engine_compile`: its own LLVM level, and no
 machine code for the helpers of their own (they are optimised and turned
 into machine code once, inside :func:`run_engine`). All jitted code lives in
@@ -74,7 +74,7 @@ from numba import njit
 
 from stochpound.model.friction import STUCK
 from stochpound.model.guards import Guard
-from stochpound.solvers.compiling import NO_RUNTIME, engine_compile, numba_default_requested
+from stochpound.solvers.compiling import NO_RUNTIME
 from stochpound.solvers.propagators import GAUSS_NODES, GAUSS_WEIGHTS
 
 ROUND_OFF = 1e-10
@@ -1424,16 +1424,3 @@ def run_engine(table, dynamics, propagators, motion, layout, run, arming, impact
         clock[0] = t_end
         ints[K] = k + 1
         _record_sample(x, running, ids[m], states, energy, sample_modes, k + 1)
-
-
-_COMPILED: list[bool] = []
-
-
-def run(*arguments: object) -> int:
-    """Call :func:`run_engine`: a process's first call compiles it (or loads it from numba's cache) in :func:`~stochpound.solvers.compiling.engine_compile`."""
-    if _COMPILED or numba_default_requested():
-        return run_engine(*arguments)
-    with engine_compile():
-        status = run_engine(*arguments)
-    _COMPILED.append(True)
-    return status

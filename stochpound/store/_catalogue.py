@@ -88,6 +88,16 @@ WALL_SUMMARIES = (
     StoreVariable("largest_wall_closure", (), "f8", "m", "largest closure toward a wall over the run and over the walls: the clearance this run needed"),
 )
 
+#: Summaries of every case of an experiment whose buildings have yielding storeys or storey heights (in the base scene or a variant),
+#: after the wall summaries: per building, the largest over its storeys (NaN where the run has no such value: an elastic building's
+#: ductility, a ratio without ``storey_height``, a drift ratio without ``[output] demands = true``).
+STOREY_SUMMARIES = (
+    StoreVariable("peak_drift_ratio", ("building",), "f8", "1", "largest peak storey drift ratio over the building's storeys (with demands and storey heights)"),
+    StoreVariable("peak_ductility", ("building",), "f8", "1", "largest peak storey ductility (drift over yield drift) over the building's yielding storeys"),
+    StoreVariable("residual_drift", ("building",), "f8", "m", "largest absolute residual storey drift over the building's storeys"),
+    StoreVariable("residual_drift_ratio", ("building",), "f8", "1", "largest absolute residual storey drift ratio over the building's storeys"),
+)
+
 #: Summaries of every fixed-base reference (the studied building alone): those of a case, named ``reference_<name>``, per building no more.
 REFERENCE_SUMMARIES = tuple(
     replace(v, name=f"reference_{v.name}", dims=(), long_name=v.long_name + _ALONE)
@@ -131,4 +141,4 @@ IMPACT_TABLE = (
 )
 
 #: Every variable of the catalogue by name (the summaries, the histories, the reference's history, the impact table).
-CATALOGUE = {v.name: v for v in (*CASE_SUMMARIES, *WALL_SUMMARIES, *REFERENCE_SUMMARIES, *_HISTORIES, REFERENCE_HISTORY, *IMPACT_TABLE)}
+CATALOGUE = {v.name: v for v in (*CASE_SUMMARIES, *WALL_SUMMARIES, *STOREY_SUMMARIES, *REFERENCE_SUMMARIES, *_HISTORIES, REFERENCE_HISTORY, *IMPACT_TABLE)}

@@ -26,6 +26,9 @@ from stochpound.motions.records._suites import SUITES, is_suite_member, list_sui
 from stochpound.motions.records._plot import plot_record, plot_spectra
 from stochpound.motions.records._statistics import RecordStatistics, arias_intensity, moments, record_statistics
 
+# For the other packages of stochpound (their interface to this one, not public API: not in __all__).
+from stochpound.motions.records._suites import METADATA_FIELDS, SELECTIONS  # noqa: F401
+
 __all__ = [
     "SUITES",
     "RawSeries",

@@ -21,10 +21,7 @@ import pandas as pd
 import xarray as xr
 
 from stochpound import motions as synthetic_motions
-from stochpound.experiment import Case
-from stochpound.experiment import GapAxis, is_fixed_base
-from stochpound.experiment._intensity import describe_measure
-from stochpound.experiment._grid import CASE
+from stochpound.experiment import CASE, Case, GapAxis, describe_measure, is_fixed_base
 from stochpound.model import laws
 from stochpound.model.contact import effective_mass
 from stochpound.model.modal_solution import modal_properties

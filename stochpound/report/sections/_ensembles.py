@@ -22,10 +22,8 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
-from stochpound.analysis import ensemble_statistics, mean_interval, of_first, pounding_probability
-from stochpound.analysis._intervals import MIN_RUNS
-from stochpound.report.render import figures
-from stochpound.report.render import Block, FigureItem, Table
+from stochpound.analysis import MIN_RUNS, ensemble_statistics, mean_interval, of_first, pounding_probability
+from stochpound.report.render import Block, FigureItem, Table, figures
 from stochpound.experiment import is_gap_axis
 from stochpound.report.sections._facets import cell_gid, dim_text, labels_text, layouts, line_colours, plain, value_text
 

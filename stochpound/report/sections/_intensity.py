@@ -9,7 +9,8 @@ For a store made with an ``[intensity]`` table (docs/intensity.md) it gives:
 * a table of every stripe: its level, the range of the scale factors and,
   per gap, the runs, those that pounded (at least one impact) and the
   probability of pounding with its 95 % Clopper–Pearson interval;
-* per gap, that probability against intensity; for IDA, the fraction of
+* per gap, that probability against intensity (for the contact-free runs,
+  which never pound, at gaps near g*, from their closures); for IDA, the fraction of
   motions whose capacity is at most x, against x, with the same interval.
 
 Other structural axes (μ, variants) give one line per combination.
@@ -17,6 +18,7 @@ Other structural axes (μ, variants) give one line per combination.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
@@ -25,25 +27,34 @@ import xarray as xr
 from matplotlib.figure import Figure
 
 from stochpound.analysis.kernels import clopper_pearson
-from stochpound.experiment._intensity import describe_measure
+from stochpound.experiment import describe_measure
 from stochpound.report.render import FigureItem, Paragraph, Section, Table
 from stochpound.experiment import is_gap_axis
 from stochpound.motions import TARGET_TOLERANCE
-from stochpound.risk import selection_misses
+from stochpound.risk import contact_free_closure, limit_state_events, selection_misses
+from stochpound.store import has_contact_free, with_contacts
 
 CONFIDENCE = 0.95
 G = 9.81
+SHOWN_GAPS = 3
+"""Most gaps at which the contact-free runs' probability of pounding is drawn against intensity."""
+CLOSURE = "peak_contact_closure"
 
 
-def intensity_section(name: str, store: xr.Dataset) -> Section:
-    """The "Intensity" section of one store (call when ``store.pound.intensity`` is not None)."""
+def intensity_section(name: str, store: xr.Dataset, gaps: Sequence[float] = ()) -> Section:
+    """The "Intensity" section of one store (call when ``store.pound.intensity`` is not None).
+
+    ``gaps`` (m), the store's risk-targeted separations g* when it has a
+    hazard, are where its contact-free runs' probability of pounding is drawn
+    against intensity (without them: the quartiles of their closures).
+    """
     setting = store.pound.intensity
     section = Section(f"Intensity: experiment {name}", key=f"intensity-{name}")
     section.add(Paragraph(method_text(store, setting)))
     section.add(_spectra(name, store, setting))
     if "intensity" in store.dims:
         section.add(_stripe_table(name, store, setting))
-        section.add(_stripe_figure(name, store, setting))
+        section.add(_stripe_figure(name, store, setting, gaps))
         if "target_median" in store:
             section.add(Paragraph(_selection_text(store, setting)))
             section.add(_selection_figure(name, store, setting))
@@ -165,26 +176,58 @@ def _stripe_table(name: str, store: xr.Dataset, setting: dict[str, Any]) -> Tabl
     )
 
 
-def _stripe_figure(name: str, store: xr.Dataset, setting: dict[str, Any]) -> FigureItem:
-    runs, pounded = _pounding_counts(store)
-    gaps = [d for d in runs.dims if is_gap_axis(d)]
+def _stripe_figure(name: str, store: xr.Dataset, setting: dict[str, Any], gaps: Sequence[float] = ()) -> FigureItem:
+    """P(pounding) against intensity: per finite gap from the runs' impacts; for the contact-free runs (gap = ∞, which never
+    pound) at gaps that mean something, from their closures (the gap identity): ``gaps`` (g*), else the closures' quartiles."""
+    contact_free = has_contact_free(store) and CLOSURE in store
+    finite = with_contacts(store) if contact_free else store
     figure = Figure(figsize=(7.5, 3.4), layout="constrained")
     ax = figure.subplots()
     levels = store["intensity"].values
-    cells = _cells(xr.Dataset({"runs": runs, "pounded": pounded}).to_array("what"), ("intensity", "what"))
+    cells: list[tuple[str, xr.DataArray]] = []
+    if all(finite.sizes[d] for d in finite["case_status"].dims):
+        runs, pounded = _pounding_counts(finite)
+        cells += _cells(xr.Dataset({"runs": runs, "pounded": pounded}).to_array("what"), ("intensity", "what"))
+    shown = np.array([])
+    if contact_free:
+        closure = contact_free_closure(store)
+        shown = _closure_gaps(closure, gaps)
+        events = limit_state_events(closure, shown, "gap")
+        counts = xr.Dataset({"runs": events.notnull().sum("record"), "pounded": events.sum("record")}).to_array("what")
+        for gap in shown:
+            for label, cell in _cells(counts.sel(gap=gap, drop=True), ("intensity", "what")):
+                cells.append((", ".join(filter(None, [f"g = {gap:.3g} m (contact-free closures)", label])), cell))
     for label, cell in cells:
         n, k = cell.sel(what="runs").values, cell.sel(what="pounded").values
         lower, upper = clopper_pearson(k, n, CONFIDENCE)
-        p = _proportion(k, n)
-        (line,) = ax.plot(levels, p, "o-", label=label or None)
+        (line,) = ax.plot(levels, _proportion(k, n), "o-", label=label or None)
         ax.fill_between(levels, lower, upper, color=line.get_color(), alpha=0.15)
     _probability_axes(ax, setting, "P(pounding)", any(label for label, _ in cells))
-    per = " per " + ", ".join(gaps) if gaps else ""
-    return FigureItem(
-        f"intensity-pounding-{name}",
-        f"Experiment {name}: probability of pounding against intensity{per}, with the stripes' {int(100 * CONFIDENCE)} % Clopper–Pearson intervals (shaded).",
-        figure,
-    )
+    gap_dims = [d for d in finite["case_status"].dims if is_gap_axis(d) and finite.sizes[d]]
+    per = " per " + ", ".join(gap_dims) if gap_dims else ""
+    caption = f"Experiment {name}: probability of pounding against intensity{per}, with the stripes' {int(100 * CONFIDENCE)} % Clopper–Pearson intervals (shaded)"
+    if shown.size:
+        which = "the risk-targeted separations g*" if any(np.isfinite(g) and g > 0 for g in gaps) else "the quartiles of the contact-free closures"
+        caption += (f"; at {_listed([f'{g:.3g} m' for g in shown])} ({which}), the contact-free runs' fraction whose contacts close by "
+                    "that gap (they pound there, the gap identity)")
+    return FigureItem(f"intensity-pounding-{name}", caption + ".", figure)
+
+
+def _closure_gaps(closure: xr.DataArray, gaps: Sequence[float]) -> np.ndarray:
+    """At most :data:`SHOWN_GAPS` gaps: the finite positive ``gaps`` (spread by their quantiles), else the closures' quartiles (m)."""
+    values = np.asarray([g for g in gaps if np.isfinite(g) and g > 0], dtype=float)
+    if values.size == 0:
+        values = closure.values[np.isfinite(closure.values) & (closure.values > 0)]
+        if values.size == 0:
+            return np.array([])
+        values = np.quantile(values, [0.25, 0.5, 0.75])
+    elif np.unique(values).size > SHOWN_GAPS:
+        values = np.quantile(values, np.linspace(0.0, 1.0, SHOWN_GAPS), method="nearest")
+    return np.unique(values)
+
+
+def _listed(items: list[str]) -> str:
+    return items[0] if len(items) == 1 else ", ".join(items[:-1]) + " and " + items[-1]
 
 
 def _selection_text(store: xr.Dataset, setting: dict[str, Any]) -> str:

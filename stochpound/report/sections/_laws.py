@@ -27,12 +27,10 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from stochpound.analysis import mean_interval, pounding_probability
-from stochpound.analysis._intervals import MIN_RUNS
+from stochpound.analysis import MIN_RUNS, mean_interval, pounding_probability
 from stochpound.experiment import is_gap_axis
 from stochpound.model import laws
-from stochpound.report.render import figures
-from stochpound.report.render import Block, FigureItem, Paragraph, Section
+from stochpound.report.render import Block, FigureItem, Paragraph, Section, figures
 from stochpound.report.sections._ensembles import Ensemble
 from stochpound.report.sections._facets import dim_text, labels_text, line_colours, plain
 

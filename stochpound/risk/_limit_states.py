@@ -1,0 +1,192 @@
+"""Limit states beyond first contact: the damage a run does, as fragilities and mean annual frequencies, and what the gap costs.
+
+A limit state is a per-case demand of a store reaching a capacity: a storey
+drift ratio, a residual drift ratio or a ductility (the yielding storeys'
+summaries, ``stochpound.store.STOREY_SUMMARIES``), a floor acceleration, an
+impact force, or the base displacement that reaches a bearing's stop. Each
+goes through the pounding chain's steps: per run, whether the demand reaches
+the capacity (:func:`~stochpound.risk.limit_state_events`); per
+configuration of the grid, a lognormal fragility of the stripes
+(:func:`~stochpound.risk.stripe_fragility`); and its mean annual frequency
+at the site (:func:`~stochpound.risk.mean_annual_frequency`).
+
+Unlike pounding, these limit states are not a property of the contact-free
+run: a run at a finite gap pounds, and the pounding changes its drifts,
+accelerations and base displacement. So they are evaluated on the runs at
+each of the grid's gaps, and set against the same limit state of the
+contact-free twins (``inf`` on every contact axis, the same motions): the
+difference of the two rates is what the gap costs in damage risk.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+import pandas as pd
+import xarray as xr
+
+from stochpound.analysis import HazardCurve, probability_from_rate
+from stochpound.risk import _store
+from stochpound.risk._fragility_ensemble import limit_state_events, stripe_fragility
+from stochpound.risk._maf import mean_annual_frequency
+from stochpound.risk._store_risk import CONFIDENCE, YEARS
+
+
+@dataclasses.dataclass(frozen=True)
+class _Kind:
+    variable: str  # the store's per-case summary
+    units: str  # the capacity's units
+    label: str
+    per_building: bool
+    note: str  # what the store needs to hold the variable
+
+
+#: The kinds of limit state: the ``[limit_states]`` keys, the store summary each reads, and the capacity's units.
+KINDS = {
+    "drift_ratio": _Kind("peak_drift_ratio", "1", "peak storey drift ratio", True, "yielding storeys or storey_height, and [output] demands = true"),
+    "residual_drift_ratio": _Kind("residual_drift_ratio", "1", "residual storey drift ratio", True, "yield_force and storey_height"),
+    "ductility": _Kind("peak_ductility", "1", "peak storey ductility", True, "yield_force"),
+    "floor_acceleration": _Kind("peak_floor_acceleration", "g", "peak floor acceleration", True, "[output] demands = true"),
+    "impact_force": _Kind("peak_impact_force", "N", "peak impact force", False, "runs at a finite gap"),
+    "isolator_displacement": _Kind("peak_sliding_displacement", "m", "base displacement (the bearing's stop)", True, "a sliding base"),
+}
+
+
+@dataclasses.dataclass(frozen=True)
+class LimitState:
+    """One limit state: a run's ``kind`` of demand reaching ``capacity``.
+
+    Attributes
+    ----------
+    kind : str
+        One of ``stochpound.risk.LIMIT_STATE_KINDS``: ``drift_ratio``, ``residual_drift_ratio``,
+        ``ductility`` (1), ``floor_acceleration`` (g), ``impact_force`` (N),
+        ``isolator_displacement`` (m, the base displacement at which the
+        bearing reaches its stop).
+    capacity : float
+        The capacity, > 0, in the kind's units.
+    building : str, optional
+        The building whose demand counts; default any building (the
+        largest over the buildings). Impact forces have no building.
+    """
+
+    kind: str
+    capacity: float
+    building: str | None = None
+
+    def __post_init__(self) -> None:
+        where = f"limit_states.{self.kind}"
+        if self.kind not in KINDS:
+            raise _store.RiskInputError(f"limit_states.{self.kind}: not a limit state; one of {', '.join(KINDS)}")
+        if isinstance(self.capacity, bool) or not (isinstance(self.capacity, (int, float)) and math.isfinite(self.capacity) and self.capacity > 0):
+            raise _store.RiskInputError(f"{where}: a capacity must be a number > 0 ({KINDS[self.kind].units}), got {self.capacity!r}")
+        if self.building is not None and not KINDS[self.kind].per_building:
+            raise _store.RiskInputError(f"{where}: has no building (an impact force is a contact's), got {self.building!r}")
+
+    @property
+    def label(self) -> str:
+        """The limit state in words, e.g. ``peak storey drift ratio of B1 ≥ 0.015``."""
+        kind = KINDS[self.kind]
+        units = "" if kind.units == "1" else f" {kind.units}"
+        return f"{kind.label}{f' of {self.building}' if self.building else ''} ≥ {self.capacity:g}{units}"
+
+
+def limit_states_from_table(table: Mapping[str, Any]) -> tuple[LimitState, ...]:
+    """The limit states of a ``[limit_states]`` table (docs/risk.md, "Limit states beyond first contact").
+
+    Each key is a kind of ``stochpound.risk.LIMIT_STATE_KINDS``; its value a capacity or a list of
+    capacities (any building), or a table of building names to a capacity or
+    a list of them.
+
+    Raises
+    ------
+    ValueError
+        (``RiskInputError``) An unknown kind, a capacity that is not a number > 0, or an empty table.
+    """
+    if not isinstance(table, Mapping) or not table:
+        raise _store.RiskInputError(f"limit_states: must be a table of {', '.join(KINDS)} to capacities, got {table!r}")
+    states = []
+    for kind, value in table.items():
+        per_building = value.items() if isinstance(value, Mapping) else [(None, value)]
+        for building, capacities in per_building:
+            for capacity in capacities if isinstance(capacities, (list, tuple)) else [capacities]:
+                states.append(LimitState(kind, capacity, building))
+    return tuple(states)
+
+
+def limit_state_risk(store: xr.Dataset, limit_states: Sequence[LimitState], hz: HazardCurve | None = None, confidence: float = CONFIDENCE,
+                     bootstrap: int = 0, seed: int = 0) -> xr.Dataset:
+    """Fragility and mean annual frequency of each limit state at every configuration of a store's grid, and what the gap costs.
+
+    Parameters
+    ----------
+    store : xarray.Dataset
+        An experiment store with intensity stripes (a yielding scene runs
+        stripes), holding the variable of every limit state (``stochpound.risk.LIMIT_STATE_KINDS``).
+    limit_states : sequence of LimitState
+        The limit states (:func:`limit_states_from_table` reads a table of them).
+    hz : HazardCurve, optional
+        The site's hazard; default the one the store carries.
+    confidence, bootstrap, seed
+        As in :func:`~stochpound.risk.stripe_fragility` (default: no bootstrap).
+
+    Returns
+    -------
+    xarray.Dataset
+        Over ``limit_state`` (coordinate: each one's label; ``kind``,
+        ``capacity`` and ``building`` beside it) and the store's other grid
+        dimensions (its gap axes, variants): the fragility (``theta``, IM
+        units; ``beta``; ``status``; per stripe ``exceeded``, ``runs``,
+        ``probability``) and ``maf`` (1/yr). With contact-free cases:
+        ``maf_contact_free`` (the contact-free twins' rate, the same motions
+        and other labels) and ``gap_cost`` = ``maf`` − ``maf_contact_free``
+        (1/yr; 0 for the twins themselves, negative where pounding lowers the
+        demand).
+
+    Raises
+    ------
+    ValueError
+        (``RiskInputError``) No limit states, a store without stripes or
+        hazard, or without a limit state's variable or building.
+    """
+    if not limit_states:
+        raise _store.RiskInputError("limit_states: give at least one limit state")
+    if _store.stripes(store) is None:
+        raise _store.RiskInputError("store: limit states need intensity stripes (run method = \"stripes\")")
+    hz = _store.site_hazard(store) if hz is None else hz
+    fits = []
+    for state in limit_states:
+        kind = KINDS[state.kind]
+        demand = _store.case_demand(store, kind.variable, state.building, kind.note)
+        if kind.units == "g":
+            demand = demand / _store.scene_g(store)
+        events = limit_state_events(demand, [state.capacity], dim="limit_state").assign_coords(limit_state=[state.label])
+        fit = stripe_fragility(events, confidence=confidence, bootstrap=bootstrap, seed=seed)
+        fits.append(fit.assign_coords(kind=("limit_state", [state.kind]), capacity=("limit_state", [float(state.capacity)]),
+                                      building=("limit_state", [state.building or ""])))
+    result = xr.concat(fits, "limit_state", coords="different", compat="equals", join="outer")
+    result["maf"] = mean_annual_frequency(result, hz)
+    twins = _store.contact_free_twins(result["maf"])
+    if twins is not None:
+        result["maf_contact_free"] = twins.assign_attrs(units="1/yr", long_name="mean annual frequency of the contact-free twins")
+        result["gap_cost"] = (result["maf"] - twins).assign_attrs(units="1/yr", long_name="what the gap costs: maf minus that of the contact-free twins")
+    return result.assign_attrs(intensity=_store.measure_text(_store.intensity_setting(store)))
+
+
+def gap_cost_frame(risk: xr.Dataset, years: float = YEARS) -> pd.DataFrame:
+    """The "what the gap costs" table of :func:`limit_state_risk`: per limit state and finite gap, λ, λ of the twins, their difference, and P in ``years``.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Indexed by the limit state and the other grid labels (the contact-free rows left out).
+    """
+    keep = [name for name in ("maf", "maf_contact_free", "gap_cost") if name in risk]
+    frame = _store.at_finite_gaps(risk[keep]).reset_coords(drop=True).to_dataframe()
+    frame[f"P in {years:g} yr"] = probability_from_rate(frame["maf"].to_numpy(), years)
+    if "maf_contact_free" in frame:
+        frame[f"P in {years:g} yr, contact-free"] = probability_from_rate(frame["maf_contact_free"].to_numpy(), years)
+    return frame.rename(columns={"maf": "λ (1/yr)", "maf_contact_free": "λ contact-free (1/yr)", "gap_cost": "Δλ (1/yr)"})

@@ -1,0 +1,77 @@
+"""The risk flagship's experiment files (experiments/risk/*.toml) carry the numbers their headers derive.
+
+The buildings' yield shears are ASCE 7-16's from the design spectrum the header takes from the bundled 2 %/50 yr
+hazard, both neighbours sit on that spectrum's plateau (so one design serves both), and the stripes are the site's
+intensities at the stated return periods.
+"""
+
+from __future__ import annotations
+
+import tomllib
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from stochpound.analysis import HazardCurve
+from stochpound.model import design_yield_shears
+
+ROOT = Path(__file__).resolve().parents[1]
+FILES = {"fixed_pair": 1.0, "isolated": 2.0}  # file: its PSA period, s
+RETURN_PERIODS = np.array([72.0, 224.0, 475.0, 975.0, 2475.0, 5000.0])
+TWO_PERCENT = -np.log(1.0 - 0.02) / 50.0  # 1/yr: 2 % in 50 years, Poisson
+HEIGHT = 6.0 / 0.3048  # ft: two 3.0 m storeys
+
+
+def _experiment(name: str) -> dict:
+    return tomllib.loads((ROOT / "experiments" / "risk" / f"{name}.toml").read_text())
+
+
+def _buildings(experiment: dict) -> dict[str, dict]:
+    return {b["name"]: b for b in experiment["scene"]["building"]}
+
+
+def _first_mode_period(mass: list[float], stiffness: list[float]) -> float:
+    (m1, m2), (k1, k2) = mass, stiffness
+    omega2 = np.linalg.eigvals(np.linalg.solve(np.diag([m1, m2]), [[k1 + k2, -k2], [-k2, k2]])).real.min()
+    return 2.0 * np.pi / np.sqrt(omega2)
+
+
+def _design_spectrum() -> tuple[float, float, float]:
+    """S_DS, S_D1 (g) and S_M1: two thirds of the MCE from the bundled 2 %/50 yr PGA / 0.4 and SA(1 s)."""
+    pga = float(HazardCurve.bundled("fox_plaza_los_angeles_pga").intensity_at(TWO_PERCENT))
+    sm1 = float(HazardCurve.bundled("fox_plaza_los_angeles_sa1p0s").intensity_at(TWO_PERCENT))
+    return 2.0 / 3.0 * pga / 0.4, 2.0 / 3.0 * sm1, sm1
+
+
+@pytest.mark.parametrize("name", sorted(FILES))
+def test_the_buildings_carry_the_code_design_of_the_header(name: str) -> None:
+    experiment = _experiment(name)
+    buildings = _buildings(experiment)
+    sds, sd1, sm1 = _design_spectrum()
+    b1 = buildings["B1"]
+    period = _first_mode_period(b1["mass"], b1["stiffness"])
+    assert period < 1.4 * 0.028 * HEIGHT**0.8  # the computed period is the design period (below C_u T_a)
+    expected = design_yield_shears(b1["mass"], b1["storey_height"], period=period, sds=sds, sd1=sd1, r=8.0, overstrength=3.0,
+                                   importance=1.0, s1=sm1)
+    for building in buildings.values():
+        np.testing.assert_allclose(building["yield_force"], expected, atol=0.5)  # N: the file rounds to 1 N
+        assert building["hardening"] == 0.02 and building["p_delta"] is True
+    # every neighbour variant is on the design spectrum's plateau (T < T_s = S_D1 / S_DS): its design strength is B1's
+    for variant in experiment["variants"]["neighbour"].values():
+        neighbour = {**buildings["B2"], **variant["building"]["B2"]}
+        t = _first_mode_period(neighbour["mass"], neighbour["stiffness"])
+        assert t < sd1 / sds
+        np.testing.assert_allclose(design_yield_shears(neighbour["mass"], neighbour["storey_height"], period=t, sds=sds, sd1=sd1, r=8.0,
+                                                       overstrength=3.0, s1=sm1), expected, rtol=1e-12)
+
+
+@pytest.mark.parametrize("name", sorted(FILES))
+def test_the_stripes_are_the_site_intensities_of_the_stated_return_periods(name: str) -> None:
+    experiment = _experiment(name)
+    intensity = experiment["intensity"]
+    assert intensity["period"] == FILES[name] and intensity["selection"] == "conditional_spectrum"
+    hazard = HazardCurve.bundled(experiment["hazard"]["bundled"])
+    expected = [float(hazard.intensity_at(1.0 / rp)) for rp in RETURN_PERIODS]
+    expected.append(1.5 * float(hazard.intensity_at(TWO_PERCENT)))
+    np.testing.assert_allclose(intensity["levels"], expected, rtol=2e-3)  # the file gives 4 significant digits
