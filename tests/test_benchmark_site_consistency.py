@@ -1,9 +1,8 @@
 """The done-when check of conditional-spectrum selection, reduced: the same buildings at the same site get about the same g*
 whichever measure their stripes are conditioned on.
 
-The experiments of benchmarks/site_consistency.py (the fixed pair of experiments/risk/fixed_pair.toml beside a stiff or
-a flexible neighbour, and the isolated Building 1 of experiments/risk/isolated.toml, mu 0.05, no moat wall, stiff
-neighbour; stripes at return periods 72-5000 years, 20 motions per stripe from the 100 FEMA P695 motions, factor <= 5,
+The experiments of benchmarks/site_consistency.py (the elastic fixed pair beside a stiff or a flexible neighbour, and
+the elastic Building 1 on a friction pendulum, mu 0.05, no moat wall, stiff neighbour; stripes at return periods 72-5000 years, 20 motions per stripe from the 100 FEMA P695 motions, factor <= 5,
 the scenario fitted to the site's four curves), conditioned on PGA, PSA(1 s) and PSA(2 s).
 
 Run: ``pytest -m slow tests/test_benchmark_site_consistency.py -s`` (prints the g* table; about 1 minute for the fixed pair and 2
