@@ -81,7 +81,8 @@ def risk(store: Path, hazard: str | None, hazard_measure: str | None, hazard_uni
     """
     from stochpound.cli._measure_choice import efficient_measure_lines
     from stochpound.experiment import open_store
-    from stochpound.risk import gap_cost_frame, limit_state_risk, site_hazard, store_risk
+    from stochpound.motions import TARGET_TOLERANCE
+    from stochpound.risk import gap_cost_frame, limit_state_risk, selection_misses, site_hazard, store_risk
 
     targets = _targets(target)
     if hazard is None and (hazard_measure or hazard_units or investigation_time is not None or hazard_site is not None):
@@ -100,6 +101,10 @@ def risk(store: Path, hazard: str | None, hazard_measure: str | None, hazard_uni
     source = hz.source.splitlines()[0] if hz.source else hz.describe()
     click.echo(f"{result.experiment or store.stem}: {result.motions} motions, {stripes} of {result.measure} "
                f"in {result.setting['units']}; hazard: {source}")
+    missed = selection_misses(data)
+    if missed:
+        click.echo(f"warning: the motions chosen for the site miss their conditional-spectrum target (mean or std of ln Sa off by more than "
+                   f"{TARGET_TOLERANCE:g} at a period) at the stripes {', '.join(f'{level:g}' for level in missed)} {result.setting['units']}")
     for line in hz.source.splitlines():
         if line.startswith("stochpound: "):
             click.echo(f"note: hazard {line.removeprefix('stochpound: ')}")

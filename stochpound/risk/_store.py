@@ -221,6 +221,14 @@ def stripe_motions(store: xr.Dataset, motions: int) -> int:
     return motions
 
 
+def selection_misses(store: xr.Dataset) -> list[float]:
+    """The levels (in the levels' units) whose stripe's selection for the site misses its target (``selection_misses_target``); [] without a selection."""
+    if "selection_misses_target" not in store:
+        return []
+    flags = store["selection_misses_target"].values.astype(bool)
+    return [float(level) for level, flag in zip(store["intensity"].values, flags) if flag]
+
+
 def motion_intensity(store: xr.Dataset) -> xr.DataArray:
     """The intensity of every motion of an IDA store at scale 1 (in the units of its levels), one motion dimension ``record``."""
     intensity = store["motion_intensity"]
