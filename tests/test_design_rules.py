@@ -150,3 +150,15 @@ def test_stochpound_risk_prints_the_codes_gaps_beside_the_suite_mean_rules(desig
         assert text in result.output
     period = float(risk.design_rules["return_period"].sel(rule="asce7_delta_mt"))
     assert f"ASCE 7 §12.12.3 δ_MT of the design analysis, once in {period:.3g} years" in result.output.replace("\n", " ")
+
+
+def test_stochpound_risk_takes_a_design_file_and_refuses_a_bad_one(design_store, tmp_path):
+    (tmp_path / "stronger.toml").write_text("[design]\nsds = 1.0\nsd1 = 0.6\nr = 4.0\ncd = 4.0\nomega0 = 2.5\n")
+    result = CliRunner().invoke(main, ["risk", str(design_store), "--bootstrap", "0", "--design", str(tmp_path / "stronger.toml")])
+    assert result.exit_code == 0, result.output
+    gaps = design_separations(open_store(design_store).pound.scene(gap=math.inf, intensity=0.3, record=open_store(design_store)["record"].values[0]),
+                              {"sds": 1.0, "sd1": 0.6, "tl": 8.0, "r": 4.0, "cd": 4.0, "omega0": 2.5, "ie": 1.0})
+    assert f"{gaps['asce7_delta_mt'][0]:.4g}" in result.output and "Eurocode 8 §4.4.2.7 d_s of the design analysis" not in result.output
+    (tmp_path / "bad.toml").write_text("[design]\nsds = 1.0\nsd1 = 0.6\nr = 8.0\ncd = 12.0\nomega0 = 3.0\n")
+    result = CliRunner().invoke(main, ["risk", str(design_store), "--bootstrap", "0", "--design", str(tmp_path / "bad.toml")])
+    assert result.exit_code != 0 and "design.cd: must be <= 10, got 12" in result.output and "Traceback" not in result.output
