@@ -162,3 +162,21 @@ def test_stochpound_risk_takes_a_design_file_and_refuses_a_bad_one(design_store,
     (tmp_path / "bad.toml").write_text("[design]\nsds = 1.0\nsd1 = 0.6\nr = 8.0\ncd = 12.0\nomega0 = 3.0\n")
     result = CliRunner().invoke(main, ["risk", str(design_store), "--bootstrap", "0", "--design", str(tmp_path / "bad.toml")])
     assert result.exit_code != 0 and "design.cd: must be <= 10, got 12" in result.output and "Traceback" not in result.output
+
+
+def test_editing_the_design_keeps_the_runs_and_records_it(tmp_path):
+    """A run after only [design] changed keeps the store's cases (no run depends on it) and records the new design."""
+    text = risk_text(FIXED, "gap = [inf]", 'measure = "psa"\nperiod = 1.0\nlevels = [0.3, 0.8]').replace("duration = 5.0", "duration = 1.0")
+    path = write_experiment(tmp_path, text, "edit.toml")
+    store = run_experiment(load_experiment(path), workers=0, progress=False).store
+    with open_store(store) as ds:
+        before = ds["peak_contact_closure"].load()
+        assert ds.pound.definition.design is None
+    path.write_text(text + DESIGN_TABLE)
+    said: list[str] = []
+    report = run_experiment(load_experiment(path), workers=0, progress=False, say=said.append)
+    assert report.nothing_to_run and report.done_now == 0
+    assert any("the [design] changed" in line for line in said) and not any("hazard changed" in line for line in said)
+    with open_store(store) as ds:
+        assert ds.pound.definition.design["cd"] == 5.5 and ds.pound.definition.design["ec8"]["q"] == 4.0
+        xr.testing.assert_identical(ds["peak_contact_closure"].load(), before)
