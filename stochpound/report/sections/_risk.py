@@ -31,6 +31,7 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 from matplotlib.figure import Figure
+from matplotlib.ticker import LogLocator, NullFormatter
 
 from stochpound.report.render import Block, FigureItem, Paragraph, Section, Table
 from stochpound.report.sections._facets import labels_text
@@ -150,6 +151,25 @@ def _panel_grid(count: int, height: float = 2.6) -> tuple[Figure, list[Any]]:
     return figure, list(np.atleast_1d(figure.subplots(rows, columns, squeeze=False)).ravel())
 
 
+RATE_DECADES = 6
+"""The most decades of annual rate a rate axis spans below its largest rate (smaller rates are off the figure)."""
+
+
+def rate_limits(rates: Any, references: Any = ()) -> tuple[float, float]:
+    """Limits (1/yr) of a logarithmic rate axis from the positive finite rates drawn and reference lines (targets).
+
+    Half the smallest to twice the largest, but no more than ``RATE_DECADES``
+    decades below the largest: a bootstrap band or a far tail down to 1e-300
+    would otherwise squash the curves into a line. (1e-6, 1) when nothing is positive.
+    """
+    values = np.concatenate([np.ravel(np.asarray(rates, dtype=float)), np.ravel(np.asarray(references, dtype=float))])
+    values = values[np.isfinite(values) & (values > 0.0)]
+    if values.size == 0:
+        return 1e-6, 1.0
+    top = 2.0 * float(values.max())
+    return max(0.5 * float(values.min()), top * 10.0**-RATE_DECADES), top
+
+
 def _risk_curve_figure(name: str, risk: StoreRisk) -> FigureItem:
     curve = risk.curve
     gaps = curve["gap"].values
@@ -167,6 +187,7 @@ def _risk_curve_figure(name: str, risk: StoreRisk) -> FigureItem:
                 ax.axvline(value, color=line.get_color(), lw=0.6, ls=":")
     for p, rate, style in zip(risk.separation["target"].values, risk.separation["target_rate"].values, ("--", "-.", ":")):
         ax.axhline(float(rate), color="k", lw=0.8, ls=style, label=f"target: {risk.target_text(p)}")
+    ax.set_ylim(rate_limits(envelope.values, risk.separation["target_rate"].values))
     ax.set_xlabel("gap g (m)")
     ax.set_ylabel("λ_P: pounding per year")
     ax.grid(True, which="both", lw=0.3, color="0.85")
@@ -273,6 +294,9 @@ def _demand_blocks(name: str, risk: StoreRisk, demands: StoreDemands | None) -> 
         for labels in configurations(curve["maf"], ("level",)):
             maf = envelope.sel(labels).values
             ax.loglog(levels, np.where(maf > 0, maf, np.nan), lw=1.1, label=labels_text(labels) or None)
+        ax.set_ylim(rate_limits(envelope.values))
+        ax.xaxis.set_major_locator(LogLocator(subs=(1.0, 2.0, 5.0)))
+        ax.xaxis.set_minor_formatter(NullFormatter())  # labels on 1-2-5 only: the minor ones overlapped on short axes
         ax.set_title(label, fontsize=7)
         ax.set_xlabel(f"{label} ({demands.units[label]})", fontsize=7)
         ax.set_ylabel("exceedances per year", fontsize=7)
