@@ -35,6 +35,7 @@ from matplotlib.ticker import LogLocator, NullFormatter
 
 from stochpound.report.render import Block, FigureItem, Paragraph, Section, Table
 from stochpound.report.sections._facets import labels_text
+from stochpound.report.sections._stripe_motions import is_selected
 from stochpound.risk import StoreDemands, StoreRisk
 from stochpound.store import describe_measure
 
@@ -80,7 +81,7 @@ def headline_text(name: str, risk: StoreRisk) -> str:
     stripes = f"{risk.stripes} stripes of " if risk.stripes is not None else "IDA capacities in "
     return (
         f"Risk-targeted separation g* (the gap whose mean annual frequency of pounding is that of {targets}, Poisson) of experiment "
-        f"{name}, from {risk.motions} motions ({stripes}{risk.measure} in {risk.setting['units']}) at the site of its hazard curve, "
+        f"{name}, from {risk.motions} motions{' per stripe' if is_selected(risk.setting) else ''} ({stripes}{risk.measure} in {risk.setting['units']}) at the site of its hazard curve, "
         f"with {_percent(risk.confidence)} intervals ({_resampling(risk)}): " + ". ".join(per) + "."
     )
 
@@ -109,7 +110,7 @@ def risk_section(name: str, risk: StoreRisk, demands: StoreDemands | None = None
     section.add(Paragraph(headline_text(name, risk)))
     section.add(Paragraph(_hazard_text(risk)))
     section.add(Table(f"risk-separation-{name}", f"Experiment {name}: risk-targeted separation g* per configuration and target, with its "
-                      f"{_percent(risk.confidence)} BCa bootstrap interval over the {risk.motions} motions", risk.separation_frame(),
+                      f"{_percent(risk.confidence)} BCa bootstrap interval (the motions resampled)", risk.separation_frame(),
                       note=_grid_note(risk), formats={"g* (m)": "{:.3f}", "lower (m)": "{:.3f}", "upper (m)": "{:.3f}"}))
     section.add(_risk_curve_figure(name, risk))
     section.add(_surface_figure(name, risk))
@@ -133,8 +134,9 @@ def _hazard_text(risk: StoreRisk) -> str:
         f"Hazard curve of {risk.measure} in {units}, {hz.describe()} ({source}); its 10 %/50 yr intensity is "
         f"{levels[0.10]:.3g} and its 2 %/50 yr intensity {levels[0.02]:.3g} {units}. The fragility of every gap is the "
         f"lognormal {fitted}; λ_P(g) = ∫ F(x; g) |dλ(x)|; the intervals resample the motions and refit the whole chain. Assumptions: Poisson "
-        "occurrence, record-to-record variability only (not the hazard's or the model's uncertainty), and a suite scaled to each "
-        f"intensity standing for the site's motions of that intensity.{extrapolated}"
+        "occurrence, record-to-record variability only (not the hazard's or the model's uncertainty), and "
+        f"{'the motions chosen and scaled for each stripe' if is_selected(risk.setting) else 'a suite scaled to each intensity'} "
+        f"standing for the site's motions of that intensity.{extrapolated}"
     )
 
 
