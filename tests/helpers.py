@@ -510,3 +510,25 @@ def risk_text(scene: str, grid: str, intensity: str, hazard: str = f'bundled = "
 def with_gaps(scene, gaps: tuple[float, ...]):
     """``scene`` (a :class:`stochpound.model.scene.Scene`) with contact c's gap set to ``gaps[c]`` (m)."""
     return dataclasses.replace(scene, contacts=tuple(dataclasses.replace(c, gap=float(g)) for c, g in zip(scene.contacts, gaps)))
+
+
+#: Two buildings (a two-storey and a one-storey) and one contact: the scene of the intensity and site experiments' tests.
+SITE_SCENE = """
+[scene]
+g = 9.81
+[[scene.building]]
+name = "B1"
+mass = [2.0e5, 1.5e5]
+stiffness = [1.2e8, 0.9e8]
+damping_ratio = 0.05
+[[scene.building]]
+name = "B2"
+mass = [1.0e5]
+stiffness = [1.5e7]
+damping_ratio = 0.02
+[[scene.contact]]
+between = [["B1", 1], ["B2", 1]]
+gap = 0.02
+stiffness = 1.0e8
+restitution = 0.65
+"""

@@ -24,29 +24,11 @@ from stochpound.model.scene_file import scene_from_dict
 from stochpound.report.render._document import FigureItem, Table
 from stochpound.report.sections._intensity import intensity_section
 from stochpound.solvers.simulate import simulate
+from tests.helpers import SITE_SCENE as SCENE
 from tests.helpers import write_experiment
 
 REPOSITORY = Path(__file__).resolve().parent.parent
 MOTIONS = ["fema_p695_far_field/01a", "fema_p695_far_field/03b", "fema_p695_far_field/12a"]
-SCENE = """
-[scene]
-g = 9.81
-[[scene.building]]
-name = "B1"
-mass = [2.0e5, 1.5e5]
-stiffness = [1.2e8, 0.9e8]
-damping_ratio = 0.05
-[[scene.building]]
-name = "B2"
-mass = [1.0e5]
-stiffness = [1.5e7]
-damping_ratio = 0.02
-[[scene.contact]]
-between = [["B1", 1], ["B2", 1]]
-gap = 0.02
-stiffness = 1.0e8
-restitution = 0.65
-"""
 RECORDS = "".join(f'\n[[records]]\nrecord = "{name}"\nduration = 4.0\n' for name in MOTIONS)
 
 

@@ -12,30 +12,15 @@ from stochpound import open_store
 from stochpound.analysis import HazardCurve, store_risk
 from stochpound.experiment._runner import load_experiment, run_experiment
 from stochpound.experiment._spec import ExperimentError, parse_experiment
-from stochpound.motions import conditional_spectrum, select_motions, selection_periods, selection_pool
+from stochpound.motions import conditional_spectrum, misses_target, select_motions, selection_periods, selection_pool
 from stochpound.motions.records import Record, load_suite_member
+from stochpound.report.render import FigureItem, Paragraph
+from stochpound.report.sections._intensity import intensity_section
+from stochpound.risk import selection_misses
+from tests.helpers import SITE_SCENE as SCENE
 from tests.helpers import write_experiment
 
 MEMBERS = [f"fema_p695_far_field/{i:02d}{c}" for i in range(1, 7) for c in "ab"]
-SCENE = """
-[scene]
-g = 9.81
-[[scene.building]]
-name = "B1"
-mass = [2.0e5, 1.5e5]
-stiffness = [1.2e8, 0.9e8]
-damping_ratio = 0.05
-[[scene.building]]
-name = "B2"
-mass = [1.0e5]
-stiffness = [1.5e7]
-damping_ratio = 0.02
-[[scene.contact]]
-between = [["B1", 1], ["B2", 1]]
-gap = 0.02
-stiffness = 1.0e8
-restitution = 0.65
-"""
 RECORDS = "".join(f'\n[[records]]\nrecord = "{name}"\nduration = 5.0\n' for name in MEMBERS)
 SELECTION = 'measure = "psa"\nperiod = 0.5\nlevels = [0.4, 0.2]\nselection = "conditional_spectrum"\nmotions = 4\nmax_scale_factor = 5.0\nseed = 2\n'
 SITE = '[site]\nvs30 = 400.0\nmagnitude = [7.0, 6.6]\ndistance_km = 20.0\nmechanism = "strike_slip"\n'
@@ -80,6 +65,14 @@ def test_each_stripe_runs_its_chosen_motions_and_the_store_keeps_the_selection(t
         np.testing.assert_allclose(store.target_median.isel(intensity=j), target["median"].values, rtol=1e-12)
         np.testing.assert_allclose(store.selection_mean_ln.isel(intensity=j), expected["mean_ln"].values, rtol=1e-12)
         assert store.site_magnitude.values[j] == magnitude and store.site_mechanism.values[j] == "strike_slip"
+        miss = misses_target(expected["mean_ln"].values, expected["std_ln"].values, target["median"].values, target["sigma_ln"].values)
+        assert store.selection_misses_target.values[j] == int(miss)
+    # the report shows every stripe's target against its chosen set, and the stripes that miss it
+    section = intensity_section("site", store)
+    assert any(isinstance(block, FigureItem) and block.key == "intensity-selection-site" for block in section.blocks)
+    text = " ".join(block.text for block in section.blocks if isinstance(block, Paragraph))
+    missed = selection_misses(store)
+    assert "chosen for the site" in text and ("misses its target" in text) == bool(missed)
     # the risk chain counts the chosen motions of each stripe only
     risk = store_risk(store, HazardCurve.power_law(1e-4, 2.5), bootstrap=0)
     assert risk.motions == 4 and np.all(risk.fragility["runs"].values == 4)

@@ -199,7 +199,8 @@ def test_cli_prints_separation_and_rules(isolated_store, tmp_path):
     headline = risk.to_frame()
     for value in headline["separation"]:
         assert f"{value:.3f}" in result.output
-    for text in ("10 % in 50 yr", "2 % in 50 yr", "SRSS (ASCE 7 δ_MT)", "0.7 SRSS (Eurocode 8)", "DDC", "D_TM", "once in (yr)"):
+    for text in ("10 % in 50 yr", "2 % in 50 yr", "SRSS of suite-mean peaks", "0.7 SRSS of suite-mean peaks", "DDC", "D_TM", "once in (yr)",
+                 "once in, lower (yr)", "once in, upper (yr)", "P lower", "P upper", "Design to"):
         assert text in result.output
     written = {path.name: path.read_text() for path in (tmp_path / "tables" / "risk").iterdir()}  # one table per file, in a folder it created
     assert sorted(written) == ["rules.csv", "separation.csv"]
@@ -323,12 +324,15 @@ def test_report_section_states_the_separation_first(isolated_store):
     assert keys[:2] == ["risk-separation-risk", "risk-curve-risk"]
     assert {"risk-surface-risk", "risk-fragility-risk", "risk-rules-risk", "risk-demands-risk"} <= set(keys)
     rules = next(block for block in section.blocks if isinstance(block, Table) and block.key == "risk-rules-risk")
-    assert "D_TM (ASCE 7 §17.2.5.2)" in rules.frame.index.get_level_values("rule")
+    assert "D_TM of the suite-mean base displacement (ASCE 7 §17.2.5.2 form)" in rules.frame.index.get_level_values("rule")
     grid = {"design_level", "rule", *(d for d in store["case_status"].dims if d not in ("record", "realization", "intensity", "gap"))}
     assert set(rules.frame.index.names) <= grid, rules.frame.index.names  # the grid's axes, not what each point ran (base_mu, base_radius, ...)
     separation = next(block for block in section.blocks if isinstance(block, Table) and block.key == "risk-separation-risk")
     assert not any(str(name).startswith("base_") for name in separation.frame.index.names)
     assert stored_hazard(store).source.startswith("Site: Fox Plaza")
+    assert risk.assumptions["structural model"].startswith("B1: 2-storey shear building, linear elastic storeys, on a sliding base; B2:")
+    summary = section.blocks[1].text
+    assert summary.startswith("Design summary. Governing limit state: pounding between the buildings") and "scaled to every stripe" in summary
 
 
 def test_the_report_gives_the_risk_answer_in_its_summary_and_no_repr_in_its_prose(isolated_store):

@@ -26,13 +26,13 @@ from stochpound.analysis._pounding import pounding_probability
 from stochpound.analysis._separation import pounding_curve, required_separation, rule_exceedance
 from stochpound.analysis._separation_rules import contact_demands, fixed_base_cqc, separation_rules, store_contact_demands
 from stochpound.analysis._summary import run_summary
-from stochpound.analysis._consistency import hazard_consistency
-from stochpound.analysis._hazard import HazardCurve, bundled_curves, probability_from_rate, rate_from_probability, return_period
+from stochpound.analysis._consistency import hazard_consistency, stripe_rate_weights
+from stochpound.analysis._hazard import HazardCurve, bundled_curves, bundled_measure, probability_from_rate, rate_from_probability, return_period
 from stochpound.analysis._hazard_files import HazardFile, read_hazard_file
 
 # For the other packages of stochpound (their interface to this one, not public API: not in __all__).
 from stochpound.analysis._bootstrap import bootstrap_method, bootstrap_weights, interval, jackknife_weights, record_clusters  # noqa: F401
-from stochpound.analysis._hazard import bundled_measure, bundled_path  # noqa: F401
+from stochpound.analysis._hazard import bundled_path  # noqa: F401
 from stochpound.analysis._hazard_files import parse_measure, parse_units, unit_factor  # noqa: F401
 from stochpound.analysis._impacts import TABLE_COLUMNS  # noqa: F401
 from stochpound.analysis._intervals import MIN_RUNS  # noqa: F401
@@ -101,9 +101,11 @@ __all__ = [
     "HazardFile",
     "read_hazard_file",
     "bundled_curves",
+    "bundled_measure",
     "probability_from_rate",
     "rate_from_probability",
     "return_period",
     "hazard_consistency",
+    "stripe_rate_weights",
     *RISK_NAMES,
 ]

@@ -29,6 +29,28 @@ import xarray as xr
 from stochpound.analysis._hazard import HazardCurve
 
 
+def stripe_rate_weights(levels: np.ndarray, hazard: HazardCurve, field: str = "levels") -> np.ndarray:
+    """Δλ(x_j) of every stripe: the rate of IM* in the bin of its level (module docstring), 1/yr.
+
+    Parameters
+    ----------
+    levels : array of float
+        The stripes' levels of IM*, increasing (at least 2).
+    hazard : HazardCurve
+        The site's hazard of IM* (it must cover the bins' edges).
+    field : str
+        The name of ``levels`` in the error message.
+    """
+    levels = np.asarray(levels, dtype=float)
+    if levels.ndim != 1 or levels.size < 2 or not np.all(np.diff(levels) > 0):
+        raise ValueError(f"{field}: needs at least 2 increasing levels, got {levels.tolist()}")
+    log_levels = np.log(levels)
+    middle = (log_levels[1:] + log_levels[:-1]) / 2.0
+    edges = np.exp(np.concatenate([[log_levels[0] - (middle[0] - log_levels[0])], middle]))
+    rates = hazard(edges)
+    return np.append(rates[:-1] - rates[1:], rates[-1])
+
+
 def hazard_consistency(spectra: xr.DataArray, hazard: HazardCurve, other: HazardCurve, intensity_dim: str = "intensity",
                        record_dim: str = "record") -> xr.Dataset:
     """The hazard of another measure recomputed from stripes of motions, against the site's own curve (module docstring).
@@ -52,13 +74,7 @@ def hazard_consistency(spectra: xr.DataArray, hazard: HazardCurve, other: Hazard
         ``rate_weight`` (``intensity_dim``): Δλ of every stripe.
     """
     levels = np.asarray(spectra[intensity_dim].values, dtype=float)
-    if levels.size < 2 or not np.all(np.diff(levels) > 0):
-        raise ValueError(f"spectra: needs at least 2 increasing levels along {intensity_dim}, got {levels.tolist()}")
-    log_levels = np.log(levels)
-    middle = (log_levels[1:] + log_levels[:-1]) / 2.0
-    edges = np.exp(np.concatenate([[log_levels[0] - (middle[0] - log_levels[0])], middle]))
-    rates = hazard(edges)
-    weights = np.append(rates[:-1] - rates[1:], rates[-1])
+    weights = stripe_rate_weights(levels, hazard, "spectra")
     values = np.asarray(spectra.transpose(intensity_dim, record_dim).values, dtype=float)
     valid = np.isfinite(values)
     if not valid.any(axis=1).all():

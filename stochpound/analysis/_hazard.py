@@ -268,7 +268,7 @@ def bundled_measure(name: str) -> dict[str, float | str]:
     -------
     dict
         ``measure`` (``"pga"`` or ``"psa"``), for ``psa`` its ``period`` (s)
-        and ``damping`` (:data:`BUNDLED_DAMPING`), and ``units`` (``"g"``):
+        and ``damping`` (``BUNDLED_DAMPING``, 0.05), and ``units`` (``"g"``):
         the keys of an experiment's ``[intensity]`` they must match.
     """
     match = _BUNDLED_MEASURE.search(name)

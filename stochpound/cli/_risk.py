@@ -81,7 +81,8 @@ def risk(store: Path, hazard: str | None, hazard_measure: str | None, hazard_uni
     """
     from stochpound.cli._measure_choice import efficient_measure_lines
     from stochpound.experiment import open_store
-    from stochpound.risk import gap_cost_frame, limit_state_risk, site_hazard, store_risk
+    from stochpound.motions import TARGET_TOLERANCE
+    from stochpound.risk import gap_cost_frame, limit_state_risk, selection_misses, site_hazard, store_risk
 
     targets = _targets(target)
     if hazard is None and (hazard_measure or hazard_units or investigation_time is not None or hazard_site is not None):
@@ -100,6 +101,10 @@ def risk(store: Path, hazard: str | None, hazard_measure: str | None, hazard_uni
     source = hz.source.splitlines()[0] if hz.source else hz.describe()
     click.echo(f"{result.experiment or store.stem}: {result.motions} motions, {stripes} of {result.measure} "
                f"in {result.setting['units']}; hazard: {source}")
+    missed = selection_misses(data)
+    if missed:
+        click.echo(f"warning: the motions chosen for the site miss their conditional-spectrum target (mean or std of ln Sa off by more than "
+                   f"{TARGET_TOLERANCE:g} at a period) at the stripes {', '.join(f'{level:g}' for level in missed)} {result.setting['units']}")
     for line in hz.source.splitlines():
         if line.startswith("stochpound: "):
             click.echo(f"note: hazard {line.removeprefix('stochpound: ')}")
@@ -109,12 +114,19 @@ def risk(store: Path, hazard: str | None, hazard_measure: str | None, hazard_uni
     separation = result.separation_frame()
     click.echo(f"\nRisk-targeted separation g* (m; {interval}; inf: wider than every gap of the grid):")
     click.echo(separation.to_string(float_format=lambda v: f"{v:.3f}"))
+    design = result.design_frame()
+    click.echo(f"\nDesign to (m; the {design['basis'].iloc[0]}, not g* itself):")
+    click.echo(design.drop(columns="basis").assign(target=[result.target_text(p) for p in design["target"]])
+               .to_string(index=False, float_format=lambda v: f"{v:.3f}"))
+    degenerate = result.degenerate_text()
+    if degenerate:
+        click.echo(f"note: {degenerate}")
     rules = result.rules_frame()
     if result.rules is None:
         click.echo(f"\nCode rules: not evaluated: {result.rules_note}.")
     else:
-        click.echo(f"\nCode rules in risk terms (gap at the code intensity's stripe; λ_P: pounding per year at that gap; "
-                   f"'once in N years'; P in {years:g} years):")
+        click.echo(f"\nCode rules in risk terms, applied to the suite-mean peaks of the code intensity's stripe (λ_P: pounding per year "
+                   f"at that gap; 'once in N years'; P in {years:g} years; each with its interval; fit: lognormal or a degenerate step):")
         click.echo(rules.to_string(float_format=lambda v: f"{v:.4g}"))
     if costs is not None:
         click.echo(f"\nLimit states beyond first contact (λ: per year at each finite gap; contact-free: the same motions without "

@@ -6,7 +6,12 @@ and scaled to the level within ``max_scale_factor``, so that their spectra
 match the conditional spectrum of the stripe's scenario
 (:func:`stochpound.motions.select_motions`). The ``[site]`` table gives the
 scenario: ``vs30``, and ``magnitude``, ``distance_km`` and ``mechanism``,
-each one value or one per level (in the order ``levels`` lists them).
+each one value or one per level (in the order ``levels`` lists them); or,
+with ``scenario = "fitted"``, ``vs30``, ``mechanism`` and ``curves`` (the
+site's bundled hazard curves): the magnitude and distance of every level are
+then fitted so that the stripes' conditional spectra reproduce the site's
+curves at the other periods (:func:`stochpound.motions.fit_scenarios`), a
+calibration standing in for a disaggregation.
 
 The period range covers the structure: every building's first-mode period
 on a fixed base and, for a building on a sliding base with a restoring
@@ -44,6 +49,8 @@ DEFAULT_SEED = 1
 SITE_FIELDS = ("vs30", "magnitude", "distance_km", "mechanism")
 PER_LEVEL = ("magnitude", "distance_km", "mechanism")
 """``[site]`` fields that take one value per level."""
+SCENARIOS = ("given", "fitted")
+"""``[site] scenario``: magnitude and distance as the table gives them, or fitted to the site's hazard curves (``curves``)."""
 
 
 def parse_selection(table: Mapping[str, Any], site: Any, levels: list[float], entry: dict[str, Any]) -> dict[str, Any]:
@@ -100,16 +107,25 @@ def parse_selection(table: Mapping[str, Any], site: Any, levels: list[float], en
     if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0:
         raise SiteError(f"intensity.seed: must be an integer >= 0, got {seed!r}")
     note = f"{motions} motions per stripe chosen from the pool and scaled to the conditional spectrum of its scenario"
-    return {"note": note, "selection": selection, "motions": motions, "max_scale_factor": max_scale, "seed": seed, "site": parse_site(site, levels)}
+    if isinstance(site, dict) and site.get("scenario") == "fitted" and isinstance(site.get("curves"), list):
+        note += f" (the scenario fitted to the site's hazard curves {', '.join(map(str, site['curves']))}, standing in for a disaggregation)"
+    return {"note": note, "selection": selection, "motions": motions, "max_scale_factor": max_scale, "seed": seed, "site": parse_site(site, levels, entry)}
 
 
-def parse_site(site: Any, levels: list[float]) -> list[dict[str, Any]]:
-    """One scenario per level, in the order of the sorted levels, from the ``[site]`` table."""
+def parse_site(site: Any, levels: list[float], entry: Mapping[str, Any]) -> list[dict[str, Any]]:
+    """One scenario per level, in the order of the sorted levels, from the ``[site]`` table (given, or fitted to its ``curves``)."""
     from stochpound._errors import SiteError
 
     if not isinstance(site, dict):
         raise SiteError("site: a [site] table is required with the conditional spectrum (vs30, magnitude, distance_km, mechanism)")
-    toml_fields.reject_unknown(site, set(SITE_FIELDS), "site")
+    scenario_kind = site.get("scenario", SCENARIOS[0])
+    if scenario_kind not in SCENARIOS:
+        raise SiteError(f"site.scenario: must be one of {', '.join(SCENARIOS)}, got {scenario_kind!r}")
+    if scenario_kind == "fitted":
+        return fitted_site(site, levels, entry)
+    if "curves" in site:
+        raise SiteError('site.curves: only with site.scenario = "fitted"')
+    toml_fields.reject_unknown(site, {*SITE_FIELDS, "scenario"}, "site")
     columns: dict[str, list[Any]] = {}
     for key in SITE_FIELDS:
         if key not in site:
@@ -131,6 +147,51 @@ def parse_site(site: Any, levels: list[float]) -> list[dict[str, Any]]:
         scenarios.append({key: (float(v) if key != "mechanism" else v) for key, v in scenario.items()})
     order = sorted(range(len(levels)), key=lambda i: levels[i])
     return [scenarios[i] for i in order]
+
+
+def fitted_site(site: Mapping[str, Any], levels: list[float], entry: Mapping[str, Any]) -> list[dict[str, Any]]:
+    """The scenario of every level (sorted) fitted to the site's bundled hazard curves (:func:`stochpound.motions.fit_scenarios`).
+
+    ``site.curves`` names bundled curves (:func:`stochpound.analysis.bundled_curves`):
+    the one of the conditioning measure gives the stripes' rates, the others
+    (PGA or PSA) are reproduced by the fit.
+    """
+    from stochpound._errors import SiteError
+    from stochpound.analysis import HazardCurve, bundled_curves, bundled_measure, stripe_rate_weights
+    from stochpound.motions import fit_levels, fit_scenarios
+
+    toml_fields.reject_unknown(site, {"scenario", "curves", "vs30", "mechanism"}, "site")
+    for key in ("vs30", "mechanism"):
+        if key not in site:
+            raise SiteError(f"site.{key}: missing (the site's Vs30 and the mechanism of its faults)")
+        if isinstance(site[key], list):
+            raise SiteError(f'site.{key}: one value with scenario = "fitted", got a list')
+    check_scenario(6.0, 10.0, site["vs30"], site["mechanism"], {"vs30": "site.vs30", "mechanism": "site.mechanism"})
+    curves = site.get("curves")
+    known = bundled_curves()
+    if not isinstance(curves, list) or len(curves) < 2 or any(name not in known for name in curves):
+        raise SiteError(f'site.curves: two or more of the bundled hazard curves ({", ".join(known)}), got {curves!r}')
+    conditioning = None
+    others = []
+    for name in curves:
+        measure = bundled_measure(name)
+        curve = HazardCurve.bundled(name)
+        if measure["measure"] == entry["measure"] and measure.get("period") == entry.get("period"):
+            conditioning = curve
+        else:
+            others.append((measure.get("period"), curve.im, curve.rate))
+    if conditioning is None:
+        raise SiteError("site.curves: none of them is the curve of the conditioning measure ([intensity] measure and period)")
+    if not others:
+        raise SiteError("site.curves: the fit needs one or more curves at other periods than the conditioning measure's")
+    ordered = sorted(float(level) for level in levels)
+    try:
+        fine = fit_levels(ordered, conditioning.support[1])
+        scenarios = fit_scenarios(entry["measure"], entry.get("period"), ordered, fine, stripe_rate_weights(fine, conditioning, "intensity.levels"),
+                                  others, float(site["vs30"]), site["mechanism"])
+    except ValueError as error:  # a level outside the conditioning curve
+        raise SiteError(f"intensity.levels: outside the site's curve of the conditioning measure ({error})") from None
+    return scenarios
 
 
 def periods_of_interest(experiment: Experiment) -> dict[str, float]:
@@ -191,6 +252,8 @@ class StripeSelections:
 
     def coordinates(self) -> dict[str, xr.Variable]:
         """The store's record of the selection: per stripe the chosen motions' scale factors, the target and the set's spectra, the scenario."""
+        from stochpound.motions import TARGET_TOLERANCE, misses_target
+
         scale = np.full(self.chosen.shape, np.nan)
         for i, selection in enumerate(self.selections):
             scale[i, [self.labels.index(m) for m in selection["motion"].values]] = selection["scale_factor"].values
@@ -207,6 +270,10 @@ class StripeSelections:
             "target_sigma_ln": xr.Variable(per_stripe, stack["sigma_ln"], {"units": "1", "long_name": "conditional spectrum: standard deviation of ln Sa"}),
             "selection_mean_ln": xr.Variable(per_stripe, stack["mean_ln"], {"units": "1", "long_name": "mean ln Sa (g) of the chosen, scaled motions"}),
             "selection_std_ln": xr.Variable(per_stripe, stack["std_ln"], {"units": "1", "long_name": "standard deviation of ln Sa of the chosen, scaled motions"}),
+            "selection_misses_target": xr.Variable(
+                ("intensity",), misses_target(stack["mean_ln"], stack["std_ln"], stack["median"], stack["sigma_ln"]).astype(np.int8),
+                {"units": "1", "long_name": f"1 where the stripe's selection misses its target (mean or std of ln Sa off by > {TARGET_TOLERANCE:g} at a period)"},
+            ),
             "target_epsilon": xr.Variable(("intensity",), np.array([s["epsilon"] for s in scenario]), {"units": "1", "long_name": "epsilon of the level in its scenario"}),
             "site_magnitude": xr.Variable(("intensity",), np.array([s["magnitude"] for s in scenario]), {"units": "1", "long_name": "scenario moment magnitude"}),
             "site_distance_km": xr.Variable(("intensity",), np.array([s["distance_km"] for s in scenario]), {"units": "km", "long_name": "scenario rupture distance"}),

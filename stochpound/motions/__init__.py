@@ -12,12 +12,15 @@ between samples): :func:`intensity_measures`, :func:`response_spectrum`.
 The conditional spectrum of a site scenario (NGA-West2 models, Baker–Jayaram
 correlation): :func:`conditional_spectrum`; records chosen and scaled to it
 (Jayaram, Lin & Baker 2011): :func:`selection_pool`, :func:`selection_periods`,
-:func:`select_motions`.
+:func:`select_motions`; the scenario of every level fitted to the site's own
+hazard curves where no disaggregation is at hand: :func:`fit_scenarios`,
+:func:`fit_levels`, :func:`recomputed_hazard`.
 
 Conventions (PSD two-sided in ω, σ² = ∫ S dω; SI units) are in ``docs/motions.md``.
 """
 
 from stochpound.motions._conditional import conditional_spectrum
+from stochpound.motions._fitted import fit_levels, fit_scenarios, recomputed_hazard
 from stochpound.motions.baseline import baseline_correct, final_velocity_displacement
 from stochpound.motions.envelopes import (
     ENVELOPES,
@@ -42,7 +45,7 @@ from stochpound.motions.psd import (
     kanai_tajimi_psd,
     kanai_tajimi_variance,
 )
-from stochpound.motions._selection import select_motions, selection_periods, selection_pool
+from stochpound.motions._selection import TARGET_TOLERANCE, misses_target, select_motions, selection_periods, selection_pool
 from stochpound.motions._seeding import realization_rng, realization_rngs
 from stochpound.motions._spectrum import response_spectrum
 from stochpound.motions._synthetic import PSD_CONVENTION, clough_penzien, kanai_tajimi, synthetic_ground_motion
@@ -54,6 +57,7 @@ from stochpound.motions._conditional import CONDITIONING_MEASURES, MODEL_DAMPING
 __all__ = [
     "ENVELOPES",
     "PSD_CONVENTION",
+    "TARGET_TOLERANCE",
     "SOIL_PRESETS",
     "AminAng",
     "CallableEnvelope",
@@ -69,6 +73,8 @@ __all__ = [
     "clough_penzien_psd",
     "conditional_spectrum",
     "filter_samples",
+    "fit_levels",
+    "fit_scenarios",
     "final_velocity_displacement",
     "high_pass_gain",
     "intensity_measures",
@@ -77,10 +83,12 @@ __all__ = [
     "kanai_tajimi_psd",
     "kanai_tajimi_variance",
     "make_envelope",
+    "misses_target",
     "peak_ground_motion",
     "poisson_peak_factor",
     "realization_rng",
     "realization_rngs",
+    "recomputed_hazard",
     "response_spectrum",
     "s0_from_pga",
     "s0_from_rms",

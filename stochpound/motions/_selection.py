@@ -50,6 +50,8 @@ RANGE_LOW = 0.2
 RANGE_HIGH = 3.0
 #: Fault types of the FEMA P695 metadata as scenario mechanisms.
 FAULT_TYPES = {"Strike-slip": "strike_slip", "Thrust": "reverse", "Reverse": "reverse", "Reverse-Oblique": "reverse", "Normal": "normal"}
+#: A stripe's selection misses its target where its mean or standard deviation of ln Sa is farther than this from the target's at a period.
+TARGET_TOLERANCE = 0.1
 #: Weight of the quartic term of the misfit.
 QUARTIC_WEIGHT = 100.0
 _MAX_PASSES = 50
@@ -205,6 +207,28 @@ def select_motions(pool: xr.Dataset, target: xr.Dataset, motions: int, max_scale
         coords={"period": target.period},
         attrs={"level": level, "max_scale_factor": float(max_scale_factor), "seed": int(seed), "pool": int(scale.size), "candidates": int(eligible.size)},
     )
+
+
+def misses_target(mean_ln: np.ndarray, std_ln: np.ndarray, median: np.ndarray, sigma_ln: np.ndarray) -> np.ndarray:
+    """Whether a selection misses its target: its mean or standard deviation of ln Sa farther than ``TARGET_TOLERANCE`` (0.1) from the target's at any period.
+
+    Parameters
+    ----------
+    mean_ln, std_ln : array
+        The scaled set's mean and standard deviation of ln Sa (Sa in g), over periods (last axis; stripes before it).
+    median : array
+        The target's median Sa, g.
+    sigma_ln : array
+        The target's standard deviation of ln Sa.
+
+    Returns
+    -------
+    numpy.ndarray of bool
+        One per stripe (the leading axes).
+    """
+    mean_off = np.abs(np.asarray(mean_ln) - np.log(np.asarray(median)))
+    std_off = np.abs(np.asarray(std_ln) - np.asarray(sigma_ln))
+    return np.any((mean_off > TARGET_TOLERANCE) | (std_off > TARGET_TOLERANCE), axis=-1)
 
 
 def _misfit(set_mean: np.ndarray, set_std: np.ndarray, mean: np.ndarray, sigma: np.ndarray) -> np.ndarray:

@@ -36,7 +36,7 @@ from stochpound.risk._fragility_ensemble import (
     limit_state_events,
     stripe_fragility,
 )
-from stochpound.risk._maf import TARGETS, demand_hazard_curve, mean_annual_frequency, risk_curve, risk_targeted_separation
+from stochpound.risk._maf import TARGETS, degenerate_text, demand_hazard_curve, mean_annual_frequency, rate_intervals, risk_curve, risk_targeted_separation
 from stochpound.risk._code_rules import code_rules_risk
 from stochpound.risk._code_gaps import (
     Asce7Design,
@@ -47,12 +47,12 @@ from stochpound.risk._code_gaps import (
     modal_floor_displacements,
     srss_separation,
 )
-from stochpound.risk._store import RiskInputError, contact_free_closure, has_risk, site_hazard
+from stochpound.risk._store import RiskInputError, contact_free_closure, has_risk, selection_misses, site_hazard
 from stochpound.risk._store_risk import StoreRisk, pounding_fragility, risk_gaps, store_risk
 from stochpound.risk._demands import StoreDemands, store_demands
 from stochpound.risk._limit_states import KINDS as LIMIT_STATE_KINDS, LimitState, gap_cost_frame, limit_state_risk, limit_states_from_table
 from stochpound.risk._efficiency import measure_efficiency, most_efficient
-from stochpound.analysis import hazard_consistency
+from stochpound.analysis import hazard_consistency, stripe_rate_weights
 
 __all__ = [
     "Fragility",
@@ -71,6 +71,8 @@ __all__ = [
     "demand_hazard_curve",
     "mean_annual_frequency",
     "risk_curve",
+    "rate_intervals",
+    "degenerate_text",
     "risk_targeted_separation",
     "code_rules_risk",
     "Asce7Design",
@@ -96,7 +98,9 @@ __all__ = [
     "measure_efficiency",
     "most_efficient",
     "has_risk",
+    "selection_misses",
     "site_hazard",
+    "stripe_rate_weights",
     "RiskInputError",
     "TARGETS",
     "BOOTSTRAP",

@@ -36,7 +36,7 @@ from stochpound.analysis import bootstrap_method, bootstrap_weights, interval, j
 from stochpound.risk._fragility import STATUS, stripe_mle
 from stochpound.risk._fragility_ensemble import BOOTSTRAP
 from stochpound.analysis import HazardCurve, probability_from_rate, rate_from_probability, return_period
-from stochpound.risk._maf import lognormal_maf
+from stochpound.risk._maf import lognormal_maf, rate_intervals
 from stochpound.analysis import EC8_REDUCTION, separation_rules
 
 DESIGN_LEVELS = (0.02, 0.10)
@@ -120,6 +120,7 @@ def code_rules_risk(demands: xr.Dataset, hz: HazardCurve, design_levels: Sequenc
                                               input_core_dims=[["sample"], [], ["jackknife"]], output_core_dims=[[], []])
                 level[f"{name}_lower"] = lower.assign_attrs(units=units, long_name=f"lower bound of {name}", **attrs)
                 level[f"{name}_upper"] = upper.assign_attrs(units=units, long_name=f"upper bound of {name}", **attrs)
+            level = rate_intervals(level, years)
         per_level.append(level.assign_coords(code_intensity=code_intensity, stripe_intensity=levels[stripe]))
     result = xr.concat(per_level, dim="design_level", coords="all")
     result = result.assign_coords(design_level=("design_level", np.atleast_1d(np.asarray(design_levels, dtype=float)),

@@ -65,11 +65,11 @@ class StoreDemands:
         """The moat table: per clearance (m), the MAF of reaching it with its interval, the return period and the probability."""
         if self.moat is None:
             return pd.DataFrame()
-        frame = self.moat[["maf", "maf_lower", "maf_upper", "return_period", "probability"]].reset_coords(drop=True).to_dataframe()
-        frame = frame.rename(columns={"maf": "λ (1/yr)", "maf_lower": "λ lower", "maf_upper": "λ upper", "return_period": "once in (yr)",
-                                      "probability": f"P in {self.years:g} yr"})
-        frame.index = frame.index.set_names({"level": "moat clearance (m)"})
-        return frame
+        names = {"maf": "λ (1/yr)", "maf_lower": "λ lower", "maf_upper": "λ upper", "return_period": "once in (yr)",
+                 "return_period_lower": "once in, lower (yr)", "return_period_upper": "once in, upper (yr)",
+                 "probability": f"P in {self.years:g} yr", "probability_lower": "P lower", "probability_upper": "P upper"}
+        frame = self.moat[[name for name in names if name in self.moat]].reset_coords(drop=True).to_dataframe().rename(columns=names)
+        return frame.rename_axis(index={"level": "moat clearance (m)"})  # a plain index (one configuration) or a MultiIndex
 
 
 def store_demands(store: xr.Dataset, hz: HazardCurve | None = None, confidence: float = CONFIDENCE, bootstrap: int = BOOTSTRAP,

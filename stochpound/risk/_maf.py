@@ -29,6 +29,7 @@ from numpy.typing import ArrayLike
 from scipy import optimize, special
 
 from stochpound.analysis import interval, kernels
+from stochpound.risk._fragility import ALWAYS, DECREASING, EMPTY, NEVER, SEPARATED, STATUS
 from stochpound.risk._fragility_ensemble import BOOTSTRAP, limit_state_events, stripe_fragility
 from stochpound.analysis import HazardCurve, probability_from_rate, rate_from_probability, return_period
 
@@ -134,7 +135,82 @@ def risk_curve(fragility: xr.Dataset, hz: HazardCurve, years: float = 50.0, conf
             maf_jackknife=left_out.assign_attrs(units="1/yr", long_name="MAF without each motion or cluster of motions"),
         )
     result.attrs["hazard_extrapolated"] = int(hz.extrapolated)
-    return result
+    return rate_intervals(result, years)
+
+
+def degenerate_text(status: ArrayLike, hz: HazardCurve, what: str = "gaps") -> str:
+    """What the degenerate fits among ``status`` are and what each does to the MAF ("" when every fit is a lognormal).
+
+    A degenerate fit is a step (β = 0), not a lognormal (its ``status``:
+    ``always``, ``never``, ``separated``; ``decreasing`` and ``empty`` fits
+    have no λ); integrated with the
+    hazard it gives λ(θ): for ``always`` (every run exceeded, θ = 0) the
+    hazard's rate at the lowest intensity of its table, a plateau set by
+    the table, not by the structure; for ``never`` 0; for ``separated``
+    the hazard's rate at the step.
+
+    Parameters
+    ----------
+    status : array_like of int
+        Fit statuses (indices into ``STATUS``), e.g. one per gap and configuration.
+    hz : HazardCurve
+        The hazard the fits were integrated with.
+    what : str
+        What one fit is of, in words (plural), e.g. ``"gaps"``.
+
+    Returns
+    -------
+    str
+        One sentence per kind of degenerate fit found, with its count.
+    """
+    status = np.asarray(status).ravel()
+    lo = hz.support[0]
+    effect = {
+        ALWAYS: f"every run exceeded at every stripe, F ≡ 1, so λ is the hazard's rate at the lowest intensity of its table "
+                f"({lo:.3g} {hz.units}): {float(hz(lo)):.3g} /yr, a plateau set by the hazard table, not a fitted risk",
+        NEVER: "no run exceeded, F ≡ 0, so λ = 0: no risk is resolved, only that none of the runs exceeded",
+        SEPARATED: "the runs separate at one intensity (none exceeded below it, all above), so F is a step there and λ is the "
+                   "hazard's rate at that intensity",
+        DECREASING: "the fitted slope is not positive: no fragility and no λ (NaN)",
+        EMPTY: "no runs: no fragility and no λ (NaN)",
+    }
+    parts = [f"{int((status == code).sum())} of {status.size} {what}: a step '{STATUS[code]}' ({text})"
+             for code, text in effect.items() if (status == code).any()]
+    return ("Degenerate fits, not lognormals: " + "; ".join(parts) + ".") if parts else ""
+
+
+def rate_intervals(result: xr.Dataset, years: float) -> xr.Dataset:
+    """``result`` with the intervals of its return period and probability, from those of its MAF (absent without them).
+
+    Both are monotone in the MAF λ, so the interval of λ maps onto theirs
+    exactly: the return period 1/λ is in [1/λ_upper, 1/λ_lower] (yr) and
+    the probability 1 − exp(−λ t) in [its value at λ_lower, at λ_upper],
+    at the same confidence, from the same resamples.
+
+    Parameters
+    ----------
+    result : xarray.Dataset
+        With ``maf``, ``maf_lower`` and ``maf_upper`` (1/yr).
+    years : float
+        The exposure time t of the probability (yr).
+
+    Returns
+    -------
+    xarray.Dataset
+        With ``return_period_lower``/``return_period_upper`` (yr) and
+        ``probability_lower``/``probability_upper``.
+    """
+    if "maf_lower" not in result or "maf_upper" not in result:
+        return result
+    attrs = {key: value for key, value in result["maf_lower"].attrs.items() if key in ("confidence", "method", "seed")}
+    periods = {bound: xr.apply_ufunc(return_period, result[f"maf_{other}"]) for bound, other in (("lower", "upper"), ("upper", "lower"))}
+    chances = {bound: xr.apply_ufunc(probability_from_rate, result[f"maf_{bound}"], kwargs={"years": years}) for bound in ("lower", "upper")}
+    return result.assign(
+        **{f"return_period_{bound}": value.assign_attrs(units="yr", long_name=f"{bound} bound of the mean return period", **attrs)
+           for bound, value in periods.items()},
+        **{f"probability_{bound}": value.assign_attrs(units="1", long_name=f"{bound} bound of the probability in {years:g} years", **attrs)
+           for bound, value in chances.items()},
+    )
 
 
 def risk_targeted_separation(curve: xr.Dataset, targets: Sequence[float] = TARGETS, years: float = 50.0, dim: str = "gap",

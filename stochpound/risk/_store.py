@@ -24,7 +24,7 @@ import xarray as xr
 from stochpound.analysis import HazardCurve, parse_measure, parse_units, store_contact_demands
 from stochpound.experiment import check_covers, hazard_curve, hazard_option, stored_hazard
 from stochpound.motions import DEFAULT_G
-from stochpound.store import contact_free, describe_measure, gap_dims, has_contact_free, wall_free, with_contacts
+from stochpound.store import contact_free, describe_measure, gap_dims, has_contact_free, has_wall_free, wall_free, with_contacts
 
 CLOSURE = "peak_contact_closure"
 """The store's variable of per-case, per-contact peak closures (m)."""
@@ -137,6 +137,29 @@ def experiment_name(store: xr.Dataset) -> str | None:
     return store.attrs.get("experiment_name")
 
 
+def assumptions(store: xr.Dataset) -> dict[str, str]:
+    """What a risk answer from ``store`` rests on, in words, from its definition: the structural model, the suite and its
+    selection, and the scenario."""
+    definition = store.pound.definition
+    models = []
+    for building in definition.scene.get("building", []):
+        storeys = len(building.get("mass", []))
+        storey = "yielding (bilinear) storeys" if "yield_force" in building else "linear elastic storeys"
+        base = "a sliding base" if "base" in building else "a fixed base"
+        models.append(f"{building.get('name', '?')}: {storeys}-storey shear building, {storey}, on {base}")
+    kinds = {"record": "records without a named suite", "synthetic": "synthetic ensembles"}
+    suites = sorted({source.suite or kinds.get(source.kind, source.kind) for source in definition.motions})
+    count = sum(source.count for source in definition.motions)
+    entry = definition.intensity.entry if definition.intensity is not None else {}
+    selection = entry.get("selection")
+    suite = (f"{count} motions ({', '.join(suites)}), "
+             + (f"selected per stripe by {str(selection).replace('_', ' ')}" if selection else "every motion scaled to every stripe (no selection)"))
+    site = entry.get("site")
+    scenario = "; ".join(f"{key} {value}" for key, value in site.items()) if isinstance(site, Mapping) else ""
+    return {"structural model": "; ".join(models), "suite": suite,
+            "scenario": scenario or "none stated (the motions are not selected for a scenario)"}
+
+
 def stripes(store: xr.Dataset) -> int | None:
     """The number of intensity stripes of a store (None for IDA runs)."""
     return store.sizes["intensity"] if "intensity" in store.dims else None
@@ -193,6 +216,14 @@ def stripe_motions(store: xr.Dataset, motions: int) -> int:
     return motions
 
 
+def selection_misses(store: xr.Dataset) -> list[float]:
+    """The levels (in the levels' units) whose stripe's selection for the site misses its target (``selection_misses_target``); [] without a selection."""
+    if "selection_misses_target" not in store:
+        return []
+    flags = store["selection_misses_target"].values.astype(bool)
+    return [float(level) for level, flag in zip(store["intensity"].values, flags) if flag]
+
+
 def motion_intensity(store: xr.Dataset) -> xr.DataArray:
     """The intensity of every motion of an IDA store at scale 1 (in the units of its levels), one motion dimension ``record``."""
     intensity = store["motion_intensity"]
@@ -219,6 +250,18 @@ def base_displacement(store: xr.Dataset, studied: str | None, walls_free: bool =
     if not bool(slides.any()):
         return None
     return sliding.where(slides)
+
+
+def free_base_displacement(store: xr.Dataset, studied: str | None) -> tuple[xr.DataArray | None, str]:
+    """The studied building's wall-free peak base displacement for D_TM (:func:`base_displacement`), or None and why not.
+
+    A moat wall caps the displacement D_TM is to size: with walls at its
+    base and no wall-free runs there is none ("" as the reason where the
+    building simply does not slide).
+    """
+    if moat_clearances(store, studied) and not has_wall_free(store):
+        return None, "the store has no wall-free runs (a moat wall caps the displacement D_TM is to size): add inf to the wall axis"
+    return base_displacement(store, studied, walls_free=True), ""
 
 
 def stored_demands(store: xr.Dataset) -> dict[str, tuple[xr.DataArray, str]]:

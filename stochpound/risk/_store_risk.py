@@ -36,7 +36,8 @@ from stochpound.analysis import HazardCurve, rate_from_probability
 from stochpound.risk import _store
 from stochpound.risk._code_rules import MINIMUM_MOTIONS, code_rules_risk
 from stochpound.risk._fragility_ensemble import BOOTSTRAP, fragility_band, fragility_surface, homogeneous_capacities, ida_fragility, limit_state_events, stripe_fragility
-from stochpound.risk._maf import TARGETS, non_increasing, risk_curve, risk_targeted_separation
+from stochpound.risk._fragility import FIT, STATUS
+from stochpound.risk._maf import TARGETS, degenerate_text, non_increasing, risk_curve, risk_targeted_separation
 
 YEARS = 50.0
 """The default exposure time of the targets (yr)."""
@@ -46,19 +47,23 @@ RISK_GAPS = 60
 """Gaps of the default grid of :func:`risk_gaps`."""
 RULE_NAMES = {
     "abs": "ABS",
-    "srss": "SRSS (ASCE 7 δ_MT)",
-    "srss_reduced": "0.7 SRSS (Eurocode 8)",
+    "srss": "SRSS of suite-mean peaks (ASCE 7 δ_MT form)",
+    "srss_reduced": "0.7 SRSS of suite-mean peaks (Eurocode 8 form)",
     "ddc": "DDC",
     "ddc_cqc": "DDC (CQC ρ)",
-    "dtm": "D_TM (ASCE 7 §17.2.5.2)",
+    "dtm": "D_TM of the suite-mean base displacement (ASCE 7 §17.2.5.2 form)",
 }
-"""The code rules' names in the tables."""
+"""The code rules' names in the tables: each applied to the suite-mean peaks of the stripe at the design level
+(the codes apply them to the design analysis: named as suite-mean so they are not read as the codes' own gaps)."""
 CURVE_GAPS = 3
 """Fragility curves drawn per configuration (at gaps spread over the risk curve's range)."""
 IM_POINTS = 120
 """Intensities of :meth:`StoreRisk.im_axis`."""
 _SEPARATION = {"separation": "g* (m)", "lower": "lower (m)", "upper": "upper (m)"}
-_RULE_VALUES = ("maf", "maf_lower", "maf_upper", "return_period", "probability")
+_RULE_VALUES = ("maf", "maf_lower", "maf_upper", "return_period", "return_period_lower", "return_period_upper", "probability",
+                "probability_lower", "probability_upper")
+_RULE_COLUMNS = ("λ_P (1/yr)", "λ_P lower", "λ_P upper", "once in (yr)", "once in, lower (yr)", "once in, upper (yr)", "P in {years:g} yr",
+                 "P lower", "P upper")
 
 
 def risk_gaps(closure: xr.DataArray, count: int = RISK_GAPS) -> np.ndarray:
@@ -139,6 +144,12 @@ class StoreRisk:
         The exposure time of the targets (yr).
     confidence : float
         The confidence of the intervals.
+    dtm_note : str
+        Why the rules hold no D_TM ("" where they do, or where the studied building does not slide).
+    assumptions : dict of str to str
+        What the answer rests on besides the hazard, in words from the
+        store's definition: ``structural model``, ``suite`` (and its
+        selection), ``scenario``.
     """
 
     fragility: xr.Dataset
@@ -154,6 +165,8 @@ class StoreRisk:
     experiment: str | None = None
     years: float = YEARS
     confidence: float = CONFIDENCE
+    assumptions: dict[str, str] = dataclasses.field(default_factory=dict)
+    dtm_note: str = ""
 
     @property
     def measure(self) -> str:
@@ -199,7 +212,12 @@ class StoreRisk:
     def rules_frame(self) -> pd.DataFrame:
         """The code rules in risk terms: per configuration, design level and rule, its gap per contact (m) and the MAF of pounding there.
 
-        Empty when the rules were not evaluated (``rules_note`` says why).
+        With the return period and the probability, each with its interval,
+        the fit's kind (``fit``: ``lognormal`` or the step), and whether the
+        rule meets its own design level as a target (``meets its level``:
+        λ_P ≤ −ln(1 − p)/t for the level's probability p; ``meets, upper
+        bound``: the same for the upper bound of λ_P). Empty when the rules
+        were not evaluated (``rules_note`` says why).
         """
         rules = self.rules
         if rules is None:
@@ -208,15 +226,48 @@ class StoreRisk:
         years = float(rules.attrs.get("years", self.years))
         gaps = rules["gap"].to_dataframe()["gap"].unstack("contact")
         gaps.columns = [f"gap, contact {c} (m)" for c in gaps.columns]
-        values = rules[[name for name in _RULE_VALUES if name in rules]].to_dataframe()
+        values = rules[[name for name in (*_RULE_VALUES, "status") if name in rules]].to_dataframe()
         frame = gaps.join(values)
-        names = dict(zip(_RULE_VALUES, ("λ_P (1/yr)", "λ_P lower", "λ_P upper", "once in (yr)", f"P in {years:g} yr")))
+        if "status" in frame:
+            frame["status"] = [fit_name(int(s)) for s in frame["status"]]
+        allowed = rate_from_probability(frame.index.get_level_values("design_level").to_numpy(dtype=float), years)
+        frame["meets its level"] = frame["maf"] <= allowed  # λ_P at the rule's gap within the rate of its own design level
+        if "maf_upper" in frame:
+            frame["meets, upper bound"] = frame["maf_upper"] <= allowed
+        names = {**dict(zip(_RULE_VALUES, (column.format(years=years) for column in _RULE_COLUMNS))), "status": "fit"}
         frame = frame.rename(columns=names).reset_index()
         frame["design_level"] = [design_text(p, float(i), years) for p, i in zip(frame["design_level"], frame["stripe_intensity"])]
         frame["rule"] = [RULE_NAMES.get(r, r) for r in frame["rule"]]
         frame = frame.drop(columns=[c for c in ("code_intensity", "stripe_intensity") if c in frame])
-        index = [c for c in frame.columns if not c.startswith("gap, ") and c not in names.values()]
+        index = [c for c in frame.columns if not c.startswith(("gap, ", "meets")) and c not in names.values()]
         return frame.set_index(index).dropna(how="all")
+
+    def design_frame(self) -> pd.DataFrame:
+        """The gap to design to: per configuration and target, the upper bound of g*'s interval (m; g* itself without a bootstrap).
+
+        g* is the central estimate from a finite suite; its upper bound is
+        the gap that meets the target with the intervals' confidence
+        (one-sided: (1 + confidence)/2), the number to design to.
+
+        Returns
+        -------
+        pandas.DataFrame
+            Columns: the configuration's dimensions, ``target``, ``design``
+            (m), ``basis`` (what ``design`` is, in words).
+        """
+        frame = self.to_frame()
+        bounded = frame["upper"].notna()
+        one_sided = f"{100 * (1 + self.confidence) / 2:g} % one-sided upper bound of g*"
+        frame["design"] = frame["upper"].where(bounded, frame["separation"])
+        frame["basis"] = np.where(bounded, one_sided, "g* (no bootstrap: no bound)")
+        return frame[[*self.configuration_dims(), "target", "design", "basis"]]
+
+    def degenerate_text(self) -> str:
+        """The degenerate fragility fits among the gaps (steps, not lognormals) and what each does to λ_P ("" when there are none)."""
+        if "status" not in self.fragility:
+            return ""
+        what = "fits (gaps × configurations)" if self.configuration_dims() else "gaps"
+        return degenerate_text(self.fragility["status"].values, self.hazard, what)
 
     def non_increasing_maf(self) -> xr.DataArray:
         """λ_P(g) made non-increasing along the gaps (its running minimum, the curve g* is read from; 1/yr)."""
@@ -306,7 +357,8 @@ def store_risk(store: xr.Dataset, hz: HazardCurve | None = None, targets: Sequen
         (within the hazard's table), so that the grid reaches the separations
         the hazard asks for.
     studied : str, optional
-        The building whose peak base displacement is ASCE 7's D_TM; default
+        The building whose peak base displacement (wall-free: a moat wall
+        caps the displacement D_TM is meant to size) is ASCE 7's D_TM; default
         the store's ``studied`` building. The rule is left out where it does not slide.
     confidence, bootstrap, seed
         As in :func:`~stochpound.risk.stripe_fragility`.
@@ -331,16 +383,18 @@ def store_risk(store: xr.Dataset, hz: HazardCurve | None = None, targets: Sequen
     separation = risk_targeted_separation(curve, targets, years, confidence=confidence)
     motions = _store.stripe_motions(store, closure.sizes["record"])
     method = "ida" if _store.is_ida(store) else "stripes"
-    rules, note = None, ""
+    rules, note, dtm_note = None, "", ""
     if method == "ida":
         note = "IDA runs hold no stripe at the code intensity to apply the rules to"
     elif motions < MINIMUM_MOTIONS:
         note = f"the codes take the mean over at least {MINIMUM_MOTIONS} motions; the store has {motions}"
     else:
-        rules = code_rules_risk(_store.contact_free_demands(store), hz, years=years, isolator_displacement=_store.base_displacement(store, studied),
+        isolator, dtm_note = _store.free_base_displacement(store, studied)
+        rules = code_rules_risk(_store.contact_free_demands(store), hz, years=years, isolator_displacement=isolator,
                                 confidence=confidence, bootstrap=bootstrap, seed=seed)
     return StoreRisk(fragility, curve, separation, rules, note, hz, motions, method, setting=_store.intensity_setting(store) or {},
-                     stripes=_store.stripes(store), experiment=_store.experiment_name(store), years=years, confidence=confidence)
+                     stripes=_store.stripes(store), experiment=_store.experiment_name(store), years=years, confidence=confidence,
+                     assumptions=_store.assumptions(store), dtm_note=dtm_note)
 
 
 def target_text(probability: float, years: float = YEARS) -> str:
@@ -351,6 +405,11 @@ def target_text(probability: float, years: float = YEARS) -> str:
 def design_text(probability: float, stripe: float, years: float = YEARS) -> str:
     """A code's design level in words, with the stripe its rules use: ``2 %/50 yr (stripe 0.508)``."""
     return f"{100 * probability:g} %/{years:g} yr (stripe {stripe:g})"
+
+
+def fit_name(status: int) -> str:
+    """A fit's kind in words: ``lognormal`` for a fit, else the step it is (``step: always`` …)."""
+    return "lognormal" if status == FIT else f"step: {STATUS[status]}"
 
 
 def gap_text(value: float) -> str:

@@ -31,7 +31,8 @@ from stochpound.experiment import describe_measure
 from stochpound.report.render import FigureItem, Paragraph, Section, Table
 from stochpound.report.sections._stripe_motions import stripe_motions_text
 from stochpound.experiment import is_gap_axis
-from stochpound.risk import contact_free_closure, limit_state_events
+from stochpound.motions import TARGET_TOLERANCE
+from stochpound.risk import contact_free_closure, limit_state_events, selection_misses
 from stochpound.store import has_contact_free, with_contacts
 
 CONFIDENCE = 0.95
@@ -55,6 +56,9 @@ def intensity_section(name: str, store: xr.Dataset, gaps: Sequence[float] = ()) 
     if "intensity" in store.dims:
         section.add(_stripe_table(name, store, setting))
         section.add(_stripe_figure(name, store, setting, gaps))
+        if "target_median" in store:
+            section.add(Paragraph(_selection_text(store, setting)))
+            section.add(_selection_figure(name, store, setting))
     elif "ida_capacity" in store:
         section.add(_ida_figure(name, store, setting))
     return section
@@ -227,6 +231,57 @@ def _closure_gaps(closure: xr.DataArray, gaps: Sequence[float]) -> np.ndarray:
 
 def _listed(items: list[str]) -> str:
     return items[0] if len(items) == 1 else ", ".join(items[:-1]) + " and " + items[-1]
+
+
+def _selection_text(store: xr.Dataset, setting: dict[str, Any]) -> str:
+    """The selection for the site: the scenario of every stripe and the stripes whose selection misses its target."""
+    scenarios = "; ".join(
+        f"{level:g} {setting['units']}: M {m:g} at {r:g} km (ε {e:.2f})"
+        for level, m, r, e in zip(store["intensity"].values, store["site_magnitude"].values, store["site_distance_km"].values, store["target_epsilon"].values)
+    )
+    missed = selection_misses(store)
+    verdict = (
+        f"Every stripe's selection matches its target within {TARGET_TOLERANCE:g} in the mean and the standard deviation of ln Sa at every period."
+        if not missed
+        else f"The selection misses its target (mean or standard deviation of ln Sa off by more than {TARGET_TOLERANCE:g} at a period) at the "
+        f"stripes {', '.join(f'{level:g}' for level in missed)} {setting['units']}: their motions do not represent the site's at that intensity."
+    )
+    return (f"The motions of every stripe were chosen for the site: the conditional spectrum of the stripe's scenario (Vs30 "
+            f"{float(store['site_vs30'].values[0]):g} m/s, {store['site_mechanism'].values[0]} faulting): {scenarios}. {verdict}")
+
+
+def _selection_figure(name: str, store: xr.Dataset, setting: dict[str, Any]) -> FigureItem:
+    """Per stripe: the target's median and 16/84 % spectra against the chosen set's (exp of mean ± std of ln Sa)."""
+    periods = store["selection_period"].values
+    levels = store["intensity"].values
+    columns = min(levels.size, 4)
+    rows = -(-levels.size // columns)
+    figure = Figure(figsize=(7.5, 2.2 * rows + 0.4), layout="constrained")
+    axes = np.atleast_1d(figure.subplots(rows, columns, sharex=True, sharey=True, squeeze=False)).ravel()
+    for j, level in enumerate(levels):
+        ax = axes[j]
+        median, sigma = store["target_median"].values[j], store["target_sigma_ln"].values[j]
+        mean_ln, std_ln = store["selection_mean_ln"].values[j], store["selection_std_ln"].values[j]
+        ax.loglog(periods, median, color="k", lw=1.4, label="target")
+        ax.loglog(periods, median * np.exp(-sigma), "k--", lw=0.8)
+        ax.loglog(periods, median * np.exp(sigma), "k--", lw=0.8)
+        ax.loglog(periods, np.exp(mean_ln), color="C3", lw=1.2, label="chosen")
+        ax.fill_between(periods, np.exp(mean_ln - std_ln), np.exp(mean_ln + std_ln), color="C3", alpha=0.2)
+        factors = store["selection_scale_factor"].values[j]
+        factors = factors[np.isfinite(factors)]
+        ax.set_title(f"{level:g} {setting['units']}: scale {factors.min():.2g}-{factors.max():.2g}", fontsize=8)
+        ax.grid(True, which="both", lw=0.3, color="0.85")
+    for ax in axes[levels.size :]:
+        ax.set_visible(False)
+    axes[0].legend(fontsize=7)
+    figure.supxlabel("period T (s)", fontsize=9)
+    figure.supylabel("PSA (g), 5 % damping", fontsize=9)
+    return FigureItem(
+        f"intensity-selection-{name}",
+        f"Experiment {name}: per stripe, the conditional spectrum's median and 16/84 % spectra (black, dashed) against the chosen, "
+        "scaled motions' (red: the exponential of the mean and of the mean ± the standard deviation of ln Sa), and the range of their scale factors.",
+        figure,
+    )
 
 
 def _ida_figure(name: str, store: xr.Dataset, setting: dict[str, Any]) -> FigureItem:

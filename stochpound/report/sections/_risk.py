@@ -36,7 +36,7 @@ from matplotlib.ticker import LogLocator, NullFormatter
 from stochpound.report.render import Block, FigureItem, Paragraph, Section, Table
 from stochpound.report.sections._facets import labels_text
 from stochpound.report.sections._stripe_motions import is_selected
-from stochpound.risk import StoreDemands, StoreRisk
+from stochpound.risk import StoreDemands, StoreRisk, rate_from_probability
 from stochpound.store import describe_measure
 
 
@@ -108,6 +108,7 @@ def risk_section(name: str, risk: StoreRisk, demands: StoreDemands | None = None
     """The "Risk" section of one store, from its risk chain and its demand hazard curves (:func:`~stochpound.risk.store_demands`)."""
     section = Section(f"Risk: experiment {name}", key=f"risk-{name}")
     section.add(Paragraph(headline_text(name, risk)))
+    section.add(Paragraph(design_summary_text(risk, demands)))
     section.add(Paragraph(_hazard_text(risk)))
     section.add(Table(f"risk-separation-{name}", f"Experiment {name}: risk-targeted separation g* per configuration and target, with its "
                       f"{_percent(risk.confidence)} BCa bootstrap interval (the motions resampled)", risk.separation_frame(),
@@ -119,7 +120,101 @@ def risk_section(name: str, risk: StoreRisk, demands: StoreDemands | None = None
         section.add(block)
     for block in _demand_blocks(name, risk, demands):
         section.add(block)
+    moat = moat_text(risk, demands)
+    if moat:
+        section.add(Paragraph(moat))
     return section
+
+
+def design_summary_text(risk: StoreRisk, demands: StoreDemands | None = None) -> str:
+    """The design summary: the governing limit state per target, the gap to design to, which code rules meet their level, and
+    what the answer rests on (hazard, scenario, structural model, suite), all from the chain's results and the store."""
+    wall = _wall_governs(risk, demands)
+    governing = "; ".join(
+        (f"the moat wall ({wall[t][0]:.3g} m clearance, reached once in {1 / wall[t][1]:.3g} yr)" if t in wall else "pounding between the buildings")
+        + f" for {risk.target_text(t)}" for t in risk.separation["target"].values)
+    rules = risk.rules_frame()
+    if rules.empty:
+        meets = f"The code rules were not evaluated ({risk.rules_note})."
+    else:
+        column = "meets, upper bound" if "meets, upper bound" in rules else "meets its level"
+        met = rules[column].groupby(level="rule", sort=False).all()
+        meets = (f"Code rules meeting their own design level as a target in every configuration and level ({column.replace('meets, ', '') if 'upper' in column else 'estimate'}): "
+                 f"{', '.join(met.index[met]) or 'none'}; not: {', '.join(met.index[~met]) or 'none'}.")
+    rests = "; ".join(f"{key}: {value}" for key, value in {"hazard": f"{risk.hazard.describe()} ({_source(risk)})", **risk.assumptions}.items())
+    return (f"Design summary. Governing limit state: {governing}. {design_value_text(risk)} {meets} The answer holds only for what it "
+            f"rests on; a change to any of these voids it: {rests}.")
+
+
+def _source(risk: StoreRisk) -> str:
+    return risk.hazard.source.splitlines()[0] if risk.hazard.source else "no provenance stated"
+
+
+def _wall_rates(risk: StoreRisk, demands: StoreDemands) -> list[tuple[float, float, float, float, dict[str, Any]]]:
+    """Per target and moat clearance: (target, clearance m, rate of reaching the wall in its worst configuration 1/yr,
+    the target's rate 1/yr, that configuration's position)."""
+    rows = []
+    for target in risk.separation["target"].values:
+        allowed = float(rate_from_probability(float(target), risk.years))
+        for clearance in demands.moat["level"].values:
+            maf = demands.moat["maf"].sel(level=clearance)
+            worst = maf.fillna(-1.0).argmax(...)
+            rows.append((float(target), float(clearance), float(maf[worst]), allowed, worst))
+    return rows
+
+
+def _wall_governs(risk: StoreRisk, demands: StoreDemands | None) -> dict[float, tuple[float, float]]:
+    """Per target the wall is reached more often than it allows: target → (clearance m, rate of reaching it 1/yr, worst configuration)."""
+    governs: dict[float, tuple[float, float]] = {}
+    if demands is None or demands.moat is None:
+        return governs
+    for target, clearance, wall, allowed, _ in _wall_rates(risk, demands):
+        if wall > allowed and wall > governs.get(target, (0.0, 0.0))[1]:
+            governs[target] = (clearance, wall)
+    return governs
+
+
+def design_value_text(risk: StoreRisk) -> str:
+    """The number to design to: per configuration and target, the upper bound of g* (stated as such), from :meth:`StoreRisk.design_frame`."""
+    frame = risk.design_frame()
+    config = risk.configuration_dims()
+    per = []
+    for labels, rows in (frame.groupby(config, sort=False) if config else [((), frame)]):
+        labels = labels if isinstance(labels, tuple) else (labels,)
+        values = "; ".join(f"{_gap_text(row.design)} for {risk.target_text(row.target)}" for row in rows.itertuples())
+        per.append(f"{labels_text(dict(zip(config, labels))) or 'the scene'}: {values}")
+    return (f"The gap to design to is the {frame['basis'].iloc[0]}, not g* itself (g* is a central estimate from "
+            f"{risk.motions} motions and meets its target only about half the time): " + ". ".join(per) + ".")
+
+
+def moat_text(risk: StoreRisk, demands: StoreDemands | None) -> str:
+    """Whether the wall-free D_TM exceeds the moat clearance at each design level, and whether reaching the wall is more
+    frequent than each target allows (the wall then governs that target); "" without a moat or a D_TM rule."""
+    if demands is None or demands.moat is None or risk.rules is None or "dtm" not in risk.rules["rule"].values:
+        return ""
+    dtm = risk.rules["gap"].sel(rule="dtm")
+    clearances = demands.moat["level"].values
+    sentences = []
+    for level in dtm["design_level"].values:
+        value = float(dtm.sel(design_level=level).max(skipna=True))
+        if not math.isfinite(value):
+            continue
+        exceeded = [c for c in clearances if value > c]
+        verdict = (f"exceeds the moat clearance{'s' if len(exceeded) > 1 else ''} {', '.join(f'{c:.3g} m' for c in exceeded)}: "
+                   "at that level the base reaches the wall, so the code's D_TM is not met by the moat"
+                   if exceeded else f"is within the moat clearance{'s' if len(clearances) > 1 else ''} "
+                   f"{', '.join(f'{c:.3g} m' for c in clearances)}")
+        sentences.append(f"The wall-free D_TM (suite-mean peak base displacement without the wall) at {100 * level:g} %/{risk.years:g} yr is "
+                         f"{value:.3g} m and {verdict}.")
+    for target, clearance, wall, allowed, worst in _wall_rates(risk, demands):
+        bounds = demands.moat.sel(level=clearance).isel(worst) if "return_period_lower" in demands.moat else None
+        interval = (f" [{float(bounds['return_period_lower']):.3g}, {float(bounds['return_period_upper']):.3g}]"
+                    if bounds is not None else "")
+        relation = ("more often than the target allows (once in {:.3g} yr): the wall, not the gap, governs this target"
+                    if wall > allowed else "less often than the target allows (once in {:.3g} yr): the wall does not govern this target")
+        sentences.append(f"The base reaches the {clearance:.3g} m moat wall once in {1 / wall:.3g}{interval} yr (worst configuration), "
+                         + relation.format(1 / allowed) + f" ({risk.target_text(target)}).")
+    return " ".join(sentences)
 
 
 def _hazard_text(risk: StoreRisk) -> str:
@@ -129,11 +224,13 @@ def _hazard_text(risk: StoreRisk) -> str:
     source = hz.source.splitlines()[0] if hz.source else ""
     fitted = ("fitted to the stripes' counts by maximum likelihood, from the contact-free runs by the gap identity" if risk.method == "stripes"
               else "of the motions' IDA capacities IM·g/D (log-moments), from one contact-free run per motion")
+    degenerate = risk.degenerate_text() or "Every fit is a lognormal (no degenerate step)."
     extrapolated = " The hazard was extrapolated beyond its table (as a power law) for some integrals." if hz.extrapolated else ""
     return (
         f"Hazard curve of {risk.measure} in {units}, {hz.describe()} ({source}); its 10 %/50 yr intensity is "
-        f"{levels[0.10]:.3g} and its 2 %/50 yr intensity {levels[0.02]:.3g} {units}. The fragility of every gap is the "
-        f"lognormal {fitted}; λ_P(g) = ∫ F(x; g) |dλ(x)|; the intervals resample the motions and refit the whole chain. Assumptions: Poisson "
+        f"{levels[0.10]:.3g} and its 2 %/50 yr intensity {levels[0.02]:.3g} {units}. The fragility at each gap is a "
+        f"lognormal {fitted}, where the data identify one. {degenerate} λ_P(g) = ∫ F(x; g) |dλ(x)|; the intervals resample the motions and "
+        "refit the whole chain. Assumptions: Poisson "
         "occurrence, record-to-record variability only (not the hazard's or the model's uncertainty), and "
         f"{'the motions chosen and scaled for each stripe' if is_selected(risk.setting) else 'a suite scaled to each intensity'} "
         f"standing for the site's motions of that intensity.{extrapolated}"
@@ -256,6 +353,10 @@ def _curves_figure(name: str, risk: StoreRisk) -> FigureItem:
                       f"{_percent(risk.confidence)} bootstrap band (shaded){points}, one panel per configuration.", figure)
 
 
+_RATE_FORMATS = {"once in (yr)": "{:.3g}", "once in, lower (yr)": "{:.3g}", "once in, upper (yr)": "{:.3g}", "P lower": "{:.3f}",
+                 "P upper": "{:.3f}"}
+
+
 def _measure_label(risk: StoreRisk) -> str:
     return f"{risk.measure} ({risk.setting['units']})"
 
@@ -276,12 +377,12 @@ def _rules_blocks(name: str, risk: StoreRisk) -> list[Block]:
         f"configurations, the return periods range from {shortest:.3g} to {longest:.3g} years."
     )
     if "dtm" not in rules["rule"].values:
-        text += " D_TM is not applied: the studied building has no sliding base in this store."
+        text += f" D_TM is not applied: {risk.dtm_note or 'the studied building has no sliding base in this store'}."
     table = Table(f"risk-rules-{name}", f"Experiment {name}: the code separation rules in risk terms: the gap at each contact, the "
-                  f"mean annual frequency λ_P of pounding at it with its {_percent(risk.confidence)} bootstrap interval, the return period "
-                  f"and the probability in {years:g} years", frame,
-                  formats={"λ_P (1/yr)": "{:.3g}", "λ_P lower": "{:.3g}", "λ_P upper": "{:.3g}", "once in (yr)": "{:.3g}",
-                           f"P in {years:g} yr": "{:.3f}", **{c: "{:.3f}" for c in frame.columns if str(c).startswith("gap")}})
+                  f"mean annual frequency λ_P of pounding at it, the return period and the probability in {years:g} years, each with its "
+                  f"{_percent(risk.confidence)} bootstrap interval, and the fragility's kind (a lognormal, or a degenerate step)", frame,
+                  formats={**_RATE_FORMATS, "λ_P (1/yr)": "{:.3g}", "λ_P lower": "{:.3g}", "λ_P upper": "{:.3g}", f"P in {years:g} yr": "{:.3f}",
+                           **{c: "{:.3f}" for c in frame.columns if str(c).startswith("gap")}})
     return [Paragraph(text), table]
 
 
@@ -309,14 +410,14 @@ def _demand_blocks(name: str, risk: StoreRisk, demands: StoreDemands | None) -> 
     if axes[0].get_legend_handles_labels()[1]:
         axes[0].legend(fontsize=5)
     blocks: list[Block] = [FigureItem(f"risk-demands-{name}", f"Experiment {name}: demand hazard curves (mean annual frequency of "
-                                      "exceeding each level, the lognormal fragility of every level fitted over the stripes' "
-                                      "contact-free runs and integrated with the hazard, made non-increasing along the level), per "
+                                      "exceeding each level, a lognormal fragility fitted at every level over the stripes' "
+                                      "contact-free runs (a step where the runs identify no lognormal) and integrated with the hazard, made non-increasing along the level), per "
                                       "configuration.", figure)]
     if demands.moat is not None:
         blocks.append(Table(f"risk-moat-{name}", f"Experiment {name}: moat-wall contact as a limit state: the mean annual frequency with "
                             "which the studied building's base reaches the moat wall's clearance (peak base displacement ≥ clearance; "
                             "before the first wall impact a run with the wall equals the run without), with its "
-                            f"{_percent(risk.confidence)} bootstrap interval", demands.moat_frame(),
-                            formats={"λ (1/yr)": "{:.3g}", "λ lower": "{:.3g}", "λ upper": "{:.3g}", "once in (yr)": "{:.3g}",
+                            f"{_percent(risk.confidence)} bootstrap interval (of the return period and the probability too)", demands.moat_frame(),
+                            formats={**_RATE_FORMATS, "λ (1/yr)": "{:.3g}", "λ lower": "{:.3g}", "λ upper": "{:.3g}",
                                      f"P in {demands.years:g} yr": "{:.3f}"}))
     return blocks

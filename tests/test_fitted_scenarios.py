@@ -1,0 +1,130 @@
+"""Scenarios fitted to a site's own hazard curves (stochpound.motions.fit_scenarios) and [site] scenario = "fitted"."""
+
+from __future__ import annotations
+
+import tomllib
+
+import numpy as np
+import pytest
+
+from stochpound._errors import SiteError
+from stochpound.analysis import HazardCurve, stripe_rate_weights
+from stochpound.experiment._spec import ExperimentError, parse_experiment
+from tests.helpers import SITE_SCENE
+from stochpound.motions import TARGET_TOLERANCE, conditional_spectrum, fit_levels, fit_scenarios, misses_target, recomputed_hazard
+
+KNOWN = {"magnitude": 7.0, "distance_km": 10.0, "vs30": 400.0, "mechanism": "reverse"}
+IM_STAR = HazardCurve.power_law(2.0e-4, 2.2)  # PSA(1 s) in g
+
+
+def _fit(levels: np.ndarray, others: list, **change) -> list[dict]:
+    fine = fit_levels(levels)
+    arguments = {"measure": "psa", "period": 1.0, "levels": levels, "fine_levels": fine, "fine_rates": stripe_rate_weights(fine, IM_STAR),
+                 "others": others, "vs30": 400.0, "mechanism": "reverse", **change}
+    return fit_scenarios(**arguments)
+
+
+def _synthetic_site(scenario: dict) -> list[tuple[float | None, np.ndarray, np.ndarray]]:
+    """The site's PGA and PSA(2 s) curves if the scenario caused every level of PSA(1 s): the integral over 200 fine bins."""
+    fine = np.geomspace(0.02, 6.0, 200)
+    weights = stripe_rate_weights(fine, IM_STAR)
+    im = np.geomspace(0.05, 3.0, 30)
+    shell = [(None, im, np.ones(im.size)), (2.0, im, np.ones(im.size))]
+    rates = recomputed_hazard("psa", 1.0, fine, weights, [scenario] * fine.size, shell)
+    return [(node, im, rate) for (node, _, _), rate in zip(shell, rates)]
+
+
+def test_the_fit_reproduces_a_synthetic_site_built_from_a_known_scenario() -> None:
+    others = _synthetic_site(KNOWN)
+    levels = IM_STAR.intensity_at(1.0 / np.array([72.0, 224.0, 475.0, 975.0, 2475.0, 5000.0]))
+    fitted = _fit(levels, others)
+    assert len(fitted) == levels.size and all(s["vs30"] == 400.0 and s["mechanism"] == "reverse" for s in fitted)
+    assert all(s == fitted[0] for s in fitted)  # one scenario for every level
+    fine = np.geomspace(0.02, 6.0, 200)  # the fitted scenario's hazard, integrated as the synthetic site's
+    recomputed = recomputed_hazard("psa", 1.0, fine, stripe_rate_weights(fine, IM_STAR), [fitted[0]] * fine.size, others)
+    wrong = _synthetic_site({**KNOWN, "magnitude": 5.5, "distance_km": 80.0})
+    for (_, im, site), fit, (_, _, bad) in zip(others, recomputed, wrong):
+        inside = (site <= IM_STAR(levels[:1])[0]) & (site >= IM_STAR(levels[-1:])[0])  # the rates the stripes represent
+        assert inside.sum() >= 5
+        assert np.all(np.abs(np.log(fit[inside] / site[inside])) < 0.05)  # the fit integrates 60 levels over x_1/5 - 5 x_top, the site 200 over 0.02-6 g
+        assert np.max(np.abs(np.log(bad[inside] / site[inside]))) > 0.5  # the check can fail: a wrong scenario misses the curves
+    # what matters downstream: the conditional spectrum at the other periods, as the known scenario's
+    for level, scenario in zip(levels, fitted):
+        got = conditional_spectrum("psa", 1.0, level=level, periods=[0.2, 2.0], **scenario)
+        known = conditional_spectrum("psa", 1.0, level=level, periods=[0.2, 2.0], **KNOWN)
+        assert np.allclose(np.log(got["median"]), np.log(known["median"]), atol=0.15)
+
+
+def test_the_fit_is_deterministic() -> None:
+    others = _synthetic_site(KNOWN)
+    levels = IM_STAR.intensity_at(1.0 / np.array([100.0, 1000.0, 3000.0]))
+    assert _fit(levels, others) == _fit(levels, others)
+
+
+@pytest.mark.parametrize(
+    "change, field",
+    [
+        ({"measure": "pgv"}, "measure:"),
+        ({"levels": [0.3, 0.2]}, "levels:"),
+        ({"others": []}, "others:"),
+        ({"fine_levels": np.geomspace(0.25, 1.0, 60)}, "fine_levels:"),
+        ({"fine_rates": [1e-3]}, "fine_levels:"),
+        ({"vs30": 50.0}, "vs30:"),
+        ({"mechanism": "oblique"}, "mechanism:"),
+    ],
+)
+def test_bad_input_to_the_fit_is_one_line_naming_the_field(change: dict, field: str) -> None:
+    with pytest.raises(SiteError) as error:
+        _fit(**{"levels": np.array([0.2, 0.3]), "others": _synthetic_site(KNOWN), **change})
+    assert str(error.value).startswith(field) and "\n" not in str(error.value)
+
+
+
+
+def _text(intensity: str, site: str) -> str:
+    return f'[experiment]\nname = "fitted"\n{SITE_SCENE}\n[grid]\ngap = ["inf"]\n[[records]]\nsuite = "fema_p695_far_field"\n[intensity]\n{intensity}\n{site}\n'
+
+
+CURVES = '["fox_plaza_los_angeles_pga", "fox_plaza_los_angeles_sa1p0s", "fox_plaza_los_angeles_sa2p0s"]'
+FITTED_SELECTION = 'measure = "psa"\nperiod = 1.0\nlevels = [0.9, 0.4]\nselection = "conditional_spectrum"\nmotions = 4\nmax_scale_factor = 5.0\n'
+FITTED_SITE = f'[site]\nscenario = "fitted"\ncurves = {CURVES}\nvs30 = 400.0\nmechanism = "reverse"\n'
+
+
+def test_a_fitted_site_stores_the_fitted_scenario_of_every_level(tmp_path) -> None:
+    definition = parse_experiment(tomllib.loads(_text(FITTED_SELECTION, FITTED_SITE)), tmp_path)
+    scenarios = definition["intensity"]["site"]
+    assert "fitted to the site's hazard curves fox_plaza_los_angeles_pga" in definition["intensity"]["note"]
+    hazard = HazardCurve.bundled("fox_plaza_los_angeles_sa1p0s")
+    others = [(None, HazardCurve.bundled("fox_plaza_los_angeles_pga").im, HazardCurve.bundled("fox_plaza_los_angeles_pga").rate),
+              (2.0, HazardCurve.bundled("fox_plaza_los_angeles_sa2p0s").im, HazardCurve.bundled("fox_plaza_los_angeles_sa2p0s").rate)]
+    levels = np.array([0.4, 0.9])
+    fine = fit_levels(levels, hazard.support[1])
+    assert scenarios == fit_scenarios("psa", 1.0, levels, fine, stripe_rate_weights(fine, hazard), others, 400.0, "reverse")
+
+
+@pytest.mark.parametrize(
+    "site, field",
+    [
+        (FITTED_SITE.replace('"fitted"', '"disaggregated"'), "site.scenario:"),
+        (FITTED_SITE.replace(CURVES, '["fox_plaza_los_angeles_pga", "nowhere"]'), "site.curves:"),
+        (FITTED_SITE.replace(CURVES, '["fox_plaza_los_angeles_pga", "fox_plaza_los_angeles_sa2p0s"]'), "site.curves:"),
+        (FITTED_SITE.replace(CURVES, '["fox_plaza_los_angeles_sa1p0s"]'), "site.curves:"),
+        (FITTED_SITE + "magnitude = 7.0\n", "site.magnitude:"),
+        (FITTED_SITE.replace("vs30 = 400.0\n", ""), "site.vs30:"),
+        (FITTED_SITE.replace('mechanism = "reverse"', 'mechanism = ["reverse", "reverse"]'), "site.mechanism:"),
+        ('[site]\ncurves = ["fox_plaza_los_angeles_pga"]\nvs30 = 400.0\nmagnitude = 7.0\ndistance_km = 10.0\nmechanism = "reverse"\n', "site.curves:"),
+    ],
+)
+def test_bad_fitted_site_is_one_line_naming_the_field(tmp_path, site: str, field: str) -> None:
+    with pytest.raises(ExperimentError) as error:
+        parse_experiment(tomllib.loads(_text(FITTED_SELECTION, site)), tmp_path)
+    assert str(error.value).startswith(field) and "\n" not in str(error.value)
+
+
+def test_a_selection_misses_its_target_where_its_mean_or_std_of_ln_sa_is_off_by_more_than_the_tolerance() -> None:
+    median, sigma = np.array([[0.5, 0.3, 0.1]] * 3), np.array([[0.0, 0.4, 0.5]] * 3)
+    mean_ln, std_ln = np.log(median), sigma.copy()
+    mean_ln[1, 2] += TARGET_TOLERANCE * 1.1  # stripe 1: the mean off at one period
+    std_ln[2, 1] -= TARGET_TOLERANCE * 1.1  # stripe 2: the std off
+    mean_ln[0] += TARGET_TOLERANCE * 0.9  # stripe 0: within
+    assert misses_target(mean_ln, std_ln, median, sigma).tolist() == [False, True, True]

@@ -1,0 +1,127 @@
+"""Risk answers an engineer can sign (docs/risk.md): the intervals of return periods and probabilities, the gap to design to,
+degenerate fits named as steps with their effect on λ, the wall-free D_TM against the moat, and the false forms that must not return.
+
+Each check compares with an independent computation (the Poisson formulas, the hazard table itself, a hand-made chain).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pandas as pd
+import xarray as xr
+
+from stochpound.report.sections._risk import design_summary_text, design_value_text, moat_text
+from stochpound.risk import HazardCurve, StoreDemands, StoreRisk, degenerate_text, mean_annual_frequency, rate_intervals
+from stochpound.risk._fragility import ALWAYS, FIT, NEVER, Fragility
+
+HAZARD = HazardCurve([0.05, 0.2, 0.5, 1.0, 2.0], [0.0333, 8e-3, 2e-3, 5e-4, 8e-5], units="g", measure="PGA")
+
+
+def test_return_period_and_probability_intervals_map_the_maf_interval():
+    maf = xr.DataArray([1e-3, 4e-4], dims="gap")
+    result = rate_intervals(xr.Dataset({"maf": maf, "maf_lower": maf / 2, "maf_upper": maf * 3}), years=50.0)
+    np.testing.assert_allclose(result["return_period_lower"], [1 / 3e-3, 1 / 1.2e-3])  # the shortest period: the highest rate
+    np.testing.assert_allclose(result["return_period_upper"], [2000.0, 5000.0])
+    np.testing.assert_allclose(result["probability_lower"], [1 - math.exp(-0.5e-3 * 50), 1 - math.exp(-2e-4 * 50)])
+    np.testing.assert_allclose(result["probability_upper"], [1 - math.exp(-3e-3 * 50), 1 - math.exp(-1.2e-3 * 50)])
+    assert "return_period_lower" not in rate_intervals(xr.Dataset({"maf": maf}), years=50.0)  # no interval invented without one
+
+
+def test_a_degenerate_fit_is_named_a_step_with_the_rate_it_actually_gives():
+    status = np.array([FIT, ALWAYS, ALWAYS, NEVER])
+    text = degenerate_text(status, HAZARD)
+    plateau = mean_annual_frequency(Fragility(0.0, 0.0, ALWAYS, "stripes"), HAZARD)  # what the chain integrates for 'always'
+    assert math.isclose(plateau, 0.0333)  # the hazard's rate at the lowest intensity of its table
+    assert f"{plateau:.3g} /yr" in text and "2 of 4 gaps: a step 'always'" in text and "1 of 4 gaps: a step 'never'" in text
+    assert "plateau set by the hazard table" in text
+    assert "lognormal fitted" not in text and "the lognormal" not in text
+    assert degenerate_text(np.array([FIT, FIT]), HAZARD) == ""
+
+
+def _risk(rules: xr.Dataset | None = None) -> StoreRisk:
+    """A hand-made chain: g* 0.20 m [0.15, 0.31] for 10 %/50 yr and 0.40 m [0.30, 0.62] for 2 %/50 yr, one configuration."""
+    target = xr.DataArray([0.10, 0.02], dims="target", name="target")
+    separation = xr.Dataset({"separation": ("target", [0.20, 0.40]), "lower": ("target", [0.15, 0.30]), "upper": ("target", [0.31, 0.62])},
+                            coords={"target": target})
+    fragility = xr.Dataset({"status": ("gap", np.array([FIT, ALWAYS], dtype=np.int8))}, coords={"gap": [0.1, 0.5]})
+    return StoreRisk(fragility, xr.Dataset(), separation, rules, "", HAZARD, motions=22, method="stripes", years=50.0, confidence=0.95)
+
+
+def test_the_gap_to_design_to_is_the_upper_bound_of_g_star_stated_as_such():
+    risk = _risk()
+    frame = risk.design_frame()
+    assert list(frame["design"]) == [0.31, 0.62]
+    assert set(frame["basis"]) == {"97.5 % one-sided upper bound of g*"}
+    text = design_value_text(risk)
+    assert "0.310 m for 10 % in 50 yr; 0.620 m for 2 % in 50 yr" in text and "upper bound of g*, not g* itself" in text
+    unbounded = _risk()
+    unbounded.separation = unbounded.separation.drop_vars(["lower", "upper"])
+    assert list(unbounded.design_frame()["design"]) == [0.20, 0.40] and "no bootstrap" in design_value_text(unbounded)
+
+
+def test_the_wall_free_d_tm_is_compared_with_the_moat_and_the_wall_governs_a_target_it_is_hit_more_often_than():
+    rules = xr.Dataset({"gap": (("design_level", "rule"), [[0.45, 0.1], [0.92, 0.2]])},
+                       coords={"design_level": [0.10, 0.02], "rule": ["dtm", "abs"]})
+    moat = xr.Dataset({"maf": (("mu", "level"), [[1 / 918], [1 / 2000]])}, coords={"level": [0.60], "mu": [0.05, 0.12]})
+    moat = rate_intervals(moat.assign(maf_lower=moat["maf"] / 2, maf_upper=moat["maf"] * 2), 50.0)
+    text = moat_text(_risk(rules), StoreDemands({}, {}, moat))
+    assert "at 10 %/50 yr is 0.45 m and is within the moat clearance 0.6 m" in text
+    assert "at 2 %/50 yr is 0.92 m and exceeds the moat clearance 0.6 m" in text
+    # 1/918 /yr against 10 %/50 yr (once in 475 yr) and 2 %/50 yr (once in 2475 yr): governs only the rarer target
+    assert "once in 918 [459, 1.84e+03] yr (worst configuration), less often than the target allows (once in 475 yr): the wall does not govern" in text
+    assert "once in 918 [459, 1.84e+03] yr (worst configuration), more often than the target allows (once in 2.47e+03 yr): the wall, not the gap, governs" in text
+    summary = design_summary_text(_risk(), StoreDemands({}, {}, moat))
+    assert ("Governing limit state: pounding between the buildings for 10 % in 50 yr; the moat wall (0.6 m clearance, reached once in "
+            "918 yr) for 2 % in 50 yr.") in summary
+    assert "Governing limit state: pounding between the buildings for 10 % in 50 yr; pounding between the buildings for 2 %" in \
+        design_summary_text(_risk(), None)
+    single = StoreDemands({}, {}, moat.isel(mu=0, drop=True)).moat_frame()  # one configuration: a plain index
+    assert single.index.name == "moat clearance (m)" and math.isclose(single["once in, upper (yr)"].iloc[0], 2 * 918)
+    assert moat_text(_risk(rules), None) == "" and moat_text(_risk(rules.sel(rule=["abs"])), StoreDemands({}, {}, moat)) == ""
+
+
+def test_the_suite_mean_rules_are_not_named_as_the_codes_own():
+    from stochpound.risk._store_risk import RULE_NAMES
+
+    for key in ("srss", "srss_reduced", "dtm"):
+        assert "suite-mean" in RULE_NAMES[key], RULE_NAMES[key]
+    assert "SRSS (ASCE 7 δ_MT)" not in RULE_NAMES.values() and "0.7 SRSS (Eurocode 8)" not in RULE_NAMES.values()
+
+
+def test_the_rules_table_gives_each_return_period_with_its_interval_and_each_fit_its_kind():
+    dims = ("design_level", "rule", "contact")
+    shape = (1, 1, 1)
+    rules = xr.Dataset({"gap": (dims, np.full(shape, 0.3)), "status": (("design_level", "rule"), np.array([[ALWAYS]], dtype=np.int8))},
+                       coords={"design_level": [0.02], "rule": ["srss"], "contact": [0], "code_intensity": ("design_level", [0.8]),
+                               "stripe_intensity": ("design_level", [0.8])})
+    maf = xr.DataArray([[1e-3]], dims=dims[:2])
+    rules = rate_intervals(rules.assign(maf=maf, maf_lower=maf / 2, maf_upper=maf * 2, return_period=1 / maf,
+                                        probability=1 - np.exp(-50 * maf)), 50.0)
+    frame = _risk(rules).rules_frame()
+    row = frame.iloc[0]
+    assert (row["once in, lower (yr)"], row["once in (yr)"], row["once in, upper (yr)"]) == (500.0, 1000.0, 2000.0)
+    assert row["P lower"] < row["P in 50 yr"] < row["P upper"]
+    assert row["fit"] == "step: always"
+    # 2 %/50 yr allows −ln(0.98)/50 = 4.04e-4 /yr; λ_P = 1e-3 does not meet it
+    assert not row["meets its level"] and not row["meets, upper bound"]
+    met = _risk(rules.assign(maf=rules["maf"] / 10, maf_lower=rules["maf_lower"] / 10, maf_upper=rules["maf_upper"] / 10)).rules_frame().iloc[0]
+    assert met["meets its level"] and met["meets, upper bound"]  # 1e-4 and 2e-4 /yr
+    assert isinstance(frame, pd.DataFrame) and "SRSS of suite-mean peaks" in frame.index.get_level_values("rule")[0]
+
+
+WALLS = "".join(f'\n[[scene.wall]]\nbuilding = "B1"\nside = "{side}"\nlevel = 0\ngap = 0.1\nstiffness = 3283500000.0\nrestitution = 0.5\n'
+                for side in ("left", "right"))
+
+
+def test_d_tm_is_not_taken_from_runs_a_moat_wall_capped(tmp_path):
+    from stochpound import open_store
+    from stochpound.risk import store_demands, store_risk
+    from tests.helpers import ISOLATED, risk_text, run_in_process
+
+    text = risk_text(ISOLATED + WALLS, "gap = [0.05, inf]", 'measure = "psa"\nperiod = 1.0\nlevels = [0.3, 0.8, 1.5]')
+    store = open_store(run_in_process(tmp_path, "capped", text))  # walls in every run: no wall-free case
+    risk = store_risk(store, bootstrap=0)
+    assert "dtm" not in risk.rules["rule"].values and risk.dtm_note.startswith("the store has no wall-free runs")
+    assert moat_text(risk, store_demands(store, bootstrap=0)) == ""
