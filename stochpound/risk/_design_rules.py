@@ -133,12 +133,9 @@ def design_rules_risk(store: xr.Dataset, hz: HazardCurve, design: Mapping[str, A
 def _configuration_gaps(store: xr.Dataset, closure: xr.DataArray, design: Mapping[str, Any], studied: str | None) -> xr.DataArray:
     """The rules' gaps (m) over ``rule``, the configurations of ``closure`` and ``contact``, from each configuration's scene."""
     configs = [dim for dim in closure.dims if dim not in _RECORD_DIMS]
-    fixed = {dim: math.inf for dim in store.pound.gap_dims}
-    fixed.update({dim: store[dim].values[0] for dim in ("intensity", "record", "realization") if dim in store.dims})
     per_config = {}
     for labels in itertools.product(*(closure[dim].values for dim in configs)):
-        where = dict(zip(configs, labels))
-        per_config[labels] = design_separations(store.pound.scene(**fixed, **where), design, studied)
+        per_config[labels] = design_separations(_store.configuration_scene(store, dict(zip(configs, labels))), design, studied)
     rules = list(dict.fromkeys(rule for gaps in per_config.values() for rule in gaps))
     contacts = closure.sizes["contact"]
     values = np.full((len(rules), *(closure.sizes[dim] for dim in configs), contacts), np.nan)
