@@ -1,5 +1,7 @@
 """Lognormal fragility fits: stripes by binomial MLE, IDA by log-moments (censored MLE), every gap at once, bootstrap over motions."""
 
+import warnings
+
 import numpy as np
 import pytest
 import xarray as xr
@@ -206,3 +208,15 @@ def test_the_fitted_curve_has_a_band_around_it_at_every_intensity():
     assert np.all(band.lower < band.upper)
     with pytest.raises(ValueError, match="^fragility"):
         fragility_band(stripe_fragility(events, bootstrap=0), [0.5])
+
+
+def test_flat_counts_in_a_batch_raise_no_overflow_and_leave_the_other_fits_alone():
+    # nearly every run pounds at every stripe: the probit slope ends at or below 0, where exp(-a/b) overflowed
+    levels, runs = [0.2, 0.4, 0.6], [20, 20, 20]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        theta, beta, status = stripe_mle(levels, [[19, 19, 19], [20, 19, 20], [1, 8, 14]], runs)
+    assert status.tolist() == [DECREASING, DECREASING, FIT]
+    assert np.isnan(theta[:2]).all() and np.isnan(beta[:2]).all()
+    alone = stripe_mle(levels, [1, 8, 14], runs)
+    assert (theta[2], beta[2]) == (pytest.approx(float(alone[0]), rel=1e-12), pytest.approx(float(alone[1]), rel=1e-12))

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+import xarray as xr
 from scipy.stats import linregress
 
 from stochpound import open_store
@@ -75,3 +76,14 @@ def test_risk_cli_names_the_most_efficient_measure_the_sites_hazard_has(fixed_st
     best = most_efficient(efficiency, names).item()
     label = "PGA" if best == "PGA" else best.split(", hazard ")[1].rstrip(")") + ")"
     assert f"most efficient the site's hazard has: {label} (" in result.output
+
+
+def test_a_configuration_s_best_measure_is_never_another_configuration_s_structure_period() -> None:
+    from stochpound.cli._measure_choice import _of_configuration
+
+    structure = {"B1 first mode": 0.3, "B2 first mode (neighbour=flexible)": 0.8, "B2 first mode (neighbour=stiff)": 0.2}
+    measures = ["PGA", "PSA(0.3 s, B1 first mode)", "PSA(0.8 s, B2 first mode (neighbour=flexible))", "PSA(0.2 s, B2 first mode (neighbour=stiff))"]
+    for neighbour, other in (("stiff", "flexible"), ("flexible", "stiff")):
+        row = xr.DataArray(np.zeros(4), dims="measure", coords={"measure": measures, "neighbour": neighbour})
+        kept = [m for m in measures if _of_configuration(m, structure, row)]
+        assert kept == [m for m in measures if f"neighbour={other}" not in m]

@@ -167,6 +167,27 @@ def test_code_rules_in_risk_terms_apply_the_rules_to_the_suite_means_at_the_code
     assert len(table) == 2 * 5 * 2
 
 
+def test_code_rules_on_a_conditional_spectrum_store_average_only_each_stripe_s_chosen_motions():
+    # a CS store: a pool of 12 motions, 8 chosen per stripe, the other 4 NaN (never ran at that stripe)
+    demands, isolator = contact_demands_at_stripes()
+    rng = np.random.default_rng(11)
+    chosen = np.array([np.isin(np.arange(12), rng.choice(12, 8, replace=False)) for _ in range(demands.sizes["intensity"])])
+    mask = xr.DataArray(chosen, dims=("intensity", "record"))
+    demands, isolator = demands.where(mask), isolator.where(mask)
+    hz = HazardCurve.power_law_through((0.4, rate_from_probability(0.10)), (0.8, rate_from_probability(0.02)))
+    mce = code_rules_risk(demands, hz, isolator_displacement=isolator, bootstrap=0).sel(design_level=0.02)
+    picked = chosen[3]  # the stripe at 0.8
+    at_stripe = demands.sel(intensity=0.8).isel(record=np.flatnonzero(picked))
+    rules = separation_rules(at_stripe.mean("record").drop_vars("gap"))
+    assert mce.gap.sel(rule="srss").values == pytest.approx(rules.sel(rule="srss").values)
+    assert mce.gap.sel(rule="dtm").values == pytest.approx(float(isolator.sel(intensity=0.8)[picked].mean()))
+    events = ((demands.peak_closure - rules.sel(rule="srss")).max("contact", skipna=False) >= 0).astype(float).where(mask)
+    expected = mean_annual_frequency(stripe_fragility(events.drop_vars("gap"), bootstrap=0), hz)
+    assert float(mce.maf.sel(rule="srss")) == pytest.approx(float(expected))
+    with pytest.raises(ValueError, match="^record: the codes take the mean over at least 7 motions, got 6"):
+        code_rules_risk(contact_demands_at_stripes()[0].where(xr.DataArray(np.arange(12) < 6, dims="record")), hz)
+
+
 def test_code_rules_need_seven_motions_and_the_demands():
     demands, _ = contact_demands_at_stripes(records=5)
     hz = HazardCurve.power_law(2e-4, 2.4)

@@ -46,8 +46,25 @@ def efficient_measure_lines(store: Any, hazard: str | None) -> list[str]:
         where = ", ".join(f"{d}={row[d].item()}" for d in configurations) or "all runs"
         hazard_betas = {label: float(row.sel(measure=name)) for label, name in names.items()}
         best = min(hazard_betas, key=lambda label: np.inf if np.isnan(hazard_betas[label]) else hazard_betas[label]) if hazard_betas else None
-        overall = str(row["measure"].values[int(np.argmin(np.nan_to_num(row.values, nan=np.inf)))])
+        own = row.sel(measure=[m for m in row["measure"].values if _of_configuration(str(m), structure, row)])
+        overall = str(own["measure"].values[int(np.argmin(np.nan_to_num(own.values, nan=np.inf)))])
         given = "; ".join(f"{label} {value:.3f}" for label, value in hazard_betas.items())
         choice = f"most efficient the site's hazard has: {best} ({given})" if best else "the site's hazard is in no candidate measure"
-        lines.append(f"  {where}: {choice}; of all candidates: {overall} ({float(np.nanmin(row.values)):.3f})")
+        lines.append(f"  {where}: {choice}; of all candidates: {overall} ({float(np.nanmin(own.values)):.3f})")
     return lines
+
+
+def _of_configuration(measure: str, structure: dict[str, float], row: Any) -> bool:
+    """Whether a candidate measure belongs to the configuration ``row``: a structure period named for other variant labels does not.
+
+    :func:`~stochpound.experiment.periods_of_interest` names a period that
+    differs between grid points ``"B2 first mode (neighbour=stiff)"``; the
+    measure at the other configuration's period is not this one's.
+    """
+    for name in structure:
+        match = re.fullmatch(r".* \(([^()]*=[^()]*)\)", name)
+        if match is None or not measure.endswith(f", {name})"):
+            continue
+        labels = dict(item.split("=", 1) for item in match.group(1).split(", "))
+        return all(str(row[d].item()) == value for d, value in labels.items() if d in row.coords)
+    return True

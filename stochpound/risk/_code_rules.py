@@ -91,8 +91,10 @@ def code_rules_risk(demands: xr.Dataset, hz: HazardCurve, design_levels: Sequenc
         if dim not in demands["peak_closure"].dims:
             raise ValueError(f"demands: peak_closure has no dimension {dim!r}")
     motions = demands.sizes[record_dim]
-    if motions < MINIMUM_MOTIONS:
-        raise ValueError(f"{record_dim}: the codes take the mean over at least {MINIMUM_MOTIONS} motions, got {motions}")
+    ran = demands["peak_closure"].notnull().any([dim for dim in demands["peak_closure"].dims if dim not in (intensity_dim, record_dim)])
+    fewest = int(ran.sum(record_dim).min())  # a conditional-spectrum stripe runs only its chosen motions of the pool
+    if fewest < MINIMUM_MOTIONS:
+        raise ValueError(f"{record_dim}: the codes take the mean over at least {MINIMUM_MOTIONS} motions, got {fewest}")
     if "gap" in demands.coords and "gap" not in demands.dims:  # a store's contact-free selection
         demands = demands.drop_vars("gap")
     levels = np.asarray(demands[intensity_dim].values, dtype=float)
@@ -147,12 +149,12 @@ class _RuleChain:
     def _block(self, stripe: int, weights: xr.DataArray) -> xr.Dataset:
         record, intensity = self.record_dim, self.intensity_dim
         at_stripe = self.demands.isel({intensity: stripe}, drop=True)
-        means = (at_stripe * weights).sum(record) / weights.sum(record)
+        means = _suite_mean(at_stripe, weights, record)
         gaps = separation_rules(means, self.cqc, self.reduction)
         if self.isolator is not None:
             isolator = self.isolator.isel({intensity: stripe}, drop=True)
             isolator = isolator.drop_vars([name for name in isolator.coords if name == "gap"])
-            dtm = (isolator * weights).sum(record) / weights.sum(record)
+            dtm = _suite_mean(isolator, weights, record)
             gaps = xr.concat([gaps, dtm.broadcast_like(gaps.isel(rule=0, drop=True)).expand_dims(rule=["dtm"])], dim="rule")
         excess = (self.demands["peak_closure"] - gaps).max(self.contact_dim, skipna=False)
         valid = excess.notnull()
@@ -170,3 +172,8 @@ class _RuleChain:
             },
             coords=coords,
         )
+
+
+def _suite_mean(values: xr.Dataset | xr.DataArray, weights: xr.DataArray, record: str) -> xr.Dataset | xr.DataArray:
+    """Weighted mean over the motions that ran (a conditional-spectrum stripe leaves the pool's other motions NaN)."""
+    return (values * weights).sum(record) / (values.notnull() * weights).sum(record)

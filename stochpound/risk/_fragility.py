@@ -23,7 +23,8 @@ so in its ``status`` (``STATUS``), with a step (β = 0) at θ:
   (complete or quasi-complete separation: the likelihood grows without
   bound as β → 0); θ is the geometric midpoint between the highest level
   with a non-exceeding run and the lowest level with an exceeding one;
-* ``decreasing``: the fitted slope is not positive (θ, β NaN);
+* ``decreasing``: the fitted slope is not positive, or so near 0 that the
+  median lies beyond floating-point range (a flat fit; θ, β NaN);
 * ``empty``: no runs (θ, β NaN).
 """
 
@@ -41,6 +42,7 @@ FIT, NEVER, ALWAYS, SEPARATED, DECREASING, EMPTY = range(len(STATUS))
 
 _ITERATIONS = 100
 _TOLERANCE = 1e-10
+_LOG_LARGEST = float(np.log(np.finfo(float).max))
 
 
 @dataclass(frozen=True)
@@ -152,10 +154,12 @@ def stripe_mle(levels: ArrayLike, exceeded: ArrayLike, runs: ArrayLike) -> tuple
     u = np.log(x)
     status, step = _stripe_status(u, k, n)
     a, b = _probit_fisher_scoring(u, k, n, status == FIT)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        theta = np.where(b > 0.0, np.exp(-a / b), np.nan)
-        beta = np.where(b > 0.0, 1.0 / b, np.nan)
-    status = np.where((status == FIT) & ~(b > 0.0), DECREASING, status)
+    log_theta = np.divide(-a, b, out=np.full(np.shape(b), np.nan), where=b > 0.0)
+    # θ = exp(−a/b) only for a rising slope whose median is a float: a flat fit (b → 0) has no median to speak of
+    rising = (b > 0.0) & (np.abs(log_theta) < _LOG_LARGEST)
+    theta = np.exp(log_theta, out=np.full(np.shape(b), np.nan), where=rising)
+    beta = np.divide(1.0, b, out=np.full(np.shape(b), np.nan), where=rising)
+    status = np.where((status == FIT) & ~rising, DECREASING, status)
     return _degenerate(theta, beta, status, step)
 
 

@@ -27,6 +27,7 @@ from stochpound.model.contact import effective_mass
 from stochpound.model.modal_solution import modal_properties
 from stochpound.motions.records import load_record, registry_entries
 from stochpound.report.render import Paragraph, Table
+from stochpound.report.sections._stripe_motions import stripe_motions_text
 from stochpound.motions.records import is_suite_member
 from stochpound.model.scene import Building, Contact, Scene
 from stochpound.model.wall import Wall
@@ -356,7 +357,7 @@ def grid_paragraph(definition: StoreDefinition) -> Paragraph:
             axes.append(f"{dim.name} ∈ {{{numbers(dim.values)}}} m ({definition.definition.gap_axis(dim.name).targets})")
         elif dim.kind == "intensity":
             setting = definition.definition.intensity
-            axes.append(f"intensity ∈ {{{numbers(dim.values)}}} {setting['units']} ({describe_measure(setting)}, every motion scaled to every level)")
+            axes.append(f"intensity ∈ {{{numbers(dim.values)}}} {setting['units']} ({describe_measure(setting)}; {stripe_motions_text(definition.store)})")
         else:
             axes.append(f"μ ∈ {{{numbers(dim.values)}}} for {definition.mu_buildings_text} (∞: fixed base)")
     store = definition.store

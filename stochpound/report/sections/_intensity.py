@@ -33,6 +33,7 @@ from matplotlib.figure import Figure
 from stochpound.analysis.kernels import clopper_pearson
 from stochpound.experiment import describe_measure
 from stochpound.report.render import FigureItem, Paragraph, Section, Table
+from stochpound.report.sections._stripe_motions import stripe_motions_text
 from stochpound.experiment import is_gap_axis
 from stochpound.motions import TARGET_TOLERANCE
 from stochpound.risk import (
@@ -84,10 +85,11 @@ def method_text(store: xr.Dataset, setting: dict[str, Any]) -> str:
     levels = ", ".join(f"{level:g}" for level in setting["levels"])
     text = (
         f"Intensity measure {describe_measure(setting)}, in {setting['units']}. Method requested: {setting['method']}; ran: "
-        f"{setting['ran']} ({setting['note']}). {store.sizes['record']} motions"
+        f"{setting['ran']} ({setting['note']})."
     )
     if setting["ran"] == "stripes":
-        return text + f", each scaled to the levels {levels} {setting['units']} (its scale factor is the level over its own measure)."
+        return text + f" Levels {levels} {setting['units']}: {stripe_motions_text(store)} (a scale factor is the level over the motion's own measure)."
+    text += f" {store.sizes['record']} motions"
     return text + ": each run once without contacts; a motion whose contacts close by D at scale 1 first pounds at gap g at the intensity IM·g/D."
 
 
@@ -118,7 +120,7 @@ def _spectra(name: str, store: xr.Dataset, setting: dict[str, Any]) -> FigureIte
     ax = figure.subplots()
     unscaled = psa.isel(intensity=0) if "intensity" in psa.dims else psa
     rows = unscaled.stack(motion=("record", "realization")).transpose("motion", ...).values / G
-    mask = (done.isel(intensity=0) if "intensity" in done.dims else done).stack(motion=("record", "realization")).values
+    mask = (done.any("intensity") if "intensity" in done.dims else done).stack(motion=("record", "realization")).values  # a selection runs each motion at some stripes
     for row in rows[mask]:
         ax.loglog(periods, row, lw=0.4, color="0.8")
     if "intensity" in store.dims:
@@ -133,7 +135,8 @@ def _spectra(name: str, store: xr.Dataset, setting: dict[str, Any]) -> FigureIte
     ax.grid(True, which="both", lw=0.3, color="0.85")
     if "intensity" in store.dims:
         ax.legend(fontsize=7)
-    caption = f"Experiment {name}: response spectra (5 % damping) of the {int(mask.sum())} motions as recorded (grey)"
+    chosen = " chosen for some stripe" if "selection_scale_factor" in store else ""
+    caption = f"Experiment {name}: response spectra (5 % damping) of the {int(mask.sum())} motions{chosen}, as recorded (grey)"
     if "intensity" in store.dims:
         caption += "; at each level, the median and the 16-84 % band of the motions scaled to it"
     return FigureItem(f"intensity-spectra-{name}", caption + ".", figure)

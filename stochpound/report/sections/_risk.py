@@ -31,9 +31,11 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 from matplotlib.figure import Figure
+from matplotlib.ticker import LogLocator, NullFormatter
 
 from stochpound.report.render import Block, FigureItem, Paragraph, Section, Table
 from stochpound.report.sections._facets import labels_text
+from stochpound.report.sections._stripe_motions import is_selected
 from stochpound.risk import StoreDemands, StoreRisk, rate_from_probability
 from stochpound.store import describe_measure
 
@@ -79,7 +81,7 @@ def headline_text(name: str, risk: StoreRisk) -> str:
     stripes = f"{risk.stripes} stripes of " if risk.stripes is not None else "IDA capacities in "
     return (
         f"Risk-targeted separation g* (the gap whose mean annual frequency of pounding is that of {targets}, Poisson) of experiment "
-        f"{name}, from {risk.motions} motions ({stripes}{risk.measure} in {risk.setting['units']}) at the site of its hazard curve, "
+        f"{name}, from {risk.motions} motions{' per stripe' if is_selected(risk.setting) else ''} ({stripes}{risk.measure} in {risk.setting['units']}) at the site of its hazard curve, "
         f"with {_percent(risk.confidence)} intervals ({_resampling(risk)}): " + ". ".join(per) + "."
     )
 
@@ -109,7 +111,7 @@ def risk_section(name: str, risk: StoreRisk, demands: StoreDemands | None = None
     section.add(Paragraph(design_summary_text(risk, demands)))
     section.add(Paragraph(_hazard_text(risk)))
     section.add(Table(f"risk-separation-{name}", f"Experiment {name}: risk-targeted separation g* per configuration and target, with its "
-                      f"{_percent(risk.confidence)} BCa bootstrap interval over the {risk.motions} motions", risk.separation_frame(),
+                      f"{_percent(risk.confidence)} BCa bootstrap interval (the motions resampled)", risk.separation_frame(),
                       note=_grid_note(risk), formats={"g* (m)": "{:.3f}", "lower (m)": "{:.3f}", "upper (m)": "{:.3f}"}))
     section.add(_risk_curve_figure(name, risk))
     section.add(_surface_figure(name, risk))
@@ -229,8 +231,9 @@ def _hazard_text(risk: StoreRisk) -> str:
         f"{levels[0.10]:.3g} and its 2 %/50 yr intensity {levels[0.02]:.3g} {units}. The fragility at each gap is a "
         f"lognormal {fitted}, where the data identify one. {degenerate} λ_P(g) = ∫ F(x; g) |dλ(x)|; the intervals resample the motions and "
         "refit the whole chain. Assumptions: Poisson "
-        "occurrence, record-to-record variability only (not the hazard's or the model's uncertainty), and a suite scaled to each "
-        f"intensity standing for the site's motions of that intensity.{extrapolated}"
+        "occurrence, record-to-record variability only (not the hazard's or the model's uncertainty), and "
+        f"{'the motions chosen and scaled for each stripe' if is_selected(risk.setting) else 'a suite scaled to each intensity'} "
+        f"standing for the site's motions of that intensity.{extrapolated}"
     )
 
 
@@ -245,6 +248,25 @@ def _panel_grid(count: int, height: float = 2.6) -> tuple[Figure, list[Any]]:
     rows = int(math.ceil(count / columns))
     figure = Figure(figsize=(7.5, height * rows), layout="constrained")
     return figure, list(np.atleast_1d(figure.subplots(rows, columns, squeeze=False)).ravel())
+
+
+RATE_DECADES = 6
+"""The most decades of annual rate a rate axis spans below its largest rate (smaller rates are off the figure)."""
+
+
+def rate_limits(rates: Any, references: Any = ()) -> tuple[float, float]:
+    """Limits (1/yr) of a logarithmic rate axis from the positive finite rates drawn and reference lines (targets).
+
+    Half the smallest to twice the largest, but no more than ``RATE_DECADES``
+    decades below the largest: a bootstrap band or a far tail down to 1e-300
+    would otherwise squash the curves into a line. (1e-6, 1) when nothing is positive.
+    """
+    values = np.concatenate([np.ravel(np.asarray(rates, dtype=float)), np.ravel(np.asarray(references, dtype=float))])
+    values = values[np.isfinite(values) & (values > 0.0)]
+    if values.size == 0:
+        return 1e-6, 1.0
+    top = 2.0 * float(values.max())
+    return max(0.5 * float(values.min()), top * 10.0**-RATE_DECADES), top
 
 
 def _risk_curve_figure(name: str, risk: StoreRisk) -> FigureItem:
@@ -264,6 +286,7 @@ def _risk_curve_figure(name: str, risk: StoreRisk) -> FigureItem:
                 ax.axvline(value, color=line.get_color(), lw=0.6, ls=":")
     for p, rate, style in zip(risk.separation["target"].values, risk.separation["target_rate"].values, ("--", "-.", ":")):
         ax.axhline(float(rate), color="k", lw=0.8, ls=style, label=f"target: {risk.target_text(p)}")
+    ax.set_ylim(rate_limits(envelope.values, risk.separation["target_rate"].values))
     ax.set_xlabel("gap g (m)")
     ax.set_ylabel("λ_P: pounding per year")
     ax.grid(True, which="both", lw=0.3, color="0.85")
@@ -374,6 +397,9 @@ def _demand_blocks(name: str, risk: StoreRisk, demands: StoreDemands | None) -> 
         for labels in configurations(curve["maf"], ("level",)):
             maf = envelope.sel(labels).values
             ax.loglog(levels, np.where(maf > 0, maf, np.nan), lw=1.1, label=labels_text(labels) or None)
+        ax.set_ylim(rate_limits(envelope.values))
+        ax.xaxis.set_major_locator(LogLocator(subs=(1.0, 2.0, 5.0)))
+        ax.xaxis.set_minor_formatter(NullFormatter())  # labels on 1-2-5 only: the minor ones overlapped on short axes
         ax.set_title(label, fontsize=7)
         ax.set_xlabel(f"{label} ({demands.units[label]})", fontsize=7)
         ax.set_ylabel("exceedances per year", fontsize=7)

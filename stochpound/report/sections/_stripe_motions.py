@@ -1,0 +1,34 @@
+"""How a store's stripes got their motions, in words read off the store: one suite scaled to every level, or a selection per stripe."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+import xarray as xr
+
+
+def is_selected(setting: dict[str, Any] | None) -> bool:
+    """Whether the intensity setting chooses motions per stripe (``selection``) rather than scaling every motion to every level."""
+    return bool(setting) and setting.get("selection") not in (None, "none")
+
+
+def stripe_motions_text(store: xr.Dataset) -> str:
+    """The motions of the stripes: ``"100 motions, each scaled to every level"``, or the selection's method, pool, motions per stripe, scale factors and scenario."""
+    pool = store.sizes["record"]
+    if "selection_scale_factor" not in store:
+        return f"{pool} motions, each scaled to every level"
+    scale = store["selection_scale_factor"].transpose("intensity", "record").values
+    per_stripe = np.isfinite(scale).sum(axis=1)
+    count = f"{per_stripe.min()}" if per_stripe.min() == per_stripe.max() else f"{per_stripe.min()}–{per_stripe.max()}"
+    method = str((store.pound.intensity or {}).get("selection", "a selection")).replace("_", "-")
+    text = (f"{count} motions per stripe, chosen by {method} selection from a pool of {pool} and scaled to the stripe's level "
+            f"(scale factors {np.nanmin(scale):.3g}–{np.nanmax(scale):.3g})")
+    if "site_magnitude" in store:
+        text += f"; target scenario {_span(store['site_magnitude'], 'M {}')}, {_span(store['site_distance_km'], 'R {} km')}, {_span(store['site_vs30'], 'Vs30 {} m/s')}"
+    return text
+
+
+def _span(values: xr.DataArray, pattern: str) -> str:
+    low, high = float(values.min()), float(values.max())
+    return pattern.format(f"{low:.3g}" if low == high else f"{low:.3g}–{high:.3g}")

@@ -1,0 +1,41 @@
+"""Sentences about a conditional-spectrum store's motions are read off the store: pool, motions per stripe, scale factors, scenario."""
+
+from __future__ import annotations
+
+import re
+
+import numpy as np
+import pytest
+
+from stochpound import open_store
+from stochpound.experiment._runner import load_experiment, run_experiment
+from stochpound.report.sections._intensity import method_text
+from stochpound.report.sections._stripe_motions import stripe_motions_text
+from tests.helpers import FIXED, risk_text, write_experiment
+
+SELECTION = ('measure = "psa"\nperiod = 1.0\nlevels = [0.05, 0.1]\nselection = "conditional_spectrum"\nmotions = 3\nmax_scale_factor = 5.0\n'
+             '[site]\nvs30 = 400.0\nmagnitude = [6.6, 7.0]\ndistance_km = 20.0\nmechanism = "strike_slip"\n')
+
+
+@pytest.fixture(scope="module")
+def cs_store(tmp_path_factory):
+    experiment = load_experiment(write_experiment(tmp_path_factory.mktemp("cs"), risk_text(FIXED, "gap = [inf]", SELECTION), "cs.toml"))
+    report = run_experiment(experiment, workers=0, progress=False)
+    assert report.complete
+    return open_store(report.store).load()
+
+
+def test_a_selection_store_says_motions_per_stripe_from_a_pool_with_the_scale_factors_and_scenario(cs_store) -> None:
+    text = stripe_motions_text(cs_store)
+    scale = cs_store["selection_scale_factor"].values
+    assert text.startswith("3 motions per stripe, chosen by conditional-spectrum selection from a pool of 8 and scaled")
+    assert f"(scale factors {np.nanmin(scale):.3g}–{np.nanmax(scale):.3g})" in text
+    assert "target scenario M 6.6–7, R 20 km, Vs30 400 m/s" in text
+    method = method_text(cs_store, cs_store.pound.intensity)
+    assert "each scaled" not in method and "every level" not in method
+    assert re.search(r"Levels 0\.05, 0\.1 g: 3 motions per stripe", method), method
+
+
+def test_a_suite_store_says_every_motion_is_scaled_to_every_level(cs_store) -> None:
+    suite = cs_store.drop_vars([name for name in cs_store.variables if str(name).startswith(("selection_", "site_", "target_"))])
+    assert stripe_motions_text(suite) == "8 motions, each scaled to every level"
