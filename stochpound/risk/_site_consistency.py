@@ -39,7 +39,7 @@ def site_consistency(store: xr.Dataset) -> dict[str, xr.Dataset]:
     -------
     dict of str to xarray.Dataset
         Keyed by the other measure (``"PGA"``, ``"PSA(2 s)"``), in the bundled
-        curves' order: :func:`~stochpound.analysis.hazard_consistency`'s
+        curves' order: :func:`~stochpound.risk.hazard_consistency`'s
         ``recomputed``, ``site`` (1/yr) and ``ratio`` over the curve's
         intensities ``im`` (g). Empty when the store has no stripes or its
         hazard is not a bundled curve of a site with curves at other periods.
@@ -69,9 +69,19 @@ def site_consistency(store: xr.Dataset) -> dict[str, xr.Dataset]:
 
 
 def consistency_at_targets(result: xr.Dataset, years: float = 50.0) -> np.ndarray:
-    """The ratio recomputed / site (log–log interpolated in the site's rate) at the rates of :data:`~stochpound.risk.TARGETS` in ``years``.
+    """The ratio recomputed / site (log–log interpolated in the site's rate) at the rates of ``TARGETS`` (10 % and 2 %) in ``years``.
 
-    NaN where the site's curve does not reach a target's rate.
+    Parameters
+    ----------
+    result : xarray.Dataset
+        One measure of :func:`site_consistency` (``site`` in 1/yr and ``ratio`` over ``im``).
+    years : float
+        The targets' time span, years.
+
+    Returns
+    -------
+    numpy.ndarray
+        One ratio per target; NaN where the site's curve does not reach the target's rate.
     """
     rates = rate_from_probability(np.asarray(TARGETS), years)
     site, ratio = result["site"].values, result["ratio"].values
