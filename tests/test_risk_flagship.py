@@ -77,6 +77,9 @@ def test_the_stripes_are_the_site_intensities_of_the_stated_return_periods(name:
     experiment = _experiment(name)
     intensity = experiment["intensity"]
     assert intensity["period"] == FILES[name] and intensity["selection"] == "conditional_spectrum"
+    # the scenario is fitted to the site's four bundled curves, the conditioning measure's among them (no disaggregation is bundled)
+    assert experiment["site"]["scenario"] == "fitted" and experiment["hazard"]["bundled"] in experiment["site"]["curves"]
+    assert len(experiment["site"]["curves"]) == 4
     hazard = HazardCurve.bundled(experiment["hazard"]["bundled"])
     expected = [float(hazard.intensity_at(1.0 / rp)) for rp in RETURN_PERIODS]
     expected.append(1.5 * float(hazard.intensity_at(TWO_PERCENT)))

@@ -27,7 +27,7 @@ from stochpound.analysis._separation import pounding_curve, required_separation,
 from stochpound.analysis._separation_rules import contact_demands, fixed_base_cqc, separation_rules, store_contact_demands
 from stochpound.analysis._summary import run_summary
 from stochpound.analysis._consistency import hazard_consistency, stripe_rate_weights
-from stochpound.analysis._hazard import HazardCurve, bundled_curves, bundled_measure, probability_from_rate, rate_from_probability, return_period
+from stochpound.analysis._hazard import HazardCurve, bundled_curves, bundled_measure, bundled_site_curves, probability_from_rate, rate_from_probability, return_period
 from stochpound.analysis._hazard_files import HazardFile, read_hazard_file
 
 # For the other packages of stochpound (their interface to this one, not public API: not in __all__).
@@ -102,6 +102,7 @@ __all__ = [
     "read_hazard_file",
     "bundled_curves",
     "bundled_measure",
+    "bundled_site_curves",
     "probability_from_rate",
     "rate_from_probability",
     "return_period",

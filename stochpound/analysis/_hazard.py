@@ -279,6 +279,16 @@ def bundled_measure(name: str) -> dict[str, float | str]:
     return {"measure": "psa", "period": float(f"{match.group(2)}.{match.group(3)}"), "damping": BUNDLED_DAMPING, "units": "g"}
 
 
+def bundled_site_curves(name: str) -> list[str]:
+    """The bundled curves of the site of bundled curve ``name``: those whose names differ from it only in the measure's ending (itself included).
+
+    E.g. ``fox_plaza_los_angeles_sa1p0s`` gives the site's PGA and PSA(1, 2, 3 s) curves.
+    """
+    bundled_measure(name)
+    site = name[: _BUNDLED_MEASURE.search(name).start()]
+    return [other for other in bundled_curves() if (match := _BUNDLED_MEASURE.search(other)) and other[: match.start()] == site]
+
+
 def _bundled_folder() -> Path:
     folder = bundled_data_dir(BUNDLED_FOLDER, "SOURCES.md")
     if folder is None:

@@ -56,6 +56,7 @@ from stochpound.risk._demands import StoreDemands, store_demands
 from stochpound.risk._limit_states import KINDS as LIMIT_STATE_KINDS, LimitState, gap_cost_frame, limit_state_risk, limit_states_from_table
 from stochpound.risk._efficiency import measure_efficiency, most_efficient
 from stochpound.analysis import hazard_consistency, stripe_rate_weights
+from stochpound.risk._site_consistency import consistency_at_targets, site_consistency
 
 __all__ = [
     "Fragility",
@@ -101,6 +102,8 @@ __all__ = [
     "limit_state_risk",
     "gap_cost_frame",
     "hazard_consistency",
+    "consistency_at_targets",
+    "site_consistency",
     "measure_efficiency",
     "most_efficient",
     "has_risk",

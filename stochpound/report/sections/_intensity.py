@@ -11,7 +11,11 @@ For a store made with an ``[intensity]`` table (docs/intensity.md) it gives:
   probability of pounding with its 95 % Clopper–Pearson interval;
 * per gap, that probability against intensity (for the contact-free runs,
   which never pound, at gaps near g*, from their closures); for IDA, the fraction of
-  motions whose capacity is at most x, against x, with the same interval.
+  motions whose capacity is at most x, against x, with the same interval;
+* for stripes whose hazard is a bundled site's curve, the site's hazard at
+  its other measures recomputed from the stripes' motions against its own
+  curves, and their ratio at the 10 % and 2 % in 50 years intensities
+  (:func:`stochpound.risk.site_consistency`).
 
 Other structural axes (μ, variants) give one line per combination.
 """
@@ -32,7 +36,15 @@ from stochpound.report.render import FigureItem, Paragraph, Section, Table
 from stochpound.report.sections._stripe_motions import stripe_motions_text
 from stochpound.experiment import is_gap_axis
 from stochpound.motions import TARGET_TOLERANCE
-from stochpound.risk import contact_free_closure, limit_state_events, selection_misses
+from stochpound.risk import (
+    TARGETS,
+    consistency_at_targets,
+    contact_free_closure,
+    limit_state_events,
+    rate_from_probability,
+    selection_misses,
+    site_consistency,
+)
 from stochpound.store import has_contact_free, with_contacts
 
 CONFIDENCE = 0.95
@@ -59,6 +71,10 @@ def intensity_section(name: str, store: xr.Dataset, gaps: Sequence[float] = ()) 
         if "target_median" in store:
             section.add(Paragraph(_selection_text(store, setting)))
             section.add(_selection_figure(name, store, setting))
+        consistency = site_consistency(store)
+        if consistency:
+            section.add(Paragraph(_consistency_text(consistency, setting)))
+            section.add(_consistency_figure(name, consistency, setting))
     elif "ida_capacity" in store:
         section.add(_ida_figure(name, store, setting))
     return section
@@ -280,6 +296,51 @@ def _selection_figure(name: str, store: xr.Dataset, setting: dict[str, Any]) -> 
         f"intensity-selection-{name}",
         f"Experiment {name}: per stripe, the conditional spectrum's median and 16/84 % spectra (black, dashed) against the chosen, "
         "scaled motions' (red: the exponential of the mean and of the mean ± the standard deviation of ln Sa), and the range of their scale factors.",
+        figure,
+    )
+
+
+def _consistency_text(consistency: dict[str, xr.Dataset], setting: dict[str, Any]) -> str:
+    """How far the site's hazard at its other periods, recomputed from the stripes' motions, lies from its own curves."""
+    targets = _targets_text()
+    parts = []
+    for label, result in consistency.items():
+        ratios = consistency_at_targets(result)
+        shown = "/".join("beyond the curve" if np.isnan(r) else f"{r:.2f}" for r in ratios)
+        parts.append(f"{label} {shown}")
+    return (f"Hazard consistency across the stripes: the site's hazard at its other measures recomputed from the stripes' motions as "
+            f"they ran, λ(Sa(T') > y) ≈ Σ_j P(Sa(T') > y | {describe_measure(setting)} = x_j) Δλ(x_j) (P the fraction of stripe j's "
+            f"scaled motions above y, Δλ the site's rate of the stripe's bin), is {'; '.join(parts)} times the site's own curve at its "
+            f"intensities of {targets} in 50 years. A ratio near 1 says the stripes represent the site at that period; "
+            "well above 1, the motions carry too much of that period's shaking for the site, below 1 too little.")
+
+
+def _targets_text() -> str:
+    return " and ".join(f"{100 * p:g} %" for p in TARGETS)
+
+
+def _consistency_figure(name: str, consistency: dict[str, xr.Dataset], setting: dict[str, Any]) -> FigureItem:
+    """Per other measure of the site: its own hazard curve against the one recomputed from the stripes."""
+    columns = len(consistency)
+    figure = Figure(figsize=(7.5, 2.8), layout="constrained")
+    axes = np.atleast_1d(figure.subplots(1, columns, sharey=True, squeeze=False)).ravel()
+    for ax, (label, result) in zip(axes, consistency.items()):
+        y = result["im"].values
+        ax.loglog(y, result["site"].values, color="k", lw=1.4, label="site")
+        recomputed = np.where(result["recomputed"].values > 0, result["recomputed"].values, np.nan)
+        ax.loglog(y, recomputed, "o-", color="C3", ms=3, lw=1.0, label="from the stripes")
+        for rate in rate_from_probability(np.asarray(TARGETS)):
+            ax.axhline(rate, color="0.5", lw=0.6, ls=":")
+        ax.set_title(label, fontsize=8)
+        ax.set_xlabel(f"{label} (g)", fontsize=8)
+        ax.grid(True, which="both", lw=0.3, color="0.85")
+    axes[0].set_ylabel("annual rate of exceedance (1/yr)")
+    axes[0].legend(fontsize=7)
+    return FigureItem(
+        f"intensity-consistency-{name}",
+        f"Experiment {name}: the site's hazard curves at its other measures (black) against the ones recomputed from the stripes of "
+        f"{describe_measure(setting)} (red: the fraction of every stripe's scaled motions above the intensity, weighted by the site's "
+        f"rate of the stripe's bin); dotted: the rates of {_targets_text()} in 50 years.",
         figure,
     )
 

@@ -1,0 +1,80 @@
+"""The site's hazard at its other measures recomputed from a stripes store's motions as they ran (stochpound.risk.site_consistency)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import xarray as xr
+
+from stochpound import open_store
+from stochpound.analysis import HazardCurve, bundled_site_curves, rate_from_probability, stripe_rate_weights
+from stochpound.experiment._runner import load_experiment, run_experiment
+from stochpound.report.render import FigureItem, Paragraph
+from stochpound.report.sections import intensity_section
+from stochpound.risk import TARGETS, consistency_at_targets, site_consistency
+from tests.helpers import SITE_SCENE as SCENE
+from tests.helpers import write_experiment
+
+SITE = "fox_plaza_los_angeles"
+MEMBERS = [f"fema_p695_far_field/{i:02d}{c}" for i in range(1, 7) for c in "ab"]
+RECORDS = "".join(f'\n[[records]]\nrecord = "{name}"\nduration = 5.0\n' for name in MEMBERS)
+INTENSITY = ('[intensity]\nmeasure = "psa"\nperiod = 1.0\ndamping = 0.05\nunits = "g"\nlevels = [0.5611, 0.9299]\nselection = "conditional_spectrum"\n'
+             'motions = 4\nmax_scale_factor = 8.0\nseed = 3\n'
+             '[site]\nvs30 = 400.0\nmagnitude = 7.2\ndistance_km = 10.0\nmechanism = "reverse"\n')
+
+
+def _store(tmp_path, hazard: str) -> xr.Dataset:
+    text = f'[experiment]\nname = "site"\n{SCENE}\n[grid]\ngap = ["inf", 0.05]\n{RECORDS}\n{INTENSITY}\n{hazard}\n[solver]\nmethod = "exact"\n'
+    report = run_experiment(load_experiment(write_experiment(tmp_path, text, "site.toml")), workers=0, progress=False)
+    return open_store(report.store).load()
+
+
+def test_bundled_site_curves_are_the_curves_of_one_site() -> None:
+    assert bundled_site_curves(f"{SITE}_sa2p0s") == [f"{SITE}_pga", f"{SITE}_sa1p0s", f"{SITE}_sa2p0s", f"{SITE}_sa3p0s"]
+    with pytest.raises(ValueError, match="name: no bundled hazard curve"):
+        bundled_site_curves("nowhere_pga")
+
+
+def test_recomputed_from_the_motions_as_they_ran_and_shown_in_the_report(tmp_path) -> None:
+    store = _store(tmp_path, f'[hazard]\nbundled = "{SITE}_sa1p0s"\n')
+    result = site_consistency(store)
+    assert list(result) == ["PGA", "PSA(2 s)", "PSA(3 s)"]
+    # by hand: the motions that ran in each stripe, their stored PGA or PSA (log-log between the stored periods) times their scale factor
+    levels = store["intensity"].values
+    weights = stripe_rate_weights(levels, HazardCurve.bundled(f"{SITE}_sa1p0s"))
+    log_t = np.log(store["spectrum_period"].values)
+    for label, name, value in [("PGA", "pga", lambda m: float(m.motion_pga) / 9.81),
+                               ("PSA(2 s)", "sa2p0s", lambda m: np.exp(np.interp(np.log(2.0), log_t, np.log(m.motion_psa.values))) / 9.81)]:
+        other = HazardCurve.bundled(f"{SITE}_{name}")
+        expected = np.zeros(other.im.size)
+        for j in range(levels.size):
+            cases = store.isel(intensity=j, realization=0).sel(gap=np.inf)
+            ran = [r for r in cases.record.values if int(cases.case_status.sel(record=r)) == 1]
+            assert len(ran) == 4
+            spectra = np.array([value(cases.sel(record=r)) * float(cases.scale_factor.sel(record=r)) for r in ran])
+            expected += weights[j] * (spectra[:, None] > np.asarray(other.im)[None, :]).mean(axis=0)
+        np.testing.assert_allclose(result[label]["recomputed"].values, expected, rtol=1e-12)
+        np.testing.assert_allclose(result[label]["site"].values, other.rate, rtol=1e-12)
+    # the report's Intensity section: the figure, and the sentence with every measure's ratios at 10 % and 2 % in 50 years
+    section = intensity_section("site", store)
+    assert any(isinstance(block, FigureItem) and block.key == "intensity-consistency-site" for block in section.blocks)
+    text = next(block.text for block in section.blocks if isinstance(block, Paragraph) and block.text.startswith("Hazard consistency"))
+    for label, data in result.items():
+        shown = "/".join("beyond the curve" if np.isnan(r) else f"{r:.2f}" for r in consistency_at_targets(data))
+        assert f"{label} {shown}" in text
+
+
+def test_nothing_without_a_bundled_site(tmp_path) -> None:
+    store = _store(tmp_path, "[hazard]\npower_law = {k0 = 1e-4, k = 2.5}\n")
+    assert site_consistency(store) == {}
+    assert not any(isinstance(block, FigureItem) and block.key == "intensity-consistency-site" for block in intensity_section("site", store).blocks)
+
+
+def test_ratio_at_the_targets_interpolates_log_log_in_the_site_rate() -> None:
+    y = np.geomspace(0.05, 3.0, 15)
+    site = 1e-3 * y**-2.0
+    ratio = 1.5 * y**0.5  # a power law of the site's rate too: ratio = 1.5 (site / 1e-3)^(-1/4), exact under log-log interpolation
+    data = xr.Dataset({"site": ("im", site), "ratio": ("im", ratio), "recomputed": ("im", site * ratio)}, coords={"im": y})
+    rates = rate_from_probability(np.asarray(TARGETS))
+    np.testing.assert_allclose(consistency_at_targets(data), 1.5 * (rates / 1e-3) ** -0.25, rtol=1e-12)
+    assert np.isnan(consistency_at_targets(data.isel(im=slice(0, 3)))).all()  # the site's curve stops before the targets' rates
