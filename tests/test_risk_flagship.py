@@ -49,11 +49,17 @@ def test_the_buildings_carry_the_code_design_of_the_header(name: str) -> None:
     experiment = _experiment(name)
     buildings = _buildings(experiment)
     sds, sd1, sm1 = _design_spectrum()
+    design = experiment["design"]  # the [design] table the risk chain's design-analysis gaps read: the header's design
+    np.testing.assert_allclose([design["sds"], design["sd1"]], [sds, sd1], atol=5e-6)  # the file gives 5 decimals
+    assert (design["r"], design["omega0"], design["cd"], design["ie"]) == (8.0, 3.0, 5.5, 1.0)
+    if "sm1" in design:
+        assert design["sm1"] == pytest.approx(sm1, abs=5e-6)
+    sds, sd1 = design["sds"], design["sd1"]
     b1 = buildings["B1"]
     period = _first_mode_period(b1["mass"], b1["stiffness"])
     assert period < 1.4 * 0.028 * HEIGHT**0.8  # the computed period is the design period (below C_u T_a)
-    expected = design_yield_shears(b1["mass"], b1["storey_height"], period=period, sds=sds, sd1=sd1, r=8.0, overstrength=3.0,
-                                   importance=1.0, s1=sm1)
+    expected = design_yield_shears(b1["mass"], b1["storey_height"], period=period, sds=sds, sd1=sd1, r=design["r"],
+                                   overstrength=design["omega0"], importance=design["ie"], s1=sm1)
     for building in buildings.values():
         np.testing.assert_allclose(building["yield_force"], expected, atol=0.5)  # N: the file rounds to 1 N
         assert building["hardening"] == 0.02 and building["p_delta"] is True
@@ -62,8 +68,8 @@ def test_the_buildings_carry_the_code_design_of_the_header(name: str) -> None:
         neighbour = {**buildings["B2"], **variant["building"]["B2"]}
         t = _first_mode_period(neighbour["mass"], neighbour["stiffness"])
         assert t < sd1 / sds
-        np.testing.assert_allclose(design_yield_shears(neighbour["mass"], neighbour["storey_height"], period=t, sds=sds, sd1=sd1, r=8.0,
-                                                       overstrength=3.0, s1=sm1), expected, rtol=1e-12)
+        np.testing.assert_allclose(design_yield_shears(neighbour["mass"], neighbour["storey_height"], period=t, sds=sds, sd1=sd1, r=design["r"],
+                                                       overstrength=design["omega0"], importance=design["ie"], s1=sm1), expected, rtol=1e-12)
 
 
 @pytest.mark.parametrize("name", sorted(FILES))

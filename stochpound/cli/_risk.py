@@ -21,19 +21,31 @@ def _targets(value: str) -> tuple[float, ...]:
     return targets
 
 
-def _limit_states(path: Path) -> tuple:
-    """The limit states of a TOML file's ``[limit_states]`` table (``stochpound.risk.limit_states_from_table``)."""
+def _toml_table(path: Path, name: str, docs: str) -> dict:
+    """The TOML file's ``[name]`` table (its key ``name`` kept: ``{name: ...}``), or a one-line error."""
     import tomllib
-
-    from stochpound.risk import limit_states_from_table
 
     try:
         table = tomllib.loads(path.read_text())
     except tomllib.TOMLDecodeError as error:
         raise click.ClickException(f"{path}: not TOML: {error}") from None
-    if "limit_states" not in table:
-        raise click.ClickException(f"{path}: has no [limit_states] table (docs/risk.md)")
-    return limit_states_from_table(table["limit_states"])
+    if name not in table:
+        raise click.ClickException(f"{path}: has no [{name}] table ({docs})")
+    return {name: table[name]}
+
+
+def _limit_states(path: Path) -> tuple:
+    """The limit states of a TOML file's ``[limit_states]`` table (``stochpound.risk.limit_states_from_table``)."""
+    from stochpound.risk import limit_states_from_table
+
+    return limit_states_from_table(_toml_table(path, "limit_states", "docs/risk.md")["limit_states"])
+
+
+def _design(path: Path) -> dict:
+    """The buildings' code design of a TOML file's ``[design]`` table (the experiment file's table, docs/experiments.md)."""
+    from stochpound.experiment import parse_design
+
+    return parse_design(_toml_table(path, "design", "docs/experiments.md"))
 
 
 @click.command("risk")
@@ -57,12 +69,15 @@ def _limit_states(path: Path) -> tuple:
 @click.option("--limit-states", "limit_states", type=click.Path(exists=True, dir_okay=False, path_type=Path), metavar="FILE",
               help="A TOML file with a [limit_states] table (docs/risk.md): also print each limit state's mean annual frequency "
                    "at the grid's finite gaps against the contact-free twins (what the gap costs).")
+@click.option("--design", "design", type=click.Path(exists=True, dir_okay=False, path_type=Path), metavar="FILE",
+              help="A TOML file with a [design] table (docs/experiments.md) that replaces the store's: the buildings' code design "
+                   "whose design analysis gives the codes' own gaps.")
 @click.option("--csv", "csv_dir", type=click.Path(file_okay=False, path_type=Path), metavar="DIR",
               help="Also write the tables to this folder (created), one CSV file per table: separation.csv, rules.csv "
                    "(and limit_states.csv with --limit-states).")
 def risk(store: Path, hazard: str | None, hazard_measure: str | None, hazard_units: str | None, investigation_time: float | None,
          hazard_site: str | None, extrapolate: bool, target: str, years: float, bootstrap: int, seed: int, limit_states: Path | None,
-         csv_dir: Path | None) -> None:
+         design: Path | None, csv_dir: Path | None) -> None:
     """Print the risk-targeted separation g* and the code rules' risks of the experiment STORE at a site.
 
     For every configuration of the store (each combination of its grid's
@@ -91,7 +106,7 @@ def risk(store: Path, hazard: str | None, hazard_measure: str | None, hazard_uni
         data = open_store(store)
         hz = site_hazard(data, hazard, measure=hazard_measure, units=hazard_units, investigation_time=investigation_time,
                          site=hazard_site, extrapolate=extrapolate)
-        result = store_risk(data, hz, targets, years, bootstrap=bootstrap, seed=seed)
+        result = store_risk(data, hz, targets, years, bootstrap=bootstrap, seed=seed, design=None if design is None else _design(design))
         costs = None if limit_states is None else gap_cost_frame(limit_state_risk(data, _limit_states(limit_states), hz), years)
     except (StochpoundError, ValueError) as error:
         raise click.ClickException(str(error)) from None
@@ -123,11 +138,12 @@ def risk(store: Path, hazard: str | None, hazard_measure: str | None, hazard_uni
         click.echo(f"note: {degenerate}")
     rules = result.rules_frame()
     if result.rules is None:
-        click.echo(f"\nCode rules: not evaluated: {result.rules_note}.")
-    else:
-        click.echo(f"\nCode rules in risk terms, applied to the suite-mean peaks of the code intensity's stripe (λ_P: pounding per year "
-                   f"at that gap; 'once in N years'; P in {years:g} years; each with its interval; fit: lognormal or a degenerate step):")
+        click.echo(f"\nCode rules: suite-mean rules not evaluated: {result.rules_note}.")
+    if not rules.empty:
+        click.echo(f"\nCode rules in risk terms, the suite-mean rows applied to the suite-mean peaks of the code intensity's stripe (λ_P: pounding "
+                   f"per year at that gap; 'once in N years'; P in {years:g} years; each with its interval; fit: lognormal or a degenerate step):")
         click.echo(rules.to_string(float_format=lambda v: f"{v:.4g}"))
+    click.echo(result.design_rules_text())
     if costs is not None:
         click.echo(f"\nLimit states beyond first contact (λ: per year at each finite gap; contact-free: the same motions without "
                    f"contact; Δλ: what the gap costs; P in {years:g} years):")

@@ -28,6 +28,7 @@ from stochpound.experiment._runner import RunReport, default_store, load_experim
 from stochpound.experiment._status import StatusReport, store_status
 
 # For the other packages of stochpound (their interface to this one, not public API: not in __all__).
+from stochpound.experiment._design_table import parse_design  # noqa: F401
 from stochpound.experiment._ensemble import simulate_ensemble  # noqa: F401
 from stochpound.experiment._estimate import LARGE_RUN_BYTES, LARGE_RUN_CASES  # noqa: F401
 from stochpound.experiment._grid import CASE  # noqa: F401

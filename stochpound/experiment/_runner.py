@@ -39,7 +39,7 @@ from stochpound.experiment._spec import ExperimentError, load_definition
 from stochpound.experiment._store_writer import PartsIndex
 from stochpound._memory import format_bytes
 from stochpound.solvers import first_call
-from stochpound.store import canonical_json
+from stochpound.store import NOT_IN_IDENTITY, canonical_json
 
 CHECKPOINT_FACTOR = 20.0
 """A checkpoint waits at least this many times the last rebuild's duration (rebuilds cost at most ~5 % of a run)."""
@@ -206,8 +206,10 @@ def run_experiment(
             if missing:
                 raise ExperimentError(f"{store}: written by an earlier stochpound without {', '.join(missing)}, which it keeps now: "
                                       "run the experiment again with --restart to recompute its cases")
-            if stored_definition(store) != json.loads(canonical_json(experiment.definition)):
-                _record_hazard(store, experiment, {label: m.grid for label, m in motions.items()}, say)
+            stored, new = stored_definition(store), json.loads(canonical_json(experiment.definition))
+            if stored != new:
+                changed = [key for key in NOT_IN_IDENTITY if stored.get(key) != new.get(key)]
+                _record_hazard(store, experiment, {label: m.grid for label, m in motions.items()}, say, changed)
             return RunReport(store, experiment.n_cases, experiment.n_cases, elapsed=time.monotonic() - started, nothing_to_run=True)
     elif store.is_dir():
         raise ExperimentError(f"{store}: is a folder; --store must name a file")
@@ -271,17 +273,22 @@ def run_experiment(
     return report
 
 
-def _record_hazard(store: Path, experiment: Experiment, grids: dict[str, tuple[float, int]], say: Callable[[str], None]) -> None:
-    """Rewrite a complete store from its parts with the experiment's hazard (no run depends on it: the runs are kept)."""
+def _record_hazard(store: Path, experiment: Experiment, grids: dict[str, tuple[float, int]], say: Callable[[str], None],
+                   changed: list[str]) -> None:
+    """Rewrite a complete store from its parts with the experiment's hazard and design (``changed``: no run depends on them: the runs are kept)."""
     lock = FolderLock(parts_folder(store))
     if not lock.acquire():
         raise _busy(store)
     with lock:
         session = StoreSession.create(store, experiment, grids)
         if session.scan().n_done < experiment.n_cases:  # its parts folder lost cases: rewriting would lose them
-            raise ExperimentError(f"{store}: the hazard changed, but {session.folder.name}/ lacks finished cases to rewrite the store from; "
+            raise ExperimentError(f"{store}: the {' and the '.join(changed)} changed, but {session.folder.name}/ lacks finished cases to rewrite the store from; "
                                   "keep the store as it is, or run again with --restart")
         session.rebuild()
+    if "design" in changed:
+        say(f"{store}: the [design] changed; no run depends on it: the cases are kept and the new design is recorded in the store")
+    if "hazard" not in changed:
+        return
     hazard = experiment.contract.hazard
     what = "removed" if hazard is None else f"from {hazard.file or hazard.bundled or 'a power law'}" + (f" (sha256 {hazard.file_sha256[:12]}…)" if hazard.file_sha256 else "")
     say(f"{store}: the hazard changed ({what}); no run depends on it: the cases are kept and the new curve is recorded in the store")

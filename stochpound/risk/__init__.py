@@ -9,7 +9,9 @@ that meets a target probability (:func:`risk_targeted_separation`), and
 the code separation rules in risk terms (:func:`code_rules_risk`), and the
 separations as the codes compute them from a design analysis
 (:func:`asce7_inelastic_displacement`, :func:`ec8_design_displacement`,
-:func:`srss_separation`, :func:`asce7_isolator_displacement`). For an
+:func:`srss_separation`, :func:`asce7_isolator_displacement`), applied to
+a store's scene and ``[design]`` with their risk (:func:`design_separations`,
+:func:`design_rules_risk`). For an
 experiment store, :func:`store_risk` runs the whole chain and returns a
 :class:`StoreRisk`, whose tables (:meth:`StoreRisk.to_frame`,
 :meth:`StoreRisk.separation_frame`, :meth:`StoreRisk.rules_frame`) the
@@ -47,6 +49,7 @@ from stochpound.risk._code_gaps import (
     modal_floor_displacements,
     srss_separation,
 )
+from stochpound.risk._design_rules import DESIGN_RULE_LEVELS, design_rules_risk, design_separations
 from stochpound.risk._store import RiskInputError, contact_free_closure, has_risk, selection_misses, site_hazard
 from stochpound.risk._store_risk import StoreRisk, pounding_fragility, risk_gaps, store_risk
 from stochpound.risk._demands import StoreDemands, store_demands
@@ -83,6 +86,9 @@ __all__ = [
     "ec8_design_displacement",
     "srss_separation",
     "asce7_isolator_displacement",
+    "design_separations",
+    "design_rules_risk",
+    "DESIGN_RULE_LEVELS",
     "contact_free_closure",
     "pounding_fragility",
     "risk_gaps",

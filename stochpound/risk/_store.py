@@ -23,6 +23,7 @@ import xarray as xr
 
 from stochpound.analysis import HazardCurve, parse_measure, parse_units, store_contact_demands
 from stochpound.experiment import check_covers, hazard_curve, hazard_option, stored_hazard
+from stochpound.model import Scene
 from stochpound.motions import DEFAULT_G
 from stochpound.store import contact_free, describe_measure, gap_dims, has_contact_free, has_wall_free, wall_free, with_contacts
 
@@ -130,6 +131,18 @@ def _stated(measure: str | None, units: str | None, investigation_time: float | 
 def studied_building(store: xr.Dataset) -> str | None:
     """The store's studied building (its experiment's ``studied``), or None."""
     return store.pound.definition.studied
+
+
+def design(store: xr.Dataset) -> Mapping[str, Any] | None:
+    """The store's ``[design]`` entry, the buildings' code design (None without one)."""
+    return store.pound.definition.design
+
+
+def configuration_scene(store: xr.Dataset, labels: Mapping[str, Any]) -> Scene:
+    """The scene of one configuration of a store (``labels`` on its variant and μ axes): its contact-free case at the first stripe and motion."""
+    fixed = {dim: math.inf for dim in store.pound.gap_dims}
+    fixed.update({dim: store[dim].values[0] for dim in ("intensity", "record", "realization") if dim in store.dims})
+    return store.pound.scene(**fixed, **labels)
 
 
 def experiment_name(store: xr.Dataset) -> str | None:

@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
@@ -35,6 +35,7 @@ import xarray as xr
 from stochpound.analysis import HazardCurve, rate_from_probability
 from stochpound.risk import _store
 from stochpound.risk._code_rules import MINIMUM_MOTIONS, code_rules_risk
+from stochpound.risk._design_rules import design_rules_risk
 from stochpound.risk._fragility_ensemble import BOOTSTRAP, fragility_band, fragility_surface, homogeneous_capacities, ida_fragility, limit_state_events, stripe_fragility
 from stochpound.risk._fragility import FIT, STATUS
 from stochpound.risk._maf import TARGETS, degenerate_text, non_increasing, risk_curve, risk_targeted_separation
@@ -52,9 +53,13 @@ RULE_NAMES = {
     "ddc": "DDC",
     "ddc_cqc": "DDC (CQC ρ)",
     "dtm": "D_TM of the suite-mean base displacement (ASCE 7 §17.2.5.2 form)",
+    "asce7_delta_mt": "ASCE 7 §12.12.3 δ_MT of the design analysis",
+    "ec8_ds": "Eurocode 8 §4.4.2.7 d_s of the design analysis",
+    "asce7_dtm": "ASCE 7 §17.2.5.2 D_TM by eq. 17.5-1",
 }
 """The code rules' names in the tables: each applied to the suite-mean peaks of the stripe at the design level
-(the codes apply them to the design analysis: named as suite-mean so they are not read as the codes' own gaps)."""
+(the codes apply them to the design analysis: named as suite-mean so they are not read as the codes' own gaps), and the codes'
+own gaps from the design analysis of the store's ``[design]`` (:func:`~stochpound.risk.design_rules_risk`)."""
 CURVE_GAPS = 3
 """Fragility curves drawn per configuration (at gaps spread over the risk curve's range)."""
 IM_POINTS = 120
@@ -146,6 +151,11 @@ class StoreRisk:
         The confidence of the intervals.
     dtm_note : str
         Why the rules hold no D_TM ("" where they do, or where the studied building does not slide).
+    design_rules : xarray.Dataset or None
+        The codes' own gaps from the design analysis and their risk
+        (:func:`~stochpound.risk.design_rules_risk`); None without a ``[design]`` or without stripes.
+    design_note : str
+        Why ``design_rules`` is None ("" otherwise).
     assumptions : dict of str to str
         What the answer rests on besides the hazard, in words from the
         store's definition: ``structural model``, ``suite`` (and its
@@ -167,6 +177,8 @@ class StoreRisk:
     confidence: float = CONFIDENCE
     assumptions: dict[str, str] = dataclasses.field(default_factory=dict)
     dtm_note: str = ""
+    design_rules: xr.Dataset | None = None
+    design_note: str = ""
 
     @property
     def measure(self) -> str:
@@ -216,31 +228,65 @@ class StoreRisk:
         the fit's kind (``fit``: ``lognormal`` or the step), and whether the
         rule meets its own design level as a target (``meets its level``:
         λ_P ≤ −ln(1 − p)/t for the level's probability p; ``meets, upper
-        bound``: the same for the upper bound of λ_P). Empty when the rules
-        were not evaluated (``rules_note`` says why).
+        bound``: the same for the upper bound of λ_P). The suite-mean rules'
+        rows first, then the codes' own gaps from the design analysis
+        (design level ``… (design analysis)``, where the store has a
+        ``[design]``). Empty when no rule was evaluated (``rules_note`` and
+        ``design_note`` say why).
         """
-        rules = self.rules
-        if rules is None:
-            return pd.DataFrame()
-        rules = _grid_only(rules, keep=("code_intensity", "stripe_intensity"))
+        frames = []
+        if self.rules is not None:
+            rules = _grid_only(self.rules, keep=("code_intensity", "stripe_intensity"))
+            stripes = [design_text(p, float(i), float(rules.attrs.get("years", self.years)))
+                       for p, i in zip(rules["design_level"].values, rules["stripe_intensity"].values)]
+            frames.append(self._rules_rows(rules.drop_vars(["code_intensity", "stripe_intensity"]), dict(zip(rules["design_level"].values, stripes))))
+        if self.design_rules is not None:
+            rules = _grid_only(self.design_rules, keep=("design_level",))
+            years = float(rules.attrs.get("years", self.years))
+            rows = self._rules_rows(rules, {p: f"{100 * p:g} %/{years:g} yr (design analysis)" for p in rules["design_level"].values})
+            rows = rows[rows[[c for c in rows.columns if c.startswith("gap, ")]].notna().any(axis=1)]  # not where a rule does not apply
+            frames.append(rows.reorder_levels(frames[0].index.names) if frames else rows)
+        return pd.concat(frames) if frames else pd.DataFrame()
+
+    def _rules_rows(self, rules: xr.Dataset, level_names: Mapping[float, str]) -> pd.DataFrame:
+        """The rows of :meth:`rules_frame` of one rules dataset (``design_level`` a dimension or a coordinate along ``rule``)."""
         years = float(rules.attrs.get("years", self.years))
-        gaps = rules["gap"].to_dataframe()["gap"].unstack("contact")
+        gaps = rules["gap"].to_dataframe()[["gap"]]["gap"].unstack("contact")
         gaps.columns = [f"gap, contact {c} (m)" for c in gaps.columns]
         values = rules[[name for name in (*_RULE_VALUES, "status") if name in rules]].to_dataframe()
-        frame = gaps.join(values)
+        frame = gaps.join(values[[c for c in values.columns if c in (*_RULE_VALUES, "status")]])
+        if "design_level" not in frame.index.names:
+            frame = frame.set_index(pd.Index([rules["design_level"].sel(rule=r).item() for r in frame.index.get_level_values("rule")],
+                                             name="design_level"), append=True)
         if "status" in frame:
-            frame["status"] = [fit_name(int(s)) for s in frame["status"]]
+            frame["status"] = [fit_name(int(s)) if np.isfinite(s) else "" for s in frame["status"]]
         allowed = rate_from_probability(frame.index.get_level_values("design_level").to_numpy(dtype=float), years)
         frame["meets its level"] = frame["maf"] <= allowed  # λ_P at the rule's gap within the rate of its own design level
         if "maf_upper" in frame:
             frame["meets, upper bound"] = frame["maf_upper"] <= allowed
         names = {**dict(zip(_RULE_VALUES, (column.format(years=years) for column in _RULE_COLUMNS))), "status": "fit"}
         frame = frame.rename(columns=names).reset_index()
-        frame["design_level"] = [design_text(p, float(i), years) for p, i in zip(frame["design_level"], frame["stripe_intensity"])]
+        frame["design_level"] = [level_names[p] for p in frame["design_level"]]
         frame["rule"] = [RULE_NAMES.get(r, r) for r in frame["rule"]]
-        frame = frame.drop(columns=[c for c in ("code_intensity", "stripe_intensity") if c in frame])
         index = [c for c in frame.columns if not c.startswith(("gap, ", "meets")) and c not in names.values()]
         return frame.set_index(index).dropna(how="all")
+
+    def design_rules_text(self) -> str:
+        """The rules table's design-analysis rows in words: what they are, or why there are none."""
+        if self.design_rules is None:
+            return f"The codes' own gaps from the design analysis are not evaluated: {self.design_note}."
+        periods = []
+        for rule in self.design_rules["rule"].values:
+            period = self.design_rules["return_period"].sel(rule=rule)
+            period = period.where(self.design_rules["gap"].sel(rule=rule).notnull().all("contact"))  # where the rule applies
+            if bool(period.notnull().any()):
+                low, high = float(period.min()), float(period.max())
+                periods.append(f"{RULE_NAMES[str(rule)]}, once in {low:.3g}" + (f" to {high:.3g}" if high != low else "") + " years")
+        return ("The rows '(design analysis)' are the codes' own gaps, from the linear modal analysis of each building's fixed-base "
+                "storeys under the design spectrum of the store's [design] (ASCE 7-16 §12.12.3: δ_M = C_d δ_max / I_e, SRSS of the two "
+                "buildings; Eurocode 8 §4.4.2.7: d_s = q d_e, SRSS, times 0.7 where the floors stand level; ASCE 7-16 §17.2.5.2 D_TM = D_M "
+                "of eq. 17.5-1 for a friction pendulum), not from the runs; each with the mean annual frequency of pounding at that gap: "
+                f"here, each rule means pounding {'; '.join(periods)}.")
 
     def design_frame(self) -> pd.DataFrame:
         """The gap to design to: per configuration and target, the upper bound of g*'s interval (m; g* itself without a bootstrap).
@@ -335,7 +381,7 @@ def _reach_intensity(hz: HazardCurve, targets: Sequence[float], years: float) ->
 
 def store_risk(store: xr.Dataset, hz: HazardCurve | None = None, targets: Sequence[float] = TARGETS, years: float = YEARS,
                gaps: Sequence[float] | np.ndarray | None = None, studied: str | None = None, confidence: float = CONFIDENCE,
-               bootstrap: int = BOOTSTRAP, seed: int = 0) -> StoreRisk:
+               bootstrap: int = BOOTSTRAP, seed: int = 0, design: Mapping[str, Any] | None = None) -> StoreRisk:
     """Fragility at every gap, the pounding risk curve, g* and the code rules of a store's intensity-conditioned runs.
 
     Parameters
@@ -362,6 +408,9 @@ def store_risk(store: xr.Dataset, hz: HazardCurve | None = None, targets: Sequen
         the store's ``studied`` building. The rule is left out where it does not slide.
     confidence, bootstrap, seed
         As in :func:`~stochpound.risk.stripe_fragility`.
+    design : mapping, optional
+        The buildings' code design (the ``[design]`` entry, docs/experiments.md)
+        whose design analysis gives the codes' own gaps; default the store's.
 
     Raises
     ------
@@ -392,9 +441,17 @@ def store_risk(store: xr.Dataset, hz: HazardCurve | None = None, targets: Sequen
         isolator, dtm_note = _store.free_base_displacement(store, studied)
         rules = code_rules_risk(_store.contact_free_demands(store), hz, years=years, isolator_displacement=isolator,
                                 confidence=confidence, bootstrap=bootstrap, seed=seed)
+    design = _store.design(store) if design is None else design
+    design_rules, design_note = None, ""
+    if design is None:
+        design_note = "the store's experiment has no [design] table (the buildings' code design)"
+    elif method == "ida":
+        design_note = "IDA runs: the codes' gaps are fitted over stripes"
+    else:
+        design_rules = design_rules_risk(store, hz, design, studied, years, confidence, bootstrap, seed)
     return StoreRisk(fragility, curve, separation, rules, note, hz, motions, method, setting=_store.intensity_setting(store) or {},
                      stripes=_store.stripes(store), experiment=_store.experiment_name(store), years=years, confidence=confidence,
-                     assumptions=_store.assumptions(store), dtm_note=dtm_note)
+                     assumptions=_store.assumptions(store), dtm_note=dtm_note, design_rules=design_rules, design_note=design_note)
 
 
 def target_text(probability: float, years: float = YEARS) -> str:

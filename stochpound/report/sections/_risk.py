@@ -378,6 +378,7 @@ def _rules_blocks(name: str, risk: StoreRisk) -> list[Block]:
     )
     if "dtm" not in rules["rule"].values:
         text += f" D_TM is not applied: {risk.dtm_note or 'the studied building has no sliding base in this store'}."
+    text += " " + risk.design_rules_text()
     table = Table(f"risk-rules-{name}", f"Experiment {name}: the code separation rules in risk terms: the gap at each contact, the "
                   f"mean annual frequency λ_P of pounding at it, the return period and the probability in {years:g} years, each with its "
                   f"{_percent(risk.confidence)} bootstrap interval, and the fragility's kind (a lognormal, or a degenerate step)", frame,

@@ -1,0 +1,182 @@
+"""The codes' own gaps of a scene from its [design] table (against hand computations), and their rows in the risk chain.
+
+The documented example (docs/risk.md, "The codes' own gaps"): two one-storey buildings of 3 m storeys, B1 of period
+0.5 s and B2 of 1.0 s, in contact at their roofs; g = 9.81 m/s². A one-storey building's only mode has participation 1,
+so its design displacement is S(T) g (T / 2π)².
+
+* ASCE 7-16, S_DS = 1.0 g, S_D1 = 0.6 g (T_S = 0.6 s), R = 8, C_d = 5.5, I_e = 1: B1 on the plateau, S_a = 1.0 g,
+  elastic 0.062123 m, δ_M = C_d (0.062123 / (R / I_e)) / I_e = 0.042709 m (eq. 12.12-1); B2 on S_D1 / T = 0.6 g,
+  elastic 0.149094 m, δ_M = 0.102502 m; δ_MT = √(0.042709² + 0.102502²) = 0.111044 m (eq. 12.12-2).
+* Eurocode 8, a_g = 0.3 g, ground B (S 1.2, T_B 0.15 s, T_C 0.5 s, T_D 2 s), q = 4: B1 on the plateau,
+  S_d = a_g S 2.5 / q = 0.225 g, d_e = 0.013978 m, d_s = q d_e = 0.055910 m (eq. 4.23); B2 at T_C / T: S_d = 0.1125 g,
+  d_e = 0.027955 m, d_s = 0.111821 m; SRSS 0.125019 m, times 0.7 (roofs at the same height, §4.4.2.7(3)) = 0.087513 m.
+* ASCE 7-16 eq. 17.5-1 with B1 on a friction pendulum (μ = 0.05, R = 2.24 m) and S_M1 = 1.2 g: D_M ≈ 0.73 m,
+  T_M ≈ 2.80 s, β_M ≈ 8.4 % (B_M ≈ 1.14 by Table 17.5-1): checked as the equation's fixed point, every term recomputed here.
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from pathlib import Path
+
+import numpy as np
+import pytest
+import xarray as xr
+
+from click.testing import CliRunner
+
+from stochpound.cli import main
+from stochpound.experiment import load_experiment, run_experiment
+from stochpound.experiment._spec import ExperimentError, parse_experiment
+from stochpound.model.scene_file import scene_from_dict
+from stochpound.risk import design_separations, risk_curve, store_risk, stripe_fragility
+from stochpound.store import definition_sha256, open_store
+from tests.helpers import FIXED, REPOSITORY, risk_text, write_experiment
+
+G = 9.81
+DESIGN = {"sds": 1.0, "sd1": 0.6, "tl": 8.0, "r": 8.0, "cd": 5.5, "omega0": 3.0, "ie": 1.0, "sm1": 1.2,
+          "ec8": {"ag": 0.3, "ground": "B", "q": 4.0}}
+DESIGN_TABLE = '\n[design]\nsds = 1.0\nsd1 = 0.6\nr = 8.0\ncd = 5.5\nomega0 = 3.0\nec8 = { ag = 0.3, ground = "B", q = 4.0 }\n'
+
+
+def _building(name: str, period: float, base: dict | None = None) -> dict:
+    mass = 1.0e5
+    building = {"name": name, "mass": [mass], "stiffness": [mass * (2.0 * math.pi / period) ** 2], "damping_ratio": 0.05, "storey_height": [3.0]}
+    return {**building, "base": base} if base else building
+
+
+def _scene(base: dict | None = None) -> object:
+    return scene_from_dict({"g": G, "building": [_building("B1", 0.5, base), _building("B2", 1.0)],
+                            "contact": [{"between": [["B1", 1], ["B2", 1]], "gap": 0.05, "stiffness": 1.0e7, "restitution": 0.5}],
+                            "motion": {"type": "harmonic", "amplitude": 1.0, "omega": 5.0, "duration": 1.0, "dt": 0.01}})
+
+
+def test_the_codes_gaps_of_the_documented_example_equal_the_hand_computation():
+    gaps = design_separations(_scene(), DESIGN, studied="B1")
+    assert sorted(gaps) == ["asce7_delta_mt", "ec8_ds"]  # fixed bases: no eq. 17.5-1
+    assert gaps["asce7_delta_mt"][0] == pytest.approx(0.111044, abs=2e-6)
+    assert gaps["ec8_ds"][0] == pytest.approx(0.087513, abs=2e-6)
+    # the same from the formulas, term by term
+    elastic = [sa * G * (t / (2.0 * math.pi)) ** 2 for sa, t in ((1.0, 0.5), (0.6 / 1.0, 1.0))]
+    assert gaps["asce7_delta_mt"][0] == pytest.approx(math.hypot(*(5.5 * e / 8.0 for e in elastic)), rel=1e-12)
+    ec8 = [sd * G * (t / (2.0 * math.pi)) ** 2 for sd, t in ((0.3 * 1.2 * 2.5 / 4.0, 0.5), (0.3 * 1.2 * 2.5 / 4.0 * 0.5 / 1.0, 1.0))]
+    assert gaps["ec8_ds"][0] == pytest.approx(0.7 * math.hypot(*(4.0 * d for d in ec8)), rel=1e-12)
+
+
+def test_the_eurocode_reduction_applies_only_where_the_floors_stand_level():
+    scene = _scene()
+    uneven = scene_from_dict({"g": G, "building": [{**_building("B1", 0.5), "storey_height": [3.5]}, _building("B2", 1.0)],
+                              "contact": [{"between": [["B1", 1], ["B2", 1]], "gap": 0.05, "stiffness": 1.0e7, "restitution": 0.5}],
+                              "motion": {"type": "harmonic", "amplitude": 1.0, "omega": 5.0, "duration": 1.0, "dt": 0.01}})
+    level, not_level = design_separations(scene, DESIGN)["ec8_ds"][0], design_separations(uneven, DESIGN)["ec8_ds"][0]
+    assert not_level == pytest.approx(0.125019, abs=2e-6) and level == pytest.approx(0.7 * not_level, rel=1e-12)
+
+
+def test_eq_17_5_1_gives_the_pendulum_displacement_at_every_contact():
+    gaps = design_separations(_scene({"mass": 5.0e4, "mu": 0.05, "radius": 2.24}), DESIGN, studied="B1")
+    displacement = gaps["asce7_dtm"][0]
+    assert displacement == pytest.approx(0.73, abs=0.01)
+    period = 2.0 * math.pi / math.sqrt(G / 2.24 + 0.05 * G / displacement)  # eq. 17.5-2, k_M = W/R + μW/D
+    damping = 2.0 * 0.05 / (math.pi * (0.05 + displacement / 2.24))
+    coefficient = 1.0 + (damping - 0.05) / (0.10 - 0.05) * (1.2 - 1.0)  # Table 17.5-1 between 5 % and 10 %
+    assert 0.05 < damping < 0.10 and period == pytest.approx(2.80, abs=0.01)
+    assert displacement == pytest.approx(G * 1.2 * period / (4.0 * math.pi**2 * coefficient), rel=1e-8)  # eq. 17.5-1
+    assert design_separations(_scene({"mass": 5.0e4, "mu": 0.05, "radius": 2.24}), DESIGN, studied="B2").keys() == {"asce7_delta_mt", "ec8_ds"}
+
+
+@pytest.mark.parametrize(("table", "message"), [
+    ("sds = 1.0\nsd1 = 0.6\nr = 0.5\ncd = 5.5\nomega0 = 3.0", "design.r: must be >= 1, got 0.5"),
+    ("sds = 1.0\nsd1 = 0.6\nr = 8.0\ncd = 5.5", "design.omega0: missing"),
+    ("sds = 1.0\nsd1 = 0.6\nr = 8.0\ncd = 5.5\nomega0 = 3.0\nq = 4.0", "design.q: unknown field"),
+    ('sds = 1.0\nsd1 = 0.6\nr = 8.0\ncd = 5.5\nomega0 = 3.0\nec8 = { ag = 0.3, ground = "F", q = 4.0 }', "design.ec8.ground: must be one of A, B, C, D, E"),
+    ("sds = -1.0\nsd1 = 0.6\nr = 8.0\ncd = 5.5\nomega0 = 3.0", "design.sds: must be > 0"),
+])
+def test_design_errors_are_one_line_naming_the_field_and_range(table, message):
+    text = risk_text(FIXED, "gap = [inf]", 'measure = "psa"\nperiod = 1.0\nlevels = [0.3, 0.8]') + f"\n[design]\n{table}\n"
+    with pytest.raises(ExperimentError) as error:
+        parse_experiment(tomllib.loads(text), base_dir=REPOSITORY)
+    assert message in str(error.value) and "\n" not in str(error.value)
+
+
+def test_the_design_is_not_part_of_the_runs_identity():
+    text = risk_text(FIXED, "gap = [inf]", 'measure = "psa"\nperiod = 1.0\nlevels = [0.3, 0.8]')
+    without, with_design = (parse_experiment(tomllib.loads(t), base_dir=REPOSITORY) for t in (text, text + DESIGN_TABLE))
+    assert "design" not in without and with_design["design"]["cd"] == 5.5 and with_design["design"]["ie"] == 1.0
+    assert definition_sha256(with_design) == definition_sha256(without)
+
+
+@pytest.fixture(scope="module")
+def design_store(tmp_path_factory) -> Path:
+    """The fixed pair (tests.helpers.FIXED) with the [design] above: 8 motions x 3 stripes, contact-free."""
+    text = risk_text(FIXED, "gap = [inf]", 'measure = "psa"\nperiod = 1.0\nlevels = [0.3, 0.8, 1.5]') + DESIGN_TABLE
+    report = run_experiment(load_experiment(write_experiment(tmp_path_factory.mktemp("design"), text, "design.toml")), workers=0, progress=False)
+    assert report.complete
+    return report.store
+
+
+def test_the_codes_gaps_are_rows_of_the_rules_table_with_their_risk(design_store):
+    store = open_store(design_store)
+    risk = store_risk(store, bootstrap=40)
+    expected = design_separations(store.pound.scene(gap=math.inf, intensity=0.3, record=store["record"].values[0]), store.pound.definition.design)
+    np.testing.assert_allclose(risk.design_rules["gap"].sel(rule="asce7_delta_mt").values, expected["asce7_delta_mt"], rtol=1e-12)
+    np.testing.assert_allclose(risk.design_rules["gap"].sel(rule="ec8_ds").values, expected["ec8_ds"], rtol=1e-12)
+    frame = risk.rules_frame().reset_index()
+    rows = frame[frame["design_level"].str.endswith("(design analysis)")]
+    assert list(rows["rule"]) == ["ASCE 7 §12.12.3 δ_MT of the design analysis", "Eurocode 8 §4.4.2.7 d_s of the design analysis"]
+    assert list(rows["design_level"]) == ["2 %/50 yr (design analysis)", "10 %/50 yr (design analysis)"]
+    assert (frame["design_level"].str.contains("stripe")).sum() > 0  # the suite-mean rows stay beside them
+    # the risk at the gap: runs that pound counted here from the stored closures, contact by contact, and fitted by the chain
+    closure = store["peak_contact_closure"].sel(gap=math.inf).isel(realization=0).transpose("intensity", "record", "contact").values
+    for rule in ("asce7_delta_mt", "ec8_ds"):
+        gap = risk.design_rules["gap"].sel(rule=rule).values
+        pounds = np.array([[float(any(closure[i, r, c] >= gap[c] for c in range(closure.shape[2]))) for r in range(closure.shape[1])]
+                           for i in range(closure.shape[0])])
+        events = xr.DataArray(pounds, dims=("intensity", "record"), coords={"intensity": store["intensity"].values})
+        maf = risk_curve(stripe_fragility(events, bootstrap=0), risk.hazard)["maf"]
+        assert 0.0 < pounds.mean() < 1.0  # the example pounds in some runs, not all
+        assert float(risk.design_rules["maf"].sel(rule=rule)) == pytest.approx(float(maf), rel=1e-9)
+    allowed = -np.log(1.0 - np.array([0.02, 0.10])) / 50.0
+    assert list(rows["meets its level"]) == list(risk.design_rules["maf"].values <= allowed)
+    assert all(rows["once in (yr)"] == 1.0 / risk.design_rules["maf"].values)
+
+
+def test_stochpound_risk_prints_the_codes_gaps_beside_the_suite_mean_rules(design_store):
+    result = CliRunner().invoke(main, ["risk", str(design_store), "--bootstrap", "0"])
+    assert result.exit_code == 0, result.output
+    risk = store_risk(open_store(design_store), bootstrap=0)
+    for text in ("SRSS of suite-mean peaks", "ASCE 7 §12.12.3 δ_MT of the design analysis", "Eurocode 8 §4.4.2.7 d_s of the design analysis",
+                 "2 %/50 yr (design analysis)", "10 %/50 yr (design analysis)"):
+        assert text in result.output
+    period = float(risk.design_rules["return_period"].sel(rule="asce7_delta_mt"))
+    assert f"ASCE 7 §12.12.3 δ_MT of the design analysis, once in {period:.3g} years" in result.output.replace("\n", " ")
+
+
+def test_stochpound_risk_takes_a_design_file_and_refuses_a_bad_one(design_store, tmp_path):
+    (tmp_path / "stronger.toml").write_text("[design]\nsds = 1.0\nsd1 = 0.6\nr = 4.0\ncd = 4.0\nomega0 = 2.5\n")
+    result = CliRunner().invoke(main, ["risk", str(design_store), "--bootstrap", "0", "--design", str(tmp_path / "stronger.toml")])
+    assert result.exit_code == 0, result.output
+    gaps = design_separations(open_store(design_store).pound.scene(gap=math.inf, intensity=0.3, record=open_store(design_store)["record"].values[0]),
+                              {"sds": 1.0, "sd1": 0.6, "tl": 8.0, "r": 4.0, "cd": 4.0, "omega0": 2.5, "ie": 1.0})
+    assert f"{gaps['asce7_delta_mt'][0]:.4g}" in result.output and "Eurocode 8 §4.4.2.7 d_s of the design analysis" not in result.output
+    (tmp_path / "bad.toml").write_text("[design]\nsds = 1.0\nsd1 = 0.6\nr = 8.0\ncd = 12.0\nomega0 = 3.0\n")
+    result = CliRunner().invoke(main, ["risk", str(design_store), "--bootstrap", "0", "--design", str(tmp_path / "bad.toml")])
+    assert result.exit_code != 0 and "design.cd: must be <= 10, got 12" in result.output and "Traceback" not in result.output
+
+
+def test_editing_the_design_keeps_the_runs_and_records_it(tmp_path):
+    """A run after only [design] changed keeps the store's cases (no run depends on it) and records the new design."""
+    text = risk_text(FIXED, "gap = [inf]", 'measure = "psa"\nperiod = 1.0\nlevels = [0.3, 0.8]').replace("duration = 5.0", "duration = 1.0")
+    path = write_experiment(tmp_path, text, "edit.toml")
+    store = run_experiment(load_experiment(path), workers=0, progress=False).store
+    with open_store(store) as ds:
+        before = ds["peak_contact_closure"].load()
+        assert ds.pound.definition.design is None
+    path.write_text(text + DESIGN_TABLE)
+    said: list[str] = []
+    report = run_experiment(load_experiment(path), workers=0, progress=False, say=said.append)
+    assert report.nothing_to_run and report.done_now == 0
+    assert any("the [design] changed" in line for line in said) and not any("hazard changed" in line for line in said)
+    with open_store(store) as ds:
+        assert ds.pound.definition.design["cd"] == 5.5 and ds.pound.definition.design["ec8"]["q"] == 4.0
+        xr.testing.assert_identical(ds["peak_contact_closure"].load(), before)
