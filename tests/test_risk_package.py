@@ -64,9 +64,9 @@ def test_every_store_read_of_the_chain_is_in_one_module():
     select cases), and only it looks into a store (its attributes, variables, dimensions, accessor)."""
     readers = {path.name for path in RISK.glob("*.py")
                if any(module.startswith(("stochpound.experiment", "stochpound.store")) for module in _imports(path))}
-    assert readers <= {"_store.py", "_efficiency.py"}  # _efficiency.py (from the site work) still reads its stores itself: to be moved here
+    assert readers <= {"_store.py"}
     touching = {path.name for path in RISK.glob("*.py") if re.search(r"\bstore(\.attrs|\[|\.dims|\.sizes|\.sel|\.isel|\.data_vars|\.pound)", path.read_text())}
-    assert touching <= {"_store.py", "_efficiency.py"}  # the other modules hand the store to _store's functions, never look into it
+    assert touching <= {"_store.py"}  # the other modules hand the store to _store's functions, never look into it
 
 
 def test_report_sections_keep_no_cache():

@@ -18,10 +18,7 @@ import xarray as xr
 from stochpound.analysis import HazardCurve, bundled_measure, bundled_site_curves, hazard_consistency, rate_from_probability
 from stochpound.risk._efficiency import _interpolated
 from stochpound.risk._maf import TARGETS
-from stochpound.risk._store import scene_g, site_hazard, store_motions
-
-STRUCTURAL_KEEP = ("intensity", "record", "realization", "spectrum_period")
-
+from stochpound.risk._store import stripe_spectra_runs
 
 def _label(measure: dict[str, float | str]) -> str:
     return "PGA" if measure["measure"] == "pga" else f"PSA({float(measure['period']):g} s)"
@@ -44,27 +41,19 @@ def site_consistency(store: xr.Dataset) -> dict[str, xr.Dataset]:
         intensities ``im`` (g). Empty when the store has no stripes or its
         hazard is not a bundled curve of a site with curves at other periods.
     """
-    entry = store.pound.hazard
-    if "intensity" not in store.dims or entry is None or entry.bundled is None or "motion_psa" not in store:
+    runs = stripe_spectra_runs(store)
+    if runs is None:
         return {}
-    others = [name for name in bundled_site_curves(entry.bundled) if name != entry.bundled]
-    if not others:
-        return {}
-    hazard = site_hazard(store)
-    ran = (store["case_status"] == 1).any([d for d in store["case_status"].dims if d not in STRUCTURAL_KEEP])
-    first = {d: 0 for d in store["scale_factor"].dims if d not in STRUCTURAL_KEEP}
-    scale = store_motions(store["scale_factor"].isel(first).where(ran))
-    g = scene_g(store)
+    others = [name for name in bundled_site_curves(runs["bundled"]) if name != runs["bundled"]]
     results = {}
     for name in others:
         measure = bundled_measure(name)
         if measure["measure"] == "pga":
-            unscaled = store_motions(store["motion_pga"].isel({d: 0 for d in store["motion_pga"].dims if d not in STRUCTURAL_KEEP}))
+            unscaled = runs["pga"]
         else:
-            psa = store_motions(store["motion_psa"].isel({d: 0 for d in store["motion_psa"].dims if d not in STRUCTURAL_KEEP}))
-            unscaled = _interpolated(psa, store["spectrum_period"].values, [float(measure["period"])]).isel(period=0, drop=True)
-        spectra = (unscaled / g * scale).transpose("intensity", "record")
-        results[_label(measure)] = hazard_consistency(spectra, hazard, HazardCurve.bundled(name))
+            unscaled = _interpolated(runs["psa"], runs["spectrum_periods"], [float(measure["period"])]).isel(period=0, drop=True)
+        spectra = (unscaled / runs["g"] * runs["scale_factor"]).transpose("intensity", "record")
+        results[_label(measure)] = hazard_consistency(spectra, runs["hazard"], HazardCurve.bundled(name))
     return results
 
 

@@ -366,3 +366,36 @@ def at_finite_gaps(data: xr.Dataset) -> xr.Dataset:
 def contact_free_twins(data: xr.DataArray) -> xr.DataArray | None:
     """Each configuration's contact-free twin in ``data`` (``inf`` on every contact axis, broadcast over them), or None without them."""
     return contact_free(data).broadcast_like(data) if has_contact_free(data) else None
+
+
+def stripe_spectra_runs(store: xr.Dataset) -> dict[str, Any] | None:
+    """What the site-consistency check reads of a stripes store whose hazard is a bundled curve, or None.
+
+    Returns
+    -------
+    dict or None
+        ``bundled`` (the store's bundled hazard curve's name), ``hazard``
+        (the store's hazard curve), ``scale_factor`` (per ``intensity`` and
+        ``record``, NaN where the motion did not run in the stripe), ``pga``
+        (m/s²) and ``psa`` (over ``spectrum_period``, m/s²) of every motion
+        at scale 1, ``spectrum_periods`` (s) and ``g`` (m/s²). None for a
+        store without stripes, spectra or a bundled hazard.
+    """
+    entry = store.pound.hazard
+    if "intensity" not in store.dims or entry is None or entry.bundled is None or "motion_psa" not in store:
+        return None
+    keep = ("intensity", "record", "realization", "spectrum_period")
+
+    def first(name: str) -> xr.DataArray:
+        return store[name].isel({d: 0 for d in store[name].dims if d not in keep})
+
+    ran = (store["case_status"] == 1).any([d for d in store["case_status"].dims if d not in keep])
+    return {
+        "bundled": entry.bundled,
+        "hazard": site_hazard(store),
+        "scale_factor": store_motions(first("scale_factor").where(ran)),
+        "pga": store_motions(first("motion_pga")),
+        "psa": store_motions(first("motion_psa")),
+        "spectrum_periods": store["spectrum_period"].values,
+        "g": scene_g(store),
+    }
