@@ -39,3 +39,16 @@ def test_a_selection_store_says_motions_per_stripe_from_a_pool_with_the_scale_fa
 def test_a_suite_store_says_every_motion_is_scaled_to_every_level(cs_store) -> None:
     suite = cs_store.drop_vars([name for name in cs_store.variables if str(name).startswith(("selection_", "site_", "target_"))])
     assert stripe_motions_text(suite) == "8 motions, each scaled to every level"
+
+
+def test_a_configuration_s_scene_is_read_from_a_case_that_ran_where_the_first_motion_was_not_chosen(cs_store) -> None:
+    """The design rules read each configuration's scene from its contact-free case: with motions selected per stripe,
+    the first stripe's first motion may not have run there (the report build failed with a KeyError)."""
+    from stochpound.risk._store import configuration_scene
+
+    status = cs_store["case_status"]
+    labels = {dim: cs_store[dim].values[0] for dim in status.dims if dim not in ("intensity", "record", "realization", *cs_store.pound.gap_dims)}
+    scene = configuration_scene(cs_store, labels)
+    assert [b.name for b in scene.buildings] == [str(b) for b in cs_store["building"].values]
+    unchosen = cs_store.isel(record=[i for i in range(cs_store.sizes["record"]) if (status.isel(intensity=0, record=i) != 1).all()])
+    assert unchosen.sizes["record"] > 0, "the store has a motion the first stripe did not choose"

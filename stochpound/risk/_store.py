@@ -139,9 +139,18 @@ def design(store: xr.Dataset) -> Mapping[str, Any] | None:
 
 
 def configuration_scene(store: xr.Dataset, labels: Mapping[str, Any]) -> Scene:
-    """The scene of one configuration of a store (``labels`` on its variant and μ axes): its contact-free case at the first stripe and motion."""
+    """The scene of one configuration of a store (``labels`` on its variant and μ axes): its first contact-free case that ran.
+
+    With motions selected per stripe, a motion runs only at the stripes that
+    chose it: the first stripe and motion of a case that ran, not the first of each.
+    """
     fixed = {dim: math.inf for dim in store.pound.gap_dims}
-    fixed.update({dim: store[dim].values[0] for dim in ("intensity", "record", "realization") if dim in store.dims})
+    motion_dims = [dim for dim in ("intensity", "record", "realization") if dim in store.dims]
+    status = store["case_status"].sel({**fixed, **labels})
+    ran = np.argwhere(status.transpose(*motion_dims).values == 1)
+    if ran.size == 0:
+        raise RiskInputError(f"store: no contact-free case of the configuration {dict(labels)} ran")
+    fixed.update({dim: store[dim].values[index] for dim, index in zip(motion_dims, ran[0])})
     return store.pound.scene(**fixed, **labels)
 
 
