@@ -31,7 +31,7 @@ def report_text(out: Path, folder: Path) -> str:
     parts = ["\n".join(line for line in lines if line)]
     parts += [f"== {table.name}\n{table.read_text()}" for table in sorted((out / "tables").glob("*.csv"))]
     text = "\n".join(parts).replace(str(folder), "<folder>")
-    text = re.sub(r"\b[0-9a-f]{40}\b", "<commit>", text)
+    text = re.sub(r"\b[0-9a-f]{40}\b(\+dirty)?", "<commit>", text)  # a build from a tree with changes says +dirty
     return re.sub(r"\b\d{4}-\d{2}-\d{2}\b", "<date>", text) + "\n"
 
 

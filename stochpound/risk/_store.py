@@ -167,7 +167,7 @@ def assumptions(store: xr.Dataset) -> dict[str, str]:
     for building in definition.scene.get("building", []):
         storeys = len(building.get("mass", []))
         storey = "yielding (bilinear) storeys" if "yield_force" in building else "linear elastic storeys"
-        base = "a sliding base" if "base" in building else "a fixed base"
+        base = _base_words(definition.mu, building)
         models.append(f"{building.get('name', '?')}: {storeys}-storey shear building, {storey}, on {base}")
     kinds = {"record": "records without a named suite", "synthetic": "synthetic ensembles"}
     suites = sorted({source.suite or kinds.get(source.kind, source.kind) for source in definition.motions})
@@ -176,10 +176,32 @@ def assumptions(store: xr.Dataset) -> dict[str, str]:
     selection = entry.get("selection")
     suite = (f"{count} motions ({', '.join(suites)}), "
              + (f"selected per stripe by {str(selection).replace('_', ' ')}" if selection else "every motion scaled to every stripe (no selection)"))
-    site = entry.get("site")
-    scenario = "; ".join(f"{key} {value}" for key, value in site.items()) if isinstance(site, Mapping) else ""
+    scenario = _scenario_words(store, entry) if entry.get("site") else ""
     return {"structural model": "; ".join(models), "suite": suite,
             "scenario": scenario or "none stated (the motions are not selected for a scenario)"}
+
+
+def _base_words(mu: Any, building: Mapping[str, Any]) -> str:
+    """A building's base in words, as the grid's μ axis leaves it (the axis may fix a base or set its μ)."""
+    name = building.get("name", "?")
+    if mu is None or not mu.sets(name, "base" in building):
+        return "a sliding base" if "base" in building else "a fixed base"
+    if not mu.finite_values:
+        return "a fixed base (μ = ∞ on the grid)"
+    sliding = f"a sliding base (μ {', '.join(f'{v:g}' for v in mu.finite_values)} on the grid)"
+    return f"{sliding} or a fixed base" if mu.has_fixed_base else sliding
+
+
+def _scenario_words(store: xr.Dataset, intensity: Mapping[str, Any]) -> str:
+    """The stripes' scenario in words (the ``[intensity]`` entry's, as stored): fitted to the site's curves or as given, with its values."""
+    kind = "fitted to the site's hazard curves (a calibration standing in for a disaggregation)" if "fitted" in str(intensity.get("note", "")) \
+        else "as the [site] table gives it (an assumption unless it comes from the site's disaggregation)"
+    if "site_magnitude" not in store:
+        return kind
+    def span(name: str) -> str:
+        values = np.unique(np.round(store[name].values.astype(float), 2))
+        return "–".join(f"{v:g}" for v in (values[0], values[-1])) if values.size > 1 else f"{values[0]:g}"
+    return f"M {span('site_magnitude')}, R {span('site_distance_km')} km, Vs30 {span('site_vs30')} m/s, {kind}"
 
 
 def stripes(store: xr.Dataset) -> int | None:
