@@ -184,3 +184,44 @@ def test_run_takes_several_files_but_one_store(tmp_path):
     assert result.returncode != 0 and "--store names one store" in result.stderr
     result = cli("experiment", "run", str(first), str(tmp_path / "missing.toml"), check=False)
     assert result.returncode != 0 and not (tmp_path / "small.nc").exists()
+
+
+def _yielding_b2(data: dict) -> dict:
+    data["scene"]["building"][1].update(yield_force=[2.0e5, 1.2e5], hardening=0.02)
+    return data
+
+
+def test_a_variant_sets_yield_force_and_hardening():
+    """A variant replaces a building's yield shears and hardening; mass_factor leaves the yield shears as given (N)."""
+    data = _yielding_b2(small())
+    data["variants"]["neighbour"]["stiff"]["building"]["B2"].update(yield_force=[1.0e5, 6.0e4], hardening=0.05)
+    exp = experiment(data)
+    seen = {}
+    for case in exp.cases:
+        if case.kind == "case":
+            b2 = stochpound.scene_from_dict(exp.structure(case)).buildings[1]
+            seen[case.label_dict["neighbour"]] = (b2.yield_force, b2.hardening, b2.mass[0])
+    assert seen["stiff"] == ((1.0e5, 6.0e4), 0.05, pytest.approx(26268.0 * 0.5))
+    assert seen["flexible"] == ((2.0e5, 1.2e5), 0.02, pytest.approx(26268.0 * 2.0))  # mass × 2, strength unchanged
+
+
+@pytest.mark.parametrize(
+    "fields, message",
+    [
+        ({"yield_force": [1.0e5, -1.0]}, r"^case neighbour=stiff, gap=0.01, mu=0.2: building\[1\]\.yield_force\[1\]: must be > 0, got -1"),
+        ({"yield_force": [1.0e5]}, r"^case neighbour=stiff, gap=0.01, mu=0.2: building\[1\]\.yield_force: must have 2 values"),
+        ({"hardening": 1.0}, r"^case neighbour=stiff, gap=0.01, mu=0.2: building\[1\]\.hardening: must be < 1, got 1"),
+    ],
+)
+def test_bad_yielding_variants_are_named(fields, message):
+    data = _yielding_b2(small())
+    data["variants"]["neighbour"]["stiff"]["building"]["B2"].update(fields)
+    with pytest.raises(ExperimentError, match=message):
+        experiment(data)
+
+
+def test_a_variant_cannot_give_hardening_to_an_elastic_building():
+    data = small()
+    data["variants"]["neighbour"]["stiff"]["building"]["B2"]["hardening"] = 0.02
+    with pytest.raises(ExperimentError, match=r"^case neighbour=stiff, gap=0.01, mu=0.2: building\[1\]\.hardening: only a building with yield_force"):
+        experiment(data)

@@ -19,6 +19,9 @@ masses by f (floors and base) keeps its dynamics consistent:
   Kelvin–Voigt element k_imp × ratio keeps its impact frequency
   sqrt(k_imp / m_eff), and c_imp follows from the restitution (or, when given
   as ``damping``, × the same ratio, which keeps its damping ratio).
+* yielding storeys keep their ``yield_force`` as given (N): a building f
+  times heavier is 1/f as strong per unit weight (a variant gives its own
+  ``yield_force`` to keep a design).
 
 The *μ axis* rule: a finite μ is given to each chosen base by its friction
 law (:meth:`stochpound.model.laws.contract.FrictionLaw.set_mu`), which scales

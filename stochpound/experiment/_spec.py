@@ -42,7 +42,7 @@ FORMAT_VERSION = 1
 
 _TOP_KEYS = {"experiment", "scene", "variants", "grid", "records", "motions", "synthetic", "output", "solver", "intensity", "hazard", "site", "design"}
 _EXPERIMENT_KEYS = {"name", "description", "scene", "studied", "reproduces"}
-_BUILDING_OVERRIDES = {"mass_factor", "mass", "stiffness", "damping", "damping_ratio", "base", "initial"}
+_BUILDING_OVERRIDES = {"mass_factor", "mass", "stiffness", "damping", "damping_ratio", "base", "initial", "yield_force", "hardening"}
 _SCENE_OVERRIDES = {"study_compat", "wall"}
 AUTO = "auto"
 """``solver.method`` default: each case's solver chosen by :func:`stochpound.simulate` (exact unless a law is nonlinear)."""
