@@ -17,6 +17,7 @@ from dataclasses import dataclass
 from functools import cached_property
 from typing import Any
 
+import numpy as np
 import pandas as pd
 import xarray as xr
 
@@ -155,8 +156,38 @@ def _base(definition: StoreDefinition, building: Building, g: float) -> str:
     return "; ".join(parts)
 
 
+def has_yielding(definitions: Iterable[StoreDefinition]) -> bool:
+    """Whether a building the stores ran has yielding (bilinear) storeys."""
+    return any(b.yield_force is not None for d in definitions for c in d.configurations for b in c.scene.buildings)
+
+
+def _storeys(definitions: Iterable[StoreDefinition]) -> bool:
+    """Whether a building the stores ran has storey heights, yielding storeys or P-Δ (the table's storey columns)."""
+    return any(b.yield_force is not None or b.storey_height is not None for d in definitions for c in d.configurations for b in c.scene.buildings)
+
+
+def _yielding(building: Building) -> str:
+    """A building's bilinear storeys: yield shears, yield drifts (and drift ratios) and hardening; ``elastic`` without."""
+    if building.yield_force is None:
+        return "elastic"
+    drift = [force / k for force, k in zip(building.yield_force, building.stiffness)]
+    ratio = f"; {percent(d / h for d, h in zip(drift, building.storey_height))} of h" if building.storey_height else ""
+    return (f"F_y = {numbers(building.yield_force)} N (yield drift {numbers((1000.0 * d for d in drift), 3)} mm{ratio}), "
+            f"hardening α = {percent([building.hardening])}")
+
+
+def _p_delta(building: Building, g: float) -> str:
+    """A building's P-Δ storey stiffnesses −W/h and their share of the elastic ones; ``no`` without P-Δ."""
+    if not building.p_delta:
+        return "no"
+    geometric = building.geometric_stiffness(g)
+    return f"W/h = {numbers(-geometric, 4)} N/m taken off k ({percent(-geometric / np.asarray(building.stiffness))})"
+
+
 def buildings_table(definitions: Iterable[StoreDefinition]) -> Table:
-    """Every building configuration the stores ran: masses, stiffnesses, damping, modes and base."""
+    """Every building configuration the stores ran: masses, stiffnesses, damping, modes and base; storeys' heights, strength and P-Δ where any has them."""
+    definitions = list(definitions)
+    storeys = _storeys(definitions)
     rows: dict[tuple, list[str]] = {}
     for definition in definitions:
         for configuration in definition.configurations:
@@ -173,14 +204,20 @@ def buildings_table(definitions: Iterable[StoreDefinition]) -> Table:
                     percent(modes.damping_ratio) + damping_note,
                     _base(definition, building, configuration.scene.g),
                 )
+                if storeys:
+                    heights = numbers(building.storey_height) if building.storey_height else "–"
+                    row += (heights, _yielding(building), _p_delta(building, configuration.scene.g))
                 rows.setdefault(row, []).append((definition, configuration))
-    return _merged_table(
-        "table-buildings",
-        "The buildings as run: floor masses (floor 1 upwards), storey stiffnesses, damping, the fixed-base modes and the base.",
-        ["building", "floors", "masses (kg)", "storey stiffness (N/m)", "damping", "periods (s)", "modal damping", "base"],
-        rows,
-        "Periods and modal damping ratios are computed from the mass, stiffness and damping matrices of each building on a fixed base.",
-    )
+    columns = ["building", "floors", "masses (kg)", "storey stiffness (N/m)", "damping", "periods (s)", "modal damping", "base"]
+    caption = "The buildings as run: floor masses (floor 1 upwards), storey stiffnesses, damping, the fixed-base modes and the base"
+    note = "Periods and modal damping ratios are computed from the mass, stiffness and damping matrices of each building on a fixed base"
+    if storeys:
+        columns += ["storey height (m)", "storeys", "P-Δ"]
+        caption += "; the storeys' heights, strength (yield shears F_y, storey 1 upwards) and P-Δ"
+        note += (" (the elastic storey stiffnesses, without P-Δ). A yielding storey is bilinear with kinematic hardening: stiffness k "
+                 "up to its yield shear F_y (yield drift F_y/k), α k beyond it, elastic unloading. With P-Δ each storey also carries "
+                 "the geometric stiffness −W/h of the weight W above it (h its height)")
+    return _merged_table("table-buildings", caption + ".", columns, rows, note + ".")
 
 
 def _contact_row(definition: StoreDefinition, scene: Scene, index: int, contact: Contact) -> tuple[str, ...]:
@@ -379,6 +416,15 @@ def model_paragraph(definitions: list[StoreDefinition]) -> Paragraph:
     contacts = [c for s in scenes for c in s.contacts]
     isolated = any(b.base is not None for b in buildings)
     sentences = ["Buildings are shear buildings: lumped floor masses joined by storey springs and dashpots, standing in a row on the same ground."]
+    if has_yielding(definitions):
+        sentences.append(
+            "Storeys given a yield shear F_y are bilinear with kinematic hardening (table of buildings): stiffness k up to F_y, α k "
+            "beyond it, elastic unloading from the force reached; each such storey's plastic drift is a state of the solution, "
+            "yield and unloading are located as events like contact and slip (docs/model.md), and the drift a storey keeps at rest "
+            "after the run is its residual drift. There is no strength loss: no degradation, no collapse."
+        )
+    if any(b.p_delta for b in buildings):
+        sentences.append("With P-Δ a storey's spring is softened by the geometric stiffness −W/h of the weight above it, in its elastic and post-yield branches alike.")
     if isolated:
         friction = sorted({laws.friction_law(b.base.friction_law).title for b in buildings if b.base is not None})
         sentences.append(

@@ -16,7 +16,7 @@ import xarray as xr
 import stochpound
 from stochpound.motions.records import registry_entries
 from stochpound.report.sections._accuracy import accuracy_paragraphs
-from stochpound.report.sections._description import StoreDefinition, buildings_table, contacts_table, grid_paragraph, model_paragraph, motions_table, records_used
+from stochpound.report.sections._description import StoreDefinition, buildings_table, has_yielding, contacts_table, grid_paragraph, model_paragraph, motions_table, records_used
 from stochpound.report.render import Paragraph, Section, Table
 from stochpound.report.sections._intensity import method_text
 from stochpound.report.sections._risk import hazard_provenance
@@ -29,6 +29,11 @@ EXACT_TEXT = (
     "ground acceleration is a polynomial between samples (linear, or the natural cubic spline where a record asks for it), "
     "so the state is advanced by matrix exponentials without truncation error, and contact, separation, slip and stop are "
     "located on that exact flow, including crossings hidden inside a sample interval"
+)
+
+YIELDING_TEXT = (
+    "; a yielding storey is linear in each of its states (elastic, or flowing with its plastic drift following the storey's drift), "
+    "so its yield and its elastic unloading are located on the same exact flow"
 )
 
 
@@ -76,6 +81,8 @@ def solver_paragraph(definitions: list[StoreDefinition]) -> Paragraph:
             text = integrated
         else:
             text = _automatic_solver(definition, integrated)
+        if has_yielding([definition]):
+            text = text.replace(EXACT_TEXT, EXACT_TEXT + YIELDING_TEXT)
         by_solver.setdefault(text, []).append(definition.name)
     return Paragraph(" ".join(f"{', '.join(names)}: every case is solved with {text}." for text, names in by_solver.items()))
 
