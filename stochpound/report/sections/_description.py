@@ -23,7 +23,7 @@ import xarray as xr
 
 from stochpound import motions as synthetic_motions
 from stochpound.experiment import CASE, Case, GapAxis, describe_measure, is_fixed_base
-from stochpound.model import laws
+from stochpound.model import design_yield_shears, laws
 from stochpound.model.contact import effective_mass
 from stochpound.model.modal_solution import modal_properties
 from stochpound.motions.records import load_record, registry_entries
@@ -182,6 +182,42 @@ def _p_delta(building: Building, g: float) -> str:
         return "no"
     geometric = building.geometric_stiffness(g)
     return f"W/h = {numbers(-geometric, 4)} N/m taken off k ({percent(-geometric / np.asarray(building.stiffness))})"
+
+
+def design_paragraph(definition: StoreDefinition) -> Paragraph | None:
+    """The code design a store's ``[design]`` states, and each yielding building's strength against it (None without both).
+
+    The strength of a building with storey heights is set beside the ASCE 7-16
+    equivalent lateral force yield shears of that design at the building's
+    computed fixed-base period (:func:`stochpound.model.design_yield_shears`,
+    without the S_1 floor of C_s, which ``[design]`` does not give).
+    """
+    design = definition.definition.design
+    if design is None or not has_yielding([definition]):
+        return None
+    basis = (f"S_DS = {number(design['sds'], 4)} g, S_D1 = {number(design['sd1'], 4)} g, T_L = {number(design['tl'])} s, R = {number(design['r'])}, "
+             f"C_d = {number(design['cd'])}, Ω0 = {number(design['omega0'])}, I_e = {number(design['ie'])}")
+    strengths: dict[str, list[str]] = {}
+    for configuration in definition.configurations:
+        g = configuration.scene.g
+        for building in configuration.scene.buildings:
+            if building.yield_force is None:
+                continue
+            weight = g * sum(building.mass)
+            text = f"{building.name}: F_y,1 / W = {number(building.yield_force[0] / weight, 3)}"
+            if building.storey_height is not None:
+                period = float(modal_properties(building).periods[0])
+                code = design_yield_shears(building.mass, building.storey_height, period=period, sds=design["sds"], sd1=design["sd1"],
+                                           r=design["r"], overstrength=design["omega0"], importance=design["ie"], long_period=design["tl"], g=g)
+                text += (f", the design's Ω0 V / W = {number(code[0] / weight, 3)} at T1 = {number(period, 3)} s "
+                         f"(its yield shears {numbers(code, 4)} N; the building's are {numbers(np.asarray(building.yield_force) / code, 3)} times those)")
+            strengths.setdefault(text, []).append(configuration.name)
+    every = len(definition.configurations)
+    return Paragraph(
+        f"Experiment {definition.name}: the buildings' code design ([design], ASCE 7-16): {basis}. Strength (W = g Σ m, the floors' weight; "
+        "ASCE 7-16 equivalent lateral force at the computed fixed-base period, without the S_1 floor of C_s): "
+        + "; ".join(text + (f" ({' or '.join(names)})" if len(names) < every else "") for text, names in strengths.items()) + "."
+    )
 
 
 def buildings_table(definitions: Iterable[StoreDefinition]) -> Table:

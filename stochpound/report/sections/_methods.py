@@ -16,7 +16,7 @@ import xarray as xr
 import stochpound
 from stochpound.motions.records import registry_entries
 from stochpound.report.sections._accuracy import accuracy_paragraphs
-from stochpound.report.sections._description import StoreDefinition, buildings_table, has_yielding, contacts_table, grid_paragraph, model_paragraph, motions_table, records_used
+from stochpound.report.sections._description import StoreDefinition, buildings_table, design_paragraph, has_yielding, contacts_table, grid_paragraph, model_paragraph, motions_table, records_used
 from stochpound.report.render import Paragraph, Section, Table
 from stochpound.report.sections._intensity import method_text
 from stochpound.report.sections._risk import hazard_provenance
@@ -51,6 +51,9 @@ def methods_section(stores: Mapping[str, xr.Dataset]) -> Section:
         if hazard:
             section.add(Paragraph(f"Experiment {definition.name}: {hazard}"))
     section.add(buildings_table(definitions))
+    for paragraph in map(design_paragraph, definitions):
+        if paragraph is not None:
+            section.add(paragraph)
     contacts = contacts_table(definitions)
     if contacts is not None:
         section.add(contacts)
