@@ -20,7 +20,10 @@ the demand hazard curves and the moat walls' limit state
 (:class:`StoreDemands`); :func:`limit_state_risk` the fragility and MAF of
 limit states beyond first contact (:class:`LimitState`: drift ratios,
 ductility, floor acceleration, impact force, a bearing's stop) at every gap
-of a store's grid against its contact-free twins (:func:`gap_cost_frame`).
+of a store's grid against its contact-free twins (:func:`gap_cost_frame`);
+:func:`store_damage` the ductility and residual drift demands of yielding
+buildings per stripe, the runs beyond the model and the governing limit
+state (:class:`StoreDamage`).
 
 This package is the canonical home of these names; the ones that
 :mod:`stochpound.analysis` exported before it existed stay importable from
@@ -55,6 +58,7 @@ from stochpound.risk._store_risk import StoreRisk, pounding_fragility, risk_gaps
 from stochpound.risk._demands import StoreDemands, store_demands
 from stochpound.risk._limit_states import KINDS as LIMIT_STATE_KINDS, LimitState, gap_cost_frame, limit_state_risk, limit_states_from_table
 from stochpound.risk._efficiency import measure_efficiency, most_efficient
+from stochpound.risk._damage import DEFAULT_LIMIT_STATES, DEFAULT_SOURCE as DEFAULT_LIMIT_STATES_SOURCE, MODEL_DRIFT_LIMIT, StoreDamage, store_damage
 from stochpound.analysis import hazard_consistency, stripe_rate_weights
 from stochpound.risk._site_consistency import consistency_at_targets, site_consistency
 
@@ -101,6 +105,11 @@ __all__ = [
     "limit_states_from_table",
     "limit_state_risk",
     "gap_cost_frame",
+    "store_damage",
+    "StoreDamage",
+    "DEFAULT_LIMIT_STATES",
+    "DEFAULT_LIMIT_STATES_SOURCE",
+    "MODEL_DRIFT_LIMIT",
     "hazard_consistency",
     "consistency_at_targets",
     "site_consistency",

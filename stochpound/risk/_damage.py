@@ -1,0 +1,152 @@
+"""The damage yielding buildings take: ductility, residual drift and drift demands per stripe, runs beyond the model, the governing limit state.
+
+Read from a stripes store of yielding buildings (the storey summaries,
+``stochpound.store.STOREY_SUMMARIES``), over its contact-free runs where it
+has them (the runs the separations come from), else over every run:
+
+* the median and 84 % fractile over each stripe's motions of every
+  building's peak storey ductility, residual storey drift and peak storey
+  drift ratio (empirical quantiles, linear interpolation);
+* per stripe, the runs whose peak storey drift ratio exceeds
+  :data:`MODEL_DRIFT_LIMIT`: the bilinear storeys never lose strength, so
+  such a run's drifts are beyond what the model represents and are counted,
+  not taken as credible;
+* the limit states' mean annual frequencies (:func:`~stochpound.risk.limit_state_risk`)
+  and, per configuration and target, the one that governs: the most frequent
+  of pounding at the risk-targeted separation g* (the target's rate) and the
+  structural limit states.
+
+The default limit states are :data:`DEFAULT_LIMIT_STATES`, the drift ratios
+of :data:`DEFAULT_SOURCE`; an experiment's ``[limit_states]`` table (or the
+caller) replaces them.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Sequence
+
+import numpy as np
+import xarray as xr
+
+from stochpound.analysis import rate_from_probability
+from stochpound.risk import _store
+from stochpound.risk._limit_states import KINDS, LimitState, limit_state_risk
+from stochpound.risk._maf import TARGETS
+from stochpound.risk._store_risk import YEARS
+from stochpound.store import contact_free, has_contact_free
+
+MODEL_DRIFT_LIMIT = 0.05
+"""Peak storey drift ratio beyond which a run is flagged: the model has no strength loss or collapse (the collapse-prevention drift of :data:`DEFAULT_SOURCE`)."""
+QUANTILES = (0.5, 0.84)
+"""The fractiles over each stripe's motions of :attr:`StoreDamage.demands`."""
+DEFAULT_LIMIT_STATES = (
+    LimitState("drift_ratio", 0.007),
+    LimitState("drift_ratio", 0.025),
+    LimitState("residual_drift_ratio", 0.01),
+    LimitState("drift_ratio", 0.05),
+)
+"""The default limit states: peak storey drift ratios 0.7 %, 2.5 %, 5 % and a residual storey drift ratio of 1 % (:data:`DEFAULT_SOURCE`)."""
+DEFAULT_SOURCE = ("FEMA 356 (2000), Table C1-3, steel moment frames: immediate occupancy at 0.7 % transient storey drift, life safety at "
+                  "2.5 % transient or 1 % permanent, collapse prevention at 5 % transient or permanent")
+"""Where :data:`DEFAULT_LIMIT_STATES` come from."""
+POUNDING = "pounding at g*"
+"""What :meth:`StoreDamage.governing` names where no structural limit state is more frequent than pounding at g*."""
+#: The demands of :attr:`StoreDamage.demands`: store summary -> its words.
+DEMANDS = {"peak_ductility": "peak storey ductility", "residual_drift": "residual storey drift", "peak_drift_ratio": "peak storey drift ratio"}
+
+
+@dataclasses.dataclass(frozen=True)
+class StoreDamage:
+    """What the runs of a store of yielding buildings did to them (:func:`store_damage`).
+
+    Attributes
+    ----------
+    demands : xarray.Dataset
+        :data:`DEMANDS` present in the store (``peak_ductility`` 1,
+        ``residual_drift`` m, ``peak_drift_ratio`` 1) over ``quantile``
+        (:data:`QUANTILES`), ``building``, ``intensity`` and the store's other
+        grid dimensions (contact axes dropped where the runs are contact-free).
+    runs, beyond_model : xarray.DataArray
+        Per stripe and configuration: the runs done, and those whose peak
+        storey drift ratio (any building) exceeds :data:`MODEL_DRIFT_LIMIT`
+        (0 without storey heights).
+    design_stripes : dict
+        Probability of exceedance in 50 yr (:data:`~stochpound.risk.TARGETS`)
+        -> the stripe nearest (in ln IM) to the hazard's intensity of that rate.
+    risk : xarray.Dataset or None
+        :func:`~stochpound.risk.limit_state_risk` of :attr:`limit_states` on
+        the same runs (None when the store holds none of their demands).
+    limit_states : tuple of LimitState
+        Those evaluated (the given ones the store holds the demand of).
+    source : str
+        Where the limit states' capacities come from.
+    contact_free : bool
+        Whether the runs are the contact-free ones.
+    """
+
+    demands: xr.Dataset
+    runs: xr.DataArray
+    beyond_model: xr.DataArray
+    design_stripes: dict[float, float]
+    risk: xr.Dataset | None
+    limit_states: tuple[LimitState, ...]
+    source: str
+    contact_free: bool
+
+    def governing(self, probability: float) -> xr.DataArray | None:
+        """Per configuration, what is reached most often at the risk-targeted separation g* of ``probability`` in 50 yr.
+
+        Pounding at g* has the target's rate; the governing limit state is
+        the most frequent of the structural ones where its mean annual
+        frequency exceeds that rate (it is then reached before pounding at
+        g*), else :data:`POUNDING`. None without :attr:`risk`.
+        """
+        if self.risk is None:
+            return None
+        maf = self.risk["maf"].fillna(-1.0)
+        worst = maf["limit_state"][maf.argmax("limit_state")].drop_vars("limit_state", errors="ignore")
+        return worst.where(maf.max("limit_state") > float(rate_from_probability(probability, YEARS)), POUNDING)
+
+
+def store_damage(store: xr.Dataset, limit_states: Sequence[LimitState] | None = None, source: str | None = None) -> StoreDamage | None:
+    """The ductility, residual drift and drift demands per stripe, runs beyond the model, and limit states of a store of yielding buildings.
+
+    Parameters
+    ----------
+    store : xarray.Dataset
+        An experiment store with intensity stripes and a site hazard.
+    limit_states : sequence of LimitState, optional
+        Default :data:`DEFAULT_LIMIT_STATES` (then ``source`` is
+        :data:`DEFAULT_SOURCE`); those whose demand the store lacks are left out.
+    source : str, optional
+        Where the given limit states come from.
+
+    Returns
+    -------
+    StoreDamage or None
+        None for a store without yielding storeys (``peak_ductility``) or without stripes.
+    """
+    if "peak_ductility" not in store or _store.stripes(store) is None:
+        return None
+    if limit_states is None:
+        limit_states, source = DEFAULT_LIMIT_STATES, DEFAULT_SOURCE
+    free = has_contact_free(store)
+    runs_of = contact_free(store) if free else store
+    per_building = {name: _store.store_motions(runs_of[name]).load() for name in DEMANDS if name in store}
+    demands = xr.Dataset({name: data.quantile(list(QUANTILES), dim="record").assign_attrs(units=store[name].attrs.get("units", ""))
+                          for name, data in per_building.items()})
+    done = np.isfinite(per_building["peak_ductility"].max("building"))
+    drift = per_building.get("peak_drift_ratio")
+    beyond = (drift.max("building") > MODEL_DRIFT_LIMIT) if drift is not None else xr.zeros_like(done)
+    hz = _store.site_hazard(store)
+    levels = np.asarray(store["intensity"].values, float)
+    design_stripes = {p: float(levels[np.argmin(np.abs(np.log(levels) - np.log(float(hz.intensity_at(rate_from_probability(p, YEARS))))))])
+                      for p in TARGETS}
+    held = tuple(state for state in limit_states
+                 if KINDS[state.kind].variable in store and bool(np.isfinite(store[KINDS[state.kind].variable]).any()))
+    risk = None
+    if held:
+        risk = limit_state_risk(store, held, hz)
+        risk = contact_free(risk) if free else risk
+    return StoreDamage(demands, done.sum("record"), (beyond & done).sum("record"), design_stripes, risk, held, source or "", free)
