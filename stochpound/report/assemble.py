@@ -22,6 +22,7 @@ from stochpound.report.render import FigureItem, Paragraph, Report, Section
 from stochpound.report.sections import (
     INTERVAL_NOTE,
     WALLS,
+    damage_section,
     experiment_summary,
     intensity_section,
     law_axis,
@@ -33,7 +34,7 @@ from stochpound.report.sections import (
     separation_section,
     store_section,
 )
-from stochpound.risk import has_risk, store_demands, store_risk
+from stochpound.risk import has_risk, store_damage, store_demands, store_risk
 from stochpound.store import has_contact_free, has_wall_free, with_contacts, with_walls
 from stochpound.studies import claims, load_study
 
@@ -77,6 +78,9 @@ def assemble_report(paths: Sequence[str | Path], progress: Callable[[str], None]
             say(f"experiment {name}: risk")
             risks[name] = store_risk(store)
             report.sections.append(risk_section(name, risks[name], store_demands(store)))
+            damage = store_damage(store)
+            if damage is not None:
+                report.sections.append(damage_section(name, damage))
     for name, store in others.items():
         say(f"experiment {name}")
         contact_free, wall_free = has_contact_free(store), has_wall_free(store)

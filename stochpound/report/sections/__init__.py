@@ -5,6 +5,7 @@ and a study's package build with.
 """
 
 from stochpound.report.sections._accuracy import harmonic_comparisons
+from stochpound.report.sections._damage import damage_section
 from stochpound.report.sections._description import StoreDefinition
 from stochpound.report.sections._ensembles import INTERVAL_NOTE
 from stochpound.report.sections._generic import store_section
@@ -18,6 +19,7 @@ from stochpound.report.sections._summary import experiment_summary, move_per_cel
 
 __all__ = [
     "risk_section",
+    "damage_section",
     "INTERVAL_NOTE",
     "WALLS",
     "StoreDefinition",

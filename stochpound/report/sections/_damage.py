@@ -1,0 +1,110 @@
+"""The damage section: what the runs did to yielding buildings, next to the separations (all from :class:`stochpound.risk.StoreDamage`)."""
+
+from __future__ import annotations
+
+import pandas as pd
+
+from stochpound.report.render import Paragraph, Section, Table
+from stochpound.report.sections._description import number
+from stochpound.risk import MODEL_DRIFT_LIMIT, StoreDamage, return_period
+from stochpound.risk._damage import DEMANDS
+
+
+def damage_section(name: str, damage: StoreDamage) -> Section:
+    """The ductility and residual drift demands at the 10 % and 2 % in 50 yr stripes, runs beyond the model, and the governing limit state."""
+    section = Section(f"Damage: experiment {name}", key=f"damage-{name}")
+    runs = "contact-free runs (those the separations come from)" if damage.contact_free else "runs"
+    stripes = "; ".join(f"{_percent(p)} in 50 yr: stripe {number(level, 4)}" for p, level in damage.design_stripes.items())
+    section.add(Paragraph(
+        f"What the earthquakes do to the yielding buildings of experiment {name}, from its {runs}: the median and 84 % fractile over "
+        f"each stripe's motions of every building's largest peak storey ductility (drift over yield drift), residual storey drift and "
+        f"peak storey drift ratio, at the stripes nearest (in ln IM) the hazard's intensities of the design levels ({stripes})."
+    ))
+    section.add(_demands_table(name, damage))
+    section.add(Paragraph(_beyond_model_text(damage)))
+    if damage.risk is not None:
+        section.add(Paragraph(_governing_text(damage)))
+        section.add(_limit_states_table(name, damage))
+    return section
+
+
+def _configurations(data) -> list[dict]:
+    """Every combination of ``data``'s grid labels other than intensity, quantile, building and limit state."""
+    dims = [d for d in data.dims if d not in ("intensity", "quantile", "building", "limit_state")]
+    index = pd.MultiIndex.from_product([data[d].values for d in dims], names=dims) if dims else [()]
+    return [dict(zip(dims, labels if isinstance(labels, tuple) else (labels,))) for labels in index]
+
+
+def _percent(probability: float) -> str:
+    return f"{100.0 * probability:g} %"
+
+
+def _label(labels: dict) -> str:
+    return ", ".join(f"{k} {'fixed' if k == 'mu' and v == float('inf') else (number(v) if isinstance(v, float) else v)}" for k, v in labels.items()) or "–"
+
+
+def _demands_table(name: str, damage: StoreDamage) -> Table:
+    rows = []
+    demands = damage.demands
+    for labels in _configurations(demands["peak_ductility"]):
+        for probability, level in damage.design_stripes.items():
+            at = demands.sel(labels).sel(intensity=level)
+            for building in at["building"].values:
+                row = {"configuration": _label(labels), "stripe": f"{number(level, 4)} ({probability:.0%}/50 yr)", "building": str(building)}
+                for variable, scale, unit in (("peak_ductility", 1.0, ""), ("residual_drift", 1000.0, " (mm)"), ("peak_drift_ratio", 100.0, " (%)")):
+                    if variable in at:
+                        for q, word in ((0.5, "median"), (0.84, "84 %")):
+                            row[f"{DEMANDS[variable]}{unit}, {word}"] = f"{float(at[variable].sel(building=building, quantile=q)) * scale:.3g}"
+                row["runs > model"] = f"{int(damage.beyond_model.sel(labels).sel(intensity=level))} of {int(damage.runs.sel(labels).sel(intensity=level))}"
+                rows.append(row)
+    frame = pd.DataFrame(rows).set_index(["configuration", "stripe", "building"])
+    return Table(
+        key=f"table-damage-{name}",
+        caption=(f"Experiment {name}: each building's largest peak storey ductility, residual storey drift and peak storey drift ratio, "
+                 "median and 84 % fractile over the stripe's motions, at the stripes of 10 % and 2 % in 50 yr"),
+        frame=frame,
+        note=(f"runs > model: the stripe's runs whose peak storey drift ratio (any building) exceeds {_percent(MODEL_DRIFT_LIMIT)}, beyond what "
+              "the model represents (below). Empirical fractiles (linear interpolation between the ordered runs)."),
+    )
+
+
+def _beyond_model_text(damage: StoreDamage) -> str:
+    beyond = damage.beyond_model.sum([d for d in damage.beyond_model.dims if d != "intensity"])
+    runs = damage.runs.sum([d for d in damage.runs.dims if d != "intensity"])
+    flagged = [f"{int(b)} of {int(n)} at stripe {number(float(level), 4)}" for level, b, n in zip(beyond["intensity"].values, beyond.values, runs.values) if b]
+    head = (f"The storeys are bilinear without strength loss, degradation or collapse, so a drift beyond {_percent(MODEL_DRIFT_LIMIT)} of the "
+            "storey height (the collapse-prevention drift of steel moment frames) is beyond what the model represents: ")
+    if not flagged:
+        return head + f"none of the {int(runs.sum())} runs reaches it."
+    return (head + "runs reaching it, per stripe over every configuration: " + "; ".join(flagged) + ". Their drifts, ductilities and "
+            "residual drifts are not credible (a real frame would have lost strength or collapsed), and the fractiles above include them.")
+
+
+def _governing_text(damage: StoreDamage) -> str:
+    parts = []
+    for probability in damage.design_stripes:
+        governing = damage.governing(probability)
+        texts = [(f"{_label(labels)}: " if labels else "") + str(governing.sel(labels).item()) for labels in _configurations(governing)]
+        parts.append(f"for {_percent(probability)} in 50 yr, " + "; ".join(texts))
+    states = "; ".join(state.label for state in damage.limit_states)
+    return (f"Limit states (capacities from {damage.source}): {states}. Each one's mean annual frequency λ comes from its lognormal "
+            f"fragility over the stripes and the site's hazard, as for pounding (the table below). Pounding at the risk-targeted "
+            "separation g* happens at the target's rate; the governing limit state is the one reached most often: a structural limit "
+            f"state where its λ exceeds that rate (the building is then damaged before the gap closes), else pounding at g*. "
+            f"Governing: {'; '.join(parts)}. Other capacities: stochpound risk --limit-states FILE (docs/risk.md).")
+
+
+def _limit_states_table(name: str, damage: StoreDamage) -> Table:
+    maf = damage.risk["maf"]
+    rows = []
+    for labels in _configurations(maf):
+        for state in maf["limit_state"].values:
+            rate = float(maf.sel(labels).sel(limit_state=state))
+            rows.append({"configuration": _label(labels), "limit state": str(state), "λ (1/yr)": f"{rate:.3g}",
+                         "once in (yr)": f"{float(return_period(rate)):.3g}"})
+    return Table(
+        key=f"table-limit-states-{name}",
+        caption=f"Experiment {name}: the limit states' mean annual frequency λ and return period, per configuration",
+        frame=pd.DataFrame(rows).set_index(["configuration", "limit state"]),
+        note="λ of a limit state no run reaches is 0; one every run reaches at every stripe is set by the hazard table's lowest intensity.",
+    )
