@@ -14,7 +14,7 @@ def damage_section(name: str, damage: StoreDamage) -> Section:
     """The ductility and residual drift demands at the 10 % and 2 % in 50 yr stripes, runs beyond the model, and the governing limit state."""
     section = Section(f"Damage: experiment {name}", key=f"damage-{name}")
     runs = "contact-free runs (those the separations come from)" if damage.contact_free else "runs"
-    stripes = "; ".join(f"{_percent(p)} in 50 yr: stripe {number(level, 4)}" for p, level in damage.design_stripes.items())
+    stripes = "; ".join(f"{_percent(p)} in 50 yr: stripe {number(level)}" for p, level in damage.design_stripes.items())
     section.add(Paragraph(
         f"What the earthquakes do to the yielding buildings of experiment {name}, from its {runs}: the median and 84 % fractile over "
         f"each stripe's motions of every building's largest peak storey ductility (drift over yield drift), residual storey drift and "
@@ -50,7 +50,7 @@ def _demands_table(name: str, damage: StoreDamage) -> Table:
         for probability, level in damage.design_stripes.items():
             at = demands.sel(labels).sel(intensity=level)
             for building in at["building"].values:
-                row = {"configuration": _label(labels), "stripe": f"{number(level, 4)} ({probability:.0%}/50 yr)", "building": str(building)}
+                row = {"configuration": _label(labels), "stripe": f"{number(level)} ({_percent(probability)}/50 yr)", "building": str(building)}
                 for variable, scale, unit in (("peak_ductility", 1.0, ""), ("residual_drift", 1000.0, " (mm)"), ("peak_drift_ratio", 100.0, " (%)")):
                     if variable in at:
                         for q, word in ((0.5, "median"), (0.84, "84 %")):
@@ -71,7 +71,7 @@ def _demands_table(name: str, damage: StoreDamage) -> Table:
 def _beyond_model_text(damage: StoreDamage) -> str:
     beyond = damage.beyond_model.sum([d for d in damage.beyond_model.dims if d != "intensity"])
     runs = damage.runs.sum([d for d in damage.runs.dims if d != "intensity"])
-    flagged = [f"{int(b)} of {int(n)} at stripe {number(float(level), 4)}" for level, b, n in zip(beyond["intensity"].values, beyond.values, runs.values) if b]
+    flagged = [f"{int(b)} of {int(n)} at stripe {number(float(level))}" for level, b, n in zip(beyond["intensity"].values, beyond.values, runs.values) if b]
     head = (f"The storeys are bilinear without strength loss, degradation or collapse, so a drift beyond {_percent(MODEL_DRIFT_LIMIT)} of the "
             "storey height (the collapse-prevention drift of steel moment frames) is beyond what the model represents: ")
     if not flagged:

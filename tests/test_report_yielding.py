@@ -1,0 +1,117 @@
+"""The report of yielding buildings: what the Methods section says of them, the yielding check, and the Damage section.
+
+A small store: the risk flagship's fixed pair with weak yielding storeys
+(F_y = 100, 70 kN; 2 % hardening; P-Δ; 3 m storeys), 8 far-field motions
+(5 s) × 3 stripes of PSA(1 s) (0.3 g and the site's 10 %/2 % in 50 yr
+intensities), contact-free and at a 5 cm gap, with a [design] table. Every
+expected number is derived from the store or the scene here.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from stochpound._errors import VerificationError
+from stochpound.report.sections import damage_section, methods_section
+from stochpound.report.sections._accuracy import yielding_check, yielding_case
+from stochpound.report.sections._description import StoreDefinition, buildings_table, design_paragraph
+from stochpound.risk import DEFAULT_LIMIT_STATES, MODEL_DRIFT_LIMIT, store_damage
+from stochpound.store import contact_free, open_store
+from tests.helpers import FIXED, risk_text, run_in_process
+
+YIELDING = "damping_ratio = 0.05\nyield_force = [1.0e5, 0.7e5]\nhardening = 0.02\nstorey_height = [3.0, 3.0]\np_delta = true\n"
+DESIGN = "\n[design]\nsds = 1.32925\nsd1 = 0.80204\nr = 8.0\ncd = 5.5\nomega0 = 3.0\nie = 1.0\n"
+STRIPES = 'measure = "psa"\nperiod = 1.0\nlevels = [0.3, 0.7399, 1.2031]\nmethod = "stripes"'
+
+
+@pytest.fixture(scope="module")
+def store(tmp_path_factory):
+    scene = FIXED.replace("damping_ratio = 0.05\n", YIELDING)
+    assert scene.count("yield_force") == 2
+    text = risk_text(scene, "gap = [0.05, inf]", STRIPES) + "demands = true\n" + DESIGN
+    return open_store(run_in_process(tmp_path_factory.mktemp("yreport"), "yfix", text)).load()
+
+
+def _text(block) -> str:
+    return block.text if hasattr(block, "text") else ""
+
+
+def test_the_buildings_table_gives_storey_heights_strength_and_p_delta(store):
+    table = buildings_table([StoreDefinition("yfix", store)])
+    assert {"storey height (m)", "storeys", "P-Δ"} <= set(table.frame.columns)
+    b1 = table.frame[table.frame["building"] == "B1"].iloc[0]
+    drift = [1.0e5 / 24516800.0, 0.7e5 / 17512000.0]  # F_y / k, m
+    assert b1["storeys"] == f"F_y = 100000, 70000 N (yield drift {1000 * drift[0]:.3g}, {1000 * drift[1]:.3g} mm; " \
+                            f"{100 * drift[0] / 3:.3g} %, {100 * drift[1] / 3:.3g} % of h), hardening α = 2 %"
+    weight_above = 9.81 * np.array([26268.0 + 17512.0, 17512.0])
+    assert b1["P-Δ"].startswith(f"W/h = {weight_above[0] / 3:.4g}, {weight_above[1] / 3:.4g} N/m taken off k")
+
+
+def test_the_design_paragraph_sets_the_strength_beside_the_elf_design(store):
+    from stochpound.model import design_yield_shears
+    from stochpound.model.modal_solution import modal_properties
+    text = design_paragraph(StoreDefinition("yfix", store)).text
+    assert "S_DS = 1.329 g, S_D1 = 0.802 g, T_L = 8 s, R = 8, C_d = 5.5, Ω0 = 3, I_e = 1" in text
+    b1 = store.pound.scene(gap=np.inf, intensity=0.3, record=str(store["record"].values[0]), realization=0).buildings[0]
+    period = float(modal_properties(b1).periods[0])
+    code = design_yield_shears(b1.mass, b1.storey_height, period=period, sds=1.32925, sd1=0.80204, r=8.0, overstrength=3.0, importance=1.0)
+    weight = 9.81 * sum(b1.mass)
+    assert f"B1: F_y,1 / W = {1.0e5 / weight:.3g}, the design's Ω0 V / W = {code[0] / weight:.3g} at T1 = {period:.3g} s" in text
+
+
+def test_methods_says_what_yielding_is_and_that_the_modal_check_runs_an_elastic_copy(store):
+    texts = " ".join(_text(block) for block in methods_section({"yfix": store}).blocks)
+    assert "Storeys given a yield shear F_y are bilinear with kinematic hardening" in texts
+    assert "There is no strength loss: no degradation, no collapse." in texts
+    assert "so its yield and its elastic unloading are located on the same exact flow" in texts
+    assert "(an elastic copy of a yielding building: its yield shears, hardening and P-Δ left out" in texts
+    assert "dissipated in storey dashpots, yielding storeys (hysteretic), friction and impacts" in texts
+    assert "Yielding check on a stored case of yfix" in texts
+
+
+def test_the_yielding_check_reruns_a_yielded_case_and_fails_on_a_corrupted_store(store):
+    labels = yielding_case(store)
+    ductility = store["peak_ductility"].max("building")
+    yielded = np.sort(ductility.values[ductility.values > 1.0])
+    assert float(ductility.sel(labels)) == yielded[(yielded.size - 1) // 2]  # the median of the cases that yielded
+    definition = StoreDefinition("yfix", store)
+    assert "equal the store's within 1e-09" in yielding_check(definition).text
+    corrupted = store.copy(deep=True)
+    corrupted["residual_drift"].loc[labels] = corrupted["residual_drift"].loc[labels] * 1.001
+    with pytest.raises(VerificationError, match=r"^yielding check: the stored case of yfix .* re-run gives residual_drift"):
+        yielding_check(StoreDefinition("yfix", corrupted))
+
+
+def test_store_damage_fractiles_and_runs_beyond_the_model(store):
+    damage = store_damage(store)
+    free = contact_free(store)
+    assert damage.contact_free and damage.design_stripes == {0.1: 0.7399, 0.02: 1.2031}
+    runs = free["peak_ductility"].sel(intensity=1.2031, building="B1").values.ravel()
+    np.testing.assert_allclose(damage.demands["peak_ductility"].sel(intensity=1.2031, building="B1").values,
+                               np.quantile(runs, [0.5, 0.84]), rtol=1e-12)
+    drift = free["peak_drift_ratio"].max("building")
+    for level in store["intensity"].values:
+        assert int(damage.beyond_model.sel(intensity=level)) == int((drift.sel(intensity=level) > MODEL_DRIFT_LIMIT).sum())
+    assert int(damage.beyond_model.sum()) > 0  # these weak storeys go beyond the model at the upper stripes
+    assert damage.limit_states == DEFAULT_LIMIT_STATES
+    maf = damage.risk["maf"]
+    for probability in (0.1, 0.02):
+        governing = damage.governing(probability).item()
+        assert governing == str(maf["limit_state"].values[int(np.argmax(maf.values))])  # the most frequent: it exceeds the target's rate here
+        assert float(maf.max()) > -np.log(1 - probability) / 50
+
+
+def test_the_damage_section_states_fractiles_flags_and_the_governing_limit_state(store):
+    damage = store_damage(store)
+    section = damage_section("yfix", damage)
+    texts = " ".join(_text(block) for block in section.blocks)
+    table = next(block for block in section.blocks if getattr(block, "key", "") == "table-damage-yfix").frame
+    row = table.loc[("–", "1.2031 (2 %/50 yr)", "B1")]
+    median = float(damage.demands["peak_ductility"].sel(intensity=1.2031, building="B1", quantile=0.5))
+    assert row["peak storey ductility, median"] == f"{median:.3g}"
+    beyond, runs = int(damage.beyond_model.sel(intensity=1.2031)), int(damage.runs.sel(intensity=1.2031))
+    assert row["runs > model"] == f"{beyond} of {runs}"
+    assert f"{beyond} of {runs} at stripe 1.2031" in texts and "are not credible" in texts
+    assert "FEMA 356 (2000), Table C1-3, steel moment frames" in texts
+    assert f"Governing: for 10 % in 50 yr, {damage.governing(0.1).item()}; for 2 % in 50 yr, {damage.governing(0.02).item()}." in texts
