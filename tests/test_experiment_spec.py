@@ -61,7 +61,7 @@ def experiment(data: dict) -> Experiment:
         ({"solver": {"rtol": -1.0}}, r"^solver\.rtol: must be > 0, got -1"),
         ({"experiment__studied": "B7"}, r"^experiment\.studied: must be one of the scene's buildings \(B1, B2\), got 'B7'"),
         ({"scene__building": []}, r"^case neighbour=stiff.*building: at least one \[\[building\]\] is required|experiment\.studied"),
-        ({"bogus": 1}, r"^bogus: unknown field \(allowed: design, experiment, grid, hazard, intensity, motions, output, records, scene, site, solver, synthetic, variants\)"),
+        ({"bogus": 1}, r"^bogus: unknown field \(allowed: design, experiment, grid, hazard, intensity, limit_states, motions, output, records, scene, site, solver, synthetic, variants\)"),
     ],
 )
 def test_bad_fields_are_named(changes, message):

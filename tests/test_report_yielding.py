@@ -115,3 +115,48 @@ def test_the_damage_section_states_fractiles_flags_and_the_governing_limit_state
     assert f"{beyond} of {runs} at stripe 1.2031" in texts and "are not credible" in texts
     assert "FEMA 356 (2000), Table C1-3, steel moment frames" in texts
     assert f"Governing: for 10 % in 50 yr, {damage.governing(0.1).item()}; for 2 % in 50 yr, {damage.governing(0.02).item()}." in texts
+
+
+# ---------------------------------------------------------------- the [limit_states] table of an experiment file
+
+
+def test_a_limit_states_table_is_not_part_of_the_identity_and_replaces_the_defaults(store):
+    import json
+
+    import tomllib
+
+    from stochpound.experiment._spec import parse_experiment
+    from stochpound.store import definition_sha256
+    scene = FIXED.replace("damping_ratio = 0.05\n", YIELDING)
+    text = risk_text(scene, "gap = [0.05, inf]", STRIPES) + "demands = true\n" + DESIGN
+    table = '\n[limit_states]\nsource = "a test"\nductility = { B1 = [4.0, 8.0] }\nresidual_drift_ratio = 0.005\n'
+    plain, with_table = parse_experiment(tomllib.loads(text)), parse_experiment(tomllib.loads(text + table))
+    assert with_table["limit_states"] == {"source": "a test", "capacities": {"ductility": {"B1": [4.0, 8.0]}, "residual_drift_ratio": [0.005]}}
+    assert definition_sha256(with_table) == definition_sha256(plain) == store.attrs["definition_sha256"]
+    edited = store.copy()
+    edited.attrs = {**store.attrs, "definition": json.dumps({**json.loads(store.attrs["definition"]), "limit_states": with_table["limit_states"]})}
+    damage = store_damage(edited)
+    assert damage.source == "a test"
+    assert [state.label for state in damage.limit_states] == ["peak storey ductility of B1 ≥ 4", "peak storey ductility of B1 ≥ 8",
+                                                              "residual storey drift ratio ≥ 0.005"]
+    assert "Limit states (capacities from a test): peak storey ductility of B1 ≥ 4;" in " ".join(
+        _text(block) for block in damage_section("yfix", damage).blocks)
+
+
+@pytest.mark.parametrize(
+    "table, message",
+    [
+        ("drift = 0.01", r"^limit_states\.drift: not a limit state; one of drift_ratio, residual_drift_ratio"),
+        ("drift_ratio = [0.01, -1.0]", r"^limit_states\.drift_ratio\[1\]: a capacity must be a number > 0, got -1\.0"),
+        ("ductility = { B9 = 4.0 }", r"^limit_states\.ductility\.B9: unknown building \(buildings: B1, B2\)"),
+        ('source = "x"', r"^limit_states: give at least one limit state"),
+    ],
+)
+def test_bad_limit_states_tables_are_named(table, message):
+    import tomllib
+
+    from stochpound.experiment import ExperimentError
+    from stochpound.experiment._spec import parse_experiment
+    text = risk_text(FIXED, "gap = [inf]", STRIPES) + f"\n[limit_states]\n{table}\n"
+    with pytest.raises(ExperimentError, match=message):
+        parse_experiment(tomllib.loads(text))

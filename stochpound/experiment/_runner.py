@@ -285,8 +285,9 @@ def _record_hazard(store: Path, experiment: Experiment, grids: dict[str, tuple[f
             raise ExperimentError(f"{store}: the {' and the '.join(changed)} changed, but {session.folder.name}/ lacks finished cases to rewrite the store from; "
                                   "keep the store as it is, or run again with --restart")
         session.rebuild()
-    if "design" in changed:
-        say(f"{store}: the [design] changed; no run depends on it: the cases are kept and the new design is recorded in the store")
+    for table in ("design", "limit_states"):
+        if table in changed:
+            say(f"{store}: the [{table}] changed; no run depends on it: the cases are kept and the new table is recorded in the store")
     if "hazard" not in changed:
         return
     hazard = experiment.contract.hazard

@@ -27,6 +27,7 @@ from typing import Any, Mapping
 from stochpound._errors import ExperimentError, field_errors
 from stochpound._studies import parse_reproduces
 from stochpound.experiment._design_table import parse_design
+from stochpound.experiment._limit_states_table import parse_limit_states
 from stochpound.experiment._hazard import parse_hazard
 from stochpound.motions import DEFAULT_G
 from stochpound.experiment._intensity import parse_intensity
@@ -40,7 +41,7 @@ from stochpound.store import TIME_HISTORIES, is_gap_axis, read_definition
 #: Format version of the canonical definition (stored with every store).
 FORMAT_VERSION = 1
 
-_TOP_KEYS = {"experiment", "scene", "variants", "grid", "records", "motions", "synthetic", "output", "solver", "intensity", "hazard", "site", "design"}
+_TOP_KEYS = {"experiment", "scene", "variants", "grid", "records", "motions", "synthetic", "output", "solver", "intensity", "hazard", "site", "design", "limit_states"}
 _EXPERIMENT_KEYS = {"name", "description", "scene", "studied", "reproduces"}
 _BUILDING_OVERRIDES = {"mass_factor", "mass", "stiffness", "damping", "damping_ratio", "base", "initial", "yield_force", "hardening"}
 _SCENE_OVERRIDES = {"study_compat", "wall"}
@@ -150,6 +151,7 @@ def parse_experiment(data: Mapping[str, Any], base_dir: str | Path = ".", defaul
         intensity = parse_intensity(data, scene, variants, gaps, mu)
         hazard = parse_hazard(data, intensity, base_dir, float(scene["g"]) if "g" in scene else DEFAULT_G)
         design = parse_design(data)
+        limit_states = parse_limit_states(data, buildings)
     definition = {
         "format": FORMAT_VERSION,
         "name": name,
@@ -171,6 +173,8 @@ def parse_experiment(data: Mapping[str, Any], base_dir: str | Path = ".", defaul
         definition["hazard"] = hazard
     if design is not None:  # likewise absent without [design]
         definition["design"] = design
+    if limit_states is not None:  # likewise absent without [limit_states]
+        definition["limit_states"] = limit_states
     read_definition(definition)  # the typed definition reads every field parsed here
     return definition
 

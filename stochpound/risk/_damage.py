@@ -16,9 +16,9 @@ has them (the runs the separations come from), else over every run:
   of pounding at the risk-targeted separation g* (the target's rate) and the
   structural limit states.
 
-The default limit states are :data:`DEFAULT_LIMIT_STATES`, the drift ratios
-of :data:`DEFAULT_SOURCE`; an experiment's ``[limit_states]`` table (or the
-caller) replaces them.
+The limit states are the experiment's ``[limit_states]`` table (not part of
+its runs' identity: docs/risk.md), else :data:`DEFAULT_LIMIT_STATES`, the
+drift ratios of :data:`DEFAULT_SOURCE`; a caller may give others.
 """
 
 from __future__ import annotations
@@ -31,7 +31,7 @@ import xarray as xr
 
 from stochpound.analysis import rate_from_probability
 from stochpound.risk import _store
-from stochpound.risk._limit_states import KINDS, LimitState, limit_state_risk
+from stochpound.risk._limit_states import KINDS, LimitState, limit_state_risk, limit_states_from_table
 from stochpound.risk._maf import TARGETS
 from stochpound.risk._store_risk import YEARS
 from stochpound.store import contact_free, has_contact_free
@@ -50,6 +50,8 @@ DEFAULT_LIMIT_STATES = (
 DEFAULT_SOURCE = ("FEMA 356 (2000), Table C1-3, steel moment frames: immediate occupancy at 0.7 % transient storey drift, life safety at "
                   "2.5 % transient or 1 % permanent, collapse prevention at 5 % transient or permanent")
 """Where :data:`DEFAULT_LIMIT_STATES` come from."""
+EXPERIMENT_SOURCE = "the experiment's [limit_states] table"
+"""The source of limit states an experiment's ``[limit_states]`` gives without a ``source``."""
 POUNDING = "pounding at g*"
 """What :meth:`StoreDamage.governing` names where no structural limit state is more frequent than pounding at g*."""
 #: The demands of :attr:`StoreDamage.demands`: store summary -> its words.
@@ -117,8 +119,9 @@ def store_damage(store: xr.Dataset, limit_states: Sequence[LimitState] | None = 
     store : xarray.Dataset
         An experiment store with intensity stripes and a site hazard.
     limit_states : sequence of LimitState, optional
-        Default :data:`DEFAULT_LIMIT_STATES` (then ``source`` is
-        :data:`DEFAULT_SOURCE`); those whose demand the store lacks are left out.
+        Default: the experiment's ``[limit_states]`` table, else
+        :data:`DEFAULT_LIMIT_STATES` (then ``source`` is :data:`DEFAULT_SOURCE`,
+        and those whose demand the store lacks are left out).
     source : str, optional
         Where the given limit states come from.
 
@@ -126,9 +129,18 @@ def store_damage(store: xr.Dataset, limit_states: Sequence[LimitState] | None = 
     -------
     StoreDamage or None
         None for a store without yielding storeys (``peak_ductility``) or without stripes.
+
+    Raises
+    ------
+    ValueError
+        (``RiskInputError``) A given limit state the store cannot evaluate (its demand or building missing).
     """
     if "peak_ductility" not in store or _store.stripes(store) is None:
         return None
+    given = limit_states is not None
+    table = store.pound.definition.limit_states
+    if limit_states is None and table is not None:
+        limit_states, source, given = limit_states_from_table(table["capacities"]), table["source"] or EXPERIMENT_SOURCE, True
     if limit_states is None:
         limit_states, source = DEFAULT_LIMIT_STATES, DEFAULT_SOURCE
     free = has_contact_free(store)
@@ -143,8 +155,8 @@ def store_damage(store: xr.Dataset, limit_states: Sequence[LimitState] | None = 
     levels = np.asarray(store["intensity"].values, float)
     design_stripes = {p: float(levels[np.argmin(np.abs(np.log(levels) - np.log(float(hz.intensity_at(rate_from_probability(p, YEARS))))))])
                       for p in TARGETS}
-    held = tuple(state for state in limit_states
-                 if KINDS[state.kind].variable in store and bool(np.isfinite(store[KINDS[state.kind].variable]).any()))
+    held = tuple(state for state in limit_states  # the defaults the store can evaluate; every given one (an error where it cannot)
+                 if given or (KINDS[state.kind].variable in store and bool(np.isfinite(store[KINDS[state.kind].variable]).any())))
     risk = None
     if held:
         risk = limit_state_risk(store, held, hz)

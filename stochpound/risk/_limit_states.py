@@ -33,6 +33,7 @@ from stochpound.risk import _store
 from stochpound.risk._fragility_ensemble import limit_state_events, stripe_fragility
 from stochpound.risk._maf import mean_annual_frequency
 from stochpound.risk._store_risk import CONFIDENCE, YEARS
+from stochpound.store import LIMIT_STATE_DEMANDS
 
 
 @dataclasses.dataclass(frozen=True)
@@ -45,14 +46,14 @@ class _Kind:
 
 
 #: The kinds of limit state: the ``[limit_states]`` keys, the store summary each reads, and the capacity's units.
-KINDS = {
-    "drift_ratio": _Kind("peak_drift_ratio", "1", "peak storey drift ratio", True, "yielding storeys or storey_height, and [output] demands = true"),
-    "residual_drift_ratio": _Kind("residual_drift_ratio", "1", "residual storey drift ratio", True, "yield_force and storey_height"),
-    "ductility": _Kind("peak_ductility", "1", "peak storey ductility", True, "yield_force"),
-    "floor_acceleration": _Kind("peak_floor_acceleration", "g", "peak floor acceleration", True, "[output] demands = true"),
-    "impact_force": _Kind("peak_impact_force", "N", "peak impact force", False, "runs at a finite gap"),
-    "isolator_displacement": _Kind("peak_sliding_displacement", "m", "base displacement (the bearing's stop)", True, "a sliding base"),
-}
+KINDS = {kind: _Kind(LIMIT_STATE_DEMANDS[kind], *rest) for kind, rest in {
+    "drift_ratio": ("1", "peak storey drift ratio", True, "yielding storeys or storey_height, and [output] demands = true"),
+    "residual_drift_ratio": ("1", "residual storey drift ratio", True, "yield_force and storey_height"),
+    "ductility": ("1", "peak storey ductility", True, "yield_force"),
+    "floor_acceleration": ("g", "peak floor acceleration", True, "[output] demands = true"),
+    "impact_force": ("N", "peak impact force", False, "runs at a finite gap"),
+    "isolator_displacement": ("m", "base displacement (the bearing's stop)", True, "a sliding base"),
+}.items()}
 
 
 @dataclasses.dataclass(frozen=True)

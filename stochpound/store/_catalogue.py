@@ -98,6 +98,16 @@ STOREY_SUMMARIES = (
     StoreVariable("residual_drift_ratio", ("building",), "f8", "1", "largest absolute residual storey drift ratio over the building's storeys"),
 )
 
+#: The kinds of limit state (an experiment's ``[limit_states]`` keys, ``stochpound.risk.LimitState``) -> the per-case summary each reads.
+LIMIT_STATE_DEMANDS = {
+    "drift_ratio": "peak_drift_ratio",
+    "residual_drift_ratio": "residual_drift_ratio",
+    "ductility": "peak_ductility",
+    "floor_acceleration": "peak_floor_acceleration",
+    "impact_force": "peak_impact_force",
+    "isolator_displacement": "peak_sliding_displacement",
+}
+
 #: Summaries of every fixed-base reference (the studied building alone): those of a case, named ``reference_<name>``, per building no more.
 REFERENCE_SUMMARIES = tuple(
     replace(v, name=f"reference_{v.name}", dims=(), long_name=v.long_name + _ALONE)

@@ -13,7 +13,7 @@ form; :meth:`Definition.to_dict` gives it back unchanged.
 
 **The identity.** :func:`definition_sha256` hashes the canonical JSON
 (:func:`canonical_json`) without the entries that no run depends on
-(:data:`NOT_IN_IDENTITY`: the ``hazard`` and the ``design``, read by the risk chain only), so a
+(:data:`NOT_IN_IDENTITY`: the ``hazard``, the ``design`` and the ``limit_states``, read by the risk chain only), so a
 store's runs stay valid when only its hazard changes. A definition without
 those entries hashes exactly as before.
 
@@ -37,7 +37,7 @@ from typing import Any
 from stochpound._errors import ExperimentError
 from stochpound.model.friction import is_fixed_base
 
-NOT_IN_IDENTITY = ("hazard", "design")
+NOT_IN_IDENTITY = ("hazard", "design", "limit_states")
 """Entries of a canonical definition that no run depends on, left out of its identity (:func:`~stochpound.store.definition_sha256`)."""
 
 
@@ -394,6 +394,8 @@ class Definition:
         The site's hazard curve, if any (not part of the identity).
     design : mapping or None
         The ``[design]`` table's canonical entry, the buildings' code design, if any (not part of the identity).
+    limit_states : mapping or None
+        The ``[limit_states]`` table's canonical entry (``source``, ``capacities``), if any (not part of the identity).
     """
 
     name: str
@@ -412,6 +414,7 @@ class Definition:
     reproduces: str | None = None
     hazard: Hazard | None = None
     design: Mapping[str, Any] | None = None
+    limit_states: Mapping[str, Any] | None = None
 
     def to_dict(self) -> dict[str, Any]:
         """The canonical definition (a copy): what ``parse_experiment`` returned (``stochpound.experiment._spec``)."""
@@ -508,4 +511,5 @@ def _from_dict(data: dict[str, Any]) -> Definition:
         reproduces=data.get("reproduces"),
         hazard=Hazard.from_entry(data["hazard"]) if data.get("hazard") is not None else None,
         design=data.get("design"),
+        limit_states=data.get("limit_states"),
     )

@@ -91,7 +91,7 @@ def _governing_text(damage: StoreDamage) -> str:
             f"fragility over the stripes and the site's hazard, as for pounding (the table below). Pounding at the risk-targeted "
             "separation g* happens at the target's rate; the governing limit state is the one reached most often: a structural limit "
             f"state where its λ exceeds that rate (the building is then damaged before the gap closes), else pounding at g*. "
-            f"Governing: {'; '.join(parts)}. Other capacities: stochpound risk --limit-states FILE (docs/risk.md).")
+            f"Governing: {'; '.join(parts)}. A [limit_states] table in the experiment file replaces these capacities (docs/risk.md).")
 
 
 def _limit_states_table(name: str, damage: StoreDamage) -> Table:

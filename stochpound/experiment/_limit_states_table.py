@@ -1,0 +1,76 @@
+"""The ``[limit_states]`` table of an experiment file: the capacities its report's Damage section evaluates.
+
+Each key is a kind of limit state (``stochpound.store.LIMIT_STATE_DEMANDS``:
+``drift_ratio``, ``residual_drift_ratio``, ``ductility`` (1),
+``floor_acceleration`` (g), ``impact_force`` (N), ``isolator_displacement``
+(m)); its value a capacity > 0 or a list of them (any building), or a table
+of building names to a capacity or a list. ``source`` (optional) says where
+the capacities come from. Without the table the report uses
+``stochpound.risk.DEFAULT_LIMIT_STATES``.
+
+No run depends on it, so it is not part of the experiment's identity
+(``stochpound.store.NOT_IN_IDENTITY``), like ``[hazard]`` and ``[design]``.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any, Mapping, Sequence
+
+from stochpound._errors import SceneError
+from stochpound.model import fields as toml_fields
+from stochpound.store import LIMIT_STATE_DEMANDS
+
+
+def parse_limit_states(data: Mapping[str, Any], buildings: Sequence[str]) -> dict[str, Any] | None:
+    """The canonical ``limit_states`` entry of a definition (None without a ``[limit_states]`` table).
+
+    Parameters
+    ----------
+    data : mapping
+        The parsed experiment file.
+    buildings : sequence of str
+        The scene's building names.
+
+    Returns
+    -------
+    dict or None
+        ``source`` (str or None) and ``capacities``: kind -> a list of
+        capacities, or building -> a list of capacities.
+
+    Raises
+    ------
+    SceneError
+        An unknown kind or building, or a capacity that is not a number > 0, named with the field.
+    """
+    table = toml_fields.table(data, "limit_states", "")
+    if table is None:
+        return None
+    source = toml_fields.string(table, "source", "limit_states") if "source" in table else None
+    capacities: dict[str, Any] = {}
+    for kind, value in table.items():
+        if kind == "source":
+            continue
+        where = f"limit_states.{kind}"
+        if kind not in LIMIT_STATE_DEMANDS:
+            raise SceneError(f"{where}: not a limit state; one of {', '.join(LIMIT_STATE_DEMANDS)} (or source)")
+        if isinstance(value, Mapping):
+            for building in value:
+                if building not in buildings:
+                    raise SceneError(f"{where}.{building}: unknown building (buildings: {', '.join(buildings)})")
+            capacities[kind] = {building: _capacities(values, f"{where}.{building}") for building, values in value.items()}
+        else:
+            capacities[kind] = _capacities(value, where)
+    if not capacities:
+        raise SceneError(f"limit_states: give at least one limit state ({', '.join(LIMIT_STATE_DEMANDS)})")
+    return {"source": source, "capacities": capacities}
+
+
+def _capacities(value: Any, where: str) -> list[float]:
+    values = value if isinstance(value, list) else [value]
+    if not values:
+        raise SceneError(f"{where}: give a capacity > 0 or a list of them")
+    for i, capacity in enumerate(values):
+        if isinstance(capacity, bool) or not isinstance(capacity, (int, float)) or not math.isfinite(capacity) or capacity <= 0:
+            raise SceneError(f"{where}{f'[{i}]' if isinstance(value, list) else ''}: a capacity must be a number > 0, got {capacity!r}")
+    return [float(capacity) for capacity in values]
