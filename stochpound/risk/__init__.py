@@ -58,7 +58,7 @@ from stochpound.risk._store_risk import StoreRisk, pounding_fragility, risk_gaps
 from stochpound.risk._demands import StoreDemands, store_demands
 from stochpound.risk._limit_states import KINDS as LIMIT_STATE_KINDS, LimitState, gap_cost_frame, limit_state_risk, limit_states_from_table
 from stochpound.risk._efficiency import measure_efficiency, most_efficient
-from stochpound.risk._damage import DEFAULT_LIMIT_STATES, DEFAULT_SOURCE as DEFAULT_LIMIT_STATES_SOURCE, MODEL_DRIFT_LIMIT, StoreDamage, store_damage
+from stochpound.risk._damage import DAMAGE_DEMANDS, DEFAULT_LIMIT_STATES, DEFAULT_SOURCE as DEFAULT_LIMIT_STATES_SOURCE, MODEL_DRIFT_LIMIT, StoreDamage, store_damage
 from stochpound.analysis import hazard_consistency, stripe_rate_weights
 from stochpound.risk._site_consistency import consistency_at_targets, site_consistency
 
@@ -106,6 +106,7 @@ __all__ = [
     "limit_state_risk",
     "gap_cost_frame",
     "store_damage",
+    "DAMAGE_DEMANDS",
     "StoreDamage",
     "DEFAULT_LIMIT_STATES",
     "DEFAULT_LIMIT_STATES_SOURCE",

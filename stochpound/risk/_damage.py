@@ -55,7 +55,7 @@ EXPERIMENT_SOURCE = "the experiment's [limit_states] table"
 POUNDING = "pounding at g*"
 """What :meth:`StoreDamage.governing` names where no structural limit state is more frequent than pounding at g*."""
 #: The demands of :attr:`StoreDamage.demands`: store summary -> its words.
-DEMANDS = {"peak_ductility": "peak storey ductility", "residual_drift": "residual storey drift", "peak_drift_ratio": "peak storey drift ratio"}
+DAMAGE_DEMANDS = {"peak_ductility": "peak storey ductility", "residual_drift": "residual storey drift", "peak_drift_ratio": "peak storey drift ratio"}
 
 
 @dataclasses.dataclass(frozen=True)
@@ -65,7 +65,7 @@ class StoreDamage:
     Attributes
     ----------
     demands : xarray.Dataset
-        :data:`DEMANDS` present in the store (``peak_ductility`` 1,
+        :data:`DAMAGE_DEMANDS` present in the store (``peak_ductility`` 1,
         ``residual_drift`` m, ``peak_drift_ratio`` 1) over ``quantile``
         (:data:`QUANTILES`), ``building``, ``intensity`` and the store's other
         grid dimensions (contact axes dropped where the runs are contact-free).
@@ -145,7 +145,7 @@ def store_damage(store: xr.Dataset, limit_states: Sequence[LimitState] | None = 
         limit_states, source = DEFAULT_LIMIT_STATES, DEFAULT_SOURCE
     free = has_contact_free(store)
     runs_of = contact_free(store) if free else store
-    per_building = {name: _store.store_motions(runs_of[name]).load() for name in DEMANDS if name in store}
+    per_building = {name: _store.store_motions(runs_of[name]).load() for name in DAMAGE_DEMANDS if name in store}
     demands = xr.Dataset({name: data.quantile(list(QUANTILES), dim="record").assign_attrs(units=store[name].attrs.get("units", ""))
                           for name, data in per_building.items()})
     done = np.isfinite(per_building["peak_ductility"].max("building"))

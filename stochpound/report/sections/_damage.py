@@ -6,8 +6,7 @@ import pandas as pd
 
 from stochpound.report.render import Paragraph, Section, Table
 from stochpound.report.sections._description import number
-from stochpound.risk import MODEL_DRIFT_LIMIT, StoreDamage, return_period
-from stochpound.risk._damage import DEMANDS
+from stochpound.risk import DAMAGE_DEMANDS, MODEL_DRIFT_LIMIT, StoreDamage, return_period
 
 
 def damage_section(name: str, damage: StoreDamage) -> Section:
@@ -54,7 +53,7 @@ def _demands_table(name: str, damage: StoreDamage) -> Table:
                 for variable, scale, unit in (("peak_ductility", 1.0, ""), ("residual_drift", 1000.0, " (mm)"), ("peak_drift_ratio", 100.0, " (%)")):
                     if variable in at:
                         for q, word in ((0.5, "median"), (0.84, "84 %")):
-                            row[f"{DEMANDS[variable]}{unit}, {word}"] = f"{float(at[variable].sel(building=building, quantile=q)) * scale:.3g}"
+                            row[f"{DAMAGE_DEMANDS[variable]}{unit}, {word}"] = f"{float(at[variable].sel(building=building, quantile=q)) * scale:.3g}"
                 row["runs > model"] = f"{int(damage.beyond_model.sel(labels).sel(intensity=level))} of {int(damage.runs.sel(labels).sel(intensity=level))}"
                 rows.append(row)
     frame = pd.DataFrame(rows).set_index(["configuration", "stripe", "building"])
