@@ -8,7 +8,7 @@ has them (the runs the separations come from), else over every run:
   building's peak storey ductility, residual storey drift and peak storey
   drift ratio (empirical quantiles, linear interpolation);
 * per stripe, the runs whose peak storey drift ratio exceeds
-  :data:`MODEL_DRIFT_LIMIT`: the bilinear storeys never lose strength, so
+  ``MODEL_DRIFT_LIMIT``: the bilinear storeys never lose strength, so
   such a run's drifts are beyond what the model represents and are counted,
   not taken as credible;
 * the limit states' mean annual frequencies (:func:`~stochpound.risk.limit_state_risk`)
@@ -17,8 +17,8 @@ has them (the runs the separations come from), else over every run:
   structural limit states.
 
 The limit states are the experiment's ``[limit_states]`` table (not part of
-its runs' identity: docs/risk.md), else :data:`DEFAULT_LIMIT_STATES`, the
-drift ratios of :data:`DEFAULT_SOURCE`; a caller may give others.
+its runs' identity: docs/risk.md), else ``DEFAULT_LIMIT_STATES``, the
+drift ratios of ``DEFAULT_SOURCE``; a caller may give others.
 """
 
 from __future__ import annotations
@@ -37,24 +37,24 @@ from stochpound.risk._store_risk import YEARS
 from stochpound.store import contact_free, has_contact_free
 
 MODEL_DRIFT_LIMIT = 0.05
-"""Peak storey drift ratio beyond which a run is flagged: the model has no strength loss or collapse (the collapse-prevention drift of :data:`DEFAULT_SOURCE`)."""
+"""Peak storey drift ratio beyond which a run is flagged: the model has no strength loss or collapse (the collapse-prevention drift of ``DEFAULT_SOURCE``)."""
 QUANTILES = (0.5, 0.84)
-"""The fractiles over each stripe's motions of :attr:`StoreDamage.demands`."""
+"""The fractiles over each stripe's motions of ``StoreDamage.demands``."""
 DEFAULT_LIMIT_STATES = (
     LimitState("drift_ratio", 0.007),
     LimitState("drift_ratio", 0.025),
     LimitState("residual_drift_ratio", 0.01),
     LimitState("drift_ratio", 0.05),
 )
-"""The default limit states: peak storey drift ratios 0.7 %, 2.5 %, 5 % and a residual storey drift ratio of 1 % (:data:`DEFAULT_SOURCE`)."""
+"""The default limit states: peak storey drift ratios 0.7 %, 2.5 %, 5 % and a residual storey drift ratio of 1 % (``DEFAULT_SOURCE``)."""
 DEFAULT_SOURCE = ("FEMA 356 (2000), Table C1-3, steel moment frames: immediate occupancy at 0.7 % transient storey drift, life safety at "
                   "2.5 % transient or 1 % permanent, collapse prevention at 5 % transient or permanent")
-"""Where :data:`DEFAULT_LIMIT_STATES` come from."""
+"""Where ``DEFAULT_LIMIT_STATES`` come from."""
 EXPERIMENT_SOURCE = "the experiment's [limit_states] table"
 """The source of limit states an experiment's ``[limit_states]`` gives without a ``source``."""
 POUNDING = "pounding at g*"
-"""What :meth:`StoreDamage.governing` names where no structural limit state is more frequent than pounding at g*."""
-#: The demands of :attr:`StoreDamage.demands`: store summary -> its words.
+"""What ``StoreDamage.governing`` names where no structural limit state is more frequent than pounding at g*."""
+#: The demands of ``StoreDamage.demands``: store summary -> its words.
 DAMAGE_DEMANDS = {"peak_ductility": "peak storey ductility", "residual_drift": "residual storey drift", "peak_drift_ratio": "peak storey drift ratio"}
 
 
@@ -65,19 +65,19 @@ class StoreDamage:
     Attributes
     ----------
     demands : xarray.Dataset
-        :data:`DAMAGE_DEMANDS` present in the store (``peak_ductility`` 1,
+        ``DAMAGE_DEMANDS`` present in the store (``peak_ductility`` 1,
         ``residual_drift`` m, ``peak_drift_ratio`` 1) over ``quantile``
-        (:data:`QUANTILES`), ``building``, ``intensity`` and the store's other
+        (``QUANTILES``), ``building``, ``intensity`` and the store's other
         grid dimensions (contact axes dropped where the runs are contact-free).
     runs, beyond_model : xarray.DataArray
         Per stripe and configuration: the runs done, and those whose peak
-        storey drift ratio (any building) exceeds :data:`MODEL_DRIFT_LIMIT`
+        storey drift ratio (any building) exceeds ``MODEL_DRIFT_LIMIT``
         (0 without storey heights).
     design_stripes : dict
-        Probability of exceedance in 50 yr (:data:`~stochpound.risk.TARGETS`)
+        Probability of exceedance in 50 yr (``stochpound.risk.TARGETS``)
         -> the stripe nearest (in ln IM) to the hazard's intensity of that rate.
     risk : xarray.Dataset or None
-        :func:`~stochpound.risk.limit_state_risk` of :attr:`limit_states` on
+        :func:`~stochpound.risk.limit_state_risk` of ``limit_states`` on
         the same runs (None when the store holds none of their demands).
     limit_states : tuple of LimitState
         Those evaluated (the given ones the store holds the demand of).
@@ -102,7 +102,7 @@ class StoreDamage:
         Pounding at g* has the target's rate; the governing limit state is
         the most frequent of the structural ones where its mean annual
         frequency exceeds that rate (it is then reached before pounding at
-        g*), else :data:`POUNDING`. None without :attr:`risk`.
+        g*), else ``POUNDING``. None without ``risk``.
         """
         if self.risk is None:
             return None
@@ -120,7 +120,7 @@ def store_damage(store: xr.Dataset, limit_states: Sequence[LimitState] | None = 
         An experiment store with intensity stripes and a site hazard.
     limit_states : sequence of LimitState, optional
         Default: the experiment's ``[limit_states]`` table, else
-        :data:`DEFAULT_LIMIT_STATES` (then ``source`` is :data:`DEFAULT_SOURCE`,
+        ``DEFAULT_LIMIT_STATES`` (then ``source`` is ``DEFAULT_SOURCE``,
         and those whose demand the store lacks are left out).
     source : str, optional
         Where the given limit states come from.
