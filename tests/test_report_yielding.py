@@ -97,9 +97,21 @@ def test_store_damage_fractiles_and_runs_beyond_the_model(store):
     assert damage.limit_states == DEFAULT_LIMIT_STATES
     maf = damage.risk["maf"]
     for probability in (0.1, 0.02):
+        rate = -np.log(1 - probability) / 50  # the target's rate: that of pounding at g*
+        np.testing.assert_array_equal(damage.before_pounding(probability).values, maf.values > rate)
         governing = damage.governing(probability).item()
         assert governing == str(maf["limit_state"].values[int(np.argmax(maf.values))])  # the most frequent: it exceeds the target's rate here
-        assert float(maf.max()) > -np.log(1 - probability) / 50
+        assert float(maf.max()) > rate
+
+
+def test_pounding_at_g_star_governs_where_no_limit_state_is_as_frequent(store):
+    """Capacities no run reaches: every λ is 0, below the target's rate, so pounding at g* governs."""
+    from stochpound.risk import LimitState
+    damage = store_damage(store, [LimitState("ductility", 1.0e4)], "a test")
+    assert float(damage.risk["maf"].max()) == 0.0
+    assert damage.governing(0.02).item() == "pounding at g*"
+    assert "Governing: for 10 % in 50 yr, pounding at g*; for 2 % in 50 yr, pounding at g*." in " ".join(
+        _text(block) for block in damage_section("yfix", damage).blocks)
 
 
 def test_the_damage_section_states_fractiles_flags_and_the_governing_limit_state(store):
@@ -114,7 +126,13 @@ def test_the_damage_section_states_fractiles_flags_and_the_governing_limit_state
     assert row["runs > model"] == f"{beyond} of {runs}"
     assert f"{beyond} of {runs} at stripe 1.2031" in texts and "are not credible" in texts
     assert "FEMA 356 (2000), Table C1-3, steel moment frames" in texts
-    assert f"Governing: for 10 % in 50 yr, {damage.governing(0.1).item()}; for 2 % in 50 yr, {damage.governing(0.02).item()}." in texts
+    maf = damage.risk["maf"]
+    for probability in (0.1, 0.02):
+        worst = damage.governing(probability).item()
+        others = [str(state) for state in maf["limit_state"].values
+                  if float(maf.sel(limit_state=state)) > -np.log(1 - probability) / 50 and state != worst]
+        expected = worst + (f" (also reached more often than pounding at g*: {', '.join(others)})" if others else "")
+        assert f"for {100 * probability:g} % in 50 yr, {expected}" in texts
 
 
 # ---------------------------------------------------------------- the [limit_states] table of an experiment file
@@ -139,7 +157,8 @@ def test_a_limit_states_table_is_not_part_of_the_identity_and_replaces_the_defau
     assert damage.source == "a test"
     assert [state.label for state in damage.limit_states] == ["peak storey ductility of B1 ≥ 4", "peak storey ductility of B1 ≥ 8",
                                                               "residual storey drift ratio ≥ 0.005"]
-    assert "Limit states (capacities from a test): peak storey ductility of B1 ≥ 4;" in " ".join(
+    assert "Limit states (capacities from a test; one that names no building is reached when any building reaches it): " \
+           "peak storey ductility of B1 ≥ 4;" in " ".join(
         _text(block) for block in damage_section("yfix", damage).blocks)
 
 

@@ -104,11 +104,18 @@ class StoreDamage:
         frequency exceeds that rate (it is then reached before pounding at
         g*), else ``POUNDING``. None without ``risk``.
         """
-        if self.risk is None:
+        before = self.before_pounding(probability)
+        if before is None:
             return None
         maf = self.risk["maf"].fillna(-1.0)
         worst = maf["limit_state"][maf.argmax("limit_state")].drop_vars("limit_state", errors="ignore")
-        return worst.where(maf.max("limit_state") > float(rate_from_probability(probability, YEARS)), POUNDING)
+        return worst.where(before.any("limit_state"), POUNDING)
+
+    def before_pounding(self, probability: float) -> xr.DataArray | None:
+        """Per limit state and configuration, whether its λ exceeds the rate of ``probability`` in 50 yr: it is reached more often than pounding at g* (None without ``risk``)."""
+        if self.risk is None:
+            return None
+        return self.risk["maf"] > float(rate_from_probability(probability, YEARS))
 
 
 def store_damage(store: xr.Dataset, limit_states: Sequence[LimitState] | None = None, source: str | None = None) -> StoreDamage | None:

@@ -82,15 +82,24 @@ def _beyond_model_text(damage: StoreDamage) -> str:
 def _governing_text(damage: StoreDamage) -> str:
     parts = []
     for probability in damage.design_stripes:
-        governing = damage.governing(probability)
-        texts = [(f"{_label(labels)}: " if labels else "") + str(governing.sel(labels).item()) for labels in _configurations(governing)]
-        parts.append(f"for {_percent(probability)} in 50 yr, " + "; ".join(texts))
+        governing, before = damage.governing(probability), damage.before_pounding(probability)
+        grouped: dict[str, list[str]] = {}
+        for labels in _configurations(governing):
+            worst = str(governing.sel(labels).item())
+            others = [str(state) for state, flag in zip(before["limit_state"].values, before.sel(labels).values) if flag and state != worst]
+            text = worst + (f" (also reached more often than pounding at g*: {', '.join(others)})" if others else "")
+            grouped.setdefault(text, []).append(_label(labels))
+        every = len(_configurations(governing))
+        parts.append(f"for {_percent(probability)} in 50 yr, " + "; ".join(
+            (f"{' and '.join(names)}: " if len(names) < every else "") + text for text, names in grouped.items()))
     states = "; ".join(state.label for state in damage.limit_states)
-    return (f"Limit states (capacities from {damage.source}): {states}. Each one's mean annual frequency λ comes from its lognormal "
-            f"fragility over the stripes and the site's hazard, as for pounding (the table below). Pounding at the risk-targeted "
-            "separation g* happens at the target's rate; the governing limit state is the one reached most often: a structural limit "
-            f"state where its λ exceeds that rate (the building is then damaged before the gap closes), else pounding at g*. "
-            f"Governing: {'; '.join(parts)}. A [limit_states] table in the experiment file replaces these capacities (docs/risk.md).")
+    return (f"Limit states (capacities from {damage.source}; one that names no building is reached when any building reaches it): "
+            f"{states}. Each one's mean annual frequency λ comes from its fragility "
+            "over the stripes (a lognormal, or a step where the runs identify none) and the site's hazard, as for pounding (the table "
+            "below). Pounding at the risk-targeted separation g* happens at the target's rate; the governing limit state is the one "
+            "reached most often: a structural limit state where its λ exceeds that rate (the building is then damaged before the gap "
+            f"closes), else pounding at g*. Governing: {'; '.join(parts)}. A [limit_states] table in the experiment file replaces these "
+            "capacities (docs/risk.md).")
 
 
 def _limit_states_table(name: str, damage: StoreDamage) -> Table:
