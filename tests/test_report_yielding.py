@@ -179,3 +179,44 @@ def test_bad_limit_states_tables_are_named(table, message):
     text = risk_text(FIXED, "gap = [inf]", STRIPES) + f"\n[limit_states]\n{table}\n"
     with pytest.raises(ExperimentError, match=message):
         parse_experiment(tomllib.loads(text))
+
+
+def test_the_damage_section_says_which_runs_and_stripes_and_lists_every_limit_states_rate(store):
+    damage = store_damage(store)
+    section = damage_section("yfix", damage)
+    texts = " ".join(_text(block) for block in section.blocks)
+    assert ("from its contact-free runs (those the separations come from)" in texts
+            and "(10 % in 50 yr: stripe 0.7399; 2 % in 50 yr: stripe 1.2031)" in texts)
+    table = next(block for block in section.blocks if getattr(block, "key", "") == "table-limit-states-yfix").frame
+    maf = damage.risk["maf"]
+    assert len(table) == maf.sizes["limit_state"] == len(DEFAULT_LIMIT_STATES)
+    for state in maf["limit_state"].values:
+        rate = float(maf.sel(limit_state=state))
+        assert table.loc[("–", str(state)), "λ (1/yr)"] == f"{rate:.3g}"
+        assert table.loc[("–", str(state)), "once in (yr)"] == f"{1.0 / rate:.3g}"
+
+
+def test_no_run_beyond_the_model_is_said_so(store):
+    import dataclasses
+
+    from stochpound.report.sections._damage import _beyond_model_text
+    damage = store_damage(store)
+    none = dataclasses.replace(damage, beyond_model=damage.beyond_model * 0)
+    assert _beyond_model_text(none).endswith(f"none of the {int(damage.runs.sum())} runs reaches it.")
+    assert "not credible" not in _beyond_model_text(none)
+
+
+def test_methods_says_what_p_delta_does_only_where_a_building_has_it(store):
+    from stochpound.report.sections._description import model_paragraph
+    definition = StoreDefinition("yfix", store)
+    sentence = "With P-Δ a storey's spring is softened by the geometric stiffness −W/h of the weight above it"
+    assert sentence in model_paragraph([definition]).text
+    for configuration in definition.configurations:
+        object.__setattr__(configuration, "scene", _without_p_delta(configuration.scene))
+    text = model_paragraph([definition]).text
+    assert sentence not in text and "Storeys given a yield shear F_y are bilinear" in text
+
+
+def _without_p_delta(scene):
+    import dataclasses
+    return dataclasses.replace(scene, buildings=tuple(dataclasses.replace(b, p_delta=False) for b in scene.buildings))
