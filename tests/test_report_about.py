@@ -32,3 +32,14 @@ def test_a_risk_report_is_not_said_to_hold_ecdfs_or_convergence_figures():
 def test_the_summary_points_a_risk_experiment_to_its_risk_and_intensity_sections():
     sections = _sections("about", "risk-pair", "risk-other", "intensity-pair", "methods")
     assert _where("pair", sections) == ("Details: section 3 (risk-pair), section 5 (intensity-pair), section 6 (methods).")
+
+
+def test_a_damage_section_is_named_only_where_the_report_has_one():
+    stores = {"pair": xr.Dataset(attrs={"experiment_description": "a pair"})}
+    assert "A Damage section" not in _about(stores, _sections("risk-pair", "methods"))
+    assert "A Damage section per experiment of yielding buildings" in _about(stores, _sections("risk-pair", "damage-pair", "methods"))
+
+
+def test_the_summary_points_a_yielding_experiment_to_its_damage_section():
+    sections = _sections("about", "risk-pair", "damage-pair", "intensity-pair", "methods")
+    assert _where("pair", sections) == ("Details: section 3 (risk-pair), section 4 (damage-pair), section 5 (intensity-pair), section 6 (methods).")

@@ -121,6 +121,9 @@ def _about(stores: dict[str, xr.Dataset], sections: list[Section]) -> str:
     if "risk" in kinds:
         parts.append("A Risk section per experiment with a site hazard gives the risk-targeted separation g* first, then the "
                      "fragility at every gap, the mean annual frequency of pounding and the code rules in risk terms.")
+    if "damage" in kinds:
+        parts.append("A Damage section per experiment of yielding buildings gives their ductility and residual drift demands at the "
+                     "stripes of 10 % and 2 % in 50 yr, the runs beyond what the model represents, and the limit state that governs.")
     if "experiment" in kinds:
         parts.append("An experiment section gives the cases run under records one by one, and each synthetic ensemble by the "
                      "statistics of its realizations in every cell of the grid (every combination of the grid's axes): means with "

@@ -197,7 +197,7 @@ def _probability_table(name: str, store: xr.Dataset, ensembles: list[str], axis:
 
 def _where(name: str, sections: list[Section]) -> str:
     """Where the details of experiment ``name`` are: its sections by number (the summary is section 1) and title."""
-    wanted = {f"{kind}-{name}" for kind in ("risk", "experiment", "laws", "clearance", "separation", "intensity")} | {"appendix", "methods"}
+    wanted = {f"{kind}-{name}" for kind in ("risk", "damage", "experiment", "laws", "clearance", "separation", "intensity")} | {"appendix", "methods"}
     found = [f"section {number} ({section.title})" for number, section in enumerate(sections, start=2) if section.key in wanted]
     return "Details: " + ", ".join(found) + "."
 
