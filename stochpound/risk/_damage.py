@@ -34,7 +34,6 @@ from stochpound.risk import _store
 from stochpound.risk._limit_states import KINDS, LimitState, limit_state_risk, limit_states_from_table
 from stochpound.risk._maf import TARGETS
 from stochpound.risk._store_risk import YEARS
-from stochpound.store import contact_free, has_contact_free
 
 MODEL_DRIFT_LIMIT = 0.05
 """Peak storey drift ratio beyond which a run is flagged: the model has no strength loss or collapse (the collapse-prevention drift of ``DEFAULT_SOURCE``)."""
@@ -145,27 +144,24 @@ def store_damage(store: xr.Dataset, limit_states: Sequence[LimitState] | None = 
     if "peak_ductility" not in store or _store.stripes(store) is None:
         return None
     given = limit_states is not None
-    table = store.pound.definition.limit_states
+    table = _store.limit_states_table(store)
     if limit_states is None and table is not None:
         limit_states, source, given = limit_states_from_table(table["capacities"]), table["source"] or EXPERIMENT_SOURCE, True
     if limit_states is None:
         limit_states, source = DEFAULT_LIMIT_STATES, DEFAULT_SOURCE
-    free = has_contact_free(store)
-    runs_of = contact_free(store) if free else store
-    per_building = {name: _store.store_motions(runs_of[name]).load() for name in DAMAGE_DEMANDS if name in store}
-    demands = xr.Dataset({name: data.quantile(list(QUANTILES), dim="record").assign_attrs(units=store[name].attrs.get("units", ""))
-                          for name, data in per_building.items()})
+    per_building, free = _store.run_summaries(store, list(DAMAGE_DEMANDS))
+    demands = xr.Dataset({name: data.quantile(list(QUANTILES), dim="record", keep_attrs=True) for name, data in per_building.items()})
     done = np.isfinite(per_building["peak_ductility"].max("building"))
     drift = per_building.get("peak_drift_ratio")
     beyond = (drift.max("building") > MODEL_DRIFT_LIMIT) if drift is not None else xr.zeros_like(done)
     hz = _store.site_hazard(store)
-    levels = np.asarray(store["intensity"].values, float)
+    levels = _store.stripe_levels(store)
     design_stripes = {p: float(levels[np.argmin(np.abs(np.log(levels) - np.log(float(hz.intensity_at(rate_from_probability(p, YEARS))))))])
                       for p in TARGETS}
     held = tuple(state for state in limit_states  # the defaults the store can evaluate; every given one (an error where it cannot)
-                 if given or (KINDS[state.kind].variable in store and bool(np.isfinite(store[KINDS[state.kind].variable]).any())))
+                 if given or _store.holds(store, KINDS[state.kind].variable))
     risk = None
     if held:
         risk = limit_state_risk(store, held, hz)
-        risk = contact_free(risk) if free else risk
+        risk = _store.contact_free_part(risk) if free else risk
     return StoreDamage(demands, done.sum("record"), (beyond & done).sum("record"), design_stripes, risk, held, source or "", free)

@@ -33,7 +33,6 @@ from stochpound.risk import _store
 from stochpound.risk._fragility_ensemble import limit_state_events, stripe_fragility
 from stochpound.risk._maf import mean_annual_frequency
 from stochpound.risk._store_risk import CONFIDENCE, YEARS
-from stochpound.store import LIMIT_STATE_DEMANDS
 
 
 @dataclasses.dataclass(frozen=True)
@@ -46,7 +45,7 @@ class _Kind:
 
 
 #: The kinds of limit state: the ``[limit_states]`` keys, the store summary each reads, and the capacity's units.
-KINDS = {kind: _Kind(LIMIT_STATE_DEMANDS[kind], *rest) for kind, rest in {
+KINDS = {kind: _Kind(_store.limit_state_variable(kind), *rest) for kind, rest in {
     "drift_ratio": ("1", "peak storey drift ratio", True, "yielding storeys or storey_height, and [output] demands = true"),
     "residual_drift_ratio": ("1", "residual storey drift ratio", True, "yield_force and storey_height"),
     "ductility": ("1", "peak storey ductility", True, "yield_force"),

@@ -25,7 +25,7 @@ from stochpound.analysis import HazardCurve, parse_measure, parse_units, store_c
 from stochpound.experiment import check_covers, hazard_curve, hazard_option, stored_hazard
 from stochpound.model import Scene
 from stochpound.motions import DEFAULT_G
-from stochpound.store import contact_free, describe_measure, gap_dims, has_contact_free, has_wall_free, wall_free, with_contacts
+from stochpound.store import LIMIT_STATE_DEMANDS, contact_free, describe_measure, gap_dims, has_contact_free, has_wall_free, wall_free, with_contacts
 
 CLOSURE = "peak_contact_closure"
 """The store's variable of per-case, per-contact peak closures (m)."""
@@ -387,6 +387,41 @@ def case_demand(store: xr.Dataset, variable: str, building: str | None, needs: s
             raise RiskInputError(f"limit_states: building {building!r} is not one of the store's ({', '.join(names)})")
         data = data.max("building") if building is None else data.sel(building=building, drop=True)
     return store_motions(data).load().assign_attrs(units=store[variable].attrs.get("units", ""))
+
+
+def limit_state_variable(kind: str) -> str:
+    """The per-case store summary a kind of limit state reads (``stochpound.store.LIMIT_STATE_DEMANDS``)."""
+    return LIMIT_STATE_DEMANDS[kind]
+
+
+def limit_states_table(store: xr.Dataset) -> Mapping[str, Any] | None:
+    """The experiment's ``[limit_states]`` entry (``source``, ``capacities``), or None without one."""
+    return store.pound.definition.limit_states
+
+
+def holds(store: xr.Dataset, variable: str) -> bool:
+    """Whether the store has ``variable`` with at least one finite value."""
+    return variable in store and bool(np.isfinite(store[variable]).any())
+
+
+def stripe_levels(store: xr.Dataset) -> np.ndarray:
+    """The levels of a stripes store's ``intensity`` dimension (IM units)."""
+    return np.asarray(store["intensity"].values, dtype=float)
+
+
+def run_summaries(store: xr.Dataset, variables: list[str]) -> tuple[dict[str, xr.DataArray], bool]:
+    """Per-case summaries over the store's contact-free runs where it has them (else every run), one motion dimension ``record``.
+
+    Returns the summaries held (with their units) and whether the runs are the contact-free ones.
+    """
+    free = has_contact_free(store)
+    runs = contact_free(store) if free else store
+    return {name: store_motions(runs[name]).load().assign_attrs(units=store[name].attrs.get("units", "")) for name in variables if name in store}, free
+
+
+def contact_free_part(data: xr.Dataset) -> xr.Dataset:
+    """The contact-free configurations of ``data`` (over a store's grid; ``data`` itself without contact axes)."""
+    return contact_free(data)
 
 
 def at_finite_gaps(data: xr.Dataset) -> xr.Dataset:
