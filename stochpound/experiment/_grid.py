@@ -410,11 +410,9 @@ class Experiment:
 
     @cached_property
     def scene_field(self) -> str:
-        """How errors name the base scene: ``scene`` (inline), its file's path, or ``bundled scene '<name>'``."""
+        """How errors name the base scene: its file's path, else ``scene`` (inline, or a bundled scene: an error is its edits')."""
         source = self.contract.scene_source
-        if source is None:
-            return "scene"
-        return str(self.base_dir / source["file"]) if "file" in source else f"bundled scene {source['bundled']!r}"
+        return str(self.base_dir / source["file"]) if source is not None and "file" in source else "scene"
 
     def validate(self) -> None:
         """Validate the scene of every grid point (cases, then references) before anything runs.
