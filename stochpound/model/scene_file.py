@@ -53,7 +53,7 @@ def load_scene(path: str | Path) -> Scene:
 
 
 def read_scene_table(path: str | Path) -> dict[str, Any]:
-    """The parsed TOML of a scene file, not yet validated (:func:`scene_from_dict` validates it).
+    """The parsed TOML of a scene file, not yet validated (:func:`~stochpound.model.scene_file.scene_from_dict` validates it).
 
     Parameters
     ----------
@@ -91,7 +91,7 @@ def bundled_scene_path(name: str) -> Path:
     Parameters
     ----------
     name : str
-        One of :func:`bundled_scenes`, e.g. ``"elastic_pair"``.
+        One of :func:`~stochpound.model.bundled_scenes`, e.g. ``"elastic_pair"``.
 
     Returns
     -------
