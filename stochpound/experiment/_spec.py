@@ -32,7 +32,7 @@ from stochpound.motions import DEFAULT_G
 from stochpound.experiment._intensity import parse_intensity
 from stochpound.model import fields as toml_fields
 from stochpound.model.contact import ELEMENT_KEYS
-from stochpound.experiment._scene_edits import apply_overrides
+from stochpound.experiment._scene_edits import apply_overrides, building_names
 from stochpound.model.scene_file import bundled_scene_path, bundled_scenes, generator_fields, read_scene_table
 from stochpound.solvers.simulate import METHODS
 from stochpound.solvers.ivp import INTEGRATORS
@@ -113,7 +113,9 @@ def parse_experiment(data: Mapping[str, Any], base_dir: str | Path = ".", defaul
         ``scene`` (the base scene's dict, its ``[motion]`` included when it has one),
         ``studied``, ``variants``, ``gaps``, ``mu``, ``motions``, ``output``, ``solver``;
         ``intensity`` and ``hazard`` only when the file has those tables;
-        ``reproduces`` only when the file declares it.
+        ``reproduces`` only when the file declares it; ``scene_source`` only when
+        the base scene comes from a file (``file`` as given, or ``bundled``, and the file's
+        ``sha256``: not part of the identity, ``scene`` holds the content).
     """
     base_dir = Path(base_dir)
     with field_errors():
@@ -210,8 +212,8 @@ def _base_scene(data: Mapping[str, Any], header: Mapping[str, Any], base_dir: Pa
     scene, source = _scene_from_file(inline[key], base_dir, f"scene.{key}", key)
     edits = inline.get("building")
     if edits:
-        buildings = [b.get("name", f"B{i + 1}") for i, b in enumerate(scene.get("building", []))]
-        scene = apply_overrides(scene, [_override({"building": edits}, "scene", buildings, len(scene.get("contact", [])))])
+        edit = _override({"building": edits}, "scene", building_names(scene), len(scene.get("contact", [])))
+        scene = apply_overrides(scene, [edit])
     return scene, source
 
 
