@@ -40,8 +40,9 @@ def definition(scene: str, base_dir: Path = Path(".")) -> dict:
 def test_bundled_scenes_are_listed_and_found() -> None:
     assert "elastic_pair" in bundled_scenes()
     assert BUNDLED_PAIR.name == "elastic_pair.toml"
-    with pytest.raises(SceneError, match=r"^no bundled scene 'nope' \(bundled: .*elastic_pair"):
-        bundled_scene_path("nope")
+    for name in ("nope", "../study/reference_tables", "elastic_pair.toml"):
+        with pytest.raises(SceneError, match=r"^no bundled scene '.*' \(bundled: .*elastic_pair"):
+            bundled_scene_path(name)
 
 
 def test_a_scene_file_or_a_bundled_scene_has_the_identity_of_the_same_scene_inlined(tmp_path: Path) -> None:

@@ -103,11 +103,10 @@ def bundled_scene_path(name: str) -> Path:
     SceneError
         If no bundled scene has that name (the message lists them).
     """
-    folder = bundled_data_dir("scenes", "SOURCES.md")
-    path = folder / f"{name}.toml" if folder is not None and isinstance(name, str) and name else None
-    if path is None or not path.is_file():
-        raise SceneError(f"no bundled scene {name!r} (bundled: {', '.join(bundled_scenes()) or 'none'})")
-    return path
+    names = bundled_scenes()
+    if name not in names:  # a name, never a path into the data folder
+        raise SceneError(f"no bundled scene {name!r} (bundled: {', '.join(names) or 'none'})")
+    return bundled_data_dir("scenes", "SOURCES.md") / f"{name}.toml"
 
 
 def scene_from_dict(data: Mapping[str, Any], base_dir: str | Path = ".", source: str = "python") -> Scene:
