@@ -18,18 +18,44 @@ from stochpound.report.sections._accuracy import yielding_check, yielding_case
 from stochpound.report.sections._description import StoreDefinition, buildings_table, design_paragraph
 from stochpound.risk import DEFAULT_LIMIT_STATES, MODEL_DRIFT_LIMIT, store_damage
 from stochpound.store import contact_free, open_store
-from tests.helpers import FIXED, risk_text, run_in_process
+from tests.helpers import risk_text, run_in_process
 
-YIELDING = "damping_ratio = 0.05\nyield_force = [1.0e5, 0.7e5]\nhardening = 0.02\nstorey_height = [3.0, 3.0]\np_delta = true\n"
+YIELDING = "yield_force = [1.0e5, 0.7e5]\nhardening = 0.02\nstorey_height = [3.0, 3.0]\np_delta = true\n"
+#: The helpers' fixed pair (the bundled elastic pair beside the stiff neighbour), written out, with both buildings' storeys yielding.
+SCENE = f"""
+[scene]
+g = 9.81
+[[scene.building]]
+name = "B1"
+mass = [26268.0, 17512.0]
+stiffness = [24516800.0, 17512000.0]
+damping_ratio = 0.05
+{YIELDING}
+[[scene.building]]
+name = "B2"
+mass = [13134.0, 8756.0]
+stiffness = [24516800.0, 17512000.0]
+damping_ratio = 0.05
+{YIELDING}
+[[scene.contact]]
+between = [["B1", 1], ["B2", 1]]
+gap = 0.02
+stiffness = 42747262.6
+restitution = 0.5
+[[scene.contact]]
+between = [["B1", 2], ["B2", 2]]
+gap = 0.02
+stiffness = 28498175.1
+restitution = 0.5
+"""
 DESIGN = "\n[design]\nsds = 1.32925\nsd1 = 0.80204\nr = 8.0\ncd = 5.5\nomega0 = 3.0\nie = 1.0\n"
 STRIPES = 'measure = "psa"\nperiod = 1.0\nlevels = [0.3, 0.7399, 1.2031]\nmethod = "stripes"'
 
 
 @pytest.fixture(scope="module")
 def store(tmp_path_factory):
-    scene = FIXED.replace("damping_ratio = 0.05\n", YIELDING)
-    assert scene.count("yield_force") == 2
-    text = risk_text(scene, "gap = [0.05, inf]", STRIPES) + "demands = true\n" + DESIGN
+    assert SCENE.count("yield_force") == 2
+    text = risk_text(SCENE, "gap = [0.05, inf]", STRIPES) + "demands = true\n" + DESIGN
     return open_store(run_in_process(tmp_path_factory.mktemp("yreport"), "yfix", text)).load()
 
 
@@ -145,8 +171,7 @@ def test_a_limit_states_table_is_not_part_of_the_identity_and_replaces_the_defau
 
     from stochpound.experiment._spec import parse_experiment
     from stochpound.store import definition_sha256
-    scene = FIXED.replace("damping_ratio = 0.05\n", YIELDING)
-    text = risk_text(scene, "gap = [0.05, inf]", STRIPES) + "demands = true\n" + DESIGN
+    text = risk_text(SCENE, "gap = [0.05, inf]", STRIPES) + "demands = true\n" + DESIGN
     table = '\n[limit_states]\nsource = "a test"\nductility = { B1 = [4.0, 8.0] }\nresidual_drift_ratio = 0.005\n'
     plain, with_table = parse_experiment(tomllib.loads(text)), parse_experiment(tomllib.loads(text + table))
     assert with_table["limit_states"] == {"source": "a test", "capacities": {"ductility": {"B1": [4.0, 8.0]}, "residual_drift_ratio": [0.005]}}
@@ -176,7 +201,7 @@ def test_bad_limit_states_tables_are_named(table, message):
 
     from stochpound.experiment import ExperimentError
     from stochpound.experiment._spec import parse_experiment
-    text = risk_text(FIXED, "gap = [inf]", STRIPES) + f"\n[limit_states]\n{table}\n"
+    text = risk_text(SCENE, "gap = [inf]", STRIPES) + f"\n[limit_states]\n{table}\n"
     with pytest.raises(ExperimentError, match=message):
         parse_experiment(tomllib.loads(text))
 
