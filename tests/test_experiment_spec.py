@@ -225,3 +225,11 @@ def test_a_variant_cannot_give_hardening_to_an_elastic_building():
     data["variants"]["neighbour"]["stiff"]["building"]["B2"]["hardening"] = 0.02
     with pytest.raises(ExperimentError, match=r"^case neighbour=stiff, gap=0.01, mu=0.2: building\[1\]\.hardening: only a building with yield_force"):
         experiment(data)
+
+
+def test_a_bundled_scenes_edit_sets_yield_force_and_hardening():
+    from tests.helpers import FIXED, RECORDS
+    text = f'[experiment]\nname = "e"\nstudied = "B1"\n{FIXED}[scene.building.B1]\nyield_force = [2.0e5, 1.2e5]\nhardening = 0.03\n[grid]\ngap = [0.02]\n{RECORDS}'
+    exp = experiment(tomllib.loads(text))
+    b1 = stochpound.scene_from_dict(exp.structure(next(c for c in exp.cases if c.kind == "case"))).buildings[0]
+    assert (b1.yield_force, b1.hardening) == ((2.0e5, 1.2e5), 0.03)
