@@ -18,36 +18,13 @@ from stochpound.report.sections._accuracy import yielding_check, yielding_case
 from stochpound.report.sections._description import StoreDefinition, buildings_table, design_paragraph
 from stochpound.risk import DEFAULT_LIMIT_STATES, MODEL_DRIFT_LIMIT, store_damage
 from stochpound.store import contact_free, open_store
-from tests.helpers import risk_text, run_in_process
+from tests.helpers import REPOSITORY, risk_text, run_in_process
 
 YIELDING = "yield_force = [1.0e5, 0.7e5]\nhardening = 0.02\nstorey_height = [3.0, 3.0]\np_delta = true\n"
-#: The helpers' fixed pair (the bundled elastic pair beside the stiff neighbour), written out, with both buildings' storeys yielding.
-SCENE = f"""
-[scene]
-g = 9.81
-[[scene.building]]
-name = "B1"
-mass = [26268.0, 17512.0]
-stiffness = [24516800.0, 17512000.0]
-damping_ratio = 0.05
-{YIELDING}
-[[scene.building]]
-name = "B2"
-mass = [13134.0, 8756.0]
-stiffness = [24516800.0, 17512000.0]
-damping_ratio = 0.05
-{YIELDING}
-[[scene.contact]]
-between = [["B1", 1], ["B2", 1]]
-gap = 0.02
-stiffness = 42747262.6
-restitution = 0.5
-[[scene.contact]]
-between = [["B1", 2], ["B2", 2]]
-gap = 0.02
-stiffness = 28498175.1
-restitution = 0.5
-"""
+#: The helpers' fixed pair (the bundled elastic pair, its neighbour's masses x 0.5) inline, with both buildings' storeys yielding.
+_PAIR = (REPOSITORY / "data" / "scenes" / "elastic_pair.toml").read_text().replace("[[building]]", "[[scene.building]]").replace("[[contact]]", "[[scene.contact]]")
+_B2 = _PAIR.rindex("mass = [26268.0, 17512.0]")
+SCENE = "[scene]\n" + (_PAIR[:_B2] + "mass = [13134.0, 8756.0]" + _PAIR[_B2 + len("mass = [26268.0, 17512.0]"):]).replace("damping_ratio = 0.05", "damping_ratio = 0.05\n" + YIELDING)
 DESIGN = "\n[design]\nsds = 1.32925\nsd1 = 0.80204\nr = 8.0\ncd = 5.5\nomega0 = 3.0\nie = 1.0\n"
 STRIPES = 'measure = "psa"\nperiod = 1.0\nlevels = [0.3, 0.7399, 1.2031]\nmethod = "stripes"'
 
