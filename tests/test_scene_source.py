@@ -98,7 +98,7 @@ def test_the_bundled_pair_is_the_risk_flagships_pair_without_yielding_and_base()
      "scene.building: not allowed beside scene.bundled (the scene is the file's; edit its buildings in [scene.building.<name>] tables)"),
     ('[scene]\nbundled = "elastic_pair"\n[scene.building.B3]\nmass_factor = 2.0', "scene.building.B3: unknown building (buildings: B1, B2)"),
     ('[scene]\nbundled = "elastic_pair"\n[scene.building.B2]\ncolour = "red"',
-     "scene.building.B2.colour: unknown field (allowed: base, damping, damping_ratio, initial, mass, mass_factor, stiffness)"),
+     "scene.building.B2.colour: unknown field (allowed: base, damping, damping_ratio, hardening, initial, mass, mass_factor, stiffness, yield_force)"),
     ('[experiment]\nscene = "pair.toml"\n[scene]\nbundled = "elastic_pair"', "experiment.scene: give either a scene path here or an inline [scene] table, not both"),
 ])
 def test_a_bad_scene_source_is_a_one_line_error_naming_the_field(tmp_path: Path, scene: str, message: str) -> None:
