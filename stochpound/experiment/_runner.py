@@ -287,6 +287,8 @@ def _record_hazard(store: Path, experiment: Experiment, grids: dict[str, tuple[f
         session.rebuild()
     if "design" in changed:
         say(f"{store}: the [design] changed; no run depends on it: the cases are kept and the new design is recorded in the store")
+    if "site" in changed:
+        say(f"{store}: how the [site] scenario was obtained is recorded in the store (no run depends on it: the cases are kept)")
     if "hazard" not in changed:
         return
     hazard = experiment.contract.hazard

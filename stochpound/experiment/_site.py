@@ -37,6 +37,7 @@ import xarray as xr
 
 from stochpound.model import fields as toml_fields
 from stochpound.motions import CONDITIONING_MEASURES, MODEL_DAMPING, PERIOD_RANGE, check_scenario
+from stochpound.store import SCENARIO_KINDS
 
 if TYPE_CHECKING:
     from stochpound.experiment._grid import Experiment
@@ -49,8 +50,6 @@ DEFAULT_SEED = 1
 SITE_FIELDS = ("vs30", "magnitude", "distance_km", "mechanism")
 PER_LEVEL = ("magnitude", "distance_km", "mechanism")
 """``[site]`` fields that take one value per level."""
-SCENARIOS = ("given", "fitted")
-"""``[site] scenario``: magnitude and distance as the table gives them, or fitted to the site's hazard curves (``curves``)."""
 
 
 def parse_selection(table: Mapping[str, Any], site: Any, levels: list[float], entry: dict[str, Any]) -> dict[str, Any]:
@@ -112,15 +111,30 @@ def parse_selection(table: Mapping[str, Any], site: Any, levels: list[float], en
     return {"note": note, "selection": selection, "motions": motions, "max_scale_factor": max_scale, "seed": seed, "site": parse_site(site, levels, entry)}
 
 
+def site_entry(site: Any) -> dict[str, Any] | None:
+    """The definition's ``site`` entry: how the stripes' scenario was obtained, as data (None without a ``[site]`` table).
+
+    ``scenario`` is ``"given"`` or ``"fitted"``; a fitted one names the
+    ``curves`` it was fitted to. Called once :func:`parse_selection` has
+    checked the table. Not part of the identity
+    (``stochpound.store.NOT_IN_IDENTITY``): the runs depend on the scenarios
+    themselves (the ``intensity`` entry's ``site``), not on how they came.
+    """
+    if not isinstance(site, dict):
+        return None
+    kind = site.get("scenario", SCENARIO_KINDS[0])
+    return {"scenario": kind, "curves": list(site["curves"])} if kind == "fitted" else {"scenario": kind}
+
+
 def parse_site(site: Any, levels: list[float], entry: Mapping[str, Any]) -> list[dict[str, Any]]:
     """One scenario per level, in the order of the sorted levels, from the ``[site]`` table (given, or fitted to its ``curves``)."""
     from stochpound._errors import SiteError
 
     if not isinstance(site, dict):
         raise SiteError("site: a [site] table is required with the conditional spectrum (vs30, magnitude, distance_km, mechanism)")
-    scenario_kind = site.get("scenario", SCENARIOS[0])
-    if scenario_kind not in SCENARIOS:
-        raise SiteError(f"site.scenario: must be one of {', '.join(SCENARIOS)}, got {scenario_kind!r}")
+    scenario_kind = site.get("scenario", SCENARIO_KINDS[0])
+    if scenario_kind not in SCENARIO_KINDS:
+        raise SiteError(f"site.scenario: must be one of {', '.join(SCENARIO_KINDS)}, got {scenario_kind!r}")
     if scenario_kind == "fitted":
         return fitted_site(site, levels, entry)
     if "curves" in site:

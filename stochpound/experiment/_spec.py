@@ -30,6 +30,7 @@ from stochpound.experiment._design_table import parse_design
 from stochpound.experiment._hazard import parse_hazard
 from stochpound.motions import DEFAULT_G
 from stochpound.experiment._intensity import parse_intensity
+from stochpound.experiment._site import site_entry
 from stochpound.model import fields as toml_fields
 from stochpound.model.contact import ELEMENT_KEYS
 from stochpound.model.scene_file import generator_fields
@@ -109,7 +110,7 @@ def parse_experiment(data: Mapping[str, Any], base_dir: str | Path = ".", defaul
         Canonical definition: ``format``, ``name``, ``description``,
         ``scene`` (the base scene's dict, its ``[motion]`` included when it has one),
         ``studied``, ``variants``, ``gaps``, ``mu``, ``motions``, ``output``, ``solver``;
-        ``intensity`` and ``hazard`` only when the file has those tables;
+        ``intensity``, ``hazard``, ``design`` and ``site`` only when the file has those tables;
         ``reproduces`` only when the file declares it.
     """
     base_dir = Path(base_dir)
@@ -171,6 +172,9 @@ def parse_experiment(data: Mapping[str, Any], base_dir: str | Path = ".", defaul
         definition["hazard"] = hazard
     if design is not None:  # likewise absent without [design]
         definition["design"] = design
+    site = site_entry(data.get("site"))
+    if site is not None:  # likewise absent without [site]; out of the identity (the scenarios are in the intensity entry)
+        definition["site"] = site
     read_definition(definition)  # the typed definition reads every field parsed here
     return definition
 

@@ -37,7 +37,7 @@ from typing import Any
 from stochpound._errors import ExperimentError
 from stochpound.model.friction import is_fixed_base
 
-NOT_IN_IDENTITY = ("hazard", "design")
+NOT_IN_IDENTITY = ("hazard", "design", "site")
 """Entries of a canonical definition that no run depends on, left out of its identity (:func:`~stochpound.store.definition_sha256`)."""
 
 
@@ -394,6 +394,11 @@ class Definition:
         The site's hazard curve, if any (not part of the identity).
     design : mapping or None
         The ``[design]`` table's canonical entry, the buildings' code design, if any (not part of the identity).
+    site : mapping or None
+        How the stripes' scenario was obtained, with a ``[site]`` table: ``scenario`` (``"given"`` or
+        ``"fitted"``) and, when fitted, the ``curves`` it was fitted to (not part of the identity: the
+        runs depend on the scenarios themselves, ``intensity.site``); None: no ``[site]`` table (and for
+        definitions stored before the field).
     """
 
     name: str
@@ -412,6 +417,7 @@ class Definition:
     reproduces: str | None = None
     hazard: Hazard | None = None
     design: Mapping[str, Any] | None = None
+    site: Mapping[str, Any] | None = None
 
     def to_dict(self) -> dict[str, Any]:
         """The canonical definition (a copy): what ``parse_experiment`` returned (``stochpound.experiment._spec``)."""
@@ -508,4 +514,5 @@ def _from_dict(data: dict[str, Any]) -> Definition:
         reproduces=data.get("reproduces"),
         hazard=Hazard.from_entry(data["hazard"]) if data.get("hazard") is not None else None,
         design=data.get("design"),
+        site=data.get("site"),
     )
