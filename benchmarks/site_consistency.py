@@ -81,8 +81,8 @@ suite = "fema_p695_near_field"
 FIGURE = REPOSITORY / "docs" / "figures" / "site_consistency.png"
 
 
-def experiment_text(measure: str, configuration: str) -> str:
-    """The experiment file of one conditioning measure and configuration."""
+def experiment_text(measure: str, configuration: str, seed: int | None = None) -> str:
+    """The experiment file of one conditioning measure and configuration (the selection's ``seed``, or its default)."""
     from stochpound.analysis import HazardCurve
 
     lines, curve = MEASURES[measure]
@@ -91,20 +91,20 @@ def experiment_text(measure: str, configuration: str) -> str:
     curves = ", ".join(f'"{name}"' for name in CURVES)
     return (f'[experiment]\nname = "site_{curve}"\nstudied = "B1"\n{PAIR.format(base=base, variants=variants)}\n[intensity]\n{lines}\n'
             f"levels = [{', '.join(f'{x:.4f}' for x in levels)}]\n"
-            'selection = "conditional_spectrum"\nmotions = 20\nmax_scale_factor = 5.0\n'
+            'selection = "conditional_spectrum"\nmotions = 20\nmax_scale_factor = 5.0\n' + ("" if seed is None else f"seed = {seed}\n") +
             f'[site]\nscenario = "fitted"\ncurves = [{curves}]\nvs30 = 400.0\nmechanism = "reverse"\n')
 
 
-def measure_risk(folder: Path, measure: str, configuration: str, bootstrap: int = 0) -> tuple[xr.Dataset, StoreRisk]:
+def measure_risk(folder: Path, measure: str, configuration: str, bootstrap: int = 0, seed: int | None = None) -> tuple[xr.Dataset, StoreRisk]:
     """The store and the risk answer (g* at 10 % and 2 % in 50 years, ``bootstrap`` resamples for its 95 % interval) of one
-    measure and configuration, run in ``folder``."""
+    measure and configuration (the selection's ``seed``, or its default), run in ``folder``."""
     from stochpound import open_store
     from stochpound.analysis import HazardCurve, store_risk
     from stochpound.experiment import load_experiment, run_experiment
 
     name = f"{measure.replace('(', '').replace(' s)', '').replace(' ', '').lower()}.toml"
     path = folder / name
-    path.write_text(experiment_text(measure, configuration))
+    path.write_text(experiment_text(measure, configuration, seed))
     report = run_experiment(load_experiment(path), workers=0, progress=False)
     if not report.complete:
         raise RuntimeError(f"{configuration}, {measure}: the experiment did not complete")
@@ -154,7 +154,9 @@ def main(argv: list[str] | None = None) -> None:
 
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--measures", nargs="+", default=list(MEASURES), choices=list(MEASURES))
+    parser.add_argument("--configurations", nargs="+", default=list(CONFIGURATIONS), choices=list(CONFIGURATIONS))
     parser.add_argument("--bootstrap", type=int, default=200, help="resamples of the 95 %% interval of g* (0: none)")
+    parser.add_argument("--seeds", nargs="*", type=int, default=[], help="other seeds of the selection: g* of every measure again with each")
     args = parser.parse_args(argv)
     figure = Figure(figsize=(7.5, 3.4), layout="constrained")
     axes = figure.subplots(1, 2, sharey=True)
@@ -162,7 +164,7 @@ def main(argv: list[str] | None = None) -> None:
         ax.set_title(f"{target:.0%} in 50 years", fontsize=9)
         ax.set_yscale("log")
         ax.grid(True, which="both", lw=0.3, color="0.85")
-    for configuration in CONFIGURATIONS:
+    for configuration in args.configurations:
         answers, diagnoses = [], []
         with tempfile.TemporaryDirectory() as folder:
             for measure in args.measures:
@@ -176,6 +178,13 @@ def main(argv: list[str] | None = None) -> None:
         print("max/min:", ratio.to_pandas().to_string(float_format=lambda v: f"{v:.2f}"))
         print(f"\n{configuration}: what g* rests on (95 % bootstrap interval of {args.bootstrap} resamples; fragility at g*; MAF share extrapolated beyond the top stripe)")
         print(pd.concat(diagnoses).set_index(["measure"]).to_string(float_format=lambda v: f"{v:.3g}"))
+        if args.seeds:
+            with tempfile.TemporaryDirectory() as folder:
+                again = xr.concat([xr.concat([measure_risk(Path(folder), measure, configuration, seed=seed)[1].separation["separation"]
+                                              for measure in args.measures], dim="measure") for seed in args.seeds], dim="seed")
+            again = xr.concat([values.expand_dims(seed=["default"]), again.assign_coords(seed=args.seeds, measure=args.measures)], dim="seed")
+            print(f"\n{configuration}: g* (m) by the selection's seed (the same experiments otherwise)")
+            print(again.to_dataframe().unstack("seed")["separation"].to_string(float_format=lambda v: f"{v:.3f}"))
         others = [d for d in values.dims if d not in ("measure", "target")]
         stacked = values.stack(cell=others) if others else values.expand_dims(cell=[""])
         for ax, j in zip(axes, range(values.sizes["target"])):
