@@ -148,6 +148,11 @@ def diagnosis(store: xr.Dataset, risk: StoreRisk) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
+def _subfolder(folder: Path, name: str) -> Path:
+    (folder / name).mkdir(exist_ok=True)
+    return folder / name
+
+
 def main(argv: list[str] | None = None) -> None:
     """Run, print the table, draw the figure."""
     from matplotlib.figure import Figure
@@ -180,7 +185,7 @@ def main(argv: list[str] | None = None) -> None:
         print(pd.concat(diagnoses).set_index(["measure"]).to_string(float_format=lambda v: f"{v:.3g}"))
         if args.seeds:
             with tempfile.TemporaryDirectory() as folder:
-                again = xr.concat([xr.concat([measure_risk(Path(folder), measure, configuration, seed=seed)[1].separation["separation"]
+                again = xr.concat([xr.concat([measure_risk(_subfolder(Path(folder), f"seed{seed}"), measure, configuration, seed=seed)[1].separation["separation"]
                                               for measure in args.measures], dim="measure") for seed in args.seeds], dim="seed")
             again = xr.concat([values.expand_dims(seed=["default"]), again.assign_coords(seed=args.seeds, measure=args.measures)], dim="seed")
             print(f"\n{configuration}: g* (m) by the selection's seed (the same experiments otherwise)")
