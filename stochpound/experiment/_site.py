@@ -111,17 +111,27 @@ def parse_selection(table: Mapping[str, Any], site: Any, levels: list[float], en
     return {"note": note, "selection": selection, "motions": motions, "max_scale_factor": max_scale, "seed": seed, "site": parse_site(site, levels, entry)}
 
 
-def site_entry(site: Any) -> dict[str, Any] | None:
+def site_entry(site: Any, intensity: Mapping[str, Any] | None) -> dict[str, Any] | None:
     """The definition's ``site`` entry: how the stripes' scenario was obtained, as data (None without a ``[site]`` table).
 
     ``scenario`` is ``"given"`` or ``"fitted"``; a fitted one names the
-    ``curves`` it was fitted to. Called once :func:`parse_selection` has
-    checked the table. Not part of the identity
-    (``stochpound.store.NOT_IN_IDENTITY``): the runs depend on the scenarios
-    themselves (the ``intensity`` entry's ``site``), not on how they came.
+    ``curves`` it was fitted to. Called with the parsed ``intensity`` entry,
+    once :func:`parse_selection` has checked the table. Not part of the
+    identity (``stochpound.store.NOT_IN_IDENTITY``): the runs depend on the
+    scenarios themselves (the ``intensity`` entry's ``site``), not on how
+    they came.
+
+    Raises
+    ------
+    SiteError
+        A ``[site]`` table without ``[intensity]``.
     """
-    if not isinstance(site, dict):
+    from stochpound._errors import SiteError
+
+    if site is None:
         return None
+    if intensity is None:
+        raise SiteError(f'site: only with [intensity] selection = "{CONDITIONAL_SPECTRUM}" (the scenario of its targets)')
     kind = site.get("scenario", SCENARIO_KINDS[0])
     return {"scenario": kind, "curves": list(site["curves"])} if kind == "fitted" else {"scenario": kind}
 

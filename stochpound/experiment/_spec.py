@@ -172,7 +172,8 @@ def parse_experiment(data: Mapping[str, Any], base_dir: str | Path = ".", defaul
         definition["hazard"] = hazard
     if design is not None:  # likewise absent without [design]
         definition["design"] = design
-    site = site_entry(data.get("site"))
+    with field_errors():
+        site = site_entry(data.get("site"), intensity)
     if site is not None:  # likewise absent without [site]; out of the identity (the scenarios are in the intensity entry)
         definition["site"] = site
     read_definition(definition)  # the typed definition reads every field parsed here
