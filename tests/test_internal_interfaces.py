@@ -34,12 +34,10 @@ ALLOWED: dict[str, set[str]] = {}
 
 #: The imports (importer -> imported module) that close the import cycles left, each running back up: without them the
 #: modules import each other in no cycle. Each is an import inside a function: analysis gives the risk chain's names it
-#: exported before stochpound.risk existed (docs/api.md, the names users rely on); records gives the deprecated study names
-#: (``STUDY_G``, ``study_table_3_2``) from stochpound.studies; the conditional-spectrum stripes (``_site``) are chosen for an
-#: ``Experiment`` (``_grid``), which asks for them. Only shrinks.
+#: exported before stochpound.risk existed (docs/api.md, the names users rely on); the conditional-spectrum stripes (``_site``)
+#: are chosen for an ``Experiment`` (``_grid``), which asks for them. Only shrinks.
 ALLOWED_BACK_EDGES = {
     ("stochpound.analysis", "stochpound.risk"),
-    ("stochpound.motions.records", "stochpound.studies"),
     ("stochpound.experiment._site", "stochpound.experiment._grid"),
 }
 
