@@ -4,7 +4,7 @@ Every function takes and returns xarray objects and reduces only the
 dimensions it is told to, so it applies equally to one run (reduce over
 ``time``), to an experiment store (the grid's dimensions are carried along)
 and to ensembles (reduce over ``realization``). Each statistic has one
-implementation, a numpy kernel of :mod:`stochpound.analysis.kernels`, which
+implementation, a numpy kernel of :mod:`stochpound.stats.kernels`, which
 these functions apply with :func:`xarray.apply_ufunc`.
 
 The hazard curve (:class:`~stochpound.risk.HazardCurve`, which an
@@ -14,8 +14,11 @@ experiment layer; the risk chain built on these statistics is the package
 to code written before that package existed.
 """
 
+import sys
+
+from stochpound.stats import kernels
 from stochpound.analysis._moments import moments
-from stochpound.analysis._correlation import correlation
+from stochpound.stats import correlation
 from stochpound.analysis._ensemble_statistics import ensemble_statistics
 from stochpound.analysis._histogram import normal_histogram
 from stochpound.analysis._impacts import impact_statistics
@@ -31,13 +34,14 @@ from stochpound.analysis._hazard import HazardCurve, bundled_curves, bundled_mea
 from stochpound.analysis._hazard_files import HazardFile, read_hazard_file
 
 # For the other packages of stochpound (their interface to this one, not public API: not in __all__).
-from stochpound.analysis._bootstrap import bootstrap_method, bootstrap_weights, interval, jackknife_weights, record_clusters  # noqa: F401
 from stochpound.analysis._hazard import bundled_path  # noqa: F401
 from stochpound.analysis._hazard_files import parse_measure, parse_units, unit_factor  # noqa: F401
 from stochpound.analysis._impacts import TABLE_COLUMNS  # noqa: F401
 from stochpound.analysis._intervals import MIN_RUNS  # noqa: F401
 from stochpound.analysis._separation_rules import EC8_REDUCTION, STORE_NAMES  # noqa: F401
 from stochpound.analysis._summary import response_moments, top_floor_total_displacement  # noqa: F401
+
+sys.modules[f"{__name__}.kernels"] = kernels  # the kernels' old path: ``import stochpound.analysis.kernels`` still gives them
 
 
 RISK_NAMES = (

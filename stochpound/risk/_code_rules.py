@@ -32,7 +32,7 @@ from collections.abc import Sequence
 import numpy as np
 import xarray as xr
 
-from stochpound.analysis import bootstrap_method, bootstrap_weights, interval, jackknife_weights, record_clusters
+from stochpound.stats import bootstrap_method, bootstrap_weights, interval, jackknife_weights, record_clusters
 from stochpound.risk._fragility import STATUS, stripe_mle
 from stochpound.risk._fragility_ensemble import BOOTSTRAP
 from stochpound.analysis import HazardCurve, probability_from_rate, rate_from_probability, return_period
