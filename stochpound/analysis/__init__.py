@@ -29,13 +29,21 @@ from stochpound.analysis._pounding import pounding_probability
 from stochpound.analysis._separation import pounding_curve, required_separation, rule_exceedance
 from stochpound.analysis._separation_rules import contact_demands, fixed_base_cqc, separation_rules, store_contact_demands
 from stochpound.analysis._summary import run_summary
-from stochpound.analysis._consistency import hazard_consistency, stripe_rate_weights
-from stochpound.analysis._hazard import HazardCurve, bundled_curves, bundled_measure, bundled_site_curves, probability_from_rate, rate_from_probability, return_period
-from stochpound.analysis._hazard_files import HazardFile, read_hazard_file
+from stochpound.hazard import (
+    HazardCurve,
+    HazardFile,
+    bundled_curves,
+    bundled_measure,
+    bundled_site_curves,
+    hazard_consistency,
+    probability_from_rate,
+    rate_from_probability,
+    read_hazard_file,
+    return_period,
+    stripe_rate_weights,
+)
 
 # For the other packages of stochpound (their interface to this one, not public API: not in __all__).
-from stochpound.analysis._hazard import bundled_path  # noqa: F401
-from stochpound.analysis._hazard_files import parse_measure, parse_units, unit_factor  # noqa: F401
 from stochpound.analysis._impacts import TABLE_COLUMNS  # noqa: F401
 from stochpound.analysis._intervals import MIN_RUNS  # noqa: F401
 from stochpound.analysis._separation_rules import EC8_REDUCTION, STORE_NAMES  # noqa: F401

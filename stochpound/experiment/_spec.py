@@ -27,7 +27,7 @@ from typing import Any, Mapping
 from stochpound._errors import ExperimentError, field_errors
 from stochpound._studies import parse_reproduces
 from stochpound.experiment._design_table import parse_design
-from stochpound.experiment._hazard import parse_hazard
+from stochpound.hazard import parse_hazard
 from stochpound.motions import DEFAULT_G
 from stochpound.experiment._intensity import parse_intensity
 from stochpound.model import fields as toml_fields

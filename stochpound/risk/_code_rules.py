@@ -35,7 +35,7 @@ import xarray as xr
 from stochpound.stats import bootstrap_method, bootstrap_weights, interval, jackknife_weights, record_clusters
 from stochpound.risk._fragility import STATUS, stripe_mle
 from stochpound.risk._fragility_ensemble import BOOTSTRAP
-from stochpound.analysis import HazardCurve, probability_from_rate, rate_from_probability, return_period
+from stochpound.hazard import HazardCurve, probability_from_rate, rate_from_probability, return_period
 from stochpound.risk._maf import lognormal_maf, rate_intervals
 from stochpound.analysis import EC8_REDUCTION, separation_rules
 

@@ -31,7 +31,7 @@ from scipy import optimize, special
 from stochpound.stats import interval, kernels
 from stochpound.risk._fragility import ALWAYS, DECREASING, EMPTY, NEVER, SEPARATED, STATUS
 from stochpound.risk._fragility_ensemble import BOOTSTRAP, limit_state_events, stripe_fragility
-from stochpound.analysis import HazardCurve, probability_from_rate, rate_from_probability, return_period
+from stochpound.hazard import HazardCurve, probability_from_rate, rate_from_probability, return_period
 
 TARGETS = (0.10, 0.02)
 """Default target probabilities of exceedance in ``years`` (50) of :func:`risk_targeted_separation`."""

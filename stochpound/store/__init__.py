@@ -61,6 +61,9 @@ from stochpound.store._gap_axes import (
 from stochpound.store._open import open_store
 from stochpound.store._selections import fixed_base, has_fixed_base_twins, isolated_mus
 
+# For the other packages of stochpound (their interface to this one, not public API: not in __all__).
+from stochpound.store._definition import MEASURES  # noqa: F401
+
 __all__ = [
     "ACCESSOR",
     "CASE_SUMMARIES",

@@ -67,6 +67,10 @@ def definition_sha256(definition: Mapping[str, Any]) -> str:
     return hashlib.sha256(canonical_json(runs).encode()).hexdigest()
 
 
+MEASURES = ("pga", "pgv", "psa", "sa_avg")
+"""The intensity measures an ``[intensity]`` (and a ``[hazard]``) table may name."""
+
+
 def describe_measure(intensity: Mapping[str, Any]) -> str:
     """An intensity measure in words, e.g. ``PSA(T = 1 s, 5 % damping)`` or ``PGA``.
 
