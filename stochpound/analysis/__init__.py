@@ -27,7 +27,7 @@ from stochpound.analysis.mechanisms import amplification, ratcheting
 from stochpound.analysis._peaks import peak_response
 from stochpound.analysis._pounding import pounding_probability
 from stochpound.analysis._separation import pounding_curve, required_separation, rule_exceedance
-from stochpound.analysis._separation_rules import contact_demands, fixed_base_cqc, separation_rules, store_contact_demands
+from stochpound.codes import contact_demands, fixed_base_cqc, separation_rules, store_contact_demands
 from stochpound.analysis._summary import run_summary
 from stochpound.hazard import (
     HazardCurve,
@@ -46,7 +46,6 @@ from stochpound.hazard import (
 # For the other packages of stochpound (their interface to this one, not public API: not in __all__).
 from stochpound.analysis._impacts import TABLE_COLUMNS  # noqa: F401
 from stochpound.analysis._intervals import MIN_RUNS  # noqa: F401
-from stochpound.analysis._separation_rules import EC8_REDUCTION, STORE_NAMES  # noqa: F401
 from stochpound.analysis._summary import response_moments, top_floor_total_displacement  # noqa: F401
 
 sys.modules[f"{__name__}.kernels"] = kernels  # the kernels' old path: ``import stochpound.analysis.kernels`` still gives them

@@ -33,7 +33,8 @@ import xarray as xr
 from stochpound.analysis import peak_response
 from stochpound.stats import kernels
 from stochpound.analysis.names import RESPONSE_MOMENTS, without_aliases
-from stochpound.analysis import STORE_NAMES, contact_demands, response_moments, run_summary, top_floor_total_displacement
+from stochpound.analysis import response_moments, run_summary, top_floor_total_displacement
+from stochpound.codes import STORE_NAMES, contact_demands
 from stochpound.store import CATALOGUE, IMPACT_TABLE, STOREY_SUMMARIES, WALL_SUMMARIES
 
 _MOMENTS = tuple(RESPONSE_MOMENTS.values())

@@ -21,7 +21,7 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from stochpound.analysis import store_contact_demands
+from stochpound.codes import store_contact_demands
 from stochpound.hazard import HazardCurve, check_covers, hazard_curve, hazard_option, parse_measure, parse_units, stored_hazard
 from stochpound.model import Scene
 from stochpound.motions import DEFAULT_G
