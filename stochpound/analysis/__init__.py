@@ -7,11 +7,12 @@ and to ensembles (reduce over ``realization``). Each statistic has one
 implementation, a numpy kernel of :mod:`stochpound.stats.kernels`, which
 these functions apply with :func:`xarray.apply_ufunc`.
 
-The hazard curve (:class:`~stochpound.risk.HazardCurve`, which an
-experiment's ``[hazard]`` table is read with) is defined here, below the
-experiment layer; the risk chain built on these statistics is the package
-:mod:`stochpound.risk`, whose names this namespace also gives, as aliases,
-to code written before that package existed.
+This namespace also gives the site's hazard (:class:`HazardCurve`, the
+hazard files and the stripes' consistency, of :mod:`stochpound.hazard`),
+the code separation rules of a run (of :mod:`stochpound.codes`) and, as
+aliases, the names of the risk chain (:mod:`stochpound.risk`) it gave to
+code written before that package existed. The statistics sit above all
+three: none of them imports this package.
 """
 
 import sys
@@ -73,7 +74,7 @@ RISK_NAMES = (
 )
 """The risk chain's names this namespace exported before :mod:`stochpound.risk` existed (one list: the risk package exports them
 too). Aliases of that package's (the canonical names), resolved when first used, so that importing the statistics does not import
-the risk chain (which sits above them)."""
+the risk chain (which they do not need)."""
 
 
 def __getattr__(name: str) -> object:
