@@ -42,34 +42,14 @@ MEASURES = {  # measure: ([intensity] lines, bundled hazard)
     "PSA(2 s)": ('measure = "psa"\nperiod = 2.0', CURVES[2]),
     "PSA(3 s)": ('measure = "psa"\nperiod = 3.0', CURVES[3]),
 }
-CONFIGURATIONS = {  # name: (B1's base, the neighbour's variants)
+CONFIGURATIONS = {  # name: (B1's base, an edit of the bundled pair; the neighbour's variants)
     "fixed pair": ("", "[variants.neighbour.stiff.building.B2]\nmass_factor = 0.5\n[variants.neighbour.flexible.building.B2]\nmass_factor = 2.0"),
-    "isolated": ("base = { mass = 13134.0, mu = 0.05, radius = 2.24 }", "[variants.neighbour.stiff.building.B2]\nmass_factor = 0.5"),
+    "isolated": ("[scene.building.B1]\nbase = { mass = 13134.0, mu = 0.05, radius = 2.24 }", "[variants.neighbour.stiff.building.B2]\nmass_factor = 0.5"),
 }
 PAIR = """
 [scene]
-g = 9.81
-[[scene.building]]
-name = "B1"
-mass = [26268.0, 17512.0]
-stiffness = [24516800.0, 17512000.0]
-damping_ratio = 0.05
+bundled = "elastic_pair"
 {base}
-[[scene.building]]
-name = "B2"
-mass = [26268.0, 17512.0]
-stiffness = [24516800.0, 17512000.0]
-damping_ratio = 0.05
-[[scene.contact]]
-between = [["B1", 1], ["B2", 1]]
-gap = 0.02
-stiffness = 42747262.6
-restitution = 0.5
-[[scene.contact]]
-between = [["B1", 2], ["B2", 2]]
-gap = 0.02
-stiffness = 28498175.1
-restitution = 0.5
 {variants}
 [grid]
 gap = [inf]

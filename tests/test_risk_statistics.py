@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from stochpound.analysis._bootstrap import bootstrap_weights, interval, jackknife_weights, motion_clusters
+from stochpound.stats._bootstrap import bootstrap_weights, interval, jackknife_weights, motion_clusters
 from stochpound.risk._maf import _separation_kernel, non_increasing as _nonincreasing_rate
 
 

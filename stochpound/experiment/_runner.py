@@ -207,8 +207,9 @@ def run_experiment(
                 raise ExperimentError(f"{store}: written by an earlier stochpound without {', '.join(missing)}, which it keeps now: "
                                       "run the experiment again with --restart to recompute its cases")
             stored, new = stored_definition(store), json.loads(canonical_json(experiment.definition))
-            if stored != new:
-                changed = [key for key in NOT_IN_IDENTITY if stored.get(key) != new.get(key)]
+            # the scene's provenance alone (the same content, from another file or inline) leaves the store as it is
+            changed = [key for key in NOT_IN_IDENTITY if key != "scene_source" and stored.get(key) != new.get(key)]
+            if changed:
                 _record_hazard(store, experiment, {label: m.grid for label, m in motions.items()}, say, changed)
             return RunReport(store, experiment.n_cases, experiment.n_cases, elapsed=time.monotonic() - started, nothing_to_run=True)
     elif store.is_dir():

@@ -30,7 +30,8 @@ import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 from functools import cached_property
-from typing import TYPE_CHECKING, Any
+from pathlib import Path
+from typing import Any, Protocol
 
 import numpy as np
 import xarray as xr
@@ -39,8 +40,22 @@ from stochpound.model import fields as toml_fields
 from stochpound.motions import CONDITIONING_MEASURES, MODEL_DAMPING, PERIOD_RANGE, check_scenario
 from stochpound.store import SCENARIO_KINDS
 
-if TYPE_CHECKING:
-    from stochpound.experiment._grid import Experiment
+
+class GridExperiment(Protocol):
+    """What the selection reads of an experiment (an :class:`~stochpound.experiment.Experiment`, which asks for its stripes here)."""
+
+    intensity: dict[str, Any] | None
+    motions: dict[str, dict[str, Any]]
+    variants: list[dict[str, Any]]
+    building_names: list[str]
+    base_dir: Path
+    definition: dict[str, Any]
+
+    def points(self, kind: str) -> list[Any]: ...
+
+    def structure(self, case: Any) -> dict[str, Any]: ...
+
+    def motion_table(self, label: str, realization: int | None = None) -> dict[str, Any]: ...
 
 SELECTIONS = ("scale", "conditional_spectrum")
 """``[intensity] selection``: every motion scaled to every level, or motions chosen per stripe."""
@@ -218,13 +233,13 @@ def fitted_site(site: Mapping[str, Any], levels: list[float], entry: Mapping[str
     return scenarios
 
 
-def periods_of_interest(experiment: Experiment) -> dict[str, float]:
+def periods_of_interest(experiment: GridExperiment) -> dict[str, float]:
     """The structure's periods of interest (s), by name: first-mode periods on a fixed base and isolated periods, over every grid point.
 
     Names: ``"B1 first mode"``, ``"B1 isolated"``, with the grid point's
     variant labels where a building's period differs between points.
     """
-    from stochpound.experiment._grid import CASE
+    from stochpound.store import CASE
     from stochpound.model.friction import is_fixed_base
     from stochpound.model.modal_solution import modal_properties
     from stochpound.model.scene_file import scene_from_dict
@@ -250,7 +265,7 @@ def periods_of_interest(experiment: Experiment) -> dict[str, float]:
     return named
 
 
-def structure_periods(experiment: Experiment) -> list[float]:
+def structure_periods(experiment: GridExperiment) -> list[float]:
     """The distinct periods of :func:`periods_of_interest` (s), ascending."""
     return sorted(set(periods_of_interest(experiment).values()))
 
@@ -306,7 +321,7 @@ class StripeSelections:
         }  # fmt: skip
 
 
-def stripe_selections(experiment: Experiment) -> StripeSelections:
+def stripe_selections(experiment: GridExperiment) -> StripeSelections:
     """Choose and scale the motions of every stripe (module docstring).
 
     Raises
@@ -316,7 +331,7 @@ def stripe_selections(experiment: Experiment) -> StripeSelections:
         more than the pool has within ``max_scale_factor`` of a level.
     """
     from stochpound._errors import ExperimentError, SiteError, field_errors
-    from stochpound.experiment._grid import CASE
+    from stochpound.store import CASE
     from stochpound.model.scene_file import scene_from_dict
     from stochpound.motions import conditional_spectrum, select_motions, selection_periods, selection_pool
     from stochpound.motions.records import Record, is_suite_member, load_suite_member

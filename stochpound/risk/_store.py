@@ -21,8 +21,8 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from stochpound.analysis import HazardCurve, parse_measure, parse_units, store_contact_demands
-from stochpound.experiment import check_covers, hazard_curve, hazard_option, stored_hazard
+from stochpound.codes import store_contact_demands
+from stochpound.hazard import HazardCurve, check_covers, hazard_curve, hazard_option, parse_measure, parse_units, stored_hazard
 from stochpound.model import Scene
 from stochpound.motions import DEFAULT_G
 from stochpound.store import contact_free, describe_measure, gap_dims, has_contact_free, has_wall_free, scenario_kind, scenario_ranges, wall_free, with_contacts

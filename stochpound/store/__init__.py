@@ -63,6 +63,10 @@ from stochpound.store._open import open_store
 from stochpound.store._scenario import SCENARIO_KINDS, scenario_kind, scenario_ranges
 from stochpound.store._selections import fixed_base, has_fixed_base_twins, isolated_mus
 
+# For the other packages of stochpound (their interface to this one, not public API: not in __all__).
+from stochpound.store._catalogue import CASE, KINDS, REFERENCE  # noqa: F401
+from stochpound.store._definition import MEASURES  # noqa: F401
+
 __all__ = [
     "ACCESSOR",
     "CASE_SUMMARIES",
