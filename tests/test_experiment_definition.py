@@ -44,10 +44,8 @@ IDENTITIES = {
     "8e4b705fc73ef76afaf17a43eb886385aa0233150b9d597de3b98ff0fa68b8cf": "25d025290edee6b600240034af40615bef4faa550ddd7f1e16dc96666a597c3c",  # experiments/risk/isolated.toml (yielding)
     "d492a28de53b98b32b9f97c777010c9eb02c02dfe0a60221d79efa61f2ba4297": "202e09cad0306790e9903da109697590f847bdbddb7bbe822d5d4b15f5c480f9",  # experiments/risk/fixed_pair.toml (fitted scenario)
     "9b8923b0aa6b1e0b7753b436bf63cf492e61951d6e15670e6b7589efe5611375": "5cfe7294fd8c6bc0974dec1f0c06bbb870620ccc0c9a89a05fbeff4294173b1e",  # experiments/risk/isolated.toml (fitted scenario)
-    # experiments/risk/fixed_pair.toml ([design]; its canonical JSON holds the definition's site entry, out of the identity)
-    "55b8a109c6a7fe493d3cf046f0681351cd1070678c42155b611b7cb4991cc95c": "cd0ecca296191b5ad1490b58bd837a4834fcd188f29782056d468478ee7793d2",
-    # experiments/risk/isolated.toml ([design]; its canonical JSON holds the definition's site entry, out of the identity)
-    "88dc01b72bd04d6cc226d840a04e24e42421faa9c2bb9dc91a42aab11c0fbfde": "9e3c00b1d9bc0d4635f1128e3a3c06efd7e083d095902265bfbbcc6976b82aef",
+    "55b8a109c6a7fe493d3cf046f0681351cd1070678c42155b611b7cb4991cc95c": "ae6ad2bb5310b9ede71f0267bb215a055113aa32bad2e97696a1f5438d157191",  # experiments/risk/fixed_pair.toml ([design])
+    "88dc01b72bd04d6cc226d840a04e24e42421faa9c2bb9dc91a42aab11c0fbfde": "1c1c4b385d2565d2acbc4cbeaa272192f8711728fdffad85425e17a0a5896d41",  # experiments/risk/isolated.toml ([design])
     "6721b840847f3c887a64063a94280b5d169110c60ef231755da91b89a8300078": "d63aa13f0c17c62515a7f33d09c8af15f2d12f6063f66110f23227a68f70937f",  # experiments/study/gap_study.toml (declares reproduces)
     "2991b119a5949c2c82f9b2fe3c5ea23ba8308484f5adbaf6202633df2547e55f": "0fee6ef18974eda7fe49d0fa885cd06ca430f684281d7e09d9aa13ae02729a4e",  # experiments/study/harmonic.toml (declares reproduces)
     "b7cb8955ddf0e1110227ccc8d346f24b89c5f33cd69da9d0bcda4bfe1400fd19": "dc1f1332c3bbb0688ce5cc07bf78b719f5f9f549de5f0725493b705c41748dec",  # experiments/study/pair_mu.toml (declares reproduces)
@@ -84,9 +82,14 @@ def test_experiment_files_keep_their_identity() -> None:
         source = definition.pop("scene_source", None)  # new since the pins, outside the identity: the scene file's name and sha256
         scene_path = tomllib.loads(path.read_text()).get("experiment", {}).get("scene")
         assert source == (None if scene_path is None else {"file": scene_path, "sha256": hashlib.sha256((path.parent / scene_path).read_bytes()).hexdigest()}), path
+        site = definition.pop("site", None)  # new since the pins, outside the identity: how the [site] scenario was obtained
+        table = tomllib.loads(path.read_text()).get("site")
+        assert site == (None if table is None else {"scenario": "fitted", "curves": table["curves"]} if table.get("scenario") == "fitted"
+                        else {"scenario": "given"}), path
         assert hashlib.sha256(canonical_json(definition).encode()).hexdigest() == pinned, path
-        if source is not None:
-            assert definition_sha256({**definition, "scene_source": source}) == definition_sha256(definition), path
+        for key, value in (("scene_source", source), ("site", site)):
+            if value is not None:
+                assert definition_sha256({**definition, key: value}) == definition_sha256(definition), path
         assert ("hazard" in definition) == (file_sha256 in HAZARD_IDENTITIES), path
         assert definition_sha256(definition) == HAZARD_IDENTITIES.get(file_sha256, pinned), path
         checked += 1
