@@ -114,7 +114,7 @@ def code_rules_risk(demands: xr.Dataset, hz: HazardCurve, design_levels: Sequenc
             clusters = record_clusters(demands, record_dim)
             sampled = chain(stripe, xr.DataArray(bootstrap_weights(motions, bootstrap, seed, clusters), dims=("sample", record_dim)))
             left_out = chain(stripe, xr.DataArray(jackknife_weights(motions, clusters), dims=("sample", record_dim))).rename(sample="jackknife")
-            attrs = {"confidence": confidence, "method": f"{bootstrap_method(clusters)} (rule gap and fragility refitted)", "seed": seed}
+            attrs = {"confidence": confidence, "method": f"{bootstrap_method(clusters, ran.transpose(intensity_dim, record_dim).values)} (rule gap and fragility refitted)", "seed": seed}
             for name, units in (("maf", "1/yr"), ("gap", "m")):
                 lower, upper = xr.apply_ufunc(lambda b, e, j: interval(b, e, j, confidence), sampled[name], estimate[name], left_out[name],
                                               input_core_dims=[["sample"], [], ["jackknife"]], output_core_dims=[[], []])

@@ -131,7 +131,8 @@ def stripe_fragility(events: xr.DataArray, intensity_dim: str = "intensity", rec
             n_w = np.einsum("...jr,br->...bj", valid.astype(float), weights)
             return stripe_mle(levels, k_w, n_w)[:2]
 
-        result = _with_bootstrap(result, refit, record_clusters(data, record_dim), values.shape[-1], other, confidence, bootstrap, seed)
+        ran = valid.reshape(-1, *valid.shape[-2:]).any(0)  # per stripe, the motions that ran in some configuration
+        result = _with_bootstrap(result, refit, record_clusters(data, record_dim), values.shape[-1], other, confidence, bootstrap, seed, ran)
     return result
 
 
@@ -279,11 +280,12 @@ def _fit_dataset(theta: np.ndarray, beta: np.ndarray, status: np.ndarray, dims: 
 
 
 def _with_bootstrap(result: xr.Dataset, refit: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]], clusters: np.ndarray | None,
-                    motions: int, dims: tuple, confidence: float, resamples: int, seed: int) -> xr.Dataset:
-    """``result`` with θ, β refitted to bootstrap and jackknife resamples of the motions (by cluster), and their BCa intervals."""
+                    motions: int, dims: tuple, confidence: float, resamples: int, seed: int, ran: np.ndarray | None = None) -> xr.Dataset:
+    """``result`` with θ, β refitted to bootstrap and jackknife resamples of the motions (by cluster), and their BCa intervals
+    (``ran``: which motions ran, per stripe, for the method's words; :func:`~stochpound.analysis.bootstrap_method`)."""
     theta_b, beta_b = refit(bootstrap_weights(motions, resamples, seed, clusters))
     theta_j, beta_j = refit(jackknife_weights(motions, clusters))
-    attrs = {"confidence": confidence, "method": bootstrap_method(clusters), "seed": seed}
+    attrs = {"confidence": confidence, "method": bootstrap_method(clusters, ran), "seed": seed}
     variables = {}
     for name, sampled, left_out, units in (("theta", theta_b, theta_j, {}), ("beta", beta_b, beta_j, {"units": "1"})):
         lower, upper = interval(sampled, result[name].values, left_out, confidence)
