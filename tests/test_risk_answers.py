@@ -40,6 +40,35 @@ def test_a_degenerate_fit_is_named_a_step_with_the_rate_it_actually_gives():
     assert degenerate_text(np.array([FIT, FIT]), HAZARD) == ""
 
 
+def test_a_decreasing_fit_has_the_rate_of_its_flat_fit_stated_not_a_dash():
+    """19, 19 and 19 of 20 at three stripes: the probit's slope is not positive; the fit among fragilities that do not fall with
+    intensity is flat at 57/60, so λ = 0.95 × the hazard's rate at its table's lowest intensity, in the chain and in the words."""
+    from stochpound.risk import code_rules_risk, flat_fit_maf, stripe_fragility
+    from stochpound.risk._fragility import DECREASING
+    from stochpound.risk._store_risk import fit_name
+
+    levels = np.array([0.2, 0.5, 1.0])
+    events = np.ones((3, 20))
+    events[0, 3] = events[1, 11] = events[2, 17] = 0.0  # 19 of 20 at every stripe, the misses at different motions
+    fragility = stripe_fragility(xr.DataArray(events, dims=("intensity", "record"), coords={"intensity": levels}), bootstrap=0)
+    assert int(fragility["status"]) == DECREASING and np.isnan(float(fragility["theta"]))
+    rate = float(mean_annual_frequency(fragility, HAZARD))
+    assert math.isclose(rate, 57 / 60 * 0.0333, rel_tol=1e-12)  # p̄ λ(lo), by hand
+    assert math.isclose(float(flat_fit_maf([19, 19, 19], [20, 20, 20], HAZARD)), rate, rel_tol=1e-12)
+    text = degenerate_text(np.array([FIT, DECREASING]), HAZARD)
+    assert "1 of 2 gaps: a flat fit 'decreasing'" in text and "p̄ × 0.0333 /yr" in text and "upper bound" in text
+    assert "a step 'decreasing'" not in text and "NaN" not in text
+    assert fit_name(DECREASING) == "flat: decreasing (F ≡ fraction of runs that pounded)"
+    # a code rule whose gap pounds 19 of 20 at every stripe: the rules table gets the flat fit's rate, not NaN ("–")
+    closure = xr.DataArray(np.where(events > 0, 0.30, 0.01)[..., None], dims=("intensity", "record", "contact"),
+                           coords={"intensity": levels, "contact": [0]})
+    demands = xr.Dataset({"peak_closure": closure, "peak_displacement_left": closure * 0 + 0.05, "peak_displacement_right": closure * 0 + 0.05,
+                          "correlation": closure * 0.0})
+    rules = code_rules_risk(demands, HAZARD, bootstrap=0)
+    assert (rules["status"] == DECREASING).all()
+    np.testing.assert_allclose(rules["maf"], 57 / 60 * 0.0333, rtol=1e-12)
+
+
 def _risk(rules: xr.Dataset | None = None) -> StoreRisk:
     """A hand-made chain: g* 0.20 m [0.15, 0.31] for 10 %/50 yr and 0.40 m [0.30, 0.62] for 2 %/50 yr, one configuration."""
     target = xr.DataArray([0.10, 0.02], dims="target", name="target")

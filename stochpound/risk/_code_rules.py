@@ -36,7 +36,7 @@ from stochpound.analysis import bootstrap_method, bootstrap_weights, interval, j
 from stochpound.risk._fragility import STATUS, stripe_mle
 from stochpound.risk._fragility_ensemble import BOOTSTRAP
 from stochpound.analysis import HazardCurve, probability_from_rate, rate_from_probability, return_period
-from stochpound.risk._maf import lognormal_maf, rate_intervals
+from stochpound.risk._maf import fit_maf, rate_intervals
 from stochpound.analysis import EC8_REDUCTION, separation_rules
 
 DESIGN_LEVELS = (0.02, 0.10)
@@ -168,7 +168,7 @@ class _RuleChain:
                 "theta": (dims, theta, {"long_name": "median of the lognormal fragility at the rule's gap (IM units)"}),
                 "beta": (dims, beta, {"units": "1", "long_name": "log-standard deviation of that fragility"}),
                 "status": (dims, status.astype(np.int8), {"long_name": "fit status", "flag_meanings": " ".join(STATUS)}),
-                "maf": (dims, lognormal_maf(theta, beta, self.hz), {"units": "1/yr", "long_name": "mean annual frequency of pounding at the rule's gap"}),
+                "maf": (dims, fit_maf(theta, beta, status, exceeded.values, runs.values, self.hz), {"units": "1/yr", "long_name": "mean annual frequency of pounding at the rule's gap"}),
             },
             coords=coords,
         )

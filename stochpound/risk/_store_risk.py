@@ -37,7 +37,7 @@ from stochpound.risk import _store
 from stochpound.risk._code_rules import MINIMUM_MOTIONS, code_rules_risk
 from stochpound.risk._design_rules import design_rules_risk
 from stochpound.risk._fragility_ensemble import BOOTSTRAP, fragility_band, fragility_surface, homogeneous_capacities, ida_fragility, limit_state_events, stripe_fragility
-from stochpound.risk._fragility import FIT, STATUS
+from stochpound.risk._fragility import DECREASING, EMPTY, FIT, STATUS
 from stochpound.risk._maf import TARGETS, degenerate_text, non_increasing, risk_curve, risk_targeted_separation
 
 YEARS = 50.0
@@ -465,8 +465,9 @@ def design_text(probability: float, stripe: float, years: float = YEARS) -> str:
 
 
 def fit_name(status: int) -> str:
-    """A fit's kind in words: ``lognormal`` for a fit, else the step it is (``step: always`` …)."""
-    return "lognormal" if status == FIT else f"step: {STATUS[status]}"
+    """A fit's kind in words: ``lognormal`` for a fit, ``flat: decreasing`` (:func:`~stochpound.risk.flat_fit_maf`), ``no runs``,
+    else the step it is (``step: always`` …)."""
+    return {FIT: "lognormal", DECREASING: "flat: decreasing (F ≡ fraction of runs that pounded)", EMPTY: "no runs"}.get(status, f"step: {STATUS[status]}")
 
 
 def gap_text(value: float) -> str:

@@ -36,7 +36,7 @@ from matplotlib.ticker import LogLocator, NullFormatter
 from stochpound.report.render import Block, FigureItem, Paragraph, Section, Table
 from stochpound.report.sections._facets import labels_text
 from stochpound.report.sections._stripe_motions import is_selected
-from stochpound.risk import StoreDemands, StoreRisk, rate_from_probability
+from stochpound.risk import StoreDemands, StoreRisk, degenerate_text, rate_from_probability
 from stochpound.store import describe_measure
 
 
@@ -379,9 +379,17 @@ def _rules_blocks(name: str, risk: StoreRisk) -> list[Block]:
     if "dtm" not in rules["rule"].values:
         text += f" D_TM is not applied: {risk.dtm_note or 'the studied building has no sliding base in this store'}."
     text += " " + risk.design_rules_text()
+    statuses = [rules["status"].values.ravel()]
+    if risk.design_rules is not None:  # where a rule applies (a gap at every contact)
+        applies = risk.design_rules["gap"].notnull().all("contact")
+        statuses.append(risk.design_rules["status"].values[applies.broadcast_like(risk.design_rules["status"]).values])
+    degenerate = degenerate_text(np.concatenate(statuses), risk.hazard, "rule rows")
+    if degenerate:
+        text += " Rule rows whose fit is not a lognormal (their 'fit' column): " + degenerate.removeprefix("Degenerate fits, not lognormals: ")
     table = Table(f"risk-rules-{name}", f"Experiment {name}: the code separation rules in risk terms: the gap at each contact, the "
                   f"mean annual frequency λ_P of pounding at it, the return period and the probability in {years:g} years, each with its "
-                  f"{_percent(risk.confidence)} bootstrap interval, and the fragility's kind (a lognormal, or a degenerate step)", frame,
+                  f"{_percent(risk.confidence)} bootstrap interval, and the fragility's kind (a lognormal, a degenerate step, or flat where the "
+                  "counts do not rise with intensity)", frame,
                   formats={**_RATE_FORMATS, "λ_P (1/yr)": "{:.3g}", "λ_P lower": "{:.3g}", "λ_P upper": "{:.3g}", f"P in {years:g} yr": "{:.3f}",
                            **{c: "{:.3f}" for c in frame.columns if str(c).startswith("gap")}})
     return [Paragraph(text), table]
