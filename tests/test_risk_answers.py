@@ -144,6 +144,26 @@ WALLS = "".join(f'\n[[scene.wall]]\nbuilding = "B1"\nside = "{side}"\nlevel = 0\
                 for side in ("left", "right"))
 
 
+def test_d_tm_where_the_base_never_slides_is_left_out_and_said_why_not_a_dash():
+    """μ ∈ {∞, 0.05}: on the fixed base D_TM has nothing to size; its rows go, and the text says where and why."""
+    dims = ("design_level", "rule", "mu", "contact")
+    gap = np.full((1, 2, 2, 1), 0.3)
+    gap[0, 1, 0, 0] = np.nan  # dtm at μ = ∞
+    maf = xr.DataArray(np.where(np.isnan(gap[..., 0]), np.nan, 1e-3), dims=dims[:3])
+    rules = xr.Dataset({"gap": (dims, gap), "status": (dims[:3], np.where(np.isnan(gap[..., 0]), 5, FIT).astype(np.int8))},
+                       coords={"design_level": [0.02], "rule": ["abs", "dtm"], "mu": [np.inf, 0.05], "contact": [0],
+                               "code_intensity": ("design_level", [0.8]), "stripe_intensity": ("design_level", [0.8])})
+    rules = rate_intervals(rules.assign(maf=maf, maf_lower=maf / 2, maf_upper=maf * 2, return_period=1 / maf, probability=1 - np.exp(-50 * maf)), 50.0)
+    risk = _risk(rules)
+    frame = risk.rules_frame()
+    dtm = frame.xs("D_TM of the suite-mean base displacement (ASCE 7 §17.2.5.2 form)", level="rule")
+    assert list(dtm.index.get_level_values("mu")) == [0.05] and frame["λ_P (1/yr)"].notna().all()  # no row of dashes
+    text = risk.dtm_text()
+    assert "left out where the studied building's base never slid in any run (mu ∞)" in text and "fixed base (μ = ∞)" in text
+    assert _risk(rules.sel(mu=[0.05])).dtm_text() == ""
+    assert "no sliding base" in _risk(rules.sel(rule=["abs"])).dtm_text()
+
+
 def test_d_tm_is_not_taken_from_runs_a_moat_wall_capped(tmp_path):
     from stochpound import open_store
     from stochpound.risk import store_demands, store_risk

@@ -231,7 +231,9 @@ class StoreRisk:
         bound``: the same for the upper bound of λ_P). The suite-mean rules'
         rows first, then the codes' own gaps from the design analysis
         (design level ``… (design analysis)``, where the store has a
-        ``[design]``). Empty when no rule was evaluated (``rules_note`` and
+        ``[design]``). A rule's rows are left out where it does not apply
+        (D_TM where the studied building's base never slides:
+        :meth:`dtm_text`). Empty when no rule was evaluated (``rules_note`` and
         ``design_note`` say why).
         """
         frames = []
@@ -239,7 +241,8 @@ class StoreRisk:
             rules = _grid_only(self.rules, keep=("code_intensity", "stripe_intensity"))
             stripes = [design_text(p, float(i), float(rules.attrs.get("years", self.years)))
                        for p, i in zip(rules["design_level"].values, rules["stripe_intensity"].values)]
-            frames.append(self._rules_rows(rules.drop_vars(["code_intensity", "stripe_intensity"]), dict(zip(rules["design_level"].values, stripes))))
+            rows = self._rules_rows(rules.drop_vars(["code_intensity", "stripe_intensity"]), dict(zip(rules["design_level"].values, stripes)))
+            frames.append(rows[rows[[c for c in rows.columns if c.startswith("gap, ")]].notna().any(axis=1)])  # D_TM: not where the base never slides
         if self.design_rules is not None:
             rules = _grid_only(self.design_rules, keep=("design_level",))
             years = float(rules.attrs.get("years", self.years))
@@ -270,6 +273,23 @@ class StoreRisk:
         frame["rule"] = [RULE_NAMES.get(r, r) for r in frame["rule"]]
         index = [c for c in frame.columns if not c.startswith(("gap, ", "meets")) and c not in names.values()]
         return frame.set_index(index).dropna(how="all")
+
+    def dtm_text(self) -> str:
+        """Where the suite-mean D_TM rule applies, in words: why it is absent, or the configurations it is left out of ("" where it
+        applies in every one)."""
+        if self.rules is None:
+            return ""
+        if "dtm" not in self.rules["rule"].values:
+            return f"D_TM is not applied: {self.dtm_note or 'the studied building has no sliding base in this store'}."
+        missing = self.rules["gap"].sel(rule="dtm").isnull().all("contact")
+        missing = missing.any("design_level") if "design_level" in missing.dims else missing
+        if not bool(missing.any()):
+            return ""
+        where = [", ".join(f"{d} {_label(v)}" for d, v in zip(missing.dims, index)) for index in zip(*(
+            missing[d].values[i] for d, i in zip(missing.dims, np.nonzero(missing.values))))] if missing.dims else ["the scene"]
+        return ("D_TM (ASCE 7 §17.2.5.2) sizes the clearance of a base that slides; its rows are left out where the studied building's "
+                f"base never slid in any run ({'; '.join(where)}): a fixed base (μ = ∞), or friction the motions never overcame, has no "
+                "isolator displacement to size (it stays 0), and its separation is the storeys' rules'.")
 
     def design_rules_text(self) -> str:
         """The rules table's design-analysis rows in words: what they are, or why there are none."""
@@ -468,6 +488,11 @@ def fit_name(status: int) -> str:
     """A fit's kind in words: ``lognormal`` for a fit, ``flat: decreasing`` (:func:`~stochpound.risk.flat_fit_maf`), ``no runs``,
     else the step it is (``step: always`` …)."""
     return {FIT: "lognormal", DECREASING: "flat: decreasing (F ≡ fraction of runs that pounded)", EMPTY: "no runs"}.get(status, f"step: {STATUS[status]}")
+
+
+def _label(value: Any) -> str:
+    """A grid label in words: ``∞`` for inf, else as it prints."""
+    return "∞" if isinstance(value, float | np.floating) and math.isinf(value) else f"{value:g}" if isinstance(value, float | np.floating) else str(value)
 
 
 def gap_text(value: float) -> str:

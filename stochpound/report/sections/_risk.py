@@ -376,8 +376,9 @@ def _rules_blocks(name: str, risk: StoreRisk) -> list[Block]:
         f"at that gap, fitted over every stripe: 'this rule means pounding once in N years here'. Over the rules, levels and "
         f"configurations, the return periods range from {shortest:.3g} to {longest:.3g} years."
     )
-    if "dtm" not in rules["rule"].values:
-        text += f" D_TM is not applied: {risk.dtm_note or 'the studied building has no sliding base in this store'}."
+    dtm = risk.dtm_text()
+    if dtm:
+        text += f" {dtm}"
     text += " " + risk.design_rules_text()
     statuses = [rules["status"].values.ravel()]
     if risk.design_rules is not None:  # where a rule applies (a gap at every contact)
