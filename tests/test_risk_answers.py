@@ -176,6 +176,28 @@ def test_d_tm_is_not_taken_from_runs_a_moat_wall_capped(tmp_path):
     assert moat_text(risk, store_demands(store, bootstrap=0)) == ""
 
 
+def test_d_tm_of_a_moat_variant_is_its_wall_free_twins_and_is_compared_with_the_moat(tmp_path):
+    """The flagship's moat is a variant axis {none, wall}: the report said 'the store has no wall-free runs' and left D_TM and its
+    comparison with the moat out. Each configuration's D_TM is now the suite-mean base displacement of its wall-free twin."""
+    from stochpound import open_store
+    from stochpound.risk import store_demands, store_risk
+    from tests.helpers import ISOLATED, risk_text, run_in_process
+
+    variants = "\n[variants.moat.none]\n" + WALLS.replace("[[scene.wall]]", "[[variants.moat.wall.scene.wall]]")
+    text = risk_text(ISOLATED + variants, "gap = [inf]", 'measure = "psa"\nperiod = 1.0\nlevels = [0.3, 0.8, 1.5]')
+    store = open_store(run_in_process(tmp_path, "moat_variant", text))
+    risk = store_risk(store, bootstrap=0)
+    assert risk.dtm_note == "" and "dtm" in risk.rules["rule"].values
+    dtm = risk.rules["gap"].sel(rule="dtm")
+    np.testing.assert_array_equal(dtm.sel(moat="wall").values, dtm.sel(moat="none").values)  # the wall's twin's displacement
+    slid = store["peak_sliding_displacement"].sel(building="B1", moat="none", gap=np.inf).squeeze(drop=True)
+    stripe = float(risk.rules["stripe_intensity"].sel(design_level=0.02))
+    by_hand = float(slid.sel(intensity=stripe).mean())  # the suite mean of the wall-free runs at the rule's stripe
+    np.testing.assert_allclose(dtm.sel(design_level=0.02, moat="wall").values, by_hand, rtol=1e-12)
+    moat = moat_text(risk, store_demands(store, bootstrap=0))
+    assert "The wall-free D_TM (suite-mean peak base displacement without the wall) at 2 %/50 yr is" in moat and "moat clearance 0.1 m" in moat
+
+
 def test_the_assumptions_say_the_base_the_grid_leaves_and_the_scenario_the_stripes_were_selected_for():
     """A building with a base that the grid's μ = ∞ fixes is on a fixed base (the flagship's fixed pair was said to be on a
     sliding base), and a selection's scenario is named with where it comes from (it was said to be "none stated")."""
