@@ -198,6 +198,22 @@ def test_d_tm_of_a_moat_variant_is_its_wall_free_twins_and_is_compared_with_the_
     assert "The wall-free D_TM (suite-mean peak base displacement without the wall) at 2 %/50 yr is" in moat and "moat clearance 0.1 m" in moat
 
 
+def test_the_design_rows_say_why_there_is_no_eurocode_8_row():
+    """The Los Angeles flagship's [design] is ASCE 7's: EC8's row was left out silently; now the text says why and how to add it."""
+    def design(rules: list[str]) -> xr.Dataset:
+        shape = (len(rules), 1)
+        return xr.Dataset({"gap": (("rule", "contact"), np.full(shape, 0.1)), "return_period": ("rule", np.full(len(rules), 500.0))},
+                          coords={"rule": rules, "contact": [0]})
+
+    risk = _risk()
+    risk.design_rules = design(["asce7_delta_mt"])
+    text = risk.design_rules_text()
+    assert "ASCE 7 §12.12.3 δ_MT of the design analysis, once in 500 years." in text
+    assert "There is no Eurocode 8 §4.4.2.7 row: the store's [design] has no ec8 entry" in text and "give [design] an ec8 = { ag, ground, q }" in text
+    risk.design_rules = design(["asce7_delta_mt", "ec8_ds"])
+    assert "no Eurocode 8" not in risk.design_rules_text()
+
+
 def test_the_assumptions_say_the_base_the_grid_leaves_and_the_scenario_the_stripes_were_selected_for():
     """A building with a base that the grid's μ = ∞ fixes is on a fixed base (the flagship's fixed pair was said to be on a
     sliding base), and a selection's scenario is named with where it comes from (it was said to be "none stated")."""

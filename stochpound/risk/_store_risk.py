@@ -306,7 +306,15 @@ class StoreRisk:
                 "storeys under the design spectrum of the store's [design] (ASCE 7-16 §12.12.3: δ_M = C_d δ_max / I_e, SRSS of the two "
                 "buildings; Eurocode 8 §4.4.2.7: d_s = q d_e, SRSS, times 0.7 where the floors stand level; ASCE 7-16 §17.2.5.2 D_TM = D_M "
                 "of eq. 17.5-1 for a friction pendulum), not from the runs; each with the mean annual frequency of pounding at that gap: "
-                f"here, each rule means pounding {'; '.join(periods)}.")
+                f"here, each rule means pounding {'; '.join(periods)}.{self._without_ec8_text()}")
+
+    def _without_ec8_text(self) -> str:
+        """Why the design-analysis rows have no Eurocode 8 row, when they have none ("" otherwise)."""
+        if self.design_rules is None or "ec8_ds" in self.design_rules["rule"].values:
+            return ""
+        return (" There is no Eurocode 8 §4.4.2.7 row: the store's [design] has no ec8 entry (a_g, ground type, q). Eurocode 8 is "
+                "the design code of a European site, not of this one unless a user designs to it; give [design] an ec8 = { ag, ground, q } (or "
+                "stochpound risk --design) to add its row.")
 
     def design_frame(self) -> pd.DataFrame:
         """The gap to design to: per configuration and target, the upper bound of g*'s interval (m; g* itself without a bootstrap).
