@@ -9,6 +9,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pytest
 import pandas as pd
 import xarray as xr
 
@@ -176,16 +177,23 @@ def test_d_tm_is_not_taken_from_runs_a_moat_wall_capped(tmp_path):
     assert moat_text(risk, store_demands(store, bootstrap=0)) == ""
 
 
-def test_d_tm_of_a_moat_variant_is_its_wall_free_twins_and_is_compared_with_the_moat(tmp_path):
-    """The flagship's moat is a variant axis {none, wall}: the report said 'the store has no wall-free runs' and left D_TM and its
-    comparison with the moat out. Each configuration's D_TM is now the suite-mean base displacement of its wall-free twin."""
+@pytest.fixture(scope="module")
+def moat_variant_store(tmp_path_factory):
+    """The flagship's layout in small: B1 on a friction pendulum, its moat a variant axis {none, wall} (0.1 m walls), gap = ∞."""
     from stochpound import open_store
-    from stochpound.risk import store_demands, store_risk
     from tests.helpers import ISOLATED, risk_text, run_in_process
 
     variants = "\n[variants.moat.none]\n" + WALLS.replace("[[scene.wall]]", "[[variants.moat.wall.scene.wall]]")
     text = risk_text(ISOLATED + variants, "gap = [inf]", 'measure = "psa"\nperiod = 1.0\nlevels = [0.3, 0.8, 1.5]')
-    store = open_store(run_in_process(tmp_path, "moat_variant", text))
+    return open_store(run_in_process(tmp_path_factory.mktemp("moat"), "moat_variant", text))
+
+
+def test_d_tm_of_a_moat_variant_is_its_wall_free_twins_and_is_compared_with_the_moat(moat_variant_store):
+    """The flagship's moat is a variant axis {none, wall}: the report said 'the store has no wall-free runs' and left D_TM and its
+    comparison with the moat out. Each configuration's D_TM is now the suite-mean base displacement of its wall-free twin."""
+    from stochpound.risk import store_demands, store_risk
+
+    store = moat_variant_store
     risk = store_risk(store, bootstrap=0)
     assert risk.dtm_note == "" and "dtm" in risk.rules["rule"].values
     dtm = risk.rules["gap"].sel(rule="dtm")
@@ -196,6 +204,21 @@ def test_d_tm_of_a_moat_variant_is_its_wall_free_twins_and_is_compared_with_the_
     np.testing.assert_allclose(dtm.sel(design_level=0.02, moat="wall").values, by_hand, rtol=1e-12)
     moat = moat_text(risk, store_demands(store, bootstrap=0))
     assert "The wall-free D_TM (suite-mean peak base displacement without the wall) at 2 %/50 yr is" in moat and "moat clearance 0.1 m" in moat
+
+
+def test_the_stripes_table_does_not_call_wall_hits_pounding(moat_variant_store):
+    """At gap = ∞ the contacts never close: every impact of a run with the moat wall is a wall hit. The stripes table said
+    'pounded' and 'P(pounding)' for them; it now says impacts, and counts the wall hits apart."""
+    from stochpound.report.sections._intensity import intensity_section
+
+    store = moat_variant_store
+    table = next(b for b in intensity_section("moat", store).blocks if getattr(b, "key", "").startswith("intensity-stripes"))
+    frame = table.frame
+    assert "pounded" not in frame.columns and "P(pounding)" not in frame.columns and "pounding" not in table.caption
+    hits = ((store["peak_wall_penetration"] > 0) & (store["case_status"] == 1)).sum(("record", "realization")).sel(moat="wall")
+    assert int(hits.sum()) > 0  # the small store does hit its 0.1 m walls
+    np.testing.assert_array_equal(frame["wall hit"].xs("wall", level="moat").to_numpy(), hits.values.ravel())
+    np.testing.assert_array_equal(frame["impacted"].xs("wall", level="moat").to_numpy(), hits.values.ravel())  # gap = ∞: only walls
 
 
 def test_the_design_rows_say_why_there_is_no_eurocode_8_row():
