@@ -139,11 +139,15 @@ def bootstrap_method(clusters: np.ndarray | None, ran: np.ndarray | None = None)
     if used.sum() < labels.size:
         text = f"{text}, of a pool of {labels.size}"
     if counts and counts != [(len(set(labels[used])), int(used.sum()))]:
-        clusters_low, clusters_high = min(c for c, _ in counts), max(c for c, _ in counts)
-        motions_low, motions_high = min(m for _, m in counts), max(m for _, m in counts)
-        span = (lambda low, high: f"{low}" if low == high else f"{low}–{high}")
-        text = f"{text}; per stripe {span(clusters_low, clusters_high)} clusters of {span(motions_low, motions_high)} motions"
+        clusters, motions = (_span([pair[i] for pair in counts]) for i in (0, 1))
+        text = f"{text}; per stripe {clusters} clusters of {motions} motions"
     return f"BCa cluster bootstrap over events ({text}; station where the event is unknown)"
+
+
+def _span(values: list[int]) -> str:
+    """``a`` or ``a–b``: the smallest and largest of ``values``."""
+    low, high = min(values), max(values)
+    return f"{low}" if low == high else f"{low}–{high}"
 
 
 def _cluster_index(motions: int, clusters: Sequence[object] | None) -> tuple[np.ndarray, int]:
