@@ -180,3 +180,20 @@ def test_editing_the_design_keeps_the_runs_and_records_it(tmp_path):
     with open_store(store) as ds:
         assert ds.pound.definition.design["cd"] == 5.5 and ds.pound.definition.design["ec8"]["q"] == 4.0
         xr.testing.assert_identical(ds["peak_contact_closure"].load(), before)
+
+
+def test_the_flagship_s_d_m_in_the_docs_is_eq_17_5_1_s():
+    """docs/risk.md once gave β_eff 12–17 % and D_M 0.55–0.65 m for the flagship's pendulum; eq. 17.5-1 gives what it says now."""
+    import re
+    from pathlib import Path
+
+    from stochpound.risk import asce7_isolator_displacement
+    from stochpound.risk._code_gaps import damping_coefficient
+
+    docs = re.sub(r"\s+", " ", (Path(__file__).resolve().parents[1] / "docs" / "risk.md").read_text())
+    for mu in (0.08, 0.05):
+        displacement, period, damping = asce7_isolator_displacement(1.0, mu, 2.24, 1.20306)
+        stated = (f"μ = {mu:g} gives T_M = {period:.2f} s, β_M = {100 * damping:.2g} %, B_M = {damping_coefficient(damping):.2f} and "
+                  f"D_M = {displacement:.2f} m")
+        assert stated in docs, stated
+    assert "12–17 %" not in docs and "0.55–0.65 m" not in docs
