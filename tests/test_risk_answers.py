@@ -145,6 +145,32 @@ WALLS = "".join(f'\n[[scene.wall]]\nbuilding = "B1"\nside = "{side}"\nlevel = 0\
                 for side in ("left", "right"))
 
 
+def test_the_rules_paragraph_says_which_rules_its_range_covers_and_the_g_star_table_how_it_resampled():
+    """Read as the owner would: 'Over the rules ... the return periods range from 339' while a design-analysis row said 58.7 yr;
+    'each rule means pounding ASCE 7 ...' garbled; Table 1 said 'the motions resampled' of a cluster bootstrap over events."""
+    from stochpound.report.sections._risk import _rules_blocks, _separation_table
+
+    dims = ("design_level", "rule", "contact")
+    rules = xr.Dataset({"gap": (dims, np.full((1, 1, 1), 0.3)), "status": (dims[:2], np.array([[FIT]], dtype=np.int8))},
+                       coords={"design_level": [0.02], "rule": ["srss"], "contact": [0], "code_intensity": ("design_level", [0.8]),
+                               "stripe_intensity": ("design_level", [0.8])})
+    maf = xr.DataArray([[1e-3]], dims=dims[:2])
+    rules = rules.assign(maf=maf, return_period=1 / maf, probability=1 - np.exp(-50 * maf))
+    risk = _risk(rules)
+    risk.design_rules = xr.Dataset({"gap": (("rule", "contact"), [[0.05]]), "maf": ("rule", [1 / 60.0]), "return_period": ("rule", [60.0]),
+                                    "probability": ("rule", [1 - math.exp(-50 / 60.0)]), "status": ("rule", np.array([FIT], dtype=np.int8))},
+                                   coords={"rule": ["asce7_delta_mt"], "contact": [0], "design_level": ("rule", [0.02])})
+    text = _rules_blocks("pair", risk)[0].text
+    assert "Over the suite-mean rules, levels and configurations, the return periods range from 1e+03 to 1e+03 years" in text
+    assert "Over the rules," not in text and "each rule means pounding" not in text
+    assert "here: ASCE 7 §12.12.3 δ_MT of the design analysis, pounding once in 60 years." in text
+    risk.separation["lower"].attrs["method"] = "BCa cluster bootstrap over events (3 clusters of the 22 motions that ran)"
+    risk.curve = xr.Dataset(coords={"gap": [0.1, 0.5]})
+    caption = _separation_table("pair", risk).caption
+    assert caption.endswith("with its 95 % interval (BCa cluster bootstrap over events (3 clusters of the 22 motions that ran))")
+    assert "the motions resampled" not in caption
+
+
 def test_d_tm_where_the_base_never_slides_is_left_out_and_said_why_not_a_dash():
     """μ ∈ {∞, 0.05}: on the fixed base D_TM has nothing to size; its rows go, and the text says where and why."""
     dims = ("design_level", "rule", "mu", "contact")
@@ -231,7 +257,7 @@ def test_the_design_rows_say_why_there_is_no_eurocode_8_row():
     risk = _risk()
     risk.design_rules = design(["asce7_delta_mt"])
     text = risk.design_rules_text()
-    assert "ASCE 7 §12.12.3 δ_MT of the design analysis, once in 500 years." in text
+    assert "here: ASCE 7 §12.12.3 δ_MT of the design analysis, pounding once in 500 years." in text
     assert "There is no Eurocode 8 §4.4.2.7 row: the store's [design] has no ec8 entry" in text and "give [design] an ec8 = { ag, ground, q }" in text
     risk.design_rules = design(["asce7_delta_mt", "ec8_ds"])
     assert "no Eurocode 8" not in risk.design_rules_text()

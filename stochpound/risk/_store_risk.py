@@ -301,12 +301,12 @@ class StoreRisk:
             period = period.where(self.design_rules["gap"].sel(rule=rule).notnull().all("contact"))  # where the rule applies
             if bool(period.notnull().any()):
                 low, high = float(period.min()), float(period.max())
-                periods.append(f"{RULE_NAMES[str(rule)]}, once in {low:.3g}" + (f" to {high:.3g}" if high != low else "") + " years")
+                periods.append(f"{RULE_NAMES[str(rule)]}, pounding once in {low:.3g}" + (f" to {high:.3g}" if high != low else "") + " years")
         return ("The rows '(design analysis)' are the codes' own gaps, from the linear modal analysis of each building's fixed-base "
                 "storeys under the design spectrum of the store's [design] (ASCE 7-16 §12.12.3: δ_M = C_d δ_max / I_e, SRSS of the two "
                 "buildings; Eurocode 8 §4.4.2.7: d_s = q d_e, SRSS, times 0.7 where the floors stand level; ASCE 7-16 §17.2.5.2 D_TM = D_M "
                 "of eq. 17.5-1 for a friction pendulum), not from the runs; each with the mean annual frequency of pounding at that gap: "
-                f"here, each rule means pounding {'; '.join(periods)}.{self._without_ec8_text()}")
+                f"here: {'; '.join(periods)}.{self._without_ec8_text()}")
 
     def _without_ec8_text(self) -> str:
         """Why the design-analysis rows have no Eurocode 8 row, when they have none ("" otherwise)."""
@@ -344,7 +344,7 @@ class StoreRisk:
         return degenerate_text(self.fragility["status"].values, self.hazard, what)
 
     def non_increasing_maf(self) -> xr.DataArray:
-        """λ_P(g) made non-increasing along the gaps (its running minimum, the curve g* is read from; 1/yr)."""
+        """λ_P(g) made non-increasing along the gaps (isotonic regression in ln λ, pool-adjacent-violators: the curve g* is read from; 1/yr)."""
         return non_increasing_along(self.curve["maf"], "gap")
 
     def hazard_levels(self, probabilities: Sequence[float] = (0.10, 0.02)) -> dict[float, float]:
@@ -395,7 +395,8 @@ class StoreRisk:
 
 
 def non_increasing_along(maf: xr.DataArray, dim: str) -> xr.DataArray:
-    """A rate made non-increasing along its thresholds ``dim`` (the running minimum; NaN as no bound)."""
+    """A rate made non-increasing along its thresholds ``dim``: the least-squares non-increasing fit of ln λ (pool-adjacent-violators,
+    ``stochpound.risk._maf.non_increasing``), NaN left out of the fit."""
     return xr.apply_ufunc(non_increasing, maf, input_core_dims=[[dim]], output_core_dims=[[dim]]).transpose(*maf.dims)
 
 
