@@ -302,11 +302,13 @@ class StoreRisk:
             if bool(period.notnull().any()):
                 low, high = float(period.min()), float(period.max())
                 periods.append(f"{RULE_NAMES[str(rule)]}, pounding once in {low:.3g}" + (f" to {high:.3g}" if high != low else "") + " years")
+        formulas = {"asce7_delta_mt": "ASCE 7-16 §12.12.3: δ_M = C_d δ_max / I_e, SRSS of the two buildings",
+                    "ec8_ds": "Eurocode 8 §4.4.2.7: d_s = q d_e, SRSS, times 0.7 where the floors stand level",
+                    "asce7_dtm": "ASCE 7-16 §17.2.5.2 D_TM = D_M of eq. 17.5-1 for a friction pendulum"}
+        given = "; ".join(formulas[str(rule)] for rule in self.design_rules["rule"].values if str(rule) in formulas)
         return ("The rows '(design analysis)' are the codes' own gaps, from the linear modal analysis of each building's fixed-base "
-                "storeys under the design spectrum of the store's [design] (ASCE 7-16 §12.12.3: δ_M = C_d δ_max / I_e, SRSS of the two "
-                "buildings; Eurocode 8 §4.4.2.7: d_s = q d_e, SRSS, times 0.7 where the floors stand level; ASCE 7-16 §17.2.5.2 D_TM = D_M "
-                "of eq. 17.5-1 for a friction pendulum), not from the runs; each with the mean annual frequency of pounding at that gap: "
-                f"here: {'; '.join(periods)}.{self._without_ec8_text()}")
+                f"storeys under the design spectrum of the store's [design] ({given}), not from the runs; each with the mean annual "
+                f"frequency of pounding at that gap: here: {'; '.join(periods)}.{self._without_ec8_text()}")
 
     def _without_ec8_text(self) -> str:
         """Why the design-analysis rows have no Eurocode 8 row, when they have none ("" otherwise)."""

@@ -136,8 +136,8 @@ def design_summary_text(risk: StoreRisk, demands: StoreDemands | None = None) ->
     what the answer rests on (hazard, scenario, structural model, suite), all from the chain's results and the store."""
     wall = _wall_governs(risk, demands)
     governing = "; ".join(
-        (f"the moat wall ({wall[t][0]:.3g} m clearance, reached once in {1 / wall[t][1]:.3g} yr)" if t in wall else "pounding between the buildings")
-        + f" for {risk.target_text(t)}" for t in risk.separation["target"].values)
+        (f"the moat wall ({wall[t][0]:.3g} m clearance, reached once in {1 / wall[t][1]:.3g}{_wall_interval(demands, wall[t][0])} yr)"
+         if t in wall else "pounding between the buildings") + f" for {risk.target_text(t)}" for t in risk.separation["target"].values)
     rules = risk.rules_frame()
     if rules.empty:
         meets = f"The code rules were not evaluated ({risk.rules_note})."
@@ -166,6 +166,15 @@ def _wall_rates(risk: StoreRisk, demands: StoreDemands) -> list[tuple[float, flo
             worst = maf.fillna(-1.0).argmax(...)
             rows.append((float(target), float(clearance), float(maf[worst]), allowed, worst))
     return rows
+
+
+def _wall_interval(demands: StoreDemands | None, clearance: float) -> str:
+    """`` [lower, upper]`` of the return period of reaching the wall at ``clearance`` in its worst configuration ("" without a bootstrap)."""
+    if demands is None or demands.moat is None or "return_period_lower" not in demands.moat:
+        return ""
+    at = demands.moat.sel(level=clearance)
+    worst = at["maf"].fillna(-1.0).argmax(...)
+    return f" [{float(at['return_period_lower'].isel(worst)):.3g}, {float(at['return_period_upper'].isel(worst)):.3g}]"
 
 
 def _wall_governs(risk: StoreRisk, demands: StoreDemands | None) -> dict[float, tuple[float, float]]:
@@ -209,12 +218,12 @@ def moat_text(risk: StoreRisk, demands: StoreDemands | None) -> str:
                    "at that level the base reaches the wall, so the code's D_TM is not met by the moat"
                    if exceeded else f"is within the moat clearance{'s' if len(clearances) > 1 else ''} "
                    f"{', '.join(f'{c:.3g} m' for c in clearances)}")
-        sentences.append(f"The wall-free D_TM (suite-mean peak base displacement without the wall) at {100 * level:g} %/{risk.years:g} yr is "
+        values = dtm.sel(design_level=level).values
+        largest = " (the largest over the configurations)" if np.unique(values[np.isfinite(values)]).size > 1 else ""
+        sentences.append(f"The wall-free D_TM (suite-mean peak base displacement without the wall) at {100 * level:g} %/{risk.years:g} yr{largest} is "
                          f"{value:.3g} m and {verdict}.")
-    for target, clearance, wall, allowed, worst in _wall_rates(risk, demands):
-        bounds = demands.moat.sel(level=clearance).isel(worst) if "return_period_lower" in demands.moat else None
-        interval = (f" [{float(bounds['return_period_lower']):.3g}, {float(bounds['return_period_upper']):.3g}]"
-                    if bounds is not None else "")
+    for target, clearance, wall, allowed, _ in _wall_rates(risk, demands):
+        interval = _wall_interval(demands, clearance)
         relation = ("more often than the target allows (once in {:.3g} yr): the wall, not the gap, governs this target"
                     if wall > allowed else "less often than the target allows (once in {:.3g} yr): the wall does not govern this target")
         sentences.append(f"The base reaches the {clearance:.3g} m moat wall once in {1 / wall:.3g}{interval} yr (worst configuration), "
@@ -371,7 +380,8 @@ def _rules_blocks(name: str, risk: StoreRisk) -> list[Block]:
         return [Paragraph(f"Code rules in risk terms: not evaluated for experiment {name}: {risk.rules_note}.")]
     rules = risk.rules
     years = risk.years
-    code = ", ".join(f"{100 * p:g} %/{years:g} yr: {float(c):.3g} (stripe {float(s):g})" for p, c, s in
+    units = f" {risk.setting['units']}" if risk.setting.get("units") else ""
+    code = ", ".join(f"{100 * p:g} %/{years:g} yr: {float(c):.3g}{units} (stripe {float(s):g}{units})" for p, c, s in
                      zip(rules["design_level"].values, rules["code_intensity"].values, rules["stripe_intensity"].values))
     frame = risk.rules_frame()
     shortest, longest = risk.return_period_range()
