@@ -149,7 +149,7 @@ def test_stochpound_risk_prints_the_codes_gaps_beside_the_suite_mean_rules(desig
                  "2 %/50 yr (design analysis)", "10 %/50 yr (design analysis)"):
         assert text in result.output
     period = float(risk.design_rules["return_period"].sel(rule="asce7_delta_mt"))
-    assert f"ASCE 7 §12.12.3 δ_MT of the design analysis, once in {period:.3g} years" in result.output.replace("\n", " ")
+    assert f"ASCE 7 §12.12.3 δ_MT of the design analysis, pounding once in {period:.3g} years" in result.output.replace("\n", " ")
 
 
 def test_stochpound_risk_takes_a_design_file_and_refuses_a_bad_one(design_store, tmp_path):
