@@ -89,6 +89,10 @@ def test_the_gap_to_design_to_is_the_upper_bound_of_g_star_stated_as_such():
     unbounded = _risk()
     unbounded.separation = unbounded.separation.drop_vars(["lower", "upper"])
     assert list(unbounded.design_frame()["design"]) == [0.20, 0.40] and "no bootstrap" in design_value_text(unbounded)
+    assert "g* is a central estimate from 22 motions and" in text
+    selected = _risk()
+    selected.setting = {"selection": "conditional_spectrum", "units": "g"}  # motions chosen per stripe from a pool
+    assert "g* is a central estimate from 22 motions per stripe and" in design_value_text(selected)
 
 
 def test_the_wall_free_d_tm_is_compared_with_the_moat_and_the_wall_governs_a_target_it_is_hit_more_often_than():

@@ -198,7 +198,7 @@ def design_value_text(risk: StoreRisk) -> str:
         values = "; ".join(f"{_gap_text(row.design)} for {risk.target_text(row.target)}" for row in rows.itertuples())
         per.append(f"{labels_text(dict(zip(config, labels))) or 'the scene'}: {values}")
     return (f"The gap to design to is the {frame['basis'].iloc[0]}, not g* itself (g* is a central estimate from "
-            f"{risk.motions} motions and meets its target only about half the time): " + ". ".join(per) + ".")
+            f"{risk.motions} motions{' per stripe' if is_selected(risk.setting) else ''} and meets its target only about half the time): " + ". ".join(per) + ".")
 
 
 def moat_text(risk: StoreRisk, demands: StoreDemands | None) -> str:
@@ -436,7 +436,7 @@ def _demand_blocks(name: str, risk: StoreRisk, demands: StoreDemands | None) -> 
         axes[0].legend(fontsize=5)
     blocks: list[Block] = [FigureItem(f"risk-demands-{name}", f"Experiment {name}: demand hazard curves (mean annual frequency of "
                                       "exceeding each level, a lognormal fragility fitted at every level over the stripes' "
-                                      "contact-free runs (a step where the runs identify no lognormal) and integrated with the hazard, made non-increasing along the level), per "
+                                      "contact-free runs (a step, or flat, where the runs identify no lognormal) and integrated with the hazard, made non-increasing along the level), per "
                                       "configuration.", figure)]
     if demands.moat is not None:
         blocks.append(Table(f"risk-moat-{name}", f"Experiment {name}: moat-wall contact as a limit state: the mean annual frequency with "
