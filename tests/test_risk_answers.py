@@ -60,6 +60,15 @@ def test_a_decreasing_fit_has_the_rate_of_its_flat_fit_stated_not_a_dash():
     assert "1 of 2 gaps: a flat fit 'decreasing'" in text and "p̄ × 0.0333 /yr" in text and "upper bound" in text
     assert "a step 'decreasing'" not in text and "NaN" not in text
     assert fit_name(DECREASING) == "flat: decreasing (F ≡ fraction of runs that pounded)"
+    # the band: a resample whose fit is decreasing too has its flat fit's rate, not NaN (left out of the interval)
+    from stochpound.risk import risk_curve
+
+    sampled = stripe_fragility(xr.DataArray(events, dims=("intensity", "record"), coords={"intensity": levels}), bootstrap=60, seed=3)
+    curve = risk_curve(sampled, HAZARD)
+    flat = sampled["flat_bootstrap"]
+    assert int(flat.notnull().sum()) > 0 and bool(np.isfinite(curve["maf_bootstrap"]).all())
+    np.testing.assert_allclose(curve["maf_bootstrap"].where(flat.notnull()).dropna("bootstrap"), (flat * 0.0333).dropna("bootstrap"), rtol=1e-12)
+    assert float(curve["maf_lower"]) <= rate <= float(curve["maf_upper"])
     # a code rule whose gap pounds 19 of 20 at every stripe: the rules table gets the flat fit's rate, not NaN ("–")
     closure = xr.DataArray(np.where(events > 0, 0.30, 0.01)[..., None], dims=("intensity", "record", "contact"),
                            coords={"intensity": levels, "contact": [0]})

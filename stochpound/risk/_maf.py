@@ -120,7 +120,12 @@ def flat_fit_maf(exceeded: ArrayLike, runs: ArrayLike, hz: HazardCurve) -> np.nd
     """
     k, n = (np.asarray(value, dtype=float).sum(-1) for value in (exceeded, runs))
     with np.errstate(invalid="ignore", divide="ignore"):
-        return np.where(n > 0.0, k / n, np.nan) * float(hz(hz.support[0]))
+        return _flat_rate(np.where(n > 0.0, k / n, np.nan), hz)
+
+
+def _flat_rate(fraction: ArrayLike, hz: HazardCurve) -> ArrayLike:
+    """λ of F ≡ ``fraction`` over the hazard's range: the fraction times the rate at its lowest intensity (1/yr)."""
+    return fraction * float(hz(hz.support[0]))
 
 
 def fit_maf(theta: ArrayLike, beta: ArrayLike, status: ArrayLike, exceeded: ArrayLike, runs: ArrayLike, hz: HazardCurve) -> np.ndarray:
@@ -164,8 +169,7 @@ def risk_curve(fragility: xr.Dataset, hz: HazardCurve, years: float = 50.0, conf
         attrs={"years": years, "hazard": repr(hz), "hazard_source": hz.source},
     )
     if "theta_bootstrap" in fragility:
-        sampled = mean_annual_frequency(xr.Dataset({"theta": fragility["theta_bootstrap"], "beta": fragility["beta_bootstrap"]}), hz)
-        left_out = mean_annual_frequency(xr.Dataset({"theta": fragility["theta_jackknife"], "beta": fragility["beta_jackknife"]}), hz)
+        sampled, left_out = (_resampled_maf(fragility, part, hz) for part in ("bootstrap", "jackknife"))
         lower, upper = _interval(sampled, maf, left_out, confidence)
         attrs = {"units": "1/yr", "confidence": confidence, "method": fragility["theta_lower"].attrs.get("method", "")}
         result = result.assign(
@@ -176,6 +180,15 @@ def risk_curve(fragility: xr.Dataset, hz: HazardCurve, years: float = 50.0, conf
         )
     result.attrs["hazard_extrapolated"] = int(hz.extrapolated)
     return rate_intervals(result, years)
+
+
+def _resampled_maf(fragility: xr.Dataset, part: str, hz: HazardCurve) -> xr.DataArray:
+    """λ of every ``part`` (``bootstrap`` or ``jackknife``) resample of a fit Dataset, a decreasing resample's by its flat fit."""
+    rate = mean_annual_frequency(xr.Dataset({"theta": fragility[f"theta_{part}"], "beta": fragility[f"beta_{part}"]}), hz)
+    if f"flat_{part}" in fragility:
+        flat = fragility[f"flat_{part}"]
+        rate = rate.where(flat.isnull(), _flat_rate(flat, hz))
+    return rate
 
 
 def degenerate_text(status: ArrayLike, hz: HazardCurve, what: str = "gaps") -> str:
