@@ -204,7 +204,7 @@ def test_d_tm_where_the_base_never_slides_is_left_out_and_said_why_not_a_dash():
     text = risk.dtm_text()
     assert "left out where the studied building's base never slid in any run (mu ∞)" in text and "fixed base (μ = ∞)" in text
     assert _risk(rules.sel(mu=[0.05])).dtm_text() == ""
-    assert "no sliding base" in _risk(rules.sel(rule=["abs"])).dtm_text()
+    assert "base slides in no run of this store" in _risk(rules.sel(rule=["abs"])).dtm_text()
 
 
 def test_d_tm_is_not_taken_from_runs_a_moat_wall_capped(tmp_path):

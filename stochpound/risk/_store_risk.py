@@ -280,7 +280,9 @@ class StoreRisk:
         if self.rules is None:
             return ""
         if "dtm" not in self.rules["rule"].values:
-            return f"D_TM is not applied: {self.dtm_note or 'the studied building has no sliding base in this store'}."
+            never = ("the studied building's base slides in no run of this store (a fixed base, or friction the motions never overcame): "
+                     "there is no isolator displacement to size")
+            return f"D_TM is not applied: {self.dtm_note or never}."
         missing = self.rules["gap"].sel(rule="dtm").isnull().all("contact")
         missing = missing.any("design_level") if "design_level" in missing.dims else missing
         if not bool(missing.any()):
