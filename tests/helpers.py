@@ -496,8 +496,8 @@ RECORDS = "".join(f'\n[[records]]\nrecord = "fema_p695_far_field/{name}"\ndurati
 FLAGSHIP = (REPOSITORY / "experiments" / "risk" / "isolated.toml").read_text()
 _YIELDING = r"^(storey_height|yield_force|hardening|p_delta) = .*\n"  # the flagship's yielding storeys: these small experiments stay elastic (IDA)
 ISOLATED = re.sub(_YIELDING, "", FLAGSHIP[FLAGSHIP.index("[scene]"):FLAGSHIP.index("[variants")], flags=re.MULTILINE)  # its scene, no variants
-_B2 = ISOLATED.rindex("mass = [26268.0, 17512.0]")  # the neighbour: the stiff variant (masses x 0.5), else the pair moves as one
-FIXED = re.sub(r"^base = .*\n", "", ISOLATED[:_B2] + "mass = [13134.0, 8756.0]" + ISOLATED[_B2 + len("mass = [26268.0, 17512.0]"):], flags=re.MULTILINE)
+#: The same pair on fixed bases (the bundled ``elastic_pair``) beside the stiff neighbour (masses x 0.5), else the pair moves as one.
+FIXED = '[scene]\nbundled = "elastic_pair"\n[scene.building.B2]\nmass = [13134.0, 8756.0]\n'
 BUNDLED = "fox_plaza_los_angeles_sa1p0s"
 
 def risk_text(scene: str, grid: str, intensity: str, hazard: str = f'bundled = "{BUNDLED}"') -> str:

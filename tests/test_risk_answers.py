@@ -280,12 +280,10 @@ def test_the_design_rows_say_why_there_is_no_eurocode_8_row():
     assert "no Eurocode 8" not in risk.design_rules_text()
 
 
-def test_the_assumptions_say_the_base_the_grid_leaves_and_the_scenario_the_stripes_were_selected_for():
+def test_the_assumptions_say_the_base_the_grid_leaves():
     """A building with a base that the grid's μ = ∞ fixes is on a fixed base (the flagship's fixed pair was said to be on a
-    sliding base), and a selection's scenario is named with where it comes from (it was said to be "none stated")."""
-    import xarray as xr
-
-    from stochpound.risk._store import _base_words, _scenario_words
+    sliding base); the scenario's words: tests/test_fitted_scenarios.py."""
+    from stochpound.risk._store import _base_words
     from stochpound.store import MuAxis
 
     building = {"name": "B1", "base": {"mu": 0.05}}
@@ -293,8 +291,3 @@ def test_the_assumptions_say_the_base_the_grid_leaves_and_the_scenario_the_strip
     assert _base_words(MuAxis((0.05, 0.08), ("B1",)), building) == "a sliding base (μ 0.05, 0.08 on the grid)"
     assert _base_words(MuAxis((0.05, float("inf")), None), building) == "a sliding base (μ 0.05 on the grid) or a fixed base"
     assert _base_words(None, {"name": "B2"}) == "a fixed base"
-    store = xr.Dataset({"site_magnitude": ("intensity", [7.5, 8.0]), "site_distance_km": ("intensity", [30.0, 30.0]),
-                        "site_vs30": ("intensity", [400.0, 400.0])})
-    fitted = {"site": [{}], "note": "… the scenario fitted to the site's hazard curves …"}
-    assert _scenario_words(store, fitted).startswith("M 7.5–8, R 30 km, Vs30 400 m/s, fitted to the site's hazard curves")
-    assert "an assumption unless" in _scenario_words(store, {"site": [{}]})

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from stochpound.analysis._bootstrap import bootstrap_weights, interval, jackknife_weights, motion_clusters
+from stochpound.stats._bootstrap import bootstrap_weights, interval, jackknife_weights, motion_clusters
 from stochpound.risk._maf import _separation_kernel, non_increasing as _nonincreasing_rate
 
 
@@ -108,7 +108,8 @@ def test_the_bootstrap_counts_the_clusters_and_motions_that_ran_not_the_pool():
     """A selection runs some motions of a pool per stripe: the method's words count the runs' clusters and motions, per stripe."""
     import xarray as xr
 
-    from stochpound.analysis import bootstrap_method, stripe_fragility
+    from stochpound.analysis import stripe_fragility
+    from stochpound.stats import bootstrap_method
 
     rng = np.random.default_rng(5)
     levels = np.array([0.2, 0.4, 0.8])

@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import hashlib
 import itertools
-import tomllib
 from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
@@ -25,7 +24,7 @@ from typing import Any, Iterator, Mapping, Sequence
 import numpy as np
 
 from stochpound._errors import SceneError
-from stochpound.store import Definition, canonical_json, read_definition, register_grid
+from stochpound.store import CASE, KINDS, REFERENCE, Definition, canonical_json, read_definition, register_grid
 from stochpound.experiment._scene_edits import (
     apply_overrides,
     building_names,
@@ -38,12 +37,6 @@ from stochpound.experiment._scene_edits import (
 from stochpound.experiment._site import CONDITIONAL_SPECTRUM, StripeSelections, stripe_selections
 from stochpound.experiment._spec import ExperimentError
 from stochpound.model.scene_file import scene_from_dict
-
-CASE = "case"
-REFERENCE = "reference"
-KINDS = (REFERENCE, CASE)
-"""The kinds of case, in store order."""
-
 
 @dataclass(frozen=True)
 class Dim:
@@ -411,12 +404,9 @@ class Experiment:
 
     @cached_property
     def scene_field(self) -> str:
-        """How errors name the base scene: ``scene`` (inline) or its file (``experiment.scene``)."""
-        try:
-            path = tomllib.loads(self.text).get("experiment", {}).get("scene")
-        except tomllib.TOMLDecodeError:
-            path = None
-        return str(self.base_dir / path) if isinstance(path, str) else "scene"
+        """How errors name the base scene: its file's path, else ``scene`` (inline, or a bundled scene: an error is its edits')."""
+        source = self.contract.scene_source
+        return str(self.base_dir / source["file"]) if source is not None and "file" in source else "scene"
 
     def validate(self) -> None:
         """Validate the scene of every grid point (cases, then references) before anything runs.

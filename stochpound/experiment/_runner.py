@@ -207,8 +207,9 @@ def run_experiment(
                 raise ExperimentError(f"{store}: written by an earlier stochpound without {', '.join(missing)}, which it keeps now: "
                                       "run the experiment again with --restart to recompute its cases")
             stored, new = stored_definition(store), json.loads(canonical_json(experiment.definition))
-            if stored != new:
-                changed = [key for key in NOT_IN_IDENTITY if stored.get(key) != new.get(key)]
+            # the scene's provenance alone (the same content, from another file or inline) leaves the store as it is
+            changed = [key for key in NOT_IN_IDENTITY if key != "scene_source" and stored.get(key) != new.get(key)]
+            if changed:
                 _record_hazard(store, experiment, {label: m.grid for label, m in motions.items()}, say, changed)
             return RunReport(store, experiment.n_cases, experiment.n_cases, elapsed=time.monotonic() - started, nothing_to_run=True)
     elif store.is_dir():
@@ -287,6 +288,8 @@ def _record_hazard(store: Path, experiment: Experiment, grids: dict[str, tuple[f
         session.rebuild()
     if "design" in changed:
         say(f"{store}: the [design] changed; no run depends on it: the cases are kept and the new design is recorded in the store")
+    if "site" in changed:
+        say(f"{store}: how the [site] scenario was obtained is recorded in the store (no run depends on it: the cases are kept)")
     if "hazard" not in changed:
         return
     hazard = experiment.contract.hazard

@@ -24,15 +24,17 @@ import tomllib
 from pathlib import Path
 from typing import Any, Mapping
 
-from stochpound._errors import ExperimentError, field_errors
+from stochpound._errors import ExperimentError, SceneError, field_errors
 from stochpound._studies import parse_reproduces
 from stochpound.experiment._design_table import parse_design
-from stochpound.experiment._hazard import parse_hazard
+from stochpound.hazard import parse_hazard
 from stochpound.motions import DEFAULT_G
 from stochpound.experiment._intensity import parse_intensity
+from stochpound.experiment._site import site_entry
 from stochpound.model import fields as toml_fields
 from stochpound.model.contact import ELEMENT_KEYS
-from stochpound.model.scene_file import generator_fields
+from stochpound.experiment._scene_edits import apply_overrides, building_names
+from stochpound.model.scene_file import bundled_scene_path, bundled_scenes, generator_fields, read_scene_table
 from stochpound.solvers.simulate import METHODS
 from stochpound.solvers.ivp import INTEGRATORS
 from stochpound.store import TIME_HISTORIES, is_gap_axis, read_definition
@@ -44,6 +46,8 @@ _TOP_KEYS = {"experiment", "scene", "variants", "grid", "records", "motions", "s
 _EXPERIMENT_KEYS = {"name", "description", "scene", "studied", "reproduces"}
 _BUILDING_OVERRIDES = {"mass_factor", "mass", "stiffness", "damping", "damping_ratio", "base", "initial"}
 _SCENE_OVERRIDES = {"study_compat", "wall"}
+SCENE_SOURCES = ("file", "bundled")
+"""The ``[scene]`` keys that take the base scene from a scene file (at most one; beside it only ``[scene.building.<name>]`` edits)."""
 AUTO = "auto"
 """``solver.method`` default: each case's solver chosen by :func:`stochpound.simulate` (exact unless a law is nonlinear)."""
 _RECORD_KEYS = {"name", "record", "scale", "dt", "duration", "units", "interpolation"}
@@ -109,8 +113,10 @@ def parse_experiment(data: Mapping[str, Any], base_dir: str | Path = ".", defaul
         Canonical definition: ``format``, ``name``, ``description``,
         ``scene`` (the base scene's dict, its ``[motion]`` included when it has one),
         ``studied``, ``variants``, ``gaps``, ``mu``, ``motions``, ``output``, ``solver``;
-        ``intensity`` and ``hazard`` only when the file has those tables;
-        ``reproduces`` only when the file declares it.
+        ``intensity``, ``hazard``, ``design`` and ``site`` only when the file has those tables;
+        ``reproduces`` only when the file declares it; ``scene_source`` only when
+        the base scene comes from a file (``file`` as given, or ``bundled``, and the file's
+        ``sha256``: not part of the identity, ``scene`` holds the content).
     """
     base_dir = Path(base_dir)
     with field_errors():
@@ -127,7 +133,7 @@ def parse_experiment(data: Mapping[str, Any], base_dir: str | Path = ".", defaul
                 parse_reproduces(reproduces)
             except ValueError as error:
                 raise ExperimentError(f"experiment.reproduces: {error} (a published study's part, \"<study>:<part>\")") from None
-    scene = _base_scene(data, header, base_dir)
+    scene, scene_source = _base_scene(data, header, base_dir)
     buildings = [b.get("name", f"B{i + 1}") for i, b in enumerate(scene.get("building", []))]
     studied = header.get("studied", buildings[0] if buildings else "B1")
     if studied not in buildings:
@@ -163,6 +169,8 @@ def parse_experiment(data: Mapping[str, Any], base_dir: str | Path = ".", defaul
         "output": _output(data, buildings),
         "solver": _solver(data),
     }
+    if scene_source is not None:  # absent for an inline scene; not in the identity, which holds the scene's content
+        definition["scene_source"] = scene_source
     if reproduces is not None:  # absent unless declared: the definitions (and hashes) of other files are unchanged
         definition["reproduces"] = reproduces
     if intensity is not None:  # absent without [intensity]: the definitions (and hashes) of other files are unchanged
@@ -171,6 +179,10 @@ def parse_experiment(data: Mapping[str, Any], base_dir: str | Path = ".", defaul
         definition["hazard"] = hazard
     if design is not None:  # likewise absent without [design]
         definition["design"] = design
+    with field_errors():
+        site = site_entry(data.get("site"), intensity)
+    if site is not None:  # likewise absent without [site]; out of the identity (the scenarios are in the intensity entry)
+        definition["site"] = site
     read_definition(definition)  # the typed definition reads every field parsed here
     return definition
 
@@ -180,26 +192,47 @@ def _table_or_error(data: Mapping[str, Any], key: str, prefix: str) -> dict[str,
         return dict(toml_fields.table(data, key, prefix) or {})
 
 
-def _base_scene(data: Mapping[str, Any], header: Mapping[str, Any], base_dir: Path) -> dict[str, Any]:
+def _base_scene(data: Mapping[str, Any], header: Mapping[str, Any], base_dir: Path) -> tuple[dict[str, Any], dict[str, str] | None]:
+    """The base scene's dict (a file's content, its building edits applied) and its source's provenance (None: inline)."""
     inline = data.get("scene")
     path = header.get("scene")
     if inline is not None and path is not None:
         raise ExperimentError("experiment.scene: give either a scene path here or an inline [scene] table, not both")
     if inline is None and path is None:
-        raise ExperimentError("scene: missing (an inline [scene] table, or experiment.scene = \"path/to/scene.toml\")")
-    if inline is not None:
-        if not isinstance(inline, dict):
-            raise ExperimentError(f"scene: must be a table (the scene, as in a scene file), got {type(inline).__name__}")
-        return copy.deepcopy(inline)
-    if not isinstance(path, str) or not path:
-        raise ExperimentError(f"experiment.scene: must be a path to a scene file, got {path!r}")
-    file = base_dir / path
+        raise ExperimentError("scene: missing (an inline [scene] table, [scene] file = \"path/to/scene.toml\", or [scene] bundled = \"<name>\")")
+    if path is not None:
+        return _scene_from_file(path, base_dir, "experiment.scene", "file")
+    if not isinstance(inline, dict):
+        raise ExperimentError(f"scene: must be a table (the scene, as in a scene file), got {type(inline).__name__}")
+    given = [key for key in SCENE_SOURCES if key in inline]
+    if not given:
+        return copy.deepcopy(inline), None
+    if len(given) > 1:
+        raise ExperimentError(f"scene.{given[1]}: give one of scene.file and scene.bundled, not both")
+    key = given[0]
+    others = sorted(set(inline) - {key, "building"})
+    if others or ("building" in inline and not isinstance(inline["building"], dict)):
+        field = others[0] if others else "building"
+        raise ExperimentError(f"scene.{field}: not allowed beside scene.{key} (the scene is the file's; edit its buildings in [scene.building.<name>] tables)")
+    scene, source = _scene_from_file(inline[key], base_dir, f"scene.{key}", key)
+    edits = inline.get("building")
+    if edits:
+        edit = _override({"building": edits}, "scene", building_names(scene), len(scene.get("contact", [])))
+        scene = apply_overrides(scene, [edit])
+    return scene, source
+
+
+def _scene_from_file(name: Any, base_dir: Path, field: str, kind: str) -> tuple[dict[str, Any], dict[str, str]]:
+    """A scene file's dict (``kind`` ``file``: relative to ``base_dir``; ``bundled``: a bundled scene's name) and its provenance."""
+    if not isinstance(name, str) or not name:
+        what = "a path to a scene file (relative to the experiment file)" if kind == "file" else f"a bundled scene's name ({', '.join(bundled_scenes())})"
+        raise ExperimentError(f"{field}: must be {what}, got {name!r}")
     try:
-        return tomllib.loads(file.read_text())
-    except (FileNotFoundError, IsADirectoryError):
-        raise ExperimentError(f"experiment.scene: scene file {str(file)!r} not found") from None
-    except tomllib.TOMLDecodeError as error:
-        raise ExperimentError(f"experiment.scene: {str(file)!r} is not valid TOML: {error}") from None
+        path = base_dir / name if kind == "file" else bundled_scene_path(name)
+        scene = read_scene_table(path)
+    except SceneError as error:
+        raise ExperimentError(f"{field}: {error}") from None
+    return scene, {kind: name, "sha256": hashlib.sha256(path.read_bytes()).hexdigest()}
 
 
 # ---------------------------------------------------------------- variants

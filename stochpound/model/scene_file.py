@@ -15,6 +15,7 @@ from typing import Any, Mapping
 
 import numpy as np
 
+from stochpound._data_files import bundled_data_dir
 from stochpound._errors import RecordError, SceneError
 from stochpound._memory import check_memory, sample_bytes
 from stochpound.model import fields
@@ -48,13 +49,64 @@ def load_scene(path: str | Path) -> Scene:
         type or out of range.
     """
     path = Path(path)
+    return scene_from_dict(read_scene_table(path), base_dir=path.parent, source=path.name)
+
+
+def read_scene_table(path: str | Path) -> dict[str, Any]:
+    """The parsed TOML of a scene file, not yet validated (:func:`~stochpound.model.scene_file.scene_from_dict` validates it).
+
+    Parameters
+    ----------
+    path : str or Path
+        A TOML scene file (docs/scene-files.md).
+
+    Returns
+    -------
+    dict
+        The file's tables and fields as given (its ``[motion]`` included when it has one).
+
+    Raises
+    ------
+    SceneError
+        If the file is missing or not valid TOML (the message starts with its path).
+    """
+    path = Path(path)
     try:
-        data = tomllib.loads(path.read_text())
-    except FileNotFoundError:
+        return tomllib.loads(path.read_text())
+    except (FileNotFoundError, IsADirectoryError):
         raise SceneError(f"{path}: scene file not found") from None
     except tomllib.TOMLDecodeError as error:
         raise SceneError(f"{path}: not valid TOML: {error}") from None
-    return scene_from_dict(data, base_dir=path.parent, source=path.name)
+
+
+def bundled_scenes() -> list[str]:
+    """Names of the scenes shipped with stochpound (``data/scenes/<name>.toml``; provenance in ``data/scenes/SOURCES.md``)."""
+    folder = bundled_data_dir("scenes", "SOURCES.md")
+    return sorted(path.stem for path in folder.glob("*.toml")) if folder is not None else []
+
+
+def bundled_scene_path(name: str) -> Path:
+    """The file of the bundled scene ``name`` (an experiment's ``[scene] bundled = name``).
+
+    Parameters
+    ----------
+    name : str
+        One of :func:`~stochpound.model.bundled_scenes`, e.g. ``"elastic_pair"``.
+
+    Returns
+    -------
+    Path
+        The scene file (a scene file's buildings and contacts, without a ``[motion]``).
+
+    Raises
+    ------
+    SceneError
+        If no bundled scene has that name (the message lists them).
+    """
+    names = bundled_scenes()
+    if name not in names:  # a name, never a path into the data folder
+        raise SceneError(f"no bundled scene {name!r} (bundled: {', '.join(names) or 'none'})")
+    return bundled_data_dir("scenes", "SOURCES.md") / f"{name}.toml"
 
 
 def scene_from_dict(data: Mapping[str, Any], base_dir: str | Path = ".", source: str = "python") -> Scene:

@@ -27,7 +27,7 @@ This package is the canonical home of these names; the ones that
 there as aliases.
 """
 
-from stochpound.analysis import HazardCurve, bundled_curves, probability_from_rate, rate_from_probability, return_period
+from stochpound.hazard import HazardCurve, bundled_curves, probability_from_rate, rate_from_probability, return_period
 from stochpound.risk._fragility import Fragility, fit_fragility
 from stochpound.risk._fragility_ensemble import (
     BOOTSTRAP,
@@ -55,7 +55,7 @@ from stochpound.risk._store_risk import StoreRisk, pounding_fragility, risk_gaps
 from stochpound.risk._demands import StoreDemands, store_demands
 from stochpound.risk._limit_states import KINDS as LIMIT_STATE_KINDS, LimitState, gap_cost_frame, limit_state_risk, limit_states_from_table
 from stochpound.risk._efficiency import measure_efficiency, most_efficient
-from stochpound.analysis import hazard_consistency, stripe_rate_weights
+from stochpound.hazard import hazard_consistency, stripe_rate_weights
 from stochpound.risk._site_consistency import consistency_at_targets, site_consistency
 
 __all__ = [

@@ -32,12 +32,12 @@ from collections.abc import Sequence
 import numpy as np
 import xarray as xr
 
-from stochpound.analysis import bootstrap_method, bootstrap_weights, interval, jackknife_weights, record_clusters
+from stochpound.stats import bootstrap_method, bootstrap_weights, interval, jackknife_weights, record_clusters
 from stochpound.risk._fragility import STATUS, stripe_mle
 from stochpound.risk._fragility_ensemble import BOOTSTRAP
-from stochpound.analysis import HazardCurve, probability_from_rate, rate_from_probability, return_period
+from stochpound.hazard import HazardCurve, probability_from_rate, rate_from_probability, return_period
 from stochpound.risk._maf import fit_maf, rate_intervals
-from stochpound.analysis import EC8_REDUCTION, separation_rules
+from stochpound.codes import EC8_REDUCTION, separation_rules
 
 DESIGN_LEVELS = (0.02, 0.10)
 """Default design levels: probabilities of exceedance in 50 years (ASCE 7's MCE_R; Eurocode 8's design earthquake)."""
@@ -86,7 +86,7 @@ def code_rules_risk(demands: xr.Dataset, hz: HazardCurve, design_levels: Sequenc
     """
     for name in ("peak_displacement_left", "peak_displacement_right", "correlation", "peak_closure"):
         if name not in demands:
-            raise ValueError(f"demands: missing {name!r} (see stochpound.analysis._separation_rules.contact_demands)")
+            raise ValueError(f"demands: missing {name!r} (see stochpound.analysis.contact_demands)")
     for dim in (intensity_dim, record_dim, contact_dim):
         if dim not in demands["peak_closure"].dims:
             raise ValueError(f"demands: peak_closure has no dimension {dim!r}")

@@ -19,7 +19,7 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
-from stochpound.analysis import HazardCurve
+from stochpound.hazard import HazardCurve
 from stochpound.risk import _store
 from stochpound.risk._fragility_ensemble import BOOTSTRAP
 from stochpound.risk._maf import demand_hazard_curve

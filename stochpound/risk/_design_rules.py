@@ -36,7 +36,7 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from stochpound.analysis import HazardCurve
+from stochpound.hazard import HazardCurve
 from stochpound.model.building import Building
 from stochpound.model.scene import Scene
 from stochpound.risk import _store

@@ -16,7 +16,7 @@ own fit. The results are computed (not lazy).
 Bootstrap: the motions (records), not the runs, are resampled with
 replacement, the same resample for every stripe, threshold and
 configuration, and everything is refitted; the intervals are BCa
-percentiles of the refits (:mod:`stochpound.analysis._bootstrap`). The
+percentiles of the refits (:mod:`stochpound.stats._bootstrap`). The
 resamples are drawn from ``numpy.random.default_rng(seed)``, so a seed
 reproduces them.
 """
@@ -29,7 +29,7 @@ import numpy as np
 import xarray as xr
 from numpy.typing import ArrayLike
 
-from stochpound.analysis import bootstrap_method, bootstrap_weights, interval, jackknife_weights, kernels, record_clusters
+from stochpound.stats import bootstrap_method, bootstrap_weights, interval, jackknife_weights, kernels, record_clusters
 from stochpound.risk._fragility import DECREASING, STATUS, ida_mle, lognormal_cdf, stripe_mle
 
 BOOTSTRAP = 1000

@@ -28,10 +28,10 @@ import xarray as xr
 from numpy.typing import ArrayLike
 from scipy import optimize, special
 
-from stochpound.analysis import interval, kernels
+from stochpound.stats import interval, kernels
 from stochpound.risk._fragility import ALWAYS, DECREASING, EMPTY, NEVER, SEPARATED, STATUS
 from stochpound.risk._fragility_ensemble import BOOTSTRAP, limit_state_events, stripe_fragility
-from stochpound.analysis import HazardCurve, probability_from_rate, rate_from_probability, return_period
+from stochpound.hazard import HazardCurve, probability_from_rate, rate_from_probability, return_period
 
 TARGETS = (0.10, 0.02)
 """Default target probabilities of exceedance in ``years`` (50) of :func:`risk_targeted_separation`."""

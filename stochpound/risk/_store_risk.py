@@ -32,7 +32,7 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
-from stochpound.analysis import HazardCurve, rate_from_probability
+from stochpound.hazard import HazardCurve, rate_from_probability
 from stochpound.risk import _store
 from stochpound.risk._code_rules import MINIMUM_MOTIONS, code_rules_risk
 from stochpound.risk._design_rules import design_rules_risk

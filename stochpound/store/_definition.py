@@ -13,8 +13,10 @@ form; :meth:`Definition.to_dict` gives it back unchanged.
 
 **The identity.** :func:`definition_sha256` hashes the canonical JSON
 (:func:`canonical_json`) without the entries that no run depends on
-(:data:`NOT_IN_IDENTITY`: the ``hazard`` and the ``design``, read by the risk chain only), so a
-store's runs stay valid when only its hazard changes. A definition without
+(:data:`NOT_IN_IDENTITY`: the ``hazard`` and the ``design``, read by the risk chain only, and
+the ``scene_source``, the name and sha256 of the file a base scene was read from, whose content
+the ``scene`` entry holds), so a store's runs stay valid when only its hazard changes, and an
+experiment that inlines a scene file's content has the identity of one that names the file. A definition without
 those entries hashes exactly as before.
 
 The rules that name parts of a grid live once, and the store's namespace
@@ -37,7 +39,7 @@ from typing import Any
 from stochpound._errors import ExperimentError
 from stochpound.model.friction import is_fixed_base
 
-NOT_IN_IDENTITY = ("hazard", "design")
+NOT_IN_IDENTITY = ("hazard", "design", "scene_source", "site")
 """Entries of a canonical definition that no run depends on, left out of its identity (:func:`~stochpound.store.definition_sha256`)."""
 
 
@@ -65,6 +67,10 @@ def definition_sha256(definition: Mapping[str, Any]) -> str:
     """
     runs = {key: value for key, value in definition.items() if key not in NOT_IN_IDENTITY}
     return hashlib.sha256(canonical_json(runs).encode()).hexdigest()
+
+
+MEASURES = ("pga", "pgv", "psa", "sa_avg")
+"""The intensity measures an ``[intensity]`` (and a ``[hazard]``) table may name."""
 
 
 def describe_measure(intensity: Mapping[str, Any]) -> str:
@@ -394,6 +400,15 @@ class Definition:
         The site's hazard curve, if any (not part of the identity).
     design : mapping or None
         The ``[design]`` table's canonical entry, the buildings' code design, if any (not part of the identity).
+    scene_source : mapping or None
+        Where the base scene was read from: ``file`` (its path, relative to the experiment file) or
+        ``bundled`` (a bundled scene's name), and ``sha256`` (of the file's bytes); None: an inline
+        scene (not part of the identity: ``scene`` holds the file's content).
+    site : mapping or None
+        How the stripes' scenario was obtained, with a ``[site]`` table: ``scenario`` (``"given"`` or
+        ``"fitted"``) and, when fitted, the ``curves`` it was fitted to (not part of the identity: the
+        runs depend on the scenarios themselves, ``intensity.site``); None: no ``[site]`` table (and for
+        definitions stored before the field).
     """
 
     name: str
@@ -412,6 +427,8 @@ class Definition:
     reproduces: str | None = None
     hazard: Hazard | None = None
     design: Mapping[str, Any] | None = None
+    scene_source: Mapping[str, str] | None = None
+    site: Mapping[str, Any] | None = None
 
     def to_dict(self) -> dict[str, Any]:
         """The canonical definition (a copy): what ``parse_experiment`` returned (``stochpound.experiment._spec``)."""
@@ -508,4 +525,6 @@ def _from_dict(data: dict[str, Any]) -> Definition:
         reproduces=data.get("reproduces"),
         hazard=Hazard.from_entry(data["hazard"]) if data.get("hazard") is not None else None,
         design=data.get("design"),
+        scene_source=data.get("scene_source"),
+        site=data.get("site"),
     )

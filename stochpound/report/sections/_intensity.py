@@ -30,7 +30,7 @@ import pandas as pd
 import xarray as xr
 from matplotlib.figure import Figure
 
-from stochpound.analysis.kernels import clopper_pearson
+from stochpound.stats.kernels import clopper_pearson
 from stochpound.experiment import describe_measure
 from stochpound.report.render import FigureItem, Paragraph, Section, Table
 from stochpound.report.sections._stripe_motions import stripe_motions_text

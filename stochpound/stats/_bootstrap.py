@@ -38,7 +38,7 @@ def bootstrap_weights(motions: int, resamples: int, seed: int | Sequence[int], c
     are correlated; resampling them as if independent makes intervals too
     narrow. Singleton clusters in motion order give exactly the plain
     resampler's weights. The fragility and risk bootstraps and the percentile
-    bootstrap of the mean (:func:`stochpound.analysis.kernels.bootstrap_mean_interval`)
+    bootstrap of the mean (:func:`stochpound.stats.kernels.bootstrap_mean_interval`)
     all use it.
 
     Parameters

@@ -24,7 +24,7 @@ import xarray as xr
 from numpy.typing import ArrayLike
 from scipy.linalg import eigh
 
-from stochpound.analysis._correlation import correlation
+from stochpound.stats import correlation
 from stochpound.model.building import Building, storey_matrix
 from stochpound.model.scene import Scene
 
