@@ -38,7 +38,7 @@ from stochpound.risk._fragility_ensemble import (
     limit_state_events,
     stripe_fragility,
 )
-from stochpound.risk._maf import TARGETS, degenerate_text, demand_hazard_curve, mean_annual_frequency, rate_intervals, risk_curve, risk_targeted_separation
+from stochpound.risk._maf import TARGETS, degenerate_text, demand_hazard_curve, flat_fit_maf, mean_annual_frequency, rate_intervals, risk_curve, risk_targeted_separation
 from stochpound.risk._code_rules import code_rules_risk
 from stochpound.risk._code_gaps import (
     Asce7Design,
@@ -74,6 +74,7 @@ __all__ = [
     "return_period",
     "demand_hazard_curve",
     "mean_annual_frequency",
+    "flat_fit_maf",
     "risk_curve",
     "rate_intervals",
     "degenerate_text",

@@ -297,12 +297,36 @@ def free_base_displacement(store: xr.Dataset, studied: str | None) -> tuple[xr.D
     """The studied building's wall-free peak base displacement for D_TM (:func:`base_displacement`), or None and why not.
 
     A moat wall caps the displacement D_TM is to size: with walls at its
-    base and no wall-free runs there is none ("" as the reason where the
+    base, each configuration takes the displacement of its wall-free twin
+    (``inf`` on the wall axes, or the value of a variant axis that sets no
+    wall), and without one there is none ("" as the reason where the
     building simply does not slide).
     """
     if moat_clearances(store, studied) and not has_wall_free(store):
-        return None, "the store has no wall-free runs (a moat wall caps the displacement D_TM is to size): add inf to the wall axis"
+        axis = _wall_free_variant(store, studied)
+        if axis is None:
+            return None, ("the store has no wall-free runs (a moat wall caps the displacement D_TM is to size): add inf to the wall axis, "
+                          "or a variant without the wall")
+        name, free = axis
+        displacement = base_displacement(store.sel({name: free}), studied)
+        return (None if displacement is None else displacement.expand_dims({name: store[name].values})), ""
     return base_displacement(store, studied, walls_free=True), ""
+
+
+def _wall_free_variant(store: xr.Dataset, studied: str | None) -> tuple[str, str] | None:
+    """A variant axis whose values alone set the walls at the studied building's base, with its value that sets none (the
+    wall-free twin of the others: D_TM is the displacement without the wall), or None (walls in the base scene, or no such axis)."""
+    definition = store.pound.definition
+    if any(w.get("building") == studied and w.get("level", 0) == 0 for w in definition.scene.get("wall", []) or []):
+        return None
+    for variant in definition.variants:
+        walled = {value: any(w.get("building") == studied and w.get("level", 0) == 0
+                             for w in variant.overrides.get(value, {}).get("scene", {}).get("wall", []) or [])
+                  for value in variant.values}
+        free = [value for value, has in walled.items() if not has]
+        if free and len(free) < len(walled) and variant.name in store.dims:
+            return variant.name, free[0]
+    return None
 
 
 def stored_demands(store: xr.Dataset) -> dict[str, tuple[xr.DataArray, str]]:
