@@ -33,6 +33,10 @@ class VerificationError(StochpoundError):
     """A self-check of a report disagrees with what it checks (e.g. a stored case re-run does not reproduce the store)."""
 
 
+class IntensityError(ValueError):
+    """An ``[intensity]`` (or ``[hazard]``) field is invalid (the message starts with the field)."""
+
+
 class SiteError(StochpoundError, ValueError):
     """A site scenario, a conditional-spectrum target or a motion selection is invalid;
     the message names the field, e.g. ``magnitude: must be within 3.5-8.5, got 9``."""

@@ -1,18 +1,27 @@
-"""The registry of published studies, by id and parts: metadata only, at the bottom of the house.
+"""The registry of published studies, by id and parts, at the bottom of the house: the plug-in point of the studies.
 
 An experiment file may declare the part of a study it reproduces
 (``[experiment] reproduces = "<study>:<part>"``); reading the file checks
-the declaration against :data:`STUDIES` here, without importing the studies'
-packages (``stochpound.studies``, which builds their reports on top of the
-report package, re-exports these names and loads a study's package on use).
+the declaration against :data:`STUDIES` here, and the report asks
+:func:`claims` which stores each study claims and :func:`load_study` for the
+study's package (``stochpound.studies.<key>``, imported by its registered
+name on first use). So neither the experiment reader, nor the report, nor
+the deprecated names of ``stochpound.motions.records`` import the studies'
+packages, which build their reports on top of the report package:
+``stochpound.studies`` re-exports these names.
 """
 
 from __future__ import annotations
 
+import importlib
+from collections.abc import Mapping
 from dataclasses import dataclass
+from types import ModuleType
 from typing import Any
 
-__all__ = ["STUDIES", "Study", "parse_reproduces"]
+from stochpound._errors import StochpoundError
+
+__all__ = ["STUDIES", "Study", "claims", "load_study", "parse_reproduces"]
 
 
 @dataclass(frozen=True)
@@ -68,3 +77,44 @@ def parse_reproduces(value: Any) -> tuple[str, str]:
     if study not in STUDIES or part not in STUDIES[study].parts:
         raise ValueError(f"must be one of {_allowed()}, got {value!r}")
     return study, part
+
+
+def claims(declared: Mapping[str, str | None]) -> dict[str, dict[str, str]]:
+    """Which stores each study claims, by their declarations.
+
+    Parameters
+    ----------
+    declared : mapping of str to str or None
+        Each store's experiment name and its ``reproduces`` declaration (None: none).
+
+    Returns
+    -------
+    dict
+        For each study with at least one store, in the order of first appearance:
+        the experiment name of each part present, by part.
+
+    Raises
+    ------
+    StochpoundError
+        If a declaration is not a registered part, or two stores reproduce the same part.
+    """
+    claimed: dict[str, dict[str, str]] = {}
+    for name, reproduces in declared.items():
+        if reproduces is None:
+            continue
+        try:
+            study, part = parse_reproduces(reproduces)
+        except ValueError as error:
+            raise StochpoundError(f"experiment {name}: reproduces {error}") from None
+        parts = claimed.setdefault(study, {})
+        if part in parts:
+            raise StochpoundError(f"experiments {parts[part]} and {name} both reproduce {study}:{part}; report one of them at a time")
+        parts[part] = name
+    return claimed
+
+
+def load_study(key: str) -> ModuleType:
+    """The package of the study ``key`` (:data:`STUDIES`), imported on first use: a :class:`stochpound.studies.StudyReport`."""
+    if key not in STUDIES:
+        raise StochpoundError(f"unknown study {key!r} (studies: {', '.join(STUDIES)})")
+    return importlib.import_module(f"stochpound.studies.{key}")

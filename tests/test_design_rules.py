@@ -149,7 +149,8 @@ def test_stochpound_risk_prints_the_codes_gaps_beside_the_suite_mean_rules(desig
                  "2 %/50 yr (design analysis)", "10 %/50 yr (design analysis)"):
         assert text in result.output
     period = float(risk.design_rules["return_period"].sel(rule="asce7_delta_mt"))
-    assert f"ASCE 7 §12.12.3 δ_MT of the design analysis, once in {period:.3g} years" in result.output.replace("\n", " ")
+    assert f"ASCE 7 §12.12.3 δ_MT of the design analysis, pounding once in {period:.3g} years" in result.output.replace("\n", " ")
+    assert "note: D_TM is not applied: the studied building's base slides in no run of this store (a fixed base" in result.output  # why no D_TM row
 
 
 def test_stochpound_risk_takes_a_design_file_and_refuses_a_bad_one(design_store, tmp_path):
@@ -180,3 +181,20 @@ def test_editing_the_design_keeps_the_runs_and_records_it(tmp_path):
     with open_store(store) as ds:
         assert ds.pound.definition.design["cd"] == 5.5 and ds.pound.definition.design["ec8"]["q"] == 4.0
         xr.testing.assert_identical(ds["peak_contact_closure"].load(), before)
+
+
+def test_the_flagship_s_d_m_in_the_docs_is_eq_17_5_1_s():
+    """docs/risk.md once gave β_eff 12–17 % and D_M 0.55–0.65 m for the flagship's pendulum; eq. 17.5-1 gives what it says now."""
+    import re
+    from pathlib import Path
+
+    from stochpound.risk import asce7_isolator_displacement
+    from stochpound.risk._code_gaps import damping_coefficient
+
+    docs = re.sub(r"\s+", " ", (Path(__file__).resolve().parents[1] / "docs" / "risk.md").read_text())
+    for mu in (0.08, 0.05):
+        displacement, period, damping = asce7_isolator_displacement(1.0, mu, 2.24, 1.20306)
+        stated = (f"μ = {mu:g} gives T_M = {period:.2f} s, β_M = {100 * damping:.2g} %, B_M = {damping_coefficient(damping):.2f} and "
+                  f"D_M = {displacement:.2f} m")
+        assert stated in docs, stated
+    assert "12–17 %" not in docs and "0.55–0.65 m" not in docs

@@ -82,9 +82,14 @@ def test_experiment_files_keep_their_identity() -> None:
         source = definition.pop("scene_source", None)  # new since the pins, outside the identity: the scene file's name and sha256
         scene_path = tomllib.loads(path.read_text()).get("experiment", {}).get("scene")
         assert source == (None if scene_path is None else {"file": scene_path, "sha256": hashlib.sha256((path.parent / scene_path).read_bytes()).hexdigest()}), path
+        site = definition.pop("site", None)  # new since the pins, outside the identity: how the [site] scenario was obtained
+        table = tomllib.loads(path.read_text()).get("site")
+        assert site == (None if table is None else {"scenario": "fitted", "curves": table["curves"]} if table.get("scenario") == "fitted"
+                        else {"scenario": "given"}), path
         assert hashlib.sha256(canonical_json(definition).encode()).hexdigest() == pinned, path
-        if source is not None:
-            assert definition_sha256({**definition, "scene_source": source}) == definition_sha256(definition), path
+        for key, value in (("scene_source", source), ("site", site)):
+            if value is not None:
+                assert definition_sha256({**definition, key: value}) == definition_sha256(definition), path
         assert ("hazard" in definition) == (file_sha256 in HAZARD_IDENTITIES), path
         assert definition_sha256(definition) == HAZARD_IDENTITIES.get(file_sha256, pinned), path
         checked += 1

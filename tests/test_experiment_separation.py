@@ -99,6 +99,9 @@ def test_report_has_a_separation_section_built_from_the_store(contact_free_store
     assert f"{compared} runs with contacts were compared" in text and "every one pounds exactly when D ≥ g" in text
     assert "sliding bases" in text and f"{needed:.1f} cm" in text
     assert "ASCE 7 (§17.2.5.2)" in text and "no such theory" not in text and "ABS is never reached" in text
+    # §17.2.5.2's scope: the isolated structure against retaining walls and fixed obstructions, not adjacent (moving) structures
+    assert "between an isolated structure and the retaining walls or other fixed obstructions around it" in text
+    assert "separation from adjacent structures" not in text and "gives no combination rule for a neighbour that moves too" in text
     assert "the grid's own gaps" in text.lower()  # the two answers to the gap question, related
     dimensions = next(block.text for block in experiment.blocks if isinstance(block, Paragraph) and "Dimensions:" in block.text)
     assert f"gap ({len(GAPS) + 1}: {len(GAPS)} gaps here and the contact-free one" in dimensions

@@ -26,8 +26,9 @@ SELECTION = 'measure = "psa"\nperiod = 0.5\nlevels = [0.4, 0.2]\nselection = "co
 SITE = '[site]\nvs30 = 400.0\nmagnitude = [7.0, 6.6]\ndistance_km = 20.0\nmechanism = "strike_slip"\n'
 
 
-def _text(intensity: str = SELECTION, site: str = SITE) -> str:
-    return f'[experiment]\nname = "site"\n{SCENE}\n[grid]\ngap = ["inf"]\n{RECORDS}\n[intensity]\n{intensity}\n{site}\n[solver]\nmethod = "exact"\n'
+def _text(intensity: str | None = SELECTION, site: str = SITE) -> str:
+    table = "" if intensity is None else f"[intensity]\n{intensity}\n"  # None: no [intensity] table
+    return f'[experiment]\nname = "site"\n{SCENE}\n[grid]\ngap = ["inf"]\n{RECORDS}\n{table}{site}\n[solver]\nmethod = "exact"\n'
 
 
 def test_each_stripe_runs_its_chosen_motions_and_the_store_keeps_the_selection(tmp_path) -> None:
@@ -101,6 +102,7 @@ def test_the_default_selection_adds_nothing_to_the_definition(tmp_path) -> None:
         ('measure = "pgv"\nlevels = [0.2]\nselection = "conditional_spectrum"\nmotions = 4\nmax_scale_factor = 5.0', SITE, "intensity.measure:"),
         ('measure = "psa"\nperiod = 0.5\nlevels = [0.2]', SITE, "site:"),
         ('measure = "psa"\nperiod = 0.5\nlevels = [0.2]\nmotions = 4', "", "intensity.motions:"),
+        (None, SITE, "site:"),
     ],
 )
 def test_bad_input_is_one_line_naming_the_field(tmp_path, intensity: str, site: str, field: str) -> None:

@@ -2,10 +2,12 @@
 
 from __future__ import annotations
 
+import json
 import tomllib
 
 import numpy as np
 import pytest
+import xarray as xr
 
 from stochpound._errors import SiteError
 from stochpound.analysis import HazardCurve, stripe_rate_weights
@@ -100,6 +102,26 @@ def test_a_fitted_site_stores_the_fitted_scenario_of_every_level(tmp_path) -> No
     levels = np.array([0.4, 0.9])
     fine = fit_levels(levels, hazard.support[1])
     assert scenarios == fit_scenarios("psa", 1.0, levels, fine, stripe_rate_weights(fine, hazard), others, 400.0, "reverse")
+
+
+def test_the_definition_keeps_how_the_scenario_was_obtained_as_data_outside_the_identity(tmp_path) -> None:
+    """The scenario's kind is the definition's ``site`` entry (read by the risk assumptions, not guessed from the note's prose),
+    and it leaves the identity as it was: a definition without the entry (a store written before it) hashes the same."""
+    from stochpound.risk._store import _scenario_words
+    from stochpound.store import definition_sha256, read_definition
+
+    fitted = parse_experiment(tomllib.loads(_text(FITTED_SELECTION, FITTED_SITE)), tmp_path)
+    given = parse_experiment(tomllib.loads(_text(FITTED_SELECTION, '[site]\nvs30 = 400.0\nmagnitude = 7.0\ndistance_km = 10.0\nmechanism = "reverse"\n')), tmp_path)
+    assert fitted["site"] == {"scenario": "fitted", "curves": json.loads(CURVES)} and given["site"] == {"scenario": "given"}
+    assert read_definition(fitted).site["scenario"] == "fitted"
+    for definition in (fitted, given):
+        before = {key: value for key, value in definition.items() if key != "site"}
+        assert definition_sha256(definition) == definition_sha256(before) and read_definition(before).site is None
+    store = xr.Dataset({"site_magnitude": ("intensity", [7.5, 8.0]), "site_distance_km": ("intensity", [30.0, 30.0]),
+                        "site_vs30": ("intensity", [400.0, 400.0])})
+    assert _scenario_words(store, "fitted") == "M 7.5–8, R 30 km, Vs30 400 m/s, fitted to the site's hazard curves (a calibration standing in for a disaggregation)"
+    assert "an assumption unless" in _scenario_words(store, "given") and "not recorded" in _scenario_words(store, None)
+    assert _scenario_words(xr.Dataset(), "given").startswith("as the [site] table gives it")
 
 
 @pytest.mark.parametrize(

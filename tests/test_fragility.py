@@ -8,8 +8,8 @@ import xarray as xr
 from scipy import optimize, special, stats
 
 from stochpound.analysis import Fragility, fit_fragility, fragility_band, fragility_surface, homogeneous_capacities, ida_fragility, limit_state_events, stripe_fragility
-from stochpound.analysis import kernels
-from stochpound.analysis._bootstrap import bootstrap_weights
+from stochpound.stats import kernels
+from stochpound.stats._bootstrap import bootstrap_weights
 from stochpound.risk._fragility import ALWAYS, DECREASING, FIT, NEVER, SEPARATED, stripe_mle
 
 

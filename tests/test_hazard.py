@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from stochpound.analysis import HazardCurve, probability_from_rate, rate_from_probability, return_period
-from stochpound.analysis._hazard import bundled_curves
+from stochpound.hazard._curve import bundled_curves
 
 
 def test_poisson_helpers_give_the_code_rates():

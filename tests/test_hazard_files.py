@@ -13,12 +13,12 @@ import numpy as np
 import pytest
 
 from stochpound.analysis import HazardCurve
-from stochpound.analysis._hazard_files import (
+from stochpound.hazard._files import (
     parse_measure,
     read_hazard_file,
     unit_factor,
 )
-from stochpound.experiment._hazard import hazard_curve, hazard_option
+from stochpound.hazard._setting import hazard_curve, hazard_option
 from stochpound.experiment._intensity import IntensityError
 from stochpound.experiment._spec import ExperimentError, parse_experiment
 from tests.helpers import ISOLATED, risk_text as _text

@@ -134,3 +134,19 @@ def test_the_per_cell_tables_of_a_walls_only_store_name_wall_hits(report):
         assert "P(wall hit)" in heads and "P(pounding)" not in heads
         assert not any("phase" in head for head in heads) and "peak wall force, given a wall hit (kN)" in heads
         assert "wall hit" in table.caption and "pounding" not in table.caption and "P(pounding)" not in table.note
+
+
+def test_the_clearance_table_s_footnote_states_the_rule_its_empty_bounds_follow(report):
+    """Table 11's footnote said pⁿ for the upper bound; it is (1 − p)ⁿ: the bound is empty exactly where that exceeds (1 − c)/2."""
+    tables = [b for s in report.sections for b in s.blocks if isinstance(b, Table) and b.key.endswith("-clearance")]
+    assert tables
+    for table in tables:
+        assert "the upper bound needs (1 − p)ⁿ ≤ 0.025, the lower bound pⁿ ≤ 0.025" in table.note
+        frame = table.frame
+        n = frame[("realizations", "n")].to_numpy(dtype=float)
+        heads = {h for h, _ in frame.columns if h.startswith("clearance for P(wall hit) = ")}
+        assert len(heads) >= 2
+        for head in heads:
+            p = float(re.search(r"= ([0-9.]+) \(cm\)", head).group(1))
+            np.testing.assert_array_equal(np.isnan(frame[(head, "upper")].to_numpy(dtype=float)), (1 - p) ** n > 0.025)
+            np.testing.assert_array_equal(np.isnan(frame[(head, "lower")].to_numpy(dtype=float)), p**n > 0.025)

@@ -9,6 +9,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pytest
 import pandas as pd
 import xarray as xr
 
@@ -40,6 +41,44 @@ def test_a_degenerate_fit_is_named_a_step_with_the_rate_it_actually_gives():
     assert degenerate_text(np.array([FIT, FIT]), HAZARD) == ""
 
 
+def test_a_decreasing_fit_has_the_rate_of_its_flat_fit_stated_not_a_dash():
+    """19, 19 and 19 of 20 at three stripes: the probit's slope is not positive; the fit among fragilities that do not fall with
+    intensity is flat at 57/60, so λ = 0.95 × the hazard's rate at its table's lowest intensity, in the chain and in the words."""
+    from stochpound.risk import code_rules_risk, flat_fit_maf, stripe_fragility
+    from stochpound.risk._fragility import DECREASING
+    from stochpound.risk._store_risk import fit_name
+
+    levels = np.array([0.2, 0.5, 1.0])
+    events = np.ones((3, 20))
+    events[0, 3] = events[1, 11] = events[2, 17] = 0.0  # 19 of 20 at every stripe, the misses at different motions
+    fragility = stripe_fragility(xr.DataArray(events, dims=("intensity", "record"), coords={"intensity": levels}), bootstrap=0)
+    assert int(fragility["status"]) == DECREASING and np.isnan(float(fragility["theta"]))
+    rate = float(mean_annual_frequency(fragility, HAZARD))
+    assert math.isclose(rate, 57 / 60 * 0.0333, rel_tol=1e-12)  # p̄ λ(lo), by hand
+    assert math.isclose(float(flat_fit_maf([19, 19, 19], [20, 20, 20], HAZARD)), rate, rel_tol=1e-12)
+    text = degenerate_text(np.array([FIT, DECREASING]), HAZARD)
+    assert "1 of 2 gaps: a flat fit 'decreasing'" in text and "p̄ × 0.0333 /yr" in text and "upper bound" in text
+    assert "a step 'decreasing'" not in text and "NaN" not in text
+    assert fit_name(DECREASING) == "flat: decreasing (F ≡ fraction of runs that pounded)"
+    # the band: a resample whose fit is decreasing too has its flat fit's rate, not NaN (left out of the interval)
+    from stochpound.risk import risk_curve
+
+    sampled = stripe_fragility(xr.DataArray(events, dims=("intensity", "record"), coords={"intensity": levels}), bootstrap=60, seed=3)
+    curve = risk_curve(sampled, HAZARD)
+    flat = sampled["flat_bootstrap"]
+    assert int(flat.notnull().sum()) > 0 and bool(np.isfinite(curve["maf_bootstrap"]).all())
+    np.testing.assert_allclose(curve["maf_bootstrap"].where(flat.notnull()).dropna("bootstrap"), (flat * 0.0333).dropna("bootstrap"), rtol=1e-12)
+    assert float(curve["maf_lower"]) <= rate <= float(curve["maf_upper"])
+    # a code rule whose gap pounds 19 of 20 at every stripe: the rules table gets the flat fit's rate, not NaN ("–")
+    closure = xr.DataArray(np.where(events > 0, 0.30, 0.01)[..., None], dims=("intensity", "record", "contact"),
+                           coords={"intensity": levels, "contact": [0]})
+    demands = xr.Dataset({"peak_closure": closure, "peak_displacement_left": closure * 0 + 0.05, "peak_displacement_right": closure * 0 + 0.05,
+                          "correlation": closure * 0.0})
+    rules = code_rules_risk(demands, HAZARD, bootstrap=0)
+    assert (rules["status"] == DECREASING).all()
+    np.testing.assert_allclose(rules["maf"], 57 / 60 * 0.0333, rtol=1e-12)
+
+
 def _risk(rules: xr.Dataset | None = None) -> StoreRisk:
     """A hand-made chain: g* 0.20 m [0.15, 0.31] for 10 %/50 yr and 0.40 m [0.30, 0.62] for 2 %/50 yr, one configuration."""
     target = xr.DataArray([0.10, 0.02], dims="target", name="target")
@@ -59,6 +98,10 @@ def test_the_gap_to_design_to_is_the_upper_bound_of_g_star_stated_as_such():
     unbounded = _risk()
     unbounded.separation = unbounded.separation.drop_vars(["lower", "upper"])
     assert list(unbounded.design_frame()["design"]) == [0.20, 0.40] and "no bootstrap" in design_value_text(unbounded)
+    assert "g* is a central estimate from 22 motions and" in text
+    selected = _risk()
+    selected.setting = {"selection": "conditional_spectrum", "units": "g"}  # motions chosen per stripe from a pool
+    assert "g* is a central estimate from 22 motions per stripe and" in design_value_text(selected)
 
 
 def test_the_wall_free_d_tm_is_compared_with_the_moat_and_the_wall_governs_a_target_it_is_hit_more_often_than():
@@ -68,13 +111,16 @@ def test_the_wall_free_d_tm_is_compared_with_the_moat_and_the_wall_governs_a_tar
     moat = rate_intervals(moat.assign(maf_lower=moat["maf"] / 2, maf_upper=moat["maf"] * 2), 50.0)
     text = moat_text(_risk(rules), StoreDemands({}, {}, moat))
     assert "at 10 %/50 yr is 0.45 m and is within the moat clearance 0.6 m" in text
-    assert "at 2 %/50 yr is 0.92 m and exceeds the moat clearance 0.6 m" in text
+    assert "at 2 %/50 yr is 0.92 m and exceeds the moat clearance 0.6 m" in text  # one value over the configurations: no "largest"
+    varied = xr.Dataset({"gap": (("design_level", "rule", "mu"), [[[0.45, 0.40], [0.1, 0.1]], [[0.92, 0.70], [0.2, 0.2]]])},
+                        coords={"design_level": [0.10, 0.02], "rule": ["dtm", "abs"], "mu": [0.05, 0.12]})
+    assert "at 2 %/50 yr (the largest over the configurations) is 0.92 m" in moat_text(_risk(varied), StoreDemands({}, {}, moat))
     # 1/918 /yr against 10 %/50 yr (once in 475 yr) and 2 %/50 yr (once in 2475 yr): governs only the rarer target
     assert "once in 918 [459, 1.84e+03] yr (worst configuration), less often than the target allows (once in 475 yr): the wall does not govern" in text
     assert "once in 918 [459, 1.84e+03] yr (worst configuration), more often than the target allows (once in 2.47e+03 yr): the wall, not the gap, governs" in text
     summary = design_summary_text(_risk(), StoreDemands({}, {}, moat))
     assert ("Governing limit state: pounding between the buildings for 10 % in 50 yr; the moat wall (0.6 m clearance, reached once in "
-            "918 yr) for 2 % in 50 yr.") in summary
+            "918 [459, 1.84e+03] yr) for 2 % in 50 yr.") in summary  # the return period with its interval
     assert "Governing limit state: pounding between the buildings for 10 % in 50 yr; pounding between the buildings for 2 %" in \
         design_summary_text(_risk(), None)
     single = StoreDemands({}, {}, moat.isel(mu=0, drop=True)).moat_frame()  # one configuration: a plain index
@@ -115,6 +161,52 @@ WALLS = "".join(f'\n[[scene.wall]]\nbuilding = "B1"\nside = "{side}"\nlevel = 0\
                 for side in ("left", "right"))
 
 
+def test_the_rules_paragraph_says_which_rules_its_range_covers_and_the_g_star_table_how_it_resampled():
+    """Read as the owner would: 'Over the rules ... the return periods range from 339' while a design-analysis row said 58.7 yr;
+    'each rule means pounding ASCE 7 ...' garbled; Table 1 said 'the motions resampled' of a cluster bootstrap over events."""
+    from stochpound.report.sections._risk import _rules_blocks, _separation_table
+
+    dims = ("design_level", "rule", "contact")
+    rules = xr.Dataset({"gap": (dims, np.full((1, 1, 1), 0.3)), "status": (dims[:2], np.array([[FIT]], dtype=np.int8))},
+                       coords={"design_level": [0.02], "rule": ["srss"], "contact": [0], "code_intensity": ("design_level", [0.8]),
+                               "stripe_intensity": ("design_level", [0.8])})
+    maf = xr.DataArray([[1e-3]], dims=dims[:2])
+    rules = rules.assign(maf=maf, return_period=1 / maf, probability=1 - np.exp(-50 * maf))
+    risk = _risk(rules)
+    risk.design_rules = xr.Dataset({"gap": (("rule", "contact"), [[0.05]]), "maf": ("rule", [1 / 60.0]), "return_period": ("rule", [60.0]),
+                                    "probability": ("rule", [1 - math.exp(-50 / 60.0)]), "status": ("rule", np.array([FIT], dtype=np.int8))},
+                                   coords={"rule": ["asce7_delta_mt"], "contact": [0], "design_level": ("rule", [0.02])})
+    text = _rules_blocks("pair", risk)[0].text
+    assert "Over the suite-mean rules, levels and configurations, the return periods range from 1e+03 to 1e+03 years" in text
+    assert "Over the rules," not in text and "each rule means pounding" not in text
+    assert "here: ASCE 7 §12.12.3 δ_MT of the design analysis, pounding once in 60 years." in text
+    risk.separation["lower"].attrs["method"] = "BCa cluster bootstrap over events (3 clusters of the 22 motions that ran)"
+    risk.curve = xr.Dataset(coords={"gap": [0.1, 0.5]})
+    caption = _separation_table("pair", risk).caption
+    assert caption.endswith("with its 95 % interval (BCa cluster bootstrap over events (3 clusters of the 22 motions that ran))")
+    assert "the motions resampled" not in caption
+
+
+def test_d_tm_where_the_base_never_slides_is_left_out_and_said_why_not_a_dash():
+    """μ ∈ {∞, 0.05}: on the fixed base D_TM has nothing to size; its rows go, and the text says where and why."""
+    dims = ("design_level", "rule", "mu", "contact")
+    gap = np.full((1, 2, 2, 1), 0.3)
+    gap[0, 1, 0, 0] = np.nan  # dtm at μ = ∞
+    maf = xr.DataArray(np.where(np.isnan(gap[..., 0]), np.nan, 1e-3), dims=dims[:3])
+    rules = xr.Dataset({"gap": (dims, gap), "status": (dims[:3], np.where(np.isnan(gap[..., 0]), 5, FIT).astype(np.int8))},
+                       coords={"design_level": [0.02], "rule": ["abs", "dtm"], "mu": [np.inf, 0.05], "contact": [0],
+                               "code_intensity": ("design_level", [0.8]), "stripe_intensity": ("design_level", [0.8])})
+    rules = rate_intervals(rules.assign(maf=maf, maf_lower=maf / 2, maf_upper=maf * 2, return_period=1 / maf, probability=1 - np.exp(-50 * maf)), 50.0)
+    risk = _risk(rules)
+    frame = risk.rules_frame()
+    dtm = frame.xs("D_TM of the suite-mean base displacement (ASCE 7 §17.2.5.2 form)", level="rule")
+    assert list(dtm.index.get_level_values("mu")) == [0.05] and frame["λ_P (1/yr)"].notna().all()  # no row of dashes
+    text = risk.dtm_text()
+    assert "left out where the studied building's base never slid in any run (mu ∞)" in text and "fixed base (μ = ∞)" in text
+    assert _risk(rules.sel(mu=[0.05])).dtm_text() == ""
+    assert "base slides in no run of this store" in _risk(rules.sel(rule=["abs"])).dtm_text()
+
+
 def test_d_tm_is_not_taken_from_runs_a_moat_wall_capped(tmp_path):
     from stochpound import open_store
     from stochpound.risk import store_demands, store_risk
@@ -127,12 +219,71 @@ def test_d_tm_is_not_taken_from_runs_a_moat_wall_capped(tmp_path):
     assert moat_text(risk, store_demands(store, bootstrap=0)) == ""
 
 
-def test_the_assumptions_say_the_base_the_grid_leaves_and_the_scenario_the_stripes_were_selected_for():
-    """A building with a base that the grid's μ = ∞ fixes is on a fixed base (the flagship's fixed pair was said to be on a
-    sliding base), and a selection's scenario is named with where it comes from (it was said to be "none stated")."""
-    import xarray as xr
+@pytest.fixture(scope="module")
+def moat_variant_store(tmp_path_factory):
+    """The flagship's layout in small: B1 on a friction pendulum, its moat a variant axis {none, wall} (0.1 m walls), gap = ∞."""
+    from stochpound import open_store
+    from tests.helpers import ISOLATED, risk_text, run_in_process
 
-    from stochpound.risk._store import _base_words, _scenario_words
+    variants = "\n[variants.moat.none]\n" + WALLS.replace("[[scene.wall]]", "[[variants.moat.wall.scene.wall]]")
+    text = risk_text(ISOLATED + variants, "gap = [inf]", 'measure = "psa"\nperiod = 1.0\nlevels = [0.3, 0.8, 1.5]')
+    return open_store(run_in_process(tmp_path_factory.mktemp("moat"), "moat_variant", text))
+
+
+def test_d_tm_of_a_moat_variant_is_its_wall_free_twins_and_is_compared_with_the_moat(moat_variant_store):
+    """The flagship's moat is a variant axis {none, wall}: the report said 'the store has no wall-free runs' and left D_TM and its
+    comparison with the moat out. Each configuration's D_TM is now the suite-mean base displacement of its wall-free twin."""
+    from stochpound.risk import store_demands, store_risk
+
+    store = moat_variant_store
+    risk = store_risk(store, bootstrap=0)
+    assert risk.dtm_note == "" and "dtm" in risk.rules["rule"].values
+    dtm = risk.rules["gap"].sel(rule="dtm")
+    np.testing.assert_array_equal(dtm.sel(moat="wall").values, dtm.sel(moat="none").values)  # the wall's twin's displacement
+    slid = store["peak_sliding_displacement"].sel(building="B1", moat="none", gap=np.inf).squeeze(drop=True)
+    stripe = float(risk.rules["stripe_intensity"].sel(design_level=0.02))
+    by_hand = float(slid.sel(intensity=stripe).mean())  # the suite mean of the wall-free runs at the rule's stripe
+    np.testing.assert_allclose(dtm.sel(design_level=0.02, moat="wall").values, by_hand, rtol=1e-12)
+    moat = moat_text(risk, store_demands(store, bootstrap=0))
+    assert "The wall-free D_TM (suite-mean peak base displacement without the wall) at 2 %/50 yr is" in moat and "moat clearance 0.1 m" in moat
+
+
+def test_the_stripes_table_does_not_call_wall_hits_pounding(moat_variant_store):
+    """At gap = ∞ the contacts never close: every impact of a run with the moat wall is a wall hit. The stripes table said
+    'pounded' and 'P(pounding)' for them; it now says impacts, and counts the wall hits apart."""
+    from stochpound.report.sections._intensity import intensity_section
+
+    store = moat_variant_store
+    table = next(b for b in intensity_section("moat", store).blocks if getattr(b, "key", "").startswith("intensity-stripes"))
+    frame = table.frame
+    assert "pounded" not in frame.columns and "P(pounding)" not in frame.columns and "pounding" not in table.caption
+    hits = ((store["peak_wall_penetration"] > 0) & (store["case_status"] == 1)).sum(("record", "realization")).sel(moat="wall")
+    assert int(hits.sum()) > 0  # the small store does hit its 0.1 m walls
+    np.testing.assert_array_equal(frame["wall hit"].xs("wall", level="moat").to_numpy(), hits.values.ravel())
+    np.testing.assert_array_equal(frame["impacted"].xs("wall", level="moat").to_numpy(), hits.values.ravel())  # gap = ∞: only walls
+
+
+def test_the_design_rows_say_why_there_is_no_eurocode_8_row():
+    """The Los Angeles flagship's [design] is ASCE 7's: EC8's row was left out silently; now the text says why and how to add it."""
+    def design(rules: list[str]) -> xr.Dataset:
+        shape = (len(rules), 1)
+        return xr.Dataset({"gap": (("rule", "contact"), np.full(shape, 0.1)), "return_period": ("rule", np.full(len(rules), 500.0))},
+                          coords={"rule": rules, "contact": [0]})
+
+    risk = _risk()
+    risk.design_rules = design(["asce7_delta_mt"])
+    text = risk.design_rules_text()
+    assert "here: ASCE 7 §12.12.3 δ_MT of the design analysis, pounding once in 500 years." in text
+    assert "(ASCE 7-16 §12.12.3: δ_M = C_d δ_max / I_e, SRSS of the two buildings), not from the runs" in text  # only the rules it has
+    assert "There is no Eurocode 8 §4.4.2.7 row: the store's [design] has no ec8 entry" in text and "give [design] an ec8 = { ag, ground, q }" in text
+    risk.design_rules = design(["asce7_delta_mt", "ec8_ds"])
+    assert "no Eurocode 8" not in risk.design_rules_text()
+
+
+def test_the_assumptions_say_the_base_the_grid_leaves():
+    """A building with a base that the grid's μ = ∞ fixes is on a fixed base (the flagship's fixed pair was said to be on a
+    sliding base); the scenario's words: tests/test_fitted_scenarios.py."""
+    from stochpound.risk._store import _base_words
     from stochpound.store import MuAxis
 
     building = {"name": "B1", "base": {"mu": 0.05}}
@@ -140,8 +291,3 @@ def test_the_assumptions_say_the_base_the_grid_leaves_and_the_scenario_the_strip
     assert _base_words(MuAxis((0.05, 0.08), ("B1",)), building) == "a sliding base (μ 0.05, 0.08 on the grid)"
     assert _base_words(MuAxis((0.05, float("inf")), None), building) == "a sliding base (μ 0.05 on the grid) or a fixed base"
     assert _base_words(None, {"name": "B2"}) == "a fixed base"
-    store = xr.Dataset({"site_magnitude": ("intensity", [7.5, 8.0]), "site_distance_km": ("intensity", [30.0, 30.0]),
-                        "site_vs30": ("intensity", [400.0, 400.0])})
-    fitted = {"site": [{}], "note": "… the scenario fitted to the site's hazard curves …"}
-    assert _scenario_words(store, fitted).startswith("M 7.5–8, R 30 km, Vs30 400 m/s, fitted to the site's hazard curves")
-    assert "an assumption unless" in _scenario_words(store, {"site": [{}]})

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from stochpound.analysis._bootstrap import bootstrap_weights, interval, jackknife_weights, motion_clusters
+from stochpound.stats._bootstrap import bootstrap_weights, interval, jackknife_weights, motion_clusters
 from stochpound.risk._maf import _separation_kernel, non_increasing as _nonincreasing_rate
 
 
@@ -98,7 +98,30 @@ def test_stripe_fragility_resamples_the_events_of_a_store():
                                 "record_event": ("record", [f"quake {i // 2}" for i in range(12)]),
                                 "record_station": ("record", [f"station {i // 2}" for i in range(12)])})
     clustered = stripe_fragility(data, bootstrap=200, seed=1)
-    assert clustered.sizes["jackknife"] == 6 and "cluster bootstrap over events (6 clusters of 12 motions" in clustered["theta_lower"].attrs["method"]
+    assert clustered.sizes["jackknife"] == 6 and "cluster bootstrap over events (6 clusters of the 12 motions that ran;" in clustered["theta_lower"].attrs["method"]
     plain = stripe_fragility(data.drop_vars(["record_event", "record_station"]), bootstrap=200, seed=1)
     assert plain.sizes["jackknife"] == 12 and plain["theta_lower"].attrs["method"] == "BCa bootstrap over motions"
     np.testing.assert_array_equal(clustered["theta"], plain["theta"])  # the estimate itself does not change
+
+
+def test_the_bootstrap_counts_the_clusters_and_motions_that_ran_not_the_pool():
+    """A selection runs some motions of a pool per stripe: the method's words count the runs' clusters and motions, per stripe."""
+    import xarray as xr
+
+    from stochpound.analysis import stripe_fragility
+    from stochpound.stats import bootstrap_method
+
+    rng = np.random.default_rng(5)
+    levels = np.array([0.2, 0.4, 0.8])
+    events = (rng.random((3, 12)) < levels[:, None] / 1.0).astype(float)
+    chosen = np.zeros((3, 12), dtype=bool)  # a pool of 12 motions of 6 quakes; each stripe runs 4 of them, from 2 or 3 quakes
+    chosen[0, [0, 1, 2, 3]] = chosen[1, [2, 3, 4, 5]] = chosen[2, [0, 2, 4, 6]] = True
+    data = xr.DataArray(np.where(chosen, events, np.nan), dims=("intensity", "record"),
+                        coords={"intensity": levels, "record": [f"m{i}" for i in range(12)],
+                                "record_event": ("record", [f"quake {i // 2}" for i in range(12)])})
+    method = stripe_fragility(data, bootstrap=50, seed=1)["theta_lower"].attrs["method"]
+    assert method == ("BCa cluster bootstrap over events (4 clusters of the 7 motions that ran, of a pool of 12; per stripe 2–4 clusters "
+                      "of 4 motions; station where the event is unknown)")
+    assert "12 motions that ran" not in method and "6 clusters" not in method  # the pool is not what was resampled
+    every = bootstrap_method(np.array(["a", "a", "b"], dtype=object), np.ones((2, 3), dtype=bool))
+    assert every == "BCa cluster bootstrap over events (2 clusters of the 3 motions that ran; station where the event is unknown)"

@@ -31,7 +31,7 @@ from click.testing import CliRunner
 from stochpound import open_store
 from stochpound.risk import HazardCurve, StoreRisk, contact_free_closure, pounding_fragility, risk_gaps, store_demands, store_risk
 from stochpound.cli import main
-from stochpound.experiment._hazard import hazard_curve, stored_hazard
+from stochpound.hazard._setting import hazard_curve, stored_hazard
 from stochpound.experiment._runner import load_experiment, run_experiment
 from stochpound.experiment._spec import ExperimentError, load_definition, parse_experiment
 from stochpound.store import definition_sha256

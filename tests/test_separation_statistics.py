@@ -8,7 +8,7 @@ import xarray as xr
 from scipy import stats
 
 from stochpound.analysis import contact_demands, pounding_curve, required_separation, rule_exceedance, separation_rules
-from stochpound.analysis._separation_rules import abs_rule, cqc_coefficient, ddc_rule, fixed_base_cqc, fundamental_mode, srss_rule
+from stochpound.codes._separation_rules import abs_rule, cqc_coefficient, ddc_rule, fixed_base_cqc, fundamental_mode, srss_rule
 from stochpound.model.building import fixed_base_frequencies
 from stochpound.model.scene_file import scene_from_dict
 from stochpound.studies.agarwal2004 import study_scene

@@ -4,18 +4,22 @@ Every function takes and returns xarray objects and reduces only the
 dimensions it is told to, so it applies equally to one run (reduce over
 ``time``), to an experiment store (the grid's dimensions are carried along)
 and to ensembles (reduce over ``realization``). Each statistic has one
-implementation, a numpy kernel of :mod:`stochpound.analysis.kernels`, which
+implementation, a numpy kernel of :mod:`stochpound.stats.kernels`, which
 these functions apply with :func:`xarray.apply_ufunc`.
 
-The hazard curve (:class:`~stochpound.risk.HazardCurve`, which an
-experiment's ``[hazard]`` table is read with) is defined here, below the
-experiment layer; the risk chain built on these statistics is the package
-:mod:`stochpound.risk`, whose names this namespace also gives, as aliases,
-to code written before that package existed.
+This namespace also gives the site's hazard (:class:`HazardCurve`, the
+hazard files and the stripes' consistency, of :mod:`stochpound.hazard`),
+the code separation rules of a run (of :mod:`stochpound.codes`) and, as
+aliases, the names of the risk chain (:mod:`stochpound.risk`) it gave to
+code written before that package existed. The statistics sit above all
+three: none of them imports this package.
 """
 
+import sys
+
+from stochpound.stats import kernels
 from stochpound.analysis._moments import moments
-from stochpound.analysis._correlation import correlation
+from stochpound.stats import correlation
 from stochpound.analysis._ensemble_statistics import ensemble_statistics
 from stochpound.analysis._histogram import normal_histogram
 from stochpound.analysis._impacts import impact_statistics
@@ -24,20 +28,28 @@ from stochpound.analysis.mechanisms import amplification, ratcheting
 from stochpound.analysis._peaks import peak_response
 from stochpound.analysis._pounding import pounding_probability
 from stochpound.analysis._separation import pounding_curve, required_separation, rule_exceedance
-from stochpound.analysis._separation_rules import contact_demands, fixed_base_cqc, separation_rules, store_contact_demands
+from stochpound.codes import contact_demands, fixed_base_cqc, separation_rules, store_contact_demands
 from stochpound.analysis._summary import run_summary
-from stochpound.analysis._consistency import hazard_consistency, stripe_rate_weights
-from stochpound.analysis._hazard import HazardCurve, bundled_curves, bundled_measure, bundled_site_curves, probability_from_rate, rate_from_probability, return_period
-from stochpound.analysis._hazard_files import HazardFile, read_hazard_file
+from stochpound.hazard import (
+    HazardCurve,
+    HazardFile,
+    bundled_curves,
+    bundled_measure,
+    bundled_site_curves,
+    hazard_consistency,
+    probability_from_rate,
+    rate_from_probability,
+    read_hazard_file,
+    return_period,
+    stripe_rate_weights,
+)
 
 # For the other packages of stochpound (their interface to this one, not public API: not in __all__).
-from stochpound.analysis._bootstrap import bootstrap_method, bootstrap_weights, interval, jackknife_weights, record_clusters  # noqa: F401
-from stochpound.analysis._hazard import bundled_path  # noqa: F401
-from stochpound.analysis._hazard_files import parse_measure, parse_units, unit_factor  # noqa: F401
 from stochpound.analysis._impacts import TABLE_COLUMNS  # noqa: F401
 from stochpound.analysis._intervals import MIN_RUNS  # noqa: F401
-from stochpound.analysis._separation_rules import EC8_REDUCTION, STORE_NAMES  # noqa: F401
 from stochpound.analysis._summary import response_moments, top_floor_total_displacement  # noqa: F401
+
+sys.modules[f"{__name__}.kernels"] = kernels  # the kernels' old path: ``import stochpound.analysis.kernels`` still gives them
 
 
 RISK_NAMES = (
@@ -62,7 +74,7 @@ RISK_NAMES = (
 )
 """The risk chain's names this namespace exported before :mod:`stochpound.risk` existed (one list: the risk package exports them
 too). Aliases of that package's (the canonical names), resolved when first used, so that importing the statistics does not import
-the risk chain (which sits above them)."""
+the risk chain (which they do not need)."""
 
 
 def __getattr__(name: str) -> object:

@@ -54,7 +54,7 @@ PEAKS = (
 GIVEN_POUNDING = ("peak_impact_force",)
 #: Summaries that can be of either sign: their means get a Student-t interval. Every other summary (counts, forces,
 #: peaks, standard deviations) cannot be negative and gets the percentile bootstrap, whose bounds stay within the
-#: sample's range (:func:`stochpound.analysis.kernels.bootstrap_mean_interval`).
+#: sample's range (:func:`stochpound.stats.kernels.bootstrap_mean_interval`).
 SIGNED = ("response_skewness", "response_excess", "fixed_base_correlation", "residual_sliding")
 
 

@@ -6,7 +6,7 @@ import numpy as np
 import xarray as xr
 from scipy import stats
 
-from stochpound.analysis import kernels
+from stochpound.stats import kernels
 
 
 def normal_histogram(data: xr.DataArray, bins: int = 40) -> xr.Dataset:

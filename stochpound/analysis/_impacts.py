@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
-from stochpound.analysis import kernels
-from stochpound.analysis._ufunc import reduce
+from stochpound.stats import kernels
+from stochpound.stats import reduce
 
 TABLE_COLUMNS = ("impact_in_phase", "impact_peak_force", "impact_duration", "impact_impulse")
 """The impact-table columns :func:`impact_statistics` reads."""
@@ -25,7 +25,7 @@ def impact_statistics(run: xr.Dataset, dim: str = "impact", valid: xr.DataArray 
 
     Works on a run's table and on padded tables, e.g. (realization, impact)
     with each realization's impacts followed by NaN rows; lazy on dask-backed
-    tables (:func:`stochpound.analysis.kernels.impact_counts`).
+    tables (:func:`stochpound.stats.kernels.impact_counts`).
 
     Parameters
     ----------

@@ -1,7 +1,7 @@
 """Ensemble estimates with their uncertainty: means with confidence intervals, quantiles, running estimates.
 
 Each function reduces (or runs along) the ensemble dimension of an xarray
-object with a kernel of :mod:`stochpound.analysis.kernels`, lazily on dask;
+object with a kernel of :mod:`stochpound.stats.kernels`, lazily on dask;
 NaN (a missing case) is left out.
 """
 
@@ -12,9 +12,9 @@ from typing import Literal
 
 import xarray as xr
 
-from stochpound.analysis import kernels
+from stochpound.stats import kernels
 from stochpound.analysis._pounding import pounded
-from stochpound.analysis._ufunc import reduce
+from stochpound.stats import reduce
 
 MIN_RUNS = 30
 """Fewest runs (values) behind an ensemble estimate that a conclusion is drawn from, that is compared or drawn as a
@@ -63,9 +63,9 @@ def mean_interval(data: xr.DataArray, dim: str = "realization", confidence: floa
     confidence : float
         Two-sided confidence level, in (0, 1).
     method : {"t", "bootstrap"}
-        ``t``: Student t (:func:`stochpound.analysis.kernels.mean_interval`),
+        ``t``: Student t (:func:`stochpound.stats.kernels.mean_interval`),
         for a quantity of either sign; ``bootstrap``: the percentile bootstrap
-        of the mean (:func:`stochpound.analysis.kernels.bootstrap_mean_interval`),
+        of the mean (:func:`stochpound.stats.kernels.bootstrap_mean_interval`),
         for a quantity that cannot be negative (counts, forces, peaks): never a
         negative bound.
 
@@ -94,7 +94,7 @@ def running_mean(data: xr.DataArray, dim: str = "realization", confidence: float
     -------
     xarray.Dataset
         ``mean``, ``lower``, ``upper`` and ``count`` on the same dimensions
-        as ``data`` (:func:`stochpound.analysis.kernels.running_mean_interval`).
+        as ``data`` (:func:`stochpound.stats.kernels.running_mean_interval`).
     """
     kernels.check_confidence(confidence)
     values = reduce(lambda x: tuple(kernels.running_mean_interval(x, confidence)), [data], [dim], 4, new_dims={dim: data.sizes[dim]})
@@ -118,7 +118,7 @@ def running_pounding_probability(impacts: xr.DataArray, dim: str = "realization"
     -------
     xarray.Dataset
         ``probability``, ``lower``, ``upper`` and ``count`` on the dimensions
-        of ``impacts`` (:func:`stochpound.analysis.kernels.running_proportion_interval`).
+        of ``impacts`` (:func:`stochpound.stats.kernels.running_proportion_interval`).
     """
     kernels.check_confidence(confidence)
     events = pounded(impacts).assign_attrs(units="1", long_name="pounding (at least one impact)")

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import xarray as xr
 
-from stochpound.analysis import kernels
-from stochpound.analysis._ufunc import reduce
+from stochpound.stats import kernels
+from stochpound.stats import reduce
 
 MOMENT_NAMES = kernels.Moments._fields
 
@@ -27,7 +27,7 @@ def moments(data: xr.DataArray, dim: str | list[str] = "time") -> xr.Dataset:
     xarray.Dataset
         ``mean`` and ``std`` in the units of ``data``, ``variance`` in its
         square, ``skewness`` = m3/m2^1.5 and ``excess`` = m4/m2² − 3
-        (population moments, ddof = 0; :func:`stochpound.analysis.kernels.moments`).
+        (population moments, ddof = 0; :func:`stochpound.stats.kernels.moments`).
         Lazy if ``data`` is.
     """
     dims = [dim] if isinstance(dim, str) else list(dim)

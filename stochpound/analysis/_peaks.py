@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import xarray as xr
 
-from stochpound.analysis import kernels
-from stochpound.analysis._ufunc import reduce
+from stochpound.stats import kernels
+from stochpound.stats import reduce
 
 
 def peak_response(run: xr.Dataset, dim: str = "time") -> xr.Dataset:

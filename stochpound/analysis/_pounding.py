@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import xarray as xr
 
-from stochpound.analysis import kernels
-from stochpound.analysis._ufunc import reduce
+from stochpound.stats import kernels
+from stochpound.stats import reduce
 
 
 def pounded(impacts: xr.DataArray) -> xr.DataArray:
@@ -30,7 +30,7 @@ def pounding_probability(impacts: xr.DataArray, dim: str = "realization", confid
     -------
     xarray.Dataset
         ``probability``, ``lower`` and ``upper`` (all in [0, 1]) and
-        ``realizations`` (:func:`stochpound.analysis.kernels.proportion_interval`).
+        ``realizations`` (:func:`stochpound.stats.kernels.proportion_interval`).
         Lazy on dask-backed inputs.
     """
     kernels.check_confidence(confidence)

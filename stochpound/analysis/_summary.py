@@ -4,13 +4,13 @@ from __future__ import annotations
 
 import xarray as xr
 
-from stochpound.analysis import kernels
-from stochpound.analysis._correlation import correlation
+from stochpound.stats import kernels
+from stochpound.stats import correlation
 from stochpound.analysis._impacts import impact_statistics
 from stochpound.analysis._moments import moments
 from stochpound.analysis.names import RESPONSE_MOMENTS, RUN_SUMMARY_ALIASES, with_aliases
 from stochpound.analysis._peaks import peak_response
-from stochpound.analysis._ufunc import reduce
+from stochpound.stats import reduce
 
 
 def top_floor_total_displacement(run: xr.Dataset, building: str) -> xr.DataArray:

@@ -141,8 +141,11 @@ def risk(store: Path, hazard: str | None, hazard_measure: str | None, hazard_uni
         click.echo(f"\nCode rules: suite-mean rules not evaluated: {result.rules_note}.")
     if not rules.empty:
         click.echo(f"\nCode rules in risk terms, the suite-mean rows applied to the suite-mean peaks of the code intensity's stripe (λ_P: pounding "
-                   f"per year at that gap; 'once in N years'; P in {years:g} years; each with its interval; fit: lognormal or a degenerate step):")
+                   f"per year at that gap; 'once in N years'; P in {years:g} years; each with its interval; fit: lognormal, a degenerate step "
+                   f"or flat):")
         click.echo(rules.to_string(float_format=lambda v: f"{v:.4g}"))
+    if result.dtm_text():
+        click.echo(f"note: {result.dtm_text()}")
     click.echo(result.design_rules_text())
     if costs is not None:
         click.echo(f"\nLimit states beyond first contact (λ: per year at each finite gap; contact-free: the same motions without "

@@ -24,7 +24,7 @@ from typing import Any, Iterator, Mapping, Sequence
 import numpy as np
 
 from stochpound._errors import SceneError
-from stochpound.store import Definition, canonical_json, read_definition, register_grid
+from stochpound.store import CASE, KINDS, REFERENCE, Definition, canonical_json, read_definition, register_grid
 from stochpound.experiment._scene_edits import (
     apply_overrides,
     building_names,
@@ -37,12 +37,6 @@ from stochpound.experiment._scene_edits import (
 from stochpound.experiment._site import CONDITIONAL_SPECTRUM, StripeSelections, stripe_selections
 from stochpound.experiment._spec import ExperimentError
 from stochpound.model.scene_file import scene_from_dict
-
-CASE = "case"
-REFERENCE = "reference"
-KINDS = (REFERENCE, CASE)
-"""The kinds of case, in store order."""
-
 
 @dataclass(frozen=True)
 class Dim:

@@ -36,9 +36,9 @@ from stochpound.model import fields as toml_fields
 from stochpound.experiment._site import parse_selection
 from stochpound.model.friction import is_fixed_base
 from stochpound.motions import arias_intensity, peak_ground_motion, response_spectrum, significant_duration
-from stochpound.store import describe_measure
+from stochpound._errors import IntensityError
+from stochpound.store import MEASURES, describe_measure
 
-MEASURES = ("pga", "pgv", "psa", "sa_avg")
 METHODS = ("stripes", "ida")
 UNITS = {"pga": ("g", "m/s2"), "psa": ("g", "m/s2"), "sa_avg": ("g", "m/s2"), "pgv": ("m/s", "cm/s")}
 """Units of ``levels`` allowed for each measure (the first is the default)."""
@@ -69,10 +69,6 @@ SUMMARIES: dict[str, tuple[str, str]] = {
     "motion_psa": ("m/s2", "pseudo-spectral acceleration (5 % damping) of the unscaled motion"),
     "ida_capacity": ("{units}", "IDA pounding capacity: intensity at which the motion first closes the gap (contact-free run)"),
 }
-
-
-class IntensityError(ValueError):
-    """An ``[intensity]`` field is invalid (the message starts with the field)."""
 
 
 def parse_intensity(data: Mapping[str, Any], scene: Mapping[str, Any], variants: list[dict[str, Any]], gaps: list[dict[str, Any]], mu: Any) -> dict[str, Any] | None:

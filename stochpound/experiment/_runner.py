@@ -289,6 +289,8 @@ def _record_hazard(store: Path, experiment: Experiment, grids: dict[str, tuple[f
     for table in ("design", "limit_states"):
         if table in changed:
             say(f"{store}: the [{table}] changed; no run depends on it: the cases are kept and the new table is recorded in the store")
+    if "site" in changed:
+        say(f"{store}: how the [site] scenario was obtained is recorded in the store (no run depends on it: the cases are kept)")
     if "hazard" not in changed:
         return
     hazard = experiment.contract.hazard

@@ -30,16 +30,32 @@ import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 from functools import cached_property
-from typing import TYPE_CHECKING, Any
+from pathlib import Path
+from typing import Any, Protocol
 
 import numpy as np
 import xarray as xr
 
 from stochpound.model import fields as toml_fields
 from stochpound.motions import CONDITIONING_MEASURES, MODEL_DAMPING, PERIOD_RANGE, check_scenario
+from stochpound.store import SCENARIO_KINDS
 
-if TYPE_CHECKING:
-    from stochpound.experiment._grid import Experiment
+
+class GridExperiment(Protocol):
+    """What the selection reads of an experiment (an :class:`~stochpound.experiment.Experiment`, which asks for its stripes here)."""
+
+    intensity: dict[str, Any] | None
+    motions: dict[str, dict[str, Any]]
+    variants: list[dict[str, Any]]
+    building_names: list[str]
+    base_dir: Path
+    definition: dict[str, Any]
+
+    def points(self, kind: str) -> list[Any]: ...
+
+    def structure(self, case: Any) -> dict[str, Any]: ...
+
+    def motion_table(self, label: str, realization: int | None = None) -> dict[str, Any]: ...
 
 SELECTIONS = ("scale", "conditional_spectrum")
 """``[intensity] selection``: every motion scaled to every level, or motions chosen per stripe."""
@@ -49,8 +65,6 @@ DEFAULT_SEED = 1
 SITE_FIELDS = ("vs30", "magnitude", "distance_km", "mechanism")
 PER_LEVEL = ("magnitude", "distance_km", "mechanism")
 """``[site]`` fields that take one value per level."""
-SCENARIOS = ("given", "fitted")
-"""``[site] scenario``: magnitude and distance as the table gives them, or fitted to the site's hazard curves (``curves``)."""
 
 
 def parse_selection(table: Mapping[str, Any], site: Any, levels: list[float], entry: dict[str, Any]) -> dict[str, Any]:
@@ -112,15 +126,40 @@ def parse_selection(table: Mapping[str, Any], site: Any, levels: list[float], en
     return {"note": note, "selection": selection, "motions": motions, "max_scale_factor": max_scale, "seed": seed, "site": parse_site(site, levels, entry)}
 
 
+def site_entry(site: Any, intensity: Mapping[str, Any] | None) -> dict[str, Any] | None:
+    """The definition's ``site`` entry: how the stripes' scenario was obtained, as data (None without a ``[site]`` table).
+
+    ``scenario`` is ``"given"`` or ``"fitted"``; a fitted one names the
+    ``curves`` it was fitted to. Called with the parsed ``intensity`` entry,
+    once :func:`parse_selection` has checked the table. Not part of the
+    identity (``stochpound.store.NOT_IN_IDENTITY``): the runs depend on the
+    scenarios themselves (the ``intensity`` entry's ``site``), not on how
+    they came.
+
+    Raises
+    ------
+    SiteError
+        A ``[site]`` table without ``[intensity]``.
+    """
+    from stochpound._errors import SiteError
+
+    if site is None:
+        return None
+    if intensity is None:
+        raise SiteError(f'site: only with [intensity] selection = "{CONDITIONAL_SPECTRUM}" (the scenario of its targets)')
+    kind = site.get("scenario", SCENARIO_KINDS[0])
+    return {"scenario": kind, "curves": list(site["curves"])} if kind == "fitted" else {"scenario": kind}
+
+
 def parse_site(site: Any, levels: list[float], entry: Mapping[str, Any]) -> list[dict[str, Any]]:
     """One scenario per level, in the order of the sorted levels, from the ``[site]`` table (given, or fitted to its ``curves``)."""
     from stochpound._errors import SiteError
 
     if not isinstance(site, dict):
         raise SiteError("site: a [site] table is required with the conditional spectrum (vs30, magnitude, distance_km, mechanism)")
-    scenario_kind = site.get("scenario", SCENARIOS[0])
-    if scenario_kind not in SCENARIOS:
-        raise SiteError(f"site.scenario: must be one of {', '.join(SCENARIOS)}, got {scenario_kind!r}")
+    scenario_kind = site.get("scenario", SCENARIO_KINDS[0])
+    if scenario_kind not in SCENARIO_KINDS:
+        raise SiteError(f"site.scenario: must be one of {', '.join(SCENARIO_KINDS)}, got {scenario_kind!r}")
     if scenario_kind == "fitted":
         return fitted_site(site, levels, entry)
     if "curves" in site:
@@ -194,13 +233,13 @@ def fitted_site(site: Mapping[str, Any], levels: list[float], entry: Mapping[str
     return scenarios
 
 
-def periods_of_interest(experiment: Experiment) -> dict[str, float]:
+def periods_of_interest(experiment: GridExperiment) -> dict[str, float]:
     """The structure's periods of interest (s), by name: first-mode periods on a fixed base and isolated periods, over every grid point.
 
     Names: ``"B1 first mode"``, ``"B1 isolated"``, with the grid point's
     variant labels where a building's period differs between points.
     """
-    from stochpound.experiment._grid import CASE
+    from stochpound.store import CASE
     from stochpound.model.friction import is_fixed_base
     from stochpound.model.modal_solution import modal_properties
     from stochpound.model.scene_file import scene_from_dict
@@ -226,7 +265,7 @@ def periods_of_interest(experiment: Experiment) -> dict[str, float]:
     return named
 
 
-def structure_periods(experiment: Experiment) -> list[float]:
+def structure_periods(experiment: GridExperiment) -> list[float]:
     """The distinct periods of :func:`periods_of_interest` (s), ascending."""
     return sorted(set(periods_of_interest(experiment).values()))
 
@@ -282,7 +321,7 @@ class StripeSelections:
         }  # fmt: skip
 
 
-def stripe_selections(experiment: Experiment) -> StripeSelections:
+def stripe_selections(experiment: GridExperiment) -> StripeSelections:
     """Choose and scale the motions of every stripe (module docstring).
 
     Raises
@@ -292,7 +331,7 @@ def stripe_selections(experiment: Experiment) -> StripeSelections:
         more than the pool has within ``max_scale_factor`` of a level.
     """
     from stochpound._errors import ExperimentError, SiteError, field_errors
-    from stochpound.experiment._grid import CASE
+    from stochpound.store import CASE
     from stochpound.model.scene_file import scene_from_dict
     from stochpound.motions import conditional_spectrum, select_motions, selection_periods, selection_pool
     from stochpound.motions.records import Record, is_suite_member, load_suite_member

@@ -28,9 +28,10 @@ from stochpound._errors import ExperimentError, SceneError, field_errors
 from stochpound._studies import parse_reproduces
 from stochpound.experiment._design_table import parse_design
 from stochpound.experiment._limit_states_table import parse_limit_states
-from stochpound.experiment._hazard import parse_hazard
+from stochpound.hazard import parse_hazard
 from stochpound.motions import DEFAULT_G
 from stochpound.experiment._intensity import parse_intensity
+from stochpound.experiment._site import site_entry
 from stochpound.model import fields as toml_fields
 from stochpound.model.contact import ELEMENT_KEYS
 from stochpound.experiment._scene_edits import apply_overrides, building_names
@@ -113,7 +114,7 @@ def parse_experiment(data: Mapping[str, Any], base_dir: str | Path = ".", defaul
         Canonical definition: ``format``, ``name``, ``description``,
         ``scene`` (the base scene's dict, its ``[motion]`` included when it has one),
         ``studied``, ``variants``, ``gaps``, ``mu``, ``motions``, ``output``, ``solver``;
-        ``intensity`` and ``hazard`` only when the file has those tables;
+        ``intensity``, ``hazard``, ``design`` and ``site`` only when the file has those tables;
         ``reproduces`` only when the file declares it; ``scene_source`` only when
         the base scene comes from a file (``file`` as given, or ``bundled``, and the file's
         ``sha256``: not part of the identity, ``scene`` holds the content).
@@ -182,6 +183,10 @@ def parse_experiment(data: Mapping[str, Any], base_dir: str | Path = ".", defaul
         definition["design"] = design
     if limit_states is not None:  # likewise absent without [limit_states]
         definition["limit_states"] = limit_states
+    with field_errors():
+        site = site_entry(data.get("site"), intensity)
+    if site is not None:  # likewise absent without [site]; out of the identity (the scenarios are in the intensity entry)
+        definition["site"] = site
     read_definition(definition)  # the typed definition reads every field parsed here
     return definition
 

@@ -18,7 +18,7 @@ xarray datasets (their metadata names and describes the store's variables);
 per case, the experiment takes the same values from :func:`case_values` and
 :func:`reference_values`, which read the run's variables directly
 (``run.variables``) and call the numpy kernels of
-:mod:`stochpound.analysis.kernels` (xarray's per-call overhead would cost
+:mod:`stochpound.stats.kernels` (xarray's per-call overhead would cost
 several times the solver's time). Both go through the same kernels; the
 tests check that they agree.
 """
@@ -30,9 +30,11 @@ from typing import Mapping, Sequence
 import numpy as np
 import xarray as xr
 
-from stochpound.analysis import kernels, peak_response
+from stochpound.analysis import peak_response
+from stochpound.stats import kernels
 from stochpound.analysis.names import RESPONSE_MOMENTS, without_aliases
-from stochpound.analysis import STORE_NAMES, contact_demands, response_moments, run_summary, top_floor_total_displacement
+from stochpound.analysis import response_moments, run_summary, top_floor_total_displacement
+from stochpound.codes import STORE_NAMES, contact_demands
 from stochpound.store import CATALOGUE, IMPACT_TABLE, STOREY_SUMMARIES, WALL_SUMMARIES
 
 _MOMENTS = tuple(RESPONSE_MOMENTS.values())
@@ -166,7 +168,7 @@ def _storey_values(run: xr.Dataset) -> dict[str, np.ndarray]:
 
 
 def _wall_penetration(run: xr.Dataset) -> np.float64:
-    """The largest wall penetration of the run, m, from its walls' located peak closures (:func:`stochpound.analysis.kernels.wall_penetration`; NaN without walls)."""
+    """The largest wall penetration of the run, m, from its walls' located peak closures (:func:`stochpound.stats.kernels.wall_penetration`; NaN without walls)."""
     variables = run.variables
     if "peak_wall_closure" not in variables:
         return np.float64(np.nan)
@@ -174,7 +176,7 @@ def _wall_penetration(run: xr.Dataset) -> np.float64:
 
 
 def _wall_closure(run: xr.Dataset) -> np.float64:
-    """The largest peak closure toward a wall over the run and its walls, m (:func:`stochpound.analysis.kernels.largest_wall_closure`; NaN without walls)."""
+    """The largest peak closure toward a wall over the run and its walls, m (:func:`stochpound.stats.kernels.largest_wall_closure`; NaN without walls)."""
     variables = run.variables
     if "peak_wall_closure" not in variables:
         return np.float64(np.nan)

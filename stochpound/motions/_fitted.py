@@ -23,11 +23,11 @@ The fit: every scenario of a grid (:data:`MAGNITUDES` × :data:`DISTANCES`,
 within the models' range, Vs30 and mechanism given) is a candidate for
 every level. The misfit is the sum over the other curves and their
 tabulated intensities y whose site rate lies within the stripes' rates
-(from λ_IM*(x_top) to λ_IM*(x_1)) of (ln recomputed − ln site)². Start
-from the best single scenario for all levels, then coordinate descent: each
-level in turn takes the candidate that most lowers the misfit, until a pass
-changes nothing. Deterministic: no random numbers, ties go to the first
-candidate (smaller M, then smaller R).
+(from λ_IM*(x_top) to λ_IM*(x_1)) of (ln recomputed − ln site)². The
+fitted scenario is the candidate of least misfit, the same for every level
+(a scenario per level and one varying smoothly with the level were tried
+and dropped: docs/intensity.md). Deterministic: no random numbers, ties go
+to the first candidate (smaller M, then smaller R).
 
 It is a calibration, not a disaggregation: M and R trade off (a larger M
 farther away can give the same spectral shape), so the fitted scenario is

@@ -36,7 +36,7 @@ from stochpound.report.sections import (
 )
 from stochpound.risk import has_risk, store_damage, store_demands, store_risk
 from stochpound.store import has_contact_free, has_wall_free, with_contacts, with_walls
-from stochpound.studies import claims, load_study
+from stochpound._studies import claims, load_study
 
 
 def assemble_report(paths: Sequence[str | Path], progress: Callable[[str], None] | None = None) -> Report:

@@ -30,7 +30,7 @@ This package is the canonical home of these names; the ones that
 there as aliases.
 """
 
-from stochpound.analysis import HazardCurve, bundled_curves, probability_from_rate, rate_from_probability, return_period
+from stochpound.hazard import HazardCurve, bundled_curves, probability_from_rate, rate_from_probability, return_period
 from stochpound.risk._fragility import Fragility, fit_fragility
 from stochpound.risk._fragility_ensemble import (
     BOOTSTRAP,
@@ -41,7 +41,7 @@ from stochpound.risk._fragility_ensemble import (
     limit_state_events,
     stripe_fragility,
 )
-from stochpound.risk._maf import TARGETS, degenerate_text, demand_hazard_curve, mean_annual_frequency, rate_intervals, risk_curve, risk_targeted_separation
+from stochpound.risk._maf import TARGETS, degenerate_text, demand_hazard_curve, flat_fit_maf, mean_annual_frequency, rate_intervals, risk_curve, risk_targeted_separation
 from stochpound.risk._code_rules import code_rules_risk
 from stochpound.risk._code_gaps import (
     Asce7Design,
@@ -59,7 +59,7 @@ from stochpound.risk._demands import StoreDemands, store_demands
 from stochpound.risk._limit_states import KINDS as LIMIT_STATE_KINDS, LimitState, gap_cost_frame, limit_state_risk, limit_states_from_table
 from stochpound.risk._efficiency import measure_efficiency, most_efficient
 from stochpound.risk._damage import DAMAGE_DEMANDS, DEFAULT_LIMIT_STATES, DEFAULT_SOURCE as DEFAULT_LIMIT_STATES_SOURCE, MODEL_DRIFT_LIMIT, StoreDamage, store_damage
-from stochpound.analysis import hazard_consistency, stripe_rate_weights
+from stochpound.hazard import hazard_consistency, stripe_rate_weights
 from stochpound.risk._site_consistency import consistency_at_targets, site_consistency
 
 __all__ = [
@@ -78,6 +78,7 @@ __all__ = [
     "return_period",
     "demand_hazard_curve",
     "mean_annual_frequency",
+    "flat_fit_maf",
     "risk_curve",
     "rate_intervals",
     "degenerate_text",

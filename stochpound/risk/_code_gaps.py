@@ -51,9 +51,6 @@ from scipy.linalg import eigh
 
 from stochpound.model.building import Building, storey_matrix
 
-EC8_REDUCTION = 0.7
-"""EN 1998-1 §4.4.2.7(3): the factor on the separation where the floor levels of the two units coincide."""
-
 #: ASCE 7-16 Table 17.5-1: damping coefficient B_M against effective damping β_M (interpolated linearly).
 ASCE7_DAMPING_TABLE = ((0.02, 0.8), (0.05, 1.0), (0.10, 1.2), (0.20, 1.5), (0.30, 1.7), (0.40, 1.9), (0.50, 2.0))
 

@@ -32,12 +32,12 @@ from collections.abc import Sequence
 import numpy as np
 import xarray as xr
 
-from stochpound.analysis import bootstrap_method, bootstrap_weights, interval, jackknife_weights, record_clusters
+from stochpound.stats import bootstrap_method, bootstrap_weights, interval, jackknife_weights, record_clusters
 from stochpound.risk._fragility import STATUS, stripe_mle
 from stochpound.risk._fragility_ensemble import BOOTSTRAP
-from stochpound.analysis import HazardCurve, probability_from_rate, rate_from_probability, return_period
-from stochpound.risk._maf import lognormal_maf, rate_intervals
-from stochpound.analysis import EC8_REDUCTION, separation_rules
+from stochpound.hazard import HazardCurve, probability_from_rate, rate_from_probability, return_period
+from stochpound.risk._maf import fit_maf, rate_intervals
+from stochpound.codes import EC8_REDUCTION, separation_rules
 
 DESIGN_LEVELS = (0.02, 0.10)
 """Default design levels: probabilities of exceedance in 50 years (ASCE 7's MCE_R; Eurocode 8's design earthquake)."""
@@ -86,7 +86,7 @@ def code_rules_risk(demands: xr.Dataset, hz: HazardCurve, design_levels: Sequenc
     """
     for name in ("peak_displacement_left", "peak_displacement_right", "correlation", "peak_closure"):
         if name not in demands:
-            raise ValueError(f"demands: missing {name!r} (see stochpound.analysis._separation_rules.contact_demands)")
+            raise ValueError(f"demands: missing {name!r} (see stochpound.analysis.contact_demands)")
     for dim in (intensity_dim, record_dim, contact_dim):
         if dim not in demands["peak_closure"].dims:
             raise ValueError(f"demands: peak_closure has no dimension {dim!r}")
@@ -114,7 +114,7 @@ def code_rules_risk(demands: xr.Dataset, hz: HazardCurve, design_levels: Sequenc
             clusters = record_clusters(demands, record_dim)
             sampled = chain(stripe, xr.DataArray(bootstrap_weights(motions, bootstrap, seed, clusters), dims=("sample", record_dim)))
             left_out = chain(stripe, xr.DataArray(jackknife_weights(motions, clusters), dims=("sample", record_dim))).rename(sample="jackknife")
-            attrs = {"confidence": confidence, "method": f"{bootstrap_method(clusters)} (rule gap and fragility refitted)", "seed": seed}
+            attrs = {"confidence": confidence, "method": f"{bootstrap_method(clusters, ran.transpose(intensity_dim, record_dim).values)} (rule gap and fragility refitted)", "seed": seed}
             for name, units in (("maf", "1/yr"), ("gap", "m")):
                 lower, upper = xr.apply_ufunc(lambda b, e, j: interval(b, e, j, confidence), sampled[name], estimate[name], left_out[name],
                                               input_core_dims=[["sample"], [], ["jackknife"]], output_core_dims=[[], []])
@@ -168,7 +168,7 @@ class _RuleChain:
                 "theta": (dims, theta, {"long_name": "median of the lognormal fragility at the rule's gap (IM units)"}),
                 "beta": (dims, beta, {"units": "1", "long_name": "log-standard deviation of that fragility"}),
                 "status": (dims, status.astype(np.int8), {"long_name": "fit status", "flag_meanings": " ".join(STATUS)}),
-                "maf": (dims, lognormal_maf(theta, beta, self.hz), {"units": "1/yr", "long_name": "mean annual frequency of pounding at the rule's gap"}),
+                "maf": (dims, fit_maf(theta, beta, status, exceeded.values, runs.values, self.hz), {"units": "1/yr", "long_name": "mean annual frequency of pounding at the rule's gap"}),
             },
             coords=coords,
         )

@@ -19,7 +19,7 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
-from stochpound.analysis import HazardCurve
+from stochpound.hazard import HazardCurve
 from stochpound.risk import _store
 from stochpound.risk._fragility_ensemble import BOOTSTRAP
 from stochpound.risk._maf import demand_hazard_curve
@@ -58,7 +58,7 @@ class StoreDemands:
     years: float = YEARS
 
     def non_increasing_maf(self, label: str) -> xr.DataArray:
-        """A demand's exceedance rate made non-increasing along its levels (the running minimum; 1/yr)."""
+        """A demand's exceedance rate made non-increasing along its levels (isotonic regression in ln λ, pool-adjacent-violators; 1/yr)."""
         return non_increasing_along(self.curves[label]["maf"], "level")
 
     def moat_frame(self) -> pd.DataFrame:

@@ -36,11 +36,12 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from stochpound.analysis import HazardCurve
+from stochpound.hazard import HazardCurve
 from stochpound.model.building import Building
 from stochpound.model.scene import Scene
 from stochpound.risk import _store
-from stochpound.risk._code_gaps import (EC8_REDUCTION, Asce7Design, Ec8Design, asce7_inelastic_displacement, asce7_isolator_displacement,
+from stochpound.codes import EC8_REDUCTION
+from stochpound.risk._code_gaps import (Asce7Design, Ec8Design, asce7_inelastic_displacement, asce7_isolator_displacement,
                                         ec8_design_displacement, modal_floor_displacements, srss_separation)
 from stochpound.risk._fragility_ensemble import BOOTSTRAP, stripe_fragility
 from stochpound.risk._maf import rate_intervals, risk_curve

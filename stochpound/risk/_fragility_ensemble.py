@@ -16,7 +16,7 @@ own fit. The results are computed (not lazy).
 Bootstrap: the motions (records), not the runs, are resampled with
 replacement, the same resample for every stripe, threshold and
 configuration, and everything is refitted; the intervals are BCa
-percentiles of the refits (:mod:`stochpound.analysis._bootstrap`). The
+percentiles of the refits (:mod:`stochpound.stats._bootstrap`). The
 resamples are drawn from ``numpy.random.default_rng(seed)``, so a seed
 reproduces them.
 """
@@ -29,8 +29,8 @@ import numpy as np
 import xarray as xr
 from numpy.typing import ArrayLike
 
-from stochpound.analysis import bootstrap_method, bootstrap_weights, interval, jackknife_weights, kernels, record_clusters
-from stochpound.risk._fragility import STATUS, ida_mle, lognormal_cdf, stripe_mle
+from stochpound.stats import bootstrap_method, bootstrap_weights, interval, jackknife_weights, kernels, record_clusters
+from stochpound.risk._fragility import DECREASING, STATUS, ida_mle, lognormal_cdf, stripe_mle
 
 BOOTSTRAP = 1000
 """Default number of bootstrap resamples of the motions."""
@@ -126,12 +126,16 @@ def stripe_fragility(events: xr.DataArray, intensity_dim: str = "intensity", rec
         probability_upper=(per_stripe, upper, {"units": "1", "long_name": "upper Clopper-Pearson bound", "confidence": confidence}),
     ).assign_coords({intensity_dim: data[intensity_dim]})
     if bootstrap:
-        def refit(weights: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        def refit(weights: np.ndarray) -> tuple[np.ndarray, ...]:
             k_w = np.einsum("...jr,br->...bj", np.where(valid, values, 0.0), weights)
             n_w = np.einsum("...jr,br->...bj", valid.astype(float), weights)
-            return stripe_mle(levels, k_w, n_w)[:2]
+            theta_w, beta_w, status_w = stripe_mle(levels, k_w, n_w)
+            with np.errstate(invalid="ignore", divide="ignore"):  # a decreasing resample's flat fit: its pooled fraction
+                flat = np.where(status_w == DECREASING, k_w.sum(-1) / n_w.sum(-1), np.nan)
+            return theta_w, beta_w, flat
 
-        result = _with_bootstrap(result, refit, record_clusters(data, record_dim), values.shape[-1], other, confidence, bootstrap, seed)
+        ran = valid.reshape(-1, *valid.shape[-2:]).any(0)  # per stripe, the motions that ran in some configuration
+        result = _with_bootstrap(result, refit, record_clusters(data, record_dim), values.shape[-1], other, confidence, bootstrap, seed, ran)
     return result
 
 
@@ -278,13 +282,22 @@ def _fit_dataset(theta: np.ndarray, beta: np.ndarray, status: np.ndarray, dims: 
     )
 
 
-def _with_bootstrap(result: xr.Dataset, refit: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]], clusters: np.ndarray | None,
-                    motions: int, dims: tuple, confidence: float, resamples: int, seed: int) -> xr.Dataset:
-    """``result`` with θ, β refitted to bootstrap and jackknife resamples of the motions (by cluster), and their BCa intervals."""
-    theta_b, beta_b = refit(bootstrap_weights(motions, resamples, seed, clusters))
-    theta_j, beta_j = refit(jackknife_weights(motions, clusters))
-    attrs = {"confidence": confidence, "method": bootstrap_method(clusters), "seed": seed}
+def _with_bootstrap(result: xr.Dataset, refit: Callable[[np.ndarray], tuple[np.ndarray, ...]], clusters: np.ndarray | None,
+                    motions: int, dims: tuple, confidence: float, resamples: int, seed: int, ran: np.ndarray | None = None) -> xr.Dataset:
+    """``result`` with θ, β refitted to bootstrap and jackknife resamples of the motions (by cluster), and their BCa intervals
+    (``ran``: which motions ran, per stripe, for the method's words; :func:`~stochpound.analysis.bootstrap_method`).
+
+    A ``refit`` that returns a third array gives, per resample, the flat fit's
+    fraction where that resample's fit is ``decreasing`` (NaN elsewhere):
+    ``flat_bootstrap``/``flat_jackknife``, which the MAF of the resamples uses.
+    """
+    theta_b, beta_b, *flat_b = refit(bootstrap_weights(motions, resamples, seed, clusters))
+    theta_j, beta_j, *flat_j = refit(jackknife_weights(motions, clusters))
+    attrs = {"confidence": confidence, "method": bootstrap_method(clusters, ran), "seed": seed}
     variables = {}
+    if flat_b:
+        flat = {"units": "1", "long_name": "fraction of runs that exceeded, where the resample's fit is decreasing (flat)"}
+        variables.update({"flat_bootstrap": ((*dims, "bootstrap"), flat_b[0], flat), "flat_jackknife": ((*dims, "jackknife"), flat_j[0], flat)})
     for name, sampled, left_out, units in (("theta", theta_b, theta_j, {}), ("beta", beta_b, beta_j, {"units": "1"})):
         lower, upper = interval(sampled, result[name].values, left_out, confidence)
         variables.update({

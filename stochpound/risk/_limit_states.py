@@ -28,7 +28,7 @@ from typing import Any
 import pandas as pd
 import xarray as xr
 
-from stochpound.analysis import HazardCurve, probability_from_rate
+from stochpound.hazard import HazardCurve, probability_from_rate
 from stochpound.risk import _store
 from stochpound.risk._fragility_ensemble import limit_state_events, stripe_fragility
 from stochpound.risk._maf import mean_annual_frequency

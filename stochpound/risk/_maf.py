@@ -28,10 +28,10 @@ import xarray as xr
 from numpy.typing import ArrayLike
 from scipy import optimize, special
 
-from stochpound.analysis import interval, kernels
+from stochpound.stats import interval, kernels
 from stochpound.risk._fragility import ALWAYS, DECREASING, EMPTY, NEVER, SEPARATED, STATUS
 from stochpound.risk._fragility_ensemble import BOOTSTRAP, limit_state_events, stripe_fragility
-from stochpound.analysis import HazardCurve, probability_from_rate, rate_from_probability, return_period
+from stochpound.hazard import HazardCurve, probability_from_rate, rate_from_probability, return_period
 
 TARGETS = (0.10, 0.02)
 """Default target probabilities of exceedance in ``years`` (50) of :func:`risk_targeted_separation`."""
@@ -51,7 +51,9 @@ def mean_annual_frequency(frag: object, hz: HazardCurve) -> float | np.ndarray |
         (floats, arrays or DataArrays, broadcast): a
         :class:`~stochpound.risk._fragility.Fragility` or a fit Dataset
         of :func:`~stochpound.risk.stripe_fragility`. A step (β = 0)
-        at θ gives λ(θ); θ = inf gives 0.
+        at θ gives λ(θ); θ = inf gives 0. A fit Dataset with ``status``,
+        ``exceeded`` and ``runs`` gives its ``decreasing`` fits the rate of
+        their flat fit (:func:`flat_fit_maf`) instead of NaN.
     hz : HazardCurve
         The site's hazard, in the same intensity measure and units.
 
@@ -63,6 +65,10 @@ def mean_annual_frequency(frag: object, hz: HazardCurve) -> float | np.ndarray |
     theta, beta = frag.theta, frag.beta
     if isinstance(theta, xr.DataArray) or isinstance(beta, xr.DataArray):
         rate = xr.apply_ufunc(lambda t, b: lognormal_maf(t, b, hz), theta, beta)
+        if isinstance(frag, xr.Dataset) and {"status", "exceeded", "runs"} <= set(frag.data_vars):
+            stripes = [d for d in frag["exceeded"].dims if d not in frag["status"].dims]
+            flat = xr.apply_ufunc(lambda k, n: flat_fit_maf(k, n, hz), frag["exceeded"], frag["runs"], input_core_dims=[stripes, stripes])
+            rate = rate.where(frag["status"] != DECREASING, flat)
         return rate.assign_attrs(units="1/yr", long_name="mean annual frequency of exceedance")
     rate = lognormal_maf(theta, beta, hz)
     return rate.item() if rate.ndim == 0 else rate
@@ -86,6 +92,45 @@ def lognormal_maf(theta: ArrayLike, beta: ArrayLike, hz: HazardCurve) -> np.ndar
         index = regular[start:start + _CHUNK]
         out[index] = _lognormal_integral(t[index], b[index], hz, lo, hi)
     return out.reshape(shape)
+
+
+def flat_fit_maf(exceeded: ArrayLike, runs: ArrayLike, hz: HazardCurve) -> np.ndarray:
+    """λ (1/yr) of a flat fit: F ≡ p̄, the fraction of all runs that exceeded, at every intensity.
+
+    Where the probit's fitted slope is not positive (``decreasing``: no more
+    exceedances at the higher stripes than at the lower, e.g. 19, 19 and 19
+    of 20), the maximum-likelihood fit among fragilities that do not fall
+    with intensity (slope ≥ 0) is flat at p̄ = Σ k_j / Σ n_j. Integrated
+    with the hazard over its range [lo, hi], λ = p̄ λ(lo): like ``always``
+    (F ≡ 1), a plateau set by the lowest intensity of the hazard's table,
+    not by the structure, and an upper bound in that the runs say nothing
+    below their lowest stripe.
+
+    Parameters
+    ----------
+    exceeded, runs : array_like
+        k_j and n_j per stripe (last axis).
+    hz : HazardCurve
+        The site's hazard.
+
+    Returns
+    -------
+    numpy.ndarray
+        p̄ λ(lo) over the leading axes (NaN without runs).
+    """
+    k, n = (np.asarray(value, dtype=float).sum(-1) for value in (exceeded, runs))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return _flat_rate(np.where(n > 0.0, k / n, np.nan), hz)
+
+
+def _flat_rate(fraction: ArrayLike, hz: HazardCurve) -> ArrayLike:
+    """λ of F ≡ ``fraction`` over the hazard's range: the fraction times the rate at its lowest intensity (1/yr)."""
+    return fraction * float(hz(hz.support[0]))
+
+
+def fit_maf(theta: ArrayLike, beta: ArrayLike, status: ArrayLike, exceeded: ArrayLike, runs: ArrayLike, hz: HazardCurve) -> np.ndarray:
+    """λ (1/yr) of stripe fits: :func:`lognormal_maf` of θ, β, and :func:`flat_fit_maf` of the counts where the fit is ``decreasing``."""
+    return np.where(np.asarray(status) == DECREASING, flat_fit_maf(exceeded, runs, hz), lognormal_maf(theta, beta, hz))
 
 
 def risk_curve(fragility: xr.Dataset, hz: HazardCurve, years: float = 50.0, confidence: float = 0.95) -> xr.Dataset:
@@ -124,8 +169,7 @@ def risk_curve(fragility: xr.Dataset, hz: HazardCurve, years: float = 50.0, conf
         attrs={"years": years, "hazard": repr(hz), "hazard_source": hz.source},
     )
     if "theta_bootstrap" in fragility:
-        sampled = mean_annual_frequency(xr.Dataset({"theta": fragility["theta_bootstrap"], "beta": fragility["beta_bootstrap"]}), hz)
-        left_out = mean_annual_frequency(xr.Dataset({"theta": fragility["theta_jackknife"], "beta": fragility["beta_jackknife"]}), hz)
+        sampled, left_out = (_resampled_maf(fragility, part, hz) for part in ("bootstrap", "jackknife"))
         lower, upper = _interval(sampled, maf, left_out, confidence)
         attrs = {"units": "1/yr", "confidence": confidence, "method": fragility["theta_lower"].attrs.get("method", "")}
         result = result.assign(
@@ -138,12 +182,22 @@ def risk_curve(fragility: xr.Dataset, hz: HazardCurve, years: float = 50.0, conf
     return rate_intervals(result, years)
 
 
+def _resampled_maf(fragility: xr.Dataset, part: str, hz: HazardCurve) -> xr.DataArray:
+    """λ of every ``part`` (``bootstrap`` or ``jackknife``) resample of a fit Dataset, a decreasing resample's by its flat fit."""
+    rate = mean_annual_frequency(xr.Dataset({"theta": fragility[f"theta_{part}"], "beta": fragility[f"beta_{part}"]}), hz)
+    if f"flat_{part}" in fragility:
+        flat = fragility[f"flat_{part}"]
+        rate = rate.where(flat.isnull(), _flat_rate(flat, hz))
+    return rate
+
+
 def degenerate_text(status: ArrayLike, hz: HazardCurve, what: str = "gaps") -> str:
     """What the degenerate fits among ``status`` are and what each does to the MAF ("" when every fit is a lognormal).
 
     A degenerate fit is a step (β = 0), not a lognormal (its ``status``:
-    ``always``, ``never``, ``separated``; ``decreasing`` and ``empty`` fits
-    have no λ); integrated with the
+    ``always``, ``never``, ``separated``; a ``decreasing`` fit is flat at
+    the fraction of runs that exceeded, :func:`flat_fit_maf`; an ``empty``
+    one has no λ); integrated with the
     hazard it gives λ(θ): for ``always`` (every run exceeded, θ = 0) the
     hazard's rate at the lowest intensity of its table, a plateau set by
     the table, not by the structure; for ``never`` 0; for ``separated``
@@ -171,10 +225,14 @@ def degenerate_text(status: ArrayLike, hz: HazardCurve, what: str = "gaps") -> s
         NEVER: "no run exceeded, F ≡ 0, so λ = 0: no risk is resolved, only that none of the runs exceeded",
         SEPARATED: "the runs separate at one intensity (none exceeded below it, all above), so F is a step there and λ is the "
                    "hazard's rate at that intensity",
-        DECREASING: "the fitted slope is not positive: no fragility and no λ (NaN)",
+        DECREASING: f"the fitted slope is not positive: no more runs exceeded at the higher stripes than at the lower, so the fit is "
+                    f"flat at the fraction p̄ of all runs that exceeded (the maximum-likelihood fit that does not fall with intensity) and "
+                    f"λ = p̄ × the hazard's rate at the lowest intensity of its table ({lo:.3g} {hz.units}), p̄ × {float(hz(lo)):.3g} /yr: "
+                    f"a plateau set by the hazard table, an upper bound rather than a fitted risk",
         EMPTY: "no runs: no fragility and no λ (NaN)",
     }
-    parts = [f"{int((status == code).sum())} of {status.size} {what}: a step '{STATUS[code]}' ({text})"
+    kind = {DECREASING: "a flat fit", EMPTY: "no fit"}
+    parts = [f"{int((status == code).sum())} of {status.size} {what}: {kind.get(code, 'a step')} '{STATUS[code]}' ({text})"
              for code, text in effect.items() if (status == code).any()]
     return ("Degenerate fits, not lognormals: " + "; ".join(parts) + ".") if parts else ""
 

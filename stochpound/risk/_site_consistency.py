@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
-from stochpound.analysis import HazardCurve, bundled_measure, bundled_site_curves, hazard_consistency, rate_from_probability
+from stochpound.hazard import HazardCurve, bundled_measure, bundled_site_curves, hazard_consistency, rate_from_probability
 from stochpound.risk._efficiency import _interpolated
 from stochpound.risk._maf import TARGETS
 from stochpound.risk._store import stripe_spectra_runs

@@ -21,11 +21,11 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from stochpound.analysis import HazardCurve, parse_measure, parse_units, store_contact_demands
-from stochpound.experiment import check_covers, hazard_curve, hazard_option, stored_hazard
+from stochpound.codes import store_contact_demands
+from stochpound.hazard import HazardCurve, check_covers, hazard_curve, hazard_option, parse_measure, parse_units, stored_hazard
 from stochpound.model import Scene
 from stochpound.motions import DEFAULT_G
-from stochpound.store import LIMIT_STATE_DEMANDS, contact_free, describe_measure, gap_dims, has_contact_free, has_wall_free, wall_free, with_contacts
+from stochpound.store import LIMIT_STATE_DEMANDS, contact_free, describe_measure, gap_dims, has_contact_free, has_wall_free, scenario_kind, scenario_ranges, wall_free, with_contacts
 
 CLOSURE = "peak_contact_closure"
 """The store's variable of per-case, per-contact peak closures (m)."""
@@ -176,7 +176,7 @@ def assumptions(store: xr.Dataset) -> dict[str, str]:
     selection = entry.get("selection")
     suite = (f"{count} motions ({', '.join(suites)}), "
              + (f"selected per stripe by {str(selection).replace('_', ' ')}" if selection else "every motion scaled to every stripe (no selection)"))
-    scenario = _scenario_words(store, entry) if entry.get("site") else ""
+    scenario = _scenario_words(store, scenario_kind(store)) if entry.get("site") else ""
     return {"structural model": "; ".join(models), "suite": suite,
             "scenario": scenario or "none stated (the motions are not selected for a scenario)"}
 
@@ -192,16 +192,13 @@ def _base_words(mu: Any, building: Mapping[str, Any]) -> str:
     return f"{sliding} or a fixed base" if mu.has_fixed_base else sliding
 
 
-def _scenario_words(store: xr.Dataset, intensity: Mapping[str, Any]) -> str:
-    """The stripes' scenario in words (the ``[intensity]`` entry's, as stored): fitted to the site's curves or as given, with its values."""
-    kind = "fitted to the site's hazard curves (a calibration standing in for a disaggregation)" if "fitted" in str(intensity.get("note", "")) \
-        else "as the [site] table gives it (an assumption unless it comes from the site's disaggregation)"
-    if "site_magnitude" not in store:
-        return kind
-    def span(name: str) -> str:
-        values = np.unique(np.round(store[name].values.astype(float), 2))
-        return "–".join(f"{v:g}" for v in (values[0], values[-1])) if values.size > 1 else f"{values[0]:g}"
-    return f"M {span('site_magnitude')}, R {span('site_distance_km')} km, Vs30 {span('site_vs30')} m/s, {kind}"
+def _scenario_words(store: xr.Dataset, kind: str | None) -> str:
+    """The stripes' scenario in words: its values as stored, and how it was obtained (``kind``, the definition's ``site.scenario``)."""
+    words = {"fitted": "fitted to the site's hazard curves (a calibration standing in for a disaggregation)",
+             "given": "as the [site] table gives it (an assumption unless it comes from the site's disaggregation)",
+             None: "how it was obtained is not recorded (a store written before the definition kept it)"}[kind]
+    ranges = scenario_ranges(store)
+    return words if ranges is None else f"{ranges}, {words}"
 
 
 def stripes(store: xr.Dataset) -> int | None:
@@ -300,12 +297,36 @@ def free_base_displacement(store: xr.Dataset, studied: str | None) -> tuple[xr.D
     """The studied building's wall-free peak base displacement for D_TM (:func:`base_displacement`), or None and why not.
 
     A moat wall caps the displacement D_TM is to size: with walls at its
-    base and no wall-free runs there is none ("" as the reason where the
+    base, each configuration takes the displacement of its wall-free twin
+    (``inf`` on the wall axes, or the value of a variant axis that sets no
+    wall), and without one there is none ("" as the reason where the
     building simply does not slide).
     """
     if moat_clearances(store, studied) and not has_wall_free(store):
-        return None, "the store has no wall-free runs (a moat wall caps the displacement D_TM is to size): add inf to the wall axis"
+        axis = _wall_free_variant(store, studied)
+        if axis is None:
+            return None, ("the store has no wall-free runs (a moat wall caps the displacement D_TM is to size): add inf to the wall axis, "
+                          "or a variant without the wall")
+        name, free = axis
+        displacement = base_displacement(store.sel({name: free}), studied)
+        return (None if displacement is None else displacement.expand_dims({name: store[name].values})), ""
     return base_displacement(store, studied, walls_free=True), ""
+
+
+def _wall_free_variant(store: xr.Dataset, studied: str | None) -> tuple[str, str] | None:
+    """A variant axis whose values alone set the walls at the studied building's base, with its value that sets none (the
+    wall-free twin of the others: D_TM is the displacement without the wall), or None (walls in the base scene, or no such axis)."""
+    definition = store.pound.definition
+    if any(w.get("building") == studied and w.get("level", 0) == 0 for w in definition.scene.get("wall", []) or []):
+        return None
+    for variant in definition.variants:
+        walled = {value: any(w.get("building") == studied and w.get("level", 0) == 0
+                             for w in variant.overrides.get(value, {}).get("scene", {}).get("wall", []) or [])
+                  for value in variant.values}
+        free = [value for value, has in walled.items() if not has]
+        if free and len(free) < len(walled) and variant.name in store.dims:
+            return variant.name, free[0]
+    return None
 
 
 def stored_demands(store: xr.Dataset) -> dict[str, tuple[xr.DataArray, str]]:

@@ -32,12 +32,12 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
-from stochpound.analysis import HazardCurve, rate_from_probability
+from stochpound.hazard import HazardCurve, rate_from_probability
 from stochpound.risk import _store
 from stochpound.risk._code_rules import MINIMUM_MOTIONS, code_rules_risk
 from stochpound.risk._design_rules import design_rules_risk
 from stochpound.risk._fragility_ensemble import BOOTSTRAP, fragility_band, fragility_surface, homogeneous_capacities, ida_fragility, limit_state_events, stripe_fragility
-from stochpound.risk._fragility import FIT, STATUS
+from stochpound.risk._fragility import DECREASING, EMPTY, FIT, STATUS
 from stochpound.risk._maf import TARGETS, degenerate_text, non_increasing, risk_curve, risk_targeted_separation
 
 YEARS = 50.0
@@ -231,7 +231,9 @@ class StoreRisk:
         bound``: the same for the upper bound of λ_P). The suite-mean rules'
         rows first, then the codes' own gaps from the design analysis
         (design level ``… (design analysis)``, where the store has a
-        ``[design]``). Empty when no rule was evaluated (``rules_note`` and
+        ``[design]``). A rule's rows are left out where it does not apply
+        (D_TM where the studied building's base never slides:
+        :meth:`dtm_text`). Empty when no rule was evaluated (``rules_note`` and
         ``design_note`` say why).
         """
         frames = []
@@ -239,7 +241,8 @@ class StoreRisk:
             rules = _grid_only(self.rules, keep=("code_intensity", "stripe_intensity"))
             stripes = [design_text(p, float(i), float(rules.attrs.get("years", self.years)))
                        for p, i in zip(rules["design_level"].values, rules["stripe_intensity"].values)]
-            frames.append(self._rules_rows(rules.drop_vars(["code_intensity", "stripe_intensity"]), dict(zip(rules["design_level"].values, stripes))))
+            rows = self._rules_rows(rules.drop_vars(["code_intensity", "stripe_intensity"]), dict(zip(rules["design_level"].values, stripes)))
+            frames.append(rows[rows[[c for c in rows.columns if c.startswith("gap, ")]].notna().any(axis=1)])  # D_TM: not where the base never slides
         if self.design_rules is not None:
             rules = _grid_only(self.design_rules, keep=("design_level",))
             years = float(rules.attrs.get("years", self.years))
@@ -271,6 +274,25 @@ class StoreRisk:
         index = [c for c in frame.columns if not c.startswith(("gap, ", "meets")) and c not in names.values()]
         return frame.set_index(index).dropna(how="all")
 
+    def dtm_text(self) -> str:
+        """Where the suite-mean D_TM rule applies, in words: why it is absent, or the configurations it is left out of ("" where it
+        applies in every one)."""
+        if self.rules is None:
+            return ""
+        if "dtm" not in self.rules["rule"].values:
+            never = ("the studied building's base slides in no run of this store (a fixed base, or friction the motions never overcame): "
+                     "there is no isolator displacement to size")
+            return f"D_TM is not applied: {self.dtm_note or never}."
+        missing = self.rules["gap"].sel(rule="dtm").isnull().all("contact")
+        missing = missing.any("design_level") if "design_level" in missing.dims else missing
+        if not bool(missing.any()):
+            return ""
+        where = [", ".join(f"{d} {_label(v)}" for d, v in zip(missing.dims, index)) for index in zip(*(
+            missing[d].values[i] for d, i in zip(missing.dims, np.nonzero(missing.values))))] if missing.dims else ["the scene"]
+        return ("D_TM (ASCE 7 §17.2.5.2) sizes the clearance of a base that slides; its rows are left out where the studied building's "
+                f"base never slid in any run ({'; '.join(where)}): a fixed base (μ = ∞), or friction the motions never overcame, has no "
+                "isolator displacement to size (it stays 0), and its separation is the storeys' rules'.")
+
     def design_rules_text(self) -> str:
         """The rules table's design-analysis rows in words: what they are, or why there are none."""
         if self.design_rules is None:
@@ -281,12 +303,22 @@ class StoreRisk:
             period = period.where(self.design_rules["gap"].sel(rule=rule).notnull().all("contact"))  # where the rule applies
             if bool(period.notnull().any()):
                 low, high = float(period.min()), float(period.max())
-                periods.append(f"{RULE_NAMES[str(rule)]}, once in {low:.3g}" + (f" to {high:.3g}" if high != low else "") + " years")
+                periods.append(f"{RULE_NAMES[str(rule)]}, pounding once in {low:.3g}" + (f" to {high:.3g}" if high != low else "") + " years")
+        formulas = {"asce7_delta_mt": "ASCE 7-16 §12.12.3: δ_M = C_d δ_max / I_e, SRSS of the two buildings",
+                    "ec8_ds": "Eurocode 8 §4.4.2.7: d_s = q d_e, SRSS, times 0.7 where the floors stand level",
+                    "asce7_dtm": "ASCE 7-16 §17.2.5.2 D_TM = D_M of eq. 17.5-1 for a friction pendulum"}
+        given = "; ".join(formulas[str(rule)] for rule in self.design_rules["rule"].values if str(rule) in formulas)
         return ("The rows '(design analysis)' are the codes' own gaps, from the linear modal analysis of each building's fixed-base "
-                "storeys under the design spectrum of the store's [design] (ASCE 7-16 §12.12.3: δ_M = C_d δ_max / I_e, SRSS of the two "
-                "buildings; Eurocode 8 §4.4.2.7: d_s = q d_e, SRSS, times 0.7 where the floors stand level; ASCE 7-16 §17.2.5.2 D_TM = D_M "
-                "of eq. 17.5-1 for a friction pendulum), not from the runs; each with the mean annual frequency of pounding at that gap: "
-                f"here, each rule means pounding {'; '.join(periods)}.")
+                f"storeys under the design spectrum of the store's [design] ({given}), not from the runs; each with the mean annual "
+                f"frequency of pounding at that gap: here: {'; '.join(periods)}.{self._without_ec8_text()}")
+
+    def _without_ec8_text(self) -> str:
+        """Why the design-analysis rows have no Eurocode 8 row, when they have none ("" otherwise)."""
+        if self.design_rules is None or "ec8_ds" in self.design_rules["rule"].values:
+            return ""
+        return (" There is no Eurocode 8 §4.4.2.7 row: the store's [design] has no ec8 entry (a_g, ground type, q). Eurocode 8 is "
+                "the design code of a European site, not of this one unless a user designs to it; give [design] an ec8 = { ag, ground, q } (or "
+                "stochpound risk --design) to add its row.")
 
     def design_frame(self) -> pd.DataFrame:
         """The gap to design to: per configuration and target, the upper bound of g*'s interval (m; g* itself without a bootstrap).
@@ -316,7 +348,7 @@ class StoreRisk:
         return degenerate_text(self.fragility["status"].values, self.hazard, what)
 
     def non_increasing_maf(self) -> xr.DataArray:
-        """λ_P(g) made non-increasing along the gaps (its running minimum, the curve g* is read from; 1/yr)."""
+        """λ_P(g) made non-increasing along the gaps (isotonic regression in ln λ, pool-adjacent-violators: the curve g* is read from; 1/yr)."""
         return non_increasing_along(self.curve["maf"], "gap")
 
     def hazard_levels(self, probabilities: Sequence[float] = (0.10, 0.02)) -> dict[float, float]:
@@ -367,7 +399,8 @@ class StoreRisk:
 
 
 def non_increasing_along(maf: xr.DataArray, dim: str) -> xr.DataArray:
-    """A rate made non-increasing along its thresholds ``dim`` (the running minimum; NaN as no bound)."""
+    """A rate made non-increasing along its thresholds ``dim``: the least-squares non-increasing fit of ln λ (pool-adjacent-violators,
+    ``stochpound.risk._maf.non_increasing``), NaN left out of the fit."""
     return xr.apply_ufunc(non_increasing, maf, input_core_dims=[[dim]], output_core_dims=[[dim]]).transpose(*maf.dims)
 
 
@@ -465,8 +498,14 @@ def design_text(probability: float, stripe: float, years: float = YEARS) -> str:
 
 
 def fit_name(status: int) -> str:
-    """A fit's kind in words: ``lognormal`` for a fit, else the step it is (``step: always`` …)."""
-    return "lognormal" if status == FIT else f"step: {STATUS[status]}"
+    """A fit's kind in words: ``lognormal`` for a fit, ``flat: decreasing`` (:func:`~stochpound.risk.flat_fit_maf`), ``no runs``,
+    else the step it is (``step: always`` …)."""
+    return {FIT: "lognormal", DECREASING: "flat: decreasing (F ≡ fraction of runs that pounded)", EMPTY: "no runs"}.get(status, f"step: {STATUS[status]}")
+
+
+def _label(value: Any) -> str:
+    """A grid label in words: ``∞`` for inf, else as it prints."""
+    return "∞" if isinstance(value, float | np.floating) and math.isinf(value) else f"{value:g}" if isinstance(value, float | np.floating) else str(value)
 
 
 def gap_text(value: float) -> str:

@@ -8,7 +8,8 @@ The package holds the definition parsed into types
 (:func:`read_definition`, :class:`Definition`, its identity
 :func:`definition_sha256`), the catalogue of the store's variables
 (:data:`CATALOGUE`: units and long name of each, declared once), the gap axes
-and the selections by meaning (contact-free, wall-free, fixed-base cases),
+and the selections by meaning (contact-free, wall-free, fixed-base cases), the
+stripes' site scenario (:func:`scenario_kind`, :func:`scenario_ranges`),
 :func:`open_store`, and the one door to an open store, the ``pound``
 accessor of an xarray dataset (:class:`StoreAccessor`). It imports the model
 and the shared utilities only: the experiment layer writes stores, the
@@ -60,7 +61,12 @@ from stochpound.store._gap_axes import (
     with_walls,
 )
 from stochpound.store._open import open_store
+from stochpound.store._scenario import SCENARIO_KINDS, scenario_kind, scenario_ranges
 from stochpound.store._selections import fixed_base, has_fixed_base_twins, isolated_mus
+
+# For the other packages of stochpound (their interface to this one, not public API: not in __all__).
+from stochpound.store._catalogue import CASE, KINDS, REFERENCE  # noqa: F401
+from stochpound.store._definition import MEASURES  # noqa: F401
 
 __all__ = [
     "ACCESSOR",
@@ -71,6 +77,7 @@ __all__ = [
     "NOT_IN_IDENTITY",
     "REFERENCE_HISTORY",
     "REFERENCE_SUMMARIES",
+    "SCENARIO_KINDS",
     "SETS",
     "STOREY_SUMMARIES",
     "LIMIT_STATE_DEMANDS",
@@ -103,6 +110,8 @@ __all__ = [
     "open_store",
     "read_definition",
     "register_grid",
+    "scenario_kind",
+    "scenario_ranges",
     "wall_free",
     "wall_gap_dims",
     "with_contacts",

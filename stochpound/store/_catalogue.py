@@ -17,6 +17,11 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 
+CASE = "case"
+REFERENCE = "reference"
+KINDS = (REFERENCE, CASE)
+"""The kinds of case a store holds, in store order: the fixed-base references and the cases."""
+
 _STUDIED = "of the studied building's top-floor total displacement"
 _ALONE = " (studied building alone on a fixed base)"
 

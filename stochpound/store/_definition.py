@@ -39,7 +39,7 @@ from typing import Any
 from stochpound._errors import ExperimentError
 from stochpound.model.friction import is_fixed_base
 
-NOT_IN_IDENTITY = ("hazard", "design", "scene_source", "limit_states")
+NOT_IN_IDENTITY = ("hazard", "design", "scene_source", "site", "limit_states")
 """Entries of a canonical definition that no run depends on, left out of its identity (:func:`~stochpound.store.definition_sha256`)."""
 
 
@@ -67,6 +67,10 @@ def definition_sha256(definition: Mapping[str, Any]) -> str:
     """
     runs = {key: value for key, value in definition.items() if key not in NOT_IN_IDENTITY}
     return hashlib.sha256(canonical_json(runs).encode()).hexdigest()
+
+
+MEASURES = ("pga", "pgv", "psa", "sa_avg")
+"""The intensity measures an ``[intensity]`` (and a ``[hazard]``) table may name."""
 
 
 def describe_measure(intensity: Mapping[str, Any]) -> str:
@@ -402,6 +406,11 @@ class Definition:
         Where the base scene was read from: ``file`` (its path, relative to the experiment file) or
         ``bundled`` (a bundled scene's name), and ``sha256`` (of the file's bytes); None: an inline
         scene (not part of the identity: ``scene`` holds the file's content).
+    site : mapping or None
+        How the stripes' scenario was obtained, with a ``[site]`` table: ``scenario`` (``"given"`` or
+        ``"fitted"``) and, when fitted, the ``curves`` it was fitted to (not part of the identity: the
+        runs depend on the scenarios themselves, ``intensity.site``); None: no ``[site]`` table (and for
+        definitions stored before the field).
     """
 
     name: str
@@ -422,6 +431,7 @@ class Definition:
     design: Mapping[str, Any] | None = None
     limit_states: Mapping[str, Any] | None = None
     scene_source: Mapping[str, str] | None = None
+    site: Mapping[str, Any] | None = None
 
     def to_dict(self) -> dict[str, Any]:
         """The canonical definition (a copy): what ``parse_experiment`` returned (``stochpound.experiment._spec``)."""
@@ -520,4 +530,5 @@ def _from_dict(data: dict[str, Any]) -> Definition:
         design=data.get("design"),
         limit_states=data.get("limit_states"),
         scene_source=data.get("scene_source"),
+        site=data.get("site"),
     )

@@ -21,12 +21,10 @@ gives (see :class:`StudyReport`):
 
 from __future__ import annotations
 
-import importlib
 from collections.abc import Callable, Mapping
 from typing import TYPE_CHECKING, Protocol
 
-from stochpound._errors import StochpoundError
-from stochpound._studies import STUDIES, Study, parse_reproduces
+from stochpound._studies import STUDIES, Study, claims, load_study, parse_reproduces
 
 if TYPE_CHECKING:
     import xarray as xr
@@ -46,44 +44,3 @@ class StudyReport(Protocol):
 
     def summary(self, sections: list[Section]) -> Section | None:
         """The summary that opens the report, given its sections; None: no summary."""
-
-
-def claims(declared: Mapping[str, str | None]) -> dict[str, dict[str, str]]:
-    """Which stores each study claims, by their declarations.
-
-    Parameters
-    ----------
-    declared : mapping of str to str or None
-        Each store's experiment name and its ``reproduces`` declaration (None: none).
-
-    Returns
-    -------
-    dict
-        For each study with at least one store, in the order of first appearance:
-        the experiment name of each part present, by part.
-
-    Raises
-    ------
-    StochpoundError
-        If a declaration is not a registered part, or two stores reproduce the same part.
-    """
-    claimed: dict[str, dict[str, str]] = {}
-    for name, reproduces in declared.items():
-        if reproduces is None:
-            continue
-        try:
-            study, part = parse_reproduces(reproduces)
-        except ValueError as error:
-            raise StochpoundError(f"experiment {name}: reproduces {error}") from None
-        parts = claimed.setdefault(study, {})
-        if part in parts:
-            raise StochpoundError(f"experiments {parts[part]} and {name} both reproduce {study}:{part}; report one of them at a time")
-        parts[part] = name
-    return claimed
-
-
-def load_study(key: str) -> StudyReport:
-    """The package of the study ``key`` (:data:`STUDIES`), imported on first use."""
-    if key not in STUDIES:
-        raise StochpoundError(f"unknown study {key!r} (studies: {', '.join(STUDIES)})")
-    return importlib.import_module(f"{__name__}.{key}")  # type: ignore[return-value]

@@ -64,7 +64,7 @@ def __getattr__(name: str) -> Any:
     """The names of :data:`_MOVED`, from their study (loaded through the study registry), with a DeprecationWarning."""
     if name not in _MOVED:
         raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    from stochpound.studies import load_study
+    from stochpound._studies import load_study
 
     study = _MOVED[name]
     warnings.warn(f"stochpound.motions.records.{name} is deprecated: use stochpound.studies.{study}.{name}",

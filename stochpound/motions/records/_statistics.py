@@ -15,7 +15,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from stochpound.analysis import kernels
+from stochpound.stats import kernels
 from stochpound.motions._arias import DEFAULT_G, arias_intensity
 from stochpound.motions.records._record import Record
 

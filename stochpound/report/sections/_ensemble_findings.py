@@ -16,7 +16,7 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
-from stochpound.analysis import kernels
+from stochpound.stats import kernels
 from stochpound.report.render import Block, Paragraph, Table
 from stochpound.report.sections._ensembles import CM, MIN_RUNS, Ensemble
 from stochpound.experiment import FIXED_BASE, is_fixed_base, is_gap_axis

@@ -30,7 +30,7 @@ import pandas as pd
 import xarray as xr
 from matplotlib.figure import Figure
 
-from stochpound.analysis.kernels import clopper_pearson
+from stochpound.stats.kernels import clopper_pearson
 from stochpound.experiment import describe_measure
 from stochpound.report.render import FigureItem, Paragraph, Section, Table
 from stochpound.report.sections._stripe_motions import stripe_motions_text
@@ -168,15 +168,13 @@ def _stripe_table(name: str, store: xr.Dataset, setting: dict[str, Any]) -> Tabl
     runs, pounded = _pounding_counts(store)
     lower, upper = clopper_pearson(pounded.values, runs.values, CONFIDENCE)
     probability = xr.DataArray(_proportion(pounded.values, runs.values), runs.coords, runs.dims)
-    frame = xr.Dataset(
-        {
-            "runs": runs,
-            "pounded": pounded,
-            "P(pounding)": probability,
-            "lower": (runs.dims, lower),
-            "upper": (runs.dims, upper),
-        }
-    ).to_dataframe()
+    # a run's impacts count its hits on a moat wall too: where a wall was hit, they are impacts, not pounding on the neighbour
+    walls = "peak_wall_penetration" in store and bool((store["peak_wall_penetration"] > 0).any())
+    event, probability_name = ("impacted", "P(impact)") if walls else ("pounded", "P(pounding)")
+    counts = {event: pounded, probability_name: probability}
+    if walls:
+        counts["wall hit"] = ((store["peak_wall_penetration"] > 0) & (store["case_status"] == 1)).sum(("record", "realization"))
+    frame = xr.Dataset({"runs": runs, **counts, "lower": (runs.dims, lower), "upper": (runs.dims, upper)}).to_dataframe()
     scale = _first_cell(store["scale_factor"]).where(_first_cell(store["case_status"]) == 1)
     factors = pd.DataFrame(
         {
@@ -186,12 +184,15 @@ def _stripe_table(name: str, store: xr.Dataset, setting: dict[str, Any]) -> Tabl
         }
     )
     frame = frame.reset_index().merge(factors.reset_index(), on="intensity").set_index(list(runs.dims))
+    what = ("runs with an impact (on the neighbour or on a moat wall: at gap = ∞ the contacts never close, so every impact there "
+            "is a wall hit), the runs that hit a wall, and the probability of an impact" if walls else
+            "runs that pounded and the probability of pounding")
     return Table(
         f"intensity-stripes-{name}",
-        f"Experiment {name}: every stripe ({describe_measure(setting)} in {setting['units']}): scale factors, runs, runs that "
-        f"pounded and the probability of pounding with its {int(100 * CONFIDENCE)} % Clopper–Pearson interval",
+        f"Experiment {name}: every stripe ({describe_measure(setting)} in {setting['units']}): scale factors, runs, {what} with its "
+        f"{int(100 * CONFIDENCE)} % Clopper–Pearson interval",
         frame,
-        formats={"runs": "{:.0f}", "pounded": "{:.0f}", "P(pounding)": "{:.3f}", "lower": "{:.3f}", "upper": "{:.3f}"},
+        formats={"runs": "{:.0f}", event: "{:.0f}", "wall hit": "{:.0f}", probability_name: "{:.3f}", "lower": "{:.3f}", "upper": "{:.3f}"},
     )
 
 

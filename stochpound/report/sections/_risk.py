@@ -36,7 +36,7 @@ from matplotlib.ticker import LogLocator, NullFormatter
 from stochpound.report.render import Block, FigureItem, Paragraph, Section, Table
 from stochpound.report.sections._facets import labels_text
 from stochpound.report.sections._stripe_motions import is_selected
-from stochpound.risk import StoreDemands, StoreRisk, rate_from_probability
+from stochpound.risk import StoreDemands, StoreRisk, degenerate_text, rate_from_probability
 from stochpound.store import describe_measure
 
 
@@ -110,9 +110,7 @@ def risk_section(name: str, risk: StoreRisk, demands: StoreDemands | None = None
     section.add(Paragraph(headline_text(name, risk)))
     section.add(Paragraph(design_summary_text(risk, demands)))
     section.add(Paragraph(_hazard_text(risk)))
-    section.add(Table(f"risk-separation-{name}", f"Experiment {name}: risk-targeted separation g* per configuration and target, with its "
-                      f"{_percent(risk.confidence)} BCa bootstrap interval (the motions resampled)", risk.separation_frame(),
-                      note=_grid_note(risk), formats={"g* (m)": "{:.3f}", "lower (m)": "{:.3f}", "upper (m)": "{:.3f}"}))
+    section.add(_separation_table(name, risk))
     section.add(_risk_curve_figure(name, risk))
     section.add(_surface_figure(name, risk))
     section.add(_curves_figure(name, risk))
@@ -126,13 +124,20 @@ def risk_section(name: str, risk: StoreRisk, demands: StoreDemands | None = None
     return section
 
 
+def _separation_table(name: str, risk: StoreRisk) -> Table:
+    """The g* table, its caption saying how the intervals resampled the motions."""
+    return Table(f"risk-separation-{name}", f"Experiment {name}: risk-targeted separation g* per configuration and target, with its "
+                 f"{_percent(risk.confidence)} interval ({_resampling(risk)})", risk.separation_frame(),
+                 note=_grid_note(risk), formats={"g* (m)": "{:.3f}", "lower (m)": "{:.3f}", "upper (m)": "{:.3f}"})
+
+
 def design_summary_text(risk: StoreRisk, demands: StoreDemands | None = None) -> str:
     """The design summary: the governing limit state per target, the gap to design to, which code rules meet their level, and
     what the answer rests on (hazard, scenario, structural model, suite), all from the chain's results and the store."""
     wall = _wall_governs(risk, demands)
     governing = "; ".join(
-        (f"the moat wall ({wall[t][0]:.3g} m clearance, reached once in {1 / wall[t][1]:.3g} yr)" if t in wall else "pounding between the buildings")
-        + f" for {risk.target_text(t)}" for t in risk.separation["target"].values)
+        (f"the moat wall ({wall[t][0]:.3g} m clearance, reached once in {1 / wall[t][1]:.3g}{_wall_interval(demands, wall[t][0])} yr)"
+         if t in wall else "pounding between the buildings") + f" for {risk.target_text(t)}" for t in risk.separation["target"].values)
     rules = risk.rules_frame()
     if rules.empty:
         meets = f"The code rules were not evaluated ({risk.rules_note})."
@@ -163,6 +168,15 @@ def _wall_rates(risk: StoreRisk, demands: StoreDemands) -> list[tuple[float, flo
     return rows
 
 
+def _wall_interval(demands: StoreDemands | None, clearance: float) -> str:
+    """`` [lower, upper]`` of the return period of reaching the wall at ``clearance`` in its worst configuration ("" without a bootstrap)."""
+    if demands is None or demands.moat is None or "return_period_lower" not in demands.moat:
+        return ""
+    at = demands.moat.sel(level=clearance)
+    worst = at["maf"].fillna(-1.0).argmax(...)
+    return f" [{float(at['return_period_lower'].isel(worst)):.3g}, {float(at['return_period_upper'].isel(worst)):.3g}]"
+
+
 def _wall_governs(risk: StoreRisk, demands: StoreDemands | None) -> dict[float, tuple[float, float]]:
     """Per target the wall is reached more often than it allows: target → (clearance m, rate of reaching it 1/yr, worst configuration)."""
     governs: dict[float, tuple[float, float]] = {}
@@ -184,7 +198,7 @@ def design_value_text(risk: StoreRisk) -> str:
         values = "; ".join(f"{_gap_text(row.design)} for {risk.target_text(row.target)}" for row in rows.itertuples())
         per.append(f"{labels_text(dict(zip(config, labels))) or 'the scene'}: {values}")
     return (f"The gap to design to is the {frame['basis'].iloc[0]}, not g* itself (g* is a central estimate from "
-            f"{risk.motions} motions and meets its target only about half the time): " + ". ".join(per) + ".")
+            f"{risk.motions} motions{' per stripe' if is_selected(risk.setting) else ''} and meets its target only about half the time): " + ". ".join(per) + ".")
 
 
 def moat_text(risk: StoreRisk, demands: StoreDemands | None) -> str:
@@ -204,12 +218,12 @@ def moat_text(risk: StoreRisk, demands: StoreDemands | None) -> str:
                    "at that level the base reaches the wall, so the code's D_TM is not met by the moat"
                    if exceeded else f"is within the moat clearance{'s' if len(clearances) > 1 else ''} "
                    f"{', '.join(f'{c:.3g} m' for c in clearances)}")
-        sentences.append(f"The wall-free D_TM (suite-mean peak base displacement without the wall) at {100 * level:g} %/{risk.years:g} yr is "
+        values = dtm.sel(design_level=level).values
+        largest = " (the largest over the configurations)" if np.unique(values[np.isfinite(values)]).size > 1 else ""
+        sentences.append(f"The wall-free D_TM (suite-mean peak base displacement without the wall) at {100 * level:g} %/{risk.years:g} yr{largest} is "
                          f"{value:.3g} m and {verdict}.")
-    for target, clearance, wall, allowed, worst in _wall_rates(risk, demands):
-        bounds = demands.moat.sel(level=clearance).isel(worst) if "return_period_lower" in demands.moat else None
-        interval = (f" [{float(bounds['return_period_lower']):.3g}, {float(bounds['return_period_upper']):.3g}]"
-                    if bounds is not None else "")
+    for target, clearance, wall, allowed, _ in _wall_rates(risk, demands):
+        interval = _wall_interval(demands, clearance)
         relation = ("more often than the target allows (once in {:.3g} yr): the wall, not the gap, governs this target"
                     if wall > allowed else "less often than the target allows (once in {:.3g} yr): the wall does not govern this target")
         sentences.append(f"The base reaches the {clearance:.3g} m moat wall once in {1 / wall:.3g}{interval} yr (worst configuration), "
@@ -366,22 +380,32 @@ def _rules_blocks(name: str, risk: StoreRisk) -> list[Block]:
         return [Paragraph(f"Code rules in risk terms: not evaluated for experiment {name}: {risk.rules_note}.")]
     rules = risk.rules
     years = risk.years
-    code = ", ".join(f"{100 * p:g} %/{years:g} yr: {float(c):.3g} (stripe {float(s):g})" for p, c, s in
+    units = f" {risk.setting['units']}" if risk.setting.get("units") else ""
+    code = ", ".join(f"{100 * p:g} %/{years:g} yr: {float(c):.3g}{units} (stripe {float(s):g}{units})" for p, c, s in
                      zip(rules["design_level"].values, rules["code_intensity"].values, rules["stripe_intensity"].values))
     frame = risk.rules_frame()
     shortest, longest = risk.return_period_range()
     text = (
-        f"Code rules in risk terms (experiment {name}): each rule's gap is computed from the suite means of the stripe nearest the "
-        f"code intensity (the hazard's intensities, and the stripes used: {code}); its risk is the mean annual frequency of pounding "
-        f"at that gap, fitted over every stripe: 'this rule means pounding once in N years here'. Over the rules, levels and "
-        f"configurations, the return periods range from {shortest:.3g} to {longest:.3g} years."
+        f"Code rules in risk terms (experiment {name}): each suite-mean rule's gap is computed from the suite means of the stripe "
+        f"nearest the code intensity (the hazard's intensities, and the stripes used: {code}); its risk is the mean annual frequency "
+        f"of pounding at that gap, fitted over every stripe: 'this rule means pounding once in N years here'. Over the suite-mean "
+        f"rules, levels and configurations, the return periods range from {shortest:.3g} to {longest:.3g} years."
     )
-    if "dtm" not in rules["rule"].values:
-        text += f" D_TM is not applied: {risk.dtm_note or 'the studied building has no sliding base in this store'}."
+    dtm = risk.dtm_text()
+    if dtm:
+        text += f" {dtm}"
     text += " " + risk.design_rules_text()
+    statuses = [rules["status"].values.ravel()]
+    if risk.design_rules is not None:  # where a rule applies (a gap at every contact)
+        applies = risk.design_rules["gap"].notnull().all("contact")
+        statuses.append(risk.design_rules["status"].values[applies.broadcast_like(risk.design_rules["status"]).values])
+    degenerate = degenerate_text(np.concatenate(statuses), risk.hazard, "rule rows")
+    if degenerate:
+        text += " Rule rows whose fit is not a lognormal (their 'fit' column): " + degenerate.removeprefix("Degenerate fits, not lognormals: ")
     table = Table(f"risk-rules-{name}", f"Experiment {name}: the code separation rules in risk terms: the gap at each contact, the "
                   f"mean annual frequency λ_P of pounding at it, the return period and the probability in {years:g} years, each with its "
-                  f"{_percent(risk.confidence)} bootstrap interval, and the fragility's kind (a lognormal, or a degenerate step)", frame,
+                  f"{_percent(risk.confidence)} bootstrap interval, and the fragility's kind (a lognormal, a degenerate step, or flat where the "
+                  "counts do not rise with intensity)", frame,
                   formats={**_RATE_FORMATS, "λ_P (1/yr)": "{:.3g}", "λ_P lower": "{:.3g}", "λ_P upper": "{:.3g}", f"P in {years:g} yr": "{:.3f}",
                            **{c: "{:.3f}" for c in frame.columns if str(c).startswith("gap")}})
     return [Paragraph(text), table]
@@ -412,7 +436,7 @@ def _demand_blocks(name: str, risk: StoreRisk, demands: StoreDemands | None) -> 
         axes[0].legend(fontsize=5)
     blocks: list[Block] = [FigureItem(f"risk-demands-{name}", f"Experiment {name}: demand hazard curves (mean annual frequency of "
                                       "exceeding each level, a lognormal fragility fitted at every level over the stripes' "
-                                      "contact-free runs (a step where the runs identify no lognormal) and integrated with the hazard, made non-increasing along the level), per "
+                                      "contact-free runs (a step, or flat, where the runs identify no lognormal) and integrated with the hazard, made non-increasing along the level), per "
                                       "configuration.", figure)]
     if demands.moat is not None:
         blocks.append(Table(f"risk-moat-{name}", f"Experiment {name}: moat-wall contact as a limit state: the mean annual frequency with "

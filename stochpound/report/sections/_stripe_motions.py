@@ -7,6 +7,8 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
+from stochpound.store import scenario_ranges
+
 
 def is_selected(setting: dict[str, Any] | None) -> bool:
     """Whether the intensity setting chooses motions per stripe (``selection``) rather than scaling every motion to every level."""
@@ -24,11 +26,5 @@ def stripe_motions_text(store: xr.Dataset) -> str:
     method = str((store.pound.intensity or {}).get("selection", "a selection")).replace("_", "-")
     text = (f"{count} motions per stripe, chosen by {method} selection from a pool of {pool} and scaled to the stripe's level "
             f"(scale factors {np.nanmin(scale):.3g}–{np.nanmax(scale):.3g})")
-    if "site_magnitude" in store:
-        text += f"; target scenario {_span(store['site_magnitude'], 'M {}')}, {_span(store['site_distance_km'], 'R {} km')}, {_span(store['site_vs30'], 'Vs30 {} m/s')}"
-    return text
-
-
-def _span(values: xr.DataArray, pattern: str) -> str:
-    low, high = float(values.min()), float(values.max())
-    return pattern.format(f"{low:.3g}" if low == high else f"{low:.3g}–{high:.3g}")
+    ranges = scenario_ranges(store)
+    return text if ranges is None else f"{text}; target scenario {ranges}"

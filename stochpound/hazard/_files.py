@@ -38,7 +38,7 @@ from typing import Any
 
 import numpy as np
 
-from stochpound.analysis._hazard import HazardCurve, rate_from_probability
+from stochpound.hazard._curve import HazardCurve, rate_from_probability
 
 FORMATS = ("stochpound", "openquake", "nshmp-haz")
 """The hazard-file formats :func:`read_hazard_file` reads."""

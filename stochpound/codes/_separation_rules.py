@@ -24,12 +24,12 @@ import xarray as xr
 from numpy.typing import ArrayLike
 from scipy.linalg import eigh
 
-from stochpound.analysis._correlation import correlation
+from stochpound.stats import correlation
 from stochpound.model.building import Building, storey_matrix
 from stochpound.model.scene import Scene
 
 EC8_REDUCTION = 0.7
-"""Eurocode 8's factor on the SRSS separation where the floor levels of the two buildings coincide."""
+"""Eurocode 8's factor on the SRSS separation where the floor levels of the two buildings coincide (EN 1998-1 §4.4.2.7(3))."""
 RULES = ("abs", "srss", "srss_reduced", "ddc", "ddc_cqc")
 """Names of the rules on the ``rule`` dimension of :func:`separation_rules` (``ddc_cqc`` only when given a CQC ρ)."""
 

@@ -27,7 +27,7 @@ from typing import NamedTuple
 import numpy as np
 from scipy import stats
 
-from stochpound.analysis._bootstrap import bootstrap_weights
+from stochpound.stats._bootstrap import bootstrap_weights
 
 Axis = int | tuple[int, ...]
 
@@ -320,7 +320,7 @@ def bootstrap_mean_interval(values: np.ndarray, confidence: float = 0.95, resamp
 
 @lru_cache(maxsize=64)
 def _resample_weights(n: int, resamples: int) -> np.ndarray:
-    """:func:`~stochpound.analysis._bootstrap.bootstrap_weights` of n values seeded with (:data:`BOOTSTRAP_SEED`, n), cached read-only."""
+    """:func:`~stochpound.stats._bootstrap.bootstrap_weights` of n values seeded with (:data:`BOOTSTRAP_SEED`, n), cached read-only."""
     weights = bootstrap_weights(n, resamples, (BOOTSTRAP_SEED, n))
     weights.flags.writeable = False
     return weights

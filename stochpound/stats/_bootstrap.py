@@ -38,7 +38,7 @@ def bootstrap_weights(motions: int, resamples: int, seed: int | Sequence[int], c
     are correlated; resampling them as if independent makes intervals too
     narrow. Singleton clusters in motion order give exactly the plain
     resampler's weights. The fragility and risk bootstraps and the percentile
-    bootstrap of the mean (:func:`stochpound.analysis.kernels.bootstrap_mean_interval`)
+    bootstrap of the mean (:func:`stochpound.stats.kernels.bootstrap_mean_interval`)
     all use it.
 
     Parameters
@@ -114,11 +114,40 @@ def record_clusters(data: xr.DataArray | xr.Dataset, record_dim: str = "record")
     return motion_clusters(data.coords["record_event"].values, stations)
 
 
-def bootstrap_method(clusters: np.ndarray | None) -> str:
-    """How the motions were resampled, in words, for results' ``method`` attributes."""
+def bootstrap_method(clusters: np.ndarray | None, ran: np.ndarray | None = None) -> str:
+    """How the motions were resampled, in words, for results' ``method`` attributes.
+
+    Parameters
+    ----------
+    clusters : numpy.ndarray or None
+        Each motion's cluster (:func:`motion_clusters`); None: every motion its own.
+    ran : numpy.ndarray of bool, optional
+        Which motions ran (last axis: the motions; leading axes, e.g. one per
+        stripe, each a sample of its own). A motion that did not run (a
+        conditional-spectrum stripe runs only its chosen motions of a pool)
+        adds nothing to the fits, so the sentence counts the clusters and
+        motions of the runs: over all of them and, where they differ, per
+        stripe. Default: every motion ran.
+    """
     if clusters is None:
         return "BCa bootstrap over motions"
-    return f"BCa cluster bootstrap over events ({len(set(clusters))} clusters of {len(clusters)} motions; station where the event is unknown)"
+    labels = np.asarray(clusters, dtype=object)
+    ran = np.ones((1, labels.size), dtype=bool) if ran is None else np.asarray(ran, dtype=bool).reshape(-1, labels.size)
+    used = ran.any(0)
+    counts = sorted({(len(set(labels[row])), int(row.sum())) for row in ran if row.any()})
+    text = f"{len(set(labels[used]))} clusters of the {int(used.sum())} motions that ran"
+    if used.sum() < labels.size:
+        text = f"{text}, of a pool of {labels.size}"
+    if counts and counts != [(len(set(labels[used])), int(used.sum()))]:
+        clusters, motions = (_span([pair[i] for pair in counts]) for i in (0, 1))
+        text = f"{text}; per stripe {clusters} clusters of {motions} motions"
+    return f"BCa cluster bootstrap over events ({text}; station where the event is unknown)"
+
+
+def _span(values: list[int]) -> str:
+    """``a`` or ``a–b``: the smallest and largest of ``values``."""
+    low, high = min(values), max(values)
+    return f"{low}" if low == high else f"{low}–{high}"
 
 
 def _cluster_index(motions: int, clusters: Sequence[object] | None) -> tuple[np.ndarray, int]:

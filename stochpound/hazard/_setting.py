@@ -42,9 +42,10 @@ from typing import Any, Mapping, Sequence
 
 import xarray as xr
 
-from stochpound.analysis import HazardCurve, bundled_curves, bundled_measure, bundled_path, parse_units, read_hazard_file, unit_factor
-from stochpound.experiment._intensity import MEASURES, IntensityError
-from stochpound.store import describe_measure
+from stochpound._errors import IntensityError
+from stochpound.hazard._curve import HazardCurve, bundled_curves, bundled_measure, bundled_path
+from stochpound.hazard._files import parse_units, read_hazard_file, unit_factor
+from stochpound.store import MEASURES, describe_measure
 from stochpound.model import fields as toml_fields
 from stochpound.motions import DEFAULT_G
 

@@ -1,4 +1,4 @@
-"""Applying a numpy kernel (:mod:`stochpound.analysis.kernels`) to xarray objects, lazily on dask."""
+"""Applying a numpy kernel (:mod:`stochpound.stats.kernels`) to xarray objects, lazily on dask."""
 
 from __future__ import annotations
 

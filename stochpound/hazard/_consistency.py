@@ -26,7 +26,7 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
-from stochpound.analysis._hazard import HazardCurve
+from stochpound.hazard._curve import HazardCurve
 
 
 def stripe_rate_weights(levels: np.ndarray, hazard: HazardCurve, field: str = "levels") -> np.ndarray:

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import xarray as xr
 
-from stochpound.analysis import kernels
-from stochpound.analysis._ufunc import reduce
+from stochpound.stats import kernels
+from stochpound.stats._ufunc import reduce
 
 
 def correlation(response: xr.DataArray, reference: xr.DataArray, dim: str = "time") -> xr.DataArray:
@@ -15,7 +15,7 @@ def correlation(response: xr.DataArray, reference: xr.DataArray, dim: str = "tim
     displacement with the single fixed-base building's under the same motion.
     Dimensions other than ``dim`` broadcast (e.g. a grid over μ against one
     fixed-base reference); pairs with a NaN are dropped
-    (:func:`stochpound.analysis.kernels.pearson`). Lazy on dask-backed inputs.
+    (:func:`stochpound.stats.kernels.pearson`). Lazy on dask-backed inputs.
     """
     result = reduce(kernels.pearson, [response, reference], [dim])
     return result.assign_attrs(units="1", long_name=f"correlation along {dim}")

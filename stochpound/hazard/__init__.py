@@ -1,0 +1,41 @@
+"""A site's seismic hazard: the curve, the files it is read from, an experiment's ``[hazard]`` table, the stripes' consistency with it.
+
+:class:`HazardCurve` is the mean annual rate at which an intensity measure
+is exceeded (a table or a power law; the bundled sites' curves);
+:func:`read_hazard_file` reads one from stochpound's, OpenQuake's or
+nshmp-haz's files with what it is a curve of; :func:`parse_hazard` reads
+an experiment file's ``[hazard]`` table into the canonical entry a store
+carries, :func:`stored_hazard` gives a store's curve back and
+:func:`hazard_option` reads ``stochpound risk --hazard``;
+:func:`hazard_consistency` recomputes the hazard at another measure from
+the stripes' motions. The experiment reader, the statistics
+(:mod:`stochpound.analysis`, which gives these names to its users) and the
+risk chain (:mod:`stochpound.risk`) all read the hazard here: this package
+imports none of them.
+"""
+
+from stochpound.hazard._curve import HazardCurve, bundled_curves, bundled_measure, bundled_site_curves, probability_from_rate, rate_from_probability, return_period
+from stochpound.hazard._files import HazardFile, parse_measure, parse_units, read_hazard_file
+from stochpound.hazard._consistency import hazard_consistency, stripe_rate_weights
+from stochpound.hazard._setting import check_covers, hazard_curve, hazard_option, parse_hazard, stored_hazard
+
+__all__ = [
+    "HazardCurve",
+    "bundled_curves",
+    "bundled_measure",
+    "bundled_site_curves",
+    "probability_from_rate",
+    "rate_from_probability",
+    "return_period",
+    "HazardFile",
+    "read_hazard_file",
+    "parse_measure",
+    "parse_units",
+    "hazard_consistency",
+    "stripe_rate_weights",
+    "parse_hazard",
+    "hazard_curve",
+    "check_covers",
+    "hazard_option",
+    "stored_hazard",
+]
