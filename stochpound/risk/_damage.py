@@ -29,7 +29,7 @@ from collections.abc import Sequence
 import numpy as np
 import xarray as xr
 
-from stochpound.analysis import rate_from_probability
+from stochpound.hazard import rate_from_probability
 from stochpound.risk import _store
 from stochpound.risk._limit_states import KINDS, LimitState, limit_state_risk, limit_states_from_table
 from stochpound.risk._maf import TARGETS
