@@ -222,3 +222,20 @@ def test_methods_says_what_p_delta_does_only_where_a_building_has_it(store):
 def _without_p_delta(scene):
     import dataclasses
     return dataclasses.replace(scene, buildings=tuple(dataclasses.replace(b, p_delta=False) for b in scene.buildings))
+
+
+def test_the_design_summary_names_the_limit_state_the_damage_section_finds_governing(store):
+    """The summary's governing limit state agrees with the Damage section's: a structural limit state reached more often than
+    pounding at g* is named there with its count of configurations; with capacities no run reaches, pounding alone."""
+    from stochpound.report.sections._risk import design_summary_text
+    from stochpound.risk import LimitState, store_risk
+    risk, damage = store_risk(store), store_damage(store)
+    text = design_summary_text(risk, None, damage)
+    for probability in (0.1, 0.02):
+        governing = [str(v) for v in damage.governing(probability).values.ravel()]
+        structural = [g for g in governing if g != "pounding at g*"]
+        assert structural, "the weak storeys of this store reach a drift limit more often than the target's rate"
+        assert f"{structural[0]} in {governing.count(structural[0])} of {len(governing)} configurations" in text
+    unreached = store_damage(store, [LimitState("ductility", 1.0e4)], "a test")
+    assert "except where" not in design_summary_text(risk, None, unreached)
+    assert "except where" not in design_summary_text(risk, None, None)

@@ -77,8 +77,8 @@ def assemble_report(paths: Sequence[str | Path], progress: Callable[[str], None]
         if has_risk(store):
             say(f"experiment {name}: risk")
             risks[name] = store_risk(store)
-            report.sections.append(risk_section(name, risks[name], store_demands(store)))
             damage = store_damage(store)
+            report.sections.append(risk_section(name, risks[name], store_demands(store), damage))
             if damage is not None:
                 report.sections.append(damage_section(name, damage))
     for name, store in others.items():

@@ -36,7 +36,7 @@ from matplotlib.ticker import LogLocator, NullFormatter
 from stochpound.report.render import Block, FigureItem, Paragraph, Section, Table
 from stochpound.report.sections._facets import labels_text
 from stochpound.report.sections._stripe_motions import is_selected
-from stochpound.risk import StoreDemands, StoreRisk, degenerate_text, rate_from_probability
+from stochpound.risk import StoreDamage, StoreDemands, StoreRisk, degenerate_text, rate_from_probability
 from stochpound.store import describe_measure
 
 
@@ -104,11 +104,12 @@ def summary_answer(name: str, risk: StoreRisk) -> list[Block]:
 # ---------------------------------------------------------------- the section
 
 
-def risk_section(name: str, risk: StoreRisk, demands: StoreDemands | None = None) -> Section:
-    """The "Risk" section of one store, from its risk chain and its demand hazard curves (:func:`~stochpound.risk.store_demands`)."""
+def risk_section(name: str, risk: StoreRisk, demands: StoreDemands | None = None, damage: StoreDamage | None = None) -> Section:
+    """The "Risk" section of one store, from its risk chain, its demand hazard curves (:func:`~stochpound.risk.store_demands`)
+    and, for yielding buildings, the damage its runs did (:func:`~stochpound.risk.store_damage`)."""
     section = Section(f"Risk: experiment {name}", key=f"risk-{name}")
     section.add(Paragraph(headline_text(name, risk)))
-    section.add(Paragraph(design_summary_text(risk, demands)))
+    section.add(Paragraph(design_summary_text(risk, demands, damage)))
     section.add(Paragraph(_hazard_text(risk)))
     section.add(_separation_table(name, risk))
     section.add(_risk_curve_figure(name, risk))
@@ -131,13 +132,14 @@ def _separation_table(name: str, risk: StoreRisk) -> Table:
                  note=_grid_note(risk), formats={"g* (m)": "{:.3f}", "lower (m)": "{:.3f}", "upper (m)": "{:.3f}"})
 
 
-def design_summary_text(risk: StoreRisk, demands: StoreDemands | None = None) -> str:
+def design_summary_text(risk: StoreRisk, demands: StoreDemands | None = None, damage: StoreDamage | None = None) -> str:
     """The design summary: the governing limit state per target, the gap to design to, which code rules meet their level, and
     what the answer rests on (hazard, scenario, structural model, suite), all from the chain's results and the store."""
     wall = _wall_governs(risk, demands)
     governing = "; ".join(
         (f"the moat wall ({wall[t][0]:.3g} m clearance, reached once in {1 / wall[t][1]:.3g}{_wall_interval(demands, wall[t][0])} yr)"
-         if t in wall else "pounding between the buildings") + f" for {risk.target_text(t)}" for t in risk.separation["target"].values)
+         if t in wall else "pounding between the buildings") + _structural_governs(damage, float(t)) + f" for {risk.target_text(t)}"
+        for t in risk.separation["target"].values)
     rules = risk.rules_frame()
     if rules.empty:
         meets = f"The code rules were not evaluated ({risk.rules_note})."
@@ -149,6 +151,21 @@ def design_summary_text(risk: StoreRisk, demands: StoreDemands | None = None) ->
     rests = "; ".join(f"{key}: {value}" for key, value in {"hazard": f"{risk.hazard.describe()} ({_source(risk)})", **risk.assumptions}.items())
     return (f"Design summary. Governing limit state: {governing}. {design_value_text(risk)} {meets} The answer holds only for what it "
             f"rests on; a change to any of these voids it: {rests}.")
+
+
+def _structural_governs(damage: StoreDamage | None, target: float) -> str:
+    """", except where <limit state> is reached more often (n of N configurations; the Damage section)" for the structural limit
+    states :meth:`~stochpound.risk.StoreDamage.governing` names at ``target`` ("" where pounding governs everywhere or without damage)."""
+    governing = damage.governing(target) if damage is not None else None
+    if governing is None:
+        return ""
+    names = [str(v) for v in governing.values.ravel()]
+    structural = {str(state) for state in damage.risk["limit_state"].values}
+    states = {n: names.count(n) for n in names if n in structural}
+    if not states:
+        return ""
+    return (", except where the buildings' own limit state is reached more often than pounding at g*: "
+            + ", ".join(f"{state} in {count} of {len(names)} configurations" for state, count in states.items()) + " (see the Damage section)")
 
 
 def _source(risk: StoreRisk) -> str:
