@@ -236,6 +236,8 @@ def test_the_design_summary_names_the_limit_state_the_damage_section_finds_gover
         structural = [g for g in governing if g != "pounding at g*"]
         assert structural, "the weak storeys of this store reach a drift limit more often than the target's rate"
         assert f"{structural[0]} in {governing.count(structural[0])} of {len(governing)} configurations" in text
+        assert "reached more often than pounding at g*" in text
     unreached = store_damage(store, [LimitState("ductility", 1.0e4)], "a test")
-    assert "except where" not in design_summary_text(risk, None, unreached)
-    assert "except where" not in design_summary_text(risk, None, None)
+    for damage in (unreached, None):
+        text = design_summary_text(risk, None, damage)
+        assert "Governing limit state: pounding between the buildings for 10 % in 50 yr" in text and "own limit state" not in text

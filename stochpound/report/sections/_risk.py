@@ -137,9 +137,9 @@ def design_summary_text(risk: StoreRisk, demands: StoreDemands | None = None, da
     what the answer rests on (hazard, scenario, structural model, suite), all from the chain's results and the store."""
     wall = _wall_governs(risk, demands)
     governing = "; ".join(
-        (f"the moat wall ({wall[t][0]:.3g} m clearance, reached once in {1 / wall[t][1]:.3g}{_wall_interval(demands, wall[t][0])} yr)"
-         if t in wall else "pounding between the buildings") + _structural_governs(damage, float(t)) + f" for {risk.target_text(t)}"
-        for t in risk.separation["target"].values)
+        _structural_governs(damage, float(t), f"the moat wall ({wall[t][0]:.3g} m clearance, reached once in "
+                            f"{1 / wall[t][1]:.3g}{_wall_interval(demands, wall[t][0])} yr)" if t in wall else "pounding between the buildings")
+        + f" for {risk.target_text(t)}" for t in risk.separation["target"].values)
     rules = risk.rules_frame()
     if rules.empty:
         meets = f"The code rules were not evaluated ({risk.rules_note})."
@@ -153,19 +153,21 @@ def design_summary_text(risk: StoreRisk, demands: StoreDemands | None = None, da
             f"rests on; a change to any of these voids it: {rests}.")
 
 
-def _structural_governs(damage: StoreDamage | None, target: float) -> str:
-    """", except where <limit state> is reached more often (n of N configurations; the Damage section)" for the structural limit
-    states :meth:`~stochpound.risk.StoreDamage.governing` names at ``target`` ("" where pounding governs everywhere or without damage)."""
+def _structural_governs(damage: StoreDamage | None, target: float, separation: str) -> str:
+    """What governs at ``target``: ``separation`` (what limits the gap), preceded by the buildings' own limit states where
+    :meth:`~stochpound.risk.StoreDamage.governing` names one (reached more often than pounding at g*), with their counts of
+    configurations; ``separation`` alone where pounding governs everywhere or without ``damage``."""
     governing = damage.governing(target) if damage is not None else None
     if governing is None:
-        return ""
+        return separation
     names = [str(v) for v in governing.values.ravel()]
     structural = {str(state) for state in damage.risk["limit_state"].values}
     states = {n: names.count(n) for n in names if n in structural}
     if not states:
-        return ""
-    return (", except where the buildings' own limit state is reached more often than pounding at g*: "
-            + ", ".join(f"{state} in {count} of {len(names)} configurations" for state, count in states.items()) + " (see the Damage section)")
+        return separation
+    listed = ", ".join(f"{state} in {count} of {len(names)} configurations" for state, count in states.items())
+    rest = "of the separation" if sum(states.values()) == len(names) else "in the other configurations"
+    return f"{listed} (the buildings' own limit state, reached more often than pounding at g*: the Damage section); {rest}, {separation}"
 
 
 def _source(risk: StoreRisk) -> str:
