@@ -98,3 +98,14 @@ def test_every_risk_name_analysis_gives_is_the_risk_package_s():
 
     assert set(stochpound.analysis.RISK_NAMES) <= set(stochpound.risk.__all__)
     assert all(getattr(stochpound.analysis, name) is getattr(stochpound.risk, name) for name in stochpound.analysis.RISK_NAMES)
+
+
+@pytest.mark.parametrize("name", ["HazardCurve", "HazardFile", "read_hazard_file", "bundled_curves", "bundled_measure", "bundled_site_curves",
+                                  "probability_from_rate", "rate_from_probability", "return_period", "hazard_consistency", "stripe_rate_weights"])
+def test_the_analysis_hazard_names_are_the_hazard_package_s(name):
+    """The hazard names analysis exported before stochpound.hazard existed: still there, the same objects."""
+    import stochpound.analysis
+    import stochpound.hazard
+
+    assert name in stochpound.analysis.__all__ and name in stochpound.hazard.__all__
+    assert getattr(stochpound.analysis, name) is getattr(stochpound.hazard, name)
