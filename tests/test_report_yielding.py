@@ -241,3 +241,18 @@ def test_the_design_summary_names_the_limit_state_the_damage_section_finds_gover
     for damage in (unreached, None):
         text = design_summary_text(risk, None, damage)
         assert "Governing limit state: pounding between the buildings for 10 % in 50 yr" in text and "own limit state" not in text
+
+
+def test_the_design_summary_says_how_many_runs_are_beyond_the_model(store):
+    """The summary's assumptions count the runs beyond the model's drift (from StoreDamage), and say nothing of it without them."""
+    import dataclasses
+
+    from stochpound.report.sections._risk import design_summary_text
+    from stochpound.risk import store_risk
+    risk, damage = store_risk(store), store_damage(store)
+    beyond, runs = int(damage.beyond_model.sum()), int(damage.runs.sum())
+    assert beyond > 0, "the weak storeys of this store drift beyond the model at the top stripe"
+    assert f"beyond the model: {beyond} of {runs} runs exceed a {100 * MODEL_DRIFT_LIMIT:g} % storey drift" in design_summary_text(risk, None, damage)
+    assert "beyond the model" not in design_summary_text(risk, None, None)
+    within = dataclasses.replace(damage, beyond_model=damage.beyond_model * 0)
+    assert "beyond the model" not in design_summary_text(risk, None, within)

@@ -36,7 +36,7 @@ from matplotlib.ticker import LogLocator, NullFormatter
 from stochpound.report.render import Block, FigureItem, Paragraph, Section, Table
 from stochpound.report.sections._facets import labels_text
 from stochpound.report.sections._stripe_motions import is_selected
-from stochpound.risk import StoreDamage, StoreDemands, StoreRisk, degenerate_text, rate_from_probability
+from stochpound.risk import MODEL_DRIFT_LIMIT, StoreDamage, StoreDemands, StoreRisk, degenerate_text, rate_from_probability
 from stochpound.store import describe_measure
 
 
@@ -148,7 +148,8 @@ def design_summary_text(risk: StoreRisk, demands: StoreDemands | None = None, da
         met = rules[column].groupby(level="rule", sort=False).all()
         meets = (f"Code rules meeting their own design level as a target in every configuration and level ({column.replace('meets, ', '') if 'upper' in column else 'estimate'}): "
                  f"{', '.join(met.index[met]) or 'none'}; not: {', '.join(met.index[~met]) or 'none'}.")
-    rests = "; ".join(f"{key}: {value}" for key, value in {"hazard": f"{risk.hazard.describe()} ({_source(risk)})", **risk.assumptions}.items())
+    rests = "; ".join(f"{key}: {value}" for key, value in {"hazard": f"{risk.hazard.describe()} ({_source(risk)})", **risk.assumptions,
+                                                          **_beyond_model(damage)}.items())
     return (f"Design summary. Governing limit state: {governing}. {design_value_text(risk)} {meets} The answer holds only for what it "
             f"rests on; a change to any of these voids it: {rests}.")
 
@@ -168,6 +169,16 @@ def _structural_governs(damage: StoreDamage | None, target: float, separation: s
     listed = ", ".join(f"{state} in {count} of {len(names)} configurations" for state, count in states.items())
     rest = "of the separation" if sum(states.values()) == len(names) else "in the other configurations"
     return f"{listed} (the buildings' own limit state, reached more often than pounding at g*: the Damage section); {rest}, {separation}"
+
+
+def _beyond_model(damage: StoreDamage | None) -> dict[str, str]:
+    """The assumption the runs beyond the model strain: {"beyond the model": "<n> of <N> runs ..."} where some run exceeds
+    ``MODEL_DRIFT_LIMIT`` ({} otherwise or without ``damage``)."""
+    if damage is None or not int(damage.beyond_model.sum()):
+        return {}
+    return {"beyond the model": f"{int(damage.beyond_model.sum())} of {int(damage.runs.sum())} runs exceed a "
+                                f"{100 * MODEL_DRIFT_LIMIT:g} % storey drift, where the storeys' lack of strength loss and collapse makes their "
+                                "response not credible; they enter g* and the limit states as computed (the Damage section)"}
 
 
 def _source(risk: StoreRisk) -> str:
