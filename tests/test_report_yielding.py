@@ -168,7 +168,8 @@ def test_a_limit_states_table_is_not_part_of_the_identity_and_replaces_the_defau
     "table, message",
     [
         ("drift = 0.01", r"^limit_states\.drift: not a limit state; one of drift_ratio, residual_drift_ratio"),
-        ("drift_ratio = [0.01, -1.0]", r"^limit_states\.drift_ratio\[1\]: a capacity must be a number > 0, got -1\.0"),
+        ("drift_ratio = [0.01, -1.0]", r"^limit_states\.drift_ratio\[1\]: a capacity must be a number > 0 \(1\), got -1\.0"),
+        ("impact_force = { B1 = 1.0e5 }", r"^limit_states\.impact_force\.B1: has no building \(an impact force is a contact's\), got 'B1'"),
         ("ductility = { B9 = 4.0 }", r"^limit_states\.ductility\.B9: unknown building \(buildings: B1, B2\)"),
         ('source = "x"', r"^limit_states: give at least one limit state"),
     ],

@@ -14,11 +14,11 @@ No run depends on it, so it is not part of the experiment's identity
 
 from __future__ import annotations
 
-import math
 from typing import Any, Mapping, Sequence
 
 from stochpound._errors import SceneError
 from stochpound.model import fields as toml_fields
+from stochpound.risk import limit_state_problem
 from stochpound.store import LIMIT_STATE_DEMANDS
 
 
@@ -58,19 +58,21 @@ def parse_limit_states(data: Mapping[str, Any], buildings: Sequence[str]) -> dic
             for building in value:
                 if building not in buildings:
                     raise SceneError(f"{where}.{building}: unknown building (buildings: {', '.join(buildings)})")
-            capacities[kind] = {building: _capacities(values, f"{where}.{building}") for building, values in value.items()}
+            capacities[kind] = {building: _capacities(kind, values, f"{where}.{building}", building) for building, values in value.items()}
         else:
-            capacities[kind] = _capacities(value, where)
+            capacities[kind] = _capacities(kind, value, where)
     if not capacities:
         raise SceneError(f"limit_states: give at least one limit state ({', '.join(LIMIT_STATE_DEMANDS)})")
     return {"source": source, "capacities": capacities}
 
 
-def _capacities(value: Any, where: str) -> list[float]:
+def _capacities(kind: str, value: Any, where: str, building: str | None = None) -> list[float]:
+    """The capacities of ``value`` (one or a list), each checked by the limit states' one rule (``stochpound.risk.limit_state_problem``)."""
     values = value if isinstance(value, list) else [value]
     if not values:
         raise SceneError(f"{where}: give a capacity > 0 or a list of them")
     for i, capacity in enumerate(values):
-        if isinstance(capacity, bool) or not isinstance(capacity, (int, float)) or not math.isfinite(capacity) or capacity <= 0:
-            raise SceneError(f"{where}{f'[{i}]' if isinstance(value, list) else ''}: a capacity must be a number > 0, got {capacity!r}")
+        problem = limit_state_problem(kind, capacity, building)
+        if problem is not None:
+            raise SceneError(f"{where}{f'[{i}]' if isinstance(value, list) else ''}: {problem}")
     return [float(capacity) for capacity in values]

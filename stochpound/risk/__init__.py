@@ -56,7 +56,7 @@ from stochpound.risk._design_rules import DESIGN_RULE_LEVELS, design_rules_risk,
 from stochpound.risk._store import RiskInputError, contact_free_closure, has_risk, selection_misses, site_hazard
 from stochpound.risk._store_risk import StoreRisk, pounding_fragility, risk_gaps, store_risk
 from stochpound.risk._demands import StoreDemands, store_demands
-from stochpound.risk._limit_states import KINDS as LIMIT_STATE_KINDS, LimitState, gap_cost_frame, limit_state_risk, limit_states_from_table
+from stochpound.risk._limit_states import KINDS as LIMIT_STATE_KINDS, LimitState, gap_cost_frame, limit_state_problem, limit_state_risk, limit_states_from_table
 from stochpound.risk._efficiency import measure_efficiency, most_efficient
 from stochpound.risk._damage import DAMAGE_DEMANDS, DEFAULT_LIMIT_STATES, DEFAULT_SOURCE as DEFAULT_LIMIT_STATES_SOURCE, MODEL_DRIFT_LIMIT, StoreDamage, store_damage
 from stochpound.hazard import hazard_consistency, stripe_rate_weights
@@ -104,6 +104,7 @@ __all__ = [
     "LimitState",
     "LIMIT_STATE_KINDS",
     "limit_states_from_table",
+    "limit_state_problem",
     "limit_state_risk",
     "gap_cost_frame",
     "store_damage",

@@ -55,6 +55,22 @@ KINDS = {kind: _Kind(_store.limit_state_variable(kind), *rest) for kind, rest in
 }.items()}
 
 
+def limit_state_problem(kind: str, capacity: object, building: str | None = None) -> str | None:
+    """What is wrong with a limit state of ``kind`` at ``capacity`` for ``building``, in words for an error naming the field; None if nothing.
+
+    The one rule of a limit state's fields, for :class:`LimitState` and an experiment file's ``[limit_states]`` table:
+    ``kind`` one of ``stochpound.risk.LIMIT_STATE_KINDS``, ``capacity`` a finite number > 0 (in the kind's units), and no
+    ``building`` for a kind that is not a building's (an impact force is a contact's).
+    """
+    if kind not in KINDS:
+        return f"not a limit state; one of {', '.join(KINDS)}"
+    if isinstance(capacity, bool) or not (isinstance(capacity, (int, float)) and math.isfinite(capacity) and capacity > 0):
+        return f"a capacity must be a number > 0 ({KINDS[kind].units}), got {capacity!r}"
+    if building is not None and not KINDS[kind].per_building:
+        return f"has no building (an impact force is a contact's), got {building!r}"
+    return None
+
+
 @dataclasses.dataclass(frozen=True)
 class LimitState:
     """One limit state: a run's ``kind`` of demand reaching ``capacity``.
@@ -78,13 +94,9 @@ class LimitState:
     building: str | None = None
 
     def __post_init__(self) -> None:
-        where = f"limit_states.{self.kind}"
-        if self.kind not in KINDS:
-            raise _store.RiskInputError(f"limit_states.{self.kind}: not a limit state; one of {', '.join(KINDS)}")
-        if isinstance(self.capacity, bool) or not (isinstance(self.capacity, (int, float)) and math.isfinite(self.capacity) and self.capacity > 0):
-            raise _store.RiskInputError(f"{where}: a capacity must be a number > 0 ({KINDS[self.kind].units}), got {self.capacity!r}")
-        if self.building is not None and not KINDS[self.kind].per_building:
-            raise _store.RiskInputError(f"{where}: has no building (an impact force is a contact's), got {self.building!r}")
+        problem = limit_state_problem(self.kind, self.capacity, self.building)
+        if problem is not None:
+            raise _store.RiskInputError(f"limit_states.{self.kind}: {problem}")
 
     @property
     def label(self) -> str:
