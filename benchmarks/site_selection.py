@@ -68,7 +68,7 @@ def report(measure: str, configuration: str, max_scale_factor: float, folder: Pa
     hazard = HazardCurve.bundled(MEASURES[measure][1])
     levels = scale["intensity"].values
     stripes = [dict(t.attrs) for t in sorted(chosen.targets, key=lambda t: t.attrs["level"])]
-    fine = fit_levels(levels, hazard.support[1])
+    fine = fit_levels(levels, hazard.support[1], hazard.support[0])
     conditioning = bundled_measure(MEASURES[measure][1])
     lines = []
     for other, (kind, period) in OTHERS.items():

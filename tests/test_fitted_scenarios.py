@@ -104,6 +104,19 @@ def test_a_fitted_site_stores_the_fitted_scenario_of_every_level(tmp_path) -> No
     assert scenarios == fit_scenarios("psa", 1.0, levels, fine, stripe_rate_weights(fine, hazard), others, 400.0, "reverse")
 
 
+def test_a_fitted_site_takes_stripes_down_to_the_start_of_the_hazard_table(tmp_path) -> None:
+    """Stripes of frequent shaking (an inefficient measure needs them: weak shaking pounds often) are fitted on a fine grid that
+    starts within the table instead of failing five times below the lowest stripe; the grid's first bin stays inside it."""
+    hazard = HazardCurve.bundled("fox_plaza_los_angeles_sa1p0s")
+    low = float(hazard.intensity_at(1.0 / 3.0))  # the 3-year level, less than 5 times the table's first intensity
+    assert low / 5.0 < hazard.support[0]
+    definition = parse_experiment(tomllib.loads(_text(FITTED_SELECTION.replace("[0.9, 0.4]", f"[0.9, {low:.4f}]"), FITTED_SITE)), tmp_path)
+    assert len(definition["intensity"]["site"]) == 2
+    fine = fit_levels([low, 0.9], hazard.support[1], hazard.support[0])
+    assert fine[0] >= hazard.support[0] and fine[0] <= low
+    assert np.all(np.isfinite(stripe_rate_weights(fine, hazard)))
+
+
 def test_the_definition_keeps_how_the_scenario_was_obtained_as_data_outside_the_identity(tmp_path) -> None:
     """The scenario's kind is the definition's ``site`` entry (read by the risk assumptions, not guessed from the note's prose),
     and it leaves the identity as it was: a definition without the entry (a store written before it) hashes the same."""

@@ -225,7 +225,7 @@ def fitted_site(site: Mapping[str, Any], levels: list[float], entry: Mapping[str
         raise SiteError("site.curves: the fit needs one or more curves at other periods than the conditioning measure's")
     ordered = sorted(float(level) for level in levels)
     try:
-        fine = fit_levels(ordered, conditioning.support[1])
+        fine = fit_levels(ordered, conditioning.support[1], conditioning.support[0])
         scenarios = fit_scenarios(entry["measure"], entry.get("period"), ordered, fine, stripe_rate_weights(fine, conditioning, "intensity.levels"),
                                   others, float(site["vs30"]), site["mechanism"])
     except ValueError as error:  # a level outside the conditioning curve

@@ -14,7 +14,7 @@ normal, its conditional mean and σ; :mod:`stochpound.motions._conditional`)
 and Δλ(x_j) the rate of IM* in the bin of x_j
 (:func:`stochpound.risk.stripe_rate_weights`). The fit integrates on a
 fine grid of :data:`FINE_LEVELS` levels (:func:`fit_levels`) from
-:data:`SPAN` times below the lowest stripe to :data:`SPAN` times above the
+:data:`SPAN` times below the lowest stripe (or the start of the hazard's table) to :data:`SPAN` times above the
 highest or the end of the hazard's table (weaker and stronger shaking add
 to the rates compared; the last takes the whole tail), so that the scenario
 is fitted to the site's curves and not to the coarseness of a few stripes.
@@ -55,17 +55,21 @@ DISTANCES = (1.0, 2.0, 4.0, 7.0, 10.0, 15.0, 20.0, 30.0, 50.0, 80.0, 120.0)
 FINE_LEVELS = 60
 #: The fine grid spans from this factor below the lowest stripe to this factor above the highest (or the hazard table's end).
 SPAN = 5.0
+#: The fine grid starts at least this factor above the start of the hazard's table (its first bin reaches half a step below it).
+LOW_MARGIN = 1.2
 
 
-def fit_levels(levels: Sequence[float], highest: float = np.inf) -> np.ndarray:
+def fit_levels(levels: Sequence[float], highest: float = np.inf, lowest: float = 0.0) -> np.ndarray:
     """The fine grid (g) on which :func:`fit_scenarios` integrates: 60 log-spaced levels.
 
-    From 5 times below the lowest of ``levels`` (g) to
-    5 times above the highest, or ``highest`` (g, e.g. the end of
-    the hazard's table) if lower.
+    From 5 times below the lowest of ``levels`` (g), or :data:`LOW_MARGIN`
+    times ``lowest`` (g, e.g. the start of the hazard's table) if higher, so
+    that the first level's bin (:func:`stochpound.risk.stripe_rate_weights`,
+    half a step below it) stays within the table; to 5 times above the
+    highest, or ``highest`` (g, e.g. the end of the table) if lower.
     """
     x = np.sort(np.asarray(levels, dtype=float))
-    return np.geomspace(x[0] / SPAN, max(min(x[-1] * SPAN, highest), x[-1]), FINE_LEVELS)
+    return np.geomspace(min(max(x[0] / SPAN, lowest * LOW_MARGIN), x[0]), max(min(x[-1] * SPAN, highest), x[-1]), FINE_LEVELS)
 
 
 def _node_label(node: float | None) -> str:

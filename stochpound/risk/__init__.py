@@ -15,7 +15,9 @@ a store's scene and ``[design]`` with their risk (:func:`design_separations`,
 experiment store, :func:`store_risk` runs the whole chain and returns a
 :class:`StoreRisk`, whose tables (:meth:`StoreRisk.to_frame`,
 :meth:`StoreRisk.separation_frame`, :meth:`StoreRisk.rules_frame`) the
-report renders and ``stochpound risk`` prints; :func:`store_demands` gives
+report renders and ``stochpound risk`` prints; :func:`stripe_demand_rate`
+the same rate curve from a lognormal demand per stripe (every run's value,
+not only the counts); :func:`store_demands` gives
 the demand hazard curves and the moat walls' limit state
 (:class:`StoreDemands`); :func:`limit_state_risk` the fragility and MAF of
 limit states beyond first contact (:class:`LimitState`: drift ratios,
@@ -61,6 +63,7 @@ from stochpound.risk._efficiency import measure_efficiency, most_efficient
 from stochpound.risk._damage import DAMAGE_DEMANDS, DEFAULT_LIMIT_STATES, DEFAULT_SOURCE as DEFAULT_LIMIT_STATES_SOURCE, MODEL_DRIFT_LIMIT, StoreDamage, store_damage
 from stochpound.hazard import hazard_consistency, stripe_rate_weights
 from stochpound.risk._site_consistency import consistency_at_targets, site_consistency
+from stochpound.risk._stripe_demand import stripe_demand_rate
 
 __all__ = [
     "Fragility",
@@ -77,6 +80,7 @@ __all__ = [
     "rate_from_probability",
     "return_period",
     "demand_hazard_curve",
+    "stripe_demand_rate",
     "mean_annual_frequency",
     "flat_fit_maf",
     "risk_curve",
