@@ -119,37 +119,13 @@ def g_star(folder: Path, measure: str, configuration: str) -> xr.DataArray:
 
 def diagnosis(store: xr.Dataset, risk: StoreRisk) -> pd.DataFrame:
     """What a measure's g* rests on, per configuration cell and target: g* and its 95 % bootstrap interval (m); the fragility at
-    g* (θ in g and β, interpolated in ln g between the risk's gaps); the share of the MAF at g* from shaking weaker than the
-    lowest stripe (below: λ minus the λ of the hazard from the lowest stripe up); the share owed to the fragility's rise
-    beyond the top stripe (extrapolated: λ minus the λ of the hazard cut at the top stripe, whose rate above it counts at
-    F(top)); the stripes whose selection misses its target."""
-    from stochpound.analysis import HazardCurve
-    from stochpound.risk import mean_annual_frequency
-
-    hazard, fragility = risk.hazard, risk.fragility
-    top, lowest = float(fragility["intensity"].max()), float(fragility["intensity"].min())
-    below = hazard.im[hazard.im < top]
-    cut = HazardCurve(np.append(below, top), np.exp(hazard.log_rate(np.log(np.append(below, top)))))
-    above = hazard.im[hazard.im > lowest]
-    from_lowest = HazardCurve(np.insert(above, 0, lowest), np.exp(hazard.log_rate(np.log(np.insert(above, 0, lowest)))))
+    g* (θ in g and β); the shares of the MAF at g* from shaking weaker than the lowest stripe and from the fitted fragility's
+    rise beyond the top one (:meth:`stochpound.risk.StoreRisk.outside_stripes`); the stripes whose selection misses its target."""
     misses = int(store["selection_misses_target"].sum())
-    rows = []
-    separation = risk.separation.to_dataframe()
-    for index, row in separation.iterrows():
-        labels = dict(zip(separation.index.names, index if isinstance(index, tuple) else (index,)))
-        cell = fragility.sel({k: v for k, v in labels.items() if k in fragility.dims})
-        log_gap = np.log(cell["gap"].values)
-        with np.errstate(divide="ignore"):  # θ = 0 at gaps every motion closes
-            log_theta = np.log(cell["theta"].values)
-        theta = float(np.exp(np.interp(np.log(row["separation"]), log_gap, log_theta)))
-        beta = float(np.interp(np.log(row["separation"]), log_gap, cell["beta"].values))
-        frag = xr.Dataset({"theta": theta, "beta": beta})
-        total = float(mean_annual_frequency(frag, hazard))
-        rows.append({**labels, "g*": row["separation"], "lower": row.get("lower", np.nan), "upper": row.get("upper", np.nan),
-                     "theta": theta, "beta": beta, "below": 1.0 - float(mean_annual_frequency(frag, from_lowest)) / total,
-                     "extrapolated": 1.0 - float(mean_annual_frequency(frag, cut)) / total,
-                     "missed stripes": f"{misses}/{store.sizes['intensity']}"})
-    return pd.DataFrame(rows)
+    columns = {"separation": "g*", "lower": "lower", "upper": "upper", "theta": "theta", "beta": "beta", "below": "below", "above": "extrapolated"}
+    table = xr.merge([risk.separation.drop_vars("target_rate", errors="ignore"), risk.outside_stripes()], compat="override").to_dataframe()
+    table = table[[name for name in columns if name in table]].rename(columns=columns).reset_index()
+    return table.assign(**{"missed stripes": f"{misses}/{store.sizes['intensity']}"})
 
 
 def _print_seeds(configuration: str, args: argparse.Namespace, counted: xr.DataArray, fitted: xr.DataArray) -> None:

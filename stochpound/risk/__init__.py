@@ -64,6 +64,7 @@ from stochpound.risk._damage import DAMAGE_DEMANDS, DEFAULT_LIMIT_STATES, DEFAUL
 from stochpound.hazard import hazard_consistency, stripe_rate_weights
 from stochpound.risk._site_consistency import consistency_at_targets, site_consistency
 from stochpound.risk._stripe_demand import stripe_demand_rate
+from stochpound.risk._stripe_coverage import fragility_at_separation, maf_outside_stripes
 
 __all__ = [
     "Fragility",
@@ -81,6 +82,8 @@ __all__ = [
     "return_period",
     "demand_hazard_curve",
     "stripe_demand_rate",
+    "maf_outside_stripes",
+    "fragility_at_separation",
     "mean_annual_frequency",
     "flat_fit_maf",
     "risk_curve",

@@ -39,6 +39,7 @@ from stochpound.risk._design_rules import design_rules_risk
 from stochpound.risk._fragility_ensemble import BOOTSTRAP, fragility_band, fragility_surface, homogeneous_capacities, ida_fragility, limit_state_events, stripe_fragility
 from stochpound.risk._fragility import DECREASING, EMPTY, FIT, STATUS
 from stochpound.risk._maf import TARGETS, degenerate_text, non_increasing, risk_curve, risk_targeted_separation
+from stochpound.risk._stripe_coverage import maf_outside_stripes
 
 YEARS = 50.0
 """The default exposure time of the targets (yr)."""
@@ -346,6 +347,13 @@ class StoreRisk:
             return ""
         what = "fits (gaps × configurations)" if self.configuration_dims() else "gaps"
         return degenerate_text(self.fragility["status"].values, self.hazard, what)
+
+    def outside_stripes(self) -> xr.Dataset | None:
+        """The shares of λ_P at g* from shaking below the lowest stripe and beyond the top one, with the fit there
+        (:func:`~stochpound.risk.maf_outside_stripes`); None for IDA runs."""
+        if self.method != "stripes":
+            return None
+        return maf_outside_stripes(self.fragility, self.separation["separation"], self.hazard)
 
     def non_increasing_maf(self) -> xr.DataArray:
         """λ_P(g) made non-increasing along the gaps (isotonic regression in ln λ, pool-adjacent-violators: the curve g* is read from; 1/yr)."""

@@ -277,8 +277,28 @@ def _hazard_text(risk: StoreRisk) -> str:
         "refit the whole chain. Assumptions: Poisson "
         "occurrence, record-to-record variability only (not the hazard's or the model's uncertainty), and "
         f"{'the motions chosen and scaled for each stripe' if is_selected(risk.setting) else 'a suite scaled to each intensity'} "
-        f"standing for the site's motions of that intensity.{extrapolated}"
+        f"standing for the site's motions of that intensity.{extrapolated}{_outside_stripes_text(risk)}"
     )
+
+
+def _outside_stripes_text(risk: StoreRisk) -> str:
+    """How much of λ_P at g* comes from shaking below the lowest stripe and beyond the top one, where the fit is extrapolated
+    (the worst configuration per target; "" for IDA runs or without a finite g*)."""
+    shares = risk.outside_stripes()
+    if shares is None or not np.isfinite(shares["below"].values).any():
+        return ""
+    levels = np.asarray(risk.fragility["intensity"].values, dtype=float)
+    units = risk.setting.get("units", "")
+    per_target = [(float(shares["below"].sel(target=t).max()), float(shares["above"].sel(target=t).max()), risk.target_text(float(t)))
+                  for t in shares["target"].values]
+    below = " and ".join(f"{_percent(b)} for {text}" for b, _, text in per_target if np.isfinite(b))
+    above = " and ".join(f"{_percent(a)} for {text}" for _, a, text in per_target if np.isfinite(a))
+    worst = max(b for b, _, _ in per_target if np.isfinite(b))
+    advice = (" That part of the answer rests on the fitted fragility's extrapolation: stripes at more frequent intensities would "
+              "replace it by runs." if worst >= OUTSIDE_STRIPES_NOTABLE else "")
+    return (f" Shaking weaker than the lowest stripe ({levels.min():.3g} {units}, once in "
+            f"{float(1.0 / risk.hazard(levels.min())):.3g} yr), where the fitted fragility is extrapolated, carries up to this share of "
+            f"λ_P at g* (the worst configuration): {below}; the fitted fragility's rise beyond the top stripe up to {above}.{advice}")
 
 
 def _grid_note(risk: StoreRisk) -> str:
@@ -294,6 +314,13 @@ def _panel_grid(count: int, height: float = 2.6) -> tuple[Figure, list[Any]]:
     return figure, list(np.atleast_1d(figure.subplots(rows, columns, squeeze=False)).ravel())
 
 
+def _percent(share: float) -> str:
+    """A share in words: ``37 %``, or ``under 1 %``."""
+    return "under 1 %" if share < 0.005 else f"{100.0 * share:.0f} %"
+
+
+OUTSIDE_STRIPES_NOTABLE = 0.10
+"""A share of λ_P at g* from below the lowest stripe from which the report says the answer rests on the extrapolation."""
 RATE_DECADES = 6
 """The most decades of annual rate a rate axis spans below its largest rate (smaller rates are off the figure)."""
 

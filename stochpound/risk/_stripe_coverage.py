@@ -1,0 +1,101 @@
+"""How much of the pounding rate at g* comes from shaking the stripes did not run: below the lowest stripe and above the top one.
+
+The MAF λ_P = ∫ F(x) ``|dλ(x)|`` counts every intensity of the hazard's
+range, but the stripes only observe F between the lowest level x_1 and the
+top one x_n; outside, the fitted lognormal is extrapolated. At g* of each
+configuration and target, with F the lognormal fitted there (θ and β
+interpolated between the grid's gaps, linearly in ln g):
+
+* ``below``: the share of λ_P owed to shaking weaker than x_1,
+  ∫ F |dλ| from the hazard's lower end to x_1, over λ_P;
+* ``above``: the share owed to the fitted fragility's rise beyond x_n,
+  1 − λ⁻/λ_P, λ⁻ = ∫ F |dλ| up to x_n + F(x_n) λ(x_n): the rate above
+  x_n counted at the top stripe's F, not at the extrapolated rise.
+
+Both partial integrals are sums over 4000 log-spaced intensities (a power
+law from where F is 10⁻¹⁵ of its median, 8 β below θ).
+
+A large ``below`` share (a measure far from the structure's periods, whose
+frequent, weak shaking still pounds) means g* rests on an extrapolation:
+stripes at more frequent intensities replace it by runs.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import xarray as xr
+
+from stochpound.hazard import HazardCurve
+from stochpound.risk._fragility import lognormal_cdf
+from stochpound.risk._maf import mean_annual_frequency
+
+_POINTS = 4000
+
+
+def fragility_at_separation(fragility: xr.Dataset, separation: xr.DataArray) -> xr.Dataset:
+    """θ (IM units) and β of the fitted fragility at each g* (m), interpolated between the grid's gaps linearly in ln g.
+
+    NaN where g* is not finite or lies outside the gap grid.
+    """
+
+    def interpolate(values: np.ndarray, gaps: np.ndarray, at: np.ndarray, log: bool) -> np.ndarray:
+        with np.errstate(divide="ignore", invalid="ignore"):
+            inside = np.isfinite(at) & (at >= gaps[0]) & (at <= gaps[-1])
+            where = np.log(np.where(inside, at, gaps[0]))
+            table = np.log(values) if log else values
+            out = np.interp(where, np.log(gaps), table)
+        return np.where(inside, np.exp(out) if log else out, np.nan)
+
+    gaps = np.asarray(fragility["gap"].values, dtype=float)
+    parts = {}
+    for name, log in (("theta", True), ("beta", False)):
+        parts[name] = xr.apply_ufunc(lambda values, at, log=log: interpolate(values, gaps, at, log), fragility[name], separation,
+                                     input_core_dims=[["gap"], []], vectorize=True)
+    return xr.Dataset(parts)
+
+
+def maf_outside_stripes(fragility: xr.Dataset, separation: xr.DataArray, hz: HazardCurve) -> xr.Dataset:
+    """The shares of λ_P at g* from below the lowest stripe (``below``) and beyond the top one (``above``), module docstring.
+
+    Parameters
+    ----------
+    fragility : xarray.Dataset
+        A stripes fit over ``gap`` (:func:`~stochpound.risk.pounding_fragility`), with its ``intensity`` coordinate.
+    separation : xarray.DataArray
+        g* (m) per configuration and target (:func:`~stochpound.risk.risk_targeted_separation`'s ``separation``).
+    hz : HazardCurve
+        The site's hazard the fit was integrated with.
+
+    Returns
+    -------
+    xarray.Dataset
+        ``below`` and ``above`` (fractions of λ_P at g*), ``theta`` and ``beta``
+        of the fit at g*, over the dimensions of ``separation``; NaN where g* is not finite.
+    """
+    levels = np.asarray(fragility["intensity"].values, dtype=float)
+    at = fragility_at_separation(fragility, separation)
+    total = mean_annual_frequency(at, hz)
+    below, middle = (xr.apply_ufunc(lambda t, b, upper=upper: _rate_between(t, b, hz, upper), at["theta"], at["beta"], vectorize=True)
+                     for upper in (float(levels.min()), float(levels.max())))
+    top = float(min(levels.max(), hz.support[1]))
+    at_top = xr.apply_ufunc(lambda t, b: lognormal_cdf(top, t, b), at["theta"], at["beta"]) * float(hz(top))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        shares = {"below": below / total, "above": 1.0 - (middle + at_top) / total}
+    return xr.Dataset({"below": shares["below"].assign_attrs(units="1", long_name="share of the MAF at g* from below the lowest stripe"),
+                       "above": shares["above"].assign_attrs(units="1", long_name="share of the MAF at g* from the fragility's rise beyond the top stripe"),
+                       "theta": at["theta"], "beta": at["beta"]})
+
+
+def _rate_between(theta: float, beta: float, hz: HazardCurve, upper: float) -> float:
+    """∫ F |dλ| from the hazard's lower end (a power law: where F is 10⁻¹⁵ of its median) to ``upper``, 1/yr (NaN for a NaN fit)."""
+    if not (np.isfinite(theta) and np.isfinite(beta)) or theta <= 0.0:
+        return np.nan
+    low, high = hz.support
+    start = low if low > 0.0 else theta * np.exp(-8.0 * max(beta, 1e-3))
+    end = min(upper, high)
+    if end <= start:
+        return 0.0
+    x = np.geomspace(start, end, _POINTS)
+    rate = hz(x)
+    middle = np.sqrt(x[1:] * x[:-1])
+    return float(np.sum(lognormal_cdf(middle, theta, beta) * (rate[:-1] - rate[1:])))
