@@ -81,3 +81,18 @@ def test_the_report_states_the_shares_it_computes_and_says_when_the_answer_rests
     assert f"{100 * float(shares['below'].sel(target=0.1)):.0f} % for 10 % in 50 yr" in text or "under 1 % for 10 % in 50 yr" in text
     assert ("rests on the fitted fragility's extrapolation" in text) is notable
     assert f"({lowest:.3g} g, once in {1.0 / float(hz(lowest)):.3g} yr)" in text
+
+
+@pytest.mark.parametrize(("lowest", "notable"), [(0.2, True), (0.005, False)])
+def test_the_design_summary_lists_the_shaking_below_the_stripes_among_what_the_answer_rests_on_when_it_matters(lowest: float, notable: bool) -> None:
+    from stochpound.report.sections._risk import _outside_stripes_assumption
+    from stochpound.risk import StoreRisk
+
+    hz = HazardCurve.power_law(K0, K)
+    fit = _fit(np.array([0.1, 0.2, 0.4, 0.8]), np.full(4, 0.9)).assign_coords(intensity=("intensity", [lowest, 0.4, 0.8]))
+    separation = xr.Dataset({"separation": ("target", [0.02, 0.04])}, coords={"target": [0.1, 0.02]})
+    entry = _outside_stripes_assumption(StoreRisk(fit, xr.Dataset(), separation, None, "", hz, 20, "stripes", setting={"units": "g"}))
+    assert bool(entry) is notable
+    if notable:
+        share = float(maf_outside_stripes(fit, separation["separation"], hz)["below"].sel(target=0.1))
+        assert entry["shaking below the stripes"].startswith(f"{100 * share:.0f} % for 10 % in 50 yr")

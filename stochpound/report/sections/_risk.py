@@ -149,7 +149,7 @@ def design_summary_text(risk: StoreRisk, demands: StoreDemands | None = None, da
         meets = (f"Code rules meeting their own design level as a target in every configuration and level ({column.replace('meets, ', '') if 'upper' in column else 'estimate'}): "
                  f"{', '.join(met.index[met]) or 'none'}; not: {', '.join(met.index[~met]) or 'none'}.")
     rests = "; ".join(f"{key}: {value}" for key, value in {"hazard": f"{risk.hazard.describe()} ({_source(risk)})", **risk.assumptions,
-                                                          **_beyond_model(damage)}.items())
+                                                          **_outside_stripes_assumption(risk), **_beyond_model(damage)}.items())
     return (f"Design summary. Governing limit state: {governing}. {design_value_text(risk)} {meets} The answer holds only for what it "
             f"rests on; a change to any of these voids it: {rests}.")
 
@@ -281,24 +281,44 @@ def _hazard_text(risk: StoreRisk) -> str:
     )
 
 
+def _worst_outside(risk: StoreRisk) -> list[tuple[float, float, float]]:
+    """Per target: (target, below, above), the worst configuration's shares of λ_P at g* from below the lowest stripe and beyond
+    the top one ([] for IDA runs or without a finite g*)."""
+    shares = risk.outside_stripes()
+    if shares is None or not np.isfinite(shares["below"].values).any():
+        return []
+    return [(float(t), float(shares["below"].sel(target=t).max()), float(shares["above"].sel(target=t).max())) for t in shares["target"].values]
+
+
+def _lowest_stripe_text(risk: StoreRisk) -> str:
+    """The lowest stripe's level and return period in words."""
+    lowest = float(np.min(risk.fragility["intensity"].values))
+    return f"{lowest:.3g} {risk.setting.get('units', '')}, once in {float(1.0 / risk.hazard(lowest)):.3g} yr"
+
+
 def _outside_stripes_text(risk: StoreRisk) -> str:
     """How much of λ_P at g* comes from shaking below the lowest stripe and beyond the top one, where the fit is extrapolated
     (the worst configuration per target; "" for IDA runs or without a finite g*)."""
-    shares = risk.outside_stripes()
-    if shares is None or not np.isfinite(shares["below"].values).any():
+    worst = _worst_outside(risk)
+    if not worst:
         return ""
-    levels = np.asarray(risk.fragility["intensity"].values, dtype=float)
-    units = risk.setting.get("units", "")
-    per_target = [(float(shares["below"].sel(target=t).max()), float(shares["above"].sel(target=t).max()), risk.target_text(float(t)))
-                  for t in shares["target"].values]
-    below = " and ".join(f"{_percent(b)} for {text}" for b, _, text in per_target if np.isfinite(b))
-    above = " and ".join(f"{_percent(a)} for {text}" for _, a, text in per_target if np.isfinite(a))
-    worst = max(b for b, _, _ in per_target if np.isfinite(b))
+    below = " and ".join(f"{_percent(b)} for {risk.target_text(t)}" for t, b, _ in worst if np.isfinite(b))
+    above = " and ".join(f"{_percent(a)} for {risk.target_text(t)}" for t, _, a in worst if np.isfinite(a))
     advice = (" That part of the answer rests on the fitted fragility's extrapolation: stripes at more frequent intensities would "
-              "replace it by runs." if worst >= OUTSIDE_STRIPES_NOTABLE else "")
-    return (f" Shaking weaker than the lowest stripe ({levels.min():.3g} {units}, once in "
-            f"{float(1.0 / risk.hazard(levels.min())):.3g} yr), where the fitted fragility is extrapolated, carries up to this share of "
-            f"λ_P at g* (the worst configuration): {below}; the fitted fragility's rise beyond the top stripe up to {above}.{advice}")
+              "replace it by runs." if max(b for _, b, _ in worst if np.isfinite(b)) >= OUTSIDE_STRIPES_NOTABLE else "")
+    return (f" Shaking weaker than the lowest stripe ({_lowest_stripe_text(risk)}), where the fitted fragility is extrapolated, carries up "
+            f"to this share of λ_P at g* (the worst configuration): {below}; the fitted fragility's rise beyond the top stripe up to "
+            f"{above}.{advice}")
+
+
+def _outside_stripes_assumption(risk: StoreRisk) -> dict[str, str]:
+    """{"shaking below the stripes": ...} where that shaking carries at least :data:`OUTSIDE_STRIPES_NOTABLE` of λ_P at g*, else {}."""
+    notable = [(t, b) for t, b, _ in _worst_outside(risk) if np.isfinite(b) and b >= OUTSIDE_STRIPES_NOTABLE]
+    if not notable:
+        return {}
+    shares = " and ".join(f"{_percent(b)} for {risk.target_text(t)}" for t, b in notable)
+    return {"shaking below the stripes": f"{shares} of λ_P at g* (the worst configuration) comes from shaking weaker than the lowest "
+                                         f"stripe ({_lowest_stripe_text(risk)}), where the fitted fragility is extrapolated"}
 
 
 def _grid_note(risk: StoreRisk) -> str:
