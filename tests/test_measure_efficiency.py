@@ -64,7 +64,7 @@ def test_risk_cli_names_the_most_efficient_measure_the_sites_hazard_has(fixed_st
     from click.testing import CliRunner
 
     from stochpound.cli import main
-    from stochpound.cli._measure_choice import hazard_measures
+    from stochpound.experiment import hazard_measures
 
     store = open_store(fixed_stores[0]).load()
     available = hazard_measures(store, "fox_plaza_los_angeles_sa1p0s")
@@ -79,7 +79,7 @@ def test_risk_cli_names_the_most_efficient_measure_the_sites_hazard_has(fixed_st
 
 
 def test_a_configuration_s_best_measure_is_never_another_configuration_s_structure_period() -> None:
-    from stochpound.cli._measure_choice import _of_configuration
+    from stochpound.experiment._measure_choice import _of_configuration
 
     structure = {"B1 first mode": 0.3, "B2 first mode (neighbour=flexible)": 0.8, "B2 first mode (neighbour=stiff)": 0.2}
     measures = ["PGA", "PSA(0.3 s, B1 first mode)", "PSA(0.8 s, B2 first mode (neighbour=flexible))", "PSA(0.2 s, B2 first mode (neighbour=stiff))"]
@@ -87,3 +87,29 @@ def test_a_configuration_s_best_measure_is_never_another_configuration_s_structu
         row = xr.DataArray(np.zeros(4), dims="measure", coords={"measure": measures, "neighbour": neighbour})
         kept = [m for m in measures if _of_configuration(m, structure, row)]
         assert kept == [m for m in measures if f"neighbour={other}" not in m]
+
+
+def test_the_report_names_the_most_efficient_measure_and_weighs_the_stores_own_against_the_estimates_noise(fixed_stores) -> None:
+    """The Risk section says which measure the site's hazard has is the most efficient per configuration (the same frame as
+    stochpound risk prints), and how far the store's own measure is from it against the standard error of a β."""
+    import math
+
+    from stochpound.experiment import measure_choice
+    from stochpound.report.sections._risk import _measure_choice_blocks
+    from stochpound.risk import store_risk
+
+    store = open_store(fixed_stores[0]).load()
+    choice = measure_choice(store, "fox_plaza_los_angeles_sa1p0s")
+    risk = store_risk(store, bootstrap=0)
+    text = _measure_choice_blocks("s", risk, choice)[0].text
+    counts = choice["most efficient"].value_counts()
+    assert "the most efficient is " + ", ".join(f"{m} in {c} of {len(choice)} configurations" for m, c in counts.items()) in text
+    own = "PGA" if risk.setting["measure"] == "pga" else f"PSA({risk.setting['period']:g} s)"
+    worst = max(float(row[own] - row[row["most efficient"]]) for _, row in choice.iterrows())
+    if worst == 0.0:
+        assert f"conditioned on {own}, the most efficient in every configuration" in text
+    else:
+        runs = risk.motions * risk.stripes
+        noise = float(choice[own].max()) / math.sqrt(2.0 * (runs - 2))
+        assert f"by up to {worst:.3f}: {'within' if worst <= 2 * noise else 'beyond'} twice" in text and f"≈ {noise:.3f}" in text
+    assert _measure_choice_blocks("s", risk, None) == []

@@ -62,7 +62,7 @@ LOW_MARGIN = 1.2
 def fit_levels(levels: Sequence[float], highest: float = np.inf, lowest: float = 0.0) -> np.ndarray:
     """The fine grid (g) on which :func:`fit_scenarios` integrates: 60 log-spaced levels.
 
-    From 5 times below the lowest of ``levels`` (g), or :data:`LOW_MARGIN`
+    From 5 times below the lowest of ``levels`` (g), or ``LOW_MARGIN`` (1.2)
     times ``lowest`` (g, e.g. the start of the hazard's table) if higher, so
     that the first level's bin (:func:`stochpound.risk.stripe_rate_weights`,
     half a step below it) stays within the table; to 5 times above the

@@ -34,6 +34,7 @@ from stochpound.report.sections import (
     separation_section,
     store_section,
 )
+from stochpound.experiment import measure_choice
 from stochpound.risk import has_risk, store_damage, store_demands, store_risk
 from stochpound.store import has_contact_free, has_wall_free, with_contacts, with_walls
 from stochpound._studies import claims, load_study
@@ -78,7 +79,7 @@ def assemble_report(paths: Sequence[str | Path], progress: Callable[[str], None]
             say(f"experiment {name}: risk")
             risks[name] = store_risk(store)
             damage = store_damage(store)
-            report.sections.append(risk_section(name, risks[name], store_demands(store), damage))
+            report.sections.append(risk_section(name, risks[name], store_demands(store), damage, measure_choice(store)))
             if damage is not None:
                 report.sections.append(damage_section(name, damage))
     for name, store in others.items():

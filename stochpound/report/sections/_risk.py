@@ -104,13 +104,17 @@ def summary_answer(name: str, risk: StoreRisk) -> list[Block]:
 # ---------------------------------------------------------------- the section
 
 
-def risk_section(name: str, risk: StoreRisk, demands: StoreDemands | None = None, damage: StoreDamage | None = None) -> Section:
-    """The "Risk" section of one store, from its risk chain, its demand hazard curves (:func:`~stochpound.risk.store_demands`)
-    and, for yielding buildings, the damage its runs did (:func:`~stochpound.risk.store_damage`)."""
+def risk_section(name: str, risk: StoreRisk, demands: StoreDemands | None = None, damage: StoreDamage | None = None,
+                 choice: pd.DataFrame | None = None) -> Section:
+    """The "Risk" section of one store, from its risk chain, its demand hazard curves (:func:`~stochpound.risk.store_demands`),
+    for yielding buildings the damage its runs did (:func:`~stochpound.risk.store_damage`) and which measure is the most
+    efficient (:func:`~stochpound.experiment.measure_choice`)."""
     section = Section(f"Risk: experiment {name}", key=f"risk-{name}")
     section.add(Paragraph(headline_text(name, risk)))
     section.add(Paragraph(design_summary_text(risk, demands, damage)))
     section.add(Paragraph(_hazard_text(risk)))
+    for block in _measure_choice_blocks(name, risk, choice):
+        section.add(block)
     section.add(_separation_table(name, risk))
     section.add(_risk_curve_figure(name, risk))
     section.add(_surface_figure(name, risk))
@@ -302,8 +306,8 @@ def _outside_stripes_text(risk: StoreRisk) -> str:
     worst = _worst_outside(risk)
     if not worst:
         return ""
-    below = " and ".join(f"{_percent(b)} for {risk.target_text(t)}" for t, b, _ in worst if np.isfinite(b))
-    above = " and ".join(f"{_percent(a)} for {risk.target_text(t)}" for t, _, a in worst if np.isfinite(a))
+    below = " and ".join(f"{_share_text(b)} for {risk.target_text(t)}" for t, b, _ in worst if np.isfinite(b))
+    above = " and ".join(f"{_share_text(a)} for {risk.target_text(t)}" for t, _, a in worst if np.isfinite(a))
     advice = (" That part of the answer rests on the fitted fragility's extrapolation: stripes at more frequent intensities would "
               "replace it by runs." if max(b for _, b, _ in worst if np.isfinite(b)) >= OUTSIDE_STRIPES_NOTABLE else "")
     return (f" Shaking weaker than the lowest stripe ({_lowest_stripe_text(risk)}), where the fitted fragility is extrapolated, carries up "
@@ -316,9 +320,39 @@ def _outside_stripes_assumption(risk: StoreRisk) -> dict[str, str]:
     notable = [(t, b) for t, b, _ in _worst_outside(risk) if np.isfinite(b) and b >= OUTSIDE_STRIPES_NOTABLE]
     if not notable:
         return {}
-    shares = " and ".join(f"{_percent(b)} for {risk.target_text(t)}" for t, b in notable)
+    shares = " and ".join(f"{_share_text(b)} for {risk.target_text(t)}" for t, b in notable)
     return {"shaking below the stripes": f"{shares} of λ_P at g* (the worst configuration) comes from shaking weaker than the lowest "
                                          f"stripe ({_lowest_stripe_text(risk)}), where the fitted fragility is extrapolated"}
+
+
+def _measure_choice_blocks(name: str, risk: StoreRisk, choice: pd.DataFrame | None) -> list[Block]:
+    """Which measure: the most efficient the site's hazard has per configuration, against the store's own, with the estimate's noise."""
+    if choice is None or choice.empty or not choice.attrs.get("hazard_measures"):
+        return []
+    measures = choice.attrs["hazard_measures"]
+    own = "PGA" if risk.setting.get("measure") == "pga" else f"PSA({risk.setting.get('period', float('nan')):g} s)"
+    counts = choice["most efficient"].value_counts()
+    best = ", ".join(f"{label} in {count} of {len(choice)} configurations" for label, count in counts.items())
+    runs = risk.motions * (risk.stripes or 1)
+    noise = float(choice[own if own in measures else measures].max().max()) / math.sqrt(2.0 * max(runs - 2, 1))
+    gaps = [float(row[own] - row[row["most efficient"]]) for _, row in choice.iterrows() if own in choice and row["most efficient"]]
+    if own not in measures:
+        verdict = f"The store is conditioned on {own}, a measure the site's hazard is not given in among these."
+    elif max(gaps, default=0.0) == 0.0:
+        verdict = f"The store is conditioned on {own}, the most efficient in every configuration."
+    else:
+        within = "within" if max(gaps) <= 2.0 * noise else "beyond"
+        verdict = (f"The store is conditioned on {own}, whose β exceeds the most efficient one's by up to {max(gaps):.3f}: {within} twice the "
+                   f"estimate's standard error (about β/√(2(n − 2)) ≈ {noise:.3f} for the {runs} contact-free runs of a configuration).")
+    text = (f"Which measure: β, the dispersion of ln(peak closure) given each measure the site's hazard is given in, over the contact-free "
+            f"runs (a smaller β needs fewer motions for the same precision; stochpound.experiment.measure_choice): the most efficient is "
+            f"{best}. {verdict} Of all candidates (PSA at the structure's own periods, PGV, Sa_avg), the most efficient is named per "
+            "configuration in the table: a measure the site's hazard is not given in cannot carry the risk integral.")
+    columns = ["where", *measures, "most efficient", "best candidate", "best β"]
+    table = Table(f"risk-measure-{name}", f"Experiment {name}: β of ln(peak closure) given each measure, per configuration",
+                  choice[columns].rename(columns={"where": "configuration"}).set_index("configuration"),
+                  formats={**{m: "{:.3f}" for m in measures}, "best β": "{:.3f}"})
+    return [Paragraph(text), table]
 
 
 def _grid_note(risk: StoreRisk) -> str:
@@ -334,7 +368,7 @@ def _panel_grid(count: int, height: float = 2.6) -> tuple[Figure, list[Any]]:
     return figure, list(np.atleast_1d(figure.subplots(rows, columns, squeeze=False)).ravel())
 
 
-def _percent(share: float) -> str:
+def _share_text(share: float) -> str:
     """A share in words: ``37 %``, or ``under 1 %``."""
     return "under 1 %" if share < 0.005 else f"{100.0 * share:.0f} %"
 

@@ -1,0 +1,97 @@
+"""Which intensity measure a risk answer should be conditioned on: the most efficient one the site's hazard is given in.
+
+For every configuration of a store, β of ln(peak closure) given each
+candidate measure (:func:`stochpound.risk.measure_efficiency`, over the
+contact-free runs): the measures the site's hazard is available in (every
+bundled curve of the store's site, or the store's own measure) and PSA at
+the structure's own periods (:func:`periods_of_interest`), PGA, PGV and
+Sa_avg. ``stochpound risk`` prints it and the report's Risk section shows it.
+"""
+
+from __future__ import annotations
+
+import re
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from stochpound.experiment._grid import Experiment
+from stochpound.experiment._site import periods_of_interest
+
+
+def hazard_measures(store: Any, hazard: str | None = None) -> dict[str, float | None]:
+    """The measures the site's hazard is available in: name -> PSA period (s; None for PGA).
+
+    A bundled curve (``hazard`` or the store's ``[hazard] bundled``):
+    every bundled curve of the same site; otherwise the store's own measure.
+    """
+    from stochpound.hazard import bundled_curves, bundled_measure
+
+    name = hazard if hazard in bundled_curves() else (store.pound.hazard or {}).get("bundled")
+    if name:
+        site = re.sub(r"_(pga|sa\d+p\d+s)$", "", name)
+        measures = [bundled_measure(curve) for curve in bundled_curves() if curve.startswith(site + "_")]
+    else:
+        intensity = store.pound.intensity or {}
+        measures = [intensity] if intensity.get("measure") in ("pga", "psa") else []
+    return {("PGA" if m["measure"] == "pga" else f"PSA({m['period']:g} s)"): (None if m["measure"] == "pga" else float(m["period"])) for m in measures}
+
+
+def measure_choice(store: Any, hazard: str | None = None) -> pd.DataFrame:
+    """Per configuration, β of ln(peak closure) given each measure the site's hazard has, the most efficient of them, and the
+    most efficient of all candidates with its β.
+
+    Parameters
+    ----------
+    store : xarray.Dataset
+        A store with contact-free runs (stripes or IDA).
+    hazard : str, optional
+        A bundled curve naming the site (default: the store's ``[hazard] bundled``).
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per configuration (its labels as columns, ``where`` in
+        words), a column per hazard measure (β), ``most efficient`` (among
+        them; "" when the hazard has none), ``best candidate`` and ``best β``.
+    """
+    from stochpound.risk import measure_efficiency
+
+    structure = periods_of_interest(Experiment(store.pound.definition))
+    available = hazard_measures(store, hazard)
+    candidates = {**structure, **{f"hazard {name}": period for name, period in available.items() if period is not None}}
+    beta = measure_efficiency(store, candidates, structure, studied=store.attrs.get("studied_building"))["beta"].sel(response="closure")
+    names = {name: ("PGA" if period is None else f"PSA({period:.3g} s, hazard {name})") for name, period in available.items()}
+    configurations = [d for d in beta.dims if d != "measure"]
+    rows = []
+    for index in np.ndindex(*[beta.sizes[d] for d in configurations]):
+        cell = beta.isel(dict(zip(configurations, index)))
+        row: dict[str, Any] = {d: cell[d].item() for d in configurations}
+        row["where"] = ", ".join(f"{d}={cell[d].item()}" for d in configurations) or "all runs"
+        hazard_betas = {label: float(cell.sel(measure=name)) for label, name in names.items()}
+        row.update(hazard_betas)
+        row["most efficient"] = min(hazard_betas, key=lambda label: np.nan_to_num(hazard_betas[label], nan=np.inf)) if hazard_betas else ""
+        own = cell.sel(measure=[m for m in cell["measure"].values if _of_configuration(str(m), structure, cell)])
+        best = int(np.argmin(np.nan_to_num(own.values, nan=np.inf)))
+        row["best candidate"], row["best β"] = str(own["measure"].values[best]), float(own.values[best])
+        rows.append(row)
+    frame = pd.DataFrame(rows)
+    frame.attrs["hazard_measures"] = list(available)
+    return frame
+
+
+def _of_configuration(measure: str, structure: dict[str, float], row: Any) -> bool:
+    """Whether a candidate measure belongs to the configuration ``row``: a structure period named for other variant labels does not.
+
+    :func:`~stochpound.experiment.periods_of_interest` names a period that
+    differs between grid points ``"B2 first mode (neighbour=stiff)"``; the
+    measure at the other configuration's period is not this one's.
+    """
+    for name in structure:
+        match = re.fullmatch(r".* \(([^()]*=[^()]*)\)", name)
+        if match is None or not measure.endswith(f", {name})"):
+            continue
+        labels = dict(item.split("=", 1) for item in match.group(1).split(", "))
+        return all(str(row[d].item()) == value for d, value in labels.items() if d in row.coords)
+    return True
