@@ -113,3 +113,21 @@ def test_the_report_names_the_most_efficient_measure_and_weighs_the_stores_own_a
         noise = float(choice[own].max()) / math.sqrt(2.0 * (runs - 2))
         assert f"by up to {worst:.3f}: {'within' if worst <= 2 * noise else 'beyond'} twice" in text and f"≈ {noise:.3f}" in text
     assert _measure_choice_blocks("s", risk, None) == []
+
+
+@pytest.mark.parametrize(("own_beta", "verdict"), [(0.52, "within twice"), (0.70, "beyond twice"), (0.50, "the most efficient in every")])
+def test_the_verdict_on_the_stores_own_measure_follows_the_numbers(own_beta: float, verdict: str) -> None:
+    import pandas as pd
+
+    from stochpound.report.sections._risk import _measure_choice_blocks
+    from stochpound.risk import HazardCurve, StoreRisk
+
+    choice = pd.DataFrame([{"where": "all runs", "PGA": 0.50, "PSA(1 s)": own_beta, "most efficient": "PGA" if own_beta > 0.50 else "PSA(1 s)",
+                            "best candidate": "PGV", "best β": 0.4}])
+    choice.attrs["hazard_measures"] = ["PGA", "PSA(1 s)"]
+    risk = StoreRisk(xr.Dataset(), xr.Dataset(), xr.Dataset(), None, "", HazardCurve.power_law(1e-4, 2.0), 20, "stripes",
+                     setting={"measure": "psa", "period": 1.0, "units": "g"}, stripes=7)
+    text = _measure_choice_blocks("s", risk, choice)[0].text
+    assert text.count("The store is conditioned on PSA(1 s)") == 1 and verdict in text
+    if verdict != "the most efficient in every":
+        assert f"by up to {own_beta - 0.50:.3f}" in text and f"≈ {own_beta / np.sqrt(2 * 138):.3f}" in text

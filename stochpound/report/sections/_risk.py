@@ -341,9 +341,10 @@ def _measure_choice_blocks(name: str, risk: StoreRisk, choice: pd.DataFrame | No
     elif max(gaps, default=0.0) == 0.0:
         verdict = f"The store is conditioned on {own}, the most efficient in every configuration."
     else:
-        within = "within" if max(gaps) <= 2.0 * noise else "beyond"
-        verdict = (f"The store is conditioned on {own}, whose β exceeds the most efficient one's by up to {max(gaps):.3f}: {within} twice the "
-                   f"estimate's standard error (about β/√(2(n − 2)) ≈ {noise:.3f} for the {runs} contact-free runs of a configuration).")
+        within = max(gaps) <= 2.0 * noise
+        verdict = (f"The store is conditioned on {own}, whose β exceeds the most efficient one's by up to {max(gaps):.3f}: "
+                   f"{'within' if within else 'beyond'} twice the standard error of one β estimate (about β/√(2(n − 2)) ≈ {noise:.3f} "
+                   f"for the {runs} contact-free runs of a configuration)" + (", so these runs do not tell the two apart." if within else "."))
     text = (f"Which measure: β, the dispersion of ln(peak closure) given each measure the site's hazard is given in, over the contact-free "
             f"runs (a smaller β needs fewer motions for the same precision; stochpound.experiment.measure_choice): the most efficient is "
             f"{best}. {verdict} Of all candidates (PSA at the structure's own periods, PGV, Sa_avg), the most efficient is named per "
