@@ -35,7 +35,18 @@ _POINTS = 4000
 def fragility_at_separation(fragility: xr.Dataset, separation: xr.DataArray) -> xr.Dataset:
     """θ (IM units) and β of the fitted fragility at each g* (m), interpolated between the grid's gaps linearly in ln g.
 
-    NaN where g* is not finite or lies outside the gap grid.
+    Parameters
+    ----------
+    fragility : xarray.Dataset
+        ``theta`` and ``beta`` over ``gap`` (m, ascending) and the configurations.
+    separation : xarray.DataArray
+        g* (m) over the configurations and, e.g., ``target``.
+
+    Returns
+    -------
+    xarray.Dataset
+        ``theta`` (ln θ interpolated) and ``beta`` over the dimensions of
+        ``separation``; NaN where g* is not finite or lies outside the gap grid.
     """
 
     def interpolate(values: np.ndarray, gaps: np.ndarray, at: np.ndarray, log: bool) -> np.ndarray:
