@@ -350,8 +350,8 @@ class StoreRisk:
 
     def outside_stripes(self) -> xr.Dataset | None:
         """The shares of λ_P at g* from shaking below the lowest stripe and beyond the top one, with the fit there
-        (:func:`~stochpound.risk.maf_outside_stripes`); None for IDA runs."""
-        if self.method != "stripes":
+        (:func:`~stochpound.risk.maf_outside_stripes`); None for IDA runs or a fit without its stripes' levels."""
+        if self.method != "stripes" or "intensity" not in self.fragility.coords or "separation" not in self.separation:
             return None
         return maf_outside_stripes(self.fragility, self.separation["separation"], self.hazard)
 
