@@ -120,10 +120,10 @@ def g_star(folder: Path, measure: str, configuration: str) -> xr.DataArray:
 def diagnosis(store: xr.Dataset, risk: StoreRisk) -> pd.DataFrame:
     """What a measure's g* rests on, per configuration cell and target: g* and its 95 % bootstrap interval (m); the fragility at
     g* (θ in g and β); the shares of the MAF at g* from shaking weaker than the lowest stripe and from the fitted fragility's
-    rise beyond the top one (:meth:`stochpound.risk.StoreRisk.outside_stripes`); the stripes whose selection misses its target."""
+    rise beyond the top one (:attr:`stochpound.risk.StoreRisk.outside_stripes`); the stripes whose selection misses its target."""
     misses = int(store["selection_misses_target"].sum())
     columns = {"separation": "g*", "lower": "lower", "upper": "upper", "theta": "theta", "beta": "beta", "below": "below", "above": "extrapolated"}
-    table = xr.merge([risk.separation.drop_vars("target_rate", errors="ignore"), risk.outside_stripes()], compat="override").to_dataframe()
+    table = xr.merge([risk.separation.drop_vars("target_rate", errors="ignore"), risk.outside_stripes], compat="override").to_dataframe()
     table = table[[name for name in columns if name in table]].rename(columns=columns).reset_index()
     return table.assign(**{"missed stripes": f"{misses}/{store.sizes['intensity']}"})
 

@@ -105,6 +105,7 @@ def test_the_report_names_the_most_efficient_measure_and_weighs_the_stores_own_a
     counts = choice["most efficient"].value_counts()
     assert "the most efficient is " + ", ".join(f"{m} in {c} of {len(choice)} configurations" for m, c in counts.items()) in text
     own = "PGA" if risk.setting["measure"] == "pga" else f"PSA({risk.setting['period']:g} s)"
+    assert choice.attrs["store_measure"] == own
     worst = max(float(row[own] - row[row["most efficient"]]) for _, row in choice.iterrows())
     if worst == 0.0:
         assert f"conditioned on {own}, the most efficient in every configuration" in text
@@ -124,7 +125,7 @@ def test_the_verdict_on_the_stores_own_measure_follows_the_numbers(own_beta: flo
 
     choice = pd.DataFrame([{"where": "all runs", "PGA": 0.50, "PSA(1 s)": own_beta, "most efficient": "PGA" if own_beta > 0.50 else "PSA(1 s)",
                             "best candidate": "PGV", "best β": 0.4}])
-    choice.attrs["hazard_measures"] = ["PGA", "PSA(1 s)"]
+    choice.attrs.update(hazard_measures=["PGA", "PSA(1 s)"], store_measure="PSA(1 s)")
     risk = StoreRisk(xr.Dataset(), xr.Dataset(), xr.Dataset(), None, "", HazardCurve.power_law(1e-4, 2.0), 20, "stripes",
                      setting={"measure": "psa", "period": 1.0, "units": "g"}, stripes=7)
     text = _measure_choice_blocks("s", risk, choice)[0].text

@@ -11,6 +11,7 @@ Sa_avg. ``stochpound risk`` prints it and the report's Risk section shows it.
 from __future__ import annotations
 
 import re
+from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
@@ -26,16 +27,22 @@ def hazard_measures(store: Any, hazard: str | None = None) -> dict[str, float | 
     A bundled curve (``hazard`` or the store's ``[hazard] bundled``):
     every bundled curve of the same site; otherwise the store's own measure.
     """
-    from stochpound.hazard import bundled_curves, bundled_measure
+    from stochpound.hazard import bundled_curves, bundled_measure, bundled_site_curves
 
     name = hazard if hazard in bundled_curves() else (store.pound.hazard or {}).get("bundled")
     if name:
-        site = re.sub(r"_(pga|sa\d+p\d+s)$", "", name)
-        measures = [bundled_measure(curve) for curve in bundled_curves() if curve.startswith(site + "_")]
+        measures = [bundled_measure(curve) for curve in bundled_site_curves(name)]
     else:
         intensity = store.pound.intensity or {}
         measures = [intensity] if intensity.get("measure") in ("pga", "psa") else []
-    return {("PGA" if m["measure"] == "pga" else f"PSA({m['period']:g} s)"): (None if m["measure"] == "pga" else float(m["period"])) for m in measures}
+    return {measure_label(m): (None if m["measure"] == "pga" else float(m["period"])) for m in measures}
+
+
+def measure_label(entry: Mapping[str, Any]) -> str:
+    """A measure's short name from its ``[intensity]``-like entry: ``PGA``, ``PSA(1 s)``; other measures by their key (``PGV``)."""
+    if entry.get("measure") == "psa":
+        return f"PSA({float(entry['period']):g} s)"
+    return str(entry.get("measure", "")).upper()
 
 
 def measure_choice(store: Any, hazard: str | None = None) -> pd.DataFrame:
@@ -55,6 +62,8 @@ def measure_choice(store: Any, hazard: str | None = None) -> pd.DataFrame:
         One row per configuration (its labels as columns, ``where`` in
         words), a column per hazard measure (β), ``most efficient`` (among
         them; "" when the hazard has none), ``best candidate`` and ``best β``.
+        Its ``attrs``: ``hazard_measures`` (those columns' names) and
+        ``store_measure`` (the store's own measure, named alike: :func:`measure_label`).
     """
     from stochpound.risk import measure_efficiency
 
@@ -78,6 +87,7 @@ def measure_choice(store: Any, hazard: str | None = None) -> pd.DataFrame:
         rows.append(row)
     frame = pd.DataFrame(rows)
     frame.attrs["hazard_measures"] = list(available)
+    frame.attrs["store_measure"] = measure_label(store.pound.intensity or {})
     return frame
 
 

@@ -24,6 +24,7 @@ returns a :class:`StoreRisk`, which owns the chain's tables
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 from collections.abc import Mapping, Sequence
 from typing import Any
@@ -348,9 +349,10 @@ class StoreRisk:
         what = "fits (gaps × configurations)" if self.configuration_dims() else "gaps"
         return degenerate_text(self.fragility["status"].values, self.hazard, what)
 
+    @functools.cached_property
     def outside_stripes(self) -> xr.Dataset | None:
         """The shares of λ_P at g* from shaking below the lowest stripe and beyond the top one, with the fit there
-        (:func:`~stochpound.risk.maf_outside_stripes`); None for IDA runs or a fit without its stripes' levels."""
+        (:func:`~stochpound.risk.maf_outside_stripes`, computed once); None for IDA runs or a fit without its stripes' levels."""
         if self.method != "stripes" or "intensity" not in self.fragility.coords or "separation" not in self.separation:
             return None
         return maf_outside_stripes(self.fragility, self.separation["separation"], self.hazard)

@@ -288,7 +288,7 @@ def _hazard_text(risk: StoreRisk) -> str:
 def _worst_outside(risk: StoreRisk) -> list[tuple[float, float, float]]:
     """Per target: (target, below, above), the worst configuration's shares of λ_P at g* from below the lowest stripe and beyond
     the top one ([] for IDA runs or without a finite g*)."""
-    shares = risk.outside_stripes()
+    shares = risk.outside_stripes
     if shares is None or not np.isfinite(shares["below"].values).any():
         return []
     return [(float(t), float(shares["below"].sel(target=t).max()), float(shares["above"].sel(target=t).max())) for t in shares["target"].values]
@@ -329,22 +329,22 @@ def _measure_choice_blocks(name: str, risk: StoreRisk, choice: pd.DataFrame | No
     """Which measure: the most efficient the site's hazard has per configuration, against the store's own, with the estimate's noise."""
     if choice is None or choice.empty or not choice.attrs.get("hazard_measures"):
         return []
-    measures = choice.attrs["hazard_measures"]
-    own = "PGA" if risk.setting.get("measure") == "pga" else f"PSA({risk.setting.get('period', float('nan')):g} s)"
+    measures, own = choice.attrs["hazard_measures"], choice.attrs["store_measure"]
     counts = choice["most efficient"].value_counts()
     best = ", ".join(f"{label} in {count} of {len(choice)} configurations" for label, count in counts.items())
     runs = risk.motions * (risk.stripes or 1)
-    noise = float(choice[own if own in measures else measures].max().max()) / math.sqrt(2.0 * max(runs - 2, 1))
-    gaps = [float(row[own] - row[row["most efficient"]]) for _, row in choice.iterrows() if own in choice and row["most efficient"]]
     if own not in measures:
         verdict = f"The store is conditioned on {own}, a measure the site's hazard is not given in among these."
-    elif max(gaps, default=0.0) == 0.0:
-        verdict = f"The store is conditioned on {own}, the most efficient in every configuration."
     else:
-        within = max(gaps) <= 2.0 * noise
-        verdict = (f"The store is conditioned on {own}, whose β exceeds the most efficient one's by up to {max(gaps):.3f}: "
-                   f"{'within' if within else 'beyond'} twice the standard error of one β estimate (about β/√(2(n − 2)) ≈ {noise:.3f} "
-                   f"for the {runs} contact-free runs of a configuration)" + (", so these runs do not tell the two apart." if within else "."))
+        excess = max(float(row[own] - row[row["most efficient"]]) for _, row in choice.iterrows())
+        noise = float(choice[own].max()) / math.sqrt(2.0 * max(runs - 2, 1))
+        if excess == 0.0:
+            verdict = f"The store is conditioned on {own}, the most efficient in every configuration."
+        else:
+            within = excess <= 2.0 * noise
+            verdict = (f"The store is conditioned on {own}, whose β exceeds the most efficient one's by up to {excess:.3f}: "
+                       f"{'within' if within else 'beyond'} twice the standard error of one β estimate (about β/√(2(n − 2)) ≈ {noise:.3f} "
+                       f"for the {runs} contact-free runs of a configuration)" + (", so these runs do not tell the two apart." if within else "."))
     text = (f"Which measure: β, the dispersion of ln(peak closure) given each measure the site's hazard is given in, over the contact-free "
             f"runs (a smaller β needs fewer motions for the same precision; stochpound.experiment.measure_choice): the most efficient is "
             f"{best}. {verdict} Of all candidates (PSA at the structure's own periods, PGV, Sa_avg), the most efficient is named per "
