@@ -116,6 +116,19 @@ def test_the_report_names_the_most_efficient_measure_and_weighs_the_stores_own_a
     assert _measure_choice_blocks("s", risk, None) == []
 
 
+def test_a_hazard_in_the_stores_measure_only_is_not_called_a_comparison() -> None:
+    import pandas as pd
+
+    from stochpound.report.sections._risk import _measure_choice_blocks
+    from stochpound.risk import HazardCurve, StoreRisk
+
+    choice = pd.DataFrame([{"where": "all runs", "PSA(1 s)": 0.5, "most efficient": "PSA(1 s)", "best candidate": "PGV", "best β": 0.4}])
+    choice.attrs.update(hazard_measures=["PSA(1 s)"], store_measure="PSA(1 s)")
+    risk = StoreRisk(xr.Dataset(), xr.Dataset(), xr.Dataset(), None, "", HazardCurve.power_law(1e-4, 2.0), 20, "stripes", stripes=7)
+    text = _measure_choice_blocks("s", risk, choice)[0].text
+    assert "no other measure is compared with it" in text and "the most efficient in every" not in text
+
+
 @pytest.mark.parametrize(("own_beta", "verdict"), [(0.52, "within twice"), (0.70, "beyond twice"), (0.50, "the most efficient in every")])
 def test_the_verdict_on_the_stores_own_measure_follows_the_numbers(own_beta: float, verdict: str) -> None:
     import pandas as pd

@@ -335,6 +335,8 @@ def _measure_choice_blocks(name: str, risk: StoreRisk, choice: pd.DataFrame | No
     runs = risk.motions * (risk.stripes or 1)
     if own not in measures:
         verdict = f"The store is conditioned on {own}, a measure the site's hazard is not given in among these."
+    elif measures == [own]:
+        verdict = f"The site's hazard is given in the store's own measure, {own}, only: no other measure is compared with it."
     else:
         excess = max(float(row[own] - row[row["most efficient"]]) for _, row in choice.iterrows())
         noise = float(choice[own].max()) / math.sqrt(2.0 * max(runs - 2, 1))
