@@ -41,6 +41,23 @@ def test_ctrl_c_prints_only_the_message(tmp_path):
     assert out.startswith("interrupted: ") and "rerun the same command to complete the missing cases" in out, out
 
 
+WORKER_ERROR_RECORD = """
+import logging
+from stochpound.experiment._runner import _dask_client
+
+with _dask_client(2, None, lambda message: None) as client:
+    client.run(lambda: logging.getLogger("distributed.worker").error("Failed to communicate with scheduler during heartbeat."))
+print("done")
+"""
+
+
+@pytest.mark.slow
+def test_the_local_workers_error_records_do_not_reach_the_terminal():
+    """What made a Ctrl-C print a worker's record now and then: an ERROR of ``distributed.worker`` in a worker process."""
+    result = subprocess.run([sys.executable, "-c", WORKER_ERROR_RECORD], capture_output=True, text=True, timeout=300, cwd=REPO)
+    assert (result.returncode, result.stdout, result.stderr) == (0, "done\n", ""), result.stderr
+
+
 def test_the_store_and_its_parts_follow_the_umask(tmp_path):
     umask, mode = 0o027, 0o640  # neither mkstemp's 0600 nor the usual 0644
     experiment = write_experiment(tmp_path, TINY_EXPERIMENT, "tiny.toml")

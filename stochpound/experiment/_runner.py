@@ -45,6 +45,11 @@ CHECKPOINT_FACTOR = 20.0
 """A checkpoint waits at least this many times the last rebuild's duration (rebuilds cost at most ~5 % of a run)."""
 IN_FLIGHT_PER_WORKER = 2
 """Batches submitted ahead per worker thread."""
+CLUSTER_LOG_LEVEL = logging.CRITICAL
+"""What dask's own logs print, in this process and in the local workers: nothing short of critical. A case's error
+reaches this process as the exception of its future (and stops the run with its message); dask's logs are otherwise
+its view of the cluster closing after a Ctrl-C (e.g. "Failed to communicate with scheduler during heartbeat", an ERROR record
+written to the terminal after the run's last message, as its heartbeat races the scheduler's close)."""
 LOCAL_CLUSTER_CONFIG = {
     "distributed.worker.profile.enabled": False,
     "distributed.admin.system-monitor.interval": "2s",
@@ -453,7 +458,7 @@ def _dask_client(workers: int | None, scheduler: str | None, say: Callable[[str]
         return client
 
     for name in ("distributed", "distributed.nanny", "distributed.worker", "distributed.scheduler", "distributed.core"):
-        logging.getLogger(name).setLevel(logging.ERROR)
+        logging.getLogger(name).setLevel(CLUSTER_LOG_LEVEL)
     if scheduler is not None:
         say(f"connecting to the dask scheduler {scheduler}…")
         client = Client(scheduler, timeout="30s")
@@ -473,7 +478,7 @@ def _dask_client(workers: int | None, scheduler: str | None, say: Callable[[str]
         # a SIGINT during the cluster's start (which an exception would leave half made) is raised once it can be closed
         with dask.config.set(LOCAL_CLUSTER_CONFIG), _handling_sigint(lambda signum, frame: requested.append(signum)):
             cluster = LocalCluster(  # its HTTP server on a free port (the default, 8787, may be taken: a warning)
-                n_workers=n_workers, threads_per_worker=1, processes=True, dashboard_address=":0", silence_logs=logging.ERROR
+                n_workers=n_workers, threads_per_worker=1, processes=True, dashboard_address=":0", silence_logs=CLUSTER_LOG_LEVEL
             )
         if requested:
             raise KeyboardInterrupt
