@@ -12,7 +12,7 @@ from stochpound import open_store
 from stochpound.analysis import HazardCurve, store_risk
 from stochpound.experiment._runner import load_experiment, run_experiment
 from stochpound.experiment._spec import ExperimentError, parse_experiment
-from stochpound.motions import conditional_spectrum, misses_target, select_motions, selection_periods, selection_pool
+from stochpound.motions import TRUNCATION_EPSILON, conditional_spectrum, misses_target, select_motions, selection_periods, selection_pool
 from stochpound.motions.records import Record, load_suite_member
 from stochpound.report.render import FigureItem, Paragraph
 from stochpound.report.sections._intensity import intensity_section
@@ -74,6 +74,11 @@ def test_each_stripe_runs_its_chosen_motions_and_the_store_keeps_the_selection(t
     text = " ".join(block.text for block in section.blocks if isinstance(block, Paragraph))
     missed = selection_misses(store)
     assert "chosen for the site" in text and ("misses its target" in text) == bool(missed)
+    # a stripe whose scenario needs more than 3σ to reach its level is named as beyond the hazard models' truncation
+    assert np.all(store.target_epsilon.values <= TRUNCATION_EPSILON) and "truncate" not in text
+    beyond = store.assign(target_epsilon=store.target_epsilon.copy(data=[1.0, 3.4]))
+    text = " ".join(block.text for block in intensity_section("site", beyond).blocks if isinstance(block, Paragraph))
+    assert "At the stripe 0.4 g the scenario's ε is beyond 3, where hazard models truncate the ground motion" in text
     # the risk chain counts the chosen motions of each stripe only
     risk = store_risk(store, HazardCurve.power_law(1e-4, 2.5), bootstrap=0)
     assert risk.motions == 4 and np.all(risk.fragility["runs"].values == 4)

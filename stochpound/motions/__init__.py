@@ -19,7 +19,7 @@ hazard curves where no disaggregation is at hand: :func:`fit_scenarios`,
 Conventions (PSD two-sided in ω, σ² = ∫ S dω; SI units) are in ``docs/motions.md``.
 """
 
-from stochpound.motions._conditional import conditional_spectrum
+from stochpound.motions._conditional import TRUNCATION_EPSILON, conditional_spectrum
 from stochpound.motions._fitted import fit_levels, fit_scenarios, recomputed_hazard
 from stochpound.motions.baseline import baseline_correct, final_velocity_displacement
 from stochpound.motions.envelopes import (
@@ -58,6 +58,7 @@ __all__ = [
     "ENVELOPES",
     "PSD_CONVENTION",
     "TARGET_TOLERANCE",
+    "TRUNCATION_EPSILON",
     "SOIL_PRESETS",
     "AminAng",
     "CallableEnvelope",

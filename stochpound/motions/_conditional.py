@@ -58,6 +58,9 @@ PERIOD_RANGE = (0.01, 10.0)
 PGA_PERIOD = 0.01
 #: Damping ratio of the models' spectra.
 MODEL_DAMPING = 0.05
+#: ε (standard deviations above the models' median) at which hazard models truncate the ground motion: a level beyond it
+#: is not caused by the scenario in such a model (the USGS models of the bundled curves: nshmp-haz's upper truncation at 3σ).
+TRUNCATION_EPSILON = 3.0
 _SCENARIO_FIELDS = {"magnitude": "mag", "distance_km": "dist_rup", "vs30": "v_s30"}
 
 

@@ -35,7 +35,7 @@ from stochpound.experiment import describe_measure
 from stochpound.report.render import FigureItem, Paragraph, Section, Table
 from stochpound.report.sections._stripe_motions import stripe_motions_text
 from stochpound.experiment import is_gap_axis
-from stochpound.motions import TARGET_TOLERANCE
+from stochpound.motions import TARGET_TOLERANCE, TRUNCATION_EPSILON
 from stochpound.risk import (
     TARGETS,
     consistency_at_targets,
@@ -257,6 +257,14 @@ def _selection_text(store: xr.Dataset, setting: dict[str, Any]) -> str:
         for level, m, r, e in zip(store["intensity"].values, store["site_magnitude"].values, store["site_distance_km"].values, store["target_epsilon"].values)
     )
     missed = selection_misses(store)
+    beyond = store["intensity"].values[store["target_epsilon"].values > TRUNCATION_EPSILON]
+    truncation = (
+        ""
+        if beyond.size == 0
+        else f" At {'the stripe' if beyond.size == 1 else 'the stripes'} {', '.join(f'{level:g}' for level in beyond)} {setting['units']} the scenario's "
+        f"ε is beyond {TRUNCATION_EPSILON:g}, where hazard models truncate the ground motion (the USGS models of the bundled curves do): "
+        "there no earthquake of that magnitude and distance causes the level, and the stripe stands for larger or nearer ones than its scenario."
+    )
     verdict = (
         f"Every stripe's selection matches its target within {TARGET_TOLERANCE:g} in the mean and the standard deviation of ln Sa at every period."
         if not missed
@@ -264,7 +272,7 @@ def _selection_text(store: xr.Dataset, setting: dict[str, Any]) -> str:
         f"stripes {', '.join(f'{level:g}' for level in missed)} {setting['units']}: their motions do not represent the site's at that intensity."
     )
     return (f"The motions of every stripe were chosen for the site: the conditional spectrum of the stripe's scenario (Vs30 "
-            f"{float(store['site_vs30'].values[0]):g} m/s, {store['site_mechanism'].values[0]} faulting): {scenarios}. {verdict}")
+            f"{float(store['site_vs30'].values[0]):g} m/s, {store['site_mechanism'].values[0]} faulting): {scenarios}.{truncation} {verdict}")
 
 
 def _selection_figure(name: str, store: xr.Dataset, setting: dict[str, Any]) -> FigureItem:
