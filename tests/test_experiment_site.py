@@ -79,6 +79,7 @@ def test_each_stripe_runs_its_chosen_motions_and_the_store_keeps_the_selection(t
     beyond = store.assign(target_epsilon=store.target_epsilon.copy(data=[1.0, 3.4]))
     text = " ".join(block.text for block in intensity_section("site", beyond).blocks if isinstance(block, Paragraph))
     assert "At the stripe 0.4 g the scenario's ε is beyond 3, where hazard models truncate the ground motion" in text
+    assert "and the stripe stands for larger or nearer ones than the scenario." in text
     # the risk chain counts the chosen motions of each stripe only
     risk = store_risk(store, HazardCurve.power_law(1e-4, 2.5), bootstrap=0)
     assert risk.motions == 4 and np.all(risk.fragility["runs"].values == 4)

@@ -263,7 +263,8 @@ def _selection_text(store: xr.Dataset, setting: dict[str, Any]) -> str:
         if beyond.size == 0
         else f" At {'the stripe' if beyond.size == 1 else 'the stripes'} {', '.join(f'{level:g}' for level in beyond)} {setting['units']} the scenario's "
         f"ε is beyond {TRUNCATION_EPSILON:g}, where hazard models truncate the ground motion (the USGS models of the bundled curves do): "
-        "there no earthquake of that magnitude and distance causes the level, and the stripe stands for larger or nearer ones than its scenario."
+        f"there no earthquake of that magnitude and distance causes the level, and {'the stripe stands' if beyond.size == 1 else 'those stripes stand'} "
+        "for larger or nearer ones than the scenario."
     )
     verdict = (
         f"Every stripe's selection matches its target within {TARGET_TOLERANCE:g} in the mean and the standard deviation of ln Sa at every period."
