@@ -35,3 +35,28 @@ def test_g_star_hardly_depends_on_the_conditioning_measure(tmp_path, configurati
     print(separations.assign_coords(measure=list(MEASURES)).to_dataframe()["separation"].to_string())
     print("max/min", ratio.to_pandas().to_string())
     assert float(ratio.max()) <= 1.3
+
+
+def test_the_selection_benchmarks_lognormal_recomputation_agrees_with_the_counts_where_they_resolve_the_rate() -> None:
+    """benchmarks.site_selection's hazard from a lognormal ln Sa(T') per stripe: with 4000 lognormal motions per stripe it is the
+    counts' (``hazard_consistency``) where they resolve the rate, and it still gives a rate beyond the largest motion."""
+    import numpy as np
+
+    from benchmarks.site_selection import _lognormal_recomputed
+    from stochpound.analysis import HazardCurve, hazard_consistency
+
+    hazard = HazardCurve.power_law(1.0e-3, 2.0)
+    y = np.geomspace(0.02, 20.0, 40)
+    other = HazardCurve(y, 5.0e-4 * y**-2.5)
+    rng = np.random.default_rng(7)
+    means, stds = np.log([0.1, 0.3]), np.array([0.5, 0.7])
+    values = np.exp(means[:, None] + stds[:, None] * rng.standard_normal((2, 4000)))
+    values[0, :100] = np.nan  # motions that did not run in a stripe
+    scaled = xr.DataArray(values, dims=("intensity", "record"), coords={"intensity": [0.2, 0.5]})
+    counted = hazard_consistency(scaled, hazard, other)["recomputed"].values
+    lognormal = _lognormal_recomputed(scaled, hazard, other)
+    resolved = counted > 0.05 * counted.max()
+    assert resolved.sum() >= 5
+    np.testing.assert_allclose(lognormal[resolved], counted[resolved], rtol=0.05)
+    beyond = other.im > np.nanmax(values)
+    assert beyond.any() and np.all(counted[beyond] == 0) and np.all(lognormal[beyond] > 0)
