@@ -11,7 +11,7 @@ from stochpound import open_store
 from stochpound.experiment._runner import load_experiment, run_experiment
 from stochpound.report.sections._intensity import method_text
 from stochpound.report.sections._stripe_motions import stripe_motions_text
-from tests.helpers import FIXED, risk_text, write_experiment
+from tests.helpers import FIXED, invoke, risk_text, write_experiment
 
 SELECTION = ('measure = "psa"\nperiod = 1.0\nlevels = [0.05, 0.1]\nselection = "conditional_spectrum"\nmotions = 3\nmax_scale_factor = 5.0\n'
              '[site]\nvs30 = 400.0\nmagnitude = [6.6, 7.0]\ndistance_km = 20.0\nmechanism = "strike_slip"\n')
@@ -52,3 +52,26 @@ def test_a_configuration_s_scene_is_read_from_a_case_that_ran_where_the_first_mo
     assert [b.name for b in scene.buildings] == [str(b) for b in cs_store["building"].values]
     unchosen = cs_store.isel(record=[i for i in range(cs_store.sizes["record"]) if (status.isel(intensity=0, record=i) != 1).all()])
     assert unchosen.sizes["record"] > 0, "the store has a motion the first stripe did not choose"
+
+
+def test_risk_warns_of_stripes_that_miss_their_target_or_lie_beyond_the_truncation(cs_store, tmp_path) -> None:
+    """``stochpound risk`` names the stripes whose selection misses its target and those its scenario puts beyond ε 3; neither
+    warning without cause."""
+    from stochpound.risk import selection_misses, stripes_beyond_truncation
+
+    assert stripes_beyond_truncation(cs_store) == [] and np.all(cs_store.target_epsilon.values <= 3.0)
+    clean = cs_store.assign(selection_misses_target=cs_store.selection_misses_target * 0)
+    flagged = cs_store.assign(selection_misses_target=cs_store.selection_misses_target.copy(data=[0, 1]),
+                              target_epsilon=cs_store.target_epsilon.copy(data=[1.0, 3.4]))
+    assert selection_misses(flagged) == [0.1] and stripes_beyond_truncation(flagged) == [0.1]
+    outputs = []
+    for name, store in (("clean", clean), ("flagged", flagged)):
+        store.to_netcdf(tmp_path / f"{name}.nc")
+        result = invoke("risk", str(tmp_path / f"{name}.nc"), "--bootstrap", "0")
+        assert result.exit_code == 0, result.output
+        outputs.append(result.stdout)
+    assert "warning" not in outputs[0]
+    assert ("warning: the motions chosen for the site miss their conditional-spectrum target (mean or std of ln Sa off by more than 0.1 "
+            "at a period) at the stripes 0.1 g") in outputs[1]
+    assert ("warning: the scenario puts the stripes 0.1 g beyond ε 3, where hazard models truncate the ground motion: no earthquake of "
+            "that scenario causes them there") in outputs[1]

@@ -96,8 +96,8 @@ def risk(store: Path, hazard: str | None, hazard_measure: str | None, hazard_uni
     """
     from stochpound.cli._measure_choice import efficient_measure_lines
     from stochpound.experiment import open_store
-    from stochpound.motions import TARGET_TOLERANCE
-    from stochpound.risk import gap_cost_frame, limit_state_risk, selection_misses, site_hazard, store_risk
+    from stochpound.motions import TARGET_TOLERANCE, TRUNCATION_EPSILON
+    from stochpound.risk import gap_cost_frame, limit_state_risk, selection_misses, site_hazard, store_risk, stripes_beyond_truncation
 
     targets = _targets(target)
     if hazard is None and (hazard_measure or hazard_units or investigation_time is not None or hazard_site is not None):
@@ -120,6 +120,10 @@ def risk(store: Path, hazard: str | None, hazard_measure: str | None, hazard_uni
     if missed:
         click.echo(f"warning: the motions chosen for the site miss their conditional-spectrum target (mean or std of ln Sa off by more than "
                    f"{TARGET_TOLERANCE:g} at a period) at the stripes {', '.join(f'{level:g}' for level in missed)} {result.setting['units']}")
+    beyond = stripes_beyond_truncation(data)
+    if beyond:
+        click.echo(f"warning: the scenario puts the stripes {', '.join(f'{level:g}' for level in beyond)} {result.setting['units']} beyond "
+                   f"ε {TRUNCATION_EPSILON:g}, where hazard models truncate the ground motion: no earthquake of that scenario causes them there")
     for line in hz.source.splitlines():
         if line.startswith("stochpound: "):
             click.echo(f"note: hazard {line.removeprefix('stochpound: ')}")

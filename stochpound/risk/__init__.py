@@ -55,7 +55,7 @@ from stochpound.risk._code_gaps import (
     srss_separation,
 )
 from stochpound.risk._design_rules import DESIGN_RULE_LEVELS, design_rules_risk, design_separations
-from stochpound.risk._store import RiskInputError, contact_free_closure, has_risk, selection_misses, site_hazard
+from stochpound.risk._store import RiskInputError, contact_free_closure, has_risk, selection_misses, site_hazard, stripes_beyond_truncation
 from stochpound.risk._store_risk import StoreRisk, pounding_fragility, risk_gaps, store_risk
 from stochpound.risk._demands import StoreDemands, store_demands
 from stochpound.risk._limit_states import KINDS as LIMIT_STATE_KINDS, LimitState, gap_cost_frame, limit_state_problem, limit_state_risk, limit_states_from_table
@@ -127,6 +127,7 @@ __all__ = [
     "most_efficient",
     "has_risk",
     "selection_misses",
+    "stripes_beyond_truncation",
     "site_hazard",
     "stripe_rate_weights",
     "RiskInputError",

@@ -24,7 +24,7 @@ import xarray as xr
 from stochpound.codes import store_contact_demands
 from stochpound.hazard import HazardCurve, check_covers, hazard_curve, hazard_option, parse_measure, parse_units, stored_hazard
 from stochpound.model import Scene
-from stochpound.motions import DEFAULT_G
+from stochpound.motions import DEFAULT_G, TRUNCATION_EPSILON
 from stochpound.store import LIMIT_STATE_DEMANDS, contact_free, describe_measure, gap_dims, has_contact_free, has_wall_free, scenario_kind, scenario_ranges, wall_free, with_contacts
 
 CLOSURE = "peak_contact_closure"
@@ -263,6 +263,19 @@ def selection_misses(store: xr.Dataset) -> list[float]:
         return []
     flags = store["selection_misses_target"].values.astype(bool)
     return [float(level) for level, flag in zip(store["intensity"].values, flags) if flag]
+
+
+def stripes_beyond_truncation(store: xr.Dataset) -> list[float]:
+    """The levels (in the levels' units) whose stripe's scenario puts them beyond ε :data:`~stochpound.motions.TRUNCATION_EPSILON`.
+
+    Where hazard models truncate the ground motion (the USGS models of the
+    bundled curves, at 3σ), no earthquake of that scenario causes such a
+    level: the stripe stands for larger or nearer ones. [] without a
+    selection for the site (``target_epsilon``).
+    """
+    if "target_epsilon" not in store:
+        return []
+    return [float(level) for level, epsilon in zip(store["intensity"].values, store["target_epsilon"].values) if epsilon > TRUNCATION_EPSILON]
 
 
 def motion_intensity(store: xr.Dataset) -> xr.DataArray:

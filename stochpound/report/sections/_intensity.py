@@ -44,6 +44,7 @@ from stochpound.risk import (
     rate_from_probability,
     selection_misses,
     site_consistency,
+    stripes_beyond_truncation,
 )
 from stochpound.store import has_contact_free, with_contacts
 
@@ -257,13 +258,13 @@ def _selection_text(store: xr.Dataset, setting: dict[str, Any]) -> str:
         for level, m, r, e in zip(store["intensity"].values, store["site_magnitude"].values, store["site_distance_km"].values, store["target_epsilon"].values)
     )
     missed = selection_misses(store)
-    beyond = store["intensity"].values[store["target_epsilon"].values > TRUNCATION_EPSILON]
+    beyond = stripes_beyond_truncation(store)
     truncation = (
         ""
-        if beyond.size == 0
-        else f" At {'the stripe' if beyond.size == 1 else 'the stripes'} {', '.join(f'{level:g}' for level in beyond)} {setting['units']} the scenario's "
+        if not beyond
+        else f" At {'the stripe' if len(beyond) == 1 else 'the stripes'} {', '.join(f'{level:g}' for level in beyond)} {setting['units']} the scenario's "
         f"ε is beyond {TRUNCATION_EPSILON:g}, where hazard models truncate the ground motion (the USGS models of the bundled curves do): "
-        f"there no earthquake of that magnitude and distance causes the level, and {'the stripe stands' if beyond.size == 1 else 'those stripes stand'} "
+        f"there no earthquake of that magnitude and distance causes the level, and {'the stripe stands' if len(beyond) == 1 else 'those stripes stand'} "
         "for larger or nearer ones than the scenario."
     )
     verdict = (
