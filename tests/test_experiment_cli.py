@@ -531,3 +531,40 @@ def test_every_command_s_g_option_has_the_same_default():
 
     found = dict(options(main, "stochpound"))
     assert len(found) >= 2 and len(set(found.values())) == 1, found
+
+
+def _group_with_a_library_that_turns_ctrl_c_into_its_error(ctrl_c: bool):
+    """A command group whose command meets a library that raises its own error in place of a KeyboardInterrupt."""
+    import click
+
+    from stochpound.cli._group import HelpGroup
+
+    @click.group(cls=HelpGroup)
+    def group() -> None:
+        """A group."""
+
+    @group.command()
+    def read() -> None:
+        """Read a file."""
+        try:
+            if ctrl_c:
+                os.kill(os.getpid(), signal.SIGINT)
+            time.sleep(0.5)  # Python's handler raises here
+        except KeyboardInterrupt:
+            pass
+        raise click.ClickException("NetCDF: HDF error")  # the error the library raised instead, as a command words it
+
+    return group
+
+
+@pytest.mark.parametrize("ctrl_c", [True, False])
+def test_an_error_raised_after_a_ctrl_c_is_the_ctrl_c(ctrl_c):
+    """What made `report build` now and then exit 1 with a library's message after a Ctrl-C: the error, not the interrupt,
+    reached the command's end. After a SIGINT any error ends the command as interrupted (130); without one the error stands."""
+    from click.testing import CliRunner
+
+    result = CliRunner().invoke(_group_with_a_library_that_turns_ctrl_c_into_its_error(ctrl_c), ["read"])
+    if ctrl_c:
+        assert (result.exit_code, result.stderr) == (130, "interrupted\n"), result.output
+    else:
+        assert result.exit_code == 1 and result.stderr == "Error: NetCDF: HDF error\n", result.output

@@ -2,7 +2,11 @@
 
 from __future__ import annotations
 
+import signal
 import sys
+from collections.abc import Iterator
+from contextlib import contextmanager
+from typing import Any
 
 import click
 
@@ -24,13 +28,23 @@ class HelpGroup(click.Group):
         return super().parse_args(ctx, args)
 
     def invoke(self, ctx: click.Context) -> object:
-        """Run the command; a Ctrl-C anywhere in it ends it with exit status 130 and no traceback (click's is 1, "Aborted!")."""
-        try:
-            return super().invoke(ctx)
-        except KeyboardInterrupt:
-            from stochpound.cli import interrupted
+        """Run the command; a Ctrl-C anywhere in it ends it with exit status 130 and no traceback (click's is 1, "Aborted!").
 
-            interrupted()
+        Also when a library turned the Ctrl-C's KeyboardInterrupt into an
+        error of its own (an HDF5 or netCDF read cut short fails with its
+        message instead): an error raised after a Ctrl-C is the Ctrl-C.
+        """
+        from stochpound.cli import interrupted
+
+        with _noting_ctrl_c() as ctrl_c:
+            try:
+                return super().invoke(ctx)
+            except KeyboardInterrupt:
+                interrupted()
+            except Exception:
+                if ctrl_c:
+                    interrupted()
+                raise
 
     def format_commands(self, ctx: click.Context, formatter: click.HelpFormatter) -> None:
         """The ``Commands:`` section, each command's first sentence whole."""
@@ -42,3 +56,31 @@ class HelpGroup(click.Group):
         if rows:
             with formatter.section("Commands"):
                 formatter.write_dl(rows)
+
+
+@contextmanager
+def _noting_ctrl_c() -> Iterator[list[int]]:
+    """Inside the block, SIGINT raises KeyboardInterrupt as Python's own handler does, and is noted in the list yielded.
+
+    Only where SIGINT has Python's own handler: ignored (a job started in the
+    background) or handled otherwise, it stays so, and nothing is noted;
+    nor outside the main thread (no signal handlers there).
+    """
+    noted: list[int] = []
+    if signal.getsignal(signal.SIGINT) is not signal.default_int_handler:
+        yield noted
+        return
+
+    def handler(signum: int, frame: Any) -> None:
+        noted.append(signum)
+        signal.default_int_handler(signum, frame)
+
+    try:
+        previous = signal.signal(signal.SIGINT, handler)
+    except ValueError:  # not the main thread
+        yield noted
+        return
+    try:
+        yield noted
+    finally:
+        signal.signal(signal.SIGINT, previous)
