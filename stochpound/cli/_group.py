@@ -10,6 +10,8 @@ from typing import Any
 
 import click
 
+from stochpound._signals import handling
+
 
 class HelpGroup(click.Group):
     """A click group that lists each command with the whole first sentence of its help.
@@ -75,12 +77,5 @@ def _noting_ctrl_c() -> Iterator[list[int]]:
         noted.append(signum)
         signal.default_int_handler(signum, frame)
 
-    try:
-        previous = signal.signal(signal.SIGINT, handler)
-    except ValueError:  # not the main thread
+    with handling(handler):
         yield noted
-        return
-    try:
-        yield noted
-    finally:
-        signal.signal(signal.SIGINT, previous)

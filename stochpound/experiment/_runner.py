@@ -28,6 +28,7 @@ from pathlib import Path
 from typing import Any, Callable, Iterable, Iterator
 
 from stochpound import __version__
+from stochpound._signals import handling
 from stochpound.experiment._batches import automatic_size, make_batches
 from stochpound.experiment._compute import BatchResult, BatchTask, run_batch, warm_up
 from stochpound.experiment._estimate import LARGE_RUN_BYTES, LARGE_RUN_CASES, estimate_run, startup_step
@@ -58,7 +59,7 @@ LOCAL_CLUSTER_CONFIG = {
 }
 """dask settings of the local cluster: no statistical profiler in the workers (it samples their threads every
 10 ms), slower system monitors and event-loop ticks: idle, the cluster takes about 3 % of a core instead of 13 %;
-worker processes forked by multiprocessing's fork server (which ignores SIGINT: :func:`_handling_sigint`)."""
+worker processes forked by multiprocessing's fork server (which ignores SIGINT: :func:`_dask_client`)."""
 
 
 @dataclass
@@ -470,13 +471,17 @@ def _dask_client(workers: int | None, scheduler: str | None, say: Callable[[str]
     _warm_up(say)
     n_workers = workers or os.cpu_count() or 1
     say(f"starting a local dask cluster ({n_workers} worker{'s' if n_workers > 1 else ''})…")
-    with _handling_sigint(signal.SIG_IGN):  # the fork server, and every worker process it forks, ignore SIGINT
+    # The fork server is started while SIGINT is ignored: it, and every worker process it forks, inherit the ignored SIGINT.
+    # A Ctrl-C in a terminal reaches every process of the foreground group; the workers then stop with the cluster instead
+    # of printing their own tracebacks. Ignoring lasts as long as the fork server's fork and exec (milliseconds, once per
+    # process): a Ctrl-C then is lost.
+    with handling(signal.SIG_IGN):
         forkserver.ensure_running()
     cluster = client = None
     requested: list[int] = []
     try:
         # a SIGINT during the cluster's start (which an exception would leave half made) is raised once it can be closed
-        with dask.config.set(LOCAL_CLUSTER_CONFIG), _handling_sigint(lambda signum, frame: requested.append(signum)):
+        with dask.config.set(LOCAL_CLUSTER_CONFIG), handling(lambda signum, frame: requested.append(signum)):
             cluster = LocalCluster(  # its HTTP server on a free port (the default, 8787, may be taken: a warning)
                 n_workers=n_workers, threads_per_worker=1, processes=True, dashboard_address=":0", silence_logs=CLUSTER_LOG_LEVEL
             )
@@ -489,28 +494,6 @@ def _dask_client(workers: int | None, scheduler: str | None, say: Callable[[str]
             client.close(timeout=10)
         if cluster is not None:
             cluster.close(timeout=10)
-
-
-@contextmanager
-def _handling_sigint(handler: Any) -> Iterator[None]:
-    """SIGINT goes to ``handler`` inside the block (``signal.SIG_IGN``: ignored); nothing changes outside the main thread.
-
-    The local workers are forked by multiprocessing's fork server
-    (:data:`LOCAL_CLUSTER_CONFIG`), started while SIGINT is ignored: they
-    inherit the ignored SIGINT. A Ctrl-C in a terminal reaches every process
-    of the foreground group; the workers then stop with the cluster instead of
-    printing their own tracebacks. Ignoring lasts as long as the fork server's
-    fork and exec (milliseconds, once per process): a Ctrl-C then is lost.
-    """
-    try:
-        previous = signal.signal(signal.SIGINT, handler)
-    except ValueError:  # not the main thread
-        yield
-        return
-    try:
-        yield
-    finally:
-        signal.signal(signal.SIGINT, previous)
 
 
 def _local_workers(workers: int | None, scheduler: str | None) -> int:
@@ -550,16 +533,8 @@ def _interrupts() -> Iterator[_StopFlag]:
         flag.requested = True
         raise KeyboardInterrupt
 
-    try:
-        previous = {sig: signal.signal(sig, handler) for sig in (signal.SIGINT, signal.SIGTERM)}
-    except ValueError:  # not the main thread
+    with handling(handler, (signal.SIGINT, signal.SIGTERM)):
         yield flag
-        return
-    try:
-        yield flag
-    finally:
-        for sig, old in previous.items():
-            signal.signal(sig, old)
 
 
 class _NoBar:
