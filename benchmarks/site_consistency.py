@@ -1,4 +1,4 @@
-"""g* by conditioning measure at the bundled Fox Plaza site: ``python -m benchmarks.site_consistency``.
+"""g* by conditioning measure at the bundled Fox Plaza site, or at a site of one scenario: ``python -m benchmarks.site_consistency``.
 
 The same buildings at the same site, stripes of motions chosen to the
 conditional spectrum (``selection = "conditional_spectrum"``, 20 motions
@@ -20,7 +20,16 @@ lognormal demand per stripe (:func:`stochpound.risk.stripe_demand_rate`:
 every run's closure enters, not only whether it reaches a gap) and what
 each g* rests on, and draws both in ``docs/figures/site_consistency.png``
 (g* against the conditioning measure); ``--seeds`` repeats both with other
-seeds of the selection, ``--return-periods`` moves the stripes. About 6
+seeds of the selection, ``--return-periods`` moves the stripes.
+
+``--site scenario`` runs the same at a site shaken by one earthquake
+scenario (``--scenario M R mechanism rate``, default M 7.5 at 10 km,
+strike-slip, 0.01 per year; Vs30 400 m/s), its four curves from the same
+models as the conditional spectra (:func:`stochpound.analysis.scenario_hazard`)
+and that scenario given at every level (``[site] scenario = "given"``):
+hazard-consistent by construction, so the measures must agree there up to
+what the pool and the stripes cannot carry (docs/intensity.md, finding 8);
+the figure is then ``docs/figures/site_consistency_scenario.png``. About 6
 minutes per configuration on 2 cores for the four measures (3 times that
 with two more seeds); ``--measures PGA "PSA(1 s)"`` runs fewer. tests/test_benchmark_site_consistency.py
 runs the reduced check with the same experiments.
@@ -30,6 +39,8 @@ from __future__ import annotations
 
 import argparse
 import tempfile
+from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -40,6 +51,7 @@ import xarray as xr
 from benchmarks.timing import REPOSITORY
 
 if TYPE_CHECKING:
+    from stochpound.analysis import HazardCurve
     from stochpound.risk import StoreRisk
 
 RETURN_PERIODS = np.array([10.0, 25.0, 72.0, 224.0, 475.0, 975.0, 2475.0, 5000.0])
@@ -66,40 +78,80 @@ suite = "fema_p695_far_field"
 [[records]]
 suite = "fema_p695_near_field"
 """
-FIGURE = REPOSITORY / "docs" / "figures" / "site_consistency.png"
+FIGURES = {"fox_plaza": REPOSITORY / "docs" / "figures" / "site_consistency.png",
+           "scenario": REPOSITORY / "docs" / "figures" / "site_consistency_scenario.png"}
+#: The measures as stochpound's measure and period (a site of one scenario computes their hazard).
+MEASURE_ARGS: dict[str, tuple[str, float | None]] = {"PGA": ("pga", None), "PSA(1 s)": ("psa", 1.0), "PSA(2 s)": ("psa", 2.0), "PSA(3 s)": ("psa", 3.0)}
+#: The default scenario of ``--site scenario``: magnitude, rupture distance (km), mechanism, annual rate (1/yr).
+SCENARIO = (7.5, 10.0, "strike_slip", 0.01)
 
 
-def experiment_text(measure: str, configuration: str, seed: int | None = None, return_periods: np.ndarray = RETURN_PERIODS) -> str:
-    """The experiment file of one conditioning measure and configuration (the selection's ``seed``, or its default; stripes at
-    the site's intensities of ``return_periods``, yr)."""
+@dataclass(frozen=True)
+class Site:
+    """Where the stripes are: each measure's hazard curve, the experiment's ``[site]`` table, the default stripes' return periods (yr)."""
+
+    name: str
+    hazard: Callable[[str], HazardCurve]
+    table: str
+    return_periods: np.ndarray
+
+
+def _bundled_hazard(measure: str) -> HazardCurve:
     from stochpound.analysis import HazardCurve
 
-    lines, curve = MEASURES[measure]
-    levels = HazardCurve.bundled(curve).intensity_at(1.0 / np.asarray(return_periods, dtype=float))
+    return HazardCurve.bundled(MEASURES[measure][1])
+
+
+#: The bundled Fox Plaza site, the scenario fitted to its four curves (Vs30 and mechanism assumed: the curves state neither).
+FOX_PLAZA = Site("fox_plaza", _bundled_hazard, '[site]\nscenario = "fitted"\ncurves = [' + ", ".join(f'"{name}"' for name in CURVES) +
+                 ']\nvs30 = 400.0\nmechanism = "reverse"\n', RETURN_PERIODS)
+
+
+def scenario_site(magnitude: float, distance_km: float, mechanism: str, rate: float, vs30: float = 400.0) -> Site:
+    """A site shaken by one scenario recurring at ``rate`` (1/yr): its curves from the conditional spectrum's models, the scenario given
+    at every level. Default stripes: 1.5 / rate years (the scenario's median shaking, ε about −0.4), the return periods of
+    :data:`RETURN_PERIODS` beyond it, and 10 000 years."""
+    from stochpound.analysis import scenario_hazard
+
+    def hazard(measure: str) -> HazardCurve:
+        kind, period = MEASURE_ARGS[measure]
+        return scenario_hazard(kind, period, magnitude=magnitude, distance_km=distance_km, vs30=vs30, mechanism=mechanism, rate=rate)
+
+    table = f'[site]\nmagnitude = {magnitude}\ndistance_km = {distance_km}\nvs30 = {vs30}\nmechanism = "{mechanism}"\n'
+    lowest = 1.5 / rate
+    return Site("scenario", hazard, table, np.unique(np.r_[lowest, RETURN_PERIODS[RETURN_PERIODS > lowest], 10000.0]))
+
+
+def experiment_text(measure: str, configuration: str, seed: int | None = None, return_periods: np.ndarray | None = None,
+                    site: Site = FOX_PLAZA) -> str:
+    """The experiment file of one conditioning measure and configuration at ``site`` (the selection's ``seed``, or its default;
+    stripes at the site's intensities of ``return_periods``, yr, by default the site's)."""
+    periods = site.return_periods if return_periods is None else np.asarray(return_periods, dtype=float)
+    levels = site.hazard(measure).intensity_at(1.0 / periods)
     base, variants = CONFIGURATIONS[configuration]
-    curves = ", ".join(f'"{name}"' for name in CURVES)
-    return (f'[experiment]\nname = "site_{curve}"\nstudied = "B1"\n{PAIR.format(base=base, variants=variants)}\n[intensity]\n{lines}\n'
-            f"levels = [{', '.join(f'{x:.4f}' for x in levels)}]\n"
+    return (f'[experiment]\nname = "site_{site.name}"\nstudied = "B1"\n{PAIR.format(base=base, variants=variants)}\n[intensity]\n'
+            f"{MEASURES[measure][0]}\nlevels = [{', '.join(f'{x:.4f}' for x in levels)}]\n"
             'selection = "conditional_spectrum"\nmotions = 20\nmax_scale_factor = 5.0\n' + ("" if seed is None else f"seed = {seed}\n") +
-            f'[site]\nscenario = "fitted"\ncurves = [{curves}]\nvs30 = 400.0\nmechanism = "reverse"\n')
+            site.table)
 
 
 def measure_risk(folder: Path, measure: str, configuration: str, bootstrap: int = 0, seed: int | None = None,
-                 return_periods: np.ndarray = RETURN_PERIODS) -> tuple[xr.Dataset, StoreRisk]:
+                 return_periods: np.ndarray | None = None, site: Site = FOX_PLAZA) -> tuple[xr.Dataset, StoreRisk]:
     """The store and the risk answer (g* at 10 % and 2 % in 50 years, ``bootstrap`` resamples for its 95 % interval) of one
-    measure and configuration (the selection's ``seed``, or its default; stripes at ``return_periods``), run in ``folder``."""
+    measure and configuration at ``site`` (the selection's ``seed``, or its default; stripes at ``return_periods``, by default
+    the site's), run in ``folder``."""
     from stochpound import open_store
-    from stochpound.analysis import HazardCurve, store_risk
+    from stochpound.analysis import store_risk
     from stochpound.experiment import load_experiment, run_experiment
 
     name = f"{measure.replace('(', '').replace(' s)', '').replace(' ', '').lower()}.toml"
     path = folder / name
-    path.write_text(experiment_text(measure, configuration, seed, return_periods))
+    path.write_text(experiment_text(measure, configuration, seed, return_periods, site))
     report = run_experiment(load_experiment(path), workers=0, progress=False)
     if not report.complete:
         raise RuntimeError(f"{configuration}, {measure}: the experiment did not complete")
     store = open_store(report.store).load()
-    return store, store_risk(store, HazardCurve.bundled(MEASURES[measure][1]), targets=(0.1, 0.02), bootstrap=bootstrap)
+    return store, store_risk(store, site.hazard(measure), targets=(0.1, 0.02), bootstrap=bootstrap)
 
 
 def lognormal_g_star(store: xr.Dataset, risk: StoreRisk) -> xr.DataArray:
@@ -112,9 +164,10 @@ def lognormal_g_star(store: xr.Dataset, risk: StoreRisk) -> xr.DataArray:
     return risk_targeted_separation(xr.Dataset({"maf": rate}), targets, risk.years)["separation"]
 
 
-def g_star(folder: Path, measure: str, configuration: str) -> xr.DataArray:
-    """g* (m) at 10 % and 2 % in 50 years of one measure and configuration from a lognormal demand per stripe, run in ``folder``."""
-    return lognormal_g_star(*measure_risk(folder, measure, configuration))
+def g_star(folder: Path, measure: str, configuration: str, site: Site = FOX_PLAZA) -> xr.DataArray:
+    """g* (m) at 10 % and 2 % in 50 years of one measure and configuration at ``site`` from a lognormal demand per stripe, run in
+    ``folder``."""
+    return lognormal_g_star(*measure_risk(folder, measure, configuration, site=site))
 
 
 def diagnosis(store: xr.Dataset, risk: StoreRisk) -> pd.DataFrame:
@@ -133,7 +186,8 @@ def _print_seeds(configuration: str, args: argparse.Namespace, counted: xr.DataA
     again: dict[str, list[xr.DataArray]] = {"counted": [], "lognormal demand per stripe": []}
     with tempfile.TemporaryDirectory() as folder:
         for seed in args.seeds:
-            runs = [measure_risk(_subfolder(Path(folder), f"seed{seed}"), measure, configuration, seed=seed, return_periods=args.return_periods)
+            runs = [measure_risk(_subfolder(Path(folder), f"seed{seed}"), measure, configuration, seed=seed, return_periods=args.return_periods,
+                                 site=args.site)
                     for measure in args.measures]
             again["counted"].append(xr.concat([risk.separation["separation"] for _, risk in runs], dim="measure"))
             again["lognormal demand per stripe"].append(xr.concat([lognormal_g_star(store, risk) for store, risk in runs], dim="measure"))
@@ -179,10 +233,17 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--measures", nargs="+", default=list(MEASURES), choices=list(MEASURES))
     parser.add_argument("--configurations", nargs="+", default=list(CONFIGURATIONS), choices=list(CONFIGURATIONS))
     parser.add_argument("--bootstrap", type=int, default=200, help="resamples of the 95 %% interval of g* (0: none)")
-    parser.add_argument("--return-periods", nargs="+", type=float, default=list(RETURN_PERIODS),
-                        help="return periods (yr) of the stripes' intensities (default %(default)s)")
+    parser.add_argument("--return-periods", nargs="+", type=float, default=None,
+                        help=f"return periods (yr) of the stripes' intensities (default: the site's; Fox Plaza {list(RETURN_PERIODS)})")
     parser.add_argument("--seeds", nargs="*", type=int, default=[], help="other seeds of the selection: g* of every measure again with each")
+    parser.add_argument("--site", choices=list(FIGURES), default="fox_plaza", help="the bundled Fox Plaza site, or a site of one scenario")
+    parser.add_argument("--scenario", nargs=4, metavar=("M", "R_KM", "MECHANISM", "RATE"), default=list(SCENARIO),
+                        help="--site scenario's magnitude, rupture distance (km), mechanism and annual rate (default %(default)s)")
     args = parser.parse_args(argv)
+    args.site = FOX_PLAZA if args.site == "fox_plaza" else scenario_site(float(args.scenario[0]), float(args.scenario[1]), args.scenario[2],
+                                                                        float(args.scenario[3]))
+    args.return_periods = args.site.return_periods if args.return_periods is None else np.asarray(args.return_periods, dtype=float)
+    print(f"site: {args.site.name}; stripes at return periods {', '.join(f'{t:g}' for t in args.return_periods)} yr")
     figure = Figure(figsize=(7.5, 3.4), layout="constrained")
     axes = figure.subplots(1, 2, sharey=True)
     for ax, target in zip(axes, (0.1, 0.02)):
@@ -193,7 +254,8 @@ def main(argv: list[str] | None = None) -> None:
         answers, lognormal, diagnoses = [], [], []
         with tempfile.TemporaryDirectory() as folder:
             for measure in args.measures:
-                store, risk = measure_risk(Path(folder), measure, configuration, bootstrap=args.bootstrap, return_periods=args.return_periods)
+                store, risk = measure_risk(Path(folder), measure, configuration, bootstrap=args.bootstrap, return_periods=args.return_periods,
+                                           site=args.site)
                 answers.append(risk.separation["separation"])
                 lognormal.append(lognormal_g_star(store, risk))
                 diagnoses.append(diagnosis(store, risk).assign(measure=measure))
@@ -209,8 +271,8 @@ def main(argv: list[str] | None = None) -> None:
         _draw(axes, configuration, counted, fitted)
     axes[0].set_ylabel("g* (m): lognormal demand per stripe (solid), counts (dashed)", fontsize=7)
     axes[1].legend(fontsize=7)
-    figure.savefig(FIGURE, dpi=150)
-    print(f"\nfigure: {FIGURE.relative_to(REPOSITORY)}")
+    figure.savefig(FIGURES[args.site.name], dpi=150)
+    print(f"\nfigure: {FIGURES[args.site.name].relative_to(REPOSITORY)}")
 
 
 if __name__ == "__main__":

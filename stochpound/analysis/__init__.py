@@ -41,6 +41,7 @@ from stochpound.hazard import (
     rate_from_probability,
     read_hazard_file,
     return_period,
+    scenario_hazard,
     stripe_rate_weights,
 )
 
@@ -120,5 +121,6 @@ __all__ = [
     "return_period",
     "hazard_consistency",
     "stripe_rate_weights",
+    "scenario_hazard",
     *RISK_NAMES,
 ]

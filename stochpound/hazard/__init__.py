@@ -8,7 +8,9 @@ an experiment file's ``[hazard]`` table into the canonical entry a store
 carries, :func:`stored_hazard` gives a store's curve back and
 :func:`hazard_option` reads ``stochpound risk --hazard``;
 :func:`hazard_consistency` recomputes the hazard at another measure from
-the stripes' motions. The experiment reader, the statistics
+the stripes' motions; :func:`scenario_hazard` is the hazard of a site
+shaken by one earthquake scenario, consistent with the ground-motion models
+by construction. The experiment reader, the statistics
 (:mod:`stochpound.analysis`, which gives these names to its users) and the
 risk chain (:mod:`stochpound.risk`) all read the hazard here: this package
 imports none of them.
@@ -17,6 +19,7 @@ imports none of them.
 from stochpound.hazard._curve import HazardCurve, bundled_curves, bundled_measure, bundled_site_curves, probability_from_rate, rate_from_probability, return_period
 from stochpound.hazard._files import HazardFile, parse_measure, parse_units, read_hazard_file
 from stochpound.hazard._consistency import hazard_consistency, stripe_rate_weights
+from stochpound.hazard._scenario import scenario_hazard
 from stochpound.hazard._setting import check_covers, hazard_curve, hazard_option, parse_hazard, stored_hazard
 
 __all__ = [
@@ -33,6 +36,7 @@ __all__ = [
     "parse_units",
     "hazard_consistency",
     "stripe_rate_weights",
+    "scenario_hazard",
     "parse_hazard",
     "hazard_curve",
     "check_covers",

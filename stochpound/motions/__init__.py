@@ -10,7 +10,8 @@ Intensity measures and the response spectrum (exact for accelerations linear
 between samples): :func:`intensity_measures`, :func:`response_spectrum`.
 
 The conditional spectrum of a site scenario (NGA-West2 models, Baker–Jayaram
-correlation): :func:`conditional_spectrum`; records chosen and scaled to it
+correlation): :func:`conditional_spectrum`, and the scenario's own median and σ
+of a measure: :func:`scenario_distribution`; records chosen and scaled to it
 (Jayaram, Lin & Baker 2011): :func:`selection_pool`, :func:`selection_periods`,
 :func:`select_motions`; the scenario of every level fitted to the site's own
 hazard curves where no disaggregation is at hand: :func:`fit_scenarios`,
@@ -19,7 +20,7 @@ hazard curves where no disaggregation is at hand: :func:`fit_scenarios`,
 Conventions (PSD two-sided in ω, σ² = ∫ S dω; SI units) are in ``docs/motions.md``.
 """
 
-from stochpound.motions._conditional import TRUNCATION_EPSILON, conditional_spectrum
+from stochpound.motions._conditional import TRUNCATION_EPSILON, conditional_spectrum, scenario_distribution
 from stochpound.motions._fitted import fit_levels, fit_scenarios, recomputed_hazard
 from stochpound.motions.baseline import baseline_correct, final_velocity_displacement
 from stochpound.motions.envelopes import (
@@ -94,6 +95,7 @@ __all__ = [
     "s0_from_pga",
     "s0_from_rms",
     "sa_avg",
+    "scenario_distribution",
     "select_motions",
     "selection_periods",
     "selection_pool",

@@ -143,36 +143,27 @@ def _check_periods(values: Sequence[float], field: str) -> np.ndarray:
     return periods
 
 
-def conditional_distribution(
-    measure: str,
-    period: float | Sequence[float] | None,
-    level: float,
-    periods: Sequence[float],
-    magnitude: float,
-    distance_km: float,
-    vs30: float,
-    mechanism: str,
-) -> ConditionalDistribution:
-    """ln Sa (g) at ``periods`` given the measure = ``level`` (module docstring), after checking every input."""
+def _conditioning_nodes(measure: str, period: float | Sequence[float] | None) -> list[float | None]:
+    """The nodes (a period in s, or None for PGA) the measure averages ln Sa over, after checking ``measure`` and ``period``."""
     if measure not in CONDITIONING_MEASURES:
         raise SiteError(f"measure: must be one of {', '.join(CONDITIONING_MEASURES)} (no PGV–Sa correlation in the model), got {measure!r}")
     if measure == "pga":
         if period is not None:
             raise SiteError(f"period: pga takes no period, got {period!r}")
-        conditioning: list[float | None] = [None]
-    elif measure == "psa":
+        return [None]
+    if measure == "psa":
         if period is None or np.ndim(period) != 0:
             raise SiteError(f"period: psa needs one period T* in s, got {period!r}")
-        conditioning = list(_check_periods([period], "period"))
-    else:
-        if period is None or np.ndim(period) != 1 or len(period) < 2:
-            raise SiteError(f"period: sa_avg needs a list of at least 2 periods in s, got {period!r}")
-        conditioning = list(_check_periods(period, "period"))
-    if not isinstance(level, (int, float)) or isinstance(level, bool) or not np.isfinite(level) or level <= 0:
-        raise SiteError(f"level: must be > 0 (g), got {level!r}")
-    output = _check_periods(periods, "periods")
-    if np.unique(output).size != output.size:
-        raise SiteError("periods: repeated period")
+        return list(_check_periods([period], "period"))
+    if period is None or np.ndim(period) != 1 or len(period) < 2:
+        raise SiteError(f"period: sa_avg needs a list of at least 2 periods in s, got {period!r}")
+    return list(_check_periods(period, "period"))
+
+
+def _joint_model(measure: str, period: float | Sequence[float] | None, output: Sequence[float], magnitude: float, distance_km: float,
+                 vs30: float, mechanism: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """ln Sa at the ``output`` periods followed by the measure's own nodes: mean μ, covariance C and the measure's weights w."""
+    conditioning = _conditioning_nodes(measure, period)
     check_scenario(magnitude, distance_km, vs30, mechanism)
     from pygmm.baker_jayaram_2008 import calc_correls
 
@@ -188,7 +179,59 @@ def conditional_distribution(
     mean, sigma = _average_model(nodes, magnitude, distance_km, vs30, mechanism)
     at = np.array([PGA_PERIOD if node is None else node for node in nodes])
     correlation = np.array([calc_correls(at, t) for t in at])
-    covariance = correlation * np.outer(sigma, sigma)
+    return mean, correlation * np.outer(sigma, sigma), weights
+
+
+def scenario_distribution(measure: str, period: float | Sequence[float] | None = None, *, magnitude: float, distance_km: float,
+                          vs30: float, mechanism: str) -> tuple[float, float]:
+    """The median (g) and the standard deviation of ln of a measure in a scenario: the conditional spectrum's own model.
+
+    Parameters
+    ----------
+    measure : {"pga", "psa", "sa_avg"}
+        The measure.
+    period : float or list of float, optional
+        T (s) for ``psa``; the averaging periods (s) for ``sa_avg``; none for ``pga``.
+    magnitude, distance_km, vs30 : float
+        Moment magnitude, rupture distance (km) and Vs30 (m/s) of the scenario.
+    mechanism : {"strike_slip", "reverse", "normal"}
+        Faulting mechanism.
+
+    Returns
+    -------
+    tuple of float
+        exp(wᵀμ) (g) and √(wᵀCw) (module docstring): for PGA and PSA(T) the
+        four models' average median and σ; for Sa_avg those of the geometric
+        mean, the periods' correlation included.
+
+    Raises
+    ------
+    SiteError
+        Naming the field, as :func:`conditional_spectrum`.
+    """
+    mean, covariance, weights = _joint_model(measure, period, [], magnitude, distance_km, vs30, mechanism)
+    return float(np.exp(weights @ mean)), float(np.sqrt(weights @ covariance @ weights))
+
+
+def conditional_distribution(
+    measure: str,
+    period: float | Sequence[float] | None,
+    level: float,
+    periods: Sequence[float],
+    magnitude: float,
+    distance_km: float,
+    vs30: float,
+    mechanism: str,
+) -> ConditionalDistribution:
+    """ln Sa (g) at ``periods`` given the measure = ``level`` (module docstring), after checking every input."""
+    _conditioning_nodes(measure, period)
+    if not isinstance(level, (int, float)) or isinstance(level, bool) or not np.isfinite(level) or level <= 0:
+        raise SiteError(f"level: must be > 0 (g), got {level!r}")
+    output = _check_periods(periods, "periods")
+    if np.unique(output).size != output.size:
+        raise SiteError("periods: repeated period")
+    mean, covariance, weights = _joint_model(measure, period, list(output), magnitude, distance_km, vs30, mechanism)
+    sigma = np.sqrt(np.diag(covariance))
     cw = covariance @ weights
     variance = float(weights @ cw)
     epsilon = (np.log(level) - float(weights @ mean)) / np.sqrt(variance)
