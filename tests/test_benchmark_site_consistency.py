@@ -29,7 +29,9 @@ MEASURES = ("PGA", "PSA(1 s)", "PSA(2 s)", "PSA(3 s)")
     pytest.param("isolated", marks=pytest.mark.xfail(strict=True, reason=(
         "not yet within x1.3: measured x1.46 / x1.57 (the scaled suite gave x1.9-2.1), the same with other seeds of the selection: "
         "the stripes of PGA and PSA(1 s) carry the site's hazard at the isolated period poorly, and no population of earthquakes under the "
-        "models and the assumed site gives the site's long- and short-period curves together (docs/intensity.md, findings 4 and 7); "
+        "models and the assumed site gives the site's long- and short-period curves together (docs/intensity.md, findings 4 and 7), and "
+        "even at a site consistent by construction the measures part for this building where its g* comes from the rare tail of a "
+        "spectrum weak at long periods (finding 8); "
         "strict: it fails the day it passes, to be un-marked"))),
 ])  # fmt: skip
 def test_g_star_hardly_depends_on_the_conditioning_measure(tmp_path, configuration: str) -> None:

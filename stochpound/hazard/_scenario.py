@@ -58,8 +58,8 @@ def scenario_hazard(measure: str, period: float | Sequence[float] | None = None,
     Returns
     -------
     HazardCurve
-        λ(x) (1/yr) tabulated at :data:`TABLE_POINTS` intensities (g) from
-        ε −4 to 6; its ``source`` names the scenario and the rate.
+        λ(x) (1/yr) tabulated at ``TABLE_POINTS`` intensities (g), log-spaced
+        over ``EPSILON_RANGE`` (ε −4 to 6); its ``source`` names the scenario and the rate.
 
     Raises
     ------
