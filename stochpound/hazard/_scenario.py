@@ -42,14 +42,8 @@ def scenario_hazard(measure: str, period: float | Sequence[float] | None = None,
 
     Parameters
     ----------
-    measure : {"pga", "psa", "sa_avg"}
-        The measure; ``period`` as for :func:`stochpound.motions.conditional_spectrum`.
-    period : float or list of float, optional
-        T (s) for ``psa``; the averaging periods (s) for ``sa_avg``; none for ``pga``.
-    magnitude, distance_km, vs30 : float
-        Moment magnitude, rupture distance (km) and Vs30 (m/s) of the scenario.
-    mechanism : {"strike_slip", "reverse", "normal"}
-        Faulting mechanism.
+    measure, period, magnitude, distance_km, vs30, mechanism
+        The measure and the scenario, as for :func:`stochpound.motions.scenario_distribution`.
     rate : float
         ν, the scenario's annual rate of occurrence (1/yr), > 0.
     extrapolate : bool
