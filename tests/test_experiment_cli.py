@@ -557,14 +557,24 @@ def _group_with_a_library_that_turns_ctrl_c_into_its_error(ctrl_c: bool):
     return group
 
 
-@pytest.mark.parametrize("ctrl_c", [True, False])
-def test_an_error_raised_after_a_ctrl_c_is_the_ctrl_c(ctrl_c):
+@pytest.mark.parametrize(("ctrl_c", "sigint"), [
+    (True, signal.default_int_handler),
+    (False, signal.default_int_handler),
+    (True, signal.SIG_IGN),
+])  # fmt: skip
+def test_an_error_raised_after_a_ctrl_c_is_the_ctrl_c(ctrl_c, sigint):
     """What made `report build` now and then exit 1 with a library's message after a Ctrl-C: the error, not the interrupt,
-    reached the command's end. After a SIGINT any error ends the command as interrupted (130); without one the error stands."""
+    reached the command's end. After a SIGINT any error ends the command as interrupted (130); without one the error stands,
+    and so it does where SIGINT is ignored (a job started in the background, as a shell starts one with &: the process
+    starts with SIGINT ignored, and the command leaves it so). The test sets SIGINT's handler itself: it is inherited."""
     from click.testing import CliRunner
 
-    result = CliRunner().invoke(_group_with_a_library_that_turns_ctrl_c_into_its_error(ctrl_c), ["read"])
-    if ctrl_c:
+    from stochpound._signals import handling
+
+    with handling(sigint):
+        result = CliRunner().invoke(_group_with_a_library_that_turns_ctrl_c_into_its_error(ctrl_c), ["read"])
+        assert signal.getsignal(signal.SIGINT) is sigint
+    if ctrl_c and sigint is signal.default_int_handler:
         assert (result.exit_code, result.stderr) == (130, "interrupted\n"), result.output
     else:
         assert result.exit_code == 1 and result.stderr == "Error: NetCDF: HDF error\n", result.output
