@@ -24,6 +24,8 @@ def test_the_curve_is_the_rate_times_the_scenarios_lognormal_exceedance(measure:
     k = np.array([-2.0, -1.0, 0.5, 1.0, 2.0, 3.0, 1.0137, 2.4711])  # the last two between the table's intensities
     np.testing.assert_allclose(curve(median * np.exp(k * sigma)), RATE * ndtr(-k), rtol=2e-3)
     assert "M 7 at 20 km" in curve.source and curve.units == "g"
+    assert curve.measure == ("PGA" if period is None else f"PSA({period:g} s)")
+    assert scenario_hazard("sa_avg", [0.5, 1.0, 4.0], **SCENARIO, rate=RATE).measure == "Sa_avg(0.5-4 s)"
 
 
 def test_the_scenarios_distribution_is_the_conditional_spectrums_own() -> None:

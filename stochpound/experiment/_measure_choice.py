@@ -19,6 +19,7 @@ import pandas as pd
 
 from stochpound.experiment._grid import Experiment
 from stochpound.experiment._site import periods_of_interest
+from stochpound.motions import measure_label
 
 
 def hazard_measures(store: Any, hazard: str | None = None) -> dict[str, float | None]:
@@ -35,14 +36,12 @@ def hazard_measures(store: Any, hazard: str | None = None) -> dict[str, float | 
     else:
         intensity = store.pound.intensity or {}
         measures = [intensity] if intensity.get("measure") in ("pga", "psa") else []
-    return {measure_label(m): (None if m["measure"] == "pga" else float(m["period"])) for m in measures}
+    return {_entry_label(m): (None if m["measure"] == "pga" else float(m["period"])) for m in measures}
 
 
-def measure_label(entry: Mapping[str, Any]) -> str:
-    """A measure's short name from its ``[intensity]``-like entry: ``PGA``, ``PSA(1 s)``; other measures by their key (``PGV``)."""
-    if entry.get("measure") == "psa":
-        return f"PSA({float(entry['period']):g} s)"
-    return str(entry.get("measure", "")).upper()
+def _entry_label(entry: Mapping[str, Any]) -> str:
+    """The short name (``stochpound.motions.measure_label``) of an ``[intensity]``-like entry's measure; "" for none."""
+    return measure_label(str(entry.get("measure", "")), entry.get("period", entry.get("periods")))
 
 
 def measure_choice(store: Any, hazard: str | None = None) -> pd.DataFrame:
@@ -63,7 +62,7 @@ def measure_choice(store: Any, hazard: str | None = None) -> pd.DataFrame:
         words), a column per hazard measure (β), ``most efficient`` (among
         them; "" when the hazard has none), ``best candidate`` and ``best β``.
         Its ``attrs``: ``hazard_measures`` (those columns' names) and
-        ``store_measure`` (the store's own measure, named alike: :func:`measure_label`).
+        ``store_measure`` (the store's own measure, named alike: ``stochpound.motions.measure_label``).
     """
     from stochpound.risk import measure_efficiency
 
@@ -87,7 +86,7 @@ def measure_choice(store: Any, hazard: str | None = None) -> pd.DataFrame:
         rows.append(row)
     frame = pd.DataFrame(rows)
     frame.attrs["hazard_measures"] = list(available)
-    frame.attrs["store_measure"] = measure_label(store.pound.intensity or {})
+    frame.attrs["store_measure"] = _entry_label(store.pound.intensity or {})
     return frame
 
 

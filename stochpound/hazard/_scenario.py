@@ -28,7 +28,7 @@ import numpy as np
 from scipy.special import ndtr
 
 from stochpound.hazard._curve import HazardCurve
-from stochpound.motions import scenario_distribution
+from stochpound.motions import measure_label, scenario_distribution
 
 #: ε of the table's first and last intensities (standard deviations of ln IM from the scenario's median).
 EPSILON_RANGE = (-4.0, 6.0)
@@ -66,8 +66,7 @@ def scenario_hazard(measure: str, period: float | Sequence[float] | None = None,
         raise ValueError(f"rate: must be a finite annual rate > 0 (1/yr), got {rate!r}")
     median, sigma = scenario_distribution(measure, period, magnitude=magnitude, distance_km=distance_km, vs30=vs30, mechanism=mechanism)
     epsilon = np.linspace(*EPSILON_RANGE, TABLE_POINTS)
-    label = "PGA" if measure == "pga" else f"{measure.upper()}({' '.join(f'{p:g}' for p in np.atleast_1d(period))} s)"
     source = (f"one scenario, M {magnitude:g} at {distance_km:g} km, Vs30 {vs30:g} m/s, {mechanism.replace('_', '-')}, "
               f"{rate:g} per year; NGA-West2 average (pygmm)")
-    return HazardCurve(median * np.exp(sigma * epsilon), rate * ndtr(-epsilon), extrapolate=extrapolate, measure=label, units="g",
+    return HazardCurve(median * np.exp(sigma * epsilon), rate * ndtr(-epsilon), extrapolate=extrapolate, measure=measure_label(measure, period), units="g",
                        source=source)

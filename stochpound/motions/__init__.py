@@ -54,6 +54,7 @@ from stochpound.motions._synthetic import PSD_CONVENTION, clough_penzien, kanai_
 # For the other packages of stochpound (their interface to this one, not public API: not in __all__).
 from stochpound.motions._arias import DEFAULT_G, arias_intensity  # noqa: F401
 from stochpound.motions._conditional import CONDITIONING_MEASURES, MODEL_DAMPING, PERIOD_RANGE, check_scenario  # noqa: F401
+from stochpound.motions._measures import measure_label  # noqa: F401
 
 __all__ = [
     "ENVELOPES",

@@ -46,6 +46,7 @@ from scipy.special import ndtr
 
 from stochpound._errors import SiteError
 from stochpound.motions._conditional import CONDITIONING_MEASURES, PGA_PERIOD, _average_model, check_scenario
+from stochpound.motions._measures import measure_label
 
 #: Candidate magnitudes of the fit.
 MAGNITUDES = tuple(np.round(np.arange(5.5, 8.01, 0.1), 2))
@@ -70,10 +71,6 @@ def fit_levels(levels: Sequence[float], highest: float = np.inf, lowest: float =
     """
     x = np.sort(np.asarray(levels, dtype=float))
     return np.geomspace(min(max(x[0] / SPAN, lowest * LOW_MARGIN), x[0]), max(min(x[-1] * SPAN, highest), x[-1]), FINE_LEVELS)
-
-
-def _node_label(node: float | None) -> str:
-    return "PGA" if node is None else f"PSA({node:g} s)"
 
 
 def fit_scenarios(
@@ -138,7 +135,7 @@ def fit_scenarios(
         im, rate = np.asarray(im, dtype=float), np.asarray(rate, dtype=float)
         keep = (rate >= low_rate) & (rate <= high_rate)
         if not keep.any():
-            raise SiteError(f"others: the site's {_node_label(node)} curve has no intensity whose rate is within the stripes' {low_rate:.3g}-{high_rate:.3g}/yr")
+            raise SiteError(f"others: the site's {measure_label('pga' if node is None else 'psa', node)} curve has no intensity whose rate is within the stripes' {low_rate:.3g}-{high_rate:.3g}/yr")
         targets.append((im[keep], np.log(rate[keep])))
     candidates = [(m, r) for m in MAGNITUDES for r in DISTANCES]
     scores = []

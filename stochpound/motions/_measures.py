@@ -20,6 +20,7 @@ A motion scaled by λ has every measure scaled by abs(λ), I_a by λ², D5–95 
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -35,6 +36,17 @@ if TYPE_CHECKING:
 
 #: Fractions of the Arias intensity that bound the significant duration.
 SIGNIFICANT_FRACTIONS = (0.05, 0.95)
+
+
+def measure_label(measure: str, period: float | Sequence[float] | None = None) -> str:
+    """A measure's short name: ``PGA``, ``PSA(1 s)``, ``Sa_avg(0.5-4 s)`` (its first and last periods); others by their key in
+    capitals (``PGV``)."""
+    if measure == "psa":
+        return f"PSA({float(period):g} s)"
+    if measure == "sa_avg":
+        periods = np.atleast_1d(np.asarray(period, dtype=float))
+        return f"Sa_avg({periods[0]:g}-{periods[-1]:g} s)"
+    return measure.upper()
 
 
 def peak_ground_motion(acceleration: np.ndarray, dt: float) -> tuple[float, float, float]:

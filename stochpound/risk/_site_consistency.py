@@ -16,12 +16,10 @@ import numpy as np
 import xarray as xr
 
 from stochpound.hazard import HazardCurve, bundled_measure, bundled_site_curves, hazard_consistency, rate_from_probability
+from stochpound.motions import measure_label
 from stochpound.risk._efficiency import _interpolated
 from stochpound.risk._maf import TARGETS
 from stochpound.risk._store import stripe_spectra_runs
-
-def _label(measure: dict[str, float | str]) -> str:
-    return "PGA" if measure["measure"] == "pga" else f"PSA({float(measure['period']):g} s)"
 
 
 def site_consistency(store: xr.Dataset) -> dict[str, xr.Dataset]:
@@ -53,7 +51,7 @@ def site_consistency(store: xr.Dataset) -> dict[str, xr.Dataset]:
         else:
             unscaled = _interpolated(runs["psa"], runs["spectrum_periods"], [float(measure["period"])]).isel(period=0, drop=True)
         spectra = (unscaled / runs["g"] * runs["scale_factor"]).transpose("intensity", "record")
-        results[_label(measure)] = hazard_consistency(spectra, runs["hazard"], HazardCurve.bundled(name))
+        results[measure_label(str(measure["measure"]), measure.get("period"))] = hazard_consistency(spectra, runs["hazard"], HazardCurve.bundled(name))
     return results
 
 
