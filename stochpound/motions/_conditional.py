@@ -160,10 +160,10 @@ def _conditioning_nodes(measure: str, period: float | Sequence[float] | None) ->
     return list(_check_periods(period, "period"))
 
 
-def _joint_model(measure: str, period: float | Sequence[float] | None, output: Sequence[float], magnitude: float, distance_km: float,
-                 vs30: float, mechanism: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """ln Sa at the ``output`` periods followed by the measure's own nodes: mean μ, covariance C and the measure's weights w."""
-    conditioning = _conditioning_nodes(measure, period)
+def _joint_model(conditioning: Sequence[float | None], output: Sequence[float], magnitude: float, distance_km: float, vs30: float,
+                 mechanism: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """ln Sa at the ``output`` periods followed by the measure's own nodes (``conditioning``, :func:`_conditioning_nodes`): mean μ,
+    covariance C and the measure's weights w."""
     check_scenario(magnitude, distance_km, vs30, mechanism)
     from pygmm.baker_jayaram_2008 import calc_correls
 
@@ -209,7 +209,7 @@ def scenario_distribution(measure: str, period: float | Sequence[float] | None =
     SiteError
         Naming the field, as :func:`conditional_spectrum`.
     """
-    mean, covariance, weights = _joint_model(measure, period, [], magnitude, distance_km, vs30, mechanism)
+    mean, covariance, weights = _joint_model(_conditioning_nodes(measure, period), [], magnitude, distance_km, vs30, mechanism)
     return float(np.exp(weights @ mean)), float(np.sqrt(weights @ covariance @ weights))
 
 
@@ -224,13 +224,13 @@ def conditional_distribution(
     mechanism: str,
 ) -> ConditionalDistribution:
     """ln Sa (g) at ``periods`` given the measure = ``level`` (module docstring), after checking every input."""
-    _conditioning_nodes(measure, period)
+    conditioning = _conditioning_nodes(measure, period)
     if not isinstance(level, (int, float)) or isinstance(level, bool) or not np.isfinite(level) or level <= 0:
         raise SiteError(f"level: must be > 0 (g), got {level!r}")
     output = _check_periods(periods, "periods")
     if np.unique(output).size != output.size:
         raise SiteError("periods: repeated period")
-    mean, covariance, weights = _joint_model(measure, period, list(output), magnitude, distance_km, vs30, mechanism)
+    mean, covariance, weights = _joint_model(conditioning, list(output), magnitude, distance_km, vs30, mechanism)
     sigma = np.sqrt(np.diag(covariance))
     cw = covariance @ weights
     variance = float(weights @ cw)
