@@ -578,3 +578,53 @@ def test_an_error_raised_after_a_ctrl_c_is_the_ctrl_c(ctrl_c, sigint):
         assert (result.exit_code, result.stderr) == (130, "interrupted\n"), result.output
     else:
         assert result.exit_code == 1 and result.stderr == "Error: NetCDF: HDF error\n", result.output
+
+
+class _FileHandle:
+    """An object whose finaliser meets the Ctrl-C (as a netCDF file or a figure closed by the garbage collector may)."""
+
+    def __del__(self) -> None:
+        os.kill(os.getpid(), signal.SIGINT)
+        time.sleep(0.5)  # Python's handler raises here, in the finaliser: Python prints "Exception ignored" and goes on
+
+
+def _group_whose_ctrl_c_never_reaches_the_command(where: str):
+    """A command group whose command returns normally although a Ctrl-C came: it was caught by a library, or in a finaliser."""
+    import click
+
+    from stochpound.cli._group import HelpGroup
+
+    @click.group(cls=HelpGroup)
+    def group() -> None:
+        """A group."""
+
+    @group.command()
+    def read() -> None:
+        """Read a file."""
+        if where == "library":
+            try:
+                os.kill(os.getpid(), signal.SIGINT)
+                time.sleep(0.5)
+            except KeyboardInterrupt:
+                pass
+        else:
+            _FileHandle()
+        click.echo("read")
+
+    return group
+
+
+@pytest.mark.parametrize("where", ["library", "finaliser"])
+def test_a_ctrl_c_that_never_reaches_the_command_still_ends_it(where):
+    """What made `report build` now and then exit 0 after a Ctrl-C (the last CI run on a clone failed on it): the
+    KeyboardInterrupt was raised in a finaliser, which Python reports as 'Exception ignored' with a traceback and goes on,
+    or caught by a library. The command still ends as interrupted (130), with no traceback."""
+    from click.testing import CliRunner
+
+    from stochpound._signals import handling
+
+    hook = sys.unraisablehook
+    with handling(signal.default_int_handler):
+        result = CliRunner().invoke(_group_whose_ctrl_c_never_reaches_the_command(where), ["read"])
+    assert (result.exit_code, result.stderr) == (130, "interrupted\n"), (result.exit_code, result.stderr)
+    assert sys.unraisablehook is hook

@@ -34,19 +34,26 @@ class HelpGroup(click.Group):
 
         Also when a library turned the Ctrl-C's KeyboardInterrupt into an
         error of its own (an HDF5 or netCDF read cut short fails with its
-        message instead): an error raised after a Ctrl-C is the Ctrl-C.
+        message instead): an error raised after a Ctrl-C is the Ctrl-C. And
+        when the KeyboardInterrupt never reached the command: raised inside a
+        finaliser (``__del__``, a weakref callback), where Python prints it as
+        "Exception ignored" and goes on, or caught by a library; the command
+        then ends as interrupted when it returns.
         """
         from stochpound.cli import interrupted
 
         with _noting_ctrl_c() as ctrl_c:
             try:
-                return super().invoke(ctx)
+                result = super().invoke(ctx)
             except KeyboardInterrupt:
                 interrupted()
             except Exception:
                 if ctrl_c:
                     interrupted()
                 raise
+            if ctrl_c:
+                interrupted()
+            return result
 
     def format_commands(self, ctx: click.Context, formatter: click.HelpFormatter) -> None:
         """The ``Commands:`` section, each command's first sentence whole."""
@@ -66,7 +73,9 @@ def _noting_ctrl_c() -> Iterator[list[int]]:
 
     Only where SIGINT has Python's own handler: ignored (a job started in the
     background) or handled otherwise, it stays so, and nothing is noted;
-    nor outside the main thread (no signal handlers there).
+    nor outside the main thread (no signal handlers there). A KeyboardInterrupt
+    raised in a finaliser is not printed as "Exception ignored" with its
+    traceback: it is noted, and the command ends as interrupted.
     """
     noted: list[int] = []
     if signal.getsignal(signal.SIGINT) is not signal.default_int_handler:
@@ -77,5 +86,15 @@ def _noting_ctrl_c() -> Iterator[list[int]]:
         noted.append(signum)
         signal.default_int_handler(signum, frame)
 
-    with handling(handler):
-        yield noted
+    printing_unraisable = sys.unraisablehook
+
+    def unraisable(report: Any) -> None:
+        if not (noted and report.exc_type is KeyboardInterrupt):
+            printing_unraisable(report)
+
+    sys.unraisablehook = unraisable
+    try:
+        with handling(handler):
+            yield noted
+    finally:
+        sys.unraisablehook = printing_unraisable
