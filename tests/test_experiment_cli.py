@@ -11,6 +11,7 @@ import signal
 import stat
 import subprocess
 import sys
+import textwrap
 import time
 from collections.abc import Iterator
 
@@ -628,3 +629,27 @@ def test_a_ctrl_c_that_never_reaches_the_command_still_ends_it(where):
         result = CliRunner().invoke(_group_whose_ctrl_c_never_reaches_the_command(where), ["read"])
     assert (result.exit_code, result.stderr) == (130, "interrupted\n"), (result.exit_code, result.stderr)
     assert sys.unraisablehook is hook
+
+
+def test_a_ctrl_c_swallowed_while_the_commands_load_still_ends_the_process():
+    """The same while click and the command modules load (`stochpound.cli._load`): a KeyboardInterrupt raised in a
+    finaliser meanwhile ends the process as interrupted (130) before any command starts, with no traceback."""
+    script = textwrap.dedent("""
+        import os, signal, time
+        import stochpound.cli as cli
+
+        class FileHandle:
+            def __del__(self):
+                os.kill(os.getpid(), signal.SIGINT)
+                time.sleep(0.5)
+
+        def build():
+            FileHandle()
+            return "the group"
+
+        cli._build = build
+        print(cli._load())
+    """)
+    result = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120,
+                            env={**os.environ, "PYTHONPATH": str(REPO)})
+    assert (result.returncode, result.stdout, result.stderr) == (130, "", "interrupted\n"), result

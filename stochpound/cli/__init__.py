@@ -8,7 +8,7 @@ runs (:class:`~stochpound.cli._group.HelpGroup`).
 
 import os
 import sys
-from typing import NoReturn
+from typing import Any, NoReturn
 
 INTERRUPTED = 130
 """Exit status of a command stopped by Ctrl-C (128 + SIGINT), as shells report it."""
@@ -29,24 +29,19 @@ def interrupted(loading: bool = False) -> NoReturn:
     raise SystemExit(INTERRUPTED)
 
 
-try:
+def _build() -> Any:
+    """The ``stochpound`` command group with its commands (this loads click and the command modules)."""
     import click
 
     from stochpound import __version__
     from stochpound.cli._group import HelpGroup
-except KeyboardInterrupt:
-    interrupted(loading=True)
 
+    @click.group(cls=HelpGroup, context_settings={"help_option_names": ["-h", "--help"]})
+    @click.version_option(__version__, prog_name="stochpound")
+    def main() -> None:
+        """Stochastic analysis of earthquake pounding between adjacent buildings."""
 
-@click.group(cls=HelpGroup, context_settings={"help_option_names": ["-h", "--help"]})
-@click.version_option(__version__, prog_name="stochpound")
-def main() -> None:
-    """Stochastic analysis of earthquake pounding between adjacent buildings."""
-
-
-def _register() -> None:
     from stochpound.cli._simulate import simulate
-
     main.add_command(simulate)
     from stochpound.cli._records import records
     main.add_command(records)
@@ -56,9 +51,22 @@ def _register() -> None:
     main.add_command(report)
     from stochpound.cli._risk import risk
     main.add_command(risk)
+    return main
 
 
-try:
-    _register()
-except KeyboardInterrupt:
-    interrupted(loading=True)
+def _load() -> Any:
+    """:func:`_build`, ended as interrupted by a Ctrl-C meanwhile: also one a library or a finaliser swallowed."""
+    try:
+        from stochpound._signals import noting_ctrl_c
+
+        with noting_ctrl_c() as ctrl_c:
+            group = _build()
+    except KeyboardInterrupt:
+        interrupted(loading=True)
+    if ctrl_c:
+        interrupted(loading=True)
+    return group
+
+
+main = _load()
+"""The ``stochpound`` command (``python -m stochpound``, the ``stochpound`` script)."""

@@ -2,15 +2,11 @@
 
 from __future__ import annotations
 
-import signal
 import sys
-from collections.abc import Iterator
-from contextlib import contextmanager
-from typing import Any
 
 import click
 
-from stochpound._signals import handling
+from stochpound._signals import noting_ctrl_c
 
 
 class HelpGroup(click.Group):
@@ -42,7 +38,7 @@ class HelpGroup(click.Group):
         """
         from stochpound.cli import interrupted
 
-        with _noting_ctrl_c() as ctrl_c:
+        with noting_ctrl_c() as ctrl_c:
             try:
                 result = super().invoke(ctx)
             except KeyboardInterrupt:
@@ -65,36 +61,3 @@ class HelpGroup(click.Group):
         if rows:
             with formatter.section("Commands"):
                 formatter.write_dl(rows)
-
-
-@contextmanager
-def _noting_ctrl_c() -> Iterator[list[int]]:
-    """Inside the block, SIGINT raises KeyboardInterrupt as Python's own handler does, and is noted in the list yielded.
-
-    Only where SIGINT has Python's own handler: ignored (a job started in the
-    background) or handled otherwise, it stays so, and nothing is noted;
-    nor outside the main thread (no signal handlers there). A KeyboardInterrupt
-    raised in a finaliser is not printed as "Exception ignored" with its
-    traceback: it is noted, and the command ends as interrupted.
-    """
-    noted: list[int] = []
-    if signal.getsignal(signal.SIGINT) is not signal.default_int_handler:
-        yield noted
-        return
-
-    def handler(signum: int, frame: Any) -> None:
-        noted.append(signum)
-        signal.default_int_handler(signum, frame)
-
-    printing_unraisable = sys.unraisablehook
-
-    def unraisable(report: Any) -> None:
-        if not (noted and report.exc_type is KeyboardInterrupt):
-            printing_unraisable(report)
-
-    sys.unraisablehook = unraisable
-    try:
-        with handling(handler):
-            yield noted
-    finally:
-        sys.unraisablehook = printing_unraisable
