@@ -633,9 +633,11 @@ def test_a_ctrl_c_that_never_reaches_the_command_still_ends_it(where):
 
 def test_a_ctrl_c_swallowed_while_the_commands_load_still_ends_the_process():
     """The same while click and the command modules load (`stochpound.cli._load`): a KeyboardInterrupt raised in a
-    finaliser meanwhile ends the process as interrupted (130) before any command starts, with no traceback."""
+    finaliser meanwhile ends the process as interrupted (130) before any command starts, with no traceback. The script sets
+    Python's own SIGINT handler: a process started with SIGINT ignored (a background job's) rightly leaves it so."""
     script = textwrap.dedent("""
         import os, signal, time
+        signal.signal(signal.SIGINT, signal.default_int_handler)
         import stochpound.cli as cli
 
         class FileHandle:
