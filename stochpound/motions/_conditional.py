@@ -160,13 +160,9 @@ def _conditioning_nodes(measure: str, period: float | Sequence[float] | None) ->
     return list(_check_periods(period, "period"))
 
 
-def _joint_model(conditioning: Sequence[float | None], output: Sequence[float], magnitude: float, distance_km: float, vs30: float,
-                 mechanism: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """ln Sa at the ``output`` periods followed by the measure's own nodes (``conditioning``, :func:`_conditioning_nodes`): mean μ,
-    covariance C and the measure's weights w."""
-    check_scenario(magnitude, distance_km, vs30, mechanism)
-    from pygmm.baker_jayaram_2008 import calc_correls
-
+def _joint_nodes(conditioning: Sequence[float | None], output: Sequence[float | None]) -> tuple[list[float | None], np.ndarray]:
+    """The joint model's nodes, the ``output`` ones followed by the measure's own (``conditioning``, :func:`_conditioning_nodes`)
+    not among them, and the measure's weights w over those nodes."""
     nodes: list[float | None] = list(output)
     weights = np.zeros(len(nodes) + len(conditioning))
     for node in conditioning:
@@ -175,11 +171,35 @@ def _joint_model(conditioning: Sequence[float | None], output: Sequence[float], 
             nodes.append(node)
             index = len(nodes) - 1
         weights[index] += 1.0 / len(conditioning)
-    weights = weights[: len(nodes)]
-    mean, sigma = _average_model(nodes, magnitude, distance_km, vs30, mechanism)
+    return nodes, weights[: len(nodes)]
+
+
+def _node_correlation(nodes: Sequence[float | None]) -> np.ndarray:
+    """ρ of ln Sa between every two nodes (Baker & Jayaram 2008; PGA at :data:`PGA_PERIOD`)."""
+    from pygmm.baker_jayaram_2008 import calc_correls
+
     at = np.array([PGA_PERIOD if node is None else node for node in nodes])
-    correlation = np.array([calc_correls(at, t) for t in at])
-    return mean, correlation * np.outer(sigma, sigma), weights
+    return np.array([calc_correls(at, t) for t in at])
+
+
+def _joint_model(conditioning: Sequence[float | None], output: Sequence[float | None], magnitude: float, distance_km: float,
+                 vs30: float, mechanism: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """ln Sa at the nodes of :func:`_joint_nodes` in a scenario: mean μ, covariance C and the measure's weights w."""
+    check_scenario(magnitude, distance_km, vs30, mechanism)
+    nodes, weights = _joint_nodes(conditioning, output)
+    mean, sigma = _average_model(nodes, magnitude, distance_km, vs30, mechanism)
+    return mean, _node_correlation(nodes) * np.outer(sigma, sigma), weights
+
+
+def _conditioned(mean: np.ndarray, covariance: np.ndarray, weights: np.ndarray,
+                 ln_levels: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Given wᵀx = ln x_j for each level j (module docstring): the conditional mean [level, node], the conditional
+    covariance [node, node] and ε* [level]."""
+    cw = covariance @ weights
+    variance = float(weights @ cw)
+    epsilon = (np.asarray(ln_levels, dtype=float) - float(weights @ mean)) / np.sqrt(variance)
+    conditional_mean = mean[None, :] + np.outer(epsilon, cw) / np.sqrt(variance)
+    return conditional_mean, covariance - np.outer(cw, cw) / variance, epsilon
 
 
 def scenario_distribution(measure: str, period: float | Sequence[float] | None = None, *, magnitude: float, distance_km: float,
@@ -232,13 +252,9 @@ def conditional_distribution(
         raise SiteError("periods: repeated period")
     mean, covariance, weights = _joint_model(conditioning, list(output), magnitude, distance_km, vs30, mechanism)
     sigma = np.sqrt(np.diag(covariance))
-    cw = covariance @ weights
-    variance = float(weights @ cw)
-    epsilon = (np.log(level) - float(weights @ mean)) / np.sqrt(variance)
+    conditional_mean, conditional_cov, epsilon = _conditioned(mean, covariance, weights, np.log([level]))
     n = output.size
-    conditional_mean = (mean + cw * epsilon / np.sqrt(variance))[:n]
-    conditional_cov = (covariance - np.outer(cw, cw) / variance)[:n, :n]
-    return ConditionalDistribution(output, conditional_mean, conditional_cov, mean[:n], sigma[:n], float(epsilon))
+    return ConditionalDistribution(output, conditional_mean[0, :n], conditional_cov[:n, :n], mean[:n], sigma[:n], float(epsilon[0]))
 
 
 def conditional_spectrum(

@@ -45,7 +45,15 @@ import numpy as np
 from scipy.special import ndtr
 
 from stochpound._errors import SiteError
-from stochpound.motions._conditional import CONDITIONING_MEASURES, PGA_PERIOD, _average_model, check_scenario
+from stochpound.motions._conditional import (
+    CONDITIONING_MEASURES,
+    _average_model,
+    _conditioned,
+    _conditioning_nodes,
+    _joint_nodes,
+    _node_correlation,
+    check_scenario,
+)
 from stochpound.motions._measures import measure_label
 
 #: Candidate magnitudes of the fit.
@@ -151,30 +159,24 @@ def fit_scenarios(
 
 
 class _SiteModel:
-    """The average NGA-West2 model at the other curves' periods and the conditioning one, for the stripes' levels."""
+    """The average NGA-West2 model at the other curves' periods and the conditioning one, for the stripes' levels.
+
+    The nodes and their correlation are those of the conditional spectrum
+    (:mod:`stochpound.motions._conditional`), computed once for every scenario the fit tries.
+    """
 
     def __init__(self, measure: str, period: float | Sequence[float] | None, levels: np.ndarray,
                  others: Sequence[tuple[float | None, Sequence[float], Sequence[float]]], vs30: float, mechanism: str) -> None:
-        from pygmm.baker_jayaram_2008 import calc_correls
-
-        conditioning: list[float | None] = [None] if measure == "pga" else [float(p) for p in np.atleast_1d(period)]
         other_nodes = [None if node is None else float(node) for node, _, _ in others]
-        self.nodes = other_nodes + conditioning
-        self.weights = np.zeros(len(self.nodes))
-        self.weights[len(other_nodes) :] = 1.0 / len(conditioning)
-        at = np.array([PGA_PERIOD if node is None else node for node in self.nodes])
-        self.correlation = np.array([calc_correls(at, t) for t in at])
+        self.nodes, self.weights = _joint_nodes(_conditioning_nodes(measure, period), other_nodes)
+        self.correlation = _node_correlation(self.nodes)
         self.levels, self.vs30, self.mechanism, self.count = levels, vs30, mechanism, len(other_nodes)
 
     def exceedance(self, magnitude: float, distance_km: float, intensities: Sequence[np.ndarray]) -> list[list[np.ndarray]]:
         """P(Sa(T'_k) > y | IM* = x_j) of the scenario, [level j][other curve k] over that curve's ``intensities`` (g)."""
         mean, sigma = _average_model(self.nodes, magnitude, distance_km, self.vs30, self.mechanism)
-        covariance = self.correlation * np.outer(sigma, sigma)
-        cw = covariance @ self.weights
-        variance = float(self.weights @ cw)
-        epsilon = (np.log(self.levels) - float(self.weights @ mean)) / np.sqrt(variance)
-        cond_mean = mean[None, :] + np.outer(epsilon, cw) / np.sqrt(variance)
-        cond_sd = np.sqrt(np.clip(np.diag(covariance) - cw**2 / variance, 1e-12, None))
+        cond_mean, cond_cov, _ = _conditioned(mean, self.correlation * np.outer(sigma, sigma), self.weights, np.log(self.levels))
+        cond_sd = np.sqrt(np.clip(np.diag(cond_cov), 1e-12, None))
         return [[ndtr((cond_mean[j, k] - np.log(y)) / cond_sd[k]) for k, y in enumerate(intensities)] for j in range(self.levels.size)]
 
 
