@@ -130,6 +130,7 @@ def scenario_site(magnitude: float, distance_km: float, mechanism: str, rate: fl
         kind, period = MEASURE_ARGS[measure]
         return scenario_hazard(kind, period, magnitude=magnitude, distance_km=distance_km, vs30=vs30, mechanism=mechanism, rate=rate)
 
+    hazard(next(iter(MEASURE_ARGS)))  # the scenario and the rate checked (SiteError, ValueError naming the field) before they are used
     table = f'[site]\nmagnitude = {magnitude}\ndistance_km = {distance_km}\nvs30 = {vs30}\nmechanism = "{mechanism}"\n'
     lowest = 1.5 / rate
     return Site("scenario", hazard, table, np.unique(np.r_[lowest, RETURN_PERIODS[RETURN_PERIODS > lowest], 10000.0]), tuple(MEASURE_ARGS))
@@ -241,6 +242,20 @@ def _subfolder(folder: Path, name: str) -> Path:
     return folder / name
 
 
+def _scenario_site(parser: argparse.ArgumentParser, values: list[str]) -> Site:
+    """The site of ``--scenario M R_KM MECHANISM RATE``; a bad value ends the run with a one-line usage error naming it."""
+    from stochpound import SiteError
+
+    try:
+        magnitude, distance_km, rate = float(values[0]), float(values[1]), float(values[3])
+    except ValueError:
+        parser.error(f"--scenario: M, R_KM and RATE must be numbers, got {' '.join(values)}")
+    try:
+        return scenario_site(magnitude, distance_km, values[2], rate)
+    except (SiteError, ValueError) as error:
+        parser.error(f"--scenario: {error}")
+
+
 def main(argv: list[str] | None = None) -> None:
     """Run, print the table, draw the figure."""
     from matplotlib.figure import Figure
@@ -257,8 +272,7 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--scenario", nargs=4, metavar=("M", "R_KM", "MECHANISM", "RATE"), default=list(SCENARIO),
                         help="--site scenario's magnitude, rupture distance (km), mechanism and annual rate (default %(default)s)")
     args = parser.parse_args(argv)
-    args.site = FOX_PLAZA if args.site == "fox_plaza" else scenario_site(float(args.scenario[0]), float(args.scenario[1]), args.scenario[2],
-                                                                        float(args.scenario[3]))
+    args.site = FOX_PLAZA if args.site == "fox_plaza" else _scenario_site(parser, args.scenario)
     args.return_periods = args.site.return_periods if args.return_periods is None else np.asarray(args.return_periods, dtype=float)
     args.measures = list(args.site.measures) if args.measures is None else args.measures
     if not set(args.measures) <= set(args.site.measures):

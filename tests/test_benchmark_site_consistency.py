@@ -77,3 +77,16 @@ def test_the_selection_benchmarks_lognormal_recomputation_agrees_with_the_counts
     np.testing.assert_allclose(lognormal[resolved], counted[resolved], rtol=0.05)
     beyond = other.im > np.nanmax(values)
     assert beyond.any() and np.all(counted[beyond] == 0) and np.all(lognormal[beyond] > 0)
+
+
+@pytest.mark.parametrize(("scenario", "message"), [
+    (["7.5", "x", "strike_slip", "0.01"], "--scenario: M, R_KM and RATE must be numbers, got 7.5 x strike_slip 0.01"),
+    (["7.5", "10", "sideways", "0.01"], "--scenario: mechanism: must be one of strike_slip, reverse, normal, got 'sideways'"),
+    (["7.5", "10", "strike_slip", "0"], "--scenario: rate: must be a finite annual rate > 0 (1/yr), got 0.0"),
+])  # fmt: skip
+def test_a_bad_scenario_is_a_one_line_usage_error(capsys, scenario: list[str], message: str) -> None:
+    from benchmarks.site_consistency import main
+
+    with pytest.raises(SystemExit) as stopped:
+        main(["--site", "scenario", "--scenario", *scenario])
+    assert stopped.value.code == 2 and capsys.readouterr().err.strip().splitlines()[-1].endswith(f"error: {message}")
