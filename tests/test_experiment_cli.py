@@ -631,12 +631,15 @@ def test_a_ctrl_c_that_never_reaches_the_command_still_ends_it(where):
     assert sys.unraisablehook is hook
 
 
-def test_a_ctrl_c_swallowed_while_the_commands_load_still_ends_the_process():
+@pytest.mark.parametrize("where", ["finaliser", "extension"])
+def test_a_ctrl_c_swallowed_while_the_commands_load_still_ends_the_process(where):
     """The same while click and the command modules load (`stochpound.cli._load`): a KeyboardInterrupt raised in a
-    finaliser meanwhile ends the process as interrupted (130) before any command starts, with no traceback. The script sets
-    Python's own SIGINT handler: a process started with SIGINT ignored (a background job's) rightly leaves it so."""
+    finaliser meanwhile, or one that an extension module's import turned into 'ImportError: initialization failed' (a
+    run under load printed that traceback), ends the process as interrupted (130) before any command starts, with no
+    traceback. The script sets Python's own SIGINT handler: a process started with SIGINT ignored (a background job's)
+    rightly leaves it so."""
     script = textwrap.dedent("""
-        import os, signal, time
+        import os, signal, sys, time
         signal.signal(signal.SIGINT, signal.default_int_handler)
         import stochpound.cli as cli
 
@@ -646,12 +649,18 @@ def test_a_ctrl_c_swallowed_while_the_commands_load_still_ends_the_process():
                 time.sleep(0.5)
 
         def build():
-            FileHandle()
-            return "the group"
+            if sys.argv[1] == "finaliser":
+                FileHandle()
+                return "the group"
+            try:
+                os.kill(os.getpid(), signal.SIGINT)
+                time.sleep(0.5)
+            except KeyboardInterrupt:
+                raise ImportError("initialization failed") from None
 
         cli._build = build
         print(cli._load())
     """)
-    result = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120,
+    result = subprocess.run([sys.executable, "-c", script, where], capture_output=True, text=True, timeout=120,
                             env={**os.environ, "PYTHONPATH": str(REPO)})
     assert (result.returncode, result.stdout, result.stderr) == (130, "", "interrupted\n"), result

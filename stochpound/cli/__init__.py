@@ -55,7 +55,9 @@ def _build() -> Any:
 
 
 def _load() -> Any:
-    """:func:`_build`, ended as interrupted by a Ctrl-C meanwhile: also one a library or a finaliser swallowed."""
+    """:func:`_build`, ended as interrupted by a Ctrl-C meanwhile: also one a library or a finaliser swallowed, or one
+    that an extension module's import turned into an error (``ImportError: initialization failed``)."""
+    ctrl_c: list[int] = []
     try:
         from stochpound._signals import noting_ctrl_c
 
@@ -63,6 +65,10 @@ def _load() -> Any:
             group = _build()
     except KeyboardInterrupt:
         interrupted(loading=True)
+    except Exception:
+        if ctrl_c:
+            interrupted(loading=True)
+        raise
     if ctrl_c:
         interrupted(loading=True)
     return group
