@@ -29,34 +29,53 @@ def handling(handler: Handler, signals: Sequence[int] = (signal.SIGINT,)) -> Ite
             signal.signal(sig, old)
 
 
+class _NotingCtrlC:
+    """SIGINT's handler inside :func:`noting_ctrl_c`: notes each Ctrl-C, and raises KeyboardInterrupt while ``raising``."""
+
+    def __init__(self, raising: bool) -> None:
+        self.noted: list[int] = []
+        self.raising = raising
+
+    def __call__(self, signum: int, frame: Any) -> None:
+        self.noted.append(signum)
+        if self.raising:
+            signal.default_int_handler(signum, frame)
+
+
 @contextmanager
-def noting_ctrl_c() -> Iterator[list[int]]:
-    """Inside the block, SIGINT raises KeyboardInterrupt as Python's own handler does, and is noted in the list yielded.
+def noting_ctrl_c(raising: bool = True) -> Iterator[list[int]]:
+    """Inside the block, SIGINT is noted in the list yielded and, if ``raising``, raises KeyboardInterrupt as Python's own handler does.
 
     Only where SIGINT has Python's own handler: ignored (a job started in the
     background) or handled otherwise, it stays so, and nothing is noted;
-    nor outside the main thread (no signal handlers there). A KeyboardInterrupt
-    raised in a finaliser is not printed as "Exception ignored" with its
-    traceback: it is noted (the caller ends as interrupted).
+    nor outside the main thread (no signal handlers there). A block inside
+    another shares its list and sets ``raising`` for its length (a command
+    raises; the code around it, which would print its own message, only
+    notes). A KeyboardInterrupt raised in a finaliser is not printed as
+    "Exception ignored" with its traceback: it is noted (the caller ends as
+    interrupted).
     """
-    noted: list[int] = []
-    if signal.getsignal(signal.SIGINT) is not signal.default_int_handler:
-        yield noted
+    current = signal.getsignal(signal.SIGINT)
+    if isinstance(current, _NotingCtrlC):
+        before, current.raising = current.raising, raising
+        try:
+            yield current.noted
+        finally:
+            current.raising = before
         return
-
-    def handler(signum: int, frame: Any) -> None:
-        noted.append(signum)
-        signal.default_int_handler(signum, frame)
-
+    if current is not signal.default_int_handler:
+        yield []
+        return
+    handler = _NotingCtrlC(raising)
     printing_unraisable = sys.unraisablehook
 
     def unraisable(report: Any) -> None:
-        if not (noted and report.exc_type is KeyboardInterrupt):
+        if not (handler.noted and report.exc_type is KeyboardInterrupt):
             printing_unraisable(report)
 
     sys.unraisablehook = unraisable
     try:
         with handling(handler):
-            yield noted
+            yield handler.noted
     finally:
         sys.unraisablehook = printing_unraisable

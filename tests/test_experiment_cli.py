@@ -664,3 +664,44 @@ def test_a_ctrl_c_swallowed_while_the_commands_load_still_ends_the_process(where
     result = subprocess.run([sys.executable, "-c", script, where], capture_output=True, text=True, timeout=120,
                             env={**os.environ, "PYTHONPATH": str(REPO)})
     assert (result.returncode, result.stdout, result.stderr) == (130, "", "interrupted\n"), result
+
+
+def _ctrl_c() -> None:
+    os.kill(os.getpid(), signal.SIGINT)
+    time.sleep(0.5)
+
+
+def _group_with_a_ctrl_c_around_its_command(when: str):
+    """A command group that meets a Ctrl-C while click parses its options (before the command) or closes its context (after)."""
+    import click
+
+    from stochpound.cli._group import HelpGroup
+
+    @click.group(cls=HelpGroup)
+    @click.option("--early", is_flag=True, callback=lambda ctx, param, value: _ctrl_c() if value else None)
+    def group(early: bool) -> None:
+        """A group."""
+        if when == "after":
+            click.get_current_context().call_on_close(_ctrl_c)
+
+    @group.command()
+    def read() -> None:
+        """Read a file."""
+        click.echo("read")
+
+    return group, (["--early", "read"] if when == "before" else ["read"])
+
+
+@pytest.mark.parametrize("when", ["before", "after"])
+def test_a_ctrl_c_just_before_or_after_the_command_ends_it_as_interrupted(when):
+    """click's own main turns a KeyboardInterrupt into 'Aborted!' and status 1 (a sweep of Ctrl-C moments under load met it
+    once): around the command a Ctrl-C is only noted, and the command ends as interrupted (130)."""
+    from click.testing import CliRunner
+
+    from stochpound._signals import handling
+
+    group, args = _group_with_a_ctrl_c_around_its_command(when)
+    with handling(signal.default_int_handler):
+        result = CliRunner().invoke(group, args)
+    assert (result.exit_code, result.stderr) == (130, "interrupted\n"), (result.exit_code, result.output)
+    assert result.stdout == ("" if when == "before" else "read\n")

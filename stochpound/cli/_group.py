@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import sys
+from typing import Any
 
 import click
 
@@ -25,6 +26,25 @@ class HelpGroup(click.Group):
             ctx.exit(0)
         return super().parse_args(ctx, args)
 
+    def main(self, *args: Any, **kwargs: Any) -> Any:
+        """click's ``main``; a Ctrl-C before the command starts or after it ends ends it as interrupted too (:meth:`invoke`).
+
+        Around the command a Ctrl-C is only noted, not raised: click would
+        print "Aborted!" and exit with status 1.
+        """
+        from stochpound.cli import INTERRUPTED, interrupted
+
+        with noting_ctrl_c(raising=False) as ctrl_c:
+            try:
+                result = super().main(*args, **kwargs)
+            except SystemExit as exit:
+                if ctrl_c and exit.code != INTERRUPTED:
+                    interrupted()
+                raise
+            if ctrl_c:
+                interrupted()
+            return result
+
     def invoke(self, ctx: click.Context) -> object:
         """Run the command; a Ctrl-C anywhere in it ends it with exit status 130 and no traceback (click's is 1, "Aborted!").
 
@@ -40,6 +60,8 @@ class HelpGroup(click.Group):
 
         with noting_ctrl_c() as ctrl_c:
             try:
+                if ctrl_c:  # noted before the command started
+                    raise KeyboardInterrupt
                 result = super().invoke(ctx)
             except KeyboardInterrupt:
                 interrupted()
