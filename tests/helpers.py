@@ -29,7 +29,13 @@ import xarray as xr
 import stochpound
 from stochpound.studies.agarwal2004 import reference_building, study_contacts, study_scene
 
-REPO = Path(__file__).resolve().parents[1]
+REPOSITORY = Path(__file__).resolve().parents[1]
+"""The repository's root."""
+PYTHON_WITH_CTRL_C = [sys.executable, "-c", "import os, signal, sys; signal.signal(signal.SIGINT, signal.SIG_DFL); "
+                      "os.execv(sys.executable, [sys.executable, *sys.argv[1:]])"]
+"""The start of a command line that runs this Python with SIGINT at its default, as a terminal's foreground job has it,
+for tests that send a Ctrl-C: a test run started as a background job (``... &``) has SIGINT ignored, which its
+subprocesses inherit, and the command then rightly leaves it ignored."""
 
 #: 2 neighbours x 2 gaps x 2 mu x (El Centro 8 s + 2 Kanai-Tajimi realizations) = 24 cases + 3 references.
 SMALL_EXPERIMENT = """
@@ -97,7 +103,7 @@ buildings = ["B1"]
 """
 
 N_CASES = 27
-QUICKSTART = REPO / "experiments" / "quickstart.toml"
+QUICKSTART = REPOSITORY / "experiments" / "quickstart.toml"
 
 
 def quickstart_cell(motions: str, gap: float = 0.02, mu: float = 0.2, neighbour: str = "flexible") -> str:
@@ -489,8 +495,6 @@ def _random_motion(rng: np.random.Generator, duration: float) -> dict:
 
 # ---------------------------------------------------------------- the risk flagship's scene in small experiments
 
-REPOSITORY = Path(__file__).resolve().parent.parent
-"""The repository's root."""
 MOTIONS = ["01a", "03b", "05a", "07b", "10a", "12a", "14b", "19a"]
 RECORDS = "".join(f'\n[[records]]\nrecord = "fema_p695_far_field/{name}"\nduration = 5.0\n' for name in MOTIONS)
 FLAGSHIP = (REPOSITORY / "experiments" / "risk" / "isolated.toml").read_text()

@@ -21,7 +21,7 @@ import xarray as xr
 from stochpound import open_store
 from stochpound.experiment._parts import part_paths, parts_folder
 from stochpound.experiment._session import PACKAGE, git_commit, sources_sha256
-from tests.helpers import REPO, SMALL_EXPERIMENT, TINY_EXPERIMENT, invoke, quickstart_cell, read_only, write_experiment
+from tests.helpers import PYTHON_WITH_CTRL_C, REPOSITORY, SMALL_EXPERIMENT, TINY_EXPERIMENT, invoke, quickstart_cell, read_only, write_experiment
 
 
 @pytest.mark.slow
@@ -29,7 +29,7 @@ def test_ctrl_c_prints_only_the_message(tmp_path):
     """SIGINT to the whole process group, as a terminal's Ctrl-C: no worker traceback, exit status 130."""
     experiment = write_experiment(tmp_path, SMALL_EXPERIMENT.replace("count = 2", "count = 400"))
     env = {**os.environ, "STOCHPOUND_EXPERIMENT_PART_CASES": "5"}
-    command = [sys.executable, "-m", "stochpound", "experiment", "run", str(experiment), "--workers", "2", "--quiet", "--batch", "4"]
+    command = [*PYTHON_WITH_CTRL_C, "-m", "stochpound", "experiment", "run", str(experiment), "--workers", "2", "--quiet", "--batch", "4"]
     process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env, start_new_session=True)
     deadline = time.monotonic() + 300
     while not part_paths(parts_folder(tmp_path / "small.nc")):
@@ -55,7 +55,7 @@ print("done")
 @pytest.mark.slow
 def test_the_local_workers_error_records_do_not_reach_the_terminal():
     """What made a Ctrl-C print a worker's record now and then: an ERROR of ``distributed.worker`` in a worker process."""
-    result = subprocess.run([sys.executable, "-c", WORKER_ERROR_RECORD], capture_output=True, text=True, timeout=300, cwd=REPO)
+    result = subprocess.run([sys.executable, "-c", WORKER_ERROR_RECORD], capture_output=True, text=True, timeout=300, cwd=REPOSITORY)
     assert (result.returncode, result.stdout, result.stderr) == (0, "done\n", ""), result.stderr
 
 
@@ -118,7 +118,7 @@ def test_an_installed_copy_records_its_version_and_sources(tmp_path):
 
 def test_a_git_checkout_records_its_commit():
     commit = git_commit()
-    if not (REPO / ".git").exists():
+    if not (REPOSITORY / ".git").exists():
         pytest.skip("not a git checkout")
     assert len(commit.split("+")[0]) == 40
 
@@ -245,7 +245,7 @@ def test_a_store_on_a_read_only_disk_can_be_read(stationary, tmp_path, monkeypat
 def test_writing_onto_a_read_only_disk_is_a_one_line_error(stationary, tmp_path, monkeypatch):
     experiment, store = _copy(stationary, tmp_path)
     store.unlink()  # a resume: the store file must be rebuilt from the parts
-    scene = REPO / "experiments" / "scenes" / "study_b1_isolated_flexible.toml"
+    scene = REPOSITORY / "experiments" / "scenes" / "study_b1_isolated_flexible.toml"
     with read_only(store.parent, monkeypatch):
         resume = invoke("experiment", "run", str(experiment), "--workers", "0")
         fresh = invoke("experiment", "run", str(experiment), "--workers", "0", "--store", str(store.parent / "new" / "fresh.nc"))
@@ -277,7 +277,7 @@ def test_a_large_experiment_shows_its_estimate_and_asks_for_yes(tmp_path, monkey
 def test_a_first_run_says_what_it_does_and_ctrl_c_during_the_cluster_start_stops_it(tmp_path):
     """The start-up messages as they happen; SIGINT to the process group while the local cluster starts: exit 130, a readable store."""
     experiment = write_experiment(tmp_path, STATIONARY_EXPERIMENT, "still.toml")
-    command = [sys.executable, "-m", "stochpound", "experiment", "run", str(experiment), "--workers", "2"]
+    command = [*PYTHON_WITH_CTRL_C, "-m", "stochpound", "experiment", "run", str(experiment), "--workers", "2"]
     process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
     lines = []
     for line in process.stderr:
@@ -330,7 +330,7 @@ def test_experiment_error_is_importable_from_the_package():
 
 
 def test_the_readme_plot_example_shows_or_saves_its_figure():
-    text = (REPO / "README.md").read_text()
+    text = (REPOSITORY / "README.md").read_text()
     block = text[text.index("```python\nimport matplotlib.pyplot as plt\nimport stochpound") :]
     block = block[: block.index("```", 3)]
     assert ".plot()" in block and ("plt.savefig(" in block or "plt.show()" in block)
@@ -411,7 +411,7 @@ def test_a_cold_cache_compile_is_said_once_by_the_python_api_and_timed(tmp_path)
 
     code = ("import stochpound\nfrom stochpound.model.scene_file import scene_from_dict\nfrom stochpound.solvers.exact import WARM_UP_SCENE\n"
             "stochpound.simulate(scene_from_dict(WARM_UP_SCENE))\nprint('done')")
-    env = {**os.environ, "PYTHONPATH": str(REPO), "NUMBA_CACHE_DIR": str(tmp_path / "cache")}
+    env = {**os.environ, "PYTHONPATH": str(REPOSITORY), "NUMBA_CACHE_DIR": str(tmp_path / "cache")}
     first, second = (subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=600) for _ in range(2))
     assert first.returncode == 0 and first.stdout == "done\n", first.stderr
     assert first.stderr.startswith("stochpound: compiling the exact solver's engine (numba's cache of it is empty; not yet timed")
@@ -476,7 +476,7 @@ def _fill(disk, leave: int) -> None:
 
 def _stochpound(*args: str, cwd) -> subprocess.CompletedProcess:
     return subprocess.run([sys.executable, "-m", "stochpound", *args], capture_output=True, text=True, cwd=cwd, timeout=600,
-                          env={**os.environ, "PYTHONPATH": str(REPO)})
+                          env={**os.environ, "PYTHONPATH": str(REPOSITORY)})
 
 
 def test_a_really_full_disk_crashes_nothing_and_loses_nothing(stationary, small_disk):
@@ -662,7 +662,7 @@ def test_a_ctrl_c_swallowed_while_the_commands_load_still_ends_the_process(where
         print(cli._load())
     """)
     result = subprocess.run([sys.executable, "-c", script, where], capture_output=True, text=True, timeout=120,
-                            env={**os.environ, "PYTHONPATH": str(REPO)})
+                            env={**os.environ, "PYTHONPATH": str(REPOSITORY)})
     assert (result.returncode, result.stdout, result.stderr) == (130, "", "interrupted\n"), result
 
 

@@ -9,18 +9,18 @@ import pytest
 from nbclient import NotebookClient
 
 from stochpound.experiment import load_experiment, open_store, run_experiment
-from tests.helpers import REPO
+from tests.helpers import REPOSITORY
 
 pytestmark = pytest.mark.slow
 
-NOTEBOOK = REPO / "docs" / "notebooks" / "explore_store.ipynb"
+NOTEBOOK = REPOSITORY / "docs" / "notebooks" / "explore_store.ipynb"
 
 
 @pytest.fixture(scope="module")
 def quickstart_store(tmp_path_factory):
     folder = tmp_path_factory.mktemp("quickstart")
     experiment = folder / "quickstart.toml"
-    shutil.copy(REPO / "experiments" / "quickstart.toml", experiment)
+    shutil.copy(REPOSITORY / "experiments" / "quickstart.toml", experiment)
     report = run_experiment(load_experiment(experiment), workers=0, progress=False)
     assert report.complete and not report.failed
     return report.store

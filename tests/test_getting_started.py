@@ -10,9 +10,9 @@ import matplotlib
 from click.testing import CliRunner
 
 from stochpound.cli import main
-from tests.helpers import REPO
+from tests.helpers import REPOSITORY
 
-PAGE = REPO / "docs" / "getting-started.md"
+PAGE = REPOSITORY / "docs" / "getting-started.md"
 
 
 def blocks(language: str) -> list[str]:
@@ -38,8 +38,8 @@ def test_the_page_has_the_snippets_this_test_runs():
 
 def test_getting_started_runs_as_written(tmp_path, monkeypatch):
     matplotlib.use("Agg")
-    shutil.copytree(REPO / "experiments" / "scenes", tmp_path / "experiments" / "scenes")
-    shutil.copy(REPO / "experiments" / "quickstart.toml", tmp_path / "experiments")
+    shutil.copytree(REPOSITORY / "experiments" / "scenes", tmp_path / "experiments" / "scenes")
+    shutil.copy(REPOSITORY / "experiments" / "quickstart.toml", tmp_path / "experiments")
     monkeypatch.chdir(tmp_path)
     first, table, store = blocks("python")
     namespace: dict = {}

@@ -17,7 +17,6 @@ import os
 import re
 import signal
 import subprocess
-import sys
 import time
 import tomllib
 from pathlib import Path
@@ -40,7 +39,7 @@ from stochpound.report.assemble import assemble_report
 from stochpound.report.render._document import FigureItem
 from stochpound.report.sections._intensity import intensity_section
 from stochpound.report.sections._risk import risk_section
-from tests.helpers import BUNDLED, FIXED, ISOLATED, MOTIONS, RECORDS, REPOSITORY, risk_text as _text, write_experiment
+from tests.helpers import BUNDLED, FIXED, ISOLATED, MOTIONS, PYTHON_WITH_CTRL_C, RECORDS, REPOSITORY, risk_text as _text, write_experiment
 
 PINNED = {  # canonical definitions of files without [hazard]: unchanged by it
     "quickstart.toml": "128add143f75d2a6807a3bdadd1a10eccb86101908995348243d55d4932ab1bb",
@@ -285,7 +284,7 @@ def test_ctrl_c_at_any_moment_exits_130_without_a_traceback(isolated_store, tmp_
     """SIGINT while the modules load (0.3 s) or while `risk` and `report build` work: 'interrupted', status 130, no traceback."""
     commands = [["risk", str(isolated_store), "--bootstrap", "200000"], ["report", "build", str(isolated_store), "--out", str(tmp_path / "out")]]
     for command in commands:
-        process = subprocess.Popen([sys.executable, "-m", "stochpound", *command], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+        process = subprocess.Popen([*PYTHON_WITH_CTRL_C, "-m", "stochpound", *command], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                                    env={**os.environ, "PYTHONPATH": str(REPOSITORY)}, cwd=tmp_path)
         time.sleep(delay)
         if process.poll() is not None:  # finished before the signal: nothing to test at this delay
