@@ -3,11 +3,13 @@
 from __future__ import annotations
 
 import shutil
+import signal
 
 import nbformat
 import pytest
 from nbclient import NotebookClient
 
+from stochpound._signals import handling
 from stochpound.experiment import load_experiment, open_store, run_experiment
 from tests.helpers import REPOSITORY
 
@@ -36,7 +38,8 @@ def test_notebook_executes(quickstart_store, monkeypatch):
     monkeypatch.setenv("STOCHPOUND_STORE", str(quickstart_store))
     monkeypatch.setenv("MPLBACKEND", "Agg")
     notebook = nbformat.read(NOTEBOOK, as_version=4)
-    NotebookClient(notebook, timeout=300, kernel_name="python3", resources={"metadata": {"path": str(NOTEBOOK.parent)}}).execute()
+    with handling(signal.getsignal(signal.SIGINT)):  # the client installs Python's SIGINT handler: the test run's is restored after
+        NotebookClient(notebook, timeout=300, kernel_name="python3", resources={"metadata": {"path": str(NOTEBOOK.parent)}}).execute()
     outputs = [o for cell in notebook.cells if cell.cell_type == "code" for o in cell.get("outputs", [])]
     assert not [o for o in outputs if o.get("output_type") == "error"]
     text = "".join(o.get("text", "") for o in outputs if o.get("output_type") == "stream")
