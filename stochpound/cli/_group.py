@@ -37,8 +37,8 @@ class HelpGroup(click.Group):
         with noting_ctrl_c(raising=False) as ctrl_c:
             try:
                 result = super().main(*args, **kwargs)
-            except SystemExit as exit:
-                if ctrl_c and exit.code != INTERRUPTED:
+            except SystemExit as ending:
+                if ctrl_c and ending.code != INTERRUPTED:
                     interrupted()
                 raise
             if ctrl_c:
