@@ -59,19 +59,15 @@ if TYPE_CHECKING:
 
 RETURN_PERIODS = np.array([10.0, 25.0, 72.0, 224.0, 475.0, 975.0, 2475.0, 5000.0])
 CURVES = ["fox_plaza_los_angeles_pga", "fox_plaza_los_angeles_sa1p0s", "fox_plaza_los_angeles_sa2p0s", "fox_plaza_los_angeles_sa3p0s"]
-MEASURES = {  # measure: ([intensity] lines, bundled hazard)
-    "PGA": ('measure = "pga"', CURVES[0]),
-    "PSA(1 s)": ('measure = "psa"\nperiod = 1.0', CURVES[1]),
-    "PSA(2 s)": ('measure = "psa"\nperiod = 2.0', CURVES[2]),
-    "PSA(3 s)": ('measure = "psa"\nperiod = 3.0', CURVES[3]),
-}
+#: Fox Plaza's measures, each with its bundled hazard curve.
+MEASURES = dict(zip(("PGA", "PSA(1 s)", "PSA(2 s)", "PSA(3 s)"), CURVES))
 #: The periods (s) of the average spectral acceleration the site of one scenario adds to the measures: the band the isolated
 #: building's closure follows (docs/intensity.md, finding 8).
 SA_AVG_PERIODS = (0.5, 1.0, 1.5, 2.0, 2.5, 3.0, 3.5, 4.0)
 SA_AVG = "Sa_avg(0.5-4 s)"
-#: Every measure's [intensity] lines.
-INTENSITY_LINES = {**{measure: lines for measure, (lines, _) in MEASURES.items()},
-                   SA_AVG: f'measure = "sa_avg"\nperiods = [{", ".join(f"{t:g}" for t in SA_AVG_PERIODS)}]'}
+#: Every measure as stochpound's measure and period (s): Fox Plaza's four, and the one a site of one scenario adds.
+MEASURE_ARGS: dict[str, tuple[str, float | tuple[float, ...] | None]] = {
+    "PGA": ("pga", None), "PSA(1 s)": ("psa", 1.0), "PSA(2 s)": ("psa", 2.0), "PSA(3 s)": ("psa", 3.0), SA_AVG: ("sa_avg", SA_AVG_PERIODS)}
 CONFIGURATIONS = {  # name: (B1's base, an edit of the bundled pair; the neighbour's variants)
     "fixed pair": ("", "[variants.neighbour.stiff.building.B2]\nmass_factor = 0.5\n[variants.neighbour.flexible.building.B2]\nmass_factor = 2.0"),
     "isolated": ("[scene.building.B1]\nbase = { mass = 13134.0, mu = 0.05, radius = 2.24 }", "[variants.neighbour.stiff.building.B2]\nmass_factor = 0.5"),
@@ -90,9 +86,6 @@ suite = "fema_p695_near_field"
 """
 FIGURES = {"fox_plaza": REPOSITORY / "docs" / "figures" / "site_consistency.png",
            "scenario": REPOSITORY / "docs" / "figures" / "site_consistency_scenario.png"}
-#: The measures as stochpound's measure and period (a site of one scenario computes their hazard).
-MEASURE_ARGS: dict[str, tuple[str, float | tuple[float, ...] | None]] = {
-    "PGA": ("pga", None), "PSA(1 s)": ("psa", 1.0), "PSA(2 s)": ("psa", 2.0), "PSA(3 s)": ("psa", 3.0), SA_AVG: ("sa_avg", SA_AVG_PERIODS)}
 #: The default scenario of ``--site scenario``: magnitude, rupture distance (km), mechanism, annual rate (1/yr).
 SCENARIO = (7.5, 10.0, "strike_slip", 0.01)
 
@@ -112,7 +105,7 @@ class Site:
 def _bundled_hazard(measure: str) -> HazardCurve:
     from stochpound.analysis import HazardCurve
 
-    return HazardCurve.bundled(MEASURES[measure][1])
+    return HazardCurve.bundled(MEASURES[measure])
 
 
 #: The bundled Fox Plaza site, the scenario fitted to its four curves (Vs30 and mechanism assumed: the curves state neither).
@@ -136,6 +129,16 @@ def scenario_site(magnitude: float, distance_km: float, mechanism: str, rate: fl
     return Site("scenario", hazard, table, np.unique(np.r_[lowest, RETURN_PERIODS[RETURN_PERIODS > lowest], 10000.0]), tuple(MEASURE_ARGS))
 
 
+def _intensity_lines(measure: str) -> str:
+    """The measure's lines of an experiment's ``[intensity]`` table."""
+    kind, period = MEASURE_ARGS[measure]
+    if kind == "pga":
+        return 'measure = "pga"'
+    if kind == "psa":
+        return f'measure = "psa"\nperiod = {period}'
+    return f'measure = "sa_avg"\nperiods = [{", ".join(f"{t:g}" for t in period)}]'
+
+
 def experiment_text(measure: str, configuration: str, seed: int | None = None, return_periods: np.ndarray | None = None,
                     site: Site = FOX_PLAZA) -> str:
     """The experiment file of one conditioning measure and configuration at ``site`` (the selection's ``seed``, or its default;
@@ -144,7 +147,7 @@ def experiment_text(measure: str, configuration: str, seed: int | None = None, r
     levels = site.hazard(measure).intensity_at(1.0 / periods)
     base, variants = CONFIGURATIONS[configuration]
     return (f'[experiment]\nname = "site_{site.name}"\nstudied = "B1"\n{PAIR.format(base=base, variants=variants)}\n[intensity]\n'
-            f"{INTENSITY_LINES[measure]}\nlevels = [{', '.join(f'{x:.4f}' for x in levels)}]\n"
+            f"{_intensity_lines(measure)}\nlevels = [{', '.join(f'{x:.4f}' for x in levels)}]\n"
             'selection = "conditional_spectrum"\nmotions = 20\nmax_scale_factor = 5.0\n' + ("" if seed is None else f"seed = {seed}\n") +
             site.table)
 
@@ -261,7 +264,7 @@ def main(argv: list[str] | None = None) -> None:
     from matplotlib.figure import Figure
 
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--measures", nargs="+", default=None, choices=list(INTENSITY_LINES),
+    parser.add_argument("--measures", nargs="+", default=None, choices=list(MEASURE_ARGS),
                         help=f"default: the site's (Fox Plaza's four; {SA_AVG} too at the site of one scenario)")
     parser.add_argument("--configurations", nargs="+", default=list(CONFIGURATIONS), choices=list(CONFIGURATIONS))
     parser.add_argument("--bootstrap", type=int, default=200, help="resamples of the 95 %% interval of g* (0: none)")

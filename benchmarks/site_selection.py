@@ -26,10 +26,7 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from benchmarks.site_consistency import CONFIGURATIONS, MEASURES, experiment_text
-
-OTHERS = {"PGA": ("pga", None), "PSA(1 s)": ("psa", 1.0), "PSA(2 s)": ("psa", 2.0), "PSA(3 s)": ("psa", 3.0)}
-"""Every measure of the site as the pool computes it: kind and period (s)."""
+from benchmarks.site_consistency import CONFIGURATIONS, MEASURE_ARGS, MEASURES, experiment_text
 
 
 def _ratios(recomputed: np.ndarray, curve_name: str) -> str:
@@ -82,16 +79,16 @@ def report(measure: str, configuration: str, max_scale_factor: float, folder: Pa
         records.append(Record(label, record.dt, record.acceleration(9.81), "m/s2"))
     scale = xr.DataArray(chosen.coordinates()["selection_scale_factor"].values, dims=("intensity", "record"),
                          coords={"intensity": chosen.experiment_levels, "record": chosen.labels}).sortby("intensity")
-    hazard = HazardCurve.bundled(MEASURES[measure][1])
+    hazard = HazardCurve.bundled(MEASURES[measure])
     levels = scale["intensity"].values
     stripes = [dict(t.attrs) for t in sorted(chosen.targets, key=lambda t: t.attrs["level"])]
     fine = fit_levels(levels, hazard.support[1], hazard.support[0])
-    conditioning = bundled_measure(MEASURES[measure][1])
+    conditioning = bundled_measure(MEASURES[measure])
     lines = []
-    for other, (kind, period) in OTHERS.items():
+    for other, name in MEASURES.items():
         if other == measure:
             continue
-        name = MEASURES[other][1]
+        kind, period = MEASURE_ARGS[other]
         unscaled = selection_pool(records, [1.0], kind, period)["intensity"].values
         scaled = scale * xr.DataArray(unscaled, dims="record", coords={"record": chosen.labels})
         from_motions = hazard_consistency(scaled, hazard, HazardCurve.bundled(name))
