@@ -534,6 +534,12 @@ def test_every_command_s_g_option_has_the_same_default():
     assert len(found) >= 2 and len(set(found.values())) == 1, found
 
 
+def _ctrl_c() -> None:
+    """A Ctrl-C to this process: Python's handler raises in the sleep."""
+    os.kill(os.getpid(), signal.SIGINT)
+    time.sleep(0.5)
+
+
 def _group_with_a_library_that_turns_ctrl_c_into_its_error(ctrl_c: bool):
     """A command group whose command meets a library that raises its own error in place of a KeyboardInterrupt."""
     import click
@@ -549,8 +555,7 @@ def _group_with_a_library_that_turns_ctrl_c_into_its_error(ctrl_c: bool):
         """Read a file."""
         try:
             if ctrl_c:
-                os.kill(os.getpid(), signal.SIGINT)
-            time.sleep(0.5)  # Python's handler raises here
+                _ctrl_c()
         except KeyboardInterrupt:
             pass
         raise click.ClickException("NetCDF: HDF error")  # the error the library raised instead, as a command words it
@@ -585,8 +590,7 @@ class _FileHandle:
     """An object whose finaliser meets the Ctrl-C (as a netCDF file or a figure closed by the garbage collector may)."""
 
     def __del__(self) -> None:
-        os.kill(os.getpid(), signal.SIGINT)
-        time.sleep(0.5)  # Python's handler raises here, in the finaliser: Python prints "Exception ignored" and goes on
+        _ctrl_c()  # raised in the finaliser: Python prints "Exception ignored" and goes on
 
 
 def _group_whose_ctrl_c_never_reaches_the_command(where: str):
@@ -604,8 +608,7 @@ def _group_whose_ctrl_c_never_reaches_the_command(where: str):
         """Read a file."""
         if where == "library":
             try:
-                os.kill(os.getpid(), signal.SIGINT)
-                time.sleep(0.5)
+                _ctrl_c()
             except KeyboardInterrupt:
                 pass
         else:
@@ -664,11 +667,6 @@ def test_a_ctrl_c_swallowed_while_the_commands_load_still_ends_the_process(where
     result = subprocess.run([sys.executable, "-c", script, where], capture_output=True, text=True, timeout=120,
                             env={**os.environ, "PYTHONPATH": str(REPOSITORY)})
     assert (result.returncode, result.stdout, result.stderr) == (130, "", "interrupted\n"), result
-
-
-def _ctrl_c() -> None:
-    os.kill(os.getpid(), signal.SIGINT)
-    time.sleep(0.5)
 
 
 def _group_with_a_ctrl_c_around_its_command(when: str):
