@@ -3,15 +3,18 @@
 A Ctrl-C at any moment ends a command with exit status 130 and one line,
 ``interrupted``, on stderr, never a traceback: while the modules load (caught
 here; ``import stochpound`` itself loads almost nothing), and while a command
-runs (:class:`~stochpound.cli._group.HelpGroup`).
+runs (:class:`~stochpound.cli._group.HelpGroup`), both through
+:func:`interruptible`.
 """
 
 import os
 import sys
-from typing import Any, NoReturn
+from collections.abc import Callable
+from typing import Any, NoReturn, TypeVar
 
 INTERRUPTED = 130
 """Exit status of a command stopped by Ctrl-C (128 + SIGINT), as shells report it."""
+T = TypeVar("T")
 
 
 def interrupted(loading: bool = False) -> NoReturn:
@@ -27,6 +30,37 @@ def interrupted(loading: bool = False) -> NoReturn:
         sys.stderr.flush()
         os._exit(INTERRUPTED)
     raise SystemExit(INTERRUPTED)
+
+
+def interruptible(work: Callable[[], T], loading: bool = False) -> T:
+    """``work()``; a Ctrl-C meanwhile ends the command as :func:`interrupted` (``loading`` passed on), whatever ``work`` did then.
+
+    Also when a library turned the Ctrl-C's KeyboardInterrupt into an error
+    of its own (an HDF5 or netCDF read cut short fails with its message; an
+    extension module's import with ``ImportError: initialization failed``):
+    an error raised after a Ctrl-C is the Ctrl-C. And when the
+    KeyboardInterrupt never reached ``work``: raised inside a finaliser
+    (``__del__``, a weakref callback), where Python prints it as "Exception
+    ignored" and goes on, or caught by a library; ``work`` then returns and
+    the command ends as interrupted. A Ctrl-C noted by an enclosing block
+    before ``work`` starts ends it before it starts.
+    """
+    from stochpound._signals import noting_ctrl_c
+
+    with noting_ctrl_c() as ctrl_c:
+        try:
+            if ctrl_c:
+                raise KeyboardInterrupt
+            result = work()
+        except KeyboardInterrupt:
+            interrupted(loading)
+        except Exception:
+            if ctrl_c:
+                interrupted(loading)
+            raise
+        if ctrl_c:
+            interrupted(loading)
+        return result
 
 
 def _build() -> Any:
@@ -55,23 +89,11 @@ def _build() -> Any:
 
 
 def _load() -> Any:
-    """:func:`_build`, ended as interrupted by a Ctrl-C meanwhile: also one a library or a finaliser swallowed, or one
-    that an extension module's import turned into an error (``ImportError: initialization failed``)."""
-    ctrl_c: list[int] = []
+    """:func:`_build`, ended as interrupted by a Ctrl-C meanwhile (:func:`interruptible`)."""
     try:
-        from stochpound._signals import noting_ctrl_c
-
-        with noting_ctrl_c() as ctrl_c:
-            group = _build()
-    except KeyboardInterrupt:
+        return interruptible(_build, loading=True)
+    except KeyboardInterrupt:  # before the Ctrl-C could be noted
         interrupted(loading=True)
-    except Exception:
-        if ctrl_c:
-            interrupted(loading=True)
-        raise
-    if ctrl_c:
-        interrupted(loading=True)
-    return group
 
 
 main = _load()

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import sys
+from functools import partial
 from typing import Any
 
 import click
@@ -46,32 +47,11 @@ class HelpGroup(click.Group):
             return result
 
     def invoke(self, ctx: click.Context) -> object:
-        """Run the command; a Ctrl-C anywhere in it ends it with exit status 130 and no traceback (click's is 1, "Aborted!").
+        """Run the command; a Ctrl-C anywhere in it ends it with exit status 130 and no traceback (click's is 1, "Aborted!"),
+        also one a library swallowed or turned into its own error (:func:`stochpound.cli.interruptible`)."""
+        from stochpound.cli import interruptible
 
-        Also when a library turned the Ctrl-C's KeyboardInterrupt into an
-        error of its own (an HDF5 or netCDF read cut short fails with its
-        message instead): an error raised after a Ctrl-C is the Ctrl-C. And
-        when the KeyboardInterrupt never reached the command: raised inside a
-        finaliser (``__del__``, a weakref callback), where Python prints it as
-        "Exception ignored" and goes on, or caught by a library; the command
-        then ends as interrupted when it returns.
-        """
-        from stochpound.cli import interrupted
-
-        with noting_ctrl_c() as ctrl_c:
-            try:
-                if ctrl_c:  # noted before the command started
-                    raise KeyboardInterrupt
-                result = super().invoke(ctx)
-            except KeyboardInterrupt:
-                interrupted()
-            except Exception:
-                if ctrl_c:
-                    interrupted()
-                raise
-            if ctrl_c:
-                interrupted()
-            return result
+        return interruptible(partial(super().invoke, ctx))
 
     def format_commands(self, ctx: click.Context, formatter: click.HelpFormatter) -> None:
         """The ``Commands:`` section, each command's first sentence whole."""
