@@ -29,7 +29,7 @@ from stochpound._studies import parse_reproduces
 from stochpound.experiment._design_table import parse_design
 from stochpound.experiment._limit_states_table import parse_limit_states
 from stochpound.hazard import parse_hazard
-from stochpound.motions import DEFAULT_G
+from stochpound.motions import DEFAULT_G, SYNTHETIC_TYPES
 from stochpound.experiment._intensity import parse_intensity
 from stochpound.experiment._site import site_entry
 from stochpound.model import fields as toml_fields
@@ -53,7 +53,6 @@ AUTO = "auto"
 """``solver.method`` default: each case's solver chosen by :func:`stochpound.simulate` (exact unless a law is nonlinear)."""
 _RECORD_KEYS = {"name", "record", "scale", "dt", "duration", "units", "interpolation"}
 _SUITE_KEYS = {"name", "suite", "scale", "duration", "interpolation"}
-_SYNTHETIC_TYPES = ("kanai_tajimi", "clough_penzien")
 MAX_REALIZATIONS = 10**8
 """Largest ``count`` of a synthetic ensemble: the run's client holds a few hundred bytes per case
 (a larger count is refused before anything is allocated; runs above
@@ -425,7 +424,7 @@ def _motions(data: Mapping[str, Any], scene: Mapping[str, Any], base_dir: Path) 
         if not isinstance(table, dict):
             raise ExperimentError("records: no motion (give [[records]], [[motions]], [synthetic.<name>], or a [motion] in the base scene)")
         kind = table.get("type", "record")
-        if kind in _SYNTHETIC_TYPES:
+        if kind in SYNTHETIC_TYPES:
             entry = dict(table)
             realization = entry.pop("realization", 0)
             motions.append({"label": kind, "kind": "synthetic", "field": "scene.motion", "motion": entry, "start": realization, "count": 1})
@@ -530,8 +529,8 @@ def _synthetic_source(label: str, table: Any, where: str) -> dict[str, Any]:
         raise ExperimentError(f"{where}: must be a table (type, count, seed and the generator's parameters)")
     entry = dict(table)
     kind = entry.get("type", "kanai_tajimi")
-    if kind not in _SYNTHETIC_TYPES:
-        raise ExperimentError(f"{where}.type: must be one of {', '.join(_SYNTHETIC_TYPES)}, got {kind!r}")
+    if kind not in SYNTHETIC_TYPES:
+        raise ExperimentError(f"{where}.type: must be one of {', '.join(SYNTHETIC_TYPES)}, got {kind!r}")
     entry["type"] = kind
     from stochpound import motions
 

@@ -23,10 +23,10 @@ from stochpound.model.building import buildings_from_tables
 from stochpound.model.contact import contact_from_table
 from stochpound.model.scene import Scene
 from stochpound.model.wall import walls_from_tables
+from stochpound.motions import SYNTHETIC_TYPES
 from stochpound.motions.ground import GroundMotion, HarmonicMotion, SampledMotion
 
 _TOP_KEYS = {"g", "study_compat", "building", "contact", "wall", "motion"}
-_SYNTHETIC_TYPES = {"kanai_tajimi", "clough_penzien"}
 
 
 def load_scene(path: str | Path) -> Scene:
@@ -147,12 +147,12 @@ def _motion(data: Mapping[str, Any], base_dir: Path, g: float, per_sample: int) 
     """The scene's ground motion; a run needing more than the memory limit (``per_sample`` bytes a sample) is refused first."""
     table = fields.table(data, "motion", "")
     if table is None:
-        raise SceneError("motion: missing ([motion] with a record, or type = harmonic | constant | kanai_tajimi | clough_penzien)")
+        raise SceneError(f"motion: missing ([motion] with a record, or type = harmonic | constant | {' | '.join(SYNTHETIC_TYPES)})")
     kind = fields.string(table, "type", "motion", default="record")
-    if kind in _SYNTHETIC_TYPES:
+    if kind in SYNTHETIC_TYPES:
         return _synthetic_motion(table, kind, per_sample)
     if kind not in _MOTION_KEYS:
-        raise SceneError(f"motion.type: must be one of record, harmonic, constant, kanai_tajimi, clough_penzien; got {kind!r}")
+        raise SceneError(f"motion.type: must be one of record, harmonic, constant, {', '.join(SYNTHETIC_TYPES)}; got {kind!r}")
     fields.reject_unknown(table, _MOTION_KEYS[kind], "motion")
     if kind == "harmonic":
         return _harmonic_motion(table, per_sample)

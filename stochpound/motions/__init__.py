@@ -1,10 +1,14 @@
-"""Synthetic ground motions: Kanai–Tajimi and Clough–Penzien PSDs, envelopes, generators.
+"""Synthetic ground motions: white noise, Kanai–Tajimi and Clough–Penzien PSDs, envelopes, generators.
 
 >>> from stochpound import motions
 >>> a = motions.kanai_tajimi(100, 20.0, 0.01, omega_g=15.0, zeta_g=0.6, pga=3.0,
 ...                          envelope="jennings", seed=1)          # doctest: +SKIP
 >>> a.sizes                                                         # doctest: +SKIP
 {'realization': 100, 'time': 2001}
+
+Every synthetic motion is a function of a vector of standard normals
+(:func:`normal_motion`, :class:`NormalMotion`), for samplers that move in
+that space (subset simulation).
 
 Intensity measures and the response spectrum (exact for accelerations linear
 between samples): :func:`intensity_measures`, :func:`response_spectrum`.
@@ -33,7 +37,7 @@ from stochpound.motions.envelopes import (
     Trapezoidal,
     make_envelope,
 )
-from stochpound.motions.generators import filter_samples, spectral_samples, stationary_samples
+from stochpound.motions.generators import filter_from_normals, filter_samples, spectral_from_phases, spectral_samples, stationary_samples
 from stochpound.motions._measures import intensity_measures, peak_ground_motion, sa_avg, significant_duration
 from stochpound.motions.intensity import poisson_peak_factor, s0_from_pga, s0_from_rms, simulated_peak_factor
 from stochpound.motions._presets import SOIL_PRESETS, SoilPreset, soil_preset
@@ -49,7 +53,16 @@ from stochpound.motions.psd import (
 from stochpound.motions._selection import TARGET_TOLERANCE, misses_target, select_motions, selection_periods, selection_pool
 from stochpound.motions._seeding import realization_rng, realization_rngs
 from stochpound.motions._spectrum import response_spectrum
-from stochpound.motions._synthetic import PSD_CONVENTION, clough_penzien, kanai_tajimi, synthetic_ground_motion
+from stochpound.motions._normals import NormalMotion
+from stochpound.motions._synthetic import (
+    PSD_CONVENTION,
+    SYNTHETIC_TYPES,
+    clough_penzien,
+    kanai_tajimi,
+    normal_motion,
+    synthetic_ground_motion,
+    white_noise,
+)
 
 # For the other packages of stochpound (their interface to this one, not public API: not in __all__).
 from stochpound.motions._arias import DEFAULT_G, arias_intensity  # noqa: F401
@@ -62,11 +75,13 @@ __all__ = [
     "TARGET_TOLERANCE",
     "TRUNCATION_EPSILON",
     "SOIL_PRESETS",
+    "SYNTHETIC_TYPES",
     "AminAng",
     "CallableEnvelope",
     "Envelope",
     "FilteredWhiteNoise",
     "Jennings",
+    "NormalMotion",
     "SaragoniHart",
     "SoilPreset",
     "Trapezoidal",
@@ -75,6 +90,7 @@ __all__ = [
     "clough_penzien_model",
     "clough_penzien_psd",
     "conditional_spectrum",
+    "filter_from_normals",
     "filter_samples",
     "fit_levels",
     "fit_scenarios",
@@ -87,6 +103,7 @@ __all__ = [
     "kanai_tajimi_variance",
     "make_envelope",
     "misses_target",
+    "normal_motion",
     "peak_ground_motion",
     "poisson_peak_factor",
     "realization_rng",
@@ -103,7 +120,9 @@ __all__ = [
     "significant_duration",
     "soil_preset",
     "simulated_peak_factor",
+    "spectral_from_phases",
     "spectral_samples",
     "stationary_samples",
     "synthetic_ground_motion",
+    "white_noise",
 ]

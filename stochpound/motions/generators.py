@@ -72,20 +72,46 @@ def spectral_samples(
     ``band_limit=True`` uses S(ω) on abs(ω) ≤ π/dt instead of the aliased S_d:
     the spectral shape below the Nyquist frequency is exact (e.g. a
     Clough–Penzien process keeps S(0) = 0) but the variance above π/dt is lost.
-    Each realization is synthesised on its own (one inverse FFT per row), so
-    its numbers cannot depend on how many others are generated with it.
+    Each realization draws its phases φ_j ~ U(0, 2π) from its own generator.
+    """
+    n_phases = spectral_length(model, n_time, dt) // 2 + 1
+    phases = np.array([rng.uniform(0.0, 2.0 * np.pi, n_phases) for rng in rngs]).reshape(len(rngs), n_phases)
+    return spectral_from_phases(model, n_time, dt, phases, band_limit)
+
+
+def spectral_from_phases(model: FilteredWhiteNoise, n_time: int, dt: float, phases: np.ndarray, band_limit: bool = False) -> np.ndarray:
+    """Stationary samples (rows of ``phases``, n_time) by the spectral representation, given the phases.
+
+    Parameters
+    ----------
+    model : FilteredWhiteNoise
+        The process (its S0 included).
+    n_time : int
+        Samples per realization.
+    dt : float
+        Step, s.
+    phases : np.ndarray
+        (realizations, M/2 + 1) phases φ_j, rad, M = :func:`spectral_length`.
+    band_limit : bool
+        As in :func:`spectral_samples`.
+
+    Returns
+    -------
+    np.ndarray
+        (realizations, n_time) accelerations, m/s². Each realization is
+        synthesised on its own (one inverse FFT per row), so its numbers cannot
+        depend on how many others are generated with it.
     """
     n_fft = spectral_length(model, n_time, dt)
     amplitudes = spectral_amplitudes(model, n_fft, dt, band_limit)
     scaled = (0.5 * n_fft) * amplitudes
-    out = np.empty((len(rngs), n_time))
-    for row, rng in enumerate(rngs):
-        phases = rng.uniform(0.0, 2.0 * np.pi, amplitudes.size)
-        coefficients = scaled * np.exp(1j * phases)
+    out = np.empty((len(phases), n_time))
+    for row, phase in enumerate(phases):
+        coefficients = scaled * np.exp(1j * phase)
         # irfft reads only the real part of the first and last coefficients and
         # counts them once: the A_0 and A_{M/2} cosines need twice that.
-        coefficients[0] = 2.0 * scaled[0] * np.cos(phases[0])
-        coefficients[-1] = 2.0 * scaled[-1] * np.cos(phases[-1])
+        coefficients[0] = 2.0 * scaled[0] * np.cos(phase[0])
+        coefficients[-1] = 2.0 * scaled[-1] * np.cos(phase[-1])
         out[row] = irfft(coefficients, n=n_fft)[:n_time]
     return out
 
@@ -93,17 +119,49 @@ def spectral_samples(
 def filter_samples(model: FilteredWhiteNoise, n_time: int, dt: float, rngs: list[np.random.Generator]) -> np.ndarray:
     """Stationary samples (len(rngs), n_time) by exact discrete-time filtering of white noise.
 
-    The recursion runs over a block of realizations at once with element-wise
-    operations only (no BLAS), so each row's numbers do not depend on the batch.
+    Each realization draws its (n_time + 1) × order standard normals from its
+    own generator (:func:`filter_from_normals` maps them to the samples).
     """
-    Phi, noise_factor, C, start_factor = model.discretize(dt)
-    order = Phi.shape[0]
+    order = model.discretize(dt)[0].shape[0]
     out = np.empty((len(rngs), n_time))
     for first in range(0, len(rngs), BLOCK):
         block = rngs[first : first + BLOCK]
-        # per realization: `order` normals start the state, then `order` per step drive it
-        z = np.stack([rng.standard_normal((n_time + 1) * order).reshape(n_time + 1, order) for rng in block])
-        z = np.ascontiguousarray(z.transpose(2, 1, 0))  # (order, n_time + 1, block)
+        z = np.stack([rng.standard_normal((n_time + 1) * order) for rng in block])
+        out[first : first + len(block)] = filter_from_normals(model, n_time, dt, z)
+    return out
+
+
+def filter_from_normals(model: FilteredWhiteNoise, n_time: int, dt: float, normals: np.ndarray) -> np.ndarray:
+    """Stationary samples by exact discrete-time filtering, given the standard normals that drive it.
+
+    Parameters
+    ----------
+    model : FilteredWhiteNoise
+        The process (its S0 included).
+    n_time : int
+        Samples per realization.
+    dt : float
+        Step, s.
+    normals : np.ndarray
+        (realizations, (n_time + 1) · order) independent standard normals,
+        order the filter's: per realization the first ``order`` start the
+        state in its stationary distribution, the next ``order`` per step
+        drive it.
+
+    Returns
+    -------
+    np.ndarray
+        (realizations, n_time) accelerations, m/s². The recursion runs over a
+        block of realizations at once with element-wise operations only (no
+        BLAS), so each row's numbers do not depend on the batch.
+    """
+    Phi, noise_factor, C, start_factor = model.discretize(dt)
+    order = Phi.shape[0]
+    normals = np.asarray(normals, dtype=float)
+    out = np.empty((len(normals), n_time))
+    for first in range(0, len(normals), BLOCK):
+        block = normals[first : first + BLOCK]
+        z = np.ascontiguousarray(block.reshape(len(block), n_time + 1, order).transpose(2, 1, 0))  # (order, n_time + 1, block)
         state = _apply(start_factor, list(z[:, 0, :]))
         eta = np.stack(_apply(noise_factor, list(z[:, 1:, :])))  # (order, n_time, block)
         y = np.empty((n_time, len(block)))

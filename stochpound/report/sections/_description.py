@@ -341,7 +341,9 @@ def _synthetic_parameters(table: Mapping[str, Any], start: int) -> tuple[str, di
     """The generator's parameters as run, with the intensity S0 and σ it implies (one realization is generated)."""
     parameters = {k: v for k, v in table.items() if k not in ("type", "interpolation")}
     attrs = getattr(synthetic_motions, table["type"])(1, start=start, **parameters).attrs
-    filters = f"ω_g = {number(attrs['omega_g'])} rad/s, ζ_g = {number(attrs['zeta_g'])}"
+    filtered = "omega_g" in attrs  # white noise has no filter
+    title = table["type"].replace("_", "–").title() if filtered else "White noise"
+    filters = f"ω_g = {number(attrs['omega_g'])} rad/s, ζ_g = {number(attrs['zeta_g'])}" if filtered else "independent samples"
     if "omega_f" in attrs:
         filters += f", ω_f = {number(attrs['omega_f'])} rad/s, ζ_f = {number(attrs['zeta_f'])}"
     if "pga_target" in attrs:
@@ -353,8 +355,8 @@ def _synthetic_parameters(table: Mapping[str, Any], start: int) -> tuple[str, di
     envelope = json.loads(attrs["envelope"])
     shape = "stationary" if envelope is None else f"{envelope.pop('type')} envelope ({', '.join(f'{k} = {number(v, 4)}' for k, v in envelope.items())})"
     text = (
-        f"{table['type'].replace('_', '–').title()}: {filters}; {intensity}, S0 = {number(attrs['S0'], 4)} m²/s³ "
-        f"(two-sided), σ = {number(attrs['sigma'], 4)} m/s²; {shape}; {attrs['method']} method"
+        f"{title}: {filters}; {intensity}, S0 = {number(attrs['S0'], 4)} m²/s³ "
+        f"(two-sided), σ = {number(attrs['sigma'], 4)} m/s²; {shape}" + (f"; {attrs['method']} method" if filtered else "")
         + ("; baseline-corrected (ends at rest)" if attrs.get("baseline_corrected") else "")
         + ("; band-limited" if attrs.get("band_limited") else "")
         + "; linear interpolation between samples"
