@@ -11,7 +11,9 @@ This namespace also gives the site's hazard (:class:`HazardCurve`, the
 hazard files and the stripes' consistency, of :mod:`stochpound.hazard`),
 the code separation rules of a run (of :mod:`stochpound.codes`) and, as
 aliases, the names of the risk chain (:mod:`stochpound.risk`) it gave to
-code written before that package existed. The statistics sit above all
+code written before that package existed. Small exceedance probabilities of
+a run's response come from subset simulation (:func:`subset_simulation`,
+which runs the solvers). The statistics sit above all
 three: none of them imports this package.
 """
 
@@ -29,6 +31,7 @@ from stochpound.analysis._peaks import peak_response
 from stochpound.analysis._pounding import pounding_probability
 from stochpound.analysis._separation import pounding_curve, required_separation, rule_exceedance
 from stochpound.codes import contact_demands, fixed_base_cqc, separation_rules, store_contact_demands
+from stochpound.analysis._subset_simulation import RESPONSES, subset_simulation
 from stochpound.analysis._summary import run_summary
 from stochpound.hazard import (
     HazardCurve,
@@ -110,6 +113,8 @@ __all__ = [
     "store_contact_demands",
     "fixed_base_cqc",
     "run_summary",
+    "subset_simulation",
+    "RESPONSES",
     "HazardCurve",
     "HazardFile",
     "read_hazard_file",
