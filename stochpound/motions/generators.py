@@ -91,7 +91,7 @@ def spectral_from_phases(model: FilteredWhiteNoise, n_time: int, dt: float, phas
     dt : float
         Step, s.
     phases : np.ndarray
-        (realizations, M/2 + 1) phases φ_j, rad, M = :func:`spectral_length`.
+        (realizations, M/2 + 1) phases φ_j, rad, M = ``spectral_length(model, n_time, dt)``.
     band_limit : bool
         As in :func:`spectral_samples`.
 
