@@ -88,3 +88,23 @@ def test_a_scene_runs_a_white_noise_realization():
     table = {"type": "white_noise", "S0": 0.2, "seed": 3, "realization": 4, "duration": 2.0, "dt": 0.01}
     scene = scene_from_dict({"building": [{"name": "A", "mass": [1.0e5], "stiffness": [4.0e7], "damping_ratio": 0.05}], "motion": table})
     assert np.array_equal(scene.motion.values, white_noise(1, 2.0, 0.01, S0=0.2, seed=3, start=4).values[0])
+
+
+def test_the_report_describes_a_white_noise_ensemble():
+    from stochpound.report.sections._description import _synthetic_parameters
+
+    text, attrs = _synthetic_parameters({"type": "white_noise", "rms": 2.0, "seed": 1, "duration": 5.0, "dt": 0.01}, start=0)
+    assert text.startswith("White noise: independent samples; RMS 2 m/s², S0 = ")
+    assert "method" not in text and attrs["sigma"] == pytest.approx(2.0)
+
+
+def test_an_experiment_takes_a_white_noise_ensemble():
+    from stochpound._errors import ExperimentError
+    from stochpound.experiment._spec import parse_experiment
+
+    data = {"experiment": {"name": "white"}, "scene": {"bundled": "elastic_pair"},
+            "synthetic": {"white": {"type": "white_noise", "S0": 0.01, "count": 3, "seed": 2, "duration": 2.0, "dt": 0.02}}}
+    definition = parse_experiment(data)
+    assert [m["motion"]["type"] for m in definition["motions"]] == ["white_noise"]
+    with pytest.raises(ExperimentError, match="synthetic.white.omega_g: unknown field"):
+        parse_experiment({**data, "synthetic": {"white": {**data["synthetic"]["white"], "omega_g": 3.0}}})
