@@ -136,12 +136,9 @@ def filter_from_normals(model: FilteredWhiteNoise, n_time: int, dt: float, norma
 
     Parameters
     ----------
-    model : FilteredWhiteNoise
-        The process (its S0 included).
-    n_time : int
-        Samples per realization.
-    dt : float
-        Step, s.
+    model, n_time, dt
+        The process (its S0 included), the samples per realization and the
+        step (s), as in :func:`spectral_from_phases`.
     normals : np.ndarray
         (realizations, (n_time + 1) · order) independent standard normals,
         order the filter's: per realization the first ``order`` start the
