@@ -201,14 +201,15 @@ def pair_section(measured: dict, info: dict[str, str]) -> str:
         f"(commit {info['commit']}, {info['date']}, load {info['load average (1 min) at start']}). "
         "`python -m benchmarks rare_events pair` rewrites this section.",
         "",
-        "| b (m) | crude MC (its CoV) | subset simulation (reported CoV) | difference / combined CoV |",
+        "| b (m) | crude MC (its CoV) | subset simulation (reported CoV) | difference / combined standard deviation |",
         "|---:|---:|---:|---:|",
     ]
     for b, probability, cov in zip(PAIR_THRESHOLDS, result.probability.values, result.cov.values):
         crude = float(np.mean(closures > b))
         crude_cov = math.sqrt((1.0 - crude) / (crude * closures.size)) if crude > 0.0 else math.nan
         combined = math.hypot(cov * probability, crude_cov * crude) if crude > 0.0 else math.nan
-        lines.append(f"| {b:g} | {crude:.3g} ({crude_cov:.0%}) | {probability:.3g} ({cov:.0%}) | "
+        crude_text = f"{crude:.3g} ({crude_cov:.0%})" if crude > 0.0 else "0"
+        lines.append(f"| {b:g} | {crude_text} | {probability:.3g} ({cov:.0%}) | "
                      + (f"{(probability - crude) / combined:+.1f} |" if crude > 0.0 else "crude MC has no run beyond |"))
     lines.append(PAIR_END)
     return "\n".join(lines) + "\n"

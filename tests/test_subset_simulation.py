@@ -182,3 +182,22 @@ def test_a_pounding_pair_agrees_with_crude_monte_carlo():
         crude = np.mean(closures > b)
         combined = math.hypot(cov * probability, math.sqrt(crude * (1.0 - crude) / closures.size))
         assert abs(probability - crude) < 3.0 * combined
+
+
+@pytest.mark.parametrize(("arguments", "message"), [
+    ({"response": "speed"}, "response: must be one of closure, peak_storey_drift, base_displacement, impact_force"),
+    ({"building": "B9"}, "building: must be one of B1, got 'B9'"),
+    ({"floor": 2}, r"floor: must be a storey of 'B1', 1 .. 1, got 2"),
+    ({"response": "closure"}, "contact: the scene has no contact"),
+    ({"response": "base_displacement"}, "building: 'B1' has a fixed base"),
+    ({"motion": {"type": "white_noise", "duration": 3.0, "dt": 0.02}}, "give exactly one of S0, rms"),
+])
+def test_a_scene_s_bad_response_is_named_before_any_run(arguments, message):
+    scene = stochpound.scene_from_dict({
+        "building": [{"name": "B1", "mass": [1.0e5], "stiffness": [1.0e5 * OMEGA**2], "damping_ratio": ZETA}],
+        "motion": {"type": "constant", "acceleration": 0.0, "duration": 1.0, "dt": 0.5},
+    })
+    settings = {"motion": {"type": "white_noise", "S0": S, "duration": 3.0, "dt": 0.02}, "response": "peak_storey_drift", "building": "B1", "floor": 1,
+                "thresholds": [0.1], "samples_per_level": 10, **arguments}
+    with pytest.raises(ValueError, match=message):
+        subset_simulation(scene, **settings)
