@@ -3,34 +3,37 @@
 The response Y = g(u) is a function of n independent standard normals u (a
 synthetic motion's randomness, :func:`~stochpound.motions.normal_motion`).
 P(Y > b) is written as a product of conditional probabilities of nested
-events {Y > b_i}: level 0 is crude Monte Carlo with N samples; each
-intermediate threshold b_{i+1} is the (1 − p0) quantile of level i (the
-midpoint of the p0·N-th and the next largest responses), so that exactly
-p0·N samples exceed it; they seed p0·N Markov chains of 1/p0 states each,
-which sample level i + 1 from the conditional distribution given Y > b_{i+1}.
+events {Y ≥ b_i}: level 0 is crude Monte Carlo with N samples; each
+intermediate threshold b_{i+1} is the p0·N-th largest response of level i,
+so that p0·N samples reach it (a few more when a chain's repeated state
+ties with it); they seed as many Markov chains of 1/p0 states each, which
+sample level i + 1 from the conditional distribution given Y ≥ b_{i+1}.
 The levels stop when at least p0·N samples of a level exceed the largest
 threshold asked for (or after ``max_levels``). For any threshold b with
 b_i ≤ b < b_{i+1} (the last level's b_{i+1} = ∞),
 
-    P(Y > b) ≈ p0^i · P_i(b),   P_i(b) = the fraction of level i's samples above b,
+    P(Y > b) ≈ p_0 ⋯ p_{i−1} · P_i(b),
+
+p_j the fraction of level j that reached b_{j+1} (p0, or a little more
+with ties) and P_i(b) the fraction of level i's samples above b,
 
 so one run gives the whole exceedance curve down to the target.
 
 The chains move by the component-wise modified Metropolis algorithm of
 Au & Beck (2001): each component's candidate ξ_k is uniform on
 u_k ± 1 and replaces u_k with probability min(1, φ(ξ_k)/φ(u_k)); the
-candidate state is accepted if its response exceeds the level's threshold,
+candidate state is accepted if its response reaches the level's threshold,
 else the chain repeats its state. All chains advance together: the
 response is evaluated on the candidates of every chain at once.
 
 The coefficient of variation is Au & Beck's, δ² = Σ_j δ_j², with
-δ_0² = (1 − p)/(p N) for level 0 and δ_j² = (1 − p)/(p N)(1 + γ_j) for a
-level of chains, γ_j = 2 Σ_{k=1}^{N_s−1} (1 − k/N_s) ρ_j(k) from the
+δ_0² = (1 − p)/(p N) for level 0 and δ_j² = (1 − p)/(p N_j)(1 + γ_j) for a
+level of chains (N_j its samples), γ_j = 2 Σ_{k=1}^{N_s−1} (1 − k/N_s) ρ_j(k) from the
 correlation ρ_j of the indicator along the chains (N_s states a chain),
-computed for the probability actually estimated at that level: p0 and the
-indicator of Y > b_{j+1} for the intermediate levels, P_i(b) and the
+computed for the probability actually estimated at that level: p_j and the
+indicator of Y ≥ b_{j+1} for the intermediate levels, P_i(b) and the
 indicator of Y > b for the last one. The levels' estimates are taken as
-uncorrelated (the estimate of δ is then a lower bound, Au & Beck 2001).
+uncorrelated, as Au & Beck (2001) do.
 """
 
 from __future__ import annotations
@@ -106,7 +109,9 @@ def subset_simulation(
         The contact index of ``closure`` and ``impact_force``.
     samples_per_level : int
         N, the samples of each level (runs of level 0); p0·N must be an
-        integer that divides N.
+        integer that divides N. A level whose threshold ties with a chain's
+        repeated state takes the tied samples as seeds too, and so has a few
+        more samples.
     p0 : float
         The conditional probability of each intermediate level, in (0, 0.5].
     seed : int
