@@ -12,6 +12,7 @@ from __future__ import annotations
 import builtins
 import dataclasses
 import errno
+import html
 import io
 import itertools
 import os
@@ -536,3 +537,53 @@ gap = 0.02
 stiffness = 1.0e8
 restitution = 0.65
 """
+
+
+# ---------------------------------------------------------------- report texts, compared without the machine's last digits
+
+
+ROUNDING = 1e-9
+"""Two printed numbers that differ by less than this, absolutely or relative to their size, are the same number: the
+machine's last digits. A report's solver differences and residuals are rounding (7.6e-13 m on one machine, 9.2e-13 m on
+another) and its tables print 17 digits, the last few set by the BLAS kernels of the CPU; nothing a report states means
+anything at 1e-9 (a nanometre, once in a billion years), and any real change is far larger."""
+_NUMBER = re.compile(r"(?<![\w.])[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?(?!\w|\.\d)")
+_SOFTWARE = re.compile(r"^(Software: .*)$", re.MULTILINE)
+
+
+def report_page_text(out: Path, folder: Path) -> str:
+    """The words and tables of the report built into ``out`` (figures left out), with what differs between machines masked:
+    the build date, the commit, the run ``folder`` and the versions of the software it lists (their names kept)."""
+    page = (out / "index.html").read_text()
+    page = re.sub(r"<(style|script)\b.*?</\1>", "", page, flags=re.S)
+    page = re.sub(r'src="data:[^"]*"', "", page)
+    lines = (" ".join(line.split()) for line in html.unescape(re.sub(r"<[^>]+>", " ", page)).splitlines())
+    parts = ["\n".join(line for line in lines if line)]
+    parts += [f"== {table.name}\n{table.read_text()}" for table in sorted((out / "tables").glob("*.csv"))]
+    text = "\n".join(parts).replace(str(folder), "<folder>")
+    text = re.sub(r"\b[0-9a-f]{40}\b(\+dirty)?", "<commit>", text)  # a build from a tree with changes says +dirty
+    text = _SOFTWARE.sub(lambda line: re.sub(r" \d[\w.+-]*(?=[,.]( |$))", " <version>", line.group(1)), text)
+    return re.sub(r"\b\d{4}-\d{2}-\d{2}\b", "<date>", text) + "\n"
+
+
+def text_difference(text: str, reference: str, rounding: float = ROUNDING) -> str:
+    """Where ``text`` differs from ``reference`` beyond the machine's last digits ("" where it does not).
+
+    The words, punctuation and layout must be identical; each number must
+    equal the reference's to ``rounding``, absolutely or relatively
+    (:data:`ROUNDING`). Returns the first line that differs, both versions,
+    with the numbers that differ named.
+    """
+    ours, theirs = text.splitlines(), reference.splitlines()
+    for number, (line, expected) in enumerate(zip(ours, theirs), start=1):
+        if line == expected:
+            continue
+        if _NUMBER.split(line) != _NUMBER.split(expected):
+            return f"line {number}: the words differ:\n  now:       {line}\n  reference: {expected}"
+        pairs = zip(_NUMBER.findall(line), _NUMBER.findall(expected))
+        far = [(a, b) for a, b in pairs if abs(float(a) - float(b)) > rounding * max(1.0, abs(float(a)), abs(float(b)))]
+        if far:
+            return f"line {number}: the numbers {', '.join(f'{a} (reference {b})' for a, b in far)} differ beyond {rounding:g}:\n  now:       {line}"
+    if len(ours) != len(theirs):
+        return f"the text has {len(ours)} lines, the reference {len(theirs)}"
+    return ""

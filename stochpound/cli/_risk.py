@@ -114,7 +114,7 @@ def risk(store: Path, hazard: str | None, hazard_measure: str | None, hazard_uni
         raise click.ClickException(os_error_message(error)) from None
     stripes = f"{result.stripes} stripes" if result.stripes is not None else "IDA capacities"
     source = hz.source.splitlines()[0] if hz.source else hz.describe()
-    click.echo(f"{result.experiment or store.stem}: {result.motions} motions, {stripes} of {result.measure} "
+    click.echo(f"{result.experiment or store.stem}: {result.motions} motion{'s' if result.motions != 1 else ''}, {stripes} of {result.measure} "
                f"in {result.setting['units']}; hazard: {source}")
     missed = selection_misses(data)
     if missed:
@@ -129,12 +129,16 @@ def risk(store: Path, hazard: str | None, hazard_measure: str | None, hazard_uni
             click.echo(f"note: hazard {line.removeprefix('stochpound: ')}")
     if hz.extrapolated:
         click.echo(f"note: the hazard table [{hz.im[0]:g}, {hz.im[-1]:g}] {hz.units} was extrapolated beyond its intensities as power laws (--extrapolate)")
-    interval = f"95 % interval, {result.separation['lower'].attrs.get('method', 'BCa bootstrap')}" if bootstrap else "no bootstrap"
+    interval = f"95 % interval, {result.separation['lower'].attrs.get('method', 'BCa bootstrap')}" if "lower" in result.separation else (
+        "no interval: not estimable" if result.no_interval else "no bootstrap")
     separation = result.separation_frame()
     click.echo(f"\nRisk-targeted separation g* (m; {interval}; inf: wider than every gap of the grid):")
     click.echo(separation.to_string(float_format=lambda v: f"{v:.3f}"))
+    if result.no_interval:
+        click.echo(f"note: no interval is estimable for g*, the rates or the code rules: {result.no_interval}.")
     design = result.design_frame()
-    click.echo(f"\nDesign to (m; the {design['basis'].iloc[0]}, not g* itself):")
+    basis = f"the {design['basis'].iloc[0]}, not g* itself" if "upper" in result.separation else design["basis"].iloc[0]
+    click.echo(f"\nDesign to (m; {basis}):")
     click.echo(design.drop(columns="basis").assign(target=[result.target_text(p) for p in design["target"]])
                .to_string(index=False, float_format=lambda v: f"{v:.3f}"))
     degenerate = result.degenerate_text()

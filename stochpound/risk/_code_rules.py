@@ -32,7 +32,7 @@ from collections.abc import Sequence
 import numpy as np
 import xarray as xr
 
-from stochpound.stats import bootstrap_method, bootstrap_weights, interval, jackknife_weights, record_clusters
+from stochpound.stats import bootstrap_method, bootstrap_weights, interval, jackknife_weights, record_clusters, resampling_obstacle
 from stochpound.risk._fragility import STATUS, stripe_mle
 from stochpound.risk._fragility_ensemble import BOOTSTRAP
 from stochpound.hazard import HazardCurve, probability_from_rate, rate_from_probability, return_period
@@ -82,7 +82,9 @@ def code_rules_risk(demands: xr.Dataset, hz: HazardCurve, design_levels: Sequenc
         per contact), the fragility's ``theta``, ``beta``, ``status``, and
         ``maf`` (1/yr), ``probability`` in ``years`` and ``return_period``
         (yr); with a bootstrap, ``maf_lower``/``maf_upper`` and
-        ``gap_lower``/``gap_upper``. ``.to_dataframe()`` gives a table.
+        ``gap_lower``/``gap_upper`` (none where the motions cannot be
+        resampled, e.g. all from one earthquake: the attribute
+        ``no_interval`` says why). ``.to_dataframe()`` gives a table.
     """
     for name in ("peak_displacement_left", "peak_displacement_right", "correlation", "peak_closure"):
         if name not in demands:
@@ -100,6 +102,8 @@ def code_rules_risk(demands: xr.Dataset, hz: HazardCurve, design_levels: Sequenc
     levels = np.asarray(demands[intensity_dim].values, dtype=float)
     chain = _RuleChain(demands, hz, isolator_displacement, cqc, reduction, intensity_dim, record_dim, contact_dim)
     motions_all = xr.DataArray(np.ones((1, motions)), dims=("sample", record_dim))
+    clusters = record_clusters(demands, record_dim)
+    obstacle = resampling_obstacle(motions, clusters) if bootstrap else ""
     per_level = []
     for probability in np.atleast_1d(np.asarray(design_levels, dtype=float)):
         code_intensity = float(hz.intensity_at(rate_from_probability(probability, years)))
@@ -110,8 +114,7 @@ def code_rules_risk(demands: xr.Dataset, hz: HazardCurve, design_levels: Sequenc
                 units="1", long_name=f"probability of pounding in {years:g} years (Poisson)"),
             return_period=xr.apply_ufunc(return_period, estimate["maf"]).assign_attrs(units="yr", long_name="mean return period of pounding"),
         )
-        if bootstrap:
-            clusters = record_clusters(demands, record_dim)
+        if bootstrap and not obstacle:
             sampled = chain(stripe, xr.DataArray(bootstrap_weights(motions, bootstrap, seed, clusters), dims=("sample", record_dim)))
             left_out = chain(stripe, xr.DataArray(jackknife_weights(motions, clusters), dims=("sample", record_dim))).rename(sample="jackknife")
             attrs = {"confidence": confidence, "method": f"{bootstrap_method(clusters, ran.transpose(intensity_dim, record_dim).values)} (rule gap and fragility refitted)", "seed": seed}
@@ -127,7 +130,7 @@ def code_rules_risk(demands: xr.Dataset, hz: HazardCurve, design_levels: Sequenc
                                                 {"units": "1", "long_name": f"probability of exceedance in {years:g} years of the code intensity"}))
     result["code_intensity"].attrs.update(long_name="intensity with the design level's rate on the hazard curve")
     result["stripe_intensity"].attrs.update(long_name="level of the stripe the rules are applied at (nearest in ln IM)")
-    return result.assign_attrs(years=years, hazard=repr(hz))
+    return result.assign_attrs(years=years, hazard=repr(hz), **({"no_interval": obstacle} if obstacle else {}))
 
 
 class _RuleChain:

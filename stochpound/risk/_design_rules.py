@@ -44,7 +44,7 @@ from stochpound.codes import EC8_REDUCTION
 from stochpound.risk._code_gaps import (Asce7Design, Ec8Design, asce7_inelastic_displacement, asce7_isolator_displacement,
                                         ec8_design_displacement, modal_floor_displacements, srss_separation)
 from stochpound.risk._fragility_ensemble import BOOTSTRAP, stripe_fragility
-from stochpound.risk._maf import rate_intervals, risk_curve
+from stochpound.risk._maf import no_interval_attrs, rate_intervals, risk_curve
 
 DESIGN_RULE_LEVELS = {"asce7_delta_mt": 0.02, "ec8_ds": 0.10, "asce7_dtm": 0.02}
 """Each design-analysis rule's design level: the probability of exceedance in 50 years its code sets its objective at."""
@@ -111,7 +111,9 @@ def design_rules_risk(store: xr.Dataset, hz: HazardCurve, design: Mapping[str, A
         in ``years``) and the configurations: ``gap`` (m, per contact), the
         fragility's ``theta``, ``beta``, ``status``, ``maf`` (1/yr),
         ``probability``, ``return_period`` (yr) and, with a bootstrap, their
-        bounds. A rule that does not apply to a configuration is NaN there.
+        bounds (or the attribute ``no_interval``, as in
+        :func:`~stochpound.risk.stripe_fragility`). A rule that does not
+        apply to a configuration is NaN there.
     """
     closure = _store.contact_free_demands(store)["peak_closure"]
     if "gap" in closure.coords and "gap" not in closure.dims:
@@ -128,7 +130,7 @@ def design_rules_risk(store: xr.Dataset, hz: HazardCurve, design: Mapping[str, A
         result = rate_intervals(result, years)
     levels = [DESIGN_RULE_LEVELS[rule] for rule in result["rule"].values]
     return result.assign_coords(design_level=("rule", levels, {"units": "1", "long_name": f"the rule's design level in {years:g} years"}))\
-        .assign_attrs(years=years)
+        .assign_attrs(years=years, **no_interval_attrs(fragility))
 
 
 def _configuration_gaps(store: xr.Dataset, closure: xr.DataArray, design: Mapping[str, Any], studied: str | None) -> xr.DataArray:

@@ -29,7 +29,7 @@ import numpy as np
 import xarray as xr
 from numpy.typing import ArrayLike
 
-from stochpound.stats import bootstrap_method, bootstrap_weights, interval, jackknife_weights, kernels, record_clusters
+from stochpound.stats import bootstrap_method, bootstrap_weights, interval, jackknife_weights, kernels, record_clusters, resampling_obstacle
 from stochpound.risk._fragility import DECREASING, STATUS, ida_mle, lognormal_cdf, stripe_mle
 
 BOOTSTRAP = 1000
@@ -99,7 +99,10 @@ def stripe_fragility(events: xr.DataArray, intensity_dim: str = "intensity", rec
         ``beta_jackknife`` (dimension ``jackknife``, one per motion left
         out), for the risk chain; per stripe, the
         empirical points ``exceeded``, ``runs``, ``probability`` and their
-        Clopper–Pearson ``probability_lower``/``probability_upper``.
+        Clopper–Pearson ``probability_lower``/``probability_upper``. Where
+        the motions cannot be resampled (one motion, or every motion from one
+        earthquake) there are no bootstrap variables and the attribute
+        ``no_interval`` says why.
     """
     kernels.check_confidence(confidence)
     _check_dims(events, "events", intensity_dim, record_dim)
@@ -158,7 +161,7 @@ def ida_fragility(capacities: xr.DataArray, record_dim: str = "record", censored
     -------
     xarray.Dataset
         ``theta``, ``beta``, ``status`` and their bootstrap intervals and
-        samples, as in :func:`stripe_fragility` (no per-stripe points).
+        samples (or ``no_interval``), as in :func:`stripe_fragility` (no per-stripe points).
     """
     kernels.check_confidence(confidence)
     _check_dims(capacities, "capacities", record_dim)
@@ -290,7 +293,14 @@ def _with_bootstrap(result: xr.Dataset, refit: Callable[[np.ndarray], tuple[np.n
     A ``refit`` that returns a third array gives, per resample, the flat fit's
     fraction where that resample's fit is ``decreasing`` (NaN elsewhere):
     ``flat_bootstrap``/``flat_jackknife``, which the MAF of the resamples uses.
+
+    Where the motions cannot be resampled (one motion, or one earthquake:
+    ``stochpound.stats.resampling_obstacle``) ``result`` is returned
+    without intervals, its attribute ``no_interval`` saying why.
     """
+    obstacle = resampling_obstacle(motions, clusters)
+    if obstacle:
+        return result.assign_attrs(no_interval=obstacle)
     theta_b, beta_b, *flat_b = refit(bootstrap_weights(motions, resamples, seed, clusters))
     theta_j, beta_j, *flat_j = refit(jackknife_weights(motions, clusters))
     attrs = {"confidence": confidence, "method": bootstrap_method(clusters, ran), "seed": seed}

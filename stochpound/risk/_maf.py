@@ -155,7 +155,8 @@ def risk_curve(fragility: xr.Dataset, hz: HazardCurve, years: float = 50.0, conf
     xarray.Dataset
         ``maf`` (1/yr), ``probability`` (of at least one exceedance in
         ``years``, Poisson), ``return_period`` (yr), and with a bootstrap
-        ``maf_lower``, ``maf_upper`` and ``maf_bootstrap``.
+        ``maf_lower``, ``maf_upper`` and ``maf_bootstrap`` (or the
+        fragility's attribute ``no_interval``: why there is no interval).
     """
     kernels.check_confidence(confidence)
     maf = mean_annual_frequency(fragility, hz)
@@ -166,7 +167,7 @@ def risk_curve(fragility: xr.Dataset, hz: HazardCurve, years: float = 50.0, conf
                 units="1", long_name=f"probability of at least one exceedance in {years:g} years (Poisson)"),
             "return_period": xr.apply_ufunc(return_period, maf).assign_attrs(units="yr", long_name="mean return period"),
         },
-        attrs={"years": years, "hazard": repr(hz), "hazard_source": hz.source},
+        attrs={"years": years, "hazard": repr(hz), "hazard_source": hz.source, **no_interval_attrs(fragility)},
     )
     if "theta_bootstrap" in fragility:
         sampled, left_out = (_resampled_maf(fragility, part, hz) for part in ("bootstrap", "jackknife"))
@@ -305,7 +306,7 @@ def risk_targeted_separation(curve: xr.Dataset, targets: Sequence[float] = TARGE
         dimensions: ``separation`` (m; ``inf`` when even the widest gap of
         the grid is too risky, the grid's first gap when that one already
         meets the target), ``target_rate`` (1/yr) and, with a bootstrap,
-        ``lower`` and ``upper``.
+        ``lower`` and ``upper`` (or the curve's attribute ``no_interval``).
     """
     kernels.check_confidence(confidence)
     if dim not in curve.dims:
@@ -330,7 +331,12 @@ def risk_targeted_separation(curve: xr.Dataset, targets: Sequence[float] = TARGE
     return result.assign_coords(
         target=("target", np.atleast_1d(np.asarray(targets, dtype=float)), {"units": "1", "long_name": f"target probability of pounding in {years:g} years"}),
         target_rate=("target", rates, {"units": "1/yr", "long_name": "target mean annual frequency"}),
-    ).assign_attrs(years=years)
+    ).assign_attrs(years=years, **no_interval_attrs(curve))
+
+
+def no_interval_attrs(data: xr.Dataset) -> dict[str, str]:
+    """``data``'s ``no_interval`` attribute (why its motions gave no interval: :func:`~stochpound.risk.stripe_fragility`), to pass on."""
+    return {"no_interval": data.attrs["no_interval"]} if "no_interval" in data.attrs else {}
 
 
 def demand_hazard_curve(demand: xr.DataArray, levels: Sequence[float] | np.ndarray, hz: HazardCurve, dim: str = "level",

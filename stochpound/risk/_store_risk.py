@@ -183,6 +183,12 @@ class StoreRisk:
     design_note: str = ""
 
     @property
+    def no_interval(self) -> str:
+        """Why g* has no interval though a bootstrap was asked: the motions cannot be resampled (one motion, or every motion
+        from one earthquake: ``stochpound.stats.resampling_obstacle``); "" where it has one, or where none was asked."""
+        return str(self.separation.attrs.get("no_interval", ""))
+
+    @property
     def measure(self) -> str:
         """The intensity measure in words, e.g. ``PSA(2 s, 5 %)`` ("" without a setting)."""
         return _store.measure_text(self.setting) if self.setting else ""
@@ -323,7 +329,7 @@ class StoreRisk:
                 "stochpound risk --design) to add its row.")
 
     def design_frame(self) -> pd.DataFrame:
-        """The gap to design to: per configuration and target, the upper bound of g*'s interval (m; g* itself without a bootstrap).
+        """The gap to design to: per configuration and target, the upper bound of g*'s interval (m; g* itself without one).
 
         g* is the central estimate from a finite suite; its upper bound is
         the gap that meets the target with the intervals' confidence
@@ -339,7 +345,7 @@ class StoreRisk:
         bounded = frame["upper"].notna()
         one_sided = f"{100 * (1 + self.confidence) / 2:g} % one-sided upper bound of g*"
         frame["design"] = frame["upper"].where(bounded, frame["separation"])
-        frame["basis"] = np.where(bounded, one_sided, "g* (no bootstrap: no bound)")
+        frame["basis"] = np.where(bounded, one_sided, "g* (no bound: the interval is not estimable)" if self.no_interval else "g* (no bootstrap: no bound)")
         return frame[[*self.configuration_dims(), "target", "design", "basis"]]
 
     def degenerate_text(self) -> str:

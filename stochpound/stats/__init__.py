@@ -12,7 +12,7 @@ all compute with these; this package imports none of them.
 """
 
 from stochpound.stats import kernels
-from stochpound.stats._bootstrap import bootstrap_method, bootstrap_weights, interval, jackknife_weights, record_clusters
+from stochpound.stats._bootstrap import bootstrap_method, bootstrap_weights, interval, jackknife_weights, record_clusters, resampling_obstacle
 from stochpound.stats._correlation import correlation
 from stochpound.stats._ufunc import reduce
 
@@ -24,5 +24,6 @@ __all__ = [
     "jackknife_weights",
     "record_clusters",
     "bootstrap_method",
+    "resampling_obstacle",
     "interval",
 ]

@@ -59,20 +59,64 @@ def bootstrap_weights(motions: int, resamples: int, seed: int | Sequence[int], c
     """
     if not (isinstance(resamples, (int, np.integer)) and resamples > 0):
         raise ValueError(f"bootstrap: must be a positive number of resamples, got {resamples!r}")
-    if motions < 2:
-        raise ValueError(f"record: the bootstrap needs at least 2 motions, got {motions}")
+    _require_resampling(motions, clusters)
     index, count = _cluster_index(motions, clusters)
     drawn = np.random.default_rng(seed).integers(0, count, size=(resamples, count))
     drawn_counts = np.bincount((drawn + count * np.arange(resamples)[:, None]).ravel(), minlength=resamples * count)
     return drawn_counts.reshape(resamples, count)[:, index].astype(np.float64)
 
 
+def resampling_obstacle(motions: int, clusters: Sequence[object] | None = None) -> str:
+    """Why the motions cannot be resampled, in words; "" when they can (at least 2 motions, and 2 clusters where clustered).
+
+    Record-to-record variability is estimated from the spread between
+    independent draws: with one motion, or with every motion in one cluster
+    (one earthquake, whose motions are drawn together), every resample is
+    the sample itself, so no interval is estimable (a zero-width one would
+    claim a certainty the motions do not give). The risk chain then gives
+    its estimates without intervals and says why (this sentence).
+
+    Parameters
+    ----------
+    motions : int
+        Number of motions.
+    clusters : sequence, optional
+        One label per motion (:func:`motion_clusters`: ``event <name>``,
+        ``station <name>`` or ``motion <i>``); None: every motion its own.
+
+    Returns
+    -------
+    str
+        "" when a bootstrap can run, else the reason, e.g. "all 3 motions
+        come from one earthquake (Northridge 1994), and ...".
+    """
+    if motions < 2:
+        return "only one motion, and a single record has no record-to-record variability to resample" if motions == 1 else "no motion"
+    _, count = _cluster_index(motions, clusters)
+    if count > 1:
+        return ""
+    kind, _, name = str(next(iter(clusters))).partition(" ")  # one cluster: clusters is not None
+    unit, named = {"event": ("earthquake", f" ({name})"), "station": ("station", f" ({name}, earthquake unknown)")}.get(kind, ("cluster", ""))
+    every = "both" if motions == 2 else f"all {motions}"
+    return (f"{every} motions come from one {unit}{named}, and the bootstrap draws the motions of one {unit} together (they are "
+            f"not independent), so a single {unit} leaves nothing to resample from record to record")
+
+
+def _require_resampling(motions: int, clusters: Sequence[object] | None) -> None:
+    """Raise ValueError naming the field where :func:`resampling_obstacle` finds the motions cannot be resampled."""
+    obstacle = resampling_obstacle(motions, clusters)
+    if obstacle:
+        field, fewest = ("record", f"2 motions, got {motions}") if motions < 2 else ("clusters", "2 clusters (events), got 1")
+        raise ValueError(f"{field}: the bootstrap needs at least {fewest}: {obstacle}")
+
+
 def jackknife_weights(motions: int, clusters: Sequence[object] | None = None) -> np.ndarray:
     """Leave-one-out weights, shape (clusters, motions): 0 for the motions of the cluster left out, 1 elsewhere.
 
     Without ``clusters`` every motion is its own cluster (an array
-    (motions, motions), 0 on the diagonal).
+    (motions, motions), 0 on the diagonal). Like :func:`bootstrap_weights`, it needs at least 2 clusters.
     """
+    _require_resampling(motions, clusters)
     index, count = _cluster_index(motions, clusters)
     return (np.arange(count)[:, None] != index[None, :]).astype(np.float64)
 
@@ -159,8 +203,6 @@ def _cluster_index(motions: int, clusters: Sequence[object] | None) -> tuple[np.
         raise ValueError(f"clusters: must hold one label per motion ({motions}), got {len(labels)}")
     numbers: dict[object, int] = {}
     index = np.array([numbers.setdefault(label, len(numbers)) for label in labels], dtype=np.intp)
-    if len(numbers) < 2:
-        raise ValueError(f"clusters: the bootstrap needs at least 2 clusters (events), got {len(numbers)}")
     return index, len(numbers)
 
 

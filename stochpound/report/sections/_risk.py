@@ -75,19 +75,28 @@ def headline_text(name: str, risk: StoreRisk) -> str:
     per = []
     for labels, rows in (frame.groupby(config, sort=False) if config else [((), frame)]):
         labels = labels if isinstance(labels, tuple) else (labels,)
-        values = "; ".join(f"{_gap_text(row.separation)} for {risk.target_text(row.target)} [{_gap_text(row.lower)}, {_gap_text(row.upper)}]"
-                           for row in rows.itertuples())
+        values = "; ".join(f"{_gap_text(row.separation)} for {risk.target_text(row.target)}"
+                           + ("" if risk.no_interval else f" [{_gap_text(row.lower)}, {_gap_text(row.upper)}]") for row in rows.itertuples())
         per.append(f"{labels_text(dict(zip(config, labels))) or 'the scene'}: {values}")
     stripes = f"{risk.stripes} stripes of " if risk.stripes is not None else "IDA capacities in "
     return (
         f"Risk-targeted separation g* (the gap whose mean annual frequency of pounding is that of {targets}, Poisson) of experiment "
-        f"{name}, from {risk.motions} motions{' per stripe' if is_selected(risk.setting) else ''} ({stripes}{risk.measure} in {risk.setting['units']}) at the site of its hazard curve, "
-        f"with {_percent(risk.confidence)} intervals ({_resampling(risk)}): " + ". ".join(per) + "."
+        f"{name}, from {_motions_text(risk)}{' per stripe' if is_selected(risk.setting) else ''} ({stripes}{risk.measure} in {risk.setting['units']}) at the site of its hazard curve, "
+        + (f"without intervals (not estimable: {risk.no_interval}): " if risk.no_interval else
+           f"with {_percent(risk.confidence)} intervals ({_resampling(risk)}): ") + ". ".join(per) + "."
     )
 
 
 def _gap_text(value: float) -> str:
     return "wider than every gap of the grid" if math.isinf(value) else f"{value:.3f} m"
+
+
+def _with_interval(risk: StoreRisk, what: str, shown: str = "") -> str:
+    """``with its 95 % bootstrap <what><shown>``, or ``without a <what> (not estimable: <why>)`` where the motions cannot be
+    resampled (:attr:`~stochpound.risk.StoreRisk.no_interval`)."""
+    if risk.no_interval:
+        return f"without {'an' if what[0] in 'aeiou' else 'a'} {what} (not estimable: {risk.no_interval})"
+    return f"with its {_percent(risk.confidence)} bootstrap {what}{shown}"
 
 
 def _resampling(risk: StoreRisk) -> str:
@@ -131,8 +140,9 @@ def risk_section(name: str, risk: StoreRisk, demands: StoreDemands | None = None
 
 def _separation_table(name: str, risk: StoreRisk) -> Table:
     """The g* table, its caption saying how the intervals resampled the motions."""
-    return Table(f"risk-separation-{name}", f"Experiment {name}: risk-targeted separation g* per configuration and target, with its "
-                 f"{_percent(risk.confidence)} interval ({_resampling(risk)})", risk.separation_frame(),
+    interval = _with_interval(risk, "interval") if risk.no_interval else f"with its {_percent(risk.confidence)} interval ({_resampling(risk)})"
+    return Table(f"risk-separation-{name}", f"Experiment {name}: risk-targeted separation g* per configuration and target, {interval}",
+                 risk.separation_frame(),
                  note=_grid_note(risk), formats={"g* (m)": "{:.3f}", "lower (m)": "{:.3f}", "upper (m)": "{:.3f}"})
 
 
@@ -231,8 +241,18 @@ def design_value_text(risk: StoreRisk) -> str:
         labels = labels if isinstance(labels, tuple) else (labels,)
         values = "; ".join(f"{_gap_text(row.design)} for {risk.target_text(row.target)}" for row in rows.itertuples())
         per.append(f"{labels_text(dict(zip(config, labels))) or 'the scene'}: {values}")
+    motions = f"{_motions_text(risk)}{' per stripe' if is_selected(risk.setting) else ''}"
+    if "upper" not in risk.separation:
+        why = "its interval is not estimable" if risk.no_interval else "no bootstrap was run"
+        return (f"There is no upper bound of g* to design to ({why}): the values are g* itself, a central estimate "
+                f"from {motions} that meets its target only about half the time: " + ". ".join(per) + ".")
     return (f"The gap to design to is the {frame['basis'].iloc[0]}, not g* itself (g* is a central estimate from "
-            f"{risk.motions} motions{' per stripe' if is_selected(risk.setting) else ''} and meets its target only about half the time): " + ". ".join(per) + ".")
+            f"{motions} and meets its target only about half the time): " + ". ".join(per) + ".")
+
+
+def _motions_text(risk: StoreRisk) -> str:
+    """``N motions``, or ``1 motion``."""
+    return f"{risk.motions} motion{'s' if risk.motions != 1 else ''}"
 
 
 def moat_text(risk: StoreRisk, demands: StoreDemands | None) -> str:
@@ -420,7 +440,7 @@ def _risk_curve_figure(name: str, risk: StoreRisk) -> FigureItem:
     ax.grid(True, which="both", lw=0.3, color="0.85")
     ax.legend(fontsize=6)
     return FigureItem(f"risk-curve-{name}", f"Experiment {name}: the pounding risk curve λ_P(g) per configuration (made non-increasing "
-                      f"along g) with its {_percent(risk.confidence)} bootstrap band (shaded), the targets (black) and g* (dotted verticals).",
+                      f"along g) {_with_interval(risk, 'band', ' (shaded)')}, the targets (black) and g* (dotted verticals).",
                       figure)
 
 
@@ -477,8 +497,8 @@ def _curves_figure(name: str, risk: StoreRisk) -> FigureItem:
     for ax in axes[len(cells):]:
         ax.set_visible(False)
     points = " with the stripes' empirical points and their Clopper–Pearson intervals" if "probability" in fragility else ""
-    return FigureItem(f"risk-fragility-{name}", f"Experiment {name}: fitted pounding fragility at {len(shown)} gaps with its "
-                      f"{_percent(risk.confidence)} bootstrap band (shaded){points}, one panel per configuration.", figure)
+    return FigureItem(f"risk-fragility-{name}", f"Experiment {name}: fitted pounding fragility at {len(shown)} gaps "
+                      f"{_with_interval(risk, 'band', ' (shaded)')}{points}, one panel per configuration.", figure)
 
 
 _RATE_FORMATS = {"once in (yr)": "{:.3g}", "once in, lower (yr)": "{:.3g}", "once in, upper (yr)": "{:.3g}", "P lower": "{:.3f}",
@@ -517,8 +537,8 @@ def _rules_blocks(name: str, risk: StoreRisk) -> list[Block]:
     if degenerate:
         text += " Rule rows whose fit is not a lognormal (their 'fit' column): " + degenerate.removeprefix("Degenerate fits, not lognormals: ")
     table = Table(f"risk-rules-{name}", f"Experiment {name}: the code separation rules in risk terms: the gap at each contact, the "
-                  f"mean annual frequency λ_P of pounding at it, the return period and the probability in {years:g} years, each with its "
-                  f"{_percent(risk.confidence)} bootstrap interval, and the fragility's kind (a lognormal, a degenerate step, or flat where the "
+                  f"mean annual frequency λ_P of pounding at it, the return period and the probability in {years:g} years, each "
+                  f"{_with_interval(risk, 'interval')}, and the fragility's kind (a lognormal, a degenerate step, or flat where the "
                   "counts do not rise with intensity)", frame,
                   formats={**_RATE_FORMATS, "λ_P (1/yr)": "{:.3g}", "λ_P lower": "{:.3g}", "λ_P upper": "{:.3g}", f"P in {years:g} yr": "{:.3f}",
                            **{c: "{:.3f}" for c in frame.columns if str(c).startswith("gap")}})
@@ -555,8 +575,8 @@ def _demand_blocks(name: str, risk: StoreRisk, demands: StoreDemands | None) -> 
     if demands.moat is not None:
         blocks.append(Table(f"risk-moat-{name}", f"Experiment {name}: moat-wall contact as a limit state: the mean annual frequency with "
                             "which the studied building's base reaches the moat wall's clearance (peak base displacement ≥ clearance; "
-                            "before the first wall impact a run with the wall equals the run without), with its "
-                            f"{_percent(risk.confidence)} bootstrap interval (of the return period and the probability too)", demands.moat_frame(),
+                            "before the first wall impact a run with the wall equals the run without), "
+                            f"{_with_interval(risk, 'interval', ' (of the return period and the probability too)')}", demands.moat_frame(),
                             formats={**_RATE_FORMATS, "λ (1/yr)": "{:.3g}", "λ lower": "{:.3g}", "λ upper": "{:.3g}",
                                      f"P in {demands.years:g} yr": "{:.3f}"}))
     return blocks
