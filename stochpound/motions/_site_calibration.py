@@ -37,10 +37,10 @@ import numpy as np
 from scipy import optimize, stats
 
 from stochpound.motions._arias import DEFAULT_G
-from stochpound.motions._conditional import MODEL_DAMPING, PGA_PERIOD, _average_model, _node_correlation
+from stochpound.motions._conditional import MODEL_DAMPING, _average_model, _node_correlation
 from stochpound.motions._seeding import realization_rng
 from stochpound.motions._site_model import (
-    FEATURES, PARAMETERS, SiteModel, load_site_model, mean_normals, motion_parameters, motions_from_parameters, scenario_features,
+    FEATURES, PARAMETERS, SiteModel, load_site_model, mean_normals, motion_parameters, motions_from_parameters,
 )  # fmt: skip
 from stochpound.motions._spectrum import _spectrum_kernel
 
@@ -232,12 +232,21 @@ def start_vector() -> np.ndarray:
     return np.concatenate([np.zeros(count), [0.0, math.log(0.2), 0.0, math.log(0.3)]])
 
 
-def fit_calibration(n: int = 1000, seed: int = 7, dt: float = 0.01, scenarios: Sequence[tuple] = SCENARIOS) -> dict:
-    """Fit the calibration (module docstring) on pools of ``n`` motions per scenario; the coefficients and diagnostics."""
-    pools = [_pool(scenario, n, seed, dt) for scenario in scenarios]
+def calibration_pools(n: int = 1000, seed: int = 7, dt: float = 0.01, scenarios: Sequence[tuple] = SCENARIOS) -> list[_Pool]:
+    """The pools of ``n`` motions per scenario the calibration reweights (module docstring)."""
+    return [_pool(scenario, n, seed, dt) for scenario in scenarios]
+
+
+def fit_pools(pools: Sequence[_Pool]) -> dict:
+    """Fit the calibration (module docstring) on ``pools``; the coefficients and diagnostics."""
     result = optimize.least_squares(_residuals, start_vector(), args=(pools,), method="trf", x_scale=1.0, diff_step=1e-4)
     adjustments, scale, corner = _unpack(result.x)
     sizes = [_pool_statistics(pool, result.x)[3] for pool in pools]
-    return {"adjustments": {name: adjustments[PARAMETERS.index(name)].tolist() for name in ADJUSTED},
+    return {"adjustments": {name: adjustments[PARAMETERS.index(name), :count].tolist() for name, count in ADJUSTED.items()},
             "residual_scale": {"arias_intensity": scale}, "corner": {"ln_hz": corner[:2].tolist(), "sigma_ln": float(corner[2])},
-            "cost": float(result.cost), "effective_sizes": sizes, "n": n, "seed": seed, "scenarios": [list(s) for s in scenarios]}
+            "cost": float(result.cost), "effective_sizes": sizes, "n": pools[0].nu.shape[0], "scenarios": [list(p.scenario) for p in pools]}
+
+
+def fit_calibration(n: int = 1000, seed: int = 7, dt: float = 0.01, scenarios: Sequence[tuple] = SCENARIOS) -> dict:
+    """Fit the calibration on fresh pools (:func:`calibration_pools`, :func:`fit_pools`)."""
+    return {**fit_pools(calibration_pools(n, seed, dt, scenarios)), "seed": seed}

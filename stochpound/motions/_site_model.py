@@ -110,7 +110,7 @@ def load_site_model(model: str) -> SiteModel:
     if model == "hazard_compatible":
         calibration = _read(CALIBRATION_FILE)
         for parameter, values in calibration["adjustments"].items():
-            adjustments[PARAMETERS.index(parameter)] = values
+            adjustments[PARAMETERS.index(parameter), : len(values)] = values
         for parameter, factor in calibration["residual_scale"].items():
             scale[PARAMETERS.index(parameter)] *= factor
         corner = np.array(calibration["corner"]["ln_hz"] + [calibration["corner"]["sigma_ln"]], dtype=float)
