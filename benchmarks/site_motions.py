@@ -117,11 +117,12 @@ def write_calibration(fit: dict[str, Any], elapsed: float) -> Path:
         "",
         'name = "nga_west2_calibration_1"',
         "",
-        "[adjustments]  # added to nu (standard normal space): d . [1, M - 7, ln(R/25), ln(Vs30/750), reverse, normal][:len(d)]",
+        "[adjustments]  # added to nu (standard normal space): d . [1, M - 7, ln(R/25), ln(Vs30/750), reverse, normal, (M - 7)^2, (M - 7) ln(R/25)][:len(d)]",
     ]
     lines += [f"{name} = [{', '.join(f'{v:.6g}' for v in values)}]" for name, values in fit["adjustments"].items()]
-    lines += ["", "[residual_scale]  # multiplies the published total residual standard deviation",
-              f"arias_intensity = {fit['residual_scale']['arias_intensity']:.6g}", "",
+    lines += ["", "[residual_scale]  # multiplies the published total residual standard deviation"]
+    lines += [f"{name} = {value:.6g}" for name, value in fit["residual_scale"].items()]
+    lines += ["",
               "[corner]  # ln f_c (Hz) = ln_hz[0] + ln_hz[1] (M - 7) + sigma_ln z",
               f"ln_hz = [{fit['corner']['ln_hz'][0]:.6g}, {fit['corner']['ln_hz'][1]:.6g}]", f"sigma_ln = {fit['corner']['sigma_ln']:.6g}", ""]
     CALIBRATION.write_text("\n".join(lines))

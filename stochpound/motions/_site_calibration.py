@@ -10,9 +10,9 @@ Baker & Jayaram (2008).
 
 The calibration (:func:`fit_calibration`) adds to the published equations, in
 the standard normal space, ν_i += d_i · x(scenario) for the Arias intensity
-(x: 1, M − 7, ln(R/25), ln(Vs30/750), reverse, normal), the filter frequency
+(x: 1, M − 7, ln(R/25), ln(Vs30/750), reverse, normal, (M − 7)², (M − 7) ln(R/25)), the filter frequency
 f_mid (1, M − 7, ln(R/25), ln(Vs30/750)) and the damping ζ_f (1); scales
-the Arias intensity's residual; and makes the corner f_c lognormal about
+the residuals of the Arias intensity and of f_mid; and makes the corner f_c lognormal about
 c0 + c1 (M − 7). Those coefficients minimise, over a grid of scenarios and
 the periods, the squared misfit of the simulated mean and σ of ln Sa to the
 models' and of the ε correlations at the checked pairs to Baker & Jayaram's,
@@ -60,6 +60,8 @@ SCENARIOS: tuple[tuple[float, float, float, str], ...] = (
 ADJUSTED = {"arias_intensity": len(FEATURES), "f_mid": 4, "zeta_f": 1}
 #: Weight of the ε correlations' misfit beside the ln Sa moments'.
 CORRELATION_WEIGHT = 1.0
+#: Parameters whose residual's standard deviation the calibration scales.
+SCALED = ("arias_intensity", "f_mid")
 #: Ridge weight of the adjustments (per coefficient, in the misfit's units of ln Sa²).
 RIDGE = 0.02
 #: The proposal's widening of the published residuals, and its corner's ln-distribution (ln Hz).
@@ -176,25 +178,27 @@ def _pool(scenario: tuple, n: int, seed: int, dt: float) -> _Pool:
     return _Pool(scenario, nu, ln_corner, log_proposal, rng.standard_normal(n), ln_spectra(acceleration, dt), mean, sigma)
 
 
-def _unpack(x: np.ndarray) -> tuple[np.ndarray, float, np.ndarray]:
-    """Adjustments [6, FEATURES], the Arias residual's scale and the corner (c0, c1, σ) from the fitted vector."""
+def _unpack(x: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Adjustments [6, FEATURES], the residual scales of SCALED and the corner (c0, c1, σ) from the fitted vector."""
     adjustments = np.zeros((len(PARAMETERS), len(FEATURES)))
     at = 0
     for name, count in ADJUSTED.items():
         adjustments[PARAMETERS.index(name), :count] = x[at:at + count]
         at += count
-    return adjustments, float(np.exp(x[at])), np.array([x[at + 1], x[at + 2], np.exp(x[at + 3])])
+    scales = np.exp(x[at:at + len(SCALED)])
+    at += len(SCALED)
+    return adjustments, scales, np.array([x[at], x[at + 1], np.exp(x[at + 2])])
 
 
 def _pool_statistics(pool: _Pool, x: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
     """Weighted mean and σ of ln Sa of a pool under the candidate ``x``, the correlations at CORRELATION_PAIRS, the effective sample size."""
     published = load_site_model("rezaeian_2010")
-    adjustments, scale, corner = _unpack(x)
+    adjustments, scales, corner = _unpack(x)
     model = SiteModel("candidate", published.coefficients, published.cholesky, published.marginals, adjustments, corner, "")
     mu = mean_normals(model, *pool.scenario)
-    covariance = published.cholesky @ published.cholesky.T
-    covariance[0, :] *= scale
-    covariance[:, 0] *= scale
+    factor = np.ones(len(PARAMETERS))
+    factor[[PARAMETERS.index(name) for name in SCALED]] = scales
+    covariance = published.cholesky @ published.cholesky.T * np.outer(factor, factor)
     rest = covariance[1:, 1:]
     log_target = stats.multivariate_normal(mu[1:], rest).logpdf(pool.nu)
     log_target += stats.norm(corner[0] + corner[1] * (pool.scenario[0] - 7.0), corner[2]).logpdf(pool.ln_corner)
@@ -221,15 +225,14 @@ def _residuals(x: np.ndarray, pools: Sequence[_Pool]) -> np.ndarray:
     for pool in pools:
         mean, sigma, correlation, _ = _pool_statistics(pool, x)
         parts.extend([mean - pool.mean, sigma - pool.sigma, CORRELATION_WEIGHT * (correlation - bj)])
-    adjustments, _, _ = _unpack(x)
-    parts.append(math.sqrt(RIDGE) * adjustments[adjustments != 0.0])
+    parts.append(math.sqrt(RIDGE) * x[: sum(ADJUSTED.values())])
     return np.concatenate(parts)
 
 
 def start_vector() -> np.ndarray:
-    """The published model in the fitted vector's terms: no adjustment, scale 1, f_c = 0.2 Hz with a small spread."""
+    """The published model in the fitted vector's terms: no adjustment, scales 1, f_c = 0.2 Hz with a small spread."""
     count = sum(ADJUSTED.values())
-    return np.concatenate([np.zeros(count), [0.0, math.log(0.2), 0.0, math.log(0.3)]])
+    return np.concatenate([np.zeros(count), np.zeros(len(SCALED)), [math.log(0.2), 0.0, math.log(0.3)]])
 
 
 def calibration_pools(n: int = 1000, seed: int = 7, dt: float = 0.01, scenarios: Sequence[tuple] = SCENARIOS) -> list[_Pool]:
@@ -240,10 +243,10 @@ def calibration_pools(n: int = 1000, seed: int = 7, dt: float = 0.01, scenarios:
 def fit_pools(pools: Sequence[_Pool]) -> dict:
     """Fit the calibration (module docstring) on ``pools``; the coefficients and diagnostics."""
     result = optimize.least_squares(_residuals, start_vector(), args=(pools,), method="trf", x_scale=1.0, diff_step=1e-4)
-    adjustments, scale, corner = _unpack(result.x)
+    adjustments, scales, corner = _unpack(result.x)
     sizes = [_pool_statistics(pool, result.x)[3] for pool in pools]
     return {"adjustments": {name: adjustments[PARAMETERS.index(name), :count].tolist() for name, count in ADJUSTED.items()},
-            "residual_scale": {"arias_intensity": scale}, "corner": {"ln_hz": corner[:2].tolist(), "sigma_ln": float(corner[2])},
+            "residual_scale": dict(zip(SCALED, scales.tolist())), "corner": {"ln_hz": corner[:2].tolist(), "sigma_ln": float(corner[2])},
             "cost": float(result.cost), "effective_sizes": sizes, "n": pools[0].nu.shape[0], "scenarios": [list(p.scenario) for p in pools]}
 
 

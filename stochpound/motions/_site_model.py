@@ -65,8 +65,8 @@ F_MIN = 0.1
 ZETA_MAX = 0.95
 #: The impulse response is followed until its envelope falls below this fraction of its start.
 IRF_TOLERANCE = 1e-4
-#: Features of the calibration's adjustments: 1, M − 7, ln(R/25), ln(Vs30/750), reverse, normal.
-FEATURES = ("intercept", "magnitude", "ln_distance", "ln_vs30", "reverse", "normal")
+#: Features of the calibration's adjustments: 1, M − 7, ln(R/25), ln(Vs30/750), reverse, normal, (M − 7)², (M − 7) ln(R/25).
+FEATURES = ("intercept", "magnitude", "ln_distance", "ln_vs30", "reverse", "normal", "magnitude_squared", "magnitude_ln_distance")
 
 
 @dataclass(frozen=True)
@@ -124,8 +124,8 @@ def load_site_model(model: str) -> SiteModel:
 
 def scenario_features(magnitude: float, distance_km: float, vs30: float, mechanism: str) -> np.ndarray:
     """The calibration's features (:data:`FEATURES`) of a scenario."""
-    return np.array([1.0, magnitude - 7.0, math.log(distance_km / 25.0), math.log(vs30 / 750.0),
-                     float(mechanism == "reverse"), float(mechanism == "normal")])
+    m, r = magnitude - 7.0, math.log(distance_km / 25.0)
+    return np.array([1.0, m, r, math.log(vs30 / 750.0), float(mechanism == "reverse"), float(mechanism == "normal"), m * m, m * r])
 
 
 def mean_normals(model: SiteModel, magnitude: float, distance_km: float, vs30: float, mechanism: str) -> np.ndarray:
