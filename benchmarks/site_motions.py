@@ -87,7 +87,8 @@ def speed_section(data: dict[str, Any], info: dict[str, str]) -> str:
         f"| 1 | {data['one']:.0f} |",
         f"| 2 (wall clock of both) | {data['two']:.0f} (each {', '.join(f'{r:.0f}' for r in data['per_process'])}) |",
         "",
-        f"Target **{verdict}**. The cost is the time-varying filter: every sample's impulse response is followed "
+        f"Target **{verdict}** at this load (with the machine's 2 cores saturated by other work, two processes cannot run side by side; "
+        "the figures are lower bounds). The cost is the time-varying filter: every sample's impulse response is followed "
         "until its envelope has decayed to 10⁻⁴ (a few hundred samples at the median filter frequency and damping, "
         "thousands for the low-frequency, lightly damped draws).",
         SPEED.end,

@@ -162,6 +162,7 @@ def test_normals_of_the_wrong_shape_are_refused():
         site_motions_from_normals(np.zeros((2, 8)), **SCENARIO)
 
 
+@pytest.mark.slow  # 400 motions and their spectra: about 12 s on the loaded 2-core machine
 def test_reduced_calibration_check_against_nga_west2():
     """Two scenarios, 200 motions each: the medians and σ of ln Sa within the full check's targets (0.2, 0.1) widened by
     three standard errors of the sample's mean (σ/√n ≈ 0.05) and standard deviation (σ/√(2n) ≈ 0.035); the published

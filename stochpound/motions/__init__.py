@@ -60,7 +60,7 @@ from stochpound.motions._synthetic import PSD_CONVENTION, clough_penzien, kanai_
 from stochpound.motions._arias import DEFAULT_G, arias_intensity  # noqa: F401
 from stochpound.motions._conditional import CONDITIONING_MEASURES, MODEL_DAMPING, PERIOD_RANGE, check_scenario  # noqa: F401
 from stochpound.motions._measures import measure_label  # noqa: F401
-from stochpound.motions._site_calibration import CheckTable, calibration_pools, calibration_table, fit_calibration, fit_pools  # noqa: F401
+from stochpound.motions._site_calibration import calibration_table, fit_calibration  # noqa: F401
 
 __all__ = [
     "ENVELOPES",

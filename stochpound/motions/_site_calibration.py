@@ -40,7 +40,7 @@ from stochpound.motions._arias import DEFAULT_G
 from stochpound.motions._conditional import MODEL_DAMPING, _average_model, _node_correlation
 from stochpound.motions._seeding import realization_rng
 from stochpound.motions._site_model import (
-    FEATURES, PARAMETERS, SiteModel, load_site_model, mean_normals, motion_parameters, motions_from_parameters,
+    FEATURES, PARAMETERS, ZETA_MAX, SiteModel, _marginal_ppf, load_site_model, mean_normals, motion_parameters, motions_from_parameters,
 )  # fmt: skip
 from stochpound.motions._spectrum import _spectrum_kernel
 
@@ -166,8 +166,6 @@ def _pool(scenario: tuple, n: int, seed: int, dt: float) -> _Pool:
     log_proposal = stats.multivariate_normal(centre, covariance).logpdf(nu) + stats.norm(*PROPOSAL_CORNER).logpdf(ln_corner)
     p = np.clip(stats.norm.cdf(nu), 1e-12, 1.0 - 1e-12)
     parameters = {"arias_intensity": np.ones(n)}
-    from stochpound.motions._site_model import ZETA_MAX, _marginal_ppf
-
     for i, name in enumerate(PARAMETERS[1:]):
         parameters[name] = _marginal_ppf(published.marginals[i + 1], p[:, i])
     parameters["zeta_f"] = np.minimum(parameters["zeta_f"], ZETA_MAX)

@@ -16,6 +16,7 @@ import math
 
 import numpy as np
 import xarray as xr
+from scipy import special
 
 from stochpound._errors import SiteError
 from stochpound.motions._conditional import check_scenario
@@ -40,8 +41,6 @@ def _check(magnitude: float, distance_km: float, vs30: float, mechanism: str, dt
 
 def _window(parameters: dict[str, np.ndarray]) -> float:
     """The default duration (s): every motion's WINDOW_FRACTION of intensity and the post-filter's tail, rounded up."""
-    from scipy import special
-
     k, rate = gamma_shape(parameters["t_mid"], parameters["d5_95"])
     end = special.gammaincinv(k, WINDOW_FRACTION) / rate + WINDOW_TAIL_PERIODS / parameters["f_corner"]
     return WINDOW_ROUND * math.ceil(float(np.max(end)) / WINDOW_ROUND)
@@ -84,7 +83,7 @@ def site_motions_from_normals(normals: np.ndarray, *, magnitude: float, distance
     Returns
     -------
     xarray.Dataset
-        As :func:`site_motions`.
+        As :func:`~stochpound.motions.site_motions`.
     """
     _check(magnitude, distance_km, vs30, mechanism, dt, model)
     normals = np.asarray(normals, dtype=float)
