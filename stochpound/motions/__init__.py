@@ -21,6 +21,10 @@ of a measure: :func:`scenario_distribution`; records chosen and scaled to it
 hazard curves where no disaggregation is at hand: :func:`fit_scenarios`,
 :func:`fit_levels`, :func:`recomputed_hazard`.
 
+Site-based stochastic motions of a scenario (Rezaeian & Der Kiureghian 2010,
+calibrated to the NGA-West2 models): :func:`site_motions`, and the same map
+from explicit standard normals: :func:`site_motions_from_normals`.
+
 Conventions (PSD two-sided in ω, σ² = ∫ S dω; SI units) are in ``docs/motions.md``.
 """
 
@@ -50,6 +54,7 @@ from stochpound.motions.psd import (
     kanai_tajimi_psd,
     kanai_tajimi_variance,
 )
+from stochpound.motions._site_motions import site_motions, site_motions_from_normals
 from stochpound.motions._selection import TARGET_TOLERANCE, misses_target, select_motions, selection_periods, selection_pool
 from stochpound.motions._seeding import realization_rng, realization_rngs
 from stochpound.motions._spectrum import response_spectrum
@@ -68,6 +73,7 @@ from stochpound.motions._synthetic import (
 from stochpound.motions._arias import DEFAULT_G, arias_intensity  # noqa: F401
 from stochpound.motions._conditional import CONDITIONING_MEASURES, MODEL_DAMPING, PERIOD_RANGE, check_scenario  # noqa: F401
 from stochpound.motions._measures import measure_label  # noqa: F401
+from stochpound.motions._site_calibration import calibration_table, fit_calibration  # noqa: F401
 
 __all__ = [
     "ENVELOPES",
@@ -121,6 +127,8 @@ __all__ = [
     "soil_preset",
     "simulated_peak_factor",
     "spectral_from_phases",
+    "site_motions",
+    "site_motions_from_normals",
     "spectral_samples",
     "stationary_samples",
     "synthetic_ground_motion",

@@ -84,16 +84,18 @@ def scenario_limits() -> dict[str, tuple[float, float]]:
     return limits
 
 
-def check_scenario(magnitude: float, distance_km: float, vs30: float, mechanism: str, names: Mapping[str, str] | None = None) -> None:
+def check_scenario(magnitude: float, distance_km: float, vs30: float, mechanism: str, names: Mapping[str, str] | None = None,
+                   limits: Mapping[str, tuple[float, float]] | None = None, source: str = "the NGA-West2 models' range") -> None:
     """Raise :class:`SiteError` naming the field of a scenario outside the models' range or of an unknown mechanism.
 
-    ``names`` spells a field in the message (default: its own name).
+    ``names`` spells a field in the message (default: its own name); ``limits``
+    (default :func:`scenario_limits`) are the ranges, ``source`` says whose.
     """
     names = names or {}
-    for field, (low, high) in scenario_limits().items():
+    for field, (low, high) in (limits or scenario_limits()).items():
         value = {"magnitude": magnitude, "distance_km": distance_km, "vs30": vs30}[field]
         if not isinstance(value, (int, float)) or isinstance(value, bool) or not low <= value <= high:
-            raise SiteError(f"{names.get(field, field)}: must be within {low:g}-{high:g} (the NGA-West2 models' range), got {value!r}")
+            raise SiteError(f"{names.get(field, field)}: must be within {low:g}-{high:g} ({source}), got {value!r}")
     if mechanism not in MECHANISMS:
         raise SiteError(f"{names.get('mechanism', 'mechanism')}: must be one of {', '.join(MECHANISMS)}, got {mechanism!r}")
 

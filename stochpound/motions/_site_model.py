@@ -1,0 +1,305 @@
+"""The site-based stochastic ground-motion model of Rezaeian & Der Kiureghian (2010): from standard normals to motions.
+
+A motion is a modulated, filtered white noise whose filter frequency varies
+linearly in time, then high-passed:
+
+    x(t) = q(t) · Σ_{τ_i < t} h(t − τ_i; ω_f(τ_i), ζ_f) w_i / σ_f(t),
+    σ_f(t)² = Σ_{τ_i < t} h(t − τ_i; ω_f(τ_i), ζ_f)²,
+    h(s; ω, ζ) = ω/√(1 − ζ²) · exp(−ζ ω s) · sin(ω √(1 − ζ²) s),
+    ω_f(τ) = max(2π [f_mid + f_slope (τ − t_mid)], 2π F_MIN),
+
+w_i independent standard normals at the samples τ_i = i dt, so x has unit
+variance times q(t)². The modulation is gamma-shaped, q(t) = α1 t^(α2−1) e^(−α3 t):
+∫_0^t q² / ∫_0^∞ q² is the distribution function of a gamma variable of shape
+k = 2α2 − 1 and rate λ = 2α3, so the time of 45 % of the Arias intensity is
+t_mid = G_k⁻¹(0.45)/λ and D5–95 = (G_k⁻¹(0.95) − G_k⁻¹(0.05))/λ: k solves
+G_k⁻¹(0.45)/(G_k⁻¹(0.95) − G_k⁻¹(0.05)) = t_mid/D5–95 (that ratio rises with k),
+then λ, and α1² = (2g/π) I_a λ^k/Γ(k) gives the expected Arias intensity I_a.
+The high-pass post-filter is a critically damped oscillator of corner
+frequency f_c, ü + 2ω_c u̇ + ω_c² u = x, the motion its ü = x − 2ω_c u̇ − ω_c² u
+(integrated exactly for x linear between samples); the baseline correction
+of :mod:`stochpound.motions.baseline` then removes the small velocity and
+displacement the filter's tail leaves at the end of the window.
+
+The six parameters (I_a, D5–95, t_mid, f_mid, f_slope, ζ_f) come from
+predictive equations in the standard normal space with correlated residuals
+(data/site_motions/rezaeian_2010.toml), each mapped to its marginal; the
+hazard-compatible calibration (data/site_motions/calibration.toml) adds a
+linear adjustment in the scenario to some of the equations and predicts f_c.
+The corner f_c is lognormal about a line in M (a constant for the published
+model). A motion is a deterministic function of 7 + n_time independent
+standard normals: the first 6 give its parameters (through the residuals'
+covariance), the 7th its corner, the rest are the w_i.
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from dataclasses import dataclass
+from functools import lru_cache
+
+import numpy as np
+from numba import njit
+from scipy import special, stats
+
+from stochpound._data_files import bundled_data_dir
+from stochpound.motions._arias import DEFAULT_G
+from stochpound.motions.baseline import baseline_correct
+
+#: The folder of the model's data (data/site_motions).
+DATA_FOLDER = "site_motions"
+#: The published model's file and the calibration's.
+PUBLISHED_FILE, CALIBRATION_FILE = "rezaeian_2010.toml", "calibration.toml"
+#: The models ``site_motions`` offers: the published equations, and with the hazard-compatible calibration.
+MODELS = ("hazard_compatible", "rezaeian_2010")
+#: The physical parameters of a motion, in the order of its first six normals, then the post-filter's corner.
+PARAMETERS = ("arias_intensity", "d5_95", "t_mid", "f_mid", "f_slope", "zeta_f")
+#: Normals that give a motion's parameters: the six above and the post-filter's corner.
+PARAMETER_NORMALS = 7
+#: Units of the parameters as :func:`motion_parameters` returns them.
+UNITS = {"arias_intensity": "m/s", "d5_95": "s", "t_mid": "s", "f_mid": "Hz", "f_slope": "Hz/s", "zeta_f": "1", "f_corner": "Hz"}
+#: Lowest filter frequency (Hz): ω_f(t) is held there where the linear trend would fall below it.
+F_MIN = 0.1
+#: Highest filter damping ratio (the marginal reaches 1, where h degenerates).
+ZETA_MAX = 0.95
+#: The impulse response is followed until its envelope falls below this fraction of its start.
+IRF_TOLERANCE = 1e-4
+#: Features of the calibration's adjustments: 1, M − 7, ln(R/25), ln(Vs30/750), reverse, normal, (M − 7)², (M − 7) ln(R/25).
+FEATURES = ("intercept", "magnitude", "ln_distance", "ln_vs30", "reverse", "normal", "magnitude_squared", "magnitude_ln_distance")
+
+
+@dataclass(frozen=True)
+class SiteModel:
+    """A model's predictive equations in the standard normal space, its marginals and its post-filter.
+
+    ``coefficients`` [6, 5]: b0, b_m, b_f, b_r, b_v of the published equations;
+    ``cholesky`` [6, 6]: lower factor of the residuals' covariance;
+    ``adjustments`` [6, len(FEATURES)]: added to ν (zero for the published model);
+    ``corner`` [3]: ln f_c = corner[0] + corner[1] (M − 7) + corner[2] z (f_c in Hz, z the motion's
+    seventh normal).
+    """
+
+    name: str
+    coefficients: np.ndarray
+    cholesky: np.ndarray
+    marginals: tuple[dict, ...]
+    adjustments: np.ndarray
+    corner: np.ndarray
+    provenance: str
+
+
+def _read(name: str) -> dict:
+    folder = bundled_data_dir(DATA_FOLDER, PUBLISHED_FILE)
+    if folder is None:  # pragma: no cover - a broken installation
+        raise FileNotFoundError(f"{DATA_FOLDER}/{PUBLISHED_FILE}: the site-motion model's data is missing from this installation")
+    return tomllib.loads((folder / name).read_text())
+
+
+@lru_cache(maxsize=None)
+def load_site_model(model: str) -> SiteModel:
+    """The model ``model`` (one of :data:`MODELS`) from its bundled data."""
+    published = _read(PUBLISHED_FILE)
+    if published["parameters"] != list(PARAMETERS):  # pragma: no cover - the data file's own consistency
+        raise ValueError(f"{PUBLISHED_FILE}: parameters must be {PARAMETERS}")
+    residuals = published["residuals"]
+    scale = np.hypot(residuals["sigma"], residuals["tau"])
+    adjustments = np.zeros((len(PARAMETERS), len(FEATURES)))
+    corner = np.array([math.log(published["post_filter"]["corner_hz"]), 0.0, 0.0])
+    provenance = published["name"]
+    if model == "hazard_compatible":
+        calibration = _read(CALIBRATION_FILE)
+        for parameter, values in calibration["adjustments"].items():
+            adjustments[PARAMETERS.index(parameter), : len(values)] = values
+        for parameter, factor in calibration["residual_scale"].items():
+            scale[PARAMETERS.index(parameter)] *= factor
+        corner = np.array(calibration["corner"]["ln_hz"] + [calibration["corner"]["sigma_ln"]], dtype=float)
+        provenance = f"{published['name']} + {calibration['name']}"
+    elif model != "rezaeian_2010":
+        raise ValueError(f"model: must be one of {', '.join(MODELS)}, got {model!r}")
+    covariance = np.asarray(residuals["correlation"]) * np.outer(scale, scale)
+    return SiteModel(model, np.array([published["coefficients"][p] for p in PARAMETERS]), np.linalg.cholesky(covariance),
+                     tuple(published["marginals"][p] for p in PARAMETERS), adjustments, corner, provenance)
+
+
+def scenario_features(magnitude: float, distance_km: float, vs30: float, mechanism: str) -> np.ndarray:
+    """The calibration's features (:data:`FEATURES`) of a scenario."""
+    m, r = magnitude - 7.0, math.log(distance_km / 25.0)
+    return np.array([1.0, m, r, math.log(vs30 / 750.0), float(mechanism == "reverse"), float(mechanism == "normal"), m * m, m * r])
+
+
+def mean_normals(model: SiteModel, magnitude: float, distance_km: float, vs30: float, mechanism: str) -> np.ndarray:
+    """ν of the scenario before its residuals: the published equations (F = 1 for reverse faulting) plus the adjustments."""
+    f = float(mechanism == "reverse")
+    b = model.coefficients
+    first = b[0] @ [1.0, magnitude / 7.0, f, math.log(distance_km / 25.0), math.log(vs30 / 750.0)]
+    others = b[1:] @ [1.0, magnitude, f, distance_km, vs30]
+    return np.concatenate([[first], others]) + model.adjustments @ scenario_features(magnitude, distance_km, vs30, mechanism)
+
+
+def _two_sided_exponential_ppf(p: np.ndarray, a: float, b: float, c: float, low: float, high: float) -> np.ndarray:
+    """Inverse of the distribution c e^(b x) (low ≤ x < 0), c e^(−a x) (0 ≤ x ≤ high)."""
+    at_zero = c / b * (1.0 - math.exp(b * low))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        below = np.log(np.clip(p * b / c + math.exp(b * low), 1e-300, None)) / b
+        above = -np.log(np.clip(1.0 - (p - at_zero) * a / c, 1e-300, None)) / a
+    return np.clip(np.where(p < at_zero, below, above), low, high)
+
+
+def _marginal_ppf(marginal: dict, p: np.ndarray) -> np.ndarray:
+    kind = marginal["kind"]
+    if kind == "lognormal":
+        return np.exp(stats.norm.ppf(p, marginal["mu"], marginal["sigma"]))
+    if kind == "beta":
+        return marginal["low"] + (marginal["high"] - marginal["low"]) * stats.beta.ppf(p, marginal["a"], marginal["b"])
+    if kind == "gamma":
+        return stats.gamma.ppf(p, marginal["shape"], scale=marginal["scale"])
+    if kind == "two_sided_exponential":
+        return _two_sided_exponential_ppf(p, marginal["a"], marginal["b"], marginal["c"], marginal["low"], marginal["high"])
+    raise ValueError(f"marginal kind {kind!r} unknown")  # pragma: no cover - the data file's own consistency
+
+
+def motion_parameters(model: SiteModel, magnitude: float, distance_km: float, vs30: float, mechanism: str,
+                      normals: np.ndarray) -> dict[str, np.ndarray]:
+    """Each motion's parameters (:data:`UNITS`) from its :data:`PARAMETER_NORMALS` standard normals ``normals`` [n, 7]."""
+    normals = np.asarray(normals, dtype=float)
+    nu = mean_normals(model, magnitude, distance_km, vs30, mechanism)[None, :] + normals[:, :6] @ model.cholesky.T
+    p = np.clip(stats.norm.cdf(nu), 1e-12, 1.0 - 1e-12)
+    values = {name: _marginal_ppf(marginal, p[:, i]) for i, (name, marginal) in enumerate(zip(PARAMETERS, model.marginals))}
+    values["arias_intensity"] = values["arias_intensity"] * DEFAULT_G  # s·g → m/s
+    values["zeta_f"] = np.minimum(values["zeta_f"], ZETA_MAX)
+    values["f_corner"] = np.exp(model.corner[0] + model.corner[1] * (magnitude - 7.0) + model.corner[2] * normals[:, 6])
+    return values
+
+
+def gamma_shape(t_mid: np.ndarray, d5_95: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Shape k and rate λ (1/s) of the gamma distribution whose 45 % point is ``t_mid`` and 5–95 % range ``d5_95`` (s)."""
+    ratio = np.asarray(t_mid, dtype=float) / np.asarray(d5_95, dtype=float)
+    low, high = np.full(ratio.shape, math.log(1e-2)), np.full(ratio.shape, math.log(1e4))
+    for _ in range(50):  # bisection in ln k: the ratio rises with k
+        middle = 0.5 * (low + high)
+        k = np.exp(middle)
+        rises = special.gammaincinv(k, 0.45) / (special.gammaincinv(k, 0.95) - special.gammaincinv(k, 0.05)) < ratio
+        low, high = np.where(rises, middle, low), np.where(rises, high, middle)
+    k = np.exp(0.5 * (low + high))
+    return k, special.gammaincinv(k, 0.45) / t_mid
+
+
+def modulation(parameters: dict[str, np.ndarray], times: np.ndarray) -> np.ndarray:
+    """q(t) [n, n_time] (m/s²) of every motion: the gamma-shaped envelope of its I_a, D5–95 and t_mid (module docstring)."""
+    k, rate = gamma_shape(parameters["t_mid"], parameters["d5_95"])
+    ln_alpha1_sq = np.log(2.0 * DEFAULT_G / np.pi * parameters["arias_intensity"]) + k * np.log(rate) - special.gammaln(k)
+    t = times[None, 1:]
+    ln_q = 0.5 * ln_alpha1_sq[:, None] + 0.5 * (k[:, None] - 1.0) * np.log(t) - 0.5 * rate[:, None] * t
+    return np.concatenate([np.zeros((k.size, 1)), np.exp(ln_q)], axis=1)  # q(0) multiplies a zero noise sample
+
+
+@njit(cache=True)
+def _impulse(dt, f_mid, f_slope, t_mid, zeta, i):  # pragma: no cover - compiled
+    """h at lag 1 of impulse i, the recurrence's two coefficients and the lags to follow it (module docstring)."""
+    omega = 2.0 * math.pi * max(f_mid + f_slope * (i * dt - t_mid), F_MIN)
+    root = math.sqrt(1.0 - zeta * zeta)
+    decay = math.exp(-zeta * omega * dt)
+    first = omega / root * decay * math.sin(omega * root * dt)
+    return first, 2.0 * decay * math.cos(omega * root * dt), decay * decay, int(math.log(1.0 / IRF_TOLERANCE) / (zeta * omega * dt)) + 1
+
+
+@njit(cache=True)
+def _normalized_noise(noise, dt, f_mid, f_slope, t_mid, zeta, out):  # pragma: no cover - compiled
+    """out[m] = Σ h w / σ_f of every motion m (module docstring).
+
+    h(s) of an impulse at the samples s = lag·dt follows the recurrence
+    h_{l+1} = 2e^{−ζω dt} cos(ω_d dt) h_l − e^{−2ζω dt} h_{l−1} (h_0 = 0), and is
+    followed until its envelope has fallen below :data:`IRF_TOLERANCE` of its
+    start. Four consecutive impulses are stepped together (independent
+    recurrences, so the processor overlaps them), each as long as the slowest
+    of the four needs.
+    """
+    n_motion, n_time = noise.shape
+    total = np.empty(2 * n_time + 4)  # the tail past n_time takes the overrun of the last impulses
+    energy = np.empty(2 * n_time + 4)
+    for m in range(n_motion):
+        total[:] = 0.0
+        energy[:] = 0.0
+        for start in range(0, n_time - 1, 4):
+            b0, p0, q, l0 = _impulse(dt, f_mid[m], f_slope[m], t_mid[m], zeta[m], start)
+            b1, p1, q1, l1 = _impulse(dt, f_mid[m], f_slope[m], t_mid[m], zeta[m], start + 1)
+            b2, p2, q2, l2 = _impulse(dt, f_mid[m], f_slope[m], t_mid[m], zeta[m], start + 2)
+            b3, p3, q3, l3 = _impulse(dt, f_mid[m], f_slope[m], t_mid[m], zeta[m], start + 3)
+            w0 = noise[m, start]
+            w1 = noise[m, start + 1] if start + 1 < n_time - 1 else 0.0
+            w2 = noise[m, start + 2] if start + 2 < n_time - 1 else 0.0
+            w3 = noise[m, start + 3] if start + 3 < n_time - 1 else 0.0
+            a0 = a1 = a2 = a3 = 0.0
+            length = min(n_time - 1 - start, max(max(l0, l1), max(l2, l3)))
+            for lag in range(1, length + 1):
+                k = start + lag
+                total[k] += b0 * w0
+                energy[k] += b0 * b0
+                total[k + 1] += b1 * w1
+                energy[k + 1] += b1 * b1
+                total[k + 2] += b2 * w2
+                energy[k + 2] += b2 * b2
+                total[k + 3] += b3 * w3
+                energy[k + 3] += b3 * b3
+                a0, b0 = b0, p0 * b0 - q * a0
+                a1, b1 = b1, p1 * b1 - q1 * a1
+                a2, b2 = b2, p2 * b2 - q2 * a2
+                a3, b3 = b3, p3 * b3 - q3 * a3
+        out[m, 0] = 0.0
+        for k in range(1, n_time):
+            out[m, k] = total[k] / math.sqrt(energy[k]) if energy[k] > 0.0 else 0.0
+
+
+@lru_cache(maxsize=64)
+def _hold_matrices(omega_c: float, dt: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Exact step of ü + 2ω_c u̇ + ω_c² u = x for x linear in the step: s⁺ = Φ s + g0 x_k + g1 (x_{k+1} − x_k)/dt."""
+    from scipy.linalg import expm
+
+    augmented = np.zeros((4, 4))
+    augmented[:2, :2] = [[0.0, 1.0], [-omega_c**2, -2.0 * omega_c]]
+    augmented[1, 2] = 1.0
+    augmented[2, 3] = 1.0
+    exponential = expm(augmented * dt)
+    return exponential[:2, :2].copy(), exponential[:2, 2].copy(), exponential[:2, 3].copy() / dt
+
+
+@njit(cache=True)
+def _high_pass_kernel(x, omega_c, phi, g0, g1, out):  # pragma: no cover - compiled
+    """out[k] = ü_k = x_k − 2ω_c u̇_k − ω_c² u_k, the state stepped exactly (:func:`_hold_matrices`)."""
+    u, v = 0.0, 0.0
+    n = x.shape[0]
+    for k in range(n):
+        out[k] = x[k] - 2.0 * omega_c * v - omega_c * omega_c * u
+        if k + 1 < n:
+            slope = x[k + 1] - x[k]
+            u, v = (phi[0, 0] * u + phi[0, 1] * v + g0[0] * x[k] + g1[0] * slope,
+                    phi[1, 0] * u + phi[1, 1] * v + g0[1] * x[k] + g1[1] * slope)
+
+
+def high_pass(acceleration: np.ndarray, dt: float, f_corner: np.ndarray) -> np.ndarray:
+    """The post-filter's output ü [n, n_time] (m/s²) of every motion, its corner ``f_corner`` [n] in Hz."""
+    out = np.empty_like(acceleration)
+    for m, corner in enumerate(f_corner):
+        omega_c = 2.0 * math.pi * float(corner)
+        phi, g0, g1 = _hold_matrices(omega_c, float(dt))
+        _high_pass_kernel(acceleration[m], omega_c, phi, g0, g1, out[m])
+    return out
+
+
+def motions_from_parameters(parameters: dict[str, np.ndarray], noise: np.ndarray, dt: float) -> np.ndarray:
+    """Accelerations [n, n_time] (m/s², from t = 0 at ``dt``) of motions of given parameters and white noise ``noise`` [n, n_time]."""
+    noise = np.ascontiguousarray(noise, dtype=float)
+    times = np.arange(noise.shape[1]) * dt
+    unit = np.empty_like(noise)
+    _normalized_noise(noise, float(dt), parameters["f_mid"], parameters["f_slope"], parameters["t_mid"], parameters["zeta_f"], unit)
+    filtered = high_pass(modulation(parameters, times) * unit, dt, parameters["f_corner"])
+    return baseline_correct(filtered, dt)
+
+
+def motions_from_normals(model: SiteModel, magnitude: float, distance_km: float, vs30: float, mechanism: str,
+                         normals: np.ndarray, dt: float) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+    """Accelerations [n, n_time] (m/s², from t = 0 at ``dt``) and parameters of the motions of ``normals`` [n, 7 + n_time]."""
+    normals = np.asarray(normals, dtype=float)
+    parameters = motion_parameters(model, magnitude, distance_km, vs30, mechanism, normals[:, :PARAMETER_NORMALS])
+    return motions_from_parameters(parameters, normals[:, PARAMETER_NORMALS:], dt), parameters

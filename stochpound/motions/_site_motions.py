@@ -1,0 +1,156 @@
+"""Site-based stochastic ground motions of a scenario (Rezaeian & Der Kiureghian 2010, made hazard-compatible).
+
+:func:`site_motions` draws any number of motions of a scenario (magnitude,
+rupture distance, Vs30, mechanism) from a seed; :func:`site_motions_from_normals`
+is the same map from an explicit array of independent standard normals, one
+row per motion (its first 7 give the motion's parameters, the others the
+white noise at each sample: the model is in ``stochpound.motions._site_model``).
+Motion i of a seed uses the generator of realization i
+(:func:`~stochpound.motions.realization_rng`): its 7 parameter normals, then
+its noise.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import xarray as xr
+from scipy import special
+
+from stochpound._errors import SiteError
+from stochpound.motions._conditional import check_scenario
+from stochpound.motions._seeding import check_seed, realization_rng
+from stochpound.motions._site_model import MODELS, PARAMETER_NORMALS, UNITS, gamma_shape, load_site_model, motion_parameters, motions_from_normals
+
+#: The scenarios the hazard-compatible calibration covers; outside them the model is not offered.
+SITE_MOTION_LIMITS: dict[str, tuple[float, float]] = {"magnitude": (5.5, 8.0), "distance_km": (5.0, 100.0), "vs30": (200.0, 1100.0)}
+#: The default window ends when every motion's modulation has delivered this fraction of its Arias intensity ...
+WINDOW_FRACTION = 0.999
+#: ... plus this many periods of the post-filter's corner (its transient), rounded up to whole WINDOW_ROUND seconds.
+WINDOW_TAIL_PERIODS, WINDOW_ROUND = 2.0, 5.0
+
+
+def _check(magnitude: float, distance_km: float, vs30: float, mechanism: str, dt: float, model: str) -> None:
+    check_scenario(magnitude, distance_km, vs30, mechanism, limits=SITE_MOTION_LIMITS, source="the site-motion model's calibrated range")
+    if isinstance(dt, bool) or not isinstance(dt, (int, float)) or not 0.0 < dt <= 0.02:
+        raise SiteError(f"dt: must be within 0-0.02 s (the model's filter reaches 25 Hz and more), got {dt!r}")
+    if model not in MODELS:
+        raise SiteError(f"model: must be one of {', '.join(MODELS)}, got {model!r}")
+
+
+def _window(parameters: dict[str, np.ndarray]) -> float:
+    """The default duration (s): every motion's WINDOW_FRACTION of intensity and the post-filter's tail, rounded up."""
+    k, rate = gamma_shape(parameters["t_mid"], parameters["d5_95"])
+    end = special.gammaincinv(k, WINDOW_FRACTION) / rate + WINDOW_TAIL_PERIODS / parameters["f_corner"]
+    return WINDOW_ROUND * math.ceil(float(np.max(end)) / WINDOW_ROUND)
+
+
+def _dataset(acceleration: np.ndarray, parameters: dict[str, np.ndarray], dt: float, attrs: dict) -> xr.Dataset:
+    n, n_time = acceleration.shape
+    variables = {"acceleration": (("realization", "time"), acceleration, {"units": "m/s2", "long_name": "ground acceleration"})}
+    for name, values in parameters.items():
+        variables[name] = ("realization", values, {"units": UNITS[name]})
+    coords = {"realization": np.arange(n), "time": ("time", np.arange(n_time) * dt, {"units": "s"})}
+    return xr.Dataset(variables, coords=coords, attrs={**attrs, "dt": float(dt)})
+
+
+def _attrs(magnitude: float, distance_km: float, vs30: float, mechanism: str, model: str) -> dict:
+    return {"magnitude": float(magnitude), "distance_km": float(distance_km), "vs30": float(vs30), "mechanism": mechanism,
+            "model": model, "model_provenance": load_site_model(model).provenance}
+
+
+def site_motions_from_normals(normals: np.ndarray, *, magnitude: float, distance_km: float, vs30: float, mechanism: str,
+                              dt: float = 0.01, model: str = "hazard_compatible") -> xr.Dataset:
+    """Motions of a scenario as a deterministic function of independent standard normals.
+
+    Parameters
+    ----------
+    normals : array_like, shape (n, 7 + n_time)
+        Row i: motion i's normals; the first 6 give its parameters (the
+        predictive equations' residuals, correlated through the model's
+        covariance), the 7th its post-filter's corner, the next n_time the
+        white noise at t = 0, dt, ….
+    magnitude, distance_km, vs30 : float
+        Moment magnitude (5.5–8), rupture distance (5–100 km), Vs30 (200–1100 m/s).
+    mechanism : {"strike_slip", "reverse", "normal"}
+        Faulting mechanism.
+    dt : float
+        Time step, s (≤ 0.02).
+    model : {"hazard_compatible", "rezaeian_2010"}
+        The calibrated equations (default) or the published ones.
+
+    Returns
+    -------
+    xarray.Dataset
+        As :func:`~stochpound.motions.site_motions`.
+    """
+    _check(magnitude, distance_km, vs30, mechanism, dt, model)
+    normals = np.asarray(normals, dtype=float)
+    if normals.ndim != 2 or normals.shape[1] < PARAMETER_NORMALS + 3 or not np.all(np.isfinite(normals)):
+        raise SiteError(f"normals: must be a finite array of shape (n, 7 + n_time) with n_time >= 3, got shape {normals.shape}")
+    acceleration, parameters = motions_from_normals(load_site_model(model), magnitude, distance_km, vs30, mechanism, normals, dt)
+    return _dataset(acceleration, parameters, dt, _attrs(magnitude, distance_km, vs30, mechanism, model))
+
+
+def site_motions(magnitude: float, distance_km: float, vs30: float, mechanism: str, n: int, seed: int, dt: float = 0.01, *,
+                 duration: float | None = None, model: str = "hazard_compatible") -> xr.Dataset:
+    """Stochastic ground motions of a site's scenario (Rezaeian & Der Kiureghian 2010, hazard-compatible; model §11).
+
+    Parameters
+    ----------
+    magnitude : float
+        Moment magnitude, 5.5–8.
+    distance_km : float
+        Rupture distance, 5–100 km.
+    vs30 : float
+        Time-averaged shear-wave velocity of the top 30 m, 200–1100 m/s.
+    mechanism : {"strike_slip", "reverse", "normal"}
+        Faulting mechanism.
+    n : int
+        Number of motions (≥ 1).
+    seed : int
+        Seed (≥ 0): motion i depends on (seed, i) and the window alone.
+    dt : float
+        Time step, s (≤ 0.02).
+    duration : float, optional
+        Length of the window, s; default: long enough for every motion's
+        modulation to deliver 99.9 % of its Arias intensity plus two periods of
+        the post-filter's corner, rounded up to 5 s.
+    model : {"hazard_compatible", "rezaeian_2010"}
+        The calibrated equations (default; docs/motions.md) or the published ones.
+
+    Returns
+    -------
+    xarray.Dataset
+        ``acceleration`` (realization, time; m/s², zero velocity and
+        displacement at the end), and per realization its parameters:
+        ``arias_intensity`` (m/s, the expected value of the modulation),
+        ``d5_95`` and ``t_mid`` (s), ``f_mid`` (Hz), ``f_slope`` (Hz/s),
+        ``zeta_f`` and ``f_corner`` (Hz). Attributes: the scenario, ``model``,
+        ``model_provenance``, ``seed``, ``dt``.
+
+    Raises
+    ------
+    SiteError
+        Naming the field: a scenario outside the calibrated range, an unknown
+        mechanism or model, a bad ``n``, ``dt`` or ``duration``.
+    """
+    _check(magnitude, distance_km, vs30, mechanism, dt, model)
+    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1:
+        raise SiteError(f"n: must be an integer >= 1, got {n!r}")
+    try:
+        seed = check_seed(seed)
+    except ValueError as error:
+        raise SiteError(str(error)) from None
+    rngs = [realization_rng(seed, i) for i in range(int(n))]
+    first = np.array([rng.standard_normal(PARAMETER_NORMALS) for rng in rngs])
+    if duration is None:
+        duration = _window(motion_parameters(load_site_model(model), magnitude, distance_km, vs30, mechanism, first))
+    elif isinstance(duration, bool) or not isinstance(duration, (int, float)) or not 10.0 * dt <= duration <= 600.0:
+        raise SiteError(f"duration: must be within {10 * dt:g}-600 s, got {duration!r}")
+    n_time = int(round(duration / dt)) + 1
+    normals = np.concatenate([first, np.array([rng.standard_normal(n_time) for rng in rngs])], axis=1)
+    dataset = site_motions_from_normals(normals, magnitude=magnitude, distance_km=distance_km, vs30=vs30, mechanism=mechanism, dt=dt, model=model)
+    dataset.attrs["seed"] = seed
+    return dataset

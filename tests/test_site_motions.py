@@ -1,0 +1,174 @@
+"""Site-based stochastic motions (Rezaeian & Der Kiureghian 2010, hazard-compatible): the model's pieces against
+closed forms and direct sums, reproducibility, bad input, and a reduced check against the NGA-West2 models."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from scipy import integrate, special
+
+from stochpound._errors import SiteError
+from stochpound.motions import final_velocity_displacement, realization_rng, site_motions, site_motions_from_normals
+from stochpound.motions._arias import arias_intensity
+from stochpound.motions._site_calibration import calibration_table, target
+from stochpound.motions._site_model import (
+    F_MIN, _hold_matrices, _marginal_ppf, _normalized_noise, gamma_shape, high_pass, load_site_model, modulation, motions_from_parameters,
+)  # fmt: skip
+
+SCENARIO = {"magnitude": 7.0, "distance_km": 20.0, "vs30": 400.0, "mechanism": "strike_slip"}
+
+
+@pytest.mark.parametrize("d5_95, t_mid", [(10.0, 6.0), (25.0, 12.0), (6.0, 1.5), (40.0, 30.0)])
+def test_modulation_has_the_arias_intensity_d5_95_and_t_mid_it_is_given(d5_95, t_mid):
+    """∫q² and the 5/45/95 % times of the gamma modulation, integrated numerically, against its parameters."""
+    parameters = {"arias_intensity": np.array([0.8]), "d5_95": np.array([d5_95]), "t_mid": np.array([t_mid])}
+    k, rate = gamma_shape(parameters["t_mid"], parameters["d5_95"])
+    # the closed form: the gamma distribution's quantiles
+    assert special.gammainc(k[0], rate[0] * t_mid) == pytest.approx(0.45, abs=1e-10)
+    quantiles = special.gammaincinv(k[0], [0.05, 0.95]) / rate[0]
+    assert quantiles[1] - quantiles[0] == pytest.approx(d5_95, rel=1e-9)
+    # the envelope sampled finely: its Arias intensity and the times of 5, 45 and 95 % of it
+    dt = 1e-3
+    times = np.arange(0.0, quantiles[1] * 4 + 20.0, dt)
+    q = modulation(parameters, times)[0]
+    assert arias_intensity(q, dt) == pytest.approx(0.8, rel=2e-3)
+    cumulative = integrate.cumulative_trapezoid(q**2, times, initial=0.0)
+    cumulative /= cumulative[-1]
+    t5, t45, t95 = np.interp([0.05, 0.45, 0.95], cumulative, times)
+    assert t95 - t5 == pytest.approx(d5_95, abs=0.02)
+    assert t45 == pytest.approx(t_mid, abs=0.02)
+
+
+def _direct_noise(noise, dt, f_mid, f_slope, t_mid, zeta):
+    """Σ_{i<k} h(t_k − τ_i; ω(τ_i)) w_i / σ(t_k), summed in full (no recurrence, no truncation)."""
+    n = noise.size
+    t = np.arange(n) * dt
+    omega = 2 * np.pi * np.maximum(f_mid + f_slope * (t - t_mid), F_MIN)
+    root = math.sqrt(1 - zeta**2)
+    lag = t[:, None] - t[None, :]
+    h = np.where(lag > 0, omega[None, :] / root * np.exp(-zeta * omega[None, :] * lag) * np.sin(omega[None, :] * root * lag), 0.0)
+    energy = (h**2).sum(axis=1)
+    out = np.zeros(n)
+    out[1:] = (h @ noise)[1:] / np.sqrt(energy[1:])
+    return out
+
+
+@pytest.mark.parametrize("f_mid, f_slope, zeta", [(5.0, -0.1, 0.3), (2.0, 0.2, 0.05), (8.0, -1.5, 0.6)])
+def test_normalized_noise_equals_the_direct_sum(f_mid, f_slope, zeta):
+    rng = np.random.default_rng(4)
+    noise = rng.standard_normal((1, 700))
+    out = np.empty_like(noise)
+    _normalized_noise(noise, 0.01, np.array([f_mid]), np.array([f_slope]), np.array([3.0]), np.array([zeta]), out)
+    direct = _direct_noise(noise[0], 0.01, f_mid, f_slope, 3.0, zeta)
+    assert np.max(np.abs(out[0] - direct)) < 2e-3 * np.max(np.abs(direct))
+
+
+def test_high_pass_step_is_the_exact_solution_of_the_oscillator():
+    """The critically damped oscillator driven by a linear-in-the-step input, against an ODE solver."""
+    omega_c, dt = 2 * np.pi * 0.2, 0.01
+    x = np.sin(np.linspace(0.0, 7.0, 301)) * np.linspace(1.0, 0.0, 301)
+    times = np.arange(x.size) * dt
+    out = high_pass(x[None, :], dt, np.array([0.2]))[0]
+    solution = integrate.solve_ivp(lambda t, s: [s[1], np.interp(t, times, x) - 2 * omega_c * s[1] - omega_c**2 * s[0]],
+                                   (0.0, times[-1]), [0.0, 0.0], t_eval=times, rtol=1e-11, atol=1e-13, max_step=dt / 4)
+    expected = x - 2 * omega_c * solution.y[1] - omega_c**2 * solution.y[0]
+    assert np.max(np.abs(out - expected)) < 1e-8
+    phi, _, _ = _hold_matrices(omega_c, dt)
+    assert np.all(np.abs(np.linalg.eigvals(phi)) < 1.0)
+
+
+def test_two_sided_exponential_marginal_inverts_its_distribution():
+    marginal = load_site_model("rezaeian_2010").marginals[4]
+    a, b, c, low = marginal["a"], marginal["b"], marginal["c"], marginal["low"]
+    x = _marginal_ppf(marginal, np.array([0.01, 0.3, 0.7, 0.95, 0.999]))
+    cdf = [integrate.quad(lambda s: c * (np.exp(b * s) if s < 0 else np.exp(-a * s)), low, value, points=[0.0] if value > 0 else None)[0] for value in x]
+    assert np.allclose(cdf, [0.01, 0.3, 0.7, 0.95, 0.999], atol=1e-6)
+
+
+def test_motions_end_at_rest_and_keep_their_parameters():
+    motions = site_motions(**SCENARIO, n=4, seed=11, dt=0.01)
+    a = motions.acceleration.values
+    velocity, displacement = final_velocity_displacement(a, 0.01)
+    peak_velocity = np.max(np.abs(np.cumsum(a, axis=1) * 0.01))
+    assert np.all(np.abs(velocity) < 1e-10 * peak_velocity)
+    assert np.all(np.abs(displacement) < 1e-10 * peak_velocity * motions.time.values[-1])
+    assert np.all(a[:, 0] == 0.0)
+    for name, unit in (("arias_intensity", "m/s"), ("d5_95", "s"), ("t_mid", "s"), ("f_mid", "Hz"), ("f_slope", "Hz/s"), ("zeta_f", "1"), ("f_corner", "Hz")):
+        assert motions[name].dims == ("realization",) and motions[name].attrs["units"] == unit
+    assert motions.attrs["seed"] == 11 and motions.attrs["model"] == "hazard_compatible"
+    # the window holds 99.9 % of every motion's modulation
+    assert motions.time.values[-1] >= float(np.max(motions.t_mid + motions.d5_95))
+
+
+def test_same_seed_same_motions_and_motion_i_independent_of_n():
+    first = site_motions(**SCENARIO, n=3, seed=5, dt=0.01, duration=20.0)
+    again = site_motions(**SCENARIO, n=3, seed=5, dt=0.01, duration=20.0)
+    more = site_motions(**SCENARIO, n=5, seed=5, dt=0.01, duration=20.0)
+    other = site_motions(**SCENARIO, n=3, seed=6, dt=0.01, duration=20.0)
+    assert np.array_equal(first.acceleration.values, again.acceleration.values)
+    assert np.array_equal(first.acceleration.values, more.acceleration.values[:3])
+    assert not np.allclose(first.acceleration.values, other.acceleration.values)
+
+
+def test_the_seeded_motions_are_the_map_of_their_normals():
+    n_time = 1001
+    normals = []
+    for i in range(2):
+        rng = realization_rng(9, i)
+        normals.append(np.concatenate([rng.standard_normal(7), rng.standard_normal(n_time)]))
+    from_normals = site_motions_from_normals(np.array(normals), **SCENARIO, dt=0.01)
+    seeded = site_motions(**SCENARIO, n=2, seed=9, dt=0.01, duration=10.0)
+    assert np.array_equal(from_normals.acceleration.values, seeded.acceleration.values)
+    # the published model from the same normals: other parameters, the same noise
+    published = site_motions_from_normals(np.array(normals), **SCENARIO, dt=0.01, model="rezaeian_2010")
+    assert published.attrs["model"] == "rezaeian_2010" and np.all(published.f_corner == 0.2)
+
+
+def test_a_motion_scales_with_the_square_root_of_its_arias_intensity():
+    """Doubling the Arias intensity parameter, all else equal, doubles the motion's ∫a² exactly (the model is linear
+    in the envelope), and the expected ∫a² of the unit-variance noise under q is that parameter."""
+    parameters = {"arias_intensity": np.array([0.5, 1.0]), "d5_95": np.array([12.0, 12.0]), "t_mid": np.array([7.0, 7.0]),
+                  "f_mid": np.array([4.0, 4.0]), "f_slope": np.array([-0.1, -0.1]), "zeta_f": np.array([0.3, 0.3]), "f_corner": np.array([0.2, 0.2])}
+    noise = np.random.default_rng(1).standard_normal((1, 3001)).repeat(2, axis=0)
+    a = motions_from_parameters(parameters, noise, 0.01)
+    assert arias_intensity(a[1], 0.01) / arias_intensity(a[0], 0.01) == pytest.approx(2.0, rel=1e-12)
+    many = motions_from_parameters({k: np.full(100, v[0]) for k, v in parameters.items()}, np.random.default_rng(2).standard_normal((100, 3001)), 0.01)
+    mean_arias = np.mean([arias_intensity(x, 0.01) for x in many])
+    assert mean_arias == pytest.approx(0.5, rel=0.08)  # the high-pass removes a little; 100 draws: about ±3 % (2σ)
+
+
+@pytest.mark.parametrize("field, value, message", [
+    ("magnitude", 8.5, "magnitude: must be within 5.5-8"),
+    ("distance_km", 2.0, "distance_km: must be within 5-100"),
+    ("vs30", 150.0, "vs30: must be within 200-1100"),
+    ("mechanism", "oblique", "mechanism: must be one of strike_slip, reverse, normal"),
+    ("n", 0, "n: must be an integer >= 1"),
+    ("dt", 0.05, "dt: must be within 0-0.02 s"),
+    ("seed", -1, "seed: must be an integer >= 0"),
+    ("model", "boore", "model: must be one of hazard_compatible, rezaeian_2010"),
+    ("duration", 0.01, "duration: must be within"),
+])  # fmt: skip
+def test_bad_input_is_a_one_line_error_naming_the_field(field, value, message):
+    arguments = {**SCENARIO, "n": 2, "seed": 1, "dt": 0.01, field: value}
+    with pytest.raises(SiteError) as error:
+        site_motions(**arguments)
+    assert str(error.value).startswith(message) and "\n" not in str(error.value)
+
+
+def test_normals_of_the_wrong_shape_are_refused():
+    with pytest.raises(SiteError, match=r"^normals: must be a finite array of shape \(n, 7 \+ n_time\)"):
+        site_motions_from_normals(np.zeros((2, 8)), **SCENARIO)
+
+
+@pytest.mark.slow  # 400 motions and their spectra: about 12 s on the loaded 2-core machine
+def test_reduced_calibration_check_against_nga_west2():
+    """Two scenarios, 200 motions each: the medians and σ of ln Sa within the full check's targets (0.2, 0.1) widened by
+    three standard errors of the sample's mean (σ/√n ≈ 0.05) and standard deviation (σ/√(2n) ≈ 0.035); the published
+    model misses the second scenario by more than 1 at 1-3 s (docs/motions.md), so the test can fail."""
+    scenarios = [(6.5, 20.0, 400.0, "strike_slip"), (7.5, 40.0, 300.0, "strike_slip")]
+    table = calibration_table(scenarios=scenarios, n=200, seed=3)
+    sigma = np.array([target(s)[1] for s in scenarios])
+    assert np.all(np.abs(table.ln_median_ratio) <= 0.2 + 3 * sigma / math.sqrt(200))
+    assert np.all(np.abs(table.sigma_difference) <= 0.1 + 3 * sigma / math.sqrt(400))
