@@ -109,7 +109,7 @@ def building_periods(building: Building, g: float) -> dict[str, float]:
 
 
 def scene_periods(scene: Scene) -> dict[str, float]:
-    """Every building's periods of interest (:func:`building_periods`), s, named ``"<building> first mode"``, ``"<building> isolated"``."""
+    """Every building's periods of interest (:func:`~stochpound.model.building_periods`), s, named ``"<building> first mode"``, ``"<building> isolated"``."""
     return {f"{building.name} {kind}": period for building in scene.buildings for kind, period in building_periods(building, scene.g).items()}
 
 

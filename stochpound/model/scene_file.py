@@ -27,7 +27,7 @@ from stochpound.motions.ground import GroundMotion, HarmonicMotion, SampledMotio
 
 _TOP_KEYS = {"g", "study_compat", "building", "contact", "wall", "motion"}
 EARTH_GRAVITY = (9.7, 9.9)
-"""The range of g at the Earth's surface, m/s²: a scene's ``g`` outside it is allowed, with a warning (:func:`scene_warnings`)."""
+"""The range of g at the Earth's surface, m/s²: a scene's ``g`` outside it is allowed, with a warning (:func:`~stochpound.model.scene_warnings`)."""
 _SYNTHETIC_TYPES = {"kanai_tajimi", "clough_penzien"}
 
 
@@ -138,13 +138,13 @@ def scene_from_dict(data: Mapping[str, Any], base_dir: str | Path = ".", source:
 def scene_warnings(scene: Scene, prefix: str = "") -> list[str]:
     """What a valid scene holds that looks like a slip, one line each starting with the field; empty when nothing does.
 
-    A ``g`` outside :data:`EARTH_GRAVITY` (``g = 1``, or g in ft/s²) is
+    A ``g`` outside :data:`~stochpound.model.scene_file.EARTH_GRAVITY` (``g = 1``, or g in ft/s²) is
     allowed (a model may want another gravity), and said here.
 
     Parameters
     ----------
     scene : Scene
-        A scene (from :func:`load_scene` or :func:`scene_from_dict`).
+        A scene (from :func:`~stochpound.load_scene` or :func:`~stochpound.scene_from_dict`).
     prefix : str
         The path of the scene's table, prefixed to the field (``"scene"`` in an experiment file).
 
