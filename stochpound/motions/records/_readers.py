@@ -16,8 +16,7 @@ PEER ``.AT2``
     then the samples, any number per line. Units are read from the header
     in any of the usual spellings (``UNITS OF G``, ``units are (g)``, ``IN GAL``,
     ``(cm/s^2)``, ``CM/S/S``, ``m/s²``; the list is in docs/records.md); g if
-    the header names none. Velocity or displacement series
-    are refused.
+    the header names none. Velocity or displacement series are refused.
 Text
     Blank lines and comment lines (``#``, ``%`` or ``!``) are skipped; values
     are separated by spaces, tabs, commas or semicolons, and every data line
