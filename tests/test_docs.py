@@ -3,6 +3,7 @@
 import re
 import subprocess
 import sys
+import tomllib
 from pathlib import Path
 
 import pytest
@@ -37,3 +38,14 @@ def test_no_project_file_cites_a_document_outside_the_project():
     assert len(checked) > 50
     citing = [str(path.relative_to(ROOT)) for path in checked if outside.search(path.read_text(errors="ignore"))]
     assert citing == []
+
+
+def test_the_readme_names_the_suites_duration_and_the_slow_marker():
+    """Beside the test command: how long the whole suite takes, and the quick run without the `slow` tests."""
+    text = (ROOT / "README.md").read_text()
+    tests = text[text.index("<!-- test-command") : text.index("## What it does")]
+    assert re.search(r"whole suite takes about \d+ minutes on 2 cores", tests)
+    quick = re.search(r'`(python -m pytest[^`]* -m "not slow")`', tests)
+    assert quick and re.search(r"quick run of about \d+ minutes", tests), "the README's quick test command"
+    markers = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["pytest"]["ini_options"]["markers"]
+    assert [marker.split(":")[0] for marker in markers] == ["slow"]

@@ -9,14 +9,16 @@ import pytest
 
 from stochpound._errors import RecordError
 from stochpound.motions.records import load_record, read_at2, read_record_file, read_text, records_dir, registry_entries
+from tests.helpers import invoke
 
 
-def _write_at2(path: Path, values: np.ndarray, dt: float, style: str, per_line: int = 5, units: str = "G") -> Path:
+def _write_at2(path: Path, values: np.ndarray, dt: float, style: str, per_line: int = 5, units: str = "G", units_line: str | None = None) -> Path:
     if style == "west2":
         npts_line = f"NPTS={len(values):7d}, DT={dt:9.4f} SEC,"
     else:
         npts_line = f"{len(values):7d} {dt:10.4f}    NPTS, DT"
-    lines = ["PEER NGA STRONG MOTION DATABASE RECORD", "Test event, test station, 090", f"ACCELERATION TIME SERIES IN UNITS OF {units}", npts_line]
+    third = f"ACCELERATION TIME SERIES IN UNITS OF {units}" if units_line is None else units_line
+    lines = ["PEER NGA STRONG MOTION DATABASE RECORD", "Test event, test station, 090", third, npts_line]
     for start in range(0, len(values), per_line):
         lines.append("".join(f"{float(v)!r:>26s}" for v in values[start : start + per_line]))
     path.write_text("\n".join(lines) + "\n")
@@ -106,6 +108,127 @@ def test_units_and_comment_header(tmp_path):
 def test_at2_units_from_header(tmp_path):
     path = _write_at2(tmp_path / "gal.AT2", np.array([1.0, 2.0]), 0.01, "west2", units="CM/S/S")
     assert read_at2(path).units == "cm/s2"
+
+
+# ---------------------------------------------------------------- units: every spelling, unknown units, implausible peaks
+
+#: m/s² per unit of each canonical name, written out independently of the reader (g taken as 9.81).
+SI = {"g": 9.81, "m/s2": 1.0, "cm/s2": 0.01}
+#: A record of peak 632 cm/s² (0.64 g) in each unit: read as g it would be 632 g.
+PEAK_632_GAL = {units: np.array([0.0, 300.0, -632.0, 150.0]) * 0.01 / factor for units, factor in SI.items()}
+
+AT2_SPELLINGS = [
+    ("ACCELERATION TIME SERIES IN GAL", "cm/s2"),
+    ("ACCELERATION TIME SERIES IN UNITS OF GALS", "cm/s2"),
+    ("ACCELERATION (cm/s^2)", "cm/s2"),
+    ("ACCELERATION IN CM/SEC2", "cm/s2"),
+    ("Acceleration in cm/s²", "cm/s2"),
+    ("acceleration [cm s-2], baseline corrected", "cm/s2"),
+    ("UNITS: cm/s**2", "cm/s2"),
+    ("ACCELERATION TIME HISTORY IN CM/SEC/SEC", "cm/s2"),
+    ("ACCELERATION TIME HISTORY IN M/S/S", "m/s2"),
+    ("acceleration (m/s²)", "m/s2"),
+    ("the units are m/s^2", "m/s2"),
+    ("ACCELERATION TIME HISTORY IN UNITS OF G", "g"),
+    ("ACCELERATION TIME HISTORY IN G", "g"),
+    ("Acceleration [g]", "g"),
+    ("acceleration as a fraction of g", "g"),
+]
+
+
+@pytest.mark.parametrize("line, units", AT2_SPELLINGS, ids=[line for line, _ in AT2_SPELLINGS])
+def test_at2_units_read_in_every_spelling(tmp_path, line, units):
+    values = PEAK_632_GAL[units]
+    path = _write_at2(tmp_path / "r.AT2", values, 0.01, "west2", units_line=line)
+    record = load_record(path)
+    assert record.units == units
+    np.testing.assert_allclose(record.acceleration(g=9.81), values * SI[units])
+    assert np.max(np.abs(record.acceleration(g=9.81))) == pytest.approx(6.32)
+
+
+@pytest.mark.parametrize("header, units", [
+    ("# station X, acceleration in gal", "cm/s2"),
+    ("# t (s), a (cm/s^2)", "cm/s2"),
+    ("# t [s]  a [m/s/s]", "m/s2"),
+    ("# units: m/s^2 (divide by 9.81 for g)", "m/s2"),
+    ("# acceleration in g", "g"),
+])
+def test_text_comment_units_read_in_every_spelling(tmp_path, header, units):
+    values = PEAK_632_GAL[units]
+    path = _write_text(tmp_path / "r.txt", [0.01 * np.arange(values.size), values], header=header)
+    record = load_record(path)
+    assert record.units == units
+    np.testing.assert_allclose(record.acceleration(g=9.81), values * SI[units])
+
+
+@pytest.mark.parametrize("line, spelling", [
+    ("ACCELERATION IN MM/S2", "MM/S2"),
+    ("ACCELERATION IN IN/S/S", "IN/S/S"),
+    ("ACCELERATION TIME SERIES IN UNITS OF FT/SEC2", "FT/SEC2"),
+    ("UNITS: counts", "counts"),
+])
+def test_at2_header_naming_unknown_units_is_refused(tmp_path, line, spelling):
+    path = _write_at2(tmp_path / "odd.AT2", np.array([0.1, -0.2]), 0.01, "west2", units_line=line)
+    message = _error(path)
+    assert message.startswith(f"{path}, line 3: the header names units {spelling!r}") and "\n" not in message
+
+
+def test_text_comment_naming_unknown_units_is_refused(tmp_path):
+    path = _write_text(tmp_path / "odd.txt", [np.array([0.1, -0.2])], header="# units: mm/s^2")
+    assert _error(path, dt=0.01).startswith(f"{path}, line 1: the header names units 'mm/s^2'")
+
+
+def test_header_naming_two_units_is_refused(tmp_path):
+    path = _write_at2(tmp_path / "two.AT2", np.array([0.1, -0.2]), 0.01, "west2", units_line="ACCELERATION IN GAL, PEAK GIVEN (g)")
+    message = _error(path)
+    assert message.startswith(f"{path}: the header names two units") and "'GAL' (line 3)" in message and "(g)" in message
+
+
+def test_stated_units_win_over_units_named_elsewhere(tmp_path):
+    path = _write_text(tmp_path / "r.txt", [PEAK_632_GAL["cm/s2"]], header="# units: cm/s2\n# peak 0.64 in g")
+    assert load_record(path, dt=0.01).units == "cm/s2"
+
+
+def test_at2_in_gal_labelled_g_is_refused_for_its_peak(tmp_path):
+    """The newcomer's file: values in gal under a header saying g; its 632 g peak is refused, naming the units that fit."""
+    path = _write_at2(tmp_path / "gal.AT2", PEAK_632_GAL["cm/s2"], 0.01, "west2")
+    message = _error(path)
+    assert message.startswith(f"{path}: peak 632 g") and "the file's header" in message
+    assert "more than 5 g" in message and "cm/s2" in message and "\n" not in message
+
+
+def test_implausible_peaks_are_refused_whatever_gave_the_units(tmp_path):
+    plain = _write_text(tmp_path / "plain.txt", [PEAK_632_GAL["cm/s2"]])
+    message = _error(plain, dt=0.01)
+    assert "peak 632 g" in message and "the default, g (the file names no units)" in message and "cm/s2" in message
+    message = _error(plain, dt=0.01, units="m/s2")
+    assert "peak 632 m/s2 (64.4 g; units from units='m/s2')" in message and "cm/s2" in message
+    assert load_record(plain, dt=0.01, units="cm/s2").units == "cm/s2"
+
+
+def test_the_plausible_peak_is_5_g(tmp_path):
+    below = _write_text(tmp_path / "below.txt", [np.array([0.0, 4.99, -1.0])], header="# units: g")
+    assert load_record(below, dt=0.01).units == "g"
+    above = _write_text(tmp_path / "above.txt", [np.array([0.0, 5.01 * 9.81, -1.0])], header="# units: m/s2")
+    assert "more than 5 g" in _error(above, dt=0.01)
+
+
+@pytest.mark.parametrize("name,fields", _bundled_files(), ids=[name for name, _ in _bundled_files()])
+def test_bundled_files_read_in_the_registry_units_without_being_told(name, fields):
+    """Each bundled file's own header (or the default, g) gives the units the registry states."""
+    series = read_record_file(records_dir() / fields["file"], column=fields.get("column"), dt=fields.get("dt"), fmt=fields.get("format"))
+    assert series.units == fields["units"]
+
+
+def test_records_list_shows_each_files_units(tmp_path):
+    listed = {line.split()[0]: line.split()[1] for line in invoke("records", "list").stdout.splitlines() if line[:1].strip() and " " in line.strip()}
+    assert listed["northridge_1994_sylmar_hospital_360"] == "m/s2" and listed["northridge_1994_substitute"] == "m/s2"
+    assert listed["el_centro_1940_ngaw2_rsn6"] == "g" and listed["el_centro_1940_study"] == "g"
+    _write_at2(tmp_path / "a_gal.AT2", PEAK_632_GAL["cm/s2"], 0.01, "west2", units_line="ACCELERATION IN GAL")
+    _write_text(tmp_path / "b_g.txt", [0.01 * np.arange(4), PEAK_632_GAL["g"]])
+    rows = invoke("records", "list", "--suite", str(tmp_path)).stdout.splitlines()
+    assert rows[0].split()[-1] == "units"
+    assert [row.split()[-1] for row in rows[1:]] == ["cm/s2", "g"]
 
 
 def test_comma_separated_and_fortran_exponents(tmp_path):

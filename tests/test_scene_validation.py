@@ -4,6 +4,7 @@ import copy
 import subprocess
 import sys
 
+import numpy as np
 import pytest
 
 import stochpound
@@ -152,3 +153,102 @@ def test_cli_reports_the_field_and_writes_nothing(tmp_path):
     assert "building[0].base.mu: must be >= 0, got -0.2" in result.stderr
     assert not out.exists()
     assert list(tmp_path.iterdir()) == [scene_file]
+
+
+# ---------------------------------------------------------------- scene checks a designer expects: repeated contacts and walls, periods, g
+
+
+def test_a_contact_written_twice_is_refused_naming_both_tables():
+    """The same between pair in two [[contact]] tables added their stiffnesses without a word (75 impacts instead of 46)."""
+    message = rejected(lambda s: s["contact"].append(copy.deepcopy(s["contact"][0])))
+    assert message.startswith("contact[2].between: 'B1' floor 1 and 'B2' floor 1, the same as contact[0];") and "\n" not in message
+
+    def other_law(scene):
+        scene["contact"].insert(0, {**copy.deepcopy(scene["contact"][1]), "stiffness": 1.0e6})
+
+    assert rejected(other_law).startswith("contact[2].between: 'B1' floor 2 and 'B2' floor 2, the same as contact[0];")
+
+
+WALL = {"building": "B2", "side": "right", "level": 2, "gap": 0.05, "stiffness": 1.0e7, "restitution": 0.5}
+
+
+def test_a_wall_written_twice_is_refused_naming_both_tables():
+    message = rejected(lambda s: s.update(wall=[dict(WALL), {**WALL, "gap": 0.1}]))
+    assert message.startswith("wall[1]: building 'B2', side 'right', level 2, the same as wall[0];") and "\n" not in message
+    elsewhere = copy.deepcopy(VALID)
+    elsewhere["wall"] = [dict(WALL), {**WALL, "level": 1}, {**WALL, "building": "B1", "side": "left"}]
+    assert len(stochpound.scene_from_dict(elsewhere).walls) == 3
+
+
+def _one_storey(floor_mass: float, stiffness: float, **base) -> dict:
+    building = {"name": "B1", "mass": [floor_mass], "stiffness": [stiffness]}
+    if base:
+        building["base"] = base
+    return {"building": [building], "motion": {"type": "constant", "acceleration": 0.0, "duration": 0.1, "dt": 0.01}}
+
+
+def test_building_periods_against_closed_forms():
+    from stochpound.model import building_periods, scene_periods
+
+    single = stochpound.scene_from_dict(_one_storey(2.0e5, 3.0e7))
+    assert building_periods(single.buildings[0], 9.81) == {"first mode": pytest.approx(2 * np.pi * np.sqrt(2.0e5 / 3.0e7), rel=1e-12)}
+    # two equal storeys of equal masses: ω1² = (3 - √5)/2 · k/m
+    pair = stochpound.scene_from_dict({"building": [{"name": "A", "mass": [1.0e5, 1.0e5], "stiffness": [4.0e7, 4.0e7]}], "motion": _one_storey(1, 1)["motion"]})
+    assert scene_periods(pair) == {"A first mode": pytest.approx(2 * np.pi / np.sqrt((3 - np.sqrt(5)) / 2 * 4.0e7 / 1.0e5), rel=1e-12)}
+    spring = stochpound.scene_from_dict(_one_storey(2.0e5, 3.0e7, mass=1.0e5, mu=0.1, restoring_stiffness=6.0e5))
+    assert scene_periods(spring)["B1 isolated"] == pytest.approx(2 * np.pi * np.sqrt(3.0e5 / 6.0e5), rel=1e-12)
+    pendulum = stochpound.scene_from_dict({**_one_storey(2.0e5, 3.0e7, mass=1.0e5, mu=0.05, radius=2.0), "g": 9.81})
+    assert scene_periods(pendulum)["B1 isolated"] == pytest.approx(2 * np.pi * np.sqrt(2.0 / 9.81), rel=1e-12)
+    assert set(scene_periods(stochpound.scene_from_dict(_one_storey(2.0e5, 3.0e7, mass=1.0e5, mu=0.1)))) == {"B1 first mode"}
+
+
+@pytest.mark.parametrize("g, warned", [(9.81, False), (9.7, False), (9.9, False), (9.814, False), (1.0, True), (32.174, True), (9.6, True)])
+def test_g_outside_the_earths_range_is_warned_not_refused(g, warned):
+    from stochpound.model import scene_warnings
+
+    scene = stochpound.scene_from_dict({**_one_storey(2.0e5, 3.0e7), "g": g})
+    assert scene.g == g
+    expected = [f"g: {g:g} m/s² is outside 9.7-9.9 m/s², the Earth's gravity (g is in m/s², e.g. 9.81); used as given"] if warned else []
+    assert scene_warnings(scene) == expected
+    assert scene_warnings(scene, "scene") == [line.replace("g:", "scene.g:", 1) for line in expected]
+
+
+def _scene_file(tmp_path, mass: float, g: float = 9.81) -> str:
+    path = tmp_path / "scene.toml"
+    path.write_text(f"g = {g}\n[[building]]\nname = \"B1\"\nmass = [{mass}]\nstiffness = [3.0e7]\n"
+                    "[motion]\ntype = \"harmonic\"\namplitude = 1.0\nomega = 5.0\nduration = 0.5\ndt = 0.01\n")
+    return str(path)
+
+
+def test_simulate_prints_each_buildings_period_and_warns_on_g(tmp_path):
+    """Masses in tonnes show at once in the printed period; g = 1 is run, with a warning naming the field."""
+    from tests.helpers import invoke
+
+    in_tonnes = invoke("simulate", _scene_file(tmp_path, 200.0, g=1.0), "--out", str(tmp_path / "t.nc"), "--method", "ivp")
+    assert in_tonnes.exit_code == 0 and (tmp_path / "t.nc").exists(), in_tonnes.output
+    assert f"periods B1 first mode {2 * np.pi * np.sqrt(200.0 / 3.0e7):.3g} s" in in_tonnes.stdout  # 0.0162 s: 0.513 s in kg
+    assert in_tonnes.stderr.strip().splitlines() == ["warning: g: 1 m/s² is outside 9.7-9.9 m/s², the Earth's gravity (g is in m/s², e.g. 9.81); used as given"]
+
+
+def _two_storey_first_period(mass: list[float], stiffness: list[float]) -> float:
+    """T1 of a two-storey shear building from det(K - ω²M) = 0: m1 m2 ω⁴ - (m1 k2 + m2 (k1 + k2)) ω² + k1 k2 = 0."""
+    (m1, m2), (k1, k2) = mass, stiffness
+    b = m1 * k2 + m2 * (k1 + k2)
+    omega_squared = (b - np.sqrt(b * b - 4 * m1 * m2 * k1 * k2)) / (2 * m1 * m2)
+    return 2 * np.pi / np.sqrt(omega_squared)
+
+
+def test_experiment_check_prints_the_periods_and_warns_on_g(tmp_path):
+    """The small experiment: B1 [26268, 17512] kg on [24.5168, 17.512] MN/m; B2 the same with masses x 0.5 (stiff) or x 2 (flexible)."""
+    from tests.helpers import SMALL_EXPERIMENT, invoke, write_experiment
+
+    checked = invoke("experiment", "check", str(write_experiment(tmp_path)))
+    assert checked.exit_code == 0, checked.output
+    periods = [line for line in checked.stdout.splitlines() if line.strip().startswith("periods")]
+    mass, stiffness = np.array([26268.0, 17512.0]), [24516800.0, 17512000.0]
+    assert len(periods) == 1 and f"B1 first mode {_two_storey_first_period(mass, stiffness):.3g} s" in periods[0]
+    assert f"B2 first mode (neighbour=stiff) {_two_storey_first_period(0.5 * mass, stiffness):.3g} s" in periods[0]
+    assert f"B2 first mode (neighbour=flexible) {_two_storey_first_period(2.0 * mass, stiffness):.3g} s" in periods[0]
+    assert "warning" not in checked.stderr
+    one_g = invoke("experiment", "check", str(write_experiment(tmp_path, SMALL_EXPERIMENT.replace("g = 9.814", "g = 1.0"), "one_g.toml")))
+    assert one_g.exit_code == 0 and "warning: scene.g: 1 m/s² is outside 9.7-9.9 m/s²" in one_g.stderr

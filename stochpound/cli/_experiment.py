@@ -11,6 +11,7 @@ from typing import TYPE_CHECKING, Iterator
 import click
 
 from stochpound.cli._group import HelpGroup
+from stochpound.cli._scene_notes import experiment_warnings, periods_text, say_scene_warnings
 from stochpound._errors import StochpoundError, os_error_message
 from stochpound.experiment import LARGE_RUN_BYTES, LARGE_RUN_CASES, parts_folder
 from stochpound._memory import format_bytes
@@ -55,6 +56,7 @@ def run_command(
     for path in experiment_files:
         with _errors_of(path, several):
             loaded.append(load_experiment(path))
+            say_scene_warnings([f"{path}: {line}" if several else line for line in experiment_warnings(loaded[-1])])
     failed = False
     for experiment_file, definition in zip(experiment_files, loaded):
         if several:
@@ -144,7 +146,7 @@ def _has_hazard(store: Path) -> bool:
 @click.argument("experiment_file", type=click.Path(dir_okay=False))
 def check_command(experiment_file: str) -> None:
     """Validate EXPERIMENT_FILE and list its dimensions (runs nothing)."""
-    from stochpound.experiment import load_experiment, resolve_motions
+    from stochpound.experiment import load_experiment, periods_of_interest, resolve_motions
 
     try:
         loaded = load_experiment(experiment_file)
@@ -156,6 +158,9 @@ def check_command(experiment_file: str) -> None:
         click.echo(f"  {dim.name:14s} {len(dim.values):5d}  {', '.join(_fmt(v) for v in dim.values[:8])}{' ...' if len(dim.values) > 8 else ''}")
     n_reference = int(loaded.in_grid("reference").sum())
     click.echo(f"  {loaded.n_cases - n_reference} cases + {n_reference} fixed-base reference cases")
+    with _errors_of(experiment_file, False):
+        click.echo(f"  {'periods':14s} {periods_text(periods_of_interest(loaded))}")
+        say_scene_warnings(experiment_warnings(loaded))
 
 
 def _fmt(value) -> str:

@@ -19,8 +19,8 @@ def records() -> None:
 @records.command("list")
 @click.option("--suite", default=None, help="List the motions of a suite (fema_p695_far_field, ...) or of a folder of record files instead.")
 def list_command(suite: str | None) -> None:
-    """List the bundled records and their named variants, then the suites (or the motions of one suite)."""
-    from stochpound.motions.records import SUITES, registry_entries
+    """List the bundled records and their named variants with their units, then the suites (or the motions of one suite)."""
+    from stochpound.motions.records import SUITES, load_record, registry_entries
 
     if suite is not None:
         _list_suite(suite)
@@ -29,7 +29,11 @@ def list_command(suite: str | None) -> None:
         fields = entry.fields
         kind = f"variant of {fields['base']}" if entry.is_variant else f"{fields.get('file')}"
         flag = "  [SUBSTITUTE]" if entry.substitute_for else ""
-        click.echo(f"{name:38s}{kind}{flag}")
+        try:
+            units = load_record(name).units
+        except RecordError as error:
+            raise click.ClickException(str(error)) from None
+        click.echo(f"{name:38s}{units:7s}{kind}{flag}")
         click.echo(f"{'':38s}{entry.description}")
     click.echo("\nsuites (stochpound records list --suite NAME):")
     for name, source in SUITES.items():
@@ -43,12 +47,12 @@ def _list_suite(suite: str) -> None:
         motions = load_suite(suite)
     except RecordError as error:
         raise click.ClickException(str(error)) from None
-    click.echo(f"{'name':34s}{'event':30s}{'station':32s}{'component':18s}{'M':>5s}{'R (km)':>8s}{'Vs30':>7s}{'dt (s)':>8s}{'npts':>7s}")
+    click.echo(f"{'name':34s}{'event':30s}{'station':32s}{'component':18s}{'M':>5s}{'R (km)':>8s}{'Vs30':>7s}{'dt (s)':>8s}{'npts':>7s}  units")
     for record in motions:
         meta = record.metadata
         click.echo(
             f"{record.name:34s}{str(meta.get('event', ''))[:29]:30s}{str(meta.get('station', ''))[:31]:32s}{str(meta.get('component', ''))[:17]:18s}"
-            f"{meta.get('magnitude', float('nan')):5.1f}{meta.get('distance', float('nan')):8.1f}{meta.get('vs30', float('nan')):7.0f}{record.dt:8.4f}{record.npts:7d}"
+            f"{meta.get('magnitude', float('nan')):5.1f}{meta.get('distance', float('nan')):8.1f}{meta.get('vs30', float('nan')):7.0f}{record.dt:8.4f}{record.npts:7d}  {record.units}"
         )
 
 

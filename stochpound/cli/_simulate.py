@@ -8,8 +8,10 @@ import click
 
 from stochpound._atomic import check_writable
 from stochpound._errors import StochpoundError, os_error_message
+from stochpound.cli._scene_notes import periods_text, say_scene_warnings
 from stochpound.results.dataset import write_dataset
-from stochpound.model.scene_file import load_scene
+from stochpound.model.modal_solution import scene_periods
+from stochpound.model.scene_file import load_scene, scene_warnings
 from stochpound.solvers.simulate import METHODS, simulate as run_simulation
 from stochpound.solvers.ivp import INTEGRATORS
 
@@ -29,6 +31,8 @@ def simulate(scene_file: str, out: str, overwrite: bool, method: str | None, int
     _check_output(Path(out), overwrite)
     try:
         scene = load_scene(scene_file)
+        say_scene_warnings(scene_warnings(scene))
+        click.echo(f"{scene_file}: periods {periods_text(scene_periods(scene))}")
         result = run_simulation(scene, method, integrator=integrator, rtol=rtol, atol=atol, demands=demands)
         write_dataset(result, out)
     except (StochpoundError, ValueError) as error:

@@ -26,7 +26,6 @@ are unchanged.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 from functools import cached_property
@@ -240,24 +239,17 @@ def periods_of_interest(experiment: GridExperiment) -> dict[str, float]:
     variant labels where a building's period differs between points.
     """
     from stochpound.store import CASE
-    from stochpound.model.friction import is_fixed_base
-    from stochpound.model.modal_solution import modal_properties
+    from stochpound.model.modal_solution import scene_periods
     from stochpound.model.scene_file import scene_from_dict
 
     found: dict[str, set[float]] = {}
     labels: dict[tuple[str, float], str] = {}
     for point in experiment.points(CASE):
         variants = ", ".join(f"{name}={value}" for name, value in point.labels if name in {v["name"] for v in experiment.variants})
-        scene = scene_from_dict(experiment.structure(point), base_dir=experiment.base_dir)
-        for name, building in zip(experiment.building_names, scene.buildings):
-            periods = {f"{name} first mode": float(modal_properties(building).periods[0])}
-            base = building.base
-            if base is not None and not is_fixed_base(base.mu) and base.restoring(building.total_mass * scene.g) > 0:
-                periods[f"{name} isolated"] = 2.0 * math.pi * math.sqrt(building.total_mass / base.restoring(building.total_mass * scene.g))
-            for key, period in periods.items():
-                period = round(period, 12)
-                found.setdefault(key, set()).add(period)
-                labels.setdefault((key, period), variants)
+        for key, period in scene_periods(scene_from_dict(experiment.structure(point), base_dir=experiment.base_dir)).items():
+            period = round(period, 12)
+            found.setdefault(key, set()).add(period)
+            labels.setdefault((key, period), variants)
     named = {}
     for key, values in found.items():
         for period in sorted(values):

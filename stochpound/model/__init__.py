@@ -11,7 +11,8 @@ and one module per contact or friction law), :mod:`~stochpound.model.scene` and
 :mod:`~stochpound.model.modal_solution` (a closed-form reference),
 :mod:`~stochpound.model.yielding` (bilinear yielding storeys) and
 :func:`design_yield_shears` (a code-designed building's yield shears);
-:func:`bundled_scenes` and :func:`bundled_scene_path` find the scenes shipped with stochpound.
+:func:`bundled_scenes` and :func:`bundled_scene_path` find the scenes shipped with stochpound;
+:func:`building_periods`, :func:`scene_periods` and :func:`scene_warnings` say what a scene's numbers mean at a glance.
 """
 
 import importlib
@@ -22,10 +23,12 @@ from stochpound.model.building import Building, InitialState
 from stochpound.model.contact import Contact, ImpactElement
 from stochpound.model.friction import Base
 from stochpound.model.scene import Scene
-from stochpound.model.scene_file import bundled_scene_path, bundled_scenes
+from stochpound.model.modal_solution import building_periods, scene_periods
+from stochpound.model.scene_file import bundled_scene_path, bundled_scenes, scene_warnings
 from stochpound.model.wall import Wall
 
-__all__ = ["Scene", "Building", "InitialState", "Base", "Contact", "Wall", "ImpactElement", "design_yield_shears", "bundled_scenes", "bundled_scene_path"]
+__all__ = ["Scene", "Building", "InitialState", "Base", "Contact", "Wall", "ImpactElement", "design_yield_shears", "bundled_scenes", "bundled_scene_path",
+           "building_periods", "scene_periods", "scene_warnings"]
 
 _MOVED_LAWS = {"law": "contract", **{name: name for name in ("kelvin", "hertz", "hertz_damp_ye", "hertz_damp_exact", "jankowski", "coulomb",
                                                              "velocity_friction")}}

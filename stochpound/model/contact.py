@@ -102,6 +102,17 @@ def effective_mass(mass_1: float, mass_2: float) -> float:
 # ---------------------------------------------------------------- scene file
 
 
+def contacts_from_tables(tables: list[Mapping[str, Any]], buildings: Sequence[Building]) -> list[Contact]:
+    """The ``[[contact]]`` tables of a scene, validated; two at the same floors are refused (they would add their stiffnesses)."""
+    contacts = [contact_from_table(table, f"contact[{i}]", buildings) for i, table in enumerate(tables)]
+    fields.reject_repeated(
+        [((c.left, c.left_floor, c.right, c.right_floor), f"{buildings[c.left].name!r} floor {c.left_floor} and {buildings[c.right].name!r} floor {c.right_floor}")
+         for c in contacts],
+        "contact", "between", "two contacts between the same floors add their forces (two equal ones act as one of twice the stiffness)",
+    )
+    return contacts
+
+
 def contact_from_table(table: Mapping[str, Any], prefix: str, buildings: Sequence[Building]) -> Contact:
     """One ``[[contact]]`` table (at ``prefix``) between ``buildings``, validated."""
     fields.reject_unknown(table, CONTACT_KEYS, prefix)

@@ -9,7 +9,7 @@ e.g. ``building[0].base.mu: must be >= 0, got -0.2``.
 from __future__ import annotations
 
 import math
-from typing import Any, Mapping
+from typing import Any, Hashable, Mapping, Sequence
 
 from stochpound._errors import SceneError
 
@@ -125,3 +125,18 @@ def array_of_tables(parent: Mapping[str, Any], key: str) -> list[Mapping[str, An
     if not isinstance(value, list) or not all(isinstance(v, dict) for v in value):
         raise SceneError(f"{key}: must be an array of tables ([[{key}]])")
     return value
+
+
+def reject_repeated(places: Sequence[tuple[Hashable, str]], table: str, field: str, what: str) -> None:
+    """Raise for the first ``[[table]]`` whose place an earlier one already holds.
+
+    ``places`` gives each table's place (a key to compare, and how it reads in
+    the message), in the file's order; ``field`` is the field that sets it
+    (empty: several fields); ``what`` says what two tables at one place would do.
+    """
+    first: dict[Hashable, int] = {}
+    for i, (key, shown) in enumerate(places):
+        if key in first:
+            path = field_path(f"{table}[{i}]", field) if field else f"{table}[{i}]"
+            raise SceneError(f"{path}: {shown}, the same as {table}[{first[key]}]; {what}: write one [[{table}]] there")
+        first[key] = i

@@ -1,4 +1,4 @@
-"""Closed-form response of a fixed-base, classically damped shear building to harmonic ground acceleration.
+"""The modes and periods of a shear building, and the closed-form response of a fixed-base, classically damped one to harmonic ground acceleration.
 
 The study's harmonic check (its section 3.1) compares the numerical solution
 with this semi-analytic one. For a building whose damping matrix is
@@ -16,10 +16,17 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import math
+from typing import TYPE_CHECKING
+
 import numpy as np
 from scipy.linalg import eigh
 
 from stochpound.model.building import Building, storey_matrix
+from stochpound.model.friction import is_fixed_base
+
+if TYPE_CHECKING:
+    from stochpound.model.scene import Scene
 
 #: Largest off-diagonal modal damping, relative to the diagonal, still treated as
 #: classical (and neglected): the study's dashpots are a1·K rounded to 6 digits.
@@ -69,6 +76,41 @@ def modal_properties(building: Building) -> Modes:
     omega = np.sqrt(eigenvalues)
     participation = shapes.T @ mass @ np.ones(len(building.mass))
     return Modes(omega, np.diag(modal_damping) / (2.0 * omega), shapes, participation, classical)
+
+
+def building_periods(building: Building, g: float) -> dict[str, float]:
+    """The periods of interest of a building, s, by name.
+
+    Parameters
+    ----------
+    building : Building
+        A shear building.
+    g : float
+        Acceleration of gravity, m/s² (a friction pendulum's restoring stiffness is W/R).
+
+    Returns
+    -------
+    dict
+        ``"first mode"``: the first-mode period of the floors on a fixed base
+        (elastic storeys, without P-Δ; inf for a storey without stiffness),
+        unless the building has no floors; ``"isolated"``: 2π √(M/k_r) of a
+        sliding base with a restoring stiffness k_r (M the floors' and the
+        base's mass).
+    """
+    periods = {}
+    if building.n_floors:
+        with np.errstate(divide="ignore", invalid="ignore"):
+            first = float(modal_properties(building).periods[0])
+        periods["first mode"] = first if math.isfinite(first) else math.inf
+    base = building.base
+    if base is not None and not is_fixed_base(base.mu) and base.restoring(building.total_mass * g) > 0:
+        periods["isolated"] = 2.0 * math.pi * math.sqrt(building.total_mass / base.restoring(building.total_mass * g))
+    return periods
+
+
+def scene_periods(scene: Scene) -> dict[str, float]:
+    """Every building's periods of interest (:func:`~stochpound.model.building_periods`), s, named ``"<building> first mode"``, ``"<building> isolated"``."""
+    return {f"{building.name} {kind}": period for building in scene.buildings for kind, period in building_periods(building, scene.g).items()}
 
 
 def harmonic_response(building: Building, amplitude: float, omega: float, times: np.ndarray) -> np.ndarray:

@@ -20,13 +20,15 @@ from stochpound._errors import RecordError, SceneError
 from stochpound._memory import check_memory, sample_bytes
 from stochpound.model import fields
 from stochpound.model.building import buildings_from_tables
-from stochpound.model.contact import contact_from_table
+from stochpound.model.contact import contacts_from_tables
 from stochpound.model.scene import Scene
 from stochpound.model.wall import walls_from_tables
 from stochpound.motions import SYNTHETIC_TYPES
 from stochpound.motions.ground import GroundMotion, HarmonicMotion, SampledMotion
 
 _TOP_KEYS = {"g", "study_compat", "building", "contact", "wall", "motion"}
+EARTH_GRAVITY = (9.7, 9.9)
+"""The range of g at the Earth's surface, m/s²: a scene's ``g`` outside it is allowed, with a warning (:func:`~stochpound.model.scene_warnings`)."""
 
 
 def load_scene(path: str | Path) -> Scene:
@@ -125,12 +127,37 @@ def scene_from_dict(data: Mapping[str, Any], base_dir: str | Path = ".", source:
     g = fields.number(data, "g", "", default=9.81, low=0.0, low_open=True)
     study_compat = fields.boolean(data, "study_compat", "", default=False)
     buildings = buildings_from_tables(fields.array_of_tables(data, "building"))
-    contacts = [contact_from_table(table, f"contact[{i}]", buildings) for i, table in enumerate(fields.array_of_tables(data, "contact"))]
+    contacts = contacts_from_tables(fields.array_of_tables(data, "contact"), buildings)
     walls = walls_from_tables(fields.array_of_tables(data, "wall"), buildings)
     n_dof = sum(b.n_floors + (b.base is not None) for b in buildings)
     per_sample = sample_bytes(n_dof, len(buildings), max((b.n_floors for b in buildings), default=1), len(contacts) + len(walls))
     motion = _motion(data, Path(base_dir), g, per_sample)
     return Scene(tuple(buildings), tuple(contacts), motion, g=g, study_compat=study_compat, walls=tuple(walls), source=source)
+
+
+def scene_warnings(scene: Scene, prefix: str = "") -> list[str]:
+    """What a valid scene holds that looks like a slip, one line each starting with the field; empty when nothing does.
+
+    A ``g`` outside :data:`~stochpound.model.scene_file.EARTH_GRAVITY` (``g = 1``, or g in ft/s²) is
+    allowed (a model may want another gravity), and said here.
+
+    Parameters
+    ----------
+    scene : Scene
+        A scene (from :func:`~stochpound.load_scene` or :func:`~stochpound.scene_from_dict`).
+    prefix : str
+        The path of the scene's table, prefixed to the field (``"scene"`` in an experiment file).
+
+    Returns
+    -------
+    list of str
+        The warnings, e.g. ``g: 1 m/s² is outside 9.7-9.9 m/s², the Earth's gravity (g is in m/s²); used as given``.
+    """
+    low, high = EARTH_GRAVITY
+    if low <= scene.g <= high:
+        return []
+    return [f"{fields.field_path(prefix, 'g')}: {scene.g:g} m/s² is outside {low:g}-{high:g} m/s², the Earth's gravity (g is in m/s², "
+            "e.g. 9.81); used as given"]
 
 
 # ---------------------------------------------------------------- motion

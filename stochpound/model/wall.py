@@ -61,8 +61,13 @@ class Wall(ImpactElement):
 
 
 def walls_from_tables(tables: list[Mapping[str, Any]], buildings: Sequence[Building]) -> list[Wall]:
-    """The ``[[wall]]`` tables of a scene, validated."""
-    return [wall_from_table(table, f"wall[{i}]", buildings) for i, table in enumerate(tables)]
+    """The ``[[wall]]`` tables of a scene, validated; two beside the same level on the same side are refused (they would add their stiffnesses)."""
+    walls = [wall_from_table(table, f"wall[{i}]", buildings) for i, table in enumerate(tables)]
+    fields.reject_repeated(
+        [((w.building, w.side, w.level), f"building {buildings[w.building].name!r}, side {w.side_name!r}, level {w.level}") for w in walls],
+        "wall", "", "two walls beside the same level on the same side add their forces (two equal ones act as one of twice the stiffness)",
+    )
+    return walls
 
 
 def wall_from_table(table: Mapping[str, Any], prefix: str, buildings: Sequence[Building]) -> Wall:

@@ -14,7 +14,8 @@ import warnings
 from typing import Any
 
 from stochpound.motions.records._readers import RawSeries, read_at2, read_record_file, read_text
-from stochpound.motions.records._record import Record, normalize_units
+from stochpound.motions.records._record import Record
+from stochpound.motions.records._units import normalize_units
 from stochpound.motions.records._registry import (
     RegistryEntry,
     list_records,

@@ -14,8 +14,9 @@ PEER ``.AT2``
           2688    0.0200    NPTS, DT            (NGA-West1 / older)
 
     then the samples, any number per line. Units are read from the header
-    ("UNITS OF G", "units are (g)", "CM/S/S"); g if the header does not say.
-    Velocity or displacement series are refused.
+    in any of the usual spellings (``UNITS OF G``, ``units are (g)``, ``IN GAL``,
+    ``(cm/s^2)``, ``CM/S/S``, ``m/s²``; the list is in docs/records.md); g if
+    the header names none. Velocity or displacement series are refused.
 Text
     Blank lines and comment lines (``#``, ``%`` or ``!``) are skipped; values
     are separated by spaces, tabs, commas or semicolons, and every data line
@@ -27,8 +28,11 @@ Text
     * more columns: time first, and ``column`` says which one holds the
       acceleration (0-based, e.g. ``column=1``).
 
-    Units: the ``units`` argument, else a ``units: ...`` comment in the
-    header, else g.
+    Units: the ``units`` argument, else units named in the comment lines
+    (read as an AT2 header's), else g.
+
+Both readers refuse a header naming units they do not know, or two units,
+and a record whose peak is more than ``PLAUSIBLE_PEAK_G`` (5 g) in its units.
 """
 
 from __future__ import annotations
@@ -42,7 +46,8 @@ from pathlib import Path
 import numpy as np
 
 from stochpound._errors import RecordError
-from stochpound.motions.records._record import Record, normalize_units
+from stochpound.motions.records._record import Record
+from stochpound.motions.records._units import check_plausible_peak, header_units, normalize_units
 
 #: Relative tolerance on the uniformity of a time column (fraction of a step).
 TIME_STEP_TOLERANCE = 0.01
@@ -51,8 +56,6 @@ AT2_MAX_HEADER_LINES = 40
 
 _NGA_WEST2 = re.compile(r"NPTS\s*=\s*(\d+)\s*[,;]?\s*DT\s*=\s*([-+0-9.eEdD]+)", re.IGNORECASE)
 _NGA_WEST1 = re.compile(r"^\s*(\d+)\s+([-+0-9.eEdD]+)\s+NPTS\s*[,;]?\s*DT", re.IGNORECASE)
-_AT2_UNITS = re.compile(r"(?:UNITS\s+OF|UNITS\s+ARE|UNITS\s*[:=])\s*\(?\s*([A-Za-z/^0-9²]+)", re.IGNORECASE)
-_TEXT_UNITS = re.compile(r"\bunits?\s*[:=]\s*([A-Za-z/^0-9²]+)", re.IGNORECASE)
 _SEPARATORS = re.compile(r"[,;\s]+")
 _COMMENT_PREFIXES = ("#", "%", "!")
 
@@ -226,14 +229,18 @@ def _check_given_dt(given: float | None, found: float, shown: str, where: str) -
         raise RecordError(f"{shown}: dt={given:g} s was given but {where} says dt={found:g} s")
 
 
-def _resolve_units(given: str | None, stated: str | None, shown: str) -> str:
+def _resolve_units(values: np.ndarray, given: str | None, stated: str | None, shown: str) -> str:
+    """The units of ``values``: ``given``, which must agree with those the file states, else the stated ones, else g; a peak implausible in them is refused."""
     try:
         given_n = normalize_units(given) if given is not None else None
     except ValueError as error:
         raise RecordError(f"{shown}: {error}") from None
     if given_n is not None and stated is not None and given_n != stated:
         raise RecordError(f"{shown}: units={given!r} was given but the file states {stated!r}")
-    return given_n or stated or "g"
+    units = given_n or stated or "g"
+    source = f"units={given!r}" if given_n else "the file's header" if stated else "the default, g (the file names no units)"
+    check_plausible_peak(values, units, shown, source)
+    return units
 
 
 def _parse_at2(lines: list[str], shown: str, *, dt: float | None, units: str | None) -> RawSeries:
@@ -250,17 +257,7 @@ def _parse_at2(lines: list[str], shown: str, *, dt: float | None, units: str | N
     head_text = "\n".join(header).upper()
     if ("VELOCITY" in head_text or "DISPLACEMENT" in head_text) and "ACCELERATION" not in head_text:
         raise RecordError(f"{shown}: the header describes a velocity or displacement series; an acceleration is needed")
-    stated = None
-    for line in header:
-        match = _AT2_UNITS.search(line)
-        if match:
-            try:
-                stated = normalize_units(match.group(1))
-            except ValueError:
-                raise RecordError(
-                    f"{shown}: header units {match.group(1)!r} are not an acceleration unit (g, m/s2, cm/s2)"
-                ) from None
-            break
+    stated = header_units(list(enumerate(header, start=1)), shown)
     values: list[float] = []
     for line_no, line in enumerate(lines[index + 1 :], start=index + 2):
         for token in line.split():
@@ -272,13 +269,14 @@ def _parse_at2(lines: list[str], shown: str, *, dt: float | None, units: str | N
             f"{shown}: header line {index + 1} says NPTS={npts} but {len(values)} values follow "
             f"(lines {index + 2}-{len(lines)})"
         )
-    return RawSeries(np.asarray(values, dtype=np.float64), file_dt, _resolve_units(units, stated, shown), 0.0, header)
+    samples = np.asarray(values, dtype=np.float64)
+    return RawSeries(samples, file_dt, _resolve_units(samples, units, stated, shown), 0.0, header)
 
 
 def _parse_text(
     lines: list[str], shown: str, *, dt: float | None, units: str | None, column: int | None
 ) -> RawSeries:
-    header: list[str] = []
+    header: list[tuple[int, str]] = []
     rows: list[list[float]] = []
     row_lines: list[int] = []
     n_columns = None
@@ -287,7 +285,7 @@ def _parse_text(
         if not stripped:
             continue
         if stripped.startswith(_COMMENT_PREFIXES):
-            header.append(stripped)
+            header.append((line_no, stripped))
             continue
         tokens = [token for token in _SEPARATORS.split(stripped) if token]
         if n_columns is None:
@@ -301,17 +299,8 @@ def _parse_text(
         row_lines.append(line_no)
     if not rows:
         raise RecordError(f"{shown}: no data lines (the record is empty)")
-    stated = None
-    for line in header:
-        match = _TEXT_UNITS.search(line)
-        if match:
-            try:
-                stated = normalize_units(match.group(1).rstrip(".,;)"))
-            except ValueError:
-                stated = None
-            if stated is not None:
-                break
-    unit = _resolve_units(units, stated, shown)
+    stated = header_units(header, shown)
+    comments = [line for _, line in header]
     table = np.asarray(rows, dtype=np.float64)
     if n_columns == 1:
         if column not in (None, 0):
@@ -319,7 +308,7 @@ def _parse_text(
         if dt is None:
             raise RecordError(f"{shown}: missing dt: a one-column file holds no times, so give dt (s), e.g. dt=0.02")
         step = _positive_dt(float(dt), shown, "")
-        return RawSeries(table[:, 0], step, unit, 0.0, header)
+        return RawSeries(table[:, 0], step, _resolve_units(table[:, 0], units, stated, shown), 0.0, comments)
     if column is None:
         if n_columns != 2:
             raise RecordError(
@@ -337,7 +326,7 @@ def _parse_text(
     else:
         step = _uniform_step(times, row_lines, shown)
         _check_given_dt(dt, step, shown, "its time column")
-    return RawSeries(table[:, column], step, unit, float(times[0]), header)
+    return RawSeries(table[:, column], step, _resolve_units(table[:, column], units, stated, shown), float(times[0]), comments)
 
 
 def _uniform_step(times: np.ndarray, row_lines: list[int], shown: str) -> float:

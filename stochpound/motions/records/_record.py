@@ -7,38 +7,7 @@ from typing import Any, Mapping
 
 import numpy as np
 
-#: Canonical unit names, and the spellings accepted for each.
-UNIT_ALIASES: dict[str, str] = {
-    "g": "g",
-    "m/s2": "m/s2",
-    "m/s^2": "m/s2",
-    "m/s²": "m/s2",
-    "m/s/s": "m/s2",
-    "mps2": "m/s2",
-    "cm/s2": "cm/s2",
-    "cm/s^2": "cm/s2",
-    "cm/s²": "cm/s2",
-    "cm/s/s": "cm/s2",
-    "cm/sec/sec": "cm/s2",
-    "gal": "cm/s2",
-}
-
-#: Factor from each unit to m/s² (None for "g", whose factor is the chosen g).
-_TO_SI: dict[str, float | None] = {"g": None, "m/s2": 1.0, "cm/s2": 0.01}
-
-
-def normalize_units(units: str) -> str:
-    """Canonical name (``"g"``, ``"m/s2"`` or ``"cm/s2"``) of a unit spelling.
-
-    Raises
-    ------
-    ValueError
-        If the spelling is not one of ``UNIT_ALIASES``.
-    """
-    key = str(units).strip().lower()
-    if key not in UNIT_ALIASES:
-        raise ValueError(f"units must be one of g, m/s2, cm/s2; got {units!r}")
-    return UNIT_ALIASES[key]
+from stochpound.motions.records._units import TO_SI, normalize_units
 
 
 @dataclass
@@ -108,5 +77,5 @@ class Record:
             Acceleration of gravity used to convert values in g, m/s². The
             reference study used 9.814. Ignored for records in m/s² or cm/s².
         """
-        factor = _TO_SI[self.units]
+        factor = TO_SI[self.units]
         return self.values * (float(g) if factor is None else factor)

@@ -17,7 +17,8 @@ from typing import Any, Mapping
 from stochpound._data_files import bundled_data_dir
 from stochpound._errors import RecordError
 from stochpound.motions.records._readers import read_record_file, record_from_file
-from stochpound.motions.records._record import Record, normalize_units
+from stochpound.motions.records._record import Record
+from stochpound.motions.records._units import normalize_units
 from stochpound.motions.records._suites import is_suite_member, load_suite_member
 
 REGISTRY_FILE = "registry.toml"
