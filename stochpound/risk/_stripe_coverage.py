@@ -31,7 +31,7 @@ import numpy as np
 import xarray as xr
 
 from stochpound.hazard import HazardCurve
-from stochpound.risk._fragility import FIT, lognormal_cdf
+from stochpound.risk._fragility import FIT, SEPARATED, lognormal_cdf
 from stochpound.risk._maf import mean_annual_frequency
 
 _POINTS = 4000
@@ -106,8 +106,11 @@ def top_capped_maf(fragility: xr.Dataset, hz: HazardCurve) -> xr.DataArray:
     """λ⁻ (1/yr) of every fit: its MAF with the fragility beyond the top stripe held at its value there (module docstring).
 
     λ⁻ = ∫ F |dλ| up to the top stripe's level x_n + F(x_n) λ(x_n) for a
-    lognormal fit; a step or flat fit (which does not rise beyond the
-    stripes' data) keeps its MAF (:func:`~stochpound.risk.mean_annual_frequency`).
+    lognormal fit. A ``separated`` step whose top stripe's runs did not all
+    exceed (none below it, k of n at it: the likelihood's step at x_n says
+    F = 1 beyond, the runs say k/n) gives the fraction that exceeded at x_n,
+    k/n λ(x_n). Any other step or flat fit keeps its MAF
+    (:func:`~stochpound.risk.mean_annual_frequency`): it does not rise beyond the runs.
 
     Parameters
     ----------
@@ -124,7 +127,10 @@ def top_capped_maf(fragility: xr.Dataset, hz: HazardCurve) -> xr.DataArray:
     top = float(min(np.max(fragility["intensity"].values), hz.support[1]))
     middle = xr.apply_ufunc(lambda t, b: _rate_between(t, b, hz, top), fragility["theta"], fragility["beta"], vectorize=True)
     at_top = xr.apply_ufunc(lambda t, b: lognormal_cdf(top, t, b), fragility["theta"], fragility["beta"]) * float(hz(top))
-    return mean_annual_frequency(fragility, hz).where(fragility["status"] != FIT, middle + at_top)
+    exceeded, runs = (fragility[name].sel(intensity=fragility["intensity"].max(), drop=True) for name in ("exceeded", "runs"))
+    fraction = exceeded / runs.where(runs > 0)
+    step = mean_annual_frequency(fragility, hz).where((fragility["status"] != SEPARATED) | ~(fraction < 1.0), fraction * float(hz(top)))
+    return step.where(fragility["status"] != FIT, middle + at_top)
 
 
 def _rate_between(theta: float, beta: float, hz: HazardCurve, upper: float) -> float:

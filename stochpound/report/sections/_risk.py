@@ -75,14 +75,18 @@ def headline_text(name: str, risk: StoreRisk) -> str:
     per = []
     for labels, rows in (frame.groupby(config, sort=False) if config else [((), frame)]):
         labels = labels if isinstance(labels, tuple) else (labels,)
-        values = "; ".join(f"{_gap_text(row.separation)} for {risk.target_text(row.target)} [{_gap_text(row.lower)}, {_gap_text(row.upper)}]"
+        values = "; ".join(f"at least {_gap_text(row.separation)} for {risk.target_text(row.target)} (beyond the stripes' runs: no interval)"
+                           if row.lower_bound else
+                           f"{_gap_text(row.separation)} for {risk.target_text(row.target)} [{_gap_text(row.lower)}, {_gap_text(row.upper)}]"
                            for row in rows.itertuples())
         per.append(f"{labels_text(dict(zip(config, labels))) or 'the scene'}: {values}")
     stripes = f"{risk.stripes} stripes of " if risk.stripes is not None else "IDA capacities in "
+    partial = f" (an unfinished store, {risk.progress}: answered from the cases that ran)" if risk.progress else ""
+    beyond = risk.beyond_stripes_text()
     return (
         f"Risk-targeted separation g* (the gap whose mean annual frequency of pounding is that of {targets}, Poisson) of experiment "
-        f"{name}, from {risk.motions} motions{' per stripe' if is_selected(risk.setting) else ''} ({stripes}{risk.measure} in {risk.setting['units']}) at the site of its hazard curve, "
-        f"with {_percent(risk.confidence)} intervals ({_resampling(risk)}): " + ". ".join(per) + "."
+        f"{name}{partial}, from {risk.motions} motions{' per stripe' if is_selected(risk.setting) else ''} ({stripes}{risk.measure} in {risk.setting['units']}) at the site of its hazard curve, "
+        f"with {_percent(risk.confidence)} intervals ({_resampling(risk)}): " + ". ".join(per) + "." + (f" {beyond}" if beyond else "")
     )
 
 
@@ -229,9 +233,12 @@ def design_value_text(risk: StoreRisk) -> str:
     per = []
     for labels, rows in (frame.groupby(config, sort=False) if config else [((), frame)]):
         labels = labels if isinstance(labels, tuple) else (labels,)
-        values = "; ".join(f"{_gap_text(row.design)} for {risk.target_text(row.target)}" for row in rows.itertuples())
+        values = "; ".join(f"{_gap_text(row.design) if row.design == row.design else row.basis} for {risk.target_text(row.target)}"
+                           for row in rows.itertuples())
         per.append(f"{labels_text(dict(zip(config, labels))) or 'the scene'}: {values}")
-    return (f"The gap to design to is the {frame['basis'].iloc[0]}, not g* itself (g* is a central estimate from "
+    given = frame["design"].notna()
+    basis = frame.loc[given, "basis"].iloc[0] if given.any() else "upper bound of g*'s interval"
+    return (f"The gap to design to is the {basis}, not g* itself (g* is a central estimate from "
             f"{risk.motions} motions{' per stripe' if is_selected(risk.setting) else ''} and meets its target only about half the time): " + ". ".join(per) + ".")
 
 
