@@ -162,7 +162,7 @@ def test_read_hazard_file_is_given_by_the_risk_package():
 def test_the_bootstrap_estimate_bounds_the_chains_peak_within_a_factor_of_three():
     """Peak of numpy's allocations (tracemalloc) while the stripes are refitted to the resamples, integrated and g* solved."""
     _chain((0.2, 0.4), motions=10, bootstrap=10)  # warm the imports and caches
-    for levels, motions, resamples in (((0.2, 0.4, 0.8), 40, 2000), ((0.1, 0.2, 0.4, 0.8, 1.6), 20, 1500)):
+    for levels, motions, resamples in (((0.2, 0.4, 0.8), 40, 300), ((0.1, 0.2, 0.4, 0.8, 1.6), 20, 700)):
         tracemalloc.start()
         try:
             _chain(levels, motions, resamples)

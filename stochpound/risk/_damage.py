@@ -158,10 +158,10 @@ def store_damage(store: xr.Dataset, limit_states: Sequence[LimitState] | None = 
     ductility = per_building["peak_ductility"]
     yields = ductility.notnull().any([d for d in ductility.dims if d != "building"])
     elastic = tuple(str(b) for b, flag in zip(ductility["building"].values, yields.values) if not flag)
-    if elastic:  # an elastic building has no ductility: its fractiles NaN (none at all when no building yields), not an all-NaN quantile
-        per_building["peak_ductility"] = ductility.sel(building=yields)
-    demands = xr.Dataset({name: data.quantile(list(QUANTILES), dim="record", keep_attrs=True).reindex(building=ductility["building"])
-                          for name, data in per_building.items() if bool(data.notnull().any())})  # a demand no run has: left out
+    # an elastic building has no ductility: its fractiles NaN (a placeholder 0 in the quantile, not an all-NaN slice); a demand no run has: left out
+    demands = xr.Dataset({name: data.where(yields, 0.0).quantile(list(QUANTILES), dim="record", keep_attrs=True).where(yields)
+                          if name == "peak_ductility" else data.quantile(list(QUANTILES), dim="record", keep_attrs=True)
+                          for name, data in per_building.items() if bool(data.notnull().any())})
     done = xr.concat([data.notnull().any("building") for data in per_building.values()], "demand").any("demand")
     drift = per_building.get("peak_drift_ratio")
     beyond = (drift.max("building") > MODEL_DRIFT_LIMIT) if drift is not None else xr.zeros_like(done)

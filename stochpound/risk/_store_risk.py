@@ -470,10 +470,11 @@ def bootstrap_bytes(resamples: int, fits: int, stripes: int, motions: int) -> in
     Counted in doubles per resample: the stripes' weighted counts and the
     maximum-likelihood fit's work arrays (16 per fit and stripe), each
     fit's θ, β, flat fraction, λ and g* with their sorted copies for the
-    intervals (24 per fit), the resample's weights (2 per motion). The
-    tests check it against the measured peak of the chain.
+    intervals (24 per fit), the resample's weights (2 per motion); and
+    64 MiB whatever their number, the quadrature of the MAF (chunks of 4096
+    fits at 192 nodes). The tests check it against the measured peak of the chain.
     """
-    return 8 * resamples * (16 * fits * stripes + 24 * fits + 2 * motions)
+    return 8 * resamples * (16 * fits * stripes + 24 * fits + 2 * motions) + 64 * 2**20
 
 
 def check_bootstrap(resamples: int, fits: int, stripes: int, motions: int) -> None:
