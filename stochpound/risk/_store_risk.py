@@ -201,7 +201,7 @@ class StoreRisk:
             ``years``), ``separation``, ``lower``, ``upper`` (m; ``inf``: wider
             than every gap of the grid), ``lower_bound`` (True where
             ``separation`` is only a lower bound of g*, the target beyond
-            the stripes' runs: :func:`bound_beyond_stripes`; its interval is
+            the stripes' runs: ``stochpound.risk._store_risk.bound_beyond_stripes``; its interval is
             then NaN), ``confidence``, ``motions``.
         """
         separation = self.separation
@@ -220,7 +220,7 @@ class StoreRisk:
 
     def separation_frame(self) -> pd.DataFrame:
         """The g* table: per configuration, g* and its interval (m) for each target (columns grouped by target); a g* that
-        is only a lower bound (:func:`bound_beyond_stripes`) is the text ``≥ 0.640``, its interval empty."""
+        is only a lower bound (``stochpound.risk._store_risk.bound_beyond_stripes``) is the text ``≥ 0.640``, its interval empty."""
         frame = self.to_frame()
         years = float(self.separation.attrs.get("years", self.years))
         config = self.configuration_dims()
@@ -345,7 +345,7 @@ class StoreRisk:
         pandas.DataFrame
             Columns: the configuration's dimensions, ``target``, ``design``
             (m; NaN, withheld, where g* is only a lower bound: the target lies
-            beyond the stripes' runs, :func:`bound_beyond_stripes`), ``basis``
+            beyond the stripes' runs, ``stochpound.risk._store_risk.bound_beyond_stripes``), ``basis``
             (what ``design`` is, in words).
         """
         frame = self.to_frame()
@@ -493,7 +493,7 @@ def bound_beyond_stripes(separation: xr.Dataset, fragility: xr.Dataset, hz: Haza
     seen, however rare the target), or (b) the target's rate is below the
     hazard's rate at the top stripe (the pounding it allows comes from
     shaking no stripe ran). There ``separation`` becomes a lower bound that
-    rests on the runs alone: the gap where λ⁻ (:func:`~stochpound.risk._stripe_coverage.top_capped_maf`,
+    rests on the runs alone: the gap where λ⁻ (``stochpound.risk._stripe_coverage.top_capped_maf``,
     the fragility held beyond the top stripe at its value there) meets the
     target, and no wider than ``reach``; its interval is withheld (NaN).
 
@@ -576,7 +576,7 @@ def store_risk(store: xr.Dataset, hz: HazardCurve | None = None, targets: Sequen
         (``RiskInputError``) A store without stripes or IDA capacities, or
         without contact-free runs, or without a hazard when none is given;
         (``UnfinishedStoreError``) a store with missing cases without ``partial``;
-        (``MemoryLimitError``) a ``bootstrap`` beyond the memory limit (:func:`check_bootstrap`).
+        (``MemoryLimitError``) a ``bootstrap`` beyond the memory limit (``stochpound.risk._store_risk.check_bootstrap``).
     """
     _store.check_finished(store, partial)
     hz = _store.site_hazard(store) if hz is None else hz
