@@ -286,7 +286,8 @@ def test_ctrl_c_at_any_moment_exits_130_without_a_traceback(isolated_store, tmp_
     commands = [["risk", str(isolated_store), "--bootstrap", "200000"], ["report", "build", str(isolated_store), "--out", str(tmp_path / "out")]]
     for command in commands:
         process = subprocess.Popen([*PYTHON_WITH_CTRL_C, "-m", "stochpound", *command], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                                   env={**os.environ, "PYTHONPATH": str(REPOSITORY)}, cwd=tmp_path)
+                                   # the bootstrap's memory guard would refuse 200000 resamples on a small machine before any work
+                                   env={**os.environ, "PYTHONPATH": str(REPOSITORY), "STOCHPOUND_MEMORY_LIMIT": "64GiB"}, cwd=tmp_path)
         time.sleep(delay)
         if process.poll() is not None:  # finished before the signal: nothing to test at this delay
             continue
