@@ -57,7 +57,7 @@ def _design(path: Path) -> dict:
               help="What the --hazard file's curve is of, when the file does not say, e.g. 'PSA(1.0 s, 5 %) in g' or 'PGA in m/s2'.")
 @click.option("--hazard-units", "hazard_units", metavar="UNITS", help="Units of the --hazard file's intensities (g, m/s2, cm/s2, m/s, cm/s).")
 @click.option("--investigation-time", "investigation_time", type=click.FloatRange(min=0.0, min_open=True), metavar="YEARS",
-              help="Years of a --hazard file of probabilities of exceedance (a 'poe' column), converted to annual rates.")
+              help="Years of a --hazard file of probabilities of exceedance (a 'poe' column, in [0, 1]: per cent is refused), converted to annual rates.")
 @click.option("--hazard-site", "hazard_site", metavar="ROW|NAME", help="The site of a --hazard file of several (its row, 0-based, or name).")
 @click.option("--extrapolate", is_flag=True, help="Extend the hazard table beyond its intensities as power laws (stated in the output).")
 @click.option("--target", "target", default=",".join(f"{t:g}" for t in TARGETS), show_default=True,
