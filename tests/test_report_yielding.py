@@ -257,3 +257,38 @@ def test_the_design_summary_says_how_many_runs_are_beyond_the_model(store):
     assert "beyond the model" not in design_summary_text(risk, None, None)
     within = dataclasses.replace(damage, beyond_model=damage.beyond_model * 0)
     assert "beyond the model" not in design_summary_text(risk, None, within)
+
+
+def _cells(section) -> list[str]:
+    """Every paragraph and every table cell of a section, as text."""
+    texts = [_text(block) for block in section.blocks]
+    return texts + [str(cell) for block in section.blocks if hasattr(block, "frame") for cell in block.cell_text().to_numpy().ravel()]
+
+
+def test_the_damage_of_elastic_buildings_has_no_nan_and_no_warning(store):
+    """Elastic buildings (storey heights, no yield force) store NaN ductility: their Damage section says they are elastic, with
+    no 'nan' cell and no RuntimeWarning; with one building elastic, its ductility cells say so and the other's stand."""
+    import warnings
+
+    elastic = store.assign(peak_ductility=store["peak_ductility"] * np.nan)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        damage = store_damage(elastic)
+        section = damage_section("yfix", damage)
+    assert damage.elastic == ("B1", "B2") and "peak_ductility" not in damage.demands
+    assert damage.runs.equals(store_damage(store).runs)  # the runs done are counted without a ductility
+    cells = _cells(section)
+    assert not any("nan" in cell.lower() for cell in cells), [cell for cell in cells if "nan" in cell.lower()]
+    assert "The buildings are elastic (no storey yields in any run)" in " ".join(cells) and "ductility, median" not in " ".join(
+        str(c) for block in section.blocks if hasattr(block, "frame") for c in block.frame.columns)
+    one = store.assign(peak_ductility=store["peak_ductility"].where(store["building"] == "B1"))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        damage = store_damage(one)
+        section = damage_section("yfix", damage)
+    assert damage.elastic == ("B2",)
+    table = next(block for block in section.blocks if getattr(block, "key", "") == "table-damage-yfix").frame
+    assert table.loc[("–", "1.2031 (2 %/50 yr)", "B2"), "peak storey ductility, median"] == "elastic"
+    median = float(store_damage(store).demands["peak_ductility"].sel(intensity=1.2031, building="B1", quantile=0.5))
+    assert table.loc[("–", "1.2031 (2 %/50 yr)", "B1"), "peak storey ductility, median"] == f"{median:.3g}"
+    assert not any("nan" in cell.lower() for cell in _cells(section))

@@ -23,6 +23,7 @@ from pathlib import Path
 
 import matplotlib.pyplot as plt
 import numpy as np
+import pandas as pd
 import xarray as xr
 import pytest
 from click.testing import CliRunner
@@ -285,7 +286,8 @@ def test_ctrl_c_at_any_moment_exits_130_without_a_traceback(isolated_store, tmp_
     commands = [["risk", str(isolated_store), "--bootstrap", "200000"], ["report", "build", str(isolated_store), "--out", str(tmp_path / "out")]]
     for command in commands:
         process = subprocess.Popen([*PYTHON_WITH_CTRL_C, "-m", "stochpound", *command], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                                   env={**os.environ, "PYTHONPATH": str(REPOSITORY)}, cwd=tmp_path)
+                                   # the bootstrap's memory guard would refuse 200000 resamples on a small machine before any work
+                                   env={**os.environ, "PYTHONPATH": str(REPOSITORY), "STOCHPOUND_MEMORY_LIMIT": "64GiB"}, cwd=tmp_path)
         time.sleep(delay)
         if process.poll() is not None:  # finished before the signal: nothing to test at this delay
             continue
@@ -405,3 +407,77 @@ def test_the_ida_gap_grid_reaches_the_separations_of_the_hazards_intensities(fix
     im = ida["motion_intensity"].isel(gap=0, realization=0)
     assert float(risk.curve["gap"].max()) >= 1.5 * float((closure * reach / im).max()) * (1 - 1e-12)
     assert float(risk.separation["separation"].max()) < float(risk.curve["gap"].max())
+
+
+# ---------------------------------------------------------------- where the store's data stop (issue 49)
+
+
+def test_cli_gives_a_rare_targets_separation_as_a_lower_bound_and_names_the_stripes_to_add(isolated_store, tmp_path):
+    """0.1 % and 0.01 % in 50 yr are rarer than the top stripe (1.5 g): '≥', no interval, no gap to design to, the stripes to add."""
+    result = CliRunner().invoke(main, ["risk", str(isolated_store), "--bootstrap", "100", "--target", "0.1,0.001,0.0001", "--csv", str(tmp_path)])
+    assert result.exit_code == 0, result.output
+    risk = store_risk(open_store(isolated_store), targets=(0.1, 0.001, 0.0001), bootstrap=100)
+    bounds = risk.separation["separation"].sel(target=[0.001, 0.0001]).values
+    assert risk.separation["lower_bound"].values.tolist() == [False, True, True]
+    lines = _separation_lines(result.output)
+    assert any(line.split()[:4] == ["0.1", "%", "in", "50"] and f"≥ {bounds[0]:.3f}" in line and line.split()[-2:] == ["NaN", "NaN"] for line in lines), lines
+    assert f"withheld: g* ≥ {bounds[0]:.3f} m, beyond the stripes' runs" in result.output
+    assert "warning: g* for 0.1 % in 50 yr lies beyond the stripes' runs in every configuration" in result.output
+    assert "add stripes above 1.5 g, up to about" in result.output and "warning: g* for 10 % in 50 yr" not in result.output
+    table = pd.read_csv(tmp_path / "separation.csv")
+    assert table["lower_bound"].tolist() == [False, True, True] and table["lower"].isna().tolist() == [False, True, True]
+    # the bound rests on the runs: no wider than the widest gap the top stripe's runs close
+    free = open_store(isolated_store)["peak_contact_closure"].sel(gap=np.inf).max("contact")
+    assert np.all(bounds <= float(free.sel(intensity=1.5).max()))
+
+
+def _unfinished(store: Path, folder: Path) -> Path:
+    """A copy of ``store`` whose last motion's cases (contact-free and at 5 cm, every stripe) are missing, as a stopped run leaves them."""
+    import h5py
+
+    copy = folder / "unfinished.nc"
+    copy.write_bytes(store.read_bytes())
+    with h5py.File(copy, "r+") as handle:
+        handle["case_status"][:, :, -1, :] = 0  # dims gap, intensity, record, realization
+        handle["peak_contact_closure"][:, :, -1, :, :] = np.nan
+        missing = 2 * handle["case_status"].shape[1]
+        handle.attrs["cases_done"] = int(handle.attrs["cases_total"][0]) - missing
+        handle.attrs["complete"] = 0
+    return copy
+
+
+def test_an_unfinished_store_is_refused_unless_partial_and_its_counts_are_what_ran(isolated_store, tmp_path):
+    partial = _unfinished(isolated_store, tmp_path)
+    total = int(open_store(isolated_store).attrs["cases_total"])
+    done = f"{total - 6}/{total} cases done"
+    runner = CliRunner()
+    refused = runner.invoke(main, ["risk", str(partial), "--bootstrap", "0"])
+    assert refused.exit_code == 1 and refused.output.startswith(f"Error: risk: {done}: ") and "--partial" in refused.output, refused.output
+    assert len(refused.output.strip().splitlines()) == 1
+    report = runner.invoke(main, ["report", "build", str(partial), "--out", str(tmp_path / "report")])
+    assert report.exit_code == 1 and f"Error: unfinished.nc: {done}: " in report.output and not (tmp_path / "report" / "index.html").exists()
+    answered = runner.invoke(main, ["risk", str(partial), "--bootstrap", "0", "--partial"])
+    assert answered.exit_code == 0, answered.output
+    assert answered.output.startswith(f"risk: {done}, answered from the cases that ran (--partial); {len(MOTIONS) - 1} motions, 3 stripes")
+    risk = store_risk(open_store(partial), bootstrap=0, partial=True)
+    free = open_store(isolated_store)["peak_contact_closure"].sel(gap=np.inf).max("contact").isel(record=slice(0, -1), realization=0)
+    counts = (free >= risk.fragility["gap"]).sum("record").transpose("gap", "intensity")
+    assert np.array_equal(risk.fragility["exceeded"].transpose("gap", "intensity").values, counts.values)  # the fits count what ran
+    assert np.all(risk.fragility["runs"].values == len(MOTIONS) - 1)
+    text = risk_section("risk", risk).blocks[0].text
+    assert f"(an unfinished store, {done}: answered from the cases that ran), from {len(MOTIONS) - 1} motions" in text
+
+
+def test_a_bootstrap_beyond_the_memory_limit_is_refused_in_one_line(isolated_store):
+    result = CliRunner().invoke(main, ["risk", str(isolated_store), "--bootstrap", "100000000"], env={"STOCHPOUND_MEMORY_LIMIT": "8GiB"})
+    assert result.exit_code == 1 and len(result.output.strip().splitlines()) == 1, result.output
+    assert result.output.startswith("Error: bootstrap (--bootstrap): 100000000 resamples of 8 motions") and "more than the memory limit of 8 GiB" in result.output
+
+
+def test_limit_states_of_a_store_without_finite_gaps_are_a_sentence_not_an_empty_table(fixed_stores, tmp_path):
+    states = tmp_path / "states.toml"
+    states.write_text("[limit_states]\nimpact_force = [1.0e6]\n")
+    result = CliRunner().invoke(main, ["risk", str(fixed_stores[0]), "--bootstrap", "0", "--limit-states", str(states)])
+    assert result.exit_code == 0, result.output
+    assert "Empty DataFrame" not in result.output
+    assert "Limit states beyond first contact: none to give: the store's grid has no finite gap" in result.output

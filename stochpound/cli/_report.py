@@ -29,7 +29,10 @@ def report() -> None:
     show_default=True,
     help="Document to write; repeat for several.",
 )
-def build_command(stores: tuple[Path, ...], out: Path, formats: tuple[str, ...]) -> None:
+@click.option("--partial", is_flag=True,
+              help="Report a store with missing cases from the cases that ran (the report says how many ran); without it such a store "
+                   "is refused.")
+def build_command(stores: tuple[Path, ...], out: Path, formats: tuple[str, ...], partial: bool) -> None:
     """Build the report from the experiment STORE files into --out.
 
     Writes OUT/index.html (self-contained page), OUT/report.pdf, and every
@@ -37,14 +40,15 @@ def build_command(stores: tuple[Path, ...], out: Path, formats: tuple[str, ...])
     Figures and tables of an earlier build into OUT that this one does not
     write again are removed (only those: OUT/.stochpound-report.json lists them).
     The stores are only read (they may be on a read-only disk); OUT is
-    checked to be writable before any work.
+    checked to be writable before any work. A store with missing cases
+    (a run stopped, or cases that failed) is refused unless --partial.
     """
     from stochpound.report.assemble import assemble_report
     from stochpound.report.render.output import check_output_folder, write_report
 
     try:
         check_output_folder(out)
-        document = assemble_report(list(stores), progress=_progress)
+        document = assemble_report(list(stores), progress=_progress, partial=partial)
         written = write_report(document, out, formats, progress=_progress)
     except (StochpoundError, ValueError) as error:
         raise click.ClickException(str(error)) from None

@@ -57,7 +57,7 @@ def _design(path: Path) -> dict:
               help="What the --hazard file's curve is of, when the file does not say, e.g. 'PSA(1.0 s, 5 %) in g' or 'PGA in m/s2'.")
 @click.option("--hazard-units", "hazard_units", metavar="UNITS", help="Units of the --hazard file's intensities (g, m/s2, cm/s2, m/s, cm/s).")
 @click.option("--investigation-time", "investigation_time", type=click.FloatRange(min=0.0, min_open=True), metavar="YEARS",
-              help="Years of a --hazard file of probabilities of exceedance (a 'poe' column), converted to annual rates.")
+              help="Years of a --hazard file of probabilities of exceedance (a 'poe' column, in [0, 1]: per cent is refused), converted to annual rates.")
 @click.option("--hazard-site", "hazard_site", metavar="ROW|NAME", help="The site of a --hazard file of several (its row, 0-based, or name).")
 @click.option("--extrapolate", is_flag=True, help="Extend the hazard table beyond its intensities as power laws (stated in the output).")
 @click.option("--target", "target", default=",".join(f"{t:g}" for t in TARGETS), show_default=True,
@@ -72,12 +72,15 @@ def _design(path: Path) -> dict:
 @click.option("--design", "design", type=click.Path(exists=True, dir_okay=False, path_type=Path), metavar="FILE",
               help="A TOML file with a [design] table (docs/experiments.md) that replaces the store's: the buildings' code design "
                    "whose design analysis gives the codes' own gaps.")
+@click.option("--partial", is_flag=True,
+              help="Answer from the cases that ran of a store with missing cases (its header says how many ran); without it such a "
+                   "store is refused.")
 @click.option("--csv", "csv_dir", type=click.Path(file_okay=False, path_type=Path), metavar="DIR",
               help="Also write the tables to this folder (created), one CSV file per table: separation.csv, rules.csv "
                    "(and limit_states.csv with --limit-states).")
 def risk(store: Path, hazard: str | None, hazard_measure: str | None, hazard_units: str | None, investigation_time: float | None,
          hazard_site: str | None, extrapolate: bool, target: str, years: float, bootstrap: int, seed: int, limit_states: Path | None,
-         design: Path | None, csv_dir: Path | None) -> None:
+         design: Path | None, partial: bool, csv_dir: Path | None) -> None:
     """Print the risk-targeted separation g* and the code rules' risks of the experiment STORE at a site.
 
     For every configuration of the store (each combination of its grid's
@@ -93,6 +96,13 @@ def risk(store: Path, hazard: str | None, hazard_measure: str | None, hazard_uni
     With --limit-states, the limit states beyond first contact (storey
     drift ratio, ductility, floor acceleration, impact force, a bearing's
     stop) at each finite gap against the contact-free twins.
+
+    A target rarer than the stripes reach (its rate below the hazard's at
+    the top stripe, or g* wider than every gap the top stripe's runs close)
+    gets g* as a lower bound, "≥ x", with no interval and no gap to design
+    to, and a note saying which stripes to add. A store with missing cases
+    is refused unless --partial; --bootstrap is refused beyond the memory
+    limit (STOCHPOUND_MEMORY_LIMIT, default half the machine's memory).
     """
     from stochpound.cli._measure_choice import efficient_measure_lines
     from stochpound.experiment import open_store
@@ -106,7 +116,8 @@ def risk(store: Path, hazard: str | None, hazard_measure: str | None, hazard_uni
         data = open_store(store)
         hz = site_hazard(data, hazard, measure=hazard_measure, units=hazard_units, investigation_time=investigation_time,
                          site=hazard_site, extrapolate=extrapolate)
-        result = store_risk(data, hz, targets, years, bootstrap=bootstrap, seed=seed, design=None if design is None else _design(design))
+        result = store_risk(data, hz, targets, years, bootstrap=bootstrap, seed=seed, design=None if design is None else _design(design),
+                            partial=partial)
         costs = None if limit_states is None else gap_cost_frame(limit_state_risk(data, _limit_states(limit_states), hz), years)
     except (StochpoundError, ValueError) as error:
         raise click.ClickException(str(error)) from None
@@ -114,7 +125,8 @@ def risk(store: Path, hazard: str | None, hazard_measure: str | None, hazard_uni
         raise click.ClickException(os_error_message(error)) from None
     stripes = f"{result.stripes} stripes" if result.stripes is not None else "IDA capacities"
     source = hz.source.splitlines()[0] if hz.source else hz.describe()
-    click.echo(f"{result.experiment or store.stem}: {result.motions} motion{'s' if result.motions != 1 else ''}, {stripes} of {result.measure} "
+    done = f"{result.progress}, answered from the cases that ran (--partial); " if result.progress else ""
+    click.echo(f"{result.experiment or store.stem}: {done}{result.motions} motion{'s' if result.motions != 1 else ''}, {stripes} of {result.measure} "
                f"in {result.setting['units']}; hazard: {source}")
     missed = selection_misses(data)
     if missed:
@@ -132,15 +144,25 @@ def risk(store: Path, hazard: str | None, hazard_measure: str | None, hazard_uni
     interval = f"95 % interval, {result.separation['lower'].attrs.get('method', 'BCa bootstrap')}" if "lower" in result.separation else (
         "no interval: not estimable" if result.no_interval else "no bootstrap")
     separation = result.separation_frame()
-    click.echo(f"\nRisk-targeted separation g* (m; {interval}; inf: wider than every gap of the grid):")
+    click.echo(f"\nRisk-targeted separation g* (m; {interval}; inf: wider than every gap of the grid; ≥: a lower bound, the target "
+               "beyond the stripes' runs):")
     click.echo(separation.to_string(float_format=lambda v: f"{v:.3f}"))
     if result.no_interval:
         click.echo(f"note: no interval is estimable for g*, the rates or the code rules: {result.no_interval}.")
     design = result.design_frame()
-    basis = f"the {design['basis'].iloc[0]}, not g* itself" if "upper" in result.separation else design["basis"].iloc[0]
+    given = design["design"].notna()
+    if not given.any():
+        basis = "none: every g* is a lower bound"
+    elif "upper" in result.separation:
+        basis = f"the {design.loc[given, 'basis'].iloc[0]}, not g* itself"
+    else:
+        basis = design.loc[given, "basis"].iloc[0]
     click.echo(f"\nDesign to (m; {basis}):")
-    click.echo(design.drop(columns="basis").assign(target=[result.target_text(p) for p in design["target"]])
-               .to_string(index=False, float_format=lambda v: f"{v:.3f}"))
+    click.echo(design.assign(design=[f"{v:.3f}" if ok else b for v, ok, b in zip(design["design"], given, design["basis"])])
+               .drop(columns="basis").assign(target=[result.target_text(p) for p in design["target"]]).to_string(index=False))
+    beyond = result.beyond_stripes_text()
+    if beyond:
+        click.echo(f"warning: {beyond}")
     degenerate = result.degenerate_text()
     if degenerate:
         click.echo(f"note: {degenerate}")
@@ -155,7 +177,10 @@ def risk(store: Path, hazard: str | None, hazard_measure: str | None, hazard_uni
     if result.dtm_text():
         click.echo(f"note: {result.dtm_text()}")
     click.echo(result.design_rules_text())
-    if costs is not None:
+    if costs is not None and costs.empty:
+        click.echo("\nLimit states beyond first contact: none to give: the store's grid has no finite gap (only its contact-free "
+                   "runs, gap = inf), and a limit state's cost is taken at a finite gap against its contact-free twin.")
+    elif costs is not None:
         click.echo(f"\nLimit states beyond first contact (λ: per year at each finite gap; contact-free: the same motions without "
                    f"contact; Δλ: what the gap costs; P in {years:g} years):")
         click.echo(costs.to_string(float_format=lambda v: f"{v:.4g}"))

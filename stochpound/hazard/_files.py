@@ -235,15 +235,26 @@ def read_hazard_file(path: str | Path, *, site: int | str | None = None) -> Haza
         raise ValueError(f"{path.name}: empty")
     try:
         if lines[0].startswith("#") and "investigation_time=" in lines[0] and "imt=" in lines[0]:
-            return _openquake(path, lines, site)
+            return _checked(_openquake(path, lines, site))
         first = [cell.strip().lower() for cell in next(csv.reader([lines[0]]))]
         if first[:3] == ["name", "lon", "lat"] or first[:2] == ["lon", "lat"]:
-            return _nshmp(path, lines, site)
+            return _checked(_nshmp(path, lines, site))
         if site is not None:
             raise ValueError("site: a stochpound hazard file holds one site's curve")
-        return _stochpound(path, lines)
+        return _checked(_stochpound(path, lines))
     except ValueError as error:
         raise ValueError(f"{path.name}: {error}") from None
+
+
+def _checked(curve: HazardFile) -> HazardFile:
+    """``curve``, its values checked: probabilities in [0, 1] (above 1 they look like per cent), rates ≥ 0."""
+    values = curve.values
+    if curve.quantity == "poe" and np.any(values > 1.0):
+        raise ValueError(f"poe: {int(np.count_nonzero(values > 1.0))} value(s) above 1 (largest {float(values.max()):g}): these look like "
+                         "per cent; give probabilities of exceedance in [0, 1] (divide by 100)")
+    if np.any(~np.isfinite(values)) or np.any(values < 0.0):
+        raise ValueError(f"{curve.quantity}: values must be finite and >= 0, got {', '.join(f'{v:g}' for v in values if not v >= 0.0 or not np.isfinite(v))}")
+    return curve
 
 
 def _stochpound(path: Path, lines: list[str]) -> HazardFile:

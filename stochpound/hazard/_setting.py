@@ -185,14 +185,16 @@ def _read(path: Path, given: Mapping[str, Any], site: Any, intensity: Mapping[st
                 raise IntensityError(f"{_field(where, key)}: {value!r} years, but {path.name} states {read.investigation_time:g} years")
             continue
         if key in stated and not _equal(value, stated[key]):
-            raise IntensityError(f"{_field(where, key)}: {value!r}, but {path.name} states {key} = {stated[key]!r}")
+            named = "" if _field(where, key).endswith(key) else f"{key} "
+            raise IntensityError(f"{_field(where, key)}: {named}{value!r}, but {path.name} states {key} = {stated[key]!r}")
         stated[key] = value
     if "measure" not in stated:
         raise IntensityError(f"{_field(where, 'measure')}: not stated: {path.name} does not say which measure its curve is of "
                              "(a '# Measure:' line, e.g. '# Measure: 5 %-damped spectral acceleration at T = 1.0 s, in g'); state it")
     for key in _REQUIRED.get(stated["measure"], ()):
         if key not in stated:
-            raise IntensityError(f"{_field(where, key)}: not stated: {path.name} does not give its curve's {key}; state it")
+            example = " (e.g. 'PSA(1.0 s, 5 %) in g')" if key in ("period", "damping") and where.startswith("--") else ""
+            raise IntensityError(f"{_field(where, key)}: not stated: {path.name} does not give its curve's {key}; state it{example}")
     _check_measure(where, {key: stated[key] for key in _MATCHED if key in stated}, intensity)
     read.stated = stated
     try:
@@ -205,9 +207,15 @@ def _read(path: Path, given: Mapping[str, Any], site: Any, intensity: Mapping[st
         raise IntensityError(f"{where}.file: {path.name}: {message}") from None
 
 
+_OPTIONS = {"measure": "{where}-measure", "period": "{where}-measure", "periods": "{where}-measure", "damping": "{where}-measure",
+            "units": "{where}-units", "site": "{where}-site", "investigation_time": "--investigation-time"}
+"""The command-line option that states each field (a spectral measure's period and damping are in ``--hazard-measure``'s text)."""
+
+
 def _field(where: str, key: str) -> str:
-    """The name of a stated field: ``hazard.units`` in a file, ``--hazard-units`` on the command line."""
-    return f"{where}.{key}" if not where.startswith("--") else f"{where}-{key.replace('_', '-')}"
+    """The name of a stated field: ``hazard.units`` in a file, the option that states it on the command line (``--hazard-units``;
+    ``--hazard-measure`` for a period or damping, which its text gives)."""
+    return f"{where}.{key}" if not where.startswith("--") else _OPTIONS[key].format(where=where)
 
 
 def _bundled(name: str, intensity: Mapping[str, Any], g: float, extrapolate: bool, where: str) -> HazardCurve:

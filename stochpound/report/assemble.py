@@ -36,11 +36,11 @@ from stochpound.report.sections import (
 )
 from stochpound.experiment import measure_choice
 from stochpound.risk import has_risk, store_damage, store_demands, store_risk
-from stochpound.store import has_contact_free, has_wall_free, with_contacts, with_walls
+from stochpound.store import check_finished, has_contact_free, has_wall_free, with_contacts, with_walls
 from stochpound._studies import claims, load_study
 
 
-def assemble_report(paths: Sequence[str | Path], progress: Callable[[str], None] | None = None) -> Report:
+def assemble_report(paths: Sequence[str | Path], progress: Callable[[str], None] | None = None, partial: bool = False) -> Report:
     """Build the report of the given stores.
 
     Parameters
@@ -49,14 +49,24 @@ def assemble_report(paths: Sequence[str | Path], progress: Callable[[str], None]
         Experiment store files.
     progress : callable, optional
         Called with a short message before each step.
+    partial : bool
+        Report a store with missing cases from the cases that ran (its
+        sections say how many ran); without it such a store is refused.
 
     Returns
     -------
     Report
+
+    Raises
+    ------
+    ValueError
+        (``UnfinishedStoreError``) A store with missing cases without ``partial``: ``<name>: 288/704 cases done: ...``.
     """
     say = progress or (lambda message: None)
     say("reading stores")
     stores = open_stores(paths)
+    for name, store in stores.items():
+        check_finished(store, Path(store.encoding.get("source", name)).name, partial, option="--partial (partial=True from Python)")
     claimed = claims({name: store.pound.definition.reproduces for name, store in stores.items()})
     studied = {name for parts in claimed.values() for name in parts.values()}
     others = {name: store for name, store in stores.items() if name not in studied}
@@ -77,7 +87,7 @@ def assemble_report(paths: Sequence[str | Path], progress: Callable[[str], None]
     for name, store in others.items():  # the answer first: each store's risk at its site, right after the introduction
         if has_risk(store):
             say(f"experiment {name}: risk")
-            risks[name] = store_risk(store)
+            risks[name] = store_risk(store, partial=partial)
             damage = store_damage(store)
             report.sections.append(risk_section(name, risks[name], store_demands(store), damage, measure_choice(store)))
             if damage is not None:

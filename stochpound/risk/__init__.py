@@ -61,7 +61,7 @@ from stochpound.risk._demands import StoreDemands, store_demands
 from stochpound.risk._limit_states import KINDS as LIMIT_STATE_KINDS, LimitState, gap_cost_frame, limit_state_problem, limit_state_risk, limit_states_from_table
 from stochpound.risk._efficiency import measure_efficiency, most_efficient
 from stochpound.risk._damage import DAMAGE_DEMANDS, DEFAULT_LIMIT_STATES, DEFAULT_SOURCE as DEFAULT_LIMIT_STATES_SOURCE, MODEL_DRIFT_LIMIT, StoreDamage, store_damage
-from stochpound.hazard import hazard_consistency, stripe_rate_weights
+from stochpound.hazard import hazard_consistency, read_hazard_file, stripe_rate_weights
 from stochpound.risk._site_consistency import consistency_at_targets, site_consistency
 from stochpound.risk._stripe_demand import stripe_demand_rate
 from stochpound.risk._stripe_coverage import fragility_at_separation, maf_outside_stripes
@@ -77,6 +77,7 @@ __all__ = [
     "stripe_fragility",
     "HazardCurve",
     "bundled_curves",
+    "read_hazard_file",
     "probability_from_rate",
     "rate_from_probability",
     "return_period",

@@ -64,7 +64,7 @@ class StoreDamage:
     Attributes
     ----------
     demands : xarray.Dataset
-        ``DAMAGE_DEMANDS`` present in the store (``peak_ductility`` 1,
+        ``DAMAGE_DEMANDS`` present in the store with a value in some run (``peak_ductility`` 1,
         ``residual_drift`` m, ``peak_drift_ratio`` 1) over ``quantile``
         (``QUANTILES``), ``building``, ``intensity`` and the store's other
         grid dimensions (contact axes dropped where the runs are contact-free).
@@ -84,6 +84,10 @@ class StoreDamage:
         Where the limit states' capacities come from.
     contact_free : bool
         Whether the runs are the contact-free ones.
+    elastic : tuple of str
+        The buildings whose storeys never yield in any run (no yield force:
+        no ductility; their ``peak_ductility`` is NaN, and absent from
+        ``demands`` when no building yields).
     """
 
     demands: xr.Dataset
@@ -94,6 +98,7 @@ class StoreDamage:
     limit_states: tuple[LimitState, ...]
     source: str
     contact_free: bool
+    elastic: tuple[str, ...] = ()
 
     def governing(self, probability: float) -> xr.DataArray | None:
         """Per configuration, what is reached most often at the risk-targeted separation g* of ``probability`` in 50 yr.
@@ -150,8 +155,14 @@ def store_damage(store: xr.Dataset, limit_states: Sequence[LimitState] | None = 
     if limit_states is None:
         limit_states, source = DEFAULT_LIMIT_STATES, DEFAULT_SOURCE
     per_building, free = _store.run_summaries(store, list(DAMAGE_DEMANDS))
-    demands = xr.Dataset({name: data.quantile(list(QUANTILES), dim="record", keep_attrs=True) for name, data in per_building.items()})
-    done = np.isfinite(per_building["peak_ductility"].max("building"))
+    ductility = per_building["peak_ductility"]
+    yields = ductility.notnull().any([d for d in ductility.dims if d != "building"])
+    elastic = tuple(str(b) for b, flag in zip(ductility["building"].values, yields.values) if not flag)
+    # an elastic building has no ductility: its fractiles NaN (a placeholder 0 in the quantile, not an all-NaN slice); a demand no run has: left out
+    demands = xr.Dataset({name: data.where(yields, 0.0).quantile(list(QUANTILES), dim="record", keep_attrs=True).where(yields)
+                          if name == "peak_ductility" else data.quantile(list(QUANTILES), dim="record", keep_attrs=True)
+                          for name, data in per_building.items() if bool(data.notnull().any())})
+    done = xr.concat([data.notnull().any("building") for data in per_building.values()], "demand").any("demand")
     drift = per_building.get("peak_drift_ratio")
     beyond = (drift.max("building") > MODEL_DRIFT_LIMIT) if drift is not None else xr.zeros_like(done)
     hz = _store.site_hazard(store)
@@ -164,4 +175,4 @@ def store_damage(store: xr.Dataset, limit_states: Sequence[LimitState] | None = 
     if held:
         risk = limit_state_risk(store, held, hz)
         risk = _store.contact_free_part(risk) if free else risk
-    return StoreDamage(demands, done.sum("record"), (beyond & done).sum("record"), design_stripes, risk, held, source or "", free)
+    return StoreDamage(demands, done.sum("record"), (beyond & done).sum("record"), design_stripes, risk, held, source or "", free, elastic)

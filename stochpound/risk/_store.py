@@ -25,7 +25,8 @@ from stochpound.codes import store_contact_demands
 from stochpound.hazard import HazardCurve, check_covers, hazard_curve, hazard_option, parse_measure, parse_units, stored_hazard
 from stochpound.model import Scene
 from stochpound.motions import DEFAULT_G, TRUNCATION_EPSILON
-from stochpound.store import LIMIT_STATE_DEMANDS, contact_free, describe_measure, gap_dims, has_contact_free, has_wall_free, scenario_kind, scenario_ranges, wall_free, with_contacts
+from stochpound.store import (LIMIT_STATE_DEMANDS, cases_done, check_finished as _check_finished, contact_free, describe_measure, gap_dims,
+                              has_contact_free, has_wall_free, scenario_kind, scenario_ranges, wall_free, with_contacts)
 
 CLOSURE = "peak_contact_closure"
 """The store's variable of per-case, per-contact peak closures (m)."""
@@ -250,11 +251,33 @@ def contact_free_closure(store: xr.Dataset, contact_dim: str = "contact") -> xr.
     return store_motions(closure).load().assign_attrs(units="m", long_name="largest contact-free peak closure over the contacts")
 
 
-def stripe_motions(store: xr.Dataset, motions: int) -> int:
-    """The motions of every stripe: all ``motions`` of the store, or the fewest chosen per stripe by a selection for the site."""
+def check_finished(store: xr.Dataset, partial: bool) -> None:
+    """Refuse a store with missing cases unless ``partial`` (``UnfinishedStoreError``, naming the store's experiment)."""
+    _check_finished(store, experiment_name(store) or "store", partial, option="--partial (partial=True from Python)")
+
+
+def progress(store: xr.Dataset) -> str:
+    """``288/704 cases done`` for a store with missing cases, "" for a finished one."""
+    done, total = cases_done(store)
+    return f"{done}/{total} cases done" if done < total else ""
+
+
+def stripe_motions(store: xr.Dataset, closure: xr.DataArray) -> int:
+    """The motions of every stripe: all of the store's (``closure``'s ``record``), the fewest chosen per stripe by a selection for
+    the site, and of a store with missing cases the fewest that ran in a stripe and configuration (a contact-free closure)."""
+    motions = closure.sizes["record"]
     if "selection_scale_factor" in store:
-        return int(np.isfinite(store["selection_scale_factor"]).sum("record").min())
+        motions = int(np.isfinite(store["selection_scale_factor"]).sum("record").min())
+    if progress(store):
+        motions = min(motions, int(closure.notnull().sum("record").min()))
     return motions
+
+
+def stripes_run(store: xr.Dataset, closure: xr.DataArray) -> int | None:
+    """The store's intensity stripes (None for IDA runs); of a store with missing cases, those with a contact-free run (``closure``)."""
+    if stripes(store) is None or not progress(store):
+        return stripes(store)
+    return int(closure.notnull().any([d for d in closure.dims if d != "intensity"]).sum())
 
 
 def selection_misses(store: xr.Dataset) -> list[float]:

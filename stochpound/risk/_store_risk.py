@@ -33,6 +33,7 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
+from stochpound._memory import check_memory
 from stochpound.hazard import HazardCurve, rate_from_probability
 from stochpound.risk import _store
 from stochpound.risk._code_rules import MINIMUM_MOTIONS, code_rules_risk
@@ -40,7 +41,7 @@ from stochpound.risk._design_rules import design_rules_risk
 from stochpound.risk._fragility_ensemble import BOOTSTRAP, fragility_band, fragility_surface, homogeneous_capacities, ida_fragility, limit_state_events, stripe_fragility
 from stochpound.risk._fragility import DECREASING, EMPTY, FIT, STATUS
 from stochpound.risk._maf import TARGETS, degenerate_text, non_increasing, risk_curve, risk_targeted_separation
-from stochpound.risk._stripe_coverage import maf_outside_stripes
+from stochpound.risk._stripe_coverage import maf_outside_stripes, top_capped_maf
 
 YEARS = 50.0
 """The default exposure time of the targets (yr)."""
@@ -138,13 +139,15 @@ class StoreRisk:
     hazard : HazardCurve
         The site's hazard.
     motions : int
-        The motions of every stripe (the bootstrap's sample size).
+        The motions of every stripe (the bootstrap's sample size): the fewest that ran in a stripe and configuration.
     method : str
         ``"stripes"`` or ``"ida"``.
     setting : dict
         The store's ``[intensity]`` entry (its measure, units and levels).
     stripes : int or None
-        The store's intensity stripes (None for IDA runs).
+        The store's intensity stripes that ran (None for IDA runs).
+    progress : str
+        The store's cases done, ``288/704 cases done`` ("" for a store whose every case ran).
     experiment : str or None
         The store's experiment name.
     years : float
@@ -174,6 +177,7 @@ class StoreRisk:
     method: str
     setting: dict[str, Any] = dataclasses.field(default_factory=dict)
     stripes: int | None = None
+    progress: str = ""
     experiment: str | None = None
     years: float = YEARS
     confidence: float = CONFIDENCE
@@ -201,26 +205,33 @@ class StoreRisk:
         pandas.DataFrame
             Columns: the configuration's dimensions, ``target`` (probability in
             ``years``), ``separation``, ``lower``, ``upper`` (m; ``inf``: wider
-            than every gap of the grid), ``confidence``, ``motions``.
+            than every gap of the grid), ``lower_bound`` (True where
+            ``separation`` is only a lower bound of g*, the target beyond
+            the stripes' runs: ``stochpound.risk._store_risk.bound_beyond_stripes``; its interval is
+            then NaN), ``confidence``, ``motions``.
         """
         separation = self.separation
         for bound in ("lower", "upper"):  # absent without a bootstrap
             if bound not in separation:
                 separation = separation.assign({bound: xr.full_like(separation["separation"], np.nan)})
-        frame = _grid_only(separation[list(_SEPARATION)]).to_dataframe().reset_index()
+        if "lower_bound" not in separation:  # IDA runs: homogeneity carries every gap
+            separation = separation.assign(lower_bound=xr.zeros_like(separation["separation"], dtype=bool))
+        frame = _grid_only(separation[[*_SEPARATION, "lower_bound"]]).to_dataframe().reset_index()
         frame = frame.drop(columns=[c for c in ("target_rate",) if c in frame])
         return frame.assign(confidence=self.confidence, motions=self.motions)
 
     def configuration_dims(self) -> list[str]:
         """The dimensions of :meth:`to_frame` that name a configuration (every grid axis but the gap)."""
-        return [c for c in self.to_frame().columns if c not in ("target", *_SEPARATION, "confidence", "motions")]
+        return [c for c in self.to_frame().columns if c not in ("target", *_SEPARATION, "lower_bound", "confidence", "motions")]
 
     def separation_frame(self) -> pd.DataFrame:
-        """The g* table: per configuration, g* and its interval (m) for each target (columns grouped by target)."""
+        """The g* table: per configuration, g* and its interval (m) for each target (columns grouped by target); a g* that
+        is only a lower bound (``stochpound.risk._store_risk.bound_beyond_stripes``) is the text ``≥ 0.640``, its interval empty."""
         frame = self.to_frame()
         years = float(self.separation.attrs.get("years", self.years))
         config = self.configuration_dims()
         frame["target"] = [target_text(p, years) for p in frame["target"]]
+        frame["separation"] = [f"≥ {value:.3f}" if bound else value for value, bound in zip(frame["separation"], frame["lower_bound"])]
         table = frame.set_index([*config, "target"])[list(_SEPARATION)].rename(columns=_SEPARATION)
         if config:
             table = table.unstack("target")
@@ -339,14 +350,44 @@ class StoreRisk:
         -------
         pandas.DataFrame
             Columns: the configuration's dimensions, ``target``, ``design``
-            (m), ``basis`` (what ``design`` is, in words).
+            (m; NaN, withheld, where g* is only a lower bound: the target lies
+            beyond the stripes' runs, ``stochpound.risk._store_risk.bound_beyond_stripes``), ``basis``
+            (what ``design`` is, in words).
         """
         frame = self.to_frame()
         bounded = frame["upper"].notna()
         one_sided = f"{100 * (1 + self.confidence) / 2:g} % one-sided upper bound of g*"
-        frame["design"] = frame["upper"].where(bounded, frame["separation"])
+        frame["design"] = frame["upper"].where(bounded, frame["separation"]).where(~frame["lower_bound"])
         frame["basis"] = np.where(bounded, one_sided, "g* (no bound: the interval is not estimable)" if self.no_interval else "g* (no bootstrap: no bound)")
+        frame.loc[frame["lower_bound"], "basis"] = [f"withheld: g* ≥ {value:.3f} m, beyond the stripes' runs"
+                                                    for value in frame.loc[frame["lower_bound"], "separation"]]
         return frame[[*self.configuration_dims(), "target", "design", "basis"]]
+
+    def beyond_stripes_text(self) -> str:
+        """Which targets' g* lie beyond the stripes' runs (given as lower bounds) and what to add, in words ("" when none does)."""
+        if "lower_bound" not in self.separation or not bool(self.separation["lower_bound"].any()):
+            return ""
+        top = float(self.separation.attrs["top_stripe"])
+        units = self.setting.get("units", self.hazard.units)
+        sentences = []
+        for target in self.separation["target"].values:
+            at = self.separation.sel(target=target)
+            flagged = at["lower_bound"]
+            if not bool(flagged.any()):
+                continue
+            rate = float(at["target_rate"])
+            where = "in every configuration" if bool(flagged.all()) else f"in {int(flagged.sum())} of {flagged.size} configurations"
+            reach = float(at["reach"].where(flagged).max())
+            at_top = float(self.hazard(min(top, self.hazard.support[1])))
+            why = (f"its rate, {rate:.3g} /yr, is below the hazard's rate at the top stripe ({top:g} {units}, {at_top:.3g} /yr)"
+                   if rate < at_top else f"the top stripe's runs close no gap wider than {reach:.3f} m, where λ_P is still above it")
+            level = _reach_intensity(self.hazard, [float(target)], self.years)
+            add = (f"add stripes above {top:g} {units}" + (f", up to about {level:.3g} {units} (where the hazard's rate is a tenth of the "
+                                                           f"target's)" if level > top else ""))
+            sentences.append(f"g* for {self.target_text(float(target))} lies beyond the stripes' runs {where}: {why}. It is given as a lower "
+                             f"bound (≥, the gap where pounding is as frequent as the target with the fragility held at its top-stripe "
+                             f"value beyond it, at most {reach:.3f} m); its interval and the gap to design to are withheld: {add}.")
+        return " ".join(sentences)
 
     def degenerate_text(self) -> str:
         """The degenerate fragility fits among the gaps (steps, not lognormals) and what each does to λ_P ("" when there are none)."""
@@ -428,9 +469,79 @@ def _reach_intensity(hz: HazardCurve, targets: Sequence[float], years: float) ->
     return float(hz.intensity_at(rate))
 
 
+def bootstrap_bytes(resamples: int, fits: int, stripes: int, motions: int) -> int:
+    """Upper estimate of the memory (bytes) the resamples of the risk chain hold at once: ``resamples`` refits of ``fits`` fits
+    (gaps × configurations) over ``stripes`` stripes (1 for IDA runs) of ``motions`` motions.
+
+    Counted in doubles per resample: the stripes' weighted counts and the
+    maximum-likelihood fit's work arrays (16 per fit and stripe), each
+    fit's θ, β, flat fraction, λ and g* with their sorted copies for the
+    intervals (24 per fit), the resample's weights (2 per motion); and
+    64 MiB whatever their number, the quadrature of the MAF (chunks of 4096
+    fits at 192 nodes). The tests check it against the measured peak of the chain.
+    """
+    return 8 * resamples * (16 * fits * stripes + 24 * fits + 2 * motions) + 64 * 2**20
+
+
+def check_bootstrap(resamples: int, fits: int, stripes: int, motions: int) -> None:
+    """Refuse a bootstrap whose resamples would hold more memory than the limit (``MemoryLimitError``, naming ``bootstrap``)."""
+    check_memory(bootstrap_bytes(resamples, fits, stripes, motions),
+                 f"bootstrap (--bootstrap): {resamples} resamples of {motions} motions, each refitting {fits} fits (gaps × configurations) "
+                 f"over {stripes} stripe{'s' if stripes != 1 else ''}; the risk chain")
+
+
+def bound_beyond_stripes(separation: xr.Dataset, fragility: xr.Dataset, hz: HazardCurve, years: float = YEARS) -> xr.Dataset:
+    """g* of a stripes fit, given as a lower bound where it lies beyond what the stripes' runs observe.
+
+    A target's g* is beyond the runs where (a) it is wider than ``reach``,
+    the widest grid gap the top stripe's runs still close (wider gaps fit
+    ``never``: λ_P drops to 0 there, and g* would stop at the largest closure
+    seen, however rare the target), or (b) the target's rate is below the
+    hazard's rate at the top stripe (the pounding it allows comes from
+    shaking no stripe ran). There ``separation`` becomes a lower bound that
+    rests on the runs alone: the gap where λ⁻ (``stochpound.risk._stripe_coverage.top_capped_maf``,
+    the fragility held beyond the top stripe at its value there) meets the
+    target, and no wider than ``reach``; its interval is withheld (NaN).
+
+    Parameters
+    ----------
+    separation : xarray.Dataset
+        From :func:`~stochpound.risk.risk_targeted_separation` of the fit's risk curve.
+    fragility : xarray.Dataset
+        The stripes fit over ``gap`` (with ``exceeded`` per stripe and the ``intensity`` coordinate).
+    hz : HazardCurve
+        The site's hazard.
+    years : float
+        The targets' exposure time (yr).
+
+    Returns
+    -------
+    xarray.Dataset
+        ``separation`` with ``lower_bound`` (True where ``separation`` is a
+        lower bound), ``reach`` (m, per configuration) and the attribute
+        ``top_stripe`` (the top stripe's level, IM units).
+    """
+    top = float(np.max(fragility["intensity"].values))
+    gap = fragility["gap"]
+    reach = gap.where(fragility["exceeded"].sel(intensity=top, drop=True) > 0.0).max("gap")
+    capped = risk_targeted_separation(xr.Dataset({"maf": top_capped_maf(fragility, hz)}), separation["target"].values, years)["separation"]
+    value = separation["separation"]
+    rarer = separation["target_rate"] < float(hz(min(top, hz.support[1])))
+    beyond = value.notnull() & (rarer | ~(value <= reach))
+    bound = np.fmin(np.fmin(capped, reach), value)
+    result = separation.assign(separation=value.where(~beyond, bound).assign_attrs(value.attrs))
+    for name in ("lower", "upper"):
+        if name in result:
+            result[name] = result[name].where(~beyond).assign_attrs(result[name].attrs)
+    flag = {"long_name": "separation is only a lower bound of g* (the target lies beyond the stripes' runs)"}
+    return result.assign(lower_bound=beyond.assign_attrs(flag),
+                         reach=reach.assign_attrs(units="m", long_name="widest gap of the grid the top stripe's runs close")
+                         ).assign_attrs(top_stripe=top)
+
+
 def store_risk(store: xr.Dataset, hz: HazardCurve | None = None, targets: Sequence[float] = TARGETS, years: float = YEARS,
                gaps: Sequence[float] | np.ndarray | None = None, studied: str | None = None, confidence: float = CONFIDENCE,
-               bootstrap: int = BOOTSTRAP, seed: int = 0, design: Mapping[str, Any] | None = None) -> StoreRisk:
+               bootstrap: int = BOOTSTRAP, seed: int = 0, design: Mapping[str, Any] | None = None, partial: bool = False) -> StoreRisk:
     """Fragility at every gap, the pounding risk curve, g* and the code rules of a store's intensity-conditioned runs.
 
     Parameters
@@ -460,13 +571,20 @@ def store_risk(store: xr.Dataset, hz: HazardCurve | None = None, targets: Sequen
     design : mapping, optional
         The buildings' code design (the ``[design]`` entry, docs/experiments.md)
         whose design analysis gives the codes' own gaps; default the store's.
+    partial : bool
+        Answer from the cases that ran of a store with missing cases (its
+        counts of motions and stripes are those that ran); without it such a
+        store is refused.
 
     Raises
     ------
     ValueError
         (``RiskInputError``) A store without stripes or IDA capacities, or
-        without contact-free runs, or without a hazard when none is given.
+        without contact-free runs, or without a hazard when none is given;
+        (``UnfinishedStoreError``) a store with missing cases without ``partial``;
+        (``MemoryLimitError``) a ``bootstrap`` beyond the memory limit (``stochpound.risk._store_risk.check_bootstrap``).
     """
+    _store.check_finished(store, partial)
     hz = _store.site_hazard(store) if hz is None else hz
     studied = _store.studied_building(store) if studied is None else studied
     closure = _store.contact_free_closure(store)
@@ -476,10 +594,14 @@ def store_risk(store: xr.Dataset, hz: HazardCurve | None = None, targets: Sequen
         grid = risk_gaps(xr.concat([closure, closure * (_reach_intensity(hz, targets, years) / _store.motion_intensity(store))], "record"))
     else:
         grid = risk_gaps(closure)
+    configurations = math.prod(size for dim, size in closure.sizes.items() if dim not in ("record", "intensity"))
+    check_bootstrap(bootstrap, grid.size * configurations, closure.sizes.get("intensity", 1), closure.sizes["record"])
     fragility = pounding_fragility(store, grid, confidence=confidence, bootstrap=bootstrap, seed=seed)
     curve = risk_curve(fragility, hz, years, confidence)
     separation = risk_targeted_separation(curve, targets, years, confidence=confidence)
-    motions = _store.stripe_motions(store, closure.sizes["record"])
+    if not _store.is_ida(store):
+        separation = bound_beyond_stripes(separation, fragility, hz, years)
+    motions = _store.stripe_motions(store, closure)
     method = "ida" if _store.is_ida(store) else "stripes"
     rules, note, dtm_note = None, "", ""
     if method == "ida":
@@ -499,7 +621,7 @@ def store_risk(store: xr.Dataset, hz: HazardCurve | None = None, targets: Sequen
     else:
         design_rules = design_rules_risk(store, hz, design, studied, years, confidence, bootstrap, seed)
     return StoreRisk(fragility, curve, separation, rules, note, hz, motions, method, setting=_store.intensity_setting(store) or {},
-                     stripes=_store.stripes(store), experiment=_store.experiment_name(store), years=years, confidence=confidence,
+                     stripes=_store.stripes_run(store, closure), progress=_store.progress(store), experiment=_store.experiment_name(store), years=years, confidence=confidence,
                      assumptions=_store.assumptions(store), dtm_note=dtm_note, design_rules=design_rules, design_note=design_note)
 
 

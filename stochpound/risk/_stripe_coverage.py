@@ -18,6 +18,11 @@ law from where F is 10⁻¹⁵ of its median, 8 β below θ).
 A large ``below`` share (a measure far from the structure's periods, whose
 frequent, weak shaking still pounds) means g* rests on an extrapolation:
 stripes at more frequent intensities replace it by runs.
+
+λ⁻ itself, at every gap of the grid (:func:`top_capped_maf`), is a lower
+bound of λ_P that rests on the runs alone (F does not fall with intensity,
+so beyond x_n it is at least F(x_n)): the gap where λ⁻ meets a target is a
+lower bound of g*, the answer for a target rarer than the stripes reach.
 """
 
 from __future__ import annotations
@@ -26,7 +31,7 @@ import numpy as np
 import xarray as xr
 
 from stochpound.hazard import HazardCurve
-from stochpound.risk._fragility import lognormal_cdf
+from stochpound.risk._fragility import FIT, SEPARATED, lognormal_cdf
 from stochpound.risk._maf import mean_annual_frequency
 
 _POINTS = 4000
@@ -95,6 +100,37 @@ def maf_outside_stripes(fragility: xr.Dataset, separation: xr.DataArray, hz: Haz
     return xr.Dataset({"below": shares["below"].assign_attrs(units="1", long_name="share of the MAF at g* from below the lowest stripe"),
                        "above": shares["above"].assign_attrs(units="1", long_name="share of the MAF at g* from the fragility's rise beyond the top stripe"),
                        "theta": at["theta"], "beta": at["beta"]})
+
+
+def top_capped_maf(fragility: xr.Dataset, hz: HazardCurve) -> xr.DataArray:
+    """λ⁻ (1/yr) of every fit: its MAF with the fragility beyond the top stripe held at its value there (module docstring).
+
+    λ⁻ = ∫ F |dλ| up to the top stripe's level x_n + F(x_n) λ(x_n) for a
+    lognormal fit. A ``separated`` step whose top stripe's runs did not all
+    exceed (none below it, k of n at it: the likelihood's step at x_n says
+    F = 1 beyond, the runs say k/n) gives the fraction that exceeded at x_n,
+    k/n λ(x_n). Any other step or flat fit keeps its MAF
+    (:func:`~stochpound.risk.mean_annual_frequency`): it does not rise beyond the runs.
+
+    Parameters
+    ----------
+    fragility : xarray.Dataset
+        A stripes fit (:func:`~stochpound.risk.pounding_fragility`), with its ``intensity`` coordinate.
+    hz : HazardCurve
+        The site's hazard the fit is integrated with.
+
+    Returns
+    -------
+    xarray.DataArray
+        λ⁻ over the fit's dimensions (e.g. ``gap`` and the configurations), ≤ the MAF.
+    """
+    top = float(min(np.max(fragility["intensity"].values), hz.support[1]))
+    middle = xr.apply_ufunc(lambda t, b: _rate_between(t, b, hz, top), fragility["theta"], fragility["beta"], vectorize=True)
+    at_top = xr.apply_ufunc(lambda t, b: lognormal_cdf(top, t, b), fragility["theta"], fragility["beta"]) * float(hz(top))
+    exceeded, runs = (fragility[name].sel(intensity=fragility["intensity"].max(), drop=True) for name in ("exceeded", "runs"))
+    fraction = exceeded / runs.where(runs > 0)
+    step = mean_annual_frequency(fragility, hz).where((fragility["status"] != SEPARATED) | ~(fraction < 1.0), fraction * float(hz(top)))
+    return step.where(fragility["status"] != FIT, middle + at_top)
 
 
 def _rate_between(theta: float, beta: float, hz: HazardCurve, upper: float) -> float:

@@ -67,6 +67,7 @@ from stochpound.store._selections import fixed_base, has_fixed_base_twins, isola
 # For the other packages of stochpound (their interface to this one, not public API: not in __all__).
 from stochpound.store._catalogue import CASE, KINDS, REFERENCE  # noqa: F401
 from stochpound.store._definition import MEASURES  # noqa: F401
+from stochpound.store._progress import UnfinishedStoreError, cases_done, check_finished  # noqa: F401
 
 __all__ = [
     "ACCESSOR",

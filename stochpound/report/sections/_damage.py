@@ -14,10 +14,11 @@ def damage_section(name: str, damage: StoreDamage) -> Section:
     section = Section(f"Damage: experiment {name}", key=f"damage-{name}")
     runs = "contact-free runs (those the separations come from)" if damage.contact_free else "runs"
     stripes = "; ".join(f"{_percent(p)} in 50 yr: stripe {number(level)}" for p, level in damage.design_stripes.items())
+    measured = [DAMAGE_DEMANDS[name] + (" (drift over yield drift)" if name == "peak_ductility" else "") for name in DAMAGE_DEMANDS if name in damage.demands]
     section.add(Paragraph(
-        f"What the earthquakes do to the yielding buildings of experiment {name}, from its {runs}: the median and 84 % fractile over "
-        f"each stripe's motions of every building's largest peak storey ductility (drift over yield drift), residual storey drift and "
-        f"peak storey drift ratio, at the stripes nearest (in ln IM) the hazard's intensities of the design levels ({stripes})."
+        f"What the earthquakes do to the buildings of experiment {name}, from its {runs}: the median and 84 % fractile over "
+        f"each stripe's motions of every building's largest {', '.join(measured)}, at the stripes nearest (in ln IM) the hazard's "
+        f"intensities of the design levels ({stripes}).{_elastic_text(damage)}"
     ))
     section.add(_demands_table(name, damage))
     section.add(Paragraph(_beyond_model_text(damage)))
@@ -25,6 +26,16 @@ def damage_section(name: str, damage: StoreDamage) -> Section:
         section.add(Paragraph(_governing_text(damage)))
         section.add(_limit_states_table(name, damage))
     return section
+
+
+def _elastic_text(damage: StoreDamage) -> str:
+    """Which buildings are elastic (their storeys never yield: no ductility), in a sentence ("" when every building yields)."""
+    if not damage.elastic:
+        return ""
+    if "peak_ductility" not in damage.demands:
+        return " The buildings are elastic (no storey yields in any run): they have no ductility, and the table gives their drifts only."
+    return (f" {', '.join(damage.elastic)} {'is' if len(damage.elastic) == 1 else 'are'} elastic (no storey yields in any run): no ductility "
+            "('elastic' in its column).")
 
 
 def _configurations(data) -> list[dict]:
@@ -45,7 +56,7 @@ def _label(labels: dict) -> str:
 def _demands_table(name: str, damage: StoreDamage) -> Table:
     rows = []
     demands = damage.demands
-    for labels in _configurations(demands["peak_ductility"]):
+    for labels in _configurations(demands[next(iter(demands.data_vars))]):
         for probability, level in damage.design_stripes.items():
             at = demands.sel(labels).sel(intensity=level)
             for building in at["building"].values:
@@ -53,13 +64,15 @@ def _demands_table(name: str, damage: StoreDamage) -> Table:
                 for variable, scale, unit in (("peak_ductility", 1.0, ""), ("residual_drift", 1000.0, " (mm)"), ("peak_drift_ratio", 100.0, " (%)")):
                     if variable in at:
                         for q, word in ((0.5, "median"), (0.84, "84 %")):
-                            row[f"{DAMAGE_DEMANDS[variable]}{unit}, {word}"] = f"{float(at[variable].sel(building=building, quantile=q)) * scale:.3g}"
+                            value = float(at[variable].sel(building=building, quantile=q)) * scale
+                            elastic = variable == "peak_ductility" and str(building) in damage.elastic
+                            row[f"{DAMAGE_DEMANDS[variable]}{unit}, {word}"] = "elastic" if elastic else f"{value:.3g}"
                 row["runs > model"] = f"{int(damage.beyond_model.sel(labels).sel(intensity=level))} of {int(damage.runs.sel(labels).sel(intensity=level))}"
                 rows.append(row)
     frame = pd.DataFrame(rows).set_index(["configuration", "stripe", "building"])
     return Table(
         key=f"table-damage-{name}",
-        caption=(f"Experiment {name}: each building's largest peak storey ductility, residual storey drift and peak storey drift ratio, "
+        caption=(f"Experiment {name}: each building's largest {', '.join(DAMAGE_DEMANDS[v] for v in DAMAGE_DEMANDS if v in demands)}, "
                  "median and 84 % fractile over the stripe's motions, at the stripes of 10 % and 2 % in 50 yr"),
         frame=frame,
         note=(f"runs > model: the stripe's runs whose peak storey drift ratio (any building) exceeds {_percent(MODEL_DRIFT_LIMIT)}, beyond what "

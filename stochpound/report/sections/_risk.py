@@ -75,15 +75,20 @@ def headline_text(name: str, risk: StoreRisk) -> str:
     per = []
     for labels, rows in (frame.groupby(config, sort=False) if config else [((), frame)]):
         labels = labels if isinstance(labels, tuple) else (labels,)
-        values = "; ".join(f"{_gap_text(row.separation)} for {risk.target_text(row.target)}"
-                           + ("" if risk.no_interval else f" [{_gap_text(row.lower)}, {_gap_text(row.upper)}]") for row in rows.itertuples())
+        values = "; ".join(f"at least {_gap_text(row.separation)} for {risk.target_text(row.target)} (beyond the stripes' runs: no interval)"
+                           if row.lower_bound else
+                           f"{_gap_text(row.separation)} for {risk.target_text(row.target)}"
+                           + ("" if risk.no_interval else f" [{_gap_text(row.lower)}, {_gap_text(row.upper)}]")
+                           for row in rows.itertuples())
         per.append(f"{labels_text(dict(zip(config, labels))) or 'the scene'}: {values}")
     stripes = f"{risk.stripes} stripes of " if risk.stripes is not None else "IDA capacities in "
+    partial = f" (an unfinished store, {risk.progress}: answered from the cases that ran)" if risk.progress else ""
+    beyond = risk.beyond_stripes_text()
     return (
         f"Risk-targeted separation g* (the gap whose mean annual frequency of pounding is that of {targets}, Poisson) of experiment "
-        f"{name}, from {_motions_text(risk)}{' per stripe' if is_selected(risk.setting) else ''} ({stripes}{risk.measure} in {risk.setting['units']}) at the site of its hazard curve, "
+        f"{name}{partial}, from {_motions_text(risk)}{' per stripe' if is_selected(risk.setting) else ''} ({stripes}{risk.measure} in {risk.setting['units']}) at the site of its hazard curve, "
         + (f"without intervals (not estimable: {risk.no_interval}): " if risk.no_interval else
-           f"with {_percent(risk.confidence)} intervals ({_resampling(risk)}): ") + ". ".join(per) + "."
+           f"with {_percent(risk.confidence)} intervals ({_resampling(risk)}): ") + ". ".join(per) + "." + (f" {beyond}" if beyond else "")
     )
 
 
@@ -239,14 +244,17 @@ def design_value_text(risk: StoreRisk) -> str:
     per = []
     for labels, rows in (frame.groupby(config, sort=False) if config else [((), frame)]):
         labels = labels if isinstance(labels, tuple) else (labels,)
-        values = "; ".join(f"{_gap_text(row.design)} for {risk.target_text(row.target)}" for row in rows.itertuples())
+        values = "; ".join(f"{_gap_text(row.design) if row.design == row.design else row.basis} for {risk.target_text(row.target)}"
+                           for row in rows.itertuples())
         per.append(f"{labels_text(dict(zip(config, labels))) or 'the scene'}: {values}")
     motions = f"{_motions_text(risk)}{' per stripe' if is_selected(risk.setting) else ''}"
     if "upper" not in risk.separation:
         why = "its interval is not estimable" if risk.no_interval else "no bootstrap was run"
         return (f"There is no upper bound of g* to design to ({why}): the values are g* itself, a central estimate "
                 f"from {motions} that meets its target only about half the time: " + ". ".join(per) + ".")
-    return (f"The gap to design to is the {frame['basis'].iloc[0]}, not g* itself (g* is a central estimate from "
+    given = frame["design"].notna()
+    basis = frame.loc[given, "basis"].iloc[0] if given.any() else "upper bound of g*'s interval"
+    return (f"The gap to design to is the {basis}, not g* itself (g* is a central estimate from "
             f"{motions} and meets its target only about half the time): " + ". ".join(per) + ".")
 
 
