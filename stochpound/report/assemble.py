@@ -40,7 +40,7 @@ from stochpound.store import has_contact_free, has_wall_free, with_contacts, wit
 from stochpound._studies import claims, load_study
 
 
-def assemble_report(paths: Sequence[str | Path], progress: Callable[[str], None] | None = None) -> Report:
+def assemble_report(paths: Sequence[str | Path], progress: Callable[[str], None] | None = None, edited: str = "warn") -> Report:
     """Build the report of the given stores.
 
     Parameters
@@ -49,6 +49,9 @@ def assemble_report(paths: Sequence[str | Path], progress: Callable[[str], None]
         Experiment store files.
     progress : callable, optional
         Called with a short message before each step.
+    edited : {"warn", "refuse", "accept"}
+        A store whose definition does not match its recorded sha256 (:func:`~stochpound.open_store`;
+        ``stochpound report build`` refuses it without ``--accept-edited``).
 
     Returns
     -------
@@ -56,7 +59,7 @@ def assemble_report(paths: Sequence[str | Path], progress: Callable[[str], None]
     """
     say = progress or (lambda message: None)
     say("reading stores")
-    stores = open_stores(paths)
+    stores = open_stores(paths, edited)
     claimed = claims({name: store.pound.definition.reproduces for name, store in stores.items()})
     studied = {name for parts in claimed.values() for name in parts.values()}
     others = {name: store for name, store in stores.items() if name not in studied}

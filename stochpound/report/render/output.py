@@ -80,11 +80,11 @@ def write_report(
     date = datetime.date.today()
     written = {"figures": out / "figures", "tables": out / "tables"}
     owned = [f"figures/{item.key}.png" for item in report.figures()] + [f"tables/{table.key}.csv" for table in report.tables()]
-    _claim(out, owned, [FILE_NAMES[name] for name in formats])
+    previous = _claim(out, owned, [FILE_NAMES[name] for name in formats])
     try:
         figure_png = _write_figures(report, written["figures"], say)
         _write_tables(report, written["tables"], say)
-        _replace_owned(out, owned, [FILE_NAMES[name] for name in formats])
+        _replace_owned(out, previous, owned, [FILE_NAMES[name] for name in formats])
         if "html" in formats:
             say(FILE_NAMES["html"])
             written["html"] = _replace(out / FILE_NAMES["html"], render_html(report, figure_png, date).encode("utf-8"))
@@ -114,11 +114,12 @@ def check_output_folder(out: Path, stores: Sequence[Path] = ()) -> None:
     check_writable(out / MANIFEST)
 
 
-def _claim(out: Path, owned: list[str], documents: list[str]) -> None:
+def _claim(out: Path, owned: list[str], documents: list[str]) -> list | None:
     """Before any file is written: refuse a file the build would replace in a folder of no earlier build; list this build's files beside an earlier build's.
 
     The list is written first, so that a build interrupted midway leaves a folder
-    whose files a later build recognises as its own.
+    whose files a later build recognises as its own. Returns the earlier build's
+    list (None: no earlier build), as it was before.
     """
     previous = _previous(out)
     if previous is None:
@@ -128,6 +129,7 @@ def _claim(out: Path, owned: list[str], documents: list[str]) -> None:
                                  "(or one of an earlier report), or move the file")
     listed = {name for name in previous or [] if isinstance(name, str) and _OWNED.fullmatch(name)}
     _replace(out / MANIFEST, json.dumps(sorted(listed | set(owned)), indent=0).encode("utf-8"))
+    return previous
 
 
 def _previous(out: Path) -> list | None:
@@ -139,14 +141,13 @@ def _previous(out: Path) -> list | None:
     return previous if isinstance(previous, list) else None
 
 
-def _replace_owned(out: Path, owned: list[str], documents: list[str]) -> None:
-    """Remove the files the previous build's list names and this build did not write; list this build's files.
+def _replace_owned(out: Path, previous: list | None, owned: list[str], documents: list[str]) -> None:
+    """Remove the files the previous build's list (``previous``, from :func:`_claim`) names and this build did not write; list this build's files.
 
     A folder with a list is an earlier build's: its document (``index.html``,
     ``report.pdf``) that this build does not write (``documents``) is stale
     and removed too (an HTML-only rebuild leaves no PDF of the old one).
     """
-    previous = _previous(out)
     kept = set(owned)
     for name in previous or []:
         if isinstance(name, str) and name not in kept and _OWNED.fullmatch(name):
