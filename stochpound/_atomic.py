@@ -15,7 +15,7 @@ import secrets
 import shutil
 from contextlib import contextmanager
 from pathlib import Path
-from typing import Iterator
+from typing import Iterable, Iterator
 
 TEMPORARY_SUFFIX = ".tmp"
 
@@ -58,6 +58,25 @@ def check_writable(path: str | Path) -> None:
         os.unlink(_create_temporary(path))
     except OSError as error:
         raise OSError(error.errno, error.strerror, str(path.parent)) from None
+
+
+def check_not_input(output: str | Path, inputs: Iterable[tuple[str | Path, str]], option: str) -> None:
+    """Refuse to write ``output`` over a file the same command reads: raise ``ValueError`` naming it and what it is.
+
+    Parameters
+    ----------
+    output : str or Path
+        The file the command would write (or replace).
+    inputs : iterable of (path, str)
+        The files the command reads, each with what it is (``"the experiment file"``).
+    option : str
+        The option that names ``output`` (``--store``), for the message.
+    """
+    output = Path(output)
+    for path, what in inputs:
+        path = Path(path)
+        if output.exists() and path.exists() and os.path.samefile(output, path):
+            raise ValueError(f"{output}: is {what}, an input of this command; {option} must name another file")
 
 
 def check_room(path: str | Path, needed: int) -> None:

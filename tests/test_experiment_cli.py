@@ -209,11 +209,13 @@ def test_a_damaged_store_with_intact_parts_is_repaired_by_run(stationary, tmp_pa
     assert "damaged; rebuilding it from the 4 finished cases" in result.stderr
     with open_store(store) as dataset:
         assert int((dataset.case_status == 1).sum()) == 2 and int((dataset.reference_status == 1).sum()) == 2
-    # without parts there is nothing to repair from: then, and only then, the advice is --restart
+    # without parts nothing tells it is a store: no advice to discard it, and --restart does not (issue 48)
     shutil.rmtree(parts_folder(store))
     store.write_bytes(b"not a store")
-    result = invoke("experiment", "run", str(experiment), "--workers", "0")
-    assert result.exit_code == 1 and "use --restart to discard it" in result.stderr, result.stderr
+    for restart in ([], ["--restart"]):
+        result = invoke("experiment", "run", str(experiment), "--workers", "0", *restart)
+        assert result.exit_code == 1 and "not a store of stochpound's" in result.stderr and "use --restart" not in result.stderr, result.stderr
+        assert store.read_bytes() == b"not a store"
 
 
 def test_a_complete_store_is_not_run_again(stationary, tmp_path):

@@ -6,6 +6,7 @@ import hashlib
 
 import dask.array
 import numpy as np
+import h5py
 import pytest
 import xarray as xr
 
@@ -113,10 +114,12 @@ def test_changed_definition_is_refused_without_restart(small_store, tmp_path):
 def test_restart_replaces_a_store(tmp_path):
     path = write_experiment(tmp_path, SMALL_EXPERIMENT.replace("count = 2", "count = 1").replace("gap = [0.01, 0.02]", "gap = [0.02]"))
     store = tmp_path / "other.nc"
-    store.write_bytes(b"not a store")
-    with pytest.raises(ExperimentError, match=r"other\.nc: not a readable netCDF4/HDF5 file .*--restart"):
+    with h5py.File(store, "w") as handle:  # a store of another definition (its identity attribute is what tells a store)
+        handle.attrs["definition_sha256"] = "0" * 64
+    before = store.read_bytes()
+    with pytest.raises(ExperimentError, match=r"other\.nc: made from a different experiment definition .*--restart"):
         run_experiment(load_experiment(path), store, workers=0, progress=False)
-    assert store.read_bytes() == b"not a store"
+    assert store.read_bytes() == before
     report = run_experiment(load_experiment(path), store, workers=0, progress=False, restart=True)
     assert report.complete and report.total == 2 * 2 * 2 + 2
     with open_store(store) as ds:

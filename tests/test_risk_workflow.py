@@ -481,3 +481,31 @@ def test_limit_states_of_a_store_without_finite_gaps_are_a_sentence_not_an_empty
     assert result.exit_code == 0, result.output
     assert "Empty DataFrame" not in result.output
     assert "Limit states beyond first contact: none to give: the store's grid has no finite gap" in result.output
+# ---------------------------------------------------------------- issue 48: a store lacking a variable, a hand-edited store
+
+
+def test_a_store_lacking_a_variable_is_one_line_before_any_answer(fixed_stores, tmp_path):
+    lacking = tmp_path / "lacking.nc"
+    with xr.open_dataset(fixed_stores[0], engine="h5netcdf") as store:
+        store.load().drop_vars("motion_pga").to_netcdf(lacking, engine="h5netcdf")  # read after the answers until issue 48
+    result = CliRunner().invoke(main, ["risk", str(lacking), "--bootstrap", "0"])
+    assert result.exit_code == 1 and isinstance(result.exception, (SystemExit, type(None))), repr(result.exception)
+    assert result.output.strip() == f"Error: {lacking}: the store has no variable 'motion_pga', which this command reads " \
+                                    "(removed from the store, or written by another stochpound?)"
+
+
+def test_a_hand_edited_store_is_refused_unless_accepted(fixed_stores, tmp_path):
+    import h5py
+
+    edited = tmp_path / "edited.nc"
+    edited.write_bytes(fixed_stores[0].read_bytes())
+    with h5py.File(edited, "a") as handle:  # its description changed by hand, the runs and the recorded sha256 left as they were
+        text = handle.attrs["definition"]
+        assert '"description":""' in text
+        handle.attrs["definition"] = text.replace('"description":""', '"description":"edited"')
+    refused = CliRunner().invoke(main, ["risk", str(edited), "--bootstrap", "0"])
+    assert refused.exit_code == 1 and refused.output.startswith(f"Error: {edited}: its definition does not match its recorded definition_sha256")
+    assert len(refused.output.strip().splitlines()) == 1 and "--accept-edited" in refused.output
+    accepted = CliRunner().invoke(main, ["risk", str(edited), "--bootstrap", "0", "--accept-edited"])
+    assert accepted.exit_code == 0, accepted.output
+    assert "Risk-targeted separation g*" in accepted.output

@@ -151,13 +151,14 @@ def check_command(experiment_file: str) -> None:
     try:
         loaded = load_experiment(experiment_file)
         resolve_motions(loaded)
+        n_reference = int(loaded.in_grid("reference").sum())  # a conditional-spectrum selection is made here: its errors too
+        n_cases = loaded.n_cases
     except (StochpoundError, ValueError) as error:
         raise click.ClickException(str(error)) from None
     click.echo(f"{experiment_file}: valid; definition sha256 {loaded.sha256}")
     for dim in loaded.dims:
         click.echo(f"  {dim.name:14s} {len(dim.values):5d}  {', '.join(_fmt(v) for v in dim.values[:8])}{' ...' if len(dim.values) > 8 else ''}")
-    n_reference = int(loaded.in_grid("reference").sum())
-    click.echo(f"  {loaded.n_cases - n_reference} cases + {n_reference} fixed-base reference cases")
+    click.echo(f"  {n_cases - n_reference} cases + {n_reference} fixed-base reference cases")
     with _errors_of(experiment_file, False):
         click.echo(f"  {'periods':14s} {periods_text(periods_of_interest(loaded))}")
         say_scene_warnings(experiment_warnings(loaded))

@@ -8,6 +8,7 @@ from typing import Any
 
 import click
 
+from stochpound._errors import StochpoundError
 from stochpound._signals import noting_ctrl_c
 
 
@@ -48,10 +49,17 @@ class HelpGroup(click.Group):
 
     def invoke(self, ctx: click.Context) -> object:
         """Run the command; a Ctrl-C anywhere in it ends it with exit status 130 and no traceback (click's is 1, "Aborted!"),
-        also one a library swallowed or turned into its own error (:func:`stochpound.cli.interruptible`)."""
+        also one a library swallowed or turned into its own error (:func:`stochpound.cli.interruptible`).
+
+        An error stochpound raises on purpose (:class:`~stochpound.StochpoundError`, whose message names the
+        field or file) that a command did not catch ends it with that one line, never a traceback.
+        """
         from stochpound.cli import interruptible
 
-        return interruptible(partial(super().invoke, ctx))
+        try:
+            return interruptible(partial(super().invoke, ctx))
+        except StochpoundError as error:
+            raise click.ClickException(str(error)) from None
 
     def format_commands(self, ctx: click.Context, formatter: click.HelpFormatter) -> None:
         """The ``Commands:`` section, each command's first sentence whole."""

@@ -7,6 +7,7 @@ import math
 import click
 
 from stochpound.cli._group import HelpGroup
+from stochpound._atomic import check_not_input
 from stochpound._errors import RecordError
 from stochpound.motions import DEFAULT_G
 
@@ -70,6 +71,7 @@ def show_command(name: str, plot_path: str | None, g: float, dt: float | None, u
 
     if not g > 0:
         raise click.BadParameter(f"must be > 0, got {g}", param_hint="--g")
+    _check_plot(plot_path, name)
     try:
         record = load_record(name, dt=dt, units=units)
     except RecordError as error:
@@ -78,6 +80,16 @@ def show_command(name: str, plot_path: str | None, g: float, dt: float | None, u
     if plot_path:
         plot_record(record, plot_path, g=g)
         click.echo(f"\nplot written to {plot_path}")
+
+
+def _check_plot(plot_path: str | None, name: str) -> None:
+    """Refuse a --plot that is the record file itself (it would be overwritten by the picture)."""
+    if plot_path is None:
+        return
+    try:
+        check_not_input(plot_path, [(name, "the record file")], "--plot")
+    except ValueError as error:
+        raise click.BadParameter(str(error), param_hint="--plot") from None
 
 
 def parse_periods(text: str) -> list[float]:
@@ -108,6 +120,7 @@ def spectrum_command(name: str, periods_text: str, damping: float, plot_path: st
 
     if not g > 0:
         raise click.BadParameter(f"must be > 0, got {g}", param_hint="--g")
+    _check_plot(plot_path, name)
     periods = parse_periods(periods_text)
     try:
         record = load_record(name, dt=dt, units=units)

@@ -8,6 +8,7 @@ import click
 
 from stochpound.cli._group import HelpGroup
 from stochpound._errors import StochpoundError, os_error_message
+from stochpound.cli._store_errors import store_variables
 
 FORMAT_CHOICES = ("html", "pdf")
 
@@ -32,7 +33,9 @@ def report() -> None:
 @click.option("--partial", is_flag=True,
               help="Report a store with missing cases from the cases that ran (the report says how many ran); without it such a store "
                    "is refused.")
-def build_command(stores: tuple[Path, ...], out: Path, formats: tuple[str, ...], partial: bool) -> None:
+@click.option("--accept-edited", "accept_edited", is_flag=True,
+              help="Build the report of a store whose definition does not match its recorded sha256 (changed since it was written); refused otherwise.")
+def build_command(stores: tuple[Path, ...], out: Path, formats: tuple[str, ...], partial: bool, accept_edited: bool) -> None:
     """Build the report from the experiment STORE files into --out.
 
     Writes OUT/index.html (self-contained page), OUT/report.pdf, and every
@@ -47,8 +50,9 @@ def build_command(stores: tuple[Path, ...], out: Path, formats: tuple[str, ...],
     from stochpound.report.render.output import check_output_folder, write_report
 
     try:
-        check_output_folder(out)
-        document = assemble_report(list(stores), progress=_progress, partial=partial)
+        check_output_folder(out, stores)
+        with store_variables(stores):
+            document = assemble_report(list(stores), progress=_progress, partial=partial, edited="accept" if accept_edited else "refuse")
         written = write_report(document, out, formats, progress=_progress)
     except (StochpoundError, ValueError) as error:
         raise click.ClickException(str(error)) from None

@@ -7,7 +7,10 @@ from pathlib import Path
 import click
 
 from stochpound import StochpoundError
+from stochpound._atomic import check_not_input
 from stochpound._errors import os_error_message
+from stochpound._text_files import read_text_file
+from stochpound.cli._store_errors import store_variables
 from stochpound.risk import BOOTSTRAP, TARGETS
 
 
@@ -26,7 +29,7 @@ def _toml_table(path: Path, name: str, docs: str) -> dict:
     import tomllib
 
     try:
-        table = tomllib.loads(path.read_text())
+        table = tomllib.loads(read_text_file(path, click.ClickException))
     except tomllib.TOMLDecodeError as error:
         raise click.ClickException(f"{path}: not TOML: {error}") from None
     if name not in table:
@@ -46,6 +49,19 @@ def _design(path: Path) -> dict:
     from stochpound.experiment import parse_design
 
     return parse_design(_toml_table(path, "design", "docs/experiments.md"))
+
+
+def _check_csv(csv_dir: Path, inputs: list[tuple[str | Path, str]]) -> None:
+    """Refuse a --csv folder where a table's file would replace an input of the command."""
+    try:
+        for name in CSV_TABLES:
+            check_not_input(csv_dir / f"{name}.csv", [(path, what) for path, what in inputs if path], "--csv")
+    except ValueError as error:
+        raise click.BadParameter(str(error), param_hint="--csv") from None
+
+
+CSV_TABLES = ("separation", "rules", "limit_states")
+"""The tables ``--csv`` writes (one file each)."""
 
 
 @click.command("risk")
@@ -75,12 +91,14 @@ def _design(path: Path) -> dict:
 @click.option("--partial", is_flag=True,
               help="Answer from the cases that ran of a store with missing cases (its header says how many ran); without it such a "
                    "store is refused.")
+@click.option("--accept-edited", "accept_edited", is_flag=True,
+              help="Answer for a store whose definition does not match its recorded sha256 (changed since it was written); refused otherwise.")
 @click.option("--csv", "csv_dir", type=click.Path(file_okay=False, path_type=Path), metavar="DIR",
               help="Also write the tables to this folder (created), one CSV file per table: separation.csv, rules.csv "
                    "(and limit_states.csv with --limit-states).")
 def risk(store: Path, hazard: str | None, hazard_measure: str | None, hazard_units: str | None, investigation_time: float | None,
          hazard_site: str | None, extrapolate: bool, target: str, years: float, bootstrap: int, seed: int, limit_states: Path | None,
-         design: Path | None, partial: bool, csv_dir: Path | None) -> None:
+         design: Path | None, partial: bool, accept_edited: bool, csv_dir: Path | None) -> None:
     """Print the risk-targeted separation g* and the code rules' risks of the experiment STORE at a site.
 
     For every configuration of the store (each combination of its grid's
@@ -112,13 +130,19 @@ def risk(store: Path, hazard: str | None, hazard_measure: str | None, hazard_uni
     targets = _targets(target)
     if hazard is None and (hazard_measure or hazard_units or investigation_time is not None or hazard_site is not None):
         raise click.UsageError("--hazard-measure, --hazard-units, --investigation-time and --hazard-site describe a --hazard file: give one")
+    if csv_dir is not None:
+        _check_csv(csv_dir, [(store, "the store"), (hazard or "", "the --hazard file"), (limit_states or "", "the --limit-states file"),
+                             (design or "", "the --design file")])
     try:
-        data = open_store(store)
-        hz = site_hazard(data, hazard, measure=hazard_measure, units=hazard_units, investigation_time=investigation_time,
-                         site=hazard_site, extrapolate=extrapolate)
-        result = store_risk(data, hz, targets, years, bootstrap=bootstrap, seed=seed, design=None if design is None else _design(design),
-                            partial=partial)
-        costs = None if limit_states is None else gap_cost_frame(limit_state_risk(data, _limit_states(limit_states), hz), years)
+        with store_variables([store]):
+            data = open_store(store, edited="accept" if accept_edited else "refuse")
+            hz = site_hazard(data, hazard, measure=hazard_measure, units=hazard_units, investigation_time=investigation_time,
+                             site=hazard_site, extrapolate=extrapolate)
+            result = store_risk(data, hz, targets, years, bootstrap=bootstrap, seed=seed, design=None if design is None else _design(design),
+                                partial=partial)
+            costs = None if limit_states is None else gap_cost_frame(limit_state_risk(data, _limit_states(limit_states), hz), years)
+            missed, beyond = selection_misses(data), stripes_beyond_truncation(data)  # every read of the store before the first answer
+            measure_lines = efficient_measure_lines(data, hazard)
     except (StochpoundError, ValueError) as error:
         raise click.ClickException(str(error)) from None
     except OSError as error:
@@ -128,11 +152,9 @@ def risk(store: Path, hazard: str | None, hazard_measure: str | None, hazard_uni
     done = f"{result.progress}, answered from the cases that ran (--partial); " if result.progress else ""
     click.echo(f"{result.experiment or store.stem}: {done}{result.motions} motion{'s' if result.motions != 1 else ''}, {stripes} of {result.measure} "
                f"in {result.setting['units']}; hazard: {source}")
-    missed = selection_misses(data)
     if missed:
         click.echo(f"warning: the motions chosen for the site miss their conditional-spectrum target (mean or std of ln Sa off by more than "
                    f"{TARGET_TOLERANCE:g} at a period) at the stripes {', '.join(f'{level:g}' for level in missed)} {result.setting['units']}")
-    beyond = stripes_beyond_truncation(data)
     if beyond:
         click.echo(f"warning: the scenario puts the stripes {', '.join(f'{level:g}' for level in beyond)} {result.setting['units']} beyond "
                    f"ε {TRUNCATION_EPSILON:g}, where hazard models truncate the ground motion: no earthquake of that scenario causes them there")
@@ -184,7 +206,7 @@ def risk(store: Path, hazard: str | None, hazard_measure: str | None, hazard_uni
         click.echo(f"\nLimit states beyond first contact (λ: per year at each finite gap; contact-free: the same motions without "
                    f"contact; Δλ: what the gap costs; P in {years:g} years):")
         click.echo(costs.to_string(float_format=lambda v: f"{v:.4g}"))
-    click.echo("\n".join(efficient_measure_lines(data, hazard)))
+    click.echo("\n".join(measure_lines))
     if csv_dir is not None:
         tables = {"separation": result.to_frame()}
         if not rules.empty:

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import click
 
-from stochpound._atomic import check_writable
+from stochpound._atomic import check_not_input, check_writable
 from stochpound._errors import StochpoundError, os_error_message
 from stochpound.cli._scene_notes import periods_text, say_scene_warnings
 from stochpound.results.dataset import write_dataset
@@ -28,7 +28,7 @@ from stochpound.solvers.ivp import INTEGRATORS
 @click.option("--demands", is_flag=True, help="Also record floor accelerations, storey drifts and shears, and their peaks.")
 def simulate(scene_file: str, out: str, overwrite: bool, method: str | None, integrator: str, rtol: float, atol: float, demands: bool) -> None:
     """Simulate SCENE_FILE and write the result dataset to --out."""
-    _check_output(Path(out), overwrite)
+    _check_output(Path(out), overwrite, Path(scene_file))
     try:
         scene = load_scene(scene_file)
         say_scene_warnings(scene_warnings(scene))
@@ -46,8 +46,13 @@ def simulate(scene_file: str, out: str, overwrite: bool, method: str | None, int
     )
 
 
-def _check_output(out: Path, overwrite: bool) -> None:
-    """Refuse an existing --out without --overwrite, or one that cannot be written (before anything runs); warn on a suffix other than .nc."""
+def _check_output(out: Path, overwrite: bool, scene_file: Path) -> None:
+    """Refuse an existing --out without --overwrite, the scene file itself, or one that cannot be written (before anything runs);
+    warn on a suffix other than .nc."""
+    try:
+        check_not_input(out, [(scene_file, "the scene file")], "--out")
+    except ValueError as error:
+        raise click.BadParameter(str(error), param_hint="--out") from None
     if out.exists() and not overwrite:
         raise click.BadParameter(f"{out} exists; give --overwrite to replace it", param_hint="--out")
     try:

@@ -34,7 +34,7 @@ from stochpound.experiment._compute import BatchResult, BatchTask, run_batch, wa
 from stochpound.experiment._estimate import LARGE_RUN_BYTES, LARGE_RUN_CASES, estimate_run, startup_step
 from stochpound.experiment._grid import Experiment
 from stochpound.experiment._parts import FolderLock, PartBuffer, append_run, parts_folder, remove_temporaries
-from stochpound.experiment._session import StoreSession, check_store, clear_store, code_identity, machine, missing_summaries, now, store_complete, stored_definition
+from stochpound.experiment._session import StoreSession, check_store, check_store_path, clear_store, code_identity, machine, missing_summaries, now, store_complete, stored_definition
 from stochpound.experiment._sources import ResolvedMotion, resolve_motions
 from stochpound.experiment._spec import ExperimentError, load_definition
 from stochpound.experiment._store_writer import PartsIndex
@@ -184,9 +184,10 @@ def run_experiment(
     Raises
     ------
     ExperimentError
-        Before any case runs: a bad motion, an unreadable store without
-        parts to rebuild it from, a store of another definition (without
-        ``restart``), a store being written by another run, or a large
+        Before any case runs: a bad motion, a store path that is an input of the
+        run (the experiment file, its scene, record or hazard file), a file that is
+        not a store without parts to rebuild it from (``restart`` discards only a
+        store), a store of another definition (without ``restart``), a store being written by another run, or a large
         experiment without ``large_ok``. The existing store is then left unchanged.
     OSError
         If the store's folder cannot be written.
@@ -201,6 +202,7 @@ def run_experiment(
     started = time.monotonic()
     say = say or (lambda message: None)
     store = Path(store) if store is not None else default_store(experiment.path or f"{experiment.name}.toml")
+    check_store_path(store, experiment, restart)
     motions = resolve_motions(experiment)
     repair = False
     if not restart:

@@ -11,17 +11,17 @@ import hashlib
 import json
 import os
 import platform
-import shutil
 import subprocess
 from functools import lru_cache
 from pathlib import Path
-from typing import Any
+from typing import Any, Iterator
 
 import numpy as np
 
 from stochpound import __version__
 from stochpound.experiment._grid import KINDS, Experiment
-from stochpound.experiment._parts import DEFINITION_FILE, part_paths, parts_folder, read_experiment_json, read_runs, write_experiment_json
+from stochpound._atomic import check_not_input, temporaries
+from stochpound.experiment._parts import DEFINITION_FILE, RUNS_FILE, part_paths, parts_folder, read_experiment_json, read_runs, write_experiment_json
 from stochpound.experiment._spec import ExperimentError
 from stochpound.store import canonical_json, definition_sha256
 from stochpound.experiment._store import PREFIX, layout
@@ -77,7 +77,7 @@ def folder_identity(record: dict[str, Any]) -> str:
 
 
 def check_store(store: Path, sha256: str) -> bool:
-    """Refuse a store (or parts folder) that belongs to another experiment definition.
+    """Refuse a store (or parts folder) that belongs to another experiment definition, or a file that is not a store.
 
     Returns
     -------
@@ -88,21 +88,22 @@ def check_store(store: Path, sha256: str) -> bool:
     Raises
     ------
     ExperimentError
-        The store is a folder, is unreadable without parts to rebuild it from,
-        or was made from a different definition.
+        The store is a folder, is not a store (a file that is no netCDF4/HDF5 store of
+        stochpound's, without parts to rebuild it from: ``--restart`` is not offered,
+        it would not discard it), or was made from a different definition.
     """
     hint = "use --restart to discard it and start again, or --store to write elsewhere"
     if store.is_dir():
         raise ExperimentError(f"{store}: is a folder; --store must name a file")
     folder = parts_folder(store)
-    parts = folder.exists() and ((folder / DEFINITION_FILE).exists() or bool(part_paths(folder)))
+    parts = has_parts(store)
     damaged = False
     if store.exists():
         try:
             found = store_identity(store)
         except ExperimentError as error:
             if not parts:
-                raise ExperimentError(f"{error}; {hint}") from None
+                raise ExperimentError(f"{error}; {NOT_A_STORE}") from None
             damaged = True  # rebuilt from the parts, if they hold this definition's cases (checked below)
         else:
             if found != sha256:
@@ -115,6 +116,65 @@ def check_store(store: Path, sha256: str) -> bool:
         if found != sha256:
             raise ExperimentError(f"{folder}: holds cases of a different experiment definition (sha256 {found[:12]}…, this one {sha256[:12]}…); {hint}")
     return damaged
+
+
+NOT_A_STORE = ("not a store of stochpound's, so neither a run nor --restart replaces it: give --store another file "
+               "(a damaged store without its parts folder: delete it yourself)")
+"""Why a file that is not a store is left alone (the end of the message that refuses it)."""
+
+
+def has_parts(store: Path) -> bool:
+    """Whether the store's parts folder holds a run's files (its ``experiment.json`` or finished cases)."""
+    folder = parts_folder(store)
+    return folder.is_dir() and ((folder / DEFINITION_FILE).exists() or bool(part_paths(folder)))
+
+
+def check_store_path(store: Path, experiment: Experiment, restart: bool) -> None:
+    """Refuse a store path that is an input of the run, or (with ``restart``) a file ``--restart`` cannot tell is a store.
+
+    ``--restart`` discards the store file only when it is a store (a netCDF4/HDF5
+    file with stochpound's ``definition_sha256``, :func:`store_identity`) or the
+    file of a run's parts folder (:func:`has_parts`); never another file.
+
+    Raises
+    ------
+    ExperimentError
+        Naming the store and what it is.
+    """
+    try:
+        check_not_input(store, input_files(experiment), "--store")
+    except ValueError as error:
+        raise ExperimentError(f"{error} (the store to write; default: the experiment file's name with suffix .nc)") from None
+    if restart and store.is_file() and not has_parts(store):
+        try:
+            store_identity(store)
+        except ExperimentError as error:
+            raise ExperimentError(f"{error}; {NOT_A_STORE}") from None
+
+
+def input_files(experiment: Experiment) -> list[tuple[Path, str]]:
+    """The files a run reads, each with what it is: the experiment file, its scene file, record files and hazard file."""
+    base = experiment.base_dir
+    definition = experiment.definition
+    found = [(Path(experiment.path), "the experiment file")] if experiment.path else []
+    source = definition.get("scene_source") or {}
+    if "file" in source:
+        found.append((base / source["file"], "the experiment's scene file"))
+    if (definition.get("hazard") or {}).get("file"):
+        found.append((base / definition["hazard"]["file"], "the experiment's hazard file"))
+    found += [(base / table["record"], "a record file of the experiment") for table in _tables(definition)
+              if table.get("file_sha256") and isinstance(table.get("record"), str)]
+    return found
+
+
+def _tables(value: Any) -> Iterator[dict[str, Any]]:
+    """Every table (dict) in a definition, at any depth."""
+    if isinstance(value, dict):
+        yield value
+        value = list(value.values())
+    if isinstance(value, list):
+        for item in value:
+            yield from _tables(item)
 
 
 def store_complete(store: Path) -> bool:
@@ -135,11 +195,15 @@ def missing_summaries(store: Path, experiment: Experiment, motion_grids: dict[st
 
 
 def clear_store(store: Path) -> None:
-    """Delete a store file and its parts (``--restart``; call with the folder's lock held)."""
+    """Delete a store file and its parts (``--restart``, after :func:`check_store_path`; call with the folder's lock held).
+
+    Only the parts folder's own files go (``experiment.json``, ``runs.jsonl``,
+    the parts and the temporaries of interrupted writes); anything else a
+    user put there stays.
+    """
     folder = parts_folder(store)
-    for path in folder.iterdir():
-        if path.name != ".lock":
-            shutil.rmtree(path) if path.is_dir() else path.unlink()
+    for path in [folder / DEFINITION_FILE, folder / RUNS_FILE, *part_paths(folder), *temporaries(folder)]:
+        path.unlink(missing_ok=True)
     store.unlink(missing_ok=True)
 
 

@@ -26,6 +26,7 @@ from typing import Any, Mapping
 
 from stochpound._errors import ExperimentError, SceneError, field_errors
 from stochpound._studies import parse_reproduces
+from stochpound._text_files import read_text_file
 from stochpound.experiment._design_table import parse_design
 from stochpound.experiment._limit_states_table import parse_limit_states
 from stochpound.hazard import parse_hazard
@@ -81,11 +82,11 @@ def load_definition(path: str | Path) -> tuple[dict[str, Any], str]:
     Raises
     ------
     ExperimentError
-        If the file is missing, not TOML, or any field is invalid.
+        If the file is missing, not UTF-8 text, not TOML, or any field is invalid.
     """
     path = Path(path)
     try:
-        text = path.read_text()
+        text = read_text_file(path, ExperimentError)
     except (FileNotFoundError, IsADirectoryError):
         raise ExperimentError(f"{path}: experiment file not found") from None
     try:

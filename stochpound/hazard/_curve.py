@@ -22,6 +22,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from stochpound._data_files import bundled_data_dir
+from stochpound._text_files import read_text_file
 
 BUNDLED_FOLDER = "hazard"
 """Name of the bundled hazard folder (``data/hazard/`` in the repository, with its ``SOURCES.md``)."""
@@ -144,20 +145,19 @@ class HazardCurve:
         """
         path = Path(path)
         comments, rows = [], []
-        with path.open(newline="") as handle:
-            for number, line in enumerate(handle, start=1):
-                text = line.strip()
-                if not text:
-                    continue
-                if text.startswith("#"):
-                    comments.append(text.lstrip("#").strip())
-                    continue
-                fields = next(csv.reader([text]))
-                try:
-                    rows.append((float(fields[0]), float(fields[1])))
-                except (ValueError, IndexError):
-                    if rows:
-                        raise ValueError(f"{path}:{number}: expected two numbers 'im, rate', got {text!r}") from None
+        for number, line in enumerate(read_text_file(path).splitlines(), start=1):
+            text = line.strip()
+            if not text:
+                continue
+            if text.startswith("#"):
+                comments.append(text.lstrip("#").strip())
+                continue
+            fields = next(csv.reader([text]))
+            try:
+                rows.append((float(fields[0]), float(fields[1])))
+            except (ValueError, IndexError):
+                if rows:
+                    raise ValueError(f"{path}:{number}: expected two numbers 'im, rate', got {text!r}") from None
         if not rows:
             raise ValueError(f"{path}: no rows of 'im, rate'")
         im, rate = zip(*rows)

@@ -38,6 +38,7 @@ from typing import Any
 
 import numpy as np
 
+from stochpound._text_files import read_text_file
 from stochpound.hazard._curve import HazardCurve, rate_from_probability
 
 FORMATS = ("stochpound", "openquake", "nshmp-haz")
@@ -230,7 +231,7 @@ def read_hazard_file(path: str | Path, *, site: int | str | None = None) -> Haza
         Starting with the file's name: an unreadable or ambiguous file.
     """
     path = Path(path)
-    lines = [line.rstrip("\r\n") for line in path.read_text(encoding="utf-8-sig").splitlines() if line.strip()]
+    lines = [line.rstrip("\r\n") for line in read_text_file(path).splitlines() if line.strip()]
     if not lines:
         raise ValueError(f"{path.name}: empty")
     try:

@@ -18,6 +18,7 @@ import numpy as np
 from stochpound._data_files import bundled_data_dir
 from stochpound._errors import RecordError, SceneError
 from stochpound._memory import check_memory, sample_bytes
+from stochpound._text_files import read_text_file
 from stochpound.model import fields
 from stochpound.model.building import buildings_from_tables
 from stochpound.model.contact import contacts_from_tables
@@ -70,11 +71,11 @@ def read_scene_table(path: str | Path) -> dict[str, Any]:
     Raises
     ------
     SceneError
-        If the file is missing or not valid TOML (the message starts with its path).
+        If the file is missing, not UTF-8 text or not valid TOML (the message starts with its path).
     """
     path = Path(path)
     try:
-        return tomllib.loads(path.read_text())
+        return tomllib.loads(read_text_file(path, SceneError))
     except (FileNotFoundError, IsADirectoryError):
         raise SceneError(f"{path}: scene file not found") from None
     except tomllib.TOMLDecodeError as error:

@@ -40,7 +40,8 @@ from stochpound.store import check_finished, has_contact_free, has_wall_free, wi
 from stochpound._studies import claims, load_study
 
 
-def assemble_report(paths: Sequence[str | Path], progress: Callable[[str], None] | None = None, partial: bool = False) -> Report:
+def assemble_report(paths: Sequence[str | Path], progress: Callable[[str], None] | None = None, partial: bool = False,
+                    edited: str = "warn") -> Report:
     """Build the report of the given stores.
 
     Parameters
@@ -52,6 +53,9 @@ def assemble_report(paths: Sequence[str | Path], progress: Callable[[str], None]
     partial : bool
         Report a store with missing cases from the cases that ran (its
         sections say how many ran); without it such a store is refused.
+    edited : {"warn", "refuse", "accept"}
+        A store whose definition does not match its recorded sha256 (:func:`~stochpound.open_store`;
+        ``stochpound report build`` refuses it without ``--accept-edited``).
 
     Returns
     -------
@@ -64,7 +68,7 @@ def assemble_report(paths: Sequence[str | Path], progress: Callable[[str], None]
     """
     say = progress or (lambda message: None)
     say("reading stores")
-    stores = open_stores(paths)
+    stores = open_stores(paths, edited)
     for name, store in stores.items():
         check_finished(store, Path(store.encoding.get("source", name)).name, partial, option="--partial (partial=True from Python)")
     claimed = claims({name: store.pound.definition.reproduces for name, store in stores.items()})

@@ -46,6 +46,7 @@ from pathlib import Path
 import numpy as np
 
 from stochpound._errors import RecordError
+from stochpound._text_files import decode_text
 from stochpound.motions.records._record import Record
 from stochpound.motions.records._units import check_plausible_peak, header_units, normalize_units
 
@@ -191,9 +192,10 @@ def _read_bytes(path: str | Path, shown: str) -> bytes:
 
 
 def _decode(raw: bytes, shown: str) -> str:
-    if b"\x00" in raw[:4096]:
-        raise RecordError(f"{shown}: looks like a binary file; expected a PEER .AT2 or a text file of numbers")
-    return raw.decode("utf-8", errors="replace")
+    try:
+        return decode_text(raw, shown, RecordError, lenient=True)
+    except RecordError as error:
+        raise RecordError(f"{error}; expected a PEER .AT2 or a text file of numbers") from None
 
 
 def _find_at2_header(lines: list[str]) -> tuple[int, int, str] | None:

@@ -12,6 +12,8 @@ Every file is written to a temporary name and then renamed, so an
 interrupted build never leaves a half-written file. A build into a folder
 that holds an earlier one removes the earlier figures and tables it does not
 write again: only files the earlier build's list names, never another file.
+A folder without that list is not an earlier build's: a file there that the
+build would write (a user's ``index.html``, say) is refused, not replaced.
 """
 
 from __future__ import annotations
@@ -25,7 +27,7 @@ from typing import Callable, Sequence
 
 import matplotlib.pyplot as plt
 
-from stochpound._atomic import check_writable
+from stochpound._atomic import check_not_input, check_writable
 from stochpound._atomic import replacing as _replacing  # a full disk is reported naming the file
 from stochpound.report.render._document import Report
 from stochpound.report.render._html import render_html
@@ -68,7 +70,8 @@ def write_report(
     ------
     ValueError
         For an unknown format (the message names ``--format`` and the allowed
-        values), or table/figure keys that are duplicated or unusable as file names.
+        values), table/figure keys that are duplicated or unusable as file names,
+        or a file in ``out`` that the build would replace but no earlier build wrote.
     """
     formats = _check_formats(formats)
     _check_keys(report)
@@ -76,11 +79,12 @@ def write_report(
     out = Path(out)
     date = datetime.date.today()
     written = {"figures": out / "figures", "tables": out / "tables"}
+    owned = [f"figures/{item.key}.png" for item in report.figures()] + [f"tables/{table.key}.csv" for table in report.tables()]
+    previous = _claim(out, owned, [FILE_NAMES[name] for name in formats])
     try:
         figure_png = _write_figures(report, written["figures"], say)
         _write_tables(report, written["tables"], say)
-        _replace_owned(out, [f"figures/{item.key}.png" for item in report.figures()] + [f"tables/{table.key}.csv" for table in report.tables()],
-                       [FILE_NAMES[name] for name in formats])
+        _replace_owned(out, previous, owned, [FILE_NAMES[name] for name in formats])
         if "html" in formats:
             say(FILE_NAMES["html"])
             written["html"] = _replace(out / FILE_NAMES["html"], render_html(report, figure_png, date).encode("utf-8"))
@@ -96,27 +100,59 @@ def write_report(
     return written
 
 
-def check_output_folder(out: Path) -> None:
-    """Raise the ``OSError`` that writing into the folder ``out`` would raise (it is created if needed), before any work."""
-    check_writable(Path(out) / MANIFEST)
+def check_output_folder(out: Path, stores: Sequence[Path] = ()) -> None:
+    """Raise the ``OSError`` that writing into the folder ``out`` would raise (it is created if needed), before any work.
+
+    Also a ``ValueError`` if one of the ``stores`` the report reads is a file the build would write.
+    """
+    out = Path(out)
+    for store in stores:
+        for name in (*FILE_NAMES.values(), MANIFEST):
+            check_not_input(out / name, [(store, "a store of this report")], "--out")
+        if Path(store).resolve().parent in ((out / "figures").resolve(), (out / "tables").resolve()):
+            raise ValueError(f"{store}: a store of this report, in the folder the report writes its figures and tables to: give --out another folder")
+    check_writable(out / MANIFEST)
 
 
-def _replace_owned(out: Path, owned: list[str], documents: list[str]) -> None:
-    """Remove the files the previous build's list names and this build did not write; list this build's files.
+def _claim(out: Path, owned: list[str], documents: list[str]) -> list | None:
+    """Before any file is written: refuse a file the build would replace in a folder of no earlier build; list this build's files beside an earlier build's.
+
+    The list is written first, so that a build interrupted midway leaves a folder
+    whose files a later build recognises as its own. Returns the earlier build's
+    list (None: no earlier build), as it was before.
+    """
+    previous = _previous(out)
+    if previous is None:
+        for name in [*owned, *documents]:
+            if (out / name).exists():
+                raise ValueError(f"{out / name}: exists, and {out} holds no earlier report ({MANIFEST}): give --out a new or empty folder "
+                                 "(or one of an earlier report), or move the file")
+    listed = {name for name in previous or [] if isinstance(name, str) and _OWNED.fullmatch(name)}
+    _replace(out / MANIFEST, json.dumps(sorted(listed | set(owned)), indent=0).encode("utf-8"))
+    return previous
+
+
+def _previous(out: Path) -> list | None:
+    """The file list of the earlier build in ``out``, or None when there was none (no list, or an unreadable one)."""
+    try:
+        previous = json.loads((out / MANIFEST).read_text())
+    except (OSError, ValueError):
+        return None
+    return previous if isinstance(previous, list) else None
+
+
+def _replace_owned(out: Path, previous: list | None, owned: list[str], documents: list[str]) -> None:
+    """Remove the files the previous build's list (``previous``, from :func:`_claim`) names and this build did not write; list this build's files.
 
     A folder with a list is an earlier build's: its document (``index.html``,
     ``report.pdf``) that this build does not write (``documents``) is stale
     and removed too (an HTML-only rebuild leaves no PDF of the old one).
     """
-    try:
-        previous = json.loads((out / MANIFEST).read_text())
-    except (OSError, ValueError):
-        previous = None  # no earlier build here
     kept = set(owned)
-    for name in previous if isinstance(previous, list) else []:
+    for name in previous or []:
         if isinstance(name, str) and name not in kept and _OWNED.fullmatch(name):
             (out / name).unlink(missing_ok=True)
-    if isinstance(previous, list):  # a folder of an earlier build: its document not written again is stale (an HTML-only rebuild's PDF)
+    if previous is not None:  # a folder of an earlier build: its document not written again is stale (an HTML-only rebuild's PDF)
         for name in FILE_NAMES.values():
             if name not in documents:
                 (out / name).unlink(missing_ok=True)

@@ -133,7 +133,7 @@ class Ensemble:
     @property
     def event(self) -> str:
         """What an impact is in this ensemble's words: "pounding", or "a wall hit" in a store whose only impact elements are walls."""
-        return "a wall hit" if self.data.sizes.get("contact", 0) == 0 and "peak_wall_penetration" in self.data else "pounding"
+        return "a wall hit" if walls_only(self.data) else "pounding"
 
     @property
     def probability_label(self) -> str:
@@ -172,7 +172,7 @@ class Ensemble:
             for part, suffix in (("P", ""), ("lower", "_lower"), ("upper", "_upper")):
                 columns[(self.probability_label, part)] = stats[f"pounding_probability{suffix}"]
         for quantity in QUANTITIES[kind]:
-            if walls and quantity.variable.startswith("impacts_"):
+            if walls and quantity.variable in PHASES:
                 continue  # a wall moves with the ground: its hits have no phase
             if walls and quantity.variable == "peak_impact_force":
                 quantity = Quantity(quantity.variable, "peak wall force, given a wall hit", quantity.unit, quantity.factor)
@@ -382,6 +382,15 @@ class Ensemble:
         if reference is not None:
             blocks.append(reference)
         return blocks + self.figures()
+
+
+def walls_only(data: xr.Dataset) -> bool:
+    """Whether a store's only impact elements are walls (no contact): every impact is a wall hit, which has no phase (a wall moves with the ground)."""
+    return data.sizes.get("contact", 0) == 0 and "peak_wall_penetration" in data
+
+
+PHASES = ("impacts_in_phase", "impacts_out_of_phase")
+"""The summaries that split the impacts by phase (between buildings only)."""
 
 
 def table_frame(columns: dict[tuple[str, str], xr.DataArray], dims: list[str]) -> pd.DataFrame:

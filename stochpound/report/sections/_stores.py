@@ -12,13 +12,15 @@ from stochpound._errors import StochpoundError
 from stochpound.experiment import open_store
 
 
-def open_stores(paths: Sequence[str | Path]) -> dict[str, xr.Dataset]:
+def open_stores(paths: Sequence[str | Path], edited: str = "warn") -> dict[str, xr.Dataset]:
     """Open experiment stores, keyed by their experiment name.
 
     Parameters
     ----------
     paths : sequence of path
         Store files written by ``stochpound experiment run``.
+    edited : {"warn", "refuse", "accept"}
+        A store whose definition does not match its recorded sha256 (:func:`~stochpound.open_store`).
 
     Returns
     -------
@@ -28,14 +30,17 @@ def open_stores(paths: Sequence[str | Path]) -> dict[str, xr.Dataset]:
     Raises
     ------
     StochpoundError
-        If a file is missing, is not a store, or two stores have the same experiment name.
+        If a file is missing, is not a store (or, with ``edited="refuse"``, one changed since
+        it was written), or two stores have the same experiment name.
     """
     stores: dict[str, xr.Dataset] = {}
     for path in map(Path, paths):
         if not path.is_file():
             raise StochpoundError(f"store {path}: no such file")
         try:
-            store = open_store(path)
+            store = open_store(path, edited=edited)
+        except StochpoundError:
+            raise
         except (OSError, ValueError, KeyError) as error:
             raise StochpoundError(f"store {path}: not a readable stochpound store ({error})") from None
         name = str(store.attrs.get("experiment_name", ""))
