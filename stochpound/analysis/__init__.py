@@ -31,8 +31,11 @@ from stochpound.analysis._separation import pounding_curve, required_separation,
 from stochpound.codes import contact_demands, fixed_base_cqc, separation_rules, store_contact_demands
 from stochpound.analysis._summary import run_summary
 from stochpound.hazard import (
+    RUPTURE_COLUMNS,
     HazardCurve,
     HazardFile,
+    RuptureSite,
+    bundled_rupture_sites,
     bundled_curves,
     bundled_measure,
     bundled_site_curves,
@@ -122,5 +125,8 @@ __all__ = [
     "hazard_consistency",
     "stripe_rate_weights",
     "scenario_hazard",
+    "RUPTURE_COLUMNS",
+    "RuptureSite",
+    "bundled_rupture_sites",
     *RISK_NAMES,
 ]
