@@ -34,8 +34,11 @@ from stochpound.codes import contact_demands, fixed_base_cqc, separation_rules, 
 from stochpound.analysis._subset_simulation import RESPONSES, subset_simulation
 from stochpound.analysis._summary import run_summary
 from stochpound.hazard import (
+    RUPTURE_COLUMNS,
     HazardCurve,
     HazardFile,
+    RuptureSite,
+    bundled_rupture_sites,
     bundled_curves,
     bundled_measure,
     bundled_site_curves,
@@ -127,5 +130,8 @@ __all__ = [
     "hazard_consistency",
     "stripe_rate_weights",
     "scenario_hazard",
+    "RUPTURE_COLUMNS",
+    "RuptureSite",
+    "bundled_rupture_sites",
     *RISK_NAMES,
 ]

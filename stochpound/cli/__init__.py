@@ -85,6 +85,8 @@ def _build() -> Any:
     main.add_command(report)
     from stochpound.cli._risk import risk
     main.add_command(risk)
+    from stochpound.cli._site import site
+    main.add_command(site)
     return main
 
 

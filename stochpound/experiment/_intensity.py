@@ -28,6 +28,7 @@ response spectrum over ``spectrum_period``) and its ``scale_factor``.
 from __future__ import annotations
 
 import math
+from pathlib import Path
 from typing import Any, Mapping
 
 import numpy as np
@@ -71,8 +72,11 @@ SUMMARIES: dict[str, tuple[str, str]] = {
 }
 
 
-def parse_intensity(data: Mapping[str, Any], scene: Mapping[str, Any], variants: list[dict[str, Any]], gaps: list[dict[str, Any]], mu: Any) -> dict[str, Any] | None:
+def parse_intensity(data: Mapping[str, Any], scene: Mapping[str, Any], variants: list[dict[str, Any]], gaps: list[dict[str, Any]], mu: Any,
+                    base_dir: Path = Path(".")) -> dict[str, Any] | None:
     """The canonical ``intensity`` entry of a definition (None without an ``[intensity]`` table).
+
+    ``base_dir`` is the experiment file's folder (a ``[site]`` rupture table's path is relative to it).
 
     Raises
     ------
@@ -129,7 +133,7 @@ def parse_intensity(data: Mapping[str, Any], scene: Mapping[str, Any], variants:
         )
     entry["synthetic"] = synthetic
     entry["ran"], entry["note"] = _method_run(method, scene, variants, gaps, mu)
-    entry.update(parse_selection(table, data.get("site"), levels, entry))
+    entry.update(parse_selection(table, data.get("site"), levels, entry, base_dir))
     return entry
 
 

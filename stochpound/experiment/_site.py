@@ -11,7 +11,14 @@ with ``scenario = "fitted"``, ``vs30``, ``mechanism`` and ``curves`` (the
 site's bundled hazard curves): the magnitude and distance of every level are
 then fitted so that the stripes' conditional spectra reproduce the site's
 curves at the other periods (:func:`stochpound.motions.fit_scenarios`), a
-calibration standing in for a disaggregation.
+calibration standing in for a disaggregation; or, with ``ruptures`` (a
+rupture table's file, relative to the experiment file, or a bundled site's
+name) and the site's ``vs30`` (and ``z1p0_km``, ``z2p5_km``) where the table
+does not state them, the site of those ruptures
+(:class:`stochpound.analysis.RuptureSite`): every stripe's target is then its
+exact conditional spectrum, the ruptures' mixture by their shares at the
+level, and the ruptures themselves are part of the definition (its
+``intensity.ruptures``, so of the identity).
 
 The period range covers the structure: every building's first-mode period
 on a fixed base and, for a building on a sliding base with a restoring
@@ -66,7 +73,7 @@ PER_LEVEL = ("magnitude", "distance_km", "mechanism")
 """``[site]`` fields that take one value per level."""
 
 
-def parse_selection(table: Mapping[str, Any], site: Any, levels: list[float], entry: dict[str, Any]) -> dict[str, Any]:
+def parse_selection(table: Mapping[str, Any], site: Any, levels: list[float], entry: dict[str, Any], base_dir: Path = Path(".")) -> dict[str, Any]:
     """The selection's entries of the ``intensity`` definition ({} for the default ``scale``).
 
     Parameters
@@ -79,6 +86,8 @@ def parse_selection(table: Mapping[str, Any], site: Any, levels: list[float], en
         The levels as the file lists them.
     entry : mapping
         The ``intensity`` entry parsed so far (measure, period(s), damping, units, method).
+    base_dir : Path
+        The experiment file's folder (a rupture table's path is relative to it).
 
     Raises
     ------
@@ -122,14 +131,45 @@ def parse_selection(table: Mapping[str, Any], site: Any, levels: list[float], en
     note = f"{motions} motions per stripe chosen from the pool and scaled to the conditional spectrum of its scenario"
     if isinstance(site, dict) and site.get("scenario") == "fitted" and isinstance(site.get("curves"), list):
         note += f" (the scenario fitted to the site's hazard curves {', '.join(map(str, site['curves']))}, standing in for a disaggregation)"
-    return {"note": note, "selection": selection, "motions": motions, "max_scale_factor": max_scale, "seed": seed, "site": parse_site(site, levels, entry)}
+    chosen = {"note": note, "selection": selection, "motions": motions, "max_scale_factor": max_scale, "seed": seed}
+    if isinstance(site, dict) and "ruptures" in site:
+        ruptures = rupture_site(site, base_dir)
+        chosen["note"] = (f"{motions} motions per stripe chosen from the pool and scaled to the exact conditional spectrum of the site's "
+                          f"{len(ruptures)} ruptures")
+        return {**chosen, "site": mixture_scenarios(ruptures, levels, entry), "ruptures": ruptures.to_entry(identity=True)}
+    return {**chosen, "site": parse_site(site, levels, entry)}
+
+
+def rupture_site(site: Mapping[str, Any], base_dir: Path) -> Any:
+    """The :class:`~stochpound.analysis.RuptureSite` of a ``[site]`` table with ``ruptures`` (a file or a bundled site's name).
+
+    Raises
+    ------
+    SiteError
+        Naming the field: an unknown key, neither a file nor a bundled site,
+        a table's error (its file, line and field), a site field missing or contradicting the table.
+    """
+    from stochpound.hazard import RUPTURE_SITE_FIELDS, named_rupture_site
+
+    toml_fields.reject_unknown(site, {"ruptures", *RUPTURE_SITE_FIELDS}, "site")
+    return named_rupture_site(site["ruptures"], base_dir, {key: site[key] for key in RUPTURE_SITE_FIELDS if key in site}, "site")
+
+
+def mixture_scenarios(ruptures: Any, levels: list[float], entry: Mapping[str, Any]) -> list[dict[str, Any]]:
+    """The scenario of every level (sorted) a store records of a site of ruptures: the means of M and R_rup by the exact conditional
+    spectrum's weights P(r | IM* = x) (:meth:`~stochpound.analysis.RuptureSite.disaggregation`'s ``density_share``), Vs30 and the
+    mechanism of the largest weight (:meth:`~stochpound.analysis.RuptureSite.mean_scenario`)."""
+    period = entry.get("period", entry.get("periods"))
+    shares = ruptures.disaggregation(entry["measure"], period, levels=sorted(float(level) for level in levels))["density_share"].values
+    return [ruptures.mean_scenario(share) for share in shares]
 
 
 def site_entry(site: Any, intensity: Mapping[str, Any] | None) -> dict[str, Any] | None:
     """The definition's ``site`` entry: how the stripes' scenario was obtained, as data (None without a ``[site]`` table).
 
-    ``scenario`` is ``"given"`` or ``"fitted"``; a fitted one names the
-    ``curves`` it was fitted to. Called with the parsed ``intensity`` entry,
+    ``scenario`` is ``"given"``, ``"fitted"`` or ``"ruptures"``; a fitted one
+    names the ``curves`` it was fitted to, a site of ruptures its ``ruptures``
+    (the file or bundled site as ``[site]`` names it). Called with the parsed ``intensity`` entry,
     once :func:`parse_selection` has checked the table. Not part of the
     identity (``stochpound.store.NOT_IN_IDENTITY``): the runs depend on the
     scenarios themselves (the ``intensity`` entry's ``site``), not on how
@@ -146,6 +186,8 @@ def site_entry(site: Any, intensity: Mapping[str, Any] | None) -> dict[str, Any]
         return None
     if intensity is None:
         raise SiteError(f'site: only with [intensity] selection = "{CONDITIONAL_SPECTRUM}" (the scenario of its targets)')
+    if "ruptures" in site:
+        return {"scenario": "ruptures", "ruptures": site["ruptures"]}
     kind = site.get("scenario", SCENARIO_KINDS[0])
     return {"scenario": kind, "curves": list(site["curves"])} if kind == "fitted" else {"scenario": kind}
 
@@ -157,8 +199,9 @@ def parse_site(site: Any, levels: list[float], entry: Mapping[str, Any]) -> list
     if not isinstance(site, dict):
         raise SiteError("site: a [site] table is required with the conditional spectrum (vs30, magnitude, distance_km, mechanism)")
     scenario_kind = site.get("scenario", SCENARIO_KINDS[0])
-    if scenario_kind not in SCENARIO_KINDS:
-        raise SiteError(f"site.scenario: must be one of {', '.join(SCENARIO_KINDS)}, got {scenario_kind!r}")
+    if scenario_kind not in SCENARIO_KINDS[:2]:
+        raise SiteError(f"site.scenario: must be one of {', '.join(SCENARIO_KINDS[:2])} (a site of ruptures: ruptures = \"<file or bundled site>\"), "
+                        f"got {scenario_kind!r}")
     if scenario_kind == "fitted":
         return fitted_site(site, levels, entry)
     if "curves" in site:
@@ -347,8 +390,14 @@ def stripe_selections(experiment: GridExperiment) -> StripeSelections:
     g = float(experiment.definition["scene"].get("g", 9.81))
     pool = selection_pool(records, periods, measure, period, MODEL_DAMPING, g)
     selections, targets = [], []
-    for level, scenario in zip(intensity["levels"], intensity["site"]):
-        target = conditional_spectrum(measure, period, level=level, periods=periods, **scenario)
+    if "ruptures" in intensity:  # the exact conditional spectrum of every stripe
+        from stochpound.analysis import RuptureSite
+
+        stripe_targets = RuptureSite.from_entry(intensity["ruptures"]).conditional_spectra(measure, period, levels=intensity["levels"], periods=periods)
+    else:
+        stripe_targets = [conditional_spectrum(measure, period, level=level, periods=periods, **scenario)
+                          for level, scenario in zip(intensity["levels"], intensity["site"])]
+    for level, target in zip(intensity["levels"], stripe_targets):
         try:
             selections.append(select_motions(pool, target, intensity["motions"], intensity["max_scale_factor"], intensity["seed"]))
         except SiteError as error:

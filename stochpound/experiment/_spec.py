@@ -154,7 +154,7 @@ def parse_experiment(data: Mapping[str, Any], base_dir: str | Path = ".", defaul
     gaps = [_gap_axis(key, grid[key], n_contacts, contact_floors, n_walls) for key in grid if is_gap_axis(key)]
     mu = _mu_axis(grid["mu"], buildings) if "mu" in grid else None
     with field_errors():
-        intensity = parse_intensity(data, scene, variants, gaps, mu)
+        intensity = parse_intensity(data, scene, variants, gaps, mu, base_dir)
         hazard = parse_hazard(data, intensity, base_dir, float(scene["g"]) if "g" in scene else DEFAULT_G)
         design = parse_design(data)
         limit_states = parse_limit_states(data, buildings)

@@ -10,7 +10,10 @@ carries, :func:`stored_hazard` gives a store's curve back and
 :func:`hazard_consistency` recomputes the hazard at another measure from
 the stripes' motions; :func:`scenario_hazard` is the hazard of a site
 shaken by one earthquake scenario, consistent with the ground-motion models
-by construction. The experiment reader, the statistics
+by construction; a :class:`RuptureSite` is a site given by its ruptures
+(a table of them, :func:`bundled_rupture_sites` the demonstration ones):
+the hazard of any measure, its exact disaggregation, the uniform-hazard
+spectrum and the exact conditional spectrum. The experiment reader, the statistics
 (:mod:`stochpound.analysis`, which gives these names to its users) and the
 risk chain (:mod:`stochpound.risk`) all read the hazard here: this package
 imports none of them.
@@ -19,8 +22,12 @@ imports none of them.
 from stochpound.hazard._curve import HazardCurve, bundled_curves, bundled_measure, bundled_site_curves, probability_from_rate, rate_from_probability, return_period
 from stochpound.hazard._files import HazardFile, parse_measure, parse_units, read_hazard_file
 from stochpound.hazard._consistency import hazard_consistency, stripe_rate_weights
+from stochpound.hazard._ruptures import RUPTURE_COLUMNS, RuptureSite, bundled_rupture_sites
 from stochpound.hazard._scenario import scenario_hazard
 from stochpound.hazard._setting import check_covers, hazard_curve, hazard_option, parse_hazard, stored_hazard
+
+# For the other packages of stochpound (their interface to this one, not public API: not in __all__).
+from stochpound.hazard._ruptures import SITE_FIELDS as RUPTURE_SITE_FIELDS, named_rupture_site  # noqa: F401
 
 __all__ = [
     "HazardCurve",
@@ -37,6 +44,9 @@ __all__ = [
     "hazard_consistency",
     "stripe_rate_weights",
     "scenario_hazard",
+    "RUPTURE_COLUMNS",
+    "RuptureSite",
+    "bundled_rupture_sites",
     "parse_hazard",
     "hazard_curve",
     "check_covers",

@@ -18,6 +18,8 @@ toolkit (docs/intensity.md). It also stands for a characteristic
 earthquake of a fault that dominates a site. A one-scenario hazard is one
 lognormal, so it is written here rather than taken from a hazard code
 (OpenQuake and nshmp-haz integrate source models: far more than this needs).
+It is the site of one rupture (:class:`~stochpound.analysis.RuptureSite`)
+whose geometry is the conditional spectrum's estimate for the scenario.
 """
 
 from __future__ import annotations
@@ -25,15 +27,10 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 import numpy as np
-from scipy.special import ndtr
 
 from stochpound.hazard._curve import HazardCurve
-from stochpound.motions import measure_label, scenario_distribution
-
-#: ε of the table's first and last intensities (standard deviations of ln IM from the scenario's median).
-EPSILON_RANGE = (-4.0, 6.0)
-#: Intensities of the table, log-spaced over :data:`EPSILON_RANGE`.
-TABLE_POINTS = 401
+from stochpound.hazard._ruptures import RuptureSite
+from stochpound.motions import MECHANISMS, check_scenario
 
 
 def scenario_hazard(measure: str, period: float | Sequence[float] | None = None, *, magnitude: float, distance_km: float, vs30: float,
@@ -52,8 +49,8 @@ def scenario_hazard(measure: str, period: float | Sequence[float] | None = None,
     Returns
     -------
     HazardCurve
-        λ(x) (1/yr) tabulated at ``TABLE_POINTS`` intensities (g), log-spaced
-        over ``EPSILON_RANGE`` (ε −4 to 6); its ``source`` names the scenario and the rate.
+        λ(x) (1/yr) tabulated at 401 intensities (g), log-spaced over ε −4
+        to 6 (:meth:`~stochpound.analysis.RuptureSite.hazard_curve`); its ``source`` names the scenario and the rate.
 
     Raises
     ------
@@ -64,9 +61,9 @@ def scenario_hazard(measure: str, period: float | Sequence[float] | None = None,
     """
     if not isinstance(rate, (int, float)) or isinstance(rate, bool) or not np.isfinite(rate) or rate <= 0:
         raise ValueError(f"rate: must be a finite annual rate > 0 (1/yr), got {rate!r}")
-    median, sigma = scenario_distribution(measure, period, magnitude=magnitude, distance_km=distance_km, vs30=vs30, mechanism=mechanism)
-    epsilon = np.linspace(*EPSILON_RANGE, TABLE_POINTS)
-    source = (f"one scenario, M {magnitude:g} at {distance_km:g} km, Vs30 {vs30:g} m/s, {mechanism.replace('_', '-')}, "
-              f"{rate:g} per year; NGA-West2 average (pygmm)")
-    return HazardCurve(median * np.exp(sigma * epsilon), rate * ndtr(-epsilon), extrapolate=extrapolate, measure=measure_label(measure, period), units="g",
-                       source=source)
+    check_scenario(magnitude, distance_km, vs30, mechanism)
+    site = RuptureSite((magnitude,), (distance_km,), (distance_km,), (-distance_km,), (0.0,), (MECHANISMS[mechanism][1],), (mechanism,), (rate,), vs30)
+    curve = site.hazard_curve(measure, period, extrapolate=extrapolate)
+    curve.source = (f"one scenario, M {magnitude:g} at {distance_km:g} km, Vs30 {vs30:g} m/s, {mechanism.replace('_', '-')}, "
+                    f"{rate:g} per year; NGA-West2 average (pygmm)")
+    return curve

@@ -8,7 +8,12 @@ One of three sources (docs/risk.md):
   experiment file;
 * ``bundled = "fox_plaza_los_angeles_sa2p0s"``: a curve shipped with
   stochpound (:meth:`~stochpound.analysis.HazardCurve.bundled`);
-* ``power_law = { k0 = 2.0e-4, k = 2.2 }``: λ(x) = k0 x^(−k).
+* ``power_law = { k0 = 2.0e-4, k = 2.2 }``: λ(x) = k0 x^(−k);
+* ``ruptures = "site.csv"`` (or a bundled site's name), with ``vs30``,
+  ``z1p0_km``, ``z2p5_km`` where the table does not state them: the curve of
+  ``[intensity]``'s measure from the site's ruptures
+  (:meth:`~stochpound.analysis.RuptureSite.hazard_curve`), the same ruptures
+  as ``[site]``'s for stripes chosen to their exact conditional spectra.
 
 **A hazard is read, never guessed.** A hazard curve is only meaningful
 with the fragility's intensity measure, so the hazard's measure must be the
@@ -45,15 +50,16 @@ import xarray as xr
 from stochpound._errors import IntensityError
 from stochpound.hazard._curve import HazardCurve, bundled_curves, bundled_measure, bundled_path
 from stochpound.hazard._files import parse_units, read_hazard_file, unit_factor
+from stochpound.hazard._ruptures import SITE_FIELDS as RUPTURE_SITE_FIELDS, named_rupture_site
 from stochpound.store import MEASURES, describe_measure
 from stochpound.model import fields as toml_fields
 from stochpound.motions import DEFAULT_G
 
-SOURCES = ("file", "bundled", "power_law")
+SOURCES = ("file", "bundled", "power_law", "ruptures")
 """The keys that name a hazard's source (exactly one per ``[hazard]`` table)."""
 STATED = ("measure", "period", "periods", "damping", "units", "investigation_time")
 """The ``[hazard]`` fields (and ``stochpound risk`` options) that state what a file's curve is of, when the file does not."""
-_KEYS = {*SOURCES, *STATED, "site", "extrapolate"}
+_KEYS = {*SOURCES, *STATED, "site", "extrapolate", *RUPTURE_SITE_FIELDS}
 _MATCHED = ("measure", "period", "periods", "damping")
 _REQUIRED = {"pga": ("units",), "pgv": ("units",), "psa": ("period", "damping", "units"), "sa_avg": ("periods", "damping", "units")}
 _TOLERANCE = 1e-9
@@ -100,6 +106,9 @@ def parse_hazard(data: Mapping[str, Any], intensity: Mapping[str, Any] | None, b
     if len(given) != 1:
         raise IntensityError(f"hazard: give exactly one of {', '.join(SOURCES)}, got {', '.join(given) or 'none'}")
     source = given[0]
+    for key in RUPTURE_SITE_FIELDS:
+        if key in table and source != "ruptures":
+            raise IntensityError(f"hazard.{key}: only with ruptures = ... (the site of a rupture table)")
     extrapolate = toml_fields.boolean(table, "extrapolate", "hazard", default=False)
     entry: dict[str, Any] = {"source": source, **_measure_of(intensity), "units": intensity["units"], "extrapolate": extrapolate}
     stated = _stated_fields(table)
@@ -114,6 +123,10 @@ def parse_hazard(data: Mapping[str, Any], intensity: Mapping[str, Any] | None, b
             raise IntensityError(f"hazard.file: {name!r} not found (a hazard-curve file, relative to the experiment file)")
         curve = _read(path, stated, table.get("site"), intensity, g, extrapolate, "hazard")
         entry["file"], entry["file_sha256"] = name, hashlib.sha256(path.read_bytes()).hexdigest()
+    elif source == "ruptures":
+        _check_measure("hazard", {key: stated[key] for key in _MATCHED if key in stated}, intensity)
+        curve = _rupture_curve(table, intensity, base_dir, g, extrapolate)
+        entry["ruptures"] = table["ruptures"]
     else:
         _check_measure("hazard", {key: stated[key] for key in _MATCHED if key in stated}, intensity)
         entry["power_law"] = _power_law(table["power_law"], stated.get("units", intensity["units"]), intensity["units"], g)
@@ -124,6 +137,24 @@ def parse_hazard(data: Mapping[str, Any], intensity: Mapping[str, Any] | None, b
             check_covers(curve, intensity["levels"], "hazard", "intensity.levels", "extrapolate = true")
     entry["provenance"] = curve.source
     return entry
+
+
+def _rupture_curve(table: Mapping[str, Any], intensity: Mapping[str, Any], base_dir: Path, g: float, extrapolate: bool) -> HazardCurve:
+    """The hazard curve of ``[intensity]``'s measure from the site of ruptures ``[hazard]`` names, in the levels' units."""
+    from stochpound._errors import SiteError
+
+    given = {key: table[key] for key in RUPTURE_SITE_FIELDS if key in table}
+    try:
+        site = named_rupture_site(table["ruptures"], base_dir, given, "hazard")
+        if intensity.get("damping", 0.05) != 0.05:
+            raise SiteError(f"hazard.ruptures: the NGA-West2 models give 5 % damped spectra only; intensity.damping is {intensity['damping']!r}")
+        curve = site.hazard_curve(intensity["measure"], intensity.get("period", intensity.get("periods")), extrapolate=extrapolate)
+        factor = unit_factor("g", intensity["units"], g)
+    except (SiteError, ValueError) as error:
+        message = str(error)
+        raise IntensityError(message if message.startswith("hazard.") else f"hazard.ruptures: {message}") from None
+    return HazardCurve(curve.im * factor, curve.rate, extrapolate=extrapolate, measure=describe_measure(intensity), units=intensity["units"],
+                       source=f"{curve.source}; {site.source}" if site.source else curve.source)
 
 
 def hazard_curve(entry: Mapping[str, Any], extrapolate: bool | None = None) -> HazardCurve:

@@ -34,7 +34,10 @@ and R_x = −R_rup (no hanging-wall term); the dip is 90° for strike-slip,
 40° for reverse and 50° for normal faulting (Kaklamanos et al. 2011);
 region California, Vs30 measured; the basin depths Z1.0 and Z2.5, the
 rupture width and the hypocentral depth are each model's own default
-estimate in pygmm (from Vs30, M and the dip).
+estimate in pygmm (from Vs30, M and the dip). A scenario's ``geometry``
+(:data:`GEOMETRY_FIELDS`: R_JB, R_x, Z_tor, dip, Z1.0, Z2.5, e.g. a
+rupture of a site's table, :class:`stochpound.analysis.RuptureSite`) replaces
+those estimates field by field; the site is on the hanging wall where R_x ≥ 0.
 """
 
 from __future__ import annotations
@@ -62,6 +65,11 @@ MODEL_DAMPING = 0.05
 #: is not caused by the scenario in such a model (the USGS models of the bundled curves: nshmp-haz's upper truncation at 3σ).
 TRUNCATION_EPSILON = 3.0
 _SCENARIO_FIELDS = {"magnitude": "mag", "distance_km": "dist_rup", "vs30": "v_s30"}
+#: A scenario's geometry beyond its magnitude, rupture distance, Vs30 and mechanism (module docstring), by the toolkit's
+#: name (km and degrees), with pygmm's name: the Joyner–Boore distance, the site's distance from the top edge's strike line
+#: (R_x, ≥ 0 on the hanging wall), the depth to the top of rupture, the dip, the site's depths to 1.0 and 2.5 km/s.
+GEOMETRY_FIELDS = {"distance_jb_km": "dist_jb", "distance_x_km": "dist_x", "ztor_km": "depth_tor", "dip": "dip",
+                   "z1p0_km": "depth_1_0", "z2p5_km": "depth_2_5"}
 
 
 def _models() -> tuple[type, ...]:
@@ -70,10 +78,10 @@ def _models() -> tuple[type, ...]:
     return (pygmm.AbrahamsonSilvaKamai2014, pygmm.BooreStewartSeyhanAtkinson2014, pygmm.CampbellBozorgnia2014, pygmm.ChiouYoungs2014)
 
 
-def scenario_limits() -> dict[str, tuple[float, float]]:
-    """The range of magnitude, distance_km and vs30 every one of the four models is meant for (the intersection of their limits)."""
+def _common_limits(fields: Mapping[str, str]) -> dict[str, tuple[float, float]]:
+    """The range (from 0 up) of each field (toolkit's name: pygmm's) every one of the four models is meant for: the intersection of their limits."""
     limits = {}
-    for field, name in _SCENARIO_FIELDS.items():
+    for field, name in fields.items():
         low, high = 0.0, np.inf
         for model in _models():
             for parameter in model.PARAMS:
@@ -84,43 +92,93 @@ def scenario_limits() -> dict[str, tuple[float, float]]:
     return limits
 
 
+def scenario_limits() -> dict[str, tuple[float, float]]:
+    """The range of magnitude, distance_km and vs30 every one of the four models is meant for (the intersection of their limits)."""
+    return _common_limits(_SCENARIO_FIELDS)
+
+
+def geometry_limits(distance_km: float) -> dict[str, tuple[float, float]]:
+    """The range of every :data:`GEOMETRY_FIELDS` entry for a scenario at rupture distance ``distance_km``.
+
+    The four models' common limits (Z_tor 0–20 km, dip 15–90°, Z2.5 0–10 km,
+    R_JB ≤ 300 km), and what a geometry must be: 0 ≤ R_JB ≤ R_rup,
+    |R_x| ≤ 300 km, Z1.0 ≥ 0.
+    """
+    given = {"distance_jb_km": (0.0, min(300.0, float(distance_km))), "distance_x_km": (-300.0, 300.0), "z1p0_km": (0.0, np.inf)}
+    return _common_limits({field: name for field, name in GEOMETRY_FIELDS.items() if field not in given}) | given
+
+
+def _is_number(value: object) -> bool:
+    return isinstance(value, (int, float, np.floating, np.integer)) and not isinstance(value, bool) and bool(np.isfinite(value))
+
+
 def check_scenario(magnitude: float, distance_km: float, vs30: float, mechanism: str, names: Mapping[str, str] | None = None,
-                   limits: Mapping[str, tuple[float, float]] | None = None, source: str = "the NGA-West2 models' range") -> None:
+                   geometry: Mapping[str, float | None] | None = None, *, limits: Mapping[str, tuple[float, float]] | None = None,
+                   source: str = "the NGA-West2 models' range") -> None:
     """Raise :class:`SiteError` naming the field of a scenario outside the models' range or of an unknown mechanism.
 
-    ``names`` spells a field in the message (default: its own name); ``limits``
-    (default :func:`scenario_limits`) are the ranges, ``source`` says whose.
+    ``names`` spells a field in the message (default: its own name);
+    ``geometry`` (:data:`GEOMETRY_FIELDS`, None values left to the models'
+    estimates) is checked against :func:`geometry_limits`; ``limits``
+    (default :func:`scenario_limits`) are the ranges of magnitude,
+    distance_km and vs30, ``source`` says whose.
     """
     names = names or {}
     for field, (low, high) in (limits or scenario_limits()).items():
         value = {"magnitude": magnitude, "distance_km": distance_km, "vs30": vs30}[field]
-        if not isinstance(value, (int, float)) or isinstance(value, bool) or not low <= value <= high:
+        if not _is_number(value) or not low <= value <= high:
             raise SiteError(f"{names.get(field, field)}: must be within {low:g}-{high:g} ({source}), got {value!r}")
     if mechanism not in MECHANISMS:
         raise SiteError(f"{names.get('mechanism', 'mechanism')}: must be one of {', '.join(MECHANISMS)}, got {mechanism!r}")
+    unknown = set(geometry or {}) - set(GEOMETRY_FIELDS)
+    if unknown:
+        raise SiteError(f"geometry: unknown field(s) {', '.join(sorted(unknown))}; known: {', '.join(GEOMETRY_FIELDS)}")
+    for field, (low, high) in geometry_limits(distance_km).items():
+        value = (geometry or {}).get(field)
+        if value is not None and (not _is_number(value) or not low <= value <= high):
+            what = "at most the rupture distance, " if field == "distance_jb_km" else ""
+            raise SiteError(f"{names.get(field, field)}: must be within {low:g}-{high:g} ({what}the NGA-West2 models' range), got {value!r}")
 
 
 @dataclass(frozen=True)
 class ConditionalDistribution:
-    """ln Sa at ``periods`` given the conditioning measure: mean, covariance and the unconditional moments."""
+    """ln Sa (g) at ``periods`` given the conditioning measure at each of ``levels`` (g), in one scenario.
+
+    ``mean_ln`` [level, period] and ``covariance`` [period, period] (the
+    same at every level) of the conditional normal, ``epsilon`` [level] the
+    levels' ε*; the scenario's unconditional moments at ``periods``, and
+    those of ln IM* (``measure_mean_ln``, ``measure_sigma_ln``).
+    """
 
     periods: np.ndarray
+    levels: np.ndarray
     mean_ln: np.ndarray
     covariance: np.ndarray
     unconditional_mean_ln: np.ndarray
     unconditional_sigma_ln: np.ndarray
-    epsilon: float
+    epsilon: np.ndarray
+    measure_mean_ln: float
+    measure_sigma_ln: float
 
 
-def _average_model(nodes: Sequence[float | None], magnitude: float, distance_km: float, vs30: float, mechanism: str) -> tuple[np.ndarray, np.ndarray]:
-    """Mean ln median (g) and σ of the four models at every node (a period in s, or None for PGA)."""
+def _pygmm_scenario(magnitude: float, distance_km: float, vs30: float, mechanism: str, geometry: Mapping[str, float | None] | None):
+    """pygmm's scenario: the estimates of the module docstring, replaced by the ``geometry`` given (not None)."""
     import pygmm
 
     code, dip = MECHANISMS[mechanism]
-    scenario = pygmm.Scenario(
-        mag=float(magnitude), dist_rup=float(distance_km), dist_jb=float(distance_km), dist_x=-float(distance_km),
-        v_s30=float(vs30), mechanism=code, dip=dip, depth_tor=0.0, region="california", vs_source="measured",
-    )  # fmt: skip
+    fields = {"mag": float(magnitude), "dist_rup": float(distance_km), "dist_jb": float(distance_km), "dist_x": -float(distance_km),
+              "v_s30": float(vs30), "mechanism": code, "dip": dip, "depth_tor": 0.0, "region": "california", "vs_source": "measured"}
+    given = {GEOMETRY_FIELDS[field]: float(value) for field, value in (geometry or {}).items() if value is not None}
+    if given:
+        fields.update(given)
+        fields["on_hanging_wall"] = fields["dist_x"] >= 0.0
+    return pygmm.Scenario(**fields)
+
+
+def _average_model(nodes: Sequence[float | None], magnitude: float, distance_km: float, vs30: float, mechanism: str,
+                   geometry: Mapping[str, float | None] | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Mean ln median (g) and σ of the four models at every node (a period in s, or None for PGA)."""
+    scenario = _pygmm_scenario(magnitude, distance_km, vs30, mechanism, geometry)
     periods = np.array([PGA_PERIOD if node is None else node for node in nodes], dtype=float)
     is_pga = np.array([node is None for node in nodes])
     means, variances = [], []
@@ -185,11 +243,11 @@ def _node_correlation(nodes: Sequence[float | None]) -> np.ndarray:
 
 
 def _joint_model(conditioning: Sequence[float | None], output: Sequence[float | None], magnitude: float, distance_km: float,
-                 vs30: float, mechanism: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+                 vs30: float, mechanism: str, geometry: Mapping[str, float | None] | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """ln Sa at the nodes of :func:`_joint_nodes` in a scenario: mean μ, covariance C and the measure's weights w."""
-    check_scenario(magnitude, distance_km, vs30, mechanism)
+    check_scenario(magnitude, distance_km, vs30, mechanism, geometry=geometry)
     nodes, weights = _joint_nodes(conditioning, output)
-    mean, sigma = _average_model(nodes, magnitude, distance_km, vs30, mechanism)
+    mean, sigma = _average_model(nodes, magnitude, distance_km, vs30, mechanism, geometry)
     return mean, _node_correlation(nodes) * np.outer(sigma, sigma), weights
 
 
@@ -205,7 +263,7 @@ def _conditioned(mean: np.ndarray, covariance: np.ndarray, weights: np.ndarray,
 
 
 def scenario_distribution(measure: str, period: float | Sequence[float] | None = None, *, magnitude: float, distance_km: float,
-                          vs30: float, mechanism: str) -> tuple[float, float]:
+                          vs30: float, mechanism: str, geometry: Mapping[str, float | None] | None = None) -> tuple[float, float]:
     """The median (g) and the standard deviation of ln of a measure in a scenario: the conditional spectrum's own model.
 
     Parameters
@@ -218,6 +276,10 @@ def scenario_distribution(measure: str, period: float | Sequence[float] | None =
         Moment magnitude, rupture distance (km) and Vs30 (m/s) of the scenario.
     mechanism : {"strike_slip", "reverse", "normal"}
         Faulting mechanism.
+    geometry : mapping, optional
+        The rupture's geometry and the site's basin depths (:data:`GEOMETRY_FIELDS`:
+        ``distance_jb_km``, ``distance_x_km``, ``ztor_km``, ``dip`` in degrees,
+        ``z1p0_km``, ``z2p5_km``); a field left out keeps the estimate of the module docstring.
 
     Returns
     -------
@@ -231,32 +293,86 @@ def scenario_distribution(measure: str, period: float | Sequence[float] | None =
     SiteError
         Naming the field, as :func:`conditional_spectrum`.
     """
-    mean, covariance, weights = _joint_model(_conditioning_nodes(measure, period), [], magnitude, distance_km, vs30, mechanism)
+    mean, covariance, weights = _joint_model(_conditioning_nodes(measure, period), [], magnitude, distance_km, vs30, mechanism, geometry)
     return float(np.exp(weights @ mean)), float(np.sqrt(weights @ covariance @ weights))
+
+
+def scenario_spectrum(periods: Sequence[float], *, magnitude: float, distance_km: float, vs30: float, mechanism: str,
+                      geometry: Mapping[str, float | None] | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Mean ln PSA (g) and its σ at every period (s; 0 stands for PGA) in a scenario: :func:`scenario_distribution` of many periods at once."""
+    nodes = [None if p == 0 else p for p in np.atleast_1d(np.asarray(periods, dtype=float))]
+    _check_periods([p for p in nodes if p is not None] or [PGA_PERIOD], "periods")
+    check_scenario(magnitude, distance_km, vs30, mechanism, geometry=geometry)
+    return _average_model(nodes, magnitude, distance_km, vs30, mechanism, geometry)
+
+
+def _check_level(level: object) -> None:
+    if not _is_number(level) or level <= 0:
+        raise SiteError(f"level: must be > 0 (g), got {level!r}")
 
 
 def conditional_distribution(
     measure: str,
     period: float | Sequence[float] | None,
-    level: float,
+    levels: float | Sequence[float],
     periods: Sequence[float],
     magnitude: float,
     distance_km: float,
     vs30: float,
     mechanism: str,
+    geometry: Mapping[str, float | None] | None = None,
 ) -> ConditionalDistribution:
-    """ln Sa (g) at ``periods`` given the measure = ``level`` (module docstring), after checking every input."""
+    """ln Sa (g) at ``periods`` given the measure at each of ``levels`` (module docstring), after checking every input."""
     conditioning = _conditioning_nodes(measure, period)
-    if not isinstance(level, (int, float)) or isinstance(level, bool) or not np.isfinite(level) or level <= 0:
-        raise SiteError(f"level: must be > 0 (g), got {level!r}")
+    for level in np.atleast_1d(levels).tolist():
+        _check_level(level)
     output = _check_periods(periods, "periods")
     if np.unique(output).size != output.size:
         raise SiteError("periods: repeated period")
-    mean, covariance, weights = _joint_model(conditioning, list(output), magnitude, distance_km, vs30, mechanism)
+    mean, covariance, weights = _joint_model(conditioning, list(output), magnitude, distance_km, vs30, mechanism, geometry)
     sigma = np.sqrt(np.diag(covariance))
-    conditional_mean, conditional_cov, epsilon = _conditioned(mean, covariance, weights, np.log([level]))
+    levels = np.atleast_1d(np.asarray(levels, dtype=float))
+    conditional_mean, conditional_cov, epsilon = _conditioned(mean, covariance, weights, np.log(levels))
     n = output.size
-    return ConditionalDistribution(output, conditional_mean[0, :n], conditional_cov[:n, :n], mean[:n], sigma[:n], float(epsilon[0]))
+    return ConditionalDistribution(output, levels, conditional_mean[:, :n], conditional_cov[:n, :n], mean[:n], sigma[:n], epsilon,
+                                   float(weights @ mean), float(np.sqrt(weights @ covariance @ weights)))
+
+
+def spectrum_dataset(periods: np.ndarray, mean_ln: np.ndarray, covariance: np.ndarray, unconditional_mean_ln: np.ndarray,
+                     unconditional_sigma_ln: np.ndarray, attrs: Mapping[str, object]) -> xr.Dataset:
+    """A conditional spectrum as :func:`conditional_spectrum` returns it, from the conditional mean and covariance of ln Sa (g)."""
+    sigma = np.sqrt(np.clip(np.diag(covariance), 0.0, None))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        correlation = np.where(np.outer(sigma, sigma) > 0, covariance / np.outer(sigma, sigma), 0.0)
+    np.fill_diagonal(correlation, 1.0)
+    coords = {"period": ("period", periods, {"units": "s"}), "other_period": ("other_period", periods, {"units": "s"})}
+    return xr.Dataset(
+        {
+            "median": ("period", np.exp(mean_ln), {"units": "g", "long_name": "median Sa given the level"}),
+            "sigma_ln": ("period", sigma, {"units": "1", "long_name": "standard deviation of ln Sa given the level"}),
+            "unconditional_median": ("period", np.exp(unconditional_mean_ln), {"units": "g", "long_name": "median Sa of the scenario"}),
+            "unconditional_sigma_ln": ("period", unconditional_sigma_ln, {"units": "1", "long_name": "standard deviation of ln Sa of the scenario"}),
+            "correlation": (("period", "other_period"), correlation, {"units": "1", "long_name": "correlation of ln Sa given the level"}),
+        },
+        coords=coords,
+        attrs=dict(attrs),
+    )
+
+
+#: The models and the correlation of every conditional spectrum, in words (a dataset's ``models`` attribute).
+MODELS_TEXT = "ASK14 BSSA14 CB14 CY14 (pygmm), mean of ln medians, sigma = rms of sigmas; Baker-Jayaram 2008 correlation"
+
+
+def conditioning_attrs(measure: str, period: float | Sequence[float] | None, level: float) -> dict[str, object]:
+    """The attributes of a conditional spectrum that name its conditioning: ``measure``, ``conditioning_period``, ``level``, ``damping``, ``models``."""
+    return {"measure": measure, "conditioning_period": "" if period is None else " ".join(f"{p:g}" for p in np.atleast_1d(period)),
+            "level": float(level), "damping": MODEL_DAMPING, "models": MODELS_TEXT}
+
+
+def check_damping(damping: float) -> None:
+    """Raise :class:`SiteError` unless ``damping`` is the models' 5 %."""
+    if damping != MODEL_DAMPING:
+        raise SiteError(f"damping: the NGA-West2 models give 5 % damped spectra only (0.05), got {damping!r}")
 
 
 def conditional_spectrum(
@@ -270,6 +386,7 @@ def conditional_spectrum(
     vs30: float,
     mechanism: str,
     damping: float = MODEL_DAMPING,
+    geometry: Mapping[str, float | None] | None = None,
 ) -> xr.Dataset:
     """The conditional spectrum: ln Sa given the measure at ``level``, for a scenario (module docstring).
 
@@ -290,6 +407,8 @@ def conditional_spectrum(
         Faulting mechanism.
     damping : float
         0.05 only (the models' damping).
+    geometry : mapping, optional
+        The rupture's geometry and the site's basin depths, as for :func:`scenario_distribution`.
 
     Returns
     -------
@@ -298,7 +417,7 @@ def conditional_spectrum(
         level; ``unconditional_median`` (g) and ``unconditional_sigma_ln`` of
         the scenario; ``correlation`` (``period``, ``other_period``) of the
         conditional ln Sa. Attributes: ``epsilon`` (ε* of the level),
-        ``measure``, the scenario and the models.
+        ``measure``, the scenario (its geometry's given fields too) and the models.
 
     Raises
     ------
@@ -306,33 +425,10 @@ def conditional_spectrum(
         Naming the field: an unknown measure or mechanism, a period outside
         0.01–10 s, a scenario outside the models' range, a damping other than 5 %.
     """
-    if damping != MODEL_DAMPING:
-        raise SiteError(f"damping: the NGA-West2 models give 5 % damped spectra only (0.05), got {damping!r}")
-    target = conditional_distribution(measure, period, level, periods, magnitude, distance_km, vs30, mechanism)
-    sigma = np.sqrt(np.clip(np.diag(target.covariance), 0.0, None))
-    with np.errstate(divide="ignore", invalid="ignore"):
-        correlation = np.where(np.outer(sigma, sigma) > 0, target.covariance / np.outer(sigma, sigma), 0.0)
-    np.fill_diagonal(correlation, 1.0)
-    coords = {"period": ("period", target.periods, {"units": "s"}), "other_period": ("other_period", target.periods, {"units": "s"})}
-    return xr.Dataset(
-        {
-            "median": ("period", np.exp(target.mean_ln), {"units": "g", "long_name": "median Sa given the level"}),
-            "sigma_ln": ("period", sigma, {"units": "1", "long_name": "standard deviation of ln Sa given the level"}),
-            "unconditional_median": ("period", np.exp(target.unconditional_mean_ln), {"units": "g", "long_name": "median Sa of the scenario"}),
-            "unconditional_sigma_ln": ("period", target.unconditional_sigma_ln, {"units": "1", "long_name": "standard deviation of ln Sa of the scenario"}),
-            "correlation": (("period", "other_period"), correlation, {"units": "1", "long_name": "correlation of ln Sa given the level"}),
-        },
-        coords=coords,
-        attrs={
-            "epsilon": target.epsilon,
-            "measure": measure,
-            "conditioning_period": "" if period is None else " ".join(f"{p:g}" for p in np.atleast_1d(period)),
-            "level": float(level),
-            "magnitude": float(magnitude),
-            "distance_km": float(distance_km),
-            "vs30": float(vs30),
-            "mechanism": mechanism,
-            "damping": MODEL_DAMPING,
-            "models": "ASK14 BSSA14 CB14 CY14 (pygmm), mean of ln medians, sigma = rms of sigmas; Baker-Jayaram 2008 correlation",
-        },
-    )
+    check_damping(damping)
+    _check_level(level)
+    target = conditional_distribution(measure, period, level, periods, magnitude, distance_km, vs30, mechanism, geometry)
+    scenario = {"magnitude": float(magnitude), "distance_km": float(distance_km), "vs30": float(vs30), "mechanism": mechanism}
+    scenario.update({field: float(value) for field, value in (geometry or {}).items() if value is not None})
+    return spectrum_dataset(target.periods, target.mean_ln[0], target.covariance, target.unconditional_mean_ln, target.unconditional_sigma_ln,
+                            {"epsilon": float(target.epsilon[0]), **conditioning_attrs(measure, period, level), **scenario})

@@ -197,6 +197,7 @@ def _scenario_words(store: xr.Dataset, kind: str | None) -> str:
     """The stripes' scenario in words: its values as stored, and how it was obtained (``kind``, the definition's ``site.scenario``)."""
     words = {"fitted": "fitted to the site's hazard curves (a calibration standing in for a disaggregation)",
              "given": "as the [site] table gives it (an assumption unless it comes from the site's disaggregation)",
+             "ruptures": "the exact conditional spectrum of the site's ruptures (their mixture by the shares at each level; M and R its means)",
              None: "how it was obtained is not recorded (a store written before the definition kept it)"}[kind]
     ranges = scenario_ranges(store)
     return words if ranges is None else f"{ranges}, {words}"

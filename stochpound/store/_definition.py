@@ -167,7 +167,7 @@ class Hazard(_Entry):
     Attributes
     ----------
     source : str
-        ``file``, ``bundled`` or ``power_law``.
+        ``file``, ``bundled``, ``power_law`` or ``ruptures`` (the site of a rupture table, the entry's ``ruptures``).
     units : str
         Units of the intensities (the ``[intensity]`` levels').
     im, rate : tuple of float

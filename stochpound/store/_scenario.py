@@ -5,12 +5,13 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
-SCENARIO_KINDS = ("given", "fitted")
-"""How a scenario was obtained: as the ``[site]`` table gives it, or fitted to the site's hazard curves."""
+SCENARIO_KINDS = ("given", "fitted", "ruptures")
+"""How a scenario was obtained: as the ``[site]`` table gives it, fitted to the site's hazard curves, or from the site's ruptures
+(the exact conditional spectrum's mixture; the stored M and R its means)."""
 
 
 def scenario_kind(store: xr.Dataset) -> str | None:
-    """``"given"`` or ``"fitted"``: how the store's stripes' scenario was obtained; None for a store without a ``[site]`` table
+    """``"given"``, ``"fitted"`` or ``"ruptures"``: how the store's stripes' scenario was obtained; None for a store without a ``[site]`` table
     (or written before the definition kept it)."""
     site = store.pound.definition.site
     return None if site is None else str(site["scenario"])

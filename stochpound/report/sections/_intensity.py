@@ -46,7 +46,7 @@ from stochpound.risk import (
     site_consistency,
     stripes_beyond_truncation,
 )
-from stochpound.store import has_contact_free, with_contacts
+from stochpound.store import has_contact_free, scenario_kind, with_contacts
 
 CONFIDENCE = 0.95
 G = 9.81
@@ -253,8 +253,9 @@ def _listed(items: list[str]) -> str:
 
 def _selection_text(store: xr.Dataset, setting: dict[str, Any]) -> str:
     """The selection for the site: the scenario of every stripe and the stripes whose selection misses its target."""
+    mixture = scenario_kind(store) == "ruptures"  # the exact conditional spectrum: the means of its mixture over the site's ruptures
     scenarios = "; ".join(
-        f"{level:g} {setting['units']}: M {m:g} at {r:g} km (ε {e:.2f})"
+        f"{level:g} {setting['units']}: " + (f"the ruptures' mean M {m:.3g} at {r:.3g} km (mean ε {e:.2f})" if mixture else f"M {m:g} at {r:g} km (ε {e:.2f})")
         for level, m, r, e in zip(store["intensity"].values, store["site_magnitude"].values, store["site_distance_km"].values, store["target_epsilon"].values)
     )
     missed = selection_misses(store)

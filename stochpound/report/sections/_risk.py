@@ -46,7 +46,8 @@ def hazard_provenance(store: xr.Dataset) -> str:
     if entry is None:
         return ""
     given = {"file": lambda: f"the file {entry['file']} (sha256 {entry['file_sha256']})", "bundled": lambda: f"the bundled curve {entry['bundled']}",
-             "power_law": lambda: f"the power law {entry['power_law']['k0']:g} x^-{entry['power_law']['k']:g}"}[entry["source"]]()
+             "power_law": lambda: f"the power law {entry['power_law']['k0']:g} x^-{entry['power_law']['k']:g}",
+             "ruptures": lambda: f"the site's ruptures {entry['ruptures']} (the NGA-West2 average summed over them)"}[entry["source"]]()
     table = (f", a table of {len(entry['im'])} intensities from {entry['im'][0]:g} to {entry['im'][-1]:g} {entry['units']} "
              f"(log-log interpolation{', extrapolated beyond it as power laws' if entry['extrapolate'] else '; no extrapolation'})"
              if "im" in entry else "")
