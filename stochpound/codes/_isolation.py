@@ -85,7 +85,7 @@ class SlidingBase:
         W_s, the same without the base level (N), in (0, W].
     lambda_max, lambda_min : float
         Property-modification factors on μ (§17.2.8.4): λ_max >= 1, 0 < λ_min <= 1.
-        Defaults :data:`PROPERTY_MODIFICATION`.
+        Defaults 1.8 and 0.6 (``PROPERTY_MODIFICATION``).
     breakaway : float, optional
         Nominal breakaway (static) friction coefficient (1), >= ``mu``, for
         §17.5.4.3 item 3c (times λ_max); None: taken as ``mu``.

@@ -195,7 +195,7 @@ def asce7_isolator_displacement(weight: float, mu: float, radius: float, sm1: fl
                                 tolerance: float = 1e-10) -> tuple[float, float, float]:
     """ASCE 7-16 §17.5.3's displacement D_M of a friction pendulum (or flat slider with restoring stiffness W/R).
 
-    :func:`stochpound.codes.isolator_displacement` (eqs. 17.5-1, 17.5-2, Table 17.5-1; the weight cancels).
+    ``stochpound.codes.isolator_displacement`` (eqs. 17.5-1, 17.5-2, Table 17.5-1; the weight cancels).
 
     Parameters
     ----------
