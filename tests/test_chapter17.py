@@ -90,8 +90,9 @@ def test_the_separation_from_a_fixed_neighbour_is_dtm_plus_its_delta_m():
 
 
 def test_given_plan_inputs_replace_the_defaults():
-    plan = IsolatedPlan(10.0, 10.0, eccentricity=0.0, distance=5.0)
-    assert plan.amplification == 1.0 and plan.assumptions == ()
+    plan = IsolatedPlan(10.0, 10.0, eccentricity=1.0, distance=2.0)
+    assert plan.amplification == pytest.approx(1.0 + 2.0 * 12.0 * 1.0 / 200.0) and plan.assumptions == ()
+    assert IsolatedPlan(10.0, 10.0, distance=0.0).amplification == 1.0  # the centre of rigidity itself
     assert IsolatedPlan(10.0, 10.0).amplification == pytest.approx(1.15)  # square plan, defaults: 1 + 5 x 12 x 0.5 / 200
 
 
@@ -106,6 +107,7 @@ def test_given_plan_inputs_replace_the_defaults():
     (lambda: MceSpectrum.from_geometric_mean(1.8, 1.2, 8.0, long_factor=0.9), "long_factor: must be >= 1"),
     (lambda: IsolatedPlan(20.0, 10.0), "short_side: must be <= long_side"),
     (lambda: IsolatedPlan(10.0, 20.0, distance=25.0), r"distance: must be in \[0, long_side"),
+    (lambda: IsolatedPlan(10.0, 20.0, eccentricity=0.5), "eccentricity: must be >= the accidental 0.05 long_side = 1 m"),
     (lambda: chapter17_design(SlidingBase(0.05, R, W, WS), MceSpectrum(2.0, 1.5, 8.0), IsolatedPlan(10.0, 20.0), 0.0), "r: must be a positive"),
     (lambda: isolated_separation(_design(), float("nan")), "neighbour_displacement: must be >= 0"),
 ])

@@ -162,7 +162,7 @@ class IsolatedPlan:
     short_side, long_side : float
         b and d, the shortest and longest plan dimensions (m), 0 < b <= d.
     eccentricity : float, optional
-        e (m), actual plus accidental eccentricity; None: accidental only,
+        e (m), actual plus accidental eccentricity, >= 0.05 d; None: accidental only,
         0.05 d (a slider's stiffness follows the weight it carries, so its
         centre of rigidity sits under the centre of mass).
     distance : float, optional
@@ -185,8 +185,10 @@ class IsolatedPlan:
             _positive(name, getattr(self, name))
         if self.short_side > self.long_side:
             raise ValueError(f"short_side: must be <= long_side = {self.long_side:g} m, got {self.short_side!r}")
-        if self.eccentricity is not None:
-            _at_least("eccentricity", self.eccentricity, 0.0)
+        if self.eccentricity is not None and not (math.isfinite(self.eccentricity)
+                                                  and self.eccentricity >= ACCIDENTAL_ECCENTRICITY * self.long_side):
+            raise ValueError(f"eccentricity: must be >= the accidental 0.05 long_side = {ACCIDENTAL_ECCENTRICITY * self.long_side:g} m "
+                             f"(actual plus accidental), got {self.eccentricity!r}")
         if self.distance is not None and not (math.isfinite(self.distance) and 0.0 <= self.distance <= self.long_side):
             raise ValueError(f"distance: must be in [0, long_side = {self.long_side:g}] m, got {self.distance!r}")
 
