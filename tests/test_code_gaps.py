@@ -9,7 +9,7 @@ import pytest
 
 from stochpound.risk import (Asce7Design, Ec8Design, asce7_inelastic_displacement, asce7_isolator_displacement, ec8_design_displacement,
                              modal_floor_displacements, srss_separation)
-from stochpound.risk._code_gaps import damping_coefficient
+from stochpound.codes import damping_coefficient
 from stochpound.model.building import Building
 
 G = 9.81

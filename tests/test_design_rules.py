@@ -189,7 +189,7 @@ def test_the_flagship_s_d_m_in_the_docs_is_eq_17_5_1_s():
     from pathlib import Path
 
     from stochpound.risk import asce7_isolator_displacement
-    from stochpound.risk._code_gaps import damping_coefficient
+    from stochpound.codes import damping_coefficient
 
     docs = re.sub(r"\s+", " ", (Path(__file__).resolve().parents[1] / "docs" / "risk.md").read_text())
     for mu in (0.08, 0.05):

@@ -9,7 +9,10 @@ that meets a target probability (:func:`risk_targeted_separation`), and
 the code separation rules in risk terms (:func:`code_rules_risk`), and the
 separations as the codes compute them from a design analysis
 (:func:`asce7_inelastic_displacement`, :func:`ec8_design_displacement`,
-:func:`srss_separation`, :func:`asce7_isolator_displacement`), applied to
+:func:`srss_separation`, :func:`asce7_isolator_displacement`; an isolated
+building's ASCE 7 chapter 17 design at both friction bounds,
+:func:`chapter17_design`, and its separation from a fixed-base neighbour,
+:func:`isolated_separation`), applied to
 a store's scene and ``[design]`` with their risk (:func:`design_separations`,
 :func:`design_rules_risk`). For an
 experiment store, :func:`store_risk` runs the whole chain and returns a
@@ -45,6 +48,7 @@ from stochpound.risk._fragility_ensemble import (
 )
 from stochpound.risk._maf import TARGETS, degenerate_text, demand_hazard_curve, flat_fit_maf, mean_annual_frequency, rate_intervals, risk_curve, risk_targeted_separation
 from stochpound.risk._code_rules import code_rules_risk
+from stochpound.codes import Chapter17Design, IsolatedPlan, IsolatedSeparation, IsolationBound, MceSpectrum, SlidingBase, chapter17_design, isolated_separation
 from stochpound.risk._code_gaps import (
     Asce7Design,
     Ec8Design,
@@ -99,6 +103,14 @@ __all__ = [
     "ec8_design_displacement",
     "srss_separation",
     "asce7_isolator_displacement",
+    "chapter17_design",
+    "Chapter17Design",
+    "IsolationBound",
+    "SlidingBase",
+    "MceSpectrum",
+    "IsolatedPlan",
+    "isolated_separation",
+    "IsolatedSeparation",
     "design_separations",
     "design_rules_risk",
     "DESIGN_RULE_LEVELS",

@@ -37,7 +37,9 @@ so where a gap is reported.
 No maintained Python package computes these (the ``asce7-16`` package has
 the ASCE 7 design spectrum, used here, but neither the §12.12 separations,
 chapter 17's displacement nor Eurocode 8's spectra), so the formulas are
-written out here with their clauses.
+written out here with their clauses; chapter 17's are in
+:mod:`stochpound.codes` (the isolated building's design, forces and
+displacements at both friction bounds).
 """
 
 from __future__ import annotations
@@ -49,10 +51,8 @@ import numpy as np
 from asce7_16.seismic import design_response_spectrum
 from scipy.linalg import eigh
 
+from stochpound.codes import isolator_displacement
 from stochpound.model.building import Building, storey_matrix
-
-#: ASCE 7-16 Table 17.5-1: damping coefficient B_M against effective damping β_M (interpolated linearly).
-ASCE7_DAMPING_TABLE = ((0.02, 0.8), (0.05, 1.0), (0.10, 1.2), (0.20, 1.5), (0.30, 1.7), (0.40, 1.9), (0.50, 2.0))
 
 #: EN 1998-1 Table 3.2 (Type 1 spectrum): S, T_B, T_C, T_D (s) of each ground type.
 EC8_TYPE1_GROUND = {
@@ -195,9 +195,7 @@ def asce7_isolator_displacement(weight: float, mu: float, radius: float, sm1: fl
                                 tolerance: float = 1e-10) -> tuple[float, float, float]:
     """ASCE 7-16 §17.5.3's displacement D_M of a friction pendulum (or flat slider with restoring stiffness W/R).
 
-    Solves D = g S_M1 T_M / (4 π² B_M) (eq. 17.5-1) with T_M = 2π √(W / (k_M g))
-    (eq. 17.5-2), k_M = W/R + μW/D and B_M from Table 17.5-1 at
-    β_M = 2μ / (π (μ + D/R)), by fixed-point iteration from D = 0.1 m.
+    ``stochpound.codes.isolator_displacement`` (eqs. 17.5-1, 17.5-2, Table 17.5-1; the weight cancels).
 
     Parameters
     ----------
@@ -212,29 +210,13 @@ def asce7_isolator_displacement(weight: float, mu: float, radius: float, sm1: fl
     g : float
         Standard gravity (m/s²).
     tolerance : float
-        Stop when D changes by less than this (m).
+        Tolerance on D (m).
 
     Returns
     -------
     displacement, period, damping : float
         D_M (m), T_M (s), β_M (1).
     """
-    for name, value in (("weight", weight), ("mu", mu), ("radius", radius), ("sm1", sm1)):
-        if not (math.isfinite(value) and value > 0.0):
-            raise ValueError(f"{name}: must be a positive number, got {value!r}")
-    displacement = 0.1
-    for _ in range(500):
-        stiffness = weight / radius + mu * weight / displacement
-        period = 2.0 * math.pi * math.sqrt(weight / (stiffness * g))
-        damping = 2.0 * mu / (math.pi * (mu + displacement / radius))
-        updated = g * sm1 * period / (4.0 * math.pi**2 * damping_coefficient(damping))
-        if abs(updated - displacement) < tolerance:
-            return updated, period, damping
-        displacement = updated
-    raise ValueError(f"mu, radius: ASCE 7 eq. 17.5-1 found no displacement (last {displacement:.4g} m)")
-
-
-def damping_coefficient(damping: float) -> float:
-    """B_M of ASCE 7-16 Table 17.5-1 at effective damping β (linear interpolation; the table's ends outside it)."""
-    ratios, coefficients = zip(*ASCE7_DAMPING_TABLE, strict=True)
-    return float(np.interp(damping, ratios, coefficients))
+    if not (math.isfinite(weight) and weight > 0.0):
+        raise ValueError(f"weight: must be a positive number, got {weight!r}")
+    return isolator_displacement(mu, radius, sm1, g, tolerance)

@@ -24,6 +24,8 @@ import numpy as np
 import xarray as xr
 from scipy import special
 
+from stochpound.stats._earthquakes import earthquake_identities
+
 
 def bootstrap_weights(motions: int, resamples: int, seed: int | Sequence[int], clusters: Sequence[object] | None = None) -> np.ndarray:
     """How many times each motion appears in each resample with replacement: the one resampler of the toolkit.
@@ -121,15 +123,23 @@ def jackknife_weights(motions: int, clusters: Sequence[object] | None = None) ->
     return (np.arange(count)[:, None] != index[None, :]).astype(np.float64)
 
 
-def motion_clusters(events: Sequence[object], stations: Sequence[object] | None = None) -> np.ndarray | None:
+def motion_clusters(events: Sequence[object], stations: Sequence[object] | None = None,
+                    magnitudes: Sequence[float] | None = None) -> np.ndarray | None:
     """Cluster labels of motions for :func:`bootstrap_weights`: their earthquake, or their station where the event is unknown.
+
+    The earthquake is the event normalised across suites
+    (:func:`stochpound.motions.records.earthquake_identities`: "Northridge
+    1994" and "Northridge-01 1994" of the same magnitude are one cluster).
 
     Parameters
     ----------
     events : sequence of str
-        Each motion's earthquake ("" where unknown).
+        Each motion's event, ``"<name> <year>"`` ("" where unknown).
     stations : sequence of str, optional
         Each motion's recording station, used where the event is blank.
+    magnitudes : sequence of float, optional
+        Each motion's moment magnitude (NaN where unknown), which the
+        normalisation checks; None: only identical event names are one earthquake.
 
     Returns
     -------
@@ -137,7 +147,7 @@ def motion_clusters(events: Sequence[object], stations: Sequence[object] | None 
         One label per motion; None when no motion has an event or station
         (every motion is then its own cluster).
     """
-    events = [str(e) for e in events]
+    events = earthquake_identities(events, magnitudes)
     stations = [str(s) for s in stations] if stations is not None else [""] * len(events)
     if len(stations) != len(events):
         raise ValueError(f"stations: must hold one per motion ({len(events)}), got {len(stations)}")
@@ -151,11 +161,13 @@ def motion_clusters(events: Sequence[object], stations: Sequence[object] | None 
 
 def record_clusters(data: xr.DataArray | xr.Dataset, record_dim: str = "record") -> np.ndarray | None:
     """The cluster of each motion along ``record_dim`` from a store's motion metadata: :func:`motion_clusters` of its
-    ``record_event`` (and ``record_station``) coordinates; None where ``data`` has neither (every motion its own cluster)."""
+    ``record_event`` (and ``record_station``, ``record_magnitude``) coordinates; None where ``data`` has neither (every motion its own cluster)."""
     if "record_event" not in data.coords or record_dim not in data["record_event"].dims:
         return None
     stations = data.coords["record_station"].values if "record_station" in data.coords else None
-    return motion_clusters(data.coords["record_event"].values, stations)
+    magnitude = data.coords.get("record_magnitude")
+    magnitudes = magnitude.values if magnitude is not None and magnitude.dims == data["record_event"].dims else None
+    return motion_clusters(data.coords["record_event"].values, stations, magnitudes)
 
 
 def bootstrap_method(clusters: np.ndarray | None, ran: np.ndarray | None = None) -> str:

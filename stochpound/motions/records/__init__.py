@@ -26,6 +26,7 @@ from stochpound.motions.records._registry import (
 from stochpound.motions.records._suites import SUITES, is_suite_member, list_suites, load_suite, load_suite_member, select_members, suite_members
 from stochpound.motions.records._plot import plot_record, plot_spectra
 from stochpound.motions.records._statistics import RecordStatistics, arias_intensity, moments, record_statistics
+from stochpound.stats import earthquake_identities
 
 # For the other packages of stochpound (their interface to this one, not public API: not in __all__).
 from stochpound.motions.records._suites import METADATA_FIELDS, SELECTIONS  # noqa: F401
@@ -37,6 +38,7 @@ __all__ = [
     "RecordStatistics",
     "RegistryEntry",
     "arias_intensity",
+    "earthquake_identities",
     "is_suite_member",
     "list_records",
     "list_suites",
