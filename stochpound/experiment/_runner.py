@@ -228,9 +228,9 @@ def run_experiment(
     lock = FolderLock(parts_folder(store))
     if not lock.acquire():
         raise _busy(store)
-    if _local_workers(workers, scheduler):
-        _start_fork_server()  # it imports the workers' modules while this process writes the store and compiles the solver
     with lock, _interrupts() as stop:
+        if _local_workers(workers, scheduler):
+            _start_fork_server()  # it imports the workers' modules while this process writes the store and compiles the solver
         if restart:
             clear_store(store)
         remove_temporaries(parts_folder(store))
