@@ -82,8 +82,11 @@ def fallback_folder() -> Path | None:
 
 
 def _private_folder(folder: Path) -> Path:
-    """``folder``, created private (0700) if absent; a fresh private folder when it is not the user's own and private."""
-    folder.mkdir(mode=0o700, exist_ok=True)
+    """``folder``, created private (0700) if absent; a fresh private folder when it is not the user's own private folder."""
+    try:
+        folder.mkdir(mode=0o700)
+    except FileExistsError:  # a folder (checked below), or another kind of file
+        pass
     status = folder.lstat()
     owned = not hasattr(os, "getuid") or status.st_uid == os.getuid()
     if stat.S_ISDIR(status.st_mode) and owned and not status.st_mode & (stat.S_IWGRP | stat.S_IWOTH):

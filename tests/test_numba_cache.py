@@ -74,7 +74,7 @@ def test_without_any_writable_folder_the_kernels_compile_without_a_cache(tmp_pat
 
 
 def test_a_fallback_folder_that_is_not_private_is_not_used(tmp_path, monkeypatch):
-    """A folder of that name open to others (someone could plant compiled code in it) is passed over for a fresh private one."""
+    """A folder of that name open to others (someone could plant compiled code in it), or a file of that name, is passed over for a fresh private folder."""
     from stochpound import _jit
 
     planted = tmp_path / f"{FALLBACK_PREFIX}{os.getuid()}"
@@ -82,6 +82,10 @@ def test_a_fallback_folder_that_is_not_private_is_not_used(tmp_path, monkeypatch
     planted.chmod(0o777)
     chosen = _jit._private_folder(planted)
     assert chosen != planted and chosen.name.startswith(FALLBACK_PREFIX) and oct(chosen.stat().st_mode & 0o777) == "0o700"
+    chosen.rmdir()
+    (tmp_path / "a-file").write_text("")
+    chosen = _jit._private_folder(tmp_path / "a-file")
+    assert chosen.is_dir() and chosen.name.startswith(FALLBACK_PREFIX)
     chosen.rmdir()
     private = tmp_path / "mine"
     assert _jit._private_folder(private) == private and oct(private.stat().st_mode & 0o777) == "0o700"
