@@ -62,16 +62,14 @@ def parse_arguments(argv: list[str] | None) -> argparse.Namespace:
     """Options of ``python -m benchmarks startup``."""
     parser = argparse.ArgumentParser(prog="python -m benchmarks startup", description=__doc__.splitlines()[0])
     parser.add_argument("--rounds", type=int, default=3, help="rounds, each a run with an empty cache then one with the cache it filled (default 3)")
-    parser.add_argument("--against", metavar="REV", default=None, help="also time revision REV of this repository, alternating round by round")
     parser.add_argument("--out", type=Path, default=REPOSITORY / "docs" / "benchmarks.md", help="the Markdown file whose section is rewritten")
+    parser.add_argument("--against", metavar="REV", default=None, help="also time revision REV of this repository, alternating round by round")
     return parser.parse_args(argv)
 
 
 def main(argv: list[str] | None = None) -> int:
     """Measure and rewrite the section of ``--out``."""
-    arguments = parse_arguments(argv)
-    info = report.machine()
-    started = time.perf_counter()
+    arguments, started, info = parse_arguments(argv), time.perf_counter(), report.machine()
     with tempfile.TemporaryDirectory(prefix="stochpound-startup-") as folder:
         rounds = measure(trees(arguments.against, Path(folder)), arguments.rounds, Path(folder))
     results = {"rounds": rounds, "elapsed": time.perf_counter() - started, "load_end": f"{os.getloadavg()[0]:.2f}"}
