@@ -99,15 +99,20 @@ def main(argv: list[str] | None = None) -> int:
     info = report.machine()
     started = time.perf_counter()
     with tempfile.TemporaryDirectory(prefix="stochpound-compare-") as folder:
-        earlier = Path(folder) / "earlier"
-        checkout(arguments.revision, earlier)
-        trees = {"this tree": REPOSITORY, arguments.revision: earlier}
-        rounds = measure(trees, arguments.rounds, arguments.repeats, arguments.demands, Path(folder))
+        rounds = measure(trees(arguments.revision, Path(folder)), arguments.rounds, arguments.repeats, arguments.demands, Path(folder))
     results = {"revision": arguments.revision, "head": info["commit"], "rounds": rounds, "repeats": arguments.repeats,
                "demands": arguments.demands, "elapsed": time.perf_counter() - started}
     SECTION.write(arguments.out, section(results, info))
     print(f"wrote the section 'Against an earlier revision' of {arguments.out} in {results['elapsed']:.0f} s")
     return 0
+
+
+def trees(revision: str | None, folder: Path) -> dict[str, Path]:
+    """The trees to time, by name: this one and, given a ``revision``, its files checked out in ``folder``/earlier."""
+    if revision is None:
+        return {"this tree": REPOSITORY}
+    checkout(revision, folder / "earlier")
+    return {"this tree": REPOSITORY, revision: folder / "earlier"}
 
 
 def checkout(revision: str, folder: Path) -> None:

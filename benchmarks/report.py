@@ -210,6 +210,7 @@ python -m benchmarks --quick       # smoke run (< 1 min), written to a temporary
 python -m benchmarks compare REV   # this tree against revision REV in one session (a few minutes): its own section
 python -m benchmarks compare REV --demands   # the same, every run monitoring the demand parameters
 python -m benchmarks yielding     # yielding storeys: OpenSees Steel01 cross-check and speed (1 min): its own section
+python -m benchmarks startup [--against REV]   # the quick start's start-up, empty and warm numba cache (a few minutes): its own section
 ```
 {quick}
 The benchmark process runs on one thread (OMP, OpenBLAS, MKL and numba thread

@@ -250,16 +250,19 @@ def _twins(task: BatchTask, grounds: dict[int, GroundMotion]) -> dict[str, dict[
     return twins
 
 
-def warm_up() -> None:
-    """Compile the exact solver's engine, the twin's recursion and the response spectrum's kernel (or load them from numba's cache).
+def warm_up(spectrum: bool = True) -> None:
+    """Compile the kernels a batch runs (or load them from numba's cache): the exact solver's engine, the twin's recursion
+    and, with ``spectrum``, the response spectrum's kernel (an experiment with ``[intensity]`` measures its motions).
 
     numba caches compiled kernels on disk (``cache=True``): compiled once
-    here, before local workers start, every worker loads them in about a
-    second instead of compiling them concurrently.
+    by the process that starts the local workers, before they start, every
+    worker loads them in a fraction of a second instead of compiling them
+    concurrently; a kernel an experiment does not run is not compiled.
     """
     from stochpound.solvers.exact import WARM_UP_SCENE, compile_engine
 
     compile_engine()
-    intensity.warm_up()
+    if spectrum:
+        intensity.warm_up()
     twin = scene_from_dict(with_motion(reference_scene(WARM_UP_SCENE, "B2"), WARM_UP_SCENE["motion"]), source="warm_up")
     fixed_base_displacements(twin, [twin.motion])

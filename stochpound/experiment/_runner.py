@@ -59,7 +59,9 @@ LOCAL_CLUSTER_CONFIG = {
 }
 """dask settings of the local cluster: no statistical profiler in the workers (it samples their threads every
 10 ms), slower system monitors and event-loop ticks: idle, the cluster takes about 3 % of a core instead of 13 %;
-worker processes forked by multiprocessing's fork server (which ignores SIGINT: :func:`_dask_client`)."""
+worker processes forked by multiprocessing's fork server (which ignores SIGINT: :func:`_start_fork_server`)."""
+WORKER_MODULES = ("distributed", "stochpound.experiment._compute")
+"""The modules a local worker runs with, imported once by the fork server the workers are forked from (:func:`_start_fork_server`)."""
 
 
 @dataclass
@@ -229,6 +231,8 @@ def run_experiment(
     if not lock.acquire():
         raise _busy(store)
     with lock, _interrupts() as stop:
+        if _local_workers(workers, scheduler):
+            _start_fork_server()  # it imports the workers' modules while this process writes the store and compiles the solver
         if restart:
             clear_store(store)
         remove_temporaries(parts_folder(store))
@@ -402,15 +406,16 @@ def execute(
     for each of its cases.
     """
     labels = list(experiment.motions)
+    spectrum = experiment.intensity is not None  # the kernels the batches run (stochpound.experiment._compute.warm_up)
     if workers == 0 and scheduler is None:
-        _warm_up(say)  # the compile on a cold cache is start-up, not the first batch's time
+        _warm_up(say, spectrum)  # the compile on a cold cache is start-up, not the first batch's time
         ready()
         for task in batches:
             yield task, run_batch(task, motions[labels[task.record]].motion)
         return
     from distributed import as_completed
 
-    with _dask_client(workers, scheduler, say) as client:
+    with _dask_client(workers, scheduler, say, spectrum) as client:
         shipped = {m: client.scatter(motions[label].motion, broadcast=True, hash=False) for m, label in enumerate(labels) if motions[label].motion is not None}
         ahead = IN_FLIGHT_PER_WORKER * max(1, sum(client.nthreads().values()))
         pending = iter(batches)
@@ -442,23 +447,56 @@ def execute(
             client.cancel(list(tasks))
 
 
-def _warm_up(say: Callable[[str], None]) -> None:
-    """Compile the solver in this process (a log line says so, and the compile is timed) or load it from numba's cache."""
+def _warm_up(say: Callable[[str], None], spectrum: bool) -> None:
+    """Compile the kernels the batches run in this process (a log line says so, and the compile is timed) or load them from numba's cache."""
     if first_call.engine_cached():
         say("loading the compiled solver…")
     with first_call.announced_compile():
-        warm_up()
+        warm_up(spectrum)
+
+
+def _start_fork_server() -> None:
+    """Start multiprocessing's fork server, which forks the local workers, unless it runs: it imports :data:`WORKER_MODULES` once.
+
+    Each worker forked from it starts with them imported, instead of importing
+    them itself (seconds of CPU each). The server starts at once and imports
+    them in the background, while this process goes on (writing the store,
+    compiling the solver); it is started while SIGINT is ignored: it, and every
+    worker process it forks, inherit the ignored SIGINT. A Ctrl-C in a
+    terminal reaches every process of the foreground group; the workers then
+    stop with the cluster instead of printing their own tracebacks. Ignoring
+    lasts as long as the fork server's fork and exec (milliseconds, once per
+    process): a Ctrl-C then is lost.
+    """
+    with handling(signal.SIG_IGN):
+        forkserver.set_forkserver_preload(["__main__", *WORKER_MODULES])  # "__main__": multiprocessing's default
+        forkserver.ensure_running()
+
+
+def _load_solver(client: Any, spectrum: bool, one_per_host_first: bool) -> Any:
+    """Have every worker of ``client`` compile or load the batches' kernels (:func:`~stochpound.experiment._compute.warm_up`).
+
+    ``one_per_host_first``: one worker of each host first, then the others,
+    which then load from numba's cache what the first compiled (a cluster
+    this process did not start, whose caches may be cold); otherwise all at
+    once (local workers, which load what this process compiled).
+    """
+    from distributed import wait
+
+    workers = client.scheduler_info()["workers"]
+    first: dict[str, str] = {}
+    for address, info in workers.items():
+        first.setdefault(info.get("host", address) if one_per_host_first else address, address)
+    for group in (list(first.values()), [address for address in workers if address not in first.values()]):
+        wait([client.submit(warm_up, spectrum, pure=False, workers=[address]) for address in group])
+    return client
 
 
 @contextmanager
-def _dask_client(workers: int | None, scheduler: str | None, say: Callable[[str], None]) -> Iterator[Any]:
-    """A client whose workers have loaded the compiled solver: of the scheduler, or of a local cluster."""
+def _dask_client(workers: int | None, scheduler: str | None, say: Callable[[str], None], spectrum: bool = True) -> Iterator[Any]:
+    """A client whose workers have loaded the compiled solver (with the spectrum's kernel if ``spectrum``): of the scheduler, or of a local cluster."""
     import dask
-    from distributed import Client, LocalCluster, wait
-
-    def loaded(client: Any) -> Any:
-        wait([client.submit(warm_up, pure=False, workers=[worker]) for worker in client.scheduler_info()["workers"]])
-        return client
+    from distributed import Client, LocalCluster
 
     for name in ("distributed", "distributed.nanny", "distributed.worker", "distributed.scheduler", "distributed.core"):
         logging.getLogger(name).setLevel(CLUSTER_LOG_LEVEL)
@@ -466,19 +504,14 @@ def _dask_client(workers: int | None, scheduler: str | None, say: Callable[[str]
         say(f"connecting to the dask scheduler {scheduler}…")
         client = Client(scheduler, timeout="30s")
         try:
-            yield loaded(client)
+            yield _load_solver(client, spectrum, one_per_host_first=True)
         finally:
             client.close(timeout=10)
         return
-    _warm_up(say)
+    _start_fork_server()  # started by the run already, unless _dask_client is called on its own
+    _warm_up(say, spectrum)  # before the workers start: they load what it compiles
     n_workers = workers or os.cpu_count() or 1
     say(f"starting a local dask cluster ({n_workers} worker{'s' if n_workers > 1 else ''})…")
-    # The fork server is started while SIGINT is ignored: it, and every worker process it forks, inherit the ignored SIGINT.
-    # A Ctrl-C in a terminal reaches every process of the foreground group; the workers then stop with the cluster instead
-    # of printing their own tracebacks. Ignoring lasts as long as the fork server's fork and exec (milliseconds, once per
-    # process): a Ctrl-C then is lost.
-    with handling(signal.SIG_IGN):
-        forkserver.ensure_running()
     cluster = client = None
     requested: list[int] = []
     try:
@@ -489,7 +522,7 @@ def _dask_client(workers: int | None, scheduler: str | None, say: Callable[[str]
             )
         if requested:
             raise KeyboardInterrupt
-        client = loaded(Client(cluster))
+        client = _load_solver(Client(cluster), spectrum, one_per_host_first=False)
         yield client
     finally:
         if client is not None:

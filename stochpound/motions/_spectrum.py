@@ -43,8 +43,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 import xarray as xr
-from numba import njit
 
+from stochpound._jit import cached_njit
 from stochpound.motions._arias import DEFAULT_G
 
 if TYPE_CHECKING:  # the records package imports the analysis kernels, which import the model
@@ -147,13 +147,13 @@ def response_spectrum(
     )
 
 
-@njit(cache=True)
+@cached_njit()
 def _value(l0: float, l1: float, E: float, F: float, sigma: float, wd: float, tau: float) -> float:
     """f(τ) = l0 + l1 τ + e^{−στ}(E cos ω_d τ + F sin ω_d τ)."""
     return l0 + l1 * tau + math.exp(-sigma * tau) * (E * math.cos(wd * tau) + F * math.sin(wd * tau))
 
 
-@njit(cache=True)
+@cached_njit()
 def _step_peak(l0: float, l1: float, E: float, F: float, sigma: float, wd: float, h: float) -> float:
     """Largest abs(f) at the zeros of f′ inside (0, h) (0 if there are none)."""
     E1, F1 = -sigma * E + wd * F, -sigma * F - wd * E  # f' = l1 + e(E1 cos + F1 sin)
@@ -202,7 +202,7 @@ def _step_peak(l0: float, l1: float, E: float, F: float, sigma: float, wd: float
     return peak
 
 
-@njit(cache=True)
+@cached_njit()
 def _needs_search(f0: float, f1: float, d0: float, d1: float, b2: float, h: float, peak: float) -> bool:
     """Whether a step with end values f0, f1, slopes d0, d1 and abs(f″) ≤ b2 can hold a value above ``peak``.
 
@@ -215,7 +215,7 @@ def _needs_search(f0: float, f1: float, d0: float, d1: float, b2: float, h: floa
     return d0 * d1 <= 0.0 or abs(d0) + abs(d1) <= h * b2
 
 
-@njit(cache=True)
+@cached_njit()
 def _spectrum_kernel(a, h, omega, zeta, sd_out, sa_out):  # pragma: no cover - compiled
     """max abs(u) and max abs(ü + a_g) for every ω (module docstring).
 

@@ -72,6 +72,7 @@ from collections import namedtuple
 import numpy as np
 from numba import njit
 
+from stochpound._jit import cached_njit
 from stochpound.model.friction import STUCK
 from stochpound.model.guards import Guard
 from stochpound.solvers.compiling import NO_RUNTIME
@@ -1347,7 +1348,7 @@ def _supplied_step(m, n, modes, codes, rate, guard, force, monitor, power, motio
 # ---------------------------------------------------------------- the run
 
 
-@njit(cache=True, nogil=True, no_cfunc_wrapper=True, error_model="numpy", **NO_RUNTIME)
+@cached_njit(nogil=True, no_cfunc_wrapper=True, error_model="numpy", **NO_RUNTIME)
 def run_engine(table, dynamics, propagators, motion, layout, run, arming, impacts, outputs, supplied, readouts, scratch, saved, marks, external):
     """Run (or resume) the simulation; returns FINISHED, NEED_MODE, NEED_SPACE, NEED_STEP or NEED_READOUTS.
 

@@ -28,14 +28,15 @@ from __future__ import annotations
 from dataclasses import replace
 from typing import Sequence
 
-import numba
 import numpy as np
 
+from stochpound._jit import cached_njit
 from stochpound.model.modes import initial_mode
 from stochpound.motions.ground import GroundMotion
 from stochpound.solvers.propagators import EXO_SIZE, interval_forcing, propagator_library
 from stochpound.model.scene import Scene
 from stochpound.model.system import build_system
+from stochpound.solvers.compiling import NO_RUNTIME
 from stochpound.solvers.exact import run_exact
 
 
@@ -73,21 +74,26 @@ def fixed_base_displacements(scene: Scene, motions: Sequence[GroundMotion]) -> n
     forcing = np.stack([interval_forcing(motion) for motion in motions])
     floors = np.asarray(system.floor_dofs[0], dtype=np.int64)
     out = np.empty((len(motions), len(floors), forcing.shape[1] + 1))
-    _recursion(np.ascontiguousarray(step), np.ascontiguousarray(forcing, dtype=float), system.initial_state.astype(float), floors, out)
+    _recursion(np.ascontiguousarray(step), np.ascontiguousarray(forcing, dtype=float), system.initial_state.astype(float), floors, out,
+               np.empty((2, step.shape[0])))
     return out
 
 
-@numba.njit(cache=True)
-def _recursion(step: np.ndarray, forcing: np.ndarray, x0: np.ndarray, rows: np.ndarray, out: np.ndarray) -> None:  # pragma: no cover - compiled
+@cached_njit(error_model="numpy", **NO_RUNTIME)
+def _recursion(step: np.ndarray, forcing: np.ndarray, x0: np.ndarray, rows: np.ndarray, out: np.ndarray,
+               work: np.ndarray) -> None:  # pragma: no cover - compiled
     """x_{k+1} = Φ x_k + Γ w_k + γ for every realization; ``out[r, j, k]`` = x_k[rows[j]] of realization r.
 
-    ``step`` holds [Φ, Γ, γ] (2N × (2N + 5)); ``forcing`` is (realizations, intervals, 4).
+    ``step`` holds [Φ, Γ, γ] (2N × (2N + 5)); ``forcing`` is (realizations, intervals, 4); ``work`` (2 × 2N) holds x_k and x_{k+1}.
+    Like the engine (:mod:`stochpound.solvers.engine`), it allocates nothing and assigns no slice, so that it compiles in a
+    fraction of a second, without numba's runtime.
     """
     n = step.shape[0]
-    x = np.empty(n)
-    following = np.empty(n)
+    x = work[0]
+    following = work[1]
     for r in range(forcing.shape[0]):
-        x[:] = x0
+        for i in range(n):
+            x[i] = x0[i]
         for j in range(rows.size):
             out[r, j, 0] = x[rows[j]]
         for k in range(forcing.shape[1]):
@@ -98,6 +104,7 @@ def _recursion(step: np.ndarray, forcing: np.ndarray, x0: np.ndarray, rows: np.n
                 for e in range(EXO_SIZE):
                     total += step[i, n + e] * forcing[r, k, e]
                 following[i] = total
-            x[:] = following
+            for i in range(n):
+                x[i] = following[i]
             for j in range(rows.size):
                 out[r, j, k + 1] = x[rows[j]]

@@ -1,0 +1,62 @@
+"""The start-up of an experiment run: which workers load the compiled kernels when, and which kernels are compiled."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+
+import pytest
+
+from stochpound.experiment import _runner
+from tests.helpers import REPOSITORY
+
+
+class _Client:
+    """The two methods of a dask client the kernels' loading uses, recording what is submitted to which worker."""
+
+    def __init__(self, hosts: dict[str, str]) -> None:
+        self.hosts = hosts
+        self.groups: list[list[str]] = []
+
+    def scheduler_info(self) -> dict:
+        return {"workers": {address: {"host": host} for address, host in self.hosts.items()}}
+
+    def submit(self, function, spectrum, pure, workers):
+        assert function is _runner.warm_up and pure is False
+        return (workers[0], spectrum)
+
+
+@pytest.fixture
+def waits(monkeypatch):
+    """The groups of workers :func:`_runner._load_solver` waits for, in order."""
+    import distributed
+
+    groups: list[list[tuple[str, bool]]] = []
+    monkeypatch.setattr(distributed, "wait", lambda futures: groups.append(list(futures)))
+    return groups
+
+
+def test_a_scheduler_s_workers_load_one_per_host_first_then_the_others(waits):
+    """Three workers on two hosts: one of each host compiles (or loads), then the third loads what its host's first compiled."""
+    client = _Client({"tcp://a:1": "a", "tcp://a:2": "a", "tcp://b:1": "b"})
+    assert _runner._load_solver(client, False, one_per_host_first=True) is client
+    assert waits == [[("tcp://a:1", False), ("tcp://b:1", False)], [("tcp://a:2", False)]]
+
+
+def test_local_workers_all_load_at_once(waits):
+    """Local workers load what the run's own process compiled: all at once, with the spectrum's kernel when asked."""
+    client = _Client({"tcp://127.0.0.1:1": "127.0.0.1", "tcp://127.0.0.1:2": "127.0.0.1"})
+    _runner._load_solver(client, True, one_per_host_first=False)
+    assert waits == [[("tcp://127.0.0.1:1", True), ("tcp://127.0.0.1:2", True)], []]
+
+
+@pytest.mark.slow
+def test_the_warm_up_compiles_the_spectrum_s_kernel_only_when_asked(tmp_path):
+    """An experiment without [intensity] never measures a spectrum: its warm-up compiles the engine and the twin, not that kernel."""
+    code = ("from stochpound.experiment._compute import warm_up\nfrom stochpound.motions import _spectrum\nfrom stochpound.solvers import twin\n"
+            "warm_up(False)\nprint(len(_spectrum._spectrum_kernel.signatures), len(twin._recursion.signatures))\n"
+            "warm_up(True)\nprint(len(_spectrum._spectrum_kernel.signatures))")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=900,
+                          env={**os.environ, "PYTHONPATH": str(REPOSITORY), "NUMBA_CACHE_DIR": str(tmp_path / "cache")})
+    assert done.returncode == 0 and done.stdout.split() == ["0", "1", "1"], done.stderr
