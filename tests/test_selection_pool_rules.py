@@ -9,6 +9,7 @@ import pytest
 
 from stochpound import open_store
 from stochpound.experiment._runner import load_experiment, run_experiment
+from stochpound.experiment._sources import resolve_motions
 from stochpound.experiment._spec import ExperimentError
 from stochpound.motions import conditional_spectrum, select_motions, selection_pool, site_model_provenance, site_motions
 from stochpound.motions.records import Record, load_suite, load_suite_member
@@ -35,6 +36,7 @@ def test_simulated_motions_join_the_pool_and_regenerate_bit_for_bit_from_the_sto
     kinds = dict(zip(store.record.values, store.record_kind.values))
     simulated = [label for label, kind in kinds.items() if kind == "simulated"]
     assert simulated, "the chosen motions should include simulated ones (the records alone are 6 for 2 x 4 places)"
+    ran_motions = resolve_motions(experiment)
     for label in simulated:  # regenerated from what the store records, compared with what ran
         table = json.loads(str(store.record_motion.sel(record=label).values))
         motion = site_motions(table["magnitude"], table["distance_km"], table["vs30"], table["mechanism"], n=table["n"], seed=table["seed"],
@@ -43,9 +45,12 @@ def test_simulated_motions_join_the_pool_and_regenerate_bit_for_bit_from_the_sto
         stripe = int(np.flatnonzero(np.isfinite(store.selection_scale_factor.sel(record=label).values))[0])
         ran = store.isel(intensity=stripe, realization=0).sel(gap=np.inf, record=label)
         scale = float(ran.scale_factor)
-        np.testing.assert_array_equal(experiment.selection and _ran_motion(experiment, label), motion)
+        np.testing.assert_array_equal(ran_motions[label].motion.values, motion)
         assert float(ran.motion_pga) == pytest.approx(np.max(np.abs(motion)), rel=1e-12)
         assert scale == pytest.approx(float(ran.selection_scale_factor), rel=1e-12)
+        level = float(store.intensity.values[stripe])
+        replayed = store.pound.scene(gap=np.inf, intensity=level, record=label, realization=0).motion  # the case's scene, from its table
+        np.testing.assert_array_equal(replayed.values, motion * scale)
     # each stripe states its recorded and simulated motions and its earthquakes (a simulated motion its own)
     for j in range(2):
         chosen = store.record.values[np.isfinite(store.selection_scale_factor.isel(intensity=j).values)]
@@ -53,12 +58,6 @@ def test_simulated_motions_join_the_pool_and_regenerate_bit_for_bit_from_the_sto
         assert int(store.selection_simulated[j]) == n_sim and int(store.selection_recorded[j]) == len(chosen) - n_sim == 4 - n_sim
         events = {str(store.record_event.sel(record=c).values) if kinds[c] == "record" else c for c in chosen}
         assert int(store.selection_earthquakes[j]) == len(events)
-
-
-def _ran_motion(experiment, label: str) -> np.ndarray:
-    from stochpound.experiment._sources import resolve_motions
-
-    return resolve_motions(experiment)[label].motion.values
 
 
 def test_the_simulated_motions_are_part_of_the_identity(tmp_path) -> None:
@@ -103,3 +102,21 @@ def test_a_pool_that_cannot_meet_the_rules_is_a_one_line_error_naming_the_fields
         load_experiment(write_experiment(tmp_path, _text(SELECTION + "max_per_earthquake = 0\n"), "z.toml"))
     with pytest.raises(ExperimentError, match=r"^site.simulated_motions: .*got -1$"):
         load_experiment(write_experiment(tmp_path, _text(site=SITE.replace("= 6", "= -1")), "n.toml"))
+
+
+def test_a_subset_of_site_motions_is_bit_for_bit_the_same_rows_and_a_scene_runs_one() -> None:
+    from stochpound.model.scene_file import scene_from_dict
+
+    full = site_motions(6.6, 20.0, 400.0, "strike_slip", n=5, seed=4)
+    part = site_motions(6.6, 20.0, 400.0, "strike_slip", n=5, seed=4, realizations=[3, 1])
+    np.testing.assert_array_equal(part.acceleration.values, full.acceleration.values[[3, 1]])
+    assert list(part.realization.values) == [3, 1] and part.attrs["n"] == 5
+    building = {"name": "B1", "mass": [1.0e5], "stiffness": [1.5e7], "damping_ratio": 0.05}
+    table = {"type": "site_motions", "magnitude": 6.6, "distance_km": 20.0, "vs30": 400.0, "mechanism": "strike_slip", "n": 5, "seed": 4,
+             "realization": 3, "scale": 1.5, "calibration": site_model_provenance()}
+    motion = scene_from_dict({"building": [building], "motion": table}).motion
+    np.testing.assert_array_equal(motion.values, full.acceleration.values[3] * 1.5)
+    with pytest.raises(Exception, match=r"^motion.calibration: "):
+        scene_from_dict({"building": [building], "motion": {**table, "calibration": "another"}})
+    with pytest.raises(Exception, match=r"^motion.realization: "):
+        scene_from_dict({"building": [building], "motion": {**table, "realization": 5}})
