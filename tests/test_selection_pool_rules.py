@@ -12,7 +12,9 @@ from stochpound.experiment._runner import load_experiment, run_experiment
 from stochpound.experiment._sources import resolve_motions
 from stochpound.experiment._spec import ExperimentError
 from stochpound.motions import conditional_spectrum, select_motions, selection_pool, site_model_provenance, site_motions
-from stochpound.motions.records import Record, load_suite, load_suite_member
+from stochpound.motions.records import load_suite, load_suite_member
+from stochpound.report.render import Paragraph
+from stochpound.report.sections._intensity import intensity_section
 from tests.helpers import SITE_SCENE as SCENE
 from tests.helpers import write_experiment
 
@@ -26,6 +28,25 @@ def _text(intensity: str = SELECTION, site: str = SITE) -> str:
     return f'[experiment]\nname = "pool"\n{SCENE}\n[grid]\ngap = ["inf"]\n{RECORDS}\n[intensity]\n{intensity}\n{site}\n[solver]\nmethod = "exact"\n'
 
 
+def test_the_chosen_simulated_motions_are_the_ones_their_tables_regenerate(tmp_path) -> None:
+    experiment = load_experiment(write_experiment(tmp_path, _text(), "pool.toml"))
+    selection = experiment.selection
+    assert list(experiment.motions) == MEMBERS + list(selection.simulated) and selection.simulated
+    resolved = resolve_motions(experiment)
+    for label, source in selection.simulated.items():
+        table = experiment.motion_table(label)
+        assert source["kind"] == "simulated" and table["type"] == "site_motions" and table["n"] == 6
+        again = site_motions(table["magnitude"], table["distance_km"], table["vs30"], table["mechanism"], n=6, seed=2, dt=0.01)
+        np.testing.assert_array_equal(resolved[label].motion.values, again.acceleration.values[table["realization"]])
+    counts = selection.stripe_counts()
+    for j, chosen in enumerate(selection.selections):
+        labels = [str(m) for m in chosen.motion.values]
+        n_sim = sum(label in selection.simulated for label in labels)
+        assert int(counts["selection_simulated"].values[j]) == n_sim and int(counts["selection_recorded"].values[j]) == 4 - n_sim
+        assert all(label.startswith(f"simulated {j + 1}.") for label in labels if label in selection.simulated)
+
+
+@pytest.mark.slow
 def test_simulated_motions_join_the_pool_and_regenerate_bit_for_bit_from_the_store(tmp_path) -> None:
     experiment = load_experiment(write_experiment(tmp_path, _text(), "pool.toml"))
     setting = experiment.intensity["simulated_motions"]
@@ -58,6 +79,8 @@ def test_simulated_motions_join_the_pool_and_regenerate_bit_for_bit_from_the_sto
         assert int(store.selection_simulated[j]) == n_sim and int(store.selection_recorded[j]) == len(chosen) - n_sim == 4 - n_sim
         events = {str(store.record_event.sel(record=c).values) if kinds[c] == "record" else c for c in chosen}
         assert int(store.selection_earthquakes[j]) == len(events)
+    text = " ".join(block.text for block in intensity_section("pool", store).blocks if isinstance(block, Paragraph))
+    assert f"0.2 g: {int(store.selection_recorded[0])} recorded and {int(store.selection_simulated[0])} simulated from" in text
 
 
 def test_the_simulated_motions_are_part_of_the_identity(tmp_path) -> None:

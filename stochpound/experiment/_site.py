@@ -401,7 +401,8 @@ def stripe_selections(experiment: GridExperiment) -> StripeSelections:
     ------
     ExperimentError
         Naming the field: a synthetic ensemble in the pool, ``intensity.motions``
-        more than the pool has within ``max_scale_factor`` of a level.
+        more than the pool (the records and any simulated motions) has within
+        ``max_scale_factor`` of a level under the rules.
     """
     from stochpound._errors import ExperimentError, SiteError, field_errors
     from stochpound.store import CASE

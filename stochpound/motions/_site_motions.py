@@ -133,7 +133,8 @@ def site_motions(magnitude: float, distance_km: float, vs30: float, mechanism: s
         ``arias_intensity`` (m/s, the expected value of the modulation),
         ``d5_95`` and ``t_mid`` (s), ``f_mid`` (Hz), ``f_slope`` (Hz/s),
         ``zeta_f`` and ``f_corner`` (Hz). Attributes: the scenario, ``model``,
-        ``model_provenance``, ``seed``, ``dt``.
+        ``model_provenance``, ``seed``, ``n``, ``dt``; ``realization`` numbers
+        the motions among the n.
 
     Raises
     ------

@@ -15,6 +15,10 @@ the metadata): scaling to an intensity is the experiment's job. A member is
 named ``<suite>/<ID><component>``, e.g. ``fema_p695_far_field/01a``, and
 :func:`stochpound.motions.records.load_record` loads it by that name.
 
+A near-field motion's metadata say whether FEMA P695 lists its record
+among the pulse records (``pulse``, from the ``nearfield_pulse`` set); the
+far-field motions carry no such mark.
+
 A folder of record files is a suite too: every ``.AT2`` and ``.txt`` file in
 it (sorted by name), read as :func:`~stochpound.motions.records.load_record` reads a file.
 """
