@@ -143,3 +143,11 @@ def test_a_subset_of_site_motions_is_bit_for_bit_the_same_rows_and_a_scene_runs_
         scene_from_dict({"building": [building], "motion": {**table, "calibration": "another"}})
     with pytest.raises(Exception, match=r"^motion.realization: "):
         scene_from_dict({"building": [building], "motion": {**table, "realization": 5}})
+
+
+def test_a_scenario_outside_the_site_motion_model_is_a_one_line_error(tmp_path) -> None:
+    site = SITE.replace("magnitude = [7.0, 6.6]", "magnitude = [7.0, 5.2]")  # within the NGA-West2 models, below the site-motion model's 5.5
+    experiment = load_experiment(write_experiment(tmp_path, _text(site=site), "m.toml"))
+    with pytest.raises(ExperimentError, match=r"^site.simulated_motions: the stripe 0.2 g's scenario: magnitude: .*5.5") as error:
+        experiment.selection
+    assert "\n" not in str(error.value)

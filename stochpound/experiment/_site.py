@@ -433,7 +433,10 @@ def stripe_selections(experiment: GridExperiment) -> StripeSelections:
     for stripe, (level, scenario) in enumerate(zip(intensity["levels"], intensity["site"])):
         target = conditional_spectrum(measure, period, level=level, periods=periods, **scenario)
         sources = simulated_sources(intensity.get("simulated_motions"), stripe, scenario)
-        stripe_pool = xr.concat([pool, simulated_pool(sources, periods, measure, period, g)], "motion") if sources else pool
+        try:
+            stripe_pool = xr.concat([pool, simulated_pool(sources, periods, measure, period, g)], "motion") if sources else pool
+        except SiteError as error:  # a scenario outside the site-motion model's calibrated range
+            raise ExperimentError(f"site.simulated_motions: the stripe {level:g} g's scenario: {error}") from None
         try:
             selection = select_motions(stripe_pool, target, intensity["motions"], intensity["max_scale_factor"], intensity["seed"], **rules)
         except SiteError as error:
