@@ -15,6 +15,7 @@ from stochpound.motions import conditional_spectrum, select_motions, selection_p
 from stochpound.motions.records import load_suite, load_suite_member
 from stochpound.report.render import Paragraph
 from stochpound.report.sections._intensity import intensity_section
+from stochpound.report.sections._stripe_motions import stripe_motions_text
 from tests.helpers import SITE_SCENE as SCENE
 from tests.helpers import write_experiment
 
@@ -80,6 +81,7 @@ def test_simulated_motions_join_the_pool_and_regenerate_bit_for_bit_from_the_sto
         events = {str(store.record_event.sel(record=c).values) if kinds[c] == "record" else c for c in chosen}
         assert int(store.selection_earthquakes[j]) == len(events)
     text = " ".join(block.text for block in intensity_section("pool", store).blocks if isinstance(block, Paragraph))
+    assert "from a pool of 6 records and 6 simulated motions of each stripe's scenario" in stripe_motions_text(store)
     assert f"0.2 g: {int(store.selection_recorded[0])} recorded and {int(store.selection_simulated[0])} simulated from" in text
 
 
