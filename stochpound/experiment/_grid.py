@@ -156,7 +156,7 @@ class Experiment:
         self.name: str = self.definition["name"]
         self.studied: str = self.definition["studied"]
         self.variants: list[dict[str, Any]] = self.definition["variants"]
-        self.motions: dict[str, dict[str, Any]] = {m["label"]: m for m in self.definition["motions"]}
+        self.recorded_motions: dict[str, dict[str, Any]] = {m["label"]: m for m in self.definition["motions"]}
         self.output: dict[str, Any] = self.definition["output"]
         self.solver: dict[str, Any] = self.definition["solver"]
         self.intensity: dict[str, Any] | None = self.definition.get("intensity")
@@ -192,6 +192,13 @@ class Experiment:
         return any("yield_force" in b or "storey_height" in b for b in buildings)
 
     @cached_property
+    def motions(self) -> dict[str, dict[str, Any]]:
+        """The motions on ``record``, by label: the definition's, then the simulated motions a selection chose (``[site] simulated_motions``)."""
+        if self.selection is None:
+            return self.recorded_motions
+        return {**self.recorded_motions, **self.selection.simulated}
+
+    @cached_property
     def motion_dims(self) -> list[Dim]:
         """``record`` (motion labels) and ``realization`` (union of realization indices)."""
         realizations = np.sort(np.concatenate([self.realization_numbers(label) for label in self.motions]))
@@ -222,8 +229,13 @@ class Experiment:
     @cached_property
     def reference_dims(self) -> list[Dim]:
         """Dimensions of the fixed-base reference: variant axes that change the studied building, then the motion."""
+        return self._reference_grid_dims + self.motion_dims
+
+    @cached_property
+    def _reference_grid_dims(self) -> list[Dim]:
+        """:attr:`reference_dims` but the motion (so that the structure's grid points need no motion: a selection reads them)."""
         touched = [d for d in self.grid_dims if d.kind == "variant" and self._touches_studied(d.name)]
-        return touched + self.intensity_dims + self.motion_dims
+        return touched + self.intensity_dims
 
     def _touches_studied(self, axis: str) -> bool:
         variant = next(v for v in self.variants if v["name"] == axis)
@@ -234,9 +246,9 @@ class Experiment:
         return False
 
     def realizations(self, label: str) -> range:
-        """Realization indices of a motion: 0 for a record, start .. start+count−1 for an ensemble."""
+        """Realization indices of a motion: 0 for a record (and a simulated motion), start .. start+count−1 for an ensemble."""
         motion = self.motions[label]
-        if motion["kind"] == "record":
+        if motion["kind"] in ("record", "simulated"):
             return range(1)
         return range(motion["start"], motion["start"] + motion["count"])
 
@@ -263,7 +275,7 @@ class Experiment:
     def _points(self) -> dict[str, list[Point]]:
         points = {}
         for kind in KINDS:
-            structural = self.kind_dims(kind)[:-2]
+            structural = self.grid_dims if kind != REFERENCE else self._reference_grid_dims
             points[kind] = [
                 Point(kind, position, tuple((d.name, d.values[i]) for d, i in zip(structural, position)))
                 for position in itertools.product(*(range(len(d.values)) for d in structural))
@@ -438,7 +450,7 @@ class Experiment:
 
     def motion_table(self, label: str, realization: int | None = None) -> dict[str, Any]:
         """The scene ``[motion]`` table of a motion (with ``realization`` for an ensemble)."""
-        motion = self.motions[label]
+        motion = self.recorded_motions[label] if label in self.recorded_motions else self.motions[label]
         table = {k: v for k, v in motion["motion"].items() if k != "file_sha256"}
         if motion["kind"] == "synthetic":
             table["realization"] = motion["start"] if realization is None else realization

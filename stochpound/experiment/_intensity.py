@@ -56,7 +56,7 @@ not to the recorded ground motion."""
 SPECTRUM_PERIODS = np.geomspace(0.05, 5.0, 25)
 """Periods (s) of the unscaled spectrum stored for every motion (5 % damping)."""
 SPECTRUM_DAMPING = 0.05
-_KEYS = {"measure", "period", "periods", "damping", "levels", "units", "method", "synthetic", "selection", "motions", "max_scale_factor", "seed"}
+_KEYS = {"measure", "period", "periods", "damping", "levels", "units", "method", "synthetic", "selection", "motions", "max_scale_factor", "seed", "max_per_earthquake", "exclude_pulses"}
 
 #: Per-case variables of an intensity-conditioned store: units and long names (units of levels filled in).
 SUMMARIES: dict[str, tuple[str, str]] = {

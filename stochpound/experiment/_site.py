@@ -26,6 +26,22 @@ force (a friction pendulum), its isolated period 2π √(M/k_r) (M the
 building's and base's mass, k_r the restoring stiffness), over every grid
 point; the range runs from 0.2 times the shortest to 3 times the longest.
 
+``[site] simulated_motions = N`` adds, to every stripe's pool, N
+site-based stochastic motions of the stripe's scenario
+(:func:`stochpound.motions.site_motions`, the hazard-compatible model, seed
+``[intensity] seed``, dt = 0.01 s), mixed with the records. They are not
+stored: the definition keeps the model, its calibration, the seed and N, and
+a chosen motion is regenerated bit for bit from them (its ``realization``
+among the N). Each simulated motion is its own earthquake for
+``max_per_earthquake`` and never a pulse. The pool is generated a stripe at
+a time, :data:`SIMULATED_CHUNK` motions at once.
+
+``[intensity] max_per_earthquake`` (at most that many motions of one
+earthquake in a stripe; no limit unless given) and ``exclude_pulses = true``
+(no record the metadata mark as a pulse) are the selection's rules
+(:func:`stochpound.motions.select_motions`); a stripe never holds the same
+recording twice.
+
 The default ``selection = "scale"`` (every motion scaled to every level)
 adds nothing to the definition, so the identities of existing experiments
 are unchanged.
@@ -34,7 +50,8 @@ are unchanged.
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass
+from collections.abc import Sequence
+from dataclasses import dataclass, field
 from functools import cached_property
 from pathlib import Path
 from typing import Any, Protocol
@@ -51,7 +68,7 @@ class GridExperiment(Protocol):
     """What the selection reads of an experiment (an :class:`~stochpound.experiment.Experiment`, which asks for its stripes here)."""
 
     intensity: dict[str, Any] | None
-    motions: dict[str, dict[str, Any]]
+    recorded_motions: dict[str, dict[str, Any]]
     variants: list[dict[str, Any]]
     building_names: list[str]
     base_dir: Path
@@ -69,6 +86,16 @@ CONDITIONAL_SPECTRUM = SELECTIONS[1]
 DEFAULT_SEED = 1
 """Seed of the selection when ``[intensity] seed`` is not given."""
 SITE_FIELDS = ("vs30", "magnitude", "distance_km", "mechanism")
+SIMULATED_MODEL = "hazard_compatible"
+"""The site-motion model of ``[site] simulated_motions``."""
+SIMULATED_DT = 0.01
+"""Time step of the simulated motions, s."""
+SIMULATED_CHUNK = 256
+"""Simulated motions generated at once while their spectra are computed."""
+SIMULATED_LIMIT = 100_000
+"""Largest ``[site] simulated_motions`` (per stripe)."""
+RULES = ("max_per_earthquake", "exclude_pulses")
+"""``[intensity]`` fields of the selection's rules, in the definition only where given."""
 PER_LEVEL = ("magnitude", "distance_km", "mechanism")
 """``[site]`` fields that take one value per level."""
 
@@ -102,7 +129,7 @@ def parse_selection(table: Mapping[str, Any], site: Any, levels: list[float], en
     if selection not in SELECTIONS:
         raise SiteError(f"intensity.selection: must be one of {', '.join(SELECTIONS)}, got {selection!r}")
     if selection == SELECTIONS[0]:
-        for key in ("motions", "max_scale_factor", "seed"):
+        for key in ("motions", "max_scale_factor", "seed", *RULES):
             if key in table:
                 raise SiteError(f'intensity.{key}: only with selection = "{CONDITIONAL_SPECTRUM}"')
         if site is not None:
@@ -131,13 +158,48 @@ def parse_selection(table: Mapping[str, Any], site: Any, levels: list[float], en
     note = f"{motions} motions per stripe chosen from the pool and scaled to the conditional spectrum of its scenario"
     if isinstance(site, dict) and site.get("scenario") == "fitted" and isinstance(site.get("curves"), list):
         note += f" (the scenario fitted to the site's hazard curves {', '.join(map(str, site['curves']))}, standing in for a disaggregation)"
-    chosen = {"note": note, "selection": selection, "motions": motions, "max_scale_factor": max_scale, "seed": seed}
+    chosen = {"note": note, "selection": selection, "motions": motions, "max_scale_factor": max_scale, "seed": seed,
+              **parse_rules(table)}
     if isinstance(site, dict) and "ruptures" in site:
+        if "simulated_motions" in site:
+            from stochpound._errors import SiteError
+
+            raise SiteError("site.simulated_motions: not available with site.ruptures yet (the motions would be of one mean scenario, "
+                            "not of each causal rupture): leave one of the two out")
         ruptures = rupture_site(site, base_dir)
         chosen["note"] = (f"{motions} motions per stripe chosen from the pool and scaled to the exact conditional spectrum of the site's "
                           f"{len(ruptures)} ruptures")
         return {**chosen, "site": mixture_scenarios(ruptures, levels, entry), "ruptures": ruptures.to_entry(identity=True)}
-    return {**chosen, "site": parse_site(site, levels, entry)}
+    return {**chosen, "site": parse_site(site, levels, entry), **parse_simulated(site, seed)}
+
+
+def parse_rules(table: Mapping[str, Any]) -> dict[str, Any]:
+    """The rules' entries of the ``intensity`` definition, only those the table gives (so older definitions keep their identity)."""
+    from stochpound._errors import SiteError
+
+    rules: dict[str, Any] = {}
+    if "max_per_earthquake" in table:
+        value = table["max_per_earthquake"]
+        if not isinstance(value, int) or isinstance(value, bool) or value < 1:
+            raise SiteError(f"intensity.max_per_earthquake: at most this many motions of one earthquake per stripe, an integer >= 1, got {value!r}")
+        rules["max_per_earthquake"] = value
+    if "exclude_pulses" in table:
+        rules["exclude_pulses"] = toml_fields.boolean(table, "exclude_pulses", "intensity", default=False)
+    return rules
+
+
+def parse_simulated(site: Mapping[str, Any], seed: int) -> dict[str, Any]:
+    """``{"simulated_motions": {count, model, calibration, seed, dt}}`` for ``[site] simulated_motions``; {} without it."""
+    from stochpound._errors import SiteError
+    from stochpound.motions import site_model_provenance
+
+    if "simulated_motions" not in site:
+        return {}
+    count = site["simulated_motions"]
+    if not isinstance(count, int) or isinstance(count, bool) or not 1 <= count <= SIMULATED_LIMIT:
+        raise SiteError(f"site.simulated_motions: simulated motions of each stripe's scenario in its pool, an integer within 1-{SIMULATED_LIMIT}, got {count!r}")
+    return {"simulated_motions": {"count": count, "model": SIMULATED_MODEL, "calibration": site_model_provenance(SIMULATED_MODEL),
+                                  "seed": seed, "dt": SIMULATED_DT}}
 
 
 def rupture_site(site: Mapping[str, Any], base_dir: Path) -> Any:
@@ -206,7 +268,7 @@ def parse_site(site: Any, levels: list[float], entry: Mapping[str, Any]) -> list
         return fitted_site(site, levels, entry)
     if "curves" in site:
         raise SiteError('site.curves: only with site.scenario = "fitted"')
-    toml_fields.reject_unknown(site, {*SITE_FIELDS, "scenario"}, "site")
+    toml_fields.reject_unknown(site, {*SITE_FIELDS, "scenario", "simulated_motions"}, "site")
     columns: dict[str, list[Any]] = {}
     for key in SITE_FIELDS:
         if key not in site:
@@ -241,7 +303,7 @@ def fitted_site(site: Mapping[str, Any], levels: list[float], entry: Mapping[str
     from stochpound.analysis import HazardCurve, bundled_curves, bundled_measure, stripe_rate_weights
     from stochpound.motions import fit_levels, fit_scenarios
 
-    toml_fields.reject_unknown(site, {"scenario", "curves", "vs30", "mechanism"}, "site")
+    toml_fields.reject_unknown(site, {"scenario", "curves", "vs30", "mechanism", "simulated_motions"}, "site")
     for key in ("vs30", "mechanism"):
         if key not in site:
             raise SiteError(f"site.{key}: missing (the site's Vs30 and the mechanism of its faults)")
@@ -315,6 +377,8 @@ class StripeSelections:
     structure: list[float]
     selections: list[xr.Dataset]
     targets: list[xr.Dataset]
+    simulated: dict[str, dict[str, Any]] = field(default_factory=dict)
+    """The chosen simulated motions' sources, by label (``[site] simulated_motions``; :func:`simulated_source`)."""
 
     @cached_property
     def chosen(self) -> np.ndarray:
@@ -353,7 +417,21 @@ class StripeSelections:
             "site_distance_km": xr.Variable(("intensity",), np.array([s["distance_km"] for s in scenario]), {"units": "km", "long_name": "scenario rupture distance"}),
             "site_vs30": xr.Variable(("intensity",), np.array([s["vs30"] for s in scenario]), {"units": "m/s", "long_name": "scenario Vs30"}),
             "site_mechanism": xr.Variable(("intensity",), np.array([s["mechanism"] for s in scenario], dtype=object), {"units": "1", "long_name": "scenario mechanism"}),
+            **self.stripe_counts(),
         }  # fmt: skip
+
+    def stripe_counts(self) -> dict[str, xr.Variable]:
+        """Per stripe: its recorded and simulated motions and its earthquakes (a simulated motion is its own)."""
+        counts = {"recorded": [], "simulated": [], "earthquakes": []}
+        for selection in self.selections:
+            simulated = int(sum(str(m) in self.simulated for m in selection["motion"].values))
+            counts["simulated"].append(simulated)
+            counts["recorded"].append(selection.sizes["selected"] - simulated)
+            counts["earthquakes"].append(len(set(selection["earthquake"].values.astype(str))))
+        names = {"recorded": "recorded motions in the stripe", "simulated": "simulated motions in the stripe ([site] simulated_motions)",
+                 "earthquakes": "earthquakes in the stripe (a simulated motion is its own)"}
+        return {f"selection_{key}": xr.Variable(("intensity",), np.array(values, dtype=np.int64), {"units": "1", "long_name": names[key]})
+                for key, values in counts.items()}
 
 
 def stripe_selections(experiment: GridExperiment) -> StripeSelections:
@@ -363,7 +441,8 @@ def stripe_selections(experiment: GridExperiment) -> StripeSelections:
     ------
     ExperimentError
         Naming the field: a synthetic ensemble in the pool, ``intensity.motions``
-        more than the pool has within ``max_scale_factor`` of a level.
+        more than the pool (the records and any simulated motions) has within
+        ``max_scale_factor`` of a level under the rules.
     """
     from stochpound._errors import ExperimentError, SiteError, field_errors
     from stochpound.store import CASE
@@ -374,7 +453,7 @@ def stripe_selections(experiment: GridExperiment) -> StripeSelections:
     intensity = experiment.intensity
     scene = experiment.structure(experiment.points(CASE)[0])
     records = []
-    for label, source in experiment.motions.items():  # the motions as the cases run them (a duration or a start applied)
+    for label, source in experiment.recorded_motions.items():  # the motions as the cases run them (a duration or a start applied)
         if source["kind"] != "record":
             raise ExperimentError(f"{source['field']}: the conditional-spectrum pool takes records and suites, not synthetic ensembles")
         with field_errors(scene_prefix=source["field"]):
@@ -389,7 +468,8 @@ def stripe_selections(experiment: GridExperiment) -> StripeSelections:
     periods = selection_periods(structure, conditioning)
     g = float(experiment.definition["scene"].get("g", 9.81))
     pool = selection_pool(records, periods, measure, period, MODEL_DAMPING, g)
-    selections, targets = [], []
+    selections, targets, simulated = [], [], {}
+    rules = {key: intensity[key] for key in RULES if key in intensity}
     if "ruptures" in intensity:  # the exact conditional spectrum of every stripe
         from stochpound.analysis import RuptureSite
 
@@ -397,10 +477,66 @@ def stripe_selections(experiment: GridExperiment) -> StripeSelections:
     else:
         stripe_targets = [conditional_spectrum(measure, period, level=level, periods=periods, **scenario)
                           for level, scenario in zip(intensity["levels"], intensity["site"])]
-    for level, target in zip(intensity["levels"], stripe_targets):
+    for stripe, (level, scenario, target) in enumerate(zip(intensity["levels"], intensity["site"], stripe_targets)):
+        sources = simulated_sources(intensity.get("simulated_motions"), stripe, scenario)
         try:
-            selections.append(select_motions(pool, target, intensity["motions"], intensity["max_scale_factor"], intensity["seed"]))
+            stripe_pool = xr.concat([pool, simulated_pool(sources, periods, measure, period, g)], "motion") if sources else pool
+        except SiteError as error:  # a scenario outside the site-motion model's calibrated range
+            raise ExperimentError(f"site.simulated_motions: the stripe {level:g} g's scenario: {error}") from None
+        try:
+            selection = select_motions(stripe_pool, target, intensity["motions"], intensity["max_scale_factor"], intensity["seed"], **rules)
         except SiteError as error:
             raise ExperimentError(f"intensity.{error} (stripe {level:g} g)") from None
+        simulated.update({str(label): sources[str(label)] for label in selection["motion"].values if str(label) in sources})
+        selections.append(selection)
         targets.append(target)
-    return StripeSelections(list(intensity["levels"]), list(experiment.motions), periods, structure, selections, targets)
+    labels = list(experiment.recorded_motions) + list(simulated)
+    return StripeSelections(list(intensity["levels"]), labels, periods, structure, selections, targets, simulated)
+
+
+def simulated_sources(setting: Mapping[str, Any] | None, stripe: int, scenario: Mapping[str, Any]) -> dict[str, dict[str, Any]]:
+    """The simulated motions of a stripe's pool as motion sources, by label (``simulated <stripe>.<i>``, from 1); {} without them.
+
+    A source's ``motion`` table holds what regenerates it: the scenario, the
+    model and its calibration, ``n``, ``seed``, ``dt`` and its ``realization``.
+    """
+    if not setting:
+        return {}
+    count = setting["count"]
+    table = {"type": "site_motions", **{key: scenario[key] for key in SITE_FIELDS}, "n": count, "seed": setting["seed"], "dt": setting["dt"],
+             "model": setting["model"], "calibration": setting["calibration"]}
+    width = len(str(count - 1))
+    return {
+        f"simulated {stripe + 1}.{i:0{width}d}": {"label": f"simulated {stripe + 1}.{i:0{width}d}", "kind": "simulated", "field": "site.simulated_motions",
+                                                  "motion": {**table, "realization": i}}
+        for i in range(count)
+    }
+
+
+def simulated_motions(sources: Sequence[Mapping[str, Any]]) -> list[Any]:
+    """The motions (m/s², :class:`~stochpound.motions.ground.SampledMotion`) of simulated sources of one table, regenerated from it bit for bit."""
+    from stochpound.motions import site_motions
+    from stochpound.motions.ground import SampledMotion
+
+    table = sources[0]["motion"]
+    generated = site_motions(table["magnitude"], table["distance_km"], table["vs30"], table["mechanism"], n=table["n"], seed=table["seed"],
+                             dt=table["dt"], model=table["model"], realizations=[source["motion"]["realization"] for source in sources])
+    return [SampledMotion(table["dt"], values, "linear", f"{source['label']} ({table['model']}, seed {table['seed']})")
+            for source, values in zip(sources, generated["acceleration"].values)]
+
+
+def simulated_pool(sources: Mapping[str, Mapping[str, Any]], periods: np.ndarray, measure: str, period: Any, g: float) -> xr.Dataset:
+    """:func:`~stochpound.motions.selection_pool` of a stripe's simulated motions, generated :data:`SIMULATED_CHUNK` at a time."""
+    from stochpound.motions import selection_pool
+    from stochpound.motions.records import Record
+
+    items = list(sources.values())
+    parts = []
+    for start in range(0, len(items), SIMULATED_CHUNK):
+        chunk = items[start : start + SIMULATED_CHUNK]
+        table = chunk[0]["motion"]
+        metadata = {"magnitude": table["magnitude"], "distance": table["distance_km"], "vs30": table["vs30"]}
+        records = [Record(source["label"], motion.dt, motion.values, "m/s2", metadata={**metadata, "event": source["label"]})
+                   for source, motion in zip(chunk, simulated_motions(chunk))]
+        parts.append(selection_pool(records, periods, measure, period, MODEL_DAMPING, g))
+    return xr.concat(parts, "motion")

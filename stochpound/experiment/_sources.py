@@ -19,6 +19,8 @@ from stochpound import motions as synthetic_motions
 from stochpound.experiment._grid import CASE, Experiment
 from stochpound.experiment._intensity import check_resolution, ensemble_intensity
 from stochpound.experiment._scene_edits import with_motion
+from stochpound.experiment._site import simulated_motions
+from stochpound.store import canonical_json
 from stochpound.experiment._spec import ExperimentError, field_errors
 from stochpound.motions.ground import GroundMotion, SampledMotion
 from stochpound.model.scene_file import scene_from_dict
@@ -62,17 +64,21 @@ def resolve_motions(experiment: Experiment) -> dict[str, ResolvedMotion]:
     """
     structure = experiment.structure(experiment.points(CASE)[0])  # every building: the memory check counts them all
     resolved = {}
+    simulated = _simulated(experiment)
     for label, source in experiment.motions.items():
         table = experiment.motion_table(label)
-        with field_errors(scene_prefix=source["field"]):
-            motion = scene_from_dict(with_motion(structure, table), base_dir=experiment.base_dir).motion
+        if label in simulated:
+            motion = simulated[label]
+        else:
+            with field_errors(scene_prefix=source["field"]):
+                motion = scene_from_dict(with_motion(structure, table), base_dir=experiment.base_dir).motion
         grid = (float(motion.times[1] - motion.times[0]), len(motion.times))
         if experiment.intensity is not None:
             with field_errors():
                 check_resolution(experiment.intensity, grid[0], f"{source['field']} ({label})")
                 if not isinstance(motion, SampledMotion):
                     raise ExperimentError(f"{source['field']}: a {type(motion).__name__} cannot be scaled to an intensity level; [intensity] takes records, suites and synthetic ensembles")
-        if source["kind"] == "record":
+        if source["kind"] in ("record", "simulated"):
             resolved[label] = ResolvedMotion(label, motion, None, grid)
         else:
             worker_table = _worker_table(table, motion, structure)
@@ -82,6 +88,15 @@ def resolve_motions(experiment: Experiment) -> dict[str, ResolvedMotion]:
                 expected = ensemble_intensity(experiment.intensity, worker_table, experiment.realizations(label), g)
             resolved[label] = ResolvedMotion(label, None, worker_table, grid, expected)
     return resolved
+
+
+def _simulated(experiment: Experiment) -> dict[str, GroundMotion]:
+    """The chosen simulated motions, regenerated from their tables (one call per stripe's scenario), by label."""
+    sources = [experiment.motions[label] for label in experiment.motions if experiment.motions[label]["kind"] == "simulated"]
+    groups: dict[str, list[dict[str, Any]]] = {}
+    for source in sources:
+        groups.setdefault(canonical_json({k: v for k, v in source["motion"].items() if k != "realization"}), []).append(source)
+    return {source["label"]: motion for group in groups.values() for source, motion in zip(group, simulated_motions(group))}
 
 
 def _worker_table(table: dict[str, Any], motion: GroundMotion, structure: dict[str, Any]) -> dict[str, Any]:

@@ -276,6 +276,9 @@ def _suite_coordinates(experiment: Experiment) -> dict[str, xr.Variable]:
         record = str(source["motion"].get("record", ""))
         if is_suite_member(record):
             rows.append(load_suite_member(record).metadata)
+        elif source["kind"] == "simulated":  # its own earthquake: no event (a cluster of its own), the scenario's magnitude, distance and Vs30
+            table = source["motion"]
+            rows.append({"suite": "simulated", "magnitude": table["magnitude"], "distance": table["distance_km"], "vs30": table["vs30"]})
         elif "suite" in source:  # a folder: the file name is all that is known
             rows.append({"suite": source["suite"], "component": Path(record).name})
         else:

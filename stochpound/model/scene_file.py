@@ -168,6 +168,7 @@ _MOTION_KEYS = {
     "record": {"type", "record", "scale", "dt", "duration", "units", "interpolation"},
     "harmonic": {"type", "amplitude", "omega", "phase", "duration", "dt"},
     "constant": {"type", "acceleration", "duration", "dt"},
+    "site_motions": {"type", "magnitude", "distance_km", "vs30", "mechanism", "n", "seed", "dt", "model", "calibration", "realization", "scale"},
 }
 
 
@@ -180,12 +181,14 @@ def _motion(data: Mapping[str, Any], base_dir: Path, g: float, per_sample: int) 
     if kind in SYNTHETIC_TYPES:
         return _synthetic_motion(table, kind, per_sample)
     if kind not in _MOTION_KEYS:
-        raise SceneError(f"motion.type: must be one of record, harmonic, constant, {', '.join(SYNTHETIC_TYPES)}; got {kind!r}")
+        raise SceneError(f"motion.type: must be one of record, harmonic, constant, site_motions, {', '.join(SYNTHETIC_TYPES)}; got {kind!r}")
     fields.reject_unknown(table, _MOTION_KEYS[kind], "motion")
     if kind == "harmonic":
         return _harmonic_motion(table, per_sample)
     if kind == "constant":
         return _constant_motion(table, per_sample)
+    if kind == "site_motions":
+        return _site_motion(table, per_sample)
     return _record_motion(table, base_dir, g, per_sample)
 
 
@@ -213,6 +216,41 @@ def _constant_motion(table: Mapping[str, Any], per_sample: int) -> SampledMotion
     duration, dt = _timing(table, required=True, per_sample=per_sample)
     n_samples = int(round(duration / dt)) + 1
     return SampledMotion(dt, np.full(n_samples, acceleration), description=f"constant {acceleration:g} m/s²")
+
+
+def _site_motion(table: Mapping[str, Any], per_sample: int) -> SampledMotion:
+    """Motion ``realization`` of :func:`~stochpound.motions.site_motions` (``n`` motions of a scenario from ``seed``), times ``scale``.
+
+    ``calibration``, when given, must name the model's calibration
+    (:func:`~stochpound.motions.site_model_provenance`): a table written with
+    another calibration cannot regenerate its motion.
+    """
+    from stochpound._errors import SiteError
+    from stochpound.motions import site_model_provenance, site_motions
+
+    model = fields.string(table, "model", "motion", default="hazard_compatible")
+    realization = table.get("realization", 0)
+    scale = fields.number(table, "scale", "motion", default=1.0)
+    missing = [key for key in ("magnitude", "distance_km", "vs30", "mechanism", "n", "seed") if key not in table]
+    if missing:
+        raise SceneError(f"motion.{missing[0]}: required for type = 'site_motions' (see docs/motions.md)")
+    n = table["n"]
+    if isinstance(realization, bool) or not isinstance(realization, int) or not (0 <= realization < n if isinstance(n, int) else realization >= 0):
+        raise SceneError(f"motion.realization: must be an integer within 0 and n - 1 = {n!r} - 1, got {realization!r}")
+    try:
+        if "calibration" in table and table["calibration"] != site_model_provenance(model):
+            raise SceneError(f"motion.calibration: {table['calibration']!r} is not the calibration of model {model!r} here "
+                             f"({site_model_provenance(model)!r}): the motion cannot be regenerated")
+        generated = site_motions(table["magnitude"], table["distance_km"], table["vs30"], table["mechanism"], n=table["n"], seed=table["seed"],
+                                 dt=table.get("dt", 0.01), model=model, realizations=[realization])
+    except SiteError as error:
+        raise SceneError(f"motion.{error}") from None
+    values = np.asarray(generated["acceleration"].values[0], dtype=float)
+    check_memory(len(values) * per_sample, f"motion: {len(values)} samples; a run")
+    if scale != 1.0:
+        values = values * scale
+    description = f"site_motions realization {realization} of {table['n']} (seed {table['seed']}, {model})" + (f" x {scale:.9g}" if scale != 1.0 else "")
+    return SampledMotion(float(generated.attrs["dt"]), values, "linear", description)
 
 
 def _record_motion(table: Mapping[str, Any], base_dir: Path, g: float, per_sample: int) -> SampledMotion:

@@ -55,7 +55,7 @@ from stochpound.motions.psd import (
     kanai_tajimi_psd,
     kanai_tajimi_variance,
 )
-from stochpound.motions._site_motions import site_motions, site_motions_from_normals
+from stochpound.motions._site_motions import site_model_provenance, site_motions, site_motions_from_normals
 from stochpound.motions._selection import TARGET_TOLERANCE, misses_target, select_motions, selection_periods, selection_pool
 from stochpound.motions._seeding import realization_rng, realization_rngs
 from stochpound.motions._spectrum import response_spectrum
@@ -137,6 +137,7 @@ __all__ = [
     "soil_preset",
     "simulated_peak_factor",
     "spectral_from_phases",
+    "site_model_provenance",
     "site_motions",
     "site_motions_from_normals",
     "spectral_samples",

@@ -19,6 +19,15 @@ of :func:`~stochpound.motions.conditional_spectrum` over a period range):
    of 0.1, holds the worst period down);
 5. steps 2–4 are repeated for 20 simulated sets and the set of least misfit kept.
 
+Rules of the field: a set never holds the same recording twice (a motion
+is known by its PEER record sequence number and component where the
+metadata give them, else by its name); with ``max_per_earthquake`` it holds
+at most that many motions of an earthquake (the metadata's ``event``; a
+motion without one, such as a simulated motion, is its own earthquake); with
+``exclude_pulses`` the records the metadata mark as pulses (``pulse``: the
+FEMA P695 near-field pulse subset) are no candidates. Steps 3 and 4 only
+ever take a candidate the rules allow.
+
 Everything random comes from ``numpy.random.default_rng(seed)``: the same
 pool, target and seed give the same selection.
 
@@ -106,7 +115,10 @@ def selection_pool(
     xarray.Dataset
         Over ``motion`` (the records' names): ``psa`` (``motion``, ``period``; g),
         ``intensity`` (g), ``magnitude``, ``distance_km``, ``vs30`` (NaN where
-        unknown) and ``mechanism`` ("" where unknown).
+        unknown), ``mechanism`` ("" where unknown), ``earthquake`` (the
+        metadata's ``event``, else the motion's name), ``recording`` (PEER
+        record sequence number and component, else the name) and ``pulse``
+        (the metadata's ``pulse``, False where unknown).
     """
     psa, intensity = [], []
     conditioning = [] if measure == "pga" else list(np.atleast_1d(np.asarray(period, dtype=float)))
@@ -125,13 +137,23 @@ def selection_pool(
             "distance_km": ("motion", np.array([float(m.get("distance", np.nan)) for m in meta]), {"units": "km"}),
             "vs30": ("motion", np.array([float(m.get("vs30", np.nan)) for m in meta]), {"units": "m/s"}),
             "mechanism": ("motion", np.array([FAULT_TYPES.get(str(m.get("fault_type", "")), "") for m in meta], dtype=object)),
+            "earthquake": ("motion", np.array([str(m.get("event") or r.name) for m, r in zip(meta, records)], dtype=object)),
+            "recording": ("motion", np.array([_recording(m, r.name) for m, r in zip(meta, records)], dtype=object)),
+            "pulse": ("motion", np.array([bool(m.get("pulse", False)) for m in meta])),
         },
         coords={"motion": [record.name for record in records], "period": ("period", grid, {"units": "s"})},
         attrs={"damping": float(damping), "measure": measure},
     )
 
 
-def select_motions(pool: xr.Dataset, target: xr.Dataset, motions: int, max_scale_factor: float, seed: int = 0) -> xr.Dataset:
+def _recording(metadata: dict, name: str) -> str:
+    """A motion's recording: ``RSN <n> <component>`` where the metadata give them, else its name."""
+    rsn = metadata.get("rsn")
+    return f"RSN {int(rsn)} {metadata.get('component', '')}" if rsn is not None and np.isfinite(rsn) else str(name)
+
+
+def select_motions(pool: xr.Dataset, target: xr.Dataset, motions: int, max_scale_factor: float, seed: int = 0, *,
+                   max_per_earthquake: int | None = None, exclude_pulses: bool = False) -> xr.Dataset:
     """Choose and scale ``motions`` motions of ``pool`` to match ``target`` (module docstring).
 
     Parameters
@@ -146,11 +168,15 @@ def select_motions(pool: xr.Dataset, target: xr.Dataset, motions: int, max_scale
         Largest scale factor allowed (≥ 1).
     seed : int
         Seed of the simulated target spectra.
+    max_per_earthquake : int, optional
+        Most motions of one earthquake in the set (≥ 1; default: no limit).
+    exclude_pulses : bool
+        Leave out the records the metadata mark as pulses.
 
     Returns
     -------
     xarray.Dataset
-        Over ``selected``: ``motion`` (names), ``scale_factor``; over
+        Over ``selected``: ``motion`` (names), ``scale_factor``, ``earthquake``; over
         ``period``: the set's ``mean_ln`` and ``std_ln`` (sample, n − 1) of
         the scaled ln Sa, the target's ``median`` and ``sigma_ln``.
 
@@ -159,7 +185,8 @@ def select_motions(pool: xr.Dataset, target: xr.Dataset, motions: int, max_scale
     SiteError
         Naming the field: ``motions`` < 2 or more than the pool's motions within
         ``max_scale_factor`` of the level, ``max_scale_factor`` < 1, periods
-        of pool and target that differ.
+        of pool and target that differ, candidates that cannot make
+        ``motions`` distinct motions under ``max_per_earthquake``.
     """
     if isinstance(motions, bool) or not isinstance(motions, (int, np.integer)) or motions < 2:
         raise SiteError(f"motions: must be an integer >= 2, got {motions!r}")
@@ -167,13 +194,28 @@ def select_motions(pool: xr.Dataset, target: xr.Dataset, motions: int, max_scale
         raise SiteError(f"max_scale_factor: must be >= 1, got {max_scale_factor!r}")
     if pool.period.size != target.period.size or not np.allclose(pool.period.values, target.period.values, rtol=1e-9):
         raise SiteError("periods: the pool's spectra and the target are over different periods")
+    if max_per_earthquake is not None and (isinstance(max_per_earthquake, bool) or not isinstance(max_per_earthquake, (int, np.integer))
+                                           or max_per_earthquake < 1):
+        raise SiteError(f"max_per_earthquake: must be an integer >= 1, got {max_per_earthquake!r}")
     level = float(target.attrs["level"])
     scale = level / pool["intensity"].values
-    eligible = np.flatnonzero(scale <= max_scale_factor * (1 + 1e-12))
+    names = pool["motion"].values
+    kept = ~pool["pulse"].values if exclude_pulses and "pulse" in pool else np.ones(scale.size, dtype=bool)
+    eligible = np.flatnonzero((scale <= max_scale_factor * (1 + 1e-12)) & kept)
+    pulses = " and not pulses (exclude_pulses)" if exclude_pulses else ""
     if eligible.size < motions:
         raise SiteError(
             f"motions: only {eligible.size} of the pool's {scale.size} motions reach the level {level:g} g within max_scale_factor = "
-            f"{max_scale_factor:g}, fewer than motions = {motions} (add records or raise max_scale_factor)"
+            f"{max_scale_factor:g}{pulses}, fewer than motions = {motions} (add records or raise max_scale_factor)"
+        )
+    earthquakes = pool["earthquake"].values if "earthquake" in pool else names
+    rules = _Rules(earthquakes[eligible], (pool["recording"].values if "recording" in pool else names)[eligible], max_per_earthquake)
+    if rules.capacity < motions:
+        limit = f"at most max_per_earthquake = {max_per_earthquake} of an earthquake" if max_per_earthquake is not None else "no recording twice"
+        raise SiteError(
+            f"motions: the {eligible.size} motions of the pool within max_scale_factor = {max_scale_factor:g} of the level {level:g} g{pulses} make "
+            f"only {rules.capacity} distinct motions with {limit}, fewer than motions = {motions} "
+            "(add records or simulated_motions, or raise max_scale_factor or max_per_earthquake)"
         )
     ln_sa = np.log(pool["psa"].values[eligible]) + np.log(scale[eligible])[:, None]
     mean = np.log(target["median"].values)
@@ -186,9 +228,9 @@ def select_motions(pool: xr.Dataset, target: xr.Dataset, motions: int, max_scale
         chosen: list[int] = []
         for spectrum in rng.multivariate_normal(mean, covariance, size=motions, method="eigh"):
             distance = np.sum(((ln_sa - spectrum) * weights) ** 2, axis=1)
-            distance[chosen] = np.inf
+            distance[~rules.allowed(chosen)] = np.inf
             chosen.append(int(np.argmin(distance)))
-        chosen = _swap(ln_sa, chosen, mean, sigma)
+        chosen = _swap(ln_sa, chosen, mean, sigma, rules)
         misfit = _set_misfit(ln_sa[chosen], mean, sigma)
         if best is None or misfit < best[0]:
             best = (misfit, chosen)
@@ -199,6 +241,7 @@ def select_motions(pool: xr.Dataset, target: xr.Dataset, motions: int, max_scale
         {
             "motion": ("selected", pool["motion"].values[picked]),
             "scale_factor": ("selected", scale[picked], {"units": "1"}),
+            "earthquake": ("selected", earthquakes[picked]),
             "mean_ln": ("period", spectra.mean(axis=0), {"units": "1", "long_name": "mean ln Sa (g) of the scaled set"}),
             "std_ln": ("period", spectra.std(axis=0, ddof=1), {"units": "1", "long_name": "standard deviation of ln Sa of the scaled set"}),
             "median": target["median"],
@@ -242,8 +285,24 @@ def _set_misfit(spectra: np.ndarray, mean: np.ndarray, sigma: np.ndarray) -> flo
     return float(_misfit(spectra.mean(axis=0), spectra.std(axis=0, ddof=1), mean, sigma))
 
 
-def _swap(ln_sa: np.ndarray, chosen: list[int], mean: np.ndarray, sigma: np.ndarray) -> list[int]:
-    """Greedy swaps of chosen rows of ``ln_sa`` for unused ones while the misfit falls (each slot in turn, best replacement)."""
+class _Rules:
+    """Which candidates a set may still take: no recording twice, at most ``cap`` motions of an earthquake (module docstring)."""
+
+    def __init__(self, earthquakes: np.ndarray, recordings: np.ndarray, cap: int | None) -> None:
+        self.earthquake = np.unique(earthquakes.astype(str), return_inverse=True)[1]
+        self.recording = np.unique(recordings.astype(str), return_inverse=True)[1]
+        self.cap = np.inf if cap is None else cap
+        distinct = np.unique(np.stack([self.earthquake, self.recording]), axis=1)[0]  # one entry per recording, by its earthquake
+        self.capacity = int(np.minimum(np.bincount(distinct), self.cap).sum())
+
+    def allowed(self, taken: list[int]) -> np.ndarray:
+        """Candidates a set holding the rows ``taken`` may add (bool, one per row)."""
+        counts = np.bincount(self.earthquake[taken], minlength=self.earthquake.max() + 1)
+        return (counts[self.earthquake] < self.cap) & ~np.isin(self.recording, self.recording[taken])
+
+
+def _swap(ln_sa: np.ndarray, chosen: list[int], mean: np.ndarray, sigma: np.ndarray, rules: _Rules) -> list[int]:
+    """Greedy swaps of chosen rows of ``ln_sa`` for allowed ones while the misfit falls (each slot in turn, best replacement)."""
     chosen = list(chosen)
     n = len(chosen)
     best = _set_misfit(ln_sa[chosen], mean, sigma)
@@ -255,7 +314,7 @@ def _swap(ln_sa: np.ndarray, chosen: list[int], mean: np.ndarray, sigma: np.ndar
             set_mean = (total + ln_sa) / n  # every row as the slot's motion
             variance = np.clip((squares + ln_sa**2 - n * set_mean**2) / (n - 1), 0.0, None)
             misfit = _misfit(set_mean, np.sqrt(variance), mean, sigma)
-            misfit[[c for k, c in enumerate(chosen) if k != slot]] = np.inf
+            misfit[~rules.allowed([c for k, c in enumerate(chosen) if k != slot])] = np.inf
             row = int(np.argmin(misfit))
             if misfit[row] < best - 1e-12:
                 chosen[slot], best, improved = row, float(misfit[row]), True

@@ -163,7 +163,8 @@ def motion_parameters(model: SiteModel, magnitude: float, distance_km: float, vs
                       normals: np.ndarray) -> dict[str, np.ndarray]:
     """Each motion's parameters (:data:`UNITS`) from its :data:`PARAMETER_NORMALS` standard normals ``normals`` [n, 7]."""
     normals = np.asarray(normals, dtype=float)
-    nu = mean_normals(model, magnitude, distance_km, vs30, mechanism)[None, :] + normals[:, :6] @ model.cholesky.T
+    correlated = np.sum(normals[:, None, :6] * model.cholesky[None, :, :], axis=2)  # L z row by row: a BLAS product's rounding depends on n
+    nu = mean_normals(model, magnitude, distance_km, vs30, mechanism)[None, :] + correlated
     p = np.clip(stats.norm.cdf(nu), 1e-12, 1.0 - 1e-12)
     values = {name: _marginal_ppf(marginal, p[:, i]) for i, (name, marginal) in enumerate(zip(PARAMETERS, model.marginals))}
     values["arias_intensity"] = values["arias_intensity"] * DEFAULT_G  # s·g → m/s

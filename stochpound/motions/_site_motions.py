@@ -13,6 +13,7 @@ its noise.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 
 import numpy as np
 import xarray as xr
@@ -94,7 +95,7 @@ def site_motions_from_normals(normals: np.ndarray, *, magnitude: float, distance
 
 
 def site_motions(magnitude: float, distance_km: float, vs30: float, mechanism: str, n: int, seed: int, dt: float = 0.01, *,
-                 duration: float | None = None, model: str = "hazard_compatible") -> xr.Dataset:
+                 duration: float | None = None, model: str = "hazard_compatible", realizations: Sequence[int] | None = None) -> xr.Dataset:
     """Stochastic ground motions of a site's scenario (Rezaeian & Der Kiureghian 2010, hazard-compatible; model §11).
 
     Parameters
@@ -119,6 +120,10 @@ def site_motions(magnitude: float, distance_km: float, vs30: float, mechanism: s
         the post-filter's corner, rounded up to 5 s.
     model : {"hazard_compatible", "rezaeian_2010"}
         The calibrated equations (default; docs/motions.md) or the published ones.
+    realizations : list of int, optional
+        Only these motions of the ``n`` (each in 0 … n − 1), in this order:
+        bit for bit the same rows as of the full set (the window is still the
+        full set's), at the memory of these alone. Default: all ``n``.
 
     Returns
     -------
@@ -128,7 +133,8 @@ def site_motions(magnitude: float, distance_km: float, vs30: float, mechanism: s
         ``arias_intensity`` (m/s, the expected value of the modulation),
         ``d5_95`` and ``t_mid`` (s), ``f_mid`` (Hz), ``f_slope`` (Hz/s),
         ``zeta_f`` and ``f_corner`` (Hz). Attributes: the scenario, ``model``,
-        ``model_provenance``, ``seed``, ``dt``.
+        ``model_provenance``, ``seed``, ``n``, ``dt``; ``realization`` numbers
+        the motions among the n.
 
     Raises
     ------
@@ -143,14 +149,44 @@ def site_motions(magnitude: float, distance_km: float, vs30: float, mechanism: s
         seed = check_seed(seed)
     except ValueError as error:
         raise SiteError(str(error)) from None
-    rngs = [realization_rng(seed, i) for i in range(int(n))]
-    first = np.array([rng.standard_normal(PARAMETER_NORMALS) for rng in rngs])
+    rows = _rows(realizations, int(n))
     if duration is None:
+        first = np.array([realization_rng(seed, i).standard_normal(PARAMETER_NORMALS) for i in range(int(n))])
         duration = _window(motion_parameters(load_site_model(model), magnitude, distance_km, vs30, mechanism, first))
     elif isinstance(duration, bool) or not isinstance(duration, (int, float)) or not 10.0 * dt <= duration <= 600.0:
         raise SiteError(f"duration: must be within {10 * dt:g}-600 s, got {duration!r}")
     n_time = int(round(duration / dt)) + 1
-    normals = np.concatenate([first, np.array([rng.standard_normal(n_time) for rng in rngs])], axis=1)
+    rngs = [realization_rng(seed, i) for i in rows]
+    normals = np.array([np.concatenate([rng.standard_normal(PARAMETER_NORMALS), rng.standard_normal(n_time)]) for rng in rngs])
     dataset = site_motions_from_normals(normals, magnitude=magnitude, distance_km=distance_km, vs30=vs30, mechanism=mechanism, dt=dt, model=model)
-    dataset.attrs["seed"] = seed
+    dataset = dataset.assign_coords(realization=np.asarray(rows, dtype=int))
+    dataset.attrs.update(seed=seed, n=int(n))
     return dataset
+
+
+def _rows(realizations: Sequence[int] | None, n: int) -> list[int]:
+    """The motions asked for (all ``n`` by default), checked to be integers in 0 … n − 1."""
+    if realizations is None:
+        return list(range(n))
+    rows = list(realizations)
+    if not rows or any(isinstance(i, bool) or not isinstance(i, (int, np.integer)) or not 0 <= i < n for i in rows):
+        raise SiteError(f"realizations: must be one or more integers within 0-{n - 1} (the motions of the n = {n}), got {rows!r}")
+    return [int(i) for i in rows]
+
+
+def site_model_provenance(model: str = "hazard_compatible") -> str:
+    """The names of a site-motion model's published equations and calibration, e.g. ``"rezaeian_der_kiureghian_2010 + nga_west2_calibration_1"``.
+
+    Parameters
+    ----------
+    model : {"hazard_compatible", "rezaeian_2010"}
+        The model, as :func:`~stochpound.motions.site_motions` takes it.
+
+    Raises
+    ------
+    SiteError
+        An unknown model.
+    """
+    if model not in MODELS:
+        raise SiteError(f"model: must be one of {', '.join(MODELS)}, got {model!r}")
+    return load_site_model(model).provenance

@@ -202,7 +202,7 @@ class StoreAccessor:
         motion = grid.motion_table(where["record"], where.get("realization"))
         factor = float(self._at("scale_factor", **labels)) if "scale_factor" in self._dataset else 1.0
         if factor != 1.0:
-            if motion.get("type", "record") != "record":
+            if motion.get("type", "record") not in ("record", "site_motions"):
                 raise ExperimentError(f"case at {labels}: its {motion['type']} motion ran scaled by {factor:.9g} (scale_factor), "
                                       "which a generator's [motion] table cannot say; scale the scene's ground motion instead")
             motion["scale"] = float(motion.get("scale", 1.0)) * factor

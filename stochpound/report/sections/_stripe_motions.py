@@ -23,7 +23,11 @@ def stripe_motions_text(store: xr.Dataset) -> str:
     scale = store["selection_scale_factor"].transpose("intensity", "record").values
     per_stripe = np.isfinite(scale).sum(axis=1)
     count = f"{per_stripe.min()}" if per_stripe.min() == per_stripe.max() else f"{per_stripe.min()}–{per_stripe.max()}"
-    method = str((store.pound.intensity or {}).get("selection", "a selection")).replace("_", "-")
+    setting = store.pound.intensity or {}
+    method = str(setting.get("selection", "a selection")).replace("_", "-")
+    if "simulated_motions" in setting:  # the record axis holds the chosen simulated motions only
+        pool = (f"{int(np.sum(store['record_kind'].values != 'simulated'))} records and {setting['simulated_motions']['count']} simulated motions "
+                "of each stripe's scenario")
     text = (f"{count} motions per stripe, chosen by {method} selection from a pool of {pool} and scaled to the stripe's level "
             f"(scale factors {np.nanmin(scale):.3g}–{np.nanmax(scale):.3g})")
     ranges = scenario_ranges(store)
