@@ -21,7 +21,9 @@ from scipy import special
 from stochpound._errors import SiteError
 from stochpound.motions._conditional import check_scenario
 from stochpound.motions._seeding import check_seed, realization_rng
-from stochpound.motions._site_model import MODELS, PARAMETER_NORMALS, UNITS, gamma_shape, load_site_model, motion_parameters, motions_from_normals
+from stochpound.motions._site_model import (
+    MODELS, PARAMETER_NORMALS, UNITS, gamma_shape, load_site_model, motion_parameters, motions_from_noise_rows, motions_from_normals,
+)  # fmt: skip
 
 #: The scenarios the hazard-compatible calibration covers; outside them the model is not offered.
 SITE_MOTION_LIMITS: dict[str, tuple[float, float]] = {"magnitude": (5.5, 8.0), "distance_km": (5.0, 100.0), "vs30": (200.0, 1100.0)}
@@ -145,12 +147,13 @@ def site_motions(magnitude: float, distance_km: float, vs30: float, mechanism: s
         raise SiteError(str(error)) from None
     rngs = [realization_rng(seed, i) for i in range(int(n))]
     first = np.array([rng.standard_normal(PARAMETER_NORMALS) for rng in rngs])
+    parameters = motion_parameters(load_site_model(model), magnitude, distance_km, vs30, mechanism, first)
     if duration is None:
-        duration = _window(motion_parameters(load_site_model(model), magnitude, distance_km, vs30, mechanism, first))
+        duration = _window(parameters)
     elif isinstance(duration, bool) or not isinstance(duration, (int, float)) or not 10.0 * dt <= duration <= 600.0:
         raise SiteError(f"duration: must be within {10 * dt:g}-600 s, got {duration!r}")
     n_time = int(round(duration / dt)) + 1
-    normals = np.concatenate([first, np.array([rng.standard_normal(n_time) for rng in rngs])], axis=1)
-    dataset = site_motions_from_normals(normals, magnitude=magnitude, distance_km=distance_km, vs30=vs30, mechanism=mechanism, dt=dt, model=model)
+    acceleration = motions_from_noise_rows(parameters, lambda rows: np.array([rng.standard_normal(n_time) for rng in rngs[rows]]), n_time, dt)
+    dataset = _dataset(acceleration, parameters, dt, _attrs(magnitude, distance_km, vs30, mechanism, model))
     dataset.attrs["seed"] = seed
     return dataset
