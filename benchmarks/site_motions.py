@@ -47,35 +47,37 @@ def parse_arguments(argv: list[str] | None) -> argparse.Namespace:
     return parser.parse_args(argv)
 
 
-def _timed(n: int, seed: int, threads: int) -> tuple[float, float]:
-    """Wall-clock and CPU seconds of ``n`` motions of seed ``seed`` on ``threads`` threads (warm)."""
-    import numba
-
-    from stochpound.motions import site_motions
-
-    numba.set_num_threads(threads)
-    wall, cpu = time.perf_counter(), time.process_time()
-    site_motions(**SCENARIO, n=n, seed=seed, dt=DT, duration=DURATION)
-    return time.perf_counter() - wall, time.process_time() - cpu
-
-
-def _first_call(cache: str | None) -> float:
-    """Seconds of a fresh process's first call (2 motions), numba's cache in ``cache`` (None: the package's own)."""
-    code = ("import time; from stochpound.motions import site_motions; start = time.perf_counter(); "
-            f"site_motions(**{SCENARIO!r}, n=2, seed=0, dt={DT}, duration={DURATION}); print(time.perf_counter() - start)")
-    environment = dict(os.environ, **({"NUMBA_CACHE_DIR": cache} if cache else {}))
+def _in_new_process(code: str, threads: int, cache: str | None = None) -> list[float]:
+    """The numbers a new process running ``code`` prints, on ``threads`` threads (numba's cache in ``cache``; None: the package's)."""
+    environment = single_thread_environment(dict(os.environ))  # BLAS on one thread, site_motions on numba's
+    environment["NUMBA_NUM_THREADS"] = str(threads)
+    if cache:
+        environment["NUMBA_CACHE_DIR"] = cache
     result = subprocess.run([sys.executable, "-c", code], env=environment, capture_output=True, text=True, check=True, cwd=REPOSITORY)
-    return float(result.stdout.split()[-1])
+    return [float(value) for value in result.stdout.split()]
+
+
+def _call(n: int, seed: int) -> str:
+    return f"site_motions(**{SCENARIO!r}, n={n}, seed={seed}, dt={DT}, duration={DURATION})"
+
+
+def _timed(n: int, threads: int) -> tuple[float, float]:
+    """Best of 3 wall-clock and CPU seconds of ``n`` motions on ``threads`` threads, after a warm-up, in a new process."""
+    code = ("import time; from stochpound.motions import site_motions; " + _call(2, 0) + "\n"
+            "runs = []\nfor _ in range(3):\n    wall, cpu = time.perf_counter(), time.process_time(); " + _call(n, 1)
+            + "; runs.append((time.perf_counter() - wall, time.process_time() - cpu))\nprint(*min(runs))")
+    wall, cpu = _in_new_process(code, threads)
+    return wall, cpu
 
 
 def speed(n: int) -> dict[str, Any]:
-    """Motions per second on 1 and 2 threads (best of 3, wall clock; and per CPU second), and the first call's cost."""
+    """Motions per second on 1 and 2 threads (wall clock; and per CPU second on 1), and a new process's first call."""
+    first = "import time; from stochpound.motions import site_motions; start = time.perf_counter(); " + _call(2, 0) + "; print(time.perf_counter() - start)"
     with tempfile.TemporaryDirectory() as cache:
-        compile_seconds = _first_call(cache)
-    cached_seconds = _first_call(None)
-    _timed(2, 0, 1)
-    runs = {threads: min(_timed(n, 1, threads) for _ in range(3)) for threads in (1, 2)}
-    return {"n": n, "one": n / runs[1][0], "two": n / runs[2][0], "cpu": n / runs[1][1], "compile": compile_seconds, "cached": cached_seconds}
+        compile_seconds = _in_new_process(first, 1, cache)[0]
+    cached_seconds = _in_new_process(first, 1)[0]
+    one, two = _timed(n, 1), _timed(n, 2)
+    return {"n": n, "one": n / one[0], "two": n / two[0], "cpu": n / one[1], "compile": compile_seconds, "cached": cached_seconds}
 
 
 def speed_section(data: dict[str, Any], info: dict[str, str]) -> str:
@@ -86,7 +88,7 @@ def speed_section(data: dict[str, Any], info: dict[str, str]) -> str:
         "## Site-based stochastic motions",
         "",
         f"`stochpound.motions.site_motions` for M {SCENARIO['magnitude']:g}, R {SCENARIO['distance_km']:g} km, Vs30 {SCENARIO['vs30']:g} m/s, "
-        f"strike-slip: {data['n']} motions of {DURATION:g} s at dt = {DT:g} s ({int(DURATION / DT) + 1} samples), best of 3 after a warm-up "
+        f"strike-slip: {data['n']} motions of {DURATION:g} s at dt = {DT:g} s ({int(DURATION / DT) + 1} samples), best of 3 after a warm-up in a new process "
         f"(commit {info['commit']}, {info['date']}, load {info['load average (1 min) at start']} at start, "
         "on a machine shared with other work). Target: ≥ 500 motions per second on 2 cores. "
         "`python -m benchmarks site_motions speed` rewrites this section.",
@@ -207,8 +209,6 @@ def main(argv: list[str] | None = None) -> int:
     """Run the task."""
     arguments = parse_arguments(argv)
     if arguments.task == "speed":
-        single_thread_environment()
-        os.environ["NUMBA_NUM_THREADS"] = "2"  # site_motions' own threads: 1 or 2 by numba.set_num_threads
         out = arguments.out or REPOSITORY / "docs" / "benchmarks.md"
         info = report.machine()
         data = speed(arguments.n or 500)

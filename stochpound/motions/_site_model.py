@@ -222,7 +222,7 @@ def _impulse(dt, f_mid, f_slope, t_mid, zeta, i):  # pragma: no cover - compiled
     return first, 2.0 * decay * math.cos(omega * root * dt), decay * decay, int(math.log(1.0 / IRF_TOLERANCE) / (zeta * omega * dt)) + 1
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, fastmath={"contract"})  # fused multiply-adds: round-off only
 def _normalized_row(noise, dt, f_mid, f_slope, t_mid, zeta, out, total, energy):  # pragma: no cover - compiled
     """out = Σ h w / σ_f of one motion (module docstring); ``total`` and ``energy`` are work arrays of 2 n_time + 4.
 
