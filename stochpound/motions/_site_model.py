@@ -283,12 +283,11 @@ def _normalized_noise(noise, dt, f_mid, f_slope, t_mid, zeta, out):  # pragma: n
 
 @njit(cache=True, nogil=True)
 def _product(a, b):  # pragma: no cover - compiled
-    """a @ b of square matrices, in loops (no BLAS call)."""
-    n = a.shape[0]
-    out = np.zeros((n, n))
-    for i in range(n):
-        for j in range(n):
-            for m in range(n):
+    """a @ b of 4 × 4 matrices, in loops (no BLAS call)."""
+    out = np.zeros((4, 4))
+    for i in range(4):
+        for j in range(4):
+            for m in range(4):
                 out[i, j] += a[i, m] * b[m, j]
     return out
 
@@ -298,28 +297,39 @@ def _hold_matrices(omega_c, dt):  # pragma: no cover - compiled
     """Exact step of ü + 2ω_c u̇ + ω_c² u = x for x linear in the step: s⁺ = Φ s + g0 x_k + g1 (x_{k+1} − x_k)/dt.
 
     The exponential of the augmented system's matrix M dt (state u, u̇, then
-    the input's value and slope) by its Taylor series, scaled and squared
-    so that the series' argument has a norm below 1/2: its terms then fall
-    below round-off within 30 terms.
+    the input's value and slope) by its Taylor series, the matrix halved
+    until its largest entry is below 1/8 (then 30 terms reach round-off) and
+    the result squared back.
     """
-    augmented = np.zeros((4, 4))
-    augmented[0, 1] = dt
-    augmented[1, 0] = -omega_c * omega_c * dt
-    augmented[1, 1] = -2.0 * omega_c * dt
-    augmented[1, 2] = dt
-    augmented[2, 3] = dt
     squarings = 0
-    while np.max(np.abs(augmented)) * 4.0 > 0.5:
-        augmented /= 2.0
+    scale = 1.0
+    while max(dt, omega_c * omega_c * dt, 2.0 * omega_c * dt) * scale > 0.125:
+        scale *= 0.5
         squarings += 1
-    exponential = np.eye(4)
-    term = np.eye(4)
+    augmented = np.zeros((4, 4))
+    augmented[0, 1] = dt * scale
+    augmented[1, 0] = -omega_c * omega_c * dt * scale
+    augmented[1, 1] = -2.0 * omega_c * dt * scale
+    augmented[1, 2] = dt * scale
+    augmented[2, 3] = dt * scale
+    exponential = np.zeros((4, 4))
+    term = np.zeros((4, 4))
+    for i in range(4):
+        exponential[i, i] = term[i, i] = 1.0
     for n in range(1, 30):
-        term = _product(term, augmented) / n
-        exponential += term
+        term = _product(term, augmented)
+        for i in range(4):
+            for j in range(4):
+                term[i, j] /= n
+                exponential[i, j] += term[i, j]
     for _ in range(squarings):
         exponential = _product(exponential, exponential)
-    return exponential[:2, :2].copy(), exponential[:2, 2].copy(), exponential[:2, 3] / dt
+    phi = np.empty((2, 2))
+    g0, g1 = np.empty(2), np.empty(2)
+    for i in range(2):
+        phi[i, 0], phi[i, 1] = exponential[i, 0], exponential[i, 1]
+        g0[i], g1[i] = exponential[i, 2], exponential[i, 3] / dt
+    return phi, g0, g1
 
 
 @njit(cache=True, nogil=True)
