@@ -100,7 +100,7 @@ def speed_section(data: dict[str, Any], info: dict[str, str]) -> str:
         "",
         f"Target **{verdict}** at this load (with the machine's 2 cores shared with other work the wall-clock figures are lower bounds; "
         "the rate per CPU second is what one free core gives). `site_motions` runs on numba's thread count "
-        "(`NUMBA_NUM_THREADS`, `numba.set_num_threads`), 16 motions at a time per thread; the motions do not depend on it. "
+        "(the environment variable `NUMBA_NUM_THREADS`, default the cores), 16 motions at a time per thread; the motions do not depend on it. "
         "Most of the cost is the time-varying filter: every sample's impulse response is followed "
         "until its envelope has decayed to 10⁻⁴ (a few hundred samples at the median filter frequency and damping, "
         "thousands for the low-frequency, lightly damped draws). "

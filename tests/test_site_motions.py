@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import math
 
-import numba
 import numpy as np
 import pytest
 from scipy import integrate, linalg, special
@@ -13,6 +12,7 @@ from scipy import integrate, linalg, special
 from stochpound._errors import SiteError
 from stochpound.motions import final_velocity_displacement, realization_rng, site_motions, site_motions_from_normals
 from stochpound.motions._arias import arias_intensity
+from stochpound.motions import _site_model
 from stochpound.motions._site_calibration import calibration_table, target
 from stochpound.motions._site_model import (
     F_MIN, IRF_TOLERANCE, _hold_matrices, _marginal_ppf, _normalized_noise, gamma_shape, high_pass, load_site_model, modulation, motions_from_parameters,
@@ -108,15 +108,11 @@ def test_hold_matrices_are_the_matrix_exponential(f_corner, dt):
         assert np.allclose(ours, reference, rtol=1e-11, atol=0.0)
 
 
-def test_motions_do_not_depend_on_the_threads():
-    threads = numba.get_num_threads()
-    try:
-        numba.set_num_threads(1)
-        one = site_motions(**SCENARIO, n=20, seed=9, duration=12.0).acceleration.values
-        numba.set_num_threads(min(2, numba.config.NUMBA_NUM_THREADS))
-        two = site_motions(**SCENARIO, n=20, seed=9, duration=12.0).acceleration.values
-    finally:
-        numba.set_num_threads(threads)
+def test_motions_do_not_depend_on_the_threads(monkeypatch):
+    monkeypatch.setattr(_site_model, "motion_threads", lambda: 1)
+    one = site_motions(**SCENARIO, n=20, seed=9, duration=12.0).acceleration.values
+    monkeypatch.setattr(_site_model, "motion_threads", lambda: 2)
+    two = site_motions(**SCENARIO, n=20, seed=9, duration=12.0).acceleration.values
     assert np.array_equal(one, two)
     assert np.array_equal(site_motions(**SCENARIO, n=3, seed=9, duration=12.0).acceleration.values, one[:3])
 

@@ -377,8 +377,8 @@ BATCH = 16
 
 
 def motion_threads() -> int:
-    """Threads :func:`motions_from_parameters` uses: numba's (``NUMBA_NUM_THREADS``, ``numba.set_num_threads``)."""
-    return numba.get_num_threads()
+    """Threads :func:`motions_from_parameters` uses: numba's ``NUMBA_NUM_THREADS`` (default: the cores; its threading layer is not started)."""
+    return int(numba.config.NUMBA_NUM_THREADS)
 
 
 def motions_from_parameters(parameters: dict[str, np.ndarray], noise: np.ndarray, dt: float) -> np.ndarray:
