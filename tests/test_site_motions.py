@@ -7,14 +7,15 @@ import math
 
 import numpy as np
 import pytest
-from scipy import integrate, special
+from scipy import integrate, linalg, special
 
 from stochpound._errors import SiteError
 from stochpound.motions import final_velocity_displacement, realization_rng, site_motions, site_motions_from_normals
 from stochpound.motions._arias import arias_intensity
+from stochpound.motions import _site_model
 from stochpound.motions._site_calibration import calibration_table, target
 from stochpound.motions._site_model import (
-    F_MIN, _hold_matrices, _marginal_ppf, _normalized_noise, gamma_shape, high_pass, load_site_model, modulation, motions_from_parameters,
+    F_MIN, IRF_TOLERANCE, _hold_matrices, _marginal_ppf, _normalized_noise, gamma_shape, high_pass, load_site_model, modulation, motions_from_parameters,
 )  # fmt: skip
 
 SCENARIO = {"magnitude": 7.0, "distance_km": 20.0, "vs30": 400.0, "mechanism": "strike_slip"}
@@ -63,6 +64,57 @@ def test_normalized_noise_equals_the_direct_sum(f_mid, f_slope, zeta):
     _normalized_noise(noise, 0.01, np.array([f_mid]), np.array([f_slope]), np.array([3.0]), np.array([zeta]), out)
     direct = _direct_noise(noise[0], 0.01, f_mid, f_slope, 3.0, zeta)
     assert np.max(np.abs(out[0] - direct)) < 2e-3 * np.max(np.abs(direct))
+
+
+def _truncated_noise(noise, dt, f_mid, f_slope, t_mid, zeta):
+    """The kernel's sum written out: impulse i (closed-form h) followed for the lags its group of 4 needs, then / σ_f."""
+    n = noise.size
+    index = np.arange(n + 3)
+    omega = 2 * np.pi * np.maximum(f_mid + f_slope * (index * dt - t_mid), F_MIN)
+    own = (np.log(1.0 / IRF_TOLERANCE) / (zeta * omega * dt)).astype(int) + 1
+    group = own[: 4 * ((n + 2) // 4)].reshape(-1, 4).max(axis=1)
+    total, energy = np.zeros(n), np.zeros(n)
+    root = math.sqrt(1 - zeta**2)
+    for i in range(n - 1):
+        lag = np.arange(1, min(group[i // 4], n - 1 - i) + 1)
+        h = omega[i] / root * np.exp(-zeta * omega[i] * lag * dt) * np.sin(omega[i] * root * lag * dt)
+        total[i + lag] += h * noise[i]
+        energy[i + lag] += h**2
+    out = np.zeros(n)
+    out[1:] = total[1:] / np.sqrt(energy[1:])
+    return out
+
+
+@pytest.mark.parametrize("f_mid, f_slope, zeta", [(5.0, -0.1, 0.3), (0.5, -0.2, 0.05), (12.0, 1.5, 0.9)])
+def test_normalized_noise_is_the_truncated_sum_to_round_off(f_mid, f_slope, zeta):
+    """The compiled kernel (recurrence, register window) against the same truncated sum in closed form."""
+    rng = np.random.default_rng(11)
+    noise = rng.standard_normal((2, 403))
+    out = np.empty_like(noise)
+    _normalized_noise(noise, 0.01, np.full(2, f_mid), np.full(2, f_slope), np.full(2, 2.0), np.full(2, zeta), out)
+    for row, w in zip(out, noise):
+        direct = _truncated_noise(w, 0.01, f_mid, f_slope, 2.0, zeta)
+        assert np.max(np.abs(row - direct)) < 1e-10 * np.max(np.abs(direct))
+
+
+@pytest.mark.parametrize("f_corner, dt", [(0.02, 0.001), (0.2, 0.01), (3.0, 0.02), (40.0, 0.01)])
+def test_hold_matrices_are_the_matrix_exponential(f_corner, dt):
+    omega_c = 2 * np.pi * f_corner
+    augmented = np.zeros((4, 4))
+    augmented[:2, :2] = [[0.0, 1.0], [-omega_c**2, -2.0 * omega_c]]
+    augmented[1, 2] = augmented[2, 3] = 1.0
+    exponential = linalg.expm(augmented * dt)
+    for ours, reference in zip(_hold_matrices(omega_c, dt), (exponential[:2, :2], exponential[:2, 2], exponential[:2, 3] / dt)):
+        assert np.allclose(ours, reference, rtol=1e-11, atol=0.0)
+
+
+def test_motions_do_not_depend_on_the_threads(monkeypatch):
+    monkeypatch.setattr(_site_model, "motion_threads", lambda: 1)
+    one = site_motions(**SCENARIO, n=20, seed=9, duration=12.0).acceleration.values
+    monkeypatch.setattr(_site_model, "motion_threads", lambda: 2)
+    two = site_motions(**SCENARIO, n=20, seed=9, duration=12.0).acceleration.values
+    assert np.array_equal(one, two)
+    assert np.array_equal(site_motions(**SCENARIO, n=3, seed=9, duration=12.0).acceleration.values, one[:3])
 
 
 def test_high_pass_step_is_the_exact_solution_of_the_oscillator():

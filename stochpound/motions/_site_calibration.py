@@ -30,7 +30,7 @@ re-simulation.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -66,6 +66,8 @@ SCALED = ("arias_intensity", "f_mid")
 RIDGE = 0.02
 #: The proposal's widening of the published residuals, and its corner's ln-distribution (ln Hz).
 PROPOSAL_WIDTH, PROPOSAL_CORNER = 1.4, (math.log(0.15), 0.8)
+#: Motions simulated at a time where only their spectra are kept (memory: 8 n_time bytes a motion).
+SPECTRA_BATCH = 256
 
 
 def ln_spectra(acceleration: np.ndarray, dt: float, periods: Sequence[float | None] = CHECK_PERIODS) -> np.ndarray:
@@ -92,13 +94,20 @@ def target(scenario: tuple[float, float, float, str], periods: Sequence[float | 
 def _draw(model: SiteModel, scenario: tuple, n: int, seed: int, dt: float, duration: float) -> np.ndarray:
     """ln Sa [n, periods] of n motions of the model for a scenario (realizations 0..n−1 of ``seed``)."""
     n_time = int(round(duration / dt)) + 1
-    rows = []
-    for i in range(n):
-        rng = realization_rng(seed, i)
-        rows.append(np.concatenate([rng.standard_normal(7), rng.standard_normal(n_time)]))
-    normals = np.array(rows)
-    parameters = motion_parameters(model, *scenario, normals[:, :7])
-    return ln_spectra(motions_from_parameters(parameters, normals[:, 7:], dt), dt)
+    rngs = [realization_rng(seed, i) for i in range(n)]
+    parameters = motion_parameters(model, *scenario, np.array([rng.standard_normal(7) for rng in rngs]))
+    return _spectra_in_batches(parameters, lambda rows: np.array([rng.standard_normal(n_time) for rng in rngs[rows]]), dt)
+
+
+def _spectra_in_batches(parameters: dict[str, np.ndarray], noise_rows: Callable[[slice], np.ndarray], dt: float) -> np.ndarray:
+    """ln Sa [n, periods] of the motions of ``parameters``, SPECTRA_BATCH at a time (``noise_rows(rows)``: their noise, called in order)."""
+    n = parameters["t_mid"].size
+    spectra = []
+    for start in range(0, n, SPECTRA_BATCH):
+        rows = slice(start, min(start + SPECTRA_BATCH, n))
+        chosen = {name: values[rows] for name, values in parameters.items()}
+        spectra.append(ln_spectra(motions_from_parameters(chosen, noise_rows(rows), dt), dt))
+    return np.concatenate(spectra)
 
 
 def scenario_duration(scenario: tuple) -> float:
@@ -171,9 +180,9 @@ def _pool(scenario: tuple, n: int, seed: int, dt: float) -> _Pool:
     parameters["zeta_f"] = np.minimum(parameters["zeta_f"], ZETA_MAX)
     parameters["f_corner"] = np.exp(ln_corner)
     n_time = int(round(scenario_duration(scenario) / dt)) + 1
-    acceleration = motions_from_parameters(parameters, rng.standard_normal((n, n_time)), dt)
+    ln_sa_unit = _spectra_in_batches(parameters, lambda rows: rng.standard_normal((rows.stop - rows.start, n_time)), dt)
     mean, sigma = target(scenario)
-    return _Pool(scenario, nu, ln_corner, log_proposal, rng.standard_normal(n), ln_spectra(acceleration, dt), mean, sigma)
+    return _Pool(scenario, nu, ln_corner, log_proposal, rng.standard_normal(n), ln_sa_unit, mean, sigma)
 
 
 def _unpack(x: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -36,10 +36,13 @@ from __future__ import annotations
 
 import math
 import tomllib
+from collections.abc import Callable
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from functools import lru_cache
 
 import numpy as np
+import numba
 from numba import njit
 from scipy import special, stats
 
@@ -186,16 +189,31 @@ def gamma_shape(t_mid: np.ndarray, d5_95: np.ndarray) -> tuple[np.ndarray, np.nd
     return k, special.gammaincinv(k, 0.45) / t_mid
 
 
-def modulation(parameters: dict[str, np.ndarray], times: np.ndarray) -> np.ndarray:
-    """q(t) [n, n_time] (m/s²) of every motion: the gamma-shaped envelope of its I_a, D5–95 and t_mid (module docstring)."""
+def modulation_constants(parameters: dict[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """ln α1² (α1 in m/s^(α2+1)), k and λ (1/s) of every motion's modulation q² = α1² t^(k−1) e^(−λt) (module docstring)."""
     k, rate = gamma_shape(parameters["t_mid"], parameters["d5_95"])
-    ln_alpha1_sq = np.log(2.0 * DEFAULT_G / np.pi * parameters["arias_intensity"]) + k * np.log(rate) - special.gammaln(k)
-    t = times[None, 1:]
-    ln_q = 0.5 * ln_alpha1_sq[:, None] + 0.5 * (k[:, None] - 1.0) * np.log(t) - 0.5 * rate[:, None] * t
-    return np.concatenate([np.zeros((k.size, 1)), np.exp(ln_q)], axis=1)  # q(0) multiplies a zero noise sample
+    return np.log(2.0 * DEFAULT_G / np.pi * parameters["arias_intensity"]) + k * np.log(rate) - special.gammaln(k), k, rate
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
+def _modulation_row(ln_alpha1_sq, k, rate, times, out):  # pragma: no cover - compiled
+    """out[i] = q(times[i]) of one motion (m/s²); q(times[0]) = 0 multiplies a zero noise sample."""
+    out[0] = 0.0
+    for i in range(1, out.shape[0]):
+        t = times[i]
+        out[i] = math.exp(0.5 * ln_alpha1_sq + 0.5 * (k - 1.0) * math.log(t) - 0.5 * rate * t)
+
+
+def modulation(parameters: dict[str, np.ndarray], times: np.ndarray) -> np.ndarray:
+    """q(t) [n, n_time] (m/s²) of every motion at the samples ``times`` = 0, dt, 2 dt, … (s): its gamma-shaped envelope."""
+    times = np.asarray(times, dtype=float)
+    out = np.empty((np.size(parameters["t_mid"]), times.size))
+    for m, constants in enumerate(zip(*modulation_constants(parameters))):
+        _modulation_row(*constants, times, out[m])
+    return out
+
+
+@njit(cache=True, nogil=True)
 def _impulse(dt, f_mid, f_slope, t_mid, zeta, i):  # pragma: no cover - compiled
     """h at lag 1 of impulse i, the recurrence's two coefficients and the lags to follow it (module docstring)."""
     omega = 2.0 * math.pi * max(f_mid + f_slope * (i * dt - t_mid), F_MIN)
@@ -205,67 +223,117 @@ def _impulse(dt, f_mid, f_slope, t_mid, zeta, i):  # pragma: no cover - compiled
     return first, 2.0 * decay * math.cos(omega * root * dt), decay * decay, int(math.log(1.0 / IRF_TOLERANCE) / (zeta * omega * dt)) + 1
 
 
-@njit(cache=True)
-def _normalized_noise(noise, dt, f_mid, f_slope, t_mid, zeta, out):  # pragma: no cover - compiled
-    """out[m] = Σ h w / σ_f of every motion m (module docstring).
+@njit(cache=True, nogil=True, fastmath={"contract"})  # fused multiply-adds: round-off only
+def _normalized_row(noise, dt, f_mid, f_slope, t_mid, zeta, out, total, energy):  # pragma: no cover - compiled
+    """out = Σ h w / σ_f of one motion (module docstring); ``total`` and ``energy`` are work arrays of 2 n_time + 4.
 
     h(s) of an impulse at the samples s = lag·dt follows the recurrence
-    h_{l+1} = 2e^{−ζω dt} cos(ω_d dt) h_l − e^{−2ζω dt} h_{l−1} (h_0 = 0), and is
-    followed until its envelope has fallen below :data:`IRF_TOLERANCE` of its
-    start. Four consecutive impulses are stepped together (independent
-    recurrences, so the processor overlaps them), each as long as the slowest
-    of the four needs.
+    h_{l+1} = 2e^{−ζω dt} cos(ω_d dt) h_l − e^{−2ζω dt} h_{l−1} (h_0 = 0). The
+    impulses go in groups of four consecutive ones, each followed for as
+    many lags as the slowest of its group needs for its envelope to fall
+    below :data:`IRF_TOLERANCE` of its start. A group's four impulses reach
+    the outputs k, k+1, k+2, k+3 at one lag: their sums for k+1 to k+3 wait
+    in registers (s, r) and each output is added to memory once a group.
     """
-    n_motion, n_time = noise.shape
-    total = np.empty(2 * n_time + 4)  # the tail past n_time takes the overrun of the last impulses
+    n_time = noise.shape[0]
+    total[:] = 0.0
+    energy[:] = 0.0
+    for start in range(0, n_time - 1, 4):
+        b0, p0, q0, l0 = _impulse(dt, f_mid, f_slope, t_mid, zeta, start)
+        b1, p1, q1, l1 = _impulse(dt, f_mid, f_slope, t_mid, zeta, start + 1)
+        b2, p2, q2, l2 = _impulse(dt, f_mid, f_slope, t_mid, zeta, start + 2)
+        b3, p3, q3, l3 = _impulse(dt, f_mid, f_slope, t_mid, zeta, start + 3)
+        w0 = noise[start]
+        w1 = noise[start + 1] if start + 1 < n_time - 1 else 0.0
+        w2 = noise[start + 2] if start + 2 < n_time - 1 else 0.0
+        w3 = noise[start + 3] if start + 3 < n_time - 1 else 0.0
+        a0 = a1 = a2 = a3 = 0.0
+        s1 = s2 = s3 = r1 = r2 = r3 = 0.0
+        length = min(n_time - 1 - start, max(max(l0, l1), max(l2, l3)))
+        t = total[start + 1:]  # views indexed from 0: no negative-index handling in the loop
+        e = energy[start + 1:]
+        for k in range(length):
+            t[k] += s1 + b0 * w0
+            e[k] += r1 + b0 * b0
+            s1, s2, s3 = s2 + b1 * w1, s3 + b2 * w2, b3 * w3
+            r1, r2, r3 = r2 + b1 * b1, r3 + b2 * b2, b3 * b3
+            a0, b0 = b0, p0 * b0 - q0 * a0
+            a1, b1 = b1, p1 * b1 - q1 * a1
+            a2, b2 = b2, p2 * b2 - q2 * a2
+            a3, b3 = b3, p3 * b3 - q3 * a3
+        t[length] += s1
+        e[length] += r1
+        t[length + 1] += s2
+        e[length + 1] += r2
+        t[length + 2] += s3
+        e[length + 2] += r3
+    out[0] = 0.0
+    for k in range(1, n_time):
+        out[k] = total[k] / math.sqrt(energy[k]) if energy[k] > 0.0 else 0.0
+
+
+@njit(cache=True, nogil=True)
+def _normalized_noise(noise, dt, f_mid, f_slope, t_mid, zeta, out):  # pragma: no cover - compiled
+    """out[m] = Σ h w / σ_f of every motion m (:func:`_normalized_row`)."""
+    n_time = noise.shape[1]
+    total = np.empty(2 * n_time + 4)
     energy = np.empty(2 * n_time + 4)
-    for m in range(n_motion):
-        total[:] = 0.0
-        energy[:] = 0.0
-        for start in range(0, n_time - 1, 4):
-            b0, p0, q, l0 = _impulse(dt, f_mid[m], f_slope[m], t_mid[m], zeta[m], start)
-            b1, p1, q1, l1 = _impulse(dt, f_mid[m], f_slope[m], t_mid[m], zeta[m], start + 1)
-            b2, p2, q2, l2 = _impulse(dt, f_mid[m], f_slope[m], t_mid[m], zeta[m], start + 2)
-            b3, p3, q3, l3 = _impulse(dt, f_mid[m], f_slope[m], t_mid[m], zeta[m], start + 3)
-            w0 = noise[m, start]
-            w1 = noise[m, start + 1] if start + 1 < n_time - 1 else 0.0
-            w2 = noise[m, start + 2] if start + 2 < n_time - 1 else 0.0
-            w3 = noise[m, start + 3] if start + 3 < n_time - 1 else 0.0
-            a0 = a1 = a2 = a3 = 0.0
-            length = min(n_time - 1 - start, max(max(l0, l1), max(l2, l3)))
-            for lag in range(1, length + 1):
-                k = start + lag
-                total[k] += b0 * w0
-                energy[k] += b0 * b0
-                total[k + 1] += b1 * w1
-                energy[k + 1] += b1 * b1
-                total[k + 2] += b2 * w2
-                energy[k + 2] += b2 * b2
-                total[k + 3] += b3 * w3
-                energy[k + 3] += b3 * b3
-                a0, b0 = b0, p0 * b0 - q * a0
-                a1, b1 = b1, p1 * b1 - q1 * a1
-                a2, b2 = b2, p2 * b2 - q2 * a2
-                a3, b3 = b3, p3 * b3 - q3 * a3
-        out[m, 0] = 0.0
-        for k in range(1, n_time):
-            out[m, k] = total[k] / math.sqrt(energy[k]) if energy[k] > 0.0 else 0.0
+    for m in range(noise.shape[0]):
+        _normalized_row(noise[m], dt, f_mid[m], f_slope[m], t_mid[m], zeta[m], out[m], total, energy)
 
 
-@lru_cache(maxsize=64)
-def _hold_matrices(omega_c: float, dt: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Exact step of ü + 2ω_c u̇ + ω_c² u = x for x linear in the step: s⁺ = Φ s + g0 x_k + g1 (x_{k+1} − x_k)/dt."""
-    from scipy.linalg import expm
+@njit(cache=True, nogil=True)
+def _product(a, b):  # pragma: no cover - compiled
+    """a @ b of 4 × 4 matrices, in loops (no BLAS call)."""
+    out = np.zeros((4, 4))
+    for i in range(4):
+        for j in range(4):
+            for m in range(4):
+                out[i, j] += a[i, m] * b[m, j]
+    return out
 
+
+@njit(cache=True, nogil=True)
+def _hold_matrices(omega_c, dt):  # pragma: no cover - compiled
+    """Exact step of ü + 2ω_c u̇ + ω_c² u = x for x linear in the step: s⁺ = Φ s + g0 x_k + g1 (x_{k+1} − x_k)/dt.
+
+    The exponential of the augmented system's matrix M dt (state u, u̇, then
+    the input's value and slope) by its Taylor series, the matrix halved
+    until its largest entry is below 1/8 (then 30 terms reach round-off) and
+    the result squared back.
+    """
+    squarings = 0
+    scale = 1.0
+    while max(dt, omega_c * omega_c * dt, 2.0 * omega_c * dt) * scale > 0.125:
+        scale *= 0.5
+        squarings += 1
     augmented = np.zeros((4, 4))
-    augmented[:2, :2] = [[0.0, 1.0], [-omega_c**2, -2.0 * omega_c]]
-    augmented[1, 2] = 1.0
-    augmented[2, 3] = 1.0
-    exponential = expm(augmented * dt)
-    return exponential[:2, :2].copy(), exponential[:2, 2].copy(), exponential[:2, 3].copy() / dt
+    augmented[0, 1] = dt * scale
+    augmented[1, 0] = -omega_c * omega_c * dt * scale
+    augmented[1, 1] = -2.0 * omega_c * dt * scale
+    augmented[1, 2] = dt * scale
+    augmented[2, 3] = dt * scale
+    exponential = np.zeros((4, 4))
+    term = np.zeros((4, 4))
+    for i in range(4):
+        exponential[i, i] = term[i, i] = 1.0
+    for n in range(1, 30):
+        term = _product(term, augmented)
+        for i in range(4):
+            for j in range(4):
+                term[i, j] /= n
+                exponential[i, j] += term[i, j]
+    for _ in range(squarings):
+        exponential = _product(exponential, exponential)
+    phi = np.empty((2, 2))
+    g0, g1 = np.empty(2), np.empty(2)
+    for i in range(2):
+        phi[i, 0], phi[i, 1] = exponential[i, 0], exponential[i, 1]
+        g0[i], g1[i] = exponential[i, 2], exponential[i, 3] / dt
+    return phi, g0, g1
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _high_pass_kernel(x, omega_c, phi, g0, g1, out):  # pragma: no cover - compiled
     """out[k] = ü_k = x_k − 2ω_c u̇_k − ω_c² u_k, the state stepped exactly (:func:`_hold_matrices`)."""
     u, v = 0.0, 0.0
@@ -283,19 +351,73 @@ def high_pass(acceleration: np.ndarray, dt: float, f_corner: np.ndarray) -> np.n
     out = np.empty_like(acceleration)
     for m, corner in enumerate(f_corner):
         omega_c = 2.0 * math.pi * float(corner)
-        phi, g0, g1 = _hold_matrices(omega_c, float(dt))
-        _high_pass_kernel(acceleration[m], omega_c, phi, g0, g1, out[m])
+        _high_pass_kernel(acceleration[m], omega_c, *_hold_matrices(omega_c, float(dt)), out[m])
     return out
+
+
+@njit(cache=True, nogil=True)
+def _filtered_motions(noise, dt, f_mid, f_slope, t_mid, zeta, ln_alpha1_sq, k, rate, f_corner, out):  # pragma: no cover - compiled
+    """out[m] = the post-filtered q · Σ h w / σ_f of every motion m (before the baseline correction)."""
+    n_time = noise.shape[1]
+    total = np.empty(2 * n_time + 4)
+    energy = np.empty(2 * n_time + 4)
+    unit = np.empty(n_time)
+    envelope = np.empty(n_time)
+    times = np.arange(n_time) * dt
+    for m in range(noise.shape[0]):
+        _normalized_row(noise[m], dt, f_mid[m], f_slope[m], t_mid[m], zeta[m], unit, total, energy)
+        _modulation_row(ln_alpha1_sq[m], k[m], rate[m], times, envelope)
+        envelope *= unit
+        omega_c = 2.0 * math.pi * f_corner[m]
+        phi, g0, g1 = _hold_matrices(omega_c, dt)
+        _high_pass_kernel(envelope, omega_c, phi, g0, g1, out[m])
+
+
+#: Motions computed together by one thread (the split depends on nothing else, so neither do the results).
+BATCH = 16
+
+
+def motion_threads() -> int:
+    """Threads :func:`motions_from_parameters` uses: numba's ``NUMBA_NUM_THREADS`` (default: the cores; its threading layer is not started)."""
+    return int(numba.config.NUMBA_NUM_THREADS)
 
 
 def motions_from_parameters(parameters: dict[str, np.ndarray], noise: np.ndarray, dt: float) -> np.ndarray:
     """Accelerations [n, n_time] (m/s², from t = 0 at ``dt``) of motions of given parameters and white noise ``noise`` [n, n_time]."""
-    noise = np.ascontiguousarray(noise, dtype=float)
-    times = np.arange(noise.shape[1]) * dt
-    unit = np.empty_like(noise)
-    _normalized_noise(noise, float(dt), parameters["f_mid"], parameters["f_slope"], parameters["t_mid"], parameters["zeta_f"], unit)
-    filtered = high_pass(modulation(parameters, times) * unit, dt, parameters["f_corner"])
-    return baseline_correct(filtered, dt)
+    noise = np.asarray(noise, dtype=float)
+    return motions_from_noise_rows(parameters, lambda rows: noise[rows], noise.shape[1], dt)
+
+
+def motions_from_noise_rows(parameters: dict[str, np.ndarray], noise_rows: Callable[[slice], np.ndarray], n_time: int,
+                            dt: float) -> np.ndarray:
+    """Accelerations [n, n_time] (m/s²) of motions of given parameters, ``noise_rows(rows)`` giving the white noise of ``rows``.
+
+    The motions are computed in batches of :data:`BATCH` on :func:`motion_threads`
+    threads (``noise_rows`` is called once per batch, from its thread); each
+    motion depends on its own parameters and noise alone. Memory: the result
+    (8 n_time bytes a motion) and a batch's work arrays.
+    """
+    n = np.size(parameters["t_mid"])
+    out = np.empty((n, n_time))
+
+    def batch(start: int) -> None:
+        rows = slice(start, min(start + BATCH, n))
+        chosen = {name: np.ascontiguousarray(values[rows], dtype=float) for name, values in parameters.items()}
+        ln_alpha1_sq, k, rate = modulation_constants(chosen)
+        noise = np.ascontiguousarray(noise_rows(rows), dtype=float)
+        _filtered_motions(noise, float(dt), chosen["f_mid"], chosen["f_slope"], chosen["t_mid"], chosen["zeta_f"],
+                          ln_alpha1_sq, k, rate, chosen["f_corner"], out[rows])
+        out[rows] = baseline_correct(out[rows], dt)
+
+    starts = range(0, n, BATCH)
+    threads = min(motion_threads(), len(starts))
+    if threads <= 1:
+        for start in starts:
+            batch(start)
+    else:
+        with ThreadPoolExecutor(threads) as pool:
+            list(pool.map(batch, starts))
+    return out
 
 
 def motions_from_normals(model: SiteModel, magnitude: float, distance_km: float, vs30: float, mechanism: str,

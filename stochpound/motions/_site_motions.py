@@ -22,7 +22,9 @@ from scipy import special
 from stochpound._errors import SiteError
 from stochpound.motions._conditional import check_scenario
 from stochpound.motions._seeding import check_seed, realization_rng
-from stochpound.motions._site_model import MODELS, PARAMETER_NORMALS, UNITS, gamma_shape, load_site_model, motion_parameters, motions_from_normals
+from stochpound.motions._site_model import (
+    MODELS, PARAMETER_NORMALS, UNITS, gamma_shape, load_site_model, motion_parameters, motions_from_noise_rows, motions_from_normals,
+)  # fmt: skip
 
 #: The scenarios the hazard-compatible calibration covers; outside them the model is not offered.
 SITE_MOTION_LIMITS: dict[str, tuple[float, float]] = {"magnitude": (5.5, 8.0), "distance_km": (5.0, 100.0), "vs30": (200.0, 1100.0)}
@@ -150,15 +152,20 @@ def site_motions(magnitude: float, distance_km: float, vs30: float, mechanism: s
     except ValueError as error:
         raise SiteError(str(error)) from None
     rows = _rows(realizations, int(n))
-    if duration is None:
-        first = np.array([realization_rng(seed, i).standard_normal(PARAMETER_NORMALS) for i in range(int(n))])
-        duration = _window(motion_parameters(load_site_model(model), magnitude, distance_km, vs30, mechanism, first))
+    site_model = load_site_model(model)
+    rngs = [realization_rng(seed, i) for i in rows]
+    first = np.array([rng.standard_normal(PARAMETER_NORMALS) for rng in rngs])
+    parameters = motion_parameters(site_model, magnitude, distance_km, vs30, mechanism, first)
+    if duration is None:  # the window of the whole set of n, whichever of its motions are asked for
+        whole = parameters if len(rows) == int(n) and rows == list(range(int(n))) else motion_parameters(
+            site_model, magnitude, distance_km, vs30, mechanism,
+            np.array([realization_rng(seed, i).standard_normal(PARAMETER_NORMALS) for i in range(int(n))]))
+        duration = _window(whole)
     elif isinstance(duration, bool) or not isinstance(duration, (int, float)) or not 10.0 * dt <= duration <= 600.0:
         raise SiteError(f"duration: must be within {10 * dt:g}-600 s, got {duration!r}")
     n_time = int(round(duration / dt)) + 1
-    rngs = [realization_rng(seed, i) for i in rows]
-    normals = np.array([np.concatenate([rng.standard_normal(PARAMETER_NORMALS), rng.standard_normal(n_time)]) for rng in rngs])
-    dataset = site_motions_from_normals(normals, magnitude=magnitude, distance_km=distance_km, vs30=vs30, mechanism=mechanism, dt=dt, model=model)
+    acceleration = motions_from_noise_rows(parameters, lambda batch: np.array([rng.standard_normal(n_time) for rng in rngs[batch]]), n_time, dt)
+    dataset = _dataset(acceleration, parameters, dt, _attrs(magnitude, distance_km, vs30, mechanism, model))
     dataset = dataset.assign_coords(realization=np.asarray(rows, dtype=int))
     dataset.attrs.update(seed=seed, n=int(n))
     return dataset
