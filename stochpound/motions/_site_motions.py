@@ -152,17 +152,15 @@ def site_motions(magnitude: float, distance_km: float, vs30: float, mechanism: s
     except ValueError as error:
         raise SiteError(str(error)) from None
     rows = _rows(realizations, int(n))
-    site_model = load_site_model(model)
-    rngs = [realization_rng(seed, i) for i in rows]
-    first = np.array([rng.standard_normal(PARAMETER_NORMALS) for rng in rngs])
-    parameters = motion_parameters(site_model, magnitude, distance_km, vs30, mechanism, first)
-    if duration is None:  # the window of the whole set of n, whichever of its motions are asked for
-        whole = parameters if len(rows) == int(n) and rows == list(range(int(n))) else motion_parameters(
-            site_model, magnitude, distance_km, vs30, mechanism,
-            np.array([realization_rng(seed, i).standard_normal(PARAMETER_NORMALS) for i in range(int(n))]))
+    rngs = [realization_rng(seed, i) for i in range(int(n))]
+    first = np.array([rng.standard_normal(PARAMETER_NORMALS) for rng in rngs])  # the whole set's: its window is theirs
+    whole = motion_parameters(load_site_model(model), magnitude, distance_km, vs30, mechanism, first)
+    if duration is None:
         duration = _window(whole)
     elif isinstance(duration, bool) or not isinstance(duration, (int, float)) or not 10.0 * dt <= duration <= 600.0:
         raise SiteError(f"duration: must be within {10 * dt:g}-600 s, got {duration!r}")
+    parameters = {name: values[rows] for name, values in whole.items()}  # each motion's parameters are its own row's
+    rngs = [rngs[i] for i in rows]
     n_time = int(round(duration / dt)) + 1
     acceleration = motions_from_noise_rows(parameters, lambda batch: np.array([rng.standard_normal(n_time) for rng in rngs[batch]]), n_time, dt)
     dataset = _dataset(acceleration, parameters, dt, _attrs(magnitude, distance_km, vs30, mechanism, model))
