@@ -81,11 +81,14 @@ from stochpound.motions._conditional import (  # noqa: F401
     scenario_spectrum,
     spectrum_dataset,
 )
+from stochpound.motions._measure import KINDS as MEASURE_KINDS, Measure
 from stochpound.motions._measures import measure_label  # noqa: F401
 from stochpound.motions._site_calibration import calibration_table, fit_calibration  # noqa: F401
 
 __all__ = [
     "ENVELOPES",
+    "MEASURE_KINDS",
+    "Measure",
     "GEOMETRY_FIELDS",
     "PSD_CONVENTION",
     "TARGET_TOLERANCE",

@@ -28,6 +28,7 @@ import numpy as np
 import xarray as xr
 from scipy.optimize import brentq
 
+from stochpound.motions._measure import Measure
 from stochpound.motions._arias import DEFAULT_G, arias_intensity, squared_integrals
 from stochpound.motions._spectrum import DEFAULT_DAMPING, as_acceleration, response_spectrum
 
@@ -39,14 +40,8 @@ SIGNIFICANT_FRACTIONS = (0.05, 0.95)
 
 
 def measure_label(measure: str, period: float | Sequence[float] | None = None) -> str:
-    """A measure's short name: ``PGA``, ``PSA(1 s)``, ``Sa_avg(0.5-4 s)`` (its first and last periods); others by their key in
-    capitals (``PGV``)."""
-    if measure == "psa":
-        return f"PSA({float(period):g} s)"
-    if measure == "sa_avg":
-        periods = np.atleast_1d(np.asarray(period, dtype=float))
-        return f"Sa_avg({periods[0]:g}-{periods[-1]:g} s)"
-    return measure.upper()
+    """A measure's short name: ``PGA``, ``PSA(1 s)``, ``Sa_avg(0.5-4 s)`` (:attr:`~stochpound.motions.Measure.label`)."""
+    return Measure.of(measure, period).label
 
 
 def peak_ground_motion(acceleration: np.ndarray, dt: float) -> tuple[float, float, float]:

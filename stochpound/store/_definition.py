@@ -38,6 +38,7 @@ from typing import Any
 
 from stochpound._errors import ExperimentError
 from stochpound.model.friction import is_fixed_base
+from stochpound.motions import MEASURE_KINDS, Measure
 
 NOT_IN_IDENTITY = ("hazard", "design", "scene_source", "site", "limit_states")
 """Entries of a canonical definition that no run depends on, left out of its identity (:func:`~stochpound.store.definition_sha256`)."""
@@ -69,12 +70,12 @@ def definition_sha256(definition: Mapping[str, Any]) -> str:
     return hashlib.sha256(canonical_json(runs).encode()).hexdigest()
 
 
-MEASURES = ("pga", "pgv", "psa", "sa_avg")
-"""The intensity measures an ``[intensity]`` (and a ``[hazard]``) table may name."""
+MEASURES = MEASURE_KINDS
+"""The intensity measures an ``[intensity]`` (and a ``[hazard]``) table may name (:data:`stochpound.motions.MEASURE_KINDS`)."""
 
 
 def describe_measure(intensity: Mapping[str, Any]) -> str:
-    """An intensity measure in words, e.g. ``PSA(T = 1 s, 5 % damping)`` or ``PGA``.
+    """An intensity measure in words, e.g. ``PSA(T = 1 s, 5 % damping)`` or ``PGA`` (:attr:`~stochpound.motions.Measure.description`).
 
     Parameters
     ----------
@@ -82,13 +83,7 @@ def describe_measure(intensity: Mapping[str, Any]) -> str:
         ``measure`` (``pga``, ``pgv``, ``psa``, ``sa_avg``) and, for a spectral
         measure, ``period`` or ``periods`` (s) and ``damping`` (fraction of critical).
     """
-    measure = intensity["measure"]
-    if measure == "psa":
-        return f"PSA(T = {intensity['period']:g} s, {100 * intensity['damping']:g} % damping)"
-    if measure == "sa_avg":
-        periods = intensity["periods"]
-        return f"Sa_avg({periods[0]:g}-{periods[-1]:g} s, {len(periods)} periods, {100 * intensity['damping']:g} % damping)"
-    return measure.upper()
+    return Measure.from_entry(intensity).description
 
 
 class _Entry(Mapping[str, Any]):
