@@ -84,6 +84,7 @@ from stochpound.motions._conditional import (  # noqa: F401
 from stochpound.motions._measure import KINDS as MEASURE_KINDS, Measure
 from stochpound.motions._measures import measure_label  # noqa: F401
 from stochpound.motions._site_calibration import calibration_table, fit_calibration  # noqa: F401
+from stochpound.motions._site_motions import SITE_MOTION_LIMITS  # noqa: F401  (the analysis's measure-free risk clamps to it)
 
 __all__ = [
     "ENVELOPES",
