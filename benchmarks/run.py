@@ -7,7 +7,8 @@ comparison with an earlier revision (:mod:`benchmarks.compare`),
 ``python -m benchmarks yielding`` the yielding storeys' (:mod:`benchmarks.yielding`),
 ``python -m benchmarks rare_events`` subset simulation's on Au & Beck's oscillator (:mod:`benchmarks.rare_events`),
 ``python -m benchmarks site_motions`` the site-based stochastic motions' (:mod:`benchmarks.site_motions`),
-``python -m benchmarks startup`` the quick start's start-up (:mod:`benchmarks.startup`).
+``python -m benchmarks startup`` the quick start's start-up (:mod:`benchmarks.startup`),
+``python -m benchmarks measure_free`` the measure-free risk at the demo site (:mod:`benchmarks.measure_free`).
 
 The thread pools of BLAS, OpenMP and numba are set to one thread here,
 before numpy is imported, so that every in-process measurement runs on one core.
@@ -30,7 +31,7 @@ import tempfile  # noqa: E402
 import time  # noqa: E402
 from pathlib import Path  # noqa: E402
 
-from benchmarks import compare, experiment_scale, rare_events, report, site_motions, spectrum, startup, suite, yielding  # noqa: E402
+from benchmarks import compare, experiment_scale, measure_free, rare_events, report, site_motions, spectrum, startup, suite, yielding  # noqa: E402
 from benchmarks.sections import keep_sections  # noqa: E402
 from benchmarks.timing import REPOSITORY  # noqa: E402
 
@@ -70,6 +71,8 @@ def main(argv: list[str] | None = None) -> int:
         return site_motions.main(argv[1:])
     if argv[:1] == ["startup"]:
         return startup.main(argv[1:])
+    if argv[:1] == ["measure_free"]:
+        return measure_free.main(argv[1:])
     arguments = parse_arguments(argv)
     config = suite.Config.quick_preset() if arguments.quick else suite.Config.full()
     if arguments.no_opensees:
@@ -82,7 +85,7 @@ def main(argv: list[str] | None = None) -> int:
     figure = report.figure(results, folder / "figures" / report.FIGURE_NAME)
     markdown = folder / "benchmarks.md"
     old = markdown.read_text() if markdown.exists() else ""
-    sections = (experiment_scale.SECTION, compare.SECTION, spectrum.SECTION, yielding.SECTION, site_motions.SECTION, startup.SECTION)
+    sections = (experiment_scale.SECTION, compare.SECTION, spectrum.SECTION, yielding.SECTION, site_motions.SECTION, startup.SECTION, measure_free.SECTION)
     markdown.write_text(keep_sections(old, report.document(results, info, elapsed), sections))
     print(f"wrote {markdown} and {figure} in {elapsed:.1f} s")
     return 0

@@ -118,7 +118,7 @@ def test_neyman_allocation_sends_the_extra_runs_where_the_rate_is_carried():
     rng = np.random.default_rng(0)
     carrying, quiet = rng.lognormal(np.log(0.05), 0.5, 40), rng.lognormal(np.log(0.005), 0.5, 40)
     counts = _measure_free.neyman_allocation([carrying, quiet], np.array([0.01, 0.01]), 2.0e-3, 101)
-    assert counts.sum() == 101 and counts[0] > 3 * counts[1]  # the quiet one keeps a share: none of its 40 runs is beyond, p = 0.5/41
+    assert counts.sum() == 101 and counts[1] <= 1  # the quiet one's lognormal puts almost nothing beyond the level
     # two alike ruptures, one twice as frequent: twice the runs (n_r ∝ ν_r at equal p_r)
     counts = _measure_free.neyman_allocation([carrying, carrying.copy()], np.array([0.02, 0.01]), 2.0e-3, 90)
     assert counts.tolist() == [60, 30]

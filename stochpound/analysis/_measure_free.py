@@ -23,12 +23,13 @@ at which the sum first exceeds λ_target.
 
 *Importance over ruptures* (``extra``): a first stage of ``motions`` runs
 per rupture, then ``extra`` more shared out by Neyman allocation,
-n_r ∝ ν_r √(p_r (1 − p_r)) with p_r = (k_r + ½)/(n_r + 1) from the first
-stage's k_r runs beyond its g* of the rarest target: the ruptures that
-carry the rate at the target get the runs. The estimate pools both stages
-(the allocation depends on the first stage: a two-stage design, its bias
-of the order of the first stage's noise in the allocation, not of the
-estimate).
+n_r ∝ ν_r √(p_r (1 − p_r)), p_r = Φc((ln x* − m_r)/s_r) at the first
+stage's level x* of the rarest target, m_r and s_r the mean and standard
+deviation of ln D over rupture r's first-stage runs (a lognormal fit, used
+to allocate only: it resolves the small p_r of frequent distant ruptures
+that a few runs' counts cannot): the ruptures that carry the rate at the
+target get the runs. The estimate pools both stages and stays the count
+above (the allocation, not the estimate, depends on the first stage).
 
 *Interval*: the stratified bootstrap over motions within each rupture
 (each rupture's runs resampled with replacement, ``bootstrap`` times, the
@@ -53,6 +54,7 @@ from typing import Any, Callable, Sequence
 
 import numpy as np
 import xarray as xr
+from scipy.special import ndtr
 
 from stochpound._errors import SiteError
 from stochpound.analysis._subset_simulation import RESPONSES, _reader
@@ -74,8 +76,10 @@ THRESHOLDS = 200
 METHOD = ("stratified Monte Carlo over the site's ruptures: lambda(D > x) = sum_r nu_r (1/n_r) #{D_ri > x}, "
           "n_r runs of simulated motions of rupture r (site_motions of its magnitude, R_rup, the site's Vs30 and its mechanism)")
 INTERVAL = "stratified bootstrap over the motions within each rupture (rates nu_r taken as given), percentile interval"
-ALLOCATION = ("Neyman allocation of the extra runs, n_r proportional to nu_r sqrt(p_r (1 - p_r)), p_r = (k_r + 1/2)/(n_r + 1) "
-              "from the first stage's runs beyond its level at the rarest target")
+ALLOCATION = ("Neyman allocation of the extra runs, n_r proportional to nu_r sqrt(p_r (1 - p_r)), p_r from a lognormal fit of the "
+              "rupture's first-stage responses at the first stage's level of the rarest target")
+SPREAD_FLOOR = 0.05
+"""Smallest standard deviation of ln D taken in the allocation's lognormal fit (runs that barely differ)."""
 
 
 @dataclass(frozen=True)
@@ -336,14 +340,24 @@ def response_reader(scene: Scene, response: str, building: str | None, floor: in
 def neyman_allocation(values: Sequence[np.ndarray], rates: np.ndarray, target_rate: float, extra: int) -> np.ndarray:
     """Extra runs per rupture, ∝ ν_r √(p_r (1 − p_r)) at the first stage's level of ``target_rate`` (module docstring), summing to ``extra``."""
     level = _levels(values, rates, np.array([target_rate]))[0]
-    beyond = np.array([np.count_nonzero(v >= level) for v in values], dtype=float)
-    n = np.array([v.size for v in values], dtype=float)
-    p = (beyond + 0.5) / (n + 1.0)
+    p = np.array([_lognormal_exceedance(v, level) for v in values])
     spread = rates * np.sqrt(p * (1.0 - p))
+    if not spread.sum() > 0.0:
+        spread = rates.astype(float)
     share = extra * spread / spread.sum()
     counts = np.floor(share).astype(int)
     counts[np.argsort(-(share - counts), kind="stable")[: extra - counts.sum()]] += 1  # largest remainders
     return counts
+
+
+def _lognormal_exceedance(values: np.ndarray, level: float) -> float:
+    """P(D > level) of the lognormal fitted to the positive responses (0 without any, or at a level <= 0: 1)."""
+    if level <= 0.0:
+        return 1.0
+    logs = np.log(values[values > 0.0])
+    if logs.size < 2:
+        return 0.0
+    return float(ndtr((logs.mean() - math.log(level)) / max(float(logs.std(ddof=1)), SPREAD_FLOOR)))
 
 
 def _weights(values: Sequence[np.ndarray], rates: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
