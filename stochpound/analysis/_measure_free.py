@@ -22,14 +22,16 @@ smallest x with λ̂(x) ≤ λ_target: walking down the runs' responses
 at which the sum first exceeds λ_target.
 
 *Importance over ruptures* (``extra``): a first stage of ``motions`` runs
-per rupture, then ``extra`` more shared out by Neyman allocation,
-n_r ∝ ν_r √(p_r (1 − p_r)), p_r = Φc((ln x* − m_r)/s_r) at the first
-stage's level x* of the rarest target, m_r and s_r the mean and standard
-deviation of ln D over rupture r's first-stage runs (a lognormal fit, used
-to allocate only: it resolves the small p_r of frequent distant ruptures
-that a few runs' counts cannot): the ruptures that carry the rate at the
-target get the runs. The estimate pools both stages and stays the count
-above (the allocation, not the estimate, depends on the first stage).
+per rupture, then ``extra`` more in :data:`ROUNDS` rounds, each shared out
+by Neyman allocation on all the runs before it, n_r ∝ ν_r √(p_r (1 − p_r)),
+at the level x* of the rarest target estimated from those runs; p_r is the
+larger of rupture r's fraction of runs at or beyond x* and
+Φc((ln x* − m_r)/s_r), m_r and s_r the mean and standard deviation of ln D
+over its runs (a lognormal fit, used to allocate only: it resolves the
+small p_r of frequent distant ruptures that a few runs' counts cannot). The
+ruptures that carry the rate at the target get the runs. The estimate pools
+all rounds and stays the count above (the allocation, not the estimate,
+depends on the earlier runs).
 
 *Interval*: the stratified bootstrap over motions within each rupture
 (each rupture's runs resampled with replacement, ``bootstrap`` times, the
@@ -76,8 +78,10 @@ THRESHOLDS = 200
 METHOD = ("stratified Monte Carlo over the site's ruptures: lambda(D > x) = sum_r nu_r (1/n_r) #{D_ri > x}, "
           "n_r runs of simulated motions of rupture r (site_motions of its magnitude, R_rup, the site's Vs30 and its mechanism)")
 INTERVAL = "stratified bootstrap over the motions within each rupture (rates nu_r taken as given), percentile interval"
-ALLOCATION = ("Neyman allocation of the extra runs, n_r proportional to nu_r sqrt(p_r (1 - p_r)), p_r from a lognormal fit of the "
-              "rupture's first-stage responses at the first stage's level of the rarest target")
+ALLOCATION = ("Neyman allocation of the extra runs in rounds, n_r proportional to nu_r sqrt(p_r (1 - p_r)) at the level of the rarest "
+              "target from the runs before, p_r the larger of the rupture's fraction beyond it and its lognormal fit's")
+ROUNDS = 3
+"""Rounds the extra runs come in, each allocated on all the runs before it."""
 SPREAD_FLOOR = 0.05
 """Smallest standard deviation of ln D taken in the allocation's lognormal fit (runs that barely differ)."""
 
@@ -143,7 +147,7 @@ def measure_free_risk(
         Runs of each rupture in the first stage (>= 2).
     extra : int
         Further runs (>= 0) shared out over the ruptures by Neyman allocation
-        at the first stage's level of the rarest target (module docstring).
+        at the level of the rarest target, in rounds (module docstring).
     seed : int
         Seed (>= 0) of the motions: the same seed gives the same runs and result.
     building, floor, contact
@@ -215,9 +219,9 @@ def measure_free_risk(
     ruptures = [_rupture(site, index, outside, seed, motions + extra, dt, model) for index in range(len(site))]
     run = _Runner(scene, reading, ruptures, motions + extra, dt, model, workers)
     values = run([range(motions)] * len(site))
-    if extra:
-        counts = neyman_allocation(values, np.asarray(site.rate), float(target_rates.min()), extra)
-        more = run([range(motions, motions + count) for count in counts])
+    for step in range(ROUNDS if extra else 0):
+        counts = neyman_allocation(values, np.asarray(site.rate), float(target_rates.min()), extra * (step + 1) // ROUNDS - extra * step // ROUNDS)
+        more = run([range(v.size, v.size + count) for v, count in zip(values, counts)])
         values = [np.concatenate(pair) for pair in zip(values, more)]
     result = _estimate(values, np.asarray(site.rate), target_rates, thresholds, confidence, bootstrap, seed,
                        np.array([bool(r.clamped) for r in ruptures]))
@@ -340,7 +344,7 @@ def response_reader(scene: Scene, response: str, building: str | None, floor: in
 def neyman_allocation(values: Sequence[np.ndarray], rates: np.ndarray, target_rate: float, extra: int) -> np.ndarray:
     """Extra runs per rupture, ∝ ν_r √(p_r (1 − p_r)) at the first stage's level of ``target_rate`` (module docstring), summing to ``extra``."""
     level = _levels(values, rates, np.array([target_rate]))[0]
-    p = np.array([_lognormal_exceedance(v, level) for v in values])
+    p = np.array([max(_lognormal_exceedance(v, level), np.count_nonzero(v >= level) / v.size) for v in values])
     spread = rates * np.sqrt(p * (1.0 - p))
     if not spread.sum() > 0.0:
         spread = rates.astype(float)
