@@ -230,10 +230,10 @@ def measure_free_risk(
         "extra": int(extra), "years": float(years), "confidence": float(confidence), "bootstrap": int(bootstrap), "outside": outside,
         "dt": float(dt), "model": model, "model_provenance": site_model_provenance(model), "method": METHOD, "interval": INTERVAL,
         "allocation": ALLOCATION if extra else "the same runs for every rupture", "site": site.describe(),
-        "targets": np.asarray(targets_or_default(targets), dtype=float)})
+        "targets": np.asarray(_targets_or_default(targets), dtype=float)})
 
 
-def targets_or_default(targets: Sequence[float] | None) -> Sequence[float]:
+def _targets_or_default(targets: Sequence[float] | None) -> Sequence[float]:
     """The target probabilities: those given, or the risk chain's (``stochpound.risk.TARGETS``)."""
     if targets is not None:
         return targets
@@ -243,7 +243,7 @@ def targets_or_default(targets: Sequence[float] | None) -> Sequence[float]:
 
 
 def _target_rates(targets: Sequence[float] | None, years: float) -> np.ndarray:
-    values = np.atleast_1d(np.asarray(targets_or_default(targets), dtype=float))
+    values = np.atleast_1d(np.asarray(_targets_or_default(targets), dtype=float))
     if values.ndim != 1 or not values.size or not np.all((values > 0.0) & (values < 1.0)):
         raise ValueError(f"targets: must be one or more probabilities in (0, 1), got {targets!r}")
     if isinstance(years, bool) or not isinstance(years, (int, float)) or not 0.0 < years < math.inf:
