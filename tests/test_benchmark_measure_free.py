@@ -1,0 +1,30 @@
+"""The measure-free benchmark's scenes are the risk flagship's, and its command writes its section (benchmarks/measure_free.py)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from benchmarks import measure_free
+
+
+def test_the_scenes_are_the_flagship_s_contact_free_with_the_neighbour_and_base_asked_for():
+    fixed = measure_free.flagship_scene("fixed_pair.toml", measure_free.FLEXIBLE, None)
+    isolated = measure_free.flagship_scene("isolated.toml", measure_free.STIFF, 0.05)
+    assert all(math.isinf(contact.gap) for scene in (fixed, isolated) for contact in scene.contacts)
+    assert fixed.buildings[0].base is None and isolated.buildings[0].base is not None and not isolated.walls
+    np.testing.assert_allclose(fixed.buildings[1].stiffness, measure_free.FLEXIBLE)
+    np.testing.assert_allclose(isolated.buildings[1].stiffness, measure_free.STIFF)
+
+
+@pytest.mark.slow
+def test_a_reduced_run_writes_the_section_with_every_configuration_and_target(tmp_path):
+    out = tmp_path / "benchmarks.md"
+    out.write_text("# Benchmarks\n")
+    assert measure_free.main(["--motions", "2", "--extra", "6", "--bootstrap", "100", "--out", str(out)]) == 0
+    section = measure_free.SECTION.kept(out.read_text())
+    rows = [line for line in section.splitlines() if line.startswith("| ") and "in 50 yr" in line]
+    assert len(rows) == 2 * len(measure_free.CONFIGURATIONS)
+    assert all(" 42 |" in row for row in rows)  # 18 ruptures x 2 + 6 runs
