@@ -2,7 +2,7 @@
 
 Tests import their shared builders from here (``from tests.helpers import
 ...``), never from another test module or from ``conftest.py``, which holds
-fixtures only; the reference study's buildings and pairs are
+fixtures (and the hooks that order the run) only; the reference study's buildings and pairs are
 :mod:`stochpound.studies.agarwal2004`'s (``study_scene``, ``reference_building``,
 ``study_contacts``). The benchmarks import nothing of the tests.
 """

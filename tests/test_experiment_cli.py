@@ -105,7 +105,8 @@ def test_an_installed_copy_records_its_version_and_sources(tmp_path):
     assert git_commit(copy) == "none"
     assert sources_sha256(copy) == sources_sha256(PACKAGE)
     experiment = write_experiment(tmp_path, TINY_EXPERIMENT, "tiny.toml")
-    env = {**os.environ, "PYTHONPATH": str(copy.parent)}
+    # the engine run by Python (NUMBA_DISABLE_JIT): the copy's cache is empty, and its cold compile (tens of seconds) is not what this checks
+    env = {**os.environ, "PYTHONPATH": str(copy.parent), "NUMBA_DISABLE_JIT": "1"}
     command = [sys.executable, "-m", "stochpound", "experiment", "run", str(experiment), "--workers", "0", "--quiet"]
     subprocess.run(command, check=True, capture_output=True, env=env, cwd=tmp_path)  # not the checkout's folder: python -m looks there first
     with xr.open_dataset(tmp_path / "tiny.nc") as store:
