@@ -106,10 +106,16 @@ def estimate_run(experiment: Experiment, motion_grids: Mapping[str, tuple[float,
     """
     store = layout(experiment, motion_grids, 0)
     histories = sum(spec.dtype.itemsize * math.prod(store.sizes[d] for d in spec.dims) for spec in store.of("history"))
+    return RunEstimate(cases, cpu_seconds(experiment, motion_grids, cases), file_bytes(store, {"definition": canonical_json(experiment.definition)}), histories,
+                       startup_steps(cases, workers))
+
+
+def startup_steps(cases: int, workers: int) -> tuple[tuple[str, float | None], ...]:
+    """:attr:`RunEstimate.startup` of a run of ``cases`` cases on a local cluster of ``workers`` (0: none)."""
     startup = [(COMPILE, first_call.measured("compile"))] if cases and not first_call.engine_cached() else []
     if cases:
         startup.append((startup_step(workers), first_call.measured(startup_step(workers))))
-    return RunEstimate(cases, cpu_seconds(experiment, motion_grids, cases), file_bytes(store, {"definition": canonical_json(experiment.definition)}), histories, tuple(startup))
+    return tuple(startup)
 
 
 def cpu_seconds(experiment: Experiment, motion_grids: Mapping[str, tuple[float, int]], cases: int) -> float:

@@ -1,7 +1,7 @@
 """``experiment run``: the missing cases of an experiment, on dask, into its store.
 
 The client (this process) validates everything, checks the store, writes the
-store file once before the first case, submits batches of cases
+store file once before the first case (a small run in this process: at its end only), submits batches of cases
 (:mod:`stochpound.experiment._batches`) with a bounded number in flight,
 writes finished cases to part files as results arrive (one per
 :data:`~stochpound.experiment._parts.PART_REALIZATIONS` realizations or a few seconds),
@@ -22,7 +22,7 @@ import sys
 import threading
 import time
 from contextlib import contextmanager
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from multiprocessing import forkserver
 from pathlib import Path
 from typing import Any, Callable, Iterable, Iterator
@@ -31,7 +31,7 @@ from stochpound import __version__
 from stochpound._signals import handling
 from stochpound.experiment._batches import automatic_size, make_batches
 from stochpound.experiment._compute import BatchResult, BatchTask, run_batch, warm_up
-from stochpound.experiment._estimate import LARGE_RUN_BYTES, LARGE_RUN_CASES, cpu_seconds, estimate_run, startup_step
+from stochpound.experiment._estimate import LARGE_RUN_BYTES, LARGE_RUN_CASES, RunEstimate, cpu_seconds, estimate_run, startup_step, startup_steps
 from stochpound.experiment._grid import Experiment
 from stochpound.experiment._parts import FolderLock, PartBuffer, append_run, parts_folder, remove_temporaries
 from stochpound.experiment._session import StoreSession, check_store, check_store_path, clear_store, code_identity, machine, missing_summaries, now, store_complete, stored_definition
@@ -231,7 +231,7 @@ def run_experiment(
     elif store.is_dir():
         raise ExperimentError(f"{store}: is a folder; --store must name a file")
     grids = {label: m.grid for label, m in motions.items()}
-    _check_size(experiment, grids, store, restart, large_ok, _cores(workers, scheduler))
+    checked = _check_size(experiment, grids, store, restart, large_ok, _cores(workers, scheduler))
     parts_folder(store).mkdir(parents=True, exist_ok=True)
     lock = FolderLock(parts_folder(store))
     if not lock.acquire():
@@ -251,14 +251,15 @@ def run_experiment(
         if repair:
             say(f"{store}: damaged; rebuilding it from the {report.done_before} finished cases in {session.folder.name}/")
         if report.done_before < report.total:
-            say(estimate_run(experiment, grids, report.total - report.done_before, _local_workers(workers, scheduler)).describe(_cores(workers, scheduler)))
+            say(_estimate(experiment, grids, report.total - report.done_before, _local_workers(workers, scheduler), checked).describe(_cores(workers, scheduler)))
         if small:
             say("running in this process, without dask: a run this small ends sooner than local workers would start (--workers N starts N)")
         cold = not first_call.engine_cached()
         identity = code_identity()
         append_run(session.folder, {"started": now(), "machine": machine(), "executor": report.executor, **identity})
         missing = session.missing()
-        session.rebuild()
+        if not small:  # a small run's store is written at its end (its parts keep the finished cases meanwhile)
+            session.rebuild()
         checkpoints = _Checkpoints(checkpoint, session)
         bar: Any = _NoBar()
         realizations = sum(len(experiment.realizations(label)) for label in experiment.motions)
@@ -324,10 +325,11 @@ def _busy(store: Path) -> ExperimentError:
     return ExperimentError(f"{store}: another run is writing this store (its parts folder is locked)")
 
 
-def _check_size(experiment: Experiment, grids: dict[str, tuple[float, int]], store: Path, restart: bool, large_ok: bool, cores: int) -> None:
-    """Refuse a large run (:attr:`RunEstimate.large`, its finished cases not counted) unless ``large_ok``."""
+def _check_size(experiment: Experiment, grids: dict[str, tuple[float, int]], store: Path, restart: bool, large_ok: bool,
+                cores: int) -> RunEstimate | None:
+    """Refuse a large run (:attr:`RunEstimate.large`, its finished cases not counted) unless ``large_ok``; the estimate made (None if none)."""
     if large_ok:
-        return
+        return None
     estimate = estimate_run(experiment, grids, experiment.n_cases)
     if estimate.large and not restart and parts_folder(store).is_dir():
         estimate = estimate_run(experiment, grids, experiment.n_cases - PartsIndex.scan(experiment, parts_folder(store)).n_done)
@@ -336,6 +338,15 @@ def _check_size(experiment: Experiment, grids: dict[str, tuple[float, int]], sto
             f"{experiment.path or experiment.name}: {estimate.describe(cores)}; "
             f"above {LARGE_RUN_CASES:,} cases or {format_bytes(LARGE_RUN_BYTES)} of store: give --yes to run it"
         )
+    return estimate
+
+
+def _estimate(experiment: Experiment, grids: dict[str, tuple[float, int]], cases: int, workers: int, checked: RunEstimate | None) -> RunEstimate:
+    """The estimate of a run of ``cases`` cases on ``workers`` local workers: :func:`_check_size`'s (``checked``) when it counted
+    as many cases (the store's size is measured once), with this run's start-up steps."""
+    if checked is None or checked.cases != cases:
+        return estimate_run(experiment, grids, cases, workers)
+    return replace(checked, startup=startup_steps(cases, workers))
 
 
 def _record(experiment: Experiment, report: RunReport, buffer: PartBuffer, task: BatchTask, result: BatchResult) -> None:
