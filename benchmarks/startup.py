@@ -1,7 +1,9 @@
 """The quick start's start-up, from an empty and from a warm numba cache: ``python -m benchmarks startup``.
 
-Runs the README's quick start (``experiments/quickstart.toml`` on a local
-dask cluster of one worker per core, into a temporary store) in fresh
+Runs the README's quick start (``experiments/quickstart.toml`` with the
+default workers, into a temporary store: wherever the tree runs it, a
+local dask cluster of one worker per core or, for a run this small, the
+process itself) in fresh
 processes: first with numba's cache in an empty folder (``NUMBA_CACHE_DIR``:
 the first run on a new machine compiles the solver), then again with the
 cache that run filled. Each run is timed from its process's start (the
@@ -53,7 +55,7 @@ began = time.time()
 report = run_experiment(experiment, sys.argv[2], progress=False)
 assert report.complete, report
 print(json.dumps({"first_case": began - born + report.setup, "before_run": began - born, "setup": report.setup,
-                  "running": report.elapsed - report.setup}))
+                  "running": report.elapsed - report.setup, "executor": report.executor}))
 """
 """Run in a fresh interpreter: the quick start into the store ``argv[2]``; prints its times (s) as JSON."""
 
@@ -110,7 +112,7 @@ def section(results: dict[str, Any], info: dict[str, str]) -> str:
         SECTION.start,
         "## Start-up",
         "",
-        f"The README's quick start (`stochpound experiment run {EXPERIMENT}`: {_workers()} local workers) in fresh processes, "
+        f"The README's quick start (`stochpound experiment run {EXPERIMENT}`, default workers) in fresh processes, "
         "first with numba's cache in an empty folder, then with the cache that run filled; "
         f"commit {info['commit']}, {info['date']}, in {results['elapsed']:.0f} s (load average {info['load average (1 min) at start']} "
         f"at the start, {results['load_end']} at the end). *First case*: from the process's start (interpreter, imports and the "
@@ -118,6 +120,8 @@ def section(results: dict[str, Any], info: dict[str, str]) -> str:
         "*load*: the 1-minute load average before the run. Other work on the machine slows every run (with a load above the number of cores, "
         "several times over), while the targets are an idle machine's: on a shared machine the ratios of two trees timed in the same session "
         "(`--against`) are what the runs show reliably. `python -m benchmarks startup [--against REV]` rewrites this section.",
+        "",
+        "Where the cases ran: " + "; ".join(f"{name}: {_executors(rounds[name])}" for name in names) + ".",
         "",
         "| tree | round | numba cache | first case (s) | of which start-up (s) | running (s) | load |",
         "|---|---|---|---:|---:|---:|---:|",
@@ -142,5 +146,6 @@ def _median(rows: list[dict[str, Any]], state: str) -> float:
     return statistics.median(row["first_case"] for row in rows if row["cache"] == state)
 
 
-def _workers() -> int:
-    return os.cpu_count() or 1
+def _executors(rows: list[dict[str, Any]]) -> str:
+    """The executors a tree's runs reported (what ``experiment run`` prints after "on")."""
+    return ", ".join(dict.fromkeys(row.get("executor", "?") for row in rows))

@@ -60,3 +60,23 @@ def test_the_warm_up_compiles_the_spectrum_s_kernel_only_when_asked():
     # numba's own cache, as the session has it: a kernel loaded from the cache counts a signature as a compiled one does
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=900, env={**os.environ, "PYTHONPATH": str(REPOSITORY)})
     assert done.returncode == 0 and done.stdout.split() == ["0", "1", "1"], done.stderr
+
+
+def test_a_small_run_given_no_workers_runs_in_this_process(tmp_path, monkeypatch):
+    """No workers given: a run whose cases are estimated under IN_PROCESS_CPU_SECONDS of CPU runs in this process, without
+    dask (said as it starts and in its report); above it, the local cluster is chosen (not started here)."""
+    from stochpound.experiment import load_experiment, run_experiment
+    from stochpound.experiment._estimate import cpu_seconds
+    from stochpound.experiment._sources import resolve_motions
+    from tests.helpers import write_experiment
+
+    experiment = load_experiment(write_experiment(tmp_path))
+    grids = {label: motion.grid for label, motion in resolve_motions(experiment).items()}
+    estimated = cpu_seconds(experiment, grids, experiment.n_cases)
+    assert 0 < estimated < _runner.IN_PROCESS_CPU_SECONDS and _runner.in_process(experiment, grids, experiment.n_cases)
+    lines: list[str] = []
+    report = run_experiment(experiment, progress=False, say=lines.append)
+    assert report.complete and report.executor == "this process (no dask) for a small run", report.executor
+    assert any(line.startswith("running in this process, without dask") for line in lines), lines
+    monkeypatch.setattr(_runner, "IN_PROCESS_CPU_SECONDS", estimated)
+    assert not _runner.in_process(experiment, grids, experiment.n_cases)

@@ -104,18 +104,34 @@ def estimate_run(experiment: Experiment, motion_grids: Mapping[str, tuple[float,
     workers : int
         Worker processes of the local cluster the run starts (0: none, the cases run in this process or on a scheduler's).
     """
-    per_point = sum(len(experiment.realizations(label)) * samples for label, (_, samples) in motion_grids.items())
-    cpu = 0.0
-    for kind in KINDS:
-        for point in experiment.points(kind):
-            cpu += per_point * CPU_SECONDS_PER_SAMPLE[_method(experiment, point)]
-    share = cases / experiment.n_cases if experiment.n_cases else 0.0
     store = layout(experiment, motion_grids, 0)
     histories = sum(spec.dtype.itemsize * math.prod(store.sizes[d] for d in spec.dims) for spec in store.of("history"))
+    return RunEstimate(cases, cpu_seconds(experiment, motion_grids, cases), file_bytes(store, {"definition": canonical_json(experiment.definition)}), histories,
+                       startup_steps(cases, workers))
+
+
+def startup_steps(cases: int, workers: int) -> tuple[tuple[str, float | None], ...]:
+    """:attr:`RunEstimate.startup` of a run of ``cases`` cases on a local cluster of ``workers`` (0: none)."""
     startup = [(COMPILE, first_call.measured("compile"))] if cases and not first_call.engine_cached() else []
     if cases:
         startup.append((startup_step(workers), first_call.measured(startup_step(workers))))
-    return RunEstimate(cases, cpu * share, file_bytes(store, {"definition": canonical_json(experiment.definition)}), histories, tuple(startup))
+    return tuple(startup)
+
+
+def cpu_seconds(experiment: Experiment, motion_grids: Mapping[str, tuple[float, int]], cases: int) -> float:
+    """The estimated CPU time (one core) of ``cases`` of the experiment's cases, s: their share of its samples at :data:`CPU_SECONDS_PER_SAMPLE`.
+
+    Parameters
+    ----------
+    experiment : Experiment
+    motion_grids : mapping of str to (float, int)
+        Sample spacing (s) and number of samples of each motion.
+    cases : int
+        Cases to run.
+    """
+    per_point = sum(len(experiment.realizations(label)) * samples for label, (_, samples) in motion_grids.items())
+    cpu = sum(per_point * CPU_SECONDS_PER_SAMPLE[_method(experiment, point)] for kind in KINDS for point in experiment.points(kind))
+    return cpu * (cases / experiment.n_cases if experiment.n_cases else 0.0)
 
 
 def startup_step(workers: int) -> str:

@@ -1,7 +1,7 @@
 """``experiment run``: the missing cases of an experiment, on dask, into its store.
 
 The client (this process) validates everything, checks the store, writes the
-store file once before the first case, submits batches of cases
+store file once before the first case (a small run in this process: at its end only), submits batches of cases
 (:mod:`stochpound.experiment._batches`) with a bounded number in flight,
 writes finished cases to part files as results arrive (one per
 :data:`~stochpound.experiment._parts.PART_REALIZATIONS` realizations or a few seconds),
@@ -22,7 +22,7 @@ import sys
 import threading
 import time
 from contextlib import contextmanager
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from multiprocessing import forkserver
 from pathlib import Path
 from typing import Any, Callable, Iterable, Iterator
@@ -31,7 +31,7 @@ from stochpound import __version__
 from stochpound._signals import handling
 from stochpound.experiment._batches import automatic_size, make_batches
 from stochpound.experiment._compute import BatchResult, BatchTask, run_batch, warm_up
-from stochpound.experiment._estimate import LARGE_RUN_BYTES, LARGE_RUN_CASES, estimate_run, startup_step
+from stochpound.experiment._estimate import LARGE_RUN_BYTES, LARGE_RUN_CASES, RunEstimate, cpu_seconds, estimate_run, startup_step, startup_steps
 from stochpound.experiment._grid import Experiment
 from stochpound.experiment._parts import FolderLock, PartBuffer, append_run, parts_folder, remove_temporaries
 from stochpound.experiment._session import StoreSession, check_store, check_store_path, clear_store, code_identity, machine, missing_summaries, now, store_complete, stored_definition
@@ -60,6 +60,11 @@ LOCAL_CLUSTER_CONFIG = {
 """dask settings of the local cluster: no statistical profiler in the workers (it samples their threads every
 10 ms), slower system monitors and event-loop ticks: idle, the cluster takes about 3 % of a core instead of 13 %;
 worker processes forked by multiprocessing's fork server (which ignores SIGINT: :func:`_start_fork_server`)."""
+IN_PROCESS_CPU_SECONDS = 3.0
+"""Below this estimated CPU time of its cases (:func:`~stochpound.experiment._estimate.cpu_seconds`), a run given
+neither workers nor a scheduler runs in this process, without dask: starting local workers takes 3–4 s on an idle
+2-core machine (they import their modules and load the compiled solver) and the estimate is low by up to a factor 2
+on small runs, whose cases are short (docs/benchmarks.md, "Start-up"). The results are the same either way."""
 WORKER_MODULES = ("distributed", "stochpound.experiment._compute")
 """The modules a local worker runs with, imported once by the fork server the workers are forked from (:func:`_start_fork_server`)."""
 
@@ -159,8 +164,9 @@ def run_experiment(
     store : str or Path, optional
         Store file (default: beside the experiment file, ``.nc``).
     workers : int, optional
-        Local dask worker processes (default: the machine's cores); 0 runs
-        every case in this process, without dask.
+        Local dask worker processes (default: the machine's cores, or none
+        when the cases' CPU time is estimated under 3 s: a small run ends
+        sooner in this process); 0 runs every case in this process, without dask.
     scheduler : str, optional
         Address of an existing dask.distributed scheduler (``tcp://host:port``).
     restart : bool
@@ -225,30 +231,35 @@ def run_experiment(
     elif store.is_dir():
         raise ExperimentError(f"{store}: is a folder; --store must name a file")
     grids = {label: m.grid for label, m in motions.items()}
-    _check_size(experiment, grids, store, restart, large_ok, _cores(workers, scheduler))
+    checked = _check_size(experiment, grids, store, restart, large_ok, _cores(workers, scheduler))
     parts_folder(store).mkdir(parents=True, exist_ok=True)
     lock = FolderLock(parts_folder(store))
     if not lock.acquire():
         raise _busy(store)
     with lock, _interrupts() as stop:
-        if _local_workers(workers, scheduler):
-            _start_fork_server()  # it imports the workers' modules while this process writes the store and compiles the solver
         if restart:
             clear_store(store)
         remove_temporaries(parts_folder(store))
         session = StoreSession.create(store, experiment, grids)
         session.scan(remove_unreadable=True)
         report = RunReport(store, experiment.n_cases, session.index.n_done, repaired=repair)
-        report.executor = _describe_executor(workers, scheduler)
+        small = workers is None and scheduler is None and in_process(experiment, grids, report.total - report.done_before)
+        workers = 0 if small else workers
+        if _local_workers(workers, scheduler):
+            _start_fork_server()  # it imports the workers' modules while this process writes the store and compiles the solver
+        report.executor = _describe_executor(workers, scheduler) + (" for a small run" if small else "")
         if repair:
             say(f"{store}: damaged; rebuilding it from the {report.done_before} finished cases in {session.folder.name}/")
         if report.done_before < report.total:
-            say(estimate_run(experiment, grids, report.total - report.done_before, _local_workers(workers, scheduler)).describe(_cores(workers, scheduler)))
+            say(_estimate(experiment, grids, report.total - report.done_before, _local_workers(workers, scheduler), checked).describe(_cores(workers, scheduler)))
+        if small:
+            say("running in this process, without dask: a run this small ends sooner than local workers would start (--workers N starts N)")
         cold = not first_call.engine_cached()
         identity = code_identity()
         append_run(session.folder, {"started": now(), "machine": machine(), "executor": report.executor, **identity})
         missing = session.missing()
-        session.rebuild()
+        if not small:  # a small run's store is written at its end (its parts keep the finished cases meanwhile)
+            session.rebuild()
         checkpoints = _Checkpoints(checkpoint, session)
         bar: Any = _NoBar()
         realizations = sum(len(experiment.realizations(label)) for label in experiment.motions)
@@ -314,10 +325,11 @@ def _busy(store: Path) -> ExperimentError:
     return ExperimentError(f"{store}: another run is writing this store (its parts folder is locked)")
 
 
-def _check_size(experiment: Experiment, grids: dict[str, tuple[float, int]], store: Path, restart: bool, large_ok: bool, cores: int) -> None:
-    """Refuse a large run (:attr:`RunEstimate.large`, its finished cases not counted) unless ``large_ok``."""
+def _check_size(experiment: Experiment, grids: dict[str, tuple[float, int]], store: Path, restart: bool, large_ok: bool,
+                cores: int) -> RunEstimate | None:
+    """Refuse a large run (:attr:`RunEstimate.large`, its finished cases not counted) unless ``large_ok``; the estimate made (None if none)."""
     if large_ok:
-        return
+        return None
     estimate = estimate_run(experiment, grids, experiment.n_cases)
     if estimate.large and not restart and parts_folder(store).is_dir():
         estimate = estimate_run(experiment, grids, experiment.n_cases - PartsIndex.scan(experiment, parts_folder(store)).n_done)
@@ -326,6 +338,15 @@ def _check_size(experiment: Experiment, grids: dict[str, tuple[float, int]], sto
             f"{experiment.path or experiment.name}: {estimate.describe(cores)}; "
             f"above {LARGE_RUN_CASES:,} cases or {format_bytes(LARGE_RUN_BYTES)} of store: give --yes to run it"
         )
+    return estimate
+
+
+def _estimate(experiment: Experiment, grids: dict[str, tuple[float, int]], cases: int, workers: int, checked: RunEstimate | None) -> RunEstimate:
+    """The estimate of a run of ``cases`` cases on ``workers`` local workers: :func:`_check_size`'s (``checked``) when it counted
+    as many cases (the store's size is measured once), with this run's start-up steps."""
+    if checked is None or checked.cases != cases:
+        return estimate_run(experiment, grids, cases, workers)
+    return replace(checked, startup=startup_steps(cases, workers))
 
 
 def _record(experiment: Experiment, report: RunReport, buffer: PartBuffer, task: BatchTask, result: BatchResult) -> None:
@@ -529,6 +550,12 @@ def _dask_client(workers: int | None, scheduler: str | None, say: Callable[[str]
             client.close(timeout=10)
         if cluster is not None:
             cluster.close(timeout=10)
+
+
+def in_process(experiment: Experiment, grids: dict[str, tuple[float, int]], cases: int) -> bool:
+    """True if ``cases`` of the experiment take less CPU time than :data:`IN_PROCESS_CPU_SECONDS` (estimated): the
+    run then ends sooner in this process than on local workers, which take seconds to start (the default's choice)."""
+    return cpu_seconds(experiment, grids, cases) < IN_PROCESS_CPU_SECONDS
 
 
 def _local_workers(workers: int | None, scheduler: str | None) -> int:
