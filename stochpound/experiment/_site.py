@@ -319,10 +319,10 @@ def fitted_site(site: Mapping[str, Any], levels: list[float], entry: Mapping[str
     for name in curves:
         measure = bundled_measure(name)
         curve = HazardCurve.bundled(name)
-        if measure["measure"] == entry["measure"] and measure.get("period") == entry.get("period"):
+        if measure.kind == entry["measure"] and measure.period == entry.get("period"):
             conditioning = curve
         else:
-            others.append((measure.get("period"), curve.im, curve.rate))
+            others.append((measure.period, curve.im, curve.rate))
     if conditioning is None:
         raise SiteError("site.curves: none of them is the curve of the conditioning measure ([intensity] measure and period)")
     if not others:

@@ -53,12 +53,12 @@ from stochpound._errors import SiteError
 from stochpound.hazard._curve import HazardCurve
 from stochpound.motions import (
     MECHANISMS,
+    Measure,
     Scenario,
     check_damping,
     conditional_distribution,
     conditioning_attrs,
     measure_distribution,
-    measure_label,
     scenario_spectrum,
     spectrum_dataset,
 )
@@ -271,7 +271,7 @@ class RuptureSite:
         mean, sigma = self.moments(measure, period)
         low, high = np.min(mean + EPSILON_RANGE[0] * sigma), np.max(mean + EPSILON_RANGE[1] * sigma)
         im = np.exp(np.linspace(low, high, points))
-        return HazardCurve(im, self.rate_of_exceedance(measure, period, im), extrapolate=extrapolate, measure=measure_label(measure, period),
+        return HazardCurve(im, self.rate_of_exceedance(measure, period, im), extrapolate=extrapolate, measure=Measure.of(measure, period).label,
                            units="g", source=self.describe())
 
     def intensity_at(self, measure: str, period: float | Sequence[float] | None, rate: Any) -> np.ndarray:
@@ -371,7 +371,7 @@ class RuptureSite:
                 "binned_share": (("level", "magnitude_bin", "distance_bin", "epsilon_bin"), binned, {"units": "1"}),
             },
             coords=coords,
-            attrs={"measure": measure_label(measure, period), "site": self.describe()},
+            attrs={"measure": Measure.of(measure, period).label, "site": self.describe()},
         )
 
     # ------------------------------------------------------------ the exact conditional spectrum

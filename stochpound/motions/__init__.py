@@ -85,7 +85,6 @@ from stochpound.motions._conditional import (  # noqa: F401
 )
 from stochpound.motions._measure import KINDS as MEASURE_KINDS, Measure
 from stochpound.motions._scenario import MECHANISMS, given_scenario  # noqa: F401
-from stochpound.motions._measures import measure_label  # noqa: F401
 from stochpound.motions._site_calibration import calibration_table, fit_calibration  # noqa: F401
 
 __all__ = [

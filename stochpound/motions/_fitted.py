@@ -55,7 +55,7 @@ from stochpound.motions._conditional import (
     _node_correlation,
 )
 from stochpound.motions._scenario import Scenario
-from stochpound.motions._measures import measure_label
+from stochpound.motions._measure import Measure
 
 #: Candidate magnitudes of the fit.
 MAGNITUDES = tuple(np.round(np.arange(5.5, 8.01, 0.1), 2))
@@ -144,7 +144,8 @@ def fit_scenarios(
         im, rate = np.asarray(im, dtype=float), np.asarray(rate, dtype=float)
         keep = (rate >= low_rate) & (rate <= high_rate)
         if not keep.any():
-            raise SiteError(f"others: the site's {measure_label('pga' if node is None else 'psa', node)} curve has no intensity whose rate is within the stripes' {low_rate:.3g}-{high_rate:.3g}/yr")
+            other = Measure("pga") if node is None else Measure("psa", float(node))
+            raise SiteError(f"others: the site's {other.label} curve has no intensity whose rate is within the stripes' {low_rate:.3g}-{high_rate:.3g}/yr")
         targets.append((im[keep], np.log(rate[keep])))
     candidates = [(m, r) for m in MAGNITUDES for r in DISTANCES]
     scores = []
