@@ -37,6 +37,9 @@ WINDOW_TAIL_PERIODS, WINDOW_ROUND = 2.0, 5.0
 def _checked(scenario: Scenario | None, loose: tuple, dt: float, model: str) -> Scenario:
     """The scenario given (:func:`~stochpound.motions._scenario.given_scenario`), checked against the calibrated range, after ``dt`` and ``model``."""
     checked = given_scenario(scenario, *loose, limits=SITE_MOTION_LIMITS, source="the site-motion model's calibrated range")
+    if checked.geometry:
+        raise SiteError(f"scenario: the site-motion model takes magnitude, distance_km, vs30 and mechanism only, not a geometry "
+                        f"({', '.join(checked.geometry)}): give the scenario without it")
     if isinstance(dt, bool) or not isinstance(dt, (int, float)) or not 0.0 < dt <= 0.02:
         raise SiteError(f"dt: must be within 0-0.02 s (the model's filter reaches 25 Hz and more), got {dt!r}")
     if model not in MODELS:
