@@ -58,6 +58,7 @@ from stochpound.motions import (
     check_damping,
     conditional_distribution,
     conditioning_attrs,
+    conditioning_measure,
     measure_distribution,
     scenario_spectrum,
     spectrum_dataset,
@@ -427,7 +428,7 @@ class RuptureSite:
         unconditional = np.array([part.unconditional_mean_ln for part in parts])
         unconditional_mean = p @ unconditional
         unconditional_var = p @ (np.array([part.unconditional_sigma_ln for part in parts]) ** 2 + (unconditional - unconditional_mean) ** 2)
-        attrs = {"epsilon": float(p @ epsilon), **conditioning_attrs(measure, period, level), **self.mean_scenario(p),
+        attrs = {"epsilon": float(p @ epsilon), **conditioning_attrs(conditioning_measure(measure, period), level), **self.mean_scenario(p),
                  "weights": WEIGHT_TEXT[weights], "ruptures": len(self), "site": self.name or "a site of ruptures"}
         target = spectrum_dataset(parts[0].periods, mean, within + between, unconditional_mean, np.sqrt(unconditional_var), attrs)
         target["between_sigma_ln"] = ("period", np.sqrt(np.clip(np.diag(between), 0.0, None)),

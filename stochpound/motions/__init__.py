@@ -79,6 +79,7 @@ from stochpound.motions._conditional import (  # noqa: F401
     check_damping,
     conditional_distribution,
     conditioning_attrs,
+    conditioning_measure,
     measure_distribution,
     scenario_spectrum,
     spectrum_dataset,

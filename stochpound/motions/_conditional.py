@@ -50,6 +50,7 @@ import numpy as np
 import xarray as xr
 
 from stochpound._errors import SiteError
+from stochpound.motions._measure import Measure
 from stochpound.motions._scenario import GEOMETRY_FIELDS, MECHANISMS, Scenario, given_scenario, ground_motion_models, is_finite_number
 
 #: Measures a conditional spectrum can be conditioned on.
@@ -128,21 +129,27 @@ def _check_periods(values: Sequence[float], field: str) -> np.ndarray:
     return periods
 
 
-def _conditioning_nodes(measure: str, period: float | Sequence[float] | None) -> list[float | None]:
-    """The nodes (a period in s, or None for PGA) the measure averages ln Sa over, after checking ``measure`` and ``period``."""
+def conditioning_measure(measure: str, period: float | Sequence[float] | None) -> Measure:
+    """The measure a conditional spectrum can be conditioned on (:data:`CONDITIONING_MEASURES`, periods within
+    :data:`PERIOD_RANGE`), or a one-line :class:`SiteError` naming ``measure`` or ``period``."""
     if measure not in CONDITIONING_MEASURES:
         raise SiteError(f"measure: must be one of {', '.join(CONDITIONING_MEASURES)} (no PGV–Sa correlation in the model), got {measure!r}")
     if measure == "pga":
         if period is not None:
             raise SiteError(f"period: pga takes no period, got {period!r}")
-        return [None]
+        return Measure("pga")
     if measure == "psa":
         if period is None or np.ndim(period) != 0:
             raise SiteError(f"period: psa needs one period T* in s, got {period!r}")
-        return list(_check_periods([period], "period"))
+        return Measure("psa", float(_check_periods([period], "period")[0]))
     if period is None or np.ndim(period) != 1 or len(period) < 2:
         raise SiteError(f"period: sa_avg needs a list of at least 2 periods in s, got {period!r}")
-    return list(_check_periods(period, "period"))
+    return Measure("sa_avg", periods=tuple(float(p) for p in _check_periods(period, "period")))
+
+
+def _conditioning_nodes(measure: Measure) -> list[float | None]:
+    """The nodes (a period in s, or None for PGA) the measure averages ln Sa over."""
+    return [None] if measure.kind == "pga" else [measure.period] if measure.kind == "psa" else list(measure.periods)
 
 
 def _joint_nodes(conditioning: Sequence[float | None], output: Sequence[float | None]) -> tuple[list[float | None], np.ndarray]:
@@ -220,13 +227,13 @@ def scenario_distribution(measure: str, period: float | Sequence[float] | None =
     SiteError
         Naming the field, as :func:`conditional_spectrum`.
     """
-    conditioning = _conditioning_nodes(measure, period)
+    conditioning = _conditioning_nodes(conditioning_measure(measure, period))
     return _measure_moments(conditioning, given_scenario(scenario, magnitude, distance_km, vs30, mechanism, geometry))
 
 
 def measure_distribution(measure: str, period: float | Sequence[float] | None, scenario: Scenario) -> tuple[float, float]:
     """:func:`scenario_distribution` in a scenario already checked against the models' range (a site's rupture)."""
-    return _measure_moments(_conditioning_nodes(measure, period), scenario)
+    return _measure_moments(_conditioning_nodes(conditioning_measure(measure, period)), scenario)
 
 
 def _measure_moments(conditioning: list[float | None], scenario: Scenario) -> tuple[float, float]:
@@ -262,7 +269,7 @@ def conditional_distribution(
 def _checked_inputs(measure: str, period: float | Sequence[float] | None, levels: float | Sequence[float],
                     periods: Sequence[float]) -> tuple[list[float | None], np.ndarray]:
     """The measure's nodes (:func:`_conditioning_nodes`) and the output periods (s), after checking them and the levels."""
-    conditioning = _conditioning_nodes(measure, period)
+    conditioning = _conditioning_nodes(conditioning_measure(measure, period))
     for level in np.atleast_1d(levels).tolist():
         _check_level(level)
     output = _check_periods(periods, "periods")
@@ -308,9 +315,10 @@ def spectrum_dataset(periods: np.ndarray, mean_ln: np.ndarray, covariance: np.nd
 MODELS_TEXT = "ASK14 BSSA14 CB14 CY14 (pygmm), mean of ln medians, sigma = rms of sigmas; Baker-Jayaram 2008 correlation"
 
 
-def conditioning_attrs(measure: str, period: float | Sequence[float] | None, level: float) -> dict[str, object]:
+def conditioning_attrs(measure: Measure, level: float) -> dict[str, object]:
     """The attributes of a conditional spectrum that name its conditioning: ``measure``, ``conditioning_period``, ``level``, ``damping``, ``models``."""
-    return {"measure": measure, "conditioning_period": "" if period is None else " ".join(f"{p:g}" for p in np.atleast_1d(period)),
+    period = measure.spectral_period
+    return {"measure": measure.kind, "conditioning_period": "" if period is None else " ".join(f"{p:g}" for p in np.atleast_1d(period)),
             "level": float(level), "damping": MODEL_DAMPING, "models": MODELS_TEXT}
 
 
@@ -379,4 +387,4 @@ def conditional_spectrum(
     scenario = given_scenario(scenario, magnitude, distance_km, vs30, mechanism, geometry)
     target = _distribution(conditioning, output, level, scenario)
     return spectrum_dataset(target.periods, target.mean_ln[0], target.covariance, target.unconditional_mean_ln, target.unconditional_sigma_ln,
-                            {"epsilon": float(target.epsilon[0]), **conditioning_attrs(measure, period, level), **scenario.attrs()})
+                            {"epsilon": float(target.epsilon[0]), **conditioning_attrs(conditioning_measure(measure, period), level), **scenario.attrs()})

@@ -51,6 +51,7 @@ from stochpound.motions._conditional import (
     _average_model,
     _conditioned,
     _conditioning_nodes,
+    conditioning_measure,
     _joint_nodes,
     _node_correlation,
 )
@@ -170,7 +171,7 @@ class _SiteModel:
     def __init__(self, measure: str, period: float | Sequence[float] | None, levels: np.ndarray,
                  others: Sequence[tuple[float | None, Sequence[float], Sequence[float]]]) -> None:
         other_nodes = [None if node is None else float(node) for node, _, _ in others]
-        self.nodes, self.weights = _joint_nodes(_conditioning_nodes(measure, period), other_nodes)
+        self.nodes, self.weights = _joint_nodes(_conditioning_nodes(conditioning_measure(measure, period)), other_nodes)
         self.correlation = _node_correlation(self.nodes)
         self.levels, self.count = levels, len(other_nodes)
 
