@@ -270,7 +270,7 @@ def _check_measure(where: str, stated: Mapping[str, Any], intensity: Mapping[str
     wanted = _measure_of(intensity)
     for key, value in stated.items():
         field = where if bundled else _field(where, key)
-        what = f"{bundled!r} is {describe_measure({**wanted, **stated})}" if bundled else f"the hazard's {key} is {value!r}"
+        what = f"{bundled!r} is {describe_measure(stated)}" if bundled else f"the hazard's {key} is {value!r}"
         if key not in wanted or not _equal(value, wanted[key]):
             detail = f" (intensity.{key} = {wanted[key]!r})" if key in wanted else ""
             raise IntensityError(f"{field}: the hazard's measure must be [intensity]'s, {describe_measure(intensity)}{detail}; {what}")
