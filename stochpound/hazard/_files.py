@@ -74,7 +74,7 @@ class StatedMeasure:
     damping : float or None
         The damping ratio of a spectral measure.
     units : str or None
-        The units of the intensities (a key of :data:`UNITS`).
+        The units of the intensities: ``g``, ``m/s2``, ``cm/s2``, ``m/s`` or ``cm/s``.
     """
 
     kind: str | None = None

@@ -110,7 +110,7 @@ class RuptureSite:
     name, source : str
         The site's name and provenance (a file's comment lines); two sites of the same ruptures are equal whatever their names.
     row_names : sequence of mapping, optional
-        Per rupture, how its fields are named in an error (a file's line, :func:`read_ruptures`); default ``ruptures[i].column``.
+        Per rupture, how its fields are named in an error (a rupture table's file and line); default ``ruptures[i].column``.
 
     Raises
     ------

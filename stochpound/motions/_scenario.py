@@ -157,8 +157,8 @@ class Scenario:
            source: str = MODELS_RANGE) -> Scenario:
         """The scenario of loose fields and a ``geometry`` mapping (:data:`GEOMETRY_FIELDS`, None values left to the estimates).
 
-        ``names`` spells a field in the messages (e.g. ``site.magnitude``); ``limits`` (default
-        :func:`scenario_limits`) are the ranges of magnitude, distance_km and vs30, ``source`` says whose.
+        ``names`` spells a field in the messages (e.g. ``site.magnitude``); ``limits`` (default: the four NGA-West2
+        models' common range) are the ranges of magnitude, distance_km and vs30, ``source`` says whose.
 
         Raises
         ------
@@ -171,13 +171,14 @@ class Scenario:
 
     def check(self, *, names: Mapping[str, str] | None = None, limits: Mapping[str, tuple[float, float]] | None = None,
               source: str = MODELS_RANGE) -> Scenario:
-        """The scenario itself, once checked against ``limits`` (default :func:`scenario_limits`; ``source`` says whose).
+        """The scenario itself, once checked against ``limits`` (default: the four NGA-West2 models' common range; ``source`` says whose).
 
         Raises
         ------
         stochpound.SiteError
             Naming the field (as ``names`` spells it): a magnitude, distance or Vs30 outside ``limits``, an
-            unknown mechanism, a geometry outside :func:`geometry_limits`.
+            unknown mechanism, a geometry outside the models' common range (0 ≤ R_JB ≤ R_rup, R_x within ±300 km, Z_tor 0–20 km,
+            dip 15–90°, Z2.5 0–10 km, Z1.0 ≥ 0).
         """
         _check(self.loose(), self.geometry, names or {}, limits, source)
         return self
