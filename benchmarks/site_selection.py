@@ -95,9 +95,9 @@ def report(measure: str, configuration: str, max_scale_factor: float, folder: Pa
         lognormal = _lognormal_recomputed(scaled, hazard, HazardCurve.bundled(name))
         site = [(period, HazardCurve.bundled(name).im, HazardCurve.bundled(name).rate)]
         scenarios = [{key: s[key] for key in ("magnitude", "distance_km", "vs30", "mechanism")} for s in stripes]
-        on_stripes = recomputed_hazard(conditioning["measure"], conditioning.get("period"), levels, stripe_rate_weights(levels, hazard), scenarios, site)[0]
+        on_stripes = recomputed_hazard(conditioning.kind, conditioning.period, levels, stripe_rate_weights(levels, hazard), scenarios, site)[0]
         nearest = [scenarios[int(np.argmin(np.abs(np.log(levels) - np.log(x))))] for x in fine]
-        on_fine = recomputed_hazard(conditioning["measure"], conditioning.get("period"), fine, stripe_rate_weights(fine, hazard), nearest, site)[0]
+        on_fine = recomputed_hazard(conditioning.kind, conditioning.period, fine, stripe_rate_weights(fine, hazard), nearest, site)[0]
         lines.append(f"{other}: motions {_ratios(from_motions['recomputed'].values, name)} (lognormal {_ratios(lognormal, name)}), spectra on the stripes {_ratios(on_stripes, name)}, "
                      f"on the fine grid {_ratios(on_fine, name)}")
     print("  recomputed / site at 10 %/2 % in 50 yr:", "; ".join(lines))

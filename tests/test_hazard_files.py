@@ -12,8 +12,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from stochpound.analysis import HazardCurve
+from stochpound.analysis import HazardCurve, bundled_measure
+from stochpound.motions import Measure
 from stochpound.hazard._files import (
+    StatedMeasure,
     parse_measure,
     read_hazard_file,
     unit_factor,
@@ -41,6 +43,26 @@ def test_parse_measure_reads_the_usual_spellings():
         parse_measure("MMI")
 
 
+def test_a_stated_measure_is_a_value_with_what_the_text_leaves_out_left_none():
+    """The parser's one result: a frozen value whose entry() is parse_measure's keys, a Measure once kind and period are stated."""
+    stated = StatedMeasure.parse("PSA(2.0 s, 5 %) in m/s²")
+    assert stated == StatedMeasure("psa", 2.0, damping=0.05, units="m/s2") and hash(stated) == hash(StatedMeasure.from_entry(stated.entry()))
+    assert stated.entry() == parse_measure("PSA(2.0 s, 5 %) in m/s²")
+    assert stated.measure == Measure("psa", 2.0, damping=0.05)
+    partial = StatedMeasure.parse("spectral acceleration")
+    assert (partial.kind, partial.period, partial.units, partial.measure) == ("psa", None, None, None)
+    assert StatedMeasure.parse("SA(0.2)").measure.description == "PSA(T = 0.2 s)"  # no damping stated: none described
+    assert StatedMeasure.of(bundled_measure("fox_plaza_los_angeles_pga"), "g") == StatedMeasure.parse("PGA in g")
+
+
+def test_bundled_curves_name_their_measure_as_a_value():
+    measure = bundled_measure("fox_plaza_los_angeles_sa1p0s")
+    assert measure == Measure("psa", 1.0, damping=0.05) and measure.label == "PSA(1 s)"
+    assert bundled_measure("fox_plaza_los_angeles_pga") == Measure("pga")
+    with pytest.raises(ValueError, match="^name: no bundled hazard curve 'nowhere_pga'"):
+        bundled_measure("nowhere_pga")
+
+
 def test_unit_factors():
     assert unit_factor("cm/s2", "g", 9.81) == pytest.approx(1 / 981.0, rel=1e-15)
     assert unit_factor("g", "m/s2", 9.80665) == 9.80665 and unit_factor("cm/s", "m/s", 9.81) == 0.01
@@ -51,7 +73,7 @@ def test_unit_factors():
 def test_openquake_file_is_probabilities_in_its_investigation_time():
     read = read_hazard_file(OPENQUAKE, site=0)
     assert read.format == "openquake" and read.quantity == "poe" and read.investigation_time == 50.0
-    assert read.stated == {"measure": "psa", "period": 1.0, "damping": 0.05, "units": "g"}
+    assert read.stated == StatedMeasure("psa", 1.0, damping=0.05, units="g")
     curve = read.curve("g", 9.81)
     np.testing.assert_allclose(curve.im, FOX.im, rtol=1e-12)
     np.testing.assert_allclose(curve.rate[1:], FOX.rate[1:], rtol=1e-9)  # the first P is 1 - 1e-12: 4 digits left in 1 - P
@@ -71,7 +93,7 @@ def test_openquake_longitude_is_not_read_as_an_intensity():
 def test_nshmp_file_is_rates_its_measure_the_folder_and_zeros_left_out():
     read = read_hazard_file(NSHMP, site="Fox Plaza")
     assert read.format == "nshmp-haz" and read.quantity == "rate"
-    assert read.stated == {"measure": "psa", "period": 1.0, "damping": 0.05, "units": "g"}
+    assert read.stated == StatedMeasure("psa", 1.0, damping=0.05, units="g")
     curve = read.curve("g", 9.81)
     np.testing.assert_array_equal(curve.im, FOX.im)
     np.testing.assert_array_equal(curve.rate, FOX.rate)

@@ -136,8 +136,8 @@ def test_the_exact_spectrum_of_two_ruptures_is_their_mixture() -> None:
     parts, moments = [], []
     for i in range(2):
         scenario = site.scenario(i)
-        parts.append(conditional_spectrum("psa", 1.0, level=level, periods=PERIODS, **scenario))
-        moments.append(scenario_distribution("psa", 1.0, **scenario))
+        parts.append(conditional_spectrum("psa", 1.0, level=level, periods=PERIODS, scenario=scenario))
+        moments.append(scenario_distribution("psa", 1.0, scenario=scenario))
     epsilon = np.array([part.attrs["epsilon"] for part in parts])
     sigma = np.array([m[1] for m in moments])
     np.testing.assert_allclose(epsilon, (np.log(level) - np.log([m[0] for m in moments])) / sigma, rtol=1e-12)
@@ -168,7 +168,7 @@ def test_the_exact_spectrum_is_the_site_given_the_level_by_monte_carlo() -> None
     which = rng.random(n) < site.rate[0] / sum(site.rate)
     spectra = np.empty((n, len(periods)))
     for i, chosen in enumerate((which, ~which)):
-        unconditional = conditional_spectrum("psa", 1.0, level=level, periods=periods, **site.scenario(i))
+        unconditional = conditional_spectrum("psa", 1.0, level=level, periods=periods, scenario=site.scenario(i))
         s = unconditional.unconditional_sigma_ln.values
         spectra[chosen] = rng.multivariate_normal(np.log(unconditional.unconditional_median.values), rho * np.outer(s, s), size=int(chosen.sum()))
     near = np.abs(spectra[:, 2] - np.log(level)) < 0.015

@@ -11,7 +11,6 @@ Sa_avg. ``stochpound risk`` prints it and the report's Risk section shows it.
 from __future__ import annotations
 
 import re
-from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
@@ -19,7 +18,7 @@ import pandas as pd
 
 from stochpound.experiment._grid import Experiment
 from stochpound.experiment._site import periods_of_interest
-from stochpound.motions import measure_label
+from stochpound.motions import Measure
 
 
 def hazard_measures(store: Any, hazard: str | None = None) -> dict[str, float | None]:
@@ -34,14 +33,15 @@ def hazard_measures(store: Any, hazard: str | None = None) -> dict[str, float | 
     if name:
         measures = [bundled_measure(curve) for curve in bundled_site_curves(name)]
     else:
-        intensity = store.pound.intensity or {}
-        measures = [intensity] if intensity.get("measure") in ("pga", "psa") else []
-    return {_entry_label(m): (None if m["measure"] == "pga" else float(m["period"])) for m in measures}
+        own = _store_measure(store)
+        measures = [own] if own is not None and own.kind in ("pga", "psa") else []
+    return {measure.label: measure.period for measure in measures}
 
 
-def _entry_label(entry: Mapping[str, Any]) -> str:
-    """The short name (``stochpound.motions.measure_label``) of an ``[intensity]``-like entry's measure; "" for none."""
-    return measure_label(str(entry.get("measure", "")), entry.get("period", entry.get("periods")))
+def _store_measure(store: Any) -> Measure | None:
+    """The measure of the store's ``[intensity]`` (None without one)."""
+    intensity = store.pound.intensity
+    return Measure.from_entry(intensity) if intensity else None
 
 
 def measure_choice(store: Any, hazard: str | None = None) -> pd.DataFrame:
@@ -62,15 +62,15 @@ def measure_choice(store: Any, hazard: str | None = None) -> pd.DataFrame:
         words), a column per hazard measure (β), ``most efficient`` (among
         them; "" when the hazard has none), ``best candidate`` and ``best β``.
         Its ``attrs``: ``hazard_measures`` (those columns' names) and
-        ``store_measure`` (the store's own measure, named alike: ``stochpound.motions.measure_label``).
+        ``store_measure`` (the store's own measure, named alike: :attr:`stochpound.motions.Measure.label`; "" for none).
     """
-    from stochpound.risk import measure_efficiency
+    from stochpound.risk import candidate_name, measure_efficiency
 
     structure = periods_of_interest(Experiment(store.pound.definition))
     available = hazard_measures(store, hazard)
     candidates = {**structure, **{f"hazard {name}": period for name, period in available.items() if period is not None}}
     beta = measure_efficiency(store, candidates, structure, studied=store.attrs.get("studied_building"))["beta"].sel(response="closure")
-    names = {name: ("PGA" if period is None else f"PSA({period:.3g} s, hazard {name})") for name, period in available.items()}
+    names = {name: candidate_name(period, f"hazard {name}") for name, period in available.items()}
     configurations = [d for d in beta.dims if d != "measure"]
     rows = []
     for index in np.ndindex(*[beta.sizes[d] for d in configurations]):
@@ -86,7 +86,8 @@ def measure_choice(store: Any, hazard: str | None = None) -> pd.DataFrame:
         rows.append(row)
     frame = pd.DataFrame(rows)
     frame.attrs["hazard_measures"] = list(available)
-    frame.attrs["store_measure"] = _entry_label(store.pound.intensity or {})
+    own = _store_measure(store)
+    frame.attrs["store_measure"] = own.label if own is not None else ""
     return frame
 
 

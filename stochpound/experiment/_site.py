@@ -60,7 +60,7 @@ import numpy as np
 import xarray as xr
 
 from stochpound.model import fields as toml_fields
-from stochpound.motions import CONDITIONING_MEASURES, MODEL_DAMPING, PERIOD_RANGE, check_scenario
+from stochpound.motions import CONDITIONING_MEASURES, MODEL_DAMPING, PERIOD_RANGE, Scenario
 from stochpound.store import SCENARIO_KINDS
 
 
@@ -286,7 +286,7 @@ def parse_site(site: Any, levels: list[float], entry: Mapping[str, Any]) -> list
     for i in range(len(levels)):
         scenario = {key: columns[key][i] for key in SITE_FIELDS}
         names = {key: f"site.{key}[{i}]" if isinstance(site[key], list) else f"site.{key}" for key in SITE_FIELDS}
-        check_scenario(scenario["magnitude"], scenario["distance_km"], scenario["vs30"], scenario["mechanism"], names)
+        Scenario.of(scenario["magnitude"], scenario["distance_km"], scenario["vs30"], scenario["mechanism"], names=names)
         scenarios.append({key: (float(v) if key != "mechanism" else v) for key, v in scenario.items()})
     order = sorted(range(len(levels)), key=lambda i: levels[i])
     return [scenarios[i] for i in order]
@@ -309,7 +309,7 @@ def fitted_site(site: Mapping[str, Any], levels: list[float], entry: Mapping[str
             raise SiteError(f"site.{key}: missing (the site's Vs30 and the mechanism of its faults)")
         if isinstance(site[key], list):
             raise SiteError(f'site.{key}: one value with scenario = "fitted", got a list')
-    check_scenario(6.0, 10.0, site["vs30"], site["mechanism"], {"vs30": "site.vs30", "mechanism": "site.mechanism"})
+    Scenario.of(6.0, 10.0, site["vs30"], site["mechanism"], names={"vs30": "site.vs30", "mechanism": "site.mechanism"})
     curves = site.get("curves")
     known = bundled_curves()
     if not isinstance(curves, list) or len(curves) < 2 or any(name not in known for name in curves):
@@ -319,10 +319,10 @@ def fitted_site(site: Mapping[str, Any], levels: list[float], entry: Mapping[str
     for name in curves:
         measure = bundled_measure(name)
         curve = HazardCurve.bundled(name)
-        if measure["measure"] == entry["measure"] and measure.get("period") == entry.get("period"):
+        if measure.kind == entry["measure"] and measure.period == entry.get("period"):
             conditioning = curve
         else:
-            others.append((measure.get("period"), curve.im, curve.rate))
+            others.append((measure.period, curve.im, curve.rate))
     if conditioning is None:
         raise SiteError("site.curves: none of them is the curve of the conditioning measure ([intensity] measure and period)")
     if not others:

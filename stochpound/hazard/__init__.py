@@ -3,7 +3,8 @@
 :class:`HazardCurve` is the mean annual rate at which an intensity measure
 is exceeded (a table or a power law; the bundled sites' curves);
 :func:`read_hazard_file` reads one from stochpound's, OpenQuake's or
-nshmp-haz's files with what it is a curve of; :func:`parse_hazard` reads
+nshmp-haz's files with what it is a curve of (a :class:`StatedMeasure`;
+:func:`bundled_measure` gives a bundled curve's :class:`~stochpound.motions.Measure`); :func:`parse_hazard` reads
 an experiment file's ``[hazard]`` table into the canonical entry a store
 carries, :func:`stored_hazard` gives a store's curve back and
 :func:`hazard_option` reads ``stochpound risk --hazard``;
@@ -20,7 +21,7 @@ imports none of them.
 """
 
 from stochpound.hazard._curve import HazardCurve, bundled_curves, bundled_measure, bundled_site_curves, probability_from_rate, rate_from_probability, return_period
-from stochpound.hazard._files import HazardFile, parse_measure, parse_units, read_hazard_file
+from stochpound.hazard._files import HazardFile, StatedMeasure, parse_measure, parse_units, read_hazard_file
 from stochpound.hazard._consistency import hazard_consistency, stripe_rate_weights
 from stochpound.hazard._ruptures import RUPTURE_COLUMNS, RuptureSite, bundled_rupture_sites
 from stochpound.hazard._scenario import scenario_hazard
@@ -38,6 +39,7 @@ __all__ = [
     "rate_from_probability",
     "return_period",
     "HazardFile",
+    "StatedMeasure",
     "read_hazard_file",
     "parse_measure",
     "parse_units",

@@ -23,11 +23,14 @@ from numpy.typing import ArrayLike
 
 from stochpound._data_files import bundled_data_dir
 from stochpound._text_files import read_text_file
+from stochpound.motions import Measure
 
 BUNDLED_FOLDER = "hazard"
 """Name of the bundled hazard folder (``data/hazard/`` in the repository, with its ``SOURCES.md``)."""
 BUNDLED_DAMPING = 0.05
 """Damping ratio of the bundled spectral-acceleration curves."""
+BUNDLED_UNITS = "g"
+"""Units of the bundled curves' intensities."""
 _BUNDLED_MEASURE = re.compile(r"_(?:(pga)|sa(\d+)p(\d+)s)$")
 
 
@@ -167,7 +170,7 @@ class HazardCurve:
     @classmethod
     def bundled(cls, name: str, *, extrapolate: bool = False) -> HazardCurve:
         """A hazard curve shipped with stochpound (``data/hazard/<name>.csv``; :func:`~stochpound.analysis.bundled_curves` lists them)."""
-        return cls.from_file(bundled_path(name), extrapolate=extrapolate, units="g")
+        return cls.from_file(bundled_path(name), extrapolate=extrapolate, units=BUNDLED_UNITS)
 
     # ------------------------------------------------------------ evaluation
 
@@ -261,22 +264,21 @@ def bundled_path(name: str) -> Path:
     return path
 
 
-def bundled_measure(name: str) -> dict[str, float | str]:
+def bundled_measure(name: str) -> Measure:
     """The intensity measure of a bundled curve, from the end of its name (``_pga``, or ``_sa<T>s`` with ``p`` for the point).
 
     Returns
     -------
-    dict
-        ``measure`` (``"pga"`` or ``"psa"``), for ``psa`` its ``period`` (s)
-        and ``damping`` (``BUNDLED_DAMPING``, 0.05), and ``units`` (``"g"``):
-        the keys of an experiment's ``[intensity]`` they must match.
+    stochpound.motions.Measure
+        PGA, or PSA at the period the name gives (s) with the damping
+        ``BUNDLED_DAMPING`` (0.05); every bundled curve is in ``BUNDLED_UNITS`` (g).
     """
     match = _BUNDLED_MEASURE.search(name)
     if match is None or name not in bundled_curves():
         raise ValueError(f"name: no bundled hazard curve {name!r}; bundled: {', '.join(bundled_curves())}")
     if match.group(1):
-        return {"measure": "pga", "units": "g"}
-    return {"measure": "psa", "period": float(f"{match.group(2)}.{match.group(3)}"), "damping": BUNDLED_DAMPING, "units": "g"}
+        return Measure("pga")
+    return Measure("psa", float(f"{match.group(2)}.{match.group(3)}"), damping=BUNDLED_DAMPING)
 
 
 def bundled_site_curves(name: str) -> list[str]:

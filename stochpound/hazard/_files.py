@@ -32,7 +32,8 @@ from __future__ import annotations
 
 import csv
 import re
-from dataclasses import dataclass, field
+from collections.abc import Mapping
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -40,6 +41,7 @@ import numpy as np
 
 from stochpound._text_files import read_text_file
 from stochpound.hazard._curve import HazardCurve, rate_from_probability
+from stochpound.motions import Measure
 
 FORMATS = ("stochpound", "openquake", "nshmp-haz")
 """The hazard-file formats :func:`read_hazard_file` reads."""
@@ -54,6 +56,78 @@ _TOOL_UNITS = {"pga": "g", "psa": "g", "pgv": "cm/s"}
 _NUMBER = r"(\d+(?:\.\d*)?|\.\d+)"
 _RATE_COLUMNS = ("rate", "annual_rate", "mafe", "lambda", "afe")
 _POE_COLUMNS = ("poe", "probability")
+
+
+@dataclass(frozen=True)
+class StatedMeasure:
+    """What a hazard file, a bundled curve's name or a command-line option states of a curve's measure: each part None
+    (``periods`` empty) when not stated, e.g. a file's ``SA(0.2)`` states no damping and no units.
+
+    Attributes
+    ----------
+    kind : str or None
+        ``pga``, ``pgv``, ``psa`` or ``sa_avg`` (:data:`~stochpound.motions.MEASURE_KINDS`).
+    period : float or None
+        The period of ``psa``, s.
+    periods : tuple of float
+        The periods of ``sa_avg``, s.
+    damping : float or None
+        The damping ratio of a spectral measure.
+    units : str or None
+        The units of the intensities: ``g``, ``m/s2``, ``cm/s2``, ``m/s`` or ``cm/s``.
+    """
+
+    kind: str | None = None
+    period: float | None = None
+    periods: tuple[float, ...] = ()
+    damping: float | None = None
+    units: str | None = None
+
+    @classmethod
+    def parse(cls, text: str) -> StatedMeasure:
+        """A measure as written in a file's ``# Measure:`` line or on the command line.
+
+        Understands ``PGA``, ``PGV``, ``PSA``/``SA(T)``/``SA1P0``/"spectral
+        acceleration at T = 1.0 s", a damping as a percentage ("5 %-damped",
+        "5 %"), and units after "in" or a last comma.
+
+        >>> StatedMeasure.parse("SA(0.2)")
+        StatedMeasure(kind='psa', period=0.2, periods=(), damping=None, units=None)
+
+        Raises
+        ------
+        ValueError
+            Naming ``measure`` or ``units``: no measure stochpound knows, an average spectral acceleration, unknown units.
+        """
+        return cls.from_entry(_parsed(text))
+
+    @classmethod
+    def of(cls, measure: Measure, units: str | None = None) -> StatedMeasure:
+        """The whole of a measure, and its units if known."""
+        return cls(measure.kind, measure.period, measure.periods, measure.damping, units)
+
+    @classmethod
+    def from_entry(cls, entry: Mapping[str, Any]) -> StatedMeasure:
+        """The stated keys (``measure``, ``period``, ``periods``, ``damping``, ``units``) of a mapping; other keys are ignored."""
+        return cls(entry.get("measure"), entry.get("period"), tuple(entry.get("periods") or ()), entry.get("damping"), entry.get("units"))
+
+    def entry(self) -> dict[str, Any]:
+        """The parts stated, by their keys in an experiment's ``[hazard]`` (``measure``, ``period``, ``periods``, ``damping``, ``units``)."""
+        parts = {"measure": self.kind, "period": self.period, "periods": list(self.periods) or None, "damping": self.damping, "units": self.units}
+        return {key: value for key, value in parts.items() if value is not None}
+
+    @property
+    def measure(self) -> Measure | None:
+        """The measure once its kind and, for a spectral kind, its period(s) are stated (the damping may be unstated); else None.
+
+        Raises
+        ------
+        ValueError
+            As :class:`~stochpound.motions.Measure`: a stated part out of its range.
+        """
+        if self.kind is None or (self.kind == "psa" and self.period is None) or (self.kind == "sa_avg" and not self.periods):
+            return None
+        return Measure(self.kind, self.period, self.periods, self.damping)
 
 
 @dataclass
@@ -71,9 +145,8 @@ class HazardFile:
         ``"rate"`` or ``"poe"``.
     investigation_time : float or None
         Years of a ``poe`` curve, when the file states it.
-    stated : dict
-        What the file states of its measure: ``measure``, ``period``,
-        ``damping``, ``units`` (absent keys: not stated).
+    stated : StatedMeasure
+        What the file states of its measure and units (None: not stated).
     format : str
         One of ``FORMATS`` (stochpound, openquake, nshmp-haz).
     provenance : str
@@ -84,7 +157,7 @@ class HazardFile:
     values: np.ndarray
     quantity: str
     investigation_time: float | None
-    stated: dict[str, Any]
+    stated: StatedMeasure
     format: str
     provenance: str
     notes: list[str] = field(default_factory=list)
@@ -114,9 +187,9 @@ class HazardFile:
             no investigation time, or the table is not a decreasing curve.
         """
         notes = list(self.notes)
-        im = self.im * unit_factor(self.stated["units"], units, g)
-        if self.stated["units"] != units:
-            notes.append(f"intensities converted from {self.stated['units']} to {units} (g = {g:g} m/s²)")
+        im = self.im * unit_factor(self.stated.units, units, g)
+        if self.stated.units != units:
+            notes.append(f"intensities converted from {self.stated.units} to {units} (g = {g:g} m/s²)")
         values = self.values
         if self.quantity == "poe":
             years = self.investigation_time if self.investigation_time is not None else investigation_time
@@ -172,18 +245,17 @@ def parse_units(text: str) -> str:
 
 
 def parse_measure(text: str) -> dict[str, Any]:
-    """A measure as written in a file's ``# Measure:`` line or on the command line.
-
-    Understands ``PGA``, ``PGV``, ``PSA``/``SA(T)``/``SA1P0``/"spectral
-    acceleration at T = 1.0 s", a damping as a percentage ("5 %-damped",
-    "5 %"), and units after "in" or a last comma. Returns the keys it
-    finds among ``measure``, ``period`` (s), ``damping`` (ratio), ``units``.
+    """:meth:`StatedMeasure.parse` as the keys it finds among ``measure``, ``period`` (s), ``damping`` (ratio), ``units``
+    (:meth:`StatedMeasure.entry`), for the callers that merge them with other stated keys.
 
     >>> parse_measure("5 %-damped spectral acceleration at T = 1.0 s, in g")
     {'measure': 'psa', 'period': 1.0, 'damping': 0.05, 'units': 'g'}
-    >>> parse_measure("SA(0.2)")
-    {'measure': 'psa', 'period': 0.2}
     """
+    return StatedMeasure.parse(text).entry()
+
+
+def _parsed(text: str) -> dict[str, Any]:
+    """The keys :meth:`StatedMeasure.parse` finds in ``text``."""
     lowered = text.strip().lower()
     found: dict[str, Any] = {}
     units = re.search(r"(?:\bin|,)\s*(g|m/s2|m/s²|m/s/s|cm/s2|cm/s²|cm/s/s|gal|m/s|cm/s)\s*\.?$", lowered)
@@ -269,7 +341,7 @@ def _stochpound(path: Path, lines: list[str]) -> HazardFile:
             key, _, value = comment.partition(":")
             key = key.strip().lower()
             if key == "measure":
-                stated.update(parse_measure(value))
+                stated.update(_parsed(value))
             elif key == "units":
                 stated["units"] = parse_units(value)
             elif key == "investigation time":
@@ -286,7 +358,7 @@ def _stochpound(path: Path, lines: list[str]) -> HazardFile:
         raise ValueError("no rows of 'im, value'")
     quantity = _quantity(header)
     im, values = (np.asarray(column, dtype=float) for column in zip(*rows))
-    return HazardFile(im, values, quantity, years, stated, "stochpound", "\n".join(comments) or path.name)
+    return HazardFile(im, values, quantity, years, StatedMeasure.from_entry(stated), "stochpound", "\n".join(comments) or path.name)
 
 
 def _quantity(header: list[str] | None) -> str:
@@ -331,9 +403,9 @@ def _nshmp(path: Path, lines: list[str], site: int | str | None) -> HazardFile:
     rows = [next(csv.reader([line])) for line in lines[1:]]
     row = _site_row(rows, site, names=[r[0] for r in rows] if start == 3 else None)
     folder = path.parent.name
-    stated = _tool_measure(folder) if re.fullmatch(r"(?i)pga|pgv|sa\d+p\d+", folder) else {}
+    stated = _tool_measure(folder) if re.fullmatch(r"(?i)pga|pgv|sa\d+p\d+", folder) else StatedMeasure()
     where = f"site {row[0]!r}, lon {row[start - 2]}, lat {row[start - 1]}" if start == 3 else f"lon {row[0]}, lat {row[1]}"
-    provenance = f"nshmp-haz hazard curve {folder}/{path.name}: {where}" if stated else f"nshmp-haz hazard curve {path.name}: {where}"
+    provenance = f"nshmp-haz hazard curve {folder}/{path.name}: {where}" if stated.kind else f"nshmp-haz hazard curve {path.name}: {where}"
     return HazardFile(np.array([float(x) for x in header[start:]]), np.array([float(x) for x in row[start:]]),
                       "rate", None, stated, "nshmp-haz", provenance)
 
@@ -355,11 +427,8 @@ def _site_row(rows: list[list[str]], site: int | str | None, names: list[str] | 
     return rows[index]
 
 
-def _tool_measure(imt: str) -> dict[str, Any]:
+def _tool_measure(imt: str) -> StatedMeasure:
     """The measure of an OpenQuake IMT (``PGA``, ``SA(1.0)``) or nshmp-haz folder (``SA1P0``), with the tool's units and damping."""
-    stated = parse_measure(imt)
-    if stated["measure"] == "psa":
-        stated["damping"] = _TOOL_DAMPING
-    stated["units"] = _TOOL_UNITS[stated["measure"]]
-    return stated
+    stated = StatedMeasure.parse(imt)
+    return replace(stated, damping=_TOOL_DAMPING if stated.kind == "psa" else stated.damping, units=_TOOL_UNITS[stated.kind])
 

@@ -37,8 +37,8 @@ rupture. Bundled demonstration sites are in ``data/ruptures/``
 from __future__ import annotations
 
 import csv
-from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field, fields
+from collections.abc import Iterator, Mapping, Sequence
+from dataclasses import InitVar, dataclass, field, fields
 from functools import lru_cache
 from pathlib import Path
 from typing import Any
@@ -53,12 +53,13 @@ from stochpound._errors import SiteError
 from stochpound.hazard._curve import HazardCurve
 from stochpound.motions import (
     MECHANISMS,
+    Measure,
+    Scenario,
     check_damping,
-    check_scenario,
     conditional_distribution,
     conditioning_attrs,
-    measure_label,
-    scenario_distribution,
+    conditioning_measure,
+    measure_distribution,
     scenario_spectrum,
     spectrum_dataset,
 )
@@ -87,7 +88,10 @@ _GEOMETRY = ("distance_jb_km", "distance_x_km", "ztor_km", "dip")
 
 @dataclass(frozen=True)
 class RuptureSite:
-    """A site given by the ruptures that can shake it (module docstring): a frozen value, checked when made.
+    """A site given by the ruptures that can shake it (module docstring): a frozen value, every rupture checked once, when made.
+
+    Iterating it gives each rupture as its :class:`~stochpound.motions.Scenario` (the site's Vs30 and basin depths
+    with the rupture's magnitude, distances, depth, dip and mechanism) and its annual rate of occurrence.
 
     Parameters
     ----------
@@ -105,6 +109,8 @@ class RuptureSite:
         A label per rupture (default: ``"r1"``, ``"r2"``, ...).
     name, source : str
         The site's name and provenance (a file's comment lines); two sites of the same ruptures are equal whatever their names.
+    row_names : sequence of mapping, optional
+        Per rupture, how its fields are named in an error (a rupture table's file and line); default ``ruptures[i].column``.
 
     Raises
     ------
@@ -126,8 +132,9 @@ class RuptureSite:
     names: tuple[str, ...] = ()
     name: str = field(default="", compare=False)
     source: str = field(default="", compare=False)
+    row_names: InitVar[Sequence[Mapping[str, str]] | None] = None
 
-    def __post_init__(self) -> None:
+    def __post_init__(self, row_names: Sequence[Mapping[str, str]] | None) -> None:
         count = len(self.magnitude)
         if count == 0:
             raise SiteError("ruptures: a site needs one or more ruptures")
@@ -139,8 +146,8 @@ class RuptureSite:
             object.__setattr__(self, "names", tuple(f"r{i + 1}" for i in range(count)))
         if len(self.names) != count or len(set(self.names)) != count:
             raise SiteError(f"names: must be {count} distinct labels, one per rupture")
-        for i in range(count):
-            check_rupture(self.row(i), self.site_fields(), {column: f"ruptures[{i}].{column}" for column in RUPTURE_COLUMNS})
+        spelled = row_names or [{column: f"ruptures[{i}].{column}" for column in RUPTURE_COLUMNS} for i in range(count)]
+        object.__setattr__(self, "_scenarios", tuple(_rupture_scenario(self.row(i), self.site_fields(), spelled[i]) for i in range(count)))
 
     # ------------------------------------------------------------ construction
 
@@ -168,6 +175,32 @@ class RuptureSite:
         return cls.from_file(bundled_rupture_path(name), **site, name=name)
 
     @classmethod
+    def from_scenarios(cls, ruptures: Sequence[tuple[Scenario, float]], *, name: str = "", source: str = "") -> RuptureSite:
+        """The site of ruptures given as (scenario, annual rate of occurrence) pairs, as iterating a site gives them back.
+
+        The scenarios share the site's ``vs30``, ``z1p0_km`` and ``z2p5_km``; a rupture's geometry a scenario leaves
+        out is the conditional spectrum's estimate (R_JB = R_rup, R_x = −R_rup, Z_tor = 0, the mechanism's dip).
+
+        Raises
+        ------
+        SiteError
+            No ruptures, scenarios of different sites, or as the constructor.
+        """
+        if not ruptures:
+            raise SiteError("ruptures: a site needs one or more ruptures")
+        first = ruptures[0][0]
+        for index, (scenario, _) in enumerate(ruptures):
+            for key in SITE_FIELDS:
+                if getattr(scenario, key) != getattr(first, key):
+                    raise SiteError(f"ruptures[{index}].{key}: the ruptures of a site share its {key}, got {getattr(scenario, key)!r} "
+                                    f"and {getattr(first, key)!r}")
+        rows = [{"distance_jb_km": s.distance_km, "distance_x_km": -s.distance_km, "ztor_km": 0.0, "dip": MECHANISMS[s.mechanism][1]}
+                | {key: value for key, value in s.geometry.items() if key in _GEOMETRY} for s, _ in ruptures]
+        return cls(tuple(s.magnitude for s, _ in ruptures), tuple(s.distance_km for s, _ in ruptures),
+                   *(tuple(row[key] for row in rows) for key in _GEOMETRY), tuple(s.mechanism for s, _ in ruptures),
+                   tuple(rate for _, rate in ruptures), first.vs30, first.z1p0_km, first.z2p5_km, name=name, source=source)
+
+    @classmethod
     def from_entry(cls, entry: Mapping[str, Any]) -> RuptureSite:
         """The site of a canonical entry (:meth:`to_entry`), as a definition stores it."""
         return cls(**{key: tuple(entry[key]) for key in (*RUPTURE_COLUMNS, "names")},
@@ -184,6 +217,10 @@ class RuptureSite:
     def __len__(self) -> int:
         return len(self.magnitude)
 
+    def __iter__(self) -> Iterator[tuple[Scenario, float]]:
+        """Every rupture as its scenario and its annual rate of occurrence (1/yr)."""
+        return zip(self._scenarios, self.rate)
+
     def row(self, index: int) -> dict[str, Any]:
         """Rupture ``index`` (0-based) as a mapping of the table's columns (:data:`~stochpound.analysis.RUPTURE_COLUMNS`)."""
         return {column: getattr(self, column)[index] for column in RUPTURE_COLUMNS}
@@ -192,12 +229,9 @@ class RuptureSite:
         """The site's ``vs30``, ``z1p0_km`` and ``z2p5_km``."""
         return {key: getattr(self, key) for key in SITE_FIELDS}
 
-    def scenario(self, index: int) -> dict[str, Any]:
-        """Rupture ``index`` as the keyword arguments of :func:`~stochpound.motions.conditional_spectrum` (its ``geometry`` included)."""
-        row = self.row(index)
-        geometry = {key: row[key] for key in _GEOMETRY} | {"z1p0_km": self.z1p0_km, "z2p5_km": self.z2p5_km}
-        return {"magnitude": row["magnitude"], "distance_km": row["distance_rup_km"], "vs30": self.vs30, "mechanism": row["mechanism"],
-                "geometry": geometry}
+    def scenario(self, index: int) -> Scenario:
+        """Rupture ``index`` (0-based) as a scenario (:func:`~stochpound.motions.conditional_spectrum`'s ``scenario=``), its geometry given."""
+        return self._scenarios[index]
 
     def mean_scenario(self, weights: Sequence[float]) -> dict[str, Any]:
         """The ruptures summed up by ``weights`` (one per rupture, summing to 1): the means of ``magnitude`` and ``distance_km``
@@ -238,7 +272,7 @@ class RuptureSite:
         mean, sigma = self.moments(measure, period)
         low, high = np.min(mean + EPSILON_RANGE[0] * sigma), np.max(mean + EPSILON_RANGE[1] * sigma)
         im = np.exp(np.linspace(low, high, points))
-        return HazardCurve(im, self.rate_of_exceedance(measure, period, im), extrapolate=extrapolate, measure=measure_label(measure, period),
+        return HazardCurve(im, self.rate_of_exceedance(measure, period, im), extrapolate=extrapolate, measure=Measure.of(measure, period).label,
                            units="g", source=self.describe())
 
     def intensity_at(self, measure: str, period: float | Sequence[float] | None, rate: Any) -> np.ndarray:
@@ -273,7 +307,7 @@ class RuptureSite:
             raise SiteError(f"periods: must be one or more periods in s, got {periods!r}")
         if years.ndim != 1 or not years.size or not np.all(np.isfinite(years) & (years > 0)):
             raise SiteError(f"return_periods: must be one or more return periods > 0 yr, got {return_periods!r}")
-        moments = [scenario_spectrum(grid, **self.scenario(i)) for i in range(len(self))]
+        moments = [scenario_spectrum(grid, scenario) for scenario in self._scenarios]
         mean, sigma = (np.array([m[k] for m in moments]) for k in (0, 1))
         rates = np.asarray(self.rate)
         psa = np.array([[_solve(rates, mean[:, j], sigma[:, j], 1.0 / t)[()] for j in range(grid.size)] for t in years])
@@ -338,7 +372,7 @@ class RuptureSite:
                 "binned_share": (("level", "magnitude_bin", "distance_bin", "epsilon_bin"), binned, {"units": "1"}),
             },
             coords=coords,
-            attrs={"measure": measure_label(measure, period), "site": self.describe()},
+            attrs={"measure": Measure.of(measure, period).label, "site": self.describe()},
         )
 
     # ------------------------------------------------------------ the exact conditional spectrum
@@ -372,7 +406,7 @@ class RuptureSite:
         if weights not in WEIGHTS:
             raise SiteError(f"weights: must be one of {', '.join(WEIGHTS)}, got {weights!r}")
         x = _intensities(levels)
-        parts = [conditional_distribution(measure, period, x, periods, **self.scenario(i)) for i in range(len(self))]
+        parts = [conditional_distribution(measure, period, x, periods, scenario) for scenario in self._scenarios]
         epsilon = np.stack([part.epsilon for part in parts], axis=1)
         sigma = np.array([part.measure_sigma_ln for part in parts])
         rates = np.asarray(self.rate)
@@ -394,7 +428,7 @@ class RuptureSite:
         unconditional = np.array([part.unconditional_mean_ln for part in parts])
         unconditional_mean = p @ unconditional
         unconditional_var = p @ (np.array([part.unconditional_sigma_ln for part in parts]) ** 2 + (unconditional - unconditional_mean) ** 2)
-        attrs = {"epsilon": float(p @ epsilon), **conditioning_attrs(measure, period, level), **self.mean_scenario(p),
+        attrs = {"epsilon": float(p @ epsilon), **conditioning_attrs(conditioning_measure(measure, period), level), **self.mean_scenario(p),
                  "weights": WEIGHT_TEXT[weights], "ruptures": len(self), "site": self.name or "a site of ruptures"}
         target = spectrum_dataset(parts[0].periods, mean, within + between, unconditional_mean, np.sqrt(unconditional_var), attrs)
         target["between_sigma_ln"] = ("period", np.sqrt(np.clip(np.diag(between), 0.0, None)),
@@ -419,7 +453,7 @@ WEIGHT_TEXT = {"level": "P(rupture | IM* = level), proportional to rate x densit
 @lru_cache(maxsize=64)
 def _moments(site: RuptureSite, measure: str, period: Any) -> tuple[np.ndarray, np.ndarray]:
     argument = list(period) if isinstance(period, tuple) else period
-    pairs = [scenario_distribution(measure, argument, **site.scenario(i)) for i in range(len(site))]
+    pairs = [measure_distribution(measure, argument, scenario) for scenario, _ in site]
     median, sigma = (np.array(values) for values in zip(*pairs))
     return np.log(median), sigma
 
@@ -467,14 +501,14 @@ def _solve(rates: np.ndarray, mean: np.ndarray, sigma: np.ndarray, rate: Any) ->
     return np.exp(np.vectorize(lambda wanted: brentq(excess, low, high, args=(wanted,), xtol=1e-12))(target))
 
 
-def check_rupture(row: Mapping[str, Any], site: Mapping[str, Any], names: Mapping[str, str]) -> None:
-    """Raise :class:`SiteError` naming the field (``names``) of a rupture outside the models' range, or of a rate not > 0."""
+def _rupture_scenario(row: Mapping[str, Any], site: Mapping[str, Any], names: Mapping[str, str]) -> Scenario:
+    """The rupture's scenario, checked: a :class:`SiteError` naming the field (``names``) outside the models' range, or a rate not > 0."""
     rate = row["rate"]
     if isinstance(rate, bool) or not isinstance(rate, (int, float)) or not np.isfinite(rate) or rate <= 0:
         raise SiteError(f"{names['rate']}: must be an annual rate of occurrence > 0 (1/yr), got {rate!r}")
     geometry = {key: row[key] for key in _GEOMETRY} | {key: site[key] for key in ("z1p0_km", "z2p5_km")}
     spelled = {"distance_km": names["distance_rup_km"], "vs30": names.get("vs30", "vs30"), **names}
-    check_scenario(row["magnitude"], row["distance_rup_km"], site["vs30"], row["mechanism"], spelled, geometry)
+    return Scenario.of(row["magnitude"], row["distance_rup_km"], site["vs30"], row["mechanism"], geometry, names=spelled)
 
 
 def read_ruptures(path: Path, given: Mapping[str, float | None], name: str) -> RuptureSite:
@@ -508,15 +542,14 @@ def read_ruptures(path: Path, given: Mapping[str, float | None], name: str) -> R
     site = _site(path, stated, given)
     values: dict[str, list[Any]] = {column: [] for column in (*RUPTURE_COLUMNS, "names")}
     for index, (number, cells) in enumerate(rows):
-        row = {column: cells[column] if column == "mechanism" else _number(path, number, column, cells[column]) for column in RUPTURE_COLUMNS}
-        where = f"{path.name}, line {number}"
-        check_rupture(row, site, {column: f"{where}: {column}" for column in RUPTURE_COLUMNS} | {"vs30": f"{path.name}: vs30"})
         for column in RUPTURE_COLUMNS:
-            values[column].append(row[column])
+            values[column].append(cells[column] if column == "mechanism" else _number(path, number, column, cells[column]))
         values["names"].append(cells.get("name") or f"r{index + 1}")
     if len(set(values["names"])) != len(rows):
         raise SiteError(f"{path.name}: name: every rupture's name must be distinct")
-    return RuptureSite(**{key: tuple(column) for key, column in values.items()}, **site, name=name, source="\n".join(comments) or path.name)
+    spelled = [{column: f"{path.name}, line {number}: {column}" for column in RUPTURE_COLUMNS} | {"vs30": f"{path.name}: vs30"} for number, _ in rows]
+    return RuptureSite(**{key: tuple(column) for key, column in values.items()}, **site, name=name, source="\n".join(comments) or path.name,
+                       row_names=spelled)
 
 
 def _header(path: Path, number: int, cells: list[str]) -> list[str]:

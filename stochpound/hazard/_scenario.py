@@ -30,11 +30,12 @@ import numpy as np
 
 from stochpound.hazard._curve import HazardCurve
 from stochpound.hazard._ruptures import RuptureSite
-from stochpound.motions import MECHANISMS, check_scenario
+from stochpound.motions import Scenario, given_scenario
 
 
-def scenario_hazard(measure: str, period: float | Sequence[float] | None = None, *, magnitude: float, distance_km: float, vs30: float,
-                    mechanism: str, rate: float, extrapolate: bool = False) -> HazardCurve:
+def scenario_hazard(measure: str, period: float | Sequence[float] | None = None, *, magnitude: float | None = None,
+                    distance_km: float | None = None, vs30: float | None = None, mechanism: str | None = None, rate: float,
+                    extrapolate: bool = False, scenario: Scenario | None = None) -> HazardCurve:
     """The hazard curve of a site shaken by one scenario recurring at ``rate`` per year (module docstring).
 
     Parameters
@@ -45,6 +46,9 @@ def scenario_hazard(measure: str, period: float | Sequence[float] | None = None,
         ν, the scenario's annual rate of occurrence (1/yr), > 0.
     extrapolate : bool
         As :class:`HazardCurve`: beyond the table's ε of −4 to 6, extend it as a power law.
+    scenario : stochpound.motions.Scenario, optional
+        The scenario as one value, instead of ``magnitude``, ``distance_km``, ``vs30`` and ``mechanism``;
+        its geometry given replaces the conditional spectrum's estimates.
 
     Returns
     -------
@@ -61,9 +65,8 @@ def scenario_hazard(measure: str, period: float | Sequence[float] | None = None,
     """
     if not isinstance(rate, (int, float)) or isinstance(rate, bool) or not np.isfinite(rate) or rate <= 0:
         raise ValueError(f"rate: must be a finite annual rate > 0 (1/yr), got {rate!r}")
-    check_scenario(magnitude, distance_km, vs30, mechanism)
-    site = RuptureSite((magnitude,), (distance_km,), (distance_km,), (-distance_km,), (0.0,), (MECHANISMS[mechanism][1],), (mechanism,), (rate,), vs30)
-    curve = site.hazard_curve(measure, period, extrapolate=extrapolate)
-    curve.source = (f"one scenario, M {magnitude:g} at {distance_km:g} km, Vs30 {vs30:g} m/s, {mechanism.replace('_', '-')}, "
-                    f"{rate:g} per year; NGA-West2 average (pygmm)")
+    scenario = given_scenario(scenario, magnitude, distance_km, vs30, mechanism)
+    curve = RuptureSite.from_scenarios([(scenario, rate)]).hazard_curve(measure, period, extrapolate=extrapolate)
+    curve.source = (f"one scenario, M {scenario.magnitude:g} at {scenario.distance_km:g} km, Vs30 {scenario.vs30:g} m/s, "
+                    f"{scenario.mechanism.replace('_', '-')}, {rate:g} per year; NGA-West2 average (pygmm)")
     return curve

@@ -48,8 +48,8 @@ from typing import Any, Mapping, Sequence
 import xarray as xr
 
 from stochpound._errors import IntensityError
-from stochpound.hazard._curve import HazardCurve, bundled_curves, bundled_measure, bundled_path
-from stochpound.hazard._files import parse_units, read_hazard_file, unit_factor
+from stochpound.hazard._curve import BUNDLED_UNITS, HazardCurve, bundled_curves, bundled_measure, bundled_path
+from stochpound.hazard._files import StatedMeasure, parse_units, read_hazard_file, unit_factor
 from stochpound.hazard._ruptures import SITE_FIELDS as RUPTURE_SITE_FIELDS, named_rupture_site
 from stochpound.store import MEASURES, describe_measure
 from stochpound.model import fields as toml_fields
@@ -209,7 +209,7 @@ def _read(path: Path, given: Mapping[str, Any], site: Any, intensity: Mapping[st
         read = read_hazard_file(path, site=site)
     except (ValueError, UnicodeDecodeError) as error:
         raise IntensityError(f"{where}.file: {error}") from None
-    stated = dict(read.stated)
+    stated = read.stated.entry()
     for key, value in given.items():
         if key == "investigation_time":
             if read.investigation_time is not None and not _equal(value, read.investigation_time):
@@ -227,7 +227,7 @@ def _read(path: Path, given: Mapping[str, Any], site: Any, intensity: Mapping[st
             example = " (e.g. 'PSA(1.0 s, 5 %) in g')" if key in ("period", "damping") and where.startswith("--") else ""
             raise IntensityError(f"{_field(where, key)}: not stated: {path.name} does not give its curve's {key}; state it{example}")
     _check_measure(where, {key: stated[key] for key in _MATCHED if key in stated}, intensity)
-    read.stated = stated
+    read.stated = StatedMeasure.from_entry(stated)
     try:
         return read.curve(intensity["units"], g, investigation_time=given.get("investigation_time"), extrapolate=extrapolate,
                           description=describe_measure(intensity))
@@ -254,9 +254,9 @@ def _bundled(name: str, intensity: Mapping[str, Any], g: float, extrapolate: boo
     if name not in bundled_curves():
         raise IntensityError(f"{where}: no bundled hazard curve {name!r} (bundled: {', '.join(bundled_curves())})")
     measure = bundled_measure(name)
-    _check_measure(where, {key: value for key, value in measure.items() if key != "units"}, intensity, bundled=name)
+    _check_measure(where, measure.entry(), intensity, bundled=name)
     read = read_hazard_file(bundled_path(name))
-    read.stated = measure
+    read.stated = StatedMeasure.of(measure, BUNDLED_UNITS)
     return read.curve(intensity["units"], g, extrapolate=extrapolate, description=describe_measure(intensity))
 
 
@@ -270,7 +270,7 @@ def _check_measure(where: str, stated: Mapping[str, Any], intensity: Mapping[str
     wanted = _measure_of(intensity)
     for key, value in stated.items():
         field = where if bundled else _field(where, key)
-        what = f"{bundled!r} is {describe_measure({**wanted, **stated})}" if bundled else f"the hazard's {key} is {value!r}"
+        what = f"{bundled!r} is {describe_measure(stated)}" if bundled else f"the hazard's {key} is {value!r}"
         if key not in wanted or not _equal(value, wanted[key]):
             detail = f" (intensity.{key} = {wanted[key]!r})" if key in wanted else ""
             raise IntensityError(f"{field}: the hazard's measure must be [intensity]'s, {describe_measure(intensity)}{detail}; {what}")

@@ -13,7 +13,8 @@ that space (subset simulation).
 Intensity measures and the response spectrum (exact for accelerations linear
 between samples): :func:`intensity_measures`, :func:`response_spectrum`.
 
-The conditional spectrum of a site scenario (NGA-West2 models, Baker–Jayaram
+An earthquake scenario at a site as one value: :class:`Scenario`. The
+conditional spectrum of a site scenario (NGA-West2 models, Baker–Jayaram
 correlation): :func:`conditional_spectrum`, and the scenario's own median and σ
 of a measure: :func:`scenario_distribution` (a scenario's rupture geometry and
 basin depths, :data:`GEOMETRY_FIELDS`, given or estimated); records chosen and scaled to it
@@ -29,7 +30,8 @@ from explicit standard normals: :func:`site_motions_from_normals`.
 Conventions (PSD two-sided in ω, σ² = ∫ S dω; SI units) are in ``docs/motions.md``.
 """
 
-from stochpound.motions._conditional import GEOMETRY_FIELDS, TRUNCATION_EPSILON, conditional_spectrum, scenario_distribution
+from stochpound.motions._conditional import TRUNCATION_EPSILON, conditional_spectrum, scenario_distribution
+from stochpound.motions._scenario import GEOMETRY_FIELDS, Scenario
 from stochpound.motions._fitted import fit_levels, fit_scenarios, recomputed_hazard
 from stochpound.motions.baseline import baseline_correct, final_velocity_displacement
 from stochpound.motions.envelopes import (
@@ -72,17 +74,18 @@ from stochpound.motions._synthetic import (
 
 # For the other packages of stochpound (their interface to this one, not public API: not in __all__).
 from stochpound.motions._arias import DEFAULT_G, arias_intensity  # noqa: F401
-from stochpound.motions._conditional import CONDITIONING_MEASURES, MODEL_DAMPING, PERIOD_RANGE, check_scenario  # noqa: F401
+from stochpound.motions._conditional import CONDITIONING_MEASURES, MODEL_DAMPING, PERIOD_RANGE  # noqa: F401
 from stochpound.motions._conditional import (  # noqa: F401
-    MECHANISMS,
     check_damping,
     conditional_distribution,
     conditioning_attrs,
+    conditioning_measure,
+    measure_distribution,
     scenario_spectrum,
     spectrum_dataset,
 )
 from stochpound.motions._measure import KINDS as MEASURE_KINDS, Measure
-from stochpound.motions._measures import measure_label  # noqa: F401
+from stochpound.motions._scenario import MECHANISMS, given_scenario  # noqa: F401
 from stochpound.motions._site_calibration import calibration_table, fit_calibration  # noqa: F401
 from stochpound.motions._site_motions import SITE_MOTION_LIMITS  # noqa: F401  (the analysis's measure-free risk clamps to it)
 
@@ -91,6 +94,7 @@ __all__ = [
     "MEASURE_KINDS",
     "Measure",
     "GEOMETRY_FIELDS",
+    "Scenario",
     "PSD_CONVENTION",
     "TARGET_TOLERANCE",
     "TRUNCATION_EPSILON",

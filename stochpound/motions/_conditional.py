@@ -50,9 +50,9 @@ import numpy as np
 import xarray as xr
 
 from stochpound._errors import SiteError
+from stochpound.motions._measure import Measure
+from stochpound.motions._scenario import GEOMETRY_FIELDS, MECHANISMS, Scenario, given_scenario, ground_motion_models, is_finite_number
 
-#: Mechanisms of a scenario: pygmm's code and the dip (°) assumed.
-MECHANISMS: dict[str, tuple[str, float]] = {"strike_slip": ("SS", 90.0), "reverse": ("RS", 40.0), "normal": ("NS", 50.0)}
 #: Measures a conditional spectrum can be conditioned on.
 CONDITIONING_MEASURES = ("pga", "psa", "sa_avg")
 #: Periods (s) of the models and of the correlation.
@@ -64,80 +64,6 @@ MODEL_DAMPING = 0.05
 #: ε (standard deviations above the models' median) at which hazard models truncate the ground motion: a level beyond it
 #: is not caused by the scenario in such a model (the USGS models of the bundled curves: nshmp-haz's upper truncation at 3σ).
 TRUNCATION_EPSILON = 3.0
-_SCENARIO_FIELDS = {"magnitude": "mag", "distance_km": "dist_rup", "vs30": "v_s30"}
-#: A scenario's geometry beyond its magnitude, rupture distance, Vs30 and mechanism (module docstring), by the toolkit's
-#: name (km and degrees), with pygmm's name: the Joyner–Boore distance, the site's distance from the top edge's strike line
-#: (R_x, ≥ 0 on the hanging wall), the depth to the top of rupture, the dip, the site's depths to 1.0 and 2.5 km/s.
-GEOMETRY_FIELDS = {"distance_jb_km": "dist_jb", "distance_x_km": "dist_x", "ztor_km": "depth_tor", "dip": "dip",
-                   "z1p0_km": "depth_1_0", "z2p5_km": "depth_2_5"}
-
-
-def _models() -> tuple[type, ...]:
-    import pygmm
-
-    return (pygmm.AbrahamsonSilvaKamai2014, pygmm.BooreStewartSeyhanAtkinson2014, pygmm.CampbellBozorgnia2014, pygmm.ChiouYoungs2014)
-
-
-def _common_limits(fields: Mapping[str, str]) -> dict[str, tuple[float, float]]:
-    """The range (from 0 up) of each field (toolkit's name: pygmm's) every one of the four models is meant for: the intersection of their limits."""
-    limits = {}
-    for field, name in fields.items():
-        low, high = 0.0, np.inf
-        for model in _models():
-            for parameter in model.PARAMS:
-                if parameter.name == name:
-                    low = max(low, parameter.min if parameter.min is not None else low)
-                    high = min(high, parameter.max if parameter.max is not None else high)
-        limits[field] = (low, high)
-    return limits
-
-
-def scenario_limits() -> dict[str, tuple[float, float]]:
-    """The range of magnitude, distance_km and vs30 every one of the four models is meant for (the intersection of their limits)."""
-    return _common_limits(_SCENARIO_FIELDS)
-
-
-def geometry_limits(distance_km: float) -> dict[str, tuple[float, float]]:
-    """The range of every :data:`GEOMETRY_FIELDS` entry for a scenario at rupture distance ``distance_km``.
-
-    The four models' common limits (Z_tor 0–20 km, dip 15–90°, Z2.5 0–10 km,
-    R_JB ≤ 300 km), and what a geometry must be: 0 ≤ R_JB ≤ R_rup,
-    |R_x| ≤ 300 km, Z1.0 ≥ 0.
-    """
-    given = {"distance_jb_km": (0.0, min(300.0, float(distance_km))), "distance_x_km": (-300.0, 300.0), "z1p0_km": (0.0, np.inf)}
-    return _common_limits({field: name for field, name in GEOMETRY_FIELDS.items() if field not in given}) | given
-
-
-def _is_number(value: object) -> bool:
-    return isinstance(value, (int, float, np.floating, np.integer)) and not isinstance(value, bool) and bool(np.isfinite(value))
-
-
-def check_scenario(magnitude: float, distance_km: float, vs30: float, mechanism: str, names: Mapping[str, str] | None = None,
-                   geometry: Mapping[str, float | None] | None = None, *, limits: Mapping[str, tuple[float, float]] | None = None,
-                   source: str = "the NGA-West2 models' range") -> None:
-    """Raise :class:`SiteError` naming the field of a scenario outside the models' range or of an unknown mechanism.
-
-    ``names`` spells a field in the message (default: its own name);
-    ``geometry`` (:data:`GEOMETRY_FIELDS`, None values left to the models'
-    estimates) is checked against :func:`geometry_limits`; ``limits``
-    (default :func:`scenario_limits`) are the ranges of magnitude,
-    distance_km and vs30, ``source`` says whose.
-    """
-    names = names or {}
-    for field, (low, high) in (limits or scenario_limits()).items():
-        value = {"magnitude": magnitude, "distance_km": distance_km, "vs30": vs30}[field]
-        if not _is_number(value) or not low <= value <= high:
-            raise SiteError(f"{names.get(field, field)}: must be within {low:g}-{high:g} ({source}), got {value!r}")
-    if mechanism not in MECHANISMS:
-        raise SiteError(f"{names.get('mechanism', 'mechanism')}: must be one of {', '.join(MECHANISMS)}, got {mechanism!r}")
-    unknown = set(geometry or {}) - set(GEOMETRY_FIELDS)
-    if unknown:
-        raise SiteError(f"geometry: unknown field(s) {', '.join(sorted(unknown))}; known: {', '.join(GEOMETRY_FIELDS)}")
-    for field, (low, high) in geometry_limits(distance_km).items():
-        value = (geometry or {}).get(field)
-        if value is not None and (not _is_number(value) or not low <= value <= high):
-            what = "at most the rupture distance, " if field == "distance_jb_km" else ""
-            raise SiteError(f"{names.get(field, field)}: must be within {low:g}-{high:g} ({what}the NGA-West2 models' range), got {value!r}")
 
 
 @dataclass(frozen=True)
@@ -161,31 +87,31 @@ class ConditionalDistribution:
     measure_sigma_ln: float
 
 
-def _pygmm_scenario(magnitude: float, distance_km: float, vs30: float, mechanism: str, geometry: Mapping[str, float | None] | None):
-    """pygmm's scenario: the estimates of the module docstring, replaced by the ``geometry`` given (not None)."""
+def _pygmm_scenario(scenario: Scenario):
+    """pygmm's scenario: the estimates of the module docstring, replaced by the scenario's geometry given."""
     import pygmm
 
-    code, dip = MECHANISMS[mechanism]
-    fields = {"mag": float(magnitude), "dist_rup": float(distance_km), "dist_jb": float(distance_km), "dist_x": -float(distance_km),
-              "v_s30": float(vs30), "mechanism": code, "dip": dip, "depth_tor": 0.0, "region": "california", "vs_source": "measured"}
-    given = {GEOMETRY_FIELDS[field]: float(value) for field, value in (geometry or {}).items() if value is not None}
+    code, dip = MECHANISMS[scenario.mechanism]
+    distance = scenario.distance_km
+    fields = {"mag": scenario.magnitude, "dist_rup": distance, "dist_jb": distance, "dist_x": -distance,
+              "v_s30": scenario.vs30, "mechanism": code, "dip": dip, "depth_tor": 0.0, "region": "california", "vs_source": "measured"}
+    given = {GEOMETRY_FIELDS[field]: value for field, value in scenario.geometry.items()}
     if given:
         fields.update(given)
         fields["on_hanging_wall"] = fields["dist_x"] >= 0.0
     return pygmm.Scenario(**fields)
 
 
-def _average_model(nodes: Sequence[float | None], magnitude: float, distance_km: float, vs30: float, mechanism: str,
-                   geometry: Mapping[str, float | None] | None = None) -> tuple[np.ndarray, np.ndarray]:
+def _average_model(nodes: Sequence[float | None], scenario: Scenario) -> tuple[np.ndarray, np.ndarray]:
     """Mean ln median (g) and σ of the four models at every node (a period in s, or None for PGA)."""
-    scenario = _pygmm_scenario(magnitude, distance_km, vs30, mechanism, geometry)
+    models_scenario = _pygmm_scenario(scenario)
     periods = np.array([PGA_PERIOD if node is None else node for node in nodes], dtype=float)
     is_pga = np.array([node is None for node in nodes])
     means, variances = [], []
-    with warnings.catch_warnings():  # the scenario is checked against the models' limits before
+    with warnings.catch_warnings():  # a Scenario is within the models' limits
         warnings.simplefilter("ignore", UserWarning)
-        for model_class in _models():
-            model = model_class(scenario)
+        for model_class in ground_motion_models():
+            model = model_class(models_scenario)
             means.append(np.where(is_pga, np.log(model.pga), model.interp_ln_spec_accels(periods)))
             variances.append(np.where(is_pga, model.ln_std_pga, model.interp_ln_stds(periods)) ** 2)
     return np.mean(means, axis=0), np.sqrt(np.mean(variances, axis=0))
@@ -203,21 +129,27 @@ def _check_periods(values: Sequence[float], field: str) -> np.ndarray:
     return periods
 
 
-def _conditioning_nodes(measure: str, period: float | Sequence[float] | None) -> list[float | None]:
-    """The nodes (a period in s, or None for PGA) the measure averages ln Sa over, after checking ``measure`` and ``period``."""
+def conditioning_measure(measure: str, period: float | Sequence[float] | None) -> Measure:
+    """The measure a conditional spectrum can be conditioned on (:data:`CONDITIONING_MEASURES`, periods within
+    :data:`PERIOD_RANGE`), or a one-line :class:`SiteError` naming ``measure`` or ``period``."""
     if measure not in CONDITIONING_MEASURES:
         raise SiteError(f"measure: must be one of {', '.join(CONDITIONING_MEASURES)} (no PGV–Sa correlation in the model), got {measure!r}")
     if measure == "pga":
         if period is not None:
             raise SiteError(f"period: pga takes no period, got {period!r}")
-        return [None]
+        return Measure("pga")
     if measure == "psa":
         if period is None or np.ndim(period) != 0:
             raise SiteError(f"period: psa needs one period T* in s, got {period!r}")
-        return list(_check_periods([period], "period"))
+        return Measure("psa", float(_check_periods([period], "period")[0]))
     if period is None or np.ndim(period) != 1 or len(period) < 2:
         raise SiteError(f"period: sa_avg needs a list of at least 2 periods in s, got {period!r}")
-    return list(_check_periods(period, "period"))
+    return Measure("sa_avg", periods=tuple(float(p) for p in _check_periods(period, "period")))
+
+
+def _conditioning_nodes(measure: Measure) -> list[float | None]:
+    """The nodes (a period in s, or None for PGA) the measure averages ln Sa over."""
+    return [None] if measure.kind == "pga" else [measure.period] if measure.kind == "psa" else list(measure.periods)
 
 
 def _joint_nodes(conditioning: Sequence[float | None], output: Sequence[float | None]) -> tuple[list[float | None], np.ndarray]:
@@ -242,12 +174,11 @@ def _node_correlation(nodes: Sequence[float | None]) -> np.ndarray:
     return np.array([calc_correls(at, t) for t in at])
 
 
-def _joint_model(conditioning: Sequence[float | None], output: Sequence[float | None], magnitude: float, distance_km: float,
-                 vs30: float, mechanism: str, geometry: Mapping[str, float | None] | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _joint_model(conditioning: Sequence[float | None], output: Sequence[float | None],
+                 scenario: Scenario) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """ln Sa at the nodes of :func:`_joint_nodes` in a scenario: mean μ, covariance C and the measure's weights w."""
-    check_scenario(magnitude, distance_km, vs30, mechanism, geometry=geometry)
     nodes, weights = _joint_nodes(conditioning, output)
-    mean, sigma = _average_model(nodes, magnitude, distance_km, vs30, mechanism, geometry)
+    mean, sigma = _average_model(nodes, scenario)
     return mean, _node_correlation(nodes) * np.outer(sigma, sigma), weights
 
 
@@ -262,8 +193,9 @@ def _conditioned(mean: np.ndarray, covariance: np.ndarray, weights: np.ndarray,
     return conditional_mean, covariance - np.outer(cw, cw) / variance, epsilon
 
 
-def scenario_distribution(measure: str, period: float | Sequence[float] | None = None, *, magnitude: float, distance_km: float,
-                          vs30: float, mechanism: str, geometry: Mapping[str, float | None] | None = None) -> tuple[float, float]:
+def scenario_distribution(measure: str, period: float | Sequence[float] | None = None, *, magnitude: float | None = None,
+                          distance_km: float | None = None, vs30: float | None = None, mechanism: str | None = None,
+                          geometry: Mapping[str, float | None] | None = None, scenario: Scenario | None = None) -> tuple[float, float]:
     """The median (g) and the standard deviation of ln of a measure in a scenario: the conditional spectrum's own model.
 
     Parameters
@@ -280,6 +212,8 @@ def scenario_distribution(measure: str, period: float | Sequence[float] | None =
         The rupture's geometry and the site's basin depths (:data:`GEOMETRY_FIELDS`:
         ``distance_jb_km``, ``distance_x_km``, ``ztor_km``, ``dip`` in degrees,
         ``z1p0_km``, ``z2p5_km``); a field left out keeps the estimate of the module docstring.
+    scenario : Scenario, optional
+        The scenario as one value, instead of ``magnitude``, ``distance_km``, ``vs30``, ``mechanism`` and ``geometry``.
 
     Returns
     -------
@@ -293,21 +227,30 @@ def scenario_distribution(measure: str, period: float | Sequence[float] | None =
     SiteError
         Naming the field, as :func:`conditional_spectrum`.
     """
-    mean, covariance, weights = _joint_model(_conditioning_nodes(measure, period), [], magnitude, distance_km, vs30, mechanism, geometry)
+    conditioning = _conditioning_nodes(conditioning_measure(measure, period))
+    return _measure_moments(conditioning, given_scenario(scenario, magnitude, distance_km, vs30, mechanism, geometry))
+
+
+def measure_distribution(measure: str, period: float | Sequence[float] | None, scenario: Scenario) -> tuple[float, float]:
+    """:func:`scenario_distribution` in a scenario already checked against the models' range (a site's rupture)."""
+    return _measure_moments(_conditioning_nodes(conditioning_measure(measure, period)), scenario)
+
+
+def _measure_moments(conditioning: list[float | None], scenario: Scenario) -> tuple[float, float]:
+    """exp(wᵀμ) (g) and √(wᵀCw) of the measure of nodes ``conditioning`` in the scenario."""
+    mean, covariance, weights = _joint_model(conditioning, [], scenario)
     return float(np.exp(weights @ mean)), float(np.sqrt(weights @ covariance @ weights))
 
 
-def scenario_spectrum(periods: Sequence[float], *, magnitude: float, distance_km: float, vs30: float, mechanism: str,
-                      geometry: Mapping[str, float | None] | None = None) -> tuple[np.ndarray, np.ndarray]:
+def scenario_spectrum(periods: Sequence[float], scenario: Scenario) -> tuple[np.ndarray, np.ndarray]:
     """Mean ln PSA (g) and its σ at every period (s; 0 stands for PGA) in a scenario: :func:`scenario_distribution` of many periods at once."""
     nodes = [None if p == 0 else p for p in np.atleast_1d(np.asarray(periods, dtype=float))]
     _check_periods([p for p in nodes if p is not None] or [PGA_PERIOD], "periods")
-    check_scenario(magnitude, distance_km, vs30, mechanism, geometry=geometry)
-    return _average_model(nodes, magnitude, distance_km, vs30, mechanism, geometry)
+    return _average_model(nodes, scenario)
 
 
 def _check_level(level: object) -> None:
-    if not _is_number(level) or level <= 0:
+    if not is_finite_number(level) or level <= 0:
         raise SiteError(f"level: must be > 0 (g), got {level!r}")
 
 
@@ -316,20 +259,29 @@ def conditional_distribution(
     period: float | Sequence[float] | None,
     levels: float | Sequence[float],
     periods: Sequence[float],
-    magnitude: float,
-    distance_km: float,
-    vs30: float,
-    mechanism: str,
-    geometry: Mapping[str, float | None] | None = None,
+    scenario: Scenario,
 ) -> ConditionalDistribution:
     """ln Sa (g) at ``periods`` given the measure at each of ``levels`` (module docstring), after checking every input."""
-    conditioning = _conditioning_nodes(measure, period)
+    conditioning, output = _checked_inputs(measure, period, levels, periods)
+    return _distribution(conditioning, output, levels, scenario)
+
+
+def _checked_inputs(measure: str, period: float | Sequence[float] | None, levels: float | Sequence[float],
+                    periods: Sequence[float]) -> tuple[list[float | None], np.ndarray]:
+    """The measure's nodes (:func:`_conditioning_nodes`) and the output periods (s), after checking them and the levels."""
+    conditioning = _conditioning_nodes(conditioning_measure(measure, period))
     for level in np.atleast_1d(levels).tolist():
         _check_level(level)
     output = _check_periods(periods, "periods")
     if np.unique(output).size != output.size:
         raise SiteError("periods: repeated period")
-    mean, covariance, weights = _joint_model(conditioning, list(output), magnitude, distance_km, vs30, mechanism, geometry)
+    return conditioning, output
+
+
+def _distribution(conditioning: list[float | None], output: np.ndarray, levels: float | Sequence[float],
+                  scenario: Scenario) -> ConditionalDistribution:
+    """:func:`conditional_distribution` of checked inputs."""
+    mean, covariance, weights = _joint_model(conditioning, list(output), scenario)
     sigma = np.sqrt(np.diag(covariance))
     levels = np.atleast_1d(np.asarray(levels, dtype=float))
     conditional_mean, conditional_cov, epsilon = _conditioned(mean, covariance, weights, np.log(levels))
@@ -363,9 +315,10 @@ def spectrum_dataset(periods: np.ndarray, mean_ln: np.ndarray, covariance: np.nd
 MODELS_TEXT = "ASK14 BSSA14 CB14 CY14 (pygmm), mean of ln medians, sigma = rms of sigmas; Baker-Jayaram 2008 correlation"
 
 
-def conditioning_attrs(measure: str, period: float | Sequence[float] | None, level: float) -> dict[str, object]:
+def conditioning_attrs(measure: Measure, level: float) -> dict[str, object]:
     """The attributes of a conditional spectrum that name its conditioning: ``measure``, ``conditioning_period``, ``level``, ``damping``, ``models``."""
-    return {"measure": measure, "conditioning_period": "" if period is None else " ".join(f"{p:g}" for p in np.atleast_1d(period)),
+    period = measure.spectral_period
+    return {"measure": measure.kind, "conditioning_period": "" if period is None else " ".join(f"{p:g}" for p in np.atleast_1d(period)),
             "level": float(level), "damping": MODEL_DAMPING, "models": MODELS_TEXT}
 
 
@@ -381,12 +334,13 @@ def conditional_spectrum(
     *,
     level: float,
     periods: Sequence[float],
-    magnitude: float,
-    distance_km: float,
-    vs30: float,
-    mechanism: str,
+    magnitude: float | None = None,
+    distance_km: float | None = None,
+    vs30: float | None = None,
+    mechanism: str | None = None,
     damping: float = MODEL_DAMPING,
     geometry: Mapping[str, float | None] | None = None,
+    scenario: Scenario | None = None,
 ) -> xr.Dataset:
     """The conditional spectrum: ln Sa given the measure at ``level``, for a scenario (module docstring).
 
@@ -409,6 +363,8 @@ def conditional_spectrum(
         0.05 only (the models' damping).
     geometry : mapping, optional
         The rupture's geometry and the site's basin depths, as for :func:`scenario_distribution`.
+    scenario : Scenario, optional
+        The scenario as one value, instead of ``magnitude``, ``distance_km``, ``vs30``, ``mechanism`` and ``geometry``.
 
     Returns
     -------
@@ -427,8 +383,8 @@ def conditional_spectrum(
     """
     check_damping(damping)
     _check_level(level)
-    target = conditional_distribution(measure, period, level, periods, magnitude, distance_km, vs30, mechanism, geometry)
-    scenario = {"magnitude": float(magnitude), "distance_km": float(distance_km), "vs30": float(vs30), "mechanism": mechanism}
-    scenario.update({field: float(value) for field, value in (geometry or {}).items() if value is not None})
+    conditioning, output = _checked_inputs(measure, period, level, periods)
+    scenario = given_scenario(scenario, magnitude, distance_km, vs30, mechanism, geometry)
+    target = _distribution(conditioning, output, level, scenario)
     return spectrum_dataset(target.periods, target.mean_ln[0], target.covariance, target.unconditional_mean_ln, target.unconditional_sigma_ln,
-                            {"epsilon": float(target.epsilon[0]), **conditioning_attrs(measure, period, level), **scenario})
+                            {"epsilon": float(target.epsilon[0]), **conditioning_attrs(conditioning_measure(measure, period), level), **scenario.attrs()})

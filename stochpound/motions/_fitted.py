@@ -40,6 +40,7 @@ are known.
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import replace
 
 import numpy as np
 from scipy.special import ndtr
@@ -50,11 +51,12 @@ from stochpound.motions._conditional import (
     _average_model,
     _conditioned,
     _conditioning_nodes,
+    conditioning_measure,
     _joint_nodes,
     _node_correlation,
-    check_scenario,
 )
-from stochpound.motions._measures import measure_label
+from stochpound.motions._scenario import Scenario
+from stochpound.motions._measure import Measure
 
 #: Candidate magnitudes of the fit.
 MAGNITUDES = tuple(np.round(np.arange(5.5, 8.01, 0.1), 2))
@@ -129,13 +131,13 @@ def fit_scenarios(
         raise SiteError(f"levels: the fit needs at least 2 increasing levels > 0 g, got {x.tolist()}")
     if not others:
         raise SiteError("others: the fit needs the site's hazard curve at one or more other periods")
-    check_scenario(MAGNITUDES[0], DISTANCES[0], vs30, mechanism)
+    first = Scenario.of(MAGNITUDES[0], DISTANCES[0], vs30, mechanism)
     fine, fine_weights = np.asarray(fine_levels, dtype=float), np.asarray(fine_rates, dtype=float)
     if fine.ndim != 1 or fine.shape != fine_weights.shape or fine.size < x.size or not np.all(np.diff(fine) > 0):
         raise SiteError("fine_levels: increasing levels, one rate of fine_rates each (fit_levels)")
     if fine[0] > x[0] or fine[-1] < x[-1]:
         raise SiteError(f"fine_levels: must span the levels {x[0]:g}-{x[-1]:g} g, got {fine[0]:g}-{fine[-1]:g} g")
-    model = _SiteModel(measure, period, fine, others, vs30, mechanism)
+    model = _SiteModel(measure, period, fine, others)
     high_rate = float(fine_weights[fine >= x[0]].sum())  # the rates of the stripes' range: λ(x_1) to λ(x_top)
     low_rate = float(fine_weights[fine >= x[-1]].sum())
     targets = []  # per other curve: the intensities y and ln site rate within the stripes' rates
@@ -143,12 +145,13 @@ def fit_scenarios(
         im, rate = np.asarray(im, dtype=float), np.asarray(rate, dtype=float)
         keep = (rate >= low_rate) & (rate <= high_rate)
         if not keep.any():
-            raise SiteError(f"others: the site's {measure_label('pga' if node is None else 'psa', node)} curve has no intensity whose rate is within the stripes' {low_rate:.3g}-{high_rate:.3g}/yr")
+            other = Measure("pga") if node is None else Measure("psa", float(node))
+            raise SiteError(f"others: the site's {other.label} curve has no intensity whose rate is within the stripes' {low_rate:.3g}-{high_rate:.3g}/yr")
         targets.append((im[keep], np.log(rate[keep])))
     candidates = [(m, r) for m in MAGNITUDES for r in DISTANCES]
     scores = []
     for magnitude, distance in candidates:
-        probabilities = model.exceedance(magnitude, distance, [y for y, _ in targets])
+        probabilities = model.exceedance(replace(first, magnitude=magnitude, distance_km=distance), [y for y, _ in targets])
         score = 0.0
         for k, (_, ln_site) in enumerate(targets):
             recomputed = sum(fine_weights[i] * probabilities[i][k] for i in range(fine.size))
@@ -166,15 +169,15 @@ class _SiteModel:
     """
 
     def __init__(self, measure: str, period: float | Sequence[float] | None, levels: np.ndarray,
-                 others: Sequence[tuple[float | None, Sequence[float], Sequence[float]]], vs30: float, mechanism: str) -> None:
+                 others: Sequence[tuple[float | None, Sequence[float], Sequence[float]]]) -> None:
         other_nodes = [None if node is None else float(node) for node, _, _ in others]
-        self.nodes, self.weights = _joint_nodes(_conditioning_nodes(measure, period), other_nodes)
+        self.nodes, self.weights = _joint_nodes(_conditioning_nodes(conditioning_measure(measure, period)), other_nodes)
         self.correlation = _node_correlation(self.nodes)
-        self.levels, self.vs30, self.mechanism, self.count = levels, vs30, mechanism, len(other_nodes)
+        self.levels, self.count = levels, len(other_nodes)
 
-    def exceedance(self, magnitude: float, distance_km: float, intensities: Sequence[np.ndarray]) -> list[list[np.ndarray]]:
+    def exceedance(self, scenario: Scenario, intensities: Sequence[np.ndarray]) -> list[list[np.ndarray]]:
         """P(Sa(T'_k) > y | IM* = x_j) of the scenario, [level j][other curve k] over that curve's ``intensities`` (g)."""
-        mean, sigma = _average_model(self.nodes, magnitude, distance_km, self.vs30, self.mechanism)
+        mean, sigma = _average_model(self.nodes, scenario)
         cond_mean, cond_cov, _ = _conditioned(mean, self.correlation * np.outer(sigma, sigma), self.weights, np.log(self.levels))
         cond_sd = np.sqrt(np.clip(np.diag(cond_cov), 1e-12, None))
         return [[ndtr((cond_mean[j, k] - np.log(y)) / cond_sd[k]) for k, y in enumerate(intensities)] for j in range(self.levels.size)]
@@ -196,11 +199,12 @@ def recomputed_hazard(
     """
     x = np.asarray(levels, dtype=float)
     weights = np.asarray(rate_weights, dtype=float)
-    model = _SiteModel(measure, period, x, others, float(scenarios[0]["vs30"]), str(scenarios[0]["mechanism"]))
+    model = _SiteModel(measure, period, x, others)
+    vs30, mechanism = float(scenarios[0]["vs30"]), str(scenarios[0]["mechanism"])
     intensities = [np.asarray(im, dtype=float) for _, im, _ in others]
     total = [np.zeros(y.size) for y in intensities]
     for j, scenario in enumerate(scenarios):
-        probabilities = model.exceedance(float(scenario["magnitude"]), float(scenario["distance_km"]), intensities)[j]
+        probabilities = model.exceedance(Scenario(float(scenario["magnitude"]), float(scenario["distance_km"]), vs30, mechanism), intensities)[j]
         for k in range(len(total)):
             total[k] += weights[j] * probabilities[k]
     return total

@@ -130,11 +130,17 @@ class Measure:
 
     @property
     def label(self) -> str:
-        """The short name: ``PGA``, ``PGV``, ``PSA(1 s)``, ``Sa_avg(0.5-4 s)`` (its first and last periods)."""
+        """The short name: ``PGA``, ``PGV``, ``PSA(1 s)``, ``Sa_avg(0.5-4 s)`` (its first and last periods; :meth:`named`)."""
+        return self.named()
+
+    def named(self, precision: str = "g", note: str = "") -> str:
+        """The short name, its periods formatted by ``precision`` (a format spec, e.g. ``".3g"``) and, for a spectral
+        measure, followed by a ``note`` (which of several it is): ``PSA(0.305 s, B1 first mode)``, ``Sa_avg(0.06-3 s)``, ``PGA``."""
+        after = f", {note}" if note else ""
         if self.kind == "psa":
-            return f"PSA({self.period:g} s)"
+            return f"PSA({self.period:{precision}} s{after})"
         if self.kind == "sa_avg":
-            return f"Sa_avg({self.periods[0]:g}-{self.periods[-1]:g} s)"
+            return f"Sa_avg({self.periods[0]:{precision}}-{self.periods[-1]:{precision}} s{after})"
         return self.kind.upper()
 
     @property

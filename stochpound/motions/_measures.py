@@ -20,7 +20,6 @@ A motion scaled by λ has every measure scaled by abs(λ), I_a by λ², D5–95 
 
 from __future__ import annotations
 
-from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -28,7 +27,6 @@ import numpy as np
 import xarray as xr
 from scipy.optimize import brentq
 
-from stochpound.motions._measure import Measure
 from stochpound.motions._arias import DEFAULT_G, arias_intensity, squared_integrals
 from stochpound.motions._spectrum import DEFAULT_DAMPING, as_acceleration, response_spectrum
 
@@ -37,11 +35,6 @@ if TYPE_CHECKING:
 
 #: Fractions of the Arias intensity that bound the significant duration.
 SIGNIFICANT_FRACTIONS = (0.05, 0.95)
-
-
-def measure_label(measure: str, period: float | Sequence[float] | None = None) -> str:
-    """A measure's short name: ``PGA``, ``PSA(1 s)``, ``Sa_avg(0.5-4 s)`` (:attr:`~stochpound.motions.Measure.label`)."""
-    return Measure.of(measure, period).label
 
 
 def peak_ground_motion(acceleration: np.ndarray, dt: float) -> tuple[float, float, float]:

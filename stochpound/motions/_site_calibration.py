@@ -38,6 +38,7 @@ from scipy import optimize, stats
 
 from stochpound.motions._arias import DEFAULT_G
 from stochpound.motions._conditional import MODEL_DAMPING, _average_model, _node_correlation
+from stochpound.motions._scenario import Scenario
 from stochpound.motions._seeding import realization_rng
 from stochpound.motions._site_model import (
     FEATURES, PARAMETERS, ZETA_MAX, SiteModel, _marginal_ppf, load_site_model, mean_normals, motion_parameters, motions_from_parameters,
@@ -88,14 +89,14 @@ def ln_spectra(acceleration: np.ndarray, dt: float, periods: Sequence[float | No
 
 def target(scenario: tuple[float, float, float, str], periods: Sequence[float | None] = CHECK_PERIODS) -> tuple[np.ndarray, np.ndarray]:
     """The NGA-West2 average's mean of ln Sa (g) and σ at ``periods`` for a scenario."""
-    return _average_model(list(periods), *scenario)
+    return _average_model(list(periods), Scenario(*scenario))
 
 
 def _draw(model: SiteModel, scenario: tuple, n: int, seed: int, dt: float, duration: float) -> np.ndarray:
     """ln Sa [n, periods] of n motions of the model for a scenario (realizations 0..n−1 of ``seed``)."""
     n_time = int(round(duration / dt)) + 1
     rngs = [realization_rng(seed, i) for i in range(n)]
-    parameters = motion_parameters(model, *scenario, np.array([rng.standard_normal(7) for rng in rngs]))
+    parameters = motion_parameters(model, Scenario(*scenario), np.array([rng.standard_normal(7) for rng in rngs]))
     return _spectra_in_batches(parameters, lambda rows: np.array([rng.standard_normal(n_time) for rng in rngs[rows]]), dt)
 
 
@@ -165,7 +166,7 @@ class _Pool:
 
 def _pool(scenario: tuple, n: int, seed: int, dt: float) -> _Pool:
     published = load_site_model("rezaeian_2010")
-    centre = mean_normals(published, *scenario)[1:]
+    centre = mean_normals(published, Scenario(*scenario))[1:]
     factor = PROPOSAL_WIDTH * published.cholesky[1:, 1:]
     rng = np.random.default_rng([seed, int(scenario[0] * 10), int(scenario[1]), int(scenario[2])])
     z = rng.standard_normal((n, 5))
@@ -202,7 +203,7 @@ def _pool_statistics(pool: _Pool, x: np.ndarray) -> tuple[np.ndarray, np.ndarray
     published = load_site_model("rezaeian_2010")
     adjustments, scales, corner = _unpack(x)
     model = SiteModel("candidate", published.coefficients, published.cholesky, published.marginals, adjustments, corner, "")
-    mu = mean_normals(model, *pool.scenario)
+    mu = mean_normals(model, Scenario(*pool.scenario))
     factor = np.ones(len(PARAMETERS))
     factor[[PARAMETERS.index(name) for name in SCALED]] = scales
     covariance = published.cholesky @ published.cholesky.T * np.outer(factor, factor)

@@ -48,6 +48,7 @@ from scipy import special, stats
 
 from stochpound._data_files import bundled_data_dir
 from stochpound.motions._arias import DEFAULT_G
+from stochpound.motions._scenario import Scenario
 from stochpound.motions.baseline import baseline_correct
 
 #: The folder of the model's data (data/site_motions).
@@ -125,19 +126,21 @@ def load_site_model(model: str) -> SiteModel:
                      tuple(published["marginals"][p] for p in PARAMETERS), adjustments, corner, provenance)
 
 
-def scenario_features(magnitude: float, distance_km: float, vs30: float, mechanism: str) -> np.ndarray:
+def scenario_features(scenario: Scenario) -> np.ndarray:
     """The calibration's features (:data:`FEATURES`) of a scenario."""
-    m, r = magnitude - 7.0, math.log(distance_km / 25.0)
-    return np.array([1.0, m, r, math.log(vs30 / 750.0), float(mechanism == "reverse"), float(mechanism == "normal"), m * m, m * r])
+    m, r = scenario.magnitude - 7.0, math.log(scenario.distance_km / 25.0)
+    mechanism = scenario.mechanism
+    return np.array([1.0, m, r, math.log(scenario.vs30 / 750.0), float(mechanism == "reverse"), float(mechanism == "normal"), m * m, m * r])
 
 
-def mean_normals(model: SiteModel, magnitude: float, distance_km: float, vs30: float, mechanism: str) -> np.ndarray:
+def mean_normals(model: SiteModel, scenario: Scenario) -> np.ndarray:
     """ν of the scenario before its residuals: the published equations (F = 1 for reverse faulting) plus the adjustments."""
-    f = float(mechanism == "reverse")
+    magnitude, distance_km, vs30 = scenario.magnitude, scenario.distance_km, scenario.vs30
+    f = float(scenario.mechanism == "reverse")
     b = model.coefficients
     first = b[0] @ [1.0, magnitude / 7.0, f, math.log(distance_km / 25.0), math.log(vs30 / 750.0)]
     others = b[1:] @ [1.0, magnitude, f, distance_km, vs30]
-    return np.concatenate([[first], others]) + model.adjustments @ scenario_features(magnitude, distance_km, vs30, mechanism)
+    return np.concatenate([[first], others]) + model.adjustments @ scenario_features(scenario)
 
 
 def _two_sided_exponential_ppf(p: np.ndarray, a: float, b: float, c: float, low: float, high: float) -> np.ndarray:
@@ -162,17 +165,16 @@ def _marginal_ppf(marginal: dict, p: np.ndarray) -> np.ndarray:
     raise ValueError(f"marginal kind {kind!r} unknown")  # pragma: no cover - the data file's own consistency
 
 
-def motion_parameters(model: SiteModel, magnitude: float, distance_km: float, vs30: float, mechanism: str,
-                      normals: np.ndarray) -> dict[str, np.ndarray]:
+def motion_parameters(model: SiteModel, scenario: Scenario, normals: np.ndarray) -> dict[str, np.ndarray]:
     """Each motion's parameters (:data:`UNITS`) from its :data:`PARAMETER_NORMALS` standard normals ``normals`` [n, 7]."""
     normals = np.asarray(normals, dtype=float)
     correlated = np.sum(normals[:, None, :6] * model.cholesky[None, :, :], axis=2)  # L z row by row: a BLAS product's rounding depends on n
-    nu = mean_normals(model, magnitude, distance_km, vs30, mechanism)[None, :] + correlated
+    nu = mean_normals(model, scenario)[None, :] + correlated
     p = np.clip(stats.norm.cdf(nu), 1e-12, 1.0 - 1e-12)
     values = {name: _marginal_ppf(marginal, p[:, i]) for i, (name, marginal) in enumerate(zip(PARAMETERS, model.marginals))}
     values["arias_intensity"] = values["arias_intensity"] * DEFAULT_G  # s·g → m/s
     values["zeta_f"] = np.minimum(values["zeta_f"], ZETA_MAX)
-    values["f_corner"] = np.exp(model.corner[0] + model.corner[1] * (magnitude - 7.0) + model.corner[2] * normals[:, 6])
+    values["f_corner"] = np.exp(model.corner[0] + model.corner[1] * (scenario.magnitude - 7.0) + model.corner[2] * normals[:, 6])
     return values
 
 
@@ -420,9 +422,8 @@ def motions_from_noise_rows(parameters: dict[str, np.ndarray], noise_rows: Calla
     return out
 
 
-def motions_from_normals(model: SiteModel, magnitude: float, distance_km: float, vs30: float, mechanism: str,
-                         normals: np.ndarray, dt: float) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+def motions_from_normals(model: SiteModel, scenario: Scenario, normals: np.ndarray, dt: float) -> tuple[np.ndarray, dict[str, np.ndarray]]:
     """Accelerations [n, n_time] (m/s², from t = 0 at ``dt``) and parameters of the motions of ``normals`` [n, 7 + n_time]."""
     normals = np.asarray(normals, dtype=float)
-    parameters = motion_parameters(model, magnitude, distance_km, vs30, mechanism, normals[:, :PARAMETER_NORMALS])
+    parameters = motion_parameters(model, scenario, normals[:, :PARAMETER_NORMALS])
     return motions_from_parameters(parameters, normals[:, PARAMETER_NORMALS:], dt), parameters

@@ -20,7 +20,7 @@ import xarray as xr
 from scipy import special
 
 from stochpound._errors import SiteError
-from stochpound.motions._conditional import check_scenario
+from stochpound.motions._scenario import Scenario, given_scenario
 from stochpound.motions._seeding import check_seed, realization_rng
 from stochpound.motions._site_model import (
     MODELS, PARAMETER_NORMALS, UNITS, gamma_shape, load_site_model, motion_parameters, motions_from_noise_rows, motions_from_normals,
@@ -34,12 +34,17 @@ WINDOW_FRACTION = 0.999
 WINDOW_TAIL_PERIODS, WINDOW_ROUND = 2.0, 5.0
 
 
-def _check(magnitude: float, distance_km: float, vs30: float, mechanism: str, dt: float, model: str) -> None:
-    check_scenario(magnitude, distance_km, vs30, mechanism, limits=SITE_MOTION_LIMITS, source="the site-motion model's calibrated range")
+def _checked(scenario: Scenario | None, loose: tuple, dt: float, model: str) -> Scenario:
+    """The scenario given (:func:`~stochpound.motions._scenario.given_scenario`), checked against the calibrated range, after ``dt`` and ``model``."""
+    checked = given_scenario(scenario, *loose, limits=SITE_MOTION_LIMITS, source="the site-motion model's calibrated range")
+    if checked.geometry:
+        raise SiteError(f"scenario: the site-motion model takes magnitude, distance_km, vs30 and mechanism only, not a geometry "
+                        f"({', '.join(checked.geometry)}): give the scenario without it")
     if isinstance(dt, bool) or not isinstance(dt, (int, float)) or not 0.0 < dt <= 0.02:
         raise SiteError(f"dt: must be within 0-0.02 s (the model's filter reaches 25 Hz and more), got {dt!r}")
     if model not in MODELS:
         raise SiteError(f"model: must be one of {', '.join(MODELS)}, got {model!r}")
+    return checked
 
 
 def _window(parameters: dict[str, np.ndarray]) -> float:
@@ -58,13 +63,13 @@ def _dataset(acceleration: np.ndarray, parameters: dict[str, np.ndarray], dt: fl
     return xr.Dataset(variables, coords=coords, attrs={**attrs, "dt": float(dt)})
 
 
-def _attrs(magnitude: float, distance_km: float, vs30: float, mechanism: str, model: str) -> dict:
-    return {"magnitude": float(magnitude), "distance_km": float(distance_km), "vs30": float(vs30), "mechanism": mechanism,
-            "model": model, "model_provenance": load_site_model(model).provenance}
+def _attrs(scenario: Scenario, model: str) -> dict:
+    return {**scenario.loose(), "model": model, "model_provenance": load_site_model(model).provenance}
 
 
-def site_motions_from_normals(normals: np.ndarray, *, magnitude: float, distance_km: float, vs30: float, mechanism: str,
-                              dt: float = 0.01, model: str = "hazard_compatible") -> xr.Dataset:
+def site_motions_from_normals(normals: np.ndarray, *, magnitude: float | None = None, distance_km: float | None = None, vs30: float | None = None,
+                              mechanism: str | None = None, dt: float = 0.01, model: str = "hazard_compatible",
+                              scenario: Scenario | None = None) -> xr.Dataset:
     """Motions of a scenario as a deterministic function of independent standard normals.
 
     Parameters
@@ -82,22 +87,25 @@ def site_motions_from_normals(normals: np.ndarray, *, magnitude: float, distance
         Time step, s (≤ 0.02).
     model : {"hazard_compatible", "rezaeian_2010"}
         The calibrated equations (default) or the published ones.
+    scenario : Scenario, optional
+        The scenario as one value, instead of ``magnitude``, ``distance_km``, ``vs30`` and ``mechanism``.
 
     Returns
     -------
     xarray.Dataset
         As :func:`~stochpound.motions.site_motions`.
     """
-    _check(magnitude, distance_km, vs30, mechanism, dt, model)
+    scenario = _checked(scenario, (magnitude, distance_km, vs30, mechanism), dt, model)
     normals = np.asarray(normals, dtype=float)
     if normals.ndim != 2 or normals.shape[1] < PARAMETER_NORMALS + 3 or not np.all(np.isfinite(normals)):
         raise SiteError(f"normals: must be a finite array of shape (n, 7 + n_time) with n_time >= 3, got shape {normals.shape}")
-    acceleration, parameters = motions_from_normals(load_site_model(model), magnitude, distance_km, vs30, mechanism, normals, dt)
-    return _dataset(acceleration, parameters, dt, _attrs(magnitude, distance_km, vs30, mechanism, model))
+    acceleration, parameters = motions_from_normals(load_site_model(model), scenario, normals, dt)
+    return _dataset(acceleration, parameters, dt, _attrs(scenario, model))
 
 
-def site_motions(magnitude: float, distance_km: float, vs30: float, mechanism: str, n: int, seed: int, dt: float = 0.01, *,
-                 duration: float | None = None, model: str = "hazard_compatible", realizations: Sequence[int] | None = None) -> xr.Dataset:
+def site_motions(magnitude: float | None = None, distance_km: float | None = None, vs30: float | None = None, mechanism: str | None = None,
+                 n: int | None = None, seed: int | None = None, dt: float = 0.01, *, duration: float | None = None, model: str = "hazard_compatible",
+                 realizations: Sequence[int] | None = None, scenario: Scenario | None = None) -> xr.Dataset:
     """Stochastic ground motions of a site's scenario (Rezaeian & Der Kiureghian 2010, hazard-compatible; model §11).
 
     Parameters
@@ -126,6 +134,9 @@ def site_motions(magnitude: float, distance_km: float, vs30: float, mechanism: s
         Only these motions of the ``n`` (each in 0 … n − 1), in this order:
         bit for bit the same rows as of the full set (the window is still the
         full set's), at the memory of these alone. Default: all ``n``.
+    scenario : Scenario, optional
+        The scenario as one value, instead of ``magnitude``, ``distance_km``, ``vs30`` and ``mechanism``
+        (``site_motions(n=100, seed=1, scenario=Scenario(7.0, 10.0, 760.0, "strike_slip"))``).
 
     Returns
     -------
@@ -144,7 +155,7 @@ def site_motions(magnitude: float, distance_km: float, vs30: float, mechanism: s
         Naming the field: a scenario outside the calibrated range, an unknown
         mechanism or model, a bad ``n``, ``dt`` or ``duration``.
     """
-    _check(magnitude, distance_km, vs30, mechanism, dt, model)
+    scenario = _checked(scenario, (magnitude, distance_km, vs30, mechanism), dt, model)
     if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1:
         raise SiteError(f"n: must be an integer >= 1, got {n!r}")
     try:
@@ -154,7 +165,7 @@ def site_motions(magnitude: float, distance_km: float, vs30: float, mechanism: s
     rows = _rows(realizations, int(n))
     rngs = [realization_rng(seed, i) for i in range(int(n))]
     first = np.array([rng.standard_normal(PARAMETER_NORMALS) for rng in rngs])  # the whole set's: its window is theirs
-    whole = motion_parameters(load_site_model(model), magnitude, distance_km, vs30, mechanism, first)
+    whole = motion_parameters(load_site_model(model), scenario, first)
     if duration is None:
         duration = _window(whole)
     elif isinstance(duration, bool) or not isinstance(duration, (int, float)) or not 10.0 * dt <= duration <= 600.0:
@@ -163,7 +174,7 @@ def site_motions(magnitude: float, distance_km: float, vs30: float, mechanism: s
     rngs = [rngs[i] for i in rows]
     n_time = int(round(duration / dt)) + 1
     acceleration = motions_from_noise_rows(parameters, lambda batch: np.array([rng.standard_normal(n_time) for rng in rngs[batch]]), n_time, dt)
-    dataset = _dataset(acceleration, parameters, dt, _attrs(magnitude, distance_km, vs30, mechanism, model))
+    dataset = _dataset(acceleration, parameters, dt, _attrs(scenario, model))
     dataset = dataset.assign_coords(realization=np.asarray(rows, dtype=int))
     dataset.attrs.update(seed=seed, n=int(n))
     return dataset

@@ -64,6 +64,7 @@ from stochpound.risk._store_risk import StoreRisk, pounding_fragility, risk_gaps
 from stochpound.risk._demands import StoreDemands, store_demands
 from stochpound.risk._limit_states import KINDS as LIMIT_STATE_KINDS, LimitState, gap_cost_frame, limit_state_problem, limit_state_risk, limit_states_from_table
 from stochpound.risk._efficiency import measure_efficiency, most_efficient
+from stochpound.risk._efficiency import candidate_name  # noqa: F401  (for stochpound.experiment.measure_choice: not public API)
 from stochpound.risk._damage import DAMAGE_DEMANDS, DEFAULT_LIMIT_STATES, DEFAULT_SOURCE as DEFAULT_LIMIT_STATES_SOURCE, MODEL_DRIFT_LIMIT, StoreDamage, store_damage
 from stochpound.hazard import hazard_consistency, read_hazard_file, stripe_rate_weights
 from stochpound.risk._site_consistency import consistency_at_targets, site_consistency

@@ -34,6 +34,7 @@ import numpy as np
 import xarray as xr
 from scipy.stats import linregress
 
+from stochpound.motions import Measure
 from stochpound.risk._store import efficiency_runs
 
 #: Periods of Sa_avg, log-spaced over 0.2 T_min – 3 T_max of the structure.
@@ -69,15 +70,16 @@ def measure_efficiency(store: xr.Dataset, periods: Mapping[str, float], structur
     structural = np.array(list((structure or periods).values()), dtype=float)
     low, high = max(0.2 * structural.min(), spectrum_periods[0]), min(3.0 * structural.max(), spectrum_periods[-1])
     average = np.geomspace(low, high, SA_AVG_PERIODS)
-    candidates = {"PGA": runs["pga"], "PGV": runs["pgv"]}
+    candidates = {Measure("pga").label: runs["pga"], Measure("pgv").label: runs["pgv"]}
     measure_periods = [np.nan, np.nan]
     for name, period in periods.items():
+        label = candidate_name(period, name)
         if period == runs["conditioning"]:  # the store's own measure, exact
-            candidates[f"PSA({period:.3g} s, {name})"] = runs["intensity"]
+            candidates[label] = runs["intensity"]
         else:
-            candidates[f"PSA({period:.3g} s, {name})"] = _interpolated(psa, spectrum_periods, [period]).isel(period=0, drop=True)
+            candidates[label] = _interpolated(psa, spectrum_periods, [period]).isel(period=0, drop=True)
         measure_periods.append(float(period))
-    candidates[f"Sa_avg({average[0]:.3g}-{average[-1]:.3g} s)"] = np.exp(np.log(_interpolated(psa, spectrum_periods, average)).mean("period"))
+    candidates[Measure("sa_avg", periods=tuple(average)).named(".3g")] = np.exp(np.log(_interpolated(psa, spectrum_periods, average)).mean("period"))
     measure_periods.append(np.nan)
     covariates = {"scale_factor": np.log(scale)}
     for key, coordinate in (("magnitude", "record_magnitude"), ("distance", "record_distance")):
@@ -87,6 +89,11 @@ def measure_efficiency(store: xr.Dataset, periods: Mapping[str, float], structur
             for response, value in runs["responses"].items()}
     result = xr.concat(list(fits.values()), "response").assign_coords(response=list(fits), measure=list(candidates))
     return result.assign_coords(measure_period=("measure", np.array(measure_periods)))
+
+
+def candidate_name(period: float | None, name: str) -> str:
+    """The name of a candidate measure: PSA at ``period`` (s; None: PGA) with the ``name`` of that period, e.g. ``PSA(0.305 s, B1 first mode)``."""
+    return Measure("pga").label if period is None else Measure("psa", float(period)).named(".3g", name)
 
 
 def most_efficient(efficiency: xr.Dataset, measures: list[str], response: str = "closure") -> xr.DataArray:

@@ -16,7 +16,6 @@ import numpy as np
 import xarray as xr
 
 from stochpound.hazard import HazardCurve, bundled_measure, bundled_site_curves, hazard_consistency, rate_from_probability
-from stochpound.motions import measure_label
 from stochpound.risk._efficiency import _interpolated
 from stochpound.risk._maf import TARGETS
 from stochpound.risk._store import stripe_spectra_runs
@@ -46,12 +45,12 @@ def site_consistency(store: xr.Dataset) -> dict[str, xr.Dataset]:
     results = {}
     for name in others:
         measure = bundled_measure(name)
-        if measure["measure"] == "pga":
+        if measure.kind == "pga":
             unscaled = runs["pga"]
         else:
-            unscaled = _interpolated(runs["psa"], runs["spectrum_periods"], [float(measure["period"])]).isel(period=0, drop=True)
+            unscaled = _interpolated(runs["psa"], runs["spectrum_periods"], [measure.period]).isel(period=0, drop=True)
         spectra = (unscaled / runs["g"] * runs["scale_factor"]).transpose("intensity", "record")
-        results[measure_label(str(measure["measure"]), measure.get("period"))] = hazard_consistency(spectra, runs["hazard"], HazardCurve.bundled(name))
+        results[measure.label] = hazard_consistency(spectra, runs["hazard"], HazardCurve.bundled(name))
     return results
 
 
