@@ -151,12 +151,12 @@ def risk(store: Path, hazard: str | None, hazard_measure: str | None, hazard_uni
     source = hz.source.splitlines()[0] if hz.source else hz.describe()
     done = f"{result.progress}, answered from the cases that ran (--partial); " if result.progress else ""
     click.echo(f"{result.experiment or store.stem}: {done}{result.motions} motion{'s' if result.motions != 1 else ''}, {stripes} of {result.measure} "
-               f"in {result.setting['units']}; hazard: {source}")
+               f"in {result.setting.units}; hazard: {source}")
     if missed:
         click.echo(f"warning: the motions chosen for the site miss their conditional-spectrum target (mean or std of ln Sa off by more than "
-                   f"{TARGET_TOLERANCE:g} at a period) at the stripes {', '.join(f'{level:g}' for level in missed)} {result.setting['units']}")
+                   f"{TARGET_TOLERANCE:g} at a period) at the stripes {', '.join(f'{level:g}' for level in missed)} {result.setting.units}")
     if beyond:
-        click.echo(f"warning: the scenario puts the stripes {', '.join(f'{level:g}' for level in beyond)} {result.setting['units']} beyond "
+        click.echo(f"warning: the scenario puts the stripes {', '.join(f'{level:g}' for level in beyond)} {result.setting.units} beyond "
                    f"ε {TRUNCATION_EPSILON:g}, where hazard models truncate the ground motion: no earthquake of that scenario causes them there")
     for line in hz.source.splitlines():
         if line.startswith("stochpound: "):

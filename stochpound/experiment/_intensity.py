@@ -27,18 +27,19 @@ response spectrum over ``spectrum_period``) and its ``scale_factor``.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Any, Mapping, Sequence
 
 import numpy as np
 
 from stochpound.model import fields as toml_fields
 from stochpound.experiment._site import parse_selection
-from stochpound.model.friction import is_fixed_base
 from stochpound.motions import arias_intensity, peak_ground_motion, response_spectrum, significant_duration
 from stochpound._errors import IntensityError
-from stochpound.store import MEASURES, describe_measure
+from stochpound.motions import Measure
+from stochpound.store import MEASURES, GapAxis, Intensity, MuAxis, VariantAxis, describe_measure, scene_g
 
 METHODS = ("stripes", "ida")
 UNITS = {"pga": ("g", "m/s2"), "psa": ("g", "m/s2"), "sa_avg": ("g", "m/s2"), "pgv": ("m/s", "cm/s")}
@@ -72,9 +73,9 @@ SUMMARIES: dict[str, tuple[str, str]] = {
 }
 
 
-def parse_intensity(data: Mapping[str, Any], scene: Mapping[str, Any], variants: list[dict[str, Any]], gaps: list[dict[str, Any]], mu: Any,
-                    base_dir: Path = Path(".")) -> dict[str, Any] | None:
-    """The canonical ``intensity`` entry of a definition (None without an ``[intensity]`` table).
+def parse_intensity(data: Mapping[str, Any], scene: Mapping[str, Any], variants: Sequence[VariantAxis], gaps: Sequence[GapAxis], mu: MuAxis | None,
+                    base_dir: Path = Path(".")) -> Intensity | None:
+    """The ``[intensity]`` setting of a definition, typed (None without an ``[intensity]`` table).
 
     ``base_dir`` is the experiment file's folder (a ``[site]`` rupture table's path is relative to it).
 
@@ -95,19 +96,19 @@ def parse_intensity(data: Mapping[str, Any], scene: Mapping[str, Any], variants:
     measure = table.get("measure")
     if measure not in MEASURES:
         raise IntensityError(f"intensity.measure: must be one of {', '.join(MEASURES)}, got {measure!r}")
-    entry: dict[str, Any] = {"measure": measure}
+    period, periods, damping = None, (), None
     if measure == "psa":
-        entry["period"] = toml_fields.number(table, "period", "intensity", required=True, low=0.0, low_open=True)
+        period = toml_fields.number(table, "period", "intensity", required=True, low=0.0, low_open=True)
     elif measure == "sa_avg":
         periods = table.get("periods")
         if not isinstance(periods, list) or len(periods) < 2 or not all(toml_fields.is_number(p) and math.isfinite(p) and p > 0 for p in periods):
             raise IntensityError(f"intensity.periods: must be a list of at least 2 periods > 0 s (e.g. log-spaced over 0.2-3 T1), got {periods!r}")
-        entry["periods"] = [float(p) for p in periods]
-    for key in ("period", "periods"):
-        if key in table and key not in entry:
+        periods = tuple(float(p) for p in periods)
+    for key, given in (("period", period is not None), ("periods", bool(periods))):
+        if key in table and not given:
             raise IntensityError(f"intensity.{key}: only for measure = {'psa' if key == 'period' else 'sa_avg'}")
     if measure in ("psa", "sa_avg"):
-        entry["damping"] = toml_fields.number(table, "damping", "intensity", default=SPECTRUM_DAMPING, low=0.0, high=1.0, high_open=True)
+        damping = toml_fields.number(table, "damping", "intensity", default=SPECTRUM_DAMPING, low=0.0, high=1.0, high_open=True)
     levels = table.get("levels")
     if not isinstance(levels, list) or not levels:
         raise IntensityError(f"intensity.levels: must be a non-empty list of levels > 0, got {levels!r}")
@@ -116,28 +117,32 @@ def parse_intensity(data: Mapping[str, Any], scene: Mapping[str, Any], variants:
             raise IntensityError(f"intensity.levels[{i}]: must be > 0, got {level!r}")
     if len(set(levels)) != len(levels):
         raise IntensityError("intensity.levels: repeated level")
-    entry["levels"] = sorted(float(level) for level in levels)
     units = table.get("units", UNITS[measure][0])
     if units not in UNITS[measure]:
         raise IntensityError(f"intensity.units: must be one of {', '.join(UNITS[measure])} for {measure}, got {units!r}")
-    entry["units"] = units
     method = table.get("method", "stripes")
     if method not in METHODS:
         raise IntensityError(f"intensity.method: must be one of {', '.join(METHODS)}, got {method!r}")
-    entry["method"] = method
     synthetic = table.get("synthetic", SYNTHETIC_SCALING[0])
     if synthetic not in SYNTHETIC_SCALING:
         raise IntensityError(
             f"intensity.synthetic: must be {' or '.join(SYNTHETIC_SCALING)} (each realization scaled to the level, or all by the level over the "
             f"ensemble's mean measure), got {synthetic!r}"
         )
-    entry["synthetic"] = synthetic
-    entry["ran"], entry["note"] = _method_run(method, scene, variants, gaps, mu)
-    entry.update(parse_selection(table, data.get("site"), levels, entry, base_dir))
-    return entry
+    ran, note = _method_run(method, scene, variants, gaps, mu)
+    try:
+        scaled_measure = Measure(measure, period, periods, damping)
+    except ValueError as error:
+        raise IntensityError(f"intensity.{error}") from None
+    setting = Intensity(scaled_measure, units, tuple(sorted(float(level) for level in levels)), method, ran, note,
+                        synthetic)
+    selection = parse_selection(table, data.get("site"), levels, setting, base_dir)
+    if not selection:
+        return setting
+    return dataclasses.replace(setting, note=selection.pop("note"), selection=selection)
 
 
-def _method_run(method: str, scene: Mapping[str, Any], variants: list[dict[str, Any]], gaps: list[dict[str, Any]], mu: Any) -> tuple[str, str]:
+def _method_run(method: str, scene: Mapping[str, Any], variants: Sequence[VariantAxis], gaps: Sequence[GapAxis], mu: MuAxis | None) -> tuple[str, str]:
     """The method that runs and why (IDA needs a homogeneous contact-free response and a gap axis)."""
     if method == "stripes":
         return "stripes", "every motion scaled to every level"
@@ -153,26 +158,26 @@ def _method_run(method: str, scene: Mapping[str, Any], variants: list[dict[str, 
     return "ida", "one contact-free run per motion; capacity IM·g/D per gap (homogeneous scene: fixed bases, at rest, no walls)"
 
 
-def inhomogeneity(scene: Mapping[str, Any], variants: list[dict[str, Any]], mu: Any) -> str:
+def inhomogeneity(scene: Mapping[str, Any], variants: Sequence[VariantAxis], mu: MuAxis | None) -> str:
     """Why a scene's contact-free response is not homogeneous in the input ("" if it is)."""
     if scene.get("wall"):
         return "the scene has walls"
-    if mu is not None and any(not is_fixed_base(value) for value in mu["values"]):
+    if mu is not None and mu.finite_values:
         return "grid.mu has finite friction coefficients (sliding bases)"
     for where, building in _building_tables(scene, variants):
-        if isinstance(building.get("base"), dict) and (mu is None or any(not is_fixed_base(v) for v in mu["values"])):
+        if isinstance(building.get("base"), dict) and (mu is None or mu.finite_values):
             return f"{where}: a building on a sliding base"
         if building.get("initial"):
             return f"{where}: a building not at rest at t = 0"
     return ""
 
 
-def _building_tables(scene: Mapping[str, Any], variants: list[dict[str, Any]]) -> list[tuple[str, Mapping[str, Any]]]:
+def _building_tables(scene: Mapping[str, Any], variants: Sequence[VariantAxis]) -> list[tuple[str, Mapping[str, Any]]]:
     """Every ``[[building]]`` table of a scene and of its variants' overrides, with where it is."""
     tables = [("scene", b) for b in scene.get("building", [])]
     for variant in variants:
-        for value, override in variant["overrides"].items():
-            tables += [(f"variants.{variant['name']}.{value}", b) for b in override.get("building", {}).values()]
+        for value, override in variant.overrides.items():
+            tables += [(f"variants.{variant.name}.{value}", b) for b in override.get("building", {}).values()]
     return tables
 
 
@@ -266,7 +271,7 @@ def task_settings(experiment: Any, motions: Mapping[str, Any]) -> dict[str, Any]
         return None
     gap_axes = [(gap["name"], list(gap["contacts"])) for gap in experiment.definition["gaps"]]
     expected = {index: motions[label].expected_intensity for index, label in enumerate(experiment.motions) if motions[label].expected_intensity is not None}
-    return {**experiment.intensity, "g": float(experiment.definition["scene"].get("g", 9.81)), "gap_axes": gap_axes, "expected": expected}
+    return {**experiment.intensity, "g": scene_g(experiment.definition["scene"]), "gap_axes": gap_axes, "expected": expected}
 
 
 def ensemble_intensity(intensity: Mapping[str, Any], table: Mapping[str, Any], realizations: range, g: float) -> float:
@@ -301,8 +306,6 @@ def scaled_case(
     uses it). The twin is linear and starts at rest, so scaling its response
     equals running it on the scaled motion.
     """
-    import dataclasses
-
     level = labels.get("intensity")
     reference = settings["expected"].get(record, measures["motion_intensity"])
     scale = 1.0 if level is None else float(level) / reference

@@ -30,12 +30,12 @@ def hazard_measures(store: Any, hazard: str | None = None) -> dict[str, float | 
     """
     from stochpound.hazard import bundled_curves, bundled_measure, bundled_site_curves
 
-    name = hazard if hazard in bundled_curves() else (store.pound.hazard or {}).get("bundled")
+    name = hazard if hazard in bundled_curves() else (store.pound.hazard.bundled if store.pound.hazard is not None else None)
     if name:
         measures = [bundled_measure(curve) for curve in bundled_site_curves(name)]
     else:
-        intensity = store.pound.intensity or {}
-        measures = [intensity] if intensity.get("measure") in ("pga", "psa") else []
+        intensity = store.pound.intensity
+        measures = [intensity.measure.entry()] if intensity is not None and intensity.measure.kind in ("pga", "psa") else []
     return {_entry_label(m): (None if m["measure"] == "pga" else float(m["period"])) for m in measures}
 
 
@@ -86,7 +86,7 @@ def measure_choice(store: Any, hazard: str | None = None) -> pd.DataFrame:
         rows.append(row)
     frame = pd.DataFrame(rows)
     frame.attrs["hazard_measures"] = list(available)
-    frame.attrs["store_measure"] = _entry_label(store.pound.intensity or {})
+    frame.attrs["store_measure"] = store.pound.intensity.measure.label if store.pound.intensity is not None else ""
     return frame
 
 

@@ -20,7 +20,7 @@ from stochpound.experiment._grid import CASE, Experiment
 from stochpound.experiment._intensity import check_resolution, ensemble_intensity
 from stochpound.experiment._scene_edits import with_motion
 from stochpound.experiment._site import simulated_motions
-from stochpound.store import canonical_json
+from stochpound.store import canonical_json, scene_g
 from stochpound.experiment._spec import ExperimentError, field_errors
 from stochpound.motions.ground import GroundMotion, SampledMotion
 from stochpound.model.scene_file import scene_from_dict
@@ -84,8 +84,7 @@ def resolve_motions(experiment: Experiment) -> dict[str, ResolvedMotion]:
             worker_table = _worker_table(table, motion, structure)
             expected = None
             if experiment.intensity is not None and experiment.intensity["synthetic"] == "expected":
-                g = float(experiment.definition["scene"].get("g", 9.81))
-                expected = ensemble_intensity(experiment.intensity, worker_table, experiment.realizations(label), g)
+                expected = ensemble_intensity(experiment.intensity, worker_table, experiment.realizations(label), scene_g(experiment.definition["scene"]))
             resolved[label] = ResolvedMotion(label, None, worker_table, grid, expected)
     return resolved
 

@@ -69,10 +69,10 @@ def design_separations(scene: Scene, design: Mapping[str, Any], studied: str | N
     dict of str to numpy.ndarray
         ``asce7_delta_mt``, and ``ec8_ds`` with an ``ec8`` design, ``asce7_dtm`` where it applies.
     """
-    asce7 = Asce7Design(design["sds"], design["sd1"], design["tl"], design["r"], design["cd"], design["ie"])
+    asce7 = Asce7Design(design.sds, design.sd1, design.tl, design.r, design.cd, design.ie)
     codes = {"asce7_delta_mt": lambda b: asce7_inelastic_displacement(modal_floor_displacements(b, design=asce7, g=scene.g), asce7)}
-    if "ec8" in design:
-        ec8 = Ec8Design(design["ec8"]["ag"], design["ec8"]["ground"], design["ec8"]["q"])
+    if design.ec8 is not None:
+        ec8 = Ec8Design(design.ec8.ag, design.ec8.ground, design.ec8.q)
         codes["ec8_ds"] = lambda b: ec8_design_displacement(modal_floor_displacements(b, design=ec8, g=scene.g), ec8)
     gaps = {}
     for rule, displacements in codes.items():
@@ -80,9 +80,9 @@ def design_separations(scene: Scene, design: Mapping[str, Any], studied: str | N
         gaps[rule] = np.array([srss_separation(floors[c.left][c.left_floor - 1], floors[c.right][c.right_floor - 1])
                                * (EC8_REDUCTION if rule == "ec8_ds" and _level_floors(scene, c) else 1.0) for c in scene.contacts])
     isolated = next((b for b in scene.buildings if b.name == studied), None)
-    if "sm1" in design and isolated is not None and _pendulum(isolated):
+    if design.sm1 is not None and isolated is not None and _pendulum(isolated):
         weight = scene.g * (sum(isolated.mass) + isolated.base.mass)
-        dtm, _, _ = asce7_isolator_displacement(weight, isolated.base.mu, isolated.base.radius, design["sm1"], scene.g)
+        dtm, _, _ = asce7_isolator_displacement(weight, isolated.base.mu, isolated.base.radius, design.sm1, scene.g)
         gaps["asce7_dtm"] = np.full(len(scene.contacts), dtm)
     return gaps
 
