@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Mapping, Sequence
 
@@ -39,7 +40,7 @@ from stochpound.experiment._site import parse_selection
 from stochpound.motions import arias_intensity, peak_ground_motion, response_spectrum, significant_duration
 from stochpound._errors import IntensityError
 from stochpound.motions import Measure
-from stochpound.store import MEASURES, GapAxis, Intensity, MuAxis, VariantAxis, describe_measure, scene_g
+from stochpound.store import MEASURES, GapAxis, Intensity, MuAxis, VariantAxis, read_definition
 
 METHODS = ("stripes", "ida")
 UNITS = {"pga": ("g", "m/s2"), "psa": ("g", "m/s2"), "sa_avg": ("g", "m/s2"), "pgv": ("m/s", "cm/s")}
@@ -181,39 +182,72 @@ def _building_tables(scene: Mapping[str, Any], variants: Sequence[VariantAxis]) 
     return tables
 
 
-def level_to_si(intensity: Mapping[str, Any], level: float, g: float) -> float:
+@dataclass(frozen=True)
+class Scaling:
+    """What a worker needs to scale an experiment's cases (:func:`task_settings`).
+
+    Attributes
+    ----------
+    intensity : Intensity
+        The ``[intensity]`` setting.
+    g : float
+        The scene's g, m/s².
+    gap_axes : tuple of (str, tuple of int)
+        Each gap axis's name and the contacts it sets.
+    expected : mapping of int to float
+        By motion number, an ensemble's mean measure (units of the levels), for ``[intensity] synthetic = "expected"``.
+    """
+
+    intensity: Intensity
+    g: float
+    gap_axes: tuple[tuple[str, tuple[int, ...]], ...]
+    expected: Mapping[int, float]
+
+    @property
+    def ran(self) -> str:
+        """The method that runs: ``stripes`` or ``ida``."""
+        return self.intensity.ran
+
+
+def as_intensity(setting: Intensity | Mapping[str, Any]) -> Intensity:
+    """The typed setting of an experiment's ``intensity`` (the record itself, or read from its canonical entry)."""
+    return setting if isinstance(setting, Intensity) else Intensity.from_entry(setting)
+
+
+def level_to_si(intensity: Intensity, level: float, g: float) -> float:
     """A level in the units of ``levels`` in SI (m/s² or m/s)."""
-    factor = {"g": g, "m/s2": 1.0, "m/s": 1.0, "cm/s": 0.01}[intensity["units"]]
+    factor = {"g": g, "m/s2": 1.0, "m/s": 1.0, "cm/s": 0.01}[intensity.units]
     return float(level) * factor
 
 
-def check_resolution(intensity: Mapping[str, Any], dt: float, where: str) -> None:
+def check_resolution(intensity: Intensity, dt: float, where: str) -> None:
     """Raise if a spectral measure's period is shorter than :data:`PERIOD_SAMPLES` steps of a motion."""
-    periods = [intensity["period"]] if "period" in intensity else intensity.get("periods", [])
+    measure = intensity.measure
+    periods = [measure.period] if measure.period is not None else measure.periods
     shortest = PERIOD_SAMPLES * dt
     for period in periods:
         if period < shortest - 1e-12:
-            key = "intensity.period" if "period" in intensity else "intensity.periods"
+            key = "intensity.period" if measure.period is not None else "intensity.periods"
             raise IntensityError(
                 f"{key}: {period:g} s is shorter than {PERIOD_SAMPLES:g}·dt = {shortest:g} s of {where}: "
                 "the sampled motion carries nothing above its Nyquist frequency 1/(2 dt)"
             )
 
 
-def motion_measures(values: np.ndarray, dt: float, intensity: Mapping[str, Any], g: float, spectrum: bool = True) -> dict[str, Any]:
+def motion_measures(values: np.ndarray, dt: float, intensity: Intensity, g: float, spectrum: bool = True) -> dict[str, Any]:
     """The unscaled measures of a motion (samples in m/s², linear between them), by store name.
 
     ``motion_intensity`` is in the units of ``levels``; ``spectrum=False`` leaves out ``motion_psa``.
     """
     pga, pgv, pgd = peak_ground_motion(values, dt)
-    measure = intensity["measure"]
-    if measure == "pga":
+    measure = intensity.measure
+    if measure.kind == "pga":
         value = pga
-    elif measure == "pgv":
+    elif measure.kind == "pgv":
         value = pgv
     else:
-        periods = [intensity["period"]] if measure == "psa" else intensity["periods"]
-        psa = response_spectrum(values, dt, periods, intensity["damping"]).psa.values
+        periods = [measure.period] if measure.kind == "psa" else list(measure.periods)
+        psa = response_spectrum(values, dt, periods, measure.damping).psa.values
         value = float(np.exp(np.mean(np.log(psa))))
     measures = {
         "motion_intensity": value / level_to_si(intensity, 1.0, g),
@@ -247,34 +281,36 @@ def ida_capacity(closure: np.ndarray, im: float, gap_axes: list[tuple[float, lis
     return float(min(capacities))
 
 
-def summary_attrs(intensity: Mapping[str, Any], name: str) -> dict[str, str]:
+def summary_attrs(intensity: Intensity | Mapping[str, Any], name: str) -> dict[str, str]:
     """Units and long name of a per-case intensity variable."""
     units, long_name = SUMMARIES[name]
-    return {"units": units.format(units=intensity["units"]), "long_name": long_name.format(measure=describe_measure(intensity))}
+    setting = as_intensity(intensity)
+    return {"units": units.format(units=setting.units), "long_name": long_name.format(measure=setting.description)}
 
 
-def store_names(intensity: Mapping[str, Any] | None) -> list[str]:
+def store_names(intensity: Intensity | Mapping[str, Any] | None) -> list[str]:
     """The per-case intensity variables of a store (none without intensity)."""
     if intensity is None:
         return []
     names = [name for name in SUMMARIES if name != "ida_capacity"]
-    return names + (["ida_capacity"] if intensity["ran"] == "ida" else [])
+    return names + (["ida_capacity"] if as_intensity(intensity).ran == "ida" else [])
 
 
-def task_settings(experiment: Any, motions: Mapping[str, Any]) -> dict[str, Any] | None:
+def task_settings(experiment: Any, motions: Mapping[str, Any]) -> Scaling | None:
     """What a worker needs to scale an experiment's cases (None without intensity).
 
-    The ``intensity`` entry, g, the gap axes and, by motion number, the
+    The intensity setting, g, the gap axes and, by motion number, the
     ensembles' mean measures (``expected``; ``[intensity] synthetic = "expected"``).
     """
     if experiment.intensity is None:
         return None
-    gap_axes = [(gap["name"], list(gap["contacts"])) for gap in experiment.definition["gaps"]]
+    definition = read_definition(experiment.definition)
+    gap_axes = tuple((gap.name, gap.contacts) for gap in definition.gaps)
     expected = {index: motions[label].expected_intensity for index, label in enumerate(experiment.motions) if motions[label].expected_intensity is not None}
-    return {**experiment.intensity, "g": scene_g(experiment.definition["scene"]), "gap_axes": gap_axes, "expected": expected}
+    return Scaling(as_intensity(experiment.intensity), definition.g, gap_axes, expected)
 
 
-def ensemble_intensity(intensity: Mapping[str, Any], table: Mapping[str, Any], realizations: range, g: float) -> float:
+def ensemble_intensity(intensity: Intensity, table: Mapping[str, Any], realizations: range, g: float) -> float:
     """Mean measure (units of ``levels``) of an ensemble's realizations, generated from its worker table in chunks."""
     from stochpound import motions as synthetic_motions
 
@@ -288,17 +324,17 @@ def ensemble_intensity(intensity: Mapping[str, Any], table: Mapping[str, Any], r
     return total / len(realizations)
 
 
-def measures_of(settings: Mapping[str, Any], ground: Any) -> dict[str, Any]:
+def measures_of(settings: Scaling, ground: Any) -> dict[str, Any]:
     """:func:`motion_measures` of a sampled ground motion (a motion given by a formula cannot be scaled to a measure)."""
     from stochpound.motions.ground import SampledMotion
 
     if not isinstance(ground, SampledMotion):
         raise IntensityError(f"intensity: only sampled motions (records, suites, synthetic ensembles) can be scaled, not {type(ground).__name__}")
-    return motion_measures(ground.values, ground.dt, settings, settings["g"])
+    return motion_measures(ground.values, ground.dt, settings.intensity, settings.g)
 
 
 def scaled_case(
-    settings: Mapping[str, Any], record: int, labels: Mapping[str, Any], ground: Any, twin: np.ndarray, measures: Mapping[str, Any]
+    settings: Scaling, record: int, labels: Mapping[str, Any], ground: Any, twin: np.ndarray, measures: Mapping[str, Any]
 ) -> tuple[Any, np.ndarray, dict[str, Any]]:
     """The case's motion and fixed-base twin scaled to its ``intensity`` level (unchanged for IDA), and its intensity variables.
 
@@ -307,7 +343,7 @@ def scaled_case(
     equals running it on the scaled motion.
     """
     level = labels.get("intensity")
-    reference = settings["expected"].get(record, measures["motion_intensity"])
+    reference = settings.expected.get(record, measures["motion_intensity"])
     scale = 1.0 if level is None else float(level) / reference
     extra = {**measures, "scale_factor": scale}
     if scale == 1.0:
@@ -316,9 +352,9 @@ def scaled_case(
     return scaled, twin * scale, extra
 
 
-def capacity_of(settings: Mapping[str, Any], summary: Mapping[str, Any], labels: Mapping[str, Any]) -> float:
+def capacity_of(settings: Scaling, summary: Mapping[str, Any], labels: Mapping[str, Any]) -> float:
     """:func:`ida_capacity` of a contact-free case from its summary and grid labels."""
-    axes = [(float(labels[name]), contacts) for name, contacts in settings["gap_axes"]]
+    axes = [(float(labels[name]), contacts) for name, contacts in settings.gap_axes]
     return ida_capacity(np.asarray(summary["peak_contact_closure"], dtype=float), float(summary["motion_intensity"]), axes)
 
 

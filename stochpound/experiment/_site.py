@@ -466,7 +466,8 @@ def stripe_selections(experiment: GridExperiment) -> StripeSelections:
     conditioning = [] if period is None else list(np.atleast_1d(period))
     structure = structure_periods(experiment)
     periods = selection_periods(structure, conditioning)
-    pool = selection_pool(records, periods, measure, period, MODEL_DAMPING, scene_g(experiment.definition["scene"]))
+    g = scene_g(experiment.definition["scene"])
+    pool = selection_pool(records, periods, measure, period, MODEL_DAMPING, g)
     selections, targets, simulated = [], [], {}
     rules = {key: intensity[key] for key in RULES if key in intensity}
     if "ruptures" in intensity:  # the exact conditional spectrum of every stripe

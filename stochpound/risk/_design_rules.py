@@ -37,6 +37,7 @@ import numpy as np
 import xarray as xr
 
 from stochpound.hazard import HazardCurve
+from stochpound.store import Design
 from stochpound.model.building import Building
 from stochpound.model.scene import Scene
 from stochpound.risk import _store
@@ -51,15 +52,15 @@ DESIGN_RULE_LEVELS = {"asce7_delta_mt": 0.02, "ec8_ds": 0.10, "asce7_dtm": 0.02}
 _RECORD_DIMS = ("intensity", "record", "contact")
 
 
-def design_separations(scene: Scene, design: Mapping[str, Any], studied: str | None = None) -> dict[str, np.ndarray]:
+def design_separations(scene: Scene, design: Design, studied: str | None = None) -> dict[str, np.ndarray]:
     """The codes' separations of a scene's contacts from its design (m): one array (one gap per contact) per rule.
 
     Parameters
     ----------
     scene : Scene
         The buildings and contacts (a base, if any, held fixed for the storeys' design analysis).
-    design : mapping
-        The canonical ``[design]`` entry (``stochpound.experiment``'s ``parse_design``).
+    design : Design
+        The ``[design]`` table (``stochpound.experiment``'s ``parse_design``; ``Design.from_entry`` of its canonical entry).
     studied : str, optional
         The building whose friction pendulum gives ``asce7_dtm`` (with ``sm1``
         in the design and a finite μ and radius in the scene).
@@ -87,7 +88,7 @@ def design_separations(scene: Scene, design: Mapping[str, Any], studied: str | N
     return gaps
 
 
-def design_rules_risk(store: xr.Dataset, hz: HazardCurve, design: Mapping[str, Any], studied: str | None = None, years: float = 50.0,
+def design_rules_risk(store: xr.Dataset, hz: HazardCurve, design: Design, studied: str | None = None, years: float = 50.0,
                       confidence: float = 0.95, bootstrap: int = BOOTSTRAP, seed: int = 0) -> xr.Dataset:
     """The codes' own gaps of every configuration of a store with stripes and the mean annual frequency of pounding at each.
 
@@ -97,7 +98,7 @@ def design_rules_risk(store: xr.Dataset, hz: HazardCurve, design: Mapping[str, A
         An experiment store with intensity stripes and contact-free cases.
     hz : HazardCurve
         The site's hazard, in the store's intensity measure.
-    design : mapping
+    design : Design
         The ``[design]`` entry (:func:`design_separations`).
     studied : str, optional
         The building of ``asce7_dtm``.
@@ -133,7 +134,7 @@ def design_rules_risk(store: xr.Dataset, hz: HazardCurve, design: Mapping[str, A
         .assign_attrs(years=years, **no_interval_attrs(fragility))
 
 
-def _configuration_gaps(store: xr.Dataset, closure: xr.DataArray, design: Mapping[str, Any], studied: str | None) -> xr.DataArray:
+def _configuration_gaps(store: xr.Dataset, closure: xr.DataArray, design: Design, studied: str | None) -> xr.DataArray:
     """The rules' gaps (m) over ``rule``, the configurations of ``closure`` and ``contact``, from each configuration's scene."""
     configs = [dim for dim in closure.dims if dim not in _RECORD_DIMS]
     per_config = {}

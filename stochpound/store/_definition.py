@@ -1,15 +1,20 @@
 """The experiment definition as typed, frozen records: what an experiment runs, read one way.
 
-``stochpound.experiment._spec.parse_experiment`` validates an experiment
-file and returns the *canonical definition*, a JSON-able dict (stored with
-every store as the ``definition`` attribute). Everything that reads a
-definition — a parsed file, a store's attribute, a dict — goes through
-:func:`read_definition`, once, which returns a :class:`Definition`: the
-grid's axes (:class:`GapAxis`, :class:`MuAxis`, :class:`VariantAxis`), the
-motions (:class:`MotionSource`), the outputs (:class:`Output`), the solver
-settings (:class:`Solver`), the intensity setting (:class:`Intensity`) and
-the site's hazard (:class:`Hazard`). The canonical dict stays the stored
-form; :meth:`Definition.to_dict` gives it back unchanged.
+Each table of an experiment file parses to one of these records
+(``stochpound.experiment._spec.parse_experiment``): the grid's axes
+(:class:`GapAxis`, :class:`MuAxis`, :class:`VariantAxis`), the motions
+(:class:`MotionSource`), the outputs (:class:`Output`), the solver settings
+(:class:`Solver`), the intensity setting (:class:`Intensity`, its measure a
+:class:`stochpound.motions.Measure`), the site's hazard (:class:`Hazard`), the
+code design (:class:`Design`), the limit states (:class:`LimitStates`) and how
+the stripes' scenario was obtained (:class:`Site`), gathered in a
+:class:`Definition`. The *canonical definition*, a JSON-able dict stored with
+every store as its ``definition`` attribute and hashed, is only written from
+them (:meth:`Definition.to_dict`, each record's ``entry()``) and read back by
+:func:`read_definition` (each record's ``from_entry``); written and read, it is
+unchanged, so stored definitions and their sha256 are. The scene itself and a
+variant's overrides stay the scene file's tables (what the model's scene
+builder reads). The scene's g is read in one place (:func:`scene_g`).
 
 **The identity.** :func:`definition_sha256` hashes the canonical JSON
 (:func:`canonical_json`) without the entries that no run depends on
@@ -77,7 +82,7 @@ MEASURES = MEASURE_KINDS
 
 
 def scene_g(scene: Mapping[str, Any]) -> float:
-    """A scene dict's acceleration of gravity, m/s²: its ``g``, or :data:`stochpound.motions.DEFAULT_G` when it leaves it out (the one reader)."""
+    """A scene dict's acceleration of gravity, m/s²: its ``g``, or ``stochpound.motions.DEFAULT_G`` (9.81) when it leaves it out (the one reader)."""
     return float(scene.get("g", DEFAULT_G))
 
 
@@ -667,7 +672,7 @@ class Definition:
 
     @property
     def g(self) -> float:
-        """The scene's acceleration of gravity, m/s² (:data:`stochpound.motions.DEFAULT_G` when the scene leaves it out)."""
+        """The scene's acceleration of gravity, m/s² (``stochpound.motions.DEFAULT_G`` (9.81) when the scene leaves it out)."""
         return scene_g(self.scene)
 
     @property
