@@ -135,19 +135,20 @@ def parse_experiment(data: Mapping[str, Any], base_dir: str | Path = ".", defaul
             except ValueError as error:
                 raise ExperimentError(f"experiment.reproduces: {error} (a published study's part, \"<study>:<part>\")") from None
     scene, scene_source = _base_scene(data, header, base_dir)
-    buildings = [b.get("name", f"B{i + 1}") for i, b in enumerate(scene.get("building", []))]
+    buildings = building_names(scene)
+    contacts = scene.get("contact", [])
     studied = header.get("studied", buildings[0] if buildings else "B1")
     if studied not in buildings:
         raise ExperimentError(f"experiment.studied: must be one of the scene's buildings ({', '.join(buildings)}), got {studied!r}")
-    declared = _variants(data, buildings, len(scene.get("contact", [])))
+    declared = _variants(data, buildings, len(contacts))
     grid = _table_or_error(data, "grid", "")
     for key in grid:
         if not (is_gap_axis(key) or key == "mu" or key in declared):
             allowed = ["gap", "gap_<name>", "mu", *sorted(declared)]
             raise ExperimentError(f"grid.{key}: unknown axis (allowed: {', '.join(allowed)}; variant axes are declared in [variants.<axis>])")
     variants = [VariantAxis(name, tuple(_variant_selection(grid, name, list(overrides))), overrides) for name, overrides in declared.items()]
-    n_contacts = len(scene.get("contact", []))
-    contact_floors = [c.get("between", [[None, None]])[0][1] for c in scene.get("contact", [])]
+    n_contacts = len(contacts)
+    contact_floors = [c.get("between", [[None, None]])[0][1] for c in contacts]
     n_walls = len(scene.get("wall", []))
     gaps = [_gap_axis(key, grid[key], n_contacts, contact_floors, n_walls) for key in grid if is_gap_axis(key)]
     mu = _mu_axis(grid["mu"], buildings) if "mu" in grid else None
@@ -543,12 +544,9 @@ def _output(data: Mapping[str, Any], buildings: list[str]) -> Output:
     if not isinstance(chosen, list) or not chosen or not all(b in buildings for b in chosen):
         raise ExperimentError(f"output.buildings: must be a non-empty list of building names ({', '.join(buildings)}), got {chosen!r}")
     _check_unique(chosen, "output.buildings")
-    impacts = table.get("impacts", True)
-    if not isinstance(impacts, bool):
-        raise ExperimentError(f"output.impacts: must be true or false, got {impacts!r}")
-    demands = table.get("demands", False)
-    if not isinstance(demands, bool):
-        raise ExperimentError(f"output.demands: must be true or false, got {demands!r}")
+    with field_errors():
+        impacts = toml_fields.boolean(table, "impacts", "output", default=True)
+        demands = toml_fields.boolean(table, "demands", "output", default=False)
     return Output(tuple(histories), tuple(b for b in buildings if b in chosen), impacts, demands)
 
 
