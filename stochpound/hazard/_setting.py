@@ -268,7 +268,7 @@ def _check_measure(where: str, stated: Mapping[str, Any], measure: Measure, bund
     wanted = measure.entry()
     for key, value in stated.items():
         field = where if bundled else _field(where, key)
-        what = f"{bundled!r} is {Measure.from_entry({**wanted, **stated}).description}" if bundled else f"the hazard's {key} is {value!r}"
+        what = f"{bundled!r} is {Measure.from_entry(stated).description}" if bundled else f"the hazard's {key} is {value!r}"
         if key not in wanted or not _equal(value, wanted[key]):
             detail = f" (intensity.{key} = {wanted[key]!r})" if key in wanted else ""
             raise IntensityError(f"{field}: the hazard's measure must be [intensity]'s, {measure.description}{detail}; {what}")
