@@ -12,6 +12,7 @@ from stochpound._errors import os_error_message
 from stochpound._text_files import read_text_file
 from stochpound.cli._store_errors import store_variables
 from stochpound.risk import BOOTSTRAP, TARGETS
+from stochpound.store import Design
 
 
 def _targets(value: str) -> tuple[float, ...]:
@@ -44,7 +45,7 @@ def _limit_states(path: Path) -> tuple:
     return limit_states_from_table(_toml_table(path, "limit_states", "docs/risk.md")["limit_states"])
 
 
-def _design(path: Path) -> dict:
+def _design(path: Path) -> Design | None:
     """The buildings' code design of a TOML file's ``[design]`` table (the experiment file's table, docs/experiments.md)."""
     from stochpound.experiment import parse_design
 
