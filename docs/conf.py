@@ -45,8 +45,8 @@ numpydoc_xref_aliases = {
         "model": ["Scene", "Building", "InitialState", "Base", "Contact", "Wall", "ImpactElement"],
         "experiment": ["Experiment", "Dim", "Case", "RunReport", "StatusReport", "ExperimentError", "Definition", "GapAxis", "MuAxis",
                        "VariantAxis", "MotionSource", "Output", "Solver"],
-        "store": ["StoreAccessor", "Intensity", "Hazard", "StoreVariable"],
-        "motions": ["Envelope", "FilteredWhiteNoise", "SoilPreset"],
+        "store": ["StoreAccessor", "Intensity", "Hazard", "Design", "DesignEc8", "LimitStates", "LimitStateCapacities", "Site", "StoreVariable"],
+        "motions": ["Envelope", "FilteredWhiteNoise", "SoilPreset", "Measure"],
         "motions.records": ["Record", "RegistryEntry", "RawSeries", "RecordStatistics"],
         "": ["SceneError", "RecordError", "SiteError", "StochpoundError"],
     }.items()

@@ -31,12 +31,12 @@ from stochpound.experiment import load_experiment, run_experiment
 from stochpound.experiment._spec import ExperimentError, parse_experiment
 from stochpound.model.scene_file import scene_from_dict
 from stochpound.risk import design_separations, risk_curve, store_risk, stripe_fragility
-from stochpound.store import definition_sha256, open_store
+from stochpound.store import Design, definition_sha256, open_store
 from tests.helpers import FIXED, REPOSITORY, risk_text, write_experiment
 
 G = 9.81
-DESIGN = {"sds": 1.0, "sd1": 0.6, "tl": 8.0, "r": 8.0, "cd": 5.5, "omega0": 3.0, "ie": 1.0, "sm1": 1.2,
-          "ec8": {"ag": 0.3, "ground": "B", "q": 4.0}}
+DESIGN = Design.from_entry({"sds": 1.0, "sd1": 0.6, "tl": 8.0, "r": 8.0, "cd": 5.5, "omega0": 3.0, "ie": 1.0, "sm1": 1.2,
+                            "ec8": {"ag": 0.3, "ground": "B", "q": 4.0}})
 DESIGN_TABLE = '\n[design]\nsds = 1.0\nsd1 = 0.6\nr = 8.0\ncd = 5.5\nomega0 = 3.0\nec8 = { ag = 0.3, ground = "B", q = 4.0 }\n'
 
 
@@ -158,7 +158,7 @@ def test_stochpound_risk_takes_a_design_file_and_refuses_a_bad_one(design_store,
     result = CliRunner().invoke(main, ["risk", str(design_store), "--bootstrap", "0", "--design", str(tmp_path / "stronger.toml")])
     assert result.exit_code == 0, result.output
     gaps = design_separations(open_store(design_store).pound.scene(gap=math.inf, intensity=0.3, record=open_store(design_store)["record"].values[0]),
-                              {"sds": 1.0, "sd1": 0.6, "tl": 8.0, "r": 4.0, "cd": 4.0, "omega0": 2.5, "ie": 1.0})
+                              Design(sds=1.0, sd1=0.6, tl=8.0, r=4.0, cd=4.0, omega0=2.5, ie=1.0))
     assert f"{gaps['asce7_delta_mt'][0]:.4g}" in result.output and "Eurocode 8 §4.4.2.7 d_s of the design analysis" not in result.output
     (tmp_path / "bad.toml").write_text("[design]\nsds = 1.0\nsd1 = 0.6\nr = 8.0\ncd = 12.0\nomega0 = 3.0\n")
     result = CliRunner().invoke(main, ["risk", str(design_store), "--bootstrap", "0", "--design", str(tmp_path / "bad.toml")])
@@ -179,7 +179,7 @@ def test_editing_the_design_keeps_the_runs_and_records_it(tmp_path):
     assert report.nothing_to_run and report.done_now == 0
     assert any("the [design] changed" in line for line in said) and not any("hazard changed" in line for line in said)
     with open_store(store) as ds:
-        assert ds.pound.definition.design["cd"] == 5.5 and ds.pound.definition.design["ec8"]["q"] == 4.0
+        assert ds.pound.definition.design.cd == 5.5 and ds.pound.definition.design.ec8.q == 4.0
         xr.testing.assert_identical(ds["peak_contact_closure"].load(), before)
 
 

@@ -104,7 +104,7 @@ def test_the_report_names_the_most_efficient_measure_and_weighs_the_stores_own_a
     text = _measure_choice_blocks("s", risk, choice)[0].text
     counts = choice["most efficient"].value_counts()
     assert "the most efficient is " + ", ".join(f"{m} in {c} of {len(choice)} configurations" for m, c in counts.items()) in text
-    own = "PGA" if risk.setting["measure"] == "pga" else f"PSA({risk.setting['period']:g} s)"
+    own = "PGA" if risk.setting.measure.kind == "pga" else f"PSA({risk.setting.measure.period:g} s)"
     assert choice.attrs["store_measure"] == own
     worst = max(float(row[own] - row[row["most efficient"]]) for _, row in choice.iterrows())
     if worst == 0.0:

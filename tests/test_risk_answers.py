@@ -16,6 +16,8 @@ import xarray as xr
 from stochpound.report.sections._risk import design_summary_text, design_value_text, moat_text
 from stochpound.risk import HazardCurve, StoreDemands, StoreRisk, degenerate_text, mean_annual_frequency, rate_intervals
 from stochpound.risk._fragility import ALWAYS, FIT, NEVER, Fragility
+from stochpound.motions import Measure
+from stochpound.store import Intensity
 
 HAZARD = HazardCurve([0.05, 0.2, 0.5, 1.0, 2.0], [0.0333, 8e-3, 2e-3, 5e-4, 8e-5], units="g", measure="PGA")
 
@@ -100,7 +102,7 @@ def test_the_gap_to_design_to_is_the_upper_bound_of_g_star_stated_as_such():
     assert list(unbounded.design_frame()["design"]) == [0.20, 0.40] and "no bootstrap" in design_value_text(unbounded)
     assert "g* is a central estimate from 22 motions and" in text
     selected = _risk()
-    selected.setting = {"selection": "conditional_spectrum", "units": "g"}  # motions chosen per stripe from a pool
+    selected.setting = Intensity(Measure("pga"), "g", (0.1,), "stripes", "stripes", "", selection={"selection": "conditional_spectrum"})  # motions chosen per stripe
     assert "g* is a central estimate from 22 motions per stripe and" in design_value_text(selected)
 
 

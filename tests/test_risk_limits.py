@@ -28,7 +28,8 @@ from stochpound.hazard import hazard_option, read_hazard_file
 from stochpound.risk import HazardCurve, StoreRisk, limit_state_events, risk_curve, risk_targeted_separation, stripe_fragility
 from stochpound.risk._store_risk import bootstrap_bytes, bound_beyond_stripes, check_bootstrap
 from stochpound.risk._stripe_coverage import top_capped_maf
-from stochpound.store import UnfinishedStoreError, check_finished
+from stochpound.motions import Measure
+from stochpound.store import Intensity, UnfinishedStoreError, check_finished
 
 A, SIGMA = 0.1, 0.4  # closure D = A x ε (m, x in g), ln ε ~ N(0, SIGMA²): F(x; g) = Φ(ln(A x / g) / SIGMA), θ(g) = g / A
 K0, K = 1e-4, 2.5  # hazard λ(x) = K0 x^-K (1/yr)
@@ -107,7 +108,7 @@ def test_the_tables_give_a_bound_as_such_and_withhold_the_design_gap():
     _, hz, fragility, plain = _chain((0.2, 0.4, 0.8))
     curve = risk_curve(fragility, hz)
     risk = StoreRisk(fragility, curve, bound_beyond_stripes(plain, fragility, hz), None, "", hz, 40, "stripes",
-                     setting={"measure": "pga", "units": "g"}, stripes=3)
+                     setting=Intensity(Measure("pga"), "g", (0.2, 0.4, 0.8), "stripes", "stripes", ""), stripes=3)
     frame = risk.to_frame()
     assert frame["lower_bound"].tolist() == [False, False, True, True]
     table = risk.separation_frame()

@@ -354,6 +354,6 @@ def test_a_run_of_a_site_of_ruptures_stores_and_reports_the_mixture(tmp_path, de
     exact = demo.conditional_spectra("psa", 1.0, levels=[0.1, 0.2], periods=store.selection_period.values)
     np.testing.assert_allclose(store.target_median.values, [cs["median"].values for cs in exact], rtol=1e-12)
     np.testing.assert_allclose(store.target_epsilon.values, [cs.attrs["epsilon"] for cs in exact], rtol=1e-12)
-    assert store.pound.hazard["source"] == "ruptures"
+    assert store.pound.hazard.source == "ruptures"
     words = " ".join(block.text for block in intensity_section("ruptures", store).blocks if isinstance(block, Paragraph))
     assert f"0.2 g: the ruptures' mean M {store.site_magnitude.values[1]:.3g} at {store.site_distance_km.values[1]:.3g} km" in words

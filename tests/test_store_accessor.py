@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import hashlib
 import math
+from collections.abc import Mapping
 
 import h5py
 import numpy as np
@@ -20,6 +21,7 @@ import xarray as xr
 
 import stochpound
 from stochpound.experiment import ExperimentError, load_experiment, run_experiment
+from stochpound.motions import Measure
 from stochpound.store import Definition, Hazard, Intensity, canonical_json, definition_sha256, open_store, read_definition
 from tests.helpers import write_experiment
 
@@ -97,14 +99,16 @@ def test_the_definition_is_typed_and_parsed_once(ds):
 def test_intensity_and_hazard_are_typed(ds, run):
     intensity = ds.pound.intensity
     assert isinstance(intensity, Intensity)
-    assert (intensity.measure, intensity.units, intensity.levels, intensity.ran) == ("pga", "g", (0.2, 0.6), "stripes")
-    assert intensity["levels"] == [0.2, 0.6] and intensity.description == "PGA"  # reads as its canonical entry too
+    assert (intensity.measure, intensity.units, intensity.levels, intensity.ran) == (Measure("pga"), "g", (0.2, 0.6), "stripes")
+    assert intensity.measure.kind == "pga" and intensity.description == "PGA" and not isinstance(intensity, Mapping)  # a record, not a dict
+    assert intensity.entry()["levels"] == [0.2, 0.6] and ds.pound.definition.to_dict()["intensity"] == intensity.entry()
     hazard = ds.pound.hazard
     assert isinstance(hazard, Hazard)
     assert (hazard.source, hazard.file, hazard.units) == ("file", "site.csv", "g")
     assert hazard.file_sha256 == hashlib.sha256((run[0] / "site.csv").read_bytes()).hexdigest()
     assert hazard.im == (0.05, 0.1, 0.3, 0.6, 1.0) and hazard.rate == (0.02, 0.008, 0.001, 0.0002, 0.00005)
     assert hazard.provenance == "Site: a made-up curve for the test\nMeasure: PGA, in g"
+    assert hazard.measure == intensity.measure and not isinstance(hazard, Mapping)
 
 
 def test_gap_axes_and_selections(ds):

@@ -12,6 +12,7 @@ from stochpound._errors import os_error_message
 from stochpound._text_files import read_text_file
 from stochpound.cli._store_errors import store_variables
 from stochpound.risk import BOOTSTRAP, TARGETS
+from stochpound.store import Design
 
 
 def _targets(value: str) -> tuple[float, ...]:
@@ -44,7 +45,7 @@ def _limit_states(path: Path) -> tuple:
     return limit_states_from_table(_toml_table(path, "limit_states", "docs/risk.md")["limit_states"])
 
 
-def _design(path: Path) -> dict:
+def _design(path: Path) -> Design | None:
     """The buildings' code design of a TOML file's ``[design]`` table (the experiment file's table, docs/experiments.md)."""
     from stochpound.experiment import parse_design
 
@@ -151,12 +152,12 @@ def risk(store: Path, hazard: str | None, hazard_measure: str | None, hazard_uni
     source = hz.source.splitlines()[0] if hz.source else hz.describe()
     done = f"{result.progress}, answered from the cases that ran (--partial); " if result.progress else ""
     click.echo(f"{result.experiment or store.stem}: {done}{result.motions} motion{'s' if result.motions != 1 else ''}, {stripes} of {result.measure} "
-               f"in {result.setting['units']}; hazard: {source}")
+               f"in {result.setting.units}; hazard: {source}")
     if missed:
         click.echo(f"warning: the motions chosen for the site miss their conditional-spectrum target (mean or std of ln Sa off by more than "
-                   f"{TARGET_TOLERANCE:g} at a period) at the stripes {', '.join(f'{level:g}' for level in missed)} {result.setting['units']}")
+                   f"{TARGET_TOLERANCE:g} at a period) at the stripes {', '.join(f'{level:g}' for level in missed)} {result.setting.units}")
     if beyond:
-        click.echo(f"warning: the scenario puts the stripes {', '.join(f'{level:g}' for level in beyond)} {result.setting['units']} beyond "
+        click.echo(f"warning: the scenario puts the stripes {', '.join(f'{level:g}' for level in beyond)} {result.setting.units} beyond "
                    f"ε {TRUNCATION_EPSILON:g}, where hazard models truncate the ground motion: no earthquake of that scenario causes them there")
     for line in hz.source.splitlines():
         if line.startswith("stochpound: "):

@@ -83,7 +83,7 @@ class BatchTask:
         ``time_histories``, ``buildings`` and ``impacts`` of the definition.
     solver : dict
         ``method``, ``integrator``, ``rtol``, ``atol``.
-    intensity : dict or None
+    intensity : Scaling or None
         :func:`stochpound.experiment._intensity.task_settings` of an intensity-conditioned experiment.
     """
 
@@ -93,7 +93,7 @@ class BatchTask:
     studied: str
     output: dict
     solver: dict
-    intensity: dict | None = None
+    intensity: intensity.Scaling | None = None
 
     @property
     def n_cases(self) -> int:
@@ -171,7 +171,7 @@ def _group(
             ground, twin, extra = grounds[realization], twins[realization], {}
             if task.intensity is not None:
                 ground, twin, extra = intensity.scaled_case(task.intensity, task.record, dict(group.labels), ground, twin, measures[realization])
-            ida = task.intensity is not None and task.intensity["ran"] == "ida" and scene is not None
+            ida = task.intensity is not None and task.intensity.ran == "ida" and scene is not None
             key = (canonical_json(group.structure), realization) if ida else None
             finished.append(_case(task, scene, ground, twin, extra, dict(group.labels), runs, key))
         except Exception:  # noqa: BLE001 - reported per case, the batch goes on
@@ -204,7 +204,7 @@ def _case(
         if key is not None:
             runs[key] = run
     summary = {**case_values(run, task.studied, twin[-1]), **extra}
-    if task.intensity is not None and task.intensity["ran"] == "ida":
+    if task.intensity is not None and task.intensity.ran == "ida":
         summary["ida_capacity"] = intensity.capacity_of(task.intensity, summary, labels)
     return case_arrays(summary, run, task.output["time_histories"], task.output["buildings"], task.output["impacts"])
 

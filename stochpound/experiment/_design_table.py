@@ -26,6 +26,7 @@ from typing import Any, Mapping
 
 from stochpound._errors import SceneError
 from stochpound.model import fields as toml_fields
+from stochpound.store import Design, DesignEc8
 
 ASCE7_FIELDS = ("sds", "sd1", "tl", "r", "cd", "omega0", "ie")
 """The ASCE 7-16 fields of ``[design]``."""
@@ -36,8 +37,8 @@ _LIMITS = {"sds": (0.0, 5.0), "sd1": (0.0, 5.0), "tl": (0.0, 20.0), "r": (1.0, 1
            "ie": (1.0, 1.5), "sm1": (0.0, 5.0), "ag": (0.0, 2.0), "q": (1.0, 8.0)}
 
 
-def parse_design(data: Mapping[str, Any]) -> dict[str, Any] | None:
-    """The canonical ``design`` entry of a definition (None without a ``[design]`` table).
+def parse_design(data: Mapping[str, Any]) -> Design | None:
+    """The ``[design]`` table of a definition, typed (None without a ``[design]`` table).
 
     Parameters
     ----------
@@ -46,7 +47,7 @@ def parse_design(data: Mapping[str, Any]) -> dict[str, Any] | None:
 
     Returns
     -------
-    dict or None
+    Design or None
         ``sds``, ``sd1`` (g), ``tl`` (s), ``r``, ``cd``, ``omega0``, ``ie``;
         ``sm1`` (g) and ``ec8`` (``ag`` in g, ``ground``, ``q``) when given.
 
@@ -59,18 +60,21 @@ def parse_design(data: Mapping[str, Any]) -> dict[str, Any] | None:
     if design is None:
         return None
     toml_fields.reject_unknown(design, {*ASCE7_FIELDS, "sm1", "ec8"}, "design")
-    entry: dict[str, Any] = {name: _number(design, name, "design", required=name not in _DEFAULTS) for name in ASCE7_FIELDS}
-    if "sm1" in design:
-        entry["sm1"] = _number(design, "sm1", "design", required=True)
+    asce7 = [_number(design, name, "design", required=name not in _DEFAULTS) for name in ASCE7_FIELDS]
+    sm1 = _number(design, "sm1", "design", required=True) if "sm1" in design else None
+    return Design(*asce7, sm1=sm1, ec8=_ec8(design))
+
+
+def _ec8(design: Mapping[str, Any]) -> DesignEc8 | None:
+    """The ``ec8`` part of ``[design]`` (None when absent)."""
     ec8 = toml_fields.table(design, "ec8", "design")
     if ec8 is not None:
         toml_fields.reject_unknown(ec8, {"ag", "ground", "q"}, "design.ec8")
         ground = toml_fields.string(ec8, "ground", "design.ec8")
         if ground not in EC8_GROUNDS:
             raise SceneError(f"design.ec8.ground: must be one of {', '.join(EC8_GROUNDS)}, got {ground!r}")
-        entry["ec8"] = {"ag": _number(ec8, "ag", "design.ec8", required=True), "ground": ground,
-                        "q": _number(ec8, "q", "design.ec8", required=True)}
-    return entry
+        return DesignEc8(_number(ec8, "ag", "design.ec8", required=True), ground, _number(ec8, "q", "design.ec8", required=True))
+    return None
 
 
 def _number(table: Mapping[str, Any], name: str, prefix: str, required: bool) -> float:

@@ -27,18 +27,20 @@ response spectrum over ``spectrum_period``) and its ``scale_factor``.
 
 from __future__ import annotations
 
+import dataclasses
 import math
+from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Any, Mapping, Sequence
 
 import numpy as np
 
 from stochpound.model import fields as toml_fields
 from stochpound.experiment._site import parse_selection
-from stochpound.model.friction import is_fixed_base
 from stochpound.motions import arias_intensity, peak_ground_motion, response_spectrum, significant_duration
 from stochpound._errors import IntensityError
-from stochpound.store import MEASURES, describe_measure
+from stochpound.motions import Measure
+from stochpound.store import MEASURES, GapAxis, Intensity, MuAxis, VariantAxis, read_definition
 
 METHODS = ("stripes", "ida")
 UNITS = {"pga": ("g", "m/s2"), "psa": ("g", "m/s2"), "sa_avg": ("g", "m/s2"), "pgv": ("m/s", "cm/s")}
@@ -72,9 +74,9 @@ SUMMARIES: dict[str, tuple[str, str]] = {
 }
 
 
-def parse_intensity(data: Mapping[str, Any], scene: Mapping[str, Any], variants: list[dict[str, Any]], gaps: list[dict[str, Any]], mu: Any,
-                    base_dir: Path = Path(".")) -> dict[str, Any] | None:
-    """The canonical ``intensity`` entry of a definition (None without an ``[intensity]`` table).
+def parse_intensity(data: Mapping[str, Any], scene: Mapping[str, Any], variants: Sequence[VariantAxis], gaps: Sequence[GapAxis], mu: MuAxis | None,
+                    base_dir: Path = Path(".")) -> Intensity | None:
+    """The ``[intensity]`` setting of a definition, typed (None without an ``[intensity]`` table).
 
     ``base_dir`` is the experiment file's folder (a ``[site]`` rupture table's path is relative to it).
 
@@ -95,19 +97,19 @@ def parse_intensity(data: Mapping[str, Any], scene: Mapping[str, Any], variants:
     measure = table.get("measure")
     if measure not in MEASURES:
         raise IntensityError(f"intensity.measure: must be one of {', '.join(MEASURES)}, got {measure!r}")
-    entry: dict[str, Any] = {"measure": measure}
+    period, periods, damping = None, (), None
     if measure == "psa":
-        entry["period"] = toml_fields.number(table, "period", "intensity", required=True, low=0.0, low_open=True)
+        period = toml_fields.number(table, "period", "intensity", required=True, low=0.0, low_open=True)
     elif measure == "sa_avg":
         periods = table.get("periods")
         if not isinstance(periods, list) or len(periods) < 2 or not all(toml_fields.is_number(p) and math.isfinite(p) and p > 0 for p in periods):
             raise IntensityError(f"intensity.periods: must be a list of at least 2 periods > 0 s (e.g. log-spaced over 0.2-3 T1), got {periods!r}")
-        entry["periods"] = [float(p) for p in periods]
-    for key in ("period", "periods"):
-        if key in table and key not in entry:
+        periods = tuple(float(p) for p in periods)
+    for key, given in (("period", period is not None), ("periods", bool(periods))):
+        if key in table and not given:
             raise IntensityError(f"intensity.{key}: only for measure = {'psa' if key == 'period' else 'sa_avg'}")
     if measure in ("psa", "sa_avg"):
-        entry["damping"] = toml_fields.number(table, "damping", "intensity", default=SPECTRUM_DAMPING, low=0.0, high=1.0, high_open=True)
+        damping = toml_fields.number(table, "damping", "intensity", default=SPECTRUM_DAMPING, low=0.0, high=1.0, high_open=True)
     levels = table.get("levels")
     if not isinstance(levels, list) or not levels:
         raise IntensityError(f"intensity.levels: must be a non-empty list of levels > 0, got {levels!r}")
@@ -116,28 +118,32 @@ def parse_intensity(data: Mapping[str, Any], scene: Mapping[str, Any], variants:
             raise IntensityError(f"intensity.levels[{i}]: must be > 0, got {level!r}")
     if len(set(levels)) != len(levels):
         raise IntensityError("intensity.levels: repeated level")
-    entry["levels"] = sorted(float(level) for level in levels)
     units = table.get("units", UNITS[measure][0])
     if units not in UNITS[measure]:
         raise IntensityError(f"intensity.units: must be one of {', '.join(UNITS[measure])} for {measure}, got {units!r}")
-    entry["units"] = units
     method = table.get("method", "stripes")
     if method not in METHODS:
         raise IntensityError(f"intensity.method: must be one of {', '.join(METHODS)}, got {method!r}")
-    entry["method"] = method
     synthetic = table.get("synthetic", SYNTHETIC_SCALING[0])
     if synthetic not in SYNTHETIC_SCALING:
         raise IntensityError(
             f"intensity.synthetic: must be {' or '.join(SYNTHETIC_SCALING)} (each realization scaled to the level, or all by the level over the "
             f"ensemble's mean measure), got {synthetic!r}"
         )
-    entry["synthetic"] = synthetic
-    entry["ran"], entry["note"] = _method_run(method, scene, variants, gaps, mu)
-    entry.update(parse_selection(table, data.get("site"), levels, entry, base_dir))
-    return entry
+    ran, note = _method_run(method, scene, variants, gaps, mu)
+    try:
+        scaled_measure = Measure(measure, period, periods, damping)
+    except ValueError as error:
+        raise IntensityError(f"intensity.{error}") from None
+    setting = Intensity(scaled_measure, units, tuple(sorted(float(level) for level in levels)), method, ran, note,
+                        synthetic)
+    selection = parse_selection(table, data.get("site"), levels, setting, base_dir)
+    if not selection:
+        return setting
+    return dataclasses.replace(setting, note=selection.pop("note"), selection=selection)
 
 
-def _method_run(method: str, scene: Mapping[str, Any], variants: list[dict[str, Any]], gaps: list[dict[str, Any]], mu: Any) -> tuple[str, str]:
+def _method_run(method: str, scene: Mapping[str, Any], variants: Sequence[VariantAxis], gaps: Sequence[GapAxis], mu: MuAxis | None) -> tuple[str, str]:
     """The method that runs and why (IDA needs a homogeneous contact-free response and a gap axis)."""
     if method == "stripes":
         return "stripes", "every motion scaled to every level"
@@ -153,62 +159,95 @@ def _method_run(method: str, scene: Mapping[str, Any], variants: list[dict[str, 
     return "ida", "one contact-free run per motion; capacity IM·g/D per gap (homogeneous scene: fixed bases, at rest, no walls)"
 
 
-def inhomogeneity(scene: Mapping[str, Any], variants: list[dict[str, Any]], mu: Any) -> str:
+def inhomogeneity(scene: Mapping[str, Any], variants: Sequence[VariantAxis], mu: MuAxis | None) -> str:
     """Why a scene's contact-free response is not homogeneous in the input ("" if it is)."""
     if scene.get("wall"):
         return "the scene has walls"
-    if mu is not None and any(not is_fixed_base(value) for value in mu["values"]):
+    if mu is not None and mu.finite_values:
         return "grid.mu has finite friction coefficients (sliding bases)"
     for where, building in _building_tables(scene, variants):
-        if isinstance(building.get("base"), dict) and (mu is None or any(not is_fixed_base(v) for v in mu["values"])):
+        if isinstance(building.get("base"), dict) and (mu is None or mu.finite_values):
             return f"{where}: a building on a sliding base"
         if building.get("initial"):
             return f"{where}: a building not at rest at t = 0"
     return ""
 
 
-def _building_tables(scene: Mapping[str, Any], variants: list[dict[str, Any]]) -> list[tuple[str, Mapping[str, Any]]]:
+def _building_tables(scene: Mapping[str, Any], variants: Sequence[VariantAxis]) -> list[tuple[str, Mapping[str, Any]]]:
     """Every ``[[building]]`` table of a scene and of its variants' overrides, with where it is."""
     tables = [("scene", b) for b in scene.get("building", [])]
     for variant in variants:
-        for value, override in variant["overrides"].items():
-            tables += [(f"variants.{variant['name']}.{value}", b) for b in override.get("building", {}).values()]
+        for value, override in variant.overrides.items():
+            tables += [(f"variants.{variant.name}.{value}", b) for b in override.get("building", {}).values()]
     return tables
 
 
-def level_to_si(intensity: Mapping[str, Any], level: float, g: float) -> float:
+@dataclass(frozen=True)
+class Scaling:
+    """What a worker needs to scale an experiment's cases (:func:`task_settings`).
+
+    Attributes
+    ----------
+    intensity : Intensity
+        The ``[intensity]`` setting.
+    g : float
+        The scene's g, m/s².
+    gap_axes : tuple of (str, tuple of int)
+        Each gap axis's name and the contacts it sets.
+    expected : mapping of int to float
+        By motion number, an ensemble's mean measure (units of the levels), for ``[intensity] synthetic = "expected"``.
+    """
+
+    intensity: Intensity
+    g: float
+    gap_axes: tuple[tuple[str, tuple[int, ...]], ...]
+    expected: Mapping[int, float]
+
+    @property
+    def ran(self) -> str:
+        """The method that runs: ``stripes`` or ``ida``."""
+        return self.intensity.ran
+
+
+def as_intensity(setting: Intensity | Mapping[str, Any]) -> Intensity:
+    """The typed setting of an experiment's ``intensity`` (the record itself, or read from its canonical entry)."""
+    return setting if isinstance(setting, Intensity) else Intensity.from_entry(setting)
+
+
+def level_to_si(intensity: Intensity, level: float, g: float) -> float:
     """A level in the units of ``levels`` in SI (m/s² or m/s)."""
-    factor = {"g": g, "m/s2": 1.0, "m/s": 1.0, "cm/s": 0.01}[intensity["units"]]
+    factor = {"g": g, "m/s2": 1.0, "m/s": 1.0, "cm/s": 0.01}[intensity.units]
     return float(level) * factor
 
 
-def check_resolution(intensity: Mapping[str, Any], dt: float, where: str) -> None:
+def check_resolution(intensity: Intensity, dt: float, where: str) -> None:
     """Raise if a spectral measure's period is shorter than :data:`PERIOD_SAMPLES` steps of a motion."""
-    periods = [intensity["period"]] if "period" in intensity else intensity.get("periods", [])
+    measure = intensity.measure
+    periods = [measure.period] if measure.period is not None else measure.periods
     shortest = PERIOD_SAMPLES * dt
     for period in periods:
         if period < shortest - 1e-12:
-            key = "intensity.period" if "period" in intensity else "intensity.periods"
+            key = "intensity.period" if measure.period is not None else "intensity.periods"
             raise IntensityError(
                 f"{key}: {period:g} s is shorter than {PERIOD_SAMPLES:g}·dt = {shortest:g} s of {where}: "
                 "the sampled motion carries nothing above its Nyquist frequency 1/(2 dt)"
             )
 
 
-def motion_measures(values: np.ndarray, dt: float, intensity: Mapping[str, Any], g: float, spectrum: bool = True) -> dict[str, Any]:
+def motion_measures(values: np.ndarray, dt: float, intensity: Intensity, g: float, spectrum: bool = True) -> dict[str, Any]:
     """The unscaled measures of a motion (samples in m/s², linear between them), by store name.
 
     ``motion_intensity`` is in the units of ``levels``; ``spectrum=False`` leaves out ``motion_psa``.
     """
     pga, pgv, pgd = peak_ground_motion(values, dt)
-    measure = intensity["measure"]
-    if measure == "pga":
+    measure = intensity.measure
+    if measure.kind == "pga":
         value = pga
-    elif measure == "pgv":
+    elif measure.kind == "pgv":
         value = pgv
     else:
-        periods = [intensity["period"]] if measure == "psa" else intensity["periods"]
-        psa = response_spectrum(values, dt, periods, intensity["damping"]).psa.values
+        periods = [measure.period] if measure.kind == "psa" else list(measure.periods)
+        psa = response_spectrum(values, dt, periods, measure.damping).psa.values
         value = float(np.exp(np.mean(np.log(psa))))
     measures = {
         "motion_intensity": value / level_to_si(intensity, 1.0, g),
@@ -242,34 +281,36 @@ def ida_capacity(closure: np.ndarray, im: float, gap_axes: list[tuple[float, lis
     return float(min(capacities))
 
 
-def summary_attrs(intensity: Mapping[str, Any], name: str) -> dict[str, str]:
+def summary_attrs(intensity: Intensity | Mapping[str, Any], name: str) -> dict[str, str]:
     """Units and long name of a per-case intensity variable."""
     units, long_name = SUMMARIES[name]
-    return {"units": units.format(units=intensity["units"]), "long_name": long_name.format(measure=describe_measure(intensity))}
+    setting = as_intensity(intensity)
+    return {"units": units.format(units=setting.units), "long_name": long_name.format(measure=setting.description)}
 
 
-def store_names(intensity: Mapping[str, Any] | None) -> list[str]:
+def store_names(intensity: Intensity | Mapping[str, Any] | None) -> list[str]:
     """The per-case intensity variables of a store (none without intensity)."""
     if intensity is None:
         return []
     names = [name for name in SUMMARIES if name != "ida_capacity"]
-    return names + (["ida_capacity"] if intensity["ran"] == "ida" else [])
+    return names + (["ida_capacity"] if as_intensity(intensity).ran == "ida" else [])
 
 
-def task_settings(experiment: Any, motions: Mapping[str, Any]) -> dict[str, Any] | None:
+def task_settings(experiment: Any, motions: Mapping[str, Any]) -> Scaling | None:
     """What a worker needs to scale an experiment's cases (None without intensity).
 
-    The ``intensity`` entry, g, the gap axes and, by motion number, the
+    The intensity setting, g, the gap axes and, by motion number, the
     ensembles' mean measures (``expected``; ``[intensity] synthetic = "expected"``).
     """
     if experiment.intensity is None:
         return None
-    gap_axes = [(gap["name"], list(gap["contacts"])) for gap in experiment.definition["gaps"]]
+    definition = read_definition(experiment.definition)
+    gap_axes = tuple((gap.name, gap.contacts) for gap in definition.gaps)
     expected = {index: motions[label].expected_intensity for index, label in enumerate(experiment.motions) if motions[label].expected_intensity is not None}
-    return {**experiment.intensity, "g": float(experiment.definition["scene"].get("g", 9.81)), "gap_axes": gap_axes, "expected": expected}
+    return Scaling(as_intensity(experiment.intensity), definition.g, gap_axes, expected)
 
 
-def ensemble_intensity(intensity: Mapping[str, Any], table: Mapping[str, Any], realizations: range, g: float) -> float:
+def ensemble_intensity(intensity: Intensity, table: Mapping[str, Any], realizations: range, g: float) -> float:
     """Mean measure (units of ``levels``) of an ensemble's realizations, generated from its worker table in chunks."""
     from stochpound import motions as synthetic_motions
 
@@ -283,17 +324,17 @@ def ensemble_intensity(intensity: Mapping[str, Any], table: Mapping[str, Any], r
     return total / len(realizations)
 
 
-def measures_of(settings: Mapping[str, Any], ground: Any) -> dict[str, Any]:
+def measures_of(settings: Scaling, ground: Any) -> dict[str, Any]:
     """:func:`motion_measures` of a sampled ground motion (a motion given by a formula cannot be scaled to a measure)."""
     from stochpound.motions.ground import SampledMotion
 
     if not isinstance(ground, SampledMotion):
         raise IntensityError(f"intensity: only sampled motions (records, suites, synthetic ensembles) can be scaled, not {type(ground).__name__}")
-    return motion_measures(ground.values, ground.dt, settings, settings["g"])
+    return motion_measures(ground.values, ground.dt, settings.intensity, settings.g)
 
 
 def scaled_case(
-    settings: Mapping[str, Any], record: int, labels: Mapping[str, Any], ground: Any, twin: np.ndarray, measures: Mapping[str, Any]
+    settings: Scaling, record: int, labels: Mapping[str, Any], ground: Any, twin: np.ndarray, measures: Mapping[str, Any]
 ) -> tuple[Any, np.ndarray, dict[str, Any]]:
     """The case's motion and fixed-base twin scaled to its ``intensity`` level (unchanged for IDA), and its intensity variables.
 
@@ -301,10 +342,8 @@ def scaled_case(
     uses it). The twin is linear and starts at rest, so scaling its response
     equals running it on the scaled motion.
     """
-    import dataclasses
-
     level = labels.get("intensity")
-    reference = settings["expected"].get(record, measures["motion_intensity"])
+    reference = settings.expected.get(record, measures["motion_intensity"])
     scale = 1.0 if level is None else float(level) / reference
     extra = {**measures, "scale_factor": scale}
     if scale == 1.0:
@@ -313,9 +352,9 @@ def scaled_case(
     return scaled, twin * scale, extra
 
 
-def capacity_of(settings: Mapping[str, Any], summary: Mapping[str, Any], labels: Mapping[str, Any]) -> float:
+def capacity_of(settings: Scaling, summary: Mapping[str, Any], labels: Mapping[str, Any]) -> float:
     """:func:`ida_capacity` of a contact-free case from its summary and grid labels."""
-    axes = [(float(labels[name]), contacts) for name, contacts in settings["gap_axes"]]
+    axes = [(float(labels[name]), contacts) for name, contacts in settings.gap_axes]
     return ida_capacity(np.asarray(summary["peak_contact_closure"], dtype=float), float(summary["motion_intensity"]), axes)
 
 

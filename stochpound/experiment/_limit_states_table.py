@@ -19,11 +19,11 @@ from typing import Any, Mapping, Sequence
 from stochpound._errors import SceneError
 from stochpound.model import fields as toml_fields
 from stochpound.risk import limit_state_problem
-from stochpound.store import LIMIT_STATE_DEMANDS
+from stochpound.store import LIMIT_STATE_DEMANDS, LimitStateCapacities, LimitStates
 
 
-def parse_limit_states(data: Mapping[str, Any], buildings: Sequence[str]) -> dict[str, Any] | None:
-    """The canonical ``limit_states`` entry of a definition (None without a ``[limit_states]`` table).
+def parse_limit_states(data: Mapping[str, Any], buildings: Sequence[str]) -> LimitStates | None:
+    """The ``[limit_states]`` table of a definition, typed (None without a ``[limit_states]`` table).
 
     Parameters
     ----------
@@ -34,9 +34,8 @@ def parse_limit_states(data: Mapping[str, Any], buildings: Sequence[str]) -> dic
 
     Returns
     -------
-    dict or None
-        ``source`` (str or None) and ``capacities``: kind -> a list of
-        capacities, or building -> a list of capacities.
+    LimitStates or None
+        ``source`` (str or None) and the capacities of each kind, for any building or by building.
 
     Raises
     ------
@@ -47,7 +46,7 @@ def parse_limit_states(data: Mapping[str, Any], buildings: Sequence[str]) -> dic
     if table is None:
         return None
     source = toml_fields.string(table, "source", "limit_states") if "source" in table else None
-    capacities: dict[str, Any] = {}
+    states: list[LimitStateCapacities] = []
     for kind, value in table.items():
         if kind == "source":
             continue
@@ -58,15 +57,15 @@ def parse_limit_states(data: Mapping[str, Any], buildings: Sequence[str]) -> dic
             for building in value:
                 if building not in buildings:
                     raise SceneError(f"{where}.{building}: unknown building (buildings: {', '.join(buildings)})")
-            capacities[kind] = {building: _capacities(kind, values, f"{where}.{building}", building) for building, values in value.items()}
+            states += [LimitStateCapacities(kind, _capacities(kind, values, f"{where}.{building}", building), building) for building, values in value.items()]
         else:
-            capacities[kind] = _capacities(kind, value, where)
-    if not capacities:
+            states.append(LimitStateCapacities(kind, _capacities(kind, value, where)))
+    if not states:
         raise SceneError(f"limit_states: give at least one limit state ({', '.join(LIMIT_STATE_DEMANDS)})")
-    return {"source": source, "capacities": capacities}
+    return LimitStates(source, tuple(states))
 
 
-def _capacities(kind: str, value: Any, where: str, building: str | None = None) -> list[float]:
+def _capacities(kind: str, value: Any, where: str, building: str | None = None) -> tuple[float, ...]:
     """The capacities of ``value`` (one or a list), each checked by the limit states' one rule (``stochpound.risk.limit_state_problem``)."""
     values = value if isinstance(value, list) else [value]
     if not values:
@@ -75,4 +74,4 @@ def _capacities(kind: str, value: Any, where: str, building: str | None = None) 
         problem = limit_state_problem(kind, capacity, building)
         if problem is not None:
             raise SceneError(f"{where}{f'[{i}]' if isinstance(value, list) else ''}: {problem}")
-    return [float(capacity) for capacity in values]
+    return tuple(float(capacity) for capacity in values)

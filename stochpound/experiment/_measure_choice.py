@@ -29,7 +29,7 @@ def hazard_measures(store: Any, hazard: str | None = None) -> dict[str, float | 
     """
     from stochpound.hazard import bundled_curves, bundled_measure, bundled_site_curves
 
-    name = hazard if hazard in bundled_curves() else (store.pound.hazard or {}).get("bundled")
+    name = hazard if hazard in bundled_curves() else (store.pound.hazard.bundled if store.pound.hazard is not None else None)
     if name:
         measures = [bundled_measure(curve) for curve in bundled_site_curves(name)]
     else:
@@ -41,7 +41,7 @@ def hazard_measures(store: Any, hazard: str | None = None) -> dict[str, float | 
 def _store_measure(store: Any) -> Measure | None:
     """The measure of the store's ``[intensity]`` (None without one)."""
     intensity = store.pound.intensity
-    return Measure.from_entry(intensity) if intensity else None
+    return intensity.measure if intensity is not None else None
 
 
 def measure_choice(store: Any, hazard: str | None = None) -> pd.DataFrame:

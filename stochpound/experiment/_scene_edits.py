@@ -40,6 +40,7 @@ from stochpound.model import building as building_law
 from stochpound.model import laws
 from stochpound.model.contact import ELEMENT_KEYS, effective_mass
 from stochpound.model.friction import is_fixed_base
+from stochpound.store import scene_g
 
 #: Motion used while validating a scene's structure (the real motion is set per case).
 PLACEHOLDER_MOTION = {"type": "constant", "acceleration": 0.0, "duration": 1.0, "dt": 1.0}
@@ -231,4 +232,4 @@ def reference_scene(scene: Mapping[str, Any], studied: str) -> dict[str, Any]:
     building.pop("base", None)
     building.pop("initial", None)
     building["name"] = studied
-    return {"g": scene.get("g", 9.81), "building": [building], "contact": []}
+    return {"g": scene_g(scene), "building": [building], "contact": []}

@@ -60,8 +60,8 @@ import numpy as np
 import xarray as xr
 
 from stochpound.model import fields as toml_fields
-from stochpound.motions import CONDITIONING_MEASURES, MODEL_DAMPING, PERIOD_RANGE, Scenario
-from stochpound.store import SCENARIO_KINDS
+from stochpound.motions import CONDITIONING_MEASURES, MODEL_DAMPING, PERIOD_RANGE, Measure, Scenario
+from stochpound.store import SCENARIO_KINDS, Intensity, Site, scene_g
 
 
 class GridExperiment(Protocol):
@@ -100,7 +100,7 @@ PER_LEVEL = ("magnitude", "distance_km", "mechanism")
 """``[site]`` fields that take one value per level."""
 
 
-def parse_selection(table: Mapping[str, Any], site: Any, levels: list[float], entry: dict[str, Any], base_dir: Path = Path(".")) -> dict[str, Any]:
+def parse_selection(table: Mapping[str, Any], site: Any, levels: list[float], setting: Intensity, base_dir: Path = Path(".")) -> dict[str, Any]:
     """The selection's entries of the ``intensity`` definition ({} for the default ``scale``).
 
     Parameters
@@ -111,8 +111,8 @@ def parse_selection(table: Mapping[str, Any], site: Any, levels: list[float], en
         The ``[site]`` table.
     levels : list of float
         The levels as the file lists them.
-    entry : mapping
-        The ``intensity`` entry parsed so far (measure, period(s), damping, units, method).
+    setting : Intensity
+        The ``[intensity]`` setting parsed so far (its measure, units, method; no selection yet).
     base_dir : Path
         The experiment file's folder (a rupture table's path is relative to it).
 
@@ -135,18 +135,19 @@ def parse_selection(table: Mapping[str, Any], site: Any, levels: list[float], en
         if site is not None:
             raise SiteError(f'site: only with [intensity] selection = "{CONDITIONAL_SPECTRUM}" (the scenario of its targets)')
         return {}
-    if entry["measure"] not in CONDITIONING_MEASURES:
-        raise SiteError(f"intensity.measure: the conditional spectrum conditions on {', '.join(CONDITIONING_MEASURES)}, got {entry['measure']!r}")
-    if entry["units"] != "g":
-        raise SiteError(f'intensity.units: the conditional spectrum takes levels in g, got {entry["units"]!r}')
-    if entry["method"] != "stripes":
+    measure = setting.measure
+    if measure.kind not in CONDITIONING_MEASURES:
+        raise SiteError(f"intensity.measure: the conditional spectrum conditions on {', '.join(CONDITIONING_MEASURES)}, got {measure.kind!r}")
+    if setting.units != "g":
+        raise SiteError(f'intensity.units: the conditional spectrum takes levels in g, got {setting.units!r}')
+    if setting.method != "stripes":
         raise SiteError('intensity.method: the conditional spectrum chooses motions per stripe: method = "stripes"')
-    if entry.get("damping", MODEL_DAMPING) != MODEL_DAMPING:
-        raise SiteError(f"intensity.damping: the NGA-West2 models give 5 % damped spectra only (0.05), got {entry['damping']!r}")
+    if measure.damping is not None and measure.damping != MODEL_DAMPING:
+        raise SiteError(f"intensity.damping: the NGA-West2 models give 5 % damped spectra only (0.05), got {measure.damping!r}")
     low, high = PERIOD_RANGE
-    for period in [entry["period"]] if "period" in entry else entry.get("periods", []):
+    for period in [measure.period] if measure.period is not None else measure.periods:
         if not low <= period <= high:
-            key = "intensity.period" if "period" in entry else "intensity.periods"
+            key = "intensity.period" if measure.period is not None else "intensity.periods"
             raise SiteError(f"{key}: must be within {low:g}-{high:g} s for the conditional spectrum (the NGA-West2 models' range), got {period:g}")
     motions = table.get("motions")
     if not isinstance(motions, int) or isinstance(motions, bool) or motions < 2:
@@ -169,8 +170,8 @@ def parse_selection(table: Mapping[str, Any], site: Any, levels: list[float], en
         ruptures = rupture_site(site, base_dir)
         chosen["note"] = (f"{motions} motions per stripe chosen from the pool and scaled to the exact conditional spectrum of the site's "
                           f"{len(ruptures)} ruptures")
-        return {**chosen, "site": mixture_scenarios(ruptures, levels, entry), "ruptures": ruptures.to_entry(identity=True)}
-    return {**chosen, "site": parse_site(site, levels, entry), **parse_simulated(site, seed)}
+        return {**chosen, "site": mixture_scenarios(ruptures, levels, measure), "ruptures": ruptures.to_entry(identity=True)}
+    return {**chosen, "site": parse_site(site, levels, measure), **parse_simulated(site, seed)}
 
 
 def parse_rules(table: Mapping[str, Any]) -> dict[str, Any]:
@@ -217,17 +218,16 @@ def rupture_site(site: Mapping[str, Any], base_dir: Path) -> Any:
     return named_rupture_site(site["ruptures"], base_dir, {key: site[key] for key in RUPTURE_SITE_FIELDS if key in site}, "site")
 
 
-def mixture_scenarios(ruptures: Any, levels: list[float], entry: Mapping[str, Any]) -> list[dict[str, Any]]:
+def mixture_scenarios(ruptures: Any, levels: list[float], measure: Measure) -> list[dict[str, Any]]:
     """The scenario of every level (sorted) a store records of a site of ruptures: the means of M and R_rup by the exact conditional
     spectrum's weights P(r | IM* = x) (:meth:`~stochpound.analysis.RuptureSite.disaggregation`'s ``density_share``), Vs30 and the
     mechanism of the largest weight (:meth:`~stochpound.analysis.RuptureSite.mean_scenario`)."""
-    period = entry.get("period", entry.get("periods"))
-    shares = ruptures.disaggregation(entry["measure"], period, levels=sorted(float(level) for level in levels))["density_share"].values
+    shares = ruptures.disaggregation(measure.kind, measure.spectral_period, levels=sorted(float(level) for level in levels))["density_share"].values
     return [ruptures.mean_scenario(share) for share in shares]
 
 
-def site_entry(site: Any, intensity: Mapping[str, Any] | None) -> dict[str, Any] | None:
-    """The definition's ``site`` entry: how the stripes' scenario was obtained, as data (None without a ``[site]`` table).
+def site_entry(site: Any, intensity: Intensity | None) -> Site | None:
+    """The definition's ``site``: how the stripes' scenario was obtained, typed (None without a ``[site]`` table).
 
     ``scenario`` is ``"given"``, ``"fitted"`` or ``"ruptures"``; a fitted one
     names the ``curves`` it was fitted to, a site of ruptures its ``ruptures``
@@ -249,12 +249,12 @@ def site_entry(site: Any, intensity: Mapping[str, Any] | None) -> dict[str, Any]
     if intensity is None:
         raise SiteError(f'site: only with [intensity] selection = "{CONDITIONAL_SPECTRUM}" (the scenario of its targets)')
     if "ruptures" in site:
-        return {"scenario": "ruptures", "ruptures": site["ruptures"]}
+        return Site("ruptures", ruptures=site["ruptures"])
     kind = site.get("scenario", SCENARIO_KINDS[0])
-    return {"scenario": kind, "curves": list(site["curves"])} if kind == "fitted" else {"scenario": kind}
+    return Site(kind, curves=tuple(site["curves"])) if kind == "fitted" else Site(kind)
 
 
-def parse_site(site: Any, levels: list[float], entry: Mapping[str, Any]) -> list[dict[str, Any]]:
+def parse_site(site: Any, levels: list[float], measure: Measure) -> list[dict[str, Any]]:
     """One scenario per level, in the order of the sorted levels, from the ``[site]`` table (given, or fitted to its ``curves``)."""
     from stochpound._errors import SiteError
 
@@ -265,7 +265,7 @@ def parse_site(site: Any, levels: list[float], entry: Mapping[str, Any]) -> list
         raise SiteError(f"site.scenario: must be one of {', '.join(SCENARIO_KINDS[:2])} (a site of ruptures: ruptures = \"<file or bundled site>\"), "
                         f"got {scenario_kind!r}")
     if scenario_kind == "fitted":
-        return fitted_site(site, levels, entry)
+        return fitted_site(site, levels, measure)
     if "curves" in site:
         raise SiteError('site.curves: only with site.scenario = "fitted"')
     toml_fields.reject_unknown(site, {*SITE_FIELDS, "scenario", "simulated_motions"}, "site")
@@ -292,7 +292,7 @@ def parse_site(site: Any, levels: list[float], entry: Mapping[str, Any]) -> list
     return [scenarios[i] for i in order]
 
 
-def fitted_site(site: Mapping[str, Any], levels: list[float], entry: Mapping[str, Any]) -> list[dict[str, Any]]:
+def fitted_site(site: Mapping[str, Any], levels: list[float], conditioning_measure: Measure) -> list[dict[str, Any]]:
     """The scenario of every level (sorted) fitted to the site's bundled hazard curves (:func:`stochpound.motions.fit_scenarios`).
 
     ``site.curves`` names bundled curves (:func:`stochpound.analysis.bundled_curves`):
@@ -319,7 +319,7 @@ def fitted_site(site: Mapping[str, Any], levels: list[float], entry: Mapping[str
     for name in curves:
         measure = bundled_measure(name)
         curve = HazardCurve.bundled(name)
-        if measure.kind == entry["measure"] and measure.period == entry.get("period"):
+        if measure.kind == conditioning_measure.kind and measure.period == conditioning_measure.period:
             conditioning = curve
         else:
             others.append((measure.period, curve.im, curve.rate))
@@ -330,7 +330,7 @@ def fitted_site(site: Mapping[str, Any], levels: list[float], entry: Mapping[str
     ordered = sorted(float(level) for level in levels)
     try:
         fine = fit_levels(ordered, conditioning.support[1], conditioning.support[0])
-        scenarios = fit_scenarios(entry["measure"], entry.get("period"), ordered, fine, stripe_rate_weights(fine, conditioning, "intensity.levels"),
+        scenarios = fit_scenarios(conditioning_measure.kind, conditioning_measure.period, ordered, fine, stripe_rate_weights(fine, conditioning, "intensity.levels"),
                                   others, float(site["vs30"]), site["mechanism"])
     except ValueError as error:  # a level outside the conditioning curve
         raise SiteError(f"intensity.levels: outside the site's curve of the conditioning measure ({error})") from None
@@ -466,7 +466,7 @@ def stripe_selections(experiment: GridExperiment) -> StripeSelections:
     conditioning = [] if period is None else list(np.atleast_1d(period))
     structure = structure_periods(experiment)
     periods = selection_periods(structure, conditioning)
-    g = float(experiment.definition["scene"].get("g", 9.81))
+    g = scene_g(experiment.definition["scene"])
     pool = selection_pool(records, periods, measure, period, MODEL_DAMPING, g)
     selections, targets, simulated = [], [], {}
     rules = {key: intensity[key] for key in RULES if key in intensity}

@@ -17,10 +17,10 @@ import numpy as np
 
 from stochpound import motions as synthetic_motions
 from stochpound.experiment._grid import CASE, Experiment
-from stochpound.experiment._intensity import check_resolution, ensemble_intensity
+from stochpound.experiment._intensity import as_intensity, check_resolution, ensemble_intensity
 from stochpound.experiment._scene_edits import with_motion
 from stochpound.experiment._site import simulated_motions
-from stochpound.store import canonical_json
+from stochpound.store import canonical_json, scene_g
 from stochpound.experiment._spec import ExperimentError, field_errors
 from stochpound.motions.ground import GroundMotion, SampledMotion
 from stochpound.model.scene_file import scene_from_dict
@@ -75,7 +75,7 @@ def resolve_motions(experiment: Experiment) -> dict[str, ResolvedMotion]:
         grid = (float(motion.times[1] - motion.times[0]), len(motion.times))
         if experiment.intensity is not None:
             with field_errors():
-                check_resolution(experiment.intensity, grid[0], f"{source['field']} ({label})")
+                check_resolution(as_intensity(experiment.intensity), grid[0], f"{source['field']} ({label})")
                 if not isinstance(motion, SampledMotion):
                     raise ExperimentError(f"{source['field']}: a {type(motion).__name__} cannot be scaled to an intensity level; [intensity] takes records, suites and synthetic ensembles")
         if source["kind"] in ("record", "simulated"):
@@ -83,9 +83,8 @@ def resolve_motions(experiment: Experiment) -> dict[str, ResolvedMotion]:
         else:
             worker_table = _worker_table(table, motion, structure)
             expected = None
-            if experiment.intensity is not None and experiment.intensity["synthetic"] == "expected":
-                g = float(experiment.definition["scene"].get("g", 9.81))
-                expected = ensemble_intensity(experiment.intensity, worker_table, experiment.realizations(label), g)
+            if experiment.intensity is not None and as_intensity(experiment.intensity).synthetic == "expected":
+                expected = ensemble_intensity(as_intensity(experiment.intensity), worker_table, experiment.realizations(label), scene_g(experiment.definition["scene"]))
             resolved[label] = ResolvedMotion(label, None, worker_table, grid, expected)
     return resolved
 

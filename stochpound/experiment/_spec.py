@@ -30,7 +30,7 @@ from stochpound._text_files import read_text_file
 from stochpound.experiment._design_table import parse_design
 from stochpound.experiment._limit_states_table import parse_limit_states
 from stochpound.hazard import parse_hazard
-from stochpound.motions import DEFAULT_G, SYNTHETIC_TYPES
+from stochpound.motions import SYNTHETIC_TYPES
 from stochpound.experiment._intensity import parse_intensity
 from stochpound.experiment._site import site_entry
 from stochpound.model import fields as toml_fields
@@ -39,7 +39,7 @@ from stochpound.experiment._scene_edits import apply_overrides, building_names
 from stochpound.model.scene_file import bundled_scene_path, bundled_scenes, generator_fields, read_scene_table
 from stochpound.solvers.simulate import METHODS
 from stochpound.solvers.ivp import INTEGRATORS
-from stochpound.store import TIME_HISTORIES, is_gap_axis, read_definition
+from stochpound.store import TIME_HISTORIES, Definition, GapAxis, MotionSource, MuAxis, Output, Solver, VariantAxis, is_gap_axis, scene_g
 
 #: Format version of the canonical definition (stored with every store).
 FORMAT_VERSION = 1
@@ -135,60 +135,36 @@ def parse_experiment(data: Mapping[str, Any], base_dir: str | Path = ".", defaul
             except ValueError as error:
                 raise ExperimentError(f"experiment.reproduces: {error} (a published study's part, \"<study>:<part>\")") from None
     scene, scene_source = _base_scene(data, header, base_dir)
-    buildings = [b.get("name", f"B{i + 1}") for i, b in enumerate(scene.get("building", []))]
+    buildings = building_names(scene)
+    contacts = scene.get("contact", [])
     studied = header.get("studied", buildings[0] if buildings else "B1")
     if studied not in buildings:
         raise ExperimentError(f"experiment.studied: must be one of the scene's buildings ({', '.join(buildings)}), got {studied!r}")
-    variants = _variants(data, buildings, len(scene.get("contact", [])))
+    declared = _variants(data, buildings, len(contacts))
     grid = _table_or_error(data, "grid", "")
-    known_axes = {v["name"] for v in variants}
     for key in grid:
-        if not (is_gap_axis(key) or key == "mu" or key in known_axes):
-            allowed = ["gap", "gap_<name>", "mu", *sorted(known_axes)]
+        if not (is_gap_axis(key) or key == "mu" or key in declared):
+            allowed = ["gap", "gap_<name>", "mu", *sorted(declared)]
             raise ExperimentError(f"grid.{key}: unknown axis (allowed: {', '.join(allowed)}; variant axes are declared in [variants.<axis>])")
-    for variant in variants:
-        variant["values"] = _variant_selection(grid, variant)
-    n_contacts = len(scene.get("contact", []))
-    contact_floors = [c.get("between", [[None, None]])[0][1] for c in scene.get("contact", [])]
+    variants = [VariantAxis(name, tuple(_variant_selection(grid, name, list(overrides))), overrides) for name, overrides in declared.items()]
+    n_contacts = len(contacts)
+    contact_floors = [c.get("between", [[None, None]])[0][1] for c in contacts]
     n_walls = len(scene.get("wall", []))
     gaps = [_gap_axis(key, grid[key], n_contacts, contact_floors, n_walls) for key in grid if is_gap_axis(key)]
     mu = _mu_axis(grid["mu"], buildings) if "mu" in grid else None
     with field_errors():
         intensity = parse_intensity(data, scene, variants, gaps, mu, base_dir)
-        hazard = parse_hazard(data, intensity, base_dir, float(scene["g"]) if "g" in scene else DEFAULT_G)
+        hazard = parse_hazard(data, intensity, base_dir, scene_g(scene))
         design = parse_design(data)
         limit_states = parse_limit_states(data, buildings)
-    definition = {
-        "format": FORMAT_VERSION,
-        "name": name,
-        "description": description,
-        "scene": scene,
-        "studied": studied,
-        "variants": variants,
-        "gaps": gaps,
-        "mu": mu,
-        "motions": _motions(data, scene, base_dir),
-        "output": _output(data, buildings),
-        "solver": _solver(data),
-    }
-    if scene_source is not None:  # absent for an inline scene; not in the identity, which holds the scene's content
-        definition["scene_source"] = scene_source
-    if reproduces is not None:  # absent unless declared: the definitions (and hashes) of other files are unchanged
-        definition["reproduces"] = reproduces
-    if intensity is not None:  # absent without [intensity]: the definitions (and hashes) of other files are unchanged
-        definition["intensity"] = intensity
-    if hazard is not None:  # likewise absent without [hazard]
-        definition["hazard"] = hazard
-    if design is not None:  # likewise absent without [design]
-        definition["design"] = design
-    if limit_states is not None:  # likewise absent without [limit_states]
-        definition["limit_states"] = limit_states
+    motions = _motions(data, scene, base_dir)
+    output, solver = _output(data, buildings), _solver(data)
     with field_errors():
         site = site_entry(data.get("site"), intensity)
-    if site is not None:  # likewise absent without [site]; out of the identity (the scenarios are in the intensity entry)
-        definition["site"] = site
-    read_definition(definition)  # the typed definition reads every field parsed here
-    return definition
+    # optional records left None are absent from the written definition: the definitions (and hashes) of other files are unchanged
+    definition = Definition(name, description, scene, studied, tuple(variants), tuple(gaps), mu, motions, output, solver, intensity, FORMAT_VERSION,
+                            reproduces=reproduces, hazard=hazard, design=design, limit_states=limit_states, scene_source=scene_source, site=site)
+    return definition.to_dict()
 
 
 def _table_or_error(data: Mapping[str, Any], key: str, prefix: str) -> dict[str, Any]:
@@ -242,9 +218,10 @@ def _scene_from_file(name: Any, base_dir: Path, field: str, kind: str) -> tuple[
 # ---------------------------------------------------------------- variants
 
 
-def _variants(data: Mapping[str, Any], buildings: list[str], n_contacts: int) -> list[dict[str, Any]]:
+def _variants(data: Mapping[str, Any], buildings: list[str], n_contacts: int) -> dict[str, dict[str, dict[str, Any]]]:
+    """The declared variant axes: each axis's variants' overrides, by name."""
     table = _table_or_error(data, "variants", "")
-    axes = []
+    axes = {}
     for axis, values in table.items():
         where = f"variants.{axis}"
         _check_dim_name(axis, where)
@@ -253,7 +230,7 @@ def _variants(data: Mapping[str, Any], buildings: list[str], n_contacts: int) ->
         overrides = {}
         for value, override in values.items():
             overrides[value] = _override(override, f"{where}.{value}", buildings, n_contacts)
-        axes.append({"name": axis, "values": list(values), "overrides": overrides})
+        axes[axis] = overrides
     return axes
 
 
@@ -309,8 +286,7 @@ def _override(override: Any, where: str, buildings: list[str], n_contacts: int) 
     return copy.deepcopy(dict(override))
 
 
-def _variant_selection(grid: Mapping[str, Any], variant: Mapping[str, Any]) -> list[str]:
-    name, declared = variant["name"], variant["values"]
+def _variant_selection(grid: Mapping[str, Any], name: str, declared: list[str]) -> list[str]:
     if name not in grid:
         return list(declared)
     chosen = grid[name]
@@ -364,7 +340,7 @@ def _numbers(values: Any, where: str, allow_inf: bool, inf_meaning: str = "a fix
     return numbers
 
 
-def _gap_axis(key: str, spec: Any, n_contacts: int, contact_floors: list[Any], n_walls: int) -> dict[str, Any]:
+def _gap_axis(key: str, spec: Any, n_contacts: int, contact_floors: list[Any], n_walls: int) -> GapAxis:
     """A gap axis: its contacts (every contact, or ``contacts`` / ``floors``) and, with ``walls``, the scene's walls it sets."""
     where = f"grid.{key}"
     values, options = _axis_values(spec, where, {"contacts", "floors", "walls"})
@@ -384,10 +360,7 @@ def _gap_axis(key: str, spec: Any, n_contacts: int, contact_floors: list[Any], n
         contacts = [i for i, floor in enumerate(contact_floors) if floor in floors]
         if not contacts:
             raise ExperimentError(f"{where}.floors: no contact has its left floor in {floors!r} (contact floors: {contact_floors})")
-    axis = {"name": key, "values": gaps, "contacts": sorted(set(contacts))}
-    if walls is not None:  # absent without walls: the definitions (and hashes) of other files are unchanged
-        axis["walls"] = walls
-    return axis
+    return GapAxis(key, tuple(gaps), tuple(sorted(set(contacts))), tuple(walls or ()))
 
 
 def _indices(options: Mapping[str, Any], key: str, where: str, count: int, what: str) -> list[int]:
@@ -400,7 +373,7 @@ def _indices(options: Mapping[str, Any], key: str, where: str, count: int, what:
     return sorted(set(chosen))
 
 
-def _mu_axis(spec: Any, buildings: list[str]) -> dict[str, Any]:
+def _mu_axis(spec: Any, buildings: list[str]) -> MuAxis:
     values, options = _axis_values(spec, "grid.mu", {"buildings"})
     mus = _numbers(values, "grid.mu.values" if options else "grid.mu", allow_inf=True)
     chosen = options.get("buildings")
@@ -408,13 +381,13 @@ def _mu_axis(spec: Any, buildings: list[str]) -> dict[str, Any]:
         if not isinstance(chosen, list) or not chosen or not all(b in buildings for b in chosen):
             raise ExperimentError(f"grid.mu.buildings: must be a non-empty list of building names ({', '.join(buildings)}), got {chosen!r}")
         _check_unique(chosen, "grid.mu.buildings")
-    return {"values": mus, "buildings": chosen}
+    return MuAxis(tuple(mus), tuple(chosen) if chosen is not None else None)
 
 
 # ---------------------------------------------------------------- motions
 
 
-def _motions(data: Mapping[str, Any], scene: Mapping[str, Any], base_dir: Path) -> list[dict[str, Any]]:
+def _motions(data: Mapping[str, Any], scene: Mapping[str, Any], base_dir: Path) -> tuple[MotionSource, ...]:
     records = _array_of_tables(data, "records")
     synthetic = _table_or_error(data, "synthetic", "")
     motions = [source for i, table in enumerate(records) for source in _record_sources(table, f"records[{i}]", base_dir)]
@@ -428,19 +401,19 @@ def _motions(data: Mapping[str, Any], scene: Mapping[str, Any], base_dir: Path) 
         if kind in SYNTHETIC_TYPES:
             entry = dict(table)
             realization = entry.pop("realization", 0)
-            motions.append({"label": kind, "kind": "synthetic", "field": "scene.motion", "motion": entry, "start": realization, "count": 1})
+            motions.append(MotionSource(kind, "synthetic", "scene.motion", entry, realization, 1))
         else:  # a record (or a harmonic or constant motion), read on the client and shipped
             motion = dict(table)
             label = kind
             if kind == "record":
                 motion["file_sha256"] = _file_sha256(base_dir, table.get("record"))
                 label = Path(str(table.get("record", kind))).stem
-            motions.append({"label": label, "kind": "record", "field": "scene.motion", "motion": motion})
-    labels = [m["label"] for m in motions]
+            motions.append(MotionSource(label, "record", "scene.motion", motion))
+    labels = [m.label for m in motions]
     for i, label in enumerate(labels):
         if labels.index(label) != i:
             raise ExperimentError(f"records: motion label {label!r} is used twice (give each [[records]] a distinct name)")
-    return motions
+    return tuple(motions)
 
 
 def _array_of_tables(data: Mapping[str, Any], key: str) -> list[dict[str, Any]]:
@@ -451,7 +424,7 @@ def _array_of_tables(data: Mapping[str, Any], key: str) -> list[dict[str, Any]]:
     return tables
 
 
-def _analytic_source(table: Mapping[str, Any], where: str) -> dict[str, Any]:
+def _analytic_source(table: Mapping[str, Any], where: str) -> MotionSource:
     """A ``[[motions]]`` entry: a named analytic motion (a scene ``[motion]`` table of type harmonic or constant)."""
     with field_errors():
         label = toml_fields.string(table, "name", where)
@@ -459,7 +432,7 @@ def _analytic_source(table: Mapping[str, Any], where: str) -> dict[str, Any]:
     kind = motion.get("type")
     if kind not in _ANALYTIC_TYPES:
         raise ExperimentError(f"{where}.type: must be one of {', '.join(_ANALYTIC_TYPES)} (records go in [[records]]), got {kind!r}")
-    return {"label": label, "kind": "record", "field": where, "motion": motion}
+    return MotionSource(label, "record", where, motion)
 
 
 def _file_sha256(base_dir: Path, spec: Any) -> str | None:
@@ -469,7 +442,7 @@ def _file_sha256(base_dir: Path, spec: Any) -> str | None:
     return hashlib.sha256(file.read_bytes()).hexdigest() if file.is_file() else None
 
 
-def _record_sources(table: Mapping[str, Any], where: str, base_dir: Path) -> list[dict[str, Any]]:
+def _record_sources(table: Mapping[str, Any], where: str, base_dir: Path) -> list[MotionSource]:
     """A ``[[records]]`` entry: one record, or every motion of a suite (``suite = "fema_p695_far_field"`` or a folder)."""
     if "suite" not in table:
         return [_record_source(table, where, base_dir)]
@@ -490,7 +463,7 @@ def _record_sources(table: Mapping[str, Any], where: str, base_dir: Path) -> lis
         label = member if suite in SUITES else Path(member).stem
         motion = {k: v for k, v in table.items() if k not in ("name", "suite", *SELECTIONS)}
         motion.update(type="record", record=record, file_sha256=_file_sha256(base_dir, record))
-        sources.append({"label": f"{prefix}/{label}" if prefix else label, "kind": "record", "field": where, "motion": motion, "suite": suite})
+        sources.append(MotionSource(f"{prefix}/{label}" if prefix else label, "record", where, motion, suite=suite))
     return sources
 
 
@@ -514,7 +487,7 @@ def _suite_choice(table: Mapping[str, Any], where: str) -> dict[str, Any]:
     return choice
 
 
-def _record_source(table: Mapping[str, Any], where: str, base_dir: Path) -> dict[str, Any]:
+def _record_source(table: Mapping[str, Any], where: str, base_dir: Path) -> MotionSource:
     with field_errors():
         toml_fields.reject_unknown(table, _RECORD_KEYS, where)
         record = toml_fields.string(table, "record", where)
@@ -522,10 +495,10 @@ def _record_source(table: Mapping[str, Any], where: str, base_dir: Path) -> dict
     motion = {k: v for k, v in table.items() if k != "name"}
     motion["type"] = "record"
     motion["file_sha256"] = _file_sha256(base_dir, record)
-    return {"label": label, "kind": "record", "field": where, "motion": motion}
+    return MotionSource(label, "record", where, motion)
 
 
-def _synthetic_source(label: str, table: Any, where: str) -> dict[str, Any]:
+def _synthetic_source(label: str, table: Any, where: str) -> MotionSource:
     if not isinstance(table, dict):
         raise ExperimentError(f"{where}: must be a table (type, count, seed and the generator's parameters)")
     entry = dict(table)
@@ -550,13 +523,13 @@ def _synthetic_source(label: str, table: Any, where: str) -> dict[str, Any]:
         counts[key] = value
     if "seed" not in entry:
         raise ExperimentError(f"{where}.seed: missing (an integer >= 0; realization i depends on (seed, i) only)")
-    return {"label": label, "kind": "synthetic", "field": where, "motion": entry, **counts}
+    return MotionSource(label, "synthetic", where, entry, counts["start"], counts["count"])
 
 
 # ---------------------------------------------------------------- output and solver
 
 
-def _output(data: Mapping[str, Any], buildings: list[str]) -> dict[str, Any]:
+def _output(data: Mapping[str, Any], buildings: list[str]) -> Output:
     table = _table_or_error(data, "output", "")
     with field_errors():
         toml_fields.reject_unknown(table, {"time_histories", "buildings", "impacts", "demands"}, "output")
@@ -571,19 +544,13 @@ def _output(data: Mapping[str, Any], buildings: list[str]) -> dict[str, Any]:
     if not isinstance(chosen, list) or not chosen or not all(b in buildings for b in chosen):
         raise ExperimentError(f"output.buildings: must be a non-empty list of building names ({', '.join(buildings)}), got {chosen!r}")
     _check_unique(chosen, "output.buildings")
-    impacts = table.get("impacts", True)
-    if not isinstance(impacts, bool):
-        raise ExperimentError(f"output.impacts: must be true or false, got {impacts!r}")
-    demands = table.get("demands", False)
-    if not isinstance(demands, bool):
-        raise ExperimentError(f"output.demands: must be true or false, got {demands!r}")
-    output = {"time_histories": list(histories), "buildings": [b for b in buildings if b in chosen], "impacts": impacts}
-    if demands:  # absent when false: the definitions (and hashes) of stores without demands are unchanged
-        output["demands"] = True
-    return output
+    with field_errors():
+        impacts = toml_fields.boolean(table, "impacts", "output", default=True)
+        demands = toml_fields.boolean(table, "demands", "output", default=False)
+    return Output(tuple(histories), tuple(b for b in buildings if b in chosen), impacts, demands)
 
 
-def _solver(data: Mapping[str, Any]) -> dict[str, Any]:
+def _solver(data: Mapping[str, Any]) -> Solver:
     table = _table_or_error(data, "solver", "")
     with field_errors():
         toml_fields.reject_unknown(table, {"method", "integrator", "rtol", "atol"}, "solver")
@@ -595,4 +562,4 @@ def _solver(data: Mapping[str, Any]) -> dict[str, Any]:
         raise ExperimentError(f"solver.method: must be one of {AUTO}, {', '.join(METHODS)}, got {method!r}")
     if integrator not in INTEGRATORS:
         raise ExperimentError(f"solver.integrator: must be one of {', '.join(INTEGRATORS)}, got {integrator!r}")
-    return {"method": method, "integrator": integrator, "rtol": rtol, "atol": atol}
+    return Solver(method, integrator, rtol, atol)

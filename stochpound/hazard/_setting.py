@@ -51,7 +51,8 @@ from stochpound._errors import IntensityError
 from stochpound.hazard._curve import BUNDLED_UNITS, HazardCurve, bundled_curves, bundled_measure, bundled_path
 from stochpound.hazard._files import StatedMeasure, parse_units, read_hazard_file, unit_factor
 from stochpound.hazard._ruptures import SITE_FIELDS as RUPTURE_SITE_FIELDS, named_rupture_site
-from stochpound.store import MEASURES, describe_measure
+from stochpound.motions import Measure
+from stochpound.store import MEASURES, Hazard, Intensity
 from stochpound.model import fields as toml_fields
 from stochpound.motions import DEFAULT_G
 
@@ -65,15 +66,15 @@ _REQUIRED = {"pga": ("units",), "pgv": ("units",), "psa": ("period", "damping", 
 _TOLERANCE = 1e-9
 
 
-def parse_hazard(data: Mapping[str, Any], intensity: Mapping[str, Any] | None, base_dir: Path, g: float = DEFAULT_G) -> dict[str, Any] | None:
-    """The canonical ``hazard`` entry of a definition (None without a ``[hazard]`` table).
+def parse_hazard(data: Mapping[str, Any], intensity: Intensity | None, base_dir: Path, g: float = DEFAULT_G) -> Hazard | None:
+    """The ``[hazard]`` table of a definition, typed (None without a ``[hazard]`` table).
 
     Parameters
     ----------
     data : mapping
         The parsed experiment file.
-    intensity : mapping or None
-        The canonical ``intensity`` entry (a hazard needs one).
+    intensity : Intensity or None
+        The ``[intensity]`` setting (a hazard needs one).
     base_dir : Path
         The experiment file's folder (a ``file`` is relative to it).
     g : float
@@ -81,9 +82,9 @@ def parse_hazard(data: Mapping[str, Any], intensity: Mapping[str, Any] | None, b
 
     Returns
     -------
-    dict or None
+    Hazard or None
         ``source`` (one of :data:`SOURCES`), the source's key as given,
-        the measure (as ``[intensity]``'s), ``units``, ``extrapolate``,
+        the measure (``[intensity]``'s), ``units``, ``extrapolate``,
         ``im`` and ``rate`` (a table, in the units of the levels and in
         annual rates; a power law: ``power_law``), ``provenance`` (with
         any conversion) and, for a file, ``file_sha256``.
@@ -110,62 +111,65 @@ def parse_hazard(data: Mapping[str, Any], intensity: Mapping[str, Any] | None, b
         if key in table and source != "ruptures":
             raise IntensityError(f"hazard.{key}: only with ruptures = ... (the site of a rupture table)")
     extrapolate = toml_fields.boolean(table, "extrapolate", "hazard", default=False)
-    entry: dict[str, Any] = {"source": source, **_measure_of(intensity), "units": intensity["units"], "extrapolate": extrapolate}
+    measure, units = intensity.measure, intensity.units
     stated = _stated_fields(table)
+    matched = {key: stated[key] for key in _MATCHED if key in stated}
+    sources: dict[str, str] = {}
+    power_law = None
     if source == "bundled":
-        name = toml_fields.string(table, "bundled", "hazard")
-        curve = _bundled(name, intensity, g, extrapolate, "hazard.bundled")
-        entry["bundled"] = name
+        sources["bundled"] = toml_fields.string(table, "bundled", "hazard")
+        curve = _bundled(sources["bundled"], measure, units, g, extrapolate, "hazard.bundled")
     elif source == "file":
         name = toml_fields.string(table, "file", "hazard")
         path = base_dir / name
         if not path.is_file():
             raise IntensityError(f"hazard.file: {name!r} not found (a hazard-curve file, relative to the experiment file)")
-        curve = _read(path, stated, table.get("site"), intensity, g, extrapolate, "hazard")
-        entry["file"], entry["file_sha256"] = name, hashlib.sha256(path.read_bytes()).hexdigest()
+        curve = _read(path, stated, table.get("site"), measure, units, g, extrapolate, "hazard")
+        sources.update(file=name, file_sha256=hashlib.sha256(path.read_bytes()).hexdigest())
     elif source == "ruptures":
-        _check_measure("hazard", {key: stated[key] for key in _MATCHED if key in stated}, intensity)
-        curve = _rupture_curve(table, intensity, base_dir, g, extrapolate)
-        entry["ruptures"] = table["ruptures"]
+        _check_measure("hazard", matched, measure)
+        curve = _rupture_curve(table, measure, units, base_dir, g, extrapolate)
+        sources["ruptures"] = table["ruptures"]
     else:
-        _check_measure("hazard", {key: stated[key] for key in _MATCHED if key in stated}, intensity)
-        entry["power_law"] = _power_law(table["power_law"], stated.get("units", intensity["units"]), intensity["units"], g)
-        curve = HazardCurve.power_law(**entry["power_law"])
-    if curve.power is None:
-        entry["im"], entry["rate"] = [float(x) for x in curve.im], [float(y) for y in curve.rate]
-        if intensity.get("ran") == "stripes":
-            check_covers(curve, intensity["levels"], "hazard", "intensity.levels", "extrapolate = true")
-    entry["provenance"] = curve.source
-    return entry
+        _check_measure("hazard", matched, measure)
+        power_law = _power_law(table["power_law"], stated.get("units", units), units, g)
+        curve = HazardCurve.power_law(**power_law)
+    if curve.power is None and intensity.ran == "stripes":
+        check_covers(curve, intensity.levels, "hazard", "intensity.levels", "extrapolate = true")
+    table_values = ((), ()) if curve.power is not None else (tuple(float(x) for x in curve.im), tuple(float(y) for y in curve.rate))
+    return Hazard(source, measure, units, extrapolate, curve.source, *table_values, power_law=power_law, **sources)
 
 
-def _rupture_curve(table: Mapping[str, Any], intensity: Mapping[str, Any], base_dir: Path, g: float, extrapolate: bool) -> HazardCurve:
+def _rupture_curve(table: Mapping[str, Any], measure: Measure, units: str, base_dir: Path, g: float, extrapolate: bool) -> HazardCurve:
     """The hazard curve of ``[intensity]``'s measure from the site of ruptures ``[hazard]`` names, in the levels' units."""
     from stochpound._errors import SiteError
 
     given = {key: table[key] for key in RUPTURE_SITE_FIELDS if key in table}
     try:
         site = named_rupture_site(table["ruptures"], base_dir, given, "hazard")
-        if intensity.get("damping", 0.05) != 0.05:
-            raise SiteError(f"hazard.ruptures: the NGA-West2 models give 5 % damped spectra only; intensity.damping is {intensity['damping']!r}")
-        curve = site.hazard_curve(intensity["measure"], intensity.get("period", intensity.get("periods")), extrapolate=extrapolate)
-        factor = unit_factor("g", intensity["units"], g)
+        if measure.damping is not None and measure.damping != 0.05:
+            raise SiteError(f"hazard.ruptures: the NGA-West2 models give 5 % damped spectra only; intensity.damping is {measure.damping!r}")
+        curve = site.hazard_curve(measure.kind, measure.spectral_period, extrapolate=extrapolate)
+        factor = unit_factor("g", units, g)
     except (SiteError, ValueError) as error:
         message = str(error)
         raise IntensityError(message if message.startswith("hazard.") else f"hazard.ruptures: {message}") from None
-    return HazardCurve(curve.im * factor, curve.rate, extrapolate=extrapolate, measure=describe_measure(intensity), units=intensity["units"],
+    return HazardCurve(curve.im * factor, curve.rate, extrapolate=extrapolate, measure=measure.description, units=units,
                        source=f"{curve.source}; {site.source}" if site.source else curve.source)
 
 
-def hazard_curve(entry: Mapping[str, Any], extrapolate: bool | None = None) -> HazardCurve:
-    """The :class:`~stochpound.analysis.HazardCurve` of a canonical ``hazard`` entry (from its stored values, not its file).
+def hazard_curve(hazard: Hazard | Mapping[str, Any], extrapolate: bool | None = None) -> HazardCurve:
+    """The :class:`~stochpound.analysis.HazardCurve` of a store's hazard (from its stored values, not its file).
 
-    ``extrapolate`` overrides the entry's (``stochpound risk --extrapolate``).
+    ``hazard`` is the typed :class:`~stochpound.store.Hazard` or its canonical entry; ``extrapolate`` overrides
+    its own (``stochpound risk --extrapolate``).
     """
-    description = {"measure": describe_measure(entry), "units": entry["units"], "source": entry["provenance"]}
-    if "power_law" in entry:
-        return HazardCurve.power_law(**entry["power_law"], **description)
-    return HazardCurve(entry["im"], entry["rate"], extrapolate=entry["extrapolate"] if extrapolate is None else extrapolate, **description)
+    if not isinstance(hazard, Hazard):
+        hazard = Hazard.from_entry(hazard)
+    description = {"measure": hazard.description, "units": hazard.units, "source": hazard.provenance}
+    if hazard.power_law is not None:
+        return HazardCurve.power_law(**hazard.power_law, **description)
+    return HazardCurve(hazard.im, hazard.rate, extrapolate=hazard.extrapolate if extrapolate is None else extrapolate, **description)
 
 
 def check_covers(curve: HazardCurve, levels: Sequence[float], where: str, what: str, remedy: str) -> None:
@@ -203,8 +207,8 @@ def _stated_fields(table: Mapping[str, Any]) -> dict[str, Any]:
     return stated
 
 
-def _read(path: Path, given: Mapping[str, Any], site: Any, intensity: Mapping[str, Any], g: float, extrapolate: bool, where: str) -> HazardCurve:
-    """A hazard file's curve, its measure (the file's, completed by ``given``) checked against ``intensity``, converted to its units and to rates."""
+def _read(path: Path, given: Mapping[str, Any], site: Any, measure: Measure, units: str, g: float, extrapolate: bool, where: str) -> HazardCurve:
+    """A hazard file's curve, its measure (the file's, completed by ``given``) checked against ``measure``, converted to ``units`` and to rates."""
     try:
         read = read_hazard_file(path, site=site)
     except (ValueError, UnicodeDecodeError) as error:
@@ -226,11 +230,10 @@ def _read(path: Path, given: Mapping[str, Any], site: Any, intensity: Mapping[st
         if key not in stated:
             example = " (e.g. 'PSA(1.0 s, 5 %) in g')" if key in ("period", "damping") and where.startswith("--") else ""
             raise IntensityError(f"{_field(where, key)}: not stated: {path.name} does not give its curve's {key}; state it{example}")
-    _check_measure(where, {key: stated[key] for key in _MATCHED if key in stated}, intensity)
+    _check_measure(where, {key: stated[key] for key in _MATCHED if key in stated}, measure)
     read.stated = StatedMeasure.from_entry(stated)
     try:
-        return read.curve(intensity["units"], g, investigation_time=given.get("investigation_time"), extrapolate=extrapolate,
-                          description=describe_measure(intensity))
+        return read.curve(units, g, investigation_time=given.get("investigation_time"), extrapolate=extrapolate, description=measure.description)
     except ValueError as error:
         message = str(error)
         if message.startswith("investigation_time:"):
@@ -249,31 +252,26 @@ def _field(where: str, key: str) -> str:
     return f"{where}.{key}" if not where.startswith("--") else _OPTIONS[key].format(where=where)
 
 
-def _bundled(name: str, intensity: Mapping[str, Any], g: float, extrapolate: bool, where: str) -> HazardCurve:
-    """A bundled curve, its measure (from its name) checked against ``intensity``, converted to the levels' units."""
+def _bundled(name: str, measure: Measure, units: str, g: float, extrapolate: bool, where: str) -> HazardCurve:
+    """A bundled curve, its measure (from its name) checked against ``measure``, converted to ``units``."""
     if name not in bundled_curves():
         raise IntensityError(f"{where}: no bundled hazard curve {name!r} (bundled: {', '.join(bundled_curves())})")
-    measure = bundled_measure(name)
-    _check_measure(where, measure.entry(), intensity, bundled=name)
+    stated = bundled_measure(name)
+    _check_measure(where, stated.entry(), measure, bundled=name)
     read = read_hazard_file(bundled_path(name))
-    read.stated = StatedMeasure.of(measure, BUNDLED_UNITS)
-    return read.curve(intensity["units"], g, extrapolate=extrapolate, description=describe_measure(intensity))
+    read.stated = StatedMeasure.of(stated, BUNDLED_UNITS)
+    return read.curve(units, g, extrapolate=extrapolate, description=measure.description)
 
 
-def _measure_of(intensity: Mapping[str, Any]) -> dict[str, Any]:
-    """The keys of ``[intensity]`` that define its measure."""
-    return {key: intensity[key] for key in _MATCHED if key in intensity}
-
-
-def _check_measure(where: str, stated: Mapping[str, Any], intensity: Mapping[str, Any], bundled: str = "") -> None:
+def _check_measure(where: str, stated: Mapping[str, Any], measure: Measure, bundled: str = "") -> None:
     """Raise unless every stated key of the hazard's measure equals ``[intensity]``'s (units are converted, not matched)."""
-    wanted = _measure_of(intensity)
+    wanted = measure.entry()
     for key, value in stated.items():
         field = where if bundled else _field(where, key)
-        what = f"{bundled!r} is {describe_measure(stated)}" if bundled else f"the hazard's {key} is {value!r}"
+        what = f"{bundled!r} is {Measure.from_entry(stated).description}" if bundled else f"the hazard's {key} is {value!r}"
         if key not in wanted or not _equal(value, wanted[key]):
             detail = f" (intensity.{key} = {wanted[key]!r})" if key in wanted else ""
-            raise IntensityError(f"{field}: the hazard's measure must be [intensity]'s, {describe_measure(intensity)}{detail}; {what}")
+            raise IntensityError(f"{field}: the hazard's measure must be [intensity]'s, {measure.description}{detail}; {what}")
 
 
 def _equal(a: Any, b: Any) -> bool:
@@ -301,11 +299,11 @@ def _power_law(table: Any, units: str, target: str, g: float) -> dict[str, float
 
 def stored_hazard(store: xr.Dataset) -> HazardCurve | None:
     """The hazard an experiment store carries (``store.pound.hazard``, typed), as a curve; None without one."""
-    entry = store.pound.hazard
-    return None if entry is None else hazard_curve(entry)
+    hazard = store.pound.hazard
+    return None if hazard is None else hazard_curve(hazard)
 
 
-def hazard_option(value: str, intensity: Mapping[str, Any], g: float = DEFAULT_G, *, stated: Mapping[str, Any] | None = None,
+def hazard_option(value: str, intensity: Intensity | Mapping[str, Any], g: float = DEFAULT_G, *, stated: Mapping[str, Any] | None = None,
                   site: Any = None, extrapolate: bool = False, option: str = "--hazard") -> HazardCurve:
     """A hazard named on the command line: a bundled curve's name or a hazard-curve file, checked against ``intensity``.
 
@@ -314,8 +312,8 @@ def hazard_option(value: str, intensity: Mapping[str, Any], g: float = DEFAULT_G
     value : str
         A bundled curve's name or a hazard-curve file
         (:func:`~stochpound.analysis.read_hazard_file`).
-    intensity : mapping
-        The store's ``intensity`` entry.
+    intensity : Intensity or mapping
+        The store's intensity setting (or a mapping of its measure's keys and ``units``).
     g : float
         The store's g (m/s²), for a conversion to or from g.
     stated : mapping, optional
@@ -331,9 +329,10 @@ def hazard_option(value: str, intensity: Mapping[str, Any], g: float = DEFAULT_G
         Neither a bundled name nor a file, an invalid file, a measure other
         than the store's or one nobody states.
     """
+    measure, units = (intensity.measure, intensity.units) if isinstance(intensity, Intensity) else (Measure.from_entry(intensity), intensity["units"])
     if value in bundled_curves():
-        return _bundled(value, intensity, g, extrapolate, option)
+        return _bundled(value, measure, units, g, extrapolate, option)
     path = Path(value)
     if not path.is_file():
         raise IntensityError(f"{option}: {value!r} is neither a file nor a bundled hazard curve (bundled: {', '.join(bundled_curves())})")
-    return _read(path, stated or {}, site, intensity, g, extrapolate, option)
+    return _read(path, stated or {}, site, measure, units, g, extrapolate, option)

@@ -17,6 +17,7 @@ from stochpound.model import laws
 from stochpound.model.building import Building
 from stochpound.model.contact import Contact
 from stochpound.model.wall import Wall
+from stochpound.motions import DEFAULT_G
 from stochpound.motions.ground import GroundMotion
 
 
@@ -45,7 +46,7 @@ class Scene:
     buildings: tuple[Building, ...]
     contacts: tuple[Contact, ...]
     motion: GroundMotion
-    g: float = 9.81
+    g: float = DEFAULT_G
     study_compat: bool = False
     walls: tuple[Wall, ...] = ()
     source: str = field(default="python", compare=False)

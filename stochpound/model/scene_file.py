@@ -24,7 +24,7 @@ from stochpound.model.building import buildings_from_tables
 from stochpound.model.contact import contacts_from_tables
 from stochpound.model.scene import Scene
 from stochpound.model.wall import walls_from_tables
-from stochpound.motions import SYNTHETIC_TYPES
+from stochpound.motions import DEFAULT_G, SYNTHETIC_TYPES
 from stochpound.motions.ground import GroundMotion, HarmonicMotion, SampledMotion
 
 _TOP_KEYS = {"g", "study_compat", "building", "contact", "wall", "motion"}
@@ -125,7 +125,7 @@ def scene_from_dict(data: Mapping[str, Any], base_dir: str | Path = ".", source:
         Provenance label stored with the scene.
     """
     fields.reject_unknown(data, _TOP_KEYS, "")
-    g = fields.number(data, "g", "", default=9.81, low=0.0, low_open=True)
+    g = fields.number(data, "g", "", default=DEFAULT_G, low=0.0, low_open=True)
     study_compat = fields.boolean(data, "study_compat", "", default=False)
     buildings = buildings_from_tables(fields.array_of_tables(data, "building"))
     contacts = contacts_from_tables(fields.array_of_tables(data, "contact"), buildings)

@@ -31,7 +31,7 @@ import xarray as xr
 
 from stochpound.hazard import rate_from_probability
 from stochpound.risk import _store
-from stochpound.risk._limit_states import KINDS, LimitState, limit_state_risk, limit_states_from_table
+from stochpound.risk._limit_states import KINDS, LimitState, limit_state_risk, limit_states_of
 from stochpound.risk._maf import TARGETS
 from stochpound.risk._store_risk import YEARS
 
@@ -151,7 +151,7 @@ def store_damage(store: xr.Dataset, limit_states: Sequence[LimitState] | None = 
     given = limit_states is not None
     table = _store.limit_states_table(store)
     if limit_states is None and table is not None:
-        limit_states, source, given = limit_states_from_table(table["capacities"]), table["source"] or EXPERIMENT_SOURCE, True
+        limit_states, source, given = limit_states_of(table), table.source or EXPERIMENT_SOURCE, True
     if limit_states is None:
         limit_states, source = DEFAULT_LIMIT_STATES, DEFAULT_SOURCE
     per_building, free = _store.run_summaries(store, list(DAMAGE_DEMANDS))

@@ -30,13 +30,13 @@ from __future__ import annotations
 
 import itertools
 import math
-from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
 import xarray as xr
 
 from stochpound.hazard import HazardCurve
+from stochpound.store import Design
 from stochpound.model.building import Building
 from stochpound.model.scene import Scene
 from stochpound.risk import _store
@@ -51,15 +51,15 @@ DESIGN_RULE_LEVELS = {"asce7_delta_mt": 0.02, "ec8_ds": 0.10, "asce7_dtm": 0.02}
 _RECORD_DIMS = ("intensity", "record", "contact")
 
 
-def design_separations(scene: Scene, design: Mapping[str, Any], studied: str | None = None) -> dict[str, np.ndarray]:
+def design_separations(scene: Scene, design: Design, studied: str | None = None) -> dict[str, np.ndarray]:
     """The codes' separations of a scene's contacts from its design (m): one array (one gap per contact) per rule.
 
     Parameters
     ----------
     scene : Scene
         The buildings and contacts (a base, if any, held fixed for the storeys' design analysis).
-    design : mapping
-        The canonical ``[design]`` entry (``stochpound.experiment``'s ``parse_design``).
+    design : Design
+        The ``[design]`` table (``stochpound.experiment``'s ``parse_design``; ``Design.from_entry`` of its canonical entry).
     studied : str, optional
         The building whose friction pendulum gives ``asce7_dtm`` (with ``sm1``
         in the design and a finite μ and radius in the scene).
@@ -69,10 +69,10 @@ def design_separations(scene: Scene, design: Mapping[str, Any], studied: str | N
     dict of str to numpy.ndarray
         ``asce7_delta_mt``, and ``ec8_ds`` with an ``ec8`` design, ``asce7_dtm`` where it applies.
     """
-    asce7 = Asce7Design(design["sds"], design["sd1"], design["tl"], design["r"], design["cd"], design["ie"])
+    asce7 = Asce7Design(design.sds, design.sd1, design.tl, design.r, design.cd, design.ie)
     codes = {"asce7_delta_mt": lambda b: asce7_inelastic_displacement(modal_floor_displacements(b, design=asce7, g=scene.g), asce7)}
-    if "ec8" in design:
-        ec8 = Ec8Design(design["ec8"]["ag"], design["ec8"]["ground"], design["ec8"]["q"])
+    if design.ec8 is not None:
+        ec8 = Ec8Design(design.ec8.ag, design.ec8.ground, design.ec8.q)
         codes["ec8_ds"] = lambda b: ec8_design_displacement(modal_floor_displacements(b, design=ec8, g=scene.g), ec8)
     gaps = {}
     for rule, displacements in codes.items():
@@ -80,14 +80,14 @@ def design_separations(scene: Scene, design: Mapping[str, Any], studied: str | N
         gaps[rule] = np.array([srss_separation(floors[c.left][c.left_floor - 1], floors[c.right][c.right_floor - 1])
                                * (EC8_REDUCTION if rule == "ec8_ds" and _level_floors(scene, c) else 1.0) for c in scene.contacts])
     isolated = next((b for b in scene.buildings if b.name == studied), None)
-    if "sm1" in design and isolated is not None and _pendulum(isolated):
+    if design.sm1 is not None and isolated is not None and _pendulum(isolated):
         weight = scene.g * (sum(isolated.mass) + isolated.base.mass)
-        dtm, _, _ = asce7_isolator_displacement(weight, isolated.base.mu, isolated.base.radius, design["sm1"], scene.g)
+        dtm, _, _ = asce7_isolator_displacement(weight, isolated.base.mu, isolated.base.radius, design.sm1, scene.g)
         gaps["asce7_dtm"] = np.full(len(scene.contacts), dtm)
     return gaps
 
 
-def design_rules_risk(store: xr.Dataset, hz: HazardCurve, design: Mapping[str, Any], studied: str | None = None, years: float = 50.0,
+def design_rules_risk(store: xr.Dataset, hz: HazardCurve, design: Design, studied: str | None = None, years: float = 50.0,
                       confidence: float = 0.95, bootstrap: int = BOOTSTRAP, seed: int = 0) -> xr.Dataset:
     """The codes' own gaps of every configuration of a store with stripes and the mean annual frequency of pounding at each.
 
@@ -97,7 +97,7 @@ def design_rules_risk(store: xr.Dataset, hz: HazardCurve, design: Mapping[str, A
         An experiment store with intensity stripes and contact-free cases.
     hz : HazardCurve
         The site's hazard, in the store's intensity measure.
-    design : mapping
+    design : Design
         The ``[design]`` entry (:func:`design_separations`).
     studied : str, optional
         The building of ``asce7_dtm``.
@@ -133,7 +133,7 @@ def design_rules_risk(store: xr.Dataset, hz: HazardCurve, design: Mapping[str, A
         .assign_attrs(years=years, **no_interval_attrs(fragility))
 
 
-def _configuration_gaps(store: xr.Dataset, closure: xr.DataArray, design: Mapping[str, Any], studied: str | None) -> xr.DataArray:
+def _configuration_gaps(store: xr.Dataset, closure: xr.DataArray, design: Design, studied: str | None) -> xr.DataArray:
     """The rules' gaps (m) over ``rule``, the configurations of ``closure`` and ``contact``, from each configuration's scene."""
     configs = [dim for dim in closure.dims if dim not in _RECORD_DIMS]
     per_config = {}

@@ -32,6 +32,7 @@ from stochpound.hazard import HazardCurve, probability_from_rate
 from stochpound.risk import _store
 from stochpound.risk._fragility_ensemble import limit_state_events, stripe_fragility
 from stochpound.risk._maf import mean_annual_frequency
+from stochpound.store import LimitStates
 from stochpound.risk._store_risk import CONFIDENCE, YEARS
 
 
@@ -104,6 +105,11 @@ class LimitState:
         kind = KINDS[self.kind]
         units = "" if kind.units == "1" else f" {kind.units}"
         return f"{kind.label}{f' of {self.building}' if self.building else ''} ≥ {self.capacity:g}{units}"
+
+
+def limit_states_of(table: LimitStates) -> tuple[LimitState, ...]:
+    """The limit states of an experiment's ``[limit_states]`` table (:class:`~stochpound.store.LimitStates`), in its order."""
+    return tuple(LimitState(state.kind, capacity, state.building) for state in table.states for capacity in state.capacities)
 
 
 def limit_states_from_table(table: Mapping[str, Any]) -> tuple[LimitState, ...]:

@@ -24,8 +24,8 @@ import xarray as xr
 from stochpound.codes import store_contact_demands
 from stochpound.hazard import HazardCurve, check_covers, hazard_curve, hazard_option, parse_measure, parse_units, stored_hazard
 from stochpound.model import Scene
-from stochpound.motions import DEFAULT_G, TRUNCATION_EPSILON
-from stochpound.store import (LIMIT_STATE_DEMANDS, cases_done, check_finished as _check_finished, contact_free, describe_measure, gap_dims,
+from stochpound.motions import TRUNCATION_EPSILON
+from stochpound.store import (LIMIT_STATE_DEMANDS, Design, Intensity, cases_done, check_finished as _check_finished, contact_free, gap_dims,
                               has_contact_free, has_wall_free, scenario_kind, scenario_ranges, wall_free, with_contacts)
 
 CLOSURE = "peak_contact_closure"
@@ -47,14 +47,14 @@ class RiskInputError(ValueError):
     """A store cannot go through the risk chain (the message says why, in one line)."""
 
 
-def intensity_setting(store: xr.Dataset) -> dict[str, Any] | None:
-    """The definition's ``intensity`` entry of a store (None if it has none), through its ``pound`` accessor."""
+def intensity_setting(store: xr.Dataset) -> Intensity | None:
+    """The definition's intensity setting of a store (None if it has none), through its ``pound`` accessor."""
     return store.pound.intensity
 
 
-def measure_text(setting: Mapping[str, Any]) -> str:
-    """The intensity measure of an ``intensity`` entry in words (e.g. ``PSA(2 s, 5 %)``)."""
-    return describe_measure(setting)
+def measure_text(setting: Intensity) -> str:
+    """The intensity measure of an intensity setting in words (e.g. ``PSA(T = 2 s, 5 % damping)``)."""
+    return setting.description
 
 
 def has_risk(store: xr.Dataset) -> bool:
@@ -101,8 +101,7 @@ def site_hazard(store: xr.Dataset, hazard: str | None = None, option: str = "--h
     if hazard is None and (stated or site is not None):
         raise RiskInputError(f"{option}-measure, {option}-units, --investigation-time and {option}-site describe a {option} file: give one")
     if hazard is not None:
-        g = float(store.pound.definition.to_dict()["scene"].get("g", DEFAULT_G))
-        hz = hazard_option(hazard, setting, g, stated=stated, site=site, extrapolate=extrapolate, option=option)
+        hz = hazard_option(hazard, setting, store.pound.definition.g, stated=stated, site=site, extrapolate=extrapolate, option=option)
     else:
         entry = store.pound.hazard
         if entry is None:
@@ -134,7 +133,7 @@ def studied_building(store: xr.Dataset) -> str | None:
     return store.pound.definition.studied
 
 
-def design(store: xr.Dataset) -> Mapping[str, Any] | None:
+def design(store: xr.Dataset) -> Design | None:
     """The store's ``[design]`` entry, the buildings' code design (None without one)."""
     return store.pound.definition.design
 
@@ -173,11 +172,11 @@ def assumptions(store: xr.Dataset) -> dict[str, str]:
     kinds = {"record": "records without a named suite", "synthetic": "synthetic ensembles"}
     suites = sorted({source.suite or kinds.get(source.kind, source.kind) for source in definition.motions})
     count = sum(source.count for source in definition.motions)
-    entry = definition.intensity.entry if definition.intensity is not None else {}
-    selection = entry.get("selection")
+    selection_entry = definition.intensity.selection if definition.intensity is not None else {}
+    selection = selection_entry.get("selection")
     suite = (f"{count} motions ({', '.join(suites)}), "
              + (f"selected per stripe by {str(selection).replace('_', ' ')}" if selection else "every motion scaled to every stripe (no selection)"))
-    scenario = _scenario_words(store, scenario_kind(store)) if entry.get("site") else ""
+    scenario = _scenario_words(store, scenario_kind(store)) if selection_entry.get("site") else ""
     return {"structural model": "; ".join(models), "suite": suite,
             "scenario": scenario or "none stated (the motions are not selected for a scenario)"}
 
@@ -409,8 +408,8 @@ def efficiency_runs(store: xr.Dataset, studied: str | None) -> dict[str, Any]:
     sliding = None if is_ida(store) else base_displacement(free, studied)
     if sliding is not None:
         responses["base_displacement"] = sliding
-    setting = intensity_setting(store) or {}
-    psa_in_g = setting.get("measure") == "psa" and setting.get("damping") == 0.05 and setting.get("units") == "g"
+    setting = intensity_setting(store)
+    psa_in_g = setting is not None and setting.measure.kind == "psa" and setting.measure.damping == 0.05 and setting.units == "g"
     return {
         "responses": responses,
         "scale_factor": store_motions(free["scale_factor"]).load(),
@@ -419,14 +418,14 @@ def efficiency_runs(store: xr.Dataset, studied: str | None) -> dict[str, Any]:
         "pga": store_motions(free["motion_pga"]).load(),
         "pgv": store_motions(free["motion_pgv"]).load(),
         "intensity": store_motions(free["motion_intensity"]).load(),
-        "conditioning": float(setting["period"]) if psa_in_g else None,
+        "conditioning": float(setting.measure.period) if psa_in_g else None,
         "covariates": {name: store_motions(free[name]) for name in ("record_magnitude", "record_distance") if name in free.coords},
     }
 
 
 def scene_g(store: xr.Dataset) -> float:
     """The acceleration of gravity of the store's scene, m/s²."""
-    return float(store.pound.definition.to_dict()["scene"].get("g", DEFAULT_G))
+    return store.pound.definition.g
 
 
 def case_demand(store: xr.Dataset, variable: str, building: str | None, needs: str) -> xr.DataArray:

@@ -35,6 +35,7 @@ import xarray as xr
 
 from stochpound._memory import check_memory
 from stochpound.hazard import HazardCurve, rate_from_probability
+from stochpound.store import Intensity
 from stochpound.risk import _store
 from stochpound.risk._code_rules import MINIMUM_MOTIONS, code_rules_risk
 from stochpound.risk._design_rules import design_rules_risk
@@ -175,7 +176,7 @@ class StoreRisk:
     hazard: HazardCurve
     motions: int
     method: str
-    setting: dict[str, Any] = dataclasses.field(default_factory=dict)
+    setting: Intensity | None = None
     stripes: int | None = None
     progress: str = ""
     experiment: str | None = None
@@ -368,7 +369,7 @@ class StoreRisk:
         if "lower_bound" not in self.separation or not bool(self.separation["lower_bound"].any()):
             return ""
         top = float(self.separation.attrs["top_stripe"])
-        units = self.setting.get("units", self.hazard.units)
+        units = self.setting.units if self.setting is not None else self.hazard.units
         sentences = []
         for target in self.separation["target"].values:
             at = self.separation.sel(target=target)
@@ -620,7 +621,7 @@ def store_risk(store: xr.Dataset, hz: HazardCurve | None = None, targets: Sequen
         design_note = "IDA runs: the codes' gaps are fitted over stripes"
     else:
         design_rules = design_rules_risk(store, hz, design, studied, years, confidence, bootstrap, seed)
-    return StoreRisk(fragility, curve, separation, rules, note, hz, motions, method, setting=_store.intensity_setting(store) or {},
+    return StoreRisk(fragility, curve, separation, rules, note, hz, motions, method, setting=_store.intensity_setting(store),
                      stripes=_store.stripes_run(store, closure), progress=_store.progress(store), experiment=_store.experiment_name(store), years=years, confidence=confidence,
                      assumptions=_store.assumptions(store), dtm_note=dtm_note, design_rules=design_rules, design_note=design_note)
 

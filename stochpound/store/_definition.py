@@ -1,15 +1,20 @@
 """The experiment definition as typed, frozen records: what an experiment runs, read one way.
 
-``stochpound.experiment._spec.parse_experiment`` validates an experiment
-file and returns the *canonical definition*, a JSON-able dict (stored with
-every store as the ``definition`` attribute). Everything that reads a
-definition — a parsed file, a store's attribute, a dict — goes through
-:func:`read_definition`, once, which returns a :class:`Definition`: the
-grid's axes (:class:`GapAxis`, :class:`MuAxis`, :class:`VariantAxis`), the
-motions (:class:`MotionSource`), the outputs (:class:`Output`), the solver
-settings (:class:`Solver`), the intensity setting (:class:`Intensity`) and
-the site's hazard (:class:`Hazard`). The canonical dict stays the stored
-form; :meth:`Definition.to_dict` gives it back unchanged.
+Each table of an experiment file parses to one of these records
+(``stochpound.experiment._spec.parse_experiment``): the grid's axes
+(:class:`GapAxis`, :class:`MuAxis`, :class:`VariantAxis`), the motions
+(:class:`MotionSource`), the outputs (:class:`Output`), the solver settings
+(:class:`Solver`), the intensity setting (:class:`Intensity`, its measure a
+:class:`stochpound.motions.Measure`), the site's hazard (:class:`Hazard`), the
+code design (:class:`Design`), the limit states (:class:`LimitStates`) and how
+the stripes' scenario was obtained (:class:`Site`), gathered in a
+:class:`Definition`. The *canonical definition*, a JSON-able dict stored with
+every store as its ``definition`` attribute and hashed, is only written from
+them (:meth:`Definition.to_dict`, each record's ``entry()``) and read back by
+:func:`read_definition` (each record's ``from_entry``); written and read, it is
+unchanged, so stored definitions and their sha256 are. The scene itself and a
+variant's overrides stay the scene file's tables (what the model's scene
+builder reads). The scene's g is read in one place (:func:`scene_g`).
 
 **The identity.** :func:`definition_sha256` hashes the canonical JSON
 (:func:`canonical_json`) without the entries that no run depends on
@@ -32,13 +37,15 @@ import copy
 import hashlib
 import json
 import math
-from collections.abc import Iterator, Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, TypeVar
 
 from stochpound._errors import ExperimentError
 from stochpound.model.friction import is_fixed_base
-from stochpound.motions import MEASURE_KINDS, Measure
+from stochpound.motions import DEFAULT_G, MEASURE_KINDS, Measure
+
+_Record = TypeVar("_Record")
 
 NOT_IN_IDENTITY = ("hazard", "design", "scene_source", "site", "limit_states")
 """Entries of a canonical definition that no run depends on, left out of its identity (:func:`~stochpound.store.definition_sha256`)."""
@@ -74,6 +81,11 @@ MEASURES = MEASURE_KINDS
 """The intensity measures an ``[intensity]`` (and a ``[hazard]``) table may name (:data:`stochpound.motions.MEASURE_KINDS`)."""
 
 
+def scene_g(scene: Mapping[str, Any]) -> float:
+    """A scene dict's acceleration of gravity, m/s²: its ``g``, or ``stochpound.motions.DEFAULT_G`` (9.81) when it leaves it out (the one reader)."""
+    return float(scene.get("g", DEFAULT_G))
+
+
 def describe_measure(intensity: Mapping[str, Any]) -> str:
     """An intensity measure in words, e.g. ``PSA(T = 1 s, 5 % damping)`` or ``PGA`` (:attr:`~stochpound.motions.Measure.description`).
 
@@ -86,74 +98,74 @@ def describe_measure(intensity: Mapping[str, Any]) -> str:
     return Measure.from_entry(intensity).description
 
 
-class _Entry(Mapping[str, Any]):
-    """A typed record that reads as its canonical entry too (``setting["levels"]`` and ``setting.levels``)."""
-
-    entry: Mapping[str, Any]
-
-    def __getitem__(self, key: str) -> Any:
-        return self.entry[key]
-
-    def __iter__(self) -> Iterator[str]:
-        return iter(self.entry)
-
-    def __len__(self) -> int:
-        return len(self.entry)
+_MEASURE_KEYS = ("measure", "period", "periods", "damping")
+_INTENSITY_KEYS = (*_MEASURE_KEYS, "levels", "units", "method", "synthetic", "ran", "note")
 
 
-@dataclass(frozen=True, eq=False)
-class Intensity(_Entry):
+@dataclass(frozen=True)
+class Intensity:
     """The ``[intensity]`` setting: the measure the motions were scaled to, and how (docs/intensity.md).
 
     Attributes
     ----------
-    measure : str
-        ``pga``, ``pgv``, ``psa`` or ``sa_avg``.
+    measure : Measure
+        The intensity measure (:class:`stochpound.motions.Measure`; its ``kind`` is ``pga``, ``pgv``, ``psa`` or ``sa_avg``).
     units : str
         Units of the levels (and of the measure).
     levels : tuple of float
         Target levels, ascending.
     method : str
-        The method asked for (``stripes``, ``ida`` or ``auto``).
+        The method asked for (``stripes`` or ``ida``).
     ran : str
         The method that ran (``stripes`` or ``ida``).
     note : str
-        Why that method ran.
-    period : float or None
-        Period of ``psa``, s.
-    periods : tuple of float
-        Periods of ``sa_avg``, s (empty otherwise).
-    damping : float or None
-        Damping ratio of a spectral measure.
-    entry : mapping
-        The canonical ``intensity`` entry (the record reads as it: ``setting["levels"]``).
+        Why that method ran (with a conditional-spectrum selection: how the stripes' motions were chosen).
+    synthetic : str or None
+        How a synthetic ensemble is scaled (``each`` or ``expected``); None for a definition stored before the field.
+    selection : mapping
+        The conditional-spectrum selection's canonical entries (``selection``, ``motions``, ``max_scale_factor``,
+        ``seed``, the rules, ``site`` and ``ruptures`` or ``simulated_motions``; docs/intensity.md); empty for the
+        default ``scale``, which adds none.
     """
 
-    measure: str
+    measure: Measure
     units: str
     levels: tuple[float, ...]
     method: str
     ran: str
     note: str
-    period: float | None
-    periods: tuple[float, ...]
-    damping: float | None
-    entry: Mapping[str, Any] = field(repr=False)
+    synthetic: str | None = None
+    selection: Mapping[str, Any] = field(default_factory=dict)
 
     @classmethod
     def from_entry(cls, entry: Mapping[str, Any]) -> Intensity:
         """The typed setting of a canonical ``intensity`` entry."""
-        return cls(entry["measure"], entry["units"], tuple(float(x) for x in entry["levels"]), entry["method"], entry["ran"], entry["note"],
-                   entry.get("period"), tuple(entry.get("periods", ())), entry.get("damping"), entry)
+        selection = {key: value for key, value in entry.items() if key not in _INTENSITY_KEYS}
+        return cls(Measure.from_entry(entry), entry["units"], tuple(float(x) for x in entry["levels"]), entry["method"], entry["ran"],
+                   entry["note"], entry.get("synthetic"), selection)
+
+    def entry(self) -> dict[str, Any]:
+        """The canonical ``intensity`` entry (as definitions store it)."""
+        written = {**self.measure.entry(), "levels": list(self.levels), "units": self.units, "method": self.method}
+        if self.synthetic is not None:
+            written["synthetic"] = self.synthetic
+        written.update(ran=self.ran, note=self.note)
+        written.update(copy.deepcopy(dict(self.selection)))
+        return written
 
     @property
     def description(self) -> str:
-        """The measure in words (:func:`~stochpound.store.describe_measure`)."""
-        return describe_measure(self.entry)
+        """The measure in words (:attr:`stochpound.motions.Measure.description`)."""
+        return self.measure.description
+
+    @property
+    def selection_method(self) -> str:
+        """How the stripes' motions were chosen: ``scale`` (every motion scaled to every level) or ``conditional_spectrum``."""
+        return str(self.selection.get("selection", "scale"))
 
 
-@dataclass(frozen=True, eq=False)
-class Hazard(_Entry):
+@dataclass(frozen=True)
+class Hazard:
     """The site's hazard curve a store carries (the ``[hazard]`` table, docs/risk.md): its values and provenance.
 
     Not part of the runs' identity (:data:`~stochpound.store.NOT_IN_IDENTITY`): a new curve
@@ -162,47 +174,223 @@ class Hazard(_Entry):
     Attributes
     ----------
     source : str
-        ``file``, ``bundled``, ``power_law`` or ``ruptures`` (the site of a rupture table, the entry's ``ruptures``).
+        ``file``, ``bundled``, ``power_law`` or ``ruptures`` (the site of a rupture table).
+    measure : Measure
+        The curve's intensity measure (the ``[intensity]`` measure).
     units : str
         Units of the intensities (the ``[intensity]`` levels').
-    im, rate : tuple of float
-        The table: intensities and their annual rates of exceedance, 1/yr (empty for a power law).
-    power_law : mapping or None
-        ``k0`` (1/yr) and ``k`` of λ(x) = k0 x^(−k), for a power law.
     extrapolate : bool
         Whether the curve is extrapolated beyond its table.
     provenance : str
         Where the curve came from, in words (the file's comment lines, the bundled curve's source).
+    im, rate : tuple of float
+        The table: intensities and their annual rates of exceedance, 1/yr (empty for a power law).
+    power_law : mapping or None
+        ``k0`` (1/yr) and ``k`` of λ(x) = k0 x^(−k), for a power law.
     file, file_sha256 : str or None
         A file's path as given and the sha256 of its bytes when read.
     bundled : str or None
         A bundled curve's name.
-    entry : mapping
-        The canonical ``hazard`` entry (the record reads as it).
+    ruptures : str or None
+        The rupture table (a file or a bundled site's name) of a ``ruptures`` source.
     """
 
     source: str
+    measure: Measure
     units: str
-    im: tuple[float, ...]
-    rate: tuple[float, ...]
-    power_law: Mapping[str, float] | None
     extrapolate: bool
     provenance: str
-    file: str | None
-    file_sha256: str | None
-    bundled: str | None
-    entry: Mapping[str, Any] = field(repr=False)
+    im: tuple[float, ...] = ()
+    rate: tuple[float, ...] = ()
+    power_law: Mapping[str, float] | None = None
+    file: str | None = None
+    file_sha256: str | None = None
+    bundled: str | None = None
+    ruptures: str | None = None
 
     @classmethod
     def from_entry(cls, entry: Mapping[str, Any]) -> Hazard:
         """The typed hazard of a canonical ``hazard`` entry."""
-        return cls(entry["source"], entry["units"], tuple(entry.get("im", ())), tuple(entry.get("rate", ())), entry.get("power_law"),
-                   entry["extrapolate"], entry["provenance"], entry.get("file"), entry.get("file_sha256"), entry.get("bundled"), entry)
+        return cls(entry["source"], Measure.from_entry(entry), entry["units"], entry["extrapolate"], entry["provenance"],
+                   tuple(entry.get("im", ())), tuple(entry.get("rate", ())), entry.get("power_law"), entry.get("file"),
+                   entry.get("file_sha256"), entry.get("bundled"), entry.get("ruptures"))
+
+    def entry(self) -> dict[str, Any]:
+        """The canonical ``hazard`` entry (as definitions store it)."""
+        written: dict[str, Any] = {"source": self.source, **self.measure.entry(), "units": self.units, "extrapolate": self.extrapolate}
+        sources = {"bundled": self.bundled, "file": self.file, "file_sha256": self.file_sha256, "ruptures": self.ruptures,
+                   "power_law": dict(self.power_law) if self.power_law is not None else None}
+        written.update({key: value for key, value in sources.items() if value is not None})
+        if self.im:
+            written.update(im=list(self.im), rate=list(self.rate))
+        written["provenance"] = self.provenance
+        return written
 
     @property
     def description(self) -> str:
-        """Its measure in words (:func:`~stochpound.store.describe_measure`)."""
-        return describe_measure(self.entry)
+        """Its measure in words (:attr:`stochpound.motions.Measure.description`)."""
+        return self.measure.description
+
+
+@dataclass(frozen=True)
+class DesignEc8:
+    """The ``ec8`` part of a ``[design]`` table: Eurocode 8's design of the buildings.
+
+    Attributes
+    ----------
+    ag : float
+        Design ground acceleration on type A ground (g).
+    ground : str
+        Ground type, ``A`` to ``E`` (Type 1 spectrum).
+    q : float
+        Behaviour factor (≥ 1).
+    """
+
+    ag: float
+    ground: str
+    q: float
+
+
+@dataclass(frozen=True)
+class Design:
+    """The ``[design]`` table: the code design the buildings were given, for the codes' own separations (docs/risk.md).
+
+    Not part of the runs' identity (:data:`~stochpound.store.NOT_IN_IDENTITY`).
+
+    Attributes
+    ----------
+    sds, sd1 : float
+        ASCE 7-16 design spectral accelerations S_DS and S_D1 (g).
+    tl : float
+        Long-period transition period T_L (s).
+    r, cd, omega0 : float
+        The system's R, C_d and Ω0.
+    ie : float
+        Importance factor I_e.
+    sm1 : float or None
+        MCE_R spectral acceleration at 1 s, S_M1 (g), for a building on a friction pendulum; None: not given.
+    ec8 : DesignEc8 or None
+        Eurocode 8's design, if given.
+    """
+
+    sds: float
+    sd1: float
+    tl: float
+    r: float
+    cd: float
+    omega0: float
+    ie: float
+    sm1: float | None = None
+    ec8: DesignEc8 | None = None
+
+    @classmethod
+    def from_entry(cls, entry: Mapping[str, Any]) -> Design:
+        """The typed design of a canonical ``design`` entry."""
+        ec8 = entry.get("ec8")
+        return cls(entry["sds"], entry["sd1"], entry["tl"], entry["r"], entry["cd"], entry["omega0"], entry["ie"], entry.get("sm1"),
+                   DesignEc8(ec8["ag"], ec8["ground"], ec8["q"]) if ec8 is not None else None)
+
+    def entry(self) -> dict[str, Any]:
+        """The canonical ``design`` entry (as definitions store it)."""
+        written: dict[str, Any] = {"sds": self.sds, "sd1": self.sd1, "tl": self.tl, "r": self.r, "cd": self.cd, "omega0": self.omega0, "ie": self.ie}
+        if self.sm1 is not None:
+            written["sm1"] = self.sm1
+        if self.ec8 is not None:
+            written["ec8"] = {"ag": self.ec8.ag, "ground": self.ec8.ground, "q": self.ec8.q}
+        return written
+
+
+@dataclass(frozen=True)
+class LimitStateCapacities:
+    """The capacities one ``[limit_states]`` key gives, for one building or for any.
+
+    Attributes
+    ----------
+    kind : str
+        The kind of limit state (:data:`~stochpound.store.LIMIT_STATE_DEMANDS`).
+    capacities : tuple of float
+        Its capacities, in the kind's units.
+    building : str or None
+        The building they apply to; None: any building.
+    """
+
+    kind: str
+    capacities: tuple[float, ...]
+    building: str | None = None
+
+
+@dataclass(frozen=True)
+class LimitStates:
+    """The ``[limit_states]`` table: the capacities a report's Damage section evaluates (docs/risk.md).
+
+    Not part of the runs' identity (:data:`~stochpound.store.NOT_IN_IDENTITY`).
+
+    Attributes
+    ----------
+    source : str or None
+        Where the capacities come from, as the table states; None: not stated.
+    states : tuple of LimitStateCapacities
+        The capacities, in the table's order (by kind, then building).
+    """
+
+    source: str | None
+    states: tuple[LimitStateCapacities, ...]
+
+    @classmethod
+    def from_entry(cls, entry: Mapping[str, Any]) -> LimitStates:
+        """The typed limit states of a canonical ``limit_states`` entry."""
+        states = []
+        for kind, value in entry["capacities"].items():
+            per_building = value.items() if isinstance(value, Mapping) else [(None, value)]
+            states += [LimitStateCapacities(kind, tuple(float(c) for c in capacities), building) for building, capacities in per_building]
+        return cls(entry["source"], tuple(states))
+
+    def entry(self) -> dict[str, Any]:
+        """The canonical ``limit_states`` entry (as definitions store it)."""
+        capacities: dict[str, Any] = {}
+        for state in self.states:
+            if state.building is None:
+                capacities[state.kind] = list(state.capacities)
+            else:
+                capacities.setdefault(state.kind, {})[state.building] = list(state.capacities)
+        return {"source": self.source, "capacities": capacities}
+
+
+@dataclass(frozen=True)
+class Site:
+    """How the stripes' scenario was obtained, with a ``[site]`` table (docs/intensity.md).
+
+    Not part of the runs' identity (:data:`~stochpound.store.NOT_IN_IDENTITY`): the runs depend on the scenarios
+    themselves (the ``intensity`` entry's ``site``).
+
+    Attributes
+    ----------
+    scenario : str
+        ``given``, ``fitted`` or ``ruptures`` (:data:`~stochpound.store.SCENARIO_KINDS`).
+    curves : tuple of str or None
+        The site's hazard curves a fitted scenario was fitted to; None otherwise.
+    ruptures : str or None
+        The rupture table (a file or a bundled site's name) of a site of ruptures; None otherwise.
+    """
+
+    scenario: str
+    curves: tuple[str, ...] | None = None
+    ruptures: str | None = None
+
+    @classmethod
+    def from_entry(cls, entry: Mapping[str, Any]) -> Site:
+        """The typed site of a canonical ``site`` entry."""
+        curves = entry.get("curves")
+        return cls(entry["scenario"], tuple(curves) if curves is not None else None, entry.get("ruptures"))
+
+    def entry(self) -> dict[str, Any]:
+        """The canonical ``site`` entry (as definitions store it)."""
+        written: dict[str, Any] = {"scenario": self.scenario}
+        if self.ruptures is not None:
+            written["ruptures"] = self.ruptures
+        if self.curves is not None:
+            written["curves"] = list(self.curves)
+        return written
 
 
 @dataclass(frozen=True)
@@ -226,6 +414,13 @@ class GapAxis:
     contacts: tuple[int, ...]
     walls: tuple[int, ...] = ()
 
+    def entry(self) -> dict[str, Any]:
+        """The canonical entry of the axis (``walls`` only when it sets walls)."""
+        written: dict[str, Any] = {"name": self.name, "values": list(self.values), "contacts": list(self.contacts)}
+        if self.walls:
+            written["walls"] = list(self.walls)
+        return written
+
     @property
     def targets(self) -> str:
         """What the axis sets, in words: ``contacts 0, 1``, ``walls 0`` or both."""
@@ -247,6 +442,10 @@ class MuAxis:
 
     values: tuple[float, ...]
     buildings: tuple[str, ...] | None
+
+    def entry(self) -> dict[str, Any]:
+        """The canonical entry of the axis."""
+        return {"values": list(self.values), "buildings": list(self.buildings) if self.buildings is not None else None}
 
     def sets(self, building: str, has_base: bool) -> bool:
         """Whether the axis sets this building's friction (a building in ``buildings``, or any building on a base)."""
@@ -281,6 +480,10 @@ class VariantAxis:
     values: tuple[str, ...]
     overrides: Mapping[str, Mapping[str, Any]]
 
+    def entry(self) -> dict[str, Any]:
+        """The canonical entry of the axis (its overrides copied)."""
+        return {"name": self.name, "values": list(self.values), "overrides": copy.deepcopy(dict(self.overrides))}
+
 
 @dataclass(frozen=True)
 class MotionSource:
@@ -310,6 +513,15 @@ class MotionSource:
     count: int = 1
     suite: str | None = None
 
+    def entry(self) -> dict[str, Any]:
+        """The canonical entry of the motion (``start`` and ``count`` for an ensemble, ``suite`` for a suite's record)."""
+        written: dict[str, Any] = {"label": self.label, "kind": self.kind, "field": self.field, "motion": copy.deepcopy(dict(self.motion))}
+        if self.kind == "synthetic":
+            written.update(start=self.start, count=self.count)
+        if self.suite is not None:
+            written["suite"] = self.suite
+        return written
+
     @property
     def realizations(self) -> range:
         """Realization indices: 0 for a record, ``start`` .. ``start + count − 1`` for an ensemble."""
@@ -337,6 +549,13 @@ class Output:
     impacts: bool
     demands: bool = False
 
+    def entry(self) -> dict[str, Any]:
+        """The canonical ``output`` entry (``demands`` only when kept)."""
+        written: dict[str, Any] = {"time_histories": list(self.time_histories), "buildings": list(self.buildings), "impacts": self.impacts}
+        if self.demands:
+            written["demands"] = True
+        return written
+
 
 @dataclass(frozen=True)
 class Solver:
@@ -356,6 +575,10 @@ class Solver:
     integrator: str
     rtol: float
     atol: float
+
+    def entry(self) -> dict[str, Any]:
+        """The canonical ``solver`` entry."""
+        return {"method": self.method, "integrator": self.integrator, "rtol": self.rtol, "atol": self.atol}
 
 
 @dataclass(frozen=True)
@@ -386,25 +609,22 @@ class Definition:
         The ``[intensity]`` setting, if any.
     format : int
         Format version of the canonical definition.
-    canonical : mapping
-        The canonical dict itself (every field, later ones included): :meth:`Definition.to_dict`.
     reproduces : str or None
         The part of a published study the experiment reproduces, ``"<study>:<part>"``
         (``stochpound.studies.STUDIES``); None: none (and for definitions stored before the field).
     hazard : Hazard or None
         The site's hazard curve, if any (not part of the identity).
-    design : mapping or None
-        The ``[design]`` table's canonical entry, the buildings' code design, if any (not part of the identity).
-    limit_states : mapping or None
-        The ``[limit_states]`` table's canonical entry (``source``, ``capacities``), if any (not part of the identity).
+    design : Design or None
+        The ``[design]`` table, the buildings' code design, if any (not part of the identity).
+    limit_states : LimitStates or None
+        The ``[limit_states]`` table (its ``source`` and capacities), if any (not part of the identity).
     scene_source : mapping or None
         Where the base scene was read from: ``file`` (its path, relative to the experiment file) or
         ``bundled`` (a bundled scene's name), and ``sha256`` (of the file's bytes); None: an inline
         scene (not part of the identity: ``scene`` holds the file's content).
-    site : mapping or None
-        How the stripes' scenario was obtained, with a ``[site]`` table: ``scenario`` (``"given"`` or
-        ``"fitted"``) and, when fitted, the ``curves`` it was fitted to (not part of the identity: the
-        runs depend on the scenarios themselves, ``intensity.site``); None: no ``[site]`` table (and for
+    site : Site or None
+        How the stripes' scenario was obtained, with a ``[site]`` table (not part of the identity: the
+        runs depend on the scenarios themselves, the intensity's ``site``); None: no ``[site]`` table (and for
         definitions stored before the field).
     """
 
@@ -420,22 +640,40 @@ class Definition:
     solver: Solver
     intensity: Intensity | None
     format: int
-    canonical: Mapping[str, Any]
     reproduces: str | None = None
     hazard: Hazard | None = None
-    design: Mapping[str, Any] | None = None
-    limit_states: Mapping[str, Any] | None = None
+    design: Design | None = None
+    limit_states: LimitStates | None = None
     scene_source: Mapping[str, str] | None = None
-    site: Mapping[str, Any] | None = None
+    site: Site | None = None
 
     def to_dict(self) -> dict[str, Any]:
-        """The canonical definition (a copy): what ``parse_experiment`` returned (``stochpound.experiment._spec``)."""
-        return copy.deepcopy(dict(self.canonical))
+        """The canonical definition, written from the records: what ``parse_experiment`` returns (``stochpound.experiment._spec``).
+
+        Optional entries are written only when set, so the definitions (and identities) of files without them are unchanged.
+        """
+        written: dict[str, Any] = {
+            "format": self.format, "name": self.name, "description": self.description, "scene": copy.deepcopy(dict(self.scene)),
+            "studied": self.studied, "variants": [axis.entry() for axis in self.variants], "gaps": [axis.entry() for axis in self.gaps],
+            "mu": self.mu.entry() if self.mu is not None else None, "motions": [motion.entry() for motion in self.motions],
+            "output": self.output.entry(), "solver": self.solver.entry(),
+        }
+        optional = {"scene_source": dict(self.scene_source) if self.scene_source is not None else None, "reproduces": self.reproduces,
+                    **{key: record.entry() if record is not None else None for key, record in
+                       (("intensity", self.intensity), ("hazard", self.hazard), ("design", self.design), ("limit_states", self.limit_states),
+                        ("site", self.site))}}
+        written.update({key: value for key, value in optional.items() if value is not None})
+        return written
 
     @property
     def sha256(self) -> str:
         """The experiment's identity (:func:`~stochpound.store.definition_sha256`: what its runs depend on)."""
-        return definition_sha256(self.canonical)
+        return definition_sha256(self.to_dict())
+
+    @property
+    def g(self) -> float:
+        """The scene's acceleration of gravity, m/s² (``stochpound.motions.DEFAULT_G`` (9.81) when the scene leaves it out)."""
+        return scene_g(self.scene)
 
     @property
     def building_names(self) -> tuple[str, ...]:
@@ -494,7 +732,7 @@ def read_definition(source: Any) -> Definition:
     data = json.loads(source) if isinstance(source, str) else copy.deepcopy(dict(source))
     try:
         return _from_dict(data)
-    except (KeyError, TypeError) as error:
+    except (KeyError, TypeError, ValueError) as error:
         raise ExperimentError(f"definition: missing or malformed field {error}") from None
 
 
@@ -517,13 +755,18 @@ def _from_dict(data: dict[str, Any]) -> Definition:
         ),
         output=Output(tuple(output["time_histories"]), tuple(output["buildings"]), output["impacts"], output.get("demands", False)),
         solver=Solver(**data["solver"]),
-        intensity=Intensity.from_entry(data["intensity"]) if data.get("intensity") is not None else None,
+        intensity=_optional(data, "intensity", Intensity.from_entry),
         format=data["format"],
-        canonical=data,
         reproduces=data.get("reproduces"),
-        hazard=Hazard.from_entry(data["hazard"]) if data.get("hazard") is not None else None,
-        design=data.get("design"),
-        limit_states=data.get("limit_states"),
+        hazard=_optional(data, "hazard", Hazard.from_entry),
+        design=_optional(data, "design", Design.from_entry),
+        limit_states=_optional(data, "limit_states", LimitStates.from_entry),
         scene_source=data.get("scene_source"),
-        site=data.get("site"),
+        site=_optional(data, "site", Site.from_entry),
     )
+
+
+def _optional(data: Mapping[str, Any], key: str, read: Callable[[Mapping[str, Any]], _Record]) -> _Record | None:
+    """The record of an optional entry (None when absent)."""
+    entry = data.get(key)
+    return read(entry) if entry is not None else None

@@ -14,7 +14,7 @@ def scenario_kind(store: xr.Dataset) -> str | None:
     """``"given"``, ``"fitted"`` or ``"ruptures"``: how the store's stripes' scenario was obtained; None for a store without a ``[site]`` table
     (or written before the definition kept it)."""
     site = store.pound.definition.site
-    return None if site is None else str(site["scenario"])
+    return None if site is None else site.scenario
 
 
 def scenario_ranges(store: xr.Dataset) -> str | None:

@@ -22,7 +22,7 @@ import pandas as pd
 import xarray as xr
 
 from stochpound import motions as synthetic_motions
-from stochpound.experiment import CASE, Case, GapAxis, describe_measure, is_fixed_base
+from stochpound.experiment import CASE, Case, GapAxis, is_fixed_base
 from stochpound.model import design_yield_shears, laws
 from stochpound.model.contact import effective_mass
 from stochpound.model.modal_solution import modal_properties
@@ -195,8 +195,8 @@ def design_paragraph(definition: StoreDefinition) -> Paragraph | None:
     design = definition.definition.design
     if design is None or not has_yielding([definition]):
         return None
-    basis = (f"S_DS = {number(design['sds'], 4)} g, S_D1 = {number(design['sd1'], 4)} g, T_L = {number(design['tl'])} s, R = {number(design['r'])}, "
-             f"C_d = {number(design['cd'])}, Ω0 = {number(design['omega0'])}, I_e = {number(design['ie'])}")
+    basis = (f"S_DS = {number(design.sds, 4)} g, S_D1 = {number(design.sd1, 4)} g, T_L = {number(design.tl)} s, R = {number(design.r)}, "
+             f"C_d = {number(design.cd)}, Ω0 = {number(design.omega0)}, I_e = {number(design.ie)}")
     strengths: dict[str, list[str]] = {}
     for configuration in definition.configurations:
         g = configuration.scene.g
@@ -207,8 +207,8 @@ def design_paragraph(definition: StoreDefinition) -> Paragraph | None:
             text = f"{building.name}: F_y,1 / W = {number(building.yield_force[0] / weight, 3)}"
             if building.storey_height is not None:
                 period = float(modal_properties(building).periods[0])
-                code = design_yield_shears(building.mass, building.storey_height, period=period, sds=design["sds"], sd1=design["sd1"],
-                                           r=design["r"], overstrength=design["omega0"], importance=design["ie"], long_period=design["tl"], g=g)
+                code = design_yield_shears(building.mass, building.storey_height, period=period, sds=design.sds, sd1=design.sd1,
+                                           r=design.r, overstrength=design.omega0, importance=design.ie, long_period=design.tl, g=g)
                 text += (f", the design's Ω0 V / W = {number(code[0] / weight, 3)} at T1 = {number(period, 3)} s "
                          f"(its yield shears {numbers(code, 4)} N; the building's are {numbers(np.asarray(building.yield_force) / code, 3)} times those)")
             strengths.setdefault(text, []).append(configuration.name)
@@ -432,7 +432,7 @@ def grid_paragraph(definition: StoreDefinition) -> Paragraph:
             axes.append(f"{dim.name} ∈ {{{numbers(dim.values)}}} m ({definition.definition.gap_axis(dim.name).targets})")
         elif dim.kind == "intensity":
             setting = definition.definition.intensity
-            axes.append(f"intensity ∈ {{{numbers(dim.values)}}} {setting['units']} ({describe_measure(setting)}; {stripe_motions_text(definition.store)})")
+            axes.append(f"intensity ∈ {{{numbers(dim.values)}}} {setting.units} ({setting.description}; {stripe_motions_text(definition.store)})")
         else:
             axes.append(f"μ ∈ {{{numbers(dim.values)}}} for {definition.mu_buildings_text} (∞: fixed base)")
     store = definition.store

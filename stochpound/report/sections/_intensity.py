@@ -31,7 +31,6 @@ import xarray as xr
 from matplotlib.figure import Figure
 
 from stochpound.stats.kernels import clopper_pearson
-from stochpound.experiment import describe_measure
 from stochpound.report.render import FigureItem, Paragraph, Section, Table
 from stochpound.report.sections._stripe_motions import stripe_motions_text
 from stochpound.experiment import is_gap_axis
@@ -83,13 +82,13 @@ def intensity_section(name: str, store: xr.Dataset, gaps: Sequence[float] = ()) 
 
 def method_text(store: xr.Dataset, setting: dict[str, Any]) -> str:
     """What ran (stripes or IDA, and why), the measure and the levels: one paragraph of the section and of the methods."""
-    levels = ", ".join(f"{level:g}" for level in setting["levels"])
+    levels = ", ".join(f"{level:g}" for level in setting.levels)
     text = (
-        f"Intensity measure {describe_measure(setting)}, in {setting['units']}. Method requested: {setting['method']}; ran: "
-        f"{setting['ran']} ({setting['note']})."
+        f"Intensity measure {setting.description}, in {setting.units}. Method requested: {setting.method}; ran: "
+        f"{setting.ran} ({setting.note})."
     )
-    if setting["ran"] == "stripes":
-        return text + f" Levels {levels} {setting['units']}: {stripe_motions_text(store)} (a scale factor is the level over the motion's own measure)."
+    if setting.ran == "stripes":
+        return text + f" Levels {levels} {setting.units}: {stripe_motions_text(store)} (a scale factor is the level over the motion's own measure)."
     text += f" {store.sizes['record']} motions"
     return text + ": each run once without contacts; a motion whose contacts close by D at scale 1 first pounds at gap g at the intensity IM·g/D."
 
@@ -129,7 +128,7 @@ def _spectra(name: str, store: xr.Dataset, setting: dict[str, Any]) -> FigureIte
         for j, level in enumerate(store["intensity"].values):
             scaled = (psa.isel(intensity=j) * scale.isel(intensity=j)).stack(motion=("record", "realization")).transpose("motion", ...).values[mask] / G
             low, median, high = np.nanpercentile(scaled, [16, 50, 84], axis=0)
-            (line,) = ax.loglog(periods, median, lw=1.6, label=f"{level:g} {setting['units']}: median, 16/84 %")
+            (line,) = ax.loglog(periods, median, lw=1.6, label=f"{level:g} {setting.units}: median, 16/84 %")
             ax.fill_between(periods, low, high, color=line.get_color(), alpha=0.15)
     ax.set_xlabel("period T (s)")
     ax.set_ylabel("PSA (g), 5 % damping")
@@ -157,7 +156,7 @@ def _proportion(k: np.ndarray, n: np.ndarray) -> np.ndarray:
 
 def _probability_axes(ax: Any, setting: dict[str, Any], label: str, legend: bool) -> None:
     """Axes of a probability against the intensity measure."""
-    ax.set_xlabel(f"{describe_measure(setting)} ({setting['units']})")
+    ax.set_xlabel(f"{setting.description} ({setting.units})")
     ax.set_ylabel(label)
     ax.set_ylim(-0.02, 1.02)
     ax.grid(True, lw=0.3, color="0.85")
@@ -190,7 +189,7 @@ def _stripe_table(name: str, store: xr.Dataset, setting: dict[str, Any]) -> Tabl
             "runs that pounded and the probability of pounding")
     return Table(
         f"intensity-stripes-{name}",
-        f"Experiment {name}: every stripe ({describe_measure(setting)} in {setting['units']}): scale factors, runs, {what} with its "
+        f"Experiment {name}: every stripe ({setting.description} in {setting.units}): scale factors, runs, {what} with its "
         f"{int(100 * CONFIDENCE)} % Clopper–Pearson interval",
         frame,
         formats={"runs": "{:.0f}", event: "{:.0f}", "wall hit": "{:.0f}", probability_name: "{:.3f}", "lower": "{:.3f}", "upper": "{:.3f}"},
@@ -255,7 +254,7 @@ def _selection_text(store: xr.Dataset, setting: dict[str, Any]) -> str:
     """The selection for the site: the scenario of every stripe and the stripes whose selection misses its target."""
     mixture = scenario_kind(store) == "ruptures"  # the exact conditional spectrum: the means of its mixture over the site's ruptures
     scenarios = "; ".join(
-        f"{level:g} {setting['units']}: " + (f"the ruptures' mean M {m:.3g} at {r:.3g} km (mean ε {e:.2f})" if mixture else f"M {m:g} at {r:g} km (ε {e:.2f})")
+        f"{level:g} {setting.units}: " + (f"the ruptures' mean M {m:.3g} at {r:.3g} km (mean ε {e:.2f})" if mixture else f"M {m:g} at {r:g} km (ε {e:.2f})")
         for level, m, r, e in zip(store["intensity"].values, store["site_magnitude"].values, store["site_distance_km"].values, store["target_epsilon"].values)
     )
     missed = selection_misses(store)
@@ -263,7 +262,7 @@ def _selection_text(store: xr.Dataset, setting: dict[str, Any]) -> str:
     truncation = (
         ""
         if not beyond
-        else f" At {'the stripe' if len(beyond) == 1 else 'the stripes'} {', '.join(f'{level:g}' for level in beyond)} {setting['units']} the scenario's "
+        else f" At {'the stripe' if len(beyond) == 1 else 'the stripes'} {', '.join(f'{level:g}' for level in beyond)} {setting.units} the scenario's "
         f"ε is beyond {TRUNCATION_EPSILON:g}, where hazard models truncate the ground motion (the USGS models of the bundled curves do): "
         f"there no earthquake of that magnitude and distance causes the level, and {'the stripe stands' if len(beyond) == 1 else 'those stripes stand'} "
         "for larger or nearer ones than the scenario."
@@ -272,7 +271,7 @@ def _selection_text(store: xr.Dataset, setting: dict[str, Any]) -> str:
         f"Every stripe's selection matches its target within {TARGET_TOLERANCE:g} in the mean and the standard deviation of ln Sa at every period."
         if not missed
         else f"The selection misses its target (mean or standard deviation of ln Sa off by more than {TARGET_TOLERANCE:g} at a period) at the "
-        f"stripes {', '.join(f'{level:g}' for level in missed)} {setting['units']}: their motions do not represent the site's at that intensity."
+        f"stripes {', '.join(f'{level:g}' for level in missed)} {setting.units}: their motions do not represent the site's at that intensity."
     )
     return (f"The motions of every stripe were chosen for the site: the conditional spectrum of the stripe's scenario (Vs30 "
             f"{float(store['site_vs30'].values[0]):g} m/s, {store['site_mechanism'].values[0]} faulting): {scenarios}.{truncation} {verdict}"
@@ -284,7 +283,7 @@ def _holdings(store: xr.Dataset, setting: dict[str, Any]) -> str:
     if "selection_recorded" not in store:
         return ""
     stripes = "; ".join(
-        f"{level:g} {setting['units']}: {int(recorded)} recorded and {int(simulated)} simulated from {int(earthquakes)} earthquakes"
+        f"{level:g} {setting.units}: {int(recorded)} recorded and {int(simulated)} simulated from {int(earthquakes)} earthquakes"
         for level, recorded, simulated, earthquakes in zip(store["intensity"].values, store["selection_recorded"].values,
                                                            store["selection_simulated"].values, store["selection_earthquakes"].values)
     )
@@ -310,7 +309,7 @@ def _selection_figure(name: str, store: xr.Dataset, setting: dict[str, Any]) -> 
         ax.fill_between(periods, np.exp(mean_ln - std_ln), np.exp(mean_ln + std_ln), color="C3", alpha=0.2)
         factors = store["selection_scale_factor"].values[j]
         factors = factors[np.isfinite(factors)]
-        ax.set_title(f"{level:g} {setting['units']}: scale {factors.min():.2g}-{factors.max():.2g}", fontsize=8)
+        ax.set_title(f"{level:g} {setting.units}: scale {factors.min():.2g}-{factors.max():.2g}", fontsize=8)
         ax.grid(True, which="both", lw=0.3, color="0.85")
     for ax in axes[levels.size :]:
         ax.set_visible(False)
@@ -334,7 +333,7 @@ def _consistency_text(consistency: dict[str, xr.Dataset], setting: dict[str, Any
         shown = "/".join("beyond the curve" if np.isnan(r) else f"{r:.2f}" for r in ratios)
         parts.append(f"{label} {shown}")
     return (f"Hazard consistency across the stripes: the site's hazard at its other measures recomputed from the stripes' motions as "
-            f"they ran, λ(Sa(T') > y) ≈ Σ_j P(Sa(T') > y | {describe_measure(setting)} = x_j) Δλ(x_j) (P the fraction of stripe j's "
+            f"they ran, λ(Sa(T') > y) ≈ Σ_j P(Sa(T') > y | {setting.description} = x_j) Δλ(x_j) (P the fraction of stripe j's "
             f"scaled motions above y, Δλ the site's rate of the stripe's bin), is {'; '.join(parts)} times the site's own curve at its "
             f"intensities of {targets} in 50 years. A ratio near 1 says the stripes represent the site at that period; "
             "well above 1, the motions carry too much of that period's shaking for the site, below 1 too little.")
@@ -364,7 +363,7 @@ def _consistency_figure(name: str, consistency: dict[str, xr.Dataset], setting: 
     return FigureItem(
         f"intensity-consistency-{name}",
         f"Experiment {name}: the site's hazard curves at its other measures (black) against the ones recomputed from the stripes of "
-        f"{describe_measure(setting)} (red: the fraction of every stripe's scaled motions above the intensity, weighted by the site's "
+        f"{setting.description} (red: the fraction of every stripe's scaled motions above the intensity, weighted by the site's "
         f"rate of the stripe's bin); dotted: the rates of {_targets_text()} in 50 years.",
         figure,
     )

@@ -37,22 +37,21 @@ from stochpound.report.render import Block, FigureItem, Paragraph, Section, Tabl
 from stochpound.report.sections._facets import labels_text
 from stochpound.report.sections._stripe_motions import is_selected
 from stochpound.risk import MODEL_DRIFT_LIMIT, StoreDamage, StoreDemands, StoreRisk, degenerate_text, rate_from_probability
-from stochpound.store import describe_measure
 
 
 def hazard_provenance(store: xr.Dataset) -> str:
     """Where a store's hazard curve comes from, in a sentence ("" without one): its source, range and provenance lines."""
-    entry = store.pound.hazard
-    if entry is None:
+    hazard = store.pound.hazard
+    if hazard is None:
         return ""
-    given = {"file": lambda: f"the file {entry['file']} (sha256 {entry['file_sha256']})", "bundled": lambda: f"the bundled curve {entry['bundled']}",
-             "power_law": lambda: f"the power law {entry['power_law']['k0']:g} x^-{entry['power_law']['k']:g}",
-             "ruptures": lambda: f"the site's ruptures {entry['ruptures']} (the NGA-West2 average summed over them)"}[entry["source"]]()
-    table = (f", a table of {len(entry['im'])} intensities from {entry['im'][0]:g} to {entry['im'][-1]:g} {entry['units']} "
-             f"(log-log interpolation{', extrapolated beyond it as power laws' if entry['extrapolate'] else '; no extrapolation'})"
-             if "im" in entry else "")
-    provenance = " ".join(line.strip() for line in entry["provenance"].splitlines())
-    return f"hazard curve ({describe_measure(entry)} in {entry['units']}) from {given}{table}, carried in the store. Provenance: {provenance}"
+    given = {"file": lambda: f"the file {hazard.file} (sha256 {hazard.file_sha256})", "bundled": lambda: f"the bundled curve {hazard.bundled}",
+             "power_law": lambda: f"the power law {hazard.power_law['k0']:g} x^-{hazard.power_law['k']:g}",
+             "ruptures": lambda: f"the site's ruptures {hazard.ruptures} (the NGA-West2 average summed over them)"}[hazard.source]()
+    table = (f", a table of {len(hazard.im)} intensities from {hazard.im[0]:g} to {hazard.im[-1]:g} {hazard.units} "
+             f"(log-log interpolation{', extrapolated beyond it as power laws' if hazard.extrapolate else '; no extrapolation'})"
+             if hazard.im else "")
+    provenance = " ".join(line.strip() for line in hazard.provenance.splitlines())
+    return f"hazard curve ({hazard.description} in {hazard.units}) from {given}{table}, carried in the store. Provenance: {provenance}"
 
 
 def configurations(data: xr.DataArray | xr.Dataset, keep: tuple[str, ...] = ()) -> list[dict[str, Any]]:
@@ -87,7 +86,7 @@ def headline_text(name: str, risk: StoreRisk) -> str:
     beyond = risk.beyond_stripes_text()
     return (
         f"Risk-targeted separation g* (the gap whose mean annual frequency of pounding is that of {targets}, Poisson) of experiment "
-        f"{name}{partial}, from {_motions_text(risk)}{' per stripe' if is_selected(risk.setting) else ''} ({stripes}{risk.measure} in {risk.setting['units']}) at the site of its hazard curve, "
+        f"{name}{partial}, from {_motions_text(risk)}{' per stripe' if is_selected(risk.setting) else ''} ({stripes}{risk.measure} in {risk.setting.units}) at the site of its hazard curve, "
         + (f"without intervals (not estimable: {risk.no_interval}): " if risk.no_interval else
            f"with {_percent(risk.confidence)} intervals ({_resampling(risk)}): ") + ". ".join(per) + "." + (f" {beyond}" if beyond else "")
     )
@@ -297,7 +296,7 @@ def moat_text(risk: StoreRisk, demands: StoreDemands | None) -> str:
 def _hazard_text(risk: StoreRisk) -> str:
     hz = risk.hazard
     levels = risk.hazard_levels((0.10, 0.02))
-    units = risk.setting["units"]
+    units = risk.setting.units
     source = hz.source.splitlines()[0] if hz.source else ""
     fitted = ("fitted to the stripes' counts by maximum likelihood, from the contact-free runs by the gap identity" if risk.method == "stripes"
               else "of the motions' IDA capacities IM·g/D (log-moments), from one contact-free run per motion")
@@ -326,7 +325,7 @@ def _worst_outside(risk: StoreRisk) -> list[tuple[float, float, float]]:
 def _lowest_stripe_text(risk: StoreRisk) -> str:
     """The lowest stripe's level and return period in words."""
     lowest = float(np.min(risk.fragility["intensity"].values))
-    return f"{lowest:.3g} {risk.setting.get('units', '')}, once in {float(1.0 / risk.hazard(lowest)):.3g} yr"
+    return f"{lowest:.3g} {(risk.setting.units if risk.setting is not None else '')}, once in {float(1.0 / risk.hazard(lowest)):.3g} yr"
 
 
 def _outside_stripes_text(risk: StoreRisk) -> str:
@@ -515,7 +514,7 @@ _RATE_FORMATS = {"once in (yr)": "{:.3g}", "once in, lower (yr)": "{:.3g}", "onc
 
 
 def _measure_label(risk: StoreRisk) -> str:
-    return f"{risk.measure} ({risk.setting['units']})"
+    return f"{risk.measure} ({risk.setting.units})"
 
 
 def _rules_blocks(name: str, risk: StoreRisk) -> list[Block]:
@@ -523,7 +522,7 @@ def _rules_blocks(name: str, risk: StoreRisk) -> list[Block]:
         return [Paragraph(f"Code rules in risk terms: not evaluated for experiment {name}: {risk.rules_note}.")]
     rules = risk.rules
     years = risk.years
-    units = f" {risk.setting['units']}" if risk.setting.get("units") else ""
+    units = f" {risk.setting.units}" if risk.setting is not None else ""
     code = ", ".join(f"{100 * p:g} %/{years:g} yr: {float(c):.3g}{units} (stripe {float(s):g}{units})" for p, c, s in
                      zip(rules["design_level"].values, rules["code_intensity"].values, rules["stripe_intensity"].values))
     frame = risk.rules_frame()

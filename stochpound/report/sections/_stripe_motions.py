@@ -2,17 +2,16 @@
 
 from __future__ import annotations
 
-from typing import Any
 
 import numpy as np
 import xarray as xr
 
-from stochpound.store import scenario_ranges
+from stochpound.store import Intensity, scenario_ranges
 
 
-def is_selected(setting: dict[str, Any] | None) -> bool:
+def is_selected(setting: Intensity | None) -> bool:
     """Whether the intensity setting chooses motions per stripe (``selection``) rather than scaling every motion to every level."""
-    return bool(setting) and setting.get("selection") not in (None, "none")
+    return setting is not None and setting.selection_method != "scale"
 
 
 def stripe_motions_text(store: xr.Dataset) -> str:
@@ -23,10 +22,10 @@ def stripe_motions_text(store: xr.Dataset) -> str:
     scale = store["selection_scale_factor"].transpose("intensity", "record").values
     per_stripe = np.isfinite(scale).sum(axis=1)
     count = f"{per_stripe.min()}" if per_stripe.min() == per_stripe.max() else f"{per_stripe.min()}–{per_stripe.max()}"
-    setting = store.pound.intensity or {}
-    method = str(setting.get("selection", "a selection")).replace("_", "-")
-    if "simulated_motions" in setting:  # the record axis holds the chosen simulated motions only
-        pool = (f"{int(np.sum(store['record_kind'].values != 'simulated'))} records and {setting['simulated_motions']['count']} simulated motions "
+    selection = store.pound.intensity.selection if store.pound.intensity is not None else {}
+    method = str(selection.get("selection", "a selection")).replace("_", "-")
+    if "simulated_motions" in selection:  # the record axis holds the chosen simulated motions only
+        pool = (f"{int(np.sum(store['record_kind'].values != 'simulated'))} records and {selection['simulated_motions']['count']} simulated motions "
                 "of each stripe's scenario")
     text = (f"{count} motions per stripe, chosen by {method} selection from a pool of {pool} and scaled to the stripe's level "
             f"(scale factors {np.nanmin(scale):.3g}–{np.nanmax(scale):.3g})")
