@@ -46,7 +46,7 @@ def test_a_decreasing_fit_has_the_rate_of_its_flat_fit_stated_not_a_dash():
     intensity is flat at 57/60, so λ = 0.95 × the hazard's rate at its table's lowest intensity, in the chain and in the words."""
     from stochpound.risk import code_rules_risk, flat_fit_maf, stripe_fragility
     from stochpound.risk._fragility import DECREASING
-    from stochpound.risk._store_risk import fit_name
+    from stochpound.risk._chain import fit_name
 
     levels = np.array([0.2, 0.5, 1.0])
     events = np.ones((3, 20))
@@ -129,7 +129,7 @@ def test_the_wall_free_d_tm_is_compared_with_the_moat_and_the_wall_governs_a_tar
 
 
 def test_the_suite_mean_rules_are_not_named_as_the_codes_own():
-    from stochpound.risk._store_risk import RULE_NAMES
+    from stochpound.risk._chain import RULE_NAMES
 
     for key in ("srss", "srss_reduced", "dtm"):
         assert "suite-mean" in RULE_NAMES[key], RULE_NAMES[key]
@@ -283,7 +283,7 @@ def test_the_design_rows_say_why_there_is_no_eurocode_8_row():
 def test_the_assumptions_say_the_base_the_grid_leaves():
     """A building with a base that the grid's μ = ∞ fixes is on a fixed base (the flagship's fixed pair was said to be on a
     sliding base); the scenario's words: tests/test_fitted_scenarios.py."""
-    from stochpound.risk._store import _base_words
+    from stochpound.risk._inputs import _base_words
     from stochpound.store import MuAxis
 
     building = {"name": "B1", "base": {"mu": 0.05}}

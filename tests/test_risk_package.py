@@ -3,7 +3,7 @@
 * ``stochpound.risk`` is the canonical home of the chain's names; the ones
   ``stochpound.analysis`` exported before stay importable there as the same
   objects, and importing the statistics does not import the risk chain;
-* every store read of the chain is in ``stochpound/risk/_store.py``;
+* every store read of the chain is in ``stochpound/risk/_inputs.py``;
 * report sections compute nothing and cache nothing: no process-wide cache;
 * ``stochpound risk`` imports no report section and no private module of
   another package.
@@ -60,13 +60,13 @@ def test_importing_the_statistics_does_not_import_the_risk_chain():
 
 
 def test_every_store_read_of_the_chain_is_in_one_module():
-    """Only ``_store.py`` imports the experiment or store layers (the definition, the store's hazard, the gap axes that
+    """Only ``_inputs.py`` imports the experiment or store layers (the definition, the store's hazard, the gap axes that
     select cases), and only it looks into a store (its attributes, variables, dimensions, accessor)."""
     readers = {path.name for path in RISK.glob("*.py")
                if any(module.startswith(("stochpound.experiment", "stochpound.store")) for module in _imports(path))}
-    assert readers <= {"_store.py"}
+    assert readers <= {"_inputs.py"}
     touching = {path.name for path in RISK.glob("*.py") if re.search(r"\bstore(\.attrs|\[|\.dims|\.sizes|\.sel|\.isel|\.data_vars|\.pound)", path.read_text())}
-    assert touching <= {"_store.py"}  # the other modules hand the store to _store's functions, never look into it
+    assert touching <= {"_inputs.py"}  # the other modules hand the store to _inputs's functions, never look into it
 
 
 def test_report_sections_keep_no_cache():

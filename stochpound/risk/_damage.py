@@ -30,10 +30,10 @@ import numpy as np
 import xarray as xr
 
 from stochpound.hazard import rate_from_probability
-from stochpound.risk import _store
+from stochpound.risk import _inputs
 from stochpound.risk._limit_states import KINDS, LimitState, limit_state_risk, limit_states_from_table
 from stochpound.risk._maf import TARGETS
-from stochpound.risk._store_risk import YEARS
+from stochpound.risk._chain import YEARS
 
 MODEL_DRIFT_LIMIT = 0.05
 """Peak storey drift ratio beyond which a run is flagged: the model has no strength loss or collapse (the collapse-prevention drift of ``DEFAULT_SOURCE``)."""
@@ -146,15 +146,15 @@ def store_damage(store: xr.Dataset, limit_states: Sequence[LimitState] | None = 
     ValueError
         (``RiskInputError``) A given limit state the store cannot evaluate (its demand or building missing).
     """
-    if "peak_ductility" not in store or _store.stripes(store) is None:
+    if "peak_ductility" not in store or _inputs.stripes(store) is None:
         return None
     given = limit_states is not None
-    table = _store.limit_states_table(store)
+    table = _inputs.limit_states_table(store)
     if limit_states is None and table is not None:
         limit_states, source, given = limit_states_from_table(table["capacities"]), table["source"] or EXPERIMENT_SOURCE, True
     if limit_states is None:
         limit_states, source = DEFAULT_LIMIT_STATES, DEFAULT_SOURCE
-    per_building, free = _store.run_summaries(store, list(DAMAGE_DEMANDS))
+    per_building, free = _inputs.run_summaries(store, list(DAMAGE_DEMANDS))
     ductility = per_building["peak_ductility"]
     yields = ductility.notnull().any([d for d in ductility.dims if d != "building"])
     elastic = tuple(str(b) for b, flag in zip(ductility["building"].values, yields.values) if not flag)
@@ -165,14 +165,14 @@ def store_damage(store: xr.Dataset, limit_states: Sequence[LimitState] | None = 
     done = xr.concat([data.notnull().any("building") for data in per_building.values()], "demand").any("demand")
     drift = per_building.get("peak_drift_ratio")
     beyond = (drift.max("building") > MODEL_DRIFT_LIMIT) if drift is not None else xr.zeros_like(done)
-    hz = _store.site_hazard(store)
-    levels = _store.stripe_levels(store)
+    hz = _inputs.site_hazard(store)
+    levels = _inputs.stripe_levels(store)
     design_stripes = {p: float(levels[np.argmin(np.abs(np.log(levels) - np.log(float(hz.intensity_at(rate_from_probability(p, YEARS))))))])
                       for p in TARGETS}
     held = tuple(state for state in limit_states  # the defaults the store can evaluate; every given one (an error where it cannot)
-                 if given or _store.holds(store, KINDS[state.kind].variable))
+                 if given or _inputs.holds(store, KINDS[state.kind].variable))
     risk = None
     if held:
         risk = limit_state_risk(store, held, hz)
-        risk = _store.contact_free_part(risk) if free else risk
+        risk = _inputs.contact_free_part(risk) if free else risk
     return StoreDamage(demands, done.sum("record"), (beyond & done).sum("record"), design_stripes, risk, held, source or "", free, elastic)

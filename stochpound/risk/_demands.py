@@ -20,10 +20,10 @@ import pandas as pd
 import xarray as xr
 
 from stochpound.hazard import HazardCurve
-from stochpound.risk import _store
+from stochpound.risk import _inputs
 from stochpound.risk._fragility_ensemble import BOOTSTRAP
 from stochpound.risk._maf import demand_hazard_curve
-from stochpound.risk._store_risk import CONFIDENCE, YEARS, non_increasing_along
+from stochpound.risk._chain import CONFIDENCE, YEARS, non_increasing_along
 
 DEMAND_LEVELS = 40
 """Levels of each demand hazard curve."""
@@ -89,15 +89,15 @@ def store_demands(store: xr.Dataset, hz: HazardCurve | None = None, confidence: 
     seed : int
         Seed of the resamples.
     """
-    if _store.stripes(store) is None:
+    if _inputs.stripes(store) is None:
         return None
-    hz = _store.site_hazard(store) if hz is None else hz
-    studied = _store.studied_building(store)
+    hz = _inputs.site_hazard(store) if hz is None else hz
+    studied = _inputs.studied_building(store)
     demands: dict[str, tuple[xr.DataArray, str]] = {}
-    sliding = _store.base_displacement(store, studied, walls_free=True)
+    sliding = _inputs.base_displacement(store, studied, walls_free=True)
     if sliding is not None:
         demands[f"peak base displacement of {studied}"] = (sliding, "m")
-    demands.update(_store.stored_demands(store))
+    demands.update(_inputs.stored_demands(store))
     if not demands:
         return None
     curves = {}
@@ -105,7 +105,7 @@ def store_demands(store: xr.Dataset, hz: HazardCurve | None = None, confidence: 
         values = demand.values[np.isfinite(demand.values) & (demand.values > 0)]
         levels = np.geomspace(np.quantile(values, 0.01), values.max(), DEMAND_LEVELS)
         curves[label] = demand_hazard_curve(demand, levels, hz, confidence=confidence, bootstrap=0)
-    clearances = _store.moat_clearances(store, studied)
+    clearances = _inputs.moat_clearances(store, studied)
     moat = (demand_hazard_curve(sliding, clearances, hz, confidence=confidence, bootstrap=bootstrap, seed=seed)
             if sliding is not None and clearances else None)
     return StoreDemands(curves, {label: units for label, (_, units) in demands.items()}, moat)

@@ -19,7 +19,7 @@ from stochpound.hazard import HazardCurve, bundled_measure, bundled_site_curves,
 from stochpound.motions import measure_label
 from stochpound.risk._efficiency import _interpolated
 from stochpound.risk._maf import TARGETS
-from stochpound.risk._store import stripe_spectra_runs
+from stochpound.risk._inputs import stripe_spectra_runs
 
 
 def site_consistency(store: xr.Dataset) -> dict[str, xr.Dataset]:

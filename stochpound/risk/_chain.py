@@ -18,7 +18,7 @@ returns a :class:`StoreRisk`, which owns the chain's tables
 (:meth:`StoreRisk.to_frame`, :meth:`StoreRisk.separation_frame`,
 :meth:`StoreRisk.rules_frame`): the report renders them and
 ``stochpound risk`` prints them. Every read of the store is in
-``stochpound.risk._store``.
+``stochpound.risk._inputs``.
 """
 
 from __future__ import annotations
@@ -35,7 +35,8 @@ import xarray as xr
 
 from stochpound._memory import check_memory
 from stochpound.hazard import HazardCurve, rate_from_probability
-from stochpound.risk import _store
+from stochpound.risk import _inputs
+from stochpound.risk._inputs import RiskInputError, RiskInputs, read_risk_inputs
 from stochpound.risk._code_rules import MINIMUM_MOTIONS, code_rules_risk
 from stochpound.risk._design_rules import design_rules_risk
 from stochpound.risk._fragility_ensemble import BOOTSTRAP, fragility_band, fragility_surface, homogeneous_capacities, ida_fragility, limit_state_events, stripe_fragility
@@ -83,12 +84,12 @@ def risk_gaps(closure: xr.DataArray, count: int = RISK_GAPS) -> np.ndarray:
     values = np.asarray(closure.values, dtype=float)
     positive = values[np.isfinite(values) & (values > 0.0)]
     if positive.size == 0:
-        raise _store.RiskInputError("store: no contact-free run closes any contact (every peak closure <= 0): no gap can pound")
+        raise RiskInputError("store: no contact-free run closes any contact (every peak closure <= 0): no gap can pound")
     return np.geomspace(0.5 * positive.min(), 1.5 * positive.max(), count)
 
 
-def pounding_fragility(store: xr.Dataset, gaps: Sequence[float] | np.ndarray, intensity_dim: str = "intensity", record_dim: str = "record",
-                       confidence: float = CONFIDENCE, bootstrap: int = BOOTSTRAP, seed: int = 0) -> xr.Dataset:
+def pounding_fragility(store: xr.Dataset | RiskInputs, gaps: Sequence[float] | np.ndarray, intensity_dim: str = "intensity",
+                       record_dim: str = "record", confidence: float = CONFIDENCE, bootstrap: int = BOOTSTRAP, seed: int = 0) -> xr.Dataset:
     """The pounding fragility at every gap of ``gaps`` (m) and every configuration of a store, from stripes or IDA runs.
 
     Stripes: the contact-free closures' events at every gap
@@ -97,14 +98,20 @@ def pounding_fragility(store: xr.Dataset, gaps: Sequence[float] | np.ndarray, in
     capacity IM·g/D at every gap (:func:`~stochpound.risk.homogeneous_capacities`),
     fitted by :func:`~stochpound.risk.ida_fragility`.
 
+    Parameters
+    ----------
+    store : xarray.Dataset or RiskInputs
+        The store, or its inputs already read (:func:`~stochpound.risk.read_risk_inputs`).
+
     Returns
     -------
     xarray.Dataset
         The fit over ``gap`` (the given gaps) and the store's other grid dimensions.
     """
-    closure = _store.contact_free_closure(store)
-    if _store.is_ida(store):
-        capacities = homogeneous_capacities(closure, _store.motion_intensity(store), gaps)
+    closure, intensity = ((store.closure, store.motion_intensity) if isinstance(store, RiskInputs)
+                          else (_inputs.contact_free_closure(store), _inputs.motion_intensity(store) if _inputs.is_ida(store) else None))
+    if intensity is not None:
+        capacities = homogeneous_capacities(closure, intensity, gaps)
         return ida_fragility(capacities, record_dim, confidence=confidence, bootstrap=bootstrap, seed=seed)
     events = limit_state_events(closure, gaps, "gap")
     return stripe_fragility(events, intensity_dim, record_dim, confidence, bootstrap, seed)
@@ -195,7 +202,7 @@ class StoreRisk:
     @property
     def measure(self) -> str:
         """The intensity measure in words, e.g. ``PSA(2 s, 5 %)`` ("" without a setting)."""
-        return _store.measure_text(self.setting) if self.setting else ""
+        return _inputs.measure_text(self.setting) if self.setting else ""
 
     def to_frame(self) -> pd.DataFrame:
         """The g* numbers: one row per configuration and target.
@@ -207,7 +214,7 @@ class StoreRisk:
             ``years``), ``separation``, ``lower``, ``upper`` (m; ``inf``: wider
             than every gap of the grid), ``lower_bound`` (True where
             ``separation`` is only a lower bound of g*, the target beyond
-            the stripes' runs: ``stochpound.risk._store_risk.bound_beyond_stripes``; its interval is
+            the stripes' runs: ``stochpound.risk._chain.bound_beyond_stripes``; its interval is
             then NaN), ``confidence``, ``motions``.
         """
         separation = self.separation
@@ -226,7 +233,7 @@ class StoreRisk:
 
     def separation_frame(self) -> pd.DataFrame:
         """The g* table: per configuration, g* and its interval (m) for each target (columns grouped by target); a g* that
-        is only a lower bound (``stochpound.risk._store_risk.bound_beyond_stripes``) is the text ``≥ 0.640``, its interval empty."""
+        is only a lower bound (``stochpound.risk._chain.bound_beyond_stripes``) is the text ``≥ 0.640``, its interval empty."""
         frame = self.to_frame()
         years = float(self.separation.attrs.get("years", self.years))
         config = self.configuration_dims()
@@ -351,7 +358,7 @@ class StoreRisk:
         pandas.DataFrame
             Columns: the configuration's dimensions, ``target``, ``design``
             (m; NaN, withheld, where g* is only a lower bound: the target lies
-            beyond the stripes' runs, ``stochpound.risk._store_risk.bound_beyond_stripes``), ``basis``
+            beyond the stripes' runs, ``stochpound.risk._chain.bound_beyond_stripes``), ``basis``
             (what ``design`` is, in words).
         """
         frame = self.to_frame()
@@ -539,16 +546,17 @@ def bound_beyond_stripes(separation: xr.Dataset, fragility: xr.Dataset, hz: Haza
                          ).assign_attrs(top_stripe=top)
 
 
-def store_risk(store: xr.Dataset, hz: HazardCurve | None = None, targets: Sequence[float] = TARGETS, years: float = YEARS,
+def store_risk(store: xr.Dataset | RiskInputs, hz: HazardCurve | None = None, targets: Sequence[float] = TARGETS, years: float = YEARS,
                gaps: Sequence[float] | np.ndarray | None = None, studied: str | None = None, confidence: float = CONFIDENCE,
                bootstrap: int = BOOTSTRAP, seed: int = 0, design: Mapping[str, Any] | None = None, partial: bool = False) -> StoreRisk:
     """Fragility at every gap, the pounding risk curve, g* and the code rules of a store's intensity-conditioned runs.
 
     Parameters
     ----------
-    store : xarray.Dataset
+    store : xarray.Dataset or RiskInputs
         An experiment store with intensity stripes (contact-free cases at
-        ``gap = inf``) or IDA capacities.
+        ``gap = inf``) or IDA capacities, read here once
+        (:func:`~stochpound.risk.read_risk_inputs`), or its inputs already read.
     hz : HazardCurve, optional
         The site's hazard, in the store's intensity measure and units;
         default: the hazard the store carries (its experiment's ``[hazard]``).
@@ -574,7 +582,8 @@ def store_risk(store: xr.Dataset, hz: HazardCurve | None = None, targets: Sequen
     partial : bool
         Answer from the cases that ran of a store with missing cases (its
         counts of motions and stripes are those that ran); without it such a
-        store is refused.
+        store is refused. With inputs already read, ``studied``, ``design``
+        and ``partial`` are theirs (giving them again is refused).
 
     Raises
     ------
@@ -582,47 +591,44 @@ def store_risk(store: xr.Dataset, hz: HazardCurve | None = None, targets: Sequen
         (``RiskInputError``) A store without stripes or IDA capacities, or
         without contact-free runs, or without a hazard when none is given;
         (``UnfinishedStoreError``) a store with missing cases without ``partial``;
-        (``MemoryLimitError``) a ``bootstrap`` beyond the memory limit (``stochpound.risk._store_risk.check_bootstrap``).
+        (``MemoryLimitError``) a ``bootstrap`` beyond the memory limit (``stochpound.risk._chain.check_bootstrap``).
     """
-    _store.check_finished(store, partial)
-    hz = _store.site_hazard(store) if hz is None else hz
-    studied = _store.studied_building(store) if studied is None else studied
-    closure = _store.contact_free_closure(store)
+    if isinstance(store, RiskInputs) and (studied is not None or design is not None or partial):
+        raise RiskInputError("store_risk: studied, design and partial are read with the inputs (read_risk_inputs): give them there")
+    inputs = store if isinstance(store, RiskInputs) else read_risk_inputs(store, hz, studied=studied, design=design, partial=partial)
+    hz = inputs.hazard if hz is None else hz
+    closure = inputs.closure
     if gaps is not None:
         grid = np.asarray(gaps, dtype=float)
-    elif _store.is_ida(store):  # the unscaled closures, and each scaled to the hazard's intensities (IDA runs hold scale 1 only)
-        grid = risk_gaps(xr.concat([closure, closure * (_reach_intensity(hz, targets, years) / _store.motion_intensity(store))], "record"))
+    elif inputs.motion_intensity is not None:  # the unscaled closures, and each scaled to the hazard's intensities (IDA runs hold scale 1 only)
+        grid = risk_gaps(xr.concat([closure, closure * (_reach_intensity(hz, targets, years) / inputs.motion_intensity)], "record"))
     else:
         grid = risk_gaps(closure)
     configurations = math.prod(size for dim, size in closure.sizes.items() if dim not in ("record", "intensity"))
     check_bootstrap(bootstrap, grid.size * configurations, closure.sizes.get("intensity", 1), closure.sizes["record"])
-    fragility = pounding_fragility(store, grid, confidence=confidence, bootstrap=bootstrap, seed=seed)
+    fragility = pounding_fragility(inputs, grid, confidence=confidence, bootstrap=bootstrap, seed=seed)
     curve = risk_curve(fragility, hz, years, confidence)
     separation = risk_targeted_separation(curve, targets, years, confidence=confidence)
-    if not _store.is_ida(store):
+    if inputs.method == "stripes":
         separation = bound_beyond_stripes(separation, fragility, hz, years)
-    motions = _store.stripe_motions(store, closure)
-    method = "ida" if _store.is_ida(store) else "stripes"
-    rules, note, dtm_note = None, "", ""
-    if method == "ida":
+    rules, note = None, ""
+    if inputs.method == "ida":
         note = "IDA runs hold no stripe at the code intensity to apply the rules to"
-    elif motions < MINIMUM_MOTIONS:
-        note = f"the codes take the mean over at least {MINIMUM_MOTIONS} motions; the store has {motions}"
+    elif inputs.motions < MINIMUM_MOTIONS:
+        note = f"the codes take the mean over at least {MINIMUM_MOTIONS} motions; the store has {inputs.motions}"
     else:
-        isolator, dtm_note = _store.free_base_displacement(store, studied)
-        rules = code_rules_risk(_store.contact_free_demands(store), hz, years=years, isolator_displacement=isolator,
+        rules = code_rules_risk(inputs.demands, hz, years=years, isolator_displacement=inputs.isolator,
                                 confidence=confidence, bootstrap=bootstrap, seed=seed)
-    design = _store.design(store) if design is None else design
     design_rules, design_note = None, ""
-    if design is None:
+    if inputs.design is None:
         design_note = "the store's experiment has no [design] table (the buildings' code design)"
-    elif method == "ida":
+    elif inputs.method == "ida":
         design_note = "IDA runs: the codes' gaps are fitted over stripes"
     else:
-        design_rules = design_rules_risk(store, hz, design, studied, years, confidence, bootstrap, seed)
-    return StoreRisk(fragility, curve, separation, rules, note, hz, motions, method, setting=_store.intensity_setting(store) or {},
-                     stripes=_store.stripes_run(store, closure), progress=_store.progress(store), experiment=_store.experiment_name(store), years=years, confidence=confidence,
-                     assumptions=_store.assumptions(store), dtm_note=dtm_note, design_rules=design_rules, design_note=design_note)
+        design_rules = design_rules_risk(inputs, hz, inputs.design, inputs.studied, years, confidence, bootstrap, seed)
+    return StoreRisk(fragility, curve, separation, rules, note, hz, inputs.motions, inputs.method, setting=inputs.setting,
+                     stripes=inputs.stripes, progress=inputs.progress, experiment=inputs.experiment, years=years, confidence=confidence,
+                     assumptions=inputs.assumptions, dtm_note=inputs.dtm_note, design_rules=design_rules, design_note=design_note)
 
 
 def target_text(probability: float, years: float = YEARS) -> str:
