@@ -291,3 +291,28 @@ def test_the_assumptions_say_the_base_the_grid_leaves():
     assert _base_words(MuAxis((0.05, 0.08), ("B1",)), building) == "a sliding base (μ 0.05, 0.08 on the grid)"
     assert _base_words(MuAxis((0.05, float("inf")), None), building) == "a sliding base (μ 0.05 on the grid) or a fixed base"
     assert _base_words(None, {"name": "B2"}) == "a fixed base"
+
+
+def test_the_chain_reads_its_store_once_and_answers_from_the_inputs_alone(moat_variant_store, tmp_path):
+    """``read_risk_inputs`` reads what ``store_risk`` needs once; the chain then answers from the frozen inputs with the store
+    closed (no step goes back to it), and its answer is the one ``store_risk`` gives from the store itself."""
+    import dataclasses
+
+    from stochpound import open_store
+    from stochpound.risk import RiskInputError, RiskInputs, read_risk_inputs, store_risk
+
+    path = tmp_path / "copy.nc"
+    path.write_bytes(open(moat_variant_store.encoding["source"], "rb").read())
+    store = open_store(path)
+    inputs = read_risk_inputs(store)
+    store.close()
+    assert isinstance(inputs, RiskInputs) and inputs.method == "stripes" and inputs.studied == "B1"
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        inputs.motions = 1  # type: ignore[misc]
+    from_inputs = store_risk(inputs, bootstrap=0)
+    from_store = store_risk(moat_variant_store, bootstrap=0)
+    xr.testing.assert_identical(from_inputs.separation, from_store.separation)
+    xr.testing.assert_identical(from_inputs.rules, from_store.rules)
+    assert (from_inputs.setting, from_inputs.motions, from_inputs.assumptions) == (from_store.setting, from_store.motions, from_store.assumptions)
+    with pytest.raises(RiskInputError, match="read with the inputs"):
+        store_risk(inputs, studied="B2")
