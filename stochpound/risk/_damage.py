@@ -29,7 +29,7 @@ from collections.abc import Sequence
 import numpy as np
 import xarray as xr
 
-from stochpound.hazard import rate_from_probability
+from stochpound.hazard import rate_from_probability, return_period
 from stochpound.risk import _inputs
 from stochpound.risk._limit_states import KINDS, LimitState, limit_state_risk, limit_states_from_table
 from stochpound.risk._maf import TARGETS
@@ -99,6 +99,22 @@ class StoreDamage:
     source: str
     contact_free: bool
     elastic: tuple[str, ...] = ()
+
+    def beyond_model_per_stripe(self) -> list[tuple[float, int, int]]:
+        """Per stripe, over every configuration: (its level in IM units, the runs beyond the model, the runs done)."""
+        beyond = self.beyond_model.sum([d for d in self.beyond_model.dims if d != "intensity"])
+        runs = self.runs.sum([d for d in self.runs.dims if d != "intensity"])
+        return [(float(level), int(b), int(n)) for level, b, n in zip(beyond["intensity"].values, beyond.values, runs.values)]
+
+    def beyond_model_total(self) -> tuple[int, int]:
+        """The runs beyond the model and the runs done, over every stripe and configuration."""
+        return int(self.beyond_model.sum()), int(self.runs.sum())
+
+    def return_period(self) -> xr.DataArray | None:
+        """Each limit state's mean return period 1/λ (yr; inf where no run reaches it), over ``risk``'s dimensions; None without ``risk``."""
+        if self.risk is None:
+            return None
+        return xr.apply_ufunc(return_period, self.risk["maf"])
 
     def governing(self, probability: float) -> xr.DataArray | None:
         """Per configuration, what is reached most often at the risk-targeted separation g* of ``probability`` in 50 yr.

@@ -194,9 +194,10 @@ def _structural_governs(damage: StoreDamage | None, target: float, separation: s
 def _beyond_model(damage: StoreDamage | None) -> dict[str, str]:
     """The assumption the runs beyond the model strain: {"beyond the model": "<n> of <N> runs ..."} where some run exceeds
     ``MODEL_DRIFT_LIMIT`` ({} otherwise or without ``damage``)."""
-    if damage is None or not int(damage.beyond_model.sum()):
+    beyond, runs = damage.beyond_model_total() if damage is not None else (0, 0)
+    if not beyond:
         return {}
-    return {"beyond the model": f"{int(damage.beyond_model.sum())} of {int(damage.runs.sum())} runs exceed a "
+    return {"beyond the model": f"{beyond} of {runs} runs exceed a "
                                 f"{100 * MODEL_DRIFT_LIMIT:g} % storey drift, where the storeys' lack of strength loss and collapse makes their "
                                 "response not credible; they enter g* and the limit states as computed (the Damage section)"}
 
