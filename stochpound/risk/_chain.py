@@ -411,6 +411,47 @@ class StoreRisk:
             return None
         return maf_outside_stripes(self.fragility, self.separation["separation"], self.hazard)
 
+    def worst_outside_stripes(self) -> list[tuple[float, float, float]]:
+        """Per target: (target, below, above), the worst configuration's shares of λ_P at g* from below the lowest stripe and
+        beyond the top one (:attr:`outside_stripes`; [] for IDA runs or without a finite g*)."""
+        shares = self.outside_stripes
+        if shares is None or not np.isfinite(shares["below"].values).any():
+            return []
+        return [(float(t), float(shares["below"].sel(target=t).max()), float(shares["above"].sel(target=t).max())) for t in shares["target"].values]
+
+    def lowest_stripe(self) -> tuple[float, float]:
+        """The lowest stripe's level (IM units) and the hazard's return period there (yr)."""
+        lowest = float(np.min(self.fragility["intensity"].values))
+        return lowest, float(1.0 / self.hazard(lowest))
+
+    def rules_meeting(self) -> tuple[str, pd.Series]:
+        """Which code rules meet their own design level as a target in every configuration and level: the column of
+        :meth:`rules_frame` read (``meets, upper bound`` with a bootstrap, else ``meets its level``) and, per rule, whether it does."""
+        rules = self.rules_frame()
+        column = "meets, upper bound" if "meets, upper bound" in rules else "meets its level"
+        return column, rules[column].groupby(level="rule", sort=False).all()
+
+    def largest_dtm(self) -> dict[float, tuple[float, bool]]:
+        """Per design level of the suite-mean D_TM rule: its largest gap over the configurations (m) and whether the configurations'
+        finite gaps differ; {} without the rule."""
+        if self.rules is None or "dtm" not in self.rules["rule"].values:
+            return {}
+        dtm = self.rules["gap"].sel(rule="dtm")
+        largest = {}
+        for level in dtm["design_level"].values:
+            values = dtm.sel(design_level=level).values
+            largest[float(level)] = (float(dtm.sel(design_level=level).max(skipna=True)), np.unique(values[np.isfinite(values)]).size > 1)
+        return largest
+
+    def rules_degenerate_text(self) -> str:
+        """The degenerate fits among the rules' rows, suite-mean and design-analysis (where a rule applies: a gap at every
+        contact), and what each does to λ_P (:func:`~stochpound.risk.degenerate_text`; "" when there are none)."""
+        statuses = [self.rules["status"].values.ravel()] if self.rules is not None else []
+        if self.design_rules is not None:
+            applies = self.design_rules["gap"].notnull().all("contact")
+            statuses.append(self.design_rules["status"].values[applies.broadcast_like(self.design_rules["status"]).values])
+        return degenerate_text(np.concatenate(statuses), self.hazard, "rule rows") if statuses else ""
+
     def non_increasing_maf(self) -> xr.DataArray:
         """λ_P(g) made non-increasing along the gaps (isotonic regression in ln λ, pool-adjacent-violators: the curve g* is read from; 1/yr)."""
         return non_increasing_along(self.curve["maf"], "gap")

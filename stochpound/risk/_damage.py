@@ -116,6 +116,16 @@ class StoreDamage:
             return None
         return xr.apply_ufunc(return_period, self.risk["maf"])
 
+    def governing_counts(self, probability: float) -> tuple[dict[str, int], int] | None:
+        """At the g* of ``probability`` in 50 yr: the configurations each structural limit state governs (:meth:`governing`), in
+        the order first met, and the number of configurations; None without ``risk``."""
+        governing = self.governing(probability)
+        if governing is None:
+            return None
+        names = [str(v) for v in governing.values.ravel()]
+        structural = {str(state) for state in self.risk["limit_state"].values}
+        return {n: names.count(n) for n in names if n in structural}, len(names)
+
     def governing(self, probability: float) -> xr.DataArray | None:
         """Per configuration, what is reached most often at the risk-targeted separation g* of ``probability`` in 50 yr.
 

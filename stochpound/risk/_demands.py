@@ -19,7 +19,9 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
-from stochpound.hazard import HazardCurve
+from collections.abc import Sequence
+
+from stochpound.hazard import HazardCurve, rate_from_probability
 from stochpound.risk import _inputs
 from stochpound.risk._fragility_ensemble import BOOTSTRAP
 from stochpound.risk._maf import demand_hazard_curve
@@ -60,6 +62,27 @@ class StoreDemands:
     def non_increasing_maf(self, label: str) -> xr.DataArray:
         """A demand's exceedance rate made non-increasing along its levels (isotonic regression in ln λ, pool-adjacent-violators; 1/yr)."""
         return non_increasing_along(self.curves[label]["maf"], "level")
+
+    def wall_rates(self, targets: Sequence[float], years: float) -> list[tuple[float, float, float, float]]:
+        """Per target (a probability in ``years``) and moat clearance: (target, clearance m, rate of reaching the wall in its worst
+        configuration 1/yr, the target's rate 1/yr); [] without a moat."""
+        if self.moat is None:
+            return []
+        rows = []
+        for target in targets:
+            allowed = float(rate_from_probability(float(target), years))
+            for clearance in self.moat["level"].values:
+                maf = self.moat["maf"].sel(level=clearance)
+                rows.append((float(target), float(clearance), float(maf[maf.fillna(-1.0).argmax(...)]), allowed))
+        return rows
+
+    def wall_interval(self, clearance: float) -> tuple[float, float] | None:
+        """The interval (yr) of the return period of reaching the wall at ``clearance`` in its worst configuration; None without a bootstrap."""
+        if self.moat is None or "return_period_lower" not in self.moat:
+            return None
+        at = self.moat.sel(level=clearance)
+        worst = at["maf"].fillna(-1.0).argmax(...)
+        return float(at["return_period_lower"].isel(worst)), float(at["return_period_upper"].isel(worst))
 
     def moat_frame(self) -> pd.DataFrame:
         """The moat table: per clearance (m), the MAF of reaching it with its interval, the return period and the probability."""
