@@ -47,7 +47,7 @@ from stochpound._memory import check_memory, sample_bytes
 from stochpound.motions.ground import SampledMotion
 from stochpound.model.scene import Scene
 from stochpound.results.record import ENERGY_TERMS
-from stochpound.solvers.simulate import simulate
+from stochpound.solvers.simulate import METHODS, simulate
 
 KEEP = ("summary", "histories")
 """What an ensemble keeps: summaries only, or also the displacement and impact force histories."""

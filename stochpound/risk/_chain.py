@@ -413,7 +413,7 @@ class StoreRisk:
 
     def worst_outside_stripes(self) -> list[tuple[float, float, float]]:
         """Per target: (target, below, above), the worst configuration's shares of λ_P at g* from below the lowest stripe and
-        beyond the top one (:attr:`outside_stripes`; [] for IDA runs or without a finite g*)."""
+        beyond the top one (``outside_stripes``; [] for IDA runs or without a finite g*)."""
         shares = self.outside_stripes
         if shares is None or not np.isfinite(shares["below"].values).any():
             return []

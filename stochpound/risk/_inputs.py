@@ -86,22 +86,26 @@ class RiskInputs:
     experiment : str or None
         The store's experiment name.
     assumptions : dict of str to str
-        What an answer rests on besides the hazard, in words (:func:`assumptions`).
+        What an answer rests on besides the hazard, in words (``assumptions``).
     design : mapping or None
         The buildings' code design (the ``[design]`` entry, given or the store's).
     demands : xarray.Dataset or None
         The inputs of the code separation rules of every contact-free case
-        (:func:`contact_free_demands`); read for stripes with a design or at
-        least :data:`~stochpound.risk._code_rules.MINIMUM_MOTIONS` motions, else None.
+        (``contact_free_demands``); read for stripes with a design or at
+        least ``MINIMUM_MOTIONS`` (7) motions, else None.
     isolator : xarray.DataArray or None
         The studied building's wall-free peak base displacement (m) for the
-        suite-mean D_TM (:func:`free_base_displacement`); read with the suite-mean rules.
+        suite-mean D_TM (``free_base_displacement``); read with the suite-mean rules.
     dtm_note : str
         Why ``isolator`` is None though the rules were read ("" otherwise).
     scenes : dict
         The scene of each configuration of ``demands`` (keyed by its labels
         on the dimensions of ``demands["peak_closure"]`` other than
-        :data:`CASE_DIMS`, in their order), for the design analysis; empty without a design.
+        ``CASE_DIMS``, in their order), for the design analysis; empty without a design.
+    selection_misses : tuple of float
+        The levels whose stripe's selection for the site misses its target (:func:`selection_misses`).
+    beyond_truncation : tuple of float
+        The levels whose stripe's scenario puts them beyond the ground motion's truncation (:func:`stripes_beyond_truncation`).
     """
 
     setting: Mapping[str, Any]
@@ -120,6 +124,8 @@ class RiskInputs:
     isolator: xr.DataArray | None
     dtm_note: str
     scenes: dict[tuple[Any, ...], Scene]
+    selection_misses: tuple[float, ...]
+    beyond_truncation: tuple[float, ...]
 
 
 def read_risk_inputs(store: xr.Dataset, hazard: HazardCurve | None = None, *, studied: str | None = None,
@@ -158,7 +164,8 @@ def read_risk_inputs(store: xr.Dataset, hazard: HazardCurve | None = None, *, st
     isolator, dtm_note = free_base_displacement(store, studied) if rules else (None, "")
     read = {"setting": intensity_setting(store) or {}, "motion_intensity": motion_intensity(store) if ida else None,
             "stripes": stripes_run(store, closure), "progress": progress(store), "experiment": experiment_name(store),
-            "assumptions": assumptions(store)}
+            "assumptions": assumptions(store), "selection_misses": tuple(selection_misses(store)),
+            "beyond_truncation": tuple(stripes_beyond_truncation(store))}
     scenes = configuration_scenes(store, demands["peak_closure"]) if demands is not None and design is not None else {}
     return RiskInputs(hazard=hazard, studied=studied, method="ida" if ida else "stripes", closure=closure, motions=motions, design=design,
                       demands=demands, isolator=isolator, dtm_note=dtm_note, scenes=scenes, **read)
@@ -570,6 +577,27 @@ def case_demand(store: xr.Dataset, variable: str, building: str | None, needs: s
             raise RiskInputError(f"limit_states: building {building!r} is not one of the store's ({', '.join(names)})")
         data = data.max("building") if building is None else data.sel(building=building, drop=True)
     return store_motions(data).load().assign_attrs(units=store[variable].attrs.get("units", ""))
+
+
+def limit_state_inputs(store: xr.Dataset, demands: list[tuple[str, str | None, str, bool]],
+                       hazard: HazardCurve | None = None) -> tuple[HazardCurve, list[xr.DataArray], str]:
+    """What :func:`~stochpound.risk.limit_state_risk` reads of a stripes store, read once: the site's hazard (``hazard``, or the
+    store's), each limit state's demand (``demands``: its variable, building, what the store needs to keep it, and whether it is
+    given in g: :func:`case_demand`, divided by the scene's g) and the intensity measure in words.
+
+    Raises
+    ------
+    ValueError
+        (``RiskInputError``) A store without stripes or hazard, or without a demand's variable or building.
+    """
+    if stripes(store) is None:
+        raise RiskInputError("store: limit states need intensity stripes (run method = \"stripes\")")
+    hazard = site_hazard(store) if hazard is None else hazard
+    read = []
+    for variable, building, needs, in_g in demands:
+        demand = case_demand(store, variable, building, needs)
+        read.append(demand / scene_g(store) if in_g else demand)
+    return hazard, read, measure_text(intensity_setting(store))
 
 
 def limit_state_variable(kind: str) -> str:

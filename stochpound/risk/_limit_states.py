@@ -166,15 +166,10 @@ def limit_state_risk(store: xr.Dataset, limit_states: Sequence[LimitState], hz: 
     """
     if not limit_states:
         raise _inputs.RiskInputError("limit_states: give at least one limit state")
-    if _inputs.stripes(store) is None:
-        raise _inputs.RiskInputError("store: limit states need intensity stripes (run method = \"stripes\")")
-    hz = _inputs.site_hazard(store) if hz is None else hz
+    hz, demands, measure = _inputs.limit_state_inputs(store, [(KINDS[s.kind].variable, s.building, KINDS[s.kind].note, KINDS[s.kind].units == "g")
+                                                              for s in limit_states], hz)
     fits = []
-    for state in limit_states:
-        kind = KINDS[state.kind]
-        demand = _inputs.case_demand(store, kind.variable, state.building, kind.note)
-        if kind.units == "g":
-            demand = demand / _inputs.scene_g(store)
+    for state, demand in zip(limit_states, demands):
         events = limit_state_events(demand, [state.capacity], dim="limit_state").assign_coords(limit_state=[state.label])
         fit = stripe_fragility(events, confidence=confidence, bootstrap=bootstrap, seed=seed)
         fits.append(fit.assign_coords(kind=("limit_state", [state.kind]), capacity=("limit_state", [float(state.capacity)]),
@@ -185,7 +180,7 @@ def limit_state_risk(store: xr.Dataset, limit_states: Sequence[LimitState], hz: 
     if twins is not None:
         result["maf_contact_free"] = twins.assign_attrs(units="1/yr", long_name="mean annual frequency of the contact-free twins")
         result["gap_cost"] = (result["maf"] - twins).assign_attrs(units="1/yr", long_name="what the gap costs: maf minus that of the contact-free twins")
-    return result.assign_attrs(intensity=_inputs.measure_text(_inputs.intensity_setting(store)))
+    return result.assign_attrs(intensity=measure)
 
 
 def gap_cost_frame(risk: xr.Dataset, years: float = YEARS) -> pd.DataFrame:
