@@ -17,8 +17,9 @@ into one ``record`` dimension when there is more than one realization).
 returns a :class:`StoreRisk`, which owns the chain's tables
 (:meth:`StoreRisk.to_frame`, :meth:`StoreRisk.separation_frame`,
 :meth:`StoreRisk.rules_frame`): the report renders them and
-``stochpound risk`` prints them. Every read of the store is in
-``stochpound.risk._inputs``.
+``stochpound risk`` prints them. The store is read once, in
+``stochpound.risk._inputs`` (:func:`~stochpound.risk.read_risk_inputs`),
+and the chain runs on those inputs (:class:`~stochpound.risk.RiskInputs`).
 """
 
 from __future__ import annotations
