@@ -158,7 +158,7 @@ def measure_risk(folder: Path, measure: str, configuration: str, bootstrap: int 
     measure and configuration at ``site`` (the selection's ``seed``, or its default; stripes at ``return_periods``, by default
     the site's), run in ``folder``."""
     from stochpound import open_store
-    from stochpound.analysis import store_risk
+    from stochpound.risk import store_risk
     from stochpound.experiment import load_experiment, run_experiment
 
     name = f"{measure.replace('(', '').replace(' s)', '').replace(' ', '').replace('.', 'p').lower()}.toml"

@@ -9,7 +9,8 @@ import numpy as np
 import pytest
 
 from stochpound import open_store
-from stochpound.analysis import HazardCurve, store_risk
+from stochpound.analysis import HazardCurve
+from stochpound.risk import store_risk
 from stochpound.experiment._runner import load_experiment, run_experiment
 from stochpound.experiment._spec import ExperimentError, parse_experiment
 from stochpound.motions import TRUNCATION_EPSILON, conditional_spectrum, misses_target, select_motions, selection_periods, selection_pool

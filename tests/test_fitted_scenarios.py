@@ -120,7 +120,7 @@ def test_a_fitted_site_takes_stripes_down_to_the_start_of_the_hazard_table(tmp_p
 def test_the_definition_keeps_how_the_scenario_was_obtained_as_data_outside_the_identity(tmp_path) -> None:
     """The scenario's kind is the definition's ``site`` entry (read by the risk assumptions, not guessed from the note's prose),
     and it leaves the identity as it was: a definition without the entry (a store written before it) hashes the same."""
-    from stochpound.risk._store import _scenario_words
+    from stochpound.risk._inputs import _scenario_words
     from stochpound.store import definition_sha256, read_definition
 
     fitted = parse_experiment(tomllib.loads(_text(FITTED_SELECTION, FITTED_SITE)), tmp_path)

@@ -7,7 +7,8 @@ import pytest
 import xarray as xr
 from scipy import optimize, special, stats
 
-from stochpound.analysis import Fragility, fit_fragility, fragility_band, fragility_surface, homogeneous_capacities, ida_fragility, limit_state_events, stripe_fragility
+from stochpound.analysis import fit_fragility
+from stochpound.risk import Fragility, fragility_band, fragility_surface, homogeneous_capacities, ida_fragility, limit_state_events, stripe_fragility
 from stochpound.stats import kernels
 from stochpound.stats._bootstrap import bootstrap_weights
 from stochpound.risk._fragility import ALWAYS, DECREASING, FIT, NEVER, SEPARATED, stripe_mle

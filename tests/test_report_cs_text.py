@@ -44,7 +44,7 @@ def test_a_suite_store_says_every_motion_is_scaled_to_every_level(cs_store) -> N
 def test_a_configuration_s_scene_is_read_from_a_case_that_ran_where_the_first_motion_was_not_chosen(cs_store) -> None:
     """The design rules read each configuration's scene from its contact-free case: with motions selected per stripe,
     the first stripe's first motion may not have run there (the report build failed with a KeyError)."""
-    from stochpound.risk._store import configuration_scene
+    from stochpound.risk._inputs import configuration_scene
 
     status = cs_store["case_status"]
     labels = {dim: cs_store[dim].values[0] for dim in status.dims if dim not in ("intensity", "record", "realization", *cs_store.pound.gap_dims)}

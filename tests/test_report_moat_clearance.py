@@ -116,7 +116,7 @@ def test_the_mechanisms_speak_of_a_wall_not_of_pounding(report, moat):
 def test_the_risk_section_s_moat_clearances_are_the_gap_axis_s():
     """With a hazard, the moat-wall limit state is judged at the clearances the gap axis sets (not the walls' own placeholder gap)."""
     from stochpound.experiment._spec import load_definition
-    from stochpound.risk._store import moat_clearances
+    from stochpound.risk._inputs import moat_clearances
     from stochpound.store import canonical_json
 
     definition, _ = load_definition(ROOT / "experiments" / "laws" / "moat_wall.toml")

@@ -5,20 +5,16 @@ import pytest
 import xarray as xr
 from scipy import integrate, stats
 
-from stochpound.analysis import (
+from stochpound.analysis import HazardCurve, fit_fragility, mean_annual_frequency, rate_from_probability, separation_rules
+from stochpound.risk import (
     Fragility,
-    HazardCurve,
     code_rules_risk,
     contact_free_closure,
     demand_hazard_curve,
-    fit_fragility,
     limit_state_events,
-    mean_annual_frequency,
     pounding_fragility,
-    rate_from_probability,
     risk_curve,
     risk_targeted_separation,
-    separation_rules,
     stripe_fragility,
 )
 

@@ -48,7 +48,7 @@ def test_a_decreasing_fit_has_the_rate_of_its_flat_fit_stated_not_a_dash():
     intensity is flat at 57/60, so λ = 0.95 × the hazard's rate at its table's lowest intensity, in the chain and in the words."""
     from stochpound.risk import code_rules_risk, flat_fit_maf, stripe_fragility
     from stochpound.risk._fragility import DECREASING
-    from stochpound.risk._store_risk import fit_name
+    from stochpound.risk._chain import fit_name
 
     levels = np.array([0.2, 0.5, 1.0])
     events = np.ones((3, 20))
@@ -131,7 +131,7 @@ def test_the_wall_free_d_tm_is_compared_with_the_moat_and_the_wall_governs_a_tar
 
 
 def test_the_suite_mean_rules_are_not_named_as_the_codes_own():
-    from stochpound.risk._store_risk import RULE_NAMES
+    from stochpound.risk._chain import RULE_NAMES
 
     for key in ("srss", "srss_reduced", "dtm"):
         assert "suite-mean" in RULE_NAMES[key], RULE_NAMES[key]
@@ -285,7 +285,7 @@ def test_the_design_rows_say_why_there_is_no_eurocode_8_row():
 def test_the_assumptions_say_the_base_the_grid_leaves():
     """A building with a base that the grid's μ = ∞ fixes is on a fixed base (the flagship's fixed pair was said to be on a
     sliding base); the scenario's words: tests/test_fitted_scenarios.py."""
-    from stochpound.risk._store import _base_words
+    from stochpound.risk._inputs import _base_words
     from stochpound.store import MuAxis
 
     building = {"name": "B1", "base": {"mu": 0.05}}
@@ -293,3 +293,28 @@ def test_the_assumptions_say_the_base_the_grid_leaves():
     assert _base_words(MuAxis((0.05, 0.08), ("B1",)), building) == "a sliding base (μ 0.05, 0.08 on the grid)"
     assert _base_words(MuAxis((0.05, float("inf")), None), building) == "a sliding base (μ 0.05 on the grid) or a fixed base"
     assert _base_words(None, {"name": "B2"}) == "a fixed base"
+
+
+def test_the_chain_reads_its_store_once_and_answers_from_the_inputs_alone(moat_variant_store, tmp_path):
+    """``read_risk_inputs`` reads what ``store_risk`` needs once; the chain then answers from the frozen inputs with the store
+    closed (no step goes back to it), and its answer is the one ``store_risk`` gives from the store itself."""
+    import dataclasses
+
+    from stochpound import open_store
+    from stochpound.risk import RiskInputError, RiskInputs, read_risk_inputs, store_risk
+
+    path = tmp_path / "copy.nc"
+    path.write_bytes(open(moat_variant_store.encoding["source"], "rb").read())
+    store = open_store(path)
+    inputs = read_risk_inputs(store)
+    store.close()
+    assert isinstance(inputs, RiskInputs) and inputs.method == "stripes" and inputs.studied == "B1"
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        inputs.motions = 1  # type: ignore[misc]
+    from_inputs = store_risk(inputs, bootstrap=0)
+    from_store = store_risk(moat_variant_store, bootstrap=0)
+    xr.testing.assert_identical(from_inputs.separation, from_store.separation)
+    xr.testing.assert_identical(from_inputs.rules, from_store.rules)
+    assert (from_inputs.setting, from_inputs.motions, from_inputs.assumptions) == (from_store.setting, from_store.motions, from_store.assumptions)
+    with pytest.raises(RiskInputError, match="read with the inputs"):
+        store_risk(inputs, studied="B2")

@@ -26,7 +26,7 @@ from stochpound._memory import LIMIT_VARIABLE, MemoryLimitError
 from stochpound.cli._risk import risk as risk_command
 from stochpound.hazard import hazard_option, read_hazard_file
 from stochpound.risk import HazardCurve, StoreRisk, limit_state_events, risk_curve, risk_targeted_separation, stripe_fragility
-from stochpound.risk._store_risk import bootstrap_bytes, bound_beyond_stripes, check_bootstrap
+from stochpound.risk._chain import bootstrap_bytes, bound_beyond_stripes, check_bootstrap
 from stochpound.risk._stripe_coverage import top_capped_maf
 from stochpound.motions import Measure
 from stochpound.store import Intensity, UnfinishedStoreError, check_finished

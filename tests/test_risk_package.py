@@ -1,9 +1,10 @@
 """The risk chain as its own package (docs/risk.md, "Where things live").
 
-* ``stochpound.risk`` is the canonical home of the chain's names; the ones
-  ``stochpound.analysis`` exported before stay importable there as the same
-  objects, and importing the statistics does not import the risk chain;
-* every store read of the chain is in ``stochpound/risk/_store.py``;
+* ``stochpound.risk`` is the canonical home of the chain's names; the ones the
+  contract lists under ``stochpound.analysis`` stay importable there as the
+  same objects, the other old aliases are retired, and importing the
+  statistics does not import the risk chain;
+* every store read of the chain is in ``stochpound/risk/_inputs.py``;
 * report sections compute nothing and cache nothing: no process-wide cache;
 * ``stochpound risk`` imports no report section and no private module of
   another package.
@@ -36,14 +37,32 @@ def _imports(path: Path) -> set[str]:
     return found
 
 
-@pytest.mark.parametrize("name", ["fit_fragility", "HazardCurve", "mean_annual_frequency", "Fragility", "stripe_fragility", "risk_curve",
-                                  "risk_targeted_separation", "code_rules_risk", "store_risk", "StoreRisk", "contact_free_closure"])
-def test_the_analysis_names_are_the_risk_package_s(name):
+@pytest.mark.parametrize("name", ["fit_fragility", "HazardCurve", "mean_annual_frequency", "subset_simulation"])
+def test_the_contract_s_analysis_names_stay(name):
+    """The names the project's contract lists under stochpound.analysis; its risk names are the risk package's objects."""
     import stochpound.analysis
     import stochpound.risk
 
-    assert name in stochpound.analysis.__all__ and name in stochpound.risk.__all__
-    assert getattr(stochpound.analysis, name) is getattr(stochpound.risk, name)
+    assert name in stochpound.analysis.__all__
+    if name in stochpound.risk.__all__:
+        assert getattr(stochpound.analysis, name) is getattr(stochpound.risk, name)
+
+
+@pytest.mark.parametrize("name", ["Fragility", "stripe_fragility", "risk_curve", "risk_targeted_separation", "code_rules_risk", "store_risk",
+                                  "StoreRisk", "contact_free_closure", "pounding_fragility", "risk_gaps", "RISK_NAMES"])
+def test_the_retired_risk_aliases_of_analysis_are_gone(name):
+    import stochpound.analysis
+
+    assert name not in stochpound.analysis.__all__
+    with pytest.raises(AttributeError, match=name):
+        getattr(stochpound.analysis, name)
+
+
+def test_the_kernels_have_one_path():
+    """``stochpound.analysis.kernels`` (the kernels' old path, an alias in sys.modules) is retired: stochpound.stats.kernels."""
+    code = "import stochpound.analysis.kernels"
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT)
+    assert result.returncode != 0 and "ModuleNotFoundError" in result.stderr
 
 
 def test_an_unknown_analysis_name_is_still_an_attribute_error():
@@ -60,13 +79,13 @@ def test_importing_the_statistics_does_not_import_the_risk_chain():
 
 
 def test_every_store_read_of_the_chain_is_in_one_module():
-    """Only ``_store.py`` imports the experiment or store layers (the definition, the store's hazard, the gap axes that
+    """Only ``_inputs.py`` imports the experiment or store layers (the definition, the store's hazard, the gap axes that
     select cases), and only it looks into a store (its attributes, variables, dimensions, accessor)."""
     readers = {path.name for path in RISK.glob("*.py")
                if any(module.startswith(("stochpound.experiment", "stochpound.store")) for module in _imports(path))}
-    assert readers <= {"_store.py"}
+    assert readers <= {"_inputs.py"}
     touching = {path.name for path in RISK.glob("*.py") if re.search(r"\bstore(\.attrs|\[|\.dims|\.sizes|\.sel|\.isel|\.data_vars|\.pound)", path.read_text())}
-    assert touching <= {"_store.py"}  # the other modules hand the store to _store's functions, never look into it
+    assert touching <= {"_inputs.py"}  # the other modules hand the store to _inputs's functions, never look into it
 
 
 def test_report_sections_keep_no_cache():
@@ -97,8 +116,8 @@ def test_every_risk_name_analysis_gives_is_the_risk_package_s():
     import stochpound.analysis
     import stochpound.risk
 
-    assert set(stochpound.analysis.RISK_NAMES) <= set(stochpound.risk.__all__)
-    assert all(getattr(stochpound.analysis, name) is getattr(stochpound.risk, name) for name in stochpound.analysis.RISK_NAMES)
+    assert stochpound.analysis.CONTRACT_RISK_NAMES == ("fit_fragility", "mean_annual_frequency")
+    assert all(getattr(stochpound.analysis, name) is getattr(stochpound.risk, name) for name in stochpound.analysis.CONTRACT_RISK_NAMES)
 
 
 @pytest.mark.parametrize("name", ["HazardCurve", "HazardFile", "read_hazard_file", "bundled_curves", "bundled_measure", "bundled_site_curves",

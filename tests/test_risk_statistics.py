@@ -88,7 +88,7 @@ def test_isotonic_rate_keeps_a_monotone_curve_and_fills_missing_gaps():
 def test_stripe_fragility_resamples_the_events_of_a_store():
     import xarray as xr
 
-    from stochpound.analysis import stripe_fragility
+    from stochpound.risk import stripe_fragility
 
     rng = np.random.default_rng(4)
     levels = np.array([0.2, 0.4, 0.8, 1.6])
@@ -108,7 +108,7 @@ def test_the_bootstrap_counts_the_clusters_and_motions_that_ran_not_the_pool():
     """A selection runs some motions of a pool per stripe: the method's words count the runs' clusters and motions, per stripe."""
     import xarray as xr
 
-    from stochpound.analysis import stripe_fragility
+    from stochpound.risk import stripe_fragility
     from stochpound.stats import bootstrap_method
 
     rng = np.random.default_rng(5)

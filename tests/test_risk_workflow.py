@@ -395,7 +395,8 @@ def test_rules_table_is_indexed_by_the_grid_not_by_what_each_point_ran():
 
 def test_the_ida_gap_grid_reaches_the_separations_of_the_hazards_intensities(fixed_stores):
     """IDA runs hold the closures at scale 1: the default grid must reach them scaled to the hazard's rare intensities, or g* is "inf"."""
-    from stochpound.analysis import rate_from_probability, store_risk
+    from stochpound.analysis import rate_from_probability
+    from stochpound.risk import store_risk
 
     ida = open_store(fixed_stores[1]).load()
     hz = HazardCurve.bundled(BUNDLED)

@@ -94,7 +94,7 @@ def test_demands_leave_the_walls_peak_closures_and_impacts_as_they_are():
 def test_the_largest_wall_penetration_is_the_closed_form_of_one_kelvin_collision(method, rel):
     """A frictionless block at v0 into a Kelvin wall: δ(t) = v0/ω_d e^(−ζωt) sin(ω_d t) while closed, whose peak is
     (v0/ω) exp(−ζ arccos(ζ)/√(1−ζ²)); the summary takes it from the located peak closure, not from the coarse samples."""
-    from stochpound.analysis.kernels import wall_penetration
+    from stochpound.stats.kernels import wall_penetration
 
     m, k, gap, v0 = 1.0e4, 1.0e7, 0.115, 0.5
     scene = {"building": [{"name": "block", "mass": [], "stiffness": [], "base": {"mass": m, "mu": 0.0}, "initial": {"base_velocity": v0}}],

@@ -9,17 +9,14 @@ these functions apply with :func:`xarray.apply_ufunc`.
 
 This namespace also gives the site's hazard (:class:`HazardCurve`, the
 hazard files and the stripes' consistency, of :mod:`stochpound.hazard`),
-the code separation rules of a run (of :mod:`stochpound.codes`) and, as
-aliases, the names of the risk chain (:mod:`stochpound.risk`) it gave to
-code written before that package existed. Small exceedance probabilities of
+the code separation rules of a run (of :mod:`stochpound.codes`) and the two
+names of the risk chain (:mod:`stochpound.risk`) the project's contract lists
+here, :func:`fit_fragility` and :func:`mean_annual_frequency`. Small exceedance probabilities of
 a run's response come from subset simulation (:func:`subset_simulation`,
 which runs the solvers). The statistics sit above all
 three: none of them imports this package.
 """
 
-import sys
-
-from stochpound.stats import kernels
 from stochpound.analysis._moments import moments
 from stochpound.stats import correlation
 from stochpound.analysis._ensemble_statistics import ensemble_statistics
@@ -58,37 +55,17 @@ from stochpound.analysis._impacts import TABLE_COLUMNS  # noqa: F401
 from stochpound.analysis._intervals import MIN_RUNS  # noqa: F401
 from stochpound.analysis._summary import response_moments, top_floor_total_displacement  # noqa: F401
 
-sys.modules[f"{__name__}.kernels"] = kernels  # the kernels' old path: ``import stochpound.analysis.kernels`` still gives them
 
-
-RISK_NAMES = (
-    "Fragility",
-    "fit_fragility",
-    "fragility_band",
-    "fragility_surface",
-    "homogeneous_capacities",
-    "ida_fragility",
-    "limit_state_events",
-    "stripe_fragility",
-    "demand_hazard_curve",
-    "mean_annual_frequency",
-    "risk_curve",
-    "risk_targeted_separation",
-    "code_rules_risk",
-    "contact_free_closure",
-    "pounding_fragility",
-    "risk_gaps",
-    "store_risk",
-    "StoreRisk",
-)
-"""The risk chain's names this namespace exported before :mod:`stochpound.risk` existed (one list: the risk package exports them
-too). Aliases of that package's (the canonical names), resolved when first used, so that importing the statistics does not import
-the risk chain (which they do not need)."""
+CONTRACT_RISK_NAMES = ("fit_fragility", "mean_annual_frequency")
+"""The risk chain's names the project's contract lists under this namespace (with :class:`HazardCurve` and
+:func:`subset_simulation`, imported above): kept here as aliases of :mod:`stochpound.risk`'s (their canonical home), resolved
+when first used, so that importing the statistics does not import the risk chain. The other risk names this namespace once
+gave are retired (import them from :mod:`stochpound.risk`)."""
 
 
 def __getattr__(name: str) -> object:
-    """A risk chain's name, from :mod:`stochpound.risk` (imported on first use)."""
-    if name in RISK_NAMES:
+    """A contract name of the risk chain (:data:`CONTRACT_RISK_NAMES`), from :mod:`stochpound.risk` (imported on first use)."""
+    if name in CONTRACT_RISK_NAMES:
         import stochpound.risk
 
         return getattr(stochpound.risk, name)
@@ -138,5 +115,5 @@ __all__ = [
     "RUPTURE_COLUMNS",
     "RuptureSite",
     "bundled_rupture_sites",
-    *RISK_NAMES,
+    *CONTRACT_RISK_NAMES,
 ]

@@ -126,7 +126,7 @@ def risk(store: Path, hazard: str | None, hazard_measure: str | None, hazard_uni
     from stochpound.cli._measure_choice import efficient_measure_lines
     from stochpound.experiment import open_store
     from stochpound.motions import TARGET_TOLERANCE, TRUNCATION_EPSILON
-    from stochpound.risk import gap_cost_frame, limit_state_risk, selection_misses, site_hazard, store_risk, stripes_beyond_truncation
+    from stochpound.risk import gap_cost_frame, limit_state_risk, read_risk_inputs, site_hazard, store_risk
 
     targets = _targets(target)
     if hazard is None and (hazard_measure or hazard_units or investigation_time is not None or hazard_site is not None):
@@ -139,10 +139,10 @@ def risk(store: Path, hazard: str | None, hazard_measure: str | None, hazard_uni
             data = open_store(store, edited="accept" if accept_edited else "refuse")
             hz = site_hazard(data, hazard, measure=hazard_measure, units=hazard_units, investigation_time=investigation_time,
                              site=hazard_site, extrapolate=extrapolate)
-            result = store_risk(data, hz, targets, years, bootstrap=bootstrap, seed=seed, design=None if design is None else _design(design),
-                                partial=partial)
+            inputs = read_risk_inputs(data, hz, design=None if design is None else _design(design), partial=partial)  # the chain's one read
+            result = store_risk(inputs, targets=targets, years=years, bootstrap=bootstrap, seed=seed)
             costs = None if limit_states is None else gap_cost_frame(limit_state_risk(data, _limit_states(limit_states), hz), years)
-            missed, beyond = selection_misses(data), stripes_beyond_truncation(data)  # every read of the store before the first answer
+            missed, beyond = inputs.selection_misses, inputs.beyond_truncation  # every read of the store before the first answer
             measure_lines = efficient_measure_lines(data, hazard)
     except (StochpoundError, ValueError) as error:
         raise click.ClickException(str(error)) from None

@@ -47,11 +47,10 @@ from stochpound._memory import check_memory, sample_bytes
 from stochpound.motions.ground import SampledMotion
 from stochpound.model.scene import Scene
 from stochpound.results.record import ENERGY_TERMS
-from stochpound.solvers.simulate import simulate
+from stochpound.solvers.simulate import METHODS, simulate
 
 KEEP = ("summary", "histories")
 """What an ensemble keeps: summaries only, or also the displacement and impact force histories."""
-METHODS = ("exact", "ivp")
 HISTORIES = ("total_displacement", "relative_displacement", "sliding_displacement", "impact_force")
 """The time histories an ensemble keeps with ``keep="histories"`` (the names of :func:`stochpound.simulate`)."""
 FINAL_ENERGIES = tuple(f"energy_{term}" for term in ENERGY_TERMS)

@@ -15,7 +15,8 @@ building's ASCE 7 chapter 17 design at both friction bounds,
 :func:`isolated_separation`), applied to
 a store's scene and ``[design]`` with their risk (:func:`design_separations`,
 :func:`design_rules_risk`). For an
-experiment store, :func:`store_risk` runs the whole chain and returns a
+experiment store, :func:`read_risk_inputs` reads once what the chain needs
+(:class:`RiskInputs`) and :func:`store_risk` runs the whole chain on them and returns a
 :class:`StoreRisk`, whose tables (:meth:`StoreRisk.to_frame`,
 :meth:`StoreRisk.separation_frame`, :meth:`StoreRisk.rules_frame`) the
 report renders and ``stochpound risk`` prints; :func:`stripe_demand_rate`
@@ -59,8 +60,9 @@ from stochpound.risk._code_gaps import (
     srss_separation,
 )
 from stochpound.risk._design_rules import DESIGN_RULE_LEVELS, design_rules_risk, design_separations
-from stochpound.risk._store import RiskInputError, contact_free_closure, has_risk, selection_misses, site_hazard, stripes_beyond_truncation
-from stochpound.risk._store_risk import StoreRisk, pounding_fragility, risk_gaps, store_risk
+from stochpound.risk._inputs import (RiskInputError, RiskInputs, contact_free_closure, has_risk, read_risk_inputs, selection_misses, site_hazard,
+                                    stripes_beyond_truncation)
+from stochpound.risk._chain import StoreRisk, pounding_fragility, risk_gaps, store_risk
 from stochpound.risk._demands import StoreDemands, store_demands
 from stochpound.risk._limit_states import KINDS as LIMIT_STATE_KINDS, LimitState, gap_cost_frame, limit_state_problem, limit_state_risk, limit_states_from_table
 from stochpound.risk._efficiency import measure_efficiency, most_efficient
@@ -120,6 +122,8 @@ __all__ = [
     "risk_gaps",
     "store_risk",
     "StoreRisk",
+    "read_risk_inputs",
+    "RiskInputs",
     "store_demands",
     "StoreDemands",
     "LimitState",

@@ -29,11 +29,11 @@ from collections.abc import Sequence
 import numpy as np
 import xarray as xr
 
-from stochpound.hazard import rate_from_probability
-from stochpound.risk import _store
+from stochpound.hazard import rate_from_probability, return_period
+from stochpound.risk import _inputs
 from stochpound.risk._limit_states import KINDS, LimitState, limit_state_risk, limit_states_of
 from stochpound.risk._maf import TARGETS
-from stochpound.risk._store_risk import YEARS
+from stochpound.risk._chain import YEARS
 
 MODEL_DRIFT_LIMIT = 0.05
 """Peak storey drift ratio beyond which a run is flagged: the model has no strength loss or collapse (the collapse-prevention drift of ``DEFAULT_SOURCE``)."""
@@ -100,6 +100,32 @@ class StoreDamage:
     contact_free: bool
     elastic: tuple[str, ...] = ()
 
+    def beyond_model_per_stripe(self) -> list[tuple[float, int, int]]:
+        """Per stripe, over every configuration: (its level in IM units, the runs beyond the model, the runs done)."""
+        beyond = self.beyond_model.sum([d for d in self.beyond_model.dims if d != "intensity"])
+        runs = self.runs.sum([d for d in self.runs.dims if d != "intensity"])
+        return [(float(level), int(b), int(n)) for level, b, n in zip(beyond["intensity"].values, beyond.values, runs.values)]
+
+    def beyond_model_total(self) -> tuple[int, int]:
+        """The runs beyond the model and the runs done, over every stripe and configuration."""
+        return int(self.beyond_model.sum()), int(self.runs.sum())
+
+    def return_period(self) -> xr.DataArray | None:
+        """Each limit state's mean return period 1/λ (yr; inf where no run reaches it), over ``risk``'s dimensions; None without ``risk``."""
+        if self.risk is None:
+            return None
+        return xr.apply_ufunc(return_period, self.risk["maf"])
+
+    def governing_counts(self, probability: float) -> tuple[dict[str, int], int] | None:
+        """At the g* of ``probability`` in 50 yr: the configurations each structural limit state governs (:meth:`governing`), in
+        the order first met, and the number of configurations; None without ``risk``."""
+        governing = self.governing(probability)
+        if governing is None:
+            return None
+        names = [str(v) for v in governing.values.ravel()]
+        structural = {str(state) for state in self.risk["limit_state"].values}
+        return {n: names.count(n) for n in names if n in structural}, len(names)
+
     def governing(self, probability: float) -> xr.DataArray | None:
         """Per configuration, what is reached most often at the risk-targeted separation g* of ``probability`` in 50 yr.
 
@@ -146,15 +172,15 @@ def store_damage(store: xr.Dataset, limit_states: Sequence[LimitState] | None = 
     ValueError
         (``RiskInputError``) A given limit state the store cannot evaluate (its demand or building missing).
     """
-    if "peak_ductility" not in store or _store.stripes(store) is None:
+    if "peak_ductility" not in store or _inputs.stripes(store) is None:
         return None
     given = limit_states is not None
-    table = _store.limit_states_table(store)
+    table = _inputs.limit_states_table(store)
     if limit_states is None and table is not None:
         limit_states, source, given = limit_states_of(table), table.source or EXPERIMENT_SOURCE, True
     if limit_states is None:
         limit_states, source = DEFAULT_LIMIT_STATES, DEFAULT_SOURCE
-    per_building, free = _store.run_summaries(store, list(DAMAGE_DEMANDS))
+    per_building, free = _inputs.run_summaries(store, list(DAMAGE_DEMANDS))
     ductility = per_building["peak_ductility"]
     yields = ductility.notnull().any([d for d in ductility.dims if d != "building"])
     elastic = tuple(str(b) for b, flag in zip(ductility["building"].values, yields.values) if not flag)
@@ -165,14 +191,14 @@ def store_damage(store: xr.Dataset, limit_states: Sequence[LimitState] | None = 
     done = xr.concat([data.notnull().any("building") for data in per_building.values()], "demand").any("demand")
     drift = per_building.get("peak_drift_ratio")
     beyond = (drift.max("building") > MODEL_DRIFT_LIMIT) if drift is not None else xr.zeros_like(done)
-    hz = _store.site_hazard(store)
-    levels = _store.stripe_levels(store)
+    hz = _inputs.site_hazard(store)
+    levels = _inputs.stripe_levels(store)
     design_stripes = {p: float(levels[np.argmin(np.abs(np.log(levels) - np.log(float(hz.intensity_at(rate_from_probability(p, YEARS))))))])
                       for p in TARGETS}
     held = tuple(state for state in limit_states  # the defaults the store can evaluate; every given one (an error where it cannot)
-                 if given or _store.holds(store, KINDS[state.kind].variable))
+                 if given or _inputs.holds(store, KINDS[state.kind].variable))
     risk = None
     if held:
         risk = limit_state_risk(store, held, hz)
-        risk = _store.contact_free_part(risk) if free else risk
+        risk = _inputs.contact_free_part(risk) if free else risk
     return StoreDamage(demands, done.sum("record"), (beyond & done).sum("record"), design_stripes, risk, held, source or "", free, elastic)

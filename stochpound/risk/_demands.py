@@ -19,11 +19,13 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
-from stochpound.hazard import HazardCurve
-from stochpound.risk import _store
+from collections.abc import Sequence
+
+from stochpound.hazard import HazardCurve, rate_from_probability
+from stochpound.risk import _inputs
 from stochpound.risk._fragility_ensemble import BOOTSTRAP
 from stochpound.risk._maf import demand_hazard_curve
-from stochpound.risk._store_risk import CONFIDENCE, YEARS, non_increasing_along
+from stochpound.risk._chain import CONFIDENCE, YEARS, non_increasing_along
 
 DEMAND_LEVELS = 40
 """Levels of each demand hazard curve."""
@@ -61,6 +63,27 @@ class StoreDemands:
         """A demand's exceedance rate made non-increasing along its levels (isotonic regression in ln λ, pool-adjacent-violators; 1/yr)."""
         return non_increasing_along(self.curves[label]["maf"], "level")
 
+    def wall_rates(self, targets: Sequence[float], years: float) -> list[tuple[float, float, float, float]]:
+        """Per target (a probability in ``years``) and moat clearance: (target, clearance m, rate of reaching the wall in its worst
+        configuration 1/yr, the target's rate 1/yr); [] without a moat."""
+        if self.moat is None:
+            return []
+        rows = []
+        for target in targets:
+            allowed = float(rate_from_probability(float(target), years))
+            for clearance in self.moat["level"].values:
+                maf = self.moat["maf"].sel(level=clearance)
+                rows.append((float(target), float(clearance), float(maf[maf.fillna(-1.0).argmax(...)]), allowed))
+        return rows
+
+    def wall_interval(self, clearance: float) -> tuple[float, float] | None:
+        """The interval (yr) of the return period of reaching the wall at ``clearance`` in its worst configuration; None without a bootstrap."""
+        if self.moat is None or "return_period_lower" not in self.moat:
+            return None
+        at = self.moat.sel(level=clearance)
+        worst = at["maf"].fillna(-1.0).argmax(...)
+        return float(at["return_period_lower"].isel(worst)), float(at["return_period_upper"].isel(worst))
+
     def moat_frame(self) -> pd.DataFrame:
         """The moat table: per clearance (m), the MAF of reaching it with its interval, the return period and the probability."""
         if self.moat is None:
@@ -89,15 +112,15 @@ def store_demands(store: xr.Dataset, hz: HazardCurve | None = None, confidence: 
     seed : int
         Seed of the resamples.
     """
-    if _store.stripes(store) is None:
+    if _inputs.stripes(store) is None:
         return None
-    hz = _store.site_hazard(store) if hz is None else hz
-    studied = _store.studied_building(store)
+    hz = _inputs.site_hazard(store) if hz is None else hz
+    studied = _inputs.studied_building(store)
     demands: dict[str, tuple[xr.DataArray, str]] = {}
-    sliding = _store.base_displacement(store, studied, walls_free=True)
+    sliding = _inputs.base_displacement(store, studied, walls_free=True)
     if sliding is not None:
         demands[f"peak base displacement of {studied}"] = (sliding, "m")
-    demands.update(_store.stored_demands(store))
+    demands.update(_inputs.stored_demands(store))
     if not demands:
         return None
     curves = {}
@@ -105,7 +128,7 @@ def store_demands(store: xr.Dataset, hz: HazardCurve | None = None, confidence: 
         values = demand.values[np.isfinite(demand.values) & (demand.values > 0)]
         levels = np.geomspace(np.quantile(values, 0.01), values.max(), DEMAND_LEVELS)
         curves[label] = demand_hazard_curve(demand, levels, hz, confidence=confidence, bootstrap=0)
-    clearances = _store.moat_clearances(store, studied)
+    clearances = _inputs.moat_clearances(store, studied)
     moat = (demand_hazard_curve(sliding, clearances, hz, confidence=confidence, bootstrap=bootstrap, seed=seed)
             if sliding is not None and clearances else None)
     return StoreDemands(curves, {label: units for label, (_, units) in demands.items()}, moat)

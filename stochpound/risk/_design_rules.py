@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import itertools
 import math
+from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
@@ -39,7 +40,8 @@ from stochpound.hazard import HazardCurve
 from stochpound.store import Design
 from stochpound.model.building import Building
 from stochpound.model.scene import Scene
-from stochpound.risk import _store
+from stochpound.risk import _inputs
+from stochpound.risk._inputs import CASE_DIMS, RiskInputError, RiskInputs
 from stochpound.codes import EC8_REDUCTION
 from stochpound.risk._code_gaps import (Asce7Design, Ec8Design, asce7_inelastic_displacement, asce7_isolator_displacement,
                                         ec8_design_displacement, modal_floor_displacements, srss_separation)
@@ -48,7 +50,6 @@ from stochpound.risk._maf import no_interval_attrs, rate_intervals, risk_curve
 
 DESIGN_RULE_LEVELS = {"asce7_delta_mt": 0.02, "ec8_ds": 0.10, "asce7_dtm": 0.02}
 """Each design-analysis rule's design level: the probability of exceedance in 50 years its code sets its objective at."""
-_RECORD_DIMS = ("intensity", "record", "contact")
 
 
 def design_separations(scene: Scene, design: Design, studied: str | None = None) -> dict[str, np.ndarray]:
@@ -87,14 +88,15 @@ def design_separations(scene: Scene, design: Design, studied: str | None = None)
     return gaps
 
 
-def design_rules_risk(store: xr.Dataset, hz: HazardCurve, design: Design, studied: str | None = None, years: float = 50.0,
+def design_rules_risk(store: xr.Dataset | RiskInputs, hz: HazardCurve, design: Design, studied: str | None = None, years: float = 50.0,
                       confidence: float = 0.95, bootstrap: int = BOOTSTRAP, seed: int = 0) -> xr.Dataset:
     """The codes' own gaps of every configuration of a store with stripes and the mean annual frequency of pounding at each.
 
     Parameters
     ----------
-    store : xarray.Dataset
-        An experiment store with intensity stripes and contact-free cases.
+    store : xarray.Dataset or RiskInputs
+        An experiment store with intensity stripes and contact-free cases, or
+        its inputs read with a design (:func:`~stochpound.risk.read_risk_inputs`).
     hz : HazardCurve
         The site's hazard, in the store's intensity measure.
     design : Design
@@ -115,10 +117,16 @@ def design_rules_risk(store: xr.Dataset, hz: HazardCurve, design: Design, studie
         :func:`~stochpound.risk.stripe_fragility`). A rule that does not
         apply to a configuration is NaN there.
     """
-    closure = _store.contact_free_demands(store)["peak_closure"]
+    if isinstance(store, RiskInputs):
+        if store.demands is None or not store.scenes:
+            raise RiskInputError("design_rules_risk: the inputs were read without a design (read_risk_inputs(..., design=...))")
+        closure, scenes = store.demands["peak_closure"], store.scenes
+    else:
+        closure = _inputs.contact_free_demands(store)["peak_closure"]
+        scenes = _inputs.configuration_scenes(store, closure)
     if "gap" in closure.coords and "gap" not in closure.dims:
         closure = closure.drop_vars("gap")
-    gaps = _configuration_gaps(store, closure, design, studied)
+    gaps = _configuration_gaps(scenes, closure, design, studied)
     excess = (closure - gaps).max("contact", skipna=False)
     events = (excess >= 0.0).astype(float).where(excess.notnull())
     fragility = stripe_fragility(events, "intensity", "record", confidence, bootstrap, seed)
@@ -133,12 +141,12 @@ def design_rules_risk(store: xr.Dataset, hz: HazardCurve, design: Design, studie
         .assign_attrs(years=years, **no_interval_attrs(fragility))
 
 
-def _configuration_gaps(store: xr.Dataset, closure: xr.DataArray, design: Design, studied: str | None) -> xr.DataArray:
-    """The rules' gaps (m) over ``rule``, the configurations of ``closure`` and ``contact``, from each configuration's scene."""
-    configs = [dim for dim in closure.dims if dim not in _RECORD_DIMS]
-    per_config = {}
-    for labels in itertools.product(*(closure[dim].values for dim in configs)):
-        per_config[labels] = design_separations(_store.configuration_scene(store, dict(zip(configs, labels))), design, studied)
+def _configuration_gaps(scenes: Mapping[tuple[Any, ...], Scene], closure: xr.DataArray, design: Design,
+                        studied: str | None) -> xr.DataArray:
+    """The rules' gaps (m) over ``rule``, the configurations of ``closure`` and ``contact``, from each configuration's scene
+    (``scenes``, keyed by its labels: :func:`~stochpound.risk._inputs.configuration_scenes`)."""
+    configs = [dim for dim in closure.dims if dim not in CASE_DIMS]
+    per_config = {labels: design_separations(scene, design, studied) for labels, scene in scenes.items()}
     rules = list(dict.fromkeys(rule for gaps in per_config.values() for rule in gaps))
     contacts = closure.sizes["contact"]
     values = np.full((len(rules), *(closure.sizes[dim] for dim in configs), contacts), np.nan)

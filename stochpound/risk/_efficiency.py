@@ -35,7 +35,7 @@ import xarray as xr
 from scipy.stats import linregress
 
 from stochpound.motions import Measure
-from stochpound.risk._store import efficiency_runs
+from stochpound.risk._inputs import efficiency_runs
 
 #: Periods of Sa_avg, log-spaced over 0.2 T_min – 3 T_max of the structure.
 SA_AVG_PERIODS = 10

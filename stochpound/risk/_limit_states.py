@@ -29,11 +29,11 @@ import pandas as pd
 import xarray as xr
 
 from stochpound.hazard import HazardCurve, probability_from_rate
-from stochpound.risk import _store
+from stochpound.risk import _inputs
 from stochpound.risk._fragility_ensemble import limit_state_events, stripe_fragility
 from stochpound.risk._maf import mean_annual_frequency
 from stochpound.store import LimitStates
-from stochpound.risk._store_risk import CONFIDENCE, YEARS
+from stochpound.risk._chain import CONFIDENCE, YEARS
 
 
 @dataclasses.dataclass(frozen=True)
@@ -46,7 +46,7 @@ class _Kind:
 
 
 #: The kinds of limit state: the ``[limit_states]`` keys, the store summary each reads, and the capacity's units.
-KINDS = {kind: _Kind(_store.limit_state_variable(kind), *rest) for kind, rest in {
+KINDS = {kind: _Kind(_inputs.limit_state_variable(kind), *rest) for kind, rest in {
     "drift_ratio": ("1", "peak storey drift ratio", True, "yielding storeys or storey_height, and [output] demands = true"),
     "residual_drift_ratio": ("1", "residual storey drift ratio", True, "yield_force and storey_height"),
     "ductility": ("1", "peak storey ductility", True, "yield_force"),
@@ -97,7 +97,7 @@ class LimitState:
     def __post_init__(self) -> None:
         problem = limit_state_problem(self.kind, self.capacity, self.building)
         if problem is not None:
-            raise _store.RiskInputError(f"limit_states.{self.kind}: {problem}")
+            raise _inputs.RiskInputError(f"limit_states.{self.kind}: {problem}")
 
     @property
     def label(self) -> str:
@@ -125,7 +125,7 @@ def limit_states_from_table(table: Mapping[str, Any]) -> tuple[LimitState, ...]:
         (``RiskInputError``) An unknown kind, a capacity that is not a number > 0, or an empty table.
     """
     if not isinstance(table, Mapping) or not table:
-        raise _store.RiskInputError(f"limit_states: must be a table of {', '.join(KINDS)} to capacities, got {table!r}")
+        raise _inputs.RiskInputError(f"limit_states: must be a table of {', '.join(KINDS)} to capacities, got {table!r}")
     states = []
     for kind, value in table.items():
         per_building = value.items() if isinstance(value, Mapping) else [(None, value)]
@@ -171,27 +171,22 @@ def limit_state_risk(store: xr.Dataset, limit_states: Sequence[LimitState], hz: 
         hazard, or without a limit state's variable or building.
     """
     if not limit_states:
-        raise _store.RiskInputError("limit_states: give at least one limit state")
-    if _store.stripes(store) is None:
-        raise _store.RiskInputError("store: limit states need intensity stripes (run method = \"stripes\")")
-    hz = _store.site_hazard(store) if hz is None else hz
+        raise _inputs.RiskInputError("limit_states: give at least one limit state")
+    hz, demands, measure = _inputs.limit_state_inputs(store, [(KINDS[s.kind].variable, s.building, KINDS[s.kind].note, KINDS[s.kind].units == "g")
+                                                              for s in limit_states], hz)
     fits = []
-    for state in limit_states:
-        kind = KINDS[state.kind]
-        demand = _store.case_demand(store, kind.variable, state.building, kind.note)
-        if kind.units == "g":
-            demand = demand / _store.scene_g(store)
+    for state, demand in zip(limit_states, demands):
         events = limit_state_events(demand, [state.capacity], dim="limit_state").assign_coords(limit_state=[state.label])
         fit = stripe_fragility(events, confidence=confidence, bootstrap=bootstrap, seed=seed)
         fits.append(fit.assign_coords(kind=("limit_state", [state.kind]), capacity=("limit_state", [float(state.capacity)]),
                                       building=("limit_state", [state.building or ""])))
     result = xr.concat(fits, "limit_state", coords="different", compat="equals", join="outer")
     result["maf"] = mean_annual_frequency(result, hz)
-    twins = _store.contact_free_twins(result["maf"])
+    twins = _inputs.contact_free_twins(result["maf"])
     if twins is not None:
         result["maf_contact_free"] = twins.assign_attrs(units="1/yr", long_name="mean annual frequency of the contact-free twins")
         result["gap_cost"] = (result["maf"] - twins).assign_attrs(units="1/yr", long_name="what the gap costs: maf minus that of the contact-free twins")
-    return result.assign_attrs(intensity=_store.measure_text(_store.intensity_setting(store)))
+    return result.assign_attrs(intensity=measure)
 
 
 def gap_cost_frame(risk: xr.Dataset, years: float = YEARS) -> pd.DataFrame:
@@ -203,7 +198,7 @@ def gap_cost_frame(risk: xr.Dataset, years: float = YEARS) -> pd.DataFrame:
         Indexed by the limit state and the other grid labels (the contact-free rows left out).
     """
     keep = [name for name in ("maf", "maf_contact_free", "gap_cost") if name in risk]
-    frame = _store.at_finite_gaps(risk[keep]).reset_coords(drop=True).to_dataframe()
+    frame = _inputs.at_finite_gaps(risk[keep]).reset_coords(drop=True).to_dataframe()
     frame[f"P in {years:g} yr"] = probability_from_rate(frame["maf"].to_numpy(), years)
     if "maf_contact_free" in frame:
         frame[f"P in {years:g} yr, contact-free"] = probability_from_rate(frame["maf_contact_free"].to_numpy(), years)

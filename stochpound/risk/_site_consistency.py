@@ -18,7 +18,7 @@ import xarray as xr
 from stochpound.hazard import HazardCurve, bundled_measure, bundled_site_curves, hazard_consistency, rate_from_probability
 from stochpound.risk._efficiency import _interpolated
 from stochpound.risk._maf import TARGETS
-from stochpound.risk._store import stripe_spectra_runs
+from stochpound.risk._inputs import stripe_spectra_runs
 
 
 def site_consistency(store: xr.Dataset) -> dict[str, xr.Dataset]:

@@ -29,7 +29,7 @@ from stochpound.model import laws
 from stochpound.model.modal_solution import harmonic_response, modal_properties
 from stochpound.report.sections._description import StoreDefinition, has_yielding, number, numbers
 from stochpound.report.render import Paragraph
-from stochpound.report.sections._stores import select
+from stochpound.report.sections._store_reading import select
 from stochpound.model.scene import Building, Contact, Scene
 
 #: Closing velocity of the single-collision check, m/s.

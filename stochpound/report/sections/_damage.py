@@ -6,7 +6,7 @@ import pandas as pd
 
 from stochpound.report.render import Paragraph, Section, Table
 from stochpound.report.sections._description import number
-from stochpound.risk import DAMAGE_DEMANDS, MODEL_DRIFT_LIMIT, StoreDamage, return_period
+from stochpound.risk import DAMAGE_DEMANDS, MODEL_DRIFT_LIMIT, StoreDamage
 
 
 def damage_section(name: str, damage: StoreDamage) -> Section:
@@ -81,13 +81,12 @@ def _demands_table(name: str, damage: StoreDamage) -> Table:
 
 
 def _beyond_model_text(damage: StoreDamage) -> str:
-    beyond = damage.beyond_model.sum([d for d in damage.beyond_model.dims if d != "intensity"])
-    runs = damage.runs.sum([d for d in damage.runs.dims if d != "intensity"])
-    flagged = [f"{int(b)} of {int(n)} at stripe {number(float(level))}" for level, b, n in zip(beyond["intensity"].values, beyond.values, runs.values) if b]
+    per_stripe = damage.beyond_model_per_stripe()
+    flagged = [f"{b} of {n} at stripe {number(level)}" for level, b, n in per_stripe if b]
     head = (f"The storeys are bilinear without strength loss, degradation or collapse, so a drift beyond {_percent(MODEL_DRIFT_LIMIT)} of the "
             "storey height (the collapse-prevention drift of steel moment frames) is beyond what the model represents: ")
     if not flagged:
-        return head + f"none of the {int(runs.sum())} runs reaches it."
+        return head + f"none of the {damage.beyond_model_total()[1]} runs reaches it."
     return (head + "runs reaching it, per stripe over every configuration: " + "; ".join(flagged) + ". Their drifts, ductilities and "
             "residual drifts are not credible (a real frame would have lost strength or collapsed), and the fractiles above include them.")
 
@@ -116,13 +115,13 @@ def _governing_text(damage: StoreDamage) -> str:
 
 
 def _limit_states_table(name: str, damage: StoreDamage) -> Table:
-    maf = damage.risk["maf"]
+    maf, periods = damage.risk["maf"], damage.return_period()
     rows = []
     for labels in _configurations(maf):
         for state in maf["limit_state"].values:
             rate = float(maf.sel(labels).sel(limit_state=state))
             rows.append({"configuration": _label(labels), "limit state": str(state), "λ (1/yr)": f"{rate:.3g}",
-                         "once in (yr)": f"{float(return_period(rate)):.3g}"})
+                         "once in (yr)": f"{float(periods.sel(labels).sel(limit_state=state)):.3g}"})
     return Table(
         key=f"table-limit-states-{name}",
         caption=f"Experiment {name}: the limit states' mean annual frequency λ and return period, per configuration",

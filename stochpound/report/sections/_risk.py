@@ -36,7 +36,7 @@ from matplotlib.ticker import LogLocator, NullFormatter
 from stochpound.report.render import Block, FigureItem, Paragraph, Section, Table
 from stochpound.report.sections._facets import labels_text
 from stochpound.report.sections._stripe_motions import is_selected
-from stochpound.risk import MODEL_DRIFT_LIMIT, StoreDamage, StoreDemands, StoreRisk, degenerate_text, rate_from_probability
+from stochpound.risk import MODEL_DRIFT_LIMIT, StoreDamage, StoreDemands, StoreRisk
 
 
 def hazard_provenance(store: xr.Dataset) -> str:
@@ -159,12 +159,10 @@ def design_summary_text(risk: StoreRisk, demands: StoreDemands | None = None, da
         _structural_governs(damage, float(t), f"the moat wall ({wall[t][0]:.3g} m clearance, reached once in "
                             f"{1 / wall[t][1]:.3g}{_wall_interval(demands, wall[t][0])} yr)" if t in wall else "pounding between the buildings")
         + f" for {risk.target_text(t)}" for t in risk.separation["target"].values)
-    rules = risk.rules_frame()
-    if rules.empty:
+    if risk.rules_frame().empty:
         meets = f"The code rules were not evaluated ({risk.rules_note})."
     else:
-        column = "meets, upper bound" if "meets, upper bound" in rules else "meets its level"
-        met = rules[column].groupby(level="rule", sort=False).all()
+        column, met = risk.rules_meeting()
         meets = (f"Code rules meeting their own design level as a target in every configuration and level ({column.replace('meets, ', '') if 'upper' in column else 'estimate'}): "
                  f"{', '.join(met.index[met]) or 'none'}; not: {', '.join(met.index[~met]) or 'none'}.")
     rests = "; ".join(f"{key}: {value}" for key, value in {"hazard": f"{risk.hazard.describe()} ({_source(risk)})", **risk.assumptions,
@@ -177,25 +175,22 @@ def _structural_governs(damage: StoreDamage | None, target: float, separation: s
     """What governs at ``target``: ``separation`` (what limits the gap), preceded by the buildings' own limit states where
     :meth:`~stochpound.risk.StoreDamage.governing` names one (reached more often than pounding at g*), with their counts of
     configurations; ``separation`` alone where pounding governs everywhere or without ``damage``."""
-    governing = damage.governing(target) if damage is not None else None
-    if governing is None:
+    counted = damage.governing_counts(target) if damage is not None else None
+    if counted is None or not counted[0]:
         return separation
-    names = [str(v) for v in governing.values.ravel()]
-    structural = {str(state) for state in damage.risk["limit_state"].values}
-    states = {n: names.count(n) for n in names if n in structural}
-    if not states:
-        return separation
-    listed = ", ".join(f"{state} in {count} of {len(names)} configurations" for state, count in states.items())
-    rest = "of the separation" if sum(states.values()) == len(names) else "in the other configurations"
+    states, configurations = counted
+    listed = ", ".join(f"{state} in {count} of {configurations} configurations" for state, count in states.items())
+    rest = "of the separation" if sum(states.values()) == configurations else "in the other configurations"
     return f"{listed} (the buildings' own limit state, reached more often than pounding at g*: the Damage section); {rest}, {separation}"
 
 
 def _beyond_model(damage: StoreDamage | None) -> dict[str, str]:
     """The assumption the runs beyond the model strain: {"beyond the model": "<n> of <N> runs ..."} where some run exceeds
     ``MODEL_DRIFT_LIMIT`` ({} otherwise or without ``damage``)."""
-    if damage is None or not int(damage.beyond_model.sum()):
+    beyond, runs = damage.beyond_model_total() if damage is not None else (0, 0)
+    if not beyond:
         return {}
-    return {"beyond the model": f"{int(damage.beyond_model.sum())} of {int(damage.runs.sum())} runs exceed a "
+    return {"beyond the model": f"{beyond} of {runs} runs exceed a "
                                 f"{100 * MODEL_DRIFT_LIMIT:g} % storey drift, where the storeys' lack of strength loss and collapse makes their "
                                 "response not credible; they enter g* and the limit states as computed (the Damage section)"}
 
@@ -204,26 +199,10 @@ def _source(risk: StoreRisk) -> str:
     return risk.hazard.source.splitlines()[0] if risk.hazard.source else "no provenance stated"
 
 
-def _wall_rates(risk: StoreRisk, demands: StoreDemands) -> list[tuple[float, float, float, float, dict[str, Any]]]:
-    """Per target and moat clearance: (target, clearance m, rate of reaching the wall in its worst configuration 1/yr,
-    the target's rate 1/yr, that configuration's position)."""
-    rows = []
-    for target in risk.separation["target"].values:
-        allowed = float(rate_from_probability(float(target), risk.years))
-        for clearance in demands.moat["level"].values:
-            maf = demands.moat["maf"].sel(level=clearance)
-            worst = maf.fillna(-1.0).argmax(...)
-            rows.append((float(target), float(clearance), float(maf[worst]), allowed, worst))
-    return rows
-
-
 def _wall_interval(demands: StoreDemands | None, clearance: float) -> str:
     """`` [lower, upper]`` of the return period of reaching the wall at ``clearance`` in its worst configuration ("" without a bootstrap)."""
-    if demands is None or demands.moat is None or "return_period_lower" not in demands.moat:
-        return ""
-    at = demands.moat.sel(level=clearance)
-    worst = at["maf"].fillna(-1.0).argmax(...)
-    return f" [{float(at['return_period_lower'].isel(worst)):.3g}, {float(at['return_period_upper'].isel(worst)):.3g}]"
+    interval = demands.wall_interval(clearance) if demands is not None else None
+    return "" if interval is None else f" [{interval[0]:.3g}, {interval[1]:.3g}]"
 
 
 def _wall_governs(risk: StoreRisk, demands: StoreDemands | None) -> dict[float, tuple[float, float]]:
@@ -231,7 +210,7 @@ def _wall_governs(risk: StoreRisk, demands: StoreDemands | None) -> dict[float, 
     governs: dict[float, tuple[float, float]] = {}
     if demands is None or demands.moat is None:
         return governs
-    for target, clearance, wall, allowed, _ in _wall_rates(risk, demands):
+    for target, clearance, wall, allowed in demands.wall_rates(risk.separation["target"].values, risk.years):
         if wall > allowed and wall > governs.get(target, (0.0, 0.0))[1]:
             governs[target] = (clearance, wall)
     return governs
@@ -266,13 +245,12 @@ def _motions_text(risk: StoreRisk) -> str:
 def moat_text(risk: StoreRisk, demands: StoreDemands | None) -> str:
     """Whether the wall-free D_TM exceeds the moat clearance at each design level, and whether reaching the wall is more
     frequent than each target allows (the wall then governs that target); "" without a moat or a D_TM rule."""
-    if demands is None or demands.moat is None or risk.rules is None or "dtm" not in risk.rules["rule"].values:
+    largest_dtm = risk.largest_dtm()
+    if demands is None or demands.moat is None or not largest_dtm:
         return ""
-    dtm = risk.rules["gap"].sel(rule="dtm")
     clearances = demands.moat["level"].values
     sentences = []
-    for level in dtm["design_level"].values:
-        value = float(dtm.sel(design_level=level).max(skipna=True))
+    for level, (value, varies) in largest_dtm.items():
         if not math.isfinite(value):
             continue
         exceeded = [c for c in clearances if value > c]
@@ -280,11 +258,10 @@ def moat_text(risk: StoreRisk, demands: StoreDemands | None) -> str:
                    "at that level the base reaches the wall, so the code's D_TM is not met by the moat"
                    if exceeded else f"is within the moat clearance{'s' if len(clearances) > 1 else ''} "
                    f"{', '.join(f'{c:.3g} m' for c in clearances)}")
-        values = dtm.sel(design_level=level).values
-        largest = " (the largest over the configurations)" if np.unique(values[np.isfinite(values)]).size > 1 else ""
+        largest = " (the largest over the configurations)" if varies else ""
         sentences.append(f"The wall-free D_TM (suite-mean peak base displacement without the wall) at {100 * level:g} %/{risk.years:g} yr{largest} is "
                          f"{value:.3g} m and {verdict}.")
-    for target, clearance, wall, allowed, _ in _wall_rates(risk, demands):
+    for target, clearance, wall, allowed in demands.wall_rates(risk.separation["target"].values, risk.years):
         interval = _wall_interval(demands, clearance)
         relation = ("more often than the target allows (once in {:.3g} yr): the wall, not the gap, governs this target"
                     if wall > allowed else "less often than the target allows (once in {:.3g} yr): the wall does not govern this target")
@@ -313,25 +290,16 @@ def _hazard_text(risk: StoreRisk) -> str:
     )
 
 
-def _worst_outside(risk: StoreRisk) -> list[tuple[float, float, float]]:
-    """Per target: (target, below, above), the worst configuration's shares of λ_P at g* from below the lowest stripe and beyond
-    the top one ([] for IDA runs or without a finite g*)."""
-    shares = risk.outside_stripes
-    if shares is None or not np.isfinite(shares["below"].values).any():
-        return []
-    return [(float(t), float(shares["below"].sel(target=t).max()), float(shares["above"].sel(target=t).max())) for t in shares["target"].values]
-
-
 def _lowest_stripe_text(risk: StoreRisk) -> str:
     """The lowest stripe's level and return period in words."""
-    lowest = float(np.min(risk.fragility["intensity"].values))
-    return f"{lowest:.3g} {(risk.setting.units if risk.setting is not None else '')}, once in {float(1.0 / risk.hazard(lowest)):.3g} yr"
+    lowest, period = risk.lowest_stripe()
+    return f"{lowest:.3g} {(risk.setting.units if risk.setting is not None else '')}, once in {period:.3g} yr"
 
 
 def _outside_stripes_text(risk: StoreRisk) -> str:
     """How much of λ_P at g* comes from shaking below the lowest stripe and beyond the top one, where the fit is extrapolated
     (the worst configuration per target; "" for IDA runs or without a finite g*)."""
-    worst = _worst_outside(risk)
+    worst = risk.worst_outside_stripes()
     if not worst:
         return ""
     below = " and ".join(f"{_share_text(b)} for {risk.target_text(t)}" for t, b, _ in worst if np.isfinite(b))
@@ -345,7 +313,7 @@ def _outside_stripes_text(risk: StoreRisk) -> str:
 
 def _outside_stripes_assumption(risk: StoreRisk) -> dict[str, str]:
     """{"shaking below the stripes": ...} where that shaking carries at least :data:`OUTSIDE_STRIPES_NOTABLE` of λ_P at g*, else {}."""
-    notable = [(t, b) for t, b, _ in _worst_outside(risk) if np.isfinite(b) and b >= OUTSIDE_STRIPES_NOTABLE]
+    notable = [(t, b) for t, b, _ in risk.worst_outside_stripes() if np.isfinite(b) and b >= OUTSIDE_STRIPES_NOTABLE]
     if not notable:
         return {}
     shares = " and ".join(f"{_share_text(b)} for {risk.target_text(t)}" for t, b in notable)
@@ -537,11 +505,7 @@ def _rules_blocks(name: str, risk: StoreRisk) -> list[Block]:
     if dtm:
         text += f" {dtm}"
     text += " " + risk.design_rules_text()
-    statuses = [rules["status"].values.ravel()]
-    if risk.design_rules is not None:  # where a rule applies (a gap at every contact)
-        applies = risk.design_rules["gap"].notnull().all("contact")
-        statuses.append(risk.design_rules["status"].values[applies.broadcast_like(risk.design_rules["status"]).values])
-    degenerate = degenerate_text(np.concatenate(statuses), risk.hazard, "rule rows")
+    degenerate = risk.rules_degenerate_text()
     if degenerate:
         text += " Rule rows whose fit is not a lognormal (their 'fit' column): " + degenerate.removeprefix("Degenerate fits, not lognormals: ")
     table = Table(f"risk-rules-{name}", f"Experiment {name}: the code separation rules in risk terms: the gap at each contact, the "

@@ -1,4 +1,4 @@
-"""Every read of an experiment store by the risk chain, in one module.
+"""The risk chain's inputs: every read of an experiment store by the chain, in one module.
 
 The chain needs, from a store: its definition's ``[intensity]`` and
 ``[hazard]`` entries, its studied building and the moat walls at that
@@ -9,11 +9,15 @@ summaries the limit states beyond first contact read, with
 the motions (records, and the realizations of a synthetic ensemble) on one
 ``record`` dimension. Nothing else in :mod:`stochpound.risk` opens, selects
 or parses a store, so a new way to read stores is a change of this module
-alone.
+alone. :func:`read_risk_inputs` reads what :func:`~stochpound.risk.store_risk`
+needs once, into one frozen :class:`RiskInputs` that the chain's steps take
+instead of the store.
 """
 
 from __future__ import annotations
 
+import dataclasses
+import itertools
 import math
 from collections.abc import Mapping
 from typing import Any
@@ -25,6 +29,7 @@ from stochpound.codes import store_contact_demands
 from stochpound.hazard import HazardCurve, check_covers, hazard_curve, hazard_option, parse_measure, parse_units, stored_hazard
 from stochpound.model import Scene
 from stochpound.motions import TRUNCATION_EPSILON
+from stochpound.risk._code_rules import MINIMUM_MOTIONS
 from stochpound.store import (LIMIT_STATE_DEMANDS, Design, Intensity, cases_done, check_finished as _check_finished, contact_free, gap_dims,
                               has_contact_free, has_wall_free, scenario_kind, scenario_ranges, wall_free, with_contacts)
 
@@ -43,12 +48,131 @@ NOT_INTENSITY = "store: has no intensity stripes or IDA capacities (run an exper
 """The error of a store without intensity-conditioned runs."""
 
 
+CASE_DIMS = ("intensity", "record", "contact")
+"""The dimensions of the contact-free demands that are not a configuration's (the stripes, the motions, the contacts)."""
+
+
 class RiskInputError(ValueError):
     """A store cannot go through the risk chain (the message says why, in one line)."""
 
 
+@dataclasses.dataclass(frozen=True)
+class RiskInputs:
+    """What the risk chain of :func:`~stochpound.risk.store_risk` reads of one store, read once (:func:`read_risk_inputs`).
+
+    The chain's steps take it instead of the store: none of them goes back
+    to the store.
+
+    Attributes
+    ----------
+    setting : Intensity or None
+        The store's ``[intensity]`` setting (its measure, units and levels).
+    hazard : HazardCurve
+        The site's hazard, in the store's intensity measure and units.
+    studied : str or None
+        The studied building (its peak base displacement is ASCE 7's D_TM).
+    method : str
+        ``"stripes"`` or ``"ida"``.
+    closure : xarray.DataArray
+        The largest contact-free peak closure over the contacts (m), one motion dimension ``record`` (:func:`contact_free_closure`).
+    motion_intensity : xarray.DataArray or None
+        IDA runs: each motion's intensity at scale 1 (IM units); None for stripes.
+    motions : int
+        The motions of every stripe: the fewest that ran in a stripe and configuration.
+    stripes : int or None
+        The intensity stripes that ran (None for IDA runs).
+    progress : str
+        ``288/704 cases done`` for a store with missing cases, "" for a finished one.
+    experiment : str or None
+        The store's experiment name.
+    assumptions : dict of str to str
+        What an answer rests on besides the hazard, in words (``assumptions``).
+    design : mapping or None
+        The buildings' code design (the ``[design]`` entry, given or the store's).
+    demands : xarray.Dataset or None
+        The inputs of the code separation rules of every contact-free case
+        (``contact_free_demands``); read for stripes with a design or at
+        least ``MINIMUM_MOTIONS`` (7) motions, else None.
+    isolator : xarray.DataArray or None
+        The studied building's wall-free peak base displacement (m) for the
+        suite-mean D_TM (``free_base_displacement``); read with the suite-mean rules.
+    dtm_note : str
+        Why ``isolator`` is None though the rules were read ("" otherwise).
+    scenes : dict
+        The scene of each configuration of ``demands`` (keyed by its labels
+        on the dimensions of ``demands["peak_closure"]`` other than
+        ``CASE_DIMS``, in their order), for the design analysis; empty without a design.
+    selection_misses : tuple of float
+        The levels whose stripe's selection for the site misses its target (:func:`selection_misses`).
+    beyond_truncation : tuple of float
+        The levels whose stripe's scenario puts them beyond the ground motion's truncation (:func:`stripes_beyond_truncation`).
+    """
+
+    setting: Intensity | None
+    hazard: HazardCurve
+    studied: str | None
+    method: str
+    closure: xr.DataArray
+    motion_intensity: xr.DataArray | None
+    motions: int
+    stripes: int | None
+    progress: str
+    experiment: str | None
+    assumptions: dict[str, str]
+    design: Mapping[str, Any] | None
+    demands: xr.Dataset | None
+    isolator: xr.DataArray | None
+    dtm_note: str
+    scenes: dict[tuple[Any, ...], Scene]
+    selection_misses: tuple[float, ...]
+    beyond_truncation: tuple[float, ...]
+
+
+def read_risk_inputs(store: xr.Dataset, hazard: HazardCurve | None = None, *, studied: str | None = None,
+                     design: Mapping[str, Any] | None = None, partial: bool = False) -> RiskInputs:
+    """Read once what the risk chain needs of a store: its :class:`RiskInputs`.
+
+    Parameters
+    ----------
+    store : xarray.Dataset
+        An experiment store with intensity stripes (contact-free cases at ``gap = inf``) or IDA capacities.
+    hazard : HazardCurve, optional
+        The site's hazard; default the one the store carries (:func:`site_hazard`).
+    studied : str, optional
+        The building of D_TM; default the store's ``studied`` building.
+    design : mapping, optional
+        The ``[design]`` entry whose design analysis gives the codes' own gaps; default the store's.
+    partial : bool
+        Read the cases that ran of a store with missing cases; without it such a store is refused.
+
+    Raises
+    ------
+    ValueError
+        (``RiskInputError``) A store without stripes or IDA capacities, or
+        without contact-free runs, or without a hazard when none is given;
+        (``UnfinishedStoreError``) a store with missing cases without ``partial``.
+    """
+    check_finished(store, partial)
+    hazard = site_hazard(store) if hazard is None else hazard
+    studied = studied_building(store) if studied is None else studied
+    closure = contact_free_closure(store)
+    ida = is_ida(store)
+    motions = stripe_motions(store, closure)
+    design = design_entry(store) if design is None else design
+    rules = not ida and motions >= MINIMUM_MOTIONS
+    demands = contact_free_demands(store) if not ida and (rules or design is not None) else None
+    isolator, dtm_note = free_base_displacement(store, studied) if rules else (None, "")
+    read = {"setting": intensity_setting(store), "motion_intensity": motion_intensity(store) if ida else None,
+            "stripes": stripes_run(store, closure), "progress": progress(store), "experiment": experiment_name(store),
+            "assumptions": assumptions(store), "selection_misses": tuple(selection_misses(store)),
+            "beyond_truncation": tuple(stripes_beyond_truncation(store))}
+    scenes = configuration_scenes(store, demands["peak_closure"]) if demands is not None and design is not None else {}
+    return RiskInputs(hazard=hazard, studied=studied, method="ida" if ida else "stripes", closure=closure, motions=motions, design=design,
+                      demands=demands, isolator=isolator, dtm_note=dtm_note, scenes=scenes, **read)
+
+
 def intensity_setting(store: xr.Dataset) -> Intensity | None:
-    """The definition's intensity setting of a store (None if it has none), through its ``pound`` accessor."""
+    """The definition's ``intensity`` entry of a store (None if it has none), through its ``pound`` accessor."""
     return store.pound.intensity
 
 
@@ -133,7 +257,7 @@ def studied_building(store: xr.Dataset) -> str | None:
     return store.pound.definition.studied
 
 
-def design(store: xr.Dataset) -> Design | None:
+def design_entry(store: xr.Dataset) -> Design | None:
     """The store's ``[design]`` entry, the buildings' code design (None without one)."""
     return store.pound.definition.design
 
@@ -152,6 +276,14 @@ def configuration_scene(store: xr.Dataset, labels: Mapping[str, Any]) -> Scene:
         raise RiskInputError(f"store: no contact-free case of the configuration {dict(labels)} ran")
     fixed.update({dim: store[dim].values[index] for dim, index in zip(motion_dims, ran[0])})
     return store.pound.scene(**fixed, **labels)
+
+
+def configuration_scenes(store: xr.Dataset, closure: xr.DataArray) -> dict[tuple[Any, ...], Scene]:
+    """The scene of every configuration of ``closure`` (over a store's grid; :func:`configuration_scene`), keyed by its labels on
+    the dimensions of ``closure`` other than :data:`CASE_DIMS`, in their order."""
+    configs = [dim for dim in closure.dims if dim not in CASE_DIMS]
+    return {labels: configuration_scene(store, dict(zip(configs, labels)))
+            for labels in itertools.product(*(closure[dim].values for dim in configs))}
 
 
 def experiment_name(store: xr.Dataset) -> str | None:
@@ -444,6 +576,27 @@ def case_demand(store: xr.Dataset, variable: str, building: str | None, needs: s
             raise RiskInputError(f"limit_states: building {building!r} is not one of the store's ({', '.join(names)})")
         data = data.max("building") if building is None else data.sel(building=building, drop=True)
     return store_motions(data).load().assign_attrs(units=store[variable].attrs.get("units", ""))
+
+
+def limit_state_inputs(store: xr.Dataset, demands: list[tuple[str, str | None, str, bool]],
+                       hazard: HazardCurve | None = None) -> tuple[HazardCurve, list[xr.DataArray], str]:
+    """What :func:`~stochpound.risk.limit_state_risk` reads of a stripes store, read once: the site's hazard (``hazard``, or the
+    store's), each limit state's demand (``demands``: its variable, building, what the store needs to keep it, and whether it is
+    given in g: :func:`case_demand`, divided by the scene's g) and the intensity measure in words.
+
+    Raises
+    ------
+    ValueError
+        (``RiskInputError``) A store without stripes or hazard, or without a demand's variable or building.
+    """
+    if stripes(store) is None:
+        raise RiskInputError("store: limit states need intensity stripes (run method = \"stripes\")")
+    hazard = site_hazard(store) if hazard is None else hazard
+    read = []
+    for variable, building, needs, in_g in demands:
+        demand = case_demand(store, variable, building, needs)
+        read.append(demand / scene_g(store) if in_g else demand)
+    return hazard, read, measure_text(intensity_setting(store))
 
 
 def limit_state_variable(kind: str) -> str:

@@ -17,8 +17,9 @@ into one ``record`` dimension when there is more than one realization).
 returns a :class:`StoreRisk`, which owns the chain's tables
 (:meth:`StoreRisk.to_frame`, :meth:`StoreRisk.separation_frame`,
 :meth:`StoreRisk.rules_frame`): the report renders them and
-``stochpound risk`` prints them. Every read of the store is in
-``stochpound.risk._store``.
+``stochpound risk`` prints them. The store is read once, in
+``stochpound.risk._inputs`` (:func:`~stochpound.risk.read_risk_inputs`),
+and the chain runs on those inputs (:class:`~stochpound.risk.RiskInputs`).
 """
 
 from __future__ import annotations
@@ -36,7 +37,8 @@ import xarray as xr
 from stochpound._memory import check_memory
 from stochpound.hazard import HazardCurve, rate_from_probability
 from stochpound.store import Intensity
-from stochpound.risk import _store
+from stochpound.risk import _inputs
+from stochpound.risk._inputs import RiskInputError, RiskInputs, read_risk_inputs
 from stochpound.risk._code_rules import MINIMUM_MOTIONS, code_rules_risk
 from stochpound.risk._design_rules import design_rules_risk
 from stochpound.risk._fragility_ensemble import BOOTSTRAP, fragility_band, fragility_surface, homogeneous_capacities, ida_fragility, limit_state_events, stripe_fragility
@@ -84,12 +86,12 @@ def risk_gaps(closure: xr.DataArray, count: int = RISK_GAPS) -> np.ndarray:
     values = np.asarray(closure.values, dtype=float)
     positive = values[np.isfinite(values) & (values > 0.0)]
     if positive.size == 0:
-        raise _store.RiskInputError("store: no contact-free run closes any contact (every peak closure <= 0): no gap can pound")
+        raise RiskInputError("store: no contact-free run closes any contact (every peak closure <= 0): no gap can pound")
     return np.geomspace(0.5 * positive.min(), 1.5 * positive.max(), count)
 
 
-def pounding_fragility(store: xr.Dataset, gaps: Sequence[float] | np.ndarray, intensity_dim: str = "intensity", record_dim: str = "record",
-                       confidence: float = CONFIDENCE, bootstrap: int = BOOTSTRAP, seed: int = 0) -> xr.Dataset:
+def pounding_fragility(store: xr.Dataset | RiskInputs, gaps: Sequence[float] | np.ndarray, intensity_dim: str = "intensity",
+                       record_dim: str = "record", confidence: float = CONFIDENCE, bootstrap: int = BOOTSTRAP, seed: int = 0) -> xr.Dataset:
     """The pounding fragility at every gap of ``gaps`` (m) and every configuration of a store, from stripes or IDA runs.
 
     Stripes: the contact-free closures' events at every gap
@@ -98,14 +100,20 @@ def pounding_fragility(store: xr.Dataset, gaps: Sequence[float] | np.ndarray, in
     capacity IM·g/D at every gap (:func:`~stochpound.risk.homogeneous_capacities`),
     fitted by :func:`~stochpound.risk.ida_fragility`.
 
+    Parameters
+    ----------
+    store : xarray.Dataset or RiskInputs
+        The store, or its inputs already read (:func:`~stochpound.risk.read_risk_inputs`).
+
     Returns
     -------
     xarray.Dataset
         The fit over ``gap`` (the given gaps) and the store's other grid dimensions.
     """
-    closure = _store.contact_free_closure(store)
-    if _store.is_ida(store):
-        capacities = homogeneous_capacities(closure, _store.motion_intensity(store), gaps)
+    closure, intensity = ((store.closure, store.motion_intensity) if isinstance(store, RiskInputs)
+                          else (_inputs.contact_free_closure(store), _inputs.motion_intensity(store) if _inputs.is_ida(store) else None))
+    if intensity is not None:
+        capacities = homogeneous_capacities(closure, intensity, gaps)
         return ida_fragility(capacities, record_dim, confidence=confidence, bootstrap=bootstrap, seed=seed)
     events = limit_state_events(closure, gaps, "gap")
     return stripe_fragility(events, intensity_dim, record_dim, confidence, bootstrap, seed)
@@ -196,7 +204,7 @@ class StoreRisk:
     @property
     def measure(self) -> str:
         """The intensity measure in words, e.g. ``PSA(2 s, 5 %)`` ("" without a setting)."""
-        return _store.measure_text(self.setting) if self.setting else ""
+        return _inputs.measure_text(self.setting) if self.setting else ""
 
     def to_frame(self) -> pd.DataFrame:
         """The g* numbers: one row per configuration and target.
@@ -208,7 +216,7 @@ class StoreRisk:
             ``years``), ``separation``, ``lower``, ``upper`` (m; ``inf``: wider
             than every gap of the grid), ``lower_bound`` (True where
             ``separation`` is only a lower bound of g*, the target beyond
-            the stripes' runs: ``stochpound.risk._store_risk.bound_beyond_stripes``; its interval is
+            the stripes' runs: ``stochpound.risk._chain.bound_beyond_stripes``; its interval is
             then NaN), ``confidence``, ``motions``.
         """
         separation = self.separation
@@ -227,7 +235,7 @@ class StoreRisk:
 
     def separation_frame(self) -> pd.DataFrame:
         """The g* table: per configuration, g* and its interval (m) for each target (columns grouped by target); a g* that
-        is only a lower bound (``stochpound.risk._store_risk.bound_beyond_stripes``) is the text ``≥ 0.640``, its interval empty."""
+        is only a lower bound (``stochpound.risk._chain.bound_beyond_stripes``) is the text ``≥ 0.640``, its interval empty."""
         frame = self.to_frame()
         years = float(self.separation.attrs.get("years", self.years))
         config = self.configuration_dims()
@@ -352,7 +360,7 @@ class StoreRisk:
         pandas.DataFrame
             Columns: the configuration's dimensions, ``target``, ``design``
             (m; NaN, withheld, where g* is only a lower bound: the target lies
-            beyond the stripes' runs, ``stochpound.risk._store_risk.bound_beyond_stripes``), ``basis``
+            beyond the stripes' runs, ``stochpound.risk._chain.bound_beyond_stripes``), ``basis``
             (what ``design`` is, in words).
         """
         frame = self.to_frame()
@@ -404,6 +412,47 @@ class StoreRisk:
         if self.method != "stripes" or "intensity" not in self.fragility.coords or "separation" not in self.separation:
             return None
         return maf_outside_stripes(self.fragility, self.separation["separation"], self.hazard)
+
+    def worst_outside_stripes(self) -> list[tuple[float, float, float]]:
+        """Per target: (target, below, above), the worst configuration's shares of λ_P at g* from below the lowest stripe and
+        beyond the top one (``outside_stripes``; [] for IDA runs or without a finite g*)."""
+        shares = self.outside_stripes
+        if shares is None or not np.isfinite(shares["below"].values).any():
+            return []
+        return [(float(t), float(shares["below"].sel(target=t).max()), float(shares["above"].sel(target=t).max())) for t in shares["target"].values]
+
+    def lowest_stripe(self) -> tuple[float, float]:
+        """The lowest stripe's level (IM units) and the hazard's return period there (yr)."""
+        lowest = float(np.min(self.fragility["intensity"].values))
+        return lowest, float(1.0 / self.hazard(lowest))
+
+    def rules_meeting(self) -> tuple[str, pd.Series]:
+        """Which code rules meet their own design level as a target in every configuration and level: the column of
+        :meth:`rules_frame` read (``meets, upper bound`` with a bootstrap, else ``meets its level``) and, per rule, whether it does."""
+        rules = self.rules_frame()
+        column = "meets, upper bound" if "meets, upper bound" in rules else "meets its level"
+        return column, rules[column].groupby(level="rule", sort=False).all()
+
+    def largest_dtm(self) -> dict[float, tuple[float, bool]]:
+        """Per design level of the suite-mean D_TM rule: its largest gap over the configurations (m) and whether the configurations'
+        finite gaps differ; {} without the rule."""
+        if self.rules is None or "dtm" not in self.rules["rule"].values:
+            return {}
+        dtm = self.rules["gap"].sel(rule="dtm")
+        largest = {}
+        for level in dtm["design_level"].values:
+            values = dtm.sel(design_level=level).values
+            largest[float(level)] = (float(dtm.sel(design_level=level).max(skipna=True)), np.unique(values[np.isfinite(values)]).size > 1)
+        return largest
+
+    def rules_degenerate_text(self) -> str:
+        """The degenerate fits among the rules' rows, suite-mean and design-analysis (where a rule applies: a gap at every
+        contact), and what each does to λ_P (:func:`~stochpound.risk.degenerate_text`; "" when there are none)."""
+        statuses = [self.rules["status"].values.ravel()] if self.rules is not None else []
+        if self.design_rules is not None:
+            applies = self.design_rules["gap"].notnull().all("contact")
+            statuses.append(self.design_rules["status"].values[applies.broadcast_like(self.design_rules["status"]).values])
+        return degenerate_text(np.concatenate(statuses), self.hazard, "rule rows") if statuses else ""
 
     def non_increasing_maf(self) -> xr.DataArray:
         """λ_P(g) made non-increasing along the gaps (isotonic regression in ln λ, pool-adjacent-violators: the curve g* is read from; 1/yr)."""
@@ -540,16 +589,17 @@ def bound_beyond_stripes(separation: xr.Dataset, fragility: xr.Dataset, hz: Haza
                          ).assign_attrs(top_stripe=top)
 
 
-def store_risk(store: xr.Dataset, hz: HazardCurve | None = None, targets: Sequence[float] = TARGETS, years: float = YEARS,
+def store_risk(store: xr.Dataset | RiskInputs, hz: HazardCurve | None = None, targets: Sequence[float] = TARGETS, years: float = YEARS,
                gaps: Sequence[float] | np.ndarray | None = None, studied: str | None = None, confidence: float = CONFIDENCE,
                bootstrap: int = BOOTSTRAP, seed: int = 0, design: Mapping[str, Any] | None = None, partial: bool = False) -> StoreRisk:
     """Fragility at every gap, the pounding risk curve, g* and the code rules of a store's intensity-conditioned runs.
 
     Parameters
     ----------
-    store : xarray.Dataset
+    store : xarray.Dataset or RiskInputs
         An experiment store with intensity stripes (contact-free cases at
-        ``gap = inf``) or IDA capacities.
+        ``gap = inf``) or IDA capacities, read here once
+        (:func:`~stochpound.risk.read_risk_inputs`), or its inputs already read.
     hz : HazardCurve, optional
         The site's hazard, in the store's intensity measure and units;
         default: the hazard the store carries (its experiment's ``[hazard]``).
@@ -575,7 +625,8 @@ def store_risk(store: xr.Dataset, hz: HazardCurve | None = None, targets: Sequen
     partial : bool
         Answer from the cases that ran of a store with missing cases (its
         counts of motions and stripes are those that ran); without it such a
-        store is refused.
+        store is refused. With inputs already read, ``studied``, ``design``
+        and ``partial`` are theirs (giving them again is refused).
 
     Raises
     ------
@@ -583,47 +634,44 @@ def store_risk(store: xr.Dataset, hz: HazardCurve | None = None, targets: Sequen
         (``RiskInputError``) A store without stripes or IDA capacities, or
         without contact-free runs, or without a hazard when none is given;
         (``UnfinishedStoreError``) a store with missing cases without ``partial``;
-        (``MemoryLimitError``) a ``bootstrap`` beyond the memory limit (``stochpound.risk._store_risk.check_bootstrap``).
+        (``MemoryLimitError``) a ``bootstrap`` beyond the memory limit (``stochpound.risk._chain.check_bootstrap``).
     """
-    _store.check_finished(store, partial)
-    hz = _store.site_hazard(store) if hz is None else hz
-    studied = _store.studied_building(store) if studied is None else studied
-    closure = _store.contact_free_closure(store)
+    if isinstance(store, RiskInputs) and (studied is not None or design is not None or partial):
+        raise RiskInputError("store_risk: studied, design and partial are read with the inputs (read_risk_inputs): give them there")
+    inputs = store if isinstance(store, RiskInputs) else read_risk_inputs(store, hz, studied=studied, design=design, partial=partial)
+    hz = inputs.hazard if hz is None else hz
+    closure = inputs.closure
     if gaps is not None:
         grid = np.asarray(gaps, dtype=float)
-    elif _store.is_ida(store):  # the unscaled closures, and each scaled to the hazard's intensities (IDA runs hold scale 1 only)
-        grid = risk_gaps(xr.concat([closure, closure * (_reach_intensity(hz, targets, years) / _store.motion_intensity(store))], "record"))
+    elif inputs.motion_intensity is not None:  # the unscaled closures, and each scaled to the hazard's intensities (IDA runs hold scale 1 only)
+        grid = risk_gaps(xr.concat([closure, closure * (_reach_intensity(hz, targets, years) / inputs.motion_intensity)], "record"))
     else:
         grid = risk_gaps(closure)
     configurations = math.prod(size for dim, size in closure.sizes.items() if dim not in ("record", "intensity"))
     check_bootstrap(bootstrap, grid.size * configurations, closure.sizes.get("intensity", 1), closure.sizes["record"])
-    fragility = pounding_fragility(store, grid, confidence=confidence, bootstrap=bootstrap, seed=seed)
+    fragility = pounding_fragility(inputs, grid, confidence=confidence, bootstrap=bootstrap, seed=seed)
     curve = risk_curve(fragility, hz, years, confidence)
     separation = risk_targeted_separation(curve, targets, years, confidence=confidence)
-    if not _store.is_ida(store):
+    if inputs.method == "stripes":
         separation = bound_beyond_stripes(separation, fragility, hz, years)
-    motions = _store.stripe_motions(store, closure)
-    method = "ida" if _store.is_ida(store) else "stripes"
-    rules, note, dtm_note = None, "", ""
-    if method == "ida":
+    rules, note = None, ""
+    if inputs.method == "ida":
         note = "IDA runs hold no stripe at the code intensity to apply the rules to"
-    elif motions < MINIMUM_MOTIONS:
-        note = f"the codes take the mean over at least {MINIMUM_MOTIONS} motions; the store has {motions}"
+    elif inputs.motions < MINIMUM_MOTIONS:
+        note = f"the codes take the mean over at least {MINIMUM_MOTIONS} motions; the store has {inputs.motions}"
     else:
-        isolator, dtm_note = _store.free_base_displacement(store, studied)
-        rules = code_rules_risk(_store.contact_free_demands(store), hz, years=years, isolator_displacement=isolator,
+        rules = code_rules_risk(inputs.demands, hz, years=years, isolator_displacement=inputs.isolator,
                                 confidence=confidence, bootstrap=bootstrap, seed=seed)
-    design = _store.design(store) if design is None else design
     design_rules, design_note = None, ""
-    if design is None:
+    if inputs.design is None:
         design_note = "the store's experiment has no [design] table (the buildings' code design)"
-    elif method == "ida":
+    elif inputs.method == "ida":
         design_note = "IDA runs: the codes' gaps are fitted over stripes"
     else:
-        design_rules = design_rules_risk(store, hz, design, studied, years, confidence, bootstrap, seed)
-    return StoreRisk(fragility, curve, separation, rules, note, hz, motions, method, setting=_store.intensity_setting(store),
-                     stripes=_store.stripes_run(store, closure), progress=_store.progress(store), experiment=_store.experiment_name(store), years=years, confidence=confidence,
-                     assumptions=_store.assumptions(store), dtm_note=dtm_note, design_rules=design_rules, design_note=design_note)
+        design_rules = design_rules_risk(inputs, hz, inputs.design, inputs.studied, years, confidence, bootstrap, seed)
+    return StoreRisk(fragility, curve, separation, rules, note, hz, inputs.motions, inputs.method, setting=inputs.setting,
+                     stripes=inputs.stripes, progress=inputs.progress, experiment=inputs.experiment, years=years, confidence=confidence,
+                     assumptions=inputs.assumptions, dtm_note=inputs.dtm_note, design_rules=design_rules, design_note=design_note)
 
 
 def target_text(probability: float, years: float = YEARS) -> str:
