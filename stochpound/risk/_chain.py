@@ -36,9 +36,8 @@ import xarray as xr
 
 from stochpound._memory import check_memory
 from stochpound.hazard import HazardCurve, rate_from_probability
-from stochpound.store import Intensity
 from stochpound.risk import _inputs
-from stochpound.risk._inputs import RiskInputError, RiskInputs, read_risk_inputs
+from stochpound.risk._inputs import Intensity, RiskInputError, RiskInputs, read_risk_inputs
 from stochpound.risk._code_rules import MINIMUM_MOTIONS, code_rules_risk
 from stochpound.risk._design_rules import design_rules_risk
 from stochpound.risk._fragility_ensemble import BOOTSTRAP, fragility_band, fragility_surface, homogeneous_capacities, ida_fragility, limit_state_events, stripe_fragility

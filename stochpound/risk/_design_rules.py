@@ -37,11 +37,10 @@ import numpy as np
 import xarray as xr
 
 from stochpound.hazard import HazardCurve
-from stochpound.store import Design
 from stochpound.model.building import Building
 from stochpound.model.scene import Scene
 from stochpound.risk import _inputs
-from stochpound.risk._inputs import CASE_DIMS, RiskInputError, RiskInputs
+from stochpound.risk._inputs import CASE_DIMS, Design, RiskInputError, RiskInputs
 from stochpound.codes import EC8_REDUCTION
 from stochpound.risk._code_gaps import (Asce7Design, Ec8Design, asce7_inelastic_displacement, asce7_isolator_displacement,
                                         ec8_design_displacement, modal_floor_displacements, srss_separation)

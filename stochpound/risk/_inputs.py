@@ -30,7 +30,7 @@ from stochpound.hazard import HazardCurve, check_covers, hazard_curve, hazard_op
 from stochpound.model import Scene
 from stochpound.motions import TRUNCATION_EPSILON
 from stochpound.risk._code_rules import MINIMUM_MOTIONS
-from stochpound.store import (LIMIT_STATE_DEMANDS, Design, Intensity, cases_done, check_finished as _check_finished, contact_free, gap_dims,
+from stochpound.store import (LIMIT_STATE_DEMANDS, Design, Intensity, LimitStates, cases_done, check_finished as _check_finished, contact_free, gap_dims,
                               has_contact_free, has_wall_free, scenario_kind, scenario_ranges, wall_free, with_contacts)
 
 CLOSURE = "peak_contact_closure"
@@ -604,7 +604,7 @@ def limit_state_variable(kind: str) -> str:
     return LIMIT_STATE_DEMANDS[kind]
 
 
-def limit_states_table(store: xr.Dataset) -> Mapping[str, Any] | None:
+def limit_states_table(store: xr.Dataset) -> LimitStates | None:
     """The experiment's ``[limit_states]`` entry (``source``, ``capacities``), or None without one."""
     return store.pound.definition.limit_states
 

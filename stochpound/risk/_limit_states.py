@@ -30,9 +30,9 @@ import xarray as xr
 
 from stochpound.hazard import HazardCurve, probability_from_rate
 from stochpound.risk import _inputs
+from stochpound.risk._inputs import LimitStates
 from stochpound.risk._fragility_ensemble import limit_state_events, stripe_fragility
 from stochpound.risk._maf import mean_annual_frequency
-from stochpound.store import LimitStates
 from stochpound.risk._chain import CONFIDENCE, YEARS
 
 
