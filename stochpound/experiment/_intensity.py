@@ -264,9 +264,9 @@ def task_settings(experiment: Any, motions: Mapping[str, Any]) -> dict[str, Any]
     """
     if experiment.intensity is None:
         return None
-    gap_axes = [(gap["name"], list(gap["contacts"])) for gap in experiment.definition["gaps"]]
+    gap_axes = [(gap.name, list(gap.contacts)) for gap in experiment.definition.gaps]
     expected = {index: motions[label].expected_intensity for index, label in enumerate(experiment.motions) if motions[label].expected_intensity is not None}
-    return {**experiment.intensity, "g": float(experiment.definition["scene"].get("g", 9.81)), "gap_axes": gap_axes, "expected": expected}
+    return {**experiment.intensity, "g": float(experiment.definition.scene.get("g", 9.81)), "gap_axes": gap_axes, "expected": expected}
 
 
 def ensemble_intensity(intensity: Mapping[str, Any], table: Mapping[str, Any], realizations: range, g: float) -> float:

@@ -61,18 +61,18 @@ import xarray as xr
 
 from stochpound.model import fields as toml_fields
 from stochpound.motions import CONDITIONING_MEASURES, MODEL_DAMPING, PERIOD_RANGE, check_scenario
-from stochpound.store import SCENARIO_KINDS
+from stochpound.store import CONDITIONAL_SPECTRUM, SCENARIO_KINDS, Definition, Intensity, MotionSource, VariantAxis
 
 
 class GridExperiment(Protocol):
     """What the selection reads of an experiment (an :class:`~stochpound.experiment.Experiment`, which asks for its stripes here)."""
 
-    intensity: dict[str, Any] | None
-    recorded_motions: dict[str, dict[str, Any]]
-    variants: list[dict[str, Any]]
+    intensity: Intensity | None
+    recorded_motions: dict[str, MotionSource]
+    variants: tuple[VariantAxis, ...]
     building_names: list[str]
     base_dir: Path
-    definition: dict[str, Any]
+    definition: Definition
 
     def points(self, kind: str) -> list[Any]: ...
 
@@ -80,9 +80,8 @@ class GridExperiment(Protocol):
 
     def motion_table(self, label: str, realization: int | None = None) -> dict[str, Any]: ...
 
-SELECTIONS = ("scale", "conditional_spectrum")
+SELECTIONS = ("scale", CONDITIONAL_SPECTRUM)
 """``[intensity] selection``: every motion scaled to every level, or motions chosen per stripe."""
-CONDITIONAL_SPECTRUM = SELECTIONS[1]
 DEFAULT_SEED = 1
 """Seed of the selection when ``[intensity] seed`` is not given."""
 SITE_FIELDS = ("vs30", "magnitude", "distance_km", "mechanism")
@@ -350,7 +349,7 @@ def periods_of_interest(experiment: GridExperiment) -> dict[str, float]:
     found: dict[str, set[float]] = {}
     labels: dict[tuple[str, float], str] = {}
     for point in experiment.points(CASE):
-        variants = ", ".join(f"{name}={value}" for name, value in point.labels if name in {v["name"] for v in experiment.variants})
+        variants = ", ".join(f"{name}={value}" for name, value in point.labels if name in {v.name for v in experiment.variants})
         for key, period in scene_periods(scene_from_dict(experiment.structure(point), base_dir=experiment.base_dir)).items():
             period = round(period, 12)
             found.setdefault(key, set()).add(period)
@@ -454,11 +453,11 @@ def stripe_selections(experiment: GridExperiment) -> StripeSelections:
     scene = experiment.structure(experiment.points(CASE)[0])
     records = []
     for label, source in experiment.recorded_motions.items():  # the motions as the cases run them (a duration or a start applied)
-        if source["kind"] != "record":
-            raise ExperimentError(f"{source['field']}: the conditional-spectrum pool takes records and suites, not synthetic ensembles")
-        with field_errors(scene_prefix=source["field"]):
+        if source.kind != "record":
+            raise ExperimentError(f"{source.field}: the conditional-spectrum pool takes records and suites, not synthetic ensembles")
+        with field_errors(scene_prefix=source.field):
             motion = scene_from_dict({**scene, "motion": experiment.motion_table(label)}, base_dir=experiment.base_dir).motion
-        name = str(source["motion"].get("record", ""))
+        name = str(source.motion.get("record", ""))
         metadata = load_suite_member(name).metadata if is_suite_member(name) else {}
         records.append(Record(label, motion.dt, motion.values, "m/s2", metadata=metadata))
     measure = intensity["measure"]
@@ -466,7 +465,7 @@ def stripe_selections(experiment: GridExperiment) -> StripeSelections:
     conditioning = [] if period is None else list(np.atleast_1d(period))
     structure = structure_periods(experiment)
     periods = selection_periods(structure, conditioning)
-    g = float(experiment.definition["scene"].get("g", 9.81))
+    g = float(experiment.definition.scene.get("g", 9.81))
     pool = selection_pool(records, periods, measure, period, MODEL_DAMPING, g)
     selections, targets, simulated = [], [], {}
     rules = {key: intensity[key] for key in RULES if key in intensity}

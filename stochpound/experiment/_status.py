@@ -11,11 +11,12 @@ import numpy as np
 
 from stochpound._errors import os_error_message
 from stochpound.store import open_store
-from stochpound.experiment._grid import KINDS, Case, Experiment
+from stochpound.experiment._experiment import Experiment
+from stochpound.store import KINDS, Case
 from stochpound.experiment._parts import DEFINITION_FILE, FolderLock, parts_folder
 from stochpound.experiment._session import StoreSession
 from stochpound.experiment._spec import ExperimentError
-from stochpound.experiment._store import PREFIX
+from stochpound.experiment._file_layout import PREFIX
 
 
 @dataclass
