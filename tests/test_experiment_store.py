@@ -245,7 +245,7 @@ def test_the_store_is_written_under_a_lock_of_this_process_while_a_dask_client_i
     def locks(lock):  # the locks inside xarray's CombinedLock
         return [inner for part in lock.locks for inner in locks(part)] if hasattr(lock, "locks") else [lock]
 
-    monkeypatch.setattr(store_writer, "H5NetCDFStore", RecordingStore)
+    monkeypatch.setattr(file_assembly, "H5NetCDFStore", RecordingStore)
     _, store = small_store
     session = StoreSession.open(store)
     rebuilt = tmp_path / "rebuilt.nc"

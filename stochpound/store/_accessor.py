@@ -104,12 +104,12 @@ class StoreAccessor:
         """The experiment's grid (:class:`~stochpound.store.ExperimentGrid`): dimensions, cases, their scenes; built once per definition.
 
         With stripes of chosen motions (a conditional-spectrum selection), the
-        choice is the one the store records (:class:`~stochpound.store._grid.StoredChoice`).
+        choice is the one the store records (``selection_scale_factor``, the simulated motions' tables on ``record``).
         """
         text = self._text
         intensity = _definition(text).intensity
-        recorded = intensity is not None and "selection_scale_factor" in self._dataset.variables
-        return _grid(text, StoredChoice.from_store(self._dataset, intensity.levels) if intensity is not None and recorded else None)
+        chose = intensity is not None and "selection_scale_factor" in self._dataset.variables
+        return _grid(text, StoredChoice.from_store(self._dataset, intensity.levels) if chose and intensity is not None else None)
 
     # ------------------------------------------------------------ gap axes and selections
 

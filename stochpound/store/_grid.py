@@ -14,8 +14,8 @@ it does not depend on the order of the grid or on how the run is split.
 The grid is read from the typed definition alone (:class:`ExperimentGrid`),
 with one exception: with ``[intensity] selection = "conditional_spectrum"``
 which motions each stripe runs is chosen when the experiment runs
-(``stochpound.experiment``, which builds the grid with its choice), and a
-store records it (``selection_scale_factor``, the simulated motions' tables
+(``stochpound.experiment.Experiment``, the grid that chooses them when first
+asked), and a store records it (``selection_scale_factor``, the simulated motions' tables
 on ``record``), from which :class:`StoredChoice` reads it back, so that a
 store's grid (``ds.pound.grid``) needs nothing above this layer.
 """
