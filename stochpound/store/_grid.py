@@ -212,7 +212,7 @@ class ExperimentGrid:
     ----------
     definition : mapping or Definition
         Canonical definition (``stochpound.experiment._spec.parse_experiment``), or
-        its typed form (:func:`~stochpound.store.read_definition`).
+        its typed form (:func:`~stochpound.experiment.read_definition`).
     text : str
         The experiment file's text (provenance).
     base_dir : str or Path
@@ -244,7 +244,7 @@ class ExperimentGrid:
 
     @property
     def contract(self) -> Definition:
-        """The typed definition (:attr:`definition`; the name older code reads)."""
+        """The typed definition (``definition``; the name older code reads)."""
         return self.definition
 
     # ------------------------------------------------------------ dimensions
