@@ -75,7 +75,7 @@ def report(measure: str, configuration: str, max_scale_factor: float, folder: Pa
               f"{float(selection['scale_factor'].max()):.2f}; worst mean {mean_off[m]:+.2f} at {periods[m]:.2g} s, worst std {std_off[s]:+.2f} at {periods[s]:.2g} s")
     records = []
     for label, source in experiment.motions.items():
-        record = load_suite_member(source["motion"]["record"])
+        record = load_suite_member(source.motion["record"])
         records.append(Record(label, record.dt, record.acceleration(9.81), "m/s2"))
     scale = xr.DataArray(chosen.coordinates()["selection_scale_factor"].values, dims=("intensity", "record"),
                          coords={"intensity": chosen.experiment_levels, "record": chosen.labels}).sortby("intensity")

@@ -45,7 +45,7 @@ numpydoc_xref_aliases = {
         "model": ["Scene", "Building", "InitialState", "Base", "Contact", "Wall", "ImpactElement"],
         "experiment": ["Experiment", "Dim", "Case", "RunReport", "StatusReport", "ExperimentError", "Definition", "GapAxis", "MuAxis",
                        "VariantAxis", "MotionSource", "Output", "Solver"],
-        "store": ["StoreAccessor", "Intensity", "Hazard", "Design", "DesignEc8", "LimitStates", "LimitStateCapacities", "Site", "StoreVariable"],
+        "store": ["StoreAccessor", "Intensity", "Hazard", "Design", "DesignEc8", "LimitStates", "LimitStateCapacities", "Site", "StoreVariable", "ExperimentGrid", "Point"],
         "motions": ["Envelope", "FilteredWhiteNoise", "SoilPreset", "Measure"],
         "motions.records": ["Record", "RegistryEntry", "RawSeries", "RecordStatistics"],
         "": ["SceneError", "RecordError", "SiteError", "StochpoundError"],

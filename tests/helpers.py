@@ -163,8 +163,8 @@ def cli_process(*args: str, env: dict | None = None) -> subprocess.Popen:
 def done_cases(store: Path) -> int:
     """Finished cases in a store's parts folder."""
     from stochpound.experiment._parts import parts_folder, read_experiment_json
-    from stochpound.experiment._grid import Experiment
-    from stochpound.experiment._store_writer import PartsIndex
+    from stochpound.experiment import Experiment
+    from stochpound.experiment._file_assembly import PartsIndex
 
     folder = parts_folder(store)
     if not (folder / "experiment.json").is_file():

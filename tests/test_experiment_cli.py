@@ -344,11 +344,11 @@ def _disk_full(*args, **kwargs):
 
 
 def test_a_full_disk_during_status_names_the_store_and_keeps_everything(stationary, tmp_path, monkeypatch):
-    from stochpound.experiment import _store_writer
+    from stochpound.experiment import _file_assembly
 
     experiment, store = _copy(stationary, tmp_path)
     before = store.read_bytes()
-    monkeypatch.setattr(_store_writer, "_create", _disk_full)
+    monkeypatch.setattr(_file_assembly, "_create", _disk_full)
     result = invoke("experiment", "status", str(store))
     assert result.exit_code == 0, result.output
     assert result.stderr.strip() == f"store not rebuilt (its finished cases are kept in its parts): {store}: cannot write here (No space left on device)"
@@ -430,10 +430,10 @@ def test_the_store_size_is_measured_within_a_few_per_cent(tmp_path, monkeypatch)
     from stochpound.experiment._estimate import estimate_run
     from stochpound.experiment._runner import load_experiment
     from stochpound.experiment._sources import resolve_motions
-    from stochpound.experiment._store import layout
+    from stochpound.experiment._file_layout import layout
     from stochpound import _atomic
-    from stochpound.experiment import _store_writer
-    from stochpound.experiment._store_writer import file_bytes
+    from stochpound.experiment import _file_assembly
+    from stochpound.experiment._file_assembly import file_bytes
 
     histories = TINY_EXPERIMENT + '\n[output]\ntime_histories = ["total_displacement"]\nbuildings = ["B1"]\nimpacts = true\n'
     for name, text in (("plain.toml", TINY_EXPERIMENT), ("histories.toml", histories)):
@@ -445,11 +445,11 @@ def test_the_store_size_is_measured_within_a_few_per_cent(tmp_path, monkeypatch)
         with open_store(store) as data:
             store_layout, attrs = layout(experiment, grids, data.sizes["impact"]), dict(data.attrs)
         measured = file_bytes(store_layout, attrs)
-        needed = int(_store_writer.ROOM_FACTOR * measured) + _store_writer.ROOM_MARGIN
-        for module in (_store_writer, _atomic):  # one byte too few: the quick bound must not skip the measure
+        needed = int(_file_assembly.ROOM_FACTOR * measured) + _file_assembly.ROOM_MARGIN
+        for module in (_file_assembly, _atomic):  # one byte too few: the quick bound must not skip the measure
             monkeypatch.setattr(module, "free_bytes", lambda path: needed - 1)
         with pytest.raises(OSError, match=f"about {needed / 1e6:.1f} MB needed"):
-            _store_writer._check_room(store, store_layout, attrs)
+            _file_assembly._check_room(store, store_layout, attrs)
         monkeypatch.undo()
         estimate = estimate_run(experiment, grids, experiment.n_cases)
         if name == "plain.toml":
@@ -508,10 +508,10 @@ def test_a_really_full_disk_crashes_nothing_and_loses_nothing(stationary, small_
 
 
 def test_a_full_disk_during_a_run_is_one_line_naming_the_store_and_loses_nothing(tmp_path, monkeypatch):
-    from stochpound.experiment import _store_writer
+    from stochpound.experiment import _file_assembly
 
     experiment = write_experiment(tmp_path, TINY_EXPERIMENT, "tiny.toml")
-    monkeypatch.setattr(_store_writer, "_create", _disk_full)
+    monkeypatch.setattr(_file_assembly, "_create", _disk_full)
     result = invoke("experiment", "run", str(experiment), "--workers", "0")
     assert result.exit_code == 1
     assert result.stderr.strip().splitlines()[-1] == f"Error: {tmp_path / 'tiny.nc'}: cannot write here (No space left on device)", result.stderr

@@ -10,7 +10,7 @@ import pytest
 
 import stochpound
 from stochpound.experiment import ExperimentError, load_experiment, open_store, run_experiment
-from stochpound.experiment._grid import CASE
+from stochpound.store import CASE
 from stochpound.model import laws
 from stochpound.studies.agarwal2004 import reference_building
 from tests.helpers import laws_pair_text, write_experiment
@@ -191,7 +191,7 @@ def test_every_grid_axis_keeps_each_laws_parameters(tmp_path, contact_name, base
     and inf removes the base. Checked on the scene every grid point runs.
     """
     experiment = _axes_experiment(tmp_path, CONTACT_TABLES[contact_name], BASES[base_name])
-    base_scene = stochpound.scene_from_dict({**experiment.definition["scene"], "motion": {"type": "constant", "acceleration": 0.0, "duration": 1.0, "dt": 1.0}})
+    base_scene = stochpound.scene_from_dict({**experiment.definition.scene, "motion": {"type": "constant", "acceleration": 0.0, "duration": 1.0, "dt": 1.0}})
     before_base = base_scene.buildings[0].base
 
     def contact_mass(scene):  # the contact joins the first floors of B1 and B2

@@ -44,6 +44,13 @@ def test_each_stripe_runs_its_chosen_motions_and_the_store_keeps_the_selection(t
     report = run_experiment(experiment, workers=0, progress=False)
     assert report.complete and experiment.n_cases == 2 * 4 * 2  # cases and their references: 4 motions per stripe
     store = open_store(report.store).load()
+    # a store's grid reads the choice from the store (nothing chosen again): the run's motions, cases and ids
+    grid = store.pound.grid
+    assert list(grid.motions) == list(experiment.motions) and grid.motions == experiment.motions
+    for kind in ("case", "reference"):
+        np.testing.assert_array_equal(grid.in_grid(kind), experiment.in_grid(kind))
+        np.testing.assert_array_equal(grid.grid_case_ids(kind), experiment.grid_case_ids(kind))
+    assert [c.case_id for c in grid.cases] == [c.case_id for c in experiment.cases]
     periods = selection_periods(experiment.selection.structure, [0.5])
     np.testing.assert_allclose(store.selection_period.values, periods)
     records = []
@@ -58,6 +65,8 @@ def test_each_stripe_runs_its_chosen_motions_and_the_store_keeps_the_selection(t
         stripe = store.isel(intensity=j, realization=0).sel(gap=np.inf)
         chosen = list(stripe.record.values[np.isfinite(stripe.selection_scale_factor.values)])
         assert sorted(chosen) == sorted(expected["motion"].values)
+        replayed = stripe.pound.scene(record=chosen[0]).motion  # one stripe of the store: its grid reads that stripe's choice
+        np.testing.assert_array_equal(replayed.values, store.pound.scene(gap=np.inf, intensity=level, record=chosen[0], realization=0).motion.values)
         assert list(stripe.record.values[stripe.case_status.values == 1]) == chosen  # the others are not in the grid (-1)
         assert set(stripe.case_status.values) == {1, -1}
         ran = stripe.scale_factor.sel(record=chosen).values

@@ -181,7 +181,7 @@ def test_both_netcdf_engines_read_the_same_store(small_store):
 
 def test_a_large_ensemble_is_chunked_along_realization(tmp_path):
     """Blocks (and the file's chunks) of consecutive realizations; open_store keeps them as dask chunks."""
-    from stochpound.experiment._store import SUMMARY_BLOCK, block_shape, blocks
+    from stochpound.experiment._file_layout import SUMMARY_BLOCK, block_shape, blocks
 
     assert block_shape((1, 1000000), SUMMARY_BLOCK) == (1, SUMMARY_BLOCK)
     assert block_shape((2, 3, 4, 1, 10), 50) == (1, 1, 4, 1, 10)
@@ -190,7 +190,7 @@ def test_a_large_ensemble_is_chunked_along_realization(tmp_path):
     text = SMALL_EXPERIMENT.replace("count = 2", "count = 300").replace("duration = 8.0\ndt = 0.02", "duration = 1.0\ndt = 0.02")
     text = text.replace("gap = [0.01, 0.02]", "gap = [0.01]\nneighbour = [\"stiff\"]").replace("values = [0.2, inf]", "values = [0.2]")
     path = write_experiment(tmp_path, text.replace('time_histories = ["total_displacement", "impact_force"]', ""))
-    import stochpound.experiment._store as layout
+    import stochpound.experiment._file_layout as layout
 
     original = layout.SUMMARY_BLOCK
     layout.SUMMARY_BLOCK = 128
@@ -230,7 +230,7 @@ def test_the_store_is_written_under_a_lock_of_this_process_while_a_dask_client_i
     from distributed import Lock as DistributedLock
     from xarray.backends import H5NetCDFStore
 
-    from stochpound.experiment import _store_writer as store_writer
+    from stochpound.experiment import _file_assembly as file_assembly
     from stochpound.experiment._session import StoreSession
 
     opened = []
@@ -245,13 +245,13 @@ def test_the_store_is_written_under_a_lock_of_this_process_while_a_dask_client_i
     def locks(lock):  # the locks inside xarray's CombinedLock
         return [inner for part in lock.locks for inner in locks(part)] if hasattr(lock, "locks") else [lock]
 
-    monkeypatch.setattr(store_writer, "H5NetCDFStore", RecordingStore)
+    monkeypatch.setattr(file_assembly, "H5NetCDFStore", RecordingStore)
     _, store = small_store
     session = StoreSession.open(store)
     rebuilt = tmp_path / "rebuilt.nc"
     with LocalCluster(processes=False, n_workers=1, threads_per_worker=1, dashboard_address=None) as cluster, Client(cluster):
         assert any(isinstance(lock, DistributedLock) for lock in locks(xr.backends.locks.get_write_lock("probe")))  # the default
-        store_writer.write_store(session.experiment, session.scan(), session.motion_grids, session.attrs(), rebuilt)
+        file_assembly.write_store(session.experiment, session.scan(), session.motion_grids, session.attrs(), rebuilt)
     assert opened and not any(isinstance(lock, DistributedLock) for store in opened for lock in locks(store.lock))
     with xr.open_dataset(store) as expected, xr.open_dataset(rebuilt) as actual:
         xr.testing.assert_identical(actual.drop_attrs(), expected.drop_attrs())

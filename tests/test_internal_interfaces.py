@@ -121,12 +121,12 @@ def test_no_import_crosses_into_another_package_s_private_module_but_the_listed_
 @pytest.mark.parametrize(
     ("importer", "source", "crossed"),
     [
-        ("stochpound.report.sections._generic", "from stochpound.experiment._grid import CASE", {"stochpound.experiment._grid"}),
+        ("stochpound.report.sections._generic", "from stochpound.experiment._file_layout import PREFIX", {"stochpound.experiment._file_layout"}),
         ("stochpound.report.sections._generic", "from stochpound.report.render import _figures as figures", {"stochpound.report.render._figures"}),
         ("stochpound.report.sections._generic", "def f():\n    import stochpound.analysis._summary\n", {"stochpound.analysis._summary"}),
         ("stochpound.cli._records", "if TYPE_CHECKING:\n    from stochpound.motions.records._record import Record\n", {"stochpound.motions.records._record"}),
         ("stochpound.motions.records._statistics", "from stochpound.motions._arias import arias_intensity", set()),
-        ("stochpound.experiment._grid", "from stochpound.experiment._spec import parse_experiment", set()),
+        ("stochpound.experiment._runner", "from stochpound.experiment._spec import parse_experiment", set()),
         ("stochpound.report.sections._generic", "from stochpound.report.render import figures", set()),
         ("stochpound.report.assemble", "from stochpound._errors import StochpoundError", set()),
         ("benchmarks.suite", "from stochpound._errors import StochpoundError", {"stochpound._errors"}),

@@ -23,7 +23,8 @@ from stochpound.store import (
     open_store,
     read_definition,
 )
-from stochpound.experiment._grid import Case, Dim, Experiment
+from stochpound.experiment._experiment import Experiment
+from stochpound.store import Case, Dim
 from stochpound.experiment._runner import RunReport, default_store, load_experiment, run_experiment
 from stochpound.experiment._status import StatusReport, store_status
 
@@ -31,13 +32,12 @@ from stochpound.experiment._status import StatusReport, store_status
 from stochpound.experiment._design_table import parse_design  # noqa: F401
 from stochpound.experiment._ensemble import simulate_ensemble  # noqa: F401
 from stochpound.experiment._estimate import LARGE_RUN_BYTES, LARGE_RUN_CASES  # noqa: F401
-from stochpound.experiment._grid import CASE  # noqa: F401
-from stochpound.store import describe_measure  # noqa: F401
+from stochpound.store import CASE, describe_measure  # noqa: F401
 from stochpound.experiment._measure_choice import hazard_measures, measure_choice  # noqa: F401
 from stochpound.experiment._parts import parts_folder, read_experiment_json  # noqa: F401
 from stochpound.experiment._site import periods_of_interest  # noqa: F401
 from stochpound.experiment._sources import resolve_motions  # noqa: F401
-from stochpound.experiment._store_writer import PartsIndex  # noqa: F401
+from stochpound.experiment._file_assembly import PartsIndex  # noqa: F401
 
 __all__ = [
     "FIXED_BASE",

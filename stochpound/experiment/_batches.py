@@ -21,7 +21,8 @@ import numpy as np
 
 from stochpound.experiment._compute import BatchTask, Group
 from stochpound.experiment._intensity import task_settings
-from stochpound.experiment._grid import CASE, KINDS, Experiment, Point
+from stochpound.experiment._experiment import Experiment
+from stochpound.store import CASE, KINDS, Point
 from stochpound.experiment._sources import ResolvedMotion
 from stochpound._memory import sample_bytes
 from stochpound.model.scene_file import scene_from_dict

@@ -24,11 +24,9 @@ import numpy as np
 
 from stochpound import motions as synthetic_motions
 from stochpound.experiment import _intensity as intensity
-from stochpound.experiment._grid import REFERENCE
+from stochpound.store import REFERENCE, Output, Solver, canonical_json, reference_scene, with_motion
 from stochpound.experiment._parts import concatenate, section_key, stack_cases
-from stochpound.experiment._scene_edits import reference_scene, with_motion
 from stochpound.experiment._spec import AUTO
-from stochpound.store import canonical_json
 from stochpound.experiment._summary import case_arrays, case_values, reference_arrays, reference_values
 from stochpound.solvers.twin import fixed_base_displacements
 from stochpound.model.scene import Scene
@@ -79,10 +77,10 @@ class BatchTask:
     groups : tuple of Group
     studied : str
         The studied building.
-    output : dict
-        ``time_histories``, ``buildings`` and ``impacts`` of the definition.
-    solver : dict
-        ``method``, ``integrator``, ``rtol``, ``atol``.
+    output : Output
+        What the store keeps (the definition's).
+    solver : Solver
+        The solver settings (the definition's).
     intensity : Scaling or None
         :func:`stochpound.experiment._intensity.task_settings` of an intensity-conditioned experiment.
     """
@@ -91,8 +89,8 @@ class BatchTask:
     motion_table: dict | None
     groups: tuple[Group, ...]
     studied: str
-    output: dict
-    solver: dict
+    output: Output
+    solver: Solver
     intensity: intensity.Scaling | None = None
 
     @property
@@ -192,21 +190,21 @@ def _case(
     ``extra``: the intensity variables of the case (none without ``[intensity]``); a run with a ``key`` is kept in ``runs`` and reused.
     """
     if scene is None:
-        return reference_arrays({**reference_values(twin), **extra}, twin, "total_displacement" in task.output["time_histories"])
+        return reference_arrays({**reference_values(twin), **extra}, twin, "total_displacement" in task.output.time_histories)
     solver = task.solver
-    method = None if solver["method"] == AUTO else solver["method"]
+    method = None if solver.method == AUTO else solver.method
     run = runs.get(key) if key is not None else None
     if run is None:
         run = simulate(
-            dataclasses.replace(scene, motion=ground), method, integrator=solver["integrator"], rtol=solver["rtol"], atol=solver["atol"],
-            demands=task.output.get("demands", False),
+            dataclasses.replace(scene, motion=ground), method, integrator=solver.integrator, rtol=solver.rtol, atol=solver.atol,
+            demands=task.output.demands,
         )
         if key is not None:
             runs[key] = run
     summary = {**case_values(run, task.studied, twin[-1]), **extra}
     if task.intensity is not None and task.intensity.ran == "ida":
         summary["ida_capacity"] = intensity.capacity_of(task.intensity, summary, labels)
-    return case_arrays(summary, run, task.output["time_histories"], task.output["buildings"], task.output["impacts"])
+    return case_arrays(summary, run, task.output.time_histories, task.output.buildings, task.output.impacts)
 
 
 _SCENES: dict[str, Scene] = {}

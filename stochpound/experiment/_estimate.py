@@ -11,10 +11,11 @@ import math
 from dataclasses import dataclass
 from typing import Mapping
 
-from stochpound.experiment._grid import KINDS, Experiment, Point
+from stochpound.experiment._experiment import Experiment
+from stochpound.store import KINDS, Point
 from stochpound.experiment._spec import AUTO
-from stochpound.experiment._store import layout
-from stochpound.experiment._store_writer import file_bytes
+from stochpound.experiment._file_layout import layout
+from stochpound.experiment._file_assembly import file_bytes
 from stochpound._memory import format_bytes
 from stochpound.model.scene_file import scene_from_dict
 from stochpound.solvers import first_call
@@ -46,7 +47,7 @@ class RunEstimate:
     cpu_seconds : float
         Their CPU time (one core), s.
     store_bytes : int
-        Size of the complete store file without its impact table (:func:`~stochpound.experiment._store_writer.file_bytes`:
+        Size of the complete store file without its impact table (:func:`~stochpound.experiment._file_assembly.file_bytes`:
         measured on its metadata written in memory, time histories uncompressed), bytes; the parts folder holds about as much again.
     history_bytes : int
         The time histories' part of ``store_bytes``, uncompressed (the file holds them compressed: usually less), bytes.
@@ -106,7 +107,7 @@ def estimate_run(experiment: Experiment, motion_grids: Mapping[str, tuple[float,
     """
     store = layout(experiment, motion_grids, 0)
     histories = sum(spec.dtype.itemsize * math.prod(store.sizes[d] for d in spec.dims) for spec in store.of("history"))
-    return RunEstimate(cases, cpu_seconds(experiment, motion_grids, cases), file_bytes(store, {"definition": canonical_json(experiment.definition)}), histories,
+    return RunEstimate(cases, cpu_seconds(experiment, motion_grids, cases), file_bytes(store, {"definition": canonical_json(experiment.definition.canonical)}), histories,
                        startup_steps(cases, workers))
 
 
@@ -141,7 +142,7 @@ def startup_step(workers: int) -> str:
 
 def _method(experiment: Experiment, point: Point) -> str:
     """The solver of a grid point's cases: the experiment's, or with ``auto`` the one :func:`stochpound.simulate` picks."""
-    method = experiment.solver["method"]
+    method = experiment.solver.method
     if method != AUTO:
         return method
     scene = scene_from_dict(experiment.structure(point), base_dir=experiment.base_dir)

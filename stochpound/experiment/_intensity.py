@@ -40,7 +40,7 @@ from stochpound.experiment._site import parse_selection
 from stochpound.motions import arias_intensity, peak_ground_motion, response_spectrum, significant_duration
 from stochpound._errors import IntensityError
 from stochpound.motions import Measure
-from stochpound.store import MEASURES, GapAxis, Intensity, MuAxis, VariantAxis, read_definition
+from stochpound.store import MEASURES, GapAxis, Intensity, MuAxis, VariantAxis
 
 METHODS = ("stripes", "ida")
 UNITS = {"pga": ("g", "m/s2"), "psa": ("g", "m/s2"), "sa_avg": ("g", "m/s2"), "pgv": ("m/s", "cm/s")}
@@ -304,10 +304,9 @@ def task_settings(experiment: Any, motions: Mapping[str, Any]) -> Scaling | None
     """
     if experiment.intensity is None:
         return None
-    definition = read_definition(experiment.definition)
-    gap_axes = tuple((gap.name, gap.contacts) for gap in definition.gaps)
+    gap_axes = tuple((gap.name, gap.contacts) for gap in experiment.definition.gaps)
     expected = {index: motions[label].expected_intensity for index, label in enumerate(experiment.motions) if motions[label].expected_intensity is not None}
-    return Scaling(as_intensity(experiment.intensity), definition.g, gap_axes, expected)
+    return Scaling(experiment.intensity, experiment.definition.g, gap_axes, expected)
 
 
 def ensemble_intensity(intensity: Intensity, table: Mapping[str, Any], realizations: range, g: float) -> float:

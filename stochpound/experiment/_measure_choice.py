@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from stochpound.experiment._grid import Experiment
+from stochpound.experiment._experiment import Experiment
 from stochpound.experiment._site import periods_of_interest
 from stochpound.motions import Measure
 

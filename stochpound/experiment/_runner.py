@@ -32,12 +32,12 @@ from stochpound._signals import handling
 from stochpound.experiment._batches import automatic_size, make_batches
 from stochpound.experiment._compute import BatchResult, BatchTask, run_batch, warm_up
 from stochpound.experiment._estimate import LARGE_RUN_BYTES, LARGE_RUN_CASES, RunEstimate, cpu_seconds, estimate_run, startup_step, startup_steps
-from stochpound.experiment._grid import Experiment
+from stochpound.experiment._experiment import Experiment
 from stochpound.experiment._parts import FolderLock, PartBuffer, append_run, parts_folder, remove_temporaries
 from stochpound.experiment._session import StoreSession, check_store, check_store_path, clear_store, code_identity, machine, missing_summaries, now, store_complete, stored_definition
 from stochpound.experiment._sources import ResolvedMotion, resolve_motions
 from stochpound.experiment._spec import ExperimentError, load_definition
-from stochpound.experiment._store_writer import PartsIndex
+from stochpound.experiment._file_assembly import PartsIndex
 from stochpound._memory import format_bytes
 from stochpound.solvers import first_call
 from stochpound.store import NOT_IN_IDENTITY, canonical_json
@@ -222,7 +222,7 @@ def run_experiment(
             if missing:
                 raise ExperimentError(f"{store}: written by an earlier stochpound without {', '.join(missing)}, which it keeps now: "
                                       "run the experiment again with --restart to recompute its cases")
-            stored, new = stored_definition(store), json.loads(canonical_json(experiment.definition))
+            stored, new = stored_definition(store), json.loads(canonical_json(experiment.definition.canonical))
             # the scene's provenance alone (the same content, from another file or inline) leaves the store as it is
             changed = [key for key in NOT_IN_IDENTITY if key != "scene_source" and stored.get(key) != new.get(key)]
             if changed:
@@ -316,7 +316,7 @@ def _record_hazard(store: Path, experiment: Experiment, grids: dict[str, tuple[f
         say(f"{store}: how the [site] scenario was obtained is recorded in the store (no run depends on it: the cases are kept)")
     if "hazard" not in changed:
         return
-    hazard = experiment.contract.hazard
+    hazard = experiment.definition.hazard
     what = "removed" if hazard is None else f"from {hazard.file or hazard.bundled or 'a power law'}" + (f" (sha256 {hazard.file_sha256[:12]}…)" if hazard.file_sha256 else "")
     say(f"{store}: the hazard changed ({what}); no run depends on it: the cases are kept and the new curve is recorded in the store")
 

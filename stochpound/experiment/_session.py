@@ -19,13 +19,14 @@ from typing import Any, Iterator
 import numpy as np
 
 from stochpound import __version__
-from stochpound.experiment._grid import KINDS, Experiment
+from stochpound.experiment._experiment import Experiment
+from stochpound.store import KINDS
 from stochpound._atomic import check_not_input, temporaries
 from stochpound.experiment._parts import DEFINITION_FILE, RUNS_FILE, part_paths, parts_folder, read_experiment_json, read_runs, write_experiment_json
 from stochpound.experiment._spec import ExperimentError
 from stochpound.store import canonical_json, definition_sha256
-from stochpound.experiment._store import PREFIX, layout
-from stochpound.experiment._store_writer import PartsIndex, write_store
+from stochpound.experiment._file_layout import PREFIX, layout
+from stochpound.experiment._file_assembly import PartsIndex, write_store
 
 
 def now() -> str:
@@ -157,12 +158,12 @@ def input_files(experiment: Experiment) -> list[tuple[Path, str]]:
     base = experiment.base_dir
     definition = experiment.definition
     found = [(Path(experiment.path), "the experiment file")] if experiment.path else []
-    source = definition.get("scene_source") or {}
+    source = definition.scene_source or {}
     if "file" in source:
         found.append((base / source["file"], "the experiment's scene file"))
-    if (definition.get("hazard") or {}).get("file"):
-        found.append((base / definition["hazard"]["file"], "the experiment's hazard file"))
-    found += [(base / table["record"], "a record file of the experiment") for table in _tables(definition)
+    if definition.hazard is not None and definition.hazard.file:
+        found.append((base / definition.hazard.file, "the experiment's hazard file"))
+    found += [(base / table["record"], "a record file of the experiment") for table in _tables(definition.canonical)
               if table.get("file_sha256") and isinstance(table.get("record"), str)]
     return found
 
@@ -186,7 +187,7 @@ def store_complete(store: Path) -> bool:
 
 
 def missing_summaries(store: Path, experiment: Experiment, motion_grids: dict[str, tuple[float, int]]) -> list[str]:
-    """The summaries the experiment's store keeps today (:func:`stochpound.experiment._store.layout`) that the store file lacks: one written
+    """The summaries the experiment's store keeps today (:func:`stochpound.experiment._file_layout.layout`) that the store file lacks: one written
     by an earlier stochpound (e.g. ``peak_wall_penetration``, kept since for a scene with walls)."""
     import h5py
 
@@ -278,7 +279,7 @@ class StoreSession:
         folder.mkdir(parents=True, exist_ok=True)
         if (folder / DEFINITION_FILE).exists():
             record = read_experiment_json(folder)
-            definition = json.loads(canonical_json(experiment.definition))
+            definition = json.loads(canonical_json(experiment.definition.canonical))
             if record["definition"] != definition:  # the same runs (checked by check_store), another hazard: record it
                 record.update(definition=definition, definition_sha256=experiment.sha256, text=experiment.text,
                               text_sha256=hashlib.sha256(experiment.text.encode()).hexdigest())
@@ -286,7 +287,7 @@ class StoreSession:
         else:
             record = {
                 "definition_sha256": experiment.sha256,
-                "definition": json.loads(canonical_json(experiment.definition)),
+                "definition": json.loads(canonical_json(experiment.definition.canonical)),
                 "text": experiment.text,
                 "text_sha256": hashlib.sha256(experiment.text.encode()).hexdigest(),
                 "file": experiment.path,
@@ -336,20 +337,20 @@ class StoreSession:
         last = runs[-1] if runs else {}
         return {
             "experiment_name": experiment.name,
-            "experiment_description": experiment.definition.get("description", ""),
+            "experiment_description": experiment.definition.description,
             "experiment_file": self.record.get("file", ""),
             "experiment_text": self.record.get("text", ""),
             "experiment_sha256": self.record.get("text_sha256", ""),
             "definition_sha256": experiment.sha256,
-            "definition": canonical_json(experiment.definition),
+            "definition": canonical_json(experiment.definition.canonical),
             "studied_building": experiment.studied,
             "stochpound_version": __version__,
             "git_commit": last.get("git_commit", "none"),
             "stochpound_sources_sha256": last.get("sources_sha256", ""),
-            "solver": solver["method"],
-            "solver_integrator": solver["integrator"],
-            "solver_rtol": solver["rtol"],
-            "solver_atol": solver["atol"],
+            "solver": solver.method,
+            "solver_integrator": solver.integrator,
+            "solver_rtol": solver.rtol,
+            "solver_atol": solver.atol,
             "solver_note": "integrator, rtol and atol apply to the ivp solver only",
             "seeds": json.dumps(experiment.seeds()),
             "created": self.record.get("created", ""),

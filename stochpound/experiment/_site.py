@@ -61,18 +61,18 @@ import xarray as xr
 
 from stochpound.model import fields as toml_fields
 from stochpound.motions import CONDITIONING_MEASURES, MODEL_DAMPING, PERIOD_RANGE, Measure, Scenario
-from stochpound.store import SCENARIO_KINDS, Intensity, Site, scene_g
+from stochpound.store import CONDITIONAL_SPECTRUM, SCENARIO_KINDS, Definition, Intensity, MotionSource, Site, VariantAxis
 
 
 class GridExperiment(Protocol):
     """What the selection reads of an experiment (an :class:`~stochpound.experiment.Experiment`, which asks for its stripes here)."""
 
-    intensity: dict[str, Any] | None
-    recorded_motions: dict[str, dict[str, Any]]
-    variants: list[dict[str, Any]]
+    intensity: Intensity | None
+    recorded_motions: dict[str, MotionSource]
+    variants: tuple[VariantAxis, ...]
     building_names: list[str]
     base_dir: Path
-    definition: dict[str, Any]
+    definition: Definition
 
     def points(self, kind: str) -> list[Any]: ...
 
@@ -80,9 +80,8 @@ class GridExperiment(Protocol):
 
     def motion_table(self, label: str, realization: int | None = None) -> dict[str, Any]: ...
 
-SELECTIONS = ("scale", "conditional_spectrum")
+SELECTIONS = ("scale", CONDITIONAL_SPECTRUM)
 """``[intensity] selection``: every motion scaled to every level, or motions chosen per stripe."""
-CONDITIONAL_SPECTRUM = SELECTIONS[1]
 DEFAULT_SEED = 1
 """Seed of the selection when ``[intensity] seed`` is not given."""
 SITE_FIELDS = ("vs30", "magnitude", "distance_km", "mechanism")
@@ -350,7 +349,7 @@ def periods_of_interest(experiment: GridExperiment) -> dict[str, float]:
     found: dict[str, set[float]] = {}
     labels: dict[tuple[str, float], str] = {}
     for point in experiment.points(CASE):
-        variants = ", ".join(f"{name}={value}" for name, value in point.labels if name in {v["name"] for v in experiment.variants})
+        variants = ", ".join(f"{name}={value}" for name, value in point.labels if name in {v.name for v in experiment.variants})
         for key, period in scene_periods(scene_from_dict(experiment.structure(point), base_dir=experiment.base_dir)).items():
             period = round(period, 12)
             found.setdefault(key, set()).add(period)
@@ -454,44 +453,45 @@ def stripe_selections(experiment: GridExperiment) -> StripeSelections:
     scene = experiment.structure(experiment.points(CASE)[0])
     records = []
     for label, source in experiment.recorded_motions.items():  # the motions as the cases run them (a duration or a start applied)
-        if source["kind"] != "record":
-            raise ExperimentError(f"{source['field']}: the conditional-spectrum pool takes records and suites, not synthetic ensembles")
-        with field_errors(scene_prefix=source["field"]):
+        if source.kind != "record":
+            raise ExperimentError(f"{source.field}: the conditional-spectrum pool takes records and suites, not synthetic ensembles")
+        with field_errors(scene_prefix=source.field):
             motion = scene_from_dict({**scene, "motion": experiment.motion_table(label)}, base_dir=experiment.base_dir).motion
-        name = str(source["motion"].get("record", ""))
+        name = str(source.motion.get("record", ""))
         metadata = load_suite_member(name).metadata if is_suite_member(name) else {}
         records.append(Record(label, motion.dt, motion.values, "m/s2", metadata=metadata))
-    measure = intensity["measure"]
-    period = intensity.get("period", intensity.get("periods"))
+    measure = intensity.measure.kind
+    period = intensity.measure.spectral_period
+    chosen = intensity.selection  # the conditional-spectrum selection's entries
     conditioning = [] if period is None else list(np.atleast_1d(period))
     structure = structure_periods(experiment)
     periods = selection_periods(structure, conditioning)
-    g = scene_g(experiment.definition["scene"])
+    g = experiment.definition.g
     pool = selection_pool(records, periods, measure, period, MODEL_DAMPING, g)
     selections, targets, simulated = [], [], {}
-    rules = {key: intensity[key] for key in RULES if key in intensity}
-    if "ruptures" in intensity:  # the exact conditional spectrum of every stripe
+    rules = {key: chosen[key] for key in RULES if key in chosen}
+    if "ruptures" in chosen:  # the exact conditional spectrum of every stripe
         from stochpound.analysis import RuptureSite
 
-        stripe_targets = RuptureSite.from_entry(intensity["ruptures"]).conditional_spectra(measure, period, levels=intensity["levels"], periods=periods)
+        stripe_targets = RuptureSite.from_entry(chosen["ruptures"]).conditional_spectra(measure, period, levels=list(intensity.levels), periods=periods)
     else:
         stripe_targets = [conditional_spectrum(measure, period, level=level, periods=periods, **scenario)
-                          for level, scenario in zip(intensity["levels"], intensity["site"])]
-    for stripe, (level, scenario, target) in enumerate(zip(intensity["levels"], intensity["site"], stripe_targets)):
-        sources = simulated_sources(intensity.get("simulated_motions"), stripe, scenario)
+                          for level, scenario in zip(intensity.levels, chosen["site"])]
+    for stripe, (level, scenario, target) in enumerate(zip(intensity.levels, chosen["site"], stripe_targets)):
+        sources = simulated_sources(chosen.get("simulated_motions"), stripe, scenario)
         try:
             stripe_pool = xr.concat([pool, simulated_pool(sources, periods, measure, period, g)], "motion") if sources else pool
         except SiteError as error:  # a scenario outside the site-motion model's calibrated range
             raise ExperimentError(f"site.simulated_motions: the stripe {level:g} g's scenario: {error}") from None
         try:
-            selection = select_motions(stripe_pool, target, intensity["motions"], intensity["max_scale_factor"], intensity["seed"], **rules)
+            selection = select_motions(stripe_pool, target, chosen["motions"], chosen["max_scale_factor"], chosen["seed"], **rules)
         except SiteError as error:
             raise ExperimentError(f"intensity.{error} (stripe {level:g} g)") from None
         simulated.update({str(label): sources[str(label)] for label in selection["motion"].values if str(label) in sources})
         selections.append(selection)
         targets.append(target)
     labels = list(experiment.recorded_motions) + list(simulated)
-    return StripeSelections(list(intensity["levels"]), labels, periods, structure, selections, targets, simulated)
+    return StripeSelections(list(intensity.levels), labels, periods, structure, selections, targets, simulated)
 
 
 def simulated_sources(setting: Mapping[str, Any] | None, stripe: int, scenario: Mapping[str, Any]) -> dict[str, dict[str, Any]]:

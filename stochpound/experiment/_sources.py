@@ -11,16 +11,15 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Mapping
 
 import numpy as np
 
 from stochpound import motions as synthetic_motions
-from stochpound.experiment._grid import CASE, Experiment
-from stochpound.experiment._intensity import as_intensity, check_resolution, ensemble_intensity
-from stochpound.experiment._scene_edits import with_motion
+from stochpound.experiment._experiment import Experiment
+from stochpound.experiment._intensity import check_resolution, ensemble_intensity
 from stochpound.experiment._site import simulated_motions
-from stochpound.store import canonical_json, scene_g
+from stochpound.store import CASE, canonical_json, with_motion
 from stochpound.experiment._spec import ExperimentError, field_errors
 from stochpound.motions.ground import GroundMotion, SampledMotion
 from stochpound.model.scene_file import scene_from_dict
@@ -70,29 +69,29 @@ def resolve_motions(experiment: Experiment) -> dict[str, ResolvedMotion]:
         if label in simulated:
             motion = simulated[label]
         else:
-            with field_errors(scene_prefix=source["field"]):
+            with field_errors(scene_prefix=source.field):
                 motion = scene_from_dict(with_motion(structure, table), base_dir=experiment.base_dir).motion
         grid = (float(motion.times[1] - motion.times[0]), len(motion.times))
         if experiment.intensity is not None:
             with field_errors():
-                check_resolution(as_intensity(experiment.intensity), grid[0], f"{source['field']} ({label})")
+                check_resolution(experiment.intensity, grid[0], f"{source.field} ({label})")
                 if not isinstance(motion, SampledMotion):
-                    raise ExperimentError(f"{source['field']}: a {type(motion).__name__} cannot be scaled to an intensity level; [intensity] takes records, suites and synthetic ensembles")
-        if source["kind"] in ("record", "simulated"):
+                    raise ExperimentError(f"{source.field}: a {type(motion).__name__} cannot be scaled to an intensity level; [intensity] takes records, suites and synthetic ensembles")
+        if source.kind in ("record", "simulated"):
             resolved[label] = ResolvedMotion(label, motion, None, grid)
         else:
             worker_table = _worker_table(table, motion, structure)
             expected = None
-            if experiment.intensity is not None and as_intensity(experiment.intensity).synthetic == "expected":
-                expected = ensemble_intensity(as_intensity(experiment.intensity), worker_table, experiment.realizations(label), scene_g(experiment.definition["scene"]))
+            if experiment.intensity is not None and experiment.intensity.synthetic == "expected":
+                expected = ensemble_intensity(experiment.intensity, worker_table, experiment.realizations(label), experiment.definition.g)
             resolved[label] = ResolvedMotion(label, None, worker_table, grid, expected)
     return resolved
 
 
 def _simulated(experiment: Experiment) -> dict[str, GroundMotion]:
     """The chosen simulated motions, regenerated from their tables (one call per stripe's scenario), by label."""
-    sources = [experiment.motions[label] for label in experiment.motions if experiment.motions[label]["kind"] == "simulated"]
-    groups: dict[str, list[dict[str, Any]]] = {}
+    sources = list(experiment.selection.simulated.values()) if experiment.selection is not None else []
+    groups: dict[str, list[Mapping[str, Any]]] = {}
     for source in sources:
         groups.setdefault(canonical_json({k: v for k, v in source["motion"].items() if k != "realization"}), []).append(source)
     return {source["label"]: motion for group in groups.values() for source, motion in zip(group, simulated_motions(group))}

@@ -7,7 +7,7 @@ field). :func:`parse_experiment` checks every field and returns the
 *canonical definition*: a JSON-able dict with every default filled in and the
 base scene inlined. Its sha256, without the hazard that no run depends on
 (``stochpound.store.definition_sha256``), identifies the experiment: a store
-made from a different definition is refused. :class:`stochpound.experiment._grid.Experiment`
+made from a different definition is refused. :class:`stochpound.store.ExperimentGrid`
 is built from it.
 
 Errors raise :class:`ExperimentError` whose message starts with the field's
@@ -35,7 +35,7 @@ from stochpound.experiment._intensity import parse_intensity
 from stochpound.experiment._site import site_entry
 from stochpound.model import fields as toml_fields
 from stochpound.model.contact import ELEMENT_KEYS
-from stochpound.experiment._scene_edits import apply_overrides, building_names
+from stochpound.store import apply_overrides, building_names
 from stochpound.model.scene_file import bundled_scene_path, bundled_scenes, generator_fields, read_scene_table
 from stochpound.solvers.simulate import METHODS
 from stochpound.solvers.ivp import INTEGRATORS

@@ -11,11 +11,11 @@ import numpy as np
 
 from stochpound._errors import os_error_message
 from stochpound.store import open_store
-from stochpound.experiment._grid import KINDS, Case, Experiment
+from stochpound.store import KINDS, Case, ExperimentGrid
 from stochpound.experiment._parts import DEFINITION_FILE, FolderLock, parts_folder
 from stochpound.experiment._session import StoreSession
 from stochpound.experiment._spec import ExperimentError
-from stochpound.experiment._store import PREFIX
+from stochpound.experiment._file_layout import PREFIX
 
 
 @dataclass
@@ -25,7 +25,8 @@ class StatusReport:
     Attributes
     ----------
     store : Path
-    experiment : Experiment
+    experiment : ExperimentGrid
+        The store's experiment (its grid).
     done_mask : dict of np.ndarray
         For each kind, which cases of its grid are finished (bool).
     running : bool
@@ -38,7 +39,7 @@ class StatusReport:
     """
 
     store: Path
-    experiment: Experiment
+    experiment: ExperimentGrid
     done_mask: dict[str, np.ndarray]
     running: bool = False
     rebuilt: bool = False
@@ -111,7 +112,7 @@ def _from_file(store: Path) -> StatusReport:
     """Status from the store file alone (its parts folder was removed)."""
     dataset = open_store(store)
     try:
-        experiment = Experiment(dataset.pound.definition, str(dataset.attrs.get("experiment_text", "")))
+        experiment = dataset.pound.grid  # a conditional-spectrum store's choice of motions read from it, not chosen again
         done = {kind: dataset[f"{PREFIX[kind]}_status"].values == 1 for kind in KINDS}
     except (KeyError, ValueError) as error:
         raise ExperimentError(f"{store}: not a stochpound experiment store ({error})") from None

@@ -10,6 +10,8 @@ The package holds the definition parsed into types
 (:data:`CATALOGUE`: units and long name of each, declared once), the gap axes
 and the selections by meaning (contact-free, wall-free, fixed-base cases), the
 stripes' site scenario (:func:`scenario_kind`, :func:`scenario_ranges`),
+what an experiment is (:class:`ExperimentGrid`: its dimensions, cases with
+stable ids and each case's scene, edited by the scene edits of this layer),
 :func:`open_store`, and the one door to an open store, the ``pound``
 accessor of an xarray dataset (:class:`StoreAccessor`). It imports the model
 and the shared utilities only: the experiment layer writes stores, the
@@ -17,7 +19,7 @@ analysis, the risk chain, the report and the command line read them through
 here.
 """
 
-from stochpound.store._accessor import ACCESSOR, StoreAccessor, register_grid
+from stochpound.store._accessor import ACCESSOR, StoreAccessor
 from stochpound.store._catalogue import (
     CASE_SUMMARIES,
     CATALOGUE,
@@ -53,6 +55,7 @@ from stochpound.store._definition import (
     read_definition,
     scene_g,
 )
+from stochpound.store._grid import Case, Dim, ExperimentGrid, Point
 from stochpound.store._gap_axes import (
     SETS,
     contact_free,
@@ -74,6 +77,8 @@ from stochpound.store._selections import fixed_base, has_fixed_base_twins, isola
 from stochpound.store._catalogue import CASE, KINDS, REFERENCE  # noqa: F401
 from stochpound.store._definition import MEASURES  # noqa: F401
 from stochpound.store._progress import UnfinishedStoreError, cases_done, check_finished  # noqa: F401
+from stochpound.store._grid import CONDITIONAL_SPECTRUM  # noqa: F401
+from stochpound.store._scene_edits import apply_overrides, building_names, reference_scene, with_motion  # noqa: F401
 
 __all__ = [
     "ACCESSOR",
@@ -90,9 +95,12 @@ __all__ = [
     "LIMIT_STATE_DEMANDS",
     "TIME_HISTORIES",
     "WALL_SUMMARIES",
+    "Case",
     "Definition",
     "Design",
     "DesignEc8",
+    "Dim",
+    "ExperimentGrid",
     "GapAxis",
     "Hazard",
     "Intensity",
@@ -102,6 +110,7 @@ __all__ = [
     "MuAxis",
     "Output",
     "Site",
+    "Point",
     "Solver",
     "StoreAccessor",
     "StoreVariable",
@@ -121,7 +130,6 @@ __all__ = [
     "isolated_mus",
     "open_store",
     "read_definition",
-    "register_grid",
     "scenario_kind",
     "scenario_ranges",
     "scene_g",

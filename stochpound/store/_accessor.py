@@ -8,17 +8,15 @@ meaning (contact-free, wall-free, fixed-base cases), the experiment's grid,
 what ran in a case (its scene) and its impacts. The report, the command line,
 the studies and the risk chain read stores through it.
 
-The grid (cases, their ids and structures) is the experiment layer's
-(``stochpound.experiment.Experiment``), which sits above this layer: it
-registers itself here (:func:`register_grid`) when it is imported, which
-``import stochpound`` does.
+The grid (cases, their ids and structures) is this layer's
+(:class:`~stochpound.store.ExperimentGrid`), built from the store's definition
+and, for stripes of chosen motions, the choice the store records: nothing
+above this layer needs to be imported first.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from functools import lru_cache
-from typing import Any
 
 import numpy as np
 import xarray as xr
@@ -29,18 +27,15 @@ from stochpound.model.scene_file import scene_from_dict
 from stochpound.store._gap_axes import contact_free, contact_gap_dims, gap_dims, has_contact_free, has_wall_free, wall_free, wall_gap_dims
 from stochpound.store._selections import fixed_base, has_fixed_base_twins
 from stochpound.store._definition import Definition, Hazard, Intensity, read_definition
+from stochpound.store._grid import ExperimentGrid, StoredChoice
 
-__all__ = ["ACCESSOR", "StoreAccessor", "register_grid"]
+__all__ = ["ACCESSOR", "StoreAccessor"]
 
 ACCESSOR = "pound"
 """The accessor's name: ``ds.pound``."""
 
-_GRIDS: list[Callable[[Definition], Any]] = []
-
-
-def register_grid(factory: Callable[[Definition], Any]) -> None:
-    """Register the factory of an experiment's grid from its definition (``stochpound.experiment.Experiment``; called once, on its import)."""
-    _GRIDS[:] = [factory]
+Label = str | float | int
+"""A case's label on one dimension: a variant or a motion (str), a gap, μ or a level (float), a realization (int)."""
 
 
 @lru_cache(maxsize=64)
@@ -50,10 +45,9 @@ def _definition(text: str) -> Definition:
 
 
 @lru_cache(maxsize=16)
-def _grid(text: str) -> Any:
-    if not _GRIDS:
-        raise ExperimentError("the experiment's grid is not available: import stochpound (it registers stochpound.experiment's grid)")
-    return _GRIDS[0](_definition(text))
+def _grid(text: str, choice: StoredChoice | None) -> ExperimentGrid:
+    """A store's grid, built once per definition (and choice of the stripes' motions)."""
+    return ExperimentGrid(_definition(text), choice=choice)
 
 
 @xr.register_dataset_accessor(ACCESSOR)
@@ -106,9 +100,16 @@ class StoreAccessor:
         return self.definition.hazard
 
     @property
-    def grid(self) -> Any:
-        """The experiment's grid (``stochpound.experiment.Experiment``): dimensions, cases, their scenes; built once per definition."""
-        return _grid(self._text)
+    def grid(self) -> ExperimentGrid:
+        """The experiment's grid (:class:`~stochpound.store.ExperimentGrid`): dimensions, cases, their scenes; built once per definition.
+
+        With stripes of chosen motions (a conditional-spectrum selection), the
+        choice is the one the store records (``selection_scale_factor``, the simulated motions' tables on ``record``).
+        """
+        text = self._text
+        intensity = _definition(text).intensity
+        chose = intensity is not None and "selection_scale_factor" in self._dataset.variables
+        return _grid(text, StoredChoice.from_store(self._dataset, intensity.levels) if chose and intensity is not None else None)
 
     # ------------------------------------------------------------ gap axes and selections
 
@@ -156,7 +157,7 @@ class StoreAccessor:
 
     # ------------------------------------------------------------ cases
 
-    def _at(self, variable: str, **labels: Any) -> Any:
+    def _at(self, variable: str, **labels: Label) -> np.ndarray:
         """The one value of ``variable`` at ``labels`` (labels of dimensions the store lacks ignored, one realization squeezed)."""
         present = {dim: value for dim, value in labels.items() if dim in self._dataset.dims}
         data = self._dataset[variable].sel(present)
@@ -166,7 +167,7 @@ class StoreAccessor:
             raise ExperimentError(f"case at {labels}: {data.size} cases, expected one (give every dimension: {dict(data.sizes)})")
         return data.values.reshape(())
 
-    def case_id(self, **labels: Any) -> str:
+    def case_id(self, **labels: Label) -> str:
         """The id of the case at ``labels`` (one label on every grid dimension; a single realization needs none).
 
         Raises
@@ -178,7 +179,7 @@ class StoreAccessor:
         """
         return str(self._at("case_id", **labels))
 
-    def scene(self, **labels: Any) -> Scene:
+    def scene(self, **labels: Label) -> Scene:
         """What ran in one case: its scene (structure and motion), rebuilt from the store's definition.
 
         A case of intensity stripes ran its record scaled to its level: the
@@ -208,7 +209,7 @@ class StoreAccessor:
             motion["scale"] = float(motion.get("scale", 1.0)) * factor
         return scene_from_dict({**grid.structure(case), "motion": motion})
 
-    def impacts(self, **labels: Any) -> xr.Dataset:
+    def impacts(self, **labels: Label) -> xr.Dataset:
         """The rows of the impact table of the cases at ``labels`` (the ``impact_*`` variables; all of them without labels), loaded."""
         store = self._dataset
         table = store[[name for name in store.data_vars if name.startswith("impact_") and store[name].dims == ("impact",)]]

@@ -3,7 +3,7 @@
 A store holds, on its grid, the summaries of every case and of every
 fixed-base reference, the kept time histories, and the table of impacts.
 Their metadata is declared here, once; the store's layout
-(:mod:`stochpound.experiment._store`) is built from it without running
+(:mod:`stochpound.experiment._file_layout`) is built from it without running
 anything. The tests hold the catalogue against what a real
 :func:`stochpound.simulate` and the summaries of
 :mod:`stochpound.experiment._summary` return, so it cannot drift from them.

@@ -2,7 +2,7 @@
 
 Every store keeps its experiment's canonical definition (``definition``, JSON).
 This module reads the scenes of each configuration of the grid from it
-(``ds.pound.grid``, the :class:`stochpound.experiment.Experiment` of the
+(``ds.pound.grid``, the :class:`stochpound.store.ExperimentGrid` of the
 store) and describes them: nothing
 here is fixed text, and a value appears only if a store ran it. Several
 stores that ran the same building or contact share one row.
@@ -94,7 +94,7 @@ class StoreDefinition:
     def configurations(self) -> list[Configuration]:
         """One per combination of the variant axes, in grid order."""
         cases = [c for c in self.experiment.cases if c.kind == CASE]
-        variant_axes = [v["name"] for v in self.experiment.variants]
+        variant_axes = [v.name for v in self.experiment.variants]
         chosen: dict[tuple, Case] = {}
         for case in cases:
             labels = case.label_dict
@@ -324,9 +324,9 @@ def _where(uses: list[tuple[StoreDefinition, Configuration]]) -> str:
         chosen = [c for d, c in uses if d is definition]
         axes = []
         for axis in definition.experiment.variants:
-            values = list(dict.fromkeys(c.labels[axis["name"]] for c in chosen))
-            if len(values) < len(axis["values"]):
-                axes.append(f"{axis['name']} = {' or '.join(values)}")
+            values = list(dict.fromkeys(c.labels[axis.name] for c in chosen))
+            if len(values) < len(axis.values):
+                axes.append(f"{axis.name} = {' or '.join(values)}")
         texts.append(definition.name + (f" ({', '.join(axes)})" if axes else ""))
     return "; ".join(texts)
 

@@ -1,9 +1,9 @@
 """Writing the store file from the parts, block by block.
 
 The file is created with every variable's metadata and chunking
-(:meth:`stochpound.experiment._store.Layout.template`, written by xarray's own
+(:meth:`stochpound.experiment._file_layout.Layout.template`, written by xarray's own
 netCDF4 back end, so that xarray and netCDF tools read it as any xarray-written
-file) but no data; then each block of the grid (:func:`stochpound.experiment._store.blocks`)
+file) but no data; then each block of the grid (:func:`stochpound.experiment._file_layout.blocks`)
 is assembled in memory from the parts that hold its cases and written as
 one hyperslab per variable. The impact table's rows follow the cases in
 grid order, whatever the order in which the parts were written. Memory is
@@ -29,10 +29,11 @@ import numpy as np
 from xarray.backends import H5NetCDFStore
 
 from stochpound._atomic import check_room, free_bytes, replacing
-from stochpound.experiment._grid import CASE, KINDS, Experiment
+from stochpound.experiment._experiment import Experiment
+from stochpound.store import CASE, KINDS
 from stochpound.experiment._parts import part_paths, read_part, split_key
 from stochpound.experiment._spec import ExperimentError
-from stochpound.experiment._store import INT_FILL, Layout, Spec, blocks, layout, union_times
+from stochpound.experiment._file_layout import INT_FILL, Layout, Spec, blocks, layout, union_times
 
 PART_CACHE_BYTES = 64 * 2**20
 """Parts kept in memory while the blocks that need them are written, bytes."""
@@ -389,7 +390,7 @@ class _Writer:
         kind = spec.kind
         shape = self.experiment.grid_shape(kind)
         trailing = spec.chunks[len(shape):]
-        kept = [self.experiment.building_names.index(b) for b in self.experiment.output["buildings"]]
+        kept = [self.experiment.building_names.index(b) for b in self.experiment.output.buildings]
         own_dims = spec.dims[len(shape) : -1]  # a part keeps the output buildings only: their rows of ``building``
         for block in blocks(shape, spec.chunks[: len(shape)]):
             source = self.index.source[kind][block]

@@ -18,7 +18,7 @@ Every variable on the case dimensions is chunked in *blocks* of consecutive
 grid positions (:func:`blocks`): along ``realization`` for an ensemble, so
 that the file opens lazily chunked along realization and is written, block by
 block, in time and memory independent of the number of cases
-(:mod:`stochpound.experiment._store_writer`).
+(:mod:`stochpound.experiment._file_assembly`).
 """
 
 from __future__ import annotations
@@ -34,7 +34,8 @@ import xarray as xr
 
 from stochpound.store import CASE_SUMMARIES, IMPACT_TABLE, REFERENCE_HISTORY, REFERENCE_SUMMARIES, SETS, STOREY_SUMMARIES, StoreVariable, TIME_HISTORIES, WALL_SUMMARIES, canonical_json
 from stochpound.experiment import _intensity as intensity
-from stochpound.experiment._grid import CASE, REFERENCE, Dim, Experiment
+from stochpound.experiment._experiment import Experiment
+from stochpound.store import CASE, REFERENCE, Dim
 from stochpound.experiment._summary import DEMAND_SUMMARIES
 from stochpound.model.scene_file import scene_from_dict
 from stochpound.motions.records import METADATA_FIELDS
@@ -137,7 +138,7 @@ def layout(experiment: Experiment, motion_grids: Mapping[str, tuple[float, int]]
         specs.append(Spec(f"{prefix}_status", kind, "status", dims, np.dtype(np.int8), {**_STATUS_ATTRS, "long_name": f"{long} status"}, chunks))
         specs.append(Spec(f"{prefix}_id", kind, "id", dims, np.dtype("<U1"), {"units": "1", "long_name": f"{long} id"}, chunks))
         for variable in variables:
-            if variable.name in DEMAND_SUMMARIES and not experiment.output.get("demands", False):
+            if variable.name in DEMAND_SUMMARIES and not experiment.output.demands:
                 continue
             if any(sizes[d] == 0 for d in variable.dims):  # e.g. per-contact summaries of a scene without contacts
                 continue
@@ -146,7 +147,7 @@ def layout(experiment: Experiment, motion_grids: Mapping[str, tuple[float, int]]
             specs.append(Spec(variable.name, kind, "summary", dims + variable.dims, dtype, variable.attrs, chunks + tuple(sizes[d] for d in variable.dims), encoding))
     specs += _intensity_specs(experiment, sizes)
     specs += _history_specs(experiment, sizes)
-    if experiment.output["impacts"]:
+    if experiment.output.impacts:
         specs += _impact_specs(experiment, max(n_impacts, 0))
     return Layout(coords, {**sizes, "impact": n_impacts}, specs)
 
@@ -164,7 +165,7 @@ def _intensity_specs(experiment: Experiment, sizes: Mapping[str, int]) -> list[S
 
 
 def _history_specs(experiment: Experiment, sizes: Mapping[str, int]) -> list[Spec]:
-    names = experiment.output["time_histories"]
+    names = experiment.output.time_histories
     jobs: list[tuple[StoreVariable, str]] = [(TIME_HISTORIES[name], CASE) for name in names]
     if "total_displacement" in names:
         jobs.append((REFERENCE_HISTORY, REFERENCE))
@@ -221,9 +222,9 @@ def _coordinates(experiment: Experiment, motion_grids: Mapping[str, tuple[float,
     for dim in experiment.dims:
         coords[dim.name] = _dim_coordinate(experiment, dim)
     motions = experiment.motions
-    coords["record_kind"] = xr.Variable(("record",), np.array([motions[m]["kind"] for m in motions], dtype=object), {"units": "1", "long_name": "record or synthetic ensemble"})
+    coords["record_kind"] = xr.Variable(("record",), np.array([motions[m].kind for m in motions], dtype=object), {"units": "1", "long_name": "record or synthetic ensemble"})
     coords["record_motion"] = xr.Variable(
-        ("record",), np.array([canonical_json(motions[m]["motion"]) for m in motions], dtype=object), {"units": "1", "long_name": "the motion's scene table (JSON)"}
+        ("record",), np.array([canonical_json(motions[m].motion) for m in motions], dtype=object), {"units": "1", "long_name": "the motion's scene table (JSON)"}
     )
     coords.update(_suite_coordinates(experiment))
     if experiment.selection is not None:
@@ -232,12 +233,12 @@ def _coordinates(experiment: Experiment, motion_grids: Mapping[str, tuple[float,
         coords["spectrum_period"] = xr.Variable(
             ("spectrum_period",), intensity.SPECTRUM_PERIODS, {"units": "s", "long_name": "period of the stored spectra (5 % damping)"}
         )
-    scene = experiment.definition["scene"]
+    scene = experiment.definition.scene
     coords["building"] = xr.Variable(("building",), np.array(experiment.building_names, dtype=object), {"units": "1", "long_name": "building name, left to right"})
     coords["floor"] = xr.Variable(("floor",), np.arange(1, experiment.max_floors + 1), {"units": "1", "long_name": "floor number, 1 = lowest"})
     coords["contact"] = xr.Variable(("contact",), np.arange(len(scene.get("contact", []))), {"units": "1", "long_name": "contact index"})
     coords.update(_scene_coordinates(experiment))
-    if experiment.output["time_histories"]:
+    if experiment.output.time_histories:
         coords["time"] = xr.Variable(("time",), union_times(motion_grids), {"units": "s", "long_name": "time (union of the motions' sample times)"})
     return coords
 
@@ -273,14 +274,14 @@ def _suite_coordinates(experiment: Experiment) -> dict[str, xr.Variable]:
 
     rows: list[Mapping[str, Any]] = []
     for source in experiment.motions.values():
-        record = str(source["motion"].get("record", ""))
+        record = str(source.motion.get("record", ""))
         if is_suite_member(record):
             rows.append(load_suite_member(record).metadata)
-        elif source["kind"] == "simulated":  # its own earthquake: no event (a cluster of its own), the scenario's magnitude, distance and Vs30
-            table = source["motion"]
+        elif source.kind == "simulated":  # its own earthquake: no event (a cluster of its own), the scenario's magnitude, distance and Vs30
+            table = source.motion
             rows.append({"suite": "simulated", "magnitude": table["magnitude"], "distance": table["distance_km"], "vs30": table["vs30"]})
-        elif "suite" in source:  # a folder: the file name is all that is known
-            rows.append({"suite": source["suite"], "component": Path(record).name})
+        elif source.suite is not None:  # a folder: the file name is all that is known
+            rows.append({"suite": source.suite, "component": Path(record).name})
         else:
             rows.append({})
     if not any(rows):
@@ -302,12 +303,12 @@ def _dim_coordinate(experiment: Experiment, dim: Dim) -> xr.Variable:
     if dim.kind == "variant":
         return xr.Variable((dim.name,), np.array(dim.values, dtype=object), {"units": "1", "long_name": f"variant of axis {dim.name}"})
     if dim.kind == "gap":
-        gap = experiment.contract.gap_axis(dim.name)
+        gap = experiment.definition.gap_axis(dim.name)
         walls = f" and walls {list(gap.walls)}" if gap.walls else ""
         sets = " and ".join(what for what, indices in (("contacts", gap.contacts), ("walls", gap.walls)) if indices)
         return xr.Variable((dim.name,), np.array(dim.values, float), {"units": "m", "long_name": f"at-rest gap of contacts {list(gap.contacts)}{walls}", SETS: sets})
     if dim.kind == "mu":
-        chosen = experiment.contract.mu.buildings
+        chosen = experiment.definition.mu.buildings
         which = ", ".join(chosen) if chosen else "every isolated building"
         return xr.Variable(("mu",), np.array(dim.values, float), {"units": "1", "long_name": f"friction coefficient of {which} (inf: fixed base)"})
     if dim.kind == "record":

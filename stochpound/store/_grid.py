@@ -1,4 +1,4 @@
-"""An experiment's grid: dimensions, cases with stable ids, and each case's scene.
+"""What an experiment is: its grid's dimensions, cases with stable ids, and each case's scene.
 
 Two kinds of case exist:
 
@@ -10,22 +10,35 @@ Two kinds of case exist:
 
 A case id is the first 16 hex digits of the sha256 of its kind and labels, so
 it does not depend on the order of the grid or on how the run is split.
+
+The grid is read from the typed definition alone (:class:`ExperimentGrid`),
+with one exception: with ``[intensity] selection = "conditional_spectrum"``
+which motions each stripe runs is chosen when the experiment runs
+(``stochpound.experiment.Experiment``, the grid that chooses them when first
+asked), and a store records it (``selection_scale_factor``, the simulated motions' tables
+on ``record``), from which :class:`StoredChoice` reads it back, so that a
+store's grid (``ds.pound.grid``) needs nothing above this layer.
 """
 
 from __future__ import annotations
 
 import hashlib
 import itertools
+import json
+from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
-from typing import Any, Iterator, Mapping, Sequence
+from typing import Any, Protocol
 
 import numpy as np
+import xarray as xr
 
-from stochpound._errors import SceneError
-from stochpound.store import CASE, KINDS, REFERENCE, Definition, canonical_json, read_definition, register_grid
-from stochpound.experiment._scene_edits import (
+from stochpound._errors import ExperimentError, SceneError
+from stochpound.model.scene_file import scene_from_dict
+from stochpound.store._catalogue import CASE, KINDS, REFERENCE
+from stochpound.store._definition import Definition, Intensity, MotionSource, Output, Solver, VariantAxis, canonical_json, read_definition
+from stochpound.store._scene_edits import (
     apply_overrides,
     building_names,
     reference_scene,
@@ -34,9 +47,12 @@ from stochpound.experiment._scene_edits import (
     with_motion,
     without_motion,
 )
-from stochpound.experiment._site import CONDITIONAL_SPECTRUM, StripeSelections, stripe_selections
-from stochpound.experiment._spec import ExperimentError
-from stochpound.model.scene_file import scene_from_dict
+
+CONDITIONAL_SPECTRUM = "conditional_spectrum"
+"""``[intensity] selection`` that chooses the motions of every stripe (docs/intensity.md)."""
+SIMULATED = "simulated"
+"""The kind of a motion simulated for a stripe's pool (``[site] simulated_motions``) and chosen."""
+
 
 @dataclass(frozen=True)
 class Dim:
@@ -130,8 +146,67 @@ def case_ids(kind: str, labels: Mapping[str, Any], realizations: Sequence[int]) 
     return [hashlib.sha256(f"{head}{int(r)}{tail[0]}".encode()).hexdigest()[:16] for r in realizations]
 
 
-class Experiment:
-    """A validated experiment: its definition, dimensions, cases and their scenes.
+class StripeChoice(Protocol):
+    """Which motions each stripe runs, chosen for a conditional-spectrum selection (:attr:`ExperimentGrid.selection`).
+
+    ``stochpound.experiment`` chooses them when it runs; a store's grid reads
+    them back from the store (:class:`StoredChoice`).
+    """
+
+    @property
+    def chosen(self) -> np.ndarray:
+        """Which motions run at every level (bool, level × motion on ``record``)."""
+
+    @property
+    def simulated(self) -> Mapping[str, Mapping[str, Any]]:
+        """The chosen simulated motions' sources (``label``, ``kind``, ``field``, ``motion``), by label, in ``record`` order."""
+
+
+@dataclass(frozen=True)
+class StoredChoice:
+    """The motions each stripe ran, as a store records them (:class:`StripeChoice`).
+
+    Attributes
+    ----------
+    runs : tuple of tuple of bool
+        Per level, per motion on ``record``: whether the motion ran in the stripe
+        (its ``selection_scale_factor`` is finite).
+    tables : tuple of (str, str)
+        The simulated motions on ``record``: label and ``[motion]`` table (JSON, the ``record_motion`` coordinate).
+    """
+
+    runs: tuple[tuple[bool, ...], ...]
+    tables: tuple[tuple[str, str], ...]
+
+    @classmethod
+    def from_store(cls, store: xr.Dataset, levels: Sequence[float]) -> StoredChoice:
+        """The choice a store records, on the definition's ``levels`` (a level or motion the dataset lacks runs nothing)."""
+        scale = store["selection_scale_factor"]
+        if "record" not in scale.dims:
+            scale = scale.expand_dims("record")
+        if "intensity" not in scale.dims:
+            scale = scale.expand_dims("intensity")
+        finite = np.isfinite(scale.transpose("intensity", "record").values)
+        rows = {float(level): row for level, row in zip(np.atleast_1d(scale["intensity"].values), finite)}
+        empty = np.zeros(finite.shape[1], dtype=bool)
+        runs = tuple(tuple(bool(x) for x in rows.get(float(level), empty)) for level in levels)
+        kinds = np.atleast_1d(store["record_kind"].values)
+        tables = zip(np.atleast_1d(store["record"].values), kinds, np.atleast_1d(store["record_motion"].values))
+        return cls(runs, tuple((str(label), str(table)) for label, kind, table in tables if kind == SIMULATED))
+
+    @cached_property
+    def chosen(self) -> np.ndarray:
+        """Which motions run at every level (bool, level × motion on ``record``)."""
+        return np.array(self.runs, dtype=bool).reshape(len(self.runs), -1)
+
+    @cached_property
+    def simulated(self) -> dict[str, dict[str, Any]]:
+        """The simulated motions' sources, by label, in ``record`` order."""
+        return {label: {"label": label, "kind": SIMULATED, "field": "site.simulated_motions", "motion": json.loads(table)} for label, table in self.tables}
+
+
+class ExperimentGrid:
+    """What an experiment is: its typed definition, dimensions, cases and their scenes.
 
     Parameters
     ----------
@@ -144,59 +219,70 @@ class Experiment:
         Folder of the experiment file (record files are resolved against it).
     path : str, optional
         The experiment file, for provenance.
+    choice : StripeChoice, optional
+        The motions chosen for every stripe, when ``[intensity] selection =
+        "conditional_spectrum"`` (:attr:`selection`); ignored otherwise.
     """
 
-    def __init__(self, definition: Mapping[str, Any] | Definition, text: str = "", base_dir: str | Path = ".", path: str = "") -> None:
-        self.contract: Definition = read_definition(definition)
-        self.definition = self.contract.to_dict()
+    def __init__(
+        self, definition: Mapping[str, Any] | Definition, text: str = "", base_dir: str | Path = ".", path: str = "", choice: StripeChoice | None = None
+    ) -> None:
+        self.definition: Definition = read_definition(definition)
         self.text = text
         self.base_dir = Path(base_dir)
         self.path = path
-        self.sha256 = self.contract.sha256
-        self.name: str = self.definition["name"]
-        self.studied: str = self.definition["studied"]
-        self.variants: list[dict[str, Any]] = self.definition["variants"]
-        self.recorded_motions: dict[str, dict[str, Any]] = {m["label"]: m for m in self.definition["motions"]}
-        self.output: dict[str, Any] = self.definition["output"]
-        self.solver: dict[str, Any] = self.definition["solver"]
-        self.intensity: dict[str, Any] | None = self.definition.get("intensity")
+        self.sha256 = self.definition.sha256
+        self.name: str = self.definition.name
+        self.studied: str = self.definition.studied
+        self.variants: tuple[VariantAxis, ...] = self.definition.variants
+        self.recorded_motions: dict[str, MotionSource] = {m.label: m for m in self.definition.motions}
+        self.output: Output = self.definition.output
+        self.solver: Solver = self.definition.solver
+        self.intensity: Intensity | None = self.definition.intensity
+        self._choice = choice
         self._grid_case_ids: dict[str, np.ndarray] = {}
+
+    @property
+    def contract(self) -> Definition:
+        """The typed definition (``definition``; the name older code reads)."""
+        return self.definition
 
     # ------------------------------------------------------------ dimensions
 
     @cached_property
     def building_names(self) -> list[str]:
         """Buildings of the base scene, left to right."""
-        return building_names(self.definition["scene"])
+        return building_names(self.definition.scene)
 
     @cached_property
     def max_floors(self) -> int:
         """Largest number of floors of any building, in the base scene or a variant."""
-        counts = [len(b.get("mass", [])) for b in self.definition["scene"]["building"]]
+        counts = [len(b.get("mass", [])) for b in self.definition.scene["building"]]
         for variant in self.variants:
-            for override in variant["overrides"].values():
+            for override in variant.overrides.values():
                 counts += [len(f["mass"]) for f in override.get("building", {}).values() if isinstance(f.get("mass"), list)]
         return max(counts + [1])
 
     @cached_property
     def has_walls(self) -> bool:
         """Whether a case's scene can have walls: the base scene's or a variant's ``[[wall]]``."""
-        overrides = [o for variant in self.variants for o in variant["overrides"].values()]
-        return bool(self.definition["scene"].get("wall")) or any(o.get("scene", {}).get("wall") for o in overrides)
+        overrides = [o for variant in self.variants for o in variant.overrides.values()]
+        return bool(self.definition.scene.get("wall")) or any(o.get("scene", {}).get("wall") for o in overrides)
 
     @cached_property
     def has_storey_summaries(self) -> bool:
         """Whether a case's buildings can have yielding storeys or storey heights (``yield_force``, ``storey_height``), in the base scene or a variant."""
-        buildings = list(self.definition["scene"]["building"])
-        buildings += [f for variant in self.variants for o in variant["overrides"].values() for f in o.get("building", {}).values()]
+        buildings = list(self.definition.scene["building"])
+        buildings += [f for variant in self.variants for o in variant.overrides.values() for f in o.get("building", {}).values()]
         return any("yield_force" in b or "storey_height" in b for b in buildings)
 
     @cached_property
-    def motions(self) -> dict[str, dict[str, Any]]:
+    def motions(self) -> dict[str, MotionSource]:
         """The motions on ``record``, by label: the definition's, then the simulated motions a selection chose (``[site] simulated_motions``)."""
         if self.selection is None:
             return self.recorded_motions
-        return {**self.recorded_motions, **self.selection.simulated}
+        simulated = {label: MotionSource(label, s["kind"], s["field"], s["motion"]) for label, s in self.selection.simulated.items()}
+        return {**self.recorded_motions, **simulated}
 
     @cached_property
     def motion_dims(self) -> list[Dim]:
@@ -208,18 +294,18 @@ class Experiment:
     @cached_property
     def grid_dims(self) -> list[Dim]:
         """Variant axes, gap axes and μ, in that order (the structural dimensions)."""
-        dims = [Dim(v["name"], "variant", tuple(v["values"])) for v in self.variants]
-        dims += [Dim(g.name, "gap", g.values) for g in self.contract.gaps]
-        if self.contract.mu is not None:
-            dims.append(Dim("mu", "mu", self.contract.mu.values))
+        dims = [Dim(v.name, "variant", v.values) for v in self.variants]
+        dims += [Dim(g.name, "gap", g.values) for g in self.definition.gaps]
+        if self.definition.mu is not None:
+            dims.append(Dim("mu", "mu", self.definition.mu.values))
         return dims + self.intensity_dims
 
     @cached_property
     def intensity_dims(self) -> list[Dim]:
         """``intensity`` (the target levels) when stripes run; none otherwise."""
-        if self.intensity is None or self.intensity["ran"] != "stripes":
+        if self.intensity is None or self.intensity.ran != "stripes":
             return []
-        return [Dim("intensity", "intensity", tuple(self.intensity["levels"]))]
+        return [Dim("intensity", "intensity", self.intensity.levels)]
 
     @cached_property
     def dims(self) -> list[Dim]:
@@ -238,8 +324,8 @@ class Experiment:
         return touched + self.intensity_dims
 
     def _touches_studied(self, axis: str) -> bool:
-        variant = next(v for v in self.variants if v["name"] == axis)
-        for override in variant["overrides"].values():
+        variant = next(v for v in self.variants if v.name == axis)
+        for override in variant.overrides.values():
             fields = override.get("building", {}).get(self.studied, {})
             if set(fields) - {"base"}:
                 return True
@@ -247,10 +333,7 @@ class Experiment:
 
     def realizations(self, label: str) -> range:
         """Realization indices of a motion: 0 for a record (and a simulated motion), start .. start+count−1 for an ensemble."""
-        motion = self.motions[label]
-        if motion["kind"] in ("record", "simulated"):
-            return range(1)
-        return range(motion["start"], motion["start"] + motion["count"])
+        return self.motions[label].realizations
 
     def realization_numbers(self, label: str) -> np.ndarray:
         """:meth:`realizations` as an array."""
@@ -301,18 +384,32 @@ class Experiment:
             mask = mask & self.selection.chosen[:, :, None]
         return np.broadcast_to(mask, self.grid_shape(kind))
 
+    @property
+    def selects_motions(self) -> bool:
+        """Whether every stripe runs motions chosen for it (``[intensity] selection = "conditional_spectrum"``)."""
+        return self.intensity is not None and self.intensity.selection_method == CONDITIONAL_SPECTRUM
+
     @cached_property
-    def selection(self) -> StripeSelections | None:
-        """The motions chosen for every stripe (``[intensity] selection = "conditional_spectrum"``); None otherwise."""
-        if self.intensity is None or self.intensity.get("selection") != CONDITIONAL_SPECTRUM:
+    def selection(self) -> StripeChoice | None:
+        """The motions chosen for every stripe (:attr:`selects_motions`); None otherwise.
+
+        Raises
+        ------
+        ExperimentError
+            If the stripes choose their motions and the grid was built without the choice.
+        """
+        if not self.selects_motions:
             return None
-        return stripe_selections(self)
+        if self._choice is None:
+            raise ExperimentError(f"{self.name}: the stripes' choice of motions is not known here: a store's grid reads it from the store (ds.pound.grid), "
+                                  "an experiment file's from stochpound.experiment.load_experiment")
+        return self._choice
 
     def _runs(self, point: Point, record: int) -> bool:
         """Whether the motion numbered ``record`` runs at ``point`` (not where a selection left it out of the stripe)."""
         if self.selection is None:
             return True
-        return bool(self.selection.chosen[self.intensity["levels"].index(dict(point.labels)["intensity"]), record])
+        return bool(self.selection.chosen[self.intensity.levels.index(dict(point.labels)["intensity"]), record])
 
     @cached_property
     def n_cases(self) -> int:
@@ -375,17 +472,17 @@ class Experiment:
         """
         point = self._point_of(case)
         labels = dict(point.labels)
-        scene = without_motion(self.definition["scene"])
-        overrides = [v["overrides"][labels[v["name"]]] for v in self.variants if v["name"] in labels]
+        scene = without_motion(self.definition.scene)
+        overrides = [v.overrides[labels[v.name]] for v in self.variants if v.name in labels]
         scene = apply_overrides(scene, overrides)
         if point.kind == REFERENCE:
             scene = reference_scene(scene, self.studied)
         else:
-            for gap in self.contract.gaps:
+            for gap in self.definition.gaps:
                 set_gaps(scene, gap.contacts, labels[gap.name], gap.walls)
-            if self.intensity is not None and self.intensity["ran"] == "ida":  # contact-free: capacities come from the closures
+            if self.intensity is not None and self.intensity.ran == "ida":  # contact-free: capacities come from the closures
                 set_gaps(scene, range(len(scene.get("contact", []))), float("inf"))
-            mu = self.contract.mu
+            mu = self.definition.mu
             if mu is not None:
                 missing = set_mu(scene, mu.buildings, labels["mu"])
                 if missing:
@@ -417,7 +514,7 @@ class Experiment:
     @cached_property
     def scene_field(self) -> str:
         """How errors name the base scene: its file's path, else ``scene`` (inline, or a bundled scene: an error is its edits')."""
-        source = self.contract.scene_source
+        source = self.definition.scene_source
         return str(self.base_dir / source["file"]) if source is not None and "file" in source else "scene"
 
     def validate(self) -> None:
@@ -443,7 +540,7 @@ class Experiment:
     def _base_scene_error(self) -> str | None:
         """The error of the base scene on its own (with a placeholder motion), if any."""
         try:
-            scene_from_dict(with_motion(without_motion(self.definition["scene"])), base_dir=self.base_dir)
+            scene_from_dict(with_motion(without_motion(self.definition.scene)), base_dir=self.base_dir)
         except (SceneError, ValueError) as error:
             return str(error)
         return None
@@ -451,14 +548,11 @@ class Experiment:
     def motion_table(self, label: str, realization: int | None = None) -> dict[str, Any]:
         """The scene ``[motion]`` table of a motion (with ``realization`` for an ensemble)."""
         motion = self.recorded_motions[label] if label in self.recorded_motions else self.motions[label]
-        table = {k: v for k, v in motion["motion"].items() if k != "file_sha256"}
-        if motion["kind"] == "synthetic":
-            table["realization"] = motion["start"] if realization is None else realization
+        table = {k: v for k, v in motion.motion.items() if k != "file_sha256"}
+        if motion.kind == "synthetic":
+            table["realization"] = motion.start if realization is None else realization
         return table
 
     def seeds(self) -> dict[str, int]:
         """Seeds of the synthetic ensembles, by label."""
-        return {label: m["motion"]["seed"] for label, m in self.motions.items() if m["kind"] == "synthetic"}
-
-
-register_grid(Experiment)  # the store layer's accessor (ds.pound) builds a store's grid with it
+        return {label: m.motion["seed"] for label, m in self.motions.items() if m.kind == "synthetic"}
