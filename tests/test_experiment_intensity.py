@@ -70,7 +70,7 @@ def test_ida_capacities_agree_with_brute_force(tmp_path):
     gaps = [0.005, 0.02]
     text = _experiment(f"gap = {gaps}", 'measure = "pga"\nlevels = [0.3]\nmethod = "ida"')
     experiment = load_experiment(write_experiment(tmp_path, text, "ida.toml"))
-    assert experiment.intensity["ran"] == "ida" and "intensity" not in [d.name for d in experiment.dims]
+    assert experiment.intensity.ran == "ida" and "intensity" not in [d.name for d in experiment.dims]
     report = run_experiment(experiment, workers=0, progress=False)
     store = open_store(report.store).load()
     capacity = store.ida_capacity.isel(realization=0)

@@ -50,7 +50,7 @@ def test_the_chosen_simulated_motions_are_the_ones_their_tables_regenerate(tmp_p
 @pytest.mark.slow
 def test_simulated_motions_join_the_pool_and_regenerate_bit_for_bit_from_the_store(tmp_path) -> None:
     experiment = load_experiment(write_experiment(tmp_path, _text(), "pool.toml"))
-    setting = experiment.intensity["simulated_motions"]
+    setting = experiment.intensity.selection["simulated_motions"]
     assert setting == {"count": 6, "model": "hazard_compatible", "calibration": site_model_provenance(), "seed": 2, "dt": 0.01}
     report = run_experiment(experiment, workers=0, progress=False)
     assert report.complete
@@ -90,7 +90,7 @@ def test_the_simulated_motions_are_part_of_the_identity(tmp_path) -> None:
     without = load_experiment(write_experiment(tmp_path, _text(site=SITE.replace("simulated_motions = 6\n", "")), "b.toml"))
     other = load_experiment(write_experiment(tmp_path, _text(site=SITE.replace("= 6", "= 7")), "c.toml"))
     assert len({with_them.sha256, without.sha256, other.sha256}) == 3
-    assert "simulated_motions" not in without.intensity and "max_per_earthquake" not in without.intensity
+    assert "simulated_motions" not in without.intensity.selection and "max_per_earthquake" not in without.intensity.selection
 
 
 def _pool(names: list[str], periods: np.ndarray) -> object:

@@ -107,7 +107,7 @@ def estimate_run(experiment: Experiment, motion_grids: Mapping[str, tuple[float,
     """
     store = layout(experiment, motion_grids, 0)
     histories = sum(spec.dtype.itemsize * math.prod(store.sizes[d] for d in spec.dims) for spec in store.of("history"))
-    return RunEstimate(cases, cpu_seconds(experiment, motion_grids, cases), file_bytes(store, {"definition": canonical_json(experiment.definition.canonical)}), histories,
+    return RunEstimate(cases, cpu_seconds(experiment, motion_grids, cases), file_bytes(store, {"definition": canonical_json(experiment.definition.to_dict())}), histories,
                        startup_steps(cases, workers))
 
 

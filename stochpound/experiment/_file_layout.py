@@ -315,7 +315,7 @@ def _dim_coordinate(experiment: Experiment, dim: Dim) -> xr.Variable:
         return xr.Variable(("record",), np.array(dim.values, dtype=object), {"units": "1", "long_name": "ground motion (record or synthetic ensemble)"})
     if dim.kind == "intensity":
         setting = experiment.intensity
-        return xr.Variable(("intensity",), np.array(dim.values, float), {"units": setting["units"], "long_name": f"target intensity level, {intensity.as_intensity(setting).description}"})
+        return xr.Variable(("intensity",), np.array(dim.values, float), {"units": setting.units, "long_name": f"target intensity level, {setting.description}"})
     return xr.Variable(("realization",), np.array(dim.values, dtype=np.int64), {"units": "1", "long_name": "realization index (0 for a record)"})
 
 

@@ -163,7 +163,7 @@ def input_files(experiment: Experiment) -> list[tuple[Path, str]]:
         found.append((base / source["file"], "the experiment's scene file"))
     if definition.hazard is not None and definition.hazard.file:
         found.append((base / definition.hazard.file, "the experiment's hazard file"))
-    found += [(base / table["record"], "a record file of the experiment") for table in _tables(definition.canonical)
+    found += [(base / table["record"], "a record file of the experiment") for table in _tables(definition.to_dict())
               if table.get("file_sha256") and isinstance(table.get("record"), str)]
     return found
 

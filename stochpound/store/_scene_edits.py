@@ -40,7 +40,7 @@ from stochpound.model import building as building_law
 from stochpound.model import laws
 from stochpound.model.contact import ELEMENT_KEYS, effective_mass
 from stochpound.model.friction import is_fixed_base
-from stochpound.store import scene_g
+from stochpound.store._definition import scene_g
 
 #: Motion used while validating a scene's structure (the real motion is set per case).
 PLACEHOLDER_MOTION = {"type": "constant", "acceleration": 0.0, "duration": 1.0, "dt": 1.0}
