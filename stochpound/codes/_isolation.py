@@ -42,6 +42,8 @@ import numpy as np
 from asce7_16.seismic import seismic_response_coeff
 from scipy.optimize import brentq
 
+from stochpound.motions import DEFAULT_G
+
 DAMPING_TABLE = ((0.02, 0.8), (0.05, 1.0), (0.10, 1.2), (0.20, 1.5), (0.30, 1.7), (0.40, 1.9), (0.50, 2.0))
 """ASCE 7-16 Table 17.5-1: damping coefficient B_M against effective damping β_M (interpolated linearly, the ends held)."""
 MAXIMUM_DIRECTION = (1.1, 1.3)
@@ -310,7 +312,7 @@ class IsolatedSeparation:
     separation: float
 
 
-def isolator_displacement(mu: float, radius: float, sm1: float, g: float = 9.81, tolerance: float = 1e-13) -> tuple[float, float, float]:
+def isolator_displacement(mu: float, radius: float, sm1: float, g: float = DEFAULT_G, tolerance: float = 1e-13) -> tuple[float, float, float]:
     """D_M (m), T_M (s), β_M (1) of a friction slider of friction ``mu`` and radius ``radius`` (m) at S_M1 = ``sm1`` (g).
 
     The fixed point of eq. 17.5-1 with eq. 17.5-2, k_M = W/R + μW/D and
@@ -336,7 +338,7 @@ def isolator_displacement(mu: float, radius: float, sm1: float, g: float = 9.81,
 
 
 def chapter17_design(base: SlidingBase, spectrum: MceSpectrum, plan: IsolatedPlan, r: float, *, wind_shear: float | None = None,
-                     abrupt: bool = True, g: float = 9.81) -> Chapter17Design:
+                     abrupt: bool = True, g: float = DEFAULT_G) -> Chapter17Design:
     """Design an isolated building on a sliding base by ASCE 7-16 §17.5 at both friction bounds.
 
     Parameters

@@ -12,10 +12,12 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from stochpound.motions import DEFAULT_G
+
 
 def design_yield_shears(mass: Sequence[float], storey_height: Sequence[float], *, period: float, sds: float, sd1: float, r: float,
                         overstrength: float, importance: float = 1.0, s1: float = 0.0, long_period: float = 8.0,
-                        g: float = 9.81) -> np.ndarray:
+                        g: float = DEFAULT_G) -> np.ndarray:
     """The storey yield shears F_y (N) of a shear building designed by ASCE 7-16's equivalent lateral force procedure.
 
     The design base shear is V = C_s W (§12.8.1) with W = g Σ m the seismic

@@ -52,6 +52,7 @@ from asce7_16.seismic import design_response_spectrum
 from scipy.linalg import eigh
 
 from stochpound.codes import isolator_displacement
+from stochpound.motions import DEFAULT_G
 from stochpound.model.building import Building, storey_matrix
 
 #: EN 1998-1 Table 3.2 (Type 1 spectrum): S, T_B, T_C, T_D (s) of each ground type.
@@ -144,7 +145,7 @@ class Ec8Design:
 
 
 def modal_floor_displacements(building: Building, spectrum_g: np.ndarray | None = None, *, design: Asce7Design | Ec8Design | None = None,
-                              g: float = 9.81) -> np.ndarray:
+                              g: float = DEFAULT_G) -> np.ndarray:
     """Peak floor displacements (m) of a fixed-base shear building under a design spectrum: modal analysis, SRSS of modes.
 
     Parameters
@@ -191,7 +192,7 @@ def srss_separation(left: float, right: float) -> float:
     return float(math.hypot(left, right))
 
 
-def asce7_isolator_displacement(weight: float, mu: float, radius: float, sm1: float, g: float = 9.81,
+def asce7_isolator_displacement(weight: float, mu: float, radius: float, sm1: float, g: float = DEFAULT_G,
                                 tolerance: float = 1e-10) -> tuple[float, float, float]:
     """ASCE 7-16 §17.5.3's displacement D_M of a friction pendulum (or flat slider with restoring stiffness W/R).
 

@@ -28,7 +28,7 @@ import xarray as xr
 from stochpound.codes import store_contact_demands
 from stochpound.hazard import HazardCurve, check_covers, hazard_curve, hazard_option, parse_measure, parse_units, stored_hazard
 from stochpound.model import Scene
-from stochpound.motions import TRUNCATION_EPSILON
+from stochpound.motions import DEFAULT_G, TRUNCATION_EPSILON
 from stochpound.risk._code_rules import MINIMUM_MOTIONS
 from stochpound.store import (LIMIT_STATE_DEMANDS, Design, Intensity, LimitStates, cases_done, check_finished as _check_finished, contact_free, gap_dims,
                               has_contact_free, has_wall_free, scenario_kind, scenario_ranges, wall_free, with_contacts)
@@ -41,7 +41,7 @@ SLIDING = "peak_sliding_displacement"
 """The store's variable of per-case, per-building peak base (sliding) displacements max|s| (m)."""
 DEMANDS = {
     "peak_interstorey_drift": ("peak storey drift", "m", 1.0),
-    "peak_floor_acceleration": ("peak floor acceleration", "g", 1.0 / 9.81),
+    "peak_floor_acceleration": ("peak floor acceleration", "g", 1.0 / DEFAULT_G),
 }
 """Demands of a store with ``[output] demands = true`` given as hazard curves: (name, display units, factor from SI)."""
 NOT_INTENSITY = "store: has no intensity stripes or IDA capacities (run an experiment with an [intensity] table)"

@@ -7,6 +7,7 @@ from typing import Any, Mapping
 
 import numpy as np
 
+from stochpound.motions._arias import DEFAULT_G
 from stochpound.motions.records._units import TO_SI, normalize_units
 
 
@@ -68,7 +69,7 @@ class Record:
         """Time of the last sample, ``(npts − 1)·dt``, s."""
         return (self.npts - 1) * self.dt
 
-    def acceleration(self, g: float = 9.81) -> np.ndarray:
+    def acceleration(self, g: float = DEFAULT_G) -> np.ndarray:
         """The samples in m/s².
 
         Parameters

@@ -22,13 +22,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from stochpound._errors import RecordError
+from stochpound.motions._arias import DEFAULT_G
 
 #: Spellings :func:`normalize_units` accepts beside those a header may use.
 OTHER_SPELLINGS: dict[str, str] = {"mps2": "m/s2"}
 #: The peak ground acceleration (g) beyond which a record is refused as implausible for its units.
 PLAUSIBLE_PEAK_G = 5.0
-#: g (m/s²) used to express a peak in g for the plausibility check (its exact value does not matter there).
-CHECK_G = 9.81
 #: Factor from each unit to m/s² (None for "g", whose factor is the chosen g).
 TO_SI: dict[str, float | None] = {"g": None, "m/s2": 1.0, "cm/s2": 0.01}
 
@@ -162,7 +161,7 @@ def check_plausible_peak(values: np.ndarray, units: str, shown: str, source: str
         Naming the peak, the units and which other units would make it plausible.
     """
     peak = float(np.max(np.abs(values), initial=0.0))
-    in_g = {name: peak * (1.0 if factor is None else factor / CHECK_G) for name, factor in TO_SI.items()}
+    in_g = {name: peak * (1.0 if factor is None else factor / DEFAULT_G) for name, factor in TO_SI.items()}
     if in_g[units] <= PLAUSIBLE_PEAK_G:
         return
     others = [name for name in TO_SI if name != units and in_g[name] <= PLAUSIBLE_PEAK_G]

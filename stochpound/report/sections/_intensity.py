@@ -34,7 +34,7 @@ from stochpound.stats.kernels import clopper_pearson
 from stochpound.report.render import FigureItem, Paragraph, Section, Table
 from stochpound.report.sections._stripe_motions import stripe_motions_text
 from stochpound.experiment import is_gap_axis
-from stochpound.motions import TARGET_TOLERANCE, TRUNCATION_EPSILON
+from stochpound.motions import DEFAULT_G, TARGET_TOLERANCE, TRUNCATION_EPSILON
 from stochpound.risk import (
     TARGETS,
     consistency_at_targets,
@@ -48,7 +48,6 @@ from stochpound.risk import (
 from stochpound.store import has_contact_free, scenario_kind, with_contacts
 
 CONFIDENCE = 0.95
-G = 9.81
 SHOWN_GAPS = 3
 """Most gaps at which the contact-free runs' probability of pounding is drawn against intensity."""
 CLOSURE = "peak_contact_closure"
@@ -119,14 +118,14 @@ def _spectra(name: str, store: xr.Dataset, setting: dict[str, Any]) -> FigureIte
     figure = Figure(figsize=(7.5, 4.0), layout="constrained")
     ax = figure.subplots()
     unscaled = psa.isel(intensity=0) if "intensity" in psa.dims else psa
-    rows = unscaled.stack(motion=("record", "realization")).transpose("motion", ...).values / G
+    rows = unscaled.stack(motion=("record", "realization")).transpose("motion", ...).values / DEFAULT_G
     mask = (done.any("intensity") if "intensity" in done.dims else done).stack(motion=("record", "realization")).values  # a selection runs each motion at some stripes
     for row in rows[mask]:
         ax.loglog(periods, row, lw=0.4, color="0.8")
     if "intensity" in store.dims:
         scale = _first_cell(store["scale_factor"])
         for j, level in enumerate(store["intensity"].values):
-            scaled = (psa.isel(intensity=j) * scale.isel(intensity=j)).stack(motion=("record", "realization")).transpose("motion", ...).values[mask] / G
+            scaled = (psa.isel(intensity=j) * scale.isel(intensity=j)).stack(motion=("record", "realization")).transpose("motion", ...).values[mask] / DEFAULT_G
             low, median, high = np.nanpercentile(scaled, [16, 50, 84], axis=0)
             (line,) = ax.loglog(periods, median, lw=1.6, label=f"{level:g} {setting.units}: median, 16/84 %")
             ax.fill_between(periods, low, high, color=line.get_color(), alpha=0.15)
