@@ -203,7 +203,7 @@ class StoreRisk:
     @property
     def measure(self) -> str:
         """The intensity measure in words, e.g. ``PSA(2 s, 5 %)`` ("" without a setting)."""
-        return _inputs.measure_text(self.setting) if self.setting else ""
+        return self.setting.description if self.setting is not None else ""
 
     def to_frame(self) -> pd.DataFrame:
         """The g* numbers: one row per configuration and target.

@@ -176,11 +176,6 @@ def intensity_setting(store: xr.Dataset) -> Intensity | None:
     return store.pound.intensity
 
 
-def measure_text(setting: Intensity) -> str:
-    """The intensity measure of an intensity setting in words (e.g. ``PSA(T = 2 s, 5 % damping)``)."""
-    return setting.description
-
-
 def has_risk(store: xr.Dataset) -> bool:
     """Whether a store can go through the risk chain at its own site: intensity levels (stripes or IDA) and a stored hazard."""
     return intensity_setting(store) is not None and stored_hazard(store) is not None and ("intensity" in store.dims or CAPACITY in store)
@@ -596,7 +591,7 @@ def limit_state_inputs(store: xr.Dataset, demands: list[tuple[str, str | None, s
     for variable, building, needs, in_g in demands:
         demand = case_demand(store, variable, building, needs)
         read.append(demand / scene_g(store) if in_g else demand)
-    return hazard, read, measure_text(intensity_setting(store))
+    return hazard, read, intensity_setting(store).description
 
 
 def limit_state_variable(kind: str) -> str:
