@@ -5,7 +5,8 @@ import pytest
 import xarray as xr
 from scipy import stats
 
-from stochpound.analysis import ensemble_statistics, kernels, mean_interval, quantiles, running_mean, running_pounding_probability
+from stochpound.analysis import ensemble_statistics, mean_interval, quantiles, running_mean, running_pounding_probability
+from stochpound.stats import kernels
 from stochpound.analysis.names import ENSEMBLE_ALIASES, with_aliases, without_aliases
 
 

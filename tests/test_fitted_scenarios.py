@@ -126,7 +126,7 @@ def test_the_definition_keeps_how_the_scenario_was_obtained_as_data_outside_the_
     fitted = parse_experiment(tomllib.loads(_text(FITTED_SELECTION, FITTED_SITE)), tmp_path)
     given = parse_experiment(tomllib.loads(_text(FITTED_SELECTION, '[site]\nvs30 = 400.0\nmagnitude = 7.0\ndistance_km = 10.0\nmechanism = "reverse"\n')), tmp_path)
     assert fitted["site"] == {"scenario": "fitted", "curves": json.loads(CURVES)} and given["site"] == {"scenario": "given"}
-    assert read_definition(fitted).site["scenario"] == "fitted"
+    assert read_definition(fitted).site.scenario == "fitted"
     for definition in (fitted, given):
         before = {key: value for key, value in definition.items() if key != "site"}
         assert definition_sha256(definition) == definition_sha256(before) and read_definition(before).site is None

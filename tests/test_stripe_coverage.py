@@ -7,11 +7,14 @@ import pytest
 import xarray as xr
 from scipy import integrate, stats
 
+from stochpound.motions import Measure
 from stochpound.risk import HazardCurve, maf_outside_stripes, mean_annual_frequency
+from stochpound.store import Intensity
 
 K0, K = 2.0e-4, 2.4
 LEVELS = np.array([0.2, 0.4, 0.8])
 GAPS = np.array([0.01, 0.02, 0.04, 0.08])
+_SETTING = Intensity(Measure("pga"), "g", tuple(LEVELS), "stripes", "stripes", "")
 
 
 def _fit(theta: np.ndarray, beta: np.ndarray) -> xr.Dataset:
@@ -73,7 +76,7 @@ def test_the_report_states_the_shares_it_computes_and_says_when_the_answer_rests
     hz = HazardCurve.power_law(K0, K)
     fit = _fit(np.array([0.1, 0.2, 0.4, 0.8]), np.full(4, 0.9)).assign_coords(intensity=("intensity", [lowest, 0.4, 0.8]))
     separation = xr.Dataset({"separation": ("target", [0.02, 0.04])}, coords={"target": [0.1, 0.02]})
-    risk = StoreRisk(fit, xr.Dataset(), separation, None, "", hz, 20, "stripes", setting={"units": "g"})
+    risk = StoreRisk(fit, xr.Dataset(), separation, None, "", hz, 20, "stripes", setting=_SETTING)
     shares = maf_outside_stripes(fit, separation["separation"], hz)
     text = _outside_stripes_text(risk)
     worst = float(shares["below"].max())
@@ -91,7 +94,7 @@ def test_the_design_summary_lists_the_shaking_below_the_stripes_among_what_the_a
     hz = HazardCurve.power_law(K0, K)
     fit = _fit(np.array([0.1, 0.2, 0.4, 0.8]), np.full(4, 0.9)).assign_coords(intensity=("intensity", [lowest, 0.4, 0.8]))
     separation = xr.Dataset({"separation": ("target", [0.02, 0.04])}, coords={"target": [0.1, 0.02]})
-    entry = _outside_stripes_assumption(StoreRisk(fit, xr.Dataset(), separation, None, "", hz, 20, "stripes", setting={"units": "g"}))
+    entry = _outside_stripes_assumption(StoreRisk(fit, xr.Dataset(), separation, None, "", hz, 20, "stripes", setting=_SETTING))
     assert bool(entry) is notable
     if notable:
         share = float(maf_outside_stripes(fit, separation["separation"], hz)["below"].sel(target=0.1))
