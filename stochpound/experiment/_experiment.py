@@ -19,17 +19,7 @@ from stochpound.store import ExperimentGrid
 class Experiment(ExperimentGrid):
     """A validated experiment (:func:`~stochpound.experiment.load_experiment`): its grid, with its stripes' motions chosen.
 
-    Parameters
-    ----------
-    definition : mapping or Definition
-        Canonical definition (``stochpound.experiment._spec.parse_experiment``), or
-        its typed form (:func:`~stochpound.experiment.read_definition`).
-    text : str
-        The experiment file's text (provenance).
-    base_dir : str or Path
-        Folder of the experiment file (record files are resolved against it).
-    path : str, optional
-        The experiment file, for provenance.
+    Its parameters are :class:`~stochpound.store.ExperimentGrid`'s but ``choice``: the run chooses the stripes' motions itself.
     """
 
     @cached_property
