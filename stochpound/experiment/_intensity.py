@@ -209,11 +209,6 @@ class Scaling:
         return self.intensity.ran
 
 
-def as_intensity(setting: Intensity | Mapping[str, Any]) -> Intensity:
-    """The typed setting of an experiment's ``intensity`` (the record itself, or read from its canonical entry)."""
-    return setting if isinstance(setting, Intensity) else Intensity.from_entry(setting)
-
-
 def level_to_si(intensity: Intensity, level: float, g: float) -> float:
     """A level in the units of ``levels`` in SI (m/s² or m/s)."""
     factor = {"g": g, "m/s2": 1.0, "m/s": 1.0, "cm/s": 0.01}[intensity.units]
@@ -281,19 +276,18 @@ def ida_capacity(closure: np.ndarray, im: float, gap_axes: list[tuple[float, lis
     return float(min(capacities))
 
 
-def summary_attrs(intensity: Intensity | Mapping[str, Any], name: str) -> dict[str, str]:
+def summary_attrs(intensity: Intensity, name: str) -> dict[str, str]:
     """Units and long name of a per-case intensity variable."""
     units, long_name = SUMMARIES[name]
-    setting = as_intensity(intensity)
-    return {"units": units.format(units=setting.units), "long_name": long_name.format(measure=setting.description)}
+    return {"units": units.format(units=intensity.units), "long_name": long_name.format(measure=intensity.description)}
 
 
-def store_names(intensity: Intensity | Mapping[str, Any] | None) -> list[str]:
+def store_names(intensity: Intensity | None) -> list[str]:
     """The per-case intensity variables of a store (none without intensity)."""
     if intensity is None:
         return []
     names = [name for name in SUMMARIES if name != "ida_capacity"]
-    return names + (["ida_capacity"] if as_intensity(intensity).ran == "ida" else [])
+    return names + (["ida_capacity"] if intensity.ran == "ida" else [])
 
 
 def task_settings(experiment: Any, motions: Mapping[str, Any]) -> Scaling | None:
