@@ -222,7 +222,7 @@ def run_experiment(
             if missing:
                 raise ExperimentError(f"{store}: written by an earlier stochpound without {', '.join(missing)}, which it keeps now: "
                                       "run the experiment again with --restart to recompute its cases")
-            stored, new = stored_definition(store), json.loads(canonical_json(experiment.definition.canonical))
+            stored, new = stored_definition(store), json.loads(canonical_json(experiment.definition.to_dict()))
             # the scene's provenance alone (the same content, from another file or inline) leaves the store as it is
             changed = [key for key in NOT_IN_IDENTITY if key != "scene_source" and stored.get(key) != new.get(key)]
             if changed:

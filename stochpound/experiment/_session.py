@@ -279,7 +279,7 @@ class StoreSession:
         folder.mkdir(parents=True, exist_ok=True)
         if (folder / DEFINITION_FILE).exists():
             record = read_experiment_json(folder)
-            definition = json.loads(canonical_json(experiment.definition.canonical))
+            definition = json.loads(canonical_json(experiment.definition.to_dict()))
             if record["definition"] != definition:  # the same runs (checked by check_store), another hazard: record it
                 record.update(definition=definition, definition_sha256=experiment.sha256, text=experiment.text,
                               text_sha256=hashlib.sha256(experiment.text.encode()).hexdigest())
@@ -287,7 +287,7 @@ class StoreSession:
         else:
             record = {
                 "definition_sha256": experiment.sha256,
-                "definition": json.loads(canonical_json(experiment.definition.canonical)),
+                "definition": json.loads(canonical_json(experiment.definition.to_dict())),
                 "text": experiment.text,
                 "text_sha256": hashlib.sha256(experiment.text.encode()).hexdigest(),
                 "file": experiment.path,
@@ -342,7 +342,7 @@ class StoreSession:
             "experiment_text": self.record.get("text", ""),
             "experiment_sha256": self.record.get("text_sha256", ""),
             "definition_sha256": experiment.sha256,
-            "definition": canonical_json(experiment.definition.canonical),
+            "definition": canonical_json(experiment.definition.to_dict()),
             "studied_building": experiment.studied,
             "stochpound_version": __version__,
             "git_commit": last.get("git_commit", "none"),

@@ -647,11 +647,6 @@ class Definition:
     scene_source: Mapping[str, str] | None = None
     site: Site | None = None
 
-    @property
-    def canonical(self) -> dict[str, Any]:
-        """The canonical definition (:meth:`to_dict`), as stored and hashed."""
-        return self.to_dict()
-
     def to_dict(self) -> dict[str, Any]:
         """The canonical definition, written from the records: what ``parse_experiment`` returns (``stochpound.experiment._spec``).
 
