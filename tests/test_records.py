@@ -106,7 +106,7 @@ def test_every_name_loads_with_verified_hash():
         assert "sha256" in record.provenance
     for entry in registry_entries().values():
         if not entry.is_variant:
-            assert sha256_of(records_dir() / entry.fields["file"]) == entry.fields["sha256"]
+            assert sha256_of(records_dir() / entry.file) == entry.sha256
 
 
 def test_variants_are_transformations_of_their_base():

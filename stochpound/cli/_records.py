@@ -27,8 +27,7 @@ def list_command(suite: str | None) -> None:
         _list_suite(suite)
         return
     for name, entry in registry_entries().items():
-        fields = entry.fields
-        kind = f"variant of {fields['base']}" if entry.is_variant else f"{fields.get('file')}"
+        kind = f"variant of {entry.base}" if entry.is_variant else f"{entry.file}"
         flag = "  [SUBSTITUTE]" if entry.substitute_for else ""
         try:
             units = load_record(name).units

@@ -9,10 +9,10 @@ from __future__ import annotations
 
 import math
 import tomllib
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 from functools import lru_cache
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Mapping
 
 from stochpound._data_files import bundled_data_dir
 from stochpound._errors import RecordError
@@ -22,45 +22,88 @@ from stochpound.motions.records._units import normalize_units
 from stochpound.motions.records._suites import is_suite_member, load_suite_member
 
 REGISTRY_FILE = "registry.toml"
-_VARIANT_KEYS = {"base", "first", "scale", "divide_by"}
+_FILE_FIELDS = ("source", "file", "format", "units", "dt", "column", "sha256", "source_start_time")
+"""The fields of a file entry, which a variant (its base's file) does not take."""
 
 
 @dataclass(frozen=True)
 class RegistryEntry:
-    """One named record of the registry.
+    """One named record of the registry: a ``[records.<name>]`` table of ``registry.toml``, read once.
+
+    A *file entry* names a bundled file (``file``, with its ``format``,
+    ``units``, ``dt``...); a *variant* transforms another entry (``base``,
+    with ``first``, ``scale``, ``divide_by``).
 
     Attributes
     ----------
     name : str
         Registry name.
-    fields : Mapping[str, Any]
-        The entry's table in ``registry.toml``.
+    description : str
+        One-line description.
+    source : str
+        Where the file comes from (empty for a variant: its base's).
+    file, format, units : str or None
+        A file entry's file (in the records folder), format (``at2``, ``text``) and units.
+    dt : float or None
+        The file's sample step, s, where the registry states it.
+    column : int or None
+        The acceleration column of a text file with several.
+    sha256 : str or None
+        The file's checksum, checked at every load.
+    source_start_time : float or None
+        Time of the file's first sample in its source, s, where it is not 0.
+    substitute_for : str or None
+        What the record stands in for, if it is a labelled substitute.
+    study_row : str or None
+        Key of the study's Table 3.2 row this record relates to, if any.
+    study_relation : str
+        How the record relates to the study's own record (empty: unrelated).
+    base : str or None
+        A variant's base entry (None: a file entry).
+    first : int or None
+        A variant keeps its base's first samples.
+    scale, divide_by : float or None
+        A variant multiplies (divides) its base's samples.
     """
 
     name: str
-    fields: Mapping[str, Any]
+    description: str = ""
+    source: str = ""
+    file: str | None = None
+    format: str | None = None
+    units: str | None = None
+    dt: float | None = None
+    column: int | None = None
+    sha256: str | None = None
+    source_start_time: float | None = None
+    substitute_for: str | None = None
+    study_row: str | None = None
+    study_relation: str = ""
+    base: str | None = None
+    first: int | None = None
+    scale: float | None = None
+    divide_by: float | None = None
+
+    @classmethod
+    def from_table(cls, name: str, table: Mapping[str, object]) -> RegistryEntry:
+        """The entry ``name`` from its ``registry.toml`` table; an unknown field raises :class:`~stochpound._errors.RecordError`."""
+        unknown = sorted(set(table) - _FIELDS)
+        if unknown:
+            raise RecordError(f"{name}: malformed registry entry (unknown fields {unknown})")
+        return cls(name, **table)
 
     @property
     def is_variant(self) -> bool:
         """True for a transformation of another entry (``base = ...``)."""
-        return "base" in self.fields
+        return self.base is not None
 
-    @property
-    def description(self) -> str:
-        """One-line description."""
-        return str(self.fields.get("description", ""))
+    def to_dict(self) -> dict[str, object]:
+        """The entry's table as ``registry.toml`` gives it (the fields it sets; a loaded record's metadata)."""
+        return {item.name: getattr(self, item.name) for item in fields(self)[1:] if getattr(self, item.name) != item.default}
 
-    @property
-    def substitute_for(self) -> str | None:
-        """What the record stands in for, if it is a labelled substitute."""
-        value = self.fields.get("substitute_for")
-        return None if value is None else str(value)
 
-    @property
-    def study_row(self) -> str | None:
-        """Key of the study's Table 3.2 row this record relates to, if any."""
-        value = self.fields.get("study_row")
-        return None if value is None else str(value)
+_FIELDS = {item.name for item in fields(RegistryEntry)[1:]}
+"""The fields a ``[records.<name>]`` table may set."""
 
 
 def records_dir() -> Path:
@@ -85,14 +128,15 @@ def _records_dir() -> Path:
 
 
 @lru_cache(maxsize=1)
-def _registry() -> dict[str, Any]:
+def _registry() -> tuple[RegistryEntry, ...]:
+    """The ``[records.<name>]`` tables of ``registry.toml``, read once, in file order."""
     with open(records_dir() / REGISTRY_FILE, "rb") as handle:
-        return tomllib.load(handle)
+        return tuple(RegistryEntry.from_table(name, table) for name, table in tomllib.load(handle)["records"].items())
 
 
 def registry_entries() -> dict[str, RegistryEntry]:
     """All registry entries by name, in file order."""
-    return {name: RegistryEntry(name, fields) for name, fields in _registry().get("records", {}).items()}
+    return {entry.name: entry for entry in _registry()}
 
 
 def list_records() -> list[str]:
@@ -169,23 +213,17 @@ def _check_override(record: Record, dt: float | None, units: str | None) -> None
 
 def _load_entry(entries: dict[str, RegistryEntry], name: str, _depth: int = 0) -> Record:
     entry = entries[name]
-    fields = entry.fields
     if entry.is_variant:
         return _load_variant(entries, entry, _depth)
-    folder = records_dir()
-    filename = str(fields["file"])
-    path = folder / filename
-    shown = f"data/records/{filename}"
+    path = records_dir() / str(entry.file)
+    shown = f"data/records/{entry.file}"
     if not path.is_file():
         raise RecordError(f"{name}: bundled file {shown} is missing")
-    series = read_record_file(
-        path, dt=fields.get("dt"), units=fields.get("units"), column=fields.get("column"), fmt=fields.get("format")
-    )
-    expected = fields.get("sha256")
-    if expected and series.sha256 != expected:
-        raise RecordError(f"{name}: bundled file {shown} has sha256 {series.sha256}, the registry says {expected}")
-    start = float(fields.get("source_start_time", series.source_start_time))
-    provenance = f"{fields.get('source', '')}; file {filename}, sha256 {series.sha256}"
+    series = read_record_file(path, dt=entry.dt, units=entry.units, column=entry.column, fmt=entry.format)
+    if entry.sha256 and series.sha256 != entry.sha256:
+        raise RecordError(f"{name}: bundled file {shown} has sha256 {series.sha256}, the registry says {entry.sha256}")
+    start = float(entry.source_start_time if entry.source_start_time is not None else series.source_start_time)
+    provenance = f"{entry.source}; file {entry.file}, sha256 {series.sha256}"
     if entry.substitute_for:
         provenance = f"SUBSTITUTE for {entry.substitute_for}; {provenance}"
     return Record(
@@ -196,29 +234,27 @@ def _load_entry(entries: dict[str, RegistryEntry], name: str, _depth: int = 0) -
         description=entry.description,
         provenance=provenance,
         source_start_time=start,
-        metadata=dict(fields),
+        metadata=entry.to_dict(),
     )
 
 
 def _load_variant(entries: dict[str, RegistryEntry], entry: RegistryEntry, depth: int) -> Record:
-    fields = entry.fields
-    unknown = set(fields) - _VARIANT_KEYS - {"description", "substitute_for", "study_row", "study_relation"}
-    base_name = str(fields["base"])
-    if unknown or base_name not in entries or depth > 8:
-        raise RecordError(f"{entry.name}: malformed registry variant (base {base_name!r}, fields {sorted(unknown)})")
+    base_name = str(entry.base)
+    stray = sorted(key for key in _FILE_FIELDS if key in entry.to_dict())
+    if stray or base_name not in entries or depth > 8:
+        raise RecordError(f"{entry.name}: malformed registry variant (base {base_name!r}, fields {stray})")
     base = _load_entry(entries, base_name, depth + 1)
     values = base.values
     steps = []
-    if "first" in fields:
-        first = int(fields["first"])
-        values = values[:first]
-        steps.append(f"first {first} samples")
-    if "scale" in fields:
-        values = values * float(fields["scale"])
-        steps.append("sign reversed" if float(fields["scale"]) == -1.0 else f"multiplied by {fields['scale']}")
-    if "divide_by" in fields:
-        values = values / float(fields["divide_by"])
-        steps.append(f"divided by {fields['divide_by']}")
+    if entry.first is not None:
+        values = values[: entry.first]
+        steps.append(f"first {entry.first} samples")
+    if entry.scale is not None:
+        values = values * float(entry.scale)
+        steps.append("sign reversed" if float(entry.scale) == -1.0 else f"multiplied by {entry.scale}")
+    if entry.divide_by is not None:
+        values = values / float(entry.divide_by)
+        steps.append(f"divided by {entry.divide_by}")
     transform = ", ".join(steps) if steps else "unchanged"
     provenance = f"variant of {base_name} ({transform}); {base.provenance}"
     if entry.substitute_for:
@@ -231,5 +267,5 @@ def _load_variant(entries: dict[str, RegistryEntry], entry: RegistryEntry, depth
         description=entry.description,
         provenance=provenance,
         source_start_time=base.source_start_time,
-        metadata={**base.metadata, **dict(fields)},
+        metadata={**base.metadata, **entry.to_dict()},
     )

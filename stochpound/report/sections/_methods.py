@@ -108,9 +108,9 @@ def records_provenance(definitions: list[StoreDefinition]) -> Table:
     rows = {}
     for name in records_used(definitions):
         entry = entries[name]
-        base = entries.get(str(entry.fields.get("base", "")))
-        source = entry.fields.get("source") or (base.fields.get("source") if base is not None else "")
-        rows[name] = [entry.description, source, entry.fields.get("study_relation", "")]
+        base = entries.get(str(entry.base))
+        source = entry.source or (base.source if base is not None else "")
+        rows[name] = [entry.description, source, entry.study_relation]
     frame = pd.DataFrame.from_dict(rows, orient="index", columns=["record", "source", "relation to the study"])
     frame.index.name = "name"
     return Table(
