@@ -49,8 +49,7 @@ def test_every_contact_law_has_consistent_force_partials_and_power(name):
     np.testing.assert_array_equal(law.power(element, delta, rate, onset), law.force(element, delta, rate, onset) * rate)
     assert law.energy_term == "impact"
     table = {"law": name, "stiffness": 2.0, **({"damping": 3.0} if "damping" in law.keys else {})}
-    law.rescale_table(table, 1.5)
-    assert table["stiffness"] == 3.0 and table.get("damping", 4.5) == 4.5
+    assert law.rescaled(table, 1.5) == {"stiffness": 3.0, **({"damping": 4.5} if "damping" in law.keys else {})}
 
 
 def test_the_friction_laws_and_the_friction_pendulum_describe_themselves():

@@ -159,10 +159,15 @@ def buildings_from_tables(tables: list[Mapping[str, Any]]) -> list[Building]:
     return buildings
 
 
+def default_name(index: int) -> str:
+    """The name of the ``index``-th (0-based) ``[[building]]`` of a scene that gives it none: B1, B2, ..."""
+    return f"B{index + 1}"
+
+
 def building_from_table(table: Mapping[str, Any], prefix: str, index: int) -> Building:
     """One ``[[building]]`` table (at ``prefix``, the ``index``-th: default name B{index + 1}), validated."""
     fields.reject_unknown(table, BUILDING_KEYS, prefix)
-    name = fields.string(table, "name", prefix, default=f"B{index + 1}")
+    name = fields.string(table, "name", prefix, default=default_name(index))
     base = base_from_table(fields.table(table, "base", prefix), f"{prefix}.base")
     mass = fields.number_list(table, "mass", prefix, low=0.0, low_open=True)
     if not mass and base is None:
@@ -227,15 +232,18 @@ def _initial(table: Mapping[str, Any] | None, prefix: str, n_floors: int, has_ba
     )
 
 
-def scale_masses(table: dict[str, Any], factor: float) -> None:
-    """Multiply a ``[[building]]`` table's floor and base masses by ``factor`` in place, keeping its modal damping ratios.
+def scaled_masses(table: Mapping[str, Any], factor: float) -> dict[str, Any]:
+    """The fields of a ``[[building]]`` table whose masses are multiplied by ``factor``, keeping its modal damping ratios.
 
-    Storey dashpots given as ``damping`` are multiplied by √factor (M → fM
-    with K fixed scales every frequency by 1/√f, so C → √f C keeps every
-    modal damping ratio); a ``damping_ratio`` is kept as it is.
+    The floor masses and a base's ``mass`` × factor; storey dashpots given as
+    ``damping`` × √factor (M → fM with K fixed scales every frequency by
+    1/√f, so C → √f C keeps every modal damping ratio); a ``damping_ratio``
+    is kept as it is (not among the fields returned).
     """
-    table["mass"] = [float(m) * factor for m in table["mass"]]
-    if isinstance(table.get("base"), dict) and "mass" in table["base"]:
-        table["base"]["mass"] = float(table["base"]["mass"]) * factor
+    scaled: dict[str, Any] = {"mass": [float(m) * factor for m in table["mass"]]}
+    base = table.get("base")
+    if isinstance(base, dict) and "mass" in base:
+        scaled["base"] = {**base, "mass": float(base["mass"]) * factor}
     if "damping" in table:
-        table["damping"] = [float(c) * math.sqrt(factor) for c in table["damping"]]
+        scaled["damping"] = [float(c) * math.sqrt(factor) for c in table["damping"]]
+    return scaled

@@ -3,8 +3,11 @@
 A scene dict has the structure of a scene file (docs/scene-files.md); this
 module owns that shape on the experiment side: the buildings by name, their
 bases, the contacts and walls, the ``[motion]``. Every edit of a case's
-scene goes through it, and every edit of a law's parameters asks the law
-(:mod:`stochpound.model.laws`); validation of the result is left to
+scene goes through it, and every edit is a set of fields given to one table
+of the scene in one place (``_give``): the values come from the override
+tables, the axes, or the rule that owns them (a building's mass scaling,
+:func:`stochpound.model.building.scaled_masses`; a law's parameters,
+:mod:`stochpound.model.laws`). Validation of the result is left to
 :func:`stochpound.scene_from_dict`.
 
 The *mass factor* rule (docs/experiments.md): multiplying a building's
@@ -14,7 +17,7 @@ masses by f (floors and base) keeps its dynamics consistent:
   every modal damping ratio (M → fM, K fixed, C → sqrt(f) C); a
   ``damping_ratio`` is kept as it is;
 * every contact touching the building and every wall beside it is rescaled
-  by its law's rule (:meth:`stochpound.model.laws.contract.ContactLaw.rescale_table`)
+  by its law's rule (:meth:`stochpound.model.laws.contract.ContactLaw.rescaled`)
   with the ratio m_eff,new / m_eff,old, m_eff = m1 m2 / (m1 + m2): for a
   Kelvin–Voigt element k_imp × ratio keeps its impact frequency
   sqrt(k_imp / m_eff), and c_imp follows from the restitution (or, when given
@@ -24,7 +27,7 @@ masses by f (floors and base) keeps its dynamics consistent:
   ``yield_force`` to keep a design).
 
 The *μ axis* rule: a finite μ is given to each chosen base by its friction
-law (:meth:`stochpound.model.laws.contract.FrictionLaw.set_mu`), which scales
+law (:meth:`stochpound.model.laws.contract.FrictionLaw.with_mu`), which scales
 its coefficients (Coulomb: ``mu`` = μ, ``mu_static`` keeps its ratio to
 ``mu``; velocity-dependent: ``fast`` = μ, ``slow`` and ``mu_static`` keep
 their ratios to ``fast``) or refuses; μ = inf removes the base (a fixed base).
@@ -36,8 +39,8 @@ import copy
 from typing import Any, Iterable, Mapping
 
 from stochpound._errors import SceneError
-from stochpound.model import building as building_law
 from stochpound.model import laws
+from stochpound.model.building import default_name, scaled_masses
 from stochpound.model.contact import ELEMENT_KEYS, effective_mass
 from stochpound.model.friction import is_fixed_base
 from stochpound.store._definition import scene_g
@@ -48,15 +51,27 @@ PLACEHOLDER_MOTION = {"type": "constant", "acceleration": 0.0, "duration": 1.0, 
 
 def building_names(scene: Mapping[str, Any]) -> list[str]:
     """The names of the scene's buildings, left to right (default names B1, B2, ...)."""
-    return [building.get("name", f"B{i + 1}") for i, building in enumerate(scene.get("building", []))]
+    return [building.get("name", default_name(i)) for i, building in enumerate(_tables(scene, "building"))]
 
 
-def building_table(scene: Mapping[str, Any], name: str) -> dict[str, Any]:
+def _tables(scene: Mapping[str, Any], part: str) -> list[Any]:
+    """The scene's array of tables ``part`` (``building``, ``contact`` or ``wall``), empty when it has none."""
+    return scene.get(part, [])
+
+
+def _building(scene: Mapping[str, Any], name: str) -> dict[str, Any]:
     """The ``[[building]]`` table named ``name`` (default names B1, B2, ... included)."""
     names = building_names(scene)
     if name not in names:
         raise KeyError(name)
     return scene["building"][names.index(name)]
+
+
+def _give(table: dict[str, Any], fields: Mapping[str, Any], dropped: Iterable[str] = ()) -> None:
+    """Give a table of the scene ``fields`` (copies), after dropping the fields ``dropped``, in place: the one way an edit writes the scene."""
+    for key in dropped:
+        table.pop(key, None)
+    table.update(copy.deepcopy(dict(fields)))
 
 
 def without_motion(scene: Mapping[str, Any]) -> dict[str, Any]:
@@ -88,24 +103,28 @@ def apply_overrides(scene: Mapping[str, Any], overrides: Iterable[Mapping[str, A
     scene = copy.deepcopy(dict(scene))
     factors: dict[str, float] = {}
     for override in overrides:
-        scene.update(copy.deepcopy(override.get("scene", {})))
+        _give(scene, override.get("scene", {}))
         _override_contacts(scene, override.get("contact"))
         for name, fields in override.get("building", {}).items():
-            building = building_table(scene, name)
-            for key, value in fields.items():
-                if key == "mass_factor":
-                    factors[name] = factors.get(name, 1.0) * float(value)
-                elif key == "base":
-                    _set_base(building, value)
-                elif key in ("damping", "damping_ratio"):
-                    building.pop("damping", None)
-                    building.pop("damping_ratio", None)
-                    building[key] = copy.deepcopy(value)
-                else:
-                    building[key] = copy.deepcopy(value)
+            if "mass_factor" in fields:
+                factors[name] = factors.get(name, 1.0) * float(fields["mass_factor"])
+            _override_building(_building(scene, name), fields)
     for name, factor in factors.items():
         scale_masses(scene, name, factor)
     return scene
+
+
+def _override_building(building: dict[str, Any], fields: Mapping[str, Any]) -> None:
+    """Give a ``[[building]]`` table a variant's fields (its ``mass_factor`` aside).
+
+    ``base = false`` removes the base, a ``base`` table is merged into the
+    base's; a ``damping`` or a ``damping_ratio`` replaces both.
+    """
+    for key, value in fields.items():
+        if key == "base":
+            _give(building, {}, ["base"]) if value is False else _give(building, {"base": {**building.get("base", {}), **value}})
+        elif key != "mass_factor":
+            _give(building, {key: value}, ["damping", "damping_ratio"] if key in ("damping", "damping_ratio") else [])
 
 
 def _override_contacts(scene: dict[str, Any], part: Mapping[str, Any] | list | None) -> None:
@@ -117,45 +136,34 @@ def _override_contacts(scene: dict[str, Any], part: Mapping[str, Any] | list | N
     """
     if part is None:
         return
-    contacts = scene.get("contact", [])
-    tables = part if isinstance(part, list) else [part] * len(contacts)
-    for contact, fields in zip(contacts, tables):
-        if "law" in fields:
-            for key in ELEMENT_KEYS:
-                contact.pop(key, None)
-        contact.update(copy.deepcopy(dict(fields)))
-
-
-def _set_base(building: dict[str, Any], value: Any) -> None:
-    if value is False:
-        building.pop("base", None)
-    else:
-        building["base"] = {**building.get("base", {}), **copy.deepcopy(value)}
+    contacts = _tables(scene, "contact")
+    for contact, fields in zip(contacts, part if isinstance(part, list) else [part] * len(contacts)):
+        _give(contact, fields, ELEMENT_KEYS if "law" in fields else [])
 
 
 def scale_masses(scene: dict[str, Any], name: str, factor: float) -> None:
     """Multiply building ``name``'s masses by ``factor`` in place, with what the laws derive from them.
 
-    The building's own rule (:func:`stochpound.model.building.scale_masses`:
+    The building's own rule (:func:`stochpound.model.building.scaled_masses`:
     dashpots × √factor), then every contact touching it and every wall beside
-    it by their law's rule (:meth:`stochpound.model.laws.contract.ContactLaw.rescale_table`,
+    it by their law's rule (:meth:`stochpound.model.laws.contract.ContactLaw.rescaled`,
     with the ratio of the effective masses, new over old: the factor itself
     for a wall).
     """
-    building = building_table(scene, name)
+    building = _building(scene, name)
     old_mass = [float(m) for m in building["mass"]]
-    building_law.scale_masses(building, factor)
-    for contact in scene.get("contact", []):
+    _give(building, scaled_masses(building, factor))
+    for contact in _tables(scene, "contact"):
         try:
             ends = [(str(end_name), int(floor)) for end_name, floor in contact["between"]]
             if name not in [end[0] for end in ends]:
                 continue
-            masses_new = [float(building_table(scene, end_name)["mass"][floor - 1]) for end_name, floor in ends]
+            masses_new = [float(_building(scene, end_name)["mass"][floor - 1]) for end_name, floor in ends]
             masses_old = [old_mass[floor - 1] if end_name == name else new for (end_name, floor), new in zip(ends, masses_new)]
         except (KeyError, IndexError, TypeError, ValueError):
             continue  # a malformed contact: scene validation names it
         _rescale_element(contact, effective_mass(*masses_new) / effective_mass(*masses_old))
-    for wall in scene.get("wall", []):
+    for wall in _tables(scene, "wall"):
         if wall.get("building") == name:  # a wall's effective mass is its level's mass, scaled by the factor
             _rescale_element(wall, factor)
 
@@ -166,15 +174,14 @@ def _rescale_element(table: dict[str, Any], mass_ratio: float) -> None:
         law = laws.contact_law(str(table.get("law", laws.DEFAULT_CONTACT_LAW)))
     except SceneError:
         return
-    law.rescale_table(table, mass_ratio)
+    _give(table, law.rescaled(table, mass_ratio))
 
 
 def set_gaps(scene: dict[str, Any], contacts: Iterable[int], gap: float, walls: Iterable[int] = ()) -> None:
     """Set the gap (m) of the given contacts and walls (0-based indices into ``contact`` and ``wall``) in place."""
-    for index in contacts:
-        scene["contact"][index]["gap"] = float(gap)
-    for index in walls:
-        scene["wall"][index]["gap"] = float(gap)
+    for part, indices in (("contact", contacts), ("wall", walls)):
+        for index in indices:
+            _give(scene[part][index], {"gap": float(gap)})
 
 
 def set_mu(scene: dict[str, Any], buildings: Iterable[str] | None, mu: float) -> list[str]:
@@ -189,7 +196,7 @@ def set_mu(scene: dict[str, Any], buildings: Iterable[str] | None, mu: float) ->
     mu : float
         The μ axis value (dimensionless), >= 0, or inf for a fixed base. A
         finite μ goes to the base's law
-        (:meth:`stochpound.model.laws.contract.FrictionLaw.set_mu`: it scales
+        (:meth:`stochpound.model.laws.contract.FrictionLaw.with_mu`: it scales
         its coefficients or refuses); a malformed base is left for scene
         validation to name.
 
@@ -204,13 +211,13 @@ def set_mu(scene: dict[str, Any], buildings: Iterable[str] | None, mu: float) ->
         When a base's law refuses μ, naming the field (``building[0].base.mu.fast: ...``).
     """
     names = building_names(scene)
-    chosen = list(buildings) if buildings is not None else [n for n in names if isinstance(building_table(scene, n).get("base"), dict)]
+    chosen = list(buildings) if buildings is not None else [n for n in names if isinstance(_building(scene, n).get("base"), dict)]
     missing = []
     for name in chosen:
-        building = building_table(scene, name)
+        building = _building(scene, name)
         base = building.get("base")
         if is_fixed_base(mu):
-            building.pop("base", None)
+            _give(building, {}, ["base"])
         elif not isinstance(base, dict):
             missing.append(name)
         else:
@@ -220,7 +227,7 @@ def set_mu(scene: dict[str, Any], buildings: Iterable[str] | None, mu: float) ->
                 law.read(base, prefix)
             except SceneError:
                 continue  # a malformed base: scene validation names it, as without the axis
-            law.set_mu(base, float(mu), prefix)
+            _give(base, law.with_mu(base, float(mu), prefix))
     if buildings is None and not chosen and not is_fixed_base(mu):
         missing.append("(no building has a [building.base])")
     return missing
@@ -228,8 +235,6 @@ def set_mu(scene: dict[str, Any], buildings: Iterable[str] | None, mu: float) ->
 
 def reference_scene(scene: Mapping[str, Any], studied: str) -> dict[str, Any]:
     """The studied building alone on a fixed base (no contacts), same g."""
-    building = copy.deepcopy(building_table(scene, studied))
-    building.pop("base", None)
-    building.pop("initial", None)
-    building["name"] = studied
+    building = copy.deepcopy(_building(scene, studied))
+    _give(building, {"name": studied}, ["base", "initial"])
     return {"g": scene_g(scene), "building": [building], "contact": []}

@@ -15,8 +15,8 @@ signature per kind of law:
   it adds to a closed mode, :func:`stochpound.model.contact.closed_terms`);
 * its power (the rate of work of its force, the energy term it enters);
 * what an experiment's axes do to its parameters: a contact law's mass
-  rescaling for variants (:meth:`ContactLaw.rescale_table`), a friction law's
-  answer to a μ axis (:meth:`FrictionLaw.set_mu`: scale its coefficients or
+  rescaling for variants (:meth:`ContactLaw.rescaled`), a friction law's
+  answer to a μ axis (:meth:`FrictionLaw.with_mu`: scale its coefficients or
   refuse, never replace the law);
 * ``describe()``: its name, parameters and units, for methods text;
 * a friction law's result variables (``FrictionLaw.variables``): how a
@@ -120,16 +120,15 @@ class ContactLaw(ABC):
         """When a closed element opens, in words (the nonlinear laws' force vanishes with δ: they never pull)."""
         return "at δ = 0, where its force vanishes (never pulls)"
 
-    def rescale_table(self, table: dict[str, Any], mass_ratio: float) -> None:
-        """Rescale the element's table in place after its m_eff changed by ``mass_ratio`` (new/old).
+    def rescaled(self, table: Mapping[str, Any], mass_ratio: float) -> dict[str, float]:
+        """The fields of the element's table that change when its m_eff changes by ``mass_ratio`` (new/old).
 
         The stiffness × ratio keeps the impact's time scale for a given
         approach velocity (√(k/m_eff) for Kelvin–Voigt); a given ``damping``
-        × ratio keeps its damping ratio (a ``restitution`` is kept).
+        × ratio keeps its damping ratio (a ``restitution`` is kept). A field
+        the table lacks is left for the scene's validation to name.
         """
-        table["stiffness"] = float(table["stiffness"]) * mass_ratio
-        if "damping" in table:
-            table["damping"] = float(table["damping"]) * mass_ratio
+        return {key: float(table[key]) * mass_ratio for key in ("stiffness", "damping") if key in table}
 
 
 class FrictionParameters(NamedTuple):
@@ -219,8 +218,8 @@ class FrictionLaw(ABC):
         return FrictionParameters(mu, fields.number(table, "mu_static", prefix, default=mu, low=mu), fast, rate)
 
     @abstractmethod
-    def set_mu(self, table: dict[str, Any], mu: float, prefix: str) -> None:
-        """Give the base table (at ``prefix``) an experiment's μ-axis value ``mu`` (finite, dimensionless), in place.
+    def with_mu(self, table: Mapping[str, Any], mu: float, prefix: str) -> dict[str, Any]:
+        """The fields of the base table (at ``prefix``) that an experiment's μ-axis value ``mu`` (finite, dimensionless) sets.
 
         The law scales its coefficients (its rule in its docstring) or
         refuses with a :class:`~stochpound._errors.SceneError` naming the

@@ -9,7 +9,7 @@ piecewise linear (:func:`stochpound.model.friction.slip_force` adds it to
 the mode's load) and the exact solver takes it. Mass scaling: W follows the
 masses; μ is kept.
 
-An experiment's μ axis (:meth:`Coulomb.set_mu`) sets ``mu``; ``mu_static``
+An experiment's μ axis (:meth:`Coulomb.with_mu`) sets ``mu``; ``mu_static``
 keeps its ratio to ``mu`` (equal to it unless the scene gives it).
 """
 
@@ -42,13 +42,12 @@ class Coulomb(FrictionLaw):
     def read_mu(self, table: Mapping[str, Any], prefix: str) -> tuple[float, None, None]:
         return fields.number(table, "mu", prefix, required=True, low=0.0), None, None
 
-    def set_mu(self, table: dict[str, Any], mu: float, prefix: str) -> None:
+    def with_mu(self, table: Mapping[str, Any], mu: float, prefix: str) -> dict[str, float]:
         """``mu`` ← the axis value; ``mu_static`` ← μ × (μ_s/μ) of the table (refused when the table has μ = 0 < μ_s: no ratio)."""
         parameters = self.read(table, prefix)
         if parameters.mu == 0.0 and parameters.mu_static > 0.0:
             raise SceneError(f"{prefix}.mu_static: a μ axis keeps mu_static/mu, which mu = 0 leaves undefined; give mu > 0 or no mu_static")
-        table["mu"] = float(mu)
-        table["mu_static"] = float(mu) * (parameters.mu_static / parameters.mu if parameters.mu > 0.0 else 1.0)
+        return {"mu": float(mu), "mu_static": float(mu) * (parameters.mu_static / parameters.mu if parameters.mu > 0.0 else 1.0)}
 
     def force(self, base: Any, state: int, speed: np.ndarray) -> np.ndarray:
         return np.full(np.shape(speed), -state * base.mu * base.weight)

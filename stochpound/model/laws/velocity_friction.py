@@ -13,7 +13,7 @@ and slips as with Coulomb friction (stick while the force it needs stays
 within μ_s W). With μ_fast = μ_slow it is Coulomb friction. Not piecewise
 linear: a scene that asks for it runs on the ivp path.
 
-An experiment's μ axis (:meth:`VelocityDependent.set_mu`) sets ``fast``;
+An experiment's μ axis (:meth:`VelocityDependent.with_mu`) sets ``fast``;
 ``slow`` and a given ``mu_static`` keep their ratios to ``fast`` and
 ``rate`` is kept: the curve μ(ṡ) is scaled, its shape kept. A μ of 0 is
 refused (``fast`` must be > 0).
@@ -59,14 +59,13 @@ class VelocityDependent(FrictionLaw):
     def read_mu(self, table: Mapping[str, Any], prefix: str) -> tuple[float, float, float]:
         return mu_from_table(table["mu"], f"{prefix}.mu")
 
-    def set_mu(self, table: dict[str, Any], mu: float, prefix: str) -> None:
+    def with_mu(self, table: Mapping[str, Any], mu: float, prefix: str) -> dict[str, Any]:
         """``fast`` ← the axis value; ``slow`` ← μ × slow/fast and a given ``mu_static`` ← μ × μ_s/fast; ``rate`` kept (μ = 0 refused)."""
         parameters = self.read(table, prefix)
         if mu <= 0.0:
             raise SceneError(f"{prefix}.mu.fast: a μ axis sets fast, which must be > 0 for velocity-dependent friction; got {mu:g}")
-        table["mu"] = {"slow": float(mu) * (parameters.mu / parameters.mu_fast), "fast": float(mu), "rate": parameters.mu_rate}
-        if "mu_static" in table:
-            table["mu_static"] = float(mu) * (parameters.mu_static / parameters.mu_fast)
+        scaled = {"mu": {"slow": float(mu) * (parameters.mu / parameters.mu_fast), "fast": float(mu), "rate": parameters.mu_rate}}
+        return scaled | ({"mu_static": float(mu) * (parameters.mu_static / parameters.mu_fast)} if "mu_static" in table else {})
 
     def force(self, base: Any, state: int, speed: np.ndarray) -> np.ndarray:
         return -state * base.weight * coefficient(base.mu, base.mu_fast, base.mu_rate, speed)
