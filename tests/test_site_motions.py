@@ -15,7 +15,7 @@ from stochpound.motions._arias import arias_intensity
 from stochpound.motions import _site_model
 from stochpound.motions._site_calibration import calibration_table, target
 from stochpound.motions._site_model import (
-    F_MIN, IRF_TOLERANCE, _hold_matrices, _marginal_ppf, _normalized_noise, gamma_shape, high_pass, load_site_model, modulation, motions_from_parameters,
+    F_MIN, IRF_TOLERANCE, _hold_matrices, _normalized_noise, gamma_shape, high_pass, load_site_model, modulation, motions_from_parameters,
 )  # fmt: skip
 
 SCENARIO = {"magnitude": 7.0, "distance_km": 20.0, "vs30": 400.0, "mechanism": "strike_slip"}
@@ -133,8 +133,8 @@ def test_high_pass_step_is_the_exact_solution_of_the_oscillator():
 
 def test_two_sided_exponential_marginal_inverts_its_distribution():
     marginal = load_site_model("rezaeian_2010").marginals[4]
-    a, b, c, low = marginal["a"], marginal["b"], marginal["c"], marginal["low"]
-    x = _marginal_ppf(marginal, np.array([0.01, 0.3, 0.7, 0.95, 0.999]))
+    a, b, c, low = marginal.a, marginal.b, marginal.c, marginal.low
+    x = marginal.ppf(np.array([0.01, 0.3, 0.7, 0.95, 0.999]))
     cdf = [integrate.quad(lambda s: c * (np.exp(b * s) if s < 0 else np.exp(-a * s)), low, value, points=[0.0] if value > 0 else None)[0] for value in x]
     assert np.allclose(cdf, [0.01, 0.3, 0.7, 0.95, 0.999], atol=1e-6)
 

@@ -315,7 +315,7 @@ def spectrum_dataset(periods: np.ndarray, mean_ln: np.ndarray, covariance: np.nd
 MODELS_TEXT = "ASK14 BSSA14 CB14 CY14 (pygmm), mean of ln medians, sigma = rms of sigmas; Baker-Jayaram 2008 correlation"
 
 
-def conditioning_attrs(measure: Measure, level: float) -> dict[str, object]:
+def conditioning_attrs(measure: Measure, level: float) -> dict[str, float | str]:
     """The attributes of a conditional spectrum that name its conditioning: ``measure``, ``conditioning_period``, ``level``, ``damping``, ``models``."""
     period = measure.spectral_period
     return {"measure": measure.kind, "conditioning_period": "" if period is None else " ".join(f"{p:g}" for p in np.atleast_1d(period)),

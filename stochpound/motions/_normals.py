@@ -30,7 +30,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Any, Callable
+from typing import Callable
 
 import numpy as np
 from scipy.special import ndtr
@@ -71,7 +71,7 @@ class NormalMotion:
         e(t) multiplying the stationary samples; None = stationary.
     baseline : bool
         Correct each motion to end with zero velocity and displacement.
-    attrs : dict
+    attrs : dict[str, float | str]
         The motion's parameters, as the generators' results carry them.
     """
 
@@ -83,7 +83,7 @@ class NormalMotion:
     band_limit: bool = False
     envelope: Callable[[np.ndarray], np.ndarray] | None = None
     baseline: bool = False
-    attrs: dict[str, Any] = field(default_factory=dict, compare=False)
+    attrs: dict[str, float | str] = field(default_factory=dict, compare=False)
 
     @property
     def time(self) -> np.ndarray:

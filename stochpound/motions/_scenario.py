@@ -82,7 +82,7 @@ def is_finite_number(value: object) -> bool:
     return isinstance(value, (int, float, np.floating, np.integer)) and not isinstance(value, bool) and bool(np.isfinite(value))
 
 
-def _check(values: Mapping[str, Any], geometry: Mapping[str, Any], names: Mapping[str, str],
+def _check(values: Mapping[str, float | str], geometry: Mapping[str, float], names: Mapping[str, str],
            limits: Mapping[str, tuple[float, float]] | None, source: str) -> None:
     """Raise :class:`SiteError` naming (``names``) the first field of a scenario outside its range or of an unknown mechanism."""
     for field, (low, high) in (limits or scenario_limits()).items():
@@ -183,7 +183,7 @@ class Scenario:
         _check(self.loose(), self.geometry, names or {}, limits, source)
         return self
 
-    def loose(self) -> dict[str, Any]:
+    def loose(self) -> dict[str, float | str]:
         """``magnitude``, ``distance_km``, ``vs30`` and ``mechanism``, the keywords of the public functions that take a scenario."""
         return {"magnitude": self.magnitude, "distance_km": self.distance_km, "vs30": self.vs30, "mechanism": self.mechanism}
 
@@ -192,7 +192,7 @@ class Scenario:
         """The geometry given (:data:`GEOMETRY_FIELDS` order), without the fields left to the estimates."""
         return {field: value for field in GEOMETRY_FIELDS if (value := getattr(self, field)) is not None}
 
-    def attrs(self) -> dict[str, Any]:
+    def attrs(self) -> dict[str, float | str]:
         """The scenario as a dataset's attributes: :meth:`loose` and the geometry given."""
         return {**self.loose(), **self.geometry}
 

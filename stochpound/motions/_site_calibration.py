@@ -41,7 +41,7 @@ from stochpound.motions._conditional import MODEL_DAMPING, _average_model, _node
 from stochpound.motions._scenario import Scenario
 from stochpound.motions._seeding import realization_rng
 from stochpound.motions._site_model import (
-    FEATURES, PARAMETERS, ZETA_MAX, SiteModel, _marginal_ppf, load_site_model, mean_normals, motion_parameters, motions_from_parameters,
+    FEATURES, PARAMETERS, ZETA_MAX, SiteModel, load_site_model, mean_normals, motion_parameters, motions_from_parameters,
 )  # fmt: skip
 from stochpound.motions._spectrum import _spectrum_kernel
 
@@ -125,7 +125,7 @@ class CheckTable:
     scenarios: tuple
     ln_median_ratio: np.ndarray  # [scenario, period]
     sigma_difference: np.ndarray  # [scenario, period]
-    correlation: dict  # pair -> (simulated, Baker-Jayaram)
+    correlation: dict[tuple[float, float], tuple[float, float]]  # pair of periods (s) -> (simulated, Baker-Jayaram)
     n: int
 
 
@@ -177,7 +177,7 @@ def _pool(scenario: tuple, n: int, seed: int, dt: float) -> _Pool:
     p = np.clip(stats.norm.cdf(nu), 1e-12, 1.0 - 1e-12)
     parameters = {"arias_intensity": np.ones(n)}
     for i, name in enumerate(PARAMETERS[1:]):
-        parameters[name] = _marginal_ppf(published.marginals[i + 1], p[:, i])
+        parameters[name] = published.marginals[i + 1].ppf(p[:, i])
     parameters["zeta_f"] = np.minimum(parameters["zeta_f"], ZETA_MAX)
     parameters["f_corner"] = np.exp(ln_corner)
     n_time = int(round(scenario_duration(scenario) / dt)) + 1
@@ -217,7 +217,7 @@ def _pool_statistics(pool: _Pool, x: np.ndarray) -> tuple[np.ndarray, np.ndarray
     conditional_sd = math.sqrt(covariance[0, 0] - covariance[1:, 0] @ gain)
     nu_arias = conditional_mean + conditional_sd * pool.z_arias
     marginal = published.marginals[0]
-    ln_arias = marginal["mu"] + marginal["sigma"] * nu_arias + math.log(DEFAULT_G)  # ln I_a in m/s
+    ln_arias = marginal.mu + marginal.sigma * nu_arias + math.log(DEFAULT_G)  # ln I_a in m/s
     ln_sa = pool.ln_sa_unit + 0.5 * ln_arias[:, None]
     mean = weights @ ln_sa
     deviation = ln_sa - mean

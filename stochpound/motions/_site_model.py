@@ -36,7 +36,7 @@ from __future__ import annotations
 
 import math
 import tomllib
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from functools import lru_cache
@@ -74,6 +74,70 @@ FEATURES = ("intercept", "magnitude", "ln_distance", "ln_vs30", "reverse", "norm
 
 
 @dataclass(frozen=True)
+class Lognormal:
+    """A lognormal marginal: ln x is normal with mean ``mu`` and standard deviation ``sigma``."""
+
+    mu: float
+    sigma: float
+
+    def ppf(self, p: np.ndarray) -> np.ndarray:
+        """The quantiles at probabilities ``p``."""
+        return np.exp(stats.norm.ppf(p, self.mu, self.sigma))
+
+
+@dataclass(frozen=True)
+class Beta:
+    """A beta marginal of shapes ``a``, ``b`` on [``low``, ``high``]."""
+
+    a: float
+    b: float
+    low: float
+    high: float
+
+    def ppf(self, p: np.ndarray) -> np.ndarray:
+        """The quantiles at probabilities ``p``."""
+        return self.low + (self.high - self.low) * stats.beta.ppf(p, self.a, self.b)
+
+
+@dataclass(frozen=True)
+class Gamma:
+    """A gamma marginal of ``shape`` and ``scale``."""
+
+    shape: float
+    scale: float
+
+    def ppf(self, p: np.ndarray) -> np.ndarray:
+        """The quantiles at probabilities ``p``."""
+        return stats.gamma.ppf(p, self.shape, scale=self.scale)
+
+
+@dataclass(frozen=True)
+class TwoSidedExponential:
+    """The density c e^(b x) on [``low``, 0) and c e^(−a x) on [0, ``high``]."""
+
+    a: float
+    b: float
+    c: float
+    low: float
+    high: float
+
+    def ppf(self, p: np.ndarray) -> np.ndarray:
+        """The quantiles at probabilities ``p``."""
+        return _two_sided_exponential_ppf(p, self.a, self.b, self.c, self.low, self.high)
+
+
+Marginal = Lognormal | Beta | Gamma | TwoSidedExponential
+"""A parameter's marginal distribution (the data file's ``kind``)."""
+_MARGINALS = {"lognormal": Lognormal, "beta": Beta, "gamma": Gamma, "two_sided_exponential": TwoSidedExponential}
+
+
+def _marginal(table: Mapping[str, float | str]) -> Marginal:
+    """A ``[marginals]`` entry of the data file: its ``kind`` with that kind's parameters."""
+    fields = dict(table)
+    return _MARGINALS[str(fields.pop("kind"))](**fields)
+
+
+@dataclass(frozen=True)
 class SiteModel:
     """A model's predictive equations in the standard normal space, its marginals and its post-filter.
 
@@ -87,7 +151,7 @@ class SiteModel:
     name: str
     coefficients: np.ndarray
     cholesky: np.ndarray
-    marginals: tuple[dict, ...]
+    marginals: tuple[Marginal, ...]
     adjustments: np.ndarray
     corner: np.ndarray
     provenance: str
@@ -123,7 +187,7 @@ def load_site_model(model: str) -> SiteModel:
         raise ValueError(f"model: must be one of {', '.join(MODELS)}, got {model!r}")
     covariance = np.asarray(residuals["correlation"]) * np.outer(scale, scale)
     return SiteModel(model, np.array([published["coefficients"][p] for p in PARAMETERS]), np.linalg.cholesky(covariance),
-                     tuple(published["marginals"][p] for p in PARAMETERS), adjustments, corner, provenance)
+                     tuple(_marginal(published["marginals"][p]) for p in PARAMETERS), adjustments, corner, provenance)
 
 
 def scenario_features(scenario: Scenario) -> np.ndarray:
@@ -152,26 +216,13 @@ def _two_sided_exponential_ppf(p: np.ndarray, a: float, b: float, c: float, low:
     return np.clip(np.where(p < at_zero, below, above), low, high)
 
 
-def _marginal_ppf(marginal: dict, p: np.ndarray) -> np.ndarray:
-    kind = marginal["kind"]
-    if kind == "lognormal":
-        return np.exp(stats.norm.ppf(p, marginal["mu"], marginal["sigma"]))
-    if kind == "beta":
-        return marginal["low"] + (marginal["high"] - marginal["low"]) * stats.beta.ppf(p, marginal["a"], marginal["b"])
-    if kind == "gamma":
-        return stats.gamma.ppf(p, marginal["shape"], scale=marginal["scale"])
-    if kind == "two_sided_exponential":
-        return _two_sided_exponential_ppf(p, marginal["a"], marginal["b"], marginal["c"], marginal["low"], marginal["high"])
-    raise ValueError(f"marginal kind {kind!r} unknown")  # pragma: no cover - the data file's own consistency
-
-
 def motion_parameters(model: SiteModel, scenario: Scenario, normals: np.ndarray) -> dict[str, np.ndarray]:
     """Each motion's parameters (:data:`UNITS`) from its :data:`PARAMETER_NORMALS` standard normals ``normals`` [n, 7]."""
     normals = np.asarray(normals, dtype=float)
     correlated = np.sum(normals[:, None, :6] * model.cholesky[None, :, :], axis=2)  # L z row by row: a BLAS product's rounding depends on n
     nu = mean_normals(model, scenario)[None, :] + correlated
     p = np.clip(stats.norm.cdf(nu), 1e-12, 1.0 - 1e-12)
-    values = {name: _marginal_ppf(marginal, p[:, i]) for i, (name, marginal) in enumerate(zip(PARAMETERS, model.marginals))}
+    values = {name: marginal.ppf(p[:, i]) for i, (name, marginal) in enumerate(zip(PARAMETERS, model.marginals))}
     values["arias_intensity"] = values["arias_intensity"] * DEFAULT_G  # s·g → m/s
     values["zeta_f"] = np.minimum(values["zeta_f"], ZETA_MAX)
     values["f_corner"] = np.exp(model.corner[0] + model.corner[1] * (scenario.magnitude - 7.0) + model.corner[2] * normals[:, 6])

@@ -296,7 +296,7 @@ def _filtered_motion(
         raise ValueError(f"give exactly one of S0, pga, rms (got {', '.join(given) or 'none'})")
     if peak_factor is not None and pga is None:
         raise ValueError("peak_factor: only used with pga")
-    attrs: dict[str, Any] = {}
+    attrs: dict[str, float | str] = {}
     omega_max = math.pi / dt if band_limit else None
     if S0 is not None:
         level = _positive(S0, "S0")

@@ -39,7 +39,7 @@ class Envelope:
     def __call__(self, t: np.ndarray) -> np.ndarray:
         raise NotImplementedError
 
-    def parameters(self) -> dict[str, Any]:
+    def parameters(self) -> dict[str, float | str]:
         """Parameters, for attributes and reports."""
         return asdict(self) if hasattr(self, "__dataclass_fields__") else {}
 
@@ -61,11 +61,10 @@ class Jennings(Envelope):
         _require(self.t1 > 0 and self.t2 >= self.t1 and self.c > 0, f"{self.name}: need 0 < t1 <= t2 and c > 0, got {self}")
 
     @classmethod
-    def default(cls, duration: float, **overrides: float) -> "Jennings":
-        """t1 = 0.1 D, t2 = 0.5 D, c = ln(20)/(D − t2), replaced by any of ``overrides`` (s, 1/s)."""
-        t2 = overrides.get("t2", 0.5 * duration)
-        params = {"t1": 0.1 * duration, "t2": t2, "c": math.log(20.0) / max(duration - t2, 1e-12)}
-        return cls(**{**params, **overrides})
+    def default(cls, duration: float, t1: float | None = None, t2: float | None = None, c: float | None = None) -> "Jennings":
+        """t1 = 0.1 D, t2 = 0.5 D, c = ln(20)/(D − t2) for a motion of duration D (s), where not given (s, 1/s)."""
+        t2 = 0.5 * duration if t2 is None else t2
+        return cls(0.1 * duration if t1 is None else t1, t2, math.log(20.0) / max(duration - t2, 1e-12) if c is None else c)
 
     def __call__(self, t: np.ndarray) -> np.ndarray:
         t = np.asarray(t, dtype=float)
@@ -94,9 +93,9 @@ class Trapezoidal(Envelope):
         _require(0 < self.t1 <= self.t2 < self.t3, f"trapezoidal: need 0 < t1 <= t2 < t3, got {self}")
 
     @classmethod
-    def default(cls, duration: float, **overrides: float) -> "Trapezoidal":
-        """t1 = 0.1 D, t2 = 0.6 D, t3 = D, replaced by any of ``overrides`` (s)."""
-        return cls(**{"t1": 0.1 * duration, "t2": 0.6 * duration, "t3": duration, **overrides})
+    def default(cls, duration: float, t1: float | None = None, t2: float | None = None, t3: float | None = None) -> "Trapezoidal":
+        """t1 = 0.1 D, t2 = 0.6 D, t3 = D for a motion of duration D (s), where not given (s)."""
+        return cls(0.1 * duration if t1 is None else t1, 0.6 * duration if t2 is None else t2, duration if t3 is None else t3)
 
     def __call__(self, t: np.ndarray) -> np.ndarray:
         return np.interp(np.asarray(t, dtype=float), [0.0, self.t1, self.t2, self.t3], [0.0, 1.0, 1.0, 0.0], left=0.0, right=0.0)
@@ -121,11 +120,14 @@ class SaragoniHart(Envelope):
         return cls(b=b, c=b / (eps * tw))
 
     @classmethod
-    def default(cls, duration: float, **overrides: float) -> "SaragoniHart":
-        """``b`` and ``c`` if given, else Boore's shape with eps = 0.2, eta = 0.05, tw = D (overridable)."""
-        if "b" in overrides or "c" in overrides:
-            return cls(**overrides)
-        return cls.from_shape(overrides.get("tw", duration), overrides.get("eps", 0.2), overrides.get("eta", 0.05))
+    def default(cls, duration: float, b: float | None = None, c: float | None = None, tw: float | None = None, eps: float | None = None,
+                eta: float | None = None) -> "SaragoniHart":
+        """``b`` and ``c`` if given (both, and no shape), else Boore's shape with eps = 0.2, eta = 0.05 and tw = D (s), where not given."""
+        if b is not None or c is not None:
+            _require(b is not None and c is not None and (tw, eps, eta) == (None, None, None),
+                     f"saragoni_hart: give b and c (1/s), or the shape tw, eps, eta; got b={b}, c={c}, tw={tw}, eps={eps}, eta={eta}")
+            return cls(b, c)
+        return cls.from_shape(duration if tw is None else tw, 0.2 if eps is None else eps, 0.05 if eta is None else eta)
 
     @property
     def peak_time(self) -> float:
@@ -151,7 +153,7 @@ class CallableEnvelope(Envelope):
         _require(values.shape == np.shape(t) and bool(np.all(np.isfinite(values))), "envelope: the callable must return finite values shaped like t")
         return values
 
-    def parameters(self) -> dict[str, Any]:
+    def parameters(self) -> dict[str, float | str]:
         """The function's name."""
         return {"function": getattr(self.function, "__name__", repr(self.function))}
 
@@ -196,7 +198,7 @@ def make_envelope(spec: Any, duration: float) -> Envelope | None:
     raise ValueError(f"envelope: must be a name ({', '.join(ENVELOPES)}), a table with 'type', or a callable; got {spec!r}")
 
 
-def _named(kind: str, duration: float, params: dict[str, Any]) -> Envelope:
+def _named(kind: str, duration: float, params: Mapping[str, float]) -> Envelope:
     cls = ENVELOPES.get(kind.lower())
     if cls is None:
         raise ValueError(f"envelope.type: must be one of {', '.join(ENVELOPES)}; got {kind!r}")

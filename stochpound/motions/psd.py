@@ -97,15 +97,15 @@ class FilteredWhiteNoise:
         Two-sided PSD of the input white noise, m²/s³.
     name : str
         Model name (``"kanai_tajimi"``, ``"clough_penzien"``).
-    parameters : dict
-        Physical parameters (for attributes and messages).
+    parameters : dict[str, float]
+        Physical parameters (for attributes and messages), e.g. ``omega_g`` (rad/s) and ``zeta_g``.
     """
 
     numerator: tuple[float, ...]
     denominator: tuple[float, ...]
     S0: float = 1.0
     name: str = "filtered_white_noise"
-    parameters: dict = field(default_factory=dict, compare=False)
+    parameters: dict[str, float] = field(default_factory=dict, compare=False)
 
     def __post_init__(self) -> None:
         if len(self.numerator) >= len(self.denominator):

@@ -36,7 +36,7 @@ def _var(dims: tuple[str, ...], data: np.ndarray, units: str, long_name: str, **
     return dims, data, {"units": units, "long_name": long_name, **attrs}
 
 
-def build_dataset(scene: Scene, system: System, recorder: Recorder, counters: EventCounters, solver_attrs: dict[str, Any]) -> xr.Dataset:
+def build_dataset(scene: Scene, system: System, recorder: Recorder, counters: EventCounters, solver_attrs: dict[str, float | str]) -> xr.Dataset:
     """Assemble the result dataset of one run.
 
     Parameters
@@ -44,8 +44,8 @@ def build_dataset(scene: Scene, system: System, recorder: Recorder, counters: Ev
     scene, system : the simulated scene and its assembled system.
     recorder : Recorder with the recorded outputs.
     counters : EventCounters of the run.
-    solver_attrs : dict
-        Solver name and settings, stored as attributes.
+    solver_attrs : dict[str, float | str]
+        Solver name and settings (``solver``, ``rtol``...), stored as attributes.
     """
     data_vars = {
         **_response_variables(scene, system, recorder),

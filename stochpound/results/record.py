@@ -115,7 +115,7 @@ class Recorder:
         infinite gap (m; :func:`stochpound.model.modes.monitored_contacts`), then ± the
         demand parameters when the system monitors them
         (:func:`stochpound.model.modes.monitor_rows`).
-    demands : dict of str to np.ndarray
+    demands : dict[str, np.ndarray]
         When the system monitors demands: each parameter of
         :data:`stochpound.model.demands.DEMANDS` at every floor and output
         time (floor, in the order of the system's floors × time), filled by

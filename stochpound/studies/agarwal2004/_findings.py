@@ -7,6 +7,8 @@ numbers behind the verdict (or None when the store it needs is missing).
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+
 import numpy as np
 import xarray as xr
 
@@ -64,7 +66,7 @@ def _column_variable(column: str, statistic: str) -> str:
     return f"{'reference_' if column == 'single' else ''}response_{statistic}"
 
 
-def _column_labels(spec: dict, column: str) -> dict:
+def _column_labels(spec: Mapping[str, str], column: str) -> dict[str, str | float]:
     if column == "single":
         return {}
     return {"isolation": spec["configuration"], "neighbour": spec["neighbour"], "gap": 0.02, "mu": FIXED_BASE, "model": "corrected"}

@@ -14,6 +14,7 @@ Every number is computed from the stores or from those reruns.
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Mapping
 
 import numpy as np
 import pandas as pd
@@ -85,7 +86,7 @@ def northridge_means(pair_records: xr.Dataset, single: xr.Dataset | None, record
     return [Paragraph(text), FigureItem("figure-northridge-sliding", caption, figure)]
 
 
-def _zoom(runs: dict) -> tuple[float, float]:
+def _zoom(runs: Mapping[str, tuple[xr.Dataset, float]]) -> tuple[float, float]:
     starts = np.concatenate([run["impact_start"].values for run, _ in runs.values()])
     if not starts.size:
         return (0.0, 5.0)

@@ -118,7 +118,7 @@ def mu_table(number: str, store: xr.Dataset | None) -> Table:
     )
 
 
-def _mu_cell(store: xr.Dataset | None, variable: str, factor: float, column: float | str, spec: Mapping, labels: Mapping[str, str]) -> float:
+def _mu_cell(store: xr.Dataset | None, variable: str, factor: float, column: float | str, spec: Mapping[str, str], labels: Mapping[str, str]) -> float:
     record = labels["record"]
     if column == "single":
         if variable == "impacts":
