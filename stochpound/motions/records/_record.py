@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any, Mapping
+from typing import Mapping
 
 import numpy as np
 
@@ -36,8 +36,8 @@ class Record:
         ``SUBSTITUTE for ...`` where the record stands in for another one.
     source_start_time : float
         Time of the first sample in the source file's own clock, s.
-    metadata : Mapping[str, Any]
-        Registry fields (e.g. ``substitute_for``, ``study_row``), informative only.
+    metadata : Mapping[str, float | str]
+        Registry fields (e.g. ``substitute_for``, ``study_row``) or a suite motion's (``event``, ``magnitude``...), informative only.
     """
 
     name: str
@@ -47,7 +47,7 @@ class Record:
     description: str = ""
     provenance: str = ""
     source_start_time: float = 0.0
-    metadata: Mapping[str, Any] = field(default_factory=dict)
+    metadata: Mapping[str, float | str] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         self.values = np.asarray(self.values, dtype=np.float64)

@@ -97,7 +97,7 @@ class RegistryEntry:
         """True for a transformation of another entry (``base = ...``)."""
         return self.base is not None
 
-    def to_dict(self) -> dict[str, object]:
+    def to_dict(self) -> dict[str, float | str]:
         """The entry's table as ``registry.toml`` gives it (the fields it sets; a loaded record's metadata)."""
         return {item.name: getattr(self, item.name) for item in fields(self)[1:] if getattr(self, item.name) != item.default}
 

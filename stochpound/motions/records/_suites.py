@@ -192,7 +192,7 @@ def load_suite_member(name: str) -> Record:
     event = data.records.loc[record_id]
     values = np.asarray(row["RecordedAcceleration"], dtype=np.float64)
     digest = hashlib.sha256(values.tobytes()).hexdigest()
-    metadata: dict[str, Any] = {
+    metadata: dict[str, float | str] = {
         "suite": suite,
         "event": f"{event['EarthquakeName']} {int(event['EarthquakeYear'])}",
         "year": int(event["EarthquakeYear"]),
@@ -236,7 +236,7 @@ def _pulse(suite: str, rsn: int) -> dict[str, bool]:
     return {"pulse": rsn in {int(value) for value in pulses}}
 
 
-def _blank_metadata() -> dict[str, Any]:
+def _blank_metadata() -> dict[str, float | str]:
     return {name: ("" if name in ("event", "station", "component") else np.nan) for name in METADATA_FIELDS}
 
 
