@@ -1,0 +1,80 @@
+"""The answer without an intensity measure for a store's configurations (stochpound.analysis.store_measure_free): each
+configuration's scene is the one its conditioned answer ran, its runs are measure_free_risk's on that scene, every demand is
+read from the same runs, and the table gives every configuration, demand and target."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from stochpound import open_store
+from stochpound.analysis import MeasureFreeDemand, RuptureSite, measure_free_risk, store_measure_free
+from stochpound.experiment._runner import load_experiment, run_experiment
+from stochpound.risk import configuration_scene
+from tests.helpers import ISOLATED, risk_text, write_experiment
+
+STRIPES = 'measure = "psa"\nperiod = 1.0\nlevels = [0.3, 0.8]'
+SITE = RuptureSite(magnitude=(7.0, 6.0), distance_rup_km=(20.0, 10.0), distance_jb_km=(20.0, 10.0), distance_x_km=(-20.0, -10.0),
+                   ztor_km=(0.0, 0.0), dip=(90.0, 90.0), mechanism=("strike_slip", "reverse"), rate=(0.01, 0.05), vs30=400.0, name="two")
+
+
+@pytest.fixture(scope="module")
+def store(tmp_path_factory):
+    """B1 on a friction pendulum (μ 0.05 and 0.08, the configurations) beside a fixed B2, contact-free, 8 motions x 2 stripes."""
+    text = risk_text(ISOLATED, 'gap = [inf]\nmu = { values = [0.05, 0.08], buildings = ["B1"] }', STRIPES)
+    report = run_experiment(load_experiment(write_experiment(tmp_path_factory.mktemp("store"), text, "isolated.toml")), workers=0, progress=False)
+    assert report.complete
+    return open_store(report.store).load()
+
+
+@pytest.fixture(scope="module")
+def answer(store):
+    return store_measure_free(store, SITE, runs=8, seed=3, bootstrap=100)
+
+
+def test_each_configuration_runs_its_own_scene_as_measure_free_risk_would(store, answer):
+    assert answer.configurations == ((("mu", 0.05),), (("mu", 0.08),))
+    assert (answer.runs, answer.first_stage, answer.extra) == (8, 2, 4) and "two of 2 ruptures" in answer.site
+    for labels, results in zip(answer.configurations, answer.results):
+        scene = configuration_scene(store, dict(labels))
+        assert all(math.isinf(contact.gap) for contact in scene.contacts) and scene.buildings[0].base.mu == dict(labels)["mu"]
+        alone = measure_free_risk(scene, SITE, motions=2, extra=4, seed=3, bootstrap=100)
+        closure, base, *drifts = results
+        for name in ("response_value", "level", "level_lower", "level_upper", "motions"):
+            np.testing.assert_array_equal(closure[name].values, alone[name].values)
+        assert base.attrs["demand"] == "base displacement of B1" and [d.attrs["demand"] for d in drifts] == [
+            "storey drift of B1 (largest over its storeys)", "storey drift of B2 (largest over its storeys)"]
+        np.testing.assert_array_equal(base.motions.values, closure.motions.values)  # the same runs
+    # the same motions for both configurations: the fixed neighbour's drift does not depend on B1's friction (no contact)
+    np.testing.assert_allclose(answer.results[0][3].response_value.values, answer.results[1][3].response_value.values, rtol=1e-9)
+    assert not np.allclose(answer.results[0][1].response_value.values[:, :2], answer.results[1][1].response_value.values[:, :2])
+
+
+def test_the_table_has_every_configuration_demand_and_target(answer):
+    frame = answer.frame()
+    assert len(frame) == 2 * 4 * 2 and set(frame["target"]) == {0.10, 0.02} and set(frame["mu"]) == {0.05, 0.08}
+    row = frame[(frame["mu"] == 0.08) & (frame["demand"] == "closure (largest over the contacts)") & (frame["target"] == 0.02)].iloc[0]
+    closure = answer.results[1][0]
+    assert row["level"] == float(closure.level.sel(target=0.02)) and row["lower"] <= row["level"] <= row["upper"] and row["runs"] == 8
+    assert "8 runs a configuration (2 runs of each rupture, then 4 shared out by Neyman allocation" in answer.conditions()
+
+
+def test_a_budget_below_two_runs_a_rupture_is_one_line(store):
+    with pytest.raises(ValueError, match=r"^runs: must be an integer >= 4 \(two runs of each of the site's 2 ruptures\), got 3$"):
+        store_measure_free(store, SITE, runs=3)
+
+
+@pytest.mark.slow
+def test_the_answer_does_not_depend_on_the_workers(store, answer):
+    again = store_measure_free(store, SITE, runs=8, seed=3, bootstrap=100, workers=2)
+    assert again.frame().equals(answer.frame())
+
+
+def test_the_demands_of_a_scene_put_the_closure_first(store):
+    from stochpound.analysis._measure_free_store import scene_demands
+
+    assert scene_demands(configuration_scene(store, {"mu": 0.05})) == [
+        MeasureFreeDemand("closure"), MeasureFreeDemand("base_displacement", "B1"), MeasureFreeDemand("peak_storey_drift", "B1"),
+        MeasureFreeDemand("peak_storey_drift", "B2")]
