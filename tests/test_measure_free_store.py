@@ -13,7 +13,7 @@ from stochpound import open_store
 from stochpound.analysis import MeasureFreeDemand, RuptureSite, measure_free_risk, store_measure_free
 from stochpound.experiment._runner import load_experiment, run_experiment
 from stochpound.risk import configuration_scene
-from tests.helpers import ISOLATED, risk_text, write_experiment
+from tests.helpers import ISOLATED, invoke, risk_text, write_experiment
 
 STRIPES = 'measure = "psa"\nperiod = 1.0\nlevels = [0.3, 0.8]'
 SITE = RuptureSite(magnitude=(7.0, 6.0), distance_rup_km=(20.0, 10.0), distance_jb_km=(20.0, 10.0), distance_x_km=(-20.0, -10.0),
@@ -21,12 +21,17 @@ SITE = RuptureSite(magnitude=(7.0, 6.0), distance_rup_km=(20.0, 10.0), distance_
 
 
 @pytest.fixture(scope="module")
-def store(tmp_path_factory):
+def store_path(tmp_path_factory):
     """B1 on a friction pendulum (μ 0.05 and 0.08, the configurations) beside a fixed B2, contact-free, 8 motions x 2 stripes."""
     text = risk_text(ISOLATED, 'gap = [inf]\nmu = { values = [0.05, 0.08], buildings = ["B1"] }', STRIPES)
     report = run_experiment(load_experiment(write_experiment(tmp_path_factory.mktemp("store"), text, "isolated.toml")), workers=0, progress=False)
     assert report.complete
-    return open_store(report.store).load()
+    return report.store
+
+
+@pytest.fixture(scope="module")
+def store(store_path):
+    return open_store(store_path).load()
 
 
 @pytest.fixture(scope="module")
@@ -78,3 +83,30 @@ def test_the_demands_of_a_scene_put_the_closure_first(store):
     assert scene_demands(configuration_scene(store, {"mu": 0.05})) == [
         MeasureFreeDemand("closure"), MeasureFreeDemand("base_displacement", "B1"), MeasureFreeDemand("peak_storey_drift", "B1"),
         MeasureFreeDemand("peak_storey_drift", "B2")]
+
+
+TABLE = ("# vs30: 400\nname,magnitude,distance_rup_km,distance_jb_km,distance_x_km,ztor_km,dip,mechanism,rate\n"
+         "r1,7.0,20,20,-20,0,90,strike_slip,0.01\nr2,6.0,10,10,-10,0,90,reverse,0.05\n")
+
+
+def test_the_risk_command_prints_it_beside_the_conditioned_answer_with_its_site_and_conditions(store_path, store, tmp_path):
+    table = tmp_path / "two.csv"
+    table.write_text(TABLE)
+    result = invoke("risk", str(store_path), "--ruptures", str(table), "--ruptures-runs", "8", "--seed", "3", "--bootstrap", "0")
+    assert result.exit_code == 0, result.output
+    site = RuptureSite.from_file(table)
+    expected = store_measure_free(store, site, runs=8, seed=3)
+    text = result.output
+    assert "Without an intensity measure (docs/measure-free.md): at the site of ruptures " + site.describe() in text
+    assert expected.conditions() in text and "The answers above are at the hazard's site (" in text
+    assert expected.display_frame().to_string() in text
+    assert text.index("Risk-targeted separation g*") < text.index("Without an intensity measure") < text.index("Design to")
+
+
+def test_the_risk_commands_ruptures_errors_are_one_line(store_path):
+    for args, message in ((["--ruptures", "nowhere"], "Invalid value for --ruptures: 'nowhere' is neither a file nor a bundled site"),
+                          (["--ruptures", "demo_three_sources", "--ruptures-runs", "20"],
+                           "Invalid value for --ruptures-runs: must be an integer >= 28 (two runs of each of the site's 14 ruptures), got 20")):
+        result = invoke("risk", str(store_path), *args)
+        assert result.exit_code == 2 and message in result.output, result.output
+        assert len([line for line in result.output.splitlines() if line.startswith("Error")]) == 1

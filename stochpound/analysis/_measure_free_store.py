@@ -28,7 +28,7 @@ from stochpound.hazard import RuptureSite
 from stochpound.model.scene import Scene
 from stochpound.risk import TARGETS, configuration_scene, contact_free_closure
 
-RUNS = 300
+MEASURE_FREE_RUNS = 300
 """Runs per configuration of :func:`store_measure_free` by default (half of them the first stage, the rest allocated)."""
 CASE_DIMS = ("intensity", "record", "realization", "contact")
 """Dimensions of the contact-free closure that are not a configuration's: the stripe, the motion and the contact."""
@@ -71,6 +71,20 @@ class StoreMeasureFree:
                                  "beyond": int(result.motions_beyond.values[t].sum()), "units": result.attrs["units"]})
         return pd.DataFrame(rows)
 
+    def display_frame(self) -> pd.DataFrame:
+        """The answer as text cells: one row per configuration and demand, one column per target with the level (m; for the
+        closure g*) and its interval, ``"0.0540 (0.0440-0.0700)"``, and the runs."""
+        rows = []
+        for labels, datasets in zip(self.configurations, self.results):
+            for result in datasets:
+                row = {"configuration": configuration_label(labels), "demand": result.attrs["demand"]}
+                for t, target in enumerate(result.target.values):
+                    level, low, high = (float(result[name].values[t]) for name in ("level", "level_lower", "level_upper"))
+                    row[f"{target:.0%} in {result.attrs['years']:g} yr ({result.attrs['units']})"] = f"{level:.4f} ({low:.4f}-{high:.4f})"
+                row["runs"] = int(result.attrs["runs"])
+                rows.append(row)
+        return pd.DataFrame(rows).set_index(["configuration", "demand"])
+
     def conditions(self) -> str:
         """The conditions of the answer in words: the runs, their allocation, the seed, the motions and the intervals."""
         first = self.results[0][0].attrs
@@ -82,7 +96,7 @@ class StoreMeasureFree:
                 "within each rupture (the ruptures' rates taken as given)")
 
 
-def store_measure_free(store: xr.Dataset, site: RuptureSite, *, runs: int = RUNS, seed: int = 0, targets: Sequence[float] = TARGETS,
+def store_measure_free(store: xr.Dataset, site: RuptureSite, *, runs: int = MEASURE_FREE_RUNS, seed: int = 0, targets: Sequence[float] = TARGETS,
                        years: float = 50.0, confidence: float = 0.95, bootstrap: int = 1000, workers: int = 1,
                        outside: str = "refuse") -> StoreMeasureFree:
     """The answer without an intensity measure for every configuration of a store at a site of ruptures (module docstring).
@@ -124,6 +138,12 @@ def store_measure_free(store: xr.Dataset, site: RuptureSite, *, runs: int = RUNS
         results.append(measure_free_demands(scene, site, scene_demands(scene), motions=first, extra=extra, seed=seed, targets=targets,
                                             years=years, confidence=confidence, bootstrap=bootstrap, outside=outside, workers=workers))
     return StoreMeasureFree(site.describe(), configurations, tuple(results), first * len(site) + extra, first, extra, int(seed))
+
+
+def configuration_label(labels: tuple[tuple[str, Any], ...]) -> str:
+    """A configuration's labels in words, e.g. ``"neighbour stiff, mu 0.05"`` (``mu inf``: a fixed base; "-" without labels)."""
+    words = [f"{dim} {'fixed' if dim == 'mu' and value == math.inf else (f'{value:g}' if isinstance(value, float) else value)}" for dim, value in labels]
+    return ", ".join(words) or "-"
 
 
 def _labels(closure: xr.DataArray, dims: list[str]) -> list[tuple[Any, ...]]:
