@@ -110,3 +110,30 @@ def test_the_risk_commands_ruptures_errors_are_one_line(store_path):
         result = invoke("risk", str(store_path), *args)
         assert result.exit_code == 2 and message in result.output, result.output
         assert len([line for line in result.output.splitlines() if line.startswith("Error")]) == 1
+    result = invoke("report", "build", str(store_path), "--out", str(store_path.parent / "report"), "--ruptures", "nowhere")
+    assert result.exit_code == 2 and "Error: Invalid value for --ruptures: 'nowhere' is neither a file" in result.output
+    assert not (store_path.parent / "report").exists()
+
+
+def test_the_report_section_formats_the_answer_and_names_both_sites(answer):
+    from stochpound.report.render import Paragraph, Table
+    from stochpound.report.sections import measure_free_section
+
+    section = measure_free_section("isolated", answer, "the hazard curve of somewhere")
+    assert section.title == "Without an intensity measure: experiment isolated" and section.key == "measure-free-isolated"
+    words = " ".join(block.text for block in section.blocks if isinstance(block, Paragraph))
+    assert f"at the site of ruptures {answer.site}" in words and answer.conditions() in words
+    assert "conditioned on the hazard of its site (the hazard curve of somewhere)" in words
+    (table,) = [block for block in section.blocks if isinstance(block, Table)]
+    assert table.frame.equals(answer.display_frame()) and table.caption.endswith("at two")
+
+
+@pytest.mark.slow
+def test_the_report_gets_the_section_after_the_risk_section_when_given_ruptures(store_path, answer):
+    from stochpound.report.assemble import assemble_report
+
+    report = assemble_report([store_path], ruptures=SITE, ruptures_runs=8)
+    keys = [section.key.rsplit("-", 1)[0] for section in report.sections]
+    assert keys.index("measure-free") == keys.index("risk") + 1
+    section = report.sections[keys.index("measure-free")]
+    assert section.blocks[-1].frame.equals(store_measure_free(open_store(store_path).load(), SITE, runs=8).display_frame())

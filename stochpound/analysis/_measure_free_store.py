@@ -42,6 +42,8 @@ class StoreMeasureFree:
     ----------
     site : str
         The site of ruptures in words (:meth:`~stochpound.analysis.RuptureSite.describe`).
+    site_name : str
+        Its name (a bundled site's, or given; "a site of ruptures" without one).
     configurations : tuple of tuple
         Each configuration's labels, as (dimension, label) pairs (empty: a store of one configuration).
     results : tuple of tuple of xarray.Dataset
@@ -51,6 +53,7 @@ class StoreMeasureFree:
     """
 
     site: str
+    site_name: str
     configurations: tuple[tuple[tuple[str, Any], ...], ...]
     results: tuple[tuple[xr.Dataset, ...], ...]
     runs: int
@@ -137,7 +140,7 @@ def store_measure_free(store: xr.Dataset, site: RuptureSite, *, runs: int = MEAS
         scene = configuration_scene(store, dict(labels))
         results.append(measure_free_demands(scene, site, scene_demands(scene), motions=first, extra=extra, seed=seed, targets=targets,
                                             years=years, confidence=confidence, bootstrap=bootstrap, outside=outside, workers=workers))
-    return StoreMeasureFree(site.describe(), configurations, tuple(results), first * len(site) + extra, first, extra, int(seed))
+    return StoreMeasureFree(site.describe(), site.name or "a site of ruptures", configurations, tuple(results), first * len(site) + extra, first, extra, int(seed))
 
 
 def configuration_label(labels: tuple[tuple[str, Any], ...]) -> str:

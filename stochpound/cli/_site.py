@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -88,9 +89,10 @@ def rupture_site_option(value: str, option: str) -> RuptureSite:
     from stochpound.hazard import named_rupture_site
 
     try:
-        return named_rupture_site(value, Path("."), {}, "site")
+        site = named_rupture_site(value, Path("."), {}, "site")
     except SiteError as error:
         raise click.BadParameter(str(error).removeprefix("site.ruptures: "), param_hint=option) from None
+    return site if site.name else dataclasses.replace(site, name=Path(value).stem)
 
 
 def measure_free_answer(store: xr.Dataset, site: RuptureSite, runs: int, seed: int, targets: tuple[float, ...], years: float,
