@@ -7,7 +7,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pandas as pd
 import pytest
+import xarray as xr
 
 from stochpound import open_store
 from stochpound.analysis import MeasureFreeDemand, RuptureSite, measure_free_risk, store_measure_free
@@ -137,3 +139,25 @@ def test_the_report_gets_the_section_after_the_risk_section_when_given_ruptures(
     assert keys.index("measure-free") == keys.index("risk") + 1
     section = report.sections[keys.index("measure-free")]
     assert section.blocks[-1].frame.equals(store_measure_free(open_store(store_path).load(), SITE, runs=8).display_frame())
+
+
+def test_the_comparison_puts_each_measures_seeds_beside_the_measure_free_g_star(answer):
+    from stochpound.analysis import compare_measures
+
+    free = {labels[0][1]: results[0].level for labels, results in zip(answer.configurations, answer.results)}  # over target, per μ
+
+    def g_star(factor: float) -> xr.DataArray:  # g* over (target, mu): the measure-free one times a factor
+        return xr.concat([free[mu] * factor for mu in (0.05, 0.08)], dim=pd.Index([0.05, 0.08], name="mu"))
+
+    table = compare_measures({"PGA": [g_star(1.1), g_star(1.5), g_star(1.3)], "PSA(1 s)": [g_star(0.9)]}, answer)
+    assert len(table) == 2 * 2 * 2
+    row = table.loc[("mu 0.08", "PGA", 0.02)]
+    reference = float(free[0.08].sel(target=0.02))
+    assert row["measure-free"] == reference and row["median"] == pytest.approx(1.3 * reference, rel=1e-12)
+    assert row["seed spread"] == pytest.approx(1.5 / 1.1, rel=1e-12) and row["seeds"] == 3
+    assert row["ratio"] == pytest.approx(1.3, rel=1e-12) and not row["agrees"]
+    assert table.loc[("mu 0.05", "PSA(1 s)", 0.1)]["agrees"] and table.loc[("mu 0.05", "PSA(1 s)", 0.1)]["seed spread"] == 1.0
+    with pytest.raises(ValueError, match=r"^conditioned\['PGA'\]: g\* has no dimension 'mu'"):
+        compare_measures({"PGA": [free[0.05]]}, answer)
+    with pytest.raises(ValueError, match=r"^tolerance: must be a ratio > 1"):
+        compare_measures({"PGA": [g_star(1.0)]}, answer, tolerance=0.8)
