@@ -29,8 +29,7 @@ from benchmarks import report
 from benchmarks.sections import Section
 from benchmarks.timing import REPOSITORY
 import stochpound
-from stochpound.analysis import RuptureSite, measure_free_demands
-from stochpound.analysis._measure_free_store import scene_demands
+from stochpound.analysis import RuptureSite, measure_free_demands, scene_demands
 
 SECTION = Section("<!-- measure-free risk: start -->", "<!-- measure-free risk: end -->")
 """This benchmark's section of docs/benchmarks.md."""
