@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
+from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -62,7 +63,7 @@ def compare_measures(conditioned: Mapping[str, Sequence[xr.DataArray]], free: St
         closure = results[0]
         for measure, seeds in conditioned.items():
             for t, target in enumerate(closure.target.values):
-                values = np.array([_at(g_star, dict(labels), float(target), measure) for g_star in seeds])
+                values = np.array([_at(g_star, labels, float(target), measure) for g_star in seeds])
                 reference = float(closure.level.values[t])
                 median = float(np.median(values))
                 rows.append({"configuration": configuration_label(labels), "measure": measure, "target": float(target),
@@ -73,9 +74,9 @@ def compare_measures(conditioned: Mapping[str, Sequence[xr.DataArray]], free: St
     return pd.DataFrame(rows).set_index(["configuration", "measure", "target"])
 
 
-def _at(g_star: xr.DataArray, labels: dict, target: float, measure: str) -> float:
-    """g* of one configuration and target, or a one-line error naming what the measure's answer lacks."""
-    where = {"target": target, **labels}
+def _at(g_star: xr.DataArray, labels: tuple[tuple[str, Any], ...], target: float, measure: str) -> float:
+    """g* of one configuration (its (dimension, label) pairs) and target, or a one-line error naming what the measure's answer lacks."""
+    where = {"target": target, **dict(labels)}
     missing = [dim for dim in where if dim not in g_star.dims]
     if missing:
         raise ValueError(f"conditioned[{measure!r}]: g* has no dimension {missing[0]!r} (the measure-free answer's configurations: "

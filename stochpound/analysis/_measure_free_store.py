@@ -83,7 +83,7 @@ class StoreMeasureFree:
                 row = {"configuration": configuration_label(labels), "demand": result.attrs["demand"]}
                 for t, target in enumerate(result.target.values):
                     level, low, high = (float(result[name].values[t]) for name in ("level", "level_lower", "level_upper"))
-                    row[f"{target:.0%} in {result.attrs['years']:g} yr ({result.attrs['units']})"] = f"{level:.4f} ({low:.4f}-{high:.4f})"
+                    row[f"{100 * target:g} % in {result.attrs['years']:g} yr ({result.attrs['units']})"] = f"{level:.4f} ({low:.4f}-{high:.4f})"
                 row["runs"] = int(result.attrs["runs"])
                 rows.append(row)
         return pd.DataFrame(rows).set_index(["configuration", "demand"])
@@ -95,7 +95,7 @@ class StoreMeasureFree:
                       "level of the rarest target" if self.extra else f"{self.first_stage} runs of each rupture")
         return (f"{self.runs} runs a configuration ({allocation}), the same motions for every configuration (seed {self.seed}): "
                 f"simulated motions of each rupture ({first['model']} site_motions, dt {first['dt']:g} s); "
-                f"{first['confidence']:.0%} intervals from {first['bootstrap']} stratified bootstrap resamples over the motions "
+                f"{100 * first['confidence']:g} % intervals from {first['bootstrap']} stratified bootstrap resamples over the motions "
                 "within each rupture (the ruptures' rates taken as given)")
 
 
