@@ -32,6 +32,7 @@ import time  # noqa: E402
 from pathlib import Path  # noqa: E402
 
 from benchmarks import compare, experiment_scale, measure_free, rare_events, report, site_motions, spectrum, startup, suite, yielding  # noqa: E402
+from benchmarks import measure_comparison  # noqa: E402
 from benchmarks.sections import keep_sections  # noqa: E402
 from benchmarks.timing import REPOSITORY  # noqa: E402
 
@@ -86,6 +87,7 @@ def main(argv: list[str] | None = None) -> int:
     markdown = folder / "benchmarks.md"
     old = markdown.read_text() if markdown.exists() else ""
     sections = (experiment_scale.SECTION, compare.SECTION, spectrum.SECTION, yielding.SECTION, site_motions.SECTION, startup.SECTION, measure_free.SECTION)
+    sections += (measure_comparison.SECTION,)
     markdown.write_text(keep_sections(old, report.document(results, info, elapsed), sections))
     print(f"wrote {markdown} and {figure} in {elapsed:.1f} s")
     return 0

@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from benchmarks import measure_free
+from stochpound.analysis._measure_free_store import scene_demands
 
 
 def test_the_scenes_are_the_flagship_s_contact_free_with_the_neighbour_and_base_asked_for():
@@ -26,5 +27,7 @@ def test_a_reduced_run_writes_the_section_with_every_configuration_and_target(tm
     assert measure_free.main(["--motions", "2", "--extra", "6", "--bootstrap", "100", "--out", str(out)]) == 0
     section = measure_free.SECTION.kept(out.read_text())
     rows = [line for line in section.splitlines() if line.startswith("| ") and "in 50 yr" in line]
-    assert len(rows) == 2 * len(measure_free.CONFIGURATIONS)
-    assert all(" 42 |" in row for row in rows)  # 18 ruptures x 2 + 6 runs
+    demands = [len(scene_demands(measure_free.flagship_scene(file, neighbour, mu))) for _, file, neighbour, mu in measure_free.CONFIGURATIONS]
+    assert demands == [3, 3, 4]  # closure and both storey drifts; the isolated building's base displacement too
+    assert len(rows) == 2 * sum(demands) and sum("closure: g*" in row for row in rows) == 2 * len(demands)
+    assert all(" 34 |" in row for row in rows)  # 14 ruptures x 2 + 6 runs

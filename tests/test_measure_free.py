@@ -191,3 +191,25 @@ def test_bad_arguments_are_one_line_naming_the_field(arguments, message):
 def test_a_scene_that_can_pound_is_refused_for_the_closure():
     with pytest.raises(ValueError, match=r"^scene: contact 0 has gap 0.02 m; the closure needs a contact-free scene"):
         measure_free_risk(linear_pair(gap=0.02), two_ruptures())
+
+
+def test_several_demands_are_read_from_the_same_runs_as_each_alone():
+    """measure_free_demands: the first demand allocates the extra runs and is measure_free_risk's answer; every other demand is
+    read from those same runs (with extra = 0, each alone gives the same runs: the motions' window is fixed by the runs a rupture
+    may get); a storey drift without a storey is the largest over the storeys."""
+    closure, drift = _measure_free.measure_free_demands(
+        linear_pair(), two_ruptures(), [_measure_free.MeasureFreeDemand(), _measure_free.MeasureFreeDemand("peak_storey_drift", "B")],
+        motions=3, extra=2, seed=4, bootstrap=100)
+    alone = measure_free_risk(linear_pair(), two_ruptures(), motions=3, extra=2, seed=4, bootstrap=100)
+    for name in ("response_value", "rate_of_exceedance", "level", "level_lower", "motions"):
+        np.testing.assert_array_equal(closure[name].values, alone[name].values)
+    assert drift.attrs["allocated_on"] == "closure (largest over the contacts)" and drift.attrs["demand"] == "storey drift of B (largest over its storeys)"
+    np.testing.assert_array_equal(drift.motions.values, alone.motions.values)
+    _, drift = _measure_free.measure_free_demands(
+        linear_pair(), two_ruptures(), [_measure_free.MeasureFreeDemand(), _measure_free.MeasureFreeDemand("peak_storey_drift", "B")],
+        motions=3, seed=4, bootstrap=100)
+    storey = measure_free_risk(linear_pair(), two_ruptures(), "peak_storey_drift", building="B", floor=1, motions=3, seed=4, bootstrap=100)
+    np.testing.assert_array_equal(drift.response_value.values, storey.response_value.values)
+    np.testing.assert_array_equal(drift.level.values, storey.level.values)
+    with pytest.raises(ValueError, match=r"^demands: must be one or more MeasureFreeDemand"):
+        _measure_free.measure_free_demands(linear_pair(), two_ruptures(), [])

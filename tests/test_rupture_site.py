@@ -17,7 +17,7 @@ from stochpound.analysis import RUPTURE_COLUMNS, RuptureSite, bundled_rupture_si
 from stochpound.experiment._runner import load_experiment
 from stochpound.experiment._spec import ExperimentError, parse_experiment
 from stochpound.hazard._ruptures import bundled_rupture_path
-from stochpound.motions import conditional_spectrum, scenario_distribution
+from stochpound.motions import SITE_MOTION_LIMITS, conditional_spectrum, scenario_distribution
 from stochpound.store import definition_sha256
 from tests.helpers import SITE_SCENE, write_experiment
 
@@ -84,9 +84,10 @@ def test_the_disaggregation_sums_to_the_curve_at_every_level(demo: RuptureSite) 
     np.testing.assert_allclose(d.share, share, rtol=1e-9)
     np.testing.assert_allclose(d.mean_magnitude, share @ np.array(demo.magnitude), rtol=1e-9)
     np.testing.assert_allclose(d.mean_epsilon, np.sum(share * epsilon, axis=1), rtol=1e-7, atol=1e-9)
-    # the ruptures of one magnitude bin (the background's M 5.25) add up to that bin's share
-    in_bin = np.array(demo.magnitude) == 5.25
-    np.testing.assert_allclose(d.binned_share.sel(magnitude_bin=5.0).sum(("distance_bin", "epsilon_bin")), share[:, in_bin].sum(axis=1), rtol=1e-12)
+    # the ruptures of one magnitude bin (the background's M 5.75) add up to that bin's share
+    in_bin = np.array(demo.magnitude) == 5.75
+    assert in_bin.sum() == 4
+    np.testing.assert_allclose(d.binned_share.sel(magnitude_bin=5.5).sum(("distance_bin", "epsilon_bin")), share[:, in_bin].sum(axis=1), rtol=1e-12)
     # the demo's levels of 72 to 10 000 years: within the models' range, caused at moderate ε
     assert np.all(np.diff(d.mean_epsilon.values) > 0) and d.mean_epsilon.values[-1] < 2.5
     assert 5.0 < d.mean_magnitude.min() and d.mean_magnitude.max() < 8.0
@@ -234,15 +235,18 @@ def test_a_bad_rupture_table_is_one_line_naming_file_line_and_field(tmp_path, te
 def test_the_bundled_demo_is_made_as_its_sources_say(demo: RuptureSite) -> None:
     assert DEMO in bundled_rupture_sites() and demo.vs30 == 400.0
     background = [i for i, name in enumerate(demo.names) if name.startswith("background")]
-    assert len(background) == 16
-    for i in background:  # b = 1, 0.2 per year above M 5, truncated at M 7, rings of a 100 km disc by area
+    assert len(background) == 12
+    low, high = SITE_MOTION_LIMITS["magnitude"]  # every rupture's motions can be simulated (the answer without a measure)
+    assert all(low <= m <= high for m in demo.magnitude) and min(demo.magnitude[i] for i in background) - 0.25 == low
+    for i in background:  # b = 1, 0.2 per year above M 5, truncated at M 7, from M 5.5 on, rings of a 100 km disc by area
         m1 = demo.magnitude[i] - 0.25
         ring = demo.names[i].split("_r")[1]
         r1, r2 = (float(v) for v in ring.split("-"))
         expected = 0.2 * (10 ** -(m1 - 5) - 10 ** -(m1 + 0.5 - 5)) / (1 - 10**-2) * (r2**2 - r1**2) / 100**2
         assert demo.rate[i] == pytest.approx(expected, rel=5e-4)
         assert demo.distance_jb_km[i] == pytest.approx(2 / 3 * (r2**3 - r1**3) / (r2**2 - r1**2), abs=0.05)
-    assert sum(demo.rate) == pytest.approx(0.2087, abs=1e-4)
+    background_rate = 0.2 * (10 ** -(low - 5) - 10**-2) / (1 - 10**-2)  # M 5.5 to 7 of the truncated law
+    assert sum(demo.rate) == pytest.approx(1 / 150 + 1 / 500 + background_rate, rel=5e-4)
     reverse = demo.names.index("reverse_fault")
     assert demo.distance_rup_km[reverse] == pytest.approx(10 * np.sin(np.radians(40)) + 5 * np.cos(np.radians(40)), abs=0.05)
     assert rate_from_probability(0.5, 50) > 1 / 72.2  # 72 years: 50 % in 50 years, a level the site reaches

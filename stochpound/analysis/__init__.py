@@ -29,7 +29,9 @@ from stochpound.analysis._pounding import pounding_probability
 from stochpound.analysis._separation import pounding_curve, required_separation, rule_exceedance
 from stochpound.codes import contact_demands, fixed_base_cqc, separation_rules, store_contact_demands
 from stochpound.analysis._subset_simulation import RESPONSES, subset_simulation
-from stochpound.analysis._measure_free import MEASURE_FREE_RESPONSES, measure_free_risk
+from stochpound.analysis._measure_free import MEASURE_FREE_RESPONSES, MeasureFreeDemand, measure_free_demands, measure_free_risk
+from stochpound.analysis._measure_free_store import MEASURE_FREE_RUNS, StoreMeasureFree, scene_demands, store_measure_free
+from stochpound.analysis._measure_comparison import compare_measures
 from stochpound.analysis._summary import run_summary
 from stochpound.hazard import (
     RUPTURE_COLUMNS,
@@ -98,6 +100,13 @@ __all__ = [
     "subset_simulation",
     "RESPONSES",
     "measure_free_risk",
+    "measure_free_demands",
+    "MeasureFreeDemand",
+    "store_measure_free",
+    "StoreMeasureFree",
+    "scene_demands",
+    "MEASURE_FREE_RUNS",
+    "compare_measures",
     "MEASURE_FREE_RESPONSES",
     "HazardCurve",
     "HazardFile",

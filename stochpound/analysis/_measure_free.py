@@ -87,6 +87,37 @@ SPREAD_FLOOR = 0.05
 
 
 @dataclass(frozen=True)
+class MeasureFreeDemand:
+    """One response read from every run of :func:`measure_free_demands` (units in :data:`~stochpound.analysis.RESPONSES`).
+
+    Attributes
+    ----------
+    response : {"closure", "base_displacement", "peak_storey_drift"}
+        The run's largest closure (m), a sliding base's largest absolute
+        displacement (m) or a storey's largest absolute drift (m).
+    building : str, optional
+        The building of ``base_displacement`` and ``peak_storey_drift``.
+    floor : int, optional
+        The storey of ``peak_storey_drift`` (1 = lowest); None: the largest over the building's storeys.
+    contact : int, optional
+        The contact of ``closure``; None: the largest over the contacts (the gap identity's, for one gap of all).
+    """
+
+    response: str = "closure"
+    building: str | None = None
+    floor: int | None = None
+    contact: int | None = None
+
+    def describe(self) -> str:
+        """The demand in words, e.g. ``"storey drift of B1 (largest over its storeys)"``."""
+        if self.response == "closure":
+            return "closure (largest over the contacts)" if self.contact is None else f"closure of contact {self.contact}"
+        if self.response == "base_displacement":
+            return f"base displacement of {self.building}"
+        return f"storey drift of {self.building} ({'largest over its storeys' if self.floor is None else f'storey {self.floor}'})"
+
+
+@dataclass(frozen=True)
 class _Rupture:
     """How one rupture's motions are drawn: the scenario run, its seed, window and whether it was clamped to the model's range."""
 
@@ -98,10 +129,10 @@ class _Rupture:
 
 @dataclass(frozen=True)
 class _Task:
-    """One batch of runs: a rupture's motions ``realizations`` of the scene, the response read from each."""
+    """One batch of runs: a rupture's motions ``realizations`` of the scene, the demands read from each."""
 
     scene: Scene
-    reading: tuple[str, str | None, int | None, int | None]
+    demands: tuple[MeasureFreeDemand, ...]
     rupture: _Rupture
     realizations: tuple[int, ...]
     n: int
@@ -152,8 +183,9 @@ def measure_free_risk(
         Seed (>= 0) of the motions: the same seed gives the same runs and result.
     building, floor, contact
         The building (of ``base_displacement`` and ``peak_storey_drift``),
-        storey (1 = lowest) and contact index (of ``closure``; None: the
-        largest over the contacts, the gap identity's for one gap of all).
+        storey (1 = lowest; None: the largest over the building's storeys)
+        and contact index (of ``closure``; None: the largest over the
+        contacts, the gap identity's for one gap of all).
     thresholds : sequence of float, optional
         Levels x of the response (m) at which λ(D > x) is given; default
         200 log-spaced from the smallest positive response to the largest.
@@ -209,28 +241,77 @@ def measure_free_risk(
         A rupture outside the site-motion model's range with ``outside="refuse"``,
         naming the rupture and the field.
     """
+    demand = MeasureFreeDemand(response, building, floor, contact)
+    return measure_free_demands(scene, site, [demand], motions=motions, extra=extra, seed=seed, thresholds=thresholds, targets=targets,
+                                years=years, confidence=confidence, bootstrap=bootstrap, outside=outside, dt=dt, model=model, workers=workers)[0]
+
+
+def measure_free_demands(
+    scene: Scene,
+    site: RuptureSite,
+    demands: Sequence[MeasureFreeDemand],
+    *,
+    motions: int = 100,
+    extra: int = 0,
+    seed: int = 0,
+    thresholds: Sequence[float] | None = None,
+    targets: Sequence[float] | None = None,
+    years: float = 50.0,
+    confidence: float = 0.95,
+    bootstrap: int = 1000,
+    outside: str = "refuse",
+    dt: float = 0.01,
+    model: str = "hazard_compatible",
+    workers: int = 1,
+) -> tuple[xr.Dataset, ...]:
+    """Several demands' rates of exceedance at a site of ruptures from the same runs (:func:`measure_free_risk` of each).
+
+    Every run is read for every demand; the extra runs are allocated at the
+    rarest target's level of the *first* demand (the others' estimates stay
+    the same unbiased count over the runs, their intervals say how well
+    those runs serve them). The arguments are :func:`measure_free_risk`'s.
+
+    Returns
+    -------
+    tuple of xarray.Dataset
+        One dataset per demand, as :func:`measure_free_risk` returns, in the order given
+        (attribute ``allocated_on``: the demand the extra runs were allocated for).
+
+    Raises
+    ------
+    ValueError, SiteError
+        As :func:`measure_free_risk`; ``demands`` empty or not :class:`MeasureFreeDemand`.
+    """
     started = time.perf_counter()
-    reading = _check_reading(scene, response, building, floor, contact)
+    if not demands or not all(isinstance(d, MeasureFreeDemand) for d in demands):
+        raise ValueError(f"demands: must be one or more MeasureFreeDemand, got {demands!r}")
+    demands = tuple(_check_demand(scene, demand) for demand in demands)
     _check_counts(motions, extra, seed, bootstrap, workers)
     kernels.check_confidence(confidence)
     target_rates = _target_rates(targets, years)
     if outside not in OUTSIDE:
         raise ValueError(f"outside: must be one of {', '.join(OUTSIDE)}, got {outside!r}")
     ruptures = [_rupture(site, index, outside, seed, motions + extra, dt, model) for index in range(len(site))]
-    run = _Runner(scene, reading, ruptures, motions + extra, dt, model, workers)
+    run = _Runner(scene, demands, ruptures, motions + extra, dt, model, workers)
     values = run([range(motions)] * len(site))
     for step in range(ROUNDS if extra else 0):
-        counts = neyman_allocation(values, np.asarray(site.rate), float(target_rates.min()), extra * (step + 1) // ROUNDS - extra * step // ROUNDS)
-        more = run([range(v.size, v.size + count) for v, count in zip(values, counts)])
+        counts = neyman_allocation([v[:, 0] for v in values], np.asarray(site.rate), float(target_rates.min()),
+                                   extra * (step + 1) // ROUNDS - extra * step // ROUNDS)
+        more = run([range(len(v), len(v) + count) for v, count in zip(values, counts)])
         values = [np.concatenate(pair) for pair in zip(values, more)]
-    result = _estimate(values, np.asarray(site.rate), target_rates, thresholds, confidence, bootstrap, seed,
-                       np.array([bool(r.clamped) for r in ruptures]))
-    return _dataset(result, site, ruptures, values, reading, {
-        "runs": int(sum(v.size for v in values)), "seconds": time.perf_counter() - started, "seed": int(seed), "first_stage": int(motions),
+    clamped = np.array([bool(r.clamped) for r in ruptures])
+    attrs = {
+        "runs": int(sum(len(v) for v in values)), "seconds": time.perf_counter() - started, "seed": int(seed), "first_stage": int(motions),
         "extra": int(extra), "years": float(years), "confidence": float(confidence), "bootstrap": int(bootstrap), "outside": outside,
         "dt": float(dt), "model": model, "model_provenance": site_model_provenance(model), "method": METHOD, "interval": INTERVAL,
-        "allocation": ALLOCATION if extra else "the same runs for every rupture", "site": site.describe(),
-        "targets": np.asarray(_targets_or_default(targets), dtype=float)})
+        "allocation": ALLOCATION if extra else "the same runs for every rupture", "allocated_on": demands[0].describe(), "site": site.describe(),
+        "targets": np.asarray(_targets_or_default(targets), dtype=float)}
+    results = []
+    for k, demand in enumerate(demands):
+        each = [v[:, k] for v in values]
+        result = _estimate(each, np.asarray(site.rate), target_rates, thresholds, confidence, bootstrap, seed, clamped)
+        results.append(_dataset(result, site, ruptures, each, demand, dict(attrs)))
+    return tuple(results)
 
 
 def _targets_or_default(targets: Sequence[float] | None) -> Sequence[float]:
@@ -251,24 +332,21 @@ def _target_rates(targets: Sequence[float] | None, years: float) -> np.ndarray:
     return np.atleast_1d(rate_from_probability(values, years))
 
 
-def _check_reading(scene: Any, response: str, building: str | None, floor: int | None, contact: int | None) -> tuple:
-    """The response's reading (response, building, floor, contact), checked against the scene."""
+def _check_demand(scene: Any, demand: MeasureFreeDemand) -> MeasureFreeDemand:
+    """The demand, checked against the scene (its response, building, storey or contact)."""
     if not isinstance(scene, Scene):
         raise ValueError(f"scene: must be a Scene, got {type(scene).__name__}")
-    if response not in MEASURE_FREE_RESPONSES:
-        raise ValueError(f"response: must be one of {', '.join(MEASURE_FREE_RESPONSES)}, got {response!r}")
-    if response == "closure":
+    if demand.response not in MEASURE_FREE_RESPONSES:
+        raise ValueError(f"response: must be one of {', '.join(MEASURE_FREE_RESPONSES)}, got {demand.response!r}")
+    if demand.response == "closure":
         if not scene.contacts:
             raise ValueError("scene: has no contact (the closure needs one)")
         closing = [i for i, c in enumerate(scene.contacts) if math.isfinite(c.gap)]
         if closing:
             raise ValueError(f"scene: contact {closing[0]} has gap {scene.contacts[closing[0]].gap:g} m; the closure needs a contact-free scene (every gap inf), "
                              "whose closure gives every gap's pounding (the gap identity)")
-        if contact is not None:
-            _reader(scene, response, building, floor, contact)
-    else:
-        _reader(scene, response, building, floor, 0)
-    return (response, building, floor, contact)
+    response_reader(scene, demand)
+    return demand
 
 
 def _check_counts(motions: Any, extra: Any, seed: Any, bootstrap: Any, workers: Any) -> None:
@@ -301,12 +379,13 @@ def _rupture(site: RuptureSite, index: int, outside: str, seed: int, most: int, 
 class _Runner:
     """Runs batches of each rupture's motions (in ``workers`` processes), reading the response of each run."""
 
-    def __init__(self, scene: Scene, reading: tuple, ruptures: list[_Rupture], n: int, dt: float, model: str, workers: int) -> None:
-        self.scene, self.reading, self.ruptures, self.n, self.dt, self.model, self.workers = scene, reading, ruptures, n, dt, model, workers
+    def __init__(self, scene: Scene, demands: tuple[MeasureFreeDemand, ...], ruptures: list[_Rupture], n: int, dt: float, model: str,
+                 workers: int) -> None:
+        self.scene, self.demands, self.ruptures, self.n, self.dt, self.model, self.workers = scene, demands, ruptures, n, dt, model, workers
 
     def __call__(self, wanted: Sequence[range]) -> list[np.ndarray]:
-        """The responses of the realizations ``wanted[r]`` of each rupture r, in their order."""
-        tasks = [(r, _Task(self.scene, self.reading, self.ruptures[r], tuple(chunk), self.n, self.dt, self.model))
+        """The demands (realization, demand) of the realizations ``wanted[r]`` of each rupture r, in their order."""
+        tasks = [(r, _Task(self.scene, self.demands, self.ruptures[r], tuple(chunk), self.n, self.dt, self.model))
                  for r, indices in enumerate(wanted) for chunk in _chunks(list(indices))]
         if self.workers > 1 and len(tasks) > 1:
             with ProcessPoolExecutor(self.workers, mp_context=multiprocessing.get_context("spawn")) as pool:
@@ -316,7 +395,7 @@ class _Runner:
         out = [[] for _ in wanted]
         for (r, _), values in zip(tasks, results):
             out[r].append(values)
-        return [np.concatenate(parts) if parts else np.empty(0) for parts in out]
+        return [np.concatenate(parts) if parts else np.empty((0, len(self.demands))) for parts in out]
 
 
 def _chunks(indices: list[int]) -> list[list[int]]:
@@ -324,21 +403,25 @@ def _chunks(indices: list[int]) -> list[list[int]]:
 
 
 def run_task(task: _Task) -> np.ndarray:
-    """The responses of one batch: its motions generated and each run (a worker's job; module-level so that it pickles)."""
+    """The demands (realization, demand) of one batch: its motions generated and each run (a worker's job; module-level so that it pickles)."""
     generated = site_motions(**task.rupture.scenario, n=task.n, seed=task.rupture.seed, dt=task.dt, duration=task.rupture.duration,
                              model=task.model, realizations=list(task.realizations))
-    read = response_reader(task.scene, *task.reading)
-    demands = task.reading[0] == "peak_storey_drift"
+    readers = [response_reader(task.scene, demand) for demand in task.demands]
+    drift = any(demand.response == "peak_storey_drift" for demand in task.demands)
     label = f"site motion of M {task.rupture.scenario['magnitude']:g} at {task.rupture.scenario['distance_km']:g} km"
-    return np.array([read(simulate(replace(task.scene, motion=SampledMotion(task.dt, a, "linear", label)), demands=demands))
-                     for a in generated["acceleration"].values], dtype=float)
+    runs = (simulate(replace(task.scene, motion=SampledMotion(task.dt, a, "linear", label)), demands=drift) for a in generated["acceleration"].values)
+    return np.array([[read(run) for read in readers] for run in runs], dtype=float).reshape(-1, len(readers))
 
 
-def response_reader(scene: Scene, response: str, building: str | None, floor: int | None, contact: int | None) -> Callable[[xr.Dataset], float]:
-    """The response read from a run: the closure of ``contact`` (None: the largest over the contacts), or subset simulation's readers."""
-    if response == "closure" and contact is None:
+def response_reader(scene: Scene, demand: MeasureFreeDemand) -> Callable[[xr.Dataset], float]:
+    """The demand read from a run: the closure of ``contact`` (None: the largest over the contacts), a storey drift (floor None:
+    the largest over the building's storeys), or subset simulation's readers (which check the building, storey and contact)."""
+    if demand.response == "closure" and demand.contact is None:
         return lambda run: float(np.max(run["peak_contact_closure"].values))
-    return _reader(scene, response, building, floor, 0 if contact is None else contact)
+    if demand.response == "peak_storey_drift" and demand.floor is None:
+        _reader(scene, demand.response, demand.building, 1, 0)
+        return lambda run: float(np.max(run["peak_storey_drift"].sel(building=demand.building).values))
+    return _reader(scene, demand.response, demand.building, demand.floor, 0 if demand.contact is None else demand.contact)
 
 
 def neyman_allocation(values: Sequence[np.ndarray], rates: np.ndarray, target_rate: float, extra: int) -> np.ndarray:
@@ -444,8 +527,9 @@ def _thresholds(thresholds: Sequence[float] | None, responses: np.ndarray) -> np
     return grid
 
 
-def _dataset(estimate: _Estimate, site: RuptureSite, ruptures: list[_Rupture], values: list[np.ndarray], reading: tuple, attrs: dict) -> xr.Dataset:
-    units = RESPONSES[reading[0]]
+def _dataset(estimate: _Estimate, site: RuptureSite, ruptures: list[_Rupture], values: list[np.ndarray], demand: MeasureFreeDemand,
+             attrs: dict) -> xr.Dataset:
+    units = RESPONSES[demand.response]
     names = list(site.names)
     table = np.full((len(values), max(v.size for v in values)), np.nan)
     for r, v in enumerate(values):
@@ -455,7 +539,7 @@ def _dataset(estimate: _Estimate, site: RuptureSite, ruptures: list[_Rupture], v
     share = share / np.where(share.sum(axis=1, keepdims=True) > 0.0, share.sum(axis=1, keepdims=True), 1.0)
     rate_attrs = {"units": "1/yr"}
     data = {
-        "rate_of_exceedance": ("threshold", estimate.rate, {**rate_attrs, "long_name": f"annual rate of the {reading[0]} exceeding the threshold"}),
+        "rate_of_exceedance": ("threshold", estimate.rate, {**rate_attrs, "long_name": f"annual rate of the {demand.response} exceeding the threshold"}),
         "rate_lower": ("threshold", estimate.rate_interval[0], rate_attrs),
         "rate_upper": ("threshold", estimate.rate_interval[1], rate_attrs),
         "clamped_rate": ("threshold", estimate.clamped_rate, {**rate_attrs, "long_name": "part of the rate from ruptures clamped to the model's range"}),
@@ -468,9 +552,9 @@ def _dataset(estimate: _Estimate, site: RuptureSite, ruptures: list[_Rupture], v
         "clamped": ("rupture", np.array([r.clamped for r in ruptures], dtype=object), {"long_name": "what was clamped to the site-motion model's range"}),
         "motion_seed": ("rupture", np.array([r.seed for r in ruptures], dtype=np.int64), {"long_name": "seed of the rupture's site_motions"}),
         "motion_duration": ("rupture", np.array([r.duration for r in ruptures]), {"units": "s", "long_name": "window of the rupture's site_motions"}),
-        "response_value": (("rupture", "motion"), table, {"units": units, "long_name": f"each run's {reading[0]} (NaN past the rupture's runs)"}),
+        "response_value": (("rupture", "motion"), table, {"units": units, "long_name": f"each run's {demand.response} (NaN past the rupture's runs)"}),
         "target_rate": ("target", estimate.target_rates, rate_attrs),
-        "level": ("target", estimate.level, {"units": units, "long_name": f"{reading[0]} exceeded at the target rate (closure: the separation g*)"}),
+        "level": ("target", estimate.level, {"units": units, "long_name": f"{demand.response} exceeded at the target rate (closure: the separation g*)"}),
         "level_lower": ("target", estimate.level_interval[0], {"units": units}),
         "level_upper": ("target", estimate.level_interval[1], {"units": units}),
         "level_without_clamped": ("target", estimate.level_without_clamped, {"units": units, "long_name": "level with the clamped ruptures left out"}),
@@ -479,6 +563,7 @@ def _dataset(estimate: _Estimate, site: RuptureSite, ruptures: list[_Rupture], v
     }
     coords = {"threshold": ("threshold", estimate.thresholds, {"units": units}), "rupture": names, "motion": np.arange(table.shape[1]),
               "target": ("target", attrs.pop("targets"), {"units": "1", "long_name": f"probability of exceedance in {attrs['years']:g} years"})}
-    reading_attrs = {"response": reading[0], "units": units, "building": reading[1] or "", "floor": reading[2] or 0,
-                     "contact": "largest over the contacts" if reading[0] == "closure" and reading[3] is None else str(reading[3] if reading[3] is not None else "")}
-    return xr.Dataset(data, coords=coords, attrs={**attrs, **reading_attrs})
+    demand_attrs = {"response": demand.response, "units": units, "building": demand.building or "", "floor": demand.floor or 0,
+                    "contact": "largest over the contacts" if demand.response == "closure" and demand.contact is None else
+                    str(demand.contact if demand.contact is not None else ""), "demand": demand.describe()}
+    return xr.Dataset(data, coords=coords, attrs={**attrs, **demand_attrs})

@@ -6,7 +6,9 @@ from pathlib import Path
 
 import click
 
+from stochpound.analysis import MEASURE_FREE_RUNS
 from stochpound.cli._group import HelpGroup
+from stochpound.cli._site import rupture_site_option
 from stochpound._errors import StochpoundError, os_error_message
 from stochpound.cli._store_errors import store_variables
 
@@ -35,7 +37,12 @@ def report() -> None:
                    "is refused.")
 @click.option("--accept-edited", "accept_edited", is_flag=True,
               help="Build the report of a store whose definition does not match its recorded sha256 (changed since it was written); refused otherwise.")
-def build_command(stores: tuple[Path, ...], out: Path, formats: tuple[str, ...], partial: bool, accept_edited: bool) -> None:
+@click.option("--ruptures", "ruptures", metavar="FILE|NAME", help="Also give each Risk section's answer without an intensity measure at this "
+              "site of ruptures (a rupture table or a bundled site's name; docs/measure-free.md), in a section of its own.")
+@click.option("--ruptures-runs", "ruptures_runs", default=MEASURE_FREE_RUNS, show_default=True, type=click.IntRange(min=2),
+              help="Runs a configuration of --ruptures.")
+def build_command(stores: tuple[Path, ...], out: Path, formats: tuple[str, ...], partial: bool, accept_edited: bool, ruptures: str | None,
+                  ruptures_runs: int) -> None:
     """Build the report from the experiment STORE files into --out.
 
     Writes OUT/index.html (self-contained page), OUT/report.pdf, and every
@@ -49,10 +56,12 @@ def build_command(stores: tuple[Path, ...], out: Path, formats: tuple[str, ...],
     from stochpound.report.assemble import assemble_report
     from stochpound.report.render.output import check_output_folder, write_report
 
+    site = None if ruptures is None else rupture_site_option(ruptures, "--ruptures")
     try:
         check_output_folder(out, stores)
         with store_variables(stores):
-            document = assemble_report(list(stores), progress=_progress, partial=partial, edited="accept" if accept_edited else "refuse")
+            document = assemble_report(list(stores), progress=_progress, partial=partial, edited="accept" if accept_edited else "refuse",
+                                       ruptures=site, ruptures_runs=ruptures_runs)
         written = write_report(document, out, formats, progress=_progress)
     except (StochpoundError, ValueError) as error:
         raise click.ClickException(str(error)) from None

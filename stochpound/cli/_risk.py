@@ -10,7 +10,9 @@ from stochpound import StochpoundError
 from stochpound._atomic import check_not_input
 from stochpound._errors import os_error_message
 from stochpound._text_files import read_text_file
+from stochpound.cli._site import measure_free_answer, measure_free_lines, rupture_site_option
 from stochpound.cli._store_errors import store_variables
+from stochpound.analysis import MEASURE_FREE_RUNS
 from stochpound.risk import BOOTSTRAP, TARGETS
 from stochpound.store import Design
 
@@ -97,9 +99,16 @@ CSV_TABLES = ("separation", "rules", "limit_states")
 @click.option("--csv", "csv_dir", type=click.Path(file_okay=False, path_type=Path), metavar="DIR",
               help="Also write the tables to this folder (created), one CSV file per table: separation.csv, rules.csv "
                    "(and limit_states.csv with --limit-states).")
+@click.option("--ruptures", "ruptures", metavar="FILE|NAME", help="Also print the answer without an intensity measure at this site of "
+              "ruptures (a rupture table or a bundled site's name, e.g. demo_three_sources; docs/measure-free.md): every configuration "
+              "run under simulated motions of each rupture, seeded by --seed.")
+@click.option("--ruptures-runs", "ruptures_runs", default=MEASURE_FREE_RUNS, show_default=True, type=click.IntRange(min=2),
+              help="Runs a configuration of --ruptures (half of them two or more of each rupture, the rest where g* needs them).")
+@click.option("--workers", default=1, show_default=True, type=click.IntRange(min=1), help="Processes running --ruptures (the answer does not depend on them).")
 def risk(store: Path, hazard: str | None, hazard_measure: str | None, hazard_units: str | None, investigation_time: float | None,
          hazard_site: str | None, extrapolate: bool, target: str, years: float, bootstrap: int, seed: int, limit_states: Path | None,
-         design: Path | None, partial: bool, accept_edited: bool, csv_dir: Path | None) -> None:
+         design: Path | None, partial: bool, accept_edited: bool, csv_dir: Path | None, ruptures: str | None, ruptures_runs: int,
+         workers: int) -> None:
     """Print the risk-targeted separation g* and the code rules' risks of the experiment STORE at a site.
 
     For every configuration of the store (each combination of its grid's
@@ -115,6 +124,10 @@ def risk(store: Path, hazard: str | None, hazard_measure: str | None, hazard_uni
     With --limit-states, the limit states beyond first contact (storey
     drift ratio, ductility, floor acceleration, impact force, a bearing's
     stop) at each finite gap against the contact-free twins.
+    With --ruptures, beside g*: the answer without an intensity measure at
+    that site of ruptures (docs/measure-free.md), each configuration's
+    contact-free scene run under simulated motions of each rupture, its
+    closure (g*), base displacements and storey drifts at the targets.
 
     A target rarer than the stripes reach (its rate below the hazard's at
     the top stripe, or g* wider than every gap the top stripe's runs close)
@@ -129,6 +142,7 @@ def risk(store: Path, hazard: str | None, hazard_measure: str | None, hazard_uni
     from stochpound.risk import gap_cost_frame, limit_state_risk, read_risk_inputs, site_hazard, store_risk
 
     targets = _targets(target)
+    site = None if ruptures is None else rupture_site_option(ruptures, "--ruptures")
     if hazard is None and (hazard_measure or hazard_units or investigation_time is not None or hazard_site is not None):
         raise click.UsageError("--hazard-measure, --hazard-units, --investigation-time and --hazard-site describe a --hazard file: give one")
     if csv_dir is not None:
@@ -144,6 +158,7 @@ def risk(store: Path, hazard: str | None, hazard_measure: str | None, hazard_uni
             costs = None if limit_states is None else gap_cost_frame(limit_state_risk(data, _limit_states(limit_states), hz), years)
             missed, beyond = inputs.selection_misses, inputs.beyond_truncation  # every read of the store before the first answer
             measure_lines = efficient_measure_lines(data, hazard)
+            free = None if site is None else measure_free_answer(data, site, ruptures_runs, seed, targets, years, workers)
     except (StochpoundError, ValueError) as error:
         raise click.ClickException(str(error)) from None
     except OSError as error:
@@ -172,6 +187,8 @@ def risk(store: Path, hazard: str | None, hazard_measure: str | None, hazard_uni
     click.echo(separation.to_string(float_format=lambda v: f"{v:.3f}"))
     if result.no_interval:
         click.echo(f"note: no interval is estimable for g*, the rates or the code rules: {result.no_interval}.")
+    if free is not None:
+        click.echo("\n".join(measure_free_lines(free, source)))
     design = result.design_frame()
     given = design["design"].notna()
     if not given.any():

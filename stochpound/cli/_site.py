@@ -2,9 +2,17 @@
 
 from __future__ import annotations
 
+import dataclasses
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import click
+
+if TYPE_CHECKING:
+    import xarray as xr
+
+    from stochpound.analysis import StoreMeasureFree
+    from stochpound.hazard import RuptureSite
 
 DEFAULT_RETURN_PERIODS = "72,475,2475,10000"
 """Return periods (yr) printed by default: 50 %, 10 %, 2 % in 50 years, and 10 000 years."""
@@ -73,3 +81,37 @@ def _periods(text: str | None, measure: str) -> float | list[float] | None:
         return None
     values = _numbers(text, "--period")
     return values[0] if measure == "psa" and len(values) == 1 else values
+
+
+def rupture_site_option(value: str, option: str) -> RuptureSite:
+    """The site of ruptures an option names: a rupture table's file or a bundled site's name, or a one-line error naming the option."""
+    from stochpound._errors import SiteError
+    from stochpound.hazard import named_rupture_site
+
+    try:
+        site = named_rupture_site(value, Path("."), {}, "site")
+    except SiteError as error:
+        raise click.BadParameter(str(error).removeprefix("site.ruptures: "), param_hint=option) from None
+    return site if site.name else dataclasses.replace(site, name=Path(value).stem)
+
+
+def measure_free_answer(store: xr.Dataset, site: RuptureSite, runs: int, seed: int, targets: tuple[float, ...], years: float,
+                        workers: int) -> StoreMeasureFree:
+    """``stochpound.analysis.store_measure_free`` of the store at the site, its budget's error naming ``--ruptures-runs``."""
+    from stochpound.analysis import store_measure_free
+
+    try:
+        return store_measure_free(store, site, runs=runs, seed=seed, targets=targets, years=years, workers=workers)
+    except ValueError as error:
+        message = str(error)
+        raise click.BadParameter(message.removeprefix("runs: "), param_hint="--ruptures-runs") if message.startswith("runs:") else error from None
+
+
+def measure_free_lines(answer: StoreMeasureFree, hazard: str) -> list[str]:
+    """The answer without an intensity measure as ``stochpound risk`` prints it, saying whose site it is and its conditions."""
+    return [
+        f"\nWithout an intensity measure (docs/measure-free.md): at the site of ruptures {answer.site}; {answer.conditions()}. "
+        f"The answers above are at the hazard's site ({hazard}); this one is at the ruptures' site, the same site only where that "
+        "hazard is of these ruptures. Level of each demand at each target (m; its interval), from the same runs; the closure's is g*:",
+        answer.display_frame().to_string(),
+    ]

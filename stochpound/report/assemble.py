@@ -27,6 +27,7 @@ from stochpound.report.sections import (
     intensity_section,
     law_axis,
     laws_section,
+    measure_free_section,
     methods_section,
     move_per_cell_tables,
     open_stores,
@@ -35,13 +36,14 @@ from stochpound.report.sections import (
     store_section,
 )
 from stochpound.experiment import measure_choice
+from stochpound.analysis import MEASURE_FREE_RUNS, RuptureSite, store_measure_free
 from stochpound.risk import has_risk, store_damage, store_demands, store_risk
 from stochpound.store import check_finished, has_contact_free, has_wall_free, with_contacts, with_walls
 from stochpound._studies import claims, load_study
 
 
 def assemble_report(paths: Sequence[str | Path], progress: Callable[[str], None] | None = None, partial: bool = False,
-                    edited: str = "warn") -> Report:
+                    edited: str = "warn", ruptures: RuptureSite | None = None, ruptures_runs: int = MEASURE_FREE_RUNS) -> Report:
     """Build the report of the given stores.
 
     Parameters
@@ -56,6 +58,9 @@ def assemble_report(paths: Sequence[str | Path], progress: Callable[[str], None]
     edited : {"warn", "refuse", "accept"}
         A store whose definition does not match its recorded sha256 (:func:`~stochpound.open_store`;
         ``stochpound report build`` refuses it without ``--accept-edited``).
+    ruptures : RuptureSite, optional
+        A site of ruptures: each store with a Risk section also gets the answer without an intensity measure there
+        (:func:`~stochpound.analysis.store_measure_free`, ``ruptures_runs`` runs a configuration, seed 0).
 
     Returns
     -------
@@ -94,6 +99,10 @@ def assemble_report(paths: Sequence[str | Path], progress: Callable[[str], None]
             risks[name] = store_risk(store, partial=partial)
             damage = store_damage(store)
             report.sections.append(risk_section(name, risks[name], store_demands(store), damage, measure_choice(store)))
+            if ruptures is not None:
+                say(f"experiment {name}: without an intensity measure")
+                answer = store_measure_free(store, ruptures, runs=ruptures_runs)
+                report.sections.append(measure_free_section(name, answer, risks[name].hazard.describe()))
             if damage is not None:
                 report.sections.append(damage_section(name, damage))
     for name, store in others.items():
@@ -136,6 +145,9 @@ def _about(stores: dict[str, xr.Dataset], sections: list[Section]) -> str:
     if "risk" in kinds:
         parts.append("A Risk section per experiment with a site hazard gives the risk-targeted separation g* first, then the "
                      "fragility at every gap, the mean annual frequency of pounding and the code rules in risk terms.")
+    if "measure" in kinds:
+        parts.append("A section 'Without an intensity measure' follows a Risk section with the same question's answer at a site of "
+                     "ruptures, from simulated motions of each rupture and no intensity measure.")
     if "damage" in kinds:
         parts.append("A Damage section per experiment of yielding buildings gives their ductility and residual drift demands at the "
                      "stripes of 10 % and 2 % in 50 yr, the runs beyond what the model represents, and the limit state that governs.")

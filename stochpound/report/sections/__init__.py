@@ -13,6 +13,7 @@ from stochpound.report.sections._intensity import intensity_section
 from stochpound.report.sections._risk import risk_section
 from stochpound.report.sections._laws import law_axis, laws_section
 from stochpound.report.sections._methods import methods_section
+from stochpound.report.sections._measure_free import measure_free_section
 from stochpound.report.sections._separation import WALLS, separation_section
 from stochpound.report.sections._store_reading import open_stores, select, value
 from stochpound.report.sections._summary import experiment_summary, move_per_cell_tables
@@ -29,6 +30,7 @@ __all__ = [
     "law_axis",
     "laws_section",
     "methods_section",
+    "measure_free_section",
     "move_per_cell_tables",
     "open_stores",
     "select",
