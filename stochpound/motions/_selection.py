@@ -347,15 +347,17 @@ def _swap(ln_sa: np.ndarray, chosen: list[int], mean: np.ndarray, sigma: np.ndar
     chosen = list(chosen)
     n = len(chosen)
     best = _set_misfit(ln_sa[chosen], mean, sigma)
+    ln_sa_squared = ln_sa**2
     for _ in range(_MAX_PASSES):
         improved = False
         for slot in range(n):
-            others = ln_sa[[c for k, c in enumerate(chosen) if k != slot]]
+            kept = chosen[:slot] + chosen[slot + 1 :]
+            others = ln_sa[kept]
             total, squares = others.sum(axis=0), (others**2).sum(axis=0)
             set_mean = (total + ln_sa) / n  # every row as the slot's motion
-            variance = np.clip((squares + ln_sa**2 - n * set_mean**2) / (n - 1), 0.0, None)
+            variance = np.maximum((squares + ln_sa_squared - n * set_mean**2) / (n - 1), 0.0)
             misfit = _misfit(set_mean, np.sqrt(variance), mean, sigma)
-            misfit[~rules.allowed([c for k, c in enumerate(chosen) if k != slot])] = np.inf
+            misfit[~rules.allowed(kept)] = np.inf
             row = int(np.argmin(misfit))
             if misfit[row] < best - 1e-12:
                 chosen[slot], best, improved = row, float(misfit[row]), True
