@@ -36,19 +36,14 @@ periods logarithmically from 0.2 times its shortest to 3 times its longest
 period of interest (each building's first-mode period and the isolated
 period), within the models' 0.01–10 s, the conditioning period added.
 
-A process computes a pool motion's spectrum at a period once: the values are
-kept by the motion's content (its samples in m/s², their step) and the
-damping, per period (:data:`SPECTRUM_CACHE_MOTIONS` motions, the least
-recently used dropped first), so the experiments of one process that share a
-pool (stripes conditioned on other measures, other seeds) reuse them. The
-spectrum at a period does not depend on the other periods computed with it:
-the values are those of one call over all the periods, bit for bit.
+A process computes a pool motion's spectrum at a period once (the cache of
+:func:`~stochpound.motions.response_spectrum`): the experiments of one
+process that share a pool (stripes conditioned on other measures, other
+seeds) reuse it.
 """
 
 from __future__ import annotations
 
-import hashlib
-from collections import OrderedDict
 from collections.abc import Sequence
 
 import numpy as np
@@ -74,9 +69,6 @@ TARGET_TOLERANCE = 0.1
 #: Weight of the quartic term of the misfit.
 QUARTIC_WEIGHT = 100.0
 _MAX_PASSES = 50
-#: Motions whose spectra a process keeps (module docstring).
-SPECTRUM_CACHE_MOTIONS = 2048
-_SPECTRA: OrderedDict[tuple[bytes, float, float], dict[float, float]] = OrderedDict()
 
 
 def selection_periods(structure_periods: Sequence[float], conditioning: Sequence[float] = (), count: int = RANGE_PERIODS) -> np.ndarray:
@@ -138,7 +130,7 @@ def selection_pool(
     grid = np.asarray(periods, dtype=float)
     for record in records:
         a = record.acceleration(g)
-        spectrum = pool_spectrum(a, record.dt, np.concatenate([grid, conditioning]), damping) / g
+        spectrum = response_spectrum(a, record.dt, np.concatenate([grid, conditioning]), damping).psa.values / g
         psa.append(spectrum[: grid.size])
         intensity.append(peak_ground_motion(a, record.dt)[0] / g if measure == "pga" else float(np.exp(np.mean(np.log(spectrum[grid.size :])))))
     meta = [record.metadata or {} for record in records]
@@ -157,32 +149,6 @@ def selection_pool(
         coords={"motion": [record.name for record in records], "period": ("period", grid, {"units": "s"})},
         attrs={"damping": float(damping), "measure": measure},
     )
-
-
-def pool_spectrum(acceleration: np.ndarray, dt: float, periods: np.ndarray, damping: float) -> np.ndarray:
-    """``psa`` (m/s²) of :func:`~stochpound.motions.response_spectrum` at ``periods`` (s), each period computed once per process (module docstring).
-
-    Parameters
-    ----------
-    acceleration : numpy.ndarray
-        Samples, m/s², at ``dt`` (s) from t = 0.
-    dt : float
-        Step, s.
-    periods : numpy.ndarray
-        Oscillator periods, s.
-    damping : float
-        Damping ratio.
-    """
-    a = np.ascontiguousarray(acceleration, dtype=np.float64)
-    key = (hashlib.sha256(a.tobytes()).digest(), float(dt), float(damping))
-    known = _SPECTRA.pop(key, {})
-    _SPECTRA[key] = known  # the most recently used last
-    if len(_SPECTRA) > SPECTRUM_CACHE_MOTIONS:
-        _SPECTRA.popitem(last=False)
-    missing = np.array(sorted({float(period) for period in periods} - known.keys()))
-    if missing.size:
-        known.update(zip(missing.tolist(), response_spectrum(a, dt, missing, damping).psa.values.tolist()))
-    return np.array([known[float(period)] for period in periods])
 
 
 def _recording(metadata: dict, name: str) -> str:
