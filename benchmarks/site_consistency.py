@@ -164,7 +164,7 @@ def measure_risk(folder: Path, measure: str, configuration: str, bootstrap: int 
     name = f"{measure.replace('(', '').replace(' s)', '').replace(' ', '').replace('.', 'p').lower()}.toml"
     path = folder / name
     path.write_text(experiment_text(measure, configuration, seed, return_periods, site))
-    report = run_experiment(load_experiment(path), workers=0, progress=False)
+    report = run_experiment(load_experiment(path), workers=0, progress=False, checkpoint=float("inf"))  # no store written mid-run: read at the end only
     if not report.complete:
         raise RuntimeError(f"{configuration}, {measure}: the experiment did not complete")
     store = open_store(report.store).load()

@@ -211,3 +211,31 @@ def test_same_motion_resampled_gives_the_same_spectrum(zeta):
     coarse, refined = response_spectrum(a, dt, periods, zeta), response_spectrum(fine, fine_dt, periods, zeta)
     for name in ("sd", "sa"):
         np.testing.assert_allclose(coarse[name].values, refined[name].values, rtol=1e-9)
+
+
+def test_a_motions_peaks_are_computed_once_a_period_and_equal_a_fresh_computation_bit_for_bit(monkeypatch):
+    """The process's cache of peaks (by the motion's content, step and damping): a period known is not computed again, and
+    every call gives the kernel's values of that period bit for bit, whatever the other periods and their order."""
+    from stochpound.motions import _spectrum
+
+    record = load_record(RECORD)
+    a, dt = record.acceleration(9.81), record.dt
+    periods = np.array([2.0, 0.1, 0.7, 0.1, 3.3])
+    kernel = _spectrum._spectrum_kernel
+
+    def fresh(values: np.ndarray, zeta: float) -> tuple[np.ndarray, np.ndarray]:
+        sd, sa = np.empty_like(values), np.empty_like(values)
+        kernel(a, dt, 2.0 * np.pi / values, zeta, sd, sa)
+        return sd, sa
+
+    computed: list[list[float]] = []
+    monkeypatch.setattr(_spectrum, "_PEAKS", type(_spectrum._PEAKS)())
+    monkeypatch.setattr(_spectrum, "_spectrum_kernel", lambda a, h, omega, *rest: (computed.append(list(2.0 * np.pi / omega)), kernel(a, h, omega, *rest)))
+    for values, zeta in ((periods[:3], 0.05), (periods, 0.05), (periods[::-1], 0.05), (periods, 0.02)):
+        spectrum = response_spectrum(a, dt, values, zeta)
+        sd, sa = fresh(values, zeta)
+        assert spectrum.sd.values.tobytes() == sd.tobytes() and spectrum.sa.values.tobytes() == sa.tobytes()
+        assert spectrum.psa.values.tobytes() == ((2.0 * np.pi / values) ** 2 * sd).tobytes()
+    assert computed == [[0.1, 0.7, 2.0], [3.3], [0.1, 0.7, 2.0, 3.3]]  # the new periods only; another damping is another motion's
+    response_spectrum(a * 2.0, dt, [0.7], 0.05)
+    assert computed[-1] == [0.7]  # other samples: computed

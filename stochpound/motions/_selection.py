@@ -35,6 +35,11 @@ The period range covers the structure: :func:`selection_periods` spaces
 periods logarithmically from 0.2 times its shortest to 3 times its longest
 period of interest (each building's first-mode period and the isolated
 period), within the models' 0.01–10 s, the conditioning period added.
+
+A process computes a pool motion's spectrum at a period once (the cache of
+:func:`~stochpound.motions.response_spectrum`): the experiments of one
+process that share a pool (stripes conditioned on other measures, other
+seeds) reuse it.
 """
 
 from __future__ import annotations
@@ -298,7 +303,9 @@ class _Rules:
     def allowed(self, taken: list[int]) -> np.ndarray:
         """Candidates a set holding the rows ``taken`` may add (bool, one per row)."""
         counts = np.bincount(self.earthquake[taken], minlength=self.earthquake.max() + 1)
-        return (counts[self.earthquake] < self.cap) & ~np.isin(self.recording, self.recording[taken])
+        recorded = np.zeros(self.recording.max() + 1, dtype=bool)
+        recorded[self.recording[taken]] = True
+        return (counts[self.earthquake] < self.cap) & ~recorded[self.recording]
 
 
 def _swap(ln_sa: np.ndarray, chosen: list[int], mean: np.ndarray, sigma: np.ndarray, rules: _Rules) -> list[int]:
@@ -306,15 +313,17 @@ def _swap(ln_sa: np.ndarray, chosen: list[int], mean: np.ndarray, sigma: np.ndar
     chosen = list(chosen)
     n = len(chosen)
     best = _set_misfit(ln_sa[chosen], mean, sigma)
+    ln_sa_squared = ln_sa**2
     for _ in range(_MAX_PASSES):
         improved = False
         for slot in range(n):
-            others = ln_sa[[c for k, c in enumerate(chosen) if k != slot]]
+            kept = chosen[:slot] + chosen[slot + 1 :]
+            others = ln_sa[kept]
             total, squares = others.sum(axis=0), (others**2).sum(axis=0)
             set_mean = (total + ln_sa) / n  # every row as the slot's motion
-            variance = np.clip((squares + ln_sa**2 - n * set_mean**2) / (n - 1), 0.0, None)
+            variance = np.maximum((squares + ln_sa_squared - n * set_mean**2) / (n - 1), 0.0)
             misfit = _misfit(set_mean, np.sqrt(variance), mean, sigma)
-            misfit[~rules.allowed([c for k, c in enumerate(chosen) if k != slot])] = np.inf
+            misfit[~rules.allowed(kept)] = np.inf
             row = int(np.argmin(misfit))
             if misfit[row] < best - 1e-12:
                 chosen[slot], best, improved = row, float(misfit[row]), True

@@ -33,11 +33,20 @@ kernel (numba, cached on disk), periods in the outer loop.
 The recurrence loses accuracy for very long periods, where p0 (of order
 a_g/ω² and s/ω³) grows large against u: about 1e-13 relative at T = 5 s and
 h = 0.01 s, still below 1e-10 at T = 50 s.
+
+A process computes a motion's peaks at a period once: they are kept by the
+motion's content (its samples in m/s² and their step) and the damping, per
+period, for :data:`CACHED_MOTIONS` motions (the least recently used dropped
+first). The peaks at a period do not depend on the other periods of the
+call, so the values are those of one call over all the periods, bit for bit.
 """
 
 from __future__ import annotations
 
+import hashlib
 import math
+import threading
+from collections import OrderedDict
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -53,6 +62,10 @@ if TYPE_CHECKING:  # the records package imports the analysis kernels, which imp
 #: Default damping ratio of the spectrum.
 DEFAULT_DAMPING = 0.05
 _NEWTON_ITERATIONS = 60
+#: Motions whose peaks a process keeps (module docstring).
+CACHED_MOTIONS = 512
+_PEAKS: OrderedDict[tuple[bytes, float, float], dict[float, tuple[float, float]]] = OrderedDict()
+_PEAKS_LOCK = threading.Lock()
 
 
 def as_acceleration(
@@ -133,8 +146,7 @@ def response_spectrum(
         raise ValueError("periods: required (s)")
     values, zeta = check_periods(periods, damping)
     omega = 2.0 * np.pi / values
-    sd, sa = np.empty_like(omega), np.empty_like(omega)
-    _spectrum_kernel(a, step, omega, zeta, sd, sa)
+    sd, sa = _peaks(a, step, values, zeta)
     return xr.Dataset(
         {
             "sd": ("period", sd, {"units": "m", "long_name": "spectral displacement"}),
@@ -145,6 +157,24 @@ def response_spectrum(
         coords={"period": ("period", values, {"units": "s"})},
         attrs={"damping": zeta},
     )
+
+
+def _peaks(a: np.ndarray, step: float, periods: np.ndarray, zeta: float) -> tuple[np.ndarray, np.ndarray]:
+    """max abs(u) (m) and max abs(ü + a_g) (m/s²) at ``periods`` (s), each computed once per process for a motion (module docstring)."""
+    key = (hashlib.sha256(a.tobytes()).digest(), step, zeta)
+    with _PEAKS_LOCK:
+        known = _PEAKS.pop(key, {})
+        _PEAKS[key] = known  # the most recently used last
+        if len(_PEAKS) > CACHED_MOTIONS:
+            _PEAKS.popitem(last=False)
+        missing = np.array(sorted(set(periods.tolist()) - known.keys()))
+    if missing.size:
+        sd, sa = np.empty_like(missing), np.empty_like(missing)
+        _spectrum_kernel(a, step, 2.0 * np.pi / missing, zeta, sd, sa)
+        with _PEAKS_LOCK:
+            known.update(zip(missing.tolist(), zip(sd.tolist(), sa.tolist())))
+    peaks = np.array([known[period] for period in periods.tolist()]).reshape(-1, 2)
+    return peaks[:, 0].copy(), peaks[:, 1].copy()
 
 
 @cached_njit()
