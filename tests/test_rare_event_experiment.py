@@ -1,0 +1,140 @@
+"""Rare-event experiments (issue 46, item 3): the [rare_event] table, its resumable store, bit for bit whatever the workers."""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+import xarray as xr
+
+from stochpound._errors import ExperimentError
+from stochpound.experiment import is_rare_event_file, load_rare_event, rare_event_results, run_rare_event
+from stochpound.experiment._rare_event_run import RUNS_PER_BATCH
+
+FILE = """
+[experiment]
+name = "pair_rare"
+
+[scene]
+bundled = "elastic_pair"
+
+[scene.building.B2]
+mass_factor = 2.0
+
+[synthetic.wn]
+type = "white_noise"
+S0 = 0.01
+duration = 2.0
+dt = 0.02
+
+[rare_event]
+method = "subset"
+response = "closure"
+contact = 1
+target_probability = 1e-3
+samples_per_level = {samples}
+p0 = 0.1
+seed = 3
+"""
+
+
+def _file(folder: Path, samples: int = 20, **edits: str) -> Path:
+    text = FILE.format(samples=samples)
+    for old, new in edits.items():
+        text = text.replace(old, new)
+    path = folder / "pair.toml"
+    path.write_text(text)
+    return path
+
+
+@pytest.mark.parametrize(("old", "new", "message"), [
+    ('method = "subset"', 'method = "line"', r"rare_event.method: must be one of subset, got 'line'"),
+    ("target_probability = 1e-3", "target_probability = 0.5", r"rare_event.target_probability: must be <= 0.1, got 0.5"),
+    ("p0 = 0.1", "p0 = 0.7", r"rare_event.p0: must be <= 0.5, got 0.7"),
+    ("seed = 3", "seed = -1", r"rare_event.seed: must be an integer in \[0, "),
+    ("contact = 1", "contact = 2", r"rare_event.contact: must be an integer in \[0, 1\], got 2"),
+    ('response = "closure"', 'response = "speed"', "rare_event.response: must be one of closure, peak_storey_drift, base_displacement, impact_force, limit_state"),
+    ('response = "closure"\ncontact = 1', 'response = "base_displacement"\nbuilding = "B1"', "rare_event.building: 'B1' has a fixed base"),
+    ('response = "closure"\ncontact = 1', 'response = "peak_storey_drift"\nbuilding = "B1"\nfloor = 3', r"rare_event.floor: must be an integer in \[1, 2\], got 3"),
+    ("p0 = 0.1", "p0 = 0.1\nfloor = 1", "rare_event.floor: not used by response = 'closure'"),
+    ("S0 = 0.01", "S9 = 0.01", "synthetic.wn.S9: unknown field"),
+])
+def test_bad_fields_are_named_in_one_line(tmp_path, old, new, message):
+    path = _file(tmp_path, **{old: new})
+    assert is_rare_event_file(path)
+    with pytest.raises(ExperimentError, match=message) as error:
+        load_rare_event(path)
+    assert "\n" not in str(error.value)
+
+
+def test_samples_per_level_must_split_into_chains(tmp_path):
+    with pytest.raises(ExperimentError, match=r"rare_event.samples_per_level: p0 × samples_per_level must be an integer that divides it"):
+        load_rare_event(_file(tmp_path, samples=25))
+
+
+def test_the_table_is_typed_and_the_store_holds_the_levels(tmp_path):
+    definition = load_rare_event(_file(tmp_path))
+    assert definition.table.response == "closure" and definition.table.samples_per_level == 20 and definition.motion["type"] == "white_noise"
+    report = run_rare_event(definition, tmp_path / "a.nc")
+    assert report.complete and report.levels == 3 and report.runs == 20 + 2 * 2 * 9
+    with xr.open_dataset(tmp_path / "a.nc", engine="h5netcdf") as store:
+        assert store.attrs["runs"] == report.runs and store.attrs["complete"] == 1
+        assert list(store["level_runs"].values) == [20, 18, 18]
+        assert np.isneginf(store["level_threshold"].values[0]) and np.all(np.diff(store["level_threshold"].values) > 0)
+        results = rare_event_results(store.load())
+    # the levels' thresholds have the estimated probabilities p0 and p0²; the curve reaches the target
+    assert 0.0 < float(results.curve.probability.min()) <= 1e-3 * (1 + 1e-9)
+    assert np.isfinite(results.separations["value"][0]) and np.isnan(results.separations["value"][1])
+
+
+def test_an_interrupted_run_resumes_at_the_last_finished_batch(tmp_path):
+    definition = load_rare_event(_file(tmp_path, samples=200))
+    whole = run_rare_event(definition, tmp_path / "whole.nc")
+    first = run_rare_event(definition, tmp_path / "split.nc", stop_after=3)
+    assert first.interrupted and not first.complete and first.batches_now == 3
+    again = run_rare_event(definition, tmp_path / "split.nc")
+    per_level = [2] + [-(-20 // (RUNS_PER_BATCH // 10))] * (whole.levels - 1)
+    assert first.batches_now + again.batches_now == sum(per_level)  # nothing redone
+    assert again.runs == whole.runs
+    assert (tmp_path / "whole.nc").read_bytes() == (tmp_path / "split.nc").read_bytes()
+
+
+def test_a_killed_command_resumes_to_the_same_store(tmp_path):
+    """``experiment run`` killed (SIGKILL) once its first batch is written, then run again: the store of an uninterrupted run, bit for bit."""
+    environment = {**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parent.parent)}
+    command = [sys.executable, "-m", "stochpound", "experiment", "run", "pair.toml", "--store", "pair.nc", "--quiet"]
+    for name in ("killed", "whole"):
+        (tmp_path / name).mkdir()
+        _file(tmp_path / name, samples=400)
+    subprocess.run(command, cwd=tmp_path / "whole", env=environment, check=True, capture_output=True)
+    process = subprocess.Popen(command, cwd=tmp_path / "killed", env=environment, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    parts = tmp_path / "killed" / "pair.nc.parts"
+    deadline = time.monotonic() + 120
+    while not list(parts.glob("batch-*.npz")) and process.poll() is None and time.monotonic() < deadline:
+        time.sleep(0.05)
+    process.send_signal(signal.SIGKILL)
+    process.wait()
+    assert list(parts.glob("*.npz")) and not (tmp_path / "killed" / "pair.nc").exists()
+    resumed = subprocess.run(command, cwd=tmp_path / "killed", env=environment, check=True, capture_output=True, text=True)
+    assert "0 of the level under way before" not in resumed.stdout
+    assert (tmp_path / "killed" / "pair.nc").read_bytes() == (tmp_path / "whole" / "pair.nc").read_bytes()
+
+
+@pytest.mark.slow
+def test_one_or_two_workers_give_the_same_store(tmp_path):
+    definition = load_rare_event(_file(tmp_path))
+    for workers in (1, 2):
+        run_rare_event(definition, tmp_path / f"{workers}.nc", workers=workers)
+    assert (tmp_path / "1.nc").read_bytes() == (tmp_path / "2.nc").read_bytes()
+
+
+def test_a_store_of_another_definition_is_refused(tmp_path):
+    run_rare_event(load_rare_event(_file(tmp_path)), tmp_path / "a.nc", stop_after=1)
+    with pytest.raises(ExperimentError, match="made by another definition"):
+        run_rare_event(load_rare_event(_file(tmp_path, **{"seed = 3": "seed = 4"})), tmp_path / "a.nc")
