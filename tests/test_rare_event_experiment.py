@@ -11,10 +11,9 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-import xarray as xr
 
 from stochpound._errors import ExperimentError
-from stochpound.experiment import is_rare_event_file, load_rare_event, rare_event_results, run_rare_event
+from stochpound.experiment import is_rare_event_file, is_rare_event_store, load_rare_event, open_rare_event_store, rare_event_results, run_rare_event
 from stochpound.experiment._rare_event_run import RUNS_PER_BATCH
 
 FILE = """
@@ -83,11 +82,12 @@ def test_the_table_is_typed_and_the_store_holds_the_levels(tmp_path):
     assert definition.table.response == "closure" and definition.table.samples_per_level == 20 and definition.motion["type"] == "white_noise"
     report = run_rare_event(definition, tmp_path / "a.nc")
     assert report.complete and report.levels == 3 and report.runs == 20 + 2 * 2 * 9
-    with xr.open_dataset(tmp_path / "a.nc", engine="h5netcdf") as store:
-        assert store.attrs["runs"] == report.runs and store.attrs["complete"] == 1
-        assert list(store["level_runs"].values) == [20, 18, 18]
-        assert np.isneginf(store["level_threshold"].values[0]) and np.all(np.diff(store["level_threshold"].values) > 0)
-        results = rare_event_results(store.load())
+    assert is_rare_event_store(tmp_path / "a.nc") and not is_rare_event_store(tmp_path / "pair.toml")
+    store = open_rare_event_store(tmp_path / "a.nc")
+    assert store.attrs["runs"] == report.runs and store.attrs["complete"] == 1
+    assert list(store["level_runs"].values) == [20, 18, 18]
+    assert np.isneginf(store["level_threshold"].values[0]) and np.all(np.diff(store["level_threshold"].values) > 0)
+    results = rare_event_results(store)
     # the levels' thresholds have the estimated probabilities p0 and p0²; the curve reaches the target
     assert 0.0 < float(results.curve.probability.min()) <= 1e-3 * (1 + 1e-9)
     assert np.isfinite(results.separations["value"][0]) and np.isnan(results.separations["value"][1])
@@ -138,3 +138,21 @@ def test_a_store_of_another_definition_is_refused(tmp_path):
     run_rare_event(load_rare_event(_file(tmp_path)), tmp_path / "a.nc", stop_after=1)
     with pytest.raises(ExperimentError, match="made by another definition"):
         run_rare_event(load_rare_event(_file(tmp_path, **{"seed = 3": "seed = 4"})), tmp_path / "a.nc")
+
+
+def test_the_report_draws_the_curve_and_states_the_separations(tmp_path):
+    """``report build`` on a rare-event store: a section of its own with the curve to the target, its interval, and the separation table."""
+    from stochpound.report.assemble import assemble_report
+    from stochpound.report.render import FigureItem, Table
+
+    definition = load_rare_event(_file(tmp_path))
+    run_rare_event(definition, tmp_path / "a.nc")
+    report = assemble_report([tmp_path / "a.nc"])
+    section = next(s for s in report.sections if s.key == "rare-pair_rare")
+    figure = next(b for b in section.blocks if isinstance(b, FigureItem))
+    table = next(b for b in section.blocks if isinstance(b, Table))
+    results = rare_event_results(open_rare_event_store(tmp_path / "a.nc"))
+    assert list(table.frame.index) == [1e-3, 1e-4, 1e-6]
+    assert table.frame["separation (m)"].values[0] == results.separations["value"][0]
+    assert np.all(results.curve.lower <= results.curve.probability) and np.all(results.curve.probability <= results.curve.upper)
+    assert "down to 0.001" in figure.caption and "n = 56 runs" in section.blocks[0].text

@@ -36,6 +36,8 @@ from stochpound.experiment._rare_event_table import TABLE, RareEventDefinition
 DEFINITION_FILE = "definition.json"
 KIND = "rare_event"
 """The ``kind`` attribute of a rare-event store."""
+INTERVAL_Z = 1.96
+"""The standard normal quantile of the report's intervals: p·exp(±z δ), a lognormal estimate's 95 % interval."""
 SEPARATION_PROBABILITIES = (1e-3, 1e-4, 1e-6)
 """The probabilities per event whose response (for a closure, the separation) the report states."""
 
@@ -141,9 +143,19 @@ def write_store(store: Path, definition: RareEventDefinition, levels: list[Finis
         data.to_netcdf(temporary, engine="h5netcdf", invalid_netcdf=False)
 
 
-def is_rare_event_store(data: xr.Dataset) -> bool:
-    """Whether an opened store is a rare-event experiment's."""
-    return data.attrs.get("kind") == KIND
+def is_rare_event_store(path: str | Path) -> bool:
+    """Whether a file is a rare-event experiment's store (False for any other file)."""
+    try:
+        with xr.open_dataset(path, engine="h5netcdf") as data:
+            return data.attrs.get("kind") == KIND
+    except (OSError, ValueError):
+        return False
+
+
+def open_rare_event_store(path: str | Path) -> xr.Dataset:
+    """A rare-event store, loaded (it is small: the levels' responses)."""
+    with xr.open_dataset(path, engine="h5netcdf") as data:
+        return data.load()
 
 
 def store_levels(data: xr.Dataset) -> list[SubsetLevel]:
@@ -163,7 +175,8 @@ class RareEventResults:
     Attributes
     ----------
     curve : xarray.Dataset
-        ``probability`` and ``cov`` over ``threshold`` (the response's units), down to the target.
+        ``probability``, ``cov`` and the 95 % interval ``lower`` .. ``upper`` (p·exp(∓1.96 δ)) over
+        ``threshold`` (the response's units), down to the target.
     separations : dict of np.ndarray
         For :data:`SEPARATION_PROBABILITIES` (``probability``): ``value``, ``low``, ``high`` (the
         response exceeded with that probability and its 95 % interval) and ``cov``.
@@ -171,6 +184,8 @@ class RareEventResults:
         The experiment's definition.
     runs : int
         Solver runs used.
+    levels : int
+        Levels run (level 0 included).
     complete : bool
         The levels reached the target.
     """
@@ -179,6 +194,7 @@ class RareEventResults:
     separations: dict[str, np.ndarray]
     definition: dict[str, Any]
     runs: int
+    levels: int
     complete: bool
 
     @property
@@ -190,7 +206,9 @@ class RareEventResults:
 def rare_event_results(data: xr.Dataset) -> RareEventResults:
     """The exceedance curve and the separations for 1e-3, 1e-4 and 1e-6 per event of a rare-event store."""
     levels = store_levels(data)
-    quantiles = exceedance_quantiles(levels, SEPARATION_PROBABILITIES)
-    curve = data[["probability", "cov"]] if "probability" in data else xr.Dataset()
+    quantiles = exceedance_quantiles(levels, SEPARATION_PROBABILITIES, INTERVAL_Z)
+    curve = data[["probability", "cov"]].load() if "probability" in data else xr.Dataset({"probability": ("threshold", []), "cov": ("threshold", [])})
+    spread = np.exp(INTERVAL_Z * curve["cov"].fillna(np.inf))
+    curve = curve.assign(lower=curve["probability"] / spread, upper=np.minimum(curve["probability"] * spread, 1.0))
     return RareEventResults(curve, {"probability": np.array(SEPARATION_PROBABILITIES), **quantiles}, json.loads(data.attrs["definition"]),
-                            int(data.attrs["runs"]), bool(data.attrs["complete"]))
+                            int(data.attrs["runs"]), len(levels), bool(data.attrs["complete"]))
