@@ -85,6 +85,15 @@ def _sampler(definition: str) -> tuple[SubsetSampler, str]:
     return SubsetSampler(function, n, table["samples_per_level"], table["p0"], table["seed"]), units
 
 
+def rare_event_sampler(definition: RareEventDefinition) -> SubsetSampler:
+    """The sampler of a rare-event experiment: its response as a function of the motion's normals, N, p0 and seed.
+
+    Its :meth:`~stochpound.analysis.SubsetSampler.start` with another seed's
+    sampler gives crude Monte Carlo of the same response.
+    """
+    return _sampler(canonical_json(definition.to_dict()))[0]
+
+
 def run_batch(task: RareEventTask) -> dict[str, np.ndarray]:
     """Run one batch: its responses (chains, states), accepted moves and the normals of its states that may seed the next level."""
     sampler, _ = _sampler(task.definition)

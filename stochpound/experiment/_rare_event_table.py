@@ -64,7 +64,7 @@ class RareEventTable:
         The sampler's seed, >= 0.
     motion : str
         The label of the synthetic motion (``scene`` for the scene's own ``[motion]``).
-    contact : int
+    contact : int or None
         The contact of ``closure`` and ``impact_force``.
     building : str or None
         The building of ``peak_storey_drift``, ``base_displacement`` and ``isolator_displacement``.
@@ -85,7 +85,7 @@ class RareEventTable:
     p0: float
     seed: int
     motion: str
-    contact: int = 0
+    contact: int | None = None
     building: str | None = None
     floor: int | None = None
     limit_state: str | None = None
