@@ -225,7 +225,7 @@ def subset_simulation(
     thresholds : sequence of float, optional
         Thresholds b, in the response's units; the levels go on until the
         largest is reached (without ``target_probability``). Without them, the
-        curve's thresholds span its levels (:func:`curve_thresholds`).
+        curve's thresholds span its levels, from level 0's median response to the target.
     target_probability : float, optional
         The probability in (0, 1) the levels go down to instead: they stop
         when the last level's probability times p0 is at most this.

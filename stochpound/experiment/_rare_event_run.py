@@ -8,7 +8,7 @@ it finishes (:mod:`stochpound.experiment._rare_event_store`). A level whose
 batches are all written is written as a level file, which names the next
 level's threshold and seeds. An interrupted run resumes at the batches
 missing from the level under way; every chain draws from a generator of its
-own (:class:`~stochpound.analysis.SubsetSampler`), so the store is the same,
+own (``stochpound.analysis.SubsetSampler``), so the store is the same,
 bit for bit, whatever the workers, the batches' order and the interruptions.
 """
 
@@ -88,8 +88,8 @@ def _sampler(definition: str) -> tuple[SubsetSampler, str]:
 def rare_event_sampler(definition: RareEventDefinition) -> SubsetSampler:
     """The sampler of a rare-event experiment: its response as a function of the motion's normals, N, p0 and seed.
 
-    Its :meth:`~stochpound.analysis.SubsetSampler.start` with another seed's
-    sampler gives crude Monte Carlo of the same response.
+    Its ``start`` (level 0's independent samples), on a sampler of another
+    seed, gives crude Monte Carlo of the same response.
     """
     return _sampler(canonical_json(definition.to_dict()))[0]
 

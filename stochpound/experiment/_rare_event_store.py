@@ -178,7 +178,7 @@ class RareEventResults:
         ``probability``, ``cov`` and the 95 % interval ``lower`` .. ``upper`` (p·exp(∓1.96 δ)) over
         ``threshold`` (the response's units), down to the target.
     separations : dict of np.ndarray
-        For :data:`SEPARATION_PROBABILITIES` (``probability``): ``value``, ``low``, ``high`` (the
+        For 1e-3, 1e-4 and 1e-6 per event (``probability``): ``value``, ``low``, ``high`` (the
         response exceeded with that probability and its 95 % interval) and ``cov``.
     definition : dict
         The experiment's definition.

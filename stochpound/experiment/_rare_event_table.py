@@ -71,7 +71,7 @@ class RareEventTable:
     floor : int or None
         The storey of ``peak_storey_drift``.
     limit_state : str or None
-        One of :data:`LIMIT_STATES`, with ``response = "limit_state"``.
+        ``isolator_displacement`` or ``impact_force``, with ``response = "limit_state"``.
     capacity : float or None
         The limit state's capacity (m or N), > 0.
     max_levels : int
