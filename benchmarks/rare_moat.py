@@ -18,6 +18,7 @@ take (δ² ∝ 1/N at a fixed number of levels).
 from __future__ import annotations
 
 import argparse
+import json
 import math
 import tempfile
 import time
@@ -40,6 +41,8 @@ MOTION = {"type": "kanai_tajimi", "omega_g": 15.0, "zeta_g": 0.6, "pga": 3.0, "e
 CRUDE_PROBABILITIES = (0.1, 0.03, 0.01)
 """The probabilities (of the subset curve) at whose clearances crude Monte Carlo checks it."""
 TARGET_COV = 0.15
+CRUDE_BATCH = 100
+"""Crude Monte Carlo runs kept at a time (a stopped benchmark resumes after the last)."""
 
 
 def moat_definition(samples: int, target: float, seed: int) -> RareEventDefinition:
@@ -52,19 +55,30 @@ def moat_definition(samples: int, target: float, seed: int) -> RareEventDefiniti
                                parse_rare_event(table, "kt", ["B1"], scene))
 
 
-def measure(samples: int, crude_runs: int, target: float, seed: int, workers: int) -> dict:
-    """One rare-event run and crude Monte Carlo of the same response; their results and wall times."""
+def measure(samples: int, crude_runs: int, target: float, seed: int, workers: int, store: Path) -> dict | None:
+    """One rare-event run into ``store`` and crude Monte Carlo of the same response, in batches kept beside it: their results and
+    wall times, summed over the invocations that made them (None while either is incomplete: run again to resume)."""
     definition = moat_definition(samples, target, seed)
-    with tempfile.TemporaryDirectory() as folder:
-        start = time.perf_counter()
-        run = run_rare_event(definition, Path(folder) / "moat_rare.nc", workers=workers)
-        subset_time = time.perf_counter() - start
-        results = rare_event_results(open_rare_event_store(Path(folder) / "moat_rare.nc"))
+    clock = store.with_suffix(".seconds.json")
+    seconds = json.loads(clock.read_text()) if clock.is_file() else {"subset": 0.0, "crude": 0.0}
+    start = time.perf_counter()
+    run = run_rare_event(definition, store, workers=workers)
+    seconds["subset"] += time.perf_counter() - start
+    clock.write_text(json.dumps(seconds))
+    if not run.complete:
+        return None
     sampler = rare_event_sampler(definition)
     crude_sampler = type(sampler)(sampler.function, sampler.dimension, sampler.samples_per_level, sampler.p0, seed + 1000)
-    start = time.perf_counter()
-    _, crude = crude_sampler.start(range(crude_runs))
-    return {"run": run, "results": results, "subset_time": subset_time, "crude": crude, "crude_time": time.perf_counter() - start}
+    kept = store.with_suffix(".crude.npy")
+    crude = np.load(kept) if kept.is_file() else np.empty(0)
+    while crude.size < crude_runs:
+        start = time.perf_counter()
+        crude = np.concatenate([crude, crude_sampler.start(range(crude.size, min(crude_runs, crude.size + CRUDE_BATCH)))[1]])
+        np.save(kept, crude)
+        seconds["crude"] += time.perf_counter() - start
+        clock.write_text(json.dumps(seconds))
+    results = rare_event_results(open_rare_event_store(store))
+    return {"results": results, "subset_time": seconds["subset"], "crude": crude[:crude_runs], "crude_time": seconds["crude"]}
 
 
 def section(measured: dict, info: dict[str, str], samples: int, target: float, workers: int) -> str:
@@ -83,8 +97,8 @@ def section(measured: dict, info: dict[str, str], samples: int, target: float, w
         "(ω_g = 15 rad/s, ζ_g = 0.6, expected PGA 3 m/s², Jennings envelope, 15 s at dt = 0.02 s, `method = \"filter\"`): P(peak sliding "
         "displacement > c), which is P(moat impact) at a clearance c by the gap identity. One rare-event experiment "
         f"(`[rare_event]`, N = {samples} a level, p0 = 0.1, target {target:g}) run by `stochpound experiment run` on {workers} local "
-        f"workers: {results.levels} levels, {results.runs} runs, {measured['subset_time']:.0f} s wall time; crude Monte Carlo of "
-        f"{crude.size} runs of the same response ({measured['crude_time']:.0f} s in one process). Machine: {info['cores']} cores, "
+        f"workers: {results.levels} levels, {results.runs} runs, {measured['subset_time']:.0f} s wall time (summed over the invocations "
+        f"that resumed it); crude Monte Carlo of {crude.size} runs of the same response ({measured['crude_time']:.0f} s in one process). Machine: {info['cores']} cores, "
         f"load {info['load average (1 min) at start']} at the start (commit {info['commit']}, {info['date']}). "
         "`python -m benchmarks rare_events moat` rewrites this section.",
         "",
@@ -116,10 +130,15 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--target", type=float, default=1e-6)
     parser.add_argument("--seed", type=int, default=1)
     parser.add_argument("--workers", type=int, default=2)
+    parser.add_argument("--store", type=Path, default=Path(tempfile.gettempdir()) / "stochpound-moat-rare.nc",
+                        help="the rare-event store (and its crude runs beside it): a stopped benchmark resumes from them")
     parser.add_argument("--out", type=Path, default=REPOSITORY / "docs" / "benchmarks.md")
     arguments = parser.parse_args(argv)
     info = report.machine()
-    measured = measure(arguments.samples, arguments.crude_runs, arguments.target, arguments.seed, arguments.workers)
+    measured = measure(arguments.samples, arguments.crude_runs, arguments.target, arguments.seed, arguments.workers, arguments.store)
+    if measured is None:
+        print(f"stopped before the rare-event run ended: run the same command again to resume ({arguments.store})")
+        return 1
     SECTION.write(arguments.out, section(measured, info, arguments.samples, arguments.target, arguments.workers))
     print(f"wrote the section 'Rare events: the moat impact at 1e-6' of {arguments.out}")
     return 0

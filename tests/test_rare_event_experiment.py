@@ -156,3 +156,66 @@ def test_the_report_draws_the_curve_and_states_the_separations(tmp_path):
     assert table.frame["separation (m)"].values[0] == results.separations["value"][0]
     assert np.all(results.curve.lower <= results.curve.probability) and np.all(results.curve.probability <= results.curve.upper)
     assert "down to 0.001" in figure.caption and "n = 56 runs" in section.blocks[0].text
+
+
+STOCHASTIC = """
+[experiment]
+name = "pair_stoch"
+
+[scene]
+bundled = "elastic_pair"
+
+[scene.building.B2]
+mass_factor = 2.0
+
+[grid]
+gap = [0.03, 0.035, inf]
+
+[synthetic.wn]
+type = "white_noise"
+S0 = 0.01
+duration = 2.0
+dt = 0.02
+count = 40
+seed = 1
+"""
+
+
+def test_a_stochastic_experiment_of_the_same_runs_checks_the_curve_at_its_gaps(tmp_path):
+    """With the stochastic store of the same scene and motion, the section gives crude Monte Carlo at its gaps beside the curve;
+    a store of another motion is not compared."""
+    from stochpound.experiment import crude_check, load_experiment, run_experiment
+    from stochpound.report.assemble import assemble_report
+
+    run_rare_event(load_rare_event(_file(tmp_path)), tmp_path / "a.nc")
+    for name, text in (("same", STOCHASTIC), ("other", STOCHASTIC.replace("S0 = 0.01", "S0 = 0.02"))):
+        (tmp_path / f"{name}.toml").write_text(text.replace("pair_stoch", f"pair_{name}"))
+        run_experiment(load_experiment(tmp_path / f"{name}.toml"), tmp_path / f"{name}.nc", workers=0, progress=False)
+    rare = open_rare_event_store(tmp_path / "a.nc")
+    with stochpound_store(tmp_path / "same.nc") as same, stochpound_store(tmp_path / "other.nc") as other:
+        check = crude_check(rare, same)
+        assert crude_check(rare, other) is None
+        closure = same.pound.contact_free()["peak_contact_closure"].isel(record=0, contact=1).values
+        assert list(check["gap"].values) == [0.03, 0.035]
+        assert check["crude"].values[0] == np.mean(closure >= 0.03) and check["realizations"].values[0] == 40
+        assert np.all(np.isfinite(check["subset"].values)) and check["subset"].values[0] >= check["subset"].values[1] > 0.0
+    report = assemble_report([tmp_path / "same.nc", tmp_path / "a.nc"])
+    section = next(s for s in report.sections if s.key == "rare-pair_rare")
+    assert any(getattr(block, "key", "") == "rare-pair_rare-crude" for block in section.blocks)
+
+
+def stochpound_store(path):
+    import stochpound
+
+    return stochpound.open_store(path)
+
+
+def test_experiment_check_names_a_rare_event_file(tmp_path):
+    from click.testing import CliRunner
+
+    from stochpound.cli import main
+
+    result = CliRunner().invoke(main, ["experiment", "check", str(_file(tmp_path))])
+    assert result.exit_code == 0 and "valid rare-event experiment" in result.output
+    bad = CliRunner().invoke(main, ["experiment", "run", str(_file(tmp_path, **{"p0 = 0.1": "p0 = 0.9"}))])
+    assert bad.exit_code == 1 and "rare_event.p0: must be <= 0.5, got 0.9" in bad.output

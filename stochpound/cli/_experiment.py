@@ -167,8 +167,15 @@ def _has_hazard(store: Path) -> bool:
 @click.argument("experiment_file", type=click.Path(dir_okay=False))
 def check_command(experiment_file: str) -> None:
     """Validate EXPERIMENT_FILE and list its dimensions (runs nothing)."""
-    from stochpound.experiment import load_experiment, periods_of_interest, resolve_motions
+    from stochpound.experiment import is_rare_event_file, load_experiment, load_rare_event, periods_of_interest, resolve_motions
 
+    if is_rare_event_file(experiment_file):
+        with _errors_of(experiment_file, False):
+            rare = load_rare_event(experiment_file)
+        click.echo(f"{experiment_file}: valid rare-event experiment; definition sha256 {rare.sha256}")
+        click.echo(f"  {rare.table.method} simulation of {rare.table.response} under {rare.motion.get('type')}, target {rare.table.target_probability:g}, "
+                   f"N = {rare.table.samples_per_level}, p0 = {rare.table.p0:g}, seed {rare.table.seed}")
+        return
     try:
         loaded = load_experiment(experiment_file)
         resolve_motions(loaded)

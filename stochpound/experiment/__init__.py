@@ -28,7 +28,7 @@ from stochpound.store import Case, Dim
 from stochpound.experiment._runner import RunReport, default_store, load_experiment, run_experiment
 from stochpound.experiment._status import StatusReport, store_status
 from stochpound.experiment._rare_event_run import RareEventReport, rare_event_sampler, run_rare_event
-from stochpound.experiment._rare_event_store import RareEventResults, is_rare_event_store, open_rare_event_store, rare_event_results
+from stochpound.experiment._rare_event_store import RareEventResults, crude_check, is_rare_event_store, open_rare_event_store, rare_event_results
 from stochpound.experiment._rare_event_table import RareEventDefinition, RareEventTable, is_rare_event_file, load_rare_event, parse_rare_event
 
 # For the other packages of stochpound (their interface to this one, not public API: not in __all__).
@@ -47,6 +47,7 @@ __all__ = [
     "RareEventReport",
     "RareEventResults",
     "RareEventTable",
+    "crude_check",
     "is_rare_event_file",
     "is_rare_event_store",
     "load_rare_event",

@@ -35,7 +35,7 @@ from stochpound.report.sections import (
     separation_section,
     store_section,
 )
-from stochpound.experiment import is_rare_event_store, measure_choice, open_rare_event_store, rare_event_results
+from stochpound.experiment import crude_check, is_rare_event_store, measure_choice, open_rare_event_store, rare_event_results
 from stochpound.risk import has_risk, store_damage, store_demands, store_risk
 from stochpound.store import check_finished, has_contact_free, has_wall_free, with_contacts, with_walls
 from stochpound._studies import claims, load_study
@@ -119,7 +119,8 @@ def assemble_report(paths: Sequence[str | Path], progress: Callable[[str], None]
             report.sections.append(intensity_section(name, store, near))
     for data in rare.values():
         say(f"rare events {data.attrs['experiment_name']}")
-        report.sections.append(rare_event_section(data.attrs["experiment_name"], rare_event_results(data)))
+        checks = (crude_check(data, store) for store in stores.values())  # a stochastic experiment of the same runs, if one is given
+        report.sections.append(rare_event_section(data.attrs["experiment_name"], rare_event_results(data), next((c for c in checks if c is not None), None)))
     if stores:
         say("methods")
         report.sections.append(methods_section(stores))

@@ -10,25 +10,35 @@ from __future__ import annotations
 from typing import Any
 
 import pandas as pd
+import xarray as xr
 from matplotlib.figure import Figure
 
 from stochpound.experiment import RareEventResults
 from stochpound.report.render import FigureItem, Paragraph, Section, Table
 
 
-def rare_event_section(name: str, results: RareEventResults) -> Section:
-    """The section of the rare-event experiment ``name``: conditions and n, the exceedance curve with its 95 % interval, the separations."""
+def rare_event_section(name: str, results: RareEventResults, crude: xr.Dataset | None = None) -> Section:
+    """The section of the rare-event experiment ``name``: conditions and n, the exceedance curve with its 95 % interval, the separations;
+    with ``crude`` (:func:`~stochpound.experiment.crude_check`), the curve against a stochastic experiment's crude Monte Carlo at its gaps."""
     table = results.table
     closure = table["response"] == "closure"
     units = results.curve["threshold"].attrs.get("units", "")
     section = Section(f"Rare events: {name}", key=f"rare-{name}")
     section.add(Paragraph(_conditions(results)))
-    section.add(FigureItem(f"rare-{name}-curve", _caption(results, closure, units), _curve_figure(results, closure, units)))
+    section.add(FigureItem(f"rare-{name}-curve", _caption(results, closure, units, crude), _curve_figure(results, closure, units, crude)))
     section.add(Table(f"rare-{name}-separation", _table_caption(closure, units), _frame(results, closure, units),
                       note="Per event: per motion of the ensemble. The interval is the response at which the estimated curve crosses "
                            "p·exp(±1.96 δ), δ the estimate's coefficient of variation at p (Au & Beck's, from the chains' correlation); "
                            "a probability below the run's reach has no value.",
                       formats={"probability per event": "{:.0e}", "coefficient of variation": "{:.2f}", "runs (n)": "{:.0f}"}))
+    if crude is not None:
+        section.add(Table(f"rare-{name}-crude", f"The probability of pounding per event at the gaps of experiment {crude.attrs['experiment']}: "
+                          f"its contact-free runs of ensemble {crude.attrs['record']} (crude Monte Carlo) against subset simulation",
+                          _crude_frame(crude, results.runs),
+                          note="Crude Monte Carlo: the fraction of the contact-free runs whose closure reaches the gap, with its 95 % "
+                               "Clopper–Pearson interval; subset simulation: the curve above at the gap and its coefficient of variation. "
+                               "The two use independent random numbers.",
+                          formats={"runs (crude)": "{:.0f}", "runs (subset)": "{:.0f}", "subset CoV": "{:.2f}"}))
     return section
 
 
@@ -50,19 +60,24 @@ def _text(value: Any) -> str:
     return f"{value:g}" if isinstance(value, float) else str(value)
 
 
-def _caption(results: RareEventResults, closure: bool, units: str) -> str:
+def _caption(results: RareEventResults, closure: bool, units: str, crude: xr.Dataset | None) -> str:
     what = "probability of pounding per event against the gap" if closure else "probability per event of exceeding each value"
+    against = ("" if crude is None else f"; the points, crude Monte Carlo of experiment {crude.attrs['experiment']}'s contact-free runs at its gaps "
+               "with their 95 % Clopper–Pearson intervals")
     return (f"The {what} ({units or 'ratio'}) by subset simulation, down to {results.table['target_probability']:g}, with its 95 % interval "
-            f"(shaded); n = {results.runs} runs.")
+            f"(shaded); n = {results.runs} runs{against}.")
 
 
-def _curve_figure(results: RareEventResults, closure: bool, units: str) -> Figure:
+def _curve_figure(results: RareEventResults, closure: bool, units: str, crude: xr.Dataset | None) -> Figure:
     curve = results.curve
     figure = Figure(figsize=(6.0, 3.6), layout="constrained")
     ax = figure.add_subplot()
     ax.set_yscale("log")
     ax.fill_between(curve["threshold"].values, curve["lower"].values, curve["upper"].values, color="C0", alpha=0.25, linewidth=0, label="95 % interval")
     ax.plot(curve["threshold"].values, curve["probability"].values, color="C0", label="subset simulation")
+    if crude is not None:
+        ax.errorbar(crude["gap"].values, crude["crude"].values, yerr=[crude["crude"].values - crude["crude_lower"].values,
+                    crude["crude_upper"].values - crude["crude"].values], fmt="o", color="C1", label=f"crude Monte Carlo ({crude.attrs['experiment']})")
     ax.set_xlabel(f"{'gap' if closure else 'threshold'} ({units or 'ratio'})")
     ax.set_ylabel("probability per event")
     ax.grid(True, which="both", alpha=0.3)
@@ -73,6 +88,19 @@ def _curve_figure(results: RareEventResults, closure: bool, units: str) -> Figur
 def _table_caption(closure: bool, units: str) -> str:
     what = "The separation (the gap) for each probability of pounding per event" if closure else "The response exceeded with each probability per event"
     return f"{what} ({units or 'ratio'}), with its 95 % interval and the estimate's coefficient of variation"
+
+
+def _crude_frame(crude: xr.Dataset, runs: int) -> pd.DataFrame:
+    return pd.DataFrame({
+        "gap (m)": crude["gap"].values,
+        "crude Monte Carlo": crude["crude"].values,
+        "95 % interval, low": crude["crude_lower"].values,
+        "95 % interval, high": crude["crude_upper"].values,
+        "runs (crude)": crude["realizations"].values,
+        "subset simulation": crude["subset"].values,
+        "subset CoV": crude["subset_cov"].values,
+        "runs (subset)": [runs] * crude.sizes["gap"],
+    }).set_index("gap (m)")
 
 
 def _frame(results: RareEventResults, closure: bool, units: str) -> pd.DataFrame:
