@@ -219,3 +219,10 @@ def test_experiment_check_names_a_rare_event_file(tmp_path):
     assert result.exit_code == 0 and "valid rare-event experiment" in result.output
     bad = CliRunner().invoke(main, ["experiment", "run", str(_file(tmp_path, **{"p0 = 0.1": "p0 = 0.9"}))])
     assert bad.exit_code == 1 and "rare_event.p0: must be <= 0.5, got 0.9" in bad.output
+
+
+def test_a_run_stopped_by_max_levels_says_the_target_was_not_reached(tmp_path):
+    run = run_rare_event(load_rare_event(_file(tmp_path, **{"seed = 3": "seed = 3\nmax_levels = 2"})), tmp_path / "a.nc")
+    results = rare_event_results(open_rare_event_store(tmp_path / "a.nc"))
+    assert run.complete and run.levels == 2 and results.complete and not results.target_reached
+    assert np.all(np.isnan(results.separations["value"]))  # 1e-3 is below the reach of two levels of 20 samples

@@ -125,6 +125,7 @@ def write_store(store: Path, definition: RareEventDefinition, levels: list[Finis
     curve = xr.Dataset()
     if levels:
         attrs["reached_probability"] = level_probability(subset) * table.p0 if complete else level_probability(subset)
+        attrs["target_reached"] = int(complete and attrs["reached_probability"] <= table.target_probability * (1.0 + 1e-9))
         thresholds = curve_thresholds(subset, table.target_probability if complete else None) if len(levels) > 1 or complete else np.array([])
         curve = curve_dataset(thresholds, *exceedance(subset, thresholds), units, {})
         attrs |= {key: value for key, value in level_attributes(subset, round(table.p0 * table.samples_per_level)).items() if key != "level_thresholds"}
@@ -189,7 +190,9 @@ class RareEventResults:
     levels : int
         Levels run (level 0 included).
     complete : bool
-        The levels reached the target.
+        The run ended (its last level is written).
+    target_reached : bool
+        It ended at the target probability (not at ``max_levels``).
     """
 
     curve: xr.Dataset
@@ -198,6 +201,7 @@ class RareEventResults:
     runs: int
     levels: int
     complete: bool
+    target_reached: bool
 
     @property
     def table(self) -> dict[str, Any]:
@@ -213,7 +217,8 @@ def rare_event_results(data: xr.Dataset) -> RareEventResults:
     spread = np.exp(INTERVAL_Z * curve["cov"].fillna(np.inf))
     curve = curve.assign(lower=curve["probability"] / spread, upper=np.minimum(curve["probability"] * spread, 1.0))
     return RareEventResults(curve, {"probability": np.array(SEPARATION_PROBABILITIES), **quantiles}, json.loads(data.attrs["definition"]),
-                            int(data.attrs["runs"]), len(levels), bool(data.attrs["complete"]))
+                            int(data.attrs["runs"]), len(levels), bool(data.attrs["complete"]),
+                            bool(data.attrs.get("target_reached", 0)))
 
 
 _NOT_THE_MOTION = ("count", "seed", "start", "realization", "interpolation")

@@ -49,7 +49,8 @@ def _conditions(results: RareEventResults) -> str:
             "limit_state": f"the ratio of the {table.get('limit_state')} demand to its capacity {table.get('capacity')}"}.get(
         table["response"], f"the run's {table['response'].replace('_', ' ')}" + "".join(f", {key} {table[key]}" for key in ("building", "floor", "contact") if key in table))
     parameters = ", ".join(f"{key} = {_text(value)}" for key, value in motion.items() if key != "type")
-    state = "reached" if results.complete else "not reached (the run is incomplete: rerun it)"
+    state = "reached" if results.target_reached else ("not reached: the run is incomplete (rerun it)" if not results.complete
+                                                       else f"not reached: it stopped after max_levels = {table['max_levels']}")
     return (f"One subset simulation (Au & Beck 2001; component-wise modified Metropolis) of {what}, under a {motion.get('type', '')} "
             f"ground motion ({parameters}), its randomness a vector of standard normals. N = {table['samples_per_level']} samples a level, "
             f"p0 = {table['p0']}, seed {table['seed']}: {results.levels} levels and n = {results.runs} runs in all, down to the target "
