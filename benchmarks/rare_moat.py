@@ -96,7 +96,7 @@ def section(measured: dict, info: dict[str, str], samples: int, target: float, w
         "The reference study's Building 1 alone on a friction pendulum (R = 2.24 m, T_b = 3.0 s, μ = 0.05) under a Kanai–Tajimi motion "
         "(ω_g = 15 rad/s, ζ_g = 0.6, expected PGA 3 m/s², Jennings envelope, 15 s at dt = 0.02 s, `method = \"filter\"`): P(peak sliding "
         "displacement > c), which is P(moat impact) at a clearance c by the gap identity. One rare-event experiment "
-        f"(`[rare_event]`, N = {samples} a level, p0 = 0.1, target {target:g}) run by `stochpound experiment run` on {workers} local "
+        f"(`[rare_event]`, N = {samples} a level, p0 = 0.1, target {target:g}) run by `run_rare_event` (what `stochpound experiment run` runs) on {workers} local "
         f"workers: {results.levels} levels, {results.runs} runs, {measured['subset_time']:.0f} s wall time (summed over the invocations "
         f"that resumed it); crude Monte Carlo of {crude.size} runs of the same response ({measured['crude_time']:.0f} s in one process). Machine: {info['cores']} cores, "
         f"load {info['load average (1 min) at start']} at the start (commit {info['commit']}, {info['date']}). "
@@ -105,7 +105,8 @@ def section(measured: dict, info: dict[str, str], samples: int, target: float, w
         f"At the target: P = {probability[last]:.3g} at c = {curve['threshold'].values[last]:.3f} m, CoV {cov[last]:.0%}; the clearance for "
         f"{target:g} per event {at_target:.3f} m. A CoV of {TARGET_COV:.0%} there would take about {needed:,.0f} runs "
         f"(N ≈ {samples * (cov[last] / TARGET_COV) ** 2:,.0f} a level; δ² ∝ 1/N at a fixed number of levels)"
-        + (" — reduced run: the issue's full run (CoV ≤ 15 % in ≤ 3×10⁴ runs) was not made." if cov[last] > TARGET_COV else "."),
+        + (f" — reduced run: the issue's full run (CoV ≤ 15 % in ≤ 3×10⁴ runs) was not made; with p0 = 0.1 it would take "
+           f"{'more' if needed > 3e4 else 'fewer'} than 3×10⁴ runs." if cov[last] > TARGET_COV else "."),
         "",
         "| c (m) | subset simulation (reported CoV) | crude MC (its CoV) | difference / combined standard deviation |",
         "|---:|---:|---:|---:|",
