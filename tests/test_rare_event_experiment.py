@@ -136,8 +136,13 @@ def test_one_or_two_workers_give_the_same_store(tmp_path):
 
 def test_a_store_of_another_definition_is_refused(tmp_path):
     run_rare_event(load_rare_event(_file(tmp_path)), tmp_path / "a.nc", stop_after=1)
+    other = load_rare_event(_file(tmp_path, **{"seed = 3": "seed = 4"}))
     with pytest.raises(ExperimentError, match="made by another definition"):
-        run_rare_event(load_rare_event(_file(tmp_path, **{"seed = 3": "seed = 4"})), tmp_path / "a.nc")
+        run_rare_event(other, tmp_path / "a.nc")
+    run_rare_event(other, tmp_path / "b.nc")
+    restarted = run_rare_event(other, tmp_path / "a.nc", restart=True)
+    assert restarted.complete and restarted.batches_before == 0
+    assert (tmp_path / "a.nc").read_bytes() == (tmp_path / "b.nc").read_bytes()
 
 
 def test_the_report_draws_the_curve_and_states_the_separations(tmp_path):

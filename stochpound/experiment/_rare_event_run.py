@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import functools
 import json
-import shutil
 import time
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -26,7 +25,7 @@ import numpy as np
 
 from stochpound.analysis import SubsetLevel, SubsetSampler, scene_response
 from stochpound.experiment._parts import FolderLock, parts_folder
-from stochpound.experiment._runner import _interrupts
+from stochpound.experiment._runner import _describe_executor, _interrupts
 from stochpound.experiment._rare_event_store import (
     DEFINITION_FILE, FinishedLevel, batch_path, finished_levels, load_arrays, save_arrays, save_level, stored_definition, write_store,
 )
@@ -139,16 +138,16 @@ def run_rare_event(definition: RareEventDefinition, store: str | Path | None = N
     started, say = time.monotonic(), say or (lambda message: None)
     store = Path(store) if store is not None else Path(definition.path or definition.name).with_suffix(".nc")
     text = canonical_json(definition.to_dict())
-    if restart:
-        shutil.rmtree(parts_folder(store), ignore_errors=True)
-        store.unlink(missing_ok=True)
     folder = parts_folder(store)
     folder.mkdir(parents=True, exist_ok=True)
     lock = FolderLock(folder)
     if not lock.acquire():
         raise ExperimentError(f"{store}: another run is writing this store (its parts folder is locked)")
-    report = RareEventReport(store, executor="this process (no dask)" if not workers and scheduler is None else f"dask, {workers or 'scheduler'}")
+    report = RareEventReport(store, executor=_describe_executor(workers or 0 if scheduler is None else None, scheduler))
     with lock, _interrupts():
+        if restart:
+            for path in [*folder.glob("*.npz"), folder / DEFINITION_FILE, store]:
+                path.unlink(missing_ok=True)
         known = stored_definition(store)
         if known is not None and canonical_json(known) != text:
             raise ExperimentError(f"{store}: made by another definition (its [rare_event], scene or motion differ); give --restart to discard it")
@@ -157,14 +156,14 @@ def run_rare_event(definition: RareEventDefinition, store: str | Path | None = N
         levels = finished_levels(store)
         report.batches_before = len(list(folder.glob("batch-*.npz")))
         try:
-            with _executor(workers, scheduler, say) as execute:
+            with _Executor(workers, scheduler, say) as execute:
                 while not levels or levels[-1].next_threshold is not None:
                     if stop_after is not None and report.batches_now >= stop_after:
                         raise KeyboardInterrupt
                     levels.append(_level(store, sampler, definition, levels, execute, report, stop_after))
                     last = levels[-1]
                     say(f"level {len(levels) - 1}: {last.runs} runs, "
-                        + (f"next threshold {last.next_threshold:.6g} {units}" if last.next_threshold is not None else "target reached"))
+                        + (f"next threshold {last.next_threshold:.6g} {units}" if last.next_threshold is not None else "the last level"))
         except KeyboardInterrupt:
             report.interrupted = True
         finally:
@@ -225,7 +224,7 @@ def _level(store: Path, sampler: SubsetSampler, definition: RareEventDefinition,
     return finished
 
 
-class _executor:
+class _Executor:
     """A context giving ``execute(tasks)``: an iterator of (number, result) as batches finish, in this process or on dask."""
 
     def __init__(self, workers: int | None, scheduler: str | None, say: Callable[[str], None]) -> None:
