@@ -29,7 +29,7 @@ from stochpound.experiment._runner import _describe_executor, _interrupts
 from stochpound.experiment._rare_event_store import (
     DEFINITION_FILE, FinishedLevel, batch_path, finished_levels, load_arrays, save_arrays, save_level, stored_definition, write_store,
 )
-from stochpound.experiment._rare_event_table import LIMIT_STATES, RareEventDefinition
+from stochpound.experiment._rare_event_table import RareEventDefinition
 from stochpound.experiment._spec import ExperimentError
 from stochpound.model.scene_file import scene_from_dict
 from stochpound.store import canonical_json, with_motion
@@ -69,19 +69,16 @@ class RareEventReport:
 @functools.lru_cache(maxsize=4)
 def _sampler(definition: str) -> tuple[SubsetSampler, str]:
     """The sampler of a canonical definition's JSON (cached: a worker builds it once), and the response's units."""
-    data = json.loads(definition)
-    table = data["rare_event"]
-    scene = json.loads(json.dumps(data["scene"]))
-    if table["response"] == "closure":  # the contact-free pair: its closure does not depend on the gap
-        for contact in scene.get("contact", []):
-            contact["gap"] = float("inf")
-    sampled = LIMIT_STATES.get(table.get("limit_state"), table["response"])
-    function, n, units = scene_response(scene_from_dict(with_motion(scene)), data["motion"], sampled, table.get("building"), table.get("floor"),
-                                        table.get("contact", 0))
-    if "capacity" in table:
-        capacity, demand = float(table["capacity"]), function
+    typed = RareEventDefinition.from_dict(json.loads(definition))
+    table, scene = typed.table, typed.scene
+    if table.response == "closure":  # the contact-free pair: its closure does not depend on the gap
+        scene = {**scene, "contact": [{**contact, "gap": float("inf")} for contact in scene.get("contact", [])]}
+    function, n, units = scene_response(scene_from_dict(with_motion(scene)), typed.motion, table.sampled, table.building, table.floor,
+                                        table.contact or 0)
+    if table.capacity is not None:
+        capacity, demand = table.capacity, function
         function, units = (lambda u: demand(u) / capacity), "1"
-    return SubsetSampler(function, n, table["samples_per_level"], table["p0"], table["seed"]), units
+    return SubsetSampler(function, n, table.samples_per_level, table.p0, table.seed), units
 
 
 def rare_event_sampler(definition: RareEventDefinition) -> SubsetSampler:

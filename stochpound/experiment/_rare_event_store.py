@@ -32,7 +32,7 @@ from stochpound._atomic import replacing
 from stochpound.analysis import METHOD, SubsetLevel, curve_dataset, curve_thresholds, exceedance, exceedance_quantiles, level_attributes, level_probability
 from stochpound.analysis import pounding_curve
 from stochpound.experiment._parts import parts_folder
-from stochpound.experiment._rare_event_table import TABLE, RareEventDefinition
+from stochpound.experiment._rare_event_table import RareEventDefinition
 from stochpound.store import contact_free, contact_gap_dims, has_contact_free
 
 DEFINITION_FILE = "definition.json"
@@ -183,7 +183,7 @@ class RareEventResults:
     separations : dict of np.ndarray
         For 1e-3, 1e-4 and 1e-6 per event (``probability``): ``value``, ``low``, ``high`` (the
         response exceeded with that probability and its 95 % interval) and ``cov``.
-    definition : dict
+    definition : RareEventDefinition
         The experiment's definition.
     runs : int
         Solver runs used.
@@ -197,16 +197,16 @@ class RareEventResults:
 
     curve: xr.Dataset
     separations: dict[str, np.ndarray]
-    definition: dict[str, Any]
+    definition: RareEventDefinition
     runs: int
     levels: int
     complete: bool
     target_reached: bool
 
-    @property
-    def table(self) -> dict[str, Any]:
-        """The ``[rare_event]`` table."""
-        return self.definition[TABLE]
+
+def stored_rare_event(data: xr.Dataset) -> RareEventDefinition:
+    """The definition a rare-event store was run with."""
+    return RareEventDefinition.from_dict(json.loads(data.attrs["definition"]), data.attrs.get("experiment_file", ""))
 
 
 def rare_event_results(data: xr.Dataset) -> RareEventResults:
@@ -216,7 +216,7 @@ def rare_event_results(data: xr.Dataset) -> RareEventResults:
     curve = data[["probability", "cov"]].load() if "probability" in data else xr.Dataset({"probability": ("threshold", []), "cov": ("threshold", [])})
     spread = np.exp(INTERVAL_Z * curve["cov"].fillna(np.inf))
     curve = curve.assign(lower=curve["probability"] / spread, upper=np.minimum(curve["probability"] * spread, 1.0))
-    return RareEventResults(curve, {"probability": np.array(SEPARATION_PROBABILITIES), **quantiles}, json.loads(data.attrs["definition"]),
+    return RareEventResults(curve, {"probability": np.array(SEPARATION_PROBABILITIES), **quantiles}, stored_rare_event(data),
                             int(data.attrs["runs"]), len(levels), bool(data.attrs["complete"]),
                             bool(data.attrs.get("target_reached", 0)))
 
@@ -241,20 +241,19 @@ def crude_check(rare: xr.Dataset, store: xr.Dataset) -> xr.Dataset | None:
         ``realizations``; ``subset`` and ``subset_cov`` (the rare-event curve there); attrs ``experiment`` and
         ``record`` (the ensemble's label). None when they do not describe the same runs.
     """
-    definition = json.loads(rare.attrs["definition"])
-    table = definition[TABLE]
+    definition = stored_rare_event(rare)
     axes = contact_gap_dims(store)
-    if table["response"] != "closure" or len(axes) != 1 or not has_contact_free(store):
+    if definition.table.response != "closure" or len(axes) != 1 or not has_contact_free(store):
         return None
     stochastic = store.pound.definition
-    if _without_gaps(stochastic.scene) != _without_gaps(definition["scene"]):
+    if _without_gaps(stochastic.scene) != _without_gaps(definition.scene):
         return None
-    motion = _motion_fields(definition["motion"])
+    motion = _motion_fields(definition.motion)
     labels = [m.label for m in stochastic.motions if m.kind == "synthetic" and _motion_fields(m.motion) == motion]
     closure = contact_free(store)["peak_contact_closure"]
     if not labels or set(closure.dims) - {"record", "realization", "contact"}:
         return None
-    runs = closure.sel(record=labels[0]).isel(contact=table.get("contact", 0))
+    runs = closure.sel(record=labels[0]).isel(contact=definition.table.contact)
     gaps = store[axes[0]].values[np.isfinite(store[axes[0]].values)]
     crude = pounding_curve(runs, gaps, contact_dim=None)
     probability, cov = exceedance(store_levels(rare), gaps)

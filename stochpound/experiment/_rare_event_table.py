@@ -127,6 +127,11 @@ class RareEventDefinition:
     table: RareEventTable
     path: str = ""
 
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any], path: str = "") -> RareEventDefinition:
+        """The definition a store holds (:meth:`to_dict`'s), typed again."""
+        return cls(data["name"], data["description"], dict(data["scene"]), dict(data["motion"]), RareEventTable(**data[TABLE]), path)
+
     def to_dict(self) -> dict[str, Any]:
         """The canonical definition (written in the store; its sha256 is the experiment's identity)."""
         return {"format": FORMAT_VERSION, "kind": TABLE, "name": self.name, "description": self.description, "scene": self.scene,

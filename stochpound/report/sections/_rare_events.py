@@ -20,8 +20,7 @@ from stochpound.report.render import FigureItem, Paragraph, Section, Table
 def rare_event_section(name: str, results: RareEventResults, crude: xr.Dataset | None = None) -> Section:
     """The section of the rare-event experiment ``name``: conditions and n, the exceedance curve with its 95 % interval, the separations;
     with ``crude`` (:func:`~stochpound.experiment.crude_check`), the curve against a stochastic experiment's crude Monte Carlo at its gaps."""
-    table = results.table
-    closure = table["response"] == "closure"
+    closure = results.definition.table.response == "closure"
     units = results.curve["threshold"].attrs.get("units", "")
     section = Section(f"Rare events: {name}", key=f"rare-{name}")
     section.add(Paragraph(_conditions(results)))
@@ -43,18 +42,21 @@ def rare_event_section(name: str, results: RareEventResults, crude: xr.Dataset |
 
 
 def _conditions(results: RareEventResults) -> str:
-    table, motion = results.table, results.definition["motion"]
-    what = {"closure": f"the closure of contact {table.get('contact', 0)} of the contact-free scene (every gap infinite): by the gap identity, "
-                       "P(closure > g) is the probability of pounding at a gap g",
-            "limit_state": f"the ratio of the {table.get('limit_state')} demand to its capacity {table.get('capacity')}"}.get(
-        table["response"], f"the run's {table['response'].replace('_', ' ')}" + "".join(f", {key} {table[key]}" for key in ("building", "floor", "contact") if key in table))
+    table, motion = results.definition.table, results.definition.motion
+    where = "".join(f", {key} {value}" for key, value in (("building", table.building), ("floor", table.floor), ("contact", table.contact)) if value is not None)
+    what = f"the run's {table.response.replace('_', ' ')}{where}"
+    if table.response == "closure":
+        what = (f"the closure of contact {table.contact} of the contact-free scene (every gap infinite): by the gap identity, "
+                "P(closure > g) is the probability of pounding at a gap g")
+    elif table.response == "limit_state":
+        what = f"the ratio of the {table.limit_state} demand{where} to its capacity {table.capacity:g}"
     parameters = ", ".join(f"{key} = {_text(value)}" for key, value in motion.items() if key != "type")
     state = "reached" if results.target_reached else ("not reached: the run is incomplete (rerun it)" if not results.complete
-                                                       else f"not reached: it stopped after max_levels = {table['max_levels']}")
-    return (f"One subset simulation (Au & Beck 2001; component-wise modified Metropolis) of {what}, under a {motion.get('type', '')} "
-            f"ground motion ({parameters}), its randomness a vector of standard normals. N = {table['samples_per_level']} samples a level, "
-            f"p0 = {table['p0']}, seed {table['seed']}: {results.levels} levels and n = {results.runs} runs in all, down to the target "
-            f"probability {table['target_probability']:g} per event ({state}).")
+                                                       else f"not reached: it stopped after max_levels = {table.max_levels}")
+    return (f"One subset simulation (Au & Beck 2001; component-wise modified Metropolis) of {what}, under a {motion.get('type', 'kanai_tajimi')} "
+            f"ground motion ({parameters}), its randomness a vector of standard normals. N = {table.samples_per_level} samples a level, "
+            f"p0 = {table.p0}, seed {table.seed}: {results.levels} levels and n = {results.runs} runs in all, down to the target "
+            f"probability {table.target_probability:g} per event ({state}).")
 
 
 def _text(value: Any) -> str:
@@ -65,7 +67,7 @@ def _caption(results: RareEventResults, closure: bool, units: str, crude: xr.Dat
     what = "probability of pounding per event against the gap" if closure else "probability per event of exceeding each value"
     against = ("" if crude is None else f"; the points, crude Monte Carlo of experiment {crude.attrs['experiment']}'s contact-free runs at its gaps "
                "with their 95 % Clopper–Pearson intervals")
-    return (f"The {what} ({units or 'ratio'}) by subset simulation, down to {results.table['target_probability']:g}, with its 95 % interval "
+    return (f"The {what} ({units or 'ratio'}) by subset simulation, down to {results.definition.table.target_probability:g}, with its 95 % interval "
             f"(shaded); n = {results.runs} runs{against}.")
 
 
