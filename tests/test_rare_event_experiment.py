@@ -231,3 +231,16 @@ def test_a_run_stopped_by_max_levels_says_the_target_was_not_reached(tmp_path):
     results = rare_event_results(open_rare_event_store(tmp_path / "a.nc"))
     assert run.complete and run.levels == 2 and results.complete and not results.target_reached
     assert np.all(np.isnan(results.separations["value"]))  # 1e-3 is below the reach of two levels of 20 samples
+
+
+def test_a_limit_state_is_its_demand_over_its_capacity(tmp_path):
+    """``response = "limit_state"``: the sampler's response is the demand's (here the impact force at contact 1, gaps kept) over the capacity."""
+    from stochpound.experiment import rare_event_sampler
+
+    force = load_rare_event(_file(tmp_path, **{'response = "closure"': 'response = "impact_force"', "S0 = 0.01": "S0 = 1.0"}))
+    limit = load_rare_event(_file(tmp_path, **{'response = "closure"': 'response = "limit_state"\nlimit_state = "impact_force"\ncapacity = 2.0e5',
+                                               "S0 = 0.01": "S0 = 1.0"}))
+    assert limit.table.sampled == "impact_force" and limit.table.capacity == 2.0e5
+    demand = rare_event_sampler(force).start(range(3))[1]
+    ratio = rare_event_sampler(limit).start(range(3))[1]
+    assert np.any(demand > 0.0) and np.array_equal(ratio, demand / 2.0e5)

@@ -129,7 +129,7 @@ class RareEventDefinition:
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any], path: str = "") -> RareEventDefinition:
-        """The definition a store holds (:meth:`to_dict`'s), typed again."""
+        """The definition a store holds (``to_dict``'s), typed again."""
         return cls(data["name"], data["description"], dict(data["scene"]), dict(data["motion"]), RareEventTable(**data[TABLE]), path)
 
     def to_dict(self) -> dict[str, Any]:
