@@ -31,7 +31,7 @@ import tempfile  # noqa: E402
 import time  # noqa: E402
 from pathlib import Path  # noqa: E402
 
-from benchmarks import compare, experiment_scale, measure_free, rare_events, report, site_motions, spectrum, startup, suite, yielding  # noqa: E402
+from benchmarks import compare, experiment_scale, measure_free, rare_events, rare_moat, report, site_motions, spectrum, startup, suite, yielding  # noqa: E402
 from benchmarks import measure_comparison  # noqa: E402
 from benchmarks.sections import keep_sections  # noqa: E402
 from benchmarks.timing import REPOSITORY  # noqa: E402
@@ -86,7 +86,8 @@ def main(argv: list[str] | None = None) -> int:
     figure = report.figure(results, folder / "figures" / report.FIGURE_NAME)
     markdown = folder / "benchmarks.md"
     old = markdown.read_text() if markdown.exists() else ""
-    sections = (experiment_scale.SECTION, compare.SECTION, spectrum.SECTION, yielding.SECTION, site_motions.SECTION, startup.SECTION, measure_free.SECTION)
+    sections = (experiment_scale.SECTION, compare.SECTION, spectrum.SECTION, yielding.SECTION, site_motions.SECTION, startup.SECTION, measure_free.SECTION,
+                rare_moat.SECTION)
     sections += (measure_comparison.SECTION,)
     markdown.write_text(keep_sections(old, report.document(results, info, elapsed), sections))
     print(f"wrote {markdown} and {figure} in {elapsed:.1f} s")

@@ -117,7 +117,7 @@ def test_a_half_space_has_its_exact_probability():
 def test_repeated_runs_scatter_as_their_reported_cov():
     """20 runs at 2.1 (P ≈ 3e-5): every estimate within 3 reported CoV of the reference, the mean reported CoV within 35 % of the empirical one."""
     reference, reference_cov = _isee(2.1, 2000, seed=5)
-    runs = [subset_simulation(_peak, thresholds=[2.1], samples_per_level=500, p0=0.1, seed=seed, dimension=N_TIME) for seed in range(20)]
+    runs = [subset_simulation(_peak, thresholds=[2.1], samples_per_level=1000, p0=0.1, seed=seed, dimension=N_TIME) for seed in range(20)]
     estimates = np.array([r.probability.values[0] for r in runs])
     reported = np.array([r.cov.values[0] for r in runs])
     assert np.all(np.abs(estimates - reference) < 3.0 * np.hypot(reported, reference_cov) * reference)

@@ -56,12 +56,135 @@ METHOD = "subset simulation (Au & Beck 2001), component-wise modified Metropolis
 
 
 @dataclass(frozen=True)
-class _Level:
-    """One level: its conditioning threshold (−∞ for level 0) and its responses as (chains, states a chain)."""
+class SubsetLevel:
+    """One level of a subset run: its conditioning threshold (−∞ for level 0), its responses and its chains' acceptance rate.
+
+    Attributes
+    ----------
+    threshold : float
+        b_j, in the response's units (−∞ for level 0, whose samples are independent).
+    responses : np.ndarray
+        (chains, states a chain) responses: (N, 1) for level 0.
+    acceptance : float
+        Fraction of the chains' candidates accepted (1 for level 0).
+    """
 
     threshold: float
     responses: np.ndarray
     acceptance: float
+
+
+@dataclass(frozen=True)
+class ChainRun:
+    """What :meth:`SubsetSampler.advance` returns: every state of some chains of a level.
+
+    Attributes
+    ----------
+    states : np.ndarray
+        (chains, states a chain, n) normals.
+    responses : np.ndarray
+        (chains, states a chain) responses.
+    accepted : int
+        Candidates accepted.
+    """
+
+    states: np.ndarray
+    responses: np.ndarray
+    accepted: int
+
+
+@dataclass(frozen=True)
+class SubsetSampler:
+    """The steps of subset simulation, each chain on a generator of its own (seed, level, chain): any split of a level's
+    chains into batches, run anywhere and in any order, gives the same samples.
+
+    Parameters
+    ----------
+    function : callable
+        g(u): (m, n) standard normals to (m,) responses (each row's response depends on that row alone).
+    dimension : int
+        n.
+    samples_per_level : int
+        N.
+    p0 : float
+        The conditional probability of each intermediate level.
+    seed : int
+        The sampler's seed (>= 0).
+    """
+
+    function: Callable[[np.ndarray], np.ndarray]
+    dimension: int
+    samples_per_level: int
+    p0: float
+    seed: int
+
+    @property
+    def chains(self) -> int:
+        """p0·N, the chains of a level (a few more when the level's threshold ties)."""
+        return round(self.p0 * self.samples_per_level)
+
+    @property
+    def length(self) -> int:
+        """States a chain (1/p0), its seed included."""
+        return self.samples_per_level // self.chains
+
+    def start(self, samples: Sequence[int]) -> tuple[np.ndarray, np.ndarray]:
+        """Level 0's samples ``samples`` (indices in 0 .. N − 1), each drawn by its own generator: (m, n) normals and (m,) responses."""
+        u = np.array([_generator(self.seed, 0, sample).standard_normal(self.dimension) for sample in samples]).reshape(len(samples), self.dimension)
+        return u, _evaluate(self.function, u)
+
+    def advance(self, level: int, u: np.ndarray, y: np.ndarray, threshold: float, chains: Sequence[int]) -> ChainRun:
+        """The states of chains ``chains`` (indices in the level) of level ``level`` >= 1, started at ``u`` (all in {Y ≥ threshold}).
+
+        All chains advance together: g is called on every chain's candidate at once.
+        """
+        generators = [_generator(self.seed, level, chain) for chain in chains]
+        states, responses, accepted = [u], [y], 0
+        for _ in range(self.length - 1):
+            candidate = np.array([_modified_metropolis(row, rng) for row, rng in zip(u, generators)]).reshape(u.shape)
+            response = _evaluate(self.function, candidate)
+            move = response >= threshold
+            u = np.where(move[:, None], candidate, u)
+            y = np.where(move, response, y)
+            accepted += int(np.count_nonzero(move))
+            states.append(u)
+            responses.append(y)
+        return ChainRun(np.stack(states, axis=1), np.stack(responses, axis=1), accepted)
+
+    def seeds(self, responses: np.ndarray, level: int) -> tuple[float, np.ndarray]:
+        """The next level's threshold and its chains' seeds: indices into ``responses`` (chains, states) read chain by chain.
+
+        The threshold is the (p0·N)-th largest response; the seeds are the
+        responses at or above it (a chain's repeated state tied with it
+        included), the largest first.
+
+        Raises
+        ------
+        ValueError
+            Naming the response, when too many tie at the threshold (``level``: the level whose threshold it is).
+        """
+        y = responses.reshape(-1)
+        order = np.argsort(-y, kind="stable")
+        threshold = float(y[order[self.chains - 1]])
+        seeds = order[y[order] >= threshold]
+        if len(seeds) == len(y) or len(seeds) > 2 * self.chains:
+            raise ValueError(
+                f"response: ties at level {level}'s threshold ({threshold:g} is the response of {len(seeds) - self.chains + 1} of its {len(y)} samples); "
+                "subset simulation needs a response that keeps varying (e.g. the closure rather than the impact force)"
+            )
+        return threshold, seeds
+
+    def done(self, levels: Sequence[SubsetLevel], threshold: float | None, target_probability: float | None) -> bool:
+        """Whether the levels reach the largest threshold (p0·N samples of the last level above it) or the target
+        probability (the last level's probability times p0 at or below it)."""
+        if threshold is not None:
+            return np.count_nonzero(levels[-1].responses > threshold) >= self.chains
+        return level_probability(levels) * self.p0 <= target_probability * (1.0 + 1e-9)
+
+
+def level_probability(levels: Sequence[SubsetLevel]) -> float:
+    """P(Y ≥ b_i) of the last level: the product of the steps p_j = P(Y ≥ b_{j+1} | Y ≥ b_j) estimated so far."""
+    return math.prod(_steps(levels))
 
 
 def subset_simulation(
@@ -69,7 +192,8 @@ def subset_simulation(
     motion: Mapping[str, Any] | None = None,
     response: str = "closure",
     *,
-    thresholds: Sequence[float],
+    thresholds: Sequence[float] | None = None,
+    target_probability: float | None = None,
     building: str | None = None,
     floor: int | None = None,
     contact: int = 0,
@@ -98,9 +222,13 @@ def subset_simulation(
         ``building`` (m, ``peak_storey_drift``), largest absolute sliding
         displacement of ``building``'s base at the samples (m), or largest
         force of an impact at contact ``contact`` (N, 0 without impact).
-    thresholds : sequence of float
+    thresholds : sequence of float, optional
         Thresholds b, in the response's units; the levels go on until the
-        largest is reached.
+        largest is reached (without ``target_probability``). Without them, the
+        curve's thresholds span its levels, from level 0's median response to the target.
+    target_probability : float, optional
+        The probability in (0, 1) the levels go down to instead: they stop
+        when the last level's probability times p0 is at most this.
     building : str, optional
         The building of ``peak_storey_drift`` and ``base_displacement``.
     floor : int, optional
@@ -129,7 +257,7 @@ def subset_simulation(
         probability is 0); attrs: ``runs`` (solver runs, or evaluations of g),
         ``level_thresholds``, ``gamma`` and ``acceptance`` per level,
         ``target_reached`` (1 if the last level reached the largest
-        threshold), ``p0``, ``samples_per_level``, ``seed`` and ``method``.
+        threshold or the target probability), ``target_probability`` (if given), ``p0``, ``samples_per_level``, ``seed`` and ``method``.
 
     Raises
     ------
@@ -139,37 +267,53 @@ def subset_simulation(
         level's samples: sample a response that keeps varying, e.g. the
         closure rather than the impact force).
     """
-    chains, values, rng = _settings(thresholds, samples_per_level, p0, seed, max_levels)
+    values = _settings(thresholds, samples_per_level, p0, seed, max_levels, target_probability)
     function, n, units = _response_function(scene, motion, response, building, floor, contact, dimension)
-    levels, runs = _levels(function, n, values.max(), samples_per_level, chains, rng, max_levels)
-    gamma = [0.0] + [_gamma(level.responses >= nxt.threshold) for level, nxt in zip(levels[1:-1], levels[2:])]
-    probability, cov = _curve(levels, gamma, values)
+    sampler = SubsetSampler(function, n, int(samples_per_level), float(p0), int(seed))
+    levels, runs = _levels(sampler, float(values.max()) if target_probability is None else None, target_probability, max_levels)
+    if values is None:
+        values = curve_thresholds(levels, target_probability)
+    probability, cov = exceedance(levels, values)
     attrs = {
         "runs": runs,
-        "levels": len(levels),
-        "level_thresholds": np.array([level.threshold for level in levels[1:]], dtype=float),
-        "gamma": np.array(gamma[: len(levels) - 1], dtype=float),
-        "acceptance": np.array([level.acceptance for level in levels[1:]], dtype=float),
-        "target_reached": int(np.count_nonzero(levels[-1].responses > values.max()) >= chains),
+        **level_attributes(levels, sampler.chains),
+        "target_reached": int(sampler.done(levels, None if target_probability is not None else float(values.max()), target_probability)),
         "p0": float(p0),
         "samples_per_level": int(samples_per_level),
         "seed": int(seed),
         "method": METHOD,
         "response": response if not callable(scene) else "g(u)",
     }
-    coords = {"threshold": xr.Variable(("threshold",), values, {"units": units})}
+    if target_probability is not None:
+        attrs["target_probability"] = float(target_probability)
+    return curve_dataset(values, probability, cov, units, attrs)
+
+
+def curve_dataset(thresholds: np.ndarray, probability: np.ndarray, cov: np.ndarray, units: str, attrs: Mapping[str, Any]) -> xr.Dataset:
+    """An exceedance curve as :func:`subset_simulation` returns it: ``probability`` and ``cov`` over ``threshold`` (``units``)."""
+    coords = {"threshold": xr.Variable(("threshold",), np.asarray(thresholds, dtype=float), {"units": units})}
     return xr.Dataset(
         {
             "probability": xr.Variable(("threshold",), probability, {"units": "1", "long_name": "probability of the response exceeding the threshold"}),
             "cov": xr.Variable(("threshold",), cov, {"units": "1", "long_name": "estimated coefficient of variation of the probability"}),
         },
         coords=coords,
-        attrs=attrs,
+        attrs=dict(attrs),
     )
 
 
-def _settings(thresholds: Any, samples: Any, p0: Any, seed: Any, max_levels: Any) -> tuple[int, np.ndarray, np.random.Generator]:
-    """The number of chains, the thresholds and the sampler's generator, each argument checked."""
+def level_attributes(levels: Sequence[SubsetLevel], chains: int) -> dict[str, Any]:
+    """``levels``, ``level_thresholds``, ``gamma`` and ``acceptance`` per level after level 0 (``chains``: p0·N)."""
+    return {
+        "levels": len(levels),
+        "level_thresholds": np.array([level.threshold for level in levels[1:]], dtype=float),
+        "gamma": np.array(_step_gammas(levels)[: len(levels) - 1], dtype=float),
+        "acceptance": np.array([level.acceptance for level in levels[1:]], dtype=float),
+    }
+
+
+def _settings(thresholds: Any, samples: Any, p0: Any, seed: Any, max_levels: Any, target: Any) -> np.ndarray | None:
+    """The thresholds (None: the curve's own, down to the target probability), each argument checked."""
     if not isinstance(p0, (int, float)) or isinstance(p0, bool) or not 0.0 < p0 <= 0.5:
         raise ValueError(f"p0: must be a number in (0, 0.5], got {p0!r}")
     if isinstance(samples, bool) or not isinstance(samples, (int, np.integer)) or samples < 2:
@@ -181,55 +325,34 @@ def _settings(thresholds: Any, samples: Any, p0: Any, seed: Any, max_levels: Any
         raise ValueError(f"max_levels: must be an integer >= 1, got {max_levels!r}")
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
         raise ValueError(f"seed: must be an integer >= 0, got {seed!r}")
+    if target is not None and (isinstance(target, bool) or not isinstance(target, (int, float)) or not 0.0 < target < 1.0):
+        raise ValueError(f"target_probability: must be a number in (0, 1), got {target!r}")
+    if thresholds is None and target is not None:
+        return None
     values = np.atleast_1d(np.asarray(thresholds, dtype=float))
     if values.ndim != 1 or values.size == 0 or not np.all(np.isfinite(values)):
-        raise ValueError(f"thresholds: must be one or more finite numbers, got {thresholds!r}")
-    return chains, values, np.random.default_rng(seed)
+        raise ValueError(f"thresholds: must be one or more finite numbers (or give target_probability), got {thresholds!r}")
+    return values
 
 
-def _levels(
-    function: Callable[[np.ndarray], np.ndarray], n: int, target: float, samples: int, chains: int, rng: np.random.Generator, max_levels: int
-) -> tuple[list[_Level], int]:
-    """The levels down to ``target``, and the evaluations of ``function`` they took."""
-    u = rng.standard_normal((samples, n))
-    y = _evaluate(function, u)
-    levels, runs = [_Level(-math.inf, y[:, None], 1.0)], samples
-    length = samples // chains
-    while np.count_nonzero(y > target) < chains and len(levels) < max_levels:
-        order = np.argsort(-y, kind="stable")
-        threshold = y[order[chains - 1]]
-        seeds = order[y[order] >= threshold]  # the top p0·N, and any state tied with the last (a chain's repeated state)
-        if len(seeds) == len(y) or len(seeds) > 2 * chains:
-            raise ValueError(
-                f"response: ties at level {len(levels)}'s threshold ({threshold:g} is the response of {len(seeds) - chains + 1} of its {len(y)} samples); "
-                "subset simulation needs a response that keeps varying (e.g. the closure rather than the impact force)"
-            )
-        u, y, accepted = _chains(function, u[seeds], y[seeds], threshold, length, rng)
-        runs += len(seeds) * (length - 1)
-        levels.append(_Level(threshold, y.reshape(length, len(seeds)).T, accepted))
+def _generator(seed: int, level: int, chain: int) -> np.random.Generator:
+    """The generator of one chain of a level (of one sample of level 0)."""
+    return np.random.default_rng([seed, level, chain])
+
+
+def _levels(sampler: SubsetSampler, threshold: float | None, target: float | None, max_levels: int) -> tuple[list[SubsetLevel], int]:
+    """The levels down to ``threshold`` (or the ``target`` probability), in this process, and the evaluations of g they took."""
+    u, y = sampler.start(range(sampler.samples_per_level))
+    states = u[:, None, :]
+    levels, runs = [SubsetLevel(-math.inf, y[:, None], 1.0)], sampler.samples_per_level
+    while not sampler.done(levels, threshold, target) and len(levels) < max_levels:
+        bound, seeds = sampler.seeds(levels[-1].responses, len(levels))
+        flat = states.reshape(-1, sampler.dimension)
+        run = sampler.advance(len(levels), flat[seeds], levels[-1].responses.reshape(-1)[seeds], bound, range(len(seeds)))
+        runs += len(seeds) * (sampler.length - 1)
+        levels.append(SubsetLevel(bound, run.responses, run.accepted / (len(seeds) * (sampler.length - 1)) if sampler.length > 1 else 1.0))
+        states = run.states
     return levels, runs
-
-
-def _chains(
-    function: Callable[[np.ndarray], np.ndarray], u: np.ndarray, y: np.ndarray, threshold: float, length: int, rng: np.random.Generator
-) -> tuple[np.ndarray, np.ndarray, float]:
-    """``length`` states of each chain started at ``u`` (all in {Y ≥ threshold}), state by state; and the acceptance rate.
-
-    Returns the states and responses ordered state-major (state 0 of every
-    chain, then state 1, ...), and the fraction of candidates accepted.
-    """
-    states, responses, accepted = [u], [y], 0
-    for _ in range(length - 1):
-        candidate = _modified_metropolis(u, rng)
-        response = _evaluate(function, candidate)
-        move = response >= threshold
-        u = np.where(move[:, None], candidate, u)
-        y = np.where(move, response, y)
-        accepted += int(np.count_nonzero(move))
-        states.append(u)
-        responses.append(y)
-    rate = accepted / (len(y) * (length - 1)) if length > 1 else 1.0
-    return np.concatenate(states), np.concatenate(responses), rate
 
 
 def _modified_metropolis(u: np.ndarray, rng: np.random.Generator) -> np.ndarray:
@@ -246,12 +369,12 @@ def _evaluate(function: Callable[[np.ndarray], np.ndarray], u: np.ndarray) -> np
     return y
 
 
-def _curve(levels: list[_Level], gamma: list[float], thresholds: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """P(Y > b) and its coefficient of variation for every threshold b (``gamma``: γ_j of each level's step to the next, γ_0 = 0)."""
+def exceedance(levels: Sequence[SubsetLevel], thresholds: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """P(Y > b) and its coefficient of variation (Au & Beck's) for every threshold b, from a run's levels."""
     bounds = np.array([level.threshold for level in levels[1:]])
-    steps = [nxt.responses.shape[0] / level.responses.size for level, nxt in zip(levels, levels[1:])]  # p_j = P(Y ≥ b_{j+1} | Y ≥ b_j)
-    variances = [(1.0 - p) / (p * level.responses.size) * (1.0 + g) for p, level, g in zip(steps, levels, gamma)]
-    probability, cov = np.empty(thresholds.size), np.empty(thresholds.size)
+    steps = _steps(levels)
+    variances = [(1.0 - p) / (p * level.responses.size) * (1.0 + g) for p, level, g in zip(steps, levels, _step_gammas(levels))]
+    probability, cov = np.empty(len(thresholds)), np.empty(len(thresholds))
     for index, b in enumerate(thresholds):
         level = int(np.searchsorted(bounds, b, side="right"))  # the levels conditioned on thresholds <= b
         indicator = levels[level].responses > b
@@ -260,6 +383,85 @@ def _curve(levels: list[_Level], gamma: list[float], thresholds: np.ndarray) -> 
         own = (1.0 - p) / (p * indicator.size) * (1.0 + (_gamma(indicator) if level else 0.0)) if p > 0.0 else math.nan
         cov[index] = math.sqrt(sum(variances[:level]) + own)
     return probability, cov
+
+
+def curve_thresholds(levels: Sequence[SubsetLevel], target: float | None, points: int = 25) -> np.ndarray:
+    """Thresholds that draw a run's exceedance curve: ``points`` a level, from level 0's median response to the
+    response at the ``target`` probability (or the last level's (p0·N)-th largest), evenly between each level's bounds."""
+    bounds = [float(np.median(levels[0].responses))] + [level.threshold for level in levels[1:]]
+    last = np.sort(levels[-1].responses.reshape(-1))[::-1]
+    reach = level_probability(levels)
+    share = (target / reach) if target is not None else levels[1].responses.shape[0] / levels[0].responses.size if len(levels) > 1 else 0.5
+    bounds.append(float(last[min(len(last) - 1, round(share * len(last)))]))  # P̂(Y > it) = reach · share
+    pieces = [np.linspace(low, high, points, endpoint=False) for low, high in zip(bounds, bounds[1:]) if high > low]
+    return np.unique(np.concatenate([*pieces, [bounds[-1]]]))
+
+
+def exceedance_quantiles(levels: Sequence[SubsetLevel], probabilities: Sequence[float], z: float = 1.96) -> dict[str, np.ndarray]:
+    """The response exceeded with each probability p, and an interval of it, from a run's levels.
+
+    The value b_p is the smallest of the run's responses with P̂(Y > b_p) ≤ p
+    (for a closure, the separation for probability p of pounding); its
+    interval the values at p·exp(±z δ), δ the estimate's coefficient of
+    variation at b_p (a lognormal estimate's 95 % interval for z = 1.96),
+    read off the same curve. A probability below the run's reach (the last
+    level's probability times p0) gives NaN.
+
+    Parameters
+    ----------
+    levels : sequence of SubsetLevel
+        A run's levels.
+    probabilities : sequence of float
+        The probabilities p.
+    z : float
+        The standard normal quantile of the interval.
+
+    Returns
+    -------
+    dict of np.ndarray
+        ``value``, ``low``, ``high`` (the response's units) and ``cov`` (δ) for each p.
+    """
+    candidates = np.unique(np.concatenate([level.responses.reshape(-1) for level in levels]))
+    curve = _probabilities(levels, candidates)
+    reach = level_probability(levels) * levels[-1].responses.shape[0] / levels[-1].responses.size * (1.0 - 1e-9)
+
+    def at(p: float) -> float:
+        below = np.flatnonzero(curve <= p)
+        return float(candidates[below[0]]) if p >= reach and below.size else math.nan
+
+    result: dict[str, list[float]] = {"value": [], "low": [], "high": [], "cov": []}
+    for p in probabilities:
+        value = at(p)
+        delta = float(exceedance(levels, np.array([value]))[1][0]) if np.isfinite(value) else math.nan
+        result["value"].append(value)
+        result["cov"].append(delta)
+        result["low"].append(at(p * math.exp(z * delta)) if np.isfinite(delta) else math.nan)
+        result["high"].append(at(p * math.exp(-z * delta)) if np.isfinite(delta) else math.nan)
+    return {key: np.array(values, dtype=float) for key, values in result.items()}
+
+
+def _probabilities(levels: Sequence[SubsetLevel], thresholds: np.ndarray) -> np.ndarray:
+    """P̂(Y > b) at sorted thresholds b (without its CoV: many thresholds at once)."""
+    bounds = np.array([level.threshold for level in levels[1:]])
+    scale = np.cumprod([1.0, *_steps(levels)])
+    which = np.searchsorted(bounds, thresholds, side="right")
+    probability = np.empty(len(thresholds))
+    for index, level in enumerate(levels):
+        chosen = which == index
+        ordered = np.sort(level.responses.reshape(-1))
+        above = ordered.size - np.searchsorted(ordered, thresholds[chosen], side="right")
+        probability[chosen] = scale[index] * above / ordered.size
+    return probability
+
+
+def _steps(levels: Sequence[SubsetLevel]) -> list[float]:
+    """p_j = P(Y ≥ b_{j+1} | Y ≥ b_j), each level's fraction of samples that seeded the next."""
+    return [nxt.responses.shape[0] / level.responses.size for level, nxt in zip(levels, levels[1:])]
+
+
+def _step_gammas(levels: Sequence[SubsetLevel]) -> list[float]:
+    """γ_j of each level's step to the next (γ_0 = 0: level 0's samples are independent)."""
+    return [0.0] + [_gamma(level.responses >= nxt.threshold) for level, nxt in zip(levels[1:-1], levels[2:])]
 
 
 def _gamma(indicator: np.ndarray) -> float:
@@ -287,6 +489,22 @@ def _response_function(
         return scene, int(dimension), ""
     if not isinstance(scene, Scene):
         raise ValueError(f"scene: must be a Scene or a function of the normals, got {type(scene).__name__}")
+    return scene_response(scene, motion, response, building, floor, contact)
+
+
+def scene_response(
+    scene: Scene, motion: Mapping[str, Any], response: str, building: str | None = None, floor: int | None = None, contact: int = 0
+) -> tuple[Callable[[np.ndarray], np.ndarray], int, str]:
+    """g(u), n and the response's units: a scene's runs under the synthetic motion of the normals u.
+
+    Parameters are :func:`subset_simulation`'s; each row of u is one run, its
+    response independent of the other rows.
+
+    Raises
+    ------
+    ValueError
+        Naming the response, building, floor, contact or motion field that is out of range.
+    """
     if response not in RESPONSES:
         raise ValueError(f"response: must be one of {', '.join(RESPONSES)}, got {response!r}")
     read = _reader(scene, response, building, floor, contact)

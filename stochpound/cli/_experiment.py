@@ -45,7 +45,7 @@ def run_command(
     them. Ctrl-C stops cleanly. Every file is checked before any runs; the
     time and size of each run are estimated before it starts.
     """
-    from stochpound.experiment import load_experiment, run_experiment
+    from stochpound.experiment import is_rare_event_file, load_experiment, load_rare_event, run_experiment
 
     if workers is not None and scheduler is not None:
         raise click.BadParameter("give --workers or --scheduler, not both", param_hint="--workers")
@@ -55,12 +55,19 @@ def run_command(
     loaded = []
     for path in experiment_files:
         with _errors_of(path, several):
+            if is_rare_event_file(path):  # a [rare_event] table: one subset simulation (docs/rare-events.md)
+                loaded.append(load_rare_event(path))
+                continue
             loaded.append(load_experiment(path))
             say_scene_warnings([f"{path}: {line}" if several else line for line in experiment_warnings(loaded[-1])])
     failed = False
     for experiment_file, definition in zip(experiment_files, loaded):
         if several:
             click.echo(f"{experiment_file}:")
+        if not hasattr(definition, "n_cases"):
+            with _errors_of(experiment_file, several):
+                _run_rare_event(definition, store, workers, scheduler, restart, quiet)
+            continue
         with _errors_of(experiment_file, several), _silenced(quiet):
             try:
                 report = run_experiment(
@@ -76,6 +83,20 @@ def run_command(
         failed |= bool(report.failed)
     if failed:
         sys.exit(1)
+
+
+def _run_rare_event(definition, store: str | None, workers: int | None, scheduler: str | None, restart: bool, quiet: bool) -> None:
+    """Run a rare-event experiment (in this process unless --workers or --scheduler) and say what it did."""
+    from stochpound.experiment import run_rare_event
+
+    report = run_rare_event(definition, store, workers=workers or 0, scheduler=scheduler, restart=restart, say=None if quiet else _say)
+    state = "interrupted" if report.interrupted else ("complete" if report.complete else "incomplete")
+    click.echo(f"{state}: {report.levels} levels, {report.runs} runs ({report.batches_now} batches this run, {report.batches_before} of the level "
+               f"under way before) on {report.executor}; {report.elapsed:.1f} s")
+    click.echo(f"store: {report.store}; next: stochpound report build {report.store} --out {report.store.with_suffix('')}-report"
+               if report.complete else "rerun the same command to complete the missing batches")
+    if report.interrupted:
+        sys.exit(130)
 
 
 @contextmanager
@@ -146,8 +167,15 @@ def _has_hazard(store: Path) -> bool:
 @click.argument("experiment_file", type=click.Path(dir_okay=False))
 def check_command(experiment_file: str) -> None:
     """Validate EXPERIMENT_FILE and list its dimensions (runs nothing)."""
-    from stochpound.experiment import load_experiment, periods_of_interest, resolve_motions
+    from stochpound.experiment import is_rare_event_file, load_experiment, load_rare_event, periods_of_interest, resolve_motions
 
+    if is_rare_event_file(experiment_file):
+        with _errors_of(experiment_file, False):
+            rare = load_rare_event(experiment_file)
+        click.echo(f"{experiment_file}: valid rare-event experiment; definition sha256 {rare.sha256}")
+        click.echo(f"  {rare.table.method} simulation of {rare.table.response} under {rare.motion.get('type')}, target {rare.table.target_probability:g}, "
+                   f"N = {rare.table.samples_per_level}, p0 = {rare.table.p0:g}, seed {rare.table.seed}")
+        return
     try:
         loaded = load_experiment(experiment_file)
         resolve_motions(loaded)

@@ -27,6 +27,9 @@ from stochpound.experiment._experiment import Experiment
 from stochpound.store import Case, Dim
 from stochpound.experiment._runner import RunReport, default_store, load_experiment, run_experiment
 from stochpound.experiment._status import StatusReport, store_status
+from stochpound.experiment._rare_event_run import RareEventReport, rare_event_sampler, run_rare_event
+from stochpound.experiment._rare_event_store import RareEventResults, crude_check, is_rare_event_store, open_rare_event_store, rare_event_results
+from stochpound.experiment._rare_event_table import RareEventDefinition, RareEventTable, is_rare_event_file, load_rare_event, parse_rare_event
 
 # For the other packages of stochpound (their interface to this one, not public API: not in __all__).
 from stochpound.experiment._design_table import parse_design  # noqa: F401
@@ -40,6 +43,19 @@ from stochpound.experiment._sources import resolve_motions  # noqa: F401
 from stochpound.experiment._file_assembly import PartsIndex  # noqa: F401
 
 __all__ = [
+    "RareEventDefinition",
+    "RareEventReport",
+    "RareEventResults",
+    "RareEventTable",
+    "crude_check",
+    "is_rare_event_file",
+    "is_rare_event_store",
+    "load_rare_event",
+    "open_rare_event_store",
+    "parse_rare_event",
+    "rare_event_results",
+    "rare_event_sampler",
+    "run_rare_event",
     "FIXED_BASE",
     "Case",
     "Definition",

@@ -31,12 +31,13 @@ from stochpound.report.sections import (
     methods_section,
     move_per_cell_tables,
     open_stores,
+    rare_event_section,
     risk_section,
     separation_section,
     store_section,
 )
-from stochpound.experiment import measure_choice
 from stochpound.analysis import MEASURE_FREE_RUNS, RuptureSite, store_measure_free
+from stochpound.experiment import crude_check, is_rare_event_store, measure_choice, open_rare_event_store, rare_event_results
 from stochpound.risk import has_risk, store_damage, store_demands, store_risk
 from stochpound.store import check_finished, has_contact_free, has_wall_free, with_contacts, with_walls
 from stochpound._studies import claims, load_study
@@ -73,7 +74,8 @@ def assemble_report(paths: Sequence[str | Path], progress: Callable[[str], None]
     """
     say = progress or (lambda message: None)
     say("reading stores")
-    stores = open_stores(paths, edited)
+    rare = {Path(path): open_rare_event_store(path) for path in paths if is_rare_event_store(path)}  # a rare-event store: a section of its own
+    stores = open_stores([path for path in paths if Path(path) not in rare], edited)
     for name, store in stores.items():
         check_finished(store, Path(store.encoding.get("source", name)).name, partial, option="--partial (partial=True from Python)")
     claimed = claims({name: store.pound.definition.reproduces for name, store in stores.items()})
@@ -81,7 +83,7 @@ def assemble_report(paths: Sequence[str | Path], progress: Callable[[str], None]
     others = {name: store for name, store in stores.items() if name not in studied}
     studies = {key: load_study(key) for key in claimed}
     report = Report(
-        title="; ".join(study.TITLE for study in studies.values()) if studies else f"Pounding experiments: {', '.join(others)}",
+        title="; ".join(study.TITLE for study in studies.values()) if studies else f"Pounding experiments: {', '.join([*others, *(d.attrs['experiment_name'] for d in rare.values())])}",
         subtitle=f"stochpound report of {', '.join(stores)}, built {date.today().isoformat()}",
         sources=[f"{name}: {store.attrs.get('experiment_file', '')}, definition sha256 {store.attrs.get('definition_sha256', '')}" for name, store in stores.items()],
     )
@@ -124,8 +126,13 @@ def assemble_report(paths: Sequence[str | Path], progress: Callable[[str], None]
             say(f"experiment {name}: intensity")
             near = risks[name].separation["separation"].values.ravel() if name in risks else ()  # g*: where the contact-free runs pound
             report.sections.append(intensity_section(name, store, near))
-    say("methods")
-    report.sections.append(methods_section(stores))
+    for data in rare.values():
+        say(f"rare events {data.attrs['experiment_name']}")
+        checks = (crude_check(data, store) for store in stores.values())  # a stochastic experiment of the same runs, if one is given
+        report.sections.append(rare_event_section(data.attrs["experiment_name"], rare_event_results(data), next((c for c in checks if c is not None), None)))
+    if stores:
+        say("methods")
+        report.sections.append(methods_section(stores))
     if others and not studies:
         appendix = move_per_cell_tables(report.sections)
         if appendix is not None:

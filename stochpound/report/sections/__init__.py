@@ -10,6 +10,7 @@ from stochpound.report.sections._description import StoreDefinition
 from stochpound.report.sections._ensembles import INTERVAL_NOTE
 from stochpound.report.sections._generic import store_section
 from stochpound.report.sections._intensity import intensity_section
+from stochpound.report.sections._rare_events import rare_event_section
 from stochpound.report.sections._risk import risk_section
 from stochpound.report.sections._laws import law_axis, laws_section
 from stochpound.report.sections._methods import methods_section
@@ -19,6 +20,7 @@ from stochpound.report.sections._store_reading import open_stores, select, value
 from stochpound.report.sections._summary import experiment_summary, move_per_cell_tables
 
 __all__ = [
+    "rare_event_section",
     "risk_section",
     "damage_section",
     "INTERVAL_NOTE",

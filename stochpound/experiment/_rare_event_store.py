@@ -1,0 +1,274 @@
+"""The store of a rare-event experiment: its parts folder (finished levels and batches) and its netCDF file.
+
+A run keeps, in ``<store>.parts/``:
+
+``definition.json``
+    The canonical definition (a store of another definition is refused).
+``level-LL.npz``
+    A finished level: its responses (chains, states a chain), the sample of
+    the previous level that seeded each chain, its acceptance and runs; and,
+    unless it is the last, the next level's threshold, seeds and their normals.
+``batch-LL-BBBBB.npz``
+    A finished batch of the level under way: its chains' responses, accepted
+    moves, and the normals of its states that may seed the next level (its
+    own p0·N largest responses, ties included). Removed once the level is written.
+
+Every file is written atomically; the store file is rebuilt from the level
+files alone (:func:`write_store`), so it is the same, bit for bit, whatever
+the workers and interruptions.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import xarray as xr
+
+from stochpound._atomic import replacing
+from stochpound.analysis import METHOD, SubsetLevel, curve_dataset, curve_thresholds, exceedance, exceedance_quantiles, level_attributes, level_probability
+from stochpound.analysis import pounding_curve
+from stochpound.experiment._parts import parts_folder
+from stochpound.experiment._rare_event_table import RareEventDefinition
+from stochpound.store import contact_free, contact_gap_dims, has_contact_free
+
+DEFINITION_FILE = "definition.json"
+KIND = "rare_event"
+"""The ``kind`` attribute of a rare-event store."""
+INTERVAL_Z = 1.96
+"""The standard normal quantile of the report's intervals: p·exp(±z δ), a lognormal estimate's 95 % interval."""
+SEPARATION_PROBABILITIES = (1e-3, 1e-4, 1e-6)
+"""The probabilities per event whose response (for a closure, the separation) the report states."""
+
+
+@dataclass(frozen=True)
+class FinishedLevel:
+    """A finished level as its file holds it (``next_*``: the next level's threshold, seeds and their normals; None for the last)."""
+
+    level: SubsetLevel
+    seeds: np.ndarray
+    runs: int
+    next_threshold: float | None = None
+    next_seeds: np.ndarray | None = None
+    next_states: np.ndarray | None = None
+
+
+def level_path(store: Path, level: int) -> Path:
+    return parts_folder(store) / f"level-{level:02d}.npz"
+
+
+def batch_path(store: Path, level: int, batch: int) -> Path:
+    return parts_folder(store) / f"batch-{level:02d}-{batch:05d}.npz"
+
+
+def save_arrays(path: Path, **arrays: Any) -> None:
+    """Write ``arrays`` to ``path`` (npz) atomically."""
+    with replacing(path) as temporary:
+        with open(temporary, "wb") as stream:
+            np.savez(stream, **arrays)
+
+
+def load_arrays(path: Path) -> dict[str, np.ndarray]:
+    with np.load(path) as data:
+        return {key: data[key] for key in data.files}
+
+
+def save_level(store: Path, index: int, finished: FinishedLevel) -> None:
+    """Write a finished level and remove its batches."""
+    arrays = {"threshold": finished.level.threshold, "responses": finished.level.responses, "acceptance": finished.level.acceptance,
+              "seeds": finished.seeds, "runs": finished.runs}
+    if finished.next_threshold is not None:
+        arrays |= {"next_threshold": finished.next_threshold, "next_seeds": finished.next_seeds, "next_states": finished.next_states}
+    save_arrays(level_path(store, index), **arrays)
+    for batch in parts_folder(store).glob(f"batch-{index:02d}-*.npz"):
+        batch.unlink()
+
+
+def finished_levels(store: Path) -> list[FinishedLevel]:
+    """The finished levels in the store's parts folder, in order."""
+    levels = []
+    while level_path(store, len(levels)).is_file():
+        data = load_arrays(level_path(store, len(levels)))
+        nxt = {key: data.get(f"next_{key}") for key in ("threshold", "seeds", "states")}
+        levels.append(FinishedLevel(SubsetLevel(float(data["threshold"]), data["responses"], float(data["acceptance"])), data["seeds"], int(data["runs"]),
+                                    None if nxt["threshold"] is None else float(nxt["threshold"]), nxt["seeds"], nxt["states"]))
+    return levels
+
+
+def stored_definition(store: Path) -> dict[str, Any] | None:
+    """The definition a store's parts were run with (None without one)."""
+    path = parts_folder(store) / DEFINITION_FILE
+    return json.loads(path.read_text()) if path.is_file() else None
+
+
+def write_store(store: Path, definition: RareEventDefinition, levels: list[FinishedLevel], units: str) -> None:
+    """Write the store file from the finished levels (a run under way: ``complete`` 0, the curve of the levels so far)."""
+    table = definition.table
+    complete = bool(levels) and levels[-1].next_threshold is None
+    samples = max(f.level.responses.size for f in levels) if levels else 0
+    chains = max(len(f.seeds) for f in levels) if levels else 0
+    response = np.full((len(levels), samples), np.nan)
+    seeds = np.full((len(levels), chains), -1, dtype=np.int64)
+    for index, finished in enumerate(levels):
+        response[index, : finished.level.responses.size] = finished.level.responses.reshape(-1)
+        seeds[index, : len(finished.seeds)] = finished.seeds
+    subset = [f.level for f in levels]
+    attrs = {
+        "kind": KIND, "experiment_name": definition.name, "experiment_description": definition.description, "experiment_file": definition.path,
+        "definition": json.dumps(definition.to_dict(), sort_keys=True), "definition_sha256": definition.sha256, "method": METHOD,
+        "response": table.response, "target_probability": table.target_probability, "samples_per_level": table.samples_per_level, "p0": table.p0,
+        "seed": table.seed, "complete": int(complete), "runs": int(sum(f.runs for f in levels)),
+    }
+    curve = xr.Dataset()
+    if levels:
+        attrs["reached_probability"] = level_probability(subset) * table.p0 if complete else level_probability(subset)
+        attrs["target_reached"] = int(complete and attrs["reached_probability"] <= table.target_probability * (1.0 + 1e-9))
+        thresholds = curve_thresholds(subset, table.target_probability if complete else None) if len(levels) > 1 or complete else np.array([])
+        curve = curve_dataset(thresholds, *exceedance(subset, thresholds), units, {})
+        attrs |= {key: value for key, value in level_attributes(subset, round(table.p0 * table.samples_per_level)).items() if key != "level_thresholds"}
+    data = xr.Dataset(
+        {
+            "level_threshold": ("level", np.array([f.level.threshold for f in levels], dtype=float), {"units": units, "long_name": "level's conditioning threshold (-inf: level 0)"}),
+            "level_chains": ("level", np.array([f.level.responses.shape[0] for f in levels], dtype=np.int64)),
+            "level_length": ("level", np.array([f.level.responses.shape[1] for f in levels], dtype=np.int64), {"long_name": "states a chain"}),
+            "level_acceptance": ("level", np.array([f.level.acceptance for f in levels], dtype=float)),
+            "level_runs": ("level", np.array([f.runs for f in levels], dtype=np.int64)),
+            "response": (("level", "sample"), response, {"units": units, "long_name": "the level's responses, chain by chain"}),
+            "seed_sample": (("level", "chain"), seeds, {"long_name": "the previous level's sample that seeded the chain (-1: none)"}),
+            **{name: curve[name] for name in curve.data_vars},
+        },
+        attrs=attrs,
+    )
+    with replacing(store) as temporary:
+        data.to_netcdf(temporary, engine="h5netcdf", invalid_netcdf=False)
+
+
+def is_rare_event_store(path: str | Path) -> bool:
+    """Whether a file is a rare-event experiment's store (False for any other file)."""
+    try:
+        with xr.open_dataset(path, engine="h5netcdf") as data:
+            return data.attrs.get("kind") == KIND
+    except (OSError, ValueError):
+        return False
+
+
+def open_rare_event_store(path: str | Path) -> xr.Dataset:
+    """A rare-event store, loaded (it is small: the levels' responses)."""
+    with xr.open_dataset(path, engine="h5netcdf") as data:
+        return data.load()
+
+
+def store_levels(data: xr.Dataset) -> list[SubsetLevel]:
+    """A rare-event store's levels, as the sampler made them."""
+    levels = []
+    for index in range(data.sizes["level"]):
+        chains, length = int(data["level_chains"].values[index]), int(data["level_length"].values[index])
+        responses = data["response"].values[index, : chains * length].reshape(chains, length)
+        levels.append(SubsetLevel(float(data["level_threshold"].values[index]), responses, float(data["level_acceptance"].values[index])))
+    return levels
+
+
+@dataclass(frozen=True)
+class RareEventResults:
+    """What a rare-event store answers (computed from its levels).
+
+    Attributes
+    ----------
+    curve : xarray.Dataset
+        ``probability``, ``cov`` and the 95 % interval ``lower`` .. ``upper`` (p·exp(∓1.96 δ)) over
+        ``threshold`` (the response's units), down to the target.
+    separations : dict of np.ndarray
+        For 1e-3, 1e-4 and 1e-6 per event (``probability``): ``value``, ``low``, ``high`` (the
+        response exceeded with that probability and its 95 % interval) and ``cov``.
+    definition : RareEventDefinition
+        The experiment's definition.
+    runs : int
+        Solver runs used.
+    levels : int
+        Levels run (level 0 included).
+    complete : bool
+        The run ended (its last level is written).
+    target_reached : bool
+        It ended at the target probability (not at ``max_levels``).
+    """
+
+    curve: xr.Dataset
+    separations: dict[str, np.ndarray]
+    definition: RareEventDefinition
+    runs: int
+    levels: int
+    complete: bool
+    target_reached: bool
+
+
+def stored_rare_event(data: xr.Dataset) -> RareEventDefinition:
+    """The definition a rare-event store was run with."""
+    return RareEventDefinition.from_dict(json.loads(data.attrs["definition"]), data.attrs.get("experiment_file", ""))
+
+
+def rare_event_results(data: xr.Dataset) -> RareEventResults:
+    """The exceedance curve and the separations for 1e-3, 1e-4 and 1e-6 per event of a rare-event store."""
+    levels = store_levels(data)
+    quantiles = exceedance_quantiles(levels, SEPARATION_PROBABILITIES, INTERVAL_Z)
+    curve = data[["probability", "cov"]].load() if "probability" in data else xr.Dataset({"probability": ("threshold", []), "cov": ("threshold", [])})
+    spread = np.exp(INTERVAL_Z * curve["cov"].fillna(np.inf))
+    curve = curve.assign(lower=curve["probability"] / spread, upper=np.minimum(curve["probability"] * spread, 1.0))
+    return RareEventResults(curve, {"probability": np.array(SEPARATION_PROBABILITIES), **quantiles}, stored_rare_event(data),
+                            int(data.attrs["runs"]), len(levels), bool(data.attrs["complete"]),
+                            bool(data.attrs.get("target_reached", 0)))
+
+
+_NOT_THE_MOTION = ("count", "seed", "start", "realization", "interpolation")
+"""A synthetic ensemble's fields that name its realizations, not its motion."""
+
+
+def crude_check(rare: xr.Dataset, store: xr.Dataset) -> xr.Dataset | None:
+    """A rare-event store's closure curve against a stochastic experiment's crude Monte Carlo at that experiment's own gaps.
+
+    Only when they describe the same runs: the rare-event response is a
+    contact's closure, the stochastic store has contact-free cases on one
+    contact axis and no other axis, the same scene (but its contacts' gaps)
+    and a synthetic ensemble of the same motion (but its seed and count).
+
+    Returns
+    -------
+    xarray.Dataset or None
+        Over ``gap`` (m, the store's finite gaps): ``crude``, ``crude_lower``, ``crude_upper`` (the fraction of
+        its contact-free runs whose closure reaches the gap, with its 95 % Clopper–Pearson interval),
+        ``realizations``; ``subset`` and ``subset_cov`` (the rare-event curve there); attrs ``experiment`` and
+        ``record`` (the ensemble's label). None when they do not describe the same runs.
+    """
+    definition = stored_rare_event(rare)
+    axes = contact_gap_dims(store)
+    if definition.table.response != "closure" or len(axes) != 1 or not has_contact_free(store):
+        return None
+    stochastic = store.pound.definition
+    if _without_gaps(stochastic.scene) != _without_gaps(definition.scene):
+        return None
+    motion = _motion_fields(definition.motion)
+    labels = [m.label for m in stochastic.motions if m.kind == "synthetic" and _motion_fields(m.motion) == motion]
+    closure = contact_free(store)["peak_contact_closure"]
+    if not labels or set(closure.dims) - {"record", "realization", "contact"}:
+        return None
+    runs = closure.sel(record=labels[0]).isel(contact=definition.table.contact)
+    gaps = store[axes[0]].values[np.isfinite(store[axes[0]].values)]
+    crude = pounding_curve(runs, gaps, contact_dim=None)
+    probability, cov = exceedance(store_levels(rare), gaps)
+    return xr.Dataset(
+        {"crude": ("gap", crude["probability"].values), "crude_lower": ("gap", crude["lower"].values), "crude_upper": ("gap", crude["upper"].values),
+         "realizations": ("gap", np.broadcast_to(crude["realizations"].values, gaps.shape)), "subset": ("gap", probability), "subset_cov": ("gap", cov)},
+        coords={"gap": ("gap", gaps, {"units": "m"})}, attrs={"experiment": store.attrs.get("experiment_name", ""), "record": labels[0]},
+    )
+
+
+def _without_gaps(scene: dict[str, Any]) -> dict[str, Any]:
+    """A scene's table without its motion and its contacts' gaps."""
+    return {key: [{k: v for k, v in c.items() if k != "gap"} for c in value] if key == "contact" else value
+            for key, value in scene.items() if key != "motion"}
+
+
+def _motion_fields(motion: Any) -> dict[str, Any]:
+    return {key: value for key, value in dict(motion).items() if key not in _NOT_THE_MOTION}

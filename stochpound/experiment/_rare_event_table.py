@@ -1,0 +1,265 @@
+"""Rare-event experiment files: the ``[rare_event]`` table, its scene and its synthetic motion, typed (docs/rare-events.md).
+
+A file with a ``[rare_event]`` table is a rare-event experiment: one subset
+simulation (:class:`~stochpound.analysis.SubsetSampler`) of one response of
+its scene under one synthetic motion, which ``stochpound experiment run``
+runs into a resumable store (:mod:`stochpound.experiment._rare_event_run`).
+Beside it the file has ``[experiment]`` (``name``, ``description``,
+``scene``), the base scene (``[scene]``, as in any experiment file) and the
+motion: one ``[synthetic.<name>]`` table (its ``count`` and ``seed`` are not
+used: the sampler draws the normals) or the scene's own synthetic
+``[motion]``. Errors name the field and its allowed range in one line.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import math
+import tomllib
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from typing import Any, Mapping
+
+from stochpound._errors import ExperimentError, field_errors
+from stochpound._text_files import read_text_file
+from stochpound.experiment._spec import _base_scene
+from stochpound.analysis import RESPONSES
+from stochpound.model import fields as toml_fields
+from stochpound.motions import SYNTHETIC_TYPES, normal_motion
+from stochpound.store import building_names, canonical_json
+
+TABLE = "rare_event"
+"""The experiment file's table that makes it a rare-event experiment."""
+METHODS = ("subset",)
+"""``rare_event.method``: subset simulation (Au & Beck 2001)."""
+LIMIT_STATES = {"isolator_displacement": "base_displacement", "impact_force": "impact_force"}
+"""``rare_event.limit_state`` kinds and the response whose ratio to ``capacity`` they take."""
+RESPONSE_CHOICES = (*RESPONSES, "limit_state")
+_TOP_KEYS = {"experiment", "scene", "synthetic", TABLE}
+_KEYS = {"method", "response", "target_probability", "samples_per_level", "p0", "seed", "motion", "contact", "building", "floor",
+         "limit_state", "capacity", "max_levels"}
+FORMAT_VERSION = 1
+
+
+@dataclass(frozen=True)
+class RareEventTable:
+    """The ``[rare_event]`` table of an experiment file.
+
+    Attributes
+    ----------
+    method : str
+        ``subset``.
+    response : str
+        ``closure`` (of the contact-free pair: every contact's gap set to
+        infinity, so one run gives P(pounding) at every gap), ``peak_storey_drift``,
+        ``base_displacement``, ``impact_force`` or ``limit_state`` (the ratio of
+        ``limit_state``'s demand to ``capacity``).
+    target_probability : float
+        The probability in (0, 0.1] the levels go down to.
+    samples_per_level : int
+        N, >= 10; p0·N an integer that divides N.
+    p0 : float
+        The conditional probability of each level, in (0, 0.5].
+    seed : int
+        The sampler's seed, >= 0.
+    motion : str
+        The label of the synthetic motion (``scene`` for the scene's own ``[motion]``).
+    contact : int or None
+        The contact of ``closure`` and ``impact_force``.
+    building : str or None
+        The building of ``peak_storey_drift``, ``base_displacement`` and ``isolator_displacement``.
+    floor : int or None
+        The storey of ``peak_storey_drift``.
+    limit_state : str or None
+        ``isolator_displacement`` or ``impact_force``, with ``response = "limit_state"``.
+    capacity : float or None
+        The limit state's capacity (m or N), > 0.
+    max_levels : int
+        Most levels, in [2, 40].
+    """
+
+    method: str
+    response: str
+    target_probability: float
+    samples_per_level: int
+    p0: float
+    seed: int
+    motion: str
+    contact: int | None = None
+    building: str | None = None
+    floor: int | None = None
+    limit_state: str | None = None
+    capacity: float | None = None
+    max_levels: int = 20
+
+    @property
+    def sampled(self) -> str:
+        """The run's response the sampler reads (a limit state's demand)."""
+        return LIMIT_STATES[self.limit_state] if self.response == "limit_state" else self.response
+
+    def to_dict(self) -> dict[str, Any]:
+        """The table as the definition writes it (fields left None omitted)."""
+        return {key: value for key, value in asdict(self).items() if value is not None}
+
+
+@dataclass(frozen=True)
+class RareEventDefinition:
+    """A rare-event experiment: its name, scene, motion and ``[rare_event]`` table.
+
+    Attributes
+    ----------
+    name, description : str
+        From ``[experiment]``.
+    scene : dict
+        The base scene's table, its ``[motion]`` removed.
+    motion : dict
+        The synthetic motion's fields (``type`` and the generator's parameters).
+    table : RareEventTable
+        The ``[rare_event]`` table.
+    path : str
+        The experiment file.
+    """
+
+    name: str
+    description: str
+    scene: dict[str, Any]
+    motion: dict[str, Any]
+    table: RareEventTable
+    path: str = ""
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any], path: str = "") -> RareEventDefinition:
+        """The definition a store holds (``to_dict``'s), typed again."""
+        return cls(data["name"], data["description"], dict(data["scene"]), dict(data["motion"]), RareEventTable(**data[TABLE]), path)
+
+    def to_dict(self) -> dict[str, Any]:
+        """The canonical definition (written in the store; its sha256 is the experiment's identity)."""
+        return {"format": FORMAT_VERSION, "kind": TABLE, "name": self.name, "description": self.description, "scene": self.scene,
+                "motion": self.motion, TABLE: self.table.to_dict()}
+
+    @property
+    def sha256(self) -> str:
+        """sha256 of the canonical definition's JSON."""
+        return hashlib.sha256(canonical_json(self.to_dict()).encode()).hexdigest()
+
+
+def is_rare_event_file(path: str | Path) -> bool:
+    """Whether an experiment file has a ``[rare_event]`` table (False for a file that is not TOML: the experiment's reader says why)."""
+    try:
+        return TABLE in tomllib.loads(read_text_file(Path(path), ExperimentError))
+    except (OSError, ExperimentError, tomllib.TOMLDecodeError):
+        return False
+
+
+def load_rare_event(path: str | Path) -> RareEventDefinition:
+    """Read and check a rare-event experiment file.
+
+    Raises
+    ------
+    ExperimentError
+        Naming the field and its allowed range.
+    """
+    path = Path(path)
+    data = tomllib.loads(read_text_file(path, ExperimentError))
+    with field_errors():
+        toml_fields.reject_unknown(data, _TOP_KEYS, "")
+        header = dict(toml_fields.table(data, "experiment", "") or {})
+        toml_fields.reject_unknown(header, {"name", "description", "scene"}, "experiment")
+        name = toml_fields.string(header, "name", "experiment", default=path.stem)
+    description = header.get("description", "")
+    if not isinstance(description, str):
+        raise ExperimentError(f"experiment.description: must be a string, got {description!r}")
+    scene, _ = _base_scene(data, header, path.parent)
+    label, motion = _motion(data, scene)
+    table = parse_rare_event(data[TABLE], label, building_names(scene), scene)
+    scene = {key: value for key, value in scene.items() if key != "motion"}
+    return RareEventDefinition(name, description, scene, motion, table, str(path))
+
+
+def parse_rare_event(table: Any, motion: str, buildings: list[str], scene: Mapping[str, Any]) -> RareEventTable:
+    """The ``[rare_event]`` table, typed and checked against the scene (``motion``: the label of the file's synthetic motion)."""
+    if not isinstance(table, dict):
+        raise ExperimentError(f"{TABLE}: must be a table (method, response, target_probability, samples_per_level, p0, seed)")
+    with field_errors():
+        toml_fields.reject_unknown(table, _KEYS, TABLE)
+        method = _choice(table, "method", METHODS, "subset")
+        response = _choice(table, "response", RESPONSE_CHOICES, None)
+        target = toml_fields.number(table, "target_probability", TABLE, required=True, low=0.0, low_open=True, high=0.1)
+        p0 = toml_fields.number(table, "p0", TABLE, default=0.1, low=0.0, low_open=True, high=0.5)
+        samples = _integer(table, "samples_per_level", 10, 10**6, None)
+        seed = _integer(table, "seed", 0, 2**63 - 1, None)
+        max_levels = _integer(table, "max_levels", 2, 40, 20)
+        chains = round(p0 * samples)
+        if chains < 1 or not math.isclose(chains, p0 * samples) or samples % chains:
+            raise ExperimentError(f"{TABLE}.samples_per_level: p0 × samples_per_level must be an integer that divides it (p0 = {p0:g}), got {samples}")
+        if table.get("motion", motion) != motion:
+            raise ExperimentError(f"{TABLE}.motion: must name the file's synthetic motion ({motion}), got {table['motion']!r}")
+        where = _where(table, response, buildings, scene)
+    return RareEventTable(method, response, target, samples, p0, seed, motion, max_levels=max_levels, **where)
+
+
+def _where(table: Mapping[str, Any], response: str, buildings: list[str], scene: Mapping[str, Any]) -> dict[str, Any]:
+    """The contact, building, floor, limit state and capacity the response needs (and no other)."""
+    limit_state = _choice(table, "limit_state", tuple(LIMIT_STATES), None) if response == "limit_state" else None
+    sampled = LIMIT_STATES[limit_state] if limit_state else response
+    needs = {"contact"} if sampled in ("closure", "impact_force") else {"building"} | ({"floor"} if sampled == "peak_storey_drift" else set())
+    needs |= {"limit_state", "capacity"} if limit_state else set()
+    for key in ("contact", "building", "floor", "limit_state", "capacity"):
+        if key in table and key not in needs:
+            raise ExperimentError(f"{TABLE}.{key}: not used by response = {response!r} (it takes {', '.join(sorted(needs))})")
+    found: dict[str, Any] = {}
+    if "contact" in needs:
+        contacts = len(scene.get("contact", []))
+        if not contacts:
+            raise ExperimentError(f"{TABLE}.response: {response!r} needs a contact, and the scene has none")
+        found["contact"] = _integer(table, "contact", 0, contacts - 1, 0)
+    if "building" in needs:
+        found["building"] = _choice(table, "building", tuple(buildings), buildings[0] if len(buildings) == 1 else None)
+        if sampled == "base_displacement" and not isinstance(_building(scene, found["building"]).get("base"), dict):
+            raise ExperimentError(f"{TABLE}.building: {found['building']!r} has a fixed base ({sampled} needs a sliding base)")
+    if "floor" in needs:
+        found["floor"] = _integer(table, "floor", 1, len(_building(scene, found["building"]).get("mass", [])), None)
+    if limit_state:
+        found["limit_state"] = limit_state
+        found["capacity"] = toml_fields.number(table, "capacity", TABLE, required=True, low=0.0, low_open=True)
+    return found
+
+
+def _building(scene: Mapping[str, Any], name: str) -> Mapping[str, Any]:
+    return next(b for b in scene.get("building", []) if b.get("name") == name)
+
+
+def _choice(table: Mapping[str, Any], key: str, allowed: tuple[str, ...], default: str | None) -> str:
+    value = table.get(key, default)
+    if value not in allowed:
+        got = "missing" if key not in table else f"got {value!r}"
+        raise ExperimentError(f"{TABLE}.{key}: must be one of {', '.join(allowed)}, {got}")
+    return value
+
+
+def _integer(table: Mapping[str, Any], key: str, low: int, high: int, default: int | None) -> int:
+    value = table.get(key, default)
+    if isinstance(value, bool) or not isinstance(value, int) or not low <= value <= high:
+        got = "missing" if key not in table else f"got {value!r}"
+        raise ExperimentError(f"{TABLE}.{key}: must be an integer in [{low}, {high}], {got}")
+    return value
+
+
+def _motion(data: Mapping[str, Any], scene: Mapping[str, Any]) -> tuple[str, dict[str, Any]]:
+    """The label and fields of the file's one synthetic motion: a ``[synthetic.<name>]`` table, or the scene's own ``[motion]``."""
+    synthetic = data.get("synthetic", {})
+    if not isinstance(synthetic, dict) or len(synthetic) > 1:
+        raise ExperimentError("synthetic: a rare-event experiment takes one [synthetic.<name>] table (or the scene's synthetic [motion])")
+    if synthetic:
+        label, fields = next(iter(synthetic.items()))
+        where = f"synthetic.{label}"
+    else:
+        label, fields, where = "scene", scene.get("motion"), "scene.motion"
+        if not isinstance(fields, dict) or fields.get("type") not in SYNTHETIC_TYPES:
+            raise ExperimentError(f"synthetic: missing (a [synthetic.<name>] table, or a scene [motion] of type {', '.join(SYNTHETIC_TYPES)})")
+    if not isinstance(fields, dict):
+        raise ExperimentError(f"{where}: must be a table (type and the generator's parameters)")
+    motion = {key: value for key, value in fields.items() if key not in ("count", "seed", "start", "realization")}
+    with field_errors(scene_prefix=where):
+        normal_motion(motion)
+    return label, motion

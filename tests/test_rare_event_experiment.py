@@ -1,0 +1,246 @@
+"""Rare-event experiments (issue 46, item 3): the [rare_event] table, its resumable store, bit for bit whatever the workers."""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from stochpound._errors import ExperimentError
+from stochpound.experiment import is_rare_event_file, is_rare_event_store, load_rare_event, open_rare_event_store, rare_event_results, run_rare_event
+from stochpound.experiment._rare_event_run import RUNS_PER_BATCH
+
+FILE = """
+[experiment]
+name = "pair_rare"
+
+[scene]
+bundled = "elastic_pair"
+
+[scene.building.B2]
+mass_factor = 2.0
+
+[synthetic.wn]
+type = "white_noise"
+S0 = 0.01
+duration = 2.0
+dt = 0.02
+
+[rare_event]
+method = "subset"
+response = "closure"
+contact = 1
+target_probability = 1e-3
+samples_per_level = {samples}
+p0 = 0.1
+seed = 3
+"""
+
+
+def _file(folder: Path, samples: int = 20, **edits: str) -> Path:
+    text = FILE.format(samples=samples)
+    for old, new in edits.items():
+        text = text.replace(old, new)
+    path = folder / "pair.toml"
+    path.write_text(text)
+    return path
+
+
+@pytest.mark.parametrize(("old", "new", "message"), [
+    ('method = "subset"', 'method = "line"', r"rare_event.method: must be one of subset, got 'line'"),
+    ("target_probability = 1e-3", "target_probability = 0.5", r"rare_event.target_probability: must be <= 0.1, got 0.5"),
+    ("p0 = 0.1", "p0 = 0.7", r"rare_event.p0: must be <= 0.5, got 0.7"),
+    ("seed = 3", "seed = -1", r"rare_event.seed: must be an integer in \[0, "),
+    ("contact = 1", "contact = 2", r"rare_event.contact: must be an integer in \[0, 1\], got 2"),
+    ('response = "closure"', 'response = "speed"', "rare_event.response: must be one of closure, peak_storey_drift, base_displacement, impact_force, limit_state"),
+    ('response = "closure"\ncontact = 1', 'response = "base_displacement"\nbuilding = "B1"', "rare_event.building: 'B1' has a fixed base"),
+    ('response = "closure"\ncontact = 1', 'response = "peak_storey_drift"\nbuilding = "B1"\nfloor = 3', r"rare_event.floor: must be an integer in \[1, 2\], got 3"),
+    ("p0 = 0.1", "p0 = 0.1\nfloor = 1", "rare_event.floor: not used by response = 'closure'"),
+    ("S0 = 0.01", "S9 = 0.01", "synthetic.wn.S9: unknown field"),
+])
+def test_bad_fields_are_named_in_one_line(tmp_path, old, new, message):
+    path = _file(tmp_path, **{old: new})
+    assert is_rare_event_file(path)
+    with pytest.raises(ExperimentError, match=message) as error:
+        load_rare_event(path)
+    assert "\n" not in str(error.value)
+
+
+def test_samples_per_level_must_split_into_chains(tmp_path):
+    with pytest.raises(ExperimentError, match=r"rare_event.samples_per_level: p0 × samples_per_level must be an integer that divides it"):
+        load_rare_event(_file(tmp_path, samples=25))
+
+
+def test_the_table_is_typed_and_the_store_holds_the_levels(tmp_path):
+    definition = load_rare_event(_file(tmp_path))
+    assert definition.table.response == "closure" and definition.table.samples_per_level == 20 and definition.motion["type"] == "white_noise"
+    report = run_rare_event(definition, tmp_path / "a.nc")
+    assert report.complete and report.levels == 3 and report.runs == 20 + 2 * 2 * 9
+    assert is_rare_event_store(tmp_path / "a.nc") and not is_rare_event_store(tmp_path / "pair.toml")
+    store = open_rare_event_store(tmp_path / "a.nc")
+    assert store.attrs["runs"] == report.runs and store.attrs["complete"] == 1
+    assert list(store["level_runs"].values) == [20, 18, 18]
+    assert np.isneginf(store["level_threshold"].values[0]) and np.all(np.diff(store["level_threshold"].values) > 0)
+    results = rare_event_results(store)
+    # the levels' thresholds have the estimated probabilities p0 and p0²; the curve reaches the target
+    assert 0.0 < float(results.curve.probability.min()) <= 1e-3 * (1 + 1e-9)
+    assert np.isfinite(results.separations["value"][0]) and np.isnan(results.separations["value"][1])
+
+
+def test_an_interrupted_run_resumes_at_the_last_finished_batch(tmp_path):
+    definition = load_rare_event(_file(tmp_path, samples=200))
+    whole = run_rare_event(definition, tmp_path / "whole.nc")
+    first = run_rare_event(definition, tmp_path / "split.nc", stop_after=3)
+    assert first.interrupted and not first.complete and first.batches_now == 3
+    again = run_rare_event(definition, tmp_path / "split.nc")
+    per_level = [2] + [-(-20 // (RUNS_PER_BATCH // 10))] * (whole.levels - 1)
+    assert first.batches_now + again.batches_now == sum(per_level)  # nothing redone
+    assert again.runs == whole.runs
+    assert (tmp_path / "whole.nc").read_bytes() == (tmp_path / "split.nc").read_bytes()
+
+
+def test_a_killed_command_resumes_to_the_same_store(tmp_path):
+    """``experiment run`` killed (SIGKILL) once its first batch is written, then run again: the store of an uninterrupted run, bit for bit."""
+    environment = {**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parent.parent)}
+    command = [sys.executable, "-m", "stochpound", "experiment", "run", "pair.toml", "--store", "pair.nc", "--quiet"]
+    for name in ("killed", "whole"):
+        (tmp_path / name).mkdir()
+        _file(tmp_path / name, samples=400)
+    subprocess.run(command, cwd=tmp_path / "whole", env=environment, check=True, capture_output=True)
+    process = subprocess.Popen(command, cwd=tmp_path / "killed", env=environment, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    parts = tmp_path / "killed" / "pair.nc.parts"
+    deadline = time.monotonic() + 120
+    while not list(parts.glob("batch-*.npz")) and process.poll() is None and time.monotonic() < deadline:
+        time.sleep(0.05)
+    process.send_signal(signal.SIGKILL)
+    process.wait()
+    assert list(parts.glob("*.npz")) and not (tmp_path / "killed" / "pair.nc").exists()
+    resumed = subprocess.run(command, cwd=tmp_path / "killed", env=environment, check=True, capture_output=True, text=True)
+    assert "0 of the level under way before" not in resumed.stdout
+    assert (tmp_path / "killed" / "pair.nc").read_bytes() == (tmp_path / "whole" / "pair.nc").read_bytes()
+
+
+@pytest.mark.slow
+def test_one_or_two_workers_give_the_same_store(tmp_path):
+    definition = load_rare_event(_file(tmp_path))
+    for workers in (1, 2):
+        run_rare_event(definition, tmp_path / f"{workers}.nc", workers=workers)
+    assert (tmp_path / "1.nc").read_bytes() == (tmp_path / "2.nc").read_bytes()
+
+
+def test_a_store_of_another_definition_is_refused(tmp_path):
+    run_rare_event(load_rare_event(_file(tmp_path)), tmp_path / "a.nc", stop_after=1)
+    other = load_rare_event(_file(tmp_path, **{"seed = 3": "seed = 4"}))
+    with pytest.raises(ExperimentError, match="made by another definition"):
+        run_rare_event(other, tmp_path / "a.nc")
+    run_rare_event(other, tmp_path / "b.nc")
+    restarted = run_rare_event(other, tmp_path / "a.nc", restart=True)
+    assert restarted.complete and restarted.batches_before == 0
+    assert (tmp_path / "a.nc").read_bytes() == (tmp_path / "b.nc").read_bytes()
+
+
+def test_the_report_draws_the_curve_and_states_the_separations(tmp_path):
+    """``report build`` on a rare-event store: a section of its own with the curve to the target, its interval, and the separation table."""
+    from stochpound.report.assemble import assemble_report
+    from stochpound.report.render import FigureItem, Table
+
+    definition = load_rare_event(_file(tmp_path))
+    run_rare_event(definition, tmp_path / "a.nc")
+    report = assemble_report([tmp_path / "a.nc"])
+    section = next(s for s in report.sections if s.key == "rare-pair_rare")
+    figure = next(b for b in section.blocks if isinstance(b, FigureItem))
+    table = next(b for b in section.blocks if isinstance(b, Table))
+    results = rare_event_results(open_rare_event_store(tmp_path / "a.nc"))
+    assert list(table.frame.index) == [1e-3, 1e-4, 1e-6]
+    assert table.frame["separation (m)"].values[0] == results.separations["value"][0]
+    assert np.all(results.curve.lower <= results.curve.probability) and np.all(results.curve.probability <= results.curve.upper)
+    assert "down to 0.001" in figure.caption and "n = 56 runs" in section.blocks[0].text
+
+
+STOCHASTIC = """
+[experiment]
+name = "pair_stoch"
+
+[scene]
+bundled = "elastic_pair"
+
+[scene.building.B2]
+mass_factor = 2.0
+
+[grid]
+gap = [0.03, 0.035, inf]
+
+[synthetic.wn]
+type = "white_noise"
+S0 = 0.01
+duration = 2.0
+dt = 0.02
+count = 40
+seed = 1
+"""
+
+
+def test_a_stochastic_experiment_of_the_same_runs_checks_the_curve_at_its_gaps(tmp_path):
+    """With the stochastic store of the same scene and motion, the section gives crude Monte Carlo at its gaps beside the curve;
+    a store of another motion is not compared."""
+    from stochpound.experiment import crude_check, load_experiment, run_experiment
+    from stochpound.report.assemble import assemble_report
+
+    run_rare_event(load_rare_event(_file(tmp_path)), tmp_path / "a.nc")
+    for name, text in (("same", STOCHASTIC), ("other", STOCHASTIC.replace("S0 = 0.01", "S0 = 0.02"))):
+        (tmp_path / f"{name}.toml").write_text(text.replace("pair_stoch", f"pair_{name}"))
+        run_experiment(load_experiment(tmp_path / f"{name}.toml"), tmp_path / f"{name}.nc", workers=0, progress=False)
+    rare = open_rare_event_store(tmp_path / "a.nc")
+    with stochpound_store(tmp_path / "same.nc") as same, stochpound_store(tmp_path / "other.nc") as other:
+        check = crude_check(rare, same)
+        assert crude_check(rare, other) is None
+        closure = same.pound.contact_free()["peak_contact_closure"].isel(record=0, contact=1).values
+        assert list(check["gap"].values) == [0.03, 0.035]
+        assert check["crude"].values[0] == np.mean(closure >= 0.03) and check["realizations"].values[0] == 40
+        assert np.all(np.isfinite(check["subset"].values)) and check["subset"].values[0] >= check["subset"].values[1] > 0.0
+    report = assemble_report([tmp_path / "same.nc", tmp_path / "a.nc"])
+    section = next(s for s in report.sections if s.key == "rare-pair_rare")
+    assert any(getattr(block, "key", "") == "rare-pair_rare-crude" for block in section.blocks)
+
+
+def stochpound_store(path):
+    import stochpound
+
+    return stochpound.open_store(path)
+
+
+def test_experiment_check_names_a_rare_event_file(tmp_path):
+    from click.testing import CliRunner
+
+    from stochpound.cli import main
+
+    result = CliRunner().invoke(main, ["experiment", "check", str(_file(tmp_path))])
+    assert result.exit_code == 0 and "valid rare-event experiment" in result.output
+    bad = CliRunner().invoke(main, ["experiment", "run", str(_file(tmp_path, **{"p0 = 0.1": "p0 = 0.9"}))])
+    assert bad.exit_code == 1 and "rare_event.p0: must be <= 0.5, got 0.9" in bad.output
+
+
+def test_a_run_stopped_by_max_levels_says_the_target_was_not_reached(tmp_path):
+    run = run_rare_event(load_rare_event(_file(tmp_path, **{"seed = 3": "seed = 3\nmax_levels = 2"})), tmp_path / "a.nc")
+    results = rare_event_results(open_rare_event_store(tmp_path / "a.nc"))
+    assert run.complete and run.levels == 2 and results.complete and not results.target_reached
+    assert np.all(np.isnan(results.separations["value"]))  # 1e-3 is below the reach of two levels of 20 samples
+
+
+def test_a_limit_state_is_its_demand_over_its_capacity(tmp_path):
+    """``response = "limit_state"``: the sampler's response is the demand's (here the impact force at contact 1, gaps kept) over the capacity."""
+    from stochpound.experiment import rare_event_sampler
+
+    force = load_rare_event(_file(tmp_path, **{'response = "closure"': 'response = "impact_force"', "S0 = 0.01": "S0 = 1.0"}))
+    limit = load_rare_event(_file(tmp_path, **{'response = "closure"': 'response = "limit_state"\nlimit_state = "impact_force"\ncapacity = 2.0e5',
+                                               "S0 = 0.01": "S0 = 1.0"}))
+    assert limit.table.sampled == "impact_force" and limit.table.capacity == 2.0e5
+    demand = rare_event_sampler(force).start(range(3))[1]
+    ratio = rare_event_sampler(limit).start(range(3))[1]
+    assert np.any(demand > 0.0) and np.array_equal(ratio, demand / 2.0e5)
