@@ -46,16 +46,17 @@ class TomlTable:
         self.values = values
         self.name = name
         if allowed is not None:
-            toml_fields.reject_unknown(values, set(allowed), name)
+            self.reject_unknown(allowed)
+
+    def reject_unknown(self, allowed: Collection[str]) -> None:
+        """Refuse the first key not in ``allowed``, naming the table, the key and the allowed keys."""
+        toml_fields.reject_unknown(self.values, set(allowed), self.name)
 
     def __contains__(self, key: str) -> bool:
         return key in self.values
 
     def __iter__(self) -> Iterator[str]:
         return iter(self.values)
-
-    def __len__(self) -> int:
-        return len(self.values)
 
     def field(self, key: str) -> str:
         """The full name of field ``key`` (``design.sds``, ``records[2].name``)."""
@@ -106,10 +107,26 @@ class TomlTable:
         """The boolean ``key``, or ``default`` when absent."""
         return toml_fields.boolean(self.values, key, self.name, default)
 
-    def table(self, key: str, allowed: Collection[str] | None = None) -> TomlTable | None:
-        """The sub-table ``key`` (named ``<name>.<key>``, its keys checked against ``allowed``), or None when absent."""
+    def numbers(self, key: str, default: Any = _REQUIRED, *, low: float, low_open: bool = False) -> Any:
+        """The list of finite numbers ``key`` as a tuple, each >= ``low`` (> when ``low_open``), or ``default`` when absent."""
+        if key not in self.values and default is not _REQUIRED:
+            return default
+        return toml_fields.number_list(self.values, key, self.name, low=low, low_open=low_open)
+
+    def table(self, key: str, allowed: Collection[str] | None = None, hint: str = "") -> TomlTable | None:
+        """The sub-table ``key`` (named ``<name>.<key>``, its keys checked against ``allowed``), or None when absent.
+
+        ``hint`` shows the table's form in the message of a value that is not a table (e.g. ``{ k0 = ..., k = ... }``).
+        """
+        value = self.raw(key)
+        if hint and value is not None and not isinstance(value, dict):
+            raise self.error(key, f"must be a table {hint}, got {value!r}")
         values = toml_fields.table(self.values, key, self.name)
         return None if values is None else TomlTable(values, self.field(key), allowed)
+
+    def table_or_empty(self, key: str, allowed: Collection[str] | None = None, hint: str = "") -> TomlTable:
+        """The sub-table ``key`` as :meth:`table` reads it, an empty one when absent (a table whose every field has a default)."""
+        return self.table(key, allowed, hint) or TomlTable({}, self.field(key))
 
     def tables(self, key: str, hint: str = "") -> list[TomlTable]:
         """The array of tables ``[[key]]``, each named ``<key>[i]``; empty when absent (``hint`` says what each table holds)."""
