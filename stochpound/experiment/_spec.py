@@ -137,8 +137,8 @@ def _definition(file: TomlTable, base_dir: Path, default_name: str) -> Definitio
         except ValueError as error:
             raise ExperimentError(f"experiment.reproduces: {error} (a published study's part, \"<study>:<part>\")") from None
     scene, scene_source = _base_scene(file, header, base_dir)
-    buildings = building_names(scene)
-    contacts = scene.get("contact", [])
+    buildings, scene_table = building_names(scene), TomlTable(scene, "scene")
+    contacts = scene_table.tables("contact")
     studied = header.raw("studied", buildings[0] if buildings else "B1")
     if studied not in buildings:
         raise ExperimentError(f"experiment.studied: must be one of the scene's buildings ({', '.join(buildings)}), got {studied!r}")
@@ -150,15 +150,15 @@ def _definition(file: TomlTable, base_dir: Path, default_name: str) -> Definitio
             raise ExperimentError(f"grid.{key}: unknown axis (allowed: {', '.join(allowed)}; variant axes are declared in [variants.<axis>])")
     variants = [VariantAxis(name, tuple(_variant_selection(grid, name, list(overrides))), overrides) for name, overrides in declared.items()]
     n_contacts = len(contacts)
-    contact_floors = [c.get("between", [[None, None]])[0][1] for c in contacts]
-    n_walls = len(scene.get("wall", []))
+    contact_floors = [c.raw("between", [[None, None]])[0][1] for c in contacts]
+    n_walls = len(scene_table.tables("wall"))
     gaps = [_gap_axis(key, grid.raw(key), n_contacts, contact_floors, n_walls) for key in grid if is_gap_axis(key)]
     mu = _mu_axis(grid.raw("mu"), buildings) if "mu" in grid else None
     intensity = parse_intensity(file.values, scene, variants, gaps, mu, base_dir)
     hazard = parse_hazard(file, intensity, base_dir, scene_g(scene))
     design = parse_design(file)
     limit_states = parse_limit_states(file, buildings)
-    motions = _motions(file, scene, base_dir)
+    motions = _motions(file, scene_table, base_dir)
     output, solver = _output(file, buildings), _solver(file)
     site = site_entry(file.raw("site"), intensity)
     # optional records left None are absent from the written definition: the definitions (and hashes) of other files are unchanged
@@ -191,7 +191,7 @@ def _base_scene(file: TomlTable, header: TomlTable, base_dir: Path) -> tuple[dic
     scene, source = _scene_from_file(inline[key], base_dir, f"scene.{key}", key)
     edits = inline["building"] if "building" in inline else None
     if edits:
-        edit = _override({"building": edits}, "scene", building_names(scene), len(scene.get("contact", [])))
+        edit = _override({"building": edits}, "scene", building_names(scene), len(TomlTable(scene, "scene").tables("contact")))
         scene = apply_overrides(scene, [edit])
     return scene, source
 
@@ -367,33 +367,35 @@ def _mu_axis(spec: Any, buildings: list[str]) -> MuAxis:
 # ---------------------------------------------------------------- motions
 
 
-def _motions(file: TomlTable, scene: Mapping[str, Any], base_dir: Path) -> tuple[MotionSource, ...]:
+def _motions(file: TomlTable, scene: TomlTable, base_dir: Path) -> tuple[MotionSource, ...]:
     records = file.tables("records", hint="record = name or file")
     synthetic = file.table_or_empty("synthetic")
     motions = [source for table in records for source in _record_sources(table, base_dir)]
     motions += [_analytic_source(table) for table in file.tables("motions", hint="name, type = harmonic | constant and its parameters")]
     motions += [_synthetic_source(label, synthetic.raw(label), synthetic.field(label)) for label in synthetic]
     if not motions:
-        table = scene.get("motion")
-        if not isinstance(table, dict):
-            raise ExperimentError("records: no motion (give [[records]], [[motions]], [synthetic.<name>], or a [motion] in the base scene)")
-        kind = table.get("type", "record")
-        if kind in SYNTHETIC_TYPES:
-            entry = dict(table)
-            realization = entry.pop("realization", 0)
-            motions.append(MotionSource(kind, "synthetic", "scene.motion", entry, realization, 1))
-        else:  # a record (or a harmonic or constant motion), read on the client and shipped
-            motion = dict(table)
-            label = kind
-            if kind == "record":
-                motion["file_sha256"] = _file_sha256(base_dir, table.get("record"))
-                label = Path(str(table.get("record", kind))).stem
-            motions.append(MotionSource(label, "record", "scene.motion", motion))
+        motions.append(_scene_motion(scene, base_dir))
     labels = [m.label for m in motions]
     for i, label in enumerate(labels):
         if labels.index(label) != i:
             raise ExperimentError(f"records: motion label {label!r} is used twice (give each [[records]] a distinct name)")
     return tuple(motions)
+
+
+def _scene_motion(scene: TomlTable, base_dir: Path) -> MotionSource:
+    """The base scene's ``[motion]``, the experiment's one motion when the file gives none."""
+    if not isinstance(scene.raw("motion"), dict):
+        raise ExperimentError("records: no motion (give [[records]], [[motions]], [synthetic.<name>], or a [motion] in the base scene)")
+    table = scene.table("motion")
+    kind = table.raw("type", "record")
+    if kind in SYNTHETIC_TYPES:
+        entry = {key: value for key, value in table.values.items() if key != "realization"}
+        return MotionSource(kind, "synthetic", table.name, entry, table.raw("realization", 0), 1)
+    motion = dict(table.values)  # a record (or a harmonic or constant motion), read on the client and shipped
+    if kind != "record":
+        return MotionSource(kind, "record", table.name, motion)
+    motion["file_sha256"] = _file_sha256(base_dir, table.raw("record"))
+    return MotionSource(Path(str(table.raw("record", kind))).stem, "record", table.name, motion)
 
 
 def _analytic_source(table: TomlTable) -> MotionSource:

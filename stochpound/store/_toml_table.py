@@ -87,11 +87,11 @@ class TomlTable:
         """
         if key not in self.values:
             if default is _REQUIRED:
-                raise self.error(key, f"missing ({meaning or 'an integer'}, an integer {_integer_range(low, high)})")
+                raise self.error(key, f"missing ({meaning or 'an integer'}, an integer{_integer_range(low, high)})")
             return default
         value = self.values[key]
         if not isinstance(value, int) or isinstance(value, bool) or (low is not None and value < low) or (high is not None and value > high):
-            raise self.error(key, f"must be an integer {_integer_range(low, high)}, got {value!r}")
+            raise self.error(key, f"must be an integer{_integer_range(low, high)}, got {value!r}")
         return value
 
     def string(self, key: str, default: Any = _REQUIRED, *, choices: Collection[str] | None = None, hint: str = "") -> Any:
@@ -107,8 +107,8 @@ class TomlTable:
         """The boolean ``key``, or ``default`` when absent."""
         return toml_fields.boolean(self.values, key, self.name, default)
 
-    def numbers(self, key: str, default: Any = _REQUIRED, *, low: float, low_open: bool = False) -> Any:
-        """The list of finite numbers ``key`` as a tuple, each >= ``low`` (> when ``low_open``), or ``default`` when absent."""
+    def numbers(self, key: str, default: Any = _REQUIRED, *, low: float | None = None, low_open: bool = False) -> Any:
+        """The list of finite numbers ``key`` as a tuple, each >= ``low`` (> when ``low_open``; None: any), or ``default`` when absent."""
         if key not in self.values and default is not _REQUIRED:
             return default
         return toml_fields.number_list(self.values, key, self.name, low=low, low_open=low_open)
@@ -137,7 +137,7 @@ class TomlTable:
 
 
 def _integer_range(low: int | None, high: int | None) -> str:
-    """``in [low, high]``, ``>= low`` or ``<= high`` (empty: any integer)."""
+    """`` in [low, high]``, `` >= low`` or `` <= high`` (empty: any integer)."""
     if low is not None and high is not None:
-        return f"in [{low}, {high}]"
-    return f">= {low}" if low is not None else (f"<= {high}" if high is not None else "")
+        return f" in [{low}, {high}]"
+    return f" >= {low}" if low is not None else (f" <= {high}" if high is not None else "")
