@@ -10,8 +10,10 @@ base scene inlined. Its sha256, without the hazard that no run depends on
 made from a different definition is refused. :class:`stochpound.store.ExperimentGrid`
 is built from it.
 
-Errors raise :class:`ExperimentError` whose message starts with the field's
-path, e.g. ``grid.mu[2]: must be >= 0 or inf, got -0.1``.
+Each table is read with :class:`stochpound.store.TomlTable`, which declares
+its fields and refuses unknown keys; errors raise :class:`ExperimentError`
+whose message starts with the field's path, e.g.
+``grid.mu[2]: must be >= 0 or inf, got -0.1``.
 """
 
 from __future__ import annotations
@@ -120,10 +122,10 @@ def parse_experiment(data: Mapping[str, Any], base_dir: str | Path = ".", defaul
         ``sha256``: not part of the identity, ``scene`` holds the content).
     """
     with field_errors():  # the tables' readers raise SceneError: named as the experiment's fields
-        return _definition(TomlTable(data, "", _TOP_KEYS), Path(base_dir), default_name).to_dict()
+        return _parsed_definition(TomlTable(data, "", _TOP_KEYS), Path(base_dir), default_name).to_dict()
 
 
-def _definition(file: TomlTable, base_dir: Path, default_name: str) -> Definition:
+def _parsed_definition(file: TomlTable, base_dir: Path, default_name: str) -> Definition:
     """The typed definition of a parsed experiment file (its top level, its keys checked)."""
     header = file.table_or_empty("experiment", _EXPERIMENT_KEYS)
     name = header.string("name", default_name)
