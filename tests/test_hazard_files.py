@@ -16,13 +16,13 @@ from stochpound.analysis import HazardCurve, bundled_measure
 from stochpound.motions import Measure
 from stochpound.hazard._files import (
     StatedMeasure,
-    parse_measure,
     read_hazard_file,
     unit_factor,
 )
 from stochpound.hazard._setting import hazard_curve, hazard_option
 from stochpound.experiment._intensity import IntensityError
 from stochpound.experiment._spec import ExperimentError, parse_experiment
+from stochpound.store import Hazard
 from tests.helpers import ISOLATED, risk_text as _text
 
 DATA = Path(__file__).resolve().parent / "data" / "hazard"
@@ -30,24 +30,24 @@ OPENQUAKE = DATA / "hazard_curve-mean-SA(1.0)_42.csv"
 NSHMP = DATA / "curves" / "SA1P0" / "total.csv"
 POE_CM = DATA / "site_poe_cm_s2.csv"
 FOX = HazardCurve.bundled("fox_plaza_los_angeles_sa1p0s")
-PSA1 = {"measure": "psa", "period": 1.0, "damping": 0.05, "units": "g", "levels": [0.3, 0.8, 1.5], "ran": "stripes"}
+PSA1 = Measure("psa", 1.0, damping=0.05)
 
 
-def test_parse_measure_reads_the_usual_spellings():
-    assert parse_measure("5 %-damped spectral acceleration at T = 1.0 s, in g") == {"measure": "psa", "period": 1.0, "damping": 0.05, "units": "g"}
-    assert parse_measure("peak ground acceleration (PGA), in g") == {"measure": "pga", "units": "g"}
-    assert parse_measure("PSA(2.0 s, 5 %) in m/s²") == {"measure": "psa", "period": 2.0, "damping": 0.05, "units": "m/s2"}
-    assert parse_measure("PGA in gal") == {"measure": "pga", "units": "cm/s2"}
-    assert parse_measure("SA1P0") == {"measure": "psa", "period": 1.0}
+def test_a_stated_measure_is_parsed_from_the_usual_spellings():
+    assert StatedMeasure.parse("5 %-damped spectral acceleration at T = 1.0 s, in g") == StatedMeasure("psa", 1.0, damping=0.05, units="g")
+    assert StatedMeasure.parse("peak ground acceleration (PGA), in g") == StatedMeasure("pga", units="g")
+    assert StatedMeasure.parse("PSA(2.0 s, 5 %) in m/s²") == StatedMeasure("psa", 2.0, damping=0.05, units="m/s2")
+    assert StatedMeasure.parse("PGA in gal") == StatedMeasure("pga", units="cm/s2")
+    assert StatedMeasure.parse("SA1P0") == StatedMeasure("psa", 1.0)
     with pytest.raises(ValueError, match="^measure: 'MMI' names no measure"):
-        parse_measure("MMI")
+        StatedMeasure.parse("MMI")
 
 
 def test_a_stated_measure_is_a_value_with_what_the_text_leaves_out_left_none():
-    """The parser's one result: a frozen value whose entry() is parse_measure's keys, a Measure once kind and period are stated."""
+    """The parser's one result: a frozen value whose entry() gives its stated keys back, a Measure once kind and period are stated."""
     stated = StatedMeasure.parse("PSA(2.0 s, 5 %) in m/s²")
     assert stated == StatedMeasure("psa", 2.0, damping=0.05, units="m/s2") and hash(stated) == hash(StatedMeasure.from_entry(stated.entry()))
-    assert stated.entry() == parse_measure("PSA(2.0 s, 5 %) in m/s²")
+    assert stated.entry() == {"measure": "psa", "period": 2.0, "damping": 0.05, "units": "m/s2"}
     assert stated.measure == Measure("psa", 2.0, damping=0.05)
     partial = StatedMeasure.parse("spectral acceleration")
     assert (partial.kind, partial.period, partial.units, partial.measure) == ("psa", None, None, None)
@@ -149,12 +149,12 @@ def _copy(tmp_path: Path, source: Path, text: str | None = None) -> str:
 
 def test_a_hazard_in_cm_s2_is_converted_or_refused(tmp_path):
     name = _copy(tmp_path, POE_CM)
-    curve = hazard_curve(_entry(tmp_path, f'file = "{name}"'))
+    curve = hazard_curve(Hazard.from_entry(_entry(tmp_path, f'file = "{name}"')))
     np.testing.assert_allclose(curve.im, FOX.im, rtol=1e-12)
     unstated = _copy(tmp_path, POE_CM, POE_CM.read_text().replace("in cm/s2", ""))
     with pytest.raises(ExperimentError, match=rf"^hazard\.units: not stated: {unstated} does not give its curve's units"):
         _entry(tmp_path, f'file = "{unstated}"')
-    np.testing.assert_allclose(hazard_curve(_entry(tmp_path, f'file = "{unstated}"\nunits = "cm/s2"')).im, FOX.im, rtol=1e-12)
+    np.testing.assert_allclose(hazard_curve(Hazard.from_entry(_entry(tmp_path, f'file = "{unstated}"\nunits = "cm/s2"'))).im, FOX.im, rtol=1e-12)
     with pytest.raises(ExperimentError, match=rf"^hazard\.units: 'g', but {name} states units = 'cm/s2'"):
         _entry(tmp_path, f'file = "{name}"\nunits = "g"')
 
@@ -176,17 +176,17 @@ def test_a_pga_curve_for_a_psa_store_is_an_error_naming_both(tmp_path):
                                               r"\(intensity\.measure = 'psa'\); the hazard's measure is 'pga'"):
         _entry(tmp_path, f'file = "{pga}"')
     with pytest.raises(IntensityError, match=r"^--hazard-measure: the hazard's measure must be"):
-        hazard_option(str(tmp_path / pga), PSA1)
+        hazard_option(str(tmp_path / pga), PSA1, "g")
 
 
 def test_levels_in_m_s2_with_a_hazard_in_g_are_converted(tmp_path):
     intensity = 'measure = "psa"\nperiod = 1.0\nlevels = [3.0, 8.0, 15.0]\nunits = "m/s2"'
     entry = _entry(tmp_path, 'bundled = "fox_plaza_los_angeles_sa1p0s"', intensity)
-    curve = hazard_curve(entry)
+    curve = hazard_curve(Hazard.from_entry(entry))
     assert entry["units"] == "m/s2" and curve.units == "m/s2"
     x = np.array([0.3, 0.8, 1.5])
     np.testing.assert_allclose(curve(x * 9.81), FOX(x), rtol=1e-12)
-    law = hazard_curve(_entry(tmp_path, 'power_law = { k0 = 2.0e-4, k = 2.2 }\nunits = "g"', intensity))
+    law = hazard_curve(Hazard.from_entry(_entry(tmp_path, 'power_law = { k0 = 2.0e-4, k = 2.2 }\nunits = "g"', intensity)))
     np.testing.assert_allclose(law(x * 9.81), 2.0e-4 * x**-2.2, rtol=1e-12)
 
 

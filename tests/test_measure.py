@@ -3,7 +3,6 @@
 import pytest
 
 from stochpound.motions import Measure
-from stochpound.store import describe_measure
 
 
 @pytest.mark.parametrize("entry", [
@@ -26,7 +25,7 @@ def test_the_names_are_the_ones_tables_and_reports_print():
     avg = Measure.of("sa_avg", [0.5, 1.0, 2.0, 4.0], 0.05)
     assert (avg.label, avg.description) == ("Sa_avg(0.5-4 s)", "Sa_avg(0.5-4 s, 4 periods, 5 % damping)")
     assert (Measure("pga").label, Measure("pgv").description, str(psa)) == ("PGA", "PGV", "PSA(1 s)")
-    assert describe_measure({"measure": "psa", "period": 3.0, "damping": 0.05}) == "PSA(T = 3 s, 5 % damping)"
+    assert Measure.from_entry({"measure": "psa", "period": 3.0, "damping": 0.05}).description == "PSA(T = 3 s, 5 % damping)"
 
 
 @pytest.mark.parametrize("entry, message", [

@@ -24,7 +24,7 @@ import stochpound.hazard
 import stochpound.risk
 from stochpound._memory import LIMIT_VARIABLE, MemoryLimitError
 from stochpound.cli._risk import risk as risk_command
-from stochpound.hazard import hazard_option, read_hazard_file
+from stochpound.hazard import StatedMeasure, hazard_option, read_hazard_file
 from stochpound.risk import HazardCurve, StoreRisk, limit_state_events, risk_curve, risk_targeted_separation, stripe_fragility
 from stochpound.risk._chain import bootstrap_bytes, bound_beyond_stripes, check_bootstrap
 from stochpound.risk._stripe_coverage import top_capped_maf
@@ -130,7 +130,7 @@ def test_probabilities_above_one_are_refused_as_per_cent(tmp_path, extrapolate):
     with pytest.raises(ValueError, match=r"^percent\.csv: poe: 3 value\(s\) above 1 \(largest 63\): these look like per cent"):
         read_hazard_file(path)
     with pytest.raises(ValueError, match=r"^--hazard\.file: percent\.csv: poe: 3 value\(s\) above 1 .* look like per cent"):
-        hazard_option(str(path), {"measure": "pga", "units": "g"}, 9.81, extrapolate=extrapolate)
+        hazard_option(str(path), Measure("pga"), "g", 9.81, extrapolate=extrapolate)
     path.write_text("# Measure: PGA in g\n# Investigation time: 50\nim,poe\n0.1,0.63\n0.3,0.1\n0.6,0.02\n1.0,0.005\n")
     assert read_hazard_file(path).values.max() == 0.63
 
@@ -139,21 +139,21 @@ def test_the_hazard_errors_name_only_options_of_stochpound_risk(tmp_path):
     options = {name for parameter in risk_command.params for name in parameter.opts if name.startswith("--")}
     bare = tmp_path / "bare.csv"
     bare.write_text("im,poe\n0.1,0.5\n0.5,0.1\n1.0,0.02\n")
-    psa = {"measure": "psa", "period": 1.0, "damping": 0.05, "units": "g"}
+    psa = Measure("psa", 1.0, damping=0.05)
     cases = [({"measure": "psa", "units": "g"}, "--hazard-measure: not stated: bare.csv does not give its curve's period"),
              ({"measure": "psa", "period": 1.0, "units": "g"}, "--hazard-measure: not stated: bare.csv does not give its curve's damping"),
              ({"measure": "psa", "period": 2.0, "damping": 0.05, "units": "g"}, "--hazard-measure: the hazard's measure must be"),
              ({"measure": "psa", "period": 1.0, "damping": 0.05, "units": "g"}, "--investigation-time: the values are probabilities")]
     for stated, start in cases:
         with pytest.raises(ValueError) as error:
-            hazard_option(str(bare), psa, 9.81, stated=stated)
+            hazard_option(str(bare), psa, "g", 9.81, stated=StatedMeasure.from_entry(stated))
         message = str(error.value)
         assert message.startswith(start), message
         assert set(re.findall(r"--[a-z-]+", message)) <= options, message
     header = tmp_path / "stated.csv"
     header.write_text("# Measure: PSA(1.0 s, 5 %) in g\nim,rate\n0.1,0.02\n0.5,0.002\n1.0,0.0004\n")
     with pytest.raises(ValueError, match=r"^--hazard-measure: period 2\.0, but stated\.csv states period = 1\.0"):
-        hazard_option(str(header), {**psa, "period": 2.0}, 9.81, stated={"period": 2.0})
+        hazard_option(str(header), Measure("psa", 2.0, damping=0.05), "g", 9.81, stated=StatedMeasure(period=2.0))
 
 
 def test_read_hazard_file_is_given_by_the_risk_package():

@@ -32,6 +32,7 @@ from stochpound import open_store
 from stochpound.risk import HazardCurve, StoreRisk, contact_free_closure, pounding_fragility, risk_gaps, store_demands, store_risk
 from stochpound.cli import main
 from stochpound.hazard._setting import hazard_curve, stored_hazard
+from stochpound.store import Hazard
 from stochpound.experiment._runner import load_experiment, run_experiment
 from stochpound.experiment._spec import ExperimentError, load_definition, parse_experiment
 from stochpound.store import definition_sha256
@@ -89,14 +90,14 @@ def test_hazard_is_carried_in_the_definition(tmp_path):
     assert entry["source"] == "bundled" and entry["measure"] == "psa" and entry["period"] == 1.0 and entry["units"] == "g"
     assert entry["im"] == list(bundled.im) and entry["rate"] == list(bundled.rate) and "Fox Plaza" in entry["provenance"]
     x = np.geomspace(0.02, 1.9, 25)
-    np.testing.assert_array_equal(hazard_curve(entry)(x), bundled(x))
+    np.testing.assert_array_equal(hazard_curve(Hazard.from_entry(entry))(x), bundled(x))
     (tmp_path / "site.csv").write_text("# my site\n# Measure: PSA(1.0 s, 5 %) in g\nim,rate\n0.1,0.02\n0.5,0.002\n1.0,0.0004\n2.0,0.00005\n")
     entry = _parse('file = "site.csv"', base_dir=tmp_path)["hazard"]
     assert entry["file"] == "site.csv" and entry["rate"] == [0.02, 0.002, 0.0004, 0.00005]
     assert entry["provenance"] == "my site\nMeasure: PSA(1.0 s, 5 %) in g"
     assert len(entry["file_sha256"]) == 64
     entry = _parse("power_law = { k0 = 2.0e-4, k = 2.2 }\nmeasure = \"psa\"\nperiod = 1.0")["hazard"]
-    assert hazard_curve(entry)(0.5) == pytest.approx(2.0e-4 * 0.5**-2.2, rel=1e-12) and "im" not in entry
+    assert hazard_curve(Hazard.from_entry(entry))(0.5) == pytest.approx(2.0e-4 * 0.5**-2.2, rel=1e-12) and "im" not in entry
 
 
 @pytest.mark.parametrize(
@@ -140,7 +141,7 @@ def test_the_flagship_experiments_use_the_bundled_hazard_in_their_measure():
         assert intensity["measure"] == "psa" and intensity["period"] in (1.0, 2.0, 3.0)
         assert definition["hazard"]["bundled"] == f"fox_plaza_los_angeles_sa{intensity['period']:.0f}p0s"  # the curve of its measure
         levels = intensity["levels"]
-        hz = hazard_curve(definition["hazard"])
+        hz = hazard_curve(Hazard.from_entry(definition["hazard"]))
         two_percent = float(hz.intensity_at(-np.log(0.98) / 50))
         assert len(levels) >= 7 and max(levels) >= 1.5 * two_percent * 0.999
         assert min(abs(np.log(np.array(levels) / two_percent))) < 1e-3 and min(abs(np.log(np.array(levels) / hz.intensity_at(-np.log(0.9) / 50)))) < 1e-3

@@ -50,8 +50,9 @@ def _limit_states(path: Path) -> tuple:
 def _design(path: Path) -> Design | None:
     """The buildings' code design of a TOML file's ``[design]`` table (the experiment file's table, docs/experiments.md)."""
     from stochpound.experiment import parse_design
+    from stochpound.store import TomlTable
 
-    return parse_design(_toml_table(path, "design", "docs/experiments.md"))
+    return parse_design(TomlTable(_toml_table(path, "design", "docs/experiments.md")))
 
 
 def _check_csv(csv_dir: Path, inputs: list[tuple[str | Path, str]]) -> None:

@@ -35,7 +35,7 @@ from stochpound.experiment._rare_event_table import RareEventDefinition, RareEve
 from stochpound.experiment._design_table import parse_design  # noqa: F401
 from stochpound.experiment._ensemble import simulate_ensemble  # noqa: F401
 from stochpound.experiment._estimate import LARGE_RUN_BYTES, LARGE_RUN_CASES  # noqa: F401
-from stochpound.store import CASE, describe_measure  # noqa: F401
+from stochpound.store import CASE  # noqa: F401
 from stochpound.experiment._measure_choice import hazard_measures, measure_choice  # noqa: F401
 from stochpound.experiment._parts import parts_folder, read_experiment_json  # noqa: F401
 from stochpound.experiment._site import periods_of_interest  # noqa: F401

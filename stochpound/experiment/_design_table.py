@@ -22,11 +22,7 @@ No run depends on it, so it is not part of the experiment's identity
 
 from __future__ import annotations
 
-from typing import Any, Mapping
-
-from stochpound._errors import SceneError
-from stochpound.model import fields as toml_fields
-from stochpound.store import Design, DesignEc8
+from stochpound.store import Design, DesignEc8, TomlTable
 
 ASCE7_FIELDS = ("sds", "sd1", "tl", "r", "cd", "omega0", "ie")
 """The ASCE 7-16 fields of ``[design]``."""
@@ -37,13 +33,13 @@ _LIMITS = {"sds": (0.0, 5.0), "sd1": (0.0, 5.0), "tl": (0.0, 20.0), "r": (1.0, 1
            "ie": (1.0, 1.5), "sm1": (0.0, 5.0), "ag": (0.0, 2.0), "q": (1.0, 8.0)}
 
 
-def parse_design(data: Mapping[str, Any]) -> Design | None:
+def parse_design(file: TomlTable) -> Design | None:
     """The ``[design]`` table of a definition, typed (None without a ``[design]`` table).
 
     Parameters
     ----------
-    data : mapping
-        The parsed experiment file.
+    file : TomlTable
+        The parsed experiment file (its top level).
 
     Returns
     -------
@@ -56,29 +52,26 @@ def parse_design(data: Mapping[str, Any]) -> Design | None:
     SceneError
         A field missing, unknown or out of its range, named with the range.
     """
-    design = toml_fields.table(data, "design", "")
+    design = file.table("design", {*ASCE7_FIELDS, "sm1", "ec8"})
     if design is None:
         return None
-    toml_fields.reject_unknown(design, {*ASCE7_FIELDS, "sm1", "ec8"}, "design")
-    asce7 = [_number(design, name, "design", required=name not in _DEFAULTS) for name in ASCE7_FIELDS]
-    sm1 = _number(design, "sm1", "design", required=True) if "sm1" in design else None
-    return Design(*asce7, sm1=sm1, ec8=_ec8(design))
+    asce7 = [_number(design, name) for name in ASCE7_FIELDS]
+    return Design(*asce7, sm1=_number(design, "sm1", optional=True), ec8=_ec8(design.table("ec8", {"ag", "ground", "q"})))
 
 
-def _ec8(design: Mapping[str, Any]) -> DesignEc8 | None:
+def _ec8(ec8: TomlTable | None) -> DesignEc8 | None:
     """The ``ec8`` part of ``[design]`` (None when absent)."""
-    ec8 = toml_fields.table(design, "ec8", "design")
-    if ec8 is not None:
-        toml_fields.reject_unknown(ec8, {"ag", "ground", "q"}, "design.ec8")
-        ground = toml_fields.string(ec8, "ground", "design.ec8")
-        if ground not in EC8_GROUNDS:
-            raise SceneError(f"design.ec8.ground: must be one of {', '.join(EC8_GROUNDS)}, got {ground!r}")
-        return DesignEc8(_number(ec8, "ag", "design.ec8", required=True), ground, _number(ec8, "q", "design.ec8", required=True))
-    return None
+    if ec8 is None:
+        return None
+    ground = ec8.string("ground", choices=EC8_GROUNDS)
+    return DesignEc8(_number(ec8, "ag"), ground, _number(ec8, "q"))
 
 
-def _number(table: Mapping[str, Any], name: str, prefix: str, required: bool) -> float:
+def _number(table: TomlTable, name: str, optional: bool = False) -> float | None:
+    """A design number within its range (:data:`_LIMITS`, open at 0): its default (:data:`_DEFAULTS`) or None when absent and
+    ``optional``, else required."""
     low, high = _LIMITS[name]
-    value = toml_fields.number(table, name, prefix, default=_DEFAULTS.get(name), required=required, low=low,
-                               low_open=low == 0.0, high=high)
-    return float(value)
+    limits = {"low": low, "low_open": low == 0.0, "high": high}
+    if name in _DEFAULTS or optional:
+        return table.number(name, _DEFAULTS.get(name), **limits)
+    return table.number(name, **limits)

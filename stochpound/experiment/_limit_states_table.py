@@ -14,21 +14,21 @@ No run depends on it, so it is not part of the experiment's identity
 
 from __future__ import annotations
 
-from typing import Any, Mapping, Sequence
+from collections.abc import Sequence
+from typing import Any
 
 from stochpound._errors import SceneError
-from stochpound.model import fields as toml_fields
 from stochpound.risk import limit_state_problem
-from stochpound.store import LIMIT_STATE_DEMANDS, LimitStateCapacities, LimitStates
+from stochpound.store import LIMIT_STATE_DEMANDS, LimitStateCapacities, LimitStates, TomlTable
 
 
-def parse_limit_states(data: Mapping[str, Any], buildings: Sequence[str]) -> LimitStates | None:
+def parse_limit_states(file: TomlTable, buildings: Sequence[str]) -> LimitStates | None:
     """The ``[limit_states]`` table of a definition, typed (None without a ``[limit_states]`` table).
 
     Parameters
     ----------
-    data : mapping
-        The parsed experiment file.
+    file : TomlTable
+        The parsed experiment file (its top level).
     buildings : sequence of str
         The scene's building names.
 
@@ -42,24 +42,26 @@ def parse_limit_states(data: Mapping[str, Any], buildings: Sequence[str]) -> Lim
     SceneError
         An unknown kind or building, or a capacity that is not a number > 0, named with the field.
     """
-    table = toml_fields.table(data, "limit_states", "")
+    table = file.table("limit_states")
     if table is None:
         return None
-    source = toml_fields.string(table, "source", "limit_states") if "source" in table else None
+    source = table.string("source", None)
     states: list[LimitStateCapacities] = []
-    for kind, value in table.items():
+    for kind in table:
         if kind == "source":
             continue
-        where = f"limit_states.{kind}"
         if kind not in LIMIT_STATE_DEMANDS:
-            raise SceneError(f"{where}: not a limit state; one of {', '.join(LIMIT_STATE_DEMANDS)} (or source)")
-        if isinstance(value, Mapping):
-            for building in value:
-                if building not in buildings:
-                    raise SceneError(f"{where}.{building}: unknown building (buildings: {', '.join(buildings)})")
-            states += [LimitStateCapacities(kind, _capacities(kind, values, f"{where}.{building}", building), building) for building, values in value.items()]
-        else:
-            states.append(LimitStateCapacities(kind, _capacities(kind, value, where)))
+            raise table.error(kind, f"not a limit state; one of {', '.join(LIMIT_STATE_DEMANDS)} (or source)")
+        value = table.raw(kind)
+        if not isinstance(value, dict):
+            states.append(LimitStateCapacities(kind, _capacities(kind, value, table.field(kind))))
+            continue
+        by_building = TomlTable(value, table.field(kind))
+        for building in by_building:
+            if building not in buildings:
+                raise by_building.error(building, f"unknown building (buildings: {', '.join(buildings)})")
+        states += [LimitStateCapacities(kind, _capacities(kind, by_building.raw(building), by_building.field(building), building), building)
+                   for building in by_building]
     if not states:
         raise SceneError(f"limit_states: give at least one limit state ({', '.join(LIMIT_STATE_DEMANDS)})")
     return LimitStates(source, tuple(states))

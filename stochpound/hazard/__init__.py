@@ -21,7 +21,7 @@ imports none of them.
 """
 
 from stochpound.hazard._curve import HazardCurve, bundled_curves, bundled_measure, bundled_site_curves, probability_from_rate, rate_from_probability, return_period
-from stochpound.hazard._files import HazardFile, StatedMeasure, parse_measure, parse_units, read_hazard_file
+from stochpound.hazard._files import HazardFile, StatedMeasure, parse_units, read_hazard_file
 from stochpound.hazard._consistency import hazard_consistency, stripe_rate_weights
 from stochpound.hazard._ruptures import RUPTURE_COLUMNS, RuptureSite, bundled_rupture_sites
 from stochpound.hazard._scenario import scenario_hazard
@@ -41,7 +41,6 @@ __all__ = [
     "HazardFile",
     "StatedMeasure",
     "read_hazard_file",
-    "parse_measure",
     "parse_units",
     "hazard_consistency",
     "stripe_rate_weights",

@@ -99,7 +99,7 @@ class StatedMeasure:
         ValueError
             Naming ``measure`` or ``units``: no measure stochpound knows, an average spectral acceleration, unknown units.
         """
-        return cls.from_entry(_parsed(text))
+        return _parsed(text)
 
     @classmethod
     def of(cls, measure: Measure, units: str | None = None) -> StatedMeasure:
@@ -244,46 +244,31 @@ def parse_units(text: str) -> str:
     return _UNIT_ALIASES[key]
 
 
-def parse_measure(text: str) -> dict[str, Any]:
-    """:meth:`StatedMeasure.parse` as the keys it finds among ``measure``, ``period`` (s), ``damping`` (ratio), ``units``
-    (:meth:`StatedMeasure.entry`), for the callers that merge them with other stated keys.
-
-    >>> parse_measure("5 %-damped spectral acceleration at T = 1.0 s, in g")
-    {'measure': 'psa', 'period': 1.0, 'damping': 0.05, 'units': 'g'}
-    """
-    return StatedMeasure.parse(text).entry()
-
-
-def _parsed(text: str) -> dict[str, Any]:
-    """The keys :meth:`StatedMeasure.parse` finds in ``text``."""
+def _parsed(text: str) -> StatedMeasure:
+    """What :meth:`StatedMeasure.parse` finds in ``text``."""
     lowered = text.strip().lower()
-    found: dict[str, Any] = {}
     units = re.search(r"(?:\bin|,)\s*(g|m/s2|m/s²|m/s/s|cm/s2|cm/s²|cm/s/s|gal|m/s|cm/s)\s*\.?$", lowered)
     body = lowered[:units.start()] if units else lowered
     tool = re.fullmatch(r"\s*sa(\d+)p(\d+)\s*", body)
     if tool:
-        return {"measure": "psa", "period": float(f"{tool.group(1)}.{tool.group(2)}")}
+        return StatedMeasure("psa", float(f"{tool.group(1)}.{tool.group(2)}"))
     if re.search(r"average|sa_avg|saavg", body):
         raise ValueError(f"measure: {text!r}: an average spectral acceleration is not read from a file; "
                          "state measure = \"sa_avg\", periods and damping in [hazard]")
+    period = None
     if re.search(r"\bpga\b|peak ground acceleration", body):
-        found["measure"] = "pga"
+        kind = "pga"
     elif re.search(r"\bpgv\b|peak ground velocity", body):
-        found["measure"] = "pgv"
+        kind = "pgv"
     elif re.search(r"\bp?sa\b|\bp?sa\(|spectral acceleration", body):
-        found["measure"] = "psa"
-        period = (re.search(rf"\bt\s*=\s*{_NUMBER}\s*s", body) or re.search(rf"\bp?sa\s*\(\s*{_NUMBER}", body)
-                  or re.search(rf"{_NUMBER}\s*s\b", body))
-        if period:
-            found["period"] = float(period.group(1))
+        kind = "psa"
+        found = (re.search(rf"\bt\s*=\s*{_NUMBER}\s*s", body) or re.search(rf"\bp?sa\s*\(\s*{_NUMBER}", body)
+                 or re.search(rf"{_NUMBER}\s*s\b", body))
+        period = float(found.group(1)) if found else None
     else:
         raise ValueError(f"measure: {text!r} names no measure stochpound knows (PGA, PGV, PSA/SA(T))")
     damping = re.search(rf"{_NUMBER}\s*%", body)
-    if damping:
-        found["damping"] = float(damping.group(1)) / 100.0
-    if units:
-        found["units"] = parse_units(units.group(1))
-    return found
+    return StatedMeasure(kind, period, (), float(damping.group(1)) / 100.0 if damping else None, parse_units(units.group(1)) if units else None)
 
 
 def read_hazard_file(path: str | Path, *, site: int | str | None = None) -> HazardFile:
@@ -331,7 +316,7 @@ def _checked(curve: HazardFile) -> HazardFile:
 
 
 def _stochpound(path: Path, lines: list[str]) -> HazardFile:
-    comments, header, rows, stated = [], None, [], {}
+    comments, header, rows, stated = [], None, [], StatedMeasure()
     years = None
     for number, line in enumerate(lines, start=1):
         text = line.strip()
@@ -341,9 +326,10 @@ def _stochpound(path: Path, lines: list[str]) -> HazardFile:
             key, _, value = comment.partition(":")
             key = key.strip().lower()
             if key == "measure":
-                stated.update(_parsed(value))
+                measure_line = _parsed(value)
+                stated = replace(measure_line, units=measure_line.units or stated.units)
             elif key == "units":
-                stated["units"] = parse_units(value)
+                stated = replace(stated, units=parse_units(value))
             elif key == "investigation time":
                 years = _years(value)
             continue
@@ -358,7 +344,7 @@ def _stochpound(path: Path, lines: list[str]) -> HazardFile:
         raise ValueError("no rows of 'im, value'")
     quantity = _quantity(header)
     im, values = (np.asarray(column, dtype=float) for column in zip(*rows))
-    return HazardFile(im, values, quantity, years, StatedMeasure.from_entry(stated), "stochpound", "\n".join(comments) or path.name)
+    return HazardFile(im, values, quantity, years, stated, "stochpound", "\n".join(comments) or path.name)
 
 
 def _quantity(header: list[str] | None) -> str:

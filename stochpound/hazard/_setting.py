@@ -42,8 +42,10 @@ from __future__ import annotations
 
 import hashlib
 import math
+from dataclasses import replace
 from pathlib import Path
-from typing import Any, Mapping, Sequence
+from collections.abc import Sequence
+from typing import Any
 
 import xarray as xr
 
@@ -52,8 +54,8 @@ from stochpound.hazard._curve import BUNDLED_UNITS, HazardCurve, bundled_curves,
 from stochpound.hazard._files import StatedMeasure, parse_units, read_hazard_file, unit_factor
 from stochpound.hazard._ruptures import SITE_FIELDS as RUPTURE_SITE_FIELDS, named_rupture_site
 from stochpound.motions import Measure
-from stochpound.store import MEASURES, Hazard, Intensity
-from stochpound.model import fields as toml_fields
+from stochpound.store import MEASURES, Hazard, Intensity, TomlTable
+from stochpound.model.fields import is_number
 from stochpound.motions import DEFAULT_G
 
 SOURCES = ("file", "bundled", "power_law", "ruptures")
@@ -61,18 +63,17 @@ SOURCES = ("file", "bundled", "power_law", "ruptures")
 STATED = ("measure", "period", "periods", "damping", "units", "investigation_time")
 """The ``[hazard]`` fields (and ``stochpound risk`` options) that state what a file's curve is of, when the file does not."""
 _KEYS = {*SOURCES, *STATED, "site", "extrapolate", *RUPTURE_SITE_FIELDS}
-_MATCHED = ("measure", "period", "periods", "damping")
 _REQUIRED = {"pga": ("units",), "pgv": ("units",), "psa": ("period", "damping", "units"), "sa_avg": ("periods", "damping", "units")}
 _TOLERANCE = 1e-9
 
 
-def parse_hazard(data: Mapping[str, Any], intensity: Intensity | None, base_dir: Path, g: float = DEFAULT_G) -> Hazard | None:
+def parse_hazard(file: TomlTable, intensity: Intensity | None, base_dir: Path, g: float = DEFAULT_G) -> Hazard | None:
     """The ``[hazard]`` table of a definition, typed (None without a ``[hazard]`` table).
 
     Parameters
     ----------
-    data : mapping
-        The parsed experiment file.
+    file : TomlTable
+        The parsed experiment file (its top level).
     intensity : Intensity or None
         The ``[intensity]`` setting (a hazard needs one).
     base_dir : Path
@@ -97,10 +98,9 @@ def parse_hazard(data: Mapping[str, Any], intensity: Intensity | None, base_dir:
         a measure or units the file and ``[hazard]`` both leave unstated or
         state differently, a curve that misses the stripes.
     """
-    table = toml_fields.table(data, "hazard", "")
+    table = file.table("hazard", _KEYS)
     if table is None:
         return None
-    toml_fields.reject_unknown(table, _KEYS, "hazard")
     if intensity is None:
         raise IntensityError("hazard: needs an [intensity] table (the hazard is a curve of its measure, in the units of its levels)")
     given = [key for key in SOURCES if key in table]
@@ -110,29 +110,28 @@ def parse_hazard(data: Mapping[str, Any], intensity: Intensity | None, base_dir:
     for key in RUPTURE_SITE_FIELDS:
         if key in table and source != "ruptures":
             raise IntensityError(f"hazard.{key}: only with ruptures = ... (the site of a rupture table)")
-    extrapolate = toml_fields.boolean(table, "extrapolate", "hazard", default=False)
+    extrapolate = table.boolean("extrapolate", default=False)
     measure, units = intensity.measure, intensity.units
-    stated = _stated_fields(table)
-    matched = {key: stated[key] for key in _MATCHED if key in stated}
+    stated, investigation_time = _stated_fields(table), table.number("investigation_time", None, low=0.0, low_open=True)
     sources: dict[str, str] = {}
     power_law = None
     if source == "bundled":
-        sources["bundled"] = toml_fields.string(table, "bundled", "hazard")
+        sources["bundled"] = table.string("bundled")
         curve = _bundled(sources["bundled"], measure, units, g, extrapolate, "hazard.bundled")
     elif source == "file":
-        name = toml_fields.string(table, "file", "hazard")
+        name = table.string("file")
         path = base_dir / name
         if not path.is_file():
             raise IntensityError(f"hazard.file: {name!r} not found (a hazard-curve file, relative to the experiment file)")
-        curve = _read(path, stated, table.get("site"), measure, units, g, extrapolate, "hazard")
+        curve = _read(path, stated, investigation_time, table.raw("site"), measure, units, g, extrapolate, "hazard")
         sources.update(file=name, file_sha256=hashlib.sha256(path.read_bytes()).hexdigest())
     elif source == "ruptures":
-        _check_measure("hazard", matched, measure)
+        _check_measure("hazard", stated, measure)
         curve = _rupture_curve(table, measure, units, base_dir, g, extrapolate)
-        sources["ruptures"] = table["ruptures"]
+        sources["ruptures"] = table.raw("ruptures")
     else:
-        _check_measure("hazard", matched, measure)
-        power_law = _power_law(table["power_law"], stated.get("units", units), units, g)
+        _check_measure("hazard", stated, measure)
+        power_law = _power_law(table.table("power_law", {"k0", "k"}, hint="{ k0 = ..., k = ... } (rate = k0 x^-k, 1/yr)"), stated.units or units, units, g)
         curve = HazardCurve.power_law(**power_law)
     if curve.power is None and intensity.ran == "stripes":
         check_covers(curve, intensity.levels, "hazard", "intensity.levels", "extrapolate = true")
@@ -140,13 +139,13 @@ def parse_hazard(data: Mapping[str, Any], intensity: Intensity | None, base_dir:
     return Hazard(source, measure, units, extrapolate, curve.source, *table_values, power_law=power_law, **sources)
 
 
-def _rupture_curve(table: Mapping[str, Any], measure: Measure, units: str, base_dir: Path, g: float, extrapolate: bool) -> HazardCurve:
+def _rupture_curve(table: TomlTable, measure: Measure, units: str, base_dir: Path, g: float, extrapolate: bool) -> HazardCurve:
     """The hazard curve of ``[intensity]``'s measure from the site of ruptures ``[hazard]`` names, in the levels' units."""
     from stochpound._errors import SiteError
 
-    given = {key: table[key] for key in RUPTURE_SITE_FIELDS if key in table}
+    given = {key: table.raw(key) for key in RUPTURE_SITE_FIELDS if key in table}
     try:
-        site = named_rupture_site(table["ruptures"], base_dir, given, "hazard")
+        site = named_rupture_site(table.raw("ruptures"), base_dir, given, "hazard")
         if measure.damping is not None and measure.damping != 0.05:
             raise SiteError(f"hazard.ruptures: the NGA-West2 models give 5 % damped spectra only; intensity.damping is {measure.damping!r}")
         curve = site.hazard_curve(measure.kind, measure.spectral_period, extrapolate=extrapolate)
@@ -158,14 +157,11 @@ def _rupture_curve(table: Mapping[str, Any], measure: Measure, units: str, base_
                        source=f"{curve.source}; {site.source}" if site.source else curve.source)
 
 
-def hazard_curve(hazard: Hazard | Mapping[str, Any], extrapolate: bool | None = None) -> HazardCurve:
+def hazard_curve(hazard: Hazard, extrapolate: bool | None = None) -> HazardCurve:
     """The :class:`~stochpound.analysis.HazardCurve` of a store's hazard (from its stored values, not its file).
 
-    ``hazard`` is the typed :class:`~stochpound.store.Hazard` or its canonical entry; ``extrapolate`` overrides
-    its own (``stochpound risk --extrapolate``).
+    ``extrapolate`` overrides the hazard's own (``stochpound risk --extrapolate``).
     """
-    if not isinstance(hazard, Hazard):
-        hazard = Hazard.from_entry(hazard)
     description = {"measure": hazard.description, "units": hazard.units, "source": hazard.provenance}
     if hazard.power_law is not None:
         return HazardCurve.power_law(**hazard.power_law, **description)
@@ -185,60 +181,57 @@ def check_covers(curve: HazardCurve, levels: Sequence[float], where: str, what: 
                              "to extend it as power laws (stated in the report)")
 
 
-def _stated_fields(table: Mapping[str, Any]) -> dict[str, Any]:
-    """What ``[hazard]`` states of its curve: measure, period(s), damping, units, investigation time."""
-    stated: dict[str, Any] = {}
-    if "measure" in table:
-        stated["measure"] = toml_fields.string(table, "measure", "hazard")
-        if stated["measure"] not in MEASURES:
-            raise IntensityError(f"hazard.measure: must be one of {', '.join(MEASURES)}, got {stated['measure']!r}")
-    for key in ("period", "investigation_time"):
-        if key in table:
-            stated[key] = toml_fields.number(table, key, "hazard", required=True, low=0.0, low_open=True)
-    if "damping" in table:
-        stated["damping"] = toml_fields.number(table, "damping", "hazard", required=True, low=0.0, high=1.0, high_open=True)
-    if "periods" in table:
-        stated["periods"] = table["periods"]
-    if "units" in table:
-        try:
-            stated["units"] = parse_units(toml_fields.string(table, "units", "hazard"))
-        except ValueError as error:
-            raise IntensityError(f"hazard.{error}") from None
-    return stated
+def _stated_fields(table: TomlTable) -> StatedMeasure:
+    """What ``[hazard]`` states of its curve's measure: measure, period(s), damping, units (each None when not stated)."""
+    kind = table.string("measure", None, choices=MEASURES)
+    period = table.number("period", None, low=0.0, low_open=True)
+    damping = table.number("damping", None, low=0.0, high=1.0, high_open=True)
+    periods = table.numbers("periods", (), low=0.0, low_open=True)
+    units = table.string("units", None)
+    try:
+        return StatedMeasure(kind, period, periods, damping, None if units is None else parse_units(units))
+    except ValueError as error:
+        raise IntensityError(f"hazard.{error}") from None
 
 
-def _read(path: Path, given: Mapping[str, Any], site: Any, measure: Measure, units: str, g: float, extrapolate: bool, where: str) -> HazardCurve:
+def _read(path: Path, given: StatedMeasure, investigation_time: float | None, site: Any, measure: Measure, units: str, g: float,
+          extrapolate: bool, where: str) -> HazardCurve:
     """A hazard file's curve, its measure (the file's, completed by ``given``) checked against ``measure``, converted to ``units`` and to rates."""
     try:
         read = read_hazard_file(path, site=site)
     except (ValueError, UnicodeDecodeError) as error:
         raise IntensityError(f"{where}.file: {error}") from None
-    stated = read.stated.entry()
-    for key, value in given.items():
-        if key == "investigation_time":
-            if read.investigation_time is not None and not _equal(value, read.investigation_time):
-                raise IntensityError(f"{_field(where, key)}: {value!r} years, but {path.name} states {read.investigation_time:g} years")
-            continue
-        if key in stated and not _equal(value, stated[key]):
-            named = "" if _field(where, key).endswith(key) else f"{key} "
-            raise IntensityError(f"{_field(where, key)}: {named}{value!r}, but {path.name} states {key} = {stated[key]!r}")
-        stated[key] = value
-    if "measure" not in stated:
+    if investigation_time is not None and read.investigation_time is not None and not _equal(investigation_time, read.investigation_time):
+        raise IntensityError(f"{_field(where, 'investigation_time')}: {investigation_time!r} years, but {path.name} states "
+                             f"{read.investigation_time:g} years")
+    read.stated = _completed(read.stated, given, path.name, where)
+    if read.stated.kind is None:
         raise IntensityError(f"{_field(where, 'measure')}: not stated: {path.name} does not say which measure its curve is of "
                              "(a '# Measure:' line, e.g. '# Measure: 5 %-damped spectral acceleration at T = 1.0 s, in g'); state it")
-    for key in _REQUIRED.get(stated["measure"], ()):
+    stated = read.stated.entry()
+    for key in _REQUIRED.get(read.stated.kind, ()):
         if key not in stated:
             example = " (e.g. 'PSA(1.0 s, 5 %) in g')" if key in ("period", "damping") and where.startswith("--") else ""
             raise IntensityError(f"{_field(where, key)}: not stated: {path.name} does not give its curve's {key}; state it{example}")
-    _check_measure(where, {key: stated[key] for key in _MATCHED if key in stated}, measure)
-    read.stated = StatedMeasure.from_entry(stated)
+    _check_measure(where, read.stated, measure)
     try:
-        return read.curve(units, g, investigation_time=given.get("investigation_time"), extrapolate=extrapolate, description=measure.description)
+        return read.curve(units, g, investigation_time=investigation_time, extrapolate=extrapolate, description=measure.description)
     except ValueError as error:
         message = str(error)
         if message.startswith("investigation_time:"):
             raise IntensityError(f"{_field(where, 'investigation_time')}{message.removeprefix('investigation_time')}") from None
         raise IntensityError(f"{where}.file: {path.name}: {message}") from None
+
+
+def _completed(file: StatedMeasure, given: StatedMeasure, name: str, where: str) -> StatedMeasure:
+    """What the file ``name`` states of its measure, completed by what ``given`` states; a part both state differently is an error."""
+    stated = file.entry()
+    for key, value in given.entry().items():
+        if key in stated and not _equal(value, stated[key]):
+            named = "" if _field(where, key).endswith(key) else f"{key} "
+            raise IntensityError(f"{_field(where, key)}: {named}{value!r}, but {name} states {key} = {stated[key]!r}")
+        stated[key] = value
+    return StatedMeasure.from_entry(stated)
 
 
 _OPTIONS = {"measure": "{where}-measure", "period": "{where}-measure", "periods": "{where}-measure", "damping": "{where}-measure",
@@ -256,19 +249,18 @@ def _bundled(name: str, measure: Measure, units: str, g: float, extrapolate: boo
     """A bundled curve, its measure (from its name) checked against ``measure``, converted to ``units``."""
     if name not in bundled_curves():
         raise IntensityError(f"{where}: no bundled hazard curve {name!r} (bundled: {', '.join(bundled_curves())})")
-    stated = bundled_measure(name)
-    _check_measure(where, stated.entry(), measure, bundled=name)
     read = read_hazard_file(bundled_path(name))
-    read.stated = StatedMeasure.of(stated, BUNDLED_UNITS)
+    read.stated = StatedMeasure.of(bundled_measure(name), BUNDLED_UNITS)
+    _check_measure(where, read.stated, measure, bundled=name)
     return read.curve(units, g, extrapolate=extrapolate, description=measure.description)
 
 
-def _check_measure(where: str, stated: Mapping[str, Any], measure: Measure, bundled: str = "") -> None:
-    """Raise unless every stated key of the hazard's measure equals ``[intensity]``'s (units are converted, not matched)."""
+def _check_measure(where: str, stated: StatedMeasure, measure: Measure, bundled: str = "") -> None:
+    """Raise unless every stated part of the hazard's measure equals ``[intensity]``'s (units are converted, not matched)."""
     wanted = measure.entry()
-    for key, value in stated.items():
+    for key, value in replace(stated, units=None).entry().items():
         field = where if bundled else _field(where, key)
-        what = f"{bundled!r} is {Measure.from_entry(stated).description}" if bundled else f"the hazard's {key} is {value!r}"
+        what = f"{bundled!r} is {stated.measure.description}" if bundled else f"the hazard's {key} is {value!r}"
         if key not in wanted or not _equal(value, wanted[key]):
             detail = f" (intensity.{key} = {wanted[key]!r})" if key in wanted else ""
             raise IntensityError(f"{field}: the hazard's measure must be [intensity]'s, {measure.description}{detail}; {what}")
@@ -277,17 +269,14 @@ def _check_measure(where: str, stated: Mapping[str, Any], measure: Measure, bund
 def _equal(a: Any, b: Any) -> bool:
     if isinstance(a, list) and isinstance(b, list):
         return len(a) == len(b) and all(_equal(x, y) for x, y in zip(a, b))
-    if toml_fields.is_number(a) and toml_fields.is_number(b):
+    if is_number(a) and is_number(b):
         return math.isclose(float(a), float(b), rel_tol=_TOLERANCE, abs_tol=0.0)
     return a == b
 
 
-def _power_law(table: Any, units: str, target: str, g: float) -> dict[str, float]:
+def _power_law(table: TomlTable, units: str, target: str, g: float) -> dict[str, float]:
     """``k0`` and ``k`` of λ(x) = k0 x^(−k), k0 converted to x in the levels' units (x in ``units`` → c x in ``target``: k0 c^k)."""
-    if not isinstance(table, dict):
-        raise IntensityError(f"hazard.power_law: must be a table {{ k0 = ..., k = ... }} (rate = k0 x^-k, 1/yr), got {table!r}")
-    toml_fields.reject_unknown(table, {"k0", "k"}, "hazard.power_law")
-    law = {key: toml_fields.number(table, key, "hazard.power_law", required=True, low=0.0, low_open=True) for key in ("k0", "k")}
+    law = {key: table.number(key, low=0.0, low_open=True) for key in ("k0", "k")}
     try:
         factor = unit_factor(units, target, g)
     except ValueError as error:
@@ -303,21 +292,25 @@ def stored_hazard(store: xr.Dataset) -> HazardCurve | None:
     return None if hazard is None else hazard_curve(hazard)
 
 
-def hazard_option(value: str, intensity: Intensity | Mapping[str, Any], g: float = DEFAULT_G, *, stated: Mapping[str, Any] | None = None,
-                  site: Any = None, extrapolate: bool = False, option: str = "--hazard") -> HazardCurve:
-    """A hazard named on the command line: a bundled curve's name or a hazard-curve file, checked against ``intensity``.
+def hazard_option(value: str, measure: Measure, units: str, g: float = DEFAULT_G, *, stated: StatedMeasure | None = None,
+                  investigation_time: float | None = None, site: Any = None, extrapolate: bool = False, option: str = "--hazard") -> HazardCurve:
+    """A hazard named on the command line: a bundled curve's name or a hazard-curve file, checked against the store's measure.
 
     Parameters
     ----------
     value : str
         A bundled curve's name or a hazard-curve file
         (:func:`~stochpound.analysis.read_hazard_file`).
-    intensity : Intensity or mapping
-        The store's intensity setting (or a mapping of its measure's keys and ``units``).
+    measure : Measure
+        The store's intensity measure (its ``[intensity]``'s).
+    units : str
+        The units of the store's intensity levels (the curve's intensities are converted to them).
     g : float
         The store's g (m/s²), for a conversion to or from g.
-    stated : mapping, optional
-        What the options state of the file's curve (keys of :data:`STATED`).
+    stated : StatedMeasure, optional
+        What the options state of the file's curve, where the file does not say (``--hazard-measure``, ``--hazard-units``).
+    investigation_time : float, optional
+        Years of a file of probabilities of exceedance that does not state them (``--investigation-time``).
     site : int or str, optional
         The site of a file of several.
     extrapolate : bool
@@ -329,10 +322,9 @@ def hazard_option(value: str, intensity: Intensity | Mapping[str, Any], g: float
         Neither a bundled name nor a file, an invalid file, a measure other
         than the store's or one nobody states.
     """
-    measure, units = (intensity.measure, intensity.units) if isinstance(intensity, Intensity) else (Measure.from_entry(intensity), intensity["units"])
     if value in bundled_curves():
         return _bundled(value, measure, units, g, extrapolate, option)
     path = Path(value)
     if not path.is_file():
         raise IntensityError(f"{option}: {value!r} is neither a file nor a bundled hazard curve (bundled: {', '.join(bundled_curves())})")
-    return _read(path, stated or {}, site, measure, units, g, extrapolate, option)
+    return _read(path, stated or StatedMeasure(), investigation_time, site, measure, units, g, extrapolate, option)

@@ -26,7 +26,7 @@ import numpy as np
 import xarray as xr
 
 from stochpound.codes import store_contact_demands
-from stochpound.hazard import HazardCurve, check_covers, hazard_curve, hazard_option, parse_measure, parse_units, stored_hazard
+from stochpound.hazard import HazardCurve, check_covers, hazard_curve, hazard_option, parse_units, stored_hazard, StatedMeasure
 from stochpound.model import Scene
 from stochpound.motions import DEFAULT_G, TRUNCATION_EPSILON
 from stochpound.risk._code_rules import MINIMUM_MOTIONS
@@ -216,11 +216,12 @@ def site_hazard(store: xr.Dataset, hazard: str | None = None, option: str = "--h
     setting = intensity_setting(store)
     if setting is None:
         raise RiskInputError(NOT_INTENSITY)
-    stated = _stated(measure, units, investigation_time)
-    if hazard is None and (stated or site is not None):
+    stated = _stated(measure, units)
+    if hazard is None and (stated != StatedMeasure() or investigation_time is not None or site is not None):
         raise RiskInputError(f"{option}-measure, {option}-units, --investigation-time and {option}-site describe a {option} file: give one")
     if hazard is not None:
-        hz = hazard_option(hazard, setting, store.pound.definition.g, stated=stated, site=site, extrapolate=extrapolate, option=option)
+        hz = hazard_option(hazard, setting.measure, setting.units, store.pound.definition.g, stated=stated, investigation_time=investigation_time,
+                           site=site, extrapolate=extrapolate, option=option)
     else:
         entry = store.pound.hazard
         if entry is None:
@@ -232,19 +233,13 @@ def site_hazard(store: xr.Dataset, hazard: str | None = None, option: str = "--h
     return hz
 
 
-def _stated(measure: str | None, units: str | None, investigation_time: float | None) -> dict[str, Any]:
-    """The hazard file's description given beside it (its measure, units, investigation time), parsed."""
-    stated: dict[str, Any] = {}
+def _stated(measure: str | None, units: str | None) -> StatedMeasure:
+    """The hazard file's measure and units given beside it, parsed (parts not given: None)."""
     try:
-        if measure is not None:
-            stated.update(parse_measure(measure))
-        if units is not None:
-            stated["units"] = parse_units(units)
+        stated = StatedMeasure.parse(measure) if measure is not None else StatedMeasure()
+        return dataclasses.replace(stated, units=parse_units(units)) if units is not None else stated
     except ValueError as error:
         raise RiskInputError(f"--hazard-{error}") from None
-    if investigation_time is not None:
-        stated["investigation_time"] = investigation_time
-    return stated
 
 
 def studied_building(store: xr.Dataset) -> str | None:

@@ -50,7 +50,6 @@ from stochpound.store._definition import (
     VariantAxis,
     canonical_json,
     definition_sha256,
-    describe_measure,
     Site,
     read_definition,
     scene_g,
@@ -78,6 +77,7 @@ from stochpound.store._catalogue import CASE, KINDS, REFERENCE  # noqa: F401
 from stochpound.store._definition import MEASURES  # noqa: F401
 from stochpound.store._progress import UnfinishedStoreError, cases_done, check_finished  # noqa: F401
 from stochpound.store._grid import CONDITIONAL_SPECTRUM  # noqa: F401
+from stochpound.store._toml_table import TomlTable  # noqa: F401
 from stochpound.store._scene_edits import apply_overrides, building_names, reference_scene, with_motion  # noqa: F401
 
 __all__ = [
@@ -119,7 +119,6 @@ __all__ = [
     "contact_free",
     "contact_gap_dims",
     "definition_sha256",
-    "describe_measure",
     "fixed_base",
     "gap_dims",
     "has_contact_free",

@@ -86,18 +86,6 @@ def scene_g(scene: Mapping[str, Any]) -> float:
     return float(scene.get("g", DEFAULT_G))
 
 
-def describe_measure(intensity: Mapping[str, Any]) -> str:
-    """An intensity measure in words, e.g. ``PSA(T = 1 s, 5 % damping)`` or ``PGA`` (:attr:`~stochpound.motions.Measure.description`).
-
-    Parameters
-    ----------
-    intensity : mapping
-        ``measure`` (``pga``, ``pgv``, ``psa``, ``sa_avg``) and, for a spectral
-        measure, ``period`` or ``periods`` (s) and ``damping`` (fraction of critical).
-    """
-    return Measure.from_entry(intensity).description
-
-
 _MEASURE_KEYS = ("measure", "period", "periods", "damping")
 _INTENSITY_KEYS = (*_MEASURE_KEYS, "levels", "units", "method", "synthetic", "ran", "note")
 
