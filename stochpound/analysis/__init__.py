@@ -31,6 +31,7 @@ from stochpound.codes import contact_demands, fixed_base_cqc, separation_rules, 
 from stochpound.analysis._subset_simulation import RESPONSES, subset_simulation
 from stochpound.analysis._measure_free import MEASURE_FREE_RESPONSES, measure_free_risk
 from stochpound.analysis._summary import run_summary
+from stochpound.analysis._store_ensemble import StoreEnsemble
 from stochpound.hazard import (
     RUPTURE_COLUMNS,
     HazardCurve,
@@ -95,6 +96,7 @@ __all__ = [
     "store_contact_demands",
     "fixed_base_cqc",
     "run_summary",
+    "StoreEnsemble",
     "subset_simulation",
     "RESPONSES",
     "measure_free_risk",

@@ -232,6 +232,13 @@ class StoreRisk:
         """The dimensions of :meth:`to_frame` that name a configuration (every grid axis but the gap)."""
         return [c for c in self.to_frame().columns if c not in ("target", *_SEPARATION, "lower_bound", "confidence", "motions")]
 
+    def by_configuration(self, frame: pd.DataFrame) -> list[tuple[dict[str, Any], pd.DataFrame]]:
+        """The rows of ``frame`` (:meth:`to_frame`, :meth:`design_frame`) per configuration, in their order: its labels
+        (dimension -> value of :meth:`configuration_dims`; empty for the one configuration of a scene without axes) and its rows."""
+        config = self.configuration_dims()
+        groups = frame.groupby(config, sort=False) if config else [((), frame)]
+        return [(dict(zip(config, labels if isinstance(labels, tuple) else (labels,))), rows) for labels, rows in groups]
+
     def separation_frame(self) -> pd.DataFrame:
         """The g* table: per configuration, g* and its interval (m) for each target (columns grouped by target); a g* that
         is only a lower bound (``stochpound.risk._chain.bound_beyond_stripes``) is the text ``≥ 0.640``, its interval empty."""
@@ -491,6 +498,23 @@ class StoreRisk:
             band = fragility_band(shown, levels, self.confidence)
             curves = curves.assign(lower=band["lower"], upper=band["upper"])
         return curves
+
+    def design_basis(self) -> str:
+        """What the gap to design to is (:meth:`design_frame`'s ``basis`` of its first row with a value): by default the upper
+        bound of g*'s interval."""
+        frame = self.design_frame()
+        given = frame["design"].notna()
+        return str(frame.loc[given, "basis"].iloc[0]) if given.any() else "upper bound of g*'s interval"
+
+    def measure_margin(self, choice: pd.DataFrame, own: str) -> tuple[float, float, int]:
+        """How far the store's own measure ``own`` is from the most efficient one of ``choice`` (the measure choice's table:
+        β per measure and configuration, ``most efficient`` naming the smallest): the largest excess of its β over the
+        smallest, the standard error of one β estimate (about β/√(2(n − 2)), its largest β), and n, the contact-free runs
+        of a configuration (motions × stripes)."""
+        runs = self.motions * (self.stripes or 1)
+        excess = max(float(row[own] - row[row["most efficient"]]) for _, row in choice.iterrows())
+        noise = float(choice[own].max()) / math.sqrt(2.0 * max(runs - 2, 1))
+        return excess, noise, runs
 
     def return_period_range(self) -> tuple[float, float]:
         """The smallest and largest finite return period (yr) over the rules, levels and configurations (NaN without rules)."""

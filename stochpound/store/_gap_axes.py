@@ -88,6 +88,11 @@ def with_walls(data: Data) -> Data:
     return _at_finite(data, wall_gap_dims(data))
 
 
+def walls_only(data: xr.Dataset) -> bool:
+    """Whether a store's only impact elements are walls (no contact): every impact is a wall hit, which has no phase (a wall moves with the ground)."""
+    return data.sizes.get("contact", 0) == 0 and "peak_wall_penetration" in data
+
+
 def _holds_inf(data: xr.Dataset | xr.DataArray, dims: list[str]) -> bool:
     return bool(dims) and all(np.isinf(data[d].values).any() for d in dims)
 

@@ -27,7 +27,7 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from stochpound.analysis import MIN_RUNS, mean_interval, pounding_probability
+from stochpound.analysis import MIN_RUNS
 from stochpound.experiment import is_gap_axis
 from stochpound.model import laws
 from stochpound.report.render import Block, FigureItem, Paragraph, Section, figures
@@ -107,7 +107,7 @@ def laws_section(name: str, store: xr.Dataset) -> Section:
         "in what follows the first impact. " if all(set(o) <= {"contact"} for o in overrides.values()) else "")
     section.add(Paragraph(
         f"The {dim_text(axis)} axis gives the contacts different laws: "
-        + "; ".join(f"{value}: {' / '.join(laws.contact_law(law).title for law in named[value].split('/'))}"
+        + "; ".join(f"{value}: {' / '.join(laws.CONTACT_LAWS[law].title for law in named[value].split('/'))}"
                     for value in map(plain, store[axis].values))
         + f". Methods gives each element's parameters and units. {same_until_contact}Below, every law is drawn in the same "
         "panel; means are "
@@ -124,8 +124,8 @@ def _ensemble_blocks(ensemble: Ensemble, axis: str) -> list[Block]:
     gap = next((d for d in ensemble.grid if is_gap_axis(d)), None)
     others = [d for d in ensemble.grid if d not in (axis, gap)]
     panels = [dict(zip(others, values)) for values in itertools.product(*(ensemble.grid[d] for d in others))]
-    estimates = {"pounding": _pounding(ensemble)}
-    estimates |= {q.variable: _means(ensemble, q) for q in QUANTITIES if q.variable in ensemble.data}
+    estimates = {"pounding": ensemble.pounding()}
+    estimates |= {q.variable: ensemble.means(q.variable, q.factor, q.pounding_only) for q in QUANTITIES if q.variable in ensemble.data}
     blocks: list[Block] = []
     for key, table in estimates.items():
         quantity = next((q for q in QUANTITIES if q.variable == key), None)
@@ -135,24 +135,6 @@ def _ensemble_blocks(ensemble: Ensemble, axis: str) -> list[Block]:
         blocks.append(_figure(ensemble, axis, gap, panels, table, f"{text}{unit}", f"{y_label}{unit}", key))
         blocks.append(Paragraph(_comparison(ensemble, axis, gap, panels, table, text, "" if quantity is None else quantity.unit)))
     return blocks
-
-
-def _pounding(ensemble: Ensemble) -> xr.Dataset:
-    """P(pounding) of every cell: ``estimate``, ``lower``, ``upper``, ``count``."""
-    result = pounding_probability(ensemble.sample("impacts")).compute()
-    return xr.Dataset({"estimate": result["probability"], "lower": result["lower"], "upper": result["upper"], "count": result["realizations"]})
-
-
-def _means(ensemble: Ensemble, quantity: LawQuantity) -> xr.Dataset:
-    """The mean of ``quantity`` in every cell with its percentile-bootstrap interval over the runs
-    (:func:`stochpound.analysis.mean_interval`; NaN from fewer than MIN_RUNS)."""
-    values = ensemble.sample(quantity.variable) * quantity.factor
-    if quantity.pounding_only:
-        values = values.where(ensemble.sample("impacts") > 0)
-    result = mean_interval(values, "realization", method="bootstrap").compute()
-    enough = result["count"] >= MIN_RUNS
-    return xr.Dataset({"estimate": result["mean"].where(enough), "lower": result["lower"].where(enough),
-                       "upper": result["upper"].where(enough), "count": result["count"]})
 
 
 def _figure(ensemble: Ensemble, axis: str, gap: str | None, panels: list[dict[str, Any]], table: xr.Dataset, text: str, y_label: str,
