@@ -31,6 +31,7 @@ from stochpound.codes import contact_demands, fixed_base_cqc, separation_rules, 
 from stochpound.analysis._subset_simulation import RESPONSES, subset_simulation
 from stochpound.analysis._measure_free import MEASURE_FREE_RESPONSES, measure_free_risk
 from stochpound.analysis._summary import run_summary
+from stochpound.analysis._mechanism_cells import MechanismCells, WallPenetration
 from stochpound.analysis._store_ensemble import StoreEnsemble
 from stochpound.hazard import (
     RUPTURE_COLUMNS,
@@ -97,6 +98,8 @@ __all__ = [
     "fixed_base_cqc",
     "run_summary",
     "StoreEnsemble",
+    "MechanismCells",
+    "WallPenetration",
     "subset_simulation",
     "RESPONSES",
     "measure_free_risk",

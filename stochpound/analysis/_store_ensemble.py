@@ -20,8 +20,10 @@ import xarray as xr
 
 from stochpound.analysis._ensemble_statistics import ensemble_statistics
 from stochpound.analysis._intervals import MIN_RUNS, mean_interval, of_first
+from stochpound.analysis._mechanism_cells import MechanismCells, WallPenetration
+from stochpound.analysis.mechanisms import amplification, ratcheting
 from stochpound.analysis._pounding import pounding_probability
-from stochpound.store import walls_only
+from stochpound.store import isolated_mus, walls_only
 
 CONVERGENCE_POINTS = 8
 """Sample sizes, from :data:`MIN_RUNS` to the ensemble's size (geometrically spaced), at which running estimates are taken."""
@@ -131,3 +133,23 @@ class StoreEnsemble:
             panels[dim] = [panels[dim][i] for i in kept]
         return panels
 
+
+    def ratcheting_against(self, free: StoreEnsemble, away: int) -> MechanismCells:
+        """:func:`stochpound.analysis.ratcheting` of the studied building's residual sliding in this ensemble's cells on a sliding
+        base (a μ axis's fixed-base cells left out) against ``free`` (the contact-free twins), from :data:`MIN_RUNS` paired runs."""
+        residual, twin = self.sample("residual_sliding"), free.sample("residual_sliding")
+        if "mu" in residual.dims:
+            sliding = isolated_mus(residual["mu"].values)
+            residual, twin = residual.sel(mu=sliding), twin.sel(mu=sliding)
+        found = ratcheting(residual, twin, away, MIN_RUNS, confidence=self.confidence).compute()
+        return MechanismCells(found, "ratchets", "abs_change_mean", "abs_count")
+
+    def amplification_over(self, twins: StoreEnsemble, variable: str) -> MechanismCells:
+        """:func:`stochpound.analysis.amplification` of the studied building's demand ``variable`` in this ensemble's cells over
+        ``twins`` (the same motions without impacts), from :data:`MIN_RUNS` paired runs."""
+        found = amplification(self.sample(variable), twins.sample(variable), MIN_RUNS, confidence=self.confidence).compute()
+        return MechanismCells(found, "raises", "ratio_mean", "with_count")
+
+    def wall_penetration(self, walls: str | None = None) -> WallPenetration:
+        """The largest wall penetration over the runs (and per value of ``walls``, the axis that sets the walls, if any)."""
+        return WallPenetration.of(self.sample("peak_wall_penetration"), walls)
