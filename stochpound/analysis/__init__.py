@@ -32,7 +32,9 @@ from stochpound.analysis._subset_simulation import RESPONSES, subset_simulation
 from stochpound.analysis._measure_free import MEASURE_FREE_RESPONSES, measure_free_risk
 from stochpound.analysis._summary import run_summary
 from stochpound.analysis._mechanism_cells import MechanismCells, WallPenetration
-from stochpound.analysis._store_ensemble import StoreEnsemble
+from stochpound.analysis._store_ensemble import RARE, ProbabilityAt, StoreEnsemble
+from stochpound.analysis._record_cases import RecordPounding
+from stochpound.analysis._store_separation import CONTACTS, WALLS, Closure, Needed, StoreSeparation, ValueRange
 from stochpound.hazard import (
     RUPTURE_COLUMNS,
     HazardCurve,
@@ -98,6 +100,15 @@ __all__ = [
     "fixed_base_cqc",
     "run_summary",
     "StoreEnsemble",
+    "ProbabilityAt",
+    "RecordPounding",
+    "RARE",
+    "StoreSeparation",
+    "Needed",
+    "Closure",
+    "CONTACTS",
+    "WALLS",
+    "ValueRange",
     "MechanismCells",
     "WallPenetration",
     "subset_simulation",

@@ -12,6 +12,7 @@ the running estimates over the first n realizations.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from functools import cached_property
 from typing import Any
 
@@ -27,8 +28,23 @@ from stochpound.store import isolated_mus, walls_only
 
 CONVERGENCE_POINTS = 8
 """Sample sizes, from :data:`MIN_RUNS` to the ensemble's size (geometrically spaced), at which running estimates are taken."""
+RARE = 0.05
+"""The probability of pounding below which (its upper Clopper–Pearson bound) pounding is rare."""
 CONVERGENCE_PANELS = 4
 """Most panels of a convergence figure: the cells slowest to settle (P(pounding) nearest 0.5), not every cell."""
+
+
+@dataclass(frozen=True)
+class ProbabilityAt:
+    """P(pounding) (or of another event) over the cells at one value of an axis: ``value``, ``cells``, ``fewest`` runs of a cell,
+    ``lowest`` and ``highest`` probability, and the ``highest_upper`` bound of its interval."""
+
+    value: Any
+    cells: int
+    fewest: int
+    lowest: float
+    highest: float
+    highest_upper: float
 
 
 class StoreEnsemble:
@@ -117,6 +133,23 @@ class StoreEnsemble:
         return of_first(lambda first: mean_interval(first, confidence=self.confidence, method="bootstrap"), self.sample(variable),
                         self.convergence_counts).compute()
 
+    def probability_along(self, axis: str, events: str = "impacts") -> tuple[list[str], list[ProbabilityAt]]:
+        """The fraction of runs with ``events`` (impacts, a wall's penetration) > 0 in every cell, with its Clopper–Pearson
+        interval, summarised at each value of ``axis`` over the other axes: those other axes, and per value of ``axis``
+        its cells, fewest runs, lowest and highest probability and highest upper bound."""
+        probability = pounding_probability(self.data[events], confidence=self.confidence).compute()
+        others = [d for d in probability["probability"].dims if d != axis]
+        rows = []
+        for value in probability[axis].values:
+            at = probability.sel({axis: value})
+            rows.append(ProbabilityAt(value.item(), int(at["probability"].size), int(at["realizations"].min()), float(at["probability"].min()),
+                                      float(at["probability"].max()), float(at["upper"].max())))
+        return others, rows
+
+    def rare_gap(self, dim: str) -> xr.DataArray:
+        """The smallest gap of gap axis ``dim`` from which on pounding is rare in every cell (:func:`rare_gap` of the statistics' upper bound)."""
+        return rare_gap(self.statistics["pounding_probability_upper"], dim)
+
     def slowest_panels(self, line_dim: str | None) -> dict[str, list[Any]]:
         """The grid's axes other than ``line_dim``, the longest cut (repeatedly) to its values with P(pounding) nearest 0.5, to at
         most :data:`CONVERGENCE_PANELS` combinations."""
@@ -153,3 +186,12 @@ class StoreEnsemble:
     def wall_penetration(self, walls: str | None = None) -> WallPenetration:
         """The largest wall penetration over the runs (and per value of ``walls``, the axis that sets the walls, if any)."""
         return WallPenetration.of(self.sample("peak_wall_penetration"), walls)
+
+
+def rare_gap(upper: xr.DataArray, dim: str) -> xr.DataArray:
+    """The smallest value of gap axis ``dim`` from which on every larger gap has P(pounding)'s upper bound ``upper`` below :data:`RARE` (m, NaN if none)."""
+    rare = (upper < RARE).transpose(dim, ...)
+    # rare from this gap on: a reversed cumulative "all"
+    from_here = rare.isel({dim: slice(None, None, -1)}).cumprod(dim).isel({dim: slice(None, None, -1)}).astype(bool)
+    gaps = xr.DataArray(np.asarray(upper[dim].values, dtype=float), dims=dim, coords={dim: upper[dim]})
+    return gaps.where(from_here).min(dim)

@@ -13,7 +13,8 @@ from stochpound.report.sections._intensity import intensity_section
 from stochpound.report.sections._risk import risk_section
 from stochpound.report.sections._laws import law_axis, laws_section
 from stochpound.report.sections._methods import methods_section
-from stochpound.report.sections._separation import WALLS, separation_section
+from stochpound.analysis import WALLS
+from stochpound.report.sections._separation import separation_section
 from stochpound.report.sections._store_reading import open_stores, select, value
 from stochpound.report.sections._summary import experiment_summary, move_per_cell_tables
 

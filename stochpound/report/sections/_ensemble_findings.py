@@ -17,6 +17,7 @@ import pandas as pd
 import xarray as xr
 
 from stochpound.stats import kernels
+from stochpound.analysis import RARE
 from stochpound.report.render import Block, Paragraph, Table
 from stochpound.report.sections._ensembles import CM, MIN_RUNS, Ensemble
 from stochpound.experiment import FIXED_BASE, is_fixed_base, is_gap_axis
@@ -29,8 +30,6 @@ COMPARED = {
     "peak_relative_displacement": "peak relative displacement",
     "peak_total_displacement": "peak total displacement",
 }
-#: A cell "rarely pounds" when the upper bound of its probability of pounding is below this.
-RARE = 0.05
 
 
 def ensemble_findings(ensemble: Ensemble) -> list[Block]:
@@ -111,15 +110,6 @@ def _force_spread(stats: xr.Dataset, top: float, impacting: str) -> str:
     return text + (f"; the other {rest} cells have fewer {impacting} and give no ratio." if rest else ".")
 
 
-def rare_gap(upper: xr.DataArray, dim: str) -> xr.DataArray:
-    """The smallest value of gap axis ``dim`` from which on every larger gap has P(pounding)'s upper bound ``upper`` below :data:`RARE` (m, NaN if none)."""
-    rare = (upper < RARE).transpose(dim, ...)
-    # rare from this gap on: a reversed cumulative "all"
-    from_here = rare.isel({dim: slice(None, None, -1)}).cumprod(dim).isel({dim: slice(None, None, -1)}).astype(bool)
-    gaps = xr.DataArray(np.asarray(upper[dim].values, dtype=float), dims=dim, coords={dim: upper[dim]})
-    return gaps.where(from_here).min(dim)
-
-
 def gap_effect(ensemble: Ensemble, dim: str) -> list[Block]:
     """How P(pounding) falls with gap axis ``dim``, and the gap beyond which pounding is rare (a table)."""
     stats = ensemble.statistics
@@ -127,7 +117,7 @@ def gap_effect(ensemble: Ensemble, dim: str) -> list[Block]:
     first, last = p.isel({dim: 0}), p.isel({dim: -1})
     lines = int(first.size)
     lower_at_end = int((last < first).sum())
-    needed = rare_gap(stats["pounding_probability_upper"], dim)
+    needed = ensemble.rare_gap(dim)
     event, gap = ensemble.event, ("clearance" if ensemble.event != "pounding" else "gap")
     reached = needed.notnull()
     others = [d for d in ensemble.grid if d != dim]
