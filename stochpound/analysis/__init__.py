@@ -34,6 +34,7 @@ from stochpound.analysis._summary import run_summary
 from stochpound.analysis._mechanism_cells import MechanismCells, WallPenetration
 from stochpound.analysis._store_ensemble import RARE, ProbabilityAt, StoreEnsemble
 from stochpound.analysis._record_cases import RecordPounding
+from stochpound.analysis._cell_statistics import CellStatistics
 from stochpound.analysis._store_separation import CONTACTS, WALLS, Closure, Needed, StoreSeparation, ValueRange
 from stochpound.hazard import (
     RUPTURE_COLUMNS,
@@ -58,6 +59,7 @@ from stochpound.hazard import (
 from stochpound.analysis._impacts import TABLE_COLUMNS  # noqa: F401
 from stochpound.analysis._intervals import MIN_RUNS  # noqa: F401
 from stochpound.analysis._summary import response_moments, top_floor_total_displacement  # noqa: F401
+from stochpound.analysis._cell_statistics import ForceSpread, Largest  # noqa: F401
 
 
 CONTRACT_RISK_NAMES = ("fit_fragility", "mean_annual_frequency")
@@ -102,6 +104,7 @@ __all__ = [
     "StoreEnsemble",
     "ProbabilityAt",
     "RecordPounding",
+    "CellStatistics",
     "RARE",
     "StoreSeparation",
     "Needed",

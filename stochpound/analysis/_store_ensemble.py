@@ -24,6 +24,7 @@ from stochpound.analysis._intervals import MIN_RUNS, mean_interval, of_first
 from stochpound.analysis._mechanism_cells import MechanismCells, WallPenetration
 from stochpound.analysis.mechanisms import amplification, ratcheting
 from stochpound.analysis._pounding import pounding_probability
+from stochpound.stats import kernels
 from stochpound.store import isolated_mus, walls_only
 
 CONVERGENCE_POINTS = 8
@@ -145,6 +146,11 @@ class StoreEnsemble:
             rows.append(ProbabilityAt(value.item(), int(at["probability"].size), int(at["realizations"].min()), float(at["probability"].min()),
                                       float(at["probability"].max()), float(at["upper"].max())))
         return others, rows
+
+    @property
+    def none_upper_bound(self) -> float:
+        """The upper Clopper–Pearson bound of P(pounding) when none of the ensemble's runs pounds (the smallest probability it resolves)."""
+        return float(kernels.clopper_pearson(0, self.size, self.confidence)[1])
 
     def rare_gap(self, dim: str) -> xr.DataArray:
         """The smallest gap of gap axis ``dim`` from which on pounding is rare in every cell (:func:`rare_gap` of the statistics' upper bound)."""
