@@ -71,10 +71,6 @@ COMPUTED: dict[str, dict[str, int]] = {
         ".any": 1, ".exp": 2, ".idxmax": 1, ".max": 8, ".min": 1, ".nanmax": 2, ".sqrt": 4, "harmonic_response": 2, "laws.contact_law": 1,
         "modal_properties": 1
     },
-    "_description.py": {
-        "design_yield_shears": 1, "effective_mass": 1, "laws.contact_law": 3, "laws.friction_law": 2, "modal_properties": 2,
-        "scene_from_dict": 1
-    },
     "_intensity.py": {
         ".any": 2, ".exp": 5, ".linspace": 2, ".max": 3, ".median": 1, ".min": 2, ".nanpercentile": 1, ".quantile": 2, ".sum": 7,
         "clopper_pearson": 3, "consistency_at_targets": 1, "contact_free_closure": 1, "limit_state_events": 1, "rate_from_probability": 1,

@@ -35,6 +35,7 @@ from stochpound.analysis._mechanism_cells import MechanismCells, WallPenetration
 from stochpound.analysis._store_ensemble import RARE, ProbabilityAt, StoreEnsemble
 from stochpound.analysis._record_cases import RecordPounding
 from stochpound.analysis._cell_statistics import CellStatistics
+from stochpound.analysis._store_scenes import Configuration, StoreScenes
 from stochpound.analysis._store_separation import CONTACTS, WALLS, Closure, Needed, StoreSeparation, ValueRange
 from stochpound.hazard import (
     RUPTURE_COLUMNS,
@@ -105,6 +106,8 @@ __all__ = [
     "ProbabilityAt",
     "RecordPounding",
     "CellStatistics",
+    "StoreScenes",
+    "Configuration",
     "RARE",
     "StoreSeparation",
     "Needed",
