@@ -36,6 +36,19 @@ from stochpound.analysis._store_ensemble import RARE, ProbabilityAt, StoreEnsemb
 from stochpound.analysis._record_cases import RecordPounding
 from stochpound.analysis._cell_statistics import CellStatistics
 from stochpound.analysis._store_scenes import Configuration, StoreScenes
+from stochpound.analysis._solver_checks import (
+    COLLISION_VELOCITY,
+    CROSS_CHECK_TOLERANCE,
+    HARMONIC_AMPLITUDE,
+    HARMONIC_DETUNING,
+    REFERENCE_RTOL,
+    SUMMARY_RTOL,
+    CollisionCheck,
+    HarmonicComparison,
+    ModalCheck,
+    ReferenceRun,
+    free_collision_restitution,
+)
 from stochpound.analysis._store_separation import CONTACTS, WALLS, Closure, Needed, StoreSeparation, ValueRange
 from stochpound.hazard import (
     RUPTURE_COLUMNS,
@@ -108,6 +121,17 @@ __all__ = [
     "CellStatistics",
     "StoreScenes",
     "Configuration",
+    "CollisionCheck",
+    "HarmonicComparison",
+    "ModalCheck",
+    "ReferenceRun",
+    "free_collision_restitution",
+    "COLLISION_VELOCITY",
+    "CROSS_CHECK_TOLERANCE",
+    "HARMONIC_AMPLITUDE",
+    "HARMONIC_DETUNING",
+    "REFERENCE_RTOL",
+    "SUMMARY_RTOL",
     "RARE",
     "StoreSeparation",
     "Needed",

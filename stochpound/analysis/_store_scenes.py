@@ -104,6 +104,11 @@ class StoreScenes:
         total = sum(1 for c in self.experiment.cases if c.kind == CASE)
         return total // max(len(self.configurations), 1)
 
+    @property
+    def energy_residual(self) -> float | None:
+        """The largest energy residual over the stored cases, as a share of the energy input (None where the store has none)."""
+        return float(self.store["energy_residual_ratio"].max()) if "energy_residual_ratio" in self.store else None
+
     @staticmethod
     def modes(building: Building) -> Modes:
         """The building's modes on a fixed base (:func:`stochpound.model.modal_solution.modal_properties`)."""
