@@ -74,6 +74,7 @@ from stochpound.analysis._impacts import TABLE_COLUMNS  # noqa: F401
 from stochpound.analysis._intervals import MIN_RUNS  # noqa: F401
 from stochpound.analysis._summary import response_moments, top_floor_total_displacement  # noqa: F401
 from stochpound.analysis._cell_statistics import ForceSpread, Largest  # noqa: F401
+from stochpound.analysis._cells import CellLabels  # noqa: F401
 
 
 CONTRACT_RISK_NAMES = ("fit_fragility", "mean_annual_frequency")

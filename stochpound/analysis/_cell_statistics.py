@@ -17,6 +17,7 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
+from stochpound.analysis._cells import CellLabels
 from stochpound.analysis._intervals import MIN_RUNS
 from stochpound.analysis._store_ensemble import rare_gap
 from stochpound.store import FIXED_BASE, fixed_base, is_fixed_base, isolated_mus
@@ -81,15 +82,15 @@ class GapEffect:
     reached: int
     rare_low: float
     rare_high: float
-    missing: list[dict[str, Any]]
+    missing: list[CellLabels]
 
 
 @dataclass(frozen=True)
 class Largest:
     """The cell of the largest clear change of P(pounding) by isolation: its labels (``mu`` included) and the fixed base's."""
 
-    cell: dict[str, Any]
-    fixed: dict[str, Any]
+    cell: CellLabels
+    fixed: CellLabels
 
 
 @dataclass(frozen=True)
@@ -249,6 +250,6 @@ def _largest(candidates: list[tuple[float, xr.DataArray]]) -> Largest | None:
     return Largest({**labels, "mu": mu}, labels)
 
 
-def _cells(data: xr.DataArray, dims: list[str]) -> list[dict[str, Any]]:
+def _cells(data: xr.DataArray, dims: list[str]) -> list[CellLabels]:
     stacked = data.transpose(*dims).to_series() if dims else pd.Series([data.item()])
     return [dict(zip(dims, label if isinstance(label, tuple) else (label,))) for label in stacked.index] if dims else [{}]

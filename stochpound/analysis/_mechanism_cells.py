@@ -15,6 +15,7 @@ from typing import Any
 
 import xarray as xr
 
+from stochpound.analysis._cells import CellLabels
 
 @dataclass(frozen=True)
 class MechanismCells:
@@ -37,25 +38,25 @@ class MechanismCells:
     effect: str
     count: str
 
-    def cells(self) -> list[dict[str, Any]]:
+    def cells(self) -> list[CellLabels]:
         """The labels of every cell, in grid order."""
         data = self.found[self.flag]
         stacked = data.stack(cell=list(data.dims)) if data.dims else data.expand_dims(cell=[0])
         return [{d: stacked[d].values[i].item() for d in data.dims} for i in range(stacked.sizes["cell"])]
 
-    def assessed(self) -> list[dict[str, Any]]:
+    def assessed(self) -> list[CellLabels]:
         """The cells with enough paired runs."""
         return [c for c in self.cells() if bool(self.found["enough"].sel(c))]
 
-    def short(self) -> list[dict[str, Any]]:
+    def short(self) -> list[CellLabels]:
         """The cells with too few paired runs."""
         return [c for c in self.cells() if not bool(self.found["enough"].sel(c))]
 
-    def flagged(self) -> list[dict[str, Any]]:
+    def flagged(self) -> list[CellLabels]:
         """The assessed cells where the effect is resolved, the largest effect first."""
         return sorted((c for c in self.assessed() if bool(self.found[self.flag].sel(c))), key=lambda c: -float(self.found[self.effect].sel(c)))
 
-    def lowered(self) -> list[dict[str, Any]]:
+    def lowered(self) -> list[CellLabels]:
         """The assessed cells where the impacts resolve the opposite effect (``lowers``)."""
         return [c for c in self.assessed() if bool(self.found["lowers"].sel(c))]
 
@@ -63,7 +64,7 @@ class MechanismCells:
         """Cells where the impacts move the residual away from the neighbour (interval above 0) without ratcheting it (ratcheting only)."""
         return self.found["enough"] & ~self.found["ratchets"] & (self.found["away_change_lower"] > 0)
 
-    def pushed(self) -> list[dict[str, Any]]:
+    def pushed(self) -> list[CellLabels]:
         """The assessed cells of :meth:`pushed_away`."""
         return [c for c in self.assessed() if bool(self.pushed_away().sel(c))]
 
@@ -123,7 +124,7 @@ class WallPenetration:
 
     runs: int
     largest: float
-    at: dict[str, Any]
+    at: CellLabels
     per_value: list[tuple[Any, float]]
 
     @classmethod

@@ -14,11 +14,11 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 import xarray as xr
 
+from stochpound.analysis._cells import CellLabels
 from stochpound.analysis._pounding import pounding_probability
 from stochpound.analysis._separation import TARGET_PROBABILITIES, pounding_curve, required_separation, rule_exceedance
 from stochpound.analysis._store_ensemble import RARE, StoreEnsemble, rare_gap
@@ -128,7 +128,7 @@ class Needed:
         """The grid's cells."""
         return int(self.data["separation"].isel(probability=0).size)
 
-    def extreme_cells(self, probability: float) -> tuple[dict[str, Any], dict[str, Any]]:
+    def extreme_cells(self, probability: float) -> tuple[CellLabels, CellLabels]:
         """Labels of the cells with the smallest and largest separation needed for ``probability`` (NaN ignored; the first
         cell twice when none is finite)."""
         values = self.data["separation"].sel(probability=probability)
@@ -136,12 +136,12 @@ class Needed:
         order = np.argsort(np.where(np.isnan(flat.values), np.inf, flat.values))
         finite = [i for i in order if np.isfinite(flat.values[i])] or [int(order[0])]
 
-        def labels(i: int) -> dict[str, Any]:
+        def labels(i: int) -> CellLabels:
             return {d: flat[d].values[i].item() for d in values.dims}
 
         return labels(finite[0]), labels(finite[-1])
 
-    def extremes(self, probability: float) -> tuple[dict[str, Any], dict[str, Any]] | None:
+    def extremes(self, probability: float) -> tuple[CellLabels, CellLabels] | None:
         """Labels of the first cells with the smallest and the largest finite separation needed for ``probability``; None
         with fewer than two finite cells."""
         values = self.data["separation"].sel(probability=probability)
@@ -150,7 +150,7 @@ class Needed:
             return None
         stacked = finite.stack(cell=finite.dims)
 
-        def labels(i: int) -> dict[str, Any]:
+        def labels(i: int) -> CellLabels:
             return {d: stacked[d].values[i].item() for d in finite.dims}
 
         return labels(int(np.nanargmin(stacked.values))), labels(int(np.nanargmax(stacked.values)))

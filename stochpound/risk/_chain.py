@@ -150,8 +150,8 @@ class StoreRisk:
         The motions of every stripe (the bootstrap's sample size): the fewest that ran in a stripe and configuration.
     method : str
         ``"stripes"`` or ``"ida"``.
-    setting : dict
-        The store's ``[intensity]`` entry (its measure, units and levels).
+    setting : Intensity or None
+        The store's ``[intensity]`` setting (its measure, units and levels; :class:`stochpound.store.Intensity`).
     stripes : int or None
         The store's intensity stripes that ran (None for IDA runs).
     progress : str
@@ -243,7 +243,7 @@ class StoreRisk:
         """The g* table: per configuration, g* and its interval (m) for each target (columns grouped by target); a g* that
         is only a lower bound (``stochpound.risk._chain.bound_beyond_stripes``) is the text ``≥ 0.640``, its interval empty."""
         frame = self.to_frame()
-        years = float(self.separation.attrs.get("years", self.years))
+        years = _stated_years(self.separation, self.years)
         config = self.configuration_dims()
         frame["target"] = [target_text(p, years) for p in frame["target"]]
         frame["separation"] = [f"≥ {value:.3f}" if bound else value for value, bound in zip(frame["separation"], frame["lower_bound"])]
@@ -273,13 +273,13 @@ class StoreRisk:
         frames = []
         if self.rules is not None:
             rules = _grid_only(self.rules, keep=("code_intensity", "stripe_intensity"))
-            stripes = [design_text(p, float(i), float(rules.attrs.get("years", self.years)))
+            stripes = [design_text(p, float(i), _stated_years(rules, self.years))
                        for p, i in zip(rules["design_level"].values, rules["stripe_intensity"].values)]
             rows = self._rules_rows(rules.drop_vars(["code_intensity", "stripe_intensity"]), dict(zip(rules["design_level"].values, stripes)))
             frames.append(rows[rows[[c for c in rows.columns if c.startswith("gap, ")]].notna().any(axis=1)])  # D_TM: not where the base never slides
         if self.design_rules is not None:
             rules = _grid_only(self.design_rules, keep=("design_level",))
-            years = float(rules.attrs.get("years", self.years))
+            years = _stated_years(rules, self.years)
             rows = self._rules_rows(rules, {p: f"{100 * p:g} %/{years:g} yr (design analysis)" for p in rules["design_level"].values})
             rows = rows[rows[[c for c in rows.columns if c.startswith("gap, ")]].notna().any(axis=1)]  # not where a rule does not apply
             frames.append(rows.reorder_levels(frames[0].index.names) if frames else rows)
@@ -287,7 +287,7 @@ class StoreRisk:
 
     def _rules_rows(self, rules: xr.Dataset, level_names: Mapping[float, str]) -> pd.DataFrame:
         """The rows of :meth:`rules_frame` of one rules dataset (``design_level`` a dimension or a coordinate along ``rule``)."""
-        years = float(rules.attrs.get("years", self.years))
+        years = _stated_years(rules, self.years)
         gaps = rules["gap"].to_dataframe()[["gap"]]["gap"].unstack("contact")
         gaps.columns = [f"gap, contact {c} (m)" for c in gaps.columns]
         values = rules[[name for name in (*_RULE_VALUES, "status") if name in rules]].to_dataframe()
@@ -526,6 +526,11 @@ class StoreRisk:
     def target_text(self, probability: float) -> str:
         """A target in words: ``10 % in 50 yr``."""
         return target_text(probability, self.years)
+
+
+def _stated_years(result: xr.Dataset, years: float) -> float:
+    """The investigation time (yr) a result of the chain states in its ``years`` attribute, else ``years``."""
+    return float(result.attrs.get("years", years))
 
 
 def non_increasing_along(maf: xr.DataArray, dim: str) -> xr.DataArray:

@@ -20,7 +20,7 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
-from stochpound.analysis import MIN_RUNS, StoreEnsemble
+from stochpound.analysis import MIN_RUNS, CellLabels, StoreEnsemble
 from stochpound.report.render import Block, FigureItem, Table, figures
 from stochpound.experiment import is_gap_axis
 from stochpound.report.sections._facets import cell_gid, dim_text, labels_text, layouts, line_colours, value_text
@@ -97,7 +97,7 @@ class Ensemble(StoreEnsemble):
         """Its probability as a label: "P(pounding)" or "P(wall hit)"."""
         return f"P({self.event.removeprefix('a ')})"
 
-    def gid(self, labels: dict[str, Any]) -> str:
+    def gid(self, labels: CellLabels) -> str:
         """The ``gid`` of a cell of this ensemble."""
         return cell_gid({**labels, "record": self.label})
 
@@ -190,7 +190,7 @@ class Ensemble(StoreEnsemble):
         x_values = self.grid[x_dim]
         positions, ticks = _axis_positions(x_dim, x_values)
 
-        def curves(panel: dict[str, Any]) -> list[figures.Curve]:
+        def curves(panel: CellLabels) -> list[figures.Curve]:
             result = []
             for value, colour in lines(self.grid, line_dim):
                 where = {**panel, **({line_dim: value} if line_dim else {})}
@@ -217,7 +217,7 @@ class Ensemble(StoreEnsemble):
         sample = self.sample(quantity.variable)
         reference = self.twin_sample(twin) if twin else None
 
-        def curves(panel: dict[str, Any]) -> list[figures.Curve]:
+        def curves(panel: CellLabels) -> list[figures.Curve]:
             result = []
             for value, colour in lines(self.grid, line_dim):
                 where = {**panel, **({line_dim: value} if line_dim else {})}
@@ -254,7 +254,7 @@ class Ensemble(StoreEnsemble):
             "peak": (self.running_mean(PEAK_DISPLACEMENT.variable), "mean", CM, "mean peak total displacement (cm)", "percentile-bootstrap"),
         }
         for key, (estimate, field, factor, y_label, method) in running.items():
-            def curves(panel: dict[str, Any], estimate: xr.Dataset = estimate, field: str = field, factor: float = factor) -> list[figures.Curve]:
+            def curves(panel: CellLabels, estimate: xr.Dataset = estimate, field: str = field, factor: float = factor) -> list[figures.Curve]:
                 result = []
                 for value, colour in lines(self.grid, line_dim):
                     where = {**panel, **({line_dim: value} if line_dim else {})}
@@ -276,7 +276,7 @@ class Ensemble(StoreEnsemble):
         return items
 
     def facet_figures(
-        self, kind: str, drawn: Sequence[str | None], curves: Callable[[dict[str, Any]], list[figures.Curve]], x_label: str, y_label: str, what: str, title: str = "",
+        self, kind: str, drawn: Sequence[str | None], curves: Callable[[CellLabels], list[figures.Curve]], x_label: str, y_label: str, what: str, title: str = "",
         panel_grid: dict[str, list[Any]] | None = None, **options: Any
     ) -> list[FigureItem]:
         """One figure per layout of the dimensions not ``drawn`` (each combination a panel; ``panel_grid``: only those values of them)."""

@@ -22,6 +22,7 @@ from typing import Any
 
 import numpy as np
 
+from stochpound.analysis import CellLabels
 from stochpound.experiment import is_fixed_base, is_gap_axis
 from stochpound.report.render import figures
 
@@ -51,12 +52,12 @@ def dim_text(dim: str) -> str:
     return "μ" if dim == "mu" else dim
 
 
-def labels_text(labels: Mapping[str, Any]) -> str:
+def labels_text(labels: CellLabels) -> str:
     """``neighbour stiff, gap 2 cm, μ fixed`` (empty for no labels)."""
     return ", ".join(f"{dim_text(dim)} {value_text(dim, value)}" for dim, value in labels.items())
 
 
-def cell_gid(labels: Mapping[str, Any]) -> str:
+def cell_gid(labels: CellLabels) -> str:
     """The ``gid`` of an artist that draws the cell with these labels (sorted JSON, ∞ as "inf")."""
 
     def jsonable(value: Any) -> Any:
@@ -70,8 +71,8 @@ def cell_gid(labels: Mapping[str, Any]) -> str:
 class Layout:
     """One figure of a family: its panels (labels of the panel dimensions) and the labels it shares."""
 
-    panels: list[dict[str, Any]]
-    shared: dict[str, Any]
+    panels: list[CellLabels]
+    shared: CellLabels
 
     @property
     def title(self) -> str:

@@ -22,12 +22,11 @@ from __future__ import annotations
 
 import itertools
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 import xarray as xr
 
-from stochpound.analysis import MIN_RUNS
+from stochpound.analysis import MIN_RUNS, CellLabels
 from stochpound.experiment import is_gap_axis
 from stochpound.model import laws
 from stochpound.report.render import Block, FigureItem, Paragraph, Section, figures
@@ -80,7 +79,7 @@ def law_axis(store: xr.Dataset) -> str | None:
     return None
 
 
-def variant_laws(definition: dict[str, Any], axis: str) -> dict[str, str]:
+def variant_laws(definition: CellLabels, axis: str) -> dict[str, str]:
     """Each value of variant ``axis`` -> the contact laws of its scene (joined with "/" when the contacts differ)."""
     scene_laws = [str(c.get("law", laws.DEFAULT_CONTACT_LAW)) for c in definition.get("scene", {}).get("contact", [])]
     variant = next(v for v in definition["variants"] if v["name"] == axis)
@@ -137,7 +136,7 @@ def _ensemble_blocks(ensemble: Ensemble, axis: str) -> list[Block]:
     return blocks
 
 
-def _figure(ensemble: Ensemble, axis: str, gap: str | None, panels: list[dict[str, Any]], table: xr.Dataset, text: str, y_label: str,
+def _figure(ensemble: Ensemble, axis: str, gap: str | None, panels: list[CellLabels], table: xr.Dataset, text: str, y_label: str,
             key: str) -> FigureItem:
     values = ensemble.grid[axis]
     colours = line_colours(axis, values)
@@ -159,7 +158,7 @@ def _figure(ensemble: Ensemble, axis: str, gap: str | None, panels: list[dict[st
     return FigureItem(f"laws-{ensemble.name}-{ensemble.label}-{key}", caption, figure)
 
 
-def _comparison(ensemble: Ensemble, axis: str, gap: str | None, panels: list[dict[str, Any]], table: xr.Dataset, text: str, unit: str) -> str:
+def _comparison(ensemble: Ensemble, axis: str, gap: str | None, panels: list[CellLabels], table: xr.Dataset, text: str, unit: str) -> str:
     """Which law gives the largest ``text`` at each gap of each panel, by how much, and whether the laws' intervals overlap."""
     sentences = []
     for panel in panels:

@@ -26,7 +26,7 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from stochpound.analysis import MechanismCells
+from stochpound.analysis import CellLabels, MechanismCells
 from stochpound.experiment import is_gap_axis
 from stochpound.store import contact_free, contact_gap_dims, has_contact_free, wall_axis, with_contacts
 from stochpound.report.render import Block, Paragraph
@@ -166,7 +166,7 @@ def ratcheting_text(pounding: Ensemble, free: Ensemble, away: int | None) -> str
     if not enough:
         return opening + f"not assessed: no cell has {MIN_RUNS} runs paired with their contact-free twins (at most {found.most_runs})."
 
-    def describe(cell: dict[str, Any]) -> str:
+    def describe(cell: CellLabels) -> str:
         at = found.found.sel(cell)
         n = int(at["abs_change_count"])
         return (f"at {labels_text(cell)}, mean abs(residual sliding) {_value(float(at.abs_mean), float(at.abs_lower), float(at.abs_upper), 'cm', CM)} "
@@ -214,7 +214,7 @@ def amplification_text(impacts: Ensemble, twins: Ensemble, variable: str, cause:
     if not enough:
         return opening + f"not assessed: no cell has {MIN_RUNS} runs paired with {twin} (at most {found.most_runs})."
 
-    def describe(cell: dict[str, Any]) -> str:
+    def describe(cell: CellLabels) -> str:
         at = found.found.sel(cell)
         return (f"{labels_text(cell)}: {_value(float(at.ratio_mean), float(at.ratio_lower), float(at.ratio_upper), '', 1.0)} times "
                 f"({_value(float(at.with_mean), float(at.with_lower), float(at.with_upper), unit, factor)} against "

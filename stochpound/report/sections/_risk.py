@@ -33,6 +33,7 @@ import xarray as xr
 from matplotlib.figure import Figure
 from matplotlib.ticker import LogLocator, NullFormatter
 
+from stochpound.analysis import CellLabels
 from stochpound.report.render import Block, FigureItem, Paragraph, Section, Table, figures
 from stochpound.report.sections._facets import labels_text
 from stochpound.report.sections._stripe_motions import is_selected
@@ -54,7 +55,7 @@ def hazard_provenance(store: xr.Dataset) -> str:
     return f"hazard curve ({hazard.description} in {hazard.units}) from {given}{table}, carried in the store. Provenance: {provenance}"
 
 
-def configurations(data: xr.DataArray | xr.Dataset, keep: tuple[str, ...] = ()) -> list[dict[str, Any]]:
+def configurations(data: xr.DataArray | xr.Dataset, keep: tuple[str, ...] = ()) -> list[CellLabels]:
     """The labels of every configuration: each combination of ``data``'s dimensions other than ``keep``."""
     dims = [d for d in data.dims if d not in keep]
     if not dims:

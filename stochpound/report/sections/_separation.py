@@ -24,12 +24,11 @@ per cell. Every sentence is computed from the store.
 from __future__ import annotations
 
 import math
-from typing import Any
 
 import numpy as np
 import xarray as xr
 
-from stochpound.analysis import CONTACTS, RARE, Closure, Needed, StoreSeparation, ValueRange
+from stochpound.analysis import CONTACTS, RARE, CellLabels, Closure, Needed, StoreSeparation, ValueRange
 from stochpound.report.render import figures
 from stochpound.report.render import Block, FigureItem, Paragraph, Section, Table
 from stochpound.report.sections._ensembles import Ensemble, line_label, lines, table_frame
@@ -287,7 +286,7 @@ class SeparationEnsemble(StoreSeparation):
         c = self.closure
         line_dim = ensemble.line_dim()
 
-        def curves(panel: dict[str, Any]) -> list[figures.Curve]:
+        def curves(panel: CellLabels) -> list[figures.Curve]:
             result = []
             for value, colour in lines(ensemble.grid, line_dim):
                 where = {**panel, **({line_dim: value} if line_dim else {})}
@@ -317,7 +316,7 @@ class SeparationEnsemble(StoreSeparation):
         needed = self.needed(usable)
         line_dim = ensemble.line_dim()
 
-        def curves(panel: dict[str, Any]) -> list[figures.Curve]:
+        def curves(panel: CellLabels) -> list[figures.Curve]:
             result = []
             for value, colour in lines(ensemble.grid, line_dim):
                 where = {**panel, **({line_dim: value} if line_dim else {})}
