@@ -28,6 +28,7 @@ import xarray as xr
 
 from stochpound.analysis import MIN_RUNS, CellLabels
 from stochpound.experiment import is_gap_axis
+from stochpound.store import Definition
 from stochpound.model import laws
 from stochpound.report.render import Block, FigureItem, Paragraph, Section, figures
 from stochpound.report.sections._ensembles import Ensemble
@@ -71,21 +72,21 @@ QUANTITIES = (
 
 def law_axis(store: xr.Dataset) -> str | None:
     """The variant axis whose values give the contacts different laws (from the stored definition), or None."""
-    definition = store.pound.definition.to_dict()
-    for axis in definition.get("variants", []):
-        named = variant_laws(definition, axis["name"]) if axis["name"] in store.dims else {}
-        if len({named[plain(v)] for v in store[axis["name"]].values}) > 1:
-            return str(axis["name"])
+    definition = store.pound.definition
+    for axis in definition.variants:
+        named = variant_laws(definition, axis.name) if axis.name in store.dims else {}
+        if len({named[plain(v)] for v in store[axis.name].values}) > 1:
+            return axis.name
     return None
 
 
-def variant_laws(definition: CellLabels, axis: str) -> dict[str, str]:
+def variant_laws(definition: Definition, axis: str) -> dict[str, str]:
     """Each value of variant ``axis`` -> the contact laws of its scene (joined with "/" when the contacts differ)."""
-    scene_laws = [str(c.get("law", laws.DEFAULT_CONTACT_LAW)) for c in definition.get("scene", {}).get("contact", [])]
-    variant = next(v for v in definition["variants"] if v["name"] == axis)
+    scene_laws = [str(c.get("law", laws.DEFAULT_CONTACT_LAW)) for c in definition.scene.get("contact", [])]
+    variant = next(v for v in definition.variants if v.name == axis)
     result = {}
-    for value in variant["values"]:
-        part = variant["overrides"][value].get("contact")
+    for value in variant.values:
+        part = variant.overrides[value].get("contact")
         tables = part if isinstance(part, list) else [part or {}] * len(scene_laws)
         names = [str(t.get("law", own)) if "law" in t else own for t, own in zip(tables, scene_laws)]
         result[value] = "/".join(dict.fromkeys(names))
@@ -97,9 +98,9 @@ def laws_section(name: str, store: xr.Dataset) -> Section:
     axis = law_axis(store)
     assert axis is not None
     section = Section(f"Contact laws compared: experiment {name}", key=f"laws-{name}")
-    definition = store.pound.definition.to_dict()
+    definition = store.pound.definition
     named = variant_laws(definition, axis)
-    overrides = next(v for v in definition["variants"] if v["name"] == axis)["overrides"]
+    overrides = next(v for v in definition.variants if v.name == axis).overrides
     same_until_contact = (
         "A law acts only once the floors touch, and this axis changes nothing else: up to its first impact a run is the "
         "same under every law, so the laws can differ in P(pounding) only within the solvers' tolerances, and they differ "
