@@ -7,9 +7,9 @@ restitution in closed form (:func:`free_collision_restitution`), a building on
 a fixed base under a_g = A sin(Ωt) against the closed-form modal solution
 (:func:`stochpound.model.modal_solution.harmonic_response`), and a stored case
 re-run with the solver the store used and with scipy's DOP853 at rtol 1e-12
-(:class:`ReferenceRun`, of the case :func:`cross_check_case` or :func:`yielding_case`
-chooses). :func:`verify` raises :class:`~stochpound._errors.VerificationError`
-where a re-run disagrees.
+(:class:`ReferenceRun`, of the case :meth:`ReferenceRun.pounding_case` or
+:meth:`ReferenceRun.yielding_case` chooses). :meth:`ReferenceRun.verify` raises
+:class:`~stochpound._errors.VerificationError` where a re-run disagrees.
 """
 
 from __future__ import annotations

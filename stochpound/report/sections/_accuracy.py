@@ -7,7 +7,7 @@ Five checks, each against something known exactly or computed independently:
   a store's harmonic motions (``[[motions]]`` of type harmonic), when present, are checked on its stored runs;
 * every contact element as a single collision of its two floor masses, free,
   against the restitution the Kelvin–Voigt law gives in closed form
-  (:func:`free_collision_restitution`);
+  (:func:`stochpound.analysis.free_collision_restitution`);
 * one stored case with pounding (and sliding, where a store has it) rerun
   with the exact solver and with scipy's DOP853 at rtol 1e-12;
 * per store with yielding storeys, one stored case that yielded, rerun the
