@@ -313,7 +313,7 @@ class SeparationEnsemble(StoreSeparation):
         """The separation needed against the target probability (log axis), with its interval."""
         ensemble = self.ensemble
         usable = self.curve_probabilities()
-        needed = self.needed(usable)
+        needed = self.needed(usable).data
         line_dim = ensemble.line_dim()
 
         def curves(panel: CellLabels) -> list[figures.Curve]:
