@@ -18,18 +18,8 @@ Five checks, each against something known exactly or computed independently:
 from __future__ import annotations
 
 from stochpound._errors import VerificationError
-from stochpound.analysis import (
-    COLLISION_VELOCITY,
-    CROSS_CHECK_TOLERANCE,
-    HARMONIC_AMPLITUDE,
-    HARMONIC_DETUNING,
-    REFERENCE_RTOL,
-    SUMMARY_RTOL,
-    CollisionCheck,
-    HarmonicComparison,
-    ModalCheck,
-    ReferenceRun,
-)
+from stochpound.analysis import (COLLISION_VELOCITY, CROSS_CHECK_TOLERANCE, HARMONIC_AMPLITUDE, HARMONIC_DETUNING, REFERENCE_RTOL,
+                                 SUMMARY_RTOL, CollisionCheck, HarmonicComparison, ModalCheck, ReferenceRun)
 from stochpound.model import laws
 from stochpound.model.scene import Scene
 from stochpound.report.render import Paragraph
