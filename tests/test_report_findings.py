@@ -61,7 +61,8 @@ def test_no_ratio_from_cells_with_too_few_runs():
 
 def test_convergence_starts_at_min_runs_in_a_handful_of_panels():
     """40 realizations on a 5 gaps × 3 μ grid: estimates at n = 30 … 40, in CONVERGENCE_PANELS panels, those nearest P = 0.5."""
-    from stochpound.report.sections._ensembles import CONVERGENCE_PANELS, Ensemble
+    from stochpound.analysis._store_ensemble import CONVERGENCE_PANELS
+    from stochpound.report.sections._ensembles import Ensemble
 
     rng = np.random.default_rng(4)
     gaps, mus, n = [0.0, 0.01, 0.02, 0.04, 0.08], [0.1, 0.2, math.inf], 40

@@ -6,9 +6,11 @@ import numpy as np
 import pytest
 import xarray as xr
 
+from stochpound.analysis import StoreEnsemble
 from stochpound.experiment import open_store
 from stochpound.report.sections._ensembles import MIN_RUNS, Ensemble
-from stochpound.report.sections._mechanism_findings import amplification_text, mechanism_answer, mechanism_findings, ratcheting_text, wall_axis
+from stochpound.report.sections._mechanism_findings import amplification_text, mechanism_answer, mechanism_findings, ratcheting_text
+from stochpound.store import wall_axis
 from tests.helpers import run_in_process
 
 N = 40
@@ -22,6 +24,9 @@ class Runs:
 
     def sample(self, variable: str) -> xr.DataArray:
         return self.samples[variable]
+
+    ratcheting_against = StoreEnsemble.ratcheting_against
+    amplification_over = StoreEnsemble.amplification_over
 
 
 def _runs(values: np.ndarray) -> xr.DataArray:
@@ -231,11 +236,9 @@ dt = 0.02
 
 
 def test_a_residual_pushed_away_without_ratcheting_is_counted_in_the_summary_too():
-    from stochpound.report.sections._mechanism_findings import _pushed_away, ratcheting_of
-
     free = _runs(np.random.default_rng(8).normal(0.05, 0.005, N))
     pushed = (free - 0.05 + np.random.default_rng(9).normal(0.0, 0.001, N)).expand_dims(gap=[0.02])  # towards the neighbour's side, smaller
     pounding, twins = Runs({"residual_sliding": pushed}), Runs({"residual_sliding": free})
-    found = ratcheting_of(pounding, twins, away=-1)
-    assert int(found["ratchets"].sum()) == 0 and int(_pushed_away(found).sum()) == 1
+    found = pounding.ratcheting_against(twins, away=-1)
+    assert found.flagged_count == 0 and found.pushed_count == 1
     assert "In 1 cells the impacts push the residual away from the neighbour" in ratcheting_text(pounding, twins, away=-1)

@@ -14,7 +14,8 @@ from stochpound.experiment import open_store
 from stochpound.store import contact_free, has_contact_free, has_wall_free, wall_free, wall_gap_dims, with_walls
 from stochpound.report.assemble import assemble_report
 from stochpound.report.render._document import FigureItem, Paragraph, Table
-from stochpound.report.sections._mechanism_findings import mechanism_answer, wall_axis
+from stochpound.report.sections._mechanism_findings import mechanism_answer
+from stochpound.store import wall_axis
 from tests.helpers import run_in_process
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from stochpound.report.sections._risk import RATE_DECADES, rate_limits
+from stochpound.report.render._figures import RATE_DECADES, rate_limits
 
 
 def test_a_far_tail_does_not_stretch_the_rate_axis_beyond_its_decades():

@@ -9,7 +9,8 @@ import xarray as xr
 
 from stochpound._errors import VerificationError
 from stochpound.experiment import load_experiment, run_experiment
-from stochpound.report.sections._accuracy import cross_check, cross_check_case
+from stochpound.analysis import ReferenceRun
+from stochpound.report.sections._accuracy import cross_check
 from stochpound.report.sections._description import StoreDefinition
 
 PAIR = """
@@ -65,7 +66,7 @@ def stripes_store(tmp_path_factory) -> Path:
 def test_the_cross_check_reruns_a_scaled_case_and_counts_the_stores_impacts(stripes_store):
     with xr.open_dataset(stripes_store) as store:
         store = store.load()
-    labels, _ = cross_check_case(store)
+    labels, _ = ReferenceRun.pounding_case(store)
     case = store["impacts"].sel(labels)
     assert float(store["scale_factor"].sel(labels)) != pytest.approx(1.0, abs=0.05)  # the case ran scaled
     paragraph = cross_check([StoreDefinition("verify", store)])
@@ -76,7 +77,7 @@ def test_the_cross_check_reruns_a_scaled_case_and_counts_the_stores_impacts(stri
 def test_a_corrupted_store_makes_the_check_fail_in_one_line(stripes_store):
     with xr.open_dataset(stripes_store) as store:
         store = store.load()
-    labels, _ = cross_check_case(store)
+    labels, _ = ReferenceRun.pounding_case(store)
     store["impacts"].loc[labels] = store["impacts"].sel(labels) + 1
     with pytest.raises(VerificationError, match=r"^cross-check: the stored case of verify \(.*\) re-run counts \d+ impacts, the store holds \d+$"):
         cross_check([StoreDefinition("verify", store)])

@@ -14,7 +14,8 @@ import pytest
 
 from stochpound._errors import VerificationError
 from stochpound.report.sections import damage_section, methods_section
-from stochpound.report.sections._accuracy import yielding_check, yielding_case
+from stochpound.analysis import ReferenceRun
+from stochpound.report.sections._accuracy import yielding_check
 from stochpound.report.sections._description import StoreDefinition, buildings_table, design_paragraph
 from stochpound.risk import DEFAULT_LIMIT_STATES, MODEL_DRIFT_LIMIT, store_damage
 from stochpound.store import contact_free, open_store
@@ -74,7 +75,7 @@ def test_methods_says_what_yielding_is_and_that_the_modal_check_runs_an_elastic_
 
 
 def test_the_yielding_check_reruns_a_yielded_case_and_fails_on_a_corrupted_store(store):
-    labels = yielding_case(store)
+    labels = ReferenceRun.yielding_case(store)
     ductility = store["peak_ductility"].max("building")
     yielded = np.sort(ductility.values[ductility.values > 1.0])
     assert float(ductility.sel(labels)) == yielded[(yielded.size - 1) // 2]  # the median of the cases that yielded

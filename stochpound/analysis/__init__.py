@@ -33,6 +33,25 @@ from stochpound.analysis._measure_free import MEASURE_FREE_RESPONSES, MeasureFre
 from stochpound.analysis._measure_free_store import MEASURE_FREE_RUNS, StoreMeasureFree, scene_demands, store_measure_free
 from stochpound.analysis._measure_comparison import compare_measures
 from stochpound.analysis._summary import run_summary
+from stochpound.analysis._mechanism_cells import MechanismCells, WallPenetration
+from stochpound.analysis._store_ensemble import RARE, ProbabilityAt, StoreEnsemble
+from stochpound.analysis._record_cases import RecordPounding
+from stochpound.analysis._cell_statistics import CellStatistics
+from stochpound.analysis._store_scenes import Configuration, StoreScenes
+from stochpound.analysis._solver_checks import (
+    COLLISION_VELOCITY,
+    CROSS_CHECK_TOLERANCE,
+    HARMONIC_AMPLITUDE,
+    HARMONIC_DETUNING,
+    REFERENCE_RTOL,
+    SUMMARY_RTOL,
+    CollisionCheck,
+    HarmonicComparison,
+    ModalCheck,
+    ReferenceRun,
+    free_collision_restitution,
+)
+from stochpound.analysis._store_separation import CONTACTS, WALLS, Closure, Needed, StoreSeparation, ValueRange
 from stochpound.hazard import (
     RUPTURE_COLUMNS,
     HazardCurve,
@@ -60,6 +79,8 @@ from stochpound.analysis._subset_simulation import (  # noqa: F401
     METHOD, ChainRun, SubsetLevel, SubsetSampler, curve_dataset, curve_thresholds, exceedance, exceedance_quantiles, level_attributes,
     level_probability, scene_response,
 )
+from stochpound.analysis._cell_statistics import ForceSpread, Largest  # noqa: F401
+from stochpound.analysis._cells import CellLabels  # noqa: F401
 
 
 CONTRACT_RISK_NAMES = ("fit_fragility", "mean_annual_frequency")
@@ -101,6 +122,32 @@ __all__ = [
     "store_contact_demands",
     "fixed_base_cqc",
     "run_summary",
+    "StoreEnsemble",
+    "ProbabilityAt",
+    "RecordPounding",
+    "CellStatistics",
+    "StoreScenes",
+    "Configuration",
+    "CollisionCheck",
+    "HarmonicComparison",
+    "ModalCheck",
+    "ReferenceRun",
+    "free_collision_restitution",
+    "COLLISION_VELOCITY",
+    "CROSS_CHECK_TOLERANCE",
+    "HARMONIC_AMPLITUDE",
+    "HARMONIC_DETUNING",
+    "REFERENCE_RTOL",
+    "SUMMARY_RTOL",
+    "RARE",
+    "StoreSeparation",
+    "Needed",
+    "Closure",
+    "CONTACTS",
+    "WALLS",
+    "ValueRange",
+    "MechanismCells",
+    "WallPenetration",
     "subset_simulation",
     "RESPONSES",
     "measure_free_risk",

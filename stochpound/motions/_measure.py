@@ -9,7 +9,8 @@ experiment's ``[intensity]`` or ``[hazard]``, a bundled curve's measure) and
 their sha256 are unchanged. Its two names are :attr:`Measure.label`, short
 (``PSA(1 s)``, for tables and store attributes), and
 :attr:`Measure.description`, in words with the damping (``PSA(T = 1 s, 5 %
-damping)``, for reports and errors). OpenQuake's ``hazardlib.imt`` does the
+damping)``, for reports and errors), which :meth:`Measure.axis_label` gives
+with the units of its values for a figure's axis. OpenQuake's ``hazardlib.imt`` does the
 same for its intensity measure types.
 """
 
@@ -153,6 +154,11 @@ class Measure:
         if self.kind == "sa_avg":
             return f"Sa_avg({self.periods[0]:g}-{self.periods[-1]:g} s, {len(self.periods)} periods{damping})"
         return self.kind.upper()
+
+    def axis_label(self, units: str) -> str:
+        """The measure in words (:attr:`description`) with the ``units`` of its values, for a figure's axis:
+        ``PSA(T = 1 s, 5 % damping) (g)``."""
+        return f"{self.description} ({units})"
 
     def __str__(self) -> str:
         return self.label

@@ -150,8 +150,8 @@ class StoreRisk:
         The motions of every stripe (the bootstrap's sample size): the fewest that ran in a stripe and configuration.
     method : str
         ``"stripes"`` or ``"ida"``.
-    setting : dict
-        The store's ``[intensity]`` entry (its measure, units and levels).
+    setting : Intensity or None
+        The store's ``[intensity]`` setting (its measure, units and levels; :class:`stochpound.store.Intensity`).
     stripes : int or None
         The store's intensity stripes that ran (None for IDA runs).
     progress : str
@@ -232,11 +232,18 @@ class StoreRisk:
         """The dimensions of :meth:`to_frame` that name a configuration (every grid axis but the gap)."""
         return [c for c in self.to_frame().columns if c not in ("target", *_SEPARATION, "lower_bound", "confidence", "motions")]
 
+    def by_configuration(self, frame: pd.DataFrame) -> list[tuple[dict[str, Any], pd.DataFrame]]:
+        """The rows of ``frame`` (:meth:`to_frame`, :meth:`design_frame`) per configuration, in their order: its labels
+        (dimension -> value of :meth:`configuration_dims`; empty for the one configuration of a scene without axes) and its rows."""
+        config = self.configuration_dims()
+        groups = frame.groupby(config, sort=False) if config else [((), frame)]
+        return [(dict(zip(config, labels if isinstance(labels, tuple) else (labels,))), rows) for labels, rows in groups]
+
     def separation_frame(self) -> pd.DataFrame:
         """The g* table: per configuration, g* and its interval (m) for each target (columns grouped by target); a g* that
         is only a lower bound (``stochpound.risk._chain.bound_beyond_stripes``) is the text ``≥ 0.640``, its interval empty."""
         frame = self.to_frame()
-        years = float(self.separation.attrs.get("years", self.years))
+        years = _stated_years(self.separation, self.years)
         config = self.configuration_dims()
         frame["target"] = [target_text(p, years) for p in frame["target"]]
         frame["separation"] = [f"≥ {value:.3f}" if bound else value for value, bound in zip(frame["separation"], frame["lower_bound"])]
@@ -266,13 +273,13 @@ class StoreRisk:
         frames = []
         if self.rules is not None:
             rules = _grid_only(self.rules, keep=("code_intensity", "stripe_intensity"))
-            stripes = [design_text(p, float(i), float(rules.attrs.get("years", self.years)))
+            stripes = [design_text(p, float(i), _stated_years(rules, self.years))
                        for p, i in zip(rules["design_level"].values, rules["stripe_intensity"].values)]
             rows = self._rules_rows(rules.drop_vars(["code_intensity", "stripe_intensity"]), dict(zip(rules["design_level"].values, stripes)))
             frames.append(rows[rows[[c for c in rows.columns if c.startswith("gap, ")]].notna().any(axis=1)])  # D_TM: not where the base never slides
         if self.design_rules is not None:
             rules = _grid_only(self.design_rules, keep=("design_level",))
-            years = float(rules.attrs.get("years", self.years))
+            years = _stated_years(rules, self.years)
             rows = self._rules_rows(rules, {p: f"{100 * p:g} %/{years:g} yr (design analysis)" for p in rules["design_level"].values})
             rows = rows[rows[[c for c in rows.columns if c.startswith("gap, ")]].notna().any(axis=1)]  # not where a rule does not apply
             frames.append(rows.reorder_levels(frames[0].index.names) if frames else rows)
@@ -280,7 +287,7 @@ class StoreRisk:
 
     def _rules_rows(self, rules: xr.Dataset, level_names: Mapping[float, str]) -> pd.DataFrame:
         """The rows of :meth:`rules_frame` of one rules dataset (``design_level`` a dimension or a coordinate along ``rule``)."""
-        years = float(rules.attrs.get("years", self.years))
+        years = _stated_years(rules, self.years)
         gaps = rules["gap"].to_dataframe()[["gap"]]["gap"].unstack("contact")
         gaps.columns = [f"gap, contact {c} (m)" for c in gaps.columns]
         values = rules[[name for name in (*_RULE_VALUES, "status") if name in rules]].to_dataframe()
@@ -492,6 +499,23 @@ class StoreRisk:
             curves = curves.assign(lower=band["lower"], upper=band["upper"])
         return curves
 
+    def design_basis(self) -> str:
+        """What the gap to design to is (:meth:`design_frame`'s ``basis`` of its first row with a value): by default the upper
+        bound of g*'s interval."""
+        frame = self.design_frame()
+        given = frame["design"].notna()
+        return str(frame.loc[given, "basis"].iloc[0]) if given.any() else "upper bound of g*'s interval"
+
+    def measure_margin(self, choice: pd.DataFrame, own: str) -> tuple[float, float, int]:
+        """How far the store's own measure ``own`` is from the most efficient one of ``choice`` (the measure choice's table:
+        β per measure and configuration, ``most efficient`` naming the smallest): the largest excess of its β over the
+        smallest, the standard error of one β estimate (about β/√(2(n − 2)), its largest β), and n, the contact-free runs
+        of a configuration (motions × stripes)."""
+        runs = self.motions * (self.stripes or 1)
+        excess = max(float(row[own] - row[row["most efficient"]]) for _, row in choice.iterrows())
+        noise = float(choice[own].max()) / math.sqrt(2.0 * max(runs - 2, 1))
+        return excess, noise, runs
+
     def return_period_range(self) -> tuple[float, float]:
         """The smallest and largest finite return period (yr) over the rules, levels and configurations (NaN without rules)."""
         if self.rules is None:
@@ -502,6 +526,11 @@ class StoreRisk:
     def target_text(self, probability: float) -> str:
         """A target in words: ``10 % in 50 yr``."""
         return target_text(probability, self.years)
+
+
+def _stated_years(result: xr.Dataset, years: float) -> float:
+    """The investigation time (yr) a result of the chain states in its ``years`` attribute, else ``years``."""
+    return float(result.attrs.get("years", years))
 
 
 def non_increasing_along(maf: xr.DataArray, dim: str) -> xr.DataArray:

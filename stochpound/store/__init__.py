@@ -63,14 +63,16 @@ from stochpound.store._gap_axes import (
     has_contact_free,
     has_wall_free,
     is_gap_axis,
+    wall_axis,
     wall_free,
+    walls_only,
     wall_gap_dims,
     with_contacts,
     with_walls,
 )
 from stochpound.store._open import open_store
 from stochpound.store._scenario import SCENARIO_KINDS, scenario_kind, scenario_ranges
-from stochpound.store._selections import fixed_base, has_fixed_base_twins, isolated_mus
+from stochpound.store._selections import fixed_base, has_fixed_base_twins, isolated_mus, select_case
 
 # For the other packages of stochpound (their interface to this one, not public API: not in __all__).
 from stochpound.store._catalogue import CASE, KINDS, REFERENCE  # noqa: F401
@@ -132,7 +134,10 @@ __all__ = [
     "scenario_kind",
     "scenario_ranges",
     "scene_g",
+    "select_case",
+    "wall_axis",
     "wall_free",
+    "walls_only",
     "wall_gap_dims",
     "with_contacts",
     "with_walls",

@@ -23,7 +23,7 @@ over realizations, say).
 from __future__ import annotations
 
 import re
-from typing import TypeVar
+from typing import Any, TypeVar
 
 import numpy as np
 import xarray as xr
@@ -86,6 +86,32 @@ def wall_free(data: Data) -> Data:
 def with_walls(data: Data) -> Data:
     """``data`` without its wall-free cases: the finite clearances of every wall axis."""
     return _at_finite(data, wall_gap_dims(data))
+
+
+def walls_only(data: xr.Dataset) -> bool:
+    """Whether a store's only impact elements are walls (no contact): every impact is a wall hit, which has no phase (a wall moves with the ground)."""
+    return data.sizes.get("contact", 0) == 0 and "peak_wall_penetration" in data
+
+
+def wall_axis(store: xr.Dataset) -> tuple[str, Any] | None:
+    """The axis that sets walls and its value without a wall reached: a gap axis over the walls only holding ``inf`` and
+    finite clearances (``(axis, inf)``), or a variant axis whose first value without walls is the reference when the base
+    scene has no wall and the axis's other values add some; else None."""
+    for axis in wall_gap_dims(store):
+        values = store[axis].values
+        if np.isinf(values).any() and np.isfinite(values).any():
+            return axis, float(np.inf)
+    definition = store.pound.definition
+    if definition.scene.get("wall"):
+        return None
+    for axis in definition.variants:
+        if axis.name not in store.dims:
+            continue
+        walled = {value: bool(axis.overrides[value].get("scene", {}).get("wall")) for value in axis.values}
+        bare = [value for value, has in walled.items() if not has]
+        if bare and any(walled.values()):
+            return axis.name, bare[0]
+    return None
 
 
 def _holds_inf(data: xr.Dataset | xr.DataArray, dims: list[str]) -> bool:

@@ -13,7 +13,7 @@ on its grid dimensions (statistics over realizations, say).
 from __future__ import annotations
 
 from collections.abc import Iterable
-from typing import TypeVar
+from typing import Any, TypeVar
 
 import xarray as xr
 
@@ -42,3 +42,16 @@ def isolated_mus(mus: Iterable[float]) -> list[float]:
 def fixed_base(data: Data) -> Data:
     """The fixed-base cases (μ = :data:`~stochpound.experiment.FIXED_BASE`), the ``mu`` coordinate kept."""
     return data.sel(mu=FIXED_BASE)
+
+
+def select_case(store: xr.Dataset, **labels: Any) -> xr.Dataset:
+    """The store at the given labels; labels of dimensions the store lacks are ignored.
+
+    A ``realization`` of length 1 is squeezed. A label missing from its
+    dimension raises ``KeyError`` (callers show such cells as missing).
+    """
+    present = {dim: value for dim, value in labels.items() if dim in store.dims}
+    selected = store.sel(present)
+    if "realization" in selected.dims and selected.sizes["realization"] == 1:
+        selected = selected.isel(realization=0)
+    return selected

@@ -9,6 +9,8 @@ substitutes as such.
 
 from __future__ import annotations
 
+import itertools
+import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -18,6 +20,9 @@ import xarray as xr
 from matplotlib.figure import Figure
 
 from stochpound.analysis import normal_histogram
+
+MAX_PANELS = 16
+"""Most panels in one figure."""
 
 #: Line styles cycled over the lines of one panel.
 STYLES = ("-", "--", ":", "-.")
@@ -302,3 +307,54 @@ def _draw(ax: Any, curve: Curve) -> Any:
 
 def _cycle(count: int) -> list[str]:
     return [STYLES[i % len(STYLES)] for i in range(count)]
+
+
+def spread_panels(grid: Mapping[str, Sequence[Any]], max_panels: int = MAX_PANELS) -> list[tuple[list[dict[str, Any]], dict[str, Any]]]:
+    """Every combination of ``grid`` (dimension -> values) spread over figures of at most ``max_panels`` panels: per figure,
+    its panels' labels and the labels its panels share. The outermost dimensions are split off into separate figures until
+    the rest fits; an empty grid gives one figure with one panel."""
+    dims = list(grid)
+    split = 0
+    while split < len(dims) and math.prod(len(grid[d]) for d in dims[split:]) > max_panels:
+        split += 1
+    outer, inner = dims[:split], dims[split:]
+    result = []
+    for shared in itertools.product(*(grid[d] for d in outer)):
+        panels = [dict(zip(inner, combination)) for combination in itertools.product(*(grid[d] for d in inner))]
+        result.append((panels, dict(zip(outer, shared))))
+    return result
+
+
+def line_colours(dim: str | None, values: Sequence[Any]) -> list[Any]:
+    """One colour per value of the line dimension: a sequential map for numbers (∞, a fixed base, in black), a qualitative one otherwise."""
+    from matplotlib import colormaps
+
+    if dim is None:
+        return ["C0"] * len(values)
+    numeric = [v.item() if isinstance(v, np.generic) else v for v in values]
+    if all(isinstance(v, float) for v in numeric):
+        finite = [v for v in numeric if not math.isinf(v)]
+        scale = colormaps["viridis"]
+        positions = np.linspace(0.0, 0.9, len(finite)) if len(finite) > 1 else [0.0]
+        ranks = {v: p for v, p in zip(sorted(finite), positions)}
+        return ["black" if math.isinf(v) else scale(ranks[v]) for v in numeric]
+    return [f"C{i % 10}" for i in range(len(values))]
+
+
+RATE_DECADES = 6
+"""The most decades of annual rate a rate axis spans below its largest rate (smaller rates are off the figure)."""
+
+
+def rate_limits(rates: Any, references: Any = ()) -> tuple[float, float]:
+    """Limits (1/yr) of a logarithmic rate axis from the positive finite rates drawn and reference lines (targets).
+
+    Half the smallest to twice the largest, but no more than ``RATE_DECADES``
+    decades below the largest: a bootstrap band or a far tail down to 1e-300
+    would otherwise squash the curves into a line. (1e-6, 1) when nothing is positive.
+    """
+    values = np.concatenate([np.ravel(np.asarray(rates, dtype=float)), np.ravel(np.asarray(references, dtype=float))])
+    values = values[np.isfinite(values) & (values > 0.0)]
+    if values.size == 0:
+        return 1e-6, 1.0
+    top = 2.0 * float(values.max())
+    return max(0.5 * float(values.min()), top * 10.0**-RATE_DECADES), top

@@ -14,8 +14,9 @@ from stochpound.report.sections._rare_events import rare_event_section
 from stochpound.report.sections._risk import risk_section
 from stochpound.report.sections._laws import law_axis, laws_section
 from stochpound.report.sections._methods import methods_section
+from stochpound.analysis import WALLS
 from stochpound.report.sections._measure_free import measure_free_section
-from stochpound.report.sections._separation import WALLS, separation_section
+from stochpound.report.sections._separation import separation_section
 from stochpound.report.sections._store_reading import open_stores, select, value
 from stochpound.report.sections._summary import experiment_summary, move_per_cell_tables
 

@@ -7,7 +7,7 @@ Five checks, each against something known exactly or computed independently:
   a store's harmonic motions (``[[motions]]`` of type harmonic), when present, are checked on its stored runs;
 * every contact element as a single collision of its two floor masses, free,
   against the restitution the Kelvin–Voigt law gives in closed form
-  (:func:`free_collision_restitution`);
+  (:func:`stochpound.analysis.free_collision_restitution`);
 * one stored case with pounding (and sliding, where a store has it) rerun
   with the exact solver and with scipy's DOP853 at rtol 1e-12;
 * per store with yielding storeys, one stored case that yielded, rerun the
@@ -17,171 +17,17 @@ Five checks, each against something known exactly or computed independently:
 
 from __future__ import annotations
 
-import math
-from dataclasses import dataclass
-
-import numpy as np
-import xarray as xr
-
-import stochpound
 from stochpound._errors import VerificationError
+from stochpound.analysis import (COLLISION_VELOCITY, CROSS_CHECK_TOLERANCE, HARMONIC_AMPLITUDE, HARMONIC_DETUNING, REFERENCE_RTOL,
+                                 SUMMARY_RTOL, CollisionCheck, HarmonicComparison, ModalCheck, ReferenceRun)
 from stochpound.model import laws
-from stochpound.model.modal_solution import harmonic_response, modal_properties
-from stochpound.report.sections._description import StoreDefinition, has_yielding, number, numbers
+from stochpound.model.scene import Scene
 from stochpound.report.render import Paragraph
+from stochpound.report.sections._description import StoreDefinition, has_yielding, number, numbers
 from stochpound.report.sections._store_reading import select
-from stochpound.model.scene import Building, Contact, Scene
 
-#: Closing velocity of the single-collision check, m/s.
-COLLISION_VELOCITY = 0.5
-#: Ground-acceleration amplitude of the modal check, m/s²; Ω is this fraction of ω1.
-HARMONIC_AMPLITUDE, HARMONIC_DETUNING = 1.0, 0.9
-#: Tolerances of the DOP853 reference run.
-REFERENCE_RTOL, REFERENCE_ATOL = 1e-12, 1e-14
-CROSS_CHECK_TOLERANCE = 1e-6
-"""Largest difference of the cross-check's two solvers, as a share of the peak displacement, that passes."""
-
-
-def free_collision_restitution(damping_ratio: float, tensile: bool) -> float:
-    """Coefficient of restitution of two free masses colliding through a Kelvin–Voigt element.
-
-    With ζ = c / (2 √(k m_eff)) < 1 the penetration is δ = v0/ω_d e^{−ζωt} sin ω_d t.
-    A tensile element separates when δ returns to 0 (ω_d t = π), giving
-    r = exp(−ζπ/√(1−ζ²)). A non-tensile one separates when its force
-    k δ + c δ̇ returns to 0, at ω_d t = π − atan2(2ζ√(1−ζ²), 1 − 2ζ²),
-    giving r = −δ̇(t)/v0 there.
-    """
-    root = math.sqrt(1.0 - damping_ratio**2)
-    if tensile:
-        return math.exp(-damping_ratio * math.pi / root)
-    phase = math.pi - math.atan2(2.0 * damping_ratio * root, 1.0 - 2.0 * damping_ratio**2)
-    return -math.exp(-damping_ratio * phase / root) * (math.cos(phase) - damping_ratio / root * math.sin(phase))
-
-
-@dataclass(frozen=True)
-class CollisionCheck:
-    """A contact's single collision: restitution measured on the solver's run and its closed form."""
-
-    masses: tuple[float, float]
-    contact: Contact
-    expected: float
-    measured: float
-
-
-def collision_check(masses: tuple[float, float], contact: Contact) -> CollisionCheck:
-    """Run the two floor masses, free, into each other through ``contact`` (exact solver) and measure the restitution."""
-    effective = masses[0] * masses[1] / (masses[0] + masses[1])
-    omega = math.sqrt(contact.stiffness / effective)
-    zeta = contact.damping / (2.0 * math.sqrt(contact.stiffness * effective))
-    duration = 3.0 * math.pi / (omega * math.sqrt(1.0 - zeta**2))
-
-    def body(name: str, mass: float, velocity: float) -> dict:
-        return {"name": name, "mass": [mass], "stiffness": [0.0], "damping": [0.0], "initial": {"velocity": [velocity]}}
-
-    scene = {
-        "building": [body("A", masses[0], COLLISION_VELOCITY), body("B", masses[1], 0.0)],
-        "contact": [{"between": [["A", 1], ["B", 1]], "gap": 0.0, "stiffness": contact.stiffness, "damping": contact.damping, "tensile": contact.tensile}],
-        "motion": {"type": "constant", "acceleration": 0.0, "duration": duration, "dt": duration / 300},
-    }
-    run = stochpound.simulate(stochpound.scene_from_dict(scene), method="exact")
-    y, t = run["total_displacement"].sel(floor=1).values, run["time"].values
-    velocities = (y[:, -1] - y[:, -2]) / (t[-1] - t[-2])
-    measured = float((velocities[1] - velocities[0]) / COLLISION_VELOCITY)
-    return CollisionCheck(masses, contact, free_collision_restitution(zeta, contact.tensile), measured)
-
-
-@dataclass(frozen=True)
-class ModalCheck:
-    """A building under A sin(Ωt) on a fixed base: the solver against the closed-form modal solution (m)."""
-
-    building: Building
-    omega: float
-    error: float
-    peak: float
-
-
-def modal_check(building: Building) -> ModalCheck | None:
-    """Run ``building`` alone on a fixed base under A sin(0.9 ω1 t) for 20 periods (None if its damping is not classical)."""
-    modes = modal_properties(building)
-    if not modes.classical:
-        return None
-    omega = HARMONIC_DETUNING * float(modes.omega[0])
-    period = 2.0 * math.pi / float(modes.omega[0])
-    alone = Building(building.name, building.mass, building.stiffness, building.damping, building.damping_ratio)
-    motion = {"type": "harmonic", "amplitude": HARMONIC_AMPLITUDE, "omega": omega, "duration": 20.0 * period, "dt": period / 40.0}
-    scene = stochpound.scene_from_dict({"building": [_building_table(alone)], "motion": motion})
-    run = stochpound.simulate(scene, method="exact")
-    computed = run["relative_displacement"].sel(building=building.name).values
-    exact = harmonic_response(alone, HARMONIC_AMPLITUDE, omega, run["time"].values)
-    return ModalCheck(building, omega, float(np.max(np.abs(computed - exact))), float(np.max(np.abs(exact))))
-
-
-def _building_table(building: Building) -> dict:
-    return {"name": building.name, "mass": list(building.mass), "stiffness": list(building.stiffness), "damping": list(building.damping)}
-
-
-@dataclass(frozen=True)
-class HarmonicComparison:
-    """A stored harmonic-check run beside the closed-form modal solution.
-
-    Attributes
-    ----------
-    amplitude, omega : float
-        A (m/s²) and Ω (rad/s) of a_g = A sin(Ωt).
-    time : numpy.ndarray
-        s.
-    computed, exact : numpy.ndarray
-        Floor displacements relative to the ground, m, (floors, time).
-    """
-
-    amplitude: float
-    omega: float
-    time: np.ndarray
-    computed: np.ndarray
-    exact: np.ndarray
-
-    @property
-    def error(self) -> float:
-        """The largest absolute difference between computed and exact, m."""
-        return float(np.max(np.abs(self.computed - self.exact)))
-
-
-def harmonic_comparisons(store: xr.Dataset) -> list[HarmonicComparison]:
-    """A store's harmonic motions (``[[motions]]`` of type harmonic) beside the closed-form modal solution."""
-    comparisons = []
-    for motion in store.pound.definition.motions:
-        if motion.motion.get("type") != "harmonic":
-            continue
-        building = store.pound.scene(record=motion.label).buildings[0]
-        run = select(store, record=motion.label)
-        computed = run["relative_displacement"].sel(building=building.name).values
-        valid = np.isfinite(computed[0])
-        time = run["time"].values[valid]
-        amplitude, omega = float(motion.motion["amplitude"]), float(motion.motion["omega"])
-        comparisons.append(HarmonicComparison(amplitude, omega, time, computed[:, valid], harmonic_response(building, amplitude, omega, time)))
-    return comparisons
-
-
-def cross_check_case(store: xr.Dataset) -> tuple[dict, bool] | None:
-    """A stored case with pounding, and with sliding if the store has such a case, and whether it slides.
-
-    Among those, the case with the median impact count (the first in grid
-    order); None when no stored case pounds.
-    """
-    impacts = store["impacts"].load()
-    pounding = impacts > 0
-    slides = False
-    if "peak_sliding_displacement" in store:
-        sliding = (store["peak_sliding_displacement"].max("building") > 1e-3).load()
-        slides = bool((pounding & sliding).any())
-        if slides:
-            pounding = pounding & sliding
-    counts = impacts.where(pounding).stack(case=impacts.dims).dropna("case")
-    if counts.size == 0:
-        return None
-    median = float(np.sort(counts.values)[(counts.size - 1) // 2])
-    chosen = counts.where(counts == median, drop=True).isel(case=0)
-    return {dim: chosen[dim].item() for dim in impacts.dims}, slides
+harmonic_comparisons = HarmonicComparison.of_store
+"""A store's harmonic motions beside the closed-form modal solution (:meth:`stochpound.analysis.HarmonicComparison.of_store`)."""
 
 
 def cross_check(definitions: list[StoreDefinition]) -> Paragraph | None:
@@ -194,19 +40,20 @@ def cross_check(definitions: list[StoreDefinition]) -> Paragraph | None:
     impacts, or when they differ by more than :data:`CROSS_CHECK_TOLERANCE`
     of the peak displacement.
     """
-    candidates = [(d, found) for d in definitions if "impacts" in d.store for found in [cross_check_case(d.store)] if found is not None]
+    candidates = [(d, found) for d in definitions if "impacts" in d.store for found in [ReferenceRun.pounding_case(d.store)] if found is not None]
     if not candidates:
         return None
     definition, (labels, _) = next((c for c in candidates if c[1][1]), candidates[0])
     name, store = definition.name, definition.store
     scene: Scene = store.pound.scene(**labels)
     nonlinear = scene.nonlinear_laws()
-    exact, reference, difference, peak = _against_reference(scene)
+    run = ReferenceRun.of(scene)
+    difference, peak = run.difference, run.peak
     held = int(select(store, **labels)["impacts"])
     where = ", ".join(f"{k} = {number(v) if isinstance(v, float) else v}" for k, v in labels.items())
-    counts = (exact.sizes["impact"], reference.sizes["impact"])
-    _verify(name, where, held, counts, difference, peak)
-    sliding = float(exact["sliding_displacement"].max() - exact["sliding_displacement"].min())
+    counts = run.impacts
+    run.verify(name, where, held)
+    sliding = run.sliding
     scale = float(select(store, **labels)["scale_factor"]) if "scale_factor" in store else 1.0
     return Paragraph(
         f"Cross-check on a stored case of {name} ({where}"
@@ -222,33 +69,6 @@ def cross_check(definitions: list[StoreDefinition]) -> Paragraph | None:
     )
 
 
-def _against_reference(scene: Scene) -> tuple[xr.Dataset, xr.Dataset, float, float]:
-    """``scene`` run as a store runs it and with scipy's DOP853 at rtol 1e-12: both runs, their largest difference and the peak (m)."""
-    exact = stochpound.simulate(scene)  # the solver the store used: exact, or the integrator at its defaults for a nonlinear law
-    reference = stochpound.simulate(scene, method="ivp", integrator="DOP853", rtol=REFERENCE_RTOL, atol=REFERENCE_ATOL)
-    difference = float(np.nanmax(np.abs(exact["total_displacement"].values - reference["total_displacement"].values)))
-    return exact, reference, difference, float(np.nanmax(np.abs(reference["total_displacement"].values)))
-
-
-#: The store's yielding summaries the yielding check recomputes: name -> the run's per-storey variable (largest absolute value over the storeys).
-YIELDING_SUMMARIES = {"peak_ductility": "peak_storey_ductility", "residual_drift": "residual_storey_drift"}
-SUMMARY_RTOL = 1e-9
-"""Largest relative difference of a re-run's yielding summaries from the store's that passes."""
-
-
-def yielding_case(store: xr.Dataset) -> dict | None:
-    """A stored case whose storeys yielded: the median peak ductility among those > 1 (the first in grid order); None if none yielded."""
-    if "peak_ductility" not in store:
-        return None
-    ductility = store["peak_ductility"].max("building").load()
-    yielded = ductility.where(ductility > 1.0).stack(case=ductility.dims).dropna("case")
-    if yielded.size == 0:
-        return None
-    median = float(np.sort(yielded.values)[(yielded.size - 1) // 2])
-    chosen = yielded.where(yielded == median, drop=True).isel(case=0)
-    return {dim: chosen[dim].item() for dim in ductility.dims}
-
-
 def yielding_check(definition: StoreDefinition) -> Paragraph | None:
     """A stored case whose storeys yielded, re-run as it ran, against scipy's DOP853 (rtol 1e-12) and against the store (None without one).
 
@@ -259,21 +79,20 @@ def yielding_check(definition: StoreDefinition) -> Paragraph | None:
     or DOP853's, or when the two solvers differ by more than
     :data:`CROSS_CHECK_TOLERANCE` of the peak displacement.
     """
-    labels = yielding_case(definition.store)
+    labels = ReferenceRun.yielding_case(definition.store)
     if labels is None:
         return None
     name, stored = definition.name, select(definition.store, **labels)
     scene: Scene = definition.store.pound.scene(**labels)
-    exact, reference, difference, peak = _against_reference(scene)
+    run = ReferenceRun.of(scene)
+    exact, difference, peak = run.exact, run.difference, run.peak
     where = ", ".join(f"{k} = {number(v) if isinstance(v, float) else v}" for k, v in labels.items())
-    _verify(name, where, int(stored["impacts"]) if "impacts" in stored else exact.sizes["impact"], (exact.sizes["impact"], reference.sizes["impact"]),
-            difference, peak)
-    rerun = {key: np.abs(exact[source]).max("floor").sel(building=stored["building"]) for key, source in YIELDING_SUMMARIES.items()}
-    for key, values in rerun.items():
-        if not np.allclose(values.values, stored[key].values, rtol=SUMMARY_RTOL, atol=0.0, equal_nan=True):
-            raise VerificationError(f"yielding check: the stored case of {name} ({where}) re-run gives {key} {numbers(values.values, 10)}, "
-                                    f"the store holds {numbers(stored[key].values, 10)}")
-    building = str(rerun["peak_ductility"].idxmax("building").item())
+    run.verify(name, where, int(stored["impacts"]) if "impacts" in stored else exact.sizes["impact"])
+    rerun = run.yielding_summaries(stored["building"])
+    for key in run.mismatched_summaries(rerun, stored):
+        raise VerificationError(f"yielding check: the stored case of {name} ({where}) re-run gives {key} {numbers(rerun[key].values, 10)}, "
+                                f"the store holds {numbers(stored[key].values, 10)}")
+    building = run.most_ductile(rerun)
     scale = float(stored["scale_factor"]) if "scale_factor" in stored else 1.0
     return Paragraph(
         f"Yielding check on a stored case of {name} ({where}"
@@ -288,23 +107,11 @@ def yielding_check(definition: StoreDefinition) -> Paragraph | None:
     )
 
 
-def _verify(name: str, where: str, held: int, counts: tuple[int, int], difference: float, peak: float) -> None:
-    """Raise :class:`~stochpound._errors.VerificationError` where the re-run disagrees with the store or the reference."""
-    if counts[0] != held:
-        raise VerificationError(f"cross-check: the stored case of {name} ({where}) re-run counts {counts[0]} impacts, the store holds {held}")
-    if counts[1] != counts[0]:
-        raise VerificationError(f"cross-check: on the stored case of {name} ({where}) the solver counts {counts[0]} impacts, "
-                                f"scipy's DOP853 {counts[1]}")
-    if not difference <= CROSS_CHECK_TOLERANCE * peak:
-        raise VerificationError(f"cross-check: on the stored case of {name} ({where}) the solver and scipy's DOP853 differ by "
-                                f"{difference:.1e} m, more than {CROSS_CHECK_TOLERANCE:g} of the peak {peak:.3g} m")
-
-
 def accuracy_paragraphs(definitions: list[StoreDefinition]) -> list[Paragraph]:
     """Every check of the module docstring, run now on the stores."""
     paragraphs = []
     for definition in definitions:
-        for check in harmonic_comparisons(definition.store):
+        for check in HarmonicComparison.of_store(definition.store):
             paragraphs.append(Paragraph(
                 f"Stored harmonic run of {definition.name} (A = {number(check.amplitude)} m/s², Ω = {number(check.omega)} rad/s, "
                 f"{number(float(check.time[-1]))} s) against the closed-form modal solution: largest difference in floor "
@@ -316,7 +123,7 @@ def accuracy_paragraphs(definitions: list[StoreDefinition]) -> list[Paragraph]:
     if crossed is not None:
         paragraphs.append(crossed)
     paragraphs += [checked for checked in map(yielding_check, definitions) if checked is not None]
-    residuals = {d.name: float(d.store["energy_residual_ratio"].max()) for d in definitions if "energy_residual_ratio" in d.store}
+    residuals = {d.name: d.energy_residual for d in definitions if d.energy_residual is not None}
     if residuals:
         worst = max(residuals, key=residuals.get)
         storeys = "storey dashpots, yielding storeys (hysteretic)" if has_yielding(definitions) else "storeys"
@@ -334,7 +141,7 @@ def _modal_paragraphs(definitions: list[StoreDefinition]) -> list[Paragraph]:
             building = next(b for b in configuration.scene.buildings if b.name == definition.experiment.studied)
             key = (building.mass, building.stiffness, building.damping)
             if key not in checked:
-                checked[key] = modal_check(building)
+                checked[key] = ModalCheck.run(building)
     sentences = []
     for check in checked.values():
         if check is None:
@@ -364,11 +171,11 @@ def _collision_paragraphs(definitions: list[StoreDefinition]) -> list[Paragraph]
     for definition in definitions:
         for configuration in definition.configurations:
             scene = configuration.scene
-            for contact in (c for c in scene.contacts if laws.contact_law(c.law).piecewise_linear):  # the closed form is the linear element's
+            for contact in (c for c in scene.contacts if laws.CONTACT_LAWS[c.law].piecewise_linear):  # the closed form is the linear element's
                 masses = (scene.buildings[contact.left].mass[contact.left_floor - 1], scene.buildings[contact.right].mass[contact.right_floor - 1])
                 key = (masses, contact.stiffness, contact.damping, contact.tensile)
                 if key not in checked:
-                    checked[key] = collision_check(masses, contact)
+                    checked[key] = CollisionCheck.run(masses, contact)
     if not checked:
         return []
     rows = [

@@ -13,26 +13,21 @@ from __future__ import annotations
 import json
 import math
 from collections.abc import Iterable, Mapping
-from dataclasses import dataclass
-from functools import cached_property
 from typing import Any
 
 import numpy as np
 import pandas as pd
-import xarray as xr
 
 from stochpound import motions as synthetic_motions
-from stochpound.experiment import CASE, Case, GapAxis, is_fixed_base
-from stochpound.model import design_yield_shears, laws
-from stochpound.model.contact import effective_mass
-from stochpound.model.modal_solution import modal_properties
+from stochpound.experiment import CASE, is_fixed_base
+from stochpound.analysis import Configuration, StoreScenes
+from stochpound.model import laws
 from stochpound.motions.records import load_record, registry_entries
 from stochpound.report.render import Paragraph, Table
 from stochpound.report.sections._stripe_motions import stripe_motions_text
 from stochpound.motions.records import is_suite_member
 from stochpound.model.scene import Building, Contact, Scene
 from stochpound.model.wall import Wall
-from stochpound.model.scene_file import scene_from_dict
 
 
 def number(value: float, digits: int = 6) -> str:
@@ -50,89 +45,14 @@ def percent(values: Iterable[float]) -> str:
     return ", ".join(f"{100.0 * float(v):.3g} %" for v in values)
 
 
-@dataclass(frozen=True)
-class Configuration:
-    """One structural configuration of an experiment: a combination of its variant axes' values.
-
-    Attributes
-    ----------
-    labels : dict
-        The variant axes' values (empty without variant axes).
-    scene : Scene
-        The scene of the configuration's first case with a finite μ (its
-        gaps and μ are those of that case; the grid's values are described
-        separately).
-    """
-
-    labels: dict[str, str]
-    scene: Scene
-
-    @property
-    def name(self) -> str:
-        """``neighbour = stiff, model = corrected``, or ``–`` without variant axes."""
-        return ", ".join(f"{axis} = {value}" for axis, value in self.labels.items()) or "–"
-
-
-class StoreDefinition:
-    """An experiment store's definition, with its configurations' scenes.
-
-    Parameters
-    ----------
-    name : str
-        The experiment's name.
-    store : xarray.Dataset
-        The store (its ``definition`` attribute is read).
-    """
-
-    def __init__(self, name: str, store: xr.Dataset) -> None:
-        self.name = name
-        self.store = store
-        self.experiment = store.pound.grid
-        self.definition = self.experiment.contract
-
-    @cached_property
-    def configurations(self) -> list[Configuration]:
-        """One per combination of the variant axes, in grid order."""
-        cases = [c for c in self.experiment.cases if c.kind == CASE]
-        variant_axes = [v.name for v in self.experiment.variants]
-        chosen: dict[tuple, Case] = {}
-        for case in cases:
-            labels = case.label_dict
-            key = tuple(labels[axis] for axis in variant_axes)
-            finite = not is_fixed_base(labels.get("mu", 0.0))
-            if key not in chosen or (finite and is_fixed_base(chosen[key].label_dict.get("mu", 0.0))):
-                chosen[key] = case
-        return [Configuration(dict(zip(variant_axes, key)), scene_from_dict(self.experiment.structure(case))) for key, case in chosen.items()]
-
-    def takes_grid_mu(self, building: Building) -> bool:
-        """Whether the grid's ``mu`` axis sets this building's friction (it must then stand on a base)."""
-        mu = self.definition.mu
-        return mu is not None and building.base is not None and mu.sets(building.name, has_base=True)
+class StoreDefinition(StoreScenes):
+    """An experiment store's definition, with its configurations' scenes (:class:`stochpound.analysis.StoreScenes`), as the report describes it."""
 
     @property
     def mu_buildings_text(self) -> str:
         """The buildings the ``mu`` axis applies to, in words."""
         chosen = self.definition.mu.buildings
         return ", ".join(chosen) if chosen else "every building on a sliding base"
-
-    @property
-    def mu_values(self) -> list[float]:
-        """The ``mu`` axis's values (empty without one)."""
-        return list(self.definition.mu.values) if self.definition.mu is not None else []
-
-    def gap_axis(self, contact: int) -> GapAxis | None:
-        """The grid's gap axis that sets this contact's gap, if any."""
-        return self.definition.contact_gap_axis(contact)
-
-    @property
-    def study_compat_cases(self) -> int:
-        """How many grid cases run the study's equations (``study_compat``)."""
-        return sum(1 for c in self.configurations if c.scene.study_compat) * self._cases_per_configuration
-
-    @property
-    def _cases_per_configuration(self) -> int:
-        total = sum(1 for c in self.experiment.cases if c.kind == CASE)
-        return total // max(len(self.configurations), 1)
 
 
 def _damping(building: Building) -> str:
@@ -145,7 +65,7 @@ def _base(definition: StoreDefinition, building: Building, g: float) -> str:
     base = building.base
     if base is None:
         return "fixed"
-    law = laws.friction_law(base.friction_law)
+    law = laws.FRICTION_LAWS[base.friction_law]
     if definition.takes_grid_mu(building):
         finite = [m for m in definition.mu_values if not is_fixed_base(m)]
         parts = [f"sliding, {law.title}, μ = μ_s ∈ {{{numbers(finite)}}}" + (" or fixed (μ = ∞)" if len(finite) < len(definition.mu_values) else "")]
@@ -206,9 +126,7 @@ def design_paragraph(definition: StoreDefinition) -> Paragraph | None:
             weight = g * sum(building.mass)
             text = f"{building.name}: F_y,1 / W = {number(building.yield_force[0] / weight, 3)}"
             if building.storey_height is not None:
-                period = float(modal_properties(building).periods[0])
-                code = design_yield_shears(building.mass, building.storey_height, period=period, sds=design.sds, sd1=design.sd1,
-                                           r=design.r, overstrength=design.omega0, importance=design.ie, long_period=design.tl, g=g)
+                period, code = definition.design_shears(building, g)
                 text += (f", the design's Ω0 V / W = {number(code[0] / weight, 3)} at T1 = {number(period, 3)} s "
                          f"(its yield shears {numbers(code, 4)} N; the building's are {numbers(np.asarray(building.yield_force) / code, 3)} times those)")
             strengths.setdefault(text, []).append(configuration.name)
@@ -228,7 +146,7 @@ def buildings_table(definitions: Iterable[StoreDefinition]) -> Table:
     for definition in definitions:
         for configuration in definition.configurations:
             for building in configuration.scene.buildings:
-                modes = modal_properties(building)
+                modes = definition.modes(building)
                 damping_note = "" if modes.classical else " (damping not classical: ζ from the diagonal of ΦᵀCΦ)"
                 row = (
                     building.name,
@@ -258,9 +176,9 @@ def buildings_table(definitions: Iterable[StoreDefinition]) -> Table:
 
 def _contact_row(definition: StoreDefinition, scene: Scene, index: int, contact: Contact) -> tuple[str, ...]:
     left, right = scene.buildings[contact.left], scene.buildings[contact.right]
-    parameters = contact.parameters(effective_mass(left.mass[contact.left_floor - 1], right.mass[contact.right_floor - 1]))
+    parameters = definition.contact_parameters(scene, contact)
     axis = definition.gap_axis(index)
-    law = laws.contact_law(contact.law)
+    law = laws.CONTACT_LAWS[contact.law]
     return (
         f"{left.name} floor {contact.left_floor} – {right.name} floor {contact.right_floor}",
         law.describe(parameters),
@@ -272,9 +190,9 @@ def _contact_row(definition: StoreDefinition, scene: Scene, index: int, contact:
 def _wall_row(definition: StoreDefinition, scene: Scene, index: int, wall: Wall) -> tuple[str, ...]:
     building = scene.buildings[wall.building]
     axis = definition.definition.wall_gap_axis(index)
-    parameters = wall.parameters(building.base.mass if wall.level == 0 and building.base is not None else building.mass[max(wall.level, 1) - 1])
+    parameters = definition.wall_parameters(scene, wall)
     level = "base" if wall.level == 0 else f"floor {wall.level}"
-    law = laws.contact_law(wall.law)
+    law = laws.CONTACT_LAWS[wall.law]
     return (
         f"{building.name} {level} – wall on its {wall.side_name} (moves with the ground)",
         law.describe(parameters),
@@ -464,7 +382,7 @@ def model_paragraph(definitions: list[StoreDefinition]) -> Paragraph:
     if any(b.p_delta for b in buildings):
         sentences.append("With P-Δ a storey's spring is softened by the geometric stiffness −W/h of the weight above it, in its elastic and post-yield branches alike.")
     if isolated:
-        friction = sorted({laws.friction_law(b.base.friction_law).title for b in buildings if b.base is not None})
+        friction = sorted({laws.FRICTION_LAWS[b.base.friction_law].title for b in buildings if b.base is not None})
         sentences.append(
             f"A building on a sliding base has one more degree of freedom, its sliding displacement s; {' or '.join(friction)} "
             "opposes the sliding, and the base sticks while the friction force it needs stays below μ_s W (W its weight); "
@@ -472,7 +390,7 @@ def model_paragraph(definitions: list[StoreDefinition]) -> Paragraph:
         )
     walls = [w for s in scenes for w in s.walls]
     if contacts or walls:
-        used = [laws.contact_law(name) for name in dict.fromkeys(e.law for e in (*contacts, *walls))]
+        used = [laws.CONTACT_LAWS[name] for name in dict.fromkeys(e.law for e in (*contacts, *walls))]
         sentences.append(
             "Impact elements act only while their gap is closed: " + "; ".join(f"{law.title}, {law.formula}" for law in used)
             + " (δ the penetration, δ̇ its rate, δ̇₀ its rate at the onset of the impact; parameters in the table of contacts)."

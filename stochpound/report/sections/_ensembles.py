@@ -12,27 +12,21 @@ realizations. Every cell is in every figure family (:mod:`stochpound.report.sect
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from functools import cached_property
 from typing import Any
 
 import numpy as np
 import pandas as pd
 import xarray as xr
 
-from stochpound.analysis import MIN_RUNS, ensemble_statistics, mean_interval, of_first, pounding_probability
+from stochpound.analysis import MIN_RUNS, CellLabels, StoreEnsemble
 from stochpound.report.render import Block, FigureItem, Table, figures
 from stochpound.experiment import is_gap_axis
-from stochpound.report.sections._facets import cell_gid, dim_text, labels_text, layouts, line_colours, plain, value_text
+from stochpound.report.sections._facets import cell_gid, dim_text, labels_text, layouts, line_colours, value_text
 
 CM = 100.0
 KN = 1e-3
-CONVERGENCE_POINTS = 8
-"""Sample sizes, from :data:`MIN_RUNS` to the ensemble's size (geometrically spaced), at which a convergence figure draws the estimates."""
-CONVERGENCE_PANELS = 4
-"""Most panels of a convergence figure: the cells slowest to settle (P(pounding) nearest 0.5), not every cell."""
 
 
 @dataclass(frozen=True)
@@ -90,62 +84,20 @@ def _with_unit(quantity: Quantity) -> str:
     return f"{quantity.label} ({quantity.unit})" if quantity.unit else quantity.label
 
 
-class Ensemble:
-    """One synthetic ensemble of a store, its grid and its statistics.
-
-    Parameters
-    ----------
-    name : str
-        The experiment's name.
-    store : xarray.Dataset
-        The store.
-    label : str
-        The ensemble's label on the ``record`` dimension.
-    confidence : float
-        Level of every interval.
-    """
-
-    def __init__(self, name: str, store: xr.Dataset, label: str, confidence: float = 0.95) -> None:
-        self.name, self.label, self.confidence = name, label, confidence
-        status = store["case_status"].sel(record=label)
-        realizations = (status >= 0).any([d for d in status.dims if d != "realization"]).values
-        self.data = store.sel(record=label).isel(realization=np.flatnonzero(realizations))
-        self.studied = str(store.attrs.get("studied_building", ""))
-        self.grid = {d: [plain(v) for v in self.data[d].values] for d in status.dims if d not in ("record", "realization")}
-
-    @property
-    def size(self) -> int:
-        """Realizations per cell."""
-        return self.data.sizes["realization"]
-
-    @cached_property
-    def statistics(self) -> xr.Dataset:
-        """:func:`stochpound.analysis.ensemble_statistics` of every cell, computed, the studied building selected."""
-        return self._studied(ensemble_statistics(self.data, confidence=self.confidence)).compute()
-
-    def _studied(self, data: Any) -> Any:
-        return data.sel(building=self.studied, drop=True) if "building" in data.dims else data
-
-    def sample(self, variable: str) -> xr.DataArray:
-        """A summary's values per cell and realization (the studied building's), loaded."""
-        return self._studied(self.data[variable]).load()
+class Ensemble(StoreEnsemble):
+    """One synthetic ensemble of a store (:class:`stochpound.analysis.StoreEnsemble`) as the report shows it: its tables and figures."""
 
     @property
     def event(self) -> str:
         """What an impact is in this ensemble's words: "pounding", or "a wall hit" in a store whose only impact elements are walls."""
-        return "a wall hit" if walls_only(self.data) else "pounding"
+        return "a wall hit" if self.walls_only else "pounding"
 
     @property
     def probability_label(self) -> str:
         """Its probability as a label: "P(pounding)" or "P(wall hit)"."""
         return f"P({self.event.removeprefix('a ')})"
 
-    @property
-    def sliding(self) -> bool:
-        """Whether any case of the ensemble slides."""
-        return "peak_sliding_displacement" in self.data and bool((self.sample("peak_sliding_displacement") > 0).any())
-
-    def gid(self, labels: dict[str, Any]) -> str:
+    def gid(self, labels: CellLabels) -> str:
         """The ``gid`` of a cell of this ensemble."""
         return cell_gid({**labels, "record": self.label})
 
@@ -238,7 +190,7 @@ class Ensemble:
         x_values = self.grid[x_dim]
         positions, ticks = _axis_positions(x_dim, x_values)
 
-        def curves(panel: dict[str, Any]) -> list[figures.Curve]:
+        def curves(panel: CellLabels) -> list[figures.Curve]:
             result = []
             for value, colour in lines(self.grid, line_dim):
                 where = {**panel, **({line_dim: value} if line_dim else {})}
@@ -263,9 +215,9 @@ class Ensemble:
         """Empirical CDFs of a summary over the realizations of every cell (and of the fixed-base twin's)."""
         line_dim = self.line_dim()
         sample = self.sample(quantity.variable)
-        reference = self._studied(self.data[twin]).load() if twin and twin in self.data else None
+        reference = self.twin_sample(twin) if twin else None
 
-        def curves(panel: dict[str, Any]) -> list[figures.Curve]:
+        def curves(panel: CellLabels) -> list[figures.Curve]:
             result = []
             for value, colour in lines(self.grid, line_dim):
                 where = {**panel, **({line_dim: value} if line_dim else {})}
@@ -290,23 +242,19 @@ class Ensemble:
         if self.size < MIN_RUNS:
             return []
         line_dim = self.line_dim()
-        counts = np.unique(np.round(np.geomspace(MIN_RUNS, self.size, CONVERGENCE_POINTS)).astype(int))
-        panels = self._slowest_panels(line_dim)
+        counts = self.convergence_counts
+        panels = self.slowest_panels(line_dim)
         cut = {d: v for d, v in panels.items() if len(v) < len(self.grid[d])}
         hit = self.probability_label
         which = (f"; only the panels whose {hit} is nearest 0.5, the slowest to settle: "
                  + "; ".join(f"{dim_text(d)} {', '.join(value_text(d, x) for x in v)}" for d, v in cut.items())) if cut else ""
         items = []
         running = {
-            "pounding": (of_first(lambda first: pounding_probability(first, confidence=self.confidence), self.sample("impacts"), counts),
-                         "probability", 1.0, hit, "Clopper–Pearson"),
-            "peak": (of_first(lambda first: mean_interval(first, confidence=self.confidence, method="bootstrap"), self.sample(PEAK_DISPLACEMENT.variable), counts),
-                     "mean", CM, "mean peak total displacement (cm)", "percentile-bootstrap"),
+            "pounding": (self.running_pounding(), "probability", 1.0, hit, "Clopper–Pearson"),
+            "peak": (self.running_mean(PEAK_DISPLACEMENT.variable), "mean", CM, "mean peak total displacement (cm)", "percentile-bootstrap"),
         }
         for key, (estimate, field, factor, y_label, method) in running.items():
-            estimate = estimate.compute()
-
-            def curves(panel: dict[str, Any], estimate: xr.Dataset = estimate, field: str = field, factor: float = factor) -> list[figures.Curve]:
+            def curves(panel: CellLabels, estimate: xr.Dataset = estimate, field: str = field, factor: float = factor) -> list[figures.Curve]:
                 result = []
                 for value, colour in lines(self.grid, line_dim):
                     where = {**panel, **({line_dim: value} if line_dim else {})}
@@ -327,23 +275,8 @@ class Ensemble:
             )
         return items
 
-    def _slowest_panels(self, line_dim: str | None) -> dict[str, list[Any]]:
-        """The panel axes of a convergence figure, the longest cut (repeatedly) to its values with P(pounding) nearest 0.5, to at most :data:`CONVERGENCE_PANELS` panels."""
-        panels = {d: list(v) for d, v in self.grid.items() if d != line_dim}
-        probability = self.statistics["pounding_probability"]
-        while math.prod(len(v) for v in panels.values()) > CONVERGENCE_PANELS:
-            dim = max(panels, key=lambda d: len(panels[d]))
-            if len(panels[dim]) == 1:
-                break
-            others = math.prod(len(v) for d, v in panels.items() if d != dim)
-            keep = max(1, min(len(panels[dim]) - 1, CONVERGENCE_PANELS // others))
-            distance = abs(probability.mean([d for d in probability.dims if d != dim]).sel({dim: panels[dim]}).values - 0.5)
-            kept = sorted(np.argsort(distance, kind="stable")[:keep])
-            panels[dim] = [panels[dim][i] for i in kept]
-        return panels
-
     def facet_figures(
-        self, kind: str, drawn: Sequence[str | None], curves: Callable[[dict[str, Any]], list[figures.Curve]], x_label: str, y_label: str, what: str, title: str = "",
+        self, kind: str, drawn: Sequence[str | None], curves: Callable[[CellLabels], list[figures.Curve]], x_label: str, y_label: str, what: str, title: str = "",
         panel_grid: dict[str, list[Any]] | None = None, **options: Any
     ) -> list[FigureItem]:
         """One figure per layout of the dimensions not ``drawn`` (each combination a panel; ``panel_grid``: only those values of them)."""
@@ -382,11 +315,6 @@ class Ensemble:
         if reference is not None:
             blocks.append(reference)
         return blocks + self.figures()
-
-
-def walls_only(data: xr.Dataset) -> bool:
-    """Whether a store's only impact elements are walls (no contact): every impact is a wall hit, which has no phase (a wall moves with the ground)."""
-    return data.sizes.get("contact", 0) == 0 and "peak_wall_penetration" in data
 
 
 PHASES = ("impacts_in_phase", "impacts_out_of_phase")

@@ -14,7 +14,6 @@ they show.
 
 from __future__ import annotations
 
-import itertools
 import json
 import math
 from collections.abc import Mapping, Sequence
@@ -23,10 +22,11 @@ from typing import Any
 
 import numpy as np
 
+from stochpound.analysis import CellLabels
 from stochpound.experiment import is_fixed_base, is_gap_axis
+from stochpound.report.render import figures
 
-#: Most panels in one figure.
-MAX_PANELS = 16
+MAX_PANELS = figures.MAX_PANELS
 #: Dimensions whose values are lengths in m, shown in cm.
 CM = 100.0
 
@@ -52,12 +52,12 @@ def dim_text(dim: str) -> str:
     return "μ" if dim == "mu" else dim
 
 
-def labels_text(labels: Mapping[str, Any]) -> str:
+def labels_text(labels: CellLabels) -> str:
     """``neighbour stiff, gap 2 cm, μ fixed`` (empty for no labels)."""
     return ", ".join(f"{dim_text(dim)} {value_text(dim, value)}" for dim, value in labels.items())
 
 
-def cell_gid(labels: Mapping[str, Any]) -> str:
+def cell_gid(labels: CellLabels) -> str:
     """The ``gid`` of an artist that draws the cell with these labels (sorted JSON, ∞ as "inf")."""
 
     def jsonable(value: Any) -> Any:
@@ -71,8 +71,8 @@ def cell_gid(labels: Mapping[str, Any]) -> str:
 class Layout:
     """One figure of a family: its panels (labels of the panel dimensions) and the labels it shares."""
 
-    panels: list[dict[str, Any]]
-    shared: dict[str, Any]
+    panels: list[CellLabels]
+    shared: CellLabels
 
     @property
     def title(self) -> str:
@@ -81,34 +81,11 @@ class Layout:
 
 
 def layouts(grid: Mapping[str, Sequence[Any]], max_panels: int = MAX_PANELS) -> list[Layout]:
-    """Spread every combination of ``grid`` over figures of at most ``max_panels`` panels.
-
-    The outermost dimensions are split off into separate figures until the
-    rest fits; an empty grid gives one figure with one panel.
+    """Spread every combination of ``grid`` over figures of at most ``max_panels`` panels
+    (:func:`stochpound.report.render.figures.spread_panels`): the outermost dimensions are split off into separate
+    figures until the rest fits; an empty grid gives one figure with one panel.
     """
-    dims = list(grid)
-    split = 0
-    while split < len(dims) and math.prod(len(grid[d]) for d in dims[split:]) > max_panels:
-        split += 1
-    outer, inner = dims[:split], dims[split:]
-    result = []
-    for shared in itertools.product(*(grid[d] for d in outer)):
-        panels = [dict(zip(inner, combination)) for combination in itertools.product(*(grid[d] for d in inner))]
-        result.append(Layout(panels, dict(zip(outer, shared))))
-    return result
+    return [Layout(panels, shared) for panels, shared in figures.spread_panels(grid, max_panels)]
 
 
-def line_colours(dim: str | None, values: Sequence[Any]) -> list[Any]:
-    """One colour per value of the line dimension: a sequential map for numbers (∞, a fixed base, in black), a qualitative one otherwise."""
-    from matplotlib import colormaps
-
-    if dim is None:
-        return ["C0"] * len(values)
-    numeric = [plain(v) for v in values]
-    if all(isinstance(v, float) for v in numeric):
-        finite = [v for v in numeric if not math.isinf(v)]
-        scale = colormaps["viridis"]
-        positions = np.linspace(0.0, 0.9, len(finite)) if len(finite) > 1 else [0.0]
-        ranks = {v: p for v, p in zip(sorted(finite), positions)}
-        return ["black" if math.isinf(v) else scale(ranks[v]) for v in numeric]
-    return [f"C{i % 10}" for i in range(len(values))]
+line_colours = figures.line_colours

@@ -20,10 +20,10 @@ import xarray as xr
 from stochpound.report.render import figures
 from stochpound.report.render import Block, FigureItem, Paragraph, Section, Table
 from stochpound.report.sections._ensemble_findings import compare_ensembles, ensemble_findings, isolation_across
-from stochpound.report.sections._ensembles import PHASES, Ensemble, walls_only
+from stochpound.report.sections._ensembles import PHASES, Ensemble
 from stochpound.report.sections._mechanism_findings import mechanism_findings
 from stochpound.experiment import is_gap_axis
-from stochpound.store import wall_gap_dims
+from stochpound.store import wall_gap_dims, walls_only
 from stochpound.report.sections._facets import dim_text, labels_text, layouts, line_colours, plain, value_text, cell_gid
 
 CM = 100.0

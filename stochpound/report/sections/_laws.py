@@ -22,13 +22,13 @@ from __future__ import annotations
 
 import itertools
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 import xarray as xr
 
-from stochpound.analysis import MIN_RUNS, mean_interval, pounding_probability
+from stochpound.analysis import MIN_RUNS, CellLabels
 from stochpound.experiment import is_gap_axis
+from stochpound.store import Definition
 from stochpound.model import laws
 from stochpound.report.render import Block, FigureItem, Paragraph, Section, figures
 from stochpound.report.sections._ensembles import Ensemble
@@ -72,21 +72,21 @@ QUANTITIES = (
 
 def law_axis(store: xr.Dataset) -> str | None:
     """The variant axis whose values give the contacts different laws (from the stored definition), or None."""
-    definition = store.pound.definition.to_dict()
-    for axis in definition.get("variants", []):
-        named = variant_laws(definition, axis["name"]) if axis["name"] in store.dims else {}
-        if len({named[plain(v)] for v in store[axis["name"]].values}) > 1:
-            return str(axis["name"])
+    definition = store.pound.definition
+    for axis in definition.variants:
+        named = variant_laws(definition, axis.name) if axis.name in store.dims else {}
+        if len({named[plain(v)] for v in store[axis.name].values}) > 1:
+            return axis.name
     return None
 
 
-def variant_laws(definition: dict[str, Any], axis: str) -> dict[str, str]:
+def variant_laws(definition: Definition, axis: str) -> dict[str, str]:
     """Each value of variant ``axis`` -> the contact laws of its scene (joined with "/" when the contacts differ)."""
-    scene_laws = [str(c.get("law", laws.DEFAULT_CONTACT_LAW)) for c in definition.get("scene", {}).get("contact", [])]
-    variant = next(v for v in definition["variants"] if v["name"] == axis)
+    scene_laws = [str(c.get("law", laws.DEFAULT_CONTACT_LAW)) for c in definition.scene.get("contact", [])]
+    variant = next(v for v in definition.variants if v.name == axis)
     result = {}
-    for value in variant["values"]:
-        part = variant["overrides"][value].get("contact")
+    for value in variant.values:
+        part = variant.overrides[value].get("contact")
         tables = part if isinstance(part, list) else [part or {}] * len(scene_laws)
         names = [str(t.get("law", own)) if "law" in t else own for t, own in zip(tables, scene_laws)]
         result[value] = "/".join(dict.fromkeys(names))
@@ -98,16 +98,16 @@ def laws_section(name: str, store: xr.Dataset) -> Section:
     axis = law_axis(store)
     assert axis is not None
     section = Section(f"Contact laws compared: experiment {name}", key=f"laws-{name}")
-    definition = store.pound.definition.to_dict()
+    definition = store.pound.definition
     named = variant_laws(definition, axis)
-    overrides = next(v for v in definition["variants"] if v["name"] == axis)["overrides"]
+    overrides = next(v for v in definition.variants if v.name == axis).overrides
     same_until_contact = (
         "A law acts only once the floors touch, and this axis changes nothing else: up to its first impact a run is the "
         "same under every law, so the laws can differ in P(pounding) only within the solvers' tolerances, and they differ "
         "in what follows the first impact. " if all(set(o) <= {"contact"} for o in overrides.values()) else "")
     section.add(Paragraph(
         f"The {dim_text(axis)} axis gives the contacts different laws: "
-        + "; ".join(f"{value}: {' / '.join(laws.contact_law(law).title for law in named[value].split('/'))}"
+        + "; ".join(f"{value}: {' / '.join(laws.CONTACT_LAWS[law].title for law in named[value].split('/'))}"
                     for value in map(plain, store[axis].values))
         + f". Methods gives each element's parameters and units. {same_until_contact}Below, every law is drawn in the same "
         "panel; means are "
@@ -124,8 +124,8 @@ def _ensemble_blocks(ensemble: Ensemble, axis: str) -> list[Block]:
     gap = next((d for d in ensemble.grid if is_gap_axis(d)), None)
     others = [d for d in ensemble.grid if d not in (axis, gap)]
     panels = [dict(zip(others, values)) for values in itertools.product(*(ensemble.grid[d] for d in others))]
-    estimates = {"pounding": _pounding(ensemble)}
-    estimates |= {q.variable: _means(ensemble, q) for q in QUANTITIES if q.variable in ensemble.data}
+    estimates = {"pounding": ensemble.pounding()}
+    estimates |= {q.variable: ensemble.means(q.variable, q.factor, q.pounding_only) for q in QUANTITIES if q.variable in ensemble.data}
     blocks: list[Block] = []
     for key, table in estimates.items():
         quantity = next((q for q in QUANTITIES if q.variable == key), None)
@@ -137,25 +137,7 @@ def _ensemble_blocks(ensemble: Ensemble, axis: str) -> list[Block]:
     return blocks
 
 
-def _pounding(ensemble: Ensemble) -> xr.Dataset:
-    """P(pounding) of every cell: ``estimate``, ``lower``, ``upper``, ``count``."""
-    result = pounding_probability(ensemble.sample("impacts")).compute()
-    return xr.Dataset({"estimate": result["probability"], "lower": result["lower"], "upper": result["upper"], "count": result["realizations"]})
-
-
-def _means(ensemble: Ensemble, quantity: LawQuantity) -> xr.Dataset:
-    """The mean of ``quantity`` in every cell with its percentile-bootstrap interval over the runs
-    (:func:`stochpound.analysis.mean_interval`; NaN from fewer than MIN_RUNS)."""
-    values = ensemble.sample(quantity.variable) * quantity.factor
-    if quantity.pounding_only:
-        values = values.where(ensemble.sample("impacts") > 0)
-    result = mean_interval(values, "realization", method="bootstrap").compute()
-    enough = result["count"] >= MIN_RUNS
-    return xr.Dataset({"estimate": result["mean"].where(enough), "lower": result["lower"].where(enough),
-                       "upper": result["upper"].where(enough), "count": result["count"]})
-
-
-def _figure(ensemble: Ensemble, axis: str, gap: str | None, panels: list[dict[str, Any]], table: xr.Dataset, text: str, y_label: str,
+def _figure(ensemble: Ensemble, axis: str, gap: str | None, panels: list[CellLabels], table: xr.Dataset, text: str, y_label: str,
             key: str) -> FigureItem:
     values = ensemble.grid[axis]
     colours = line_colours(axis, values)
@@ -177,7 +159,7 @@ def _figure(ensemble: Ensemble, axis: str, gap: str | None, panels: list[dict[st
     return FigureItem(f"laws-{ensemble.name}-{ensemble.label}-{key}", caption, figure)
 
 
-def _comparison(ensemble: Ensemble, axis: str, gap: str | None, panels: list[dict[str, Any]], table: xr.Dataset, text: str, unit: str) -> str:
+def _comparison(ensemble: Ensemble, axis: str, gap: str | None, panels: list[CellLabels], table: xr.Dataset, text: str, unit: str) -> str:
     """Which law gives the largest ``text`` at each gap of each panel, by how much, and whether the laws' intervals overlap."""
     sentences = []
     for panel in panels:

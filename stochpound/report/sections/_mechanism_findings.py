@@ -26,12 +26,12 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from stochpound.analysis.mechanisms import amplification, ratcheting
+from stochpound.analysis import CellLabels, MechanismCells
 from stochpound.experiment import is_gap_axis
-from stochpound.store import contact_free, contact_gap_dims, has_contact_free, isolated_mus, wall_gap_dims, with_contacts
+from stochpound.store import contact_free, contact_gap_dims, has_contact_free, wall_axis, with_contacts
 from stochpound.report.render import Block, Paragraph
 from stochpound.report.sections._ensembles import CM, MIN_RUNS, Ensemble
-from stochpound.report.sections._facets import dim_text, labels_text, plain, value_text
+from stochpound.report.sections._facets import dim_text, labels_text, value_text
 
 #: Demands compared with their twins without impacts: store variable -> (words, unit shown, factor to it).
 DEMANDS = {
@@ -88,21 +88,6 @@ def has_twins(store: xr.Dataset) -> bool:
     return has_contact_free(store) and all(with_contacts(store).sizes[d] for d in contact_gap_dims(store))
 
 
-def ratcheting_of(pounding: Ensemble, free: Ensemble, away: int) -> xr.Dataset:
-    """:func:`stochpound.analysis.ratcheting` of the studied building's residual sliding in ``pounding``'s cells on a sliding base
-    (a μ axis's fixed-base cells left out) against ``free``, computed."""
-    residual, twin = pounding.sample("residual_sliding"), free.sample("residual_sliding")
-    if "mu" in residual.dims:
-        sliding = isolated_mus(residual["mu"].values)
-        residual, twin = residual.sel(mu=sliding), twin.sel(mu=sliding)
-    return ratcheting(residual, twin, away, MIN_RUNS, confidence=pounding.confidence).compute()
-
-
-def amplification_of(impacts: Ensemble, twins: Ensemble, variable: str) -> xr.Dataset:
-    """:func:`stochpound.analysis.amplification` of the studied building's demand ``variable`` in ``impacts``' cells over ``twins``, computed."""
-    return amplification(impacts.sample(variable), twins.sample(variable), MIN_RUNS, confidence=impacts.confidence).compute()
-
-
 def mechanism_answer(name: str, store: xr.Dataset) -> str | None:
     """The summary's answer "Which mechanisms do the runs show?", per synthetic ensemble in one sentence (None when the store can show none)."""
     kinds = dict(zip(store["record"].values.tolist(), store["record_kind"].values.tolist()))
@@ -114,15 +99,15 @@ def mechanism_answer(name: str, store: xr.Dataset) -> str | None:
             compared = True
             away = away_from_neighbour(store, impacts.studied)
             if cause == "pounding" and away is not None and impacts.sliding:
-                result = ratcheting_of(impacts, twins, away)
-                pushed = int(_pushed_away(result).sum())
-                found.append(f"pounding ratchets {impacts.studied}'s sliding base in {int(result['ratchets'].sum())} of "
-                             f"{int(result['enough'].sum())} cells"
+                result = impacts.ratcheting_against(twins, away)
+                pushed = result.pushed_count
+                found.append(f"pounding ratchets {impacts.studied}'s sliding base in {result.flagged_count} of "
+                             f"{result.assessed_count} cells"
                              + (f" and pushes its residual away from the neighbour, without a resolved increase of its size, in "
                                 f"{pushed} more" if pushed else ""))
-            found += [_raised(amplification_of(impacts, twins, v), cause, DEMANDS[v][0]) for v in DEMANDS if v in store]
+            found += [_raised(impacts.amplification_over(twins, v), cause, DEMANDS[v][0]) for v in DEMANDS if v in store]
         if "peak_wall_penetration" in store:
-            deepest = float(_walled(name, store, label, axis).sample("peak_wall_penetration").max())
+            deepest = _walled(name, store, label, axis).wall_penetration().largest
             found.append(f"the walls were penetrated by up to {deepest * CM:.3g} cm" if np.isfinite(deepest) else "no run with a wall")
         if found:
             parts.append(f"ensemble {label}: " + "; ".join(found))
@@ -133,12 +118,12 @@ def mechanism_answer(name: str, store: xr.Dataset) -> str | None:
     return f"Which mechanisms do the runs show{how}? " + "; ".join(parts) + "."
 
 
-def _raised(found: xr.Dataset, cause: str, words: str) -> str:
+def _raised(found: MechanismCells, cause: str, words: str) -> str:
     """"a wall raises the peak floor acceleration in 4 of 4 cells (5.02–13.3 times per run)"."""
-    raised = found["ratio_mean"].where(found["raises"])
-    text = f"{cause} raises the {words} in {int(found['raises'].sum())} of {int(found['enough'].sum())} cells"
-    if bool(found["raises"].any()):
-        low, high = float(raised.min()), float(raised.max())
+    text = f"{cause} raises the {words} in {found.flagged_count} of {found.assessed_count} cells"
+    ratios = found.ratio_range()
+    if ratios is not None:
+        low, high = ratios
         text += f" ({low:.3g}–{high:.3g} times per run)" if f"{low:.3g}" != f"{high:.3g}" else f" ({low:.3g} times per run)"
     return text
 
@@ -156,33 +141,6 @@ def away_from_neighbour(store: xr.Dataset, building: str) -> int | None:
     return None
 
 
-def wall_axis(store: xr.Dataset) -> tuple[str, Any] | None:
-    """The axis that sets walls and its value without a wall reached: a gap axis over the walls only holding ``inf`` and
-    finite clearances (``(axis, inf)``), or a variant axis whose first value without walls is the reference when the base
-    scene has no wall and the axis's other values add some; else None."""
-    for axis in wall_gap_dims(store):
-        values = store[axis].values
-        if np.isinf(values).any() and np.isfinite(values).any():
-            return axis, float(np.inf)
-    definition = store.pound.definition
-    if definition.scene.get("wall"):
-        return None
-    for axis in definition.variants:
-        if axis.name not in store.dims:
-            continue
-        walled = {value: bool(axis.overrides[value].get("scene", {}).get("wall")) for value in axis.values}
-        bare = [value for value, has in walled.items() if not has]
-        if bare and any(walled.values()):
-            return axis.name, bare[0]
-    return None
-
-
-def _cells(data: xr.DataArray) -> list[dict[str, Any]]:
-    """The labels of every cell of ``data``, in grid order."""
-    stacked = data.stack(cell=list(data.dims)) if data.dims else data.expand_dims(cell=[0])
-    return [{d: plain(stacked[d].values[i]) for d in data.dims} for i in range(stacked.sizes["cell"])]
-
-
 def _value(mean: float, lower: float, upper: float, unit: str, factor: float, digits: str = ".3g") -> str:
     """``20.4 cm [16.1, 24.9]``."""
     suffix = f" {unit}" if unit else ""
@@ -195,11 +153,6 @@ def _listed(parts: list[str]) -> str:
     return shown + (f"; and {len(parts) - LISTED} more cells" if len(parts) > LISTED else "")
 
 
-def _pushed_away(found: xr.Dataset) -> xr.DataArray:
-    """Cells where the impacts move the residual away from the neighbour (interval above 0) without ratcheting it."""
-    return found["enough"] & ~found["ratchets"] & (found["away_change_lower"] > 0)
-
-
 def ratcheting_text(pounding: Ensemble, free: Ensemble, away: int | None) -> str:
     """Where pounding ratchets the studied building's sliding base against its contact-free twins, and where it does not."""
     building, opening = pounding.studied, f"Ratcheting ({pounding.label}, {pounding.studied}): "
@@ -207,15 +160,14 @@ def ratcheting_text(pounding: Ensemble, free: Ensemble, away: int | None) -> str
         return opening + "not assessed: the studied building has neighbours on both sides or none, so 'away from the neighbour' is undefined."
     if not pounding.sliding:
         return opening + "none possible: the studied building's base does not slide in any cell."
-    found = ratcheting_of(pounding, free, away)
+    found = pounding.ratcheting_against(free, away)
     direction = "left" if away < 0 else "right"
-    cells = _cells(found["ratchets"])
-    enough = [c for c in cells if bool(found["enough"].sel(c))]
+    enough = found.assessed()
     if not enough:
-        return opening + f"not assessed: no cell has {MIN_RUNS} runs paired with their contact-free twins (at most {int(found['abs_count'].max())})."
+        return opening + f"not assessed: no cell has {MIN_RUNS} runs paired with their contact-free twins (at most {found.most_runs})."
 
-    def describe(cell: dict[str, Any]) -> str:
-        at = found.sel(cell)
+    def describe(cell: CellLabels) -> str:
+        at = found.found.sel(cell)
         n = int(at["abs_change_count"])
         return (f"at {labels_text(cell)}, mean abs(residual sliding) {_value(float(at.abs_mean), float(at.abs_lower), float(at.abs_upper), 'cm', CM)} "
                 f"against {_value(float(at.free_abs_mean), float(at.free_abs_lower), float(at.free_abs_upper), 'cm', CM)} in the twins (paired "
@@ -223,9 +175,7 @@ def ratcheting_text(pounding: Ensemble, free: Ensemble, away: int | None) -> str
                 f"residual away from the neighbour {_value(float(at.away_mean), float(at.away_lower), float(at.away_upper), 'cm', CM)}, "
                 f"{_value(float(at.away_change_mean), float(at.away_change_lower), float(at.away_change_upper), 'cm', CM)} more than the twins' (n = {n})")
 
-    ratchets = sorted((c for c in enough if bool(found["ratchets"].sel(c))), key=lambda c: -float(found["abs_change_mean"].sel(c)))
-    lowers = [c for c in enough if bool(found["lowers"].sel(c))]
-    pushed = [c for c in enough if bool(_pushed_away(found).sel(c))]
+    ratchets, lowers, pushed = found.flagged(), found.lowered(), found.pushed()
     rest = [c for c in enough if c not in ratchets and c not in lowers and c not in pushed]
     text = opening + (
         f"pounding ratchets {building}'s sliding base — the paired {pounding.confidence:.0%} bootstrap intervals of the increase of abs(residual sliding) over "
@@ -234,7 +184,7 @@ def ratcheting_text(pounding: Ensemble, free: Ensemble, away: int | None) -> str
     )
     text += (": " + _listed([describe(c) for c in ratchets]) + "." if ratchets else "; it does not ratchet it in any of them.")
     if ratchets and len(enough) > LISTED:
-        text += " " + _by_axis(found["ratchets"], found["enough"], "ratcheting")
+        text += " " + _by_axis(found, "ratcheting")
     if pushed:
         text += (f" In {len(pushed)} cells the impacts push the residual away from the neighbour without a resolved increase of its size: "
                  + _listed([describe(c) for c in pushed]) + ".")
@@ -242,41 +192,35 @@ def ratcheting_text(pounding: Ensemble, free: Ensemble, away: int | None) -> str
         text += f" The sign flips in {len(lowers)} cells, where pounding leaves the base nearer its start than without contacts: " + _listed([describe(c) for c in lowers]) + "."
     if rest:
         text += f" No resolved ratcheting at {_listed([labels_text(c) for c in rest])}."
-    short = [c for c in cells if c not in enough]
+    short = found.short()
     if short:
         text += f" Fewer than {MIN_RUNS} paired runs, not assessed: {_listed([labels_text(c) for c in short])}."
     return text
 
 
-def _by_axis(flags: xr.DataArray, enough: xr.DataArray, what: str) -> str:
-    """Where ``flags`` hold, counted along each axis of more than one value: "Cells with ratcheting, by gap: 2 cm 3 of 4; ..."."""
-    parts = []
-    for dim in (d for d in flags.dims if flags.sizes[d] > 1):
-        others = [d for d in flags.dims if d != dim]
-        held, assessed = (flags & enough).sum(others), enough.sum(others)
-        parts.append(f"by {dim_text(dim)}: " + ", ".join(f"{value_text(dim, plain(v))} {int(h)} of {int(a)}"
-                                                        for v, h, a in zip(flags[dim].values, held.values, assessed.values)))
+def _by_axis(found: MechanismCells, what: str) -> str:
+    """Where the effect is resolved, counted along each axis of more than one value: "Cells with ratcheting, by gap: 2 cm 3 of 4; ..."."""
+    parts = [f"by {dim_text(dim)}: " + ", ".join(f"{value_text(dim, v)} {held} of {assessed}" for v, held, assessed in counts)
+             for dim, counts in found.by_axis()]
     return f"Cells with {what}, " + "; ".join(parts) + "." if parts else ""
 
 
 def amplification_text(impacts: Ensemble, twins: Ensemble, variable: str, cause: str, twin: str) -> str:
     """How much ``cause`` (pounding, a wall) raises the studied building's demand ``variable`` over ``twin``, cell by cell."""
     words, unit, factor = DEMANDS[variable]
-    found = amplification_of(impacts, twins, variable)
-    cells = _cells(found["raises"])
-    enough = [c for c in cells if bool(found["enough"].sel(c))]
+    found = impacts.amplification_over(twins, variable)
+    enough = found.assessed()
     opening = f"Amplification of the {words} by {cause} ({impacts.label}, {impacts.studied}): "
     if not enough:
-        return opening + f"not assessed: no cell has {MIN_RUNS} runs paired with {twin} (at most {int(found['with_count'].max())})."
+        return opening + f"not assessed: no cell has {MIN_RUNS} runs paired with {twin} (at most {found.most_runs})."
 
-    def describe(cell: dict[str, Any]) -> str:
-        at = found.sel(cell)
+    def describe(cell: CellLabels) -> str:
+        at = found.found.sel(cell)
         return (f"{labels_text(cell)}: {_value(float(at.ratio_mean), float(at.ratio_lower), float(at.ratio_upper), '', 1.0)} times "
                 f"({_value(float(at.with_mean), float(at.with_lower), float(at.with_upper), unit, factor)} against "
                 f"{_value(float(at.twin_mean), float(at.twin_lower), float(at.twin_upper), unit, factor)}, n = {int(at.ratio_count)})")
 
-    raises = sorted((c for c in enough if bool(found["raises"].sel(c))), key=lambda c: -float(found["ratio_mean"].sel(c)))
-    lowers = [c for c in enough if bool(found["lowers"].sel(c))]
+    raises, lowers = found.flagged(), found.lowered()
     rest = [c for c in enough if c not in raises and c not in lowers]
     text = opening + (
         f"{cause} multiplies {impacts.studied}'s {words} over {twin} by the mean of the per-run ratios given for each cell "
@@ -287,10 +231,10 @@ def amplification_text(impacts: Ensemble, twins: Ensemble, variable: str, cause:
     if lowers:
         text += f" It lowers it in {len(lowers)}: " + _listed([describe(c) for c in lowers]) + "."
     if raises and len(enough) > LISTED:
-        text += " " + _by_axis(found["raises"], found["enough"], f"a resolved rise of the {words}")
+        text += " " + _by_axis(found, f"a resolved rise of the {words}")
     if rest:
         text += f" No resolved change at {_listed([labels_text(c) for c in rest])}."
-    short = [c for c in cells if c not in enough]
+    short = found.short()
     if short:
         text += f" Fewer than {MIN_RUNS} paired runs, not assessed: {_listed([labels_text(c) for c in short])}."
     return text
@@ -299,19 +243,17 @@ def amplification_text(impacts: Ensemble, twins: Ensemble, variable: str, cause:
 def penetration_text(ensemble: Ensemble, walls: str | None) -> str:
     """The largest penetration of the walls over the runs of ``ensemble`` (its cells with walls), and where, also per value of the
     axis ``walls`` that adds them or sets their clearance (if any): what a 'rigid' wall is here."""
-    penetration = ensemble.sample("peak_wall_penetration")
+    penetration = ensemble.wall_penetration(walls)
     definition = ensemble.data.pound.definition
     tables = list(definition.scene.get("wall", [])) + [w for axis in definition.variants for override in axis.overrides.values()
                                                        for w in override.get("scene", {}).get("wall", [])]
     stiffness = sorted({float(w["stiffness"]) for w in tables if "stiffness" in w})
-    runs = int(penetration.notnull().sum())
+    runs = penetration.runs
     if runs == 0:
         return f"Wall penetration ({ensemble.label}): no run with a wall is in the store."
-    where = penetration.where(penetration == penetration.max(), drop=True)
-    at = {d: plain(where[d].values[0]) for d in where.dims}
-    largest = float(penetration.max())
+    at, largest = penetration.at, penetration.largest
     per_wall = "" if walls is None else (f"; the largest per value of {walls}: "
-                                         + "; ".join(f"{value_text(walls, plain(v))}: {float(penetration.sel({walls: v}).max()) * CM:.3g} cm" for v in penetration[walls].values))
+                                         + "; ".join(f"{value_text(walls, v)}: {deepest * CM:.3g} cm" for v, deepest in penetration.per_value))
     return (
         f"Wall penetration ({ensemble.label}, {ensemble.studied}): a 'rigid' wall is here a stiff impact element"
         + (f" (k = {', '.join(f'{k / 1e6:.4g}' for k in stiffness)} MN/m)" if stiffness else "")

@@ -33,7 +33,8 @@ import xarray as xr
 from matplotlib.figure import Figure
 from matplotlib.ticker import LogLocator, NullFormatter
 
-from stochpound.report.render import Block, FigureItem, Paragraph, Section, Table
+from stochpound.analysis import CellLabels
+from stochpound.report.render import Block, FigureItem, Paragraph, Section, Table, figures
 from stochpound.report.sections._facets import labels_text
 from stochpound.report.sections._stripe_motions import is_selected
 from stochpound.risk import MODEL_DRIFT_LIMIT, StoreDamage, StoreDemands, StoreRisk
@@ -54,7 +55,7 @@ def hazard_provenance(store: xr.Dataset) -> str:
     return f"hazard curve ({hazard.description} in {hazard.units}) from {given}{table}, carried in the store. Provenance: {provenance}"
 
 
-def configurations(data: xr.DataArray | xr.Dataset, keep: tuple[str, ...] = ()) -> list[dict[str, Any]]:
+def configurations(data: xr.DataArray | xr.Dataset, keep: tuple[str, ...] = ()) -> list[CellLabels]:
     """The labels of every configuration: each combination of ``data``'s dimensions other than ``keep``."""
     dims = [d for d in data.dims if d not in keep]
     if not dims:
@@ -69,18 +70,15 @@ def _percent(confidence: float) -> str:
 
 def headline_text(name: str, risk: StoreRisk) -> str:
     """The section's first paragraph: g* for each target, per configuration, with its interval and the number of motions."""
-    frame = risk.to_frame()
-    config = risk.configuration_dims()
     targets = " and ".join(risk.target_text(p) for p in risk.separation["target"].values)
     per = []
-    for labels, rows in (frame.groupby(config, sort=False) if config else [((), frame)]):
-        labels = labels if isinstance(labels, tuple) else (labels,)
+    for labels, rows in risk.by_configuration(risk.to_frame()):
         values = "; ".join(f"at least {_gap_text(row.separation)} for {risk.target_text(row.target)} (beyond the stripes' runs: no interval)"
                            if row.lower_bound else
                            f"{_gap_text(row.separation)} for {risk.target_text(row.target)}"
                            + ("" if risk.no_interval else f" [{_gap_text(row.lower)}, {_gap_text(row.upper)}]")
                            for row in rows.itertuples())
-        per.append(f"{labels_text(dict(zip(config, labels))) or 'the scene'}: {values}")
+        per.append(f"{labels_text(labels) or 'the scene'}: {values}")
     stripes = f"{risk.stripes} stripes of " if risk.stripes is not None else "IDA capacities in "
     partial = f" (an unfinished store, {risk.progress}: answered from the cases that ran)" if risk.progress else ""
     beyond = risk.beyond_stripes_text()
@@ -218,22 +216,17 @@ def _wall_governs(risk: StoreRisk, demands: StoreDemands | None) -> dict[float, 
 
 def design_value_text(risk: StoreRisk) -> str:
     """The number to design to: per configuration and target, the upper bound of g* (stated as such), from :meth:`StoreRisk.design_frame`."""
-    frame = risk.design_frame()
-    config = risk.configuration_dims()
     per = []
-    for labels, rows in (frame.groupby(config, sort=False) if config else [((), frame)]):
-        labels = labels if isinstance(labels, tuple) else (labels,)
+    for labels, rows in risk.by_configuration(risk.design_frame()):
         values = "; ".join(f"{_gap_text(row.design) if row.design == row.design else row.basis} for {risk.target_text(row.target)}"
                            for row in rows.itertuples())
-        per.append(f"{labels_text(dict(zip(config, labels))) or 'the scene'}: {values}")
+        per.append(f"{labels_text(labels) or 'the scene'}: {values}")
     motions = f"{_motions_text(risk)}{' per stripe' if is_selected(risk.setting) else ''}"
     if "upper" not in risk.separation:
         why = "its interval is not estimable" if risk.no_interval else "no bootstrap was run"
         return (f"There is no upper bound of g* to design to ({why}): the values are g* itself, a central estimate "
                 f"from {motions} that meets its target only about half the time: " + ". ".join(per) + ".")
-    given = frame["design"].notna()
-    basis = frame.loc[given, "basis"].iloc[0] if given.any() else "upper bound of g*'s interval"
-    return (f"The gap to design to is the {basis}, not g* itself (g* is a central estimate from "
+    return (f"The gap to design to is the {risk.design_basis()}, not g* itself (g* is a central estimate from "
             f"{motions} and meets its target only about half the time): " + ". ".join(per) + ".")
 
 
@@ -328,14 +321,12 @@ def _measure_choice_blocks(name: str, risk: StoreRisk, choice: pd.DataFrame | No
     measures, own = choice.attrs["hazard_measures"], choice.attrs["store_measure"]
     counts = choice["most efficient"].value_counts()
     best = ", ".join(f"{label} in {count} of {len(choice)} configurations" for label, count in counts.items())
-    runs = risk.motions * (risk.stripes or 1)
     if own not in measures:
         verdict = f"The store is conditioned on {own}, a measure the site's hazard is not given in among these."
     elif measures == [own]:
         verdict = f"The site's hazard is given in the store's own measure, {own}, only: no other measure is compared with it."
     else:
-        excess = max(float(row[own] - row[row["most efficient"]]) for _, row in choice.iterrows())
-        noise = float(choice[own].max()) / math.sqrt(2.0 * max(runs - 2, 1))
+        excess, noise, runs = risk.measure_margin(choice, own)
         if excess == 0.0:
             verdict = f"The store is conditioned on {own}, the most efficient in every configuration."
         else:
@@ -374,23 +365,6 @@ def _share_text(share: float) -> str:
 
 OUTSIDE_STRIPES_NOTABLE = 0.10
 """A share of λ_P at g* from below the lowest stripe from which the report says the answer rests on the extrapolation."""
-RATE_DECADES = 6
-"""The most decades of annual rate a rate axis spans below its largest rate (smaller rates are off the figure)."""
-
-
-def rate_limits(rates: Any, references: Any = ()) -> tuple[float, float]:
-    """Limits (1/yr) of a logarithmic rate axis from the positive finite rates drawn and reference lines (targets).
-
-    Half the smallest to twice the largest, but no more than ``RATE_DECADES``
-    decades below the largest: a bootstrap band or a far tail down to 1e-300
-    would otherwise squash the curves into a line. (1e-6, 1) when nothing is positive.
-    """
-    values = np.concatenate([np.ravel(np.asarray(rates, dtype=float)), np.ravel(np.asarray(references, dtype=float))])
-    values = values[np.isfinite(values) & (values > 0.0)]
-    if values.size == 0:
-        return 1e-6, 1.0
-    top = 2.0 * float(values.max())
-    return max(0.5 * float(values.min()), top * 10.0**-RATE_DECADES), top
 
 
 def _risk_curve_figure(name: str, risk: StoreRisk) -> FigureItem:
@@ -410,7 +384,7 @@ def _risk_curve_figure(name: str, risk: StoreRisk) -> FigureItem:
                 ax.axvline(value, color=line.get_color(), lw=0.6, ls=":")
     for p, rate, style in zip(risk.separation["target"].values, risk.separation["target_rate"].values, ("--", "-.", ":")):
         ax.axhline(float(rate), color="k", lw=0.8, ls=style, label=f"target: {risk.target_text(p)}")
-    ax.set_ylim(rate_limits(envelope.values, risk.separation["target_rate"].values))
+    ax.set_ylim(figures.rate_limits(envelope.values, risk.separation["target_rate"].values))
     ax.set_xlabel("gap g (m)")
     ax.set_ylabel("λ_P: pounding per year")
     ax.grid(True, which="both", lw=0.3, color="0.85")
@@ -433,7 +407,7 @@ def _surface_figure(name: str, risk: StoreRisk) -> FigureItem:
         ax.contour(levels, gaps, values, levels=[0.1, 0.5, 0.9], colors="w", linewidths=0.6)
         ax.set_yscale("log")
         ax.set_title(labels_text(labels) or name, fontsize=7)
-        ax.set_xlabel(_measure_label(risk), fontsize=7)
+        ax.set_xlabel(risk.setting.measure.axis_label(risk.setting.units), fontsize=7)
         ax.set_ylabel("gap (m)", fontsize=7)
         ax.tick_params(labelsize=6)
     for ax in axes[len(cells):]:
@@ -464,7 +438,7 @@ def _curves_figure(name: str, risk: StoreRisk) -> FigureItem:
                 ax.errorbar(x, p, yerr=[p - points["probability_lower"].values, points["probability_upper"].values - p], fmt="o",
                             ms=3, color=line.get_color(), capsize=2, lw=0.8)
         ax.set_title(labels_text(labels) or name, fontsize=7)
-        ax.set_xlabel(_measure_label(risk), fontsize=7)
+        ax.set_xlabel(risk.setting.measure.axis_label(risk.setting.units), fontsize=7)
         ax.set_ylabel("P(pounding)", fontsize=7)
         ax.set_ylim(-0.02, 1.02)
         ax.tick_params(labelsize=6)
@@ -479,10 +453,6 @@ def _curves_figure(name: str, risk: StoreRisk) -> FigureItem:
 
 _RATE_FORMATS = {"once in (yr)": "{:.3g}", "once in, lower (yr)": "{:.3g}", "once in, upper (yr)": "{:.3g}", "P lower": "{:.3f}",
                  "P upper": "{:.3f}"}
-
-
-def _measure_label(risk: StoreRisk) -> str:
-    return f"{risk.measure} ({risk.setting.units})"
 
 
 def _rules_blocks(name: str, risk: StoreRisk) -> list[Block]:
@@ -528,7 +498,7 @@ def _demand_blocks(name: str, risk: StoreRisk, demands: StoreDemands | None) -> 
         for labels in configurations(curve["maf"], ("level",)):
             maf = envelope.sel(labels).values
             ax.loglog(levels, np.where(maf > 0, maf, np.nan), lw=1.1, label=labels_text(labels) or None)
-        ax.set_ylim(rate_limits(envelope.values))
+        ax.set_ylim(figures.rate_limits(envelope.values))
         ax.xaxis.set_major_locator(LogLocator(subs=(1.0, 2.0, 5.0)))
         ax.xaxis.set_minor_formatter(NullFormatter())  # labels on 1-2-5 only: the minor ones overlapped on short axes
         ax.set_title(label, fontsize=7)

@@ -24,19 +24,15 @@ per cell. Every sentence is computed from the store.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
-from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 import xarray as xr
 
-from stochpound.analysis import pounding_curve, pounding_probability, required_separation, rule_exceedance, separation_rules, store_contact_demands
+from stochpound.analysis import CONTACTS, RARE, CellLabels, Closure, Needed, StoreSeparation, ValueRange
 from stochpound.report.render import figures
 from stochpound.report.render import Block, FigureItem, Paragraph, Section, Table
-from stochpound.report.sections._ensemble_findings import RARE, rare_gap
 from stochpound.report.sections._ensembles import Ensemble, line_label, lines, table_frame
-from stochpound.store import contact_free, contact_gap_dims, isolated_mus, wall_free, wall_gap_dims, with_contacts, with_walls
+from stochpound.store import contact_gap_dims, isolated_mus, wall_gap_dims
 from stochpound.report.sections._facets import dim_text, labels_text, value_text
 
 CM = 100.0
@@ -46,62 +42,8 @@ RULE_TEXT = {
     "srss_reduced": "0.7·SRSS (Eurocode 8, floor levels coinciding)",
     "ddc": "DDC (√(u1² + u2² − 2ρ u1 u2), ρ from the histories)",
 }
-#: Target probabilities of the separation-against-probability figure.
-CURVE_PROBABILITIES = tuple(np.round(np.geomspace(0.005, 0.9, 31), 5))
 #: Target probabilities of a wall hit whose clearance the findings state (among the table's).
 WALL_TARGETS = (0.05, 0.01)
-
-
-@dataclass(frozen=True)
-class Closure:
-    """What a Separation section separates, and the words for it: buildings from each other, or a building from its moat's walls.
-
-    Attributes
-    ----------
-    kind : str
-        ``contacts`` (between buildings: the separation rules apply) or ``walls``.
-    variable : str
-        The store's peak closure D of a run (m), per ``contact`` (the largest is taken) or one per run.
-    events : str
-        The store variable that is positive in a run that closed the gap (impacts, or the wall penetration).
-    event : str
-        The event, as in "P(pounding)".
-    gap : str
-        The separation's name ("gap", "clearance"), ``symbol`` its letter.
-    free : str
-        The runs whose gaps never close ("contact-free", "wall-free").
-    free_cases, finite_cases, axes : callable
-        The store's runs at ``inf``, its runs at the finite values, and the gap axes concerned
-        (``stochpound.store._gap_axes``).
-    """
-
-    kind: str
-    variable: str
-    events: str
-    event: str
-    gap: str
-    symbol: str
-    free: str
-    free_cases: Callable[[xr.Dataset], xr.Dataset]
-    finite_cases: Callable[[xr.Dataset], xr.Dataset]
-    axes: Callable[[xr.Dataset], list[str]]
-
-    @property
-    def walls(self) -> bool:
-        """Whether the gap separates a building from walls (no separation rules then)."""
-        return self.kind == "walls"
-
-
-CONTACTS = Closure("contacts", "peak_contact_closure", "impacts", "pounding", "gap", "g", "contact-free", contact_free, with_contacts, contact_gap_dims)
-"""The gap between buildings: gap axes that set contacts, their contact-free runs."""
-WALLS = Closure("walls", "largest_wall_closure", "peak_wall_penetration", "wall hit", "clearance", "c", "wall-free", wall_free, with_walls, wall_gap_dims)
-"""A moat's clearance: gap axes that set walls only, their wall-free runs (walls never reached, the closure toward them located)."""
-
-
-def closure_demand(data: xr.Dataset, closure: Closure) -> xr.DataArray:
-    """The run's peak closure D (m) that decides whether it closes a gap: the largest over the contacts (NaN if one is)."""
-    demand = data[closure.variable].load()
-    return demand.max("contact", skipna=False) if "contact" in demand.dims else demand
 
 
 def separation_section(name: str, store: xr.Dataset, closure: Closure = CONTACTS) -> Section:
@@ -158,15 +100,10 @@ def _method_paragraph(store: xr.Dataset) -> Paragraph:
     return Paragraph(text)
 
 
-def _rule_gaps(free: xr.Dataset) -> xr.DataArray:
-    """Each rule's gap per case, the largest over contacts (m)."""
-    return separation_rules(store_contact_demands(free)).max("contact")
-
-
 def _record_table(name: str, free: xr.Dataset, closure: Closure) -> Table:
     """Per record cell: D and every rule's gap (cm; between buildings only)."""
     dims = [d for d in free["case_status"].dims]
-    columns = {(f"D, {'clearance' if closure.walls else 'separation'} needed", "cm"): closure_demand(free, closure) * CM}
+    columns = {(f"D, {'clearance' if closure.walls else 'separation'} needed", "cm"): closure.demand(free) * CM}
     if closure.walls:
         return Table(
             key=f"table-{name}-clearance-records",
@@ -175,7 +112,7 @@ def _record_table(name: str, free: xr.Dataset, closure: Closure) -> Table:
             note="A record hits a wall at any clearance up to D.",
             per_cell=True,
         )
-    rules = _rule_gaps(free)
+    rules = StoreSeparation.rule_gaps_of(free)
     for rule in rules["rule"].values:
         columns[(RULE_TEXT[str(rule)], "cm")] = rules.sel(rule=rule, drop=True) * CM
     return Table(
@@ -187,26 +124,20 @@ def _record_table(name: str, free: xr.Dataset, closure: Closure) -> Table:
     )
 
 
-class SeparationEnsemble:
-    """The contact-free (wall-free) cells of one synthetic ensemble and the separation (clearance) they call for."""
+class SeparationEnsemble(StoreSeparation):
+    """The separation (clearance) one synthetic ensemble calls for (:class:`stochpound.analysis.StoreSeparation`), as the report shows it."""
 
     def __init__(self, name: str, store: xr.Dataset, label: str, confidence: float = 0.95, closure: Closure = CONTACTS) -> None:
+        super().__init__(name, store, label, confidence, closure)
         self.ensemble = Ensemble(name, closure.free_cases(store), label, confidence)
-        self.name, self.label, self.confidence, self.closure = name, label, confidence, closure
-        self.demand = closure_demand(self.ensemble.data, closure)
-        # the runs at the grid's finite gaps, compared with D when one gap axis sets every gap
-        axes = closure.axes(store)
-        finite = store[axes[0]].values[np.isfinite(store[axes[0]].values)] if len(axes) == 1 else []
-        self.gap_axis = axes[0] if len(finite) else None
-        self.impacts = Ensemble(name, closure.finite_cases(store), label, confidence).data[closure.events].load() if self.gap_axis else None
 
     def blocks(self) -> list[Block]:
         """Findings, tables and figures, in reading order."""
-        needed = required_separation(self.demand, confidence=self.confidence, contact_dim=None).compute()
+        needed = self.needed()
         if self.closure.walls:
             return [*self._identity_check(), self._wall_findings(needed), self._separation_table(needed), *self._curve_figures(), *self._separation_figures()]
-        rules = _rule_gaps(self.ensemble.data).load()
-        exceedance = rule_exceedance(self.demand, rules, confidence=self.confidence, contact_dim=None).compute()
+        rules = self.rule_gaps()
+        exceedance = self.exceedance(rules)
         return [
             *self._identity_check(),
             self._findings(needed, exceedance),
@@ -216,50 +147,33 @@ class SeparationEnsemble:
             *self._separation_figures(),
         ]
 
-    def hit_probability(self) -> xr.Dataset:
-        """The fraction of the store's runs at its finite gaps that closed one (P(pounding), P(wall hit)) with its interval, computed."""
-        return pounding_probability(self.impacts, confidence=self.confidence).compute()
-
-    def curve_at_grid(self) -> xr.Dataset:
-        """P(D ≥ g) from the contact-free (wall-free) runs at the grid's finite gaps, on the gap axis, with its interval, computed
-        (call when :attr:`gap_axis` is not None)."""
-        axis = self.gap_axis
-        curve = pounding_curve(self.demand, self.impacts[axis].values, confidence=self.confidence, contact_dim=None).compute()
-        return curve.rename(gap=axis) if axis != "gap" else curve
-
     # ------------------------------------------------------------ text
 
     def _identity_check(self) -> list[Block]:
         """Runs at the store's finite gaps against the contact-free (wall-free) closures of the same realizations."""
-        if self.gap_axis is None:
+        check = self.identity_check()
+        if check is None:
             return []
-        c = self.closure
-        axis, impacts = self.gap_axis, self.impacts
-        pounded = (impacts > 0).where(impacts.notnull())
-        gaps = xr.DataArray(impacts[axis].values, dims=axis)
-        reached = (self.demand >= gaps).where(self.demand.notnull())
-        both = pounded.notnull() & reached.notnull()
-        ties = both & (abs(self.demand - gaps) <= 1e-9)
-        compared = int((both & ~ties).sum())
-        disagree = int(((pounded != reached) & both & ~ties).sum())
+        c, axis = self.closure, self.gap_axis
+        compared, disagree, gaps = check.compared, check.disagree, check.gaps
         text = (
-            f"Checked on this store: at its {gaps.size} finite {c.gap}(s) ({', '.join(value_text(axis, g) for g in gaps.values)}), "
+            f"Checked on this store: at its {gaps.size} finite {c.gap}(s) ({', '.join(value_text(axis, g) for g in gaps)}), "
             f"{compared} runs with {'walls' if c.walls else 'contacts'} were compared with the {c.free} run of the same cell and realization; "
         )
         closes = "hits a wall" if c.walls else "pounds"
         text += (f"every one {closes} exactly when D ≥ {c.symbol}." if disagree == 0
                  else f"{disagree} of them disagree with D ≥ {c.symbol} (see docs/separation.md for the assumption).")
-        if int(ties.sum()):
-            text += f" {int(ties.sum())} runs with D within 1e-9 m of g are not counted."
+        if check.ties:
+            text += f" {check.ties} runs with D within 1e-9 m of g are not counted."
         return [Paragraph(text)]
 
-    def _findings(self, needed: xr.Dataset, exceedance: xr.Dataset) -> Paragraph:
+    def _findings(self, needed: Needed, exceedance: xr.Dataset) -> Paragraph:
         p = 0.05 if 0.05 in needed["probability"].values else float(needed["probability"].values[0])
         separation = needed["separation"].sel(probability=p)
-        low, high = _extreme_cells(separation)
-        n = int(needed["realizations"].min())
+        low, high = needed.extreme_cells(p)
+        n = needed.fewest_runs
         text = (
-            f"With {n}{'' if n == int(needed['realizations'].max()) else '–' + str(int(needed['realizations'].max()))} contact-free realizations per cell, "
+            f"With {n}{'' if n == needed.most_runs else '–' + str(needed.most_runs)} contact-free realizations per cell, "
             f"a {p:.0%} probability of pounding needs a gap of {_cm(separation.sel(low))} ({labels_text(low) or 'the one cell'})"
         )
         if high != low:
@@ -267,61 +181,54 @@ class SeparationEnsemble:
         text += ". "
         text += self._grid_answer(needed, p)
         sentences = []
-        for rule in exceedance["rule"].values:
-            probability = exceedance["probability"].sel(rule=rule)
-            lo, hi = float(probability.min()), float(probability.max())
-            share = float((exceedance["upper"].sel(rule=rule) <= p).mean())
+        for reach in self.rule_reach(exceedance, p):
+            rule, lo, hi, share = reach.rule, reach.lowest, reach.highest, reach.share_within
             if rule == "abs" and hi == 0.0:
                 sentences.append("ABS is never reached (it bounds D by construction)")
                 continue
             sentences.append(
-                f"{RULE_TEXT[str(rule)].split(' (')[0]} is reached with probability {lo:.3f}" + (f" to {hi:.3f}" if hi > lo else "")
+                f"{RULE_TEXT[rule].split(' (')[0]} is reached with probability {lo:.3f}" + (f" to {hi:.3f}" if hi > lo else "")
                 + f" (upper bound ≤ {p:.0%} in {share:.0%} of the cells)"
             )
         text += "Separated by a rule's gap, the buildings pound: " + "; ".join(sentences) + "."
         return Paragraph(text)
 
-    def _wall_findings(self, needed: xr.Dataset) -> Paragraph:
+    def _wall_findings(self, needed: Needed) -> Paragraph:
         """P(wall hit) at the grid's clearances from the wall-free runs against the runs there, and the clearance for each target."""
-        n = int(needed["realizations"].min())
-        text = f"With {n} wall-free realizations per cell: "
+        text = f"With {needed.fewest_runs} wall-free realizations per cell: "
         if self.gap_axis is not None:
             clearances = self.impacts[self.gap_axis].values
-            curve, direct = self.curve_at_grid(), self.hit_probability()
-            inside = ((direct["probability"] >= curve["lower"]) & (direct["probability"] <= curve["upper"])) | direct["probability"].isnull()
+            curve = self.curve_at_grid()
+            inside, cells = self.curve_agreement()
             text += (
                 f"P(wall hit | c) = P(D ≥ c) is {'; '.join(f'{value_text(self.gap_axis, c)}: {span(curve.probability.sel({self.gap_axis: c}))}' for c in clearances)} "
                 f"over the cells; the runs at those clearances hit a wall in a fraction within its {self.confidence:.0%} Clopper–Pearson "
-                f"interval in {int(inside.sum())} of {int(inside.size)} cells. "
+                f"interval in {inside} of {cells} cells. "
             )
         for p in WALL_TARGETS:
             separation = needed["separation"].sel(probability=p)
-            low, high = _extreme_cells(separation)
+            low, high = needed.extreme_cells(p)
             text += f"P(wall hit) = {p:.0%} needs a clearance of {_cm(separation.sel(low))} ({labels_text(low) or 'the one cell'})"
             if high != low:
                 text += f" up to {_cm(separation.sel(high))} ({labels_text(high)})"
             text += f", upper {self.confidence:.0%} bound {span_cm(needed['upper'].sel(probability=p))}. "
         return Paragraph(text.strip())
 
-    def _grid_answer(self, needed: xr.Dataset, p: float) -> str:
+    def _grid_answer(self, needed: Needed, p: float) -> str:
         """How the answer from the grid's own gaps (the experiment section's "rare" gap) relates to the contact-free quantile at ``p``."""
-        if self.gap_axis is None or p != RARE:
+        rare = self.grid_rare(needed, p)
+        if rare is None:
             return ""
-        upper = pounding_probability(self.impacts, confidence=self.confidence)["upper"].compute()
-        grid = rare_gap(upper, self.gap_axis)
+        grid, above, above_bound, cells = rare.gap, rare.above_estimate, rare.above_bound, rare.cells
         estimate, bound = needed["separation"].sel(probability=p), needed["upper"].sel(probability=p)
-        known = grid.notnull()
-        cells = int(known.size)
-        if not bool(known.any()):
+        if not rare.known:
             return (
                 f"On the grid's own gaps (the experiment's section) the same question has no answer: no gap of the grid brings "
                 f"the upper {self.confidence:.0%} bound of P(pounding) below {RARE:.0%}. "
             )
-        above = int((known & (grid >= estimate)).sum())
-        above_bound = int((known & (grid >= bound)).sum())
         return (
             f"The experiment's section answers the same question on the grid's own gaps: the smallest gap of the grid from which "
-            f"on the upper {self.confidence:.0%} bound of P(pounding) is below {RARE:.0%}, {span_cm(grid)} in {int(known.sum())} of "
+            f"on the upper {self.confidence:.0%} bound of P(pounding) is below {RARE:.0%}, {span_cm(grid)} in {rare.known} of "
             f"{cells} cells. That answer can only name a gap of the grid, and asks the bound, not the estimate, to be below "
             f"{RARE:.0%}: it is at or above the estimate here in {above} of those cells and at or above its upper bound in "
             f"{above_bound}; the quantile of D gives the gap between the grid's gaps (estimate {span_cm(estimate)}, upper "
@@ -330,7 +237,7 @@ class SeparationEnsemble:
 
     # ------------------------------------------------------------ tables
 
-    def _separation_table(self, needed: xr.Dataset) -> Table:
+    def _separation_table(self, needed: Needed) -> Table:
         columns: dict[tuple[str, str], xr.DataArray] = {("realizations", "n"): needed["realizations"]}
         for p in needed["probability"].values:
             head = f"{self.closure.gap} for P({self.closure.event}) = {p:g} (cm)"
@@ -353,7 +260,7 @@ class SeparationEnsemble:
         columns: dict[tuple[str, str], xr.DataArray] = {("realizations", "n"): exceedance["realizations"].isel(rule=0, drop=True)}
         for rule in rules["rule"].values:
             head = RULE_TEXT[str(rule)].split(" (")[0]
-            columns[(head, "mean gap (cm)")] = rules.sel(rule=rule, drop=True).mean("realization") * CM
+            columns[(head, "mean gap (cm)")] = self.mean_rule_gaps(rules).sel(rule=rule, drop=True) * CM
             for part in ("probability", "lower", "upper"):
                 columns[(head, "P" if part == "probability" else part)] = exceedance[part].sel(rule=rule, drop=True)
         return Table(
@@ -372,16 +279,14 @@ class SeparationEnsemble:
     def _curve_figures(self) -> list[FigureItem]:
         """P(D ≥ g) against g, and the store's runs at its finite gaps as markers."""
         ensemble = self.ensemble
-        finite = self.demand.values[np.isfinite(self.demand.values)]
-        top = float(np.quantile(finite, 0.995)) if finite.size else 0.1  # the far tail of one cell would squeeze the others
-        gaps = np.linspace(0.0, 1.05 * top, 211)
-        curve = pounding_curve(self.demand, gaps, confidence=self.confidence, contact_dim=None).compute()
+        gaps = self.curve_gaps()
+        curve = self.curve(gaps)
         axis = self.gap_axis
         direct = self.hit_probability()["probability"] if axis else None
         c = self.closure
         line_dim = ensemble.line_dim()
 
-        def curves(panel: dict[str, Any]) -> list[figures.Curve]:
+        def curves(panel: CellLabels) -> list[figures.Curve]:
             result = []
             for value, colour in lines(ensemble.grid, line_dim):
                 where = {**panel, **({line_dim: value} if line_dim else {})}
@@ -407,11 +312,11 @@ class SeparationEnsemble:
     def _separation_figures(self) -> list[FigureItem]:
         """The separation needed against the target probability (log axis), with its interval."""
         ensemble = self.ensemble
-        usable = [p for p in CURVE_PROBABILITIES if p >= 1.0 / max(ensemble.size, 1)]
-        needed = required_separation(self.demand, usable, confidence=self.confidence, contact_dim=None).compute()
+        usable = self.curve_probabilities()
+        needed = self.needed(usable).data
         line_dim = ensemble.line_dim()
 
-        def curves(panel: dict[str, Any]) -> list[figures.Curve]:
+        def curves(panel: CellLabels) -> list[figures.Curve]:
             result = []
             for value, colour in lines(ensemble.grid, line_dim):
                 where = {**panel, **({line_dim: value} if line_dim else {})}
@@ -428,33 +333,21 @@ class SeparationEnsemble:
                                       title=f"{c.gap} needed" if c.walls else "separation needed", log_x=True, legend_title=dim_text(line_dim) if line_dim else "")
 
 
-def _extreme_cells(values: xr.DataArray) -> tuple[dict[str, Any], dict[str, Any]]:
-    """Labels of the cells with the smallest and largest value (NaN ignored)."""
-    flat = values.stack(cell=values.dims) if values.dims else values.expand_dims(cell=[0])
-    order = np.argsort(np.where(np.isnan(flat.values), np.inf, flat.values))
-    finite = [i for i in order if np.isfinite(flat.values[i])] or [int(order[0])]
-
-    def labels(i: int) -> dict[str, Any]:
-        return {d: flat[d].values[i].item() for d in values.dims}
-
-    return labels(finite[0]), labels(finite[-1])
-
-
 def span(values: xr.DataArray) -> str:
     """The range of the probabilities ``values`` over their cells, NaN ignored ("—" if none)."""
-    finite = values.values[np.isfinite(values.values)]
-    if not finite.size:
+    extent = ValueRange.of(values)
+    if extent is None:
         return "—"
-    low, high = f"{finite.min():.3f}", f"{finite.max():.3f}"
+    low, high = f"{extent.low:.3f}", f"{extent.high:.3f}"
     return low if low == high else f"{low}–{high}"
 
 
 def span_cm(values: xr.DataArray) -> str:
     """The range of ``values`` (m) in cm, NaN ignored ("—" if none)."""
-    finite = values.values[np.isfinite(values.values)]
-    if not finite.size:
+    extent = ValueRange.of(values)
+    if extent is None:
         return "—"
-    low, high = finite.min() * CM, finite.max() * CM
+    low, high = extent.low * CM, extent.high * CM
     return f"{low:.1f} cm" if f"{low:.1f}" == f"{high:.1f}" else f"{low:.1f}–{high:.1f} cm"
 
 

@@ -10,6 +10,7 @@ import xarray as xr
 
 from stochpound._errors import StochpoundError
 from stochpound.experiment import open_store
+from stochpound.store import select_case
 
 
 def open_stores(paths: Sequence[str | Path], edited: str = "warn") -> dict[str, xr.Dataset]:
@@ -52,17 +53,8 @@ def open_stores(paths: Sequence[str | Path], edited: str = "warn") -> dict[str, 
     return stores
 
 
-def select(store: xr.Dataset, **labels: Any) -> xr.Dataset:
-    """The store at the given labels; labels of dimensions the store lacks are ignored.
-
-    A ``realization`` of length 1 is squeezed. A label missing from its
-    dimension raises ``KeyError`` (callers show such cells as missing).
-    """
-    present = {dim: value for dim, value in labels.items() if dim in store.dims}
-    selected = store.sel(present)
-    if "realization" in selected.dims and selected.sizes["realization"] == 1:
-        selected = selected.isel(realization=0)
-    return selected
+select = select_case
+"""The store at the given labels (:func:`stochpound.store.select_case`)."""
 
 
 def value(store: xr.Dataset | None, variable: str, scale: float = 1.0, **labels: Any) -> float:

@@ -24,18 +24,17 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping
 
-import numpy as np
 import pandas as pd
 import xarray as xr
 
-from stochpound.analysis import pounding_probability, required_separation
+from stochpound.analysis import CONTACTS, WALLS, Closure, Needed, RecordPounding, StoreSeparation
 from stochpound.report.render import Paragraph, Section, Table
 from stochpound.report.sections._ensembles import MIN_RUNS, Ensemble
 from stochpound.report.sections._facets import dim_text, labels_text, value_text
 from stochpound.report.sections._mechanism_findings import mechanism_answer
 from stochpound.store import gap_dims, has_contact_free, has_wall_free, wall_gap_dims, with_contacts, with_walls
 from stochpound.report.sections._risk import summary_answer
-from stochpound.report.sections._separation import CONTACTS, WALLS, Closure, SeparationEnsemble, span, span_cm
+from stochpound.report.sections._separation import span, span_cm
 from stochpound.risk import StoreRisk
 
 CM = 100.0
@@ -96,9 +95,9 @@ def _clearance_answer(name: str, store: xr.Dataset, ensembles: list[str], confid
     for each target probability with its upper bound, per ensemble over its cells."""
     parts = []
     for label in ensembles:
-        separation = SeparationEnsemble(name, store, label, confidence, closure=WALLS)
-        needed = required_separation(separation.demand, SEPARATION_TARGETS, confidence=confidence, contact_dim=None).compute()
-        n, cells = int(needed["realizations"].min()), int(needed["separation"].isel(probability=0).size)
+        separation = StoreSeparation(name, store, label, confidence, closure=WALLS)
+        needed = separation.needed(SEPARATION_TARGETS)
+        n, cells = needed.fewest_runs, needed.cells
         few = f"; fewer than {MIN_RUNS}, so indicative only" if n < MIN_RUNS else ""
         text = f"ensemble {label} ({n} wall-free realizations in each of {cells} cells{few}): "
         axis = separation.gap_axis
@@ -119,24 +118,23 @@ def _separation_answer(name: str, store: xr.Dataset, ensembles: list[str], confi
     """How wide the gap must be: the separation for each target probability, its upper bound, per ensemble over its cells."""
     parts = []
     for label in ensembles:
-        demand = SeparationEnsemble(name, store, label, confidence).demand
-        needed = required_separation(demand, SEPARATION_TARGETS, confidence=confidence, contact_dim=None).compute()
-        n, cells = int(needed["realizations"].min()), int(needed["separation"].isel(probability=0).size)
+        needed = StoreSeparation(name, store, label, confidence).needed(SEPARATION_TARGETS)
+        n, cells = needed.fewest_runs, needed.cells
         answers = _target_answers(needed, lambda p: f"for P(pounding) = {p:.0%}, ", confidence)
         few = f"; fewer than {MIN_RUNS}, so indicative only" if n < MIN_RUNS else ""
         parts.append(f"ensemble {label} ({n} contact-free realizations in each of {cells} cells{few}): " + "; ".join(answers))
     return "How wide must the gap be? The separation needed, the 1 − p quantile of the contact-free peak closure D: " + "; ".join(parts) + "."
 
 
-def _target_answers(needed: xr.Dataset, lead: Callable[[float], str], confidence: float) -> list[str]:
+def _target_answers(needed: Needed, lead: Callable[[float], str], confidence: float) -> list[str]:
     """For each target of ``SEPARATION_TARGETS``: ``lead(p)``, the separation needed over the cells (cm) with its extremes and upper
-    bound, and, where some cells have none, why (``needed``: :func:`~stochpound.analysis.required_separation`'s result)."""
-    n, cells = int(needed["realizations"].min()), int(needed["separation"].isel(probability=0).size)
+    bound, and, where some cells have none, why (``needed``: :meth:`~stochpound.analysis.StoreSeparation.needed`)."""
+    n, cells = needed.fewest_runs, needed.cells
     answers = []
     for p in SEPARATION_TARGETS:
         estimate, upper = needed["separation"].sel(probability=p), needed["upper"].sel(probability=p)
-        text = f"{lead(p)}{span_cm(estimate)}{_extremes(estimate)}"
-        missing = int(upper.isnull().sum())
+        text = f"{lead(p)}{span_cm(estimate)}{_extremes(needed, p)}"
+        missing = needed.missing_upper(p)
         if missing < upper.size:
             text += f", upper {confidence:.0%} bound {span_cm(upper)}"
         if missing:
@@ -148,40 +146,28 @@ def _target_answers(needed: xr.Dataset, lead: Callable[[float], str], confidence
 
 def _records_answer(store: xr.Dataset, records: list[str]) -> str:
     """What the records' cases answer: in how many cases each record pounded (one realization each: no probability)."""
-    finite = _finite(store)
-    impacts = finite["impacts"].sel(record=records).isel(realization=0)
-    done = (finite["case_status"].sel(record=records).isel(realization=0) == 1)
-    counts = "; ".join(f"{label}: {int(((impacts.sel(record=label) > 0) & done.sel(record=label)).sum())} of {int(done.sel(record=label).sum())}"
-                       for label in records)
+    cases = RecordPounding.of(_finite(store), records)
+    counts = "; ".join(f"{label}: {pounded} of {done}" for label, pounded, done in zip(cases.records, cases.pounded, cases.done))
     return (f"Does a record make the buildings pound? Cases with at least one impact, per record: {counts}. A record is one "
             "realization: it answers yes or no per case, not with a probability.")
 
 
-def _extremes(values: xr.DataArray) -> str:
-    """" (smallest at …, largest at …)" naming the cells of the extremes, "" for one cell."""
-    finite = values.where(np.isfinite(values))
-    if finite.size < 2 or int(finite.notnull().sum()) < 2:
+def _extremes(needed: Needed, probability: float) -> str:
+    """" (smallest at …, largest at …)" naming the cells of the extremes of the separation needed for ``probability``, "" for one cell."""
+    extremes = needed.extremes(probability)
+    if extremes is None:
         return ""
-    stacked = finite.stack(cell=finite.dims)
-    low, high = int(np.nanargmin(stacked.values)), int(np.nanargmax(stacked.values))
-
-    def labels(i: int) -> str:
-        return labels_text({d: stacked[d].values[i].item() for d in finite.dims})
-
-    return f" (smallest at {labels(low)}, largest at {labels(high)})"
+    low, high = extremes
+    return f" (smallest at {labels_text(low)}, largest at {labels_text(high)})"
 
 
 def _probability_table(name: str, store: xr.Dataset, ensembles: list[str], axis: str, confidence: float, closure: Closure) -> Table:
     """P(pounding) (P(wall hit)) at each gap (clearance) of the grid, per ensemble: its range over the other cells and the highest upper bound."""
     rows = {}
     for label in ensembles:
-        impacts = Ensemble(name, store, label, confidence).data[closure.events]
-        probability = pounding_probability(impacts, confidence=confidence).compute()
-        others = [d for d in probability["probability"].dims if d != axis]
-        for gap in probability[axis].values:
-            at = probability.sel({axis: gap})
-            rows[(label, value_text(axis, gap))] = [int(at["probability"].size), int(at["realizations"].min()), float(at["probability"].min()),
-                                                    float(at["probability"].max()), float(at["upper"].max())]
+        others, along = Ensemble(name, store, label, confidence).probability_along(axis, closure.events)
+        for at in along:
+            rows[(label, value_text(axis, at.value))] = [at.cells, at.fewest, at.lowest, at.highest, at.highest_upper]
         cells = ", ".join(dim_text(d) for d in others) or "one cell"
     frame = pd.DataFrame.from_dict(rows, orient="index", columns=["cells", "n", "P lowest", "P highest", "highest upper bound"])
     frame.index = pd.MultiIndex.from_tuples(list(rows), names=["ensemble", dim_text(axis)])

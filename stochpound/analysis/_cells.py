@@ -1,0 +1,8 @@
+"""The labels of one cell of an experiment's grid: each grid dimension's name and the cell's coordinate value on it."""
+
+from __future__ import annotations
+
+from typing import Any
+
+CellLabels = dict[str, Any]
+"""A grid cell's labels, dimension -> value (``{"gap": 0.02, "mu": 0.1}``), as ``xarray``'s ``.sel`` takes them."""
