@@ -30,7 +30,9 @@ def _store(tmp_path, hazard: str) -> xr.Dataset:
 
 
 def test_bundled_site_curves_are_the_curves_of_one_site() -> None:
-    assert bundled_site_curves(f"{SITE}_sa2p0s") == [f"{SITE}_pga", f"{SITE}_sa1p0s", f"{SITE}_sa2p0s", f"{SITE}_sa3p0s"]
+    curves = bundled_site_curves(f"{SITE}_sa2p0s")
+    assert len(curves) == 17 and curves[0] == f"{SITE}_pga" and curves[-3:] == [f"{SITE}_sa3p0s", f"{SITE}_sa4p0s", f"{SITE}_sa5p0s"]
+    assert curves[1:5] == [f"{SITE}_sa0p03s", f"{SITE}_sa0p05s", f"{SITE}_sa0p1s", f"{SITE}_sa0p15s"]  # by period, not by name
     with pytest.raises(ValueError, match="name: no bundled hazard curve"):
         bundled_site_curves("nowhere_pga")
 
