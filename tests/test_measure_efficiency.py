@@ -68,7 +68,8 @@ def test_risk_cli_names_the_most_efficient_measure_the_sites_hazard_has(fixed_st
 
     store = open_store(fixed_stores[0]).load()
     available = hazard_measures(store, "fox_plaza_los_angeles_sa1p0s")
-    assert available == {"PGA": None, "PSA(1 s)": 1.0, "PSA(2 s)": 2.0, "PSA(3 s)": 3.0}
+    periods = (0.03, 0.05, 0.1, 0.15, 0.2, 0.3, 0.4, 0.5, 0.6, 0.75, 1.0, 1.5, 2.0, 3.0, 4.0, 5.0)  # the bundled site's PSA curves
+    assert available == {"PGA": None, **{f"PSA({period:g} s)": period for period in periods}}
     result = CliRunner().invoke(main, ["risk", str(fixed_stores[0]), "--hazard", "fox_plaza_los_angeles_sa1p0s", "--bootstrap", "0"])
     assert result.exit_code == 0, result.output
     efficiency = measure_efficiency(store, {f"hazard {k}": v for k, v in available.items() if v is not None})

@@ -16,6 +16,8 @@ from tests.helpers import SITE_SCENE as SCENE
 from tests.helpers import write_experiment
 
 SITE = "fox_plaza_los_angeles"
+SITE_PERIODS = (0.03, 0.05, 0.1, 0.15, 0.2, 0.3, 0.4, 0.5, 0.6, 0.75, 1.0, 1.5, 2.0, 3.0, 4.0, 5.0)
+"""The periods (s) of the bundled site's PSA curves (besides its PGA one)."""
 MEMBERS = [f"fema_p695_far_field/{i:02d}{c}" for i in range(1, 7) for c in "ab"]
 RECORDS = "".join(f'\n[[records]]\nrecord = "{name}"\nduration = 5.0\n' for name in MEMBERS)
 INTENSITY = ('[intensity]\nmeasure = "psa"\nperiod = 1.0\ndamping = 0.05\nunits = "g"\nlevels = [0.5611, 0.9299]\nselection = "conditional_spectrum"\n'
@@ -30,7 +32,9 @@ def _store(tmp_path, hazard: str) -> xr.Dataset:
 
 
 def test_bundled_site_curves_are_the_curves_of_one_site() -> None:
-    assert bundled_site_curves(f"{SITE}_sa2p0s") == [f"{SITE}_pga", f"{SITE}_sa1p0s", f"{SITE}_sa2p0s", f"{SITE}_sa3p0s"]
+    curves = bundled_site_curves(f"{SITE}_sa2p0s")
+    assert len(curves) == 17 and curves[0] == f"{SITE}_pga" and curves[-3:] == [f"{SITE}_sa3p0s", f"{SITE}_sa4p0s", f"{SITE}_sa5p0s"]
+    assert curves[1:5] == [f"{SITE}_sa0p03s", f"{SITE}_sa0p05s", f"{SITE}_sa0p1s", f"{SITE}_sa0p15s"]  # by period, not by name
     with pytest.raises(ValueError, match="name: no bundled hazard curve"):
         bundled_site_curves("nowhere_pga")
 
@@ -38,7 +42,7 @@ def test_bundled_site_curves_are_the_curves_of_one_site() -> None:
 def test_recomputed_from_the_motions_as_they_ran_and_shown_in_the_report(tmp_path) -> None:
     store = _store(tmp_path, f'[hazard]\nbundled = "{SITE}_sa1p0s"\n')
     result = site_consistency(store)
-    assert list(result) == ["PGA", "PSA(2 s)", "PSA(3 s)"]
+    assert list(result) == ["PGA", *(f"PSA({period:g} s)" for period in SITE_PERIODS if period != 1.0)]  # every other curve of the site
     # by hand: the motions that ran in each stripe, their stored PGA or PSA (log-log between the stored periods) times their scale factor
     levels = store["intensity"].values
     weights = stripe_rate_weights(levels, HazardCurve.bundled(f"{SITE}_sa1p0s"))

@@ -282,13 +282,15 @@ def bundled_measure(name: str) -> Measure:
 
 
 def bundled_site_curves(name: str) -> list[str]:
-    """The bundled curves of the site of bundled curve ``name``: those whose names differ from it only in the measure's ending (itself included).
+    """The bundled curves of the site of bundled curve ``name``: those whose names differ from it only in the measure's ending (itself included),
+    PGA first, then PSA by increasing period.
 
-    E.g. ``fox_plaza_los_angeles_sa1p0s`` gives the site's PGA and PSA(1, 2, 3 s) curves.
+    E.g. ``fox_plaza_los_angeles_sa1p0s`` gives the site's PGA and PSA(0.03, 0.05, 0.1, ..., 5 s) curves.
     """
     bundled_measure(name)
     site = name[: _BUNDLED_MEASURE.search(name).start()]
-    return [other for other in bundled_curves() if (match := _BUNDLED_MEASURE.search(other)) and other[: match.start()] == site]
+    curves = [other for other in bundled_curves() if (match := _BUNDLED_MEASURE.search(other)) and other[: match.start()] == site]
+    return sorted(curves, key=lambda curve: bundled_measure(curve).period or 0.0)
 
 
 def _bundled_folder() -> Path:

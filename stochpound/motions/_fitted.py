@@ -3,7 +3,7 @@
 A conditional spectrum needs, per level x_j of the conditioning measure IM*,
 the scenario (magnitude M, rupture distance R) that causes it: the hazard's
 disaggregation. Where none is at hand but the site's hazard curves are known
-at other periods T' (the bundled site: PGA and PSA at 1, 2 and 3 s), the
+at other periods T' (the bundled site: PGA and PSA at 0.03–5 s), the
 scenario can be calibrated so that the stripes reproduce those curves, the
 hazard-consistency check of Lin, Haselton & Baker (2013) used as the fit:
 

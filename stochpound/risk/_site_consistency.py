@@ -1,7 +1,7 @@
 """A stripes store's hazard consistency: the site's hazard at its other periods recomputed from the motions as they ran.
 
 For a store whose hazard is a bundled site's curve (the bundled Fox Plaza
-site has PGA and PSA at 1, 2 and 3 s), every other curve of that site is
+site has PGA and PSA at 16 periods from 0.03 to 5 s), every other curve of that site is
 recomputed from the stripes (:func:`stochpound.analysis.hazard_consistency`:
 λ(Sa(T') > y) ≈ Σ_j P(Sa(T') > y | IM* = x_j) Δλ(x_j), P the fraction of
 the stripe's motions, scaled as they ran, above y) and set against the
