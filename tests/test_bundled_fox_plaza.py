@@ -21,6 +21,7 @@ from stochpound.experiment._spec import parse_experiment
 from stochpound.hazard._curve import bundled_path
 from stochpound.hazard._files import StatedMeasure, read_hazard_file
 from stochpound.hazard._setting import hazard_curve
+from stochpound.store import Hazard
 from stochpound.motions import Measure
 from tests.helpers import ISOLATED, REPOSITORY, risk_text
 
@@ -67,5 +68,5 @@ def test_a_short_building_s_stripes_take_the_site_s_curve_at_their_own_period(tm
     assert bundled_measure(name) == Measure("psa", period, damping=0.05)
     intensity = f'measure = "psa"\nperiod = {period}\nlevels = [0.3, 0.8, 1.5]'
     text = risk_text(ISOLATED, "gap = [inf]", intensity, f'bundled = "{name}"')
-    curve = hazard_curve(parse_experiment(tomllib.loads(text), base_dir=tmp_path)["hazard"])
+    curve = hazard_curve(Hazard.from_entry(parse_experiment(tomllib.loads(text), base_dir=tmp_path)["hazard"]))
     np.testing.assert_allclose(curve(curve.im), HazardCurve.bundled(name).rate, rtol=1e-12)
