@@ -137,10 +137,11 @@ def parse_intensity(data: Mapping[str, Any], scene: Mapping[str, Any], variants:
         raise IntensityError(f"intensity.{error}") from None
     setting = Intensity(scaled_measure, units, tuple(sorted(float(level) for level in levels)), method, ran, note,
                         synthetic)
-    selection = parse_selection(table, data.get("site"), levels, setting, base_dir)
-    if not selection:
+    chosen = parse_selection(table, data.get("site"), levels, setting, base_dir)
+    if chosen is None:
         return setting
-    return dataclasses.replace(setting, note=selection.pop("note"), selection=selection)
+    selection, note = chosen
+    return dataclasses.replace(setting, note=note, selection=selection)
 
 
 def _method_run(method: str, scene: Mapping[str, Any], variants: Sequence[VariantAxis], gaps: Sequence[GapAxis], mu: MuAxis | None) -> tuple[str, str]:

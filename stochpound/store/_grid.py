@@ -52,6 +52,8 @@ CONDITIONAL_SPECTRUM = "conditional_spectrum"
 """``[intensity] selection`` that chooses the motions of every stripe (docs/intensity.md)."""
 SIMULATED = "simulated"
 """The kind of a motion simulated for a stripe's pool (``[site] simulated_motions``) and chosen."""
+SIMULATED_FIELD = "site.simulated_motions"
+"""The field that declares the simulated motions (how messages name a chosen one)."""
 
 
 @dataclass(frozen=True)
@@ -158,8 +160,8 @@ class StripeChoice(Protocol):
         """Which motions run at every level (bool, level × motion on ``record``)."""
 
     @property
-    def simulated(self) -> Mapping[str, Mapping[str, Any]]:
-        """The chosen simulated motions' sources (``label``, ``kind``, ``field``, ``motion``), by label, in ``record`` order."""
+    def simulated(self) -> Mapping[str, MotionSource]:
+        """The chosen simulated motions' sources, by label, in ``record`` order."""
 
 
 @dataclass(frozen=True)
@@ -200,9 +202,9 @@ class StoredChoice:
         return np.array(self.runs, dtype=bool).reshape(len(self.runs), -1)
 
     @cached_property
-    def simulated(self) -> dict[str, dict[str, Any]]:
+    def simulated(self) -> dict[str, MotionSource]:
         """The simulated motions' sources, by label, in ``record`` order."""
-        return {label: {"label": label, "kind": SIMULATED, "field": "site.simulated_motions", "motion": json.loads(table)} for label, table in self.tables}
+        return {label: MotionSource(label, SIMULATED, SIMULATED_FIELD, json.loads(table)) for label, table in self.tables}
 
 
 class ExperimentGrid:
@@ -281,8 +283,7 @@ class ExperimentGrid:
         """The motions on ``record``, by label: the definition's, then the simulated motions a selection chose (``[site] simulated_motions``)."""
         if self.selection is None:
             return self.recorded_motions
-        simulated = {label: MotionSource(label, s["kind"], s["field"], s["motion"]) for label, s in self.selection.simulated.items()}
-        return {**self.recorded_motions, **simulated}
+        return {**self.recorded_motions, **self.selection.simulated}
 
     @cached_property
     def motion_dims(self) -> list[Dim]:
