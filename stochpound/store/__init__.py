@@ -78,7 +78,7 @@ from stochpound.store._selections import fixed_base, has_fixed_base_twins, isola
 from stochpound.store._catalogue import CASE, KINDS, REFERENCE  # noqa: F401
 from stochpound.store._definition import MEASURES  # noqa: F401
 from stochpound.store._progress import UnfinishedStoreError, cases_done, check_finished  # noqa: F401
-from stochpound.store._grid import CONDITIONAL_SPECTRUM, SIMULATED, SIMULATED_FIELD  # noqa: F401
+from stochpound.store._grid import CONDITIONAL_SPECTRUM, SIMULATED, SIMULATED_FIELD, Label  # noqa: F401
 from stochpound.store._scene_edits import apply_overrides, building_names, reference_scene, with_motion  # noqa: F401
 
 __all__ = [

@@ -37,7 +37,8 @@ import xarray as xr
 from stochpound._errors import ExperimentError, SceneError
 from stochpound.model.scene_file import scene_from_dict
 from stochpound.store._catalogue import CASE, KINDS, REFERENCE
-from stochpound.store._definition import Definition, Intensity, MotionSource, Output, Solver, VariantAxis, canonical_json, read_definition
+from stochpound.store._definition import (Definition, Intensity, MotionSource, Output, Solver, VariantAxis, canonical_json, definition_sha256,
+                                          read_definition)
 from stochpound.store._scene_edits import (
     apply_overrides,
     building_names,
@@ -52,6 +53,8 @@ CONDITIONAL_SPECTRUM = "conditional_spectrum"
 """``[intensity] selection`` that chooses the motions of every stripe (docs/intensity.md)."""
 SIMULATED = "simulated"
 """The kind of a motion simulated for a stripe's pool (``[site] simulated_motions``) and chosen."""
+Label = str | float | int
+"""A case's label on one dimension: a variant or a motion (str), a gap, μ or a level (float), a realization (int)."""
 SIMULATED_FIELD = "site.simulated_motions"
 """The field that declares the simulated motions (how messages name a chosen one)."""
 
@@ -93,11 +96,11 @@ class Case:
 
     case_id: str
     kind: str
-    labels: tuple[tuple[str, Any], ...]
+    labels: tuple[tuple[str, Label], ...]
     position: tuple[int, ...]
 
     @property
-    def label_dict(self) -> dict[str, Any]:
+    def label_dict(self) -> dict[str, Label]:
         """The labels as a dict."""
         return dict(self.labels)
 
@@ -122,7 +125,7 @@ class Point:
 
     kind: str
     position: tuple[int, ...]
-    labels: tuple[tuple[str, Any], ...]
+    labels: tuple[tuple[str, Label], ...]
 
     def describe(self) -> str:
         """``case neighbour=stiff, gap=0.01, mu=0.1`` (``(base scene)`` without structural dimensions)."""
@@ -133,12 +136,12 @@ def _format(value: Any) -> str:
     return f"{value:g}" if isinstance(value, float) else str(value)
 
 
-def case_id(kind: str, labels: Mapping[str, Any]) -> str:
+def case_id(kind: str, labels: Mapping[str, Label]) -> str:
     """Stable id of a case from its kind and labels."""
     return hashlib.sha256(canonical_json({"kind": kind, "labels": dict(labels)}).encode()).hexdigest()[:16]
 
 
-def case_ids(kind: str, labels: Mapping[str, Any], realizations: Sequence[int]) -> list[str]:
+def case_ids(kind: str, labels: Mapping[str, Label], realizations: Sequence[int]) -> list[str]:
     """:func:`case_id` of the cases with ``labels`` at each of ``realizations`` (the JSON around the number is built once)."""
     marker = -7340912358  # a number that no other label renders as
     text = canonical_json({"kind": kind, "labels": {**labels, "realization": marker}})
@@ -230,10 +233,13 @@ class ExperimentGrid:
         self, definition: Mapping[str, Any] | Definition, text: str = "", base_dir: str | Path = ".", path: str = "", choice: StripeChoice | None = None
     ) -> None:
         self.definition: Definition = read_definition(definition)
+        written = self.definition.to_dict()
+        self.definition_json = canonical_json(written)
+        """The canonical definition's JSON, written once (a store's ``definition`` attribute)."""
+        self.sha256 = definition_sha256(written)
         self.text = text
         self.base_dir = Path(base_dir)
         self.path = path
-        self.sha256 = self.definition.sha256
         self.name: str = self.definition.name
         self.studied: str = self.definition.studied
         self.variants: tuple[VariantAxis, ...] = self.definition.variants
