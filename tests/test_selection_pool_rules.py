@@ -37,7 +37,7 @@ def test_the_chosen_simulated_motions_are_the_ones_their_tables_regenerate(tmp_p
     resolved = resolve_motions(experiment)
     for label, source in selection.simulated.items():
         table = experiment.motion_table(label)
-        assert source["kind"] == "simulated" and table["type"] == "site_motions" and table["n"] == 6
+        assert source.kind == "simulated" and table["type"] == "site_motions" and table["n"] == 6
         again = site_motions(table["magnitude"], table["distance_km"], table["vs30"], table["mechanism"], n=6, seed=2, dt=0.01)
         np.testing.assert_array_equal(resolved[label].motion.values, again.acceleration.values[table["realization"]])
     counts = selection.stripe_counts()

@@ -54,31 +54,16 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
 from pathlib import Path
-from typing import Any, Protocol
+from typing import Any
 
 import numpy as np
 import xarray as xr
 
 from stochpound.model import fields as toml_fields
 from stochpound.motions import CONDITIONING_MEASURES, MODEL_DAMPING, PERIOD_RANGE, Measure, Scenario
-from stochpound.store import CONDITIONAL_SPECTRUM, SCENARIO_KINDS, SIMULATED, SIMULATED_FIELD, Definition, Intensity, MotionSource, Selection, SimulatedMotions, Site, VariantAxis
+from stochpound.store import (CONDITIONAL_SPECTRUM, SCENARIO_KINDS, SIMULATED, SIMULATED_FIELD, ExperimentGrid, Intensity, MotionSource, Selection,
+                              SimulatedMotions, Site)
 
-
-class GridExperiment(Protocol):
-    """What the selection reads of an experiment (an :class:`~stochpound.experiment.Experiment`, which asks for its stripes here)."""
-
-    intensity: Intensity | None
-    recorded_motions: dict[str, MotionSource]
-    variants: tuple[VariantAxis, ...]
-    building_names: list[str]
-    base_dir: Path
-    definition: Definition
-
-    def points(self, kind: str) -> list[Any]: ...
-
-    def structure(self, case: Any) -> dict[str, Any]: ...
-
-    def motion_table(self, label: str, realization: int | None = None) -> dict[str, Any]: ...
 
 SELECTIONS = ("scale", CONDITIONAL_SPECTRUM)
 """``[intensity] selection``: every motion scaled to every level, or motions chosen per stripe."""
@@ -330,7 +315,7 @@ def fitted_site(site: Mapping[str, Any], levels: list[float], conditioning_measu
     return tuple(Scenario(**scenario) for scenario in scenarios)
 
 
-def periods_of_interest(experiment: GridExperiment) -> dict[str, float]:
+def periods_of_interest(experiment: ExperimentGrid) -> dict[str, float]:
     """The structure's periods of interest (s), by name: first-mode periods on a fixed base and isolated periods, over every grid point.
 
     Names: ``"B1 first mode"``, ``"B1 isolated"``, with the grid point's
@@ -355,7 +340,7 @@ def periods_of_interest(experiment: GridExperiment) -> dict[str, float]:
     return named
 
 
-def structure_periods(experiment: GridExperiment) -> list[float]:
+def structure_periods(experiment: ExperimentGrid) -> list[float]:
     """The distinct periods of :func:`periods_of_interest` (s), ascending."""
     return sorted(set(periods_of_interest(experiment).values()))
 
@@ -427,7 +412,7 @@ class StripeSelections:
                 for key, values in counts.items()}
 
 
-def stripe_selections(experiment: GridExperiment) -> StripeSelections:
+def stripe_selections(experiment: ExperimentGrid) -> StripeSelections:
     """Choose and scale the motions of every stripe (module docstring).
 
     Raises
