@@ -287,7 +287,7 @@ class FolderRecord:
     @classmethod
     def from_json(cls, data: Any) -> FolderRecord:
         """The record of an ``experiment.json``'s contents (the fields a folder of an older stochpound lacks take their defaults)."""
-        grids = tuple((label, float(grid[0]), int(grid[1])) for label, grid in data.get("motion_grids", {}).items())
+        grids = tuple((label, float(grid[0]), int(grid[1])) for label, grid in data["motion_grids"].items())
         known = {name: data[name] for name in ("definition", "text", "text_sha256", "file", "base_dir", "created") if name in data}
         return cls(data["definition_sha256"], motion_grids=grids, **known)
 
