@@ -31,7 +31,7 @@ import dataclasses
 import math
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Mapping, Sequence
+from typing import Any, Mapping, Sequence
 
 import numpy as np
 
@@ -41,9 +41,6 @@ from stochpound.motions import arias_intensity, peak_ground_motion, response_spe
 from stochpound._errors import IntensityError
 from stochpound.motions import Measure
 from stochpound.store import MEASURES, ExperimentGrid, GapAxis, Intensity, Label, MuAxis, VariantAxis
-
-if TYPE_CHECKING:
-    from stochpound.experiment._sources import ResolvedMotion
 
 METHODS = ("stripes", "ida")
 UNITS = {"pga": ("g", "m/s2"), "psa": ("g", "m/s2"), "sa_avg": ("g", "m/s2"), "pgv": ("m/s", "cm/s")}
@@ -296,7 +293,7 @@ def store_names(intensity: Intensity | None) -> list[str]:
     return names + (["ida_capacity"] if intensity.ran == "ida" else [])
 
 
-def task_settings(experiment: ExperimentGrid, motions: Mapping[str, ResolvedMotion]) -> Scaling | None:
+def task_settings(experiment: ExperimentGrid, motions: Mapping[str, Any]) -> Scaling | None:
     """What a worker needs to scale an experiment's cases (None without intensity).
 
     The intensity setting, g, the gap axes and, by motion number, the
