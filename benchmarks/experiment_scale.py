@@ -183,7 +183,7 @@ def _done(store: Path) -> int:
 
     folder = parts_folder(store)
     try:
-        return PartsIndex.scan(Experiment(read_experiment_json(folder)["definition"]), folder).n_done
+        return PartsIndex.scan(Experiment(read_experiment_json(folder).definition), folder).n_done
     except Exception:  # noqa: BLE001 - not there yet
         return 0
 

@@ -169,7 +169,7 @@ def done_cases(store: Path) -> int:
     folder = parts_folder(store)
     if not (folder / "experiment.json").is_file():
         return 0
-    return PartsIndex.scan(Experiment(read_experiment_json(folder)["definition"]), folder).n_done
+    return PartsIndex.scan(Experiment(read_experiment_json(folder).definition), folder).n_done
 
 
 def assert_same_results(first: Path, second: Path) -> None:

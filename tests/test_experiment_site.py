@@ -34,8 +34,8 @@ def _text(intensity: str | None = SELECTION, site: str = SITE) -> str:
 
 def test_each_stripe_runs_its_chosen_motions_and_the_store_keeps_the_selection(tmp_path) -> None:
     experiment = load_experiment(write_experiment(tmp_path, _text(), "site.toml"))
-    scenarios = experiment.intensity.selection["site"]
-    assert [s["magnitude"] for s in scenarios] == [6.6, 7.0]  # one per level, in the order of the sorted levels
+    scenarios = experiment.intensity.selection.scenarios
+    assert [s.magnitude for s in scenarios] == [6.6, 7.0]  # one per level, in the order of the sorted levels
     # the structure's first-mode periods; the range 0.2 T_min - 3 T_max with T* added
     m1, m2, k1, k2 = 2.0e5, 1.5e5, 1.2e8, 0.9e8  # B1's first mode: det(K - ω² M) = 0, the smaller root
     b, c = (k1 + k2) / m1 + k2 / m2, k1 * k2 / (m1 * m2)

@@ -17,7 +17,7 @@ from stochpound.report.sections._risk import design_summary_text, design_value_t
 from stochpound.risk import HazardCurve, StoreDemands, StoreRisk, degenerate_text, mean_annual_frequency, rate_intervals
 from stochpound.risk._fragility import ALWAYS, FIT, NEVER, Fragility
 from stochpound.motions import Measure
-from stochpound.store import Intensity
+from stochpound.store import Intensity, Selection
 
 HAZARD = HazardCurve([0.05, 0.2, 0.5, 1.0, 2.0], [0.0333, 8e-3, 2e-3, 5e-4, 8e-5], units="g", measure="PGA")
 
@@ -102,7 +102,7 @@ def test_the_gap_to_design_to_is_the_upper_bound_of_g_star_stated_as_such():
     assert list(unbounded.design_frame()["design"]) == [0.20, 0.40] and "no bootstrap" in design_value_text(unbounded)
     assert "g* is a central estimate from 22 motions and" in text
     selected = _risk()
-    selected.setting = Intensity(Measure("pga"), "g", (0.1,), "stripes", "stripes", "", selection={"selection": "conditional_spectrum"})  # motions chosen per stripe
+    selected.setting = Intensity(Measure("pga"), "g", (0.1,), "stripes", "stripes", "", selection=Selection("conditional_spectrum", 22, 4.0, 1, ()))  # motions chosen per stripe
     assert "g* is a central estimate from 22 motions per stripe and" in design_value_text(selected)
 
 

@@ -16,6 +16,7 @@ from stochpound.motions.records import load_suite, load_suite_member
 from stochpound.report.render import Paragraph
 from stochpound.report.sections._intensity import intensity_section
 from stochpound.report.sections._stripe_motions import stripe_motions_text
+from stochpound.store import SimulatedMotions
 from tests.helpers import SITE_SCENE as SCENE
 from tests.helpers import write_experiment
 
@@ -36,7 +37,7 @@ def test_the_chosen_simulated_motions_are_the_ones_their_tables_regenerate(tmp_p
     resolved = resolve_motions(experiment)
     for label, source in selection.simulated.items():
         table = experiment.motion_table(label)
-        assert source["kind"] == "simulated" and table["type"] == "site_motions" and table["n"] == 6
+        assert source.kind == "simulated" and table["type"] == "site_motions" and table["n"] == 6
         again = site_motions(table["magnitude"], table["distance_km"], table["vs30"], table["mechanism"], n=6, seed=2, dt=0.01)
         np.testing.assert_array_equal(resolved[label].motion.values, again.acceleration.values[table["realization"]])
     counts = selection.stripe_counts()
@@ -50,8 +51,10 @@ def test_the_chosen_simulated_motions_are_the_ones_their_tables_regenerate(tmp_p
 @pytest.mark.slow
 def test_simulated_motions_join_the_pool_and_regenerate_bit_for_bit_from_the_store(tmp_path) -> None:
     experiment = load_experiment(write_experiment(tmp_path, _text(), "pool.toml"))
-    setting = experiment.intensity.selection["simulated_motions"]
-    assert setting == {"count": 6, "model": "hazard_compatible", "calibration": site_model_provenance(), "seed": 2, "dt": 0.01}
+    setting = experiment.intensity.selection.simulated
+    assert setting == SimulatedMotions(6, "hazard_compatible", site_model_provenance(), 2, 0.01)
+    assert experiment.definition.to_dict()["intensity"]["simulated_motions"] == {"count": 6, "model": "hazard_compatible",
+                                                                                "calibration": site_model_provenance(), "seed": 2, "dt": 0.01}
     report = run_experiment(experiment, workers=0, progress=False)
     assert report.complete
     store = open_store(report.store).load()
@@ -90,7 +93,9 @@ def test_the_simulated_motions_are_part_of_the_identity(tmp_path) -> None:
     without = load_experiment(write_experiment(tmp_path, _text(site=SITE.replace("simulated_motions = 6\n", "")), "b.toml"))
     other = load_experiment(write_experiment(tmp_path, _text(site=SITE.replace("= 6", "= 7")), "c.toml"))
     assert len({with_them.sha256, without.sha256, other.sha256}) == 3
-    assert "simulated_motions" not in without.intensity.selection and "max_per_earthquake" not in without.intensity.selection
+    assert without.intensity.selection.simulated is None and without.intensity.selection.max_per_earthquake is None
+    entry = without.definition.to_dict()["intensity"]
+    assert "simulated_motions" not in entry and "max_per_earthquake" not in entry
 
 
 def _pool(names: list[str], periods: np.ndarray) -> object:

@@ -18,13 +18,15 @@ from __future__ import annotations
 
 import dataclasses
 import traceback
+from collections.abc import Mapping
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from stochpound import motions as synthetic_motions
 from stochpound.experiment import _intensity as intensity
-from stochpound.store import REFERENCE, Output, Solver, canonical_json, reference_scene, with_motion
+from stochpound.store import REFERENCE, Label, Output, Solver, canonical_json, reference_scene, with_motion
 from stochpound.experiment._parts import concatenate, section_key, stack_cases
 from stochpound.experiment._spec import AUTO
 from stochpound.experiment._summary import case_arrays, case_values, reference_arrays, reference_values
@@ -33,6 +35,9 @@ from stochpound.model.scene import Scene
 from stochpound.model.scene_file import scene_from_dict
 from stochpound.motions.ground import GroundMotion, SampledMotion
 from stochpound.solvers.simulate import simulate
+
+if TYPE_CHECKING:
+    import xarray as xr
 
 
 @dataclass(frozen=True)
@@ -152,7 +157,8 @@ def run_batch(task: BatchTask, motion: GroundMotion | None = None) -> BatchResul
 
 
 def _group(
-    task: BatchTask, group: Group, grounds: dict[int, GroundMotion], twins: dict[int, np.ndarray], measures: dict[int, dict], runs: dict, failures: list
+    task: BatchTask, group: Group, grounds: dict[int, GroundMotion], twins: dict[int, np.ndarray], measures: dict[int, intensity.CaseVariables],
+    runs: dict[tuple[str, int], xr.Dataset], failures: list[tuple[str, tuple[int, ...], str]]
 ) -> dict[str, np.ndarray]:
     """The section of a group's finished cases (empty if none finished); failures are appended to ``failures``.
 
@@ -183,7 +189,8 @@ def _group(
 
 
 def _case(
-    task: BatchTask, scene: Scene | None, ground: GroundMotion, twin: np.ndarray, extra: dict, labels: dict, runs: dict, key: tuple | None
+    task: BatchTask, scene: Scene | None, ground: GroundMotion, twin: np.ndarray, extra: intensity.CaseVariables, labels: Mapping[str, Label],
+    runs: dict[tuple[str, int], xr.Dataset], key: tuple[str, int] | None
 ) -> dict[str, np.ndarray]:
     """Part arrays of one case: ``scene`` (placeholder motion) under ``ground``, or, without a scene, a reference case (its twin's response).
 

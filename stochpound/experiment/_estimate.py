@@ -20,7 +20,6 @@ from stochpound._memory import format_bytes
 from stochpound.model.scene_file import scene_from_dict
 from stochpound.solvers import first_call
 from stochpound.solvers.first_call import compile_text
-from stochpound.store import canonical_json
 
 COMPILE = "compiling the solver"
 """The start-up step of compiling the exact solver into numba's empty cache."""
@@ -107,7 +106,7 @@ def estimate_run(experiment: Experiment, motion_grids: Mapping[str, tuple[float,
     """
     store = layout(experiment, motion_grids, 0)
     histories = sum(spec.dtype.itemsize * math.prod(store.sizes[d] for d in spec.dims) for spec in store.of("history"))
-    return RunEstimate(cases, cpu_seconds(experiment, motion_grids, cases), file_bytes(store, {"definition": canonical_json(experiment.definition.to_dict())}), histories,
+    return RunEstimate(cases, cpu_seconds(experiment, motion_grids, cases), file_bytes(store, {"definition": experiment.definition_json}), histories,
                        startup_steps(cases, workers))
 
 

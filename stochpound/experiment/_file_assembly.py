@@ -33,7 +33,7 @@ from stochpound.experiment._experiment import Experiment
 from stochpound.store import CASE, KINDS
 from stochpound.experiment._parts import part_paths, read_part, split_key
 from stochpound.experiment._spec import ExperimentError
-from stochpound.experiment._file_layout import INT_FILL, Layout, Spec, blocks, layout, union_times
+from stochpound.experiment._file_layout import INT_FILL, Layout, Spec, StoreAttributes, blocks, layout, union_times
 
 PART_CACHE_BYTES = 64 * 2**20
 """Parts kept in memory while the blocks that need them are written, bytes."""
@@ -127,7 +127,7 @@ def _sections(experiment: Experiment, arrays: dict[str, np.ndarray]) -> dict[str
     return found
 
 
-def write_store(experiment: Experiment, index: PartsIndex, motion_grids: Mapping[str, tuple[float, int]], attrs: Mapping[str, Any], path: Path) -> Path:
+def write_store(experiment: Experiment, index: PartsIndex, motion_grids: Mapping[str, tuple[float, int]], attrs: StoreAttributes, path: Path) -> Path:
     """(Re)write the store file from the finished cases of ``index``, atomically.
 
     Parameters
@@ -165,7 +165,7 @@ def write_store(experiment: Experiment, index: PartsIndex, motion_grids: Mapping
     return path
 
 
-def _check_room(path: Path, store_layout: Layout, attrs: Mapping[str, Any]) -> None:
+def _check_room(path: Path, store_layout: Layout, attrs: StoreAttributes) -> None:
     """Raise ``OSError(ENOSPC)`` naming ``path`` unless its disk has room for the file, with a margin (:data:`ROOM_FACTOR`, :data:`ROOM_MARGIN`).
 
     HDF5 may crash the process when the disk fills while it writes (a
@@ -194,7 +194,7 @@ def _chunks(shape: tuple[int, ...], chunks: tuple[int, ...] | None, dtype: np.dt
     return tuple(math.ceil(n / c) if c else 0 for n, c in zip(shape, chunks)), per_chunk
 
 
-def file_bytes(store_layout: Layout, attrs: Mapping[str, Any]) -> int:
+def file_bytes(store_layout: Layout, attrs: StoreAttributes) -> int:
     """The size of the store file :func:`write_store` writes for ``store_layout``, bytes, measured on an in-memory file.
 
     The file's metadata is written as :func:`write_store` writes it, in
@@ -246,7 +246,7 @@ class _MetadataOnly:
             target[region or ...] = source
 
 
-def _create(store_layout: Layout, attrs: Mapping[str, Any], path: Path) -> None:
+def _create(store_layout: Layout, attrs: StoreAttributes, path: Path) -> None:
     """Create the store file: dimensions, coordinates, attributes and every variable (chunked, no data).
 
     Not ``to_netcdf(compute=False)``: it leaves the file open until the
@@ -330,9 +330,9 @@ class _Writer:
             if (source >= 0).any():  # a block without finished cases stays unwritten: the file's fill values
                 for spec in specs:
                     self.handle[spec.name][block] = buffers[spec.name]
-            if rows is not None and len(rows["columns"]["impact_case_id"]):
-                for name, values in rows["columns"].items():
-                    self.handle[name][rows["first"] : rows["first"] + len(values)] = values
+            if rows is not None and len(rows.columns["impact_case_id"]):
+                for name, values in rows.columns.items():
+                    self.handle[name][rows.first : rows.first + len(values)] = values
 
     def _contributions(self, kind: str, block: tuple[slice, ...], source: np.ndarray):
         """(rows of the section, their positions in the block, the part's arrays, the section's prefix) of each section with cases in the block."""
@@ -353,16 +353,16 @@ class _Writer:
 
     # ------------------------------------------------------------ impact table
 
-    def _impact_rows(self, block: tuple[slice, ...]) -> dict[str, Any]:
+    def _impact_rows(self, block: tuple[slice, ...]) -> ImpactRows:
         """Empty buffers for the impact rows of the block's cases (contiguous in grid order)."""
         shape = self.experiment.grid_shape(CASE)
         flat = np.ravel_multi_index(tuple(np.array([s.start, s.stop - 1]) for s in block), shape)
         counts = self.index.impacts.ravel()
         first, last = int(self.impact_starts[flat[0]]), int(self.impact_starts[flat[1]] + counts[flat[1]])
         columns = {spec.name: np.zeros(last - first, dtype=_file_dtype(spec)) for spec in self.layout.of("impact")}
-        return {"first": first, "columns": columns}
+        return ImpactRows(first, columns)
 
-    def _fill_impacts(self, rows: dict[str, Any], block: tuple[slice, ...], local: tuple[np.ndarray, ...], section: np.ndarray, arrays: dict[str, np.ndarray], prefix: str, ids: np.ndarray) -> None:
+    def _fill_impacts(self, rows: ImpactRows, block: tuple[slice, ...], local: tuple[np.ndarray, ...], section: np.ndarray, arrays: dict[str, np.ndarray], prefix: str, ids: np.ndarray) -> None:
         """Copy the impact rows of a section's cases in the block to their places in grid order."""
         counts = arrays[f"{prefix}/i:count"]
         section_starts = np.cumsum(counts) - counts
@@ -372,8 +372,8 @@ class _Writer:
         flat = np.ravel_multi_index(positions, shape)
         within = np.arange(chosen.sum()) - np.repeat(np.cumsum(chosen) - chosen, chosen)
         source_rows = np.repeat(section_starts[section], chosen) + within
-        target_rows = np.repeat(self.impact_starts[flat] - rows["first"], chosen) + within
-        columns = rows["columns"]
+        target_rows = np.repeat(self.impact_starts[flat] - rows.first, chosen) + within
+        columns = rows.columns
         for name in columns:
             if name == "impact_case_id":
                 columns[name][target_rows] = np.repeat(ids[local], chosen)
@@ -408,6 +408,22 @@ class _Writer:
                 rows = [np.asarray(kept) if dim == "building" else np.arange(n) for dim, n in zip(own_dims, values.shape[1:-1])]
                 flat_buffer[np.ix_(where, *rows, columns)] = values
             self.handle[spec.name][block] = buffer
+
+
+@dataclass(frozen=True)
+class ImpactRows:
+    """The impact rows of a block's cases, filled section by section before they are written.
+
+    Attributes
+    ----------
+    first : int
+        The first row's index in the store's impact table.
+    columns : dict of str to np.ndarray
+        A buffer per impact variable (in the file's dtype), by name.
+    """
+
+    first: int
+    columns: dict[str, np.ndarray]
 
 
 def _file_dtype(spec: Spec) -> Any:

@@ -76,10 +76,11 @@ class Spec:
     dtype : numpy dtype
         In memory (bool is stored as int8 with ``dtype = "bool"``, ``<U1``
         stands for variable-length strings).
-    attrs : dict
+    attrs : mapping of str to str or np.ndarray
+        The variable's attributes (units, long name, flags).
     chunks : tuple of int
         Chunk shape in the file (a block of the grid, whole trailing dimensions).
-    encoding : dict
+    encoding : mapping of str to int or bool
         Further encoding (``_FillValue`` of integers, compression).
     coordinate : bool
         A coordinate (the impact table's case id and labels).
@@ -90,10 +91,15 @@ class Spec:
     family: str
     dims: tuple[str, ...]
     dtype: np.dtype
-    attrs: dict[str, Any]
+    attrs: Mapping[str, str | np.ndarray]
     chunks: tuple[int, ...]
-    encoding: dict[str, Any] = field(default_factory=dict)
+    encoding: Mapping[str, int | bool] = field(default_factory=dict)
     coordinate: bool = False
+
+
+StoreAttributes = Mapping[str, str | int | float]
+"""A store's global attributes, as netCDF keeps them (text and numbers): its provenance (the definition and its identity,
+the experiment file, the code, the solver's settings) and its progress."""
 
 
 @dataclass(frozen=True)
@@ -108,7 +114,7 @@ class Layout:
         """The variables of a family (and kind)."""
         return [s for s in self.specs if s.family == family and (kind is None or s.kind == kind)]
 
-    def template(self, attrs: Mapping[str, Any]) -> xr.Dataset:
+    def template(self, attrs: StoreAttributes) -> xr.Dataset:
         """The store as a dataset whose variables are lazy placeholders (dask), the file's encoding in ``encoding``."""
         import dask.array as da
 

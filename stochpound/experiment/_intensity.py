@@ -40,7 +40,7 @@ from stochpound.experiment._site import parse_selection
 from stochpound.motions import arias_intensity, peak_ground_motion, response_spectrum, significant_duration
 from stochpound._errors import IntensityError
 from stochpound.motions import Measure
-from stochpound.store import MEASURES, GapAxis, Intensity, MuAxis, VariantAxis
+from stochpound.store import MEASURES, ExperimentGrid, GapAxis, Intensity, Label, MuAxis, VariantAxis
 
 METHODS = ("stripes", "ida")
 UNITS = {"pga": ("g", "m/s2"), "psa": ("g", "m/s2"), "sa_avg": ("g", "m/s2"), "pgv": ("m/s", "cm/s")}
@@ -58,6 +58,8 @@ not to the recorded ground motion."""
 SPECTRUM_PERIODS = np.geomspace(0.05, 5.0, 25)
 """Periods (s) of the unscaled spectrum stored for every motion (5 % damping)."""
 SPECTRUM_DAMPING = 0.05
+CaseVariables = dict[str, float | np.ndarray]
+"""A case's per-case variables by store name (:data:`SUMMARIES`): numbers, and arrays (``motion_psa`` over :data:`SPECTRUM_PERIODS`)."""
 _KEYS = {"measure", "period", "periods", "damping", "levels", "units", "method", "synthetic", "selection", "motions", "max_scale_factor", "seed", "max_per_earthquake", "exclude_pulses"}
 
 #: Per-case variables of an intensity-conditioned store: units and long names (units of levels filled in).
@@ -137,10 +139,11 @@ def parse_intensity(data: Mapping[str, Any], scene: Mapping[str, Any], variants:
         raise IntensityError(f"intensity.{error}") from None
     setting = Intensity(scaled_measure, units, tuple(sorted(float(level) for level in levels)), method, ran, note,
                         synthetic)
-    selection = parse_selection(table, data.get("site"), levels, setting, base_dir)
-    if not selection:
+    chosen = parse_selection(table, data.get("site"), levels, setting, base_dir)
+    if chosen is None:
         return setting
-    return dataclasses.replace(setting, note=selection.pop("note"), selection=selection)
+    selection, note = chosen
+    return dataclasses.replace(setting, note=note, selection=selection)
 
 
 def _method_run(method: str, scene: Mapping[str, Any], variants: Sequence[VariantAxis], gaps: Sequence[GapAxis], mu: MuAxis | None) -> tuple[str, str]:
@@ -229,7 +232,7 @@ def check_resolution(intensity: Intensity, dt: float, where: str) -> None:
             )
 
 
-def motion_measures(values: np.ndarray, dt: float, intensity: Intensity, g: float, spectrum: bool = True) -> dict[str, Any]:
+def motion_measures(values: np.ndarray, dt: float, intensity: Intensity, g: float, spectrum: bool = True) -> CaseVariables:
     """The unscaled measures of a motion (samples in m/s², linear between them), by store name.
 
     ``motion_intensity`` is in the units of ``levels``; ``spectrum=False`` leaves out ``motion_psa``.
@@ -290,7 +293,7 @@ def store_names(intensity: Intensity | None) -> list[str]:
     return names + (["ida_capacity"] if intensity.ran == "ida" else [])
 
 
-def task_settings(experiment: Any, motions: Mapping[str, Any]) -> Scaling | None:
+def task_settings(experiment: ExperimentGrid, motions: Mapping[str, Any]) -> Scaling | None:
     """What a worker needs to scale an experiment's cases (None without intensity).
 
     The intensity setting, g, the gap axes and, by motion number, the
@@ -317,7 +320,7 @@ def ensemble_intensity(intensity: Intensity, table: Mapping[str, Any], realizati
     return total / len(realizations)
 
 
-def measures_of(settings: Scaling, ground: Any) -> dict[str, Any]:
+def measures_of(settings: Scaling, ground: Any) -> CaseVariables:
     """:func:`motion_measures` of a sampled ground motion (a motion given by a formula cannot be scaled to a measure)."""
     from stochpound.motions.ground import SampledMotion
 
@@ -327,8 +330,8 @@ def measures_of(settings: Scaling, ground: Any) -> dict[str, Any]:
 
 
 def scaled_case(
-    settings: Scaling, record: int, labels: Mapping[str, Any], ground: Any, twin: np.ndarray, measures: Mapping[str, Any]
-) -> tuple[Any, np.ndarray, dict[str, Any]]:
+    settings: Scaling, record: int, labels: Mapping[str, Label], ground: Any, twin: np.ndarray, measures: CaseVariables
+) -> tuple[Any, np.ndarray, CaseVariables]:
     """The case's motion and fixed-base twin scaled to its ``intensity`` level (unchanged for IDA), and its intensity variables.
 
     ``record`` is the motion's number (an ensemble scaled by its mean measure
@@ -345,7 +348,7 @@ def scaled_case(
     return scaled, twin * scale, extra
 
 
-def capacity_of(settings: Scaling, summary: Mapping[str, Any], labels: Mapping[str, Any]) -> float:
+def capacity_of(settings: Scaling, summary: CaseVariables, labels: Mapping[str, Label]) -> float:
     """:func:`ida_capacity` of a contact-free case from its summary and grid labels."""
     axes = [(float(labels[name]), contacts) for name, contacts in settings.gap_axes]
     return ida_capacity(np.asarray(summary["peak_contact_closure"], dtype=float), float(summary["motion_intensity"]), axes)

@@ -16,7 +16,6 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from stochpound.experiment._experiment import Experiment
 from stochpound.experiment._site import periods_of_interest
 from stochpound.motions import Measure
 
@@ -66,10 +65,10 @@ def measure_choice(store: Any, hazard: str | None = None) -> pd.DataFrame:
     """
     from stochpound.risk import candidate_name, measure_efficiency
 
-    structure = periods_of_interest(Experiment(store.pound.definition))
+    structure = periods_of_interest(store.pound.grid)
     available = hazard_measures(store, hazard)
     candidates = {**structure, **{f"hazard {name}": period for name, period in available.items() if period is not None}}
-    beta = measure_efficiency(store, candidates, structure, studied=store.attrs.get("studied_building"))["beta"].sel(response="closure")
+    beta = measure_efficiency(store, candidates, structure, studied=store.pound.definition.studied)["beta"].sel(response="closure")
     names = {name: candidate_name(period, f"hazard {name}") for name, period in available.items()}
     configurations = [d for d in beta.dims if d != "measure"]
     rows = []

@@ -37,6 +37,7 @@ import os
 import secrets
 import time
 import zipfile
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Iterable, Sequence
 
@@ -44,6 +45,7 @@ import numpy as np
 
 from stochpound._atomic import replacing, temporaries
 from stochpound.experiment._spec import ExperimentError
+from stochpound.store import definition_sha256
 
 DEFINITION_FILE = "experiment.json"
 RUNS_FILE = "runs.jsonl"
@@ -251,20 +253,82 @@ def remove_temporaries(folder: Path) -> None:
         path.unlink(missing_ok=True)
 
 
-def read_experiment_json(folder: Path) -> dict[str, Any]:
-    """The contents of ``experiment.json`` (definition, sha256, text, motion grids, created)."""
+@dataclass(frozen=True)
+class FolderRecord:
+    """What a parts folder's ``experiment.json`` holds: the run's definition and identity, the experiment file, the motions' grids.
+
+    Attributes
+    ----------
+    definition_sha256 : str
+        The identity of the definition the folder's cases ran (the rule of the time it was written).
+    definition : dict or None
+        The canonical definition (as its JSON reads back); None in a folder written before it was kept.
+    text, text_sha256 : str
+        The experiment file's text and its sha256.
+    file : str
+        The experiment file's path.
+    base_dir : str
+        The experiment file's folder (absolute).
+    motion_grids : tuple of (str, float, int)
+        Each motion's label, time step (s) and number of samples.
+    created : str
+        When the folder was created (UTC, ISO 8601).
+    """
+
+    definition_sha256: str
+    definition: dict[str, Any] | None = None
+    text: str = ""
+    text_sha256: str = ""
+    file: str = ""
+    base_dir: str = "."
+    motion_grids: tuple[tuple[str, float, int], ...] = ()
+    created: str = ""
+
+    @classmethod
+    def from_json(cls, data: Any) -> FolderRecord:
+        """The record of an ``experiment.json``'s contents (the fields a folder of an older stochpound lacks take their defaults)."""
+        grids = tuple((label, float(grid[0]), int(grid[1])) for label, grid in data["motion_grids"].items())
+        known = {name: data[name] for name in ("definition", "text", "text_sha256", "file", "base_dir", "created") if name in data}
+        return cls(data["definition_sha256"], motion_grids=grids, **known)
+
+    def to_json(self) -> dict[str, Any]:
+        """The ``experiment.json`` contents, its fields in the order they are written."""
+        written = {"definition_sha256": self.definition_sha256, "definition": self.definition, "text": self.text, "text_sha256": self.text_sha256,
+                   "file": self.file, "base_dir": self.base_dir, "motion_grids": {label: [dt, samples] for label, dt, samples in self.motion_grids},
+                   "created": self.created}
+        return {key: value for key, value in written.items() if key != "definition" or value is not None}
+
+    @property
+    def identity(self) -> str:
+        """The identity of the folder's runs by today's rule (:func:`~stochpound.store.definition_sha256` of its definition, when it has one)."""
+        return definition_sha256(self.definition) if self.definition is not None else self.definition_sha256
+
+    @property
+    def grids(self) -> dict[str, tuple[float, int]]:
+        """(dt, samples) of each motion, by label."""
+        return {label: (dt, samples) for label, dt, samples in self.motion_grids}
+
+
+def read_experiment_json(folder: Path) -> FolderRecord:
+    """The contents of ``experiment.json`` (definition, sha256, text, motion grids, created).
+
+    Raises
+    ------
+    ExperimentError
+        If the file is missing, unreadable, or lacks ``definition_sha256``.
+    """
     path = folder / DEFINITION_FILE
     try:
-        return json.loads(path.read_text())
+        return FolderRecord.from_json(json.loads(path.read_text()))
     except FileNotFoundError:
         raise ExperimentError(f"{folder}: not an experiment store folder ({DEFINITION_FILE} missing)") from None
-    except (OSError, ValueError) as error:
+    except (OSError, ValueError, KeyError, TypeError, AttributeError) as error:
         raise ExperimentError(f"{path}: unreadable ({error}); use --restart to start the store again") from None
 
 
-def write_experiment_json(folder: Path, record: dict[str, Any]) -> None:
+def write_experiment_json(folder: Path, record: FolderRecord) -> None:
     """Write ``experiment.json`` atomically."""
-    atomic_write(folder / DEFINITION_FILE, lambda stream: stream.write(json.dumps(record, indent=1).encode()))
+    atomic_write(folder / DEFINITION_FILE, lambda stream: stream.write(json.dumps(record.to_json(), indent=1).encode()))
 
 
 def append_run(folder: Path, entry: dict[str, Any]) -> None:

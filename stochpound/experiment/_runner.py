@@ -40,7 +40,7 @@ from stochpound.experiment._spec import ExperimentError, load_definition
 from stochpound.experiment._file_assembly import PartsIndex
 from stochpound._memory import format_bytes
 from stochpound.solvers import first_call
-from stochpound.store import NOT_IN_IDENTITY, canonical_json
+from stochpound.store import NOT_IN_IDENTITY
 
 CHECKPOINT_FACTOR = 20.0
 """A checkpoint waits at least this many times the last rebuild's duration (rebuilds cost at most ~5 % of a run)."""
@@ -222,7 +222,7 @@ def run_experiment(
             if missing:
                 raise ExperimentError(f"{store}: written by an earlier stochpound without {', '.join(missing)}, which it keeps now: "
                                       "run the experiment again with --restart to recompute its cases")
-            stored, new = stored_definition(store), json.loads(canonical_json(experiment.definition.to_dict()))
+            stored, new = stored_definition(store), json.loads(experiment.definition_json)
             # the scene's provenance alone (the same content, from another file or inline) leaves the store as it is
             changed = [key for key in NOT_IN_IDENTITY if key != "scene_source" and stored.get(key) != new.get(key)]
             if changed:

@@ -6,6 +6,7 @@ Used by ``experiment run`` (with the folder's lock held) and by
 
 from __future__ import annotations
 
+import dataclasses
 import datetime as _dt
 import hashlib
 import json
@@ -22,9 +23,10 @@ from stochpound import __version__
 from stochpound.experiment._experiment import Experiment
 from stochpound.store import KINDS
 from stochpound._atomic import check_not_input, temporaries
-from stochpound.experiment._parts import DEFINITION_FILE, RUNS_FILE, part_paths, parts_folder, read_experiment_json, read_runs, write_experiment_json
+from stochpound.experiment._parts import (DEFINITION_FILE, RUNS_FILE, FolderRecord, part_paths, parts_folder, read_experiment_json, read_runs,
+                                          write_experiment_json)
 from stochpound.experiment._spec import ExperimentError
-from stochpound.store import canonical_json, definition_sha256
+from stochpound.store import definition_sha256
 from stochpound.experiment._file_layout import PREFIX, layout
 from stochpound.experiment._file_assembly import PartsIndex, write_store
 
@@ -72,11 +74,6 @@ def stored_definition(store: Path) -> dict[str, Any]:
         return json.loads(_text(handle.attrs["definition"])) if "definition" in handle.attrs else {}
 
 
-def folder_identity(record: dict[str, Any]) -> str:
-    """The identity of a parts folder's runs (its ``experiment.json``), by today's rule, like :func:`store_identity`."""
-    return definition_sha256(record["definition"]) if "definition" in record else record["definition_sha256"]
-
-
 def check_store(store: Path, sha256: str) -> bool:
     """Refuse a store (or parts folder) that belongs to another experiment definition, or a file that is not a store.
 
@@ -111,8 +108,8 @@ def check_store(store: Path, sha256: str) -> bool:
                 raise ExperimentError(f"{store}: made from a different experiment definition (sha256 {found[:12]}…, this one {sha256[:12]}…); {hint}")
     if parts:
         try:
-            found = folder_identity(read_experiment_json(folder))
-        except (ExperimentError, KeyError, TypeError) as error:
+            found = read_experiment_json(folder).identity
+        except ExperimentError as error:
             raise ExperimentError(f"{folder}: unreadable parts folder ({error}); {hint}") from None
         if found != sha256:
             raise ExperimentError(f"{folder}: holds cases of a different experiment definition (sha256 {found[:12]}…, this one {sha256[:12]}…); {hint}")
@@ -163,7 +160,7 @@ def input_files(experiment: Experiment) -> list[tuple[Path, str]]:
         found.append((base / source["file"], "the experiment's scene file"))
     if definition.hazard is not None and definition.hazard.file:
         found.append((base / definition.hazard.file, "the experiment's hazard file"))
-    found += [(base / table["record"], "a record file of the experiment") for table in _tables(definition.to_dict())
+    found += [(base / table["record"], "a record file of the experiment") for table in _tables(json.loads(experiment.definition_json))
               if table.get("file_sha256") and isinstance(table.get("record"), str)]
     return found
 
@@ -261,11 +258,11 @@ class StoreSession:
     store : Path
         The store file.
     experiment : Experiment
-    record : dict
+    record : FolderRecord
         Contents of ``experiment.json``.
     """
 
-    def __init__(self, store: Path, experiment: Experiment, record: dict[str, Any]) -> None:
+    def __init__(self, store: Path, experiment: Experiment, record: FolderRecord) -> None:
         self.store = Path(store)
         self.folder = parts_folder(self.store)
         self.experiment = experiment
@@ -277,24 +274,17 @@ class StoreSession:
         """Open the parts folder for a run, writing ``experiment.json`` if it is new."""
         folder = parts_folder(store)
         folder.mkdir(parents=True, exist_ok=True)
+        definition, text_sha256 = json.loads(experiment.definition_json), hashlib.sha256(experiment.text.encode()).hexdigest()
         if (folder / DEFINITION_FILE).exists():
             record = read_experiment_json(folder)
-            definition = json.loads(canonical_json(experiment.definition.to_dict()))
-            if record["definition"] != definition:  # the same runs (checked by check_store), another hazard: record it
-                record.update(definition=definition, definition_sha256=experiment.sha256, text=experiment.text,
-                              text_sha256=hashlib.sha256(experiment.text.encode()).hexdigest())
+            if record.definition != definition:  # the same runs (checked by check_store), another hazard: record it
+                record = dataclasses.replace(record, definition=definition, definition_sha256=experiment.sha256, text=experiment.text,
+                                             text_sha256=text_sha256)
                 write_experiment_json(folder, record)
         else:
-            record = {
-                "definition_sha256": experiment.sha256,
-                "definition": json.loads(canonical_json(experiment.definition.to_dict())),
-                "text": experiment.text,
-                "text_sha256": hashlib.sha256(experiment.text.encode()).hexdigest(),
-                "file": experiment.path,
-                "base_dir": str(experiment.base_dir.resolve()),
-                "motion_grids": {k: list(v) for k, v in motion_grids.items()},
-                "created": now(),
-            }
+            grids = tuple((label, dt, samples) for label, (dt, samples) in motion_grids.items())
+            record = FolderRecord(experiment.sha256, definition, experiment.text, text_sha256, experiment.path, str(experiment.base_dir.resolve()),
+                                  grids, now())
             write_experiment_json(folder, record)
         return cls(store, experiment, record)
 
@@ -309,13 +299,15 @@ class StoreSession:
         """
         folder = parts_folder(store)
         record = read_experiment_json(folder)
-        experiment = Experiment(record["definition"], record.get("text", ""), record.get("base_dir", "."), record.get("file", ""))
+        if record.definition is None:
+            raise ExperimentError(f"{folder / DEFINITION_FILE}: written by an older stochpound, without the definition; run the experiment again")
+        experiment = Experiment(record.definition, record.text, record.base_dir, record.file)
         return cls(store, experiment, record)
 
     @property
     def motion_grids(self) -> dict[str, tuple[float, int]]:
         """(dt, samples) of each motion."""
-        return {k: (float(v[0]), int(v[1])) for k, v in self.record["motion_grids"].items()}
+        return self.record.grids
 
     def scan(self, remove_unreadable: bool = False) -> PartsIndex:
         """Find the finished cases in the parts (unreadable parts count as missing, and are deleted if asked)."""
@@ -329,7 +321,7 @@ class StoreSession:
         """For each kind, which cases of its grid are still to run (bool, from the last :meth:`scan`)."""
         return {kind: self.experiment.in_grid(kind) & ~self.index.done(kind) for kind in KINDS}
 
-    def attrs(self) -> dict[str, Any]:
+    def attrs(self) -> dict[str, str | float]:
         """Provenance attributes of the store."""
         experiment = self.experiment
         solver = experiment.solver
@@ -338,11 +330,11 @@ class StoreSession:
         return {
             "experiment_name": experiment.name,
             "experiment_description": experiment.definition.description,
-            "experiment_file": self.record.get("file", ""),
-            "experiment_text": self.record.get("text", ""),
-            "experiment_sha256": self.record.get("text_sha256", ""),
+            "experiment_file": self.record.file,
+            "experiment_text": self.record.text,
+            "experiment_sha256": self.record.text_sha256,
             "definition_sha256": experiment.sha256,
-            "definition": canonical_json(experiment.definition.to_dict()),
+            "definition": experiment.definition_json,
             "studied_building": experiment.studied,
             "stochpound_version": __version__,
             "git_commit": last.get("git_commit", "none"),
@@ -353,7 +345,7 @@ class StoreSession:
             "solver_atol": solver.atol,
             "solver_note": "integrator, rtol and atol apply to the ivp solver only",
             "seeds": json.dumps(experiment.seeds()),
-            "created": self.record.get("created", ""),
+            "created": self.record.created,
             "updated": now(),
             "machine": last.get("machine", machine()),
             "runs": json.dumps(runs),

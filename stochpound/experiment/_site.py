@@ -54,31 +54,16 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
 from pathlib import Path
-from typing import Any, Protocol
+from typing import Any
 
 import numpy as np
 import xarray as xr
 
 from stochpound.model import fields as toml_fields
 from stochpound.motions import CONDITIONING_MEASURES, MODEL_DAMPING, PERIOD_RANGE, Measure, Scenario
-from stochpound.store import CONDITIONAL_SPECTRUM, SCENARIO_KINDS, Definition, Intensity, MotionSource, Site, VariantAxis
+from stochpound.store import (CONDITIONAL_SPECTRUM, SCENARIO_KINDS, SIMULATED, SIMULATED_FIELD, ExperimentGrid, Intensity, MotionSource, Selection,
+                              SimulatedMotions, Site)
 
-
-class GridExperiment(Protocol):
-    """What the selection reads of an experiment (an :class:`~stochpound.experiment.Experiment`, which asks for its stripes here)."""
-
-    intensity: Intensity | None
-    recorded_motions: dict[str, MotionSource]
-    variants: tuple[VariantAxis, ...]
-    building_names: list[str]
-    base_dir: Path
-    definition: Definition
-
-    def points(self, kind: str) -> list[Any]: ...
-
-    def structure(self, case: Any) -> dict[str, Any]: ...
-
-    def motion_table(self, label: str, realization: int | None = None) -> dict[str, Any]: ...
 
 SELECTIONS = ("scale", CONDITIONAL_SPECTRUM)
 """``[intensity] selection``: every motion scaled to every level, or motions chosen per stripe."""
@@ -94,13 +79,14 @@ SIMULATED_CHUNK = 256
 SIMULATED_LIMIT = 100_000
 """Largest ``[site] simulated_motions`` (per stripe)."""
 RULES = ("max_per_earthquake", "exclude_pulses")
-"""``[intensity]`` fields of the selection's rules, in the definition only where given."""
+"""``[intensity]`` fields of the selection's rules (:attr:`stochpound.store.Selection.rules`), in the definition only where given."""
 PER_LEVEL = ("magnitude", "distance_km", "mechanism")
 """``[site]`` fields that take one value per level."""
 
 
-def parse_selection(table: Mapping[str, Any], site: Any, levels: list[float], setting: Intensity, base_dir: Path = Path(".")) -> dict[str, Any]:
-    """The selection's entries of the ``intensity`` definition ({} for the default ``scale``).
+def parse_selection(table: Mapping[str, Any], site: Any, levels: list[float], setting: Intensity,
+                    base_dir: Path = Path(".")) -> tuple[Selection, str] | None:
+    """The selection of the ``[intensity]`` table, checked, and the note saying how it chooses (None for the default ``scale``).
 
     Parameters
     ----------
@@ -133,7 +119,7 @@ def parse_selection(table: Mapping[str, Any], site: Any, levels: list[float], se
                 raise SiteError(f'intensity.{key}: only with selection = "{CONDITIONAL_SPECTRUM}"')
         if site is not None:
             raise SiteError(f'site: only with [intensity] selection = "{CONDITIONAL_SPECTRUM}" (the scenario of its targets)')
-        return {}
+        return None
     measure = setting.measure
     if measure.kind not in CONDITIONING_MEASURES:
         raise SiteError(f"intensity.measure: the conditional spectrum conditions on {', '.join(CONDITIONING_MEASURES)}, got {measure.kind!r}")
@@ -158,48 +144,43 @@ def parse_selection(table: Mapping[str, Any], site: Any, levels: list[float], se
     note = f"{motions} motions per stripe chosen from the pool and scaled to the conditional spectrum of its scenario"
     if isinstance(site, dict) and site.get("scenario") == "fitted" and isinstance(site.get("curves"), list):
         note += f" (the scenario fitted to the site's hazard curves {', '.join(map(str, site['curves']))}, standing in for a disaggregation)"
-    chosen = {"note": note, "selection": selection, "motions": motions, "max_scale_factor": max_scale, "seed": seed,
-              **parse_rules(table)}
+    max_per_earthquake, exclude_pulses = parse_rules(table)
     if isinstance(site, dict) and "ruptures" in site:
         if "simulated_motions" in site:
-            from stochpound._errors import SiteError
-
             raise SiteError("site.simulated_motions: not available with site.ruptures yet (the motions would be of one mean scenario, "
                             "not of each causal rupture): leave one of the two out")
         ruptures = rupture_site(site, base_dir)
-        chosen["note"] = (f"{motions} motions per stripe chosen from the pool and scaled to the exact conditional spectrum of the site's "
-                          f"{len(ruptures)} ruptures")
-        return {**chosen, "site": mixture_scenarios(ruptures, levels, measure), "ruptures": ruptures.to_entry(identity=True)}
-    return {**chosen, "site": parse_site(site, levels, measure), **parse_simulated(site, seed)}
+        note = f"{motions} motions per stripe chosen from the pool and scaled to the exact conditional spectrum of the site's {len(ruptures)} ruptures"
+        return Selection(selection, motions, max_scale, seed, mixture_scenarios(ruptures, levels, measure), max_per_earthquake, exclude_pulses,
+                         ruptures=ruptures.to_entry(identity=True)), note
+    scenarios = parse_site(site, levels, measure)
+    return Selection(selection, motions, max_scale, seed, scenarios, max_per_earthquake, exclude_pulses, simulated=parse_simulated(site, seed)), note
 
 
-def parse_rules(table: Mapping[str, Any]) -> dict[str, Any]:
-    """The rules' entries of the ``intensity`` definition, only those the table gives (so older definitions keep their identity)."""
+def parse_rules(table: Mapping[str, Any]) -> tuple[int | None, bool | None]:
+    """The selection's rules, ``max_per_earthquake`` and ``exclude_pulses``: each None unless the table gives it (so that the definitions
+    of files without them keep their identity)."""
     from stochpound._errors import SiteError
 
-    rules: dict[str, Any] = {}
-    if "max_per_earthquake" in table:
-        value = table["max_per_earthquake"]
-        if not isinstance(value, int) or isinstance(value, bool) or value < 1:
-            raise SiteError(f"intensity.max_per_earthquake: at most this many motions of one earthquake per stripe, an integer >= 1, got {value!r}")
-        rules["max_per_earthquake"] = value
-    if "exclude_pulses" in table:
-        rules["exclude_pulses"] = toml_fields.boolean(table, "exclude_pulses", "intensity", default=False)
-    return rules
+    max_per_earthquake = table["max_per_earthquake"] if "max_per_earthquake" in table else None
+    if max_per_earthquake is not None and (not isinstance(max_per_earthquake, int) or isinstance(max_per_earthquake, bool) or max_per_earthquake < 1):
+        raise SiteError("intensity.max_per_earthquake: at most this many motions of one earthquake per stripe, an integer >= 1, "
+                        f"got {max_per_earthquake!r}")
+    exclude_pulses = toml_fields.boolean(table, "exclude_pulses", "intensity", default=False) if "exclude_pulses" in table else None
+    return max_per_earthquake, exclude_pulses
 
 
-def parse_simulated(site: Mapping[str, Any], seed: int) -> dict[str, Any]:
-    """``{"simulated_motions": {count, model, calibration, seed, dt}}`` for ``[site] simulated_motions``; {} without it."""
+def parse_simulated(site: Mapping[str, Any], seed: int) -> SimulatedMotions | None:
+    """The simulated motions of ``[site] simulated_motions`` (seed: the selection's); None without them."""
     from stochpound._errors import SiteError
     from stochpound.motions import site_model_provenance
 
     if "simulated_motions" not in site:
-        return {}
+        return None
     count = site["simulated_motions"]
     if not isinstance(count, int) or isinstance(count, bool) or not 1 <= count <= SIMULATED_LIMIT:
         raise SiteError(f"site.simulated_motions: simulated motions of each stripe's scenario in its pool, an integer within 1-{SIMULATED_LIMIT}, got {count!r}")
-    return {"simulated_motions": {"count": count, "model": SIMULATED_MODEL, "calibration": site_model_provenance(SIMULATED_MODEL),
-                                  "seed": seed, "dt": SIMULATED_DT}}
+    return SimulatedMotions(count, SIMULATED_MODEL, site_model_provenance(SIMULATED_MODEL), seed, SIMULATED_DT)
 
 
 def rupture_site(site: Mapping[str, Any], base_dir: Path) -> Any:
@@ -217,12 +198,12 @@ def rupture_site(site: Mapping[str, Any], base_dir: Path) -> Any:
     return named_rupture_site(site["ruptures"], base_dir, {key: site[key] for key in RUPTURE_SITE_FIELDS if key in site}, "site")
 
 
-def mixture_scenarios(ruptures: Any, levels: list[float], measure: Measure) -> list[dict[str, Any]]:
+def mixture_scenarios(ruptures: Any, levels: list[float], measure: Measure) -> tuple[Scenario, ...]:
     """The scenario of every level (sorted) a store records of a site of ruptures: the means of M and R_rup by the exact conditional
     spectrum's weights P(r | IM* = x) (:meth:`~stochpound.analysis.RuptureSite.disaggregation`'s ``density_share``), Vs30 and the
     mechanism of the largest weight (:meth:`~stochpound.analysis.RuptureSite.mean_scenario`)."""
     shares = ruptures.disaggregation(measure.kind, measure.spectral_period, levels=sorted(float(level) for level in levels))["density_share"].values
-    return [ruptures.mean_scenario(share) for share in shares]
+    return tuple(Scenario(**ruptures.mean_scenario(share)) for share in shares)
 
 
 def site_entry(site: Any, intensity: Intensity | None) -> Site | None:
@@ -253,7 +234,7 @@ def site_entry(site: Any, intensity: Intensity | None) -> Site | None:
     return Site(kind, curves=tuple(site["curves"])) if kind == "fitted" else Site(kind)
 
 
-def parse_site(site: Any, levels: list[float], measure: Measure) -> list[dict[str, Any]]:
+def parse_site(site: Any, levels: list[float], measure: Measure) -> tuple[Scenario, ...]:
     """One scenario per level, in the order of the sorted levels, from the ``[site]`` table (given, or fitted to its ``curves``)."""
     from stochpound._errors import SiteError
 
@@ -283,15 +264,13 @@ def parse_site(site: Any, levels: list[float], measure: Measure) -> list[dict[st
             columns[key] = [value] * len(levels)
     scenarios = []
     for i in range(len(levels)):
-        scenario = {key: columns[key][i] for key in SITE_FIELDS}
         names = {key: f"site.{key}[{i}]" if isinstance(site[key], list) else f"site.{key}" for key in SITE_FIELDS}
-        Scenario.of(scenario["magnitude"], scenario["distance_km"], scenario["vs30"], scenario["mechanism"], names=names)
-        scenarios.append({key: (float(v) if key != "mechanism" else v) for key, v in scenario.items()})
+        scenarios.append(Scenario.of(columns["magnitude"][i], columns["distance_km"][i], columns["vs30"][i], columns["mechanism"][i], names=names))
     order = sorted(range(len(levels)), key=lambda i: levels[i])
-    return [scenarios[i] for i in order]
+    return tuple(scenarios[i] for i in order)
 
 
-def fitted_site(site: Mapping[str, Any], levels: list[float], conditioning_measure: Measure) -> list[dict[str, Any]]:
+def fitted_site(site: Mapping[str, Any], levels: list[float], conditioning_measure: Measure) -> tuple[Scenario, ...]:
     """The scenario of every level (sorted) fitted to the site's bundled hazard curves (:func:`stochpound.motions.fit_scenarios`).
 
     ``site.curves`` names bundled curves (:func:`stochpound.analysis.bundled_curves`):
@@ -333,10 +312,10 @@ def fitted_site(site: Mapping[str, Any], levels: list[float], conditioning_measu
                                   others, float(site["vs30"]), site["mechanism"])
     except ValueError as error:  # a level outside the conditioning curve
         raise SiteError(f"intensity.levels: outside the site's curve of the conditioning measure ({error})") from None
-    return scenarios
+    return tuple(Scenario(**scenario) for scenario in scenarios)
 
 
-def periods_of_interest(experiment: GridExperiment) -> dict[str, float]:
+def periods_of_interest(experiment: ExperimentGrid) -> dict[str, float]:
     """The structure's periods of interest (s), by name: first-mode periods on a fixed base and isolated periods, over every grid point.
 
     Names: ``"B1 first mode"``, ``"B1 isolated"``, with the grid point's
@@ -361,7 +340,7 @@ def periods_of_interest(experiment: GridExperiment) -> dict[str, float]:
     return named
 
 
-def structure_periods(experiment: GridExperiment) -> list[float]:
+def structure_periods(experiment: ExperimentGrid) -> list[float]:
     """The distinct periods of :func:`periods_of_interest` (s), ascending."""
     return sorted(set(periods_of_interest(experiment).values()))
 
@@ -376,8 +355,8 @@ class StripeSelections:
     structure: list[float]
     selections: list[xr.Dataset]
     targets: list[xr.Dataset]
-    simulated: dict[str, dict[str, Any]] = field(default_factory=dict)
-    """The chosen simulated motions' sources, by label (``[site] simulated_motions``; :func:`simulated_source`)."""
+    simulated: dict[str, MotionSource] = field(default_factory=dict)
+    """The chosen simulated motions' sources, by label (``[site] simulated_motions``; :func:`simulated_sources`)."""
 
     @cached_property
     def chosen(self) -> np.ndarray:
@@ -433,7 +412,7 @@ class StripeSelections:
                 for key, values in counts.items()}
 
 
-def stripe_selections(experiment: GridExperiment) -> StripeSelections:
+def stripe_selections(experiment: ExperimentGrid) -> StripeSelections:
     """Choose and scale the motions of every stripe (module docstring).
 
     Raises
@@ -462,29 +441,28 @@ def stripe_selections(experiment: GridExperiment) -> StripeSelections:
         records.append(Record(label, motion.dt, motion.values, "m/s2", metadata=metadata))
     measure = intensity.measure.kind
     period = intensity.measure.spectral_period
-    chosen = intensity.selection  # the conditional-spectrum selection's entries
+    chosen = intensity.selection
     conditioning = [] if period is None else list(np.atleast_1d(period))
     structure = structure_periods(experiment)
     periods = selection_periods(structure, conditioning)
     g = experiment.definition.g
     pool = selection_pool(records, periods, measure, period, MODEL_DAMPING, g)
     selections, targets, simulated = [], [], {}
-    rules = {key: chosen[key] for key in RULES if key in chosen}
-    if "ruptures" in chosen:  # the exact conditional spectrum of every stripe
+    if chosen.ruptures is not None:  # the exact conditional spectrum of every stripe
         from stochpound.analysis import RuptureSite
 
-        stripe_targets = RuptureSite.from_entry(chosen["ruptures"]).conditional_spectra(measure, period, levels=list(intensity.levels), periods=periods)
+        stripe_targets = RuptureSite.from_entry(chosen.ruptures).conditional_spectra(measure, period, levels=list(intensity.levels), periods=periods)
     else:
-        stripe_targets = [conditional_spectrum(measure, period, level=level, periods=periods, **scenario)
-                          for level, scenario in zip(intensity.levels, chosen["site"])]
-    for stripe, (level, scenario, target) in enumerate(zip(intensity.levels, chosen["site"], stripe_targets)):
-        sources = simulated_sources(chosen.get("simulated_motions"), stripe, scenario)
+        stripe_targets = [conditional_spectrum(measure, period, level=level, periods=periods, scenario=scenario)
+                          for level, scenario in zip(intensity.levels, chosen.scenarios)]
+    for stripe, (level, scenario, target) in enumerate(zip(intensity.levels, chosen.scenarios, stripe_targets)):
+        sources = simulated_sources(chosen.simulated, stripe, scenario)
         try:
             stripe_pool = xr.concat([pool, simulated_pool(sources, periods, measure, period, g)], "motion") if sources else pool
         except SiteError as error:  # a scenario outside the site-motion model's calibrated range
             raise ExperimentError(f"site.simulated_motions: the stripe {level:g} g's scenario: {error}") from None
         try:
-            selection = select_motions(stripe_pool, target, chosen["motions"], chosen["max_scale_factor"], chosen["seed"], **rules)
+            selection = select_motions(stripe_pool, target, chosen.motions, chosen.max_scale_factor, chosen.seed, **chosen.rules)
         except SiteError as error:
             raise ExperimentError(f"intensity.{error} (stripe {level:g} g)") from None
         simulated.update({str(label): sources[str(label)] for label in selection["motion"].values if str(label) in sources})
@@ -494,38 +472,34 @@ def stripe_selections(experiment: GridExperiment) -> StripeSelections:
     return StripeSelections(list(intensity.levels), labels, periods, structure, selections, targets, simulated)
 
 
-def simulated_sources(setting: Mapping[str, Any] | None, stripe: int, scenario: Mapping[str, Any]) -> dict[str, dict[str, Any]]:
+def simulated_sources(setting: SimulatedMotions | None, stripe: int, scenario: Scenario) -> dict[str, MotionSource]:
     """The simulated motions of a stripe's pool as motion sources, by label (``simulated <stripe>.<i>``, from 1); {} without them.
 
     A source's ``motion`` table holds what regenerates it: the scenario, the
     model and its calibration, ``n``, ``seed``, ``dt`` and its ``realization``.
     """
-    if not setting:
+    if setting is None:
         return {}
-    count = setting["count"]
-    table = {"type": "site_motions", **{key: scenario[key] for key in SITE_FIELDS}, "n": count, "seed": setting["seed"], "dt": setting["dt"],
-             "model": setting["model"], "calibration": setting["calibration"]}
-    width = len(str(count - 1))
-    return {
-        f"simulated {stripe + 1}.{i:0{width}d}": {"label": f"simulated {stripe + 1}.{i:0{width}d}", "kind": "simulated", "field": "site.simulated_motions",
-                                                  "motion": {**table, "realization": i}}
-        for i in range(count)
-    }
+    count = setting.count
+    table = {"type": "site_motions", **{key: getattr(scenario, key) for key in SITE_FIELDS}, "n": count, "seed": setting.seed, "dt": setting.dt,
+             "model": setting.model, "calibration": setting.calibration}
+    labels = [f"simulated {stripe + 1}.{i:0{len(str(count - 1))}d}" for i in range(count)]
+    return {label: MotionSource(label, SIMULATED, SIMULATED_FIELD, {**table, "realization": i}) for i, label in enumerate(labels)}
 
 
-def simulated_motions(sources: Sequence[Mapping[str, Any]]) -> list[Any]:
+def simulated_motions(sources: Sequence[MotionSource]) -> list[Any]:
     """The motions (m/s², :class:`~stochpound.motions.ground.SampledMotion`) of simulated sources of one table, regenerated from it bit for bit."""
     from stochpound.motions import site_motions
     from stochpound.motions.ground import SampledMotion
 
-    table = sources[0]["motion"]
+    table = sources[0].motion
     generated = site_motions(table["magnitude"], table["distance_km"], table["vs30"], table["mechanism"], n=table["n"], seed=table["seed"],
-                             dt=table["dt"], model=table["model"], realizations=[source["motion"]["realization"] for source in sources])
-    return [SampledMotion(table["dt"], values, "linear", f"{source['label']} ({table['model']}, seed {table['seed']})")
+                             dt=table["dt"], model=table["model"], realizations=[source.motion["realization"] for source in sources])
+    return [SampledMotion(table["dt"], values, "linear", f"{source.label} ({table['model']}, seed {table['seed']})")
             for source, values in zip(sources, generated["acceleration"].values)]
 
 
-def simulated_pool(sources: Mapping[str, Mapping[str, Any]], periods: np.ndarray, measure: str, period: Any, g: float) -> xr.Dataset:
+def simulated_pool(sources: Mapping[str, MotionSource], periods: np.ndarray, measure: str, period: Any, g: float) -> xr.Dataset:
     """:func:`~stochpound.motions.selection_pool` of a stripe's simulated motions, generated :data:`SIMULATED_CHUNK` at a time."""
     from stochpound.motions import selection_pool
     from stochpound.motions.records import Record
@@ -534,9 +508,9 @@ def simulated_pool(sources: Mapping[str, Mapping[str, Any]], periods: np.ndarray
     parts = []
     for start in range(0, len(items), SIMULATED_CHUNK):
         chunk = items[start : start + SIMULATED_CHUNK]
-        table = chunk[0]["motion"]
+        table = chunk[0].motion
         metadata = {"magnitude": table["magnitude"], "distance": table["distance_km"], "vs30": table["vs30"]}
-        records = [Record(source["label"], motion.dt, motion.values, "m/s2", metadata={**metadata, "event": source["label"]})
+        records = [Record(source.label, motion.dt, motion.values, "m/s2", metadata={**metadata, "event": source.label})
                    for source, motion in zip(chunk, simulated_motions(chunk))]
         parts.append(selection_pool(records, periods, measure, period, MODEL_DAMPING, g))
     return xr.concat(parts, "motion")

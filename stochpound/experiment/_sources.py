@@ -11,7 +11,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any, Mapping
+from typing import Any
 
 import numpy as np
 
@@ -19,7 +19,7 @@ from stochpound import motions as synthetic_motions
 from stochpound.experiment._experiment import Experiment
 from stochpound.experiment._intensity import check_resolution, ensemble_intensity
 from stochpound.experiment._site import simulated_motions
-from stochpound.store import CASE, canonical_json, with_motion
+from stochpound.store import CASE, MotionSource, canonical_json, with_motion
 from stochpound.experiment._spec import ExperimentError, field_errors
 from stochpound.motions.ground import GroundMotion, SampledMotion
 from stochpound.model.scene_file import scene_from_dict
@@ -91,10 +91,10 @@ def resolve_motions(experiment: Experiment) -> dict[str, ResolvedMotion]:
 def _simulated(experiment: Experiment) -> dict[str, GroundMotion]:
     """The chosen simulated motions, regenerated from their tables (one call per stripe's scenario), by label."""
     sources = list(experiment.selection.simulated.values()) if experiment.selection is not None else []
-    groups: dict[str, list[Mapping[str, Any]]] = {}
+    groups: dict[str, list[MotionSource]] = {}
     for source in sources:
-        groups.setdefault(canonical_json({k: v for k, v in source["motion"].items() if k != "realization"}), []).append(source)
-    return {source["label"]: motion for group in groups.values() for source, motion in zip(group, simulated_motions(group))}
+        groups.setdefault(canonical_json({k: v for k, v in source.motion.items() if k != "realization"}), []).append(source)
+    return {source.label: motion for group in groups.values() for source, motion in zip(group, simulated_motions(group))}
 
 
 def _worker_table(table: dict[str, Any], motion: GroundMotion, structure: dict[str, Any]) -> dict[str, Any]:

@@ -294,11 +294,10 @@ def assumptions(store: xr.Dataset) -> dict[str, str]:
     kinds = {"record": "records without a named suite", "synthetic": "synthetic ensembles"}
     suites = sorted({source.suite or kinds.get(source.kind, source.kind) for source in definition.motions})
     count = sum(source.count for source in definition.motions)
-    selection_entry = definition.intensity.selection if definition.intensity is not None else {}
-    selection = selection_entry.get("selection")
+    selection = definition.intensity.selection if definition.intensity is not None else None
     suite = (f"{count} motions ({', '.join(suites)}), "
-             + (f"selected per stripe by {str(selection).replace('_', ' ')}" if selection else "every motion scaled to every stripe (no selection)"))
-    scenario = _scenario_words(store, scenario_kind(store)) if selection_entry.get("site") else ""
+             + (f"selected per stripe by {selection.method.replace('_', ' ')}" if selection else "every motion scaled to every stripe (no selection)"))
+    scenario = _scenario_words(store, scenario_kind(store)) if selection and selection.scenarios else ""
     return {"structural model": "; ".join(models), "suite": suite,
             "scenario": scenario or "none stated (the motions are not selected for a scenario)"}
 

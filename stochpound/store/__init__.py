@@ -55,6 +55,7 @@ from stochpound.store._definition import (
     scene_g,
 )
 from stochpound.store._grid import Case, Dim, ExperimentGrid, Point
+from stochpound.store._stripe_selection import Selection, SimulatedMotions
 from stochpound.store._gap_axes import (
     SETS,
     contact_free,
@@ -78,7 +79,7 @@ from stochpound.store._selections import fixed_base, has_fixed_base_twins, isola
 from stochpound.store._catalogue import CASE, KINDS, REFERENCE  # noqa: F401
 from stochpound.store._definition import MEASURES  # noqa: F401
 from stochpound.store._progress import UnfinishedStoreError, cases_done, check_finished  # noqa: F401
-from stochpound.store._grid import CONDITIONAL_SPECTRUM  # noqa: F401
+from stochpound.store._grid import CONDITIONAL_SPECTRUM, SIMULATED, SIMULATED_FIELD, Label  # noqa: F401
 from stochpound.store._toml_table import TomlTable  # noqa: F401
 from stochpound.store._scene_edits import apply_overrides, building_names, reference_scene, with_motion  # noqa: F401
 
@@ -112,6 +113,8 @@ __all__ = [
     "MuAxis",
     "Output",
     "Site",
+    "Selection",
+    "SimulatedMotions",
     "Point",
     "Solver",
     "StoreAccessor",

@@ -27,15 +27,13 @@ from stochpound.model.scene_file import scene_from_dict
 from stochpound.store._gap_axes import contact_free, contact_gap_dims, gap_dims, has_contact_free, has_wall_free, wall_free, wall_gap_dims
 from stochpound.store._selections import fixed_base, has_fixed_base_twins
 from stochpound.store._definition import Definition, Hazard, Intensity, read_definition
-from stochpound.store._grid import ExperimentGrid, StoredChoice
+from stochpound.store._grid import ExperimentGrid, Label, StoredChoice
 
 __all__ = ["ACCESSOR", "StoreAccessor"]
 
 ACCESSOR = "pound"
 """The accessor's name: ``ds.pound``."""
 
-Label = str | float | int
-"""A case's label on one dimension: a variant or a motion (str), a gap, μ or a level (float), a realization (int)."""
 
 
 @lru_cache(maxsize=64)

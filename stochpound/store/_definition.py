@@ -38,12 +38,13 @@ import hashlib
 import json
 import math
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any, TypeVar
 
 from stochpound._errors import ExperimentError
 from stochpound.model.friction import is_fixed_base
 from stochpound.motions import DEFAULT_G, MEASURE_KINDS, Measure
+from stochpound.store._stripe_selection import Selection
 
 _Record = TypeVar("_Record")
 
@@ -86,8 +87,6 @@ def scene_g(scene: Mapping[str, Any]) -> float:
     return float(scene.get("g", DEFAULT_G))
 
 
-_MEASURE_KEYS = ("measure", "period", "periods", "damping")
-_INTENSITY_KEYS = (*_MEASURE_KEYS, "levels", "units", "method", "synthetic", "ran", "note")
 
 
 @dataclass(frozen=True)
@@ -110,10 +109,9 @@ class Intensity:
         Why that method ran (with a conditional-spectrum selection: how the stripes' motions were chosen).
     synthetic : str or None
         How a synthetic ensemble is scaled (``each`` or ``expected``); None for a definition stored before the field.
-    selection : mapping
-        The conditional-spectrum selection's canonical entries (``selection``, ``motions``, ``max_scale_factor``,
-        ``seed``, the rules, ``site`` and ``ruptures`` or ``simulated_motions``; docs/intensity.md); empty for the
-        default ``scale``, which adds none.
+    selection : Selection or None
+        How a conditional-spectrum selection chooses the stripes' motions (:class:`~stochpound.store.Selection`);
+        None for the default ``scale``, which adds nothing to the entry.
     """
 
     measure: Measure
@@ -123,14 +121,13 @@ class Intensity:
     ran: str
     note: str
     synthetic: str | None = None
-    selection: Mapping[str, Any] = field(default_factory=dict)
+    selection: Selection | None = None
 
     @classmethod
     def from_entry(cls, entry: Mapping[str, Any]) -> Intensity:
         """The typed setting of a canonical ``intensity`` entry."""
-        selection = {key: value for key, value in entry.items() if key not in _INTENSITY_KEYS}
         return cls(Measure.from_entry(entry), entry["units"], tuple(float(x) for x in entry["levels"]), entry["method"], entry["ran"],
-                   entry["note"], entry.get("synthetic"), selection)
+                   entry["note"], entry.get("synthetic"), Selection.from_entry(entry))
 
     def entry(self) -> dict[str, Any]:
         """The canonical ``intensity`` entry (as definitions store it)."""
@@ -138,7 +135,7 @@ class Intensity:
         if self.synthetic is not None:
             written["synthetic"] = self.synthetic
         written.update(ran=self.ran, note=self.note)
-        written.update(copy.deepcopy(dict(self.selection)))
+        written.update(self.selection.entry() if self.selection is not None else {})
         return written
 
     @property
@@ -149,7 +146,7 @@ class Intensity:
     @property
     def selection_method(self) -> str:
         """How the stripes' motions were chosen: ``scale`` (every motion scaled to every level) or ``conditional_spectrum``."""
-        return str(self.selection.get("selection", "scale"))
+        return self.selection.method if self.selection is not None else "scale"
 
 
 @dataclass(frozen=True)

@@ -37,7 +37,8 @@ import xarray as xr
 from stochpound._errors import ExperimentError, SceneError
 from stochpound.model.scene_file import scene_from_dict
 from stochpound.store._catalogue import CASE, KINDS, REFERENCE
-from stochpound.store._definition import Definition, Intensity, MotionSource, Output, Solver, VariantAxis, canonical_json, read_definition
+from stochpound.store._definition import (Definition, Intensity, MotionSource, Output, Solver, VariantAxis, canonical_json, definition_sha256,
+                                          read_definition)
 from stochpound.store._scene_edits import (
     apply_overrides,
     building_names,
@@ -52,6 +53,10 @@ CONDITIONAL_SPECTRUM = "conditional_spectrum"
 """``[intensity] selection`` that chooses the motions of every stripe (docs/intensity.md)."""
 SIMULATED = "simulated"
 """The kind of a motion simulated for a stripe's pool (``[site] simulated_motions``) and chosen."""
+Label = str | float | int
+"""A case's label on one dimension: a variant or a motion (str), a gap, μ or a level (float), a realization (int)."""
+SIMULATED_FIELD = "site.simulated_motions"
+"""The field that declares the simulated motions (how messages name a chosen one)."""
 
 
 @dataclass(frozen=True)
@@ -91,11 +96,11 @@ class Case:
 
     case_id: str
     kind: str
-    labels: tuple[tuple[str, Any], ...]
+    labels: tuple[tuple[str, Label], ...]
     position: tuple[int, ...]
 
     @property
-    def label_dict(self) -> dict[str, Any]:
+    def label_dict(self) -> dict[str, Label]:
         """The labels as a dict."""
         return dict(self.labels)
 
@@ -120,7 +125,7 @@ class Point:
 
     kind: str
     position: tuple[int, ...]
-    labels: tuple[tuple[str, Any], ...]
+    labels: tuple[tuple[str, Label], ...]
 
     def describe(self) -> str:
         """``case neighbour=stiff, gap=0.01, mu=0.1`` (``(base scene)`` without structural dimensions)."""
@@ -131,12 +136,12 @@ def _format(value: Any) -> str:
     return f"{value:g}" if isinstance(value, float) else str(value)
 
 
-def case_id(kind: str, labels: Mapping[str, Any]) -> str:
+def case_id(kind: str, labels: Mapping[str, Label]) -> str:
     """Stable id of a case from its kind and labels."""
     return hashlib.sha256(canonical_json({"kind": kind, "labels": dict(labels)}).encode()).hexdigest()[:16]
 
 
-def case_ids(kind: str, labels: Mapping[str, Any], realizations: Sequence[int]) -> list[str]:
+def case_ids(kind: str, labels: Mapping[str, Label], realizations: Sequence[int]) -> list[str]:
     """:func:`case_id` of the cases with ``labels`` at each of ``realizations`` (the JSON around the number is built once)."""
     marker = -7340912358  # a number that no other label renders as
     text = canonical_json({"kind": kind, "labels": {**labels, "realization": marker}})
@@ -158,8 +163,8 @@ class StripeChoice(Protocol):
         """Which motions run at every level (bool, level × motion on ``record``)."""
 
     @property
-    def simulated(self) -> Mapping[str, Mapping[str, Any]]:
-        """The chosen simulated motions' sources (``label``, ``kind``, ``field``, ``motion``), by label, in ``record`` order."""
+    def simulated(self) -> Mapping[str, MotionSource]:
+        """The chosen simulated motions' sources, by label, in ``record`` order."""
 
 
 @dataclass(frozen=True)
@@ -200,9 +205,9 @@ class StoredChoice:
         return np.array(self.runs, dtype=bool).reshape(len(self.runs), -1)
 
     @cached_property
-    def simulated(self) -> dict[str, dict[str, Any]]:
+    def simulated(self) -> dict[str, MotionSource]:
         """The simulated motions' sources, by label, in ``record`` order."""
-        return {label: {"label": label, "kind": SIMULATED, "field": "site.simulated_motions", "motion": json.loads(table)} for label, table in self.tables}
+        return {label: MotionSource(label, SIMULATED, SIMULATED_FIELD, json.loads(table)) for label, table in self.tables}
 
 
 class ExperimentGrid:
@@ -228,10 +233,13 @@ class ExperimentGrid:
         self, definition: Mapping[str, Any] | Definition, text: str = "", base_dir: str | Path = ".", path: str = "", choice: StripeChoice | None = None
     ) -> None:
         self.definition: Definition = read_definition(definition)
+        written = self.definition.to_dict()
+        self.definition_json = canonical_json(written)
+        """The canonical definition's JSON, written once (a store's ``definition`` attribute)."""
+        self.sha256 = definition_sha256(written)
         self.text = text
         self.base_dir = Path(base_dir)
         self.path = path
-        self.sha256 = self.definition.sha256
         self.name: str = self.definition.name
         self.studied: str = self.definition.studied
         self.variants: tuple[VariantAxis, ...] = self.definition.variants
@@ -281,8 +289,7 @@ class ExperimentGrid:
         """The motions on ``record``, by label: the definition's, then the simulated motions a selection chose (``[site] simulated_motions``)."""
         if self.selection is None:
             return self.recorded_motions
-        simulated = {label: MotionSource(label, s["kind"], s["field"], s["motion"]) for label, s in self.selection.simulated.items()}
-        return {**self.recorded_motions, **simulated}
+        return {**self.recorded_motions, **self.selection.simulated}
 
     @cached_property
     def motion_dims(self) -> list[Dim]:

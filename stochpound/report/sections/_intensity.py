@@ -45,7 +45,7 @@ from stochpound.risk import (
     site_consistency,
     stripes_beyond_truncation,
 )
-from stochpound.store import has_contact_free, scenario_kind, with_contacts
+from stochpound.store import Intensity, has_contact_free, scenario_kind, with_contacts
 
 CONFIDENCE = 0.95
 SHOWN_GAPS = 3
@@ -79,7 +79,7 @@ def intensity_section(name: str, store: xr.Dataset, gaps: Sequence[float] = ()) 
     return section
 
 
-def method_text(store: xr.Dataset, setting: dict[str, Any]) -> str:
+def method_text(store: xr.Dataset, setting: Intensity) -> str:
     """What ran (stripes or IDA, and why), the measure and the levels: one paragraph of the section and of the methods."""
     levels = ", ".join(f"{level:g}" for level in setting.levels)
     text = (
@@ -111,7 +111,7 @@ def _first_cell(data: xr.DataArray) -> xr.DataArray:
     return data.isel({d: 0 for d in data.dims if d not in ("record", "realization", "spectrum_period", "intensity")})
 
 
-def _spectra(name: str, store: xr.Dataset, setting: dict[str, Any]) -> FigureItem:
+def _spectra(name: str, store: xr.Dataset, setting: Intensity) -> FigureItem:
     periods = store["spectrum_period"].values
     psa = _first_cell(store["motion_psa"])
     done = _first_cell(store["case_status"]) == 1
@@ -153,7 +153,7 @@ def _proportion(k: np.ndarray, n: np.ndarray) -> np.ndarray:
     return np.where(n > 0, k / np.maximum(n, 1), np.nan)
 
 
-def _probability_axes(ax: Any, setting: dict[str, Any], label: str, legend: bool) -> None:
+def _probability_axes(ax: Any, setting: Intensity, label: str, legend: bool) -> None:
     """Axes of a probability against the intensity measure."""
     ax.set_xlabel(f"{setting.description} ({setting.units})")
     ax.set_ylabel(label)
@@ -163,7 +163,7 @@ def _probability_axes(ax: Any, setting: dict[str, Any], label: str, legend: bool
         ax.legend(fontsize=7)
 
 
-def _stripe_table(name: str, store: xr.Dataset, setting: dict[str, Any]) -> Table:
+def _stripe_table(name: str, store: xr.Dataset, setting: Intensity) -> Table:
     runs, pounded = _pounding_counts(store)
     lower, upper = clopper_pearson(pounded.values, runs.values, CONFIDENCE)
     probability = xr.DataArray(_proportion(pounded.values, runs.values), runs.coords, runs.dims)
@@ -195,7 +195,7 @@ def _stripe_table(name: str, store: xr.Dataset, setting: dict[str, Any]) -> Tabl
     )
 
 
-def _stripe_figure(name: str, store: xr.Dataset, setting: dict[str, Any], gaps: Sequence[float] = ()) -> FigureItem:
+def _stripe_figure(name: str, store: xr.Dataset, setting: Intensity, gaps: Sequence[float] = ()) -> FigureItem:
     """P(pounding) against intensity: per finite gap from the runs' impacts; for the contact-free runs (gap = ∞, which never
     pound) at gaps that mean something, from their closures (the gap identity): ``gaps`` (g*), else the closures' quartiles."""
     contact_free = has_contact_free(store) and CLOSURE in store
@@ -249,7 +249,7 @@ def _listed(items: list[str]) -> str:
     return items[0] if len(items) == 1 else ", ".join(items[:-1]) + " and " + items[-1]
 
 
-def _selection_text(store: xr.Dataset, setting: dict[str, Any]) -> str:
+def _selection_text(store: xr.Dataset, setting: Intensity) -> str:
     """The selection for the site: the scenario of every stripe and the stripes whose selection misses its target."""
     mixture = scenario_kind(store) == "ruptures"  # the exact conditional spectrum: the means of its mixture over the site's ruptures
     scenarios = "; ".join(
@@ -277,7 +277,7 @@ def _selection_text(store: xr.Dataset, setting: dict[str, Any]) -> str:
             f"{_holdings(store, setting)}")
 
 
-def _holdings(store: xr.Dataset, setting: dict[str, Any]) -> str:
+def _holdings(store: xr.Dataset, setting: Intensity) -> str:
     """What every stripe holds: its recorded and simulated motions and its earthquakes ("" for a store that does not say)."""
     if "selection_recorded" not in store:
         return ""
@@ -289,7 +289,7 @@ def _holdings(store: xr.Dataset, setting: dict[str, Any]) -> str:
     return f" The stripes hold (each simulated motion its own earthquake) {stripes}."
 
 
-def _selection_figure(name: str, store: xr.Dataset, setting: dict[str, Any]) -> FigureItem:
+def _selection_figure(name: str, store: xr.Dataset, setting: Intensity) -> FigureItem:
     """Per stripe: the target's median and 16/84 % spectra against the chosen set's (exp of mean ± std of ln Sa)."""
     periods = store["selection_period"].values
     levels = store["intensity"].values
@@ -323,7 +323,7 @@ def _selection_figure(name: str, store: xr.Dataset, setting: dict[str, Any]) -> 
     )
 
 
-def _consistency_text(consistency: dict[str, xr.Dataset], setting: dict[str, Any]) -> str:
+def _consistency_text(consistency: dict[str, xr.Dataset], setting: Intensity) -> str:
     """How far the site's hazard at its other periods, recomputed from the stripes' motions, lies from its own curves."""
     targets = _targets_text()
     parts = []
@@ -342,7 +342,7 @@ def _targets_text() -> str:
     return " and ".join(f"{100 * p:g} %" for p in TARGETS)
 
 
-def _consistency_figure(name: str, consistency: dict[str, xr.Dataset], setting: dict[str, Any]) -> FigureItem:
+def _consistency_figure(name: str, consistency: dict[str, xr.Dataset], setting: Intensity) -> FigureItem:
     """Per other measure of the site: its own hazard curve against the one recomputed from the stripes."""
     columns = len(consistency)
     figure = Figure(figsize=(7.5, 2.8), layout="constrained")
@@ -368,7 +368,7 @@ def _consistency_figure(name: str, consistency: dict[str, xr.Dataset], setting: 
     )
 
 
-def _ida_figure(name: str, store: xr.Dataset, setting: dict[str, Any]) -> FigureItem:
+def _ida_figure(name: str, store: xr.Dataset, setting: Intensity) -> FigureItem:
     capacity = store["ida_capacity"].where(store["case_status"] == 1)
     figure = Figure(figsize=(7.5, 3.4), layout="constrained")
     ax = figure.subplots()

@@ -22,10 +22,10 @@ def stripe_motions_text(store: xr.Dataset) -> str:
     scale = store["selection_scale_factor"].transpose("intensity", "record").values
     per_stripe = np.isfinite(scale).sum(axis=1)
     count = f"{per_stripe.min()}" if per_stripe.min() == per_stripe.max() else f"{per_stripe.min()}–{per_stripe.max()}"
-    selection = store.pound.intensity.selection if store.pound.intensity is not None else {}
-    method = str(selection.get("selection", "a selection")).replace("_", "-")
-    if "simulated_motions" in selection:  # the record axis holds the chosen simulated motions only
-        pool = (f"{int(np.sum(store['record_kind'].values != 'simulated'))} records and {selection['simulated_motions']['count']} simulated motions "
+    selection = store.pound.intensity.selection if store.pound.intensity is not None else None
+    method = (selection.method if selection is not None else "a selection").replace("_", "-")
+    if selection is not None and selection.simulated is not None:  # the record axis holds the chosen simulated motions only
+        pool = (f"{int(np.sum(store['record_kind'].values != 'simulated'))} records and {selection.simulated.count} simulated motions "
                 "of each stripe's scenario")
     text = (f"{count} motions per stripe, chosen by {method} selection from a pool of {pool} and scaled to the stripe's level "
             f"(scale factors {np.nanmin(scale):.3g}–{np.nanmax(scale):.3g})")
