@@ -80,18 +80,3 @@ def test_a_small_run_given_no_workers_runs_in_this_process(tmp_path, monkeypatch
     assert any(line.startswith("running in this process, without dask") for line in lines), lines
     monkeypatch.setattr(_runner, "IN_PROCESS_CPU_SECONDS", estimated)
     assert not _runner.in_process(experiment, grids, experiment.n_cases)
-
-
-@pytest.mark.slow
-def test_a_cold_cache_s_engine_is_compiled_in_another_process_and_loaded_here(tmp_path):
-    """compiling_elsewhere with an empty cache: the other process is stopped if the block is left before the engine's first
-    call; otherwise that call waits for it and loads the engine from the cache (a cache hit, no compile in this process)."""
-    code = ("from stochpound.solvers import first_call\nfrom stochpound.solvers.engine import run_engine\n"
-            "with first_call.compiling_elsewhere():\n    child = first_call._ELSEWHERE[0]\n"
-            "print(child.poll() is not None, first_call.engine_cached())\n"
-            "with first_call.compiling_elsewhere():\n    from stochpound.solvers.exact import compile_engine\n    compile_engine()\n"
-            "print(first_call._ELSEWHERE == [], sum(run_engine.stats.cache_hits.values()), sum(run_engine.stats.cache_misses.values()))\n"
-            "with first_call.compiling_elsewhere():\n    print(first_call._ELSEWHERE == [])")
-    environment = {**os.environ, "PYTHONPATH": str(REPOSITORY), "NUMBA_CACHE_DIR": str(tmp_path)}
-    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=900, env=environment)
-    assert done.returncode == 0 and done.stdout.split() == ["True", "False", "True", "1", "0", "True"], (done.stdout, done.stderr)
