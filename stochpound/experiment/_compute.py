@@ -256,13 +256,11 @@ def warm_up(spectrum: bool = True) -> None:
     by the process that starts the local workers, before they start, every
     worker loads them in a fraction of a second instead of compiling them
     concurrently; a kernel an experiment does not run is not compiled.
-    The engine comes last: the experiment runner may have started its compile
-    in another process (:func:`~stochpound.solvers.first_call.compiling_elsewhere`).
     """
     from stochpound.solvers.exact import WARM_UP_SCENE, compile_engine
 
+    compile_engine()
     if spectrum:
         intensity.warm_up()
     twin = scene_from_dict(with_motion(reference_scene(WARM_UP_SCENE, "B2"), WARM_UP_SCENE["motion"]), source="warm_up")
     fixed_base_displacements(twin, [twin.motion])
-    compile_engine()  # last: while the small kernels above compile, the engine may be compiling in another process

@@ -236,7 +236,7 @@ def run_experiment(
     lock = FolderLock(parts_folder(store))
     if not lock.acquire():
         raise _busy(store)
-    with lock, _interrupts() as stop, first_call.compiling_elsewhere():  # a cold cache: the engine compiles on the other core meanwhile
+    with lock, _interrupts() as stop:
         if restart:
             clear_store(store)
         remove_temporaries(parts_folder(store))

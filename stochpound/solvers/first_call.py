@@ -20,12 +20,6 @@ cold compile (``"compile"``), and the rest of an experiment run's start-up
 (loading the solver, the store, a local dask cluster; named by the runner).
 The runner's estimate adds the last measured ones to the run time
 (:func:`measured`); a step not yet measured on this machine is said to be so.
-
-With a cold cache the experiment runner has the engine compiled in another
-process (:func:`compiling_elsewhere`) while it goes on with the run's
-checks, the store and the other kernels on the machine's other core; the
-engine's first call here waits for that process, then loads what it put in
-the cache: the engine is compiled once, in one process.
 """
 
 from __future__ import annotations
@@ -33,9 +27,6 @@ from __future__ import annotations
 import contextlib
 import json
 import logging
-import os
-import subprocess
-import sys
 import time
 from collections.abc import Iterator
 from pathlib import Path
@@ -56,7 +47,6 @@ def run(*arguments: object) -> int:
     in :func:`~stochpound.solvers.compiling.engine_compile`, announced and timed when the cache is cold (:func:`announced_compile`)."""
     if _COMPILED:
         return run_engine(*arguments)
-    _wait_elsewhere()  # a compile in another process (compiling_elsewhere): the call below loads its result from the cache
     with announced_compile(), (contextlib.nullcontext() if numba_default_requested() else engine_compile()):
         status = run_engine(*arguments)
     _COMPILED.append(True)
@@ -64,53 +54,6 @@ def run(*arguments: object) -> int:
 
 
 _COMPILED: list[bool] = []
-
-
-@contextlib.contextmanager
-def compiling_elsewhere() -> Iterator[None]:
-    """A block during which the engine compiles into numba's cache in another process, if it is not cached.
-
-    Nothing is started when the cache holds the engine, when numba keeps no
-    cache or compiles nothing (``NUMBA_DISABLE_JIT``), or inside another such
-    block. This process goes on meanwhile (on a machine's other core); its
-    first call of the engine (:func:`run`) waits for the other process,
-    then loads the engine from the cache (and compiles it itself if that
-    process failed): the engine is compiled once. The other process imports
-    this very package and uses this one's numba cache folder. Leaving the
-    block before the engine's first call (an error, a Ctrl-C) stops it.
-    """
-    if _ELSEWHERE or numba.config.DISABLE_JIT or not _cache_kept() or engine_cached():
-        yield
-        return
-    package = str(Path(__file__).resolve().parents[2])
-    code = f"import sys; sys.path.insert(0, {package!r}); from stochpound.solvers.exact import compile_engine; compile_engine()"
-    environment = {**os.environ, **({"NUMBA_CACHE_DIR": str(numba.config.CACHE_DIR)} if numba.config.CACHE_DIR else {})}
-    process = subprocess.Popen([sys.executable, "-c", code], env=environment, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
-                               stderr=subprocess.DEVNULL)
-    _ELSEWHERE.append(process)
-    try:
-        yield
-    finally:
-        if _ELSEWHERE:  # never waited for: stopped
-            _ELSEWHERE.clear()
-            process.kill()
-            process.wait()
-
-
-_ELSEWHERE: list[subprocess.Popen] = []
-"""The process compiling the engine for this one (:func:`compiling_elsewhere`), until this one waits for it."""
-
-
-def _wait_elsewhere() -> None:
-    """Wait for the compile started by :func:`compiling_elsewhere`, if any (its outcome is read from the cache)."""
-    if _ELSEWHERE:
-        _ELSEWHERE[0].wait()
-        _ELSEWHERE.clear()
-
-
-def _cache_kept() -> bool:
-    """True if numba keeps the engine in an on-disk cache (not when no cache folder could be written, see stochpound._jit)."""
-    return type(getattr(run_engine, "_cache", None)).__name__ not in ("NullCache", "NoneType")
 
 
 def engine_cached() -> bool:
