@@ -63,7 +63,7 @@ print(json.dumps({"first_case": began - born + report.setup, "before_run": began
                   "running": report.elapsed - report.setup, "executor": report.executor, "cpu": cpu[0]}))
 """
 """Run in a fresh interpreter: the quick start into the store ``argv[2]``; prints its times (s) as JSON, with ``cpu``, the CPU time
-of the process and of the processes it waited for (a compile elsewhere) up to the first case."""
+of the process and of the child processes it waited for, up to the first case."""
 
 
 def parse_arguments(argv: list[str] | None) -> argparse.Namespace:
