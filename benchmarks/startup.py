@@ -46,18 +46,24 @@ TARGETS = {"empty": 15.0, "warm": 3.0}
 """Most seconds from the process's start to the first case, by numba cache, on an idle 2-core machine (issue 48)."""
 
 PROBE = """
-import json, sys, time
+import json, resource, sys, time
 import psutil
 born = psutil.Process().create_time()
-from stochpound.experiment import load_experiment, run_experiment
+from stochpound.experiment import _runner, load_experiment, run_experiment
+cpu = []
+def _cpu_then_bar(*arguments, bar=_runner._progress_bar):
+    cpu.append(sum(u.ru_utime + u.ru_stime for u in map(resource.getrusage, (resource.RUSAGE_SELF, resource.RUSAGE_CHILDREN))))
+    return bar(*arguments)
+_runner._progress_bar = _cpu_then_bar  # called by the runner as the first case is submitted, right after the start-up is timed
 experiment = load_experiment(sys.argv[1])
 began = time.time()
 report = run_experiment(experiment, sys.argv[2], progress=False)
 assert report.complete, report
 print(json.dumps({"first_case": began - born + report.setup, "before_run": began - born, "setup": report.setup,
-                  "running": report.elapsed - report.setup, "executor": report.executor}))
+                  "running": report.elapsed - report.setup, "executor": report.executor, "cpu": cpu[0]}))
 """
-"""Run in a fresh interpreter: the quick start into the store ``argv[2]``; prints its times (s) as JSON."""
+"""Run in a fresh interpreter: the quick start into the store ``argv[2]``; prints its times (s) as JSON, with ``cpu``, the CPU time
+of the process and of the child processes it waited for, up to the first case."""
 
 
 def parse_arguments(argv: list[str] | None) -> argparse.Namespace:
@@ -123,12 +129,13 @@ def section(results: dict[str, Any], info: dict[str, str]) -> str:
         "",
         "Where the cases ran: " + "; ".join(f"{name}: {_executors(rounds[name])}" for name in names) + ".",
         "",
-        "| tree | round | numba cache | first case (s) | of which start-up (s) | running (s) | load |",
-        "|---|---|---|---:|---:|---:|---:|",
+        "| tree | round | numba cache | first case (s) | of which start-up (s) | CPU to the first case (s) | running (s) | load |",
+        "|---|---|---|---:|---:|---:|---:|---:|",
     ]
     for name in names:
         for row in rounds[name]:
-            lines.append(f"| {name} | {row['round']} | {row['cache']} | {row['first_case']:.1f} | {row['setup']:.1f} | {row['running']:.1f} | {row['load']:.2f} |")
+            cpu = f"{row['cpu']:.1f}" if "cpu" in row else "–"
+            lines.append(f"| {name} | {row['round']} | {row['cache']} | {row['first_case']:.1f} | {row['setup']:.1f} | {cpu} | {row['running']:.1f} | {row['load']:.2f} |")
     lines += ["", "Medians of the first case, s:", "", "| tree | empty cache | warm cache | target (empty / warm, idle machine) |", "|---|---:|---:|---|"]
     for name in names:
         empty, warm = (_median(rounds[name], state) for state in ("empty", "warm"))
@@ -138,12 +145,16 @@ def section(results: dict[str, Any], info: dict[str, str]) -> str:
         ratios = [f"{_median(rounds[this], state) / _median(rounds[earlier], state):.2f}× with {article} {state} cache"
                   for state, article in (("empty", "an"), ("warm", "a"))]
         lines += ["", f"This tree against {earlier}, measured in the same session: {' and '.join(ratios)} (medians of the first case)."]
+        if all("cpu" in row for name in names for row in rounds[name]):
+            cpu = [f"{_median(rounds[this], state, 'cpu') / _median(rounds[earlier], state, 'cpu'):.2f}× with {article} {state} cache"
+                   for state, article in (("empty", "an"), ("warm", "a"))]
+            lines += [f"CPU time to the first case (all the run's processes, less sensitive to other work on the machine): {' and '.join(cpu)}."]
     lines += [SECTION.end]
     return "\n".join(lines) + "\n"
 
 
-def _median(rows: list[dict[str, Any]], state: str) -> float:
-    return statistics.median(row["first_case"] for row in rows if row["cache"] == state)
+def _median(rows: list[dict[str, Any]], state: str, key: str = "first_case") -> float:
+    return statistics.median(row[key] for row in rows if row["cache"] == state)
 
 
 def _executors(rows: list[dict[str, Any]]) -> str:

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import numpy as np
 import xarray as xr
-from scipy import stats
 
 from stochpound.stats import kernels
 
@@ -26,6 +25,8 @@ def normal_histogram(data: xr.DataArray, bins: int = 40) -> xr.Dataset:
         bin centres, and bin ``edges`` (dimension ``edge``); attributes
         ``mean`` and ``std`` of the fitted normal.
     """
+    from scipy import stats
+
     values = np.asarray(data.values, dtype=float).ravel()
     values = values[np.isfinite(values)]
     density, edges = np.histogram(values, bins=bins, density=True)

@@ -56,7 +56,6 @@ from typing import Any, Callable, Sequence
 
 import numpy as np
 import xarray as xr
-from scipy.special import ndtr
 
 from stochpound._errors import SiteError
 from stochpound.analysis._subset_simulation import RESPONSES, _reader
@@ -439,6 +438,8 @@ def neyman_allocation(values: Sequence[np.ndarray], rates: np.ndarray, target_ra
 
 def _lognormal_exceedance(values: np.ndarray, level: float) -> float:
     """P(D > level) of the lognormal fitted to the positive responses (0 without any, or at a level <= 0: 1)."""
+    from scipy.special import ndtr
+
     if level <= 0.0:
         return 1.0
     logs = np.log(values[values > 0.0])

@@ -23,7 +23,6 @@ from collections.abc import Sequence
 
 import numpy as np
 import xarray as xr
-from scipy import stats
 
 TARGET_PROBABILITIES = (0.5, 0.16, 0.05, 0.01)
 """Default target pounding probabilities of :func:`required_separation`."""
@@ -220,6 +219,8 @@ def _exceedance_kernel(samples: np.ndarray, gaps: np.ndarray, confidence: float)
 
 def _clopper_pearson(successes: np.ndarray, trials: np.ndarray, confidence: float) -> tuple[np.ndarray, np.ndarray]:
     """Exact two-sided binomial interval of the proportion successes/trials (NaN for no trials)."""
+    from scipy import stats
+
     tail = (1.0 - confidence) / 2.0
     with np.errstate(invalid="ignore"):
         lower = np.where(successes > 0, stats.beta.ppf(tail, successes, trials - successes + 1), 0.0)
@@ -230,6 +231,8 @@ def _clopper_pearson(successes: np.ndarray, trials: np.ndarray, confidence: floa
 
 def _quantile_kernel(samples: np.ndarray, levels: np.ndarray, confidence: float) -> tuple[np.ndarray, ...]:
     """Inverse-CDF quantiles at ``levels`` of non-NaN ``samples`` (last axis), their order-statistic bounds, and the count."""
+    from scipy import stats
+
     trials = np.count_nonzero(~np.isnan(samples), axis=-1)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)  # all-NaN rows give NaN

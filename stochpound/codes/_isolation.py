@@ -39,8 +39,6 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from asce7_16.seismic import seismic_response_coeff
-from scipy.optimize import brentq
 
 from stochpound.motions import DEFAULT_G
 
@@ -320,6 +318,8 @@ def isolator_displacement(mu: float, radius: float, sm1: float, g: float = DEFAU
     displacement too small (where eq. 17.5-1 gives more) and the frictionless
     pendulum's (T_M = 2π √(R/g), B_M = 0.8), to ``tolerance`` (m); ``g`` in m/s².
     """
+    from scipy.optimize import brentq
+
     for name, value in (("mu", mu), ("radius", radius), ("sm1", sm1), ("g", g)):
         _positive(name, value)
 
@@ -363,6 +363,8 @@ def chapter17_design(base: SlidingBase, spectrum: MceSpectrum, plan: IsolatedPla
     -------
     Chapter17Design
     """
+    from asce7_16.seismic import seismic_response_coeff
+
     _positive("r", r)
     _positive("wind_shear", wind_shear)
     r_i = min(2.0, max(1.0, 3.0 * r / 8.0))

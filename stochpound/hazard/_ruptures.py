@@ -45,8 +45,6 @@ from typing import Any
 
 import numpy as np
 import xarray as xr
-from scipy.optimize import brentq
-from scipy.special import log_ndtr, logsumexp, ndtr
 
 from stochpound._data_files import bundled_data_dir
 from stochpound._errors import SiteError
@@ -249,6 +247,8 @@ class RuptureSite:
 
     def contributions(self, measure: str, period: float | Sequence[float] | None, x: Any) -> np.ndarray:
         """ν_r P(IM > x | r) (1/yr) of every rupture, over ``x``'s shape then the ruptures (x in g)."""
+        from scipy.special import ndtr
+
         return np.asarray(self.rate) * ndtr(-self.epsilon(measure, period, x))
 
     def epsilon(self, measure: str, period: float | Sequence[float] | None, x: Any) -> np.ndarray:
@@ -472,12 +472,16 @@ def _intensities(x: Any) -> np.ndarray:
 
 def _level_weights(rates: np.ndarray, epsilon: np.ndarray, sigma: np.ndarray) -> np.ndarray:
     """P(r | IM = x) ∝ ν_r φ(ε_r)/σ_r over the last axis (the ruptures), in logs (no underflow at large ε)."""
+    from scipy.special import logsumexp
+
     log_weight = np.log(rates) - 0.5 * epsilon**2 - np.log(sigma)
     return np.exp(log_weight - logsumexp(log_weight, axis=-1, keepdims=True))
 
 
 def _exceedance_weights(rates: np.ndarray, epsilon: np.ndarray) -> np.ndarray:
     """P(r | IM > x) ∝ ν_r Φc(ε_r) over the last axis, in logs."""
+    from scipy.special import log_ndtr, logsumexp
+
     log_weight = np.log(rates) + log_ndtr(-epsilon)
     return np.exp(log_weight - logsumexp(log_weight, axis=-1, keepdims=True))
 
@@ -489,6 +493,9 @@ def _bins(values: np.ndarray, edges: np.ndarray) -> np.ndarray:
 
 def _solve(rates: np.ndarray, mean: np.ndarray, sigma: np.ndarray, rate: Any) -> np.ndarray:
     """x with Σ_r ν_r Φc((ln x − μ_r)/σ_r) = rate, by bracketing in ln x, over ``rate``'s shape."""
+    from scipy.optimize import brentq
+    from scipy.special import ndtr
+
     target = np.asarray(rate, dtype=float)
     total = float(rates.sum())
     if not np.all(np.isfinite(target) & (target > 0) & (target < total)):

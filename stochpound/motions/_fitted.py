@@ -43,7 +43,6 @@ from collections.abc import Sequence
 from dataclasses import replace
 
 import numpy as np
-from scipy.special import ndtr
 
 from stochpound._errors import SiteError
 from stochpound.motions._conditional import (
@@ -177,6 +176,8 @@ class _SiteModel:
 
     def exceedance(self, scenario: Scenario, intensities: Sequence[np.ndarray]) -> list[list[np.ndarray]]:
         """P(Sa(T'_k) > y | IM* = x_j) of the scenario, [level j][other curve k] over that curve's ``intensities`` (g)."""
+        from scipy.special import ndtr
+
         mean, sigma = _average_model(self.nodes, scenario)
         cond_mean, cond_cov, _ = _conditioned(mean, self.correlation * np.outer(sigma, sigma), self.weights, np.log(self.levels))
         cond_sd = np.sqrt(np.clip(np.diag(cond_cov), 1e-12, None))

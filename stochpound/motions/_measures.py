@@ -25,7 +25,6 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 import xarray as xr
-from scipy.optimize import brentq
 
 from stochpound.motions._arias import DEFAULT_G, arias_intensity, squared_integrals
 from stochpound.motions._spectrum import DEFAULT_DAMPING, as_acceleration, response_spectrum
@@ -81,6 +80,8 @@ def _roots_inside(coefficients: list[np.ndarray], h: float) -> list[np.ndarray]:
 
 def significant_duration(acceleration: np.ndarray, dt: float, fractions: tuple[float, float] = SIGNIFICANT_FRACTIONS) -> float:
     """Time (s) between the instants ∫ a_g² dt reaches ``fractions`` of its total (D5–95 by default; 0 for a null motion)."""
+    from scipy.optimize import brentq
+
     a = np.asarray(acceleration, dtype=np.float64)
     h = float(dt)
     left, right = a[:-1], a[1:]

@@ -33,7 +33,6 @@ from dataclasses import dataclass, field
 from typing import Callable
 
 import numpy as np
-from scipy.special import ndtr
 
 from stochpound.motions.baseline import baseline_correct
 from stochpound.motions.generators import filter_from_normals, filter_samples, spectral_from_phases, spectral_length, spectral_samples
@@ -112,6 +111,8 @@ class NormalMotion:
         np.ndarray
             (n_time,) or (m, n_time) accelerations, m/s².
         """
+        from scipy.special import ndtr
+
         u = np.asarray(u, dtype=float)
         if u.ndim not in (1, 2) or u.shape[-1] != self.dimension:
             raise ValueError(f"u: must have shape (n,) or (m, n) with n = {self.dimension}, got {u.shape}")

@@ -34,7 +34,6 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import optimize, stats
 
 from stochpound.motions._arias import DEFAULT_G
 from stochpound.motions._conditional import MODEL_DAMPING, _average_model, _node_correlation
@@ -165,6 +164,7 @@ class _Pool:
 
 
 def _pool(scenario: tuple, n: int, seed: int, dt: float) -> _Pool:
+    from scipy import stats
     published = load_site_model("rezaeian_2010")
     centre = mean_normals(published, Scenario(*scenario))[1:]
     factor = PROPOSAL_WIDTH * published.cholesky[1:, 1:]
@@ -200,6 +200,8 @@ def _unpack(x: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 def _pool_statistics(pool: _Pool, x: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
     """Weighted mean and σ of ln Sa of a pool under the candidate ``x``, the correlations at CORRELATION_PAIRS, the effective sample size."""
+    from scipy import stats
+
     published = load_site_model("rezaeian_2010")
     adjustments, scales, corner = _unpack(x)
     model = SiteModel("candidate", published.coefficients, published.cholesky, published.marginals, adjustments, corner, "")
@@ -250,6 +252,8 @@ def calibration_pools(n: int = 1000, seed: int = 7, dt: float = 0.01, scenarios:
 
 def fit_pools(pools: Sequence[_Pool]) -> dict:
     """Fit the calibration (module docstring) on ``pools``; the coefficients and diagnostics."""
+    from scipy import optimize
+
     result = optimize.least_squares(_residuals, start_vector(), args=(pools,), method="trf", x_scale=1.0, diff_step=1e-4)
     adjustments, scales, corner = _unpack(result.x)
     sizes = [_pool_statistics(pool, result.x)[3] for pool in pools]

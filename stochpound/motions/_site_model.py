@@ -44,7 +44,6 @@ from functools import lru_cache
 import numpy as np
 import numba
 from numba import njit
-from scipy import special, stats
 
 from stochpound._data_files import bundled_data_dir
 from stochpound.motions._arias import DEFAULT_G
@@ -82,6 +81,7 @@ class Lognormal:
 
     def ppf(self, p: np.ndarray) -> np.ndarray:
         """The quantiles at probabilities ``p``."""
+        from scipy import stats
         return np.exp(stats.norm.ppf(p, self.mu, self.sigma))
 
 
@@ -96,6 +96,7 @@ class Beta:
 
     def ppf(self, p: np.ndarray) -> np.ndarray:
         """The quantiles at probabilities ``p``."""
+        from scipy import stats
         return self.low + (self.high - self.low) * stats.beta.ppf(p, self.a, self.b)
 
 
@@ -108,6 +109,7 @@ class Gamma:
 
     def ppf(self, p: np.ndarray) -> np.ndarray:
         """The quantiles at probabilities ``p``."""
+        from scipy import stats
         return stats.gamma.ppf(p, self.shape, scale=self.scale)
 
 
@@ -218,6 +220,8 @@ def _two_sided_exponential_ppf(p: np.ndarray, a: float, b: float, c: float, low:
 
 def motion_parameters(model: SiteModel, scenario: Scenario, normals: np.ndarray) -> dict[str, np.ndarray]:
     """Each motion's parameters (:data:`UNITS`) from its :data:`PARAMETER_NORMALS` standard normals ``normals`` [n, 7]."""
+    from scipy import stats
+
     normals = np.asarray(normals, dtype=float)
     correlated = np.sum(normals[:, None, :6] * model.cholesky[None, :, :], axis=2)  # L z row by row: a BLAS product's rounding depends on n
     nu = mean_normals(model, scenario)[None, :] + correlated
@@ -231,6 +235,8 @@ def motion_parameters(model: SiteModel, scenario: Scenario, normals: np.ndarray)
 
 def gamma_shape(t_mid: np.ndarray, d5_95: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Shape k and rate λ (1/s) of the gamma distribution whose 45 % point is ``t_mid`` and 5–95 % range ``d5_95`` (s)."""
+    from scipy import special
+
     ratio = np.asarray(t_mid, dtype=float) / np.asarray(d5_95, dtype=float)
     low, high = np.full(ratio.shape, math.log(1e-2)), np.full(ratio.shape, math.log(1e4))
     for _ in range(50):  # bisection in ln k: the ratio rises with k
@@ -244,6 +250,8 @@ def gamma_shape(t_mid: np.ndarray, d5_95: np.ndarray) -> tuple[np.ndarray, np.nd
 
 def modulation_constants(parameters: dict[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """ln α1² (α1 in m/s^(α2+1)), k and λ (1/s) of every motion's modulation q² = α1² t^(k−1) e^(−λt) (module docstring)."""
+    from scipy import special
+
     k, rate = gamma_shape(parameters["t_mid"], parameters["d5_95"])
     return np.log(2.0 * DEFAULT_G / np.pi * parameters["arias_intensity"]) + k * np.log(rate) - special.gammaln(k), k, rate
 

@@ -17,7 +17,6 @@ from collections.abc import Sequence
 
 import numpy as np
 import xarray as xr
-from scipy import special
 
 from stochpound._errors import SiteError
 from stochpound.motions._scenario import Scenario, given_scenario
@@ -49,6 +48,8 @@ def _checked(scenario: Scenario | None, loose: tuple, dt: float, model: str) -> 
 
 def _window(parameters: dict[str, np.ndarray]) -> float:
     """The default duration (s): every motion's WINDOW_FRACTION of intensity and the post-filter's tail, rounded up."""
+    from scipy import special
+
     k, rate = gamma_shape(parameters["t_mid"], parameters["d5_95"])
     end = special.gammaincinv(k, WINDOW_FRACTION) / rate + WINDOW_TAIL_PERIODS / parameters["f_corner"]
     return WINDOW_ROUND * math.ceil(float(np.max(end)) / WINDOW_ROUND)

@@ -19,7 +19,6 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.interpolate import CubicSpline
 
 
 class GroundMotion:
@@ -99,6 +98,8 @@ class SampledMotion(GroundMotion):
 
 def _interval_polynomials(times: np.ndarray, values: np.ndarray, interpolation: str) -> np.ndarray:
     """Per-interval cubic coefficients (n-1, 4) in powers of τ = t − t_k."""
+    from scipy.interpolate import CubicSpline
+
     n_intervals = max(len(values) - 1, 0)
     coefficients = np.zeros((n_intervals, 4))
     if n_intervals == 0:

@@ -33,7 +33,6 @@ from functools import cached_property
 
 import numpy as np
 from scipy.linalg import expm, solve_continuous_lyapunov
-from scipy.signal import tf2ss
 
 
 def kanai_tajimi_psd(omega: np.ndarray | float, omega_g: float, zeta_g: float, S0: float = 1.0) -> np.ndarray:
@@ -124,6 +123,7 @@ class FilteredWhiteNoise:
 
     @cached_property
     def _state_space(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        from scipy.signal import tf2ss
         A, B, C, _ = tf2ss(self.numerator, self.denominator)
         return A, B, C
 

@@ -48,7 +48,6 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from asce7_16.seismic import design_response_spectrum
 from scipy.linalg import eigh
 
 from stochpound.codes import isolator_displacement
@@ -98,6 +97,8 @@ class Asce7Design:
 
     def spectrum(self, period: np.ndarray) -> np.ndarray:
         """The design response spectrum S_a(T) (g) of §11.4.6, from the ``asce7-16`` package."""
+        from asce7_16.seismic import design_response_spectrum
+
         curve = design_response_spectrum(self.sds, self.sd1, self.tl)
         return np.array([float(curve(float(t))) for t in np.atleast_1d(period)])
 

@@ -32,7 +32,6 @@ from collections.abc import Mapping
 
 import numpy as np
 import xarray as xr
-from scipy.stats import linregress
 
 from stochpound.motions import Measure
 from stochpound.risk._inputs import efficiency_runs
@@ -114,6 +113,8 @@ def _interpolated(psa: xr.DataArray, spectrum_periods: np.ndarray, periods: np.n
 
 def _fit(response: xr.DataArray, im: xr.DataArray, covariates: Mapping[str, xr.DataArray]) -> xr.Dataset:
     """Least-squares ln D = a + b ln IM per configuration over the runs (the stripes and motions), with the residuals' trends."""
+    from scipy.stats import linregress
+
     runs = [d for d in ("intensity", "record") if d in response.dims]
     stacked = {name: value.broadcast_like(response).stack(_run=runs) for name, value in {"d": response, "im": im, **covariates}.items()}
     configurations = [d for d in stacked["d"].dims if d != "_run"]

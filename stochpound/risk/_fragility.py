@@ -34,7 +34,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import ArrayLike
-from scipy import special
 
 STATUS = ("fit", "never", "always", "separated", "decreasing", "empty")
 """Meaning of the integer ``status`` of a fit (its index in this tuple)."""
@@ -79,6 +78,8 @@ class Fragility:
 
 def lognormal_cdf(x: ArrayLike, theta: ArrayLike, beta: ArrayLike) -> np.ndarray:
     """Φ(ln(x/θ)/β), broadcast; with β = 0 the step 1[x ≥ θ]; NaN where θ or β is NaN."""
+    from scipy import special
+
     x, theta, beta = np.broadcast_arrays(*(np.asarray(value, dtype=float) for value in (x, theta, beta)))
     with np.errstate(divide="ignore", invalid="ignore"):
         z = (np.log(x) - np.log(theta)) / beta
@@ -247,6 +248,8 @@ def _degenerate(theta: np.ndarray, beta: np.ndarray, status: np.ndarray, step: n
 
 def _probit_loglik(u: np.ndarray, k: np.ndarray, n: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """Σ k ln Φ(a + b u) + (n − k) ln Φ(−(a + b u)) along the last axis."""
+    from scipy import special
+
     eta = a[..., None] + b[..., None] * u
     return (k * special.log_ndtr(eta) + (n - k) * special.log_ndtr(-eta)).sum(-1)
 
@@ -275,6 +278,8 @@ def _probit_fisher_scoring(u: np.ndarray, k: np.ndarray, n: np.ndarray, active: 
 
 def _scoring_step(u: np.ndarray, k: np.ndarray, n: np.ndarray, a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """One Fisher-scoring step (halved until the likelihood does not fall) and whether each fit still moves."""
+    from scipy import special
+
     eta = a[:, None] + b[:, None] * u
     log_phi = -0.5 * eta**2 - 0.5 * np.log(2.0 * np.pi)
     lower, upper = special.log_ndtr(eta), special.log_ndtr(-eta)
@@ -302,6 +307,8 @@ def _scoring_step(u: np.ndarray, k: np.ndarray, n: np.ndarray, a: np.ndarray, b:
 
 def _probit_start(u: np.ndarray, k: np.ndarray, n: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Starting (a, b): weighted least squares of the probits of the smoothed proportions on u."""
+    from scipy import special
+
     with np.errstate(invalid="ignore", divide="ignore"):
         z = special.ndtri((k + 0.5) / (n + 1.0))
         w = n
@@ -322,6 +329,8 @@ def _censored_newton(y: np.ndarray, observed: np.ndarray, censored: np.ndarray, 
 
     Newton's method on the concave log-likelihood in (δ, γ) = (1/σ, μ/σ), with step halving.
     """
+    from scipy import special
+
     sigma0 = np.where(std > 0.0, std, 0.5)
     delta, gamma = 1.0 / sigma0, mean / sigma0
 

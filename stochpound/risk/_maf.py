@@ -26,7 +26,6 @@ from collections.abc import Sequence
 import numpy as np
 import xarray as xr
 from numpy.typing import ArrayLike
-from scipy import optimize, special
 
 from stochpound.stats import interval, kernels
 from stochpound.risk._fragility import ALWAYS, DECREASING, EMPTY, NEVER, SEPARATED, STATUS
@@ -375,6 +374,8 @@ def _interval(sampled: xr.DataArray, estimate: xr.DataArray, left_out: xr.DataAr
 
 def _lognormal_integral(theta: np.ndarray, beta: np.ndarray, hz: HazardCurve, lo: float, hi: float) -> np.ndarray:
     """F(lo) λ(lo) + ∫ λ(θ e^{βz}) φ(z) dz over z in the hazard's range (composite Gauss–Legendre), per element."""
+    from scipy import special
+
     log_theta = np.log(theta)
     with np.errstate(divide="ignore"):
         z_lo = (np.log(lo) - log_theta) / beta
@@ -421,6 +422,8 @@ def non_increasing(maf: np.ndarray) -> np.ndarray:
     numpy.ndarray
         The non-increasing rates, same shape.
     """
+    from scipy import optimize
+
     maf = np.asarray(maf, dtype=float)
     rows = maf.reshape(-1, maf.shape[-1])
     fitted = np.full_like(rows, np.inf)

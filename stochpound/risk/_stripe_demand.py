@@ -34,7 +34,6 @@ from collections.abc import Sequence
 
 import numpy as np
 import xarray as xr
-from scipy import special
 
 from stochpound.hazard import HazardCurve
 
@@ -108,6 +107,8 @@ def _stripe_moments(values: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndar
 
 def _rate_kernel(values: np.ndarray, levels: np.ndarray, thresholds: np.ndarray, hz: HazardCurve) -> np.ndarray:
     """λ_D at every threshold from runs (..., stripe, run)."""
+    from scipy import special
+
     mean, std, fraction = _stripe_moments(values)
     log_levels = np.log(levels)
     lo, hi = hz.support

@@ -18,7 +18,6 @@ from __future__ import annotations
 
 import numpy as np
 from numpy.polynomial import chebyshev
-from scipy.integrate import BDF, DOP853, LSODA, RK23, RK45, Radau
 from threadpoolctl import threadpool_limits
 
 from stochpound._errors import StochpoundError
@@ -31,7 +30,8 @@ from stochpound.results.record import EventCounters, Recorder
 from stochpound.solvers import engine
 from stochpound.solvers.driver import EngineRun, VisitedModes
 
-INTEGRATORS = {"DOP853": DOP853, "RK45": RK45, "RK23": RK23, "Radau": Radau, "BDF": BDF, "LSODA": LSODA}
+INTEGRATORS = ("DOP853", "RK45", "RK23", "Radau", "BDF", "LSODA")
+"""The integrators of ``scipy.integrate`` a run can name (imported on first use: scipy.integrate takes a second to load)."""
 _IMPLICIT = {"Radau", "BDF", "LSODA"}
 SUPPLIED_DEGREE = 12
 """Chebyshev degree of a supplied step: at least the degree of every integrator's dense output (LSODA's Adams order ≤ 12)."""
@@ -84,7 +84,9 @@ class IntegratorSteps:
         self.readouts = Readouts(system)
         self.size = 2 * system.n_dof
         self.motion = motion
-        self.name, self.integrator, self.implicit = integrator, INTEGRATORS[integrator], integrator in _IMPLICIT
+        from scipy import integrate
+
+        self.name, self.integrator, self.implicit = integrator, getattr(integrate, integrator), integrator in _IMPLICIT
         self.rtol, self.atol = rtol, atol
         self.solver = None
         self.span: tuple[Mode, int] | None = None

@@ -22,7 +22,6 @@ from collections.abc import Sequence
 
 import numpy as np
 import xarray as xr
-from scipy import special
 
 from stochpound.stats._earthquakes import earthquake_identities
 
@@ -251,6 +250,8 @@ def interval(samples: np.ndarray, estimate: np.ndarray, jackknife: np.ndarray | 
 
 def _bca_levels(samples: np.ndarray, estimate: np.ndarray, jackknife: np.ndarray, levels: np.ndarray) -> np.ndarray:
     """The BCa percentile levels (…, 2); the plain ones where z0 or the acceleration is not finite."""
+    from scipy import special
+
     with np.errstate(invalid="ignore", divide="ignore", over="ignore"), warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)
         valid = ~np.isnan(samples)

@@ -25,7 +25,6 @@ from functools import lru_cache
 from typing import NamedTuple
 
 import numpy as np
-from scipy import stats
 
 from stochpound.stats._bootstrap import bootstrap_weights
 
@@ -235,6 +234,8 @@ def clopper_pearson(successes: np.ndarray, trials: np.ndarray, confidence: float
         The bounds in [0, 1]; equal to scipy's
         ``binomtest(k, n).proportion_ci(confidence, method="exact")``.
     """
+    from scipy import stats
+
     check_confidence(confidence)
     k, n = np.broadcast_arrays(np.asarray(successes, dtype=np.float64), np.asarray(trials, dtype=np.float64))
     alpha = 1.0 - confidence
@@ -254,6 +255,8 @@ def t_interval(mean: np.ndarray, std: np.ndarray, count: np.ndarray, confidence:
         mean ∓ t_{n−1, (1+c)/2} · std / sqrt(n); NaN for n < 2. Equal to
         ``scipy.stats.t.interval(c, n − 1, mean, std / sqrt(n))``.
     """
+    from scipy import stats
+
     check_confidence(confidence)
     n = np.asarray(count, dtype=np.float64)
     with np.errstate(invalid="ignore", divide="ignore"):

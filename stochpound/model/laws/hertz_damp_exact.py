@@ -30,9 +30,6 @@ from __future__ import annotations
 from functools import lru_cache
 from typing import Any, Mapping
 
-from scipy.integrate import solve_ivp
-from scipy.optimize import brentq
-
 from stochpound.model import fields
 from stochpound.model.laws.contract import ElementParameters
 from stochpound.model.laws.hertz import HertzDamp
@@ -54,6 +51,7 @@ def realised_restitution(xi: float) -> float:
     float
         −x'(τ_end) of x'' = −x^{3/2} (1 + ξ x'), x(0) = 0, x'(0) = 1, at the return to x = 0.
     """
+    from scipy.integrate import solve_ivp
 
     def rate(tau: float, y: list[float]) -> list[float]:
         x = max(y[0], 0.0)
@@ -81,6 +79,8 @@ def damping_ratio(restitution: float) -> float:
     float
         ξ ≥ 0 with :func:`realised_restitution` (ξ) = e (root found to 1e-12 in ξ); 0 for e = 1.
     """
+    from scipy.optimize import brentq
+
     if restitution >= 1.0:
         return 0.0
     upper = 8.0 * (1.0 - restitution) / (5.0 * restitution)  # Ye, Li & Zhu's ξ: realises a little less than e
