@@ -24,9 +24,8 @@ from stochpound._errors import ExperimentError, field_errors
 from stochpound._text_files import read_text_file
 from stochpound.experiment._spec import _base_scene
 from stochpound.analysis import RESPONSES
-from stochpound.model import fields as toml_fields
 from stochpound.motions import SYNTHETIC_TYPES, normal_motion
-from stochpound.store import building_names, canonical_json
+from stochpound.store import TomlTable, building_names, canonical_json
 
 TABLE = "rare_event"
 """The experiment file's table that makes it a rare-event experiment."""
@@ -162,87 +161,71 @@ def load_rare_event(path: str | Path) -> RareEventDefinition:
     path = Path(path)
     data = tomllib.loads(read_text_file(path, ExperimentError))
     with field_errors():
-        toml_fields.reject_unknown(data, _TOP_KEYS, "")
-        header = dict(toml_fields.table(data, "experiment", "") or {})
-        toml_fields.reject_unknown(header, {"name", "description", "scene"}, "experiment")
-        name = toml_fields.string(header, "name", "experiment", default=path.stem)
-    description = header.get("description", "")
-    if not isinstance(description, str):
-        raise ExperimentError(f"experiment.description: must be a string, got {description!r}")
-    scene, _ = _base_scene(data, header, path.parent)
+        file = TomlTable(data, "", _TOP_KEYS)
+        header = file.table_or_empty("experiment", {"name", "description", "scene"})
+        name = header.string("name", path.stem)
+        description = header.raw("description", "")
+        if not isinstance(description, str):
+            raise header.error("description", f"must be a string, got {description!r}")
+    scene, _ = _base_scene(file, header, path.parent)
     label, motion = _motion(data, scene)
     table = parse_rare_event(data[TABLE], label, building_names(scene), scene)
     scene = {key: value for key, value in scene.items() if key != "motion"}
     return RareEventDefinition(name, description, scene, motion, table, str(path))
 
 
-def parse_rare_event(table: Any, motion: str, buildings: list[str], scene: Mapping[str, Any]) -> RareEventTable:
+def parse_rare_event(values: Any, motion: str, buildings: list[str], scene: Mapping[str, Any]) -> RareEventTable:
     """The ``[rare_event]`` table, typed and checked against the scene (``motion``: the label of the file's synthetic motion)."""
-    if not isinstance(table, dict):
+    if not isinstance(values, dict):
         raise ExperimentError(f"{TABLE}: must be a table (method, response, target_probability, samples_per_level, p0, seed)")
     with field_errors():
-        toml_fields.reject_unknown(table, _KEYS, TABLE)
-        method = _choice(table, "method", METHODS, "subset")
-        response = _choice(table, "response", RESPONSE_CHOICES, None)
-        target = toml_fields.number(table, "target_probability", TABLE, required=True, low=0.0, low_open=True, high=0.1)
-        p0 = toml_fields.number(table, "p0", TABLE, default=0.1, low=0.0, low_open=True, high=0.5)
-        samples = _integer(table, "samples_per_level", 10, 10**6, None)
-        seed = _integer(table, "seed", 0, 2**63 - 1, None)
-        max_levels = _integer(table, "max_levels", 2, 40, 20)
+        table = TomlTable(values, TABLE, _KEYS)
+        method = table.string("method", "subset", choices=METHODS)
+        response = table.string("response", choices=RESPONSE_CHOICES)
+        target = table.number("target_probability", low=0.0, low_open=True, high=0.1)
+        p0 = table.number("p0", 0.1, low=0.0, low_open=True, high=0.5)
+        samples = table.integer("samples_per_level", low=10, high=10**6)
+        seed = table.integer("seed", low=0, high=2**63 - 1)
+        max_levels = table.integer("max_levels", 20, low=2, high=40)
         chains = round(p0 * samples)
         if chains < 1 or not math.isclose(chains, p0 * samples) or samples % chains:
-            raise ExperimentError(f"{TABLE}.samples_per_level: p0 × samples_per_level must be an integer that divides it (p0 = {p0:g}), got {samples}")
-        if table.get("motion", motion) != motion:
-            raise ExperimentError(f"{TABLE}.motion: must name the file's synthetic motion ({motion}), got {table['motion']!r}")
+            raise table.error("samples_per_level", f"p0 × samples_per_level must be an integer that divides it (p0 = {p0:g}), got {samples}")
+        if table.raw("motion", motion) != motion:
+            raise table.error("motion", f"must name the file's synthetic motion ({motion}), got {table.raw('motion')!r}")
         where = _where(table, response, buildings, scene)
     return RareEventTable(method, response, target, samples, p0, seed, motion, max_levels=max_levels, **where)
 
 
-def _where(table: Mapping[str, Any], response: str, buildings: list[str], scene: Mapping[str, Any]) -> dict[str, Any]:
+def _where(table: TomlTable, response: str, buildings: list[str], scene: Mapping[str, Any]) -> dict[str, Any]:
     """The contact, building, floor, limit state and capacity the response needs (and no other)."""
-    limit_state = _choice(table, "limit_state", tuple(LIMIT_STATES), None) if response == "limit_state" else None
+    limit_state = table.string("limit_state", choices=tuple(LIMIT_STATES)) if response == "limit_state" else None
     sampled = LIMIT_STATES[limit_state] if limit_state else response
     needs = {"contact"} if sampled in ("closure", "impact_force") else {"building"} | ({"floor"} if sampled == "peak_storey_drift" else set())
     needs |= {"limit_state", "capacity"} if limit_state else set()
     for key in ("contact", "building", "floor", "limit_state", "capacity"):
         if key in table and key not in needs:
-            raise ExperimentError(f"{TABLE}.{key}: not used by response = {response!r} (it takes {', '.join(sorted(needs))})")
+            raise table.error(key, f"not used by response = {response!r} (it takes {', '.join(sorted(needs))})")
     found: dict[str, Any] = {}
     if "contact" in needs:
         contacts = len(scene.get("contact", []))
         if not contacts:
-            raise ExperimentError(f"{TABLE}.response: {response!r} needs a contact, and the scene has none")
-        found["contact"] = _integer(table, "contact", 0, contacts - 1, 0)
+            raise table.error("response", f"{response!r} needs a contact, and the scene has none")
+        found["contact"] = table.integer("contact", 0, low=0, high=contacts - 1)
     if "building" in needs:
-        found["building"] = _choice(table, "building", tuple(buildings), buildings[0] if len(buildings) == 1 else None)
+        single = {"default": buildings[0]} if len(buildings) == 1 else {}  # one building: the default
+        found["building"] = table.string("building", **single, choices=tuple(buildings))
         if sampled == "base_displacement" and not isinstance(_building(scene, found["building"]).get("base"), dict):
-            raise ExperimentError(f"{TABLE}.building: {found['building']!r} has a fixed base ({sampled} needs a sliding base)")
+            raise table.error("building", f"{found['building']!r} has a fixed base ({sampled} needs a sliding base)")
     if "floor" in needs:
-        found["floor"] = _integer(table, "floor", 1, len(_building(scene, found["building"]).get("mass", [])), None)
+        found["floor"] = table.integer("floor", low=1, high=len(_building(scene, found["building"]).get("mass", [])))
     if limit_state:
         found["limit_state"] = limit_state
-        found["capacity"] = toml_fields.number(table, "capacity", TABLE, required=True, low=0.0, low_open=True)
+        found["capacity"] = table.number("capacity", low=0.0, low_open=True)
     return found
 
 
 def _building(scene: Mapping[str, Any], name: str) -> Mapping[str, Any]:
     return next(b for b in scene.get("building", []) if b.get("name") == name)
-
-
-def _choice(table: Mapping[str, Any], key: str, allowed: tuple[str, ...], default: str | None) -> str:
-    value = table.get(key, default)
-    if value not in allowed:
-        got = "missing" if key not in table else f"got {value!r}"
-        raise ExperimentError(f"{TABLE}.{key}: must be one of {', '.join(allowed)}, {got}")
-    return value
-
-
-def _integer(table: Mapping[str, Any], key: str, low: int, high: int, default: int | None) -> int:
-    value = table.get(key, default)
-    if isinstance(value, bool) or not isinstance(value, int) or not low <= value <= high:
-        got = "missing" if key not in table else f"got {value!r}"
-        raise ExperimentError(f"{TABLE}.{key}: must be an integer in [{low}, {high}], {got}")
-    return value
 
 
 def _motion(data: Mapping[str, Any], scene: Mapping[str, Any]) -> tuple[str, dict[str, Any]]:
