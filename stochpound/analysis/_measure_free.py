@@ -61,7 +61,7 @@ from stochpound._errors import SiteError
 from stochpound.analysis._subset_simulation import RESPONSES, _reader
 from stochpound.hazard import RuptureSite, rate_from_probability
 from stochpound.model.scene import Scene
-from stochpound.motions import SITE_MOTION_LIMITS, site_model_provenance, site_motions
+from stochpound.motions import SITE_MOTION_LIMITS, Scenario, site_model_provenance, site_motions
 from stochpound.motions.ground import SampledMotion
 from stochpound.solvers.simulate import simulate
 from stochpound.stats import kernels
@@ -120,7 +120,7 @@ class MeasureFreeDemand:
 class _Rupture:
     """How one rupture's motions are drawn: the scenario run, its seed, window and whether it was clamped to the model's range."""
 
-    scenario: dict[str, Any]
+    scenario: Scenario
     seed: int
     duration: float
     clamped: str
@@ -358,7 +358,7 @@ def _rupture(site: RuptureSite, index: int, outside: str, seed: int, most: int, 
     """Rupture ``index``'s motions: its scenario within the model's range (or refused), its seed and window."""
     row = site.row(index)
     asked = {"magnitude": row["magnitude"], "distance_km": row["distance_rup_km"], "vs30": site.vs30}
-    scenario, clamped = dict(asked), []
+    run, clamped = dict(asked), []
     for field, value in asked.items():
         low, high = SITE_MOTION_LIMITS[field]
         if low <= value <= high:
@@ -367,11 +367,11 @@ def _rupture(site: RuptureSite, index: int, outside: str, seed: int, most: int, 
         if outside == "refuse":
             raise SiteError(f"{where}: {value:g} is outside the site-motion model's range {low:g}-{high:g} "
                             "(outside='clamp' runs it at the range's edge and gives its part of the rate apart)")
-        scenario[field] = min(max(value, low), high)
-        clamped.append(f"{field} {value:g} -> {scenario[field]:g}")
-    scenario["mechanism"] = row["mechanism"]
+        run[field] = min(max(value, low), high)
+        clamped.append(f"{field} {value:g} -> {run[field]:g}")
+    scenario = Scenario(**run, mechanism=row["mechanism"])
     motion_seed = int(np.random.SeedSequence([seed, index]).generate_state(1)[0])
-    first = site_motions(**scenario, n=most, seed=motion_seed, dt=dt, model=model, realizations=[0])
+    first = site_motions(scenario=scenario, n=most, seed=motion_seed, dt=dt, model=model, realizations=[0])
     return _Rupture(scenario, motion_seed, float(first["time"].values[-1]), "; ".join(clamped))
 
 
@@ -403,11 +403,11 @@ def _chunks(indices: list[int]) -> list[list[int]]:
 
 def run_task(task: _Task) -> np.ndarray:
     """The demands (realization, demand) of one batch: its motions generated and each run (a worker's job; module-level so that it pickles)."""
-    generated = site_motions(**task.rupture.scenario, n=task.n, seed=task.rupture.seed, dt=task.dt, duration=task.rupture.duration,
+    generated = site_motions(scenario=task.rupture.scenario, n=task.n, seed=task.rupture.seed, dt=task.dt, duration=task.rupture.duration,
                              model=task.model, realizations=list(task.realizations))
     readers = [response_reader(task.scene, demand) for demand in task.demands]
     drift = any(demand.response == "peak_storey_drift" for demand in task.demands)
-    label = f"site motion of M {task.rupture.scenario['magnitude']:g} at {task.rupture.scenario['distance_km']:g} km"
+    label = f"site motion of M {task.rupture.scenario.magnitude:g} at {task.rupture.scenario.distance_km:g} km"
     runs = (simulate(replace(task.scene, motion=SampledMotion(task.dt, a, "linear", label)), demands=drift) for a in generated["acceleration"].values)
     return np.array([[read(run) for read in readers] for run in runs], dtype=float).reshape(-1, len(readers))
 
@@ -547,9 +547,9 @@ def _dataset(estimate: _Estimate, site: RuptureSite, ruptures: list[_Rupture], v
         "exceedance_probability": (("rupture", "threshold"), estimate.probability, {"units": "1", "long_name": "fraction of the rupture's runs beyond the threshold"}),
         "rate": ("rupture", np.asarray(site.rate, dtype=float), {**rate_attrs, "long_name": "annual rate of occurrence of the rupture"}),
         "motions": ("rupture", np.array([v.size for v in values]), {"units": "1", "long_name": "runs of the rupture's simulated motions"}),
-        "magnitude": ("rupture", np.array([r.scenario["magnitude"] for r in ruptures], dtype=float), {"units": "1", "long_name": "magnitude of the motions run"}),
-        "distance_km": ("rupture", np.array([r.scenario["distance_km"] for r in ruptures], dtype=float), {"units": "km", "long_name": "R_rup of the motions run"}),
-        "mechanism": ("rupture", np.array([r.scenario["mechanism"] for r in ruptures], dtype=object)),
+        "magnitude": ("rupture", np.array([r.scenario.magnitude for r in ruptures], dtype=float), {"units": "1", "long_name": "magnitude of the motions run"}),
+        "distance_km": ("rupture", np.array([r.scenario.distance_km for r in ruptures], dtype=float), {"units": "km", "long_name": "R_rup of the motions run"}),
+        "mechanism": ("rupture", np.array([r.scenario.mechanism for r in ruptures], dtype=object)),
         "clamped": ("rupture", np.array([r.clamped for r in ruptures], dtype=object), {"long_name": "what was clamped to the site-motion model's range"}),
         "motion_seed": ("rupture", np.array([r.seed for r in ruptures], dtype=np.int64), {"long_name": "seed of the rupture's site_motions"}),
         "motion_duration": ("rupture", np.array([r.duration for r in ruptures]), {"units": "s", "long_name": "window of the rupture's site_motions"}),
