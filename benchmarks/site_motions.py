@@ -218,7 +218,10 @@ def _introduction(table: Any, info: dict[str, str], elapsed: float, held_out: bo
            f"`python -m benchmarks site_motions check{' --held-out' if held_out else ''}` rewrites this section")
     scenarios = ("scenarios that are not among the calibration's 14 (the command refuses any that its data file lists), "
                  "simulated with the calibrated model (`hazard_compatible`): " if held_out else "scenarios, ")
-    return (f"{len(table.scenarios)} {scenarios}{table.n} motions each, dt = 0.01 s ({run}). "
+    where = ("They lie mostly midway between the fit's magnitudes, distances and Vs30 (the fit's own scenarios: the calibration check "
+             "in the motions guide, section \"Calibration to the NGA-West2 models\"); pygmm warns that normal faulting above M 7 lies outside "
+             "some of the four models' recommended range, as at the fit's M 7.5 normal scenario. " if held_out else "")
+    return (f"{len(table.scenarios)} {scenarios}{table.n} motions each, dt = 0.01 s ({run}). {where}"
             "ln of the simulated median over the NGA-West2 average's (first row of a scenario) and σ_sim − σ_NGA-West2 of ln Sa "
             "(second row), at PGA and 5 %-damped PSA(T), T in s:")
 
