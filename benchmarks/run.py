@@ -86,8 +86,8 @@ def main(argv: list[str] | None = None) -> int:
     figure = report.figure(results, folder / "figures" / report.FIGURE_NAME)
     markdown = folder / "benchmarks.md"
     old = markdown.read_text() if markdown.exists() else ""
-    sections = (experiment_scale.SECTION, compare.SECTION, spectrum.SECTION, yielding.SECTION, site_motions.SECTION, startup.SECTION, measure_free.SECTION,
-                rare_moat.SECTION)
+    sections = (experiment_scale.SECTION, compare.SECTION, spectrum.SECTION, yielding.SECTION, site_motions.SECTION, site_motions.HELD_OUT,
+                startup.SECTION, measure_free.SECTION, rare_moat.SECTION)
     sections += (measure_comparison.SECTION,)
     markdown.write_text(keep_sections(old, report.document(results, info, elapsed), sections))
     print(f"wrote {markdown} and {figure} in {elapsed:.1f} s")
