@@ -33,6 +33,7 @@ import xarray as xr
 from matplotlib.figure import Figure
 from matplotlib.ticker import LogLocator, NullFormatter
 
+from stochpound._plurals import counted
 from stochpound.analysis import CellLabels
 from stochpound.report.render import Block, FigureItem, Paragraph, Section, Table, figures
 from stochpound.report.sections._facets import labels_text
@@ -232,7 +233,7 @@ def design_value_text(risk: StoreRisk) -> str:
 
 def _motions_text(risk: StoreRisk) -> str:
     """``N motions``, or ``1 motion``."""
-    return f"{risk.motions} motion{'s' if risk.motions != 1 else ''}"
+    return counted(risk.motions, "motion")
 
 
 def moat_text(risk: StoreRisk, demands: StoreDemands | None) -> str:
