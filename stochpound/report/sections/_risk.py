@@ -319,6 +319,8 @@ def _measure_choice_blocks(name: str, risk: StoreRisk, choice: pd.DataFrame | No
     """Which measure: the most efficient the site's hazard has per configuration, against the store's own, with the estimate's noise."""
     if choice is None or choice.empty or not choice.attrs.get("hazard_measures"):
         return []
+    if choice.attrs["unjudged"]:
+        return [Paragraph(f"Which measure: {choice.attrs['unjudged']}.")]
     measures, own = choice.attrs["hazard_measures"], choice.attrs["store_measure"]
     counts = choice["most efficient"].value_counts()
     best = ", ".join(f"{label} in {count} of {len(choice)} configurations" for label, count in counts.items())
