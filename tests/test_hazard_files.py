@@ -16,6 +16,7 @@ from stochpound.analysis import HazardCurve, bundled_measure
 from stochpound.motions import Measure
 from stochpound.hazard._files import (
     StatedMeasure,
+    parse_units,
     read_hazard_file,
     unit_factor,
 )
@@ -41,6 +42,17 @@ def test_a_stated_measure_is_parsed_from_the_usual_spellings():
     assert StatedMeasure.parse("SA1P0") == StatedMeasure("psa", 1.0)
     with pytest.raises(ValueError, match="^measure: 'MMI' names no measure"):
         StatedMeasure.parse("MMI")
+
+
+def test_hazard_units_are_read_in_the_records_spellings():
+    """Issue 48: the hazard's units took their own short list of spellings; now the records' reader's, and m/s, cm/s for PGV."""
+    for written, units in [("cm/s^2", "cm/s2"), ("Gal", "cm/s2"), ("cm/sec/sec", "cm/s2"), ("m s-2", "m/s2"), ("G", "g"), ("cm / s", "cm/s")]:
+        assert parse_units(written) == units, written
+    assert StatedMeasure.parse("PGA in cm/s^2") == StatedMeasure("pga", units="cm/s2")
+    assert StatedMeasure.parse("PSA(1.0 s, 5 %), in m s-2") == StatedMeasure("psa", 1.0, damping=0.05, units="m/s2")
+    assert StatedMeasure.parse("PGA in mm/s2") == StatedMeasure("pga")  # no units it knows at the end: none stated, as before
+    with pytest.raises(ValueError, match=r"^units: must be one of g, m/s2, cm/s2, m/s, cm/s \(or gal, .*got 'mm/s2'$"):
+        parse_units("mm/s2")
 
 
 def test_a_stated_measure_is_a_value_with_what_the_text_leaves_out_left_none():

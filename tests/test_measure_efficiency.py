@@ -117,6 +117,28 @@ def test_the_report_names_the_most_efficient_measure_and_weighs_the_stores_own_a
     assert _measure_choice_blocks("s", risk, None) == []
 
 
+def test_one_motion_per_stripe_names_no_most_efficient_measure(fixed_stores) -> None:
+    """Issue 48: with one motion scaled to every stripe every measure fits exactly (β ≈ 0), and the least β named a measure
+    "most efficient" from round-off; now the choice, stochpound risk and the report say it cannot be judged."""
+    from stochpound.cli._measure_choice import efficient_measure_lines
+    from stochpound.experiment import measure_choice
+    from stochpound.experiment._measure_choice import ONE_MOTION
+    from stochpound.report.sections._risk import _measure_choice_blocks
+    from stochpound.risk import HazardCurve, StoreRisk
+
+    store = open_store(fixed_stores[0]).load()
+    assert measure_choice(store, "fox_plaza_los_angeles_sa1p0s").attrs["unjudged"] == ""
+    one = store.isel(record=[0])
+    choice = measure_choice(one, "fox_plaza_los_angeles_sa1p0s")
+    assert choice.attrs["unjudged"] == ONE_MOTION and ONE_MOTION.startswith("efficiency cannot be judged from one motion per stripe")
+    assert (choice["most efficient"] == "").all() and (choice["best candidate"] == "").all() and choice["best β"].isna().all()
+    assert float(choice[choice.attrs["hazard_measures"]].abs().max().max()) < 1e-6  # the fit is exact: β is round-off
+    assert efficient_measure_lines(one, "fox_plaza_los_angeles_sa1p0s") == ["", f"Which measure: {ONE_MOTION}."]
+    risk = StoreRisk(xr.Dataset(), xr.Dataset(), xr.Dataset(), None, "", HazardCurve.power_law(1e-4, 2.0), 1, "stripes", stripes=5)
+    blocks = _measure_choice_blocks("s", risk, choice)
+    assert len(blocks) == 1 and blocks[0].text == f"Which measure: {ONE_MOTION}." and "most efficient" not in blocks[0].text
+
+
 def test_a_hazard_in_the_stores_measure_only_is_not_called_a_comparison() -> None:
     import pandas as pd
 
@@ -124,7 +146,7 @@ def test_a_hazard_in_the_stores_measure_only_is_not_called_a_comparison() -> Non
     from stochpound.risk import HazardCurve, StoreRisk
 
     choice = pd.DataFrame([{"where": "all runs", "PSA(1 s)": 0.5, "most efficient": "PSA(1 s)", "best candidate": "PGV", "best β": 0.4}])
-    choice.attrs.update(hazard_measures=["PSA(1 s)"], store_measure="PSA(1 s)")
+    choice.attrs.update(hazard_measures=["PSA(1 s)"], store_measure="PSA(1 s)", unjudged="")
     risk = StoreRisk(xr.Dataset(), xr.Dataset(), xr.Dataset(), None, "", HazardCurve.power_law(1e-4, 2.0), 20, "stripes", stripes=7)
     text = _measure_choice_blocks("s", risk, choice)[0].text
     assert "no other measure is compared with it" in text and "the most efficient in every" not in text
@@ -139,7 +161,7 @@ def test_the_verdict_on_the_stores_own_measure_follows_the_numbers(own_beta: flo
 
     choice = pd.DataFrame([{"where": "all runs", "PGA": 0.50, "PSA(1 s)": own_beta, "most efficient": "PGA" if own_beta > 0.50 else "PSA(1 s)",
                             "best candidate": "PGV", "best β": 0.4}])
-    choice.attrs.update(hazard_measures=["PGA", "PSA(1 s)"], store_measure="PSA(1 s)")
+    choice.attrs.update(hazard_measures=["PGA", "PSA(1 s)"], store_measure="PSA(1 s)", unjudged="")
     risk = StoreRisk(xr.Dataset(), xr.Dataset(), xr.Dataset(), None, "", HazardCurve.power_law(1e-4, 2.0), 20, "stripes",
                      setting={"measure": "psa", "period": 1.0, "units": "g"}, stripes=7)
     text = _measure_choice_blocks("s", risk, choice)[0].text

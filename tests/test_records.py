@@ -245,6 +245,19 @@ def test_cli_show_substitute_and_file(tmp_path):
     assert result.exit_code != 0 and "missing dt" in result.output
 
 
+def test_cli_units_take_the_readers_spellings(tmp_path):
+    """Issue 48: --units took only g, m/s2 and cm/s2; now every spelling the reader knows, and an unknown one is a one-line error."""
+    path = tmp_path / "one.txt"
+    path.write_text("98.1\n-196.2\n49.05\n")
+    outputs = {units: _cli("show", str(path), "--dt", "0.02", "--units", units) for units in ("cm/s2", "gal", "cm/s²", "cm/s/s")}
+    assert all(result.exit_code == 0 for result in outputs.values()), [result.output for result in outputs.values()]
+    assert len({result.output for result in outputs.values()}) == 1 and "0.2000" in outputs["gal"].output  # peak in g
+    result = _cli("spectrum", str(path), "--dt", "0.02", "--units", "mm/s2")
+    error = [line for line in result.output.splitlines() if line.startswith("Error")]
+    assert result.exit_code == 2 and len(error) == 1, result.output
+    assert "'--units'" in error[0] and "units must be one of g, m/s2, cm/s2 (or gal," in error[0] and "'mm/s2'" in error[0]
+
+
 def test_cli_is_registered():
     from stochpound.cli import main
 

@@ -2,12 +2,14 @@
 
 from __future__ import annotations
 
+import dataclasses
 import re
 
 import numpy as np
 import pytest
 
 from stochpound import open_store
+from stochpound._plurals import counted
 from stochpound.experiment._runner import load_experiment, run_experiment
 from stochpound.report.sections._intensity import method_text
 from stochpound.report.sections._stripe_motions import stripe_motions_text
@@ -39,6 +41,19 @@ def test_a_selection_store_says_motions_per_stripe_from_a_pool_with_the_scale_fa
 def test_a_suite_store_says_every_motion_is_scaled_to_every_level(cs_store) -> None:
     suite = cs_store.drop_vars([name for name in cs_store.variables if str(name).startswith(("selection_", "site_", "target_"))])
     assert stripe_motions_text(suite) == "8 motions, each scaled to every level"
+
+
+def test_one_motion_is_written_in_the_singular(cs_store) -> None:
+    """Issue 47: a one-record store read "1 motions" in its stripe, IDA and record-suite texts."""
+    one = cs_store.drop_vars([name for name in cs_store.variables if str(name).startswith(("selection_", "site_", "target_"))]).isel(record=[0])
+    assert stripe_motions_text(one) == "1 motion, each scaled to every level"
+    ida = dataclasses.replace(one.pound.intensity, ran="ida", note="a note")
+    assert " 1 motion: each run once without contacts;" in method_text(one, ida)
+    scale = cs_store["selection_scale_factor"]
+    first = scale.notnull().cumsum("record") == 1
+    single = cs_store.assign(selection_scale_factor=scale.where(first & scale.notnull()))
+    assert stripe_motions_text(single).startswith("1 motion per stripe, chosen by conditional-spectrum selection from a pool of 8")
+    assert counted(1, "record file") == "1 record file" and counted(0, "motion") == "0 motions" and counted(22, "motion") == "22 motions"
 
 
 def test_a_configuration_s_scene_is_read_from_a_case_that_ran_where_the_first_motion_was_not_chosen(cs_store) -> None:

@@ -116,6 +116,18 @@ def test_bad_records_are_rejected(tmp_path, text, extra, message):
     assert message in rejected(lambda s: s.update(motion=record_motion(tmp_path, text, **extra)), tmp_path)
 
 
+def test_a_record_s_units_are_read_in_the_records_spellings(tmp_path):
+    """Issue 48: [motion] units took only g, m/s2 and cm/s2; now every spelling the records' reader knows (gal, cm/s², ...)."""
+    text = "0.0\n981.0\n-490.5\n0.0\n"
+    motions = {units: stochpound.scene_from_dict({**copy.deepcopy(VALID), "motion": record_motion(tmp_path, text, dt=0.02, units=units)},
+                                                 base_dir=tmp_path).motion for units in ("cm/s2", "gal", "cm/s²", "cm/s/s")}
+    samples = [motion.values for motion in motions.values()]
+    np.testing.assert_allclose(samples[0], [0.0, 9.81, -4.905, 0.0], rtol=1e-12)
+    assert all(np.array_equal(other, samples[0]) for other in samples[1:])
+    message = rejected(lambda s: s.update(motion=record_motion(tmp_path, text, dt=0.02, units="mm/s2")), tmp_path)
+    assert message.startswith("motion.units must be one of g, m/s2, cm/s2 (or gal,") and message.endswith("got 'mm/s2'") and "\n" not in message
+
+
 def test_missing_record_is_rejected():
     assert "motion.record" in rejected(lambda s: s.update(motion={"record": "no_such_record"}))
 

@@ -10,6 +10,8 @@ def efficient_measure_lines(store: Any, hazard: str | None) -> list[str]:
     from stochpound.experiment import measure_choice
 
     frame = measure_choice(store, hazard)
+    if frame.attrs["unjudged"]:
+        return ["", f"Which measure: {frame.attrs['unjudged']}."]
     lines = ["", "Which measure (β: dispersion of ln(peak closure) given the measure, over the contact-free runs; smaller needs fewer motions):"]
     for _, row in frame.iterrows():
         given = "; ".join(f"{label} {row[label]:.3f}" for label in frame.attrs["hazard_measures"])

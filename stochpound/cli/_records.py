@@ -12,6 +12,18 @@ from stochpound._errors import RecordError
 from stochpound.motions import DEFAULT_G
 
 
+def _units_option(context: click.Context, parameter: click.Parameter, units: str | None) -> str | None:
+    """The ``--units`` option's value in its canonical spelling (g, m/s2 or cm/s2); None when not given."""
+    from stochpound.motions.records import normalize_units
+
+    if units is None:
+        return None
+    try:
+        return normalize_units(units)
+    except ValueError as error:
+        raise click.BadParameter(str(error)) from None
+
+
 @click.group("records", cls=HelpGroup)
 def records() -> None:
     """Bundled ground-motion records (and record files)."""
@@ -62,7 +74,8 @@ def _list_suite(suite: str) -> None:
 @click.option("--g", "g", type=float, default=DEFAULT_G, show_default=True,
               help="g (m/s²) for conversions, peak in g and Arias intensity (the study's Table 3.2 used 9.814).")
 @click.option("--dt", type=float, default=None, help="Step (s) of a one-column text file.")
-@click.option("--units", type=click.Choice(["g", "m/s2", "cm/s2"]), default=None, help="Units of a text file's values.")
+@click.option("--units", callback=_units_option, default=None, metavar="UNITS",
+              help="Units of a text file's values: g, m/s2 or cm/s2, in any usual spelling (gal, cm/s², cm/s/s, m/s^2, ...).")
 def show_command(name: str, plot_path: str | None, g: float, dt: float | None, units: str | None) -> None:
     """Statistics of NAME (a bundled record or a file), with the reference study's Table 3.2 beside ours for its records."""
     from stochpound.motions.records import load_record, plot_record
@@ -111,7 +124,8 @@ def parse_periods(text: str) -> list[float]:
 @click.option("--plot", "plot_path", type=click.Path(dir_okay=False), default=None, help="Write a plot of PSA against period (PNG, PDF, SVG).")
 @click.option("--g", "g", type=float, default=DEFAULT_G, show_default=True, help="g (m/s²) for records in g, spectra in g and Arias intensity.")
 @click.option("--dt", type=float, default=None, help="Step (s) of a one-column text file.")
-@click.option("--units", type=click.Choice(["g", "m/s2", "cm/s2"]), default=None, help="Units of a text file's values.")
+@click.option("--units", callback=_units_option, default=None, metavar="UNITS",
+              help="Units of a text file's values: g, m/s2 or cm/s2, in any usual spelling (gal, cm/s², cm/s/s, m/s^2, ...).")
 def spectrum_command(name: str, periods_text: str, damping: float, plot_path: str | None, g: float, dt: float | None, units: str | None) -> None:
     """Intensity measures and the exact response spectrum of NAME (a bundled record, a suite's motion or a file)."""
     from stochpound.motions import intensity_measures

@@ -7,6 +7,7 @@ from pathlib import Path
 import click
 
 from stochpound import StochpoundError
+from stochpound._plurals import counted
 from stochpound._atomic import check_not_input
 from stochpound._errors import os_error_message
 from stochpound._text_files import read_text_file
@@ -167,7 +168,7 @@ def risk(store: Path, hazard: str | None, hazard_measure: str | None, hazard_uni
     stripes = f"{result.stripes} stripes" if result.stripes is not None else "IDA capacities"
     source = hz.source.splitlines()[0] if hz.source else hz.describe()
     done = f"{result.progress}, answered from the cases that ran (--partial); " if result.progress else ""
-    click.echo(f"{result.experiment or store.stem}: {done}{result.motions} motion{'s' if result.motions != 1 else ''}, {stripes} of {result.measure} "
+    click.echo(f"{result.experiment or store.stem}: {done}{counted(result.motions, 'motion')}, {stripes} of {result.measure} "
                f"in {result.setting.units}; hazard: {source}")
     if missed:
         click.echo(f"warning: the motions chosen for the site miss their conditional-spectrum target (mean or std of ln Sa off by more than "

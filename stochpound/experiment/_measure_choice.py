@@ -19,6 +19,10 @@ import pandas as pd
 from stochpound.experiment._site import periods_of_interest
 from stochpound.motions import Measure
 
+#: Why no measure is named most efficient when a stripe ran one motion (``measure_choice``'s ``unjudged``).
+ONE_MOTION = ("efficiency cannot be judged from one motion per stripe (or one motion in all): β is the scatter of the motions "
+              "about each measure's fit, and one motion has none")
+
 
 def hazard_measures(store: Any, hazard: str | None = None) -> dict[str, float | None]:
     """The measures the site's hazard is available in: name -> PSA period (s; None for PGA).
@@ -59,11 +63,13 @@ def measure_choice(store: Any, hazard: str | None = None) -> pd.DataFrame:
     pandas.DataFrame
         One row per configuration (its labels as columns, ``where`` in
         words), a column per hazard measure (β), ``most efficient`` (among
-        them; "" when the hazard has none), ``best candidate`` and ``best β``.
-        Its ``attrs``: ``hazard_measures`` (those columns' names) and
-        ``store_measure`` (the store's own measure, named alike: :attr:`stochpound.motions.Measure.label`; "" for none).
+        them; "" when the hazard has none), ``best candidate`` and ``best β``
+        ("" and NaN, and ``most efficient`` "", when a stripe ran one motion).
+        Its ``attrs``: ``hazard_measures`` (those columns' names),
+        ``store_measure`` (the store's own measure, named alike: :attr:`stochpound.motions.Measure.label`; "" for none)
+        and ``unjudged`` (why no measure is named, :data:`ONE_MOTION`; "" when one is).
     """
-    from stochpound.risk import candidate_name, measure_efficiency
+    from stochpound.risk import candidate_name, contact_free_closure, measure_efficiency, stripe_motions
 
     structure = periods_of_interest(store.pound.grid)
     available = hazard_measures(store, hazard)
@@ -71,6 +77,7 @@ def measure_choice(store: Any, hazard: str | None = None) -> pd.DataFrame:
     beta = measure_efficiency(store, candidates, structure, studied=store.pound.definition.studied)["beta"].sel(response="closure")
     names = {name: candidate_name(period, f"hazard {name}") for name, period in available.items()}
     configurations = [d for d in beta.dims if d != "measure"]
+    judged = stripe_motions(store, contact_free_closure(store)) > 1
     rows = []
     for index in np.ndindex(*[beta.sizes[d] for d in configurations]):
         cell = beta.isel(dict(zip(configurations, index)))
@@ -78,15 +85,16 @@ def measure_choice(store: Any, hazard: str | None = None) -> pd.DataFrame:
         row["where"] = ", ".join(f"{d}={cell[d].item()}" for d in configurations) or "all runs"
         hazard_betas = {label: float(cell.sel(measure=name)) for label, name in names.items()}
         row.update(hazard_betas)
-        row["most efficient"] = min(hazard_betas, key=lambda label: np.nan_to_num(hazard_betas[label], nan=np.inf)) if hazard_betas else ""
+        row["most efficient"] = min(hazard_betas, key=lambda label: np.nan_to_num(hazard_betas[label], nan=np.inf)) if hazard_betas and judged else ""
         own = cell.sel(measure=[m for m in cell["measure"].values if _of_configuration(str(m), structure, cell)])
         best = int(np.argmin(np.nan_to_num(own.values, nan=np.inf)))
-        row["best candidate"], row["best β"] = str(own["measure"].values[best]), float(own.values[best])
+        row["best candidate"], row["best β"] = (str(own["measure"].values[best]), float(own.values[best])) if judged else ("", np.nan)
         rows.append(row)
     frame = pd.DataFrame(rows)
     frame.attrs["hazard_measures"] = list(available)
     own = _store_measure(store)
     frame.attrs["store_measure"] = own.label if own is not None else ""
+    frame.attrs["unjudged"] = "" if judged else ONE_MOTION
     return frame
 
 

@@ -42,14 +42,14 @@ import numpy as np
 from stochpound._text_files import read_text_file
 from stochpound.hazard._curve import HazardCurve, rate_from_probability
 from stochpound.motions import Measure
+from stochpound.motions.records import normalize_units
 
 FORMATS = ("stochpound", "openquake", "nshmp-haz")
 """The hazard-file formats :func:`read_hazard_file` reads."""
 UNITS = {"g": ("acceleration", None), "m/s2": ("acceleration", 1.0), "cm/s2": ("acceleration", 0.01),
          "m/s": ("velocity", 1.0), "cm/s": ("velocity", 0.01)}
 """Units of a hazard's intensities: what they measure and their value in SI (None: g, the experiment's)."""
-_UNIT_ALIASES = {"g": "g", "m/s2": "m/s2", "m/s²": "m/s2", "m/s/s": "m/s2", "cm/s2": "cm/s2", "cm/s²": "cm/s2",
-                 "cm/s/s": "cm/s2", "gal": "cm/s2", "m/s": "m/s", "cm/s": "cm/s"}
+_VELOCITY_UNITS = tuple(name for name, (kind, _) in UNITS.items() if kind == "velocity")
 _TOOL_DAMPING = 0.05
 """Damping of the spectral accelerations of OpenQuake's and nshmp-haz's curves (their documented convention)."""
 _TOOL_UNITS = {"pga": "g", "psa": "g", "pgv": "cm/s"}
@@ -237,18 +237,30 @@ def unit_factor(source: str, target: str, g: float) -> float:
 
 
 def parse_units(text: str) -> str:
-    """Units as written (``g``, ``m/s²``, ``gal``, ...) in the spelling of ``g``, ``m/s2``, ``cm/s2``, ``m/s``, ``cm/s``."""
-    key = text.strip().lower().replace(" ", "")
-    if key not in _UNIT_ALIASES:
-        raise ValueError(f"units: must be one of {', '.join(UNITS)} (or cm/s², gal), got {text!r}")
-    return _UNIT_ALIASES[key]
+    """Units as written in the spelling of ``g``, ``m/s2``, ``cm/s2``, ``m/s``, ``cm/s``.
+
+    An acceleration's units in any spelling the records' reader knows
+    (:func:`~stochpound.motions.records.normalize_units`: ``gal``, ``m/s²``,
+    ``cm/s/s``, ``cm/s^2``, ...); a velocity's as ``m/s`` or ``cm/s``.
+
+    Raises
+    ------
+    ValueError
+        Naming ``units``: a spelling of none of these.
+    """
+    velocity = text.strip().lower().replace(" ", "")
+    if velocity in _VELOCITY_UNITS:
+        return velocity
+    try:
+        return normalize_units(text)
+    except ValueError:
+        raise ValueError(f"units: must be one of {', '.join(UNITS)} (or gal, cm/s², cm/s/s, cm/s^2, ...), got {text!r}") from None
 
 
 def _parsed(text: str) -> StatedMeasure:
     """What :meth:`StatedMeasure.parse` finds in ``text``."""
     lowered = text.strip().lower()
-    units = re.search(r"(?:\bin|,)\s*(g|m/s2|m/s²|m/s/s|cm/s2|cm/s²|cm/s/s|gal|m/s|cm/s)\s*\.?$", lowered)
-    body = lowered[:units.start()] if units else lowered
+    units, body = _stated_units(lowered)
     tool = re.fullmatch(r"\s*sa(\d+)p(\d+)\s*", body)
     if tool:
         return StatedMeasure("psa", float(f"{tool.group(1)}.{tool.group(2)}"))
@@ -268,7 +280,18 @@ def _parsed(text: str) -> StatedMeasure:
     else:
         raise ValueError(f"measure: {text!r} names no measure stochpound knows (PGA, PGV, PSA/SA(T))")
     damping = re.search(rf"{_NUMBER}\s*%", body)
-    return StatedMeasure(kind, period, (), float(damping.group(1)) / 100.0 if damping else None, parse_units(units.group(1)) if units else None)
+    return StatedMeasure(kind, period, (), float(damping.group(1)) / 100.0 if damping else None, units)
+
+
+def _stated_units(text: str) -> tuple[str | None, str]:
+    """(units, the rest of ``text``) when ``text`` ends with units after "in" or a last comma, else (None, ``text``)."""
+    ending = re.fullmatch(r"(?P<body>.*)(?:\bin\b|,)\s*(?P<units>[^,]*?)\s*\.?", text, re.DOTALL)
+    if ending is None:
+        return None, text
+    try:
+        return parse_units(ending.group("units")), ending.group("body")
+    except ValueError:
+        return None, text
 
 
 def read_hazard_file(path: str | Path, *, site: int | str | None = None) -> HazardFile:

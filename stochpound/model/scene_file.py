@@ -254,14 +254,16 @@ def _site_motion(table: Mapping[str, Any], per_sample: int) -> SampledMotion:
 
 
 def _record_motion(table: Mapping[str, Any], base_dir: Path, g: float, per_sample: int) -> SampledMotion:
-    from stochpound.motions.records import load_record
+    from stochpound.motions.records import load_record, normalize_units
 
     spec = fields.string(table, "record", "motion")
     scale = fields.number(table, "scale", "motion", default=1.0)
     duration, dt = _timing(table, required=False, per_sample=per_sample)
     units = fields.string(table, "units", "motion", default="") or None
-    if units not in (None, "g", "m/s2", "cm/s2"):
-        raise SceneError(f"motion.units: must be one of g, m/s2, cm/s2; got {units!r}")
+    try:
+        units = None if units is None else normalize_units(units)
+    except ValueError as error:
+        raise SceneError(f"motion.{error}") from None
     interpolation = fields.string(table, "interpolation", "motion", default="linear")
     if interpolation not in ("linear", "spline"):
         raise SceneError(f"motion.interpolation: must be 'linear' or 'spline', got {interpolation!r}")

@@ -63,6 +63,7 @@ from stochpound.risk._design_rules import DESIGN_RULE_LEVELS, design_rules_risk,
 from stochpound.risk._inputs import (RiskInputError, RiskInputs, contact_free_closure, has_risk, read_risk_inputs, selection_misses, site_hazard,
                                     stripes_beyond_truncation)
 from stochpound.risk._inputs import configuration_scene
+from stochpound.risk._inputs import stripe_motions  # noqa: F401  (for stochpound.experiment.measure_choice: not public API)
 from stochpound.risk._chain import StoreRisk, pounding_fragility, risk_gaps, store_risk
 from stochpound.risk._demands import StoreDemands, store_demands
 from stochpound.risk._limit_states import KINDS as LIMIT_STATE_KINDS, LimitState, gap_cost_frame, limit_state_problem, limit_state_risk, limit_states_from_table

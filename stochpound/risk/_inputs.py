@@ -25,6 +25,7 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
+from stochpound._plurals import counted
 from stochpound.codes import store_contact_demands
 from stochpound.hazard import HazardCurve, check_covers, hazard_curve, hazard_option, parse_units, stored_hazard, StatedMeasure
 from stochpound.model import Scene
@@ -295,7 +296,7 @@ def assumptions(store: xr.Dataset) -> dict[str, str]:
     suites = sorted({source.suite or kinds.get(source.kind, source.kind) for source in definition.motions})
     count = sum(source.count for source in definition.motions)
     selection = definition.intensity.selection if definition.intensity is not None else None
-    suite = (f"{count} motions ({', '.join(suites)}), "
+    suite = (f"{counted(count, 'motion')} ({', '.join(suites)}), "
              + (f"selected per stripe by {selection.method.replace('_', ' ')}" if selection else "every motion scaled to every stripe (no selection)"))
     scenario = _scenario_words(store, scenario_kind(store)) if selection and selection.scenarios else ""
     return {"structural model": "; ".join(models), "suite": suite,

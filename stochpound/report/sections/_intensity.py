@@ -30,6 +30,7 @@ import pandas as pd
 import xarray as xr
 from matplotlib.figure import Figure
 
+from stochpound._plurals import counted
 from stochpound.stats.kernels import clopper_pearson
 from stochpound.report.render import FigureItem, Paragraph, Section, Table
 from stochpound.report.sections._stripe_motions import stripe_motions_text
@@ -88,7 +89,7 @@ def method_text(store: xr.Dataset, setting: Intensity) -> str:
     )
     if setting.ran == "stripes":
         return text + f" Levels {levels} {setting.units}: {stripe_motions_text(store)} (a scale factor is the level over the motion's own measure)."
-    text += f" {store.sizes['record']} motions"
+    text += f" {counted(store.sizes['record'], 'motion')}"
     return text + ": each run once without contacts; a motion whose contacts close by D at scale 1 first pounds at gap g at the intensity IM·g/D."
 
 
@@ -135,7 +136,7 @@ def _spectra(name: str, store: xr.Dataset, setting: Intensity) -> FigureItem:
     if "intensity" in store.dims:
         ax.legend(fontsize=7)
     chosen = " chosen for some stripe" if "selection_scale_factor" in store else ""
-    caption = f"Experiment {name}: response spectra (5 % damping) of the {int(mask.sum())} motions{chosen}, as recorded (grey)"
+    caption = f"Experiment {name}: response spectra (5 % damping) of the {counted(int(mask.sum()), 'motion')}{chosen}, as recorded (grey)"
     if "intensity" in store.dims:
         caption += "; at each level, the median and the 16-84 % band of the motions scaled to it"
     return FigureItem(f"intensity-spectra-{name}", caption + ".", figure)

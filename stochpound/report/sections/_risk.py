@@ -33,6 +33,7 @@ import xarray as xr
 from matplotlib.figure import Figure
 from matplotlib.ticker import LogLocator, NullFormatter
 
+from stochpound._plurals import counted
 from stochpound.analysis import CellLabels
 from stochpound.report.render import Block, FigureItem, Paragraph, Section, Table, figures
 from stochpound.report.sections._facets import labels_text
@@ -232,7 +233,7 @@ def design_value_text(risk: StoreRisk) -> str:
 
 def _motions_text(risk: StoreRisk) -> str:
     """``N motions``, or ``1 motion``."""
-    return f"{risk.motions} motion{'s' if risk.motions != 1 else ''}"
+    return counted(risk.motions, "motion")
 
 
 def moat_text(risk: StoreRisk, demands: StoreDemands | None) -> str:
@@ -318,6 +319,8 @@ def _measure_choice_blocks(name: str, risk: StoreRisk, choice: pd.DataFrame | No
     """Which measure: the most efficient the site's hazard has per configuration, against the store's own, with the estimate's noise."""
     if choice is None or choice.empty or not choice.attrs.get("hazard_measures"):
         return []
+    if choice.attrs["unjudged"]:
+        return [Paragraph(f"Which measure: {choice.attrs['unjudged']}.")]
     measures, own = choice.attrs["hazard_measures"], choice.attrs["store_measure"]
     counts = choice["most efficient"].value_counts()
     best = ", ".join(f"{label} in {count} of {len(choice)} configurations" for label, count in counts.items())
