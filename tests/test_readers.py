@@ -32,7 +32,7 @@ def _write_text(path: Path, columns: list[np.ndarray], header: str = "") -> Path
 
 
 def _bundled_files() -> list[tuple[str, dict]]:
-    return [(name, dict(e.fields)) for name, e in registry_entries().items() if not e.is_variant]
+    return [(name, e.to_dict()) for name, e in registry_entries().items() if not e.is_variant]
 
 
 # ---------------------------------------------------------------- round trips of every bundled file

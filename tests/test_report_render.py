@@ -368,7 +368,7 @@ def test_cli_missing_store(tmp_path: Path) -> None:
 def fake_assemble(monkeypatch: pytest.MonkeyPatch) -> types.ModuleType:
     """A stand-in ``stochpound.report.assemble`` (the real builders are tested elsewhere)."""
     module = types.ModuleType("stochpound.report.assemble")
-    module.assemble_report = lambda paths, progress=None, partial=False, edited="warn": make_report()
+    module.assemble_report = lambda paths, progress=None, partial=False, edited="warn", **ruptures: make_report()
     monkeypatch.setitem(sys.modules, "stochpound.report.assemble", module)
     return module
 
@@ -384,7 +384,7 @@ def test_cli_build(tmp_path: Path, fake_assemble: types.ModuleType, monkeypatch:
 
 
 def test_cli_build_reports_store_errors(tmp_path: Path, fake_assemble: types.ModuleType) -> None:
-    def unreadable(paths: list[Path], progress: object = None, partial: bool = False, edited: str = "warn") -> Report:
+    def unreadable(paths: list[Path], progress: object = None, partial: bool = False, edited: str = "warn", **ruptures: object) -> Report:
         raise StochpoundError(f"{paths[0].name}: not an experiment store")
 
     fake_assemble.assemble_report = unreadable

@@ -26,7 +26,6 @@ import xarray as xr
 from stochpound.analysis._measure_free import MeasureFreeDemand, measure_free_demands
 from stochpound.hazard import RuptureSite
 from stochpound.model.scene import Scene
-from stochpound.risk import TARGETS, configuration_scene, contact_free_closure
 
 MEASURE_FREE_RUNS = 300
 """Runs per configuration of :func:`store_measure_free` by default (half of them the first stage, the rest allocated)."""
@@ -99,7 +98,7 @@ class StoreMeasureFree:
                 "within each rupture (the ruptures' rates taken as given)")
 
 
-def store_measure_free(store: xr.Dataset, site: RuptureSite, *, runs: int = MEASURE_FREE_RUNS, seed: int = 0, targets: Sequence[float] = TARGETS,
+def store_measure_free(store: xr.Dataset, site: RuptureSite, *, runs: int = MEASURE_FREE_RUNS, seed: int = 0, targets: Sequence[float] | None = None,
                        years: float = 50.0, confidence: float = 0.95, bootstrap: int = 1000, workers: int = 1,
                        outside: str = "refuse") -> StoreMeasureFree:
     """The answer without an intensity measure for every configuration of a store at a site of ruptures (module docstring).
@@ -128,6 +127,8 @@ def store_measure_free(store: xr.Dataset, site: RuptureSite, *, runs: int = MEAS
         ``runs`` below two a rupture (one line naming it), or as :func:`~stochpound.analysis.measure_free_risk`;
         (``RiskInputError``) a store without contact-free cases.
     """
+    from stochpound.risk import configuration_scene, contact_free_closure  # the risk chain, imported when used (the statistics do not import it)
+
     if isinstance(runs, bool) or not isinstance(runs, int) or runs < 2 * len(site):
         raise ValueError(f"runs: must be an integer >= {2 * len(site)} (two runs of each of the site's {len(site)} ruptures), got {runs!r}")
     first = max(2, runs // (2 * len(site)))
