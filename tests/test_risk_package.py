@@ -100,11 +100,12 @@ def test_report_sections_keep_no_cache():
 
 def test_the_risk_command_imports_only_public_namespaces():
     """No report section, and no private module of another package (the root package's own utilities, ``stochpound._errors``,
-    ``stochpound._atomic`` and ``stochpound._text_files``, are the CLI's)."""
+    ``stochpound._atomic``, ``stochpound._text_files`` and ``stochpound._plurals``, are the CLI's)."""
     imported = {module for module in _imports(ROOT / "stochpound" / "cli" / "_risk.py") if module.startswith("stochpound")}
     assert not any(module.startswith("stochpound.report") for module in imported)
     private = sorted(module for module in imported if any(part.startswith("_") for part in module.split(".")[1:])
-                     and not module.startswith(("stochpound._errors", "stochpound._atomic", "stochpound._text_files", "stochpound.cli.")))
+                     and not module.startswith(("stochpound._errors", "stochpound._atomic", "stochpound._text_files", "stochpound._plurals",
+                                                "stochpound.cli.")))
     assert private == []
     code = ("import sys, stochpound.cli._risk, stochpound.risk, stochpound.experiment; "
             "print(sorted(m for m in sys.modules if m.startswith('stochpound.report')))")
