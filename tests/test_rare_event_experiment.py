@@ -244,3 +244,16 @@ def test_a_limit_state_is_its_demand_over_its_capacity(tmp_path):
     demand = rare_event_sampler(force).start(range(3))[1]
     ratio = rare_event_sampler(limit).start(range(3))[1]
     assert np.any(demand > 0.0) and np.array_equal(ratio, demand / 2.0e5)
+
+
+def test_a_building_is_found_by_its_default_name(tmp_path):
+    """A scene whose buildings carry no ``name`` calls them B1, B2, ... everywhere, the rare-event table included."""
+    text = FILE.format(samples=20).replace('[scene]\nbundled = "elastic_pair"\n\n[scene.building.B2]\nmass_factor = 2.0\n', """[[scene.building]]
+mass = [1.0e5, 1.0e5]
+stiffness = [2.0e7, 2.0e7]
+damping_ratio = 0.05
+""").replace('response = "closure"\ncontact = 1', 'response = "peak_storey_drift"\nbuilding = "B1"\nfloor = 2')
+    path = tmp_path / "alone.toml"
+    path.write_text(text)
+    table = load_rare_event(path).table
+    assert (table.building, table.floor) == ("B1", 2)

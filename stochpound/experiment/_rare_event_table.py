@@ -25,7 +25,7 @@ from stochpound._text_files import read_text_file
 from stochpound.experiment._spec import _base_scene
 from stochpound.analysis import RESPONSES
 from stochpound.motions import SYNTHETIC_TYPES, normal_motion
-from stochpound.store import TomlTable, building_names, canonical_json
+from stochpound.store import TomlTable, building_names, building_table, canonical_json
 
 TABLE = "rare_event"
 """The experiment file's table that makes it a rare-event experiment."""
@@ -214,18 +214,14 @@ def _where(table: TomlTable, response: str, buildings: list[str], scene: Mapping
     if "building" in needs:
         single = {"default": buildings[0]} if len(buildings) == 1 else {}  # one building: the default
         found["building"] = table.string("building", **single, choices=tuple(buildings))
-        if sampled == "base_displacement" and not isinstance(_building(scene, found["building"]).get("base"), dict):
+        if sampled == "base_displacement" and not isinstance(building_table(scene, found["building"]).get("base"), dict):
             raise table.error("building", f"{found['building']!r} has a fixed base ({sampled} needs a sliding base)")
     if "floor" in needs:
-        found["floor"] = table.integer("floor", low=1, high=len(_building(scene, found["building"]).get("mass", [])))
+        found["floor"] = table.integer("floor", low=1, high=len(building_table(scene, found["building"]).get("mass", [])))
     if limit_state:
         found["limit_state"] = limit_state
         found["capacity"] = table.number("capacity", low=0.0, low_open=True)
     return found
-
-
-def _building(scene: Mapping[str, Any], name: str) -> Mapping[str, Any]:
-    return next(b for b in scene.get("building", []) if b.get("name") == name)
 
 
 def _motion(data: Mapping[str, Any], scene: Mapping[str, Any]) -> tuple[str, dict[str, Any]]:

@@ -59,7 +59,7 @@ def _tables(scene: Mapping[str, Any], part: str) -> list[Any]:
     return scene.get(part, [])
 
 
-def _building(scene: Mapping[str, Any], name: str) -> dict[str, Any]:
+def building_table(scene: Mapping[str, Any], name: str) -> dict[str, Any]:
     """The ``[[building]]`` table named ``name`` (default names B1, B2, ... included)."""
     names = building_names(scene)
     if name not in names:
@@ -108,7 +108,7 @@ def apply_overrides(scene: Mapping[str, Any], overrides: Iterable[Mapping[str, A
         for name, fields in override.get("building", {}).items():
             if "mass_factor" in fields:
                 factors[name] = factors.get(name, 1.0) * float(fields["mass_factor"])
-            _override_building(_building(scene, name), fields)
+            _override_building(building_table(scene, name), fields)
     for name, factor in factors.items():
         scale_masses(scene, name, factor)
     return scene
@@ -150,7 +150,7 @@ def scale_masses(scene: dict[str, Any], name: str, factor: float) -> None:
     with the ratio of the effective masses, new over old: the factor itself
     for a wall).
     """
-    building = _building(scene, name)
+    building = building_table(scene, name)
     old_mass = [float(m) for m in building["mass"]]
     _give(building, scaled_masses(building, factor))
     for contact in _tables(scene, "contact"):
@@ -158,7 +158,7 @@ def scale_masses(scene: dict[str, Any], name: str, factor: float) -> None:
             ends = [(str(end_name), int(floor)) for end_name, floor in contact["between"]]
             if name not in [end[0] for end in ends]:
                 continue
-            masses_new = [float(_building(scene, end_name)["mass"][floor - 1]) for end_name, floor in ends]
+            masses_new = [float(building_table(scene, end_name)["mass"][floor - 1]) for end_name, floor in ends]
             masses_old = [old_mass[floor - 1] if end_name == name else new for (end_name, floor), new in zip(ends, masses_new)]
         except (KeyError, IndexError, TypeError, ValueError):
             continue  # a malformed contact: scene validation names it
@@ -211,10 +211,10 @@ def set_mu(scene: dict[str, Any], buildings: Iterable[str] | None, mu: float) ->
         When a base's law refuses μ, naming the field (``building[0].base.mu.fast: ...``).
     """
     names = building_names(scene)
-    chosen = list(buildings) if buildings is not None else [n for n in names if isinstance(_building(scene, n).get("base"), dict)]
+    chosen = list(buildings) if buildings is not None else [n for n in names if isinstance(building_table(scene, n).get("base"), dict)]
     missing = []
     for name in chosen:
-        building = _building(scene, name)
+        building = building_table(scene, name)
         base = building.get("base")
         if is_fixed_base(mu):
             _give(building, {}, ["base"])
@@ -235,6 +235,6 @@ def set_mu(scene: dict[str, Any], buildings: Iterable[str] | None, mu: float) ->
 
 def reference_scene(scene: Mapping[str, Any], studied: str) -> dict[str, Any]:
     """The studied building alone on a fixed base (no contacts), same g."""
-    building = copy.deepcopy(_building(scene, studied))
+    building = copy.deepcopy(building_table(scene, studied))
     _give(building, {"name": studied}, ["base", "initial"])
     return {"g": scene_g(scene), "building": [building], "contact": []}
