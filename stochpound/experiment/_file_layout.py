@@ -276,17 +276,20 @@ def _scene_coordinates(experiment: Experiment) -> dict[str, xr.Variable]:
 
 def _suite_coordinates(experiment: Experiment) -> dict[str, xr.Variable]:
     """Metadata of the motions from suites on ``record`` (event, station, component, magnitude, distance...; none without such motions)."""
-    from stochpound.motions.records import is_suite_member, load_suite_member
+    from stochpound.motions.records import is_suite_member, load_suite_member, record_metadata
 
     rows: list[Mapping[str, Any]] = []
     for source in experiment.motions.values():
         record = str(source.motion.get("record", ""))
+        peer = record_metadata(record, experiment.base_dir) if source.kind == "record" and record and not is_suite_member(record) else {}
         if is_suite_member(record):
             rows.append(load_suite_member(record).metadata)
         elif source.kind == "simulated":  # its own earthquake: no event (a cluster of its own), the scenario's magnitude, distance and Vs30
             table = source.motion
             rows.append({"suite": "simulated", "magnitude": table["magnitude"], "distance": table["distance_km"], "vs30": table["vs30"]})
-        elif source.suite is not None:  # a folder: the file name is all that is known
+        elif "event" in peer:  # a file of a PEER download: its row of the search report
+            rows.append({**peer, "suite": source.suite or str(Path(record).parent)})
+        elif source.suite is not None:  # a folder without a search report: the file name is all that is known
             rows.append({"suite": source.suite, "component": Path(record).name})
         else:
             rows.append({})

@@ -426,19 +426,16 @@ def stripe_selections(experiment: ExperimentGrid) -> StripeSelections:
     from stochpound.store import CASE
     from stochpound.model.scene_file import scene_from_dict
     from stochpound.motions import conditional_spectrum, select_motions, selection_periods, selection_pool
-    from stochpound.motions.records import Record, is_suite_member, load_suite_member
+    from stochpound.motions.records import Record
 
     intensity = experiment.intensity
     scene = experiment.structure(experiment.points(CASE)[0])
     records = []
+    metadata = pool_metadata(experiment)
     for label, source in experiment.recorded_motions.items():  # the motions as the cases run them (a duration or a start applied)
-        if source.kind != "record":
-            raise ExperimentError(f"{source.field}: the conditional-spectrum pool takes records and suites, not synthetic ensembles")
         with field_errors(scene_prefix=source.field):
             motion = scene_from_dict({**scene, "motion": experiment.motion_table(label)}, base_dir=experiment.base_dir).motion
-        name = str(source.motion.get("record", ""))
-        metadata = load_suite_member(name).metadata if is_suite_member(name) else {}
-        records.append(Record(label, motion.dt, motion.values, "m/s2", metadata=metadata))
+        records.append(Record(label, motion.dt, motion.values, "m/s2", metadata=metadata[label]))
     measure = intensity.measure.kind
     period = intensity.measure.spectral_period
     chosen = intensity.selection
@@ -470,6 +467,34 @@ def stripe_selections(experiment: ExperimentGrid) -> StripeSelections:
         targets.append(target)
     labels = list(experiment.recorded_motions) + list(simulated)
     return StripeSelections(list(intensity.levels), labels, periods, structure, selections, targets, simulated)
+
+
+def pool_metadata(experiment: ExperimentGrid) -> dict[str, dict[str, float | str]]:
+    """The metadata of every record of the pool, by label (:func:`stochpound.motions.records.record_metadata`).
+
+    Raises
+    ------
+    ExperimentError
+        A synthetic ensemble in the pool, or records without metadata (no
+        earthquake: the selection's rules and per-stripe counts need it),
+        named, with where metadata come from.
+    """
+    from stochpound._errors import ExperimentError
+    from stochpound.motions.records import SEARCH_RESULTS, record_metadata
+
+    metadata, missing = {}, []
+    for label, source in experiment.recorded_motions.items():
+        if source.kind != "record":
+            raise ExperimentError(f"{source.field}: the conditional-spectrum pool takes records and suites, not synthetic ensembles")
+        record = source.motion["record"] if "record" in source.motion else None
+        metadata[label] = record_metadata(str(record), experiment.base_dir) if record is not None else {}
+        if not ("event" in metadata[label] and metadata[label]["event"]):
+            missing.append(label)
+    if missing:
+        shown = ", ".join(missing[:5]) + (f" and {len(missing) - 5} more" if len(missing) > 5 else "")
+        raise ExperimentError(f"records: the conditional-spectrum selection takes records with metadata (earthquake, magnitude, distance, Vs30), "
+                              f"{len(missing)} have none: {shown} (use a named suite, or a folder of PEER downloads with its {SEARCH_RESULTS})")
+    return metadata
 
 
 def simulated_sources(setting: SimulatedMotions | None, stripe: int, scenario: Scenario) -> dict[str, MotionSource]:

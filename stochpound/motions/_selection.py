@@ -25,7 +25,7 @@ metadata give them, else by its name); with ``max_per_earthquake`` it holds
 at most that many motions of an earthquake (the metadata's ``event``; a
 motion without one, such as a simulated motion, is its own earthquake); with
 ``exclude_pulses`` the records the metadata mark as pulses (``pulse``: the
-FEMA P695 near-field pulse subset) are no candidates. Steps 3 and 4 only
+FEMA P695 near-field pulse subset, or a PEER search report's pulse period) are no candidates. Steps 3 and 4 only
 ever take a candidate the rules allow.
 
 Everything random comes from ``numpy.random.default_rng(seed)``: the same
@@ -62,8 +62,9 @@ RANGE_PERIODS = 20
 RANGE_LOW = 0.2
 #: ... to this multiple of the longest.
 RANGE_HIGH = 3.0
-#: Fault types of the FEMA P695 metadata as scenario mechanisms.
-FAULT_TYPES = {"Strike-slip": "strike_slip", "Thrust": "reverse", "Reverse": "reverse", "Reverse-Oblique": "reverse", "Normal": "normal"}
+#: Fault types of the FEMA P695 metadata and mechanisms of PEER NGA-West2 search reports as scenario mechanisms.
+FAULT_TYPES = {"Strike-slip": "strike_slip", "Thrust": "reverse", "Reverse": "reverse", "Reverse-Oblique": "reverse", "Normal": "normal",
+               "strike slip": "strike_slip", "Reverse Oblique": "reverse", "Normal Oblique": "normal"}
 #: A stripe's selection misses its target where its mean or standard deviation of ln Sa is farther than this from the target's at a period.
 TARGET_TOLERANCE = 0.1
 #: Weight of the quartic term of the misfit.

@@ -20,11 +20,13 @@ from stochpound.motions.records._registry import (
     RegistryEntry,
     list_records,
     load_record,
+    record_metadata,
     records_dir,
     registry_entries,
 )
 from stochpound.motions.records._suites import SUITES, is_suite_member, list_suites, load_suite, load_suite_member, select_members, suite_members
 from stochpound.motions.records._plot import plot_record, plot_spectra
+from stochpound.motions.records._peer import SEARCH_RESULTS, folder_metadata
 from stochpound.motions.records._statistics import RecordStatistics, arias_intensity, moments, record_statistics
 from stochpound.stats import earthquake_identities
 
@@ -32,6 +34,7 @@ from stochpound.stats import earthquake_identities
 from stochpound.motions.records._suites import METADATA_FIELDS, SELECTIONS  # noqa: F401
 
 __all__ = [
+    "SEARCH_RESULTS",
     "SUITES",
     "RawSeries",
     "Record",
@@ -39,6 +42,7 @@ __all__ = [
     "RegistryEntry",
     "arias_intensity",
     "earthquake_identities",
+    "folder_metadata",
     "is_suite_member",
     "list_records",
     "list_suites",
@@ -53,6 +57,7 @@ __all__ = [
     "read_at2",
     "read_record_file",
     "read_text",
+    "record_metadata",
     "record_statistics",
     "records_dir",
     "registry_entries",

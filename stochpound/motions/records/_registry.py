@@ -16,6 +16,7 @@ from typing import Mapping
 
 from stochpound._data_files import bundled_data_dir
 from stochpound._errors import RecordError
+from stochpound.motions.records._peer import file_metadata
 from stochpound.motions.records._readers import read_record_file, record_from_file
 from stochpound.motions.records._record import Record
 from stochpound.motions.records._units import normalize_units
@@ -196,7 +197,32 @@ def load_record(
     if not path.exists():
         known = ", ".join(entries)
         raise RecordError(f"{key}: no bundled record of that name and no such file; bundled records: {known}")
-    return record_from_file(path, dt=dt, units=units, column=column, fmt=fmt)
+    record = record_from_file(path, dt=dt, units=units, column=column, fmt=fmt)
+    record.metadata = file_metadata(path)
+    return record
+
+
+def record_metadata(source: str | Path, base_dir: str | Path = ".") -> dict[str, float | str]:
+    """The metadata :func:`load_record` gives ``source``, without reading its samples.
+
+    A registry entry's fields, a suite motion's metadata (event, magnitude,
+    distance, Vs30, mechanism...), a file's row of the PEER ``_SearchResults.csv``
+    beside it; {} for a file without one.
+
+    Parameters
+    ----------
+    source : str or Path
+        As :func:`load_record` takes it.
+    base_dir : str or Path
+        The folder a relative file path is relative to.
+    """
+    entries = registry_entries()
+    key = str(source)
+    if key in entries:
+        return dict(entries[key].to_dict())
+    if is_suite_member(key):
+        return dict(load_suite_member(key).metadata)
+    return file_metadata(Path(base_dir) / source)
 
 
 def _check_override(record: Record, dt: float | None, units: str | None) -> None:

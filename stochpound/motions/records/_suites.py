@@ -21,6 +21,12 @@ far-field motions carry no such mark.
 
 A folder of record files is a suite too: every ``.AT2`` and ``.txt`` file in
 it (sorted by name), read as :func:`~stochpound.motions.records.load_record` reads a file.
+A folder of PEER NGA-West2 downloads carries its metadata in the search's
+``_SearchResults.csv`` (:mod:`stochpound.motions.records._peer`): its files
+then have their earthquake, magnitude, distances, Vs30, mechanism and pulse
+mark, can be chosen by ``event``, ``magnitude`` and ``distance`` like a named
+suite's, and the vertical components it lists are left out of the suite
+(the motions are horizontal; a vertical file can still be named alone).
 """
 
 from __future__ import annotations
@@ -36,6 +42,7 @@ from typing import Any
 import numpy as np
 
 from stochpound._errors import RecordError
+from stochpound.motions.records._peer import SEARCH_RESULTS, file_metadata, folder_metadata
 from stochpound.motions.records._readers import record_from_file
 from stochpound.motions.records._record import Record
 
@@ -103,7 +110,9 @@ def suite_members(suite: str | Path) -> list[str]:
     folder = Path(suite)
     if not folder.is_dir():
         raise RecordError(f"suite: unknown suite {str(suite)!r} and no such folder; suites: {', '.join(SUITES)}")
-    files = sorted({path for pattern in FOLDER_PATTERNS for path in folder.glob(pattern)})
+    metadata = folder_metadata(folder)
+    files = sorted({path for pattern in FOLDER_PATTERNS for path in folder.glob(pattern)
+                    if not (path.name in metadata and metadata[path.name]["orientation"] == "V")})
     if not files:
         raise RecordError(f"suite: the folder {folder} holds no .AT2 or .txt record files")
     return [str(path) for path in files]
@@ -125,11 +134,12 @@ def select_members(suite: str | Path, members: list[str] | None = None, event: l
         Members by their name in the suite (``"01a"`` for
         ``fema_p695_far_field/01a``; a folder's file names without extension).
     event : list of str, optional
-        Events (named suites): a motion is kept if its event's name contains
+        Events (named suites, and folders of PEER downloads with their
+        ``_SearchResults.csv``): a motion is kept if its event's name contains
         one of these (case-insensitive), e.g. ``["Northridge", "Kobe"]``.
     magnitude, distance : (float, float), optional
         Closed ranges of the moment magnitude and of the closest distance to
-        the rupture plane (km) (named suites).
+        the rupture plane (km) (as ``event``).
 
     Raises
     ------
@@ -146,10 +156,15 @@ def select_members(suite: str | Path, members: list[str] | None = None, event: l
             raise RecordError(f"members: no motion {unknown[0]!r} in {suite} (its members: {', '.join(short[:4])}, ...)")
         keep = [i for i in keep if short[i] in members]
     if any(choice is not None for choice in (event, magnitude, distance)):
+        key = "event" if event is not None else "magnitude" if magnitude is not None else "distance"
+        metadata = [load_suite_member(name).metadata if str(suite) in SUITES else file_metadata(name) for name in names]
         if str(suite) not in SUITES:
-            raise RecordError(f"{'event' if event is not None else 'magnitude' if magnitude is not None else 'distance'}: "
-                              "a folder's files carry no metadata: choose them by members = [file names]")
-        metadata = [load_suite_member(names[i]).metadata for i in range(len(names))]
+            if not folder_metadata(suite):
+                raise RecordError(f"{key}: a folder's files carry no metadata without a PEER {SEARCH_RESULTS} beside them: "
+                                  "choose them by members = [file names]")
+            missing = [short[i] for i in keep if not metadata[i]]
+            if missing:
+                raise RecordError(f"{key}: {_listed(missing)} of {suite} not in its {SEARCH_RESULTS} (no metadata to choose by)")
         if event is not None:
             keep = [i for i in keep if any(text.lower() in metadata[i]["event"].lower() for text in event)]
         for key, bounds in (("magnitude", magnitude), ("distance", distance)):
@@ -167,7 +182,7 @@ def load_suite(suite: str | Path) -> list[Record]:
     records = []
     for path in suite_members(suite):
         record = record_from_file(path)
-        record.metadata = {**_blank_metadata(), "component": record.name, "suite": str(suite)}
+        record.metadata = {**_blank_metadata(), "component": record.name, **file_metadata(path), "suite": str(suite)}
         records.append(record)
     return records
 
@@ -234,6 +249,12 @@ def _pulse(suite: str, rsn: int) -> dict[str, bool]:
         return {}
     pulses = _record_set(SUITES["fema_p695_near_field_pulse"].record_set).records["RecordSequenceNumber"]
     return {"pulse": rsn in {int(value) for value in pulses}}
+
+
+def _listed(names: list[str], shown: int = 4) -> str:
+    """``a, b, c, d and 3 more``: names, the first few of them."""
+    more = f" and {len(names) - shown} more" if len(names) > shown else ""
+    return ", ".join(names[:shown]) + more
 
 
 def _blank_metadata() -> dict[str, float | str]:
