@@ -80,7 +80,7 @@ def resolve_motions(experiment: Experiment) -> dict[str, ResolvedMotion]:
         if source.kind in ("record", "simulated"):
             resolved[label] = ResolvedMotion(label, motion, None, grid)
         else:
-            worker_table = _worker_table(table, motion, structure)
+            worker_table = table if table["type"] == "scenario_motions" else _worker_table(table, motion, structure)  # no S0 to resolve
             expected = None
             if experiment.intensity is not None and experiment.intensity.synthetic == "expected":
                 expected = ensemble_intensity(experiment.intensity, worker_table, experiment.realizations(label), experiment.definition.g)

@@ -33,6 +33,7 @@ from stochpound.experiment._design_table import parse_design
 from stochpound.experiment._limit_states_table import parse_limit_states
 from stochpound.hazard import parse_hazard
 from stochpound.motions import SYNTHETIC_TYPES
+from stochpound.experiment._scenario_ensembles import scenario_source
 from stochpound.experiment._intensity import parse_intensity
 from stochpound.experiment._site import site_entry
 from stochpound.model.fields import is_number
@@ -474,6 +475,8 @@ def _synthetic_source(label: str, value: Any, where: str) -> MotionSource:
         raise ExperimentError(f"{where}: must be a table (type, count, seed and the generator's parameters)")
     table = TomlTable(value, where)
     kind = table.string("type", "kanai_tajimi", choices=SYNTHETIC_TYPES)
+    if kind == "scenario_motions":  # the motions of a scenario: its window resolved (experiment/_scenario_ensembles.py)
+        return scenario_source(label, table, MAX_REALIZATIONS)
     from stochpound import motions
 
     if "realization" in table:

@@ -24,8 +24,10 @@ hazard curves where no disaggregation is at hand: :func:`fit_scenarios`,
 :func:`fit_levels`, :func:`recomputed_hazard`.
 
 Site-based stochastic motions of a scenario (Rezaeian & Der Kiureghian 2010,
-calibrated to the NGA-West2 models): :func:`site_motions`, and the same map
-from explicit standard normals: :func:`site_motions_from_normals`.
+calibrated to the NGA-West2 models): :func:`site_motions`, the same map
+from explicit standard normals: :func:`site_motions_from_normals`, and the
+same motions as a synthetic ensemble (``type = "scenario_motions"``):
+:func:`scenario_motions`, :class:`ScenarioNormalMotion`.
 
 Conventions (PSD two-sided in ω, σ² = ∫ S dω; SI units) are in ``docs/motions.md``.
 """
@@ -62,6 +64,7 @@ from stochpound.motions._selection import TARGET_TOLERANCE, misses_target, selec
 from stochpound.motions._seeding import realization_rng, realization_rngs
 from stochpound.motions._spectrum import response_spectrum
 from stochpound.motions._normals import NormalMotion
+from stochpound.motions._scenario_motions import ScenarioNormalMotion, scenario_motions
 from stochpound.motions._synthetic import (
     PSD_CONVENTION,
     SYNTHETIC_TYPES,
@@ -107,6 +110,7 @@ __all__ = [
     "Jennings",
     "NormalMotion",
     "SaragoniHart",
+    "ScenarioNormalMotion",
     "SoilPreset",
     "Trapezoidal",
     "baseline_correct",
@@ -138,6 +142,7 @@ __all__ = [
     "s0_from_rms",
     "sa_avg",
     "scenario_distribution",
+    "scenario_motions",
     "select_motions",
     "selection_periods",
     "selection_pool",

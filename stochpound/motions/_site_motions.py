@@ -134,7 +134,8 @@ def site_motions(magnitude: float | None = None, distance_km: float | None = Non
     realizations : list of int, optional
         Only these motions of the ``n`` (each in 0 … n − 1), in this order:
         bit for bit the same rows as of the full set (the window is still the
-        full set's), at the memory of these alone. Default: all ``n``.
+        full set's), at the memory of these alone (and, with ``duration``
+        given, at the cost of these alone). Default: all ``n``.
     scenario : Scenario, optional
         The scenario as one value, instead of ``magnitude``, ``distance_km``, ``vs30`` and ``mechanism``
         (``site_motions(n=100, seed=1, scenario=Scenario(7.0, 10.0, 760.0, "strike_slip"))``).
@@ -164,15 +165,16 @@ def site_motions(magnitude: float | None = None, distance_km: float | None = Non
     except ValueError as error:
         raise SiteError(str(error)) from None
     rows = _rows(realizations, int(n))
-    rngs = [realization_rng(seed, i) for i in range(int(n))]
-    first = np.array([rng.standard_normal(PARAMETER_NORMALS) for rng in rngs])  # the whole set's: its window is theirs
-    whole = motion_parameters(load_site_model(model), scenario, first)
-    if duration is None:
-        duration = _window(whole)
-    elif isinstance(duration, bool) or not isinstance(duration, (int, float)) or not 10.0 * dt <= duration <= 600.0:
+    if duration is not None and (isinstance(duration, bool) or not isinstance(duration, (int, float)) or not 10.0 * dt <= duration <= 600.0):
         raise SiteError(f"duration: must be within {10 * dt:g}-600 s, got {duration!r}")
-    parameters = {name: values[rows] for name, values in whole.items()}  # each motion's parameters are its own row's
-    rngs = [rngs[i] for i in rows]
+    drawn = range(int(n)) if duration is None else rows  # the default window is the whole set's; a given one needs the rows asked for alone
+    rngs = [realization_rng(seed, i) for i in drawn]
+    first = np.array([rng.standard_normal(PARAMETER_NORMALS) for rng in rngs])
+    parameters = motion_parameters(load_site_model(model), scenario, first)  # each motion's parameters are its own row's
+    if duration is None:
+        duration = _window(parameters)
+        parameters = {name: values[rows] for name, values in parameters.items()}
+        rngs = [rngs[i] for i in rows]
     n_time = int(round(duration / dt)) + 1
     acceleration = motions_from_noise_rows(parameters, lambda batch: np.array([rng.standard_normal(n_time) for rng in rngs[batch]]), n_time, dt)
     dataset = _dataset(acceleration, parameters, dt, _attrs(scenario, model))

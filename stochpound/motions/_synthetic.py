@@ -1,4 +1,5 @@
-"""Ensembles of synthetic ground accelerations: :func:`white_noise`, :func:`kanai_tajimi`, :func:`clough_penzien`.
+"""Ensembles of synthetic ground accelerations: :func:`white_noise`, :func:`kanai_tajimi`, :func:`clough_penzien`,
+and :func:`~stochpound.motions.scenario_motions` (the site model's, ``stochpound.motions._scenario_motions``).
 
 Each is a :class:`~stochpound.motions.NormalMotion` (the motion as a function
 of standard normals, :func:`normal_motion`) applied to every realization's own
@@ -19,11 +20,12 @@ from stochpound.motions.generators import METHODS
 from stochpound.motions.intensity import PEAK_FACTORS, poisson_peak_factor, s0_from_pga, s0_from_rms, simulated_peak_factor
 from stochpound.motions.psd import FilteredWhiteNoise, clough_penzien_model, kanai_tajimi_model
 from stochpound.motions._normals import NormalMotion
+from stochpound.motions._scenario_motions import SCENARIO_TYPE, ScenarioNormalMotion, scenario_motions, scenario_normal_motion
 from stochpound.motions._seeding import check_seed, realization_rngs
 
 PSD_CONVENTION = "two-sided in omega (rad/s) on (-inf, inf); variance = integral of S domega"
 #: The synthetic kinds: a scene's ``[motion] type`` and an experiment's ``[synthetic.<name>] type``.
-SYNTHETIC_TYPES = ("kanai_tajimi", "clough_penzien", "white_noise")
+SYNTHETIC_TYPES = ("kanai_tajimi", "clough_penzien", "white_noise", SCENARIO_TYPE)
 #: Fields of a synthetic table that :func:`normal_motion` accepts and does not use (they name seeded realizations).
 _NOT_USED = ("seed", "count", "start", "realization", "interpolation")
 
@@ -221,7 +223,7 @@ def white_noise(
     return _ensemble(_white_motion(duration, dt, S0=S0, envelope=envelope, rms=rms, baseline=baseline), count, first, seed)
 
 
-def normal_motion(motion: Mapping[str, Any]) -> NormalMotion:
+def normal_motion(motion: Mapping[str, Any]) -> NormalMotion | ScenarioNormalMotion:
     """A synthetic ensemble's motion as a function of standard normals (model §13).
 
     Parameters
@@ -236,8 +238,10 @@ def normal_motion(motion: Mapping[str, Any]) -> NormalMotion:
 
     Returns
     -------
-    NormalMotion
-        a = f(u), u ∈ Rⁿ independent standard normals.
+    NormalMotion or ScenarioNormalMotion
+        a = f(u), u ∈ Rⁿ independent standard normals (a
+        :class:`~stochpound.motions.ScenarioNormalMotion` for ``type = "scenario_motions"``,
+        the site model's map of 7 + n_time normals).
 
     Raises
     ------
@@ -261,6 +265,11 @@ def normal_motion(motion: Mapping[str, Any]) -> NormalMotion:
         raise ValueError(f"motion.{missing[0]}: required for type = {kind!r}")
     if kind == "white_noise":
         return _white_motion(**given)
+    if kind == SCENARIO_TYPE:
+        try:
+            return scenario_normal_motion(**given)
+        except ValueError as error:
+            raise ValueError(f"motion.{error}") from None
     factory, names = _MODELS[kind]
     model = factory(*(given.pop(name) for name in names))
     return _filtered_motion(model, **given)
@@ -400,4 +409,4 @@ def _positive(value: Any, name: str) -> float:
 
 
 _MODELS = {"kanai_tajimi": (kanai_tajimi_model, ("omega_g", "zeta_g")), "clough_penzien": (clough_penzien_model, ("omega_g", "zeta_g", "omega_f", "zeta_f"))}
-_GENERATORS = {"kanai_tajimi": kanai_tajimi, "clough_penzien": clough_penzien, "white_noise": white_noise}
+_GENERATORS = {"kanai_tajimi": kanai_tajimi, "clough_penzien": clough_penzien, "white_noise": white_noise, SCENARIO_TYPE: scenario_motions}

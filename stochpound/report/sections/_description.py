@@ -255,8 +255,21 @@ def _merged_table(key: str, caption: str, columns: list[str], rows: Mapping[tupl
     return Table(key=key, caption=caption, frame=frame, note=note)
 
 
+def _scenario_parameters(table: Mapping[str, float | str]) -> tuple[str, dict[str, float]]:
+    """What a scenario ensemble's motions are (``type = "scenario_motions"``), and its step and window."""
+    calibrated = ("calibrated to the NGA-West2 models" if table["model"] == "hazard_compatible" else "the published equations, not calibrated")
+    text = (f"Site-based stochastic motions of the scenario M {number(float(table['magnitude']))}, R_rup {number(float(table['distance_km']))} km, "
+            f"Vs30 {number(float(table['vs30']))} m/s, {str(table['mechanism']).replace('_', '-')} (Rezaeian & Der Kiureghian 2010, "
+            f"{calibrated}: {table['calibration']}): each realization's Arias intensity, D5–95, time of 45 % of it, filter frequency, "
+            "its slope and damping, and high-pass corner drawn from the scenario with correlated residuals, then its white noise; "
+            "ends at rest; linear interpolation between samples")
+    return text, {"dt": float(table["dt"]), "duration": float(table["duration"])}
+
+
 def _synthetic_parameters(table: Mapping[str, Any], start: int) -> tuple[str, dict[str, Any]]:
     """The generator's parameters as run, with the intensity S0 and σ it implies (one realization is generated)."""
+    if table["type"] == "scenario_motions":
+        return _scenario_parameters(table)
     parameters = {k: v for k, v in table.items() if k not in ("type", "interpolation")}
     attrs = getattr(synthetic_motions, table["type"])(1, start=start, **parameters).attrs
     filtered = "omega_g" in attrs  # white noise has no filter
