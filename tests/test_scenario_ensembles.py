@@ -9,7 +9,7 @@ from stochpound import open_store, simulate
 from stochpound.experiment._runner import load_experiment, run_experiment
 from stochpound.model.scene_file import scene_from_dict
 from stochpound.motions import SYNTHETIC_TYPES, normal_motion, realization_rng, scenario_motions, site_model_provenance, site_motions
-from stochpound.report.sections._description import _synthetic_parameters
+from stochpound.report.sections._description import StoreDefinition, _synthetic_parameters, motions_table
 from stochpound.store import with_motion
 from tests.helpers import SITE_SCENE, write_experiment
 
@@ -59,7 +59,10 @@ def test_a_scenario_ensemble_runs_and_its_store_regenerates_its_motions(tmp_path
     for i in (1, 3):
         regenerated = store.pound.scene(gap=0.005, record="quake", realization=i).motion
         np.testing.assert_array_equal(regenerated.values, window.acceleration.values[i])
-    # what ran is that motion: the run's peak closure is the one simulate gives under it
+    row = motions_table([StoreDefinition("scenario", store)]).frame.iloc[0]  # the report's table of ground motions, from the store
+    assert row["definition"].startswith("Site-based stochastic motions of the scenario M 6.8, R_rup 15 km, Vs30 450 m/s, reverse")
+    assert row["realizations"] == "3 (indices 1–3), seed 5" and row["step, duration"] == f"0.02 s, {source.motion['duration']:g} s"
+    # what ran is that motion: the run's peak displacement is the one simulate gives under it
     scene = scene_from_dict(with_motion(experiment.structure(experiment.points("case")[0]), experiment.motion_table("quake", 2)))
     direct = simulate(scene, method="exact")
     assert float(store.peak_total_displacement.sel(gap=0.005, realization=2, building="B1").max()) == pytest.approx(

@@ -153,7 +153,9 @@ def scenario_motions(n_realizations: int, duration: float, dt: float, magnitude:
     Raises
     ------
     SiteError
-        As :func:`scenario_normal_motion`, or a bad ``n_realizations``, ``start`` or ``seed``.
+        Naming the field: a scenario outside the model's calibrated range, an
+        unknown model, a ``calibration`` that is not the model's, a bad ``dt``
+        (≤ 0.02 s), ``duration`` (10 dt – 600 s), ``n_realizations``, ``start`` or ``seed``.
     """
     motion = scenario_normal_motion(duration, dt, magnitude, distance_km, vs30, mechanism, model=model, calibration=calibration)
     for name, value in (("n_realizations", n_realizations), ("start", start)):
