@@ -17,7 +17,8 @@ from stochpound import RecordError
 from stochpound.experiment._file_layout import _suite_coordinates
 from stochpound.experiment._runner import load_experiment
 from stochpound.experiment._spec import ExperimentError
-from stochpound.motions.records import folder_metadata, load_record, load_suite, record_metadata, select_members, suite_members
+from stochpound.motions.records import (folder_metadata, load_record, load_suite, load_suite_member, record_metadata, select_members,
+                                       suite_members)
 from tests.helpers import SITE_SCENE, write_experiment
 
 FIXTURE = Path(__file__).parent / "data" / "peer_nga_west2"
@@ -44,6 +45,19 @@ def test_every_component_of_a_row_gets_the_row_s_metadata() -> None:
             assert got["fault_type"] == mechanism and got["orientation"] == orientation and got["component"] == f"{event}/{code}{component}"
             assert got["pulse"] is (tp is not None) and (np.isnan(got["pulse_period"]) if tp is None else got["pulse_period"] == tp)
     assert metadata["RSN90003_IMAGVAL_GAM000.AT2"]["station"] == "Station Gamma, North"  # PEER writes "_" for a comma
+
+
+def test_a_component_is_named_as_the_fema_p695_sets_name_the_same_recording(tmp_path) -> None:
+    """Real NGA-West2 file names of two FEMA P695 far-field motions (05a: RSN 169, 01a: RSN 953): the same recording key."""
+    folder = tmp_path / "real_names"
+    folder.mkdir()
+    report = (FIXTURE / "_SearchResults.csv").read_text()
+    for name, real in (("RSN90001_IMAGVAL_ALP000.AT2", "RSN169_IMPVALL.H_H-DLT262.AT2"), ("RSN90001_IMAGVAL_ALP090.AT2", "RSN953_NORTHR_MUL009.AT2")):
+        report = report.replace(name, real)
+    (folder / "_SearchResults.csv").write_text(report)
+    metadata = folder_metadata(folder)
+    for member, file in (("05a", "RSN169_IMPVALL.H_H-DLT262.AT2"), ("01a", "RSN953_NORTHR_MUL009.AT2")):
+        assert metadata[file]["component"] == load_suite_member(f"fema_p695_far_field/{member}").metadata["component"]
 
 
 def test_a_spreadsheet_s_copy_of_the_report_reads_the_same(tmp_path) -> None:

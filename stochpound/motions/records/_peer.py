@@ -27,8 +27,10 @@ Every component a row names gets the row's metadata (the fields of
 1999"``, as the FEMA P695 sets write it), ``distance`` the rupture distance
 R_rup, ``distance_joyner_boore`` R_jb, ``fault_type`` the mechanism as
 written, ``orientation`` ``H1``, ``H2`` or ``V``, ``component`` the file
-name's station and component (``NORTHR/MUL009`` for
-``RSN953_NORTHR_MUL009.AT2``, the FEMA P695 sets' way), ``pulse`` (where the
+name's event code and station component as the FEMA P695 sets write them
+(``NORTHR/MUL009`` for ``RSN953_NORTHR_MUL009.AT2``, ``IMPVALL/H-DLT262`` for
+``RSN169_IMPVALL.H_H-DLT262.AT2``: with the record sequence number, the same
+recording in both is one recording to the selection), ``pulse`` (where the
 file has the pulse-period column: true where it gives a period) and
 ``search_scale_factor`` (the search's scale factor, kept, never applied: the
 files are as recorded, and scaling is the experiment's).
@@ -166,7 +168,9 @@ def _number(text: str, column: str, where: str) -> float:
 
 
 def _component(file_name: str) -> str:
-    """The station and component of an NGA file name: ``RSN953_NORTHR_MUL009.AT2`` → ``NORTHR/MUL009``."""
+    """The event code and station component of an NGA-West2 file name, as NGA-West1 (and the FEMA P695 sets) write them:
+    ``RSN953_NORTHR_MUL009.AT2`` → ``NORTHR/MUL009``, ``RSN169_IMPVALL.H_H-DLT262.AT2`` → ``IMPVALL/H-DLT262`` (the
+    event code's ``.H``, NGA-West2's mark of the event in a sequence, left out)."""
     stem = _RSN_PREFIX.sub("", Path(file_name).stem)
     event, _, station = stem.partition("_")
-    return f"{event}/{station}" if station else stem
+    return f"{event.split('.')[0]}/{station}" if station else stem
