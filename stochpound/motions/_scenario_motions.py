@@ -21,9 +21,9 @@ import xarray as xr
 
 from stochpound._errors import SiteError
 from stochpound.motions._scenario import Scenario, given_scenario
-from stochpound.motions._seeding import check_seed, realization_rngs
+from stochpound.motions._seeding import check_seed
 from stochpound.motions._site_model import PARAMETER_NORMALS
-from stochpound.motions._site_motions import SITE_MOTION_LIMITS, site_model_provenance, site_motions_from_normals
+from stochpound.motions._site_motions import SITE_MOTION_LIMITS, site_model_provenance, site_motions, site_motions_from_normals
 
 SCENARIO_TYPE = "scenario_motions"
 """The synthetic type (a ``[motion] type``, a ``[synthetic.<name>] type``) of :func:`scenario_motions`."""
@@ -165,10 +165,11 @@ def scenario_motions(n_realizations: int, duration: float, dt: float, magnitude:
         seed = check_seed(seed)
     except ValueError as error:
         raise SiteError(str(error)) from None
-    normals = np.array([rng.standard_normal(motion.dimension) for rng in realization_rngs(seed, int(start), int(n_realizations))])
-    generated = motion.motions(normals.reshape(int(n_realizations), motion.dimension)) if n_realizations else None
+    first, count = int(start), int(n_realizations)
+    generated = site_motions(scenario=motion.scenario, n=first + count, seed=seed, dt=motion.dt, duration=duration, model=model,
+                             realizations=range(first, first + count)) if count else None  # f(u_i) row by row, on the batches' threads
     values = generated["acceleration"].values if generated is not None else np.empty((0, motion.n_time))
-    realizations = np.arange(int(start), int(start) + int(n_realizations))
+    realizations = np.arange(first, first + count)
     coords = {"realization": realizations, "time": motion.time}
     for name in PARAMETERS:
         coords[name] = ("realization", generated[name].values if generated is not None else np.empty(0), {"units": _units(generated, name)})
