@@ -61,14 +61,14 @@ def test_a_component_is_named_as_the_fema_p695_sets_name_the_same_recording(tmp_
 
 
 def test_a_spreadsheet_s_copy_of_the_report_reads_the_same(tmp_path) -> None:
-    """Saved again by a spreadsheet: every line padded with commas to 31 fields, names quoted twice (a quote, a space, the name in doubled quotes)."""
+    """Saved again by a spreadsheet: lines padded with commas to 31 fields, names quoted twice (a quote, a space, the name in doubled quotes)."""
     folder = tmp_path / "copy"
     folder.mkdir()
     lines = []
     for line in (FIXTURE / "_SearchResults.csv").read_text().splitlines():
         line = re.sub(r', "([^"]*)"', r'," ""\1"""', line)
         lines.append(line + "," * max(0, 30 - line.count(",")))
-    (folder / "_SearchResults.csv").write_text("\n".join(lines) + "\n")
+    (folder / "_SearchResults.csv").write_bytes(("\r\n".join(lines) + "\r\n").encode())  # and Windows line ends
     assert '" ""Imaginary Valley-01"""' in (folder / "_SearchResults.csv").read_text()
     assert folder_metadata(folder) == folder_metadata(FIXTURE)
 
