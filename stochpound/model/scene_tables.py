@@ -10,7 +10,7 @@ found by name, default names B1, B2, ... included), its contacts and walls
 (:class:`WallTable`), each an attribute; :class:`SceneOverrides` reads one
 variant's overrides the same way. They check shape where they read (a
 ``[[building]]`` is a table); ranges are the builder's
-(:func:`~stochpound.model.scene_from_dict`, whose errors name the field), and
+(:func:`~stochpound.scene_from_dict`, whose errors name the field), and
 :meth:`SceneTables.to_dict` gives the scene back exactly as written.
 """
 
