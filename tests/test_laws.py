@@ -9,6 +9,7 @@ import pytest
 
 import stochpound
 from stochpound.model import laws
+from stochpound.model.fields import TomlTable
 from stochpound.model.friction import Base, SlidingBase
 from stochpound.model.law import ElementParameters
 from stochpound.studies.agarwal2004 import reference_building
@@ -49,7 +50,7 @@ def test_every_contact_law_has_consistent_force_partials_and_power(name):
     np.testing.assert_array_equal(law.power(element, delta, rate, onset), law.force(element, delta, rate, onset) * rate)
     assert law.energy_term == "impact"
     table = {"law": name, "stiffness": 2.0, **({"damping": 3.0} if "damping" in law.keys else {})}
-    assert law.rescaled(table, 1.5) == {"stiffness": 3.0, **({"damping": 4.5} if "damping" in law.keys else {})}
+    assert law.rescaled(TomlTable(table), 1.5) == {"stiffness": 3.0, **({"damping": 4.5} if "damping" in law.keys else {})}
 
 
 def test_the_friction_laws_and_the_friction_pendulum_describe_themselves():
@@ -102,5 +103,5 @@ def test_the_law_modules_old_paths_are_the_moved_modules(old, new):
 
 @pytest.mark.parametrize("mu, law", [(0.1, "coulomb"), ({"slow": 0.05, "fast": 0.1, "rate": 20.0}, "velocity")])
 def test_a_bases_friction_law_is_the_one_its_mu_is_written_for(mu, law):
-    assert laws.base_friction_law({"mass": 1.0, "mu": mu}) is laws.friction_law(law)
+    assert laws.base_friction_law(TomlTable({"mass": 1.0, "mu": mu})) is laws.friction_law(law)
     assert {name for name, other in laws.FRICTION_LAWS.items() if other.spells(mu)} == {law}

@@ -285,14 +285,15 @@ def test_the_design_rows_say_why_there_is_no_eurocode_8_row():
 def test_the_assumptions_say_the_base_the_grid_leaves():
     """A building with a base that the grid's μ = ∞ fixes is on a fixed base (the flagship's fixed pair was said to be on a
     sliding base); the scenario's words: tests/test_fitted_scenarios.py."""
+    from stochpound.model.scene_tables import SceneTables
     from stochpound.risk._inputs import _base_words
     from stochpound.store import MuAxis
 
-    building = {"name": "B1", "base": {"mu": 0.05}}
+    building, fixed = SceneTables.of({"building": [{"name": "B1", "base": {"mu": 0.05}}, {"name": "B2"}]}).buildings
     assert _base_words(MuAxis((float("inf"),), ("B1",)), building) == "a fixed base (μ = ∞ on the grid)"
     assert _base_words(MuAxis((0.05, 0.08), ("B1",)), building) == "a sliding base (μ 0.05, 0.08 on the grid)"
     assert _base_words(MuAxis((0.05, float("inf")), None), building) == "a sliding base (μ 0.05 on the grid) or a fixed base"
-    assert _base_words(None, {"name": "B2"}) == "a fixed base"
+    assert _base_words(None, fixed) == "a fixed base"
 
 
 def test_the_chain_reads_its_store_once_and_answers_from_the_inputs_alone(moat_variant_store, tmp_path):

@@ -23,7 +23,7 @@ from stochpound.model.modal_solution import Modes, modal_properties
 from stochpound.model.scene import Building, Contact, Scene
 from stochpound.model.scene_file import scene_from_dict
 from stochpound.model.wall import Wall
-from stochpound.store import CASE, GapAxis, is_fixed_base
+from stochpound.store import CASE, Case, GapAxis, is_fixed_base
 
 
 @dataclass(frozen=True)
@@ -75,8 +75,7 @@ class StoreScenes:
         for case in cases:
             labels = case.label_dict
             key = tuple(labels[axis] for axis in variant_axes)
-            finite = not is_fixed_base(labels.get("mu", 0.0))
-            if key not in chosen or (finite and is_fixed_base(chosen[key].label_dict.get("mu", 0.0))):
+            if key not in chosen or (not _fixed_by_mu(case) and _fixed_by_mu(chosen[key])):
                 chosen[key] = case
         return [Configuration(dict(zip(variant_axes, key)), scene_from_dict(self.experiment.structure(case))) for key, case in chosen.items()]
 
@@ -133,3 +132,8 @@ class StoreScenes:
         """The wall's law parameters, with the mass of the level it faces (the base's at level 0)."""
         building = scene.buildings[wall.building]
         return wall.parameters(building.base.mass if wall.level == 0 and building.base is not None else building.mass[max(wall.level, 1) - 1])
+
+
+def _fixed_by_mu(case: Case) -> bool:
+    """Whether the grid's μ axis fixes the case's bases (μ = ∞; a case without a μ axis keeps them)."""
+    return case.mu is not None and is_fixed_base(case.mu)

@@ -17,13 +17,11 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any, Mapping
-
 import numpy as np
 from scipy.linalg import eigh
 
 from stochpound._errors import SceneError
-from stochpound.model import fields
+from stochpound.model.fields import TomlTable
 from stochpound.model.friction import Base, base_from_table
 
 BUILDING_KEYS = {"name", "mass", "stiffness", "damping", "damping_ratio", "base", "initial", "storey_height", "yield_force", "hardening", "p_delta"}
@@ -147,11 +145,11 @@ def stiffness_proportional_damping(mass: np.ndarray, stiffness: np.ndarray, rati
 # ---------------------------------------------------------------- scene file
 
 
-def buildings_from_tables(tables: list[Mapping[str, Any]]) -> list[Building]:
+def buildings_from_tables(tables: list[TomlTable]) -> list[Building]:
     """The ``[[building]]`` tables of a scene file, validated (names unique)."""
     if not tables:
         raise SceneError("building: at least one [[building]] is required")
-    buildings = [building_from_table(table, f"building[{i}]", i) for i, table in enumerate(tables)]
+    buildings = [building_from_table(table, i) for i, table in enumerate(tables)]
     names = [b.name for b in buildings]
     for i, name in enumerate(names):
         if names.index(name) != i:
@@ -164,86 +162,85 @@ def default_name(index: int) -> str:
     return f"B{index + 1}"
 
 
-def building_from_table(table: Mapping[str, Any], prefix: str, index: int) -> Building:
-    """One ``[[building]]`` table (at ``prefix``, the ``index``-th: default name B{index + 1}), validated."""
-    fields.reject_unknown(table, BUILDING_KEYS, prefix)
-    name = fields.string(table, "name", prefix, default=default_name(index))
-    base = base_from_table(fields.table(table, "base", prefix), f"{prefix}.base")
-    mass = fields.number_list(table, "mass", prefix, low=0.0, low_open=True)
+def building_from_table(table: TomlTable, index: int) -> Building:
+    """One ``[[building]]`` table (the ``index``-th: default name B{index + 1}), validated."""
+    table.reject_unknown(BUILDING_KEYS)
+    name = table.string("name", default_name(index))
+    base = base_from_table(table.table("base"))
+    mass = table.numbers("mass", low=0.0, low_open=True)
     if not mass and base is None:
-        raise SceneError(f"{prefix}.mass: must have at least one floor (only a sliding base may carry no floors)")
-    stiffness = fields.number_list(table, "stiffness", prefix, low=0.0, low_open=False, length=len(mass))
-    damping, ratio = _storey_damping(table, prefix, np.array(mass), np.array(stiffness))
-    initial = _initial(fields.table(table, "initial", prefix), f"{prefix}.initial", len(mass), base is not None)
-    height = fields.number_list(table, "storey_height", prefix, low=0.0, low_open=True, length=len(mass)) if "storey_height" in table else None
-    yield_force, hardening = _yielding(table, prefix, stiffness)
+        raise table.error("mass", "must have at least one floor (only a sliding base may carry no floors)")
+    stiffness = table.numbers("stiffness", low=0.0, length=len(mass))
+    damping, ratio = _storey_damping(table, np.array(mass), np.array(stiffness))
+    initial = _initial(table.table("initial"), len(mass), base is not None)
+    height = table.numbers("storey_height", None, low=0.0, low_open=True, length=len(mass))
+    yield_force, hardening = _yielding(table, stiffness)
     if yield_force is not None:
         drift = np.diff(np.concatenate([[0.0], initial.displacement]))
         for i, (d, force, k) in enumerate(zip(drift, yield_force, stiffness)):
             if abs(d) > force / k:
-                raise SceneError(f"{prefix}.initial.displacement: storey {i + 1}'s drift {d:.6g} m is beyond its yield drift F_y/k = {force / k:.6g} m "
+                raise SceneError(f"{table.name}.initial.displacement: storey {i + 1}'s drift {d:.6g} m is beyond its yield drift F_y/k = {force / k:.6g} m "
                                  "(a yielding building starts elastic)")
-    p_delta = fields.boolean(table, "p_delta", prefix, default=False)
+    p_delta = table.boolean("p_delta", False)
     if p_delta and height is None:
-        raise SceneError(f"{prefix}.p_delta: needs storey_height (the geometric stiffness of a storey is −W/h)")
+        raise table.error("p_delta", "needs storey_height (the geometric stiffness of a storey is −W/h)")
     return Building(name, mass, stiffness, damping, ratio, base, initial, height, yield_force, hardening, p_delta)
 
 
-def _yielding(table: Mapping[str, Any], prefix: str, stiffness: tuple[float, ...]) -> tuple[tuple[float, ...] | None, float]:
+def _yielding(table: TomlTable, stiffness: tuple[float, ...]) -> tuple[tuple[float, ...] | None, float]:
     """The bilinear storeys' ``yield_force`` (None: elastic) and ``hardening`` of a ``[[building]]`` table, validated."""
     if "yield_force" not in table:
         if "hardening" in table:
-            raise SceneError(f"{prefix}.hardening: only a building with yield_force (bilinear storeys) can have it")
+            raise table.error("hardening", "only a building with yield_force (bilinear storeys) can have it")
         return None, 0.0
-    yield_force = fields.number_list(table, "yield_force", prefix, low=0.0, low_open=True, length=len(stiffness))
+    yield_force = table.numbers("yield_force", low=0.0, low_open=True, length=len(stiffness))
     if any(k <= 0.0 for k in stiffness):
-        raise SceneError(f"{prefix}.yield_force: needs every storey stiffness > 0 (the yield drift is F_y / k)")
-    return yield_force, fields.number(table, "hardening", prefix, default=0.0, low=0.0, high=1.0, high_open=True)
+        raise table.error("yield_force", "needs every storey stiffness > 0 (the yield drift is F_y / k)")
+    return yield_force, table.number("hardening", 0.0, low=0.0, high=1.0, high_open=True)
 
 
-def _storey_damping(table: Mapping[str, Any], prefix: str, mass: np.ndarray, stiffness: np.ndarray) -> tuple[tuple[float, ...], float | None]:
+def _storey_damping(table: TomlTable, mass: np.ndarray, stiffness: np.ndarray) -> tuple[tuple[float, ...], float | None]:
     if "damping" in table and "damping_ratio" in table:
-        raise SceneError(f"{prefix}.damping: give either damping (N·s/m per storey) or damping_ratio, not both")
+        raise table.error("damping", "give either damping (N·s/m per storey) or damping_ratio, not both")
     if "damping_ratio" in table:
-        ratio = fields.number(table, "damping_ratio", prefix, low=0.0, high=1.0, high_open=True)
+        ratio = table.number("damping_ratio", low=0.0, high=1.0, high_open=True)
         if len(mass) == 0 or np.any(stiffness <= 0.0):
-            raise SceneError(f"{prefix}.damping_ratio: needs every storey stiffness > 0 (mode 1 must have a frequency); give damping instead")
+            raise table.error("damping_ratio", "needs every storey stiffness > 0 (mode 1 must have a frequency); give damping instead")
         return tuple(stiffness_proportional_damping(mass, stiffness, ratio)), ratio
-    if "damping" in table:
-        return fields.number_list(table, "damping", prefix, low=0.0, low_open=False, length=len(mass)), None
-    return tuple(0.0 for _ in mass), None
+    return table.numbers("damping", tuple(0.0 for _ in mass), low=0.0, length=len(mass)), None
 
 
-def _initial(table: Mapping[str, Any] | None, prefix: str, n_floors: int, has_base: bool) -> InitialState:
+def _initial(table: TomlTable | None, n_floors: int, has_base: bool) -> InitialState:
     zeros = tuple(0.0 for _ in range(n_floors))
     if table is None:
         return InitialState(zeros, zeros)
-    fields.reject_unknown(table, INITIAL_KEYS, prefix)
+    table.reject_unknown(INITIAL_KEYS)
     for key in ("base_displacement", "base_velocity"):
         if key in table and not has_base:
-            raise SceneError(f"{prefix}.{key}: only a building with a sliding [building.base] can have it")
-    displacement = fields.number_list(table, "displacement", prefix, low=-math.inf, low_open=False, length=n_floors) if "displacement" in table else zeros
-    velocity = fields.number_list(table, "velocity", prefix, low=-math.inf, low_open=False, length=n_floors) if "velocity" in table else zeros
+            raise table.error(key, "only a building with a sliding [building.base] can have it")
     return InitialState(
-        displacement,
-        velocity,
-        fields.number(table, "base_displacement", prefix, default=0.0),
-        fields.number(table, "base_velocity", prefix, default=0.0),
+        table.numbers("displacement", zeros, low=-math.inf, length=n_floors),
+        table.numbers("velocity", zeros, low=-math.inf, length=n_floors),
+        table.number("base_displacement", 0.0),
+        table.number("base_velocity", 0.0),
     )
 
 
-def scaled_masses(table: Mapping[str, Any], factor: float) -> dict[str, Any]:
-    """The fields of a ``[[building]]`` table whose masses are multiplied by ``factor``, keeping its modal damping ratios.
+def scaled_masses(table: TomlTable, factor: float) -> tuple[dict[str, list[float]], dict[str, float]]:
+    """The fields of a ``[[building]]`` table, and of its ``[building.base]``, whose masses are multiplied by ``factor``, keeping its modal damping ratios.
 
     The floor masses and a base's ``mass`` × factor; storey dashpots given as
     ``damping`` × √factor (M → fM with K fixed scales every frequency by
     1/√f, so C → √f C keeps every modal damping ratio); a ``damping_ratio``
     is kept as it is (not among the fields returned).
+
+    Returns
+    -------
+    tuple of (dict, dict)
+        The building's changed fields (``mass``, and ``damping`` when given), and its base's (``mass``; empty without a base mass).
     """
-    scaled: dict[str, Any] = {"mass": [float(m) * factor for m in table["mass"]]}
-    base = table.get("base")
-    if isinstance(base, dict) and "mass" in base:
-        scaled["base"] = {**base, "mass": float(base["mass"]) * factor}
+    scaled = {"mass": [float(m) * factor for m in table.raw("mass")]}
     if "damping" in table:
-        scaled["damping"] = [float(c) * math.sqrt(factor) for c in table["damping"]]
-    return scaled
+        scaled["damping"] = [float(c) * math.sqrt(factor) for c in table.raw("damping")]
+    base = table.raw("base")
+    return scaled, ({"mass": float(base["mass"]) * factor} if isinstance(base, dict) and "mass" in base else {})

@@ -23,12 +23,13 @@ study's ``study_compat`` model); a nonlinear law's force is a read-out
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass
-from typing import Any, Mapping, Sequence
+from typing import Any, Sequence
 
 import numpy as np
 
 from stochpound._errors import SceneError
 from stochpound.model import fields, laws
+from stochpound.model.fields import TomlTable
 from stochpound.model.building import Building
 from stochpound.model.guards import Guard
 from stochpound.model.laws.contract import ElementParameters
@@ -102,9 +103,9 @@ def effective_mass(mass_1: float, mass_2: float) -> float:
 # ---------------------------------------------------------------- scene file
 
 
-def contacts_from_tables(tables: list[Mapping[str, Any]], buildings: Sequence[Building]) -> list[Contact]:
+def contacts_from_tables(tables: list[TomlTable], buildings: Sequence[Building]) -> list[Contact]:
     """The ``[[contact]]`` tables of a scene, validated; two at the same floors are refused (they would add their stiffnesses)."""
-    contacts = [contact_from_table(table, f"contact[{i}]", buildings) for i, table in enumerate(tables)]
+    contacts = [contact_from_table(table, buildings) for table in tables]
     fields.reject_repeated(
         [((c.left, c.left_floor, c.right, c.right_floor), f"{buildings[c.left].name!r} floor {c.left_floor} and {buildings[c.right].name!r} floor {c.right_floor}")
          for c in contacts],
@@ -113,35 +114,35 @@ def contacts_from_tables(tables: list[Mapping[str, Any]], buildings: Sequence[Bu
     return contacts
 
 
-def contact_from_table(table: Mapping[str, Any], prefix: str, buildings: Sequence[Building]) -> Contact:
-    """One ``[[contact]]`` table (at ``prefix``) between ``buildings``, validated."""
-    fields.reject_unknown(table, CONTACT_KEYS, prefix)
-    between = table.get("between")
+def contact_from_table(table: TomlTable, buildings: Sequence[Building]) -> Contact:
+    """One ``[[contact]]`` table between ``buildings``, validated."""
+    table.reject_unknown(CONTACT_KEYS)
+    between = table.raw("between")
     if not isinstance(between, list) or len(between) != 2:
-        raise SceneError(f"{prefix}.between: must be [[left building, floor], [right building, floor]], got {between!r}")
-    left, left_floor = _contact_end(between[0], f"{prefix}.between[0]", buildings)
-    right, right_floor = _contact_end(between[1], f"{prefix}.between[1]", buildings)
+        raise table.error("between", f"must be [[left building, floor], [right building, floor]], got {between!r}")
+    left, left_floor = _contact_end(between[0], f"{table.field('between')}[0]", buildings)
+    right, right_floor = _contact_end(between[1], f"{table.field('between')}[1]", buildings)
     if right != left + 1:
-        raise SceneError(
-            f"{prefix}.between: contacts join neighbours, left building first; "
+        raise table.error(
+            "between", "contacts join neighbours, left building first; "
             f"{buildings[left].name!r} and {buildings[right].name!r} are not left/right neighbours"
         )
     mass = effective_mass(buildings[left].mass[left_floor - 1], buildings[right].mass[right_floor - 1])
-    return Contact(left=left, left_floor=left_floor, right=right, right_floor=right_floor, **asdict(element_from_table(table, prefix, mass)))
+    return Contact(left=left, left_floor=left_floor, right=right, right_floor=right_floor, **asdict(element_from_table(table, mass)))
 
 
-def element_from_table(table: Mapping[str, Any], prefix: str, mass: float) -> ImpactElement:
+def element_from_table(table: TomlTable, mass: float) -> ImpactElement:
     """The impact element of a ``[[contact]]`` or ``[[wall]]`` table, validated by its law (:mod:`stochpound.model.laws`).
 
     ``mass`` is the effective mass m_eff of the collision (kg), from which a
     Kelvin–Voigt element derives its dashpot from a restitution.
     """
-    gap = fields.number(table, "gap", prefix, required=True, low=0.0, allow_inf=True)
-    law = laws.contact_law(fields.string(table, "law", prefix, default=laws.DEFAULT_CONTACT_LAW), f"{prefix}.law")
+    gap = table.number("gap", low=0.0, allow_inf=True)
+    law = laws.contact_law(table.string("law", laws.DEFAULT_CONTACT_LAW), table.field("law"))
     for key in sorted(ELEMENT_KEYS - law.keys - {"law"}):
         if key in table:
-            raise SceneError(f"{prefix}.{key}: {law.refuse(key)}")
-    stiffness, damping, restitution, tensile, _ = law.read(table, prefix, mass)
+            raise table.error(key, law.refuse(key))
+    stiffness, damping, restitution, tensile, _ = law.read(table, mass)
     return ImpactElement(gap, stiffness, damping, restitution, tensile, law.name)
 
 

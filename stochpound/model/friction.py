@@ -29,12 +29,11 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any, Mapping
 
 import numpy as np
 
-from stochpound._errors import SceneError
-from stochpound.model import fields, laws
+from stochpound.model import laws
+from stochpound.model.fields import TomlTable
 from stochpound.model.guards import Guard
 from stochpound.model.laws import coulomb, velocity_friction
 
@@ -123,17 +122,17 @@ def is_fixed_base(mu: float | str) -> bool:
     return math.isinf(float(mu))
 
 
-def base_from_table(table: Mapping[str, Any] | None, prefix: str) -> Base | None:
-    """A ``[building.base]`` table (at ``prefix``), validated; None (a fixed base) when there is none."""
+def base_from_table(table: TomlTable | None) -> Base | None:
+    """A ``[building.base]`` table, validated; None (a fixed base) when there is none."""
     if table is None:
         return None
-    fields.reject_unknown(table, BASE_KEYS, prefix)
-    mass = fields.number(table, "mass", prefix, required=True, low=0.0, low_open=True)
-    mu, mu_static, mu_fast, mu_rate = laws.base_friction_law(table).read(table, prefix)
+    table.reject_unknown(BASE_KEYS)
+    mass = table.number("mass", low=0.0, low_open=True)
+    mu, mu_static, mu_fast, mu_rate = laws.base_friction_law(table).read(table)
     if "radius" in table and "restoring_stiffness" in table:
-        raise SceneError(f"{prefix}.radius: give either radius (a friction pendulum, k_r = W/R) or restoring_stiffness, not both")
-    restoring = fields.number(table, "restoring_stiffness", prefix, default=0.0, low=0.0)
-    radius = fields.number(table, "radius", prefix, low=0.0, low_open=True)
+        raise table.error("radius", "give either radius (a friction pendulum, k_r = W/R) or restoring_stiffness, not both")
+    restoring = table.number("restoring_stiffness", 0.0, low=0.0)
+    radius = table.number("radius", None, low=0.0, low_open=True)
     return Base(mass, mu, mu_static, restoring, radius, mu_fast, mu_rate)
 
 

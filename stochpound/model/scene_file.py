@@ -19,7 +19,7 @@ from stochpound._data_files import bundled_data_dir
 from stochpound._errors import RecordError, SceneError
 from stochpound._memory import check_memory, sample_bytes
 from stochpound._text_files import read_text_file
-from stochpound.model import fields
+from stochpound.model.fields import REQUIRED, TomlTable, field_path
 from stochpound.model.building import buildings_from_tables
 from stochpound.model.contact import contacts_from_tables
 from stochpound.model.scene import Scene
@@ -124,15 +124,15 @@ def scene_from_dict(data: Mapping[str, Any], base_dir: str | Path = ".", source:
     source : str
         Provenance label stored with the scene.
     """
-    fields.reject_unknown(data, _TOP_KEYS, "")
-    g = fields.number(data, "g", "", default=DEFAULT_G, low=0.0, low_open=True)
-    study_compat = fields.boolean(data, "study_compat", "", default=False)
-    buildings = buildings_from_tables(fields.array_of_tables(data, "building"))
-    contacts = contacts_from_tables(fields.array_of_tables(data, "contact"), buildings)
-    walls = walls_from_tables(fields.array_of_tables(data, "wall"), buildings)
+    table = TomlTable(data, "", _TOP_KEYS)
+    g = table.number("g", DEFAULT_G, low=0.0, low_open=True)
+    study_compat = table.boolean("study_compat", False)
+    buildings = buildings_from_tables(table.tables("building"))
+    contacts = contacts_from_tables(table.tables("contact"), buildings)
+    walls = walls_from_tables(table.tables("wall"), buildings)
     n_dof = sum(b.n_floors + (b.base is not None) for b in buildings)
     per_sample = sample_bytes(n_dof, len(buildings), max((b.n_floors for b in buildings), default=1), len(contacts) + len(walls))
-    motion = _motion(data, Path(base_dir), g, per_sample)
+    motion = _motion(table, Path(base_dir), g, per_sample)
     return Scene(tuple(buildings), tuple(contacts), motion, g=g, study_compat=study_compat, walls=tuple(walls), source=source)
 
 
@@ -157,7 +157,7 @@ def scene_warnings(scene: Scene, prefix: str = "") -> list[str]:
     low, high = EARTH_GRAVITY
     if low <= scene.g <= high:
         return []
-    return [f"{fields.field_path(prefix, 'g')}: {scene.g:g} m/s² is outside {low:g}-{high:g} m/s², the Earth's gravity (g is in m/s², "
+    return [f"{field_path(prefix, 'g')}: {scene.g:g} m/s² is outside {low:g}-{high:g} m/s², the Earth's gravity (g is in m/s², "
             "e.g. 9.81); used as given"]
 
 
@@ -172,17 +172,17 @@ _MOTION_KEYS = {
 }
 
 
-def _motion(data: Mapping[str, Any], base_dir: Path, g: float, per_sample: int) -> GroundMotion:
+def _motion(scene: TomlTable, base_dir: Path, g: float, per_sample: int) -> GroundMotion:
     """The scene's ground motion; a run needing more than the memory limit (``per_sample`` bytes a sample) is refused first."""
-    table = fields.table(data, "motion", "")
+    table = scene.table("motion")
     if table is None:
         raise SceneError(f"motion: missing ([motion] with a record, or type = harmonic | constant | {' | '.join(SYNTHETIC_TYPES)})")
-    kind = fields.string(table, "type", "motion", default="record")
+    kind = table.string("type", "record")
     if kind in SYNTHETIC_TYPES:
         return _synthetic_motion(table, kind, per_sample)
     if kind not in _MOTION_KEYS:
         raise SceneError(f"motion.type: must be one of record, harmonic, constant, site_motions, {', '.join(SYNTHETIC_TYPES)}; got {kind!r}")
-    fields.reject_unknown(table, _MOTION_KEYS[kind], "motion")
+    table.reject_unknown(_MOTION_KEYS[kind])
     if kind == "harmonic":
         return _harmonic_motion(table, per_sample)
     if kind == "constant":
@@ -192,9 +192,9 @@ def _motion(data: Mapping[str, Any], base_dir: Path, g: float, per_sample: int) 
     return _record_motion(table, base_dir, g, per_sample)
 
 
-def _timing(table: Mapping[str, Any], required: bool, per_sample: int) -> tuple[float | None, float | None]:
-    duration = fields.number(table, "duration", "motion", required=required, low=0.0, low_open=True)
-    dt = fields.number(table, "dt", "motion", required=required, low=0.0, low_open=True)
+def _timing(table: TomlTable, required: bool, per_sample: int) -> tuple[float | None, float | None]:
+    duration = table.number("duration", REQUIRED if required else None, low=0.0, low_open=True)
+    dt = table.number("dt", REQUIRED if required else None, low=0.0, low_open=True)
     if duration is not None and dt is not None and dt > duration:
         raise SceneError(f"motion.dt: must be <= motion.duration ({duration:g} s), got {dt:g}")
     if required:  # a record's own length bounds its samples: checked once read
@@ -203,22 +203,22 @@ def _timing(table: Mapping[str, Any], required: bool, per_sample: int) -> tuple[
     return duration, dt
 
 
-def _harmonic_motion(table: Mapping[str, Any], per_sample: int) -> HarmonicMotion:
-    amplitude = fields.number(table, "amplitude", "motion", required=True)
-    omega = fields.number(table, "omega", "motion", required=True, low=0.0)
-    phase = fields.number(table, "phase", "motion", default=0.0)
+def _harmonic_motion(table: TomlTable, per_sample: int) -> HarmonicMotion:
+    amplitude = table.number("amplitude")
+    omega = table.number("omega", low=0.0)
+    phase = table.number("phase", 0.0)
     duration, dt = _timing(table, required=True, per_sample=per_sample)
     return HarmonicMotion(amplitude, omega, duration, dt, phase)
 
 
-def _constant_motion(table: Mapping[str, Any], per_sample: int) -> SampledMotion:
-    acceleration = fields.number(table, "acceleration", "motion", required=True)
+def _constant_motion(table: TomlTable, per_sample: int) -> SampledMotion:
+    acceleration = table.number("acceleration")
     duration, dt = _timing(table, required=True, per_sample=per_sample)
     n_samples = int(round(duration / dt)) + 1
     return SampledMotion(dt, np.full(n_samples, acceleration), description=f"constant {acceleration:g} m/s²")
 
 
-def _site_motion(table: Mapping[str, Any], per_sample: int) -> SampledMotion:
+def _site_motion(table: TomlTable, per_sample: int) -> SampledMotion:
     """Motion ``realization`` of :func:`~stochpound.motions.site_motions` (``n`` motions of a scenario from ``seed``), times ``scale``.
 
     ``calibration``, when given, must name the model's calibration
@@ -228,43 +228,43 @@ def _site_motion(table: Mapping[str, Any], per_sample: int) -> SampledMotion:
     from stochpound._errors import SiteError
     from stochpound.motions import site_model_provenance, site_motions
 
-    model = fields.string(table, "model", "motion", default="hazard_compatible")
-    realization = table.get("realization", 0)
-    scale = fields.number(table, "scale", "motion", default=1.0)
+    model = table.string("model", "hazard_compatible")
+    realization = table.raw("realization", 0)
+    scale = table.number("scale", 1.0)
     missing = [key for key in ("magnitude", "distance_km", "vs30", "mechanism", "n", "seed") if key not in table]
     if missing:
         raise SceneError(f"motion.{missing[0]}: required for type = 'site_motions' (see docs/motions.md)")
-    n = table["n"]
+    n = table.raw("n")
     if isinstance(realization, bool) or not isinstance(realization, int) or not (0 <= realization < n if isinstance(n, int) else realization >= 0):
         raise SceneError(f"motion.realization: must be an integer within 0 and n - 1 = {n!r} - 1, got {realization!r}")
     try:
-        if "calibration" in table and table["calibration"] != site_model_provenance(model):
-            raise SceneError(f"motion.calibration: {table['calibration']!r} is not the calibration of model {model!r} here "
+        if "calibration" in table and table.raw("calibration") != site_model_provenance(model):
+            raise SceneError(f"motion.calibration: {table.raw('calibration')!r} is not the calibration of model {model!r} here "
                              f"({site_model_provenance(model)!r}): the motion cannot be regenerated")
-        generated = site_motions(table["magnitude"], table["distance_km"], table["vs30"], table["mechanism"], n=table["n"], seed=table["seed"],
-                                 dt=table.get("dt", 0.01), model=model, realizations=[realization])
+        generated = site_motions(table.raw("magnitude"), table.raw("distance_km"), table.raw("vs30"), table.raw("mechanism"), n=n,
+                                 seed=table.raw("seed"), dt=table.raw("dt", 0.01), model=model, realizations=[realization])
     except SiteError as error:
         raise SceneError(f"motion.{error}") from None
     values = np.asarray(generated["acceleration"].values[0], dtype=float)
     check_memory(len(values) * per_sample, f"motion: {len(values)} samples; a run")
     if scale != 1.0:
         values = values * scale
-    description = f"site_motions realization {realization} of {table['n']} (seed {table['seed']}, {model})" + (f" x {scale:.9g}" if scale != 1.0 else "")
+    description = f"site_motions realization {realization} of {n} (seed {table.raw('seed')}, {model})" + (f" x {scale:.9g}" if scale != 1.0 else "")
     return SampledMotion(float(generated.attrs["dt"]), values, "linear", description)
 
 
-def _record_motion(table: Mapping[str, Any], base_dir: Path, g: float, per_sample: int) -> SampledMotion:
+def _record_motion(table: TomlTable, base_dir: Path, g: float, per_sample: int) -> SampledMotion:
     from stochpound.motions.records import load_record, normalize_units
 
-    spec = fields.string(table, "record", "motion")
-    scale = fields.number(table, "scale", "motion", default=1.0)
+    spec = table.string("record")
+    scale = table.number("scale", 1.0)
     duration, dt = _timing(table, required=False, per_sample=per_sample)
-    units = fields.string(table, "units", "motion", default="") or None
+    units = table.string("units", None)
     try:
         units = None if units is None else normalize_units(units)
     except ValueError as error:
         raise SceneError(f"motion.{error}") from None
-    interpolation = fields.string(table, "interpolation", "motion", default="linear")
+    interpolation = table.string("interpolation", "linear")
     if interpolation not in ("linear", "spline"):
         raise SceneError(f"motion.interpolation: must be 'linear' or 'spline', got {interpolation!r}")
     candidate = base_dir / spec
@@ -288,24 +288,24 @@ def generator_fields(generator: Any) -> set[str]:
     return {name for name in inspect.signature(generator).parameters if name not in ("n_realizations", "start")} | {"type", "interpolation"}
 
 
-def _check_generator_fields(table: Mapping[str, Any], generator: Any, kind: str) -> None:
+def _check_generator_fields(table: TomlTable, generator: Any, kind: str) -> None:
     """Reject fields the generator does not take, and name the required ones that are missing."""
     signature = inspect.signature(generator).parameters
     own = {name for name in signature if name not in ("n_realizations", "start")}
-    fields.reject_unknown(table, generator_fields(generator) | {"realization"}, "motion")
+    table.reject_unknown(generator_fields(generator) | {"realization"})
     for name, parameter in signature.items():
         if name in own and parameter.default is inspect.Parameter.empty and name not in table:
             raise SceneError(f"motion.{name}: required for type = {kind!r} (see docs/motions.md)")
 
 
-def _synthetic_motion(table: Mapping[str, Any], kind: str, per_sample: int) -> SampledMotion:
+def _synthetic_motion(table: TomlTable, kind: str, per_sample: int) -> SampledMotion:
     """One realization of a synthetic ensemble, fixed by (seed, realization) alone."""
     from stochpound import motions
 
     generator = getattr(motions, kind)
     _check_generator_fields(table, generator, kind)
-    parameters = {key: value for key, value in table.items() if key not in ("type", "realization", "interpolation")}
-    realization = table.get("realization", 0)
+    parameters = {key: table.raw(key) for key in table if key not in ("type", "realization", "interpolation")}
+    realization = table.raw("realization", 0)
     if not isinstance(realization, int) or isinstance(realization, bool) or realization < 0:
         raise SceneError(f"motion.realization: must be an integer >= 0, got {realization!r}")
     duration, dt = _timing(table, required=True, per_sample=per_sample)
@@ -314,5 +314,5 @@ def _synthetic_motion(table: Mapping[str, Any], kind: str, per_sample: int) -> S
         ensemble = generator(1, start=realization, **parameters)
     except (TypeError, ValueError) as error:
         raise SceneError(f"motion: {error}") from None
-    description = f"{kind} realization {realization} (seed {parameters.get('seed', 0)})"
+    description = f"{kind} realization {realization} (seed {table.raw('seed', 0)})"
     return SampledMotion(dt, np.asarray(ensemble.values[0], dtype=float), "linear", description)

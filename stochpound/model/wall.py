@@ -25,10 +25,10 @@ Mass scaling (experiment variants): its law's, with m_eff = m.
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass
-from typing import Any, Mapping, Sequence
+from typing import Sequence
 
-from stochpound._errors import SceneError
 from stochpound.model import fields
+from stochpound.model.fields import TomlTable
 from stochpound.model.building import Building
 from stochpound.model.contact import ELEMENT_KEYS, ImpactElement, element_from_table
 
@@ -60,9 +60,9 @@ class Wall(ImpactElement):
         return "right" if self.side > 0 else "left"
 
 
-def walls_from_tables(tables: list[Mapping[str, Any]], buildings: Sequence[Building]) -> list[Wall]:
+def walls_from_tables(tables: list[TomlTable], buildings: Sequence[Building]) -> list[Wall]:
     """The ``[[wall]]`` tables of a scene, validated; two beside the same level on the same side are refused (they would add their stiffnesses)."""
-    walls = [wall_from_table(table, f"wall[{i}]", buildings) for i, table in enumerate(tables)]
+    walls = [wall_from_table(table, buildings) for table in tables]
     fields.reject_repeated(
         [((w.building, w.side, w.level), f"building {buildings[w.building].name!r}, side {w.side_name!r}, level {w.level}") for w in walls],
         "wall", "", "two walls beside the same level on the same side add their forces (two equal ones act as one of twice the stiffness)",
@@ -70,21 +70,21 @@ def walls_from_tables(tables: list[Mapping[str, Any]], buildings: Sequence[Build
     return walls
 
 
-def wall_from_table(table: Mapping[str, Any], prefix: str, buildings: Sequence[Building]) -> Wall:
-    """One ``[[wall]]`` table (at ``prefix``) beside one of ``buildings``, validated."""
-    fields.reject_unknown(table, WALL_KEYS, prefix)
+def wall_from_table(table: TomlTable, buildings: Sequence[Building]) -> Wall:
+    """One ``[[wall]]`` table beside one of ``buildings``, validated."""
+    table.reject_unknown(WALL_KEYS)
     names = [b.name for b in buildings]
-    name = fields.string(table, "building", prefix)
+    name = table.string("building")
     if name not in names:
-        raise SceneError(f"{prefix}.building: unknown building {name!r} (buildings: {', '.join(names)})")
+        raise table.error("building", f"unknown building {name!r} (buildings: {', '.join(names)})")
     building = buildings[names.index(name)]
-    side = fields.string(table, "side", prefix)
+    side = table.string("side")
     if side not in SIDES:
-        raise SceneError(f"{prefix}.side: must be 'left' or 'right', got {side!r}")
-    level = table.get("level")
+        raise table.error("side", f"must be 'left' or 'right', got {side!r}")
+    level = table.raw("level")
     if not isinstance(level, int) or isinstance(level, bool) or not 0 <= level <= building.n_floors:
-        raise SceneError(f"{prefix}.level: must be 0 (the base) or a floor number in 1..{building.n_floors} for building {name!r}, got {level!r}")
+        raise table.error("level", f"must be 0 (the base) or a floor number in 1..{building.n_floors} for building {name!r}, got {level!r}")
     if level == 0 and building.base is None:
-        raise SceneError(f"{prefix}.level: 0 is the base, and building {name!r} has a fixed base (a moat wall needs a [building.base])")
+        raise table.error("level", f"0 is the base, and building {name!r} has a fixed base (a moat wall needs a [building.base])")
     mass = building.base.mass if level == 0 else building.mass[level - 1]
-    return Wall(building=names.index(name), side=SIDES[side], level=level, **asdict(element_from_table(table, prefix, mass)))
+    return Wall(building=names.index(name), side=SIDES[side], level=level, **asdict(element_from_table(table, mass)))

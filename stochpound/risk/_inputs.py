@@ -29,9 +29,10 @@ from stochpound._plurals import counted
 from stochpound.codes import store_contact_demands
 from stochpound.hazard import HazardCurve, check_covers, hazard_curve, hazard_option, parse_units, stored_hazard, StatedMeasure
 from stochpound.model import Scene
+from stochpound.model.scene_tables import BuildingTable
 from stochpound.motions import DEFAULT_G, TRUNCATION_EPSILON
 from stochpound.risk._code_rules import MINIMUM_MOTIONS
-from stochpound.store import (LIMIT_STATE_DEMANDS, Design, Intensity, LimitStates, cases_done, check_finished as _check_finished, contact_free, gap_dims,
+from stochpound.store import (LIMIT_STATE_DEMANDS, Design, Intensity, Label, LimitStates, MuAxis, cases_done, check_finished as _check_finished, contact_free, gap_dims,
                               has_contact_free, has_wall_free, scenario_kind, scenario_ranges, wall_free, with_contacts)
 
 CLOSURE = "peak_contact_closure"
@@ -88,8 +89,8 @@ class RiskInputs:
         The store's experiment name.
     assumptions : dict of str to str
         What an answer rests on besides the hazard, in words (``assumptions``).
-    design : mapping or None
-        The buildings' code design (the ``[design]`` entry, given or the store's).
+    design : Design or None
+        The buildings' code design (the ``[design]`` table, given or the store's).
     demands : xarray.Dataset or None
         The inputs of the code separation rules of every contact-free case
         (``contact_free_demands``); read for stripes with a design or at
@@ -120,7 +121,7 @@ class RiskInputs:
     progress: str
     experiment: str | None
     assumptions: dict[str, str]
-    design: Mapping[str, Any] | None
+    design: Design | None
     demands: xr.Dataset | None
     isolator: xr.DataArray | None
     dtm_note: str
@@ -130,7 +131,7 @@ class RiskInputs:
 
 
 def read_risk_inputs(store: xr.Dataset, hazard: HazardCurve | None = None, *, studied: str | None = None,
-                     design: Mapping[str, Any] | None = None, partial: bool = False) -> RiskInputs:
+                     design: Design | None = None, partial: bool = False) -> RiskInputs:
     """Read once what the risk chain needs of a store: its :class:`RiskInputs`.
 
     Parameters
@@ -141,8 +142,8 @@ def read_risk_inputs(store: xr.Dataset, hazard: HazardCurve | None = None, *, st
         The site's hazard; default the one the store carries (:func:`site_hazard`).
     studied : str, optional
         The building of D_TM; default the store's ``studied`` building.
-    design : mapping, optional
-        The ``[design]`` entry whose design analysis gives the codes' own gaps; default the store's.
+    design : Design, optional
+        The ``[design]`` table whose design analysis gives the codes' own gaps; default the store's.
     partial : bool
         Read the cases that ran of a store with missing cases; without it such a store is refused.
 
@@ -253,7 +254,7 @@ def design_entry(store: xr.Dataset) -> Design | None:
     return store.pound.definition.design
 
 
-def configuration_scene(store: xr.Dataset, labels: Mapping[str, Any]) -> Scene:
+def configuration_scene(store: xr.Dataset, labels: Mapping[str, Label]) -> Scene:
     """The scene of one configuration of a store (``labels`` on its variant and μ axes): its first contact-free case that ran.
 
     With motions selected per stripe, a motion runs only at the stripes that
@@ -287,11 +288,9 @@ def assumptions(store: xr.Dataset) -> dict[str, str]:
     selection, and the scenario."""
     definition = store.pound.definition
     models = []
-    for building in definition.scene.get("building", []):
-        storeys = len(building.get("mass", []))
-        storey = "yielding (bilinear) storeys" if "yield_force" in building else "linear elastic storeys"
-        base = _base_words(definition.mu, building)
-        models.append(f"{building.get('name', '?')}: {storeys}-storey shear building, {storey}, on {base}")
+    for building in definition.tables.buildings:
+        storey = "yielding (bilinear) storeys" if building.yields else "linear elastic storeys"
+        models.append(f"{building.name}: {building.floors}-storey shear building, {storey}, on {_base_words(definition.mu, building)}")
     kinds = {"record": "records without a named suite", "synthetic": "synthetic ensembles"}
     suites = sorted({source.suite or kinds.get(source.kind, source.kind) for source in definition.motions})
     count = sum(source.count for source in definition.motions)
@@ -303,11 +302,11 @@ def assumptions(store: xr.Dataset) -> dict[str, str]:
             "scenario": scenario or "none stated (the motions are not selected for a scenario)"}
 
 
-def _base_words(mu: Any, building: Mapping[str, Any]) -> str:
+def _base_words(mu: MuAxis | None, building: BuildingTable) -> str:
     """A building's base in words, as the grid's μ axis leaves it (the axis may fix a base or set its μ)."""
-    name = building.get("name", "?")
-    if mu is None or not mu.sets(name, "base" in building):
-        return "a sliding base" if "base" in building else "a fixed base"
+    has_base = "base" in building.table
+    if mu is None or not mu.sets(building.name, has_base):
+        return "a sliding base" if has_base else "a fixed base"
     if not mu.finite_values:
         return "a fixed base (μ = ∞ on the grid)"
     sliding = f"a sliding base (μ {', '.join(f'{v:g}' for v in mu.finite_values)} on the grid)"
@@ -475,12 +474,11 @@ def _wall_free_variant(store: xr.Dataset, studied: str | None) -> tuple[str, str
     """A variant axis whose values alone set the walls at the studied building's base, with its value that sets none (the
     wall-free twin of the others: D_TM is the displacement without the wall), or None (walls in the base scene, or no such axis)."""
     definition = store.pound.definition
-    if any(w.get("building") == studied and w.get("level", 0) == 0 for w in definition.scene.get("wall", []) or []):
+    if any(wall.at_base_of(studied) for wall in definition.tables.walls):
         return None
     for variant in definition.variants:
-        walled = {value: any(w.get("building") == studied and w.get("level", 0) == 0
-                             for w in variant.overrides.get(value, {}).get("scene", {}).get("wall", []) or [])
-                  for value in variant.values}
+        edits = variant.edits
+        walled = {value: value in edits and any(wall.at_base_of(studied) for wall in edits[value].scene.walls) for value in variant.values}
         free = [value for value, has in walled.items() if not has]
         if free and len(free) < len(walled) and variant.name in store.dims:
             return variant.name, free[0]
@@ -502,13 +500,11 @@ def moat_clearances(store: xr.Dataset, studied: str | None) -> list[float]:
     """The distinct gaps of the walls at the studied building's base in the definition (its scene, with the values of a gap axis
     that sets a wall instead of its own gap, and its variants), finite ones only."""
     definition = store.pound.definition
-    walls = [(w, axis.values if axis is not None else (w["gap"],)) for w, axis in
-             ((w, definition.wall_gap_axis(index)) for index, w in enumerate(definition.scene.get("wall", [])))]
+    walls = [(wall, axis.values if axis is not None else (wall.gap,)) for wall, axis in
+             ((wall, definition.wall_gap_axis(index)) for index, wall in enumerate(definition.tables.walls))]
     for variant in definition.variants:
-        for override in variant.overrides.values():
-            walls += [(w, (w["gap"],)) for w in override.get("scene", {}).get("wall", []) or []]
-    return sorted({float(gap) for w, gaps in walls for gap in gaps
-                   if w.get("building") == studied and w.get("level", 0) == 0 and math.isfinite(float(gap))})
+        walls += [(wall, (wall.gap,)) for override in variant.edits.values() for wall in override.scene.walls]
+    return sorted({float(gap) for wall, gaps in walls for gap in gaps if wall.at_base_of(studied) and math.isfinite(float(gap))})
 
 
 def efficiency_runs(store: xr.Dataset, studied: str | None) -> dict[str, Any]:

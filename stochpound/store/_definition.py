@@ -42,8 +42,10 @@ from dataclasses import dataclass
 from typing import Any, TypeVar
 
 from stochpound._errors import ExperimentError
+from stochpound.model.fields import TomlTable
 from stochpound.model.friction import is_fixed_base
-from stochpound.motions import DEFAULT_G, MEASURE_KINDS, Measure
+from stochpound.model.scene_tables import SceneOverrides, SceneTables
+from stochpound.motions import MEASURE_KINDS, Measure
 from stochpound.store._stripe_selection import Selection
 
 _Record = TypeVar("_Record")
@@ -83,8 +85,9 @@ MEASURES = MEASURE_KINDS
 
 
 def scene_g(scene: Mapping[str, Any]) -> float:
-    """A scene dict's acceleration of gravity, m/s²: its ``g``, or ``stochpound.motions.DEFAULT_G`` (9.81) when it leaves it out (the one reader)."""
-    return float(scene.get("g", DEFAULT_G))
+    """A scene dict's acceleration of gravity, m/s²: its ``g``, or ``stochpound.motions.DEFAULT_G`` (9.81) when it leaves it out
+    (:attr:`stochpound.model.scene_tables.SceneTables.g`, the one reader)."""
+    return SceneTables.of(scene).g
 
 
 
@@ -127,7 +130,7 @@ class Intensity:
     def from_entry(cls, entry: Mapping[str, Any]) -> Intensity:
         """The typed setting of a canonical ``intensity`` entry."""
         return cls(Measure.from_entry(entry), entry["units"], tuple(float(x) for x in entry["levels"]), entry["method"], entry["ran"],
-                   entry["note"], entry.get("synthetic"), Selection.from_entry(entry))
+                   entry["note"], TomlTable(entry).raw("synthetic"), Selection.from_entry(entry))
 
     def entry(self) -> dict[str, Any]:
         """The canonical ``intensity`` entry (as definitions store it)."""
@@ -196,9 +199,10 @@ class Hazard:
     @classmethod
     def from_entry(cls, entry: Mapping[str, Any]) -> Hazard:
         """The typed hazard of a canonical ``hazard`` entry."""
+        given = TomlTable(entry, "hazard")
         return cls(entry["source"], Measure.from_entry(entry), entry["units"], entry["extrapolate"], entry["provenance"],
-                   tuple(entry.get("im", ())), tuple(entry.get("rate", ())), entry.get("power_law"), entry.get("file"),
-                   entry.get("file_sha256"), entry.get("bundled"), entry.get("ruptures"))
+                   tuple(given.raw("im", ())), tuple(given.raw("rate", ())), given.raw("power_law"), given.raw("file"),
+                   given.raw("file_sha256"), given.raw("bundled"), given.raw("ruptures"))
 
     def entry(self) -> dict[str, Any]:
         """The canonical ``hazard`` entry (as definitions store it)."""
@@ -271,8 +275,9 @@ class Design:
     @classmethod
     def from_entry(cls, entry: Mapping[str, Any]) -> Design:
         """The typed design of a canonical ``design`` entry."""
-        ec8 = entry.get("ec8")
-        return cls(entry["sds"], entry["sd1"], entry["tl"], entry["r"], entry["cd"], entry["omega0"], entry["ie"], entry.get("sm1"),
+        given = TomlTable(entry, "design")
+        ec8 = given.raw("ec8")
+        return cls(entry["sds"], entry["sd1"], entry["tl"], entry["r"], entry["cd"], entry["omega0"], entry["ie"], given.raw("sm1"),
                    DesignEc8(ec8["ag"], ec8["ground"], ec8["q"]) if ec8 is not None else None)
 
     def entry(self) -> dict[str, Any]:
@@ -365,8 +370,9 @@ class Site:
     @classmethod
     def from_entry(cls, entry: Mapping[str, Any]) -> Site:
         """The typed site of a canonical ``site`` entry."""
-        curves = entry.get("curves")
-        return cls(entry["scenario"], tuple(curves) if curves is not None else None, entry.get("ruptures"))
+        given = TomlTable(entry, "site")
+        curves = given.raw("curves")
+        return cls(entry["scenario"], tuple(curves) if curves is not None else None, given.raw("ruptures"))
 
     def entry(self) -> dict[str, Any]:
         """The canonical ``site`` entry (as definitions store it)."""
@@ -468,6 +474,11 @@ class VariantAxis:
     def entry(self) -> dict[str, Any]:
         """The canonical entry of the axis (its overrides copied)."""
         return {"name": self.name, "values": list(self.values), "overrides": copy.deepcopy(dict(self.overrides))}
+
+    @property
+    def edits(self) -> dict[str, SceneOverrides]:
+        """Each declared variant's overrides read as typed parts (:class:`~stochpound.model.scene_tables.SceneOverrides`), by name."""
+        return {value: SceneOverrides.of(overrides, f"{self.name}.{value}") for value, overrides in self.overrides.items()}
 
 
 @dataclass(frozen=True)
@@ -656,14 +667,19 @@ class Definition:
         return definition_sha256(self.to_dict())
 
     @property
+    def tables(self) -> SceneTables:
+        """The base scene read as typed parts (:class:`~stochpound.model.scene_tables.SceneTables`: its buildings, contacts, walls, g)."""
+        return SceneTables.of(self.scene)
+
+    @property
     def g(self) -> float:
         """The scene's acceleration of gravity, m/s² (``stochpound.motions.DEFAULT_G`` (9.81) when the scene leaves it out)."""
-        return scene_g(self.scene)
+        return self.tables.g
 
     @property
     def building_names(self) -> tuple[str, ...]:
         """Buildings of the base scene, left to right."""
-        return tuple(b.get("name", f"B{i + 1}") for i, b in enumerate(self.scene.get("building", [])))
+        return self.tables.building_names
 
     def gap_axis(self, name: str) -> GapAxis:
         """The gap axis called ``name`` (KeyError if none)."""
@@ -716,42 +732,52 @@ def read_definition(source: Any) -> Definition:
         source = source.attrs["definition"]
     data = json.loads(source) if isinstance(source, str) else copy.deepcopy(dict(source))
     try:
-        return _from_dict(data)
+        return _from_dict(TomlTable(data, "definition"))
     except (KeyError, TypeError, ValueError) as error:
         raise ExperimentError(f"definition: missing or malformed field {error}") from None
 
 
-def _from_dict(data: dict[str, Any]) -> Definition:
-    for axis in [data["mu"], *data["gaps"]]:
+def _from_dict(data: TomlTable) -> Definition:
+    """The typed definition of a canonical one (a copy: its axes' values become floats again; a missing field raises KeyError)."""
+    given = data.values
+    for axis in [given["mu"], *given["gaps"]]:
         if axis is not None:
             axis["values"] = [float(v) for v in axis["values"]]
-    mu = data["mu"]
-    output = data["output"]
+    mu, output = given["mu"], TomlTable(given["output"], "output")
     return Definition(
-        name=data["name"],
-        description=data["description"],
-        scene=data["scene"],
-        studied=data["studied"],
-        variants=tuple(VariantAxis(v["name"], tuple(v["values"]), v["overrides"]) for v in data["variants"]),
-        gaps=tuple(GapAxis(g["name"], tuple(g["values"]), tuple(g["contacts"]), tuple(g.get("walls", ()))) for g in data["gaps"]),
+        name=given["name"],
+        description=given["description"],
+        scene=given["scene"],
+        studied=given["studied"],
+        variants=tuple(VariantAxis(v["name"], tuple(v["values"]), v["overrides"]) for v in given["variants"]),
+        gaps=tuple(_gap_axis(TomlTable(gap)) for gap in given["gaps"]),
         mu=MuAxis(tuple(mu["values"]), tuple(mu["buildings"]) if mu["buildings"] is not None else None) if mu is not None else None,
-        motions=tuple(
-            MotionSource(m["label"], m["kind"], m["field"], m["motion"], m.get("start", 0), m.get("count", 1), m.get("suite")) for m in data["motions"]
-        ),
-        output=Output(tuple(output["time_histories"]), tuple(output["buildings"]), output["impacts"], output.get("demands", False)),
-        solver=Solver(**data["solver"]),
+        motions=tuple(_motion_source(TomlTable(motion)) for motion in given["motions"]),
+        output=Output(tuple(output.values["time_histories"]), tuple(output.values["buildings"]), output.values["impacts"], output.raw("demands", False)),
+        solver=Solver(**given["solver"]),
         intensity=_optional(data, "intensity", Intensity.from_entry),
-        format=data["format"],
-        reproduces=data.get("reproduces"),
+        format=given["format"],
+        reproduces=data.raw("reproduces"),
         hazard=_optional(data, "hazard", Hazard.from_entry),
         design=_optional(data, "design", Design.from_entry),
         limit_states=_optional(data, "limit_states", LimitStates.from_entry),
-        scene_source=data.get("scene_source"),
+        scene_source=data.raw("scene_source"),
         site=_optional(data, "site", Site.from_entry),
     )
 
 
-def _optional(data: Mapping[str, Any], key: str, read: Callable[[Mapping[str, Any]], _Record]) -> _Record | None:
-    """The record of an optional entry (None when absent)."""
-    entry = data.get(key)
+def _gap_axis(entry: TomlTable) -> GapAxis:
+    """The gap axis of a canonical ``gaps`` entry."""
+    return GapAxis(entry.values["name"], tuple(entry.values["values"]), tuple(entry.values["contacts"]), tuple(entry.raw("walls", ())))
+
+
+def _motion_source(entry: TomlTable) -> MotionSource:
+    """The motion of a canonical ``motions`` entry."""
+    given = entry.values
+    return MotionSource(given["label"], given["kind"], given["field"], given["motion"], entry.raw("start", 0), entry.raw("count", 1), entry.raw("suite"))
+
+
+def _optional(data: TomlTable, key: str, read: Callable[..., _Record]) -> _Record | None:
+    """The record of an optional entry (None when absent; ``read``: the record's ``from_entry``)."""
+    entry = data.raw(key)
     return read(entry) if entry is not None else None

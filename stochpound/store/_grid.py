@@ -36,12 +36,12 @@ import xarray as xr
 
 from stochpound._errors import ExperimentError, SceneError
 from stochpound.model.scene_file import scene_from_dict
+from stochpound.model.scene_tables import BuildingTable, SceneOverrides, SceneTables
 from stochpound.store._catalogue import CASE, KINDS, REFERENCE
 from stochpound.store._definition import (Definition, Intensity, MotionSource, Output, Solver, VariantAxis, canonical_json, definition_sha256,
                                           read_definition)
 from stochpound.store._scene_edits import (
     apply_overrides,
-    building_names,
     reference_scene,
     set_gaps,
     set_mu,
@@ -103,6 +103,11 @@ class Case:
     def label_dict(self) -> dict[str, Label]:
         """The labels as a dict."""
         return dict(self.labels)
+
+    @property
+    def mu(self) -> float | None:
+        """Its value on the grid's μ axis (dimensionless; ∞: a fixed base), None without a μ axis."""
+        return next((float(value) for name, value in self.labels if name == "mu"), None)
 
     def describe(self) -> str:
         """``kind dim=value ...``, e.g. ``case neighbour=stiff gap=0.02 mu=inf record=el_centro realization=0``."""
@@ -260,29 +265,30 @@ class ExperimentGrid:
     @cached_property
     def building_names(self) -> list[str]:
         """Buildings of the base scene, left to right."""
-        return building_names(self.definition.scene)
+        return list(self.definition.building_names)
 
     @cached_property
     def max_floors(self) -> int:
         """Largest number of floors of any building, in the base scene or a variant."""
-        counts = [len(b.get("mass", [])) for b in self.definition.scene["building"]]
-        for variant in self.variants:
-            for override in variant.overrides.values():
-                counts += [len(f["mass"]) for f in override.get("building", {}).values() if isinstance(f.get("mass"), list)]
+        counts = [self.definition.tables.max_floors] + [len(fields.raw("mass")) for override in self._overrides for fields in override.buildings.values()
+                                                        if isinstance(fields.raw("mass"), list)]
         return max(counts + [1])
+
+    @cached_property
+    def _overrides(self) -> list[SceneOverrides]:
+        """Every variant's overrides, typed (:class:`~stochpound.model.scene_tables.SceneOverrides`)."""
+        return [override for variant in self.variants for override in variant.edits.values()]
 
     @cached_property
     def has_walls(self) -> bool:
         """Whether a case's scene can have walls: the base scene's or a variant's ``[[wall]]``."""
-        overrides = [o for variant in self.variants for o in variant.overrides.values()]
-        return bool(self.definition.scene.get("wall")) or any(o.get("scene", {}).get("wall") for o in overrides)
+        return bool(self.definition.tables.walls) or any(override.scene.walls for override in self._overrides)
 
     @cached_property
     def has_storey_summaries(self) -> bool:
         """Whether a case's buildings can have yielding storeys or storey heights (``yield_force``, ``storey_height``), in the base scene or a variant."""
-        buildings = list(self.definition.scene["building"])
-        buildings += [f for variant in self.variants for o in variant.overrides.values() for f in o.get("building", {}).values()]
-        return any("yield_force" in b or "storey_height" in b for b in buildings)
+        given = [BuildingTable(fields, 0) for override in self._overrides for fields in override.buildings.values()]
+        return any(building.has_storey_summaries for building in [*self.definition.tables.buildings, *given])
 
     @cached_property
     def motions(self) -> dict[str, MotionSource]:
@@ -332,11 +338,7 @@ class ExperimentGrid:
 
     def _touches_studied(self, axis: str) -> bool:
         variant = next(v for v in self.variants if v.name == axis)
-        for override in variant.overrides.values():
-            fields = override.get("building", {}).get(self.studied, {})
-            if set(fields) - {"base"}:
-                return True
-        return False
+        return any(override.gives(self.studied) - {"base"} for override in variant.edits.values())
 
     def realizations(self, label: str) -> range:
         """Realization indices of a motion: 0 for a record (and a simulated motion), start .. start+count−1 for an ensemble."""
@@ -485,13 +487,14 @@ class ExperimentGrid:
         if point.kind == REFERENCE:
             scene = reference_scene(scene, self.studied)
         else:
+            draft = SceneTables.of(scene)
             for gap in self.definition.gaps:
-                set_gaps(scene, gap.contacts, labels[gap.name], gap.walls)
+                set_gaps(draft, gap.contacts, labels[gap.name], gap.walls)
             if self.intensity is not None and self.intensity.ran == "ida":  # contact-free: capacities come from the closures
-                set_gaps(scene, range(len(scene.get("contact", []))), float("inf"))
+                set_gaps(draft, range(len(draft.contacts)), float("inf"))
             mu = self.definition.mu
             if mu is not None:
-                missing = set_mu(scene, mu.buildings, labels["mu"])
+                missing = set_mu(draft, mu.buildings, labels["mu"])
                 if missing:
                     raise ExperimentError(
                         f"grid.mu: building(s) {', '.join(missing)} have no [building.base] in {point.describe()}; "

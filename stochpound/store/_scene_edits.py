@@ -1,8 +1,10 @@
 """The one module that edits an experiment's scene dicts: variants, gaps, μ, the motion.
 
 A scene dict has the structure of a scene file (docs/scene-files.md); this
-module owns that shape on the experiment side: the buildings by name, their
-bases, the contacts and walls, the ``[motion]``. Every edit of a case's
+module edits it on the experiment side, reading it as typed parts
+(:class:`stochpound.model.scene_tables.SceneTables`: the buildings by name,
+their bases, the contacts and walls; a variant's overrides as
+:class:`~stochpound.model.scene_tables.SceneOverrides`). Every edit of a case's
 scene goes through it, and every edit is a set of fields given to one table
 of the scene in one place (``_give``): the values come from the override
 tables, the axes, or the rule that owns them (a building's mass scaling,
@@ -36,14 +38,15 @@ their ratios to ``fast``) or refuses; μ = inf removes the base (a fixed base).
 from __future__ import annotations
 
 import copy
-from typing import Any, Iterable, Mapping
+from typing import Any, Iterable, Mapping, cast
 
 from stochpound._errors import SceneError
 from stochpound.model import laws
-from stochpound.model.building import default_name, scaled_masses
+from stochpound.model.building import scaled_masses
 from stochpound.model.contact import ELEMENT_KEYS, effective_mass
+from stochpound.model.fields import TomlTable
 from stochpound.model.friction import is_fixed_base
-from stochpound.store._definition import scene_g
+from stochpound.model.scene_tables import SceneOverrides, SceneTables
 
 #: Motion used while validating a scene's structure (the real motion is set per case).
 PLACEHOLDER_MOTION = {"type": "constant", "acceleration": 0.0, "duration": 1.0, "dt": 1.0}
@@ -51,27 +54,20 @@ PLACEHOLDER_MOTION = {"type": "constant", "acceleration": 0.0, "duration": 1.0, 
 
 def building_names(scene: Mapping[str, Any]) -> list[str]:
     """The names of the scene's buildings, left to right (default names B1, B2, ...)."""
-    return [building.get("name", default_name(i)) for i, building in enumerate(_tables(scene, "building"))]
-
-
-def _tables(scene: Mapping[str, Any], part: str) -> list[Any]:
-    """The scene's array of tables ``part`` (``building``, ``contact`` or ``wall``), empty when it has none."""
-    return scene.get(part, [])
+    return list(SceneTables.of(scene).building_names)
 
 
 def building_table(scene: Mapping[str, Any], name: str) -> dict[str, Any]:
-    """The ``[[building]]`` table named ``name`` (default names B1, B2, ... included)."""
-    names = building_names(scene)
-    if name not in names:
-        raise KeyError(name)
-    return scene["building"][names.index(name)]
+    """The ``[[building]]`` table named ``name`` (default names B1, B2, ... included; KeyError if none)."""
+    return SceneTables.of(scene).building(name).table.values
 
 
-def _give(table: dict[str, Any], fields: Mapping[str, Any], dropped: Iterable[str] = ()) -> None:
-    """Give a table of the scene ``fields`` (copies), after dropping the fields ``dropped``, in place: the one way an edit writes the scene."""
+def _give(table: TomlTable, fields: Mapping[str, Any], dropped: Iterable[str] = ()) -> None:
+    """Give a table of a scene being edited ``fields`` (copies), after dropping the fields ``dropped``, in place: the one way an edit writes the scene."""
+    values = cast(dict, table.values)  # the tables of a scene being edited are its deep copy's dicts
     for key in dropped:
-        table.pop(key, None)
-    table.update(copy.deepcopy(dict(fields)))
+        values.pop(key, None)
+    values.update(copy.deepcopy(dict(fields)))
 
 
 def without_motion(scene: Mapping[str, Any]) -> dict[str, Any]:
@@ -92,7 +88,7 @@ def apply_overrides(scene: Mapping[str, Any], overrides: Iterable[Mapping[str, A
     scene : mapping
         Base scene dict.
     overrides : iterable of mapping
-        One override table per variant axis (``building.<name>`` and ``scene`` tables).
+        One override table per variant axis (``building.<name>`` and ``scene`` tables; :class:`~stochpound.model.scene_tables.SceneOverrides`).
 
     Returns
     -------
@@ -100,35 +96,37 @@ def apply_overrides(scene: Mapping[str, Any], overrides: Iterable[Mapping[str, A
         The new scene dict. The two phases make the result independent of the
         order of the variant axes.
     """
-    scene = copy.deepcopy(dict(scene))
+    edited = copy.deepcopy(dict(scene))
+    draft = SceneTables.of(edited)
     factors: dict[str, float] = {}
-    for override in overrides:
-        _give(scene, override.get("scene", {}))
-        _override_contacts(scene, override.get("contact"))
-        for name, fields in override.get("building", {}).items():
+    for override in map(SceneOverrides.of, overrides):
+        _give(draft.table, override.scene.table.values)
+        _override_contacts(draft, override.contacts)
+        for name, fields in override.buildings.items():
             if "mass_factor" in fields:
-                factors[name] = factors.get(name, 1.0) * float(fields["mass_factor"])
-            _override_building(building_table(scene, name), fields)
+                factors[name] = factors.get(name, 1.0) * float(fields.raw("mass_factor"))
+            _override_building(draft.building(name).table, fields)
     for name, factor in factors.items():
-        scale_masses(scene, name, factor)
-    return scene
+        scale_masses(draft, name, factor)
+    return edited
 
 
-def _override_building(building: dict[str, Any], fields: Mapping[str, Any]) -> None:
+def _override_building(building: TomlTable, fields: TomlTable) -> None:
     """Give a ``[[building]]`` table a variant's fields (its ``mass_factor`` aside).
 
     ``base = false`` removes the base, a ``base`` table is merged into the
     base's; a ``damping`` or a ``damping_ratio`` replaces both.
     """
-    for key, value in fields.items():
+    for key in fields:
+        value = fields.raw(key)
         if key == "base":
-            _give(building, {}, ["base"]) if value is False else _give(building, {"base": {**building.get("base", {}), **value}})
+            _give(building, {}, ["base"]) if value is False else _give(building, {"base": {**building.raw("base", {}), **value}})
         elif key != "mass_factor":
             _give(building, {key: value}, ["damping", "damping_ratio"] if key in ("damping", "damping_ratio") else [])
 
 
-def _override_contacts(scene: dict[str, Any], part: Mapping[str, Any] | list | None) -> None:
-    """Replace impact-element fields of every contact (one table) or of each contact (a list, one table per contact).
+def _override_contacts(scene: SceneTables, part: tuple[TomlTable, ...] | TomlTable | None) -> None:
+    """Replace impact-element fields of every contact (one table) or of each contact (a tuple, one table per contact).
 
     A table that gives ``law`` replaces the element (the old law's
     ``stiffness``, ``restitution``, ``damping`` and ``tensile`` go); one
@@ -136,12 +134,12 @@ def _override_contacts(scene: dict[str, Any], part: Mapping[str, Any] | list | N
     """
     if part is None:
         return
-    contacts = _tables(scene, "contact")
-    for contact, fields in zip(contacts, part if isinstance(part, list) else [part] * len(contacts)):
-        _give(contact, fields, ELEMENT_KEYS if "law" in fields else [])
+    contacts = scene.contacts
+    for contact, fields in zip(contacts, part if isinstance(part, tuple) else [part] * len(contacts)):
+        _give(contact, fields.values, ELEMENT_KEYS if "law" in fields else [])
 
 
-def scale_masses(scene: dict[str, Any], name: str, factor: float) -> None:
+def scale_masses(scene: SceneTables, name: str, factor: float) -> None:
     """Multiply building ``name``'s masses by ``factor`` in place, with what the laws derive from them.
 
     The building's own rule (:func:`stochpound.model.building.scaled_masses`:
@@ -150,47 +148,51 @@ def scale_masses(scene: dict[str, Any], name: str, factor: float) -> None:
     with the ratio of the effective masses, new over old: the factor itself
     for a wall).
     """
-    building = building_table(scene, name)
-    old_mass = [float(m) for m in building["mass"]]
-    _give(building, scaled_masses(building, factor))
-    for contact in _tables(scene, "contact"):
+    building = scene.building(name)
+    old_mass = [float(m) for m in building.table.values["mass"]]
+    scaled, base = scaled_masses(building.table, factor)
+    _give(building.table, scaled)
+    if base:
+        _give(building.base, base)
+    for contact in scene.contacts:
         try:
-            ends = [(str(end_name), int(floor)) for end_name, floor in contact["between"]]
+            ends = [(str(end_name), int(floor)) for end_name, floor in contact.values["between"]]
             if name not in [end[0] for end in ends]:
                 continue
-            masses_new = [float(building_table(scene, end_name)["mass"][floor - 1]) for end_name, floor in ends]
+            masses_new = [float(scene.building(end_name).table.values["mass"][floor - 1]) for end_name, floor in ends]
             masses_old = [old_mass[floor - 1] if end_name == name else new for (end_name, floor), new in zip(ends, masses_new)]
         except (KeyError, IndexError, TypeError, ValueError):
             continue  # a malformed contact: scene validation names it
         _rescale_element(contact, effective_mass(*masses_new) / effective_mass(*masses_old))
-    for wall in _tables(scene, "wall"):
-        if wall.get("building") == name:  # a wall's effective mass is its level's mass, scaled by the factor
-            _rescale_element(wall, factor)
+    for wall in scene.walls:
+        if wall.building == name:  # a wall's effective mass is its level's mass, scaled by the factor
+            _rescale_element(wall.table, factor)
 
 
-def _rescale_element(table: dict[str, Any], mass_ratio: float) -> None:
+def _rescale_element(table: TomlTable, mass_ratio: float) -> None:
     """Rescale an impact element's table by its law's rule (a table naming no known law is left for scene validation to name)."""
     try:
-        law = laws.contact_law(str(table.get("law", laws.DEFAULT_CONTACT_LAW)))
+        law = laws.contact_law(str(table.raw("law", laws.DEFAULT_CONTACT_LAW)))
     except SceneError:
         return
     _give(table, law.rescaled(table, mass_ratio))
 
 
-def set_gaps(scene: dict[str, Any], contacts: Iterable[int], gap: float, walls: Iterable[int] = ()) -> None:
-    """Set the gap (m) of the given contacts and walls (0-based indices into ``contact`` and ``wall``) in place."""
-    for part, indices in (("contact", contacts), ("wall", walls)):
-        for index in indices:
-            _give(scene[part][index], {"gap": float(gap)})
+def set_gaps(scene: SceneTables, contacts: Iterable[int], gap: float, walls: Iterable[int] = ()) -> None:
+    """Set the gap (m) of the given contacts and walls (0-based indices into ``contact`` and ``wall``) of a scene being edited, in place."""
+    for index in contacts:
+        _give(scene.contacts[index], {"gap": float(gap)})
+    for index in walls:
+        _give(scene.walls[index].table, {"gap": float(gap)})
 
 
-def set_mu(scene: dict[str, Any], buildings: Iterable[str] | None, mu: float) -> list[str]:
-    """Set the friction coefficient μ of buildings in place, by each base's friction law; μ = inf removes their base.
+def set_mu(scene: SceneTables, buildings: Iterable[str] | None, mu: float) -> list[str]:
+    """Set the friction coefficient μ of buildings of a scene being edited, in place, by each base's friction law; μ = inf removes their base.
 
     Parameters
     ----------
-    scene : dict
-        Scene dict.
+    scene : SceneTables
+        The scene being edited.
     buildings : iterable of str or None
         Buildings to change; None: every building that has a ``[building.base]``.
     mu : float
@@ -210,24 +212,22 @@ def set_mu(scene: dict[str, Any], buildings: Iterable[str] | None, mu: float) ->
     SceneError
         When a base's law refuses μ, naming the field (``building[0].base.mu.fast: ...``).
     """
-    names = building_names(scene)
-    chosen = list(buildings) if buildings is not None else [n for n in names if isinstance(building_table(scene, n).get("base"), dict)]
+    chosen = list(buildings) if buildings is not None else [b.name for b in scene.buildings if b.base is not None]
     missing = []
     for name in chosen:
-        building = building_table(scene, name)
-        base = building.get("base")
+        building = scene.building(name)
+        base = building.base
         if is_fixed_base(mu):
-            _give(building, {}, ["base"])
-        elif not isinstance(base, dict):
+            _give(building.table, {}, ["base"])
+        elif base is None:
             missing.append(name)
         else:
-            prefix = f"building[{names.index(name)}].base"
             law = laws.base_friction_law(base)
             try:
-                law.read(base, prefix)
+                law.read(base)
             except SceneError:
                 continue  # a malformed base: scene validation names it, as without the axis
-            _give(base, law.with_mu(base, float(mu), prefix))
+            _give(base, law.with_mu(base, float(mu)))
     if buildings is None and not chosen and not is_fixed_base(mu):
         missing.append("(no building has a [building.base])")
     return missing
@@ -235,6 +235,7 @@ def set_mu(scene: dict[str, Any], buildings: Iterable[str] | None, mu: float) ->
 
 def reference_scene(scene: Mapping[str, Any], studied: str) -> dict[str, Any]:
     """The studied building alone on a fixed base (no contacts), same g."""
-    building = copy.deepcopy(building_table(scene, studied))
-    _give(building, {"name": studied}, ["base", "initial"])
-    return {"g": scene_g(scene), "building": [building], "contact": []}
+    tables = SceneTables.of(scene)
+    building = copy.deepcopy(dict(tables.building(studied).table.values))
+    _give(TomlTable(building), {"name": studied}, ["base", "initial"])
+    return {"g": tables.g, "building": [building], "contact": []}

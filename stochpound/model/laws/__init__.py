@@ -8,10 +8,10 @@ defining its law object, one line here, its tests and its docs entry
 
 from __future__ import annotations
 
-from typing import Any, Mapping
 
 from stochpound._errors import SceneError
 from stochpound.model.laws import coulomb, hertz, hertz_damp_exact, hertz_damp_ye, jankowski, kelvin, velocity_friction
+from stochpound.model.fields import TomlTable
 from stochpound.model.laws.contract import ContactLaw, FrictionLaw, ResultVariable
 
 CONTACT_LAWS: dict[str, ContactLaw] = {law.name: law for law in (kelvin.KELVIN, hertz.HERTZ, hertz.HERTZ_DAMP, jankowski.JANKOWSKI,
@@ -38,6 +38,6 @@ def friction_law(name: str) -> FrictionLaw:
     return FRICTION_LAWS[name]
 
 
-def base_friction_law(table: Mapping[str, Any]) -> FrictionLaw:
+def base_friction_law(table: TomlTable) -> FrictionLaw:
     """The friction law of a ``[building.base]`` table: the one whose form its ``mu`` has (:meth:`~stochpound.model.laws.contract.FrictionLaw.spells`)."""
-    return next(law for law in FRICTION_LAWS.values() if law.spells(table.get("mu")))
+    return next(law for law in FRICTION_LAWS.values() if law.spells(table.raw("mu")))

@@ -27,11 +27,11 @@ from __future__ import annotations
 
 import math
 from abc import ABC, abstractmethod
-from typing import Any, Mapping, NamedTuple
+from typing import Any, NamedTuple
 
 import numpy as np
 
-from stochpound.model import fields
+from stochpound.model.fields import TomlTable
 
 
 class ElementParameters(NamedTuple):
@@ -93,8 +93,8 @@ class ContactLaw(ABC):
     energy_term: str = "impact"
 
     @abstractmethod
-    def read(self, table: Mapping[str, Any], prefix: str, mass: float) -> ElementParameters:
-        """The element's parameters from its table (at ``prefix``; unknown keys already rejected), validated; ``mass``: m_eff (kg)."""
+    def read(self, table: TomlTable, mass: float) -> ElementParameters:
+        """The element's parameters from its table (unknown keys already rejected), validated; ``mass``: m_eff (kg)."""
 
     @abstractmethod
     def force(self, element: ElementParameters, delta: np.ndarray, rate: np.ndarray, onset: float) -> np.ndarray:
@@ -120,7 +120,7 @@ class ContactLaw(ABC):
         """When a closed element opens, in words (the nonlinear laws' force vanishes with δ: they never pull)."""
         return "at δ = 0, where its force vanishes (never pulls)"
 
-    def rescaled(self, table: Mapping[str, Any], mass_ratio: float) -> dict[str, float]:
+    def rescaled(self, table: TomlTable, mass_ratio: float) -> dict[str, float]:
         """The fields of the element's table that change when its m_eff changes by ``mass_ratio`` (new/old).
 
         The stiffness × ratio keeps the impact's time scale for a given
@@ -128,7 +128,7 @@ class ContactLaw(ABC):
         × ratio keeps its damping ratio (a ``restitution`` is kept). A field
         the table lacks is left for the scene's validation to name.
         """
-        return {key: float(table[key]) * mass_ratio for key in ("stiffness", "damping") if key in table}
+        return {key: float(table.raw(key)) * mass_ratio for key in ("stiffness", "damping") if key in table}
 
 
 class FrictionParameters(NamedTuple):
@@ -205,21 +205,21 @@ class FrictionLaw(ABC):
         """Whether a base table's ``mu`` value is written in this law's form (a number, a table...)."""
 
     @abstractmethod
-    def read_mu(self, table: Mapping[str, Any], prefix: str) -> tuple[float, float | None, float | None]:
-        """The law's coefficients from the base table's ``mu`` (at ``prefix``), validated: (μ, μ_fast, a in s/m)."""
+    def read_mu(self, table: TomlTable) -> tuple[float, float | None, float | None]:
+        """The law's coefficients from the base table's ``mu``, validated: (μ, μ_fast, a in s/m)."""
 
-    def read(self, table: Mapping[str, Any], prefix: str) -> FrictionParameters:
-        """The base's friction parameters from its ``[building.base]`` table (at ``prefix``), validated.
+    def read(self, table: TomlTable) -> FrictionParameters:
+        """The base's friction parameters from its ``[building.base]`` table, validated.
 
         ``mu`` as the law spells it (:meth:`read_mu`), then ``mu_static``
         (≥ μ, default μ: the coefficient at vanishing velocity).
         """
-        mu, fast, rate = self.read_mu(table, prefix)
-        return FrictionParameters(mu, fields.number(table, "mu_static", prefix, default=mu, low=mu), fast, rate)
+        mu, fast, rate = self.read_mu(table)
+        return FrictionParameters(mu, table.number("mu_static", mu, low=mu), fast, rate)
 
     @abstractmethod
-    def with_mu(self, table: Mapping[str, Any], mu: float, prefix: str) -> dict[str, Any]:
-        """The fields of the base table (at ``prefix``) that an experiment's μ-axis value ``mu`` (finite, dimensionless) sets.
+    def with_mu(self, table: TomlTable, mu: float) -> dict[str, float | dict[str, float]]:
+        """The fields of the base table that an experiment's μ-axis value ``mu`` (finite, dimensionless) sets.
 
         The law scales its coefficients (its rule in its docstring) or
         refuses with a :class:`~stochpound._errors.SceneError` naming the

@@ -21,8 +21,7 @@ import math
 
 import numpy as np
 
-from stochpound._errors import SceneError
-from stochpound.model import fields
+from stochpound.model.fields import TomlTable
 from stochpound.model.laws.contract import FrictionLaw, ResultVariable
 
 
@@ -39,14 +38,14 @@ class Coulomb(FrictionLaw):
         """``mu`` is a number (or missing or malformed: :meth:`read_mu` names the error)."""
         return not isinstance(mu, Mapping)
 
-    def read_mu(self, table: Mapping[str, Any], prefix: str) -> tuple[float, None, None]:
-        return fields.number(table, "mu", prefix, required=True, low=0.0), None, None
+    def read_mu(self, table: TomlTable) -> tuple[float, None, None]:
+        return table.number("mu", low=0.0), None, None
 
-    def with_mu(self, table: Mapping[str, Any], mu: float, prefix: str) -> dict[str, float]:
+    def with_mu(self, table: TomlTable, mu: float) -> dict[str, float | dict[str, float]]:
         """``mu`` ← the axis value; ``mu_static`` ← μ × (μ_s/μ) of the table (refused when the table has μ = 0 < μ_s: no ratio)."""
-        parameters = self.read(table, prefix)
+        parameters = self.read(table)
         if parameters.mu == 0.0 and parameters.mu_static > 0.0:
-            raise SceneError(f"{prefix}.mu_static: a μ axis keeps mu_static/mu, which mu = 0 leaves undefined; give mu > 0 or no mu_static")
+            raise table.error("mu_static", "a μ axis keeps mu_static/mu, which mu = 0 leaves undefined; give mu > 0 or no mu_static")
         return {"mu": float(mu), "mu_static": float(mu) * (parameters.mu_static / parameters.mu if parameters.mu > 0.0 else 1.0)}
 
     def force(self, base: Any, state: int, speed: np.ndarray) -> np.ndarray:

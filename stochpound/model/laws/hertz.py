@@ -24,11 +24,10 @@ velocity).
 
 from __future__ import annotations
 
-from typing import Any, Mapping
 
 import numpy as np
 
-from stochpound.model import fields
+from stochpound.model.fields import TomlTable
 from stochpound.model.laws.contract import ContactLaw, ElementParameters, quantity
 
 ONSET_FLOOR = 1e-9
@@ -59,8 +58,8 @@ class Hertz(ContactLaw):
     keys = frozenset({"stiffness"})
     piecewise_linear = False
 
-    def read(self, table: Mapping[str, Any], prefix: str, mass: float) -> ElementParameters:
-        stiffness = fields.number(table, "stiffness", prefix, required=True, low=0.0, low_open=True)
+    def read(self, table: TomlTable, mass: float) -> ElementParameters:
+        stiffness = table.number("stiffness", low=0.0, low_open=True)
         return ElementParameters(stiffness, 0.0, None, True, mass)
 
     def force(self, element: ElementParameters, delta: np.ndarray, rate: np.ndarray, onset: float) -> np.ndarray:
@@ -95,9 +94,9 @@ class HertzDamp(ContactLaw):
         """c_h (N·s/m^{5/2}) for k_h (N/m^1.5), e and the approach velocity δ̇₀ (m/s, > 0)."""
         return 3.0 * stiffness * (1.0 - restitution**2) / (4.0 * onset)
 
-    def read(self, table: Mapping[str, Any], prefix: str, mass: float) -> ElementParameters:
-        stiffness = fields.number(table, "stiffness", prefix, required=True, low=0.0, low_open=True)
-        restitution = fields.number(table, "restitution", prefix, required=True, low=0.0, low_open=True, high=1.0)
+    def read(self, table: TomlTable, mass: float) -> ElementParameters:
+        stiffness = table.number("stiffness", low=0.0, low_open=True)
+        restitution = table.number("restitution", low=0.0, low_open=True, high=1.0)
         return ElementParameters(stiffness, 0.0, restitution, True, mass)
 
     def force(self, element: ElementParameters, delta: np.ndarray, rate: np.ndarray, onset: float) -> np.ndarray:

@@ -28,9 +28,8 @@ Hertz family's (k_h × m_eff,new/m_eff,old).
 from __future__ import annotations
 
 from functools import lru_cache
-from typing import Any, Mapping
 
-from stochpound.model import fields
+from stochpound.model.fields import TomlTable
 from stochpound.model.laws.contract import ElementParameters
 from stochpound.model.laws.hertz import HertzDamp
 
@@ -99,9 +98,9 @@ class HertzDampExact(HertzDamp):
     def damping_coefficient(self, stiffness: float, restitution: float, onset: float) -> float:
         return damping_ratio(restitution) * stiffness / onset
 
-    def read(self, table: Mapping[str, Any], prefix: str, mass: float) -> ElementParameters:
-        stiffness = fields.number(table, "stiffness", prefix, required=True, low=0.0, low_open=True)
-        restitution = fields.number(table, "restitution", prefix, required=True, low=LOWEST_RESTITUTION, high=1.0)
+    def read(self, table: TomlTable, mass: float) -> ElementParameters:
+        stiffness = table.number("stiffness", low=0.0, low_open=True)
+        restitution = table.number("restitution", low=LOWEST_RESTITUTION, high=1.0)
         return ElementParameters(stiffness, 0.0, restitution, True, mass)
 
     def describe(self, element: ElementParameters) -> str:

@@ -25,11 +25,10 @@ ivp path. Mass scaling (experiment variants): β × m_eff,new/m_eff,old.
 from __future__ import annotations
 
 import math
-from typing import Any, Mapping
 
 import numpy as np
 
-from stochpound.model import fields
+from stochpound.model.fields import TomlTable
 from stochpound.model.laws.contract import ContactLaw, ElementParameters, quantity
 
 
@@ -48,9 +47,9 @@ class Jankowski(ContactLaw):
     keys = frozenset({"stiffness", "restitution"})
     piecewise_linear = False
 
-    def read(self, table: Mapping[str, Any], prefix: str, mass: float) -> ElementParameters:
-        stiffness = fields.number(table, "stiffness", prefix, required=True, low=0.0, low_open=True)
-        restitution = fields.number(table, "restitution", prefix, required=True, low=0.0, low_open=True, high=1.0, high_open=True)
+    def read(self, table: TomlTable, mass: float) -> ElementParameters:
+        stiffness = table.number("stiffness", low=0.0, low_open=True)
+        restitution = table.number("restitution", low=0.0, low_open=True, high=1.0, high_open=True)
         return ElementParameters(stiffness, 0.0, restitution, True, mass)
 
     def force(self, element: ElementParameters, delta: np.ndarray, rate: np.ndarray, onset: float) -> np.ndarray:

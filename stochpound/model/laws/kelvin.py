@@ -23,12 +23,10 @@ its damping ratio.
 from __future__ import annotations
 
 import math
-from typing import Any, Mapping
 
 import numpy as np
 
-from stochpound._errors import SceneError
-from stochpound.model import fields
+from stochpound.model.fields import TomlTable
 from stochpound.model.laws.contract import ContactLaw, ElementParameters, quantity
 
 
@@ -111,17 +109,17 @@ class KelvinVoigt(ContactLaw):
     piecewise_linear = True
     stiffness_unit = "N/m"
 
-    def read(self, table: Mapping[str, Any], prefix: str, mass: float) -> ElementParameters:
-        stiffness = fields.number(table, "stiffness", prefix, required=True, low=0.0, low_open=True)
+    def read(self, table: TomlTable, mass: float) -> ElementParameters:
+        stiffness = table.number("stiffness", low=0.0, low_open=True)
         restitution = None
         if "restitution" in table and "damping" in table:
-            raise SceneError(f"{prefix}.damping: give either restitution or damping, not both")
+            raise table.error("damping", "give either restitution or damping, not both")
         if "damping" in table:
-            damping = fields.number(table, "damping", prefix, low=0.0)
+            damping = table.number("damping", None, low=0.0)
         else:
-            restitution = fields.number(table, "restitution", prefix, required=True, low=0.0, low_open=True, high=1.0)
+            restitution = table.number("restitution", low=0.0, low_open=True, high=1.0)
             damping = 2.0 * restitution_damping_ratio(restitution) * math.sqrt(stiffness * mass)
-        tensile = fields.boolean(table, "tensile", prefix, default=True)
+        tensile = table.boolean("tensile", True)
         return ElementParameters(stiffness, damping, restitution, tensile, mass)
 
     def force(self, element: ElementParameters, delta: np.ndarray, rate: np.ndarray, onset: float) -> np.ndarray:

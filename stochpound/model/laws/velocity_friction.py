@@ -26,20 +26,20 @@ from typing import Any, Mapping
 import numpy as np
 
 from stochpound._errors import SceneError
-from stochpound.model import fields
+from stochpound.model.fields import TomlTable
 from stochpound.model.laws.contract import FrictionLaw, ResultVariable
 
 MU_KEYS = {"slow", "fast", "rate"}
 
 
-def mu_from_table(table: Mapping[str, Any], prefix: str) -> tuple[float, float, float]:
-    """The ``mu = { slow, fast, rate }`` table (at ``prefix``): (μ_slow, μ_fast, a in s/m), validated."""
-    fields.reject_unknown(table, MU_KEYS, prefix)
-    slow = fields.number(table, "slow", prefix, required=True, low=0.0)
-    fast = fields.number(table, "fast", prefix, required=True, low=slow)
-    rate = fields.number(table, "rate", prefix, required=True, low=0.0, low_open=True)
+def mu_from_table(table: TomlTable) -> tuple[float, float, float]:
+    """The ``mu = { slow, fast, rate }`` table: (μ_slow, μ_fast, a in s/m), validated."""
+    table.reject_unknown(MU_KEYS)
+    slow = table.number("slow", low=0.0)
+    fast = table.number("fast", low=slow)
+    rate = table.number("rate", low=0.0, low_open=True)
     if fast == 0.0:
-        raise SceneError(f"{prefix}.fast: must be > 0 (a frictionless base is mu = 0)")
+        raise table.error("fast", "must be > 0 (a frictionless base is mu = 0)")
     return slow, fast, rate
 
 
@@ -56,14 +56,14 @@ class VelocityDependent(FrictionLaw):
         """``mu`` is a table ``{ slow, fast, rate }``."""
         return isinstance(mu, Mapping)
 
-    def read_mu(self, table: Mapping[str, Any], prefix: str) -> tuple[float, float, float]:
-        return mu_from_table(table["mu"], f"{prefix}.mu")
+    def read_mu(self, table: TomlTable) -> tuple[float, float, float]:
+        return mu_from_table(table.table("mu"))
 
-    def with_mu(self, table: Mapping[str, Any], mu: float, prefix: str) -> dict[str, Any]:
+    def with_mu(self, table: TomlTable, mu: float) -> dict[str, float | dict[str, float]]:
         """``fast`` ← the axis value; ``slow`` ← μ × slow/fast and a given ``mu_static`` ← μ × μ_s/fast; ``rate`` kept (μ = 0 refused)."""
-        parameters = self.read(table, prefix)
+        parameters = self.read(table)
         if mu <= 0.0:
-            raise SceneError(f"{prefix}.mu.fast: a μ axis sets fast, which must be > 0 for velocity-dependent friction; got {mu:g}")
+            raise SceneError(f"{table.field('mu')}.fast: a μ axis sets fast, which must be > 0 for velocity-dependent friction; got {mu:g}")
         scaled = {"mu": {"slow": float(mu) * (parameters.mu / parameters.mu_fast), "fast": float(mu), "rate": parameters.mu_rate}}
         return scaled | ({"mu_static": float(mu) * (parameters.mu_static / parameters.mu_fast)} if "mu_static" in table else {})
 
