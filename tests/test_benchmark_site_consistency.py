@@ -10,7 +10,8 @@ The same check at a site of one scenario (benchmarks.site_consistency's ``--site
 year), whose four curves come from the conditional spectrum's own models: hazard-consistent by construction, so the measures must
 agree there unless the pool or the stripes fail to carry the site's shaking (docs/intensity.md, finding 8).
 
-Run: ``pytest -m slow tests/test_benchmark_site_consistency.py -s`` (prints the g* tables; about 5 minutes on 2 cores).
+Run: ``pytest -m slow tests/test_benchmark_site_consistency.py -s`` (prints the g* tables; about 5 minutes on 2 cores). A configuration
+whose spread is beyond the limit after some measures stops there (more measures can only widen it): its table has those measures only.
 """
 
 from __future__ import annotations
@@ -20,7 +21,10 @@ import xarray as xr
 
 from benchmarks.site_consistency import FOX_PLAZA, SCENARIO, Site, g_star, scenario_site
 
-MEASURES = ("PGA", "PSA(1 s)", "PSA(2 s)", "PSA(3 s)")
+#: The measures, the two furthest apart in period first: where g* depends on the measure, they part most (docs/intensity.md's
+#: table: PGA and PSA(3 s) bound the isolated building's g*), so a spread beyond :data:`LIMIT` shows soonest (:func:`_spread`).
+MEASURES = ("PGA", "PSA(3 s)", "PSA(1 s)", "PSA(2 s)")
+LIMIT = 1.3  # the largest max/min of g* over the measures that passes
 
 
 @pytest.mark.slow
@@ -35,22 +39,33 @@ MEASURES = ("PGA", "PSA(1 s)", "PSA(2 s)", "PSA(3 s)")
         "strict: it fails the day it passes, to be un-marked"))),
 ])  # fmt: skip
 def test_g_star_hardly_depends_on_the_conditioning_measure(tmp_path, configuration: str) -> None:
-    assert _spread(tmp_path, configuration) <= 1.3
+    assert _spread(tmp_path, configuration) <= LIMIT
 
 
 @pytest.mark.slow
 @pytest.mark.parametrize("configuration", ["fixed pair", "isolated"])
 def test_at_a_site_of_one_scenario_g_star_hardly_depends_on_the_conditioning_measure(tmp_path, configuration: str) -> None:
-    assert _spread(tmp_path, configuration, scenario_site(*SCENARIO)) <= 1.3
+    assert _spread(tmp_path, configuration, scenario_site(*SCENARIO)) <= LIMIT
 
 
 def _spread(folder, configuration: str, site: Site = FOX_PLAZA) -> float:
-    """The largest max/min over the measures of the lognormal-demand g* (both targets, every neighbour), the table printed."""
-    separations = xr.concat([g_star(folder, measure, configuration, site) for measure in MEASURES], dim="measure")
-    ratio = separations.max("measure") / separations.min("measure")
-    print(f"\n{configuration} at the site {site.name}: g* (m) by conditioning measure {', '.join(MEASURES)}, and max/min:")
-    print(separations.assign_coords(measure=list(MEASURES)).to_dataframe()["separation"].to_string())
-    print("max/min", ratio.to_pandas().to_string())
+    """The largest max/min over the measures of the lognormal-demand g* (both targets, every neighbour), the table printed.
+
+    The measures run one after the other, and the next only while the spread is within :data:`LIMIT`: a spread over
+    more measures is never smaller (a max/min over more values), so one already beyond it fails the check whatever the
+    measures left would give, and they are not run (the benchmark prints every measure's g*).
+    """
+    runs = []
+    for measure in MEASURES:
+        runs.append(g_star(folder, measure, configuration, site))
+        separations = xr.concat(runs, dim="measure")
+        ratio = separations.max("measure") / separations.min("measure")
+        if float(ratio.max()) > LIMIT:
+            break
+    done = list(MEASURES[: len(runs)])
+    print(f"\n{configuration} at the site {site.name}: g* (m) by conditioning measure {', '.join(done)}, and max/min:")
+    print(separations.assign_coords(measure=done).to_dataframe()["separation"].to_string())
+    print("max/min", ratio.to_pandas().to_string(), "" if len(runs) == len(MEASURES) else f"(beyond {LIMIT} after {len(runs)} measures: the rest not run)")
     return float(ratio.max())
 
 

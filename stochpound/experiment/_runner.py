@@ -208,6 +208,7 @@ def run_experiment(
     from its parts with the new ones (its runs kept).
     """
     started = time.monotonic()
+    quiet = say is None
     say = say or (lambda message: None)
     store = Path(store) if store is not None else default_store(experiment.path or f"{experiment.name}.toml")
     check_store_path(store, experiment, restart)
@@ -250,7 +251,7 @@ def run_experiment(
         report.executor = _describe_executor(workers, scheduler) + (" for a small run" if small else "")
         if repair:
             say(f"{store}: damaged; rebuilding it from the {report.done_before} finished cases in {session.folder.name}/")
-        if report.done_before < report.total:
+        if report.done_before < report.total and not quiet:  # the estimate measures the store's size: only for someone to read it
             say(_estimate(experiment, grids, report.total - report.done_before, _local_workers(workers, scheduler), checked).describe(_cores(workers, scheduler)))
         if small:
             say("running in this process, without dask: a run this small ends sooner than local workers would start (--workers N starts N)")

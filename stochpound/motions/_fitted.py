@@ -41,6 +41,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import replace
+from functools import lru_cache
 
 import numpy as np
 
@@ -130,13 +131,12 @@ def fit_scenarios(
         raise SiteError(f"levels: the fit needs at least 2 increasing levels > 0 g, got {x.tolist()}")
     if not others:
         raise SiteError("others: the fit needs the site's hazard curve at one or more other periods")
-    first = Scenario.of(MAGNITUDES[0], DISTANCES[0], vs30, mechanism)
+    Scenario.of(MAGNITUDES[0], DISTANCES[0], vs30, mechanism)  # vs30 and mechanism checked, naming them
     fine, fine_weights = np.asarray(fine_levels, dtype=float), np.asarray(fine_rates, dtype=float)
     if fine.ndim != 1 or fine.shape != fine_weights.shape or fine.size < x.size or not np.all(np.diff(fine) > 0):
         raise SiteError("fine_levels: increasing levels, one rate of fine_rates each (fit_levels)")
     if fine[0] > x[0] or fine[-1] < x[-1]:
         raise SiteError(f"fine_levels: must span the levels {x[0]:g}-{x[-1]:g} g, got {fine[0]:g}-{fine[-1]:g} g")
-    model = _SiteModel(measure, period, fine, others)
     high_rate = float(fine_weights[fine >= x[0]].sum())  # the rates of the stripes' range: λ(x_1) to λ(x_top)
     low_rate = float(fine_weights[fine >= x[-1]].sum())
     targets = []  # per other curve: the intensities y and ln site rate within the stripes' rates
@@ -146,18 +146,39 @@ def fit_scenarios(
         if not keep.any():
             other = Measure("pga") if node is None else Measure("psa", float(node))
             raise SiteError(f"others: the site's {other.label} curve has no intensity whose rate is within the stripes' {low_rate:.3g}-{high_rate:.3g}/yr")
-        targets.append((im[keep], np.log(rate[keep])))
+        targets.append((None if node is None else float(node), tuple(im[keep].tolist()), tuple(np.log(rate[keep]).tolist())))
+    period = period if period is None or np.ndim(period) == 0 else tuple(period)
+    magnitude, distance = _least_misfit(measure, period, tuple(fine.tolist()), tuple(fine_weights.tolist()), tuple(targets), float(vs30), mechanism)
+    return [{"magnitude": float(magnitude), "distance_km": float(distance), "vs30": float(vs30), "mechanism": mechanism} for _ in x]
+
+
+@lru_cache(maxsize=32)
+def _least_misfit(measure: str, period: float | tuple[float, ...] | None, fine: tuple[float, ...], fine_weights: tuple[float, ...],
+                  targets: tuple[tuple[float | None, tuple[float, ...], tuple[float, ...]], ...], vs30: float, mechanism: str) -> tuple[float, float]:
+    """The candidate (magnitude, distance in km) of least misfit (module docstring), for :func:`fit_scenarios`'s checked inputs.
+
+    ``targets``: per other curve, its node (period in s, None for PGA), the
+    intensities y within the stripes' rates (g) and the site's ln rates
+    there. Kept per process for its inputs (exact floats): experiments at
+    the same site and stripes (a run, its report, another configuration)
+    fit once; a pure function of its arguments, so the answer is the one a
+    fit would give again.
+    """
+    first = Scenario.of(MAGNITUDES[0], DISTANCES[0], vs30, mechanism)
+    weights = np.asarray(fine_weights, dtype=float)
+    model = _SiteModel(measure, period, np.asarray(fine, dtype=float), [(node, y, ln_site) for node, y, ln_site in targets])
+    intensities = [np.asarray(y, dtype=float) for _, y, _ in targets]
+    ln_sites = [np.asarray(ln_site, dtype=float) for _, _, ln_site in targets]
     candidates = [(m, r) for m in MAGNITUDES for r in DISTANCES]
     scores = []
     for magnitude, distance in candidates:
-        probabilities = model.exceedance(replace(first, magnitude=magnitude, distance_km=distance), [y for y, _ in targets])
+        probabilities = model.exceedance(replace(first, magnitude=magnitude, distance_km=distance), intensities)
         score = 0.0
-        for k, (_, ln_site) in enumerate(targets):
-            recomputed = sum(fine_weights[i] * probabilities[i][k] for i in range(fine.size))
+        for k, ln_site in enumerate(ln_sites):
+            recomputed = sum(weights[i] * probabilities[i][k] for i in range(len(fine)))
             score += float(np.sum((np.log(np.maximum(recomputed, 1e-300)) - ln_site) ** 2))
         scores.append(score)
-    magnitude, distance = candidates[int(np.argmin(scores))]
-    return [{"magnitude": float(magnitude), "distance_km": float(distance), "vs30": float(vs30), "mechanism": mechanism} for _ in x]
+    return candidates[int(np.argmin(scores))]
 
 
 class _SiteModel:
