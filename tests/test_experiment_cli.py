@@ -382,10 +382,10 @@ def test_the_estimate_counts_the_start_up_as_last_timed_on_this_machine(tmp_path
     with caplog.at_level("WARNING", logger="stochpound.solvers"):
         result = invoke("experiment", "run", str(experiment), "--workers", "0")
     assert result.exit_code == 0, result.output
-    assert (f"on 1 core after a start-up: {COMPILE} (not yet timed on this machine: about 25 s on an idle one, minutes on a loaded one), "
+    assert (f"on 1 core after a start-up: {COMPILE} (not yet timed on this machine: about 15 s on an idle one, minutes on a loaded one), "
             f"{rest} (not yet timed on this machine), store about ") in result.stderr, result.stderr
     assert [r.getMessage() for r in caplog.records if r.name == "stochpound.solvers"] == [
-        "stochpound: compiling the exact solver's engine (numba's cache of it is empty; not yet timed on this machine: about 25 s on an idle "
+        "stochpound: compiling the exact solver's engine (numba's cache of it is empty; not yet timed on this machine: about 15 s on an idle "
         "one, minutes on a loaded one); later calls, and later processes, load it from the cache"]
     measured = json.loads(timings.read_text())
     assert measured["compile"] >= 0 and measured[rest] > 0, measured  # this process had the engine loaded: the warm-up takes ~0 s

@@ -8,6 +8,7 @@ import sys
 
 import pytest
 
+from stochpound._memory import format_bytes
 from stochpound.experiment import _runner
 from tests.helpers import REPOSITORY
 
@@ -64,11 +65,17 @@ def test_the_warm_up_compiles_the_spectrum_s_kernel_only_when_asked():
 
 def test_a_small_run_given_no_workers_runs_in_this_process(tmp_path, monkeypatch):
     """No workers given: a run whose cases are estimated under IN_PROCESS_CPU_SECONDS of CPU runs in this process, without
-    dask (said as it starts and in its report); above it, the local cluster is chosen (not started here)."""
-    from stochpound.experiment import load_experiment, run_experiment
+    dask (said as it starts and in its report), and its estimate gives the store's data size without measuring the file
+    (file_bytes, half a second of CPU); above it, the local cluster is chosen (not started here)."""
+    from stochpound.experiment import _estimate, load_experiment, run_experiment
     from stochpound.experiment._estimate import cpu_seconds
     from stochpound.experiment._sources import resolve_motions
     from tests.helpers import write_experiment
+
+    def measured(*arguments):
+        raise AssertionError("a small run measured its store on its metadata")
+
+    monkeypatch.setattr(_estimate, "file_bytes", measured)
 
     experiment = load_experiment(write_experiment(tmp_path))
     grids = {label: motion.grid for label, motion in resolve_motions(experiment).items()}
@@ -78,5 +85,17 @@ def test_a_small_run_given_no_workers_runs_in_this_process(tmp_path, monkeypatch
     report = run_experiment(experiment, progress=False, say=lines.append)
     assert report.complete and report.executor == "this process (no dask) for a small run", report.executor
     assert any(line.startswith("running in this process, without dask") for line in lines), lines
+    data = sum(spec.dtype.itemsize * spec_size for spec, spec_size in _sizes(experiment, grids))
+    assert f"store about {format_bytes(data)} of data before compression (and as much again in its .parts folder)" in lines[0], lines
     monkeypatch.setattr(_runner, "IN_PROCESS_CPU_SECONDS", estimated)
     assert not _runner.in_process(experiment, grids, experiment.n_cases)
+
+
+def _sizes(experiment, grids):
+    """Each variable of the experiment's store with its number of elements (the layout's, written out here)."""
+    import math
+
+    from stochpound.experiment._file_layout import layout
+
+    store = layout(experiment, grids, 0)
+    return [(spec, math.prod(store.sizes[d] for d in spec.dims)) for spec in store.specs]

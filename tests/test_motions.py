@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import warnings
 
 import numpy as np
 import pytest
@@ -331,3 +332,26 @@ def test_scene_style_call():
     one = kanai_tajimi(1, start=4, duration=8.0, dt=0.02, **table)
     many = kanai_tajimi(6, duration=8.0, dt=0.02, **table)
     np.testing.assert_array_equal(one.values[0], many.values[4])
+
+
+@pytest.mark.parametrize(
+    ("numerator", "denominator"),
+    [
+        (kanai_tajimi_model(15.0, 0.6).numerator, kanai_tajimi_model(15.0, 0.6).denominator),
+        (clough_penzien_model(15.0, 0.6, 1.5, 0.6).numerator, clough_penzien_model(15.0, 0.6, 1.5, 0.6).denominator),
+        ((5.0,), (2.0, 1.0)),  # first order, D's leading coefficient not 1
+        ((0.0, 0.0, 1.0), (3.0, 2.0, 1.0, 7.0)),  # N's leading zeros
+        ((1e-15, 2.0, 3.0), (0.0, 2.0, 3.0, 4.0, 5.0)),  # N's leading round-off, D's leading zero
+        ((-0.0, 1.0), (1.0, 2.0, 3.0)),
+    ],
+)
+def test_the_controllable_form_is_scipys_bit_for_bit(numerator, denominator):
+    """motions.psd.controllable_form (no scipy.signal import at start-up) gives scipy.signal.tf2ss's (A, B, C), bit for bit."""
+    from stochpound.motions.psd import controllable_form
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", signal.BadCoefficients)  # scipy's warning about N's leading zeros
+        expected = signal.tf2ss(numerator, denominator)[:3]
+    for ours, theirs in zip(controllable_form(numerator, denominator), expected):
+        assert ours.shape == theirs.shape and ours.dtype == theirs.dtype
+        assert ours.tobytes() == theirs.tobytes()

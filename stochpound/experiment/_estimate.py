@@ -14,7 +14,7 @@ from typing import Mapping
 from stochpound.experiment._experiment import Experiment
 from stochpound.store import KINDS, Point
 from stochpound.experiment._spec import AUTO
-from stochpound.experiment._file_layout import layout
+from stochpound.experiment._file_layout import Layout, Spec, layout
 from stochpound.experiment._file_assembly import file_bytes
 from stochpound._memory import format_bytes
 from stochpound.model.scene_file import scene_from_dict
@@ -48,6 +48,7 @@ class RunEstimate:
     store_bytes : int
         Size of the complete store file without its impact table (:func:`~stochpound.experiment._file_assembly.file_bytes`:
         measured on its metadata written in memory, time histories uncompressed), bytes; the parts folder holds about as much again.
+        Unless ``store_measured``: its variables' data alone, uncompressed (a small run's, not worth the measurement's half second).
     history_bytes : int
         The time histories' part of ``store_bytes``, uncompressed (the file holds them compressed: usually less), bytes.
     startup : tuple of (str, float or None)
@@ -61,6 +62,7 @@ class RunEstimate:
     store_bytes: int
     history_bytes: int = 0
     startup: tuple[tuple[str, float | None], ...] = ()
+    store_measured: bool = True
 
     @property
     def large(self) -> bool:
@@ -71,7 +73,9 @@ class RunEstimate:
         """``1,000 cases to run: roughly 2 min on 2 cores after a start-up of about 9 s (...), store about 1.2 MiB (and as much again in its .parts folder)``."""
         wall = self.cpu_seconds / max(1, cores)
         size = f"about {format_bytes(self.store_bytes)}"
-        if self.history_bytes:
+        if not self.store_measured:
+            size += " of data before compression"
+        elif self.history_bytes:
             size += f" or less ({format_bytes(self.history_bytes)} of it time histories before compression)"
         return (
             f"{self.cases:,} cases to run: roughly {_duration(wall)} on {cores} core{'s' if cores > 1 else ''}{self._startup_text()}, "
@@ -91,7 +95,8 @@ class RunEstimate:
         return f" after a start-up: {steps}"
 
 
-def estimate_run(experiment: Experiment, motion_grids: Mapping[str, tuple[float, int]], cases: int, workers: int = 0) -> RunEstimate:
+def estimate_run(experiment: Experiment, motion_grids: Mapping[str, tuple[float, int]], cases: int, workers: int = 0,
+                 measure_store: bool = True) -> RunEstimate:
     """Estimate the cost of running ``cases`` of the experiment's cases (the missing ones).
 
     Parameters
@@ -103,11 +108,19 @@ def estimate_run(experiment: Experiment, motion_grids: Mapping[str, tuple[float,
         Cases to run (their share of the experiment's samples is counted).
     workers : int
         Worker processes of the local cluster the run starts (0: none, the cases run in this process or on a scheduler's).
+    measure_store : bool
+        Measure the store file's size on its metadata written in memory (:func:`~stochpound.experiment._file_assembly.file_bytes`,
+        about half a second); if False, the store's size is its variables' data, uncompressed (:attr:`RunEstimate.store_measured`).
     """
     store = layout(experiment, motion_grids, 0)
-    histories = sum(spec.dtype.itemsize * math.prod(store.sizes[d] for d in spec.dims) for spec in store.of("history"))
-    return RunEstimate(cases, cpu_seconds(experiment, motion_grids, cases), file_bytes(store, {"definition": experiment.definition_json}), histories,
-                       startup_steps(cases, workers))
+    histories = sum(_data_bytes(store, spec) for spec in store.of("history"))
+    size = file_bytes(store, {"definition": experiment.definition_json}) if measure_store else sum(_data_bytes(store, spec) for spec in store.specs)
+    return RunEstimate(cases, cpu_seconds(experiment, motion_grids, cases), size, histories, startup_steps(cases, workers), measure_store)
+
+
+def _data_bytes(store: Layout, spec: Spec) -> int:
+    """The bytes of a variable's data, uncompressed."""
+    return spec.dtype.itemsize * math.prod(store.sizes[d] for d in spec.dims)
 
 
 def startup_steps(cases: int, workers: int) -> tuple[tuple[str, float | None], ...]:

@@ -232,7 +232,7 @@ def run_experiment(
     elif store.is_dir():
         raise ExperimentError(f"{store}: is a folder; --store must name a file")
     grids = {label: m.grid for label, m in motions.items()}
-    checked = _check_size(experiment, grids, store, restart, large_ok, _cores(workers, scheduler))
+    checked = _check_size(experiment, grids, store, restart, large_ok, _cores(workers, scheduler), workers is None and scheduler is None)
     parts_folder(store).mkdir(parents=True, exist_ok=True)
     lock = FolderLock(parts_folder(store))
     if not lock.acquire():
@@ -252,7 +252,8 @@ def run_experiment(
         if repair:
             say(f"{store}: damaged; rebuilding it from the {report.done_before} finished cases in {session.folder.name}/")
         if report.done_before < report.total and not quiet:  # the estimate measures the store's size: only for someone to read it
-            say(_estimate(experiment, grids, report.total - report.done_before, _local_workers(workers, scheduler), checked).describe(_cores(workers, scheduler)))
+            say(_estimate(experiment, grids, report.total - report.done_before, _local_workers(workers, scheduler), checked, small)
+                .describe(_cores(workers, scheduler)))
         if small:
             say("running in this process, without dask: a run this small ends sooner than local workers would start (--workers N starts N)")
         cold = not first_call.engine_cached()
@@ -327,11 +328,15 @@ def _busy(store: Path) -> ExperimentError:
 
 
 def _check_size(experiment: Experiment, grids: dict[str, tuple[float, int]], store: Path, restart: bool, large_ok: bool,
-                cores: int) -> RunEstimate | None:
-    """Refuse a large run (:attr:`RunEstimate.large`, its finished cases not counted) unless ``large_ok``; the estimate made (None if none)."""
+                cores: int, default_workers: bool) -> RunEstimate | None:
+    """Refuse a large run (:attr:`RunEstimate.large`, its finished cases not counted) unless ``large_ok``; the estimate made (None if none).
+
+    A run small enough to run in this process with the ``default_workers`` (:func:`in_process`, all its cases
+    counted) gets the estimate without the store's measured size (:func:`_estimate`).
+    """
     if large_ok:
         return None
-    estimate = estimate_run(experiment, grids, experiment.n_cases)
+    estimate = estimate_run(experiment, grids, experiment.n_cases, measure_store=not (default_workers and in_process(experiment, grids, experiment.n_cases)))
     if estimate.large and not restart and parts_folder(store).is_dir():
         estimate = estimate_run(experiment, grids, experiment.n_cases - PartsIndex.scan(experiment, parts_folder(store)).n_done)
     if estimate.large:
@@ -342,11 +347,13 @@ def _check_size(experiment: Experiment, grids: dict[str, tuple[float, int]], sto
     return estimate
 
 
-def _estimate(experiment: Experiment, grids: dict[str, tuple[float, int]], cases: int, workers: int, checked: RunEstimate | None) -> RunEstimate:
+def _estimate(experiment: Experiment, grids: dict[str, tuple[float, int]], cases: int, workers: int, checked: RunEstimate | None,
+              small: bool) -> RunEstimate:
     """The estimate of a run of ``cases`` cases on ``workers`` local workers: :func:`_check_size`'s (``checked``) when it counted
-    as many cases (the store's size is measured once), with this run's start-up steps."""
+    as many cases (the store's size is measured once), with this run's start-up steps. A ``small`` run's (run in this process
+    by default, :func:`in_process`) does not measure the store's size: its data's is given (half a second less start-up)."""
     if checked is None or checked.cases != cases:
-        return estimate_run(experiment, grids, cases, workers)
+        return estimate_run(experiment, grids, cases, workers, measure_store=not small)
     return replace(checked, startup=startup_steps(cases, workers))
 
 

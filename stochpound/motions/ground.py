@@ -98,8 +98,6 @@ class SampledMotion(GroundMotion):
 
 def _interval_polynomials(times: np.ndarray, values: np.ndarray, interpolation: str) -> np.ndarray:
     """Per-interval cubic coefficients (n-1, 4) in powers of τ = t − t_k."""
-    from scipy.interpolate import CubicSpline
-
     n_intervals = max(len(values) - 1, 0)
     coefficients = np.zeros((n_intervals, 4))
     if n_intervals == 0:
@@ -108,6 +106,8 @@ def _interval_polynomials(times: np.ndarray, values: np.ndarray, interpolation: 
         coefficients[:, 0] = values[:-1]
         coefficients[:, 1] = np.diff(values) / np.diff(times)
     elif interpolation == "spline":
+        from scipy.interpolate import CubicSpline  # a second of CPU to import: only where a spline is asked for
+
         spline = CubicSpline(times, values, bc_type="natural")
         coefficients[:] = spline.c[::-1].T  # scipy stores the highest power first
     else:

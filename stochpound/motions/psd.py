@@ -123,9 +123,7 @@ class FilteredWhiteNoise:
 
     @cached_property
     def _state_space(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        from scipy.signal import tf2ss
-        A, B, C, _ = tf2ss(self.numerator, self.denominator)
-        return A, B, C
+        return controllable_form(self.numerator, self.denominator)
 
     def state_space(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(A, B, C) with ẋ = A x + B w, output C x (controllable canonical form)."""
@@ -204,6 +202,30 @@ class FilteredWhiteNoise:
         """λ_k = ∫ abs(ω)^k S_d(ω) dω over abs(ω) ≤ π/dt (the sampled process), (m/s²)² (rad/s)^k."""
         omega = np.linspace(0.0, np.pi / dt, n_points)
         return 2.0 * float(np.trapezoid(omega**order * self.sampled_psd(omega, dt), omega))
+
+
+def controllable_form(numerator: tuple[float, ...], denominator: tuple[float, ...]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(A, B, C) of the strictly proper H(s) = N(s)/D(s) in controllable canonical form, as ``scipy.signal.tf2ss`` gives them.
+
+    The same arithmetic as scipy's (bit for bit: ``tests/test_motions.py``),
+    without importing ``scipy.signal`` (about a second of CPU, with
+    ``scipy.stats``): D's leading zeros dropped, N and D divided by D's
+    leading coefficient, N's leading coefficients of magnitude ≤ 1e-14 taken
+    as zeros, N padded with zeros to D's length; A's first row is −D[1:],
+    ones below the diagonal, B = e₁, C = N[1:] − N[0] D[1:].
+
+    Parameters
+    ----------
+    numerator, denominator : tuple of float
+        Coefficients of N and D, highest power first (D's degree greater than N's).
+    """
+    den = np.trim_zeros(np.atleast_1d(np.asarray(denominator, dtype=float)), "f")
+    num, den = np.asarray(numerator, dtype=float) / den[0], den / den[0]
+    tiny = np.flatnonzero(np.abs(num) > 1e-14)
+    num = num[min(tiny[0], num.size - 1) if tiny.size else num.size - 1:]
+    num = np.concatenate((np.zeros(den.size - num.size), num))
+    A = np.vstack((-den[np.newaxis, 1:], np.eye(den.size - 2, den.size - 1)))
+    return A, np.eye(den.size - 1, 1), (num[1:] - num[0] * den[1:])[np.newaxis, :]
 
 
 def _psd_factor(matrix: np.ndarray) -> np.ndarray:

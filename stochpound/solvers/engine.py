@@ -43,10 +43,14 @@ every jitted function on its own, optimises it again inside each caller
 on each source line as on each optimised LLVM line, copies every field of a
 named tuple wherever one is bound or passed, and inlines (``inline="always"``)
 at a high cost per call site. So :func:`run_engine` is the only entry point:
-it unpacks the named tuples once and inlines its three phases
-(:func:`_settle_pending`, :func:`_advance_quiet`, :func:`_advance_span`),
-which take arrays; the helpers take the few arrays they use, are compiled
-once without Python wrappers (:data:`INTERNAL`) and are inlined by LLVM; no
+it unpacks the named tuples once and calls its phases
+(:func:`_settle_pending`, :func:`_advance_quiet`, :func:`_advance_span`,
+:func:`_supplied_step`), which take arrays; the phases and the helpers are
+compiled once without Python wrappers (:data:`INTERNAL`), and none is inlined
+by numba: LLVM inlines the small helpers and keeps each phase a function of
+its own, which compiles in a fifth less time than the phases inlined into
+:func:`run_engine` (its one huge function then took most of LLVM's time), with
+the same results, bit for bit, and the same speed (docs/benchmarks.md, "Start-up"); no
 compile-time constant is passed to a helper (it would compile a second
 specialisation), and no array is assigned to an array slice (its error
 message alone compiles string formatting). Reference counting would make up
@@ -516,7 +520,7 @@ def _monitor_peaks(flow, t1, values0, values1, rates0, rates1, peaks, work):
     _offer_monitors(values1, t1, peaks)
 
 
-@njit(inline="always", error_model="numpy")
+@njit(**INTERNAL)
 def _advance_quiet(mode_id, n, substeps, step, propagate, chebyshev, rate, guard, force, monitor, motion, ints, clock, x, arming, is_open,
                    impact, outputs, scratch, saved):
     """Advance the current mode (its id, n guards and arrays) from interval ``ints[K]`` until an interval needs the event code.
@@ -1161,7 +1165,7 @@ def _on_transitions(mode, force, left_rows, right_rows, geometry, is_open, impac
     _offer_peaks(force, is_open, impact, t, x)
 
 
-@njit(inline="always", error_model="numpy")
+@njit(**INTERNAL)
 def _settle_pending(modes, codes, n_guards, rate, guard, force, monitor, motion, layout, arming, ints, clock, pending_x, pending_mode,
                     missing_mode, is_open, impact, table, peaks, readouts, x, scratch, marks):
     """Settle the pending event (or the start) and record it (:func:`_settle`, :func:`_on_transitions`): returns the mode index.
@@ -1260,7 +1264,7 @@ def _locate_and_record(flow, m, modes, codes, force, power, ints, clock, x0, x1,
     return True
 
 
-@njit(inline="always", error_model="numpy")
+@njit(**INTERNAL)
 def _advance_span(m, n, modes, codes, substeps, step, propagate, chebyshev, rate, guard, force, monitor, power, motion, ints, clock, x,
                   pending_x, pending_mode, arming, is_open, impact, running, peaks, k, t, t_end, scratch):
     """Exact sub-steps of mode m (n guards, its arrays) from t to t_end, each through :func:`_locate_and_record`.
@@ -1318,7 +1322,7 @@ def _advance_span(m, n, modes, codes, substeps, step, propagate, chebyshev, rate
     return False
 
 
-@njit(inline="always", error_model="numpy")
+@njit(**INTERNAL)
 def _supplied_step(m, n, modes, codes, rate, guard, force, monitor, power, motion, ints, clock, x, pending_x, pending_mode, arming, is_open,
                    impact, running, peaks, k, supplied, scratch):
     """The supplied step of mode m (n guards, its arrays) through :func:`_locate_and_record`; ξ moves to its end if no event.

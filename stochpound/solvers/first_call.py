@@ -5,7 +5,7 @@ a process's first call compiles it, or loads it from numba's cache, in
 :func:`~stochpound.solvers.compiling.engine_compile`.
 
 numba compiles the event engine on a process's first call unless its
-on-disk cache (``cache=True``) holds it; then the call takes about 25 s of CPU
+on-disk cache (``cache=True``) holds it; then the call takes about 15 s of CPU
 (docs/benchmarks.md, "Start-up"; minutes on a loaded machine) instead of
 milliseconds. A library should not print, so the
 engine says it through ``logging``: one ``WARNING`` record of the logger
@@ -98,7 +98,7 @@ def compile_text() -> str:
     """How long the engine's compile takes here: the last measured duration, or that it was never measured on this machine."""
     seconds = measured("compile")
     if seconds is None:
-        return "not yet timed on this machine: about 25 s on an idle one, minutes on a loaded one"
+        return "not yet timed on this machine: about 15 s on an idle one, minutes on a loaded one"
     return f"{seconds:.0f} s when last timed on this machine"
 
 
