@@ -55,7 +55,7 @@ HELD_OUT_SCENARIOS: tuple[tuple[float, float, float, str], ...] = (
 def parse_arguments(argv: list[str] | None) -> argparse.Namespace:
     parser = argparse.ArgumentParser(prog="python -m benchmarks site_motions", description=__doc__.splitlines()[0])
     parser.add_argument("task", choices=("speed", "calibrate", "check"))
-    parser.add_argument("--n", type=int, default=None, help="motions per process (speed: 500), per scenario (calibrate: 800, check: 2000)")
+    parser.add_argument("--n", type=int, default=None, help="motions per process (speed: 500), per scenario (calibrate: 200, check: 2000)")
     parser.add_argument("--out", type=Path, default=None, help="the document whose section is rewritten")
     parser.add_argument("--held-out", action="store_true", help="check: at the held-out scenarios (docs/benchmarks.md) instead of the fit's (docs/motions.md)")
     return parser.parse_args(argv)
@@ -134,28 +134,40 @@ def calibrate(n: int) -> Path:
     return write_calibration(fit, time.perf_counter() - start)
 
 
+def _rows(matrix: list[list[float]]) -> list[str]:
+    return [f"    [{', '.join(f'{v:.6g}' for v in row)}]," for row in matrix]
+
+
 def write_calibration(fit: dict[str, Any], elapsed: float) -> Path:
     """Write data/site_motions/calibration.toml from a fit (:func:`stochpound.motions.fit_calibration`'s result)."""
     info = report.machine()
+    history = "; ".join(f"{m:.2f} / {s:.2f}" for m, s in fit["history"])
     lines = [
-        "# Hazard-compatible calibration of the Rezaeian & Der Kiureghian (2010) model (docs/motions.md, \"Calibration\").",
+        "# Hazard-compatible calibration of the Rezaeian & Der Kiureghian (2010) model (docs/site-motions.md).",
         "# Written by `python -m benchmarks site_motions calibrate` (stochpound.motions._site_calibration.fit_calibration):",
-        f"# {fit['n']} motions per scenario (seed {fit['seed']}), dt 0.01 s, fitted against the NGA-West2 average (ASK14, BSSA14,",
-        "# CB14, CY14 in pygmm: mean of ln medians, rms of sigmas) and the Baker-Jayaram (2008) correlation,",
-        f"# commit {info['commit']}, {info['date']}, {elapsed:.0f} s. Least-squares cost {fit['cost']:.4g}; effective sample sizes of the",
-        f"# importance weights per scenario: {', '.join(f'{s:.0f}' for s in fit['effective_sizes'])}.",
+        f"# {fit['n']} motions per scenario (scenario i: realizations of seed {fit['seed']} + 1000 i), dt 0.01 s, {fit['iterations']} fixed-point",
+        "# iterations against the NGA-West2 average (ASK14, BSSA14, CB14, CY14 in pygmm: mean of ln medians, rms of sigmas) and the",
+        f"# Baker-Jayaram (2008) correlation; commit {info['commit']}, {info['date']}, {elapsed:.0f} s. Largest |ln ratio| of medians /",
+        f"# |sigma difference| over the fit's scenarios and shape periods at each iteration's simulation: {history}.",
         "# Scenarios (M, R_rup km, Vs30 m/s, mechanism): " + "; ".join(f"{s[0]:g} {s[1]:g} {s[2]:g} {s[3]}" for s in fit["scenarios"]),
         "",
-        'name = "nga_west2_calibration_1"',
+        'name = "nga_west2_calibration_2"',
         "",
-        "[adjustments]  # added to nu (standard normal space): d . [1, M - 7, ln(R/25), ln(Vs30/750), reverse, normal, (M - 7)^2, (M - 7) ln(R/25)][:len(d)]",
+        "[residual_scale]  # multiplies the published total residual standard deviation",
+        f"arias_intensity = {fit['arias_scale']:.6g}",
+        "",
+        "[corner]  # ln f_c (Hz) = ln_hz[0] + ln_hz[1] (M - 7) + sigma_ln z: the published 0.2 Hz",
+        "ln_hz = [-1.60944, 0.0]",
+        "sigma_ln = 0.0",
+        "",
+        "[spectral_shape]  # ln gain at periods T_j: mu_j - mean_j . x + sqrt(max(sigma_j^2 - variance_j . x, 0)) (L z)_j, L L' = correlation;",
+        "# x = [1, M - 7, ln(R/25), ln(Vs30/750), reverse, normal, (M - 7)^2, (M - 7) ln(R/25), ln(R/25)^2, ln(Vs30/750)^2]",
+        f"periods = [{', '.join(f'{p:g}' for p in fit['periods'])}]",
+        "mean = [", *_rows(fit["mean"]), "]",
+        "variance = [", *_rows(fit["variance"]), "]",
+        "correlation = [", *_rows(fit["correlation"]), "]",
+        "",
     ]
-    lines += [f"{name} = [{', '.join(f'{v:.6g}' for v in values)}]" for name, values in fit["adjustments"].items()]
-    lines += ["", "[residual_scale]  # multiplies the published total residual standard deviation"]
-    lines += [f"{name} = {value:.6g}" for name, value in fit["residual_scale"].items()]
-    lines += ["",
-              "[corner]  # ln f_c (Hz) = ln_hz[0] + ln_hz[1] (M - 7) + sigma_ln z",
-              f"ln_hz = [{fit['corner']['ln_hz'][0]:.6g}, {fit['corner']['ln_hz'][1]:.6g}]", f"sigma_ln = {fit['corner']['sigma_ln']:.6g}", ""]
     CALIBRATION.write_text("\n".join(lines))
     return CALIBRATION
 
@@ -283,7 +295,7 @@ def main(argv: list[str] | None = None) -> int:
         print(f"{data['one']:.0f} motions/s on one thread ({data['cpu']:.0f} per CPU second), {data['two']:.0f} on two; "
               f"first call {data['compile']:.1f} s uncached, {data['cached']:.1f} s cached; wrote {out}")
     elif arguments.task == "calibrate":
-        print(f"wrote {calibrate(arguments.n or 800)}")
+        print(f"wrote {calibrate(arguments.n or 200)}")
     else:
         out = arguments.out or REPOSITORY / "docs" / ("benchmarks.md" if arguments.held_out else "motions.md")
         worst, shares = check(arguments.n or 2000, out, arguments.held_out)
