@@ -8,23 +8,25 @@ ln medians, σ the rms of their σ); the correlation of ε at pairs of periods
 (ε: ln Sa standardised within its scenario, pooled over the scenarios) with
 Baker & Jayaram (2008).
 
-The calibration (:func:`fit_calibration`) adds to the published equations, in
-the standard normal space, ν_i += d_i · x(scenario) for the Arias intensity
-(x: 1, M − 7, ln(R/25), ln(Vs30/750), reverse, normal, (M − 7)², (M − 7) ln(R/25)), the filter frequency
-f_mid (1, M − 7, ln(R/25), ln(Vs30/750)) and the damping ζ_f (1); scales
-the residuals of the Arias intensity and of f_mid; and makes the corner f_c lognormal about
-c0 + c1 (M − 7). Those coefficients minimise, over a grid of scenarios and
-the periods, the squared misfit of the simulated mean and σ of ln Sa to the
-models' and of the ε correlations at the checked pairs to Baker & Jayaram's,
-plus a ridge penalty on the adjustments (staying near the
-published trends). The simulated statistics of a candidate come from one
-pool of motions per scenario with common random numbers: the pool's other
-parameters are drawn once from a proposal wider than the published model,
-and a candidate reweights them (importance sampling: the ratio of the
-candidate's density of ν_2…ν_6 and ln f_c to the proposal's); the Arias
-intensity only scales a motion (Sa ∝ √I_a), so each pool motion's I_a under
-the candidate follows exactly from its conditional residual, with no
-re-simulation.
+The calibration (:func:`fit_calibration`) keeps the published equations
+(their Arias residual narrowed to :data:`ARIAS_SCALE` of its published
+spread, f_c = 0.2 Hz) and adds a spectral-shape layer: each motion passes
+through a zero-phase filter whose ln gain at the periods T_j of
+``SHAPE_PERIODS`` (0.1–5 s; linear in ln T between them, held beyond) is
+μ_j − r_j + d_j (L z)_j, with μ_j, σ_j the NGA-West2 average of the scenario
+(its geometry included), r_j and v_j the mean and variance of ln Sa the base
+gives there (regressions on the scenario's features), d_j = √max(σ_j² − v_j, 0),
+L the lower factor of the gains' correlation and z the motion's 11 shape
+normals. Fit: for every scenario of :data:`FIT_SCENARIOS`, n motions with
+common random numbers; at each of :data:`ITERATIONS` fixed-point iterations
+their ln Sa moves every scenario's gain by the miss of the median
+(μ_j − simulated mean) and its spread by the miss of the variance
+(d_j² += σ_j² − simulated variance), and the correlation becomes the
+covariance the layer must add (Baker–Jayaram's times σ σ, minus the
+simulated one without the layer's), summed over the scenarios and divided
+by the summed d_i d_j, made positive definite. Last, r_j = μ_j − gain_j and
+v_j = σ_j² − d_j² are regressed (ridge :data:`RIDGE`) on the features, so
+that any scenario in the range has its layer.
 """
 
 from __future__ import annotations

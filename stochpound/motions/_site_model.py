@@ -24,12 +24,17 @@ displacement the filter's tail leaves at the end of the window.
 The six parameters (I_a, D5–95, t_mid, f_mid, f_slope, ζ_f) come from
 predictive equations in the standard normal space with correlated residuals
 (data/site_motions/rezaeian_2010.toml), each mapped to its marginal; the
-hazard-compatible calibration (data/site_motions/calibration.toml) adds a
-linear adjustment in the scenario to some of the equations and predicts f_c.
-The corner f_c is lognormal about a line in M (a constant for the published
-model). A motion is a deterministic function of 7 + n_time independent
-standard normals: the first 6 give its parameters (through the residuals'
-covariance), the 7th its corner, the rest are the w_i.
+corner f_c is lognormal about a line in M (a constant for the published
+model). The hazard-compatible calibration (data/site_motions/calibration.toml)
+may scale the residuals and adjust the equations, and adds a spectral-shape
+layer (:class:`SpectralShape`): after the post-filter, each motion passes
+through a zero-phase filter whose ln gain, linear in ln T between the layer's
+periods and held beyond them, is drawn per motion (:func:`shape_filter`);
+then the baseline correction. A motion is a deterministic function of
+``model.normals`` + n_time independent standard normals: the first 6 give its
+parameters (through the residuals' covariance), the 7th its corner, the next
+K (the shape layer's periods; none for the published model) its gains, the
+rest are the w_i.
 """
 
 from __future__ import annotations

@@ -135,14 +135,16 @@ def site_motions(magnitude: float | None = None, distance_km: float | None = Non
         modulation to deliver 99.9 % of its Arias intensity plus two periods of
         the post-filter's corner, rounded up to 5 s.
     model : {"hazard_compatible", "rezaeian_2010"}
-        The calibrated equations (default; docs/motions.md) or the published ones.
+        The calibrated model (default; docs/site-motions.md) or the published equations.
     realizations : list of int, optional
         Only these motions of the ``n`` (each in 0 … n − 1), in this order:
         bit for bit the same rows as of the full set (the window is still the
         full set's), at the memory of these alone. Default: all ``n``.
     scenario : Scenario, optional
         The scenario as one value, instead of ``magnitude``, ``distance_km``, ``vs30`` and ``mechanism``
-        (``site_motions(n=100, seed=1, scenario=Scenario(7.0, 10.0, 760.0, "strike_slip"))``).
+        (``site_motions(n=100, seed=1, scenario=Scenario(7.0, 10.0, 760.0, "strike_slip"))``); with the
+        hazard-compatible model it may carry a geometry (R_JB, R_x, Z_tor, dip, basin depths), which the
+        NGA-West2 medians and σ its spectral-shape layer follows take (a hanging-wall site, say).
 
     Returns
     -------
@@ -151,7 +153,9 @@ def site_motions(magnitude: float | None = None, distance_km: float | None = Non
         displacement at the end), and per realization its parameters:
         ``arias_intensity`` (m/s, the expected value of the modulation),
         ``d5_95`` and ``t_mid`` (s), ``f_mid`` (Hz), ``f_slope`` (Hz/s),
-        ``zeta_f`` and ``f_corner`` (Hz). Attributes: the scenario, ``model``,
+        ``zeta_f`` and ``f_corner`` (Hz); with the hazard-compatible model
+        ``spectral_shape`` (realization, shape_period): the ln gains of its
+        spectral-shape layer (docs/site-motions.md). Attributes: the scenario, ``model``,
         ``model_provenance``, ``seed``, ``n``, ``dt``; ``realization`` numbers
         the motions among the n.
 
