@@ -148,7 +148,7 @@ def test_motions_end_at_rest_and_keep_their_parameters():
     peak_velocity = np.max(np.abs(np.cumsum(a, axis=1) * 0.01))
     assert np.all(np.abs(velocity) < 1e-10 * peak_velocity)
     assert np.all(np.abs(displacement) < 1e-10 * peak_velocity * motions.time.values[-1])
-    assert np.all(a[:, 0] == 0.0)
+    assert np.all(np.abs(a[:, 0]) < 1e-5 * np.max(np.abs(a)))  # at rest at t = 0 (the causal shape filter's round-off)
     for name, unit in (("arias_intensity", "m/s"), ("d5_95", "s"), ("t_mid", "s"), ("f_mid", "Hz"), ("f_slope", "Hz/s"), ("zeta_f", "1"), ("f_corner", "Hz")):
         assert motions[name].dims == ("realization",) and motions[name].attrs["units"] == unit
     assert motions.attrs["seed"] == 11 and motions.attrs["model"] == "hazard_compatible"
@@ -187,17 +187,26 @@ def test_the_seeded_motions_are_the_map_of_their_normals():
     assert np.array_equal(seeded_published.acceleration.values, direct.acceleration.values)
 
 
-def test_the_shape_filter_is_the_gain_it_is_given():
-    """A constant ln gain c scales a motion by e^c exactly; a gain 1 at the periods ≤ 0.5 s and 0 from 1 s on multiplies the
-    Fourier amplitude by e at 10 Hz and leaves it at 0.5 Hz (a sine of each, in the window's middle, through the zero-phase filter)."""
+def test_the_shape_filter_is_the_gain_it_is_given_and_causal():
+    """A constant ln gain c scales a motion by e^c exactly. A gain 1 at the periods ≤ 0.5 s and 0 from 1 s on: the filter's
+    amplitude (the spectrum of its impulse response) is e^gain at every frequency, its phase is minimum, so nothing comes
+    out before the impulse, and a 10 Hz and a 0.5 Hz wave packet come out e and 1 times as large (their norms)."""
     t = np.arange(4001) * 0.01
     window = np.exp(-(((t - 20.0) / 6.0) ** 2))
     constant = shape_filter(np.array([window * np.sin(2 * np.pi * 3.0 * t)]), 0.01, SHAPE_PERIODS, np.full((1, len(SHAPE_PERIODS)), 0.3))
     assert np.allclose(constant[0], math.exp(0.3) * window * np.sin(2 * np.pi * 3.0 * t), atol=1e-12)
     gains = np.array([[1.0 if p <= 0.5 else (0.0 if p >= 1.0 else 1.0 - math.log(p / 0.5) / math.log(2.0)) for p in SHAPE_PERIODS]])
+    impulse = np.zeros((1, 4001))
+    impulse[0, 1000] = 1.0
+    response = shape_filter(impulse, 0.01, SHAPE_PERIODS, gains)[0]
+    assert np.max(np.abs(response[:1000])) < 1e-6 * np.max(np.abs(response))
+    frequency = np.fft.rfftfreq(3001, 0.01)[1:]
+    amplitude = np.abs(np.fft.rfft(response[1000:]))[1:]
+    wanted = np.exp(np.interp(-np.log(frequency), np.log(SHAPE_PERIODS), gains[0]))
+    assert np.allclose(amplitude, wanted, rtol=5e-3)  # 0.24 % at the kink at 1 Hz (the cepstrum folded on a finite grid)
     for frequency, factor in ((10.0, math.e), (0.5, 1.0)):
         x = window * np.sin(2 * np.pi * frequency * t)
-        assert np.allclose(shape_filter(x[None], 0.01, SHAPE_PERIODS, gains)[0], factor * x, atol=2e-3 * factor)
+        assert np.linalg.norm(shape_filter(x[None], 0.01, SHAPE_PERIODS, gains)[0]) == pytest.approx(factor * np.linalg.norm(x), rel=5e-3)
 
 
 def test_the_hazard_compatible_model_takes_a_scenario_geometry_and_the_published_one_refuses_it():

@@ -11,7 +11,7 @@ Baker & Jayaram (2008).
 The calibration (:func:`fit_calibration`) keeps the published equations
 (their Arias residual narrowed to :data:`ARIAS_SCALE` of its published
 spread, f_c = 0.2 Hz) and adds a spectral-shape layer: each motion passes
-through a zero-phase filter whose ln gain at the periods T_j of
+through a minimum-phase filter whose ln gain at the periods T_j of
 ``SHAPE_PERIODS`` (0.1–5 s; linear in ln T between them, held beyond) is
 μ_j − r_j + d_j (L z)_j, with μ_j, σ_j the NGA-West2 average of the scenario
 (its geometry included), r_j and v_j the mean and variance of ln Sa the base

@@ -28,7 +28,7 @@ corner f_c is lognormal about a line in M (a constant for the published
 model). The hazard-compatible calibration (data/site_motions/calibration.toml)
 may scale the residuals and adjust the equations, and adds a spectral-shape
 layer (:class:`SpectralShape`): after the post-filter, each motion passes
-through a zero-phase filter whose ln gain, linear in ln T between the layer's
+through a minimum-phase filter whose ln gain, linear in ln T between the layer's
 periods and held beyond them, is drawn per motion (:func:`shape_filter`);
 then the baseline correction. A motion is a deterministic function of
 ``model.normals`` + n_time independent standard normals: the first 6 give its
@@ -299,20 +299,30 @@ def motion_parameters(model: SiteModel, scenario: Scenario, normals: np.ndarray)
 
 
 def shape_filter(acceleration: np.ndarray, dt: float, periods: Sequence[float], gains: np.ndarray) -> np.ndarray:
-    """Motions [n, n_time] through their zero-phase filters: ln |H| interpolated in ln T between ``gains`` [n, K] at ``periods`` (s).
+    """Motions [n, n_time] through their minimum-phase filters: ln |H| interpolated in ln T between ``gains`` [n, K] at ``periods`` (s).
 
-    Held at the end values beyond the periods; the motion is padded with zeros to
-    1.5 times its length (and a fast FFT size) so that the filter does not wrap.
+    |H| is held at the end values beyond the periods; its phase is the minimum
+    phase of that amplitude (the real cepstrum of ln |H| folded onto positive
+    quefrencies), so the filter is causal: a motion at rest before t = 0 stays
+    so, and the filter delays rather than spreads. The motion is padded with
+    zeros to 1.5 times its length (a fast FFT size); what the filter moves past
+    the window is cut, and the baseline correction follows.
     """
     from scipy import fft
 
     n_time = acceleration.shape[1]
     size = fft.next_fast_len(int(1.5 * n_time) + 1, real=True)
+    size += size % 2
     frequency = fft.rfftfreq(size, dt)
     ln_period = -np.log(np.maximum(frequency, 1e-12))
     nodes = np.log(np.asarray(periods, dtype=float))
     basis = np.stack([np.interp(ln_period, nodes, np.eye(len(nodes))[j]) for j in range(len(nodes))], axis=1)
-    spectrum = fft.rfft(acceleration, size, axis=1) * np.exp(gains @ basis.T)
+    cepstrum = fft.irfft(np.asarray(gains) @ basis.T, size, axis=1)
+    folded = np.zeros_like(cepstrum)
+    folded[:, 0] = cepstrum[:, 0]
+    folded[:, 1:size // 2] = 2.0 * cepstrum[:, 1:size // 2]
+    folded[:, size // 2] = cepstrum[:, size // 2]
+    spectrum = fft.rfft(acceleration, size, axis=1) * np.exp(fft.rfft(folded, axis=1))
     return fft.irfft(spectrum, size, axis=1)[:, :n_time]
 
 
