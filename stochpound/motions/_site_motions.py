@@ -3,8 +3,9 @@
 :func:`site_motions` draws any number of motions of a scenario (magnitude,
 rupture distance, Vs30, mechanism) from a seed; :func:`site_motions_from_normals`
 is the same map from an explicit array of independent standard normals, one
-row per motion (its first 7 give the motion's parameters, the others the
-white noise at each sample: the model is in ``stochpound.motions._site_model``).
+row per motion (its first 7 give the motion's parameters, the next 11 its
+spectral-shape gains with the hazard-compatible model, the others the white
+noise at each sample: the model is in ``stochpound.motions._site_model``).
 Motion i of a seed uses the generator of realization i
 (:func:`~stochpound.motions.realization_rng`): its 7 parameter normals, its
 shape layer's 11 (the hazard-compatible model only), then its noise.
