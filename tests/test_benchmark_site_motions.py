@@ -89,7 +89,7 @@ def test_reduced_tail_check_on_the_hanging_wall():
     300 simulated motions exceed the levels of its own NGA-West2 ε = 0, 1 and 2 at PGA and PSA(1 s) as often as the lognormal
     says, within three binomial standard errors (±0.087, ±0.063, ±0.026). Without its geometry the NGA-West2 medians of
     this rupture are 0.6 lower at both measures (σ 0.55–0.69): motions following them would exceed the ε = 0 level about
-    0.16–0.2 of the time instead of 0.5, so the test can fail."""
+    0.14–0.21 of the time instead of 0.5, so the test can fail."""
     demo = RuptureSite.bundled("demo_three_sources")
     site = RuptureSite.from_scenarios([(demo.scenario(1), demo.rate[1])])
     assert site.scenario(0).geometry["distance_x_km"] == 10.0
@@ -97,5 +97,5 @@ def test_reduced_tail_check_on_the_hanging_wall():
     levels = np.array([np.exp(site.moments(measure, period)[0][0] + epsilons * site.moments(measure, period)[1][0])
                        for measure, period in (("pga", None), ("psa", 1.0))])
     counted = rupture_exceedance(site, 300, 11, levels)[0]
-    expected = 0.5 * math.erfc(epsilons / math.sqrt(2.0))
+    expected = np.array([0.5 * math.erfc(e / math.sqrt(2.0)) for e in epsilons])[None, :]
     assert np.all(np.abs(counted - expected) <= 3.0 * np.sqrt(expected * (1.0 - expected) / 300))
