@@ -317,13 +317,15 @@ def shape_filter(acceleration: np.ndarray, dt: float, periods: Sequence[float], 
     ln_period = -np.log(np.maximum(frequency, 1e-12))
     nodes = np.log(np.asarray(periods, dtype=float))
     basis = np.stack([np.interp(ln_period, nodes, np.eye(len(nodes))[j]) for j in range(len(nodes))], axis=1)
-    cepstrum = fft.irfft(np.asarray(gains) @ basis.T, size, axis=1)
-    folded = np.zeros_like(cepstrum)
-    folded[:, 0] = cepstrum[:, 0]
-    folded[:, 1:size // 2] = 2.0 * cepstrum[:, 1:size // 2]
-    folded[:, size // 2] = cepstrum[:, size // 2]
-    spectrum = fft.rfft(acceleration, size, axis=1) * np.exp(fft.rfft(folded, axis=1))
-    return fft.irfft(spectrum, size, axis=1)[:, :n_time]
+    out = np.empty_like(acceleration)
+    for m, row in enumerate(np.asarray(gains, dtype=float)):  # one motion at a time: batched FFTs and products round by batch
+        cepstrum = fft.irfft(basis @ row, size)
+        folded = np.zeros(size)
+        folded[0] = cepstrum[0]
+        folded[1:size // 2] = 2.0 * cepstrum[1:size // 2]
+        folded[size // 2] = cepstrum[size // 2]
+        out[m] = fft.irfft(fft.rfft(acceleration[m], size) * np.exp(fft.rfft(folded)), size)[:n_time]
+    return out
 
 
 def gamma_shape(t_mid: np.ndarray, d5_95: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
