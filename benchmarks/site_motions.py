@@ -294,16 +294,18 @@ def check(n: int, out: Path, held_out: bool = False) -> tuple[dict[str, float], 
 def rupture_exceedance(site: Any, n: int, seed: int, levels: np.ndarray, periods: tuple = TAIL_PERIODS, dt: float = 0.01) -> np.ndarray:
     """P(IM > x | r) [rupture, measure, level] counted over ``n`` simulated motions of every rupture of ``site`` (its full scenario,
     geometry included; rupture r: realizations of seed ``seed + r``), ``levels`` [measure, level] in g, IM PGA or PSA at ``periods``."""
-    from stochpound.motions import site_motions
-    from stochpound.motions._site_calibration import ln_spectra
+    from stochpound.motions import DEFAULT_G, response_spectrum, site_motions
 
+    oscillators = [p for p in periods if p is not None]
     counts = np.zeros((len(site), *levels.shape))
     for r in range(len(site)):
         scenario = site.scenario(r)
         for start in range(0, n, TAIL_BATCH):
             motions = site_motions(scenario=scenario, n=n, seed=seed + r, dt=dt, realizations=list(range(start, min(start + TAIL_BATCH, n))))
-            ln_sa = ln_spectra(motions["acceleration"].values, dt, periods)
-            counts[r] += np.sum(ln_sa[:, :, None] > np.log(levels)[None], axis=0)
+            for a in motions["acceleration"].values:
+                psa = iter(response_spectrum(a, dt, oscillators)["psa"].values if oscillators else [])
+                im = np.array([np.max(np.abs(a)) if p is None else next(psa) for p in periods]) / DEFAULT_G
+                counts[r] += im[:, None] > levels
     return counts / n
 
 

@@ -68,7 +68,7 @@ def _dataset(acceleration: np.ndarray, parameters: dict[str, np.ndarray], dt: fl
 
 
 def _attrs(scenario: Scenario, model: str) -> dict:
-    return {**scenario.loose(), "model": model, "model_provenance": load_site_model(model).provenance}
+    return {**scenario.loose(), **scenario.geometry, "model": model, "model_provenance": load_site_model(model).provenance}
 
 
 def site_motions_from_normals(normals: np.ndarray, *, magnitude: float | None = None, distance_km: float | None = None, vs30: float | None = None,
@@ -156,7 +156,7 @@ def site_motions(magnitude: float | None = None, distance_km: float | None = Non
         ``d5_95`` and ``t_mid`` (s), ``f_mid`` (Hz), ``f_slope`` (Hz/s),
         ``zeta_f`` and ``f_corner`` (Hz); with the hazard-compatible model
         ``spectral_shape`` (realization, shape_period): the ln gains of its
-        spectral-shape layer (docs/site-motions.md). Attributes: the scenario, ``model``,
+        spectral-shape layer (docs/site-motions.md). Attributes: the scenario (its geometry too, if given), ``model``,
         ``model_provenance``, ``seed``, ``n``, ``dt``; ``realization`` numbers
         the motions among the n.
 
