@@ -264,7 +264,7 @@ def test_normals_of_the_wrong_shape_are_refused():
 def test_reduced_calibration_check_against_nga_west2():
     """Two scenarios, 200 motions each: the medians and σ of ln Sa within the full check's targets (0.2, 0.1) widened by
     three standard errors of the sample's mean (σ/√n ≈ 0.05) and standard deviation (σ/√(2n) ≈ 0.035); the published
-    model misses the second scenario by more than 1 at 1-3 s (docs/motions.md), so the test can fail."""
+    model misses the second scenario by more than 1 at 1-3 s (docs/site-motions.md), so the test can fail."""
     scenarios = [(6.5, 20.0, 400.0, "strike_slip"), (7.5, 40.0, 300.0, "strike_slip")]
     table = calibration_table(scenarios=scenarios, n=200, seed=3)
     sigma = np.array([target(s)[1] for s in scenarios])
