@@ -1,4 +1,4 @@
-"""The site-based stochastic motions: ``python -m benchmarks site_motions {speed,calibrate,check [--held-out]}``.
+"""The site-based stochastic motions: ``python -m benchmarks site_motions {speed,calibrate,check [--held-out],tail}``.
 
 ``speed`` times :func:`stochpound.motions.site_motions` (motions of 40 s at
 dt = 0.01 s; target ≥ 500 motions per second on 2 cores: 1 and 2 threads,
@@ -8,7 +8,9 @@ and the first call's cost in a new process) and rewrites the "Site-based stochas
 ``data/site_motions/calibration.toml`` with its provenance. ``check``
 simulates the calibrated model over the check's scenarios (2000 motions each
 by default) against the NGA-West2 models and Baker–Jayaram, and rewrites the
-calibration table of ``docs/motions.md`` and its figure. ``check --held-out``
+calibration table of ``docs/site-motions.md`` and its figure. ``tail`` counts how often the simulated motions of the
+bundled demo site's ruptures exceed the site's 475- and 2475-year PGA and PSA(1 s) and compares the rate with the
+hazard's (docs/site-motions.md). ``check --held-out``
 runs the same check at scenarios that are not the fit's (:data:`HELD_OUT_SCENARIOS`,
 refused if the calibration file lists one of them) and rewrites its section of
 ``docs/benchmarks.md``.
@@ -34,6 +36,11 @@ from benchmarks.timing import REPOSITORY, single_thread_environment
 SPEED = Section("<!-- site motions speed: start -->", "<!-- site motions speed: end -->")
 CHECK = Section("<!-- site motions check: start -->", "<!-- site motions check: end -->")
 HELD_OUT = Section("<!-- site motions held-out check: start -->", "<!-- site motions held-out check: end -->")
+TAIL = Section("<!-- site motions tail check: start -->", "<!-- site motions tail check: end -->")
+#: The tail check: the bundled site, its return periods (years), its measures (PGA; PSA at 1 s) and the band of the ratio.
+TAIL_SITE, TAIL_RETURN_PERIODS, TAIL_PERIODS, TAIL_BAND = "demo_three_sources", (475.0, 2475.0), (None, 1.0), (0.8, 1.25)
+#: Motions computed at a time in the tail check (memory: 8 n_time bytes a motion).
+TAIL_BATCH = 250
 SECTION = SPEED
 """This benchmark's section of docs/benchmarks.md."""
 SCENARIO = {"magnitude": 7.0, "distance_km": 20.0, "vs30": 400.0, "mechanism": "strike_slip"}
@@ -54,8 +61,8 @@ HELD_OUT_SCENARIOS: tuple[tuple[float, float, float, str], ...] = (
 
 def parse_arguments(argv: list[str] | None) -> argparse.Namespace:
     parser = argparse.ArgumentParser(prog="python -m benchmarks site_motions", description=__doc__.splitlines()[0])
-    parser.add_argument("task", choices=("speed", "calibrate", "check"))
-    parser.add_argument("--n", type=int, default=None, help="motions per process (speed: 500), per scenario (calibrate: 800, check: 2000)")
+    parser.add_argument("task", choices=("speed", "calibrate", "check", "tail"))
+    parser.add_argument("--n", type=int, default=None, help="motions per process (speed: 500), per scenario (calibrate: 200, check: 2000), per rupture (tail: 2000)")
     parser.add_argument("--out", type=Path, default=None, help="the document whose section is rewritten")
     parser.add_argument("--held-out", action="store_true", help="check: at the held-out scenarios (docs/benchmarks.md) instead of the fit's (docs/motions.md)")
     return parser.parse_args(argv)
@@ -134,28 +141,40 @@ def calibrate(n: int) -> Path:
     return write_calibration(fit, time.perf_counter() - start)
 
 
+def _rows(matrix: list[list[float]]) -> list[str]:
+    return [f"    [{', '.join(f'{v:.6g}' for v in row)}]," for row in matrix]
+
+
 def write_calibration(fit: dict[str, Any], elapsed: float) -> Path:
     """Write data/site_motions/calibration.toml from a fit (:func:`stochpound.motions.fit_calibration`'s result)."""
     info = report.machine()
+    history = "; ".join(f"{m:.2f} / {s:.2f}" for m, s in fit["history"])
     lines = [
-        "# Hazard-compatible calibration of the Rezaeian & Der Kiureghian (2010) model (docs/motions.md, \"Calibration\").",
+        "# Hazard-compatible calibration of the Rezaeian & Der Kiureghian (2010) model (docs/site-motions.md).",
         "# Written by `python -m benchmarks site_motions calibrate` (stochpound.motions._site_calibration.fit_calibration):",
-        f"# {fit['n']} motions per scenario (seed {fit['seed']}), dt 0.01 s, fitted against the NGA-West2 average (ASK14, BSSA14,",
-        "# CB14, CY14 in pygmm: mean of ln medians, rms of sigmas) and the Baker-Jayaram (2008) correlation,",
-        f"# commit {info['commit']}, {info['date']}, {elapsed:.0f} s. Least-squares cost {fit['cost']:.4g}; effective sample sizes of the",
-        f"# importance weights per scenario: {', '.join(f'{s:.0f}' for s in fit['effective_sizes'])}.",
+        f"# {fit['n']} motions per scenario (scenario i: realizations of seed {fit['seed']} + 1000 i), dt 0.01 s, {fit['iterations']} fixed-point",
+        "# iterations against the NGA-West2 average (ASK14, BSSA14, CB14, CY14 in pygmm: mean of ln medians, rms of sigmas) and the",
+        f"# Baker-Jayaram (2008) correlation; commit {info['commit']}, {info['date']}, {elapsed:.0f} s. Largest |ln ratio| of medians /",
+        f"# |sigma difference| over the fit's scenarios and shape periods at each iteration's simulation: {history}.",
         "# Scenarios (M, R_rup km, Vs30 m/s, mechanism): " + "; ".join(f"{s[0]:g} {s[1]:g} {s[2]:g} {s[3]}" for s in fit["scenarios"]),
         "",
-        'name = "nga_west2_calibration_1"',
+        'name = "nga_west2_calibration_2"',
         "",
-        "[adjustments]  # added to nu (standard normal space): d . [1, M - 7, ln(R/25), ln(Vs30/750), reverse, normal, (M - 7)^2, (M - 7) ln(R/25)][:len(d)]",
+        "[residual_scale]  # multiplies the published total residual standard deviation",
+        f"arias_intensity = {fit['arias_scale']:.6g}",
+        "",
+        "[corner]  # ln f_c (Hz) = ln_hz[0] + ln_hz[1] (M - 7) + sigma_ln z: the published 0.2 Hz",
+        "ln_hz = [-1.60944, 0.0]",
+        "sigma_ln = 0.0",
+        "",
+        "[spectral_shape]  # ln gain at periods T_j: mu_j - mean_j . x + sqrt(max(sigma_j^2 - variance_j . x, 0)) (L z)_j, L L' = correlation;",
+        "# x = [1, M - 7, ln(R/25), ln(Vs30/750), reverse, normal, (M - 7)^2, (M - 7) ln(R/25), ln(R/25)^2, ln(Vs30/750)^2]",
+        f"periods = [{', '.join(f'{p:g}' for p in fit['periods'])}]",
+        "mean = [", *_rows(fit["mean"]), "]",
+        "variance = [", *_rows(fit["variance"]), "]",
+        "correlation = [", *_rows(fit["correlation"]), "]",
+        "",
     ]
-    lines += [f"{name} = [{', '.join(f'{v:.6g}' for v in values)}]" for name, values in fit["adjustments"].items()]
-    lines += ["", "[residual_scale]  # multiplies the published total residual standard deviation"]
-    lines += [f"{name} = {value:.6g}" for name, value in fit["residual_scale"].items()]
-    lines += ["",
-              "[corner]  # ln f_c (Hz) = ln_hz[0] + ln_hz[1] (M - 7) + sigma_ln z",
-              f"ln_hz = [{fit['corner']['ln_hz'][0]:.6g}, {fit['corner']['ln_hz'][1]:.6g}]", f"sigma_ln = {fit['corner']['sigma_ln']:.6g}", ""]
     CALIBRATION.write_text("\n".join(lines))
     return CALIBRATION
 
@@ -216,10 +235,10 @@ def shares_within(table: Any) -> dict[str, float]:
 def _introduction(table: Any, info: dict[str, str], elapsed: float, held_out: bool) -> str:
     run = (f"commit {info['commit']}, {info['date']}, load {info['load average (1 min) at start']} at start, {elapsed / 60:.0f} min; "
            f"`python -m benchmarks site_motions check{' --held-out' if held_out else ''}` rewrites this section")
-    scenarios = ("scenarios that are not among the calibration's 14 (the command refuses any that its data file lists), "
+    scenarios = (f"scenarios that are not among the calibration's {len(fitted_scenarios())} (the command refuses any that its data file lists), "
                  "simulated with the calibrated model (`hazard_compatible`): " if held_out else "scenarios, ")
-    where = ("They lie mostly midway between the fit's magnitudes, distances and Vs30 (the fit's own scenarios: the calibration check "
-             "in the motions guide, section \"Calibration to the NGA-West2 models\"); pygmm warns that normal faulting above M 7 lies outside "
+    where = ("They lie mostly midway between the fit's magnitudes, distances and Vs30 (the check at 14 of the fit's own scenarios: "
+             "[Site-based motions: the calibration](site-motions.md)); pygmm warns that normal faulting above M 7 lies outside "
              "some of the four models' recommended range, as at the fit's M 7.5 normal scenario. " if held_out else "")
     return (f"{len(table.scenarios)} {scenarios}{table.n} motions each, dt = 0.01 s ({run}). {where}"
             "ln of the simulated median over the NGA-West2 average's (first row of a scenario) and σ_sim − σ_NGA-West2 of ln Sa "
@@ -238,7 +257,7 @@ def _verdict(table: Any) -> str:
 
 
 def check_section(table: Any, info: dict[str, str], elapsed: float, held_out: bool = False) -> str:
-    """The check's section, markers included: the calibration table of docs/motions.md, or (``held_out``) of docs/benchmarks.md."""
+    """The check's section, markers included: the calibration table of docs/site-motions.md, or (``held_out``) of docs/benchmarks.md."""
     section, figure = (HELD_OUT, HELD_OUT_FIGURE_NAME) if held_out else (CHECK, FIGURE_NAME)
     head = ["PGA" if p is None else f"{p:g}" for p in table.periods]
     lines = [section.start, *(["## Site-based stochastic motions at held-out scenarios"] if held_out else []), "",
@@ -272,6 +291,71 @@ def check(n: int, out: Path, held_out: bool = False) -> tuple[dict[str, float], 
     return largest_misses(table), shares_within(table)
 
 
+def rupture_exceedance(site: Any, n: int, seed: int, levels: np.ndarray, periods: tuple = TAIL_PERIODS, dt: float = 0.01) -> np.ndarray:
+    """P(IM > x | r) [rupture, measure, level] counted over ``n`` simulated motions of every rupture of ``site`` (its full scenario,
+    geometry included; rupture r: realizations of seed ``seed + r``), ``levels`` [measure, level] in g, IM PGA or PSA at ``periods``."""
+    from stochpound.motions import DEFAULT_G, response_spectrum, site_motions
+
+    oscillators = [p for p in periods if p is not None]
+    counts = np.zeros((len(site), *levels.shape))
+    for r in range(len(site)):
+        scenario = site.scenario(r)
+        for start in range(0, n, TAIL_BATCH):
+            motions = site_motions(scenario=scenario, n=n, seed=seed + r, dt=dt, realizations=list(range(start, min(start + TAIL_BATCH, n))))
+            for a in motions["acceleration"].values:
+                psa = iter(response_spectrum(a, dt, oscillators)["psa"].values if oscillators else [])
+                im = np.array([np.max(np.abs(a)) if p is None else next(psa) for p in periods]) / DEFAULT_G
+                counts[r] += im[:, None] > levels
+    return counts / n
+
+
+def tail_check(n: int, seed: int = 11, site_name: str = TAIL_SITE, return_periods: tuple = TAIL_RETURN_PERIODS) -> dict[str, Any]:
+    """The simulated motions' rate of exceeding the site's hazard levels, Σ_r ν_r P(IM_sim > x | r), against the hazard's λ(x).
+
+    ``ratio`` [measure, return period] the simulated rate over the hazard's, ``low``/``high`` its 95 % interval
+    (binomial: Var = Σ ν_r² p_r (1 − p_r) / n), ``levels`` the site's intensities (g) at ``return_periods``.
+    """
+    from stochpound.hazard import RuptureSite
+
+    site = RuptureSite.bundled(site_name)
+    rates = 1.0 / np.asarray(return_periods)
+    measures = [("pga", None) if p is None else ("psa", p) for p in TAIL_PERIODS]
+    levels = np.array([site.intensity_at(measure, period, rates) for measure, period in measures])
+    hazard = np.array([site.rate_of_exceedance(measure, period, level) for (measure, period), level in zip(measures, levels)])
+    p = rupture_exceedance(site, n, seed, levels)
+    nu = np.asarray(site.rate)[:, None, None]
+    simulated = np.sum(nu * p, axis=0)
+    error = 1.96 * np.sqrt(np.sum(nu**2 * p * (1.0 - p), axis=0) / n)
+    shares = nu * p / np.maximum(simulated, 1e-300)
+    return {"site": site_name, "n": n, "seed": seed, "return_periods": list(return_periods), "levels": levels, "hazard": hazard,
+            "ratio": simulated / hazard, "low": (simulated - error) / hazard, "high": (simulated + error) / hazard,
+            "names": list(site.names), "largest_share": [[site.names[int(np.argmax(shares[:, i, j]))] for j in range(len(return_periods))]
+                                                         for i in range(len(measures))]}
+
+
+def tail_section(result: dict[str, Any], info: dict[str, str], elapsed: float) -> str:
+    """The tail check's section of docs/site-motions.md, markers included."""
+    low, high = TAIL_BAND
+    lines = [TAIL.start, "", f"The bundled site `{result['site']}` ({len(result['names'])} ruptures): {result['n']} motions of each rupture "
+             f"(rupture r: seed {result['seed']} + r; its scenario with its geometry), P(IM > x | r) counted, "
+             f"against the site's hazard at its own levels (commit {info['commit']}, {info['date']}, load "
+             f"{info['load average (1 min) at start']} at start, {elapsed / 60:.0f} min; `python -m benchmarks site_motions tail` rewrites "
+             "this section):", "",
+             "| measure | return period (yr) | level (g) | λ hazard (1/yr) | Σ ν_r P̂(IM_sim > x \\| r) / λ | 95 % interval | largest share |",
+             "|---|---:|---:|---:|---:|---|---|"]
+    met = True
+    for i, period in enumerate(TAIL_PERIODS):
+        name = "PGA" if period is None else f"PSA({period:g} s)"
+        for j, years in enumerate(result["return_periods"]):
+            ratio = result["ratio"][i, j]
+            met &= bool(low <= ratio <= high)
+            lines.append(f"| {name} | {years:g} | {result['levels'][i, j]:.3f} | {result['hazard'][i, j]:.2e} | {ratio:.2f} | "
+                         f"{result['low'][i, j]:.2f}–{result['high'][i, j]:.2f} | {result['largest_share'][i][j].replace('_', ' ')} |")
+    verdict = "**met** at every row" if met else "**not met** at every row"
+    lines += ["", f"Target: the ratio within ×{low:g}–{high:g}: {verdict}.", "", TAIL.end]
+    return "\n".join(lines) + "\n"
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run the task."""
     arguments = parse_arguments(argv)
@@ -283,9 +367,15 @@ def main(argv: list[str] | None = None) -> int:
         print(f"{data['one']:.0f} motions/s on one thread ({data['cpu']:.0f} per CPU second), {data['two']:.0f} on two; "
               f"first call {data['compile']:.1f} s uncached, {data['cached']:.1f} s cached; wrote {out}")
     elif arguments.task == "calibrate":
-        print(f"wrote {calibrate(arguments.n or 800)}")
+        print(f"wrote {calibrate(arguments.n or 200)}")
+    elif arguments.task == "tail":
+        out = arguments.out or REPOSITORY / "docs" / "site-motions.md"
+        info, start = report.machine(), time.perf_counter()
+        result = tail_check(arguments.n or 2000)
+        TAIL.write(out, tail_section(result, info, time.perf_counter() - start))
+        print(f"ratios {np.round(result['ratio'], 2).tolist()} (measures x return periods); wrote {out}")
     else:
-        out = arguments.out or REPOSITORY / "docs" / ("benchmarks.md" if arguments.held_out else "motions.md")
+        out = arguments.out or REPOSITORY / "docs" / ("benchmarks.md" if arguments.held_out else "site-motions.md")
         worst, shares = check(arguments.n or 2000, out, arguments.held_out)
         print(", ".join(f"largest {key} miss {worst[key]:.3f} ({100 * shares[key]:.0f} % within {TOLERANCES[key]})" for key in worst) + f"; wrote {out}")
     return 0

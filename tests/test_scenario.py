@@ -76,8 +76,9 @@ def test_site_motions_are_the_same_from_a_scenario_and_checked_against_the_calib
     xr.testing.assert_identical(site_motions_from_normals(normals, **LOOSE), site_motions_from_normals(normals, scenario=Scenario(**LOOSE)))
     with pytest.raises(SiteError, match=r"^distance_km: must be within 5-100 \(the site-motion model's calibrated range\), got 150.0$"):
         site_motions(n=1, seed=1, scenario=Scenario(7.0, 150.0, 760.0, "reverse"))
-    with pytest.raises(SiteError, match="^scenario: the site-motion model takes magnitude, distance_km, vs30 and mechanism only"):
-        site_motions(n=1, seed=1, scenario=Scenario(**LOOSE, ztor_km=1.0))
+    with pytest.raises(SiteError, match="^scenario: the published model takes magnitude, distance_km, vs30 and mechanism only"):
+        site_motions(n=1, seed=1, scenario=Scenario(**LOOSE, ztor_km=1.0), model="rezaeian_2010")
+    assert site_motions(n=1, seed=1, duration=5.0, scenario=Scenario(**LOOSE, ztor_km=1.0)).attrs["ztor_km"] == 1.0  # the calibrated model takes it
 
 
 def test_a_scenario_is_given_once_at_the_door():

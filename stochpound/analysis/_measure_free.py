@@ -7,7 +7,7 @@ annual rates ν_r) has a demand hazard that needs no intensity measure:
 
 P(D > x | r) the fraction of the runs of rupture r's simulated motions
 (:func:`~stochpound.motions.site_motions` of its magnitude, R_rup, the
-site's Vs30 and its mechanism) whose response D exceeds x. It is a
+site's Vs30, its mechanism and geometry) whose response D exceeds x. It is a
 stratified Monte Carlo estimate, each rupture a stratum of n_r motions:
 
     λ̂(x) = Σ_r (ν_r / n_r) #{i : D_ri > x},
@@ -75,7 +75,7 @@ CHUNK = 20
 THRESHOLDS = 200
 """Thresholds of the default grid, log-spaced from the smallest positive response to the largest."""
 METHOD = ("stratified Monte Carlo over the site's ruptures: lambda(D > x) = sum_r nu_r (1/n_r) #{D_ri > x}, "
-          "n_r runs of simulated motions of rupture r (site_motions of its magnitude, R_rup, the site's Vs30 and its mechanism)")
+          "n_r runs of simulated motions of rupture r (site_motions of its scenario: magnitude, R_rup, the site's Vs30, its mechanism and geometry)")
 INTERVAL = "stratified bootstrap over the motions within each rupture (rates nu_r taken as given), percentile interval"
 ALLOCATION = ("Neyman allocation of the extra runs in rounds, n_r proportional to nu_r sqrt(p_r (1 - p_r)) at the level of the rarest "
               "target from the runs before, p_r the larger of the rupture's fraction beyond it and its lognormal fit's")
@@ -369,7 +369,8 @@ def _rupture(site: RuptureSite, index: int, outside: str, seed: int, most: int, 
                             "(outside='clamp' runs it at the range's edge and gives its part of the rate apart)")
         run[field] = min(max(value, low), high)
         clamped.append(f"{field} {value:g} -> {run[field]:g}")
-    scenario = Scenario(**run, mechanism=row["mechanism"])
+    # the rupture's own scenario, geometry included (the hazard-compatible model follows its NGA-West2 medians), unless clamped
+    scenario = Scenario(**run, mechanism=row["mechanism"]) if clamped or model == "rezaeian_2010" else site.scenario(index)
     motion_seed = int(np.random.SeedSequence([seed, index]).generate_state(1)[0])
     first = site_motions(scenario=scenario, n=most, seed=motion_seed, dt=dt, model=model, realizations=[0])
     return _Rupture(scenario, motion_seed, float(first["time"].values[-1]), "; ".join(clamped))

@@ -6,7 +6,7 @@ model in the synthetic generators' convention (those of
 :func:`~stochpound.motions.kanai_tajimi`): the window is given, so that
 realization i depends on (seed, i) and the window alone, whatever the other
 realizations, the batch or the worker that draws it. Realization i is
-f(u_i), u_i the first 7 + n_time standard normals of realization i's
+f(u_i), u_i the first K + n_time standard normals (K the model's, 7 for the published one) of realization i's
 generator (:class:`ScenarioNormalMotion`, the map of
 :func:`~stochpound.motions.site_motions_from_normals`), hence motion i of
 ``site_motions(..., n, seed, dt, duration=duration)`` for any n > i, bit for bit.
@@ -22,7 +22,7 @@ import xarray as xr
 from stochpound._errors import SiteError
 from stochpound.motions._scenario import Scenario, given_scenario
 from stochpound.motions._seeding import check_seed
-from stochpound.motions._site_model import PARAMETER_NORMALS
+from stochpound.motions._site_model import load_site_model
 from stochpound.motions._site_motions import SITE_MOTION_LIMITS, site_model_provenance, site_motions, site_motions_from_normals
 
 SCENARIO_TYPE = "scenario_motions"
@@ -33,7 +33,7 @@ PARAMETERS = ("arias_intensity", "d5_95", "t_mid", "f_mid", "f_slope", "zeta_f",
 
 @dataclass(frozen=True)
 class ScenarioNormalMotion:
-    """A site-based motion of a scenario as a function a = f(u) of n = 7 + n_time independent standard normals.
+    """A site-based motion of a scenario as a function a = f(u) of n = K + n_time independent standard normals (K: the model's).
 
     The interface of :class:`~stochpound.motions.NormalMotion` (``dt``,
     ``n_time``, ``time``, ``dimension``, calling it on normals, ``sample``),
@@ -67,8 +67,8 @@ class ScenarioNormalMotion:
 
     @property
     def dimension(self) -> int:
-        """n, the number of standard normals a motion takes: 7 for its parameters, one per sample for its noise."""
-        return PARAMETER_NORMALS + self.n_time
+        """n, the number of standard normals a motion takes: its model's for the parameters (and spectral shape), one per sample for its noise."""
+        return load_site_model(self.model).normals + self.n_time
 
     def motions(self, u: np.ndarray) -> xr.Dataset:
         """The motions of the rows of ``u`` (m, n) with their parameters (:func:`~stochpound.motions.site_motions_from_normals`)."""

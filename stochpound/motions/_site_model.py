@@ -24,19 +24,24 @@ displacement the filter's tail leaves at the end of the window.
 The six parameters (I_a, D5–95, t_mid, f_mid, f_slope, ζ_f) come from
 predictive equations in the standard normal space with correlated residuals
 (data/site_motions/rezaeian_2010.toml), each mapped to its marginal; the
-hazard-compatible calibration (data/site_motions/calibration.toml) adds a
-linear adjustment in the scenario to some of the equations and predicts f_c.
-The corner f_c is lognormal about a line in M (a constant for the published
-model). A motion is a deterministic function of 7 + n_time independent
-standard normals: the first 6 give its parameters (through the residuals'
-covariance), the 7th its corner, the rest are the w_i.
+corner f_c is lognormal about a line in M (a constant for the published
+model). The hazard-compatible calibration (data/site_motions/calibration.toml)
+may scale the residuals and adjust the equations, and adds a spectral-shape
+layer (:class:`SpectralShape`): after the post-filter, each motion passes
+through a minimum-phase filter whose ln gain, linear in ln T between the layer's
+periods and held beyond them, is drawn per motion (:func:`shape_filter`);
+then the baseline correction. A motion is a deterministic function of
+``model.normals`` + n_time independent standard normals: the first 6 give its
+parameters (through the residuals' covariance), the 7th its corner, the next
+K (the shape layer's periods; none for the published model) its gains, the
+rest are the w_i.
 """
 
 from __future__ import annotations
 
 import math
 import tomllib
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from functools import lru_cache
@@ -60,8 +65,10 @@ MODELS = ("hazard_compatible", "rezaeian_2010")
 PARAMETERS = ("arias_intensity", "d5_95", "t_mid", "f_mid", "f_slope", "zeta_f")
 #: Normals that give a motion's parameters: the six above and the post-filter's corner.
 PARAMETER_NORMALS = 7
-#: Units of the parameters as :func:`motion_parameters` returns them.
-UNITS = {"arias_intensity": "m/s", "d5_95": "s", "t_mid": "s", "f_mid": "Hz", "f_slope": "Hz/s", "zeta_f": "1", "f_corner": "Hz"}
+#: Units of the parameters as :func:`motion_parameters` returns them (``spectral_shape``: ln gains, one per SHAPE_PERIODS).
+UNITS = {"arias_intensity": "m/s", "d5_95": "s", "t_mid": "s", "f_mid": "Hz", "f_slope": "Hz/s", "zeta_f": "1", "f_corner": "Hz", "spectral_shape": "1"}
+#: Periods (s) of the spectral-shape layer's gains (the hazard-compatible calibration; data/site_motions/calibration.toml lists them).
+SHAPE_PERIODS = (0.1, 0.2, 0.3, 0.5, 0.75, 1.0, 1.5, 2.0, 3.0, 4.0, 5.0)
 #: Lowest filter frequency (Hz): ω_f(t) is held there where the linear trend would fall below it.
 F_MIN = 0.1
 #: Highest filter damping ratio (the marginal reaches 1, where h degenerates).
@@ -70,6 +77,8 @@ ZETA_MAX = 0.95
 IRF_TOLERANCE = 1e-4
 #: Features of the calibration's adjustments: 1, M − 7, ln(R/25), ln(Vs30/750), reverse, normal, (M − 7)², (M − 7) ln(R/25).
 FEATURES = ("intercept", "magnitude", "ln_distance", "ln_vs30", "reverse", "normal", "magnitude_squared", "magnitude_ln_distance")
+#: Features of the spectral-shape layer's regressions: FEATURES, then ln(R/25)² and ln(Vs30/750)².
+SHAPE_FEATURES = FEATURES + ("ln_distance_squared", "ln_vs30_squared")
 
 
 @dataclass(frozen=True)
@@ -140,6 +149,24 @@ def _marginal(table: Mapping[str, float | str]) -> Marginal:
 
 
 @dataclass(frozen=True)
+class SpectralShape:
+    """The hazard-compatible calibration's spectral-shape layer (docs/site-motions.md).
+
+    At its ``periods`` T_j (s) a motion's filter gain is ln H_j = μ_j − r_j + d_j (L z)_j:
+    μ_j and σ_j the NGA-West2 average's mean ln Sa and σ of the scenario (its geometry
+    included), r_j = ``mean`` · x and v_j = ``variance`` · x (x the scenario's
+    :data:`SHAPE_FEATURES`) the mean and variance of ln Sa the base model gives there
+    (as fitted), d_j = √max(σ_j² − v_j, 0), L = ``cholesky`` the lower factor of the
+    gains' correlation and z the motion's shape normals.
+    """
+
+    periods: tuple[float, ...]
+    mean: np.ndarray
+    variance: np.ndarray
+    cholesky: np.ndarray
+
+
+@dataclass(frozen=True)
 class SiteModel:
     """A model's predictive equations in the standard normal space, its marginals and its post-filter.
 
@@ -147,7 +174,7 @@ class SiteModel:
     ``cholesky`` [6, 6]: lower factor of the residuals' covariance;
     ``adjustments`` [6, len(FEATURES)]: added to ν (zero for the published model);
     ``corner`` [3]: ln f_c = corner[0] + corner[1] (M − 7) + corner[2] z (f_c in Hz, z the motion's
-    seventh normal).
+    seventh normal); ``shape``: the spectral-shape layer (None for the published model).
     """
 
     name: str
@@ -157,6 +184,12 @@ class SiteModel:
     adjustments: np.ndarray
     corner: np.ndarray
     provenance: str
+    shape: SpectralShape | None = None
+
+    @property
+    def normals(self) -> int:
+        """Standard normals of a motion before its noise: :data:`PARAMETER_NORMALS` and the shape layer's one per period."""
+        return PARAMETER_NORMALS + (len(self.shape.periods) if self.shape is not None else 0)
 
 
 def _read(name: str) -> dict:
@@ -177,19 +210,44 @@ def load_site_model(model: str) -> SiteModel:
     adjustments = np.zeros((len(PARAMETERS), len(FEATURES)))
     corner = np.array([math.log(published["post_filter"]["corner_hz"]), 0.0, 0.0])
     provenance = published["name"]
+    shape = None
     if model == "hazard_compatible":
         calibration = _read(CALIBRATION_FILE)
-        for parameter, values in calibration["adjustments"].items():
+        for parameter, values in (calibration["adjustments"] if "adjustments" in calibration else {}).items():
             adjustments[PARAMETERS.index(parameter), : len(values)] = values
         for parameter, factor in calibration["residual_scale"].items():
             scale[PARAMETERS.index(parameter)] *= factor
         corner = np.array(calibration["corner"]["ln_hz"] + [calibration["corner"]["sigma_ln"]], dtype=float)
         provenance = f"{published['name']} + {calibration['name']}"
+        shape = _shape(calibration["spectral_shape"])
     elif model != "rezaeian_2010":
         raise ValueError(f"model: must be one of {', '.join(MODELS)}, got {model!r}")
     covariance = np.asarray(residuals["correlation"]) * np.outer(scale, scale)
     return SiteModel(model, np.array([published["coefficients"][p] for p in PARAMETERS]), np.linalg.cholesky(covariance),
-                     tuple(_marginal(published["marginals"][p]) for p in PARAMETERS), adjustments, corner, provenance)
+                     tuple(_marginal(published["marginals"][p]) for p in PARAMETERS), adjustments, corner, provenance, shape)
+
+
+def _shape(table: Mapping[str, list]) -> SpectralShape:
+    """The calibration file's ``[spectral_shape]`` table: periods, the base's mean and variance regressions, the gains' correlation."""
+    if tuple(table["periods"]) != SHAPE_PERIODS:  # pragma: no cover - the data file's own consistency
+        raise ValueError(f"{CALIBRATION_FILE}: spectral_shape.periods must be {SHAPE_PERIODS}")
+    return SpectralShape(tuple(float(p) for p in table["periods"]), np.array(table["mean"], dtype=float),
+                         np.array(table["variance"], dtype=float), np.linalg.cholesky(np.array(table["correlation"], dtype=float)))
+
+
+def shape_features(scenario: Scenario) -> np.ndarray:
+    """The spectral-shape layer's features (:data:`SHAPE_FEATURES`) of a scenario."""
+    x = scenario_features(scenario)
+    return np.concatenate([x, [x[2] ** 2, x[3] ** 2]])
+
+
+def shape_gains(shape: SpectralShape, scenario: Scenario) -> tuple[np.ndarray, np.ndarray]:
+    """The shape layer's mean gain μ − r and spread d (ln, at its periods) for a scenario (:class:`SpectralShape`)."""
+    from stochpound.motions._conditional import _average_model
+
+    mean, sigma = _average_model(list(shape.periods), scenario)
+    x = shape_features(scenario)
+    return mean - shape.mean @ x, np.sqrt(np.maximum(sigma**2 - shape.variance @ x, 0.0))
 
 
 def scenario_features(scenario: Scenario) -> np.ndarray:
@@ -219,7 +277,10 @@ def _two_sided_exponential_ppf(p: np.ndarray, a: float, b: float, c: float, low:
 
 
 def motion_parameters(model: SiteModel, scenario: Scenario, normals: np.ndarray) -> dict[str, np.ndarray]:
-    """Each motion's parameters (:data:`UNITS`) from its :data:`PARAMETER_NORMALS` standard normals ``normals`` [n, 7]."""
+    """Each motion's parameters (:data:`UNITS`) from its ``model.normals`` standard normals ``normals`` [n, model.normals].
+
+    With a shape layer, ``spectral_shape`` [n, K] holds each motion's ln gains at the layer's periods.
+    """
     from scipy import stats
 
     normals = np.asarray(normals, dtype=float)
@@ -230,7 +291,41 @@ def motion_parameters(model: SiteModel, scenario: Scenario, normals: np.ndarray)
     values["arias_intensity"] = values["arias_intensity"] * DEFAULT_G  # s·g → m/s
     values["zeta_f"] = np.minimum(values["zeta_f"], ZETA_MAX)
     values["f_corner"] = np.exp(model.corner[0] + model.corner[1] * (scenario.magnitude - 7.0) + model.corner[2] * normals[:, 6])
+    if model.shape is not None:
+        mean, spread = shape_gains(model.shape, scenario)
+        z = normals[:, PARAMETER_NORMALS:model.normals]
+        values["spectral_shape"] = mean + spread * np.sum(z[:, None, :] * model.shape.cholesky[None, :, :], axis=2)
     return values
+
+
+def shape_filter(acceleration: np.ndarray, dt: float, periods: Sequence[float], gains: np.ndarray) -> np.ndarray:
+    """Motions [n, n_time] through their minimum-phase filters: ln |H| interpolated in ln T between ``gains`` [n, K] at ``periods`` (s).
+
+    |H| is held at the end values beyond the periods; its phase is the minimum
+    phase of that amplitude (the real cepstrum of ln |H| folded onto positive
+    quefrencies), so the filter is causal: a motion at rest before t = 0 stays
+    so, and the filter delays rather than spreads. The motion is padded with
+    zeros to 1.5 times its length (a fast FFT size); what the filter moves past
+    the window is cut, and the baseline correction follows.
+    """
+    from scipy import fft
+
+    n_time = acceleration.shape[1]
+    size = fft.next_fast_len(int(1.5 * n_time) + 1, real=True)
+    size += size % 2
+    frequency = fft.rfftfreq(size, dt)
+    ln_period = -np.log(np.maximum(frequency, 1e-12))
+    nodes = np.log(np.asarray(periods, dtype=float))
+    basis = np.stack([np.interp(ln_period, nodes, np.eye(len(nodes))[j]) for j in range(len(nodes))], axis=1)
+    out = np.empty_like(acceleration)
+    for m, row in enumerate(np.asarray(gains, dtype=float)):  # one motion at a time: batched FFTs and products round by batch
+        cepstrum = fft.irfft(basis @ row, size)
+        folded = np.zeros(size)
+        folded[0] = cepstrum[0]
+        folded[1:size // 2] = 2.0 * cepstrum[1:size // 2]
+        folded[size // 2] = cepstrum[size // 2]
+        out[m] = fft.irfft(fft.rfft(acceleration[m], size) * np.exp(fft.rfft(folded)), size)[:n_time]
+    return out
 
 
 def gamma_shape(t_mid: np.ndarray, d5_95: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -468,6 +563,8 @@ def motions_from_noise_rows(parameters: dict[str, np.ndarray], noise_rows: Calla
         noise = np.ascontiguousarray(noise_rows(rows), dtype=float)
         _filtered_motions(noise, float(dt), chosen["f_mid"], chosen["f_slope"], chosen["t_mid"], chosen["zeta_f"],
                           ln_alpha1_sq, k, rate, chosen["f_corner"], out[rows])
+        if "spectral_shape" in chosen:
+            out[rows] = shape_filter(out[rows], dt, SHAPE_PERIODS, chosen["spectral_shape"])
         out[rows] = baseline_correct(out[rows], dt)
 
     starts = range(0, n, BATCH)
@@ -482,7 +579,7 @@ def motions_from_noise_rows(parameters: dict[str, np.ndarray], noise_rows: Calla
 
 
 def motions_from_normals(model: SiteModel, scenario: Scenario, normals: np.ndarray, dt: float) -> tuple[np.ndarray, dict[str, np.ndarray]]:
-    """Accelerations [n, n_time] (m/s², from t = 0 at ``dt``) and parameters of the motions of ``normals`` [n, 7 + n_time]."""
+    """Accelerations [n, n_time] (m/s², from t = 0 at ``dt``) and parameters of the motions of ``normals`` [n, model.normals + n_time]."""
     normals = np.asarray(normals, dtype=float)
-    parameters = motion_parameters(model, scenario, normals[:, :PARAMETER_NORMALS])
-    return motions_from_parameters(parameters, normals[:, PARAMETER_NORMALS:], dt), parameters
+    parameters = motion_parameters(model, scenario, normals[:, :model.normals])
+    return motions_from_parameters(parameters, normals[:, model.normals:], dt), parameters

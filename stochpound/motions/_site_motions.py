@@ -3,11 +3,12 @@
 :func:`site_motions` draws any number of motions of a scenario (magnitude,
 rupture distance, Vs30, mechanism) from a seed; :func:`site_motions_from_normals`
 is the same map from an explicit array of independent standard normals, one
-row per motion (its first 7 give the motion's parameters, the others the
-white noise at each sample: the model is in ``stochpound.motions._site_model``).
+row per motion (its first 7 give the motion's parameters, the next 11 its
+spectral-shape gains with the hazard-compatible model, the others the white
+noise at each sample: the model is in ``stochpound.motions._site_model``).
 Motion i of a seed uses the generator of realization i
-(:func:`~stochpound.motions.realization_rng`): its 7 parameter normals, then
-its noise.
+(:func:`~stochpound.motions.realization_rng`): its 7 parameter normals, its
+shape layer's 11 (the hazard-compatible model only), then its noise.
 """
 
 from __future__ import annotations
@@ -22,7 +23,7 @@ from stochpound._errors import SiteError
 from stochpound.motions._scenario import Scenario, given_scenario
 from stochpound.motions._seeding import check_seed, realization_rng
 from stochpound.motions._site_model import (
-    MODELS, PARAMETER_NORMALS, UNITS, gamma_shape, load_site_model, motion_parameters, motions_from_noise_rows, motions_from_normals,
+    MODELS, SHAPE_PERIODS, UNITS, gamma_shape, load_site_model, motion_parameters, motions_from_noise_rows, motions_from_normals,
 )  # fmt: skip
 
 #: The scenarios the hazard-compatible calibration covers; outside them the model is not offered.
@@ -36,9 +37,9 @@ WINDOW_TAIL_PERIODS, WINDOW_ROUND = 2.0, 5.0
 def _checked(scenario: Scenario | None, loose: tuple, dt: float, model: str) -> Scenario:
     """The scenario given (:func:`~stochpound.motions._scenario.given_scenario`), checked against the calibrated range, after ``dt`` and ``model``."""
     checked = given_scenario(scenario, *loose, limits=SITE_MOTION_LIMITS, source="the site-motion model's calibrated range")
-    if checked.geometry:
-        raise SiteError(f"scenario: the site-motion model takes magnitude, distance_km, vs30 and mechanism only, not a geometry "
-                        f"({', '.join(checked.geometry)}): give the scenario without it")
+    if checked.geometry and model == "rezaeian_2010":
+        raise SiteError(f"scenario: the published model takes magnitude, distance_km, vs30 and mechanism only, not a geometry "
+                        f"({', '.join(checked.geometry)}): give the scenario without it, or model='hazard_compatible'")
     if isinstance(dt, bool) or not isinstance(dt, (int, float)) or not 0.0 < dt <= 0.02:
         raise SiteError(f"dt: must be within 0-0.02 s (the model's filter reaches 25 Hz and more), got {dt!r}")
     if model not in MODELS:
@@ -59,13 +60,15 @@ def _dataset(acceleration: np.ndarray, parameters: dict[str, np.ndarray], dt: fl
     n, n_time = acceleration.shape
     variables = {"acceleration": (("realization", "time"), acceleration, {"units": "m/s2", "long_name": "ground acceleration"})}
     for name, values in parameters.items():
-        variables[name] = ("realization", values, {"units": UNITS[name]})
+        variables[name] = (("realization", "shape_period") if values.ndim == 2 else "realization", values, {"units": UNITS[name]})
     coords = {"realization": np.arange(n), "time": ("time", np.arange(n_time) * dt, {"units": "s"})}
+    if "spectral_shape" in parameters:
+        coords["shape_period"] = ("shape_period", np.array(SHAPE_PERIODS), {"units": "s"})
     return xr.Dataset(variables, coords=coords, attrs={**attrs, "dt": float(dt)})
 
 
 def _attrs(scenario: Scenario, model: str) -> dict:
-    return {**scenario.loose(), "model": model, "model_provenance": load_site_model(model).provenance}
+    return {**scenario.loose(), **scenario.geometry, "model": model, "model_provenance": load_site_model(model).provenance}
 
 
 def site_motions_from_normals(normals: np.ndarray, *, magnitude: float | None = None, distance_km: float | None = None, vs30: float | None = None,
@@ -75,10 +78,12 @@ def site_motions_from_normals(normals: np.ndarray, *, magnitude: float | None = 
 
     Parameters
     ----------
-    normals : array_like, shape (n, 7 + n_time)
+    normals : array_like, shape (n, 7 + K + n_time)
         Row i: motion i's normals; the first 6 give its parameters (the
         predictive equations' residuals, correlated through the model's
-        covariance), the 7th its post-filter's corner, the next n_time the
+        covariance), the 7th its post-filter's corner, the next K its
+        spectral-shape gains (``hazard_compatible``: K = 11, one per period of
+        the shape layer; ``rezaeian_2010``: K = 0), the next n_time the
         white noise at t = 0, dt, ….
     magnitude, distance_km, vs30 : float
         Moment magnitude (5.5–8), rupture distance (5–100 km), Vs30 (200–1100 m/s).
@@ -98,8 +103,9 @@ def site_motions_from_normals(normals: np.ndarray, *, magnitude: float | None = 
     """
     scenario = _checked(scenario, (magnitude, distance_km, vs30, mechanism), dt, model)
     normals = np.asarray(normals, dtype=float)
-    if normals.ndim != 2 or normals.shape[1] < PARAMETER_NORMALS + 3 or not np.all(np.isfinite(normals)):
-        raise SiteError(f"normals: must be a finite array of shape (n, 7 + n_time) with n_time >= 3, got shape {normals.shape}")
+    count = load_site_model(model).normals
+    if normals.ndim != 2 or normals.shape[1] < count + 3 or not np.all(np.isfinite(normals)):
+        raise SiteError(f"normals: must be a finite array of shape (n, {count} + n_time) with n_time >= 3 (model {model}), got shape {normals.shape}")
     acceleration, parameters = motions_from_normals(load_site_model(model), scenario, normals, dt)
     return _dataset(acceleration, parameters, dt, _attrs(scenario, model))
 
@@ -130,7 +136,7 @@ def site_motions(magnitude: float | None = None, distance_km: float | None = Non
         modulation to deliver 99.9 % of its Arias intensity plus two periods of
         the post-filter's corner, rounded up to 5 s.
     model : {"hazard_compatible", "rezaeian_2010"}
-        The calibrated equations (default; docs/motions.md) or the published ones.
+        The calibrated model (default; docs/site-motions.md) or the published equations.
     realizations : list of int, optional
         Only these motions of the ``n`` (each in 0 … n − 1), in this order:
         bit for bit the same rows as of the full set (the window is still the
@@ -138,7 +144,9 @@ def site_motions(magnitude: float | None = None, distance_km: float | None = Non
         given, at the cost of these alone). Default: all ``n``.
     scenario : Scenario, optional
         The scenario as one value, instead of ``magnitude``, ``distance_km``, ``vs30`` and ``mechanism``
-        (``site_motions(n=100, seed=1, scenario=Scenario(7.0, 10.0, 760.0, "strike_slip"))``).
+        (``site_motions(n=100, seed=1, scenario=Scenario(7.0, 10.0, 760.0, "strike_slip"))``); with the
+        hazard-compatible model it may carry a geometry (R_JB, R_x, Z_tor, dip, basin depths), which the
+        NGA-West2 medians and σ its spectral-shape layer follows take (a hanging-wall site, say).
 
     Returns
     -------
@@ -147,7 +155,9 @@ def site_motions(magnitude: float | None = None, distance_km: float | None = Non
         displacement at the end), and per realization its parameters:
         ``arias_intensity`` (m/s, the expected value of the modulation),
         ``d5_95`` and ``t_mid`` (s), ``f_mid`` (Hz), ``f_slope`` (Hz/s),
-        ``zeta_f`` and ``f_corner`` (Hz). Attributes: the scenario, ``model``,
+        ``zeta_f`` and ``f_corner`` (Hz); with the hazard-compatible model
+        ``spectral_shape`` (realization, shape_period): the ln gains of its
+        spectral-shape layer (docs/site-motions.md). Attributes: the scenario (its geometry too, if given), ``model``,
         ``model_provenance``, ``seed``, ``n``, ``dt``; ``realization`` numbers
         the motions among the n.
 
@@ -169,7 +179,7 @@ def site_motions(magnitude: float | None = None, distance_km: float | None = Non
         raise SiteError(f"duration: must be within {10 * dt:g}-600 s, got {duration!r}")
     drawn = range(int(n)) if duration is None else rows  # the default window is the whole set's; a given one needs the rows asked for alone
     rngs = [realization_rng(seed, i) for i in drawn]
-    first = np.array([rng.standard_normal(PARAMETER_NORMALS) for rng in rngs])
+    first = np.array([rng.standard_normal(load_site_model(model).normals) for rng in rngs])
     parameters = motion_parameters(load_site_model(model), scenario, first)  # each motion's parameters are its own row's
     if duration is None:
         duration = _window(parameters)

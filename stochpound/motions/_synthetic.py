@@ -241,7 +241,7 @@ def normal_motion(motion: Mapping[str, Any]) -> NormalMotion | ScenarioNormalMot
     NormalMotion or ScenarioNormalMotion
         a = f(u), u ∈ Rⁿ independent standard normals (a
         :class:`~stochpound.motions.ScenarioNormalMotion` for ``type = "scenario_motions"``,
-        the site model's map of 7 + n_time normals).
+        the site model's map of K + n_time normals, K its model's).
 
     Raises
     ------
