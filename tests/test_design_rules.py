@@ -73,16 +73,22 @@ def test_the_eurocode_reduction_applies_only_where_the_floors_stand_level():
     assert not_level == pytest.approx(0.125019, abs=2e-6) and level == pytest.approx(0.7 * not_level, rel=1e-12)
 
 
-def test_eq_17_5_1_gives_the_pendulum_displacement_at_every_contact():
+def test_a_sliding_building_is_designed_by_chapter_17_and_gets_no_section_12_12_3_row():
+    """B1 on a friction pendulum (μ = 0.05, R = 2.24 m) beside the fixed B2, S_M1 = 1.2 g given (sm1), S_MS = 1.5 S_DS: the
+    separation is D_TM (eq. 17.5-3, lower-bound friction μ = 0.6 × 0.05 = 0.03, square plan: × 1.15) + B2's δ_M (0.102502 m,
+    the module docstring); §12.12.3's δ_MT, a fixed-base structure's rule, is not given for the sliding pair (issue 45)."""
     gaps = design_separations(_scene({"mass": 5.0e4, "mu": 0.05, "radius": 2.24}), DESIGN, studied="B1")
-    displacement = gaps["asce7_dtm"][0]
-    assert displacement == pytest.approx(0.73, abs=0.01)
-    period = 2.0 * math.pi / math.sqrt(G / 2.24 + 0.05 * G / displacement)  # eq. 17.5-2, k_M = W/R + μW/D
-    damping = 2.0 * 0.05 / (math.pi * (0.05 + displacement / 2.24))
-    coefficient = 1.0 + (damping - 0.05) / (0.10 - 0.05) * (1.2 - 1.0)  # Table 17.5-1 between 5 % and 10 %
-    assert 0.05 < damping < 0.10 and period == pytest.approx(2.80, abs=0.01)
-    assert displacement == pytest.approx(G * 1.2 * period / (4.0 * math.pi**2 * coefficient), rel=1e-8)  # eq. 17.5-1
-    assert design_separations(_scene({"mass": 5.0e4, "mu": 0.05, "radius": 2.24}), DESIGN, studied="B2").keys() == {"asce7_delta_mt", "ec8_ds"}
+    assert sorted(gaps) == ["asce7_delta_mt", "asce7_isolated", "ec8_ds"] and math.isnan(gaps["asce7_delta_mt"][0])
+    separation = gaps["asce7_isolated"][0]
+    displacement = (separation - 0.102502) / 1.15  # D_M at the lower bound, within the 1e-6 m of δ_M's digits
+    mu = 0.03
+    period = 2.0 * math.pi / math.sqrt(G / 2.24 + mu * G / displacement)  # eq. 17.5-2, k_M = W/R + μW/D
+    damping = 2.0 * mu / (math.pi * (mu + displacement / 2.24))
+    coefficient = 0.8 + (damping - 0.02) / (0.05 - 0.02) * (1.0 - 0.8)  # Table 17.5-1 between 2 % and 5 %
+    assert 0.02 < damping < 0.05
+    assert displacement == pytest.approx(G * 1.2 * period / (4.0 * math.pi**2 * coefficient), rel=1e-5)  # eq. 17.5-1's fixed point
+    # the same building studied or not: every building on a pendulum is designed by chapter 17
+    assert design_separations(_scene({"mass": 5.0e4, "mu": 0.05, "radius": 2.24}), DESIGN, studied="B2")["asce7_isolated"][0] == separation
 
 
 @pytest.mark.parametrize(("table", "message"), [
@@ -151,6 +157,7 @@ def test_stochpound_risk_prints_the_codes_gaps_beside_the_suite_mean_rules(desig
     period = float(risk.design_rules["return_period"].sel(rule="asce7_delta_mt"))
     assert f"ASCE 7 §12.12.3 δ_MT of the design analysis, pounding once in {period:.3g} years" in result.output.replace("\n", " ")
     assert "note: D_TM is not applied: the studied building's base slides in no run of this store (a fixed base" in result.output  # why no D_TM row
+    assert "Chapter 17 design" not in result.output and "ch. 17" not in result.output  # fixed bases: no chapter 17
 
 
 def test_stochpound_risk_takes_a_design_file_and_refuses_a_bad_one(design_store, tmp_path):

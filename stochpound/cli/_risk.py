@@ -28,8 +28,8 @@ def _targets(value: str) -> tuple[float, ...]:
     return targets
 
 
-def _toml_table(path: Path, name: str, docs: str) -> dict:
-    """The TOML file's ``[name]`` table (its key ``name`` kept: ``{name: ...}``), or a one-line error."""
+def _toml_table(path: Path, name: str, docs: str, beside: tuple[str, ...] = ()) -> dict:
+    """The TOML file's ``[name]`` table (its key ``name`` kept: ``{name: ...}``) and the tables ``beside`` it has, or a one-line error."""
     import tomllib
 
     try:
@@ -38,7 +38,7 @@ def _toml_table(path: Path, name: str, docs: str) -> dict:
         raise click.ClickException(f"{path}: not TOML: {error}") from None
     if name not in table:
         raise click.ClickException(f"{path}: has no [{name}] table ({docs})")
-    return {name: table[name]}
+    return {key: table[key] for key in (name, *beside) if key in table}
 
 
 def _limit_states(path: Path) -> tuple:
@@ -49,11 +49,12 @@ def _limit_states(path: Path) -> tuple:
 
 
 def _design(path: Path) -> Design | None:
-    """The buildings' code design of a TOML file's ``[design]`` table (the experiment file's table, docs/experiments.md)."""
+    """The buildings' code design of a TOML file's ``[design]`` table (the experiment file's table, docs/experiments.md; its
+    ``[hazard]``, if any, gives a sliding building's chapter 17 spectrum)."""
     from stochpound.experiment import parse_design
     from stochpound.store import TomlTable
 
-    return parse_design(TomlTable(_toml_table(path, "design", "docs/experiments.md")))
+    return parse_design(TomlTable(_toml_table(path, "design", "docs/experiments.md", beside=("hazard",))))
 
 
 def _check_csv(csv_dir: Path, inputs: list[tuple[str | Path, str]]) -> None:

@@ -60,6 +60,7 @@ from stochpound.risk._code_gaps import (
     srss_separation,
 )
 from stochpound.risk._design_rules import DESIGN_RULE_LEVELS, design_rules_risk, design_separations
+from stochpound.risk._site_spectrum import site_mce
 from stochpound.risk._inputs import (RiskInputError, RiskInputs, contact_free_closure, has_risk, read_risk_inputs, selection_misses, site_hazard,
                                     stripes_beyond_truncation)
 from stochpound.risk._inputs import configuration_scene
@@ -119,6 +120,7 @@ __all__ = [
     "design_separations",
     "design_rules_risk",
     "DESIGN_RULE_LEVELS",
+    "site_mce",
     "contact_free_closure",
     "configuration_scene",
     "pounding_fragility",

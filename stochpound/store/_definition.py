@@ -44,6 +44,7 @@ from typing import Any, TypeVar
 from stochpound._errors import ExperimentError
 from stochpound.model.friction import is_fixed_base
 from stochpound.motions import DEFAULT_G, MEASURE_KINDS, Measure
+from stochpound.store._design_isolation import DesignIsolation
 from stochpound.store._stripe_selection import Selection
 
 _Record = TypeVar("_Record")
@@ -256,6 +257,8 @@ class Design:
         MCE_R spectral acceleration at 1 s, S_M1 (g), for a building on a friction pendulum; None: not given.
     ec8 : DesignEc8 or None
         Eurocode 8's design, if given.
+    isolation : DesignIsolation or None
+        ASCE 7-16 chapter 17's inputs for a building on a sliding base, if given.
     """
 
     sds: float
@@ -267,13 +270,15 @@ class Design:
     ie: float
     sm1: float | None = None
     ec8: DesignEc8 | None = None
+    isolation: DesignIsolation | None = None
 
     @classmethod
     def from_entry(cls, entry: Mapping[str, Any]) -> Design:
         """The typed design of a canonical ``design`` entry."""
         ec8 = entry.get("ec8")
+        isolation = DesignIsolation.from_entry(entry["isolation"]) if "isolation" in entry else None
         return cls(entry["sds"], entry["sd1"], entry["tl"], entry["r"], entry["cd"], entry["omega0"], entry["ie"], entry.get("sm1"),
-                   DesignEc8(ec8["ag"], ec8["ground"], ec8["q"]) if ec8 is not None else None)
+                   DesignEc8(ec8["ag"], ec8["ground"], ec8["q"]) if ec8 is not None else None, isolation)
 
     def entry(self) -> dict[str, Any]:
         """The canonical ``design`` entry (as definitions store it)."""
@@ -282,6 +287,8 @@ class Design:
             written["sm1"] = self.sm1
         if self.ec8 is not None:
             written["ec8"] = {"ag": self.ec8.ag, "ground": self.ec8.ground, "q": self.ec8.q}
+        if self.isolation is not None:
+            written["isolation"] = self.isolation.entry()
         return written
 
 
