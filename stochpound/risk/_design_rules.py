@@ -237,7 +237,7 @@ def design_rules_text(design_rules: xr.Dataset | None, note: str) -> str:
         if bool(period.notnull().any()):
             low, high = float(period.min()), float(period.max())
             periods.append(f"{DESIGN_RULE_NAMES[str(rule)]}, pounding once in {low:.3g}" + (f" to {high:.3g}" if high != low else "") + " years")
-    given = "; ".join(_FORMULAS[str(rule)] for rule in design_rules["rule"].values)
+    given = "; ".join(_FORMULAS[str(rule)] for rule in design_rules["rule"].values if bool(design_rules["gap"].sel(rule=rule).notnull().any()))
     chapter17 = str(design_rules.attrs["chapter17"]) if "chapter17" in design_rules.attrs else ""
     return ("The rows '(design analysis)' are the codes' own gaps, from the design analysis under the spectra of the store's [design] "
             f"({given}), not from the runs; each with the mean annual frequency of pounding at that gap: here: {'; '.join(periods)}."
