@@ -91,18 +91,44 @@ def test_a_sliding_building_is_designed_by_chapter_17_and_gets_no_section_12_12_
     assert design_separations(_scene({"mass": 5.0e4, "mu": 0.05, "radius": 2.24}), DESIGN, studied="B2")["asce7_isolated"][0] == separation
 
 
+_ASCE7 = "sds = 1.0\nsd1 = 0.6\nr = 8.0\ncd = 5.5\nomega0 = 3.0"
+
+
 @pytest.mark.parametrize(("table", "message"), [
     ("sds = 1.0\nsd1 = 0.6\nr = 0.5\ncd = 5.5\nomega0 = 3.0", "design.r: must be >= 1, got 0.5"),
     ("sds = 1.0\nsd1 = 0.6\nr = 8.0\ncd = 5.5", "design.omega0: missing"),
     ("sds = 1.0\nsd1 = 0.6\nr = 8.0\ncd = 5.5\nomega0 = 3.0\nq = 4.0", "design.q: unknown field"),
     ('sds = 1.0\nsd1 = 0.6\nr = 8.0\ncd = 5.5\nomega0 = 3.0\nec8 = { ag = 0.3, ground = "F", q = 4.0 }', "design.ec8.ground: must be one of A, B, C, D, E"),
     ("sds = -1.0\nsd1 = 0.6\nr = 8.0\ncd = 5.5\nomega0 = 3.0", "design.sds: must be > 0"),
+    (f"{_ASCE7}\n[design.isolation]\nplan = [20.0, 10.0]", "design.isolation.plan: must be [b, d], the shortest and longest plan dimensions"),
+    (f"{_ASCE7}\n[design.isolation]\neccentricity = 1.0", "design.isolation.eccentricity: needs plan = [b, d] (m) beside it"),
+    (f"{_ASCE7}\n[design.isolation]\nsa_short = 1.8", "design.isolation.sa_long: give sa_short and sa_long together"),
+    (f"{_ASCE7}\n[design.isolation]\nlambda_max = 0.5", "design.isolation.lambda_max: must be >= 1"),
+    (f"{_ASCE7}\n[design.isolation]\nmoat = 0.6", "design.isolation.moat: unknown field"),
 ])
 def test_design_errors_are_one_line_naming_the_field_and_range(table, message):
     text = risk_text(FIXED, "gap = [inf]", 'measure = "psa"\nperiod = 1.0\nlevels = [0.3, 0.8]') + f"\n[design]\n{table}\n"
     with pytest.raises(ExperimentError) as error:
         parse_experiment(tomllib.loads(text), base_dir=REPOSITORY)
     assert message in str(error.value) and "\n" not in str(error.value)
+
+
+def test_design_isolation_reads_the_site_s_own_sa_0_2_and_sa_1_at_2_percent_in_50_years():
+    """Issue 45: S_MS and S_M1 from the site's SA(0.2 s) and SA(1 s), not PGA / 0.4: the bundled site's curves at the rate of
+    2 % in 50 yr, their source recorded; given values are kept as given (and then no source)."""
+    from stochpound.risk import HazardCurve, rate_from_probability
+
+    text = risk_text(FIXED, "gap = [inf]", 'measure = "psa"\nperiod = 1.0\nlevels = [0.3, 0.8]') + f"\n[design]\n{_ASCE7}\n[design.isolation]\n"
+    isolation = parse_experiment(tomllib.loads(text), base_dir=REPOSITORY)["design"]["isolation"]
+    rate = -math.log(1.0 - 0.02) / 50.0
+    assert rate_from_probability(0.02, 50.0) == pytest.approx(rate, rel=1e-12)
+    assert isolation["sa_short"] == pytest.approx(float(HazardCurve.bundled("fox_plaza_los_angeles_sa0p2s").intensity_at(rate)), rel=1e-12)
+    assert isolation["sa_long"] == pytest.approx(float(HazardCurve.bundled("fox_plaza_los_angeles_sa1p0s").intensity_at(rate)), rel=1e-12)
+    assert round(isolation["sa_short"], 2) == 1.82 and round(isolation["sa_long"], 2) == 1.20  # the issue's 1.82 g; PGA / 0.4 is 1.99 g
+    assert "fox_plaza_los_angeles_sa0p2s" in isolation["spectrum_source"] and "2 %/50 yr" in isolation["spectrum_source"]
+    given = parse_experiment(tomllib.loads(text + "sa_short = 1.5\nsa_long = 0.6\nplan = [10.0, 30.0]\n"), base_dir=REPOSITORY)["design"]["isolation"]
+    assert given == {"sa_short": 1.5, "sa_long": 0.6, "plan": [10.0, 30.0]}
+    assert Design.from_entry(parse_experiment(tomllib.loads(text), base_dir=REPOSITORY)["design"]).isolation.sa_long == isolation["sa_long"]
 
 
 def test_the_design_is_not_part_of_the_runs_identity():

@@ -66,6 +66,8 @@ from stochpound.risk._inputs import (RiskInputError, RiskInputs, contact_free_cl
 from stochpound.risk._inputs import configuration_scene
 from stochpound.risk._inputs import stripe_motions  # noqa: F401  (for stochpound.experiment.measure_choice: not public API)
 from stochpound.risk._chain import StoreRisk, pounding_fragility, risk_gaps, store_risk
+from stochpound.risk._chain import fit_name  # noqa: F401  (for the report's sections: not public API)
+from stochpound.risk._damage import POUNDING as POUNDING_AT_G_STAR  # noqa: F401  (for the report's sections: not public API)
 from stochpound.risk._demands import StoreDemands, store_demands
 from stochpound.risk._limit_states import KINDS as LIMIT_STATE_KINDS, LimitState, gap_cost_frame, limit_state_problem, limit_state_risk, limit_states_from_table
 from stochpound.risk._efficiency import measure_efficiency, most_efficient

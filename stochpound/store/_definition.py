@@ -34,6 +34,7 @@ the model's rule (:mod:`stochpound.model.friction`).
 from __future__ import annotations
 
 import copy
+import dataclasses
 import hashlib
 import json
 import math
@@ -304,11 +305,14 @@ class LimitStateCapacities:
         Its capacities, in the kind's units.
     building : str or None
         The building they apply to; None: any building.
+    targets : tuple of float or None
+        Each capacity's performance objective, a probability in 50 years; None: not given.
     """
 
     kind: str
     capacities: tuple[float, ...]
     building: str | None = None
+    targets: tuple[float, ...] | None = None
 
 
 @dataclass(frozen=True)
@@ -335,6 +339,9 @@ class LimitStates:
         for kind, value in entry["capacities"].items():
             per_building = value.items() if isinstance(value, Mapping) else [(None, value)]
             states += [LimitStateCapacities(kind, tuple(float(c) for c in capacities), building) for building, capacities in per_building]
+        if "targets" in entry:  # shaped as the capacities: per kind a list, or per building a list
+            targets = entry["targets"]
+            states = [dataclasses.replace(state, targets=_state_targets(targets, state)) for state in states]
         return cls(entry["source"], tuple(states))
 
     def entry(self) -> dict[str, Any]:
@@ -345,7 +352,24 @@ class LimitStates:
                 capacities[state.kind] = list(state.capacities)
             else:
                 capacities.setdefault(state.kind, {})[state.building] = list(state.capacities)
-        return {"source": self.source, "capacities": capacities}
+        written = {"source": self.source, "capacities": capacities}
+        targets: dict[str, list[float] | dict[str, list[float]]] = {}
+        for state in (state for state in self.states if state.targets is not None):
+            if state.building is None:
+                targets[state.kind] = list(state.targets)
+            else:
+                targets.setdefault(state.kind, {})[state.building] = list(state.targets)
+        if targets:
+            written["targets"] = targets
+        return written
+
+
+def _state_targets(targets: Mapping[str, list[float] | Mapping[str, list[float]]], state: LimitStateCapacities) -> tuple[float, ...] | None:
+    """A state's targets in a canonical ``limit_states`` entry's ``targets`` (shaped as its capacities), None where not given."""
+    given = targets[state.kind] if state.kind in targets else None
+    if isinstance(given, Mapping):
+        given = given[state.building] if state.building in given else None
+    return None if given is None else tuple(float(t) for t in given)
 
 
 @dataclass(frozen=True)

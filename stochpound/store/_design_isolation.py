@@ -11,7 +11,9 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import asdict, dataclass
-from typing import Any
+
+IsolationValue = float | str | list[float]
+"""A value of the canonical ``isolation`` entry: a number, the spectrum's source, or the plan."""
 
 
 @dataclass(frozen=True)
@@ -53,13 +55,13 @@ class DesignIsolation:
     spectrum_source: str | None = None
 
     @classmethod
-    def from_entry(cls, entry: Mapping[str, Any]) -> DesignIsolation:
+    def from_entry(cls, entry: Mapping[str, IsolationValue]) -> DesignIsolation:
         """The typed record of a canonical ``isolation`` entry."""
         values = {name: entry[name] for name in cls.__dataclass_fields__ if name in entry}
         if "plan" in values:
             values["plan"] = tuple(values["plan"])
         return cls(**values)
 
-    def entry(self) -> dict[str, Any]:
+    def entry(self) -> dict[str, IsolationValue]:
         """The canonical ``isolation`` entry: its given fields only."""
         return {name: list(value) if name == "plan" else value for name, value in asdict(self).items() if value is not None}

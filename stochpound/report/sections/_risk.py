@@ -166,21 +166,25 @@ def design_summary_text(risk: StoreRisk, demands: StoreDemands | None = None, da
                  f"{', '.join(met.index[met]) or 'none'}; not: {', '.join(met.index[~met]) or 'none'}.")
     rests = "; ".join(f"{key}: {value}" for key, value in {"hazard": f"{risk.hazard.describe()} ({_source(risk)})", **risk.assumptions,
                                                           **_outside_stripes_assumption(risk), **_beyond_model(damage)}.items())
-    return (f"Design summary. Governing limit state: {governing}. {design_value_text(risk)} {meets} The answer holds only for what it "
+    judged = ("Governing limit state (the largest λ/λ_target of the limit states, each against its own objective; pounding at g* has 1)"
+              if damage is not None and damage.has_objectives() else
+              "Limit state judged (no structural limit state with an objective, so none is ranked against it)")
+    return (f"Design summary. {judged}: {governing}. {design_value_text(risk)} {meets} The answer holds only for what it "
             f"rests on; a change to any of these voids it: {rests}.")
 
 
 def _structural_governs(damage: StoreDamage | None, target: float, separation: str) -> str:
     """What governs at ``target``: ``separation`` (what limits the gap), preceded by the buildings' own limit states where
-    :meth:`~stochpound.risk.StoreDamage.governing` names one (reached more often than pounding at g*), with their counts of
-    configurations; ``separation`` alone where pounding governs everywhere or without ``damage``."""
+    :meth:`~stochpound.risk.StoreDamage.governing` names one (beyond its objective: the largest λ/λ_target), with their counts of
+    configurations; ``separation`` alone where pounding governs everywhere, without ``damage`` or without objectives."""
     counted = damage.governing_counts(target) if damage is not None else None
     if counted is None or not counted[0]:
         return separation
     states, configurations = counted
     listed = ", ".join(f"{state} in {count} of {configurations} configurations" for state, count in states.items())
     rest = "of the separation" if sum(states.values()) == configurations else "in the other configurations"
-    return f"{listed} (the buildings' own limit state, reached more often than pounding at g*: the Damage section); {rest}, {separation}"
+    return (f"{listed} (a limit state beyond its own objective, the largest λ/λ_target, where pounding at g* has 1: the Damage "
+            f"section); {rest}, {separation}")
 
 
 def _beyond_model(damage: StoreDamage | None) -> dict[str, str]:
