@@ -166,9 +166,12 @@ def design_summary_text(risk: StoreRisk, demands: StoreDemands | None = None, da
                  f"{', '.join(met.index[met]) or 'none'}; not: {', '.join(met.index[~met]) or 'none'}.")
     rests = "; ".join(f"{key}: {value}" for key, value in {"hazard": f"{risk.hazard.describe()} ({_source(risk)})", **risk.assumptions,
                                                           **_outside_stripes_assumption(risk), **_beyond_model(damage)}.items())
-    judged = ("Governing limit state (the largest λ/λ_target of the limit states, each against its own objective; pounding at g* has 1)"
-              if damage is not None and damage.has_objectives() else
-              "Limit state judged (no structural limit state with an objective, so none is ranked against it)")
+    if damage is not None and damage.has_objectives():
+        judged = "Governing limit state (the largest λ/λ_target of the limit states, each against its own objective; pounding at g* has 1)"
+    elif wall:
+        judged = "Governing limit state (the moat wall against the target's rate, where pounding at g* has 1; no structural limit state ranked)"
+    else:
+        judged = "Limit state judged (no structural limit state with an objective, so none is ranked against it)"
     return (f"Design summary. {judged}: {governing}. {design_value_text(risk)} {meets} The answer holds only for what it "
             f"rests on; a change to any of these voids it: {rests}.")
 
