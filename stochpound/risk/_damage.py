@@ -37,9 +37,8 @@ from stochpound.risk import _inputs
 from stochpound.risk._limit_states import KINDS, OBJECTIVE_YEARS, LimitState, default_target, limit_state_risk, limit_states_of
 from stochpound.risk._maf import TARGETS
 from stochpound.risk._chain import YEARS
+from stochpound.risk._collapse import MODEL_DRIFT_LIMIT
 
-MODEL_DRIFT_LIMIT = 0.05
-"""Peak storey drift ratio beyond which a run is flagged: the model has no strength loss or collapse (the collapse-prevention drift of ``DEFAULT_SOURCE``)."""
 QUANTILES = (0.5, 0.84)
 """The fractiles over each stripe's motions of ``StoreDamage.demands``."""
 DEFAULT_LIMIT_STATES = tuple(LimitState(kind, capacity, target=default_target(kind, capacity)) for kind, capacity in (

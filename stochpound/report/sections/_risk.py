@@ -38,7 +38,7 @@ from stochpound.analysis import CellLabels
 from stochpound.report.render import Block, FigureItem, Paragraph, Section, Table, figures
 from stochpound.report.sections._facets import labels_text
 from stochpound.report.sections._stripe_motions import is_selected
-from stochpound.risk import MODEL_DRIFT_LIMIT, StoreDamage, StoreDemands, StoreRisk
+from stochpound.risk import MODEL_DRIFT_LIMIT, CollapseRisk, StoreDamage, StoreDemands, StoreRisk
 
 
 def hazard_provenance(store: xr.Dataset) -> str:
@@ -118,13 +118,20 @@ def summary_answer(name: str, risk: StoreRisk) -> list[Block]:
 
 
 def risk_section(name: str, risk: StoreRisk, demands: StoreDemands | None = None, damage: StoreDamage | None = None,
-                 choice: pd.DataFrame | None = None) -> Section:
+                 choice: pd.DataFrame | None = None, collapse: CollapseRisk | None = None) -> Section:
     """The "Risk" section of one store, from its risk chain, its demand hazard curves (:func:`~stochpound.risk.store_demands`),
-    for yielding buildings the damage its runs did (:func:`~stochpound.risk.store_damage`) and which measure is the most
-    efficient (:func:`~stochpound.experiment.measure_choice`)."""
+    for yielding buildings the damage its runs did (:func:`~stochpound.risk.store_damage`), which measure is the most
+    efficient (:func:`~stochpound.experiment.measure_choice`) and g* with the runs beyond the model counted apart
+    (:func:`~stochpound.risk.collapse_risk`, shown where some run is beyond the model)."""
     section = Section(f"Risk: experiment {name}", key=f"risk-{name}")
     section.add(Paragraph(headline_text(name, risk)))
-    section.add(Paragraph(design_summary_text(risk, demands, damage)))
+    collapse = collapse if collapse is not None and collapse.collapsed else None
+    section.add(Paragraph(design_summary_text(risk, demands, damage, collapse)))
+    if collapse is not None:
+        section.add(Paragraph(collapse.text(risk.years)))
+        section.add(Table(f"risk-collapse-{name}", f"Experiment {name}: g* both ways, every run as computed and the runs beyond the "
+                          "model counted apart as collapses (FEMA P-58), with the collapse rate λ_C", collapse.both_ways(risk.separation, risk.years),
+                          formats={"g* as run (m)": "{:.3f}", "g* collapses apart (m)": "{:.3f}", "λ_C (1/yr)": "{:.3g}"}))
     section.add(Paragraph(_hazard_text(risk)))
     for block in _measure_choice_blocks(name, risk, choice):
         section.add(block)
@@ -150,7 +157,8 @@ def _separation_table(name: str, risk: StoreRisk) -> Table:
                  note=_grid_note(risk), formats={"g* (m)": "{:.3f}", "lower (m)": "{:.3f}", "upper (m)": "{:.3f}"})
 
 
-def design_summary_text(risk: StoreRisk, demands: StoreDemands | None = None, damage: StoreDamage | None = None) -> str:
+def design_summary_text(risk: StoreRisk, demands: StoreDemands | None = None, damage: StoreDamage | None = None,
+                        collapse: CollapseRisk | None = None) -> str:
     """The design summary: the governing limit state per target, the gap to design to, which code rules meet their level, and
     what the answer rests on (hazard, scenario, structural model, suite), all from the chain's results and the store."""
     wall = _wall_governs(risk, demands)
@@ -165,7 +173,7 @@ def design_summary_text(risk: StoreRisk, demands: StoreDemands | None = None, da
         meets = (f"Code rules meeting their own design level as a target in every configuration and level ({column.replace('meets, ', '') if 'upper' in column else 'estimate'}): "
                  f"{', '.join(met.index[met]) or 'none'}; not: {', '.join(met.index[~met]) or 'none'}.")
     rests = "; ".join(f"{key}: {value}" for key, value in {"hazard": f"{risk.hazard.describe()} ({_source(risk)})", **risk.assumptions,
-                                                          **_outside_stripes_assumption(risk), **_beyond_model(damage)}.items())
+                                                          **_outside_stripes_assumption(risk), **_beyond_model(damage, collapse)}.items())
     if damage is not None and damage.has_objectives():
         judged = "Governing limit state (the largest λ/λ_target of the limit states, each against its own objective; pounding at g* has 1)"
     elif wall:
@@ -190,15 +198,18 @@ def _structural_governs(damage: StoreDamage | None, target: float, separation: s
             f"section); {rest}, {separation}")
 
 
-def _beyond_model(damage: StoreDamage | None) -> dict[str, str]:
+def _beyond_model(damage: StoreDamage | None, collapse: CollapseRisk | None = None) -> dict[str, str]:
     """The assumption the runs beyond the model strain: {"beyond the model": "<n> of <N> runs ..."} where some run exceeds
-    ``MODEL_DRIFT_LIMIT`` ({} otherwise or without ``damage``)."""
+    ``MODEL_DRIFT_LIMIT`` ({} otherwise or without ``damage``), and how the answer counts them."""
     beyond, runs = damage.beyond_model_total() if damage is not None else (0, 0)
     if not beyond:
         return {}
+    counted = ("g* above and the limit states keep them as computed; g* with them counted apart as collapses (FEMA P-58, by total "
+               "probability) is given beside it, 'g* both ways'" if collapse is not None else
+               "they enter g* and the limit states as computed (the Damage section)")
     return {"beyond the model": f"{beyond} of {runs} runs exceed a "
                                 f"{100 * MODEL_DRIFT_LIMIT:g} % storey drift, where the storeys' lack of strength loss and collapse makes their "
-                                "response not credible; they enter g* and the limit states as computed (the Damage section)"}
+                                f"response not credible; {counted}"}
 
 
 def _source(risk: StoreRisk) -> str:
