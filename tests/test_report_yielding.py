@@ -340,3 +340,60 @@ def test_the_damage_of_elastic_buildings_has_no_nan_and_no_warning(store):
     median = float(store_damage(store).demands["peak_ductility"].sel(intensity=1.2031, building="B1", quantile=0.5))
     assert table.loc[("–", "1.2031 (2 %/50 yr)", "B1"), "peak storey ductility, median"] == f"{median:.3g}"
     assert not any("nan" in cell.lower() for cell in _cells(section))
+
+
+# ---------------------------------------------------------------- collapse as PBEE treats it (issue 45 item 3)
+
+
+def test_collapses_are_counted_apart_and_combined_by_total_probability(store):
+    """The runs past the model's 5 % drift are collapses: counted by hand, P(C | IM) fitted on them, and
+    λ_P(g) = ∫ [P_C + (1 − P_C) P(P | no C)] |dλ|. Checks with closed forms: no collapse at all (a limit no run passes) gives the
+    chain's own g* (an independent integrator: trapezoids against Gauss–Legendre); at a gap no credible run reaches,
+    P(P | no C) ≡ 0 and λ_P is λ_C."""
+    from stochpound.risk import collapse_risk, mean_annual_frequency, store_risk, stripe_fragility
+
+    risk = store_risk(store, bootstrap=0)
+    gaps, targets = risk.fragility["gap"].values, risk.separation["target"].values
+    collapse = collapse_risk(store, risk.hazard, gaps, targets)
+    drift = contact_free(store)["peak_drift_ratio"].max("building").isel(realization=0, drop=True)
+    hand = (drift > MODEL_DRIFT_LIMIT).astype(float).where(drift.notnull())
+    assert collapse.collapsed == int(hand.sum()) > 0 and collapse.runs == int(drift.notnull().sum())
+    np.testing.assert_array_equal(collapse.collapse["exceeded"].values.ravel(), hand.sum("record").values.ravel())
+    fit = stripe_fragility(hand, bootstrap=0)
+    assert float(collapse.collapse["maf"]) == pytest.approx(float(mean_annual_frequency(fit, risk.hazard)), rel=1e-12)
+    # no collapse: the chain's g*, to the integrators' difference
+    none = collapse_risk(store, risk.hazard, gaps, targets, limit=1.0e9)
+    assert none.collapsed == 0
+    np.testing.assert_allclose(none.separation["separation"].values, risk.separation["separation"].values, rtol=2e-3)
+    # the widest gap: no credible run reaches it, so only collapses pound there
+    closure = contact_free(store)["peak_contact_closure"].max("contact").isel(realization=0, drop=True)
+    assert float(closure.where(hand == 0.0).max()) < gaps[-1]
+    assert float(collapse.maf.isel(gap=-1)) == pytest.approx(float(collapse.collapse["maf"]), rel=2e-3)
+    # the answer both ways: collapse alone is more frequent than either target here, so no gap meets them
+    assert float(collapse.collapse["maf"]) > -np.log(1 - 0.1) / 50
+    frame = collapse.both_ways(risk.separation)
+    assert list(frame["g* collapses apart (m)"]) == [np.inf, np.inf]
+    np.testing.assert_allclose(frame["g* as run (m)"].values, risk.separation["separation"].values.ravel(), rtol=1e-12)
+    assert list(frame["runs beyond the model"]) == [f"{collapse.collapsed} of {collapse.runs}"] * 2
+    assert "there the structure, not the gap, governs" in collapse.text()
+
+
+def test_stochpound_risk_and_the_report_give_g_star_both_ways(store, tmp_path):
+    from click.testing import CliRunner
+
+    from stochpound.cli import main
+    from stochpound.report.sections._risk import risk_section
+    from stochpound.risk import collapse_risk, store_damage, store_risk
+
+    path = tmp_path / "yfix.nc"
+    store.to_netcdf(path)
+    result = CliRunner().invoke(main, ["risk", str(path), "--bootstrap", "0"])
+    assert result.exit_code == 0, result.output
+    assert "Collapse as FEMA P-58 treats it:" in result.output and "g* both ways (m):" in result.output
+    risk = store_risk(store, bootstrap=0)
+    collapse = collapse_risk(store, risk.hazard, risk.fragility["gap"].values, risk.separation["target"].values)
+    section = risk_section("yfix", risk, None, store_damage(store), None, collapse)
+    assert any(getattr(block, "key", "") == "risk-collapse-yfix" for block in section.blocks)
+    summary = " ".join(_text(block) for block in section.blocks)
+    assert "g* with them counted apart as collapses (FEMA P-58, by total probability) is given beside it" in summary
+    assert "they enter g* and the limit states as computed" not in summary
