@@ -158,8 +158,9 @@ def chapter17_text(building: Building, design: Design, g: float) -> str:
     result, spectrum, source = chapter17_of(building, design, g)
     lower, upper = result.lower, result.upper
     weight, superstructure = g * (sum(building.mass) + building.base.mass), g * sum(building.mass)
-    strength = (f"; the model's first storey yields at {building.yield_force[0] / superstructure:.3g} W_s"
-                if building.yield_force is not None else "; the model's storeys are elastic")
+    strength = (f"; against it, the [design]'s fixed-base shear is at most S_DS I_e / R = {design.sds * design.ie / design.r:.3g} W_s"
+                + (f" and the model's first storey yields at {building.yield_force[0] / superstructure:.3g} W_s"
+                   if building.yield_force is not None else " and the model's storeys are elastic"))
     return (f"{building.name} (μ = {building.base.mu:g}, R = {building.base.radius:g} m) by ASCE 7-16 §17.5 at lower/upper-bound friction "
             f"μ = {lower.mu:.3g}/{upper.mu:.3g}: T_M = {lower.period:.3g}/{upper.period:.3g} s, β_M = {100 * lower.damping:.3g}/"
             f"{100 * upper.damping:.3g} %, D_M = {lower.displacement:.3f}/{upper.displacement:.3f} m (eq. 17.5-1), D_TM = "
