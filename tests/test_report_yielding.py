@@ -397,3 +397,25 @@ def test_stochpound_risk_and_the_report_give_g_star_both_ways(store, tmp_path):
     summary = " ".join(_text(block) for block in section.blocks)
     assert "g* with them counted apart as collapses (FEMA P-58, by total probability) is given beside it" in summary
     assert "they enter g* and the limit states as computed" not in summary
+
+
+def test_the_sensitivity_table_recomputes_g_star_under_each_choice(store):
+    """Issue 45 item 4: the grid 4x finer (the chain refitted on it: its every 4th gap is the chain's own), the collapse
+    treatment, β_m folded into the fragility; a vanishing β_m gives g* back (a closed-form limit), and Δ is the change from g*."""
+    from stochpound.risk import collapse_risk, separation_sensitivity, sensitivity_text, store_risk
+
+    risk = store_risk(store, bootstrap=0)
+    gaps = risk.fragility["gap"].values
+    collapse = collapse_risk(store, risk.hazard, gaps, risk.separation["target"].values)
+    frame = separation_sensitivity(risk, store, collapse, dispersions=(1e-6, 0.3))
+    fine = np.geomspace(gaps[0], gaps[-1], 4 * (gaps.size - 1) + 1)
+    np.testing.assert_allclose(fine[::4], gaps, rtol=1e-12)
+    refined = store_risk(store, risk.hazard, gaps=fine, bootstrap=0).separation["separation"].values.ravel()
+    np.testing.assert_allclose(frame["grid ×4 finer"].values, refined, rtol=1e-12)
+    np.testing.assert_allclose(frame["g* (m)"].values, risk.separation["separation"].values.ravel(), rtol=1e-12)
+    np.testing.assert_allclose(frame["β_m = 1e-06"].values, frame["g* (m)"].values, rtol=1e-4)
+    np.testing.assert_allclose(frame["grid ×4 finer: Δ (%)"].values, 100 * (refined / frame["g* (m)"].values - 1), rtol=1e-12)
+    assert list(frame["collapses apart"]) == [np.inf, np.inf]
+    text = sensitivity_text(frame)
+    assert "Not evaluated from this store (each needs other runs): the selection seed, the conditioning measure" in text
+    assert "bound the sampling of the motions only" in text

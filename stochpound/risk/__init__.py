@@ -75,6 +75,7 @@ from stochpound.risk._limit_states import KINDS as LIMIT_STATE_KINDS, LimitState
 from stochpound.risk._efficiency import measure_efficiency, most_efficient
 from stochpound.risk._efficiency import candidate_name  # noqa: F401  (for stochpound.experiment.measure_choice: not public API)
 from stochpound.risk._collapse import CollapseRisk, collapse_risk, collapsed_runs
+from stochpound.risk._sensitivity import MODELLING_DISPERSIONS, separation_sensitivity, sensitivity_text
 from stochpound.risk._damage import DAMAGE_DEMANDS, DEFAULT_LIMIT_STATES, DEFAULT_SOURCE as DEFAULT_LIMIT_STATES_SOURCE, MODEL_DRIFT_LIMIT, StoreDamage, store_damage
 from stochpound.hazard import hazard_consistency, read_hazard_file, stripe_rate_weights
 from stochpound.risk._site_consistency import consistency_at_targets, site_consistency
@@ -151,6 +152,9 @@ __all__ = [
     "CollapseRisk",
     "collapse_risk",
     "collapsed_runs",
+    "separation_sensitivity",
+    "sensitivity_text",
+    "MODELLING_DISPERSIONS",
     "hazard_consistency",
     "consistency_at_targets",
     "site_consistency",

@@ -38,7 +38,7 @@ from stochpound.analysis import CellLabels
 from stochpound.report.render import Block, FigureItem, Paragraph, Section, Table, figures
 from stochpound.report.sections._facets import labels_text
 from stochpound.report.sections._stripe_motions import is_selected
-from stochpound.risk import MODEL_DRIFT_LIMIT, CollapseRisk, StoreDamage, StoreDemands, StoreRisk
+from stochpound.risk import MODEL_DRIFT_LIMIT, CollapseRisk, StoreDamage, StoreDemands, StoreRisk, sensitivity_text
 
 
 def hazard_provenance(store: xr.Dataset) -> str:
@@ -118,11 +118,12 @@ def summary_answer(name: str, risk: StoreRisk) -> list[Block]:
 
 
 def risk_section(name: str, risk: StoreRisk, demands: StoreDemands | None = None, damage: StoreDamage | None = None,
-                 choice: pd.DataFrame | None = None, collapse: CollapseRisk | None = None) -> Section:
+                 choice: pd.DataFrame | None = None, collapse: CollapseRisk | None = None, sensitivity: pd.DataFrame | None = None) -> Section:
     """The "Risk" section of one store, from its risk chain, its demand hazard curves (:func:`~stochpound.risk.store_demands`),
     for yielding buildings the damage its runs did (:func:`~stochpound.risk.store_damage`), which measure is the most
     efficient (:func:`~stochpound.experiment.measure_choice`) and g* with the runs beyond the model counted apart
-    (:func:`~stochpound.risk.collapse_risk`, shown where some run is beyond the model)."""
+    (:func:`~stochpound.risk.collapse_risk`, shown where some run is beyond the model), and how far g* moves under the choices it
+    rests on (:func:`~stochpound.risk.separation_sensitivity`)."""
     section = Section(f"Risk: experiment {name}", key=f"risk-{name}")
     section.add(Paragraph(headline_text(name, risk)))
     collapse = collapse if collapse is not None and collapse.collapsed else None
@@ -132,6 +133,11 @@ def risk_section(name: str, risk: StoreRisk, demands: StoreDemands | None = None
         section.add(Table(f"risk-collapse-{name}", f"Experiment {name}: g* both ways, every run as computed and the runs beyond the "
                           "model counted apart as collapses (FEMA P-58), with the collapse rate λ_C", collapse.both_ways(risk.separation, risk.years),
                           formats={"g* as run (m)": "{:.3f}", "g* collapses apart (m)": "{:.3f}", "λ_C (1/yr)": "{:.3g}"}))
+    if sensitivity is not None:
+        section.add(Paragraph(sensitivity_text(sensitivity)))
+        section.add(Table(f"risk-sensitivity-{name}", f"Experiment {name}: g* under each choice it rests on that the store can vary, each "
+                          "alone (no bootstrap), with its change from g*", sensitivity,
+                          formats={c: ("{:.1f}" if c.endswith("(%)") else "{:.3f}") for c in sensitivity.columns}))
     section.add(Paragraph(_hazard_text(risk)))
     for block in _measure_choice_blocks(name, risk, choice):
         section.add(block)
@@ -246,7 +252,9 @@ def design_value_text(risk: StoreRisk) -> str:
         return (f"There is no upper bound of g* to design to ({why}): the values are g* itself, a central estimate "
                 f"from {motions} that meets its target only about half the time: " + ". ".join(per) + ".")
     return (f"The gap to design to is the {risk.design_basis()}, not g* itself (g* is a central estimate from "
-            f"{motions} and meets its target only about half the time): " + ". ".join(per) + ".")
+            f"{motions} and meets its target only about half the time): " + ". ".join(per) + ". It bounds the sampling of the motions "
+            "only, not the choices the answer rests on (the grid, the collapse treatment, modelling dispersion, the measure, the "
+            "selection: the sensitivity table).")
 
 
 def _motions_text(risk: StoreRisk) -> str:
