@@ -407,7 +407,7 @@ def test_the_sensitivity_table_recomputes_g_star_under_each_choice(store):
     risk = store_risk(store, bootstrap=0)
     gaps = risk.fragility["gap"].values
     collapse = collapse_risk(store, risk.hazard, gaps, risk.separation["target"].values)
-    frame = separation_sensitivity(risk, store, collapse, dispersions=(1e-6, 0.3))
+    frame = separation_sensitivity(risk, store, collapse, dispersions=(1e-6, 0.3)).frame
     fine = np.geomspace(gaps[0], gaps[-1], 4 * (gaps.size - 1) + 1)
     np.testing.assert_allclose(fine[::4], gaps, rtol=1e-12)
     refined = store_risk(store, risk.hazard, gaps=fine, bootstrap=0).separation["separation"].values.ravel()

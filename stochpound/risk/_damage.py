@@ -36,7 +36,7 @@ from stochpound.hazard import rate_from_probability, return_period
 from stochpound.risk import _inputs
 from stochpound.risk._limit_states import KINDS, OBJECTIVE_YEARS, LimitState, default_target, limit_state_risk, limit_states_of
 from stochpound.risk._maf import TARGETS
-from stochpound.risk._chain import YEARS
+from stochpound.risk._chain import YEARS, fit_name
 from stochpound.risk._collapse import MODEL_DRIFT_LIMIT
 
 QUANTILES = (0.5, 0.84)
@@ -152,6 +152,20 @@ class StoreDamage:
         ratio = self.ratio()
         worst = ratio["limit_state"][ratio.fillna(-1.0).argmax("limit_state")].drop_vars("limit_state", errors="ignore")
         return worst.where(self.misses_objective().any("limit_state"), POUNDING)
+
+    def largest_ratio(self) -> tuple[xr.DataArray, xr.DataArray] | None:
+        """Per configuration, the largest λ/λ_target and the limit state that has it (None without ``risk``)."""
+        ratio = self.ratio()
+        if ratio is None:
+            return None
+        index = ratio.fillna(-1.0).argmax("limit_state")
+        return ratio.isel(limit_state=index), ratio["limit_state"][index].drop_vars("limit_state", errors="ignore")
+
+    def fits(self) -> xr.DataArray | None:
+        """Each limit state's fit in words (``lognormal``, ``step: never`` …) over ``risk``'s dimensions; None without ``risk``."""
+        if self.risk is None:
+            return None
+        return xr.apply_ufunc(np.vectorize(lambda status: fit_name(int(status)), otypes=[object]), self.risk["status"])
 
     def misses_objective(self) -> xr.DataArray | None:
         """Per limit state and configuration, whether λ exceeds its objective's rate (λ/λ_target > 1; False without an objective)."""

@@ -19,6 +19,7 @@ need other runs (another store): the table names them as not evaluated.
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Sequence
 
 import numpy as np
@@ -37,8 +38,25 @@ NOT_EVALUATED = ("the selection seed", "the conditioning measure", "the moat wal
 """Choices one store cannot vary: each needs other runs."""
 
 
+@dataclasses.dataclass(frozen=True)
+class Sensitivity:
+    """The sensitivity table of g* (:func:`separation_sensitivity`).
+
+    Attributes
+    ----------
+    frame : pandas.DataFrame
+        Indexed by the configuration and ``target``; columns ``g* (m)`` and, per choice, its g* and ``Δ (%)``.
+    """
+
+    frame: pd.DataFrame
+
+    def text(self) -> str:
+        """The table's message in words (:func:`sensitivity_text`)."""
+        return sensitivity_text(self.frame)
+
+
 def separation_sensitivity(risk: object, store: xr.Dataset, collapse: CollapseRisk | None = None,
-                           dispersions: Sequence[float] = MODELLING_DISPERSIONS, refinement: int = REFINEMENT) -> pd.DataFrame:
+                           dispersions: Sequence[float] = MODELLING_DISPERSIONS, refinement: int = REFINEMENT) -> Sensitivity:
     """g* under each choice one store can vary, per configuration and target (m), with its change from g* (%).
 
     Parameters
@@ -56,8 +74,8 @@ def separation_sensitivity(risk: object, store: xr.Dataset, collapse: CollapseRi
 
     Returns
     -------
-    pandas.DataFrame
-        Indexed by the configuration and ``target``; columns ``g* (m)`` and, per choice, its g* and ``Δ (%)``.
+    Sensitivity
+        Its ``frame``: indexed by the configuration and ``target``; columns ``g* (m)`` and, per choice, its g* and ``Δ (%)``.
     """
     from stochpound.risk._chain import store_risk
 
@@ -84,7 +102,7 @@ def separation_sensitivity(risk: object, store: xr.Dataset, collapse: CollapseRi
     for name in [c for c in columns if c != "g* (m)"]:
         with np.errstate(invalid="ignore", divide="ignore"):
             frame[f"{name}: Δ (%)"] = 100.0 * (frame[name] / base - 1.0)
-    return frame[["g* (m)", *(c for name in columns if name != "g* (m)" for c in (name, f"{name}: Δ (%)"))]]
+    return Sensitivity(frame[["g* (m)", *(c for name in columns if name != "g* (m)" for c in (name, f"{name}: Δ (%)"))]])
 
 
 def _with_dispersion(fragility: xr.Dataset, dispersion: float, hazard: object, targets: np.ndarray, years: float) -> xr.DataArray:

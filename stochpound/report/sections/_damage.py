@@ -6,7 +6,7 @@ import pandas as pd
 
 from stochpound.report.render import Paragraph, Section, Table
 from stochpound.report.sections._description import number
-from stochpound.risk import DAMAGE_DEMANDS, MODEL_DRIFT_LIMIT, POUNDING_AT_G_STAR as POUNDING, StoreDamage, fit_name
+from stochpound.risk import DAMAGE_DEMANDS, MODEL_DRIFT_LIMIT, POUNDING_AT_G_STAR as POUNDING, StoreDamage
 
 
 def damage_section(name: str, damage: StoreDamage) -> Section:
@@ -101,18 +101,17 @@ def _governing_text(damage: StoreDamage) -> str:
     if not damage.has_objectives():
         return (head + " No limit state has an objective, so none is said to govern: give [limit_states] targets (docs/risk.md). "
                 "A [limit_states] table in the experiment file replaces these capacities.")
-    governing, misses, ratio = damage.governing(float(next(iter(damage.design_stripes)))), damage.misses_objective(), damage.ratio()
+    governing, misses = damage.governing(float(next(iter(damage.design_stripes)))), damage.misses_objective()
+    largest, largest_state = damage.largest_ratio()
     grouped: dict[str, list[str]] = {}
     for labels in _configurations(governing):
         worst = str(governing.sel(labels).item())
-        at = ratio.sel(labels)
-        largest = int(at.fillna(-1.0).argmax("limit_state"))
+        value = float(largest.sel(labels))
         if worst == POUNDING:
-            text = (f"{POUNDING} (every limit state within its objective; the largest λ/λ_target is {float(at[largest]):.2g}, "
-                    f"{at['limit_state'].values[largest]})")
+            text = f"{POUNDING} (every limit state within its objective; the largest λ/λ_target is {value:.2g}, {largest_state.sel(labels).item()})"
         else:
             others = [str(state) for state, flag in zip(misses["limit_state"].values, misses.sel(labels).values) if flag and state != worst]
-            text = f"{worst} (λ/λ_target = {float(at[largest]):.2g})" + (f"; also beyond their objectives: {', '.join(others)}" if others else "")
+            text = f"{worst} (λ/λ_target = {value:.2g})" + (f"; also beyond their objectives: {', '.join(others)}" if others else "")
         grouped.setdefault(text, []).append(_label(labels))
     every = len(_configurations(governing))
     governs = "; ".join((f"{' and '.join(names)}: " if len(names) < every else "") + text for text, names in grouped.items())
@@ -123,15 +122,15 @@ def _governing_text(damage: StoreDamage) -> str:
 
 
 def _limit_states_table(name: str, damage: StoreDamage) -> Table:
-    maf, periods, ratio = damage.risk["maf"], damage.return_period(), damage.ratio()
+    maf, periods, ratio, fits = damage.risk["maf"], damage.return_period(), damage.ratio(), damage.fits()
     rows = []
     for labels in _configurations(maf):
         for state in maf["limit_state"].values:
             rate = float(maf.sel(labels).sel(limit_state=state))
             target = float(maf["target"].sel(limit_state=state))
-            status = int(damage.risk["status"].sel(labels).sel(limit_state=state))
             rows.append({"configuration": _label(labels), "limit state": str(state), "λ (1/yr)": f"{rate:.3g}",
-                         "once in (yr)": f"{float(periods.sel(labels).sel(limit_state=state)):.3g}", "fit": fit_name(status),
+                         "once in (yr)": f"{float(periods.sel(labels).sel(limit_state=state)):.3g}",
+                         "fit": str(fits.sel(labels).sel(limit_state=state).item()),
                          "objective": f"{_percent(target)} in 50 yr" if target == target else "none",
                          "λ/λ_target": f"{float(ratio.sel(labels).sel(limit_state=state)):.3g}" if target == target else ""})
     return Table(

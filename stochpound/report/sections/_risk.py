@@ -38,7 +38,7 @@ from stochpound.analysis import CellLabels
 from stochpound.report.render import Block, FigureItem, Paragraph, Section, Table, figures
 from stochpound.report.sections._facets import labels_text
 from stochpound.report.sections._stripe_motions import is_selected
-from stochpound.risk import MODEL_DRIFT_LIMIT, CollapseRisk, StoreDamage, StoreDemands, StoreRisk, sensitivity_text
+from stochpound.risk import MODEL_DRIFT_LIMIT, CollapseRisk, Sensitivity, StoreDamage, StoreDemands, StoreRisk
 
 
 def hazard_provenance(store: xr.Dataset) -> str:
@@ -118,7 +118,7 @@ def summary_answer(name: str, risk: StoreRisk) -> list[Block]:
 
 
 def risk_section(name: str, risk: StoreRisk, demands: StoreDemands | None = None, damage: StoreDamage | None = None,
-                 choice: pd.DataFrame | None = None, collapse: CollapseRisk | None = None, sensitivity: pd.DataFrame | None = None) -> Section:
+                 choice: pd.DataFrame | None = None, collapse: CollapseRisk | None = None, sensitivity: Sensitivity | None = None) -> Section:
     """The "Risk" section of one store, from its risk chain, its demand hazard curves (:func:`~stochpound.risk.store_demands`),
     for yielding buildings the damage its runs did (:func:`~stochpound.risk.store_damage`), which measure is the most
     efficient (:func:`~stochpound.experiment.measure_choice`) and g* with the runs beyond the model counted apart
@@ -134,10 +134,10 @@ def risk_section(name: str, risk: StoreRisk, demands: StoreDemands | None = None
                           "model counted apart as collapses (FEMA P-58), with the collapse rate λ_C", collapse.both_ways(risk.separation, risk.years),
                           formats={"g* as run (m)": "{:.3f}", "g* collapses apart (m)": "{:.3f}", "λ_C (1/yr)": "{:.3g}"}))
     if sensitivity is not None:
-        section.add(Paragraph(sensitivity_text(sensitivity)))
+        section.add(Paragraph(sensitivity.text()))
         section.add(Table(f"risk-sensitivity-{name}", f"Experiment {name}: g* under each choice it rests on that the store can vary, each "
-                          "alone (no bootstrap), with its change from g*", sensitivity,
-                          formats={c: ("{:.1f}" if c.endswith("(%)") else "{:.3f}") for c in sensitivity.columns}))
+                          "alone (no bootstrap), with its change from g*", sensitivity.frame,
+                          formats={c: ("{:.1f}" if c.endswith("(%)") else "{:.3f}") for c in sensitivity.frame.columns}))
     section.add(Paragraph(_hazard_text(risk)))
     for block in _measure_choice_blocks(name, risk, choice):
         section.add(block)
