@@ -231,3 +231,10 @@ def test_the_flagship_s_d_m_in_the_docs_is_eq_17_5_1_s():
                   f"D_M = {displacement:.2f} m")
         assert stated in docs, stated
     assert "12–17 %" not in docs and "0.55–0.65 m" not in docs
+
+
+def test_a_base_beyond_a_slider_s_friction_gets_neither_code_row():
+    """μ = 0.5 on a pendulum is no slider chapter 17 designs (SlidingBase takes μ <= 0.3), nor a fixed base: no row at all,
+    not an error that stops the whole risk answer."""
+    gaps = design_separations(_scene({"mass": 5.0e4, "mu": 0.5, "radius": 2.24}), DESIGN, studied="B1")
+    assert "asce7_isolated" not in gaps and math.isnan(gaps["asce7_delta_mt"][0])

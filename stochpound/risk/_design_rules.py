@@ -67,6 +67,8 @@ _FORMULAS = {"asce7_delta_mt": "ASCE 7-16 §12.12.3: δ_M = C_d δ_max / I_e, SR
              "ec8_ds": "Eurocode 8 §4.4.2.7: d_s = q d_e, SRSS, times 0.7 where the floors stand level",
              "asce7_isolated": "ASCE 7-16 chapter 17 for the building on a sliding base: its D_TM (eq. 17.5-3, the larger friction "
                                "bound's) plus the fixed-base neighbour's δ_M (eq. 12.12-1) at the contact; no §12.12.3 row for a sliding base"}
+MAX_SLIDER_MU = 0.3
+"""The largest nominal friction coefficient chapter 17 is applied to (``stochpound.codes.SlidingBase`` refuses more)."""
 SQUARE_PLAN = IsolatedPlan(1.0, 1.0)
 """The plan assumed where ``[design.isolation]`` gives none: square, so that with the accidental eccentricity 0.05 d and y = d/2
 eq. 17.5-3's amplification is 1 + 0.15 = 1.15 whatever d."""
@@ -286,6 +288,7 @@ def _slides(building: Building) -> bool:
 
 
 def _pendulum(building: Building) -> bool:
-    """Whether a building slides on a friction pendulum eq. 17.5-1 applies to (finite μ > 0, a radius)."""
+    """Whether a building slides on a friction pendulum chapter 17 designs (a radius, 0 < μ <= ``MAX_SLIDER_MU``; a higher μ is
+    no slider's: such a contact gets neither row)."""
     base = building.base
-    return base is not None and base.radius is not None and 0.0 < base.mu < math.inf
+    return base is not None and base.radius is not None and 0.0 < base.mu <= MAX_SLIDER_MU
