@@ -243,7 +243,8 @@ def design_rules_text(design_rules: xr.Dataset | None, note: str) -> str:
     given = "; ".join(_FORMULAS[str(rule)] for rule in design_rules["rule"].values if bool(design_rules["gap"].sel(rule=rule).notnull().any()))
     chapter17 = str(design_rules.attrs["chapter17"]) if "chapter17" in design_rules.attrs else ""
     return ("The rows '(design analysis)' are the codes' own gaps, from the design analysis under the spectra of the store's [design] "
-            f"({given}), not from the runs; each with the mean annual frequency of pounding at that gap: here: {'; '.join(periods)}."
+            f"({given}), not from the runs; each with the mean annual frequency of pounding at that gap: here: "
+            f"{'; '.join(periods) or 'none applies to these contacts (sliding bases beyond a slider friction of 0.3)'}."
             + (f" Chapter 17 design: {chapter17}" if chapter17 else "") + _without_ec8_text(design_rules))
 
 
