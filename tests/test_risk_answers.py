@@ -202,7 +202,7 @@ def test_d_tm_where_the_base_never_slides_is_left_out_and_said_why_not_a_dash():
     rules = rate_intervals(rules.assign(maf=maf, maf_lower=maf / 2, maf_upper=maf * 2, return_period=1 / maf, probability=1 - np.exp(-50 * maf)), 50.0)
     risk = _risk(rules)
     frame = risk.rules_frame()
-    dtm = frame.xs("D_TM of the suite-mean base displacement (ASCE 7 §17.2.5.2 form)", level="rule")
+    dtm = frame.xs("suite-mean peak base displacement (ASCE 7 D_M form: no torsion)", level="rule")
     assert list(dtm.index.get_level_values("mu")) == [0.05] and frame["λ_P (1/yr)"].notna().all()  # no row of dashes
     text = risk.dtm_text()
     assert "left out where the studied building's base never slid in any run (mu ∞)" in text and "fixed base (μ = ∞)" in text

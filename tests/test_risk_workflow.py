@@ -327,7 +327,7 @@ def test_report_section_states_the_separation_first(isolated_store):
     assert keys[:2] == ["risk-separation-risk", "risk-curve-risk"]
     assert {"risk-surface-risk", "risk-fragility-risk", "risk-rules-risk", "risk-demands-risk"} <= set(keys)
     rules = next(block for block in section.blocks if isinstance(block, Table) and block.key == "risk-rules-risk")
-    assert "D_TM of the suite-mean base displacement (ASCE 7 §17.2.5.2 form)" in rules.frame.index.get_level_values("rule")
+    assert "suite-mean peak base displacement (ASCE 7 D_M form: no torsion)" in rules.frame.index.get_level_values("rule")
     grid = {"design_level", "rule", *(d for d in store["case_status"].dims if d not in ("record", "realization", "intensity", "gap"))}
     assert set(rules.frame.index.names) <= grid, rules.frame.index.names  # the grid's axes, not what each point ran (base_mu, base_radius, ...)
     separation = next(block for block in section.blocks if isinstance(block, Table) and block.key == "risk-separation-risk")

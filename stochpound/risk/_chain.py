@@ -57,7 +57,7 @@ RULE_NAMES = {
     "srss_reduced": "0.7 SRSS of suite-mean peaks (Eurocode 8 form)",
     "ddc": "DDC",
     "ddc_cqc": "DDC (CQC ρ)",
-    "dtm": "D_TM of the suite-mean base displacement (ASCE 7 §17.2.5.2 form)",
+    "dtm": "suite-mean peak base displacement (ASCE 7 D_M form: no torsion)",
     **DESIGN_RULE_NAMES,
 }
 """The code rules' names in the tables: each applied to the suite-mean peaks of the stripe at the design level
