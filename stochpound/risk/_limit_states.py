@@ -148,7 +148,9 @@ def default_target(kind: str, capacity: float) -> float | None:
 DEFAULT_TARGETS = {("drift_ratio", 0.007): 0.50, ("drift_ratio", 0.025): 0.10, ("residual_drift_ratio", 0.01): 0.10, ("drift_ratio", 0.05): 0.02}
 """The objectives given FEMA 356's steel moment frame drifts (Table C1-3) where no target is stated: immediate occupancy
 (0.7 % transient) at 50 % in 50 yr, life safety (2.5 % transient, 1 % permanent) at 10 % in 50 yr, collapse prevention (5 %) at
-2 % in 50 yr, the probabilities of the hazard levels ASCE 41 pairs them with, read as rates the limit state may be exceeded at."""
+2 % in 50 yr: the hazard levels FEMA 356 pairs them with in its objectives (its Basic Safety Objective: life safety at 10 %/50 yr,
+collapse prevention at 2 %/50 yr; immediate occupancy at 50 %/50 yr among its enhanced ones), read as the rates the limit state
+may be exceeded at (a risk-based reading of a hazard-level objective)."""
 
 
 def limit_states_from_table(table: Mapping[str, Any]) -> tuple[LimitState, ...]:
