@@ -87,7 +87,8 @@ def separation_sensitivity(risk: object, store: xr.Dataset, collapse: CollapseRi
     gaps = risk.fragility["gap"].values
     targets, years = risk.separation["target"].values, risk.years
     columns = {"g* (m)": risk.separation["separation"]}
-    fine = store_risk(store, risk.hazard, targets, years, gaps=np.geomspace(gaps[0], gaps[-1], refinement * (gaps.size - 1) + 1), bootstrap=0)
+    fine = store_risk(store, risk.hazard, targets, years, gaps=np.geomspace(gaps[0], gaps[-1], refinement * (gaps.size - 1) + 1), bootstrap=0,
+                      partial=bool(risk.progress))  # an unfinished store answered from what ran, as the chain's answer was
     columns[f"grid ×{refinement} finer"] = fine.separation["separation"]
     if collapse is not None and collapse.collapsed:
         columns["collapses apart"] = collapse.separation["separation"]
