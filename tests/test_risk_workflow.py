@@ -201,7 +201,8 @@ def test_cli_prints_separation_and_rules(isolated_store, tmp_path):
     headline = risk.to_frame()
     for value in headline["separation"]:
         assert f"{value:.3f}" in result.output
-    for text in ("10 % in 50 yr", "2 % in 50 yr", "SRSS of suite-mean peaks", "0.7 SRSS of suite-mean peaks", "DDC", "D_TM", "once in (yr)",
+    for text in ("10 % in 50 yr", "2 % in 50 yr", "SRSS of suite-mean peaks", "0.7 SRSS of suite-mean peaks", "DDC",
+                 "suite-mean peak base displacement (ASCE 7 D_M form: no torsion)", "once in (yr)",
                  "once in, lower (yr)", "once in, upper (yr)", "P lower", "P upper", "Design to"):
         assert text in result.output
     written = {path.name: path.read_text() for path in (tmp_path / "tables" / "risk").iterdir()}  # one table per file, in a folder it created
