@@ -248,7 +248,8 @@ def test_d_tm_of_a_moat_variant_is_its_wall_free_twins_and_is_compared_with_the_
     by_hand = float(slid.sel(intensity=stripe).mean())  # the suite mean of the wall-free runs at the rule's stripe
     np.testing.assert_allclose(dtm.sel(design_level=0.02, moat="wall").values, by_hand, rtol=1e-12)
     moat = moat_text(risk, store_demands(store, bootstrap=0))
-    assert "The wall-free D_TM (suite-mean peak base displacement without the wall) at 2 %/50 yr is" in moat and "moat clearance 0.1 m" in moat
+    assert "The wall-free suite-mean peak base displacement (the D_M form, no torsion) at 2 %/50 yr is" in moat and "moat clearance 0.1 m" in moat
+    assert "D_TM (suite-mean" not in moat  # issue 45: a planar run's base displacement is no D_TM
 
 
 def test_the_stripes_table_does_not_call_wall_hits_pounding(moat_variant_store):

@@ -263,7 +263,7 @@ def _motions_text(risk: StoreRisk) -> str:
 
 
 def moat_text(risk: StoreRisk, demands: StoreDemands | None) -> str:
-    """Whether the wall-free D_TM exceeds the moat clearance at each design level, and whether reaching the wall is more
+    """Whether the wall-free suite-mean peak base displacement (the D_M form) exceeds the moat clearance at each design level, and whether reaching the wall is more
     frequent than each target allows (the wall then governs that target); "" without a moat or a D_TM rule."""
     largest_dtm = risk.largest_dtm()
     if demands is None or demands.moat is None or not largest_dtm:
@@ -275,11 +275,11 @@ def moat_text(risk: StoreRisk, demands: StoreDemands | None) -> str:
             continue
         exceeded = [c for c in clearances if value > c]
         verdict = (f"exceeds the moat clearance{'s' if len(exceeded) > 1 else ''} {', '.join(f'{c:.3g} m' for c in exceeded)}: "
-                   "at that level the base reaches the wall, so the code's D_TM is not met by the moat"
+                   "at that level the base reaches the wall, so the moat is short of even D_M (chapter 17's D_TM adds torsion)"
                    if exceeded else f"is within the moat clearance{'s' if len(clearances) > 1 else ''} "
                    f"{', '.join(f'{c:.3g} m' for c in clearances)}")
         largest = " (the largest over the configurations)" if varies else ""
-        sentences.append(f"The wall-free D_TM (suite-mean peak base displacement without the wall) at {100 * level:g} %/{risk.years:g} yr{largest} is "
+        sentences.append(f"The wall-free suite-mean peak base displacement (the D_M form, no torsion) at {100 * level:g} %/{risk.years:g} yr{largest} is "
                          f"{value:.3g} m and {verdict}.")
     for target, clearance, wall, allowed in demands.wall_rates(risk.separation["target"].values, risk.years):
         interval = _wall_interval(demands, clearance)
