@@ -3,7 +3,7 @@
 The storeys are bilinear without strength loss, so a run whose peak storey
 drift ratio passes ``MODEL_DRIFT_LIMIT`` (5 %, the collapse-prevention drift
 of steel moment frames) is beyond what the model represents: its closure is
-not credible. FEMA P-58 (2018, vol. 1 §6.4 and §7.3) keeps such runs out of
+not credible. FEMA P-58 (2018, vol. 1) keeps such runs out of
 the demands and counts them as collapses: per stripe, the fraction of runs
 that collapse gives P(C | IM), fitted by a lognormal fragility over the
 stripes (:func:`~stochpound.risk.stripe_fragility`), and the demands come

@@ -9,9 +9,10 @@ one store can answer are recomputed here, each alone, with no bootstrap:
 * **the collapse treatment**: the runs beyond the model counted apart as
   collapses (:func:`~stochpound.risk.collapse_risk`), where some run is;
 * **modelling dispersion**: β_m folded into every fitted fragility,
-  β' = √(β² + β_m²) (FEMA P-58 vol. 1 §5.2.5 and FEMA P695 §7.3 combine
-  dispersions so; a step at θ becomes a lognormal of β_m; P-58's range is
-  0.2–0.4, ``MODELLING_DISPERSIONS``).
+  β' = √(β² + β_m²) (the square root of the sum of squares by which FEMA
+  P-58 and FEMA P695 combine independent dispersions; a step at θ becomes a
+  lognormal of β_m; P-58's range for modelling uncertainty is 0.2–0.4,
+  ``MODELLING_DISPERSIONS``).
 
 The selection seed, the conditioning measure and the moat wall's stiffness
 need other runs (another store): the table names them as not evaluated.
