@@ -55,6 +55,11 @@ def test_each_record_writes_its_entry_back():
     limit_states = {"source": None, "capacities": {"drift_ratio": [0.01, 0.02], "ductility": {"B1": [2.0], "B2": [3.0, 4.0]}}}
     assert LimitStates.from_entry(limit_states).entry() == limit_states
     assert [(s.kind, s.building) for s in LimitStates.from_entry(limit_states).states] == [("drift_ratio", None), ("ductility", "B1"), ("ductility", "B2")]
+    targeted = {**limit_states, "targets": {"drift_ratio": [0.5, 0.1], "ductility": {"B2": [0.1, 0.02]}}}  # issue 45: objectives
+    assert LimitStates.from_entry(targeted).entry() == targeted
+    assert [s.targets for s in LimitStates.from_entry(targeted).states] == [(0.5, 0.1), None, (0.1, 0.02)]
+    isolated = {**design, "isolation": {"plan": [12.0, 18.0], "lambda_min": 0.7, "sa_short": 1.82, "sa_long": 1.2, "spectrum_source": "x"}}
+    assert Design.from_entry(isolated).entry() == isolated and Design.from_entry(isolated).isolation.plan == (12.0, 18.0)
     for site in ({"scenario": "given"}, {"scenario": "fitted", "curves": ["a", "b"]}, {"scenario": "ruptures", "ruptures": "demo"}):
         assert Site.from_entry(site).entry() == site
     law = {"source": "power_law", "measure": "pga", "units": "g", "extrapolate": False, "power_law": {"k0": 2.0e-4, "k": 2.2}, "provenance": "λ"}

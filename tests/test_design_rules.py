@@ -73,16 +73,25 @@ def test_the_eurocode_reduction_applies_only_where_the_floors_stand_level():
     assert not_level == pytest.approx(0.125019, abs=2e-6) and level == pytest.approx(0.7 * not_level, rel=1e-12)
 
 
-def test_eq_17_5_1_gives_the_pendulum_displacement_at_every_contact():
+def test_a_sliding_building_is_designed_by_chapter_17_and_gets_no_section_12_12_3_row():
+    """B1 on a friction pendulum (μ = 0.05, R = 2.24 m) beside the fixed B2, S_M1 = 1.2 g given (sm1), S_MS = 1.5 S_DS: the
+    separation is D_TM (eq. 17.5-3, lower-bound friction μ = 0.6 × 0.05 = 0.03, square plan: × 1.15) + B2's δ_M (0.102502 m,
+    the module docstring); §12.12.3's δ_MT, a fixed-base structure's rule, is not given for the sliding pair (issue 45)."""
     gaps = design_separations(_scene({"mass": 5.0e4, "mu": 0.05, "radius": 2.24}), DESIGN, studied="B1")
-    displacement = gaps["asce7_dtm"][0]
-    assert displacement == pytest.approx(0.73, abs=0.01)
-    period = 2.0 * math.pi / math.sqrt(G / 2.24 + 0.05 * G / displacement)  # eq. 17.5-2, k_M = W/R + μW/D
-    damping = 2.0 * 0.05 / (math.pi * (0.05 + displacement / 2.24))
-    coefficient = 1.0 + (damping - 0.05) / (0.10 - 0.05) * (1.2 - 1.0)  # Table 17.5-1 between 5 % and 10 %
-    assert 0.05 < damping < 0.10 and period == pytest.approx(2.80, abs=0.01)
-    assert displacement == pytest.approx(G * 1.2 * period / (4.0 * math.pi**2 * coefficient), rel=1e-8)  # eq. 17.5-1
-    assert design_separations(_scene({"mass": 5.0e4, "mu": 0.05, "radius": 2.24}), DESIGN, studied="B2").keys() == {"asce7_delta_mt", "ec8_ds"}
+    assert sorted(gaps) == ["asce7_delta_mt", "asce7_isolated", "ec8_ds"] and math.isnan(gaps["asce7_delta_mt"][0])
+    separation = gaps["asce7_isolated"][0]
+    displacement = (separation - 0.102502) / 1.15  # D_M at the lower bound, within the 1e-6 m of δ_M's digits
+    mu = 0.03
+    period = 2.0 * math.pi / math.sqrt(G / 2.24 + mu * G / displacement)  # eq. 17.5-2, k_M = W/R + μW/D
+    damping = 2.0 * mu / (math.pi * (mu + displacement / 2.24))
+    coefficient = 0.8 + (damping - 0.02) / (0.05 - 0.02) * (1.0 - 0.8)  # Table 17.5-1 between 2 % and 5 %
+    assert 0.02 < damping < 0.05
+    assert displacement == pytest.approx(G * 1.2 * period / (4.0 * math.pi**2 * coefficient), rel=1e-5)  # eq. 17.5-1's fixed point
+    # the same building studied or not: every building on a pendulum is designed by chapter 17
+    assert design_separations(_scene({"mass": 5.0e4, "mu": 0.05, "radius": 2.24}), DESIGN, studied="B2")["asce7_isolated"][0] == separation
+
+
+_ASCE7 = "sds = 1.0\nsd1 = 0.6\nr = 8.0\ncd = 5.5\nomega0 = 3.0"
 
 
 @pytest.mark.parametrize(("table", "message"), [
@@ -91,12 +100,35 @@ def test_eq_17_5_1_gives_the_pendulum_displacement_at_every_contact():
     ("sds = 1.0\nsd1 = 0.6\nr = 8.0\ncd = 5.5\nomega0 = 3.0\nq = 4.0", "design.q: unknown field"),
     ('sds = 1.0\nsd1 = 0.6\nr = 8.0\ncd = 5.5\nomega0 = 3.0\nec8 = { ag = 0.3, ground = "F", q = 4.0 }', "design.ec8.ground: must be one of A, B, C, D, E"),
     ("sds = -1.0\nsd1 = 0.6\nr = 8.0\ncd = 5.5\nomega0 = 3.0", "design.sds: must be > 0"),
+    (f"{_ASCE7}\n[design.isolation]\nplan = [20.0, 10.0]", "design.isolation.plan: must be [b, d], the shortest and longest plan dimensions"),
+    (f"{_ASCE7}\n[design.isolation]\neccentricity = 1.0", "design.isolation.eccentricity: needs plan = [b, d] (m) beside it"),
+    (f"{_ASCE7}\n[design.isolation]\nsa_short = 1.8", "design.isolation.sa_long: give sa_short and sa_long together"),
+    (f"{_ASCE7}\n[design.isolation]\nlambda_max = 0.5", "design.isolation.lambda_max: must be >= 1"),
+    (f"{_ASCE7}\n[design.isolation]\nmoat = 0.6", "design.isolation.moat: unknown field"),
 ])
 def test_design_errors_are_one_line_naming_the_field_and_range(table, message):
     text = risk_text(FIXED, "gap = [inf]", 'measure = "psa"\nperiod = 1.0\nlevels = [0.3, 0.8]') + f"\n[design]\n{table}\n"
     with pytest.raises(ExperimentError) as error:
         parse_experiment(tomllib.loads(text), base_dir=REPOSITORY)
     assert message in str(error.value) and "\n" not in str(error.value)
+
+
+def test_design_isolation_reads_the_site_s_own_sa_0_2_and_sa_1_at_2_percent_in_50_years():
+    """Issue 45: S_MS and S_M1 from the site's SA(0.2 s) and SA(1 s), not PGA / 0.4: the bundled site's curves at the rate of
+    2 % in 50 yr, their source recorded; given values are kept as given (and then no source)."""
+    from stochpound.risk import HazardCurve, rate_from_probability
+
+    text = risk_text(FIXED, "gap = [inf]", 'measure = "psa"\nperiod = 1.0\nlevels = [0.3, 0.8]') + f"\n[design]\n{_ASCE7}\n[design.isolation]\n"
+    isolation = parse_experiment(tomllib.loads(text), base_dir=REPOSITORY)["design"]["isolation"]
+    rate = -math.log(1.0 - 0.02) / 50.0
+    assert rate_from_probability(0.02, 50.0) == pytest.approx(rate, rel=1e-12)
+    assert isolation["sa_short"] == pytest.approx(float(HazardCurve.bundled("fox_plaza_los_angeles_sa0p2s").intensity_at(rate)), rel=1e-12)
+    assert isolation["sa_long"] == pytest.approx(float(HazardCurve.bundled("fox_plaza_los_angeles_sa1p0s").intensity_at(rate)), rel=1e-12)
+    assert round(isolation["sa_short"], 2) == 1.82 and round(isolation["sa_long"], 2) == 1.20  # the issue's 1.82 g; PGA / 0.4 is 1.99 g
+    assert "fox_plaza_los_angeles_sa0p2s" in isolation["spectrum_source"] and "2 %/50 yr" in isolation["spectrum_source"]
+    given = parse_experiment(tomllib.loads(text + "sa_short = 1.5\nsa_long = 0.6\nplan = [10.0, 30.0]\n"), base_dir=REPOSITORY)["design"]["isolation"]
+    assert given == {"sa_short": 1.5, "sa_long": 0.6, "plan": [10.0, 30.0]}
+    assert Design.from_entry(parse_experiment(tomllib.loads(text), base_dir=REPOSITORY)["design"]).isolation.sa_long == isolation["sa_long"]
 
 
 def test_the_design_is_not_part_of_the_runs_identity():
@@ -151,6 +183,7 @@ def test_stochpound_risk_prints_the_codes_gaps_beside_the_suite_mean_rules(desig
     period = float(risk.design_rules["return_period"].sel(rule="asce7_delta_mt"))
     assert f"ASCE 7 §12.12.3 δ_MT of the design analysis, pounding once in {period:.3g} years" in result.output.replace("\n", " ")
     assert "note: D_TM is not applied: the studied building's base slides in no run of this store (a fixed base" in result.output  # why no D_TM row
+    assert "Chapter 17 design" not in result.output and "ch. 17" not in result.output  # fixed bases: no chapter 17
 
 
 def test_stochpound_risk_takes_a_design_file_and_refuses_a_bad_one(design_store, tmp_path):
@@ -198,3 +231,10 @@ def test_the_flagship_s_d_m_in_the_docs_is_eq_17_5_1_s():
                   f"D_M = {displacement:.2f} m")
         assert stated in docs, stated
     assert "12–17 %" not in docs and "0.55–0.65 m" not in docs
+
+
+def test_a_base_beyond_a_slider_s_friction_gets_neither_code_row():
+    """μ = 0.5 on a pendulum is no slider chapter 17 designs (SlidingBase takes μ <= 0.3), nor a fixed base: no row at all,
+    not an error that stops the whole risk answer."""
+    gaps = design_separations(_scene({"mass": 5.0e4, "mu": 0.5, "radius": 2.24}), DESIGN, studied="B1")
+    assert "asce7_isolated" not in gaps and math.isnan(gaps["asce7_delta_mt"][0])

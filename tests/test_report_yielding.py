@@ -9,6 +9,8 @@ expected number is derived from the store or the scene here.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 
@@ -98,24 +100,52 @@ def test_store_damage_fractiles_and_runs_beyond_the_model(store):
     for level in store["intensity"].values:
         assert int(damage.beyond_model.sel(intensity=level)) == int((drift.sel(intensity=level) > MODEL_DRIFT_LIMIT).sum())
     assert int(damage.beyond_model.sum()) > 0  # these weak storeys go beyond the model at the upper stripes
-    assert damage.limit_states == DEFAULT_LIMIT_STATES
+    # each default limit state judged per building, with FEMA 356's objectives: IO 50 %, LS 10 % (and 1 % residual), CP 2 % in 50 yr
+    assert damage.limit_states == tuple(state.for_building(b) for state in DEFAULT_LIMIT_STATES for b in ("B1", "B2"))
+    assert [state.target for state in DEFAULT_LIMIT_STATES] == [0.5, 0.1, 0.1, 0.02]
     maf = damage.risk["maf"]
-    for probability in (0.1, 0.02):
-        rate = -np.log(1 - probability) / 50  # the target's rate: that of pounding at g*
-        np.testing.assert_array_equal(damage.before_pounding(probability).values, maf.values > rate)
+    target_rate = -np.log(1 - np.array([0.5, 0.5, 0.1, 0.1, 0.1, 0.1, 0.02, 0.02])) / 50  # λ_target of each, in the order above
+    ratio = maf.values / target_rate
+    np.testing.assert_allclose(damage.ratio().values, ratio, rtol=1e-12)
+    np.testing.assert_array_equal(damage.misses_objective().values, ratio > 1.0)
+    for probability in (0.1, 0.02):  # the same at every target: each limit state has its own objective
         governing = damage.governing(probability).item()
-        assert governing == str(maf["limit_state"].values[int(np.argmax(maf.values))])  # the most frequent: it exceeds the target's rate here
-        assert float(maf.max()) > rate
+        assert governing == (str(maf["limit_state"].values[int(np.argmax(ratio))]) if ratio.max() > 1.0 else "pounding at g*")
+    assert ratio.max() > 1.0  # these weak storeys miss an objective
+
+
+def test_governs_is_the_largest_ratio_to_the_objective_not_the_most_frequent_limit_state():
+    """Issue 45: 'immediate-occupancy drift governs everywhere' ranked rates of different events. Immediate occupancy is the
+    most frequent (0.01 /yr) but within its objective (50 % in 50 yr: 0.01386 /yr, ratio 0.72); collapse prevention is rarer
+    (0.001 /yr) but misses its own (2 % in 50 yr: 4.04e-4 /yr, ratio 2.47): it governs. Without objectives nothing governs."""
+    import xarray as xr
+
+    from stochpound.risk import LimitState, StoreDamage
+
+    states = (LimitState("drift_ratio", 0.007, "B1", 0.5), LimitState("drift_ratio", 0.05, "B1", 0.02))
+    risk = xr.Dataset({"maf": ("limit_state", [0.01, 0.001])},
+                      coords={"limit_state": [s.label for s in states], "target": ("limit_state", [0.5, 0.02])})
+    empty = xr.DataArray([0])
+    damage = StoreDamage(xr.Dataset(), empty, empty, {0.1: 1.0}, risk, states, "a test", True)
+    np.testing.assert_allclose(damage.ratio().values, [0.01 / (-np.log(0.5) / 50), 0.001 / (-np.log(0.98) / 50)], rtol=1e-12)
+    assert damage.governing(0.1).item() == states[1].label and damage.governing(0.02).item() == states[1].label
+    unjudged = StoreDamage(xr.Dataset(), empty, empty, {0.1: 1.0}, risk.assign_coords(target=("limit_state", [np.nan, np.nan])),
+                           (LimitState("drift_ratio", 0.007, "B1"), LimitState("drift_ratio", 0.05, "B1")), "a test", True)
+    assert unjudged.governing(0.1) is None and unjudged.governing_counts(0.1) is None
 
 
 def test_pounding_at_g_star_governs_where_no_limit_state_is_as_frequent(store):
-    """Capacities no run reaches: every λ is 0, below the target's rate, so pounding at g* governs."""
+    """Capacities no run reaches: every λ is 0, within its objective, so pounding at g* (ratio 1) governs; without an objective
+    the word goes."""
     from stochpound.risk import LimitState
-    damage = store_damage(store, [LimitState("ductility", 1.0e4)], "a test")
+    damage = store_damage(store, [LimitState("ductility", 1.0e4, target=0.02)], "a test")
     assert float(damage.risk["maf"].max()) == 0.0
     assert damage.governing(0.02).item() == "pounding at g*"
-    assert "Governing: for 10 % in 50 yr, pounding at g*; for 2 % in 50 yr, pounding at g*." in " ".join(
+    assert "Governing: pounding at g* (every limit state within its objective; the largest λ/λ_target is 0" in " ".join(
         _text(block) for block in damage_section("yfix", damage).blocks)
+    unjudged = store_damage(store, [LimitState("ductility", 1.0e4)], "a test")
+    text = " ".join(_text(block) for block in damage_section("yfix", unjudged).blocks)
+    assert unjudged.governing(0.02) is None and "none is said to govern" in text and "Governing:" not in text
 
 
 def test_the_damage_section_states_fractiles_flags_and_the_governing_limit_state(store):
@@ -130,13 +160,12 @@ def test_the_damage_section_states_fractiles_flags_and_the_governing_limit_state
     assert row["runs > model"] == f"{beyond} of {runs}"
     assert f"{beyond} of {runs} at stripe 1.2031" in texts and "are not credible" in texts
     assert "FEMA 356 (2000), Table C1-3, steel moment frames" in texts
-    maf = damage.risk["maf"]
-    for probability in (0.1, 0.02):
-        worst = damage.governing(probability).item()
-        others = [str(state) for state in maf["limit_state"].values
-                  if float(maf.sel(limit_state=state)) > -np.log(1 - probability) / 50 and state != worst]
-        expected = worst + (f" (also reached more often than pounding at g*: {', '.join(others)})" if others else "")
-        assert f"for {100 * probability:g} % in 50 yr, {expected}" in texts
+    ratio = damage.ratio()
+    worst = damage.governing(0.1).item()
+    others = [str(state) for state in ratio["limit_state"].values if float(ratio.sel(limit_state=state)) > 1.0 and state != worst]
+    expected = f"{worst} (λ/λ_target = {float(ratio.max()):.2g})" + (f"; also beyond their objectives: {', '.join(others)}" if others else "")
+    assert f"Governing: {expected}." in texts
+    assert "(objective: 50 % in 50 yr)" in texts and "(objective: 2 % in 50 yr)" in texts
 
 
 # ---------------------------------------------------------------- the [limit_states] table of an experiment file
@@ -159,10 +188,16 @@ def test_a_limit_states_table_is_not_part_of_the_identity_and_replaces_the_defau
     damage = store_damage(edited)
     assert damage.source == "a test"
     assert [state.label for state in damage.limit_states] == ["peak storey ductility of B1 ≥ 4", "peak storey ductility of B1 ≥ 8",
-                                                              "residual storey drift ratio ≥ 0.005"]
-    assert "Limit states (capacities from a test; one that names no building is reached when any building reaches it): " \
-           "peak storey ductility of B1 ≥ 4;" in " ".join(
+                                                              "residual storey drift ratio of B1 ≥ 0.005", "residual storey drift ratio of B2 ≥ 0.005"]
+    assert all(state.target is None for state in damage.limit_states)  # no targets given, and none of FEMA 356's capacities
+    assert "Limit states (capacities from a test; each building judged by its own demand): " \
+           "peak storey ductility of B1 ≥ 4 (no objective);" in " ".join(
         _text(block) for block in damage_section("yfix", damage).blocks)
+    # targets, shaped as the capacities, are carried in the definition and given to each state
+    targeted = parse_experiment(tomllib.loads(text + table + "targets = { ductility = { B1 = [0.5, 0.1] }, residual_drift_ratio = 0.1 }\n"))
+    assert targeted["limit_states"]["targets"] == {"ductility": {"B1": [0.5, 0.1]}, "residual_drift_ratio": [0.1]}
+    edited.attrs = {**store.attrs, "definition": json.dumps({**json.loads(store.attrs["definition"]), "limit_states": targeted["limit_states"]})}
+    assert [state.target for state in store_damage(edited).limit_states] == [0.5, 0.1, 0.1, 0.1]
 
 
 @pytest.mark.parametrize(
@@ -173,6 +208,9 @@ def test_a_limit_states_table_is_not_part_of_the_identity_and_replaces_the_defau
         ("impact_force = { B1 = 1.0e5 }", r"^limit_states\.impact_force\.B1: has no building \(an impact force is a contact's\), got 'B1'"),
         ("ductility = { B9 = 4.0 }", r"^limit_states\.ductility\.B9: unknown building \(buildings: B1, B2\)"),
         ('source = "x"', r"^limit_states: give at least one limit state"),
+        ("drift_ratio = [0.01, 0.02]\ntargets = { drift_ratio = [0.5, 1.5] }", r"^limit_states\.targets\.drift_ratio\[1\]: a target must be a probability in 50 years in \(0, 1\), got 1\.5"),
+        ("drift_ratio = [0.01, 0.02]\ntargets = { drift_ratio = [0.5] }", r"^limit_states\.targets\.drift_ratio: give one target or 2 \(one per capacity\), got 1"),
+        ("drift_ratio = 0.01\ntargets = { drift = 0.5 }", r"^limit_states\.targets\.drift: unknown field"),
     ],
 )
 def test_bad_limit_states_tables_are_named(table, message):
@@ -193,11 +231,16 @@ def test_the_damage_section_says_which_runs_and_stripes_and_lists_every_limit_st
             and "(10 % in 50 yr: stripe 0.7399; 2 % in 50 yr: stripe 1.2031)" in texts)
     table = next(block for block in section.blocks if getattr(block, "key", "") == "table-limit-states-yfix").frame
     maf = damage.risk["maf"]
-    assert len(table) == maf.sizes["limit_state"] == len(DEFAULT_LIMIT_STATES)
+    assert len(table) == maf.sizes["limit_state"] == 2 * len(DEFAULT_LIMIT_STATES)  # one per building
     for state in maf["limit_state"].values:
         rate = float(maf.sel(limit_state=state))
         assert table.loc[("–", str(state)), "λ (1/yr)"] == f"{rate:.3g}"
         assert table.loc[("–", str(state)), "once in (yr)"] == f"{1.0 / rate:.3g}"
+        target = float(maf["target"].sel(limit_state=state))  # its objective and λ/λ_target, and the fit's kind (issue 45: λ without its fit)
+        assert table.loc[("–", str(state)), "objective"] == f"{100 * target:g} % in 50 yr"
+        assert table.loc[("–", str(state)), "λ/λ_target"] == f"{rate / (-math.log(1 - target) / 50):.3g}"
+        assert table.loc[("–", str(state)), "fit"] in ("lognormal", "step: always", "step: never", "step: separated",
+                                                       "flat: decreasing (F ≡ fraction of runs that pounded)")
 
 
 def test_no_run_beyond_the_model_is_said_so(store):
@@ -238,11 +281,15 @@ def test_the_design_summary_names_the_limit_state_the_damage_section_finds_gover
         structural = [g for g in governing if g != "pounding at g*"]
         assert structural, "the weak storeys of this store reach a drift limit more often than the target's rate"
         assert f"{structural[0]} in {governing.count(structural[0])} of {len(governing)} configurations" in text
-        assert "reached more often than pounding at g*" in text
-    unreached = store_damage(store, [LimitState("ductility", 1.0e4)], "a test")
-    for damage in (unreached, None):
+        assert "a limit state beyond its own objective, the largest λ/λ_target" in text
+    unreached = store_damage(store, [LimitState("ductility", 1.0e4, target=0.1)], "a test")
+    text = design_summary_text(risk, None, unreached)
+    assert "Governing limit state (the largest λ/λ_target of the limit states, each against its own objective; pounding at g* has 1): " \
+           "pounding between the buildings for 10 % in 50 yr" in text and "own objective, the largest" not in text
+    for damage in (store_damage(store, [LimitState("ductility", 1.0e4)], "a test"), None):  # no objective: nothing ranked
         text = design_summary_text(risk, None, damage)
-        assert "Governing limit state: pounding between the buildings for 10 % in 50 yr" in text and "own limit state" not in text
+        assert "Limit state judged (no structural limit state with an objective, so none is ranked against it): pounding between" in text
+        assert "Governing" not in text
 
 
 def test_the_design_summary_says_how_many_runs_are_beyond_the_model(store):
@@ -293,3 +340,82 @@ def test_the_damage_of_elastic_buildings_has_no_nan_and_no_warning(store):
     median = float(store_damage(store).demands["peak_ductility"].sel(intensity=1.2031, building="B1", quantile=0.5))
     assert table.loc[("–", "1.2031 (2 %/50 yr)", "B1"), "peak storey ductility, median"] == f"{median:.3g}"
     assert not any("nan" in cell.lower() for cell in _cells(section))
+
+
+# ---------------------------------------------------------------- collapse as PBEE treats it (issue 45 item 3)
+
+
+def test_collapses_are_counted_apart_and_combined_by_total_probability(store):
+    """The runs past the model's 5 % drift are collapses: counted by hand, P(C | IM) fitted on them, and
+    λ_P(g) = ∫ [P_C + (1 − P_C) P(P | no C)] |dλ|. Checks with closed forms: no collapse at all (a limit no run passes) gives the
+    chain's own g* (an independent integrator: trapezoids against Gauss–Legendre); at a gap no credible run reaches,
+    P(P | no C) ≡ 0 and λ_P is λ_C."""
+    from stochpound.risk import collapse_risk, mean_annual_frequency, store_risk, stripe_fragility
+
+    risk = store_risk(store, bootstrap=0)
+    gaps, targets = risk.fragility["gap"].values, risk.separation["target"].values
+    collapse = collapse_risk(store, risk.hazard, gaps, targets)
+    drift = contact_free(store)["peak_drift_ratio"].max("building").isel(realization=0, drop=True)
+    hand = (drift > MODEL_DRIFT_LIMIT).astype(float).where(drift.notnull())
+    assert collapse.collapsed == int(hand.sum()) > 0 and collapse.runs == int(drift.notnull().sum())
+    np.testing.assert_array_equal(collapse.collapse["exceeded"].values.ravel(), hand.sum("record").values.ravel())
+    fit = stripe_fragility(hand, bootstrap=0)
+    assert float(collapse.collapse["maf"]) == pytest.approx(float(mean_annual_frequency(fit, risk.hazard)), rel=1e-12)
+    # no collapse: the chain's g*, to the integrators' difference
+    none = collapse_risk(store, risk.hazard, gaps, targets, limit=1.0e9)
+    assert none.collapsed == 0
+    np.testing.assert_allclose(none.separation["separation"].values, risk.separation["separation"].values, rtol=2e-3)
+    # the widest gap: no credible run reaches it, so only collapses pound there
+    closure = contact_free(store)["peak_contact_closure"].max("contact").isel(realization=0, drop=True)
+    assert float(closure.where(hand == 0.0).max()) < gaps[-1]
+    assert float(collapse.maf.isel(gap=-1)) == pytest.approx(float(collapse.collapse["maf"]), rel=2e-3)
+    # the answer both ways: collapse alone is more frequent than either target here, so no gap meets them
+    assert float(collapse.collapse["maf"]) > -np.log(1 - 0.1) / 50
+    frame = collapse.both_ways(risk.separation)
+    assert list(frame["g* collapses apart (m)"]) == [np.inf, np.inf]
+    np.testing.assert_allclose(frame["g* as run (m)"].values, risk.separation["separation"].values.ravel(), rtol=1e-12)
+    assert list(frame["runs beyond the model"]) == [f"{collapse.collapsed} of {collapse.runs}"] * 2
+    assert "there the structure, not the gap, governs" in collapse.text()
+
+
+def test_stochpound_risk_and_the_report_give_g_star_both_ways(store, tmp_path):
+    from click.testing import CliRunner
+
+    from stochpound.cli import main
+    from stochpound.report.sections._risk import risk_section
+    from stochpound.risk import collapse_risk, store_damage, store_risk
+
+    path = tmp_path / "yfix.nc"
+    store.to_netcdf(path)
+    result = CliRunner().invoke(main, ["risk", str(path), "--bootstrap", "0"])
+    assert result.exit_code == 0, result.output
+    assert "Collapse as FEMA P-58 treats it:" in result.output and "g* both ways (m):" in result.output
+    risk = store_risk(store, bootstrap=0)
+    collapse = collapse_risk(store, risk.hazard, risk.fragility["gap"].values, risk.separation["target"].values)
+    section = risk_section("yfix", risk, None, store_damage(store), None, collapse)
+    assert any(getattr(block, "key", "") == "risk-collapse-yfix" for block in section.blocks)
+    summary = " ".join(_text(block) for block in section.blocks)
+    assert "g* with them counted apart as collapses (FEMA P-58, by total probability) is given beside it" in summary
+    assert "they enter g* and the limit states as computed" not in summary
+
+
+def test_the_sensitivity_table_recomputes_g_star_under_each_choice(store):
+    """Issue 45 item 4: the grid 4x finer (the chain refitted on it: its every 4th gap is the chain's own), the collapse
+    treatment, β_m folded into the fragility; a vanishing β_m gives g* back (a closed-form limit), and Δ is the change from g*."""
+    from stochpound.risk import collapse_risk, separation_sensitivity, sensitivity_text, store_risk
+
+    risk = store_risk(store, bootstrap=0)
+    gaps = risk.fragility["gap"].values
+    collapse = collapse_risk(store, risk.hazard, gaps, risk.separation["target"].values)
+    frame = separation_sensitivity(risk, store, collapse, dispersions=(1e-6, 0.3)).frame
+    fine = np.geomspace(gaps[0], gaps[-1], 4 * (gaps.size - 1) + 1)
+    np.testing.assert_allclose(fine[::4], gaps, rtol=1e-12)
+    refined = store_risk(store, risk.hazard, gaps=fine, bootstrap=0).separation["separation"].values.ravel()
+    np.testing.assert_allclose(frame["grid ×4 finer"].values, refined, rtol=1e-12)
+    np.testing.assert_allclose(frame["g* (m)"].values, risk.separation["separation"].values.ravel(), rtol=1e-12)
+    np.testing.assert_allclose(frame["β_m = 1e-06"].values, frame["g* (m)"].values, rtol=1e-4)
+    np.testing.assert_allclose(frame["grid ×4 finer: Δ (%)"].values, 100 * (refined / frame["g* (m)"].values - 1), rtol=1e-12)
+    assert list(frame["collapses apart"]) == [np.inf, np.inf]
+    text = sensitivity_text(frame)
+    assert "Not evaluated from this store (each needs other runs): the selection seed, the conditioning measure" in text
+    assert "bound the sampling of the motions only" in text

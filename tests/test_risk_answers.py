@@ -121,10 +121,11 @@ def test_the_wall_free_d_tm_is_compared_with_the_moat_and_the_wall_governs_a_tar
     assert "once in 918 [459, 1.84e+03] yr (worst configuration), less often than the target allows (once in 475 yr): the wall does not govern" in text
     assert "once in 918 [459, 1.84e+03] yr (worst configuration), more often than the target allows (once in 2.47e+03 yr): the wall, not the gap, governs" in text
     summary = design_summary_text(_risk(), StoreDemands({}, {}, moat))
-    assert ("Governing limit state: pounding between the buildings for 10 % in 50 yr; the moat wall (0.6 m clearance, reached once in "
+    assert ("Governing limit state (the moat wall against the target's rate, where pounding at g* has 1; no structural limit state "
+            "ranked): pounding between the buildings for 10 % in 50 yr; the moat wall (0.6 m clearance, reached once in "
             "918 [459, 1.84e+03] yr) for 2 % in 50 yr.") in summary  # the return period with its interval
-    assert "Governing limit state: pounding between the buildings for 10 % in 50 yr; pounding between the buildings for 2 %" in \
-        design_summary_text(_risk(), None)
+    assert ("Limit state judged (no structural limit state with an objective, so none is ranked against it): pounding between the "
+            "buildings for 10 % in 50 yr; pounding between the buildings for 2 %") in design_summary_text(_risk(), None)
     single = StoreDemands({}, {}, moat.isel(mu=0, drop=True)).moat_frame()  # one configuration: a plain index
     assert single.index.name == "moat clearance (m)" and math.isclose(single["once in, upper (yr)"].iloc[0], 2 * 918)
     assert moat_text(_risk(rules), None) == "" and moat_text(_risk(rules.sel(rule=["abs"])), StoreDemands({}, {}, moat)) == ""
@@ -201,7 +202,7 @@ def test_d_tm_where_the_base_never_slides_is_left_out_and_said_why_not_a_dash():
     rules = rate_intervals(rules.assign(maf=maf, maf_lower=maf / 2, maf_upper=maf * 2, return_period=1 / maf, probability=1 - np.exp(-50 * maf)), 50.0)
     risk = _risk(rules)
     frame = risk.rules_frame()
-    dtm = frame.xs("D_TM of the suite-mean base displacement (ASCE 7 §17.2.5.2 form)", level="rule")
+    dtm = frame.xs("suite-mean peak base displacement (ASCE 7 D_M form: no torsion)", level="rule")
     assert list(dtm.index.get_level_values("mu")) == [0.05] and frame["λ_P (1/yr)"].notna().all()  # no row of dashes
     text = risk.dtm_text()
     assert "left out where the studied building's base never slid in any run (mu ∞)" in text and "fixed base (μ = ∞)" in text
@@ -247,7 +248,8 @@ def test_d_tm_of_a_moat_variant_is_its_wall_free_twins_and_is_compared_with_the_
     by_hand = float(slid.sel(intensity=stripe).mean())  # the suite mean of the wall-free runs at the rule's stripe
     np.testing.assert_allclose(dtm.sel(design_level=0.02, moat="wall").values, by_hand, rtol=1e-12)
     moat = moat_text(risk, store_demands(store, bootstrap=0))
-    assert "The wall-free D_TM (suite-mean peak base displacement without the wall) at 2 %/50 yr is" in moat and "moat clearance 0.1 m" in moat
+    assert "The wall-free suite-mean peak base displacement (the D_M form, no torsion) at 2 %/50 yr is" in moat and "moat clearance 0.1 m" in moat
+    assert "D_TM (suite-mean" not in moat  # issue 45: a planar run's base displacement is no D_TM
 
 
 def test_the_stripes_table_does_not_call_wall_hits_pounding(moat_variant_store):
@@ -276,7 +278,7 @@ def test_the_design_rows_say_why_there_is_no_eurocode_8_row():
     risk.design_rules = design(["asce7_delta_mt"])
     text = risk.design_rules_text()
     assert "here: ASCE 7 §12.12.3 δ_MT of the design analysis, pounding once in 500 years." in text
-    assert "(ASCE 7-16 §12.12.3: δ_M = C_d δ_max / I_e, SRSS of the two buildings), not from the runs" in text  # only the rules it has
+    assert "(ASCE 7-16 §12.12.3: δ_M = C_d δ_max / I_e, SRSS of the two buildings, for contacts of fixed-base buildings), not from the runs" in text  # only the rules it has
     assert "There is no Eurocode 8 §4.4.2.7 row: the store's [design] has no ec8 entry" in text and "give [design] an ec8 = { ag, ground, q }" in text
     risk.design_rules = design(["asce7_delta_mt", "ec8_ds"])
     assert "no Eurocode 8" not in risk.design_rules_text()

@@ -13,6 +13,7 @@
 
 from __future__ import annotations
 
+import math
 import os
 import re
 import signal
@@ -201,7 +202,8 @@ def test_cli_prints_separation_and_rules(isolated_store, tmp_path):
     headline = risk.to_frame()
     for value in headline["separation"]:
         assert f"{value:.3f}" in result.output
-    for text in ("10 % in 50 yr", "2 % in 50 yr", "SRSS of suite-mean peaks", "0.7 SRSS of suite-mean peaks", "DDC", "D_TM", "once in (yr)",
+    for text in ("10 % in 50 yr", "2 % in 50 yr", "SRSS of suite-mean peaks", "0.7 SRSS of suite-mean peaks", "DDC",
+                 "suite-mean peak base displacement (ASCE 7 D_M form: no torsion)", "once in (yr)",
                  "once in, lower (yr)", "once in, upper (yr)", "P lower", "P upper", "Design to"):
         assert text in result.output
     written = {path.name: path.read_text() for path in (tmp_path / "tables" / "risk").iterdir()}  # one table per file, in a folder it created
@@ -356,7 +358,7 @@ def test_report_section_states_the_separation_first(isolated_store):
     assert keys[:2] == ["risk-separation-risk", "risk-curve-risk"]
     assert {"risk-surface-risk", "risk-fragility-risk", "risk-rules-risk", "risk-demands-risk"} <= set(keys)
     rules = next(block for block in section.blocks if isinstance(block, Table) and block.key == "risk-rules-risk")
-    assert "D_TM of the suite-mean base displacement (ASCE 7 §17.2.5.2 form)" in rules.frame.index.get_level_values("rule")
+    assert "suite-mean peak base displacement (ASCE 7 D_M form: no torsion)" in rules.frame.index.get_level_values("rule")
     grid = {"design_level", "rule", *(d for d in store["case_status"].dims if d not in ("record", "realization", "intensity", "gap"))}
     assert set(rules.frame.index.names) <= grid, rules.frame.index.names  # the grid's axes, not what each point ran (base_mu, base_radius, ...)
     separation = next(block for block in section.blocks if isinstance(block, Table) and block.key == "risk-separation-risk")
@@ -364,7 +366,8 @@ def test_report_section_states_the_separation_first(isolated_store):
     assert stored_hazard(store).source.startswith("Site: Fox Plaza")
     assert risk.assumptions["structural model"].startswith("B1: 2-storey shear building, linear elastic storeys, on a sliding base; B2:")
     summary = section.blocks[1].text
-    assert summary.startswith("Design summary. Governing limit state: pounding between the buildings") and "scaled to every stripe" in summary
+    assert summary.startswith("Design summary. Limit state judged (no structural limit state with an objective, so none is ranked against it): "
+                              "pounding between the buildings") and "scaled to every stripe" in summary
 
 
 def test_the_report_gives_the_risk_answer_in_its_summary_and_no_repr_in_its_prose(isolated_store):
@@ -541,3 +544,44 @@ def test_a_hand_edited_store_is_refused_unless_accepted(fixed_stores, tmp_path):
     accepted = CliRunner().invoke(main, ["risk", str(edited), "--bootstrap", "0", "--accept-edited"])
     assert accepted.exit_code == 0, accepted.output
     assert "Risk-targeted separation g*" in accepted.output
+
+
+def test_a_sliding_building_s_code_row_is_chapter_17_s_separation_not_section_12_12_3(isolated_store, tmp_path):
+    """Issue 45 item 1: with a [design] whose [design.isolation] reads the site's SA(0.2 s), SA(1 s) (the bundled Fox Plaza
+    curves at 2 %/50 yr), the design-analysis row of B1 on its pendulum beside the fixed B2 is D_TM + B2's δ_M, named so; there
+    is no §12.12.3 row for the sliding base; the chapter 17 design (V_s, both friction bounds, the spectrum, the assumptions) is stated."""
+    from stochpound.codes import IsolatedPlan, MceSpectrum, SlidingBase, chapter17_design
+    from stochpound.experiment import parse_design
+    from stochpound.risk import (Asce7Design, asce7_inelastic_displacement, modal_floor_displacements, rate_from_probability,
+                                 read_risk_inputs)
+    from stochpound.store import TomlTable
+
+    design_file = tmp_path / "design.toml"
+    design_file.write_text(f'[hazard]\nbundled = "{BUNDLED}"\n[design]\nsds = 1.32925\nsd1 = 0.80204\nr = 8.0\ncd = 5.5\nomega0 = 3.0\n'
+                           '[design.isolation]\nplan = [12.0, 18.0]\n')
+    result = CliRunner().invoke(main, ["risk", str(isolated_store), "--bootstrap", "0", "--design", str(design_file)])
+    assert result.exit_code == 0, result.output
+    output = " ".join(result.output.split())
+    assert "ASCE 7 ch. 17 D_TM (eq. 17.5-3) + the neighbour's δ_M (eq. 12.12-1)" in output
+    assert "§12.12.3 δ_MT of the design analysis" not in output and "D_TM by eq. 17.5-1" not in output
+    # the site's spectrum, read off its own curves at 2 %/50 yr, and the maximum-direction factors stated
+    rate = rate_from_probability(0.02, 50.0)
+    short, long = (float(HazardCurve.bundled(f"fox_plaza_los_angeles_sa{p}s").intensity_at(rate)) for p in ("0p2", "1p0"))
+    assert f"S_MS = 1.1 × SA(0.2 s) = 1.1 × {short:.3g} g, S_M1 = 1.3 × SA(1 s) = 1.3 × {long:.3g} g" in output
+    assert "y = d/2 = 9 m assumed" in output and "λ_max = 1.8, λ_min = 0.6 assumed" in output and "square plan" not in output
+    # the gap, recomputed from chapter 17 and eq. 12.12-1 with every input written out
+    store = open_store(isolated_store)
+    scene = store.pound.scene(gap=math.inf, intensity=0.3, record=store["record"].values[0])
+    b1, b2 = scene.buildings
+    weight = scene.g * (sum(b1.mass) + b1.base.mass)
+    ch17 = chapter17_design(SlidingBase(b1.base.mu, b1.base.radius, weight, scene.g * sum(b1.mass)),
+                            MceSpectrum(1.1 * short, 1.3 * long, 8.0), IsolatedPlan(12.0, 18.0), 8.0)
+    asce7 = Asce7Design(1.32925, 0.80204, 8.0, 8.0, 5.5)
+    delta_m = asce7_inelastic_displacement(modal_floor_displacements(b2, design=asce7, g=scene.g), asce7)
+    expected = [ch17.total_displacement + delta_m[c.right_floor - 1] for c in scene.contacts]
+    design = parse_design(TomlTable(tomllib.loads(design_file.read_text())))
+    risk = store_risk(read_risk_inputs(store, design=design), bootstrap=0)
+    np.testing.assert_allclose(risk.design_rules["gap"].sel(rule="asce7_isolated").values, expected, rtol=1e-9)
+    assert np.isnan(risk.design_rules["gap"].sel(rule="asce7_delta_mt").values).all()
+    assert f"V_s = {ch17.design_shear / (scene.g * sum(b1.mass)):.3g} W_s" in output
+    assert "ASCE 7-16 §12.12.3: δ_M = C_d δ_max / I_e" not in output  # the formulas of the rows it has only

@@ -28,8 +28,8 @@ def _targets(value: str) -> tuple[float, ...]:
     return targets
 
 
-def _toml_table(path: Path, name: str, docs: str) -> dict:
-    """The TOML file's ``[name]`` table (its key ``name`` kept: ``{name: ...}``), or a one-line error."""
+def _toml_table(path: Path, name: str, docs: str, beside: tuple[str, ...] = ()) -> dict:
+    """The TOML file's ``[name]`` table (its key ``name`` kept: ``{name: ...}``) and the tables ``beside`` it has, or a one-line error."""
     import tomllib
 
     try:
@@ -38,7 +38,7 @@ def _toml_table(path: Path, name: str, docs: str) -> dict:
         raise click.ClickException(f"{path}: not TOML: {error}") from None
     if name not in table:
         raise click.ClickException(f"{path}: has no [{name}] table ({docs})")
-    return {name: table[name]}
+    return {key: table[key] for key in (name, *beside) if key in table}
 
 
 def _limit_states(path: Path) -> tuple:
@@ -49,11 +49,12 @@ def _limit_states(path: Path) -> tuple:
 
 
 def _design(path: Path) -> Design | None:
-    """The buildings' code design of a TOML file's ``[design]`` table (the experiment file's table, docs/experiments.md)."""
+    """The buildings' code design of a TOML file's ``[design]`` table (the experiment file's table, docs/experiments.md; its
+    ``[hazard]``, if any, gives a sliding building's chapter 17 spectrum)."""
     from stochpound.experiment import parse_design
     from stochpound.store import TomlTable
 
-    return parse_design(TomlTable(_toml_table(path, "design", "docs/experiments.md")))
+    return parse_design(TomlTable(_toml_table(path, "design", "docs/experiments.md", beside=("hazard",))))
 
 
 def _check_csv(csv_dir: Path, inputs: list[tuple[str | Path, str]]) -> None:
@@ -141,7 +142,7 @@ def risk(store: Path, hazard: str | None, hazard_measure: str | None, hazard_uni
     from stochpound.cli._measure_choice import efficient_measure_lines
     from stochpound.experiment import open_store
     from stochpound.motions import TARGET_TOLERANCE, TRUNCATION_EPSILON
-    from stochpound.risk import gap_cost_frame, limit_state_risk, read_risk_inputs, site_hazard, store_risk
+    from stochpound.risk import MODEL_DRIFT_LIMIT, collapse_risk, gap_cost_frame, limit_state_risk, read_risk_inputs, site_hazard, store_risk
 
     targets = _targets(target)
     site = None if ruptures is None else rupture_site_option(ruptures, "--ruptures")
@@ -158,6 +159,7 @@ def risk(store: Path, hazard: str | None, hazard_measure: str | None, hazard_uni
             inputs = read_risk_inputs(data, hz, design=None if design is None else _design(design), partial=partial)  # the chain's one read
             result = store_risk(inputs, targets=targets, years=years, bootstrap=bootstrap, seed=seed)
             costs = None if limit_states is None else gap_cost_frame(limit_state_risk(data, _limit_states(limit_states), hz), years)
+            collapse = None if result.method != "stripes" else collapse_risk(data, hz, result.fragility["gap"].values, targets, years)
             missed, beyond = inputs.selection_misses, inputs.beyond_truncation  # every read of the store before the first answer
             measure_lines = efficient_measure_lines(data, hazard)
             free = None if site is None else measure_free_answer(data, site, ruptures_runs, seed, targets, years, workers)
@@ -205,6 +207,12 @@ def risk(store: Path, hazard: str | None, hazard_measure: str | None, hazard_uni
     beyond = result.beyond_stripes_text()
     if beyond:
         click.echo(f"warning: {beyond}")
+    if collapse is not None and collapse.collapsed:
+        click.echo(f"\n{collapse.text(years)}\ng* both ways (m):")
+        click.echo(collapse.both_ways(result.separation, years).to_string(float_format=lambda v: f"{v:.4g}"))
+    elif collapse is not None:
+        click.echo(f"note: no contact-free run passes a {100 * MODEL_DRIFT_LIMIT:g} % storey drift: every run is within what the model "
+                   "represents, and g* needs no collapse treatment.")
     degenerate = result.degenerate_text()
     if degenerate:
         click.echo(f"note: {degenerate}")

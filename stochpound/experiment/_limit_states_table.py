@@ -5,7 +5,11 @@ Each key is a kind of limit state (``stochpound.store.LIMIT_STATE_DEMANDS``:
 ``floor_acceleration`` (g), ``impact_force`` (N), ``isolator_displacement``
 (m)); its value a capacity > 0 or a list of them (any building), or a table
 of building names to a capacity or a list. ``source`` (optional) says where
-the capacities come from. Without the table the report uses
+the capacities come from; ``targets`` (optional) each kind's performance
+objectives, probabilities in 50 years in (0, 1), shaped as its capacities
+(one for all, or a list of as many), for any building or by building;
+without them FEMA 356's drifts get ``stochpound.risk``'s default objectives
+and other capacities none. Without the table the report uses
 ``stochpound.risk.DEFAULT_LIMIT_STATES``.
 
 No run depends on it, so it is not part of the experiment's identity
@@ -14,6 +18,7 @@ No run depends on it, so it is not part of the experiment's identity
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Sequence
 from typing import Any
 
@@ -46,12 +51,13 @@ def parse_limit_states(file: TomlTable, buildings: Sequence[str]) -> LimitStates
     if table is None:
         return None
     source = table.string("source", None)
+    targets = table.table("targets", LIMIT_STATE_DEMANDS)
     states: list[LimitStateCapacities] = []
     for kind in table:
-        if kind == "source":
+        if kind in ("source", "targets"):
             continue
         if kind not in LIMIT_STATE_DEMANDS:
-            raise table.error(kind, f"not a limit state; one of {', '.join(LIMIT_STATE_DEMANDS)} (or source)")
+            raise table.error(kind, f"not a limit state; one of {', '.join(LIMIT_STATE_DEMANDS)} (or source, targets)")
         value = table.raw(kind)
         if not isinstance(value, dict):
             states.append(LimitStateCapacities(kind, _capacities(kind, value, table.field(kind))))
@@ -64,7 +70,25 @@ def parse_limit_states(file: TomlTable, buildings: Sequence[str]) -> LimitStates
                    for building in by_building]
     if not states:
         raise SceneError(f"limit_states: give at least one limit state ({', '.join(LIMIT_STATE_DEMANDS)})")
-    return LimitStates(source, tuple(states))
+    return LimitStates(source, tuple(dataclasses.replace(state, targets=_targets(targets, state)) for state in states))
+
+
+def _targets(targets: TomlTable | None, state: LimitStateCapacities) -> tuple[float, ...] | None:
+    """The objectives ``[limit_states] targets`` gives a state (one per capacity; None where it gives none), each in (0, 1)."""
+    if targets is None or state.kind not in targets:
+        return None
+    value, where = targets.raw(state.kind), targets.field(state.kind)
+    if isinstance(value, dict):
+        if state.building not in value:
+            return None
+        value, where = value[state.building], f"{where}.{state.building}"
+    values = value if isinstance(value, list) else [value] * len(state.capacities)
+    if len(values) != len(state.capacities):
+        raise SceneError(f"{where}: give one target or {len(state.capacities)} (one per capacity), got {len(values)}")
+    for i, target in enumerate(values):
+        if isinstance(target, bool) or not isinstance(target, (int, float)) or not 0.0 < target < 1.0:
+            raise SceneError(f"{where}{f'[{i}]' if isinstance(value, list) else ''}: a target must be a probability in 50 years in (0, 1), got {target!r}")
+    return tuple(float(t) for t in values)
 
 
 def _capacities(kind: str, value: Any, where: str, building: str | None = None) -> tuple[float, ...]:

@@ -38,7 +38,7 @@ from stochpound.report.sections import (
 )
 from stochpound.analysis import MEASURE_FREE_RUNS, RuptureSite, store_measure_free
 from stochpound.experiment import crude_check, is_rare_event_store, measure_choice, open_rare_event_store, rare_event_results
-from stochpound.risk import has_risk, store_damage, store_demands, store_risk
+from stochpound.risk import collapse_risk, has_risk, separation_sensitivity, store_damage, store_demands, store_risk
 from stochpound.store import check_finished, has_contact_free, has_wall_free, with_contacts, with_walls
 from stochpound._studies import claims, load_study
 
@@ -100,7 +100,10 @@ def assemble_report(paths: Sequence[str | Path], progress: Callable[[str], None]
             say(f"experiment {name}: risk")
             risks[name] = store_risk(store, partial=partial)
             damage = store_damage(store)
-            report.sections.append(risk_section(name, risks[name], store_demands(store), damage, measure_choice(store)))
+            collapse = None if risks[name].method != "stripes" else collapse_risk(
+                store, risks[name].hazard, risks[name].fragility["gap"].values, risks[name].separation["target"].values, risks[name].years)
+            sensitivity = None if risks[name].method != "stripes" else separation_sensitivity(risks[name], store, collapse)
+            report.sections.append(risk_section(name, risks[name], store_demands(store), damage, measure_choice(store), collapse, sensitivity))
             if ruptures is not None:
                 say(f"experiment {name}: without an intensity measure")
                 answer = store_measure_free(store, ruptures, runs=ruptures_runs)

@@ -29,7 +29,9 @@ ductility, floor acceleration, impact force, a bearing's stop) at every gap
 of a store's grid against its contact-free twins (:func:`gap_cost_frame`);
 :func:`store_damage` the ductility and residual drift demands of yielding
 buildings per stripe, the runs beyond the model and the governing limit
-state (:class:`StoreDamage`).
+state, each limit state against its own objective (:class:`StoreDamage`);
+:func:`collapse_risk` g* with the runs beyond the model counted apart as
+collapses, as FEMA P-58 does (:class:`CollapseRisk`).
 
 This package is the canonical home of these names; the ones that
 :mod:`stochpound.analysis` exported before it existed stay importable from
@@ -60,15 +62,19 @@ from stochpound.risk._code_gaps import (
     srss_separation,
 )
 from stochpound.risk._design_rules import DESIGN_RULE_LEVELS, design_rules_risk, design_separations
+from stochpound.risk._site_spectrum import site_mce
 from stochpound.risk._inputs import (RiskInputError, RiskInputs, contact_free_closure, has_risk, read_risk_inputs, selection_misses, site_hazard,
                                     stripes_beyond_truncation)
 from stochpound.risk._inputs import configuration_scene
 from stochpound.risk._inputs import stripe_motions  # noqa: F401  (for stochpound.experiment.measure_choice: not public API)
 from stochpound.risk._chain import StoreRisk, pounding_fragility, risk_gaps, store_risk
+from stochpound.risk._damage import POUNDING as POUNDING_AT_G_STAR  # noqa: F401  (for the report's sections: not public API)
 from stochpound.risk._demands import StoreDemands, store_demands
 from stochpound.risk._limit_states import KINDS as LIMIT_STATE_KINDS, LimitState, gap_cost_frame, limit_state_problem, limit_state_risk, limit_states_from_table
 from stochpound.risk._efficiency import measure_efficiency, most_efficient
 from stochpound.risk._efficiency import candidate_name  # noqa: F401  (for stochpound.experiment.measure_choice: not public API)
+from stochpound.risk._collapse import CollapseRisk, collapse_risk, collapsed_runs
+from stochpound.risk._sensitivity import MODELLING_DISPERSIONS, Sensitivity, separation_sensitivity, sensitivity_text
 from stochpound.risk._damage import DAMAGE_DEMANDS, DEFAULT_LIMIT_STATES, DEFAULT_SOURCE as DEFAULT_LIMIT_STATES_SOURCE, MODEL_DRIFT_LIMIT, StoreDamage, store_damage
 from stochpound.hazard import hazard_consistency, read_hazard_file, stripe_rate_weights
 from stochpound.risk._site_consistency import consistency_at_targets, site_consistency
@@ -119,6 +125,7 @@ __all__ = [
     "design_separations",
     "design_rules_risk",
     "DESIGN_RULE_LEVELS",
+    "site_mce",
     "contact_free_closure",
     "configuration_scene",
     "pounding_fragility",
@@ -141,6 +148,13 @@ __all__ = [
     "DEFAULT_LIMIT_STATES",
     "DEFAULT_LIMIT_STATES_SOURCE",
     "MODEL_DRIFT_LIMIT",
+    "CollapseRisk",
+    "collapse_risk",
+    "collapsed_runs",
+    "separation_sensitivity",
+    "sensitivity_text",
+    "Sensitivity",
+    "MODELLING_DISPERSIONS",
     "hazard_consistency",
     "consistency_at_targets",
     "site_consistency",

@@ -39,7 +39,7 @@ from stochpound.hazard import HazardCurve, rate_from_probability
 from stochpound.risk import _inputs
 from stochpound.risk._inputs import Intensity, RiskInputError, RiskInputs, read_risk_inputs
 from stochpound.risk._code_rules import MINIMUM_MOTIONS, code_rules_risk
-from stochpound.risk._design_rules import design_rules_risk
+from stochpound.risk._design_rules import DESIGN_RULE_NAMES, design_rules_risk, design_rules_text
 from stochpound.risk._fragility_ensemble import BOOTSTRAP, fragility_band, fragility_surface, homogeneous_capacities, ida_fragility, limit_state_events, stripe_fragility
 from stochpound.risk._fragility import DECREASING, EMPTY, FIT, STATUS
 from stochpound.risk._maf import TARGETS, degenerate_text, non_increasing, risk_curve, risk_targeted_separation
@@ -57,10 +57,8 @@ RULE_NAMES = {
     "srss_reduced": "0.7 SRSS of suite-mean peaks (Eurocode 8 form)",
     "ddc": "DDC",
     "ddc_cqc": "DDC (CQC ρ)",
-    "dtm": "D_TM of the suite-mean base displacement (ASCE 7 §17.2.5.2 form)",
-    "asce7_delta_mt": "ASCE 7 §12.12.3 δ_MT of the design analysis",
-    "ec8_ds": "Eurocode 8 §4.4.2.7 d_s of the design analysis",
-    "asce7_dtm": "ASCE 7 §17.2.5.2 D_TM by eq. 17.5-1",
+    "dtm": "suite-mean peak base displacement (ASCE 7 D_M form: no torsion)",
+    **DESIGN_RULE_NAMES,
 }
 """The code rules' names in the tables: each applied to the suite-mean peaks of the stripe at the design level
 (the codes apply them to the design analysis: named as suite-mean so they are not read as the codes' own gaps), and the codes'
@@ -328,31 +326,8 @@ class StoreRisk:
                 "isolator displacement to size (it stays 0), and its separation is the storeys' rules'.")
 
     def design_rules_text(self) -> str:
-        """The rules table's design-analysis rows in words: what they are, or why there are none."""
-        if self.design_rules is None:
-            return f"The codes' own gaps from the design analysis are not evaluated: {self.design_note}."
-        periods = []
-        for rule in self.design_rules["rule"].values:
-            period = self.design_rules["return_period"].sel(rule=rule)
-            period = period.where(self.design_rules["gap"].sel(rule=rule).notnull().all("contact"))  # where the rule applies
-            if bool(period.notnull().any()):
-                low, high = float(period.min()), float(period.max())
-                periods.append(f"{RULE_NAMES[str(rule)]}, pounding once in {low:.3g}" + (f" to {high:.3g}" if high != low else "") + " years")
-        formulas = {"asce7_delta_mt": "ASCE 7-16 §12.12.3: δ_M = C_d δ_max / I_e, SRSS of the two buildings",
-                    "ec8_ds": "Eurocode 8 §4.4.2.7: d_s = q d_e, SRSS, times 0.7 where the floors stand level",
-                    "asce7_dtm": "ASCE 7-16 §17.2.5.2 D_TM = D_M of eq. 17.5-1 for a friction pendulum"}
-        given = "; ".join(formulas[str(rule)] for rule in self.design_rules["rule"].values if str(rule) in formulas)
-        return ("The rows '(design analysis)' are the codes' own gaps, from the linear modal analysis of each building's fixed-base "
-                f"storeys under the design spectrum of the store's [design] ({given}), not from the runs; each with the mean annual "
-                f"frequency of pounding at that gap: here: {'; '.join(periods)}.{self._without_ec8_text()}")
-
-    def _without_ec8_text(self) -> str:
-        """Why the design-analysis rows have no Eurocode 8 row, when they have none ("" otherwise)."""
-        if self.design_rules is None or "ec8_ds" in self.design_rules["rule"].values:
-            return ""
-        return (" There is no Eurocode 8 §4.4.2.7 row: the store's [design] has no ec8 entry (a_g, ground type, q). Eurocode 8 is "
-                "the design code of a European site, not of this one unless a user designs to it; give [design] an ec8 = { ag, ground, q } (or "
-                "stochpound risk --design) to add its row.")
+        """The rules table's design-analysis rows in words: what they are, or why there are none (``stochpound.risk._design_rules``)."""
+        return design_rules_text(self.design_rules, self.design_note)
 
     def design_frame(self) -> pd.DataFrame:
         """The gap to design to: per configuration and target, the upper bound of g*'s interval (m; g* itself without one).

@@ -11,10 +11,13 @@ has them (the runs the separations come from), else over every run:
   ``MODEL_DRIFT_LIMIT``: the bilinear storeys never lose strength, so
   such a run's drifts are beyond what the model represents and are counted,
   not taken as credible;
-* the limit states' mean annual frequencies (:func:`~stochpound.risk.limit_state_risk`)
-  and, per configuration and target, the one that governs: the most frequent
-  of pounding at the risk-targeted separation g* (the target's rate) and the
-  structural limit states.
+* the limit states' mean annual frequencies (:func:`~stochpound.risk.limit_state_risk`),
+  each building's own (a limit state of any building is judged per building),
+  each against its performance objective λ_target (its ``target``, a
+  probability in 50 years), and per configuration the one that governs: the
+  largest ratio λ/λ_target among the structural limit states and pounding at
+  the risk-targeted separation g* (whose ratio is 1 by construction). Without
+  any objective nothing is said to govern.
 
 The limit states are the experiment's ``[limit_states]`` table (not part of
 its runs' identity: docs/risk.md), else ``DEFAULT_LIMIT_STATES``, the
@@ -31,28 +34,26 @@ import xarray as xr
 
 from stochpound.hazard import rate_from_probability, return_period
 from stochpound.risk import _inputs
-from stochpound.risk._limit_states import KINDS, LimitState, limit_state_risk, limit_states_of
+from stochpound.risk._limit_states import KINDS, OBJECTIVE_YEARS, LimitState, default_target, limit_state_risk, limit_states_of
 from stochpound.risk._maf import TARGETS
-from stochpound.risk._chain import YEARS
+from stochpound.risk._chain import YEARS, fit_name
+from stochpound.risk._collapse import MODEL_DRIFT_LIMIT
 
-MODEL_DRIFT_LIMIT = 0.05
-"""Peak storey drift ratio beyond which a run is flagged: the model has no strength loss or collapse (the collapse-prevention drift of ``DEFAULT_SOURCE``)."""
 QUANTILES = (0.5, 0.84)
 """The fractiles over each stripe's motions of ``StoreDamage.demands``."""
-DEFAULT_LIMIT_STATES = (
-    LimitState("drift_ratio", 0.007),
-    LimitState("drift_ratio", 0.025),
-    LimitState("residual_drift_ratio", 0.01),
-    LimitState("drift_ratio", 0.05),
-)
-"""The default limit states: peak storey drift ratios 0.7 %, 2.5 %, 5 % and a residual storey drift ratio of 1 % (``DEFAULT_SOURCE``)."""
+DEFAULT_LIMIT_STATES = tuple(LimitState(kind, capacity, target=default_target(kind, capacity)) for kind, capacity in (
+    ("drift_ratio", 0.007), ("drift_ratio", 0.025), ("residual_drift_ratio", 0.01), ("drift_ratio", 0.05)))
+"""The default limit states: peak storey drift ratios 0.7 %, 2.5 %, 5 % and a residual storey drift ratio of 1 % (``DEFAULT_SOURCE``),
+with the objectives of ``stochpound.risk._limit_states.DEFAULT_TARGETS`` (50 %, 10 %, 10 % and 2 % in 50 yr)."""
+PER_BUILDING = ("drift_ratio", "residual_drift_ratio")
+"""The kinds a limit state of any building is split into one per building for (each building judged by its own demand)."""
 DEFAULT_SOURCE = ("FEMA 356 (2000), Table C1-3, steel moment frames: immediate occupancy at 0.7 % transient storey drift, life safety at "
                   "2.5 % transient or 1 % permanent, collapse prevention at 5 % transient or permanent")
 """Where ``DEFAULT_LIMIT_STATES`` come from."""
 EXPERIMENT_SOURCE = "the experiment's [limit_states] table"
 """The source of limit states an experiment's ``[limit_states]`` gives without a ``source``."""
 POUNDING = "pounding at g*"
-"""What ``StoreDamage.governing`` names where no structural limit state is more frequent than pounding at g*."""
+"""What ``StoreDamage.governing`` names where every structural limit state is within its objective (λ/λ_target ≤ 1, pounding at g*'s ratio)."""
 #: The demands of ``StoreDamage.demands``: store summary -> its words.
 DAMAGE_DEMANDS = {"peak_ductility": "peak storey ductility", "residual_drift": "residual storey drift", "peak_drift_ratio": "peak storey drift ratio"}
 
@@ -116,9 +117,20 @@ class StoreDamage:
             return None
         return xr.apply_ufunc(return_period, self.risk["maf"])
 
+    def ratio(self) -> xr.DataArray | None:
+        """λ/λ_target of each limit state over ``risk``'s dimensions (NaN where it has no objective); None without ``risk``."""
+        if self.risk is None:
+            return None
+        target = self.risk["target"]
+        return self.risk["maf"] / xr.apply_ufunc(rate_from_probability, target.fillna(0.5), OBJECTIVE_YEARS).where(target.notnull())
+
+    def has_objectives(self) -> bool:
+        """Whether any limit state has a performance objective (without one, nothing is said to govern)."""
+        return self.risk is not None and bool(self.risk["target"].notnull().any())
+
     def governing_counts(self, probability: float) -> tuple[dict[str, int], int] | None:
-        """At the g* of ``probability`` in 50 yr: the configurations each structural limit state governs (:meth:`governing`), in
-        the order first met, and the number of configurations; None without ``risk``."""
+        """The configurations each structural limit state governs (:meth:`governing`), in the order first met, and the number of
+        configurations; None without ``risk`` or without any objective."""
         governing = self.governing(probability)
         if governing is None:
             return None
@@ -127,25 +139,38 @@ class StoreDamage:
         return {n: names.count(n) for n in names if n in structural}, len(names)
 
     def governing(self, probability: float) -> xr.DataArray | None:
-        """Per configuration, what is reached most often at the risk-targeted separation g* of ``probability`` in 50 yr.
+        """Per configuration, what governs at the risk-targeted separation g* of ``probability`` in 50 yr: the largest λ/λ_target.
 
-        Pounding at g* has the target's rate; the governing limit state is
-        the most frequent of the structural ones where its mean annual
-        frequency exceeds that rate (it is then reached before pounding at
-        g*), else ``POUNDING``. None without ``risk``.
+        Pounding at g* has the target's rate (ratio 1); a structural limit
+        state governs where its ratio is the largest and exceeds 1 (it misses
+        its objective), else ``POUNDING``. The answer is the same at every
+        target: each limit state has its own objective. None without
+        ``risk`` or without any objective (nothing is said to govern).
         """
-        before = self.before_pounding(probability)
-        if before is None:
+        if not self.has_objectives():
             return None
-        maf = self.risk["maf"].fillna(-1.0)
-        worst = maf["limit_state"][maf.argmax("limit_state")].drop_vars("limit_state", errors="ignore")
-        return worst.where(before.any("limit_state"), POUNDING)
+        ratio = self.ratio()
+        worst = ratio["limit_state"][ratio.fillna(-1.0).argmax("limit_state")].drop_vars("limit_state", errors="ignore")
+        return worst.where(self.misses_objective().any("limit_state"), POUNDING)
 
-    def before_pounding(self, probability: float) -> xr.DataArray | None:
-        """Per limit state and configuration, whether its λ exceeds the rate of ``probability`` in 50 yr: it is reached more often than pounding at g* (None without ``risk``)."""
+    def largest_ratio(self) -> tuple[xr.DataArray, xr.DataArray] | None:
+        """Per configuration, the largest λ/λ_target and the limit state that has it (None without ``risk``)."""
+        ratio = self.ratio()
+        if ratio is None:
+            return None
+        index = ratio.fillna(-1.0).argmax("limit_state")
+        return ratio.isel(limit_state=index), ratio["limit_state"][index].drop_vars("limit_state", errors="ignore")
+
+    def fits(self) -> xr.DataArray | None:
+        """Each limit state's fit in words (``lognormal``, ``step: never`` …) over ``risk``'s dimensions; None without ``risk``."""
         if self.risk is None:
             return None
-        return self.risk["maf"] > float(rate_from_probability(probability, YEARS))
+        return xr.apply_ufunc(np.vectorize(lambda status: fit_name(int(status)), otypes=[object]), self.risk["status"])
+
+    def misses_objective(self) -> xr.DataArray | None:
+        """Per limit state and configuration, whether λ exceeds its objective's rate (λ/λ_target > 1; False without an objective)."""
+        ratio = self.ratio()
+        return None if ratio is None else ratio > 1.0
 
 
 def store_damage(store: xr.Dataset, limit_states: Sequence[LimitState] | None = None, source: str | None = None) -> StoreDamage | None:
@@ -197,6 +222,9 @@ def store_damage(store: xr.Dataset, limit_states: Sequence[LimitState] | None = 
                       for p in TARGETS}
     held = tuple(state for state in limit_states  # the defaults the store can evaluate; every given one (an error where it cannot)
                  if given or _inputs.holds(store, KINDS[state.kind].variable))
+    buildings = [str(b) for b in ductility["building"].values]
+    held = tuple(one for state in held for one in ([state.for_building(b) for b in buildings]
+                                                   if state.building is None and state.kind in PER_BUILDING else [state]))
     risk = None
     if held:
         risk = limit_state_risk(store, held, hz)

@@ -28,12 +28,16 @@ from typing import Any
 import pandas as pd
 import xarray as xr
 
-from stochpound.hazard import HazardCurve, probability_from_rate
+from stochpound.hazard import HazardCurve, probability_from_rate, rate_from_probability
 from stochpound.risk import _inputs
 from stochpound.risk._inputs import LimitStates
 from stochpound.risk._fragility_ensemble import limit_state_events, stripe_fragility
 from stochpound.risk._maf import mean_annual_frequency
 from stochpound.risk._chain import CONFIDENCE, YEARS
+
+
+OBJECTIVE_YEARS = 50.0
+"""The exposure time of a limit state's target (yr)."""
 
 
 @dataclasses.dataclass(frozen=True)
@@ -88,16 +92,33 @@ class LimitState:
     building : str, optional
         The building whose demand counts; default any building (the
         largest over the buildings). Impact forces have no building.
+    target : float, optional
+        The performance objective: the probability in 50 years the limit
+        state may be exceeded with, in (0, 1) (e.g. immediate occupancy 0.5,
+        life safety 0.10, collapse prevention 0.02); None: no objective (its
+        λ is given, not judged).
     """
 
     kind: str
     capacity: float
     building: str | None = None
+    target: float | None = None
 
     def __post_init__(self) -> None:
         problem = limit_state_problem(self.kind, self.capacity, self.building)
+        if problem is None and self.target is not None and not (isinstance(self.target, float | int) and 0.0 < self.target < 1.0):
+            problem = f"a target must be a probability in 50 years in (0, 1), got {self.target!r}"
         if problem is not None:
             raise _inputs.RiskInputError(f"limit_states.{self.kind}: {problem}")
+
+    @property
+    def target_rate(self) -> float:
+        """λ_target (1/yr): the rate of the objective's probability in 50 years, −ln(1 − p)/50; NaN without an objective."""
+        return math.nan if self.target is None else float(rate_from_probability(self.target, OBJECTIVE_YEARS))
+
+    def for_building(self, building: str) -> LimitState:
+        """The same limit state for one building (a state of any building splits into one per building)."""
+        return dataclasses.replace(self, building=building)
 
     @property
     def label(self) -> str:
@@ -108,8 +129,28 @@ class LimitState:
 
 
 def limit_states_of(table: LimitStates) -> tuple[LimitState, ...]:
-    """The limit states of an experiment's ``[limit_states]`` table (:class:`~stochpound.store.LimitStates`), in its order."""
-    return tuple(LimitState(state.kind, capacity, state.building) for state in table.states for capacity in state.capacities)
+    """The limit states of an experiment's ``[limit_states]`` table (:class:`~stochpound.store.LimitStates`), in its order, each
+    with the target the table gives it, else :func:`default_target`'s."""
+    return tuple(LimitState(state.kind, capacity, state.building, _target_at(state.targets, index) or default_target(state.kind, capacity))
+                 for state in table.states for index, capacity in enumerate(state.capacities))
+
+
+def _target_at(targets: tuple[float, ...] | None, index: int) -> float | None:
+    """The ``index``-th target of a ``[limit_states]`` entry's targets (one per capacity), None without them."""
+    return None if targets is None else targets[index]
+
+
+def default_target(kind: str, capacity: float) -> float | None:
+    """The performance objective of a limit state at one of FEMA 356's steel moment frame capacities (``DEFAULT_TARGETS``), else None."""
+    return next((target for (k, c), target in DEFAULT_TARGETS.items() if k == kind and math.isclose(c, capacity)), None)
+
+
+DEFAULT_TARGETS = {("drift_ratio", 0.007): 0.50, ("drift_ratio", 0.025): 0.10, ("residual_drift_ratio", 0.01): 0.10, ("drift_ratio", 0.05): 0.02}
+"""The objectives given FEMA 356's steel moment frame drifts (Table C1-3) where no target is stated: immediate occupancy
+(0.7 % transient) at 50 % in 50 yr, life safety (2.5 % transient, 1 % permanent) at 10 % in 50 yr, collapse prevention (5 %) at
+2 % in 50 yr: the hazard levels FEMA 356 pairs them with in its objectives (its Basic Safety Objective: life safety at 10 %/50 yr,
+collapse prevention at 2 %/50 yr; immediate occupancy at 50 %/50 yr among its enhanced ones), read as the rates the limit state
+may be exceeded at (a risk-based reading of a hazard-level objective)."""
 
 
 def limit_states_from_table(table: Mapping[str, Any]) -> tuple[LimitState, ...]:
@@ -117,7 +158,8 @@ def limit_states_from_table(table: Mapping[str, Any]) -> tuple[LimitState, ...]:
 
     Each key is a kind of ``stochpound.risk.LIMIT_STATE_KINDS``; its value a capacity or a list of
     capacities (any building), or a table of building names to a capacity or
-    a list of them.
+    a list of them. ``targets`` (optional) gives a kind's objectives, probabilities in
+    50 years: one for all its capacities or a list, one per capacity; else :func:`default_target`.
 
     Raises
     ------
@@ -127,11 +169,17 @@ def limit_states_from_table(table: Mapping[str, Any]) -> tuple[LimitState, ...]:
     if not isinstance(table, Mapping) or not table:
         raise _inputs.RiskInputError(f"limit_states: must be a table of {', '.join(KINDS)} to capacities, got {table!r}")
     states = []
+    targets = table["targets"] if "targets" in table else {}
     for kind, value in table.items():
+        if kind == "targets":
+            continue
         per_building = value.items() if isinstance(value, Mapping) else [(None, value)]
+        given = targets[kind] if kind in targets else None
         for building, capacities in per_building:
-            for capacity in capacities if isinstance(capacities, (list, tuple)) else [capacities]:
-                states.append(LimitState(kind, capacity, building))
+            listed = capacities if isinstance(capacities, (list, tuple)) else [capacities]
+            for index, capacity in enumerate(listed):
+                target = given[index] if isinstance(given, (list, tuple)) and index < len(given) else given
+                states.append(LimitState(kind, capacity, building, target if target is not None else default_target(kind, capacity)))
     return tuple(states)
 
 
@@ -155,7 +203,7 @@ def limit_state_risk(store: xr.Dataset, limit_states: Sequence[LimitState], hz: 
     -------
     xarray.Dataset
         Over ``limit_state`` (coordinate: each one's label; ``kind``,
-        ``capacity`` and ``building`` beside it) and the store's other grid
+        ``capacity``, ``building`` and ``target``, its objective's probability in 50 yr or NaN, beside it) and the store's other grid
         dimensions (its gap axes, variants): the fragility (``theta``, IM
         units; ``beta``; ``status``; per stripe ``exceeded``, ``runs``,
         ``probability``) and ``maf`` (1/yr). With contact-free cases:
@@ -179,7 +227,8 @@ def limit_state_risk(store: xr.Dataset, limit_states: Sequence[LimitState], hz: 
         events = limit_state_events(demand, [state.capacity], dim="limit_state").assign_coords(limit_state=[state.label])
         fit = stripe_fragility(events, confidence=confidence, bootstrap=bootstrap, seed=seed)
         fits.append(fit.assign_coords(kind=("limit_state", [state.kind]), capacity=("limit_state", [float(state.capacity)]),
-                                      building=("limit_state", [state.building or ""])))
+                                      building=("limit_state", [state.building or ""]),
+                                      target=("limit_state", [math.nan if state.target is None else float(state.target)])))
     result = xr.concat(fits, "limit_state", coords="different", compat="equals", join="outer")
     result["maf"] = mean_annual_frequency(result, hz)
     twins = _inputs.contact_free_twins(result["maf"])

@@ -34,6 +34,7 @@ the model's rule (:mod:`stochpound.model.friction`).
 from __future__ import annotations
 
 import copy
+import dataclasses
 import hashlib
 import json
 import math
@@ -46,6 +47,7 @@ from stochpound.model.fields import TomlTable
 from stochpound.model.friction import is_fixed_base
 from stochpound.model.scene_tables import SceneOverrides, SceneTables
 from stochpound.motions import MEASURE_KINDS, Measure
+from stochpound.store._design_isolation import DesignIsolation
 from stochpound.store._stripe_selection import Selection
 
 _Record = TypeVar("_Record")
@@ -260,6 +262,8 @@ class Design:
         MCE_R spectral acceleration at 1 s, S_M1 (g), for a building on a friction pendulum; None: not given.
     ec8 : DesignEc8 or None
         Eurocode 8's design, if given.
+    isolation : DesignIsolation or None
+        ASCE 7-16 chapter 17's inputs for a building on a sliding base, if given.
     """
 
     sds: float
@@ -271,14 +275,17 @@ class Design:
     ie: float
     sm1: float | None = None
     ec8: DesignEc8 | None = None
+    isolation: DesignIsolation | None = None
 
     @classmethod
     def from_entry(cls, entry: Mapping[str, Any]) -> Design:
         """The typed design of a canonical ``design`` entry."""
         given = TomlTable(entry, "design")
         ec8 = given.raw("ec8")
+        isolation = given.raw("isolation")
         return cls(entry["sds"], entry["sd1"], entry["tl"], entry["r"], entry["cd"], entry["omega0"], entry["ie"], given.raw("sm1"),
-                   DesignEc8(ec8["ag"], ec8["ground"], ec8["q"]) if ec8 is not None else None)
+                   DesignEc8(ec8["ag"], ec8["ground"], ec8["q"]) if ec8 is not None else None,
+                   DesignIsolation.from_entry(isolation) if isolation is not None else None)
 
     def entry(self) -> dict[str, Any]:
         """The canonical ``design`` entry (as definitions store it)."""
@@ -287,6 +294,8 @@ class Design:
             written["sm1"] = self.sm1
         if self.ec8 is not None:
             written["ec8"] = {"ag": self.ec8.ag, "ground": self.ec8.ground, "q": self.ec8.q}
+        if self.isolation is not None:
+            written["isolation"] = self.isolation.entry()
         return written
 
 
@@ -302,11 +311,14 @@ class LimitStateCapacities:
         Its capacities, in the kind's units.
     building : str or None
         The building they apply to; None: any building.
+    targets : tuple of float or None
+        Each capacity's performance objective, a probability in 50 years; None: not given.
     """
 
     kind: str
     capacities: tuple[float, ...]
     building: str | None = None
+    targets: tuple[float, ...] | None = None
 
 
 @dataclass(frozen=True)
@@ -333,6 +345,9 @@ class LimitStates:
         for kind, value in entry["capacities"].items():
             per_building = value.items() if isinstance(value, Mapping) else [(None, value)]
             states += [LimitStateCapacities(kind, tuple(float(c) for c in capacities), building) for building, capacities in per_building]
+        if "targets" in entry:  # shaped as the capacities: per kind a list, or per building a list
+            targets = entry["targets"]
+            states = [dataclasses.replace(state, targets=_state_targets(targets, state)) for state in states]
         return cls(entry["source"], tuple(states))
 
     def entry(self) -> dict[str, Any]:
@@ -343,7 +358,24 @@ class LimitStates:
                 capacities[state.kind] = list(state.capacities)
             else:
                 capacities.setdefault(state.kind, {})[state.building] = list(state.capacities)
-        return {"source": self.source, "capacities": capacities}
+        written = {"source": self.source, "capacities": capacities}
+        targets: dict[str, list[float] | dict[str, list[float]]] = {}
+        for state in (state for state in self.states if state.targets is not None):
+            if state.building is None:
+                targets[state.kind] = list(state.targets)
+            else:
+                targets.setdefault(state.kind, {})[state.building] = list(state.targets)
+        if targets:
+            written["targets"] = targets
+        return written
+
+
+def _state_targets(targets: Mapping[str, list[float] | Mapping[str, list[float]]], state: LimitStateCapacities) -> tuple[float, ...] | None:
+    """A state's targets in a canonical ``limit_states`` entry's ``targets`` (shaped as its capacities), None where not given."""
+    given = targets[state.kind] if state.kind in targets else None
+    if isinstance(given, Mapping):
+        given = given[state.building] if state.building in given else None
+    return None if given is None else tuple(float(t) for t in given)
 
 
 @dataclass(frozen=True)

@@ -6,7 +6,7 @@ import pandas as pd
 
 from stochpound.report.render import Paragraph, Section, Table
 from stochpound.report.sections._description import number
-from stochpound.risk import DAMAGE_DEMANDS, MODEL_DRIFT_LIMIT, StoreDamage
+from stochpound.risk import DAMAGE_DEMANDS, MODEL_DRIFT_LIMIT, POUNDING_AT_G_STAR as POUNDING, StoreDamage
 
 
 def damage_section(name: str, damage: StoreDamage) -> Section:
@@ -92,39 +92,51 @@ def _beyond_model_text(damage: StoreDamage) -> str:
 
 
 def _governing_text(damage: StoreDamage) -> str:
-    parts = []
-    for probability in damage.design_stripes:
-        governing, before = damage.governing(probability), damage.before_pounding(probability)
-        grouped: dict[str, list[str]] = {}
-        for labels in _configurations(governing):
-            worst = str(governing.sel(labels).item())
-            others = [str(state) for state, flag in zip(before["limit_state"].values, before.sel(labels).values) if flag and state != worst]
-            text = worst + (f" (also reached more often than pounding at g*: {', '.join(others)})" if others else "")
-            grouped.setdefault(text, []).append(_label(labels))
-        every = len(_configurations(governing))
-        parts.append(f"for {_percent(probability)} in 50 yr, " + "; ".join(
-            (f"{' and '.join(names)}: " if len(names) < every else "") + text for text, names in grouped.items()))
-    states = "; ".join(state.label for state in damage.limit_states)
-    return (f"Limit states (capacities from {damage.source}; one that names no building is reached when any building reaches it): "
-            f"{states}. Each one's mean annual frequency λ comes from its fragility "
-            "over the stripes (a lognormal, or a step where the runs identify none) and the site's hazard, as for pounding (the table "
-            "below). Pounding at the risk-targeted separation g* happens at the target's rate; the governing limit state is the one "
-            "reached most often: a structural limit state where its λ exceeds that rate (the building is then damaged before the gap "
-            f"closes), else pounding at g*. Governing: {'; '.join(parts)}. A [limit_states] table in the experiment file replaces these "
-            "capacities (docs/risk.md).")
+    states = "; ".join(state.label + (f" (objective: {_percent(state.target)} in 50 yr)" if state.target is not None else " (no objective)")
+                       for state in damage.limit_states)
+    head = (f"Limit states (capacities from {damage.source}; each building judged by its own demand): {states}. Each one's mean annual "
+            "frequency λ comes from its fragility over the stripes (a lognormal, or a step where the runs identify none; the fit is "
+            "named in the table) and the site's hazard, as for pounding (the table below), and is set against its own performance "
+            "objective, λ_target = −ln(1 − p)/50 for its probability p in 50 yr.")
+    if not damage.has_objectives():
+        return (head + " No limit state has an objective, so none is said to govern: give [limit_states] targets (docs/risk.md). "
+                "A [limit_states] table in the experiment file replaces these capacities.")
+    governing, misses = damage.governing(float(next(iter(damage.design_stripes)))), damage.misses_objective()
+    largest, largest_state = damage.largest_ratio()
+    grouped: dict[str, list[str]] = {}
+    for labels in _configurations(governing):
+        worst = str(governing.sel(labels).item())
+        value = float(largest.sel(labels))
+        if worst == POUNDING:
+            text = f"{POUNDING} (every limit state within its objective; the largest λ/λ_target is {value:.2g}, {largest_state.sel(labels).item()})"
+        else:
+            others = [str(state) for state, flag in zip(misses["limit_state"].values, misses.sel(labels).values) if flag and state != worst]
+            text = f"{worst} (λ/λ_target = {value:.2g})" + (f"; also beyond their objectives: {', '.join(others)}" if others else "")
+        grouped.setdefault(text, []).append(_label(labels))
+    every = len(_configurations(governing))
+    governs = "; ".join((f"{' and '.join(names)}: " if len(names) < every else "") + text for text, names in grouped.items())
+    return (head + " What governs is the largest ratio λ/λ_target: pounding at the risk-targeted separation g* has ratio 1 at every "
+            "target (g* is where pounding is as frequent as the target allows), so a structural limit state governs where it misses its "
+            f"own objective (ratio above 1), at every target alike. Governing: {governs}. A [limit_states] table in the experiment file "
+            "replaces these capacities and objectives (targets; docs/risk.md).")
 
 
 def _limit_states_table(name: str, damage: StoreDamage) -> Table:
-    maf, periods = damage.risk["maf"], damage.return_period()
+    maf, periods, ratio, fits = damage.risk["maf"], damage.return_period(), damage.ratio(), damage.fits()
     rows = []
     for labels in _configurations(maf):
         for state in maf["limit_state"].values:
             rate = float(maf.sel(labels).sel(limit_state=state))
+            target = float(maf["target"].sel(limit_state=state))
             rows.append({"configuration": _label(labels), "limit state": str(state), "λ (1/yr)": f"{rate:.3g}",
-                         "once in (yr)": f"{float(periods.sel(labels).sel(limit_state=state)):.3g}"})
+                         "once in (yr)": f"{float(periods.sel(labels).sel(limit_state=state)):.3g}",
+                         "fit": str(fits.sel(labels).sel(limit_state=state).item()),
+                         "objective": f"{_percent(target)} in 50 yr" if target == target else "none",
+                         "λ/λ_target": f"{float(ratio.sel(labels).sel(limit_state=state)):.3g}" if target == target else ""})
     return Table(
         key=f"table-limit-states-{name}",
-        caption=f"Experiment {name}: the limit states' mean annual frequency λ and return period, per configuration",
+        caption=(f"Experiment {name}: the limit states' mean annual frequency λ, return period and fit, per configuration, against "
+                 "each one's objective (λ/λ_target above 1: the objective is missed)"),
         frame=pd.DataFrame(rows).set_index(["configuration", "limit state"]),
         note="λ of a limit state no run reaches is 0; one every run reaches at every stripe is set by the hazard table's lowest intensity.",
     )

@@ -38,7 +38,7 @@ from stochpound.analysis import CellLabels
 from stochpound.report.render import Block, FigureItem, Paragraph, Section, Table, figures
 from stochpound.report.sections._facets import labels_text
 from stochpound.report.sections._stripe_motions import is_selected
-from stochpound.risk import MODEL_DRIFT_LIMIT, StoreDamage, StoreDemands, StoreRisk
+from stochpound.risk import MODEL_DRIFT_LIMIT, CollapseRisk, Sensitivity, StoreDamage, StoreDemands, StoreRisk
 
 
 def hazard_provenance(store: xr.Dataset) -> str:
@@ -118,13 +118,26 @@ def summary_answer(name: str, risk: StoreRisk) -> list[Block]:
 
 
 def risk_section(name: str, risk: StoreRisk, demands: StoreDemands | None = None, damage: StoreDamage | None = None,
-                 choice: pd.DataFrame | None = None) -> Section:
+                 choice: pd.DataFrame | None = None, collapse: CollapseRisk | None = None, sensitivity: Sensitivity | None = None) -> Section:
     """The "Risk" section of one store, from its risk chain, its demand hazard curves (:func:`~stochpound.risk.store_demands`),
-    for yielding buildings the damage its runs did (:func:`~stochpound.risk.store_damage`) and which measure is the most
-    efficient (:func:`~stochpound.experiment.measure_choice`)."""
+    for yielding buildings the damage its runs did (:func:`~stochpound.risk.store_damage`), which measure is the most
+    efficient (:func:`~stochpound.experiment.measure_choice`) and g* with the runs beyond the model counted apart
+    (:func:`~stochpound.risk.collapse_risk`, shown where some run is beyond the model), and how far g* moves under the choices it
+    rests on (:func:`~stochpound.risk.separation_sensitivity`)."""
     section = Section(f"Risk: experiment {name}", key=f"risk-{name}")
     section.add(Paragraph(headline_text(name, risk)))
-    section.add(Paragraph(design_summary_text(risk, demands, damage)))
+    collapse = collapse if collapse is not None and collapse.collapsed else None
+    section.add(Paragraph(design_summary_text(risk, demands, damage, collapse)))
+    if collapse is not None:
+        section.add(Paragraph(collapse.text(risk.years)))
+        section.add(Table(f"risk-collapse-{name}", f"Experiment {name}: g* both ways, every run as computed and the runs beyond the "
+                          "model counted apart as collapses (FEMA P-58), with the collapse rate λ_C", collapse.both_ways(risk.separation, risk.years),
+                          formats={"g* as run (m)": "{:.3f}", "g* collapses apart (m)": "{:.3f}", "λ_C (1/yr)": "{:.3g}"}))
+    if sensitivity is not None:
+        section.add(Paragraph(sensitivity.text()))
+        section.add(Table(f"risk-sensitivity-{name}", f"Experiment {name}: g* under each choice it rests on that the store can vary, each "
+                          "alone (no bootstrap), with its change from g*", sensitivity.frame,
+                          formats={c: ("{:.1f}" if c.endswith("(%)") else "{:.3f}") for c in sensitivity.frame.columns}))
     section.add(Paragraph(_hazard_text(risk)))
     for block in _measure_choice_blocks(name, risk, choice):
         section.add(block)
@@ -150,7 +163,8 @@ def _separation_table(name: str, risk: StoreRisk) -> Table:
                  note=_grid_note(risk), formats={"g* (m)": "{:.3f}", "lower (m)": "{:.3f}", "upper (m)": "{:.3f}"})
 
 
-def design_summary_text(risk: StoreRisk, demands: StoreDemands | None = None, damage: StoreDamage | None = None) -> str:
+def design_summary_text(risk: StoreRisk, demands: StoreDemands | None = None, damage: StoreDamage | None = None,
+                        collapse: CollapseRisk | None = None) -> str:
     """The design summary: the governing limit state per target, the gap to design to, which code rules meet their level, and
     what the answer rests on (hazard, scenario, structural model, suite), all from the chain's results and the store."""
     wall = _wall_governs(risk, demands)
@@ -165,33 +179,43 @@ def design_summary_text(risk: StoreRisk, demands: StoreDemands | None = None, da
         meets = (f"Code rules meeting their own design level as a target in every configuration and level ({column.replace('meets, ', '') if 'upper' in column else 'estimate'}): "
                  f"{', '.join(met.index[met]) or 'none'}; not: {', '.join(met.index[~met]) or 'none'}.")
     rests = "; ".join(f"{key}: {value}" for key, value in {"hazard": f"{risk.hazard.describe()} ({_source(risk)})", **risk.assumptions,
-                                                          **_outside_stripes_assumption(risk), **_beyond_model(damage)}.items())
-    return (f"Design summary. Governing limit state: {governing}. {design_value_text(risk)} {meets} The answer holds only for what it "
+                                                          **_outside_stripes_assumption(risk), **_beyond_model(damage, collapse)}.items())
+    if damage is not None and damage.has_objectives():
+        judged = "Governing limit state (the largest λ/λ_target of the limit states, each against its own objective; pounding at g* has 1)"
+    elif wall:
+        judged = "Governing limit state (the moat wall against the target's rate, where pounding at g* has 1; no structural limit state ranked)"
+    else:
+        judged = "Limit state judged (no structural limit state with an objective, so none is ranked against it)"
+    return (f"Design summary. {judged}: {governing}. {design_value_text(risk)} {meets} The answer holds only for what it "
             f"rests on; a change to any of these voids it: {rests}.")
 
 
 def _structural_governs(damage: StoreDamage | None, target: float, separation: str) -> str:
     """What governs at ``target``: ``separation`` (what limits the gap), preceded by the buildings' own limit states where
-    :meth:`~stochpound.risk.StoreDamage.governing` names one (reached more often than pounding at g*), with their counts of
-    configurations; ``separation`` alone where pounding governs everywhere or without ``damage``."""
+    :meth:`~stochpound.risk.StoreDamage.governing` names one (beyond its objective: the largest λ/λ_target), with their counts of
+    configurations; ``separation`` alone where pounding governs everywhere, without ``damage`` or without objectives."""
     counted = damage.governing_counts(target) if damage is not None else None
     if counted is None or not counted[0]:
         return separation
     states, configurations = counted
     listed = ", ".join(f"{state} in {count} of {configurations} configurations" for state, count in states.items())
     rest = "of the separation" if sum(states.values()) == configurations else "in the other configurations"
-    return f"{listed} (the buildings' own limit state, reached more often than pounding at g*: the Damage section); {rest}, {separation}"
+    return (f"{listed} (a limit state beyond its own objective, the largest λ/λ_target, where pounding at g* has 1: the Damage "
+            f"section); {rest}, {separation}")
 
 
-def _beyond_model(damage: StoreDamage | None) -> dict[str, str]:
+def _beyond_model(damage: StoreDamage | None, collapse: CollapseRisk | None = None) -> dict[str, str]:
     """The assumption the runs beyond the model strain: {"beyond the model": "<n> of <N> runs ..."} where some run exceeds
-    ``MODEL_DRIFT_LIMIT`` ({} otherwise or without ``damage``)."""
+    ``MODEL_DRIFT_LIMIT`` ({} otherwise or without ``damage``), and how the answer counts them."""
     beyond, runs = damage.beyond_model_total() if damage is not None else (0, 0)
     if not beyond:
         return {}
+    counted = ("g* above and the limit states keep them as computed; g* with them counted apart as collapses (FEMA P-58, by total "
+               "probability) is given beside it, 'g* both ways'" if collapse is not None else
+               "they enter g* and the limit states as computed (the Damage section)")
     return {"beyond the model": f"{beyond} of {runs} runs exceed a "
                                 f"{100 * MODEL_DRIFT_LIMIT:g} % storey drift, where the storeys' lack of strength loss and collapse makes their "
-                                "response not credible; they enter g* and the limit states as computed (the Damage section)"}
+                                f"response not credible; {counted}"}
 
 
 def _source(risk: StoreRisk) -> str:
@@ -228,7 +252,9 @@ def design_value_text(risk: StoreRisk) -> str:
         return (f"There is no upper bound of g* to design to ({why}): the values are g* itself, a central estimate "
                 f"from {motions} that meets its target only about half the time: " + ". ".join(per) + ".")
     return (f"The gap to design to is the {risk.design_basis()}, not g* itself (g* is a central estimate from "
-            f"{motions} and meets its target only about half the time): " + ". ".join(per) + ".")
+            f"{motions} and meets its target only about half the time): " + ". ".join(per) + ". It bounds the sampling of the motions "
+            "only, not the choices the answer rests on (the grid, the collapse treatment, modelling dispersion, the measure, the "
+            "selection: the sensitivity table).")
 
 
 def _motions_text(risk: StoreRisk) -> str:
@@ -237,7 +263,7 @@ def _motions_text(risk: StoreRisk) -> str:
 
 
 def moat_text(risk: StoreRisk, demands: StoreDemands | None) -> str:
-    """Whether the wall-free D_TM exceeds the moat clearance at each design level, and whether reaching the wall is more
+    """Whether the wall-free suite-mean peak base displacement (the D_M form) exceeds the moat clearance at each design level, and whether reaching the wall is more
     frequent than each target allows (the wall then governs that target); "" without a moat or a D_TM rule."""
     largest_dtm = risk.largest_dtm()
     if demands is None or demands.moat is None or not largest_dtm:
@@ -249,11 +275,11 @@ def moat_text(risk: StoreRisk, demands: StoreDemands | None) -> str:
             continue
         exceeded = [c for c in clearances if value > c]
         verdict = (f"exceeds the moat clearance{'s' if len(exceeded) > 1 else ''} {', '.join(f'{c:.3g} m' for c in exceeded)}: "
-                   "at that level the base reaches the wall, so the code's D_TM is not met by the moat"
+                   "at that level the base reaches the wall, so the moat is short of even D_M (chapter 17's D_TM adds torsion)"
                    if exceeded else f"is within the moat clearance{'s' if len(clearances) > 1 else ''} "
                    f"{', '.join(f'{c:.3g} m' for c in clearances)}")
         largest = " (the largest over the configurations)" if varies else ""
-        sentences.append(f"The wall-free D_TM (suite-mean peak base displacement without the wall) at {100 * level:g} %/{risk.years:g} yr{largest} is "
+        sentences.append(f"The wall-free suite-mean peak base displacement (the D_M form, no torsion) at {100 * level:g} %/{risk.years:g} yr{largest} is "
                          f"{value:.3g} m and {verdict}.")
     for target, clearance, wall, allowed in demands.wall_rates(risk.separation["target"].values, risk.years):
         interval = _wall_interval(demands, clearance)

@@ -1,0 +1,175 @@
+"""Collapse as performance-based earthquake engineering treats it: runs beyond what the model represents counted apart.
+
+The storeys are bilinear without strength loss, so a run whose peak storey
+drift ratio passes ``MODEL_DRIFT_LIMIT`` (5 %, the collapse-prevention drift
+of steel moment frames) is beyond what the model represents: its closure is
+not credible. FEMA P-58 (2018, vol. 1) keeps such runs out of
+the demands and counts them as collapses: per stripe, the fraction of runs
+that collapse gives P(C | IM), fitted by a lognormal fragility over the
+stripes (:func:`~stochpound.risk.stripe_fragility`), and the demands come
+from the credible runs only. By total probability, with a collapse counted
+as reaching the gap (the separation is not met by a building that has lost
+its storeys),
+
+    P(P | IM, g) = P(C | IM) + (1 − P(C | IM)) P(P | IM, g, no C),
+
+P(P | IM, g, no C) the lognormal fit of the credible runs' pounding at gap g.
+Its mean annual frequency integrates it with the hazard as
+:func:`~stochpound.risk.mean_annual_frequency` integrates a lognormal:
+λ = P(lo) λ(lo) + ∫ λ(x) dP(x) over the hazard's range (trapezoids on
+``GRID_POINTS`` points in ln x; a hazard without ends from ``BEYOND`` e-folds
+below the lowest stripe to as many above the highest). g* is read off it as
+off the chain's curve (:func:`~stochpound.risk.risk_targeted_separation`).
+
+:func:`collapse_risk` gives it beside the chain's answer (every run taken as
+computed): the two answers, the collapse rate λ_C and the runs counted apart,
+so a report shows the answer both ways.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Sequence
+
+import numpy as np
+import pandas as pd
+import xarray as xr
+
+from stochpound.hazard import HazardCurve
+from stochpound.risk import _inputs
+from stochpound.risk._fragility import DECREASING, lognormal_cdf
+from stochpound.risk._fragility_ensemble import limit_state_events, stripe_fragility
+from stochpound.risk._maf import mean_annual_frequency, risk_targeted_separation
+
+MODEL_DRIFT_LIMIT = 0.05
+"""Peak storey drift ratio beyond which a run is beyond what the model represents: a collapse (no strength loss or collapse is modelled)."""
+GRID_POINTS = 2000
+"""Points in ln x of the integration over the hazard's range."""
+BEYOND = 8.0
+"""For a hazard without ends: e-folds of x integrated below the lowest stripe and above the highest."""
+
+
+@dataclasses.dataclass(frozen=True)
+class CollapseRisk:
+    """The risk-targeted separation with collapses counted apart (:func:`collapse_risk`).
+
+    Attributes
+    ----------
+    collapse : xarray.Dataset
+        The collapse fragility P(C | IM) per configuration (``theta``, ``beta``, ``status``, per stripe
+        ``exceeded``, ``runs``) and ``maf``, λ_C (1/yr).
+    separation : xarray.Dataset
+        g* per target and configuration by total probability (:func:`~stochpound.risk.risk_targeted_separation`).
+    maf : xarray.DataArray
+        λ_P(g) by total probability over ``gap`` and the configurations (1/yr).
+    collapsed, runs : int
+        The runs beyond the model and the runs, over every stripe and configuration.
+    """
+
+    collapse: xr.Dataset
+    separation: xr.Dataset
+    maf: xr.DataArray
+    collapsed: int
+    runs: int
+
+    def both_ways(self, as_run: xr.Dataset, years: float = 50.0) -> pd.DataFrame:
+        """g* both ways per configuration and target (m): ``as run`` (the chain's ``StoreRisk.separation``, every run as computed) and
+        ``collapses apart`` (this), beside each configuration's λ_C (1/yr) and its runs beyond the model."""
+        rows = xr.Dataset({"g* as run (m)": _dims_only(as_run["separation"]),
+                           "g* collapses apart (m)": _dims_only(self.separation["separation"])}).to_dataframe().reset_index()
+        rows["target"] = [f"{100 * p:g} % in {years:g} yr" for p in rows["target"]]
+        config = [name for name in rows.columns if name not in ("target", "g* as run (m)", "g* collapses apart (m)")]
+        counts = xr.Dataset({"λ_C (1/yr)": _dims_only(self.collapse["maf"]), "collapsed": _dims_only(self.collapse["exceeded"].sum("intensity")),
+                             "runs": _dims_only(self.collapse["runs"].sum("intensity"))})
+        extra = counts.to_dataframe().reset_index() if config else pd.DataFrame({name: [float(counts[name])] for name in counts.data_vars})
+        extra["runs beyond the model"] = [f"{int(k)} of {int(n)}" for k, n in zip(extra["collapsed"], extra["runs"])]
+        extra = extra.drop(columns=["collapsed", "runs"])
+        merged = rows.merge(extra, on=config) if config else rows.assign(**{name: extra[name].iloc[0] for name in extra.columns})
+        return merged.set_index([*config, "target"])
+
+    def text(self, years: float = 50.0) -> str:
+        """What the runs beyond the model are and how the answer counts them, in words."""
+        theta, beta = self.collapse["theta"], self.collapse["beta"]
+        fits = (f"θ = {float(theta.min()):.3g}" + (f"–{float(theta.max()):.3g}" if float(theta.max()) != float(theta.min()) else "")
+                + f", β = {float(beta.min()):.2g}" + (f"–{float(beta.max()):.2g}" if float(beta.max()) != float(beta.min()) else ""))
+        beyond = [f"{100 * float(p):g} % in {years:g} yr" for p in self.separation["target"].values
+                  if bool(np.isinf(self.separation["separation"].sel(target=p)).any())]
+        return (f"Collapse as FEMA P-58 treats it: {self.collapsed} of {self.runs} contact-free runs pass a {100 * MODEL_DRIFT_LIMIT:g} % "
+                "storey drift, beyond what the model represents (no strength loss or collapse is modelled); they are counted apart as "
+                f"collapses. P(C | IM) is a lognormal fitted over the stripes ({fits}; a step where the runs identify none), "
+                f"λ_C = {float(self.collapse['maf'].min()):.3g}" + (f"–{float(self.collapse['maf'].max()):.3g}"
+                if float(self.collapse["maf"].max()) != float(self.collapse["maf"].min()) else "") + " /yr; pounding is fitted on the "
+                "credible runs only and combined with it by total probability, P(P | IM) = P(C | IM) + (1 − P(C | IM)) P(P | IM, no C), a "
+                "collapse counted as reaching the gap. g* both ways: 'as run' keeps every run as computed; 'collapses apart' is the PBEE "
+                "answer" + (f"; it is inf (no gap meets the target) where collapse alone is more frequent than the target allows "
+                            f"({', '.join(beyond)}): there the structure, not the gap, governs" if beyond else "") + ".")
+
+
+def collapsed_runs(store: xr.Dataset, limit: float = MODEL_DRIFT_LIMIT) -> xr.DataArray | None:
+    """1 where a contact-free run's peak storey drift ratio (any building) exceeds ``limit``, 0 where not, NaN where it
+    did not run; None for a store without storey drift ratios."""
+    summaries, _ = _inputs.run_summaries(store, ["peak_drift_ratio"])
+    if "peak_drift_ratio" not in summaries:
+        return None
+    drift = summaries["peak_drift_ratio"].max("building")
+    return (drift > limit).astype(float).where(drift.notnull())
+
+
+def collapse_risk(store: xr.Dataset, hz: HazardCurve, gaps: Sequence[float] | np.ndarray, targets: Sequence[float],
+                  years: float = 50.0, limit: float = MODEL_DRIFT_LIMIT) -> CollapseRisk | None:
+    """g* of a stripes store with the runs beyond the model counted as collapses (module docstring); None without storey drifts.
+
+    Parameters
+    ----------
+    store : xarray.Dataset
+        An experiment store with intensity stripes and contact-free runs.
+    hz : HazardCurve
+        The site's hazard.
+    gaps : sequence of float
+        The gap grid (m), ascending (the chain's: ``StoreRisk.fragility["gap"]``).
+    targets : sequence of float
+        Probabilities of pounding in ``years``.
+    years : float
+        Their exposure time.
+    limit : float
+        The peak storey drift ratio beyond which a run counts as a collapse.
+    """
+    collapsed = collapsed_runs(store, limit)
+    if collapsed is None:
+        return None
+    closure = _inputs.contact_free_closure(store)
+    closure, collapsed = xr.align(closure, collapsed.drop_vars([c for c in collapsed.coords if c not in collapsed.dims]), join="inner")
+    credible = closure.where(collapsed == 0.0)
+    pounding = stripe_fragility(limit_state_events(credible, gaps, "gap"), bootstrap=0)
+    collapse = stripe_fragility(collapsed, bootstrap=0)
+    collapse["maf"] = mean_annual_frequency(collapse, hz)
+    maf = combined_rate(collapse, pounding, hz)
+    separation = risk_targeted_separation(xr.Dataset({"maf": maf}), targets, years)
+    return CollapseRisk(collapse, separation, maf, int(collapsed.sum()), int(collapsed.notnull().sum()))
+
+
+def combined_rate(collapse: xr.Dataset, pounding: xr.Dataset, hz: HazardCurve) -> xr.DataArray:
+    """λ (1/yr) of P(C | x) + (1 − P(C | x)) P(P | x, no C), the two stripe fits integrated with the hazard (module docstring)."""
+    levels = np.asarray(pounding["intensity"].values, dtype=float)
+    lo, hi = hz.support
+    start = np.log(lo) if lo > 0.0 else np.log(levels.min()) - BEYOND
+    stop = np.log(hi) if np.isfinite(hi) else np.log(levels.max()) + BEYOND
+    x = xr.DataArray(np.exp(np.linspace(start, stop, GRID_POINTS)), dims="im")
+    probability = _fitted(collapse, x) + (1.0 - _fitted(collapse, x)) * _fitted(pounding, x)
+    rate = xr.DataArray(np.exp(hz.log_rate(np.log(x.values))), dims="im")
+    middle = xr.DataArray(0.5 * (rate.values[1:] + rate.values[:-1]), dims="im")
+    steps = probability.diff("im", label="lower").drop_vars("im", errors="ignore") * middle
+    total = probability.isel(im=0, drop=True) * rate[0].item() + steps.sum("im")
+    return total.assign_attrs(units="1/yr", long_name="mean annual frequency of pounding, collapses counted apart")
+
+
+def _fitted(fit: xr.Dataset, x: xr.DataArray) -> xr.DataArray:
+    """F(x) of stripe fits: the lognormal (or step), and the pooled fraction Σk/Σn where the fit is ``decreasing`` (flat)."""
+    curve = xr.apply_ufunc(lognormal_cdf, x, fit["theta"], fit["beta"])
+    flat = fit["exceeded"].sum("intensity") / fit["runs"].sum("intensity")
+    return curve.where(fit["status"] != DECREASING, flat)
+
+
+def _dims_only(data: xr.DataArray) -> xr.DataArray:
+    """``data`` without its coordinates that are not dimensions."""
+    return data.drop_vars([name for name in data.coords if name not in data.dims])
