@@ -68,7 +68,7 @@ class StoreEnsemble:
         status = store["case_status"].sel(record=label)
         realizations = (status >= 0).any([d for d in status.dims if d != "realization"]).values
         self.data = store.sel(record=label).isel(realization=np.flatnonzero(realizations))
-        self.studied = str(store.attrs.get("studied_building", ""))
+        self.studied = store.pound.provenance.studied_building
         self.grid = {d: self.data[d].values.tolist() for d in status.dims if d not in ("record", "realization")}
 
     @property

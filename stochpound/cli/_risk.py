@@ -15,7 +15,7 @@ from stochpound.cli._site import measure_free_answer, measure_free_lines, ruptur
 from stochpound.cli._store_errors import store_variables
 from stochpound.analysis import MEASURE_FREE_RUNS
 from stochpound.risk import BOOTSTRAP, TARGETS
-from stochpound.store import Design
+from stochpound.store import Design, VariableAttributes
 
 
 def _targets(value: str) -> tuple[float, ...]:
@@ -181,7 +181,7 @@ def risk(store: Path, hazard: str | None, hazard_measure: str | None, hazard_uni
             click.echo(f"note: hazard {line.removeprefix('stochpound: ')}")
     if hz.extrapolated:
         click.echo(f"note: the hazard table [{hz.im[0]:g}, {hz.im[-1]:g}] {hz.units} was extrapolated beyond its intensities as power laws (--extrapolate)")
-    interval = f"95 % interval, {result.separation['lower'].attrs.get('method', 'BCa bootstrap')}" if "lower" in result.separation else (
+    interval = f"95 % interval, {VariableAttributes.of(result.separation['lower'], method='BCa bootstrap').method}" if "lower" in result.separation else (
         "no interval: not estimable" if result.no_interval else "no bootstrap")
     separation = result.separation_frame()
     click.echo(f"\nRisk-targeted separation g* (m; {interval}; inf: wider than every gap of the grid; ≥: a lower bound, the target "

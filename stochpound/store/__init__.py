@@ -72,6 +72,7 @@ from stochpound.store._gap_axes import (
     with_walls,
 )
 from stochpound.store._open import open_store
+from stochpound.store._provenance import Provenance, VariableAttributes
 from stochpound.store._scenario import SCENARIO_KINDS, scenario_kind, scenario_ranges
 from stochpound.store._selections import fixed_base, has_fixed_base_twins, isolated_mus, select_case
 
@@ -116,9 +117,11 @@ __all__ = [
     "Selection",
     "SimulatedMotions",
     "Point",
+    "Provenance",
     "Solver",
     "StoreAccessor",
     "StoreVariable",
+    "VariableAttributes",
     "VariantAxis",
     "canonical_json",
     "contact_free",

@@ -28,6 +28,7 @@ from stochpound.store._gap_axes import contact_free, contact_gap_dims, gap_dims,
 from stochpound.store._selections import fixed_base, has_fixed_base_twins
 from stochpound.store._definition import Definition, Hazard, Intensity, read_definition
 from stochpound.store._grid import ExperimentGrid, Label, StoredChoice
+from stochpound.store._provenance import Provenance
 
 __all__ = ["ACCESSOR", "StoreAccessor"]
 
@@ -83,9 +84,14 @@ class StoreAccessor:
         return _definition(self._text)
 
     @property
+    def provenance(self) -> Provenance:
+        """What wrote the store and how far its runs went (its provenance attributes, typed)."""
+        return Provenance.of(self._dataset)
+
+    @property
     def sha256(self) -> str:
         """The identity of the store's runs (its ``definition_sha256`` attribute)."""
-        return str(self._dataset.attrs.get("definition_sha256", ""))
+        return self.provenance.definition_sha256
 
     @property
     def intensity(self) -> Intensity | None:

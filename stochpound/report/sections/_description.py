@@ -361,7 +361,7 @@ def grid_paragraph(definition: StoreDefinition) -> Paragraph:
         f"{len(definition.definition.motions)} motion(s) (Table of motions); g = {number(scene.g)} m/s². The studied building is "
         f"{definition.experiment.studied}: the response whose moments are reported is its top-floor total displacement, and "
         f"it is also run alone on a fixed base under every motion ({references} reference runs). "
-        f"{int(store.attrs.get('cases_done', 0))} of {int(store.attrs.get('cases_total', 0))} runs done."
+        f"{store.pound.provenance.cases_done} of {store.pound.provenance.cases_total} runs done."
     )
 
 

@@ -148,12 +148,12 @@ def suites_paragraph(definitions: list[StoreDefinition]) -> Paragraph | None:
 
 def experiment_provenance(name: str, store: xr.Dataset) -> str:
     """One store: what it ran, how far, with what, and its identity."""
-    attrs = store.attrs
+    written = store.pound.provenance
     return (
-        f"Experiment {name} ({attrs.get('experiment_file', '')}): {attrs.get('experiment_description', '')}. "
-        f"{int(attrs.get('cases_done', 0))} of {int(attrs.get('cases_total', 0))} cases done, solver "
-        f"{attrs.get('solver', '')}, stochpound {attrs.get('stochpound_version', '')} (commit {attrs.get('git_commit', 'unknown')}), "
-        f"definition sha256 {str(attrs.get('definition_sha256', ''))[:16]}…"
+        f"Experiment {name} ({written.experiment_file}): {written.experiment_description}. "
+        f"{written.cases_done} of {written.cases_total} cases done, solver "
+        f"{written.solver}, stochpound {written.stochpound_version} (commit {written.git_commit}), "
+        f"definition sha256 {written.definition_sha256[:16]}…"
     )
 
 
