@@ -116,7 +116,7 @@ class WallPenetration:
         The runs with a wall.
     largest : float
         The largest penetration, m (NaN without a run).
-    at : dict
+    at : CellLabels
         The labels of its cell and realization (empty without a run).
     per_value : list of (value, float)
         The largest per value of the wall axis (m; empty without one).

@@ -72,6 +72,11 @@ class StoreEnsemble:
         self.grid = {d: self.data[d].values.tolist() for d in status.dims if d not in ("record", "realization")}
 
     @property
+    def mus(self) -> list[float]:
+        """The friction coefficients of the ensemble's ``mu`` axis (none without one; ∞: the fixed base)."""
+        return self.data["mu"].values.tolist() if "mu" in self.grid else []
+
+    @property
     def size(self) -> int:
         """Realizations per cell."""
         return self.data.sizes["realization"]

@@ -15,7 +15,7 @@ from stochpound.cli._site import measure_free_answer, measure_free_lines, ruptur
 from stochpound.cli._store_errors import store_variables
 from stochpound.analysis import MEASURE_FREE_RUNS
 from stochpound.risk import BOOTSTRAP, TARGETS
-from stochpound.store import Design, VariableAttributes
+from stochpound.store import Design, TomlTable, VariableAttributes
 
 
 def _targets(value: str) -> tuple[float, ...]:
@@ -28,8 +28,8 @@ def _targets(value: str) -> tuple[float, ...]:
     return targets
 
 
-def _toml_table(path: Path, name: str, docs: str) -> dict:
-    """The TOML file's ``[name]`` table (its key ``name`` kept: ``{name: ...}``), or a one-line error."""
+def _toml_table(path: Path, name: str, docs: str) -> TomlTable:
+    """The TOML file's ``[name]`` table (the file's top level with that table only), or a one-line error."""
     import tomllib
 
     try:
@@ -38,22 +38,21 @@ def _toml_table(path: Path, name: str, docs: str) -> dict:
         raise click.ClickException(f"{path}: not TOML: {error}") from None
     if name not in table:
         raise click.ClickException(f"{path}: has no [{name}] table ({docs})")
-    return {name: table[name]}
+    return TomlTable({name: table[name]})
 
 
 def _limit_states(path: Path) -> tuple:
     """The limit states of a TOML file's ``[limit_states]`` table (``stochpound.risk.limit_states_from_table``)."""
     from stochpound.risk import limit_states_from_table
 
-    return limit_states_from_table(_toml_table(path, "limit_states", "docs/risk.md")["limit_states"])
+    return limit_states_from_table(_toml_table(path, "limit_states", "docs/risk.md").raw("limit_states"))
 
 
 def _design(path: Path) -> Design | None:
     """The buildings' code design of a TOML file's ``[design]`` table (the experiment file's table, docs/experiments.md)."""
     from stochpound.experiment import parse_design
-    from stochpound.store import TomlTable
 
-    return parse_design(TomlTable(_toml_table(path, "design", "docs/experiments.md")))
+    return parse_design(_toml_table(path, "design", "docs/experiments.md"))
 
 
 def _check_csv(csv_dir: Path, inputs: list[tuple[str | Path, str]]) -> None:

@@ -35,7 +35,7 @@ import xarray as xr
 from stochpound.store import CASE_SUMMARIES, IMPACT_TABLE, REFERENCE_HISTORY, REFERENCE_SUMMARIES, SETS, STOREY_SUMMARIES, StoreVariable, TIME_HISTORIES, WALL_SUMMARIES, canonical_json
 from stochpound.experiment import _intensity as intensity
 from stochpound.experiment._experiment import Experiment
-from stochpound.store import CASE, REFERENCE, Dim
+from stochpound.store import CASE, REFERENCE, Dim, MotionTable, TomlTable
 from stochpound.experiment._summary import DEMAND_SUMMARIES
 from stochpound.model.scene_file import scene_from_dict
 from stochpound.motions.records import METADATA_FIELDS
@@ -242,7 +242,7 @@ def _coordinates(experiment: Experiment, motion_grids: Mapping[str, tuple[float,
     scene = experiment.definition.scene
     coords["building"] = xr.Variable(("building",), np.array(experiment.building_names, dtype=object), {"units": "1", "long_name": "building name, left to right"})
     coords["floor"] = xr.Variable(("floor",), np.arange(1, experiment.max_floors + 1), {"units": "1", "long_name": "floor number, 1 = lowest"})
-    coords["contact"] = xr.Variable(("contact",), np.arange(len(scene.get("contact", []))), {"units": "1", "long_name": "contact index"})
+    coords["contact"] = xr.Variable(("contact",), np.arange(len(TomlTable(scene, "scene").tables("contact"))), {"units": "1", "long_name": "contact index"})
     coords.update(_scene_coordinates(experiment))
     if experiment.output.time_histories:
         coords["time"] = xr.Variable(("time",), union_times(motion_grids), {"units": "s", "long_name": "time (union of the motions' sample times)"})
@@ -280,7 +280,7 @@ def _suite_coordinates(experiment: Experiment) -> dict[str, xr.Variable]:
 
     rows: list[Mapping[str, Any]] = []
     for source in experiment.motions.values():
-        record = str(source.motion.get("record", ""))
+        record = MotionTable.of_source(source).record or ""
         if is_suite_member(record):
             rows.append(load_suite_member(record).metadata)
         elif source.kind == "simulated":  # its own earthquake: no event (a cluster of its own), the scenario's magnitude, distance and Vs30

@@ -111,7 +111,7 @@ class StatedMeasure:
         """The stated keys (``measure``, ``period``, ``periods``, ``damping``, ``units``) of a mapping; other keys are ignored."""
         return cls(entry.get("measure"), entry.get("period"), tuple(entry.get("periods") or ()), entry.get("damping"), entry.get("units"))
 
-    def entry(self) -> dict[str, Any]:
+    def entry(self) -> dict[str, str | float | list[float]]:
         """The parts stated, by their keys in an experiment's ``[hazard]`` (``measure``, ``period``, ``periods``, ``damping``, ``units``)."""
         parts = {"measure": self.kind, "period": self.period, "periods": list(self.periods) or None, "damping": self.damping, "units": self.units}
         return {key: value for key, value in parts.items() if value is not None}

@@ -71,6 +71,7 @@ from stochpound.store._gap_axes import (
     with_contacts,
     with_walls,
 )
+from stochpound.store._motion_table import MotionTable
 from stochpound.store._open import open_store
 from stochpound.store._provenance import Provenance, VariableAttributes
 from stochpound.store._scenario import SCENARIO_KINDS, scenario_kind, scenario_ranges
@@ -111,6 +112,7 @@ __all__ = [
     "LimitStateCapacities",
     "LimitStates",
     "MotionSource",
+    "MotionTable",
     "MuAxis",
     "Output",
     "Site",

@@ -21,6 +21,7 @@ from stochpound.report.sections._description import StoreDefinition, buildings_t
 from stochpound.report.render import Paragraph, Section, Table
 from stochpound.report.sections._intensity import method_text
 from stochpound.report.sections._risk import hazard_provenance
+from stochpound.store import MotionTable
 
 #: Packages whose versions the report lists.
 PACKAGES = ("numpy", "scipy", "xarray", "numba", "dask", "pandas", "matplotlib", "h5netcdf", "jinja2")
@@ -131,7 +132,7 @@ def suites_paragraph(definitions: list[StoreDefinition]) -> Paragraph | None:
     used: dict[str, set[str]] = {}
     for definition in definitions:
         for motion in definition.definition.motions:
-            record = str(motion.motion.get("record", ""))
+            record = MotionTable.of_source(motion).record or ""
             suite = motion.suite or (record.partition("/")[0] if is_suite_member(record) else None)
             if suite:
                 used.setdefault(suite, set()).add(record)
