@@ -27,7 +27,7 @@ import itertools
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Iterator, Mapping
+from typing import Iterator, Mapping
 
 import numpy as np
 import xarray as xr
@@ -259,7 +259,7 @@ def _scene_coordinates(experiment: Experiment) -> dict[str, xr.Variable]:
     dims = tuple(d.name for d in experiment.kind_dims(CASE)[:-2])
     shape = experiment.grid_shape(CASE)[:-2]
     columns: dict[str, list[np.ndarray]] = {}
-    attrs: dict[str, tuple[tuple[str, ...], dict[str, Any]]] = {}
+    attrs: dict[str, tuple[tuple[str, ...], dict[str, str]]] = {}
     for point in points:
         scene = scene_from_dict(experiment.structure(point), base_dir=experiment.base_dir)
         for name, (variable_dims, values, variable_attrs) in scene_parameters(scene).items():
@@ -278,7 +278,7 @@ def _suite_coordinates(experiment: Experiment) -> dict[str, xr.Variable]:
     """Metadata of the motions from suites on ``record`` (event, station, component, magnitude, distance...; none without such motions)."""
     from stochpound.motions.records import is_suite_member, load_suite_member
 
-    rows: list[Mapping[str, Any]] = []
+    rows: list[Mapping[str, float | str]] = []
     for source in experiment.motions.values():
         record = MotionTable.of_source(source).record or ""
         if is_suite_member(record):

@@ -440,9 +440,9 @@ def _record_sources(table: TomlTable, base_dir: Path) -> list[MotionSource]:
     return sources
 
 
-def _suite_choice(table: TomlTable) -> dict[str, Any]:
+def _suite_choice(table: TomlTable) -> dict[str, list[str] | tuple[float, float]]:
     """The ``members``, ``event``, ``magnitude`` and ``distance`` choices of a suite entry (lists of names, closed ranges)."""
-    choice: dict[str, Any] = {}
+    choice: dict[str, list[str] | tuple[float, float]] = {}
     for key in ("members", "event"):
         if key in table:
             value = table.raw(key)

@@ -43,6 +43,7 @@ from stochpound._text_files import read_text_file
 from stochpound.hazard._curve import HazardCurve, rate_from_probability
 from stochpound.motions import Measure
 from stochpound.motions.records import normalize_units
+from stochpound.store import TomlTable
 
 FORMATS = ("stochpound", "openquake", "nshmp-haz")
 """The hazard-file formats :func:`read_hazard_file` reads."""
@@ -109,7 +110,9 @@ class StatedMeasure:
     @classmethod
     def from_entry(cls, entry: Mapping[str, Any]) -> StatedMeasure:
         """The stated keys (``measure``, ``period``, ``periods``, ``damping``, ``units``) of a mapping; other keys are ignored."""
-        return cls(entry.get("measure"), entry.get("period"), tuple(entry.get("periods") or ()), entry.get("damping"), entry.get("units"))
+        table = TomlTable(entry)
+        return cls(table.string("measure", None), table.number("period", None), table.numbers("periods", (), low=0.0, low_open=True), table.number("damping", None),
+                   table.string("units", None))
 
     def entry(self) -> dict[str, str | float | list[float]]:
         """The parts stated, by their keys in an experiment's ``[hazard]`` (``measure``, ``period``, ``periods``, ``damping``, ``units``)."""

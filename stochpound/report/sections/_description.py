@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import json
 import math
-from collections.abc import Iterable, Mapping
+from collections.abc import Hashable, Iterable, Mapping
 from typing import Any
 
 import numpy as np
@@ -28,7 +28,7 @@ from stochpound.report.sections._stripe_motions import stripe_motions_text
 from stochpound.motions.records import is_suite_member
 from stochpound.model.scene import Building, Contact, Scene
 from stochpound.model.wall import Wall
-from stochpound.store import MotionTable, TomlTable
+from stochpound.store import MotionSource, MotionTable, TomlTable
 
 
 def number(value: float, digits: int = 6) -> str:
@@ -256,10 +256,12 @@ def _merged_table(key: str, caption: str, columns: list[str], rows: Mapping[tupl
     return Table(key=key, caption=caption, frame=frame, note=note)
 
 
-def _synthetic_parameters(table: Mapping[str, Any], start: int) -> tuple[str, dict[str, Any]]:
-    """The generator's parameters as run, with the intensity S0 and σ it implies (one realization is generated)."""
+def _synthetic_parameters(source: MotionSource) -> tuple[str, dict[Hashable, Any]]:
+    """The ensemble's generator parameters as run, with the intensity S0 and σ it implies (one realization is generated), and the
+    generated realization's attributes."""
+    table = source.motion
     parameters = {k: v for k, v in table.items() if k not in ("type", "interpolation")}
-    attrs = getattr(synthetic_motions, table["type"])(1, start=start, **parameters).attrs
+    attrs = getattr(synthetic_motions, table["type"])(1, start=source.start, **parameters).attrs
     filtered = "omega_g" in attrs  # white noise has no filter
     title = table["type"].replace("_", "–").title() if filtered else "White noise"
     filters = f"ω_g = {number(attrs['omega_g'])} rad/s, ζ_g = {number(attrs['zeta_g'])}" if filtered else "independent samples"
@@ -323,7 +325,7 @@ def motions_table(definitions: Iterable[StoreDefinition]) -> Table:
         for motion in definition.definition.motions:
             table, typed = motion.motion, MotionTable.of_source(motion)
             if motion.kind == "synthetic":
-                text, attrs = _synthetic_parameters(table, motion.start)
+                text, attrs = _synthetic_parameters(motion)
                 realizations = f"{motion.count} (indices {motion.start}–{motion.start + motion.count - 1}), seed {table['seed']}"
                 grid = f"{number(attrs['dt'])} s, {number(attrs['duration'])} s"
             elif typed.is_record:

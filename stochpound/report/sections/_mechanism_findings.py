@@ -259,6 +259,6 @@ def penetration_text(ensemble: Ensemble, walls: str | None) -> str:
         + (f" (k = {', '.join(f'{k / 1e6:.4g}' for k in stiffness)} MN/m)" if stiffness else "")
         + f" that the level it faces penetrates while in contact. Over the {runs} runs with a wall the largest penetration is "
         f"{largest * CM:.3g} cm ({largest * 1000:.3g} mm), at {labels_text({k: v for k, v in at.items() if k != 'realization'})}, realization "
-        f"{at.get('realization')}{per_wall}. It is the located peak of the level's displacement toward each "
+        f"{penetration.realization}{per_wall}. It is the located peak of the level's displacement toward each "
         "wall beyond its gap (store variable peak_wall_penetration), not a sampled value."
     )
