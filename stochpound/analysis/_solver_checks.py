@@ -71,7 +71,7 @@ class CollisionCheck:
         zeta = contact.damping / (2.0 * math.sqrt(contact.stiffness * effective))
         duration = 3.0 * math.pi / (omega * math.sqrt(1.0 - zeta**2))
 
-        def body(name: str, mass: float, velocity: float) -> dict:
+        def body(name: str, mass: float, velocity: float) -> dict[str, str | list[float] | dict[str, list[float]]]:
             return {"name": name, "mass": [mass], "stiffness": [0.0], "damping": [0.0], "initial": {"velocity": [velocity]}}
 
         scene = {
@@ -113,7 +113,7 @@ class ModalCheck:
 
 
 
-def _building_table(building: Building) -> dict:
+def _building_table(building: Building) -> dict[str, str | list[float]]:
     return {"name": building.name, "mass": list(building.mass), "stiffness": list(building.stiffness), "damping": list(building.damping)}
 
 

@@ -35,7 +35,6 @@ import re
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 
@@ -108,7 +107,7 @@ class StatedMeasure:
         return cls(measure.kind, measure.period, measure.periods, measure.damping, units)
 
     @classmethod
-    def from_entry(cls, entry: Mapping[str, Any]) -> StatedMeasure:
+    def from_entry(cls, entry: Mapping[str, str | float | list[float]]) -> StatedMeasure:
         """The stated keys (``measure``, ``period``, ``periods``, ``damping``, ``units``) of a mapping; other keys are ignored."""
         table = TomlTable(entry)
         return cls(table.string("measure", None), table.number("period", None), table.numbers("periods", (), low=0.0, low_open=True), table.number("damping", None),

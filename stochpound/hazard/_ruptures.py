@@ -204,7 +204,7 @@ class RuptureSite:
         return cls(**{key: tuple(entry[key]) for key in (*RUPTURE_COLUMNS, "names")},
                    **{key: entry.get(key) for key in SITE_FIELDS}, name=entry.get("name", ""), source=entry.get("source", ""))
 
-    def to_entry(self, identity: bool = False) -> dict[str, Any]:
+    def to_entry(self, identity: bool = False) -> dict[str, list[float] | list[str] | float | str | None]:
         """The site as plain data (lists, numbers, strings), for a definition or JSON: every field, or with ``identity``
         those the ground motions depend on (not ``name`` and ``source``: a renamed file or a new comment changes no target)."""
         kept = [f.name for f in fields(self) if not (identity and f.name in ("name", "source"))]

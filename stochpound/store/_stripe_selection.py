@@ -49,7 +49,7 @@ class SimulatedMotions:
     dt: float
 
     @classmethod
-    def from_entry(cls, entry: Mapping[str, Any]) -> SimulatedMotions:
+    def from_entry(cls, entry: Mapping[str, int | str | float]) -> SimulatedMotions:
         """The record of a canonical ``simulated_motions`` entry."""
         return cls(entry["count"], entry["model"], entry["calibration"], entry["seed"], entry["dt"])
 
