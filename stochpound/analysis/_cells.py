@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from typing import Any
+from stochpound.store import Label
 
-CellLabels = dict[str, Any]
+CellLabels = dict[str, Label]
 """A grid cell's labels, dimension -> value (``{"gap": 0.02, "mu": 0.1}``), as ``xarray``'s ``.sel`` takes them."""

@@ -15,6 +15,7 @@ import xarray as xr
 
 from stochpound.analysis._intervals import QUANTILES, mean_interval, quantiles
 from stochpound.analysis._pounding import pounding_probability
+from stochpound.store import VariableAttributes
 
 #: Per-case summaries whose ensemble mean is estimated (store names).
 SUMMARIES = (
@@ -97,7 +98,7 @@ def ensemble_statistics(
     for name in (s for s in SUMMARIES if s in store and dim in store[s].dims):
         data = store[name]
         if name in GIVEN_POUNDING:
-            data = data.where(store["impacts"] > 0).assign_attrs(data.attrs, long_name=f"{data.attrs.get('long_name', name)}, given pounding")
+            data = data.where(store["impacts"] > 0).assign_attrs(data.attrs, long_name=f"{VariableAttributes.of(data, long_name=name).long_name}, given pounding")
         interval = mean_interval(data, dim, confidence, interval_method(name))
         for part in ("mean", "lower", "upper"):
             variables[f"{name}_{part}"] = interval[part]

@@ -6,6 +6,7 @@ import numpy as np
 import xarray as xr
 
 from stochpound.stats import kernels
+from stochpound.store import VariableAttributes
 
 
 def normal_histogram(data: xr.DataArray, bins: int = 40) -> xr.Dataset:
@@ -33,7 +34,7 @@ def normal_histogram(data: xr.DataArray, bins: int = 40) -> xr.Dataset:
     centres = 0.5 * (edges[:-1] + edges[1:])
     sample = kernels.moments(values)
     mean, std = float(sample.mean), float(sample.std)
-    units = data.attrs.get("units", "")
+    units = VariableAttributes.of(data, units="").units
     return xr.Dataset(
         {
             "density": ("bin", density, {"units": f"1/({units})" if units else "1", "long_name": "sample density"}),

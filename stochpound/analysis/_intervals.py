@@ -15,6 +15,7 @@ import xarray as xr
 from stochpound.stats import kernels
 from stochpound.analysis._pounding import pounded
 from stochpound.stats import reduce
+from stochpound.store import VariableAttributes
 
 MIN_RUNS = 30
 """Fewest runs (values) behind an ensemble estimate that a conclusion is drawn from, that is compared or drawn as a
@@ -38,8 +39,8 @@ def _mean_kernel(method: Method) -> tuple:
 
 
 def _interval_dataset(values: tuple, estimate: str, data: xr.DataArray, confidence: float, method: str) -> xr.Dataset:
-    units = data.attrs.get("units", "1")
-    what = data.attrs.get("long_name", data.name or "value")
+    described = VariableAttributes.of(data, units="1", long_name=str(data.name or "value"))
+    units, what = described.units, described.long_name
     return xr.Dataset(
         {
             estimate: values[0].assign_attrs(units=units, long_name=f"{estimate} of {what}"),
@@ -84,7 +85,8 @@ def mean_interval(data: xr.DataArray, dim: str = "realization", confidence: floa
 def quantiles(data: xr.DataArray, q: Sequence[float] = QUANTILES, dim: str = "realization") -> xr.DataArray:
     """Sample quantiles of ``data`` along ``dim``, on a new dimension ``quantile`` (linear interpolation, type 7)."""
     result = reduce(lambda x: kernels.quantiles(x, q), [data], [dim], new_dims={"quantile": len(q)})
-    return result.assign_coords(quantile=list(q)).assign_attrs(units=data.attrs.get("units", "1"), long_name=f"quantiles of {data.attrs.get('long_name', data.name or 'value')}")
+    described = VariableAttributes.of(data, units="1", long_name=str(data.name or "value"))
+    return result.assign_coords(quantile=list(q)).assign_attrs(units=described.units, long_name=f"quantiles of {described.long_name}")
 
 
 def running_mean(data: xr.DataArray, dim: str = "realization", confidence: float = 0.95) -> xr.Dataset:

@@ -530,7 +530,7 @@ def _thresholds(thresholds: Sequence[float] | None, responses: np.ndarray) -> np
 
 
 def _dataset(estimate: _Estimate, site: RuptureSite, ruptures: list[_Rupture], values: list[np.ndarray], demand: MeasureFreeDemand,
-             attrs: dict) -> xr.Dataset:
+             attrs: dict[str, float | str | np.ndarray]) -> xr.Dataset:
     units = RESPONSES[demand.response]
     names = list(site.names)
     table = np.full((len(values), max(v.size for v in values)), np.nan)

@@ -116,16 +116,19 @@ class WallPenetration:
         The runs with a wall.
     largest : float
         The largest penetration, m (NaN without a run).
-    at : dict
+    at : CellLabels
         The labels of its cell and realization (empty without a run).
     per_value : list of (value, float)
         The largest per value of the wall axis (m; empty without one).
+    realization : int or None
+        The realization of the largest (None without a run, or runs without a realization dimension).
     """
 
     runs: int
     largest: float
     at: CellLabels
     per_value: list[tuple[Any, float]]
+    realization: int | None = None
 
     @classmethod
     def of(cls, penetration: xr.DataArray, walls: str | None) -> WallPenetration:
@@ -136,4 +139,5 @@ class WallPenetration:
         where = penetration.where(penetration == penetration.max(), drop=True)
         at = {d: where[d].values[0].item() for d in where.dims}
         per_value = [] if walls is None else [(v.item(), float(penetration.sel({walls: v}).max())) for v in penetration[walls].values]
-        return cls(runs, float(penetration.max()), at, per_value)
+        realization = int(where["realization"].values[0]) if "realization" in where.dims else None
+        return cls(runs, float(penetration.max()), at, per_value, realization)

@@ -6,6 +6,7 @@ import xarray as xr
 
 from stochpound.stats import kernels
 from stochpound.stats import reduce
+from stochpound.store import VariableAttributes
 
 MOMENT_NAMES = kernels.Moments._fields
 
@@ -33,7 +34,7 @@ def moments(data: xr.DataArray, dim: str | list[str] = "time") -> xr.Dataset:
     dims = [dim] if isinstance(dim, str) else list(dim)
     axes = tuple(range(-len(dims), 0))
     values = reduce(lambda x: tuple(kernels.moments(x, axes)), [data], dims, len(MOMENT_NAMES))
-    units = data.attrs.get("units", "")
+    units = VariableAttributes.of(data, units="").units
     squared = f"({units})2" if units else ""
     attrs = {
         "mean": {"units": units, "long_name": "mean"},

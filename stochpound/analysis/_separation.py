@@ -24,6 +24,8 @@ from collections.abc import Sequence
 import numpy as np
 import xarray as xr
 
+from stochpound.store import VariableAttributes
+
 TARGET_PROBABILITIES = (0.5, 0.16, 0.05, 0.01)
 """Default target pounding probabilities of :func:`required_separation`."""
 
@@ -137,7 +139,7 @@ def required_separation(
         dask="parallelized", output_dtypes=[float, float, float, int],
         dask_gufunc_kwargs={"output_sizes": {"probability": len(targets)}, "allow_rechunk": True},
     )
-    units = peak_closure.attrs.get("units", "m")
+    units = VariableAttributes.of(peak_closure, units="m").units
     result = xr.Dataset(
         {
             "separation": separation.assign_attrs(units=units, long_name="gap reached with the target probability: the (1 - p) quantile of D"),

@@ -68,8 +68,13 @@ class StoreEnsemble:
         status = store["case_status"].sel(record=label)
         realizations = (status >= 0).any([d for d in status.dims if d != "realization"]).values
         self.data = store.sel(record=label).isel(realization=np.flatnonzero(realizations))
-        self.studied = str(store.attrs.get("studied_building", ""))
+        self.studied = store.pound.provenance.studied_building
         self.grid = {d: self.data[d].values.tolist() for d in status.dims if d not in ("record", "realization")}
+
+    @property
+    def mus(self) -> list[float]:
+        """The friction coefficients of the ensemble's ``mu`` axis (none without one; ∞: the fixed base)."""
+        return self.data["mu"].values.tolist() if "mu" in self.grid else []
 
     @property
     def size(self) -> int:

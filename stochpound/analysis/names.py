@@ -16,6 +16,8 @@ from collections.abc import Mapping
 
 import xarray as xr
 
+from stochpound.store import VariableAttributes
+
 #: Moment (as :func:`stochpound.analysis.moments` names it) -> the quantity's name.
 RESPONSE_MOMENTS = {
     "mean": "response_mean",
@@ -36,7 +38,7 @@ def with_aliases(dataset: xr.Dataset, aliases: Mapping[str, str]) -> xr.Dataset:
     for old, current in aliases.items():
         if current in dataset:
             variable = dataset[current]
-            added[old] = variable.copy(deep=False).assign_attrs(variable.attrs, alias_of=current, long_name=f"{variable.attrs.get('long_name', current)} (alias of {current})")
+            added[old] = variable.copy(deep=False).assign_attrs(variable.attrs, alias_of=current, long_name=f"{VariableAttributes.of(variable, long_name=current).long_name} (alias of {current})")
     return dataset.assign(added)
 
 

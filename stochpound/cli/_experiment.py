@@ -14,6 +14,7 @@ from stochpound.cli._group import HelpGroup
 from stochpound.cli._scene_notes import experiment_warnings, periods_text, say_scene_warnings
 from stochpound._errors import StochpoundError, os_error_message
 from stochpound.experiment import LARGE_RUN_BYTES, LARGE_RUN_CASES, parts_folder
+from stochpound.store import MotionTable, TomlTable
 from stochpound._memory import format_bytes
 
 if TYPE_CHECKING:
@@ -173,7 +174,7 @@ def check_command(experiment_file: str) -> None:
         with _errors_of(experiment_file, False):
             rare = load_rare_event(experiment_file)
         click.echo(f"{experiment_file}: valid rare-event experiment; definition sha256 {rare.sha256}")
-        click.echo(f"  {rare.table.method} simulation of {rare.table.response} under {rare.motion.get('type')}, target {rare.table.target_probability:g}, "
+        click.echo(f"  {rare.table.method} simulation of {rare.table.response} under {MotionTable.of(TomlTable(rare.motion, 'motion')).type}, target {rare.table.target_probability:g}, "
                    f"N = {rare.table.samples_per_level}, p0 = {rare.table.p0:g}, seed {rare.table.seed}")
         return
     try:

@@ -15,7 +15,7 @@ from stochpound.cli._site import measure_free_answer, measure_free_lines, ruptur
 from stochpound.cli._store_errors import store_variables
 from stochpound.analysis import MEASURE_FREE_RUNS
 from stochpound.risk import BOOTSTRAP, TARGETS
-from stochpound.store import Design
+from stochpound.store import Design, TomlTable, VariableAttributes
 
 
 def _targets(value: str) -> tuple[float, ...]:
@@ -28,8 +28,8 @@ def _targets(value: str) -> tuple[float, ...]:
     return targets
 
 
-def _toml_table(path: Path, name: str, docs: str, beside: tuple[str, ...] = ()) -> dict:
-    """The TOML file's ``[name]`` table (its key ``name`` kept: ``{name: ...}``) and the tables ``beside`` it has, or a one-line error."""
+def _toml_table(path: Path, name: str, docs: str, beside: tuple[str, ...] = ()) -> TomlTable:
+    """The TOML file's ``[name]`` table (the file's top level with that table only) and the tables ``beside`` it has, or a one-line error."""
     import tomllib
 
     try:
@@ -38,23 +38,22 @@ def _toml_table(path: Path, name: str, docs: str, beside: tuple[str, ...] = ()) 
         raise click.ClickException(f"{path}: not TOML: {error}") from None
     if name not in table:
         raise click.ClickException(f"{path}: has no [{name}] table ({docs})")
-    return {key: table[key] for key in (name, *beside) if key in table}
+    return TomlTable({key: table[key] for key in (name, *beside) if key in table})
 
 
 def _limit_states(path: Path) -> tuple:
     """The limit states of a TOML file's ``[limit_states]`` table (``stochpound.risk.limit_states_from_table``)."""
     from stochpound.risk import limit_states_from_table
 
-    return limit_states_from_table(_toml_table(path, "limit_states", "docs/risk.md")["limit_states"])
+    return limit_states_from_table(_toml_table(path, "limit_states", "docs/risk.md").raw("limit_states"))
 
 
 def _design(path: Path) -> Design | None:
     """The buildings' code design of a TOML file's ``[design]`` table (the experiment file's table, docs/experiments.md; its
     ``[hazard]``, if any, gives a sliding building's chapter 17 spectrum)."""
     from stochpound.experiment import parse_design
-    from stochpound.store import TomlTable
 
-    return parse_design(TomlTable(_toml_table(path, "design", "docs/experiments.md", beside=("hazard",))))
+    return parse_design(_toml_table(path, "design", "docs/experiments.md", beside=("hazard",)))
 
 
 def _check_csv(csv_dir: Path, inputs: list[tuple[str | Path, str]]) -> None:
@@ -183,7 +182,7 @@ def risk(store: Path, hazard: str | None, hazard_measure: str | None, hazard_uni
             click.echo(f"note: hazard {line.removeprefix('stochpound: ')}")
     if hz.extrapolated:
         click.echo(f"note: the hazard table [{hz.im[0]:g}, {hz.im[-1]:g}] {hz.units} was extrapolated beyond its intensities as power laws (--extrapolate)")
-    interval = f"95 % interval, {result.separation['lower'].attrs.get('method', 'BCa bootstrap')}" if "lower" in result.separation else (
+    interval = f"95 % interval, {VariableAttributes.of(result.separation['lower'], method='BCa bootstrap').method}" if "lower" in result.separation else (
         "no interval: not estimable" if result.no_interval else "no bootstrap")
     separation = result.separation_frame()
     click.echo(f"\nRisk-targeted separation g* (m; {interval}; inf: wider than every gap of the grid; ≥: a lower bound, the target "

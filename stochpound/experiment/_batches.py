@@ -62,7 +62,7 @@ def make_batches(experiment: Experiment, missing: Mapping[str, np.ndarray], moti
         Cases per batch (about).
     """
     points = [_Point(p, experiment.structure(p), experiment.reference_structure(p)) for kind in KINDS for p in experiment.points(kind)]
-    settings = task_settings(experiment, motions)
+    settings = task_settings(experiment, {label: motion.expected_intensity for label, motion in motions.items()})
     for record, label in enumerate(experiment.motions):
         realizations = experiment.realization_numbers(label)
         columns = experiment.realization_positions(label)

@@ -110,7 +110,7 @@ class BatchResult:
 
     Attributes
     ----------
-    arrays : dict
+    arrays : dict[str, numpy.ndarray]
         Part arrays of the finished cases, by section (:func:`stochpound.experiment._parts.section_key`).
     done : int
         Number of finished cases.

@@ -64,7 +64,7 @@ class PartsIndex:
     ----------
     sections : list of (Path, str)
         Every section of every readable part: (part file, ``<kind>.<record>``).
-    source : dict of np.ndarray
+    source : dict[str, numpy.ndarray]
         For each kind, an int array of its grid's shape: the index in
         ``sections`` of the section holding the case, −1 if none (the first
         part, by name, wins if two hold the same case).
@@ -418,7 +418,7 @@ class ImpactRows:
     ----------
     first : int
         The first row's index in the store's impact table.
-    columns : dict of str to np.ndarray
+    columns : dict[str, numpy.ndarray]
         A buffer per impact variable (in the file's dtype), by name.
     """
 

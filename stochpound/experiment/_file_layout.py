@@ -27,7 +27,7 @@ import itertools
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Iterator, Mapping
+from typing import Iterator, Mapping
 
 import numpy as np
 import xarray as xr
@@ -35,7 +35,7 @@ import xarray as xr
 from stochpound.store import CASE_SUMMARIES, IMPACT_TABLE, REFERENCE_HISTORY, REFERENCE_SUMMARIES, SETS, STOREY_SUMMARIES, StoreVariable, TIME_HISTORIES, WALL_SUMMARIES, canonical_json
 from stochpound.experiment import _intensity as intensity
 from stochpound.experiment._experiment import Experiment
-from stochpound.store import CASE, REFERENCE, Dim
+from stochpound.store import CASE, REFERENCE, Dim, MotionTable, TomlTable
 from stochpound.experiment._summary import DEMAND_SUMMARIES
 from stochpound.model.scene_file import scene_from_dict
 from stochpound.motions.records import METADATA_FIELDS
@@ -242,7 +242,7 @@ def _coordinates(experiment: Experiment, motion_grids: Mapping[str, tuple[float,
     scene = experiment.definition.scene
     coords["building"] = xr.Variable(("building",), np.array(experiment.building_names, dtype=object), {"units": "1", "long_name": "building name, left to right"})
     coords["floor"] = xr.Variable(("floor",), np.arange(1, experiment.max_floors + 1), {"units": "1", "long_name": "floor number, 1 = lowest"})
-    coords["contact"] = xr.Variable(("contact",), np.arange(len(scene.get("contact", []))), {"units": "1", "long_name": "contact index"})
+    coords["contact"] = xr.Variable(("contact",), np.arange(len(TomlTable(scene, "scene").tables("contact"))), {"units": "1", "long_name": "contact index"})
     coords.update(_scene_coordinates(experiment))
     if experiment.output.time_histories:
         coords["time"] = xr.Variable(("time",), union_times(motion_grids), {"units": "s", "long_name": "time (union of the motions' sample times)"})
@@ -259,7 +259,7 @@ def _scene_coordinates(experiment: Experiment) -> dict[str, xr.Variable]:
     dims = tuple(d.name for d in experiment.kind_dims(CASE)[:-2])
     shape = experiment.grid_shape(CASE)[:-2]
     columns: dict[str, list[np.ndarray]] = {}
-    attrs: dict[str, tuple[tuple[str, ...], dict[str, Any]]] = {}
+    attrs: dict[str, tuple[tuple[str, ...], dict[str, str]]] = {}
     for point in points:
         scene = scene_from_dict(experiment.structure(point), base_dir=experiment.base_dir)
         for name, (variable_dims, values, variable_attrs) in scene_parameters(scene).items():
@@ -278,9 +278,9 @@ def _suite_coordinates(experiment: Experiment) -> dict[str, xr.Variable]:
     """Metadata of the motions from suites on ``record`` (event, station, component, magnitude, distance...; none without such motions)."""
     from stochpound.motions.records import is_suite_member, load_suite_member, record_metadata
 
-    rows: list[Mapping[str, Any]] = []
+    rows: list[Mapping[str, float | str]] = []
     for source in experiment.motions.values():
-        record = str(source.motion.get("record", ""))
+        record = MotionTable.of_source(source).record or ""
         peer = record_metadata(record, experiment.base_dir) if source.kind == "record" and record and not is_suite_member(record) else {}
         if is_suite_member(record):
             rows.append(load_suite_member(record).metadata)

@@ -40,9 +40,10 @@ from stochpound.experiment._site import parse_selection
 from stochpound.motions import arias_intensity, peak_ground_motion, response_spectrum, significant_duration
 from stochpound._errors import IntensityError
 from stochpound.motions import Measure
-from stochpound.store import MEASURES, ExperimentGrid, GapAxis, Intensity, Label, MuAxis, VariantAxis
+from stochpound.store import MEASURES, ExperimentGrid, GapAxis, Intensity, Label, MuAxis, TomlTable, VariantAxis
 
-METHODS = ("stripes", "ida")
+INTENSITY_METHODS = ("stripes", "ida")
+"""The methods of an ``[intensity]`` table: multi-stripe analysis, or incremental dynamic analysis where the scene allows it."""
 UNITS = {"pga": ("g", "m/s2"), "psa": ("g", "m/s2"), "sa_avg": ("g", "m/s2"), "pgv": ("m/s", "cm/s")}
 """Units of ``levels`` allowed for each measure (the first is the default)."""
 SYNTHETIC_SCALING = ("each", "expected")
@@ -76,62 +77,43 @@ SUMMARIES: dict[str, tuple[str, str]] = {
 }
 
 
-def parse_intensity(data: Mapping[str, Any], scene: Mapping[str, Any], variants: Sequence[VariantAxis], gaps: Sequence[GapAxis], mu: MuAxis | None,
+def parse_intensity(file: TomlTable, scene: TomlTable, variants: Sequence[VariantAxis], gaps: Sequence[GapAxis], mu: MuAxis | None,
                     base_dir: Path = Path(".")) -> Intensity | None:
     """The ``[intensity]`` setting of a definition, typed (None without an ``[intensity]`` table).
 
+    ``file`` is the experiment file's top level and ``scene`` its base scene;
     ``base_dir`` is the experiment file's folder (a ``[site]`` rupture table's path is relative to it).
 
     Raises
     ------
-    IntensityError
+    IntensityError, SceneError
         Naming the field: an unknown measure, method or unit, a period ≤ 0,
         levels not > 0, ``ida`` without a gap axis.
     """
-    table = data.get("intensity")
-    if table is None:
-        if data.get("site") is not None:
+    site = file.raw("site")
+    if "intensity" not in file:
+        if site is not None:
             raise IntensityError("site: only with an [intensity] table whose selection is conditional_spectrum")
         return None
-    if not isinstance(table, dict):
+    if not isinstance(file.raw("intensity"), dict):
         raise IntensityError("intensity: must be a table (measure, levels, ...)")
-    toml_fields.reject_unknown(table, _KEYS, "intensity")
-    measure = table.get("measure")
-    if measure not in MEASURES:
-        raise IntensityError(f"intensity.measure: must be one of {', '.join(MEASURES)}, got {measure!r}")
+    table = file.table("intensity", _KEYS)
+    measure = table.string("measure", choices=MEASURES)
     period, periods, damping = None, (), None
     if measure == "psa":
-        period = toml_fields.number(table, "period", "intensity", required=True, low=0.0, low_open=True)
+        period = table.number("period", low=0.0, low_open=True)
     elif measure == "sa_avg":
-        periods = table.get("periods")
-        if not isinstance(periods, list) or len(periods) < 2 or not all(toml_fields.is_number(p) and math.isfinite(p) and p > 0 for p in periods):
-            raise IntensityError(f"intensity.periods: must be a list of at least 2 periods > 0 s (e.g. log-spaced over 0.2-3 T1), got {periods!r}")
-        periods = tuple(float(p) for p in periods)
+        periods = _periods(table.raw("periods"))
     for key, given in (("period", period is not None), ("periods", bool(periods))):
         if key in table and not given:
             raise IntensityError(f"intensity.{key}: only for measure = {'psa' if key == 'period' else 'sa_avg'}")
     if measure in ("psa", "sa_avg"):
-        damping = toml_fields.number(table, "damping", "intensity", default=SPECTRUM_DAMPING, low=0.0, high=1.0, high_open=True)
-    levels = table.get("levels")
-    if not isinstance(levels, list) or not levels:
-        raise IntensityError(f"intensity.levels: must be a non-empty list of levels > 0, got {levels!r}")
-    for i, level in enumerate(levels):
-        if not toml_fields.is_number(level) or not math.isfinite(level) or level <= 0:
-            raise IntensityError(f"intensity.levels[{i}]: must be > 0, got {level!r}")
-    if len(set(levels)) != len(levels):
-        raise IntensityError("intensity.levels: repeated level")
-    units = table.get("units", UNITS[measure][0])
-    if units not in UNITS[measure]:
-        raise IntensityError(f"intensity.units: must be one of {', '.join(UNITS[measure])} for {measure}, got {units!r}")
-    method = table.get("method", "stripes")
-    if method not in METHODS:
-        raise IntensityError(f"intensity.method: must be one of {', '.join(METHODS)}, got {method!r}")
-    synthetic = table.get("synthetic", SYNTHETIC_SCALING[0])
-    if synthetic not in SYNTHETIC_SCALING:
-        raise IntensityError(
-            f"intensity.synthetic: must be {' or '.join(SYNTHETIC_SCALING)} (each realization scaled to the level, or all by the level over the "
-            f"ensemble's mean measure), got {synthetic!r}"
-        )
+        damping = table.number("damping", SPECTRUM_DAMPING, low=0.0, high=1.0, high_open=True)
+    levels = _levels(table.raw("levels"))
+    units = table.string("units", UNITS[measure][0], choices=UNITS[measure], hint=f"for {measure}")
+    method = table.string("method", "stripes", choices=INTENSITY_METHODS)
+    synthetic = table.string("synthetic", SYNTHETIC_SCALING[0], choices=SYNTHETIC_SCALING,
+                             hint="each realization scaled to the level, or all by the level over the ensemble's mean measure")
     ran, note = _method_run(method, scene, variants, gaps, mu)
     try:
         scaled_measure = Measure(measure, period, periods, damping)
@@ -139,14 +121,33 @@ def parse_intensity(data: Mapping[str, Any], scene: Mapping[str, Any], variants:
         raise IntensityError(f"intensity.{error}") from None
     setting = Intensity(scaled_measure, units, tuple(sorted(float(level) for level in levels)), method, ran, note,
                         synthetic)
-    chosen = parse_selection(table, data.get("site"), levels, setting, base_dir)
+    chosen = parse_selection(table.values, site, levels, setting, base_dir)
     if chosen is None:
         return setting
     selection, note = chosen
     return dataclasses.replace(setting, note=note, selection=selection)
 
 
-def _method_run(method: str, scene: Mapping[str, Any], variants: Sequence[VariantAxis], gaps: Sequence[GapAxis], mu: MuAxis | None) -> tuple[str, str]:
+def _periods(periods: object) -> tuple[float, ...]:
+    """``intensity.periods`` of ``sa_avg``: at least 2 finite periods > 0 s."""
+    if not isinstance(periods, list) or len(periods) < 2 or not all(toml_fields.is_number(p) and math.isfinite(p) and p > 0 for p in periods):
+        raise IntensityError(f"intensity.periods: must be a list of at least 2 periods > 0 s (e.g. log-spaced over 0.2-3 T1), got {periods!r}")
+    return tuple(float(p) for p in periods)
+
+
+def _levels(levels: object) -> list[float]:
+    """``intensity.levels``: a non-empty list of distinct finite levels > 0, as the file lists them."""
+    if not isinstance(levels, list) or not levels:
+        raise IntensityError(f"intensity.levels: must be a non-empty list of levels > 0, got {levels!r}")
+    for i, level in enumerate(levels):
+        if not toml_fields.is_number(level) or not math.isfinite(level) or level <= 0:
+            raise IntensityError(f"intensity.levels[{i}]: must be > 0, got {level!r}")
+    if len(set(levels)) != len(levels):
+        raise IntensityError("intensity.levels: repeated level")
+    return levels
+
+
+def _method_run(method: str, scene: TomlTable, variants: Sequence[VariantAxis], gaps: Sequence[GapAxis], mu: MuAxis | None) -> tuple[str, str]:
     """The method that runs and why (IDA needs a homogeneous contact-free response and a gap axis)."""
     if method == "stripes":
         return "stripes", "every motion scaled to every level"
@@ -162,26 +163,28 @@ def _method_run(method: str, scene: Mapping[str, Any], variants: Sequence[Varian
     return "ida", "one contact-free run per motion; capacity IM·g/D per gap (homogeneous scene: fixed bases, at rest, no walls)"
 
 
-def inhomogeneity(scene: Mapping[str, Any], variants: Sequence[VariantAxis], mu: MuAxis | None) -> str:
+def inhomogeneity(scene: TomlTable, variants: Sequence[VariantAxis], mu: MuAxis | None) -> str:
     """Why a scene's contact-free response is not homogeneous in the input ("" if it is)."""
-    if scene.get("wall"):
+    if scene.raw("wall"):
         return "the scene has walls"
     if mu is not None and mu.finite_values:
         return "grid.mu has finite friction coefficients (sliding bases)"
     for where, building in _building_tables(scene, variants):
-        if isinstance(building.get("base"), dict) and (mu is None or mu.finite_values):
+        if isinstance(building.raw("base"), dict) and (mu is None or mu.finite_values):
             return f"{where}: a building on a sliding base"
-        if building.get("initial"):
+        if building.raw("initial"):
             return f"{where}: a building not at rest at t = 0"
     return ""
 
 
-def _building_tables(scene: Mapping[str, Any], variants: Sequence[VariantAxis]) -> list[tuple[str, Mapping[str, Any]]]:
+def _building_tables(scene: TomlTable, variants: Sequence[VariantAxis]) -> list[tuple[str, TomlTable]]:
     """Every ``[[building]]`` table of a scene and of its variants' overrides, with where it is."""
-    tables = [("scene", b) for b in scene.get("building", [])]
+    tables = [("scene", building) for building in scene.tables("building")]
     for variant in variants:
         for value, override in variant.overrides.items():
-            tables += [(f"variants.{variant.name}.{value}", b) for b in override.get("building", {}).values()]
+            where = f"variants.{variant.name}.{value}"
+            edits = TomlTable(override, where).table_or_empty("building")
+            tables += [(where, edits.table(name)) for name in edits]
     return tables
 
 
@@ -293,16 +296,18 @@ def store_names(intensity: Intensity | None) -> list[str]:
     return names + (["ida_capacity"] if intensity.ran == "ida" else [])
 
 
-def task_settings(experiment: ExperimentGrid, motions: Mapping[str, Any]) -> Scaling | None:
+def task_settings(experiment: ExperimentGrid, expected_intensity: Mapping[str, float | None]) -> Scaling | None:
     """What a worker needs to scale an experiment's cases (None without intensity).
 
     The intensity setting, g, the gap axes and, by motion number, the
-    ensembles' mean measures (``expected``; ``[intensity] synthetic = "expected"``).
+    ensembles' mean measures (``expected``; ``[intensity] synthetic = "expected"``),
+    from ``expected_intensity``: each motion's mean measure by label (None: scaled case by case).
     """
     if experiment.intensity is None:
         return None
     gap_axes = tuple((gap.name, gap.contacts) for gap in experiment.definition.gaps)
-    expected = {index: motions[label].expected_intensity for index, label in enumerate(experiment.motions) if motions[label].expected_intensity is not None}
+    means = {index: expected_intensity[label] for index, label in enumerate(experiment.motions)}
+    expected = {index: mean for index, mean in means.items() if mean is not None}
     return Scaling(experiment.intensity, experiment.definition.g, gap_axes, expected)
 
 

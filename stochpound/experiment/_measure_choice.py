@@ -18,6 +18,7 @@ import pandas as pd
 
 from stochpound.experiment._site import periods_of_interest
 from stochpound.motions import Measure
+from stochpound.store import Label
 
 #: Why no measure is named most efficient when a stripe ran one motion (``measure_choice``'s ``unjudged``).
 ONE_MOTION = ("efficiency cannot be judged from one motion per stripe (or one motion in all): β is the scatter of the motions "
@@ -81,7 +82,7 @@ def measure_choice(store: Any, hazard: str | None = None) -> pd.DataFrame:
     rows = []
     for index in np.ndindex(*[beta.sizes[d] for d in configurations]):
         cell = beta.isel(dict(zip(configurations, index)))
-        row: dict[str, Any] = {d: cell[d].item() for d in configurations}
+        row: dict[str, Label] = {d: cell[d].item() for d in configurations}
         row["where"] = ", ".join(f"{d}={cell[d].item()}" for d in configurations) or "all runs"
         hazard_betas = {label: float(cell.sel(measure=name)) for label, name in names.items()}
         row.update(hazard_betas)

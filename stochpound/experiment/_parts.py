@@ -36,6 +36,7 @@ import json
 import os
 import secrets
 import time
+import dataclasses
 import zipfile
 from dataclasses import dataclass
 from pathlib import Path
@@ -163,7 +164,7 @@ def section_count(arrays: dict[str, np.ndarray]) -> int:
 # ---------------------------------------------------------------- part files
 
 
-def write_part(folder: Path, name: str, arrays: dict[str, np.ndarray], meta: dict[str, Any]) -> Path:
+def write_part(folder: Path, name: str, arrays: dict[str, np.ndarray], meta: dict[str, str]) -> Path:
     """Write a part atomically as ``<name>.npz`` (``meta`` is kept as JSON)."""
     path = folder / f"{name}{PART_SUFFIX}"
     payload = {"meta": np.array(json.dumps(meta)), **arrays}
@@ -199,14 +200,14 @@ class PartBuffer:
     ----------
     folder : Path
         The parts folder.
-    meta : dict
-        Kept in every part (version, run).
+    meta : dict[str, str]
+        Kept in every part (the code's version and its sources' sha256).
     cases_per_realization : float
         The experiment's cases per realization of its motions: a part holds
         the cases of :data:`PART_REALIZATIONS` realizations.
     """
 
-    def __init__(self, folder: Path, meta: dict[str, Any], cases_per_realization: float) -> None:
+    def __init__(self, folder: Path, meta: dict[str, str], cases_per_realization: float) -> None:
         self.folder = folder
         self.meta = meta
         self.cases = _PART_CASES or max(1, round(PART_REALIZATIONS * cases_per_realization))
@@ -331,15 +332,57 @@ def write_experiment_json(folder: Path, record: FolderRecord) -> None:
     atomic_write(folder / DEFINITION_FILE, lambda stream: stream.write(json.dumps(record.to_json(), indent=1).encode()))
 
 
-def append_run(folder: Path, entry: dict[str, Any]) -> None:
+@dataclass(frozen=True)
+class RunEntry:
+    """One run of an experiment on its parts folder: a line of ``runs.jsonl``, the run history.
+
+    Attributes
+    ----------
+    started : str
+        When it started (UTC, ISO 8601).
+    machine : str
+        Host, platform, Python and CPU count of the process that ran it.
+    executor : str
+        Where its cases ran (in this process, local workers, a cluster).
+    stochpound_version, git_commit, sources_sha256 : str
+        The code that ran it (the commit ``none`` outside a git checkout, or in a line of an older stochpound that lacks it; the others empty).
+    """
+
+    started: str = ""
+    machine: str = ""
+    executor: str = ""
+    stochpound_version: str = ""
+    git_commit: str = "none"
+    sources_sha256: str = ""
+
+    @classmethod
+    def from_json(cls, line: str) -> RunEntry:
+        """The entry of one line of ``runs.jsonl`` (its fields that this record does not know are ignored).
+
+        Raises
+        ------
+        ValueError
+            If the line is not a JSON table (e.g. cut by a kill).
+        """
+        data = json.loads(line)
+        if not isinstance(data, dict):
+            raise ValueError(f"not a JSON table: {line!r}")
+        return cls(**{field.name: str(data[field.name]) for field in dataclasses.fields(cls) if field.name in data})
+
+    def to_json(self) -> dict[str, str]:
+        """The line's fields, in the order they are written."""
+        return dataclasses.asdict(self)
+
+
+def append_run(folder: Path, entry: RunEntry) -> None:
     """Append one line to ``runs.jsonl`` (the run history)."""
     with open(folder / RUNS_FILE, "a") as stream:
-        stream.write(json.dumps(entry) + "\n")
+        stream.write(json.dumps(entry.to_json()) + "\n")
         stream.flush()
         os.fsync(stream.fileno())
 
 
-def read_runs(folder: Path) -> list[dict[str, Any]]:
+def read_runs(folder: Path) -> list[RunEntry]:
     """The run history (lines that cannot be parsed, e.g. cut by a kill, are skipped)."""
     runs = []
     try:
@@ -348,7 +391,7 @@ def read_runs(folder: Path) -> list[dict[str, Any]]:
         return runs
     for line in lines:
         try:
-            runs.append(json.loads(line))
+            runs.append(RunEntry.from_json(line))
         except ValueError:
             continue
     return runs

@@ -33,7 +33,7 @@ from stochpound.analysis import METHOD, SubsetLevel, curve_dataset, curve_thresh
 from stochpound.analysis import pounding_curve
 from stochpound.experiment._parts import parts_folder
 from stochpound.experiment._rare_event_table import RareEventDefinition
-from stochpound.store import contact_free, contact_gap_dims, has_contact_free
+from stochpound.store import Provenance, contact_free, contact_gap_dims, has_contact_free
 
 DEFINITION_FILE = "definition.json"
 KIND = "rare_event"
@@ -206,7 +206,7 @@ class RareEventResults:
 
 def stored_rare_event(data: xr.Dataset) -> RareEventDefinition:
     """The definition a rare-event store was run with."""
-    return RareEventDefinition.from_dict(json.loads(data.attrs["definition"]), data.attrs.get("experiment_file", ""))
+    return RareEventDefinition.from_dict(json.loads(data.attrs["definition"]), Provenance.of(data).experiment_file)
 
 
 def rare_event_results(data: xr.Dataset) -> RareEventResults:
@@ -260,7 +260,7 @@ def crude_check(rare: xr.Dataset, store: xr.Dataset) -> xr.Dataset | None:
     return xr.Dataset(
         {"crude": ("gap", crude["probability"].values), "crude_lower": ("gap", crude["lower"].values), "crude_upper": ("gap", crude["upper"].values),
          "realizations": ("gap", np.broadcast_to(crude["realizations"].values, gaps.shape)), "subset": ("gap", probability), "subset_cov": ("gap", cov)},
-        coords={"gap": ("gap", gaps, {"units": "m"})}, attrs={"experiment": store.attrs.get("experiment_name", ""), "record": labels[0]},
+        coords={"gap": ("gap", gaps, {"units": "m"})}, attrs={"experiment": Provenance.of(store).experiment_name, "record": labels[0]},
     )
 
 

@@ -207,17 +207,17 @@ def _where(table: TomlTable, response: str, buildings: list[str], scene: Mapping
             raise table.error(key, f"not used by response = {response!r} (it takes {', '.join(sorted(needs))})")
     found: dict[str, Any] = {}
     if "contact" in needs:
-        contacts = len(scene.get("contact", []))
+        contacts = len(TomlTable(scene, "scene").tables("contact"))
         if not contacts:
             raise table.error("response", f"{response!r} needs a contact, and the scene has none")
         found["contact"] = table.integer("contact", 0, low=0, high=contacts - 1)
     if "building" in needs:
         single = {"default": buildings[0]} if len(buildings) == 1 else {}  # one building: the default
         found["building"] = table.string("building", **single, choices=tuple(buildings))
-        if sampled == "base_displacement" and not isinstance(building_table(scene, found["building"]).get("base"), dict):
+        if sampled == "base_displacement" and not isinstance(TomlTable(building_table(scene, found["building"])).raw("base"), dict):
             raise table.error("building", f"{found['building']!r} has a fixed base ({sampled} needs a sliding base)")
     if "floor" in needs:
-        found["floor"] = table.integer("floor", low=1, high=len(building_table(scene, found["building"]).get("mass", [])))
+        found["floor"] = table.integer("floor", low=1, high=len(TomlTable(building_table(scene, found["building"])).numbers("mass", ())))
     if limit_state:
         found["limit_state"] = limit_state
         found["capacity"] = table.number("capacity", low=0.0, low_open=True)

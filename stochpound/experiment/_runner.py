@@ -33,7 +33,7 @@ from stochpound.experiment._batches import automatic_size, make_batches
 from stochpound.experiment._compute import BatchResult, BatchTask, run_batch, warm_up
 from stochpound.experiment._estimate import LARGE_RUN_BYTES, LARGE_RUN_CASES, RunEstimate, cpu_seconds, estimate_run, startup_step, startup_steps
 from stochpound.experiment._experiment import Experiment
-from stochpound.experiment._parts import FolderLock, PartBuffer, append_run, parts_folder, remove_temporaries
+from stochpound.experiment._parts import FolderLock, PartBuffer, RunEntry, append_run, parts_folder, remove_temporaries
 from stochpound.experiment._session import StoreSession, check_store, check_store_path, clear_store, code_identity, machine, missing_summaries, now, store_complete, stored_definition
 from stochpound.experiment._sources import ResolvedMotion, resolve_motions
 from stochpound.experiment._spec import ExperimentError, load_definition
@@ -258,7 +258,7 @@ def run_experiment(
             say("running in this process, without dask: a run this small ends sooner than local workers would start (--workers N starts N)")
         cold = not first_call.engine_cached()
         identity = code_identity()
-        append_run(session.folder, {"started": now(), "machine": machine(), "executor": report.executor, **identity})
+        append_run(session.folder, RunEntry(now(), machine(), report.executor, **identity))
         missing = session.missing()
         if not small:  # a small run's store is written at its end (its parts keep the finished cases meanwhile)
             session.rebuild()

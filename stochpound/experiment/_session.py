@@ -15,15 +15,15 @@ import platform
 import subprocess
 from functools import lru_cache
 from pathlib import Path
-from typing import Any, Iterator
+from typing import Any
 
 import numpy as np
 
 from stochpound import __version__
 from stochpound.experiment._experiment import Experiment
-from stochpound.store import KINDS
+from stochpound.store import KINDS, MotionTable
 from stochpound._atomic import check_not_input, temporaries
-from stochpound.experiment._parts import (DEFINITION_FILE, RUNS_FILE, FolderRecord, part_paths, parts_folder, read_experiment_json, read_runs,
+from stochpound.experiment._parts import (DEFINITION_FILE, RUNS_FILE, FolderRecord, RunEntry, part_paths, parts_folder, read_experiment_json, read_runs,
                                           write_experiment_json)
 from stochpound.experiment._spec import ExperimentError
 from stochpound.store import definition_sha256
@@ -160,19 +160,9 @@ def input_files(experiment: Experiment) -> list[tuple[Path, str]]:
         found.append((base / source["file"], "the experiment's scene file"))
     if definition.hazard is not None and definition.hazard.file:
         found.append((base / definition.hazard.file, "the experiment's hazard file"))
-    found += [(base / table["record"], "a record file of the experiment") for table in _tables(json.loads(experiment.definition_json))
-              if table.get("file_sha256") and isinstance(table.get("record"), str)]
+    tables = [MotionTable.of_source(source) for source in definition.motions]
+    found += [(base / table.record, "a record file of the experiment") for table in tables if table.file_sha256 and table.record is not None]
     return found
-
-
-def _tables(value: Any) -> Iterator[dict[str, Any]]:
-    """Every table (dict) in a definition, at any depth."""
-    if isinstance(value, dict):
-        yield value
-        value = list(value.values())
-    if isinstance(value, list):
-        for item in value:
-            yield from _tables(item)
 
 
 def store_complete(store: Path) -> bool:
@@ -326,7 +316,7 @@ class StoreSession:
         experiment = self.experiment
         solver = experiment.solver
         runs = read_runs(self.folder)
-        last = runs[-1] if runs else {}
+        last = runs[-1] if runs else RunEntry()
         return {
             "experiment_name": experiment.name,
             "experiment_description": experiment.definition.description,
@@ -337,8 +327,8 @@ class StoreSession:
             "definition": experiment.definition_json,
             "studied_building": experiment.studied,
             "stochpound_version": __version__,
-            "git_commit": last.get("git_commit", "none"),
-            "stochpound_sources_sha256": last.get("sources_sha256", ""),
+            "git_commit": last.git_commit,
+            "stochpound_sources_sha256": last.sources_sha256,
             "solver": solver.method,
             "solver_integrator": solver.integrator,
             "solver_rtol": solver.rtol,
@@ -347,8 +337,8 @@ class StoreSession:
             "seeds": json.dumps(experiment.seeds()),
             "created": self.record.created,
             "updated": now(),
-            "machine": last.get("machine", machine()),
-            "runs": json.dumps(runs),
+            "machine": last.machine or machine(),
+            "runs": json.dumps([run.to_json() for run in runs]),
         }
 
     def rebuild(self) -> Path:

@@ -203,7 +203,7 @@ def mixture_scenarios(ruptures: Any, levels: list[float], measure: Measure) -> t
     spectrum's weights P(r | IM* = x) (:meth:`~stochpound.analysis.RuptureSite.disaggregation`'s ``density_share``), Vs30 and the
     mechanism of the largest weight (:meth:`~stochpound.analysis.RuptureSite.mean_scenario`)."""
     shares = ruptures.disaggregation(measure.kind, measure.spectral_period, levels=sorted(float(level) for level in levels))["density_share"].values
-    return tuple(Scenario(**ruptures.mean_scenario(share)) for share in shares)
+    return tuple(ruptures.mean_scenario(share) for share in shares)
 
 
 def site_entry(site: Any, intensity: Intensity | None) -> Site | None:

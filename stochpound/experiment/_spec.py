@@ -157,7 +157,7 @@ def _parsed_definition(file: TomlTable, base_dir: Path, default_name: str) -> De
     n_walls = len(scene_table.tables("wall"))
     gaps = [_gap_axis(key, grid.raw(key), n_contacts, contact_floors, n_walls) for key in grid if is_gap_axis(key)]
     mu = _mu_axis(grid.raw("mu"), buildings) if "mu" in grid else None
-    intensity = parse_intensity(file.values, scene, variants, gaps, mu, base_dir)
+    intensity = parse_intensity(file, scene_table, variants, gaps, mu, base_dir)
     hazard = parse_hazard(file, intensity, base_dir, scene_g(scene))
     design = parse_design(file)
     limit_states = parse_limit_states(file, buildings)
@@ -441,9 +441,9 @@ def _record_sources(table: TomlTable, base_dir: Path) -> list[MotionSource]:
     return sources
 
 
-def _suite_choice(table: TomlTable) -> dict[str, Any]:
+def _suite_choice(table: TomlTable) -> dict[str, list[str] | tuple[float, float]]:
     """The ``members``, ``event``, ``magnitude`` and ``distance`` choices of a suite entry (lists of names, closed ranges)."""
-    choice: dict[str, Any] = {}
+    choice: dict[str, list[str] | tuple[float, float]] = {}
     for key in ("members", "event"):
         if key in table:
             value = table.raw(key)

@@ -27,7 +27,7 @@ class StatusReport:
     store : Path
     experiment : ExperimentGrid
         The store's experiment (its grid).
-    done_mask : dict of np.ndarray
+    done_mask : dict[str, numpy.ndarray]
         For each kind, which cases of its grid are finished (bool).
     running : bool
         A run holds the parts folder's lock (it is being written now).

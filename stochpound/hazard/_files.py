@@ -35,7 +35,6 @@ import re
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 
@@ -43,6 +42,7 @@ from stochpound._text_files import read_text_file
 from stochpound.hazard._curve import HazardCurve, rate_from_probability
 from stochpound.motions import Measure
 from stochpound.motions.records import normalize_units
+from stochpound.store import TomlTable
 
 FORMATS = ("stochpound", "openquake", "nshmp-haz")
 """The hazard-file formats :func:`read_hazard_file` reads."""
@@ -107,11 +107,13 @@ class StatedMeasure:
         return cls(measure.kind, measure.period, measure.periods, measure.damping, units)
 
     @classmethod
-    def from_entry(cls, entry: Mapping[str, Any]) -> StatedMeasure:
+    def from_entry(cls, entry: Mapping[str, str | float | list[float]]) -> StatedMeasure:
         """The stated keys (``measure``, ``period``, ``periods``, ``damping``, ``units``) of a mapping; other keys are ignored."""
-        return cls(entry.get("measure"), entry.get("period"), tuple(entry.get("periods") or ()), entry.get("damping"), entry.get("units"))
+        table = TomlTable(entry)
+        return cls(table.string("measure", None), table.number("period", None), table.numbers("periods", (), low=0.0, low_open=True), table.number("damping", None),
+                   table.string("units", None))
 
-    def entry(self) -> dict[str, Any]:
+    def entry(self) -> dict[str, str | float | list[float]]:
         """The parts stated, by their keys in an experiment's ``[hazard]`` (``measure``, ``period``, ``periods``, ``damping``, ``units``)."""
         parts = {"measure": self.kind, "period": self.period, "periods": list(self.periods) or None, "damping": self.damping, "units": self.units}
         return {key: value for key, value in parts.items() if value is not None}

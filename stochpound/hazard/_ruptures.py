@@ -204,7 +204,7 @@ class RuptureSite:
         return cls(**{key: tuple(entry[key]) for key in (*RUPTURE_COLUMNS, "names")},
                    **{key: entry.get(key) for key in SITE_FIELDS}, name=entry.get("name", ""), source=entry.get("source", ""))
 
-    def to_entry(self, identity: bool = False) -> dict[str, Any]:
+    def to_entry(self, identity: bool = False) -> dict[str, list[float] | list[str] | float | str | None]:
         """The site as plain data (lists, numbers, strings), for a definition or JSON: every field, or with ``identity``
         those the ground motions depend on (not ``name`` and ``source``: a renamed file or a new comment changes no target)."""
         kept = [f.name for f in fields(self) if not (identity and f.name in ("name", "source"))]
@@ -219,7 +219,7 @@ class RuptureSite:
         """Every rupture as its scenario and its annual rate of occurrence (1/yr)."""
         return zip(self._scenarios, self.rate)
 
-    def row(self, index: int) -> dict[str, Any]:
+    def row(self, index: int) -> dict[str, float | str]:
         """Rupture ``index`` (0-based) as a mapping of the table's columns (:data:`~stochpound.analysis.RUPTURE_COLUMNS`)."""
         return {column: getattr(self, column)[index] for column in RUPTURE_COLUMNS}
 
@@ -231,13 +231,13 @@ class RuptureSite:
         """Rupture ``index`` (0-based) as a scenario (:func:`~stochpound.motions.conditional_spectrum`'s ``scenario=``), its geometry given."""
         return self._scenarios[index]
 
-    def mean_scenario(self, weights: Sequence[float]) -> dict[str, Any]:
-        """The ruptures summed up by ``weights`` (one per rupture, summing to 1): the means of ``magnitude`` and ``distance_km``
-        (R_rup, km), the site's ``vs30`` and the ``mechanism`` of the largest total weight."""
+    def mean_scenario(self, weights: Sequence[float]) -> Scenario:
+        """The ruptures summed up by ``weights`` (one per rupture, summing to 1): the scenario of the means of ``magnitude`` and
+        ``distance_km`` (R_rup, km), the site's ``vs30`` and the ``mechanism`` of the largest total weight."""
         p = np.asarray(weights, dtype=float)
         by_mechanism = {mechanism: float(p[np.array(self.mechanism) == mechanism].sum()) for mechanism in MECHANISMS}
-        return {"magnitude": float(p @ np.asarray(self.magnitude)), "distance_km": float(p @ np.asarray(self.distance_rup_km)),
-                "vs30": float(self.vs30), "mechanism": max(by_mechanism, key=by_mechanism.get)}
+        return Scenario(float(p @ np.asarray(self.magnitude)), float(p @ np.asarray(self.distance_rup_km)), float(self.vs30),
+                        max(by_mechanism, key=lambda mechanism: by_mechanism[mechanism]))
 
     def moments(self, measure: str, period: float | Sequence[float] | None = None) -> tuple[np.ndarray, np.ndarray]:
         """μ_r and σ_r of ln IM (IM in g) in every rupture, from :func:`~stochpound.motions.scenario_distribution`."""
@@ -428,7 +428,7 @@ class RuptureSite:
         unconditional = np.array([part.unconditional_mean_ln for part in parts])
         unconditional_mean = p @ unconditional
         unconditional_var = p @ (np.array([part.unconditional_sigma_ln for part in parts]) ** 2 + (unconditional - unconditional_mean) ** 2)
-        attrs = {"epsilon": float(p @ epsilon), **conditioning_attrs(conditioning_measure(measure, period), level), **self.mean_scenario(p),
+        attrs = {"epsilon": float(p @ epsilon), **conditioning_attrs(conditioning_measure(measure, period), level), **self.mean_scenario(p).loose(),
                  "weights": WEIGHT_TEXT[weights], "ruptures": len(self), "site": self.name or "a site of ruptures"}
         target = spectrum_dataset(parts[0].periods, mean, within + between, unconditional_mean, np.sqrt(unconditional_var), attrs)
         target["between_sigma_ln"] = ("period", np.sqrt(np.clip(np.diag(between), 0.0, None)),
@@ -508,7 +508,7 @@ def _solve(rates: np.ndarray, mean: np.ndarray, sigma: np.ndarray, rate: Any) ->
     return np.exp(np.vectorize(lambda wanted: brentq(excess, low, high, args=(wanted,), xtol=1e-12))(target))
 
 
-def _rupture_scenario(row: Mapping[str, Any], site: Mapping[str, Any], names: Mapping[str, str]) -> Scenario:
+def _rupture_scenario(row: Mapping[str, float | str], site: Mapping[str, float | None], names: Mapping[str, str]) -> Scenario:
     """The rupture's scenario, checked: a :class:`SiteError` naming the field (``names``) outside the models' range, or a rate not > 0."""
     rate = row["rate"]
     if isinstance(rate, bool) or not isinstance(rate, (int, float)) or not np.isfinite(rate) or rate <= 0:

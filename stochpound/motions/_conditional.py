@@ -291,7 +291,7 @@ def _distribution(conditioning: list[float | None], output: np.ndarray, levels: 
 
 
 def spectrum_dataset(periods: np.ndarray, mean_ln: np.ndarray, covariance: np.ndarray, unconditional_mean_ln: np.ndarray,
-                     unconditional_sigma_ln: np.ndarray, attrs: Mapping[str, object]) -> xr.Dataset:
+                     unconditional_sigma_ln: np.ndarray, attrs: Mapping[str, float | str]) -> xr.Dataset:
     """A conditional spectrum as :func:`conditional_spectrum` returns it, from the conditional mean and covariance of ln Sa (g)."""
     sigma = np.sqrt(np.clip(np.diag(covariance), 0.0, None))
     with np.errstate(divide="ignore", invalid="ignore"):

@@ -103,9 +103,9 @@ class Measure:
             return cls(kind, None, tuple(float(p) for p in (period if period is not None else ())), damping)
         return cls(kind, None if period is None else float(period), (), damping)  # type: ignore[arg-type]
 
-    def entry(self) -> dict[str, Any]:
+    def entry(self) -> dict[str, str | float | list[float]]:
         """The canonical keys (``measure`` and those of ``period``, ``periods``, ``damping`` that are set), as definitions store them."""
-        written: dict[str, Any] = {"measure": self.kind}
+        written: dict[str, str | float | list[float]] = {"measure": self.kind}
         if self.period is not None:
             written["period"] = self.period
         if self.periods:

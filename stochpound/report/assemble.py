@@ -85,7 +85,7 @@ def assemble_report(paths: Sequence[str | Path], progress: Callable[[str], None]
     report = Report(
         title="; ".join(study.TITLE for study in studies.values()) if studies else f"Pounding experiments: {', '.join([*others, *(d.attrs['experiment_name'] for d in rare.values())])}",
         subtitle=f"stochpound report of {', '.join(stores)}, built {date.today().isoformat()}",
-        sources=[f"{name}: {store.attrs.get('experiment_file', '')}, definition sha256 {store.attrs.get('definition_sha256', '')}" for name, store in stores.items()],
+        sources=[f"{name}: {store.pound.provenance.experiment_file}, definition sha256 {store.pound.sha256}" for name, store in stores.items()],
     )
     for key, study in studies.items():
         for title, section_key, build in study.sections({part: stores[name] for part, name in claimed[key].items()}):
@@ -148,7 +148,7 @@ def assemble_report(paths: Sequence[str | Path], progress: Callable[[str], None]
 
 def _about(stores: dict[str, xr.Dataset], sections: list[Section]) -> str:
     """What the report of stores no study claims holds, and how to read it: only what its ``sections`` contain."""
-    described = "; ".join(f"{name}: {store.attrs.get('experiment_description', '')}" for name, store in stores.items())
+    described = "; ".join(f"{name}: {store.pound.provenance.experiment_description}" for name, store in stores.items())
     kinds = {section.key.split("-", 1)[0] for section in sections}
     figures = [block.key for section in sections for block in section.blocks if isinstance(block, FigureItem)]
     parts = [f"This report describes the experiment stores {described}."]

@@ -37,7 +37,7 @@ import xarray as xr
 from stochpound._memory import check_memory
 from stochpound.hazard import HazardCurve, rate_from_probability
 from stochpound.risk import _inputs
-from stochpound.risk._inputs import Intensity, RiskInputError, RiskInputs, read_risk_inputs
+from stochpound.risk._inputs import Design, Intensity, RiskInputError, RiskInputs, read_risk_inputs
 from stochpound.risk._code_rules import MINIMUM_MOTIONS, code_rules_risk
 from stochpound.risk._design_rules import DESIGN_RULE_NAMES, design_rules_risk, design_rules_text
 from stochpound.risk._fragility_ensemble import BOOTSTRAP, fragility_band, fragility_surface, homogeneous_capacities, ida_fragility, limit_state_events, stripe_fragility
@@ -167,7 +167,7 @@ class StoreRisk:
         (:func:`~stochpound.risk.design_rules_risk`); None without a ``[design]`` or without stripes.
     design_note : str
         Why ``design_rules`` is None ("" otherwise).
-    assumptions : dict of str to str
+    assumptions : dict[str, str]
         What the answer rests on besides the hazard, in words from the
         store's definition: ``structural model``, ``suite`` (and its
         selection), ``scenario``.
@@ -230,7 +230,7 @@ class StoreRisk:
         """The dimensions of :meth:`to_frame` that name a configuration (every grid axis but the gap)."""
         return [c for c in self.to_frame().columns if c not in ("target", *_SEPARATION, "lower_bound", "confidence", "motions")]
 
-    def by_configuration(self, frame: pd.DataFrame) -> list[tuple[dict[str, Any], pd.DataFrame]]:
+    def by_configuration(self, frame: pd.DataFrame) -> list[tuple[dict[str, str | float | int], pd.DataFrame]]:
         """The rows of ``frame`` (:meth:`to_frame`, :meth:`design_frame`) per configuration, in their order: its labels
         (dimension -> value of :meth:`configuration_dims`; empty for the one configuration of a scene without axes) and its rows."""
         config = self.configuration_dims()
@@ -594,7 +594,7 @@ def bound_beyond_stripes(separation: xr.Dataset, fragility: xr.Dataset, hz: Haza
 
 def store_risk(store: xr.Dataset | RiskInputs, hz: HazardCurve | None = None, targets: Sequence[float] = TARGETS, years: float = YEARS,
                gaps: Sequence[float] | np.ndarray | None = None, studied: str | None = None, confidence: float = CONFIDENCE,
-               bootstrap: int = BOOTSTRAP, seed: int = 0, design: Mapping[str, Any] | None = None, partial: bool = False) -> StoreRisk:
+               bootstrap: int = BOOTSTRAP, seed: int = 0, design: Design | None = None, partial: bool = False) -> StoreRisk:
     """Fragility at every gap, the pounding risk curve, g* and the code rules of a store's intensity-conditioned runs.
 
     Parameters
@@ -622,8 +622,8 @@ def store_risk(store: xr.Dataset | RiskInputs, hz: HazardCurve | None = None, ta
         the store's ``studied`` building. The rule is left out where it does not slide.
     confidence, bootstrap, seed
         As in :func:`~stochpound.risk.stripe_fragility`.
-    design : mapping, optional
-        The buildings' code design (the ``[design]`` entry, docs/experiments.md)
+    design : Design, optional
+        The buildings' code design (an experiment file's ``[design]`` table, docs/experiments.md, parsed)
         whose design analysis gives the codes' own gaps; default the store's.
     partial : bool
         Answer from the cases that ran of a store with missing cases (its

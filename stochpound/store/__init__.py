@@ -72,7 +72,9 @@ from stochpound.store._gap_axes import (
     with_contacts,
     with_walls,
 )
+from stochpound.store._motion_table import MotionTable
 from stochpound.store._open import open_store
+from stochpound.store._provenance import Provenance, VariableAttributes
 from stochpound.store._scenario import SCENARIO_KINDS, scenario_kind, scenario_ranges
 from stochpound.store._selections import fixed_base, has_fixed_base_twins, isolated_mus, select_case
 
@@ -112,15 +114,18 @@ __all__ = [
     "LimitStateCapacities",
     "LimitStates",
     "MotionSource",
+    "MotionTable",
     "MuAxis",
     "Output",
     "Site",
     "Selection",
     "SimulatedMotions",
     "Point",
+    "Provenance",
     "Solver",
     "StoreAccessor",
     "StoreVariable",
+    "VariableAttributes",
     "VariantAxis",
     "canonical_json",
     "contact_free",

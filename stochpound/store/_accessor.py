@@ -28,6 +28,9 @@ from stochpound.store._gap_axes import contact_free, contact_gap_dims, gap_dims,
 from stochpound.store._selections import fixed_base, has_fixed_base_twins
 from stochpound.store._definition import Definition, Hazard, Intensity, read_definition
 from stochpound.store._grid import ExperimentGrid, Label, StoredChoice
+from stochpound.store._motion_table import MotionTable
+from stochpound.store._provenance import Provenance
+from stochpound.store._toml_table import TomlTable
 
 __all__ = ["ACCESSOR", "StoreAccessor"]
 
@@ -83,9 +86,14 @@ class StoreAccessor:
         return _definition(self._text)
 
     @property
+    def provenance(self) -> Provenance:
+        """What wrote the store and how far its runs went (its provenance attributes, typed)."""
+        return Provenance.of(self._dataset)
+
+    @property
     def sha256(self) -> str:
         """The identity of the store's runs (its ``definition_sha256`` attribute)."""
-        return str(self._dataset.attrs.get("definition_sha256", ""))
+        return self.provenance.definition_sha256
 
     @property
     def intensity(self) -> Intensity | None:
@@ -201,10 +209,11 @@ class StoreAccessor:
         motion = grid.motion_table(where["record"], where.get("realization"))
         factor = float(self._at("scale_factor", **labels)) if "scale_factor" in self._dataset else 1.0
         if factor != 1.0:
-            if motion.get("type", "record") not in ("record", "site_motions"):
-                raise ExperimentError(f"case at {labels}: its {motion['type']} motion ran scaled by {factor:.9g} (scale_factor), "
+            typed = MotionTable.of(TomlTable(motion, "motion"))
+            if typed.type not in ("record", "site_motions"):
+                raise ExperimentError(f"case at {labels}: its {typed.type} motion ran scaled by {factor:.9g} (scale_factor), "
                                       "which a generator's [motion] table cannot say; scale the scene's ground motion instead")
-            motion["scale"] = float(motion.get("scale", 1.0)) * factor
+            motion["scale"] = typed.scale * factor
         return scene_from_dict({**grid.structure(case), "motion": motion})
 
     def impacts(self, **labels: Label) -> xr.Dataset:

@@ -28,6 +28,8 @@ from typing import Any, TypeVar
 import numpy as np
 import xarray as xr
 
+from stochpound.store._toml_table import TomlTable
+
 Data = TypeVar("Data", xr.Dataset, xr.DataArray)
 
 SETS = "sets"
@@ -102,12 +104,13 @@ def wall_axis(store: xr.Dataset) -> tuple[str, Any] | None:
         if np.isinf(values).any() and np.isfinite(values).any():
             return axis, float(np.inf)
     definition = store.pound.definition
-    if definition.scene.get("wall"):
+    if TomlTable(definition.scene, "scene").tables("wall"):
         return None
     for axis in definition.variants:
         if axis.name not in store.dims:
             continue
-        walled = {value: bool(axis.overrides[value].get("scene", {}).get("wall")) for value in axis.values}
+        edits = {value: TomlTable(axis.overrides[value], f"variants.{axis.name}.{value}").table_or_empty("scene") for value in axis.values}
+        walled = {value: bool(edit.tables("wall")) for value, edit in edits.items()}
         bare = [value for value, has in walled.items() if not has]
         if bare and any(walled.values()):
             return axis.name, bare[0]

@@ -11,7 +11,6 @@ from __future__ import annotations
 import hashlib
 import json
 import warnings
-from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
@@ -19,6 +18,7 @@ import xarray as xr
 
 from stochpound._errors import ExperimentError
 from stochpound.store._definition import definition_sha256
+from stochpound.store._provenance import Provenance
 
 __all__ = ["open_store"]
 
@@ -69,7 +69,7 @@ def open_store(path: str | Path, chunks: Any = None, *, edited: str = "warn") ->
     if "definition_sha256" not in dataset.attrs:
         dataset.close()
         raise ExperimentError(f"{path}: not a stochpound experiment store (no definition_sha256 attribute)")
-    mismatch = identity_mismatch(dataset.attrs) if edited != "accept" else None
+    mismatch = identity_mismatch(dataset) if edited != "accept" else None
     if mismatch is not None:
         message = f"{path}: {mismatch}: changed since it was written (edited by hand?); its answers may not be its runs'"
         if edited == "refuse":
@@ -79,7 +79,7 @@ def open_store(path: str | Path, chunks: Any = None, *, edited: str = "warn") ->
     return dataset
 
 
-def identity_mismatch(attrs: Mapping[str, Any]) -> str | None:
+def identity_mismatch(store: xr.Dataset) -> str | None:
     """What is wrong with a store's identity, from its attributes, or None when its definition hashes to its ``definition_sha256``.
 
     The recorded sha256 is today's identity (:func:`~stochpound.store.definition_sha256`)
@@ -87,10 +87,10 @@ def identity_mismatch(attrs: Mapping[str, Any]) -> str | None:
     left the identity, the whole definition's. A store without a ``definition``
     attribute (the oldest) has nothing to check.
     """
-    if "definition" not in attrs:
+    if "definition" not in store.attrs:
         return None
-    recorded = str(attrs.get("definition_sha256", ""))
-    text = str(attrs["definition"])
+    recorded = Provenance.of(store).definition_sha256
+    text = str(store.attrs["definition"])
     try:
         definition = json.loads(text)
     except ValueError:

@@ -19,6 +19,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from stochpound.motions import Scenario
+from stochpound.store._toml_table import TomlTable
 
 @dataclass(frozen=True)
 class SimulatedMotions:
@@ -48,11 +49,11 @@ class SimulatedMotions:
     dt: float
 
     @classmethod
-    def from_entry(cls, entry: Mapping[str, Any]) -> SimulatedMotions:
+    def from_entry(cls, entry: Mapping[str, int | str | float]) -> SimulatedMotions:
         """The record of a canonical ``simulated_motions`` entry."""
         return cls(entry["count"], entry["model"], entry["calibration"], entry["seed"], entry["dt"])
 
-    def entry(self) -> dict[str, Any]:
+    def entry(self) -> dict[str, int | str | float]:
         """The canonical ``simulated_motions`` entry."""
         return {"count": self.count, "model": self.model, "calibration": self.calibration, "seed": self.seed, "dt": self.dt}
 
@@ -99,11 +100,12 @@ class Selection:
         """The selection of a canonical ``intensity`` entry (None for the default ``scale``, which has no ``selection`` key)."""
         if "selection" not in entry:
             return None
-        simulated = entry.get("simulated_motions")
+        table = TomlTable(entry, "intensity")
+        simulated, ruptures = table.table("simulated_motions"), table.table("ruptures")
         return cls(entry["selection"], entry["motions"], entry["max_scale_factor"], entry["seed"],
                    tuple(Scenario(s["magnitude"], s["distance_km"], s["vs30"], s["mechanism"]) for s in entry["site"]),
-                   entry.get("max_per_earthquake"), entry.get("exclude_pulses"), entry.get("ruptures"),
-                   SimulatedMotions.from_entry(simulated) if simulated is not None else None)
+                   table.integer("max_per_earthquake", None, low=1), table.raw("exclude_pulses"), None if ruptures is None else ruptures.values,
+                   SimulatedMotions.from_entry(simulated.values) if simulated is not None else None)
 
     def entry(self) -> dict[str, Any]:
         """The selection's keys of the canonical ``intensity`` entry (the optional ones only where given)."""

@@ -40,7 +40,7 @@ class Table:
         or with 4 significant digits.
     note : str
         Text under the table (sources, substitutes, what "difference" means).
-    formats : dict
+    formats : dict[str, str]
         Optional format strings (``"{:.3f}"``) by row label (level 0) or
         column label (last level); a row's format wins.
     label : str

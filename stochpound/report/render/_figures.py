@@ -13,10 +13,11 @@ import itertools
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, TypeVar
 
 import numpy as np
 import xarray as xr
+from matplotlib.artist import Artist
 from matplotlib.figure import Figure
 
 from stochpound.analysis import normal_histogram
@@ -263,7 +264,7 @@ def panel_grid(
         rows, columns, squeeze=False, sharex=True, sharey=True,
         gridspec_kw={"left": left / 7.5, "right": 1 - 0.15 / 7.5, "top": 1 - top / height, "bottom": (bottom + legend) / height, "hspace": 0.45, "wspace": 0.12},
     )
-    entries: dict[str, Any] = {}
+    entries: dict[str, Artist] = {}
     for ax, (panel, curves) in zip(axes.ravel(), panels.items()):
         for curve in curves:
             entries.setdefault(curve.label, _draw(ax, curve))
@@ -291,7 +292,7 @@ def panel_grid(
     return figure
 
 
-def _draw(ax: Any, curve: Curve) -> Any:
+def _draw(ax: Any, curve: Curve) -> Artist:
     """Draw one curve (and its band) on ``ax``; return the artist for the legend."""
     if curve.y is None:
         sample = np.asarray(curve.x, dtype=float)
@@ -309,7 +310,11 @@ def _cycle(count: int) -> list[str]:
     return [STYLES[i % len(STYLES)] for i in range(count)]
 
 
-def spread_panels(grid: Mapping[str, Sequence[Any]], max_panels: int = MAX_PANELS) -> list[tuple[list[dict[str, Any]], dict[str, Any]]]:
+Value = TypeVar("Value")
+"""A value of a grid's dimension (a label of a panel)."""
+
+
+def spread_panels(grid: Mapping[str, Sequence[Value]], max_panels: int = MAX_PANELS) -> list[tuple[list[dict[str, Value]], dict[str, Value]]]:
     """Every combination of ``grid`` (dimension -> values) spread over figures of at most ``max_panels`` panels: per figure,
     its panels' labels and the labels its panels share. The outermost dimensions are split off into separate figures until
     the rest fits; an empty grid gives one figure with one panel."""

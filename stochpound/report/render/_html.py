@@ -93,7 +93,7 @@ def render_html(report: Report, figure_png: dict[str, bytes], date: datetime.dat
     ----------
     report : Report
         The report.
-    figure_png : dict of str to bytes
+    figure_png : dict[str, bytes]
         The PNG file of every figure, by figure key (embedded as base64).
     date : datetime.date, optional
         The generation date shown on the page (default: today).

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import json
 import math
-from collections.abc import Iterable, Mapping
+from collections.abc import Hashable, Iterable, Mapping
 from typing import Any
 
 import numpy as np
@@ -28,6 +28,7 @@ from stochpound.report.sections._stripe_motions import stripe_motions_text
 from stochpound.motions.records import is_suite_member
 from stochpound.model.scene import Building, Contact, Scene
 from stochpound.model.wall import Wall
+from stochpound.store import MotionSource, MotionTable, TomlTable
 
 
 def number(value: float, digits: int = 6) -> str:
@@ -261,17 +262,21 @@ def _scenario_parameters(table: Mapping[str, float | str]) -> tuple[str, dict[st
     text = (f"Site-based stochastic motions of the scenario M {number(float(table['magnitude']))}, R_rup {number(float(table['distance_km']))} km, "
             f"Vs30 {number(float(table['vs30']))} m/s, {str(table['mechanism']).replace('_', '-')} (Rezaeian & Der Kiureghian 2010, "
             f"{calibrated}: {table['calibration']}): each realization's Arias intensity, D5–95, time of 45 % of it, filter frequency, "
-            "its slope and damping, and high-pass corner drawn from the scenario with correlated residuals, then its white noise; "
+            "its slope and damping, and high-pass corner drawn from the scenario with correlated residuals, "
+            + ("then a spectral-shape filter whose random gains follow the scenario's NGA-West2 medians and σ, " if table["model"] == "hazard_compatible" else "")
+            + "then its white noise; "
             "ends at rest; linear interpolation between samples")
     return text, {"dt": float(table["dt"]), "duration": float(table["duration"])}
 
 
-def _synthetic_parameters(table: Mapping[str, Any], start: int) -> tuple[str, dict[str, Any]]:
-    """The generator's parameters as run, with the intensity S0 and σ it implies (one realization is generated)."""
+def _synthetic_parameters(source: MotionSource) -> tuple[str, dict[Hashable, Any]]:
+    """The ensemble's generator parameters as run, with the intensity S0 and σ it implies (one realization is generated), and the
+    generated realization's attributes (a scenario ensemble's: its step and window)."""
+    table = source.motion
     if table["type"] == "scenario_motions":
         return _scenario_parameters(table)
     parameters = {k: v for k, v in table.items() if k not in ("type", "interpolation")}
-    attrs = getattr(synthetic_motions, table["type"])(1, start=start, **parameters).attrs
+    attrs = getattr(synthetic_motions, table["type"])(1, start=source.start, **parameters).attrs
     filtered = "omega_g" in attrs  # white noise has no filter
     title = table["type"].replace("_", "–").title() if filtered else "White noise"
     filters = f"ω_g = {number(attrs['omega_g'])} rad/s, ζ_g = {number(attrs['zeta_g'])}" if filtered else "independent samples"
@@ -295,34 +300,36 @@ def _synthetic_parameters(table: Mapping[str, Any], start: int) -> tuple[str, di
     return text, attrs
 
 
-def _analytic_parameters(table: Mapping[str, Any]) -> str:
-    if table["type"] == "harmonic":
-        phase = f" + {number(float(table['phase']))}" if table.get("phase") else ""
-        return f"harmonic a_g = A sin(Ωt{phase}), A = {number(float(table['amplitude']))} m/s², Ω = {number(float(table['omega']))} rad/s"
-    return f"constant a_g = {number(float(table['acceleration']))} m/s²"
+def _analytic_parameters(table: TomlTable) -> str:
+    """A harmonic or constant motion's formula and its parameters."""
+    motion = MotionTable.of(table)
+    if motion.type == "harmonic":
+        phase = f" + {number(motion.phase)}" if motion.phase else ""
+        return f"harmonic a_g = A sin(Ωt{phase}), A = {number(table.number('amplitude'))} m/s², Ω = {number(table.number('omega'))} rad/s"
+    return f"constant a_g = {number(table.number('acceleration'))} m/s²"
 
 
-def _record_parameters(table: Mapping[str, Any]) -> tuple[str, str]:
+def _record_parameters(motion: MotionTable) -> tuple[str, str]:
     """A record's description and its (step, duration) as run."""
-    name = str(table["record"])
+    name = str(motion.record)
     if is_suite_member(name):
         record = load_record(name)
         suite, _, member = name.partition("/")
-        duration = min(record.duration, float(table.get("duration", math.inf)))
+        duration = min(record.duration, motion.duration)
         meta = record.metadata
         return (f"motion {member} of the suite {suite} ({record.description}; {meta['package']}, as recorded; "
                 f"sha256 of the samples {meta['sha256'][:12]}…)"
-                + (f", scaled by {number(float(table['scale']))}" if float(table.get("scale", 1.0)) != 1.0 else ""),
+                + (f", scaled by {number(motion.scale)}" if motion.scale != 1.0 else ""),
                 f"{number(record.dt)} s, {number(duration)} s")
     entry = registry_entries().get(name)
     if entry is None:
-        return f"record file {name} (sha256 {str(table.get('file_sha256'))[:12]}…)", "the file's"
+        return f"record file {name} (sha256 {str(motion.file_sha256)[:12]}…)", "the file's"
     record = load_record(name)
-    duration = min(record.duration, float(table.get("duration", math.inf)))
+    duration = min(record.duration, motion.duration)
     parts = [f"record {name} ({entry.description})"]
-    if float(table.get("scale", 1.0)) != 1.0:
-        parts.append(f"scaled by {number(float(table['scale']))}")
-    parts.append(f"{table.get('interpolation', 'linear')} interpolation between samples")
+    if motion.scale != 1.0:
+        parts.append(f"scaled by {number(motion.scale)}")
+    parts.append(f"{motion.interpolation} interpolation between samples")
     return ", ".join(parts), f"{number(record.dt)} s, {number(duration)} s"
 
 
@@ -331,17 +338,17 @@ def motions_table(definitions: Iterable[StoreDefinition]) -> Table:
     rows = []
     for definition in definitions:
         for motion in definition.definition.motions:
-            table = motion.motion
+            table, typed = motion.motion, MotionTable.of_source(motion)
             if motion.kind == "synthetic":
-                text, attrs = _synthetic_parameters(table, motion.start)
+                text, attrs = _synthetic_parameters(motion)
                 realizations = f"{motion.count} (indices {motion.start}–{motion.start + motion.count - 1}), seed {table['seed']}"
                 grid = f"{number(attrs['dt'])} s, {number(attrs['duration'])} s"
-            elif table.get("type", "record") == "record":
-                text, grid = _record_parameters(table)
+            elif typed.is_record:
+                text, grid = _record_parameters(typed)
                 realizations = "1"
             else:
-                text, realizations = _analytic_parameters(table), "1"
-                grid = f"{number(float(table['dt']))} s, {number(float(table['duration']))} s"
+                text, realizations = _analytic_parameters(TomlTable(table, motion.field)), "1"
+                grid = f"{number(float(table['dt']))} s, {number(typed.duration)} s"
             rows.append([definition.name, motion.label, text, grid, realizations])
     frame = pd.DataFrame(rows, columns=["experiment", "motion", "definition", "step, duration", "realizations"])
     frame.index = pd.RangeIndex(1, len(frame) + 1, name="#")
@@ -374,7 +381,7 @@ def grid_paragraph(definition: StoreDefinition) -> Paragraph:
         f"{len(definition.definition.motions)} motion(s) (Table of motions); g = {number(scene.g)} m/s². The studied building is "
         f"{definition.experiment.studied}: the response whose moments are reported is its top-floor total displacement, and "
         f"it is also run alone on a fixed base under every motion ({references} reference runs). "
-        f"{int(store.attrs.get('cases_done', 0))} of {int(store.attrs.get('cases_total', 0))} runs done."
+        f"{store.pound.provenance.cases_done} of {store.pound.provenance.cases_total} runs done."
     )
 
 
@@ -426,5 +433,6 @@ def model_paragraph(definitions: list[StoreDefinition]) -> Paragraph:
 
 def records_used(definitions: Iterable[StoreDefinition]) -> list[str]:
     """Bundled records run by the stores, sorted."""
-    used = {str(m.motion["record"]) for d in definitions for m in d.definition.motions if m.motion.get("type", "record") == "record" and "record" in m.motion}
+    tables = [MotionTable.of_source(m) for d in definitions for m in d.definition.motions]
+    used = {table.record for table in tables if table.is_record and table.record is not None}
     return sorted(used & set(registry_entries()))

@@ -15,7 +15,7 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
-from stochpound.analysis import RARE, CellStatistics, ForceSpread, Largest
+from stochpound.analysis import RARE, CellLabels, CellStatistics, ForceSpread, Largest
 from stochpound.report.render import Block, Paragraph, Table
 from stochpound.report.sections._ensembles import CM, MIN_RUNS, Ensemble
 from stochpound.experiment import is_fixed_base, is_gap_axis
@@ -36,7 +36,7 @@ def ensemble_findings(ensemble: Ensemble) -> list[Block]:
     for dim in ensemble.grid:
         if is_gap_axis(dim) and len(ensemble.grid[dim]) > 1:
             blocks += gap_effect(ensemble, dim)
-    mus = ensemble.grid.get("mu", [])
+    mus = ensemble.mus
     if has_fixed_base_twins(mus):
         blocks += isolation_effect(ensemble)
     return blocks
@@ -122,7 +122,7 @@ def _most(stats: xr.Dataset, fixed: xr.Dataset, largest: Largest | None, verb: s
     if largest is None:
         return ""
 
-    def estimate(data: xr.Dataset, at: dict) -> str:
+    def estimate(data: xr.Dataset, at: CellLabels) -> str:
         return f"{float(data['pounding_probability'].sel(at)):.2f} [{float(data['pounding_probability_lower'].sel(at)):.2f}, {float(data['pounding_probability_upper'].sel(at)):.2f}]"
 
     return f"It {verb} most at {labels_text(largest.cell)}: P(pounding) {estimate(stats, largest.cell)} against {estimate(fixed, largest.fixed)} on a fixed base."
@@ -222,7 +222,7 @@ def isolation_across(ensembles: list[Ensemble]) -> Paragraph | None:
     """Whether isolation's effect on P(pounding) has the same sign in every ensemble (e.g. soils), or where it flips; None without a fixed and a sliding base."""
     counts = {}
     for ensemble in ensembles:
-        mus = ensemble.grid.get("mu", [])
+        mus = ensemble.mus
         if any(is_fixed_base(m) for m in mus) and any(not is_fixed_base(m) for m in mus):
             counts[ensemble.label] = CellStatistics(ensemble.statistics).isolation_totals(mus)
     if len(counts) < 2:

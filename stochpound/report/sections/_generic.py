@@ -63,11 +63,12 @@ def store_section(name: str, store: xr.Dataset, contact_free: bool = False, whol
     dims = [f"{d} ({store.sizes[d] + 1}: {store.sizes[d]} {'clearances' if d in walls else 'gaps'} here and the "
             f"{'wall-free one of the Moat clearance' if d in walls else 'contact-free one of the Separation'} section)" if contact_free and is_gap_axis(d)
             else f"{d} ({store.sizes[d]})" for d in store["case_status"].dims]
+    written = store.pound.provenance
     section.add(Paragraph(
-        f"{store.attrs.get('experiment_description', '')} Studied building: {store.attrs.get('studied_building', '')}; its "
+        f"{written.experiment_description} Studied building: {written.studied_building}; its "
         f"top-floor total displacement is the response, and its peaks are those shown. Dimensions: "
-        f"{', '.join(dims)}; {int(store.attrs.get('cases_done', 0))} of "
-        f"{int(store.attrs.get('cases_total', 0))} runs done (Methods describes every building, contact and motion)."
+        f"{', '.join(dims)}; {written.cases_done} of "
+        f"{written.cases_total} runs done (Methods describes every building, contact and motion)."
     ))
     kinds = dict(zip(store["record"].values.tolist(), store["record_kind"].values.tolist()))
     records = [label for label, kind in kinds.items() if kind != "synthetic"]
@@ -97,8 +98,9 @@ def record_blocks(name: str, store: xr.Dataset) -> list[Block]:
     return blocks
 
 
-def _studied(data: xr.Dataset, store_attrs: dict) -> xr.Dataset:
-    building = str(store_attrs.get("studied_building", ""))
+def _studied(data: xr.Dataset, store: xr.Dataset) -> xr.Dataset:
+    """``data`` (variables of ``store``) of the store's studied building."""
+    building = store.pound.provenance.studied_building
     return data.sel(building=building, drop=True) if "building" in data.dims else data
 
 
@@ -106,7 +108,7 @@ def summary_table(name: str, data: xr.Dataset) -> Table:
     """Every case of the records: its summaries, one row per case."""
     walls = walls_only(data)
     present = [v for v in COLUMNS if v in data and not (walls and v in PHASES)]  # a wall hit has no phase
-    values = _studied(data[present], data.attrs).load()
+    values = _studied(data[present], data).load()
     dims = list(data["case_status"].dims)
     frame = pd.DataFrame({COLUMNS[v][0]: (values[v] * COLUMNS[v][1]).transpose(*dims).to_series() for v in present})
     rows = [label if isinstance(label, tuple) else (label,) for label in frame.index]
@@ -125,7 +127,7 @@ def summary_table(name: str, data: xr.Dataset) -> Table:
 
 def against_axis(name: str, data: xr.Dataset, grid: dict[str, list], axis: str) -> list[FigureItem]:
     """Summaries against ``axis`` (a gap axis or μ), one line per value of one other axis, one panel per combination of the rest."""
-    values = _studied(data[[v for v in AGAINST if v in data]], data.attrs).load()
+    values = _studied(data[[v for v in AGAINST if v in data]], data).load()
     x_values = grid[axis]
     others = [d for d in grid if d != axis]
     line_dim = next((d for d in ("mu", *others) if d in others and len(grid[d]) > 1), None)

@@ -28,7 +28,7 @@ import xarray as xr
 
 from stochpound.analysis import MIN_RUNS, CellLabels
 from stochpound.experiment import is_gap_axis
-from stochpound.store import Definition
+from stochpound.store import Definition, TomlTable
 from stochpound.model import laws
 from stochpound.report.render import Block, FigureItem, Paragraph, Section, figures
 from stochpound.report.sections._ensembles import Ensemble
@@ -82,13 +82,14 @@ def law_axis(store: xr.Dataset) -> str | None:
 
 def variant_laws(definition: Definition, axis: str) -> dict[str, str]:
     """Each value of variant ``axis`` -> the contact laws of its scene (joined with "/" when the contacts differ)."""
-    scene_laws = [str(c.get("law", laws.DEFAULT_CONTACT_LAW)) for c in definition.scene.get("contact", [])]
+    scene_laws = [contact.string("law", laws.DEFAULT_CONTACT_LAW) for contact in TomlTable(definition.scene, "scene").tables("contact")]
     variant = next(v for v in definition.variants if v.name == axis)
     result = {}
     for value in variant.values:
-        part = variant.overrides[value].get("contact")
-        tables = part if isinstance(part, list) else [part or {}] * len(scene_laws)
-        names = [str(t.get("law", own)) if "law" in t else own for t, own in zip(tables, scene_laws)]
+        edit = TomlTable(variant.overrides[value], f"variants.{axis}.{value}")
+        part = edit.raw("contact")  # one table for every contact, or a list of one table per contact
+        tables = edit.tables("contact") if isinstance(part, list) else [edit.table_or_empty("contact")] * len(scene_laws)
+        names = [table.string("law", own) for table, own in zip(tables, scene_laws)]
         result[value] = "/".join(dict.fromkeys(names))
     return result
 

@@ -28,7 +28,7 @@ import xarray as xr
 
 from stochpound.analysis import CellLabels, MechanismCells
 from stochpound.experiment import is_gap_axis
-from stochpound.store import contact_free, contact_gap_dims, has_contact_free, wall_axis, with_contacts
+from stochpound.store import TomlTable, contact_free, contact_gap_dims, has_contact_free, wall_axis, with_contacts
 from stochpound.report.render import Block, Paragraph
 from stochpound.report.sections._ensembles import CM, MIN_RUNS, Ensemble
 from stochpound.report.sections._facets import dim_text, labels_text, value_text
@@ -245,9 +245,9 @@ def penetration_text(ensemble: Ensemble, walls: str | None) -> str:
     axis ``walls`` that adds them or sets their clearance (if any): what a 'rigid' wall is here."""
     penetration = ensemble.wall_penetration(walls)
     definition = ensemble.data.pound.definition
-    tables = list(definition.scene.get("wall", [])) + [w for axis in definition.variants for override in axis.overrides.values()
-                                                       for w in override.get("scene", {}).get("wall", [])]
-    stiffness = sorted({float(w["stiffness"]) for w in tables if "stiffness" in w})
+    edits = [TomlTable(override).table_or_empty("scene") for axis in definition.variants for override in axis.overrides.values()]
+    tables = [*TomlTable(definition.scene, "scene").tables("wall"), *(wall for edit in edits for wall in edit.tables("wall"))]
+    stiffness = sorted({wall.number("stiffness") for wall in tables if "stiffness" in wall})
     runs = penetration.runs
     if runs == 0:
         return f"Wall penetration ({ensemble.label}): no run with a wall is in the store."
@@ -259,6 +259,6 @@ def penetration_text(ensemble: Ensemble, walls: str | None) -> str:
         + (f" (k = {', '.join(f'{k / 1e6:.4g}' for k in stiffness)} MN/m)" if stiffness else "")
         + f" that the level it faces penetrates while in contact. Over the {runs} runs with a wall the largest penetration is "
         f"{largest * CM:.3g} cm ({largest * 1000:.3g} mm), at {labels_text({k: v for k, v in at.items() if k != 'realization'})}, realization "
-        f"{at.get('realization')}{per_wall}. It is the located peak of the level's displacement toward each "
+        f"{penetration.realization}{per_wall}. It is the located peak of the level's displacement toward each "
         "wall beyond its gap (store variable peak_wall_penetration), not a sampled value."
     )

@@ -21,6 +21,7 @@ from stochpound.report.sections._description import StoreDefinition, buildings_t
 from stochpound.report.render import Paragraph, Section, Table
 from stochpound.report.sections._intensity import method_text
 from stochpound.report.sections._risk import hazard_provenance
+from stochpound.store import MotionTable
 
 #: Packages whose versions the report lists.
 PACKAGES = ("numpy", "scipy", "xarray", "numba", "dask", "pandas", "matplotlib", "h5netcdf", "jinja2")
@@ -131,7 +132,7 @@ def suites_paragraph(definitions: list[StoreDefinition]) -> Paragraph | None:
     used: dict[str, set[str]] = {}
     for definition in definitions:
         for motion in definition.definition.motions:
-            record = str(motion.motion.get("record", ""))
+            record = MotionTable.of_source(motion).record or ""
             suite = motion.suite or (record.partition("/")[0] if is_suite_member(record) else None)
             if suite:
                 used.setdefault(suite, set()).add(record)
@@ -148,12 +149,12 @@ def suites_paragraph(definitions: list[StoreDefinition]) -> Paragraph | None:
 
 def experiment_provenance(name: str, store: xr.Dataset) -> str:
     """One store: what it ran, how far, with what, and its identity."""
-    attrs = store.attrs
+    written = store.pound.provenance
     return (
-        f"Experiment {name} ({attrs.get('experiment_file', '')}): {attrs.get('experiment_description', '')}. "
-        f"{int(attrs.get('cases_done', 0))} of {int(attrs.get('cases_total', 0))} cases done, solver "
-        f"{attrs.get('solver', '')}, stochpound {attrs.get('stochpound_version', '')} (commit {attrs.get('git_commit', 'unknown')}), "
-        f"definition sha256 {str(attrs.get('definition_sha256', ''))[:16]}…"
+        f"Experiment {name} ({written.experiment_file}): {written.experiment_description}. "
+        f"{written.cases_done} of {written.cases_total} cases done, solver "
+        f"{written.solver}, stochpound {written.stochpound_version} (commit {written.git_commit}), "
+        f"definition sha256 {written.definition_sha256[:16]}…"
     )
 
 

@@ -39,6 +39,7 @@ from stochpound.report.render import Block, FigureItem, Paragraph, Section, Tabl
 from stochpound.report.sections._facets import labels_text
 from stochpound.report.sections._stripe_motions import is_selected
 from stochpound.risk import MODEL_DRIFT_LIMIT, CollapseRisk, Sensitivity, StoreDamage, StoreDemands, StoreRisk
+from stochpound.store import VariableAttributes
 
 
 def hazard_provenance(store: xr.Dataset) -> str:
@@ -106,7 +107,7 @@ def _with_interval(risk: StoreRisk, what: str, shown: str = "") -> str:
 def _resampling(risk: StoreRisk) -> str:
     """How the intervals resampled the motions, as the chain's results say (by motion, or by event where the store knows them)."""
     lower = risk.separation["lower"] if "lower" in risk.separation else None
-    return (lower.attrs.get("method") if lower is not None else None) or "BCa bootstrap over motions"
+    return (VariableAttributes.of(lower).method if lower is not None else None) or "BCa bootstrap over motions"
 
 
 def summary_answer(name: str, risk: StoreRisk) -> list[Block]:

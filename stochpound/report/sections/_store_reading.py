@@ -44,7 +44,7 @@ def open_stores(paths: Sequence[str | Path], edited: str = "warn") -> dict[str, 
             raise
         except (OSError, ValueError, KeyError) as error:
             raise StochpoundError(f"store {path}: not a readable stochpound store ({error})") from None
-        name = str(store.attrs.get("experiment_name", ""))
+        name = store.pound.provenance.experiment_name
         if not name:
             raise StochpoundError(f"store {path}: not a stochpound store (no experiment_name attribute)")
         if name in stores:

@@ -52,7 +52,7 @@ def experiment_summary(stores: dict[str, xr.Dataset], sections: list[Section], c
     risks = risks or {}
     summary = Section("Summary", key="summary")
     for name, store in stores.items():
-        description = str(store.attrs.get("experiment_description", "")).strip()
+        description = store.pound.provenance.experiment_description.strip()
         summary.add(Paragraph(f"Experiment {name}{': ' + description if description else ''}. The questions its runs answer:".replace(".. ", ". ")))
         kinds = dict(zip(store["record"].values.tolist(), store["record_kind"].values.tolist()))
         ensembles = [label for label, kind in kinds.items() if kind == "synthetic"]

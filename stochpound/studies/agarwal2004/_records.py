@@ -12,6 +12,7 @@ from functools import lru_cache
 from typing import Any
 
 from stochpound.motions.records import Record, record_statistics, records_dir
+from stochpound.store import TomlTable
 
 #: The reference study's g, m/s².
 STUDY_G = 9.814
@@ -39,7 +40,7 @@ def study_table_3_2(row: str | None = None) -> dict[str, Any]:
 def _table_3_2() -> dict[str, Any]:
     """The ``study_table_3_2`` table of the bundled records' ``registry.toml``."""
     with open(records_dir() / "registry.toml", "rb") as handle:
-        return tomllib.load(handle).get("study_table_3_2", {})
+        return dict(TomlTable(tomllib.load(handle)).table_or_empty("study_table_3_2").values)
 
 _ROWS = (
     ("npts", "points", "{:d}"),
@@ -69,7 +70,8 @@ def record_report(record: Record, g: float = STUDY_G) -> str:
         m/s² for unit conversion, the peak in g and the Arias intensity.
     """
     stats = record_statistics(record, g=g).as_dict()
-    row_key = record.metadata.get("study_row")
+    metadata = TomlTable(record.metadata, f"records.{record.name}")
+    row_key = metadata.string("study_row", None)
     study = study_table_3_2(str(row_key)) if row_key else None
     lines = [
         f"{record.name}",
@@ -91,6 +93,6 @@ def record_report(record: Record, g: float = STUDY_G) -> str:
             theirs = f"{int(study['npts']):d}"
         lines.append(f"  {label:24s}{ours:>16s}{theirs:>18s}" if study else f"  {label:24s}{ours:>16s}")
     if study:
-        relation = record.metadata.get("study_relation", "")
+        relation = metadata.string("study_relation", "")
         lines += ["", f"  study record: {study['label']}; relation: {relation}"]
     return "\n".join(line for line in lines if line is not None)
