@@ -30,7 +30,7 @@ from stochpound.store._definition import Definition, Hazard, Intensity, read_def
 from stochpound.store._grid import ExperimentGrid, Label, StoredChoice
 from stochpound.store._motion_table import MotionTable
 from stochpound.store._provenance import Provenance
-from stochpound.store._toml_table import TomlTable
+from stochpound.model.fields import TomlTable
 
 __all__ = ["ACCESSOR", "StoreAccessor"]
 

@@ -28,7 +28,7 @@ from typing import Any, TypeVar
 import numpy as np
 import xarray as xr
 
-from stochpound.store._toml_table import TomlTable
+from stochpound.model.fields import TomlTable
 
 Data = TypeVar("Data", xr.Dataset, xr.DataArray)
 

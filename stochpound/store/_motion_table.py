@@ -15,7 +15,7 @@ import math
 from dataclasses import dataclass
 
 from stochpound.store._definition import MotionSource
-from stochpound.store._toml_table import TomlTable
+from stochpound.model.fields import TomlTable
 
 __all__ = ["MotionTable"]
 

@@ -19,7 +19,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from stochpound.motions import Scenario
-from stochpound.store._toml_table import TomlTable
+from stochpound.model.fields import TomlTable
 
 @dataclass(frozen=True)
 class SimulatedMotions:
