@@ -9,7 +9,7 @@ from stochpound import open_store, simulate
 from stochpound.experiment._runner import load_experiment, run_experiment
 from stochpound.model.scene_file import scene_from_dict
 from stochpound.motions import SYNTHETIC_TYPES, normal_motion, realization_rng, scenario_motions, site_model_provenance, site_motions
-from stochpound.report.sections._description import StoreDefinition, _synthetic_parameters, motions_table
+from stochpound.report.sections._description import StoreDefinition, _scenario_parameters, motions_table
 from stochpound.store import with_motion
 from tests.helpers import SITE_SCENE, write_experiment
 
@@ -90,7 +90,8 @@ def test_a_scenario_table_out_of_range_is_one_line_naming_the_field(tmp_path, ed
 def test_the_motions_table_says_what_the_motions_are() -> None:
     entry = {"type": "scenario_motions", **SCENARIO, "seed": 5, "dt": 0.02, "duration": 30.0, "model": "hazard_compatible",
              "calibration": site_model_provenance()}
-    text, grid = _synthetic_parameters(entry, 0)
+    text, grid = _scenario_parameters(entry)
     assert text.startswith("Site-based stochastic motions of the scenario M 6.8, R_rup 15 km, Vs30 450 m/s, reverse (Rezaeian & Der Kiureghian 2010, "
                            f"calibrated to the NGA-West2 models: {site_model_provenance()})")
+    assert "a spectral-shape filter whose random gains follow the scenario's NGA-West2 medians and σ" in text
     assert grid == {"dt": 0.02, "duration": 30.0}
