@@ -23,7 +23,8 @@ from scipy.special import ndtr, ndtri
 
 import stochpound
 import stochpound.model
-from stochpound.analysis import subset_simulation
+from stochpound.analysis import SubsetSampler, subset_simulation
+from stochpound.analysis._subset_simulation import INITIAL_SCALE, TARGET_ACCEPTANCE
 from stochpound.motions import normal_motion
 from stochpound.motions.ground import SampledMotion
 
@@ -85,9 +86,10 @@ def test_the_reference_oscillator_has_its_closed_form_variance():
     assert sigma == pytest.approx(math.sqrt(math.pi * S / (2.0 * ZETA * OMEGA**3)), rel=0.01)
 
 
-def test_one_run_agrees_with_importance_sampling_at_every_threshold():
+@pytest.mark.parametrize("proposal", ["mma", "acs"])
+def test_one_run_agrees_with_importance_sampling_at_every_threshold(proposal):
     """One subset run gives the curve at 1.6 and 2.1 (P ≈ 8e-3 and 3e-5), each within 3 of its CoV of the reference."""
-    result = subset_simulation(_peak, thresholds=[1.6, 2.1], samples_per_level=500, p0=0.1, seed=3, dimension=N_TIME)
+    result = subset_simulation(_peak, thresholds=[1.6, 2.1], samples_per_level=500, p0=0.1, seed=3, dimension=N_TIME, proposal=proposal)
     for b, probability, cov in zip(result.threshold.values, result.probability.values, result.cov.values):
         reference, reference_cov = _isee(b, 600, seed=1)
         assert reference_cov < 0.05
@@ -104,13 +106,42 @@ def test_same_seed_same_estimate_and_the_runs_counted():
     assert counted.attrs["runs"] == sum(calls)
 
 
-def test_a_half_space_has_its_exact_probability():
+@pytest.mark.parametrize(("proposal", "p0"), [("mma", 0.1), ("acs", 0.1), ("acs", 0.25)])
+def test_a_half_space_has_its_exact_probability(proposal, p0):
     """g(u) = u_1 in 50 dimensions: P(g > b) = Φ(−b) exactly, down to 1e-6, within 3 reported CoV."""
     b = np.array([1.0, 2.5, 4.0, 4.75])
-    result = subset_simulation(lambda u: u[:, 0], thresholds=b, samples_per_level=1000, p0=0.1, seed=2, dimension=50)
+    result = subset_simulation(lambda u: u[:, 0], thresholds=b, samples_per_level=1000, p0=p0, seed=2, dimension=50, proposal=proposal)
     exact = ndtr(-b)
     assert np.all(np.abs(result.probability.values / exact - 1.0) < 3.0 * result.cov.values)
     assert np.all(result.cov.values < 0.5)
+
+
+def test_adaptive_conditional_sampling_leaves_the_standard_normal_invariant():
+    """Without a threshold every aCS candidate is accepted: the chains are Gaussian AR(1) processes u' = ρ u + σ z,
+    ρ = √(1 − σ²), whose states stay standard normal and whose lag-1 correlation is ρ (each to 5 of its standard errors)."""
+    spread = np.array([0.1, 0.5, 0.9, 1.0, 0.3])
+    chains = 4000
+    sampler = SubsetSampler(lambda u: np.zeros(len(u)), 5, 10 * chains, 0.1, seed=4, proposal="acs")
+    u = np.random.default_rng(0).standard_normal((chains, 5))
+    run = sampler.advance(1, u, np.zeros(chains), -np.inf, range(chains), spread)
+    assert run.states.shape == (chains, 10, 5) and run.accepted == chains * 9
+    last = run.states[:, -1, :]
+    assert np.all(np.abs(last.mean(axis=0)) < 5.0 / math.sqrt(chains))
+    assert np.all(np.abs(last.var(axis=0) - 1.0) < 5.0 * math.sqrt(2.0 / chains))
+    lag = np.mean(run.states[:, 1:, :] * run.states[:, :-1, :], axis=(0, 1))
+    assert np.all(np.abs(lag - np.sqrt(1.0 - spread**2)) < 5.0 / math.sqrt(chains))
+
+
+def test_adaptive_conditional_sampling_adapts_its_spread_to_the_target_acceptance():
+    """On a half-space the groups' spread scale λ, from 0.6, rises over level 1 (whose candidates are accepted more often than
+    44 %) and settles where about 44 % are accepted at the levels after it, its groups covering each level's chains."""
+    result = subset_simulation(lambda u: u[:, 0], thresholds=[4.75], samples_per_level=1000, p0=0.1, seed=2, dimension=50, proposal="acs")
+    assert result.attrs["acceptance"][0] > TARGET_ACCEPTANCE and result.attrs["scale"][0] > INITIAL_SCALE
+    assert np.all(np.abs(result.attrs["acceptance"][1:] - TARGET_ACCEPTANCE) < 0.05)
+    assert result.attrs["proposal"] == "acs" and len(result.attrs["scale"]) == result.attrs["levels"] - 1
+    sampler = SubsetSampler(_peak, N_TIME, 1000, 0.1, seed=0, proposal="acs")
+    groups = sampler.groups(104)  # 100 chains and 4 that tie
+    assert [len(g) for g in groups] == [10] * 9 + [14] and groups[0].start == 0 and groups[-1].stop == 104
 
 
 @pytest.mark.slow
@@ -150,6 +181,7 @@ def test_the_scene_runs_the_oscillator_of_the_reference():
     ({"thresholds": []}, "thresholds: must be one or more finite numbers"),
     ({"seed": -1}, "seed: must be an integer >= 0"),
     ({"dimension": None}, "dimension: must be an integer >= 1"),
+    ({"proposal": "gibbs"}, "proposal: must be one of mma, acs, got 'gibbs'"),
 ])
 def test_bad_arguments_are_named(arguments, message):
     settings = {"thresholds": [1.0], "samples_per_level": 100, "p0": 0.1, "seed": 0, "dimension": 3, **arguments}
