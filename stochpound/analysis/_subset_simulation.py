@@ -169,7 +169,14 @@ class SubsetSampler:
 
         All chains advance together: g is called on every chain's candidate
         at once. ``spread``: aCS's σ (n,) of these chains' group (:meth:`spread`).
+
+        Raises
+        ------
+        ValueError
+            aCS without ``spread``.
         """
+        if self.proposal == "acs" and spread is None:
+            raise ValueError("spread: adaptive conditional sampling needs its group's spread (SubsetSampler.spread)")
         generators = [_generator(self.seed, level, chain) for chain in chains]
         move_one = _modified_metropolis if self.proposal == "mma" else functools.partial(_conditional_normal, spread)
         states, responses, accepted = [u], [y], 0
@@ -238,7 +245,7 @@ class SubsetSampler:
             part = slice(chains.start, chains.stop)
             spread = self.spread(u, scale) if self.proposal == "acs" else None
             run = self.advance(level, u[part], y[part], threshold, chains, spread)
-            if spread is not None and self.length > 1:
+            if spread is not None:
                 scale = self.adapt(scale, run.accepted / (len(chains) * (self.length - 1)), group)
             runs.append(run)
         return ChainRun(np.concatenate([r.states for r in runs]), np.concatenate([r.responses for r in runs]), sum(r.accepted for r in runs)), scale

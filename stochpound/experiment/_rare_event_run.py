@@ -225,7 +225,7 @@ def _level(store: Path, sampler: SubsetSampler, definition: RareEventDefinition,
             report.batches_now += 1
             if stop_after is not None and report.batches_now >= stop_after:
                 raise KeyboardInterrupt
-        if acs and sampler.length > 1:
+        if acs:
             done = [load_arrays(batch_path(store, index, number)) for number, _, _ in batches]
             moves = sum(b["responses"].shape[0] for b in done) * (sampler.length - 1)
             scale = sampler.adapt(scale, sum(int(b["accepted"]) for b in done) / moves, group)
