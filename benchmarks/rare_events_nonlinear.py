@@ -106,12 +106,13 @@ def section(measured: dict[str, dict], info: dict[str, str], samples: int) -> st
         result, crude = m["result"], m["crude"]
         probability, cov, thresholds = result.probability.values, result.cov.values, result.threshold.values
         last = int(np.flatnonzero(probability > 0)[-1])
+        unit, heading = (f" {m['units']}", f" ({m['units']})") if m["units"] != "1" else ("", "")
         lines += [
             f"**{name[0].upper() + name[1:]}**: {result.attrs['levels']} levels, {result.attrs['runs']} runs, {m['subset_time']:.0f} s; "
-            f"P = {probability[last]:.3g} (reported CoV {cov[last]:.0%}) above {thresholds[last]:.3g} {m['units']}; "
+            f"P = {probability[last]:.3g} (reported CoV {cov[last]:.0%}) above {thresholds[last]:.3g}{unit}; "
             f"crude Monte Carlo {crude.size} runs, {m['crude_time']:.0f} s.",
             "",
-            f"| threshold ({m['units']}) | subset simulation (reported CoV) | crude MC (its CoV) | difference / combined standard deviation |",
+            f"| threshold{heading} | subset simulation (reported CoV) | crude MC (its CoV) | difference / combined standard deviation |",
             "|---:|---:|---:|---:|",
         ]
         for p in CRUDE_PROBABILITIES:
