@@ -128,6 +128,9 @@ def test_adaptive_conditional_sampling_resumes_to_the_run_made_in_one_process(tm
     assert np.array_equal(alone.attrs["level_thresholds"], store["level_threshold"].values[1:]) and alone.attrs["runs"] == store.attrs["runs"]
     assert np.array_equal(alone.attrs["acceptance"], store["level_acceptance"].values[1:])
     assert store.attrs["method"].startswith("subset simulation (Au & Beck 2001), adaptive conditional sampling")
+    from stochpound.report.sections._rare_events import _conditions
+
+    assert "Au & Beck 2001; adaptive conditional sampling" in _conditions(rare_event_results(store))
 
 
 def test_the_default_proposal_keeps_the_definition_of_earlier_stores(tmp_path):
