@@ -212,7 +212,8 @@ class SubsetSampler:
         if len(seeds) == len(y) or len(seeds) > 2 * self.chains:
             raise ValueError(
                 f"response: ties at level {level}'s threshold ({threshold:g} is the response of {len(seeds) - self.chains + 1} of its {len(y)} samples); "
-                "subset simulation needs a response that keeps varying (e.g. the closure rather than the impact force)"
+                "subset simulation needs a response that keeps varying (e.g. the closure rather than the impact force) "
+                "and chains that move (a level of a chain stuck on one state ties too)"
             )
         if self.proposal == "acs":
             seeds = _generator(self.seed, level, self.samples_per_level).permutation(seeds)
