@@ -219,7 +219,7 @@ def _level(store: Path, sampler: SubsetSampler, definition: RareEventDefinition,
     scale = levels[-1].scale if levels else INITIAL_SCALE
     for group, batches in enumerate(_split(sampler, levels)):
         acs = sampler.proposal == "acs" and index > 0
-        spread = sampler.spread(levels[-1].next_states, scale) if acs else None
+        spread = sampler.spread(scale) if acs else None
         for number, result in execute(_tasks(store, sampler, text, levels, batches, spread)):
             save_arrays(batch_path(store, index, number), **result)
             report.batches_now += 1
