@@ -134,14 +134,32 @@ def test_adaptive_conditional_sampling_leaves_the_standard_normal_invariant():
 
 def test_adaptive_conditional_sampling_adapts_its_spread_to_the_target_acceptance():
     """On a half-space the groups' spread scale λ, from 0.6, rises over level 1 (whose candidates are accepted more often than
-    44 %) and settles where about 44 % are accepted at the levels after it, its groups covering each level's chains."""
+    44 %), falls over level 2 (which starts with level 1's λ, too wide for a deeper level: fewer than 44 % accepted) and
+    settles where about 44 % are accepted at the levels after it, its groups covering each level's chains."""
     result = subset_simulation(lambda u: u[:, 0], thresholds=[4.75], samples_per_level=1000, p0=0.1, seed=2, dimension=50, proposal="acs")
     assert result.attrs["acceptance"][0] > TARGET_ACCEPTANCE and result.attrs["scale"][0] > INITIAL_SCALE
-    assert np.all(np.abs(result.attrs["acceptance"][1:] - TARGET_ACCEPTANCE) < 0.05)
+    assert result.attrs["acceptance"][1] < TARGET_ACCEPTANCE and result.attrs["scale"][1] < result.attrs["scale"][0]
+    assert np.all(np.abs(result.attrs["acceptance"][2:] - TARGET_ACCEPTANCE) < 0.05)
     assert result.attrs["proposal"] == "acs" and len(result.attrs["scale"]) == result.attrs["levels"] - 1
     sampler = SubsetSampler(_peak, N_TIME, 1000, 0.1, seed=0, proposal="acs")
     groups = sampler.groups(104)  # 100 chains and 4 that tie
     assert [len(g) for g in groups] == [10] * 9 + [14] and groups[0].start == 0 and groups[-1].stop == 104
+
+
+def test_adaptive_conditional_sampling_does_not_draw_its_spread_from_the_seeds():
+    """A chain's proposal must not depend on the level's seeds, its own among them: a spread of λ × the seeds' standard
+    deviations did, and biased the oscillator's first passage low (×0.4 at 5e-7). Changing the last group's seed leaves
+    every other chain of the level as it was (a group's λ depends only on the earlier groups' acceptance)."""
+    sampler = SubsetSampler(lambda u: u[:, 0], 8, 100, 0.1, seed=5, proposal="acs")
+    seeds = np.random.default_rng(1).standard_normal((sampler.chains, 8))
+    seeds[:, 0] = 1.0 + np.abs(seeds[:, 0])
+    other = seeds.copy()
+    other[-1] = [4.0, 3.0, -3.0, 2.5, -2.5, 3.5, -3.5, 2.0]
+    first, _ = sampler.run_level(1, seeds, seeds[:, 0], 1.0, INITIAL_SCALE)
+    second, _ = sampler.run_level(1, other, other[:, 0], 1.0, INITIAL_SCALE)
+    assert len(sampler.groups(sampler.chains)[-1]) == 1 and first.accepted > 0
+    assert np.array_equal(first.states[:-1], second.states[:-1]) and not np.array_equal(first.states[-1], second.states[-1])
+    assert np.array_equal(sampler.spread(0.3), np.full(8, 0.3)) and np.array_equal(sampler.spread(2.0), np.ones(8))
 
 
 @pytest.mark.slow
