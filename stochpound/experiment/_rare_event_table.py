@@ -23,7 +23,7 @@ from typing import Any, Mapping
 from stochpound._errors import ExperimentError, field_errors
 from stochpound._text_files import read_text_file
 from stochpound.experiment._spec import _base_scene
-from stochpound.analysis import PROPOSALS, RESPONSES
+from stochpound.analysis import PROPOSALS, RESPONSES, warn_uncertified
 from stochpound.motions import SYNTHETIC_TYPES, normal_motion
 from stochpound.store import TomlTable, building_names, building_table, canonical_json
 
@@ -77,7 +77,8 @@ class RareEventTable:
         Most levels, in [2, 40].
     proposal : str
         The chains' proposal: ``mma`` (Au & Beck's component-wise modified
-        Metropolis) or ``acs`` (adaptive conditional sampling).
+        Metropolis) or ``acs`` (adaptive conditional sampling; reading it
+        warns that it is not certified on a scene's responses).
     """
 
     method: str
@@ -199,6 +200,7 @@ def parse_rare_event(values: Any, motion: str, buildings: list[str], scene: Mapp
         if table.raw("motion", motion) != motion:
             raise table.error("motion", f"must name the file's synthetic motion ({motion}), got {table.raw('motion')!r}")
         where = _where(table, response, buildings, scene)
+    warn_uncertified(proposal)
     return RareEventTable(method, response, target, samples, p0, seed, motion, max_levels=max_levels, proposal=proposal, **where)
 
 
