@@ -20,6 +20,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import os
 import tempfile
 import time
 import tomllib
@@ -61,9 +62,11 @@ def measure(samples: int, crude_runs: int, target: float, seed: int, workers: in
     definition = moat_definition(samples, target, seed)
     clock = store.with_suffix(".seconds.json")
     seconds = json.loads(clock.read_text()) if clock.is_file() else {"subset": 0.0, "crude": 0.0}
-    start = time.perf_counter()
+    start, load = time.perf_counter(), os.getloadavg()[0]
     run = run_rare_event(definition, store, workers=workers)
-    seconds["subset"] += time.perf_counter() - start
+    if run.batches_now:  # an invocation that finds the store complete only starts and stops its workers
+        seconds["subset"] += time.perf_counter() - start
+        seconds.setdefault("subset_load", load)
     clock.write_text(json.dumps(seconds))
     if not run.complete:
         return None
@@ -71,6 +74,8 @@ def measure(samples: int, crude_runs: int, target: float, seed: int, workers: in
     crude_sampler = type(sampler)(sampler.function, sampler.dimension, sampler.samples_per_level, sampler.p0, seed + 1000)
     kept = store.with_suffix(".crude.npy")
     crude = np.load(kept) if kept.is_file() else np.empty(0)
+    if crude.size < crude_runs:
+        seconds.setdefault("crude_load", os.getloadavg()[0])
     while crude.size < crude_runs:
         start = time.perf_counter()
         crude = np.concatenate([crude, crude_sampler.start(range(crude.size, min(crude_runs, crude.size + CRUDE_BATCH)))[1]])
@@ -78,7 +83,8 @@ def measure(samples: int, crude_runs: int, target: float, seed: int, workers: in
         seconds["crude"] += time.perf_counter() - start
         clock.write_text(json.dumps(seconds))
     results = rare_event_results(open_rare_event_store(store))
-    return {"results": results, "subset_time": seconds["subset"], "crude": crude[:crude_runs], "crude_time": seconds["crude"]}
+    return {"results": results, "subset_time": seconds["subset"], "crude": crude[:crude_runs], "crude_time": seconds["crude"],
+            "loads": (seconds.get("subset_load", math.nan), seconds.get("crude_load", math.nan))}
 
 
 def section(measured: dict, info: dict[str, str], samples: int, target: float, workers: int) -> str:
@@ -99,7 +105,8 @@ def section(measured: dict, info: dict[str, str], samples: int, target: float, w
         f"(`[rare_event]`, N = {samples} a level, p0 = 0.1, target {target:g}) run by `run_rare_event` (what `stochpound experiment run` runs) on {workers} local "
         f"workers: {results.levels} levels, {results.runs} runs, {measured['subset_time']:.0f} s wall time (summed over the invocations "
         f"that resumed it); crude Monte Carlo of {crude.size} runs of the same response ({measured['crude_time']:.0f} s in one process). Machine: {info['cores']} cores, "
-        f"load {info['load average (1 min) at start']} at the start (commit {info['commit']}, {info['date']}). "
+        f"load {measured['loads'][0]:.1f} at the start of the rare-event run and {measured['loads'][1]:.1f} at the start of the crude runs "
+        f"(commit {info['commit']}, {info['date']}). "
         "`python -m benchmarks rare_events moat` rewrites this section.",
         "",
         f"At the target: P = {probability[last]:.3g} at c = {curve['threshold'].values[last]:.3f} m, CoV {cov[last]:.0%}; the clearance for "

@@ -1,12 +1,15 @@
-"""The rare-event benchmark's linear maps are the solver's responses (benchmarks/rare_events.py)."""
+"""The rare-event benchmarks: their linear maps are the solver's responses (benchmarks/rare_events.py); the moat's, reduced."""
 
 from __future__ import annotations
 
+import math
 from dataclasses import replace
 
 import numpy as np
+import pytest
 
 import stochpound
+from benchmarks import rare_moat
 from benchmarks.rare_events import OSCILLATOR, PAIR_WHITE_NOISE, linear_pair, oscillator, pounding_pair
 from stochpound.motions import normal_motion
 from stochpound.motions.ground import SampledMotion
@@ -33,3 +36,19 @@ def test_the_oscillator_map_is_the_convolution_of_its_impulse_response():
     A[:, 0] = response.first
     u = np.random.default_rng(1).standard_normal((3, response.n))
     assert np.allclose(response.displacements(u), u @ A.T, rtol=0.0, atol=1e-12 * np.abs(u @ A.T).max())
+
+
+@pytest.mark.slow
+def test_the_moat_benchmark_reduced_agrees_with_crude_monte_carlo(tmp_path):
+    """The moat benchmark reduced (N = 100 a level down to 1e-2, 200 crude runs, in this process): the store is complete at the
+    target, and at the clearance of P = 0.1 the subset estimate is within 3 combined standard deviations of crude Monte Carlo."""
+    measured = rare_moat.measure(100, 200, 1e-2, 1, 0, tmp_path / "moat.nc")
+    results, crude = measured["results"], measured["crude"]
+    assert results.complete and results.target_reached and crude.size == 200
+    curve = results.curve
+    index = int(np.flatnonzero(curve["probability"].values <= 0.1)[0])
+    clearance, estimate, cov = curve["threshold"].values[index], curve["probability"].values[index], curve["cov"].values[index]
+    share = float(np.mean(crude > clearance))
+    assert abs(estimate - share) < 3.0 * math.hypot(cov * estimate, math.sqrt(share * (1.0 - share) / crude.size))
+    text = rare_moat.section(measured, {"cores": "2", "load average (1 min) at start": "0", "commit": "x", "date": "today"}, 100, 1e-2, 0)
+    assert text.startswith(rare_moat.START) and f"{results.runs} runs" in text

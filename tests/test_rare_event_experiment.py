@@ -13,7 +13,10 @@ import numpy as np
 import pytest
 
 from stochpound._errors import ExperimentError
-from stochpound.experiment import is_rare_event_file, is_rare_event_store, load_rare_event, open_rare_event_store, rare_event_results, run_rare_event
+from stochpound.analysis import subset_simulation
+from stochpound.experiment import (
+    is_rare_event_file, is_rare_event_store, load_rare_event, open_rare_event_store, rare_event_results, rare_event_sampler, run_rare_event,
+)
 from stochpound.experiment._rare_event_run import RUNS_PER_BATCH
 
 FILE = """
@@ -63,6 +66,7 @@ def _file(folder: Path, samples: int = 20, **edits: str) -> Path:
     ('response = "closure"\ncontact = 1', 'response = "peak_storey_drift"\nbuilding = "B1"\nfloor = 3', r"rare_event.floor: must be an integer in \[1, 2\], got 3"),
     ("p0 = 0.1", "p0 = 0.1\nfloor = 1", "rare_event.floor: not used by response = 'closure'"),
     ("S0 = 0.01", "S9 = 0.01", "synthetic.wn.S9: unknown field"),
+    ("p0 = 0.1", 'p0 = 0.1\nproposal = "gibbs"', "rare_event.proposal: must be one of mma, acs, got 'gibbs'"),
 ])
 def test_bad_fields_are_named_in_one_line(tmp_path, old, new, message):
     path = _file(tmp_path, **{old: new})
@@ -103,6 +107,37 @@ def test_an_interrupted_run_resumes_at_the_last_finished_batch(tmp_path):
     assert first.batches_now + again.batches_now == sum(per_level)  # nothing redone
     assert again.runs == whole.runs
     assert (tmp_path / "whole.nc").read_bytes() == (tmp_path / "split.nc").read_bytes()
+
+
+def test_adaptive_conditional_sampling_resumes_to_the_run_made_in_one_process(tmp_path):
+    """With ``proposal = "acs"`` a level's adaptation groups run one after the other (groups of one of the 10 chains,
+    one batch each): a run stopped inside level 1 resumes, its λ rebuilt from the groups' batch files, to the store of an
+    uninterrupted run, and its levels are subset_simulation's in one process (the same thresholds, runs and λ). Reading
+    the table warns that aCS is not certified on a scene's responses (its reported CoV too small on peaks over time)."""
+    with pytest.warns(UserWarning, match="adaptive conditional sampling is not certified on a run's peaks over time"):
+        definition = load_rare_event(_file(tmp_path, samples=100, **{"p0 = 0.1": 'p0 = 0.1\nproposal = "acs"'}))
+    assert definition.table.proposal == "acs" and definition.table.to_dict()["proposal"] == "acs"
+    run_rare_event(definition, tmp_path / "whole.nc")
+    first = run_rare_event(definition, tmp_path / "split.nc", stop_after=6)
+    again = run_rare_event(definition, tmp_path / "split.nc")
+    assert (tmp_path / "whole.nc").read_bytes() == (tmp_path / "split.nc").read_bytes()
+    store = open_rare_event_store(tmp_path / "whole.nc")
+    # level 0: one batch; then one group (one batch) a chain, 10 chains a level or a few more where the threshold ties
+    assert first.batches_now + again.batches_now == 1 + int(store["level_chains"].values[1:].sum())
+    sampler = rare_event_sampler(definition)
+    alone = subset_simulation(sampler.function, target_probability=1e-3, samples_per_level=100, p0=0.1, seed=3, dimension=sampler.dimension,
+                              proposal="acs")
+    assert np.array_equal(alone.attrs["level_thresholds"], store["level_threshold"].values[1:]) and alone.attrs["runs"] == store.attrs["runs"]
+    assert np.array_equal(alone.attrs["acceptance"], store["level_acceptance"].values[1:])
+    assert store.attrs["method"].startswith("subset simulation (Au & Beck 2001), adaptive conditional sampling")
+    from stochpound.report.sections._rare_events import _conditions
+
+    assert "Au & Beck 2001; adaptive conditional sampling" in _conditions(rare_event_results(store))
+
+
+def test_the_default_proposal_keeps_the_definition_of_earlier_stores(tmp_path):
+    definition = load_rare_event(_file(tmp_path))
+    assert definition.table.proposal == "mma" and "proposal" not in definition.table.to_dict()
 
 
 def test_a_killed_command_resumes_to_the_same_store(tmp_path):

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import math
 import tomllib
+import warnings
 from dataclasses import replace
 
 import numpy as np
@@ -23,7 +24,8 @@ from scipy.special import ndtr, ndtri
 
 import stochpound
 import stochpound.model
-from stochpound.analysis import subset_simulation
+from stochpound.analysis import SubsetSampler, subset_simulation
+from stochpound.analysis._subset_simulation import INITIAL_SCALE, TARGET_ACCEPTANCE
 from stochpound.motions import normal_motion
 from stochpound.motions.ground import SampledMotion
 
@@ -85,9 +87,10 @@ def test_the_reference_oscillator_has_its_closed_form_variance():
     assert sigma == pytest.approx(math.sqrt(math.pi * S / (2.0 * ZETA * OMEGA**3)), rel=0.01)
 
 
-def test_one_run_agrees_with_importance_sampling_at_every_threshold():
+@pytest.mark.parametrize("proposal", ["mma", "acs"])
+def test_one_run_agrees_with_importance_sampling_at_every_threshold(proposal):
     """One subset run gives the curve at 1.6 and 2.1 (P ≈ 8e-3 and 3e-5), each within 3 of its CoV of the reference."""
-    result = subset_simulation(_peak, thresholds=[1.6, 2.1], samples_per_level=500, p0=0.1, seed=3, dimension=N_TIME)
+    result = subset_simulation(_peak, thresholds=[1.6, 2.1], samples_per_level=500, p0=0.1, seed=3, dimension=N_TIME, proposal=proposal)
     for b, probability, cov in zip(result.threshold.values, result.probability.values, result.cov.values):
         reference, reference_cov = _isee(b, 600, seed=1)
         assert reference_cov < 0.05
@@ -104,13 +107,60 @@ def test_same_seed_same_estimate_and_the_runs_counted():
     assert counted.attrs["runs"] == sum(calls)
 
 
-def test_a_half_space_has_its_exact_probability():
+@pytest.mark.parametrize(("proposal", "p0"), [("mma", 0.1), ("acs", 0.1), ("acs", 0.25)])
+def test_a_half_space_has_its_exact_probability(proposal, p0):
     """g(u) = u_1 in 50 dimensions: P(g > b) = Φ(−b) exactly, down to 1e-6, within 3 reported CoV."""
     b = np.array([1.0, 2.5, 4.0, 4.75])
-    result = subset_simulation(lambda u: u[:, 0], thresholds=b, samples_per_level=1000, p0=0.1, seed=2, dimension=50)
+    result = subset_simulation(lambda u: u[:, 0], thresholds=b, samples_per_level=1000, p0=p0, seed=2, dimension=50, proposal=proposal)
     exact = ndtr(-b)
     assert np.all(np.abs(result.probability.values / exact - 1.0) < 3.0 * result.cov.values)
     assert np.all(result.cov.values < 0.5)
+
+
+def test_adaptive_conditional_sampling_leaves_the_standard_normal_invariant():
+    """Without a threshold every aCS candidate is accepted: the chains are Gaussian AR(1) processes u' = ρ u + σ z,
+    ρ = √(1 − σ²), whose states stay standard normal and whose lag-1 correlation is ρ (each to 5 of its standard errors)."""
+    spread = np.array([0.1, 0.5, 0.9, 1.0, 0.3])
+    chains = 4000
+    sampler = SubsetSampler(lambda u: np.zeros(len(u)), 5, 10 * chains, 0.1, seed=4, proposal="acs")
+    u = np.random.default_rng(0).standard_normal((chains, 5))
+    run = sampler.advance(1, u, np.zeros(chains), -np.inf, range(chains), spread)
+    assert run.states.shape == (chains, 10, 5) and run.accepted == chains * 9
+    last = run.states[:, -1, :]
+    assert np.all(np.abs(last.mean(axis=0)) < 5.0 / math.sqrt(chains))
+    assert np.all(np.abs(last.var(axis=0) - 1.0) < 5.0 * math.sqrt(2.0 / chains))
+    lag = np.mean(run.states[:, 1:, :] * run.states[:, :-1, :], axis=(0, 1))
+    assert np.all(np.abs(lag - np.sqrt(1.0 - spread**2)) < 5.0 / math.sqrt(chains))
+
+
+def test_adaptive_conditional_sampling_adapts_its_spread_to_the_target_acceptance():
+    """On a half-space the groups' spread scale λ, from 0.6, rises over level 1 (whose candidates are accepted more often than
+    44 %), falls over level 2 (which starts with level 1's λ, too wide for a deeper level: fewer than 44 % accepted) and
+    settles where about 44 % are accepted at the levels after it, its groups covering each level's chains."""
+    result = subset_simulation(lambda u: u[:, 0], thresholds=[4.75], samples_per_level=1000, p0=0.1, seed=2, dimension=50, proposal="acs")
+    assert result.attrs["acceptance"][0] > TARGET_ACCEPTANCE and result.attrs["scale"][0] > INITIAL_SCALE
+    assert result.attrs["acceptance"][1] < TARGET_ACCEPTANCE and result.attrs["scale"][1] < result.attrs["scale"][0]
+    assert np.all(np.abs(result.attrs["acceptance"][2:] - TARGET_ACCEPTANCE) < 0.05)
+    assert result.attrs["proposal"] == "acs" and len(result.attrs["scale"]) == result.attrs["levels"] - 1
+    sampler = SubsetSampler(_peak, N_TIME, 1000, 0.1, seed=0, proposal="acs")
+    groups = sampler.groups(104)  # 100 chains and 4 that tie
+    assert [len(g) for g in groups] == [10] * 9 + [14] and groups[0].start == 0 and groups[-1].stop == 104
+
+
+def test_adaptive_conditional_sampling_does_not_draw_its_spread_from_the_seeds():
+    """A chain's proposal must not depend on the level's seeds, its own among them: a spread of λ × the seeds' standard
+    deviations did, and biased the oscillator's first passage low (×0.4 at 5e-7). Changing the last group's seed leaves
+    every other chain of the level as it was (a group's λ depends only on the earlier groups' acceptance)."""
+    sampler = SubsetSampler(lambda u: u[:, 0], 8, 100, 0.1, seed=5, proposal="acs")
+    seeds = np.random.default_rng(1).standard_normal((sampler.chains, 8))
+    seeds[:, 0] = 1.0 + np.abs(seeds[:, 0])
+    other = seeds.copy()
+    other[-1] = [4.0, 3.0, -3.0, 2.5, -2.5, 3.5, -3.5, 2.0]
+    first, _ = sampler.run_level(1, seeds, seeds[:, 0], 1.0, INITIAL_SCALE)
+    second, _ = sampler.run_level(1, other, other[:, 0], 1.0, INITIAL_SCALE)
+    assert len(sampler.groups(sampler.chains)[-1]) == 1 and first.accepted > 0
+    assert np.array_equal(first.states[:-1], second.states[:-1]) and not np.array_equal(first.states[-1], second.states[-1])
+    assert np.array_equal(sampler.spread(0.3), np.full(8, 0.3)) and np.array_equal(sampler.spread(2.0), np.ones(8))
 
 
 @pytest.mark.slow
@@ -144,12 +194,30 @@ def test_the_scene_runs_the_oscillator_of_the_reference():
         assert sample_peak * (1.0 - 1e-9) <= peak <= sample_peak * 1.01
 
 
+def test_adaptive_conditional_sampling_warns_on_a_scene_only():
+    """aCS's reported CoV is too small on peaks over time (docs/rare-events.md): on a scene's response it warns, on a
+    function of the normals it does not, and the modified Metropolis never does."""
+    scene = stochpound.scene_from_dict({
+        "building": [{"name": "B1", "mass": [1.0e5], "stiffness": [1.0e5 * OMEGA**2], "damping_ratio": ZETA}],
+        "motion": {"type": "constant", "acceleration": 0.0, "duration": 1.0, "dt": 0.5},
+    })
+    settings = {"motion": {"type": "white_noise", "S0": S, "duration": 1.0, "dt": 0.02}, "response": "peak_storey_drift", "building": "B1", "floor": 1,
+                "thresholds": [0.0], "samples_per_level": 10, "p0": 0.5}
+    with pytest.warns(UserWarning, match="proposal: adaptive conditional sampling is not certified on a run's peaks over time"):
+        subset_simulation(scene, proposal="acs", **settings)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        subset_simulation(scene, proposal="mma", **settings)
+        subset_simulation(lambda u: u[:, 0], thresholds=[1.0], samples_per_level=100, p0=0.1, seed=0, dimension=3, proposal="acs")
+
+
 @pytest.mark.parametrize(("arguments", "message"), [
     ({"p0": 0.7}, r"p0: must be a number in \(0, 0.5\]"),
     ({"samples_per_level": 105}, "samples_per_level: p0 × samples_per_level must be an integer that divides it"),
     ({"thresholds": []}, "thresholds: must be one or more finite numbers"),
     ({"seed": -1}, "seed: must be an integer >= 0"),
     ({"dimension": None}, "dimension: must be an integer >= 1"),
+    ({"proposal": "gibbs"}, "proposal: must be one of mma, acs, got 'gibbs'"),
 ])
 def test_bad_arguments_are_named(arguments, message):
     settings = {"thresholds": [1.0], "samples_per_level": 100, "p0": 0.1, "seed": 0, "dimension": 3, **arguments}

@@ -76,8 +76,8 @@ from stochpound.analysis._impacts import TABLE_COLUMNS  # noqa: F401
 from stochpound.analysis._intervals import MIN_RUNS  # noqa: F401
 from stochpound.analysis._summary import response_moments, top_floor_total_displacement  # noqa: F401
 from stochpound.analysis._subset_simulation import (  # noqa: F401
-    METHOD, ChainRun, SubsetLevel, SubsetSampler, curve_dataset, curve_thresholds, exceedance, exceedance_quantiles, level_attributes,
-    level_probability, scene_response,
+    INITIAL_SCALE, PROPOSALS, ChainRun, SubsetLevel, SubsetSampler, curve_dataset, curve_thresholds, exceedance, exceedance_quantiles, level_attributes,
+    level_probability, scene_response, warn_uncertified,
 )
 from stochpound.analysis._cell_statistics import ForceSpread, Largest  # noqa: F401
 from stochpound.analysis._cells import CellLabels  # noqa: F401

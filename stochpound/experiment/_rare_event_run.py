@@ -2,7 +2,11 @@
 
 Each level's chains (level 0's samples) are split into batches of about
 :data:`RUNS_PER_BATCH` runs, the same split every time; a batch runs in this
-process or on a dask worker (the experiments' cluster,
+process or on a dask worker. With adaptive conditional sampling
+(``proposal = "acs"``) a level's chains run in adaptation groups, one after
+the other (the batches of a group together): a group's spread follows from
+the acceptance of the level's earlier groups, read from their batch files,
+and from λ at the end of the previous level, kept in its level file (the experiments' cluster,
 :mod:`stochpound.experiment._runner`) and is written to the parts folder as
 it finishes (:mod:`stochpound.experiment._rare_event_store`). A level whose
 batches are all written is written as a level file, which names the next
@@ -23,7 +27,7 @@ from typing import Any, Callable, Iterator
 
 import numpy as np
 
-from stochpound.analysis import SubsetLevel, SubsetSampler, scene_response
+from stochpound.analysis import INITIAL_SCALE, SubsetLevel, SubsetSampler, scene_response
 from stochpound.experiment._parts import FolderLock, parts_folder
 from stochpound.experiment._runner import _describe_executor, _interrupts
 from stochpound.experiment._rare_event_store import (
@@ -40,7 +44,8 @@ RUNS_PER_BATCH = 100
 
 @dataclass(frozen=True)
 class RareEventTask:
-    """One batch: chains ``first`` .. ``first + len(y) − 1`` (or level 0's samples) of level ``level``, started at ``u``."""
+    """One batch: chains ``first`` .. ``first + len(y) − 1`` (or level 0's samples) of level ``level``, started at ``u``
+    (``spread``: aCS's σ of their adaptation group)."""
 
     definition: str
     level: int
@@ -49,6 +54,7 @@ class RareEventTask:
     threshold: float = -np.inf
     u: np.ndarray | None = None
     y: np.ndarray | None = None
+    spread: np.ndarray | None = None
 
 
 @dataclass
@@ -78,7 +84,7 @@ def _sampler(definition: str) -> tuple[SubsetSampler, str]:
     if table.capacity is not None:
         capacity, demand = table.capacity, function
         function, units = (lambda u: demand(u) / capacity), "1"
-    return SubsetSampler(function, n, table.samples_per_level, table.p0, table.seed), units
+    return SubsetSampler(function, n, table.samples_per_level, table.p0, table.seed, table.proposal), units
 
 
 def rare_event_sampler(definition: RareEventDefinition) -> SubsetSampler:
@@ -97,7 +103,7 @@ def run_batch(task: RareEventTask) -> dict[str, np.ndarray]:
         u, y = sampler.start(range(task.first, task.first + task.count))
         states, responses, accepted = u[:, None, :], y[:, None], 0
     else:
-        run = sampler.advance(task.level, task.u, task.y, task.threshold, range(task.first, task.first + task.count))
+        run = sampler.advance(task.level, task.u, task.y, task.threshold, range(task.first, task.first + task.count), task.spread)
         states, responses, accepted = run.states, run.responses, run.accepted
     flat = responses.reshape(-1)
     keep = min(sampler.chains, flat.size)
@@ -172,25 +178,35 @@ def run_rare_event(definition: RareEventDefinition, store: str | Path | None = N
     return report
 
 
-def _tasks(store: Path, sampler: SubsetSampler, text: str, levels: list[FinishedLevel]) -> list[tuple[int, RareEventTask]]:
-    """The level under way's batches not yet written, with their numbers."""
-    index = len(levels)
-    if index == 0:
-        per, total = RUNS_PER_BATCH, sampler.samples_per_level
+def _split(sampler: SubsetSampler, levels: list[FinishedLevel]) -> list[list[tuple[int, int, int]]]:
+    """The level under way's batches, (number, first, count), in its groups (level 0: one group of its samples)."""
+    if not levels:
+        groups, per = [range(sampler.samples_per_level)], RUNS_PER_BATCH
     else:
-        per, total = max(1, RUNS_PER_BATCH // sampler.length), len(levels[-1].next_seeds)
-    tasks = []
-    for number, first in enumerate(range(0, total, per)):
+        groups, per = sampler.groups(len(levels[-1].next_seeds)), max(1, RUNS_PER_BATCH // sampler.length)
+    split, number = [], 0
+    for group in groups:
+        split.append([])
+        for first in range(group.start, group.stop, per):
+            split[-1].append((number, first, min(per, group.stop - first)))
+            number += 1
+    return split
+
+
+def _tasks(store: Path, sampler: SubsetSampler, text: str, levels: list[FinishedLevel], batches: list[tuple[int, int, int]],
+           spread: np.ndarray | None) -> list[tuple[int, RareEventTask]]:
+    """The batches of one group of the level under way that are not yet written, with their numbers."""
+    index, tasks = len(levels), []
+    for number, first, count in batches:
         if batch_path(store, index, number).is_file():
             continue
-        count = min(per, total - first)
         if index == 0:
             tasks.append((number, RareEventTask(text, 0, first, count)))
         else:
             previous = levels[-1]
             seeds = previous.next_seeds[first : first + count]
             tasks.append((number, RareEventTask(text, index, first, count, previous.next_threshold, previous.next_states[first : first + count],
-                                                previous.level.responses.reshape(-1)[seeds])))
+                                                previous.level.responses.reshape(-1)[seeds], spread)))
     return tasks
 
 
@@ -200,18 +216,26 @@ def _level(store: Path, sampler: SubsetSampler, definition: RareEventDefinition,
     """Run the level under way's missing batches, then write the level (with the next level's seeds unless the target is reached)."""
     index = len(levels)
     text = canonical_json(definition.to_dict())
-    for number, result in execute(_tasks(store, sampler, text, levels)):
-        save_arrays(batch_path(store, index, number), **result)
-        report.batches_now += 1
-        if stop_after is not None and report.batches_now >= stop_after:
-            raise KeyboardInterrupt
+    scale = levels[-1].scale if levels else INITIAL_SCALE
+    for group, batches in enumerate(_split(sampler, levels)):
+        acs = sampler.proposal == "acs" and index > 0
+        spread = sampler.spread(scale) if acs else None
+        for number, result in execute(_tasks(store, sampler, text, levels, batches, spread)):
+            save_arrays(batch_path(store, index, number), **result)
+            report.batches_now += 1
+            if stop_after is not None and report.batches_now >= stop_after:
+                raise KeyboardInterrupt
+        if acs:
+            done = [load_arrays(batch_path(store, index, number)) for number, _, _ in batches]
+            moves = sum(b["responses"].shape[0] for b in done) * (sampler.length - 1)
+            scale = sampler.adapt(scale, sum(int(b["accepted"]) for b in done) / moves, group)
     batches = [load_arrays(path) for path in sorted(parts_folder(store).glob(f"batch-{index:02d}-*.npz"))]
     responses = np.concatenate([b["responses"] for b in batches])
     length = responses.shape[1]
     moves = len(responses) * (length - 1)
     level = SubsetLevel(-np.inf if index == 0 else levels[-1].next_threshold, responses, sum(int(b["accepted"]) for b in batches) / moves if moves else 1.0)
     seeds = np.full(len(responses), -1, dtype=np.int64) if index == 0 else levels[-1].next_seeds
-    finished = FinishedLevel(level, seeds, responses.size if index == 0 else moves)
+    finished = FinishedLevel(level, seeds, responses.size if index == 0 else moves, scale)
     subset = [f.level for f in levels] + [level]
     if not sampler.done(subset, None, definition.table.target_probability) and len(subset) < definition.table.max_levels:
         threshold, chosen = sampler.seeds(responses, index + 1)

@@ -6,7 +6,8 @@ A run keeps, in ``<store>.parts/``:
     The canonical definition (a store of another definition is refused).
 ``level-LL.npz``
     A finished level: its responses (chains, states a chain), the sample of
-    the previous level that seeded each chain, its acceptance and runs; and,
+    the previous level that seeded each chain, its acceptance, runs and λ
+    at its end (aCS's spread scale; a level file without it: 0.6); and,
     unless it is the last, the next level's threshold, seeds and their normals.
 ``batch-LL-BBBBB.npz``
     A finished batch of the level under way: its chains' responses, accepted
@@ -29,7 +30,7 @@ import numpy as np
 import xarray as xr
 
 from stochpound._atomic import replacing
-from stochpound.analysis import METHOD, SubsetLevel, curve_dataset, curve_thresholds, exceedance, exceedance_quantiles, level_attributes, level_probability
+from stochpound.analysis import INITIAL_SCALE, PROPOSALS, SubsetLevel, curve_dataset, curve_thresholds, exceedance, exceedance_quantiles, level_attributes, level_probability
 from stochpound.analysis import pounding_curve
 from stochpound.experiment._parts import parts_folder
 from stochpound.experiment._rare_event_table import RareEventDefinition
@@ -46,11 +47,13 @@ SEPARATION_PROBABILITIES = (1e-3, 1e-4, 1e-6)
 
 @dataclass(frozen=True)
 class FinishedLevel:
-    """A finished level as its file holds it (``next_*``: the next level's threshold, seeds and their normals; None for the last)."""
+    """A finished level as its file holds it (``scale``: aCS's λ at its end; ``next_*``: the next level's threshold, seeds and their
+    normals; None for the last)."""
 
     level: SubsetLevel
     seeds: np.ndarray
     runs: int
+    scale: float = INITIAL_SCALE
     next_threshold: float | None = None
     next_seeds: np.ndarray | None = None
     next_states: np.ndarray | None = None
@@ -79,7 +82,7 @@ def load_arrays(path: Path) -> dict[str, np.ndarray]:
 def save_level(store: Path, index: int, finished: FinishedLevel) -> None:
     """Write a finished level and remove its batches."""
     arrays = {"threshold": finished.level.threshold, "responses": finished.level.responses, "acceptance": finished.level.acceptance,
-              "seeds": finished.seeds, "runs": finished.runs}
+              "seeds": finished.seeds, "runs": finished.runs, "scale": finished.scale}
     if finished.next_threshold is not None:
         arrays |= {"next_threshold": finished.next_threshold, "next_seeds": finished.next_seeds, "next_states": finished.next_states}
     save_arrays(level_path(store, index), **arrays)
@@ -94,7 +97,8 @@ def finished_levels(store: Path) -> list[FinishedLevel]:
         data = load_arrays(level_path(store, len(levels)))
         nxt = {key: data.get(f"next_{key}") for key in ("threshold", "seeds", "states")}
         levels.append(FinishedLevel(SubsetLevel(float(data["threshold"]), data["responses"], float(data["acceptance"])), data["seeds"], int(data["runs"]),
-                                    None if nxt["threshold"] is None else float(nxt["threshold"]), nxt["seeds"], nxt["states"]))
+                                    float(data["scale"]) if "scale" in data else INITIAL_SCALE, None if nxt["threshold"] is None else float(nxt["threshold"]),
+                                    nxt["seeds"], nxt["states"]))
     return levels
 
 
@@ -118,7 +122,7 @@ def write_store(store: Path, definition: RareEventDefinition, levels: list[Finis
     subset = [f.level for f in levels]
     attrs = {
         "kind": KIND, "experiment_name": definition.name, "experiment_description": definition.description, "experiment_file": definition.path,
-        "definition": json.dumps(definition.to_dict(), sort_keys=True), "definition_sha256": definition.sha256, "method": METHOD,
+        "definition": json.dumps(definition.to_dict(), sort_keys=True), "definition_sha256": definition.sha256, "method": PROPOSALS[table.proposal],
         "response": table.response, "target_probability": table.target_probability, "samples_per_level": table.samples_per_level, "p0": table.p0,
         "seed": table.seed, "complete": int(complete), "runs": int(sum(f.runs for f in levels)),
     }

@@ -23,7 +23,7 @@ from typing import Any, Mapping
 from stochpound._errors import ExperimentError, field_errors
 from stochpound._text_files import read_text_file
 from stochpound.experiment._spec import _base_scene
-from stochpound.analysis import RESPONSES
+from stochpound.analysis import PROPOSALS, RESPONSES, warn_uncertified
 from stochpound.motions import SYNTHETIC_TYPES, normal_motion
 from stochpound.store import TomlTable, building_names, building_table, canonical_json
 
@@ -36,7 +36,7 @@ LIMIT_STATES = {"isolator_displacement": "base_displacement", "impact_force": "i
 RESPONSE_CHOICES = (*RESPONSES, "limit_state")
 _TOP_KEYS = {"experiment", "scene", "synthetic", TABLE}
 _KEYS = {"method", "response", "target_probability", "samples_per_level", "p0", "seed", "motion", "contact", "building", "floor",
-         "limit_state", "capacity", "max_levels"}
+         "limit_state", "capacity", "max_levels", "proposal"}
 FORMAT_VERSION = 1
 
 
@@ -75,6 +75,10 @@ class RareEventTable:
         The limit state's capacity (m or N), > 0.
     max_levels : int
         Most levels, in [2, 40].
+    proposal : str
+        The chains' proposal: ``mma`` (Au & Beck's component-wise modified
+        Metropolis) or ``acs`` (adaptive conditional sampling; reading it
+        warns that it is not certified on a scene's responses).
     """
 
     method: str
@@ -90,6 +94,7 @@ class RareEventTable:
     limit_state: str | None = None
     capacity: float | None = None
     max_levels: int = 20
+    proposal: str = "mma"
 
     @property
     def sampled(self) -> str:
@@ -97,8 +102,9 @@ class RareEventTable:
         return LIMIT_STATES[self.limit_state] if self.response == "limit_state" else self.response
 
     def to_dict(self) -> dict[str, Any]:
-        """The table as the definition writes it (fields left None omitted)."""
-        return {key: value for key, value in asdict(self).items() if value is not None}
+        """The table as the definition writes it (fields left None omitted, and the default proposal, so that a definition
+        written before ``proposal`` existed keeps its identity)."""
+        return {key: value for key, value in asdict(self).items() if value is not None and (key, value) != ("proposal", "mma")}
 
 
 @dataclass(frozen=True)
@@ -187,13 +193,15 @@ def parse_rare_event(values: Any, motion: str, buildings: list[str], scene: Mapp
         samples = table.integer("samples_per_level", low=10, high=10**6)
         seed = table.integer("seed", low=0, high=2**63 - 1)
         max_levels = table.integer("max_levels", 20, low=2, high=40)
+        proposal = table.string("proposal", "mma", choices=tuple(PROPOSALS))
         chains = round(p0 * samples)
         if chains < 1 or not math.isclose(chains, p0 * samples) or samples % chains:
             raise table.error("samples_per_level", f"p0 × samples_per_level must be an integer that divides it (p0 = {p0:g}), got {samples}")
         if table.raw("motion", motion) != motion:
             raise table.error("motion", f"must name the file's synthetic motion ({motion}), got {table.raw('motion')!r}")
         where = _where(table, response, buildings, scene)
-    return RareEventTable(method, response, target, samples, p0, seed, motion, max_levels=max_levels, **where)
+    warn_uncertified(proposal)
+    return RareEventTable(method, response, target, samples, p0, seed, motion, max_levels=max_levels, proposal=proposal, **where)
 
 
 def _where(table: TomlTable, response: str, buildings: list[str], scene: Mapping[str, Any]) -> dict[str, Any]:

@@ -53,7 +53,8 @@ def _conditions(results: RareEventResults) -> str:
     parameters = ", ".join(f"{key} = {_text(value)}" for key, value in motion.items() if key != "type")
     state = "reached" if results.target_reached else ("not reached: the run is incomplete (rerun it)" if not results.complete
                                                        else f"not reached: it stopped after max_levels = {table.max_levels}")
-    return (f"One subset simulation (Au & Beck 2001; component-wise modified Metropolis) of {what}, under a {motion.get('type', 'kanai_tajimi')} "
+    chains = {"mma": "component-wise modified Metropolis", "acs": "adaptive conditional sampling, Papaioannou et al. 2015"}[table.proposal]
+    return (f"One subset simulation (Au & Beck 2001; {chains}) of {what}, under a {motion.get('type', 'kanai_tajimi')} "
             f"ground motion ({parameters}), its randomness a vector of standard normals. N = {table.samples_per_level} samples a level, "
             f"p0 = {table.p0}, seed {table.seed}: {results.levels} levels and n = {results.runs} runs in all, down to the target "
             f"probability {table.target_probability:g} per event ({state}).")
