@@ -196,8 +196,9 @@ def stripe_regression(log_demand: ArrayLike, stripe: ArrayLike, covariates: Mapp
     else:
         covariance, clusters = _clustered(xd, residual, inverse, pd.factorize(labels["cluster"])[0], s)
         dof = clusters - 1
-        if dof < 1:
-            raise ValueError(f"cluster: the runs fall in {clusters} cluster, clustered errors need two or more")
+        if clusters <= k:
+            raise ValueError(f"cluster: the runs fall in {clusters} cluster{'s' if clusters > 1 else ''}, clustered errors of {k} "
+                             f"slope{'s' if k > 1 else ''} need more than {k}")
     error = np.sqrt(np.diag(covariance))
     p = 2.0 * stats.t.sf(np.abs(slope) / error, dof)
     half = stats.t.ppf(0.5 + confidence / 2.0, dof) * error
