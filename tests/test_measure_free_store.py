@@ -161,3 +161,22 @@ def test_the_comparison_puts_each_measures_seeds_beside_the_measure_free_g_star(
         compare_measures({"PGA": [free[0.05]]}, answer)
     with pytest.raises(ValueError, match=r"^tolerance: must be a ratio > 1"):
         compare_measures({"PGA": [g_star(1.0)]}, answer, tolerance=0.8)
+
+
+def test_the_comparison_names_a_missing_measures_measured_reason(answer):
+    from stochpound.analysis import StoreSufficiency, compare_measures, stripe_regression
+
+    free = {labels[0][1]: results[0].level for labels, results in zip(answer.configurations, answer.results)}
+    g_star = xr.concat([free[mu] * 1.5 for mu in (0.05, 0.08)], dim=pd.Index([0.05, 0.08], name="mu"))  # misses by ×1.5 everywhere
+    rng = np.random.default_rng(3)
+    stripe, magnitude = np.repeat([0, 1, 2], 20), rng.uniform(6.0, 7.8, 60)
+    trend = stripe_regression(0.7 * magnitude + rng.normal(0.0, 0.1, 60), stripe, {"M": magnitude})  # a demand rising with M
+    flat = stripe_regression(rng.normal(0.0, 0.1, 60), stripe, {"M": magnitude})
+    tests = StoreSufficiency("PGA", "closure", ((("mu", 0.05),), (("mu", 0.08),)), (trend, flat))
+    table = compare_measures({"PGA": [g_star], "PSA(1 s)": [g_star / 1.5]}, answer, sufficiency={"PGA": tests})
+    assert table.loc[("mu 0.05", "PGA", 0.02), "reason"] == trend.reason() and trend.reason().startswith("insufficient with respect to M")
+    assert table.loc[("mu 0.05", "PGA", 0.02), "insufficient"] == "M" and table.loc[("mu 0.08", "PGA", 0.1), "insufficient"] == ""
+    assert table.loc[("mu 0.08", "PGA", 0.1), "reason"] == flat.reason() and flat.reason().startswith("no residual trend with M")
+    assert table.loc[("mu 0.05", "PSA(1 s)", 0.1), "reason"] == "" and table.loc[("mu 0.05", "PSA(1 s)", 0.1), "agrees"]
+    with pytest.raises(ValueError, match=r"^sufficiency: 'PGV' is not one of the measures compared \(PGA, PSA\(1 s\)\)"):
+        compare_measures({"PGA": [g_star], "PSA(1 s)": [g_star]}, answer, sufficiency={"PGV": tests})
