@@ -12,7 +12,7 @@ import pytest
 import xarray as xr
 
 from stochpound import open_store
-from stochpound.analysis import MeasureFreeDemand, RuptureSite, measure_free_risk, store_measure_free
+from stochpound.analysis import MeasureFreeDemand, RuptureSite, measure_free_risk, store_measure_free, store_sufficiency
 from stochpound.experiment._runner import load_experiment, run_experiment
 from stochpound.risk import configuration_scene
 from tests.helpers import ISOLATED, invoke, risk_text, write_experiment
@@ -138,7 +138,14 @@ def test_the_report_gets_the_section_after_the_risk_section_when_given_ruptures(
     keys = [section.key.rsplit("-", 1)[0] for section in report.sections]
     assert keys.index("measure-free") == keys.index("risk") + 1
     section = report.sections[keys.index("measure-free")]
-    assert section.blocks[-1].frame.equals(store_measure_free(open_store(store_path).load(), SITE, runs=8).display_frame())
+    (table,) = [block for block in section.blocks if str(getattr(block, "key", "")).startswith("table-measure-free-")]
+    assert table.frame.equals(store_measure_free(open_store(store_path).load(), SITE, runs=8).display_frame())
+    try:  # the store's own measure tested, or why not, as the section says
+        tested = store_sufficiency(open_store(store_path).load())
+        expected = tested.verdict() in section.blocks[-2].text and section.blocks[-1].frame.equals(tested.frame().round(4))
+    except ValueError as error:
+        expected = section.blocks[-1].text == f"The sufficiency of the store's measure was not tested: {error}."
+    assert expected
 
 
 def test_the_comparison_puts_each_measures_seeds_beside_the_measure_free_g_star(answer):
@@ -180,3 +187,22 @@ def test_the_comparison_names_a_missing_measures_measured_reason(answer):
     assert table.loc[("mu 0.05", "PSA(1 s)", 0.1), "reason"] == "" and table.loc[("mu 0.05", "PSA(1 s)", 0.1), "agrees"]
     with pytest.raises(ValueError, match=r"^sufficiency: 'PGV' is not one of the measures compared \(PGA, PSA\(1 s\)\)"):
         compare_measures({"PGA": [g_star], "PSA(1 s)": [g_star]}, answer, sufficiency={"PGV": tests})
+
+
+def test_the_report_section_says_the_measures_sufficiency_from_the_data(answer):
+    from stochpound.analysis import StoreSufficiency, stripe_regression
+    from stochpound.report.render import Paragraph, Table
+    from stochpound.report.sections import measure_free_section
+
+    rng = np.random.default_rng(3)
+    stripe, magnitude = np.repeat([0, 1], 20), rng.uniform(6.0, 7.8, 40)
+    fits = tuple(stripe_regression(slope * magnitude + rng.normal(0.0, 0.1, 40), stripe, {"M": magnitude}) for slope in (0.7, 0.0))
+    tests = StoreSufficiency("PSA(1 s)", "closure", ((("mu", 0.05),), (("mu", 0.08),)), fits)
+    section = measure_free_section("isolated", answer, "somewhere", tests)
+    words = " ".join(block.text for block in section.blocks if isinstance(block, Paragraph))
+    assert f"mu 0.05: {fits[0].reason()}; mu 0.08: {fits[1].reason()}." in words and fits[0].conditions() in words
+    assert "n 40 runs in 2 stripes" in words and "Is PSA(1 s) sufficient for the contact-free closure?" in words
+    tables = [block for block in section.blocks if isinstance(block, Table)]
+    assert tables[-1].key == "table-sufficiency-isolated" and tables[-1].frame.equals(tests.frame().round(4))
+    untested = measure_free_section("isolated", answer, "somewhere", untested="store: has no 'record_magnitude' (...)")
+    assert untested.blocks[-1].text == "The sufficiency of the store's measure was not tested: store: has no 'record_magnitude' (...)."

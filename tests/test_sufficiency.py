@@ -120,10 +120,13 @@ def test_a_small_stripe_store_is_tested_on_each_motions_own_earthquake(tmp_path)
     from stochpound.motions import scenario_distribution
     from stochpound.motions.records import load_suite_member
     from stochpound.risk import contact_free_closure
-    from tests.test_experiment_site import _text
-    from tests.helpers import write_experiment
+    from tests.helpers import SITE_SCENE, write_experiment
 
-    store = open_store(run_experiment(load_experiment(write_experiment(tmp_path, _text(), "site.toml")), workers=0, progress=False).store).load()
+    records = "".join(f'\n[[records]]\nrecord = "fema_p695_far_field/{i:02d}{c}"\nduration = 5.0\n' for i in range(1, 7) for c in "ab")
+    text = (f'[experiment]\nname = "site"\n{SITE_SCENE}\n[grid]\ngap = ["inf"]\n{records}\n[intensity]\nmeasure = "psa"\nperiod = 0.5\n'
+            'levels = [0.4, 0.2]\nselection = "conditional_spectrum"\nmotions = 4\nmax_scale_factor = 5.0\nseed = 2\n'
+            '[site]\nvs30 = 400.0\nmagnitude = [7.0, 6.6]\ndistance_km = 20.0\nmechanism = "strike_slip"\n[solver]\nmethod = "exact"\n')
+    store = open_store(run_experiment(load_experiment(write_experiment(tmp_path, text, "site.toml")), workers=0, progress=False).store).load()
     result = store_sufficiency(store, cluster=False)  # 4 motions a stripe from few earthquakes: too few clusters for 3 slopes
     (fit,) = result.results
     assert result.measure == store.pound.intensity.measure.label and result.configurations == ((),) and fit.runs == 2 * 4

@@ -253,6 +253,13 @@ class StoreSufficiency:
                 return result
         raise ValueError(f"labels: no configuration {labels!r} in the sufficiency test of {self.measure}")
 
+    def verdict(self) -> str:
+        """Each configuration's :meth:`Sufficiency.reason`, after its labels where it has any (``"mu 0.05: ...; mu 0.08: ..."``)."""
+        from stochpound.analysis._measure_free_store import configuration_label
+
+        return "; ".join(f"{configuration_label(labels)}: {result.reason()}" if labels else result.reason()
+                         for labels, result in zip(self.configurations, self.results))
+
     def frame(self) -> pd.DataFrame:
         """One row per configuration and covariate: slope, its error, interval and p-value, whether significant, and n."""
         from stochpound.analysis._measure_free_store import configuration_label
