@@ -14,8 +14,9 @@ fitted by least squares (equivalently: y and every x less its stripe's
 mean, one line through the origin). Each slope b_k comes with its standard
 error, its interval and the two-sided p-value of b_k = 0 (Student's t); the
 measure is called *insufficient with respect to x_k* where that p-value is
-below the stated level (Tothong & Luco 2007; Jalayer et al. 2012 read the
-same p-value). Each covariate is tested at the level on its own: with three
+below the stated level (the regression test of Luco & Cornell 2007 and
+Tothong & Luco 2007; Jalayer et al. 2012's information-theoretic measure
+is another, not computed here). Each covariate is tested at the level on its own: with three
 of them and no trend at all, one or more is flagged with a chance up to
 1 − (1 − level)³ (14 % at 5 %).
 
