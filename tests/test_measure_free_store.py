@@ -142,7 +142,7 @@ def test_the_report_gets_the_section_after_the_risk_section_when_given_ruptures(
     assert table.frame.equals(store_measure_free(open_store(store_path).load(), SITE, runs=8).display_frame())
     try:  # the store's own measure tested, or why not, as the section says
         tested = store_sufficiency(open_store(store_path).load())
-        expected = tested.verdict() in section.blocks[-2].text and section.blocks[-1].frame.equals(tested.frame().round(4))
+        expected = tested.verdict() in section.blocks[-2].text and section.blocks[-1].frame.equals(tested.display_frame())
     except ValueError as error:
         expected = section.blocks[-1].text == f"The sufficiency of the store's measure was not tested: {error}."
     assert expected
@@ -203,6 +203,6 @@ def test_the_report_section_says_the_measures_sufficiency_from_the_data(answer):
     assert f"mu 0.05: {fits[0].reason()}; mu 0.08: {fits[1].reason()}." in words and fits[0].conditions() in words
     assert "n 40 runs in 2 stripes" in words and "Is PSA(1 s) sufficient for the contact-free closure?" in words
     tables = [block for block in section.blocks if isinstance(block, Table)]
-    assert tables[-1].key == "table-sufficiency-isolated" and tables[-1].frame.equals(tests.frame().round(4))
+    assert tables[-1].key == "table-sufficiency-isolated" and tables[-1].frame.equals(tests.display_frame())
     untested = measure_free_section("isolated", answer, "somewhere", untested="store: has no 'record_magnitude' (...)")
     assert untested.blocks[-1].text == "The sufficiency of the store's measure was not tested: store: has no 'record_magnitude' (...)."

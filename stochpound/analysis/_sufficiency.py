@@ -54,6 +54,8 @@ import pandas as pd
 import xarray as xr
 from numpy.typing import ArrayLike
 
+from stochpound.motions import Measure
+
 SUFFICIENCY_LEVEL = 0.05
 """The level of the test by default: a slope whose two-sided p-value is below it is a measured trend."""
 COVARIATES = {"M": "magnitude", "ln R": "ln of the rupture distance (km)", "ε": "the motion's ε in its own earthquake"}
@@ -125,8 +127,8 @@ class Sufficiency:
         trends = []
         for k, name in enumerate(self.covariates):
             if name in self.insufficient:
-                trends.append(f"ln D {'rises' if self.slope[k] > 0 else 'falls'} by {abs(self.slope[k]):.2g} a unit of {name} "
-                              f"({_percent(self.confidence)}: {self.lower[k]:.2g} to {self.upper[k]:.2g}, p {self.p_value[k]:.2g})")
+                trends.append(f"ln D {'rises' if self.slope[k] > 0 else 'falls'} by {abs(self.slope[k]):.3g} a unit of {name} "
+                              f"({_percent(self.confidence)}: {self.lower[k]:.3g} to {self.upper[k]:.3g}, p {self.p_value[k]:.2g})")
         return f"insufficient with respect to {', '.join(self.insufficient)}: {'; '.join(trends)} within the stripes (n {self.runs})"
 
 
@@ -270,6 +272,12 @@ class StoreSufficiency:
                  for labels, result in zip(self.configurations, self.results)]
         return pd.concat(parts).reorder_levels(["configuration", "covariate"])
 
+    def display_frame(self) -> pd.DataFrame:
+        """:meth:`frame` for reading: slopes, errors and intervals to 4 decimals, p-values to 2 significant digits."""
+        frame = self.frame()
+        numbers = ["slope", "standard error", "lower", "upper"]
+        return frame.assign(**{name: frame[name].round(4) for name in numbers}, **{"p-value": frame["p-value"].map(lambda p: f"{p:.2g}")})
+
 
 def store_sufficiency(store: xr.Dataset, *, cluster: bool = True, level: float = SUFFICIENCY_LEVEL, confidence: float = 0.95) -> StoreSufficiency:
     """The sufficiency test of a stripe store's measure for the contact-free closure, per configuration (module docstring).
@@ -304,7 +312,7 @@ def store_sufficiency(store: xr.Dataset, *, cluster: bool = True, level: float =
     closure = contact_free_closure(store)
     if "record" not in closure.coords or closure["record"].size != store["record"].size:
         raise ValueError("store: its motions have several realizations; the test takes one run a motion and stripe")
-    covariates = _store_covariates(store, setting)
+    covariates = _store_covariates(store, setting.measure, setting.units)
     events = store["record_event"].values.astype(str) if "record_event" in store.coords else np.full(store.sizes["record"], "")
     earthquake = np.where(events == "", store["record"].values.astype(str), events)
     others = [d for d in closure.dims if d not in RUN_DIMS]
@@ -321,12 +329,11 @@ def store_sufficiency(store: xr.Dataset, *, cluster: bool = True, level: float =
     return StoreSufficiency(setting.measure.label, "closure", tuple(configurations), tuple(results))
 
 
-def _store_covariates(store: xr.Dataset, setting: Any) -> dict[str, np.ndarray]:
+def _store_covariates(store: xr.Dataset, measure: Measure, units: str) -> dict[str, np.ndarray]:
     """Each motion's M, ln R and (for a measure in g) ε in its own earthquake, the stripe's scenario mechanism (module docstring)."""
     magnitude, distance = (store[name].values.astype(float) for name in ("record_magnitude", "record_distance"))
     values = {"M": magnitude, "ln R": np.log(distance)}
-    measure = setting.measure
-    if setting.units != "g" or measure.kind not in ("pga", "psa", "sa_avg") or "motion_intensity" not in store:
+    if units != "g" or measure.kind not in ("pga", "psa", "sa_avg") or "motion_intensity" not in store:
         return values
     from stochpound._errors import SiteError
     from stochpound.motions import scenario_distribution

@@ -56,6 +56,6 @@ def _add_sufficiency(section: Section, name: str, sufficiency: StoreSufficiency)
     section.add(Table(
         key=f"table-sufficiency-{name}",
         caption=f"Experiment {name}: the trend of ln closure with M, ln R and ε within the stripes of {sufficiency.measure}",
-        frame=sufficiency.frame().round(4),
+        frame=sufficiency.display_frame(),
         note="slope: ln closure per unit of the covariate; lower, upper: its interval; significant: p-value below the test's level.",
     ))
