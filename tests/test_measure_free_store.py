@@ -206,3 +206,22 @@ def test_the_report_section_says_the_measures_sufficiency_from_the_data(answer):
     assert tables[-1].key == "table-sufficiency-isolated" and tables[-1].frame.equals(tests.display_frame())
     untested = measure_free_section("isolated", answer, "somewhere", untested="store: has no 'record_magnitude' (...)")
     assert untested.blocks[-1].text == "The sufficiency of the store's measure was not tested: store: has no 'record_magnitude' (...)."
+
+
+def test_the_sufficiency_test_runs_each_configuration_of_the_store_and_says_what_a_store_lacks(store, answer):
+    from stochpound.analysis import stripe_regression
+    from stochpound.risk import contact_free_closure
+
+    tested = store_sufficiency(store, cluster=False)
+    assert tested.configurations == answer.configurations and tested.measure == "PSA(1 s)"
+    closure = contact_free_closure(store).sel(mu=0.08).transpose("intensity", "record")
+    stripe = np.repeat(np.arange(closure.sizes["intensity"]), closure.sizes["record"])
+    magnitude = np.tile(store["record_magnitude"].values, closure.sizes["intensity"])
+    alone = store_sufficiency(store.drop_vars("motion_intensity"), cluster=False)  # no unscaled measure: M and ln R only
+    expected = stripe_regression(np.log(closure.values.ravel()), stripe,
+                                 {"M": magnitude, "ln R": np.log(np.tile(store["record_distance"].values, closure.sizes["intensity"]))})
+    assert alone.result((("mu", 0.08),)) == expected and tested.result((("mu", 0.08),)).covariates == ("M", "ln R", "ε")
+    with pytest.raises(ValueError, match=r"^store: has no 'record_magnitude' \(the motions' earthquakes"):
+        store_sufficiency(store.drop_vars("record_magnitude"))
+    with pytest.raises(ValueError, match=r"^labels: no configuration \(\('mu', 0.5\),\) in the sufficiency test of PSA\(1 s\)"):
+        tested.result((("mu", 0.5),))
