@@ -11,7 +11,10 @@ ruptures``), and its g* at 10 % and 2 % in 50 years (the risk chain's,
 from the counts, and from a lognormal demand per stripe); beside them, the
 same store's answer without a measure
 (:func:`stochpound.analysis.store_measure_free`), compared by
-:func:`stochpound.analysis.compare_measures`. Reduced by default (two
+:func:`stochpound.analysis.compare_measures` with each measure's
+sufficiency test on its first seed's store
+(:func:`stochpound.analysis.store_sufficiency`: the closure's trend with M,
+ln R and ε within the stripes), the reason given for a measure that misses. Reduced by default (two
 measures, two seeds, 10 motions a stripe; the issue asks for >= 40).
 
 Rewrites the section "Each measure against the answer without a measure"
@@ -74,10 +77,11 @@ def conditioned(folder: Path, measure: str, seed: int, motions: int) -> tuple[xr
 
 def measure(measures: list[str], seeds: list[int], motions: int, runs: int, log=print) -> dict:
     """The comparisons (counts and lognormal demand) and the measure-free answer."""
-    from stochpound.analysis import RuptureSite, compare_measures, store_measure_free
+    from stochpound.analysis import RuptureSite, compare_measures, store_measure_free, store_sufficiency
 
     counted: dict[str, list] = {m: [] for m in measures}
     lognormal: dict[str, list] = {m: [] for m in measures}
+    sufficiency = {}
     with tempfile.TemporaryDirectory() as folder:
         for name in measures:
             for seed in seeds:
@@ -85,20 +89,24 @@ def measure(measures: list[str], seeds: list[int], motions: int, runs: int, log=
                 counted[name].append(by_counts)
                 lognormal[name].append(by_demand)
                 log(f"{name}, seed {seed}: g* {by_counts.values.ravel()} (counts), {by_demand.values.ravel()} (lognormal demand)")
+                if seed == seeds[0]:
+                    sufficiency[name] = store_sufficiency(store)
+                    log(f"{name}, seed {seed}: {sufficiency[name].verdict()}")
         started = time.perf_counter()
         free = store_measure_free(store, RuptureSite.bundled(SITE), runs=runs, seed=1)
         log(f"measure-free: g* {free.results[0][0].level.values} in {time.perf_counter() - started:.0f} s")
-    return {"counts": compare_measures(counted, free), "lognormal demand per stripe": compare_measures(lognormal, free), "free": free}
+    return {"counts": compare_measures(counted, free, sufficiency=sufficiency),
+            "lognormal demand per stripe": compare_measures(lognormal, free, sufficiency=sufficiency), "free": free, "sufficiency": sufficiency}
 
 
 def table(comparison) -> list[str]:
     """A comparison as Markdown rows."""
-    lines = ["| target | measure | conditioned g*, median (m) | over the seeds (m) | seed spread | measure-free g* (m), 95 % interval | ratio | within ×1.2 |",
-             "|---|---|---:|---:|---:|---:|---:|---|"]
+    lines = ["| target | measure | conditioned g*, median (m) | over the seeds (m) | seed spread | measure-free g* (m), 95 % interval | ratio | within ×1.2 "
+             "| trend within the stripes (p < 0.05) |", "|---|---|---:|---:|---:|---:|---:|---|---|"]
     for (_, measure_name, target), row in comparison.iterrows():
         lines.append(f"| {target:.0%} in 50 yr | {measure_name} | {row['median']:.4f} | {row['lowest']:.4f}–{row['highest']:.4f} | "
                      f"×{row['seed spread']:.2f} | {row['measure-free']:.4f} ({row['lower']:.4f}–{row['upper']:.4f}) | {row['ratio']:.2f} | "
-                     f"{'yes' if row['agrees'] else '**no**'} |")
+                     f"{'yes' if row['agrees'] else '**no**'} | {row['insufficient'] or 'none'} |")
     return lines
 
 
@@ -119,6 +127,9 @@ def section(results: dict, settings: argparse.Namespace, info: dict[str, str], e
         "`python -m benchmarks.measure_comparison [--measures ... --seeds ... --motions N --runs N]` rewrites this section. "
         "Reduced: the issue's check asks for >= 40 motions a stripe and a measure-free interval within ±15 %.",
     ]
+    for name, test in results["sufficiency"].items():
+        lines += ["", f"Sufficiency of {name} for the closure (`stochpound.analysis.store_sufficiency`, seed {settings.seeds[0]}'s store; "
+                  f"{test.results[0].conditions()}): {test.verdict()}."]
     for name in ("counts", "lognormal demand per stripe"):
         lines += ["", f"g* from {'the counts (the risk chain, `store_risk`)' if name == 'counts' else 'a lognormal demand per stripe (`stripe_demand_rate`)'}:",
                   "", *table(results[name])]

@@ -12,7 +12,7 @@ import pytest
 import xarray as xr
 
 from stochpound import open_store
-from stochpound.analysis import MeasureFreeDemand, RuptureSite, measure_free_risk, store_measure_free
+from stochpound.analysis import MeasureFreeDemand, RuptureSite, measure_free_risk, store_measure_free, store_sufficiency
 from stochpound.experiment._runner import load_experiment, run_experiment
 from stochpound.risk import configuration_scene
 from tests.helpers import ISOLATED, invoke, risk_text, write_experiment
@@ -138,7 +138,14 @@ def test_the_report_gets_the_section_after_the_risk_section_when_given_ruptures(
     keys = [section.key.rsplit("-", 1)[0] for section in report.sections]
     assert keys.index("measure-free") == keys.index("risk") + 1
     section = report.sections[keys.index("measure-free")]
-    assert section.blocks[-1].frame.equals(store_measure_free(open_store(store_path).load(), SITE, runs=8).display_frame())
+    (table,) = [block for block in section.blocks if str(getattr(block, "key", "")).startswith("table-measure-free-")]
+    assert table.frame.equals(store_measure_free(open_store(store_path).load(), SITE, runs=8).display_frame())
+    try:  # the store's own measure tested, or why not, as the section says
+        tested = store_sufficiency(open_store(store_path).load())
+        expected = tested.verdict() in section.blocks[-2].text and section.blocks[-1].frame.equals(tested.display_frame())
+    except ValueError as error:
+        expected = section.blocks[-1].text == f"The sufficiency of the store's measure was not tested: {error}."
+    assert expected
 
 
 def test_the_comparison_puts_each_measures_seeds_beside_the_measure_free_g_star(answer):
@@ -161,3 +168,60 @@ def test_the_comparison_puts_each_measures_seeds_beside_the_measure_free_g_star(
         compare_measures({"PGA": [free[0.05]]}, answer)
     with pytest.raises(ValueError, match=r"^tolerance: must be a ratio > 1"):
         compare_measures({"PGA": [g_star(1.0)]}, answer, tolerance=0.8)
+
+
+def test_the_comparison_names_a_missing_measures_measured_reason(answer):
+    from stochpound.analysis import StoreSufficiency, compare_measures, stripe_regression
+
+    free = {labels[0][1]: results[0].level for labels, results in zip(answer.configurations, answer.results)}
+    g_star = xr.concat([free[mu] * 1.5 for mu in (0.05, 0.08)], dim=pd.Index([0.05, 0.08], name="mu"))  # misses by ×1.5 everywhere
+    rng = np.random.default_rng(3)
+    stripe, magnitude = np.repeat([0, 1, 2], 20), rng.uniform(6.0, 7.8, 60)
+    trend = stripe_regression(0.7 * magnitude + rng.normal(0.0, 0.1, 60), stripe, {"M": magnitude})  # a demand rising with M
+    flat = stripe_regression(rng.normal(0.0, 0.1, 60), stripe, {"M": magnitude})
+    tests = StoreSufficiency("PGA", "closure", ((("mu", 0.05),), (("mu", 0.08),)), (trend, flat))
+    table = compare_measures({"PGA": [g_star], "PSA(1 s)": [g_star / 1.5]}, answer, sufficiency={"PGA": tests})
+    assert table.loc[("mu 0.05", "PGA", 0.02), "reason"] == trend.reason() and trend.reason().startswith("insufficient with respect to M")
+    assert table.loc[("mu 0.05", "PGA", 0.02), "insufficient"] == "M" and table.loc[("mu 0.08", "PGA", 0.1), "insufficient"] == ""
+    assert table.loc[("mu 0.08", "PGA", 0.1), "reason"] == flat.reason() and flat.reason().startswith("no residual trend with M")
+    assert table.loc[("mu 0.05", "PSA(1 s)", 0.1), "reason"] == "" and table.loc[("mu 0.05", "PSA(1 s)", 0.1), "agrees"]
+    with pytest.raises(ValueError, match=r"^sufficiency: 'PGV' is not one of the measures compared \(PGA, PSA\(1 s\)\)"):
+        compare_measures({"PGA": [g_star], "PSA(1 s)": [g_star]}, answer, sufficiency={"PGV": tests})
+
+
+def test_the_report_section_says_the_measures_sufficiency_from_the_data(answer):
+    from stochpound.analysis import StoreSufficiency, stripe_regression
+    from stochpound.report.render import Paragraph, Table
+    from stochpound.report.sections import measure_free_section
+
+    rng = np.random.default_rng(3)
+    stripe, magnitude = np.repeat([0, 1], 20), rng.uniform(6.0, 7.8, 40)
+    fits = tuple(stripe_regression(slope * magnitude + rng.normal(0.0, 0.1, 40), stripe, {"M": magnitude}) for slope in (0.7, 0.0))
+    tests = StoreSufficiency("PSA(1 s)", "closure", ((("mu", 0.05),), (("mu", 0.08),)), fits)
+    section = measure_free_section("isolated", answer, "somewhere", tests)
+    words = " ".join(block.text for block in section.blocks if isinstance(block, Paragraph))
+    assert f"mu 0.05: {fits[0].reason()}; mu 0.08: {fits[1].reason()}." in words and fits[0].conditions() in words
+    assert "n 40 runs in 2 stripes" in words and "Is PSA(1 s) sufficient for the contact-free closure?" in words
+    tables = [block for block in section.blocks if isinstance(block, Table)]
+    assert tables[-1].key == "table-sufficiency-isolated" and tables[-1].frame.equals(tests.display_frame())
+    untested = measure_free_section("isolated", answer, "somewhere", untested="store: has no 'record_magnitude' (...)")
+    assert untested.blocks[-1].text == "The sufficiency of the store's measure was not tested: store: has no 'record_magnitude' (...)."
+
+
+def test_the_sufficiency_test_runs_each_configuration_of_the_store_and_says_what_a_store_lacks(store, answer):
+    from stochpound.analysis import stripe_regression
+    from stochpound.risk import contact_free_closure
+
+    tested = store_sufficiency(store, cluster=False)
+    assert tested.configurations == answer.configurations and tested.measure == "PSA(1 s)"
+    closure = contact_free_closure(store).sel(mu=0.08).transpose("intensity", "record")
+    stripe = np.repeat(np.arange(closure.sizes["intensity"]), closure.sizes["record"])
+    magnitude = np.tile(store["record_magnitude"].values, closure.sizes["intensity"])
+    alone = store_sufficiency(store.drop_vars("motion_intensity"), cluster=False)  # no unscaled measure: M and ln R only
+    expected = stripe_regression(np.log(closure.values.ravel()), stripe,
+                                 {"M": magnitude, "ln R": np.log(np.tile(store["record_distance"].values, closure.sizes["intensity"]))})
+    assert alone.result((("mu", 0.08),)) == expected and tested.result((("mu", 0.08),)).covariates == ("M", "ln R", "ε")
+    with pytest.raises(ValueError, match=r"^store: has no 'record_magnitude' \(the motions' earthquakes"):
+        store_sufficiency(store.drop_vars("record_magnitude"))
+    with pytest.raises(ValueError, match=r"^labels: no configuration \(\('mu', 0.5\),\) in the sufficiency test of PSA\(1 s\)"):
+        tested.result((("mu", 0.5),))

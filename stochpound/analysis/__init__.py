@@ -32,6 +32,7 @@ from stochpound.analysis._subset_simulation import RESPONSES, subset_simulation
 from stochpound.analysis._measure_free import MEASURE_FREE_RESPONSES, MeasureFreeDemand, measure_free_demands, measure_free_risk
 from stochpound.analysis._measure_free_store import MEASURE_FREE_RUNS, StoreMeasureFree, scene_demands, store_measure_free
 from stochpound.analysis._measure_comparison import compare_measures
+from stochpound.analysis._sufficiency import SUFFICIENCY_LEVEL, StoreSufficiency, Sufficiency, store_sufficiency, stripe_regression
 from stochpound.analysis._summary import run_summary
 from stochpound.analysis._mechanism_cells import MechanismCells, WallPenetration
 from stochpound.analysis._store_ensemble import RARE, ProbabilityAt, StoreEnsemble
@@ -158,6 +159,11 @@ __all__ = [
     "scene_demands",
     "MEASURE_FREE_RUNS",
     "compare_measures",
+    "stripe_regression",
+    "Sufficiency",
+    "store_sufficiency",
+    "StoreSufficiency",
+    "SUFFICIENCY_LEVEL",
     "MEASURE_FREE_RESPONSES",
     "HazardCurve",
     "HazardFile",

@@ -36,7 +36,7 @@ from stochpound.report.sections import (
     separation_section,
     store_section,
 )
-from stochpound.analysis import MEASURE_FREE_RUNS, RuptureSite, store_measure_free
+from stochpound.analysis import MEASURE_FREE_RUNS, RuptureSite, StoreSufficiency, store_measure_free, store_sufficiency
 from stochpound.experiment import crude_check, is_rare_event_store, measure_choice, open_rare_event_store, rare_event_results
 from stochpound.risk import collapse_risk, has_risk, separation_sensitivity, store_damage, store_demands, store_risk
 from stochpound.store import check_finished, has_contact_free, has_wall_free, with_contacts, with_walls
@@ -107,7 +107,7 @@ def assemble_report(paths: Sequence[str | Path], progress: Callable[[str], None]
             if ruptures is not None:
                 say(f"experiment {name}: without an intensity measure")
                 answer = store_measure_free(store, ruptures, runs=ruptures_runs)
-                report.sections.append(measure_free_section(name, answer, risks[name].hazard.describe()))
+                report.sections.append(measure_free_section(name, answer, risks[name].hazard.describe(), *_sufficiency(store)))
             if damage is not None:
                 report.sections.append(damage_section(name, damage))
     for name, store in others.items():
@@ -144,6 +144,14 @@ def assemble_report(paths: Sequence[str | Path], progress: Callable[[str], None]
         say("summary")
         report.sections.insert(0, experiment_summary(others, report.sections, risks=risks))
     return report
+
+
+def _sufficiency(store: xr.Dataset) -> tuple[StoreSufficiency | None, str]:
+    """The sufficiency test of a store's measure, or why there is none (the store's motions or stripes do not allow it)."""
+    try:
+        return store_sufficiency(store), ""
+    except ValueError as error:
+        return None, str(error)
 
 
 def _about(stores: dict[str, xr.Dataset], sections: list[Section]) -> str:
