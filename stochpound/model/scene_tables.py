@@ -27,7 +27,7 @@ from stochpound.motions import DEFAULT_G
 
 
 class BaseEntry(TypedDict, total=False):
-    """A ``[building.base]`` table as written (:data:`stochpound.model.friction.BASE_KEYS`); ``mu`` a number or ``{ slow, fast, rate }``."""
+    """A ``[building.base]`` table as written (``stochpound.model.friction.BASE_KEYS``); ``mu`` a number or ``{ slow, fast, rate }``."""
 
     mass: float
     mu: float | dict[str, float]
@@ -37,7 +37,7 @@ class BaseEntry(TypedDict, total=False):
 
 
 class InitialEntry(TypedDict, total=False):
-    """A ``[building.initial]`` table as written (:data:`stochpound.model.building.INITIAL_KEYS`)."""
+    """A ``[building.initial]`` table as written (``stochpound.model.building.INITIAL_KEYS``)."""
 
     displacement: list[float]
     velocity: list[float]
@@ -46,7 +46,7 @@ class InitialEntry(TypedDict, total=False):
 
 
 class BuildingEntry(TypedDict, total=False):
-    """A ``[[building]]`` table as written (:data:`stochpound.model.building.BUILDING_KEYS`); a variant's ``building.<name>`` adds ``mass_factor``."""
+    """A ``[[building]]`` table as written (``stochpound.model.building.BUILDING_KEYS``); a variant's ``building.<name>`` adds ``mass_factor``."""
 
     name: str
     mass: list[float]
@@ -63,7 +63,7 @@ class BuildingEntry(TypedDict, total=False):
 
 
 class ContactEntry(TypedDict, total=False):
-    """A ``[[contact]]`` or ``[[wall]]`` table as written (:data:`stochpound.model.contact.CONTACT_KEYS`, :data:`stochpound.model.wall.WALL_KEYS`)."""
+    """A ``[[contact]]`` or ``[[wall]]`` table as written (``stochpound.model.contact.CONTACT_KEYS``, ``stochpound.model.wall.WALL_KEYS``)."""
 
     between: list[list[str | int]]
     building: str
