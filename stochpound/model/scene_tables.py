@@ -45,20 +45,31 @@ class InitialEntry(TypedDict, total=False):
     base_velocity: float
 
 
-class BuildingEntry(TypedDict, total=False):
-    """A ``[[building]]`` table as written (``stochpound.model.building.BUILDING_KEYS``); a variant's ``building.<name>`` adds ``mass_factor``."""
+class _BuildingFields(TypedDict, total=False):
+    """The fields a ``[[building]]`` table and a variant's ``building.<name>`` table share (``stochpound.model.building.BUILDING_KEYS``)."""
 
     name: str
     mass: list[float]
     stiffness: list[float]
     damping: list[float]
     damping_ratio: float
-    base: BaseEntry
     initial: InitialEntry
     storey_height: float | list[float]
     yield_force: list[float]
     hardening: float
     p_delta: bool
+
+
+class BuildingEntry(_BuildingFields, total=False):
+    """A ``[[building]]`` table as written (``stochpound.model.building.BUILDING_KEYS``)."""
+
+    base: BaseEntry
+
+
+class BuildingOverridesEntry(_BuildingFields, total=False):
+    """A variant's ``building.<name>`` table as written: a building's fields, ``mass_factor``, and ``base = false`` to remove its base."""
+
+    base: BaseEntry | bool
     mass_factor: float
 
 
@@ -79,11 +90,11 @@ class ContactEntry(TypedDict, total=False):
 
 class MotionEntry(TypedDict, total=False):
     """A ``[motion]`` table as written: a record's, an analytic motion's or a synthetic ensemble's fields (docs/motions.md);
-    an experiment's motions add the record's ``file_sha256``."""
+    an experiment's motions add the record's ``file_sha256`` (None when it has no file of its own)."""
 
     type: str
     record: str
-    file_sha256: str
+    file_sha256: str | None
     scale: float
     dt: float
     duration: float
@@ -130,7 +141,7 @@ class SceneEntry(TypedDict, total=False):
 class OverridesEntry(TypedDict, total=False):
     """One variant's overrides as written: fields by building name, scene-level fields, and a contact table (or one per contact)."""
 
-    building: dict[str, BuildingEntry]
+    building: dict[str, BuildingOverridesEntry]
     scene: SceneEntry
     contact: ContactEntry | list[ContactEntry]
 

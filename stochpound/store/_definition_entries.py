@@ -4,12 +4,11 @@ Each typed record of :mod:`stochpound.store._definition` writes one of these
 entries (its ``entry()``) and reads it back (its ``from_entry``); they declare the
 keys written, so what a record writes and reads is a known shape, not a loose dict.
 The keys a record writes only when set are ``NotRequired`` (an entry without them
-hashes as before). The scene and a variant's overrides are the scene file's tables as
-written (:class:`~stochpound.model.scene_tables.SceneEntry`,
+hashes as before; annotations here are not postponed, so Python reads ``NotRequired``,
+and tests/test_definition_entries.py checks every shipped definition against these shapes).
+The scene and a variant's overrides are the scene file's tables as written (:class:`~stochpound.model.scene_tables.SceneEntry`,
 :class:`~stochpound.model.scene_tables.OverridesEntry`).
 """
-
-from __future__ import annotations
 
 from collections.abc import Mapping
 from typing import NotRequired, TypedDict
