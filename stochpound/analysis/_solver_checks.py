@@ -24,8 +24,9 @@ from stochpound._errors import VerificationError
 from stochpound.model.modal_solution import harmonic_response, modal_properties
 from stochpound.model.scene import Building, Contact, Scene
 from stochpound.model.scene_file import scene_from_dict
+from stochpound.model.scene_tables import BuildingEntry
 from stochpound.solvers.simulate import simulate
-from stochpound.store import select_case
+from stochpound.store import Label, select_case
 
 #: Closing velocity of the single-collision check, m/s.
 COLLISION_VELOCITY = 0.5
@@ -70,7 +71,7 @@ class CollisionCheck:
         zeta = contact.damping / (2.0 * math.sqrt(contact.stiffness * effective))
         duration = 3.0 * math.pi / (omega * math.sqrt(1.0 - zeta**2))
 
-        def body(name: str, mass: float, velocity: float) -> dict:
+        def body(name: str, mass: float, velocity: float) -> BuildingEntry:
             return {"name": name, "mass": [mass], "stiffness": [0.0], "damping": [0.0], "initial": {"velocity": [velocity]}}
 
         scene = {
@@ -112,7 +113,7 @@ class ModalCheck:
 
 
 
-def _building_table(building: Building) -> dict:
+def _building_table(building: Building) -> BuildingEntry:
     return {"name": building.name, "mass": list(building.mass), "stiffness": list(building.stiffness), "damping": list(building.damping)}
 
 
@@ -146,7 +147,7 @@ class HarmonicComparison:
         """A store's harmonic motions (``[[motions]]`` of type harmonic) beside the closed-form modal solution."""
         comparisons = []
         for motion in store.pound.definition.motions:
-            if motion.motion.get("type") != "harmonic":
+            if motion.type != "harmonic":
                 continue
             building = store.pound.scene(record=motion.label).buildings[0]
             run = select_case(store, record=motion.label)
@@ -224,7 +225,7 @@ class ReferenceRun:
                                     f"{difference:.1e} m, more than {CROSS_CHECK_TOLERANCE:g} of the peak {peak:.3g} m")
 
     @staticmethod
-    def pounding_case(store: xr.Dataset) -> tuple[dict, bool] | None:
+    def pounding_case(store: xr.Dataset) -> tuple[dict[str, Label], bool] | None:
         """A stored case with pounding, and with sliding if the store has such a case, and whether it slides.
 
         Among those, the case with the median impact count (the first in grid
@@ -246,7 +247,7 @@ class ReferenceRun:
         return {dim: chosen[dim].item() for dim in impacts.dims}, slides
 
     @staticmethod
-    def yielding_case(store: xr.Dataset) -> dict | None:
+    def yielding_case(store: xr.Dataset) -> dict[str, Label] | None:
         """A stored case whose storeys yielded: the median peak ductility among those > 1 (the first in grid order); None if none yielded."""
         if "peak_ductility" not in store:
             return None

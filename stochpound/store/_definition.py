@@ -536,6 +536,11 @@ class MotionSource:
         return written
 
     @property
+    def type(self) -> str:
+        """The ``[motion]`` table's ``type``: ``record`` when it gives none (as the scene's reader takes it)."""
+        return TomlTable(self.motion).raw("type", "record")
+
+    @property
     def realizations(self) -> range:
         """Realization indices: 0 for a record, ``start`` .. ``start + count − 1`` for an ensemble."""
         return range(self.start, self.start + self.count)
