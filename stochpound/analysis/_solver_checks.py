@@ -25,8 +25,9 @@ from stochpound._errors import VerificationError
 from stochpound.model.modal_solution import harmonic_response, modal_properties
 from stochpound.model.scene import Building, Contact, Scene
 from stochpound.model.scene_file import scene_from_dict
+from stochpound.model.scene_tables import BuildingEntry
 from stochpound.solvers.simulate import simulate
-from stochpound.store import MotionTable, select_case
+from stochpound.store import Label, select_case
 
 #: Closing velocity of the single-collision check, m/s.
 COLLISION_VELOCITY = 0.5
@@ -71,7 +72,7 @@ class CollisionCheck:
         zeta = contact.damping / (2.0 * math.sqrt(contact.stiffness * effective))
         duration = 3.0 * math.pi / (omega * math.sqrt(1.0 - zeta**2))
 
-        def body(name: str, mass: float, velocity: float) -> dict[str, str | list[float] | dict[str, list[float]]]:
+        def body(name: str, mass: float, velocity: float) -> BuildingEntry:
             return {"name": name, "mass": [mass], "stiffness": [0.0], "damping": [0.0], "initial": {"velocity": [velocity]}}
 
         scene = {
@@ -113,7 +114,7 @@ class ModalCheck:
 
 
 
-def _building_table(building: Building) -> dict[str, str | list[float]]:
+def _building_table(building: Building) -> BuildingEntry:
     return {"name": building.name, "mass": list(building.mass), "stiffness": list(building.stiffness), "damping": list(building.damping)}
 
 
@@ -147,7 +148,7 @@ class HarmonicComparison:
         """A store's harmonic motions (``[[motions]]`` of type harmonic) beside the closed-form modal solution."""
         comparisons = []
         for motion in store.pound.definition.motions:
-            if MotionTable.of_source(motion).type != "harmonic":
+            if motion.type != "harmonic":
                 continue
             building = store.pound.scene(record=motion.label).buildings[0]
             run = select_case(store, record=motion.label)
@@ -225,7 +226,7 @@ class ReferenceRun:
                                     f"{difference:.1e} m, more than {CROSS_CHECK_TOLERANCE:g} of the peak {peak:.3g} m")
 
     @staticmethod
-    def pounding_case(store: xr.Dataset) -> tuple[dict, bool] | None:
+    def pounding_case(store: xr.Dataset) -> tuple[dict[str, Label], bool] | None:
         """A stored case with pounding, and with sliding if the store has such a case, and whether it slides.
 
         Among those, the case with the median impact count (the first in grid

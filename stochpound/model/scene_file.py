@@ -11,7 +11,7 @@ import inspect
 import math
 import tomllib
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Any
 
 import numpy as np
 
@@ -23,6 +23,7 @@ from stochpound.model.fields import REQUIRED, TomlTable, field_path
 from stochpound.model.building import buildings_from_tables
 from stochpound.model.contact import contacts_from_tables
 from stochpound.model.scene import Scene
+from stochpound.model.scene_tables import SceneEntry
 from stochpound.model.wall import walls_from_tables
 from stochpound.motions import DEFAULT_G, SYNTHETIC_TYPES
 from stochpound.motions.ground import GroundMotion, HarmonicMotion, SampledMotion
@@ -55,7 +56,7 @@ def load_scene(path: str | Path) -> Scene:
     return scene_from_dict(read_scene_table(path), base_dir=path.parent, source=path.name)
 
 
-def read_scene_table(path: str | Path) -> dict[str, Any]:
+def read_scene_table(path: str | Path) -> SceneEntry:
     """The parsed TOML of a scene file, not yet validated (:func:`~stochpound.model.scene_file.scene_from_dict` validates it).
 
     Parameters
@@ -112,7 +113,7 @@ def bundled_scene_path(name: str) -> Path:
     return bundled_data_dir("scenes", "SOURCES.md") / f"{name}.toml"
 
 
-def scene_from_dict(data: Mapping[str, Any], base_dir: str | Path = ".", source: str = "python") -> Scene:
+def scene_from_dict(data: SceneEntry, base_dir: str | Path = ".", source: str = "python") -> Scene:
     """Validate a scene given as a dictionary (the parsed TOML) and build it.
 
     Parameters

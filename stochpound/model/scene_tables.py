@@ -19,11 +19,131 @@ from __future__ import annotations
 import copy
 from dataclasses import dataclass
 from functools import cached_property
-from typing import Any, Mapping
+from typing import TypedDict
 
 from stochpound.model.building import default_name
 from stochpound.model.fields import TomlTable
 from stochpound.motions import DEFAULT_G
+
+
+class BaseEntry(TypedDict, total=False):
+    """A ``[building.base]`` table as written (``stochpound.model.friction.BASE_KEYS``); ``mu`` a number or ``{ slow, fast, rate }``."""
+
+    mass: float
+    mu: float | dict[str, float]
+    mu_static: float
+    restoring_stiffness: float
+    radius: float
+
+
+class InitialEntry(TypedDict, total=False):
+    """A ``[building.initial]`` table as written (``stochpound.model.building.INITIAL_KEYS``)."""
+
+    displacement: list[float]
+    velocity: list[float]
+    base_displacement: float
+    base_velocity: float
+
+
+class _BuildingFields(TypedDict, total=False):
+    """The fields a ``[[building]]`` table and a variant's ``building.<name>`` table share (``stochpound.model.building.BUILDING_KEYS``)."""
+
+    name: str
+    mass: list[float]
+    stiffness: list[float]
+    damping: list[float]
+    damping_ratio: float
+    initial: InitialEntry
+    storey_height: float | list[float]
+    yield_force: list[float]
+    hardening: float
+    p_delta: bool
+
+
+class BuildingEntry(_BuildingFields, total=False):
+    """A ``[[building]]`` table as written (``stochpound.model.building.BUILDING_KEYS``)."""
+
+    base: BaseEntry
+
+
+class BuildingOverridesEntry(_BuildingFields, total=False):
+    """A variant's ``building.<name>`` table as written: a building's fields, ``mass_factor``, and ``base = false`` to remove its base."""
+
+    base: BaseEntry | bool
+    mass_factor: float
+
+
+class ContactEntry(TypedDict, total=False):
+    """A ``[[contact]]`` or ``[[wall]]`` table as written (``stochpound.model.contact.CONTACT_KEYS``, ``stochpound.model.wall.WALL_KEYS``)."""
+
+    between: list[list[str | int]]
+    building: str
+    side: str
+    level: int
+    gap: float
+    law: str
+    stiffness: float
+    damping: float
+    restitution: float
+    tensile: bool
+
+
+class MotionEntry(TypedDict, total=False):
+    """A ``[motion]`` table as written: a record's, an analytic motion's or a synthetic ensemble's fields (docs/motions.md);
+    an experiment's motions add the record's ``file_sha256`` (None when it has no file of its own)."""
+
+    type: str
+    record: str
+    file_sha256: str | None
+    scale: float
+    dt: float
+    duration: float
+    units: str
+    interpolation: str
+    amplitude: float
+    omega: float
+    phase: float
+    acceleration: float
+    magnitude: float
+    distance_km: float
+    vs30: float
+    mechanism: str
+    n: int
+    seed: int
+    model: str
+    calibration: str
+    realization: int
+    omega_g: float
+    zeta_g: float
+    omega_f: float
+    zeta_f: float
+    S0: float
+    pga: float
+    envelope: str | dict[str, float]
+    method: str
+    rms: float
+    peak_factor: float | str
+    baseline: bool
+    band_limit: bool
+
+
+class SceneEntry(TypedDict, total=False):
+    """A scene as written: a scene file's tables and fields (docs/scene-files.md), as an experiment's definition holds its ``scene``."""
+
+    g: float
+    study_compat: bool
+    building: list[BuildingEntry]
+    contact: list[ContactEntry]
+    wall: list[ContactEntry]
+    motion: MotionEntry
+
+
+class OverridesEntry(TypedDict, total=False):
+    """One variant's overrides as written: fields by building name, scene-level fields, and a contact table (or one per contact)."""
+
+    building: dict[str, BuildingOverridesEntry]
+    scene: SceneEntry
+    contact: ContactEntry | list[ContactEntry]
 
 
 @dataclass(frozen=True)
@@ -116,7 +236,7 @@ class SceneTables:
     # read each time, never cached: a scene being edited may be given new tables (:mod:`stochpound.store`'s scene edits)
 
     @classmethod
-    def of(cls, scene: Mapping[str, Any], name: str = "") -> SceneTables:
+    def of(cls, scene: SceneEntry, name: str = "") -> SceneTables:
         """The scene dict ``scene`` (a parsed scene file, or an experiment's ``scene``), its tables named under ``name``."""
         return cls(TomlTable(scene, name))
 
@@ -157,7 +277,7 @@ class SceneTables:
         """The most floors of any of its buildings (0 without buildings)."""
         return max((building.floors for building in self.buildings), default=0)
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> SceneEntry:
         """The scene exactly as written (a deep copy: every field given, each number as spelled)."""
         return copy.deepcopy(dict(self.table.values))
 
@@ -175,7 +295,7 @@ class SceneOverrides:
     table: TomlTable
 
     @classmethod
-    def of(cls, overrides: Mapping[str, Any], name: str = "") -> SceneOverrides:
+    def of(cls, overrides: OverridesEntry, name: str = "") -> SceneOverrides:
         """The overrides dict of one variant (as an experiment's definition holds it)."""
         return cls(TomlTable(overrides, name))
 

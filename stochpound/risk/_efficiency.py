@@ -65,16 +65,16 @@ def measure_efficiency(store: xr.Dataset, periods: Mapping[str, float], structur
         and ``p_<x>``. ``measure`` carries ``measure_period`` (s; NaN for PGA, PGV, Sa_avg).
     """
     runs = efficiency_runs(store, studied)
-    scale, spectrum_periods, psa = runs["scale_factor"], runs["spectrum_periods"], runs["psa"]
+    scale, spectrum_periods, psa = runs.scale_factor, runs.spectrum_periods, runs.psa
     structural = np.array(list((structure or periods).values()), dtype=float)
     low, high = max(0.2 * structural.min(), spectrum_periods[0]), min(3.0 * structural.max(), spectrum_periods[-1])
     average = np.geomspace(low, high, SA_AVG_PERIODS)
-    candidates = {Measure("pga").label: runs["pga"], Measure("pgv").label: runs["pgv"]}
+    candidates = {Measure("pga").label: runs.pga, Measure("pgv").label: runs.pgv}
     measure_periods = [np.nan, np.nan]
     for name, period in periods.items():
         label = candidate_name(period, name)
-        if period == runs["conditioning"]:  # the store's own measure, exact
-            candidates[label] = runs["intensity"]
+        if period == runs.conditioning:  # the store's own measure, exact
+            candidates[label] = runs.intensity
         else:
             candidates[label] = _interpolated(psa, spectrum_periods, [period]).isel(period=0, drop=True)
         measure_periods.append(float(period))
@@ -82,10 +82,10 @@ def measure_efficiency(store: xr.Dataset, periods: Mapping[str, float], structur
     measure_periods.append(np.nan)
     covariates = {"scale_factor": np.log(scale)}
     for key, coordinate in (("magnitude", "record_magnitude"), ("distance", "record_distance")):
-        if coordinate in runs["covariates"]:
-            covariates[key] = runs["covariates"][coordinate].broadcast_like(scale)
+        if coordinate in runs.covariates:
+            covariates[key] = runs.covariates[coordinate].broadcast_like(scale)
     fits = {response: xr.concat([_fit(value, im * scale, covariates) for im in candidates.values()], "measure")
-            for response, value in runs["responses"].items()}
+            for response, value in runs.responses.items()}
     result = xr.concat(list(fits.values()), "response").assign_coords(response=list(fits), measure=list(candidates))
     return result.assign_coords(measure_period=("measure", np.array(measure_periods)))
 

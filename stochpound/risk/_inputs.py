@@ -507,20 +507,43 @@ def moat_clearances(store: xr.Dataset, studied: str | None) -> list[float]:
     return sorted({float(gap) for wall, gaps in walls for gap in gaps if wall.at_base_of(studied) and math.isfinite(float(gap))})
 
 
-def efficiency_runs(store: xr.Dataset, studied: str | None) -> dict[str, Any]:
+@dataclasses.dataclass(frozen=True)
+class EfficiencyRuns:
     """What measure efficiency reads of a stripes (contact-free cases) or IDA store, every motion on one dimension ``record``.
 
-    Returns
-    -------
-    dict
-        ``responses`` (``closure``: peak closure, m; ``base_displacement`` of a
-        sliding ``studied`` building, m, stripes only), ``scale_factor``,
-        ``psa`` (over ``spectrum_period``, at scale 1, in g), ``spectrum_periods`` (s),
-        ``pga`` and ``pgv`` (at scale 1), ``intensity`` (the store's own
-        measure at scale 1) and ``conditioning`` (its period T* in s when it is
-        5 %-damped PSA in g, else None), ``covariates`` (``record_magnitude`` and
-        ``record_distance`` where the store has them).
+    Attributes
+    ----------
+    responses : mapping of str to xarray.DataArray
+        ``closure`` (peak closure, m), and ``base_displacement`` of a sliding studied building (m, stripes only).
+    scale_factor : xarray.DataArray
+        Each run's scale factor.
+    psa : xarray.DataArray
+        Each motion's PSA over ``spectrum_period`` at scale 1 (g).
+    spectrum_periods : numpy.ndarray
+        The periods of ``psa``, s.
+    pga, pgv : xarray.DataArray
+        Each motion's PGA and PGV at scale 1.
+    intensity : xarray.DataArray
+        Each motion's value of the store's own measure at scale 1.
+    conditioning : float or None
+        The store's measure's period T*, s, when it is 5 %-damped PSA in g; else None.
+    covariates : mapping of str to xarray.DataArray
+        ``record_magnitude`` and ``record_distance`` where the store has them.
     """
+
+    responses: Mapping[str, xr.DataArray]
+    scale_factor: xr.DataArray
+    psa: xr.DataArray
+    spectrum_periods: np.ndarray
+    pga: xr.DataArray
+    pgv: xr.DataArray
+    intensity: xr.DataArray
+    conditioning: float | None
+    covariates: Mapping[str, xr.DataArray]
+
+
+def efficiency_runs(store: xr.Dataset, studied: str | None) -> EfficiencyRuns:
+    """What measure efficiency reads of a stripes (contact-free cases) or IDA store (:class:`EfficiencyRuns`), every motion on one dimension ``record``."""
     free = store.isel({d: 0 for d in gap_dims(store)}) if is_ida(store) else contact_free(store)
     responses = {"closure": contact_free_closure(store)}
     sliding = None if is_ida(store) else base_displacement(free, studied)
@@ -528,17 +551,17 @@ def efficiency_runs(store: xr.Dataset, studied: str | None) -> dict[str, Any]:
         responses["base_displacement"] = sliding
     setting = intensity_setting(store)
     psa_in_g = setting is not None and setting.measure.kind == "psa" and setting.measure.damping == 0.05 and setting.units == "g"
-    return {
-        "responses": responses,
-        "scale_factor": store_motions(free["scale_factor"]).load(),
-        "psa": store_motions(free["motion_psa"]).load(),
-        "spectrum_periods": free["spectrum_period"].values,
-        "pga": store_motions(free["motion_pga"]).load(),
-        "pgv": store_motions(free["motion_pgv"]).load(),
-        "intensity": store_motions(free["motion_intensity"]).load(),
-        "conditioning": float(setting.measure.period) if psa_in_g else None,
-        "covariates": {name: store_motions(free[name]) for name in ("record_magnitude", "record_distance") if name in free.coords},
-    }
+    return EfficiencyRuns(
+        responses=responses,
+        scale_factor=store_motions(free["scale_factor"]).load(),
+        psa=store_motions(free["motion_psa"]).load(),
+        spectrum_periods=free["spectrum_period"].values,
+        pga=store_motions(free["motion_pga"]).load(),
+        pgv=store_motions(free["motion_pgv"]).load(),
+        intensity=store_motions(free["motion_intensity"]).load(),
+        conditioning=float(setting.measure.period) if psa_in_g else None,
+        covariates={name: store_motions(free[name]) for name in ("record_magnitude", "record_distance") if name in free.coords},
+    )
 
 
 def scene_g(store: xr.Dataset) -> float:
@@ -630,19 +653,40 @@ def contact_free_twins(data: xr.DataArray) -> xr.DataArray | None:
     return contact_free(data).broadcast_like(data) if has_contact_free(data) else None
 
 
-def stripe_spectra_runs(store: xr.Dataset) -> dict[str, Any] | None:
-    """What the site-consistency check reads of a stripes store whose hazard is a bundled curve, or None.
+@dataclasses.dataclass(frozen=True)
+class StripeSpectraRuns:
+    """What the site-consistency check reads of a stripes store whose hazard is a bundled curve.
 
-    Returns
-    -------
-    dict or None
-        ``bundled`` (the store's bundled hazard curve's name), ``hazard``
-        (the store's hazard curve), ``scale_factor`` (per ``intensity`` and
-        ``record``, NaN where the motion did not run in the stripe), ``pga``
-        (m/s²) and ``psa`` (over ``spectrum_period``, m/s²) of every motion
-        at scale 1, ``spectrum_periods`` (s) and ``g`` (m/s²). None for a
-        store without stripes, spectra or a bundled hazard.
+    Attributes
+    ----------
+    bundled : str
+        The store's bundled hazard curve's name.
+    hazard : HazardCurve
+        The store's hazard curve.
+    scale_factor : xarray.DataArray
+        Per ``intensity`` and ``record``; NaN where the motion did not run in the stripe.
+    pga : xarray.DataArray
+        Each motion's PGA at scale 1, m/s².
+    psa : xarray.DataArray
+        Each motion's PSA over ``spectrum_period`` at scale 1, m/s².
+    spectrum_periods : numpy.ndarray
+        The periods of ``psa``, s.
+    g : float
+        The scene's acceleration of gravity, m/s².
     """
+
+    bundled: str
+    hazard: HazardCurve
+    scale_factor: xr.DataArray
+    pga: xr.DataArray
+    psa: xr.DataArray
+    spectrum_periods: np.ndarray
+    g: float
+
+
+def stripe_spectra_runs(store: xr.Dataset) -> StripeSpectraRuns | None:
+    """What the site-consistency check reads of a stripes store whose hazard is a bundled curve (:class:`StripeSpectraRuns`),
+    or None for a store without stripes, spectra or a bundled hazard."""
     entry = store.pound.hazard
     if "intensity" not in store.dims or entry is None or entry.bundled is None or "motion_psa" not in store:
         return None
@@ -652,12 +696,12 @@ def stripe_spectra_runs(store: xr.Dataset) -> dict[str, Any] | None:
         return store[name].isel({d: 0 for d in store[name].dims if d not in keep})
 
     ran = (store["case_status"] == 1).any([d for d in store["case_status"].dims if d not in keep])
-    return {
-        "bundled": entry.bundled,
-        "hazard": site_hazard(store),
-        "scale_factor": store_motions(first("scale_factor").where(ran)),
-        "pga": store_motions(first("motion_pga")),
-        "psa": store_motions(first("motion_psa")),
-        "spectrum_periods": store["spectrum_period"].values,
-        "g": scene_g(store),
-    }
+    return StripeSpectraRuns(
+        bundled=entry.bundled,
+        hazard=site_hazard(store),
+        scale_factor=store_motions(first("scale_factor").where(ran)),
+        pga=store_motions(first("motion_pga")),
+        psa=store_motions(first("motion_psa")),
+        spectrum_periods=store["spectrum_period"].values,
+        g=scene_g(store),
+    )

@@ -41,16 +41,16 @@ def site_consistency(store: xr.Dataset) -> dict[str, xr.Dataset]:
     runs = stripe_spectra_runs(store)
     if runs is None:
         return {}
-    others = [name for name in bundled_site_curves(runs["bundled"]) if name != runs["bundled"]]
+    others = [name for name in bundled_site_curves(runs.bundled) if name != runs.bundled]
     results = {}
     for name in others:
         measure = bundled_measure(name)
         if measure.kind == "pga":
-            unscaled = runs["pga"]
+            unscaled = runs.pga
         else:
-            unscaled = _interpolated(runs["psa"], runs["spectrum_periods"], [measure.period]).isel(period=0, drop=True)
-        spectra = (unscaled / runs["g"] * runs["scale_factor"]).transpose("intensity", "record")
-        results[measure.label] = hazard_consistency(spectra, runs["hazard"], HazardCurve.bundled(name))
+            unscaled = _interpolated(runs.psa, runs.spectrum_periods, [measure.period]).isel(period=0, drop=True)
+        spectra = (unscaled / runs.g * runs.scale_factor).transpose("intensity", "record")
+        results[measure.label] = hazard_consistency(spectra, runs.hazard, HazardCurve.bundled(name))
     return results
 
 

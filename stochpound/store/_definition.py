@@ -12,9 +12,11 @@ the stripes' scenario was obtained (:class:`Site`), gathered in a
 every store as its ``definition`` attribute and hashed, is only written from
 them (:meth:`Definition.to_dict`, each record's ``entry()``) and read back by
 :func:`read_definition` (each record's ``from_entry``); written and read, it is
-unchanged, so stored definitions and their sha256 are. The scene itself and a
-variant's overrides stay the scene file's tables (what the model's scene
-builder reads). The scene's g is read in one place (:func:`scene_g`).
+unchanged, so stored definitions and their sha256 are. Each entry's shape (its
+keys, those written only when set) is declared once (:mod:`stochpound.store._definition_entries`).
+The scene itself and a variant's overrides stay the scene file's tables as written
+(:class:`~stochpound.model.scene_tables.SceneEntry`, :class:`~stochpound.model.scene_tables.OverridesEntry`:
+what the model's scene builder reads). The scene's g is read in one place (:func:`scene_g`).
 
 **The identity.** :func:`definition_sha256` hashes the canonical JSON
 (:func:`canonical_json`) without the entries that no run depends on
@@ -45,9 +47,24 @@ from typing import Any, TypeVar
 from stochpound._errors import ExperimentError
 from stochpound.model.fields import TomlTable
 from stochpound.model.friction import is_fixed_base
-from stochpound.model.scene_tables import SceneOverrides, SceneTables
+from stochpound.model.scene_tables import MotionEntry, OverridesEntry, SceneEntry, SceneOverrides, SceneTables
 from stochpound.motions import MEASURE_KINDS, Measure
 from stochpound.store._design_isolation import DesignIsolation
+from stochpound.store._definition_entries import (
+    DefinitionEntry,
+    DesignEntry,
+    GapAxisEntry,
+    HazardEntry,
+    IntensityEntry,
+    LimitStatesEntry,
+    MotionSourceEntry,
+    MuAxisEntry,
+    OutputEntry,
+    SceneSourceEntry,
+    SiteEntry,
+    SolverEntry,
+    VariantAxisEntry,
+)
 from stochpound.store._stripe_selection import Selection
 
 _Record = TypeVar("_Record")
@@ -71,7 +88,7 @@ def _jsonable(value: Any) -> Any:
     return value
 
 
-def definition_sha256(definition: Mapping[str, Any]) -> str:
+def definition_sha256(definition: DefinitionEntry) -> str:
     """The experiment's identity: sha256 of the canonical definition's JSON without :data:`~stochpound.store.NOT_IN_IDENTITY`.
 
     What the runs depend on, and nothing else: a store is refused by an
@@ -86,7 +103,7 @@ MEASURES = MEASURE_KINDS
 """The intensity measures an ``[intensity]`` (and a ``[hazard]``) table may name (:data:`stochpound.motions.MEASURE_KINDS`)."""
 
 
-def scene_g(scene: Mapping[str, Any]) -> float:
+def scene_g(scene: SceneEntry) -> float:
     """A scene dict's acceleration of gravity, m/s²: its ``g``, or ``stochpound.motions.DEFAULT_G`` (9.81) when it leaves it out
     (:attr:`stochpound.model.scene_tables.SceneTables.g`, the one reader)."""
     return SceneTables.of(scene).g
@@ -129,14 +146,14 @@ class Intensity:
     selection: Selection | None = None
 
     @classmethod
-    def from_entry(cls, entry: Mapping[str, Any]) -> Intensity:
+    def from_entry(cls, entry: IntensityEntry) -> Intensity:
         """The typed setting of a canonical ``intensity`` entry."""
         return cls(Measure.from_entry(entry), entry["units"], tuple(float(x) for x in entry["levels"]), entry["method"], entry["ran"],
                    entry["note"], TomlTable(entry).raw("synthetic"), Selection.from_entry(entry))
 
-    def entry(self) -> dict[str, Any]:
+    def entry(self) -> IntensityEntry:
         """The canonical ``intensity`` entry (as definitions store it)."""
-        written = {**self.measure.entry(), "levels": list(self.levels), "units": self.units, "method": self.method}
+        written: IntensityEntry = {**self.measure.entry(), "levels": list(self.levels), "units": self.units, "method": self.method}
         if self.synthetic is not None:
             written["synthetic"] = self.synthetic
         written.update(ran=self.ran, note=self.note)
@@ -199,16 +216,16 @@ class Hazard:
     ruptures: str | None = None
 
     @classmethod
-    def from_entry(cls, entry: Mapping[str, Any]) -> Hazard:
+    def from_entry(cls, entry: HazardEntry) -> Hazard:
         """The typed hazard of a canonical ``hazard`` entry."""
         given = TomlTable(entry, "hazard")
         return cls(entry["source"], Measure.from_entry(entry), entry["units"], entry["extrapolate"], entry["provenance"],
                    tuple(given.raw("im", ())), tuple(given.raw("rate", ())), given.raw("power_law"), given.raw("file"),
                    given.raw("file_sha256"), given.raw("bundled"), given.raw("ruptures"))
 
-    def entry(self) -> dict[str, Any]:
+    def entry(self) -> HazardEntry:
         """The canonical ``hazard`` entry (as definitions store it)."""
-        written: dict[str, Any] = {"source": self.source, **self.measure.entry(), "units": self.units, "extrapolate": self.extrapolate}
+        written: HazardEntry = {"source": self.source, **self.measure.entry(), "units": self.units, "extrapolate": self.extrapolate}
         sources = {"bundled": self.bundled, "file": self.file, "file_sha256": self.file_sha256, "ruptures": self.ruptures,
                    "power_law": dict(self.power_law) if self.power_law is not None else None}
         written.update({key: value for key, value in sources.items() if value is not None})
@@ -278,7 +295,7 @@ class Design:
     isolation: DesignIsolation | None = None
 
     @classmethod
-    def from_entry(cls, entry: Mapping[str, Any]) -> Design:
+    def from_entry(cls, entry: DesignEntry) -> Design:
         """The typed design of a canonical ``design`` entry."""
         given = TomlTable(entry, "design")
         ec8 = given.raw("ec8")
@@ -287,9 +304,9 @@ class Design:
                    DesignEc8(ec8["ag"], ec8["ground"], ec8["q"]) if ec8 is not None else None,
                    DesignIsolation.from_entry(isolation) if isolation is not None else None)
 
-    def entry(self) -> dict[str, Any]:
+    def entry(self) -> DesignEntry:
         """The canonical ``design`` entry (as definitions store it)."""
-        written: dict[str, Any] = {"sds": self.sds, "sd1": self.sd1, "tl": self.tl, "r": self.r, "cd": self.cd, "omega0": self.omega0, "ie": self.ie}
+        written: DesignEntry = {"sds": self.sds, "sd1": self.sd1, "tl": self.tl, "r": self.r, "cd": self.cd, "omega0": self.omega0, "ie": self.ie}
         if self.sm1 is not None:
             written["sm1"] = self.sm1
         if self.ec8 is not None:
@@ -339,7 +356,7 @@ class LimitStates:
     states: tuple[LimitStateCapacities, ...]
 
     @classmethod
-    def from_entry(cls, entry: Mapping[str, Any]) -> LimitStates:
+    def from_entry(cls, entry: LimitStatesEntry) -> LimitStates:
         """The typed limit states of a canonical ``limit_states`` entry."""
         states = []
         for kind, value in entry["capacities"].items():
@@ -350,9 +367,9 @@ class LimitStates:
             states = [dataclasses.replace(state, targets=_state_targets(targets, state)) for state in states]
         return cls(entry["source"], tuple(states))
 
-    def entry(self) -> dict[str, Any]:
+    def entry(self) -> LimitStatesEntry:
         """The canonical ``limit_states`` entry (as definitions store it)."""
-        capacities: dict[str, Any] = {}
+        capacities: dict[str, list[float] | dict[str, list[float]]] = {}
         for state in self.states:
             if state.building is None:
                 capacities[state.kind] = list(state.capacities)
@@ -400,15 +417,15 @@ class Site:
     ruptures: str | None = None
 
     @classmethod
-    def from_entry(cls, entry: Mapping[str, Any]) -> Site:
+    def from_entry(cls, entry: SiteEntry) -> Site:
         """The typed site of a canonical ``site`` entry."""
         given = TomlTable(entry, "site")
         curves = given.raw("curves")
         return cls(entry["scenario"], tuple(curves) if curves is not None else None, given.raw("ruptures"))
 
-    def entry(self) -> dict[str, Any]:
+    def entry(self) -> SiteEntry:
         """The canonical ``site`` entry (as definitions store it)."""
-        written: dict[str, Any] = {"scenario": self.scenario}
+        written: SiteEntry = {"scenario": self.scenario}
         if self.ruptures is not None:
             written["ruptures"] = self.ruptures
         if self.curves is not None:
@@ -437,9 +454,9 @@ class GapAxis:
     contacts: tuple[int, ...]
     walls: tuple[int, ...] = ()
 
-    def entry(self) -> dict[str, Any]:
+    def entry(self) -> GapAxisEntry:
         """The canonical entry of the axis (``walls`` only when it sets walls)."""
-        written: dict[str, Any] = {"name": self.name, "values": list(self.values), "contacts": list(self.contacts)}
+        written: GapAxisEntry = {"name": self.name, "values": list(self.values), "contacts": list(self.contacts)}
         if self.walls:
             written["walls"] = list(self.walls)
         return written
@@ -466,7 +483,7 @@ class MuAxis:
     values: tuple[float, ...]
     buildings: tuple[str, ...] | None
 
-    def entry(self) -> dict[str, Any]:
+    def entry(self) -> MuAxisEntry:
         """The canonical entry of the axis."""
         return {"values": list(self.values), "buildings": list(self.buildings) if self.buildings is not None else None}
 
@@ -501,9 +518,9 @@ class VariantAxis:
 
     name: str
     values: tuple[str, ...]
-    overrides: Mapping[str, Mapping[str, Any]]
+    overrides: Mapping[str, OverridesEntry]
 
-    def entry(self) -> dict[str, Any]:
+    def entry(self) -> VariantAxisEntry:
         """The canonical entry of the axis (its overrides copied)."""
         return {"name": self.name, "values": list(self.values), "overrides": copy.deepcopy(dict(self.overrides))}
 
@@ -536,19 +553,24 @@ class MotionSource:
     label: str
     kind: str
     field: str
-    motion: Mapping[str, Any]
+    motion: MotionEntry
     start: int = 0
     count: int = 1
     suite: str | None = None
 
-    def entry(self) -> dict[str, Any]:
+    def entry(self) -> MotionSourceEntry:
         """The canonical entry of the motion (``start`` and ``count`` for an ensemble, ``suite`` for a suite's record)."""
-        written: dict[str, Any] = {"label": self.label, "kind": self.kind, "field": self.field, "motion": copy.deepcopy(dict(self.motion))}
+        written: MotionSourceEntry = {"label": self.label, "kind": self.kind, "field": self.field, "motion": copy.deepcopy(dict(self.motion))}
         if self.kind == "synthetic":
             written.update(start=self.start, count=self.count)
         if self.suite is not None:
             written["suite"] = self.suite
         return written
+
+    @property
+    def type(self) -> str:
+        """The ``[motion]`` table's ``type``: ``record`` when it gives none (as the scene's reader takes it)."""
+        return TomlTable(self.motion).raw("type", "record")
 
     @property
     def realizations(self) -> range:
@@ -577,9 +599,9 @@ class Output:
     impacts: bool
     demands: bool = False
 
-    def entry(self) -> dict[str, Any]:
+    def entry(self) -> OutputEntry:
         """The canonical ``output`` entry (``demands`` only when kept)."""
-        written: dict[str, Any] = {"time_histories": list(self.time_histories), "buildings": list(self.buildings), "impacts": self.impacts}
+        written: OutputEntry = {"time_histories": list(self.time_histories), "buildings": list(self.buildings), "impacts": self.impacts}
         if self.demands:
             written["demands"] = True
         return written
@@ -604,7 +626,7 @@ class Solver:
     rtol: float
     atol: float
 
-    def entry(self) -> dict[str, Any]:
+    def entry(self) -> SolverEntry:
         """The canonical ``solver`` entry."""
         return {"method": self.method, "integrator": self.integrator, "rtol": self.rtol, "atol": self.atol}
 
@@ -658,7 +680,7 @@ class Definition:
 
     name: str
     description: str
-    scene: Mapping[str, Any]
+    scene: SceneEntry
     studied: str
     variants: tuple[VariantAxis, ...]
     gaps: tuple[GapAxis, ...]
@@ -672,15 +694,15 @@ class Definition:
     hazard: Hazard | None = None
     design: Design | None = None
     limit_states: LimitStates | None = None
-    scene_source: Mapping[str, str] | None = None
+    scene_source: SceneSourceEntry | None = None
     site: Site | None = None
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> DefinitionEntry:
         """The canonical definition, written from the records: what ``parse_experiment`` returns (``stochpound.experiment._spec``).
 
         Optional entries are written only when set, so the definitions (and identities) of files without them are unchanged.
         """
-        written: dict[str, Any] = {
+        written: DefinitionEntry = {
             "format": self.format, "name": self.name, "description": self.description, "scene": copy.deepcopy(dict(self.scene)),
             "studied": self.studied, "variants": [axis.entry() for axis in self.variants], "gaps": [axis.entry() for axis in self.gaps],
             "mu": self.mu.entry() if self.mu is not None else None, "motions": [motion.entry() for motion in self.motions],

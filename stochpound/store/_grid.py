@@ -36,10 +36,11 @@ import xarray as xr
 
 from stochpound._errors import ExperimentError, SceneError
 from stochpound.model.scene_file import scene_from_dict
-from stochpound.model.scene_tables import BuildingTable, SceneOverrides, SceneTables
+from stochpound.model.scene_tables import BuildingTable, MotionEntry, SceneEntry, SceneOverrides, SceneTables
 from stochpound.store._catalogue import CASE, KINDS, REFERENCE
 from stochpound.store._definition import (Definition, Intensity, MotionSource, Output, Solver, VariantAxis, canonical_json, definition_sha256,
                                           read_definition)
+from stochpound.store._definition_entries import DefinitionEntry
 from stochpound.store._scene_edits import (
     apply_overrides,
     reference_scene,
@@ -235,7 +236,7 @@ class ExperimentGrid:
     """
 
     def __init__(
-        self, definition: Mapping[str, Any] | Definition, text: str = "", base_dir: str | Path = ".", path: str = "", choice: StripeChoice | None = None
+        self, definition: DefinitionEntry | Definition, text: str = "", base_dir: str | Path = ".", path: str = "", choice: StripeChoice | None = None
     ) -> None:
         self.definition: Definition = read_definition(definition)
         written = self.definition.to_dict()
@@ -471,7 +472,7 @@ class ExperimentGrid:
         """Cases by id (builds :attr:`cases`)."""
         return {case.case_id: case for case in self.cases}
 
-    def structure(self, case: Case | Point) -> dict[str, Any]:
+    def structure(self, case: Case | Point) -> SceneEntry:
         """The scene dict of a case or a grid point without its motion (a placeholder motion is set).
 
         Raises
@@ -508,7 +509,7 @@ class ExperimentGrid:
         n = len(case.position) - 2
         return Point(case.kind, case.position[:n], case.labels[:n])
 
-    def reference_structure(self, case: Case | Point) -> dict[str, Any]:
+    def reference_structure(self, case: Case | Point) -> SceneEntry:
         """The scene dict of the fixed-base reference of a case or grid point (placeholder motion)."""
         return self.structure(self.reference_point(self._point_of(case)))
 
@@ -555,10 +556,10 @@ class ExperimentGrid:
             return str(error)
         return None
 
-    def motion_table(self, label: str, realization: int | None = None) -> dict[str, Any]:
+    def motion_table(self, label: str, realization: int | None = None) -> MotionEntry:
         """The scene ``[motion]`` table of a motion (with ``realization`` for an ensemble)."""
         motion = self.recorded_motions[label] if label in self.recorded_motions else self.motions[label]
-        table = {k: v for k, v in motion.motion.items() if k != "file_sha256"}
+        table: MotionEntry = {k: v for k, v in motion.motion.items() if k != "file_sha256"}
         if motion.kind == "synthetic":
             table["realization"] = motion.start if realization is None else realization
         return table

@@ -46,18 +46,18 @@ from stochpound.model.building import scaled_masses
 from stochpound.model.contact import ELEMENT_KEYS, effective_mass
 from stochpound.model.fields import TomlTable
 from stochpound.model.friction import is_fixed_base
-from stochpound.model.scene_tables import SceneOverrides, SceneTables
+from stochpound.model.scene_tables import BuildingEntry, MotionEntry, OverridesEntry, SceneEntry, SceneOverrides, SceneTables
 
 #: Motion used while validating a scene's structure (the real motion is set per case).
-PLACEHOLDER_MOTION = {"type": "constant", "acceleration": 0.0, "duration": 1.0, "dt": 1.0}
+PLACEHOLDER_MOTION: MotionEntry = {"type": "constant", "acceleration": 0.0, "duration": 1.0, "dt": 1.0}
 
 
-def building_names(scene: Mapping[str, Any]) -> list[str]:
+def building_names(scene: SceneEntry) -> list[str]:
     """The names of the scene's buildings, left to right (default names B1, B2, ...)."""
     return list(SceneTables.of(scene).building_names)
 
 
-def building_table(scene: Mapping[str, Any], name: str) -> dict[str, Any]:
+def building_table(scene: SceneEntry, name: str) -> BuildingEntry:
     """The ``[[building]]`` table named ``name`` (default names B1, B2, ... included; KeyError if none)."""
     return SceneTables.of(scene).building(name).table.values
 
@@ -70,17 +70,17 @@ def _give(table: TomlTable, fields: Mapping[str, Any], dropped: Iterable[str] = 
     values.update(copy.deepcopy(dict(fields)))
 
 
-def without_motion(scene: Mapping[str, Any]) -> dict[str, Any]:
+def without_motion(scene: SceneEntry) -> SceneEntry:
     """The scene's structure: a shallow copy without its ``[motion]``."""
     return {key: value for key, value in scene.items() if key != "motion"}
 
 
-def with_motion(structure: Mapping[str, Any], motion: Mapping[str, Any] = PLACEHOLDER_MOTION) -> dict[str, Any]:
+def with_motion(structure: SceneEntry, motion: MotionEntry = PLACEHOLDER_MOTION) -> SceneEntry:
     """The scene ``structure`` under the ``[motion]`` table ``motion`` (a shallow copy; default: :data:`PLACEHOLDER_MOTION`)."""
     return {**structure, "motion": dict(motion)}
 
 
-def apply_overrides(scene: Mapping[str, Any], overrides: Iterable[Mapping[str, Any]]) -> dict[str, Any]:
+def apply_overrides(scene: SceneEntry, overrides: Iterable[OverridesEntry]) -> SceneEntry:
     """Apply variant overrides: explicit fields first (in order), then all mass factors.
 
     Parameters
@@ -233,7 +233,7 @@ def set_mu(scene: SceneTables, buildings: Iterable[str] | None, mu: float) -> li
     return missing
 
 
-def reference_scene(scene: Mapping[str, Any], studied: str) -> dict[str, Any]:
+def reference_scene(scene: SceneEntry, studied: str) -> SceneEntry:
     """The studied building alone on a fixed base (no contacts), same g."""
     tables = SceneTables.of(scene)
     building = copy.deepcopy(dict(tables.building(studied).table.values))

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import copy
 
+from stochpound.model.scene_tables import BuildingEntry, ContactEntry, MotionEntry, SceneEntry
 from stochpound.studies.agarwal2004._records import STUDY_G
 
 #: Floor masses of Building 1, kg (floor 1 upwards).
@@ -22,7 +23,7 @@ REFERENCE_DAMPING = [23634.2, 16881.57]
 IMPACT_FREQUENCY = 57.05
 
 
-def reference_building(name: str = "B1", mass_factor: float = 1.0, mu: float | None = None, **extra: object) -> dict:
+def reference_building(name: str = "B1", mass_factor: float = 1.0, mu: float | None = None, **extra: object) -> BuildingEntry:
     """The study's two-storey building as a scene file's ``[[building]]`` table.
 
     Parameters
@@ -44,7 +45,7 @@ def reference_building(name: str = "B1", mass_factor: float = 1.0, mu: float | N
         ``name``, ``mass`` (kg), ``stiffness`` (N/m), ``damping`` (N·s/m) or
         ``damping_ratio``, and ``base`` when ``mu`` is given.
     """
-    building: dict = {
+    building: BuildingEntry = {
         "name": name,
         "mass": [m * mass_factor for m in REFERENCE_MASS],
         "stiffness": list(REFERENCE_STIFFNESS),
@@ -59,7 +60,7 @@ def reference_building(name: str = "B1", mass_factor: float = 1.0, mu: float | N
     return building
 
 
-def study_contacts(gap: float, left: str = "B1", right: str = "B2", mass_factor: float = 2.0) -> list[dict]:
+def study_contacts(gap: float, left: str = "B1", right: str = "B2", mass_factor: float = 2.0) -> list[ContactEntry]:
     """The impact elements at both floors between Building 1 and Building 2 (masses times ``mass_factor``).
 
     Parameters
@@ -76,7 +77,7 @@ def study_contacts(gap: float, left: str = "B1", right: str = "B2", mass_factor:
     list of dict
         ``[[contact]]`` tables: √(k/m_eff) = 57.05 rad/s (k in N/m) and restitution 0.5.
     """
-    contacts = []
+    contacts: list[ContactEntry] = []
     for floor, m1 in ((1, REFERENCE_MASS[0]), (2, REFERENCE_MASS[1])):
         m2 = m1 * mass_factor
         effective = m1 * m2 / (m1 + m2)
@@ -86,7 +87,7 @@ def study_contacts(gap: float, left: str = "B1", right: str = "B2", mass_factor:
     return contacts
 
 
-def study_scene(mu1: float | None = 0.2, mu2: float | None = None, factor: float = 2.0, gap: float = 0.02, motion: dict | None = None) -> dict:
+def study_scene(mu1: float | None = 0.2, mu2: float | None = None, factor: float = 2.0, gap: float = 0.02, motion: MotionEntry | None = None) -> SceneEntry:
     """A pair of the study: Building 1 next to Building 2, with the study's g and El Centro 1940.
 
     Parameters
@@ -97,7 +98,7 @@ def study_scene(mu1: float | None = 0.2, mu2: float | None = None, factor: float
         Mass factor of Building 2 (2: flexible, 0.5: stiff).
     gap : float
         Gap at both floors, m.
-    motion : dict, optional
+    motion : MotionEntry, optional
         The scene's ``[motion]`` table (default: the study's El Centro 1940).
 
     Returns
