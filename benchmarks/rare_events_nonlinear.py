@@ -23,7 +23,6 @@ at 1e-6").
 from __future__ import annotations
 
 import argparse
-import math
 import time
 import tomllib
 from pathlib import Path
@@ -33,6 +32,7 @@ import numpy as np
 
 from benchmarks import report
 from benchmarks.rare_events import PAIR_MOTION
+from benchmarks.rare_moat import crude_rows
 from benchmarks.sections import Section
 from benchmarks.timing import REPOSITORY
 import stochpound
@@ -115,14 +115,7 @@ def section(measured: dict[str, dict], info: dict[str, str], samples: int) -> st
             f"| threshold{heading} | subset simulation (reported CoV) | crude MC (its CoV) | difference / combined standard deviation |",
             "|---:|---:|---:|---:|",
         ]
-        for p in CRUDE_PROBABILITIES:
-            index = int(np.flatnonzero(probability <= p)[0])
-            b, estimate, delta = thresholds[index], probability[index], cov[index]
-            share = float(np.mean(crude > b))
-            crude_cov = math.sqrt((1.0 - share) / (share * crude.size)) if share > 0.0 else math.nan
-            combined = math.hypot(delta * estimate, crude_cov * share) if share > 0.0 else math.nan
-            lines.append(f"| {b:.3g} | {estimate:.3g} ({delta:.0%}) | "
-                         + (f"{share:.3g} ({crude_cov:.0%}) | {(estimate - share) / combined:+.1f} |" if share > 0.0 else "0 | – |"))
+        lines += crude_rows(thresholds, probability, cov, crude, "{:.3g}", CRUDE_PROBABILITIES)
         lines.append("")
     lines[-1] = SECTION.end
     return "\n".join(lines) + "\n"

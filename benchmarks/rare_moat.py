@@ -118,17 +118,26 @@ def section(measured: dict, info: dict[str, str], samples: int, target: float, w
         "| c (m) | subset simulation (reported CoV) | crude MC (its CoV) | difference / combined standard deviation |",
         "|---:|---:|---:|---:|",
     ]
-    thresholds = curve["threshold"].values
-    for p in CRUDE_PROBABILITIES:
+    lines += crude_rows(curve["threshold"].values, probability, cov, crude, "{:.3f}")
+    lines.append(END)
+    return "\n".join(lines) + "\n"
+
+
+
+def crude_rows(thresholds: np.ndarray, probability: np.ndarray, cov: np.ndarray, crude: np.ndarray, threshold_format: str,
+               probabilities: tuple[float, ...] = CRUDE_PROBABILITIES) -> list[str]:
+    """Table rows of subset simulation against crude Monte Carlo at ``probabilities``: the threshold where the subset estimate
+    first falls to each, both estimates with their CoV, and their difference over the combined standard deviation."""
+    rows = []
+    for p in probabilities:
         index = int(np.flatnonzero(probability <= p)[0])
         b, estimate, delta = thresholds[index], probability[index], cov[index]
         share = float(np.mean(crude > b))
         crude_cov = math.sqrt((1.0 - share) / (share * crude.size)) if share > 0.0 else math.nan
         combined = math.hypot(delta * estimate, crude_cov * share) if share > 0.0 else math.nan
-        lines.append(f"| {b:.3f} | {estimate:.3g} ({delta:.0%}) | " + (f"{share:.3g} ({crude_cov:.0%}) | {(estimate - share) / combined:+.1f} |" if share > 0.0 else "0 | – |"))
-    lines.append(END)
-    return "\n".join(lines) + "\n"
-
+        rows.append(f"| {threshold_format.format(b)} | {estimate:.3g} ({delta:.0%}) | "
+                    + (f"{share:.3g} ({crude_cov:.0%}) | {(estimate - share) / combined:+.1f} |" if share > 0.0 else "0 | – |"))
+    return rows
 
 def main(argv: list[str] | None = None) -> int:
     """Run the measurements and rewrite the section of ``--out``."""
