@@ -36,7 +36,7 @@ from stochpound.experiment._rare_event_store import (
 from stochpound.experiment._rare_event_table import RareEventDefinition
 from stochpound.experiment._spec import ExperimentError
 from stochpound.model.scene_file import scene_from_dict
-from stochpound.store import canonical_json, with_motion
+from stochpound.store import canonical_json, with_motion, with_open_gaps
 
 RUNS_PER_BATCH = 100
 """Runs a batch takes (level 0: samples; a level of chains: chains × states a chain): part of the definition of the split."""
@@ -78,7 +78,7 @@ def _sampler(definition: str) -> tuple[SubsetSampler, str]:
     typed = RareEventDefinition.from_dict(json.loads(definition))
     table, scene = typed.table, typed.scene
     if table.response == "closure":  # the contact-free pair: its closure does not depend on the gap
-        scene = {**scene, "contact": [{**contact, "gap": float("inf")} for contact in scene.get("contact", [])]}
+        scene = with_open_gaps(scene)
     function, n, units = scene_response(scene_from_dict(with_motion(scene)), typed.motion, table.sampled, table.building, table.floor,
                                         table.contact or 0)
     if table.capacity is not None:

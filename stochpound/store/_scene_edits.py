@@ -80,6 +80,13 @@ def with_motion(structure: SceneEntry, motion: MotionEntry = PLACEHOLDER_MOTION)
     return {**structure, "motion": dict(motion)}
 
 
+def with_open_gaps(scene: SceneEntry) -> SceneEntry:
+    """A copy of ``scene`` with every contact's gap infinite: its contact-free twin, whose closures run without impacts."""
+    draft = SceneTables.of(copy.deepcopy(dict(scene)))
+    set_gaps(draft, range(len(draft.contacts)), float("inf"))
+    return draft.to_dict()
+
+
 def apply_overrides(scene: SceneEntry, overrides: Iterable[OverridesEntry]) -> SceneEntry:
     """Apply variant overrides: explicit fields first (in order), then all mass factors.
 
