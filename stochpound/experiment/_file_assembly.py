@@ -26,7 +26,7 @@ from typing import Any, Mapping
 
 import h5py
 import numpy as np
-from xarray.backends import H5NetCDFStore, NetCDF4DataStore
+from xarray.backends import H5NetCDFStore
 
 from stochpound._atomic import check_room, free_bytes, replacing
 from stochpound.experiment._experiment import Experiment
@@ -197,9 +197,7 @@ def _chunks(shape: tuple[int, ...], chunks: tuple[int, ...] | None, dtype: np.dt
 def file_bytes(store_layout: Layout, attrs: StoreAttributes) -> int:
     """The size of the store file :func:`write_store` writes for ``store_layout``, bytes, measured on an in-memory file.
 
-    The file's metadata is written by h5netcdf (its files are about 5 %
-    larger than the netCDF-C ones :func:`write_store` writes: for the tests'
-    tiny store 279 kB against 264 kB, and this estimate 273 kB), in
+    The file's metadata is written as :func:`write_store` writes it, in
     memory (HDF5's core driver, nothing on disk), and one element of every
     variable, which allocates its chunk index and its first chunk; the
     other chunks are counted at their uncompressed size (an upper bound
@@ -261,16 +259,10 @@ def _create(store_layout: Layout, attrs: StoreAttributes, path: Path) -> None:
     (:class:`_MetadataOnly`, the ``add`` of xarray's ``ArrayWriter``: a change
     to that call raises, it cannot write another file), and the file is
     closed before the blocks are written.
-
-    The netCDF4 library (netCDF-C) creates it, not h5netcdf: the same file
-    as read back (every variable, attribute and encoding), in a quarter of
-    the CPU time (h5netcdf looks every dimension up again in the HDF5 file
-    for each variable it creates: 0.7 s for a store of 56 variables, 0.17 s
-    here). The blocks are then written with h5py, as before.
     """
     # A lock of this process: xarray's default write lock is a dask.distributed Lock while a client is active, and the
     # last checkpoint's rebuild may run as the run's cluster closes ("IOLoop is closed"); only this process writes here.
-    store = NetCDF4DataStore.open(path, mode="w", format="NETCDF4", lock=threading.Lock())
+    store = H5NetCDFStore.open(path, mode="w", lock=threading.Lock())
     try:
         store_layout.template(attrs).dump_to_store(store, writer=_MetadataOnly())
     finally:

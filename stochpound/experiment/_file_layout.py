@@ -181,7 +181,7 @@ def _history_specs(experiment: Experiment, sizes: Mapping[str, int]) -> list[Spe
         trailing = tuple(sizes[d] for d in variable.dims) + (sizes["time"],)
         per_case = 8 * math.prod(trailing)
         grid = block_shape(tuple(sizes[d] for d in dims), max(1, HISTORY_BLOCK_BYTES // per_case))
-        encoding = {"zlib": True, "complevel": 1, "shuffle": False}  # as h5netcdf wrote it; netCDF-C would shuffle by default
+        encoding = {"zlib": True, "complevel": 1}
         specs.append(Spec(variable.name, kind, "history", dims + variable.dims + ("time",), np.dtype(float), variable.attrs, grid + trailing, encoding))
     return specs
 
