@@ -351,7 +351,7 @@ def subset_simulation(
         (``"mma"``), or adaptive conditional sampling (``"acs"``, Papaioannou
         et al. 2015), whose spread adapts to an acceptance rate of 0.44;
         on a scene, ``"acs"`` warns that it is not certified there
-        (:data:`UNCERTIFIED`).
+        (docs/rare-events.md, "Which proposal, which p0").
 
     Returns
     -------
