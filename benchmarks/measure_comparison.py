@@ -109,10 +109,12 @@ def table(comparison) -> list[str]:
     """A comparison as Markdown rows."""
     lines = ["| target | measure | conditioned g*, median (m) | over the seeds (m) | seed spread | measure-free g* (m), 95 % interval | ratio | within ×1.2 "
              "| trend within the stripes (p < 0.05) |", "|---|---|---:|---:|---:|---:|---:|---|---|"]
+    tested = "insufficient" in comparison.columns  # no column when no measure could be tested
     for (_, measure_name, target), row in comparison.iterrows():
+        trend = (row["insufficient"] or "none") if tested else "not tested"
         lines.append(f"| {target:.0%} in 50 yr | {measure_name} | {row['median']:.4f} | {row['lowest']:.4f}–{row['highest']:.4f} | "
                      f"×{row['seed spread']:.2f} | {row['measure-free']:.4f} ({row['lower']:.4f}–{row['upper']:.4f}) | {row['ratio']:.2f} | "
-                     f"{'yes' if row['agrees'] else '**no**'} | {row['insufficient'] or 'none'} |")
+                     f"{'yes' if row['agrees'] else '**no**'} | {trend} |")
     return lines
 
 

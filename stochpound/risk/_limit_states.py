@@ -130,7 +130,7 @@ class LimitState:
 
 def limit_states_of(table: LimitStates) -> tuple[LimitState, ...]:
     """The limit states of an experiment's ``[limit_states]`` table (:class:`~stochpound.store.LimitStates`), in its order, each
-    with the target the table gives it, else :func:`default_target`'s."""
+    with the target the table gives it, else the FEMA 356 objective of its drift limit (``default_target``)."""
     return tuple(LimitState(state.kind, capacity, state.building, _target_at(state.targets, index) or default_target(state.kind, capacity))
                  for state in table.states for index, capacity in enumerate(state.capacities))
 
@@ -159,7 +159,7 @@ def limit_states_from_table(table: Mapping[str, Any]) -> tuple[LimitState, ...]:
     Each key is a kind of ``stochpound.risk.LIMIT_STATE_KINDS``; its value a capacity or a list of
     capacities (any building), or a table of building names to a capacity or
     a list of them. ``targets`` (optional) gives a kind's objectives, probabilities in
-    50 years: one for all its capacities or a list, one per capacity; else :func:`default_target`.
+    50 years: one for all its capacities or a list, one per capacity; else ``default_target`` (the FEMA 356 objectives of a drift limit).
 
     Raises
     ------
