@@ -48,6 +48,7 @@ from scipy.signal import fftconvolve
 from scipy.special import ndtr, ndtri
 
 from benchmarks import report
+from benchmarks.scenes import PAIR_MOTION
 from benchmarks.sections import Section
 from benchmarks.timing import REPOSITORY
 import stochpound
@@ -73,8 +74,6 @@ PAIR_START = "<!-- rare events pair: start -->"
 PAIR_END = "<!-- rare events pair: end -->"
 PAIR_SECTION = Section(PAIR_START, PAIR_END)
 """The pounding pair's section of docs/rare-events.md."""
-PAIR_MOTION = {"type": "kanai_tajimi", "omega_g": 15.0, "zeta_g": 0.6, "pga": 2.0, "envelope": "jennings", "method": "filter", "duration": 10.0, "dt": 0.02}
-"""The pair's ground motion (a synthetic ensemble's fields)."""
 PAIR_THRESHOLDS = (0.03, 0.036, 0.042, 0.046, 0.05, 0.06, 0.07)
 """Closures of the pair's top contact, m."""
 

@@ -1,7 +1,7 @@
 """A pounding pair's impact force and a yielding building's ductility at 1e-6: ``python -m benchmarks rare_events nonlinear``.
 
 Two of issue 46's nonlinear cases, under the Kanai–Tajimi motion of the
-pounding pair (:data:`benchmarks.rare_events.PAIR_MOTION`, ``method =
+pounding pair (:data:`benchmarks.scenes.PAIR_MOTION`, ``method =
 "filter"``, exactly Gaussian), each by one subset run (modified Metropolis,
 p0 = 0.1) down to 1e-6 and by crude Monte Carlo of the same response
 (independent normals of another seed) at the response values where the
@@ -31,8 +31,8 @@ from typing import Callable
 import numpy as np
 
 from benchmarks import report
-from benchmarks.rare_events import PAIR_MOTION
 from benchmarks.rare_moat import crude_rows
+from benchmarks.scenes import PAIR_MOTION
 from benchmarks.sections import Section
 from benchmarks.timing import REPOSITORY
 import stochpound

@@ -31,6 +31,9 @@ KANAI_TAJIMI = {**motions.soil_preset("firm").kanai_tajimi(), "pga": 0.34 * 9.81
 """The synthetic motions of the ensemble and scaling runs: firm soil, El Centro's peak (0.34 g), Jennings envelope."""
 
 
+PAIR_MOTION = {"type": "kanai_tajimi", "omega_g": 15.0, "zeta_g": 0.6, "pga": 2.0, "envelope": "jennings", "method": "filter", "duration": 10.0, "dt": 0.02}
+"""The rare-event benchmarks' pounding pair's ground motion (a synthetic ensemble's fields)."""
+
 @dataclass(frozen=True)
 class StudyScene:
     """One of the study's configurations.
