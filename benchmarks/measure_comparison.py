@@ -26,6 +26,7 @@ from __future__ import annotations
 import argparse
 import tempfile
 import time
+from collections.abc import Collection
 from pathlib import Path
 
 import xarray as xr
@@ -105,13 +106,12 @@ def measure(measures: list[str], seeds: list[int], motions: int, runs: int, log=
             "untested": untested}
 
 
-def table(comparison) -> list[str]:
-    """A comparison as Markdown rows."""
+def table(comparison, tested: Collection[str]) -> list[str]:
+    """A comparison as Markdown rows; ``tested``: the measures whose sufficiency was tested (the others say "not tested")."""
     lines = ["| target | measure | conditioned g*, median (m) | over the seeds (m) | seed spread | measure-free g* (m), 95 % interval | ratio | within ×1.2 "
              "| trend within the stripes (p < 0.05) |", "|---|---|---:|---:|---:|---:|---:|---|---|"]
-    tested = "insufficient" in comparison.columns  # no column when no measure could be tested
     for (_, measure_name, target), row in comparison.iterrows():
-        trend = (row["insufficient"] or "none") if tested else "not tested"
+        trend = (row["insufficient"] or "none") if measure_name in tested else "not tested"
         lines.append(f"| {target:.0%} in 50 yr | {measure_name} | {row['median']:.4f} | {row['lowest']:.4f}–{row['highest']:.4f} | "
                      f"×{row['seed spread']:.2f} | {row['measure-free']:.4f} ({row['lower']:.4f}–{row['upper']:.4f}) | {row['ratio']:.2f} | "
                      f"{'yes' if row['agrees'] else '**no**'} | {trend} |")
@@ -138,11 +138,11 @@ def section(results: dict, settings: argparse.Namespace, info: dict[str, str], e
     for name, test in results["sufficiency"].items():
         lines += ["", f"Sufficiency of {name} for the closure (`stochpound.analysis.store_sufficiency`, seed {settings.seeds[0]}'s store; "
                   f"{test.results[0].conditions()}): {test.verdict()}."]
-    for name, reason in results.get("untested", {}).items():
+    for name, reason in results["untested"].items():
         lines += ["", f"Sufficiency of {name} for the closure: not tested ({reason})."]
     for name in ("counts", "lognormal demand per stripe"):
         lines += ["", f"g* from {'the counts (the risk chain, `store_risk`)' if name == 'counts' else 'a lognormal demand per stripe (`stripe_demand_rate`)'}:",
-                  "", *table(results[name])]
+                  "", *table(results[name], results["sufficiency"])]
     lines.append(SECTION.end)
     return "\n".join(lines) + "\n"
 
