@@ -179,8 +179,9 @@ def site_motions(magnitude: float | None = None, distance_km: float | None = Non
         raise SiteError(f"duration: must be within {10 * dt:g}-600 s, got {duration!r}")
     drawn = range(int(n)) if duration is None else rows  # the default window is the whole set's; a given one needs the rows asked for alone
     rngs = [realization_rng(seed, i) for i in drawn]
-    first = np.array([rng.standard_normal(load_site_model(model).normals) for rng in rngs])
-    parameters = motion_parameters(load_site_model(model), scenario, first)  # each motion's parameters are its own row's
+    site_model = load_site_model(model)
+    first = np.array([rng.standard_normal(site_model.normals) for rng in rngs])
+    parameters = motion_parameters(site_model, scenario, first)  # each motion's parameters are its own row's
     if duration is None:
         duration = _window(parameters)
         parameters = {name: values[rows] for name, values in parameters.items()}
