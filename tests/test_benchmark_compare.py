@@ -50,6 +50,7 @@ def test_the_section_shows_the_experiments_throughput_and_whether_the_stores_agr
                           "earlier": [_round(3.0, 50.0, 1.0), _round(3.0, 40.0, 4.0)]}}
     text = compare.section(results, {"commit": "abc1234"})
     assert "| cases/s | 100.0 (90.0) | 50.0 (45.0) | 2.000 |" in text
+    assert "| cases/s, start-up included | 89.8 (78.7) | 47.3 (40.6) | 1.898 |" in text  # 880 cases in 9.8, 13, 18.6 and 26 s
     assert "| start-up (s) | 1.00 (1.50) | 1.00 (2.50) | 1.00 |" in text
     assert "`python -m benchmarks compare earlier --experiment` (5 min)" in text and "880 cases" in text
     assert "stores hold the same data in every round" in text and "load average (1 min) at end 3.00" in text
