@@ -125,6 +125,15 @@ def test_gap_axes_and_selections(ds):
     xr.testing.assert_identical(free["peak_contact_closure"], ds["peak_contact_closure"].sel(gap=np.inf, drop=True))
 
 
+def test_a_case_names_its_motion(ds):
+    from stochpound.store import Case
+
+    cases = ds.pound.grid.cases
+    assert cases and {case.record for case in cases} == {"el_centro"}
+    assert all(case.realization == int(dict(case.labels)["realization"]) for case in cases)
+    assert Case("0" * 16, "case", (("record", "r1"),), (0,)).realization is None
+
+
 @pytest.mark.parametrize("gap", [0.005, math.inf])
 def test_a_case_scene_runs_what_the_store_holds(ds, gap):
     """The scene of a case, run again on its own, gives the store's numbers (scaled to the stripe's level)."""

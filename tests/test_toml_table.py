@@ -65,3 +65,21 @@ def test_sub_tables_and_lists_of_tables_carry_their_dotted_names():
     assert _error(lambda: records[1].string("name")) == "records[1].name: must be a non-empty string, got 3"
     assert _error(lambda: file.tables("solver", hint="name and type")) == "solver: must be an array of tables ([[solver]] with name and type)"
     assert str(file.error("grid", "unknown axis")) == "grid: unknown axis" and file.raw("absent", 4) == 4
+
+
+def test_a_parser_of_its_own_error_class_gets_the_same_messages_raised_as_that_class():
+    from stochpound._errors import SiteError
+
+    table = TomlTable({"motions": 1, "site": {"seeds": [0.5, "x"]}, "rows": [{"gap": -1.0}]}, "intensity", raises=SiteError)
+    with pytest.raises(SiteError, match=r"^intensity\.motions: must be an integer >= 2, got 1$") as caught:
+        table.integer("motions", low=2)
+    assert not isinstance(caught.value, SceneError)
+    with pytest.raises(SiteError, match=r"^intensity\.site\.seeds\[1\]: must be a number, got str 'x'$"):
+        table.table_or_empty("site").numbers("seeds")
+    with pytest.raises(SiteError, match=r"^intensity\.rows\[0\]\.gap: must be >= 0, got -1$"):
+        table.tables("rows")[0].number("gap", low=0.0)
+    with pytest.raises(SiteError, match=r"^intensity\.kind: must be one of a, b, got 'c'$"):
+        TomlTable({"kind": "c"}, "intensity", {"kind"}, SiteError).string("kind", choices=("a", "b"))
+    with pytest.raises(SiteError, match=r"^intensity\.other: unknown field \(allowed: kind\)$"):
+        TomlTable({"other": 1}, "intensity", {"kind"}, SiteError)
+    assert _error(lambda: TomlTable({"motions": 1}, "intensity").integer("motions", low=2)) == "intensity.motions: must be an integer >= 2, got 1"

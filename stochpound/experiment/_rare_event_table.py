@@ -29,7 +29,7 @@ from stochpound.store import TomlTable, building_names, building_table, canonica
 
 TABLE = "rare_event"
 """The experiment file's table that makes it a rare-event experiment."""
-METHODS = ("subset",)
+RARE_EVENT_METHODS = ("subset",)
 """``rare_event.method``: subset simulation (Au & Beck 2001)."""
 LIMIT_STATES = {"isolator_displacement": "base_displacement", "impact_force": "impact_force"}
 """``rare_event.limit_state`` kinds and the response whose ratio to ``capacity`` they take."""
@@ -186,7 +186,7 @@ def parse_rare_event(values: Any, motion: str, buildings: list[str], scene: Mapp
         raise ExperimentError(f"{TABLE}: must be a table (method, response, target_probability, samples_per_level, p0, seed)")
     with field_errors():
         table = TomlTable(values, TABLE, _KEYS)
-        method = table.string("method", "subset", choices=METHODS)
+        method = table.string("method", "subset", choices=RARE_EVENT_METHODS)
         response = table.string("response", choices=RESPONSE_CHOICES)
         target = table.number("target_probability", low=0.0, low_open=True, high=0.1)
         p0 = table.number("p0", 0.1, low=0.0, low_open=True, high=0.5)

@@ -110,9 +110,8 @@ def parse_selection(table: Mapping[str, Any], site: Any, levels: list[float], se
     """
     from stochpound._errors import SiteError
 
-    selection = table.get("selection", SELECTIONS[0])
-    if selection not in SELECTIONS:
-        raise SiteError(f"intensity.selection: must be one of {', '.join(SELECTIONS)}, got {selection!r}")
+    intensity_table = toml_fields.TomlTable(table, "intensity", raises=SiteError)
+    selection = intensity_table.string("selection", SELECTIONS[0], choices=SELECTIONS)
     if selection == SELECTIONS[0]:
         for key in ("motions", "max_scale_factor", "seed", *RULES):
             if key in table:
@@ -134,16 +133,10 @@ def parse_selection(table: Mapping[str, Any], site: Any, levels: list[float], se
         if not low <= period <= high:
             key = "intensity.period" if measure.period is not None else "intensity.periods"
             raise SiteError(f"{key}: must be within {low:g}-{high:g} s for the conditional spectrum (the NGA-West2 models' range), got {period:g}")
-    motions = table.get("motions")
-    if not isinstance(motions, int) or isinstance(motions, bool) or motions < 2:
-        raise SiteError(f"intensity.motions: motions per stripe, an integer >= 2, got {motions!r}")
-    max_scale = toml_fields.number(table, "max_scale_factor", "intensity", required=True, low=1.0)
-    seed = table.get("seed", DEFAULT_SEED)
-    if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0:
-        raise SiteError(f"intensity.seed: must be an integer >= 0, got {seed!r}")
+    motions = intensity_table.integer("motions", low=2, meaning="motions per stripe")
+    max_scale = intensity_table.number("max_scale_factor", low=1.0)
+    seed = intensity_table.integer("seed", DEFAULT_SEED, low=0)
     note = f"{motions} motions per stripe chosen from the pool and scaled to the conditional spectrum of its scenario"
-    if isinstance(site, dict) and site.get("scenario") == "fitted" and isinstance(site.get("curves"), list):
-        note += f" (the scenario fitted to the site's hazard curves {', '.join(map(str, site['curves']))}, standing in for a disaggregation)"
     max_per_earthquake, exclude_pulses = parse_rules(table)
     if isinstance(site, dict) and "ruptures" in site:
         if "simulated_motions" in site:
@@ -154,6 +147,8 @@ def parse_selection(table: Mapping[str, Any], site: Any, levels: list[float], se
         return Selection(selection, motions, max_scale, seed, mixture_scenarios(ruptures, levels, measure), max_per_earthquake, exclude_pulses,
                          ruptures=ruptures.to_entry(identity=True)), note
     scenarios = parse_site(site, levels, measure)
+    if toml_fields.TomlTable(site, "site", raises=SiteError).string("scenario", SCENARIO_KINDS[0]) == "fitted":
+        note += f" (the scenario fitted to the site's hazard curves {', '.join(map(str, site['curves']))}, standing in for a disaggregation)"
     return Selection(selection, motions, max_scale, seed, scenarios, max_per_earthquake, exclude_pulses, simulated=parse_simulated(site, seed)), note
 
 
@@ -230,7 +225,7 @@ def site_entry(site: Any, intensity: Intensity | None) -> Site | None:
         raise SiteError(f'site: only with [intensity] selection = "{CONDITIONAL_SPECTRUM}" (the scenario of its targets)')
     if "ruptures" in site:
         return Site("ruptures", ruptures=site["ruptures"])
-    kind = site.get("scenario", SCENARIO_KINDS[0])
+    kind = toml_fields.TomlTable(site, "site", raises=SiteError).string("scenario", SCENARIO_KINDS[0])
     return Site(kind, curves=tuple(site["curves"])) if kind == "fitted" else Site(kind)
 
 
@@ -240,10 +235,8 @@ def parse_site(site: Any, levels: list[float], measure: Measure) -> tuple[Scenar
 
     if not isinstance(site, dict):
         raise SiteError("site: a [site] table is required with the conditional spectrum (vs30, magnitude, distance_km, mechanism)")
-    scenario_kind = site.get("scenario", SCENARIO_KINDS[0])
-    if scenario_kind not in SCENARIO_KINDS[:2]:
-        raise SiteError(f"site.scenario: must be one of {', '.join(SCENARIO_KINDS[:2])} (a site of ruptures: ruptures = \"<file or bundled site>\"), "
-                        f"got {scenario_kind!r}")
+    scenario_kind = toml_fields.TomlTable(site, "site", raises=SiteError).string("scenario", SCENARIO_KINDS[0], choices=SCENARIO_KINDS[:2],
+                                                                     hint='a site of ruptures: ruptures = "<file or bundled site>"')
     if scenario_kind == "fitted":
         return fitted_site(site, levels, measure)
     if "curves" in site:
@@ -288,7 +281,7 @@ def fitted_site(site: Mapping[str, Any], levels: list[float], conditioning_measu
         if isinstance(site[key], list):
             raise SiteError(f'site.{key}: one value with scenario = "fitted", got a list')
     Scenario.of(6.0, 10.0, site["vs30"], site["mechanism"], names={"vs30": "site.vs30", "mechanism": "site.mechanism"})
-    curves = site.get("curves")
+    curves = toml_fields.TomlTable(site, "site", raises=SiteError).raw("curves")
     known = bundled_curves()
     if not isinstance(curves, list) or len(curves) < 2 or any(name not in known for name in curves):
         raise SiteError(f'site.curves: two or more of the bundled hazard curves ({", ".join(known)}), got {curves!r}')

@@ -8,7 +8,8 @@ an integer, a string with its choices, a boolean, a list of numbers, a
 sub-table, a list of tables, each optional with its default. A bad value
 raises :class:`~stochpound._errors.SceneError` whose message starts with the
 field's full path and says what is allowed, e.g.
-``building[0].base.mu: must be >= 0, got -0.2``. The model's scene readers
+``building[0].base.mu: must be >= 0, got -0.2``; a parser whose errors are of
+another class gives it (``raises=SiteError``: the same messages, raised as that class). The model's scene readers
 take their tables as :class:`TomlTable` values (the table and its name travel
 together); the store layer gives the same class as ``stochpound.store.TomlTable``
 to the experiment file's parsers, which re-raise its errors as ``ExperimentError``.
@@ -36,14 +37,15 @@ def is_number(value: Any) -> bool:
     return isinstance(value, (int, float)) and not isinstance(value, bool)
 
 
-def check_range(value: float, path: str, low: float | None, low_open: bool, high: float | None, high_open: bool) -> None:
-    """Raise unless ``value`` is a number within [low, high] (open ends where asked; None: unbounded)."""
+def check_range(value: float, path: str, low: float | None, low_open: bool, high: float | None, high_open: bool,
+                raises: type[ValueError] = SceneError) -> None:
+    """Raise ``raises`` unless ``value`` is a number within [low, high] (open ends where asked; None: unbounded)."""
     if math.isnan(value):
-        raise SceneError(f"{path}: must be a number, got nan")
+        raise raises(f"{path}: must be a number, got nan")
     if low is not None and (value < low or (low_open and value == low)):
-        raise SceneError(f"{path}: must be {'>' if low_open else '>='} {low:g}, got {value:g}")
+        raise raises(f"{path}: must be {'>' if low_open else '>='} {low:g}, got {value:g}")
     if high is not None and (value > high or (high_open and value == high)):
-        raise SceneError(f"{path}: must be {'<' if high_open else '<='} {high:g}, got {value:g}")
+        raise raises(f"{path}: must be {'<' if high_open else '<='} {high:g}, got {value:g}")
 
 
 class TomlTable:
@@ -57,16 +59,21 @@ class TomlTable:
         Its dotted name, the prefix of its fields' names (empty: the file's top level).
     allowed : collection of str, optional
         The keys it may hold (unknown keys are refused); None: any key.
+    raises : type of ValueError
+        The class of its errors (and of its sub-tables'): :class:`~stochpound._errors.SceneError`, or the
+        caller's own (e.g. :class:`~stochpound._errors.SiteError`); the messages are the same whatever the class.
 
     Raises
     ------
     SceneError
-        A key not in ``allowed``: ``design.foo: unknown field (allowed: cd, ec8, ...)``.
+        A key not in ``allowed``: ``design.foo: unknown field (allowed: cd, ec8, ...)`` (``raises``, when given).
     """
 
-    def __init__(self, values: Mapping[str, Any], name: str = "", allowed: Collection[str] | None = None) -> None:
+    def __init__(self, values: Mapping[str, Any], name: str = "", allowed: Collection[str] | None = None,
+                 raises: type[ValueError] = SceneError) -> None:
         self.values = values
         self.name = name
+        self.raises = raises
         if allowed is not None:
             self.reject_unknown(allowed)
 
@@ -86,9 +93,9 @@ class TomlTable:
         """The full name of field ``key`` (``design.sds``, ``records[2].name``)."""
         return field_path(self.name, key)
 
-    def error(self, key: str, problem: str) -> SceneError:
-        """The one-line error of field ``key``: its full name, then ``problem`` (what is allowed, what was given)."""
-        return SceneError(f"{self.field(key)}: {problem}")
+    def error(self, key: str, problem: str) -> ValueError:
+        """The one-line error of field ``key`` (of the table's class, ``raises``): its full name, then ``problem`` (what is allowed, what was given)."""
+        return self.raises(f"{self.field(key)}: {problem}")
 
     def raw(self, key: str, default: Any = None) -> Any:
         """The value of ``key`` as parsed (a free-form part the caller checks itself), ``default`` when absent."""
@@ -110,7 +117,7 @@ class TomlTable:
         value = float(value)
         if math.isinf(value) and not allow_inf:
             raise self.error(key, f"must be finite, got {value}")
-        check_range(value, self.field(key), low, low_open, high, high_open)
+        check_range(value, self.field(key), low, low_open, high, high_open, self.raises)
         return value
 
     def integer(self, key: str, default: Any = REQUIRED, *, low: int | None = None, high: int | None = None, meaning: str = "") -> Any:
@@ -166,10 +173,10 @@ class TomlTable:
         for i, value in enumerate(values):
             item = f"{self.field(key)}[{i}]"
             if not is_number(value):
-                raise SceneError(f"{item}: must be a number, got {type(value).__name__} {value!r}")
+                raise self.raises(f"{item}: must be a number, got {type(value).__name__} {value!r}")
             if math.isinf(value):
-                raise SceneError(f"{item}: must be finite, got {value}")
-            check_range(float(value), item, low, low_open, None, False)
+                raise self.raises(f"{item}: must be finite, got {value}")
+            check_range(float(value), item, low, low_open, None, False, self.raises)
         return tuple(float(v) for v in values)
 
     def table(self, key: str, allowed: Collection[str] | None = None, hint: str = "") -> TomlTable | None:
@@ -180,18 +187,18 @@ class TomlTable:
         value = self.raw(key)
         if value is not None and not isinstance(value, dict):
             raise self.error(key, f"must be a table {hint}, got {value!r}" if hint else f"must be a table, got {type(value).__name__}")
-        return None if value is None else TomlTable(value, self.field(key), allowed)
+        return None if value is None else TomlTable(value, self.field(key), allowed, self.raises)
 
     def table_or_empty(self, key: str, allowed: Collection[str] | None = None, hint: str = "") -> TomlTable:
         """The sub-table ``key`` as :meth:`table` reads it, an empty one when absent (a table whose every field has a default)."""
-        return self.table(key, allowed, hint) or TomlTable({}, self.field(key))
+        return self.table(key, allowed, hint) or TomlTable({}, self.field(key), raises=self.raises)
 
     def tables(self, key: str, hint: str = "") -> list[TomlTable]:
         """The array of tables ``[[key]]``, each named ``<key>[i]``; empty when absent (``hint`` says what each table holds)."""
         values = self.raw(key, [])
         if not isinstance(values, list) or not all(isinstance(v, dict) for v in values):
             raise self.error(key, f"must be an array of tables ([[{key}]]{f' with {hint}' if hint else ''})")
-        return [TomlTable(value, f"{self.field(key)}[{i}]") for i, value in enumerate(values)]
+        return [TomlTable(value, f"{self.field(key)}[{i}]", raises=self.raises) for i, value in enumerate(values)]
 
 
 def _integer_range(low: int | None, high: int | None) -> str:

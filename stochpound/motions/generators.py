@@ -42,6 +42,7 @@ WRAP_MARGIN_EFOLDS = 20.0
 #: Realizations generated per block (bounds memory; results do not depend on it).
 BLOCK = 512
 
+#: ``method`` of the stationary samples and of the synthetic generators that draw them: spectral synthesis, or the exact recursive filter.
 METHODS = ("spectral", "filter")
 
 

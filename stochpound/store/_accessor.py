@@ -205,8 +205,7 @@ class StoreAccessor:
         """
         grid = self.grid
         case = grid.case_index[self.case_id(**labels)]
-        where = case.label_dict
-        motion = grid.motion_table(where["record"], where.get("realization"))
+        motion = grid.motion_table(case.record, case.realization)
         factor = float(self._at("scale_factor", **labels)) if "scale_factor" in self._dataset else 1.0
         if factor != 1.0:
             typed = MotionTable.of(TomlTable(motion, "motion"))

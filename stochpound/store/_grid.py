@@ -110,6 +110,16 @@ class Case:
         """Its value on the grid's μ axis (dimensionless; ∞: a fixed base), None without a μ axis."""
         return next((float(value) for name, value in self.labels if name == "mu"), None)
 
+    @property
+    def record(self) -> str:
+        """The label of its motion (its ``record`` coordinate; every case has one)."""
+        return next(str(value) for name, value in self.labels if name == "record")
+
+    @property
+    def realization(self) -> int | None:
+        """Its realization of a synthetic ensemble's motion (its ``realization`` coordinate), None where the grid has none."""
+        return next((int(value) for name, value in self.labels if name == "realization"), None)
+
     def describe(self) -> str:
         """``kind dim=value ...``, e.g. ``case neighbour=stiff gap=0.02 mu=inf record=el_centro realization=0``."""
         return " ".join([self.kind] + [f"{name}={_format(value)}" for name, value in self.labels])
