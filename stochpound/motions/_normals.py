@@ -38,10 +38,6 @@ from stochpound.motions.baseline import baseline_correct
 from stochpound.motions.generators import filter_from_normals, filter_samples, spectral_from_phases, spectral_length, spectral_samples
 from stochpound.motions.psd import FilteredWhiteNoise
 
-#: The kinds of normals a :class:`NormalMotion` takes (its ``method``).
-NORMAL_METHODS = ("white", "filter", "spectral")
-
-
 @dataclass(frozen=True)
 class NormalMotion:
     """A synthetic ground motion a = f(u) of n independent standard normals u.
