@@ -38,6 +38,7 @@ from stochpound.motions.baseline import baseline_correct
 from stochpound.motions.generators import filter_from_normals, filter_samples, spectral_from_phases, spectral_length, spectral_samples
 from stochpound.motions.psd import FilteredWhiteNoise
 
+
 @dataclass(frozen=True)
 class NormalMotion:
     """A synthetic ground motion a = f(u) of n independent standard normals u.
