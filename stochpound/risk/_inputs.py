@@ -278,6 +278,11 @@ def configuration_scenes(store: xr.Dataset, closure: xr.DataArray) -> dict[tuple
             for labels in itertools.product(*(closure[dim].values for dim in configs))}
 
 
+def definition_entries(store: xr.Dataset) -> Mapping[str, object]:
+    """The store's canonical definition (its every entry, as the store keeps it), through its ``pound`` accessor."""
+    return store.pound.definition.to_dict()
+
+
 def experiment_name(store: xr.Dataset) -> str | None:
     """The store's experiment name, or None."""
     return store.attrs.get("experiment_name")
