@@ -179,7 +179,7 @@ def check_alternative(store: xr.Dataset, other: xr.Dataset, kind: str) -> str:
     Parameters
     ----------
     store, other : xarray.Dataset
-        Experiment stores; their definitions (``store.pound.definition``) are compared entry by entry. Their names,
+        Experiment stores; their definitions (as the stores keep them) are compared entry by entry. Their names,
         descriptions, ``[design]``, ``[limit_states]``, ``[output]`` and the intensity's note may differ as well.
     kind : str
         ``seed`` (the ``[intensity]`` seed, and a simulated pool's), ``measure`` (the ``[intensity]`` measure and what follows
