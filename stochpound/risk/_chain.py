@@ -200,6 +200,12 @@ class StoreRisk:
         return str(self.separation.attrs.get("no_interval", ""))
 
     @property
+    def grid(self) -> str:
+        """How the gap grid was made, in words (``60 log-spaced gaps, refined 3 times near each g* to 84 gaps, …``;
+        ``stochpound.risk._gap_grid``), "" where the separation does not say."""
+        return str(self.separation.attrs.get("grid", ""))
+
+    @property
     def measure(self) -> str:
         """The intensity measure in words, e.g. ``PSA(2 s, 5 %)`` ("" without a setting)."""
         return self.setting.description if self.setting is not None else ""

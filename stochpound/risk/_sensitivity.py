@@ -147,7 +147,7 @@ def separation_sensitivity(risk: object, store: xr.Dataset | RiskInputs, collaps
         columns[_unique(label, columns)] = store_risk(other, hazard, targets, years, bootstrap=0, partial=bool(risk.progress)).separation[
             "separation"]
     given = {kind for kind, _ in alternatives}
-    return Sensitivity(_table(columns, years), str(risk.separation.attrs.get("grid", "")), tuple(k for k in ALTERNATIVES if k not in given))
+    return Sensitivity(_table(columns, years), risk.grid, tuple(k for k in ALTERNATIVES if k not in given))
 
 
 def _table(columns: Mapping[str, xr.DataArray], years: float) -> pd.DataFrame:

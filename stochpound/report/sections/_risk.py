@@ -379,8 +379,8 @@ def _measure_choice_blocks(name: str, risk: StoreRisk, choice: pd.DataFrame | No
 
 def _grid_note(risk: StoreRisk) -> str:
     gaps = risk.curve["gap"].values
-    return (f"g* is interpolated on a grid of {gaps.size} gaps from {gaps[0]:.3g} to {gaps[-1]:.3g} m (log-spaced over the contact-free "
-            "closures); λ_P(g) is made non-increasing along it.")
+    made = risk.grid or "log-spaced over the contact-free closures"
+    return f"g* is interpolated on a grid of {gaps.size} gaps from {gaps[0]:.3g} to {gaps[-1]:.3g} m ({made}); λ_P(g) is made non-increasing along it."
 
 
 def _panel_grid(count: int, height: float = 2.6) -> tuple[Figure, list[Any]]:
