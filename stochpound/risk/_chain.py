@@ -168,6 +168,9 @@ class StoreRisk:
         (:func:`~stochpound.risk.design_rules_risk`); None without a ``[design]`` or without stripes.
     design_note : str
         Why ``design_rules`` is None ("" otherwise).
+    grid : str
+        How the gap grid was made, in words (``60 log-spaced gaps, refined 3 times near each g* to 84 gaps, …``;
+        ``stochpound.risk._gap_grid``; also the separation's ``grid`` attribute).
     assumptions : dict[str, str]
         What the answer rests on besides the hazard, in words from the
         store's definition: ``structural model``, ``suite`` (and its
@@ -192,18 +195,13 @@ class StoreRisk:
     dtm_note: str = ""
     design_rules: xr.Dataset | None = None
     design_note: str = ""
+    grid: str = ""
 
     @property
     def no_interval(self) -> str:
         """Why g* has no interval though a bootstrap was asked: the motions cannot be resampled (one motion, or every motion
         from one earthquake: ``stochpound.stats.resampling_obstacle``); "" where it has one, or where none was asked."""
         return str(self.separation.attrs.get("no_interval", ""))
-
-    @property
-    def grid(self) -> str:
-        """How the gap grid was made, in words (``60 log-spaced gaps, refined 3 times near each g* to 84 gaps, …``;
-        ``stochpound.risk._gap_grid``), "" where the separation does not say."""
-        return str(self.separation.attrs.get("grid", ""))
 
     @property
     def measure(self) -> str:
@@ -664,6 +662,7 @@ def store_risk(store: xr.Dataset | RiskInputs, hz: HazardCurve | None = None, ta
     else:
         grid = risk_gaps(closure)
     fragility, curve, separation = _refined_chain(inputs, hz, grid, targets, years, confidence, bootstrap, seed, grid_tolerance)
+    made = str(separation.attrs["grid"])
     rules, note = None, ""
     if inputs.method == "ida":
         note = "IDA runs hold no stripe at the code intensity to apply the rules to"
@@ -683,7 +682,8 @@ def store_risk(store: xr.Dataset | RiskInputs, hz: HazardCurve | None = None, ta
         design_rules = design_rules_risk(inputs, hz, inputs.design, inputs.studied, years, confidence, bootstrap, seed)
     return StoreRisk(fragility, curve, separation, rules, note, hz, inputs.motions, inputs.method, setting=inputs.setting,
                      stripes=inputs.stripes, progress=inputs.progress, experiment=inputs.experiment, years=years, confidence=confidence,
-                     assumptions=inputs.assumptions, dtm_note=inputs.dtm_note, design_rules=design_rules, design_note=design_note)
+                     assumptions=inputs.assumptions, dtm_note=inputs.dtm_note, design_rules=design_rules, design_note=design_note,
+                     grid=made)
 
 
 def _separation(curve: xr.Dataset, fragility: xr.Dataset, hz: HazardCurve, targets: Sequence[float], years: float, confidence: float,

@@ -38,7 +38,7 @@ import xarray as xr
 from stochpound.risk._collapse import CollapseRisk
 from stochpound.risk._fragility import DECREASING, EMPTY, NEVER, ALWAYS
 from stochpound.risk._gap_grid import refinement_gaps
-from stochpound.risk._inputs import RiskInputError, RiskInputs, definition_entries, experiment_name, intensity_setting, site_hazard
+from stochpound.risk._inputs import RiskInputError, RiskInputs, store_definition, experiment_name, intensity_setting, site_hazard
 from stochpound.risk._maf import mean_annual_frequency, risk_targeted_separation
 
 REFINEMENT = 4
@@ -164,7 +164,7 @@ def _table(columns: Mapping[str, xr.DataArray], years: float) -> pd.DataFrame:
     return frame[["g* (m)", *(c for name in columns if name != "g* (m)" for c in (name, f"{name}: Δ (%)"))]]
 
 
-def _unique(label: str, taken: Mapping[str, object]) -> str:
+def _unique(label: str, taken: Mapping[str, xr.DataArray]) -> str:
     """``label``, or ``label (2)``, ``label (3)`` … where a column of that name is already taken."""
     count = 2
     name = label
@@ -197,7 +197,7 @@ def check_alternative(store: xr.Dataset, other: xr.Dataset, kind: str) -> str:
     """
     if kind not in ALTERNATIVES:
         raise RiskInputError(f"kind: must be one of {', '.join(ALTERNATIVES)}, got {kind!r}")
-    ours, theirs = definition_entries(store), definition_entries(other)
+    ours, theirs = store_definition(store).to_dict(), store_definition(other).to_dict()
     relevant = [path for path in _differences(ours, theirs) if not _under(path, _ANY)]
     chosen = [path for path in relevant if _in_choice(path, kind)]
     others = [path for path in relevant if path not in chosen]
