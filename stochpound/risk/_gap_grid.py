@@ -9,10 +9,12 @@ where g passes a run's closure, so λ_P(g) is a step function of g with its
 steps at the closures. Within a bracket the step can be anywhere: the
 interpolated g* is off by up to the bracket's width (about 8 % on 60 gaps
 over a factor 100 of closures). So the chain splits every bracket that holds
-a g* (:func:`refinement_gaps`), ``SPLIT`` times in
-ln g, and refits there only, until each lies between two gaps at most
-``GRID_TOLERANCE`` apart: any finer grid then moves it by less than that
-(λ_P between the two gaps is on the same side of the target as at them).
+a g* (:func:`refinement_gaps`), ``SPLIT`` times in ln g, and refits there
+only, until each lies between two gaps at most ``GRID_TOLERANCE`` apart: a
+finer grid then moves it by less than that wherever the non-increasing fit
+of λ_P still crosses the target inside that bracket (the fit weighs each gap
+by the share of ln g it stands for, ``stochpound.risk._maf.gap_weights``,
+so the refined stretches do not outweigh the rest).
 
 The bounds of g*'s interval are read on the same grid, not refined for
 themselves: they are percentiles of g* over the resamples, each resample's

@@ -53,8 +53,6 @@ EVALUATED_BY = {
     "wall": "a store of the same experiment with the moat walls' stiffness of a retaining wall with backfill (docs/risk.md)",
 }
 """What would evaluate each choice of :data:`ALTERNATIVES`."""
-NOT_EVALUATED = tuple(ALTERNATIVES.values())
-"""Choices one store cannot vary: each needs other runs (another store, :data:`ALTERNATIVES`)."""
 _ANY = ("name", "description", "design", "limit_states", "scene_source", "output", "intensity.note")
 """Entries of a definition no g* depends on: they may differ between a store and its alternative."""
 _ALLOWED = {
