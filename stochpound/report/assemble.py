@@ -65,7 +65,7 @@ def assemble_report(paths: Sequence[str | Path], progress: Callable[[str], None]
         (:func:`~stochpound.analysis.store_measure_free`, ``ruptures_runs`` runs a configuration, seed 0).
     alternatives : sequence of (str, path)
         Other stores for the sensitivity table of g*, each with its kind (``seed``, ``measure``, ``wall``:
-        :data:`~stochpound.risk.ALTERNATIVES`): each serves every Risk section's store it differs from only in that choice
+        ``stochpound.risk.ALTERNATIVES``): each serves every Risk section's store it differs from only in that choice
         (:func:`~stochpound.risk.check_alternative`); one that serves none is refused.
 
     Returns

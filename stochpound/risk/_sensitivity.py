@@ -52,7 +52,7 @@ EVALUATED_BY = {
     "measure": "a store of the same experiment with another [intensity] measure (its levels, scenarios and [hazard] in that measure)",
     "wall": "a store of the same experiment with the moat walls' stiffness of a retaining wall with backfill (docs/risk.md)",
 }
-"""What would evaluate each choice of :data:`ALTERNATIVES`."""
+"""What would evaluate each choice of ``ALTERNATIVES``."""
 _ANY = ("name", "description", "design", "limit_states", "scene_source", "output", "intensity.note")
 """Entries of a definition no g* depends on: they may differ between a store and its alternative."""
 _ALLOWED = {
@@ -74,7 +74,7 @@ class Sensitivity:
     grid : str
         How the chain's gap grid was made (its separation's ``grid`` attribute; "" where it does not say).
     not_evaluated : tuple of str
-        The kinds of :data:`ALTERNATIVES` no store was given for.
+        The kinds of ``ALTERNATIVES`` no store was given for.
     """
 
     frame: pd.DataFrame
@@ -104,7 +104,7 @@ def separation_sensitivity(risk: object, store: xr.Dataset | RiskInputs, collaps
     refinement : int
         How many times finer the table's refinement splits each bracket of a g* (>= 2).
     alternatives : sequence of (str, xarray.Dataset)
-        Other stores of the same experiment, each with its kind (a key of :data:`ALTERNATIVES`: ``seed``, ``measure``,
+        Other stores of the same experiment, each with its kind (a key of ``ALTERNATIVES``: ``seed``, ``measure``,
         ``wall``) and differing from ``store`` only in that (:func:`check_alternative`); a kind may come more than once.
         A ``measure`` store's g* is taken at the hazard it carries (in its measure), the others' at ``risk``'s hazard.
 
@@ -261,7 +261,7 @@ def _with_dispersion(fragility: xr.Dataset, dispersion: float, hazard: object, t
 
 def sensitivity_text(frame: pd.DataFrame, grid: str = "", not_evaluated: Sequence[str] = tuple(ALTERNATIVES)) -> str:
     """The table's message in words: how the chain's grid was made, the largest change of each choice, what is not evaluated
-    (each of ``not_evaluated``, kinds of :data:`ALTERNATIVES`, with what would evaluate it) and what the interval bounds."""
+    (each of ``not_evaluated``, kinds of ``ALTERNATIVES``, with what would evaluate it) and what the interval bounds."""
     changes = [column for column in frame.columns if column.endswith("Δ (%)")]
     said = []
     for column in changes:
