@@ -400,22 +400,25 @@ def test_stochpound_risk_and_the_report_give_g_star_both_ways(store, tmp_path):
 
 
 def test_the_sensitivity_table_recomputes_g_star_under_each_choice(store):
-    """Issue 45 item 4: the grid 4x finer (the chain refitted on it: its every 4th gap is the chain's own), the collapse
-    treatment, β_m folded into the fragility; a vanishing β_m gives g* back (a closed-form limit), and Δ is the change from g*."""
+    """Issue 45 item 4: the grid refined once more near g* (the chain refitted on the chain's grid with each bracket of a g*
+    split 4 times), the collapse treatment, β_m folded into the fragility; a vanishing β_m gives g* back (a closed-form limit),
+    and Δ is the change from g*."""
     from stochpound.risk import collapse_risk, separation_sensitivity, sensitivity_text, store_risk
+    from stochpound.risk._gap_grid import refinement_gaps
 
     risk = store_risk(store, bootstrap=0)
     gaps = risk.fragility["gap"].values
     collapse = collapse_risk(store, risk.hazard, gaps, risk.separation["target"].values)
-    frame = separation_sensitivity(risk, store, collapse, dispersions=(1e-6, 0.3)).frame
-    fine = np.geomspace(gaps[0], gaps[-1], 4 * (gaps.size - 1) + 1)
-    np.testing.assert_allclose(fine[::4], gaps, rtol=1e-12)
-    refined = store_risk(store, risk.hazard, gaps=fine, bootstrap=0).separation["separation"].values.ravel()
-    np.testing.assert_allclose(frame["grid ×4 finer"].values, refined, rtol=1e-12)
+    sensitivity = separation_sensitivity(risk, store, collapse, dispersions=(1e-6, 0.3))
+    frame = sensitivity.frame
+    fine = np.union1d(gaps, refinement_gaps(gaps, risk.separation, tolerance=0.0, split=4))
+    assert fine.size > gaps.size
+    refined = store_risk(store, risk.hazard, gaps=fine, bootstrap=0, grid_tolerance=None).separation["separation"].values.ravel()
+    np.testing.assert_allclose(frame["grid ×4 finer near g*"].values, refined, rtol=1e-12)
     np.testing.assert_allclose(frame["g* (m)"].values, risk.separation["separation"].values.ravel(), rtol=1e-12)
     np.testing.assert_allclose(frame["β_m = 1e-06"].values, frame["g* (m)"].values, rtol=1e-4)
-    np.testing.assert_allclose(frame["grid ×4 finer: Δ (%)"].values, 100 * (refined / frame["g* (m)"].values - 1), rtol=1e-12)
+    np.testing.assert_allclose(frame["grid ×4 finer near g*: Δ (%)"].values, 100 * (refined / frame["g* (m)"].values - 1), rtol=1e-12)
     assert list(frame["collapses apart"]) == [np.inf, np.inf]
-    text = sensitivity_text(frame)
-    assert "Not evaluated from this store (each needs other runs): the selection seed, the conditioning measure" in text
-    assert "bound the sampling of the motions only" in text
+    text = sensitivity_text(frame, not_evaluated=("seed", "measure", "wall"))
+    assert "Not evaluated (each needs other runs): the selection seed (needs a store of the same experiment with another" in text
+    assert "bound the record-to-record sampling of the motions only" in text

@@ -8,6 +8,7 @@ import click
 
 from stochpound.analysis import MEASURE_FREE_RUNS
 from stochpound.cli._group import HelpGroup
+from stochpound.cli._risk import SENSITIVITY_HELP, sensitivity_stores
 from stochpound.cli._site import rupture_site_option
 from stochpound._errors import StochpoundError, os_error_message
 from stochpound.cli._store_errors import store_variables
@@ -41,8 +42,9 @@ def report() -> None:
               "site of ruptures (a rupture table or a bundled site's name; docs/measure-free.md), in a section of its own.")
 @click.option("--ruptures-runs", "ruptures_runs", default=MEASURE_FREE_RUNS, show_default=True, type=click.IntRange(min=2),
               help="Runs a configuration of --ruptures.")
+@click.option("--sensitivity-store", "sensitivity", multiple=True, metavar="KIND=PATH", help=SENSITIVITY_HELP)
 def build_command(stores: tuple[Path, ...], out: Path, formats: tuple[str, ...], partial: bool, accept_edited: bool, ruptures: str | None,
-                  ruptures_runs: int) -> None:
+                  ruptures_runs: int, sensitivity: tuple[str, ...]) -> None:
     """Build the report from the experiment STORE files into --out.
 
     Writes OUT/index.html (self-contained page), OUT/report.pdf, and every
@@ -52,16 +54,19 @@ def build_command(stores: tuple[Path, ...], out: Path, formats: tuple[str, ...],
     The stores are only read (they may be on a read-only disk); OUT is
     checked to be writable before any work. A store with missing cases
     (a run stopped, or cases that failed) is refused unless --partial.
+    A --sensitivity-store gives the sensitivity table of g* of each store
+    it differs from only in its KIND's choice a column of its own.
     """
     from stochpound.report.assemble import assemble_report
     from stochpound.report.render.output import check_output_folder, write_report
 
     site = None if ruptures is None else rupture_site_option(ruptures, "--ruptures")
+    alternatives = sensitivity_stores(sensitivity)
     try:
         check_output_folder(out, stores)
         with store_variables(stores):
             document = assemble_report(list(stores), progress=_progress, partial=partial, edited="accept" if accept_edited else "refuse",
-                                       ruptures=site, ruptures_runs=ruptures_runs)
+                                       ruptures=site, ruptures_runs=ruptures_runs, alternatives=alternatives)
         written = write_report(document, out, formats, progress=_progress)
     except (StochpoundError, ValueError) as error:
         raise click.ClickException(str(error)) from None

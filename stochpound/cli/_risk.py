@@ -65,6 +65,27 @@ def _check_csv(csv_dir: Path, inputs: list[tuple[str | Path, str]]) -> None:
         raise click.BadParameter(str(error), param_hint="--csv") from None
 
 
+def sensitivity_stores(values: tuple[str, ...], option: str = "--sensitivity-store") -> list[tuple[str, Path]]:
+    """The ``KIND=PATH`` values of ``option``: (kind, path) each, KIND one of ``stochpound.risk.ALTERNATIVES``, PATH an existing file."""
+    from stochpound.risk import ALTERNATIVES
+
+    pairs = []
+    for value in values:
+        kind, _, path = value.partition("=")
+        if kind not in ALTERNATIVES or not path:
+            raise click.BadParameter(f"must be KIND=PATH with KIND one of {', '.join(ALTERNATIVES)}, got {value!r}", param_hint=option)
+        if not Path(path).is_file():
+            raise click.BadParameter(f"{kind}: no store file at {path}", param_hint=option)
+        pairs.append((kind, Path(path)))
+    return pairs
+
+
+SENSITIVITY_HELP = ("Another store of the same experiment that differs only in one choice, for the sensitivity table of g*: KIND is "
+                    "seed (the [intensity] seed), measure (the conditioning measure: its levels, scenarios and [hazard] follow) or wall "
+                    "(the moat walls' stiffness); refused where it differs in anything else. Repeat for several (docs/risk.md).")
+"""The help of ``--sensitivity-store`` (``stochpound risk`` and ``stochpound report build``)."""
+
+
 CSV_TABLES = ("separation", "rules", "limit_states")
 """The tables ``--csv`` writes (one file each)."""
 
@@ -107,10 +128,11 @@ CSV_TABLES = ("separation", "rules", "limit_states")
 @click.option("--ruptures-runs", "ruptures_runs", default=MEASURE_FREE_RUNS, show_default=True, type=click.IntRange(min=2),
               help="Runs a configuration of --ruptures (half of them two or more of each rupture, the rest where g* needs them).")
 @click.option("--workers", default=1, show_default=True, type=click.IntRange(min=1), help="Processes running --ruptures (the answer does not depend on them).")
+@click.option("--sensitivity-store", "sensitivity", multiple=True, metavar="KIND=PATH", help=SENSITIVITY_HELP)
 def risk(store: Path, hazard: str | None, hazard_measure: str | None, hazard_units: str | None, investigation_time: float | None,
          hazard_site: str | None, extrapolate: bool, target: str, years: float, bootstrap: int, seed: int, limit_states: Path | None,
          design: Path | None, partial: bool, accept_edited: bool, csv_dir: Path | None, ruptures: str | None, ruptures_runs: int,
-         workers: int) -> None:
+         workers: int, sensitivity: tuple[str, ...]) -> None:
     """Print the risk-targeted separation g* and the code rules' risks of the experiment STORE at a site.
 
     For every configuration of the store (each combination of its grid's
@@ -137,13 +159,21 @@ def risk(store: Path, hazard: str | None, hazard_measure: str | None, hazard_uni
     to, and a note saying which stripes to add. A store with missing cases
     is refused unless --partial; --bootstrap is refused beyond the memory
     limit (STOCHPOUND_MEMORY_LIMIT, default half the machine's memory).
+
+    For stripes, the sensitivity table of g*: g* under each choice it rests
+    on, each alone (the gap grid refined once more near g*, the runs beyond
+    the model counted apart, modelling dispersion, and with
+    --sensitivity-store the selection seed, the conditioning measure or the
+    moat wall's stiffness from another store), with its change from g*.
     """
     from stochpound.cli._measure_choice import efficient_measure_lines
     from stochpound.experiment import open_store
     from stochpound.motions import TARGET_TOLERANCE, TRUNCATION_EPSILON
-    from stochpound.risk import MODEL_DRIFT_LIMIT, collapse_risk, gap_cost_frame, limit_state_risk, read_risk_inputs, site_hazard, store_risk
+    from stochpound.risk import (MODEL_DRIFT_LIMIT, check_alternative, collapse_risk, gap_cost_frame, limit_state_risk, read_risk_inputs, separation_sensitivity,
+                                 site_hazard, store_risk)
 
     targets = _targets(target)
+    others = sensitivity_stores(sensitivity)
     site = None if ruptures is None else rupture_site_option(ruptures, "--ruptures")
     if hazard is None and (hazard_measure or hazard_units or investigation_time is not None or hazard_site is not None):
         raise click.UsageError("--hazard-measure, --hazard-units, --investigation-time and --hazard-site describe a --hazard file: give one")
@@ -153,12 +183,18 @@ def risk(store: Path, hazard: str | None, hazard_measure: str | None, hazard_uni
     try:
         with store_variables([store]):
             data = open_store(store, edited="accept" if accept_edited else "refuse")
+            alternatives = [(kind, open_store(path, edited="accept" if accept_edited else "refuse")) for kind, path in others]
+            for kind, other in alternatives:  # refused before any work
+                check_alternative(data, other, kind)
             hz = site_hazard(data, hazard, measure=hazard_measure, units=hazard_units, investigation_time=investigation_time,
                              site=hazard_site, extrapolate=extrapolate)
             inputs = read_risk_inputs(data, hz, design=None if design is None else _design(design), partial=partial)  # the chain's one read
             result = store_risk(inputs, targets=targets, years=years, bootstrap=bootstrap, seed=seed)
             costs = None if limit_states is None else gap_cost_frame(limit_state_risk(data, _limit_states(limit_states), hz), years)
             collapse = None if result.method != "stripes" else collapse_risk(data, hz, result.fragility["gap"].values, targets, years)
+            if others and result.method != "stripes":
+                raise click.BadParameter("the sensitivity table is of stripes; the store holds IDA capacities", param_hint="--sensitivity-store")
+            spread = None if result.method != "stripes" else separation_sensitivity(result, data, collapse, alternatives=alternatives)
             missed, beyond = inputs.selection_misses, inputs.beyond_truncation  # every read of the store before the first answer
             measure_lines = efficient_measure_lines(data, hazard)
             free = None if site is None else measure_free_answer(data, site, ruptures_runs, seed, targets, years, workers)
@@ -197,7 +233,8 @@ def risk(store: Path, hazard: str | None, hazard_measure: str | None, hazard_uni
     if not given.any():
         basis = "none: every g* is a lower bound"
     elif "upper" in result.separation:
-        basis = f"the {design.loc[given, 'basis'].iloc[0]}, not g* itself"
+        basis = (f"the {design.loc[given, 'basis'].iloc[0]}, not g* itself: it bounds the record-to-record sampling of the motions "
+                 "only, none of the choices of the sensitivity table below")
     else:
         basis = design.loc[given, "basis"].iloc[0]
     click.echo(f"\nDesign to (m; {basis}):")
@@ -212,6 +249,9 @@ def risk(store: Path, hazard: str | None, hazard_measure: str | None, hazard_uni
     elif collapse is not None:
         click.echo(f"note: no contact-free run passes a {100 * MODEL_DRIFT_LIMIT:g} % storey drift: every run is within what the model "
                    "represents, and g* needs no collapse treatment.")
+    if spread is not None:
+        click.echo(f"\n{spread.text()}\nSensitivity of g* (m; Δ: % from g*):")
+        click.echo(spread.frame.to_string(float_format=lambda v: f"{v:.3f}"))
     degenerate = result.degenerate_text()
     if degenerate:
         click.echo(f"note: {degenerate}")

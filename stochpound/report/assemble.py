@@ -38,13 +38,14 @@ from stochpound.report.sections import (
 )
 from stochpound.analysis import MEASURE_FREE_RUNS, RuptureSite, StoreSufficiency, store_measure_free, store_sufficiency
 from stochpound.experiment import crude_check, is_rare_event_store, measure_choice, open_rare_event_store, rare_event_results
-from stochpound.risk import collapse_risk, has_risk, separation_sensitivity, store_damage, store_demands, store_risk
+from stochpound.risk import RiskInputError, check_alternative, collapse_risk, has_risk, separation_sensitivity, store_damage, store_demands, store_risk
 from stochpound.store import check_finished, has_contact_free, has_wall_free, with_contacts, with_walls
 from stochpound._studies import claims, load_study
 
 
 def assemble_report(paths: Sequence[str | Path], progress: Callable[[str], None] | None = None, partial: bool = False,
-                    edited: str = "warn", ruptures: RuptureSite | None = None, ruptures_runs: int = MEASURE_FREE_RUNS) -> Report:
+                    edited: str = "warn", ruptures: RuptureSite | None = None, ruptures_runs: int = MEASURE_FREE_RUNS,
+                    alternatives: Sequence[tuple[str, str | Path]] = ()) -> Report:
     """Build the report of the given stores.
 
     Parameters
@@ -62,6 +63,10 @@ def assemble_report(paths: Sequence[str | Path], progress: Callable[[str], None]
     ruptures : RuptureSite, optional
         A site of ruptures: each store with a Risk section also gets the answer without an intensity measure there
         (:func:`~stochpound.analysis.store_measure_free`, ``ruptures_runs`` runs a configuration, seed 0).
+    alternatives : sequence of (str, path)
+        Other stores for the sensitivity table of g*, each with its kind (``seed``, ``measure``, ``wall``:
+        ``stochpound.risk.ALTERNATIVES``): each serves every Risk section's store it differs from only in that choice
+        (:func:`~stochpound.risk.check_alternative`); one that serves none is refused.
 
     Returns
     -------
@@ -95,6 +100,7 @@ def assemble_report(paths: Sequence[str | Path], progress: Callable[[str], None]
         if summary is not None:
             report.sections.insert(0, summary)
     risks = {}
+    serving = _alternatives({name: store for name, store in others.items() if has_risk(store)}, alternatives, edited)
     for name, store in others.items():  # the answer first: each store's risk at its site, right after the introduction
         if has_risk(store):
             say(f"experiment {name}: risk")
@@ -102,7 +108,8 @@ def assemble_report(paths: Sequence[str | Path], progress: Callable[[str], None]
             damage = store_damage(store)
             collapse = None if risks[name].method != "stripes" else collapse_risk(
                 store, risks[name].hazard, risks[name].fragility["gap"].values, risks[name].separation["target"].values, risks[name].years)
-            sensitivity = None if risks[name].method != "stripes" else separation_sensitivity(risks[name], store, collapse)
+            sensitivity = None if risks[name].method != "stripes" else separation_sensitivity(risks[name], store, collapse,
+                                                                                               alternatives=serving.get(name, []))
             report.sections.append(risk_section(name, risks[name], store_demands(store), damage, measure_choice(store), collapse, sensitivity))
             if ruptures is not None:
                 say(f"experiment {name}: without an intensity measure")
@@ -144,6 +151,28 @@ def assemble_report(paths: Sequence[str | Path], progress: Callable[[str], None]
         say("summary")
         report.sections.insert(0, experiment_summary(others, report.sections, risks=risks))
     return report
+
+
+def _alternatives(stores: dict[str, xr.Dataset], alternatives: Sequence[tuple[str, str | Path]], edited: str) -> dict[str, list[tuple[str, xr.Dataset]]]:
+    """Per store of ``stores`` (those with a Risk section), the alternatives of its sensitivity table that serve it (each differs
+    from it only in its kind's choice); an alternative that serves none is refused with the reason it does not serve the first."""
+    serving: dict[str, list[tuple[str, xr.Dataset]]] = {}
+    for kind, path in alternatives:
+        (other,) = open_stores([path], edited).values()  # one at a time: an alternative shares its experiment's name
+        fits, reasons = [], []
+        for name, store in stores.items():
+            try:
+                check_alternative(store, other, kind)
+            except RiskInputError as error:
+                reasons.append(str(error))
+                continue
+            fits.append(name)
+        if not fits:
+            reason = reasons[0] if reasons else "no store of the report has a Risk section"
+            raise RiskInputError(f"--sensitivity-store {kind}={Path(path).name}: {reason}")
+        for name in fits:
+            serving.setdefault(name, []).append((kind, other))
+    return serving
 
 
 def _sufficiency(store: xr.Dataset) -> tuple[StoreSufficiency | None, str]:

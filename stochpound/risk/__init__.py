@@ -68,13 +68,14 @@ from stochpound.risk._inputs import (RiskInputError, RiskInputs, contact_free_cl
 from stochpound.risk._inputs import configuration_scene
 from stochpound.risk._inputs import stripe_motions  # noqa: F401  (for stochpound.experiment.measure_choice: not public API)
 from stochpound.risk._chain import StoreRisk, pounding_fragility, risk_gaps, store_risk
+from stochpound.risk._gap_grid import GRID_TOLERANCE
 from stochpound.risk._damage import POUNDING as POUNDING_AT_G_STAR  # noqa: F401  (for the report's sections: not public API)
 from stochpound.risk._demands import StoreDemands, store_demands
 from stochpound.risk._limit_states import KINDS as LIMIT_STATE_KINDS, LimitState, gap_cost_frame, limit_state_problem, limit_state_risk, limit_states_from_table
 from stochpound.risk._efficiency import measure_efficiency, most_efficient
 from stochpound.risk._efficiency import candidate_name  # noqa: F401  (for stochpound.experiment.measure_choice: not public API)
 from stochpound.risk._collapse import CollapseRisk, collapse_risk, collapsed_runs
-from stochpound.risk._sensitivity import MODELLING_DISPERSIONS, Sensitivity, separation_sensitivity, sensitivity_text
+from stochpound.risk._sensitivity import ALTERNATIVES, MODELLING_DISPERSIONS, Sensitivity, check_alternative, separation_sensitivity, sensitivity_text
 from stochpound.risk._damage import DAMAGE_DEMANDS, DEFAULT_LIMIT_STATES, DEFAULT_SOURCE as DEFAULT_LIMIT_STATES_SOURCE, MODEL_DRIFT_LIMIT, StoreDamage, store_damage
 from stochpound.hazard import hazard_consistency, read_hazard_file, stripe_rate_weights
 from stochpound.risk._site_consistency import consistency_at_targets, site_consistency
@@ -155,6 +156,9 @@ __all__ = [
     "sensitivity_text",
     "Sensitivity",
     "MODELLING_DISPERSIONS",
+    "ALTERNATIVES",
+    "check_alternative",
+    "GRID_TOLERANCE",
     "hazard_consistency",
     "consistency_at_targets",
     "site_consistency",

@@ -42,6 +42,7 @@ from stochpound.risk._code_rules import MINIMUM_MOTIONS, code_rules_risk
 from stochpound.risk._design_rules import DESIGN_RULE_NAMES, design_rules_risk, design_rules_text
 from stochpound.risk._fragility_ensemble import BOOTSTRAP, fragility_band, fragility_surface, homogeneous_capacities, ida_fragility, limit_state_events, stripe_fragility
 from stochpound.risk._fragility import DECREASING, EMPTY, FIT, STATUS
+from stochpound.risk._gap_grid import GRID_TOLERANCE, MAX_REFINEMENTS, grid_note, refinement_gaps
 from stochpound.risk._maf import TARGETS, degenerate_text, non_increasing, risk_curve, risk_targeted_separation
 from stochpound.risk._stripe_coverage import maf_outside_stripes, top_capped_maf
 
@@ -167,6 +168,9 @@ class StoreRisk:
         (:func:`~stochpound.risk.design_rules_risk`); None without a ``[design]`` or without stripes.
     design_note : str
         Why ``design_rules`` is None ("" otherwise).
+    grid : str
+        How the gap grid was made, in words (``60 log-spaced gaps, refined 3 times near each g* to 84 gaps, …``;
+        ``stochpound.risk._gap_grid``; also the separation's ``grid`` attribute).
     assumptions : dict[str, str]
         What the answer rests on besides the hazard, in words from the
         store's definition: ``structural model``, ``suite`` (and its
@@ -191,6 +195,7 @@ class StoreRisk:
     dtm_note: str = ""
     design_rules: xr.Dataset | None = None
     design_note: str = ""
+    grid: str = ""
 
     @property
     def no_interval(self) -> str:
@@ -594,7 +599,8 @@ def bound_beyond_stripes(separation: xr.Dataset, fragility: xr.Dataset, hz: Haza
 
 def store_risk(store: xr.Dataset | RiskInputs, hz: HazardCurve | None = None, targets: Sequence[float] = TARGETS, years: float = YEARS,
                gaps: Sequence[float] | np.ndarray | None = None, studied: str | None = None, confidence: float = CONFIDENCE,
-               bootstrap: int = BOOTSTRAP, seed: int = 0, design: Design | None = None, partial: bool = False) -> StoreRisk:
+               bootstrap: int = BOOTSTRAP, seed: int = 0, design: Design | None = None, partial: bool = False,
+               grid_tolerance: float | None = GRID_TOLERANCE) -> StoreRisk:
     """Fragility at every gap, the pounding risk curve, g* and the code rules of a store's intensity-conditioned runs.
 
     Parameters
@@ -615,7 +621,7 @@ def store_risk(store: xr.Dataset | RiskInputs, hz: HazardCurve | None = None, ta
         runs (closures at scale 1) together with each closure scaled to the
         intensity where the hazard's rate is a tenth of the rarest target's
         (within the hazard's table), so that the grid reaches the separations
-        the hazard asks for.
+        the hazard asks for. Either grid is refined near each g* (``grid_tolerance``).
     studied : str, optional
         The building whose peak base displacement (wall-free: a moat wall
         caps the displacement D_TM is meant to size) is ASCE 7's D_TM; default
@@ -630,6 +636,11 @@ def store_risk(store: xr.Dataset | RiskInputs, hz: HazardCurve | None = None, ta
         counts of motions and stripes are those that ran); without it such a
         store is refused. With inputs already read, ``studied``, ``design``
         and ``partial`` are theirs (giving them again is refused).
+    grid_tolerance : float or None
+        λ_P of stripes is a step function of the gap (its steps at the runs' closures), so g* interpolated between two grid
+        gaps is off by up to their spacing: the grid is refined near each g* (``stochpound.risk._gap_grid``) until each lies
+        between two gaps at most this far apart (relative), and any finer grid moves it by less. None: the grid as given.
+        The separation's ``grid`` attribute says how the grid was made.
 
     Raises
     ------
@@ -650,18 +661,15 @@ def store_risk(store: xr.Dataset | RiskInputs, hz: HazardCurve | None = None, ta
         grid = risk_gaps(xr.concat([closure, closure * (_reach_intensity(hz, targets, years) / inputs.motion_intensity)], "record"))
     else:
         grid = risk_gaps(closure)
-    configurations = math.prod(size for dim, size in closure.sizes.items() if dim not in ("record", "intensity"))
-    check_bootstrap(bootstrap, grid.size * configurations, closure.sizes.get("intensity", 1), closure.sizes["record"])
-    fragility = pounding_fragility(inputs, grid, confidence=confidence, bootstrap=bootstrap, seed=seed)
-    curve = risk_curve(fragility, hz, years, confidence)
-    separation = risk_targeted_separation(curve, targets, years, confidence=confidence)
-    if inputs.method == "stripes":
-        separation = bound_beyond_stripes(separation, fragility, hz, years)
+    fragility, curve, separation = _refined_chain(inputs, hz, grid, targets, years, confidence, bootstrap, seed, grid_tolerance)
+    made = str(separation.attrs["grid"])
     rules, note = None, ""
     if inputs.method == "ida":
         note = "IDA runs hold no stripe at the code intensity to apply the rules to"
     elif inputs.motions < MINIMUM_MOTIONS:
         note = f"the codes take the mean over at least {MINIMUM_MOTIONS} motions; the store has {inputs.motions}"
+    elif inputs.demands is None:
+        note = "the inputs hold no peak demands of the contact-free runs to apply the rules to"
     else:
         rules = code_rules_risk(inputs.demands, hz, years=years, isolator_displacement=inputs.isolator,
                                 confidence=confidence, bootstrap=bootstrap, seed=seed)
@@ -674,7 +682,54 @@ def store_risk(store: xr.Dataset | RiskInputs, hz: HazardCurve | None = None, ta
         design_rules = design_rules_risk(inputs, hz, inputs.design, inputs.studied, years, confidence, bootstrap, seed)
     return StoreRisk(fragility, curve, separation, rules, note, hz, inputs.motions, inputs.method, setting=inputs.setting,
                      stripes=inputs.stripes, progress=inputs.progress, experiment=inputs.experiment, years=years, confidence=confidence,
-                     assumptions=inputs.assumptions, dtm_note=inputs.dtm_note, design_rules=design_rules, design_note=design_note)
+                     assumptions=inputs.assumptions, dtm_note=inputs.dtm_note, design_rules=design_rules, design_note=design_note,
+                     grid=made)
+
+
+def _separation(curve: xr.Dataset, fragility: xr.Dataset, hz: HazardCurve, targets: Sequence[float], years: float, confidence: float,
+                method: str) -> xr.Dataset:
+    """g* of a risk curve (:func:`~stochpound.risk.risk_targeted_separation`), for stripes given as a lower bound beyond the
+    stripes' runs (:func:`bound_beyond_stripes`)."""
+    separation = risk_targeted_separation(curve, targets, years, confidence=confidence)
+    return bound_beyond_stripes(separation, fragility, hz, years) if method == "stripes" else separation
+
+
+def _with_gaps(data: xr.Dataset, added: xr.Dataset) -> xr.Dataset:
+    """Two results over ``gap`` of the same runs (fits or risk curves) as one, its gaps sorted."""
+    joined = xr.concat([data, added], "gap", data_vars="minimal", coords="minimal", compat="override", combine_attrs="override")
+    if "hazard_extrapolated" in data.attrs:
+        joined.attrs["hazard_extrapolated"] = max(int(data.attrs["hazard_extrapolated"]), int(added.attrs["hazard_extrapolated"]))
+    return joined.sortby("gap")
+
+
+def _refined_chain(inputs: RiskInputs, hz: HazardCurve, grid: np.ndarray, targets: Sequence[float], years: float, confidence: float,
+                   bootstrap: int, seed: int, tolerance: float | None) -> tuple[xr.Dataset, xr.Dataset, xr.Dataset]:
+    """The fit, risk curve and g* on ``grid`` refined near each g* (``stochpound.risk._gap_grid``) until each lies between gaps
+    at most ``tolerance`` apart (None: on ``grid`` as given), each refinement fitted at its new gaps only (the same resamples
+    of the motions: they do not depend on the gaps); the separation's ``grid`` attribute says how the grid was made."""
+    closure = inputs.closure
+    configurations = math.prod(size for dim, size in closure.sizes.items() if dim not in ("record", "intensity"))
+    stripes, motions = closure.sizes.get("intensity", 1), closure.sizes["record"]
+
+    def fitted(gaps: np.ndarray, held: int) -> tuple[xr.Dataset, xr.Dataset]:
+        check_bootstrap(bootstrap, (held + gaps.size) * configurations, stripes, motions)
+        fit = pounding_fragility(inputs, gaps, confidence=confidence, bootstrap=bootstrap, seed=seed)
+        return fit, risk_curve(fit, hz, years, confidence)
+
+    fragility, curve = fitted(grid, 0)
+    refinements, converged = 0, tolerance is None
+    while not converged and refinements <= MAX_REFINEMENTS:
+        estimate = _separation(curve[["maf"]], fragility, hz, targets, years, confidence, inputs.method)  # g* alone: no resamples
+        added = refinement_gaps(fragility["gap"].values, estimate, tolerance)
+        converged = not added.size
+        if not converged and refinements < MAX_REFINEMENTS:
+            fit, more = fitted(added, fragility.sizes["gap"])
+            fragility, curve = _with_gaps(fragility, fit), _with_gaps(curve, more)
+        refinements += not converged
+    separation = _separation(curve, fragility, hz, targets, years, confidence, inputs.method)
+    note = (f"{grid.size} gaps as given, not refined" if tolerance is None else
+            grid_note(fragility.sizes["gap"], grid.size, min(refinements, MAX_REFINEMENTS), tolerance, converged))
+    return fragility, curve, separation.assign_attrs(grid=note)
 
 
 def target_text(probability: float, years: float = YEARS) -> str:

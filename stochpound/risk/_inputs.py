@@ -32,7 +32,7 @@ from stochpound.model import Scene
 from stochpound.model.scene_tables import BuildingTable
 from stochpound.motions import DEFAULT_G, TRUNCATION_EPSILON
 from stochpound.risk._code_rules import MINIMUM_MOTIONS
-from stochpound.store import (LIMIT_STATE_DEMANDS, Design, Intensity, Label, LimitStates, MuAxis, cases_done, check_finished as _check_finished, contact_free, gap_dims,
+from stochpound.store import (LIMIT_STATE_DEMANDS, Definition, Design, Intensity, Label, LimitStates, MuAxis, cases_done, check_finished as _check_finished, contact_free, gap_dims,
                               has_contact_free, has_wall_free, scenario_kind, scenario_ranges, wall_free, with_contacts)
 
 CLOSURE = "peak_contact_closure"
@@ -276,6 +276,11 @@ def configuration_scenes(store: xr.Dataset, closure: xr.DataArray) -> dict[tuple
     configs = [dim for dim in closure.dims if dim not in CASE_DIMS]
     return {labels: configuration_scene(store, dict(zip(configs, labels)))
             for labels in itertools.product(*(closure[dim].values for dim in configs))}
+
+
+def store_definition(store: xr.Dataset) -> Definition:
+    """The store's definition, typed (its every entry: ``to_dict()``), through its ``pound`` accessor."""
+    return store.pound.definition
 
 
 def experiment_name(store: xr.Dataset) -> str | None:

@@ -280,7 +280,10 @@ def risk_targeted_separation(curve: xr.Dataset, targets: Sequence[float] = TARGE
     ``non_increasing``): a wider gap cannot pound more often, so a
     rise is estimation noise, and pooling it with its neighbours keeps the
     upward fluctuations as well as the downward ones (a running minimum
-    would keep only the downward ones: biased low, non-conservative). g* is
+    would keep only the downward ones: biased low, non-conservative). Each
+    gap weighs in the fit by the share of ln g it stands for
+    (``gap_weights``: equal on an evenly log-spaced grid), so a grid refined
+    near g* fits the same curve as a uniformly finer one would there. g* is
     interpolated between the two grid gaps that bracket the target,
     linearly in ln λ against ln g (exact where λ_P is a power law of g, as
     for a linear pair under a power-law hazard; against g from a zero gap).
@@ -401,7 +404,7 @@ def _lognormal_integral(theta: np.ndarray, beta: np.ndarray, hz: HazardCurve, lo
     return integral
 
 
-def non_increasing(maf: np.ndarray) -> np.ndarray:
+def non_increasing(maf: np.ndarray, weights: np.ndarray | None = None) -> np.ndarray:
     """The closest non-increasing curve to a rate curve along its last axis, in ln λ (isotonic regression).
 
     Each curve (the last axis, ascending gaps) is replaced by the
@@ -416,6 +419,9 @@ def non_increasing(maf: np.ndarray) -> np.ndarray:
     ----------
     maf : numpy.ndarray
         Mean annual frequencies (1/yr), ≥ 0 or NaN, the gaps on the last axis.
+    weights : numpy.ndarray, optional
+        The weight of each gap in the fit (along the last axis, > 0), e.g. the share of ln g it stands for
+        (:func:`gap_weights`); default equal weights.
 
     Returns
     -------
@@ -433,7 +439,7 @@ def non_increasing(maf: np.ndarray) -> np.ndarray:
         if known.sum() > 1:
             with np.errstate(divide="ignore"):
                 logs = np.maximum(np.log(row[known]), tiny)
-            values = np.exp(optimize.isotonic_regression(logs, increasing=False).x)
+            values = np.exp(optimize.isotonic_regression(logs, weights=None if weights is None else weights[known], increasing=False).x)
             out[known] = np.where(values > np.finfo(float).tiny, values, 0.0)
         elif known.any():
             out[known] = row[known]
@@ -441,9 +447,18 @@ def non_increasing(maf: np.ndarray) -> np.ndarray:
     return fitted.reshape(maf.shape)
 
 
+def gap_weights(gaps: np.ndarray) -> np.ndarray:
+    """The share of the gap axis each gap of a grid stands for: half the distance (in ln g; in g from a zero gap) to its two
+    neighbours, the whole distance to its one neighbour at an end. Equal on an evenly spaced grid; a grid refined in places
+    (``stochpound.risk._gap_grid``) does not give its refined stretches more weight in the isotonic fit than the stretches they replace."""
+    position = np.log(gaps) if gaps[0] > 0.0 else np.asarray(gaps, dtype=float)
+    step = np.diff(position)
+    return np.concatenate([step[:1], 0.5 * (step[:-1] + step[1:]), step[-1:]])
+
+
 def _separation_kernel(maf: np.ndarray, gaps: np.ndarray, rates: np.ndarray) -> np.ndarray:
-    """g* per target rate along the last axis of ``maf`` (isotonic λ, interpolation of ln λ in ln g)."""
-    envelope = non_increasing(maf)
+    """g* per target rate along the last axis of ``maf`` (isotonic λ weighted by :func:`gap_weights`, interpolation of ln λ in ln g)."""
+    envelope = non_increasing(maf, gap_weights(gaps))
     below = envelope[..., None, :] <= rates[:, None]  # (..., target, gap)
     found = below.any(-1)
     index = np.argmax(below, axis=-1)

@@ -1,11 +1,15 @@
-"""How far g* moves under the choices the answer rests on, from one store: the sensitivity table beside g*.
+"""How far g* moves under the choices the answer rests on: the sensitivity table beside g*.
 
 The interval of g* (and "the gap to design to", its upper bound) covers the
-sampling of the motions only. Larger, systematic choices move g* too; those
-one store can answer are recomputed here, each alone, with no bootstrap:
+sampling of the motions only: which records, from record to record. Larger,
+systematic choices move g* too; each is recomputed here alone, with no
+bootstrap. From the store itself:
 
-* **the gap grid**: g* read off a grid ``REFINEMENT`` times finer over the same
-  range (the chain's grid is log-spaced; g* is interpolated between its gaps);
+* **the gap grid**: the chain's grid is refined near each g* until g* lies
+  between two gaps at most ``stochpound.risk._gap_grid.GRID_TOLERANCE``
+  apart (λ_P of stripes is a step function of the gap); the table shows what
+  one more refinement gives, every bracket of a g* split ``REFINEMENT``
+  times finer (its Δ is below the tolerance where λ_P falls monotonically);
 * **the collapse treatment**: the runs beyond the model counted apart as
   collapses (:func:`~stochpound.risk.collapse_risk`), where some run is;
 * **modelling dispersion**: β_m folded into every fitted fragility,
@@ -14,14 +18,18 @@ one store can answer are recomputed here, each alone, with no bootstrap:
   lognormal of β_m; P-58's range for modelling uncertainty is 0.2–0.4,
   ``MODELLING_DISPERSIONS``).
 
-The selection seed, the conditioning measure and the moat wall's stiffness
-need other runs (another store): the table names them as not evaluated.
+From other stores of the same experiment (``alternatives``): the selection
+seed, the conditioning measure and the moat wall's stiffness
+(``ALTERNATIVES``), each store checked to differ from the store only in that
+(:func:`check_alternative`); g* of each at the same targets. A choice no store
+was given for is named as not evaluated, with what would evaluate it.
 """
 
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Sequence
+import math
+from collections.abc import Mapping, Sequence
 
 import numpy as np
 import pandas as pd
@@ -29,14 +37,30 @@ import xarray as xr
 
 from stochpound.risk._collapse import CollapseRisk
 from stochpound.risk._fragility import DECREASING, EMPTY, NEVER, ALWAYS
+from stochpound.risk._gap_grid import refinement_gaps
+from stochpound.risk._inputs import RiskInputError, RiskInputs, store_definition, experiment_name, intensity_setting, site_hazard
 from stochpound.risk._maf import mean_annual_frequency, risk_targeted_separation
 
 REFINEMENT = 4
-"""How many times finer the refined gap grid is."""
+"""How many times finer the table's refinement splits each bracket of a g* of the chain's (already refined) grid."""
 MODELLING_DISPERSIONS = (0.2, 0.4)
 """β_m folded into the fragility: the ends of FEMA P-58's range for modelling uncertainty."""
-NOT_EVALUATED = ("the selection seed", "the conditioning measure", "the moat wall's stiffness")
-"""Choices one store cannot vary: each needs other runs."""
+ALTERNATIVES = {"seed": "the selection seed", "measure": "the conditioning measure", "wall": "the moat wall's stiffness"}
+"""The choices another store evaluates: its kind (as ``stochpound risk --sensitivity-store KIND=PATH`` names it) and the choice in words."""
+EVALUATED_BY = {
+    "seed": "a store of the same experiment with another [intensity] seed",
+    "measure": "a store of the same experiment with another [intensity] measure (its levels, scenarios and [hazard] in that measure)",
+    "wall": "a store of the same experiment with the moat walls' stiffness of a retaining wall with backfill (docs/risk.md)",
+}
+"""What would evaluate each choice of ``ALTERNATIVES``."""
+_ANY = ("name", "description", "design", "limit_states", "scene_source", "output", "intensity.note")
+"""Entries of a definition no g* depends on: they may differ between a store and its alternative."""
+_ALLOWED = {
+    "seed": ("intensity.seed", "intensity.simulated_motions.seed"),
+    "measure": ("intensity.measure", "intensity.period", "intensity.periods", "intensity.damping", "intensity.levels", "intensity.units",
+                "intensity.site", "hazard", "site"),
+}
+"""Per kind, the entries (and everything under them) its alternative may change; the wall's: any wall's ``stiffness``."""
 
 
 @dataclasses.dataclass(frozen=True)
@@ -47,36 +71,53 @@ class Sensitivity:
     ----------
     frame : pandas.DataFrame
         Indexed by the configuration and ``target``; columns ``g* (m)`` and, per choice, its g* and ``Δ (%)``.
+    grid : str
+        How the chain's gap grid was made (its separation's ``grid`` attribute; "" where it does not say).
+    not_evaluated : tuple of str
+        The kinds of ``ALTERNATIVES`` no store was given for.
     """
 
     frame: pd.DataFrame
+    grid: str = ""
+    not_evaluated: tuple[str, ...] = tuple(ALTERNATIVES)
 
     def text(self) -> str:
         """The table's message in words (:func:`sensitivity_text`)."""
-        return sensitivity_text(self.frame)
+        return sensitivity_text(self.frame, self.grid, self.not_evaluated)
 
 
-def separation_sensitivity(risk: object, store: xr.Dataset, collapse: CollapseRisk | None = None,
-                           dispersions: Sequence[float] = MODELLING_DISPERSIONS, refinement: int = REFINEMENT) -> Sensitivity:
-    """g* under each choice one store can vary, per configuration and target (m), with its change from g* (%).
+def separation_sensitivity(risk: object, store: xr.Dataset | RiskInputs, collapse: CollapseRisk | None = None,
+                           dispersions: Sequence[float] = MODELLING_DISPERSIONS, refinement: int = REFINEMENT,
+                           alternatives: Sequence[tuple[str, xr.Dataset]] = ()) -> Sensitivity:
+    """g* under each choice it rests on, per configuration and target (m), with its change from g* (%).
 
     Parameters
     ----------
     risk : StoreRisk
         The chain's answer (:func:`~stochpound.risk.store_risk`) of a stripes store.
-    store : xarray.Dataset
-        The same store (refitted on the finer grid).
+    store : xarray.Dataset or RiskInputs
+        The same store, or its inputs already read (refitted at the finer gaps; the alternatives need the store).
     collapse : CollapseRisk, optional
         The answer with collapses counted apart (a column where some run collapsed).
     dispersions : sequence of float
         β_m values folded into the fragility (> 0).
     refinement : int
-        How many times finer the refined grid is (>= 2).
+        How many times finer the table's refinement splits each bracket of a g* (>= 2).
+    alternatives : sequence of (str, xarray.Dataset)
+        Other stores of the same experiment, each with its kind (a key of ``ALTERNATIVES``: ``seed``, ``measure``,
+        ``wall``) and differing from ``store`` only in that (:func:`check_alternative`); a kind may come more than once.
+        A ``measure`` store's g* is taken at the hazard it carries (in its measure), the others' at ``risk``'s hazard.
 
     Returns
     -------
     Sensitivity
         Its ``frame``: indexed by the configuration and ``target``; columns ``g* (m)`` and, per choice, its g* and ``Δ (%)``.
+
+    Raises
+    ------
+    ValueError
+        A bad ``refinement`` or β_m; (``RiskInputError``) an alternative of an unknown kind, or one that differs from the
+        store in anything else than its kind's choice, or not in it.
     """
     from stochpound.risk._chain import store_risk
 
@@ -85,16 +126,30 @@ def separation_sensitivity(risk: object, store: xr.Dataset, collapse: CollapseRi
     for value in dispersions:
         if not value > 0.0:
             raise ValueError(f"dispersions: each β_m must be > 0, got {value!r}")
+    if alternatives and isinstance(store, RiskInputs):
+        raise RiskInputError("alternatives: compared with the store's definition: give the store, not its inputs")
+    labels = [check_alternative(store, other, kind) for kind, other in alternatives]  # every alternative checked before any work
     gaps = risk.fragility["gap"].values
     targets, years = risk.separation["target"].values, risk.years
     columns = {"g* (m)": risk.separation["separation"]}
-    fine = store_risk(store, risk.hazard, targets, years, gaps=np.geomspace(gaps[0], gaps[-1], refinement * (gaps.size - 1) + 1), bootstrap=0,
-                      partial=bool(risk.progress))  # an unfinished store answered from what ran, as the chain's answer was
-    columns[f"grid ×{refinement} finer"] = fine.separation["separation"]
+    finer = np.union1d(gaps, refinement_gaps(gaps, risk.separation, tolerance=0.0, split=refinement))
+    partial = bool(risk.progress) and not isinstance(store, RiskInputs)  # an unfinished store answered from what ran, as the chain's was
+    fine = store_risk(store, risk.hazard, targets, years, gaps=finer, bootstrap=0, grid_tolerance=None, partial=partial)
+    columns[f"grid ×{refinement} finer near g*"] = fine.separation["separation"]
     if collapse is not None and collapse.collapsed:
         columns["collapses apart"] = collapse.separation["separation"]
     for value in dispersions:
         columns[f"β_m = {value:g}"] = _with_dispersion(risk.fragility, value, risk.hazard, targets, years)
+    for (kind, other), label in zip(alternatives, labels):
+        hazard = site_hazard(other) if kind == "measure" else risk.hazard
+        columns[_unique(label, columns)] = store_risk(other, hazard, targets, years, bootstrap=0, partial=bool(risk.progress)).separation[
+            "separation"]
+    given = {kind for kind, _ in alternatives}
+    return Sensitivity(_table(columns, years), risk.grid, tuple(k for k in ALTERNATIVES if k not in given))
+
+
+def _table(columns: Mapping[str, xr.DataArray], years: float) -> pd.DataFrame:
+    """The sensitivity frame of g* per choice (``columns``, the first ``g* (m)``): each with its Δ (%) from g*."""
     table = xr.Dataset({name: _dims_only(data) for name, data in columns.items()}).to_dataframe()
     frame = table.reset_index()
     frame["target"] = [f"{100 * p:g} % in {years:g} yr" for p in frame["target"]]
@@ -104,7 +159,95 @@ def separation_sensitivity(risk: object, store: xr.Dataset, collapse: CollapseRi
     for name in [c for c in columns if c != "g* (m)"]:
         with np.errstate(invalid="ignore", divide="ignore"):
             frame[f"{name}: Δ (%)"] = 100.0 * (frame[name] / base - 1.0)
-    return Sensitivity(frame[["g* (m)", *(c for name in columns if name != "g* (m)" for c in (name, f"{name}: Δ (%)"))]])
+    return frame[["g* (m)", *(c for name in columns if name != "g* (m)" for c in (name, f"{name}: Δ (%)"))]]
+
+
+def _unique(label: str, taken: Mapping[str, xr.DataArray]) -> str:
+    """``label``, or ``label (2)``, ``label (3)`` … where a column of that name is already taken."""
+    count = 2
+    name = label
+    while name in taken:
+        name, count = f"{label} ({count})", count + 1
+    return name
+
+
+def check_alternative(store: xr.Dataset, other: xr.Dataset, kind: str) -> str:
+    """Check that ``other`` is ``store``'s experiment with only the choice ``kind`` changed, and name its column.
+
+    Parameters
+    ----------
+    store, other : xarray.Dataset
+        Experiment stores; their definitions (as the stores keep them) are compared entry by entry. Their names,
+        descriptions, ``[design]``, ``[limit_states]``, ``[output]`` and the intensity's note may differ as well.
+    kind : str
+        ``seed`` (the ``[intensity]`` seed, and a simulated pool's), ``measure`` (the ``[intensity]`` measure and what follows
+        from it: levels, units, the stripes' scenarios, ``[hazard]`` and ``[site]``) or ``wall`` (the stiffness of any wall).
+
+    Returns
+    -------
+    str
+        The alternative's column in the table, e.g. ``selection seed 2``, ``measure PGA``, ``wall stiffness 3.4e+08 N/m``.
+
+    Raises
+    ------
+    ValueError
+        (``RiskInputError``) One line: an unknown ``kind``, or what else differs (its entries), or that the choice does not.
+    """
+    if kind not in ALTERNATIVES:
+        raise RiskInputError(f"kind: must be one of {', '.join(ALTERNATIVES)}, got {kind!r}")
+    ours, theirs = store_definition(store).to_dict(), store_definition(other).to_dict()
+    relevant = [path for path in _differences(ours, theirs) if not _under(path, _ANY)]
+    chosen = [path for path in relevant if _in_choice(path, kind)]
+    others = [path for path in relevant if path not in chosen]
+    named = f"{kind} store ({experiment_name(other) or 'unnamed'})"
+    if others:
+        shown = ", ".join(others[:6]) + (f" and {len(others) - 6} more" if len(others) > 6 else "")
+        raise RiskInputError(f"{named}: differs from {experiment_name(store) or 'the store'} in more than {ALTERNATIVES[kind]}: {shown}")
+    if not chosen:
+        raise RiskInputError(f"{named}: does not differ from {experiment_name(store) or 'the store'} in {ALTERNATIVES[kind]}")
+    if kind == "measure":
+        return f"measure {intensity_setting(other).description}"
+    values = sorted({_value(theirs, path) for path in chosen})
+    shown = ", ".join(f"{value:.3g}" for value in values)
+    return f"selection seed {shown}" if kind == "seed" else f"wall stiffness {shown} N/m"
+
+
+def _value(entry: object, path: str) -> float:
+    """The number at ``path`` (``a.b[0].c``) of a canonical definition."""
+    for part in path.replace("[", ".[").split("."):
+        entry = entry[int(part[1:-1])] if part.startswith("[") else entry[part]
+    return float(entry)
+
+
+def _differences(ours: object, theirs: object, path: str = "") -> list[str]:
+    """The paths (``a.b[0].c``) where two canonical definitions differ: a table key by key, a list of the same length item by item."""
+    if isinstance(ours, Mapping) and isinstance(theirs, Mapping):
+        return [p for key in sorted(set(ours) | set(theirs), key=str)
+                for p in (_differences(ours.get(key), theirs.get(key), f"{path}.{key}" if path else str(key))
+                          if key in ours and key in theirs else [f"{path}.{key}" if path else str(key)])]
+    if isinstance(ours, list | tuple) and isinstance(theirs, list | tuple) and len(ours) == len(theirs):
+        return [p for index, (a, b) in enumerate(zip(ours, theirs)) for p in _differences(a, b, f"{path}[{index}]")]
+    return [] if _same(ours, theirs) else [path]
+
+
+def _same(ours: object, theirs: object) -> bool:
+    """Whether two leaves of a definition are equal (numbers exactly, a flag only to a flag; NaN equal to NaN)."""
+    if isinstance(ours, float) and isinstance(theirs, float) and math.isnan(ours) and math.isnan(theirs):
+        return True
+    return isinstance(ours, bool) == isinstance(theirs, bool) and ours == theirs
+
+
+def _under(path: str, entries: Sequence[str]) -> bool:
+    """Whether ``path`` is one of ``entries`` or lies under one."""
+    return any(path == entry or path.startswith((f"{entry}.", f"{entry}[")) for entry in entries)
+
+
+def _in_choice(path: str, kind: str) -> bool:
+    """Whether ``path`` belongs to the choice ``kind`` (a wall's stiffness: ``….wall[i].stiffness``)."""
+    if kind == "wall":
+        head, _, last = path.rpartition(".")
+        return last == "stiffness" and head.rsplit(".", 1)[-1].startswith("wall[")
+    return _under(path, _ALLOWED[kind])
 
 
 def _with_dispersion(fragility: xr.Dataset, dispersion: float, hazard: object, targets: np.ndarray, years: float) -> xr.DataArray:
@@ -116,8 +259,9 @@ def _with_dispersion(fragility: xr.Dataset, dispersion: float, hazard: object, t
     return risk_targeted_separation(xr.Dataset({"maf": maf}), targets, years)["separation"]
 
 
-def sensitivity_text(frame: pd.DataFrame) -> str:
-    """The table's message in words: the largest change of each choice, and what is not evaluated."""
+def sensitivity_text(frame: pd.DataFrame, grid: str = "", not_evaluated: Sequence[str] = tuple(ALTERNATIVES)) -> str:
+    """The table's message in words: how the chain's grid was made, the largest change of each choice, what is not evaluated
+    (each of ``not_evaluated``, kinds of ``ALTERNATIVES``, with what would evaluate it) and what the interval bounds."""
     changes = [column for column in frame.columns if column.endswith("Δ (%)")]
     said = []
     for column in changes:
@@ -125,10 +269,13 @@ def sensitivity_text(frame: pd.DataFrame) -> str:
         finite = values[np.isfinite(values)]
         what = column.removesuffix(": Δ (%)")
         said.append(f"{what}: up to {np.max(np.abs(finite)):.1f} %" if finite.size else f"{what}: no finite change (g* inf on one side)")
-    return ("Sensitivity of g* to the choices it rests on (each alone, no bootstrap; Δ from g*): " + "; ".join(said)
-            + ". β_m cannot spread a gap no run closes (a 'never' step has no θ): its λ stays 0, so g* with β_m stops at the widest "
-            f"gap some run closes. Not evaluated from this store (each needs other runs): {', '.join(NOT_EVALUATED)}. The interval of g* "
-            "and the gap to design to bound the sampling of the motions only, not these.")
+    grid_said = f" The chain's gap grid: {grid}." if grid else ""
+    missing = ("; ".join(f"{ALTERNATIVES[kind]} (needs {EVALUATED_BY[kind]})" for kind in not_evaluated))
+    unsaid = f" Not evaluated (each needs other runs): {missing}." if missing else ""
+    return ("Sensitivity of g* to the choices it rests on (each alone, no bootstrap; Δ from g*): " + "; ".join(said) + "."
+            + grid_said + " β_m cannot spread a gap no run closes (a 'never' step has no θ): its λ stays 0, so g* with β_m stops at the "
+            f"widest gap some run closes.{unsaid} The interval of g* and the gap to design to (its upper bound) bound the "
+            "record-to-record sampling of the motions only, none of these choices.")
 
 
 def _dims_only(data: xr.DataArray) -> xr.DataArray:

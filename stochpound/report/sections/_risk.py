@@ -136,8 +136,9 @@ def risk_section(name: str, risk: StoreRisk, demands: StoreDemands | None = None
                           formats={"g* as run (m)": "{:.3f}", "g* collapses apart (m)": "{:.3f}", "λ_C (1/yr)": "{:.3g}"}))
     if sensitivity is not None:
         section.add(Paragraph(sensitivity.text()))
-        section.add(Table(f"risk-sensitivity-{name}", f"Experiment {name}: g* under each choice it rests on that the store can vary, each "
-                          "alone (no bootstrap), with its change from g*", sensitivity.frame,
+        section.add(Table(f"risk-sensitivity-{name}", f"Experiment {name}: g* under each choice it rests on, each alone (no bootstrap; "
+                          "the selection seed, the measure and the moat wall's stiffness from other stores, where given), with its change from "
+                          "g*", sensitivity.frame,
                           formats={c: ("{:.1f}" if c.endswith("(%)") else "{:.3f}") for c in sensitivity.frame.columns}))
     section.add(Paragraph(_hazard_text(risk)))
     for block in _measure_choice_blocks(name, risk, choice):
@@ -253,9 +254,10 @@ def design_value_text(risk: StoreRisk) -> str:
         return (f"There is no upper bound of g* to design to ({why}): the values are g* itself, a central estimate "
                 f"from {motions} that meets its target only about half the time: " + ". ".join(per) + ".")
     return (f"The gap to design to is the {risk.design_basis()}, not g* itself (g* is a central estimate from "
-            f"{motions} and meets its target only about half the time): " + ". ".join(per) + ". It bounds the sampling of the motions "
-            "only, not the choices the answer rests on (the grid, the collapse treatment, modelling dispersion, the measure, the "
-            "selection: the sensitivity table).")
+            f"{motions} and meets its target only about half the time): " + ". ".join(per) + ". It bounds the record-to-record "
+            "sampling of the motions only (which records were drawn), none of the choices the answer rests on (the gap grid, the "
+            "collapse treatment, modelling dispersion, the selection seed, the conditioning measure, the moat wall's stiffness: the "
+            "sensitivity table).")
 
 
 def _motions_text(risk: StoreRisk) -> str:
@@ -377,8 +379,8 @@ def _measure_choice_blocks(name: str, risk: StoreRisk, choice: pd.DataFrame | No
 
 def _grid_note(risk: StoreRisk) -> str:
     gaps = risk.curve["gap"].values
-    return (f"g* is interpolated on a grid of {gaps.size} gaps from {gaps[0]:.3g} to {gaps[-1]:.3g} m (log-spaced over the contact-free "
-            "closures); λ_P(g) is made non-increasing along it.")
+    made = risk.grid or "log-spaced over the contact-free closures"
+    return f"g* is interpolated on a grid of {gaps.size} gaps from {gaps[0]:.3g} to {gaps[-1]:.3g} m ({made}); λ_P(g) is made non-increasing along it."
 
 
 def _panel_grid(count: int, height: float = 2.6) -> tuple[Figure, list[Any]]:
