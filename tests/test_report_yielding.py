@@ -232,15 +232,75 @@ def test_the_damage_section_says_which_runs_and_stripes_and_lists_every_limit_st
     table = next(block for block in section.blocks if getattr(block, "key", "") == "table-limit-states-yfix").frame
     maf = damage.risk["maf"]
     assert len(table) == maf.sizes["limit_state"] == 2 * len(DEFAULT_LIMIT_STATES)  # one per building
+    from stochpound.risk import at_lowest_stripe, stripes_only_maf, unidentified
+
+    lowest, why = at_lowest_stripe(damage.risk), unidentified(damage.risk)
     for state in maf["limit_state"].values:
         rate = float(maf.sel(limit_state=state))
-        assert table.loc[("–", str(state)), "λ (1/yr)"] == f"{rate:.3g}"
-        assert table.loc[("–", str(state)), "once in (yr)"] == f"{1.0 / rate:.3g}"
         target = float(maf["target"].sel(limit_state=state))  # its objective and λ/λ_target, and the fit's kind (issue 45: λ without its fit)
         assert table.loc[("–", str(state)), "objective"] == f"{100 * target:g} % in 50 yr"
-        assert table.loc[("–", str(state)), "λ/λ_target"] == f"{rate / (-math.log(1 - target) / 50):.3g}"
-        assert table.loc[("–", str(state)), "fit"] in ("lognormal", "step: always", "step: never", "step: separated",
-                                                       "flat: decreasing (F ≡ fraction of runs that pounded)")
+        row = table.loc[("–", str(state))]
+        if bool(lowest.sel(limit_state=state)):  # issue 45: a step at the lowest stripe is a bound, not a rate
+            bound = float(stripes_only_maf(damage.risk.sel(limit_state=state), damage_hazard(store)))
+            assert 0.0 < bound <= rate * (1 + 1e-12)
+            assert (row["λ (1/yr)"], row["once in (yr)"]) == (f"≥ {bound:.3g}", f"≤ {1.0 / bound:.3g}")
+            assert row["λ/λ_target"] == f"≥ {bound / (-math.log(1 - target) / 50):.3g}"
+            assert row["fit"] == "step at the lowest stripe: a bound"
+            continue
+        assert (row["λ (1/yr)"], row["once in (yr)"]) == (f"{rate:.3g}", f"{1.0 / rate:.3g}")
+        assert row["λ/λ_target"] == f"{rate / (-math.log(1 - target) / 50):.3g}"
+        reason = str(why.sel(limit_state=state).item())  # issue 45: a lognormal its runs do not pin is not presented as identified
+        assert row["fit"] in (f"lognormal, not identified ({reason})" if reason else "lognormal", "step: never", "step: separated",
+                              "flat: decreasing (F ≡ fraction of runs that pounded)")
+    assert any(lowest.values.ravel()) or any(why.values.ravel())  # the store has a bound or an unidentified fit to print
+
+
+def damage_hazard(store):
+    from stochpound.risk import site_hazard
+
+    return site_hazard(store)
+
+
+def test_the_limit_states_and_demands_are_given_both_ways(store):
+    """Issue 45 item 3: the limit states' λ and λ/λ_target and the demand curves with the runs beyond the model counted apart;
+    a collapse reaches every limit state and level, so λ apart ≥ λ_C, and drift ≥ 5 % apart (no credible run passes 5 %) is λ_C;
+    the report says which runs (per stripe) and shows both."""
+    from stochpound.report.sections._risk import risk_section
+    from stochpound.risk import collapse_risk, store_demands, store_risk
+
+    damage = store_damage(store)
+    risk = store_risk(store, bootstrap=0)
+    collapse = collapse_risk(store, risk.hazard, risk.fragility["gap"].values, risk.separation["target"].values)
+    lambda_c = float(collapse.collapse["maf"])
+    assert damage.collapses_apart() and lambda_c > 0
+    apart = damage.risk["maf_collapses_apart"]
+    assert bool((apart >= lambda_c * (1 - 2e-3)).all())
+    for building in ("B1", "B2"):
+        assert float(apart.sel(limit_state=f"peak storey drift ratio of {building} ≥ 0.05")) == pytest.approx(lambda_c, rel=2e-3)
+    np.testing.assert_allclose(damage.ratio(apart=True).values, apart.values / (-np.log(1 - damage.risk["target"].values) / 50), rtol=1e-12)
+    section = damage_section("yfix", damage)
+    table = next(block for block in section.blocks if getattr(block, "key", "") == "table-limit-states-yfix").frame
+    for state in apart["limit_state"].values:
+        assert table.loc[("–", str(state)), "λ collapses apart (1/yr)"] == f"{float(apart.sel(limit_state=state)):.3g}"
+    texts = " ".join(_text(block) for block in section.blocks)
+    assert "The limit states' table gives each λ both ways" in texts and "a collapse counted as reaching every limit state" in texts
+    demands = store_demands(store, risk.hazard)
+    assert demands.apart and set(demands.apart) == set(demands.curves)
+    drift = contact_free(store)["peak_drift_ratio"].max("building").isel(realization=0, drop=True)
+    hand = (drift > MODEL_DRIFT_LIMIT).sum("record")
+    np.testing.assert_array_equal(demands.beyond_model.values.ravel(), hand.values.ravel())
+    for label, rate in demands.apart.items():  # the highest level: reached by collapses (and perhaps a few credible runs) only
+        assert float(rate.isel(level=-1)) >= lambda_c * (1 - 2e-3)
+    levels = demands.levels_at(risk.separation["target"].values, risk.years)
+    assert set(levels["demand"]) == {f"{label} ({demands.units[label]})" for label in demands.curves}
+    assert lambda_c > -np.log(1 - 0.1) / 50 and bool(np.isinf(levels["collapses apart"]).all())  # collapse alone exceeds both targets
+    assert bool(np.isfinite(levels["as run"]).any())
+    blocks = risk_section("yfix", risk, demands, damage, None, collapse).blocks
+    shown = " ".join(_text(block) for block in blocks)
+    per_stripe = "; ".join(f"{int(b)} of {int(n)} at stripe {float(x):.4g}" for x, b, n in
+                           zip(store["intensity"].values, hand.values, drift.notnull().sum("record").values))
+    assert f"per stripe over every configuration, {per_stripe}." in shown
+    assert any(getattr(block, "key", "") == "risk-demands-apart-yfix" for block in blocks)
 
 
 def test_no_run_beyond_the_model_is_said_so(store):

@@ -34,6 +34,7 @@ from stochpound.risk._inputs import LimitStates
 from stochpound.risk._fragility_ensemble import limit_state_events, stripe_fragility
 from stochpound.risk._maf import mean_annual_frequency
 from stochpound.risk._chain import CONFIDENCE, YEARS
+from stochpound.risk._collapse import MODEL_DRIFT_LIMIT, beyond_model, rate_collapses_apart
 
 
 OBJECTIVE_YEARS = 50.0
@@ -210,7 +211,12 @@ def limit_state_risk(store: xr.Dataset, limit_states: Sequence[LimitState], hz: 
         ``maf_contact_free`` (the contact-free twins' rate, the same motions
         and other labels) and ``gap_cost`` = ``maf`` − ``maf_contact_free``
         (1/yr; 0 for the twins themselves, negative where pounding lowers the
-        demand).
+        demand). Where some run's peak storey drift ratio passes
+        ``MODEL_DRIFT_LIMIT`` (beyond the model): ``maf_collapses_apart``,
+        λ with those runs counted apart as collapses and combined by total
+        probability (:func:`~stochpound.risk.rate_collapses_apart`; a
+        collapse reaches every limit state), and ``beyond_model``, those
+        runs per stripe and configuration.
 
     Raises
     ------
@@ -222,20 +228,36 @@ def limit_state_risk(store: xr.Dataset, limit_states: Sequence[LimitState], hz: 
         raise _inputs.RiskInputError("limit_states: give at least one limit state")
     hz, demands, measure = _inputs.limit_state_inputs(store, [(KINDS[s.kind].variable, s.building, KINDS[s.kind].note, KINDS[s.kind].units == "g")
                                                               for s in limit_states], hz)
-    fits = []
+    collapsed = _collapsed_cases(store)
+    fits, apart = [], []
     for state, demand in zip(limit_states, demands):
         events = limit_state_events(demand, [state.capacity], dim="limit_state").assign_coords(limit_state=[state.label])
         fit = stripe_fragility(events, confidence=confidence, bootstrap=bootstrap, seed=seed)
         fits.append(fit.assign_coords(kind=("limit_state", [state.kind]), capacity=("limit_state", [float(state.capacity)]),
                                       building=("limit_state", [state.building or ""]),
                                       target=("limit_state", [math.nan if state.target is None else float(state.target)])))
+        if collapsed is not None:
+            apart.append(rate_collapses_apart(demand, collapsed, [state.capacity], "limit_state", hz)[0].assign_coords(limit_state=[state.label]))
     result = xr.concat(fits, "limit_state", coords="different", compat="equals", join="outer")
     result["maf"] = mean_annual_frequency(result, hz)
+    if apart:
+        result["maf_collapses_apart"] = xr.concat(apart, "limit_state", join="outer").assign_attrs(
+            units="1/yr", long_name=f"mean annual frequency, the runs beyond a {100 * MODEL_DRIFT_LIMIT:g} % storey drift counted apart as collapses")
+        result["beyond_model"] = collapsed.sum("record").assign_attrs(units="1", long_name="runs beyond the model (collapses) per stripe")
     twins = _inputs.contact_free_twins(result["maf"])
     if twins is not None:
         result["maf_contact_free"] = twins.assign_attrs(units="1/yr", long_name="mean annual frequency of the contact-free twins")
         result["gap_cost"] = (result["maf"] - twins).assign_attrs(units="1/yr", long_name="what the gap costs: maf minus that of the contact-free twins")
     return result.assign_attrs(intensity=measure)
+
+
+def _collapsed_cases(store: xr.Dataset) -> xr.DataArray | None:
+    """:func:`~stochpound.risk.beyond_model` of every case of a store (its gap axes kept), None without storey drift ratios or
+    where no run is beyond the model (the collapses-apart rate is then the rate itself)."""
+    if "peak_drift_ratio" not in store:
+        return None
+    collapsed = beyond_model(_inputs.case_demand(store, "peak_drift_ratio", None, ""))
+    return collapsed if bool((collapsed == 1.0).any()) else None
 
 
 def gap_cost_frame(risk: xr.Dataset, years: float = YEARS) -> pd.DataFrame:
