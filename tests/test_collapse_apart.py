@@ -30,13 +30,9 @@ LEVELS = [0.2, 0.5, 1.2]
 K0, K = 1.0e-3, 2.0
 HAZARD = HazardCurve.power_law(K0, K)
 #: Peak storey drift ratio of every run (stripe x run): 0, 2 and 5 of 8 pass 5 % (collapses).
-DRIFT = np.array([[0.004, 0.006, 0.008, 0.010, 0.012, 0.015, 0.018, 0.020],
-                  [0.010, 0.015, 0.020, 0.025, 0.030, 0.040, 0.060, 0.070],
-                  [0.020, 0.030, 0.045, 0.060, 0.070, 0.080, 0.090, 0.100]])
+DRIFT = np.array([[0.004, 0.006, 0.008, 0.010, 0.012, 0.015, 0.018, 0.020], [0.010, 0.015, 0.020, 0.025, 0.030, 0.040, 0.060, 0.070], [0.020, 0.030, 0.045, 0.060, 0.070, 0.080, 0.090, 0.100]])
 #: Another demand of the same runs (a base displacement, m).
-DISPLACEMENT = np.array([[0.02, 0.03, 0.05, 0.06, 0.08, 0.10, 0.12, 0.15],
-                         [0.08, 0.10, 0.15, 0.20, 0.25, 0.30, 0.35, 0.40],
-                         [0.20, 0.25, 0.30, 0.35, 0.45, 0.55, 0.65, 0.80]])
+DISPLACEMENT = np.array([[0.02, 0.03, 0.05, 0.06, 0.08, 0.10, 0.12, 0.15], [0.08, 0.10, 0.15, 0.20, 0.25, 0.30, 0.35, 0.40], [0.20, 0.25, 0.30, 0.35, 0.45, 0.55, 0.65, 0.80]])
 
 
 def _runs(values: np.ndarray) -> xr.DataArray:
@@ -50,8 +46,7 @@ def _hazard_density(im: float) -> float:
 
 def _integral(probability) -> float:
     """∫ probability(im) |dλ(im)| by adaptive quadrature in ln im (an integrator independent of the code's trapezoids)."""
-    value, _ = integrate.quad(lambda u: probability(math.exp(u)) * _hazard_density(math.exp(u)) * math.exp(u), math.log(1e-4), math.log(1e3),
-                              limit=400, points=[math.log(level) for level in LEVELS])
+    value, _ = integrate.quad(lambda u: probability(math.exp(u)) * _hazard_density(math.exp(u)) * math.exp(u), math.log(1e-4), math.log(1e3), limit=400, points=[math.log(level) for level in LEVELS])
     return value
 
 
@@ -119,7 +114,7 @@ def test_a_step_at_the_lowest_stripe_is_a_bound_from_the_stripes_alone():
     events = xr.concat([_runs((DRIFT >= c).astype(float)) for c in (0.004, 0.010, 0.03)], "level").assign_coords(level=[0.004, 0.010, 0.03])
     fit = stripe_fragility(events, bootstrap=0)
     np.testing.assert_array_equal(at_lowest_stripe(fit).values, [True, True, False])
-    rates = [K0 * x ** -K for x in LEVELS]
+    rates = [K0 * x**-K for x in LEVELS]
     bound = stripes_only_maf(fit, HAZARD)
     assert float(bound.sel(level=0.004)) == pytest.approx(rates[0], rel=1e-12)
     hand = 5 / 8 * (rates[0] - rates[1]) + 1.0 * (rates[1] - rates[2]) + 1.0 * rates[2]
@@ -132,8 +127,7 @@ def test_a_lognormal_beyond_the_top_stripe_or_too_wide_is_not_identified():
     fit = stripe_fragility(_runs(events), bootstrap=0)
     assert float(fit["theta"]) > LEVELS[-1]
     assert "beyond the top stripe" in str(unidentified(fit).item())
-    wide = xr.Dataset({"status": ("c", [0, 0, 1]), "theta": ("c", [0.5, 0.5, 0.5]), "beta": ("c", [0.4, UNIDENTIFIED_BETA, 0.0])},
-                      coords={"intensity": LEVELS})
+    wide = xr.Dataset({"status": ("c", [0, 0, 1]), "theta": ("c", [0.5, 0.5, 0.5]), "beta": ("c", [0.4, UNIDENTIFIED_BETA, 0.0])}, coords={"intensity": LEVELS})
     assert list(unidentified(wide).values) == ["", f"β = {UNIDENTIFIED_BETA:.2g} ≥ {UNIDENTIFIED_BETA:g}", ""]
 
 
@@ -144,7 +138,7 @@ def test_the_level_at_a_targets_rate_is_read_off_each_curve_both_ways():
     from stochpound.risk import StoreDemands
 
     levels = np.geomspace(0.1, 10.0, 41)
-    curve = xr.Dataset({"maf": ("level", 1e-3 * levels ** -2.0)}, coords={"level": levels})
+    curve = xr.Dataset({"maf": ("level", 1e-3 * levels**-2.0)}, coords={"level": levels})
     for collapse, expected_inf in ((4.0e-4, False), (5.0e-3, True)):
         demands = StoreDemands({"d": curve}, {"d": "m"}, None, apart={"d": curve["maf"] + collapse})
         frame = demands.levels_at([0.1], 50.0)

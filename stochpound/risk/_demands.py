@@ -20,7 +20,7 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
-from collections.abc import Sequence
+from collections.abc import Hashable, Sequence
 
 from stochpound.hazard import HazardCurve, rate_from_probability
 from stochpound.risk import _inputs
@@ -54,8 +54,8 @@ class StoreDemands:
         without moat walls at its base.
     years : float
         The exposure time of the probabilities (yr).
-    apart : dict of str to xarray.DataArray
-        Per demand, its exceedance rate over ``level`` with the runs beyond
+    apart : {str: xarray.DataArray}
+        Per demand (by label), its exceedance rate over ``level`` with the runs beyond
         the model counted apart as collapses (:func:`~stochpound.risk.rate_collapses_apart`:
         a collapse exceeds every level; 1/yr); empty where no run is beyond the model.
     beyond_model : xarray.DataArray or None
@@ -175,7 +175,7 @@ def store_demands(store: xr.Dataset, hz: HazardCurve | None = None, confidence: 
     return StoreDemands(curves, {label: units for label, (_, units) in demands.items()}, moat, apart=apart, beyond_model=counts[0], runs=counts[1])
 
 
-def _configurations(data: xr.DataArray) -> list[dict[str, object]]:
+def _configurations(data: xr.DataArray) -> list[dict[str, Hashable]]:
     """Every combination of ``data``'s labels other than ``level``."""
     dims = [d for d in data.dims if d != "level"]
     index = pd.MultiIndex.from_product([data[d].values for d in dims], names=dims) if dims else [()]

@@ -17,6 +17,7 @@ from typing import Any
 
 import numpy as np
 import pandas as pd
+import xarray as xr
 
 from stochpound import motions as synthetic_motions
 from stochpound.experiment import CASE, is_fixed_base
@@ -336,8 +337,13 @@ def _record_parameters(motion: MotionTable) -> tuple[str, str]:
 def motions_table(definitions: Iterable[StoreDefinition]) -> Table:
     """Every ground motion the stores ran: records with their treatment, ensembles with their generator and seed."""
     rows = []
+    pool = 0
     for definition in definitions:
+        ran = _motions_that_ran(definition.store)
         for motion in definition.definition.motions:
+            pool += 1
+            if motion.label not in ran:
+                continue  # a pool motion a selection did not choose: it never ran
             table, typed = motion.motion, MotionTable.of_source(motion)
             if motion.kind == "synthetic":
                 text, attrs = _synthetic_parameters(motion)
@@ -354,10 +360,17 @@ def motions_table(definitions: Iterable[StoreDefinition]) -> Table:
     frame.index = pd.RangeIndex(1, len(frame) + 1, name="#")
     return Table(
         key="table-motions",
-        caption="The ground motions as run: each record with its treatment, each synthetic ensemble with its generator, intensity, envelope, seed and size.",
+        caption="The ground motions as run: each record with its treatment, each synthetic ensemble with its generator, intensity, envelope, seed and size"
+        + (f" ({len(frame)} of the {pool} motions the experiments define: a selection's pool motions it never chose are left out)." if len(frame) < pool else "."),
         frame=frame,
         note="Realization i of an ensemble depends only on (seed, i). The PSD convention: two-sided in ω, σ² = ∫ S dω.",
     )
+
+
+def _motions_that_ran(store: xr.Dataset) -> set[str]:
+    """The labels of the motions some case of ``store`` ran (the ``record`` labels with a finished case)."""
+    done = store["case_status"] == 1
+    return {str(label) for label, flag in zip(store["record"].values, done.any([d for d in done.dims if d != "record"]).values) if flag}
 
 
 def grid_paragraph(definition: StoreDefinition) -> Paragraph:
