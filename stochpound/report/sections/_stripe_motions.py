@@ -67,10 +67,20 @@ def stripe_holdings(store: xr.Dataset) -> pd.DataFrame:
     for position, j in enumerate(order):
         level, held = levels[j], ran[j]
         names, counts = np.unique(earthquakes[held], return_counts=True)
-        largest = f"{counts.max() / held.sum():.0%} ({names[np.argmax(counts)]})" if held.any() else "–"
+        largest = _largest_share(names, counts, int(held.sum())) if held.any() else "–"
         known = np.isfinite(pulse[held])
         pulses = f"{int(np.nansum(pulse[held]))}" + (f" of {int(known.sum())} classified" if 0 < known.sum() < held.sum() else "")
         rows.append({"intensity": level, "motions": int(held.sum()), "earthquakes": int(names.size), "largest share of one earthquake": largest,
                      "pulse records": pulses if known.any() else "unknown",
                      "shared with the stripe below": int((held & ran[order[position - 1]]).sum()) if position else "–"})
     return pd.DataFrame(rows).set_index("intensity")
+
+
+def _largest_share(names: np.ndarray, counts: np.ndarray, motions: int) -> str:
+    """``3 of 11 (Northridge-01 1994)``: the most motions of one earthquake in a stripe and which (``each its own`` where no
+    earthquake has two; the first and how many more where several tie)."""
+    most = int(counts.max())
+    if most == 1:
+        return f"1 of {motions} (each motion its own earthquake)"
+    tied = [str(name) for name, count in zip(names, counts) if count == most]
+    return f"{most} of {motions} ({tied[0]}" + (f" and {len(tied) - 1} more" if len(tied) > 1 else "") + ")"
