@@ -479,3 +479,34 @@ def test_the_sensitivity_table_recomputes_g_star_under_each_choice(store):
     text = sensitivity_text(frame)
     assert "Not evaluated from this store (each needs other runs): the selection seed, the conditioning measure" in text
     assert "bound the sampling of the motions only" in text
+
+
+def test_a_rule_row_whose_fit_is_a_step_at_the_lowest_stripe_says_its_rate_is_a_bound(store):
+    """Issue 45: 'Steps at the lowest stripe are printed as rates; they are bounds (nothing is known below)'. Each rule row's
+    fit is named from the rule's own fit: a step (always, or separated with θ at the lowest stripe) says its λ_P is a bound."""
+    from stochpound.risk import store_risk
+    from stochpound.risk._chain import LOWEST_STRIPE_STEP, RULE_NAMES
+    from stochpound.risk._fragility import ALWAYS, SEPARATED
+
+    risk = store_risk(store, bootstrap=0)
+    rows = risk.rules_frame()
+    lowest = float(store["intensity"].min())
+    flagged = 0
+    for rules in (risk.rules, risk.design_rules):
+        if rules is None or "theta" not in rules:
+            continue
+        step = ((rules["status"] == ALWAYS) | ((rules["status"] == SEPARATED) & (rules["theta"] <= lowest * (1 + 1e-9))))
+        flagged += int(step.where(rules["gap"].notnull().all("contact")).sum()) if "contact" in rules["gap"].dims else int(step.sum())
+    assert int((rows["fit"] == LOWEST_STRIPE_STEP).sum()) == flagged
+    # this store's rules are all lognormals: make one suite-mean rule's fit a step at the lowest stripe, and another just above it
+    import dataclasses
+
+    status, theta = risk.rules["status"].copy(), risk.rules["theta"].copy()
+    first, second = {"rule": risk.rules["rule"].values[0]}, {"rule": risk.rules["rule"].values[1]}
+    status.loc[first], theta.loc[first] = SEPARATED, lowest
+    status.loc[second], theta.loc[second] = SEPARATED, lowest * 1.01
+    stepped = dataclasses.replace(risk, rules=risk.rules.assign(status=status, theta=theta)).rules_frame().reset_index()
+    suite_mean = ~stepped["design_level"].str.contains("design analysis")
+    fits = {name: set(stepped.loc[suite_mean & (stepped["rule"] == RULE_NAMES.get(rule, rule)), "fit"])
+            for name, rule in (("first", first["rule"]), ("second", second["rule"]))}
+    assert fits == {"first": {LOWEST_STRIPE_STEP}, "second": {"step: separated"}}  # the step above the lowest stripe keeps its name

@@ -148,10 +148,11 @@ def _rate_between(theta: float, beta: float, hz: HazardCurve, upper: float) -> f
     return float(np.sum(lognormal_cdf(middle, theta, beta) * (rate[:-1] - rate[1:])))
 
 
-def at_lowest_stripe(fragility: xr.Dataset) -> xr.DataArray:
+def at_lowest_stripe(fragility: xr.Dataset, lowest: float | None = None) -> xr.DataArray:
     """Where a stripes fit is a step at or below its lowest stripe (``always``, or ``separated`` with θ at the lowest level):
-    its rate then rests on what lies below the runs, where nothing is known, and is a bound, not a rate."""
-    lowest = float(np.min(fragility["intensity"].values))
+    its rate then rests on what lies below the runs, where nothing is known, and is a bound, not a rate. ``lowest``: the
+    lowest stripe's level (IM units), default the fit's lowest ``intensity``."""
+    lowest = float(np.min(fragility["intensity"].values)) if lowest is None else lowest
     return (fragility["status"] == ALWAYS) | ((fragility["status"] == SEPARATED) & (fragility["theta"] <= lowest * (1.0 + 1e-9)))
 
 

@@ -6,6 +6,7 @@ import math
 
 import pandas as pd
 
+from stochpound.hazard import rate_from_probability
 from stochpound.report.render import Paragraph, Section, Table
 from stochpound.report.sections._description import number
 from stochpound.risk import DAMAGE_DEMANDS, MODEL_DRIFT_LIMIT, POUNDING_AT_G_STAR as POUNDING, UNIDENTIFIED_BETA, StoreDamage
@@ -140,7 +141,7 @@ def _limit_states_table(name: str, damage: StoreDamage) -> Table:
             row = {"configuration": _label(labels), "limit state": str(state), "λ (1/yr)": _rate_cell(float(maf.sel(at)), bound),
                    "once in (yr)": _period_cell(float(periods.sel(at)), bound), "fit": str(fits.sel(at).item()),
                    "objective": f"{_percent(target)} in 50 yr" if target == target else "none",
-                   "λ/λ_target": _ratio_cell(float(ratio.sel(at)), bound / float(maf.sel(at)) * float(ratio.sel(at))) if target == target else ""}
+                   "λ/λ_target": _ratio_cell(float(ratio.sel(at)), bound / _target_rate(target) if bound == bound else math.nan) if target == target else ""}
             if apart:
                 rate = float(damage.risk["maf_collapses_apart"].sel(at))
                 row["λ collapses apart (1/yr)"] = f"{rate:.3g}"
@@ -159,6 +160,11 @@ def _limit_states_table(name: str, damage: StoreDamage) -> Table:
               f"has its median beyond the top stripe or β ≥ {UNIDENTIFIED_BETA:g}: the runs do not pin it, and its λ rests on the "
               "lognormal's extrapolation."),
     )
+
+
+def _target_rate(probability: float) -> float:
+    """λ_target (1/yr) of a probability in 50 yr, the objective's rate."""
+    return float(rate_from_probability(probability, 50.0))
 
 
 def _rate_cell(rate: float, bound: float) -> str:
