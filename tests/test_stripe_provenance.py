@@ -17,7 +17,7 @@ import xarray as xr
 from stochpound.motions import selection_pool
 from stochpound.motions.records import load_suite_member
 from stochpound.report.sections import definition_source
-from stochpound.report.sections._stripe_motions import ran_motions, stripe_holdings
+from stochpound.store import ran_motions, stripe_holdings
 
 #: Four motions over two stripes: the far-field set's Northridge and the near-field set's Northridge-01 (one earthquake, M 6.7),
 #: a Landers record and a simulated motion (no event: its own earthquake). Pulses: 1, 0, unknown, unknown.

@@ -137,6 +137,14 @@ class StoreDamage:
         maf = self.risk["maf_collapses_apart"] if apart and self.collapses_apart() else self.risk["maf"]
         return maf / xr.apply_ufunc(rate_from_probability, target.fillna(0.5), OBJECTIVE_YEARS).where(target.notnull())
 
+    def bound_ratio(self) -> xr.DataArray | None:
+        """``bound``/λ_target over ``risk``'s dimensions: the lower bound of λ/λ_target where a fit is a step at the lowest stripe
+        (NaN elsewhere or without an objective); None without ``bound``."""
+        if self.bound is None:
+            return None
+        target = self.risk["target"]
+        return self.bound / xr.apply_ufunc(rate_from_probability, target.fillna(0.5), OBJECTIVE_YEARS).where(target.notnull())
+
     def has_objectives(self) -> bool:
         """Whether any limit state has a performance objective (without one, nothing is said to govern)."""
         return self.risk is not None and bool(self.risk["target"].notnull().any())

@@ -94,6 +94,14 @@ class StoreDemands:
         """A demand's exceedance rate made non-increasing along its levels (isotonic regression in ln λ, pool-adjacent-violators; 1/yr)."""
         return non_increasing_along(self.curves[label]["maf"], "level")
 
+    def beyond_model_per_stripe(self) -> list[tuple[float, int, int]]:
+        """Per stripe, over every configuration: (its level in IM units, the runs counted apart as collapses, the runs); [] without any."""
+        if self.beyond_model is None or self.runs is None:
+            return []
+        beyond = self.beyond_model.sum([d for d in self.beyond_model.dims if d != "intensity"])
+        runs = self.runs.sum([d for d in self.runs.dims if d != "intensity"])
+        return [(float(level), int(b), int(n)) for level, b, n in zip(beyond["intensity"].values, beyond.values, runs.values)]
+
     def non_increasing_apart(self, label: str) -> xr.DataArray:
         """A demand's exceedance rate with the collapses counted apart (``apart``), made non-increasing along its levels (1/yr)."""
         return non_increasing_along(self.apart[label], "level")

@@ -6,7 +6,6 @@ import math
 
 import pandas as pd
 
-from stochpound.hazard import rate_from_probability
 from stochpound.report.render import Paragraph, Section, Table
 from stochpound.report.sections._description import number
 from stochpound.risk import DAMAGE_DEMANDS, MODEL_DRIFT_LIMIT, POUNDING_AT_G_STAR as POUNDING, UNIDENTIFIED_BETA, StoreDamage
@@ -93,7 +92,8 @@ def _beyond_model_text(damage: StoreDamage) -> str:
     both = (" The limit states' table gives each λ both ways: as run (these runs as computed), and with these runs counted apart as "
             "collapses, as FEMA P-58 does: P(C | IM) a lognormal fitted over the stripes to them, each limit state fitted on the "
             "credible runs only, and λ = ∫ [P(C | x) + (1 − P(C | x)) P(LS | x, no C)] |dλ(x)|, a collapse counted as reaching every "
-            "limit state. What governs (below) is judged on λ as run." if damage.collapses_apart() else "")
+            "limit state (of either building: past 5 % in one, the pair's response is not credible). What governs (below) is judged "
+            "on λ as run." if damage.collapses_apart() else "")
     return (head + "runs reaching it, per stripe over every configuration: " + "; ".join(flagged) + ". Their drifts, ductilities and "
             "residual drifts are not credible (a real frame would have lost strength or collapsed), and the fractiles above include them."
             + both)
@@ -131,7 +131,7 @@ def _governing_text(damage: StoreDamage) -> str:
 
 def _limit_states_table(name: str, damage: StoreDamage) -> Table:
     maf, periods, fits = damage.risk["maf"], damage.return_period(), damage.fits()
-    ratio, apart = damage.ratio(), damage.collapses_apart()
+    ratio, apart, bound_ratio = damage.ratio(), damage.collapses_apart(), damage.bound_ratio()
     rows = []
     for labels in _configurations(maf):
         for state in maf["limit_state"].values:
@@ -141,7 +141,7 @@ def _limit_states_table(name: str, damage: StoreDamage) -> Table:
             row = {"configuration": _label(labels), "limit state": str(state), "λ (1/yr)": _rate_cell(float(maf.sel(at)), bound),
                    "once in (yr)": _period_cell(float(periods.sel(at)), bound), "fit": str(fits.sel(at).item()),
                    "objective": f"{_percent(target)} in 50 yr" if target == target else "none",
-                   "λ/λ_target": _ratio_cell(float(ratio.sel(at)), bound / _target_rate(target) if bound == bound else math.nan) if target == target else ""}
+                   "λ/λ_target": _ratio_cell(float(ratio.sel(at)), float(bound_ratio.sel(at)) if bound_ratio is not None else math.nan) if target == target else ""}
             if apart:
                 rate = float(damage.risk["maf_collapses_apart"].sel(at))
                 row["λ collapses apart (1/yr)"] = f"{rate:.3g}"
@@ -160,11 +160,6 @@ def _limit_states_table(name: str, damage: StoreDamage) -> Table:
               f"has its median beyond the top stripe or β ≥ {UNIDENTIFIED_BETA:g}: the runs do not pin it, and its λ rests on the "
               "lognormal's extrapolation."),
     )
-
-
-def _target_rate(probability: float) -> float:
-    """λ_target (1/yr) of a probability in 50 yr, the objective's rate."""
-    return float(rate_from_probability(probability, 50.0))
 
 
 def _rate_cell(rate: float, bound: float) -> str:

@@ -17,7 +17,6 @@ from typing import Any
 
 import numpy as np
 import pandas as pd
-import xarray as xr
 
 from stochpound import motions as synthetic_motions
 from stochpound.experiment import CASE, is_fixed_base
@@ -29,7 +28,7 @@ from stochpound.report.sections._stripe_motions import stripe_motions_text
 from stochpound.motions.records import is_suite_member
 from stochpound.model.scene import Building, Contact, Scene
 from stochpound.model.wall import Wall
-from stochpound.store import MotionSource, MotionTable, TomlTable
+from stochpound.store import MotionSource, MotionTable, TomlTable, motions_that_ran
 
 
 def number(value: float, digits: int = 6) -> str:
@@ -339,7 +338,7 @@ def motions_table(definitions: Iterable[StoreDefinition]) -> Table:
     rows = []
     pool = 0
     for definition in definitions:
-        ran = _motions_that_ran(definition.store)
+        ran = motions_that_ran(definition.store)
         for motion in definition.definition.motions:
             pool += 1
             if motion.label not in ran:
@@ -365,12 +364,6 @@ def motions_table(definitions: Iterable[StoreDefinition]) -> Table:
         frame=frame,
         note="Realization i of an ensemble depends only on (seed, i). The PSD convention: two-sided in ω, σ² = ∫ S dω.",
     )
-
-
-def _motions_that_ran(store: xr.Dataset) -> set[str]:
-    """The labels of the motions some case of ``store`` ran (the ``record`` labels with a finished case)."""
-    done = store["case_status"] == 1
-    return {str(label) for label, flag in zip(store["record"].values, done.any([d for d in done.dims if d != "record"]).values) if flag}
 
 
 def grid_paragraph(definition: StoreDefinition) -> Paragraph:

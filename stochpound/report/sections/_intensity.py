@@ -33,7 +33,7 @@ from matplotlib.figure import Figure
 from stochpound._plurals import counted
 from stochpound.stats.kernels import clopper_pearson
 from stochpound.report.render import FigureItem, Paragraph, Section, Table
-from stochpound.report.sections._stripe_motions import stripe_holdings, stripe_motions_text
+from stochpound.report.sections._stripe_motions import stripe_motions_text
 from stochpound.experiment import is_gap_axis
 from stochpound.motions import DEFAULT_G, TARGET_TOLERANCE, TRUNCATION_EPSILON
 from stochpound.risk import (
@@ -46,7 +46,7 @@ from stochpound.risk import (
     site_consistency,
     stripes_beyond_truncation,
 )
-from stochpound.store import Intensity, has_contact_free, scenario_kind, with_contacts
+from stochpound.store import Intensity, has_contact_free, scenario_kind, stripe_holdings, with_contacts
 
 CONFIDENCE = 0.95
 SHOWN_GAPS = 3

@@ -211,9 +211,10 @@ def _beyond_model(damage: StoreDamage | None, collapse: CollapseRisk | None = No
     beyond, runs = damage.beyond_model_total() if damage is not None else (0, 0)
     if not beyond:
         return {}
+    apart = "; the limit states are given both ways too (the Damage section)" if damage.collapses_apart() else ""
     counted = ("g* above and the limit states keep them as computed; g* with them counted apart as collapses (FEMA P-58, by total "
-               "probability) is given beside it, 'g* both ways'" if collapse is not None else
-               "they enter g* and the limit states as computed (the Damage section)")
+               f"probability) is given beside it, 'g* both ways'{apart}" if collapse is not None else
+               "they enter g* and the limit states as computed (the Damage section)" + apart)
     return {"beyond the model": f"{beyond} of {runs} runs exceed a "
                                 f"{100 * MODEL_DRIFT_LIMIT:g} % storey drift, where the storeys' lack of strength loss and collapse makes their "
                                 f"response not credible; {counted}"}
@@ -519,9 +520,7 @@ def _rules_blocks(name: str, risk: StoreRisk) -> list[Block]:
 
 def _demands_both_ways(name: str, risk: StoreRisk, demands: StoreDemands) -> list[Block]:
     """The demands with the runs beyond the model counted apart: which runs (per stripe), how, and each demand's level at the targets both ways."""
-    beyond = demands.beyond_model.sum([d for d in demands.beyond_model.dims if d != "intensity"])
-    runs = demands.runs.sum([d for d in demands.runs.dims if d != "intensity"])
-    per_stripe = "; ".join(f"{int(b)} of {int(n)} at stripe {float(level):.4g}" for level, b, n in zip(beyond["intensity"].values, beyond.values, runs.values))
+    per_stripe = "; ".join(f"{b} of {n} at stripe {level:.4g}" for level, b, n in demands.beyond_model_per_stripe())
     text = (f"Demands with collapses counted apart (FEMA P-58): runs whose peak storey drift ratio passes {100 * MODEL_DRIFT_LIMIT:g} % "
             f"are beyond what the model represents; per stripe over every configuration, {per_stripe}. Counted apart, P(C | IM) is a "
             "lognormal fitted over the stripes to them, each level's exceedance is fitted on the credible runs only, and the rate is "
