@@ -137,13 +137,21 @@ class StoreDamage:
         maf = self.risk["maf_collapses_apart"] if apart and self.collapses_apart() else self.risk["maf"]
         return maf / xr.apply_ufunc(rate_from_probability, target.fillna(0.5), OBJECTIVE_YEARS).where(target.notnull())
 
-    def bound_ratio(self) -> xr.DataArray | None:
-        """``bound``/λ_target over ``risk``'s dimensions: the lower bound of λ/λ_target where a fit is a step at the lowest stripe
-        (NaN elsewhere or without an objective); None without ``bound``."""
-        if self.bound is None:
+    def bounds(self, apart: bool = False) -> xr.DataArray | None:
+        """``bound`` (1/yr), or with ``apart`` the same bound with the collapses counted as reaching the limit state
+        (``risk``'s ``bound_collapses_apart`` where ``bound`` is one); None without ``bound`` (or without collapses apart)."""
+        if self.bound is None or (apart and not self.collapses_apart()):
+            return None
+        return self.risk["bound_collapses_apart"].where(self.bound.notnull()) if apart else self.bound
+
+    def bound_ratio(self, apart: bool = False) -> xr.DataArray | None:
+        """:meth:`bounds`/λ_target over ``risk``'s dimensions: the lower bound of λ/λ_target where a fit is a step at the
+        lowest stripe (NaN elsewhere or without an objective); None without a bound."""
+        bound = self.bounds(apart)
+        if bound is None:
             return None
         target = self.risk["target"]
-        return self.bound / xr.apply_ufunc(rate_from_probability, target.fillna(0.5), OBJECTIVE_YEARS).where(target.notnull())
+        return bound / xr.apply_ufunc(rate_from_probability, target.fillna(0.5), OBJECTIVE_YEARS).where(target.notnull())
 
     def has_objectives(self) -> bool:
         """Whether any limit state has a performance objective (without one, nothing is said to govern)."""

@@ -35,6 +35,7 @@ from stochpound.risk._fragility_ensemble import limit_state_events, stripe_fragi
 from stochpound.risk._maf import mean_annual_frequency
 from stochpound.risk._chain import CONFIDENCE, YEARS
 from stochpound.risk._collapse import MODEL_DRIFT_LIMIT, beyond_model, rate_collapses_apart
+from stochpound.risk._stripe_coverage import stripes_only_maf
 
 
 OBJECTIVE_YEARS = 50.0
@@ -215,7 +216,9 @@ def limit_state_risk(store: xr.Dataset, limit_states: Sequence[LimitState], hz: 
         ``MODEL_DRIFT_LIMIT`` (beyond the model): ``maf_collapses_apart``,
         λ with those runs counted apart as collapses and combined by total
         probability (:func:`~stochpound.risk.rate_collapses_apart`; a
-        collapse reaches every limit state), and ``beyond_model``, those
+        collapse reaches every limit state), ``bound_collapses_apart``, the
+        stripes' fractions alone so counted (:func:`~stochpound.risk.stripes_only_maf`:
+        the bound of a step at the lowest stripe), and ``beyond_model``, those
         runs per stripe and configuration.
 
     Raises
@@ -237,18 +240,29 @@ def limit_state_risk(store: xr.Dataset, limit_states: Sequence[LimitState], hz: 
                                       building=("limit_state", [state.building or ""]),
                                       target=("limit_state", [math.nan if state.target is None else float(state.target)])))
         if collapsed is not None:
-            apart.append(rate_collapses_apart(demand, collapsed, [state.capacity], "limit_state", hz)[0].assign_coords(limit_state=[state.label]))
+            rate = rate_collapses_apart(demand, collapsed, [state.capacity], "limit_state", hz)[0].assign_coords(limit_state=[state.label])
+            apart.append(xr.Dataset({"maf_collapses_apart": rate, "bound_collapses_apart": _apart_bound(events, collapsed, hz)}))
     result = xr.concat(fits, "limit_state", coords="different", compat="equals", join="outer")
     result["maf"] = mean_annual_frequency(result, hz)
     if apart:
-        result["maf_collapses_apart"] = xr.concat(apart, "limit_state", join="outer").assign_attrs(
+        both = xr.concat(apart, "limit_state", join="outer")
+        result["maf_collapses_apart"] = both["maf_collapses_apart"].assign_attrs(
             units="1/yr", long_name=f"mean annual frequency, the runs beyond a {100 * MODEL_DRIFT_LIMIT:g} % storey drift counted apart as collapses")
+        result["bound_collapses_apart"] = both["bound_collapses_apart"].assign_attrs(
+            units="1/yr", long_name="the stripes' fractions alone, collapses counted as reaching the limit state (nothing below the lowest stripe)")
         result["beyond_model"] = collapsed.sum("record").assign_attrs(units="1", long_name="runs beyond the model (collapses) per stripe")
     twins = _inputs.contact_free_twins(result["maf"])
     if twins is not None:
         result["maf_contact_free"] = twins.assign_attrs(units="1/yr", long_name="mean annual frequency of the contact-free twins")
         result["gap_cost"] = (result["maf"] - twins).assign_attrs(units="1/yr", long_name="what the gap costs: maf minus that of the contact-free twins")
     return result.assign_attrs(intensity=measure)
+
+
+def _apart_bound(events: xr.DataArray, collapsed: xr.DataArray, hz: HazardCurve) -> xr.DataArray:
+    """:func:`~stochpound.risk.stripes_only_maf` of a limit state's per-run events with every collapse counted as reaching it (1/yr)."""
+    events, collapsed = xr.align(events, collapsed.drop_vars([c for c in collapsed.coords if c not in collapsed.dims]), join="inner")
+    either = xr.where(collapsed == 1.0, 1.0, events).where(events.notnull())
+    return stripes_only_maf(xr.Dataset({"exceeded": either.sum("record"), "runs": either.notnull().sum("record")}), hz)
 
 
 def _collapsed_cases(store: xr.Dataset) -> xr.DataArray | None:

@@ -143,9 +143,10 @@ def _limit_states_table(name: str, damage: StoreDamage) -> Table:
                    "objective": f"{_percent(target)} in 50 yr" if target == target else "none",
                    "λ/λ_target": _ratio_cell(float(ratio.sel(at)), float(bound_ratio.sel(at)) if bound_ratio is not None else math.nan) if target == target else ""}
             if apart:
-                rate = float(damage.risk["maf_collapses_apart"].sel(at))
-                row["λ collapses apart (1/yr)"] = f"{rate:.3g}"
-                row["λ/λ_target collapses apart"] = f"{float(damage.ratio(apart=True).sel(at)):.3g}" if target == target else ""
+                bound_apart = float(damage.bounds(apart=True).sel(at)) if damage.bound is not None else math.nan
+                row["λ collapses apart (1/yr)"] = _rate_cell(float(damage.risk["maf_collapses_apart"].sel(at)), bound_apart)
+                row["λ/λ_target collapses apart"] = (_ratio_cell(float(damage.ratio(apart=True).sel(at)), float(damage.bound_ratio(apart=True).sel(at))
+                                                                 if damage.bound is not None else math.nan) if target == target else "")
             rows.append(row)
     both = (" and, with the runs beyond the model counted apart as collapses (FEMA P-58, by total probability: above), λ and its "
             "ratio that way") if apart else ""
