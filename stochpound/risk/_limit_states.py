@@ -275,16 +275,18 @@ def _collapsed_cases(store: xr.Dataset) -> xr.DataArray | None:
 
 
 def gap_cost_frame(risk: xr.Dataset, years: float = YEARS) -> pd.DataFrame:
-    """The "what the gap costs" table of :func:`limit_state_risk`: per limit state and finite gap, λ, λ of the twins, their difference, and P in ``years``.
+    """The "what the gap costs" table of :func:`limit_state_risk`: per limit state and finite gap, λ, λ of the twins, their difference, and P in ``years``
+    (and λ with the runs beyond the model counted apart as collapses, where some run is).
 
     Returns
     -------
     pandas.DataFrame
         Indexed by the limit state and the other grid labels (the contact-free rows left out).
     """
-    keep = [name for name in ("maf", "maf_contact_free", "gap_cost") if name in risk]
+    keep = [name for name in ("maf", "maf_contact_free", "gap_cost", "maf_collapses_apart") if name in risk]
     frame = _inputs.at_finite_gaps(risk[keep]).reset_coords(drop=True).to_dataframe()
     frame[f"P in {years:g} yr"] = probability_from_rate(frame["maf"].to_numpy(), years)
     if "maf_contact_free" in frame:
         frame[f"P in {years:g} yr, contact-free"] = probability_from_rate(frame["maf_contact_free"].to_numpy(), years)
-    return frame.rename(columns={"maf": "λ (1/yr)", "maf_contact_free": "λ contact-free (1/yr)", "gap_cost": "Δλ (1/yr)"})
+    return frame.rename(columns={"maf": "λ (1/yr)", "maf_contact_free": "λ contact-free (1/yr)", "gap_cost": "Δλ (1/yr)",
+                                 "maf_collapses_apart": "λ collapses apart (1/yr)"})
