@@ -32,4 +32,3 @@ def stripe_motions_text(store: xr.Dataset) -> str:
             f"(scale factors {np.nanmin(scale):.3g}–{np.nanmax(scale):.3g})")
     ranges = scenario_ranges(store)
     return text if ranges is None else f"{text}; target scenario {ranges}"
-
