@@ -91,3 +91,14 @@ def test_risk_warns_of_stripes_that_miss_their_target_or_lie_beyond_the_truncati
             "at a period) at the stripes 0.1 g") in outputs[1]
     assert ("warning: the scenario puts the stripes 0.1 g beyond ε 3, where hazard models truncate the ground motion: no earthquake of "
             "that scenario causes them there") in outputs[1]
+
+
+def test_the_motion_table_lists_the_motions_that_ran_not_the_pool(cs_store) -> None:
+    """Issue 45: 'Table 16 lists 200 pool motions where 40 ran'. The table holds the motions some stripe chose (a pool of 8,
+    3 per stripe) and says how many of the pool it leaves out."""
+    from stochpound.report.sections._description import StoreDefinition, motions_table
+
+    chosen = {str(r) for r, flag in zip(cs_store["record"].values, np.isfinite(cs_store["selection_scale_factor"]).any("intensity").values) if flag}
+    table = motions_table([StoreDefinition("cs", cs_store)])
+    assert set(table.frame["motion"]) == chosen and 3 <= len(chosen) < 8
+    assert f"({len(chosen)} of the 8 motions the experiments define: a selection's pool motions it never chose are left out)." in table.caption

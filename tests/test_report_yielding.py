@@ -232,15 +232,90 @@ def test_the_damage_section_says_which_runs_and_stripes_and_lists_every_limit_st
     table = next(block for block in section.blocks if getattr(block, "key", "") == "table-limit-states-yfix").frame
     maf = damage.risk["maf"]
     assert len(table) == maf.sizes["limit_state"] == 2 * len(DEFAULT_LIMIT_STATES)  # one per building
+    from stochpound.risk import at_lowest_stripe, stripes_only_maf, unidentified
+
+    lowest, why = at_lowest_stripe(damage.risk), unidentified(damage.risk)
     for state in maf["limit_state"].values:
         rate = float(maf.sel(limit_state=state))
-        assert table.loc[("–", str(state)), "λ (1/yr)"] == f"{rate:.3g}"
-        assert table.loc[("–", str(state)), "once in (yr)"] == f"{1.0 / rate:.3g}"
         target = float(maf["target"].sel(limit_state=state))  # its objective and λ/λ_target, and the fit's kind (issue 45: λ without its fit)
         assert table.loc[("–", str(state)), "objective"] == f"{100 * target:g} % in 50 yr"
-        assert table.loc[("–", str(state)), "λ/λ_target"] == f"{rate / (-math.log(1 - target) / 50):.3g}"
-        assert table.loc[("–", str(state)), "fit"] in ("lognormal", "step: always", "step: never", "step: separated",
-                                                       "flat: decreasing (F ≡ fraction of runs that pounded)")
+        row = table.loc[("–", str(state))]
+        if bool(lowest.sel(limit_state=state)):  # issue 45: a step at the lowest stripe is a bound, not a rate
+            bound = float(stripes_only_maf(damage.risk.sel(limit_state=state), damage_hazard(store)))
+            assert 0.0 < bound <= rate * (1 + 1e-12)
+            assert (row["λ (1/yr)"], row["once in (yr)"]) == (f"≥ {bound:.3g}", f"≤ {1.0 / bound:.3g}")
+            assert row["λ/λ_target"] == f"≥ {bound / (-math.log(1 - target) / 50):.3g}"
+            assert row["fit"] == "step at the lowest stripe: a bound"
+            continue
+        assert (row["λ (1/yr)"], row["once in (yr)"]) == (f"{rate:.3g}", f"{1.0 / rate:.3g}")
+        assert row["λ/λ_target"] == f"{rate / (-math.log(1 - target) / 50):.3g}"
+        reason = str(why.sel(limit_state=state).item())  # issue 45: a lognormal its runs do not pin is not presented as identified
+        assert row["fit"] in (f"lognormal, not identified ({reason})" if reason else "lognormal", "step: never", "step: separated",
+                              "flat: decreasing (F ≡ fraction of runs that pounded)")
+    assert any(lowest.values.ravel()) or any(why.values.ravel())  # the store has a bound or an unidentified fit to print
+
+
+def damage_hazard(store):
+    from stochpound.risk import site_hazard
+
+    return site_hazard(store)
+
+
+def test_the_limit_states_and_demands_are_given_both_ways(store):
+    """Issue 45 item 3: the limit states' λ and λ/λ_target and the demand curves with the runs beyond the model counted apart;
+    a collapse reaches every limit state and level, so λ apart ≥ λ_C, and drift ≥ 5 % apart (no credible run passes 5 %) is λ_C;
+    the report says which runs (per stripe) and shows both."""
+    from stochpound.report.sections._risk import risk_section
+    from stochpound.risk import collapse_risk, store_demands, store_risk
+
+    damage = store_damage(store)
+    risk = store_risk(store, bootstrap=0)
+    collapse = collapse_risk(store, risk.hazard, risk.fragility["gap"].values, risk.separation["target"].values)
+    lambda_c = float(collapse.collapse["maf"])
+    assert damage.collapses_apart() and lambda_c > 0
+    apart = damage.risk["maf_collapses_apart"]
+    assert bool((apart >= lambda_c * (1 - 2e-3)).all())
+    for building in ("B1", "B2"):
+        assert float(apart.sel(limit_state=f"peak storey drift ratio of {building} ≥ 0.05")) == pytest.approx(lambda_c, rel=2e-3)
+    np.testing.assert_allclose(damage.ratio(apart=True).values, apart.values / (-np.log(1 - damage.risk["target"].values) / 50), rtol=1e-12)
+    section = damage_section("yfix", damage)
+    table = next(block for block in section.blocks if getattr(block, "key", "") == "table-limit-states-yfix").frame
+    free = contact_free(store).isel(realization=0, drop=True)
+    collapsed = free["peak_drift_ratio"].max("building") > MODEL_DRIFT_LIMIT
+    levels = store["intensity"].values
+    rates = np.append(risk.hazard(levels), 0.0)
+    bounded = 0
+    for state, one in zip(apart["limit_state"].values, damage.limit_states):
+        cell = table.loc[("–", str(state)), "λ collapses apart (1/yr)"]
+        if damage.bound is None or np.isnan(float(damage.bound.sel(limit_state=state))):
+            assert cell == f"{float(apart.sel(limit_state=state)):.3g}"
+            continue
+        # a step at the lowest stripe: the bound of the stripes' fractions, a collapse counted as reaching it, by hand
+        variable = {"drift_ratio": "peak_drift_ratio", "residual_drift_ratio": "residual_drift_ratio"}[one.kind]
+        reached = (free[variable].sel(building=one.building) >= one.capacity) | collapsed
+        fractions = reached.mean("record").values
+        assert cell == f"≥ {float(np.sum(fractions * (rates[:-1] - rates[1:]))):.3g}"
+        bounded += 1
+    assert bounded > 0  # immediate occupancy is a step at the lowest stripe here
+    texts = " ".join(_text(block) for block in section.blocks)
+    assert "The limit states' table gives each λ both ways" in texts and "a collapse counted as reaching every limit state" in texts
+    demands = store_demands(store, risk.hazard)
+    assert demands.apart and set(demands.apart) == set(demands.curves)
+    drift = contact_free(store)["peak_drift_ratio"].max("building").isel(realization=0, drop=True)
+    hand = (drift > MODEL_DRIFT_LIMIT).sum("record")
+    np.testing.assert_array_equal(demands.beyond_model.values.ravel(), hand.values.ravel())
+    for label, rate in demands.apart.items():  # the highest level: reached by collapses (and perhaps a few credible runs) only
+        assert float(rate.isel(level=-1)) >= lambda_c * (1 - 2e-3)
+    levels = demands.levels_at(risk.separation["target"].values, risk.years)
+    assert set(levels["demand"]) == {f"{label} ({demands.units[label]})" for label in demands.curves}
+    assert lambda_c > -np.log(1 - 0.1) / 50 and bool(np.isinf(levels["collapses apart"]).all())  # collapse alone exceeds both targets
+    assert bool(np.isfinite(levels["as run"]).any())
+    blocks = risk_section("yfix", risk, demands, damage, None, collapse).blocks
+    shown = " ".join(_text(block) for block in blocks)
+    per_stripe = "; ".join(f"{int(b)} of {int(n)} at stripe {float(x):.4g}" for x, b, n in
+                           zip(store["intensity"].values, hand.values, drift.notnull().sum("record").values))
+    assert f"per stripe over every configuration, {per_stripe}." in shown
+    assert any(getattr(block, "key", "") == "risk-demands-apart-yfix" for block in blocks)
 
 
 def test_no_run_beyond_the_model_is_said_so(store):
@@ -422,3 +497,34 @@ def test_the_sensitivity_table_recomputes_g_star_under_each_choice(store):
     text = sensitivity_text(frame, not_evaluated=("seed", "measure", "wall"))
     assert "Not evaluated (each needs other runs): the selection seed (needs a store of the same experiment with another" in text
     assert "bound the record-to-record sampling of the motions only" in text
+
+
+def test_a_rule_row_whose_fit_is_a_step_at_the_lowest_stripe_says_its_rate_is_a_bound(store):
+    """Issue 45: 'Steps at the lowest stripe are printed as rates; they are bounds (nothing is known below)'. Each rule row's
+    fit is named from the rule's own fit: a step (always, or separated with θ at the lowest stripe) says its λ_P is a bound."""
+    from stochpound.risk import store_risk
+    from stochpound.risk._chain import LOWEST_STRIPE_STEP, RULE_NAMES
+    from stochpound.risk._fragility import ALWAYS, SEPARATED
+
+    risk = store_risk(store, bootstrap=0)
+    rows = risk.rules_frame()
+    lowest = float(store["intensity"].min())
+    flagged = 0
+    for rules in (risk.rules, risk.design_rules):
+        if rules is None or "theta" not in rules:
+            continue
+        step = ((rules["status"] == ALWAYS) | ((rules["status"] == SEPARATED) & (rules["theta"] <= lowest * (1 + 1e-9))))
+        flagged += int(step.where(rules["gap"].notnull().all("contact")).sum()) if "contact" in rules["gap"].dims else int(step.sum())
+    assert int((rows["fit"] == LOWEST_STRIPE_STEP).sum()) == flagged
+    # this store's rules are all lognormals: make one suite-mean rule's fit a step at the lowest stripe, and another just above it
+    import dataclasses
+
+    status, theta = risk.rules["status"].copy(), risk.rules["theta"].copy()
+    first, second = {"rule": risk.rules["rule"].values[0]}, {"rule": risk.rules["rule"].values[1]}
+    status.loc[first], theta.loc[first] = SEPARATED, lowest
+    status.loc[second], theta.loc[second] = SEPARATED, lowest * 1.01
+    stepped = dataclasses.replace(risk, rules=risk.rules.assign(status=status, theta=theta)).rules_frame().reset_index()
+    suite_mean = ~stepped["design_level"].str.contains("design analysis")
+    fits = {name: set(stepped.loc[suite_mean & (stepped["rule"] == RULE_NAMES.get(rule, rule)), "fit"])
+            for name, rule in (("first", first["rule"]), ("second", second["rule"]))}
+    assert fits == {"first": {LOWEST_STRIPE_STEP}, "second": {"step: separated"}}  # the step above the lowest stripe keeps its name

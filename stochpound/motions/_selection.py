@@ -22,7 +22,7 @@ of :func:`~stochpound.motions.conditional_spectrum` over a period range):
 Rules of the field: a set never holds the same recording twice (a motion
 is known by its PEER record sequence number and component where the
 metadata give them, else by its name); with ``max_per_earthquake`` it holds
-at most that many motions of an earthquake (the metadata's ``event``; a
+at most that many motions of an earthquake (the metadata's ``event``, one name across suites; a
 motion without one, such as a simulated motion, is its own earthquake); with
 ``exclude_pulses`` the records the metadata mark as pulses (``pulse``: the
 FEMA P695 near-field pulse subset, or a PEER search report's pulse period) are no candidates. Steps 3 and 4 only
@@ -50,6 +50,7 @@ import numpy as np
 import xarray as xr
 
 from stochpound._errors import SiteError
+from stochpound.stats import earthquake_identities
 from stochpound.motions._conditional import PERIOD_RANGE
 from stochpound.motions._measures import peak_ground_motion
 from stochpound.motions._spectrum import DEFAULT_G, response_spectrum
@@ -122,7 +123,7 @@ def selection_pool(
         Over ``motion`` (the records' names): ``psa`` (``motion``, ``period``; g),
         ``intensity`` (g), ``magnitude``, ``distance_km``, ``vs30`` (NaN where
         unknown), ``mechanism`` ("" where unknown), ``earthquake`` (the
-        metadata's ``event``, else the motion's name), ``recording`` (PEER
+        metadata's ``event`` normalised across suites, :func:`~stochpound.stats.earthquake_identities`, else the motion's name), ``recording`` (PEER
         record sequence number and component, else the name) and ``pulse``
         (the metadata's ``pulse``, False where unknown).
     """
@@ -135,6 +136,8 @@ def selection_pool(
         psa.append(spectrum[: grid.size])
         intensity.append(peak_ground_motion(a, record.dt)[0] / g if measure == "pga" else float(np.exp(np.mean(np.log(spectrum[grid.size :])))))
     meta = [record.metadata or {} for record in records]
+    # one earthquake, one name across suites ("Northridge 1994" and "Northridge-01 1994" of one magnitude); a motion without one is its own
+    earthquakes = earthquake_identities([str(m.get("event") or "") for m in meta], [float(m.get("magnitude", np.nan)) for m in meta])
     return xr.Dataset(
         {
             "psa": (("motion", "period"), np.array(psa), {"units": "g", "long_name": "pseudo-spectral acceleration of the unscaled motion"}),
@@ -143,7 +146,7 @@ def selection_pool(
             "distance_km": ("motion", np.array([float(m.get("distance", np.nan)) for m in meta]), {"units": "km"}),
             "vs30": ("motion", np.array([float(m.get("vs30", np.nan)) for m in meta]), {"units": "m/s"}),
             "mechanism": ("motion", np.array([FAULT_TYPES.get(str(m.get("fault_type", "")), "") for m in meta], dtype=object)),
-            "earthquake": ("motion", np.array([str(m.get("event") or r.name) for m, r in zip(meta, records)], dtype=object)),
+            "earthquake": ("motion", np.array([identity or r.name for identity, r in zip(earthquakes, records)], dtype=object)),
             "recording": ("motion", np.array([_recording(m, r.name) for m, r in zip(meta, records)], dtype=object)),
             "pulse": ("motion", np.array([bool(m.get("pulse", False)) for m in meta])),
         },

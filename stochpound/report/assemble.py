@@ -23,6 +23,7 @@ from stochpound.report.sections import (
     INTERVAL_NOTE,
     WALLS,
     damage_section,
+    definition_source,
     experiment_summary,
     intensity_section,
     law_axis,
@@ -90,7 +91,7 @@ def assemble_report(paths: Sequence[str | Path], progress: Callable[[str], None]
     report = Report(
         title="; ".join(study.TITLE for study in studies.values()) if studies else f"Pounding experiments: {', '.join([*others, *(d.attrs['experiment_name'] for d in rare.values())])}",
         subtitle=f"stochpound report of {', '.join(stores)}, built {date.today().isoformat()}",
-        sources=[f"{name}: {store.pound.provenance.experiment_file}, definition sha256 {store.pound.sha256}" for name, store in stores.items()],
+        sources=[f"{name}: {definition_source(store)}, definition sha256 {store.pound.sha256}" for name, store in stores.items()],
     )
     for key, study in studies.items():
         for title, section_key, build in study.sections({part: stores[name] for part, name in claimed[key].items()}):

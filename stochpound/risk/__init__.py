@@ -31,7 +31,8 @@ of a store's grid against its contact-free twins (:func:`gap_cost_frame`);
 buildings per stripe, the runs beyond the model and the governing limit
 state, each limit state against its own objective (:class:`StoreDamage`);
 :func:`collapse_risk` g* with the runs beyond the model counted apart as
-collapses, as FEMA P-58 does (:class:`CollapseRisk`).
+collapses, as FEMA P-58 does (:class:`CollapseRisk`); :func:`rate_collapses_apart` the same for
+any demand (the demand curves' and the limit states' λ both ways).
 
 This package is the canonical home of these names; the ones that
 :mod:`stochpound.analysis` exported before it existed stay importable from
@@ -74,13 +75,14 @@ from stochpound.risk._demands import StoreDemands, store_demands
 from stochpound.risk._limit_states import KINDS as LIMIT_STATE_KINDS, LimitState, gap_cost_frame, limit_state_problem, limit_state_risk, limit_states_from_table
 from stochpound.risk._efficiency import measure_efficiency, most_efficient
 from stochpound.risk._efficiency import candidate_name  # noqa: F401  (for stochpound.experiment.measure_choice: not public API)
-from stochpound.risk._collapse import CollapseRisk, collapse_risk, collapsed_runs
+from stochpound.risk._collapse import CollapseRisk, beyond_model, collapse_risk, collapsed_runs, rate_collapses_apart
 from stochpound.risk._sensitivity import ALTERNATIVES, MODELLING_DISPERSIONS, Sensitivity, check_alternative, separation_sensitivity, sensitivity_text
 from stochpound.risk._damage import DAMAGE_DEMANDS, DEFAULT_LIMIT_STATES, DEFAULT_SOURCE as DEFAULT_LIMIT_STATES_SOURCE, MODEL_DRIFT_LIMIT, StoreDamage, store_damage
 from stochpound.hazard import hazard_consistency, read_hazard_file, stripe_rate_weights
 from stochpound.risk._site_consistency import consistency_at_targets, site_consistency
 from stochpound.risk._stripe_demand import stripe_demand_rate
-from stochpound.risk._stripe_coverage import fragility_at_separation, maf_outside_stripes
+from stochpound.risk._stripe_coverage import (UNIDENTIFIED_BETA, at_lowest_stripe, fragility_at_separation, maf_outside_stripes, stripes_only_maf,
+                                              unidentified)
 
 __all__ = [
     "Fragility",
@@ -152,6 +154,12 @@ __all__ = [
     "CollapseRisk",
     "collapse_risk",
     "collapsed_runs",
+    "beyond_model",
+    "rate_collapses_apart",
+    "at_lowest_stripe",
+    "stripes_only_maf",
+    "unidentified",
+    "UNIDENTIFIED_BETA",
     "separation_sensitivity",
     "sensitivity_text",
     "Sensitivity",

@@ -44,7 +44,7 @@ from stochpound.risk._fragility_ensemble import BOOTSTRAP, fragility_band, fragi
 from stochpound.risk._fragility import DECREASING, EMPTY, FIT, STATUS
 from stochpound.risk._gap_grid import GRID_TOLERANCE, MAX_REFINEMENTS, grid_note, refinement_gaps
 from stochpound.risk._maf import TARGETS, degenerate_text, non_increasing, risk_curve, risk_targeted_separation
-from stochpound.risk._stripe_coverage import maf_outside_stripes, top_capped_maf
+from stochpound.risk._stripe_coverage import at_lowest_stripe, maf_outside_stripes, top_capped_maf
 
 YEARS = 50.0
 """The default exposure time of the targets (yr)."""
@@ -293,13 +293,16 @@ class StoreRisk:
         years = _stated_years(rules, self.years)
         gaps = rules["gap"].to_dataframe()[["gap"]]["gap"].unstack("contact")
         gaps.columns = [f"gap, contact {c} (m)" for c in gaps.columns]
-        values = rules[[name for name in (*_RULE_VALUES, "status") if name in rules]].to_dataframe()
-        frame = gaps.join(values[[c for c in values.columns if c in (*_RULE_VALUES, "status")]])
+        if {"status", "theta"} <= set(rules.data_vars) and self.stripes is not None:  # a step at the lowest stripe: a bound, not a rate
+            rules = rules.assign(bound=at_lowest_stripe(rules, float(np.min(self.fragility["intensity"].values))))
+        values = rules[[name for name in (*_RULE_VALUES, "status", "bound") if name in rules]].to_dataframe()
+        frame = gaps.join(values[[c for c in values.columns if c in (*_RULE_VALUES, "status", "bound")]])
         if "design_level" not in frame.index.names:
             frame = frame.set_index(pd.Index([rules["design_level"].sel(rule=r).item() for r in frame.index.get_level_values("rule")],
                                              name="design_level"), append=True)
         if "status" in frame:
-            frame["status"] = [fit_name(int(s)) if np.isfinite(s) else "" for s in frame["status"]]
+            bound = frame.pop("bound") if "bound" in frame else pd.Series(False, index=frame.index)
+            frame["status"] = [(LOWEST_STRIPE_STEP if b else fit_name(int(s))) if np.isfinite(s) else "" for s, b in zip(frame["status"], bound)]
         allowed = rate_from_probability(frame.index.get_level_values("design_level").to_numpy(dtype=float), years)
         frame["meets its level"] = frame["maf"] <= allowed  # λ_P at the rule's gap within the rate of its own design level
         if "maf_upper" in frame:
@@ -740,6 +743,10 @@ def target_text(probability: float, years: float = YEARS) -> str:
 def design_text(probability: float, stripe: float, years: float = YEARS) -> str:
     """A code's design level in words, with the stripe its rules use: ``2 %/50 yr (stripe 0.508)``."""
     return f"{100 * probability:g} %/{years:g} yr (stripe {stripe:g})"
+
+
+LOWEST_STRIPE_STEP = "step at the lowest stripe: λ_P a bound, not a rate (nothing is known below the runs)"
+"""A rule row's fit where it is a step at or below the lowest stripe (:func:`~stochpound.risk.at_lowest_stripe`)."""
 
 
 def fit_name(status: int) -> str:

@@ -109,10 +109,46 @@ def collapsed_runs(store: xr.Dataset, limit: float = MODEL_DRIFT_LIMIT) -> xr.Da
     """1 where a contact-free run's peak storey drift ratio (any building) exceeds ``limit``, 0 where not, NaN where it
     did not run; None for a store without storey drift ratios."""
     summaries, _ = _inputs.run_summaries(store, ["peak_drift_ratio"])
-    if "peak_drift_ratio" not in summaries:
-        return None
-    drift = summaries["peak_drift_ratio"].max("building")
+    return beyond_model(summaries["peak_drift_ratio"], limit) if "peak_drift_ratio" in summaries else None
+
+
+def beyond_model(drift: xr.DataArray, limit: float = MODEL_DRIFT_LIMIT) -> xr.DataArray:
+    """1 where a run's peak storey drift ratio (the largest over a ``building`` dimension) exceeds ``limit``, 0 where not, NaN
+    where it did not run: the runs beyond what the model represents, counted apart as collapses."""
+    drift = drift.max("building") if "building" in drift.dims else drift
     return (drift > limit).astype(float).where(drift.notnull())
+
+
+def rate_collapses_apart(demand: xr.DataArray, collapsed: xr.DataArray, thresholds: Sequence[float] | np.ndarray, dim: str,
+                         hz: HazardCurve) -> tuple[xr.DataArray, xr.Dataset]:
+    """λ (1/yr) of a demand reaching each threshold with the collapses counted apart (module docstring), and the collapse fit.
+
+    A collapse counts as reaching every threshold (a building that has lost its storeys has met every limit state, FEMA P-58);
+    the credible runs' fit of demand ≥ threshold and P(C | IM) are combined by total probability, :func:`combined_rate`.
+
+    Parameters
+    ----------
+    demand : xarray.DataArray
+        One value per run (dims ``intensity``, ``record`` and the configurations), in the thresholds' units.
+    collapsed : xarray.DataArray
+        :func:`beyond_model` of the same runs (1 collapse, 0 credible, NaN not run).
+    thresholds : sequence of float
+        The thresholds (a gap m, a capacity), along the new dimension ``dim``.
+    dim : str
+        The name of the thresholds' dimension.
+    hz : HazardCurve
+        The site's hazard.
+
+    Returns
+    -------
+    tuple of xarray.DataArray and xarray.Dataset
+        λ over ``dim`` and the configurations, and P(C | IM)'s stripe fit (:func:`~stochpound.risk.stripe_fragility`) with its ``maf``, λ_C.
+    """
+    demand, collapsed = xr.align(demand, _dims_only(collapsed), join="inner")
+    collapse = stripe_fragility(collapsed, bootstrap=0)
+    collapse["maf"] = mean_annual_frequency(collapse, hz)
+    credible = stripe_fragility(limit_state_events(demand.where(collapsed == 0.0), thresholds, dim), bootstrap=0)
+    return combined_rate(collapse, credible, hz), collapse
 
 
 def collapse_risk(store: xr.Dataset, hz: HazardCurve, gaps: Sequence[float] | np.ndarray, targets: Sequence[float],
@@ -137,13 +173,8 @@ def collapse_risk(store: xr.Dataset, hz: HazardCurve, gaps: Sequence[float] | np
     collapsed = collapsed_runs(store, limit)
     if collapsed is None:
         return None
-    closure = _inputs.contact_free_closure(store)
-    closure, collapsed = xr.align(closure, collapsed.drop_vars([c for c in collapsed.coords if c not in collapsed.dims]), join="inner")
-    credible = closure.where(collapsed == 0.0)
-    pounding = stripe_fragility(limit_state_events(credible, gaps, "gap"), bootstrap=0)
-    collapse = stripe_fragility(collapsed, bootstrap=0)
-    collapse["maf"] = mean_annual_frequency(collapse, hz)
-    maf = combined_rate(collapse, pounding, hz)
+    closure, collapsed = xr.align(_inputs.contact_free_closure(store), _dims_only(collapsed), join="inner")
+    maf, collapse = rate_collapses_apart(closure, collapsed, gaps, "gap", hz)
     separation = risk_targeted_separation(xr.Dataset({"maf": maf}), targets, years)
     return CollapseRisk(collapse, separation, maf, int(collapsed.sum()), int(collapsed.notnull().sum()))
 

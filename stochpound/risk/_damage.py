@@ -38,6 +38,7 @@ from stochpound.risk._limit_states import KINDS, OBJECTIVE_YEARS, LimitState, de
 from stochpound.risk._maf import TARGETS
 from stochpound.risk._chain import YEARS, fit_name
 from stochpound.risk._collapse import MODEL_DRIFT_LIMIT
+from stochpound.risk._stripe_coverage import at_lowest_stripe, stripes_only_maf, unidentified
 
 QUANTILES = (0.5, 0.84)
 """The fractiles over each stripe's motions of ``StoreDamage.demands``."""
@@ -89,6 +90,11 @@ class StoreDamage:
         The buildings whose storeys never yield in any run (no yield force:
         no ductility; their ``peak_ductility`` is NaN, and absent from
         ``demands`` when no building yields).
+    bound : xarray.DataArray or None
+        Over ``risk``'s dimensions: where a limit state's fit is a step at
+        the lowest stripe (:func:`~stochpound.risk.at_lowest_stripe`), the
+        lower bound of λ the runs give
+        (:func:`~stochpound.risk.stripes_only_maf`, 1/yr); NaN elsewhere.
     """
 
     demands: xr.Dataset
@@ -100,6 +106,11 @@ class StoreDamage:
     source: str
     contact_free: bool
     elastic: tuple[str, ...] = ()
+    bound: xr.DataArray | None = None
+
+    def collapses_apart(self) -> bool:
+        """Whether the limit states are given both ways: some run is beyond the model (``risk`` holds ``maf_collapses_apart``)."""
+        return self.risk is not None and "maf_collapses_apart" in self.risk
 
     def beyond_model_per_stripe(self) -> list[tuple[float, int, int]]:
         """Per stripe, over every configuration: (its level in IM units, the runs beyond the model, the runs done)."""
@@ -117,12 +128,30 @@ class StoreDamage:
             return None
         return xr.apply_ufunc(return_period, self.risk["maf"])
 
-    def ratio(self) -> xr.DataArray | None:
-        """λ/λ_target of each limit state over ``risk``'s dimensions (NaN where it has no objective); None without ``risk``."""
+    def ratio(self, apart: bool = False) -> xr.DataArray | None:
+        """λ/λ_target of each limit state over ``risk``'s dimensions (NaN where it has no objective); None without ``risk``.
+        With ``apart``, of λ with the runs beyond the model counted apart as collapses (as run where none is)."""
         if self.risk is None:
             return None
         target = self.risk["target"]
-        return self.risk["maf"] / xr.apply_ufunc(rate_from_probability, target.fillna(0.5), OBJECTIVE_YEARS).where(target.notnull())
+        maf = self.risk["maf_collapses_apart"] if apart and self.collapses_apart() else self.risk["maf"]
+        return maf / xr.apply_ufunc(rate_from_probability, target.fillna(0.5), OBJECTIVE_YEARS).where(target.notnull())
+
+    def bounds(self, apart: bool = False) -> xr.DataArray | None:
+        """``bound`` (1/yr), or with ``apart`` the same bound with the collapses counted as reaching the limit state
+        (``risk``'s ``bound_collapses_apart`` where ``bound`` is one); None without ``bound`` (or without collapses apart)."""
+        if self.bound is None or (apart and not self.collapses_apart()):
+            return None
+        return self.risk["bound_collapses_apart"].where(self.bound.notnull()) if apart else self.bound
+
+    def bound_ratio(self, apart: bool = False) -> xr.DataArray | None:
+        """:meth:`bounds`/λ_target over ``risk``'s dimensions: the lower bound of λ/λ_target where a fit is a step at the
+        lowest stripe (NaN elsewhere or without an objective); None without a bound."""
+        bound = self.bounds(apart)
+        if bound is None:
+            return None
+        target = self.risk["target"]
+        return bound / xr.apply_ufunc(rate_from_probability, target.fillna(0.5), OBJECTIVE_YEARS).where(target.notnull())
 
     def has_objectives(self) -> bool:
         """Whether any limit state has a performance objective (without one, nothing is said to govern)."""
@@ -162,10 +191,15 @@ class StoreDamage:
         return ratio.isel(limit_state=index), ratio["limit_state"][index].drop_vars("limit_state", errors="ignore")
 
     def fits(self) -> xr.DataArray | None:
-        """Each limit state's fit in words (``lognormal``, ``step: never`` …) over ``risk``'s dimensions; None without ``risk``."""
+        """Each limit state's fit in words over ``risk``'s dimensions (``lognormal``, ``step: never`` …; ``lognormal, not
+        identified (why)`` where :func:`~stochpound.risk.unidentified` says so; ``step at the lowest stripe: a bound`` where its
+        λ is one); None without ``risk``."""
         if self.risk is None:
             return None
-        return xr.apply_ufunc(np.vectorize(lambda status: fit_name(int(status)), otypes=[object]), self.risk["status"])
+        name = xr.apply_ufunc(np.vectorize(lambda status: fit_name(int(status)), otypes=[object]), self.risk["status"])
+        why = unidentified(self.risk)
+        name = xr.apply_ufunc(np.vectorize(lambda n, w: f"{n}, not identified ({w})" if w else n, otypes=[object]), name, why)
+        return name.where(~at_lowest_stripe(self.risk), "step at the lowest stripe: a bound")
 
     def misses_objective(self) -> xr.DataArray | None:
         """Per limit state and configuration, whether λ exceeds its objective's rate (λ/λ_target > 1; False without an objective)."""
@@ -229,4 +263,6 @@ def store_damage(store: xr.Dataset, limit_states: Sequence[LimitState] | None = 
     if held:
         risk = limit_state_risk(store, held, hz)
         risk = _inputs.contact_free_part(risk) if free else risk
-    return StoreDamage(demands, done.sum("record"), (beyond & done).sum("record"), design_stripes, risk, held, source or "", free, elastic)
+    bound = None if risk is None else stripes_only_maf(risk, hz).where(at_lowest_stripe(risk))
+    return StoreDamage(demands, done.sum("record"), (beyond & done).sum("record"), design_stripes, risk, held, source or "", free, elastic,
+                       bound)

@@ -14,18 +14,20 @@ the first wall impact a run with the wall equals the run without).
 from __future__ import annotations
 
 import dataclasses
+import math
 
 import numpy as np
 import pandas as pd
 import xarray as xr
 
-from collections.abc import Sequence
+from collections.abc import Hashable, Sequence
 
 from stochpound.hazard import HazardCurve, rate_from_probability
 from stochpound.risk import _inputs
 from stochpound.risk._fragility_ensemble import BOOTSTRAP
 from stochpound.risk._maf import demand_hazard_curve
 from stochpound.risk._chain import CONFIDENCE, YEARS, non_increasing_along
+from stochpound.risk._collapse import beyond_model, rate_collapses_apart
 
 DEMAND_LEVELS = 40
 """Levels of each demand hazard curve."""
@@ -52,16 +54,57 @@ class StoreDemands:
         without moat walls at its base.
     years : float
         The exposure time of the probabilities (yr).
+    apart : {str: xarray.DataArray}
+        Per demand (by label), its exceedance rate over ``level`` with the runs beyond
+        the model counted apart as collapses (:func:`~stochpound.risk.rate_collapses_apart`:
+        a collapse exceeds every level; 1/yr); empty where no run is beyond the model.
+    beyond_model : xarray.DataArray or None
+        The runs beyond the model per stripe and configuration (those counted apart); None where there are none.
+    runs : xarray.DataArray or None
+        The runs per stripe and configuration the demands come from (beside ``beyond_model``).
     """
 
     curves: dict[str, xr.Dataset]
     units: dict[str, str]
     moat: xr.Dataset | None
     years: float = YEARS
+    apart: dict[str, xr.DataArray] = dataclasses.field(default_factory=dict)
+    beyond_model: xr.DataArray | None = None
+    runs: xr.DataArray | None = None
+
+    def levels_at(self, targets: Sequence[float], years: float) -> pd.DataFrame:
+        """Per demand (its units in its name), configuration and target (a probability in ``years``): the level exceeded at the
+        target's rate, ``as run`` and ``collapses apart`` (each curve made non-increasing, interpolated in ln level and ln λ; ``inf`` where the
+        rate stays above the target at every level: the collapses alone are more frequent; NaN below the curve's lowest level)."""
+        rows = []
+        for label, curve in self.curves.items():
+            ways = {"as run": self.non_increasing_maf(label)}
+            if label in self.apart:
+                ways["collapses apart"] = self.non_increasing_apart(label)
+            for labels in _configurations(curve["maf"]):
+                for target in targets:
+                    allowed = float(rate_from_probability(float(target), years))
+                    row = {"demand": f"{label} ({self.units[label]})", **labels, "target": f"{100 * float(target):g} % in {years:g} yr"}
+                    for way, maf in ways.items():
+                        row[way] = _level_at(curve["level"].values, maf.sel(labels).values, allowed)
+                    rows.append(row)
+        return pd.DataFrame(rows)
 
     def non_increasing_maf(self, label: str) -> xr.DataArray:
         """A demand's exceedance rate made non-increasing along its levels (isotonic regression in ln λ, pool-adjacent-violators; 1/yr)."""
         return non_increasing_along(self.curves[label]["maf"], "level")
+
+    def beyond_model_per_stripe(self) -> list[tuple[float, int, int]]:
+        """Per stripe, over every configuration: (its level in IM units, the runs counted apart as collapses, the runs); [] without any."""
+        if self.beyond_model is None or self.runs is None:
+            return []
+        beyond = self.beyond_model.sum([d for d in self.beyond_model.dims if d != "intensity"])
+        runs = self.runs.sum([d for d in self.runs.dims if d != "intensity"])
+        return [(float(level), int(b), int(n)) for level, b, n in zip(beyond["intensity"].values, beyond.values, runs.values)]
+
+    def non_increasing_apart(self, label: str) -> xr.DataArray:
+        """A demand's exceedance rate with the collapses counted apart (``apart``), made non-increasing along its levels (1/yr)."""
+        return non_increasing_along(self.apart[label], "level")
 
     def wall_rates(self, targets: Sequence[float], years: float) -> list[tuple[float, float, float, float]]:
         """Per target (a probability in ``years``) and moat clearance: (target, clearance m, rate of reaching the wall in its worst
@@ -123,12 +166,40 @@ def store_demands(store: xr.Dataset, hz: HazardCurve | None = None, confidence: 
     demands.update(_inputs.stored_demands(store))
     if not demands:
         return None
-    curves = {}
+    collapsed = _inputs.demand_drift(store)
+    collapsed = None if collapsed is None else beyond_model(collapsed)
+    collapsed = collapsed if collapsed is not None and bool((collapsed == 1.0).any()) else None
+    curves, apart = {}, {}
     for label, (demand, _) in demands.items():
         values = demand.values[np.isfinite(demand.values) & (demand.values > 0)]
         levels = np.geomspace(np.quantile(values, 0.01), values.max(), DEMAND_LEVELS)
         curves[label] = demand_hazard_curve(demand, levels, hz, confidence=confidence, bootstrap=0)
+        if collapsed is not None:
+            apart[label] = rate_collapses_apart(demand, collapsed, levels, "level", hz)[0].assign_coords(level=levels)
     clearances = _inputs.moat_clearances(store, studied)
     moat = (demand_hazard_curve(sliding, clearances, hz, confidence=confidence, bootstrap=bootstrap, seed=seed)
             if sliding is not None and clearances else None)
-    return StoreDemands(curves, {label: units for label, (_, units) in demands.items()}, moat)
+    counts = (None, None) if collapsed is None else (collapsed.sum("record"), collapsed.notnull().sum("record"))
+    return StoreDemands(curves, {label: units for label, (_, units) in demands.items()}, moat, apart=apart, beyond_model=counts[0], runs=counts[1])
+
+
+def _configurations(data: xr.DataArray) -> list[dict[str, Hashable]]:
+    """Every combination of ``data``'s labels other than ``level``."""
+    dims = [d for d in data.dims if d != "level"]
+    index = pd.MultiIndex.from_product([data[d].values for d in dims], names=dims) if dims else [()]
+    return [dict(zip(dims, labels if isinstance(labels, tuple) else (labels,))) for labels in index]
+
+
+def _level_at(levels: np.ndarray, maf: np.ndarray, rate: float) -> float:
+    """The level at which a non-increasing exceedance curve ``maf`` falls to ``rate`` (log-log interpolation); inf where it never
+    does, NaN where it is below ``rate`` already at the lowest level."""
+    above = maf > rate
+    if above.all():
+        return math.inf
+    if not above[0]:
+        return math.nan
+    i = int(np.argmin(above))  # the first level at or below the rate
+    if maf[i] <= 0.0:
+        return float(levels[i - 1])
+    fraction = (np.log(rate) - np.log(maf[i - 1])) / (np.log(maf[i]) - np.log(maf[i - 1]))
+    return float(np.exp(np.log(levels[i - 1]) + fraction * (np.log(levels[i]) - np.log(levels[i - 1]))))

@@ -501,6 +501,13 @@ def stored_demands(store: xr.Dataset) -> dict[str, tuple[xr.DataArray, str]]:
             for variable, (label, units, factor) in DEMANDS.items() if variable in free for building in free["building"].values}
 
 
+def demand_drift(store: xr.Dataset) -> xr.DataArray | None:
+    """The peak storey drift ratio of every case the demand curves read (without impacts: contact-free and wall-free), one
+    motion dimension ``record`` (over ``building``); None without it."""
+    free = wall_free(contact_free(store))
+    return store_motions(free["peak_drift_ratio"]).load() if "peak_drift_ratio" in free else None
+
+
 def moat_clearances(store: xr.Dataset, studied: str | None) -> list[float]:
     """The distinct gaps of the walls at the studied building's base in the definition (its scene, with the values of a gap axis
     that sets a wall instead of its own gap, and its variants), finite ones only."""

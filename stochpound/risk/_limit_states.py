@@ -34,6 +34,8 @@ from stochpound.risk._inputs import LimitStates
 from stochpound.risk._fragility_ensemble import limit_state_events, stripe_fragility
 from stochpound.risk._maf import mean_annual_frequency
 from stochpound.risk._chain import CONFIDENCE, YEARS
+from stochpound.risk._collapse import MODEL_DRIFT_LIMIT, beyond_model, rate_collapses_apart
+from stochpound.risk._stripe_coverage import stripes_only_maf
 
 
 OBJECTIVE_YEARS = 50.0
@@ -210,7 +212,14 @@ def limit_state_risk(store: xr.Dataset, limit_states: Sequence[LimitState], hz: 
         ``maf_contact_free`` (the contact-free twins' rate, the same motions
         and other labels) and ``gap_cost`` = ``maf`` − ``maf_contact_free``
         (1/yr; 0 for the twins themselves, negative where pounding lowers the
-        demand).
+        demand). Where some run's peak storey drift ratio passes
+        ``MODEL_DRIFT_LIMIT`` (beyond the model): ``maf_collapses_apart``,
+        λ with those runs counted apart as collapses and combined by total
+        probability (:func:`~stochpound.risk.rate_collapses_apart`; a
+        collapse reaches every limit state), ``bound_collapses_apart``, the
+        stripes' fractions alone so counted (:func:`~stochpound.risk.stripes_only_maf`:
+        the bound of a step at the lowest stripe), and ``beyond_model``, those
+        runs per stripe and configuration.
 
     Raises
     ------
@@ -222,15 +231,26 @@ def limit_state_risk(store: xr.Dataset, limit_states: Sequence[LimitState], hz: 
         raise _inputs.RiskInputError("limit_states: give at least one limit state")
     hz, demands, measure = _inputs.limit_state_inputs(store, [(KINDS[s.kind].variable, s.building, KINDS[s.kind].note, KINDS[s.kind].units == "g")
                                                               for s in limit_states], hz)
-    fits = []
+    collapsed = _collapsed_cases(store)
+    fits, apart = [], []
     for state, demand in zip(limit_states, demands):
         events = limit_state_events(demand, [state.capacity], dim="limit_state").assign_coords(limit_state=[state.label])
         fit = stripe_fragility(events, confidence=confidence, bootstrap=bootstrap, seed=seed)
         fits.append(fit.assign_coords(kind=("limit_state", [state.kind]), capacity=("limit_state", [float(state.capacity)]),
                                       building=("limit_state", [state.building or ""]),
                                       target=("limit_state", [math.nan if state.target is None else float(state.target)])))
+        if collapsed is not None:
+            rate = rate_collapses_apart(demand, collapsed, [state.capacity], "limit_state", hz)[0].assign_coords(limit_state=[state.label])
+            apart.append(xr.Dataset({"maf_collapses_apart": rate, "bound_collapses_apart": _apart_bound(events, collapsed, hz)}))
     result = xr.concat(fits, "limit_state", coords="different", compat="equals", join="outer")
     result["maf"] = mean_annual_frequency(result, hz)
+    if apart:
+        both = xr.concat(apart, "limit_state", join="outer")
+        result["maf_collapses_apart"] = both["maf_collapses_apart"].assign_attrs(
+            units="1/yr", long_name=f"mean annual frequency, the runs beyond a {100 * MODEL_DRIFT_LIMIT:g} % storey drift counted apart as collapses")
+        result["bound_collapses_apart"] = both["bound_collapses_apart"].assign_attrs(
+            units="1/yr", long_name="the stripes' fractions alone, collapses counted as reaching the limit state (nothing below the lowest stripe)")
+        result["beyond_model"] = collapsed.sum("record").assign_attrs(units="1", long_name="runs beyond the model (collapses) per stripe")
     twins = _inputs.contact_free_twins(result["maf"])
     if twins is not None:
         result["maf_contact_free"] = twins.assign_attrs(units="1/yr", long_name="mean annual frequency of the contact-free twins")
@@ -238,17 +258,35 @@ def limit_state_risk(store: xr.Dataset, limit_states: Sequence[LimitState], hz: 
     return result.assign_attrs(intensity=measure)
 
 
+def _apart_bound(events: xr.DataArray, collapsed: xr.DataArray, hz: HazardCurve) -> xr.DataArray:
+    """:func:`~stochpound.risk.stripes_only_maf` of a limit state's per-run events with every collapse counted as reaching it (1/yr)."""
+    events, collapsed = xr.align(events, collapsed.drop_vars([c for c in collapsed.coords if c not in collapsed.dims]), join="inner")
+    either = xr.where(collapsed == 1.0, 1.0, events).where(events.notnull())
+    return stripes_only_maf(xr.Dataset({"exceeded": either.sum("record"), "runs": either.notnull().sum("record")}), hz)
+
+
+def _collapsed_cases(store: xr.Dataset) -> xr.DataArray | None:
+    """:func:`~stochpound.risk.beyond_model` of every case of a store (its gap axes kept), None without storey drift ratios or
+    where no run is beyond the model (the collapses-apart rate is then the rate itself)."""
+    if "peak_drift_ratio" not in store:
+        return None
+    collapsed = beyond_model(_inputs.case_demand(store, "peak_drift_ratio", None, ""))
+    return collapsed if bool((collapsed == 1.0).any()) else None
+
+
 def gap_cost_frame(risk: xr.Dataset, years: float = YEARS) -> pd.DataFrame:
-    """The "what the gap costs" table of :func:`limit_state_risk`: per limit state and finite gap, λ, λ of the twins, their difference, and P in ``years``.
+    """The "what the gap costs" table of :func:`limit_state_risk`: per limit state and finite gap, λ, λ of the twins, their difference, and P in ``years``
+    (and λ with the runs beyond the model counted apart as collapses, where some run is).
 
     Returns
     -------
     pandas.DataFrame
         Indexed by the limit state and the other grid labels (the contact-free rows left out).
     """
-    keep = [name for name in ("maf", "maf_contact_free", "gap_cost") if name in risk]
+    keep = [name for name in ("maf", "maf_contact_free", "gap_cost", "maf_collapses_apart") if name in risk]
     frame = _inputs.at_finite_gaps(risk[keep]).reset_coords(drop=True).to_dataframe()
     frame[f"P in {years:g} yr"] = probability_from_rate(frame["maf"].to_numpy(), years)
     if "maf_contact_free" in frame:
         frame[f"P in {years:g} yr, contact-free"] = probability_from_rate(frame["maf_contact_free"].to_numpy(), years)
-    return frame.rename(columns={"maf": "λ (1/yr)", "maf_contact_free": "λ contact-free (1/yr)", "gap_cost": "Δλ (1/yr)"})
+    return frame.rename(columns={"maf": "λ (1/yr)", "maf_contact_free": "λ contact-free (1/yr)", "gap_cost": "Δλ (1/yr)",
+                                 "maf_collapses_apart": "λ collapses apart (1/yr)"})

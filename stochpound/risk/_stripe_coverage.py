@@ -31,7 +31,7 @@ import numpy as np
 import xarray as xr
 
 from stochpound.hazard import HazardCurve
-from stochpound.risk._fragility import FIT, SEPARATED, lognormal_cdf
+from stochpound.risk._fragility import ALWAYS, FIT, SEPARATED, lognormal_cdf
 from stochpound.risk._maf import mean_annual_frequency
 
 _POINTS = 4000
@@ -146,3 +146,59 @@ def _rate_between(theta: float, beta: float, hz: HazardCurve, upper: float) -> f
     rate = hz(x)
     middle = np.sqrt(x[1:] * x[:-1])
     return float(np.sum(lognormal_cdf(middle, theta, beta) * (rate[:-1] - rate[1:])))
+
+
+def at_lowest_stripe(fragility: xr.Dataset, lowest: float | None = None) -> xr.DataArray:
+    """Where a stripes fit is a step at or below its lowest stripe (``always``, or ``separated`` with θ at the lowest level):
+    its rate then rests on what lies below the runs, where nothing is known, and is a bound, not a rate. ``lowest``: the
+    lowest stripe's level (IM units), default the fit's lowest ``intensity``."""
+    lowest = float(np.min(fragility["intensity"].values)) if lowest is None else lowest
+    return (fragility["status"] == ALWAYS) | ((fragility["status"] == SEPARATED) & (fragility["theta"] <= lowest * (1.0 + 1e-9)))
+
+
+def stripes_only_maf(fragility: xr.Dataset, hz: HazardCurve) -> xr.DataArray:
+    """λ⁻ (1/yr) from the stripes' fractions alone, nothing below the lowest stripe: Σ_j p_j (λ(x_j) − λ(x_{j+1})).
+
+    p_j = k_j/n_j is stripe j's fraction that exceeded, held from its level x_j up to the next one (λ(x_{n+1}) = 0 above the
+    top stripe). A fragility that does not fall with intensity and is at least p_j at x_j exceeds this everywhere, so it is
+    the lower bound the runs give of a rate whose fit is a step at the lowest stripe (:func:`at_lowest_stripe`).
+
+    Parameters
+    ----------
+    fragility : xarray.Dataset
+        A stripes fit with its per-stripe ``exceeded`` and ``runs`` over ``intensity``.
+    hz : HazardCurve
+        The site's hazard.
+
+    Returns
+    -------
+    xarray.DataArray
+        λ⁻ over the fit's dimensions other than ``intensity``.
+    """
+    levels = np.asarray(fragility["intensity"].values, dtype=float)
+    order = np.argsort(levels)
+    rates = np.asarray(hz(np.minimum(levels[order], hz.support[1])), dtype=float)
+    bins = xr.DataArray(rates - np.append(rates[1:], 0.0), dims="intensity", coords={"intensity": levels[order]})
+    fraction = fragility["exceeded"] / fragility["runs"].where(fragility["runs"] > 0)
+    return (fraction.sel(intensity=levels[order]) * bins).sum("intensity", min_count=1).assign_attrs(
+        units="1/yr", long_name="mean annual frequency from the stripes' fractions alone (nothing below the lowest stripe)")
+
+
+UNIDENTIFIED_BETA = 0.8
+"""β from which a lognormal fit is not identified by the stripes: its 16–84 % range spans e^{2β} ≈ 5 times in intensity,
+wider than record-to-record dispersion (0.3–0.6 for storey drifts, FEMA P-58) and than a stripe set usually spans."""
+
+
+def unidentified(fragility: xr.Dataset) -> xr.DataArray:
+    """Why a lognormal stripes fit is not identified by its runs, in words ("" where it is, or where the fit is a step):
+    ``θ beyond the top stripe`` (its median lies where no run went) or ``β ≥ 0.8`` (``UNIDENTIFIED_BETA``)."""
+    top = float(np.max(fragility["intensity"].values))
+
+    def why(status: float, theta: float, beta: float) -> str:
+        if status != FIT:
+            return ""
+        reasons = ([f"θ = {theta:.3g} beyond the top stripe {top:.3g}"] if theta > top else []) + (
+            [f"β = {beta:.2g} ≥ {UNIDENTIFIED_BETA:g}"] if beta >= UNIDENTIFIED_BETA else [])
+        return "; ".join(reasons)
+
+    return xr.apply_ufunc(np.vectorize(why, otypes=[object]), fragility["status"], fragility["theta"], fragility["beta"])

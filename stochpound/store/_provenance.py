@@ -37,6 +37,8 @@ class Provenance:
     ----------
     experiment_name, experiment_description, experiment_file : str
         The experiment's name, description and file (as given to ``stochpound run``).
+    experiment_sha256 : str
+        The sha256 of the experiment file's text as it ran (recorded in the store with the text itself).
     definition_sha256 : str
         The identity of the store's runs.
     studied_building : str
@@ -52,6 +54,7 @@ class Provenance:
     experiment_name: str = ""
     experiment_description: str = ""
     experiment_file: str = ""
+    experiment_sha256: str = ""
     definition_sha256: str = ""
     studied_building: str = ""
     solver: str = ""

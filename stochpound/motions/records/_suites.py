@@ -82,6 +82,7 @@ METADATA_FIELDS: dict[str, str] = {
     "distance": "km",
     "vs30": "m/s",
     "rsn": "",
+    "pulse": "",
 }
 
 

@@ -17,7 +17,7 @@ from stochpound.report.sections._methods import methods_section
 from stochpound.analysis import WALLS
 from stochpound.report.sections._measure_free import measure_free_section
 from stochpound.report.sections._separation import separation_section
-from stochpound.report.sections._store_reading import open_stores, select, value
+from stochpound.report.sections._store_reading import definition_source, open_stores, select, value
 from stochpound.report.sections._summary import experiment_summary, move_per_cell_tables
 
 __all__ = [
@@ -36,6 +36,7 @@ __all__ = [
     "measure_free_section",
     "move_per_cell_tables",
     "open_stores",
+    "definition_source",
     "select",
     "separation_section",
     "store_section",

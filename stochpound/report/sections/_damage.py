@@ -2,11 +2,13 @@
 
 from __future__ import annotations
 
+import math
+
 import pandas as pd
 
 from stochpound.report.render import Paragraph, Section, Table
 from stochpound.report.sections._description import number
-from stochpound.risk import DAMAGE_DEMANDS, MODEL_DRIFT_LIMIT, POUNDING_AT_G_STAR as POUNDING, StoreDamage
+from stochpound.risk import DAMAGE_DEMANDS, MODEL_DRIFT_LIMIT, POUNDING_AT_G_STAR as POUNDING, UNIDENTIFIED_BETA, StoreDamage
 
 
 def damage_section(name: str, damage: StoreDamage) -> Section:
@@ -87,8 +89,14 @@ def _beyond_model_text(damage: StoreDamage) -> str:
             "storey height (the collapse-prevention drift of steel moment frames) is beyond what the model represents: ")
     if not flagged:
         return head + f"none of the {damage.beyond_model_total()[1]} runs reaches it."
+    both = (" The limit states' table gives each λ both ways: as run (these runs as computed), and with these runs counted apart as "
+            "collapses, as FEMA P-58 does: P(C | IM) a lognormal fitted over the stripes to them, each limit state fitted on the "
+            "credible runs only, and λ = ∫ [P(C | x) + (1 − P(C | x)) P(LS | x, no C)] |dλ(x)|, a collapse counted as reaching every "
+            "limit state (of either building: past 5 % in one, the pair's response is not credible). What governs (below) is judged "
+            "on λ as run." if damage.collapses_apart() else "")
     return (head + "runs reaching it, per stripe over every configuration: " + "; ".join(flagged) + ". Their drifts, ductilities and "
-            "residual drifts are not credible (a real frame would have lost strength or collapsed), and the fractiles above include them.")
+            "residual drifts are not credible (a real frame would have lost strength or collapsed), and the fractiles above include them."
+            + both)
 
 
 def _governing_text(damage: StoreDamage) -> str:
@@ -122,21 +130,49 @@ def _governing_text(damage: StoreDamage) -> str:
 
 
 def _limit_states_table(name: str, damage: StoreDamage) -> Table:
-    maf, periods, ratio, fits = damage.risk["maf"], damage.return_period(), damage.ratio(), damage.fits()
+    maf, periods, fits = damage.risk["maf"], damage.return_period(), damage.fits()
+    ratio, apart, bound_ratio = damage.ratio(), damage.collapses_apart(), damage.bound_ratio()
     rows = []
     for labels in _configurations(maf):
         for state in maf["limit_state"].values:
-            rate = float(maf.sel(labels).sel(limit_state=state))
+            at = {**labels, "limit_state": state}
             target = float(maf["target"].sel(limit_state=state))
-            rows.append({"configuration": _label(labels), "limit state": str(state), "λ (1/yr)": f"{rate:.3g}",
-                         "once in (yr)": f"{float(periods.sel(labels).sel(limit_state=state)):.3g}",
-                         "fit": str(fits.sel(labels).sel(limit_state=state).item()),
-                         "objective": f"{_percent(target)} in 50 yr" if target == target else "none",
-                         "λ/λ_target": f"{float(ratio.sel(labels).sel(limit_state=state)):.3g}" if target == target else ""})
+            bound = float(damage.bound.sel(at)) if damage.bound is not None else math.nan
+            row = {"configuration": _label(labels), "limit state": str(state), "λ (1/yr)": _rate_cell(float(maf.sel(at)), bound),
+                   "once in (yr)": _period_cell(float(periods.sel(at)), bound), "fit": str(fits.sel(at).item()),
+                   "objective": f"{_percent(target)} in 50 yr" if target == target else "none",
+                   "λ/λ_target": _ratio_cell(float(ratio.sel(at)), float(bound_ratio.sel(at)) if bound_ratio is not None else math.nan) if target == target else ""}
+            if apart:
+                bound_apart = float(damage.bounds(apart=True).sel(at)) if damage.bound is not None else math.nan
+                row["λ collapses apart (1/yr)"] = _rate_cell(float(damage.risk["maf_collapses_apart"].sel(at)), bound_apart)
+                row["λ/λ_target collapses apart"] = (_ratio_cell(float(damage.ratio(apart=True).sel(at)), float(damage.bound_ratio(apart=True).sel(at))
+                                                                 if damage.bound is not None else math.nan) if target == target else "")
+            rows.append(row)
+    both = (" and, with the runs beyond the model counted apart as collapses (FEMA P-58, by total probability: above), λ and its "
+            "ratio that way") if apart else ""
     return Table(
         key=f"table-limit-states-{name}",
-        caption=(f"Experiment {name}: the limit states' mean annual frequency λ, return period and fit, per configuration, against "
-                 "each one's objective (λ/λ_target above 1: the objective is missed)"),
+        caption=(f"Experiment {name}: the limit states' mean annual frequency λ with its fit, the return period, per configuration, "
+                 f"against each one's objective (λ/λ_target above 1: the objective is missed){both}"),
         frame=pd.DataFrame(rows).set_index(["configuration", "limit state"]),
-        note="λ of a limit state no run reaches is 0; one every run reaches at every stripe is set by the hazard table's lowest intensity.",
+        note=("λ of a limit state no run reaches is 0. A step at the lowest stripe (every run, or every run above the lowest stripe, "
+              "reached it) says nothing of the shaking below the runs: its λ is given as the lower bound the stripes' fractions give "
+              "(≥, nothing counted below the lowest stripe) and its return period as an upper bound (≤). A lognormal 'not identified' "
+              f"has its median beyond the top stripe or β ≥ {UNIDENTIFIED_BETA:g}: the runs do not pin it, and its λ rests on the "
+              "lognormal's extrapolation."),
     )
+
+
+def _rate_cell(rate: float, bound: float) -> str:
+    """λ in the table: the rate, or ``≥`` its bound where the fit is a step at the lowest stripe (``bound`` not NaN)."""
+    return f"≥ {bound:.3g}" if bound == bound else f"{rate:.3g}"
+
+
+def _period_cell(period: float, bound: float) -> str:
+    """The return period in the table: 1/λ, or ``≤`` 1/bound where λ is a bound."""
+    return (f"≤ {1.0 / bound:.3g}" if bound > 0 else "inf") if bound == bound else f"{period:.3g}"
+
+
+def _ratio_cell(ratio: float, bounded: float) -> str:
+    """λ/λ_target in the table, ``≥`` the bound's where λ is one."""
+    return f"≥ {bounded:.3g}" if bounded == bounded else f"{ratio:.3g}"

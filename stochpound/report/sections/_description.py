@@ -28,7 +28,7 @@ from stochpound.report.sections._stripe_motions import stripe_motions_text
 from stochpound.motions.records import is_suite_member
 from stochpound.model.scene import Building, Contact, Scene
 from stochpound.model.wall import Wall
-from stochpound.store import MotionSource, MotionTable, TomlTable
+from stochpound.store import MotionSource, MotionTable, TomlTable, motions_that_ran
 
 
 def number(value: float, digits: int = 6) -> str:
@@ -336,8 +336,13 @@ def _record_parameters(motion: MotionTable) -> tuple[str, str]:
 def motions_table(definitions: Iterable[StoreDefinition]) -> Table:
     """Every ground motion the stores ran: records with their treatment, ensembles with their generator and seed."""
     rows = []
+    pool = 0
     for definition in definitions:
+        ran = motions_that_ran(definition.store)
         for motion in definition.definition.motions:
+            pool += 1
+            if motion.label not in ran:
+                continue  # a pool motion a selection did not choose: it never ran
             table, typed = motion.motion, MotionTable.of_source(motion)
             if motion.kind == "synthetic":
                 text, attrs = _synthetic_parameters(motion)
@@ -354,7 +359,8 @@ def motions_table(definitions: Iterable[StoreDefinition]) -> Table:
     frame.index = pd.RangeIndex(1, len(frame) + 1, name="#")
     return Table(
         key="table-motions",
-        caption="The ground motions as run: each record with its treatment, each synthetic ensemble with its generator, intensity, envelope, seed and size.",
+        caption="The ground motions as run: each record with its treatment, each synthetic ensemble with its generator, intensity, envelope, seed and size"
+        + (f" ({len(frame)} of the {pool} motions the experiments define: a selection's pool motions it never chose are left out)." if len(frame) < pool else "."),
         frame=frame,
         note="Realization i of an ensemble depends only on (seed, i). The PSD convention: two-sided in ω, σ² = ∫ S dω.",
     )

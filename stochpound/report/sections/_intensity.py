@@ -46,7 +46,7 @@ from stochpound.risk import (
     site_consistency,
     stripes_beyond_truncation,
 )
-from stochpound.store import Intensity, has_contact_free, scenario_kind, with_contacts
+from stochpound.store import Intensity, has_contact_free, scenario_kind, stripe_holdings, with_contacts
 
 CONFIDENCE = 0.95
 SHOWN_GAPS = 3
@@ -183,16 +183,20 @@ def _stripe_table(name: str, store: xr.Dataset, setting: Intensity) -> Table:
             "scale max": scale.max(("record", "realization")).to_series(),
         }
     )
-    frame = frame.reset_index().merge(factors.reset_index(), on="intensity").set_index(list(runs.dims))
+    holdings = stripe_holdings(store)
+    frame = frame.reset_index().merge(factors.reset_index(), on="intensity").merge(holdings.reset_index(), on="intensity").set_index(list(runs.dims))
     what = ("runs with an impact (on the neighbour or on a moat wall: at gap = ∞ the contacts never close, so every impact there "
             "is a wall hit), the runs that hit a wall, and the probability of an impact" if walls else
             "runs that pounded and the probability of pounding")
     return Table(
         f"intensity-stripes-{name}",
         f"Experiment {name}: every stripe ({setting.description} in {setting.units}): scale factors, runs, {what} with its "
-        f"{int(100 * CONFIDENCE)} % Clopper–Pearson interval",
+        f"{int(100 * CONFIDENCE)} % Clopper–Pearson interval, and the motions that ran there: their earthquakes (one name across "
+        "suites: 'Northridge 1994' and 'Northridge-01 1994' are one), the largest share of one earthquake, the pulse records and "
+        "the motions shared with the stripe below",
         frame,
-        formats={"runs": "{:.0f}", event: "{:.0f}", "wall hit": "{:.0f}", probability_name: "{:.3f}", "lower": "{:.3f}", "upper": "{:.3f}"},
+        formats={"motions": "{:.0f}", "earthquakes": "{:.0f}", "shared with the stripe below": "{:.0f}",
+                 "runs": "{:.0f}", event: "{:.0f}", "wall hit": "{:.0f}", probability_name: "{:.3f}", "lower": "{:.3f}", "upper": "{:.3f}"},
     )
 
 
@@ -282,10 +286,10 @@ def _holdings(store: xr.Dataset, setting: Intensity) -> str:
     """What every stripe holds: its recorded and simulated motions and its earthquakes ("" for a store that does not say)."""
     if "selection_recorded" not in store:
         return ""
+    earthquakes = stripe_holdings(store)["earthquakes"]  # one name across suites (the stored count predates it in older stores)
     stripes = "; ".join(
-        f"{level:g} {setting.units}: {int(recorded)} recorded and {int(simulated)} simulated from {int(earthquakes)} earthquakes"
-        for level, recorded, simulated, earthquakes in zip(store["intensity"].values, store["selection_recorded"].values,
-                                                           store["selection_simulated"].values, store["selection_earthquakes"].values)
+        f"{level:g} {setting.units}: {int(recorded)} recorded and {int(simulated)} simulated from {int(earthquakes.loc[level])} earthquakes"
+        for level, recorded, simulated in zip(store["intensity"].values, store["selection_recorded"].values, store["selection_simulated"].values)
     )
     return f" The stripes hold (each simulated motion its own earthquake) {stripes}."
 

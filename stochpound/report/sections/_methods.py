@@ -21,6 +21,7 @@ from stochpound.report.sections._description import StoreDefinition, buildings_t
 from stochpound.report.render import Paragraph, Section, Table
 from stochpound.report.sections._intensity import method_text
 from stochpound.report.sections._risk import hazard_provenance
+from stochpound.report.sections._store_reading import definition_source
 from stochpound.store import MotionTable
 
 #: Packages whose versions the report lists.
@@ -151,7 +152,7 @@ def experiment_provenance(name: str, store: xr.Dataset) -> str:
     """One store: what it ran, how far, with what, and its identity."""
     written = store.pound.provenance
     return (
-        f"Experiment {name} ({written.experiment_file}): {written.experiment_description}. "
+        f"Experiment {name} ({definition_source(store)}): {written.experiment_description}. "
         f"{written.cases_done} of {written.cases_total} cases done, solver "
         f"{written.solver}, stochpound {written.stochpound_version} (commit {written.git_commit}), "
         f"definition sha256 {written.definition_sha256[:16]}…"

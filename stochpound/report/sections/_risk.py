@@ -212,9 +212,10 @@ def _beyond_model(damage: StoreDamage | None, collapse: CollapseRisk | None = No
     beyond, runs = damage.beyond_model_total() if damage is not None else (0, 0)
     if not beyond:
         return {}
+    apart = "; the limit states are given both ways too (the Damage section)" if damage.collapses_apart() else ""
     counted = ("g* above and the limit states keep them as computed; g* with them counted apart as collapses (FEMA P-58, by total "
-               "probability) is given beside it, 'g* both ways'" if collapse is not None else
-               "they enter g* and the limit states as computed (the Damage section)")
+               f"probability) is given beside it, 'g* both ways'{apart}" if collapse is not None else
+               "they enter g* and the limit states as computed (the Damage section)" + apart)
     return {"beyond the model": f"{beyond} of {runs} runs exceed a "
                                 f"{100 * MODEL_DRIFT_LIMIT:g} % storey drift, where the storeys' lack of strength loss and collapse makes their "
                                 f"response not credible; {counted}"}
@@ -519,6 +520,24 @@ def _rules_blocks(name: str, risk: StoreRisk) -> list[Block]:
     return [Paragraph(text), table]
 
 
+def _demands_both_ways(name: str, risk: StoreRisk, demands: StoreDemands) -> list[Block]:
+    """The demands with the runs beyond the model counted apart: which runs (per stripe), how, and each demand's level at the targets both ways."""
+    per_stripe = "; ".join(f"{b} of {n} at stripe {level:.4g}" for level, b, n in demands.beyond_model_per_stripe())
+    text = (f"Demands with collapses counted apart (FEMA P-58): runs whose peak storey drift ratio passes {100 * MODEL_DRIFT_LIMIT:g} % "
+            f"are beyond what the model represents; per stripe over every configuration, {per_stripe}. Counted apart, P(C | IM) is a "
+            "lognormal fitted over the stripes to them, each level's exceedance is fitted on the credible runs only, and the rate is "
+            "λ(D > x) = ∫ [P(C | im) + (1 − P(C | im)) P(D > x | im, no C)] |dλ(im)|, a collapse counted as exceeding every level "
+            "(the dashed curves). The table gives the level each demand exceeds at each target's rate both ways (inf: the collapses "
+            "alone are more frequent than the target allows; –: already below the target at the curve's lowest level).")
+    frame = demands.levels_at(risk.separation["target"].values, risk.years)
+    values = [c for c in frame.columns if c in ("as run", "collapses apart")]
+    index = [c for c in frame.columns if c not in values]
+    table = Table(f"risk-demands-apart-{name}", f"Experiment {name}: the level each demand exceeds at the targets' rates, as run and "
+                  "with the runs beyond the model counted apart as collapses", frame.set_index(index),
+                  formats={c: "{:.3g}" for c in values})
+    return [Paragraph(text), table]
+
+
 def _demand_blocks(name: str, risk: StoreRisk, demands: StoreDemands | None) -> list[Block]:
     """Demand hazard curves of a stripes store: base displacement (and the moat walls' clearance), drift, floor acceleration."""
     if demands is None:
@@ -527,9 +546,13 @@ def _demand_blocks(name: str, risk: StoreRisk, demands: StoreDemands | None) -> 
     for ax, (label, curve) in zip(axes, demands.curves.items()):
         levels = curve["level"].values
         envelope = demands.non_increasing_maf(label)
+        apart = demands.non_increasing_apart(label) if label in demands.apart else None
         for labels in configurations(curve["maf"], ("level",)):
             maf = envelope.sel(labels).values
-            ax.loglog(levels, np.where(maf > 0, maf, np.nan), lw=1.1, label=labels_text(labels) or None)
+            (line,) = ax.loglog(levels, np.where(maf > 0, maf, np.nan), lw=1.1, label=labels_text(labels) or None)
+            if apart is not None:
+                counted = apart.sel(labels).values
+                ax.loglog(levels, np.where(counted > 0, counted, np.nan), lw=0.9, ls="--", color=line.get_color())
         ax.set_ylim(figures.rate_limits(envelope.values))
         ax.xaxis.set_major_locator(LogLocator(subs=(1.0, 2.0, 5.0)))
         ax.xaxis.set_minor_formatter(NullFormatter())  # labels on 1-2-5 only: the minor ones overlapped on short axes
@@ -545,7 +568,10 @@ def _demand_blocks(name: str, risk: StoreRisk, demands: StoreDemands | None) -> 
     blocks: list[Block] = [FigureItem(f"risk-demands-{name}", f"Experiment {name}: demand hazard curves (mean annual frequency of "
                                       "exceeding each level, a lognormal fragility fitted at every level over the stripes' "
                                       "contact-free runs (a step, or flat, where the runs identify no lognormal) and integrated with the hazard, made non-increasing along the level), per "
-                                      "configuration.", figure)]
+                                      "configuration" + ("; dashed: the runs beyond the model counted apart as collapses (below)" if demands.apart else "")
+                                      + ".", figure)]
+    if demands.apart:
+        blocks += _demands_both_ways(name, risk, demands)
     if demands.moat is not None:
         blocks.append(Table(f"risk-moat-{name}", f"Experiment {name}: moat-wall contact as a limit state: the mean annual frequency with "
                             "which the studied building's base reaches the moat wall's clearance (peak base displacement ≥ clearance; "

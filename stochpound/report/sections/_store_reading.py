@@ -6,6 +6,8 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
+import hashlib
+
 import xarray as xr
 
 from stochpound._errors import StochpoundError
@@ -51,6 +53,23 @@ def open_stores(paths: Sequence[str | Path], edited: str = "warn") -> dict[str, 
             raise StochpoundError(f"store {path}: experiment {name!r} is given twice")
         stores[name] = store
     return stores
+
+
+def definition_source(store: xr.Dataset) -> str:
+    """Where a store's definition comes from, in words: the experiment file it names, where a file with the text it ran is
+    at that path (relative to the working directory), else the text the store records of itself, saying why the file is not
+    named (not at that path, or changed since the run): a report never names as the source a file that is not the store's."""
+    written = store.pound.provenance
+    path = Path(written.experiment_file) if written.experiment_file else None
+    if path is not None and path.is_file():
+        text = path.read_text(encoding="utf-8", errors="replace")
+        if not written.experiment_sha256 or hashlib.sha256(text.encode()).hexdigest() == written.experiment_sha256:
+            return written.experiment_file
+        why = f"its file {written.experiment_file} has changed since the run"
+    else:
+        why = f"its file {written.experiment_file} is not at that path" if written.experiment_file else "it names no file"
+    recorded = f", text sha256 {written.experiment_sha256[:16]}…" if written.experiment_sha256 else ""
+    return f"the experiment text recorded in the store ({why}{recorded})"
 
 
 select = select_case
