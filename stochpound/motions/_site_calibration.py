@@ -66,12 +66,13 @@ FIT_SCENARIOS: tuple[tuple[float, float, float, str], ...] = SCENARIOS + (
     (6.65, 30.0, 280.0, "strike_slip"), (5.7, 13.0, 210.0, "reverse"), (6.9, 24.0, 660.0, "normal"), (6.15, 12.0, 510.0, "strike_slip"),
     (6.05, 73.0, 950.0, "reverse"), (7.45, 6.0, 460.0, "normal"), (5.5, 7.0, 520.0, "strike_slip"), (5.95, 75.0, 310.0, "reverse"),
 )  # fmt: skip
-#: The base model's residuals, as fractions of the published ones (by parameter, :data:`PARAMETERS` order): the Arias
-#: intensity scales every period alike, and at its published spread that common factor alone exceeds the NGA-West2
-#: covariance of distant periods; the filter's frequency, its drift and damping move the spectrum's shape in ways the
-#: NGA-West2 correlation does not (a shift of the predominant period raises the short periods and lowers the long ones).
-#: Narrowed, the base leaves most of the σ of ln Sa to the shape layer, whose correlation the fit sets (docs/site-motions.md).
-RESIDUAL_SCALE: dict[str, float] = dict.fromkeys(PARAMETERS, 0.5)
+#: The base model's residuals, as fractions of the published ones (by parameter): the Arias intensity scales every period
+#: alike, and at its published spread that common factor alone exceeds the NGA-West2 covariance of distant periods; the
+#: filter's frequency, its drift and its damping move the spectrum's shape as the NGA-West2 correlation does not (a shift
+#: of the predominant period raises the short periods and lowers the long ones, and leaves neighbouring short periods
+#: nearly independent). Narrowed, they leave most of the σ of ln Sa to the shape layer, whose correlation the fit sets;
+#: the durations (D5–95, t_mid) keep their published spread (docs/site-motions.md).
+RESIDUAL_SCALE: dict[str, float] = {"arias_intensity": 0.5, "d5_95": 1.0, "t_mid": 1.0, "f_mid": 0.4, "f_slope": 0.4, "zeta_f": 0.4}
 #: Fixed-point iterations of the fit (each simulates every scenario's motions once).
 ITERATIONS = 6
 #: Ridge weight of the shape layer's regressions (per coefficient, the intercept free).
