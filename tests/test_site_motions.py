@@ -256,7 +256,7 @@ def test_bad_input_is_a_one_line_error_naming_the_field(field, value, message):
 
 
 def test_normals_of_the_wrong_shape_are_refused():
-    with pytest.raises(SiteError, match=r"^normals: must be a finite array of shape \(n, 18 \+ n_time\)"):
+    with pytest.raises(SiteError, match=r"^normals: must be a finite array of shape \(n, 19 \+ n_time\)"):
         site_motions_from_normals(np.zeros((2, 8)), **SCENARIO)
 
 
