@@ -32,7 +32,7 @@ def test_the_scenario_kind_joins_the_map_from_standard_normals() -> None:
     """Issue 46: every synthetic kind is a = f(u); the seeded realization i is f(u_i), u_i its generator's first n normals."""
     assert "scenario_motions" in SYNTHETIC_TYPES
     motion = normal_motion({"type": "scenario_motions", **SCENARIO, **WINDOW, "seed": 5, "count": 3})
-    assert motion.dimension == 7 + 11 + 601 and motion.dt == 0.02  # 7 parameters, 11 spectral-shape gains, 601 samples
+    assert motion.dimension == 7 + 12 + 601 and motion.dt == 0.02  # 7 parameters, 12 spectral-shape gains, 601 samples
     u = realization_rng(5, 2).standard_normal(motion.dimension)
     np.testing.assert_array_equal(motion(u), scenario_motions(1, **WINDOW, **SCENARIO, seed=5, start=2).values[0])
     with pytest.raises(ValueError, match=r"^motion\.vs30: must be within 200-1100 \(the site-motion model's calibrated range\), got 150\.0$"):

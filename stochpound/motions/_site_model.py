@@ -68,7 +68,7 @@ PARAMETER_NORMALS = 7
 #: Units of the parameters as :func:`motion_parameters` returns them (``spectral_shape``: ln gains, one per SHAPE_PERIODS).
 UNITS = {"arias_intensity": "m/s", "d5_95": "s", "t_mid": "s", "f_mid": "Hz", "f_slope": "Hz/s", "zeta_f": "1", "f_corner": "Hz", "spectral_shape": "1"}
 #: Periods (s) of the spectral-shape layer's gains (the hazard-compatible calibration; data/site_motions/calibration.toml lists them).
-SHAPE_PERIODS = (0.1, 0.2, 0.3, 0.5, 0.75, 1.0, 1.5, 2.0, 3.0, 4.0, 5.0)
+SHAPE_PERIODS = (0.05, 0.1, 0.2, 0.3, 0.5, 0.75, 1.0, 1.5, 2.0, 3.0, 4.0, 5.0)
 #: Lowest filter frequency (Hz): ω_f(t) is held there where the linear trend would fall below it.
 F_MIN = 0.1
 #: Highest filter damping ratio (the marginal reaches 1, where h degenerates).
