@@ -172,3 +172,19 @@ def test_a_selection_misses_its_target_where_its_mean_or_std_of_ln_sa_is_off_by_
     std_ln[2, 1] -= TARGET_TOLERANCE * 1.1  # stripe 2: the std off
     mean_ln[0] += TARGET_TOLERANCE * 0.9  # stripe 0: within
     assert misses_target(mean_ln, std_ln, median, sigma).tolist() == [False, True, True]
+
+
+@pytest.mark.parametrize("kind", ["fitted", "given", "ruptures", None])
+def test_the_reports_selection_says_a_fitted_scenario_stands_in_for_a_disaggregation_and_that_its_cost_is_not_measured(monkeypatch, kind) -> None:
+    """The Intensity section's selection paragraph: for a fitted scenario, what it is (a calibration standing in for a disaggregation)
+    and that the store cannot measure its cost in g*; nothing for a scenario given, from ruptures or unrecorded."""
+    from stochpound.report.sections import _intensity
+
+    monkeypatch.setattr(_intensity, "scenario_kind", lambda store: kind)
+    with_consistency, without = (_intensity._fitted_text(xr.Dataset(), shown) for shown in (True, False))
+    if kind != "fitted":
+        assert with_consistency == without == ""
+        return
+    assert "a calibration standing in for a disaggregation of the site's hazard" in with_consistency
+    assert "What it costs in g* is not measured by this store" in with_consistency and "docs/measure-free.md" in with_consistency
+    assert "(how closely: the hazard consistency below)" in with_consistency and "hazard consistency" not in without
