@@ -202,43 +202,48 @@ def table(comparison: pd.DataFrame, tested: Collection[str]) -> list[str]:
     return lines
 
 
+def short_label(configuration: str) -> str:
+    """A configuration's label for the figure: "fixed pair, stiff neighbour", "isolated, stiff neighbour"."""
+    neighbour = configuration.split("neighbour ")[1].split(",")[0]
+    return f"{'fixed pair' if 'mu fixed' in configuration else 'isolated'}, {neighbour} neighbour"
+
+
 def figure(comparisons: list[Comparison], path: Path) -> None:
-    """Each measure's conditioned g* over the measure-free one (median, seeds' range), with the ×1.2 band and the measure-free interval."""
+    """Each measure's conditioned g* over the measure-free one (median, seeds' range), from the counts and from a lognormal demand
+    per stripe, with the ×1.2 band and the measure-free interval."""
     from matplotlib.figure import Figure
 
-    frames = [c.counts for c in comparisons]
-    configurations = [name for frame in frames for name in dict.fromkeys(frame.index.get_level_values(0))]
-    fig = Figure(figsize=(7.5, 2.0 + 1.1 * len(configurations)), layout="constrained")
-    axes = np.atleast_1d(fig.subplots(1, 2, sharey=True))
+    rows = sum(len(dict.fromkeys(c.counts.index.droplevel(2))) for c in comparisons)
+    fig = Figure(figsize=(7.5, 1.2 + 0.28 * rows + 0.2 * len(comparisons)), layout="constrained")
+    axes = fig.subplots(1, 2, sharey=True)
     for ax, target in zip(axes, (0.1, 0.02)):
-        y = 0
-        ticks, labels = [], []
-        for frame in frames:
-            for configuration in dict.fromkeys(frame.index.get_level_values(0)):
-                rows = frame.xs((configuration, target), level=(0, 2))
-                reference = rows["measure-free"].iloc[0]
-                ax.fill_betweenx([y - 0.4, y + len(rows) - 0.6], rows["lower"].iloc[0] / reference, rows["upper"].iloc[0] / reference, color="0.85", lw=0)
-                for measure_name, row in rows.iterrows():
-                    ax.errorbar(
-                        row["ratio"],
-                        y,
-                        xerr=[[row["ratio"] - row["lowest"] / reference], [row["highest"] / reference - row["ratio"]]],
-                        fmt="o" if row["agrees"] else "x",
-                        color="C0" if row["agrees"] else "C3",
-                        capsize=2,
-                    )
+        y, ticks, labels = 0.0, [], []
+        for comparison in comparisons:
+            for configuration in dict.fromkeys(comparison.counts.index.get_level_values(0)):
+                counts = comparison.counts.xs((configuration, target), level=(0, 2))
+                lognormal = comparison.lognormal.xs((configuration, target), level=(0, 2))
+                reference = counts["measure-free"].iloc[0]
+                ax.fill_betweenx([y - 0.4, y + len(counts) - 0.6], counts["lower"].iloc[0] / reference, counts["upper"].iloc[0] / reference, color="0.88", lw=0)
+                for (measure_name, row), (_, other) in zip(counts.iterrows(), lognormal.iterrows()):
+                    for shift, data, marker in ((-0.15, row, "o"), (0.15, other, "^")):
+                        span = [[data["ratio"] - data["lowest"] / reference], [data["highest"] / reference - data["ratio"]]]
+                        ax.errorbar(data["ratio"], y + shift, xerr=span, fmt=marker, ms=4, capsize=2, color="C0" if data["agrees"] else "C3")
                     ticks.append(y)
-                    labels.append(f"{configuration.replace('neighbour ', '')}: {measure_name}")
+                    labels.append(f"{short_label(configuration)}: {measure_name}")
                     y += 1
-                y += 0.5
+                y += 0.6
         for bound in (1 / TOLERANCE, 1.0, TOLERANCE):
             ax.axvline(bound, color="k", lw=0.8 if bound == 1.0 else 0.6, ls="-" if bound == 1.0 else "--")
         ax.set_xscale("log")
+        ax.set_xlim(0.25, 2.0)
+        ax.set_xticks([0.3, 0.5, 1 / TOLERANCE, 1.0, TOLERANCE, 2.0], ["0.3", "0.5", f"1/{TOLERANCE:g}", "1", f"{TOLERANCE:g}", "2"])
+        ax.minorticks_off()
         ax.set_title(f"g* at {target:.0%} in 50 years", fontsize=9)
         ax.set_xlabel("conditioned g* / measure-free g*", fontsize=8)
-        ax.set_yticks(ticks, labels, fontsize=7)
-        ax.invert_yaxis()
-        ax.tick_params(axis="x", labelsize=7)
+        ax.tick_params(labelsize=7)
+        ax.grid(True, axis="x", lw=0.3, color="0.85")
+    axes[0].set_yticks(ticks, labels)
+    axes[0].invert_yaxis()  # shared: once
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=130)
 
@@ -269,9 +274,9 @@ def section(comparisons: list[Comparison], settings: argparse.Namespace, info: d
         "",
         f"![Each measure's conditioned g* over the measure-free g*]({shown})",
         "",
-        f"*Figure: per configuration and measure, the conditioned g* (from the counts, the risk chain's) over the measure-free g*: the "
-        f"median over the seeds (circle: within ×{TOLERANCE:g}, the dashed lines; cross: not) and the seeds' range (bar); grey, the "
-        "measure-free g*'s 95 % interval.*",
+        f"*Figure: per configuration and measure, the conditioned g* over the measure-free g*, from the counts (the risk chain's; "
+        f"circle) and from a lognormal demand per stripe (triangle): the median over the seeds (blue within ×{TOLERANCE:g}, the dashed "
+        "lines; red not) and the seeds' range (bar); grey, the measure-free g*'s 95 % interval over the measure-free g*.*",
     ]
     for comparison in comparisons:
         name = comparison.flagship.file
