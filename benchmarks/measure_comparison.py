@@ -47,8 +47,16 @@ SECTION = Section("<!-- measure comparison: start -->", "<!-- measure comparison
 FIGURE = REPOSITORY / "docs" / "figures" / "measure_comparison.png"
 """The figure the section shows."""
 SITE = "demo_three_sources"
-MEASURES = {"PGA": ("pga", None), "PSA(0.3 s)": ("psa", 0.3), "PSA(0.5 s)": ("psa", 0.5), "PSA(1 s)": ("psa", 1.0), "PSA(2 s)": ("psa", 2.0), "PSA(3 s)": ("psa", 3.0)}
-"""Candidate measures: stochpound's measure and period (s)."""
+MEASURES = {
+    "PGA": ("pga", None),
+    "PSA(0.3 s)": ("psa", 0.3),
+    "PSA(0.5 s)": ("psa", 0.5),
+    "PSA(1 s)": ("psa", 1.0),
+    "PSA(2 s)": ("psa", 2.0),
+    "PSA(3 s)": ("psa", 3.0),
+    "Sa_avg(0.5–4 s)": ("sa_avg", (0.5, 0.75, 1.0, 1.5, 2.0, 3.0, 4.0)),
+}
+"""Candidate measures: stochpound's measure and period (s; Sa_avg's periods: the band the isolated building's closure follows)."""
 RETURN_PERIODS = (25.0, 72.0, 475.0, 2475.0, 10000.0)
 """Return periods (yr) of the stripes."""
 TOLERANCE = 1.2
@@ -79,7 +87,9 @@ class Flagship:
 
 FLAGSHIPS = (
     Flagship("fixed", "fixed_pair.toml", 'gap = [inf]\nmu = { values = [inf], buildings = ["B1"] }', ("PGA", "PSA(0.3 s)", "PSA(1 s)")),
-    Flagship("isolated", "isolated.toml", 'gap = [inf]\nmu = { values = [0.05], buildings = ["B1"] }\nneighbour = ["stiff"]\nmoat = ["none"]', ("PGA", "PSA(1 s)", "PSA(2 s)", "PSA(3 s)")),
+    Flagship(
+        "isolated", "isolated.toml", 'gap = [inf]\nmu = { values = [0.05], buildings = ["B1"] }\nneighbour = ["stiff"]\nmoat = ["none"]', ("PGA", "PSA(1 s)", "PSA(2 s)", "PSA(3 s)", "Sa_avg(0.5–4 s)")
+    ),
 )
 """The fixed pair beside the stiff and the flexible neighbour (B1's T1 0.30 s); B1 isolated (μ 0.05, no wall, T_b 3.0 s) beside the stiff one."""
 
@@ -92,7 +102,8 @@ def experiment_text(flagship: Flagship, measure: str, seed: int, motions: int) -
     scene = text[text.index("\n[scene]") : text.index("\n[grid]")]
     kind, period = MEASURES[measure]
     levels = RuptureSite.bundled(SITE).intensity_at(kind, period, [1.0 / t for t in RETURN_PERIODS])
-    lines = f'measure = "{kind}"' + ("" if period is None else f"\nperiod = {period}")
+    field = "periods" if isinstance(period, tuple) else "period"
+    lines = f'measure = "{kind}"' + ("" if period is None else f"\n{field} = {list(period) if field == 'periods' else period}")
     return (
         f'[experiment]\nname = "compare_{flagship.name}"\nstudied = "B1"\n{scene}\n[grid]\n{flagship.grid}\n'
         '[[records]]\nsuite = "fema_p695_far_field"\n[[records]]\nsuite = "fema_p695_near_field"\n'
@@ -107,7 +118,7 @@ def conditioned(folder: Path, flagship: Flagship, measure: str, seed: int, motio
     from stochpound.experiment import load_experiment, run_experiment
     from stochpound.risk import store_risk
 
-    code = measure.replace("(", "").replace(" s)", "").replace(".", "p").replace(" ", "").lower()
+    code = measure.replace("(", "").replace(" s)", "").replace(".", "p").replace(" ", "").replace("–", "-").lower()
     path = folder / f"{flagship.name}_{code}_seed{seed}.toml"
     path.write_text(experiment_text(flagship, measure, seed, motions))
     run = run_experiment(load_experiment(path), workers=workers if workers > 1 else 0, progress=False)
