@@ -188,3 +188,18 @@ def test_the_reports_selection_says_a_fitted_scenario_stands_in_for_a_disaggrega
     assert "a calibration standing in for a disaggregation of the site's hazard" in with_consistency
     assert "What it costs in g* is not measured by this store" in with_consistency and "docs/measure-free.md" in with_consistency
     assert "(how closely: the hazard consistency below)" in with_consistency and "hazard consistency" not in without
+
+
+def test_a_fitted_stores_report_says_so_from_its_definition(tmp_path) -> None:
+    """End to end: the store of a fitted site's experiment, read back, gives the Intensity section the fitted scenario's words."""
+    from stochpound import open_store
+    from stochpound.experiment._runner import load_experiment, run_experiment
+    from stochpound.report.render import Paragraph
+    from stochpound.report.sections._intensity import intensity_section
+    from tests.helpers import write_experiment
+
+    experiment = load_experiment(write_experiment(tmp_path, _text(FITTED_SELECTION.replace("motions = 4", "motions = 2"), FITTED_SITE), "fitted.toml"))
+    report = run_experiment(experiment, workers=0, progress=False)
+    store = open_store(report.store).load()
+    text = " ".join(block.text for block in intensity_section("fitted", store).blocks if isinstance(block, Paragraph))
+    assert 'The scenario was fitted to the site\'s hazard curves ([site] scenario = "fitted"): a calibration standing in for a' in text
