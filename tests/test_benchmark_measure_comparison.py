@@ -1,5 +1,5 @@
-"""The measure comparison benchmark's experiments are at the demo site's ruptures (site and hazard), its stripes at the site's
-intensities, and its command writes its section (benchmarks/measure_comparison.py)."""
+"""The measure comparison benchmark's experiments are the risk flagship's scenes at the demo site's ruptures (site and hazard), its
+stripes at the site's intensities, and its command writes its section and figure (benchmarks/measure_comparison.py)."""
 
 from __future__ import annotations
 
@@ -9,26 +9,42 @@ import numpy as np
 import pytest
 
 from benchmarks import measure_comparison
+from benchmarks.timing import REPOSITORY
 from stochpound.analysis import RuptureSite
 
+CASES = [(flagship, name) for flagship in measure_comparison.FLAGSHIPS for name in flagship.measures]
 
-@pytest.mark.parametrize("name", ["PGA", "PSA(1 s)"])
-def test_each_experiment_is_at_the_demo_sites_ruptures_and_levels(name):
-    table = tomllib.loads(measure_comparison.experiment_text(name, seed=2, motions=7))
+
+@pytest.mark.parametrize(("flagship", "name"), CASES, ids=[f"{f.name}-{n}" for f, n in CASES])
+def test_each_experiment_is_the_flagships_scene_at_the_demo_sites_ruptures_and_levels(flagship, name):
+    table = tomllib.loads(measure_comparison.experiment_text(flagship, name, seed=2, motions=7))
     assert table["site"] == {"ruptures": measure_comparison.SITE} and table["hazard"] == {"ruptures": measure_comparison.SITE}
     intensity = table["intensity"]
     kind, period = measure_comparison.MEASURES[name]
-    assert (intensity["measure"], intensity.get("period"), intensity["seed"], intensity["motions"]) == (kind, period, 2, 7)
+    periods = tuple(intensity["periods"]) if "periods" in intensity else intensity.get("period")  # Sa_avg's band, or PSA's period
+    assert (intensity["measure"], periods, intensity["seed"], intensity["motions"]) == (kind, period, 2, 7)
+    assert (intensity["selection"], intensity["method"]) == ("conditional_spectrum", "stripes")
     expected = RuptureSite.bundled(measure_comparison.SITE).intensity_at(kind, period, 1.0 / np.array(measure_comparison.RETURN_PERIODS))
     np.testing.assert_allclose(intensity["levels"], expected, rtol=1e-5)  # written to 6 significant digits
+    flagship_table = tomllib.loads((REPOSITORY / "experiments" / "risk" / flagship.file).read_text())
+    assert table["scene"] == flagship_table["scene"] and table["variants"] == flagship_table["variants"]
     assert table["grid"]["gap"] == [float("inf")]
 
 
+def test_the_configurations_are_the_issues():
+    fixed, isolated = (tomllib.loads(measure_comparison.experiment_text(f, "PGA", seed=1, motions=40))["grid"] for f in measure_comparison.FLAGSHIPS)
+    assert fixed["mu"]["values"] == [float("inf")] and "neighbour" not in fixed  # both neighbours, fixed bases
+    assert isolated["mu"] == {"values": [0.05], "buildings": ["B1"]} and isolated["neighbour"] == ["stiff"] and isolated["moat"] == ["none"]
+
+
 @pytest.mark.slow
-def test_a_reduced_run_writes_the_section(tmp_path):
-    out = tmp_path / "benchmarks.md"
+def test_a_reduced_run_writes_the_section_and_its_figure(tmp_path):
+    out, figure = tmp_path / "benchmarks.md", tmp_path / "figure.png"
     out.write_text("# Benchmarks\n")
-    assert measure_comparison.main(["--measures", "PGA", "--seeds", "1", "--motions", "3", "--runs", "28", "--out", str(out)]) == 0
+    arguments = ["--flagships", "isolated", "--measures", "PGA", "--seeds", "1", "--motions", "3", "--runs", "28", "28"]
+    assert measure_comparison.main([*arguments, "--out", str(out), "--figure", str(figure)]) == 0
     section = measure_comparison.SECTION.kept(out.read_text())
     rows = [line for line in section.splitlines() if line.startswith("| ") and "in 50 yr | PGA |" in line]
     assert len(rows) == 2 * 2  # two targets, g* from the counts and from the lognormal demand
+    assert all(row.startswith("| neighbour stiff, moat none, mu 0.05 |") for row in rows)
+    assert "3–3 motions a stripe" in section and figure.stat().st_size > 0

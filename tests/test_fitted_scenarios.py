@@ -172,3 +172,34 @@ def test_a_selection_misses_its_target_where_its_mean_or_std_of_ln_sa_is_off_by_
     std_ln[2, 1] -= TARGET_TOLERANCE * 1.1  # stripe 2: the std off
     mean_ln[0] += TARGET_TOLERANCE * 0.9  # stripe 0: within
     assert misses_target(mean_ln, std_ln, median, sigma).tolist() == [False, True, True]
+
+
+@pytest.mark.parametrize("kind", ["fitted", "given", "ruptures", None])
+def test_the_reports_selection_says_a_fitted_scenario_stands_in_for_a_disaggregation_and_that_its_cost_is_not_measured(monkeypatch, kind) -> None:
+    """The Intensity section's selection paragraph: for a fitted scenario, what it is (a calibration standing in for a disaggregation)
+    and that the store cannot measure its cost in g*; nothing for a scenario given, from ruptures or unrecorded."""
+    from stochpound.report.sections import _intensity
+
+    monkeypatch.setattr(_intensity, "scenario_kind", lambda store: kind)
+    with_consistency, without = (_intensity._fitted_text(xr.Dataset(), shown) for shown in (True, False))
+    if kind != "fitted":
+        assert with_consistency == without == ""
+        return
+    assert "a calibration standing in for a disaggregation of the site's hazard" in with_consistency
+    assert "What it costs in g* is not measured by this store" in with_consistency and "docs/measure-free.md" in with_consistency
+    assert "(how closely: the hazard consistency below)" in with_consistency and "hazard consistency" not in without
+
+
+def test_a_fitted_stores_report_says_so_from_its_definition(tmp_path) -> None:
+    """End to end: the store of a fitted site's experiment, read back, gives the Intensity section the fitted scenario's words."""
+    from stochpound import open_store
+    from stochpound.experiment._runner import load_experiment, run_experiment
+    from stochpound.report.render import Paragraph
+    from stochpound.report.sections._intensity import intensity_section
+    from tests.helpers import write_experiment
+
+    experiment = load_experiment(write_experiment(tmp_path, _text(FITTED_SELECTION.replace("motions = 4", "motions = 2"), FITTED_SITE), "fitted.toml"))
+    report = run_experiment(experiment, workers=0, progress=False)
+    store = open_store(report.store).load()
+    text = " ".join(block.text for block in intensity_section("fitted", store).blocks if isinstance(block, Paragraph))
+    assert 'The scenario was fitted to the site\'s hazard curves ([site] scenario = "fitted"): a calibration standing in for a' in text

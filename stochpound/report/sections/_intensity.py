@@ -68,10 +68,10 @@ def intensity_section(name: str, store: xr.Dataset, gaps: Sequence[float] = ()) 
     if "intensity" in store.dims:
         section.add(_stripe_table(name, store, setting))
         section.add(_stripe_figure(name, store, setting, gaps))
-        if "target_median" in store:
-            section.add(Paragraph(_selection_text(store, setting)))
-            section.add(_selection_figure(name, store, setting))
         consistency = site_consistency(store)
+        if "target_median" in store:
+            section.add(Paragraph(_selection_text(store, setting) + _fitted_text(store, bool(consistency))))
+            section.add(_selection_figure(name, store, setting))
         if consistency:
             section.add(Paragraph(_consistency_text(consistency, setting)))
             section.add(_consistency_figure(name, consistency, setting))
@@ -280,6 +280,19 @@ def _selection_text(store: xr.Dataset, setting: Intensity) -> str:
     return (f"The motions of every stripe were chosen for the site: the conditional spectrum of the stripe's scenario (Vs30 "
             f"{float(store['site_vs30'].values[0]):g} m/s, {store['site_mechanism'].values[0]} faulting): {scenarios}.{truncation} {verdict}"
             f"{_holdings(store, setting)}")
+
+
+def _fitted_text(store: xr.Dataset, consistency: bool) -> str:
+    """For stripes of a scenario fitted to the site's curves: what it stands for, and that this store cannot say what it costs in g*
+    ("" for any other scenario); ``consistency``: the section shows the hazard consistency across the stripes."""
+    if scenario_kind(store) != "fitted":
+        return ""
+    measured = " (how closely: the hazard consistency below)" if consistency else ""
+    return (" The scenario was fitted to the site's hazard curves ([site] scenario = \"fitted\"): a calibration standing in for a "
+            "disaggregation of the site's hazard, which the experiment does not give. One scenario serves every stripe, the one whose "
+            f"conditional spectra give back the site's other curves best{measured}; it is not the earthquakes that cause each level, "
+            "and every g* of this store is conditioned on it. What it costs in g* is not measured by this store: that takes the site's "
+            "earthquakes, a site of ruptures, where the answer without an intensity measure checks the chain (docs/measure-free.md).")
 
 
 def _holdings(store: xr.Dataset, setting: Intensity) -> str:
