@@ -587,8 +587,7 @@ def _advance_quiet(mode_id, n, substeps, step, propagate, chebyshev, rate, guard
             _sub_step_energy(z0, propagated, is_open, impact[IMPULSE], running)
             _arm_where_negative(values1, threshold, tolerance, rearmable, disarmed)
             if _offer_end_monitors(monitors0, monitors1, monitor_rates0, monitor_rates1, t1 - t0, t1, peaks):
-                flow = Flow(rate, guard, force, monitor, coefficients, harmonic if is_harmonic else motion.coefficients[k], times[k], is_harmonic,
-                            t0, 2.0 / step)
+                flow = Flow(rate, guard, force, monitor, coefficients, harmonic if is_harmonic else motion.coefficients[k], times[k], is_harmonic, t0, 2.0 / step)
                 _sub_step_monitors(flow, chebyshev, z0, t1, monitors0, monitors1, monitor_rates0, monitor_rates1, peaks, work)
             _copy(values1, values0)
             _copy(rates1, rates0)
