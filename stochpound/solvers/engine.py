@@ -50,7 +50,12 @@ compiled once without Python wrappers (:data:`INTERNAL`), and none is inlined
 by numba: LLVM inlines the small helpers and keeps each phase a function of
 its own, which compiles in a fifth less time than the phases inlined into
 :func:`run_engine` (its one huge function then took most of LLVM's time), with
-the same results, bit for bit, and the same speed (docs/benchmarks.md, "Start-up"); no
+the same results, bit for bit (docs/benchmarks.md, "Start-up"). A call LLVM
+keeps passes every array as its fields (a flow's arrays are a hundred words on
+the stack), so the quiet loop builds a flow and passes it only on a sub-step
+where a monitor may peak (:func:`_offer_end_monitors`): passing it on every
+sub-step made the phases compiled on their own 1.1 to 1.2 times slower than
+inlined (docs/benchmarks.md, "Against an earlier revision"); no
 compile-time constant is passed to a helper (it would compile a second
 specialisation), and no array is assigned to an array slice (its error
 message alone compiles string formatting). Reference counting would make up
@@ -486,17 +491,30 @@ def _any_maximum_may_beat(values0, values1, rates0, rates1, h, peaks):
 
 
 @njit(**INTERNAL)
-def _sub_step_monitors(flow, chebyshev, z0, t1, values0, values1, rates0, rates1, peaks, work):
-    """The monitors' peaks over an exact sub-step [flow.t0, t1] from z0 (:func:`_monitor_peaks`).
+def _offer_end_monitors(values0, values1, rates0, rates1, h, t1, peaks):
+    """Offer the monitors' values at the end t1 of a step of h seconds as their peaks; True instead when a maximum inside may beat one.
 
-    The sub-step's Chebyshev coefficients (``chebyshev`` z0, into
-    ``flow.coefficients``) are computed only when a maximum inside may beat a peak.
+    On True nothing is offered: the caller locates the peaks on the flow
+    (:func:`_sub_step_monitors`). Most sub-steps have no such maximum, and
+    this test takes no flow: the quiet loop builds one, and passes its
+    arrays to a call, only for the few that do.
     """
-    if _any_maximum_may_beat(values0, values1, rates0, rates1, t1 - flow.t0, peaks):
-        _product(chebyshev, z0, flow.coefficients)
-        _monitor_peaks(flow, t1, values0, values1, rates0, rates1, peaks, work)
-    else:
-        _offer_monitors(values1, t1, peaks)
+    if _any_maximum_may_beat(values0, values1, rates0, rates1, h, peaks):
+        return True
+    _offer_monitors(values1, t1, peaks)
+    return False
+
+
+@njit(**INTERNAL)
+def _sub_step_monitors(flow, chebyshev, z0, t1, values0, values1, rates0, rates1, peaks, work):
+    """The monitors' peaks over an exact sub-step [flow.t0, t1] from z0, located on the flow (:func:`_monitor_peaks`).
+
+    Called when :func:`_offer_end_monitors` says a maximum inside may beat a
+    peak: the sub-step's Chebyshev coefficients (``chebyshev`` z0, into
+    ``flow.coefficients``) are computed only then.
+    """
+    _product(chebyshev, z0, flow.coefficients)
+    _monitor_peaks(flow, t1, values0, values1, rates0, rates1, peaks, work)
 
 
 @njit(**INTERNAL)
@@ -568,9 +586,9 @@ def _advance_quiet(mode_id, n, substeps, step, propagate, chebyshev, rate, guard
                 return
             _sub_step_energy(z0, propagated, is_open, impact[IMPULSE], running)
             _arm_where_negative(values1, threshold, tolerance, rearmable, disarmed)
-            flow = Flow(rate, guard, force, monitor, coefficients, harmonic if is_harmonic else motion.coefficients[k], times[k], is_harmonic, t0,
-                        2.0 / step)
-            _sub_step_monitors(flow, chebyshev, z0, t1, monitors0, monitors1, monitor_rates0, monitor_rates1, peaks, work)
+            if _offer_end_monitors(monitors0, monitors1, monitor_rates0, monitor_rates1, t1 - t0, t1, peaks):
+                flow = Flow(rate, guard, force, monitor, coefficients, harmonic if is_harmonic else motion.coefficients[k], times[k], is_harmonic, t0, 2.0 / step)
+                _sub_step_monitors(flow, chebyshev, z0, t1, monitors0, monitors1, monitor_rates0, monitor_rates1, peaks, work)
             _copy(values1, values0)
             _copy(rates1, rates0)
             _copy(monitors1, monitors0)
@@ -1310,7 +1328,8 @@ def _advance_span(m, n, modes, codes, substeps, step, propagate, chebyshev, rate
         if full and not _suspect(values0, values1, rates0, rates1, t1 - t0, threshold, tolerance) and not any_open:
             _sub_step_energy(z0, propagated, is_open, impact[IMPULSE], running)
             _arm_where_negative(values1, threshold, tolerance, rearmable, disarmed)
-            _sub_step_monitors(flow, chebyshev, z0, t1, monitors0, monitors1, monitor_rates0, monitor_rates1, peaks, scratch[2])
+            if _offer_end_monitors(monitors0, monitors1, monitor_rates0, monitor_rates1, t1 - t0, t1, peaks):
+                _sub_step_monitors(flow, chebyshev, z0, t1, monitors0, monitors1, monitor_rates0, monitor_rates1, peaks, scratch[2])
             _copy(x1, x)
             continue
         if full:
