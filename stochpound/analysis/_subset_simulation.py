@@ -103,11 +103,15 @@ class SubsetLevel:
         (chains, states a chain) responses: (N, 1) for level 0.
     acceptance : float
         Fraction of the chains' candidates accepted (1 for level 0).
+    seeds : np.ndarray or None
+        (chains,) the previous level's sample that seeded each chain, an index into its responses read chain by chain
+        (None for level 0): the levels' genealogy, which the CoV reads (:func:`exceedance`).
     """
 
     threshold: float
     responses: np.ndarray
     acceptance: float
+    seeds: np.ndarray | None = None
 
 
 @dataclass(frozen=True)
@@ -356,9 +360,11 @@ def subset_simulation(
     Returns
     -------
     xarray.Dataset
-        Over ``threshold``: ``probability`` (of the response exceeding it) and
-        ``cov`` (its estimated coefficient of variation, NaN where the
-        probability is 0); attrs: ``runs`` (solver runs, or evaluations of g),
+        Over ``threshold``: ``probability`` (of the response exceeding it),
+        ``cov`` (its estimated coefficient of variation from the levels'
+        genealogy, :func:`genealogy_cov`, NaN where the probability is 0) and
+        ``cov_au_beck`` (Au & Beck's, which leaves out the correlation
+        between levels and is too small far down); attrs: ``runs`` (solver runs, or evaluations of g),
         ``level_thresholds``, ``gamma`` and ``acceptance`` per level,
         ``target_reached`` (1 if the last level reached the largest
         threshold or the target probability), ``target_probability`` (if given), ``p0``, ``samples_per_level``, ``seed``,
@@ -398,7 +404,10 @@ def subset_simulation(
         attrs["scale"] = np.array(scales, dtype=float)
     if target_probability is not None:
         attrs["target_probability"] = float(target_probability)
-    return curve_dataset(values, probability, cov, units, attrs)
+    curve = curve_dataset(values, probability, cov, units, attrs)
+    curve["cov_au_beck"] = xr.Variable(("threshold",), au_beck_cov(levels, values),
+                                       {"units": "1", "long_name": "Au & Beck's coefficient of variation (the levels taken as uncorrelated)"})
+    return curve
 
 
 def curve_dataset(thresholds: np.ndarray, probability: np.ndarray, cov: np.ndarray, units: str, attrs: Mapping[str, Any]) -> xr.Dataset:
@@ -463,7 +472,7 @@ def _levels(sampler: SubsetSampler, threshold: float | None, target: float | Non
         flat = states.reshape(-1, sampler.dimension)
         run, scale = sampler.run_level(len(levels), flat[seeds], levels[-1].responses.reshape(-1)[seeds], bound, scales[-1])
         runs += len(seeds) * (sampler.length - 1)
-        levels.append(SubsetLevel(bound, run.responses, run.accepted / (len(seeds) * (sampler.length - 1)) if sampler.length > 1 else 1.0))
+        levels.append(SubsetLevel(bound, run.responses, run.accepted / (len(seeds) * (sampler.length - 1)) if sampler.length > 1 else 1.0, seeds))
         states = run.states
         scales.append(scale)
     return levels, runs, scales[1:]
@@ -489,19 +498,67 @@ def _evaluate(function: Callable[[np.ndarray], np.ndarray], u: np.ndarray) -> np
 
 
 def exceedance(levels: Sequence[SubsetLevel], thresholds: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """P(Y > b) and its coefficient of variation (Au & Beck's) for every threshold b, from a run's levels."""
+    """P(Y > b) and its coefficient of variation from the levels' genealogy (:func:`genealogy_cov`) for every threshold b, from a run's levels."""
+    return _probabilities(levels, np.asarray(thresholds, dtype=float)), genealogy_cov(levels, thresholds)
+
+
+def genealogy_cov(levels: Sequence[SubsetLevel], thresholds: np.ndarray) -> np.ndarray:
+    """The coefficient of variation of P̂(Y > b) from the levels' genealogy, the correlation between levels included.
+
+    Every sample of the last level used for b (level m) descends from one
+    sample i of level 0 (its ancestor, followed through each chain's seed),
+    and P̂(Y > b) = Σ_i A_i, A_i the part of the estimate from the samples
+    above b that descend from i (all samples of level m weigh the same:
+    p_0 ⋯ p_{m−1} / N_m). Treating the N ancestors' families as exchangeable
+    parts of the estimate, as the genealogy estimators of sequential Monte
+    Carlo do (Chan & Lai 2013; Lee & Whiteley 2018; consistent for adaptive
+    levels, Du & Guyader 2021), δ² = Σ_i (A_i / P̂)² − 1/N = Σ_i s_i² − 1/N,
+    s_i the share of the level-m samples above b that descend from i. At
+    level 0 it is (1 − p)/(pN), at level 1 exactly Au & Beck's δ
+    (:func:`au_beck_cov`) with γ from the chains; further down it adds the
+    correlation between the levels that Au & Beck's δ leaves out (a level's
+    chains start from the previous level's samples). NaN where P̂ = 0.
+    """
+    bounds = np.array([level.threshold for level in levels[1:]])
+    ancestors = _ancestors(levels)
+    cov = np.empty(len(thresholds))
+    for index, b in enumerate(np.asarray(thresholds, dtype=float)):
+        level = int(np.searchsorted(bounds, b, side="right"))
+        above = ancestors[level][levels[level].responses > b]
+        shares = np.bincount(above, minlength=levels[0].responses.size) / above.size if above.size else None
+        cov[index] = math.sqrt(max(0.0, float(np.sum(shares * shares)) - 1.0 / levels[0].responses.size)) if shares is not None else math.nan
+    return cov
+
+
+def au_beck_cov(levels: Sequence[SubsetLevel], thresholds: np.ndarray) -> np.ndarray:
+    """Au & Beck's (2001) coefficient of variation of P̂(Y > b), the levels taken as uncorrelated: δ² = Σ_j δ_j², δ_j² = (1 − p_j)/(p_j N_j)(1 + γ_j)."""
     bounds = np.array([level.threshold for level in levels[1:]])
     steps = _steps(levels)
     variances = [(1.0 - p) / (p * level.responses.size) * (1.0 + g) for p, level, g in zip(steps, levels, _step_gammas(levels))]
-    probability, cov = np.empty(len(thresholds)), np.empty(len(thresholds))
-    for index, b in enumerate(thresholds):
+    cov = np.empty(len(thresholds))
+    for index, b in enumerate(np.asarray(thresholds, dtype=float)):
         level = int(np.searchsorted(bounds, b, side="right"))  # the levels conditioned on thresholds <= b
         indicator = levels[level].responses > b
         p = float(indicator.mean())
-        probability[index] = math.prod(steps[:level]) * p
         own = (1.0 - p) / (p * indicator.size) * (1.0 + (_gamma(indicator) if level else 0.0)) if p > 0.0 else math.nan
         cov[index] = math.sqrt(sum(variances[:level]) + own)
-    return probability, cov
+    return cov
+
+
+def _ancestors(levels: Sequence[SubsetLevel]) -> list[np.ndarray]:
+    """For each level, the level-0 sample (0 .. N − 1) each of its samples descends from, shaped as its responses.
+
+    Raises
+    ------
+    ValueError
+        When a level after level 0 does not name its chains' seeds.
+    """
+    ancestors = [np.arange(levels[0].responses.size).reshape(levels[0].responses.shape)]
+    for index, level in enumerate(levels[1:], start=1):
+        if level.seeds is None or len(level.seeds) != level.responses.shape[0]:
+            raise ValueError(f"seeds: level {index} must name the previous level's sample that seeded each of its {level.responses.shape[0]} chains")
+        ancestors.append(np.broadcast_to(ancestors[-1].reshape(-1)[np.asarray(level.seeds)][:, None], level.responses.shape))
+    return ancestors
 
 
 def curve_thresholds(levels: Sequence[SubsetLevel], target: float | None, points: int = 25) -> np.ndarray:
@@ -560,7 +617,7 @@ def exceedance_quantiles(levels: Sequence[SubsetLevel], probabilities: Sequence[
 
 
 def _probabilities(levels: Sequence[SubsetLevel], thresholds: np.ndarray) -> np.ndarray:
-    """P̂(Y > b) at sorted thresholds b (without its CoV: many thresholds at once)."""
+    """P̂(Y > b) at thresholds b (without its CoV: many thresholds at once)."""
     bounds = np.array([level.threshold for level in levels[1:]])
     scale = np.cumprod([1.0, *_steps(levels)])
     which = np.searchsorted(bounds, thresholds, side="right")
