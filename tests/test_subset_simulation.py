@@ -192,14 +192,15 @@ def test_adaptive_conditional_sampling_does_not_draw_its_spread_from_the_seeds()
 
 @pytest.mark.slow
 def test_repeated_runs_scatter_as_their_reported_cov():
-    """20 runs at 2.1 (P ≈ 3e-5): every estimate within 3 reported CoV of the reference, the mean reported CoV within 35 % of the empirical one."""
+    """20 runs at 2.1 (P ≈ 3e-5): every estimate within 3 reported CoV of the reference, the mean reported CoV (the genealogy's)
+    within 25 % of the empirical one (about 1.1 here; Au & Beck's about 1.0)."""
     reference, reference_cov = _isee(2.1, 2000, seed=5)
     runs = [subset_simulation(_peak, thresholds=[2.1], samples_per_level=1000, p0=0.1, seed=seed, dimension=N_TIME) for seed in range(20)]
     estimates = np.array([r.probability.values[0] for r in runs])
     reported = np.array([r.cov.values[0] for r in runs])
     assert np.all(np.abs(estimates - reference) < 3.0 * np.hypot(reported, reference_cov) * reference)
     empirical = estimates.std(ddof=1) / reference
-    assert abs(reported.mean() / empirical - 1.0) < 0.35
+    assert abs(reported.mean() / empirical - 1.0) < 0.25
 
 
 def test_the_scene_runs_the_oscillator_of_the_reference():
