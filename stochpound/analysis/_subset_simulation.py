@@ -525,6 +525,23 @@ def genealogy_cov(levels: Sequence[SubsetLevel], thresholds: np.ndarray) -> np.n
     (:func:`au_beck_cov`) with γ from the chains; further down it adds the
     correlation between the levels that Au & Beck's δ leaves out (a level's
     chains start from the previous level's samples). NaN where P̂ = 0.
+
+    Parameters
+    ----------
+    levels : sequence of SubsetLevel
+        A run's levels, each after level 0 with its chains' ``seeds``.
+    thresholds : np.ndarray
+        Thresholds b, in the response's units.
+
+    Returns
+    -------
+    np.ndarray
+        δ at each threshold.
+
+    Raises
+    ------
+    ValueError
+        Naming ``seeds``, when a level after level 0 does not name its chains' seeds.
     """
     bounds = np.array([level.threshold for level in levels[1:]])
     ancestors = _ancestors(levels)
