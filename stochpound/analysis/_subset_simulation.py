@@ -85,9 +85,8 @@ PROPOSALS = {
 """The chains' proposals (``proposal``) and the method each names."""
 UNCERTIFIED = {
     "acs": "proposal: adaptive conditional sampling is not certified on a run's peaks over time (closures, drifts, base displacements, "
-           "impact forces): on Au & Beck's oscillator and a linear pair its estimates were unbiased but its Au & Beck CoV 0.64–0.79 of the "
-           "empirical one at 3e-5 to 6e-7, and its genealogy CoV is not measured there (docs/rare-events.md); use proposal \"mma\" for "
-           "certified intervals",
+           "impact forces): on Au & Beck's oscillator and a linear pair its estimates were unbiased but its reported CoV 0.73–0.86 of the "
+           "empirical one at 3e-5 to 6e-7, 0.73 at the pair's deepest row (docs/rare-events.md); use proposal \"mma\" for certified intervals",
 }
 """The proposals not certified on a scene's responses, with the warning :func:`warn_uncertified` gives."""
 ADAPTATION_SHARE = 0.1
