@@ -517,8 +517,8 @@ def genealogy_cov(levels: Sequence[SubsetLevel], thresholds: np.ndarray) -> np.n
     above b that descend from i (all samples of level m weigh the same:
     p_0 ⋯ p_{m−1} / N_m). Treating the N ancestors' families as exchangeable
     parts of the estimate, as the genealogy estimators of sequential Monte
-    Carlo do (Chan & Lai 2013; Lee & Whiteley 2018; consistent for adaptive
-    levels, Du & Guyader 2021), δ² = Σ_i (A_i / P̂)² − 1/N = Σ_i s_i² − 1/N,
+    Carlo do (Chan & Lai 2013; Lee & Whiteley 2018; Du & Guyader 2021 for
+    adaptive levels), δ² = Σ_i (A_i / P̂)² − 1/N = Σ_i s_i² − 1/N,
     s_i the share of the level-m samples above b that descend from i. At
     level 0 it is (1 − p)/(pN), at level 1 exactly Au & Beck's δ
     (:func:`au_beck_cov`) with γ from the chains; further down it adds the
