@@ -129,6 +129,7 @@ def test_adaptive_conditional_sampling_resumes_to_the_run_made_in_one_process(tm
                               proposal="acs")
     assert np.array_equal(alone.attrs["level_thresholds"], store["level_threshold"].values[1:]) and alone.attrs["runs"] == store.attrs["runs"]
     assert np.array_equal(alone.attrs["acceptance"], store["level_acceptance"].values[1:])
+    assert np.array_equal(alone.threshold.values, store.threshold.values) and np.array_equal(alone.cov.values, store["cov"].values)  # the same genealogy
     assert store.attrs["method"].startswith("subset simulation (Au & Beck 2001), adaptive conditional sampling")
     from stochpound.report.sections._rare_events import _conditions
 

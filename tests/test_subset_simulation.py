@@ -25,7 +25,7 @@ from scipy.special import ndtr, ndtri
 import stochpound
 import stochpound.model
 from stochpound.analysis import SubsetSampler, subset_simulation
-from stochpound.analysis._subset_simulation import INITIAL_SCALE, TARGET_ACCEPTANCE
+from stochpound.analysis._subset_simulation import INITIAL_SCALE, TARGET_ACCEPTANCE, SubsetLevel, au_beck_cov, genealogy_cov
 from stochpound.motions import normal_motion
 from stochpound.motions.ground import SampledMotion
 
@@ -117,6 +117,33 @@ def test_a_half_space_has_its_exact_probability(proposal, p0):
     assert np.all(result.cov.values < 0.5)
 
 
+def test_the_genealogy_cov_is_au_beck_s_on_the_first_two_levels():
+    """Down to level 1 the genealogy's δ² = Σ_i s_i² − 1/N is Au & Beck's δ² exactly: (1 − p)/(pN) on level 0 and, on
+    level 1, (1 − p0)/(p0 N) + (1 − p)/(p N_1)(1 + γ) with γ from the chains (every chain there has an ancestor of its own);
+    from level 2 on it counts the chains' common ancestors, which Au & Beck's δ leaves out."""
+    result = subset_simulation(_peak, target_probability=1e-3, samples_per_level=200, p0=0.1, seed=5, dimension=N_TIME)
+    below = result.threshold.values < result.attrs["level_thresholds"][1]
+    assert below.sum() > 20 and (~below).sum() > 5 and result.attrs["levels"] == 3
+    np.testing.assert_allclose(result.cov.values[below], result.cov_au_beck.values[below], rtol=1e-12)
+    assert not np.allclose(result.cov.values[~below], result.cov_au_beck.values[~below], rtol=1e-3)
+
+
+def test_the_genealogy_cov_is_the_ancestors_shares():
+    """A hand-made genealogy (N = 10, p0 = 0.2: two chains of five a level): level 1's chains descend from level-0
+    samples 7 and 2, level 2's from level 1's third state of each chain (so from 7 and 2 again). Above 9.5 (level 1)
+    3 samples descend from 7 and 2 from 2: δ² = (3/5)² + (2/5)² − 1/10; above 11.5 (level 2) 3 and 1: (3/4)² + (1/4)² − 1/10;
+    above 12.5 one each: 1/2 − 1/10. Beyond every sample the CoV is NaN; a level without its seeds is refused."""
+    level0 = SubsetLevel(-np.inf, np.arange(10.0)[:, None], 1.0)
+    level1 = SubsetLevel(7.5, np.array([[10.0, 10.0, 12.0, 8.0, 9.0], [9.0, 11.0, 11.0, 8.0, 8.0]]), 0.5, np.array([7, 2]))
+    level2 = SubsetLevel(10.0, np.array([[12.0, 12.0, 14.0, 10.0, 10.0], [13.0, 11.0, 11.0, 11.0, 11.0]]), 0.5, np.array([2, 7]))
+    levels = [level0, level1, level2]
+    cov = genealogy_cov(levels, np.array([9.5, 11.5, 12.5, 20.0]))
+    np.testing.assert_allclose(cov[:3], np.sqrt([13 / 25 - 0.1, 10 / 16 - 0.1, 1 / 2 - 0.1]), rtol=1e-12)
+    assert np.isnan(cov[3]) and np.isfinite(au_beck_cov(levels, np.array([11.5]))[0])
+    with pytest.raises(ValueError, match="^seeds: level 2 must name the previous level's sample that seeded each of its 2 chains"):
+        genealogy_cov([level0, level1, replace(level2, seeds=None)], np.array([12.5]))
+
+
 def test_adaptive_conditional_sampling_leaves_the_standard_normal_invariant():
     """Without a threshold every aCS candidate is accepted: the chains are Gaussian AR(1) processes u' = ρ u + σ z,
     ρ = √(1 − σ²), whose states stay standard normal and whose lag-1 correlation is ρ (each to 5 of its standard errors)."""
@@ -165,14 +192,15 @@ def test_adaptive_conditional_sampling_does_not_draw_its_spread_from_the_seeds()
 
 @pytest.mark.slow
 def test_repeated_runs_scatter_as_their_reported_cov():
-    """20 runs at 2.1 (P ≈ 3e-5): every estimate within 3 reported CoV of the reference, the mean reported CoV within 35 % of the empirical one."""
+    """20 runs at 2.1 (P ≈ 3e-5): every estimate within 3 reported CoV of the reference, the mean reported CoV (the genealogy's)
+    within 25 % of the empirical one (about 1.1 here; Au & Beck's about 1.0)."""
     reference, reference_cov = _isee(2.1, 2000, seed=5)
     runs = [subset_simulation(_peak, thresholds=[2.1], samples_per_level=1000, p0=0.1, seed=seed, dimension=N_TIME) for seed in range(20)]
     estimates = np.array([r.probability.values[0] for r in runs])
     reported = np.array([r.cov.values[0] for r in runs])
     assert np.all(np.abs(estimates - reference) < 3.0 * np.hypot(reported, reference_cov) * reference)
     empirical = estimates.std(ddof=1) / reference
-    assert abs(reported.mean() / empirical - 1.0) < 0.35
+    assert abs(reported.mean() / empirical - 1.0) < 0.25
 
 
 def test_the_scene_runs_the_oscillator_of_the_reference():

@@ -43,14 +43,20 @@ level's threshold, else the chain repeats its state. All chains of a group
 (of the level, for ``"mma"``) advance together: the response is evaluated
 on the candidates of every chain at once.
 
-The coefficient of variation is Au & Beck's, δ² = Σ_j δ_j², with
-δ_0² = (1 − p)/(p N) for level 0 and δ_j² = (1 − p)/(p N_j)(1 + γ_j) for a
-level of chains (N_j its samples), γ_j = 2 Σ_{k=1}^{N_s−1} (1 − k/N_s) ρ_j(k) from the
-correlation ρ_j of the indicator along the chains (N_s states a chain),
-computed for the probability actually estimated at that level: p_j and the
-indicator of Y ≥ b_{j+1} for the intermediate levels, P_i(b) and the
-indicator of Y > b for the last one. The levels' estimates are taken as
-uncorrelated, as Au & Beck (2001) do.
+The coefficient of variation (``cov``) is read from the levels' genealogy
+(:func:`genealogy_cov`): every sample of the last level used descends from
+one sample of level 0, and δ² = Σ_i s_i² − 1/N, s_i the share of the
+samples above the threshold that descend from level-0 sample i (Chan & Lai
+2013; Lee & Whiteley 2018; Du & Guyader 2021 for adaptive levels). It is
+Au & Beck's δ exactly down to level 1 and adds the correlation between
+levels that Au & Beck's leaves out. Au & Beck's (2001) δ² = Σ_j δ_j²
+(``cov_au_beck``, :func:`au_beck_cov`), with δ_0² = (1 − p)/(p N) for
+level 0 and δ_j² = (1 − p)/(p N_j)(1 + γ_j) for a level of chains (N_j its
+samples), γ_j = 2 Σ_{k=1}^{N_s−1} (1 − k/N_s) ρ_j(k) from the correlation
+ρ_j of the indicator along the chains (N_s states a chain), computed for
+the probability actually estimated at that level, takes the levels'
+estimates as uncorrelated; it is 20–30 % too small at 10⁻⁵–10⁻⁶ on Au &
+Beck's oscillator (docs/rare-events.md).
 """
 
 from __future__ import annotations
@@ -79,8 +85,8 @@ PROPOSALS = {
 """The chains' proposals (``proposal``) and the method each names."""
 UNCERTIFIED = {
     "acs": "proposal: adaptive conditional sampling is not certified on a run's peaks over time (closures, drifts, base displacements, "
-           "impact forces): on Au & Beck's oscillator and a linear pair its estimates were unbiased but its reported CoV 0.64–0.79 of the "
-           "empirical one at 3e-5 to 6e-7 (docs/rare-events.md); use proposal \"mma\" for certified intervals",
+           "impact forces): on Au & Beck's oscillator and a linear pair its estimates were unbiased but its reported CoV 0.73–0.86 of the "
+           "empirical one at 3e-5 to 6e-7, 0.73 at the pair's deepest row (docs/rare-events.md); use proposal \"mma\" for certified intervals",
 }
 """The proposals not certified on a scene's responses, with the warning :func:`warn_uncertified` gives."""
 ADAPTATION_SHARE = 0.1
@@ -103,11 +109,15 @@ class SubsetLevel:
         (chains, states a chain) responses: (N, 1) for level 0.
     acceptance : float
         Fraction of the chains' candidates accepted (1 for level 0).
+    seeds : np.ndarray or None
+        (chains,) the previous level's sample that seeded each chain, an index into its responses read chain by chain
+        (None for level 0): the levels' genealogy, which the CoV reads (:func:`exceedance`).
     """
 
     threshold: float
     responses: np.ndarray
     acceptance: float
+    seeds: np.ndarray | None = None
 
 
 @dataclass(frozen=True)
@@ -356,9 +366,11 @@ def subset_simulation(
     Returns
     -------
     xarray.Dataset
-        Over ``threshold``: ``probability`` (of the response exceeding it) and
-        ``cov`` (its estimated coefficient of variation, NaN where the
-        probability is 0); attrs: ``runs`` (solver runs, or evaluations of g),
+        Over ``threshold``: ``probability`` (of the response exceeding it),
+        ``cov`` (its estimated coefficient of variation from the levels'
+        genealogy, :func:`genealogy_cov`, NaN where the probability is 0) and
+        ``cov_au_beck`` (Au & Beck's, which leaves out the correlation
+        between levels and is too small far down); attrs: ``runs`` (solver runs, or evaluations of g),
         ``level_thresholds``, ``gamma`` and ``acceptance`` per level,
         ``target_reached`` (1 if the last level reached the largest
         threshold or the target probability), ``target_probability`` (if given), ``p0``, ``samples_per_level``, ``seed``,
@@ -398,7 +410,10 @@ def subset_simulation(
         attrs["scale"] = np.array(scales, dtype=float)
     if target_probability is not None:
         attrs["target_probability"] = float(target_probability)
-    return curve_dataset(values, probability, cov, units, attrs)
+    curve = curve_dataset(values, probability, cov, units, attrs)
+    curve["cov_au_beck"] = xr.Variable(("threshold",), au_beck_cov(levels, values),
+                                       {"units": "1", "long_name": "Au & Beck's coefficient of variation (the levels taken as uncorrelated)"})
+    return curve
 
 
 def curve_dataset(thresholds: np.ndarray, probability: np.ndarray, cov: np.ndarray, units: str, attrs: Mapping[str, Any]) -> xr.Dataset:
@@ -463,7 +478,7 @@ def _levels(sampler: SubsetSampler, threshold: float | None, target: float | Non
         flat = states.reshape(-1, sampler.dimension)
         run, scale = sampler.run_level(len(levels), flat[seeds], levels[-1].responses.reshape(-1)[seeds], bound, scales[-1])
         runs += len(seeds) * (sampler.length - 1)
-        levels.append(SubsetLevel(bound, run.responses, run.accepted / (len(seeds) * (sampler.length - 1)) if sampler.length > 1 else 1.0))
+        levels.append(SubsetLevel(bound, run.responses, run.accepted / (len(seeds) * (sampler.length - 1)) if sampler.length > 1 else 1.0, seeds))
         states = run.states
         scales.append(scale)
     return levels, runs, scales[1:]
@@ -489,19 +504,84 @@ def _evaluate(function: Callable[[np.ndarray], np.ndarray], u: np.ndarray) -> np
 
 
 def exceedance(levels: Sequence[SubsetLevel], thresholds: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """P(Y > b) and its coefficient of variation (Au & Beck's) for every threshold b, from a run's levels."""
+    """P(Y > b) and its coefficient of variation from the levels' genealogy (:func:`genealogy_cov`) for every threshold b, from a run's levels."""
+    return _probabilities(levels, np.asarray(thresholds, dtype=float)), genealogy_cov(levels, thresholds)
+
+
+def genealogy_cov(levels: Sequence[SubsetLevel], thresholds: np.ndarray) -> np.ndarray:
+    """The coefficient of variation of P̂(Y > b) from the levels' genealogy, the correlation between levels included.
+
+    Every sample of the last level used for b (level m) descends from one
+    sample i of level 0 (its ancestor, followed through each chain's seed),
+    and P̂(Y > b) = Σ_i A_i, A_i the part of the estimate from the samples
+    above b that descend from i (all samples of level m weigh the same:
+    p_0 ⋯ p_{m−1} / N_m). Treating the N ancestors' families as exchangeable
+    parts of the estimate, as the genealogy estimators of sequential Monte
+    Carlo do (Chan & Lai 2013; Lee & Whiteley 2018; Du & Guyader 2021 for
+    adaptive levels), δ² = Σ_i (A_i / P̂)² − 1/N = Σ_i s_i² − 1/N,
+    s_i the share of the level-m samples above b that descend from i. At
+    level 0 it is (1 − p)/(pN), at level 1 exactly Au & Beck's δ
+    (:func:`au_beck_cov`) with γ from the chains; further down it adds the
+    correlation between the levels that Au & Beck's δ leaves out (a level's
+    chains start from the previous level's samples). NaN where P̂ = 0.
+
+    Parameters
+    ----------
+    levels : sequence of SubsetLevel
+        A run's levels, each after level 0 with its chains' ``seeds``.
+    thresholds : np.ndarray
+        Thresholds b, in the response's units.
+
+    Returns
+    -------
+    np.ndarray
+        δ at each threshold.
+
+    Raises
+    ------
+    ValueError
+        Naming ``seeds``, when a level after level 0 does not name its chains' seeds.
+    """
+    bounds = np.array([level.threshold for level in levels[1:]])
+    ancestors = _ancestors(levels)
+    cov = np.empty(len(thresholds))
+    for index, b in enumerate(np.asarray(thresholds, dtype=float)):
+        level = int(np.searchsorted(bounds, b, side="right"))
+        above = ancestors[level][levels[level].responses > b]
+        shares = np.bincount(above, minlength=levels[0].responses.size) / above.size if above.size else None
+        cov[index] = math.sqrt(max(0.0, float(np.sum(shares * shares)) - 1.0 / levels[0].responses.size)) if shares is not None else math.nan
+    return cov
+
+
+def au_beck_cov(levels: Sequence[SubsetLevel], thresholds: np.ndarray) -> np.ndarray:
+    """Au & Beck's (2001) coefficient of variation of P̂(Y > b), the levels taken as uncorrelated: δ² = Σ_j δ_j², δ_j² = (1 − p_j)/(p_j N_j)(1 + γ_j)."""
     bounds = np.array([level.threshold for level in levels[1:]])
     steps = _steps(levels)
     variances = [(1.0 - p) / (p * level.responses.size) * (1.0 + g) for p, level, g in zip(steps, levels, _step_gammas(levels))]
-    probability, cov = np.empty(len(thresholds)), np.empty(len(thresholds))
-    for index, b in enumerate(thresholds):
+    cov = np.empty(len(thresholds))
+    for index, b in enumerate(np.asarray(thresholds, dtype=float)):
         level = int(np.searchsorted(bounds, b, side="right"))  # the levels conditioned on thresholds <= b
         indicator = levels[level].responses > b
         p = float(indicator.mean())
-        probability[index] = math.prod(steps[:level]) * p
         own = (1.0 - p) / (p * indicator.size) * (1.0 + (_gamma(indicator) if level else 0.0)) if p > 0.0 else math.nan
         cov[index] = math.sqrt(sum(variances[:level]) + own)
-    return probability, cov
+    return cov
+
+
+def _ancestors(levels: Sequence[SubsetLevel]) -> list[np.ndarray]:
+    """For each level, the level-0 sample (0 .. N − 1) each of its samples descends from, shaped as its responses.
+
+    Raises
+    ------
+    ValueError
+        When a level after level 0 does not name its chains' seeds.
+    """
+    ancestors = [np.arange(levels[0].responses.size).reshape(levels[0].responses.shape)]
+    for index, level in enumerate(levels[1:], start=1):
+        if level.seeds is None or len(level.seeds) != level.responses.shape[0]:
+            raise ValueError(f"seeds: level {index} must name the previous level's sample that seeded each of its {level.responses.shape[0]} chains")
+        ancestors.append(np.broadcast_to(ancestors[-1].reshape(-1)[np.asarray(level.seeds)][:, None], level.responses.shape))
+    return ancestors
 
 
 def curve_thresholds(levels: Sequence[SubsetLevel], target: float | None, points: int = 25) -> np.ndarray:
@@ -560,7 +640,7 @@ def exceedance_quantiles(levels: Sequence[SubsetLevel], probabilities: Sequence[
 
 
 def _probabilities(levels: Sequence[SubsetLevel], thresholds: np.ndarray) -> np.ndarray:
-    """P̂(Y > b) at sorted thresholds b (without its CoV: many thresholds at once)."""
+    """P̂(Y > b) at thresholds b (without its CoV: many thresholds at once)."""
     bounds = np.array([level.threshold for level in levels[1:]])
     scale = np.cumprod([1.0, *_steps(levels)])
     which = np.searchsorted(bounds, thresholds, side="right")

@@ -233,8 +233,9 @@ def _level(store: Path, sampler: SubsetSampler, definition: RareEventDefinition,
     responses = np.concatenate([b["responses"] for b in batches])
     length = responses.shape[1]
     moves = len(responses) * (length - 1)
-    level = SubsetLevel(-np.inf if index == 0 else levels[-1].next_threshold, responses, sum(int(b["accepted"]) for b in batches) / moves if moves else 1.0)
     seeds = np.full(len(responses), -1, dtype=np.int64) if index == 0 else levels[-1].next_seeds
+    level = SubsetLevel(-np.inf if index == 0 else levels[-1].next_threshold, responses, sum(int(b["accepted"]) for b in batches) / moves if moves else 1.0,
+                        None if index == 0 else seeds)
     finished = FinishedLevel(level, seeds, responses.size if index == 0 else moves, scale)
     subset = [f.level for f in levels] + [level]
     if not sampler.done(subset, None, definition.table.target_probability) and len(subset) < definition.table.max_levels:

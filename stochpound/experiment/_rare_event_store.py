@@ -96,7 +96,8 @@ def finished_levels(store: Path) -> list[FinishedLevel]:
     while level_path(store, len(levels)).is_file():
         data = load_arrays(level_path(store, len(levels)))
         nxt = {key: data.get(f"next_{key}") for key in ("threshold", "seeds", "states")}
-        levels.append(FinishedLevel(SubsetLevel(float(data["threshold"]), data["responses"], float(data["acceptance"])), data["seeds"], int(data["runs"]),
+        seeds = data["seeds"] if len(levels) else None
+        levels.append(FinishedLevel(SubsetLevel(float(data["threshold"]), data["responses"], float(data["acceptance"]), seeds), data["seeds"], int(data["runs"]),
                                     float(data["scale"]) if "scale" in data else INITIAL_SCALE, None if nxt["threshold"] is None else float(nxt["threshold"]),
                                     nxt["seeds"], nxt["states"]))
     return levels
@@ -171,7 +172,8 @@ def store_levels(data: xr.Dataset) -> list[SubsetLevel]:
     for index in range(data.sizes["level"]):
         chains, length = int(data["level_chains"].values[index]), int(data["level_length"].values[index])
         responses = data["response"].values[index, : chains * length].reshape(chains, length)
-        levels.append(SubsetLevel(float(data["level_threshold"].values[index]), responses, float(data["level_acceptance"].values[index])))
+        seeds = data["seed_sample"].values[index, :chains] if index else None
+        levels.append(SubsetLevel(float(data["level_threshold"].values[index]), responses, float(data["level_acceptance"].values[index]), seeds))
     return levels
 
 

@@ -27,7 +27,7 @@ def rare_event_section(name: str, results: RareEventResults, crude: xr.Dataset |
     section.add(FigureItem(f"rare-{name}-curve", _caption(results, closure, units, crude), _curve_figure(results, closure, units, crude)))
     section.add(Table(f"rare-{name}-separation", _table_caption(closure, units), _frame(results, closure, units),
                       note="Per event: per motion of the ensemble. The interval is the response at which the estimated curve crosses "
-                           "p·exp(±1.96 δ), δ the estimate's coefficient of variation at p (Au & Beck's, from the chains' correlation); "
+                           "p·exp(±1.96 δ), δ the estimate's coefficient of variation at p (from the levels' genealogy, which counts the correlation between levels); "
                            "a probability below the run's reach has no value.",
                       formats={"probability per event": "{:.0e}", "coefficient of variation": "{:.2f}", "runs (n)": "{:.0f}"}))
     if crude is not None:
