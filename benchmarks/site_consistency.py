@@ -21,6 +21,14 @@ every run's closure enters, not only whether it reaches a gap) and what
 each g* rests on, and draws both in ``docs/figures/site_consistency.png``
 (g* against the conditioning measure); ``--seeds`` repeats both with other
 seeds of the selection, ``--return-periods`` moves the stripes.
+``--motions 40 --simulated-motions 1000 --max-per-earthquake 3`` runs 40
+motions a stripe from the records and 1000 site-based stochastic motions of
+each stripe's scenario (``[site] simulated_motions``), at most 3 of an
+earthquake (docs/intensity.md, "the pool extended by simulated motions").
+At Fox Plaza the measures are PGA, PSA(1 s), PSA(2 s), PSA(3 s) and PSA at
+Building 1's own period on a fixed base, PSA(T1 = 0.3 s) (its scenario
+fitted to the four curves and its own; its curve stops at 3431 years, its
+top stripe there).
 
 ``--site scenario`` runs the same at a site shaken by one earthquake
 scenario (``--scenario M R mechanism rate``, default M 7.5 at 10 km,
@@ -59,15 +67,18 @@ if TYPE_CHECKING:
 
 RETURN_PERIODS = np.array([10.0, 25.0, 72.0, 224.0, 475.0, 975.0, 2475.0, 5000.0])
 CURVES = ["fox_plaza_los_angeles_pga", "fox_plaza_los_angeles_sa1p0s", "fox_plaza_los_angeles_sa2p0s", "fox_plaza_los_angeles_sa3p0s"]
-#: Fox Plaza's measures, each with its bundled hazard curve.
-MEASURES = dict(zip(("PGA", "PSA(1 s)", "PSA(2 s)", "PSA(3 s)"), CURVES))
+#: PSA at Building 1's first-mode period on a fixed base (0.30 s), the measure of the building's own period: Fox Plaza's curve of it.
+T1_MEASURE, T1_CURVE = "PSA(T1 = 0.3 s)", "fox_plaza_los_angeles_sa0p3s"
+#: Fox Plaza's measures, each with its bundled hazard curve (the scenario of each is fitted to :data:`CURVES` and its own).
+MEASURES = {**dict(zip(("PGA", "PSA(1 s)", "PSA(2 s)", "PSA(3 s)"), CURVES)), T1_MEASURE: T1_CURVE}
 #: The periods (s) of the average spectral acceleration the site of one scenario adds to the measures: the band the isolated
 #: building's closure follows (docs/intensity.md, finding 8).
 SA_AVG_PERIODS = (0.5, 1.0, 1.5, 2.0, 2.5, 3.0, 3.5, 4.0)
 SA_AVG = "Sa_avg(0.5-4 s)"
 #: Every measure as stochpound's measure and period (s): Fox Plaza's four, and the one a site of one scenario adds.
 MEASURE_ARGS: dict[str, tuple[str, float | tuple[float, ...] | None]] = {
-    "PGA": ("pga", None), "PSA(1 s)": ("psa", 1.0), "PSA(2 s)": ("psa", 2.0), "PSA(3 s)": ("psa", 3.0), SA_AVG: ("sa_avg", SA_AVG_PERIODS)}
+    "PGA": ("pga", None), "PSA(1 s)": ("psa", 1.0), "PSA(2 s)": ("psa", 2.0), "PSA(3 s)": ("psa", 3.0), T1_MEASURE: ("psa", 0.3),
+    SA_AVG: ("sa_avg", SA_AVG_PERIODS)}
 CONFIGURATIONS = {  # name: (B1's base, an edit of the bundled pair; the neighbour's variants)
     "fixed pair": ("", "[variants.neighbour.stiff.building.B2]\nmass_factor = 0.5\n[variants.neighbour.flexible.building.B2]\nmass_factor = 2.0"),
     "isolated": ("[scene.building.B1]\nbase = { mass = 13134.0, mu = 0.05, radius = 2.24 }", "[variants.neighbour.stiff.building.B2]\nmass_factor = 0.5"),
@@ -91,6 +102,28 @@ SCENARIO = (7.5, 10.0, "strike_slip", 0.01)
 
 
 @dataclass(frozen=True)
+class Pool:
+    """The stripes' motions: ``motions`` a stripe, ``simulated`` site-based stochastic motions of each stripe's scenario added to the
+    100 records (``[site] simulated_motions``; 0: none), at most ``max_per_earthquake`` of an earthquake a stripe (None: no limit)."""
+
+    motions: int = 20
+    simulated: int = 0
+    max_per_earthquake: int | None = None
+
+    def intensity_lines(self) -> str:
+        """The pool's lines of the ``[intensity]`` table."""
+        return f"motions = {self.motions}\n" + ("" if self.max_per_earthquake is None else f"max_per_earthquake = {self.max_per_earthquake}\n")
+
+    def site_lines(self) -> str:
+        """The pool's lines of the ``[site]`` table."""
+        return f"simulated_motions = {self.simulated}\n" if self.simulated else ""
+
+
+#: The records alone, 20 motions a stripe (the pool of docs/intensity.md's first tables).
+RECORDS_ONLY = Pool()
+
+
+@dataclass(frozen=True)
 class Site:
     """Where the stripes are: each measure's hazard curve, the experiment's ``[site]`` table, the default stripes' return periods (yr)
     and the measures it has a hazard curve of."""
@@ -108,7 +141,8 @@ def _bundled_hazard(measure: str) -> HazardCurve:
     return HazardCurve.bundled(MEASURES[measure])
 
 
-#: The bundled Fox Plaza site, the scenario fitted to its four curves (Vs30 and mechanism assumed: the curves state neither).
+#: The bundled Fox Plaza site, the scenario fitted to its four curves (Vs30 and mechanism assumed: the curves state neither);
+#: PSA(T1)'s to them and its own.
 FOX_PLAZA = Site("fox_plaza", _bundled_hazard, '[site]\nscenario = "fitted"\ncurves = [' + ", ".join(f'"{name}"' for name in CURVES) +
                  ']\nvs30 = 400.0\nmechanism = "reverse"\n', RETURN_PERIODS, tuple(MEASURES))
 
@@ -140,30 +174,34 @@ def _intensity_lines(measure: str) -> str:
 
 
 def experiment_text(measure: str, configuration: str, seed: int | None = None, return_periods: np.ndarray | None = None,
-                    site: Site = FOX_PLAZA) -> str:
+                    site: Site = FOX_PLAZA, pool: Pool = RECORDS_ONLY) -> str:
     """The experiment file of one conditioning measure and configuration at ``site`` (the selection's ``seed``, or its default;
-    stripes at the site's intensities of ``return_periods``, yr, by default the site's)."""
+    stripes at the site's intensities of ``return_periods``, yr, by default the site's; the stripes' motions from ``pool``)."""
     periods = site.return_periods if return_periods is None else np.asarray(return_periods, dtype=float)
-    levels = site.hazard(measure).intensity_at(1.0 / periods)
+    curve = site.hazard(measure)
+    levels = curve.intensity_at(np.maximum(1.0 / periods, float(curve.rate.min())))  # a curve that stops short (PSA(0.3 s): 3431 yr): its last level
     base, variants = CONFIGURATIONS[configuration]
+    table = site.table
+    if site.name == FOX_PLAZA.name and MEASURES[measure] not in CURVES:  # the scenario fitted to the four curves and the measure's own
+        table = table.replace(f'"{CURVES[-1]}"]', f'"{CURVES[-1]}", "{MEASURES[measure]}"]')
     return (f'[experiment]\nname = "site_{site.name}"\nstudied = "B1"\n{PAIR.format(base=base, variants=variants)}\n[intensity]\n'
             f"{_intensity_lines(measure)}\nlevels = [{', '.join(f'{x:.4f}' for x in levels)}]\n"
-            'selection = "conditional_spectrum"\nmotions = 20\nmax_scale_factor = 5.0\n' + ("" if seed is None else f"seed = {seed}\n") +
-            site.table)
+            'selection = "conditional_spectrum"\n' + pool.intensity_lines() + "max_scale_factor = 5.0\n" + ("" if seed is None else f"seed = {seed}\n") +
+            table + pool.site_lines())
 
 
 def measure_risk(folder: Path, measure: str, configuration: str, bootstrap: int = 0, seed: int | None = None,
-                 return_periods: np.ndarray | None = None, site: Site = FOX_PLAZA) -> tuple[xr.Dataset, StoreRisk]:
+                 return_periods: np.ndarray | None = None, site: Site = FOX_PLAZA, pool: Pool = RECORDS_ONLY) -> tuple[xr.Dataset, StoreRisk]:
     """The store and the risk answer (g* at 10 % and 2 % in 50 years, ``bootstrap`` resamples for its 95 % interval) of one
     measure and configuration at ``site`` (the selection's ``seed``, or its default; stripes at ``return_periods``, by default
-    the site's), run in ``folder``."""
+    the site's; motions from ``pool``), run in ``folder``."""
     from stochpound import open_store
     from stochpound.risk import store_risk
     from stochpound.experiment import load_experiment, run_experiment
 
     name = f"{measure.replace('(', '').replace(' s)', '').replace(' ', '').replace('.', 'p').lower()}.toml"
     path = folder / name
-    path.write_text(experiment_text(measure, configuration, seed, return_periods, site))
+    path.write_text(experiment_text(measure, configuration, seed, return_periods, site, pool))
     report = run_experiment(load_experiment(path), workers=0, progress=False, checkpoint=float("inf"))  # no store written mid-run: read at the end only
     if not report.complete:
         raise RuntimeError(f"{configuration}, {measure}: the experiment did not complete")
@@ -204,7 +242,7 @@ def _print_seeds(configuration: str, args: argparse.Namespace, counted: xr.DataA
     with tempfile.TemporaryDirectory() as folder:
         for seed in args.seeds:
             runs = [measure_risk(_subfolder(Path(folder), f"seed{seed}"), measure, configuration, seed=seed, return_periods=args.return_periods,
-                                 site=args.site)
+                                 site=args.site, pool=args.pool)
                     for measure in args.measures]
             again["counted"].append(xr.concat([risk.separation["separation"] for _, risk in runs], dim="measure"))
             again["lognormal demand per stripe"].append(xr.concat([lognormal_g_star(store, risk) for store, risk in runs], dim="measure"))
@@ -274,7 +312,11 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--site", choices=list(FIGURES), default="fox_plaza", help="the bundled Fox Plaza site, or a site of one scenario")
     parser.add_argument("--scenario", nargs=4, metavar=("M", "R_KM", "MECHANISM", "RATE"), default=list(SCENARIO),
                         help="--site scenario's magnitude, rupture distance (km), mechanism and annual rate (default %(default)s)")
+    parser.add_argument("--motions", type=int, default=RECORDS_ONLY.motions, help="motions a stripe (default %(default)s)")
+    parser.add_argument("--simulated-motions", type=int, default=0, help="site-based stochastic motions of each stripe's scenario added to the pool")
+    parser.add_argument("--max-per-earthquake", type=int, default=None, help="at most this many motions of an earthquake a stripe")
     args = parser.parse_args(argv)
+    args.pool = Pool(args.motions, args.simulated_motions, args.max_per_earthquake)
     args.site = FOX_PLAZA if args.site == "fox_plaza" else _scenario_site(parser, args.scenario)
     args.return_periods = args.site.return_periods if args.return_periods is None else np.asarray(args.return_periods, dtype=float)
     args.measures = list(args.site.measures) if args.measures is None else args.measures
@@ -293,7 +335,7 @@ def main(argv: list[str] | None = None) -> None:
         with tempfile.TemporaryDirectory() as folder:
             for measure in args.measures:
                 store, risk = measure_risk(Path(folder), measure, configuration, bootstrap=args.bootstrap, return_periods=args.return_periods,
-                                           site=args.site)
+                                           site=args.site, pool=args.pool)
                 answers.append(risk.separation["separation"])
                 lognormal.append(lognormal_g_star(store, risk))
                 diagnoses.append(diagnosis(store, risk).assign(measure=measure))

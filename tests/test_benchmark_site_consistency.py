@@ -105,3 +105,21 @@ def test_a_bad_scenario_is_a_one_line_usage_error(capsys, scenario: list[str], m
     with pytest.raises(SystemExit) as stopped:
         main(["--site", "scenario", "--scenario", *scenario])
     assert stopped.value.code == 2 and capsys.readouterr().err.strip().splitlines()[-1].endswith(f"error: {message}")
+
+
+def test_the_extended_pool_and_the_building_s_own_period_are_in_the_experiment_file() -> None:
+    """``--motions``, ``--simulated-motions`` and ``--max-per-earthquake`` reach the experiment file; PSA(T1)'s scenario is fitted to
+    the four curves and its own, and its stripes stop where its curve does."""
+    import tomllib
+
+    from benchmarks.site_consistency import CURVES, T1_CURVE, T1_MEASURE, Pool, experiment_text
+    from stochpound.analysis import HazardCurve
+
+    table = tomllib.loads(experiment_text(T1_MEASURE, "fixed pair", 2, pool=Pool(40, 1000, 3)))
+    intensity, site = table["intensity"], table["site"]
+    assert (intensity["motions"], intensity["max_per_earthquake"], intensity["seed"], site["simulated_motions"]) == (40, 3, 2, 1000)
+    assert site["curves"] == [*CURVES, T1_CURVE] and intensity["period"] == 0.3
+    assert intensity["levels"][-1] == pytest.approx(float(HazardCurve.bundled(T1_CURVE).im.max()), rel=1e-4)
+    records_only = tomllib.loads(experiment_text("PSA(1 s)", "fixed pair"))
+    assert records_only["intensity"]["motions"] == 20 and "max_per_earthquake" not in records_only["intensity"]
+    assert "simulated_motions" not in records_only["site"] and records_only["site"]["curves"] == CURVES

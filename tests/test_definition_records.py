@@ -41,7 +41,7 @@ def test_a_risk_experiments_tables_are_typed_records():
     assert intensity.description == "PSA(T = 2 s, 5 % damping)" and intensity.selection_method == "conditional_spectrum"
     assert isinstance(hazard, Hazard) and not isinstance(hazard, Mapping)
     assert hazard.measure == intensity.measure and hazard.bundled == "fox_plaza_los_angeles_sa2p0s" and hazard.im and len(hazard.im) == len(hazard.rate)
-    assert isinstance(definition.design, Design) and definition.design.sds == 1.32925 and definition.design.tl == 8.0
+    assert isinstance(definition.design, Design) and definition.design.sds == 1.33611 and definition.design.tl == 8.0
     limit_states = definition.limit_states
     assert isinstance(limit_states, LimitStates) and limit_states.source.startswith("FEMA 356")
     assert LimitStateCapacities("drift_ratio", (0.007, 0.025, 0.05)) in limit_states.states

@@ -1,7 +1,7 @@
 """The risk flagship's experiment files (experiments/risk/*.toml) carry the numbers their headers derive.
 
 The buildings' yield shears are ASCE 7-16's from the design spectrum the header takes from the bundled 2 %/50 yr
-hazard, both neighbours sit on that spectrum's plateau (so one design serves both), and the stripes are the site's
+hazard (S_MS = 1.1 SA(0.2 s), S_M1 = 1.3 SA(1 s), as chapter 17's part takes them), both neighbours sit on that spectrum's plateau (so one design serves both), and the stripes are the site's
 intensities at the stated return periods.
 """
 
@@ -14,7 +14,9 @@ import numpy as np
 import pytest
 
 from stochpound.analysis import HazardCurve
+from stochpound.codes import MceSpectrum
 from stochpound.model import design_yield_shears
+from stochpound.risk import site_mce
 
 ROOT = Path(__file__).resolve().parents[1]
 FILES = {"fixed_pair": 1.0, "isolated": 2.0}  # file: its PSA period, s
@@ -38,10 +40,13 @@ def _first_mode_period(mass: list[float], stiffness: list[float]) -> float:
 
 
 def _design_spectrum() -> tuple[float, float, float]:
-    """S_DS, S_D1 (g) and S_M1: two thirds of the MCE from the bundled 2 %/50 yr PGA / 0.4 and SA(1 s)."""
-    pga = float(HazardCurve.bundled("fox_plaza_los_angeles_pga").intensity_at(TWO_PERCENT))
-    sm1 = float(HazardCurve.bundled("fox_plaza_los_angeles_sa1p0s").intensity_at(TWO_PERCENT))
-    return 2.0 / 3.0 * pga / 0.4, 2.0 / 3.0 * sm1, sm1
+    """S_DS, S_D1 (g) and S_M1: two thirds of the MCE by chapter 17's rule (issue 45: one rule for both designs), the site's
+    geometric-mean SA(0.2 s) and SA(1 s) at 2 %/50 yr times the maximum-direction factors."""
+    sa_short, sa_long, _ = site_mce("fox_plaza_los_angeles_sa1p0s")
+    assert sa_short == pytest.approx(float(HazardCurve.bundled("fox_plaza_los_angeles_sa0p2s").intensity_at(TWO_PERCENT)), rel=1e-12)
+    mce = MceSpectrum.from_geometric_mean(sa_short, sa_long, 8.0)
+    assert (mce.sms / sa_short, mce.sm1 / sa_long) == pytest.approx((1.1, 1.3))
+    return 2.0 / 3.0 * mce.sms, 2.0 / 3.0 * mce.sm1, mce.sm1
 
 
 @pytest.mark.parametrize("name", sorted(FILES))

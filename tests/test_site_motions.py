@@ -166,6 +166,15 @@ def test_same_seed_same_motions_and_motion_i_independent_of_n():
     assert not np.allclose(first.acceleration.values, other.acceleration.values)
 
 
+def test_the_realizations_asked_are_the_full_sets_rows_even_repeated():
+    """A realization asked twice (the chosen motions of two stripes of one scenario) is the full set's row both times, with the
+    default window (drawn from the whole set's parameters) and with a given one."""
+    for window in ({}, {"duration": 20.0}):
+        full = site_motions(**SCENARIO, n=4, seed=5, dt=0.01, **window).acceleration.values
+        asked = site_motions(**SCENARIO, n=4, seed=5, dt=0.01, realizations=[2, 0, 2, 3, 2], **window).acceleration.values
+        np.testing.assert_array_equal(asked, full[[2, 0, 2, 3, 2]])
+
+
 def test_the_seeded_motions_are_the_map_of_their_normals():
     n_time, shape = 1001, len(SHAPE_PERIODS)
     normals = []

@@ -78,6 +78,8 @@ SIMULATED_CHUNK = 256
 """Simulated motions generated at once while their spectra are computed."""
 SIMULATED_LIMIT = 100_000
 """Largest ``[site] simulated_motions`` (per stripe)."""
+SIMULATED_WINDOW_LIMIT = 600.0
+"""Longest window (s) :func:`~stochpound.motions.site_motions` takes given; a longer default one is found again per chunk."""
 RULES = ("max_per_earthquake", "exclude_pulses")
 """``[intensity]`` fields of the selection's rules (:attr:`stochpound.store.Selection.rules`), in the definition only where given."""
 PER_LEVEL = ("magnitude", "distance_km", "mechanism")
@@ -445,10 +447,11 @@ def stripe_selections(experiment: ExperimentGrid) -> StripeSelections:
     else:
         stripe_targets = [conditional_spectrum(measure, period, level=level, periods=periods, scenario=scenario)
                           for level, scenario in zip(intensity.levels, chosen.scenarios)]
+    generated: dict[str, xr.Dataset] = {}  # the simulated pool of each distinct table: stripes of one scenario share it, relabelled
     for stripe, (level, scenario, target) in enumerate(zip(intensity.levels, chosen.scenarios, stripe_targets)):
         sources = simulated_sources(chosen.simulated, stripe, scenario)
         try:
-            stripe_pool = xr.concat([pool, simulated_pool(sources, periods, measure, period, g)], "motion") if sources else pool
+            stripe_pool = xr.concat([pool, shared_simulated_pool(sources, periods, measure, period, g, generated)], "motion") if sources else pool
         except SiteError as error:  # a scenario outside the site-motion model's calibrated range
             raise ExperimentError(f"site.simulated_motions: the stripe {level:g} g's scenario: {error}") from None
         try:
@@ -505,30 +508,66 @@ def simulated_sources(setting: SimulatedMotions | None, stripe: int, scenario: S
     return {label: MotionSource(label, SIMULATED, SIMULATED_FIELD, {**table, "realization": i}) for i, label in enumerate(labels)}
 
 
-def simulated_motions(sources: Sequence[MotionSource]) -> list[Any]:
+def simulated_motions(sources: Sequence[MotionSource], duration: float | None = None) -> list[Any]:
     """The motions (m/s², :class:`~stochpound.motions.ground.SampledMotion`) of simulated sources of one table, regenerated from it bit for bit."""
-    from stochpound.motions import site_motions
     from stochpound.motions.ground import SampledMotion
 
     table = sources[0].motion
-    generated = site_motions(table["magnitude"], table["distance_km"], table["vs30"], table["mechanism"], n=table["n"], seed=table["seed"],
-                             dt=table["dt"], model=table["model"], realizations=[source.motion["realization"] for source in sources])
     return [SampledMotion(table["dt"], values, "linear", f"{source.label} ({table['model']}, seed {table['seed']})")
-            for source, values in zip(sources, generated["acceleration"].values)]
+            for source, values in zip(sources, simulated_accelerations(sources, duration))]
+
+
+def simulated_accelerations(sources: Sequence[MotionSource], duration: float | None = None) -> np.ndarray:
+    """The ground accelerations (m/s², one row per source) of simulated sources of one table, regenerated from it bit for bit.
+
+    ``duration`` (s), the window of the table's ``n`` motions when known (:func:`simulated_pool`), spares drawing the
+    parameters of all ``n`` to find it (the window-given path of :func:`~stochpound.motions.site_motions`); the rows are the same.
+    """
+    from stochpound.motions import site_motions
+
+    table = sources[0].motion
+    generated = site_motions(table["magnitude"], table["distance_km"], table["vs30"], table["mechanism"], n=table["n"], seed=table["seed"],
+                             dt=table["dt"], model=table["model"], realizations=[source.motion["realization"] for source in sources],
+                             duration=duration)
+    return generated["acceleration"].values
 
 
 def simulated_pool(sources: Mapping[str, MotionSource], periods: np.ndarray, measure: str, period: Any, g: float) -> xr.Dataset:
-    """:func:`~stochpound.motions.selection_pool` of a stripe's simulated motions, generated :data:`SIMULATED_CHUNK` at a time."""
+    """:func:`~stochpound.motions.selection_pool` of a stripe's simulated motions, generated :data:`SIMULATED_CHUNK` at a time.
+
+    The first chunk finds the window of the table's ``n`` motions (their default one, :func:`~stochpound.motions.site_motions`);
+    the others are drawn with it given, each motion from its own generator alone: the same motions, bit for bit.
+    """
     from stochpound.motions import selection_pool
     from stochpound.motions.records import Record
 
     items = list(sources.values())
-    parts = []
+    table = items[0].motion
+    metadata = {"magnitude": table["magnitude"], "distance": table["distance_km"], "vs30": table["vs30"]}
+    parts, duration = [], None
     for start in range(0, len(items), SIMULATED_CHUNK):
         chunk = items[start : start + SIMULATED_CHUNK]
-        table = chunk[0].motion
-        metadata = {"magnitude": table["magnitude"], "distance": table["distance_km"], "vs30": table["vs30"]}
-        records = [Record(source.label, motion.dt, motion.values, "m/s2", metadata={**metadata, "event": source.label})
-                   for source, motion in zip(chunk, simulated_motions(chunk))]
+        accelerations = simulated_accelerations(chunk, duration)
+        window = (accelerations.shape[1] - 1) * table["dt"]  # n_time = round(window / dt) + 1 again
+        duration = window if window <= SIMULATED_WINDOW_LIMIT else None
+        records = [Record(source.label, table["dt"], values, "m/s2", metadata={**metadata, "event": source.label})
+                   for source, values in zip(chunk, accelerations)]
         parts.append(selection_pool(records, periods, measure, period, MODEL_DAMPING, g))
     return xr.concat(parts, "motion")
+
+
+def shared_simulated_pool(sources: Mapping[str, MotionSource], periods: np.ndarray, measure: str, period: Any, g: float,
+                          generated: dict[str, xr.Dataset]) -> xr.Dataset:
+    """:func:`simulated_pool` of a stripe's sources, reusing ``generated`` (the pools of the tables met so far, by table).
+
+    Stripes of one scenario (a fitted scenario, one given for every level) have the same table and so the same motions:
+    they are generated once and relabelled (a motion's label, earthquake and recording are its stripe's label).
+    """
+    from stochpound.store import canonical_json
+
+    table = next(iter(sources.values())).motion
+    key = canonical_json({name: value for name, value in table.items() if name != "realization"})
+    if key not in generated:
+        generated[key] = simulated_pool(sources, periods, measure, period, g)
+    labels = np.array(list(sources), dtype=object)
+    return generated[key].assign_coords(motion=labels).assign(earthquake=("motion", labels), recording=("motion", labels))

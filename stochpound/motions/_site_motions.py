@@ -185,13 +185,20 @@ def site_motions(magnitude: float | None = None, distance_km: float | None = Non
     if duration is None:
         duration = _window(parameters)
         parameters = {name: values[rows] for name, values in parameters.items()}
-        rngs = [rngs[i] for i in rows]
+        rngs = [_after_parameters(seed, i, site_model.normals) for i in rows]  # a generator per row: a realization asked twice is drawn twice alike
     n_time = int(round(duration / dt)) + 1
     acceleration = motions_from_noise_rows(parameters, lambda batch: np.array([rng.standard_normal(n_time) for rng in rngs[batch]]), n_time, dt)
     dataset = _dataset(acceleration, parameters, dt, _attrs(scenario, model))
     dataset = dataset.assign_coords(realization=np.asarray(rows, dtype=int))
     dataset.attrs.update(seed=seed, n=int(n))
     return dataset
+
+
+def _after_parameters(seed: int, realization: int, normals: int) -> np.random.Generator:
+    """Realization ``realization``'s generator past its ``normals`` parameter normals, where its noise starts."""
+    rng = realization_rng(seed, realization)
+    rng.standard_normal(normals)
+    return rng
 
 
 def _rows(realizations: Sequence[int] | None, n: int) -> list[int]:
