@@ -123,7 +123,7 @@ def selection_pool(
         Over ``motion`` (the records' names): ``psa`` (``motion``, ``period``; g),
         ``intensity`` (g), ``magnitude``, ``distance_km``, ``vs30`` (NaN where
         unknown), ``mechanism`` ("" where unknown), ``earthquake`` (the
-        metadata's ``event`` normalised across suites, :func:`~stochpound.stats.earthquake_identities`, else the motion's name), ``recording`` (PEER
+        metadata's ``event`` normalised across suites, :func:`~stochpound.motions.records.earthquake_identities`, else the motion's name), ``recording`` (PEER
         record sequence number and component, else the name) and ``pulse``
         (the metadata's ``pulse``, False where unknown).
     """

@@ -124,7 +124,7 @@ def rate_collapses_apart(demand: xr.DataArray, collapsed: xr.DataArray, threshol
     """λ (1/yr) of a demand reaching each threshold with the collapses counted apart (module docstring), and the collapse fit.
 
     A collapse counts as reaching every threshold (a building that has lost its storeys has met every limit state, FEMA P-58);
-    the credible runs' fit of demand ≥ threshold and P(C | IM) are combined by total probability, :func:`combined_rate`.
+    the credible runs' fit of demand ≥ threshold and P(C | IM) are combined by total probability, ``combined_rate``.
 
     Parameters
     ----------

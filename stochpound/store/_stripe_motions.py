@@ -18,7 +18,7 @@ def ran_motions(store: xr.Dataset) -> xr.DataArray:
 
 
 def motion_earthquakes(store: xr.Dataset) -> list[str]:
-    """Each motion's earthquake, normalised across suites (:func:`~stochpound.stats.earthquake_identities`: "Northridge 1994"
+    """Each motion's earthquake, normalised across suites (:func:`~stochpound.motions.records.earthquake_identities`: "Northridge 1994"
     and "Northridge-01 1994" of one magnitude are one); a motion without an event (a simulated one) is its own."""
     names = [str(r) for r in store["record"].values]
     if "record_event" not in store.coords:
