@@ -44,7 +44,7 @@ level's threshold, else the chain repeats its state. All chains of a group
 on the candidates of every chain at once.
 
 The coefficient of variation (``cov``) is read from the levels' genealogy
-(:func:`genealogy_cov`): every sample of the last level used descends from
+(``genealogy_cov``): every sample of the last level used descends from
 one sample of level 0, and δ² = Σ_i s_i² − 1/N, s_i the share of the
 samples above the threshold that descend from level-0 sample i (Chan & Lai
 2013; Lee & Whiteley 2018; Du & Guyader 2021 for adaptive levels). It is
@@ -368,7 +368,7 @@ def subset_simulation(
     xarray.Dataset
         Over ``threshold``: ``probability`` (of the response exceeding it),
         ``cov`` (its estimated coefficient of variation from the levels'
-        genealogy, :func:`genealogy_cov`, NaN where the probability is 0) and
+        genealogy, ``genealogy_cov``, NaN where the probability is 0) and
         ``cov_au_beck`` (Au & Beck's, which leaves out the correlation
         between levels and is too small far down); attrs: ``runs`` (solver runs, or evaluations of g),
         ``level_thresholds``, ``gamma`` and ``acceptance`` per level,
@@ -504,7 +504,7 @@ def _evaluate(function: Callable[[np.ndarray], np.ndarray], u: np.ndarray) -> np
 
 
 def exceedance(levels: Sequence[SubsetLevel], thresholds: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """P(Y > b) and its coefficient of variation from the levels' genealogy (:func:`genealogy_cov`) for every threshold b, from a run's levels."""
+    """P(Y > b) and its coefficient of variation from the levels' genealogy (``genealogy_cov``) for every threshold b, from a run's levels."""
     return _probabilities(levels, np.asarray(thresholds, dtype=float)), genealogy_cov(levels, thresholds)
 
 
