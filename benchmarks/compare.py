@@ -204,13 +204,14 @@ def run_experiments(trees: dict[str, Path], experiment: Path, folder: Path, this
 
 
 def store_differences(ours: Path, theirs: Path) -> list[str]:
-    """The variables of two stores that differ: their data variables and coordinates, each compared with ``equals``
-    (values, dimensions, coordinates; not the attributes, which hold provenance and dates), and those only one holds
-    (named ``"<name> (only in one)"``). Empty: the stores hold the same data."""
+    """The variables of two stores that differ: their data variables and coordinates, each compared on its own with
+    :meth:`xarray.Variable.equals` (values and dimensions; not the attributes, which hold provenance and dates, nor the
+    other coordinates, each compared in its own right: a coordinate only one store holds does not make every variable on
+    its dimension differ), and those only one holds (named ``"<name> (only in one)"``). Empty: the stores hold the same data."""
     with xr.open_dataset(ours) as a, xr.open_dataset(theirs) as b:
         names = set(a.variables) | set(b.variables)
         return sorted(name if name in a.variables and name in b.variables else f"{name} (only in one)"
-                      for name in names if not (name in a.variables and name in b.variables and a[name].equals(b[name])))
+                      for name in names if not (name in a.variables and name in b.variables and a.variables[name].equals(b.variables[name])))
 
 
 def throughput(run: dict[str, Any]) -> float:

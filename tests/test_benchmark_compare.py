@@ -26,6 +26,10 @@ def test_the_stores_compare_by_their_data_not_their_provenance(tmp_path):
     assert compare.store_differences(ours, changed) == ["peak"]
     longer = _store(tmp_path / "longer.nc", peak, {}, extra=True)
     assert compare.store_differences(longer, ours) == ["closure (only in one)"]
+    with xr.open_dataset(ours) as data:  # a new coordinate on a dimension: only it differs, not every variable on that dimension
+        tagged = data.load().assign_coords(record_pulse=("record", [0.0, 1.0]))
+    tagged.to_netcdf(tmp_path / "tagged.nc")
+    assert compare.store_differences(ours, tmp_path / "tagged.nc") == ["record_pulse (only in one)"]
 
 
 def test_the_option_takes_the_shipped_experiment_or_a_file():
