@@ -720,18 +720,17 @@ def _refined_chain(inputs: RiskInputs, hz: HazardCurve, grid: np.ndarray, target
         return fit, risk_curve(fit, hz, years, confidence)
 
     fragility, curve = fitted(grid, 0)
-    refinements, converged = 0, tolerance is None
-    while not converged and refinements <= MAX_REFINEMENTS:
+    for refinements in range(MAX_REFINEMENTS + 1 if tolerance is not None else 0):  # the last pass only checks convergence
         estimate = _separation(curve[["maf"]], fragility, hz, targets, years, confidence, inputs.method)  # g* alone: no resamples
         added = refinement_gaps(fragility["gap"].values, estimate, tolerance)
         converged = not added.size
-        if not converged and refinements < MAX_REFINEMENTS:
-            fit, more = fitted(added, fragility.sizes["gap"])
-            fragility, curve = _with_gaps(fragility, fit), _with_gaps(curve, more)
-        refinements += not converged
+        if converged or refinements == MAX_REFINEMENTS:
+            break
+        fit, more = fitted(added, fragility.sizes["gap"])
+        fragility, curve = _with_gaps(fragility, fit), _with_gaps(curve, more)
     separation = _separation(curve, fragility, hz, targets, years, confidence, inputs.method)
     note = (f"{grid.size} gaps as given, not refined" if tolerance is None else
-            grid_note(fragility.sizes["gap"], grid.size, min(refinements, MAX_REFINEMENTS), tolerance, converged))
+            grid_note(fragility.sizes["gap"], grid.size, refinements, tolerance, converged))
     return fragility, curve, separation.assign_attrs(grid=note)
 
 
