@@ -8,7 +8,8 @@ comparison with an earlier revision (:mod:`benchmarks.compare`),
 ``python -m benchmarks rare_events`` subset simulation's on Au & Beck's oscillator (:mod:`benchmarks.rare_events`),
 ``python -m benchmarks site_motions`` the site-based stochastic motions' (:mod:`benchmarks.site_motions`),
 ``python -m benchmarks startup`` the quick start's start-up (:mod:`benchmarks.startup`),
-``python -m benchmarks measure_free`` the measure-free risk at the demo site (:mod:`benchmarks.measure_free`).
+``python -m benchmarks measure_free`` the measure-free risk at the demo site (:mod:`benchmarks.measure_free`),
+``python -m benchmarks inelastic_demand`` simulated and recorded motions' inelastic demand at matched spectra (:mod:`benchmarks.inelastic_demand`).
 
 The thread pools of BLAS, OpenMP and numba are set to one thread here,
 before numpy is imported, so that every in-process measurement runs on one core.
@@ -32,7 +33,7 @@ import time  # noqa: E402
 from pathlib import Path  # noqa: E402
 
 from benchmarks import compare, experiment_scale, measure_free, rare_events, rare_moat, report, site_motions, spectrum, startup, suite, yielding  # noqa: E402
-from benchmarks import measure_comparison  # noqa: E402
+from benchmarks import inelastic_demand, measure_comparison  # noqa: E402
 from benchmarks.sections import keep_sections  # noqa: E402
 from benchmarks.timing import REPOSITORY  # noqa: E402
 
@@ -74,6 +75,8 @@ def main(argv: list[str] | None = None) -> int:
         return startup.main(argv[1:])
     if argv[:1] == ["measure_free"]:
         return measure_free.main(argv[1:])
+    if argv[:1] == ["inelastic_demand"]:
+        return inelastic_demand.main(argv[1:])
     arguments = parse_arguments(argv)
     config = suite.Config.quick_preset() if arguments.quick else suite.Config.full()
     if arguments.no_opensees:
@@ -88,7 +91,7 @@ def main(argv: list[str] | None = None) -> int:
     old = markdown.read_text() if markdown.exists() else ""
     sections = (experiment_scale.SECTION, compare.SECTION, spectrum.SECTION, yielding.SECTION, site_motions.SECTION, site_motions.HELD_OUT,
                 startup.SECTION, measure_free.SECTION, rare_moat.SECTION)
-    sections += (measure_comparison.SECTION,)
+    sections += (measure_comparison.SECTION, inelastic_demand.SECTION)
     markdown.write_text(keep_sections(old, report.document(results, info, elapsed), sections))
     print(f"wrote {markdown} and {figure} in {elapsed:.1f} s")
     return 0
