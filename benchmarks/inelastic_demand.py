@@ -349,10 +349,19 @@ def mixed_lines(dataset: xr.Dataset) -> list[str]:
     return lines
 
 
+def _spread_interval(sample: np.ndarray, reference: np.ndarray, draws: int = 4000, seed: int = 0) -> tuple[float, float, float]:
+    """σ ln ``sample`` − σ ln ``reference`` (sample standard deviations) and its 90 % bootstrap interval."""
+    rng = np.random.default_rng(seed)
+    ln_s, ln_r = np.log(sample), np.log(reference)
+    boot = [np.std(rng.choice(ln_s, ln_s.size), ddof=1) - np.std(rng.choice(ln_r, ln_r.size), ddof=1) for _ in range(draws)]
+    low, high = np.percentile(boot, [5.0, 95.0])
+    return float(np.std(ln_s, ddof=1) - np.std(ln_r, ddof=1)), float(low), float(high)
+
+
 def common_table(dataset: xr.Dataset) -> list[str]:
     """Building 1 under every record and the first simulated motions, each scaled to a common PSA(T1) (Markdown rows)."""
-    lines = ["| PSA(T1) (g) | motions | B1 drift, median (m) | 84 % (m) | geometric mean (m) | records / simulated, geometric means [90 % interval] |",
-             "|---|---|---:|---:|---:|---|"]
+    lines = ["| PSA(T1) (g) | motions | B1 drift, median (m) | 84 % (m) | geometric mean (m) | σ ln drift | records / simulated, geometric means "
+             "[90 % interval] | σ ln drift, records − simulated [90 % interval] |", "|---|---|---:|---:|---:|---:|---|---|"]
     pulses = _pulses(dataset, "all records")
     for stripe in STRIPES:
         level = dataset.attrs[f"PSA(T1) {stripe}"]
@@ -361,8 +370,9 @@ def common_table(dataset: xr.Dataset) -> list[str]:
         for label, drift in ((f"{everything.size} records", everything), (f"{np.sum(~pulses)} records without pulses", everything[~pulses]),
                              (f"{np.sum(pulses)} pulse records", everything[pulses]), (f"{simulated.size} simulated", simulated)):
             ratio = "" if drift is simulated else "{:.2f} [{:.2f}-{:.2f}]".format(*_ratio_interval(drift, simulated))
+            spread = "" if drift is simulated else "{:+.2f} [{:+.2f} to {:+.2f}]".format(*_spread_interval(drift, simulated))
             lines.append(f"| {level:.2f} ({_stripe_label(stripe)} median at T1) | {label} | {np.median(drift):.4f} | {np.percentile(drift, 84):.4f} | "
-                         f"{_gmean(drift):.4f} | {ratio} |")
+                         f"{_gmean(drift):.4f} | {np.std(np.log(drift), ddof=1):.2f} | {ratio} | {spread} |")
     return lines
 
 
