@@ -436,11 +436,11 @@ def newmark_check(count: int = 2) -> float:
                for m in motions)
 
 
-def section(dataset: xr.Dataset, info: dict[str, str], check: float) -> str:
+def section(dataset: xr.Dataset, check: float) -> str:
     """The section of docs/benchmarks.md (markers included)."""
     scenario = f"M {SCENARIO['magnitude']:g}, R_rup {SCENARIO['distance_km']:g} km, Vs30 {SCENARIO['vs30']:g} m/s, {SCENARIO['mechanism'].replace('_', '-')}"
     text = [SECTION.start, "", "## Inelastic demand of simulated and recorded motions", "",
-            f"`python -m benchmarks inelastic_demand` (commit {info['commit']}, {info['date']}, load {info['load average (1 min) at start']} at start, "
+            f"`python -m benchmarks inelastic_demand` (commit {dataset.attrs['commit']}, {dataset.attrs['date']}, load {dataset.attrs['load']} at start, "
             f"{dataset.attrs['minutes']:.0f} min). The risk flagship's fitted scenario ({scenario}), its stripes of PSA(1 s) and its selection "
             f"rules ({MOTIONS} motions, scale factor ≤ {MAX_SCALE_FACTOR:g}, ≤ {MAX_PER_EARTHQUAKE} of an earthquake, seed {SEED}); pools: the 100 FEMA P695 "
             f"components, {dataset.attrs['simulated']} hazard-compatible simulated motions of the scenario (seed {SEED}, dt = {DT} s), or both "
@@ -473,10 +473,14 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--load", type=Path, help="render from numbers saved by --save instead of measuring")
     parser.add_argument("--out", type=Path, default=REPOSITORY / "docs" / "benchmarks.md")
     arguments = parser.parse_args(argv)
-    info = report.machine()
-    dataset = xr.load_dataset(arguments.load) if arguments.load else measure(arguments.simulated, arguments.unselected)
+    if arguments.load:
+        dataset = xr.load_dataset(arguments.load)
+    else:
+        info = report.machine()
+        dataset = measure(arguments.simulated, arguments.unselected).assign_attrs(
+            commit=info["commit"], date=info["date"], load=info["load average (1 min) at start"])
     if arguments.save:
         dataset.to_netcdf(arguments.save)
-    SECTION.write(arguments.out, section(dataset, info, newmark_check()))
+    SECTION.write(arguments.out, section(dataset, newmark_check()))
     print(f"wrote {arguments.out}")
     return 0
