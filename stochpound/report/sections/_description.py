@@ -21,7 +21,7 @@ import pandas as pd
 from stochpound import motions as synthetic_motions
 from stochpound._plurals import counted
 from stochpound.experiment import CASE, is_fixed_base
-from stochpound.analysis import Configuration, StoreScenes
+from stochpound.analysis import Configuration, ScenarioIntensity, StoreScenes
 from stochpound.model import laws
 from stochpound.motions.records import load_record, registry_entries
 from stochpound.report.render import Paragraph, Table
@@ -258,49 +258,31 @@ def _merged_table(key: str, caption: str, columns: list[str], rows: Mapping[tupl
 
 
 def _scenario_parameters(source: MotionSource) -> tuple[str, dict[str, float]]:
-    """What a scenario ensemble's motions are (``type = "scenario_motions"``), read from its motions as run (regenerated from the
-    store's table: their high-pass corner, their PGA and PSA(1 s) beside the NGA-West2 average's), where the model is not valid,
-    and its step and window."""
+    """What a scenario ensemble's motions are (``type = "scenario_motions"``), as run (:meth:`~stochpound.analysis.ScenarioIntensity.of`:
+    their high-pass corner, their PGA and PSA(1 s) beside the NGA-West2 average's), where the model is not valid, and its step and window."""
     table = source.motion
-    scenario = {"magnitude": float(table["magnitude"]), "distance_km": float(table["distance_km"]), "vs30": float(table["vs30"]),
-                "mechanism": str(table["mechanism"])}
-    ran = synthetic_motions.scenario_motions(source.count, float(table["duration"]), float(table["dt"]), **scenario, seed=int(table["seed"]),
-                                             start=source.start, model=str(table["model"]), calibration=str(table["calibration"]))
+    ran = ScenarioIntensity.of(table, source.start, source.count)
     calibrated = table["model"] == "hazard_compatible"
-    text = (f"Site-based stochastic motions of the scenario M {number(scenario['magnitude'])}, R_rup {number(scenario['distance_km'])} km, "
-            f"Vs30 {number(scenario['vs30'])} m/s, {scenario['mechanism'].replace('_', '-')} (Rezaeian & Der Kiureghian 2010, "
+    text = (f"Site-based stochastic motions of the scenario M {number(float(table['magnitude']))}, R_rup {number(float(table['distance_km']))} km, "
+            f"Vs30 {number(float(table['vs30']))} m/s, {str(table['mechanism']).replace('_', '-')} (Rezaeian & Der Kiureghian 2010, "
             + ("calibrated to the NGA-West2 models" if calibrated else "the published equations, not calibrated")
             + f": {table['calibration']}): each realization's Arias intensity, D5–95, time of 45 % of it (its gamma-shaped modulation), "
             "filter frequency, its slope and damping drawn from the scenario with correlated residuals; "
-            + _corner_text(ran["f_corner"].values)
+            + (f"a high-pass post-filter, its corner fixed at {number(ran.corner_low, 3)} Hz" if ran.corner_low == ran.corner_high
+               else f"a high-pass post-filter, its corner drawn per realization ({number(ran.corner_low, 3)}–{number(ran.corner_high, 3)} Hz)")
             + ("; then a spectral-shape filter whose random gains at 12 periods (0.05–5 s) are set so that the motions' median and σ of "
                "ln PSA follow the scenario's NGA-West2 average (ASK14, BSSA14, CB14, CY14)" if calibrated else "")
-            + "; ends at rest; linear interpolation between samples. " + _scenario_intensity(ran, scenario)
+            + "; ends at rest; linear interpolation between samples. " + _scenario_intensity(ran)
             + " Not valid for: near-fault velocity pulses, directivity, basin effects beyond the NGA-West2 models' basin terms; "
             "one horizontal component stands for the models' RotD50 (docs/site-motions.md)")
     return text, {"dt": float(table["dt"]), "duration": float(table["duration"])}
 
 
-def _corner_text(corners: np.ndarray) -> str:
-    """The motions' high-pass corner as run: one fixed value, or the range drawn."""
-    low, high = float(corners.min()), float(corners.max())
-    if low == high:
-        return f"a high-pass post-filter, its corner fixed at {number(low, 3)} Hz"
-    return f"a high-pass post-filter, its corner drawn per realization ({number(low, 3)}–{number(high, 3)} Hz)"
-
-
-def _scenario_intensity(ran: Any, scenario: Mapping[str, float | str]) -> str:
-    """The motions' median and σ of ln PGA and ln PSA(1 s, 5 %) beside the scenario's NGA-West2 average."""
-    g = synthetic_motions.DEFAULT_G
-    pga = np.log(np.abs(ran.values).max(axis=1) / g)
-    psa = np.log([float(synthetic_motions.response_spectrum(row, float(ran.attrs["dt"]), [1.0])["psa"][0]) / g for row in ran.values])
-    parts = []
-    for words, measure, period, values in (("PGA", "pga", None, pga), ("PSA(1 s)", "psa", 1.0, psa)):
-        median, sigma = synthetic_motions.scenario_distribution(measure, period, **scenario)
-        spread = f", σ_ln {np.std(values, ddof=1):.2f}" if values.size > 1 else ""
-        parts.append(f"{words} {np.exp(np.median(values)):.3g} g{spread} (NGA-West2 average {median:.3g} g, σ_ln {sigma:.2f})")
-    count = counted(ran.sizes["realization"], "motion")
-    return f"Intensity, the median over the {count} as run: " + "; ".join(parts) + "."
+def _scenario_intensity(ran: ScenarioIntensity) -> str:
+    """The motions' median and σ of ln PGA and ln PSA(1 s) beside the scenario's NGA-West2 average, in words."""
+    parts = [f"{m.name} {m.median:.3g} g" + (f", σ_ln {m.sigma_ln:.2f}" if ran.count > 1 else "")
+             + f" (NGA-West2 average {m.target_median:.3g} g, σ_ln {m.target_sigma_ln:.2f})" for m in ran.measures]
+    return f"Intensity, the median over the {counted(ran.count, 'motion')} as run: " + "; ".join(parts) + "."
 
 
 def _synthetic_parameters(source: MotionSource) -> tuple[str, dict[Hashable, Any]]:
