@@ -40,6 +40,7 @@ IDENTITIES = {
     "bd9b53093d44e3e4acc85e308510add994bdf7abef03df62e1f2f88028935856": "4baf14717bf47188d5761c7a878b1636513e2d3c3992b75e15e25c72041021ae",  # experiments/laws/contact_laws.toml
     "b0bc24556ed7b2bb62f13e80740d38c648825a8938a77b173d1000f51d65c729": "6a1f389f07a4ddb74a22fbafd5d9eaf12cfb7b010b75506e2a1437e07f1be195",  # experiments/stochastic/pounding.toml (new header)
     "d56473cac48340cc68606154cbb115fb794049dc6fb3d77ff1821a7066fcd85a": "8a6ef71bb071e15ec33cd31b3563f219aae44fcad9ced8bf7d78fa71bc127cea",  # experiments/stochastic/scenario_m7_20km.toml
+    "086c94dc09671a62f1bfe289e8a0ee7bf0f9ccde3895b7a6d4145f49089990eb": "8a6ef71bb071e15ec33cd31b3563f219aae44fcad9ced8bf7d78fa71bc127cea",  # experiments/stochastic/scenario_m7_20km.toml (re-timed)
     "30f757d6a000b675d5a77664f7ebaac77f5f8fe2bdaaa81c5a883ef996a93fda": "8587d2f9de1b97fd57b3799a668aa67bd90c2019b1ba238e1c664b982fc3c61a",  # experiments/risk/fixed_pair.toml
     "7ee6d0bbad225fc7ce1b98b350144c895ed0d284696c10d4e0c60c6e1901feaf": "45709c88b8c56c21d821c3429b50c35316a024bc8615d148e8dad43a333a280f",  # experiments/risk/fixed_pair.toml (yielding)
     "2ac35eca7fc1effebf5cc3dea300b01aadfa0cc86abb47b348e411247cb9c803": "40f7acef22ebc787ae56e0d0b2a347f5bd6eed6c553e7fbc0902cd26d1a814df",  # experiments/risk/isolated.toml

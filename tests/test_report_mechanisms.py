@@ -9,7 +9,9 @@ import xarray as xr
 from stochpound.analysis import StoreEnsemble
 from stochpound.experiment import open_store
 from stochpound.report.sections._ensembles import MIN_RUNS, Ensemble
-from stochpound.report.sections._mechanism_findings import amplification_text, mechanism_answer, mechanism_findings, ratcheting_text
+from stochpound.report.sections._mechanism_findings import (
+    _lowered_summary, _pushed_summary, amplification_text, mechanism_answer, mechanism_findings, ratcheting_text,
+)
 from stochpound.store import wall_axis
 from tests.helpers import run_in_process
 
@@ -41,7 +43,7 @@ def free() -> xr.DataArray:
 def test_ratcheting_is_stated_where_the_runs_hold_it(free):
     pushed = (free - 0.1).expand_dims(gap=[0.02])
     text = ratcheting_text(Runs({"residual_sliding": pushed}), Runs({"residual_sliding": free}), away=-1)
-    assert "pounding ratchets B1's sliding base" in text and f"in 1 of the 1 cells with contacts that have at least {MIN_RUNS}" in text
+    assert "pounding ratchets B1's sliding base" in text and f"in 1 of the 1 cell with contacts that have at least {MIN_RUNS}" in text
     assert f"at gap 2 cm, mean abs(residual sliding) {float(abs(pushed).mean()) * 100:.3g} cm" in text and f"(n = {N})" in text
     assert "No resolved ratcheting" not in text
 
@@ -50,7 +52,7 @@ def test_ratcheting_absent_is_said_to_be_absent(free):
     same = (free + np.random.default_rng(6).normal(0.0, 0.001, N)).expand_dims(gap=[0.02])
     text = ratcheting_text(Runs({"residual_sliding": same}), Runs({"residual_sliding": free}), away=-1)
     assert "it does not ratchet it in any of them" in text and "No resolved ratcheting at gap 2 cm" in text
-    assert "pounding ratchets B1's sliding base —" in text and "in 0 of the 1 cells" in text
+    assert "pounding ratchets B1's sliding base —" in text and "in 0 of the 1 cell" in text
     few = same.where(same.realization < MIN_RUNS - 1)
     assert "not assessed: no cell has" in ratcheting_text(Runs({"residual_sliding": few}), Runs({"residual_sliding": free}), away=-1)
     assert "not assessed" in ratcheting_text(Runs({"residual_sliding": same}), Runs({"residual_sliding": free}), away=None)
@@ -128,11 +130,11 @@ def test_a_moat_store_states_the_wall_s_amplification_and_its_largest_penetratio
         assert np.isnan(store["peak_wall_penetration"].sel(moat="none")).all() and largest > 0
     assert len(texts) == 3 and not any("Ratcheting" in t for t in texts)  # no contacts: no contact-free twins
     acceleration, drift, wall = texts
-    assert acceleration.startswith("Amplification of the peak floor acceleration by a wall (kt_soft, B1)") and "It raises it in 1 of the 1 cells" in acceleration
+    assert acceleration.startswith("Amplification of the peak floor acceleration by a wall (kt_soft, B1)") and "It raises it in 1 of the 1 cell" in acceleration
     assert drift.startswith("Amplification of the peak storey drift by a wall") and "raises it in 1 of the 1" in drift
     assert f"the largest penetration is {largest * 100:.3g} cm" in wall and "at moat w02, realization" in wall
     assert "(k = 42.75 MN/m)" in wall
-    assert "ensemble kt_soft: a wall raises the peak floor acceleration in 1 of 1 cells" in answer
+    assert "ensemble kt_soft: a wall raises the peak floor acceleration in 1 of 1 cell" in answer
     assert f"the walls were penetrated by up to {largest * 100:.3g} cm" in answer and "ratchets" not in answer
     with open_store(moat_store) as store:
         tables = Ensemble("moat_test", store, "kt_soft").tables()
@@ -180,7 +182,7 @@ demands = true
         section = store_section("pair_test", with_contacts(store), True, store)
     texts = [getattr(block, "text", "") for block in section.blocks]
     ratchet = next(t for t in texts if t.startswith("Ratcheting (kt, B1): "))
-    assert "cells with contacts that have at least" in ratchet and "(to the left)" in ratchet
+    assert "with contacts that have at least" in ratchet and "(to the left)" in ratchet
     assert any(t.startswith("Amplification of the peak floor acceleration by pounding (kt, B1)") for t in texts)
     assert not any(t.startswith("Wall penetration") for t in texts)
     with open_store(tmp_path / "pair_test.nc") as store:
@@ -235,10 +237,30 @@ dt = 0.02
     assert "per value of" not in texts[0]
 
 
-def test_a_residual_pushed_away_without_ratcheting_is_counted_in_the_summary_too():
-    free = _runs(np.random.default_rng(8).normal(0.05, 0.005, N))
-    pushed = (free - 0.05 + np.random.default_rng(9).normal(0.0, 0.001, N)).expand_dims(gap=[0.02])  # towards the neighbour's side, smaller
+def test_a_residual_pushed_away_without_a_change_of_size_is_its_own_class_with_its_size_in_the_summary():
+    half = 0.01 + np.abs(np.random.default_rng(8).normal(0.0, 0.05, N // 2))
+    free = _runs(np.concatenate([half, -half]))  # as many residuals right as left, none within 1 cm of the start
+    pushed = (free - 0.002 + np.random.default_rng(9).normal(0.0, 0.0005, N)).expand_dims(gap=[0.02])  # 2 mm further left: abs ± 2 mm
     pounding, twins = Runs({"residual_sliding": pushed}), Runs({"residual_sliding": free})
     found = pounding.ratcheting_against(twins, away=-1)
-    assert found.flagged_count == 0 and found.pushed_count == 1
-    assert "In 1 cells the impacts push the residual away from the neighbour" in ratcheting_text(pounding, twins, away=-1)
+    assert found.flagged_count == 0 and len(found.pushed()) == 1 and not found.lowered()
+    text = ratcheting_text(pounding, twins, away=-1)
+    assert "In 1 cell the impacts push the residual away from the neighbour without a resolved change of its size" in text
+    assert "nearer its start" not in text
+    push = -float((pushed.squeeze("gap") - free).mean()) * 100  # cm to the left (away), the paired mean computed here
+    assert _pushed_summary(found) == (f" and pushes its residual away from the neighbour (by {push:.2g} cm on average), without a resolved "
+                                      "change of its size, in 1 more")
+
+
+def test_a_residual_moved_back_from_the_neighbours_side_is_lowered_not_pushed(free):
+    """Moved away from the neighbour and made smaller (a base left toward the neighbour brought back to its start): one class only,
+    the lowered one, in the findings and in the summary (it was counted in both, and as a push away in the summary)."""
+    start = _runs(np.random.default_rng(8).normal(0.05, 0.005, N))
+    back = (start - 0.05 + np.random.default_rng(9).normal(0.0, 0.001, N)).expand_dims(gap=[0.02])
+    pounding, twins = Runs({"residual_sliding": back}), Runs({"residual_sliding": start})
+    found = pounding.ratcheting_against(twins, away=-1)
+    assert float(found.found["away_change_lower"].squeeze()) > 0  # it did move away from the neighbour ...
+    assert found.flagged_count == 0 and len(found.lowered()) == 1 and not found.pushed()  # ... but is stated once, as lowered
+    text = ratcheting_text(pounding, twins, away=-1)
+    assert "In 1 cell pounding leaves the base nearer its start than without contacts" in text and "push the residual away" not in text
+    assert _pushed_summary(found) == "" and _lowered_summary(found) == "; it leaves the base nearer its start than without contacts in 1 cell"

@@ -8,9 +8,11 @@ import pytest
 from stochpound import open_store, simulate
 from stochpound.experiment._runner import load_experiment, run_experiment
 from stochpound.model.scene_file import scene_from_dict
-from stochpound.motions import SYNTHETIC_TYPES, normal_motion, realization_rng, scenario_motions, site_model_provenance, site_motions
-from stochpound.report.sections._description import StoreDefinition, _scenario_parameters, motions_table
-from stochpound.store import with_motion
+from stochpound.motions import (
+    SYNTHETIC_TYPES, normal_motion, realization_rng, scenario_distribution, scenario_motions, site_model_provenance, site_motions,
+)
+from stochpound.report.sections._description import StoreDefinition, _scenario_parameters, grid_paragraph, motions_table
+from stochpound.store import MotionSource, with_motion
 from tests.helpers import SITE_SCENE, write_experiment
 
 SCENARIO = {"magnitude": 6.8, "distance_km": 15.0, "vs30": 450.0, "mechanism": "reverse"}
@@ -88,10 +90,30 @@ def test_a_scenario_table_out_of_range_is_one_line_naming_the_field(tmp_path, ed
 
 
 def test_the_motions_table_says_what_the_motions_are() -> None:
+    """Read from the motions as run: the corner they have (fixed in this calibration, not drawn), their intensity beside the
+    NGA-West2 average's, and where the model is not valid (it said "high-pass corner drawn" and gave no intensity)."""
     entry = {"type": "scenario_motions", **SCENARIO, "seed": 5, "dt": 0.02, "duration": 30.0, "model": "hazard_compatible",
              "calibration": site_model_provenance()}
-    text, grid = _scenario_parameters(entry)
+    source = MotionSource("quake", "synthetic", "synthetic.quake", entry, start=2, count=6)
+    text, grid = _scenario_parameters(source)
     assert text.startswith("Site-based stochastic motions of the scenario M 6.8, R_rup 15 km, Vs30 450 m/s, reverse (Rezaeian & Der Kiureghian 2010, "
                            f"calibrated to the NGA-West2 models: {site_model_provenance()})")
-    assert "a spectral-shape filter whose random gains follow the scenario's NGA-West2 medians and σ" in text
+    ran = site_motions(**SCENARIO, n=8, seed=5, dt=0.02, duration=30.0).isel(realization=slice(2, 8))  # the 6 motions, drawn here
+    corners = np.unique(ran.f_corner.values)
+    assert corners.size == 1 and f"its corner fixed at {corners[0]:.3g} Hz" in text and "corner drawn" not in text
+    assert "random gains at 12 periods (0.05–5 s) are set so that the motions' median and σ of ln PSA follow" in text
+    pga = np.log(np.abs(ran.acceleration.values).max(axis=1) / 9.81)  # g as the calibration's check takes it
+    median, sigma = scenario_distribution("pga", magnitude=6.8, distance_km=15.0, vs30=450.0, mechanism="reverse")
+    assert (f"Intensity, the median over the 6 motions as run: PGA {np.exp(np.median(pga)):.3g} g, σ_ln {np.std(pga, ddof=1):.2f} "
+            f"(NGA-West2 average {median:.3g} g, σ_ln {sigma:.2f}); PSA(1 s) ") in text
+    assert "Not valid for: near-fault velocity pulses, directivity, basin effects" in text
     assert grid == {"dt": 0.02, "duration": 30.0}
+
+
+def test_a_scenario_ensembles_table_has_no_psd_convention_and_counts_its_realizations(tmp_path) -> None:
+    """The PSD convention belongs to Kanai–Tajimi-type ensembles, and one ensemble of 3 motions is not "1 motion(s)"."""
+    experiment = load_experiment(write_experiment(tmp_path, _text(TABLE), "scenario.toml"))
+    store = open_store(run_experiment(experiment, workers=0, progress=False).store).load()
+    definition = StoreDefinition("scenario", store)
+    assert "PSD" not in motions_table([definition]).note
+    assert "under 1 synthetic ensemble of 3 realizations (Table of motions)" in grid_paragraph(definition).text

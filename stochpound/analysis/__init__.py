@@ -35,6 +35,7 @@ from stochpound.analysis._measure_comparison import compare_measures
 from stochpound.analysis._sufficiency import SUFFICIENCY_LEVEL, StoreSufficiency, Sufficiency, store_sufficiency, stripe_regression
 from stochpound.analysis._summary import run_summary
 from stochpound.analysis._mechanism_cells import MechanismCells, WallPenetration
+from stochpound.analysis._scenario_intensity import MeasureIntensity, ScenarioIntensity
 from stochpound.analysis._store_ensemble import RARE, ProbabilityAt, StoreEnsemble
 from stochpound.analysis._record_cases import RecordPounding
 from stochpound.analysis._cell_statistics import CellStatistics
@@ -148,6 +149,8 @@ __all__ = [
     "WALLS",
     "ValueRange",
     "MechanismCells",
+    "MeasureIntensity",
+    "ScenarioIntensity",
     "WallPenetration",
     "subset_simulation",
     "RESPONSES",

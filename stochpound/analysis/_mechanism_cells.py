@@ -61,8 +61,9 @@ class MechanismCells:
         return [c for c in self.assessed() if bool(self.found["lowers"].sel(c))]
 
     def pushed_away(self) -> xr.DataArray:
-        """Cells where the impacts move the residual away from the neighbour (interval above 0) without ratcheting it (ratcheting only)."""
-        return self.found["enough"] & ~self.found["ratchets"] & (self.found["away_change_lower"] > 0)
+        """Cells where the impacts move the residual away from the neighbour (interval above 0) without a resolved change of its size
+        (ratcheting only): neither ratcheting (size up) nor lowering it (size down, :meth:`lowered`), so that a cell is in one class."""
+        return self.found["enough"] & ~self.found["ratchets"] & ~self.found["lowers"] & (self.found["away_change_lower"] > 0)
 
     def pushed(self) -> list[CellLabels]:
         """The assessed cells of :meth:`pushed_away`."""
@@ -82,11 +83,6 @@ class MechanismCells:
     def assessed_count(self) -> int:
         """How many cells have enough paired runs."""
         return int(self.found["enough"].sum())
-
-    @property
-    def pushed_count(self) -> int:
-        """How many cells :meth:`pushed_away` holds."""
-        return int(self.pushed_away().sum())
 
     def ratio_range(self) -> tuple[float, float] | None:
         """The smallest and largest mean per-run ratio over the cells that raise (amplification only); None where none does."""

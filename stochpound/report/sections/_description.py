@@ -19,8 +19,9 @@ import numpy as np
 import pandas as pd
 
 from stochpound import motions as synthetic_motions
+from stochpound._plurals import counted
 from stochpound.experiment import CASE, is_fixed_base
-from stochpound.analysis import Configuration, StoreScenes
+from stochpound.analysis import Configuration, ScenarioIntensity, StoreScenes
 from stochpound.model import laws
 from stochpound.motions.records import load_record, registry_entries
 from stochpound.report.render import Paragraph, Table
@@ -256,17 +257,32 @@ def _merged_table(key: str, caption: str, columns: list[str], rows: Mapping[tupl
     return Table(key=key, caption=caption, frame=frame, note=note)
 
 
-def _scenario_parameters(table: Mapping[str, float | str]) -> tuple[str, dict[str, float]]:
-    """What a scenario ensemble's motions are (``type = "scenario_motions"``), and its step and window."""
-    calibrated = ("calibrated to the NGA-West2 models" if table["model"] == "hazard_compatible" else "the published equations, not calibrated")
+def _scenario_parameters(source: MotionSource) -> tuple[str, dict[str, float]]:
+    """What a scenario ensemble's motions are (``type = "scenario_motions"``), as run (:meth:`~stochpound.analysis.ScenarioIntensity.of`:
+    their high-pass corner, their PGA and PSA(1 s) beside the NGA-West2 average's), where the model is not valid, and its step and window."""
+    table = source.motion
+    ran = ScenarioIntensity.of(table, source.start, source.count)
+    calibrated = table["model"] == "hazard_compatible"
     text = (f"Site-based stochastic motions of the scenario M {number(float(table['magnitude']))}, R_rup {number(float(table['distance_km']))} km, "
             f"Vs30 {number(float(table['vs30']))} m/s, {str(table['mechanism']).replace('_', '-')} (Rezaeian & Der Kiureghian 2010, "
-            f"{calibrated}: {table['calibration']}): each realization's Arias intensity, D5–95, time of 45 % of it, filter frequency, "
-            "its slope and damping, and high-pass corner drawn from the scenario with correlated residuals, "
-            + ("then a spectral-shape filter whose random gains follow the scenario's NGA-West2 medians and σ, " if table["model"] == "hazard_compatible" else "")
-            + "then its white noise; "
-            "ends at rest; linear interpolation between samples")
+            + ("calibrated to the NGA-West2 models" if calibrated else "the published equations, not calibrated")
+            + f": {table['calibration']}): each realization's Arias intensity, D5–95, time of 45 % of it (its gamma-shaped modulation), "
+            "filter frequency, its slope and damping drawn from the scenario with correlated residuals; "
+            + (f"a high-pass post-filter, its corner fixed at {number(ran.corner_low, 3)} Hz" if ran.corner_low == ran.corner_high
+               else f"a high-pass post-filter, its corner drawn per realization ({number(ran.corner_low, 3)}–{number(ran.corner_high, 3)} Hz)")
+            + ("; then a spectral-shape filter whose random gains at 12 periods (0.05–5 s) are set so that the motions' median and σ of "
+               "ln PSA follow the scenario's NGA-West2 average (ASK14, BSSA14, CB14, CY14)" if calibrated else "")
+            + "; ends at rest; linear interpolation between samples. " + _scenario_intensity(ran)
+            + " Not valid for: near-fault velocity pulses, directivity, basin effects beyond the NGA-West2 models' basin terms; "
+            "one horizontal component stands for the models' RotD50 (docs/site-motions.md)")
     return text, {"dt": float(table["dt"]), "duration": float(table["duration"])}
+
+
+def _scenario_intensity(ran: ScenarioIntensity) -> str:
+    """The motions' median and σ of ln PGA and ln PSA(1 s) beside the scenario's NGA-West2 average, in words."""
+    parts = [f"{m.name} {m.median:.3g} g" + (f", σ_ln {m.sigma_ln:.2f}" if ran.count > 1 else "")
+             + f" (NGA-West2 average {m.target_median:.3g} g, σ_ln {m.target_sigma_ln:.2f})" for m in ran.measures]
+    return f"Intensity, the median over the {counted(ran.count, 'motion')} as run: " + "; ".join(parts) + "."
 
 
 def _synthetic_parameters(source: MotionSource) -> tuple[str, dict[Hashable, Any]]:
@@ -274,7 +290,7 @@ def _synthetic_parameters(source: MotionSource) -> tuple[str, dict[Hashable, Any
     generated realization's attributes (a scenario ensemble's: its step and window)."""
     table = source.motion
     if table["type"] == "scenario_motions":
-        return _scenario_parameters(table)
+        return _scenario_parameters(source)
     parameters = {k: v for k, v in table.items() if k not in ("type", "interpolation")}
     attrs = getattr(synthetic_motions, table["type"])(1, start=source.start, **parameters).attrs
     filtered = "omega_g" in attrs  # white noise has no filter
@@ -336,7 +352,7 @@ def _record_parameters(motion: MotionTable) -> tuple[str, str]:
 def motions_table(definitions: Iterable[StoreDefinition]) -> Table:
     """Every ground motion the stores ran: records with their treatment, ensembles with their generator and seed."""
     rows = []
-    pool = 0
+    pool, spectral = 0, False
     for definition in definitions:
         ran = motions_that_ran(definition.store)
         for motion in definition.definition.motions:
@@ -345,6 +361,7 @@ def motions_table(definitions: Iterable[StoreDefinition]) -> Table:
                 continue  # a pool motion a selection did not choose: it never ran
             table, typed = motion.motion, MotionTable.of_source(motion)
             if motion.kind == "synthetic":
+                spectral = spectral or table["type"] != "scenario_motions"  # an ensemble of a PSD (Kanai–Tajimi, Clough–Penzien, ...)
                 text, attrs = _synthetic_parameters(motion)
                 realizations = f"{motion.count} (indices {motion.start}–{motion.start + motion.count - 1}), seed {table['seed']}"
                 grid = f"{number(attrs['dt'])} s, {number(attrs['duration'])} s"
@@ -362,7 +379,7 @@ def motions_table(definitions: Iterable[StoreDefinition]) -> Table:
         caption="The ground motions as run: each record with its treatment, each synthetic ensemble with its generator, intensity, envelope, seed and size"
         + (f" ({len(frame)} of the {pool} motions the experiments define: a selection's pool motions it never chose are left out)." if len(frame) < pool else "."),
         frame=frame,
-        note="Realization i of an ensemble depends only on (seed, i). The PSD convention: two-sided in ω, σ² = ∫ S dω.",
+        note="Realization i of an ensemble depends only on (seed, i)." + (" The PSD convention: two-sided in ω, σ² = ∫ S dω." if spectral else ""),
     )
 
 
@@ -384,11 +401,22 @@ def grid_paragraph(definition: StoreDefinition) -> Paragraph:
     references = sum(1 for c in definition.experiment.cases if c.kind != CASE)
     return Paragraph(
         f"Experiment {definition.name}: {', '.join(axes) or 'a single configuration'}, under "
-        f"{len(definition.definition.motions)} motion(s) (Table of motions); g = {number(scene.g)} m/s². The studied building is "
+        f"{_motions_count(definition)} (Table of motions); g = {number(scene.g)} m/s². The studied building is "
         f"{definition.experiment.studied}: the response whose moments are reported is its top-floor total displacement, and "
         f"it is also run alone on a fixed base under every motion ({references} reference runs). "
         f"{store.pound.provenance.cases_done} of {store.pound.provenance.cases_total} runs done."
     )
+
+
+def _motions_count(definition: StoreDefinition) -> str:
+    """The experiment's motions in words: "3 motions", "1 synthetic ensemble of 200 realizations", or both."""
+    sources = definition.definition.motions
+    ensembles = [source.count for source in sources if source.kind == "synthetic"]
+    parts = [counted(len(sources) - len(ensembles), "motion")] if len(ensembles) < len(sources) else []
+    if ensembles:
+        parts.append(f"{counted(len(ensembles), 'synthetic ensemble')} of {counted(sum(ensembles), 'realization')}"
+                     + (" in all" if len(ensembles) > 1 else ""))
+    return " and ".join(parts)
 
 
 def model_paragraph(definitions: list[StoreDefinition]) -> Paragraph:

@@ -15,6 +15,7 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
+from stochpound._plurals import counted
 from stochpound.analysis import RARE, CellLabels, CellStatistics, ForceSpread, Largest
 from stochpound.report.render import Block, Paragraph, Table
 from stochpound.report.sections._ensembles import CM, MIN_RUNS, Ensemble
@@ -46,7 +47,7 @@ def precision(ensemble: Ensemble) -> Paragraph:
     """How wide the 95 % intervals of P(pounding) and of the mean peak displacement are."""
     found = CellStatistics(ensemble.statistics).precision()
     return Paragraph(
-        f"Ensemble {ensemble.label}: {ensemble.size} realizations in each of {found.cells} cells. The {ensemble.confidence:.0%} "
+        f"Ensemble {ensemble.label}: {ensemble.size} realizations in {'each of ' + str(found.cells) + ' cells' if found.cells > 1 else 'its one cell'}. The {ensemble.confidence:.0%} "
         f"interval of the probability of {ensemble.event} is at most ±{found.probability_widest:.3f} wide (median ±{found.probability_median:.3f}; widest "
         f"where P is near 0.5, narrowest where it is 0 or 1), and the mean peak total displacement of {ensemble.studied} is "
         f"known to ±{found.peak_median * 100:.1f} % (median over cells; at most ±{found.peak_widest * 100:.1f} %). "
@@ -70,7 +71,7 @@ def spread(ensemble: Ensemble) -> Paragraph:
             "estimated. "
         )
     sentence += (
-        f"In {found.between} of {found.cells} cells the probability of {ensemble.event} lies strictly between 0 and 1 with "
+        f"In {found.between} of {counted(found.cells, 'cell')} the probability of {ensemble.event} lies strictly between 0 and 1 with "
         f"{ensemble.confidence:.0%} confidence: there a single record answers yes or no where the ensemble gives a probability."
     )
     if found.force is not None:
@@ -86,11 +87,11 @@ def _force_spread(force: ForceSpread, top: float, impacting: str) -> str:
             "not estimated."
         )
     text = (
-        f"In the {force.cells} cells with at least {MIN_RUNS} {impacting} (n = {force.fewest}–{force.most}), "
+        f"In the {counted(force.cells, 'cell')} with at least {MIN_RUNS} {impacting} (n = {force.fewest}–{force.most}), "
         f"the {top * 100:g} % quantile of the peak impact force is {force.lowest:.2f} to {force.highest:.2f} times its median"
     )
     rest = force.rest
-    return text + (f"; the other {rest} cells have fewer {impacting} and give no ratio." if rest else ".")
+    return text + (f"; the other {counted(rest, 'cell')} {'has' if rest == 1 else 'have'} fewer {impacting} and give no ratio." if rest else ".")
 
 
 def gap_effect(ensemble: Ensemble, dim: str) -> list[Block]:
@@ -99,18 +100,27 @@ def gap_effect(ensemble: Ensemble, dim: str) -> list[Block]:
     found = CellStatistics(ensemble.statistics).gap_effect(dim, others)
     needed = found.rare
     event, gap = ensemble.event, ("clearance" if ensemble.event != "pounding" else "gap")
-    text = (
-        f"The probability of {event} falls as {dim_text(dim)} widens: over the {found.lines} combinations of "
-        f"{', '.join(dim_text(d) for d in others) or 'the grid'} it is lower at {value_text(dim, ensemble.grid[dim][-1])} than at "
-        f"{value_text(dim, ensemble.grid[dim][0])} in {found.lower_at_end} (P from {_range(found.first)} to {_range(found.last)}). "
-        f"{event.capitalize()} becomes rare (upper {ensemble.confidence:.0%} bound below "
-        f"{RARE:.0%} at that {gap} and every larger one of the grid) within the grid in {found.reached} of them"
-    )
-    if found.reached:
-        text += f", at {found.rare_low * CM:g} to {found.rare_high * CM:g} cm"
-    missing = [labels_text(cell) for cell in found.missing]
-    if missing:
-        text += f"; it does not within {value_text(dim, ensemble.grid[dim][-1])} for " + "; ".join(missing)
+    widest, narrowest = value_text(dim, ensemble.grid[dim][-1]), value_text(dim, ensemble.grid[dim][0])
+    rare = (f"{event.capitalize()} becomes rare (upper {ensemble.confidence:.0%} bound below {RARE:.0%} at that {gap} and every larger one "
+            "of the grid)")
+    if found.lines == 1:  # one line of the grid: its own numbers, not counts over combinations
+        trend = "falls" if found.lower_at_end else "does not fall"
+        text = (f"The probability of {event} {trend} as {dim_text(dim)} widens: from {found.first[0]:.3f} at {narrowest} to "
+                f"{found.last[0]:.3f} at {widest}. ")
+        text += (f"{rare} from {found.rare_low * CM:g} cm on" if found.reached else
+                 f"{rare} nowhere within {widest}")
+    else:
+        text = (
+            f"The probability of {event} falls as {dim_text(dim)} widens: over the {found.lines} combinations of "
+            f"{', '.join(dim_text(d) for d in others)} it is lower at {widest} than at {narrowest} in {found.lower_at_end} "
+            f"(P from {_range(found.first)} to {_range(found.last)}). {rare} within the grid in {found.reached} of them"
+        )
+        if found.reached:
+            text += (f", at {found.rare_low * CM:g} cm" if found.rare_low == found.rare_high
+                     else f", at {found.rare_low * CM:g} to {found.rare_high * CM:g} cm")
+        missing = [labels_text(cell) for cell in found.missing]
+        if missing:
+            text += f"; it does not within {widest} for " + "; ".join(missing)
     blocks: list[Block] = [Paragraph(text + ".")]
     if others:
         blocks.append(_needed_table(ensemble, dim, needed, others))
@@ -129,8 +139,9 @@ def _most(stats: xr.Dataset, fixed: xr.Dataset, largest: Largest | None, verb: s
 
 
 def _range(extent: tuple[float, float]) -> str:
+    """P over cells, to 3 decimals as the tables give it (0.995 is not 0.99)."""
     low, high = extent
-    return f"{low:.2f}" if f"{low:.2f}" == f"{high:.2f}" else f"{low:.2f}–{high:.2f}"
+    return f"{low:.3f}" if f"{low:.3f}" == f"{high:.3f}" else f"{low:.3f}–{high:.3f}"
 
 
 def _needed_table(ensemble: Ensemble, dim: str, needed: xr.DataArray, others: list[str]) -> Table:

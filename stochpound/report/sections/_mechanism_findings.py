@@ -26,6 +26,7 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
+from stochpound._plurals import counted
 from stochpound.analysis import CellLabels, MechanismCells
 from stochpound.experiment import is_gap_axis
 from stochpound.store import TomlTable, contact_free, contact_gap_dims, has_contact_free, wall_axis, with_contacts
@@ -100,11 +101,8 @@ def mechanism_answer(name: str, store: xr.Dataset) -> str | None:
             away = away_from_neighbour(store, impacts.studied)
             if cause == "pounding" and away is not None and impacts.sliding:
                 result = impacts.ratcheting_against(twins, away)
-                pushed = result.pushed_count
                 found.append(f"pounding ratchets {impacts.studied}'s sliding base in {result.flagged_count} of "
-                             f"{result.assessed_count} cells"
-                             + (f" and pushes its residual away from the neighbour, without a resolved increase of its size, in "
-                                f"{pushed} more" if pushed else ""))
+                             f"{counted(result.assessed_count, 'cell')}" + _pushed_summary(result) + _lowered_summary(result))
             found += [_raised(impacts.amplification_over(twins, v), cause, DEMANDS[v][0]) for v in DEMANDS if v in store]
         if "peak_wall_penetration" in store:
             deepest = _walled(name, store, label, axis).wall_penetration().largest
@@ -118,9 +116,28 @@ def mechanism_answer(name: str, store: xr.Dataset) -> str | None:
     return f"Which mechanisms do the runs show{how}? " + "; ".join(parts) + "."
 
 
+def _pushed_summary(result: MechanismCells) -> str:
+    """" and pushes its residual away from the neighbour (by 0.04–0.17 cm on average), without a resolved change of its size, in 2
+    more" ("" when no cell is pushed): the size of the push stated, so that a resolved but tiny effect reads as tiny."""
+    pushed = result.pushed()
+    if not pushed:
+        return ""
+    sizes = [float(result.found["away_change_mean"].sel(c)) * CM for c in pushed]
+    low, high = min(sizes), max(sizes)
+    by = f"{low:.2g} cm" if f"{low:.2g}" == f"{high:.2g}" else f"{low:.2g}–{high:.2g} cm"
+    return (f" and pushes its residual away from the neighbour (by {by} on average), without a resolved change of its size, in "
+            f"{len(pushed)} more")
+
+
+def _lowered_summary(result: MechanismCells) -> str:
+    """"; it leaves the base nearer its start than without contacts in 1 cell" ("" when in none)."""
+    lowered = result.lowered()
+    return f"; it leaves the base nearer its start than without contacts in {counted(len(lowered), 'cell')}" if lowered else ""
+
+
 def _raised(found: MechanismCells, cause: str, words: str) -> str:
     """"a wall raises the peak floor acceleration in 4 of 4 cells (5.02–13.3 times per run)"."""
-    text = f"{cause} raises the {words} in {found.flagged_count} of {found.assessed_count} cells"
+    text = f"{cause} raises the {words} in {found.flagged_count} of {counted(found.assessed_count, 'cell')}"
     ratios = found.ratio_range()
     if ratios is not None:
         low, high = ratios
@@ -180,16 +197,17 @@ def ratcheting_text(pounding: Ensemble, free: Ensemble, away: int | None) -> str
     text = opening + (
         f"pounding ratchets {building}'s sliding base — the paired {pounding.confidence:.0%} bootstrap intervals of the increase of abs(residual sliding) over "
         f"the contact-free twin and of its increase away from the neighbour (to the {direction}) both lie above 0 — in {len(ratchets)} "
-        f"of the {len(enough)} cells with contacts that have at least {MIN_RUNS} paired runs"
+        f"of the {counted(len(enough), 'cell')} with contacts that have at least {MIN_RUNS} paired runs"
     )
     text += (": " + _listed([describe(c) for c in ratchets]) + "." if ratchets else "; it does not ratchet it in any of them.")
     if ratchets and len(enough) > LISTED:
         text += " " + _by_axis(found, "ratcheting")
     if pushed:
-        text += (f" In {len(pushed)} cells the impacts push the residual away from the neighbour without a resolved increase of its size: "
-                 + _listed([describe(c) for c in pushed]) + ".")
+        text += (f" In {counted(len(pushed), 'cell')} the impacts push the residual away from the neighbour without a resolved change of its "
+                 "size: " + _listed([describe(c) for c in pushed]) + ".")
     if lowers:
-        text += f" The sign flips in {len(lowers)} cells, where pounding leaves the base nearer its start than without contacts: " + _listed([describe(c) for c in lowers]) + "."
+        text += (f" In {counted(len(lowers), 'cell')} pounding leaves the base nearer its start than without contacts (the paired "
+                 "increase of abs(residual sliding) lies below 0): " + _listed([describe(c) for c in lowers]) + ".")
     if rest:
         text += f" No resolved ratcheting at {_listed([labels_text(c) for c in rest])}."
     short = found.short()
@@ -225,7 +243,7 @@ def amplification_text(impacts: Ensemble, twins: Ensemble, variable: str, cause:
     text = opening + (
         f"{cause} multiplies {impacts.studied}'s {words} over {twin} by the mean of the per-run ratios given for each cell "
         f"({impacts.confidence:.0%} bootstrap intervals in brackets; in parentheses the mean with {cause} and the twins' mean). It raises it "
-        f"in {len(raises)} of the {len(enough)} cells with at least {MIN_RUNS} paired runs"
+        f"in {len(raises)} of the {counted(len(enough), 'cell')} with at least {MIN_RUNS} paired runs"
     )
     text += (": " + _listed([describe(c) for c in raises]) + "." if raises else ".")
     if lowers:

@@ -28,6 +28,7 @@ import math
 import numpy as np
 import xarray as xr
 
+from stochpound._plurals import counted
 from stochpound.analysis import CONTACTS, RARE, CellLabels, Closure, Needed, StoreSeparation, ValueRange
 from stochpound.report.render import figures
 from stochpound.report.render import Block, FigureItem, Paragraph, Section, Table
@@ -164,7 +165,7 @@ class SeparationEnsemble(StoreSeparation):
         text += (f"every one {closes} exactly when D ≥ {c.symbol}." if disagree == 0
                  else f"{disagree} of them disagree with D ≥ {c.symbol} (see docs/separation.md for the assumption).")
         if check.ties:
-            text += f" {check.ties} runs with D within 1e-9 m of g are not counted."
+            text += f" {counted(check.ties, 'run')} with D within 1e-9 m of {c.symbol} {'is' if check.ties == 1 else 'are'} not counted."
         return [Paragraph(text)]
 
     def _findings(self, needed: Needed, exceedance: xr.Dataset) -> Paragraph:
@@ -188,7 +189,8 @@ class SeparationEnsemble(StoreSeparation):
                 continue
             sentences.append(
                 f"{RULE_TEXT[rule].split(' (')[0]} is reached with probability {lo:.3f}" + (f" to {hi:.3f}" if hi > lo else "")
-                + f" (upper bound ≤ {p:.0%} in {share:.0%} of the cells)"
+                + (f" (upper bound ≤ {p:.0%} in {share:.0%} of the cells)" if needed.cells > 1
+                   else f" (its upper bound {'at or below' if share else 'above'} {p:.0%})")
             )
         text += "Separated by a rule's gap, the buildings pound: " + "; ".join(sentences) + "."
         return Paragraph(text)
@@ -203,7 +205,7 @@ class SeparationEnsemble(StoreSeparation):
             text += (
                 f"P(wall hit | c) = P(D ≥ c) is {'; '.join(f'{value_text(self.gap_axis, c)}: {span(curve.probability.sel({self.gap_axis: c}))}' for c in clearances)} "
                 f"over the cells; the runs at those clearances hit a wall in a fraction within its {self.confidence:.0%} Clopper–Pearson "
-                f"interval in {inside} of {cells} cells. "
+                f"interval in {inside} of {counted(cells, 'cell')}. "
             )
         for p in WALL_TARGETS:
             separation = needed["separation"].sel(probability=p)
@@ -229,7 +231,7 @@ class SeparationEnsemble(StoreSeparation):
         return (
             f"The experiment's section answers the same question on the grid's own gaps: the smallest gap of the grid from which "
             f"on the upper {self.confidence:.0%} bound of P(pounding) is below {RARE:.0%}, {span_cm(grid)} in {rare.known} of "
-            f"{cells} cells. That answer can only name a gap of the grid, and asks the bound, not the estimate, to be below "
+            f"{counted(cells, 'cell')}. That answer can only name a gap of the grid, and asks the bound, not the estimate, to be below "
             f"{RARE:.0%}: it is at or above the estimate here in {above} of those cells and at or above its upper bound in "
             f"{above_bound}; the quantile of D gives the gap between the grid's gaps (estimate {span_cm(estimate)}, upper "
             f"bound {span_cm(bound)}). "

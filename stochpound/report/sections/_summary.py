@@ -99,7 +99,7 @@ def _clearance_answer(name: str, store: xr.Dataset, ensembles: list[str], confid
         needed = separation.needed(SEPARATION_TARGETS)
         n, cells = needed.fewest_runs, needed.cells
         few = f"; fewer than {MIN_RUNS}, so indicative only" if n < MIN_RUNS else ""
-        text = f"ensemble {label} ({n} wall-free realizations in each of {cells} cells{few}): "
+        text = f"ensemble {label} ({n} wall-free realizations {_in_cells(cells)}{few}): "
         axis = separation.gap_axis
         if axis is not None:
             curve, direct = separation.curve_at_grid(), separation.hit_probability()
@@ -122,8 +122,13 @@ def _separation_answer(name: str, store: xr.Dataset, ensembles: list[str], confi
         n, cells = needed.fewest_runs, needed.cells
         answers = _target_answers(needed, lambda p: f"for P(pounding) = {p:.0%}, ", confidence)
         few = f"; fewer than {MIN_RUNS}, so indicative only" if n < MIN_RUNS else ""
-        parts.append(f"ensemble {label} ({n} contact-free realizations in each of {cells} cells{few}): " + "; ".join(answers))
+        parts.append(f"ensemble {label} ({n} contact-free realizations {_in_cells(cells)}{few}): " + "; ".join(answers))
     return "How wide must the gap be? The separation needed, the 1 − p quantile of the contact-free peak closure D: " + "; ".join(parts) + "."
+
+
+def _in_cells(cells: int) -> str:
+    """"in each of 6 cells", "in its one cell"."""
+    return f"in each of {cells} cells" if cells > 1 else "in its one cell"
 
 
 def _target_answers(needed: Needed, lead: Callable[[float], str], confidence: float) -> list[str]:
@@ -138,7 +143,7 @@ def _target_answers(needed: Needed, lead: Callable[[float], str], confidence: fl
         if missing < upper.size:
             text += f", upper {confidence:.0%} bound {span_cm(upper)}"
         if missing:
-            text += (f" (no upper bound in {missing} of {cells} cells: {n} realizations are too few, it needs "
+            text += (f" (no upper bound{f' in {missing} of {cells} cells' if cells > 1 else ''}: {n} realizations are too few, it needs "
                      f"(1 − p)ⁿ ≤ {(1 - confidence) / 2:g})")
         answers.append(text)
     return answers
