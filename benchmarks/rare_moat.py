@@ -13,6 +13,11 @@ clearances it reaches (P ≈ 1e-1 to 1e-2). It rewrites its section of
 docs/benchmarks.md ("Rare events: the moat impact at 1e-6"), with the wall
 time on the machine's cores and the runs a CoV of 15 % at the target would
 take (δ² ∝ 1/N at a fixed number of levels).
+
+``python -m benchmarks rare_events moat_isee`` measures the same probability by
+importance sampling with the elementary events of the friction pendulum's
+effective linear system at the clearance (:func:`isee_main`), with the share of
+a subset run's failure samples those events miss, into its own section.
 """
 
 from __future__ import annotations
