@@ -374,6 +374,10 @@ def main(argv: list[str] | None = None) -> int:
         from benchmarks import rare_moat
 
         return rare_moat.main(argv[1:])
+    if argv and argv[0] == "moat_isee":
+        from benchmarks import rare_moat
+
+        return rare_moat.isee_main(argv[1:])
     parser = argparse.ArgumentParser(prog="python -m benchmarks rare_events", description=__doc__.splitlines()[0])
     parser.add_argument("--repeats", type=int, default=20, help="subset runs (seeds 0 ..)")
     parser.add_argument("--samples", type=int, default=1000, help="samples a level")

@@ -13,7 +13,8 @@ the code separation rules of a run (of :mod:`stochpound.codes`) and the two
 names of the risk chain (:mod:`stochpound.risk`) the project's contract lists
 here, :func:`fit_fragility` and :func:`mean_annual_frequency`. Small exceedance probabilities of
 a run's response come from subset simulation (:func:`subset_simulation`,
-which runs the solvers). The statistics sit above all
+which runs the solvers), or from importance sampling with a linear surrogate's
+elementary events (:func:`linear_importance_sampling`). The statistics sit above all
 three: none of them imports this package.
 """
 
@@ -29,6 +30,7 @@ from stochpound.analysis._pounding import pounding_probability
 from stochpound.analysis._separation import pounding_curve, required_separation, rule_exceedance
 from stochpound.codes import contact_demands, fixed_base_cqc, separation_rules, store_contact_demands
 from stochpound.analysis._subset_simulation import RESPONSES, subset_simulation
+from stochpound.analysis._linear_importance import linear_importance_sampling, oscillator_rows, surrogate_level, uncovered_share
 from stochpound.analysis._measure_free import MEASURE_FREE_RESPONSES, MeasureFreeDemand, measure_free_demands, measure_free_risk
 from stochpound.analysis._measure_free_store import MEASURE_FREE_RUNS, StoreMeasureFree, scene_demands, store_measure_free
 from stochpound.analysis._measure_comparison import compare_measures
@@ -153,6 +155,10 @@ __all__ = [
     "ScenarioIntensity",
     "WallPenetration",
     "subset_simulation",
+    "linear_importance_sampling",
+    "oscillator_rows",
+    "surrogate_level",
+    "uncovered_share",
     "RESPONSES",
     "measure_free_risk",
     "measure_free_demands",
