@@ -148,3 +148,16 @@ def test_the_stores_simulated_motions_keep_their_rupture_and_regenerate_bit_for_
         replayed = store.pound.scene(gap=np.inf, intensity=level, record=str(label), realization=0).motion
         scale = float(store.selection_scale_factor.sel(record=label).values[stripe])
         np.testing.assert_allclose(replayed.values, again[table["realization"]] * scale, rtol=1e-12, atol=0.0)
+
+
+def test_a_simulated_motions_epsilon_is_taken_in_its_own_rupture() -> None:
+    """The sufficiency test's ε of a simulated motion of a site's rupture: its rupture's mechanism and geometry, not the stripe's."""
+    import xarray as xr
+
+    from stochpound.analysis._sufficiency import _simulated_ruptures
+
+    geometry = {"distance_jb_km": 6.0, "distance_x_km": 5.0, "ztor_km": 2.0, "dip": 45.0}
+    tables = [{"type": "site_motions", "magnitude": 6.2, "distance_km": 8.0, "vs30": 400.0, "mechanism": "reverse", **geometry, "rupture": "near"},
+              {"type": "record", "record": "fema_p695_far_field/01a"}]
+    store = xr.Dataset(coords={"record": ["simulated 1.2.0", "01a"], "record_motion": ("record", [json.dumps(t) for t in tables])})
+    assert _simulated_ruptures(store) == [("reverse", geometry), (None, {})]

@@ -34,7 +34,12 @@ stored: the definition keeps the model, its calibration, the seed and N, and
 a chosen motion is regenerated bit for bit from them (its ``realization``
 among the N). Each simulated motion is its own earthquake for
 ``max_per_earthquake`` and never a pulse. The pool is generated a stripe at
-a time, :data:`SIMULATED_CHUNK` motions at once.
+a time, :data:`SIMULATED_CHUNK` motions at once. At a site of ruptures the
+N motions of a stripe are of its causal ruptures, apportioned by their
+weights in the stripe's exact conditional spectrum (:func:`rupture_allotment`,
+the largest remainders), each rupture's motions from its own table shared by
+the stripes (:func:`rupture_sources`). With simulated motions the pool needs
+no records.
 
 ``[intensity] max_per_earthquake`` (at most that many motions of one
 earthquake in a stripe; no limit unless given) and ``exclude_pulses = true``
