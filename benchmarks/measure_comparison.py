@@ -8,7 +8,10 @@ friction pendulum (μ 0.05, no moat wall) beside the stiff neighbour
 (``isolated.toml``), contact-free. For each candidate measure of a
 configuration and each seed of the selection, an experiment of stripes at
 the site's intensities of the return periods, motions selected from the 100
-FEMA P695 records to the exact conditional spectrum of the site's ruptures
+FEMA P695 records (``--simulated N``: from N simulated motions a stripe of
+the site's causal ruptures, ``[site] simulated_motions``, each rupture's
+share its disaggregation weight at the level, and no records) to the exact
+conditional spectrum of the site's ruptures
 (``[site] ruptures``: the mixture over the causal ruptures weighted by the
 disaggregation at each level), the hazard of the same ruptures (``[hazard]
 ruptures``), and its g* at 10 % and 2 % in 50 years (the risk chain's,
@@ -94,8 +97,12 @@ FLAGSHIPS = (
 """The fixed pair beside the stiff and the flexible neighbour (B1's T1 0.30 s); B1 isolated (μ 0.05, no wall, T_b 3.0 s) beside the stiff one."""
 
 
-def experiment_text(flagship: Flagship, measure: str, seed: int, motions: int) -> str:
-    """The experiment of one flagship's configurations, measure and selection seed at the demo site (the flagship's scene and variants)."""
+def experiment_text(flagship: Flagship, measure: str, seed: int, motions: int, simulated: int = 0) -> str:
+    """The experiment of one flagship's configurations, measure and selection seed at the demo site (the flagship's scene and variants).
+
+    ``simulated`` > 0: the stripes' pool holds that many simulated motions a stripe of the site's causal ruptures (``[site]
+    simulated_motions``, allotted by the disaggregation) and no record; 0: the 100 FEMA P695 records.
+    """
     from stochpound.analysis import RuptureSite
 
     text = (REPOSITORY / "experiments" / "risk" / flagship.file).read_text()
@@ -104,15 +111,17 @@ def experiment_text(flagship: Flagship, measure: str, seed: int, motions: int) -
     levels = RuptureSite.bundled(SITE).intensity_at(kind, period, [1.0 / t for t in RETURN_PERIODS])
     field = "periods" if isinstance(period, tuple) else "period"
     lines = f'measure = "{kind}"' + ("" if period is None else f"\n{field} = {list(period) if field == 'periods' else period}")
+    records = "" if simulated else '[[records]]\nsuite = "fema_p695_far_field"\n[[records]]\nsuite = "fema_p695_near_field"\n'
+    pool = f"simulated_motions = {simulated}\n" if simulated else ""
     return (
-        f'[experiment]\nname = "compare_{flagship.name}"\nstudied = "B1"\n{scene}\n[grid]\n{flagship.grid}\n'
-        '[[records]]\nsuite = "fema_p695_far_field"\n[[records]]\nsuite = "fema_p695_near_field"\n'
+        f'[experiment]\nname = "compare_{flagship.name}"\nstudied = "B1"\n{scene}\n[grid]\n{flagship.grid}\n{records}'
         f'[intensity]\n{lines}\nlevels = [{", ".join(f"{x:.6g}" for x in levels)}]\nmethod = "stripes"\nselection = "conditional_spectrum"\n'
-        f'motions = {motions}\nmax_scale_factor = 5.0\nseed = {seed}\n[site]\nruptures = "{SITE}"\n[hazard]\nruptures = "{SITE}"\n'
+        f'motions = {motions}\nmax_scale_factor = 5.0\nseed = {seed}\n[site]\nruptures = "{SITE}"\n{pool}[hazard]\nruptures = "{SITE}"\n'
     )
 
 
-def conditioned(folder: Path, flagship: Flagship, measure: str, seed: int, motions: int, workers: int) -> tuple[xr.Dataset, xr.DataArray, xr.DataArray]:
+def conditioned(folder: Path, flagship: Flagship, measure: str, seed: int, motions: int, workers: int,
+                simulated: int = 0) -> tuple[xr.Dataset, xr.DataArray, xr.DataArray]:
     """One measure and seed: its store, g* from the counts (the risk chain's) and from a lognormal demand per stripe."""
     from stochpound import open_store
     from stochpound.experiment import load_experiment, run_experiment
@@ -120,7 +129,7 @@ def conditioned(folder: Path, flagship: Flagship, measure: str, seed: int, motio
 
     code = measure.replace("(", "").replace(" s)", "").replace(".", "p").replace(" ", "").replace("–", "-").lower()
     path = folder / f"{flagship.name}_{code}_seed{seed}.toml"
-    path.write_text(experiment_text(flagship, measure, seed, motions))
+    path.write_text(experiment_text(flagship, measure, seed, motions, simulated))
     run = run_experiment(load_experiment(path), workers=workers if workers > 1 else 0, progress=False)
     if not run.complete:
         raise RuntimeError(f"{flagship.name}, {measure}, seed {seed}: the experiment did not complete")
@@ -143,7 +152,8 @@ class Comparison:
     seconds: float
 
 
-def compare(flagship: Flagship, measures: list[str], seeds: list[int], motions: int, runs: int, workers: int, log=print) -> Comparison:
+def compare(flagship: Flagship, measures: list[str], seeds: list[int], motions: int, runs: int, workers: int, simulated: int = 0,
+            log=print) -> Comparison:
     """The comparisons (counts and lognormal demand) of one flagship file and its measure-free answer."""
     from stochpound.analysis import RuptureSite, compare_measures, store_measure_free, store_sufficiency
 
@@ -154,7 +164,7 @@ def compare(flagship: Flagship, measures: list[str], seeds: list[int], motions: 
     with tempfile.TemporaryDirectory() as folder:
         for name in measures:
             for seed in seeds:
-                store, by_counts, by_demand = conditioned(Path(folder), flagship, name, seed, motions, workers)
+                store, by_counts, by_demand = conditioned(Path(folder), flagship, name, seed, motions, workers, simulated)
                 counted[name].append(by_counts)
                 lognormal[name].append(by_demand)
                 log(f"{flagship.name}, {name}, seed {seed}: g* {by_counts.values.ravel()} (counts), {by_demand.values.ravel()} (lognormal demand)")
@@ -186,14 +196,27 @@ def selection_words(store: xr.Dataset) -> str:
     """What a store's stripes hold: motions and earthquakes a stripe, scale factors, the stripes that miss their target, the target's ε and M."""
     factors = store["selection_scale_factor"].values
     missed = int(np.sum(store["selection_misses_target"].values))
+    simulated = store["selection_simulated"].values
+    count = store["selection_recorded"].values + simulated
+    magnitude = store["record_magnitude"].values.astype(float)
+    chosen = [float(np.mean(magnitude[np.isfinite(row)])) for row in factors]  # the chosen motions' mean M, stripe by stripe
     return (
-        f"{int(store['selection_recorded'].min())}–{int(store['selection_recorded'].max())} motions a stripe from "
-        f"{int(store['selection_earthquakes'].min())}–{int(store['selection_earthquakes'].max())} earthquakes, scale factors "
+        f"{int(count.min())}–{int(count.max())} motions a stripe ({int(simulated.min())}–{int(simulated.max())} simulated) from "
+        f"{int(store['selection_earthquakes'].min())}–{int(store['selection_earthquakes'].max())} earthquakes, the chosen motions' mean M "
+        f"{', '.join(f'{m:.2f}' for m in chosen)} by stripe, scale factors "
         f"{np.nanmin(factors):.2f}–{np.nanmax(factors):.2f}, {missed} of {store.sizes['intensity']} stripes missing their target by more "
         f"than the tolerance; the target's mean ε {float(store['target_epsilon'].min()):.2f}–{float(store['target_epsilon'].max()):.2f}, "
         f"mean M {float(store['site_magnitude'].min()):.2f}–{float(store['site_magnitude'].max()):.2f} and R "
         f"{float(store['site_distance_km'].min()):.0f}–{float(store['site_distance_km'].max()):.0f} km over the stripes"
     )
+
+
+def pool_words(simulated: int) -> str:
+    """What the stripes' pool holds, in words."""
+    if not simulated:
+        return "the 100 FEMA P695 records"
+    return (f"a pool of {simulated} simulated motions a stripe of the site's causal ruptures (`[site] simulated_motions`: "
+            "each rupture's share of the pool its disaggregation weight at the level, rounded by the largest remainders; no records)")
 
 
 def table(comparison: pd.DataFrame, tested: Collection[str]) -> list[str]:
@@ -273,14 +296,14 @@ def section(comparisons: list[Comparison], settings: argparse.Namespace, info: d
         "they are): the code-designed yielding pair on fixed bases beside the stiff and the flexible neighbour (`fixed_pair.toml`), and "
         "Building 1 on its friction pendulum (μ 0.05, no moat wall) beside the stiff neighbour (`isolated.toml`), contact-free. Per measure "
         f"and selection seed ({', '.join(map(str, settings.seeds))}): stripes at the site's intensities of "
-        f"{', '.join(f'{t:g}' for t in RETURN_PERIODS)} years, {settings.motions} motions a stripe selected from the 100 FEMA P695 records "
+        f"{', '.join(f'{t:g}' for t in RETURN_PERIODS)} years, {settings.motions} motions a stripe selected from {pool_words(settings.simulated)} "
         "(scale factor ≤ 5) to the exact conditional spectrum of the site's ruptures (the mixture over the causal ruptures weighted by the "
         "disaggregation at each level), the hazard of the same ruptures, g* at 10 % and 2 % in 50 years. Beside it, the same scene's answer "
         f"without a measure (`stochpound.analysis.store_measure_free`, seed 1, simulated motions of each rupture, "
         f"site-motion model {site_model_provenance()}), compared by `stochpound.analysis.compare_measures` (within ×{TOLERANCE:g} either way). "
         f"Commit {info['commit']}, {info['date']}, load {info['load average (1 min) at start']}, {settings.workers} worker "
         f"process{'es' if settings.workers > 1 else ''}, {elapsed:.0f} s in all. "
-        "`python -m benchmarks.measure_comparison [--flagships ... --measures ... --seeds ... --motions N --runs N N]` rewrites this section "
+        "`python -m benchmarks.measure_comparison [--flagships ... --measures ... --seeds ... --motions N --runs N N --simulated N]` rewrites this section "
         "and its figure.",
         "",
         f"![Each measure's conditioned g* over the measure-free g*]({shown})",
@@ -317,6 +340,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--seeds", nargs="+", type=int, default=[1, 2], help="seeds of the selection")
     parser.add_argument("--motions", type=int, default=40, help="motions a stripe")
     parser.add_argument("--runs", nargs=2, type=int, default=[700, 1500], metavar=("FIXED", "ISOLATED"), help="runs a configuration of the answer without a measure, for each flagship file")
+    parser.add_argument("--simulated", type=int, default=0, metavar="N",
+                        help="select from N simulated motions a stripe of the site's causal ruptures (allotted by the disaggregation) instead of the records")
     parser.add_argument("--workers", type=int, default=1, help="worker processes (the result does not depend on them)")
     parser.add_argument("--out", type=Path, default=REPOSITORY / "docs" / "benchmarks.md")
     parser.add_argument("--figure", type=Path, default=FIGURE)
@@ -327,7 +352,7 @@ def main(argv: list[str] | None = None) -> int:
     for flagship, runs in zip(FLAGSHIPS, arguments.runs):
         if flagship.name in arguments.flagships:
             measures = [m for m in flagship.measures if arguments.measures is None or m in arguments.measures]
-            comparisons.append(compare(flagship, measures, arguments.seeds, arguments.motions, runs, arguments.workers))
+            comparisons.append(compare(flagship, measures, arguments.seeds, arguments.motions, runs, arguments.workers, arguments.simulated))
     figure(comparisons, arguments.figure)
     SECTION.write(arguments.out, section(comparisons, arguments, info, time.perf_counter() - start))
     print(f"wrote the section 'Each measure against the answer without a measure' of {arguments.out} and {arguments.figure}")

@@ -48,3 +48,11 @@ def test_a_reduced_run_writes_the_section_and_its_figure(tmp_path):
     assert len(rows) == 2 * 2  # two targets, g* from the counts and from the lognormal demand
     assert all(row.startswith("| neighbour stiff, moat none, mu 0.05 |") for row in rows)
     assert "3–3 motions a stripe" in section and figure.stat().st_size > 0
+
+
+def test_the_simulated_pool_replaces_the_records_by_motions_of_the_sites_ruptures():
+    flagship = measure_comparison.FLAGSHIPS[1]
+    table = tomllib.loads(measure_comparison.experiment_text(flagship, "PSA(3 s)", seed=1, motions=40, simulated=300))
+    assert "records" not in table and table["site"] == {"ruptures": measure_comparison.SITE, "simulated_motions": 300}
+    with_records = tomllib.loads(measure_comparison.experiment_text(flagship, "PSA(3 s)", seed=1, motions=40))
+    assert len(with_records["records"]) == 2 and "simulated_motions" not in with_records["site"]

@@ -292,7 +292,7 @@ def test_an_experiments_site_of_ruptures_targets_the_exact_spectrum(tmp_path, de
         (f'[site]\nruptures = "{DEMO}"\nvs30 = 760.0\n', f"site.vs30: 760.0 given, but {DEMO}.csv states 400"),
         (f'[site]\nruptures = "{DEMO}"\nmagnitude = 7.0\n', "site.magnitude: unknown field"),
         ('[site]\nscenario = "ruptures"\nvs30 = 400.0\n', "site.scenario:"),
-        (f'[site]\nruptures = "{DEMO}"\nsimulated_motions = 10\n', "site.simulated_motions: not available with site.ruptures yet"),
+        (f'[site]\nruptures = "{DEMO}"\nsimulated_motions = 0\n', "site.simulated_motions: simulated motions a stripe in its pool"),
     ],
 )
 def test_a_bad_site_of_ruptures_is_one_line_naming_the_field(tmp_path, site: str, field: str) -> None:

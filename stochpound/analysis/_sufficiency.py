@@ -37,13 +37,17 @@ deviate of its own (unscaled) measure in its own earthquake, (ln IM − ln
 median) / σ, the median and σ of the NGA-West2 average the conditional
 spectrum uses (:func:`stochpound.motions.scenario_distribution`) at the
 motion's M, R_rup and Vs30 (Baker & Cornell 2005's record ε). The store
-keeps no motion's mechanism nor its R_JB: ε takes the stripe's scenario
-mechanism and the scenario estimates of the conditional spectrum (R_JB =
-R_rup, no hanging wall); it is therefore a record ε up to those terms.
+keeps no record's mechanism nor its R_JB: a record's ε takes the stripe's
+scenario mechanism and the scenario estimates of the conditional spectrum
+(R_JB = R_rup, no hanging wall); it is therefore a record ε up to those
+terms. A simulated motion of a site's rupture (``[site] simulated_motions``
+with ``[site] ruptures``) carries its rupture in its table: its ε is in
+that rupture, its mechanism and geometry included.
 """
 
 from __future__ import annotations
 
+import json
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -329,6 +333,19 @@ def store_sufficiency(store: xr.Dataset, *, cluster: bool = True, level: float =
     return StoreSufficiency(setting.measure.label, "closure", tuple(configurations), tuple(results))
 
 
+def _simulated_ruptures(store: xr.Dataset) -> list[tuple[str | None, Mapping[str, float]]]:
+    """Per motion, the mechanism and geometry of the rupture a simulated motion's table names (``[site] simulated_motions`` at a site
+    of ruptures); (None, {}) for a record, whose ε takes the stripe's scenario mechanism."""
+    from stochpound.motions import GEOMETRY_FIELDS
+
+    tables = [json.loads(str(text)) for text in store["record_motion"].values] if "record_motion" in store.coords else []
+    found: list[tuple[str | None, Mapping[str, float]]] = [(None, {})] * store.sizes["record"]
+    for j, table in enumerate(tables):
+        if isinstance(table, dict) and "rupture" in table and "mechanism" in table:
+            found[j] = (str(table["mechanism"]), {key: float(table[key]) for key in GEOMETRY_FIELDS if key in table})
+    return found
+
+
 def _store_covariates(store: xr.Dataset, measure: Measure, units: str) -> dict[str, np.ndarray]:
     """Each motion's M, ln R and (for a measure in g) ε in its own earthquake, the stripe's scenario mechanism (module docstring)."""
     magnitude, distance = (store[name].values.astype(float) for name in ("record_magnitude", "record_distance"))
@@ -342,13 +359,14 @@ def _store_covariates(store: xr.Dataset, measure: Measure, units: str) -> dict[s
     own = own.max([d for d in own.dims if d != "record"], skipna=True).values.astype(float)  # the same unscaled value at every case
     vs30 = store["record_vs30"].values.astype(float) if "record_vs30" in store.coords else np.full(magnitude.size, float(store["site_vs30"].values[0]))
     mechanism = str(store["site_mechanism"].values[0]) if "site_mechanism" in store.coords else "strike_slip"
+    own_ruptures = _simulated_ruptures(store)
     period = measure.period if measure.kind == "psa" else (list(measure.periods) if measure.kind == "sa_avg" else None)
     epsilon = np.full(magnitude.size, np.nan)  # NaN: a motion without its earthquake, or outside the models' range (left out)
     for j in range(magnitude.size):
         if all(np.isfinite(v) for v in (magnitude[j], distance[j], vs30[j], own[j])) and own[j] > 0:
             try:
                 median, sigma = scenario_distribution(measure.kind, period, magnitude=magnitude[j], distance_km=distance[j], vs30=vs30[j],
-                                                      mechanism=mechanism)
+                                                      mechanism=own_ruptures[j][0] or mechanism, geometry=own_ruptures[j][1])
             except SiteError:
                 continue
             epsilon[j] = (math.log(own[j]) - math.log(median)) / sigma

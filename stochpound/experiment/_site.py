@@ -34,7 +34,12 @@ stored: the definition keeps the model, its calibration, the seed and N, and
 a chosen motion is regenerated bit for bit from them (its ``realization``
 among the N). Each simulated motion is its own earthquake for
 ``max_per_earthquake`` and never a pulse. The pool is generated a stripe at
-a time, :data:`SIMULATED_CHUNK` motions at once.
+a time, :data:`SIMULATED_CHUNK` motions at once. At a site of ruptures the
+N motions of a stripe are of its causal ruptures, apportioned by their
+weights in the stripe's exact conditional spectrum (:func:`rupture_allotment`,
+the largest remainders), each rupture's motions from its own table shared by
+the stripes (:func:`rupture_sources`). With simulated motions the pool needs
+no records.
 
 ``[intensity] max_per_earthquake`` (at most that many motions of one
 earthquake in a stripe; no limit unless given) and ``exclude_pulses = true``
@@ -82,6 +87,8 @@ SIMULATED_WINDOW_LIMIT = 600.0
 """Longest window (s) :func:`~stochpound.motions.site_motions` takes given; a longer default one is found again per chunk."""
 RULES = ("max_per_earthquake", "exclude_pulses")
 """``[intensity]`` fields of the selection's rules (:attr:`stochpound.store.Selection.rules`), in the definition only where given."""
+SIMULATED_STREAM = 44
+"""Entropy word of the stripes' pools of simulated motions of a site's ruptures (:func:`rupture_seed`)."""
 PER_LEVEL = ("magnitude", "distance_km", "mechanism")
 """``[site]`` fields that take one value per level."""
 
@@ -141,13 +148,13 @@ def parse_selection(table: Mapping[str, Any], site: Any, levels: list[float], se
     note = f"{motions} motions per stripe chosen from the pool and scaled to the conditional spectrum of its scenario"
     max_per_earthquake, exclude_pulses = parse_rules(table)
     if isinstance(site, dict) and "ruptures" in site:
-        if "simulated_motions" in site:
-            raise SiteError("site.simulated_motions: not available with site.ruptures yet (the motions would be of one mean scenario, "
-                            "not of each causal rupture): leave one of the two out")
         ruptures = rupture_site(site, base_dir)
+        simulated = parse_simulated(site, seed)
         note = f"{motions} motions per stripe chosen from the pool and scaled to the exact conditional spectrum of the site's {len(ruptures)} ruptures"
+        if simulated is not None:
+            note += f" (the pool: {simulated.count} simulated motions a stripe of the causal ruptures, allotted by their disaggregation weights)"
         return Selection(selection, motions, max_scale, seed, mixture_scenarios(ruptures, levels, measure), max_per_earthquake, exclude_pulses,
-                         ruptures=ruptures.to_entry(identity=True)), note
+                         simulated=simulated, ruptures=ruptures.to_entry(identity=True)), note
     scenarios = parse_site(site, levels, measure)
     if toml_fields.TomlTable(site, "site", raises=SiteError).string("scenario", SCENARIO_KINDS[0]) == "fitted":
         note += f" (the scenario fitted to the site's hazard curves {', '.join(map(str, site['curves']))}, standing in for a disaggregation)"
@@ -176,7 +183,8 @@ def parse_simulated(site: Mapping[str, Any], seed: int) -> SimulatedMotions | No
         return None
     count = site["simulated_motions"]
     if not isinstance(count, int) or isinstance(count, bool) or not 1 <= count <= SIMULATED_LIMIT:
-        raise SiteError(f"site.simulated_motions: simulated motions of each stripe's scenario in its pool, an integer within 1-{SIMULATED_LIMIT}, got {count!r}")
+        raise SiteError(f"site.simulated_motions: simulated motions a stripe in its pool (of its scenario, or of the site's causal ruptures), "
+                        f"an integer within 1-{SIMULATED_LIMIT}, got {count!r}")
     return SimulatedMotions(count, SIMULATED_MODEL, site_model_provenance(SIMULATED_MODEL), seed, SIMULATED_DT)
 
 
@@ -191,7 +199,7 @@ def rupture_site(site: Mapping[str, Any], base_dir: Path) -> Any:
     """
     from stochpound.hazard import RUPTURE_SITE_FIELDS, named_rupture_site
 
-    toml_fields.reject_unknown(site, {"ruptures", *RUPTURE_SITE_FIELDS}, "site")
+    toml_fields.reject_unknown(site, {"ruptures", "simulated_motions", *RUPTURE_SITE_FIELDS}, "site")
     return named_rupture_site(site["ruptures"], base_dir, {key: site[key] for key in RUPTURE_SITE_FIELDS if key in site}, "site")
 
 
@@ -418,6 +426,7 @@ def stripe_selections(experiment: ExperimentGrid) -> StripeSelections:
         ``max_scale_factor`` of a level under the rules.
     """
     from stochpound._errors import ExperimentError, SiteError, field_errors
+    from stochpound.analysis import RuptureSite
     from stochpound.store import CASE
     from stochpound.model.scene_file import scene_from_dict
     from stochpound.motions import conditional_spectrum, select_motions, selection_periods, selection_pool
@@ -438,22 +447,31 @@ def stripe_selections(experiment: ExperimentGrid) -> StripeSelections:
     structure = structure_periods(experiment)
     periods = selection_periods(structure, conditioning)
     g = experiment.definition.g
-    pool = selection_pool(records, periods, measure, period, MODEL_DAMPING, g)
+    pool = selection_pool(records, periods, measure, period, MODEL_DAMPING, g) if records else None  # None: simulated motions alone
     selections, targets, simulated = [], [], {}
     if chosen.ruptures is not None:  # the exact conditional spectrum of every stripe
-        from stochpound.analysis import RuptureSite
-
         stripe_targets = RuptureSite.from_entry(chosen.ruptures).conditional_spectra(measure, period, levels=list(intensity.levels), periods=periods)
     else:
         stripe_targets = [conditional_spectrum(measure, period, level=level, periods=periods, scenario=scenario)
                           for level, scenario in zip(intensity.levels, chosen.scenarios)]
-    generated: dict[str, xr.Dataset] = {}  # the simulated pool of each distinct table: stripes of one scenario share it, relabelled
+    allotment = None
+    if chosen.ruptures is not None and chosen.simulated is not None:
+        site = RuptureSite.from_entry(chosen.ruptures)
+        allotment = rupture_allotment(site, measure, period, list(intensity.levels), chosen.simulated.count)
+    generated: dict[str, xr.Dataset] = {}  # the simulated pool of each distinct table: stripes of one table share it, relabelled
     for stripe, (level, scenario, target) in enumerate(zip(intensity.levels, chosen.scenarios, stripe_targets)):
-        sources = simulated_sources(chosen.simulated, stripe, scenario)
-        try:
-            stripe_pool = xr.concat([pool, shared_simulated_pool(sources, periods, measure, period, g, generated)], "motion") if sources else pool
-        except SiteError as error:  # a scenario outside the site-motion model's calibrated range
-            raise ExperimentError(f"site.simulated_motions: the stripe {level:g} g's scenario: {error}") from None
+        groups = (rupture_sources(chosen.simulated, stripe, site, allotment) if allotment is not None
+                  else [simulated_sources(chosen.simulated, stripe, scenario)])
+        parts = [] if pool is None else [pool]
+        for group in filter(None, groups):
+            try:
+                parts.append(shared_simulated_pool(group, periods, measure, period, g, generated))
+            except SiteError as error:  # a scenario outside the site-motion model's calibrated range
+                table = next(iter(group.values())).motion
+                where = f"rupture {table['rupture']}" if "rupture" in table else "scenario"
+                raise ExperimentError(f"site.simulated_motions: the stripe {level:g} g's {where}: {error}") from None
+        stripe_pool = xr.concat(parts, "motion") if len(parts) > 1 else parts[0]
+        sources = {label: source for group in groups for label, source in group.items()}
         try:
             selection = select_motions(stripe_pool, target, chosen.motions, chosen.max_scale_factor, chosen.seed, **chosen.rules)
         except SiteError as error:
@@ -508,6 +526,58 @@ def simulated_sources(setting: SimulatedMotions | None, stripe: int, scenario: S
     return {label: MotionSource(label, SIMULATED, SIMULATED_FIELD, {**table, "realization": i}) for i, label in enumerate(labels)}
 
 
+def rupture_allotment(site: Any, measure: str, period: Any, levels: list[float], count: int) -> np.ndarray:
+    """How many of a stripe's ``count`` simulated motions each rupture gives (int, level × rupture; levels ascending).
+
+    Rupture r's share at level x is its weight in the exact conditional spectrum, P(r | IM* = x)
+    (:meth:`~stochpound.analysis.RuptureSite.disaggregation`'s ``density_share``); ``count`` is apportioned by the largest
+    remainders: each rupture gets the whole part of ``count`` × its share, the motions left go one each to the largest
+    fractional parts (ties to the earlier rupture). Every level's row sums to ``count``.
+    """
+    shares = site.disaggregation(measure, period, levels=levels)["density_share"].values
+    return np.array([largest_remainders(count, row) for row in shares], dtype=np.int64)
+
+
+def largest_remainders(count: int, shares: np.ndarray) -> np.ndarray:
+    """``count`` apportioned by ``shares`` (≥ 0, summing to 1) by the largest remainders, ties to the earlier entry."""
+    exact = count * np.asarray(shares, dtype=float) / float(np.sum(shares))
+    whole = np.floor(exact).astype(np.int64)
+    order = np.lexsort((np.arange(exact.size), -(exact - whole)))  # the largest fractional part first, then the entry's order
+    whole[order[: count - int(whole.sum())]] += 1
+    return whole
+
+
+def rupture_seed(seed: int, index: int) -> int:
+    """The seed of rupture ``index``'s simulated motions in the stripes' pools (a stream apart from the measure-free answer's)."""
+    return int(np.random.SeedSequence([seed, SIMULATED_STREAM, index]).generate_state(1)[0])
+
+
+def rupture_sources(setting: SimulatedMotions, stripe: int, site: Any, allotment: np.ndarray) -> list[dict[str, MotionSource]]:
+    """The simulated motions of a stripe's pool at a site of ruptures, one mapping per rupture (label ``simulated <stripe>.<rupture>.<i>``,
+    from 1; empty where the rupture has none at the stripe).
+
+    Rupture r's table is the same at every stripe: its scenario (geometry included), its name (``rupture``), ``n`` the most it gives any
+    stripe, the seed :func:`rupture_seed`; stripe j takes its first ``allotment[j, r]`` realizations, so its motions are generated once.
+    """
+    groups = []
+    width = len(str(len(site)))
+    for index, count in enumerate(allotment[stripe]):
+        n = int(allotment[:, index].max())
+        scenario = site.scenario(index)
+        table = {"type": "site_motions", **scenario.loose(), **scenario.geometry, "rupture": site.names[index], "n": n,
+                 "seed": rupture_seed(setting.seed, index), "dt": setting.dt, "model": setting.model, "calibration": setting.calibration}
+        labels = [f"simulated {stripe + 1}.{index + 1:0{width}d}.{i:0{len(str(max(n - 1, 0)))}d}" for i in range(int(count))]
+        groups.append({label: MotionSource(label, SIMULATED, SIMULATED_FIELD, {**table, "realization": i}) for i, label in enumerate(labels)})
+    return groups
+
+
+def table_scenario(table: Mapping[str, float | str]) -> Scenario:
+    """The scenario of a simulated motion's table: magnitude, R_rup, Vs30, mechanism, and the geometry it gives (a rupture's)."""
+    from stochpound.motions import GEOMETRY_FIELDS
+
+    return Scenario(**{key: table[key] for key in (*SITE_FIELDS, *GEOMETRY_FIELDS) if key in table})
+
+
 def simulated_motions(sources: Sequence[MotionSource], duration: float | None = None) -> list[Any]:
     """The motions (m/s², :class:`~stochpound.motions.ground.SampledMotion`) of simulated sources of one table, regenerated from it bit for bit."""
     from stochpound.motions.ground import SampledMotion
@@ -526,9 +596,8 @@ def simulated_accelerations(sources: Sequence[MotionSource], duration: float | N
     from stochpound.motions import site_motions
 
     table = sources[0].motion
-    generated = site_motions(table["magnitude"], table["distance_km"], table["vs30"], table["mechanism"], n=table["n"], seed=table["seed"],
-                             dt=table["dt"], model=table["model"], realizations=[source.motion["realization"] for source in sources],
-                             duration=duration)
+    generated = site_motions(scenario=table_scenario(table), n=table["n"], seed=table["seed"], dt=table["dt"], model=table["model"],
+                             realizations=[source.motion["realization"] for source in sources], duration=duration)
     return generated["acceleration"].values
 
 
@@ -567,7 +636,9 @@ def shared_simulated_pool(sources: Mapping[str, MotionSource], periods: np.ndarr
 
     table = next(iter(sources.values())).motion
     key = canonical_json({name: value for name, value in table.items() if name != "realization"})
-    if key not in generated:
-        generated[key] = simulated_pool(sources, periods, measure, period, g)
+    if key not in generated:  # every motion of the table (a stripe may take only the first ones)
+        every = {str(i): MotionSource(str(i), SIMULATED, SIMULATED_FIELD, {**table, "realization": i}) for i in range(table["n"])}
+        generated[key] = simulated_pool(every, periods, measure, period, g)
     labels = np.array(list(sources), dtype=object)
-    return generated[key].assign_coords(motion=labels).assign(earthquake=("motion", labels), recording=("motion", labels))
+    chosen = generated[key].isel(motion=[source.motion["realization"] for source in sources.values()])
+    return chosen.assign_coords(motion=labels).assign(earthquake=("motion", labels), recording=("motion", labels))

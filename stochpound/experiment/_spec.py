@@ -161,7 +161,8 @@ def _parsed_definition(file: TomlTable, base_dir: Path, default_name: str) -> De
     hazard = parse_hazard(file, intensity, base_dir, scene_g(scene))
     design = parse_design(file)
     limit_states = parse_limit_states(file, buildings)
-    motions = _motions(file, scene_table, base_dir)
+    simulated_pool = intensity is not None and intensity.selection is not None and intensity.selection.simulated is not None
+    motions = _motions(file, scene_table, base_dir, simulated_pool)
     output, solver = _output(file, buildings), _solver(file)
     site = site_entry(file.raw("site"), intensity)
     # optional records left None are absent from the written definition: the definitions (and hashes) of other files are unchanged
@@ -370,13 +371,14 @@ def _mu_axis(spec: Any, buildings: list[str]) -> MuAxis:
 # ---------------------------------------------------------------- motions
 
 
-def _motions(file: TomlTable, scene: TomlTable, base_dir: Path) -> tuple[MotionSource, ...]:
+def _motions(file: TomlTable, scene: TomlTable, base_dir: Path, simulated_pool: bool = False) -> tuple[MotionSource, ...]:
+    """The motions the file lists; none needed where a selection's pool holds simulated motions (``simulated_pool``: ``[site] simulated_motions``)."""
     records = file.tables("records", hint="record = name or file")
     synthetic = file.table_or_empty("synthetic")
     motions = [source for table in records for source in _record_sources(table, base_dir)]
     motions += [_analytic_source(table) for table in file.tables("motions", hint="name, type = harmonic | constant and its parameters")]
     motions += [_synthetic_source(label, synthetic.raw(label), synthetic.field(label)) for label in synthetic]
-    if not motions:
+    if not motions and not simulated_pool:
         motions.append(_scene_motion(scene, base_dir))
     labels = [m.label for m in motions]
     for i, label in enumerate(labels):

@@ -169,7 +169,8 @@ _MOTION_KEYS = {
     "record": {"type", "record", "scale", "dt", "duration", "units", "interpolation"},
     "harmonic": {"type", "amplitude", "omega", "phase", "duration", "dt"},
     "constant": {"type", "acceleration", "duration", "dt"},
-    "site_motions": {"type", "magnitude", "distance_km", "vs30", "mechanism", "n", "seed", "dt", "model", "calibration", "realization", "scale"},
+    "site_motions": {"type", "magnitude", "distance_km", "vs30", "mechanism", "n", "seed", "dt", "model", "calibration", "realization", "scale",
+                     "rupture", "distance_jb_km", "distance_x_km", "ztor_km", "dip", "z1p0_km", "z2p5_km"},
 }
 
 
@@ -224,10 +225,12 @@ def _site_motion(table: TomlTable, per_sample: int) -> SampledMotion:
 
     ``calibration``, when given, must name the model's calibration
     (:func:`~stochpound.motions.site_model_provenance`): a table written with
-    another calibration cannot regenerate its motion.
+    another calibration cannot regenerate its motion. A rupture's geometry
+    (:data:`~stochpound.motions.GEOMETRY_FIELDS`), when given, is the
+    scenario's; ``rupture`` names the rupture (provenance only).
     """
     from stochpound._errors import SiteError
-    from stochpound.motions import site_model_provenance, site_motions
+    from stochpound.motions import GEOMETRY_FIELDS, Scenario, site_model_provenance, site_motions
 
     model = table.string("model", "hazard_compatible")
     realization = table.raw("realization", 0)
@@ -242,8 +245,10 @@ def _site_motion(table: TomlTable, per_sample: int) -> SampledMotion:
         if "calibration" in table and table.raw("calibration") != site_model_provenance(model):
             raise SceneError(f"motion.calibration: {table.raw('calibration')!r} is not the calibration of model {model!r} here "
                              f"({site_model_provenance(model)!r}): the motion cannot be regenerated")
-        generated = site_motions(table.raw("magnitude"), table.raw("distance_km"), table.raw("vs30"), table.raw("mechanism"), n=n,
-                                 seed=table.raw("seed"), dt=table.raw("dt", 0.01), model=model, realizations=[realization])
+        table.string("rupture", "")
+        scenario = Scenario(**{key: table.raw(key) for key in ("magnitude", "distance_km", "vs30", "mechanism", *GEOMETRY_FIELDS) if key in table})
+        generated = site_motions(scenario=scenario, n=n, seed=table.raw("seed"), dt=table.raw("dt", 0.01), model=model,
+                                 realizations=[realization])
     except SiteError as error:
         raise SceneError(f"motion.{error}") from None
     values = np.asarray(generated["acceleration"].values[0], dtype=float)
