@@ -228,7 +228,7 @@ def test_cycles_are_found():
 
 
 def test_tests_import_no_test_module_and_benchmarks_no_test():
-    """Shared test code is in tests/helpers.py (and tests/chromium.py); a test imports the benchmarks only to test them."""
+    """Shared test code is in tests/helpers.py (and tests/chromium.py, tests/au_beck_oscillator.py); a test imports the benchmarks only to test them."""
     found = []
     for path in sorted((ROOT / "tests").glob("*.py")) + sorted((ROOT / "benchmarks").glob("*.py")):
         for module in imports(path.read_text()):

@@ -10,7 +10,10 @@ import pytest
 from scipy.special import ndtr, ndtri
 
 from stochpound.analysis import linear_importance_sampling, oscillator_rows, surrogate_level, uncovered_share
-from tests.test_subset_simulation import DT, N_TIME, OMEGA, S, ZETA, _displacements, _isee, _peak
+from tests.au_beck_oscillator import DT, N_TIME, OMEGA, S, ZETA
+from tests.au_beck_oscillator import displacements as _displacements
+from tests.au_beck_oscillator import isee as _isee
+from tests.au_beck_oscillator import peak as _peak
 
 TILTED = np.array([[1.0, 0.3] + [0.0] * 48]) / math.hypot(1.0, 0.3)
 """A surrogate of g(u) = u_0 that is not it: the direction (1, 0.3) in 50 normals."""
