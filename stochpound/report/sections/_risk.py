@@ -195,8 +195,23 @@ def design_summary_text(risk: StoreRisk, demands: StoreDemands | None = None, da
 def _structural_governs(damage: StoreDamage | None, target: float, separation: str) -> str:
     """What governs at ``target``: ``separation`` (what limits the gap), preceded by the buildings' own limit states where
     :meth:`~stochpound.risk.StoreDamage.governing` names one (beyond its objective: the largest λ/λ_target), with their counts of
-    configurations; ``separation`` alone where pounding governs everywhere, without ``damage`` or without objectives."""
-    counted = damage.governing_counts(target) if damage is not None else None
+    configurations; ``separation`` alone where pounding governs everywhere, without ``damage`` or without objectives. Where some
+    run is beyond the model, judged both ways (as run, and with those runs counted apart as collapses), saying whether they agree."""
+    if damage is None or damage.governing_counts(target) is None:
+        return separation
+    run = _governs_counted(damage.governing_counts(target), separation)
+    if not damage.judged_both_ways():
+        return run
+    apart = _governs_counted(damage.governing_counts(target, apart=True), separation)
+    count, configurations = damage.disagreements()
+    agree = ("the two treatments agree in every configuration" if not count else
+             f"the two treatments disagree in {count} of {configurations} configurations: what governs depends on whether the runs "
+             "beyond the model are taken as computed or as collapses")
+    return f"as run, {run}; with the runs beyond the model counted apart as collapses, {apart} ({agree})"
+
+
+def _governs_counted(counted: tuple[dict[str, int], int] | None, separation: str) -> str:
+    """One treatment's governing limit states with their counts of configurations, then ``separation`` for the rest."""
     if counted is None or not counted[0]:
         return separation
     states, configurations = counted
