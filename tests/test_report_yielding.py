@@ -464,9 +464,10 @@ def test_the_design_summary_names_the_limit_state_the_damage_section_finds_gover
     collapse = unreached.risk["maf_collapses_apart"].item()
     assert collapse > -math.log(0.9) / 50.0
     assert ("Governing limit state (the largest λ/λ_target of the limit states, each against its own objective; pounding at g* has 1): "
-            "as run, pounding between the buildings; with the runs beyond the model counted apart as collapses, peak storey ductility ≥ "
-            "10000 in 1 of 1 configurations (a limit state beyond its own objective") in text
-    assert "(the two treatments disagree in 1 of 1 configurations: what governs depends on whether the runs beyond the model" in text
+            "as run, no limit state beyond its objective; with the runs beyond the model counted apart as collapses, peak storey "
+            "ductility ≥ 10000 in 1 of 1 configurations (a limit state beyond its own objective") in text
+    assert ("; the two treatments disagree in 1 of 1 configurations: what governs depends on whether the runs beyond the model are "
+            "taken as computed or as collapses); in the other configurations, pounding between the buildings for 10 % in 50 yr") in text
     for damage in (store_damage(store, [LimitState("ductility", 1.0e4)], "a test"), None):  # no objective: nothing ranked
         text = design_summary_text(risk, None, damage)
         assert "Limit state judged (no structural limit state with an objective, so none is ranked against it): pounding between" in text
