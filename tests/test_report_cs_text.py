@@ -111,4 +111,4 @@ def test_the_design_summary_counts_the_motions_that_ran_not_the_pool(cs_store) -
     chosen = int(np.isfinite(cs_store["selection_scale_factor"]).any("intensity").sum())
     assert 3 <= chosen < 8
     assert assumptions(cs_store)["suite"] == (f"{chosen} motions ran (records without a named suite), selected per stripe by conditional "
-                                              "spectrum from a pool of 8")
+                                              "spectrum from a pool of 8 records")

@@ -14,7 +14,7 @@
 * the gap identity that gives g* from the contact-free runs, with the walls'
   where the scene has walls;
 * the simulated motions that ran (``[site] simulated_motions``): their
-  site-motion model and its calibration (:func:`simulated_motions_text`, from the definition).
+  site-motion model and its calibration (:func:`simulated_motions_text`, from the store).
 
 The chapter 17 design's spectrum and assumptions are the design rules' own
 (``stochpound.risk._design_rules.design_assumptions``).
@@ -23,27 +23,12 @@ The chapter 17 design's spectrum and assumptions are the design rules' own
 from __future__ import annotations
 
 import math
-from collections.abc import Collection, Iterable, Mapping
-from typing import Any, Protocol
+from collections.abc import Iterable, Mapping
+from typing import Any
 
 from stochpound._plurals import counted
 from stochpound.model import Scene
 from stochpound.model.building import Building
-from stochpound.model.scene_tables import MotionEntry
-
-class _Motion(Protocol):
-    """What :func:`simulated_motions_text` reads of a motion of a definition (``stochpound.store.MotionSource``)."""
-
-    label: str
-    motion: MotionEntry
-
-    @property
-    def type(self) -> str: ...
-
-
-SITE_MOTIONS = "site_motions"
-"""The ``[motion]`` type of a simulated motion of ``[site] simulated_motions``."""
-
 
 def scene_assumptions(scenes: Mapping[tuple[Any, ...], Scene]) -> dict[str, str]:
     """What the answer rests on of the structural model and the motions, in words, each key present only where it applies.
@@ -81,15 +66,13 @@ def scene_assumptions(scenes: Mapping[tuple[Any, ...], Scene]) -> dict[str, str]
     return said
 
 
-def simulated_motions_text(motions: Iterable[_Motion], ran: Collection[str]) -> str:
-    """The simulated motions that ran (``[site] simulated_motions`` chosen into the stripes: labels in ``ran``) of a definition's
-    ``motions`` with their model and calibration, in words; "" where none ran."""
-    tables = [source.motion for source in motions if source.type == SITE_MOTIONS and source.label in ran]
-    if not tables:
+def simulated_motions_text(simulated: int, ran: int, model: str, calibration: str) -> str:
+    """The ``simulated`` motions of the ``ran`` that ran (``[site] simulated_motions`` chosen into the stripes) with their
+    site-motion ``model`` and its ``calibration``, in words; "" where none ran."""
+    if not simulated:
         return ""
-    models = _distinct(f"{table['model']} site-motion model, calibration {table['calibration']}" for table in tables)
-    return (f"{counted(len(tables), 'simulated motion')} of the {len(ran)} that ran ({'; '.join(models)}): their spectra, durations "
-            "and variability are the model's as calibrated, not recorded ones")
+    return (f"{counted(simulated, 'simulated motion')} of the {ran} that ran ({model} site-motion model, calibration {calibration}): "
+            "their spectra, durations and variability are the model's as calibrated, not recorded ones")
 
 
 def _distinct(texts: Iterable[str]) -> list[str]:

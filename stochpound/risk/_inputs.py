@@ -310,19 +310,23 @@ def assumptions(store: xr.Dataset, scenes: Mapping[tuple[Any, ...], Scene] | Non
     for building in definition.tables.buildings:
         storey = "yielding (bilinear) storeys" if building.yields else "linear elastic storeys"
         models.append(f"{building.name}: {building.floors}-storey shear building, {storey}, on {_base_words(definition.mu, building)}")
-    kinds = {"record": "records without a named suite", "synthetic": "synthetic ensembles", "simulated": "simulated site motions"}
+    kinds = {"record": "records without a named suite", "synthetic": "synthetic ensembles"}
     ran = motions_that_ran(store) if "case_status" in store else {source.label for source in definition.motions}
+    simulated = ran & {str(label) for label, kind in zip(store["record"].values, store["record_kind"].values) if kind == "simulated"} \
+        if "record_kind" in store.coords else set()
     sources = [source for source in definition.motions if source.label in ran]
-    suites = sorted({source.suite or kinds.get(source.kind, source.kind) for source in sources})
-    count, pool = sum(source.count for source in sources), sum(source.count for source in definition.motions)
+    suites = sorted({source.suite or kinds.get(source.kind, source.kind) for source in sources}) + (["simulated"] if simulated else [])
+    count, pool = sum(source.count for source in sources) + len(simulated), sum(source.count for source in definition.motions)
     selection = definition.intensity.selection if definition.intensity is not None else None
+    generated = selection.simulated if selection is not None else None
+    pool_words = f"{pool} records" + (f" and {generated.count} simulated motions of each stripe's scenario" if generated else "")
     suite = (f"{counted(count, 'motion')} ran ({', '.join(suites)}), "
-             + (f"selected per stripe by {selection.method.replace('_', ' ')} from a pool of {pool}" if selection
+             + (f"selected per stripe by {selection.method.replace('_', ' ')} from a pool of {pool_words}" if selection
                 else "every motion scaled to every stripe (no selection)"))
     scenario = _scenario_words(store, scenario_kind(store)) if selection and selection.scenarios else ""
-    simulated = simulated_motions_text(definition.motions, ran)
+    said = simulated_motions_text(len(simulated), count, generated.model, generated.calibration) if simulated and generated else ""
     return {"structural model": "; ".join(models), **scene_assumptions(scenes or {}), "suite": suite,
-            **({"simulated motions": simulated} if simulated else {}),
+            **({"simulated motions": said} if said else {}),
             "scenario": scenario or "none stated (the motions are not selected for a scenario)"}
 
 
