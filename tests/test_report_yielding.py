@@ -643,3 +643,11 @@ def test_a_rule_row_whose_fit_is_a_step_at_the_lowest_stripe_says_its_rate_is_a_
     fits = {name: set(stepped.loc[suite_mean & (stepped["rule"] == RULE_NAMES.get(rule, rule)), "fit"])
             for name, rule in (("first", first["rule"]), ("second", second["rule"]))}
     assert fits == {"first": {LOWEST_STRIPE_STEP}, "second": {"step: separated"}}  # the step above the lowest stripe keeps its name
+
+
+def test_a_ratio_that_decides_the_objective_never_prints_as_one():
+    """The flagship's table printed λ/λ_target = '1' for 0.0139/0.01386 while the text said the objective was missed."""
+    from stochpound.report.sections._damage import _ratio_cell, ratio_text
+
+    assert (ratio_text(1.003), ratio_text(0.998), ratio_text(1.02), ratio_text(0.25, 2)) == ("1.003", "0.998", "1.02", "0.25")
+    assert _ratio_cell(1.0029, math.nan) == "1.003" and _ratio_cell(0.5, 1.001) == "≥ 1.001"

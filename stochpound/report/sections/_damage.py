@@ -132,10 +132,10 @@ def _governs_text(damage: StoreDamage, probability: float, apart: bool) -> str:
         worst = str(governing.sel(labels).item())
         value = float(largest.sel(labels))
         if worst == POUNDING:
-            text = f"{POUNDING} (every limit state within its objective; the largest λ/λ_target is {value:.2g}, {largest_state.sel(labels).item()})"
+            text = f"{POUNDING} (every limit state within its objective; the largest λ/λ_target is {ratio_text(value, 2)}, {largest_state.sel(labels).item()})"
         else:
             others = [str(state) for state, flag in zip(misses["limit_state"].values, misses.sel(labels).values) if flag and state != worst]
-            text = f"{worst} (λ/λ_target = {value:.2g})" + (f"; also beyond their objectives: {', '.join(others)}" if others else "")
+            text = f"{worst} (λ/λ_target = {ratio_text(value, 2)})" + (f"; also beyond their objectives: {', '.join(others)}" if others else "")
         grouped.setdefault(text, []).append(_label(labels))
     every = len(_configurations(governing))
     return "; ".join((f"{' and '.join(names)}: " if len(names) < every else "") + text for text, names in grouped.items())
@@ -201,4 +201,10 @@ def _period_cell(period: float, bound: float) -> str:
 
 def _ratio_cell(ratio: float, bounded: float) -> str:
     """λ/λ_target in the table, ``≥`` the bound's where λ is one."""
-    return f"≥ {bounded:.3g}" if bounded == bounded else f"{ratio:.3g}"
+    return f"≥ {ratio_text(bounded)}" if bounded == bounded else ratio_text(ratio)
+
+
+def ratio_text(ratio: float, digits: int = 3) -> str:
+    """λ/λ_target to ``digits`` significant digits, but to 0.001 within 0.5 % of 1: a ratio that decides whether the objective is
+    missed never prints as a bare ``1`` (1.003 misses it, 0.998 does not)."""
+    return f"{ratio:.3f}" if abs(ratio - 1.0) < 0.005 else f"{ratio:.{digits}g}"
