@@ -102,3 +102,13 @@ def test_the_motion_table_lists_the_motions_that_ran_not_the_pool(cs_store) -> N
     table = motions_table([StoreDefinition("cs", cs_store)])
     assert set(table.frame["motion"]) == chosen and 3 <= len(chosen) < 8
     assert f"({len(chosen)} of the 8 motions the experiments define: a selection's pool motions it never chose are left out)." in table.caption
+
+
+def test_the_design_summary_counts_the_motions_that_ran_not_the_pool(cs_store) -> None:
+    """Issue 45: '44 / 56 motions run' where 13 + 27 ran. The summary's suite counts the motions some stripe chose, beside the pool."""
+    from stochpound.risk._inputs import assumptions
+
+    chosen = int(np.isfinite(cs_store["selection_scale_factor"]).any("intensity").sum())
+    assert 3 <= chosen < 8
+    assert assumptions(cs_store)["suite"] == (f"{chosen} motions ran (records without a named suite), selected per stripe by conditional "
+                                              "spectrum from a pool of 8 records")

@@ -81,3 +81,12 @@ def test_a_corrupted_store_makes_the_check_fail_in_one_line(stripes_store):
     store["impacts"].loc[labels] = store["impacts"].sel(labels) + 1
     with pytest.raises(VerificationError, match=r"^cross-check: the stored case of verify \(.*\) re-run counts \d+ impacts, the store holds \d+$"):
         cross_check([StoreDefinition("verify", store)])
+
+
+def test_the_cross_check_gives_the_peak_sliding_not_its_range():
+    """Issue 45: 'sliding over 123 cm' was the range between the extremes (−61.4 to +61.6 cm); the peak |s| is 61.6 cm."""
+    from stochpound.analysis import ReferenceRun
+
+    exact = xr.Dataset({"sliding_displacement": (("time", "building"), [[0.0, 0.0], [-0.614, 0.0], [0.616, 0.0]])})
+    run = ReferenceRun(None, exact, exact, 0.0, 1.0)
+    assert run.sliding == pytest.approx(0.616, rel=1e-12)

@@ -12,6 +12,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pandas as pd
 import pytest
 
 from stochpound._errors import VerificationError
@@ -33,10 +34,15 @@ STRIPES = 'measure = "psa"\nperiod = 1.0\nlevels = [0.3, 0.7399, 1.2031]\nmethod
 
 
 @pytest.fixture(scope="module")
-def store(tmp_path_factory):
+def store_path(tmp_path_factory):
     assert SCENE.count("yield_force") == 2
     text = risk_text(SCENE, "gap = [0.05, inf]", STRIPES) + "demands = true\n" + DESIGN
-    return open_store(run_in_process(tmp_path_factory.mktemp("yreport"), "yfix", text)).load()
+    return run_in_process(tmp_path_factory.mktemp("yreport"), "yfix", text)
+
+
+@pytest.fixture(scope="module")
+def store(store_path):
+    return open_store(store_path).load()
 
 
 def _text(block) -> str:
@@ -141,11 +147,106 @@ def test_pounding_at_g_star_governs_where_no_limit_state_is_as_frequent(store):
     damage = store_damage(store, [LimitState("ductility", 1.0e4, target=0.02)], "a test")
     assert float(damage.risk["maf"].max()) == 0.0
     assert damage.governing(0.02).item() == "pounding at g*"
-    assert "Governing: pounding at g* (every limit state within its objective; the largest λ/λ_target is 0" in " ".join(
+    assert "Governing: as run, pounding at g* (every limit state within its objective; the largest λ/λ_target is 0" in " ".join(
         _text(block) for block in damage_section("yfix", damage).blocks)
     unjudged = store_damage(store, [LimitState("ductility", 1.0e4)], "a test")
     text = " ".join(_text(block) for block in damage_section("yfix", unjudged).blocks)
     assert unjudged.governing(0.02) is None and "none is said to govern" in text and "Governing:" not in text
+
+
+def _two_treatments():
+    """Two configurations (μ 0.05, 0.08) of immediate occupancy (0.7 %, 50 % in 50 yr) and collapse prevention (5 %, 2 % in 50 yr),
+    λ as run and with the collapses counted apart, chosen so that the treatments disagree in the first configuration only."""
+    import xarray as xr
+
+    from stochpound.risk import LimitState, StoreDamage
+
+    states = (LimitState("drift_ratio", 0.007, "B1", 0.5), LimitState("drift_ratio", 0.05, "B1", 0.02))
+    coords = {"limit_state": [s.label for s in states], "mu": [0.05, 0.08], "target": ("limit_state", [0.5, 0.02])}
+    risk = xr.Dataset({"maf": (("limit_state", "mu"), [[0.01, 0.02], [3e-4, 1e-4]]),
+                       "maf_collapses_apart": (("limit_state", "mu"), [[0.011, 0.021], [9e-4, 2e-4]])}, coords=coords)
+    runs, beyond = xr.DataArray([8]), xr.DataArray([1])  # one of 8 runs beyond the model
+    return states, risk, StoreDamage(xr.Dataset(), runs, beyond, {0.1: 1.0}, risk, states, "a test", True)
+
+
+def test_governs_is_judged_in_each_treatment_of_the_collapses_and_a_disagreement_is_said():
+    """Issue 45: with the runs beyond the model counted apart the governing objective can differ. By hand (λ_target = −ln(1 − p)/50:
+    0.013863 and 4.0405e-4 /yr): μ 0.05 as run 0.72 and 0.74, nothing beyond its objective (pounding at g*), collapses apart 0.79
+    and 2.23: collapse prevention; μ 0.08 as run 1.44 and 0.25, collapses apart 1.51 and 0.49: immediate occupancy both ways."""
+    from stochpound.report.sections._damage import _governing_text
+    from stochpound.report.sections._risk import _structural_governs
+    from stochpound.risk import disagreement_text, governing_limit_state, objectives_frame
+
+    states, risk, damage = _two_treatments()
+    rates = -np.log(1.0 - np.array([0.5, 0.02])) / 50.0
+    np.testing.assert_allclose(damage.ratio(apart=True).values, risk["maf_collapses_apart"].values / rates[:, None], rtol=1e-12)
+    assert list(damage.governing(0.1).values) == ["pounding at g*", states[0].label]
+    assert list(damage.governing(0.1, apart=True).values) == [states[1].label, states[0].label]
+    assert list(damage.disagreement().values) == [True, False]
+    assert damage.governing_counts(0.02, apart=True) == ({states[1].label: 1, states[0].label: 1}, 2)
+    text = _governing_text(damage)
+    assert (f"Governing: as run, mu 0.05: pounding at g* (every limit state within its objective; the largest λ/λ_target is "
+            f"{3e-4 / rates[1]:.2g}, {states[1].label}); mu 0.08: {states[0].label} (λ/λ_target = {0.02 / rates[0]:.2g}); with the runs "
+            f"beyond the model counted apart as collapses, mu 0.05: {states[1].label} (λ/λ_target = {9e-4 / rates[1]:.2g})") in text
+    assert (f"The two treatments disagree on what governs in 1 of 2 configurations (mu 0.05: pounding at g* as run, {states[1].label} "
+            "with collapses apart)") in text
+    summary = _structural_governs(damage, 0.1, "pounding between the buildings")
+    assert summary.startswith(f"as run, {states[0].label} in 1 of 2 configurations") and "the two treatments disagree in 1 of 2" in summary
+    assert f"with the runs beyond the model counted apart as collapses, {states[1].label} in 1 of 2 configurations, {states[0].label} in 1" in summary
+    # the same judgement for stochpound risk --limit-states: a finite-gap grid says none beyond its objective where nothing misses
+    frame = objectives_frame(risk)
+    assert list(frame["governs, as run"]) == ["none beyond its objective", states[0].label]
+    assert list(frame["governs, collapses apart"]) == [states[1].label, states[0].label] and list(frame["treatments agree"]) == [False, True]
+    np.testing.assert_allclose(frame["largest λ/λ_target, collapses apart"], [9e-4 / rates[1], 0.021 / rates[0]], rtol=1e-12)
+    assert disagreement_text(frame).startswith(f"The two treatments disagree on what governs in 1 of 2 configurations (mu 0.05: none beyond "
+                                               f"its objective as run, {states[1].label} with the collapses counted apart)")
+    # agreeing treatments are said to agree; one treatment (no run beyond the model) says nothing of a second
+    agreeing = risk.assign(maf_collapses_apart=risk["maf"] * 1.01)
+    assert governing_limit_state(agreeing, apart=True).equals(governing_limit_state(agreeing))
+    assert disagreement_text(objectives_frame(agreeing)) == ("The two treatments of the runs beyond the model name the same governing "
+                                                            "limit state in every configuration.")
+    alone = objectives_frame(risk.drop_vars("maf_collapses_apart"))
+    assert list(alone.columns) == ["governs, as run", "largest λ/λ_target, as run"] and disagreement_text(alone) == ""
+    assert objectives_frame(risk.assign_coords(target=("limit_state", [np.nan, np.nan]))) is None
+
+
+def test_the_store_s_collapses_alone_miss_an_objective_no_run_reaches_as_run(store, store_path, tmp_path):
+    """A ductility of 10⁴ no run reaches: as run λ = 0 and pounding at g* governs; counted apart, the collapses reach it, at the
+    collapse rate, so it governs where that rate misses its 2 %/50 yr objective. The report and stochpound risk --limit-states say
+    which governs each way and that they disagree."""
+    from click.testing import CliRunner
+
+    from stochpound.cli import main
+    from stochpound.risk import LimitState, governing_limit_state, limit_state_risk, site_hazard
+
+    state = LimitState("ductility", 1.0e4, target=0.02)
+    damage = store_damage(store, [state], "a test")
+    collapse = float(damage.risk["maf_collapses_apart"].item())
+    assert collapse > 0.0 and float(damage.risk["maf"].item()) == 0.0
+    rate = -math.log(0.98) / 50.0
+    apart = damage.governing(0.02, apart=True).item()
+    assert apart == (state.label if collapse > rate else "pounding at g*")
+    assert collapse > rate  # these weak storeys collapse more often than once in 2475 years
+    text = " ".join(_text(block) for block in damage_section("yfix", damage).blocks)
+    assert (f"with the runs beyond the model counted apart as collapses, {state.label} (λ/λ_target = {collapse / rate:.2g}). The two "
+            f"treatments disagree on what governs in 1 of 1 configurations (pounding at g* as run, {state.label} with collapses apart)") in text
+    # the CLI, on every configuration of the grid (the 5 cm gap's runs too)
+    (tmp_path / "states.toml").write_text("[limit_states]\nductility = [1.0e4]\n[limit_states.targets]\nductility = [0.02]\n")
+    result = CliRunner().invoke(main, ["risk", str(store_path), "--bootstrap", "0", "--limit-states", str(tmp_path / "states.toml"),
+                                       "--csv", str(tmp_path / "tables")])
+    assert result.exit_code == 0, result.output
+    risk = limit_state_risk(store, [state], site_hazard(store))
+    at_gap = risk.sel(gap=0.05)
+    assert at_gap["maf"].item() == 0.0 and at_gap["maf_collapses_apart"].item() > rate  # the 5 cm runs: the same two answers
+    expected = [governing_limit_state(at_gap, apart, "none beyond its objective").item() for apart in (False, True)]
+    assert expected == ["none beyond its objective", state.label]
+    written = pd.read_csv(tmp_path / "tables" / "objectives.csv")
+    assert list(written["governs, as run"]) == [expected[0]] and list(written["governs, collapses apart"]) == [expected[1]]
+    np.testing.assert_allclose(written["largest λ/λ_target, collapses apart"], at_gap["maf_collapses_apart"].item() / rate, rtol=1e-9)
+    assert "What governs, judged against each limit state's objective" in result.output
+    assert (f"warning: The two treatments disagree on what governs in 1 of 1 configurations (gap 0.05: none beyond its objective as "
+            f"run, {state.label} with the collapses counted apart)") in result.output
+    assert "step" in "".join(pd.read_csv(tmp_path / "tables" / "limit_states.csv")["fit"])  # the fit named: no run reaches it
 
 
 def test_the_damage_section_states_fractiles_flags_and_the_governing_limit_state(store):
@@ -164,7 +265,7 @@ def test_the_damage_section_states_fractiles_flags_and_the_governing_limit_state
     worst = damage.governing(0.1).item()
     others = [str(state) for state in ratio["limit_state"].values if float(ratio.sel(limit_state=state)) > 1.0 and state != worst]
     expected = f"{worst} (λ/λ_target = {float(ratio.max()):.2g})" + (f"; also beyond their objectives: {', '.join(others)}" if others else "")
-    assert f"Governing: {expected}." in texts
+    assert damage.collapses_apart() and f"Governing: as run, {expected}; with the runs beyond the model counted apart as collapses, " in texts
     assert "(objective: 50 % in 50 yr)" in texts and "(objective: 2 % in 50 yr)" in texts
 
 
@@ -359,8 +460,14 @@ def test_the_design_summary_names_the_limit_state_the_damage_section_finds_gover
         assert "a limit state beyond its own objective, the largest λ/λ_target" in text
     unreached = store_damage(store, [LimitState("ductility", 1.0e4, target=0.1)], "a test")
     text = design_summary_text(risk, None, unreached)
-    assert "Governing limit state (the largest λ/λ_target of the limit states, each against its own objective; pounding at g* has 1): " \
-           "pounding between the buildings for 10 % in 50 yr" in text and "own objective, the largest" not in text
+    # as run no run reaches it; counted apart, the collapses do, more often than 10 % in 50 yr allows: the treatments disagree
+    collapse = unreached.risk["maf_collapses_apart"].item()
+    assert collapse > -math.log(0.9) / 50.0
+    assert ("Governing limit state (the largest λ/λ_target of the limit states, each against its own objective; pounding at g* has 1): "
+            "as run, no limit state beyond its objective; with the runs beyond the model counted apart as collapses, peak storey "
+            "ductility ≥ 10000 in 1 of 1 configurations (a limit state beyond its own objective") in text
+    assert ("; the two treatments disagree in 1 of 1 configurations: what governs depends on whether the runs beyond the model are "
+            "taken as computed or as collapses); in the other configurations, pounding between the buildings for 10 % in 50 yr") in text
     for damage in (store_damage(store, [LimitState("ductility", 1.0e4)], "a test"), None):  # no objective: nothing ranked
         text = design_summary_text(risk, None, damage)
         assert "Limit state judged (no structural limit state with an objective, so none is ranked against it): pounding between" in text
@@ -380,6 +487,14 @@ def test_the_design_summary_says_how_many_runs_are_beyond_the_model(store):
     assert "beyond the model" not in design_summary_text(risk, None, None)
     within = dataclasses.replace(damage, beyond_model=damage.beyond_model * 0)
     assert "beyond the model" not in design_summary_text(risk, None, within)
+    # every assumption of this fixed, yielding pair with a [design], each derived from the store; none of a sliding base or walls
+    text = design_summary_text(risk, None, damage)
+    for said in ("storeys: B1: storey heights 3, 3 m (the drift ratios, their limit states and P-Δ rest on them), damping ratio 5 %, "
+                 "bilinear storeys, F_y = 100, 70 kN", "No storey loses strength, degrades or collapses (no such model)",
+                 "gap identity: a run with gap g pounds if and only if", "suite: 8 motions ran (records without a named suite)",
+                 "code design: ASCE 7-16: S_DS = 1.329 g, S_D1 = 0.802 g, T_L = 8 s, R = 8, C_d = 5.5, Ω0 = 3, I_e = 1"):
+        assert said in text, said
+    assert all(absent not in text for absent in ("sliding base:", "moat walls:", "chapter 17 (", "simulated motions:", "Coulomb"))
 
 
 def _cells(section) -> list[str]:
@@ -528,3 +643,11 @@ def test_a_rule_row_whose_fit_is_a_step_at_the_lowest_stripe_says_its_rate_is_a_
     fits = {name: set(stepped.loc[suite_mean & (stepped["rule"] == RULE_NAMES.get(rule, rule)), "fit"])
             for name, rule in (("first", first["rule"]), ("second", second["rule"]))}
     assert fits == {"first": {LOWEST_STRIPE_STEP}, "second": {"step: separated"}}  # the step above the lowest stripe keeps its name
+
+
+def test_a_ratio_that_decides_the_objective_never_prints_as_one():
+    """The flagship's table printed λ/λ_target = '1' for 0.0139/0.01386 while the text said the objective was missed."""
+    from stochpound.report.sections._damage import _ratio_cell, ratio_text
+
+    assert (ratio_text(1.003), ratio_text(0.998), ratio_text(1.02), ratio_text(0.25, 2)) == ("1.003", "0.998", "1.02", "0.25")
+    assert _ratio_cell(1.0029, math.nan) == "1.003" and _ratio_cell(0.5, 1.001) == "≥ 1.001"

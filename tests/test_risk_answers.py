@@ -208,6 +208,18 @@ def test_d_tm_where_the_base_never_slides_is_left_out_and_said_why_not_a_dash():
     assert "left out where the studied building's base never slid in any run (mu ∞)" in text and "fixed base (μ = ∞)" in text
     assert _risk(rules.sel(mu=[0.05])).dtm_text() == ""
     assert "base slides in no run of this store" in _risk(rules.sel(rule=["abs"])).dtm_text()
+    # issue 45: the suite-mean base displacement is the D_M form, never called D_TM (only eq. 17.5-3's value is)
+    for said in (text, _risk(rules.sel(rule=["abs"])).dtm_text()):
+        assert "D_TM" not in said.replace("not D_TM", "")
+
+
+def test_d_tm_names_only_the_value_of_eq_17_5_3():
+    """Issue 45: 'D_TM by eq. 17.5-1' was D_M. Of every rule the tables name, only chapter 17's row says D_TM, with eq. 17.5-3."""
+    from stochpound.risk._chain import RULE_NAMES
+
+    named = {key for key, name in RULE_NAMES.items() if "D_TM" in name}
+    assert named == {"asce7_isolated"} and "D_TM (eq. 17.5-3)" in RULE_NAMES["asce7_isolated"]
+    assert "17.5-1" not in RULE_NAMES["asce7_isolated"] and "D_M form: no torsion" in RULE_NAMES["dtm"]
 
 
 def test_d_tm_is_not_taken_from_runs_a_moat_wall_capped(tmp_path):

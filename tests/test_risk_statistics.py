@@ -120,7 +120,7 @@ def test_the_bootstrap_counts_the_clusters_and_motions_that_ran_not_the_pool():
                         coords={"intensity": levels, "record": [f"m{i}" for i in range(12)],
                                 "record_event": ("record", [f"quake {i // 2}" for i in range(12)])})
     method = stripe_fragility(data, bootstrap=50, seed=1)["theta_lower"].attrs["method"]
-    assert method == ("BCa cluster bootstrap over events (4 clusters of the 7 motions that ran, of a pool of 12; per stripe 2–4 clusters "
+    assert method == ("BCa cluster bootstrap over events (4 clusters of the 7 motions that ran, of the 12 the store holds; per stripe 2–4 clusters "
                       "of 4 motions; station where the event is unknown)")
     assert "12 motions that ran" not in method and "6 clusters" not in method  # the pool is not what was resampled
     every = bootstrap_method(np.array(["a", "a", "b"], dtype=object), np.ones((2, 3), dtype=bool))

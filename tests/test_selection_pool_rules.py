@@ -91,6 +91,15 @@ def test_simulated_motions_join_the_pool_and_regenerate_bit_for_bit_from_the_sto
         assert int(store.selection_simulated[j]) == n_sim and int(store.selection_recorded[j]) == len(chosen) - n_sim == 4 - n_sim
         events = {str(store.record_event.sel(record=c).values) if kinds[c] == "record" else c for c in chosen}
         assert int(store.selection_earthquakes[j]) == len(events)
+    # issue 45: the Methods' counts and the motion table give the simulated motions that ran (the definition lists the records only)
+    from stochpound.report.sections._description import StoreDefinition, grid_paragraph, motions_table
+    ran_simulated = [label for label in simulated if bool((store["case_status"].sel(record=label) == 1).any())]
+    recorded = sum(1 for label, kind in kinds.items() if kind == "record" and bool((store["case_status"].sel(record=label) == 1).any()))
+    described = StoreDefinition("pool", store)
+    assert (f"under the {recorded + len(ran_simulated)} motions that ran ({recorded} of the 6 the experiment defines, and "
+            f"{len(ran_simulated)} simulated for the stripes' scenarios)") in grid_paragraph(described).text
+    table = motions_table([described])
+    assert table.frame["motion"].iloc[-1].endswith(f"({len(ran_simulated)} simulated)") and len(table.frame) == recorded + 1
     text = " ".join(block.text for block in intensity_section("pool", store).blocks if isinstance(block, Paragraph))
     assert "from a pool of 6 records and 6 simulated motions of each stripe's scenario" in stripe_motions_text(store)
     assert f"0.2 g: {int(store.selection_recorded[0])} recorded and {int(store.selection_simulated[0])} simulated from" in text

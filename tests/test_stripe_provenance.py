@@ -73,3 +73,15 @@ def test_the_sources_name_the_experiment_file_only_where_it_is_the_stores(tmp_pa
     assert definition_source(store).startswith(f"the experiment text recorded in the store (its file {path} is not at that path")
     assert definition_source(xr.Dataset(attrs={"experiment_file": "iso_fitted.toml"})) == (
         "the experiment text recorded in the store (its file iso_fitted.toml is not at that path)")
+
+
+def test_the_simulated_motions_that_ran_are_read_off_the_store():
+    """The definition lists the records only; the simulated motions some stripe chose are the store's, by their record_kind."""
+    import xarray as xr
+
+    from stochpound.store import simulated_that_ran
+
+    status = xr.DataArray([[1, 0, 1, 0]], dims=("intensity", "record"), coords={
+        "record": ["r1", "r2", "simulated 1.0", "simulated 1.1"], "record_kind": ("record", ["record", "record", "simulated", "simulated"])})
+    assert simulated_that_ran(xr.Dataset({"case_status": status})) == ["simulated 1.0"]
+    assert simulated_that_ran(xr.Dataset({"case_status": status.drop_vars("record_kind")})) == []

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import click
 
@@ -16,6 +17,9 @@ from stochpound.cli._store_errors import store_variables
 from stochpound.analysis import MEASURE_FREE_RUNS
 from stochpound.risk import BOOTSTRAP, TARGETS
 from stochpound.store import Design, TomlTable, VariableAttributes
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 
 def _targets(value: str) -> tuple[float, ...]:
@@ -39,6 +43,24 @@ def _toml_table(path: Path, name: str, docs: str, beside: tuple[str, ...] = ()) 
     if name not in table:
         raise click.ClickException(f"{path}: has no [{name}] table ({docs})")
     return TomlTable({key: table[key] for key in (name, *beside) if key in table})
+
+
+def objective_lines(objectives: pd.DataFrame | None) -> list[str]:
+    """What governs each configuration against the limit states' objectives, in each treatment of the runs beyond the model, and
+    whether the treatments agree (``stochpound.risk.objectives_frame``), as printed lines."""
+    from stochpound.risk import disagreement_text
+
+    if objectives is None:
+        return ["note: no limit state has a performance objective (a target): none is said to govern (docs/risk.md)."]
+    both = "governs, collapses apart" in objectives
+    head = ("\nWhat governs, judged against each limit state's objective (λ/λ_target, λ_target = −ln(1 − p)/50 yr for its target p; "
+            "the largest ratio above 1 governs" + (", as run and with the runs beyond the model counted apart as collapses" if both else "")
+            + "):")
+    lines = [head, objectives.to_string(float_format=lambda v: f"{v:.3g}")]
+    agreement = disagreement_text(objectives)
+    if agreement:
+        lines.append(("warning: " if "disagree" in agreement else "note: ") + agreement)
+    return lines
 
 
 def _limit_states(path: Path) -> tuple:
@@ -121,7 +143,7 @@ CSV_TABLES = ("separation", "rules", "limit_states")
               help="Answer for a store whose definition does not match its recorded sha256 (changed since it was written); refused otherwise.")
 @click.option("--csv", "csv_dir", type=click.Path(file_okay=False, path_type=Path), metavar="DIR",
               help="Also write the tables to this folder (created), one CSV file per table: separation.csv, rules.csv "
-                   "(and limit_states.csv with --limit-states).")
+                   "(and limit_states.csv, objectives.csv with --limit-states).")
 @click.option("--ruptures", "ruptures", metavar="FILE|NAME", help="Also print the answer without an intensity measure at this site of "
               "ruptures (a rupture table or a bundled site's name, e.g. demo_three_sources; docs/measure-free.md): every configuration "
               "run under simulated motions of each rupture, seeded by --seed.")
@@ -138,7 +160,8 @@ def risk(store: Path, hazard: str | None, hazard_measure: str | None, hazard_uni
     For every configuration of the store (each combination of its grid's
     axes other than the gap): g* for each target probability in --years,
     with its 95 % bootstrap interval over the motions, then each code rule
-    (ABS, SRSS, 0.7 SRSS, DDC, and D_TM for a sliding studied building)
+    (ABS, SRSS, 0.7 SRSS, DDC, and the suite-mean peak base displacement,
+    ASCE 7's D_M form, for a sliding studied building)
     at the hazard's 2 %/50 yr and 10 %/50 yr intensities: its gap and
     the mean annual frequency of pounding there, as a return period and
     a probability in --years. The store needs intensity stripes (with
@@ -169,8 +192,8 @@ def risk(store: Path, hazard: str | None, hazard_measure: str | None, hazard_uni
     from stochpound.cli._measure_choice import efficient_measure_lines
     from stochpound.experiment import open_store
     from stochpound.motions import TARGET_TOLERANCE, TRUNCATION_EPSILON
-    from stochpound.risk import (MODEL_DRIFT_LIMIT, check_alternative, collapse_risk, gap_cost_frame, limit_state_risk, read_risk_inputs, separation_sensitivity,
-                                 site_hazard, store_risk)
+    from stochpound.risk import (MODEL_DRIFT_LIMIT, check_alternative, collapse_risk, gap_cost_frame, limit_state_risk,
+                                 objectives_frame, read_risk_inputs, separation_sensitivity, site_hazard, store_risk)
 
     targets = _targets(target)
     others = sensitivity_stores(sensitivity)
@@ -190,7 +213,9 @@ def risk(store: Path, hazard: str | None, hazard_measure: str | None, hazard_uni
                              site=hazard_site, extrapolate=extrapolate)
             inputs = read_risk_inputs(data, hz, design=None if design is None else _design(design), partial=partial)  # the chain's one read
             result = store_risk(inputs, targets=targets, years=years, bootstrap=bootstrap, seed=seed)
-            costs = None if limit_states is None else gap_cost_frame(limit_state_risk(data, _limit_states(limit_states), hz), years)
+            states = None if limit_states is None else limit_state_risk(data, _limit_states(limit_states), hz)
+            costs = None if states is None else gap_cost_frame(states, years)
+            objectives = None if states is None else objectives_frame(states)
             collapse = None if result.method != "stripes" else collapse_risk(data, hz, result.fragility["gap"].values, targets, years)
             if others and result.method != "stripes":
                 raise click.BadParameter("the sensitivity table is of stripes; the store holds IDA capacities", param_hint="--sensitivity-store")
@@ -271,8 +296,10 @@ def risk(store: Path, hazard: str | None, hazard_measure: str | None, hazard_uni
                    "runs, gap = inf), and a limit state's cost is taken at a finite gap against its contact-free twin.")
     elif costs is not None:
         click.echo(f"\nLimit states beyond first contact (λ: per year at each finite gap; contact-free: the same motions without "
-                   f"contact; Δλ: what the gap costs; P in {years:g} years):")
+                   f"contact; Δλ: what the gap costs; P in {years:g} years; fit: the fragility's kind, a step at the lowest stripe "
+                   "giving a bound, not a rate):")
         click.echo(costs.to_string(float_format=lambda v: f"{v:.4g}"))
+        click.echo("\n".join(objective_lines(objectives)))
     click.echo("\n".join(measure_lines))
     if csv_dir is not None:
         tables = {"separation": result.to_frame()}
@@ -280,6 +307,8 @@ def risk(store: Path, hazard: str | None, hazard_measure: str | None, hazard_uni
             tables["rules"] = rules.reset_index()
         if costs is not None:
             tables["limit_states"] = costs.reset_index()
+        if objectives is not None:
+            tables["objectives"] = objectives.reset_index()
         try:
             csv_dir.mkdir(parents=True, exist_ok=True)
             for name, frame in tables.items():

@@ -26,7 +26,9 @@ the demand hazard curves and the moat walls' limit state
 (:class:`StoreDemands`); :func:`limit_state_risk` the fragility and MAF of
 limit states beyond first contact (:class:`LimitState`: drift ratios,
 ductility, floor acceleration, impact force, a bearing's stop) at every gap
-of a store's grid against its contact-free twins (:func:`gap_cost_frame`);
+of a store's grid against its contact-free twins (:func:`gap_cost_frame`), what governs
+each configuration against the limit states' objectives in each treatment of the runs beyond the model
+(:func:`governing_limit_state`, :func:`objectives_frame`);
 :func:`store_damage` the ductility and residual drift demands of yielding
 buildings per stripe, the runs beyond the model and the governing limit
 state, each limit state against its own objective (:class:`StoreDamage`);
@@ -70,9 +72,10 @@ from stochpound.risk._inputs import configuration_scene
 from stochpound.risk._inputs import stripe_motions  # noqa: F401  (for stochpound.experiment.measure_choice: not public API)
 from stochpound.risk._chain import StoreRisk, pounding_fragility, risk_gaps, store_risk
 from stochpound.risk._gap_grid import GRID_TOLERANCE
-from stochpound.risk._damage import POUNDING as POUNDING_AT_G_STAR  # noqa: F401  (for the report's sections: not public API)
+from stochpound.risk._limit_states import POUNDING as POUNDING_AT_G_STAR  # noqa: F401  (for the report's sections: not public API)
 from stochpound.risk._demands import StoreDemands, store_demands
-from stochpound.risk._limit_states import KINDS as LIMIT_STATE_KINDS, LimitState, gap_cost_frame, limit_state_problem, limit_state_risk, limit_states_from_table
+from stochpound.risk._limit_states import (KINDS as LIMIT_STATE_KINDS, LimitState, disagreement_text, gap_cost_frame, governing_limit_state,
+                                           limit_state_fits, limit_state_problem, limit_state_risk, limit_states_from_table, objectives_frame)
 from stochpound.risk._efficiency import measure_efficiency, most_efficient
 from stochpound.risk._efficiency import candidate_name  # noqa: F401  (for stochpound.experiment.measure_choice: not public API)
 from stochpound.risk._collapse import CollapseRisk, beyond_model, collapse_risk, collapsed_runs, rate_collapses_apart
@@ -145,6 +148,10 @@ __all__ = [
     "limit_state_problem",
     "limit_state_risk",
     "gap_cost_frame",
+    "governing_limit_state",
+    "objectives_frame",
+    "disagreement_text",
+    "limit_state_fits",
     "store_damage",
     "DAMAGE_DEMANDS",
     "StoreDamage",

@@ -39,7 +39,7 @@ from stochpound.hazard import HazardCurve, rate_from_probability
 from stochpound.risk import _inputs
 from stochpound.risk._inputs import Design, Intensity, RiskInputError, RiskInputs, read_risk_inputs
 from stochpound.risk._code_rules import MINIMUM_MOTIONS, code_rules_risk
-from stochpound.risk._design_rules import DESIGN_RULE_NAMES, design_rules_risk, design_rules_text
+from stochpound.risk._design_rules import DESIGN_RULE_NAMES, design_assumptions, design_rules_risk, design_rules_text
 from stochpound.risk._fragility_ensemble import BOOTSTRAP, fragility_band, fragility_surface, homogeneous_capacities, ida_fragility, limit_state_events, stripe_fragility
 from stochpound.risk._fragility import DECREASING, EMPTY, FIT, STATUS
 from stochpound.risk._gap_grid import GRID_TOLERANCE, MAX_REFINEMENTS, grid_note, refinement_gaps
@@ -162,7 +162,7 @@ class StoreRisk:
     confidence : float
         The confidence of the intervals.
     dtm_note : str
-        Why the rules hold no D_TM ("" where they do, or where the studied building does not slide).
+        Why the rules hold no suite-mean peak base displacement row ("" where they do, or where the studied building does not slide).
     design_rules : xarray.Dataset or None
         The codes' own gaps from the design analysis and their risk
         (:func:`~stochpound.risk.design_rules_risk`); None without a ``[design]`` or without stripes.
@@ -315,21 +315,22 @@ class StoreRisk:
         return frame.set_index(index).dropna(how="all")
 
     def dtm_text(self) -> str:
-        """Where the suite-mean D_TM rule applies, in words: why it is absent, or the configurations it is left out of ("" where it
+        """Where the suite-mean peak base displacement rule (the D_M form) applies, in words: why it is absent, or the configurations it is left out of ("" where it
         applies in every one)."""
         if self.rules is None:
             return ""
         if "dtm" not in self.rules["rule"].values:
             never = ("the studied building's base slides in no run of this store (a fixed base, or friction the motions never overcame): "
                      "there is no isolator displacement to size")
-            return f"D_TM is not applied: {self.dtm_note or never}."
+            return f"The row '{RULE_NAMES['dtm']}' is not given: {self.dtm_note or never}."
         missing = self.rules["gap"].sel(rule="dtm").isnull().all("contact")
         missing = missing.any("design_level") if "design_level" in missing.dims else missing
         if not bool(missing.any()):
             return ""
         where = [", ".join(f"{d} {_label(v)}" for d, v in zip(missing.dims, index)) for index in zip(*(
             missing[d].values[i] for d, i in zip(missing.dims, np.nonzero(missing.values))))] if missing.dims else ["the scene"]
-        return ("D_TM (ASCE 7 §17.2.5.2) sizes the clearance of a base that slides; its rows are left out where the studied building's "
+        return ("The suite-mean peak base displacement (ASCE 7's D_M form: no torsion, not D_TM) sizes the clearance of a base that "
+                "slides; its rows are left out where the studied building's "
                 f"base never slid in any run ({'; '.join(where)}): a fixed base (μ = ∞), or friction the motions never overcame, has no "
                 "isolator displacement to size (it stays 0), and its separation is the storeys' rules'.")
 
@@ -626,8 +627,8 @@ def store_risk(store: xr.Dataset | RiskInputs, hz: HazardCurve | None = None, ta
         (within the hazard's table), so that the grid reaches the separations
         the hazard asks for. Either grid is refined near each g* (``grid_tolerance``).
     studied : str, optional
-        The building whose peak base displacement (wall-free: a moat wall
-        caps the displacement D_TM is meant to size) is ASCE 7's D_TM; default
+        The building whose suite-mean peak base displacement (wall-free: a
+        moat wall caps the displacement it sizes) is the D_M-form rule; default
         the store's ``studied`` building. The rule is left out where it does not slide.
     confidence, bootstrap, seed
         As in :func:`~stochpound.risk.stripe_fragility`.
@@ -685,7 +686,7 @@ def store_risk(store: xr.Dataset | RiskInputs, hz: HazardCurve | None = None, ta
         design_rules = design_rules_risk(inputs, hz, inputs.design, inputs.studied, years, confidence, bootstrap, seed)
     return StoreRisk(fragility, curve, separation, rules, note, hz, inputs.motions, inputs.method, setting=inputs.setting,
                      stripes=inputs.stripes, progress=inputs.progress, experiment=inputs.experiment, years=years, confidence=confidence,
-                     assumptions=inputs.assumptions, dtm_note=inputs.dtm_note, design_rules=design_rules, design_note=design_note,
+                     assumptions={**inputs.assumptions, **design_assumptions(inputs.design, inputs.scenes)}, dtm_note=inputs.dtm_note, design_rules=design_rules, design_note=design_note,
                      grid=made)
 
 

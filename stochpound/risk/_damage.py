@@ -34,11 +34,12 @@ import xarray as xr
 
 from stochpound.hazard import rate_from_probability, return_period
 from stochpound.risk import _inputs
-from stochpound.risk._limit_states import KINDS, OBJECTIVE_YEARS, LimitState, default_target, limit_state_risk, limit_states_of
+from stochpound.risk._limit_states import (KINDS, OBJECTIVE_YEARS, POUNDING, LimitState, default_target, governing_disagreement,
+                                           governing_limit_state, limit_state_fits, limit_state_risk, limit_states_of, objective_ratio)
 from stochpound.risk._maf import TARGETS
-from stochpound.risk._chain import YEARS, fit_name
+from stochpound.risk._chain import YEARS
 from stochpound.risk._collapse import MODEL_DRIFT_LIMIT
-from stochpound.risk._stripe_coverage import at_lowest_stripe, stripes_only_maf, unidentified
+from stochpound.risk._stripe_coverage import at_lowest_stripe, stripes_only_maf
 
 QUANTILES = (0.5, 0.84)
 """The fractiles over each stripe's motions of ``StoreDamage.demands``."""
@@ -53,8 +54,6 @@ DEFAULT_SOURCE = ("FEMA 356 (2000), Table C1-3, steel moment frames: immediate o
 """Where ``DEFAULT_LIMIT_STATES`` come from."""
 EXPERIMENT_SOURCE = "the experiment's [limit_states] table"
 """The source of limit states an experiment's ``[limit_states]`` gives without a ``source``."""
-POUNDING = "pounding at g*"
-"""What ``StoreDamage.governing`` names where every structural limit state is within its objective (λ/λ_target ≤ 1, pounding at g*'s ratio)."""
 #: The demands of ``StoreDamage.demands``: store summary -> its words.
 DAMAGE_DEMANDS = {"peak_ductility": "peak storey ductility", "residual_drift": "residual storey drift", "peak_drift_ratio": "peak storey drift ratio"}
 
@@ -112,6 +111,11 @@ class StoreDamage:
         """Whether the limit states are given both ways: some run is beyond the model (``risk`` holds ``maf_collapses_apart``)."""
         return self.risk is not None and "maf_collapses_apart" in self.risk
 
+    def judged_both_ways(self) -> bool:
+        """Whether what governs is judged both ways: some run of these runs is beyond the model and λ is given with them counted
+        apart as collapses (:meth:`collapses_apart`)."""
+        return self.collapses_apart() and self.beyond_model_total()[0] > 0
+
     def beyond_model_per_stripe(self) -> list[tuple[float, int, int]]:
         """Per stripe, over every configuration: (its level in IM units, the runs beyond the model, the runs done)."""
         beyond = self.beyond_model.sum([d for d in self.beyond_model.dims if d != "intensity"])
@@ -131,11 +135,7 @@ class StoreDamage:
     def ratio(self, apart: bool = False) -> xr.DataArray | None:
         """λ/λ_target of each limit state over ``risk``'s dimensions (NaN where it has no objective); None without ``risk``.
         With ``apart``, of λ with the runs beyond the model counted apart as collapses (as run where none is)."""
-        if self.risk is None:
-            return None
-        target = self.risk["target"]
-        maf = self.risk["maf_collapses_apart"] if apart and self.collapses_apart() else self.risk["maf"]
-        return maf / xr.apply_ufunc(rate_from_probability, target.fillna(0.5), OBJECTIVE_YEARS).where(target.notnull())
+        return None if self.risk is None else objective_ratio(self.risk, apart)
 
     def bounds(self, apart: bool = False) -> xr.DataArray | None:
         """``bound`` (1/yr), or with ``apart`` the same bound with the collapses counted as reaching the limit state
@@ -157,53 +157,55 @@ class StoreDamage:
         """Whether any limit state has a performance objective (without one, nothing is said to govern)."""
         return self.risk is not None and bool(self.risk["target"].notnull().any())
 
-    def governing_counts(self, probability: float) -> tuple[dict[str, int], int] | None:
-        """The configurations each structural limit state governs (:meth:`governing`), in the order first met, and the number of
-        configurations; None without ``risk`` or without any objective."""
-        governing = self.governing(probability)
+    def governing_counts(self, probability: float, apart: bool = False) -> tuple[dict[str, int], int] | None:
+        """The configurations each structural limit state governs (:meth:`governing`, with ``apart`` on λ with the collapses
+        counted apart), in the order first met, and the number of configurations; None without ``risk`` or without any objective."""
+        governing = self.governing(probability, apart)
         if governing is None:
             return None
         names = [str(v) for v in governing.values.ravel()]
         structural = {str(state) for state in self.risk["limit_state"].values}
         return {n: names.count(n) for n in names if n in structural}, len(names)
 
-    def governing(self, probability: float) -> xr.DataArray | None:
+    def governing(self, probability: float, apart: bool = False) -> xr.DataArray | None:
         """Per configuration, what governs at the risk-targeted separation g* of ``probability`` in 50 yr: the largest λ/λ_target.
 
         Pounding at g* has the target's rate (ratio 1); a structural limit
         state governs where its ratio is the largest and exceeds 1 (it misses
         its objective), else ``POUNDING``. The answer is the same at every
-        target: each limit state has its own objective. None without
-        ``risk`` or without any objective (nothing is said to govern).
+        target: each limit state has its own objective. With ``apart``,
+        judged on λ with the runs beyond the model counted apart as
+        collapses (:func:`~stochpound.risk.governing_limit_state`). None
+        without ``risk`` or without any objective (nothing is said to govern).
         """
-        if not self.has_objectives():
-            return None
-        ratio = self.ratio()
-        worst = ratio["limit_state"][ratio.fillna(-1.0).argmax("limit_state")].drop_vars("limit_state", errors="ignore")
-        return worst.where(self.misses_objective().any("limit_state"), POUNDING)
+        return None if self.risk is None else governing_limit_state(self.risk, apart, POUNDING)
 
-    def largest_ratio(self) -> tuple[xr.DataArray, xr.DataArray] | None:
-        """Per configuration, the largest λ/λ_target and the limit state that has it (None without ``risk``)."""
-        ratio = self.ratio()
+    def disagreement(self) -> xr.DataArray | None:
+        """Per configuration, whether what governs as run differs from what governs with the collapses counted apart; None
+        without ``risk``, objectives or runs beyond the model."""
+        return None if self.risk is None else governing_disagreement(self.risk, POUNDING)
+
+    def disagreements(self) -> tuple[int, int]:
+        """The configurations where the two treatments name different governing limit states (:meth:`disagreement`), and the
+        configurations; (0, 0) where there is one treatment only."""
+        differ = self.disagreement()
+        return (0, 0) if differ is None else (int(differ.sum()), int(differ.size))
+
+    def largest_ratio(self, apart: bool = False) -> tuple[xr.DataArray, xr.DataArray] | None:
+        """Per configuration, the largest λ/λ_target and the limit state that has it (None without ``risk``); ``apart`` as in :meth:`ratio`."""
+        ratio = self.ratio(apart)
         if ratio is None:
             return None
         index = ratio.fillna(-1.0).argmax("limit_state")
         return ratio.isel(limit_state=index), ratio["limit_state"][index].drop_vars("limit_state", errors="ignore")
 
     def fits(self) -> xr.DataArray | None:
-        """Each limit state's fit in words over ``risk``'s dimensions (``lognormal``, ``step: never`` …; ``lognormal, not
-        identified (why)`` where :func:`~stochpound.risk.unidentified` says so; ``step at the lowest stripe: a bound`` where its
-        λ is one); None without ``risk``."""
-        if self.risk is None:
-            return None
-        name = xr.apply_ufunc(np.vectorize(lambda status: fit_name(int(status)), otypes=[object]), self.risk["status"])
-        why = unidentified(self.risk)
-        name = xr.apply_ufunc(np.vectorize(lambda n, w: f"{n}, not identified ({w})" if w else n, otypes=[object]), name, why)
-        return name.where(~at_lowest_stripe(self.risk), "step at the lowest stripe: a bound")
+        """Each limit state's fit in words over ``risk``'s dimensions (:func:`~stochpound.risk.limit_state_fits`); None without ``risk``."""
+        return None if self.risk is None else limit_state_fits(self.risk)
 
-    def misses_objective(self) -> xr.DataArray | None:
+    def misses_objective(self, apart: bool = False) -> xr.DataArray | None:
         """Per limit state and configuration, whether λ exceeds its objective's rate (λ/λ_target > 1; False without an objective)."""
-        ratio = self.ratio()
+        ratio = self.ratio(apart)
         return None if ratio is None else ratio > 1.0
 
 

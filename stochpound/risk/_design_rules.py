@@ -154,6 +154,28 @@ def chapter17_of(building: Building, design: Design, g: float) -> tuple[Chapter1
     return result, spectrum, source
 
 
+def design_assumptions(design: Design | None, scenes: Mapping[tuple[Any, ...], Scene]) -> dict[str, str]:
+    """What the codes' rows rest on, in words ({} without a ``design``): ``code design``, the [design]'s spectra and factors as
+    given, and per building on a friction pendulum ``chapter 17 (<name>)``, the MCE_R spectrum it read (maximum-direction factors,
+    the S_MS and S_M1 rule) and every default it took (plan and eccentricity of D_TM, property-modification factors, …)."""
+    if design is None:
+        return {}
+    given = (f"ASCE 7-16: S_DS = {design.sds:.4g} g, S_D1 = {design.sd1:.4g} g, T_L = {design.tl:g} s, R = {design.r:g}, C_d = "
+             f"{design.cd:g}, Ω0 = {design.omega0:g}, I_e = {design.ie:g}, as the [design] gives them (not derived here from the site's "
+             "hazard; the design-analysis rows' δ_M rest on them)")
+    if design.ec8 is not None:
+        given += f"; Eurocode 8: a_g = {design.ec8.ag:g} g, ground {design.ec8.ground}, q = {design.ec8.q:g}"
+    said = {"code design": given}
+    for scene in scenes.values():
+        for building in scene.buildings:
+            if _pendulum(building):
+                result, _, source = chapter17_of(building, design, scene.g)
+                key = f"chapter 17 ({building.name})"
+                text = f"MCE_R spectrum {source}; assumed: {'; '.join(result.assumptions)}"
+                said[key] = text if key not in said or text in said[key] else f"{said[key]} | μ = {building.base.mu:g}: {text}"
+    return said
+
+
 def chapter17_text(building: Building, design: Design, g: float) -> str:
     """A building's chapter 17 design in words: D_M, D_TM at both friction bounds, V_b, V_s against its model's strength, what
     governs V_s, the spectrum and every assumption."""

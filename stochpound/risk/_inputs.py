@@ -31,9 +31,10 @@ from stochpound.hazard import HazardCurve, check_covers, hazard_curve, hazard_op
 from stochpound.model import Scene
 from stochpound.model.scene_tables import BuildingTable
 from stochpound.motions import DEFAULT_G, TRUNCATION_EPSILON
+from stochpound.risk._assumptions import scene_assumptions, simulated_motions_text
 from stochpound.risk._code_rules import MINIMUM_MOTIONS
 from stochpound.store import (LIMIT_STATE_DEMANDS, Definition, Design, Intensity, Label, LimitStates, MuAxis, cases_done, check_finished as _check_finished, contact_free, gap_dims,
-                              has_contact_free, has_wall_free, scenario_kind, scenario_ranges, wall_free, with_contacts)
+                              has_contact_free, has_wall_free, motions_that_ran, scenario_kind, scenario_ranges, wall_free, with_contacts)
 
 CLOSURE = "peak_contact_closure"
 """The store's variable of per-case, per-contact peak closures (m)."""
@@ -72,7 +73,7 @@ class RiskInputs:
     hazard : HazardCurve
         The site's hazard, in the store's intensity measure and units.
     studied : str or None
-        The studied building (its peak base displacement is ASCE 7's D_TM).
+        The studied building (its suite-mean peak base displacement is the D_M-form rule, not D_TM).
     method : str
         ``"stripes"`` or ``"ida"``.
     closure : xarray.DataArray
@@ -141,7 +142,7 @@ def read_risk_inputs(store: xr.Dataset, hazard: HazardCurve | None = None, *, st
     hazard : HazardCurve, optional
         The site's hazard; default the one the store carries (:func:`site_hazard`).
     studied : str, optional
-        The building of D_TM; default the store's ``studied`` building.
+        The building of the D_M-form rule; default the store's ``studied`` building.
     design : Design, optional
         The ``[design]`` table whose design analysis gives the codes' own gaps; default the store's.
     partial : bool
@@ -166,7 +167,7 @@ def read_risk_inputs(store: xr.Dataset, hazard: HazardCurve | None = None, *, st
     isolator, dtm_note = free_base_displacement(store, studied) if rules else (None, "")
     read = {"setting": intensity_setting(store), "motion_intensity": motion_intensity(store) if ida else None,
             "stripes": stripes_run(store, closure), "progress": progress(store), "experiment": experiment_name(store),
-            "assumptions": assumptions(store), "selection_misses": tuple(selection_misses(store)),
+            "assumptions": assumptions(store, _scenes_or_none(store, closure)), "selection_misses": tuple(selection_misses(store)),
             "beyond_truncation": tuple(stripes_beyond_truncation(store))}
     scenes = configuration_scenes(store, demands["peak_closure"]) if demands is not None and design is not None else {}
     return RiskInputs(hazard=hazard, studied=studied, method="ida" if ida else "stripes", closure=closure, motions=motions, design=design,
@@ -288,22 +289,44 @@ def experiment_name(store: xr.Dataset) -> str | None:
     return store.attrs.get("experiment_name")
 
 
-def assumptions(store: xr.Dataset) -> dict[str, str]:
+def _scenes_or_none(store: xr.Dataset, closure: xr.DataArray) -> dict[tuple[Any, ...], Scene]:
+    """:func:`configuration_scenes` of ``closure``'s configurations, {} without contact-free cases (IDA runs at finite gaps) or
+    where one has no contact-free case that ran (a partial store)."""
+    if not has_contact_free(store):
+        return {}
+    try:
+        return configuration_scenes(store, closure)
+    except RiskInputError:
+        return {}
+
+
+def assumptions(store: xr.Dataset, scenes: Mapping[tuple[Any, ...], Scene] | None = None) -> dict[str, str]:
     """What a risk answer from ``store`` rests on, in words, from its definition: the structural model, the suite and its
-    selection, and the scenario."""
+    selection, and the scenario; with ``scenes`` (one per configuration: :func:`configuration_scenes`) the storeys, a sliding
+    base's friction, the moat walls, the gap identity and the simulated motions that ran
+    (``stochpound.risk._assumptions.scene_assumptions``)."""
     definition = store.pound.definition
     models = []
     for building in definition.tables.buildings:
         storey = "yielding (bilinear) storeys" if building.yields else "linear elastic storeys"
         models.append(f"{building.name}: {building.floors}-storey shear building, {storey}, on {_base_words(definition.mu, building)}")
     kinds = {"record": "records without a named suite", "synthetic": "synthetic ensembles"}
-    suites = sorted({source.suite or kinds.get(source.kind, source.kind) for source in definition.motions})
-    count = sum(source.count for source in definition.motions)
+    ran = motions_that_ran(store) if "case_status" in store else {source.label for source in definition.motions}
+    simulated = ran & {str(label) for label, kind in zip(store["record"].values, store["record_kind"].values) if kind == "simulated"} \
+        if "record_kind" in store.coords else set()
+    sources = [source for source in definition.motions if source.label in ran]
+    suites = sorted({source.suite or kinds.get(source.kind, source.kind) for source in sources}) + (["simulated"] if simulated else [])
+    count, pool = sum(source.count for source in sources) + len(simulated), sum(source.count for source in definition.motions)
     selection = definition.intensity.selection if definition.intensity is not None else None
-    suite = (f"{counted(count, 'motion')} ({', '.join(suites)}), "
-             + (f"selected per stripe by {selection.method.replace('_', ' ')}" if selection else "every motion scaled to every stripe (no selection)"))
+    generated = selection.simulated if selection is not None else None
+    pool_words = f"{pool} records" + (f" and {generated.count} simulated motions of each stripe's scenario" if generated else "")
+    suite = (f"{counted(count, 'motion')} ran ({', '.join(suites)}), "
+             + (f"selected per stripe by {selection.method.replace('_', ' ')} from a pool of {pool_words}" if selection
+                else "every motion scaled to every stripe (no selection)"))
     scenario = _scenario_words(store, scenario_kind(store)) if selection and selection.scenarios else ""
-    return {"structural model": "; ".join(models), "suite": suite,
+    said = simulated_motions_text(len(simulated), count, generated.model, generated.calibration) if simulated and generated else ""
+    return {"structural model": "; ".join(models), **scene_assumptions(scenes or {}), "suite": suite,
+            **({"simulated motions": said} if said else {}),
             "scenario": scenario or "none stated (the motions are not selected for a scenario)"}
 
 
@@ -456,9 +479,9 @@ def base_displacement(store: xr.Dataset, studied: str | None, walls_free: bool =
 
 
 def free_base_displacement(store: xr.Dataset, studied: str | None) -> tuple[xr.DataArray | None, str]:
-    """The studied building's wall-free peak base displacement for D_TM (:func:`base_displacement`), or None and why not.
+    """The studied building's wall-free peak base displacement for the D_M-form rule (:func:`base_displacement`), or None and why not.
 
-    A moat wall caps the displacement D_TM is to size: with walls at its
+    A moat wall caps the displacement the rule is to size: with walls at its
     base, each configuration takes the displacement of its wall-free twin
     (``inf`` on the wall axes, or the value of a variant axis that sets no
     wall), and without one there is none ("" as the reason where the
@@ -467,7 +490,7 @@ def free_base_displacement(store: xr.Dataset, studied: str | None) -> tuple[xr.D
     if moat_clearances(store, studied) and not has_wall_free(store):
         axis = _wall_free_variant(store, studied)
         if axis is None:
-            return None, ("the store has no wall-free runs (a moat wall caps the displacement D_TM is to size): add inf to the wall axis, "
+            return None, ("the store has no wall-free runs (a moat wall caps the displacement the rule is to size): add inf to the wall axis, "
                           "or a variant without the wall")
         name, free = axis
         displacement = base_displacement(store.sel({name: free}), studied)

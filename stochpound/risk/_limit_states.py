@@ -25,6 +25,7 @@ import math
 from collections.abc import Mapping, Sequence
 from typing import Any
 
+import numpy as np
 import pandas as pd
 import xarray as xr
 
@@ -33,13 +34,19 @@ from stochpound.risk import _inputs
 from stochpound.risk._inputs import LimitStates
 from stochpound.risk._fragility_ensemble import limit_state_events, stripe_fragility
 from stochpound.risk._maf import mean_annual_frequency
-from stochpound.risk._chain import CONFIDENCE, YEARS
+from stochpound.risk._chain import CONFIDENCE, YEARS, fit_name
 from stochpound.risk._collapse import MODEL_DRIFT_LIMIT, beyond_model, rate_collapses_apart
-from stochpound.risk._stripe_coverage import stripes_only_maf
+from stochpound.risk._stripe_coverage import at_lowest_stripe, stripes_only_maf, unidentified
 
 
 OBJECTIVE_YEARS = 50.0
 """The exposure time of a limit state's target (yr)."""
+POUNDING = "pounding at g*"
+"""What governs where every structural limit state is within its objective (λ/λ_target ≤ 1, pounding at g*'s ratio)."""
+WITHIN = "none beyond its objective"
+"""What governs at a finite gap of the grid (no g* there) where every limit state is within its objective."""
+TREATMENTS = {False: "as run", True: "collapses apart"}
+"""The two treatments of the runs beyond the model, by ``apart``: as computed, or counted apart as collapses (FEMA P-58)."""
 
 
 @dataclasses.dataclass(frozen=True)
@@ -274,6 +281,94 @@ def _collapsed_cases(store: xr.Dataset) -> xr.DataArray | None:
     return collapsed if bool((collapsed == 1.0).any()) else None
 
 
+def objective_ratio(risk: xr.Dataset, apart: bool = False) -> xr.DataArray:
+    """λ/λ_target of each limit state of :func:`limit_state_risk` (NaN without an objective), λ_target = −ln(1 − p)/50 yr for its
+    ``target`` p; with ``apart``, of λ with the runs beyond the model counted apart as collapses (λ as run where no run is)."""
+    target = risk["target"]
+    maf = risk["maf_collapses_apart"] if apart and "maf_collapses_apart" in risk else risk["maf"]
+    return maf / xr.apply_ufunc(rate_from_probability, target.fillna(0.5), OBJECTIVE_YEARS).where(target.notnull())
+
+
+def governing_limit_state(risk: xr.Dataset, apart: bool = False, within: str = POUNDING) -> xr.DataArray | None:
+    """Per configuration of :func:`limit_state_risk`, the limit state with the largest λ/λ_target where it exceeds 1 (it misses
+    its objective), else ``within``; None where no limit state has an objective (nothing is said to govern).
+
+    ``apart`` judges λ with the runs beyond the model counted apart as collapses (:func:`objective_ratio`): the two treatments
+    may name different limit states (:func:`governing_disagreement`).
+    """
+    if not bool(risk["target"].notnull().any()):
+        return None
+    ratio = objective_ratio(risk, apart)
+    worst = ratio["limit_state"][ratio.fillna(-1.0).argmax("limit_state")].drop_vars("limit_state", errors="ignore")
+    return worst.where((ratio > 1.0).any("limit_state"), within)
+
+
+def governing_disagreement(risk: xr.Dataset, within: str = POUNDING) -> xr.DataArray | None:
+    """Per configuration, whether what governs as run differs from what governs with the collapses counted apart; None without
+    objectives or where no run is beyond the model (one treatment only)."""
+    if "maf_collapses_apart" not in risk:
+        return None
+    run, apart = governing_limit_state(risk, False, within), governing_limit_state(risk, True, within)
+    return None if run is None else run != apart
+
+
+def limit_state_fits(risk: xr.Dataset) -> xr.DataArray:
+    """Each limit state's fit in words over :func:`limit_state_risk`'s dimensions: ``lognormal``, ``step: never`` …;
+    ``lognormal, not identified (why)`` where :func:`~stochpound.risk.unidentified` says so; ``step at the lowest stripe: a
+    bound`` where its λ is one (:func:`~stochpound.risk.at_lowest_stripe`)."""
+    name = xr.apply_ufunc(np.vectorize(lambda status: fit_name(int(status)), otypes=[object]), risk["status"])
+    why = unidentified(risk)
+    name = xr.apply_ufunc(np.vectorize(lambda n, w: f"{n}, not identified ({w})" if w else n, otypes=[object]), name, why)
+    return name.where(~at_lowest_stripe(risk), "step at the lowest stripe: a bound")
+
+
+def objectives_frame(risk: xr.Dataset, within: str = WITHIN) -> pd.DataFrame | None:
+    """What governs per configuration of :func:`limit_state_risk` at its finite gaps, each treatment of the runs beyond the
+    model (``TREATMENTS``: as run, and collapses apart where some run is): the limit state with the largest λ/λ_target beyond 1
+    (else ``within``) and that largest ratio, and whether the treatments agree. None without any objective.
+
+    Returns
+    -------
+    pandas.DataFrame or None
+        Indexed by the grid labels other than ``limit_state`` (the contact-free rows left out where the grid has finite gaps).
+    """
+    finite = _inputs.at_finite_gaps(risk)
+    data = finite if all(finite.sizes.values()) else risk
+    columns = {}
+    for apart in ([False, True] if "maf_collapses_apart" in data else [False]):
+        governs = governing_limit_state(data, apart, within)
+        if governs is None:
+            return None
+        columns[f"governs, {TREATMENTS[apart]}"] = governs.reset_coords(drop=True)
+        columns[f"largest λ/λ_target, {TREATMENTS[apart]}"] = objective_ratio(data, apart).max("limit_state").reset_coords(drop=True)
+    frame = xr.Dataset(columns).to_dataframe() if data["maf"].ndim > 1 else pd.DataFrame({k: [v.item()] for k, v in columns.items()})
+    if "maf_collapses_apart" in data:
+        frame["treatments agree"] = frame[f"governs, {TREATMENTS[False]}"] == frame[f"governs, {TREATMENTS[True]}"]
+    return frame
+
+
+def disagreement_text(frame: pd.DataFrame | None) -> str:
+    """In words, whether the two treatments of :func:`objectives_frame` name the same governing limit state: where they
+    disagree, each configuration and both answers; "" with one treatment only or without objectives."""
+    if frame is None or "treatments agree" not in frame:
+        return ""
+    differ = frame[~frame["treatments agree"]]
+    if differ.empty:
+        return "The two treatments of the runs beyond the model name the same governing limit state in every configuration."
+    rows = "; ".join(f"{_where(index, frame.index.names)}{row[f'governs, {TREATMENTS[False]}']} as run, "
+                     f"{row[f'governs, {TREATMENTS[True]}']} with the collapses counted apart" for index, row in differ.iterrows())
+    return (f"The two treatments disagree on what governs in {len(differ)} of {len(frame)} configurations ({rows}): the answer "
+            "depends on whether the runs beyond the model are taken as computed or as collapses.")
+
+
+def _where(index: object, names: Sequence[str | None]) -> str:
+    """A configuration's labels in words from a frame's index, then ": " ("" for a frame of one unlabelled row)."""
+    values = index if isinstance(index, tuple) else (index,)
+    words = ", ".join(f"{name} {value:g}" if isinstance(value, float) else f"{name} {value}" for name, value in zip(names, values)
+                      if name is not None)
+    return f"{words}: " if words else ""
+
+
 def gap_cost_frame(risk: xr.Dataset, years: float = YEARS) -> pd.DataFrame:
     """The "what the gap costs" table of :func:`limit_state_risk`: per limit state and finite gap, λ, λ of the twins, their difference, and P in ``years``
     (and λ with the runs beyond the model counted apart as collapses, where some run is).
@@ -284,7 +379,7 @@ def gap_cost_frame(risk: xr.Dataset, years: float = YEARS) -> pd.DataFrame:
         Indexed by the limit state and the other grid labels (the contact-free rows left out).
     """
     keep = [name for name in ("maf", "maf_contact_free", "gap_cost", "maf_collapses_apart") if name in risk]
-    frame = _inputs.at_finite_gaps(risk[keep]).reset_coords(drop=True).to_dataframe()
+    frame = _inputs.at_finite_gaps(risk[keep].assign(fit=limit_state_fits(risk))).reset_coords(drop=True).to_dataframe()
     frame[f"P in {years:g} yr"] = probability_from_rate(frame["maf"].to_numpy(), years)
     if "maf_contact_free" in frame:
         frame[f"P in {years:g} yr, contact-free"] = probability_from_rate(frame["maf_contact_free"].to_numpy(), years)

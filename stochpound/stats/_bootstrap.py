@@ -192,7 +192,7 @@ def bootstrap_method(clusters: np.ndarray | None, ran: np.ndarray | None = None)
     counts = sorted({(len(set(labels[row])), int(row.sum())) for row in ran if row.any()})
     text = f"{len(set(labels[used]))} clusters of the {int(used.sum())} motions that ran"
     if used.sum() < labels.size:
-        text = f"{text}, of a pool of {labels.size}"
+        text = f"{text}, of the {labels.size} the store holds"
     if counts and counts != [(len(set(labels[used])), int(used.sum()))]:
         clusters, motions = (_span([pair[i] for pair in counts]) for i in (0, 1))
         text = f"{text}; per stripe {clusters} clusters of {motions} motions"

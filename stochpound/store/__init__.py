@@ -85,7 +85,7 @@ from stochpound.store._progress import UnfinishedStoreError, cases_done, check_f
 from stochpound.store._grid import CONDITIONAL_SPECTRUM, SIMULATED, SIMULATED_FIELD, Label  # noqa: F401
 from stochpound.model.fields import TomlTable  # noqa: F401
 from stochpound.store._scene_edits import apply_overrides, building_names, building_table, reference_scene, with_motion, with_open_gaps  # noqa: F401
-from stochpound.store._stripe_motions import motion_earthquakes, motions_that_ran, ran_motions, stripe_holdings  # noqa: F401
+from stochpound.store._stripe_motions import motion_earthquakes, motions_that_ran, ran_motions, simulated_that_ran, stripe_holdings  # noqa: F401
 
 __all__ = [
     "ACCESSOR",

@@ -65,3 +65,12 @@ def motions_that_ran(store: xr.Dataset) -> set[str]:
     motions it never chose are not among them."""
     done = store["case_status"] == 1
     return {str(label) for label, flag in zip(store["record"].values, done.any([d for d in done.dims if d != "record"]).values) if flag}
+
+
+def simulated_that_ran(store: xr.Dataset) -> list[str]:
+    """The labels of the simulated motions (``[site] simulated_motions`` chosen for some stripe; ``record_kind`` simulated) some
+    case of ``store`` ran, in ``record`` order: the definition's motions do not list them (they are drawn for the stripes)."""
+    if "record_kind" not in store.coords:
+        return []
+    ran = motions_that_ran(store)
+    return [str(label) for label, kind in zip(store["record"].values, store["record_kind"].values) if kind == "simulated" and str(label) in ran]

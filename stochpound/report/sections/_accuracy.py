@@ -59,7 +59,7 @@ def cross_check(definitions: list[StoreDefinition]) -> Paragraph | None:
         f"Cross-check on a stored case of {name} ({where}"
         + (f", motion scale factor {number(scale, 4)}" if scale != 1.0 else "")
         + f"; {counts[0]} impacts"
-        + (f", its base's sliding displacement spanning {number(sliding * 100, 3)} cm from its least to its largest" if sliding > 0 else "")
+        + (f", peak base sliding {number(sliding * 100, 3)} cm" if sliding > 0 else "")
         + f", {number(float(scene.motion.times[-1]))} s), re-run as it was run: "
         + (f"the ivp solver at its defaults (nonlinear laws: {'; '.join(nonlinear)})" if nonlinear else "the exact solver")
         + " and scipy's DOP853 with event location "

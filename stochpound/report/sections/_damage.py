@@ -93,7 +93,7 @@ def _beyond_model_text(damage: StoreDamage) -> str:
             "collapses, as FEMA P-58 does: P(C | IM) a lognormal fitted over the stripes to them, each limit state fitted on the "
             "credible runs only, and λ = ∫ [P(C | x) + (1 − P(C | x)) P(LS | x, no C)] |dλ(x)|, a collapse counted as reaching every "
             "limit state (of either building: past 5 % in one, the pair's response is not credible). What governs (below) is judged "
-            "on λ as run." if damage.collapses_apart() else "")
+            "both ways." if damage.collapses_apart() else "")
     return (head + "runs reaching it, per stripe over every configuration: " + "; ".join(flagged) + ". Their drifts, ductilities and "
             "residual drifts are not credible (a real frame would have lost strength or collapsed), and the fractiles above include them."
             + both)
@@ -109,24 +109,50 @@ def _governing_text(damage: StoreDamage) -> str:
     if not damage.has_objectives():
         return (head + " No limit state has an objective, so none is said to govern: give [limit_states] targets (docs/risk.md). "
                 "A [limit_states] table in the experiment file replaces these capacities.")
-    governing, misses = damage.governing(float(next(iter(damage.design_stripes)))), damage.misses_objective()
-    largest, largest_state = damage.largest_ratio()
+    probability = float(next(iter(damage.design_stripes)))
+    governs = _governs_text(damage, probability, apart=False)
+    if damage.judged_both_ways():
+        governs = (f"as run, {governs}; with the runs beyond the model counted apart as collapses, "
+                   f"{_governs_text(damage, probability, apart=True)}. {_agreement_text(damage)}")
+    else:
+        governs += "."
+    return (head + " What governs is the largest ratio λ/λ_target: pounding at the risk-targeted separation g* has ratio 1 at every "
+            "target (g* is where pounding is as frequent as the target allows), so a structural limit state governs where it misses its "
+            f"own objective (ratio above 1), at every target alike. Governing: {governs} A [limit_states] table in the experiment file "
+            "replaces these capacities and objectives (targets; docs/risk.md).")
+
+
+def _governs_text(damage: StoreDamage, probability: float, apart: bool) -> str:
+    """What governs per configuration in one treatment of the runs beyond the model (``apart``: counted apart as collapses),
+    the configurations with the same answer grouped."""
+    governing, misses = damage.governing(probability, apart), damage.misses_objective(apart)
+    largest, largest_state = damage.largest_ratio(apart)
     grouped: dict[str, list[str]] = {}
     for labels in _configurations(governing):
         worst = str(governing.sel(labels).item())
         value = float(largest.sel(labels))
         if worst == POUNDING:
-            text = f"{POUNDING} (every limit state within its objective; the largest λ/λ_target is {value:.2g}, {largest_state.sel(labels).item()})"
+            text = f"{POUNDING} (every limit state within its objective; the largest λ/λ_target is {ratio_text(value, 2)}, {largest_state.sel(labels).item()})"
         else:
             others = [str(state) for state, flag in zip(misses["limit_state"].values, misses.sel(labels).values) if flag and state != worst]
-            text = f"{worst} (λ/λ_target = {value:.2g})" + (f"; also beyond their objectives: {', '.join(others)}" if others else "")
+            text = f"{worst} (λ/λ_target = {ratio_text(value, 2)})" + (f"; also beyond their objectives: {', '.join(others)}" if others else "")
         grouped.setdefault(text, []).append(_label(labels))
     every = len(_configurations(governing))
-    governs = "; ".join((f"{' and '.join(names)}: " if len(names) < every else "") + text for text, names in grouped.items())
-    return (head + " What governs is the largest ratio λ/λ_target: pounding at the risk-targeted separation g* has ratio 1 at every "
-            "target (g* is where pounding is as frequent as the target allows), so a structural limit state governs where it misses its "
-            f"own objective (ratio above 1), at every target alike. Governing: {governs}. A [limit_states] table in the experiment file "
-            "replaces these capacities and objectives (targets; docs/risk.md).")
+    return "; ".join((f"{' and '.join(names)}: " if len(names) < every else "") + text for text, names in grouped.items())
+
+
+def _agreement_text(damage: StoreDamage) -> str:
+    """Whether the two treatments name the same governing limit state, plainly, with the configurations where they do not."""
+    differ = damage.disagreement()
+    configurations = _configurations(differ)
+    where = [labels for labels in configurations if bool(differ.sel(labels))]
+    if not where:
+        return "The two treatments agree on what governs in every configuration."
+    run, apart = damage.governing(0.0, False), damage.governing(0.0, True)
+    listed = "; ".join((f"{_label(labels)}: " if labels else "") + f"{run.sel(labels).item()} as run, {apart.sel(labels).item()} with "
+                       "collapses apart" for labels in where)
+    return (f"The two treatments disagree on what governs in {len(where)} of {len(configurations)} configurations ({listed}): which "
+            "limit state governs depends on whether the runs beyond the model are taken as computed or as collapses.")
 
 
 def _limit_states_table(name: str, damage: StoreDamage) -> Table:
@@ -175,4 +201,10 @@ def _period_cell(period: float, bound: float) -> str:
 
 def _ratio_cell(ratio: float, bounded: float) -> str:
     """λ/λ_target in the table, ``≥`` the bound's where λ is one."""
-    return f"≥ {bounded:.3g}" if bounded == bounded else f"{ratio:.3g}"
+    return f"≥ {ratio_text(bounded)}" if bounded == bounded else ratio_text(ratio)
+
+
+def ratio_text(ratio: float, digits: int = 3) -> str:
+    """λ/λ_target to ``digits`` significant digits, but to 0.001 within 0.5 % of 1: a ratio that decides whether the objective is
+    missed never prints as a bare ``1`` (1.003 misses it, 0.998 does not)."""
+    return f"{ratio:.3f}" if abs(ratio - 1.0) < 0.005 else f"{ratio:.{digits}g}"

@@ -29,7 +29,7 @@ from stochpound.report.sections._stripe_motions import stripe_motions_text
 from stochpound.motions.records import is_suite_member
 from stochpound.model.scene import Building, Contact, Scene
 from stochpound.model.wall import Wall
-from stochpound.store import MotionSource, MotionTable, TomlTable, motions_that_ran
+from stochpound.store import MotionSource, MotionTable, TomlTable, motions_that_ran, simulated_that_ran
 
 
 def number(value: float, digits: int = 6) -> str:
@@ -352,7 +352,8 @@ def _record_parameters(motion: MotionTable) -> tuple[str, str]:
 def motions_table(definitions: Iterable[StoreDefinition]) -> Table:
     """Every ground motion the stores ran: records with their treatment, ensembles with their generator and seed."""
     rows = []
-    pool, spectral = 0, False
+    pool = simulated_total = 0
+    spectral = False
     for definition in definitions:
         ran = motions_that_ran(definition.store)
         for motion in definition.definition.motions:
@@ -372,12 +373,22 @@ def motions_table(definitions: Iterable[StoreDefinition]) -> Table:
                 text, realizations = _analytic_parameters(TomlTable(table, motion.field)), "1"
                 grid = f"{number(float(table['dt']))} s, {number(typed.duration)} s"
             rows.append([definition.name, motion.label, text, grid, realizations])
+        simulated = simulated_that_ran(definition.store)
+        setting = definition.definition.intensity.selection.simulated if simulated else None
+        if setting is not None:
+            rows.append([definition.name, f"{simulated[0]} … {simulated[-1]} ({len(simulated)} simulated)",
+                         f"{setting.model} site-motion model ({setting.calibration}) of each stripe's scenario, seed {setting.seed}; the "
+                         f"{len(simulated)} chosen for some stripe of the {setting.count} simulated per stripe", f"{number(setting.dt)} s",
+                         f"1 each ({len(simulated)})"])
+            simulated_total += len(simulated)
     frame = pd.DataFrame(rows, columns=["experiment", "motion", "definition", "step, duration", "realizations"])
     frame.index = pd.RangeIndex(1, len(frame) + 1, name="#")
     return Table(
         key="table-motions",
         caption="The ground motions as run: each record with its treatment, each synthetic ensemble with its generator, intensity, envelope, seed and size"
-        + (f" ({len(frame)} of the {pool} motions the experiments define: a selection's pool motions it never chose are left out)." if len(frame) < pool else "."),
+        + (f" ({len(frame) - (simulated_total > 0)} of the {pool} motions the experiments define: a selection's pool motions it never "
+           "chose are left out" + (f"; and, in one row, the {simulated_total} simulated motions some stripe chose" if simulated_total else "")
+           + ")." if len(frame) - (simulated_total > 0) < pool else "."),
         frame=frame,
         note="Realization i of an ensemble depends only on (seed, i)." + (" The PSD convention: two-sided in ω, σ² = ∫ S dω." if spectral else ""),
     )
@@ -399,9 +410,14 @@ def grid_paragraph(definition: StoreDefinition) -> Paragraph:
     store = definition.store
     scene = definition.configurations[0].scene
     references = sum(1 for c in definition.experiment.cases if c.kind != CASE)
+    defined, ran, simulated = len(definition.definition.motions), motions_that_ran(store), simulated_that_ran(store)
+    recorded = len(ran) - len(simulated)
+    motions = (_motions_count(definition) if recorded == defined and not simulated else
+               f"the {counted(len(ran), 'motion')} that ran ({recorded} of the {defined} the experiment defines"
+               + (f", and {len(simulated)} simulated for the stripes' scenarios" if simulated else "") + ")")
     return Paragraph(
         f"Experiment {definition.name}: {', '.join(axes) or 'a single configuration'}, under "
-        f"{_motions_count(definition)} (Table of motions); g = {number(scene.g)} m/s². The studied building is "
+        f"{motions} (Table of motions); g = {number(scene.g)} m/s². The studied building is "
         f"{definition.experiment.studied}: the response whose moments are reported is its top-floor total displacement, and "
         f"it is also run alone on a fixed base under every motion ({references} reference runs). "
         f"{store.pound.provenance.cases_done} of {store.pound.provenance.cases_total} runs done."

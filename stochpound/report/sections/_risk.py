@@ -195,15 +195,40 @@ def design_summary_text(risk: StoreRisk, demands: StoreDemands | None = None, da
 def _structural_governs(damage: StoreDamage | None, target: float, separation: str) -> str:
     """What governs at ``target``: ``separation`` (what limits the gap), preceded by the buildings' own limit states where
     :meth:`~stochpound.risk.StoreDamage.governing` names one (beyond its objective: the largest λ/λ_target), with their counts of
-    configurations; ``separation`` alone where pounding governs everywhere, without ``damage`` or without objectives."""
-    counted = damage.governing_counts(target) if damage is not None else None
-    if counted is None or not counted[0]:
+    configurations; ``separation`` alone where pounding governs everywhere, without ``damage`` or without objectives. Where some
+    run is beyond the model, judged both ways (as run, and with those runs counted apart as collapses), saying whether they agree."""
+    run = damage.governing_counts(target) if damage is not None else None
+    if run is None:
         return separation
+    apart = damage.governing_counts(target, apart=True) if damage.judged_both_ways() else None
+    if apart is None:
+        if not run[0]:
+            return separation
+        return f"{_listed(run)} {_WHY}; {_rest([run])}, {separation}"
+    if not run[0] and not apart[0]:
+        return f"{separation} (as run and with the runs beyond the model counted apart as collapses alike)"
+    count, configurations = damage.disagreements()
+    agree = ("the two treatments agree in every configuration" if not count else
+             f"the two treatments disagree in {count} of {configurations} configurations: what governs depends on whether the runs "
+             "beyond the model are taken as computed or as collapses")
+    return (f"as run, {_listed(run) or 'no limit state beyond its objective'}; with the runs beyond the model counted apart as "
+            f"collapses, {_listed(apart) or 'no limit state beyond its objective'} {_WHY[:-1]}; {agree}); {_rest([run, apart])}, {separation}")
+
+
+_WHY = "(a limit state beyond its own objective, the largest λ/λ_target, where pounding at g* has 1: the Damage section)"
+
+
+def _listed(counted: tuple[dict[str, int], int]) -> str:
+    """One treatment's governing limit states with their counts of configurations ("" where none governs)."""
     states, configurations = counted
-    listed = ", ".join(f"{state} in {count} of {configurations} configurations" for state, count in states.items())
-    rest = "of the separation" if sum(states.values()) == configurations else "in the other configurations"
-    return (f"{listed} (a limit state beyond its own objective, the largest λ/λ_target, where pounding at g* has 1: the Damage "
-            f"section); {rest}, {separation}")
+    return ", ".join(f"{state} in {count} of {configurations} configurations" for state, count in states.items())
+
+
+def _rest(treatments: list[tuple[dict[str, int], int]]) -> str:
+    """Where the separation's own limit governs: "of the separation" where limit states govern every configuration in every
+    treatment, else "in the other configurations"."""
+    every = all(sum(states.values()) == configurations for states, configurations in treatments)
+    return "of the separation" if every else "in the other configurations"
 
 
 def _beyond_model(damage: StoreDamage | None, collapse: CollapseRisk | None = None) -> dict[str, str]:
