@@ -49,6 +49,8 @@ IDENTITIES = {
     "9b8923b0aa6b1e0b7753b436bf63cf492e61951d6e15670e6b7589efe5611375": "5cfe7294fd8c6bc0974dec1f0c06bbb870620ccc0c9a89a05fbeff4294173b1e",  # experiments/risk/isolated.toml (fitted scenario)
     "55b8a109c6a7fe493d3cf046f0681351cd1070678c42155b611b7cb4991cc95c": "ae6ad2bb5310b9ede71f0267bb215a055113aa32bad2e97696a1f5438d157191",  # experiments/risk/fixed_pair.toml ([design])
     "88dc01b72bd04d6cc226d840a04e24e42421faa9c2bb9dc91a42aab11c0fbfde": "1c1c4b385d2565d2acbc4cbeaa272192f8711728fdffad85425e17a0a5896d41",  # experiments/risk/isolated.toml ([design])
+    "76706a47b9ed8d9b9c00281719f78adbbf7cc7ecaa91ed77f8fc343f9cafa29d": "4258c4eeb0c817062b1559066dd537d4c3acf1a9335728732bda3c4116274969",  # experiments/risk/fixed_pair.toml (calibration 3)
+    "a9c66c0e67c4e663ca9e1a34a5de92a19ee03c1d8baacb45bb4cf61b70167667": "dab82088050ceca0dcd40466dc94da4533d36efdfff06e7f1145108398b5b3b9",  # experiments/risk/isolated.toml (calibration 3)
     "6721b840847f3c887a64063a94280b5d169110c60ef231755da91b89a8300078": "d63aa13f0c17c62515a7f33d09c8af15f2d12f6063f66110f23227a68f70937f",  # experiments/study/gap_study.toml (declares reproduces)
     "2991b119a5949c2c82f9b2fe3c5ea23ba8308484f5adbaf6202633df2547e55f": "0fee6ef18974eda7fe49d0fa885cd06ca430f684281d7e09d9aa13ae02729a4e",  # experiments/study/harmonic.toml (declares reproduces)
     "b7cb8955ddf0e1110227ccc8d346f24b89c5f33cd69da9d0bcda4bfe1400fd19": "dc1f1332c3bbb0688ce5cc07bf78b719f5f9f549de5f0725493b705c41748dec",  # experiments/study/pair_mu.toml (declares reproduces)
@@ -69,6 +71,8 @@ HAZARD_IDENTITIES = {
     # [design] is not part of the identity: the same as the fitted-scenario versions without it
     "55b8a109c6a7fe493d3cf046f0681351cd1070678c42155b611b7cb4991cc95c": "18ff032947db1618ce6c8bd58a682e57cc433745d20a74253a1c4e3235420566",  # experiments/risk/fixed_pair.toml ([design])
     "88dc01b72bd04d6cc226d840a04e24e42421faa9c2bb9dc91a42aab11c0fbfde": "9364efe22b86c445b311bde449ccf19393a749628c5f0f6e9f4cff43e66a9a41",  # experiments/risk/isolated.toml ([design])
+    "76706a47b9ed8d9b9c00281719f78adbbf7cc7ecaa91ed77f8fc343f9cafa29d": "f30423076bf791f10e274b0f0743bda704505337bda66785bf6631aedaf67b47",  # experiments/risk/fixed_pair.toml (calibration 3)
+    "a9c66c0e67c4e663ca9e1a34a5de92a19ee03c1d8baacb45bb4cf61b70167667": "1190d4e22c8eaa71ec0e300d71dc4c348397c36780196be326b7c93f305de0ae",  # experiments/risk/isolated.toml (calibration 3)
 }
 
 

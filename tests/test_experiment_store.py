@@ -255,3 +255,20 @@ def test_the_store_is_written_under_a_lock_of_this_process_while_a_dask_client_i
     assert opened and not any(isinstance(lock, DistributedLock) for store in opened for lock in locks(store.lock))
     with xr.open_dataset(store) as expected, xr.open_dataset(rebuilt) as actual:
         xr.testing.assert_identical(actual.drop_attrs(), expected.drop_attrs())
+
+
+@pytest.mark.slow  # two runs of the small experiment (about 4 min at load 13)
+def test_a_changed_comment_is_recorded_without_running_again(tmp_path):
+    path = write_experiment(tmp_path)
+    store = run_experiment(load_experiment(path), workers=0, progress=False).store
+    with open_store(store) as ds:
+        before = {name: ds[name].values.copy() for name in ds.data_vars}
+    commented = "# the header, rewritten after the run\n" + SMALL_EXPERIMENT
+    path.write_text(commented)
+    report = run_experiment(load_experiment(path), workers=0, progress=False)
+    assert report.done_now == 0 and report.complete
+    with open_store(store) as ds:
+        assert ds.attrs["experiment_text"] == commented
+        assert ds.attrs["experiment_sha256"] == hashlib.sha256(commented.encode()).hexdigest()
+        for name, values in before.items():
+            np.testing.assert_array_equal(ds[name].values, values)

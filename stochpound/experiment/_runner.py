@@ -34,7 +34,8 @@ from stochpound.experiment._compute import BatchResult, BatchTask, run_batch, wa
 from stochpound.experiment._estimate import LARGE_RUN_BYTES, LARGE_RUN_CASES, RunEstimate, cpu_seconds, estimate_run, startup_step, startup_steps
 from stochpound.experiment._experiment import Experiment
 from stochpound.experiment._parts import FolderLock, PartBuffer, RunEntry, append_run, parts_folder, remove_temporaries
-from stochpound.experiment._session import StoreSession, check_store, check_store_path, clear_store, code_identity, machine, missing_summaries, now, store_complete, stored_definition
+from stochpound.experiment._session import (StoreSession, check_store, check_store_path, clear_store, code_identity, machine, missing_summaries, now,
+                                           store_complete, stored_definition, stored_text)
 from stochpound.experiment._sources import ResolvedMotion, resolve_motions
 from stochpound.experiment._spec import ExperimentError, load_definition
 from stochpound.experiment._file_assembly import PartsIndex
@@ -204,7 +205,7 @@ def run_experiment(
     -----
     A store whose file says every case is done is left as it is: no cluster
     starts and nothing runs (``nothing_to_run``); only when its definition's
-    entries outside the identity (the ``[hazard]``) changed is it rewritten
+    entries outside the identity (the ``[hazard]``) or its text alone (comments) changed is it rewritten
     from its parts with the new ones (its runs kept).
     """
     started = time.monotonic()
@@ -226,6 +227,8 @@ def run_experiment(
             stored, new = stored_definition(store), json.loads(experiment.definition_json)
             # the scene's provenance alone (the same content, from another file or inline) leaves the store as it is
             changed = [key for key in NOT_IN_IDENTITY if key != "scene_source" and stored.get(key) != new.get(key)]
+            if stored_text(store) != experiment.text:  # the same definition, another text (comments): the store records the file's text
+                changed.append("text")
             if changed:
                 _record_hazard(store, experiment, {label: m.grid for label, m in motions.items()}, say, changed)
             return RunReport(store, experiment.n_cases, experiment.n_cases, elapsed=time.monotonic() - started, nothing_to_run=True)
@@ -301,7 +304,7 @@ def run_experiment(
 
 def _record_hazard(store: Path, experiment: Experiment, grids: dict[str, tuple[float, int]], say: Callable[[str], None],
                    changed: list[str]) -> None:
-    """Rewrite a complete store from its parts with the experiment's hazard and design (``changed``: no run depends on them: the runs are kept)."""
+    """Rewrite a complete store from its parts with the experiment's hazard, design and text (``changed``: no run depends on them: the runs are kept)."""
     lock = FolderLock(parts_folder(store))
     if not lock.acquire():
         raise _busy(store)
@@ -314,6 +317,8 @@ def _record_hazard(store: Path, experiment: Experiment, grids: dict[str, tuple[f
     for table in ("design", "limit_states"):
         if table in changed:
             say(f"{store}: the [{table}] changed; no run depends on it: the cases are kept and the new table is recorded in the store")
+    if "text" in changed:
+        say(f"{store}: the experiment file's text changed, not its definition (comments); the cases are kept and the new text is recorded in the store")
     if "site" in changed:
         say(f"{store}: how the [site] scenario was obtained is recorded in the store (no run depends on it: the cases are kept)")
     if "hazard" not in changed:

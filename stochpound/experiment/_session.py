@@ -74,6 +74,14 @@ def stored_definition(store: Path) -> dict[str, Any]:
         return json.loads(_text(handle.attrs["definition"])) if "definition" in handle.attrs else {}
 
 
+def stored_text(store: Path) -> str:
+    """The experiment text an existing store file records (its ``experiment_text`` attribute; "" without one)."""
+    import h5py
+
+    with h5py.File(store, "r") as handle:
+        return _text(handle.attrs["experiment_text"]) if "experiment_text" in handle.attrs else ""
+
+
 def check_store(store: Path, sha256: str) -> bool:
     """Refuse a store (or parts folder) that belongs to another experiment definition, or a file that is not a store.
 
@@ -267,7 +275,8 @@ class StoreSession:
         definition, text_sha256 = json.loads(experiment.definition_json), hashlib.sha256(experiment.text.encode()).hexdigest()
         if (folder / DEFINITION_FILE).exists():
             record = read_experiment_json(folder)
-            if record.definition != definition:  # the same runs (checked by check_store), another hazard: record it
+            if record.definition != definition or record.text != experiment.text:  # the same runs (checked by check_store), another hazard
+                # or another text of the same definition (its comments): record it
                 record = dataclasses.replace(record, definition=definition, definition_sha256=experiment.sha256, text=experiment.text,
                                              text_sha256=text_sha256)
                 write_experiment_json(folder, record)
