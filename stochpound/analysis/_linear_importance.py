@@ -3,7 +3,7 @@
 The response Y = g(u) is a function of n independent standard normals u. A
 linear surrogate of the response's history, x_k = a_k · u at samples k (an
 equivalent linear system under the same motion of u), gives elementary
-events E_k = {|a_k · u| > c} of probability P_k = 2 Φ(−c / |a_k|), and
+events E_k = {‖a_k · u‖ > c} of probability P_k = 2 Φ(−c / ‖a_k‖), and
 Au & Beck's ISEE density q(u) = φ(u) · N(u) / S, N(u) the number of events
 u is in and S = Σ_k P_k, which puts its samples where the surrogate's peak
 exceeds c. A defensive mixture (Hesterberg 1995) h = α φ + (1 − α) q keeps
@@ -71,7 +71,7 @@ def oscillator_rows(motion: Callable[[np.ndarray], np.ndarray], dimension: int, 
 
 
 def surrogate_level(rows: np.ndarray, probability: float) -> float:
-    """The surrogate's threshold c with S = Σ_k 2 Φ(−c / |a_k|) = ``probability`` (m, by bisection)."""
+    """The surrogate's threshold c with S = Σ_k 2 Φ(−c / ‖a_k‖) = ``probability`` (m, by bisection)."""
     norms = np.linalg.norm(rows, axis=1)
     low, high = 0.0, 40.0 * float(norms.max())
     for _ in range(200):
@@ -84,7 +84,7 @@ def linear_importance_sampling(
     function: Callable[[np.ndarray], np.ndarray], rows: np.ndarray, level: float, *, thresholds: Sequence[float], samples: int, seed: int,
     defensive: float = DEFENSIVE_SHARE,
 ) -> xr.Dataset:
-    """P(g(u) > b) at thresholds b by importance sampling with the surrogate's elementary events {|a_k · u| > level}.
+    """P(g(u) > b) at thresholds b by importance sampling with the surrogate's elementary events {‖a_k · u‖ > level}.
 
     Parameters
     ----------
@@ -148,7 +148,7 @@ def linear_importance_sampling(
 
 
 def uncovered_share(rows: np.ndarray, level: float, u: np.ndarray) -> float:
-    """The share of the states u (rows: e.g. failure samples of a subset simulation) in no elementary event {|a_k · u| > level}."""
+    """The share of the states u (rows: e.g. failure samples of a subset simulation) in no elementary event {‖a_k · u‖ > level}."""
     return float(np.mean(np.count_nonzero(np.abs(np.atleast_2d(u) @ np.asarray(rows).T) > level, axis=1) == 0))
 
 

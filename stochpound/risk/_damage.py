@@ -175,7 +175,7 @@ class StoreDamage:
         its objective), else ``POUNDING``. The answer is the same at every
         target: each limit state has its own objective. With ``apart``,
         judged on λ with the runs beyond the model counted apart as
-        collapses (:func:`~stochpound.risk.governing_limit_state`). None
+        collapses (``stochpound.risk.governing_limit_state``). None
         without ``risk`` or without any objective (nothing is said to govern).
         """
         return None if self.risk is None else governing_limit_state(self.risk, apart, POUNDING)
@@ -200,7 +200,7 @@ class StoreDamage:
         return ratio.isel(limit_state=index), ratio["limit_state"][index].drop_vars("limit_state", errors="ignore")
 
     def fits(self) -> xr.DataArray | None:
-        """Each limit state's fit in words over ``risk``'s dimensions (:func:`~stochpound.risk.limit_state_fits`); None without ``risk``."""
+        """Each limit state's fit in words over ``risk``'s dimensions (``stochpound.risk.limit_state_fits``); None without ``risk``."""
         return None if self.risk is None else limit_state_fits(self.risk)
 
     def misses_objective(self, apart: bool = False) -> xr.DataArray | None:
