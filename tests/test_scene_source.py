@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import hashlib
+import json
 import re
 import tomllib
 from pathlib import Path
@@ -13,7 +14,7 @@ from stochpound._errors import SceneError
 from stochpound.experiment import load_experiment, run_experiment
 from stochpound.experiment._spec import ExperimentError, load_definition, parse_experiment
 from stochpound.model.scene_file import bundled_scene_path, bundled_scenes, read_scene_table
-from stochpound.store import canonical_json, definition_sha256
+from stochpound.store import canonical_json, definition_sha256, open_store
 from tests.helpers import FIXED, REPOSITORY, invoke, write_experiment
 
 REST = '\n[grid]\ngap = [0.01, inf]\n[[motions]]\nname = "pulse"\ntype = "harmonic"\namplitude = 3.0\nomega = 6.0\nduration = 1.0\ndt = 0.01\n'
@@ -116,13 +117,21 @@ def test_an_edit_that_breaks_a_bundled_scene_is_named_in_the_scene(tmp_path: Pat
 
 
 def test_a_complete_store_is_kept_when_only_the_scene_source_changed(tmp_path: Path) -> None:
-    """The same content from a bundled scene, then inline: nothing runs, the store is left as it is (its provenance too)."""
+    """The same content from a bundled scene, then inline: nothing runs, the cases are kept, and the store records the
+    file's new text and provenance (no bundled scene any more), so that a report names the file as it is."""
     path = write_experiment(tmp_path, f'[experiment]\nname = "pair"\n{FIXED}\n{REST}', "pair.toml")
     first = run_experiment(load_experiment(path), workers=0, progress=False)
     assert first.complete and not first.failed
-    written = first.store.read_bytes()
+    with open_store(first.store) as store:
+        before = store.load()
+    assert json.loads(before.attrs["definition"])["scene_source"]["bundled"] == "elastic_pair"
     path.write_text(f'[experiment]\nname = "pair"\n{stiff_neighbour_inline()}\n{REST}')
     again = run_experiment(load_experiment(path), workers=0, progress=False)
     assert again.nothing_to_run
-    assert first.store.read_bytes() == written
-
+    with open_store(again.store) as store:
+        after = store.load()
+    assert after.attrs["experiment_text"] == path.read_text()
+    assert "scene_source" not in json.loads(after.attrs["definition"])
+    assert after.attrs["definition_sha256"] == before.attrs["definition_sha256"]
+    for name, values in before.data_vars.items():
+        assert values.equals(after[name]), name

@@ -318,7 +318,7 @@ def _record_hazard(store: Path, experiment: Experiment, grids: dict[str, tuple[f
         if table in changed:
             say(f"{store}: the [{table}] changed; no run depends on it: the cases are kept and the new table is recorded in the store")
     if "text" in changed:
-        say(f"{store}: the experiment file's text changed, not its definition (comments); the cases are kept and the new text is recorded in the store")
+        say(f"{store}: the experiment file's text changed, not its definition's identity (comments, the scene's source); the cases are kept and the new text is recorded in the store")
     if "site" in changed:
         say(f"{store}: how the [site] scenario was obtained is recorded in the store (no run depends on it: the cases are kept)")
     if "hazard" not in changed:
