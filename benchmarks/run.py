@@ -9,6 +9,7 @@ comparison with an earlier revision (:mod:`benchmarks.compare`),
 ``python -m benchmarks site_motions`` the site-based stochastic motions' (:mod:`benchmarks.site_motions`),
 ``python -m benchmarks startup`` the quick start's start-up (:mod:`benchmarks.startup`),
 ``python -m benchmarks measure_free`` the measure-free risk at the demo site (:mod:`benchmarks.measure_free`),
+``python -m benchmarks flagship_selection FILE`` a flagship's stripes chosen without running a case (:mod:`benchmarks.flagship_selection`),
 ``python -m benchmarks inelastic_demand`` simulated and recorded motions' inelastic demand at matched spectra (:mod:`benchmarks.inelastic_demand`).
 
 The thread pools of BLAS, OpenMP and numba are set to one thread here,
@@ -75,6 +76,10 @@ def main(argv: list[str] | None = None) -> int:
         return startup.main(argv[1:])
     if argv[:1] == ["measure_free"]:
         return measure_free.main(argv[1:])
+    if argv[:1] == ["flagship_selection"]:
+        from benchmarks import flagship_selection
+
+        return flagship_selection.main(argv[1:])
     if argv[:1] == ["inelastic_demand"]:
         return inelastic_demand.main(argv[1:])
     arguments = parse_arguments(argv)

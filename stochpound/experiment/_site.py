@@ -83,6 +83,10 @@ SIMULATED_CHUNK = 256
 """Simulated motions generated at once while their spectra are computed."""
 SIMULATED_LIMIT = 100_000
 """Largest ``[site] simulated_motions`` (per stripe)."""
+SCREEN_BASE = 2000
+"""The pre-screen of a larger pool of a scenario's simulated motions: its first SCREEN_BASE motions all join it ... (:func:`screen_level`)."""
+SCREEN_MARGIN = 1.0
+"""... and the others whose own ε at the conditioning measure is at least the top stripe's ε minus SCREEN_MARGIN."""
 SIMULATED_WINDOW_LIMIT = 600.0
 """Longest window (s) :func:`~stochpound.motions.site_motions` takes given; a longer default one is found again per chunk."""
 RULES = ("max_per_earthquake", "exclude_pulses")
@@ -463,9 +467,10 @@ def stripe_selections(experiment: ExperimentGrid) -> StripeSelections:
         groups = (rupture_sources(chosen.simulated, stripe, site, allotment) if allotment is not None
                   else [simulated_sources(chosen.simulated, stripe, scenario)])
         parts = [] if pool is None else [pool]
+        screen = None if allotment is not None else screen_level(chosen.simulated, stripe, chosen.scenarios, stripe_targets, measure, period)
         for group in filter(None, groups):
             try:
-                parts.append(shared_simulated_pool(group, periods, measure, period, g, generated))
+                parts.append(shared_simulated_pool(group, periods, measure, period, g, generated, screen))
             except SiteError as error:  # a scenario outside the site-motion model's calibrated range
                 table = next(iter(group.values())).motion
                 where = f"rupture {table['rupture']}" if "rupture" in table else "scenario"
@@ -593,52 +598,81 @@ def simulated_accelerations(sources: Sequence[MotionSource], duration: float | N
     ``duration`` (s), the window of the table's ``n`` motions when known (:func:`simulated_pool`), spares drawing the
     parameters of all ``n`` to find it (the window-given path of :func:`~stochpound.motions.site_motions`); the rows are the same.
     """
+    return table_accelerations(sources[0].motion, [source.motion["realization"] for source in sources], duration)
+
+
+def table_accelerations(table: Mapping[str, Any], realizations: Sequence[int], duration: float | None = None) -> np.ndarray:
+    """The ground accelerations (m/s², one row per realization) of a simulated motions' table (:func:`simulated_accelerations`)."""
     from stochpound.motions import site_motions
 
-    table = sources[0].motion
     generated = site_motions(scenario=table_scenario(table), n=table["n"], seed=table["seed"], dt=table["dt"], model=table["model"],
-                             realizations=[source.motion["realization"] for source in sources], duration=duration)
+                             realizations=list(realizations), duration=duration)
     return generated["acceleration"].values
 
 
-def simulated_pool(sources: Mapping[str, MotionSource], periods: np.ndarray, measure: str, period: Any, g: float) -> xr.Dataset:
-    """:func:`~stochpound.motions.selection_pool` of a stripe's simulated motions, generated :data:`SIMULATED_CHUNK` at a time.
+def simulated_pool(table: Mapping[str, Any], periods: np.ndarray, measure: str, period: Any, g: float, screen: float | None = None) -> xr.Dataset:
+    """:func:`~stochpound.motions.selection_pool` of every motion of a simulated motions' table (over ``motion``: its realization,
+    ``"0"`` … ``"n-1"``), generated :data:`SIMULATED_CHUNK` at a time.
 
     The first chunk finds the window of the table's ``n`` motions (their default one, :func:`~stochpound.motions.site_motions`);
-    the others are drawn with it given, each motion from its own generator alone: the same motions, bit for bit.
+    the others are drawn with it given, each motion from its own generator alone: the same motions, bit for bit. Each chunk's
+    spectra come from one compiled call per batch (:func:`~stochpound.motions._selection.array_pool`). With ``screen`` (g; the
+    pre-screen, :func:`screen_level`), a realization from :data:`SCREEN_BASE` on joins the pool only if its own conditioning
+    measure reaches ``screen``: that measure is computed for every motion, the whole spectrum for those that join alone.
     """
-    from stochpound.motions import selection_pool
-    from stochpound.motions.records import Record
+    from stochpound.motions._selection import array_pool, pool_intensity
 
-    items = list(sources.values())
-    table = items[0].motion
-    metadata = {"magnitude": table["magnitude"], "distance": table["distance_km"], "vs30": table["vs30"]}
+    n, dt = int(table["n"]), float(table["dt"])
     parts, duration = [], None
-    for start in range(0, len(items), SIMULATED_CHUNK):
-        chunk = items[start : start + SIMULATED_CHUNK]
-        accelerations = simulated_accelerations(chunk, duration)
-        window = (accelerations.shape[1] - 1) * table["dt"]  # n_time = round(window / dt) + 1 again
+    for start in range(0, n, SIMULATED_CHUNK):
+        rows = np.arange(start, min(start + SIMULATED_CHUNK, n))
+        accelerations = table_accelerations(table, rows.tolist(), duration)
+        window = (accelerations.shape[1] - 1) * dt  # n_time = round(window / dt) + 1 again
         duration = window if window <= SIMULATED_WINDOW_LIMIT else None
-        records = [Record(source.label, table["dt"], values, "m/s2", metadata={**metadata, "event": source.label})
-                   for source, values in zip(chunk, accelerations)]
-        parts.append(selection_pool(records, periods, measure, period, MODEL_DAMPING, g))
+        intensity = pool_intensity(accelerations, dt, measure, period, MODEL_DAMPING, g)
+        kept = np.flatnonzero((rows < SCREEN_BASE) | (intensity >= screen)) if screen is not None else np.arange(rows.size)
+        if kept.size:
+            parts.append(array_pool(accelerations[kept], dt, [str(i) for i in rows[kept]], periods, measure, period, MODEL_DAMPING, g,
+                                    intensity=intensity[kept], magnitude=table["magnitude"], distance_km=table["distance_km"], vs30=table["vs30"]))
     return xr.concat(parts, "motion")
 
 
+def screen_level(setting: SimulatedMotions | None, stripe: int, scenarios: Sequence[Scenario], targets: Sequence[xr.Dataset], measure: str,
+                 period: Any) -> float | None:
+    """The pre-screen of a stripe's pool of simulated motions of its scenario (g; None: every motion's spectrum is computed).
+
+    A pool of more than :data:`SCREEN_BASE` motions keeps its first :data:`SCREEN_BASE` and, of the others, those whose own ε at
+    the conditioning measure in the scenario (:func:`~stochpound.motions.scenario_distribution`) is at least ε_top −
+    :data:`SCREEN_MARGIN`, ε_top the largest ε of the stripes of the same scenario (which share the pool): the level
+    median · exp(σ (ε_top − :data:`SCREEN_MARGIN`)).
+    """
+    from stochpound.motions import scenario_distribution
+
+    if setting is None or setting.count <= SCREEN_BASE:
+        return None
+    scenario = scenarios[stripe]
+    top = max(float(target.attrs["epsilon"]) for other, target in zip(scenarios, targets) if other == scenario)
+    median, sigma = scenario_distribution(measure, period, scenario=scenario)
+    return float(median * np.exp(sigma * (top - SCREEN_MARGIN)))
+
+
 def shared_simulated_pool(sources: Mapping[str, MotionSource], periods: np.ndarray, measure: str, period: Any, g: float,
-                          generated: dict[str, xr.Dataset]) -> xr.Dataset:
-    """:func:`simulated_pool` of a stripe's sources, reusing ``generated`` (the pools of the tables met so far, by table).
+                          generated: dict[str, xr.Dataset], screen: float | None = None) -> xr.Dataset:
+    """:func:`simulated_pool` of a stripe's sources (pre-screened by ``screen``, g), reusing ``generated`` (the pools of the tables
+    met so far, by table and screen).
 
     Stripes of one scenario (a fitted scenario, one given for every level) have the same table and so the same motions:
-    they are generated once and relabelled (a motion's label, earthquake and recording are its stripe's label).
+    they are generated once and relabelled (a motion's label, earthquake and recording are its stripe's label). A source the
+    pre-screen left out is not in the stripe's pool.
     """
     from stochpound.store import canonical_json
 
     table = next(iter(sources.values())).motion
-    key = canonical_json({name: value for name, value in table.items() if name != "realization"})
+    key = canonical_json({**{name: value for name, value in table.items() if name != "realization"}, "screen": screen})
     if key not in generated:  # every motion of the table (a stripe may take only the first ones)
-        every = {str(i): MotionSource(str(i), SIMULATED, SIMULATED_FIELD, {**table, "realization": i}) for i in range(table["n"])}
-        generated[key] = simulated_pool(every, periods, measure, period, g)
-    labels = np.array(list(sources), dtype=object)
-    chosen = generated[key].isel(motion=[source.motion["realization"] for source in sources.values()])
-    return chosen.assign_coords(motion=labels).assign(earthquake=("motion", labels), recording=("motion", labels))
+        generated[key] = simulated_pool(table, periods, measure, period, g, screen)
+    pool = generated[key]
+    wanted = {source.motion["realization"]: label for label, source in sources.items()}
+    rows = [j for j, realization in enumerate(pool["motion"].values.astype(int)) if realization in wanted]
+    labels = np.array([wanted[int(pool["motion"].values[j])] for j in rows], dtype=object)
+    return pool.isel(motion=rows).assign_coords(motion=labels).assign(earthquake=("motion", labels), recording=("motion", labels))

@@ -53,7 +53,7 @@ from stochpound._errors import SiteError
 from stochpound.stats import earthquake_identities
 from stochpound.motions._conditional import PERIOD_RANGE
 from stochpound.motions._measures import peak_ground_motion
-from stochpound.motions._spectrum import DEFAULT_G, response_spectrum
+from stochpound.motions._spectrum import DEFAULT_G, pseudo_spectra, response_spectrum
 
 #: Simulated sets of target spectra, each a start of the greedy selection.
 SIMULATED_SETS = 20
@@ -71,6 +71,9 @@ TARGET_TOLERANCE = 0.1
 #: Weight of the quartic term of the misfit.
 QUARTIC_WEIGHT = 100.0
 _MAX_PASSES = 50
+#: Attributes of a pool's metadata variables.
+_METADATA_UNITS: dict[str, dict[str, str]] = {"magnitude": {}, "distance_km": {"units": "km"}, "vs30": {"units": "m/s"}, "mechanism": {}, "earthquake": {},
+                                              "recording": {}, "pulse": {}}
 
 
 def selection_periods(structure_periods: Sequence[float], conditioning: Sequence[float] = (), count: int = RANGE_PERIODS) -> np.ndarray:
@@ -128,7 +131,7 @@ def selection_pool(
         (the metadata's ``pulse``, False where unknown).
     """
     psa, intensity = [], []
-    conditioning = [] if measure == "pga" else list(np.atleast_1d(np.asarray(period, dtype=float)))
+    conditioning = _conditioning_periods(measure, period)
     grid = np.asarray(periods, dtype=float)
     for record in records:
         a = record.acceleration(g)
@@ -138,21 +141,96 @@ def selection_pool(
     meta = [record.metadata or {} for record in records]
     # one earthquake, one name across suites ("Northridge 1994" and "Northridge-01 1994" of one magnitude); a motion without one is its own
     earthquakes = earthquake_identities([str(m.get("event") or "") for m in meta], [float(m.get("magnitude", np.nan)) for m in meta])
+    names = [record.name for record in records]
+    return _pool_dataset(names, grid, np.array(psa), np.array(intensity), measure, damping, {
+        "magnitude": np.array([float(m.get("magnitude", np.nan)) for m in meta]),
+        "distance_km": np.array([float(m.get("distance", np.nan)) for m in meta]),
+        "vs30": np.array([float(m.get("vs30", np.nan)) for m in meta]),
+        "mechanism": np.array([FAULT_TYPES.get(str(m.get("fault_type", "")), "") for m in meta], dtype=object),
+        "earthquake": np.array([identity or name for identity, name in zip(earthquakes, names)], dtype=object),
+        "recording": np.array([_recording(m, name) for m, name in zip(meta, names)], dtype=object),
+        "pulse": np.array([bool(m.get("pulse", False)) for m in meta]),
+    })
+
+
+def _conditioning_periods(measure: str, period: float | Sequence[float] | None) -> list[float]:
+    """The periods (s) of the conditioning measure's spectral values: none for PGA."""
+    return [] if measure == "pga" else list(np.atleast_1d(np.asarray(period, dtype=float)))
+
+
+def _pool_dataset(names: Sequence[str], grid: np.ndarray, psa: np.ndarray, intensity: np.ndarray, measure: str, damping: float,
+                  metadata: dict[str, np.ndarray]) -> xr.Dataset:
+    """:func:`selection_pool`'s dataset of the pool's spectra (g), measures (g) and metadata (one array per variable, over ``motion``)."""
     return xr.Dataset(
         {
-            "psa": (("motion", "period"), np.array(psa), {"units": "g", "long_name": "pseudo-spectral acceleration of the unscaled motion"}),
-            "intensity": ("motion", np.array(intensity), {"units": "g", "long_name": f"the unscaled motion's {measure}"}),
-            "magnitude": ("motion", np.array([float(m.get("magnitude", np.nan)) for m in meta])),
-            "distance_km": ("motion", np.array([float(m.get("distance", np.nan)) for m in meta]), {"units": "km"}),
-            "vs30": ("motion", np.array([float(m.get("vs30", np.nan)) for m in meta]), {"units": "m/s"}),
-            "mechanism": ("motion", np.array([FAULT_TYPES.get(str(m.get("fault_type", "")), "") for m in meta], dtype=object)),
-            "earthquake": ("motion", np.array([identity or r.name for identity, r in zip(earthquakes, records)], dtype=object)),
-            "recording": ("motion", np.array([_recording(m, r.name) for m, r in zip(meta, records)], dtype=object)),
-            "pulse": ("motion", np.array([bool(m.get("pulse", False)) for m in meta])),
+            "psa": (("motion", "period"), psa, {"units": "g", "long_name": "pseudo-spectral acceleration of the unscaled motion"}),
+            "intensity": ("motion", intensity, {"units": "g", "long_name": f"the unscaled motion's {measure}"}),
+            **{name: ("motion", values, _METADATA_UNITS[name]) for name, values in metadata.items()},
         },
-        coords={"motion": [record.name for record in records], "period": ("period", grid, {"units": "s"})},
+        coords={"motion": list(names), "period": ("period", grid, {"units": "s"})},
         attrs={"damping": float(damping), "measure": measure},
     )
+
+
+def pool_intensity(accelerations: np.ndarray, dt: float, measure: str, period: float | Sequence[float] | None = None, damping: float = 0.05,
+                   g: float = DEFAULT_G) -> np.ndarray:
+    """The conditioning measure (g) of motions of one step (rows, m/s²): :func:`selection_pool`'s ``intensity``, bit for bit.
+
+    Parameters
+    ----------
+    accelerations : array_like, shape (n, n_time)
+        The motions, m/s², at ``dt`` (s).
+    dt : float
+        Step, s.
+    measure : {"pga", "psa", "sa_avg"}
+        The conditioning measure; ``period`` its T* (psa) or averaging periods (sa_avg), s.
+    damping : float
+        Damping ratio of the spectra.
+    g : float
+        m/s².
+    """
+    a = np.asarray(accelerations, dtype=float)
+    if measure == "pga":
+        return np.max(np.abs(a), axis=1) / g
+    spectra = pseudo_spectra(a, dt, np.array(_conditioning_periods(measure, period)), damping) / g
+    return np.array([float(np.exp(np.mean(np.log(row)))) for row in spectra])
+
+
+def array_pool(accelerations: np.ndarray, dt: float, names: Sequence[str], periods: Sequence[float], measure: str,
+               period: float | Sequence[float] | None = None, damping: float = 0.05, g: float = DEFAULT_G, *,
+               intensity: np.ndarray | None = None, magnitude: float = np.nan, distance_km: float = np.nan, vs30: float = np.nan) -> xr.Dataset:
+    """:func:`selection_pool` of motions of one step given as rows, every spectrum in one compiled call per batch
+    (:func:`~stochpound.motions._spectrum.pseudo_spectra`): the same dataset, bit for bit, as of the motions as records whose
+    metadata are ``magnitude``, ``distance_km`` and ``vs30`` and whose earthquake and recording are their names.
+
+    Parameters
+    ----------
+    accelerations : array_like, shape (n, n_time)
+        The motions, m/s², at ``dt`` (s).
+    names : list of str
+        Their names (n).
+    periods, measure, period, damping, g
+        As :func:`selection_pool`.
+    intensity : array, optional
+        Their conditioning measure (g) when already known (:func:`pool_intensity`), else computed.
+    magnitude, distance_km, vs30 : float, optional
+        Moment magnitude, rupture distance (km) and Vs30 (m/s) shared by the motions (NaN: unknown).
+    """
+    grid = np.asarray(periods, dtype=float)
+    a = np.asarray(accelerations, dtype=float)
+    psa = pseudo_spectra(a, dt, grid, damping) / g
+    if intensity is None:
+        intensity = pool_intensity(a, dt, measure, period, damping, g)
+    n, labels = a.shape[0], np.array(list(names), dtype=object)
+    return _pool_dataset(list(names), grid, psa, np.asarray(intensity, dtype=float), measure, damping, {
+        "magnitude": np.full(n, float(magnitude)),
+        "distance_km": np.full(n, float(distance_km)),
+        "vs30": np.full(n, float(vs30)),
+        "mechanism": np.full(n, "", dtype=object),
+        "earthquake": labels,
+        "recording": labels.copy(),
+        "pulse": np.zeros(n, dtype=bool),
+    })
 
 
 def _recording(metadata: dict, name: str) -> str:

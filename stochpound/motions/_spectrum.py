@@ -64,6 +64,8 @@ DEFAULT_DAMPING = 0.05
 _NEWTON_ITERATIONS = 60
 #: Motions whose peaks a process keeps (module docstring).
 CACHED_MOTIONS = 512
+#: Motions of one compiled call of :func:`pseudo_spectra`.
+POOL_BATCH = 16
 _PEAKS: OrderedDict[tuple[bytes, float, float], dict[float, tuple[float, float]]] = OrderedDict()
 _PEAKS_LOCK = threading.Lock()
 
@@ -159,6 +161,57 @@ def response_spectrum(
     )
 
 
+def pseudo_spectra(accelerations: np.ndarray, dt: float, periods: np.ndarray | float, damping: float = DEFAULT_DAMPING) -> np.ndarray:
+    """Pseudo-spectral accelerations of many motions of one step: :func:`response_spectrum`'s ``psa``, bit for bit, at the cost of the
+    displacement's peaks alone.
+
+    Every motion's peaks come from one compiled call per batch of :data:`POOL_BATCH` motions, on numba's thread count
+    (``NUMBA_NUM_THREADS``, as :func:`~stochpound.motions.site_motions`); a motion's values depend on its own samples alone,
+    so not on the threads. No per-motion cache (the motions of a pool are met once).
+
+    Parameters
+    ----------
+    accelerations : array_like, shape (n, n_time)
+        Samples in m/s² at ``dt`` from t = 0, one motion a row, linear between them.
+    dt : float
+        Step, s.
+    periods : array_like
+        Oscillator periods, s (> 0).
+    damping : float
+        Damping ratio ζ in [0, 1).
+
+    Returns
+    -------
+    numpy.ndarray, shape (n, len(periods))
+        ω² max abs(u), m/s².
+    """
+    from concurrent.futures import ThreadPoolExecutor
+
+    from stochpound.motions._site_model import motion_threads
+
+    values, zeta = check_periods(periods, damping)
+    a = np.ascontiguousarray(accelerations, dtype=np.float64)
+    if a.ndim != 2 or a.shape[1] < 2:
+        raise ValueError(f"accelerations: must be a 2-D array of motions of at least 2 samples, got shape {a.shape}")
+    if not (math.isfinite(dt) and dt > 0.0):
+        raise ValueError(f"dt: must be > 0 s, got {dt!r}")
+    omega = 2.0 * np.pi / values
+    sd = np.empty((a.shape[0], values.size))
+    starts = range(0, a.shape[0], POOL_BATCH)
+
+    def batch(start: int) -> None:
+        _pool_kernel(a[start : start + POOL_BATCH], float(dt), omega, zeta, sd[start : start + POOL_BATCH])
+
+    threads = min(motion_threads(), len(starts))
+    if threads <= 1:
+        for start in starts:
+            batch(start)
+    else:
+        with ThreadPoolExecutor(threads) as pool:
+            list(pool.map(batch, starts))
+    return omega**2 * sd
+
+
 def _peaks(a: np.ndarray, step: float, periods: np.ndarray, zeta: float) -> tuple[np.ndarray, np.ndarray]:
     """max abs(u) (m) and max abs(ü + a_g) (m/s²) at ``periods`` (s), each computed once per process for a motion (module docstring)."""
     key = (hashlib.sha256(a.tobytes()).digest(), step, zeta)
@@ -247,43 +300,59 @@ def _needs_search(f0: float, f1: float, d0: float, d1: float, b2: float, h: floa
 
 @cached_njit()
 def _spectrum_kernel(a, h, omega, zeta, sd_out, sa_out):  # pragma: no cover - compiled
-    """max abs(u) and max abs(ü + a_g) for every ω (module docstring).
+    """max abs(u) and max abs(ü + a_g) for every ω (:func:`_period_peaks`, one period at a time)."""
+    for j in range(omega.size):
+        sd_out[j], sa_out[j] = _period_peaks(a, h, omega[j], zeta, True)
 
-    One pass per period: a step is searched when :func:`_needs_search` says
+
+@cached_njit(nogil=True)
+def _pool_kernel(accelerations, h, omega, zeta, sd_out):  # pragma: no cover - compiled
+    """max abs(u) for every motion (rows of ``accelerations``) and every ω (:func:`_period_peaks` without the total acceleration)."""
+    for m in range(accelerations.shape[0]):
+        a = accelerations[m]
+        for j in range(omega.size):
+            sd_out[m, j] = _period_peaks(a, h, omega[j], zeta, False)[0]
+
+
+@cached_njit(inline="always")  # into each kernel, where with_sa is a constant
+def _period_peaks(a, h, w, zeta, with_sa):  # pragma: no cover - compiled
+    """max abs(u) and (``with_sa``; else 0) max abs(ü + a_g) at circular frequency ``w`` (module docstring).
+
+    One pass: a step is searched when :func:`_needs_search` says
     it can exceed the largest value so far (a lower bound of the final
     peak, so no step that could hold the peak is skipped). With r the
     amplitude √(c1² + c2²) of u's homogeneous part, abs(ü) ≤ ω² r; the total
     acceleration's homogeneous part is −(2σλ + ω²) times u's (λ = −σ + iω_d,
     the derivative's factor), of amplitude κ r with κ = abs(2σλ + ω²), and its
-    second derivative is bounded by ω² κ r.
+    second derivative is bounded by ω² κ r. The displacement's peak does not
+    depend on ``with_sa``.
     """
     n = a.size
     root = math.sqrt(1.0 - zeta * zeta)
-    for j in range(omega.size):
-        w = omega[j]
-        w2 = w * w
-        sigma, wd = zeta * w, w * root
-        ex, cw, sw = math.exp(-sigma * h), math.cos(wd * h), math.sin(wd * h)
-        kappa = math.hypot(w2 - 2.0 * sigma * sigma, 2.0 * sigma * wd)  # abs(2σλ + ω²)
-        sd_peak, sa_peak = 0.0, 0.0
-        u, v = 0.0, 0.0
-        fa = 0.0
-        for k in range(n - 1):
-            slope = (a[k + 1] - a[k]) / h
-            p1 = -slope / w2
-            p0 = (-a[k] - 2.0 * sigma * p1) / w2
-            c1 = u - p0
-            c2 = (v - p1 + sigma * c1) / wd
-            E1, F1 = -sigma * c1 + wd * c2, -sigma * c2 - wd * c1
-            u_next = p0 + p1 * h + ex * (c1 * cw + c2 * sw)
-            v_next = p1 + ex * (E1 * cw + F1 * sw)
+    w2 = w * w
+    sigma, wd = zeta * w, w * root
+    ex, cw, sw = math.exp(-sigma * h), math.cos(wd * h), math.sin(wd * h)
+    kappa = math.hypot(w2 - 2.0 * sigma * sigma, 2.0 * sigma * wd)  # abs(2σλ + ω²)
+    sd_peak, sa_peak = 0.0, 0.0
+    u, v = 0.0, 0.0
+    fa = 0.0
+    for k in range(n - 1):
+        slope = (a[k + 1] - a[k]) / h
+        p1 = -slope / w2
+        p0 = (-a[k] - 2.0 * sigma * p1) / w2
+        c1 = u - p0
+        c2 = (v - p1 + sigma * c1) / wd
+        E1, F1 = -sigma * c1 + wd * c2, -sigma * c2 - wd * c1
+        u_next = p0 + p1 * h + ex * (c1 * cw + c2 * sw)
+        v_next = p1 + ex * (E1 * cw + F1 * sw)
+        sd_peak = max(sd_peak, abs(u_next))
+        r = math.sqrt(c1 * c1 + c2 * c2)
+        # u: f = u, f' = u̇, abs(f'') = abs(ü) <= ω² r (ü has no particular part)
+        if _needs_search(u, u_next, v, v_next, w2 * r, h, sd_peak):
+            sd_peak = max(sd_peak, _step_peak(p0, p1, c1, c2, sigma, wd, h))
+        if with_sa:
             fa_next = -(2.0 * sigma * v_next + w2 * u_next)
-            sd_peak = max(sd_peak, abs(u_next))
             sa_peak = max(sa_peak, abs(fa_next))
-            r = math.sqrt(c1 * c1 + c2 * c2)
-            # u: f = u, f' = u̇, abs(f'') = abs(ü) <= ω² r (ü has no particular part)
-            if _needs_search(u, u_next, v, v_next, w2 * r, h, sd_peak):
-                sd_peak = max(sd_peak, _step_peak(p0, p1, c1, c2, sigma, wd, h))
             # total acceleration: f = −(2σ u̇ + ω² u) = a_k + s τ + e(Ea cos + Fa sin)
             ra = kappa * r
             if max(abs(fa), abs(fa_next)) + 0.125 * w2 * ra * h * h > sa_peak:
@@ -293,6 +362,6 @@ def _spectrum_kernel(a, h, omega, zeta, sd_out, sa_out):  # pragma: no cover - c
                 d1 = slope + ex * (Ea1 * cw + Fa1 * sw)
                 if _needs_search(fa, fa_next, d0, d1, w2 * ra, h, sa_peak):
                     sa_peak = max(sa_peak, _step_peak(a[k], slope, Ea, Fa, sigma, wd, h))
-            u, v, fa = u_next, v_next, fa_next
-        sd_out[j] = sd_peak
-        sa_out[j] = sa_peak
+            fa = fa_next
+        u, v = u_next, v_next
+    return sd_peak, sa_peak
