@@ -601,7 +601,7 @@ def simulated_accelerations(sources: Sequence[MotionSource], duration: float | N
     return table_accelerations(sources[0].motion, [source.motion["realization"] for source in sources], duration)
 
 
-def table_accelerations(table: Mapping[str, Any], realizations: Sequence[int], duration: float | None = None) -> np.ndarray:
+def table_accelerations(table: Mapping[str, float | str], realizations: Sequence[int], duration: float | None = None) -> np.ndarray:
     """The ground accelerations (m/s², one row per realization) of a simulated motions' table (:func:`simulated_accelerations`)."""
     from stochpound.motions import site_motions
 
@@ -610,7 +610,7 @@ def table_accelerations(table: Mapping[str, Any], realizations: Sequence[int], d
     return generated["acceleration"].values
 
 
-def simulated_pool(table: Mapping[str, Any], periods: np.ndarray, measure: str, period: Any, g: float, screen: float | None = None) -> xr.Dataset:
+def simulated_pool(table: Mapping[str, float | str], periods: np.ndarray, measure: str, period: Any, g: float, screen: float | None = None) -> xr.Dataset:
     """:func:`~stochpound.motions.selection_pool` of every motion of a simulated motions' table (over ``motion``: its realization,
     ``"0"`` … ``"n-1"``), generated :data:`SIMULATED_CHUNK` at a time.
 
