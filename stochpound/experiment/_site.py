@@ -34,7 +34,12 @@ stored: the definition keeps the model, its calibration, the seed and N, and
 a chosen motion is regenerated bit for bit from them (its ``realization``
 among the N). Each simulated motion is its own earthquake for
 ``max_per_earthquake`` and never a pulse. The pool is generated a stripe at
-a time, :data:`SIMULATED_CHUNK` motions at once. At a site of ruptures the
+a time, :data:`SIMULATED_CHUNK` motions at once, their spectra in one compiled
+call per batch. A pool of a scenario larger than :data:`SCREEN_BASE` is
+pre-screened (:func:`screen_level`): beyond its first :data:`SCREEN_BASE`
+motions, only those whose own ε at the conditioning measure is within
+:data:`SCREEN_MARGIN` of the top stripe's (or beyond) join it, the others'
+spectra never computed. At a site of ruptures the
 N motions of a stripe are of its causal ruptures, apportioned by their
 weights in the stripe's exact conditional spectrum (:func:`rupture_allotment`,
 the largest remainders), each rupture's motions from its own table shared by

@@ -36,6 +36,10 @@ periods logarithmically from 0.2 times its shortest to 3 times its longest
 period of interest (each building's first-mode period and the isolated
 period), within the models' 0.01–10 s, the conditioning period added.
 
+:func:`array_pool` is :func:`selection_pool` of motions of one step given
+as rows (simulated motions), bit for bit, at the cost of their spectra alone;
+:func:`pool_intensity` their conditioning measure alone (a pool's pre-screen).
+
 A process computes a pool motion's spectrum at a period once (the cache of
 :func:`~stochpound.motions.response_spectrum`): the experiments of one
 process that share a pool (stripes conditioned on other measures, other

@@ -34,6 +34,11 @@ The recurrence loses accuracy for very long periods, where p0 (of order
 a_g/ω² and s/ω³) grows large against u: about 1e-13 relative at T = 5 s and
 h = 0.01 s, still below 1e-10 at T = 50 s.
 
+:func:`pseudo_spectra` gives the pseudo-spectral accelerations of many
+motions of one step (a pool of simulated motions) in one compiled call per
+batch, the same values bit for bit, without the total acceleration's peaks
+and without the cache below.
+
 A process computes a motion's peaks at a period once: they are kept by the
 motion's content (its samples in m/s² and their step) and the damping, per
 period, for :data:`CACHED_MOTIONS` motions (the least recently used dropped
