@@ -106,7 +106,8 @@ The new pool is the old one bit for bit ({'identical' if data['identical'] else 
 gain is the total acceleration's peaks, which a pool does not use, left out. What makes pools of 10⁴–10⁵ usable is the pre-screen
 (docs/intensity.md, "How many simulated motions a stripe needs"): beyond the first 2000 motions only the conditioning measure is computed
 for every motion, about {per['new'] / per['screen']:.0f}× cheaper than a whole spectrum, so such a pool costs its generation (the largest
-stage, {per['generation'] * 1e3:.1f} ms a motion here) and little more.
+stage, {per['generation'] * 1e3:.1f} ms a motion here) and little more. On a shared machine the times are wall-clock at its load: the
+ratios are what they show.
 {SECTION.end}
 """
 
