@@ -10,12 +10,15 @@ the stripe's ε), the pool's motions after the pre-screen, the chosen set's
 recorded and simulated motions, the largest share of one earthquake, and its
 worst differences from the target in mean and standard deviation of ln Sa
 (with their periods): a markdown table, then the time the selection took
-(from the file's loading), the load at its start and the commit.
+(from the file's loading), the load at its start and the commit; with
+``--picks FILE`` every stripe's chosen motions and scale factors as JSON
+(to compare two trees' selections).
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import re
 import tempfile
@@ -73,6 +76,7 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m benchmarks flagship_selection", description=__doc__.splitlines()[0])
     parser.add_argument("experiment", type=Path)
     parser.add_argument("--simulated", type=int, default=None, help="[site] simulated_motions (default: the file's)")
+    parser.add_argument("--picks", type=Path, default=None, help="write every stripe's chosen motions and scale factors here (JSON)")
     arguments = parser.parse_args(argv)
     from stochpound.experiment import load_experiment
 
@@ -89,6 +93,9 @@ def main(argv: list[str] | None = None) -> int:
     print("|" + "---|" * len(header))
     for row in stripe_rows(experiment, count):
         print("| " + " | ".join(row) + " |")
+    if arguments.picks is not None:
+        arguments.picks.write_text(json.dumps([{"motion": [str(m) for m in s["motion"].values], "scale_factor": s["scale_factor"].values.tolist()}
+                                               for s in experiment.selection.selections]))
     info = machine()
     print(f"selection (fit, pool, stripes) {elapsed:.0f} s; load {load:.1f} at start; commit {info['commit']}; "
           f"NUMBA_NUM_THREADS {os.environ.get('NUMBA_NUM_THREADS', 'default')}")
