@@ -80,7 +80,7 @@ def main(argv: list[str] | None = None) -> int:
     arguments = parser.parse_args(argv)
     from stochpound.experiment import load_experiment
 
-    load = os.getloadavg()[0]
+    info = machine()  # the commit and load as the run starts
     with tempfile.TemporaryDirectory() as folder:
         began = time.time()
         experiment = load_experiment(with_simulated(arguments.experiment, arguments.simulated, Path(folder)))
@@ -96,8 +96,7 @@ def main(argv: list[str] | None = None) -> int:
     if arguments.picks is not None:
         arguments.picks.write_text(json.dumps([{"motion": [str(m) for m in s["motion"].values], "scale_factor": s["scale_factor"].values.tolist()}
                                                for s in experiment.selection.selections]))
-    info = machine()
-    print(f"selection (fit, pool, stripes) {elapsed:.0f} s; load {load:.1f} at start; commit {info['commit']}; "
+    print(f"selection (fit, pool, stripes) {elapsed:.0f} s; load {info['load average (1 min) at start']} at start; commit {info['commit']}; "
           f"NUMBA_NUM_THREADS {os.environ.get('NUMBA_NUM_THREADS', 'default')}")
     return 0
 
