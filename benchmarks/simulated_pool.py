@@ -36,6 +36,8 @@ from benchmarks.timing import REPOSITORY
 
 SECTION = Section("<!-- simulated pool: start -->", "<!-- simulated pool: end -->")
 """This benchmark's section of docs/benchmarks.md."""
+STARTUP = Section("<!-- simulated pool start-up: start -->", "<!-- simulated pool start-up: end -->")
+"""The flagship's start-up before and after, measured by hand (benchmarks/flagship_selection.py --picks): kept by the suite."""
 TABLE = {"type": "site_motions", "magnitude": 8.0, "distance_km": 30.0, "vs30": 400.0, "mechanism": "reverse", "seed": 1, "dt": 0.01,
          "model": "hazard_compatible", "calibration": ""}
 """The fixed-pair flagship's fitted scenario (its table, ``n`` added)."""
@@ -105,8 +107,8 @@ The new pool is the old one bit for bit ({'identical' if data['identical'] else 
 {spectra:.1f}× as fast: the cost is the recurrence itself (the per-motion hashing, cache, `Record` and xarray overhead are a small part); the
 gain is the total acceleration's peaks, which a pool does not use, left out. What makes pools of 10⁴–10⁵ usable is the pre-screen
 (docs/intensity.md, "How many simulated motions a stripe needs"): beyond the first 2000 motions only the conditioning measure is computed
-for every motion, about {per['new'] / per['screen']:.0f}× cheaper than a whole spectrum, so such a pool costs its generation (the largest
-stage, {per['generation'] * 1e3:.1f} ms a motion here) and little more. On a shared machine the times are wall-clock at its load: the
+for every motion, about {per['new'] / per['screen']:.0f}× cheaper than a whole spectrum, so such a pool costs about its generation
+({per['generation'] * 1e3:.1f} ms a motion here) and little more. On a shared machine the times are wall-clock at its load: the
 ratios are what they show.
 {SECTION.end}
 """
