@@ -6,16 +6,16 @@ window) and that flagship's 21 selection periods (0.043–1.29 s, T* = 1 s),
 in one process on one core (``python -m benchmarks`` sets every thread pool
 to one), it times:
 
-* the generation (:func:`stochpound.experiment._site.table_accelerations`);
+* the generation (``stochpound.experiment._site.table_accelerations``);
 * the old pool of them: a :class:`~stochpound.motions.records.Record` per
   motion and :func:`~stochpound.motions.selection_pool` (a
   :func:`~stochpound.motions.response_spectrum` per motion: its hashing and
   cache, the total acceleration's peaks too, an xarray dataset);
-* the new one, :func:`~stochpound.motions._selection.array_pool` (every
+* the new one, ``stochpound.motions._selection.array_pool`` (every
   motion's spectrum in one compiled call per batch, the displacement's
   peaks alone), checked equal to the old one bit for bit;
 * the pre-screen's stage: the conditioning measure alone
-  (:func:`~stochpound.motions._selection.pool_intensity`, one period).
+  (``stochpound.motions._selection.pool_intensity``, one period).
 
 Old and new alternate over ``--rounds`` rounds (best of them), so that the
 load of a shared machine falls on both. It rewrites the section "A pool of

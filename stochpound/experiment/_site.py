@@ -621,7 +621,7 @@ def simulated_pool(table: Mapping[str, float | str], periods: np.ndarray, measur
 
     The first chunk finds the window of the table's ``n`` motions (their default one, :func:`~stochpound.motions.site_motions`);
     the others are drawn with it given, each motion from its own generator alone: the same motions, bit for bit. Each chunk's
-    spectra come from one compiled call per batch (:func:`~stochpound.motions._selection.array_pool`). With ``screen`` (g; the
+    spectra come from one compiled call per batch (``stochpound.motions._selection.array_pool``). With ``screen`` (g; the
     pre-screen, :func:`screen_level`), a realization from :data:`SCREEN_BASE` on joins the pool only if its own conditioning
     measure reaches ``screen``: that measure is computed for every motion, the whole spectrum for those that join alone.
     """

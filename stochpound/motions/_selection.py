@@ -204,7 +204,7 @@ def array_pool(accelerations: np.ndarray, dt: float, names: Sequence[str], perio
                period: float | Sequence[float] | None = None, damping: float = 0.05, g: float = DEFAULT_G, *,
                intensity: np.ndarray | None = None, magnitude: float = np.nan, distance_km: float = np.nan, vs30: float = np.nan) -> xr.Dataset:
     """:func:`selection_pool` of motions of one step given as rows, every spectrum in one compiled call per batch
-    (:func:`~stochpound.motions._spectrum.pseudo_spectra`): the same dataset, bit for bit, as of the motions as records whose
+    (``stochpound.motions._spectrum.pseudo_spectra``): the same dataset, bit for bit, as of the motions as records whose
     metadata are ``magnitude``, ``distance_km`` and ``vs30`` and whose earthquake and recording are their names.
 
     Parameters
