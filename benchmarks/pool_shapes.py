@@ -28,10 +28,7 @@ def main(argv: list[str] | None = None) -> int:
     """Print the comparison (module docstring)."""
     from pygmm.baker_jayaram_2008 import calc_correls
 
-    from stochpound.experiment._site import table_accelerations
-    from stochpound.motions import Scenario
-    from stochpound.motions._conditional import scenario_spectrum
-    from stochpound.motions._spectrum import pseudo_spectra
+    from stochpound.motions import Scenario, pseudo_spectra, scenario_spectrum, site_motions
 
     parser = argparse.ArgumentParser(prog="python -m benchmarks.pool_shapes", description=__doc__.splitlines()[0])
     parser.add_argument("magnitude", type=float)
@@ -42,11 +39,11 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--beyond", type=float, default=2.0)
     a = parser.parse_args(argv)
     periods = np.array([*PERIODS, a.t_star])
-    table = {"type": "site_motions", "magnitude": a.magnitude, "distance_km": a.distance_km, "vs30": 400.0, "mechanism": a.mechanism,
-             "n": a.n, "seed": 1, "dt": 0.01, "model": "hazard_compatible", "calibration": ""}
-    ln_sa = np.vstack([np.log(pseudo_spectra(table_accelerations(table, range(start, min(a.n, start + CHUNK))), 0.01, periods) / 9.81)
-                       for start in range(0, a.n, CHUNK)])
-    mean, sigma = scenario_spectrum(periods, Scenario(a.magnitude, a.distance_km, 400.0, a.mechanism))
+    scenario = Scenario(a.magnitude, a.distance_km, 400.0, a.mechanism)
+    chunks = [site_motions(scenario=scenario, n=a.n, seed=1, realizations=list(range(start, min(a.n, start + CHUNK))))["acceleration"].values
+              for start in range(0, a.n, CHUNK)]
+    ln_sa = np.vstack([np.log(pseudo_spectra(chunk, 0.01, periods) / 9.81) for chunk in chunks])
+    mean, sigma = scenario_spectrum(periods, scenario)
     epsilon = (ln_sa - mean) / sigma
     star = epsilon[:, -1]
     high = star >= a.beyond

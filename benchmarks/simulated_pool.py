@@ -6,7 +6,7 @@ window) and that flagship's 21 selection periods (0.043–1.29 s, T* = 1 s),
 in one process on one core (``python -m benchmarks`` sets every thread pool
 to one), it times:
 
-* the generation (``stochpound.experiment._site.table_accelerations``);
+* the generation (:func:`~stochpound.motions.site_motions`, the flagship's realizations 256 at a time as its pool draws them);
 * the old pool of them: a :class:`~stochpound.motions.records.Record` per
   motion and :func:`~stochpound.motions.selection_pool` (a
   :func:`~stochpound.motions.response_spectrum` per motion: its hashing and
@@ -18,7 +18,8 @@ to one), it times:
   (``stochpound.motions._selection.pool_intensity``, one period).
 
 Old and new alternate over ``--rounds`` rounds (best of them), so that the
-load of a shared machine falls on both. It rewrites the section "A pool of
+load of a shared machine falls on both; every round's motions are new (no
+spectrum cached by ``response_spectrum``). It rewrites the section "A pool of
 simulated motions" of ``docs/benchmarks.md``.
 """
 
@@ -30,6 +31,8 @@ from pathlib import Path
 from typing import Any
 
 
+import numpy as np
+
 from benchmarks import report
 from benchmarks.sections import Section
 from benchmarks.timing import REPOSITORY
@@ -38,9 +41,8 @@ SECTION = Section("<!-- simulated pool: start -->", "<!-- simulated pool: end --
 """This benchmark's section of docs/benchmarks.md."""
 STARTUP = Section("<!-- simulated pool start-up: start -->", "<!-- simulated pool start-up: end -->")
 """The flagship's start-up before and after, measured by hand (benchmarks/flagship_selection.py --picks): kept by the suite."""
-TABLE = {"type": "site_motions", "magnitude": 8.0, "distance_km": 30.0, "vs30": 400.0, "mechanism": "reverse", "seed": 1, "dt": 0.01,
-         "model": "hazard_compatible", "calibration": ""}
-"""The fixed-pair flagship's fitted scenario (its table, ``n`` added)."""
+SCENARIO = {"magnitude": 8.0, "distance_km": 30.0, "vs30": 400.0, "mechanism": "reverse"}
+"""The fixed-pair flagship's fitted scenario (its motions: seed 1, dt = 0.01 s)."""
 STRUCTURE, CONDITIONING = [0.2141, 0.3099, 0.4300], 1.0
 """The flagship's structure periods (s) and T* (s)."""
 G = 9.81
@@ -48,26 +50,30 @@ G = 9.81
 
 def measure(n: int, rounds: int) -> dict[str, Any]:
     """Seconds per motion of each stage (best of ``rounds``), and whether old and new pools are identical."""
-    from stochpound.experiment._site import table_accelerations
-    from stochpound.motions import selection_periods, selection_pool
-    from stochpound.motions._selection import array_pool, pool_intensity
-    from stochpound.motions._spectrum import _PEAKS
+    from stochpound.motions import Scenario, array_pool, pool_intensity, selection_periods, selection_pool, site_motions
     from stochpound.motions.records import Record
 
     periods = selection_periods(STRUCTURE, [CONDITIONING])
-    table = {**TABLE, "n": n}
+    scenario = Scenario(SCENARIO["magnitude"], SCENARIO["distance_km"], SCENARIO["vs30"], SCENARIO["mechanism"])
     names = [str(i) for i in range(n)]
-    metadata = {"magnitude": table["magnitude"], "distance": table["distance_km"], "vs30": table["vs30"]}
+    metadata = {"magnitude": SCENARIO["magnitude"], "distance": SCENARIO["distance_km"], "vs30": SCENARIO["vs30"]}
     times: dict[str, list[float]] = {"generation": [], "old": [], "new": [], "screen": []}
-    accelerations = table_accelerations(table, range(min(n, 8)))  # compile and warm every kernel
+
+    window: list[float] = []  # the table's window, found by the first call and given to the others, as the pool does
+
+    def generate(rows: range) -> np.ndarray:  # a table of (rounds + 1) n motions: new motions every round, none cached
+        motions = site_motions(scenario=scenario, n=(rounds + 1) * n, seed=1, realizations=list(rows), duration=(window or [None])[0])
+        window[:] = [float(motions.time.values[-1])]
+        return motions["acceleration"].values
+
+    accelerations = generate(range(min(n, 8)))  # compile and warm every kernel
     array_pool(accelerations, 0.01, names[: len(accelerations)], periods, "psa", CONDITIONING, 0.05, G)
     selection_pool([Record("w", 0.01, accelerations[0], "m/s2")], periods, "psa", CONDITIONING, 0.05, G)
     identical = True
-    for _ in range(rounds):
+    for round_ in range(1, rounds + 1):
         began = time.perf_counter()
-        accelerations = table_accelerations(table, range(n))
+        accelerations = generate(range(round_ * n, (round_ + 1) * n))
         times["generation"].append(time.perf_counter() - began)
-        _PEAKS.clear()  # a pool's motions are new to the process
         began = time.perf_counter()
         records = [Record(name, 0.01, row, "m/s2", metadata={**metadata, "event": name}) for name, row in zip(names, accelerations)]
         old = selection_pool(records, periods, "psa", CONDITIONING, 0.05, G)

@@ -625,7 +625,7 @@ def simulated_pool(table: Mapping[str, float | str], periods: np.ndarray, measur
     pre-screen, :func:`screen_level`), a realization from :data:`SCREEN_BASE` on joins the pool only if its own conditioning
     measure reaches ``screen``: that measure is computed for every motion, the whole spectrum for those that join alone.
     """
-    from stochpound.motions._selection import array_pool, pool_intensity
+    from stochpound.motions import array_pool, pool_intensity
 
     n, dt = int(table["n"]), float(table["dt"])
     parts, duration = [], None

@@ -89,6 +89,8 @@ from stochpound.motions._conditional import (  # noqa: F401
 )
 from stochpound.motions._measure import KINDS as MEASURE_KINDS, Measure
 from stochpound.motions._scenario import MECHANISMS, given_scenario  # noqa: F401
+from stochpound.motions._selection import array_pool, pool_intensity  # noqa: F401  (the experiment's pool of simulated motions)
+from stochpound.motions._spectrum import pseudo_spectra  # noqa: F401
 from stochpound.motions._site_calibration import calibration_table, fit_calibration  # noqa: F401
 from stochpound.motions._site_motions import SITE_MOTION_LIMITS  # noqa: F401  (the analysis's measure-free risk clamps to it)
 
