@@ -115,3 +115,27 @@ def test_the_screened_pool_chooses_as_the_full_pool_where_its_choices_lie_beyond
     screened = select_motions(screened_pool, target, 6, 4.0, seed=3)
     assert screened["motion"].values.tolist() == full["motion"].values.tolist()
     np.testing.assert_array_equal(screened["scale_factor"].values, full["scale_factor"].values)
+
+
+def test_an_experiment_s_stripes_select_from_the_screened_pool(tmp_path, monkeypatch):
+    """An experiment of one scenario with more simulated motions than SCREEN_BASE (here 6 of 16): every stripe's pool is the records,
+    the first 6 motions and those of the 16 whose own ε reaches the top stripe's less SCREEN_MARGIN, counted independently."""
+    from stochpound.experiment._runner import load_experiment
+    from tests.helpers import SITE_SCENE, write_experiment
+
+    monkeypatch.setattr(_site, "SCREEN_BASE", 6)
+    monkeypatch.setattr(_site, "SCREEN_MARGIN", 0.5)
+    records = "".join(f'\n[[records]]\nrecord = "fema_p695_far_field/{i:02d}{c}"\nduration = 5.0\n' for i in (1, 2) for c in "ab")
+    intensity = ('[intensity]\nmeasure = "psa"\nperiod = 0.5\nlevels = [0.3, 0.1]\nselection = "conditional_spectrum"\nmotions = 4\n'
+                 'max_scale_factor = 5.0\nseed = 2\n')
+    site = '[site]\nvs30 = 400.0\nmagnitude = 7.0\ndistance_km = 20.0\nmechanism = "strike_slip"\nsimulated_motions = 16\n'
+    text = f'[experiment]\nname = "screen"\n{SITE_SCENE}\n[grid]\ngap = ["inf"]\n{records}\n{intensity}\n{site}\n[solver]\nmethod = "exact"\n'
+    selection = load_experiment(write_experiment(tmp_path, text, "screen.toml")).selection
+    scenario = Scenario(7.0, 20.0, 400.0, "strike_slip")
+    median, sigma = scenario_distribution("psa", 0.5, scenario=scenario)
+    top = max(float(target.attrs["epsilon"]) for target in selection.targets)
+    table = {**TABLE, "magnitude": 7.0, "n": 16, "seed": 2}
+    own = np.log(pool_intensity(_site.table_accelerations(table, range(16)), 0.01, "psa", 0.5, 0.05, G) / median) / sigma
+    kept = 6 + int(np.sum(own[6:] >= top - 0.5))
+    assert 6 < kept < 16  # the screen leaves some out and keeps some
+    assert all(chosen.attrs["pool"] == 4 + kept for chosen in selection.selections)
