@@ -247,6 +247,12 @@ def selection_words(store: xr.Dataset) -> str:
     )
 
 
+def parallel_words(settings: argparse.Namespace) -> str:
+    """How the comparisons ran, when ``--assemble`` put together several runs (in parallel: the time is the longest one's)."""
+    parts = getattr(settings, "parallel", 1)
+    return f" in all ({parts} runs in parallel, one a flagship file, put together by `--assemble`; the time is the longest run's)" if parts > 1 else ""
+
+
 def pool_words(simulated: int) -> str:
     """What the stripes' pool holds, in words."""
     if not simulated:
@@ -359,7 +365,7 @@ def section(comparisons: list[Comparison], settings: argparse.Namespace, info: d
         f"without a measure (`stochpound.analysis.store_measure_free`, seed 1, simulated motions of each rupture, "
         f"site-motion model {site_model_provenance()}), compared by `stochpound.analysis.compare_measures` (within ×{TOLERANCE:g} either way). "
         f"Commit {info['commit']}, {info['date']}, load {info['load average (1 min) at start']}, {settings.workers} worker "
-        f"process{'es' if settings.workers > 1 else ''}, {elapsed:.0f} s in all. "
+        f"process{'es' if settings.workers > 1 else ''}{parallel_words(settings)}, {elapsed:.0f} s in all. "
         "`python -m benchmarks.measure_comparison [--flagships ... --measures ... --seeds ... --motions N --runs N N --simulated N]` rewrites this section "
         "and its figure.",
         "",
@@ -415,6 +421,7 @@ def main(argv: list[str] | None = None) -> int:
         comparisons = [c for part in parts for c in part["comparisons"]]
         settings, info = parts[0]["settings"], parts[0]["info"]
         settings.workers, settings.figure = sum(part["settings"].workers for part in parts), arguments.figure
+        settings.parallel = len(parts)
         elapsed = max(part["elapsed"] for part in parts)  # in parallel: the longest part's wall-clock time
     else:
         settings, info, start = arguments, report.machine(), time.perf_counter()
