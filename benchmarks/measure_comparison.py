@@ -405,7 +405,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--measures", nargs="+", choices=list(MEASURES), help="only these of each configuration's candidate measures")
     parser.add_argument("--seeds", nargs="+", type=int, default=[1, 2], help="seeds of the selection")
     parser.add_argument("--motions", type=int, default=40, help="motions a stripe")
-    parser.add_argument("--runs", nargs=2, type=int, default=[700, 1500], metavar=("FIXED", "ISOLATED"), help="runs a configuration of the answer without a measure, for each flagship file")
+    parser.add_argument("--runs", nargs=2, type=int, default=[1400, 3000], metavar=("FIXED", "ISOLATED"), help="runs a configuration of the answer without a measure, for each flagship file")
     parser.add_argument("--simulated", type=int, default=0, metavar="N",
                         help="select from N simulated motions a stripe of the site's causal ruptures (allotted by the disaggregation) instead of the records")
     parser.add_argument("--workers", type=int, default=1, help="worker processes (the result does not depend on them)")
