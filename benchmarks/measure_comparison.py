@@ -30,6 +30,7 @@ of ``docs/benchmarks.md`` and its figure.
 from __future__ import annotations
 
 import argparse
+import pickle
 import tempfile
 import time
 from collections.abc import Collection
@@ -60,8 +61,10 @@ MEASURES = {
     "Sa_avg(0.5–4 s)": ("sa_avg", (0.5, 0.75, 1.0, 1.5, 2.0, 3.0, 4.0)),
 }
 """Candidate measures: stochpound's measure and period (s; Sa_avg's periods: the band the isolated building's closure follows)."""
-RETURN_PERIODS = (25.0, 72.0, 475.0, 2475.0, 10000.0)
-"""Return periods (yr) of the stripes."""
+RETURN_PERIODS = (25.0, 72.0, 224.0, 475.0, 975.0, 2475.0, 10000.0)
+"""Return periods (yr) of the stripes: two stripes beside the 475-yr one (224, 975 yr), where the rate at 10 % in 50 years is made."""
+EARLIER = (25.0, 72.0, 475.0, 2475.0, 10000.0)
+"""The stripes of the earlier design (yr): g* from the counts is also given on these alone, from the same stores."""
 TOLERANCE = 1.2
 """The issue's tolerance: a measure agrees when its g* is within this ratio of the measure-free one, either way."""
 
@@ -91,7 +94,7 @@ class Flagship:
 FLAGSHIPS = (
     Flagship("fixed", "fixed_pair.toml", 'gap = [inf]\nmu = { values = [inf], buildings = ["B1"] }', ("PGA", "PSA(0.3 s)", "PSA(1 s)")),
     Flagship(
-        "isolated", "isolated.toml", 'gap = [inf]\nmu = { values = [0.05], buildings = ["B1"] }\nneighbour = ["stiff"]\nmoat = ["none"]', ("PGA", "PSA(1 s)", "PSA(2 s)", "PSA(3 s)", "Sa_avg(0.5–4 s)")
+        "isolated", "isolated.toml", 'gap = [inf]\nmu = { values = [0.05], buildings = ["B1"] }\nneighbour = ["stiff"]\nmoat = ["none"]', ("PGA", "PSA(1 s)", "PSA(3 s)", "Sa_avg(0.5–4 s)", "PSA(2 s)")
     ),
 )
 """The fixed pair beside the stiff and the flexible neighbour (B1's T1 0.30 s); B1 isolated (μ 0.05, no wall, T_b 3.0 s) beside the stiff one."""
@@ -121,8 +124,9 @@ def experiment_text(flagship: Flagship, measure: str, seed: int, motions: int, s
 
 
 def conditioned(folder: Path, flagship: Flagship, measure: str, seed: int, motions: int, workers: int,
-                simulated: int = 0) -> tuple[xr.Dataset, xr.DataArray, xr.DataArray]:
-    """One measure and seed: its store, g* from the counts (the risk chain's) and from a lognormal demand per stripe."""
+                simulated: int = 0) -> tuple[xr.Dataset, xr.DataArray, xr.DataArray, xr.DataArray]:
+    """One measure and seed: its store, g* from the counts (the risk chain's), from a lognormal demand per stripe, and from the
+    counts on the stripes of the earlier design alone (``EARLIER``)."""
     from stochpound import open_store
     from stochpound.experiment import load_experiment, run_experiment
     from stochpound.risk import store_risk
@@ -135,7 +139,24 @@ def conditioned(folder: Path, flagship: Flagship, measure: str, seed: int, motio
         raise RuntimeError(f"{flagship.name}, {measure}, seed {seed}: the experiment did not complete")
     store = open_store(run.store).load()
     risk = store_risk(store, targets=(0.1, 0.02), bootstrap=0)
-    return store, risk.separation["separation"], lognormal_g_star(store, risk)
+    earlier = store.isel(intensity=[RETURN_PERIODS.index(t) for t in EARLIER])
+    return store, risk.separation["separation"], lognormal_g_star(store, risk), store_risk(earlier, targets=(0.1, 0.02), bootstrap=0).separation["separation"]
+
+
+def efficiency(store: xr.Dataset, flagship: Flagship, measure: str) -> xr.DataArray:
+    """β (ln closure on ln IM over every run of ``store``, :func:`stochpound.risk.measure_efficiency`) of ``measure``, the measure
+    the store's stripes are conditioned on, per configuration."""
+    from stochpound.risk import measure_efficiency
+
+    kind, period = MEASURES[measure]
+    periods = {"stripes": period} if kind == "psa" else {"one second": 1.0}
+    average = period if kind == "sa_avg" else None
+    result = measure_efficiency(store, periods, sa_avg_periods=average)
+    if kind == "psa":
+        name = f"PSA({period:.3g} s, stripes)"
+    else:
+        name = "PGA" if kind == "pga" else next(str(m) for m in result["measure"].values if str(m).startswith("Sa_avg"))
+    return result["beta"].sel(response="closure", measure=name, drop=True)
 
 
 @dataclass
@@ -146,6 +167,8 @@ class Comparison:
     counts: pd.DataFrame
     lognormal: pd.DataFrame
     free: object
+    earlier: pd.DataFrame
+    efficiency: dict[str, list[xr.DataArray]]
     sufficiency: dict
     untested: dict[str, str]
     selections: dict[str, str]
@@ -153,21 +176,30 @@ class Comparison:
 
 
 def compare(flagship: Flagship, measures: list[str], seeds: list[int], motions: int, runs: int, workers: int, simulated: int = 0,
-            log=print) -> Comparison:
-    """The comparisons (counts and lognormal demand) of one flagship file and its measure-free answer."""
+            log=print, stores: Path | None = None) -> Comparison:
+    """The comparisons (counts, lognormal demand, counts on the earlier stripes) of one flagship file, each measure's efficiency on
+    its stores, and the measure-free answer; ``stores``: a folder that keeps the stores (default: a temporary one)."""
     from stochpound.analysis import RuptureSite, compare_measures, store_measure_free, store_sufficiency
 
     started = time.perf_counter()
     counted: dict[str, list] = {m: [] for m in measures}
     lognormal: dict[str, list] = {m: [] for m in measures}
+    earlier: dict[str, list] = {m: [] for m in measures}
+    betas: dict[str, list] = {m: [] for m in measures}
     sufficiency, untested, selections = {}, {}, {}
-    with tempfile.TemporaryDirectory() as folder:
+    free = None
+    with tempfile.TemporaryDirectory() as temporary:
+        folder = Path(temporary) if stores is None else stores
+        folder.mkdir(parents=True, exist_ok=True)
         for name in measures:
             for seed in seeds:
-                store, by_counts, by_demand = conditioned(Path(folder), flagship, name, seed, motions, workers, simulated)
+                store, by_counts, by_demand, by_earlier = conditioned(folder, flagship, name, seed, motions, workers, simulated)
                 counted[name].append(by_counts)
                 lognormal[name].append(by_demand)
-                log(f"{flagship.name}, {name}, seed {seed}: g* {by_counts.values.ravel()} (counts), {by_demand.values.ravel()} (lognormal demand)")
+                earlier[name].append(by_earlier)
+                betas[name].append(efficiency(store, flagship, name))
+                log(f"{flagship.name}, {name}, seed {seed}: g* {by_counts.values.ravel()} (counts), {by_demand.values.ravel()} (lognormal demand), "
+                    f"{by_earlier.values.ravel()} (counts, earlier stripes); beta {betas[name][-1].values.ravel()}")
                 if seed == seeds[0]:
                     selections[name] = selection_words(store)
                     try:
@@ -177,14 +209,18 @@ def compare(flagship: Flagship, measures: list[str], seeds: list[int], motions: 
                         log(f"{name}, seed {seed}: sufficiency not tested: {error}")
                     else:
                         log(f"{name}, seed {seed}: {sufficiency[name].verdict()}")
-        free_started = time.perf_counter()
-        free = store_measure_free(store, RuptureSite.bundled(SITE), runs=runs, seed=1, workers=workers)
-        log(f"{flagship.name}, measure-free: g* {[r[0].level.values for r in free.results]} in {time.perf_counter() - free_started:.0f} s")
+                if free is None:  # first: the same for every store of the file (their configurations are the same)
+                    free_started = time.perf_counter()
+                    free = store_measure_free(store, RuptureSite.bundled(SITE), runs=runs, seed=1, workers=workers)
+                    log(f"{flagship.name}, measure-free: g* {[r[0].level.values for r in free.results]}, intervals "
+                        f"{[(r[0].level_lower.values, r[0].level_upper.values) for r in free.results]} in {time.perf_counter() - free_started:.0f} s")
     return Comparison(
         flagship,
         compare_measures(counted, free, tolerance=TOLERANCE, sufficiency=sufficiency),
         compare_measures(lognormal, free, tolerance=TOLERANCE, sufficiency=sufficiency),
         free,
+        compare_measures(earlier, free, tolerance=TOLERANCE, sufficiency=sufficiency),
+        betas,
         sufficiency,
         untested,
         selections,
@@ -211,6 +247,12 @@ def selection_words(store: xr.Dataset) -> str:
     )
 
 
+def parallel_words(settings: argparse.Namespace) -> str:
+    """How the comparisons ran, when ``--assemble`` put together several runs (in parallel: the time is the longest one's)."""
+    parts = getattr(settings, "parallel", 1)
+    return f" in all ({parts} runs in parallel, one a flagship file, put together by `--assemble`; the time is the longest run's)" if parts > 1 else ""
+
+
 def pool_words(simulated: int) -> str:
     """What the stripes' pool holds, in words."""
     if not simulated:
@@ -233,6 +275,27 @@ def table(comparison: pd.DataFrame, tested: Collection[str]) -> list[str]:
             f"×{row['seed spread']:.2f} | {row['measure-free']:.4f} ({row['lower']:.4f}–{row['upper']:.4f}) | {row['ratio']:.2f} | "
             f"{'yes' if row['agrees'] else '**no**'} | {trend} |"
         )
+    return lines
+
+
+def efficiency_words(seeds: list[int]) -> str:
+    """What the efficiency table holds, in words."""
+    return (f"Efficiency: β, the residual standard deviation of ln closure on ln IM over every run of the measure's own store "
+            f"(`stochpound.risk.measure_efficiency`; one a selection seed, {', '.join(map(str, seeds))}), the least mean β in bold:")
+
+
+def efficiency_table(comparisons: list[Comparison]) -> list[str]:
+    """Each configuration's β of each of its measures (on the measure's own stores, one a seed), the least mean in bold."""
+    lines = ["| configuration | measure | β by seed | mean β |", "|---|---|---:|---:|"]
+    for comparison in comparisons:
+        labels = dict.fromkeys(comparison.counts.index.get_level_values(0))  # the configurations in compare_measures' words and order
+        for label, configuration in zip(labels, comparison.free.configurations):
+            where = {dim: value for dim, value in configuration}
+            values = {m: [float(b.sel(where)) for b in betas] for m, betas in comparison.efficiency.items()}
+            best = min(values, key=lambda m: np.mean(values[m]))
+            for measure_name, beta in values.items():
+                mean = f"**{np.mean(beta):.3f}**" if measure_name == best else f"{np.mean(beta):.3f}"
+                lines.append(f"| {label} | {measure_name} | {' / '.join(f'{b:.3f}' for b in beta)} | {mean} |")
     return lines
 
 
@@ -302,7 +365,7 @@ def section(comparisons: list[Comparison], settings: argparse.Namespace, info: d
         f"without a measure (`stochpound.analysis.store_measure_free`, seed 1, simulated motions of each rupture, "
         f"site-motion model {site_model_provenance()}), compared by `stochpound.analysis.compare_measures` (within ×{TOLERANCE:g} either way). "
         f"Commit {info['commit']}, {info['date']}, load {info['load average (1 min) at start']}, {settings.workers} worker "
-        f"process{'es' if settings.workers > 1 else ''}, {elapsed:.0f} s in all. "
+        f"process{'es' if settings.workers > 1 else ''}{parallel_words(settings)}, {elapsed:.0f} s in all. "
         "`python -m benchmarks.measure_comparison [--flagships ... --measures ... --seeds ... --motions N --runs N N --simulated N]` rewrites this section "
         "and its figure.",
         "",
@@ -323,7 +386,10 @@ def section(comparisons: list[Comparison], settings: argparse.Namespace, info: d
             )
         for measure_name, reason in comparison.untested.items():
             lines.append(f"- Sufficiency of {measure_name} for the closure: not tested ({reason}).")
-    for attribute, words in (("counts", "the counts (the risk chain, `store_risk`)"), ("lognormal", "a lognormal demand per stripe (`stripe_demand_rate`)")):
+    lines += ["", efficiency_words(settings.seeds), "", *efficiency_table(comparisons)]
+    earlier = f"the counts on the {len(EARLIER)} stripes of the earlier design alone ({', '.join(f'{t:g}' for t in EARLIER)} yr; the same stores)"
+    for attribute, words in (("counts", "the counts (the risk chain, `store_risk`)"), ("lognormal", "a lognormal demand per stripe (`stripe_demand_rate`)"),
+                             ("earlier", earlier)):
         lines += ["", f"g* from {words}:", ""]
         for comparison in comparisons:
             rows = table(getattr(comparison, attribute), comparison.sufficiency)
@@ -339,22 +405,37 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--measures", nargs="+", choices=list(MEASURES), help="only these of each configuration's candidate measures")
     parser.add_argument("--seeds", nargs="+", type=int, default=[1, 2], help="seeds of the selection")
     parser.add_argument("--motions", type=int, default=40, help="motions a stripe")
-    parser.add_argument("--runs", nargs=2, type=int, default=[700, 1500], metavar=("FIXED", "ISOLATED"), help="runs a configuration of the answer without a measure, for each flagship file")
+    parser.add_argument("--runs", nargs=2, type=int, default=[1400, 3000], metavar=("FIXED", "ISOLATED"), help="runs a configuration of the answer without a measure, for each flagship file")
     parser.add_argument("--simulated", type=int, default=0, metavar="N",
                         help="select from N simulated motions a stripe of the site's causal ruptures (allotted by the disaggregation) instead of the records")
     parser.add_argument("--workers", type=int, default=1, help="worker processes (the result does not depend on them)")
     parser.add_argument("--out", type=Path, default=REPOSITORY / "docs" / "benchmarks.md")
     parser.add_argument("--figure", type=Path, default=FIGURE)
+    parser.add_argument("--stores", type=Path, help="keep the stores in this folder (default: a temporary one, removed)")
+    parser.add_argument("--save", type=Path, help="also pickle the comparisons to this file (for --assemble)")
+    parser.add_argument("--assemble", type=Path, nargs="+", metavar="SAVED",
+                        help="run nothing: write the section and figure from the comparisons --save pickled (e.g. one file a flagship, run in parallel)")
     arguments = parser.parse_args(argv)
-    info = report.machine()
-    start = time.perf_counter()
-    comparisons = []
-    for flagship, runs in zip(FLAGSHIPS, arguments.runs):
-        if flagship.name in arguments.flagships:
-            measures = [m for m in flagship.measures if arguments.measures is None or m in arguments.measures]
-            comparisons.append(compare(flagship, measures, arguments.seeds, arguments.motions, runs, arguments.workers, arguments.simulated))
+    if arguments.assemble:
+        parts = [pickle.loads(path.read_bytes()) for path in arguments.assemble]
+        comparisons = [c for part in parts for c in part["comparisons"]]
+        settings, info = parts[0]["settings"], parts[0]["info"]
+        settings.workers, settings.figure = sum(part["settings"].workers for part in parts), arguments.figure
+        settings.parallel = len(parts)
+        elapsed = max(part["elapsed"] for part in parts)  # in parallel: the longest part's wall-clock time
+    else:
+        settings, info, start = arguments, report.machine(), time.perf_counter()
+        comparisons = []
+        for flagship, runs in zip(FLAGSHIPS, arguments.runs):
+            if flagship.name in arguments.flagships:
+                measures = [m for m in flagship.measures if arguments.measures is None or m in arguments.measures]
+                comparisons.append(compare(flagship, measures, arguments.seeds, arguments.motions, runs, arguments.workers, arguments.simulated,
+                                           stores=arguments.stores))
+        elapsed = time.perf_counter() - start
+        if arguments.save:
+            arguments.save.write_bytes(pickle.dumps({"comparisons": comparisons, "settings": arguments, "info": info, "elapsed": elapsed}))
     figure(comparisons, arguments.figure)
-    SECTION.write(arguments.out, section(comparisons, arguments, info, time.perf_counter() - start))
+    SECTION.write(arguments.out, section(comparisons, settings, info, elapsed))
     print(f"wrote the section 'Each measure against the answer without a measure' of {arguments.out} and {arguments.figure}")
     return 0
 

@@ -42,11 +42,18 @@ def test_a_reduced_run_writes_the_section_and_its_figure(tmp_path):
     out, figure = tmp_path / "benchmarks.md", tmp_path / "figure.png"
     out.write_text("# Benchmarks\n")
     arguments = ["--flagships", "isolated", "--measures", "PGA", "--seeds", "1", "--motions", "3", "--runs", "28", "28"]
-    assert measure_comparison.main([*arguments, "--out", str(out), "--figure", str(figure)]) == 0
+    saved = tmp_path / "isolated.pkl"
+    assert measure_comparison.main([*arguments, "--out", str(out), "--figure", str(figure), "--save", str(saved)]) == 0
+    again = tmp_path / "again.md"
+    again.write_text("# Benchmarks\n")
+    assert measure_comparison.main(["--assemble", str(saved), "--out", str(again), "--figure", str(tmp_path / "again" / "figure.png")]) == 0
+    assert again.read_text() == out.read_text()  # the section assembled from the saved comparisons is the run's own
     section = measure_comparison.SECTION.kept(out.read_text())
     rows = [line for line in section.splitlines() if line.startswith("| ") and "in 50 yr | PGA |" in line]
-    assert len(rows) == 2 * 2  # two targets, g* from the counts and from the lognormal demand
+    assert len(rows) == 2 * 3  # two targets; g* from the counts, from the lognormal demand, from the counts on the earlier stripes
     assert all(row.startswith("| neighbour stiff, moat none, mu 0.05 |") for row in rows)
+    efficiency = [line for line in section.splitlines() if line.startswith("| neighbour stiff, moat none, mu 0.05 | PGA | ")]
+    assert len(efficiency) == 1 and float(efficiency[0].split("|")[3]) > 0  # β on the measure's own store, the only measure in bold
     assert "3–3 motions a stripe" in section and figure.stat().st_size > 0
 
 

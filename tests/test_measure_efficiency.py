@@ -60,6 +60,22 @@ def test_stripes_of_a_homogeneous_scene_give_the_conditioning_measure_a_zero_spr
     assert float(result["slope"].sel(response="closure", measure=name)) == pytest.approx(1.0, rel=1e-9)
 
 
+def test_sa_avg_over_given_periods_is_the_regression_on_the_geometric_mean_of_those_psa(fixed_stores) -> None:
+    """``sa_avg_periods``: the Sa_avg candidate over the given (stored) periods, β from the runs' geometric mean of PSA times the scale."""
+    stripes = open_store(fixed_stores[0]).load()
+    stored = stripes["spectrum_period"].values[[8, 12, 16]]
+    result = measure_efficiency(stripes, {"one second": 1.0}, sa_avg_periods=stored)
+    free = stripes.sel(gap=np.inf).isel(realization=0)
+    mean = np.exp(np.log(free["motion_psa"].isel(spectrum_period=[8, 12, 16])).mean("spectrum_period"))
+    im, closure = xr.broadcast(mean * free["scale_factor"], free["peak_contact_closure"].max("contact"))
+    beta, slope = _direct_beta(im.values.ravel(), closure.values.ravel())
+    name = f"Sa_avg({stored[0]:.3g}-{stored[-1]:.3g} s)"
+    assert float(result["beta"].sel(response="closure", measure=name)) == pytest.approx(beta, rel=1e-9)
+    assert float(result["slope"].sel(response="closure", measure=name)) == pytest.approx(slope, rel=1e-9)
+    with pytest.raises(ValueError, match="^sa_avg_periods: must be two or more periods > 0 s"):
+        measure_efficiency(stripes, {"one second": 1.0}, sa_avg_periods=[1.0])
+
+
 def test_risk_cli_names_the_most_efficient_measure_the_sites_hazard_has(fixed_stores) -> None:
     from click.testing import CliRunner
 

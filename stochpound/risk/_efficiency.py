@@ -28,7 +28,7 @@ cent between the stored periods, and β by about as much.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 
 import numpy as np
 import xarray as xr
@@ -41,7 +41,7 @@ SA_AVG_PERIODS = 10
 
 
 def measure_efficiency(store: xr.Dataset, periods: Mapping[str, float], structure: Mapping[str, float] | None = None,
-                       studied: str | None = None) -> xr.Dataset:
+                       studied: str | None = None, sa_avg_periods: Sequence[float] | None = None) -> xr.Dataset:
     """Efficiency (β) and sufficiency (residual trends) of candidate measures, per configuration (module docstring).
 
     Parameters
@@ -54,6 +54,9 @@ def measure_efficiency(store: xr.Dataset, periods: Mapping[str, float], structur
         The structure's periods (s) over which Sa_avg is taken; default ``periods``.
     studied : str, optional
         The building whose peak base displacement is the second response (where it slides).
+    sa_avg_periods : sequence of float, optional
+        The periods (s) of the Sa_avg candidate (e.g. a store's own Sa_avg band); default 10 log-spaced over 0.2 T_min – 3 T_max
+        of ``structure``, within the stored spectrum's periods.
 
     Returns
     -------
@@ -66,9 +69,9 @@ def measure_efficiency(store: xr.Dataset, periods: Mapping[str, float], structur
     """
     runs = efficiency_runs(store, studied)
     scale, spectrum_periods, psa = runs.scale_factor, runs.spectrum_periods, runs.psa
-    structural = np.array(list((structure or periods).values()), dtype=float)
-    low, high = max(0.2 * structural.min(), spectrum_periods[0]), min(3.0 * structural.max(), spectrum_periods[-1])
-    average = np.geomspace(low, high, SA_AVG_PERIODS)
+    average = _average_periods(structure or periods, spectrum_periods) if sa_avg_periods is None else np.asarray(sa_avg_periods, dtype=float)
+    if average.ndim != 1 or average.size < 2 or not np.all(average > 0):
+        raise ValueError(f"sa_avg_periods: must be two or more periods > 0 s, got {sa_avg_periods!r}")
     candidates = {Measure("pga").label: runs.pga, Measure("pgv").label: runs.pgv}
     measure_periods = [np.nan, np.nan]
     for name, period in periods.items():
@@ -88,6 +91,13 @@ def measure_efficiency(store: xr.Dataset, periods: Mapping[str, float], structur
             for response, value in runs.responses.items()}
     result = xr.concat(list(fits.values()), "response").assign_coords(response=list(fits), measure=list(candidates))
     return result.assign_coords(measure_period=("measure", np.array(measure_periods)))
+
+
+def _average_periods(structure: Mapping[str, float], spectrum_periods: np.ndarray) -> np.ndarray:
+    """The default periods (s) of Sa_avg: ``SA_AVG_PERIODS`` log-spaced over 0.2 T_min – 3 T_max, within the stored spectrum's periods."""
+    structural = np.array(list(structure.values()), dtype=float)
+    low, high = max(0.2 * structural.min(), spectrum_periods[0]), min(3.0 * structural.max(), spectrum_periods[-1])
+    return np.geomspace(low, high, SA_AVG_PERIODS)
 
 
 def candidate_name(period: float | None, name: str) -> str:
