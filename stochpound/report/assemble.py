@@ -246,6 +246,12 @@ def _about(stores: dict[str, xr.Dataset], sections: list[Section]) -> str:
         parts.append("A separation or moat-clearance section answers the gap question from the contact-free (or wall-free) runs.")
     if "intensity" in kinds:
         parts.append("An Intensity section describes the motions' intensity measures, the stripes and their scale factors.")
+    rare = sum(1 for section in sections if section.key.startswith("rare-"))
+    if rare:
+        parts.append(f"{'A Rare events section gives' if rare == 1 else f'{rare} Rare events sections each give'} one "
+                     "subset simulation's exceedance curve per event, down to its target probability, with its 95 % interval and the "
+                     "response (for a closure, the separation) exceeded with 10⁻³, 10⁻⁴ and 10⁻⁶ per event; beside the stochastic "
+                     "experiment of which it is a cell, the curve is checked against that cell's crude Monte Carlo at the grid's gaps.")
     parts.append("The Methods section describes every building, contact and motion from the stores' own definitions and checks "
                  "the solver while the report is built; the build stops if a check fails.")
     return " ".join(parts)
