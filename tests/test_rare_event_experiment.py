@@ -360,7 +360,7 @@ def test_a_rare_event_store_is_checked_against_its_cell_of_a_grid(tmp_path):
         check = crude_check(open_rare_event_store(tmp_path / "cell.nc"), grid)
         closure = grid.pound.contact_free()["peak_contact_closure"].sel(neighbour="flexible", mu=0.05, record="high").max("contact").values
         others = grid.pound.contact_free()["peak_contact_closure"].sel(neighbour="stiff", mu=0.05, record="high").max("contact").values
-        assert check.attrs["cell"] == "neighbour = flexible, mu = 0.05" and check.attrs["record"] == "high"
+        assert check.attrs["cell"] == "neighbour flexible, μ 0.05" and check.attrs["record"] == "high"
         assert list(check["gap"].values) == [0.01, 0.03] and list(check["realizations"].values) == [30, 30]
         assert list(check["crude"].values) == [np.mean(closure >= 0.01), np.mean(closure >= 0.03)]
         assert np.mean(others >= 0.01) != np.mean(closure >= 0.01)  # the cells differ: the check took the right one
@@ -370,7 +370,7 @@ def test_a_rare_event_store_is_checked_against_its_cell_of_a_grid(tmp_path):
     report = assemble_report([tmp_path / "grid.nc", tmp_path / "cell.nc"])
     section = next(s for s in report.sections if s.key == "rare-cell_rare")
     table = next(b for b in section.blocks if isinstance(b, Table) and b.key == "rare-cell_rare-crude")
-    assert "ensemble high in its cell neighbour = flexible, mu = 0.05" in table.caption
+    assert "ensemble high in its cell neighbour flexible, μ 0.05" in table.caption
     assert list(table.frame["crude Monte Carlo"].values) == list(check["crude"].values)
     assert "largest closure of any contact" in section.blocks[0].text
     with pytest.raises(ExperimentError, match="none of its contact-free cells has the scene of none_rare"):

@@ -22,7 +22,7 @@ from stochpound.experiment._rare_event_store import store_levels, stored_rare_ev
 from stochpound.experiment._rare_event_table import CLOSURES, RareEventDefinition
 from stochpound.model.scene_file import scene_from_dict
 from stochpound.model.scene_tables import SceneEntry
-from stochpound.store import CASE, Provenance, TomlTable, contact_free, contact_gap_dims, has_contact_free, with_motion, with_open_gaps
+from stochpound.store import CASE, Provenance, TomlTable, contact_free, contact_gap_dims, has_contact_free, is_fixed_base, with_motion, with_open_gaps
 
 _NOT_THE_MOTION = ("count", "seed", "start", "realization", "interpolation")
 """A synthetic ensemble's fields that name its realizations, not its motion."""
@@ -51,7 +51,7 @@ def crude_check(rare: xr.Dataset, store: xr.Dataset) -> xr.Dataset | None:
         Over ``gap`` (m, the store's finite gaps): ``crude``, ``crude_lower``, ``crude_upper`` (the fraction of
         the cell's contact-free runs whose closure reaches the gap, with its 95 % Clopper–Pearson interval),
         ``realizations``; ``subset`` and ``subset_cov`` (the rare-event curve there); attrs ``experiment``,
-        ``record`` (the ensemble's label) and ``cell`` (the cell's labels, ``neighbour = stiff, mu = 0.05``; empty
+        ``record`` (the ensemble's label) and ``cell`` (the cell's labels, ``neighbour stiff, μ 0.05``, ``μ fixed``; empty
         without other axes). None when there is nothing to check: the rare event is not a closure, or the store
         has no contact-free cases.
 
@@ -92,7 +92,7 @@ def crude_check(rare: xr.Dataset, store: xr.Dataset) -> xr.Dataset | None:
         {"crude": ("gap", crude["probability"].values), "crude_lower": ("gap", crude["lower"].values), "crude_upper": ("gap", crude["upper"].values),
          "realizations": ("gap", np.broadcast_to(crude["realizations"].values, gaps.shape)), "subset": ("gap", probability), "subset_cov": ("gap", cov)},
         coords={"gap": ("gap", gaps, {"units": "m"})},
-        attrs={"experiment": experiment, "record": labels[0], "cell": ", ".join(f"{dim} = {_label(value)}" for dim, value in cell.items())},
+        attrs={"experiment": experiment, "record": labels[0], "cell": ", ".join(_cell_label(dim, value) for dim, value in cell.items())},
     )
 
 
@@ -121,6 +121,13 @@ def _describe(definition: RareEventDefinition) -> str:
     """The rare-event experiment's motion in words: ``white_noise (S0 = 0.02, duration = 2, dt = 0.02)``."""
     motion = definition.motion
     return f"{motion['type']} ({', '.join(f'{key} = {_label(value)}' for key, value in motion.items() if key != 'type')})"
+
+
+def _cell_label(dim: str, value: float | str) -> str:
+    """``neighbour stiff``, ``μ 0.05``, ``μ fixed`` (μ = inf)."""
+    if dim == "mu":
+        return f"μ {'fixed' if is_fixed_base(value) else _label(value)}"
+    return f"{dim} {_label(value)}"
 
 
 def _label(value: Any) -> str:

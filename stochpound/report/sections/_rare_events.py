@@ -28,7 +28,7 @@ def rare_event_section(name: str, results: RareEventResults, crude: xr.Dataset |
     section.add(Table(f"rare-{name}-separation", _table_caption(closure, units), _frame(results, closure, units),
                       note="Per event: per motion of the ensemble. The interval is the response at which the estimated curve crosses "
                            "p·exp(±1.96 δ), δ the estimate's coefficient of variation at p (from the levels' genealogy, which counts the correlation between levels); "
-                           "a probability below the run's reach has no value.",
+                           "a value, or an interval's end, below the run's reach is left blank.",
                       formats={"probability per event": "{:.0e}", "coefficient of variation": "{:.2f}", "runs (n)": "{:.0f}"}))
     if crude is not None:
         section.add(Table(f"rare-{name}-crude", f"The probability of pounding per event at the gaps of experiment {crude.attrs['experiment']}: "
@@ -57,7 +57,8 @@ def _conditions(results: RareEventResults) -> str:
     state = "reached" if results.target_reached else ("not reached: the run is incomplete (rerun it)" if not results.complete
                                                        else f"not reached: it stopped after max_levels = {table.max_levels}")
     chains = {"mma": "component-wise modified Metropolis", "acs": "adaptive conditional sampling, Papaioannou et al. 2015"}[table.proposal]
-    return (f"One subset simulation (Au & Beck 2001; {chains}) of {what}, under a {motion.get('type', 'kanai_tajimi')} "
+    described = f"{results.definition.description.rstrip('.')}. " if results.definition.description else ""
+    return (f"{described}One subset simulation (Au & Beck 2001; {chains}) of {what}, under a {motion.get('type', 'kanai_tajimi')} "
             f"ground motion ({parameters}), its randomness a vector of standard normals. N = {table.samples_per_level} samples a level, "
             f"p0 = {table.p0}, seed {table.seed}: {results.levels} levels and n = {results.runs} runs in all, down to the target "
             f"probability {table.target_probability:g} per event ({state}).")
@@ -68,7 +69,8 @@ def _cell(crude: xr.Dataset) -> str:
 
 
 def _text(value: Any) -> str:
-    return f"{value:g}" if isinstance(value, float) else str(value)
+    """A motion field as its experiment file writes it: ``15``, ``true``, ``jennings``."""
+    return f"{value:g}" if isinstance(value, float) else str(value).lower() if isinstance(value, bool) else str(value)
 
 
 def _caption(results: RareEventResults, closure: bool, units: str, crude: xr.Dataset | None) -> str:
