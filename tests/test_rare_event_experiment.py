@@ -425,3 +425,14 @@ damping_ratio = 0.05
     path.write_text(text)
     table = load_rare_event(path).table
     assert (table.building, table.floor) == ("B1", 2)
+
+
+def test_max_closure_is_the_largest_of_the_contacts_closures(tmp_path):
+    """``response = "max_closure"`` samples, run by run, the larger of the two contacts' closures of the contact-free pair; it takes no contact."""
+    from stochpound.experiment import rare_event_sampler
+
+    closures = [rare_event_sampler(load_rare_event(_file(tmp_path, **{"contact = 1": f"contact = {c}"}))).start(range(4))[1] for c in (0, 1)]
+    largest = rare_event_sampler(load_rare_event(_file(tmp_path, **{'response = "closure"\ncontact = 1': 'response = "max_closure"'}))).start(range(4))[1]
+    assert np.array_equal(largest, np.maximum(*closures)) and not np.array_equal(closures[0], closures[1])
+    with pytest.raises(ExperimentError, match="rare_event.contact: not used by response = 'max_closure'"):
+        load_rare_event(_file(tmp_path, **{'response = "closure"': 'response = "max_closure"'}))
