@@ -6,19 +6,20 @@ import copy
 import hashlib
 import math
 import tomllib
+import warnings
 from pathlib import Path
 
 import numpy as np
 import pytest
 import xarray as xr
 
-from stochpound.experiment import Experiment
+from stochpound.experiment import Experiment, is_rare_event_file, load_rare_event
 from stochpound.store import Definition, FIXED_BASE, canonical_json, definition_sha256, is_fixed_base, is_gap_axis, read_definition
 from stochpound.experiment._spec import ExperimentError, load_definition, parse_experiment
 from stochpound.report.sections._facets import value_text
 
 ROOT = Path(__file__).resolve().parents[1]
-EXPERIMENTS = sorted(p for p in (ROOT / "experiments").glob("**/*.toml") if "scenes" not in p.parts)
+EXPERIMENTS = sorted(p for p in (ROOT / "experiments").glob("**/*.toml") if "scenes" not in p.parts and not is_rare_event_file(p))  # rare-event files: their own definition
 
 #: sha256 of an experiment file's bytes -> sha256 of its canonical definition's JSON, as the code gave before the
 #: typed definition: the canonical serialisation, and (without a hazard) the identity. A change of the code that
@@ -39,6 +40,7 @@ IDENTITIES = {
     "0891f60b747a8f36d97e968b18eca6f258bb1e9f6782da805f763b739f5ba482": "17ac371fe5e1bedc1ee453a2548339086beffba24ce2aaf729d893eb2a9513a5",
     "bd9b53093d44e3e4acc85e308510add994bdf7abef03df62e1f2f88028935856": "4baf14717bf47188d5761c7a878b1636513e2d3c3992b75e15e25c72041021ae",  # experiments/laws/contact_laws.toml
     "b0bc24556ed7b2bb62f13e80740d38c648825a8938a77b173d1000f51d65c729": "6a1f389f07a4ddb74a22fbafd5d9eaf12cfb7b010b75506e2a1437e07f1be195",  # experiments/stochastic/pounding.toml (new header)
+    "95b4b472aa9b47e6d561ff939c2384a4662162f7d5fdd8e2d522815203c77ee4": "6a1f389f07a4ddb74a22fbafd5d9eaf12cfb7b010b75506e2a1437e07f1be195",  # experiments/stochastic/pounding.toml (rare cells)
     "d56473cac48340cc68606154cbb115fb794049dc6fb3d77ff1821a7066fcd85a": "8a6ef71bb071e15ec33cd31b3563f219aae44fcad9ced8bf7d78fa71bc127cea",  # experiments/stochastic/scenario_m7_20km.toml
     "086c94dc09671a62f1bfe289e8a0ee7bf0f9ccde3895b7a6d4145f49089990eb": "8a6ef71bb071e15ec33cd31b3563f219aae44fcad9ced8bf7d78fa71bc127cea",  # experiments/stochastic/scenario_m7_20km.toml (re-timed)
     "30f757d6a000b675d5a77664f7ebaac77f5f8fe2bdaaa81c5a883ef996a93fda": "8587d2f9de1b97fd57b3799a668aa67bd90c2019b1ba238e1c664b982fc3c61a",  # experiments/risk/fixed_pair.toml
@@ -74,6 +76,40 @@ HAZARD_IDENTITIES = {
     "76706a47b9ed8d9b9c00281719f78adbbf7cc7ecaa91ed77f8fc343f9cafa29d": "f30423076bf791f10e274b0f0743bda704505337bda66785bf6631aedaf67b47",  # experiments/risk/fixed_pair.toml (calibration 3)
     "a9c66c0e67c4e663ca9e1a34a5de92a19ee03c1d8baacb45bb4cf61b70167667": "1190d4e22c8eaa71ec0e300d71dc4c348397c36780196be326b7c93f305de0ae",  # experiments/risk/isolated.toml (calibration 3)
 }
+
+
+#: The rare-event experiment files (a ``[rare_event]`` table): sha256 of the file's bytes -> their definition's sha256
+#: (:class:`~stochpound.experiment.RareEventDefinition`, the identity their stores record).
+RARE_EVENT_IDENTITIES = {
+    "334009d34229ca1b82aaa3f0a305732695a9825a3ab9c83693f8fc146bd94a0f": "7f099bad648c8be51dff8c93cd91511952c3b70fab51908379d1e6bdda6087d1",  # experiments/stochastic/rare/firm_flexible_fixed.toml
+    "a86a694832d378aa619dca8fca259c28e8bf762e4b6d3c7d017da55ac3279763": "4f0d02cf7b53c7bc373823d949c0e94866a0b2f09b887f6c4324caca42af8388",  # experiments/stochastic/rare/firm_flexible_mu005.toml
+    "ec378e3a494c6e31fcb09f65d669d44b4487eb3d382c7d0aeb16942d0ca2e349": "64cc94e1c5753de5845e965f83b0510842d334ca54f07eae1f1c5125491b2328",  # experiments/stochastic/rare/firm_flexible_mu008.toml
+    "efc4757c4e09f0f4a9ed01b284724b523407af788d905a0a33cdd22cbad0cdd0": "65aafdd9f39b7c25fdc848ee568cdf50ca2c09c74103ba9d24387e23c2c0d222",  # experiments/stochastic/rare/firm_flexible_mu012.toml
+    "f827f75d6f9c342da053eb337ec10ef53797b000eaf498c2c9a26df8cea61cd1": "8a29ea79ec11695a16cbd9e7f524753993dd051e151074247099baf7dde8d137",  # experiments/stochastic/rare/firm_stiff_fixed.toml
+    "7984e14ce289a3a3847d1dbdbb67952f6e3f467439cec6e12464d4ff30db1193": "fcbaf4d859ec89740f7539a9c875a54cbd52945098b7a02a6eb98f7c36178017",  # experiments/stochastic/rare/firm_stiff_mu005.toml
+    "557bf1e1a19f811a5ee9c0f743ad498ec0de4793adb35be96d97cf8e39a4b890": "31c4b1d966ccb5ae126993b23f86a87874f0a5bf20cd60ed7de0b4e083bdb8c9",  # experiments/stochastic/rare/firm_stiff_mu008.toml
+    "2b836ff1eb087e3d41b69383eb09fbc379a6379f11bb965681357e9c468900b5": "57bddcfdffe879ac7eaf64759169075be2339bd7ab1239d9e4bb2df4f07da718",  # experiments/stochastic/rare/firm_stiff_mu012.toml
+    "0ded8ea9da1b4128460d61a7bc178e567073b5a30c4b81416e12a4d82ed3721c": "64dbaa227e73326e05a829c6fd9e1d343b1b25e235acb18f8e7b0648a2679df7",  # experiments/stochastic/rare/soft_flexible_fixed.toml
+    "7586570de6e7230ccd8dfb0e344e1edc3c26a01b3f3bbbcd2bf75b77185750ec": "9aadc08581fbb338a364210f31d43368c6d27c2aaec4780f8763004dee2c71ba",  # experiments/stochastic/rare/soft_flexible_mu005.toml
+    "04ea4103b1e039ddef7c7b19044c576fe00331629b737b27a1430aba78196264": "988400fa200a1b15a1f4d2c85f1b6532a5060080b6e603da850ca6590d5771fb",  # experiments/stochastic/rare/soft_flexible_mu008.toml
+    "d9467476630486f3c8ec21df6bd33fdfb6398ec762120e1d55d3e5ca9528d423": "85fa29fa45fdd70284e2634f66793170a7bc4f5530a978806dc0cccbbf4e9d53",  # experiments/stochastic/rare/soft_flexible_mu012.toml
+    "d924d0961906bca7993f58cdbc7a633d6146da86d71ffb941fb9fb58a238c673": "e279406d023ede9fddbbe3cd204c135e983b49af70802fe370fde01fcd784019",  # experiments/stochastic/rare/soft_stiff_fixed.toml
+    "22743ad50abaf01736c04c9d31dfd4abe6d5f51018357eb6d072c03c1325b3ed": "f8a71ad9c2ca0a02732fdcce1cfe51cda8696d905771bc2fddbf66ad5e33986b",  # experiments/stochastic/rare/soft_stiff_mu005.toml
+    "eed017de96ea0db6bf3000985a3a025807d94a17ad7718c25e920e11785557e0": "29f41853be0ba7e1c39d1dc1734f01cf353e0163e089a0ef907a0b84f396855b",  # experiments/stochastic/rare/soft_stiff_mu008.toml
+    "423bf5b07ae21aa45fd555446d4f1e17d2f6be3512d71c37cb19191a86031742": "97a3398103e84619d2a851e1e2e4675b98b3db67e3b12a919148fc9f5ce903f2",  # experiments/stochastic/rare/soft_stiff_mu012.toml
+}
+RARE_EVENT_FILES = sorted(p for p in (ROOT / "experiments").glob("**/*.toml") if "scenes" not in p.parts and is_rare_event_file(p))
+
+
+def test_rare_event_files_keep_their_identity() -> None:
+    """Every rare-event experiment file is pinned, and gives the definition (sha256) of its pin."""
+    assert RARE_EVENT_FILES, "the rare-event files of experiments/stochastic/rare/"
+    for path in RARE_EVENT_FILES:
+        file_sha256 = hashlib.sha256(path.read_bytes()).hexdigest()
+        assert file_sha256 in RARE_EVENT_IDENTITIES, f"{path}: pin its version in RARE_EVENT_IDENTITIES ({file_sha256})"
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # proposal = "acs" warns that it is not certified on peaks over time
+            assert load_rare_event(path).sha256 == RARE_EVENT_IDENTITIES[file_sha256], path
 
 
 def test_experiment_files_keep_their_identity() -> None:

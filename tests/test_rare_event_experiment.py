@@ -61,7 +61,7 @@ def _file(folder: Path, samples: int = 20, **edits: str) -> Path:
     ("p0 = 0.1", "p0 = 0.7", r"rare_event.p0: must be <= 0.5, got 0.7"),
     ("seed = 3", "seed = -1", r"rare_event.seed: must be an integer in \[0, "),
     ("contact = 1", "contact = 2", r"rare_event.contact: must be an integer in \[0, 1\], got 2"),
-    ('response = "closure"', 'response = "speed"', "rare_event.response: must be one of closure, peak_storey_drift, base_displacement, impact_force, limit_state"),
+    ('response = "closure"', 'response = "speed"', "rare_event.response: must be one of closure, peak_storey_drift, base_displacement, impact_force, max_closure, limit_state"),
     ('response = "closure"\ncontact = 1', 'response = "base_displacement"\nbuilding = "B1"', "rare_event.building: 'B1' has a fixed base"),
     ('response = "closure"\ncontact = 1', 'response = "peak_storey_drift"\nbuilding = "B1"\nfloor = 3', r"rare_event.floor: must be an integer in \[1, 2\], got 3"),
     ("p0 = 0.1", "p0 = 0.1\nfloor = 1", "rare_event.floor: not used by response = 'closure'"),
@@ -224,7 +224,7 @@ seed = 1
 
 def test_a_stochastic_experiment_of_the_same_runs_checks_the_curve_at_its_gaps(tmp_path):
     """With the stochastic store of the same scene and motion, the section gives crude Monte Carlo at its gaps beside the curve;
-    a store of another motion is not compared."""
+    a store of another motion is refused in one line, by the check and by the report."""
     from stochpound.experiment import crude_check, load_experiment, run_experiment
     from stochpound.report.assemble import assemble_report
 
@@ -235,14 +235,146 @@ def test_a_stochastic_experiment_of_the_same_runs_checks_the_curve_at_its_gaps(t
     rare = open_rare_event_store(tmp_path / "a.nc")
     with stochpound_store(tmp_path / "same.nc") as same, stochpound_store(tmp_path / "other.nc") as other:
         check = crude_check(rare, same)
-        assert crude_check(rare, other) is None
+        with pytest.raises(ExperimentError, match="rare-event experiment pair_rare against experiment pair_other: none of its ensembles has the motion") as error:
+            crude_check(rare, other)
+        assert "\n" not in str(error.value)
         closure = same.pound.contact_free()["peak_contact_closure"].isel(record=0, contact=1).values
-        assert list(check["gap"].values) == [0.03, 0.035]
+        assert list(check["gap"].values) == [0.03, 0.035] and check.attrs["cell"] == ""
         assert check["crude"].values[0] == np.mean(closure >= 0.03) and check["realizations"].values[0] == 40
         assert np.all(np.isfinite(check["subset"].values)) and check["subset"].values[0] >= check["subset"].values[1] > 0.0
     report = assemble_report([tmp_path / "same.nc", tmp_path / "a.nc"])
     section = next(s for s in report.sections if s.key == "rare-pair_rare")
     assert any(getattr(block, "key", "") == "rare-pair_rare-crude" for block in section.blocks)
+    assert any(s.key == "rare-pair_rare" for s in assemble_report([tmp_path / "other.nc", tmp_path / "same.nc", tmp_path / "a.nc"]).sections)
+    with pytest.raises(ExperimentError, match="none of its ensembles has the motion .*: give the store of the stochastic experiment it is a cell of"):
+        assemble_report([tmp_path / "other.nc", tmp_path / "a.nc"])
+
+
+GRID_SCENE = """
+g = 9.81
+
+[[building]]
+name = "B1"
+mass = [1.0e5, 1.0e5]
+stiffness = [4.0e7, 4.0e7]
+damping_ratio = 0.02
+base = { mass = 5.0e4, mu = 0.1, radius = 2.24 }
+
+[[building]]
+name = "B2"
+mass = [1.0e5, 1.0e5]
+stiffness = [2.0e7, 2.0e7]
+damping_ratio = 0.02
+
+[[contact]]
+between = [["B1", 1], ["B2", 1]]
+gap = 0.02
+stiffness = 5.0e7
+restitution = 0.5
+
+[[contact]]
+between = [["B1", 2], ["B2", 2]]
+gap = 0.02
+stiffness = 5.0e7
+restitution = 0.5
+"""
+
+GRID = """
+[experiment]
+name = "grid_stoch"
+
+[scene]
+file = "pair.toml"
+
+[variants.neighbour.stiff.building.B2]
+mass_factor = 0.5
+
+[variants.neighbour.flexible.building.B2]
+mass_factor = 2.0
+
+[grid]
+gap = [0.01, 0.03, inf]
+mu = { values = [0.05, inf], buildings = ["B1"] }
+
+[synthetic.low]
+type = "white_noise"
+S0 = 0.01
+duration = 2.0
+dt = 0.02
+count = 30
+seed = 1
+
+[synthetic.high]
+type = "white_noise"
+S0 = 0.03
+duration = 2.0
+dt = 0.02
+count = 30
+seed = 2
+"""
+
+CELL = """
+[experiment]
+name = "cell_rare"
+
+[scene]
+file = "pair.toml"
+
+[scene.building.B1]
+base = { mu = 0.05 }
+
+[scene.building.B2]
+mass_factor = 2.0
+
+[synthetic.high]
+type = "white_noise"
+S0 = 0.03
+duration = 2.0
+dt = 0.02
+
+[rare_event]
+response = "max_closure"
+target_probability = 1e-3
+samples_per_level = 20
+seed = 4
+"""
+
+
+@pytest.mark.slow
+def test_a_rare_event_store_is_checked_against_its_cell_of_a_grid(tmp_path):
+    """A stochastic experiment over neighbour × μ × gap and two ensembles: the check takes the contact-free runs of the one cell whose
+    scene and motion are the rare-event experiment's (the largest closure of either contact at each gap), and the report says which;
+    a rare-event experiment that is none of its cells (another neighbour) is refused in one line, by the check and by the report."""
+    from stochpound.experiment import crude_check, load_experiment, run_experiment
+    from stochpound.report.assemble import assemble_report
+    from stochpound.report.render import Table
+
+    (tmp_path / "pair.toml").write_text(GRID_SCENE)
+    (tmp_path / "grid.toml").write_text(GRID)
+    run_experiment(load_experiment(tmp_path / "grid.toml"), tmp_path / "grid.nc", workers=0, progress=False)
+    for name, text in (("cell", CELL), ("none", CELL.replace("mass_factor = 2.0", "mass_factor = 3.0").replace("cell_rare", "none_rare"))):
+        (tmp_path / f"{name}.toml").write_text(text)
+        assert load_rare_event(tmp_path / f"{name}.toml").table.contact is None
+        run_rare_event(load_rare_event(tmp_path / f"{name}.toml"), tmp_path / f"{name}.nc")
+    with stochpound_store(tmp_path / "grid.nc") as grid:
+        check = crude_check(open_rare_event_store(tmp_path / "cell.nc"), grid)
+        closure = grid.pound.contact_free()["peak_contact_closure"].sel(neighbour="flexible", mu=0.05, record="high").max("contact").values
+        others = grid.pound.contact_free()["peak_contact_closure"].sel(neighbour="stiff", mu=0.05, record="high").max("contact").values
+        assert check.attrs["cell"] == "neighbour flexible, μ 0.05" and check.attrs["record"] == "high"
+        assert list(check["gap"].values) == [0.01, 0.03] and list(check["realizations"].values) == [30, 30]
+        assert list(check["crude"].values) == [np.mean(closure >= 0.01), np.mean(closure >= 0.03)]
+        assert np.mean(others >= 0.01) != np.mean(closure >= 0.01)  # the cells differ: the check took the right one
+        with pytest.raises(ExperimentError, match="against experiment grid_stoch: none of its contact-free cells has the scene of none_rare") as error:
+            crude_check(open_rare_event_store(tmp_path / "none.nc"), grid)
+        assert "\n" not in str(error.value)
+    report = assemble_report([tmp_path / "grid.nc", tmp_path / "cell.nc"])
+    section = next(s for s in report.sections if s.key == "rare-cell_rare")
+    table = next(b for b in section.blocks if isinstance(b, Table) and b.key == "rare-cell_rare-crude")
+    assert "ensemble high in its cell neighbour flexible, μ 0.05" in table.caption
+    assert list(table.frame["crude Monte Carlo"].values) == list(check["crude"].values)
+    assert "largest closure of any contact" in section.blocks[0].text
+    with pytest.raises(ExperimentError, match="none of its contact-free cells has the scene of none_rare"):
+        assemble_report([tmp_path / "grid.nc", tmp_path / "none.nc"])
 
 
 def stochpound_store(path):
@@ -293,3 +425,14 @@ damping_ratio = 0.05
     path.write_text(text)
     table = load_rare_event(path).table
     assert (table.building, table.floor) == ("B1", 2)
+
+
+def test_max_closure_is_the_largest_of_the_contacts_closures(tmp_path):
+    """``response = "max_closure"`` samples, run by run, the larger of the two contacts' closures of the contact-free pair; it takes no contact."""
+    from stochpound.experiment import rare_event_sampler
+
+    closures = [rare_event_sampler(load_rare_event(_file(tmp_path, **{"contact = 1": f"contact = {c}"}))).start(range(4))[1] for c in (0, 1)]
+    largest = rare_event_sampler(load_rare_event(_file(tmp_path, **{'response = "closure"\ncontact = 1': 'response = "max_closure"'}))).start(range(4))[1]
+    assert np.array_equal(largest, np.maximum(*closures)) and not np.array_equal(closures[0], closures[1])
+    with pytest.raises(ExperimentError, match="rare_event.contact: not used by response = 'max_closure'"):
+        load_rare_event(_file(tmp_path, **{'response = "closure"': 'response = "max_closure"'}))

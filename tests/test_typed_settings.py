@@ -24,7 +24,7 @@ PACKAGE = Path(__file__).parents[1] / "stochpound"
 DICT_ANNOTATION = re.compile(r"dict\[str, *(Any|object)\]|Mapping\[str, *(Any|object)\]|(:|->) *(dict|Mapping)( |,|\)|:|$)")
 STRING_KEYED_READ = re.compile(r"\.get\([\"']")
 #: The ceilings: today's counts. Lower them when a change lowers a count; never raise them.
-CEILINGS = {"dict annotations": 79, "string-keyed reads": 54}
+CEILINGS = {"dict annotations": 78, "string-keyed reads": 54}
 
 
 def _count(pattern: re.Pattern[str]) -> int:

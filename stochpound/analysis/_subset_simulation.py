@@ -76,7 +76,7 @@ from stochpound.motions.ground import SampledMotion
 from stochpound.solvers.simulate import simulate
 
 #: The responses of a run that :func:`subset_simulation` samples (its ``response``), with their units.
-RESPONSES = {"closure": "m", "peak_storey_drift": "m", "base_displacement": "m", "impact_force": "N"}
+RESPONSES = {"closure": "m", "peak_storey_drift": "m", "base_displacement": "m", "impact_force": "N", "max_closure": "m"}
 PROPOSALS = {
     "mma": "subset simulation (Au & Beck 2001), component-wise modified Metropolis with a uniform proposal of half-width 1",
     "acs": "subset simulation (Au & Beck 2001), adaptive conditional sampling (Papaioannou et al. 2015): conditional normal proposals, "
@@ -324,12 +324,14 @@ def subset_simulation(
         A synthetic ensemble's fields, as an experiment's ``[synthetic.<name>]``
         table writes them (:func:`~stochpound.motions.normal_motion`); use
         ``method = "filter"`` for a filtered process, which is exactly Gaussian.
-    response : {"closure", "peak_storey_drift", "base_displacement", "impact_force"}
+    response : {"closure", "peak_storey_drift", "base_displacement", "impact_force", "max_closure"}
         The run's largest closure of contact ``contact`` (m,
         ``peak_contact_closure``), largest absolute drift of storey ``floor`` of
         ``building`` (m, ``peak_storey_drift``), largest absolute sliding
-        displacement of ``building``'s base at the samples (m), or largest
-        force of an impact at contact ``contact`` (N, 0 without impact).
+        displacement of ``building``'s base at the samples (m), largest
+        force of an impact at contact ``contact`` (N, 0 without impact), or
+        the largest closure of any contact (m: with one gap at every contact,
+        a contact-free pair pounds at that gap exactly when it exceeds it).
     thresholds : sequence of float, optional
         Thresholds b, in the response's units; the levels go on until the
         largest is reached (without ``target_probability``). Without them, the
@@ -719,6 +721,10 @@ def scene_response(
 def _reader(scene: Scene, response: str, building: str | None, floor: int | None, contact: int) -> Callable[[xr.Dataset], float]:
     """The response read from a run's result, its building, floor or contact checked against the scene."""
     names = [b.name for b in scene.buildings]
+    if response == "max_closure":
+        if not scene.contacts:
+            raise ValueError("response: 'max_closure' needs a contact, and the scene has none")
+        return lambda run: float(np.max(run["peak_contact_closure"].values))
     if response in ("closure", "impact_force"):
         if isinstance(contact, bool) or not isinstance(contact, (int, np.integer)) or not 0 <= contact < len(scene.contacts):
             raise ValueError(f"contact: must be a contact index in [0, {len(scene.contacts) - 1}], got {contact!r}" if scene.contacts else "contact: the scene has no contact")

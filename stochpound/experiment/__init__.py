@@ -28,7 +28,8 @@ from stochpound.store import Case, Dim
 from stochpound.experiment._runner import RunReport, default_store, load_experiment, run_experiment
 from stochpound.experiment._status import StatusReport, store_status
 from stochpound.experiment._rare_event_run import RareEventReport, rare_event_sampler, run_rare_event
-from stochpound.experiment._rare_event_store import RareEventResults, crude_check, is_rare_event_store, open_rare_event_store, rare_event_results
+from stochpound.experiment._rare_event_check import crude_check
+from stochpound.experiment._rare_event_store import RareEventResults, is_rare_event_store, open_rare_event_store, rare_event_results
 from stochpound.experiment._rare_event_table import RareEventDefinition, RareEventTable, is_rare_event_file, load_rare_event, parse_rare_event
 
 # For the other packages of stochpound (their interface to this one, not public API: not in __all__).
@@ -41,6 +42,7 @@ from stochpound.experiment._parts import parts_folder, read_experiment_json  # n
 from stochpound.experiment._site import periods_of_interest  # noqa: F401
 from stochpound.experiment._sources import resolve_motions  # noqa: F401
 from stochpound.experiment._file_assembly import PartsIndex  # noqa: F401
+from stochpound.experiment._rare_event_table import CLOSURES  # noqa: F401
 
 __all__ = [
     "RareEventDefinition",

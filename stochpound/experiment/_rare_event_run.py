@@ -33,7 +33,7 @@ from stochpound.experiment._runner import _describe_executor, _interrupts
 from stochpound.experiment._rare_event_store import (
     DEFINITION_FILE, FinishedLevel, batch_path, finished_levels, load_arrays, save_arrays, save_level, stored_definition, write_store,
 )
-from stochpound.experiment._rare_event_table import RareEventDefinition
+from stochpound.experiment._rare_event_table import CLOSURES, RareEventDefinition
 from stochpound.experiment._spec import ExperimentError
 from stochpound.model.scene_file import scene_from_dict
 from stochpound.store import canonical_json, with_motion, with_open_gaps
@@ -77,7 +77,7 @@ def _sampler(definition: str) -> tuple[SubsetSampler, str]:
     """The sampler of a canonical definition's JSON (cached: a worker builds it once), and the response's units."""
     typed = RareEventDefinition.from_dict(json.loads(definition))
     table, scene = typed.table, typed.scene
-    if table.response == "closure":  # the contact-free pair: its closure does not depend on the gap
+    if table.response in CLOSURES:  # the contact-free pair: its closure does not depend on the gap
         scene = with_open_gaps(scene)
     function, n, units = scene_response(scene_from_dict(with_motion(scene)), typed.motion, table.sampled, table.building, table.floor,
                                         table.contact or 0)

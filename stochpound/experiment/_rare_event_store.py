@@ -31,10 +31,9 @@ import xarray as xr
 
 from stochpound._atomic import replacing
 from stochpound.analysis import INITIAL_SCALE, PROPOSALS, SubsetLevel, curve_dataset, curve_thresholds, exceedance, exceedance_quantiles, level_attributes, level_probability
-from stochpound.analysis import pounding_curve
 from stochpound.experiment._parts import parts_folder
 from stochpound.experiment._rare_event_table import RareEventDefinition
-from stochpound.store import Provenance, contact_free, contact_gap_dims, has_contact_free
+from stochpound.store import Provenance
 
 DEFINITION_FILE = "definition.json"
 KIND = "rare_event"
@@ -225,56 +224,3 @@ def rare_event_results(data: xr.Dataset) -> RareEventResults:
     return RareEventResults(curve, {"probability": np.array(SEPARATION_PROBABILITIES), **quantiles}, stored_rare_event(data),
                             int(data.attrs["runs"]), len(levels), bool(data.attrs["complete"]),
                             bool(data.attrs.get("target_reached", 0)))
-
-
-_NOT_THE_MOTION = ("count", "seed", "start", "realization", "interpolation")
-"""A synthetic ensemble's fields that name its realizations, not its motion."""
-
-
-def crude_check(rare: xr.Dataset, store: xr.Dataset) -> xr.Dataset | None:
-    """A rare-event store's closure curve against a stochastic experiment's crude Monte Carlo at that experiment's own gaps.
-
-    Only when they describe the same runs: the rare-event response is a
-    contact's closure, the stochastic store has contact-free cases on one
-    contact axis and no other axis, the same scene (but its contacts' gaps)
-    and a synthetic ensemble of the same motion (but its seed and count).
-
-    Returns
-    -------
-    xarray.Dataset or None
-        Over ``gap`` (m, the store's finite gaps): ``crude``, ``crude_lower``, ``crude_upper`` (the fraction of
-        its contact-free runs whose closure reaches the gap, with its 95 % Clopper–Pearson interval),
-        ``realizations``; ``subset`` and ``subset_cov`` (the rare-event curve there); attrs ``experiment`` and
-        ``record`` (the ensemble's label). None when they do not describe the same runs.
-    """
-    definition = stored_rare_event(rare)
-    axes = contact_gap_dims(store)
-    if definition.table.response != "closure" or len(axes) != 1 or not has_contact_free(store):
-        return None
-    stochastic = store.pound.definition
-    if _without_gaps(stochastic.scene) != _without_gaps(definition.scene):
-        return None
-    motion = _motion_fields(definition.motion)
-    labels = [m.label for m in stochastic.motions if m.kind == "synthetic" and _motion_fields(m.motion) == motion]
-    closure = contact_free(store)["peak_contact_closure"]
-    if not labels or set(closure.dims) - {"record", "realization", "contact"}:
-        return None
-    runs = closure.sel(record=labels[0]).isel(contact=definition.table.contact)
-    gaps = store[axes[0]].values[np.isfinite(store[axes[0]].values)]
-    crude = pounding_curve(runs, gaps, contact_dim=None)
-    probability, cov = exceedance(store_levels(rare), gaps)
-    return xr.Dataset(
-        {"crude": ("gap", crude["probability"].values), "crude_lower": ("gap", crude["lower"].values), "crude_upper": ("gap", crude["upper"].values),
-         "realizations": ("gap", np.broadcast_to(crude["realizations"].values, gaps.shape)), "subset": ("gap", probability), "subset_cov": ("gap", cov)},
-        coords={"gap": ("gap", gaps, {"units": "m"})}, attrs={"experiment": Provenance.of(store).experiment_name, "record": labels[0]},
-    )
-
-
-def _without_gaps(scene: dict[str, Any]) -> dict[str, Any]:
-    """A scene's table without its motion and its contacts' gaps."""
-    return {key: [{k: v for k, v in c.items() if k != "gap"} for c in value] if key == "contact" else value
-            for key, value in scene.items() if key != "motion"}
-
-
-def _motion_fields(motion: Any) -> dict[str, Any]:
-    return {key: value for key, value in dict(motion).items() if key not in _NOT_THE_MOTION}

@@ -34,6 +34,8 @@ RARE_EVENT_METHODS = ("subset",)
 LIMIT_STATES = {"isolator_displacement": "base_displacement", "impact_force": "impact_force"}
 """``rare_event.limit_state`` kinds and the response whose ratio to ``capacity`` they take."""
 RESPONSE_CHOICES = (*RESPONSES, "limit_state")
+CLOSURES = ("closure", "max_closure")
+"""The responses run on the contact-free scene (every contact's gap infinite): their exceedance of g is pounding at a gap g."""
 _TOP_KEYS = {"experiment", "scene", "synthetic", TABLE}
 _KEYS = {"method", "response", "target_probability", "samples_per_level", "p0", "seed", "motion", "contact", "building", "floor",
          "limit_state", "capacity", "max_levels", "proposal"}
@@ -50,7 +52,9 @@ class RareEventTable:
         ``subset``.
     response : str
         ``closure`` (of the contact-free pair: every contact's gap set to
-        infinity, so one run gives P(pounding) at every gap), ``peak_storey_drift``,
+        infinity, so one run gives P(pounding) at every gap), ``max_closure``
+        (the largest closure of any contact of the contact-free pair: P(pounding)
+        at one gap on every contact), ``peak_storey_drift``,
         ``base_displacement``, ``impact_force`` or ``limit_state`` (the ratio of
         ``limit_state``'s demand to ``capacity``).
     target_probability : float
@@ -208,11 +212,14 @@ def _where(table: TomlTable, response: str, buildings: list[str], scene: Mapping
     """The contact, building, floor, limit state and capacity the response needs (and no other)."""
     limit_state = table.string("limit_state", choices=tuple(LIMIT_STATES)) if response == "limit_state" else None
     sampled = LIMIT_STATES[limit_state] if limit_state else response
-    needs = {"contact"} if sampled in ("closure", "impact_force") else {"building"} | ({"floor"} if sampled == "peak_storey_drift" else set())
+    needs = {"contact"} if sampled in ("closure", "impact_force") else set() if sampled == "max_closure" else \
+        {"building"} | ({"floor"} if sampled == "peak_storey_drift" else set())
     needs |= {"limit_state", "capacity"} if limit_state else set()
     for key in ("contact", "building", "floor", "limit_state", "capacity"):
         if key in table and key not in needs:
-            raise table.error(key, f"not used by response = {response!r} (it takes {', '.join(sorted(needs))})")
+            raise table.error(key, f"not used by response = {response!r} (it takes {', '.join(sorted(needs)) or 'none of contact, building, floor'})")
+    if sampled == "max_closure" and not TomlTable(scene, "scene").tables("contact"):
+        raise table.error("response", f"{response!r} needs a contact, and the scene has none")
     found: dict[str, Any] = {}
     if "contact" in needs:
         contacts = len(TomlTable(scene, "scene").tables("contact"))

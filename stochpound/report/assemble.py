@@ -41,6 +41,7 @@ from stochpound.analysis import MEASURE_FREE_RUNS, RuptureSite, StoreSufficiency
 from stochpound.experiment import crude_check, is_rare_event_store, measure_choice, open_rare_event_store, rare_event_results
 from stochpound.risk import RiskInputError, check_alternative, collapse_risk, has_risk, separation_sensitivity, store_damage, store_demands, store_risk
 from stochpound.store import check_finished, has_contact_free, has_wall_free, with_contacts, with_walls
+from stochpound._errors import ExperimentError
 from stochpound._studies import claims, load_study
 
 
@@ -77,6 +78,8 @@ def assemble_report(paths: Sequence[str | Path], progress: Callable[[str], None]
     ------
     ValueError
         (``UnfinishedStoreError``) A store with missing cases without ``partial``: ``<name>: 288/704 cases done: ...``.
+    ExperimentError
+        A rare-event store of a closure beside stores with contact-free cases of which it is no cell (``crude_check``'s reason).
     """
     say = progress or (lambda message: None)
     say("reading stores")
@@ -89,7 +92,7 @@ def assemble_report(paths: Sequence[str | Path], progress: Callable[[str], None]
     others = {name: store for name, store in stores.items() if name not in studied}
     studies = {key: load_study(key) for key in claimed}
     report = Report(
-        title="; ".join(study.TITLE for study in studies.values()) if studies else f"Pounding experiments: {', '.join([*others, *(d.attrs['experiment_name'] for d in rare.values())])}",
+        title="; ".join(study.TITLE for study in studies.values()) if studies else f"Pounding experiments: {', '.join([*others, *_rare_names(rare)])}",
         subtitle=f"stochpound report of {', '.join(stores)}, built {date.today().isoformat()}",
         sources=[f"{name}: {definition_source(store)}, definition sha256 {store.pound.sha256}" for name, store in stores.items()],
     )
@@ -139,8 +142,7 @@ def assemble_report(paths: Sequence[str | Path], progress: Callable[[str], None]
             report.sections.append(intensity_section(name, store, near))
     for data in rare.values():
         say(f"rare events {data.attrs['experiment_name']}")
-        checks = (crude_check(data, store) for store in stores.values())  # a stochastic experiment of the same runs, if one is given
-        report.sections.append(rare_event_section(data.attrs["experiment_name"], rare_event_results(data), next((c for c in checks if c is not None), None)))
+        report.sections.append(rare_event_section(data.attrs["experiment_name"], rare_event_results(data), _crude_check(data, stores)))
     if stores:
         say("methods")
         report.sections.append(methods_section(stores))
@@ -152,6 +154,36 @@ def assemble_report(paths: Sequence[str | Path], progress: Callable[[str], None]
         say("summary")
         report.sections.insert(0, experiment_summary(others, report.sections, risks=risks))
     return report
+
+
+def _rare_names(rare: dict[Path, xr.Dataset]) -> list[str]:
+    """The rare-event experiments as the title names them: each by its name, or their number beyond two."""
+    names = [data.attrs["experiment_name"] for data in rare.values()]
+    return names if len(names) <= 2 else [f"{len(names)} rare-event experiments"]
+
+
+def _crude_check(rare: xr.Dataset, stores: dict[str, xr.Dataset]) -> xr.Dataset | None:
+    """The crude Monte Carlo check of a rare-event store by the first store given that ran its runs (one of its cells): None
+    when no store given could (no contact-free cases, or the rare event is not a closure).
+
+    Raises
+    ------
+    ExperimentError
+        In one line, when stores with contact-free cases are given and none of them ran its runs (the first one's reason).
+    """
+    refusals = []
+    for store in stores.values():
+        try:
+            check = crude_check(rare, store)
+        except ExperimentError as error:
+            refusals.append(str(error))
+            continue
+        if check is not None:
+            return check
+    if refusals:
+        others = f" (and {len(refusals) - 1} other store(s) given)" if len(refusals) > 1 else ""
+        raise ExperimentError(f"{refusals[0]}{others}: give the store of the stochastic experiment it is a cell of, or report it on its own")
+    return None
 
 
 def _alternatives(stores: dict[str, xr.Dataset], alternatives: Sequence[tuple[str, str | Path]], edited: str) -> dict[str, list[tuple[str, xr.Dataset]]]:
@@ -214,6 +246,12 @@ def _about(stores: dict[str, xr.Dataset], sections: list[Section]) -> str:
         parts.append("A separation or moat-clearance section answers the gap question from the contact-free (or wall-free) runs.")
     if "intensity" in kinds:
         parts.append("An Intensity section describes the motions' intensity measures, the stripes and their scale factors.")
+    rare = sum(1 for section in sections if section.key.startswith("rare-"))
+    if rare:
+        parts.append(f"{'A Rare events section gives' if rare == 1 else f'{rare} Rare events sections each give'} one "
+                     "subset simulation's exceedance curve per event, down to its target probability, with its 95 % interval and the "
+                     "response (for a closure, the separation) exceeded with 10⁻³, 10⁻⁴ and 10⁻⁶ per event; beside the stochastic "
+                     "experiment of which it is a cell, the curve is checked against that cell's crude Monte Carlo at the grid's gaps.")
     parts.append("The Methods section describes every building, contact and motion from the stores' own definitions and checks "
                  "the solver while the report is built; the build stops if a check fails.")
     return " ".join(parts)

@@ -13,14 +13,14 @@ import pandas as pd
 import xarray as xr
 from matplotlib.figure import Figure
 
-from stochpound.experiment import RareEventResults
+from stochpound.experiment import CLOSURES, RareEventResults
 from stochpound.report.render import FigureItem, Paragraph, Section, Table
 
 
 def rare_event_section(name: str, results: RareEventResults, crude: xr.Dataset | None = None) -> Section:
     """The section of the rare-event experiment ``name``: conditions and n, the exceedance curve with its 95 % interval, the separations;
     with ``crude`` (:func:`~stochpound.experiment.crude_check`), the curve against a stochastic experiment's crude Monte Carlo at its gaps."""
-    closure = results.definition.table.response == "closure"
+    closure = results.definition.table.response in CLOSURES
     units = results.curve["threshold"].attrs.get("units", "")
     section = Section(f"Rare events: {name}", key=f"rare-{name}")
     section.add(Paragraph(_conditions(results)))
@@ -28,11 +28,11 @@ def rare_event_section(name: str, results: RareEventResults, crude: xr.Dataset |
     section.add(Table(f"rare-{name}-separation", _table_caption(closure, units), _frame(results, closure, units),
                       note="Per event: per motion of the ensemble. The interval is the response at which the estimated curve crosses "
                            "p·exp(±1.96 δ), δ the estimate's coefficient of variation at p (from the levels' genealogy, which counts the correlation between levels); "
-                           "a probability below the run's reach has no value.",
+                           "a value, or an interval's end, below the run's reach is left blank.",
                       formats={"probability per event": "{:.0e}", "coefficient of variation": "{:.2f}", "runs (n)": "{:.0f}"}))
     if crude is not None:
         section.add(Table(f"rare-{name}-crude", f"The probability of pounding per event at the gaps of experiment {crude.attrs['experiment']}: "
-                          f"its contact-free runs of ensemble {crude.attrs['record']} (crude Monte Carlo) against subset simulation",
+                          f"its contact-free runs of ensemble {crude.attrs['record']}{_cell(crude)} (crude Monte Carlo) against subset simulation",
                           _crude_frame(crude, results.runs),
                           note="Crude Monte Carlo: the fraction of the contact-free runs whose closure reaches the gap, with its 95 % "
                                "Clopper–Pearson interval; subset simulation: the curve above at the gap and its coefficient of variation. "
@@ -48,20 +48,29 @@ def _conditions(results: RareEventResults) -> str:
     if table.response == "closure":
         what = (f"the closure of contact {table.contact} of the contact-free scene (every gap infinite): by the gap identity, "
                 "P(closure > g) is the probability of pounding at a gap g")
+    elif table.response == "max_closure":
+        what = ("the largest closure of any contact of the contact-free scene (every gap infinite): by the gap identity, "
+                "P(closure > g) is the probability of pounding with the gap g at every contact")
     elif table.response == "limit_state":
         what = f"the ratio of the {table.limit_state} demand{where} to its capacity {table.capacity:g}"
     parameters = ", ".join(f"{key} = {_text(value)}" for key, value in motion.items() if key != "type")
     state = "reached" if results.target_reached else ("not reached: the run is incomplete (rerun it)" if not results.complete
                                                        else f"not reached: it stopped after max_levels = {table.max_levels}")
     chains = {"mma": "component-wise modified Metropolis", "acs": "adaptive conditional sampling, Papaioannou et al. 2015"}[table.proposal]
-    return (f"One subset simulation (Au & Beck 2001; {chains}) of {what}, under a {motion.get('type', 'kanai_tajimi')} "
+    described = f"{results.definition.description.rstrip('.')}. " if results.definition.description else ""
+    return (f"{described}One subset simulation (Au & Beck 2001; {chains}) of {what}, under a {motion.get('type', 'kanai_tajimi')} "
             f"ground motion ({parameters}), its randomness a vector of standard normals. N = {table.samples_per_level} samples a level, "
             f"p0 = {table.p0}, seed {table.seed}: {results.levels} levels and n = {results.runs} runs in all, down to the target "
             f"probability {table.target_probability:g} per event ({state}).")
 
 
+def _cell(crude: xr.Dataset) -> str:
+    return f" in its cell {crude.attrs['cell']}" if crude.attrs["cell"] else ""
+
+
 def _text(value: Any) -> str:
-    return f"{value:g}" if isinstance(value, float) else str(value)
+    """A motion field as its experiment file writes it: ``15``, ``true``, ``jennings``."""
+    return f"{value:g}" if isinstance(value, float) else str(value).lower() if isinstance(value, bool) else str(value)
 
 
 def _caption(results: RareEventResults, closure: bool, units: str, crude: xr.Dataset | None) -> str:
