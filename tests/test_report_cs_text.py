@@ -112,3 +112,15 @@ def test_the_design_summary_counts_the_motions_that_ran_not_the_pool(cs_store) -
     assert 3 <= chosen < 8
     assert assumptions(cs_store)["suite"] == (f"{chosen} motions ran (records without a named suite), selected per stripe by conditional "
                                               "spectrum from a pool of 8 records")
+
+
+def test_the_motion_table_caption_counts_one_simulated_row_per_experiment() -> None:
+    """The flagships' table said '24 of the 200 motions … and, in one row, the 522 simulated motions' for 23 record rows and two
+    simulated rows (266 and 256, one per experiment): the caption took one row off for the simulated motions whatever their rows."""
+    from stochpound.report.sections._description import motions_caption
+
+    assert motions_caption(23, 200, [266, 256]).endswith(
+        "(23 of the 200 motions the experiments define: a selection's pool motions it never chose are left out; and, in one row per "
+        "experiment, the 522 simulated motions some stripe chose).")
+    assert "in one row, the 40 simulated motions" in motions_caption(3, 8, [40])
+    assert motions_caption(8, 8).endswith("seed and size.")

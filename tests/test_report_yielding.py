@@ -190,7 +190,7 @@ def test_governs_is_judged_in_each_treatment_of_the_collapses_and_a_disagreement
             f"beyond the model counted apart as collapses, mu 0.05: {states[1].label} (λ/λ_target = {9e-4 / rates[1]:.2g})") in text
     assert (f"The two treatments disagree on what governs in 1 of 2 configurations (mu 0.05: pounding at g* as run, {states[1].label} "
             "with collapses apart)") in text
-    summary = _structural_governs(damage, 0.1, "pounding between the buildings")
+    summary = _structural_governs(damage)  # the same at every target: no target, and no separation's limit, in it
     assert summary.startswith(f"as run, {states[0].label} in 1 of 2 configurations") and "the two treatments disagree in 1 of 2" in summary
     assert f"with the runs beyond the model counted apart as collapses, {states[1].label} in 1 of 2 configurations, {states[0].label} in 1" in summary
     # the same judgement for stochpound risk --limit-states: a finite-gap grid says none beyond its objective where nothing misses
@@ -463,14 +463,18 @@ def test_the_design_summary_names_the_limit_state_the_damage_section_finds_gover
     # as run no run reaches it; counted apart, the collapses do, more often than 10 % in 50 yr allows: the treatments disagree
     collapse = unreached.risk["maf_collapses_apart"].item()
     assert collapse > -math.log(0.9) / 50.0
-    assert ("Governing limit state (the largest λ/λ_target of the limit states, each against its own objective; pounding at g* has 1): "
-            "as run, no limit state beyond its objective; with the runs beyond the model counted apart as collapses, peak storey "
-            "ductility ≥ 10000 in 1 of 1 configurations (a limit state beyond its own objective") in text
+    assert ("Governing limit state (the largest λ/λ_target of the limit states, each against its own objective, the same at every "
+            "target; pounding at g* has 1): as run, no limit state beyond its objective; with the runs beyond the model counted apart "
+            "as collapses, peak storey ductility ≥ 10000 in 1 of 1 configurations") in text
+    # said once, not once per target (the flagship's summary repeated the whole verdict for 10 % and for 2 % in 50 yr)
+    assert text.count("Governing limit state") == 1 and text.count("the two treatments disagree in 1 of 1 configurations") == 1
     assert ("; the two treatments disagree in 1 of 1 configurations: what governs depends on whether the runs beyond the model are "
-            "taken as computed or as collapses); in the other configurations, pounding between the buildings for 10 % in 50 yr") in text
+            "taken as computed or as collapses). At g*, what limits the separation: pounding between the buildings for 10 % in 50 yr; "
+            "pounding between the buildings for 2 % in 50 yr.") in text
     for damage in (store_damage(store, [LimitState("ductility", 1.0e4)], "a test"), None):  # no objective: nothing ranked
         text = design_summary_text(risk, None, damage)
-        assert "Limit state judged (no structural limit state with an objective, so none is ranked against it): pounding between" in text
+        assert ("Limit state judged (no structural limit state with an objective, so none is ranked against it; at g*, what limits the "
+                "separation): pounding between") in text
         assert "Governing" not in text
 
 
@@ -651,3 +655,5 @@ def test_a_ratio_that_decides_the_objective_never_prints_as_one():
 
     assert (ratio_text(1.003), ratio_text(0.998), ratio_text(1.02), ratio_text(0.25, 2)) == ("1.003", "0.998", "1.02", "0.25")
     assert _ratio_cell(1.0029, math.nan) == "1.003" and _ratio_cell(0.5, 1.001) == "≥ 1.001"
+    # the governs sentence (2 digits) printed '(λ/λ_target = 1)' for 1.03 and 1.01, where the table said they miss the objective
+    assert (ratio_text(1.03, 2), ratio_text(1.01, 2), ratio_text(0.96, 2), ratio_text(2.45, 2)) == ("1.03", "1.01", "0.96", "2.5")
