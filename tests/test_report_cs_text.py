@@ -79,6 +79,14 @@ def test_risk_warns_of_stripes_that_miss_their_target_or_lie_beyond_the_truncati
     flagged = cs_store.assign(selection_misses_target=cs_store.selection_misses_target.copy(data=[0, 1]),
                               target_epsilon=cs_store.target_epsilon.copy(data=[1.0, 3.4]))
     assert selection_misses(flagged) == [0.1] and stripes_beyond_truncation(flagged) == [0.1]
+    # the design summary's assumptions name them too (the flagships' listed neither, though their 2 %/50 yr stripe missed)
+    from stochpound.risk._inputs import assumptions
+
+    assert "selection fit" not in assumptions(clean)
+    assert assumptions(flagged)["selection fit"] == (
+        "the motions chosen at the stripes 0.1 g miss their conditional-spectrum target (mean or standard deviation of ln Sa off by "
+        "more than 0.1 at a period); the scenario puts the stripes 0.1 g beyond ε 3, where hazard models truncate the ground motion: "
+        "the answer takes those stripes' motions as the site's there")
     outputs = []
     for name, store in (("clean", clean), ("flagged", flagged)):
         store.to_netcdf(tmp_path / f"{name}.nc")

@@ -613,6 +613,8 @@ def test_the_sensitivity_table_recomputes_g_star_under_each_choice(store):
     np.testing.assert_allclose(frame["β_m = 1e-06"].values, frame["g* (m)"].values, rtol=1e-4)
     np.testing.assert_allclose(frame["grid ×4 finer near g*: Δ (%)"].values, 100 * (refined / frame["g* (m)"].values - 1), rtol=1e-12)
     assert list(frame["collapses apart"]) == [np.inf, np.inf]
+    # a pair without walls: their stiffness is no choice its answer rests on (the fixed flagship listed it as not evaluated)
+    assert sensitivity.not_evaluated == ("seed", "measure") and "moat wall" not in sensitivity.text()
     text = sensitivity_text(frame, not_evaluated=("seed", "measure", "wall"))
     assert "Not evaluated (each needs other runs): the selection seed (needs a store of the same experiment with another" in text
     assert "bound the record-to-record sampling of the motions only" in text
@@ -657,3 +659,30 @@ def test_a_ratio_that_decides_the_objective_never_prints_as_one():
     assert _ratio_cell(1.0029, math.nan) == "1.003" and _ratio_cell(0.5, 1.001) == "≥ 1.001"
     # the governs sentence (2 digits) printed '(λ/λ_target = 1)' for 1.03 and 1.01, where the table said they miss the objective
     assert (ratio_text(1.03, 2), ratio_text(1.01, 2), ratio_text(0.96, 2), ratio_text(2.45, 2)) == ("1.03", "1.01", "0.96", "2.5")
+
+
+def test_a_governing_limit_state_on_a_fit_the_runs_do_not_pin_says_so():
+    """The isolated flagship named 'peak storey drift ratio of B2 ≥ 0.025' governing with the collapses counted apart
+    (λ/λ_target 2.0–2.5) from the credible runs' fit over counts 0, 1, 1, 1, 1, 0, 0 of 40, a lognormal the runs do not identify,
+    whose λ is extrapolated down to the hazard table's 0.01 g; neither the sentence nor the table said on what fit."""
+    import dataclasses
+
+    from stochpound.report.sections._damage import _governing_text, _limit_states_table
+    from stochpound.report.sections._risk import _structural_governs
+    from stochpound.risk._fragility import FIT
+
+    states, risk, damage = _two_treatments()
+    fit = {"status": (("limit_state", "mu"), [[FIT, FIT], [FIT, FIT]]), "theta": (("limit_state", "mu"), [[0.5, 0.5], [0.8, 0.8]]),
+           "beta": (("limit_state", "mu"), [[0.4, 0.4], [0.5, 0.5]])}
+    apart = {f"{name}_collapses_apart": (dims, [[*row] for row in values]) for name, (dims, values) in fit.items()}
+    apart["theta_collapses_apart"] = (("limit_state", "mu"), [[0.5, 0.5], [5.0, 0.8]])  # collapse prevention at μ 0.05: beyond the top
+    damage = dataclasses.replace(damage, risk=risk.assign(**fit, **apart).assign_coords(intensity=[0.2, 0.5, 1.0]))
+    text = _governing_text(damage)
+    assert (f"mu 0.05: {states[1].label} (λ/λ_target = 2.2; its fit, lognormal, not identified (θ = 5 beyond the top stripe 1), is not "
+            "pinned by the runs: the ratio rests on it)") in text
+    assert text.count("not pinned") == 1  # as run, every governing fit is identified
+    summary = _structural_governs(damage)
+    assert f"{states[1].label} in 1 of 2 configurations (on a fit the runs do not pin" in summary
+    assert summary.count("on a fit the runs do not pin") == 1
+    table = _limit_states_table("t", damage).frame
+    assert table["fit collapses apart"].tolist().count("lognormal, not identified (θ = 5 beyond the top stripe 1)") == 1

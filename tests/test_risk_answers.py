@@ -137,7 +137,9 @@ def test_the_wall_free_d_tm_is_compared_with_the_moat_and_the_wall_governs_a_tar
     assert "in 1 of 2 configurations (μ 0.05): there the clearance, not the gap, limits" in moat_text(_risk(rules), StoreDemands({}, {}, once))
     # a scene without walls: their stiffness is no choice the answer rests on
     assert "the moat wall's stiffness" not in design_summary_text(_risk(), None)
-    assert "the conditioning measure, the moat wall's stiffness: the sensitivity table" in summary
+    walled = _risk()
+    walled.assumptions = {"moat walls": "B1 at the base, clearance 0.6 m"}
+    assert "the conditioning measure, the moat wall's stiffness: the sensitivity table" in design_value_text(walled)
     single = StoreDemands({}, {}, moat.isel(mu=0, drop=True)).moat_frame()  # one configuration: a plain index
     assert single.index.name == "moat clearance (m)" and math.isclose(single["once in, upper (yr)"].iloc[0], 2 * 918)
     assert moat_text(_risk(rules), None) == "" and moat_text(_risk(rules.sel(rule=["abs"])), StoreDemands({}, {}, moat)) == ""

@@ -334,10 +334,12 @@ def _selection_fit(store: xr.Dataset) -> dict[str, str]:
     """{"selection fit": ...} naming the stripes whose chosen motions miss their conditional-spectrum target and those its
     scenario puts beyond the truncation ε, which the answer still takes as the site's motions; {} where there are none."""
     misses, beyond = selection_misses(store), stripes_beyond_truncation(store)
-    said = ([f"the motions chosen at the stripes {', '.join(f'{level:.4g}' for level in misses)} miss their conditional-spectrum "
+    intensity = store.pound.definition.intensity
+    units = f" {intensity.units}" if intensity is not None and intensity.units else ""
+    said = ([f"the motions chosen at the stripes {', '.join(f'{level:.4g}' for level in misses)}{units} miss their conditional-spectrum "
              "target (mean or standard deviation of ln Sa off by more than 0.1 at a period)"] if misses else []) + (
-            [f"the scenario puts the stripes {', '.join(f'{level:.4g}' for level in beyond)} beyond ε {TRUNCATION_EPSILON:g}, where "
-             "hazard models truncate the ground motion"] if beyond else [])
+            [f"the scenario puts the stripes {', '.join(f'{level:.4g}' for level in beyond)}{units} beyond ε {TRUNCATION_EPSILON:g}, "
+             "where hazard models truncate the ground motion"] if beyond else [])
     return {"selection fit": "; ".join(said) + ": the answer takes those stripes' motions as the site's there"} if said else {}
 
 
