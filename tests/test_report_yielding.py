@@ -686,3 +686,11 @@ def test_a_governing_limit_state_on_a_fit_the_runs_do_not_pin_says_so():
     assert summary.count("on a fit the runs do not pin") == 1
     table = _limit_states_table("t", damage).frame
     assert table["fit collapses apart"].tolist().count("lognormal, not identified (θ = 5 beyond the top stripe 1)") == 1
+    # the flagship's credible runs of the neighbour's 2.5 % drift (0, 1, 1, 1, 1, 0, 0 of 40) gave a flat fit: its fraction held
+    # down to the hazard table's 0.01 g made λ 5 times the as-run rate, and it governed unflagged
+    from stochpound.risk import unpinned_fit
+    from stochpound.risk._chain import fit_name
+    from stochpound.risk._fragility import DECREASING
+
+    assert unpinned_fit(fit_name(DECREASING)) and unpinned_fit("step at the lowest stripe: a bound")
+    assert not unpinned_fit("lognormal") and not unpinned_fit("step: separated") and not unpinned_fit("step: never")

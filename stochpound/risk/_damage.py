@@ -217,7 +217,7 @@ class StoreDamage:
                 continue
             labels = {dim: governing[dim].values[i] for dim, i in zip(governing.dims, index)}
             fit = str(fits.sel(labels).sel(limit_state=state).item())
-            if "not identified" in fit or "lowest stripe" in fit:
+            if unpinned_fit(fit):
                 found[state] = fit
         return found
 
@@ -225,6 +225,13 @@ class StoreDamage:
         """Per limit state and configuration, whether λ exceeds its objective's rate (λ/λ_target > 1; False without an objective)."""
         ratio = self.ratio(apart)
         return None if ratio is None else ratio > 1.0
+
+
+def unpinned_fit(fit: str) -> bool:
+    """Whether a limit state's fit in words (``stochpound.risk.limit_state_fits``) is one the runs do not pin: a lognormal not
+    identified, a step at the lowest stripe (its λ a bound) or a flat fit (a fraction held down to the hazard's lowest intensity)."""
+    return "not identified" in fit or "lowest stripe" in fit or fit.startswith("flat")
+
 
 
 def store_damage(store: xr.Dataset, limit_states: Sequence[LimitState] | None = None, source: str | None = None) -> StoreDamage | None:

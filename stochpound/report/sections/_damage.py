@@ -8,7 +8,7 @@ import pandas as pd
 
 from stochpound.report.render import Paragraph, Section, Table
 from stochpound.report.sections._description import number
-from stochpound.risk import DAMAGE_DEMANDS, MODEL_DRIFT_LIMIT, POUNDING_AT_G_STAR as POUNDING, UNIDENTIFIED_BETA, StoreDamage
+from stochpound.risk import DAMAGE_DEMANDS, MODEL_DRIFT_LIMIT, POUNDING_AT_G_STAR as POUNDING, UNIDENTIFIED_BETA, StoreDamage, unpinned_fit
 
 
 def damage_section(name: str, damage: StoreDamage) -> Section:
@@ -137,8 +137,7 @@ def _governs_text(damage: StoreDamage, probability: float, apart: bool) -> str:
         else:
             others = [str(state) for state, flag in zip(misses["limit_state"].values, misses.sel(labels).values) if flag and state != worst]
             fit = str(fits.sel(labels).sel(limit_state=worst).item()) if fits is not None else ""
-            unpinned = (f"; its fit, {fit}, is not pinned by the runs: the ratio rests on it" if "not identified" in fit or "lowest stripe" in fit
-                        else "")
+            unpinned = f"; its fit, {fit}, is not pinned by the runs: the ratio rests on it" if unpinned_fit(fit) else ""
             text = (f"{worst} (λ/λ_target = {ratio_text(value, 2)}{unpinned})"
                     + (f"; also beyond their objectives: {', '.join(others)}" if others else ""))
         grouped.setdefault(text, []).append(_label(labels))
