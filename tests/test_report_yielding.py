@@ -352,7 +352,7 @@ def test_the_damage_section_says_which_runs_and_stripes_and_lists_every_limit_st
         assert row["λ/λ_target"] == f"{rate / (-math.log(1 - target) / 50):.3g}"
         reason = str(why.sel(limit_state=state).item())  # issue 45: a lognormal its runs do not pin is not presented as identified
         assert row["fit"] in (f"lognormal, not identified ({reason})" if reason else "lognormal", "step: never", "step: separated",
-                              "flat: decreasing (F ≡ fraction of runs that pounded)")
+                              "flat: decreasing (F ≡ fraction of runs that reached it)")  # reached, not pounded
     assert any(lowest.values.ravel()) or any(why.values.ravel())  # the store has a bound or an unidentified fit to print
 
 
@@ -693,4 +693,8 @@ def test_a_governing_limit_state_on_a_fit_the_runs_do_not_pin_says_so():
     from stochpound.risk._fragility import DECREASING
 
     assert unpinned_fit(fit_name(DECREASING)) and unpinned_fit("step at the lowest stripe: a bound")
+    from stochpound.risk import limit_state_fits
+
+    flat = damage.risk.assign(status_collapses_apart=damage.risk["status_collapses_apart"] * 0 + DECREASING)
+    assert set(limit_state_fits(flat, apart=True).values.ravel()) == {"flat: decreasing (F ≡ fraction of runs that reached it)"}
     assert not unpinned_fit("lognormal") and not unpinned_fit("step: separated") and not unpinned_fit("step: never")

@@ -324,7 +324,8 @@ def limit_state_fits(risk: xr.Dataset, apart: bool = False) -> xr.DataArray:
     with the runs beyond the model counted apart (the fit as run where no run is beyond it)."""
     if apart and "status_collapses_apart" in risk:
         risk = risk.assign({name: risk[f"{name}_collapses_apart"] for name in ("status", "theta", "beta")})
-    name = xr.apply_ufunc(np.vectorize(lambda status: fit_name(int(status)), otypes=[object]), risk["status"])
+    name = xr.apply_ufunc(np.vectorize(lambda status: fit_name(int(status)).replace("runs that pounded", "runs that reached it"), otypes=[object]),
+                          risk["status"])  # a limit state is reached, not pounded
     why = unidentified(risk)
     name = xr.apply_ufunc(np.vectorize(lambda n, w: f"{n}, not identified ({w})" if w else n, otypes=[object]), name, why)
     return name.where(~at_lowest_stripe(risk), "step at the lowest stripe: a bound")

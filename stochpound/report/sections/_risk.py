@@ -240,7 +240,7 @@ def _listed(counted: tuple[dict[str, int], int], unpinned: Collection[str] = ())
     (:meth:`~stochpound.risk.StoreDamage.governing_unidentified`) said to rest on a fit the runs do not pin."""
     states, configurations = counted
     return ", ".join(f"{state} in {count} of {configurations} configurations"
-                     + (" (on a fit the runs do not pin: a lognormal not identified or a bound, the Damage section's table)" if state in unpinned else "")
+                     + (" (on a fit the runs do not pin: a lognormal not identified, a flat fraction or a bound, the Damage section's table)" if state in unpinned else "")
                      for state, count in states.items())
 
 
