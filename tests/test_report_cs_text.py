@@ -79,6 +79,14 @@ def test_risk_warns_of_stripes_that_miss_their_target_or_lie_beyond_the_truncati
     flagged = cs_store.assign(selection_misses_target=cs_store.selection_misses_target.copy(data=[0, 1]),
                               target_epsilon=cs_store.target_epsilon.copy(data=[1.0, 3.4]))
     assert selection_misses(flagged) == [0.1] and stripes_beyond_truncation(flagged) == [0.1]
+    # the design summary's assumptions name them too (the flagships' listed neither, though their 2 %/50 yr stripe missed)
+    from stochpound.risk._inputs import assumptions
+
+    assert "selection fit" not in assumptions(clean)
+    assert assumptions(flagged)["selection fit"] == (
+        "the motions chosen at the stripes 0.1 g miss their conditional-spectrum target (mean or standard deviation of ln Sa off by "
+        "more than 0.1 at a period); the scenario puts the stripes 0.1 g beyond ε 3, where hazard models truncate the ground motion: "
+        "the answer takes those stripes' motions as the site's there")
     outputs = []
     for name, store in (("clean", clean), ("flagged", flagged)):
         store.to_netcdf(tmp_path / f"{name}.nc")
@@ -112,3 +120,15 @@ def test_the_design_summary_counts_the_motions_that_ran_not_the_pool(cs_store) -
     assert 3 <= chosen < 8
     assert assumptions(cs_store)["suite"] == (f"{chosen} motions ran (records without a named suite), selected per stripe by conditional "
                                               "spectrum from a pool of 8 records")
+
+
+def test_the_motion_table_caption_counts_one_simulated_row_per_experiment() -> None:
+    """The flagships' table said '24 of the 200 motions … and, in one row, the 522 simulated motions' for 23 record rows and two
+    simulated rows (266 and 256, one per experiment): the caption took one row off for the simulated motions whatever their rows."""
+    from stochpound.report.sections._description import motions_caption
+
+    assert motions_caption(23, 200, [266, 256]).endswith(
+        "(23 of the 200 motions the experiments define: a selection's pool motions it never chose are left out; and, in one row per "
+        "experiment, the 522 simulated motions some stripe chose).")
+    assert "in one row, the 40 simulated motions" in motions_caption(3, 8, [40])
+    assert motions_caption(8, 8).endswith("seed and size.")

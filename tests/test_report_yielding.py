@@ -190,7 +190,7 @@ def test_governs_is_judged_in_each_treatment_of_the_collapses_and_a_disagreement
             f"beyond the model counted apart as collapses, mu 0.05: {states[1].label} (λ/λ_target = {9e-4 / rates[1]:.2g})") in text
     assert (f"The two treatments disagree on what governs in 1 of 2 configurations (mu 0.05: pounding at g* as run, {states[1].label} "
             "with collapses apart)") in text
-    summary = _structural_governs(damage, 0.1, "pounding between the buildings")
+    summary = _structural_governs(damage)  # the same at every target: no target, and no separation's limit, in it
     assert summary.startswith(f"as run, {states[0].label} in 1 of 2 configurations") and "the two treatments disagree in 1 of 2" in summary
     assert f"with the runs beyond the model counted apart as collapses, {states[1].label} in 1 of 2 configurations, {states[0].label} in 1" in summary
     # the same judgement for stochpound risk --limit-states: a finite-gap grid says none beyond its objective where nothing misses
@@ -352,7 +352,7 @@ def test_the_damage_section_says_which_runs_and_stripes_and_lists_every_limit_st
         assert row["λ/λ_target"] == f"{rate / (-math.log(1 - target) / 50):.3g}"
         reason = str(why.sel(limit_state=state).item())  # issue 45: a lognormal its runs do not pin is not presented as identified
         assert row["fit"] in (f"lognormal, not identified ({reason})" if reason else "lognormal", "step: never", "step: separated",
-                              "flat: decreasing (F ≡ fraction of runs that pounded)")
+                              "flat: decreasing (F ≡ fraction of runs that reached it)")  # reached, not pounded
     assert any(lowest.values.ravel()) or any(why.values.ravel())  # the store has a bound or an unidentified fit to print
 
 
@@ -463,14 +463,18 @@ def test_the_design_summary_names_the_limit_state_the_damage_section_finds_gover
     # as run no run reaches it; counted apart, the collapses do, more often than 10 % in 50 yr allows: the treatments disagree
     collapse = unreached.risk["maf_collapses_apart"].item()
     assert collapse > -math.log(0.9) / 50.0
-    assert ("Governing limit state (the largest λ/λ_target of the limit states, each against its own objective; pounding at g* has 1): "
-            "as run, no limit state beyond its objective; with the runs beyond the model counted apart as collapses, peak storey "
-            "ductility ≥ 10000 in 1 of 1 configurations (a limit state beyond its own objective") in text
+    assert ("Governing limit state (the largest λ/λ_target of the limit states, each against its own objective, the same at every "
+            "target; pounding at g* has 1): as run, no limit state beyond its objective; with the runs beyond the model counted apart "
+            "as collapses, peak storey ductility ≥ 10000 in 1 of 1 configurations") in text
+    # said once, not once per target (the flagship's summary repeated the whole verdict for 10 % and for 2 % in 50 yr)
+    assert text.count("Governing limit state") == 1 and text.count("the two treatments disagree in 1 of 1 configurations") == 1
     assert ("; the two treatments disagree in 1 of 1 configurations: what governs depends on whether the runs beyond the model are "
-            "taken as computed or as collapses); in the other configurations, pounding between the buildings for 10 % in 50 yr") in text
+            "taken as computed or as collapses). At g*, what limits the separation: pounding between the buildings for 10 % in 50 yr; "
+            "pounding between the buildings for 2 % in 50 yr.") in text
     for damage in (store_damage(store, [LimitState("ductility", 1.0e4)], "a test"), None):  # no objective: nothing ranked
         text = design_summary_text(risk, None, damage)
-        assert "Limit state judged (no structural limit state with an objective, so none is ranked against it): pounding between" in text
+        assert ("Limit state judged (no structural limit state with an objective, so none is ranked against it; at g*, what limits the "
+                "separation): pounding between") in text
         assert "Governing" not in text
 
 
@@ -609,6 +613,8 @@ def test_the_sensitivity_table_recomputes_g_star_under_each_choice(store):
     np.testing.assert_allclose(frame["β_m = 1e-06"].values, frame["g* (m)"].values, rtol=1e-4)
     np.testing.assert_allclose(frame["grid ×4 finer near g*: Δ (%)"].values, 100 * (refined / frame["g* (m)"].values - 1), rtol=1e-12)
     assert list(frame["collapses apart"]) == [np.inf, np.inf]
+    # a pair without walls: their stiffness is no choice its answer rests on (the fixed flagship listed it as not evaluated)
+    assert sensitivity.not_evaluated == ("seed", "measure") and "moat wall" not in sensitivity.text()
     text = sensitivity_text(frame, not_evaluated=("seed", "measure", "wall"))
     assert "Not evaluated (each needs other runs): the selection seed (needs a store of the same experiment with another" in text
     assert "bound the record-to-record sampling of the motions only" in text
@@ -651,3 +657,44 @@ def test_a_ratio_that_decides_the_objective_never_prints_as_one():
 
     assert (ratio_text(1.003), ratio_text(0.998), ratio_text(1.02), ratio_text(0.25, 2)) == ("1.003", "0.998", "1.02", "0.25")
     assert _ratio_cell(1.0029, math.nan) == "1.003" and _ratio_cell(0.5, 1.001) == "≥ 1.001"
+    # the governs sentence (2 digits) printed '(λ/λ_target = 1)' for 1.03 and 1.01, where the table said they miss the objective
+    assert (ratio_text(1.03, 2), ratio_text(1.01, 2), ratio_text(0.96, 2), ratio_text(2.45, 2)) == ("1.03", "1.01", "0.96", "2.5")
+
+
+def test_a_governing_limit_state_on_a_fit_the_runs_do_not_pin_says_so():
+    """The isolated flagship named 'peak storey drift ratio of B2 ≥ 0.025' governing with the collapses counted apart
+    (λ/λ_target 2.0–2.5) from the credible runs' fit over counts 0, 1, 1, 1, 1, 0, 0 of 40, a lognormal the runs do not identify,
+    whose λ is extrapolated down to the hazard table's 0.01 g; neither the sentence nor the table said on what fit."""
+    import dataclasses
+
+    from stochpound.report.sections._damage import _governing_text, _limit_states_table
+    from stochpound.report.sections._risk import _structural_governs
+    from stochpound.risk._fragility import FIT
+
+    states, risk, damage = _two_treatments()
+    fit = {"status": (("limit_state", "mu"), [[FIT, FIT], [FIT, FIT]]), "theta": (("limit_state", "mu"), [[0.5, 0.5], [0.8, 0.8]]),
+           "beta": (("limit_state", "mu"), [[0.4, 0.4], [0.5, 0.5]])}
+    apart = {f"{name}_collapses_apart": (dims, [[*row] for row in values]) for name, (dims, values) in fit.items()}
+    apart["theta_collapses_apart"] = (("limit_state", "mu"), [[0.5, 0.5], [5.0, 0.8]])  # collapse prevention at μ 0.05: beyond the top
+    damage = dataclasses.replace(damage, risk=risk.assign(**fit, **apart).assign_coords(intensity=[0.2, 0.5, 1.0]))
+    text = _governing_text(damage)
+    assert (f"mu 0.05: {states[1].label} (λ/λ_target = 2.2; its fit, lognormal, not identified (θ = 5 beyond the top stripe 1), is not "
+            "pinned by the runs: the ratio rests on it)") in text
+    assert text.count("not pinned") == 1  # as run, every governing fit is identified
+    summary = _structural_governs(damage)
+    assert f"{states[1].label} in 1 of 2 configurations (on a fit the runs do not pin" in summary
+    assert summary.count("on a fit the runs do not pin") == 1
+    table = _limit_states_table("t", damage).frame
+    assert table["fit collapses apart"].tolist().count("lognormal, not identified (θ = 5 beyond the top stripe 1)") == 1
+    # the flagship's credible runs of the neighbour's 2.5 % drift (0, 1, 1, 1, 1, 0, 0 of 40) gave a flat fit: its fraction held
+    # down to the hazard table's 0.01 g made λ 5 times the as-run rate, and it governed unflagged
+    from stochpound.risk import unpinned_fit
+    from stochpound.risk._chain import fit_name
+    from stochpound.risk._fragility import DECREASING
+
+    assert unpinned_fit(fit_name(DECREASING)) and unpinned_fit("step at the lowest stripe: a bound")
+    from stochpound.risk import limit_state_fits
+
+    flat = damage.risk.assign(status_collapses_apart=damage.risk["status_collapses_apart"] * 0 + DECREASING)
+    assert set(limit_state_fits(flat, apart=True).values.ravel()) == {"flat: decreasing (F ≡ fraction of runs that reached it)"}
+    assert not unpinned_fit("lognormal") and not unpinned_fit("step: separated") and not unpinned_fit("step: never")

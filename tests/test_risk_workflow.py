@@ -366,8 +366,8 @@ def test_report_section_states_the_separation_first(isolated_store):
     assert stored_hazard(store).source.startswith("Site: Fox Plaza")
     assert risk.assumptions["structural model"].startswith("B1: 2-storey shear building, linear elastic storeys, on a sliding base; B2:")
     summary = section.blocks[1].text
-    assert summary.startswith("Design summary. Limit state judged (no structural limit state with an objective, so none is ranked against it): "
-                              "pounding between the buildings") and "scaled to every stripe" in summary
+    assert summary.startswith("Design summary. Limit state judged (no structural limit state with an objective, so none is ranked against it; "
+                              "at g*, what limits the separation): pounding between the buildings") and "scaled to every stripe" in summary
 
 
 def test_the_report_gives_the_risk_answer_in_its_summary_and_no_repr_in_its_prose(isolated_store):

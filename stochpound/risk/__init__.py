@@ -80,7 +80,7 @@ from stochpound.risk._efficiency import measure_efficiency, most_efficient
 from stochpound.risk._efficiency import candidate_name  # noqa: F401  (for stochpound.experiment.measure_choice: not public API)
 from stochpound.risk._collapse import CollapseRisk, beyond_model, collapse_risk, collapsed_runs, rate_collapses_apart
 from stochpound.risk._sensitivity import ALTERNATIVES, MODELLING_DISPERSIONS, Sensitivity, check_alternative, separation_sensitivity, sensitivity_text
-from stochpound.risk._damage import DAMAGE_DEMANDS, DEFAULT_LIMIT_STATES, DEFAULT_SOURCE as DEFAULT_LIMIT_STATES_SOURCE, MODEL_DRIFT_LIMIT, StoreDamage, store_damage
+from stochpound.risk._damage import DAMAGE_DEMANDS, DEFAULT_LIMIT_STATES, DEFAULT_SOURCE as DEFAULT_LIMIT_STATES_SOURCE, MODEL_DRIFT_LIMIT, StoreDamage, store_damage, unpinned_fit
 from stochpound.hazard import hazard_consistency, read_hazard_file, stripe_rate_weights
 from stochpound.risk._site_consistency import consistency_at_targets, site_consistency
 from stochpound.risk._stripe_demand import stripe_demand_rate
@@ -153,6 +153,7 @@ __all__ = [
     "disagreement_text",
     "limit_state_fits",
     "store_damage",
+    "unpinned_fit",
     "DAMAGE_DEMANDS",
     "StoreDamage",
     "DEFAULT_LIMIT_STATES",

@@ -147,8 +147,15 @@ def rate_collapses_apart(demand: xr.DataArray, collapsed: xr.DataArray, threshol
     demand, collapsed = xr.align(demand, _dims_only(collapsed), join="inner")
     collapse = stripe_fragility(collapsed, bootstrap=0)
     collapse["maf"] = mean_annual_frequency(collapse, hz)
-    credible = stripe_fragility(limit_state_events(demand.where(collapsed == 0.0), thresholds, dim), bootstrap=0)
-    return combined_rate(collapse, credible, hz), collapse
+    return combined_rate(collapse, credible_fit(demand, collapsed, thresholds, dim), hz), collapse
+
+
+def credible_fit(demand: xr.DataArray, collapsed: xr.DataArray, thresholds: Sequence[float] | np.ndarray, dim: str) -> xr.Dataset:
+    """The credible runs' stripe fit of ``demand`` ≥ each threshold (:func:`~stochpound.risk.stripe_fragility`, no bootstrap): the
+    fit :func:`rate_collapses_apart` combines with P(C | IM), whose kind (a lognormal the runs identify or not, a step) says what
+    its rate rests on. ``demand``, ``collapsed``, ``thresholds`` and ``dim`` as there."""
+    demand, collapsed = xr.align(demand, _dims_only(collapsed), join="inner")
+    return stripe_fragility(limit_state_events(demand.where(collapsed == 0.0), thresholds, dim), bootstrap=0)
 
 
 def collapse_risk(store: xr.Dataset, hz: HazardCurve, gaps: Sequence[float] | np.ndarray, targets: Sequence[float],

@@ -199,14 +199,39 @@ class StoreDamage:
         index = ratio.fillna(-1.0).argmax("limit_state")
         return ratio.isel(limit_state=index), ratio["limit_state"][index].drop_vars("limit_state", errors="ignore")
 
-    def fits(self) -> xr.DataArray | None:
-        """Each limit state's fit in words over ``risk``'s dimensions (``stochpound.risk.limit_state_fits``); None without ``risk``."""
-        return None if self.risk is None else limit_state_fits(self.risk)
+    def fits(self, apart: bool = False) -> xr.DataArray | None:
+        """Each limit state's fit in words over ``risk``'s dimensions (``stochpound.risk.limit_state_fits``; with ``apart``, the
+        credible runs' fit behind λ with the runs beyond the model counted apart); None without ``risk``."""
+        return None if self.risk is None or "status" not in self.risk else limit_state_fits(self.risk, apart)
+
+    def governing_unidentified(self, apart: bool = False) -> dict[str, str]:
+        """The governing limit states (:meth:`governing`) whose fit, in some configuration they govern, the runs do not pin (a
+        lognormal not identified, or a step at the lowest stripe: its λ a bound), each with that fit in words; {} where none is."""
+        governing, fits = self.governing(0.0, apart), self.fits(apart)
+        if governing is None or fits is None:
+            return {}
+        found: dict[str, str] = {}
+        for index in np.ndindex(governing.shape):
+            state = str(governing.values[index])
+            if state == POUNDING or state in found:
+                continue
+            labels = {dim: governing[dim].values[i] for dim, i in zip(governing.dims, index)}
+            fit = str(fits.sel(labels).sel(limit_state=state).item())
+            if unpinned_fit(fit):
+                found[state] = fit
+        return found
 
     def misses_objective(self, apart: bool = False) -> xr.DataArray | None:
         """Per limit state and configuration, whether λ exceeds its objective's rate (λ/λ_target > 1; False without an objective)."""
         ratio = self.ratio(apart)
         return None if ratio is None else ratio > 1.0
+
+
+def unpinned_fit(fit: str) -> bool:
+    """Whether a limit state's fit in words (``stochpound.risk.limit_state_fits``) is one the runs do not pin: a lognormal not
+    identified, a step at the lowest stripe (its λ a bound) or a flat fit (a fraction held down to the hazard's lowest intensity)."""
+    return "not identified" in fit or "lowest stripe" in fit or fit.startswith("flat")
+
 
 
 def store_damage(store: xr.Dataset, limit_states: Sequence[LimitState] | None = None, source: str | None = None) -> StoreDamage | None:

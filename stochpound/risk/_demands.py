@@ -1,12 +1,14 @@
 """Demand hazard curves of a store's stripes at its site, and moat-wall contact as a limit state.
 
-From the runs without impacts (contacts open, walls never reached) of a
-store with intensity stripes: the studied building's peak base
+From the contact-free runs (the contacts between buildings open; with a
+moat wall on a variant axis, the walled runs, whose base displacement the
+wall caps near its clearance) of a store with intensity stripes: the studied building's peak base
 displacement (when it slides) and, with ``[output] demands = true``, every
 building's peak storey drift and floor acceleration, each as a demand
 hazard curve (:func:`~stochpound.risk.demand_hazard_curve`) over
 :data:`DEMAND_LEVELS` levels from the 1 % quantile of its positive values
-to its largest. When the scene has moat walls at the studied building's
+to its largest (and, for the base displacement, the moat clearances:
+:func:`demand_levels`). When the scene has moat walls at the studied building's
 base, the rate with which its base reaches each wall's clearance (before
 the first wall impact a run with the wall equals the run without).
 """
@@ -106,9 +108,9 @@ class StoreDemands:
         """A demand's exceedance rate with the collapses counted apart (``apart``), made non-increasing along its levels (1/yr)."""
         return non_increasing_along(self.apart[label], "level")
 
-    def wall_rates(self, targets: Sequence[float], years: float) -> list[tuple[float, float, float, float]]:
-        """Per target (a probability in ``years``) and moat clearance: (target, clearance m, rate of reaching the wall in its worst
-        configuration 1/yr, the target's rate 1/yr); [] without a moat."""
+    def wall_exceedances(self, targets: Sequence[float], years: float) -> list[tuple[float, float, list[dict[str, Hashable]], int, float]]:
+        """Per target and moat clearance: (target, clearance m, the configurations whose base reaches it more often than the
+        target allows, the number of configurations, the largest rate of reaching it 1/yr); [] without a moat."""
         if self.moat is None:
             return []
         rows = []
@@ -116,7 +118,9 @@ class StoreDemands:
             allowed = float(rate_from_probability(float(target), years))
             for clearance in self.moat["level"].values:
                 maf = self.moat["maf"].sel(level=clearance)
-                rows.append((float(target), float(clearance), float(maf[maf.fillna(-1.0).argmax(...)]), allowed))
+                every = _configurations(maf)
+                over = [labels for labels in every if float(maf.sel(labels)) > allowed]
+                rows.append((float(target), float(clearance), over, len(every), float(maf.max())))
         return rows
 
     def wall_interval(self, clearance: float) -> tuple[float, float] | None:
@@ -161,26 +165,37 @@ def store_demands(store: xr.Dataset, hz: HazardCurve | None = None, confidence: 
     studied = _inputs.studied_building(store)
     demands: dict[str, tuple[xr.DataArray, str]] = {}
     sliding = _inputs.base_displacement(store, studied, walls_free=True)
+    base = f"peak base displacement of {studied}"
     if sliding is not None:
-        demands[f"peak base displacement of {studied}"] = (sliding, "m")
+        demands[base] = (sliding, "m")
     demands.update(_inputs.stored_demands(store))
     if not demands:
         return None
     collapsed = _inputs.demand_drift(store)
     collapsed = None if collapsed is None else beyond_model(collapsed)
     collapsed = collapsed if collapsed is not None and bool((collapsed == 1.0).any()) else None
+    clearances = _inputs.moat_clearances(store, studied)
     curves, apart = {}, {}
     for label, (demand, _) in demands.items():
-        values = demand.values[np.isfinite(demand.values) & (demand.values > 0)]
-        levels = np.geomspace(np.quantile(values, 0.01), values.max(), DEMAND_LEVELS)
+        levels = demand_levels(demand, clearances if label == base else ())
         curves[label] = demand_hazard_curve(demand, levels, hz, confidence=confidence, bootstrap=0)
         if collapsed is not None:
             apart[label] = rate_collapses_apart(demand, collapsed, levels, "level", hz)[0].assign_coords(level=levels)
-    clearances = _inputs.moat_clearances(store, studied)
     moat = (demand_hazard_curve(sliding, clearances, hz, confidence=confidence, bootstrap=bootstrap, seed=seed)
             if sliding is not None and clearances else None)
     counts = (None, None) if collapsed is None else (collapsed.sum("record"), collapsed.notnull().sum("record"))
     return StoreDemands(curves, {label: units for label, (_, units) in demands.items()}, moat, apart=apart, beyond_model=counts[0], runs=counts[1])
+
+
+def demand_levels(demand: xr.DataArray, clearances: Sequence[float] = ()) -> np.ndarray:
+    """The levels of a demand's hazard curve: ``DEMAND_LEVELS`` log-spaced from the 1 % quantile of its positive values to its
+    largest, with the moat clearances inside that range added (a walled run's base displacement stops at its clearance, so
+    its curve drops there: read between coarser levels, the displacement at a target's rate would fall short of a wall the
+    base reaches more often than the target allows)."""
+    values = demand.values[np.isfinite(demand.values) & (demand.values > 0)]
+    levels = np.geomspace(np.quantile(values, 0.01), values.max(), DEMAND_LEVELS)
+    inside = [c for c in clearances if levels[0] < c < levels[-1]]
+    return np.union1d(levels, inside) if inside else levels
 
 
 def _configurations(data: xr.DataArray) -> list[dict[str, Hashable]]:

@@ -150,7 +150,7 @@ def chapter17_of(building: Building, design: Design, g: float) -> tuple[Chapter1
     if plan is SQUARE_PLAN:  # the plan's own sentences speak of a 1 m side: say what was assumed instead
         said = [a for a in result.assumptions if not a.startswith(("e = ", "y = "))]
         result = dataclasses.replace(result, assumptions=("square plan assumed (no [design.isolation] plan): accidental eccentricity "
-                                                          "0.05 d at the far corner y = d/2, D_TM = 1.15 D_M whatever d", *said))
+                                                          "0.05 d at the far corner y = d/2 and P_T = 1 (isolators spread evenly), D_TM = 1.15 D_M whatever d", *said))
     return result, spectrum, source
 
 

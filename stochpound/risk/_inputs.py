@@ -327,7 +327,20 @@ def assumptions(store: xr.Dataset, scenes: Mapping[tuple[Any, ...], Scene] | Non
     said = simulated_motions_text(len(simulated), count, generated.model, generated.calibration) if simulated and generated else ""
     return {"structural model": "; ".join(models), **scene_assumptions(scenes or {}), "suite": suite,
             **({"simulated motions": said} if said else {}),
-            "scenario": scenario or "none stated (the motions are not selected for a scenario)"}
+            "scenario": scenario or "none stated (the motions are not selected for a scenario)", **_selection_fit(store)}
+
+
+def _selection_fit(store: xr.Dataset) -> dict[str, str]:
+    """{"selection fit": ...} naming the stripes whose chosen motions miss their conditional-spectrum target and those its
+    scenario puts beyond the truncation ε, which the answer still takes as the site's motions; {} where there are none."""
+    misses, beyond = selection_misses(store), stripes_beyond_truncation(store)
+    intensity = store.pound.definition.intensity
+    units = f" {intensity.units}" if intensity is not None and intensity.units else ""
+    said = ([f"the motions chosen at the stripes {', '.join(f'{level:.4g}' for level in misses)}{units} miss their conditional-spectrum "
+             "target (mean or standard deviation of ln Sa off by more than 0.1 at a period)"] if misses else []) + (
+            [f"the scenario puts the stripes {', '.join(f'{level:.4g}' for level in beyond)}{units} beyond ε {TRUNCATION_EPSILON:g}, "
+             "where hazard models truncate the ground motion"] if beyond else [])
+    return {"selection fit": "; ".join(said) + ": the answer takes those stripes' motions as the site's there"} if said else {}
 
 
 def _base_words(mu: MuAxis | None, building: BuildingTable) -> str:

@@ -35,7 +35,7 @@ from stochpound.risk._inputs import LimitStates
 from stochpound.risk._fragility_ensemble import limit_state_events, stripe_fragility
 from stochpound.risk._maf import mean_annual_frequency
 from stochpound.risk._chain import CONFIDENCE, YEARS, fit_name
-from stochpound.risk._collapse import MODEL_DRIFT_LIMIT, beyond_model, rate_collapses_apart
+from stochpound.risk._collapse import MODEL_DRIFT_LIMIT, beyond_model, credible_fit, rate_collapses_apart
 from stochpound.risk._stripe_coverage import at_lowest_stripe, stripes_only_maf, unidentified
 
 
@@ -248,7 +248,9 @@ def limit_state_risk(store: xr.Dataset, limit_states: Sequence[LimitState], hz: 
                                       target=("limit_state", [math.nan if state.target is None else float(state.target)])))
         if collapsed is not None:
             rate = rate_collapses_apart(demand, collapsed, [state.capacity], "limit_state", hz)[0].assign_coords(limit_state=[state.label])
-            apart.append(xr.Dataset({"maf_collapses_apart": rate, "bound_collapses_apart": _apart_bound(events, collapsed, hz)}))
+            credible = credible_fit(demand, collapsed, [state.capacity], "limit_state").assign_coords(limit_state=[state.label])
+            apart.append(xr.Dataset({"maf_collapses_apart": rate, "bound_collapses_apart": _apart_bound(events, collapsed, hz),
+                                     **{f"{name}_collapses_apart": credible[name] for name in ("status", "theta", "beta")}}))
     result = xr.concat(fits, "limit_state", coords="different", compat="equals", join="outer")
     result["maf"] = mean_annual_frequency(result, hz)
     if apart:
@@ -257,6 +259,9 @@ def limit_state_risk(store: xr.Dataset, limit_states: Sequence[LimitState], hz: 
             units="1/yr", long_name=f"mean annual frequency, the runs beyond a {100 * MODEL_DRIFT_LIMIT:g} % storey drift counted apart as collapses")
         result["bound_collapses_apart"] = both["bound_collapses_apart"].assign_attrs(
             units="1/yr", long_name="the stripes' fractions alone, collapses counted as reaching the limit state (nothing below the lowest stripe)")
+        for name in ("status", "theta", "beta"):  # the credible runs' fit, whose kind says what λ collapses apart rests on
+            result[f"{name}_collapses_apart"] = both[f"{name}_collapses_apart"].assign_attrs(
+                long_name=f"{name} of the credible runs' fit (the runs beyond the model left out)")
         result["beyond_model"] = collapsed.sum("record").assign_attrs(units="1", long_name="runs beyond the model (collapses) per stripe")
     twins = _inputs.contact_free_twins(result["maf"])
     if twins is not None:
@@ -312,11 +317,15 @@ def governing_disagreement(risk: xr.Dataset, within: str = POUNDING) -> xr.DataA
     return None if run is None else run != apart
 
 
-def limit_state_fits(risk: xr.Dataset) -> xr.DataArray:
+def limit_state_fits(risk: xr.Dataset, apart: bool = False) -> xr.DataArray:
     """Each limit state's fit in words over :func:`limit_state_risk`'s dimensions: ``lognormal``, ``step: never`` …;
     ``lognormal, not identified (why)`` where :func:`~stochpound.risk.unidentified` says so; ``step at the lowest stripe: a
-    bound`` where its λ is one (:func:`~stochpound.risk.at_lowest_stripe`)."""
-    name = xr.apply_ufunc(np.vectorize(lambda status: fit_name(int(status)), otypes=[object]), risk["status"])
+    bound`` where its λ is one (:func:`~stochpound.risk.at_lowest_stripe`). With ``apart``, the credible runs' fit behind λ
+    with the runs beyond the model counted apart (the fit as run where no run is beyond it)."""
+    if apart and "status_collapses_apart" in risk:
+        risk = risk.assign({name: risk[f"{name}_collapses_apart"] for name in ("status", "theta", "beta")})
+    name = xr.apply_ufunc(np.vectorize(lambda status: fit_name(int(status)).replace("runs that pounded", "runs that reached it"), otypes=[object]),
+                          risk["status"])  # a limit state is reached, not pounded
     why = unidentified(risk)
     name = xr.apply_ufunc(np.vectorize(lambda n, w: f"{n}, not identified ({w})" if w else n, otypes=[object]), name, why)
     return name.where(~at_lowest_stripe(risk), "step at the lowest stripe: a bound")

@@ -22,7 +22,8 @@ From other stores of the same experiment (``alternatives``): the selection
 seed, the conditioning measure and the moat wall's stiffness
 (``ALTERNATIVES``), each store checked to differ from the store only in that
 (:func:`check_alternative`); g* of each at the same targets. A choice no store
-was given for is named as not evaluated, with what would evaluate it.
+was given for is named as not evaluated, with what would evaluate it (the
+walls' stiffness only where the scene has a wall).
 """
 
 from __future__ import annotations
@@ -145,7 +146,14 @@ def separation_sensitivity(risk: object, store: xr.Dataset | RiskInputs, collaps
         columns[_unique(label, columns)] = store_risk(other, hazard, targets, years, bootstrap=0, partial=bool(risk.progress)).separation[
             "separation"]
     given = {kind for kind, _ in alternatives}
-    return Sensitivity(_table(columns, years), risk.grid, tuple(k for k in ALTERNATIVES if k not in given))
+    moot = set() if isinstance(store, RiskInputs) or _has_walls(store) else {"wall"}  # no wall: its stiffness is no choice of this answer
+    return Sensitivity(_table(columns, years), risk.grid, tuple(k for k in ALTERNATIVES if k not in given | moot))
+
+
+def _has_walls(store: xr.Dataset) -> bool:
+    """Whether a store's scene (or one of its variants) has a wall: without one, the walls' stiffness is no choice its answer rests on."""
+    definition = store.pound.definition
+    return bool(definition.tables.walls) or any(override.scene.walls for variant in definition.variants for override in variant.edits.values())
 
 
 def _table(columns: Mapping[str, xr.DataArray], years: float) -> pd.DataFrame:

@@ -8,7 +8,7 @@ import pandas as pd
 
 from stochpound.report.render import Paragraph, Section, Table
 from stochpound.report.sections._description import number
-from stochpound.risk import DAMAGE_DEMANDS, MODEL_DRIFT_LIMIT, POUNDING_AT_G_STAR as POUNDING, UNIDENTIFIED_BETA, StoreDamage
+from stochpound.risk import DAMAGE_DEMANDS, MODEL_DRIFT_LIMIT, POUNDING_AT_G_STAR as POUNDING, UNIDENTIFIED_BETA, StoreDamage, unpinned_fit
 
 
 def damage_section(name: str, damage: StoreDamage) -> Section:
@@ -127,6 +127,7 @@ def _governs_text(damage: StoreDamage, probability: float, apart: bool) -> str:
     the configurations with the same answer grouped."""
     governing, misses = damage.governing(probability, apart), damage.misses_objective(apart)
     largest, largest_state = damage.largest_ratio(apart)
+    fits = damage.fits(apart)
     grouped: dict[str, list[str]] = {}
     for labels in _configurations(governing):
         worst = str(governing.sel(labels).item())
@@ -135,7 +136,10 @@ def _governs_text(damage: StoreDamage, probability: float, apart: bool) -> str:
             text = f"{POUNDING} (every limit state within its objective; the largest λ/λ_target is {ratio_text(value, 2)}, {largest_state.sel(labels).item()})"
         else:
             others = [str(state) for state, flag in zip(misses["limit_state"].values, misses.sel(labels).values) if flag and state != worst]
-            text = f"{worst} (λ/λ_target = {ratio_text(value, 2)})" + (f"; also beyond their objectives: {', '.join(others)}" if others else "")
+            fit = str(fits.sel(labels).sel(limit_state=worst).item()) if fits is not None else ""
+            unpinned = f"; its fit, {fit}, is not pinned by the runs: the ratio rests on it" if unpinned_fit(fit) else ""
+            text = (f"{worst} (λ/λ_target = {ratio_text(value, 2)}{unpinned})"
+                    + (f"; also beyond their objectives: {', '.join(others)}" if others else ""))
         grouped.setdefault(text, []).append(_label(labels))
     every = len(_configurations(governing))
     return "; ".join((f"{' and '.join(names)}: " if len(names) < every else "") + text for text, names in grouped.items())
@@ -158,6 +162,7 @@ def _agreement_text(damage: StoreDamage) -> str:
 def _limit_states_table(name: str, damage: StoreDamage) -> Table:
     maf, periods, fits = damage.risk["maf"], damage.return_period(), damage.fits()
     ratio, apart, bound_ratio = damage.ratio(), damage.collapses_apart(), damage.bound_ratio()
+    fits_apart = damage.fits(apart=True)
     rows = []
     for labels in _configurations(maf):
         for state in maf["limit_state"].values:
@@ -171,11 +176,12 @@ def _limit_states_table(name: str, damage: StoreDamage) -> Table:
             if apart:
                 bound_apart = float(damage.bounds(apart=True).sel(at)) if damage.bound is not None else math.nan
                 row["λ collapses apart (1/yr)"] = _rate_cell(float(damage.risk["maf_collapses_apart"].sel(at)), bound_apart)
+                row["fit collapses apart"] = str(fits_apart.sel(at).item())
                 row["λ/λ_target collapses apart"] = (_ratio_cell(float(damage.ratio(apart=True).sel(at)), float(damage.bound_ratio(apart=True).sel(at))
                                                                  if damage.bound is not None else math.nan) if target == target else "")
             rows.append(row)
-    both = (" and, with the runs beyond the model counted apart as collapses (FEMA P-58, by total probability: above), λ and its "
-            "ratio that way") if apart else ""
+    both = (" and, with the runs beyond the model counted apart as collapses (FEMA P-58, by total probability: above), λ, the "
+            "credible runs' fit behind it and its ratio that way") if apart else ""
     return Table(
         key=f"table-limit-states-{name}",
         caption=(f"Experiment {name}: the limit states' mean annual frequency λ with its fit, the return period, per configuration, "
@@ -205,6 +211,10 @@ def _ratio_cell(ratio: float, bounded: float) -> str:
 
 
 def ratio_text(ratio: float, digits: int = 3) -> str:
-    """λ/λ_target to ``digits`` significant digits, but to 0.001 within 0.5 % of 1: a ratio that decides whether the objective is
-    missed never prints as a bare ``1`` (1.003 misses it, 0.998 does not)."""
-    return f"{ratio:.3f}" if abs(ratio - 1.0) < 0.005 else f"{ratio:.{digits}g}"
+    """λ/λ_target to ``digits`` significant digits, but to 0.001 within 0.5 % of 1, and with a digit more where ``digits`` would
+    round it to 1: a ratio that decides whether the objective is missed never prints as a bare ``1`` (1.003 misses it, 0.998
+    does not; 1.03 governs)."""
+    if abs(ratio - 1.0) < 0.005:
+        return f"{ratio:.3f}"
+    text = f"{ratio:.{digits}g}"
+    return f"{ratio:.{digits + 1}g}" if float(text) == 1.0 else text

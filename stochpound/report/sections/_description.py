@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import json
 import math
-from collections.abc import Hashable, Iterable, Mapping
+from collections.abc import Hashable, Iterable, Mapping, Sequence
 from typing import Any
 
 import numpy as np
@@ -352,7 +352,8 @@ def _record_parameters(motion: MotionTable) -> tuple[str, str]:
 def motions_table(definitions: Iterable[StoreDefinition]) -> Table:
     """Every ground motion the stores ran: records with their treatment, ensembles with their generator and seed."""
     rows = []
-    pool = simulated_total = 0
+    pool = 0
+    simulated_rows: list[int] = []
     spectral = False
     for definition in definitions:
         ran = motions_that_ran(definition.store)
@@ -380,18 +381,26 @@ def motions_table(definitions: Iterable[StoreDefinition]) -> Table:
                          f"{setting.model} site-motion model ({setting.calibration}) of each stripe's scenario, seed {setting.seed}; the "
                          f"{len(simulated)} chosen for some stripe of the {setting.count} simulated per stripe", f"{number(setting.dt)} s",
                          f"1 each ({len(simulated)})"])
-            simulated_total += len(simulated)
+            simulated_rows.append(len(simulated))
     frame = pd.DataFrame(rows, columns=["experiment", "motion", "definition", "step, duration", "realizations"])
     frame.index = pd.RangeIndex(1, len(frame) + 1, name="#")
     return Table(
         key="table-motions",
-        caption="The ground motions as run: each record with its treatment, each synthetic ensemble with its generator, intensity, envelope, seed and size"
-        + (f" ({len(frame) - (simulated_total > 0)} of the {pool} motions the experiments define: a selection's pool motions it never "
-           "chose are left out" + (f"; and, in one row, the {simulated_total} simulated motions some stripe chose" if simulated_total else "")
-           + ")." if len(frame) - (simulated_total > 0) < pool else "."),
+        caption=motions_caption(len(frame) - len(simulated_rows), pool, simulated_rows),
         frame=frame,
         note="Realization i of an ensemble depends only on (seed, i)." + (" The PSD convention: two-sided in ω, σ² = ∫ S dω." if spectral else ""),
     )
+
+
+def motions_caption(records: int, pool: int, simulated: Sequence[int] = ()) -> str:
+    """The motions table's caption: ``records`` rows of the ``pool`` motions the definitions list (the pool motions a selection
+    never chose left out), and one row per experiment of the simulated motions its stripes chose (``simulated``: their numbers)."""
+    head = "The ground motions as run: each record with its treatment, each synthetic ensemble with its generator, intensity, envelope, seed and size"
+    if records >= pool:
+        return head + "."
+    rows = "" if not simulated else (f"; and, in {'one row' if len(simulated) == 1 else 'one row per experiment'}, the {sum(simulated)} "
+                                     "simulated motions some stripe chose")
+    return head + f" ({records} of the {pool} motions the experiments define: a selection's pool motions it never chose are left out{rows})."
 
 
 def grid_paragraph(definition: StoreDefinition) -> Paragraph:

@@ -25,6 +25,7 @@ report's assembler): it computes nothing itself. It gives:
 from __future__ import annotations
 
 import math
+from collections.abc import Collection
 from typing import Any
 
 import numpy as np
@@ -38,7 +39,7 @@ from stochpound.analysis import CellLabels
 from stochpound.report.render import Block, FigureItem, Paragraph, Section, Table, figures
 from stochpound.report.sections._facets import labels_text
 from stochpound.report.sections._stripe_motions import is_selected
-from stochpound.risk import MODEL_DRIFT_LIMIT, CollapseRisk, Sensitivity, StoreDamage, StoreDemands, StoreRisk
+from stochpound.risk import MODEL_DRIFT_LIMIT, CollapseRisk, Sensitivity, StoreDamage, StoreDemands, StoreRisk, rate_from_probability
 from stochpound.store import VariableAttributes
 
 
@@ -167,13 +168,12 @@ def _separation_table(name: str, risk: StoreRisk) -> Table:
 
 def design_summary_text(risk: StoreRisk, demands: StoreDemands | None = None, damage: StoreDamage | None = None,
                         collapse: CollapseRisk | None = None) -> str:
-    """The design summary: the governing limit state per target, the gap to design to, which code rules meet their level, and
-    what the answer rests on (hazard, scenario, structural model, suite), all from the chain's results and the store."""
-    wall = _wall_governs(risk, demands)
-    governing = "; ".join(
-        _structural_governs(damage, float(t), f"the moat wall ({wall[t][0]:.3g} m clearance, reached once in "
-                            f"{1 / wall[t][1]:.3g}{_wall_interval(demands, wall[t][0])} yr)" if t in wall else "pounding between the buildings")
-        + f" for {risk.target_text(t)}" for t in risk.separation["target"].values)
+    """The design summary: the governing limit state (once: each limit state is judged against its own objective, the same at
+    every target), what limits the separation at each target (pounding at g*, or the moat clearance in the configurations whose
+    base reaches it more often than the target allows), the gap to design to, which code rules meet their level, and what the
+    answer rests on (hazard, scenario, structural model, suite), all from the chain's results and the store."""
+    targets = risk.separation["target"].values
+    limits = "; ".join(_separation_limit(risk, demands, float(t)) for t in targets)
     if risk.rules_frame().empty:
         meets = f"The code rules were not evaluated ({risk.rules_note})."
     else:
@@ -183,52 +183,72 @@ def design_summary_text(risk: StoreRisk, demands: StoreDemands | None = None, da
     rests = "; ".join(f"{key}: {value}" for key, value in {"hazard": f"{risk.hazard.describe()} ({_source(risk)})", **risk.assumptions,
                                                           **_outside_stripes_assumption(risk), **_beyond_model(damage, collapse)}.items())
     if damage is not None and damage.has_objectives():
-        judged = "Governing limit state (the largest λ/λ_target of the limit states, each against its own objective; pounding at g* has 1)"
-    elif wall:
-        judged = "Governing limit state (the moat wall against the target's rate, where pounding at g* has 1; no structural limit state ranked)"
+        judged = (f"Governing limit state (the largest λ/λ_target of the limit states, each against its own objective, the same at every "
+                  f"target; pounding at g* has 1): {_structural_governs(damage)}. At g*, what limits the separation: {limits}.")
     else:
-        judged = "Limit state judged (no structural limit state with an objective, so none is ranked against it)"
-    return (f"Design summary. {judged}: {governing}. {design_value_text(risk)} {meets} The answer holds only for what it "
+        judged = (f"Limit state judged (no structural limit state with an objective, so none is ranked against it; at g*, what limits "
+                  f"the separation): {limits}.")
+    return (f"Design summary. {judged} {design_value_text(risk)} {meets} The answer holds only for what it "
             f"rests on; a change to any of these voids it: {rests}.")
 
 
-def _structural_governs(damage: StoreDamage | None, target: float, separation: str) -> str:
-    """What governs at ``target``: ``separation`` (what limits the gap), preceded by the buildings' own limit states where
-    :meth:`~stochpound.risk.StoreDamage.governing` names one (beyond its objective: the largest λ/λ_target), with their counts of
-    configurations; ``separation`` alone where pounding governs everywhere, without ``damage`` or without objectives. Where some
-    run is beyond the model, judged both ways (as run, and with those runs counted apart as collapses), saying whether they agree."""
-    run = damage.governing_counts(target) if damage is not None else None
-    if run is None:
-        return separation
-    apart = damage.governing_counts(target, apart=True) if damage.judged_both_ways() else None
+def _separation_limit(risk: StoreRisk, demands: StoreDemands | None, target: float) -> str:
+    """What limits the separation at ``target``: pounding between the buildings, or, in the configurations whose base reaches a
+    moat clearance more often than the target allows, that clearance (named with those configurations and the worst return period)."""
+    pounding = f"pounding between the buildings for {risk.target_text(target)}"
+    reached = [row for row in (demands.wall_exceedances([target], risk.years) if demands is not None else []) if row[2]]
+    if not reached:
+        return pounding
+    parts = []
+    for _, clearance, over, every, worst in reached:
+        where = "every configuration" if len(over) == every else (f"{len(over)} of {every} configurations ("
+                                                                   + "; ".join(labels_text(labels) for labels in over) + ")")
+        parts.append(f"the base reaching the {clearance:.3g} m moat clearance (the bearing's stop) more often than the target allows in "
+                     f"{where}, once in {1 / worst:.3g}{_wall_interval(demands, clearance)} yr at worst")
+    others = "" if all(len(row[2]) == row[3] for row in reached) else ", and pounding between the buildings in the other configurations"
+    return f"for {risk.target_text(target)}, " + "; ".join(parts) + others
+
+
+def _structural_governs(damage: StoreDamage) -> str:
+    """What governs among the buildings' own limit states (:meth:`~stochpound.risk.StoreDamage.governing`, the same at every target),
+    with their counts of configurations, and pounding at g* where none misses its objective. Where some run is beyond the
+    model, judged both ways (as run, and with those runs counted apart as collapses), saying whether they agree."""
+    probability = float(next(iter(damage.design_stripes))) if damage.design_stripes else 0.1
+    run = damage.governing_counts(probability)
+    apart = damage.governing_counts(probability, apart=True) if damage.judged_both_ways() else None
     if apart is None:
         if not run[0]:
-            return separation
-        return f"{_listed(run)} {_WHY}; {_rest([run])}, {separation}"
+            return f"{POUNDING_AT_G} in every configuration (no limit state beyond its objective)"
+        return f"{_listed(run, damage.governing_unidentified())} {_WHY}{_rest([run])}"
     if not run[0] and not apart[0]:
-        return f"{separation} (as run and with the runs beyond the model counted apart as collapses alike)"
+        return f"{POUNDING_AT_G} in every configuration, as run and with the runs beyond the model counted apart as collapses alike"
     count, configurations = damage.disagreements()
     agree = ("the two treatments agree in every configuration" if not count else
              f"the two treatments disagree in {count} of {configurations} configurations: what governs depends on whether the runs "
              "beyond the model are taken as computed or as collapses")
-    return (f"as run, {_listed(run) or 'no limit state beyond its objective'}; with the runs beyond the model counted apart as "
-            f"collapses, {_listed(apart) or 'no limit state beyond its objective'} {_WHY[:-1]}; {agree}); {_rest([run, apart])}, {separation}")
+    return (f"as run, {_listed(run, damage.governing_unidentified()) or 'no limit state beyond its objective'}{_rest([run])}; with "
+            f"the runs beyond the model counted apart as collapses, {_listed(apart, damage.governing_unidentified(apart=True)) or 'no limit state beyond its objective'}"
+            f"{_rest([apart])} {_WHY[:-1]}; {agree})")
 
 
+POUNDING_AT_G = "pounding at g*"
 _WHY = "(a limit state beyond its own objective, the largest λ/λ_target, where pounding at g* has 1: the Damage section)"
 
 
-def _listed(counted: tuple[dict[str, int], int]) -> str:
-    """One treatment's governing limit states with their counts of configurations ("" where none governs)."""
+def _listed(counted: tuple[dict[str, int], int], unpinned: Collection[str] = ()) -> str:
+    """One treatment's governing limit states with their counts of configurations ("" where none governs), each of ``unpinned``
+    (:meth:`~stochpound.risk.StoreDamage.governing_unidentified`) said to rest on a fit the runs do not pin."""
     states, configurations = counted
-    return ", ".join(f"{state} in {count} of {configurations} configurations" for state, count in states.items())
+    return ", ".join(f"{state} in {count} of {configurations} configurations"
+                     + (" (on a fit the runs do not pin: a lognormal not identified, a flat fraction or a bound, the Damage section's table)" if state in unpinned else "")
+                     for state, count in states.items())
 
 
 def _rest(treatments: list[tuple[dict[str, int], int]]) -> str:
-    """Where the separation's own limit governs: "of the separation" where limit states govern every configuration in every
-    treatment, else "in the other configurations"."""
-    every = all(sum(states.values()) == configurations for states, configurations in treatments)
-    return "of the separation" if every else "in the other configurations"
+    """``, pounding at g* in the other <n>`` where the treatment's limit states leave some configurations to pounding at g*, else ""."""
+    states, configurations = treatments[0]
+    left = configurations - sum(states.values())
+    return f", {POUNDING_AT_G} in the other {left}" if left and states else ""
 
 
 def _beyond_model(damage: StoreDamage | None, collapse: CollapseRisk | None = None) -> dict[str, str]:
@@ -256,17 +276,6 @@ def _wall_interval(demands: StoreDemands | None, clearance: float) -> str:
     return "" if interval is None else f" [{interval[0]:.3g}, {interval[1]:.3g}]"
 
 
-def _wall_governs(risk: StoreRisk, demands: StoreDemands | None) -> dict[float, tuple[float, float]]:
-    """Per target the wall is reached more often than it allows: target → (clearance m, rate of reaching it 1/yr, worst configuration)."""
-    governs: dict[float, tuple[float, float]] = {}
-    if demands is None or demands.moat is None:
-        return governs
-    for target, clearance, wall, allowed in demands.wall_rates(risk.separation["target"].values, risk.years):
-        if wall > allowed and wall > governs.get(target, (0.0, 0.0))[1]:
-            governs[target] = (clearance, wall)
-    return governs
-
-
 def design_value_text(risk: StoreRisk) -> str:
     """The number to design to: per configuration and target, the upper bound of g* (stated as such), from :meth:`StoreRisk.design_frame`."""
     per = []
@@ -282,8 +291,8 @@ def design_value_text(risk: StoreRisk) -> str:
     return (f"The gap to design to is the {risk.design_basis()}, not g* itself (g* is a central estimate from "
             f"{motions} and meets its target only about half the time): " + ". ".join(per) + ". It bounds the record-to-record "
             "sampling of the motions only (which records were drawn), none of the choices the answer rests on (the gap grid, the "
-            "collapse treatment, modelling dispersion, the selection seed, the conditioning measure, the moat wall's stiffness: the "
-            "sensitivity table).")
+            "collapse treatment, modelling dispersion, the selection seed, the conditioning measure"
+            + (", the moat wall's stiffness" if "moat walls" in risk.assumptions else "") + ": the sensitivity table).")
 
 
 def _motions_text(risk: StoreRisk) -> str:
@@ -310,12 +319,17 @@ def moat_text(risk: StoreRisk, demands: StoreDemands | None) -> str:
         largest = " (the largest over the configurations)" if varies else ""
         sentences.append(f"The wall-free suite-mean peak base displacement (the D_M form, no torsion) at {100 * level:g} %/{risk.years:g} yr{largest} is "
                          f"{value:.3g} m and {verdict}.")
-    for target, clearance, wall, allowed in demands.wall_rates(risk.separation["target"].values, risk.years):
-        interval = _wall_interval(demands, clearance)
-        relation = ("more often than the target allows (once in {:.3g} yr): the wall, not the gap, governs this target"
-                    if wall > allowed else "less often than the target allows (once in {:.3g} yr): the wall does not govern this target")
-        sentences.append(f"The base reaches the {clearance:.3g} m moat wall once in {1 / wall:.3g}{interval} yr (worst configuration), "
-                         + relation.format(1 / allowed) + f" ({risk.target_text(target)}).")
+    for target, clearance, over, every, worst in demands.wall_exceedances(risk.separation["target"].values, risk.years):
+        allowed = 1.0 / float(rate_from_probability(target, risk.years))
+        head = f"The base reaches the {clearance:.3g} m moat clearance once in {1 / worst:.3g}{_wall_interval(demands, clearance)} yr in its worst configuration"
+        if not over:
+            verdict = f"less often than {risk.target_text(target)} allows (once in {allowed:.3g} yr) in every configuration: it does not limit the separation for this target"
+        else:
+            where = "every configuration" if len(over) == every else (f"{len(over)} of {every} configurations ("
+                                                                       + "; ".join(labels_text(labels) for labels in over) + ")")
+            verdict = (f"more often than {risk.target_text(target)} allows (once in {allowed:.3g} yr) in {where}: there the clearance, "
+                       "not the gap, limits the separation for this target")
+        sentences.append(f"{head}; {verdict}.")
     return " ".join(sentences)
 
 
@@ -590,11 +604,13 @@ def _demand_blocks(name: str, risk: StoreRisk, demands: StoreDemands | None) -> 
         ax.set_visible(False)
     if axes[0].get_legend_handles_labels()[1]:
         axes[0].legend(fontsize=5)
+    walled = ("; with a moat wall, the base displacement is the walled runs', capped near the wall's clearance (their only impacts "
+              "are on the wall)") if demands.moat is not None else ""
+    dashed = "; dashed: the runs beyond the model counted apart as collapses (below)" if demands.apart else ""
     blocks: list[Block] = [FigureItem(f"risk-demands-{name}", f"Experiment {name}: demand hazard curves (mean annual frequency of "
                                       "exceeding each level, a lognormal fragility fitted at every level over the stripes' "
-                                      "contact-free runs (a step, or flat, where the runs identify no lognormal) and integrated with the hazard, made non-increasing along the level), per "
-                                      "configuration" + ("; dashed: the runs beyond the model counted apart as collapses (below)" if demands.apart else "")
-                                      + ".", figure)]
+                                      "contact-free runs (a step, or flat, where the runs identify no lognormal) and integrated with the "
+                                      f"hazard, made non-increasing along the level), per configuration{walled}{dashed}.", figure)]
     if demands.apart:
         blocks += _demands_both_ways(name, risk, demands)
     if demands.moat is not None:
