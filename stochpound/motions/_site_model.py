@@ -538,6 +538,17 @@ def motion_threads() -> int:
     return int(numba.config.NUMBA_NUM_THREADS)
 
 
+def on_motion_threads(batch: Callable[[int], None], starts: range) -> None:
+    """Call ``batch(start)`` for every start, on :func:`motion_threads` threads (each call writes its own rows: no value depends on them)."""
+    threads = min(motion_threads(), len(starts))
+    if threads <= 1:
+        for start in starts:
+            batch(start)
+    else:
+        with ThreadPoolExecutor(threads) as pool:
+            list(pool.map(batch, starts))
+
+
 def motions_from_parameters(parameters: dict[str, np.ndarray], noise: np.ndarray, dt: float) -> np.ndarray:
     """Accelerations [n, n_time] (m/s², from t = 0 at ``dt``) of motions of given parameters and white noise ``noise`` [n, n_time]."""
     noise = np.asarray(noise, dtype=float)
@@ -567,14 +578,7 @@ def motions_from_noise_rows(parameters: dict[str, np.ndarray], noise_rows: Calla
             out[rows] = shape_filter(out[rows], dt, SHAPE_PERIODS, chosen["spectral_shape"])
         out[rows] = baseline_correct(out[rows], dt)
 
-    starts = range(0, n, BATCH)
-    threads = min(motion_threads(), len(starts))
-    if threads <= 1:
-        for start in starts:
-            batch(start)
-    else:
-        with ThreadPoolExecutor(threads) as pool:
-            list(pool.map(batch, starts))
+    on_motion_threads(batch, range(0, n, BATCH))
     return out
 
 

@@ -190,9 +190,7 @@ def pseudo_spectra(accelerations: np.ndarray, dt: float, periods: np.ndarray | f
     numpy.ndarray, shape (n, len(periods))
         ω² max abs(u), m/s².
     """
-    from concurrent.futures import ThreadPoolExecutor
-
-    from stochpound.motions._site_model import motion_threads
+    from stochpound.motions._site_model import on_motion_threads
 
     values, zeta = check_periods(periods, damping)
     a = np.ascontiguousarray(accelerations, dtype=np.float64)
@@ -202,18 +200,11 @@ def pseudo_spectra(accelerations: np.ndarray, dt: float, periods: np.ndarray | f
         raise ValueError(f"dt: must be > 0 s, got {dt!r}")
     omega = 2.0 * np.pi / values
     sd = np.empty((a.shape[0], values.size))
-    starts = range(0, a.shape[0], POOL_BATCH)
 
     def batch(start: int) -> None:
         _pool_kernel(a[start : start + POOL_BATCH], float(dt), omega, zeta, sd[start : start + POOL_BATCH])
 
-    threads = min(motion_threads(), len(starts))
-    if threads <= 1:
-        for start in starts:
-            batch(start)
-    else:
-        with ThreadPoolExecutor(threads) as pool:
-            list(pool.map(batch, starts))
+    on_motion_threads(batch, range(0, a.shape[0], POOL_BATCH))
     return omega**2 * sd
 
 
