@@ -204,6 +204,12 @@ class StoreDamage:
         credible runs' fit behind λ with the runs beyond the model counted apart); None without ``risk``."""
         return None if self.risk is None or "status" not in self.risk else limit_state_fits(self.risk, apart)
 
+    def unpinned(self, apart: bool = False) -> xr.DataArray | None:
+        """Whether each limit state's fit (:meth:`fits`) is one the runs do not pin (:func:`unpinned_fit`), over the same
+        dimensions; None without ``risk``."""
+        fits = self.fits(apart)
+        return None if fits is None else fits.copy(data=np.vectorize(unpinned_fit, otypes=[bool])(fits.values))
+
     def governing_unidentified(self, apart: bool = False) -> dict[str, str]:
         """The governing limit states (:meth:`governing`) whose fit, in some configuration they govern, the runs do not pin (a
         lognormal not identified, or a step at the lowest stripe: its λ a bound), each with that fit in words; {} where none is."""

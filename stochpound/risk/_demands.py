@@ -108,9 +108,10 @@ class StoreDemands:
         """A demand's exceedance rate with the collapses counted apart (``apart``), made non-increasing along its levels (1/yr)."""
         return non_increasing_along(self.apart[label], "level")
 
-    def wall_exceedances(self, targets: Sequence[float], years: float) -> list[tuple[float, float, list[dict[str, Hashable]], int, float]]:
+    def wall_exceedances(self, targets: Sequence[float], years: float) -> list[tuple[float, float, list[dict[str, Hashable]], int, float, float]]:
         """Per target and moat clearance: (target, clearance m, the configurations whose base reaches it more often than the
-        target allows, the number of configurations, the largest rate of reaching it 1/yr); [] without a moat."""
+        target allows, the number of configurations, the largest rate of reaching it 1/yr, the rate the target allows 1/yr);
+        [] without a moat."""
         if self.moat is None:
             return []
         rows = []
@@ -120,7 +121,7 @@ class StoreDemands:
                 maf = self.moat["maf"].sel(level=clearance)
                 every = _configurations(maf)
                 over = [labels for labels in every if float(maf.sel(labels)) > allowed]
-                rows.append((float(target), float(clearance), over, len(every), float(maf.max())))
+                rows.append((float(target), float(clearance), over, len(every), float(maf.max()), allowed))
         return rows
 
     def wall_interval(self, clearance: float) -> tuple[float, float] | None:

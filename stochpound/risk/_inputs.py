@@ -474,6 +474,12 @@ def contact_free_demands(store: xr.Dataset) -> xr.Dataset:
     return xr.Dataset({name: store_motions(value) for name, value in store_contact_demands(contact_free(store)).items()}).load()
 
 
+def has_walls(store: xr.Dataset) -> bool:
+    """Whether a store's scene (or one of its variants) has a wall: without one, the walls' stiffness is no choice its answer rests on."""
+    definition = store.pound.definition
+    return bool(definition.tables.walls) or any(override.scene.walls for variant in definition.variants for override in variant.edits.values())
+
+
 def base_displacement(store: xr.Dataset, studied: str | None, walls_free: bool = False) -> xr.DataArray | None:
     """A building's peak base displacement max|s| in every contact-free (and, with ``walls_free``, wall-free) case (m, one motion dimension).
 

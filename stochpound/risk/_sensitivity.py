@@ -39,7 +39,7 @@ import xarray as xr
 from stochpound.risk._collapse import CollapseRisk
 from stochpound.risk._fragility import DECREASING, EMPTY, NEVER, ALWAYS
 from stochpound.risk._gap_grid import refinement_gaps
-from stochpound.risk._inputs import RiskInputError, RiskInputs, store_definition, experiment_name, intensity_setting, site_hazard
+from stochpound.risk._inputs import RiskInputError, RiskInputs, has_walls, store_definition, experiment_name, intensity_setting, site_hazard
 from stochpound.risk._maf import mean_annual_frequency, risk_targeted_separation
 
 REFINEMENT = 4
@@ -146,14 +146,8 @@ def separation_sensitivity(risk: object, store: xr.Dataset | RiskInputs, collaps
         columns[_unique(label, columns)] = store_risk(other, hazard, targets, years, bootstrap=0, partial=bool(risk.progress)).separation[
             "separation"]
     given = {kind for kind, _ in alternatives}
-    moot = set() if isinstance(store, RiskInputs) or _has_walls(store) else {"wall"}  # no wall: its stiffness is no choice of this answer
+    moot = set() if isinstance(store, RiskInputs) or has_walls(store) else {"wall"}  # no wall: its stiffness is no choice of this answer
     return Sensitivity(_table(columns, years), risk.grid, tuple(k for k in ALTERNATIVES if k not in given | moot))
-
-
-def _has_walls(store: xr.Dataset) -> bool:
-    """Whether a store's scene (or one of its variants) has a wall: without one, the walls' stiffness is no choice its answer rests on."""
-    definition = store.pound.definition
-    return bool(definition.tables.walls) or any(override.scene.walls for variant in definition.variants for override in variant.edits.values())
 
 
 def _table(columns: Mapping[str, xr.DataArray], years: float) -> pd.DataFrame:

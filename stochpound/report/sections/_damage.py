@@ -8,7 +8,7 @@ import pandas as pd
 
 from stochpound.report.render import Paragraph, Section, Table
 from stochpound.report.sections._description import number
-from stochpound.risk import DAMAGE_DEMANDS, MODEL_DRIFT_LIMIT, POUNDING_AT_G_STAR as POUNDING, UNIDENTIFIED_BETA, StoreDamage, unpinned_fit
+from stochpound.risk import DAMAGE_DEMANDS, MODEL_DRIFT_LIMIT, POUNDING_AT_G_STAR as POUNDING, UNIDENTIFIED_BETA, StoreDamage
 
 
 def damage_section(name: str, damage: StoreDamage) -> Section:
@@ -127,7 +127,7 @@ def _governs_text(damage: StoreDamage, probability: float, apart: bool) -> str:
     the configurations with the same answer grouped."""
     governing, misses = damage.governing(probability, apart), damage.misses_objective(apart)
     largest, largest_state = damage.largest_ratio(apart)
-    fits = damage.fits(apart)
+    fits, unpinned = damage.fits(apart), damage.unpinned(apart)
     grouped: dict[str, list[str]] = {}
     for labels in _configurations(governing):
         worst = str(governing.sel(labels).item())
@@ -137,8 +137,9 @@ def _governs_text(damage: StoreDamage, probability: float, apart: bool) -> str:
         else:
             others = [str(state) for state, flag in zip(misses["limit_state"].values, misses.sel(labels).values) if flag and state != worst]
             fit = str(fits.sel(labels).sel(limit_state=worst).item()) if fits is not None else ""
-            unpinned = f"; its fit, {fit}, is not pinned by the runs: the ratio rests on it" if unpinned_fit(fit) else ""
-            text = (f"{worst} (λ/λ_target = {ratio_text(value, 2)}{unpinned})"
+            loose = unpinned is not None and bool(unpinned.sel(labels).sel(limit_state=worst).item())
+            caveat = f"; its fit, {fit}, is not pinned by the runs: the ratio rests on it" if loose else ""
+            text = (f"{worst} (λ/λ_target = {ratio_text(value, 2)}{caveat})"
                     + (f"; also beyond their objectives: {', '.join(others)}" if others else ""))
         grouped.setdefault(text, []).append(_label(labels))
     every = len(_configurations(governing))

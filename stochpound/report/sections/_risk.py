@@ -39,7 +39,7 @@ from stochpound.analysis import CellLabels
 from stochpound.report.render import Block, FigureItem, Paragraph, Section, Table, figures
 from stochpound.report.sections._facets import labels_text
 from stochpound.report.sections._stripe_motions import is_selected
-from stochpound.risk import MODEL_DRIFT_LIMIT, CollapseRisk, Sensitivity, StoreDamage, StoreDemands, StoreRisk, rate_from_probability
+from stochpound.risk import MODEL_DRIFT_LIMIT, CollapseRisk, Sensitivity, StoreDamage, StoreDemands, StoreRisk
 from stochpound.store import VariableAttributes
 
 
@@ -200,7 +200,7 @@ def _separation_limit(risk: StoreRisk, demands: StoreDemands | None, target: flo
     if not reached:
         return pounding
     parts = []
-    for _, clearance, over, every, worst in reached:
+    for _, clearance, over, every, worst, _ in reached:
         where = "every configuration" if len(over) == every else (f"{len(over)} of {every} configurations ("
                                                                    + "; ".join(labels_text(labels) for labels in over) + ")")
         parts.append(f"the base reaching the {clearance:.3g} m moat clearance (the bearing's stop) more often than the target allows in "
@@ -319,8 +319,8 @@ def moat_text(risk: StoreRisk, demands: StoreDemands | None) -> str:
         largest = " (the largest over the configurations)" if varies else ""
         sentences.append(f"The wall-free suite-mean peak base displacement (the D_M form, no torsion) at {100 * level:g} %/{risk.years:g} yr{largest} is "
                          f"{value:.3g} m and {verdict}.")
-    for target, clearance, over, every, worst in demands.wall_exceedances(risk.separation["target"].values, risk.years):
-        allowed = 1.0 / float(rate_from_probability(target, risk.years))
+    for target, clearance, over, every, worst, rate in demands.wall_exceedances(risk.separation["target"].values, risk.years):
+        allowed = 1.0 / rate
         head = f"The base reaches the {clearance:.3g} m moat clearance once in {1 / worst:.3g}{_wall_interval(demands, clearance)} yr in its worst configuration"
         if not over:
             verdict = f"less often than {risk.target_text(target)} allows (once in {allowed:.3g} yr) in every configuration: it does not limit the separation for this target"
