@@ -205,7 +205,7 @@ class StoreDamage:
         return None if self.risk is None or "status" not in self.risk else limit_state_fits(self.risk, apart)
 
     def unpinned(self, apart: bool = False) -> xr.DataArray | None:
-        """Whether each limit state's fit (:meth:`fits`) is one the runs do not pin (:func:`unpinned_fit`), over the same
+        """Whether each limit state's fit (:meth:`fits`) is one the runs do not pin (``stochpound.risk.unpinned_fit``), over the same
         dimensions; None without ``risk``."""
         fits = self.fits(apart)
         return None if fits is None else fits.copy(data=np.vectorize(unpinned_fit, otypes=[bool])(fits.values))
