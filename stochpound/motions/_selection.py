@@ -141,7 +141,7 @@ def selection_pool(
         a = record.acceleration(g)
         spectrum = response_spectrum(a, record.dt, np.concatenate([grid, conditioning]), damping).psa.values / g
         psa.append(spectrum[: grid.size])
-        intensity.append(peak_ground_motion(a, record.dt)[0] / g if measure == "pga" else float(np.exp(np.mean(np.log(spectrum[grid.size :])))))
+        intensity.append(peak_ground_motion(a, record.dt)[0] / g if measure == "pga" else float(_spectral_measure(spectrum[grid.size :])))
     meta = [record.metadata or {} for record in records]
     # one earthquake, one name across suites ("Northridge 1994" and "Northridge-01 1994" of one magnitude); a motion without one is its own
     earthquakes = earthquake_identities([str(m.get("event") or "") for m in meta], [float(m.get("magnitude", np.nan)) for m in meta])
@@ -160,6 +160,12 @@ def selection_pool(
 def _conditioning_periods(measure: str, period: float | Sequence[float] | None) -> list[float]:
     """The periods (s) of the conditioning measure's spectral values: none for PGA."""
     return [] if measure == "pga" else list(np.atleast_1d(np.asarray(period, dtype=float)))
+
+
+def _spectral_measure(psa: np.ndarray) -> np.ndarray:
+    """The conditioning measure from the PSA at its periods (g, over the last axis): PSA itself at one period, Sa_avg (their
+    geometric mean) at several."""
+    return np.exp(np.mean(np.log(psa), axis=-1))
 
 
 def _pool_dataset(names: Sequence[str], grid: np.ndarray, psa: np.ndarray, intensity: np.ndarray, measure: str, damping: float,
@@ -196,8 +202,7 @@ def pool_intensity(accelerations: np.ndarray, dt: float, measure: str, period: f
     a = np.asarray(accelerations, dtype=float)
     if measure == "pga":
         return np.max(np.abs(a), axis=1) / g
-    spectra = pseudo_spectra(a, dt, np.array(_conditioning_periods(measure, period)), damping) / g
-    return np.array([float(np.exp(np.mean(np.log(row)))) for row in spectra])
+    return _spectral_measure(pseudo_spectra(a, dt, np.array(_conditioning_periods(measure, period)), damping) / g)
 
 
 def array_pool(accelerations: np.ndarray, dt: float, names: Sequence[str], periods: Sequence[float], measure: str,
