@@ -6,7 +6,7 @@ xarray and pandas objects (``.sum()``, ``.max()``, ``.quantile()``,
 ``np.log`` …) and calls to the computing packages' functions (the
 statistics, the risk chain, the hazard, the codes, the model's modal
 analysis). A result object's own methods (``risk.rules_frame()``,
-``damage.governing(p)``) are what a section formats, not computation.
+``damage.governing()``) are what a section formats, not computation.
 
 What sections computed when this test was written is listed in
 ``COMPUTED`` per section, call by call: the test fails when a section

@@ -114,9 +114,8 @@ def test_store_damage_fractiles_and_runs_beyond_the_model(store):
     ratio = maf.values / target_rate
     np.testing.assert_allclose(damage.ratio().values, ratio, rtol=1e-12)
     np.testing.assert_array_equal(damage.misses_objective().values, ratio > 1.0)
-    for probability in (0.1, 0.02):  # the same at every target: each limit state has its own objective
-        governing = damage.governing(probability).item()
-        assert governing == (str(maf["limit_state"].values[int(np.argmax(ratio))]) if ratio.max() > 1.0 else "pounding at g*")
+    governing = damage.governing().item()  # the same at every target: each limit state has its own objective
+    assert governing == (str(maf["limit_state"].values[int(np.argmax(ratio))]) if ratio.max() > 1.0 else "pounding at g*")
     assert ratio.max() > 1.0  # these weak storeys miss an objective
 
 
@@ -134,10 +133,10 @@ def test_governs_is_the_largest_ratio_to_the_objective_not_the_most_frequent_lim
     empty = xr.DataArray([0])
     damage = StoreDamage(xr.Dataset(), empty, empty, {0.1: 1.0}, risk, states, "a test", True)
     np.testing.assert_allclose(damage.ratio().values, [0.01 / (-np.log(0.5) / 50), 0.001 / (-np.log(0.98) / 50)], rtol=1e-12)
-    assert damage.governing(0.1).item() == states[1].label and damage.governing(0.02).item() == states[1].label
+    assert damage.governing().item() == states[1].label  # the same at every target: governing takes none
     unjudged = StoreDamage(xr.Dataset(), empty, empty, {0.1: 1.0}, risk.assign_coords(target=("limit_state", [np.nan, np.nan])),
                            (LimitState("drift_ratio", 0.007, "B1"), LimitState("drift_ratio", 0.05, "B1")), "a test", True)
-    assert unjudged.governing(0.1) is None and unjudged.governing_counts(0.1) is None
+    assert unjudged.governing() is None and unjudged.governing_counts() is None
 
 
 def test_pounding_at_g_star_governs_where_no_limit_state_is_as_frequent(store):
@@ -146,12 +145,12 @@ def test_pounding_at_g_star_governs_where_no_limit_state_is_as_frequent(store):
     from stochpound.risk import LimitState
     damage = store_damage(store, [LimitState("ductility", 1.0e4, target=0.02)], "a test")
     assert float(damage.risk["maf"].max()) == 0.0
-    assert damage.governing(0.02).item() == "pounding at g*"
+    assert damage.governing().item() == "pounding at g*"
     assert "Governing: as run, pounding at g* (every limit state within its objective; the largest λ/λ_target is 0" in " ".join(
         _text(block) for block in damage_section("yfix", damage).blocks)
     unjudged = store_damage(store, [LimitState("ductility", 1.0e4)], "a test")
     text = " ".join(_text(block) for block in damage_section("yfix", unjudged).blocks)
-    assert unjudged.governing(0.02) is None and "none is said to govern" in text and "Governing:" not in text
+    assert unjudged.governing() is None and "none is said to govern" in text and "Governing:" not in text
 
 
 def _two_treatments():
@@ -180,10 +179,10 @@ def test_governs_is_judged_in_each_treatment_of_the_collapses_and_a_disagreement
     states, risk, damage = _two_treatments()
     rates = -np.log(1.0 - np.array([0.5, 0.02])) / 50.0
     np.testing.assert_allclose(damage.ratio(apart=True).values, risk["maf_collapses_apart"].values / rates[:, None], rtol=1e-12)
-    assert list(damage.governing(0.1).values) == ["pounding at g*", states[0].label]
-    assert list(damage.governing(0.1, apart=True).values) == [states[1].label, states[0].label]
+    assert list(damage.governing().values) == ["pounding at g*", states[0].label]
+    assert list(damage.governing(apart=True).values) == [states[1].label, states[0].label]
     assert list(damage.disagreement().values) == [True, False]
-    assert damage.governing_counts(0.02, apart=True) == ({states[1].label: 1, states[0].label: 1}, 2)
+    assert damage.governing_counts(apart=True) == ({states[1].label: 1, states[0].label: 1}, 2)
     text = _governing_text(damage)
     assert (f"Governing: as run, mu 0.05: pounding at g* (every limit state within its objective; the largest λ/λ_target is "
             f"{3e-4 / rates[1]:.2g}, {states[1].label}); mu 0.08: {states[0].label} (λ/λ_target = {0.02 / rates[0]:.2g}); with the runs "
@@ -224,7 +223,7 @@ def test_the_store_s_collapses_alone_miss_an_objective_no_run_reaches_as_run(sto
     collapse = float(damage.risk["maf_collapses_apart"].item())
     assert collapse > 0.0 and float(damage.risk["maf"].item()) == 0.0
     rate = -math.log(0.98) / 50.0
-    apart = damage.governing(0.02, apart=True).item()
+    apart = damage.governing(apart=True).item()
     assert apart == (state.label if collapse > rate else "pounding at g*")
     assert collapse > rate  # these weak storeys collapse more often than once in 2475 years
     text = " ".join(_text(block) for block in damage_section("yfix", damage).blocks)
@@ -262,7 +261,7 @@ def test_the_damage_section_states_fractiles_flags_and_the_governing_limit_state
     assert f"{beyond} of {runs} at stripe 1.2031" in texts and "are not credible" in texts
     assert "FEMA 356 (2000), Table C1-3, steel moment frames" in texts
     ratio = damage.ratio()
-    worst = damage.governing(0.1).item()
+    worst = damage.governing().item()
     others = [str(state) for state in ratio["limit_state"].values if float(ratio.sel(limit_state=state)) > 1.0 and state != worst]
     expected = f"{worst} (λ/λ_target = {float(ratio.max()):.2g})" + (f"; also beyond their objectives: {', '.join(others)}" if others else "")
     assert damage.collapses_apart() and f"Governing: as run, {expected}; with the runs beyond the model counted apart as collapses, " in texts
@@ -452,12 +451,11 @@ def test_the_design_summary_names_the_limit_state_the_damage_section_finds_gover
     from stochpound.risk import LimitState, store_risk
     risk, damage = store_risk(store), store_damage(store)
     text = design_summary_text(risk, None, damage)
-    for probability in (0.1, 0.02):
-        governing = [str(v) for v in damage.governing(probability).values.ravel()]
-        structural = [g for g in governing if g != "pounding at g*"]
-        assert structural, "the weak storeys of this store reach a drift limit more often than the target's rate"
-        assert f"{structural[0]} in {governing.count(structural[0])} of {len(governing)} configurations" in text
-        assert "a limit state beyond its own objective, the largest λ/λ_target" in text
+    governing = [str(v) for v in damage.governing().values.ravel()]
+    structural = [g for g in governing if g != "pounding at g*"]
+    assert structural, "the weak storeys of this store reach a drift limit more often than the target's rate"
+    assert f"{structural[0]} in {governing.count(structural[0])} of {len(governing)} configurations" in text
+    assert "a limit state beyond its own objective, the largest λ/λ_target" in text
     unreached = store_damage(store, [LimitState("ductility", 1.0e4, target=0.1)], "a test")
     text = design_summary_text(risk, None, unreached)
     # as run no run reaches it; counted apart, the collapses do, more often than 10 % in 50 yr allows: the treatments disagree

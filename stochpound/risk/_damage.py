@@ -157,18 +157,18 @@ class StoreDamage:
         """Whether any limit state has a performance objective (without one, nothing is said to govern)."""
         return self.risk is not None and bool(self.risk["target"].notnull().any())
 
-    def governing_counts(self, probability: float, apart: bool = False) -> tuple[dict[str, int], int] | None:
+    def governing_counts(self, apart: bool = False) -> tuple[dict[str, int], int] | None:
         """The configurations each structural limit state governs (:meth:`governing`, with ``apart`` on λ with the collapses
         counted apart), in the order first met, and the number of configurations; None without ``risk`` or without any objective."""
-        governing = self.governing(probability, apart)
+        governing = self.governing(apart)
         if governing is None:
             return None
         names = [str(v) for v in governing.values.ravel()]
         structural = {str(state) for state in self.risk["limit_state"].values}
         return {n: names.count(n) for n in names if n in structural}, len(names)
 
-    def governing(self, probability: float, apart: bool = False) -> xr.DataArray | None:
-        """Per configuration, what governs at the risk-targeted separation g* of ``probability`` in 50 yr: the largest λ/λ_target.
+    def governing(self, apart: bool = False) -> xr.DataArray | None:
+        """Per configuration, what governs at the risk-targeted separation g* of any target: the largest λ/λ_target.
 
         Pounding at g* has the target's rate (ratio 1); a structural limit
         state governs where its ratio is the largest and exceeds 1 (it misses
@@ -213,7 +213,7 @@ class StoreDamage:
     def governing_unidentified(self, apart: bool = False) -> dict[str, str]:
         """The governing limit states (:meth:`governing`) whose fit, in some configuration they govern, the runs do not pin (a
         lognormal not identified, or a step at the lowest stripe: its λ a bound), each with that fit in words; {} where none is."""
-        governing, fits = self.governing(0.0, apart), self.fits(apart)
+        governing, fits = self.governing(apart), self.fits(apart)
         if governing is None or fits is None:
             return {}
         found: dict[str, str] = {}

@@ -109,11 +109,10 @@ def _governing_text(damage: StoreDamage) -> str:
     if not damage.has_objectives():
         return (head + " No limit state has an objective, so none is said to govern: give [limit_states] targets (docs/risk.md). "
                 "A [limit_states] table in the experiment file replaces these capacities.")
-    probability = float(next(iter(damage.design_stripes)))
-    governs = _governs_text(damage, probability, apart=False)
+    governs = _governs_text(damage, apart=False)
     if damage.judged_both_ways():
         governs = (f"as run, {governs}; with the runs beyond the model counted apart as collapses, "
-                   f"{_governs_text(damage, probability, apart=True)}. {_agreement_text(damage)}")
+                   f"{_governs_text(damage, apart=True)}. {_agreement_text(damage)}")
     else:
         governs += "."
     return (head + " What governs is the largest ratio λ/λ_target: pounding at the risk-targeted separation g* has ratio 1 at every "
@@ -122,10 +121,10 @@ def _governing_text(damage: StoreDamage) -> str:
             "replaces these capacities and objectives (targets; docs/risk.md).")
 
 
-def _governs_text(damage: StoreDamage, probability: float, apart: bool) -> str:
+def _governs_text(damage: StoreDamage, apart: bool) -> str:
     """What governs per configuration in one treatment of the runs beyond the model (``apart``: counted apart as collapses),
     the configurations with the same answer grouped."""
-    governing, misses = damage.governing(probability, apart), damage.misses_objective(apart)
+    governing, misses = damage.governing(apart), damage.misses_objective(apart)
     largest, largest_state = damage.largest_ratio(apart)
     fits, unpinned = damage.fits(apart), damage.unpinned(apart)
     grouped: dict[str, list[str]] = {}
@@ -153,7 +152,7 @@ def _agreement_text(damage: StoreDamage) -> str:
     where = [labels for labels in configurations if bool(differ.sel(labels))]
     if not where:
         return "The two treatments agree on what governs in every configuration."
-    run, apart = damage.governing(0.0, False), damage.governing(0.0, True)
+    run, apart = damage.governing(False), damage.governing(True)
     listed = "; ".join((f"{_label(labels)}: " if labels else "") + f"{run.sel(labels).item()} as run, {apart.sel(labels).item()} with "
                        "collapses apart" for labels in where)
     return (f"The two treatments disagree on what governs in {len(where)} of {len(configurations)} configurations ({listed}): which "

@@ -201,21 +201,25 @@ def _separation_limit(risk: StoreRisk, demands: StoreDemands | None, target: flo
         return pounding
     parts = []
     for _, clearance, over, every, worst, _ in reached:
-        where = "every configuration" if len(over) == every else (f"{len(over)} of {every} configurations ("
-                                                                   + "; ".join(labels_text(labels) for labels in over) + ")")
         parts.append(f"the base reaching the {clearance:.3g} m moat clearance (the bearing's stop) more often than the target allows in "
-                     f"{where}, once in {1 / worst:.3g}{_wall_interval(demands, clearance)} yr at worst")
+                     f"{_where(over, every)}, once in {1 / worst:.3g}{_wall_interval(demands, clearance)} yr at worst")
     others = "" if all(len(row[2]) == row[3] for row in reached) else ", and pounding between the buildings in the other configurations"
     return f"for {risk.target_text(target)}, " + "; ".join(parts) + others
+
+
+def _where(over: list[dict[str, Any]], every: int) -> str:
+    """The configurations ``over`` of ``every``: ``every configuration``, or ``2 of 8 configurations (<labels>; <labels>)``."""
+    if len(over) == every:
+        return "every configuration"
+    return f"{len(over)} of {every} configurations (" + "; ".join(labels_text(labels) for labels in over) + ")"
 
 
 def _structural_governs(damage: StoreDamage) -> str:
     """What governs among the buildings' own limit states (:meth:`~stochpound.risk.StoreDamage.governing`, the same at every target),
     with their counts of configurations, and pounding at g* where none misses its objective. Where some run is beyond the
     model, judged both ways (as run, and with those runs counted apart as collapses), saying whether they agree."""
-    probability = float(next(iter(damage.design_stripes))) if damage.design_stripes else 0.1
-    run = damage.governing_counts(probability)
-    apart = damage.governing_counts(probability, apart=True) if damage.judged_both_ways() else None
+    run = damage.governing_counts()
+    apart = damage.governing_counts(apart=True) if damage.judged_both_ways() else None
     if apart is None:
         if not run[0]:
             return f"{POUNDING_AT_G} in every configuration (no limit state beyond its objective)"
@@ -325,9 +329,7 @@ def moat_text(risk: StoreRisk, demands: StoreDemands | None) -> str:
         if not over:
             verdict = f"less often than {risk.target_text(target)} allows (once in {allowed:.3g} yr) in every configuration: it does not limit the separation for this target"
         else:
-            where = "every configuration" if len(over) == every else (f"{len(over)} of {every} configurations ("
-                                                                       + "; ".join(labels_text(labels) for labels in over) + ")")
-            verdict = (f"more often than {risk.target_text(target)} allows (once in {allowed:.3g} yr) in {where}: there the clearance, "
+            verdict = (f"more often than {risk.target_text(target)} allows (once in {allowed:.3g} yr) in {_where(over, every)}: there the clearance, "
                        "not the gap, limits the separation for this target")
         sentences.append(f"{head}; {verdict}.")
     return " ".join(sentences)
