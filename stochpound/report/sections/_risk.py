@@ -25,7 +25,7 @@ report's assembler): it computes nothing itself. It gives:
 from __future__ import annotations
 
 import math
-from collections.abc import Collection
+from collections.abc import Collection, Hashable, Sequence
 from typing import Any
 
 import numpy as np
@@ -207,7 +207,7 @@ def _separation_limit(risk: StoreRisk, demands: StoreDemands | None, target: flo
     return f"for {risk.target_text(target)}, " + "; ".join(parts) + others
 
 
-def _where(over: list[dict[str, Any]], every: int) -> str:
+def _where(over: Sequence[dict[str, Hashable]], every: int) -> str:
     """The configurations ``over`` of ``every``: ``every configuration``, or ``2 of 8 configurations (<labels>; <labels>)``."""
     if len(over) == every:
         return "every configuration"
