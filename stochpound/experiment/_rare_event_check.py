@@ -72,7 +72,8 @@ def crude_check(rare: xr.Dataset, store: xr.Dataset) -> xr.Dataset | None:
         raise ExperimentError(f"{where}: its crude check needs one contact gap axis, got {len(axes)} ({', '.join(axes)})")
     stochastic = store.pound.definition
     axis = next(gap for gap in stochastic.gaps if gap.name == axes[0])
-    contacts = range(len(TomlTable(definition.scene, "scene").tables("contact"))) if table.response == "max_closure" else [table.contact]
+    every_contact = table.response == "max_closure"
+    contacts = range(len(TomlTable(definition.scene, "scene").tables("contact"))) if every_contact else [table.contact]
     if set(contacts) - set(axis.contacts):
         raise ExperimentError(f"{where}: its gap axis {axis.name} sets contacts {', '.join(map(str, axis.contacts))}, "
                               f"not every contact of the closure ({', '.join(map(str, contacts))})")
@@ -84,9 +85,9 @@ def crude_check(rare: xr.Dataset, store: xr.Dataset) -> xr.Dataset | None:
     if cell is None:
         raise ExperimentError(f"{where}: none of its contact-free cells has the scene of {definition.name} (compared with every gap infinite)")
     closure = contact_free(store)["peak_contact_closure"].sel(cell).sel(record=labels[0])
-    runs = closure if table.response == "max_closure" else closure.isel(contact=table.contact)
+    runs = closure if every_contact else closure.isel(contact=table.contact)
     gaps = store[axes[0]].values[np.isfinite(store[axes[0]].values)]
-    crude = pounding_curve(runs, gaps, contact_dim="contact" if table.response == "max_closure" else None)
+    crude = pounding_curve(runs, gaps, contact_dim="contact" if every_contact else None)
     probability, cov = exceedance(store_levels(rare), gaps)
     return xr.Dataset(
         {"crude": ("gap", crude["probability"].values), "crude_lower": ("gap", crude["lower"].values), "crude_upper": ("gap", crude["upper"].values),
