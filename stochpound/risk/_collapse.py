@@ -120,8 +120,9 @@ def beyond_model(drift: xr.DataArray, limit: float = MODEL_DRIFT_LIMIT) -> xr.Da
 
 
 def rate_collapses_apart(demand: xr.DataArray, collapsed: xr.DataArray, thresholds: Sequence[float] | np.ndarray, dim: str,
-                         hz: HazardCurve) -> tuple[xr.DataArray, xr.Dataset]:
-    """λ (1/yr) of a demand reaching each threshold with the collapses counted apart (module docstring), and the collapse fit.
+                         hz: HazardCurve, collapse: xr.Dataset | None = None) -> tuple[xr.DataArray, xr.Dataset, xr.Dataset]:
+    """λ (1/yr) of a demand reaching each threshold with the collapses counted apart (module docstring), the collapse fit and the
+    credible runs' fit.
 
     A collapse counts as reaching every threshold (a building that has lost its storeys has met every limit state, FEMA P-58);
     the credible runs' fit of demand ≥ threshold and P(C | IM) are combined by total probability, ``combined_rate``.
@@ -138,24 +139,28 @@ def rate_collapses_apart(demand: xr.DataArray, collapsed: xr.DataArray, threshol
         The name of the thresholds' dimension.
     hz : HazardCurve
         The site's hazard.
+    collapse : xarray.Dataset, optional
+        :func:`collapse_fit` of ``collapsed`` already made (several demands of the same runs share it); default fitted here.
 
     Returns
     -------
-    tuple of xarray.DataArray and xarray.Dataset
-        λ over ``dim`` and the configurations, and P(C | IM)'s stripe fit (:func:`~stochpound.risk.stripe_fragility`) with its ``maf``, λ_C.
+    tuple of xarray.DataArray, xarray.Dataset and xarray.Dataset
+        λ over ``dim`` and the configurations; P(C | IM)'s stripe fit (:func:`~stochpound.risk.stripe_fragility`) with its
+        ``maf``, λ_C; and the credible runs' stripe fit of demand ≥ each threshold, whose kind (a lognormal the runs identify
+        or not, a step) says what λ rests on.
     """
     demand, collapsed = xr.align(demand, _dims_only(collapsed), join="inner")
-    collapse = stripe_fragility(collapsed, bootstrap=0)
+    collapse = collapse_fit(collapsed, hz) if collapse is None else collapse
+    credible = stripe_fragility(limit_state_events(demand.where(collapsed == 0.0), thresholds, dim), bootstrap=0)
+    return combined_rate(collapse, credible, hz), collapse, credible
+
+
+def collapse_fit(collapsed: xr.DataArray, hz: HazardCurve) -> xr.Dataset:
+    """P(C | IM): the stripe fit (:func:`~stochpound.risk.stripe_fragility`, no bootstrap) of the runs beyond the model
+    (:func:`beyond_model`: 1 collapse, 0 credible, NaN not run), with its ``maf``, λ_C (1/yr)."""
+    collapse = stripe_fragility(_dims_only(collapsed), bootstrap=0)
     collapse["maf"] = mean_annual_frequency(collapse, hz)
-    return combined_rate(collapse, credible_fit(demand, collapsed, thresholds, dim), hz), collapse
-
-
-def credible_fit(demand: xr.DataArray, collapsed: xr.DataArray, thresholds: Sequence[float] | np.ndarray, dim: str) -> xr.Dataset:
-    """The credible runs' stripe fit of ``demand`` ≥ each threshold (:func:`~stochpound.risk.stripe_fragility`, no bootstrap): the
-    fit :func:`rate_collapses_apart` combines with P(C | IM), whose kind (a lognormal the runs identify or not, a step) says what
-    its rate rests on. ``demand``, ``collapsed``, ``thresholds`` and ``dim`` as there."""
-    demand, collapsed = xr.align(demand, _dims_only(collapsed), join="inner")
-    return stripe_fragility(limit_state_events(demand.where(collapsed == 0.0), thresholds, dim), bootstrap=0)
+    return collapse
 
 
 def collapse_risk(store: xr.Dataset, hz: HazardCurve, gaps: Sequence[float] | np.ndarray, targets: Sequence[float],
@@ -181,7 +186,7 @@ def collapse_risk(store: xr.Dataset, hz: HazardCurve, gaps: Sequence[float] | np
     if collapsed is None:
         return None
     closure, collapsed = xr.align(_inputs.contact_free_closure(store), _dims_only(collapsed), join="inner")
-    maf, collapse = rate_collapses_apart(closure, collapsed, gaps, "gap", hz)
+    maf, collapse, _ = rate_collapses_apart(closure, collapsed, gaps, "gap", hz)
     separation = risk_targeted_separation(xr.Dataset({"maf": maf}), targets, years)
     return CollapseRisk(collapse, separation, maf, int(collapsed.sum()), int(collapsed.notnull().sum()))
 

@@ -29,7 +29,7 @@ from stochpound.risk import _inputs
 from stochpound.risk._fragility_ensemble import BOOTSTRAP
 from stochpound.risk._maf import demand_hazard_curve
 from stochpound.risk._chain import CONFIDENCE, YEARS, non_increasing_along
-from stochpound.risk._collapse import beyond_model, rate_collapses_apart
+from stochpound.risk._collapse import beyond_model, collapse_fit, rate_collapses_apart
 
 DEMAND_LEVELS = 40
 """Levels of each demand hazard curve."""
@@ -175,13 +175,14 @@ def store_demands(store: xr.Dataset, hz: HazardCurve | None = None, confidence: 
     collapsed = _inputs.demand_drift(store)
     collapsed = None if collapsed is None else beyond_model(collapsed)
     collapsed = collapsed if collapsed is not None and bool((collapsed == 1.0).any()) else None
+    collapse = None if collapsed is None else collapse_fit(collapsed, hz)  # P(C | IM) once: every demand's runs are the same runs
     clearances = _inputs.moat_clearances(store, studied)
     curves, apart = {}, {}
     for label, (demand, _) in demands.items():
         levels = demand_levels(demand, clearances if label == base else ())
         curves[label] = demand_hazard_curve(demand, levels, hz, confidence=confidence, bootstrap=0)
         if collapsed is not None:
-            apart[label] = rate_collapses_apart(demand, collapsed, levels, "level", hz)[0].assign_coords(level=levels)
+            apart[label] = rate_collapses_apart(demand, collapsed, levels, "level", hz, collapse)[0].assign_coords(level=levels)
     moat = (demand_hazard_curve(sliding, clearances, hz, confidence=confidence, bootstrap=bootstrap, seed=seed)
             if sliding is not None and clearances else None)
     counts = (None, None) if collapsed is None else (collapsed.sum("record"), collapsed.notnull().sum("record"))

@@ -183,8 +183,9 @@ def design_summary_text(risk: StoreRisk, demands: StoreDemands | None = None, da
     rests = "; ".join(f"{key}: {value}" for key, value in {"hazard": f"{risk.hazard.describe()} ({_source(risk)})", **risk.assumptions,
                                                           **_outside_stripes_assumption(risk), **_beyond_model(damage, collapse)}.items())
     if damage is not None and damage.has_objectives():
-        judged = (f"Governing limit state (the largest λ/λ_target of the limit states, each against its own objective, the same at every "
-                  f"target; pounding at g* has 1): {_structural_governs(damage)}. At g*, what limits the separation: {limits}.")
+        judged = (f"Governing limit state (the largest λ/λ_target of the limit states beyond 1, each against its own objective, the same "
+                  f"at every target; pounding at g* has 1; each ratio in the Damage section): {_structural_governs(damage)}. At g*, what "
+                  f"limits the separation: {limits}.")
     else:
         judged = (f"Limit state judged (no structural limit state with an objective, so none is ranked against it; at g*, what limits "
                   f"the separation): {limits}.")
@@ -216,36 +217,50 @@ def _where(over: Sequence[dict[str, Hashable]], every: int) -> str:
 
 def _structural_governs(damage: StoreDamage) -> str:
     """What governs among the buildings' own limit states (:meth:`~stochpound.risk.StoreDamage.governing`, the same at every target),
-    with their counts of configurations, and pounding at g* where none misses its objective. Where some run is beyond the
-    model, judged both ways (as run, and with those runs counted apart as collapses), saying whether they agree."""
+    with their counts of configurations, and pounding at g* where none misses its objective; a limit state whose fit the runs
+    do not pin governs only on the lower bound of λ the stripes give (said so), and those the runs leave open are named. Where
+    some run is beyond the model, judged both ways (as run, and with those runs counted apart as collapses), saying whether they
+    agree."""
     run = damage.governing_counts()
     apart = damage.governing_counts(apart=True) if damage.judged_both_ways() else None
     if apart is None:
         if not run[0]:
-            return f"{POUNDING_AT_G} in every configuration (no limit state beyond its objective)"
-        return f"{_listed(run, damage.governing_unidentified())} {_WHY}{_rest([run])}"
+            return f"{POUNDING_AT_G} in every configuration (no limit state beyond its objective){_left_open(damage, False)}"
+        return f"{_listed(run, damage.governing_unpinned())}{_rest([run])}{_left_open(damage, False)}"
     if not run[0] and not apart[0]:
-        return f"{POUNDING_AT_G} in every configuration, as run and with the runs beyond the model counted apart as collapses alike"
+        return (f"{POUNDING_AT_G} in every configuration, as run and with the runs beyond the model counted apart as collapses alike"
+                f"{_left_open(damage, False)}{_left_open(damage, True)}")
     count, configurations = damage.disagreements()
     agree = ("the two treatments agree in every configuration" if not count else
              f"the two treatments disagree in {count} of {configurations} configurations: what governs depends on whether the runs "
              "beyond the model are taken as computed or as collapses")
-    return (f"as run, {_listed(run, damage.governing_unidentified()) or 'no limit state beyond its objective'}{_rest([run])}; with "
-            f"the runs beyond the model counted apart as collapses, {_listed(apart, damage.governing_unidentified(apart=True)) or 'no limit state beyond its objective'}"
-            f"{_rest([apart])} {_WHY[:-1]}; {agree})")
+    return (f"as run, {_listed(run, damage.governing_unpinned()) or 'no limit state beyond its objective'}{_rest([run])}"
+            f"{_left_open(damage, False)}; with the runs beyond the model counted apart as collapses, "
+            f"{_listed(apart, damage.governing_unpinned(apart=True)) or 'no limit state beyond its objective'}{_rest([apart])}"
+            f"{_left_open(damage, True)}; {agree}")
 
 
 POUNDING_AT_G = "pounding at g*"
-_WHY = "(a limit state beyond its own objective, the largest λ/λ_target, where pounding at g* has 1: the Damage section)"
 
 
 def _listed(counted: tuple[dict[str, int], int], unpinned: Collection[str] = ()) -> str:
     """One treatment's governing limit states with their counts of configurations ("" where none governs), each of ``unpinned``
-    (:meth:`~stochpound.risk.StoreDamage.governing_unidentified`) said to rest on a fit the runs do not pin."""
+    (:meth:`~stochpound.risk.StoreDamage.governing_unpinned`) said to govern on the lower bound of λ the stripes alone give."""
     states, configurations = counted
     return ", ".join(f"{state} in {count} of {configurations} configurations"
-                     + (" (on a fit the runs do not pin: a lognormal not identified, a flat fraction or a bound, the Damage section's table)" if state in unpinned else "")
+                     + (" (on the lower bound of λ the stripes' fractions alone give: its fit does not pin λ)" if state in unpinned else "")
                      for state, count in states.items())
+
+
+def _left_open(damage: StoreDamage, apart: bool) -> str:
+    """``; left open by the runs …: <state> in <n> of <m> configurations`` for the limit states whose fit the runs do not pin and
+    whose bounds straddle their objective (:meth:`~stochpound.risk.StoreDamage.undecided_counts`), else ""."""
+    counts = damage.undecided_counts(apart)
+    if not counts:
+        return ""
+    every = damage.governing_counts(apart)[1]
+    return ("; left open by the runs, its fit not pinning λ and the bounds the stripes give either side of its objective: "
+            + ", ".join(f"{state} in {n} of {every} configurations" for state, n in counts.items()))
 
 
 def _rest(treatments: list[tuple[dict[str, int], int]]) -> str:
