@@ -295,11 +295,11 @@ def test_a_limit_states_table_is_not_part_of_the_identity_and_replaces_the_defau
     edited = store.copy()
     edited.attrs = {**store.attrs, "definition": json.dumps({**json.loads(store.attrs["definition"]), "limit_states": with_table["limit_states"]})}
     damage = store_damage(edited)
-    assert damage.source == "a test"
+    assert damage.source == 'the experiment\'s [limit_states] table, whose source reads "a test"'
     assert [state.label for state in damage.limit_states] == ["peak storey ductility of B1 ≥ 4", "peak storey ductility of B1 ≥ 8",
                                                               "residual storey drift ratio of B1 ≥ 0.005", "residual storey drift ratio of B2 ≥ 0.005"]
     assert all(state.target is None for state in damage.limit_states)  # no targets given, and none of FEMA 356's capacities
-    assert "Limit states (capacities from a test; each building judged by its own demand): " \
+    assert "Limit states (capacities from the experiment's [limit_states] table, whose source reads \"a test\"; each building judged by its own demand): " \
            "peak storey ductility of B1 ≥ 4 (no objective);" in " ".join(
         _text(block) for block in damage_section("yfix", damage).blocks)
     # targets, shaped as the capacities, are carried in the definition and given to each state
@@ -739,3 +739,25 @@ def test_a_limit_state_on_a_fit_the_runs_do_not_pin_governs_only_on_its_lower_bo
     flat = damage.risk.assign(status_collapses_apart=damage.risk["status_collapses_apart"] * 0 + DECREASING)
     assert set(limit_state_fits(flat, apart=True).values.ravel()) == {"flat: decreasing (F ≡ fraction of runs that reached it)"}
     assert not bool(dataclasses.replace(damage, risk=flat).pinned(apart=True).any())
+
+
+def test_a_base_displacement_limit_state_names_no_stop_the_runs_do_not_have():
+    """Issue 45: the isolated flagship's limit state 'base displacement (the bearing's stop) of B1 ≥ 0.6 m' named a stop that no
+    configuration without a moat has: it is the base passing 0.6 m, the walled twin's clearance there, the wall in the others."""
+    import xarray as xr
+
+    from stochpound.report.sections._damage import _governing_text
+    from stochpound.risk import LimitState, StoreDamage
+
+    state = LimitState("isolator_displacement", 0.6, "B1", 0.02)
+    assert state.label == "peak base displacement of B1 ≥ 0.6 m"
+    risk = xr.Dataset({"maf": (("limit_state", "moat"), [[5e-4, 5e-4]])},
+                      coords={"limit_state": [state.label], "moat": ["none", "wall"], "target": ("limit_state", [0.02])})
+    walled = xr.DataArray([False, True], dims="moat", coords={"moat": ["none", "wall"]})
+    empty = xr.DataArray([0])
+    damage = StoreDamage(xr.Dataset(), empty, empty, {0.1: 1.0}, risk, (state,), "a test", True, (), (0.6,), walled)
+    text = _governing_text(damage)
+    assert ("peak base displacement of B1 ≥ 0.6 m counts the runs whose base passes 0.6 m: no stop is modelled at the bearing in these "
+            "runs; 0.6 m is the moat wall's clearance, so in the 1 of 2 configurations with the wall passing it is reaching the wall, and "
+            "in the 1 without it the base passes the walled twin's clearance with nothing there.") in text
+    assert "stop)" not in text and "bearing's stop" not in text

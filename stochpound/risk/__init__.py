@@ -25,7 +25,7 @@ not only the counts); :func:`store_demands` gives
 the demand hazard curves and the moat walls' limit state
 (:class:`StoreDemands`); :func:`limit_state_risk` the fragility and MAF of
 limit states beyond first contact (:class:`LimitState`: drift ratios,
-ductility, floor acceleration, impact force, a bearing's stop) at every gap
+ductility, floor acceleration, impact force, a sliding base's displacement) at every gap
 of a store's grid against its contact-free twins (:func:`gap_cost_frame`), what governs
 each configuration against the limit states' objectives in each treatment of the runs beyond the model
 (:func:`governing_limit_state`, :func:`objectives_frame`);

@@ -93,6 +93,10 @@ class StoreDamage:
         The buildings whose storeys never yield in any run (no yield force:
         no ductility; their ``peak_ductility`` is NaN, and absent from
         ``demands`` when no building yields).
+    walls : tuple of float
+        The moat walls' clearances at the studied building's base (m; () without walls).
+    walled : xarray.DataArray or None
+        Per configuration, whether its runs have those walls (None: no configuration has a wall).
     """
 
     demands: xr.Dataset
@@ -104,6 +108,8 @@ class StoreDamage:
     source: str
     contact_free: bool
     elastic: tuple[str, ...] = ()
+    walls: tuple[float, ...] = ()
+    walled: xr.DataArray | None = None
 
     def collapses_apart(self) -> bool:
         """Whether the limit states are given both ways: some run is beyond the model (``risk`` holds ``maf_collapses_apart``)."""
@@ -163,6 +169,10 @@ class StoreDamage:
         """Per limit state and configuration, whether the runs leave open if it misses its objective (``stochpound.risk.undecided``:
         a fit they do not pin, its bounds either side of the objective); None without ``risk``."""
         return None if self.risk is None else undecided(self.risk, apart)
+
+    def wall_counts(self) -> tuple[int, int]:
+        """The configurations with a moat wall at the studied building's base and the configurations ((0, 0) without walls)."""
+        return (0, 0) if self.walled is None else (int(self.walled.sum()), int(self.walled.size))
 
     def has_objectives(self) -> bool:
         """Whether any limit state has a performance objective (without one, nothing is said to govern)."""
@@ -276,7 +286,8 @@ def store_damage(store: xr.Dataset, limit_states: Sequence[LimitState] | None = 
     given = limit_states is not None
     table = _inputs.limit_states_table(store)
     if limit_states is None and table is not None:
-        limit_states, source, given = limit_states_of(table), table.source or EXPERIMENT_SOURCE, True
+        limit_states, given = limit_states_of(table), True
+        source = f'{EXPERIMENT_SOURCE}, whose source reads "{table.source}"' if table.source else EXPERIMENT_SOURCE
     if limit_states is None:
         limit_states, source = DEFAULT_LIMIT_STATES, DEFAULT_SOURCE
     per_building, free = _inputs.run_summaries(store, list(DAMAGE_DEMANDS))
@@ -303,4 +314,6 @@ def store_damage(store: xr.Dataset, limit_states: Sequence[LimitState] | None = 
     if held:
         risk = limit_state_risk(store, held, hz)
         risk = _inputs.contact_free_part(risk) if free else risk
-    return StoreDamage(demands, done.sum("record"), (beyond & done).sum("record"), design_stripes, risk, held, source or "", free, elastic)
+    walls = tuple(_inputs.moat_clearances(store, _inputs.studied_building(store)))
+    return StoreDamage(demands, done.sum("record"), (beyond & done).sum("record"), design_stripes, risk, held, source or "", free, elastic,
+                       walls, _inputs.walled_configurations(store) if walls else None)

@@ -3,7 +3,8 @@
 A limit state is a per-case demand of a store reaching a capacity: a storey
 drift ratio, a residual drift ratio or a ductility (the yielding storeys'
 summaries, ``stochpound.store.STOREY_SUMMARIES``), a floor acceleration, an
-impact force, or the base displacement that reaches a bearing's stop. Each
+impact force, or a sliding base's peak base displacement (a bearing's displacement
+capacity or a moat clearance: no stop is modelled unless the scene has a wall there). Each
 goes through the pounding chain's steps: per run, whether the demand reaches
 the capacity (:func:`~stochpound.risk.limit_state_events`); per
 configuration of the grid, a lognormal fragility of the stripes
@@ -66,7 +67,7 @@ KINDS = {kind: _Kind(_inputs.limit_state_variable(kind), *rest) for kind, rest i
     "ductility": ("1", "peak storey ductility", True, "yield_force"),
     "floor_acceleration": ("g", "peak floor acceleration", True, "[output] demands = true"),
     "impact_force": ("N", "peak impact force", False, "runs at a finite gap"),
-    "isolator_displacement": ("m", "base displacement (the bearing's stop)", True, "a sliding base"),
+    "isolator_displacement": ("m", "peak base displacement", True, "a sliding base"),
 }.items()}
 
 
@@ -95,8 +96,10 @@ class LimitState:
     kind : str
         One of ``stochpound.risk.LIMIT_STATE_KINDS``: ``drift_ratio``, ``residual_drift_ratio``,
         ``ductility`` (1), ``floor_acceleration`` (g), ``impact_force`` (N),
-        ``isolator_displacement`` (m, the base displacement at which the
-        bearing reaches its stop).
+        ``isolator_displacement`` (m, the peak base displacement of a sliding
+        base: a capacity such as a bearing's displacement capacity or a moat
+        wall's clearance; the runs model a stop there only where the scene
+        has a wall at that clearance).
     capacity : float
         The capacity, > 0, in the kind's units.
     building : str, optional

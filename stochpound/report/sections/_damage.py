@@ -102,7 +102,7 @@ def _beyond_model_text(damage: StoreDamage) -> str:
 def _governing_text(damage: StoreDamage) -> str:
     states = "; ".join(state.label + (f" (objective: {_percent(state.target)} in 50 yr)" if state.target is not None else " (no objective)")
                        for state in damage.limit_states)
-    head = (f"Limit states (capacities from {damage.source}; each building judged by its own demand): {states}. Each one's mean annual "
+    head = (f"Limit states (capacities from {damage.source}; each building judged by its own demand): {states}.{_base_text(damage)} Each one's mean annual "
             "frequency λ comes from its fragility over the stripes (the fit is named in the table) and the site's hazard, as for "
             "pounding, and is set against its own performance objective, λ_target = −ln(1 − p)/50 for its probability p in 50 yr. "
             "Where the fit is not a lognormal the runs identify (a step, a flat fraction, a lognormal with its median beyond the top "
@@ -121,6 +121,24 @@ def _governing_text(damage: StoreDamage) -> str:
             "target (g* is where pounding is as frequent as the target allows), so a structural limit state governs where it misses its "
             f"own objective (ratio above 1), at every target alike. Governing: {governs} A [limit_states] table in the experiment file "
             "replaces these capacities and objectives (targets; docs/risk.md).")
+
+
+def _base_text(damage: StoreDamage) -> str:
+    """What a limit state on the base displacement is in these runs: the base passing a displacement, with no stop modelled at
+    the bearing, and where it is a moat wall's clearance, reaching the wall only in the configurations that have it ("" without one)."""
+    states = [state for state in damage.limit_states if state.kind == "isolator_displacement"]
+    if not states:
+        return ""
+    walled, every = damage.wall_counts()
+    parts = []
+    for state in states:
+        text = f" {state.label} counts the runs whose base passes {state.capacity:g} m: no stop is modelled at the bearing in these runs"
+        if any(abs(state.capacity - wall) <= 1e-9 * wall for wall in damage.walls):
+            text += (f"; {state.capacity:g} m is the moat wall's clearance, so in the {walled} of {every} configurations with the wall "
+                     f"passing it is reaching the wall, and in the {every - walled} without it the base passes the walled twin's "
+                     "clearance with nothing there")
+        parts.append(text + ".")
+    return "".join(parts)
 
 
 def _governs_text(damage: StoreDamage, apart: bool) -> str:

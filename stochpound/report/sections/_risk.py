@@ -202,17 +202,23 @@ def _separation_limit(risk: StoreRisk, demands: StoreDemands | None, target: flo
         return pounding
     parts = []
     for _, clearance, over, every, worst, _ in reached:
-        parts.append(f"the base reaching the {clearance:.3g} m moat clearance (the bearing's stop) more often than the target allows in "
-                     f"{_where(over, every)}, once in {1 / worst:.3g}{_wall_interval(demands, clearance)} yr at worst")
-    others = "" if all(len(row[2]) == row[3] for row in reached) else ", and pounding between the buildings in the other configurations"
+        parts.append(f"the base reaching the moat wall at its {clearance:.3g} m clearance more often than the target allows in "
+                     f"{_where(over, every, _walled_noun(demands))}, once in {1 / worst:.3g}{_wall_interval(demands, clearance)} yr at worst")
+    others = "" if all(len(row[2]) == row[3] for row in reached) and demands.walled is None else ", and pounding between the buildings in the other configurations"
     return f"for {risk.target_text(target)}, " + "; ".join(parts) + others
 
 
-def _where(over: Sequence[dict[str, Hashable]], every: int) -> str:
-    """The configurations ``over`` of ``every``: ``every configuration``, or ``2 of 8 configurations (<labels>; <labels>)``."""
-    if len(over) == every:
+def _walled_noun(demands: StoreDemands) -> str:
+    """The configurations a moat wall's rows count: every one, or those with the wall where some have none."""
+    return "configurations" if demands.walled is None else "configurations with the wall"
+
+
+def _where(over: Sequence[dict[str, Hashable]], every: int, noun: str = "configurations") -> str:
+    """The configurations ``over`` of ``every``: ``every configuration``, or ``2 of 8 configurations (<labels>; <labels>)``
+    (``noun``: what the ``every`` are, e.g. the configurations with a wall)."""
+    if len(over) == every and noun == "configurations":
         return "every configuration"
-    return f"{len(over)} of {every} configurations (" + "; ".join(labels_text(labels) for labels in over) + ")"
+    return f"{len(over)} of {every} {noun} (" + "; ".join(labels_text(labels) for labels in over) + ")"
 
 
 def _structural_governs(damage: StoreDamage) -> str:
@@ -338,15 +344,22 @@ def moat_text(risk: StoreRisk, demands: StoreDemands | None) -> str:
         largest = " (the largest over the configurations)" if varies else ""
         sentences.append(f"The wall-free suite-mean peak base displacement (the D_M form, no torsion) at {100 * level:g} %/{risk.years:g} yr{largest} is "
                          f"{value:.3g} m and {verdict}.")
+    noun = _walled_noun(demands)
     for target, clearance, over, every, worst, rate in demands.wall_exceedances(risk.separation["target"].values, risk.years):
         allowed = 1.0 / rate
-        head = f"The base reaches the {clearance:.3g} m moat clearance once in {1 / worst:.3g}{_wall_interval(demands, clearance)} yr in its worst configuration"
+        head = (f"The base reaches the moat wall at its {clearance:.3g} m clearance once in {1 / worst:.3g}"
+                f"{_wall_interval(demands, clearance)} yr in its worst configuration with the wall")
         if not over:
-            verdict = f"less often than {risk.target_text(target)} allows (once in {allowed:.3g} yr) in every configuration: it does not limit the separation for this target"
+            verdict = (f"less often than {risk.target_text(target)} allows (once in {allowed:.3g} yr) in every configuration with "
+                       "the wall: it does not limit the separation for this target")
         else:
-            verdict = (f"more often than {risk.target_text(target)} allows (once in {allowed:.3g} yr) in {_where(over, every)}: there the clearance, "
-                       "not the gap, limits the separation for this target")
+            verdict = (f"more often than {risk.target_text(target)} allows (once in {allowed:.3g} yr) in {_where(over, every, noun)}: "
+                       "there the wall, not the gap, limits the separation for this target")
         sentences.append(f"{head}; {verdict}.")
+    if demands.walled is not None:
+        sentences.append("In the configurations without the wall no stop is modelled at the base (the bearing has none in these runs): "
+                         "the moat table's rows for them give how often their base passes the walled twin's clearance, with nothing "
+                         "there to reach, which limits nothing.")
     return " ".join(sentences)
 
 
@@ -633,7 +646,8 @@ def _demand_blocks(name: str, risk: StoreRisk, demands: StoreDemands | None) -> 
     if demands.moat is not None:
         blocks.append(Table(f"risk-moat-{name}", f"Experiment {name}: moat-wall contact as a limit state: the mean annual frequency with "
                             "which the studied building's base reaches the moat wall's clearance (peak base displacement ≥ clearance; "
-                            "before the first wall impact a run with the wall equals the run without), "
+                            "before the first wall impact a run with the wall equals the run without; in a configuration without the "
+                            "wall, the rate its base passes that clearance, where no stop is modelled: 'what it is'), "
                             f"{_with_interval(risk, 'interval', ' (of the return period and the probability too)')}", demands.moat_frame(),
                             formats={**_RATE_FORMATS, "λ (1/yr)": "{:.3g}", "λ lower": "{:.3g}", "λ upper": "{:.3g}",
                                      f"P in {demands.years:g} yr": "{:.3f}"}))
