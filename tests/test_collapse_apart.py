@@ -179,3 +179,25 @@ def test_the_level_at_a_targets_rate_is_read_off_each_curve_both_ways():
         else:
             assert float(frame["collapses apart"].iloc[0]) == pytest.approx(math.sqrt(1e-3 / (rate - collapse)), rel=2e-2)
     assert list(frame["demand"]) == ["d (m)"] and list(frame["target"]) == ["10 % in 50 yr"]
+
+
+def test_a_collapse_fit_the_stripes_do_not_identify_is_said_so_with_its_bounds():
+    """Issue 45: the flagships' P(C | IM) had θ = 2.88–6.71 beyond the top stripe 1.8 g and its λ_C was printed as identified. One
+    collapse of 8 at the top stripe only: a step there, no lognormal; the text says so and gives λ⁻ = λ(x_3)/8 and
+    λ⁺ = (λ(x_2) − λ(x_3))/8 + λ(x_3)."""
+    from stochpound.risk._fragility import FIT
+
+    from stochpound.risk import CollapseRisk
+    from stochpound.risk._collapse import collapse_fit
+
+    drift = _runs(np.where(np.arange(8)[None, :] < np.array([0, 0, 1])[:, None], 0.06, 0.01))
+    collapse = collapse_fit(beyond_model(drift), HAZARD)
+    assert int(collapse["status"]) != FIT
+    rates = [K0 * x**-K for x in LEVELS]
+    separation = xr.Dataset({"separation": ("target", [0.1])}, coords={"target": [0.1]})
+    text = CollapseRisk(collapse, separation, xr.DataArray(0.0), 1, 24).text()
+    low, high = rates[2] / 8, (rates[1] - rates[2]) / 8 + rates[2]
+    assert (f"(the stripes do not identify P(C | IM) in 1 of 1 configurations: a step, or a lognormal with its median beyond the top "
+            f"stripe or β ≥ 0.8, so λ_C there rests on the fit's extrapolation; the stripes' fractions alone bound it to {low:.3g}–{high:.3g} /yr)") in text
+    identified = collapse_fit(beyond_model(_runs(DRIFT)), HAZARD)  # 0, 2 and 5 of 8: a lognormal within the stripes
+    assert "do not identify" not in CollapseRisk(identified, separation, xr.DataArray(0.0), 7, 24).text()

@@ -37,9 +37,10 @@ import xarray as xr
 
 from stochpound.hazard import HazardCurve
 from stochpound.risk import _inputs
-from stochpound.risk._fragility import DECREASING, lognormal_cdf
+from stochpound.risk._fragility import DECREASING, FIT, lognormal_cdf
 from stochpound.risk._fragility_ensemble import limit_state_events, stripe_fragility
 from stochpound.risk._maf import mean_annual_frequency, risk_targeted_separation
+from stochpound.risk._stripe_coverage import stripes_only_maf, stripes_upper_maf, unidentified
 
 MODEL_DRIFT_LIMIT = 0.05
 """Peak storey drift ratio beyond which a run is beyond what the model represents: a collapse (no strength loss or collapse is modelled)."""
@@ -98,11 +99,24 @@ class CollapseRisk:
                 "storey drift, beyond what the model represents (no strength loss or collapse is modelled); they are counted apart as "
                 f"collapses. P(C | IM) is a lognormal fitted over the stripes ({fits}; a step where the runs identify none), "
                 f"λ_C = {float(self.collapse['maf'].min()):.3g}" + (f"–{float(self.collapse['maf'].max()):.3g}"
-                if float(self.collapse["maf"].max()) != float(self.collapse["maf"].min()) else "") + " /yr; pounding is fitted on the "
+                if float(self.collapse["maf"].max()) != float(self.collapse["maf"].min()) else "") + f" /yr{self._unpinned_text()}; pounding is fitted on the "
                 "credible runs only and combined with it by total probability, P(P | IM) = P(C | IM) + (1 − P(C | IM)) P(P | IM, no C), a "
                 "collapse counted as reaching the gap. g* both ways: 'as run' keeps every run as computed; 'collapses apart' is the PBEE "
                 "answer" + (f"; it is inf (no gap meets the target) where collapse alone is more frequent than the target allows "
                             f"({', '.join(beyond)}): there the structure, not the gap, governs" if beyond else "") + ".")
+
+
+    def _unpinned_text(self) -> str:
+        """Where the stripes do not identify P(C | IM) (its median beyond the top stripe, β ≥ 0.8, or a step), that λ_C rests on
+        the fit's extrapolation and the bounds the stripes' fractions alone give it; "" where they identify it everywhere."""
+        why = unidentified(self.collapse)
+        loose = (why != "") | (self.collapse["status"] != FIT)
+        if not bool(loose.any()) or "maf_lower" not in self.collapse:
+            return ""
+        low, high = self.collapse["maf_lower"].where(loose), self.collapse["maf_upper"].where(loose)
+        return (f" (the stripes do not identify P(C | IM) in {int(loose.sum())} of {int(loose.size)} configurations: a step, or a "
+                "lognormal with its median beyond the top stripe or β ≥ 0.8, so λ_C there rests on the fit's extrapolation; the stripes' "
+                f"fractions alone bound it to {float(low.min()):.3g}–{float(high.max()):.3g} /yr)")
 
 
 def collapsed_runs(store: xr.Dataset, limit: float = MODEL_DRIFT_LIMIT) -> xr.DataArray | None:
@@ -157,9 +171,12 @@ def rate_collapses_apart(demand: xr.DataArray, collapsed: xr.DataArray, threshol
 
 def collapse_fit(collapsed: xr.DataArray, hz: HazardCurve) -> xr.Dataset:
     """P(C | IM): the stripe fit (:func:`~stochpound.risk.stripe_fragility`, no bootstrap) of the runs beyond the model
-    (:func:`beyond_model`: 1 collapse, 0 credible, NaN not run), with its ``maf``, λ_C (1/yr)."""
+    (:func:`beyond_model`: 1 collapse, 0 credible, NaN not run), with its ``maf``, λ_C (1/yr), and ``maf_lower``, ``maf_upper``,
+    the bounds of λ_C the stripes' fractions alone give (:func:`~stochpound.risk.stripes_only_maf`,
+    :func:`~stochpound.risk.stripes_upper_maf`)."""
     collapse = stripe_fragility(_dims_only(collapsed), bootstrap=0)
     collapse["maf"] = mean_annual_frequency(collapse, hz)
+    collapse["maf_lower"], collapse["maf_upper"] = stripes_only_maf(collapse, hz), stripes_upper_maf(collapse, hz)
     return collapse
 
 
