@@ -153,7 +153,7 @@ def test_pounding_at_g_star_governs_where_no_limit_state_is_as_frequent(store):
     damage = store_damage(store, [LimitState("ductility", 1.0e4, target=0.02)], "a test")
     assert float(damage.risk["maf"].max()) == 0.0
     assert damage.governing().item() == "pounding at g*"
-    assert "Governing: as run, pounding at g* (every limit state within its objective as the runs judge it; the largest λ/λ_target is 0" in " ".join(
+    assert "Governing: as run, pounding at g* (no limit state the runs put beyond its objective; the largest λ/λ_target is 0" in " ".join(
         _text(block) for block in damage_section("yfix", damage).blocks)
     unjudged = store_damage(store, [LimitState("ductility", 1.0e4)], "a test")
     text = " ".join(_text(block) for block in damage_section("yfix", unjudged).blocks)
@@ -191,7 +191,7 @@ def test_governs_is_judged_in_each_treatment_of_the_collapses_and_a_disagreement
     assert list(damage.disagreement().values) == [True, False]
     assert damage.governing_counts(apart=True) == ({states[1].label: 1, states[0].label: 1}, 2)
     text = _governing_text(damage)
-    assert (f"Governing: as run, mu 0.05: pounding at g* (every limit state within its objective as the runs judge it; the largest "
+    assert (f"Governing: as run, mu 0.05: pounding at g* (no limit state the runs put beyond its objective; the largest "
             f"λ/λ_target is {3e-4 / rates[1]:.2g}, {states[1].label}); mu 0.08: {states[0].label} (λ/λ_target = {0.02 / rates[0]:.2g}); with the runs "
             f"beyond the model counted apart as collapses, mu 0.05: {states[1].label} (λ/λ_target = {9e-4 / rates[1]:.2g})") in text
     assert (f"The two treatments disagree on what governs in 1 of 2 configurations (mu 0.05: pounding at g* as run, {states[1].label} "
@@ -761,3 +761,10 @@ def test_a_base_displacement_limit_state_names_no_stop_the_runs_do_not_have():
             "runs; 0.6 m is the moat wall's clearance, so in the 1 of 2 configurations with the wall passing it is reaching the wall, and "
             "in the 1 without it the base passes the walled twin's clearance with nothing there.") in text
     assert "stop)" not in text and "bearing's stop" not in text
+    # the design summary says the same where it names that limit state governing
+    from stochpound.report.sections._risk import _structural_governs
+
+    summary = _structural_governs(StoreDamage(xr.Dataset(), empty, empty, {0.1: 1.0}, risk.assign(maf=risk["maf"] * 0 + 1e-3), (state,),
+                                              "a test", True, (), (0.6,), walled))
+    assert summary == (f"{state.label} in 2 of 2 configurations; in the 1 configuration without the moat wall, {state.label} is the "
+                       "base passing the walled twin's clearance, with no stop modelled there")

@@ -156,7 +156,7 @@ def _governs_text(damage: StoreDamage, apart: bool) -> str:
         if worst == POUNDING:
             state = str(largest_state.sel(labels).item())
             lower = "" if bounds is None or bool(pinned.sel(labels).sel(limit_state=state).item()) else " (its lower bound: its fit does not pin λ)"
-            text = (f"{POUNDING} (every limit state within its objective as the runs judge it; the largest λ/λ_target is "
+            text = (f"{POUNDING} (no limit state the runs put beyond its objective; the largest λ/λ_target is "
                     f"{ratio_text(value, 2)}{lower}, {state})")
         else:
             others = [str(state) for state, flag in zip(misses["limit_state"].values, misses.sel(labels).values) if flag and state != worst]

@@ -232,12 +232,12 @@ def _structural_governs(damage: StoreDamage) -> str:
     if apart is None:
         if not run[0]:
             return f"{POUNDING_AT_G} in every configuration (no limit state beyond its objective){_left_open(damage, False)}"
-        return f"{_listed(run, damage.governing_unpinned())}{_rest([run])}{_left_open(damage, False)}"
+        return f"{_listed(run, damage.governing_unpinned())}{_rest([run])}{_left_open(damage, False)}{_base_note(damage, run, None, '; ')}"
     if not run[0] and not apart[0]:
         return (f"{POUNDING_AT_G} in every configuration, as run and with the runs beyond the model counted apart as collapses alike"
                 f"{_left_open(damage, False)}{_left_open(damage, True)}")
     count, configurations = damage.disagreements()
-    agree = ("the two treatments agree in every configuration" if not count else
+    agree = _base_note(damage, run, apart, "", "; ") + ("the two treatments agree in every configuration" if not count else
              f"the two treatments disagree in {count} of {configurations} configurations: what governs depends on whether the runs "
              "beyond the model are taken as computed or as collapses")
     return (f"as run, {_listed(run, damage.governing_unpinned()) or 'no limit state beyond its objective'}{_rest([run])}"
@@ -247,6 +247,19 @@ def _structural_governs(damage: StoreDamage) -> str:
 
 
 POUNDING_AT_G = "pounding at g*"
+
+
+def _base_note(damage: StoreDamage, run: tuple[dict[str, int], int], apart: tuple[dict[str, int], int] | None, head: str = "",
+               tail: str = "") -> str:
+    """Where a base-displacement limit state governs somewhere and some configurations have no moat wall: ``head``, what it is
+    there (the base passing the walled twin's clearance, no stop modelled), ``tail``; "" where not."""
+    governing = set(run[0]) | (set(apart[0]) if apart is not None else set())
+    named = [state.label for state in damage.limit_states if state.kind == "isolator_displacement" and state.label in governing]
+    walled, every = damage.wall_counts()
+    if not named or not every or walled == every:
+        return ""
+    return (f"{head}in the {counted(every - walled, 'configuration')} without the moat wall, {' and '.join(named)} is the base passing the walled "
+            f"twin's clearance, with no stop modelled there{tail}")
 
 
 def _listed(counted: tuple[dict[str, int], int], unpinned: Collection[str] = ()) -> str:
@@ -458,8 +471,8 @@ def _grid_note(risk: StoreRisk) -> str:
               f"across those steps, g* differs from the value printed by up to {100 * change:.1f} % (largest over the configurations "
               "and targets)." if change == change else "")
     return (f"g* is interpolated on a grid of {gaps.size} gaps from {gaps[0]:.3g} to {gaps[-1]:.3g} m ({made}): it is where the "
-            "non-increasing fit of ln λ_P(g) (isotonic regression, each gap weighted by the share of ln g it stands for) crosses "
-            f"the target, linearly in ln λ against ln g between the two gaps that bracket it.{coarse}")
+            "non-increasing fit of ln λ_P along the gaps, an isotonic regression with each gap weighted by the share of ln g it "
+            f"stands for, crosses the target, linearly in ln λ against ln g between the two gaps that bracket it.{coarse}")
 
 
 def _panel_grid(count: int, height: float = 2.6) -> tuple[Figure, list[Any]]:
