@@ -221,7 +221,8 @@ def _limit_states_table(name: str, damage: StoreDamage) -> Table:
               "(λ⁻: each stripe's fraction held up to the next stripe, nothing below the lowest; λ⁺: each stripe's fraction held down "
               "to the stripe below, the lowest's down to the hazard's lowest intensity, and every run reaching it beyond the top "
               "stripe; the fractions' own sampling aside), and the return period and λ/λ_target that follow; such a limit state "
-              "misses its objective only where λ⁻ does."),
+              "misses its objective only where λ⁻ does. Every λ here is a point estimate from the runs, without an interval (no "
+              "resampling of the motions): a ratio within a few per cent of 1 does not decide its objective."),
     )
 
 

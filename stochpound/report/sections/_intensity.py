@@ -380,8 +380,8 @@ def _consistency_figure(name: str, consistency: dict[str, xr.Dataset], setting: 
     return FigureItem(
         f"intensity-consistency-{name}",
         f"Experiment {name}: the site's hazard curves at its other measures (black) against the ones recomputed from the stripes of "
-        f"{setting.description} (red: the fraction of every stripe's scaled motions above the intensity, weighted by the site's "
-        f"rate of the stripe's bin); dotted: the rates of {_targets_text()} in 50 years.",
+        f"{setting.description}, in red: the fraction of every stripe's scaled motions above the intensity, weighted by the site's "
+        f"rate of the stripe's bin; dotted: the rates of {_targets_text()} in 50 years.",
         figure,
     )
 
