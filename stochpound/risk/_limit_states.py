@@ -460,7 +460,9 @@ def _where(index: object, names: Sequence[str | None]) -> str:
 
 def gap_cost_frame(risk: xr.Dataset, years: float = YEARS) -> pd.DataFrame:
     """The "what the gap costs" table of :func:`limit_state_risk`: per limit state and finite gap, λ, λ of the twins, their difference, and P in ``years``
-    (and λ with the runs beyond the model counted apart as collapses, where some run is).
+    (and λ with the runs beyond the model counted apart as collapses, where some run is), the fit's kind, and where the runs do
+    not pin it (:func:`limit_state_pinned`) the bounds λ⁻ and λ⁺ they give λ (:func:`limit_state_bounds`): there λ is the fit's
+    extrapolation, not the runs'.
 
     Returns
     -------
@@ -468,9 +470,15 @@ def gap_cost_frame(risk: xr.Dataset, years: float = YEARS) -> pd.DataFrame:
         Indexed by the limit state and the other grid labels (the contact-free rows left out).
     """
     keep = [name for name in ("maf", "maf_contact_free", "gap_cost", "maf_collapses_apart") if name in risk]
-    frame = _inputs.at_finite_gaps(risk[keep].assign(fit=limit_state_fits(risk))).reset_coords(drop=True).to_dataframe()
+    data = risk[keep].assign(fit=limit_state_fits(risk))
+    bounds = limit_state_bounds(risk)
+    if bounds is not None:  # where the runs do not pin the fit, the bounds they give λ (NaN where they pin it)
+        pinned = limit_state_pinned(risk)
+        data = data.assign(maf_lower=bounds[0].where(~pinned), maf_upper=bounds[1].where(~pinned))
+    frame = _inputs.at_finite_gaps(data).reset_coords(drop=True).to_dataframe()
     frame[f"P in {years:g} yr"] = probability_from_rate(frame["maf"].to_numpy(), years)
     if "maf_contact_free" in frame:
         frame[f"P in {years:g} yr, contact-free"] = probability_from_rate(frame["maf_contact_free"].to_numpy(), years)
     return frame.rename(columns={"maf": "λ (1/yr)", "maf_contact_free": "λ contact-free (1/yr)", "gap_cost": "Δλ (1/yr)",
-                                 "maf_collapses_apart": "λ collapses apart (1/yr)"})
+                                 "maf_collapses_apart": "λ collapses apart (1/yr)", "maf_lower": "λ⁻ if not pinned (1/yr)",
+                                 "maf_upper": "λ⁺ if not pinned (1/yr)"})
