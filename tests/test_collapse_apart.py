@@ -201,3 +201,9 @@ def test_a_collapse_fit_the_stripes_do_not_identify_is_said_so_with_its_bounds()
             f"stripe or β ≥ 0.8, so λ_C there rests on the fit's extrapolation; the stripes' fractions alone bound it to {low:.3g}–{high:.3g} /yr)") in text
     identified = collapse_fit(beyond_model(_runs(DRIFT)), HAZARD)  # 0, 2 and 5 of 8: a lognormal within the stripes
     assert "do not identify" not in CollapseRisk(identified, separation, xr.DataArray(0.0), 7, 24).text()
+    # the table of g* both ways gives those bounds beside λ_C where P(C | IM) is not identified
+    from stochpound.risk._collapse import COLLAPSE_BOUNDS
+
+    frame = CollapseRisk(collapse, xr.Dataset({"separation": ("target", [0.1])}, coords={"target": [0.1]}), xr.DataArray(0.0), 1,
+                         24).both_ways(xr.Dataset({"separation": ("target", [0.1])}, coords={"target": [0.1]}))
+    assert list(frame[COLLAPSE_BOUNDS]) == [f"[{low:.3g}, {high:.3g}]"]

@@ -44,6 +44,8 @@ from stochpound.risk._stripe_coverage import stripes_only_maf, stripes_upper_maf
 
 MODEL_DRIFT_LIMIT = 0.05
 """Peak storey drift ratio beyond which a run is beyond what the model represents: a collapse (no strength loss or collapse is modelled)."""
+COLLAPSE_BOUNDS = "λ_C, stripes' bounds where P(C | IM) is not identified (1/yr)"
+"""The g* both ways table's column of what the stripes' fractions alone bound λ_C to, where they do not identify P(C | IM)."""
 GRID_POINTS = 2000
 """Points in ln x of the integration over the hazard's range."""
 BEYOND = 8.0
@@ -75,7 +77,8 @@ class CollapseRisk:
 
     def both_ways(self, as_run: xr.Dataset, years: float = 50.0) -> pd.DataFrame:
         """g* both ways per configuration and target (m): ``as run`` (the chain's ``StoreRisk.separation``, every run as computed) and
-        ``collapses apart`` (this), beside each configuration's λ_C (1/yr) and its runs beyond the model."""
+        ``collapses apart`` (this), beside each configuration's λ_C (1/yr), the bounds the stripes give it where they do not identify
+        P(C | IM) (``COLLAPSE_BOUNDS``), and its runs beyond the model."""
         rows = xr.Dataset({"g* as run (m)": _dims_only(as_run["separation"]),
                            "g* collapses apart (m)": _dims_only(self.separation["separation"])}).to_dataframe().reset_index()
         rows["target"] = [f"{100 * p:g} % in {years:g} yr" for p in rows["target"]]
@@ -85,6 +88,13 @@ class CollapseRisk:
         extra = counts.to_dataframe().reset_index() if config else pd.DataFrame({name: [float(counts[name])] for name in counts.data_vars})
         extra["runs beyond the model"] = [f"{int(k)} of {int(n)}" for k, n in zip(extra["collapsed"], extra["runs"])]
         extra = extra.drop(columns=["collapsed", "runs"])
+        if "maf_lower" in self.collapse:  # where the stripes do not identify P(C | IM), λ_C is its extrapolation: what they bound it to
+            loose = _dims_only((unidentified(self.collapse) != "") | (self.collapse["status"] != FIT))
+            bounds = xr.Dataset({"loose": loose, "lower": _dims_only(self.collapse["maf_lower"]), "upper": _dims_only(self.collapse["maf_upper"])})
+            table = bounds.to_dataframe().reset_index() if config else pd.DataFrame({name: [bounds[name].item()] for name in bounds.data_vars})
+            table[COLLAPSE_BOUNDS] = [f"[{low:.3g}, {high:.3g}]" if flag else "identified" for flag, low, high in
+                                      zip(table["loose"], table["lower"], table["upper"])]
+            extra = extra.merge(table[[*config, COLLAPSE_BOUNDS]], on=config) if config else extra.assign(**{COLLAPSE_BOUNDS: table[COLLAPSE_BOUNDS]})
         merged = rows.merge(extra, on=config) if config else rows.assign(**{name: extra[name].iloc[0] for name in extra.columns})
         return merged.set_index([*config, "target"])
 
