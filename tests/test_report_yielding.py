@@ -484,6 +484,9 @@ def test_the_design_summary_names_the_limit_state_the_damage_section_finds_gover
     assert f"{structural[0]} in {governing.count(structural[0])} of {len(governing)} configurations" in text
     assert "the largest λ/λ_target of the limit states beyond 1, each against its own objective" in text
     assert ") (" not in text  # the flagship's summary set two brackets back to back: '(… table) (a limit state …)'
+    # what the governing limit state rests on is among the summary's assumptions
+    assert (f"limit states: {len(damage.limit_states)} capacities, each with its objective, as the Damage section lists them; each λ "
+            "from its fit where the runs pin it") in text
     unreached = store_damage(store, [LimitState("ductility", 1.0e4, target=0.1)], "a test")
     text = design_summary_text(risk, None, unreached)
     # as run no run reaches it; counted apart, the collapses do, more often than 10 % in 50 yr allows: the treatments disagree

@@ -181,7 +181,8 @@ def design_summary_text(risk: StoreRisk, demands: StoreDemands | None = None, da
         meets = (f"Code rules meeting their own design level as a target in every configuration and level ({column.replace('meets, ', '') if 'upper' in column else 'estimate'}): "
                  f"{', '.join(met.index[met]) or 'none'}; not: {', '.join(met.index[~met]) or 'none'}.")
     rests = "; ".join(f"{key}: {value}" for key, value in {"hazard": f"{risk.hazard.describe()} ({_source(risk)})", **risk.assumptions,
-                                                          **_outside_stripes_assumption(risk), **_beyond_model(damage, collapse)}.items())
+                                                          **_outside_stripes_assumption(risk), **_beyond_model(damage, collapse),
+                                                          **_limit_states_assumption(damage)}.items())
     if damage is not None and damage.has_objectives():
         judged = (f"Governing limit state (the largest λ/λ_target of the limit states beyond 1, each against its own objective, the same "
                   f"at every target; pounding at g* has 1; each ratio in the Damage section): {_structural_governs(damage)}. At g*, what "
@@ -302,6 +303,16 @@ def _beyond_model(damage: StoreDamage | None, collapse: CollapseRisk | None = No
     return {"beyond the model": f"{beyond} of {runs} runs exceed a "
                                 f"{100 * MODEL_DRIFT_LIMIT:g} % storey drift, where the storeys' lack of strength loss and collapse makes their "
                                 f"response not credible; {counted}"}
+
+
+def _limit_states_assumption(damage: StoreDamage | None) -> dict[str, str]:
+    """What the governing limit state rests on: the limit states' capacities and objectives and how their λ is judged
+    ({} without limit states with objectives)."""
+    if damage is None or not damage.has_objectives():
+        return {}
+    return {"limit states": f"{len(damage.limit_states)} capacities, each with its objective, as the Damage section lists them; each λ "
+                            "from its fit where the runs pin it (a lognormal they identify), else judged on the lower bound the "
+                            "stripes' fractions give (a fragility that does not fall with intensity); point estimates without an interval"}
 
 
 def _source(risk: StoreRisk) -> str:
