@@ -73,6 +73,7 @@ def test_the_limits_of_section_17_5_4_3_by_hand():
     assert design.fixed_base_shear == pytest.approx(0.23 * WS, rel=1e-12)
     upper_damping = 2.0 * 0.09 / (math.pi * (0.09 + DOCS_DM["upper"] / R))
     assert design.activation_shear == pytest.approx(0.09 * W * (WS / W) ** (1.0 - 3.5 * upper_damping), rel=1e-4)  # mu_max W > 1.5 mu W
+    assert design.activation_shear / 1e3 == pytest.approx(397.3, abs=0.1)  # the docs' digits of item 3
     assert design.wind_shear is None
     assert (design.design_shear, design.governs) == (design.lower.shear, "eq. 17.5-8")
     assert design.total_displacement == design.lower.total_displacement
@@ -115,3 +116,37 @@ def test_bad_inputs_name_the_field_and_range(build, message):
     with pytest.raises(ValueError, match=message) as error:
         build()
     assert "\n" not in str(error.value)
+
+
+def test_the_isolated_flagships_item_3_limits_by_hand():
+    """Issue 45: the isolated flagship's report gives §17.5.4.3 item 3 as 0.101 W_s (μ 0.05) and 0.176 W_s (μ 0.08), not checked
+    by hand. Item 3 is V_st of eq. 17.5-7 with V_b the force that fully activates the isolation system at upper-bound friction,
+    μ_max W (λ_max = 1.8; it exceeds 1.5 μ W): V_st / W_s = μ_max (W_s/W)^(−3.5 β_M) with β_M at the upper bound, whose D_M is
+    found here by plain fixed-point iteration of eq. 17.5-1 (T_M, β_M and B_M of Table 17.5-1 as in the docs' hand calculation).
+    The flagship: floor masses 26 268 and 17 512 kg on a 13 134 kg base (W_s/W = 10/13), R = 2.24 m, the site's geometric-mean
+    SA(0.2 s) and SA(1 s) at 2 % in 50 yr from its bundled curves, T_L = 8 s."""
+    from stochpound.hazard import HazardCurve, rate_from_probability
+
+    rate = float(rate_from_probability(0.02, 50.0))
+    sa_short, sa_long = (float(HazardCurve.bundled(f"fox_plaza_los_angeles_{name}").intensity_at(rate)) for name in ("sa0p2s", "sa1p0s"))
+    rows = [(0.02, 0.8), (0.05, 1.0), (0.10, 1.2), (0.20, 1.5), (0.30, 1.7), (0.40, 1.9), (0.50, 2.0)]
+
+    def coefficient(beta):  # Table 17.5-1, linear between its rows
+        return next(b_a + (beta - beta_a) / (beta_b - beta_a) * (b_b - b_a) for (beta_a, b_a), (beta_b, b_b) in zip(rows, rows[1:])
+                    if beta <= beta_b)
+
+    masses, base_mass = 26268.0 + 17512.0, 13134.0
+    weight, superstructure = (masses + base_mass) * G, masses * G
+    for mu, printed in ((0.05, 0.101), (0.08, 0.176)):
+        upper, d_m = 1.8 * mu, 0.5
+        for _ in range(200):  # eq. 17.5-1: D = g S_M1 T_M / (4π² B_M), T_M and B_M at D
+            period = 2.0 * math.pi / math.sqrt(G * (1.0 / R + upper / d_m))
+            damping = 2.0 * upper / (math.pi * (upper + d_m / R))
+            d_m = G * 1.3 * sa_long * period / (4.0 * math.pi**2 * coefficient(damping))
+        damping = 2.0 * upper / (math.pi * (upper + d_m / R))
+        hand = max(upper, 1.5 * mu) * (superstructure / weight) ** (-3.5 * damping)
+        design = chapter17_design(SlidingBase(mu=mu, radius=R, weight=weight, superstructure_weight=superstructure),
+                                  MceSpectrum.from_geometric_mean(sa_short, sa_long, 8.0), IsolatedPlan(10.0, 10.0), 8.0)
+        assert design.upper.displacement == pytest.approx(d_m, rel=1e-3)
+        assert design.activation_shear / superstructure == pytest.approx(hand, rel=1e-3)
+        assert round(hand, 3) == printed  # the report's digits

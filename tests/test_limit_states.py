@@ -83,7 +83,7 @@ def test_every_limit_state_is_a_direct_count_of_the_runs_demands(store, risk):
     """The fragility's per-stripe counts are those of the stored summaries, at every gap (the contact-free twins included)."""
     states = limit_states_from_table(LIMIT_STATES)
     assert [s.label for s in states] == list(risk["limit_state"].values)
-    assert "peak floor acceleration ≥ 1 g" in risk["limit_state"].values and "base displacement (the bearing's stop) of B1 ≥ 0.1 m" in risk["limit_state"].values
+    assert "peak floor acceleration ≥ 1 g" in risk["limit_state"].values and "peak base displacement of B1 ≥ 0.1 m" in risk["limit_state"].values
     g = store.pound.definition.to_dict()["scene"]["g"]
     for state in states:
         variable = LIMIT_STATE_KINDS[state.kind].variable
@@ -166,3 +166,20 @@ def test_the_risk_command_prints_and_writes_the_limit_states(store_path, risk, t
     (tmp_path / "bad.toml").write_text("[limit_states]\ndrift_ratio = [-1.0]\n")
     bad = CliRunner().invoke(main, ["risk", str(store_path), "--bootstrap", "0", "--limit-states", str(tmp_path / "bad.toml")])
     assert bad.exit_code == 1 and "Error: limit_states.drift_ratio: a capacity must be a number > 0 (1), got -1.0" in bad.output
+
+
+def test_the_gap_cost_table_gives_the_runs_bounds_where_they_do_not_pin_the_fit(risk):
+    """Issue 45: a fit the runs do not pin gives λ as its extrapolation; the table gives beside it the bounds the stripes give."""
+    from stochpound.risk import limit_state_bounds, limit_state_pinned
+
+    table = gap_cost_frame(risk)
+    pinned = limit_state_pinned(risk).sel(gap=0.05)
+    lower, upper = (bound.sel(gap=0.05) for bound in limit_state_bounds(risk))
+    for label in risk["limit_state"].values:
+        row = table.loc[(label, 0.05)]
+        if bool(pinned.sel(limit_state=label)):
+            assert np.isnan(row["λ⁻ if not pinned (1/yr)"]) and np.isnan(row["λ⁺ if not pinned (1/yr)"])
+        else:
+            assert row["λ⁻ if not pinned (1/yr)"] == float(lower.sel(limit_state=label))
+            assert row["λ⁺ if not pinned (1/yr)"] == float(upper.sel(limit_state=label))
+    assert not bool(pinned.all())  # the store has a fit its runs do not pin

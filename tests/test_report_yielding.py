@@ -19,6 +19,7 @@ from stochpound._errors import VerificationError
 from stochpound.report.sections import damage_section, methods_section
 from stochpound.analysis import ReferenceRun
 from stochpound.report.sections._accuracy import yielding_check
+from stochpound.report.sections._damage import ratio_text
 from stochpound.report.sections._description import StoreDefinition, buildings_table, design_paragraph
 from stochpound.risk import DEFAULT_LIMIT_STATES, MODEL_DRIFT_LIMIT, store_damage
 from stochpound.store import contact_free, open_store
@@ -113,10 +114,16 @@ def test_store_damage_fractiles_and_runs_beyond_the_model(store):
     target_rate = -np.log(1 - np.array([0.5, 0.5, 0.1, 0.1, 0.1, 0.1, 0.02, 0.02])) / 50  # λ_target of each, in the order above
     ratio = maf.values / target_rate
     np.testing.assert_allclose(damage.ratio().values, ratio, rtol=1e-12)
-    np.testing.assert_array_equal(damage.misses_objective().values, ratio > 1.0)
+    # judged: the fit's ratio where the runs pin it (a lognormal they identify), else the stripes' lower bound λ⁻'s
+    fits = [str(fit) for fit in damage.fits().values]
+    pinned = np.array([fit == "lognormal" for fit in fits])
+    np.testing.assert_array_equal(damage.pinned().values, pinned)
+    judged = np.where(pinned, ratio, damage.risk["maf_lower"].values / target_rate)
+    np.testing.assert_allclose(damage.judged().values, judged, rtol=1e-12)
+    np.testing.assert_array_equal(damage.misses_objective().values, judged > 1.0)
     governing = damage.governing().item()  # the same at every target: each limit state has its own objective
-    assert governing == (str(maf["limit_state"].values[int(np.argmax(ratio))]) if ratio.max() > 1.0 else "pounding at g*")
-    assert ratio.max() > 1.0  # these weak storeys miss an objective
+    assert governing == (str(maf["limit_state"].values[int(np.argmax(judged))]) if judged.max() > 1.0 else "pounding at g*")
+    assert judged.max() > 1.0  # these weak storeys miss an objective
 
 
 def test_governs_is_the_largest_ratio_to_the_objective_not_the_most_frequent_limit_state():
@@ -146,7 +153,7 @@ def test_pounding_at_g_star_governs_where_no_limit_state_is_as_frequent(store):
     damage = store_damage(store, [LimitState("ductility", 1.0e4, target=0.02)], "a test")
     assert float(damage.risk["maf"].max()) == 0.0
     assert damage.governing().item() == "pounding at g*"
-    assert "Governing: as run, pounding at g* (every limit state within its objective; the largest λ/λ_target is 0" in " ".join(
+    assert "Governing: as run, pounding at g* (no limit state the runs put beyond its objective; the largest λ/λ_target is 0" in " ".join(
         _text(block) for block in damage_section("yfix", damage).blocks)
     unjudged = store_damage(store, [LimitState("ductility", 1.0e4)], "a test")
     text = " ".join(_text(block) for block in damage_section("yfix", unjudged).blocks)
@@ -184,8 +191,8 @@ def test_governs_is_judged_in_each_treatment_of_the_collapses_and_a_disagreement
     assert list(damage.disagreement().values) == [True, False]
     assert damage.governing_counts(apart=True) == ({states[1].label: 1, states[0].label: 1}, 2)
     text = _governing_text(damage)
-    assert (f"Governing: as run, mu 0.05: pounding at g* (every limit state within its objective; the largest λ/λ_target is "
-            f"{3e-4 / rates[1]:.2g}, {states[1].label}); mu 0.08: {states[0].label} (λ/λ_target = {0.02 / rates[0]:.2g}); with the runs "
+    assert (f"Governing: as run, mu 0.05: pounding at g* (no limit state the runs put beyond its objective; the largest "
+            f"λ/λ_target is {3e-4 / rates[1]:.2g}, {states[1].label}); mu 0.08: {states[0].label} (λ/λ_target = {0.02 / rates[0]:.2g}); with the runs "
             f"beyond the model counted apart as collapses, mu 0.05: {states[1].label} (λ/λ_target = {9e-4 / rates[1]:.2g})") in text
     assert (f"The two treatments disagree on what governs in 1 of 2 configurations (mu 0.05: pounding at g* as run, {states[1].label} "
             "with collapses apart)") in text
@@ -260,11 +267,13 @@ def test_the_damage_section_states_fractiles_flags_and_the_governing_limit_state
     assert row["runs > model"] == f"{beyond} of {runs}"
     assert f"{beyond} of {runs} at stripe 1.2031" in texts and "are not credible" in texts
     assert "FEMA 356 (2000), Table C1-3, steel moment frames" in texts
-    ratio = damage.ratio()
+    ratio = damage.judged()
     worst = damage.governing().item()
     others = [str(state) for state in ratio["limit_state"].values if float(ratio.sel(limit_state=state)) > 1.0 and state != worst]
+    assert bool(damage.pinned().sel(limit_state=worst))  # a lognormal the runs identify: its ratio is a rate's
     expected = f"{worst} (λ/λ_target = {float(ratio.max()):.2g})" + (f"; also beyond their objectives: {', '.join(others)}" if others else "")
-    assert damage.collapses_apart() and f"Governing: as run, {expected}; with the runs beyond the model counted apart as collapses, " in texts
+    assert damage.collapses_apart() and f"Governing: as run, {expected}" in texts
+    assert "; with the runs beyond the model counted apart as collapses, " in texts
     assert "(objective: 50 % in 50 yr)" in texts and "(objective: 2 % in 50 yr)" in texts
 
 
@@ -286,11 +295,11 @@ def test_a_limit_states_table_is_not_part_of_the_identity_and_replaces_the_defau
     edited = store.copy()
     edited.attrs = {**store.attrs, "definition": json.dumps({**json.loads(store.attrs["definition"]), "limit_states": with_table["limit_states"]})}
     damage = store_damage(edited)
-    assert damage.source == "a test"
+    assert damage.source == 'the experiment\'s [limit_states] table, whose source reads "a test"'
     assert [state.label for state in damage.limit_states] == ["peak storey ductility of B1 ≥ 4", "peak storey ductility of B1 ≥ 8",
                                                               "residual storey drift ratio of B1 ≥ 0.005", "residual storey drift ratio of B2 ≥ 0.005"]
     assert all(state.target is None for state in damage.limit_states)  # no targets given, and none of FEMA 356's capacities
-    assert "Limit states (capacities from a test; each building judged by its own demand): " \
+    assert "Limit states (capacities from the experiment's [limit_states] table, whose source reads \"a test\"; each building judged by its own demand): " \
            "peak storey ductility of B1 ≥ 4 (no objective);" in " ".join(
         _text(block) for block in damage_section("yfix", damage).blocks)
     # targets, shaped as the capacities, are carried in the definition and given to each state
@@ -332,27 +341,41 @@ def test_the_damage_section_says_which_runs_and_stripes_and_lists_every_limit_st
     table = next(block for block in section.blocks if getattr(block, "key", "") == "table-limit-states-yfix").frame
     maf = damage.risk["maf"]
     assert len(table) == maf.sizes["limit_state"] == 2 * len(DEFAULT_LIMIT_STATES)  # one per building
-    from stochpound.risk import at_lowest_stripe, stripes_only_maf, unidentified
+    from stochpound.risk import unidentified
 
-    lowest, why = at_lowest_stripe(damage.risk), unidentified(damage.risk)
-    for state in maf["limit_state"].values:
+    why = unidentified(damage.risk)
+    free = contact_free(store).isel(realization=0, drop=True)
+    hazard = damage_hazard(store)
+    levels = store["intensity"].values
+    rates = hazard(levels)
+    lowest_end = float(hazard(hazard.support[0]))
+    bounded = 0
+    for one in damage.limit_states:
+        state = one.label
         rate = float(maf.sel(limit_state=state))
         target = float(maf["target"].sel(limit_state=state))  # its objective and λ/λ_target, and the fit's kind (issue 45: λ without its fit)
+        target_rate = -math.log(1 - target) / 50
         assert table.loc[("–", str(state)), "objective"] == f"{100 * target:g} % in 50 yr"
         row = table.loc[("–", str(state))]
-        if bool(lowest.sel(limit_state=state)):  # issue 45: a step at the lowest stripe is a bound, not a rate
-            bound = float(stripes_only_maf(damage.risk.sel(limit_state=state), damage_hazard(store)))
-            assert 0.0 < bound <= rate * (1 + 1e-12)
-            assert (row["λ (1/yr)"], row["once in (yr)"]) == (f"≥ {bound:.3g}", f"≤ {1.0 / bound:.3g}")
-            assert row["λ/λ_target"] == f"≥ {bound / (-math.log(1 - target) / 50):.3g}"
-            assert row["fit"] == "step at the lowest stripe: a bound"
+        reason = str(why.sel(limit_state=state).item())
+        if row["fit"] == "lognormal":  # pinned by the runs: the fitted rate
+            assert (row["λ (1/yr)"], row["once in (yr)"]) == (f"{rate:.3g}", f"{1.0 / rate:.3g}")
+            assert row["λ/λ_target"] == ratio_text(rate / target_rate)
             continue
-        assert (row["λ (1/yr)"], row["once in (yr)"]) == (f"{rate:.3g}", f"{1.0 / rate:.3g}")
-        assert row["λ/λ_target"] == f"{rate / (-math.log(1 - target) / 50):.3g}"
-        reason = str(why.sel(limit_state=state).item())  # issue 45: a lognormal its runs do not pin is not presented as identified
-        assert row["fit"] in (f"lognormal, not identified ({reason})" if reason else "lognormal", "step: never", "step: separated",
+        # issue 45: a fit the runs do not pin (a step, a flat fit, a lognormal not identified) gives the bounds of the stripes'
+        # fractions alone, by hand: λ⁻ = Σ p_j (λ(x_j) − λ(x_{j+1})), λ⁺ = p_1 (λ(lo) − λ(x_1)) + Σ p_j (λ(x_{j−1}) − λ(x_j)) + λ(x_n)
+        variable = {"drift_ratio": "peak_drift_ratio", "residual_drift_ratio": "residual_drift_ratio"}[one.kind]
+        p = (free[variable].sel(building=one.building) >= one.capacity).mean("record").values
+        low = float(np.sum(p * (rates - np.append(rates[1:], 0.0))))
+        high = float(np.sum(p * (np.append(lowest_end, rates[:-1]) - rates)) + rates[-1])
+        assert row["λ (1/yr)"] == f"[{low:.3g}, {high:.3g}]"
+        assert row["once in (yr)"] == f"[{1 / high:.3g}, {(f'{1 / low:.3g}' if low > 0 else 'inf')}]"
+        assert row["λ/λ_target"] == f"[{ratio_text(low / target_rate)}, {ratio_text(high / target_rate)}]"
+        assert low <= high
+        assert row["fit"] in (f"lognormal, not identified ({reason})", "step: never", "step: separated", "step at the lowest stripe: a bound",
                               "flat: decreasing (F ≡ fraction of runs that reached it)")  # reached, not pounded
-    assert any(lowest.values.ravel()) or any(why.values.ravel())  # the store has a bound or an unidentified fit to print
+        bounded += 1
+    assert bounded  # the store has a fit the runs do not pin to print
 
 
 def damage_hazard(store):
@@ -384,17 +407,21 @@ def test_the_limit_states_and_demands_are_given_both_ways(store):
     collapsed = free["peak_drift_ratio"].max("building") > MODEL_DRIFT_LIMIT
     levels = store["intensity"].values
     rates = np.append(risk.hazard(levels), 0.0)
+    lowest_end = float(risk.hazard(risk.hazard.support[0]))
     bounded = 0
+    pinned = damage.pinned(apart=True)
     for state, one in zip(apart["limit_state"].values, damage.limit_states):
         cell = table.loc[("–", str(state)), "λ collapses apart (1/yr)"]
-        if damage.bound is None or np.isnan(float(damage.bound.sel(limit_state=state))):
+        if bool(pinned.sel(limit_state=state)):
             assert cell == f"{float(apart.sel(limit_state=state)):.3g}"
             continue
-        # a step at the lowest stripe: the bound of the stripes' fractions, a collapse counted as reaching it, by hand
+        # a fit the runs do not pin: the bounds of the stripes' fractions, a collapse counted as reaching it, by hand
         variable = {"drift_ratio": "peak_drift_ratio", "residual_drift_ratio": "residual_drift_ratio"}[one.kind]
         reached = (free[variable].sel(building=one.building) >= one.capacity) | collapsed
         fractions = reached.mean("record").values
-        assert cell == f"≥ {float(np.sum(fractions * (rates[:-1] - rates[1:]))):.3g}"
+        low = float(np.sum(fractions * (rates[:-1] - rates[1:])))
+        high = float(np.sum(fractions * (np.append(lowest_end, rates[:-2]) - rates[:-1])) + rates[-2])
+        assert cell == f"[{low:.3g}, {high:.3g}]"
         bounded += 1
     assert bounded > 0  # immediate occupancy is a step at the lowest stripe here
     texts = " ".join(_text(block) for block in section.blocks)
@@ -455,19 +482,23 @@ def test_the_design_summary_names_the_limit_state_the_damage_section_finds_gover
     structural = [g for g in governing if g != "pounding at g*"]
     assert structural, "the weak storeys of this store reach a drift limit more often than the target's rate"
     assert f"{structural[0]} in {governing.count(structural[0])} of {len(governing)} configurations" in text
-    assert "a limit state beyond its own objective, the largest λ/λ_target" in text
+    assert "the largest λ/λ_target of the limit states beyond 1, each against its own objective" in text
+    assert ") (" not in text  # the flagship's summary set two brackets back to back: '(… table) (a limit state …)'
+    # what the governing limit state rests on is among the summary's assumptions
+    assert (f"limit states: {len(damage.limit_states)} capacities, each with its objective, as the Damage section lists them; each λ "
+            "from its fit where the runs pin it") in text
     unreached = store_damage(store, [LimitState("ductility", 1.0e4, target=0.1)], "a test")
     text = design_summary_text(risk, None, unreached)
     # as run no run reaches it; counted apart, the collapses do, more often than 10 % in 50 yr allows: the treatments disagree
     collapse = unreached.risk["maf_collapses_apart"].item()
     assert collapse > -math.log(0.9) / 50.0
-    assert ("Governing limit state (the largest λ/λ_target of the limit states, each against its own objective, the same at every "
-            "target; pounding at g* has 1): as run, no limit state beyond its objective; with the runs beyond the model counted apart "
-            "as collapses, peak storey ductility ≥ 10000 in 1 of 1 configurations") in text
+    assert ("Governing limit state (the largest λ/λ_target of the limit states beyond 1, each against its own objective, the same at "
+            "every target; pounding at g* has 1; each ratio in the Damage section): as run, no limit state beyond its objective; with the "
+            "runs beyond the model counted apart as collapses, peak storey ductility ≥ 10000 in 1 of 1 configurations") in text
     # said once, not once per target (the flagship's summary repeated the whole verdict for 10 % and for 2 % in 50 yr)
     assert text.count("Governing limit state") == 1 and text.count("the two treatments disagree in 1 of 1 configurations") == 1
     assert ("; the two treatments disagree in 1 of 1 configurations: what governs depends on whether the runs beyond the model are "
-            "taken as computed or as collapses). At g*, what limits the separation: pounding between the buildings for 10 % in 50 yr; "
+            "taken as computed or as collapses. At g*, what limits the separation: pounding between the buildings for 10 % in 50 yr; "
             "pounding between the buildings for 2 % in 50 yr.") in text
     for damage in (store_damage(store, [LimitState("ductility", 1.0e4)], "a test"), None):  # no objective: nothing ranked
         text = design_summary_text(risk, None, damage)
@@ -651,48 +682,92 @@ def test_a_rule_row_whose_fit_is_a_step_at_the_lowest_stripe_says_its_rate_is_a_
 
 def test_a_ratio_that_decides_the_objective_never_prints_as_one():
     """The flagship's table printed λ/λ_target = '1' for 0.0139/0.01386 while the text said the objective was missed."""
-    from stochpound.report.sections._damage import _ratio_cell, ratio_text
-
     assert (ratio_text(1.003), ratio_text(0.998), ratio_text(1.02), ratio_text(0.25, 2)) == ("1.003", "0.998", "1.02", "0.25")
-    assert _ratio_cell(1.0029, math.nan) == "1.003" and _ratio_cell(0.5, 1.001) == "≥ 1.001"
     # the governs sentence (2 digits) printed '(λ/λ_target = 1)' for 1.03 and 1.01, where the table said they miss the objective
     assert (ratio_text(1.03, 2), ratio_text(1.01, 2), ratio_text(0.96, 2), ratio_text(2.45, 2)) == ("1.03", "1.01", "0.96", "2.5")
 
 
-def test_a_governing_limit_state_on_a_fit_the_runs_do_not_pin_says_so():
-    """The isolated flagship named 'peak storey drift ratio of B2 ≥ 0.025' governing with the collapses counted apart
-    (λ/λ_target 2.0–2.5) from the credible runs' fit over counts 0, 1, 1, 1, 1, 0, 0 of 40, a lognormal the runs do not identify,
-    whose λ is extrapolated down to the hazard table's 0.01 g; neither the sentence nor the table said on what fit."""
+def test_a_limit_state_on_a_fit_the_runs_do_not_pin_governs_only_on_its_lower_bound():
+    """Issue 45: the isolated flagship named 'peak storey drift ratio of B2 ≥ 0.025' governing with the collapses counted apart
+    (λ/λ_target 2.0–2.5) from the credible runs' fit over counts 0, 1, 1, 1, 1, 0, 0 of 40, a flat fit held down to the hazard
+    table's 0.01 g, flagged but still governing. A fit the runs do not pin (here a lognormal with θ beyond the top stripe) now
+    gives the bounds its stripes' fractions give, and governs only where the lower bound misses the objective; where the bounds
+    straddle it the runs leave it open, said so. By hand at the power law λ = 1e-3 x^-2 over stripes 0.2, 0.5, 1 g."""
     import dataclasses
 
     from stochpound.report.sections._damage import _governing_text, _limit_states_table
     from stochpound.report.sections._risk import _structural_governs
-    from stochpound.risk._fragility import FIT
+    from stochpound.risk import limit_state_fits
+    from stochpound.risk._fragility import DECREASING, FIT
 
     states, risk, damage = _two_treatments()
+    levels = [0.2, 0.5, 1.0]
     fit = {"status": (("limit_state", "mu"), [[FIT, FIT], [FIT, FIT]]), "theta": (("limit_state", "mu"), [[0.5, 0.5], [0.8, 0.8]]),
            "beta": (("limit_state", "mu"), [[0.4, 0.4], [0.5, 0.5]])}
     apart = {f"{name}_collapses_apart": (dims, [[*row] for row in values]) for name, (dims, values) in fit.items()}
     apart["theta_collapses_apart"] = (("limit_state", "mu"), [[0.5, 0.5], [5.0, 0.8]])  # collapse prevention at μ 0.05: beyond the top
-    damage = dataclasses.replace(damage, risk=risk.assign(**fit, **apart).assign_coords(intensity=[0.2, 0.5, 1.0]))
+    rate = [1e-3 * x**-2.0 for x in levels]
+    # collapse prevention at μ 0.05 counted apart: 0, 0 and 1 of 8 reach it (a collapse counted as reaching it)
+    low, high = 1 / 8 * rate[2], 1 / 8 * (rate[1] - rate[2]) + rate[2]
+    target = -math.log(0.98) / 50
+    bounds = {name: (("limit_state", "mu"), [[np.nan, np.nan], [value, np.nan]]) for name, value in
+              (("lower_collapses_apart", low), ("upper_collapses_apart", high), ("maf_lower", np.nan), ("maf_upper", np.nan))}
+    damage = dataclasses.replace(damage, risk=risk.assign(**fit, **apart, **bounds).assign_coords(intensity=levels))
+    assert not bool(damage.pinned(apart=True).sel(mu=0.05, limit_state=states[1].label))
+    assert float(damage.judged(apart=True).sel(mu=0.05, limit_state=states[1].label)) == pytest.approx(low / target, rel=1e-12)
+    assert low / target < 1.0 < high / target  # the runs leave it open: it no longer governs on its extrapolated fit (2.2)
+    assert list(damage.governing(apart=True).values) == ["pounding at g*", states[0].label]
+    assert bool(damage.undecided(apart=True).sel(mu=0.05, limit_state=states[1].label))
     text = _governing_text(damage)
-    assert (f"mu 0.05: {states[1].label} (λ/λ_target = 2.2; its fit, lognormal, not identified (θ = 5 beyond the top stripe 1), is not "
-            "pinned by the runs: the ratio rests on it)") in text
-    assert text.count("not pinned") == 1  # as run, every governing fit is identified
+    assert (f"left open by the runs (a fit they do not pin, its bounds either side of the objective): {states[1].label} "
+            f"({ratio_text(low / target, 2)}–{ratio_text(high / target, 2)} times λ_target)") in text
     summary = _structural_governs(damage)
-    assert f"{states[1].label} in 1 of 2 configurations (on a fit the runs do not pin" in summary
-    assert summary.count("on a fit the runs do not pin") == 1
+    assert (f"left open by the runs, its fit not pinning λ and the bounds the stripes give either side of its objective: "
+            f"{states[1].label} in 1 of 2 configurations") in summary and ") (" not in summary
     table = _limit_states_table("t", damage).frame
-    assert table["fit collapses apart"].tolist().count("lognormal, not identified (θ = 5 beyond the top stripe 1)") == 1
-    # the flagship's credible runs of the neighbour's 2.5 % drift (0, 1, 1, 1, 1, 0, 0 of 40) gave a flat fit: its fraction held
-    # down to the hazard table's 0.01 g made λ 5 times the as-run rate, and it governed unflagged
-    from stochpound.risk import unpinned_fit
-    from stochpound.risk._chain import fit_name
-    from stochpound.risk._fragility import DECREASING
-
-    assert unpinned_fit(fit_name(DECREASING)) and unpinned_fit("step at the lowest stripe: a bound")
-    from stochpound.risk import limit_state_fits
-
+    row = table.loc[("mu 0.05", states[1].label)]
+    assert row["fit collapses apart"] == "lognormal, not identified (θ = 5 beyond the top stripe 1)"
+    assert row["λ collapses apart (1/yr)"] == f"[{low:.3g}, {high:.3g}]"
+    assert row["λ/λ_target collapses apart"] == f"[{ratio_text(low / target)}, {ratio_text(high / target)}]"
+    assert row["once in, collapses apart (yr)"] == f"[{1 / high:.3g}, {1 / low:.3g}]"
+    # a lower bound beyond the objective governs, said to rest on the lower bound
+    above = damage.risk.assign(lower_collapses_apart=damage.risk["lower_collapses_apart"] * 0 + 2 * target)
+    damage = dataclasses.replace(damage, risk=above)
+    assert list(damage.governing(apart=True).values) == [states[1].label, states[0].label]
+    assert damage.governing_unpinned(apart=True) == (states[1].label,)
+    assert f"{states[1].label} (λ/λ_target ≥ 2, the lower bound the stripes' fractions alone give" in _governing_text(damage)
+    assert (f"{states[1].label} in 1 of 2 configurations (on the lower bound of λ the stripes' fractions alone give: its fit does not "
+            "pin λ)") in _structural_governs(damage)
+    # a flat fit is not pinned either (the flagship's): its fraction held down to the hazard table's lowest intensity is no rate
     flat = damage.risk.assign(status_collapses_apart=damage.risk["status_collapses_apart"] * 0 + DECREASING)
     assert set(limit_state_fits(flat, apart=True).values.ravel()) == {"flat: decreasing (F ≡ fraction of runs that reached it)"}
-    assert not unpinned_fit("lognormal") and not unpinned_fit("step: separated") and not unpinned_fit("step: never")
+    assert not bool(dataclasses.replace(damage, risk=flat).pinned(apart=True).any())
+
+
+def test_a_base_displacement_limit_state_names_no_stop_the_runs_do_not_have():
+    """Issue 45: the isolated flagship's limit state 'base displacement (the bearing's stop) of B1 ≥ 0.6 m' named a stop that no
+    configuration without a moat has: it is the base passing 0.6 m, the walled twin's clearance there, the wall in the others."""
+    import xarray as xr
+
+    from stochpound.report.sections._damage import _governing_text
+    from stochpound.risk import LimitState, StoreDamage
+
+    state = LimitState("isolator_displacement", 0.6, "B1", 0.02)
+    assert state.label == "peak base displacement of B1 ≥ 0.6 m"
+    risk = xr.Dataset({"maf": (("limit_state", "moat"), [[5e-4, 5e-4]])},
+                      coords={"limit_state": [state.label], "moat": ["none", "wall"], "target": ("limit_state", [0.02])})
+    walled = xr.DataArray([False, True], dims="moat", coords={"moat": ["none", "wall"]})
+    empty = xr.DataArray([0])
+    damage = StoreDamage(xr.Dataset(), empty, empty, {0.1: 1.0}, risk, (state,), "a test", True, (), (0.6,), walled)
+    text = _governing_text(damage)
+    assert ("peak base displacement of B1 ≥ 0.6 m counts the runs whose base passes 0.6 m: no stop is modelled at the bearing in these "
+            "runs; 0.6 m is the moat wall's clearance, so in the 1 of 2 configurations with the wall passing it is reaching the wall, and "
+            "in the 1 without it the base passes the walled twin's clearance with nothing there.") in text
+    assert "stop)" not in text and "bearing's stop" not in text
+    # the design summary says the same where it names that limit state governing
+    from stochpound.report.sections._risk import _structural_governs
+
+    summary = _structural_governs(StoreDamage(xr.Dataset(), empty, empty, {0.1: 1.0}, risk.assign(maf=risk["maf"] * 0 + 1e-3), (state,),
+                                              "a test", True, (), (0.6,), walled))
+    assert summary == (f"{state.label} in 2 of 2 configurations; in the 1 configuration without the moat wall, {state.label} is the "
+                       "base passing the walled twin's clearance, with no stop modelled there")

@@ -118,23 +118,39 @@ def test_the_wall_free_d_tm_is_compared_with_the_moat_and_the_wall_governs_a_tar
                         coords={"design_level": [0.10, 0.02], "rule": ["dtm", "abs"], "mu": [0.05, 0.12]})
     assert "at 2 %/50 yr (the largest over the configurations) is 0.92 m" in moat_text(_risk(varied), StoreDemands({}, {}, moat))
     # 1/918 and 1/2000 /yr against 10 %/50 yr (once in 475 yr) and 2 %/50 yr (once in 2475 yr): the clearance limits only the rarer target
-    assert ("The base reaches the 0.6 m moat clearance once in 918 [459, 1.84e+03] yr in its worst configuration; less often than 10 % "
-            "in 50 yr allows (once in 475 yr) in every configuration: it does not limit the separation for this target.") in text
-    assert ("more often than 2 % in 50 yr allows (once in 2.47e+03 yr) in every configuration: there the clearance, not the gap, "
+    assert ("The base reaches the moat wall at its 0.6 m clearance once in 918 [459, 1.84e+03] yr in its worst configuration with the "
+            "wall; less often than 10 % in 50 yr allows (once in 475 yr) in every configuration with the wall: it does not limit the "
+            "separation for this target.") in text
+    assert ("more often than 2 % in 50 yr allows (once in 2.47e+03 yr) in every configuration: there the wall, not the gap, "
             "limits the separation for this target.") in text
     summary = design_summary_text(_risk(), StoreDemands({}, {}, moat))
     assert ("Limit state judged (no structural limit state with an objective, so none is ranked against it; at g*, what limits the "
-            "separation): pounding between the buildings for 10 % in 50 yr; for 2 % in 50 yr, the base reaching the 0.6 m moat clearance "
-            "(the bearing's stop) more often than the target allows in every configuration, once in 918 [459, 1.84e+03] yr at worst.") in summary
+            "separation): pounding between the buildings for 10 % in 50 yr; for 2 % in 50 yr, the base reaching the moat wall at its 0.6 m "
+            "clearance more often than the target allows in every configuration, once in 918 [459, 1.84e+03] yr at worst.") in summary
     assert ("Limit state judged (no structural limit state with an objective, so none is ranked against it; at g*, what limits the "
             "separation): pounding between the buildings for 10 % in 50 yr; pounding between the buildings for 2 %") in design_summary_text(_risk(), None)
     # the flagship's summary said the wall governed 2 %/50 yr "in the other configurations" from its worst configuration's rate,
     # also where the base reached it less often than that target allows: each configuration is judged on its own rate
     once = rate_intervals(xr.Dataset({"maf": (("mu", "level"), [[1 / 918], [1 / 3000]])}, coords={"level": [0.60], "mu": [0.05, 0.12]}), 50.0)
     summary = design_summary_text(_risk(), StoreDemands({}, {}, once))
-    assert ("for 2 % in 50 yr, the base reaching the 0.6 m moat clearance (the bearing's stop) more often than the target allows in 1 of 2 "
+    assert ("for 2 % in 50 yr, the base reaching the moat wall at its 0.6 m clearance more often than the target allows in 1 of 2 "
             "configurations (μ 0.05), once in 918 yr at worst, and pounding between the buildings in the other configurations.") in summary
-    assert "in 1 of 2 configurations (μ 0.05): there the clearance, not the gap, limits" in moat_text(_risk(rules), StoreDemands({}, {}, once))
+    assert "in 1 of 2 configurations (μ 0.05): there the wall, not the gap, limits" in moat_text(_risk(rules), StoreDemands({}, {}, once))
+    # issue 45: the flagship's configurations without a moat were said to reach 'the 0.6 m moat clearance (the bearing's stop)', a
+    # stop no run has: only the configurations with the wall are judged by it, and the others' rows say what they are
+    both = rate_intervals(xr.Dataset({"maf": (("moat", "mu", "level"), [[[1 / 918], [1 / 3000]], [[1 / 918], [1 / 3000]]])},
+                                     coords={"level": [0.60], "moat": ["none", "wall"], "mu": [0.05, 0.12]}), 50.0)
+    walls = xr.DataArray([False, True], dims="moat", coords={"moat": ["none", "wall"]})
+    demands = StoreDemands({}, {}, both, walled=walls)
+    assert [row[2] for row in demands.wall_exceedances([0.02], 50.0)] == [[{"moat": "wall", "mu": 0.05}]]
+    summary = design_summary_text(_risk(), demands)
+    assert ("the base reaching the moat wall at its 0.6 m clearance more often than the target allows in 1 of 2 configurations with the "
+            "wall (moat wall, μ 0.05), once in 918 yr at worst, and pounding between the buildings in the other configurations") in summary
+    assert "bearing's stop" not in summary and "moat none" not in summary and ") (" not in summary
+    text = moat_text(_risk(rules), demands)
+    assert "In the configurations without the wall no stop is modelled at the base" in text
+    frame = demands.moat_frame()
+    assert list(frame["what it is"]) == ["no wall: base passes the walled twin's clearance (no stop modelled)"] * 2 + ["base reaches the wall"] * 2
     # a scene without walls: their stiffness is no choice the answer rests on
     assert "the moat wall's stiffness" not in design_summary_text(_risk(), None)
     walled = _risk()

@@ -116,4 +116,4 @@ def test_a_scenario_ensembles_table_has_no_psd_convention_and_counts_its_realiza
     store = open_store(run_experiment(experiment, workers=0, progress=False).store).load()
     definition = StoreDefinition("scenario", store)
     assert "PSD" not in motions_table([definition]).note
-    assert "under 1 synthetic ensemble of 3 realizations (Table of motions)" in grid_paragraph(definition).text
+    assert "under 1 synthetic ensemble of 3 realizations, listed in the Table of motions" in grid_paragraph(definition).text

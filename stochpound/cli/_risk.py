@@ -296,8 +296,8 @@ def risk(store: Path, hazard: str | None, hazard_measure: str | None, hazard_uni
                    "runs, gap = inf), and a limit state's cost is taken at a finite gap against its contact-free twin.")
     elif costs is not None:
         click.echo(f"\nLimit states beyond first contact (λ: per year at each finite gap; contact-free: the same motions without "
-                   f"contact; Δλ: what the gap costs; P in {years:g} years; fit: the fragility's kind, a step at the lowest stripe "
-                   "giving a bound, not a rate):")
+                   f"contact; Δλ: what the gap costs; P in {years:g} years; fit: the fragility's kind; where it is not a lognormal the "
+                   "runs identify, λ is the fit's extrapolation and λ⁻, λ⁺ are the bounds the stripes' fractions alone give it):")
         click.echo(costs.to_string(float_format=lambda v: f"{v:.4g}"))
         click.echo("\n".join(objective_lines(objectives)))
     click.echo("\n".join(measure_lines))

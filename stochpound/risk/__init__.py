@@ -25,7 +25,7 @@ not only the counts); :func:`store_demands` gives
 the demand hazard curves and the moat walls' limit state
 (:class:`StoreDemands`); :func:`limit_state_risk` the fragility and MAF of
 limit states beyond first contact (:class:`LimitState`: drift ratios,
-ductility, floor acceleration, impact force, a bearing's stop) at every gap
+ductility, floor acceleration, impact force, a sliding base's displacement) at every gap
 of a store's grid against its contact-free twins (:func:`gap_cost_frame`), what governs
 each configuration against the limit states' objectives in each treatment of the runs beyond the model
 (:func:`governing_limit_state`, :func:`objectives_frame`);
@@ -75,16 +75,17 @@ from stochpound.risk._gap_grid import GRID_TOLERANCE
 from stochpound.risk._limit_states import POUNDING as POUNDING_AT_G_STAR  # noqa: F401  (for the report's sections: not public API)
 from stochpound.risk._demands import StoreDemands, store_demands
 from stochpound.risk._limit_states import (KINDS as LIMIT_STATE_KINDS, LimitState, disagreement_text, gap_cost_frame, governing_limit_state,
-                                           limit_state_fits, limit_state_problem, limit_state_risk, limit_states_from_table, objectives_frame)
+                                           judged_ratio, limit_state_bounds, limit_state_fits, limit_state_pinned, limit_state_problem,
+                                           limit_state_risk, limit_states_from_table, objectives_frame, undecided)
 from stochpound.risk._efficiency import measure_efficiency, most_efficient
 from stochpound.risk._efficiency import candidate_name  # noqa: F401  (for stochpound.experiment.measure_choice: not public API)
 from stochpound.risk._collapse import CollapseRisk, beyond_model, collapse_risk, collapsed_runs, rate_collapses_apart
 from stochpound.risk._sensitivity import ALTERNATIVES, MODELLING_DISPERSIONS, Sensitivity, check_alternative, separation_sensitivity, sensitivity_text
-from stochpound.risk._damage import DAMAGE_DEMANDS, DEFAULT_LIMIT_STATES, DEFAULT_SOURCE as DEFAULT_LIMIT_STATES_SOURCE, MODEL_DRIFT_LIMIT, StoreDamage, store_damage, unpinned_fit
+from stochpound.risk._damage import DAMAGE_DEMANDS, DEFAULT_LIMIT_STATES, DEFAULT_SOURCE as DEFAULT_LIMIT_STATES_SOURCE, MODEL_DRIFT_LIMIT, StoreDamage, store_damage
 from stochpound.hazard import hazard_consistency, read_hazard_file, stripe_rate_weights
 from stochpound.risk._site_consistency import consistency_at_targets, site_consistency
 from stochpound.risk._stripe_demand import stripe_demand_rate
-from stochpound.risk._stripe_coverage import (UNIDENTIFIED_BETA, at_lowest_stripe, fragility_at_separation, maf_outside_stripes, stripes_only_maf,
+from stochpound.risk._stripe_coverage import (UNIDENTIFIED_BETA, at_lowest_stripe, fragility_at_separation, maf_outside_stripes, stripes_only_maf, stripes_upper_maf,
                                               unidentified)
 
 __all__ = [
@@ -152,8 +153,11 @@ __all__ = [
     "objectives_frame",
     "disagreement_text",
     "limit_state_fits",
+    "judged_ratio",
+    "limit_state_bounds",
+    "limit_state_pinned",
+    "undecided",
     "store_damage",
-    "unpinned_fit",
     "DAMAGE_DEMANDS",
     "StoreDamage",
     "DEFAULT_LIMIT_STATES",
@@ -166,6 +170,7 @@ __all__ = [
     "rate_collapses_apart",
     "at_lowest_stripe",
     "stripes_only_maf",
+    "stripes_upper_maf",
     "unidentified",
     "UNIDENTIFIED_BETA",
     "separation_sensitivity",

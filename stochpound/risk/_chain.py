@@ -444,6 +444,12 @@ class StoreRisk:
             statuses.append(self.design_rules["status"].values[applies.broadcast_like(self.design_rules["status"]).values])
         return degenerate_text(np.concatenate(statuses), self.hazard, "rule rows") if statuses else ""
 
+    def coarse_change(self) -> float:
+        """The largest |g*_coarse / g* − 1| over the configurations and targets, g*_coarse read off the gap grid as first made
+        (before its refinement near each g*): how far interpolating across the coarse grid's brackets moves g*, λ_P(g) being a
+        step function of g (NaN where the grid was given, not refined)."""
+        return float(self.separation.attrs["coarse_change"]) if "coarse_change" in self.separation.attrs else math.nan
+
     def non_increasing_maf(self) -> xr.DataArray:
         """λ_P(g) made non-increasing along the gaps (isotonic regression in ln λ, pool-adjacent-violators: the curve g* is read from; 1/yr)."""
         return non_increasing_along(self.curve["maf"], "gap")
@@ -721,8 +727,10 @@ def _refined_chain(inputs: RiskInputs, hz: HazardCurve, grid: np.ndarray, target
         return fit, risk_curve(fit, hz, years, confidence)
 
     fragility, curve = fitted(grid, 0)
+    coarse = None
     for refinements in range(MAX_REFINEMENTS + 1 if tolerance is not None else 0):  # the last pass only checks convergence
         estimate = _separation(curve[["maf"]], fragility, hz, targets, years, confidence, inputs.method)  # g* alone: no resamples
+        coarse = estimate["separation"] if coarse is None else coarse
         added = refinement_gaps(fragility["gap"].values, estimate, tolerance)
         converged = not added.size
         if converged or refinements == MAX_REFINEMENTS:
@@ -732,7 +740,18 @@ def _refined_chain(inputs: RiskInputs, hz: HazardCurve, grid: np.ndarray, target
     separation = _separation(curve, fragility, hz, targets, years, confidence, inputs.method)
     note = (f"{grid.size} gaps as given, not refined" if tolerance is None else
             grid_note(fragility.sizes["gap"], grid.size, refinements, tolerance, converged))
-    return fragility, curve, separation.assign_attrs(grid=note)
+    return fragility, curve, separation.assign_attrs(grid=note, coarse_change=_coarse_change(separation["separation"], coarse))
+
+
+def _coarse_change(refined: xr.DataArray, coarse: xr.DataArray | None) -> float:
+    """The largest relative difference |g*_coarse / g* − 1| between g* read off the grid as first made and g* on the refined grid,
+    over the finite values of both (NaN where the grid was not refined or no g* is finite)."""
+    if coarse is None:
+        return math.nan
+    with np.errstate(divide="ignore", invalid="ignore"):
+        change = np.abs(np.asarray(coarse.values, dtype=float) / np.asarray(refined.values, dtype=float) - 1.0)
+    change = change[np.isfinite(change)]
+    return float(change.max()) if change.size else math.nan
 
 
 def target_text(probability: float, years: float = YEARS) -> str:

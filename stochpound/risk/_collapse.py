@@ -37,12 +37,15 @@ import xarray as xr
 
 from stochpound.hazard import HazardCurve
 from stochpound.risk import _inputs
-from stochpound.risk._fragility import DECREASING, lognormal_cdf
+from stochpound.risk._fragility import DECREASING, FIT, lognormal_cdf
 from stochpound.risk._fragility_ensemble import limit_state_events, stripe_fragility
 from stochpound.risk._maf import mean_annual_frequency, risk_targeted_separation
+from stochpound.risk._stripe_coverage import stripes_only_maf, stripes_upper_maf, unidentified
 
 MODEL_DRIFT_LIMIT = 0.05
 """Peak storey drift ratio beyond which a run is beyond what the model represents: a collapse (no strength loss or collapse is modelled)."""
+COLLAPSE_BOUNDS = "λ_C, stripes' bounds where P(C | IM) is not identified (1/yr)"
+"""The g* both ways table's column of what the stripes' fractions alone bound λ_C to, where they do not identify P(C | IM)."""
 GRID_POINTS = 2000
 """Points in ln x of the integration over the hazard's range."""
 BEYOND = 8.0
@@ -74,7 +77,8 @@ class CollapseRisk:
 
     def both_ways(self, as_run: xr.Dataset, years: float = 50.0) -> pd.DataFrame:
         """g* both ways per configuration and target (m): ``as run`` (the chain's ``StoreRisk.separation``, every run as computed) and
-        ``collapses apart`` (this), beside each configuration's λ_C (1/yr) and its runs beyond the model."""
+        ``collapses apart`` (this), beside each configuration's λ_C (1/yr), the bounds the stripes give it where they do not identify
+        P(C | IM) (``COLLAPSE_BOUNDS``), and its runs beyond the model."""
         rows = xr.Dataset({"g* as run (m)": _dims_only(as_run["separation"]),
                            "g* collapses apart (m)": _dims_only(self.separation["separation"])}).to_dataframe().reset_index()
         rows["target"] = [f"{100 * p:g} % in {years:g} yr" for p in rows["target"]]
@@ -84,6 +88,13 @@ class CollapseRisk:
         extra = counts.to_dataframe().reset_index() if config else pd.DataFrame({name: [float(counts[name])] for name in counts.data_vars})
         extra["runs beyond the model"] = [f"{int(k)} of {int(n)}" for k, n in zip(extra["collapsed"], extra["runs"])]
         extra = extra.drop(columns=["collapsed", "runs"])
+        if "maf_lower" in self.collapse:  # where the stripes do not identify P(C | IM), λ_C is its extrapolation: what they bound it to
+            loose = _dims_only((unidentified(self.collapse) != "") | (self.collapse["status"] != FIT))
+            bounds = xr.Dataset({"loose": loose, "lower": _dims_only(self.collapse["maf_lower"]), "upper": _dims_only(self.collapse["maf_upper"])})
+            table = bounds.to_dataframe().reset_index() if config else pd.DataFrame({name: [bounds[name].item()] for name in bounds.data_vars})
+            table[COLLAPSE_BOUNDS] = [f"[{low:.3g}, {high:.3g}]" if flag else "identified" for flag, low, high in
+                                      zip(table["loose"], table["lower"], table["upper"])]
+            extra = extra.merge(table[[*config, COLLAPSE_BOUNDS]], on=config) if config else extra.assign(**{COLLAPSE_BOUNDS: table[COLLAPSE_BOUNDS]})
         merged = rows.merge(extra, on=config) if config else rows.assign(**{name: extra[name].iloc[0] for name in extra.columns})
         return merged.set_index([*config, "target"])
 
@@ -98,11 +109,24 @@ class CollapseRisk:
                 "storey drift, beyond what the model represents (no strength loss or collapse is modelled); they are counted apart as "
                 f"collapses. P(C | IM) is a lognormal fitted over the stripes ({fits}; a step where the runs identify none), "
                 f"λ_C = {float(self.collapse['maf'].min()):.3g}" + (f"–{float(self.collapse['maf'].max()):.3g}"
-                if float(self.collapse["maf"].max()) != float(self.collapse["maf"].min()) else "") + " /yr; pounding is fitted on the "
+                if float(self.collapse["maf"].max()) != float(self.collapse["maf"].min()) else "") + f" /yr{self._unpinned_text()}; pounding is fitted on the "
                 "credible runs only and combined with it by total probability, P(P | IM) = P(C | IM) + (1 − P(C | IM)) P(P | IM, no C), a "
                 "collapse counted as reaching the gap. g* both ways: 'as run' keeps every run as computed; 'collapses apart' is the PBEE "
                 "answer" + (f"; it is inf (no gap meets the target) where collapse alone is more frequent than the target allows "
                             f"({', '.join(beyond)}): there the structure, not the gap, governs" if beyond else "") + ".")
+
+
+    def _unpinned_text(self) -> str:
+        """Where the stripes do not identify P(C | IM) (its median beyond the top stripe, β ≥ 0.8, or a step), that λ_C rests on
+        the fit's extrapolation and the bounds the stripes' fractions alone give it; "" where they identify it everywhere."""
+        why = unidentified(self.collapse)
+        loose = (why != "") | (self.collapse["status"] != FIT)
+        if not bool(loose.any()) or "maf_lower" not in self.collapse:
+            return ""
+        low, high = self.collapse["maf_lower"].where(loose), self.collapse["maf_upper"].where(loose)
+        return (f" (the stripes do not identify P(C | IM) in {int(loose.sum())} of {int(loose.size)} configurations: a step, or a "
+                "lognormal with its median beyond the top stripe or β ≥ 0.8, so λ_C there rests on the fit's extrapolation; the stripes' "
+                f"fractions alone bound it to {float(low.min()):.3g}–{float(high.max()):.3g} /yr)")
 
 
 def collapsed_runs(store: xr.Dataset, limit: float = MODEL_DRIFT_LIMIT) -> xr.DataArray | None:
@@ -120,8 +144,9 @@ def beyond_model(drift: xr.DataArray, limit: float = MODEL_DRIFT_LIMIT) -> xr.Da
 
 
 def rate_collapses_apart(demand: xr.DataArray, collapsed: xr.DataArray, thresholds: Sequence[float] | np.ndarray, dim: str,
-                         hz: HazardCurve) -> tuple[xr.DataArray, xr.Dataset]:
-    """λ (1/yr) of a demand reaching each threshold with the collapses counted apart (module docstring), and the collapse fit.
+                         hz: HazardCurve, collapse: xr.Dataset | None = None) -> tuple[xr.DataArray, xr.Dataset, xr.Dataset]:
+    """λ (1/yr) of a demand reaching each threshold with the collapses counted apart (module docstring), the collapse fit and the
+    credible runs' fit.
 
     A collapse counts as reaching every threshold (a building that has lost its storeys has met every limit state, FEMA P-58);
     the credible runs' fit of demand ≥ threshold and P(C | IM) are combined by total probability, ``combined_rate``.
@@ -138,24 +163,31 @@ def rate_collapses_apart(demand: xr.DataArray, collapsed: xr.DataArray, threshol
         The name of the thresholds' dimension.
     hz : HazardCurve
         The site's hazard.
+    collapse : xarray.Dataset, optional
+        :func:`collapse_fit` of ``collapsed`` already made (several demands of the same runs share it); default fitted here.
 
     Returns
     -------
-    tuple of xarray.DataArray and xarray.Dataset
-        λ over ``dim`` and the configurations, and P(C | IM)'s stripe fit (:func:`~stochpound.risk.stripe_fragility`) with its ``maf``, λ_C.
+    tuple of xarray.DataArray, xarray.Dataset and xarray.Dataset
+        λ over ``dim`` and the configurations; P(C | IM)'s stripe fit (:func:`~stochpound.risk.stripe_fragility`) with its
+        ``maf``, λ_C; and the credible runs' stripe fit of demand ≥ each threshold, whose kind (a lognormal the runs identify
+        or not, a step) says what λ rests on.
     """
     demand, collapsed = xr.align(demand, _dims_only(collapsed), join="inner")
-    collapse = stripe_fragility(collapsed, bootstrap=0)
+    collapse = collapse_fit(collapsed, hz) if collapse is None else collapse
+    credible = stripe_fragility(limit_state_events(demand.where(collapsed == 0.0), thresholds, dim), bootstrap=0)
+    return combined_rate(collapse, credible, hz), collapse, credible
+
+
+def collapse_fit(collapsed: xr.DataArray, hz: HazardCurve) -> xr.Dataset:
+    """P(C | IM): the stripe fit (:func:`~stochpound.risk.stripe_fragility`, no bootstrap) of the runs beyond the model
+    (:func:`beyond_model`: 1 collapse, 0 credible, NaN not run), with its ``maf``, λ_C (1/yr), and ``maf_lower``, ``maf_upper``,
+    the bounds of λ_C the stripes' fractions alone give (:func:`~stochpound.risk.stripes_only_maf`,
+    :func:`~stochpound.risk.stripes_upper_maf`)."""
+    collapse = stripe_fragility(_dims_only(collapsed), bootstrap=0)
     collapse["maf"] = mean_annual_frequency(collapse, hz)
-    return combined_rate(collapse, credible_fit(demand, collapsed, thresholds, dim), hz), collapse
-
-
-def credible_fit(demand: xr.DataArray, collapsed: xr.DataArray, thresholds: Sequence[float] | np.ndarray, dim: str) -> xr.Dataset:
-    """The credible runs' stripe fit of ``demand`` ≥ each threshold (:func:`~stochpound.risk.stripe_fragility`, no bootstrap): the
-    fit :func:`rate_collapses_apart` combines with P(C | IM), whose kind (a lognormal the runs identify or not, a step) says what
-    its rate rests on. ``demand``, ``collapsed``, ``thresholds`` and ``dim`` as there."""
-    demand, collapsed = xr.align(demand, _dims_only(collapsed), join="inner")
-    return stripe_fragility(limit_state_events(demand.where(collapsed == 0.0), thresholds, dim), bootstrap=0)
+    collapse["maf_lower"], collapse["maf_upper"] = stripes_only_maf(collapse, hz), stripes_upper_maf(collapse, hz)
+    return collapse
 
 
 def collapse_risk(store: xr.Dataset, hz: HazardCurve, gaps: Sequence[float] | np.ndarray, targets: Sequence[float],
@@ -181,7 +213,7 @@ def collapse_risk(store: xr.Dataset, hz: HazardCurve, gaps: Sequence[float] | np
     if collapsed is None:
         return None
     closure, collapsed = xr.align(_inputs.contact_free_closure(store), _dims_only(collapsed), join="inner")
-    maf, collapse = rate_collapses_apart(closure, collapsed, gaps, "gap", hz)
+    maf, collapse, _ = rate_collapses_apart(closure, collapsed, gaps, "gap", hz)
     separation = risk_targeted_separation(xr.Dataset({"maf": maf}), targets, years)
     return CollapseRisk(collapse, separation, maf, int(collapsed.sum()), int(collapsed.notnull().sum()))
 

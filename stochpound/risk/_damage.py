@@ -16,7 +16,11 @@ has them (the runs the separations come from), else over every run:
   each against its performance objective λ_target (its ``target``, a
   probability in 50 years), and per configuration the one that governs: the
   largest ratio λ/λ_target among the structural limit states and pounding at
-  the risk-targeted separation g* (whose ratio is 1 by construction). Without
+  the risk-targeted separation g* (whose ratio is 1 by construction). Where the
+  runs do not pin a limit state's fit (a step, a flat fit, a lognormal not
+  identified) its λ is bounded by the stripes' fractions alone, [λ⁻, λ⁺], and
+  it misses its objective only where λ⁻ does (``stochpound.risk.judged_ratio``);
+  where the bounds straddle the objective the runs leave it open. Without
   any objective nothing is said to govern.
 
 The limit states are the experiment's ``[limit_states]`` table (not part of
@@ -34,12 +38,12 @@ import xarray as xr
 
 from stochpound.hazard import rate_from_probability, return_period
 from stochpound.risk import _inputs
-from stochpound.risk._limit_states import (KINDS, OBJECTIVE_YEARS, POUNDING, LimitState, default_target, governing_disagreement,
-                                           governing_limit_state, limit_state_fits, limit_state_risk, limit_states_of, objective_ratio)
+from stochpound.risk._limit_states import (KINDS, POUNDING, LimitState, default_target, governing_disagreement, governing_limit_state,
+                                           judged_ratio, limit_state_bounds, limit_state_fits, limit_state_pinned, limit_state_risk,
+                                           limit_states_of, objective_ratio, undecided)
 from stochpound.risk._maf import TARGETS
 from stochpound.risk._chain import YEARS
 from stochpound.risk._collapse import MODEL_DRIFT_LIMIT
-from stochpound.risk._stripe_coverage import at_lowest_stripe, stripes_only_maf
 
 QUANTILES = (0.5, 0.84)
 """The fractiles over each stripe's motions of ``StoreDamage.demands``."""
@@ -89,11 +93,10 @@ class StoreDamage:
         The buildings whose storeys never yield in any run (no yield force:
         no ductility; their ``peak_ductility`` is NaN, and absent from
         ``demands`` when no building yields).
-    bound : xarray.DataArray or None
-        Over ``risk``'s dimensions: where a limit state's fit is a step at
-        the lowest stripe (:func:`~stochpound.risk.at_lowest_stripe`), the
-        lower bound of λ the runs give
-        (:func:`~stochpound.risk.stripes_only_maf`, 1/yr); NaN elsewhere.
+    walls : tuple of float
+        The moat walls' clearances at the studied building's base (m; () without walls).
+    walled : xarray.DataArray or None
+        Per configuration, whether its runs have those walls (None: no configuration has a wall).
     """
 
     demands: xr.Dataset
@@ -105,7 +108,8 @@ class StoreDamage:
     source: str
     contact_free: bool
     elastic: tuple[str, ...] = ()
-    bound: xr.DataArray | None = None
+    walls: tuple[float, ...] = ()
+    walled: xr.DataArray | None = None
 
     def collapses_apart(self) -> bool:
         """Whether the limit states are given both ways: some run is beyond the model (``risk`` holds ``maf_collapses_apart``)."""
@@ -133,25 +137,42 @@ class StoreDamage:
         return xr.apply_ufunc(return_period, self.risk["maf"])
 
     def ratio(self, apart: bool = False) -> xr.DataArray | None:
-        """λ/λ_target of each limit state over ``risk``'s dimensions (NaN where it has no objective); None without ``risk``.
-        With ``apart``, of λ with the runs beyond the model counted apart as collapses (as run where none is)."""
+        """λ/λ_target of each limit state's fit over ``risk``'s dimensions (NaN where it has no objective); None without ``risk``.
+        With ``apart``, of λ with the runs beyond the model counted apart as collapses (as run where none is). Where the runs
+        do not pin the fit (:meth:`pinned`) this ratio is not theirs: :meth:`bound_ratios` is."""
         return None if self.risk is None else objective_ratio(self.risk, apart)
 
-    def bounds(self, apart: bool = False) -> xr.DataArray | None:
-        """``bound`` (1/yr), or with ``apart`` the same bound with the collapses counted as reaching the limit state
-        (``risk``'s ``bound_collapses_apart`` where ``bound`` is one); None without ``bound`` (or without collapses apart)."""
-        if self.bound is None or (apart and not self.collapses_apart()):
-            return None
-        return self.risk["bound_collapses_apart"].where(self.bound.notnull()) if apart else self.bound
+    def pinned(self, apart: bool = False) -> xr.DataArray | None:
+        """Whether the runs pin each limit state's λ (``stochpound.risk.limit_state_pinned``: a lognormal the stripes identify),
+        over ``risk``'s dimensions; None without ``risk``."""
+        return None if self.risk is None else limit_state_pinned(self.risk, apart)
 
-    def bound_ratio(self, apart: bool = False) -> xr.DataArray | None:
-        """:meth:`bounds`/λ_target over ``risk``'s dimensions: the lower bound of λ/λ_target where a fit is a step at the
-        lowest stripe (NaN elsewhere or without an objective); None without a bound."""
-        bound = self.bounds(apart)
-        if bound is None:
+    def rate_bounds(self, apart: bool = False) -> tuple[xr.DataArray, xr.DataArray] | None:
+        """λ⁻ and λ⁺ (1/yr), the bounds the stripes' fractions alone give each limit state's λ
+        (``stochpound.risk.limit_state_bounds``; with ``apart`` a collapse counted as reaching it); None without them."""
+        return None if self.risk is None else limit_state_bounds(self.risk, apart)
+
+    def bound_ratios(self, apart: bool = False) -> tuple[xr.DataArray, xr.DataArray] | None:
+        """λ⁻/λ_target and λ⁺/λ_target of :meth:`rate_bounds` (NaN without an objective); None without bounds."""
+        bounds = self.rate_bounds(apart)
+        if bounds is None:
             return None
-        target = self.risk["target"]
-        return bound / xr.apply_ufunc(rate_from_probability, target.fillna(0.5), OBJECTIVE_YEARS).where(target.notnull())
+        target = xr.apply_ufunc(rate_from_probability, self.risk["target"].fillna(0.5), 50.0).where(self.risk["target"].notnull())
+        return bounds[0] / target, bounds[1] / target
+
+    def judged(self, apart: bool = False) -> xr.DataArray | None:
+        """λ/λ_target as each objective is judged (``stochpound.risk.judged_ratio``): the fit's where the runs pin it, else the
+        lower bound's; None without ``risk``."""
+        return None if self.risk is None else judged_ratio(self.risk, apart)
+
+    def undecided(self, apart: bool = False) -> xr.DataArray | None:
+        """Per limit state and configuration, whether the runs leave open if it misses its objective (``stochpound.risk.undecided``:
+        a fit they do not pin, its bounds either side of the objective); None without ``risk``."""
+        return None if self.risk is None else undecided(self.risk, apart)
+
+    def wall_counts(self) -> tuple[int, int]:
+        """The configurations with a moat wall at the studied building's base and the configurations ((0, 0) without walls)."""
+        return (0, 0) if self.walled is None else (int(self.walled.sum()), int(self.walled.size))
 
     def has_objectives(self) -> bool:
         """Whether any limit state has a performance objective (without one, nothing is said to govern)."""
@@ -192,8 +213,9 @@ class StoreDamage:
         return (0, 0) if differ is None else (int(differ.sum()), int(differ.size))
 
     def largest_ratio(self, apart: bool = False) -> tuple[xr.DataArray, xr.DataArray] | None:
-        """Per configuration, the largest λ/λ_target and the limit state that has it (None without ``risk``); ``apart`` as in :meth:`ratio`."""
-        ratio = self.ratio(apart)
+        """Per configuration, the largest judged λ/λ_target (:meth:`judged`) and the limit state that has it (None without
+        ``risk``); ``apart`` as in :meth:`ratio`."""
+        ratio = self.judged(apart)
         if ratio is None:
             return None
         index = ratio.fillna(-1.0).argmax("limit_state")
@@ -204,40 +226,35 @@ class StoreDamage:
         credible runs' fit behind λ with the runs beyond the model counted apart); None without ``risk``."""
         return None if self.risk is None or "status" not in self.risk else limit_state_fits(self.risk, apart)
 
-    def unpinned(self, apart: bool = False) -> xr.DataArray | None:
-        """Whether each limit state's fit (:meth:`fits`) is one the runs do not pin (``stochpound.risk.unpinned_fit``), over the same
-        dimensions; None without ``risk``."""
-        fits = self.fits(apart)
-        return None if fits is None else fits.copy(data=np.vectorize(unpinned_fit, otypes=[bool])(fits.values))
-
-    def governing_unidentified(self, apart: bool = False) -> dict[str, str]:
-        """The governing limit states (:meth:`governing`) whose fit, in some configuration they govern, the runs do not pin (a
-        lognormal not identified, or a step at the lowest stripe: its λ a bound), each with that fit in words; {} where none is."""
-        governing, fits = self.governing(apart), self.fits(apart)
-        if governing is None or fits is None:
-            return {}
-        found: dict[str, str] = {}
+    def governing_unpinned(self, apart: bool = False) -> tuple[str, ...]:
+        """The governing limit states (:meth:`governing`) whose fit, in some configuration they govern, the runs do not pin
+        (:meth:`pinned`): they govern on the lower bound of λ the stripes give, not on a rate; () where none does."""
+        governing, pinned = self.governing(apart), self.pinned(apart)
+        if governing is None or pinned is None:
+            return ()
+        found: list[str] = []
         for index in np.ndindex(governing.shape):
             state = str(governing.values[index])
             if state == POUNDING or state in found:
                 continue
             labels = {dim: governing[dim].values[i] for dim, i in zip(governing.dims, index)}
-            fit = str(fits.sel(labels).sel(limit_state=state).item())
-            if unpinned_fit(fit):
-                found[state] = fit
-        return found
+            if not bool(pinned.sel(labels).sel(limit_state=state).item()):
+                found.append(state)
+        return tuple(found)
+
+    def undecided_counts(self, apart: bool = False) -> dict[str, int]:
+        """Each limit state the runs leave open (:meth:`undecided`) with the number of configurations where they do, in order."""
+        open_ = self.undecided(apart)
+        if open_ is None:
+            return {}
+        counts = open_.sum([d for d in open_.dims if d != "limit_state"]) if open_.ndim > 1 else open_.astype(int)
+        return {str(state): int(n) for state, n in zip(counts["limit_state"].values, counts.values) if int(n)}
 
     def misses_objective(self, apart: bool = False) -> xr.DataArray | None:
-        """Per limit state and configuration, whether λ exceeds its objective's rate (λ/λ_target > 1; False without an objective)."""
-        ratio = self.ratio(apart)
+        """Per limit state and configuration, whether it misses its objective as judged (:meth:`judged` > 1: a fit the runs do
+        not pin only where its lower bound does; False without an objective)."""
+        ratio = self.judged(apart)
         return None if ratio is None else ratio > 1.0
-
-
-def unpinned_fit(fit: str) -> bool:
-    """Whether a limit state's fit in words (``stochpound.risk.limit_state_fits``) is one the runs do not pin: a lognormal not
-    identified, a step at the lowest stripe (its λ a bound) or a flat fit (a fraction held down to the hazard's lowest intensity)."""
-    return "not identified" in fit or "lowest stripe" in fit or fit.startswith("flat")
-
 
 
 def store_damage(store: xr.Dataset, limit_states: Sequence[LimitState] | None = None, source: str | None = None) -> StoreDamage | None:
@@ -269,7 +286,8 @@ def store_damage(store: xr.Dataset, limit_states: Sequence[LimitState] | None = 
     given = limit_states is not None
     table = _inputs.limit_states_table(store)
     if limit_states is None and table is not None:
-        limit_states, source, given = limit_states_of(table), table.source or EXPERIMENT_SOURCE, True
+        limit_states, given = limit_states_of(table), True
+        source = f'{EXPERIMENT_SOURCE}, whose source reads "{table.source}"' if table.source else EXPERIMENT_SOURCE
     if limit_states is None:
         limit_states, source = DEFAULT_LIMIT_STATES, DEFAULT_SOURCE
     per_building, free = _inputs.run_summaries(store, list(DAMAGE_DEMANDS))
@@ -296,6 +314,6 @@ def store_damage(store: xr.Dataset, limit_states: Sequence[LimitState] | None = 
     if held:
         risk = limit_state_risk(store, held, hz)
         risk = _inputs.contact_free_part(risk) if free else risk
-    bound = None if risk is None else stripes_only_maf(risk, hz).where(at_lowest_stripe(risk))
+    walls = tuple(_inputs.moat_clearances(store, _inputs.studied_building(store)))
     return StoreDamage(demands, done.sum("record"), (beyond & done).sum("record"), design_stripes, risk, held, source or "", free, elastic,
-                       bound)
+                       walls, _inputs.walled_configurations(store) if walls else None)

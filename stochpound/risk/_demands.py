@@ -29,10 +29,14 @@ from stochpound.risk import _inputs
 from stochpound.risk._fragility_ensemble import BOOTSTRAP
 from stochpound.risk._maf import demand_hazard_curve
 from stochpound.risk._chain import CONFIDENCE, YEARS, non_increasing_along
-from stochpound.risk._collapse import beyond_model, rate_collapses_apart
+from stochpound.risk._collapse import beyond_model, collapse_fit, rate_collapses_apart
 
 DEMAND_LEVELS = 40
 """Levels of each demand hazard curve."""
+MOAT_REACHED = "base reaches the wall"
+"""The moat table's row of a configuration with the wall: the rate its base reaches it."""
+MOAT_PASSED = "no wall: base passes the walled twin's clearance (no stop modelled)"
+"""The moat table's row of a configuration without the wall: the rate its base passes that clearance, with nothing there."""
 
 
 @dataclasses.dataclass
@@ -64,6 +68,10 @@ class StoreDemands:
         The runs beyond the model per stripe and configuration (those counted apart); None where there are none.
     runs : xarray.DataArray or None
         The runs per stripe and configuration the demands come from (beside ``beyond_model``).
+    walled : xarray.DataArray or None
+        Per configuration, whether its runs have a moat wall (``stochpound.risk._inputs.walled_configurations``); in one
+        without, ``moat`` is the rate its base passes the walled twin's clearance, where no stop is modelled. None: every
+        configuration of ``moat`` has its wall.
     """
 
     curves: dict[str, xr.Dataset]
@@ -73,6 +81,7 @@ class StoreDemands:
     apart: dict[str, xr.DataArray] = dataclasses.field(default_factory=dict)
     beyond_model: xr.DataArray | None = None
     runs: xr.DataArray | None = None
+    walled: xr.DataArray | None = None
 
     def levels_at(self, targets: Sequence[float], years: float) -> pd.DataFrame:
         """Per demand (its units in its name), configuration and target (a probability in ``years``): the level exceeded at the
@@ -109,9 +118,10 @@ class StoreDemands:
         return non_increasing_along(self.apart[label], "level")
 
     def wall_exceedances(self, targets: Sequence[float], years: float) -> list[tuple[float, float, list[dict[str, Hashable]], int, float, float]]:
-        """Per target and moat clearance: (target, clearance m, the configurations whose base reaches it more often than the
-        target allows, the number of configurations, the largest rate of reaching it 1/yr, the rate the target allows 1/yr);
-        [] without a moat."""
+        """Per target and moat clearance, over the configurations that have the wall (``walled``; every configuration where it
+        is None): (target, clearance m, those whose base reaches it more often than the target allows, the number of them, the
+        largest rate of reaching it 1/yr, the rate the target allows 1/yr); [] without a moat. A configuration without the wall
+        has no stop there (its base passes the clearance and slides on), so it limits nothing and is not counted."""
         if self.moat is None:
             return []
         rows = []
@@ -119,10 +129,17 @@ class StoreDemands:
             allowed = float(rate_from_probability(float(target), years))
             for clearance in self.moat["level"].values:
                 maf = self.moat["maf"].sel(level=clearance)
-                every = _configurations(maf)
+                every = [labels for labels in _configurations(maf) if self.has_wall(labels)]
                 over = [labels for labels in every if float(maf.sel(labels)) > allowed]
-                rows.append((float(target), float(clearance), over, len(every), float(maf.max()), allowed))
+                worst = max((float(maf.sel(labels)) for labels in every), default=math.nan)
+                rows.append((float(target), float(clearance), over, len(every), worst, allowed))
         return rows
+
+    def has_wall(self, labels: dict[str, Hashable]) -> bool:
+        """Whether the configuration ``labels`` (of ``moat``) has its moat wall (True where ``walled`` is None)."""
+        if self.walled is None:
+            return True
+        return bool(self.walled.sel({dim: value for dim, value in labels.items() if dim in self.walled.dims}).all())
 
     def wall_interval(self, clearance: float) -> tuple[float, float] | None:
         """The interval (yr) of the return period of reaching the wall at ``clearance`` in its worst configuration; None without a bootstrap."""
@@ -140,6 +157,10 @@ class StoreDemands:
                  "return_period_lower": "once in, lower (yr)", "return_period_upper": "once in, upper (yr)",
                  "probability": f"P in {self.years:g} yr", "probability_lower": "P lower", "probability_upper": "P upper"}
         frame = self.moat[[name for name in names if name in self.moat]].reset_coords(drop=True).to_dataframe().rename(columns=names)
+        if self.walled is not None:  # what the rate is of, per row: a wall reached, or a clearance passed with nothing there
+            rows = frame.index.to_frame(index=False)
+            labels = [{dim: row[dim] for dim in self.walled.dims} for _, row in rows.iterrows()]
+            frame.insert(0, "what it is", [MOAT_REACHED if self.has_wall(one) else MOAT_PASSED for one in labels])
         return frame.rename_axis(index={"level": "moat clearance (m)"})  # a plain index (one configuration) or a MultiIndex
 
 
@@ -175,17 +196,19 @@ def store_demands(store: xr.Dataset, hz: HazardCurve | None = None, confidence: 
     collapsed = _inputs.demand_drift(store)
     collapsed = None if collapsed is None else beyond_model(collapsed)
     collapsed = collapsed if collapsed is not None and bool((collapsed == 1.0).any()) else None
+    collapse = None if collapsed is None else collapse_fit(collapsed, hz)  # P(C | IM) once: every demand's runs are the same runs
     clearances = _inputs.moat_clearances(store, studied)
     curves, apart = {}, {}
     for label, (demand, _) in demands.items():
         levels = demand_levels(demand, clearances if label == base else ())
         curves[label] = demand_hazard_curve(demand, levels, hz, confidence=confidence, bootstrap=0)
         if collapsed is not None:
-            apart[label] = rate_collapses_apart(demand, collapsed, levels, "level", hz)[0].assign_coords(level=levels)
+            apart[label] = rate_collapses_apart(demand, collapsed, levels, "level", hz, collapse)[0].assign_coords(level=levels)
     moat = (demand_hazard_curve(sliding, clearances, hz, confidence=confidence, bootstrap=bootstrap, seed=seed)
             if sliding is not None and clearances else None)
     counts = (None, None) if collapsed is None else (collapsed.sum("record"), collapsed.notnull().sum("record"))
-    return StoreDemands(curves, {label: units for label, (_, units) in demands.items()}, moat, apart=apart, beyond_model=counts[0], runs=counts[1])
+    return StoreDemands(curves, {label: units for label, (_, units) in demands.items()}, moat, apart=apart, beyond_model=counts[0], runs=counts[1],
+                        walled=_inputs.walled_configurations(store) if moat is not None else None)
 
 
 def demand_levels(demand: xr.DataArray, clearances: Sequence[float] = ()) -> np.ndarray:

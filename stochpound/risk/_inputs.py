@@ -497,6 +497,20 @@ def base_displacement(store: xr.Dataset, studied: str | None, walls_free: bool =
     return sliding.where(slides)
 
 
+WALL_CLOSURE = "largest_wall_closure"
+"""The store's per-case closure toward a wall (m; NaN in a case without walls)."""
+
+
+def walled_configurations(store: xr.Dataset) -> xr.DataArray | None:
+    """Per configuration of the contact-free runs (every grid label but the gap axes, the stripes and the motions), whether its
+    runs have a moat wall (their closure toward a wall is known); None for a store without walls in any configuration."""
+    if WALL_CLOSURE not in store:
+        return None
+    closure = store_motions(contact_free(store)[WALL_CLOSURE])
+    walled = np.isfinite(closure).any([dim for dim in ("intensity", "record") if dim in closure.dims])
+    return walled.reset_coords(drop=True) if bool(walled.any()) else None
+
+
 def free_base_displacement(store: xr.Dataset, studied: str | None) -> tuple[xr.DataArray | None, str]:
     """The studied building's wall-free peak base displacement for the D_M-form rule (:func:`base_displacement`), or None and why not.
 

@@ -3,7 +3,8 @@
 A limit state is a per-case demand of a store reaching a capacity: a storey
 drift ratio, a residual drift ratio or a ductility (the yielding storeys'
 summaries, ``stochpound.store.STOREY_SUMMARIES``), a floor acceleration, an
-impact force, or the base displacement that reaches a bearing's stop. Each
+impact force, or a sliding base's peak base displacement (a bearing's displacement
+capacity or a moat clearance: no stop is modelled unless the scene has a wall there). Each
 goes through the pounding chain's steps: per run, whether the demand reaches
 the capacity (:func:`~stochpound.risk.limit_state_events`); per
 configuration of the grid, a lognormal fragility of the stripes
@@ -35,8 +36,9 @@ from stochpound.risk._inputs import LimitStates
 from stochpound.risk._fragility_ensemble import limit_state_events, stripe_fragility
 from stochpound.risk._maf import mean_annual_frequency
 from stochpound.risk._chain import CONFIDENCE, YEARS, fit_name
-from stochpound.risk._collapse import MODEL_DRIFT_LIMIT, beyond_model, credible_fit, rate_collapses_apart
-from stochpound.risk._stripe_coverage import at_lowest_stripe, stripes_only_maf, unidentified
+from stochpound.risk._collapse import MODEL_DRIFT_LIMIT, beyond_model, collapse_fit, rate_collapses_apart
+from stochpound.risk._fragility import FIT, NEVER
+from stochpound.risk._stripe_coverage import at_lowest_stripe, stripes_only_maf, stripes_upper_maf, unidentified
 
 
 OBJECTIVE_YEARS = 50.0
@@ -65,7 +67,7 @@ KINDS = {kind: _Kind(_inputs.limit_state_variable(kind), *rest) for kind, rest i
     "ductility": ("1", "peak storey ductility", True, "yield_force"),
     "floor_acceleration": ("g", "peak floor acceleration", True, "[output] demands = true"),
     "impact_force": ("N", "peak impact force", False, "runs at a finite gap"),
-    "isolator_displacement": ("m", "base displacement (the bearing's stop)", True, "a sliding base"),
+    "isolator_displacement": ("m", "peak base displacement", True, "a sliding base"),
 }.items()}
 
 
@@ -94,8 +96,10 @@ class LimitState:
     kind : str
         One of ``stochpound.risk.LIMIT_STATE_KINDS``: ``drift_ratio``, ``residual_drift_ratio``,
         ``ductility`` (1), ``floor_acceleration`` (g), ``impact_force`` (N),
-        ``isolator_displacement`` (m, the base displacement at which the
-        bearing reaches its stop).
+        ``isolator_displacement`` (m, the peak base displacement of a sliding
+        base: a capacity such as a bearing's displacement capacity or a moat
+        wall's clearance; the runs model a stop there only where the scene
+        has a wall at that clearance).
     capacity : float
         The capacity, > 0, in the kind's units.
     building : str, optional
@@ -215,7 +219,10 @@ def limit_state_risk(store: xr.Dataset, limit_states: Sequence[LimitState], hz: 
         ``capacity``, ``building`` and ``target``, its objective's probability in 50 yr or NaN, beside it) and the store's other grid
         dimensions (its gap axes, variants): the fragility (``theta``, IM
         units; ``beta``; ``status``; per stripe ``exceeded``, ``runs``,
-        ``probability``) and ``maf`` (1/yr). With contact-free cases:
+        ``probability``), ``maf`` (1/yr), and ``maf_lower``, ``maf_upper``, the bounds the
+        stripes' fractions alone give λ (:func:`~stochpound.risk.stripes_only_maf`,
+        :func:`~stochpound.risk.stripes_upper_maf`: what the runs say where their fit does not pin λ,
+        :func:`limit_state_pinned`). With contact-free cases:
         ``maf_contact_free`` (the contact-free twins' rate, the same motions
         and other labels) and ``gap_cost`` = ``maf`` − ``maf_contact_free``
         (1/yr; 0 for the twins themselves, negative where pounding lowers the
@@ -223,10 +230,10 @@ def limit_state_risk(store: xr.Dataset, limit_states: Sequence[LimitState], hz: 
         ``MODEL_DRIFT_LIMIT`` (beyond the model): ``maf_collapses_apart``,
         λ with those runs counted apart as collapses and combined by total
         probability (:func:`~stochpound.risk.rate_collapses_apart`; a
-        collapse reaches every limit state), ``bound_collapses_apart``, the
-        stripes' fractions alone so counted (:func:`~stochpound.risk.stripes_only_maf`:
-        the bound of a step at the lowest stripe), and ``beyond_model``, those
-        runs per stripe and configuration.
+        collapse reaches every limit state), ``lower_collapses_apart`` and
+        ``upper_collapses_apart``, the same bounds with a collapse counted as reaching it, the credible
+        runs' fit (``status_collapses_apart``, ``theta_collapses_apart``, ``beta_collapses_apart``),
+        and ``beyond_model``, those runs per stripe and configuration.
 
     Raises
     ------
@@ -239,6 +246,7 @@ def limit_state_risk(store: xr.Dataset, limit_states: Sequence[LimitState], hz: 
     hz, demands, measure = _inputs.limit_state_inputs(store, [(KINDS[s.kind].variable, s.building, KINDS[s.kind].note, KINDS[s.kind].units == "g")
                                                               for s in limit_states], hz)
     collapsed = _collapsed_cases(store)
+    collapse = None if collapsed is None else collapse_fit(collapsed, hz)  # P(C | IM) once: every limit state's runs are the same runs
     fits, apart = [], []
     for state, demand in zip(limit_states, demands):
         events = limit_state_events(demand, [state.capacity], dim="limit_state").assign_coords(limit_state=[state.label])
@@ -247,22 +255,29 @@ def limit_state_risk(store: xr.Dataset, limit_states: Sequence[LimitState], hz: 
                                       building=("limit_state", [state.building or ""]),
                                       target=("limit_state", [math.nan if state.target is None else float(state.target)])))
         if collapsed is not None:
-            rate = rate_collapses_apart(demand, collapsed, [state.capacity], "limit_state", hz)[0].assign_coords(limit_state=[state.label])
-            credible = credible_fit(demand, collapsed, [state.capacity], "limit_state").assign_coords(limit_state=[state.label])
-            apart.append(xr.Dataset({"maf_collapses_apart": rate, "bound_collapses_apart": _apart_bound(events, collapsed, hz),
+            rate, _, credible = (part.assign_coords(limit_state=[state.label]) for part in
+                                 rate_collapses_apart(demand, collapsed, [state.capacity], "limit_state", hz, collapse))
+            either = _either_counts(events, collapsed)
+            apart.append(xr.Dataset({"maf_collapses_apart": rate, "lower_collapses_apart": stripes_only_maf(either, hz),
+                                     "upper_collapses_apart": stripes_upper_maf(either, hz),
                                      **{f"{name}_collapses_apart": credible[name] for name in ("status", "theta", "beta")}}))
     result = xr.concat(fits, "limit_state", coords="different", compat="equals", join="outer")
     result["maf"] = mean_annual_frequency(result, hz)
+    result["maf_lower"] = stripes_only_maf(result, hz).assign_attrs(long_name=_LOWER)
+    result["maf_upper"] = stripes_upper_maf(result, hz).assign_attrs(long_name=_UPPER)
     if apart:
         both = xr.concat(apart, "limit_state", join="outer")
         result["maf_collapses_apart"] = both["maf_collapses_apart"].assign_attrs(
             units="1/yr", long_name=f"mean annual frequency, the runs beyond a {100 * MODEL_DRIFT_LIMIT:g} % storey drift counted apart as collapses")
-        result["bound_collapses_apart"] = both["bound_collapses_apart"].assign_attrs(
-            units="1/yr", long_name="the stripes' fractions alone, collapses counted as reaching the limit state (nothing below the lowest stripe)")
+        for name, words in (("lower", _LOWER), ("upper", _UPPER)):
+            result[f"{name}_collapses_apart"] = both[f"{name}_collapses_apart"].assign_attrs(
+                units="1/yr", long_name=f"{words}, a collapse counted as reaching the limit state")
         for name in ("status", "theta", "beta"):  # the credible runs' fit, whose kind says what λ collapses apart rests on
             result[f"{name}_collapses_apart"] = both[f"{name}_collapses_apart"].assign_attrs(
                 long_name=f"{name} of the credible runs' fit (the runs beyond the model left out)")
         result["beyond_model"] = collapsed.sum("record").assign_attrs(units="1", long_name="runs beyond the model (collapses) per stripe")
+        result["collapse_identified"] = ((collapse["status"] == FIT) & (unidentified(collapse) == "")).reset_coords(drop=True).assign_attrs(
+            long_name="whether P(C | IM) is a lognormal the stripes identify")
     twins = _inputs.contact_free_twins(result["maf"])
     if twins is not None:
         result["maf_contact_free"] = twins.assign_attrs(units="1/yr", long_name="mean annual frequency of the contact-free twins")
@@ -270,11 +285,16 @@ def limit_state_risk(store: xr.Dataset, limit_states: Sequence[LimitState], hz: 
     return result.assign_attrs(intensity=measure)
 
 
-def _apart_bound(events: xr.DataArray, collapsed: xr.DataArray, hz: HazardCurve) -> xr.DataArray:
-    """:func:`~stochpound.risk.stripes_only_maf` of a limit state's per-run events with every collapse counted as reaching it (1/yr)."""
+_LOWER = "λ⁻: the stripes' fractions alone, nothing below the lowest stripe (stochpound.risk.stripes_only_maf)"
+_UPPER = "λ⁺: the stripes' fractions as upper bounds, 1 beyond the top stripe (stochpound.risk.stripes_upper_maf)"
+
+
+def _either_counts(events: xr.DataArray, collapsed: xr.DataArray) -> xr.Dataset:
+    """Per stripe, the runs that reach a limit state or collapse (``exceeded``) and the runs (``runs``): its events with every
+    collapse counted as reaching it."""
     events, collapsed = xr.align(events, collapsed.drop_vars([c for c in collapsed.coords if c not in collapsed.dims]), join="inner")
     either = xr.where(collapsed == 1.0, 1.0, events).where(events.notnull())
-    return stripes_only_maf(xr.Dataset({"exceeded": either.sum("record"), "runs": either.notnull().sum("record")}), hz)
+    return xr.Dataset({"exceeded": either.sum("record"), "runs": either.notnull().sum("record")})
 
 
 def _collapsed_cases(store: xr.Dataset) -> xr.DataArray | None:
@@ -288,22 +308,74 @@ def _collapsed_cases(store: xr.Dataset) -> xr.DataArray | None:
 
 def objective_ratio(risk: xr.Dataset, apart: bool = False) -> xr.DataArray:
     """λ/λ_target of each limit state of :func:`limit_state_risk` (NaN without an objective), λ_target = −ln(1 − p)/50 yr for its
-    ``target`` p; with ``apart``, of λ with the runs beyond the model counted apart as collapses (λ as run where no run is)."""
+    ``target`` p; with ``apart``, of λ with the runs beyond the model counted apart as collapses (λ as run where no run is).
+    λ is the fit's, whether the runs pin it or not (:func:`judged_ratio` is what an objective is judged on)."""
+    return _per_target(risk["maf_collapses_apart"] if apart and "maf_collapses_apart" in risk else risk["maf"], risk)
+
+
+def _per_target(rate: xr.DataArray, risk: xr.Dataset) -> xr.DataArray:
+    """``rate``/λ_target of each limit state of ``risk`` (NaN without an objective)."""
     target = risk["target"]
-    maf = risk["maf_collapses_apart"] if apart and "maf_collapses_apart" in risk else risk["maf"]
-    return maf / xr.apply_ufunc(rate_from_probability, target.fillna(0.5), OBJECTIVE_YEARS).where(target.notnull())
+    return rate / xr.apply_ufunc(rate_from_probability, target.fillna(0.5), OBJECTIVE_YEARS).where(target.notnull())
+
+
+def limit_state_pinned(risk: xr.Dataset, apart: bool = False) -> xr.DataArray:
+    """Whether the runs pin each limit state's λ of :func:`limit_state_risk`: its fit (with ``apart``, the credible runs' fit
+    behind λ with the runs beyond the model counted apart) is a lognormal the stripes identify
+    (:func:`~stochpound.risk.unidentified` says nothing). A step (``never``, ``always``, ``separated``: the runs place no
+    median or spread), a flat fit (``decreasing``) or a lognormal not identified is not: its λ rests on where the step or the
+    extrapolation is put, and only the bounds of :func:`limit_state_bounds` are the runs'. With ``apart``, a limit state no
+    credible run reaches has λ = λ_C, pinned where P(C | IM) is a lognormal the stripes identify. True throughout where
+    ``risk`` holds no fit kinds (nothing to judge them by)."""
+    fit = _fit_of(risk, apart)
+    if "status" not in fit:
+        return xr.ones_like(risk["maf"], dtype=bool)
+    known = "intensity" in fit.coords
+    identified = (unidentified(fit) == "" if known else xr.ones_like(fit["status"], dtype=bool)) & (fit["status"] == FIT)
+    if apart and "collapse_identified" in risk:  # no credible run reaches it: λ is λ_C, pinned where P(C | IM) is
+        identified = identified | ((fit["status"] == NEVER) & risk["collapse_identified"])
+    return identified
+
+
+def limit_state_bounds(risk: xr.Dataset, apart: bool = False) -> tuple[xr.DataArray, xr.DataArray] | None:
+    """λ⁻ and λ⁺ (1/yr) of each limit state of :func:`limit_state_risk`: the bounds the stripes' fractions alone give λ
+    (:func:`~stochpound.risk.stripes_only_maf`, :func:`~stochpound.risk.stripes_upper_maf`), with ``apart`` a collapse counted as
+    reaching it; None where ``risk`` holds none."""
+    names = ("lower_collapses_apart", "upper_collapses_apart") if apart and "maf_collapses_apart" in risk else ("maf_lower", "maf_upper")
+    return (risk[names[0]], risk[names[1]]) if all(name in risk for name in names) else None
+
+
+def judged_ratio(risk: xr.Dataset, apart: bool = False) -> xr.DataArray:
+    """λ/λ_target as an objective is judged on: the fit's ratio (:func:`objective_ratio`) where the runs pin λ
+    (:func:`limit_state_pinned`), else the lower bound's, λ⁻/λ_target (:func:`limit_state_bounds`): a limit state whose fit the
+    runs do not pin misses its objective only where the runs alone say so (NaN without an objective)."""
+    ratio = objective_ratio(risk, apart)
+    bounds = limit_state_bounds(risk, apart)
+    return ratio if bounds is None else ratio.where(limit_state_pinned(risk, apart), _per_target(bounds[0], risk))
+
+
+def undecided(risk: xr.Dataset, apart: bool = False) -> xr.DataArray:
+    """Per limit state and configuration, whether the runs leave open if it misses its objective: its fit does not pin λ
+    (:func:`limit_state_pinned`) and its bounds straddle λ_target (λ⁻/λ_target ≤ 1 < λ⁺/λ_target); False without bounds."""
+    bounds = limit_state_bounds(risk, apart)
+    if bounds is None:
+        return xr.zeros_like(risk["maf"], dtype=bool)
+    lower, upper = (_per_target(bound, risk) for bound in bounds)
+    return ~limit_state_pinned(risk, apart) & (upper > 1.0) & ~(lower > 1.0)
 
 
 def governing_limit_state(risk: xr.Dataset, apart: bool = False, within: str = POUNDING) -> xr.DataArray | None:
-    """Per configuration of :func:`limit_state_risk`, the limit state with the largest λ/λ_target where it exceeds 1 (it misses
-    its objective), else ``within``; None where no limit state has an objective (nothing is said to govern).
+    """Per configuration of :func:`limit_state_risk`, the limit state with the largest λ/λ_target (:func:`judged_ratio`: a fit
+    the runs do not pin by its lower bound) where it exceeds 1 (it misses its objective), else ``within``; None where no limit
+    state has an objective (nothing is said to govern).
 
-    ``apart`` judges λ with the runs beyond the model counted apart as collapses (:func:`objective_ratio`): the two treatments
-    may name different limit states (:func:`governing_disagreement`).
+    ``apart`` judges λ with the runs beyond the model counted apart as collapses: the two treatments may name different limit
+    states (:func:`governing_disagreement`). A limit state whose bounds straddle its objective (:func:`undecided`) does not
+    govern: the runs do not say it misses it.
     """
     if not bool(risk["target"].notnull().any()):
         return None
-    ratio = objective_ratio(risk, apart)
+    ratio = judged_ratio(risk, apart)
     worst = ratio["limit_state"][ratio.fillna(-1.0).argmax("limit_state")].drop_vars("limit_state", errors="ignore")
     return worst.where((ratio > 1.0).any("limit_state"), within)
 
@@ -317,13 +389,20 @@ def governing_disagreement(risk: xr.Dataset, within: str = POUNDING) -> xr.DataA
     return None if run is None else run != apart
 
 
+def _fit_of(risk: xr.Dataset, apart: bool) -> xr.Dataset:
+    """``risk`` with, for ``apart``, the credible runs' fit (``status``, ``theta``, ``beta``) in place of the fit as run (as run
+    where no run is beyond the model)."""
+    if apart and "status_collapses_apart" in risk:
+        return risk.assign({name: risk[f"{name}_collapses_apart"] for name in ("status", "theta", "beta")})
+    return risk
+
+
 def limit_state_fits(risk: xr.Dataset, apart: bool = False) -> xr.DataArray:
     """Each limit state's fit in words over :func:`limit_state_risk`'s dimensions: ``lognormal``, ``step: never`` …;
     ``lognormal, not identified (why)`` where :func:`~stochpound.risk.unidentified` says so; ``step at the lowest stripe: a
     bound`` where its λ is one (:func:`~stochpound.risk.at_lowest_stripe`). With ``apart``, the credible runs' fit behind λ
     with the runs beyond the model counted apart (the fit as run where no run is beyond it)."""
-    if apart and "status_collapses_apart" in risk:
-        risk = risk.assign({name: risk[f"{name}_collapses_apart"] for name in ("status", "theta", "beta")})
+    risk = _fit_of(risk, apart)
     name = xr.apply_ufunc(np.vectorize(lambda status: fit_name(int(status)).replace("runs that pounded", "runs that reached it"), otypes=[object]),
                           risk["status"])  # a limit state is reached, not pounded
     why = unidentified(risk)
@@ -334,7 +413,8 @@ def limit_state_fits(risk: xr.Dataset, apart: bool = False) -> xr.DataArray:
 def objectives_frame(risk: xr.Dataset, within: str = WITHIN) -> pd.DataFrame | None:
     """What governs per configuration of :func:`limit_state_risk` at its finite gaps, each treatment of the runs beyond the
     model (``TREATMENTS``: as run, and collapses apart where some run is): the limit state with the largest λ/λ_target beyond 1
-    (else ``within``) and that largest ratio, and whether the treatments agree. None without any objective.
+    (else ``within``) and that largest ratio (:func:`judged_ratio`: a fit the runs do not pin by its lower bound), and whether
+    the treatments agree. None without any objective.
 
     Returns
     -------
@@ -349,7 +429,7 @@ def objectives_frame(risk: xr.Dataset, within: str = WITHIN) -> pd.DataFrame | N
         if governs is None:
             return None
         columns[f"governs, {TREATMENTS[apart]}"] = governs.reset_coords(drop=True)
-        columns[f"largest λ/λ_target, {TREATMENTS[apart]}"] = objective_ratio(data, apart).max("limit_state").reset_coords(drop=True)
+        columns[f"largest λ/λ_target, {TREATMENTS[apart]}"] = judged_ratio(data, apart).max("limit_state").reset_coords(drop=True)
     frame = xr.Dataset(columns).to_dataframe() if data["maf"].ndim > 1 else pd.DataFrame({k: [v.item()] for k, v in columns.items()})
     if "maf_collapses_apart" in data:
         frame["treatments agree"] = frame[f"governs, {TREATMENTS[False]}"] == frame[f"governs, {TREATMENTS[True]}"]
@@ -380,7 +460,9 @@ def _where(index: object, names: Sequence[str | None]) -> str:
 
 def gap_cost_frame(risk: xr.Dataset, years: float = YEARS) -> pd.DataFrame:
     """The "what the gap costs" table of :func:`limit_state_risk`: per limit state and finite gap, λ, λ of the twins, their difference, and P in ``years``
-    (and λ with the runs beyond the model counted apart as collapses, where some run is).
+    (and λ with the runs beyond the model counted apart as collapses, where some run is), the fit's kind, and where the runs do
+    not pin it (:func:`limit_state_pinned`) the bounds λ⁻ and λ⁺ they give λ (:func:`limit_state_bounds`): there λ is the fit's
+    extrapolation, not the runs'.
 
     Returns
     -------
@@ -388,9 +470,15 @@ def gap_cost_frame(risk: xr.Dataset, years: float = YEARS) -> pd.DataFrame:
         Indexed by the limit state and the other grid labels (the contact-free rows left out).
     """
     keep = [name for name in ("maf", "maf_contact_free", "gap_cost", "maf_collapses_apart") if name in risk]
-    frame = _inputs.at_finite_gaps(risk[keep].assign(fit=limit_state_fits(risk))).reset_coords(drop=True).to_dataframe()
+    data = risk[keep].assign(fit=limit_state_fits(risk))
+    bounds = limit_state_bounds(risk)
+    if bounds is not None:  # where the runs do not pin the fit, the bounds they give λ (NaN where they pin it)
+        pinned = limit_state_pinned(risk)
+        data = data.assign(maf_lower=bounds[0].where(~pinned), maf_upper=bounds[1].where(~pinned))
+    frame = _inputs.at_finite_gaps(data).reset_coords(drop=True).to_dataframe()
     frame[f"P in {years:g} yr"] = probability_from_rate(frame["maf"].to_numpy(), years)
     if "maf_contact_free" in frame:
         frame[f"P in {years:g} yr, contact-free"] = probability_from_rate(frame["maf_contact_free"].to_numpy(), years)
     return frame.rename(columns={"maf": "λ (1/yr)", "maf_contact_free": "λ contact-free (1/yr)", "gap_cost": "Δλ (1/yr)",
-                                 "maf_collapses_apart": "λ collapses apart (1/yr)"})
+                                 "maf_collapses_apart": "λ collapses apart (1/yr)", "maf_lower": "λ⁻ if not pinned (1/yr)",
+                                 "maf_upper": "λ⁺ if not pinned (1/yr)"})

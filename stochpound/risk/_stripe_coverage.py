@@ -184,6 +184,38 @@ def stripes_only_maf(fragility: xr.Dataset, hz: HazardCurve) -> xr.DataArray:
         units="1/yr", long_name="mean annual frequency from the stripes' fractions alone (nothing below the lowest stripe)")
 
 
+def stripes_upper_maf(fragility: xr.Dataset, hz: HazardCurve) -> xr.DataArray:
+    """λ⁺ (1/yr) from the stripes' fractions alone: p_1 (λ(lo) − λ(x_1)) + Σ_{j≥2} p_j (λ(x_{j−1}) − λ(x_j)) + λ(x_n).
+
+    The upper counterpart of :func:`stripes_only_maf`: a fragility that does not fall with intensity and is at most p_j at
+    x_j is at most p_j on (x_{j−1}, x_j] (at most p_1 from the hazard's lower end lo up to the lowest stripe) and at most 1
+    beyond the top stripe x_n, so its λ (the chain's, :func:`~stochpound.risk.mean_annual_frequency`) is at most λ⁺.
+    Together, [λ⁻, λ⁺] is what the runs bound a rate to where their fit does not pin it (the fractions' own sampling aside);
+    λ⁺ is inf where the lowest stripe has exceedances and the hazard has no lower end.
+
+    Parameters
+    ----------
+    fragility : xarray.Dataset
+        A stripes fit with its per-stripe ``exceeded`` and ``runs`` over ``intensity``.
+    hz : HazardCurve
+        The site's hazard.
+
+    Returns
+    -------
+    xarray.DataArray
+        λ⁺ over the fit's dimensions other than ``intensity``.
+    """
+    levels = np.sort(np.asarray(fragility["intensity"].values, dtype=float))
+    rates = np.asarray(hz(np.clip(levels, hz.support[0], hz.support[1])), dtype=float)
+    below = np.append(float(hz(hz.support[0])), rates[:-1])  # λ at the lower end of each stripe's bin (x_{j-1}, x_j]
+    bins = xr.DataArray(below - rates, dims="intensity", coords={"intensity": levels})
+    fraction = (fragility["exceeded"] / fragility["runs"].where(fragility["runs"] > 0)).sel(intensity=levels)
+    with np.errstate(invalid="ignore"):  # a bin of no exceedance adds nothing, even below a hazard without a lower end (λ(lo) = inf)
+        parts = (fraction * bins).where(fraction != 0.0, 0.0).where(fraction.notnull())
+    return (parts.sum("intensity", min_count=1) + rates[-1]).assign_attrs(
+        units="1/yr", long_name="mean annual frequency bound from the stripes' fractions alone (at most 1 beyond the top stripe)")
+
+
 UNIDENTIFIED_BETA = 0.8
 """β from which a lognormal fit is not identified by the stripes: its 16–84 % range spans e^{2β} ≈ 5 times in intensity,
 wider than record-to-record dispersion (0.3–0.6 for storey drifts, FEMA P-58) and than a stripe set usually spans."""

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-import math
+from collections.abc import Hashable
 
 import pandas as pd
 
@@ -102,10 +102,12 @@ def _beyond_model_text(damage: StoreDamage) -> str:
 def _governing_text(damage: StoreDamage) -> str:
     states = "; ".join(state.label + (f" (objective: {_percent(state.target)} in 50 yr)" if state.target is not None else " (no objective)")
                        for state in damage.limit_states)
-    head = (f"Limit states (capacities from {damage.source}; each building judged by its own demand): {states}. Each one's mean annual "
-            "frequency λ comes from its fragility over the stripes (a lognormal, or a step where the runs identify none; the fit is "
-            "named in the table) and the site's hazard, as for pounding (the table below), and is set against its own performance "
-            "objective, λ_target = −ln(1 − p)/50 for its probability p in 50 yr.")
+    head = (f"Limit states (capacities from {damage.source}; each building judged by its own demand): {states}.{_base_text(damage)} Each one's mean annual "
+            "frequency λ comes from its fragility over the stripes (the fit is named in the table) and the site's hazard, as for "
+            "pounding, and is set against its own performance objective, λ_target = −ln(1 − p)/50 for its probability p in 50 yr. "
+            "Where the fit is not a lognormal the runs identify (a step, a flat fraction, a lognormal with its median beyond the top "
+            "stripe or β ≥ 0.8), the runs do not pin λ: the table gives the bounds the stripes' fractions alone give it, and such a "
+            "limit state misses its objective only where the lower bound does.")
     if not damage.has_objectives():
         return (head + " No limit state has an objective, so none is said to govern: give [limit_states] targets (docs/risk.md). "
                 "A [limit_states] table in the experiment file replaces these capacities.")
@@ -121,25 +123,56 @@ def _governing_text(damage: StoreDamage) -> str:
             "replaces these capacities and objectives (targets; docs/risk.md).")
 
 
+def _base_text(damage: StoreDamage) -> str:
+    """What a limit state on the base displacement is in these runs: the base passing a displacement, with no stop modelled at
+    the bearing, and where it is a moat wall's clearance, reaching the wall only in the configurations that have it ("" without one)."""
+    states = [state for state in damage.limit_states if state.kind == "isolator_displacement"]
+    if not states:
+        return ""
+    walled, every = damage.wall_counts()
+    parts = []
+    for state in states:
+        text = f" {state.label} counts the runs whose base passes {state.capacity:g} m: no stop is modelled at the bearing in these runs"
+        if any(abs(state.capacity - wall) <= 1e-9 * wall for wall in damage.walls):
+            text += (f"; {state.capacity:g} m is the moat wall's clearance, so in the {walled} of {every} configurations with the wall "
+                     f"passing it is reaching the wall, and in the {every - walled} without it the base passes the walled twin's "
+                     "clearance with nothing there")
+        parts.append(text + ".")
+    return "".join(parts)
+
+
 def _governs_text(damage: StoreDamage, apart: bool) -> str:
     """What governs per configuration in one treatment of the runs beyond the model (``apart``: counted apart as collapses),
-    the configurations with the same answer grouped."""
+    the configurations with the same answer grouped; a limit state whose fit the runs do not pin is judged on the lower bound of
+    λ the stripes give (said so), and those whose bounds straddle their objective are named as left open."""
     governing, misses = damage.governing(apart), damage.misses_objective(apart)
     largest, largest_state = damage.largest_ratio(apart)
-    fits, unpinned = damage.fits(apart), damage.unpinned(apart)
+    fits, pinned, open_ = damage.fits(apart), damage.pinned(apart), damage.undecided(apart)
+    bounds = damage.bound_ratios(apart)
     grouped: dict[str, list[str]] = {}
     for labels in _configurations(governing):
         worst = str(governing.sel(labels).item())
         value = float(largest.sel(labels))
         if worst == POUNDING:
-            text = f"{POUNDING} (every limit state within its objective; the largest λ/λ_target is {ratio_text(value, 2)}, {largest_state.sel(labels).item()})"
+            state = str(largest_state.sel(labels).item())
+            lower = "" if bounds is None or bool(pinned.sel(labels).sel(limit_state=state).item()) else " (its lower bound: its fit does not pin λ)"
+            text = (f"{POUNDING} (no limit state the runs put beyond its objective; the largest λ/λ_target is "
+                    f"{ratio_text(value, 2)}{lower}, {state})")
         else:
             others = [str(state) for state, flag in zip(misses["limit_state"].values, misses.sel(labels).values) if flag and state != worst]
-            fit = str(fits.sel(labels).sel(limit_state=worst).item()) if fits is not None else ""
-            loose = unpinned is not None and bool(unpinned.sel(labels).sel(limit_state=worst).item())
-            caveat = f"; its fit, {fit}, is not pinned by the runs: the ratio rests on it" if loose else ""
-            text = (f"{worst} (λ/λ_target = {ratio_text(value, 2)}{caveat})"
-                    + (f"; also beyond their objectives: {', '.join(others)}" if others else ""))
+            if bounds is None or bool(pinned.sel(labels).sel(limit_state=worst).item()):
+                text = f"{worst} (λ/λ_target = {ratio_text(value, 2)})"
+            else:
+                fit = str(fits.sel(labels).sel(limit_state=worst).item()) if fits is not None else "not a lognormal the runs identify"
+                high = float(bounds[1].sel(labels).sel(limit_state=worst))
+                text = (f"{worst} (λ/λ_target ≥ {ratio_text(value, 2)}, the lower bound the stripes' fractions alone give: its fit, "
+                        f"{fit}, does not pin λ, which the runs bound to {ratio_text(value, 2)}–{ratio_text(high, 2)} times λ_target)")
+            text += f"; also beyond their objectives: {', '.join(others)}" if others else ""
+        left = [str(state) for state, flag in zip(open_["limit_state"].values, open_.sel(labels).values) if flag]
+        if left and bounds is not None:
+            text += "; left open by the runs (a fit they do not pin, its bounds either side of the objective): " + ", ".join(
+                f"{state} ({ratio_text(float(bounds[0].sel(labels).sel(limit_state=state)), 2)}–"
+                f"{ratio_text(float(bounds[1].sel(labels).sel(limit_state=state)), 2)} times λ_target)" for state in left)
         grouped.setdefault(text, []).append(_label(labels))
     every = len(_configurations(governing))
     return "; ".join((f"{' and '.join(names)}: " if len(names) < every else "") + text for text, names in grouped.items())
@@ -160,54 +193,62 @@ def _agreement_text(damage: StoreDamage) -> str:
 
 
 def _limit_states_table(name: str, damage: StoreDamage) -> Table:
-    maf, periods, fits = damage.risk["maf"], damage.return_period(), damage.fits()
-    ratio, apart, bound_ratio = damage.ratio(), damage.collapses_apart(), damage.bound_ratio()
-    fits_apart = damage.fits(apart=True)
+    apart = damage.collapses_apart()
     rows = []
+    maf = damage.risk["maf"]
     for labels in _configurations(maf):
         for state in maf["limit_state"].values:
             at = {**labels, "limit_state": state}
             target = float(maf["target"].sel(limit_state=state))
-            bound = float(damage.bound.sel(at)) if damage.bound is not None else math.nan
-            row = {"configuration": _label(labels), "limit state": str(state), "λ (1/yr)": _rate_cell(float(maf.sel(at)), bound),
-                   "once in (yr)": _period_cell(float(periods.sel(at)), bound), "fit": str(fits.sel(at).item()),
-                   "objective": f"{_percent(target)} in 50 yr" if target == target else "none",
-                   "λ/λ_target": _ratio_cell(float(ratio.sel(at)), float(bound_ratio.sel(at)) if bound_ratio is not None else math.nan) if target == target else ""}
-            if apart:
-                bound_apart = float(damage.bounds(apart=True).sel(at)) if damage.bound is not None else math.nan
-                row["λ collapses apart (1/yr)"] = _rate_cell(float(damage.risk["maf_collapses_apart"].sel(at)), bound_apart)
-                row["fit collapses apart"] = str(fits_apart.sel(at).item())
-                row["λ/λ_target collapses apart"] = (_ratio_cell(float(damage.ratio(apart=True).sel(at)), float(damage.bound_ratio(apart=True).sel(at))
-                                                                 if damage.bound is not None else math.nan) if target == target else "")
+            row = {"configuration": _label(labels), "limit state": str(state),
+                   "objective": f"{_percent(target)} in 50 yr" if target == target else "none"}
+            for way in ([False, True] if apart else [False]):
+                cells = _rate_cells(damage, at, way, target == target)
+                row.update({(_APART_COLUMNS[column] if way else column): cell for column, cell in cells.items()})
             rows.append(row)
-    both = (" and, with the runs beyond the model counted apart as collapses (FEMA P-58, by total probability: above), λ, the "
-            "credible runs' fit behind it and its ratio that way") if apart else ""
+    both = (" and, with the runs beyond the model counted apart as collapses (FEMA P-58, by total probability: above), the same "
+            "with the credible runs' fit behind it") if apart else ""
     return Table(
         key=f"table-limit-states-{name}",
         caption=(f"Experiment {name}: the limit states' mean annual frequency λ with its fit, the return period, per configuration, "
                  f"against each one's objective (λ/λ_target above 1: the objective is missed){both}"),
         frame=pd.DataFrame(rows).set_index(["configuration", "limit state"]),
-        note=("λ of a limit state no run reaches is 0. A step at the lowest stripe (every run, or every run above the lowest stripe, "
-              "reached it) says nothing of the shaking below the runs: its λ is given as the lower bound the stripes' fractions give "
-              "(≥, nothing counted below the lowest stripe) and its return period as an upper bound (≤). A lognormal 'not identified' "
-              f"has its median beyond the top stripe or β ≥ {UNIDENTIFIED_BETA:g}: the runs do not pin it, and its λ rests on the "
-              "lognormal's extrapolation."),
+        note=("λ is the fitted rate only where the fit is a lognormal the runs identify (its median within the stripes, β < "
+              f"{UNIDENTIFIED_BETA:g}). Any other fit does not pin λ: a step (no run reaches it, every run does, or the runs separate "
+              "at one stripe), a flat fraction (the counts do not rise with intensity), a lognormal not identified (its median beyond "
+              "the top stripe or β ≥ 0.8, so λ rests on the lognormal's extrapolation). For those the table gives instead, in "
+              "brackets, the bounds the stripes' fractions alone give λ, [λ⁻, λ⁺], for a fragility that does not fall with intensity "
+              "(λ⁻: each stripe's fraction held up to the next stripe, nothing below the lowest; λ⁺: each stripe's fraction held down "
+              "to the stripe below, the lowest's down to the hazard's lowest intensity, and every run reaching it beyond the top "
+              "stripe; the fractions' own sampling aside), and the return period and λ/λ_target that follow; such a limit state "
+              "misses its objective only where λ⁻ does. Every λ here is a point estimate from the runs, without an interval (no "
+              "resampling of the motions): a ratio within a few per cent of 1 does not decide its objective."),
     )
 
 
-def _rate_cell(rate: float, bound: float) -> str:
-    """λ in the table: the rate, or ``≥`` its bound where the fit is a step at the lowest stripe (``bound`` not NaN)."""
-    return f"≥ {bound:.3g}" if bound == bound else f"{rate:.3g}"
+_APART_COLUMNS = {"λ (1/yr)": "λ collapses apart (1/yr)", "once in (yr)": "once in, collapses apart (yr)", "fit": "fit collapses apart",
+                  "λ/λ_target": "λ/λ_target collapses apart"}
+"""The limit states table's columns of λ with the runs beyond the model counted apart, by the column as run."""
 
 
-def _period_cell(period: float, bound: float) -> str:
-    """The return period in the table: 1/λ, or ``≤`` 1/bound where λ is a bound."""
-    return (f"≤ {1.0 / bound:.3g}" if bound > 0 else "inf") if bound == bound else f"{period:.3g}"
+def _rate_cells(damage: StoreDamage, at: dict[str, Hashable], apart: bool, objective: bool) -> dict[str, str]:
+    """One treatment's cells of a limit state in one configuration: λ, the return period, the fit and λ/λ_target, each the
+    fit's where the runs pin it, else the bounds the stripes give (``[λ⁻, λ⁺]``)."""
+    rate = float((damage.risk["maf_collapses_apart"] if apart else damage.risk["maf"]).sel(at))
+    fit = str(damage.fits(apart).sel(at).item())
+    pinned, bounds = bool(damage.pinned(apart).sel(at).item()), damage.rate_bounds(apart)
+    if pinned or bounds is None:
+        ratio = float(damage.ratio(apart).sel(at))
+        return {"λ (1/yr)": f"{rate:.3g}", "once in (yr)": _period(rate), "fit": fit, "λ/λ_target": ratio_text(ratio) if objective else ""}
+    low, high = (float(bound.sel(at)) for bound in bounds)
+    ratios = damage.bound_ratios(apart)
+    span = f"[{ratio_text(float(ratios[0].sel(at)))}, {ratio_text(float(ratios[1].sel(at)))}]" if objective else ""
+    return {"λ (1/yr)": f"[{low:.3g}, {high:.3g}]", "once in (yr)": f"[{_period(high)}, {_period(low)}]", "fit": fit, "λ/λ_target": span}
 
 
-def _ratio_cell(ratio: float, bounded: float) -> str:
-    """λ/λ_target in the table, ``≥`` the bound's where λ is one."""
-    return f"≥ {ratio_text(bounded)}" if bounded == bounded else ratio_text(ratio)
+def _period(rate: float) -> str:
+    """A return period 1/λ (yr), ``inf`` for a rate of 0."""
+    return f"{1.0 / rate:.3g}" if rate > 0 else "inf"
 
 
 def ratio_text(ratio: float, digits: int = 3) -> str:

@@ -130,7 +130,7 @@ def design_paragraph(definition: StoreDefinition) -> Paragraph | None:
             if building.storey_height is not None:
                 period, code = definition.design_shears(building, g)
                 text += (f", the design's Ω0 V / W = {number(code[0] / weight, 3)} at T1 = {number(period, 3)} s "
-                         f"(its yield shears {numbers(code, 4)} N; the building's are {numbers(np.asarray(building.yield_force) / code, 3)} times those)")
+                         f"with yield shears {numbers(code, 4)} N, the building's {numbers(np.asarray(building.yield_force) / code, 3)} times those")
             strengths.setdefault(text, []).append(configuration.name)
     every = len(definition.configurations)
     return Paragraph(
@@ -426,7 +426,7 @@ def grid_paragraph(definition: StoreDefinition) -> Paragraph:
                + (f", and {len(simulated)} simulated for the stripes' scenarios" if simulated else "") + ")")
     return Paragraph(
         f"Experiment {definition.name}: {', '.join(axes) or 'a single configuration'}, under "
-        f"{motions} (Table of motions); g = {number(scene.g)} m/s². The studied building is "
+        f"{motions}, listed in the Table of motions; g = {number(scene.g)} m/s². The studied building is "
         f"{definition.experiment.studied}: the response whose moments are reported is its top-floor total displacement, and "
         f"it is also run alone on a fixed base under every motion ({references} reference runs). "
         f"{store.pound.provenance.cases_done} of {store.pound.provenance.cases_total} runs done."

@@ -350,8 +350,8 @@ def _consistency_text(consistency: dict[str, xr.Dataset], setting: Intensity) ->
         shown = "/".join("beyond the curve" if np.isnan(r) else f"{r:.2f}" for r in ratios)
         parts.append(f"{label} {shown}")
     return (f"Hazard consistency across the stripes: the site's hazard at its other measures recomputed from the stripes' motions as "
-            f"they ran, λ(Sa(T') > y) ≈ Σ_j P(Sa(T') > y | {setting.description} = x_j) Δλ(x_j) (P the fraction of stripe j's "
-            f"scaled motions above y, Δλ the site's rate of the stripe's bin), is {'; '.join(parts)} times the site's own curve at its "
+            f"they ran, λ(Sa(T') > y) ≈ Σ_j P(Sa(T') > y | {setting.description} = x_j) Δλ(x_j), with P the fraction of stripe j's "
+            f"scaled motions above y and Δλ the site's rate of the stripe's bin, is {'; '.join(parts)} times the site's own curve at its "
             f"intensities of {targets} in 50 years. A ratio near 1 says the stripes represent the site at that period; "
             "well above 1, the motions carry too much of that period's shaking for the site, below 1 too little.")
 
@@ -380,8 +380,8 @@ def _consistency_figure(name: str, consistency: dict[str, xr.Dataset], setting: 
     return FigureItem(
         f"intensity-consistency-{name}",
         f"Experiment {name}: the site's hazard curves at its other measures (black) against the ones recomputed from the stripes of "
-        f"{setting.description} (red: the fraction of every stripe's scaled motions above the intensity, weighted by the site's "
-        f"rate of the stripe's bin); dotted: the rates of {_targets_text()} in 50 years.",
+        f"{setting.description}, in red: the fraction of every stripe's scaled motions above the intensity, weighted by the site's "
+        f"rate of the stripe's bin; dotted: the rates of {_targets_text()} in 50 years.",
         figure,
     )
 

@@ -181,10 +181,12 @@ def design_summary_text(risk: StoreRisk, demands: StoreDemands | None = None, da
         meets = (f"Code rules meeting their own design level as a target in every configuration and level ({column.replace('meets, ', '') if 'upper' in column else 'estimate'}): "
                  f"{', '.join(met.index[met]) or 'none'}; not: {', '.join(met.index[~met]) or 'none'}.")
     rests = "; ".join(f"{key}: {value}" for key, value in {"hazard": f"{risk.hazard.describe()} ({_source(risk)})", **risk.assumptions,
-                                                          **_outside_stripes_assumption(risk), **_beyond_model(damage, collapse)}.items())
+                                                          **_outside_stripes_assumption(risk), **_beyond_model(damage, collapse),
+                                                          **_limit_states_assumption(damage)}.items())
     if damage is not None and damage.has_objectives():
-        judged = (f"Governing limit state (the largest λ/λ_target of the limit states, each against its own objective, the same at every "
-                  f"target; pounding at g* has 1): {_structural_governs(damage)}. At g*, what limits the separation: {limits}.")
+        judged = (f"Governing limit state (the largest λ/λ_target of the limit states beyond 1, each against its own objective, the same "
+                  f"at every target; pounding at g* has 1; each ratio in the Damage section): {_structural_governs(damage)}. At g*, what "
+                  f"limits the separation: {limits}.")
     else:
         judged = (f"Limit state judged (no structural limit state with an objective, so none is ranked against it; at g*, what limits "
                   f"the separation): {limits}.")
@@ -201,51 +203,84 @@ def _separation_limit(risk: StoreRisk, demands: StoreDemands | None, target: flo
         return pounding
     parts = []
     for _, clearance, over, every, worst, _ in reached:
-        parts.append(f"the base reaching the {clearance:.3g} m moat clearance (the bearing's stop) more often than the target allows in "
-                     f"{_where(over, every)}, once in {1 / worst:.3g}{_wall_interval(demands, clearance)} yr at worst")
-    others = "" if all(len(row[2]) == row[3] for row in reached) else ", and pounding between the buildings in the other configurations"
+        parts.append(f"the base reaching the moat wall at its {clearance:.3g} m clearance more often than the target allows in "
+                     f"{_where(over, every, _walled_noun(demands))}, once in {1 / worst:.3g}{_wall_interval(demands, clearance)} yr at worst")
+    others = "" if all(len(row[2]) == row[3] for row in reached) and demands.walled is None else ", and pounding between the buildings in the other configurations"
     return f"for {risk.target_text(target)}, " + "; ".join(parts) + others
 
 
-def _where(over: Sequence[dict[str, Hashable]], every: int) -> str:
-    """The configurations ``over`` of ``every``: ``every configuration``, or ``2 of 8 configurations (<labels>; <labels>)``."""
-    if len(over) == every:
+def _walled_noun(demands: StoreDemands) -> str:
+    """The configurations a moat wall's rows count: every one, or those with the wall where some have none."""
+    return "configurations" if demands.walled is None else "configurations with the wall"
+
+
+def _where(over: Sequence[dict[str, Hashable]], every: int, noun: str = "configurations") -> str:
+    """The configurations ``over`` of ``every``: ``every configuration``, or ``2 of 8 configurations (<labels>; <labels>)``
+    (``noun``: what the ``every`` are, e.g. the configurations with a wall)."""
+    if len(over) == every and noun == "configurations":
         return "every configuration"
-    return f"{len(over)} of {every} configurations (" + "; ".join(labels_text(labels) for labels in over) + ")"
+    return f"{len(over)} of {every} {noun} (" + "; ".join(labels_text(labels) for labels in over) + ")"
 
 
 def _structural_governs(damage: StoreDamage) -> str:
     """What governs among the buildings' own limit states (:meth:`~stochpound.risk.StoreDamage.governing`, the same at every target),
-    with their counts of configurations, and pounding at g* where none misses its objective. Where some run is beyond the
-    model, judged both ways (as run, and with those runs counted apart as collapses), saying whether they agree."""
+    with their counts of configurations, and pounding at g* where none misses its objective; a limit state whose fit the runs
+    do not pin governs only on the lower bound of λ the stripes give (said so), and those the runs leave open are named. Where
+    some run is beyond the model, judged both ways (as run, and with those runs counted apart as collapses), saying whether they
+    agree."""
     run = damage.governing_counts()
     apart = damage.governing_counts(apart=True) if damage.judged_both_ways() else None
     if apart is None:
         if not run[0]:
-            return f"{POUNDING_AT_G} in every configuration (no limit state beyond its objective)"
-        return f"{_listed(run, damage.governing_unidentified())} {_WHY}{_rest([run])}"
+            return f"{POUNDING_AT_G} in every configuration (no limit state beyond its objective){_left_open(damage, False)}"
+        return f"{_listed(run, damage.governing_unpinned())}{_rest([run])}{_left_open(damage, False)}{_base_note(damage, run, None, '; ')}"
     if not run[0] and not apart[0]:
-        return f"{POUNDING_AT_G} in every configuration, as run and with the runs beyond the model counted apart as collapses alike"
+        return (f"{POUNDING_AT_G} in every configuration, as run and with the runs beyond the model counted apart as collapses alike"
+                f"{_left_open(damage, False)}{_left_open(damage, True)}")
     count, configurations = damage.disagreements()
-    agree = ("the two treatments agree in every configuration" if not count else
+    agree = _base_note(damage, run, apart, "", "; ") + ("the two treatments agree in every configuration" if not count else
              f"the two treatments disagree in {count} of {configurations} configurations: what governs depends on whether the runs "
              "beyond the model are taken as computed or as collapses")
-    return (f"as run, {_listed(run, damage.governing_unidentified()) or 'no limit state beyond its objective'}{_rest([run])}; with "
-            f"the runs beyond the model counted apart as collapses, {_listed(apart, damage.governing_unidentified(apart=True)) or 'no limit state beyond its objective'}"
-            f"{_rest([apart])} {_WHY[:-1]}; {agree})")
+    return (f"as run, {_listed(run, damage.governing_unpinned()) or 'no limit state beyond its objective'}{_rest([run])}"
+            f"{_left_open(damage, False)}; with the runs beyond the model counted apart as collapses, "
+            f"{_listed(apart, damage.governing_unpinned(apart=True)) or 'no limit state beyond its objective'}{_rest([apart])}"
+            f"{_left_open(damage, True)}; {agree}")
 
 
 POUNDING_AT_G = "pounding at g*"
-_WHY = "(a limit state beyond its own objective, the largest λ/λ_target, where pounding at g* has 1: the Damage section)"
+
+
+def _base_note(damage: StoreDamage, run: tuple[dict[str, int], int], apart: tuple[dict[str, int], int] | None, head: str = "",
+               tail: str = "") -> str:
+    """Where a base-displacement limit state governs somewhere and some configurations have no moat wall: ``head``, what it is
+    there (the base passing the walled twin's clearance, no stop modelled), ``tail``; "" where not."""
+    governing = set(run[0]) | (set(apart[0]) if apart is not None else set())
+    named = [state.label for state in damage.limit_states if state.kind == "isolator_displacement" and state.label in governing]
+    walled, every = damage.wall_counts()
+    if not named or not every or walled == every:
+        return ""
+    return (f"{head}in the {counted(every - walled, 'configuration')} without the moat wall, {' and '.join(named)} is the base passing the walled "
+            f"twin's clearance, with no stop modelled there{tail}")
 
 
 def _listed(counted: tuple[dict[str, int], int], unpinned: Collection[str] = ()) -> str:
     """One treatment's governing limit states with their counts of configurations ("" where none governs), each of ``unpinned``
-    (:meth:`~stochpound.risk.StoreDamage.governing_unidentified`) said to rest on a fit the runs do not pin."""
+    (:meth:`~stochpound.risk.StoreDamage.governing_unpinned`) said to govern on the lower bound of λ the stripes alone give."""
     states, configurations = counted
     return ", ".join(f"{state} in {count} of {configurations} configurations"
-                     + (" (on a fit the runs do not pin: a lognormal not identified, a flat fraction or a bound, the Damage section's table)" if state in unpinned else "")
+                     + (" (on the lower bound of λ the stripes' fractions alone give: its fit does not pin λ)" if state in unpinned else "")
                      for state, count in states.items())
+
+
+def _left_open(damage: StoreDamage, apart: bool) -> str:
+    """``; left open by the runs …: <state> in <n> of <m> configurations`` for the limit states whose fit the runs do not pin and
+    whose bounds straddle their objective (:meth:`~stochpound.risk.StoreDamage.undecided_counts`), else ""."""
+    counts = damage.undecided_counts(apart)
+    if not counts:
+        return ""
+    every = damage.governing_counts(apart)[1]
+    return ("; left open by the runs, its fit not pinning λ and the bounds the stripes give either side of its objective: "
+            + ", ".join(f"{state} in {n} of {every} configurations" for state, n in counts.items()))
 
 
 def _rest(treatments: list[tuple[dict[str, int], int]]) -> str:
@@ -268,6 +303,16 @@ def _beyond_model(damage: StoreDamage | None, collapse: CollapseRisk | None = No
     return {"beyond the model": f"{beyond} of {runs} runs exceed a "
                                 f"{100 * MODEL_DRIFT_LIMIT:g} % storey drift, where the storeys' lack of strength loss and collapse makes their "
                                 f"response not credible; {counted}"}
+
+
+def _limit_states_assumption(damage: StoreDamage | None) -> dict[str, str]:
+    """What the governing limit state rests on: the limit states' capacities and objectives and how their λ is judged
+    ({} without limit states with objectives)."""
+    if damage is None or not damage.has_objectives():
+        return {}
+    return {"limit states": f"{len(damage.limit_states)} capacities, each with its objective, as the Damage section lists them; each λ "
+                            "from its fit where the runs pin it (a lognormal they identify), else judged on the lower bound the "
+                            "stripes' fractions give (a fragility that does not fall with intensity); point estimates without an interval"}
 
 
 def _source(risk: StoreRisk) -> str:
@@ -323,15 +368,22 @@ def moat_text(risk: StoreRisk, demands: StoreDemands | None) -> str:
         largest = " (the largest over the configurations)" if varies else ""
         sentences.append(f"The wall-free suite-mean peak base displacement (the D_M form, no torsion) at {100 * level:g} %/{risk.years:g} yr{largest} is "
                          f"{value:.3g} m and {verdict}.")
+    noun = _walled_noun(demands)
     for target, clearance, over, every, worst, rate in demands.wall_exceedances(risk.separation["target"].values, risk.years):
         allowed = 1.0 / rate
-        head = f"The base reaches the {clearance:.3g} m moat clearance once in {1 / worst:.3g}{_wall_interval(demands, clearance)} yr in its worst configuration"
+        head = (f"The base reaches the moat wall at its {clearance:.3g} m clearance once in {1 / worst:.3g}"
+                f"{_wall_interval(demands, clearance)} yr in its worst configuration with the wall")
         if not over:
-            verdict = f"less often than {risk.target_text(target)} allows (once in {allowed:.3g} yr) in every configuration: it does not limit the separation for this target"
+            verdict = (f"less often than {risk.target_text(target)} allows (once in {allowed:.3g} yr) in every configuration with "
+                       "the wall: it does not limit the separation for this target")
         else:
-            verdict = (f"more often than {risk.target_text(target)} allows (once in {allowed:.3g} yr) in {_where(over, every)}: there the clearance, "
-                       "not the gap, limits the separation for this target")
+            verdict = (f"more often than {risk.target_text(target)} allows (once in {allowed:.3g} yr) in {_where(over, every, noun)}: "
+                       "there the wall, not the gap, limits the separation for this target")
         sentences.append(f"{head}; {verdict}.")
+    if demands.walled is not None:
+        sentences.append("In the configurations without the wall no stop is modelled at the base (the bearing has none in these runs): "
+                         "the moat table's rows for them give how often their base passes the walled twin's clearance, with nothing "
+                         "there to reach, which limits nothing.")
     return " ".join(sentences)
 
 
@@ -420,9 +472,18 @@ def _measure_choice_blocks(name: str, risk: StoreRisk, choice: pd.DataFrame | No
 
 
 def _grid_note(risk: StoreRisk) -> str:
+    """What the printed g* is exactly: where the non-increasing fit of λ_P(g) on the (refined) gap grid crosses the target, and
+    how far the grid as first made would have put it."""
     gaps = risk.curve["gap"].values
     made = risk.grid or "log-spaced over the contact-free closures"
-    return f"g* is interpolated on a grid of {gaps.size} gaps from {gaps[0]:.3g} to {gaps[-1]:.3g} m ({made}); λ_P(g) is made non-increasing along it."
+    change = risk.coarse_change()
+    coarse = (f" Each gap's λ_P comes from its own fit of the same runs, so λ_P(g) is a step function of g (its steps at the runs' "
+              f"closures), rough between neighbouring gaps: read off the grid as first made, before its refinement, interpolating "
+              f"across those steps, g* differs from the value printed by up to {100 * change:.1f} % (largest over the configurations "
+              "and targets)." if change == change else "")
+    return (f"g* is interpolated on a grid of {gaps.size} gaps from {gaps[0]:.3g} to {gaps[-1]:.3g} m ({made}): it is where the "
+            "non-increasing fit of ln λ_P along the gaps, an isotonic regression with each gap weighted by the share of ln g it "
+            f"stands for, crosses the target, linearly in ln λ against ln g between the two gaps that bracket it.{coarse}")
 
 
 def _panel_grid(count: int, height: float = 2.6) -> tuple[Figure, list[Any]]:
@@ -618,7 +679,8 @@ def _demand_blocks(name: str, risk: StoreRisk, demands: StoreDemands | None) -> 
     if demands.moat is not None:
         blocks.append(Table(f"risk-moat-{name}", f"Experiment {name}: moat-wall contact as a limit state: the mean annual frequency with "
                             "which the studied building's base reaches the moat wall's clearance (peak base displacement ≥ clearance; "
-                            "before the first wall impact a run with the wall equals the run without), "
+                            "before the first wall impact a run with the wall equals the run without; in a configuration without the "
+                            "wall, the rate its base passes that clearance, where no stop is modelled: 'what it is'), "
                             f"{_with_interval(risk, 'interval', ' (of the return period and the probability too)')}", demands.moat_frame(),
                             formats={**_RATE_FORMATS, "λ (1/yr)": "{:.3g}", "λ lower": "{:.3g}", "λ upper": "{:.3g}",
                                      f"P in {demands.years:g} yr": "{:.3f}"}))
