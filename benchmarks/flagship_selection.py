@@ -1,7 +1,8 @@
-"""A flagship's stripes chosen, without running a case: ``python -m benchmarks flagship_selection FILE [--simulated N]``.
+"""A flagship's stripes chosen, without running a case: ``python -m benchmarks flagship_selection FILE [--simulated N] [--sampling S]``.
 
 Loads the experiment file (its scenario fitted, ``[site] simulated_motions``
-replaced by ``--simulated N`` where given), computes its selection (the fit,
+replaced by ``--simulated N`` where given, ``[site] simulated_sampling = S``
+added with ``--sampling``), computes its selection (the fit,
 the pool of records and simulated motions, pre-screened beyond
 ``stochpound.experiment._site.SCREEN_BASE`` motions, and every stripe's
 choice: :attr:`stochpound.experiment.Experiment.selection`) and prints, per
@@ -12,7 +13,10 @@ worst differences from the target in mean and standard deviation of ln Sa
 (with their periods): a markdown table, then the time the selection took
 (from the file's loading), the load at its start and the commit; with
 ``--picks FILE`` every stripe's chosen motions and scale factors as JSON
-(to compare two trees' selections).
+(to compare two trees' selections); with ``--parameters`` per stripe the
+medians of its chosen simulated motions' D5–95, t_mid, f_mid and Arias
+intensity (scaled by the square of the motion's scale factor), regenerated
+from their tables.
 """
 
 from __future__ import annotations
@@ -35,16 +39,54 @@ SIMULATED_LINE = re.compile(r"^simulated_motions\s*=\s*\d+", re.MULTILINE)
 """The ``[site] simulated_motions`` line of a flagship file."""
 
 
-def with_simulated(path: Path, count: int | None, folder: Path) -> Path:
-    """The experiment file with ``simulated_motions = count`` (a copy in ``folder``; the file itself for None)."""
-    if count is None:
+def with_simulated(path: Path, count: int | None, folder: Path, sampling: str | None = None) -> Path:
+    """The experiment file with ``simulated_motions = count`` and ``simulated_sampling = sampling`` (a copy in ``folder``; the file
+    itself when both are None)."""
+    if count is None and sampling is None:
         return path
     text = path.read_text()
-    if not SIMULATED_LINE.search(text):
+    found = SIMULATED_LINE.search(text)
+    if not found:
         raise SystemExit(f"{path.name}: no [site] simulated_motions line to replace")
+    line = f"simulated_motions = {count if count is not None else found.group(0).split('=')[1].strip()}"
+    if sampling is not None:
+        line += f'\nsimulated_sampling = "{sampling}"'
     copy = folder / path.name
-    copy.write_text(SIMULATED_LINE.sub(f"simulated_motions = {count}", text, count=1))
+    copy.write_text(SIMULATED_LINE.sub(line, text, count=1))
     return copy
+
+
+PARAMETERS = ("d5_95", "t_mid", "f_mid", "arias_intensity")
+"""The chosen simulated motions' parameters whose medians ``--parameters`` prints."""
+
+
+def parameter_rows(experiment) -> list[list[str]]:
+    """Per stripe, the medians of its chosen simulated motions' :data:`PARAMETERS` (Arias intensity × scale factor²)."""
+    from stochpound.store import canonical_json
+    from stochpound.experiment._site import table_scenario
+    from stochpound.motions import site_motions
+
+    chosen = experiment.selection
+    rows = []
+    for level, selection in zip(chosen.experiment_levels, chosen.selections):
+        labels = [str(m) for m in selection["motion"].values]
+        factors = dict(zip(labels, selection["scale_factor"].values))
+        groups: dict[str, list[str]] = {}
+        for label in labels:
+            if label in chosen.simulated:
+                table = chosen.simulated[label].motion
+                groups.setdefault(canonical_json({k: v for k, v in table.items() if k != "realization"}), []).append(label)
+        values: dict[str, list[float]] = {name: [] for name in PARAMETERS}
+        for group in groups.values():
+            table = chosen.simulated[group[0]].motion
+            shift = table["shift"] if "shift" in table else None
+            generated = site_motions(scenario=table_scenario(table), n=table["n"], seed=table["seed"], dt=table["dt"], model=table["model"],
+                                     realizations=[chosen.simulated[label].motion["realization"] for label in group], normal_shift=shift)
+            for name in PARAMETERS:
+                scale = np.array([factors[label] ** 2 for label in group]) if name == "arias_intensity" else 1.0
+                values[name].extend((generated[name].values * scale).tolist())
+        rows.append([f"{level:.3g}", str(len(values["d5_95"]))] + [f"{np.median(values[name]):.3g}" if values[name] else "-" for name in PARAMETERS])
+    return rows
 
 
 def worst(difference: np.ndarray, periods: np.ndarray) -> str:
@@ -77,22 +119,31 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("experiment", type=Path)
     parser.add_argument("--simulated", type=int, default=None, help="[site] simulated_motions (default: the file's)")
     parser.add_argument("--picks", type=Path, default=None, help="write every stripe's chosen motions and scale factors here (JSON)")
+    parser.add_argument("--sampling", choices=("scenario", "tilted"), default=None, help="[site] simulated_sampling (default: the file's)")
+    parser.add_argument("--parameters", action="store_true", help="print the medians of the chosen simulated motions' parameters")
     arguments = parser.parse_args(argv)
     from stochpound.experiment import load_experiment
 
     info = machine()  # the commit and load as the run starts
     with tempfile.TemporaryDirectory() as folder:
         began = time.time()
-        experiment = load_experiment(with_simulated(arguments.experiment, arguments.simulated, Path(folder)))
+        experiment = load_experiment(with_simulated(arguments.experiment, arguments.simulated, Path(folder), arguments.sampling))
         experiment.selection
         elapsed = time.time() - began
     count = experiment.intensity.selection.simulated.count
     header = ["level (g)", "ε", "N Φ(−ε)", "pool", "recorded + simulated", "largest share of an earthquake", "mean", "σ", ""]
-    print(f"{arguments.experiment.name}, N = {count}, {experiment.selection.periods[0]:.3g}-{experiment.selection.periods[-1]:.3g} s")
+    sampling = experiment.intensity.selection.simulated.sampling
+    print(f"{arguments.experiment.name}, N = {count} ({sampling}), {experiment.selection.periods[0]:.3g}-{experiment.selection.periods[-1]:.3g} s")
     print("| " + " | ".join(header) + " |")
     print("|" + "---|" * len(header))
     for row in stripe_rows(experiment, count):
         print("| " + " | ".join(row) + " |")
+    if arguments.parameters:
+        names = ["level (g)", "simulated chosen", "D5-95 (s)", "t_mid (s)", "f_mid (Hz)", "Arias intensity × SF² (m/s)"]
+        print("| " + " | ".join(names) + " |")
+        print("|" + "---|" * len(names))
+        for row in parameter_rows(experiment):
+            print("| " + " | ".join(row) + " |")
     if arguments.picks is not None:
         arguments.picks.write_text(json.dumps([{"motion": [str(m) for m in s["motion"].values], "scale_factor": s["scale_factor"].values.tolist()}
                                                for s in experiment.selection.selections]))
