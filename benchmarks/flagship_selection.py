@@ -79,7 +79,7 @@ def parameter_rows(experiment) -> list[list[str]]:
         values: dict[str, list[float]] = {name: [] for name in PARAMETERS}
         for group in groups.values():
             table = chosen.simulated[group[0]].motion
-            shift = table["shift"] if "shift" in table else None
+            shift = table["normal_shift"] if "normal_shift" in table else None
             generated = site_motions(scenario=table_scenario(table), n=table["n"], seed=table["seed"], dt=table["dt"], model=table["model"],
                                      realizations=[chosen.simulated[label].motion["realization"] for label in group], normal_shift=shift)
             for name in PARAMETERS:

@@ -46,6 +46,15 @@ the largest remainders), each rupture's motions from its own table shared by
 the stripes (:func:`rupture_sources`). With simulated motions the pool needs
 no records.
 
+``[site] simulated_sampling = "tilted"`` (with a given or fitted scenario;
+the default ``"scenario"`` adds nothing to the definition) gives every
+stripe its own N motions, importance-sampled toward its level
+(:func:`tilted_sources`): their parameter normals are drawn N(s, I) instead
+of N(0, I), s along the direction of the least-squares line of ln IM* on
+those normals (:func:`tilt_pilot`, fitted to the scenario's first
+:data:`TILT_PILOT` untilted motions) and long enough to centre ln IM* on the
+level; each motion's table keeps s (``normal_shift``). No pre-screen.
+
 ``[intensity] max_per_earthquake`` (at most that many motions of one
 earthquake in a stripe; no limit unless given) and ``exclude_pulses = true``
 (no record the metadata mark as a pulse) are the selection's rules
@@ -573,6 +582,17 @@ class Tilt:
     intercept: float
     slope: tuple[float, ...]
 
+    @classmethod
+    def fit(cls, normals: np.ndarray, response: np.ndarray) -> Tilt:
+        """The least-squares line of ``response`` [n] on ``normals`` [n, k], its normal equations summed exactly (math.fsum: the
+        tilt does not depend on how a BLAS splits its sums) and solved."""
+        design = np.column_stack([np.ones(len(response)), normals])
+        columns = range(design.shape[1])
+        gram = np.array([[math.fsum(design[:, i] * design[:, j]) for j in columns] for i in columns])
+        moment = np.array([math.fsum(design[:, i] * response) for i in columns])
+        coefficients = np.linalg.solve(gram, moment)
+        return cls(float(coefficients[0]), tuple(float(value) for value in coefficients[1:]))
+
     def shift(self, level: float) -> list[float]:
         """The shift of the parameter normals that centres ln IM* on ln ``level`` (g): t a, t = (ln level − b0)/|a|² (a the slope)."""
         slope = np.array(self.slope)
@@ -581,19 +601,13 @@ class Tilt:
 
 
 def tilt_pilot(setting: SimulatedMotions, scenario: Scenario, measure: str, period: Any, g: float) -> Tilt:
-    """The tilt of a scenario: ln IM* of its first :data:`TILT_PILOT` motions (untilted, seed ``setting.seed``: the untilted
-    pool's first ones) regressed on their parameter normals by least squares (the normal equations summed exactly, math.fsum,
-    so that the tilt does not depend on how a BLAS splits its sums).
-    """
+    """The tilt of a scenario: ln IM* (g) of its first :data:`TILT_PILOT` motions (untilted, seed ``setting.seed``: the untilted
+    pool's first ones) regressed on their parameter normals (:meth:`Tilt.fit`)."""
     from stochpound.motions import parameter_normals
 
     table = scenario_table(setting, scenario, TILT_PILOT, setting.seed)
     response = np.log(np.concatenate([intensity for _, _, intensity in table_chunks(table, measure, period, g)]))
-    design = np.column_stack([np.ones(TILT_PILOT), parameter_normals(setting.seed, range(TILT_PILOT), setting.model)])
-    gram = np.array([[math.fsum(design[:, i] * design[:, j]) for j in range(design.shape[1])] for i in range(design.shape[1])])
-    moment = np.array([math.fsum(design[:, i] * response) for i in range(design.shape[1])])
-    coefficients = np.linalg.solve(gram, moment)
-    return Tilt(float(coefficients[0]), tuple(float(value) for value in coefficients[1:]))
+    return Tilt.fit(parameter_normals(setting.seed, range(TILT_PILOT), setting.model), response)
 
 
 def tilted_seed(seed: int, stripe: int) -> int:
@@ -608,11 +622,11 @@ def tilted_sources(setting: SimulatedMotions, stripe: int, scenario: Scenario, l
     The stripe's ``count`` motions of its scenario, seed :func:`tilted_seed`, their parameter normals drawn N(s, I) instead of
     N(0, I), s = the scenario's :class:`Tilt` (its pilot, :func:`tilt_pilot`, computed once in ``tilts``) shifted to the level:
     a shift along the regression's direction, which leaves the normals' distribution given their projection on it unchanged
-    (docs/intensity.md, "A pool tilted to each stripe"). The table's ``shift`` (the s) regenerates a motion bit for bit.
+    (docs/intensity.md, "A pool tilted to each stripe"). The table's ``normal_shift`` (the s) regenerates a motion bit for bit.
     """
     if scenario not in tilts:
         tilts[scenario] = tilt_pilot(setting, scenario, measure, period, g)
-    table = {**scenario_table(setting, scenario, setting.count, tilted_seed(setting.seed, stripe)), "shift": tilts[scenario].shift(level)}
+    table = {**scenario_table(setting, scenario, setting.count, tilted_seed(setting.seed, stripe)), "normal_shift": tilts[scenario].shift(level)}
     return table_sources(table, stripe)
 
 
@@ -691,7 +705,7 @@ def table_accelerations(table: Mapping[str, float | str], realizations: Sequence
     from stochpound.motions import site_motions
 
     generated = site_motions(scenario=table_scenario(table), n=table["n"], seed=table["seed"], dt=table["dt"], model=table["model"],
-                             realizations=list(realizations), duration=duration, normal_shift=table["shift"] if "shift" in table else None)
+                             realizations=list(realizations), duration=duration, normal_shift=table["normal_shift"] if "normal_shift" in table else None)
     return generated["acceleration"].values
 
 
