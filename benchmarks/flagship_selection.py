@@ -14,9 +14,9 @@ worst differences from the target in mean and standard deviation of ln Sa
 (from the file's loading), the load at its start and the commit; with
 ``--picks FILE`` every stripe's chosen motions and scale factors as JSON
 (to compare two trees' selections); with ``--parameters`` per stripe the
-medians of its chosen simulated motions' D5–95, t_mid, f_mid and Arias
-intensity (scaled by the square of the motion's scale factor), regenerated
-from their tables.
+medians of its chosen simulated motions' model D5–95, t_mid and f_mid, and
+their own D5–95 and Arias intensity as run (scaled), regenerated from their
+tables.
 """
 
 from __future__ import annotations
@@ -40,53 +40,22 @@ SIMULATED_LINE = re.compile(r"^simulated_motions\s*=\s*\d+", re.MULTILINE)
 
 
 def with_simulated(path: Path, count: int | None, folder: Path, sampling: str | None = None) -> Path:
-    """The experiment file with ``simulated_motions = count`` and ``simulated_sampling = sampling`` (a copy in ``folder``; the file
-    itself when both are None)."""
+    """The experiment file with ``simulated_motions = count`` and, on the next line, ``simulated_sampling = sampling`` (a copy in
+    ``folder``; the file itself when both are None)."""
     if count is None and sampling is None:
         return path
     text = path.read_text()
     found = SIMULATED_LINE.search(text)
     if not found:
         raise SystemExit(f"{path.name}: no [site] simulated_motions line to replace")
-    line = f"simulated_motions = {count if count is not None else found.group(0).split('=')[1].strip()}"
     if sampling is not None:
-        line += f'\nsimulated_sampling = "{sampling}"'
+        end = text.index("\n", found.end())
+        text = f'{text[:end]}\nsimulated_sampling = "{sampling}"{text[end:]}'
+    if count is not None:
+        text = SIMULATED_LINE.sub(f"simulated_motions = {count}", text, count=1)
     copy = folder / path.name
-    copy.write_text(SIMULATED_LINE.sub(line, text, count=1))
+    copy.write_text(text)
     return copy
-
-
-PARAMETERS = ("d5_95", "t_mid", "f_mid", "arias_intensity")
-"""The chosen simulated motions' parameters whose medians ``--parameters`` prints."""
-
-
-def parameter_rows(experiment) -> list[list[str]]:
-    """Per stripe, the medians of its chosen simulated motions' :data:`PARAMETERS` (Arias intensity × scale factor²)."""
-    from stochpound.store import canonical_json
-    from stochpound.experiment._site import table_scenario
-    from stochpound.motions import site_motions
-
-    chosen = experiment.selection
-    rows = []
-    for level, selection in zip(chosen.experiment_levels, chosen.selections):
-        labels = [str(m) for m in selection["motion"].values]
-        factors = dict(zip(labels, selection["scale_factor"].values))
-        groups: dict[str, list[str]] = {}
-        for label in labels:
-            if label in chosen.simulated:
-                table = chosen.simulated[label].motion
-                groups.setdefault(canonical_json({k: v for k, v in table.items() if k != "realization"}), []).append(label)
-        values: dict[str, list[float]] = {name: [] for name in PARAMETERS}
-        for group in groups.values():
-            table = chosen.simulated[group[0]].motion
-            shift = table["normal_shift"] if "normal_shift" in table else None
-            generated = site_motions(scenario=table_scenario(table), n=table["n"], seed=table["seed"], dt=table["dt"], model=table["model"],
-                                     realizations=[chosen.simulated[label].motion["realization"] for label in group], normal_shift=shift)
-            for name in PARAMETERS:
-                scale = np.array([factors[label] ** 2 for label in group]) if name == "arias_intensity" else 1.0
-                values[name].extend((generated[name].values * scale).tolist())
-        rows.append([f"{level:.3g}", str(len(values["d5_95"]))] + [f"{np.median(values[name]):.3g}" if values[name] else "-" for name in PARAMETERS])
-    return rows
 
 
 def worst(difference: np.ndarray, periods: np.ndarray) -> str:
@@ -110,6 +79,44 @@ def stripe_rows(experiment, count: int) -> list[list[str]]:
         rows.append([f"{level:.3g}", f"{epsilon:.2f}", f"{count * ndtr(-epsilon):.1f}", str(selection.attrs["pool"]),
                      f"{selection.sizes['selected'] - simulated} + {simulated}", f"{share:.3f}", worst(mean, periods), worst(sigma, periods),
                      "**miss**" if miss else "met"])
+    return rows
+
+
+PARAMETERS = ("d5_95", "t_mid", "f_mid")
+"""The chosen simulated motions' model parameters whose medians ``--parameters`` prints, beside two measured on the motions."""
+COLUMNS = ["level (g)", "simulated chosen", "D5-95 (s)", "t_mid (s)", "f_mid (Hz)", "D5-95 measured (s)", "Arias intensity as run (m/s)"]
+"""The columns of ``--parameters``: the model's D5–95, t_mid and f_mid, the motion's own D5–95 and the Arias intensity of it scaled."""
+
+
+def parameter_rows(experiment) -> list[list[str]]:
+    """Per stripe, the medians of its chosen simulated motions' :data:`PARAMETERS`, their own D5–95 and Arias intensity (scaled by
+    their scale factors: as run), regenerated from their tables."""
+    from stochpound.experiment._site import table_scenario
+    from stochpound.motions import arias_intensity, significant_duration, site_motions
+    from stochpound.store import canonical_json
+
+    chosen = experiment.selection
+    rows = []
+    for level, selection in zip(chosen.experiment_levels, chosen.selections):
+        labels = [str(m) for m in selection["motion"].values]
+        factors = dict(zip(labels, selection["scale_factor"].values))
+        groups: dict[str, list[str]] = {}
+        for label in labels:
+            if label in chosen.simulated:
+                table = chosen.simulated[label].motion
+                groups.setdefault(canonical_json({k: v for k, v in table.items() if k != "realization"}), []).append(label)
+        values: dict[str, list[float]] = {name: [] for name in (*PARAMETERS, "duration", "arias")}
+        for group in groups.values():
+            table = chosen.simulated[group[0]].motion
+            shift = table["normal_shift"] if "normal_shift" in table else None
+            generated = site_motions(scenario=table_scenario(table), n=table["n"], seed=table["seed"], dt=table["dt"], model=table["model"],
+                                     realizations=[chosen.simulated[label].motion["realization"] for label in group], normal_shift=shift)
+            for name in PARAMETERS:
+                values[name].extend(generated[name].values.tolist())
+            for label, row in zip(group, generated["acceleration"].values):
+                values["duration"].append(significant_duration(row, table["dt"]))
+                values["arias"].append(arias_intensity(row * factors[label], table["dt"]))
+        rows.append([f"{level:.3g}", str(len(values["d5_95"]))] + [f"{np.median(v):.3g}" if v else "-" for v in values.values()])
     return rows
 
 
@@ -139,9 +146,8 @@ def main(argv: list[str] | None = None) -> int:
     for row in stripe_rows(experiment, count):
         print("| " + " | ".join(row) + " |")
     if arguments.parameters:
-        names = ["level (g)", "simulated chosen", "D5-95 (s)", "t_mid (s)", "f_mid (Hz)", "Arias intensity × SF² (m/s)"]
-        print("| " + " | ".join(names) + " |")
-        print("|" + "---|" * len(names))
+        print("| " + " | ".join(COLUMNS) + " |")
+        print("|" + "---|" * len(COLUMNS))
         for row in parameter_rows(experiment):
             print("| " + " | ".join(row) + " |")
     if arguments.picks is not None:

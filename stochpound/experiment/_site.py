@@ -109,6 +109,8 @@ SIMULATED_STREAM = 44
 """Entropy word of the stripes' pools of simulated motions of a site's ruptures (:func:`rupture_seed`)."""
 PER_LEVEL = ("magnitude", "distance_km", "mechanism")
 """``[site]`` fields that take one value per level."""
+SimulatedValue = float | int | str | list[float]
+"""A value of a simulated motions' table (its ``normal_shift`` the one list)."""
 SAMPLINGS = ("scenario", "tilted")
 """``[site] simulated_sampling``: the scenario's motions (one pool for its stripes), or each stripe's own, tilted to its level."""
 TILT_PILOT = 2000
@@ -559,13 +561,13 @@ def simulated_sources(setting: SimulatedMotions | None, stripe: int, scenario: S
     return table_sources(scenario_table(setting, scenario, setting.count, setting.seed), stripe)
 
 
-def scenario_table(setting: SimulatedMotions, scenario: Scenario, n: int, seed: int) -> dict[str, Any]:
+def scenario_table(setting: SimulatedMotions, scenario: Scenario, n: int, seed: int) -> dict[str, SimulatedValue]:
     """The table of ``n`` simulated motions of a scenario and seed (no realization): what regenerates them with one."""
     return {"type": "site_motions", **{key: getattr(scenario, key) for key in SITE_FIELDS}, "n": n, "seed": seed, "dt": setting.dt,
             "model": setting.model, "calibration": setting.calibration}
 
 
-def table_sources(table: Mapping[str, Any], stripe: int) -> dict[str, MotionSource]:
+def table_sources(table: Mapping[str, SimulatedValue], stripe: int) -> dict[str, MotionSource]:
     """The motions of a table as a stripe's motion sources, by label (``simulated <stripe>.<i>``, from 1)."""
     count = int(table["n"])
     labels = [f"simulated {stripe + 1}.{i:0{len(str(count - 1))}d}" for i in range(count)]
@@ -731,7 +733,7 @@ def simulated_pool(table: Mapping[str, float | str], periods: np.ndarray, measur
     return xr.concat(parts, "motion")
 
 
-def table_chunks(table: Mapping[str, Any], measure: str, period: Any, g: float) -> Iterator[tuple[np.ndarray, np.ndarray, np.ndarray]]:
+def table_chunks(table: Mapping[str, SimulatedValue], measure: str, period: Any, g: float) -> Iterator[tuple[np.ndarray, np.ndarray, np.ndarray]]:
     """Every motion of a simulated motions' table, :data:`SIMULATED_CHUNK` at a time: the realizations, their accelerations (m/s²)
     and conditioning measure (g; :func:`~stochpound.motions.pool_intensity`).
 
