@@ -2,7 +2,7 @@
 
 Loads the experiment file (its scenario fitted, ``[site] simulated_motions``
 replaced by ``--simulated N`` where given, ``[site] simulated_sampling = S``
-added with ``--sampling``), computes its selection (the fit,
+added with ``--sampling``, ``[intensity] seed`` replaced by ``--seed``), computes its selection (the fit,
 the pool of records and simulated motions, pre-screened beyond
 ``stochpound.experiment._site.SCREEN_BASE`` motions, and every stripe's
 choice: :attr:`stochpound.experiment.Experiment.selection`) and prints, per
@@ -37,12 +37,14 @@ from benchmarks.report import machine
 
 SIMULATED_LINE = re.compile(r"^simulated_motions\s*=\s*\d+", re.MULTILINE)
 """The ``[site] simulated_motions`` line of a flagship file."""
+SEED_LINE = re.compile(r"^seed\s*=\s*\d+", re.MULTILINE)
+"""The ``[intensity] seed`` line of a flagship file (its only ``seed``)."""
 
 
-def with_simulated(path: Path, count: int | None, folder: Path, sampling: str | None = None) -> Path:
-    """The experiment file with ``simulated_motions = count`` and, on the next line, ``simulated_sampling = sampling`` (a copy in
-    ``folder``; the file itself when both are None)."""
-    if count is None and sampling is None:
+def with_simulated(path: Path, count: int | None, folder: Path, sampling: str | None = None, seed: int | None = None) -> Path:
+    """The experiment file with ``simulated_motions = count``, on the next line ``simulated_sampling = sampling``, and ``seed = seed``
+    (a copy in ``folder``; the file itself when all are None)."""
+    if count is None and sampling is None and seed is None:
         return path
     text = path.read_text()
     found = SIMULATED_LINE.search(text)
@@ -53,6 +55,10 @@ def with_simulated(path: Path, count: int | None, folder: Path, sampling: str | 
         text = f'{text[:end]}\nsimulated_sampling = "{sampling}"{text[end:]}'
     if count is not None:
         text = SIMULATED_LINE.sub(f"simulated_motions = {count}", text, count=1)
+    if seed is not None:
+        if len(SEED_LINE.findall(text)) != 1:
+            raise SystemExit(f"{path.name}: not one seed line to replace")
+        text = SEED_LINE.sub(f"seed = {seed}", text)
     copy = folder / path.name
     copy.write_text(text)
     return copy
@@ -127,6 +133,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--simulated", type=int, default=None, help="[site] simulated_motions (default: the file's)")
     parser.add_argument("--picks", type=Path, default=None, help="write every stripe's chosen motions and scale factors here (JSON)")
     parser.add_argument("--sampling", choices=("scenario", "tilted"), default=None, help="[site] simulated_sampling (default: the file's)")
+    parser.add_argument("--seed", type=int, default=None, help="[intensity] seed (default: the file's)")
     parser.add_argument("--parameters", action="store_true", help="print the medians of the chosen simulated motions' parameters")
     arguments = parser.parse_args(argv)
     from stochpound.experiment import load_experiment
@@ -134,13 +141,13 @@ def main(argv: list[str] | None = None) -> int:
     info = machine()  # the commit and load as the run starts
     with tempfile.TemporaryDirectory() as folder:
         began = time.time()
-        experiment = load_experiment(with_simulated(arguments.experiment, arguments.simulated, Path(folder), arguments.sampling))
+        experiment = load_experiment(with_simulated(arguments.experiment, arguments.simulated, Path(folder), arguments.sampling, arguments.seed))
         experiment.selection
         elapsed = time.time() - began
     count = experiment.intensity.selection.simulated.count
     header = ["level (g)", "ε", "N Φ(−ε)", "pool", "recorded + simulated", "largest share of an earthquake", "mean", "σ", ""]
     sampling = experiment.intensity.selection.simulated.sampling
-    print(f"{arguments.experiment.name}, N = {count} ({sampling}), {experiment.selection.periods[0]:.3g}-{experiment.selection.periods[-1]:.3g} s")
+    print(f"{arguments.experiment.name}, N = {count} ({sampling}), seed {experiment.intensity.selection.seed}, {experiment.selection.periods[0]:.3g}-{experiment.selection.periods[-1]:.3g} s")
     print("| " + " | ".join(header) + " |")
     print("|" + "---|" * len(header))
     for row in stripe_rows(experiment, count):
