@@ -9,6 +9,8 @@ noise at each sample: the model is in ``stochpound.motions._site_model``).
 Motion i of a seed uses the generator of realization i
 (:func:`~stochpound.motions.realization_rng`): its 7 parameter normals, its
 shape layer's 11 (the hazard-compatible model only), then its noise.
+``site_motions(..., normal_shift=s)`` adds s to every motion's parameter
+normals (importance sampling: the experiments' pools tilted to each stripe).
 """
 
 from __future__ import annotations
