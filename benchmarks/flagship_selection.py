@@ -70,8 +70,8 @@ def worst(difference: np.ndarray, periods: np.ndarray) -> str:
     return f"{difference[i]:+.3f} ({periods[i]:.3g} s)"
 
 
-def stripe_rows(experiment, count: int) -> list[list[str]]:
-    """One row per stripe (module docstring)."""
+def stripe_rows(experiment, count: int, tilted: bool = False) -> list[list[str]]:
+    """One row per stripe (module docstring); N Φ(−ε) is "-" for a tilted pool (each stripe's own N, centred on its level)."""
     chosen = experiment.selection
     rows = []
     for level, selection, target in zip(chosen.experiment_levels, chosen.selections, chosen.targets):
@@ -82,7 +82,7 @@ def stripe_rows(experiment, count: int) -> list[list[str]]:
         simulated = int(sum(str(m) in chosen.simulated for m in selection["motion"].values))
         share = max(Counter(str(e) for e in selection["earthquake"].values).values()) / selection.sizes["selected"]
         miss = max(np.max(np.abs(mean)), np.max(np.abs(sigma))) > 0.1
-        rows.append([f"{level:.3g}", f"{epsilon:.2f}", f"{count * ndtr(-epsilon):.1f}", str(selection.attrs["pool"]),
+        rows.append([f"{level:.3g}", f"{epsilon:.2f}", "-" if tilted else f"{count * ndtr(-epsilon):.1f}", str(selection.attrs["pool"]),
                      f"{selection.sizes['selected'] - simulated} + {simulated}", f"{share:.3f}", worst(mean, periods), worst(sigma, periods),
                      "**miss**" if miss else "met"])
     return rows
@@ -150,7 +150,7 @@ def main(argv: list[str] | None = None) -> int:
     print(f"{arguments.experiment.name}, N = {count} ({sampling}), seed {experiment.intensity.selection.seed}, {experiment.selection.periods[0]:.3g}-{experiment.selection.periods[-1]:.3g} s")
     print("| " + " | ".join(header) + " |")
     print("|" + "---|" * len(header))
-    for row in stripe_rows(experiment, count):
+    for row in stripe_rows(experiment, count, sampling == "tilted"):
         print("| " + " | ".join(row) + " |")
     if arguments.parameters:
         print("| " + " | ".join(COLUMNS) + " |")
