@@ -151,7 +151,7 @@ def site_motions(magnitude: float | None = None, distance_km: float | None = Non
         hazard-compatible model it may carry a geometry (R_JB, R_x, Z_tor, dip, basin depths), which the
         NGA-West2 medians and σ its spectral-shape layer follows take (a hanging-wall site, say).
     normal_shift : list of float, optional
-        Added to every motion's parameter normals (its first 7, and its 11
+        Added to every motion's parameter normals (its first 7, and its 12
         shape normals with the hazard-compatible model: one value each) before
         they give its parameters; the noise is unchanged. The motions are then
         drawn with those normals N(shift, I) instead of N(0, I): importance
