@@ -45,3 +45,4 @@ def test_a_stripe_s_row_gives_its_counts_shares_and_worst_misses():
     row = stripe_rows(type("E", (), {"selection": _Selection()})(), 1000)[0]
     assert row == ["0.5", "2.00", "22.8", "2100", "3 + 1", "0.500", "+0.150 (0.1 s)", "-0.050 (0.1 s)", "**miss**"]
     assert worst(np.array([0.01, -0.09]), np.array([1.0, 2.0])) == "-0.090 (2 s)"
+    assert stripe_rows(type("E", (), {"selection": _Selection()})(), 1000, tilted=True)[0][2] == "-"

@@ -46,6 +46,15 @@ the largest remainders), each rupture's motions from its own table shared by
 the stripes (:func:`rupture_sources`). With simulated motions the pool needs
 no records.
 
+``[site] simulated_sampling = "tilted"`` (with a given or fitted scenario;
+the default ``"scenario"`` adds nothing to the definition) gives every
+stripe its own N motions, importance-sampled toward its level
+(:func:`tilted_sources`): their parameter normals are drawn N(s, I) instead
+of N(0, I), s along the direction of the least-squares line of ln IM* on
+those normals (:func:`tilt_pilot`, fitted to the scenario's first
+:data:`TILT_PILOT` untilted motions) and long enough to centre ln IM* on the
+level; each motion's table keeps s (``normal_shift``). No pre-screen.
+
 ``[intensity] max_per_earthquake`` (at most that many motions of one
 earthquake in a stripe; no limit unless given) and ``exclude_pulses = true``
 (no record the metadata mark as a pulse) are the selection's rules
@@ -59,8 +68,8 @@ are unchanged.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
-from collections.abc import Sequence
+import math
+from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
 from pathlib import Path
@@ -100,6 +109,14 @@ SIMULATED_STREAM = 44
 """Entropy word of the stripes' pools of simulated motions of a site's ruptures (:func:`rupture_seed`)."""
 PER_LEVEL = ("magnitude", "distance_km", "mechanism")
 """``[site]`` fields that take one value per level."""
+SimulatedValue = float | int | str | list[float]
+"""A value of a simulated motions' table (its ``normal_shift`` the one list)."""
+SAMPLINGS = ("scenario", "tilted")
+"""``[site] simulated_sampling``: the scenario's motions (one pool for its stripes), or each stripe's own, tilted to its level."""
+TILT_PILOT = 2000
+"""Motions of the scenario (untilted, the selection's seed) whose conditioning measure gives the tilt's direction (:func:`tilt_pilot`)."""
+TILTED_STREAM = 45
+"""Entropy word of the stripes' tilted pools (:func:`tilted_seed`)."""
 
 
 def parse_selection(table: Mapping[str, Any], site: Any, levels: list[float], setting: Intensity,
@@ -188,13 +205,18 @@ def parse_simulated(site: Mapping[str, Any], seed: int) -> SimulatedMotions | No
     from stochpound._errors import SiteError
     from stochpound.motions import site_model_provenance
 
+    sampling = toml_fields.TomlTable(site, "site", raises=SiteError).string("simulated_sampling", SAMPLINGS[0], choices=SAMPLINGS)
     if "simulated_motions" not in site:
+        if "simulated_sampling" in site:
+            raise SiteError("site.simulated_sampling: only with site.simulated_motions (how the pool's simulated motions are drawn)")
         return None
     count = site["simulated_motions"]
     if not isinstance(count, int) or isinstance(count, bool) or not 1 <= count <= SIMULATED_LIMIT:
         raise SiteError(f"site.simulated_motions: simulated motions a stripe in its pool (of its scenario, or of the site's causal ruptures), "
                         f"an integer within 1-{SIMULATED_LIMIT}, got {count!r}")
-    return SimulatedMotions(count, SIMULATED_MODEL, site_model_provenance(SIMULATED_MODEL), seed, SIMULATED_DT)
+    if sampling == "tilted" and "ruptures" in site:
+        raise SiteError('site.simulated_sampling: "tilted" takes a given or fitted scenario, not a site of ruptures (use "scenario")')
+    return SimulatedMotions(count, SIMULATED_MODEL, site_model_provenance(SIMULATED_MODEL), seed, SIMULATED_DT, sampling)
 
 
 def rupture_site(site: Mapping[str, Any], base_dir: Path) -> Any:
@@ -208,7 +230,7 @@ def rupture_site(site: Mapping[str, Any], base_dir: Path) -> Any:
     """
     from stochpound.hazard import RUPTURE_SITE_FIELDS, named_rupture_site
 
-    toml_fields.reject_unknown(site, {"ruptures", "simulated_motions", *RUPTURE_SITE_FIELDS}, "site")
+    toml_fields.reject_unknown(site, {"ruptures", "simulated_motions", "simulated_sampling", *RUPTURE_SITE_FIELDS}, "site")
     return named_rupture_site(site["ruptures"], base_dir, {key: site[key] for key in RUPTURE_SITE_FIELDS if key in site}, "site")
 
 
@@ -260,7 +282,7 @@ def parse_site(site: Any, levels: list[float], measure: Measure) -> tuple[Scenar
         return fitted_site(site, levels, measure)
     if "curves" in site:
         raise SiteError('site.curves: only with site.scenario = "fitted"')
-    toml_fields.reject_unknown(site, {*SITE_FIELDS, "scenario", "simulated_motions"}, "site")
+    toml_fields.reject_unknown(site, {*SITE_FIELDS, "scenario", "simulated_motions", "simulated_sampling"}, "site")
     columns: dict[str, list[Any]] = {}
     for key in SITE_FIELDS:
         if key not in site:
@@ -293,7 +315,7 @@ def fitted_site(site: Mapping[str, Any], levels: list[float], conditioning_measu
     from stochpound.analysis import HazardCurve, bundled_curves, bundled_measure, stripe_rate_weights
     from stochpound.motions import fit_levels, fit_scenarios
 
-    toml_fields.reject_unknown(site, {"scenario", "curves", "vs30", "mechanism", "simulated_motions"}, "site")
+    toml_fields.reject_unknown(site, {"scenario", "curves", "vs30", "mechanism", "simulated_motions", "simulated_sampling"}, "site")
     for key in ("vs30", "mechanism"):
         if key not in site:
             raise SiteError(f"site.{key}: missing (the site's Vs30 and the mechanism of its faults)")
@@ -468,11 +490,18 @@ def stripe_selections(experiment: ExperimentGrid) -> StripeSelections:
         site = RuptureSite.from_entry(chosen.ruptures)
         allotment = rupture_allotment(site, measure, period, list(intensity.levels), chosen.simulated.count)
     generated: dict[str, xr.Dataset] = {}  # the simulated pool of each distinct table: stripes of one table share it, relabelled
+    tilts: dict[Scenario, Tilt] = {}  # the tilt of each scenario of a tilted pool (its pilot's regression)
     for stripe, (level, scenario, target) in enumerate(zip(intensity.levels, chosen.scenarios, stripe_targets)):
-        groups = (rupture_sources(chosen.simulated, stripe, site, allotment) if allotment is not None
-                  else [simulated_sources(chosen.simulated, stripe, scenario)])
+        tilted = chosen.simulated is not None and chosen.simulated.sampling == "tilted"
+        try:
+            groups = (rupture_sources(chosen.simulated, stripe, site, allotment) if allotment is not None
+                      else [tilted_sources(chosen.simulated, stripe, scenario, level, tilts, measure, period, g)] if tilted
+                      else [simulated_sources(chosen.simulated, stripe, scenario)])
+        except SiteError as error:  # a scenario outside the site-motion model's calibrated range (the tilt's pilot)
+            raise ExperimentError(f"site.simulated_motions: the stripe {level:g} g's scenario: {error}") from None
         parts = [] if pool is None else [pool]
-        screen = None if allotment is not None else screen_level(chosen.simulated, stripe, chosen.scenarios, stripe_targets, measure, period)
+        screen = (None if allotment is not None or tilted
+                  else screen_level(chosen.simulated, stripe, chosen.scenarios, stripe_targets, measure, period))
         for group in filter(None, groups):
             try:
                 parts.append(shared_simulated_pool(group, periods, measure, period, g, generated, screen))
@@ -529,11 +558,78 @@ def simulated_sources(setting: SimulatedMotions | None, stripe: int, scenario: S
     """
     if setting is None:
         return {}
-    count = setting.count
-    table = {"type": "site_motions", **{key: getattr(scenario, key) for key in SITE_FIELDS}, "n": count, "seed": setting.seed, "dt": setting.dt,
-             "model": setting.model, "calibration": setting.calibration}
+    return table_sources(scenario_table(setting, scenario, setting.count, setting.seed), stripe)
+
+
+def scenario_table(setting: SimulatedMotions, scenario: Scenario, n: int, seed: int) -> dict[str, SimulatedValue]:
+    """The table of ``n`` simulated motions of a scenario and seed (no realization): what regenerates them with one."""
+    return {"type": "site_motions", **{key: getattr(scenario, key) for key in SITE_FIELDS}, "n": n, "seed": seed, "dt": setting.dt,
+            "model": setting.model, "calibration": setting.calibration}
+
+
+def table_sources(table: Mapping[str, SimulatedValue], stripe: int) -> dict[str, MotionSource]:
+    """The motions of a table as a stripe's motion sources, by label (``simulated <stripe>.<i>``, from 1)."""
+    count = int(table["n"])
     labels = [f"simulated {stripe + 1}.{i:0{len(str(count - 1))}d}" for i in range(count)]
     return {label: MotionSource(label, SIMULATED, SIMULATED_FIELD, {**table, "realization": i}) for i, label in enumerate(labels)}
+
+
+@dataclass(frozen=True)
+class Tilt:
+    """The least-squares line of a scenario's ln conditioning measure on its motions' parameter normals z (:func:`tilt_pilot`).
+
+    ln IM* ≈ ``intercept`` + ``slope`` · z (IM* in g; ``slope``: one per parameter normal of the model).
+    """
+
+    intercept: float
+    slope: tuple[float, ...]
+
+    @classmethod
+    def fit(cls, normals: np.ndarray, response: np.ndarray) -> Tilt:
+        """The least-squares line of ``response`` [n] on ``normals`` [n, k], its normal equations summed exactly (math.fsum: the
+        tilt does not depend on how a BLAS splits its sums) and solved."""
+        design = np.column_stack([np.ones(len(response)), normals])
+        columns = range(design.shape[1])
+        gram = np.array([[math.fsum(design[:, i] * design[:, j]) for j in columns] for i in columns])
+        moment = np.array([math.fsum(design[:, i] * response) for i in columns])
+        coefficients = np.linalg.solve(gram, moment)
+        return cls(float(coefficients[0]), tuple(float(value) for value in coefficients[1:]))
+
+    def shift(self, level: float) -> list[float]:
+        """The shift of the parameter normals that centres ln IM* on ln ``level`` (g): t a, t = (ln level − b0)/|a|² (a the slope)."""
+        slope = np.array(self.slope)
+        t = (math.log(level) - self.intercept) / math.fsum(slope * slope)
+        return [float(value) for value in t * slope]
+
+
+def tilt_pilot(setting: SimulatedMotions, scenario: Scenario, measure: str, period: Any, g: float) -> Tilt:
+    """The tilt of a scenario: ln IM* (g) of its first :data:`TILT_PILOT` motions (untilted, seed ``setting.seed``: the untilted
+    pool's first ones) regressed on their parameter normals (:meth:`Tilt.fit`)."""
+    from stochpound.motions import parameter_normals
+
+    table = scenario_table(setting, scenario, TILT_PILOT, setting.seed)
+    response = np.log(np.concatenate([intensity for _, _, intensity in table_chunks(table, measure, period, g)]))
+    return Tilt.fit(parameter_normals(setting.seed, range(TILT_PILOT), setting.model), response)
+
+
+def tilted_seed(seed: int, stripe: int) -> int:
+    """The seed of stripe ``stripe``'s tilted motions (a stream apart from the scenario's and the ruptures')."""
+    return int(np.random.SeedSequence([seed, TILTED_STREAM, stripe]).generate_state(1)[0])
+
+
+def tilted_sources(setting: SimulatedMotions, stripe: int, scenario: Scenario, level: float, tilts: dict[Scenario, Tilt], measure: str,
+                   period: Any, g: float) -> dict[str, MotionSource]:
+    """The tilted simulated motions of a stripe's pool (``[site] simulated_sampling = "tilted"``), by label (``simulated <stripe>.<i>``).
+
+    The stripe's ``count`` motions of its scenario, seed :func:`tilted_seed`, their parameter normals drawn N(s, I) instead of
+    N(0, I), s = the scenario's :class:`Tilt` (its pilot, :func:`tilt_pilot`, computed once in ``tilts``) shifted to the level:
+    a shift along the regression's direction, which leaves the normals' distribution given their projection on it unchanged
+    (docs/intensity.md, "A pool tilted to each stripe"). The table's ``normal_shift`` (the s) regenerates a motion bit for bit.
+    """
+    if scenario not in tilts:
+        tilts[scenario] = tilt_pilot(setting, scenario, measure, period, g)
+    table = {**scenario_table(setting, scenario, setting.count, tilted_seed(setting.seed, stripe)), "normal_shift": tilts[scenario].shift(level)}
+    return table_sources(table, stripe)
 
 
 def rupture_allotment(site: Any, measure: str, period: Any, levels: list[float], count: int) -> np.ndarray:
@@ -611,7 +707,7 @@ def table_accelerations(table: Mapping[str, float | str], realizations: Sequence
     from stochpound.motions import site_motions
 
     generated = site_motions(scenario=table_scenario(table), n=table["n"], seed=table["seed"], dt=table["dt"], model=table["model"],
-                             realizations=list(realizations), duration=duration)
+                             realizations=list(realizations), duration=duration, normal_shift=table["normal_shift"] if "normal_shift" in table else None)
     return generated["acceleration"].values
 
 
@@ -625,21 +721,34 @@ def simulated_pool(table: Mapping[str, float | str], periods: np.ndarray, measur
     pre-screen, :func:`screen_level`), a realization from :data:`SCREEN_BASE` on joins the pool only if its own conditioning
     measure reaches ``screen``: that measure is computed for every motion, the whole spectrum for those that join alone.
     """
-    from stochpound.motions import array_pool, pool_intensity
+    from stochpound.motions import array_pool
 
-    n, dt = int(table["n"]), float(table["dt"])
-    parts, duration = [], None
-    for start in range(0, n, SIMULATED_CHUNK):
-        rows = np.arange(start, min(start + SIMULATED_CHUNK, n))
-        accelerations = table_accelerations(table, rows.tolist(), duration)
-        window = (accelerations.shape[1] - 1) * dt  # n_time = round(window / dt) + 1 again
-        duration = window if window <= SIMULATED_WINDOW_LIMIT else None
-        intensity = pool_intensity(accelerations, dt, measure, period, MODEL_DAMPING, g)
+    dt = float(table["dt"])
+    parts = []
+    for rows, accelerations, intensity in table_chunks(table, measure, period, g):
         kept = np.flatnonzero((rows < SCREEN_BASE) | (intensity >= screen)) if screen is not None else np.arange(rows.size)
         if kept.size:
             parts.append(array_pool(accelerations[kept], dt, [str(i) for i in rows[kept]], periods, measure, period, MODEL_DAMPING, g,
                                     intensity=intensity[kept], magnitude=table["magnitude"], distance_km=table["distance_km"], vs30=table["vs30"]))
     return xr.concat(parts, "motion")
+
+
+def table_chunks(table: Mapping[str, SimulatedValue], measure: str, period: Any, g: float) -> Iterator[tuple[np.ndarray, np.ndarray, np.ndarray]]:
+    """Every motion of a simulated motions' table, :data:`SIMULATED_CHUNK` at a time: the realizations, their accelerations (m/s²)
+    and conditioning measure (g; :func:`~stochpound.motions.pool_intensity`).
+
+    The first chunk finds the window of the table's ``n`` motions; the others are drawn with it given (:func:`simulated_pool`).
+    """
+    from stochpound.motions import pool_intensity
+
+    n, dt = int(table["n"]), float(table["dt"])
+    duration = None
+    for start in range(0, n, SIMULATED_CHUNK):
+        rows = np.arange(start, min(start + SIMULATED_CHUNK, n))
+        accelerations = table_accelerations(table, rows.tolist(), duration)
+        window = (accelerations.shape[1] - 1) * dt  # n_time = round(window / dt) + 1 again
+        duration = window if window <= SIMULATED_WINDOW_LIMIT else None
+        yield rows, accelerations, pool_intensity(accelerations, dt, measure, period, MODEL_DAMPING, g)
 
 
 def screen_level(setting: SimulatedMotions | None, stripe: int, scenarios: Sequence[Scenario], targets: Sequence[xr.Dataset], measure: str,

@@ -170,7 +170,7 @@ _MOTION_KEYS = {
     "harmonic": {"type", "amplitude", "omega", "phase", "duration", "dt"},
     "constant": {"type", "acceleration", "duration", "dt"},
     "site_motions": {"type", "magnitude", "distance_km", "vs30", "mechanism", "n", "seed", "dt", "model", "calibration", "realization", "scale",
-                     "rupture", "distance_jb_km", "distance_x_km", "ztor_km", "dip", "z1p0_km", "z2p5_km"},
+                     "normal_shift", "rupture", "distance_jb_km", "distance_x_km", "ztor_km", "dip", "z1p0_km", "z2p5_km"},
 }
 
 
@@ -227,7 +227,8 @@ def _site_motion(table: TomlTable, per_sample: int) -> SampledMotion:
     (:func:`~stochpound.motions.site_model_provenance`): a table written with
     another calibration cannot regenerate its motion. A rupture's geometry
     (:data:`~stochpound.motions.GEOMETRY_FIELDS`), when given, is the
-    scenario's; ``rupture`` names the rupture (provenance only).
+    scenario's; ``rupture`` names the rupture (provenance only); ``normal_shift``, when given, the shift of its parameter
+    normals (a motion of a tilted pool, :func:`~stochpound.motions.site_motions`).
     """
     from stochpound._errors import SiteError
     from stochpound.motions import GEOMETRY_FIELDS, Scenario, site_model_provenance, site_motions
@@ -248,7 +249,7 @@ def _site_motion(table: TomlTable, per_sample: int) -> SampledMotion:
         table.string("rupture", "")
         scenario = Scenario(**{key: table.raw(key) for key in ("magnitude", "distance_km", "vs30", "mechanism", *GEOMETRY_FIELDS) if key in table})
         generated = site_motions(scenario=scenario, n=n, seed=table.raw("seed"), dt=table.raw("dt", 0.01), model=model,
-                                 realizations=[realization])
+                                 realizations=[realization], normal_shift=table.raw("normal_shift", None))
     except SiteError as error:
         raise SceneError(f"motion.{error}") from None
     values = np.asarray(generated["acceleration"].values[0], dtype=float)

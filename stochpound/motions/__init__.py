@@ -92,6 +92,7 @@ from stochpound.motions._scenario import MECHANISMS, given_scenario  # noqa: F40
 from stochpound.motions._selection import array_pool, pool_intensity  # noqa: F401  (the experiment's pool of simulated motions)
 from stochpound.motions._spectrum import pseudo_spectra  # noqa: F401
 from stochpound.motions._site_calibration import calibration_table, fit_calibration  # noqa: F401
+from stochpound.motions._site_motions import parameter_normals  # noqa: F401  (the experiment's pool tilted to each stripe)
 from stochpound.motions._site_motions import SITE_MOTION_LIMITS  # noqa: F401  (the analysis's measure-free risk clamps to it)
 
 __all__ = [

@@ -9,6 +9,8 @@ noise at each sample: the model is in ``stochpound.motions._site_model``).
 Motion i of a seed uses the generator of realization i
 (:func:`~stochpound.motions.realization_rng`): its 7 parameter normals, its
 shape layer's 11 (the hazard-compatible model only), then its noise.
+``site_motions(..., normal_shift=s)`` adds s to every motion's parameter
+normals (importance sampling: the experiments' pools tilted to each stripe).
 """
 
 from __future__ import annotations
@@ -112,7 +114,8 @@ def site_motions_from_normals(normals: np.ndarray, *, magnitude: float | None = 
 
 def site_motions(magnitude: float | None = None, distance_km: float | None = None, vs30: float | None = None, mechanism: str | None = None,
                  n: int | None = None, seed: int | None = None, dt: float = 0.01, *, duration: float | None = None, model: str = "hazard_compatible",
-                 realizations: Sequence[int] | None = None, scenario: Scenario | None = None) -> xr.Dataset:
+                 realizations: Sequence[int] | None = None, scenario: Scenario | None = None,
+                 normal_shift: Sequence[float] | None = None) -> xr.Dataset:
     """Stochastic ground motions of a site's scenario (Rezaeian & Der Kiureghian 2010, hazard-compatible; model §11).
 
     Parameters
@@ -147,6 +150,13 @@ def site_motions(magnitude: float | None = None, distance_km: float | None = Non
         (``site_motions(n=100, seed=1, scenario=Scenario(7.0, 10.0, 760.0, "strike_slip"))``); with the
         hazard-compatible model it may carry a geometry (R_JB, R_x, Z_tor, dip, basin depths), which the
         NGA-West2 medians and σ its spectral-shape layer follows take (a hanging-wall site, say).
+    normal_shift : list of float, optional
+        Added to every motion's parameter normals (its first 7, and its 12
+        shape normals with the hazard-compatible model: one value each) before
+        they give its parameters; the noise is unchanged. The motions are then
+        drawn with those normals N(shift, I) instead of N(0, I): importance
+        sampling toward a part of the scenario (docs/intensity.md, "A pool
+        tilted to each stripe"). Default: no shift.
 
     Returns
     -------
@@ -165,9 +175,11 @@ def site_motions(magnitude: float | None = None, distance_km: float | None = Non
     ------
     SiteError
         Naming the field: a scenario outside the calibrated range, an unknown
-        mechanism or model, a bad ``n``, ``dt`` or ``duration``.
+        mechanism or model, a bad ``n``, ``dt``, ``duration`` or ``normal_shift``.
     """
     scenario = _checked(scenario, (magnitude, distance_km, vs30, mechanism), dt, model)
+    site_model = load_site_model(model)
+    shift = _shift(normal_shift, site_model.normals, model)
     if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1:
         raise SiteError(f"n: must be an integer >= 1, got {n!r}")
     try:
@@ -179,8 +191,9 @@ def site_motions(magnitude: float | None = None, distance_km: float | None = Non
         raise SiteError(f"duration: must be within {10 * dt:g}-600 s, got {duration!r}")
     drawn = range(int(n)) if duration is None else rows  # the default window is the whole set's; a given one needs the rows asked for alone
     rngs = [realization_rng(seed, i) for i in drawn]
-    site_model = load_site_model(model)
     first = np.array([rng.standard_normal(site_model.normals) for rng in rngs])
+    if normal_shift is not None:
+        first = first + shift
     parameters = motion_parameters(site_model, scenario, first)  # each motion's parameters are its own row's
     if duration is None:
         duration = _window(parameters)
@@ -192,6 +205,28 @@ def site_motions(magnitude: float | None = None, distance_km: float | None = Non
     dataset = dataset.assign_coords(realization=np.asarray(rows, dtype=int))
     dataset.attrs.update(seed=seed, n=int(n))
     return dataset
+
+
+def parameter_normals(seed: int, realizations: Sequence[int], model: str = "hazard_compatible") -> np.ndarray:
+    """The parameter normals [len(realizations), 7 + K] that :func:`site_motions` of ``seed`` draws for these motions (before any ``normal_shift``)."""
+    count = load_site_model(model).normals
+    return np.array([realization_rng(seed, int(i)).standard_normal(count) for i in realizations]).reshape(-1, count)
+
+
+def _shift(normal_shift: Sequence[float] | None, count: int, model: str) -> np.ndarray:
+    """The shift of every motion's parameter normals (zeros without one), checked: ``count`` finite numbers."""
+    if normal_shift is None:
+        return np.zeros(count)
+    shift = np.asarray(normal_shift, dtype=float) if _numbers(normal_shift) else np.array([])
+    if shift.shape != (count,) or not np.all(np.isfinite(shift)):
+        raise SiteError(f"normal_shift: {count} finite numbers (one per parameter normal of model {model}), got {normal_shift!r}")
+    return shift
+
+
+def _numbers(values: object) -> bool:
+    """Whether ``values`` is a sequence of real numbers (not booleans)."""
+    return (isinstance(values, (list, tuple, np.ndarray)) and
+            all(isinstance(v, (int, float, np.integer, np.floating)) and not isinstance(v, (bool, np.bool_)) for v in values))
 
 
 def _after_parameters(seed: int, realization: int, normals: int) -> np.random.Generator:

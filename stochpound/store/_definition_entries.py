@@ -34,6 +34,7 @@ class SimulatedMotionsEntry(TypedDict):
     calibration: str
     seed: int
     dt: float
+    sampling: NotRequired[str]
 
 
 class IntensityEntry(TypedDict):

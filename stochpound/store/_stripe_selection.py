@@ -40,6 +40,10 @@ class SimulatedMotions:
         The seed of the motions (the selection's).
     dt : float
         Their time step, s.
+    sampling : str
+        ``scenario``: the scenario's motions, one pool for the stripes of a scenario; ``tilted``: each stripe's own
+        ``count`` motions, importance-sampled toward its level (``[site] simulated_sampling``; docs/intensity.md).
+        In the entry only when not ``scenario`` (so that the definitions without it keep their identity).
     """
 
     count: int
@@ -47,15 +51,21 @@ class SimulatedMotions:
     calibration: str
     seed: int
     dt: float
+    sampling: str = "scenario"
 
     @classmethod
     def from_entry(cls, entry: Mapping[str, int | str | float]) -> SimulatedMotions:
         """The record of a canonical ``simulated_motions`` entry."""
-        return cls(entry["count"], entry["model"], entry["calibration"], entry["seed"], entry["dt"])
+        sampling = str(entry["sampling"]) if "sampling" in entry else "scenario"
+        return cls(entry["count"], entry["model"], entry["calibration"], entry["seed"], entry["dt"], sampling)
 
     def entry(self) -> dict[str, int | str | float]:
         """The canonical ``simulated_motions`` entry."""
-        return {"count": self.count, "model": self.model, "calibration": self.calibration, "seed": self.seed, "dt": self.dt}
+        written: dict[str, int | str | float] = {"count": self.count, "model": self.model, "calibration": self.calibration, "seed": self.seed,
+                                                 "dt": self.dt}
+        if self.sampling != "scenario":
+            written["sampling"] = self.sampling
+        return written
 
 
 @dataclass(frozen=True)
