@@ -84,7 +84,7 @@ def site_motions_from_normals(normals: np.ndarray, *, magnitude: float | None = 
         Row i: motion i's normals; the first 6 give its parameters (the
         predictive equations' residuals, correlated through the model's
         covariance), the 7th its post-filter's corner, the next K its
-        spectral-shape gains (``hazard_compatible``: K = 11, one per period of
+        spectral-shape gains (``hazard_compatible``: K = 12, one per period of
         the shape layer; ``rezaeian_2010``: K = 0), the next n_time the
         white noise at t = 0, dt, ….
     magnitude, distance_km, vs30 : float
