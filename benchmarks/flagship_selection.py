@@ -4,7 +4,7 @@ Loads the experiment file (its scenario fitted, ``[site] simulated_motions``
 replaced by ``--simulated N`` where given, ``[site] simulated_sampling = S``
 added with ``--sampling``, ``[intensity] seed`` replaced by ``--seed``), computes its selection (the fit,
 the pool of records and simulated motions, pre-screened beyond
-``stochpound.experiment._site.SCREEN_BASE`` motions, and every stripe's
+``SCREEN_BASE`` (stochpound.experiment's site selection) motions, and every stripe's
 choice: :attr:`stochpound.experiment.Experiment.selection`) and prints, per
 stripe, its level, ε, N Φ(−ε) (the pool's simulated motions expected beyond
 the stripe's ε), the pool's motions after the pre-screen, the chosen set's
@@ -97,7 +97,7 @@ COLUMNS = ["level (g)", "simulated chosen", "D5-95 (s)", "t_mid (s)", "f_mid (Hz
 def parameter_rows(experiment) -> list[list[str]]:
     """Per stripe, the medians of its chosen simulated motions' :data:`PARAMETERS`, their own D5–95 and Arias intensity (scaled by
     their scale factors: as run), regenerated from their tables."""
-    from stochpound.experiment._site import table_scenario
+    from stochpound.experiment import table_scenario
     from stochpound.motions import arias_intensity, significant_duration, site_motions
     from stochpound.store import canonical_json
 

@@ -1,7 +1,7 @@
 """What a pool tilted to a stripe does to the motions at its level: ``python -m benchmarks.tilted_pool FILE STRIPE [STRIPE ...]``.
 
 For a flagship with one scenario (``[site] scenario = "fitted"`` or one given
-for every level), fits the tilt (``stochpound.experiment._site.tilt_pilot``'s
+for every level), fits the tilt (the experiment's tilt pilot's
 line, on the scenario's first ``TILT_PILOT`` untilted motions), then for
 every stripe asked (from 1, in the order of the sorted levels) draws its
 tilted pool (the ``[site] simulated_motions`` N of the file, the stripe's
@@ -33,7 +33,7 @@ PARAMETERS = ("d5_95", "t_mid", "f_mid", "arias_intensity")
 
 def pool(table: dict, measure: str, period, g: float) -> tuple[np.ndarray, np.ndarray, dict[str, np.ndarray]]:
     """ln IM* (g), the parameter normals and the parameters of every motion of a simulated motions' table."""
-    from stochpound.experiment._site import table_chunks, table_scenario
+    from stochpound.experiment import table_chunks, table_scenario
     from stochpound.motions import parameter_normals, site_motions
 
     ln_intensity = np.log(np.concatenate([intensity for _, _, intensity in table_chunks(table, measure, period, g)]))
@@ -51,7 +51,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("stripes", type=int, nargs="+")
     arguments = parser.parse_args(argv)
     from stochpound.experiment import load_experiment
-    from stochpound.experiment._site import TILT_PILOT, Tilt, scenario_table, tilted_seed
+    from stochpound.experiment import TILT_PILOT, Tilt, scenario_table, tilted_seed
 
     info = machine()
     began = time.time()

@@ -9,7 +9,7 @@ is kept.
 import pytest
 
 from stochpound.experiment import load_experiment, run_experiment
-from tests.helpers import laws_pair_text, write_experiment
+from tests.helpers import laws_pair_text, tilted_site_text, write_experiment
 
 #: The test files that take longest (measured, whole suite on 2 cores, 2026-12-02), longest first: they start first;
 #: every other file follows in the usual order. Only the order changes: every test still runs.
@@ -41,3 +41,16 @@ def laws_store(tmp_path_factory):
     report = run_experiment(load_experiment(write_experiment(folder, laws_pair_text(), "laws.toml")), workers=0, progress=False)
     assert report.complete and not report.failed
     return folder / "laws.toml", report.store
+
+
+@pytest.fixture(scope="module")
+def tilted_experiment(tmp_path_factory):
+    """A small experiment of a pool tilted to each stripe (:func:`tests.helpers.tilted_site_text`; its pilot reduced to 48
+    motions), its selection made."""
+    from stochpound.experiment import _site
+
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(_site, "TILT_PILOT", 48)
+        experiment = load_experiment(write_experiment(tmp_path_factory.mktemp("tilted"), tilted_site_text(), "tilted.toml"))
+        experiment.selection
+        return experiment

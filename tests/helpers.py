@@ -587,3 +587,19 @@ def text_difference(text: str, reference: str, rounding: float = ROUNDING) -> st
     if len(ours) != len(theirs):
         return f"the text has {len(ours)} lines, the reference {len(theirs)}"
     return ""
+
+
+TILTED_MEMBERS = [f"fema_p695_far_field/{i:02d}{c}" for i in range(1, 4) for c in "ab"]
+"""Six records of the far-field set: the records of the small tilted-pool experiment (:func:`tilted_site_text`)."""
+SIMULATED_SITE = '[site]\nvs30 = 400.0\nmagnitude = 6.5\ndistance_km = 20.0\nmechanism = "strike_slip"\nsimulated_motions = 12\n'
+"""A ``[site]`` of one given scenario with 12 simulated motions a stripe."""
+TILTED_SITE = SIMULATED_SITE + 'simulated_sampling = "tilted"\n'
+"""The same, tilted to each stripe."""
+
+
+def tilted_site_text(site: str = TILTED_SITE) -> str:
+    """A small conditional-spectrum experiment (2 stripes of PSA(0.5 s), 4 motions each, 6 records) with ``site`` as its ``[site]``."""
+    records = "".join(f'\n[[records]]\nrecord = "{name}"\nduration = 5.0\n' for name in TILTED_MEMBERS)
+    intensity = ('[intensity]\nmeasure = "psa"\nperiod = 0.5\nlevels = [0.6, 0.2]\nselection = "conditional_spectrum"\nmotions = 4\n'
+                 'max_scale_factor = 5.0\nseed = 2\n')
+    return f'[experiment]\nname = "tilted"\n{SITE_SCENE}\n[grid]\ngap = ["inf"]\n{records}\n{intensity}{site}\n[solver]\nmethod = "exact"\n'

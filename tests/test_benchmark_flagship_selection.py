@@ -46,3 +46,27 @@ def test_a_stripe_s_row_gives_its_counts_shares_and_worst_misses():
     assert row == ["0.5", "2.00", "22.8", "2100", "3 + 1", "0.500", "+0.150 (0.1 s)", "-0.050 (0.1 s)", "**miss**"]
     assert worst(np.array([0.01, -0.09]), np.array([1.0, 2.0])) == "-0.090 (2 s)"
     assert stripe_rows(type("E", (), {"selection": _Selection()})(), 1000, tilted=True)[0][2] == "-"
+
+
+
+def test_the_benchmark_s_copy_adds_the_sampling_line(tmp_path):
+    flagship = REPOSITORY / "experiments" / "risk" / "fixed_pair.toml"
+    old, new = flagship.read_text().splitlines(), with_simulated(flagship, None, tmp_path, "tilted").read_text().splitlines()
+    assert len(new) == len(old) + 1 and [line for line in new if line not in old] == ['simulated_sampling = "tilted"']
+
+
+def test_the_benchmark_s_parameter_rows_count_each_stripe_s_chosen_simulated_motions(tilted_experiment):
+    from benchmarks.flagship_selection import COLUMNS, parameter_rows
+
+    selection = tilted_experiment.selection
+    rows = parameter_rows(tilted_experiment)
+    assert [len(row) for row in rows] == [len(COLUMNS)] * 2
+    for row, chosen in zip(rows, selection.selections):
+        count = sum(str(m) in selection.simulated for m in chosen["motion"].values)
+        assert row[1] == str(count) and (count == 0 or float(row[5]) > 0.0)
+
+
+def test_the_benchmark_s_copy_replaces_the_seed(tmp_path):
+    flagship = REPOSITORY / "experiments" / "risk" / "isolated.toml"
+    old, new = flagship.read_text().splitlines(), with_simulated(flagship, None, tmp_path, seed=7).read_text().splitlines()
+    assert len(new) == len(old) and [line for line in new if line not in old] == ["seed = 7"]

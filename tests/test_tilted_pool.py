@@ -12,33 +12,19 @@ import tomllib
 import numpy as np
 import pytest
 
-from benchmarks.flagship_selection import with_simulated
-from benchmarks.timing import REPOSITORY
 from stochpound.experiment import _site
-from stochpound.experiment._runner import load_experiment
 from stochpound.experiment._spec import ExperimentError, parse_experiment
 from stochpound.model.scene_file import scene_from_dict
 from stochpound.motions import Scenario, parameter_normals, site_motions, site_motions_from_normals
 from stochpound.motions import _site_model
 from stochpound.motions._site_motions import _after_parameters
 from stochpound.store import SimulatedMotions
-from tests.helpers import SITE_SCENE, write_experiment
+from tests.helpers import SIMULATED_SITE
+from tests.helpers import tilted_site_text as _text
 
 SCENARIO = Scenario(6.5, 20.0, 400.0, "strike_slip")
 NORMALS = _site_model.load_site_model("hazard_compatible").normals
 G = 9.81
-MEMBERS = [f"fema_p695_far_field/{i:02d}{c}" for i in range(1, 4) for c in "ab"]
-RECORDS = "".join(f'\n[[records]]\nrecord = "{name}"\nduration = 5.0\n' for name in MEMBERS)
-INTENSITY = ('[intensity]\nmeasure = "psa"\nperiod = 0.5\nlevels = [0.6, 0.2]\nselection = "conditional_spectrum"\nmotions = 4\n'
-             'max_scale_factor = 5.0\nseed = 2\n')
-SITE = '[site]\nvs30 = 400.0\nmagnitude = 6.5\ndistance_km = 20.0\nmechanism = "strike_slip"\nsimulated_motions = 12\n'
-TILTED = SITE + 'simulated_sampling = "tilted"\n'
-
-
-def _text(site: str = TILTED) -> str:
-    return f'[experiment]\nname = "tilted"\n{SITE_SCENE}\n[grid]\ngap = ["inf"]\n{RECORDS}\n{INTENSITY}{site}\n[solver]\nmethod = "exact"\n'
-
-
 def test_the_shift_moves_the_parameter_normals_alone_bit_for_bit():
     """site_motions with a shift is site_motions_from_normals of the seed's parameter normals plus the shift and its own noise."""
     shift = np.linspace(-1.0, 1.5, NORMALS)
@@ -105,13 +91,6 @@ def test_the_shift_keeps_the_normals_distribution_given_their_projection_and_mov
             assert abs(y.mean() - math.log(level)) < 5.0 * math.sqrt(slope @ slope + 0.04) / math.sqrt(n)
 
 
-@pytest.fixture(scope="module")
-def tilted_experiment(tmp_path_factory):
-    with pytest.MonkeyPatch.context() as patch:
-        patch.setattr(_site, "TILT_PILOT", 48)
-        experiment = load_experiment(write_experiment(tmp_path_factory.mktemp("tilted"), _text(), "tilted.toml"))
-        experiment.selection
-        return experiment
 
 
 def test_the_tilted_pool_s_definition_and_tables(tilted_experiment):
@@ -173,18 +152,18 @@ def test_a_tilted_pool_centres_its_stripe_s_measure_on_the_level(monkeypatch):
 
 def test_the_default_sampling_adds_nothing_to_the_definition(tmp_path):
     """Without simulated_sampling, or with "scenario", the definition (so the identity) is the one without the key."""
-    plain = parse_experiment(tomllib.loads(_text(SITE)), tmp_path)
+    plain = parse_experiment(tomllib.loads(_text(SIMULATED_SITE)), tmp_path)
     assert "sampling" not in plain["intensity"]["simulated_motions"]
-    assert parse_experiment(tomllib.loads(_text(SITE + 'simulated_sampling = "scenario"\n')), tmp_path) == plain
+    assert parse_experiment(tomllib.loads(_text(SIMULATED_SITE + 'simulated_sampling = "scenario"\n')), tmp_path) == plain
     assert SimulatedMotions.from_entry(plain["intensity"]["simulated_motions"]).sampling == "scenario"
 
 
 @pytest.mark.parametrize(
     "site, message",
     [
-        (SITE + 'simulated_sampling = "wide"\n', r"^site\.simulated_sampling: must be one of scenario, tilted, got 'wide'$"),
-        (SITE + "simulated_sampling = 1\n", r"^site\.simulated_sampling: must be a non-empty string, got 1$"),
-        (SITE.replace("simulated_motions = 12\n", 'simulated_sampling = "tilted"\n'), r"^site\.simulated_sampling: only with site\.simulated_motions"),
+        (SIMULATED_SITE + 'simulated_sampling = "wide"\n', r"^site\.simulated_sampling: must be one of scenario, tilted, got 'wide'$"),
+        (SIMULATED_SITE + "simulated_sampling = 1\n", r"^site\.simulated_sampling: must be a non-empty string, got 1$"),
+        (SIMULATED_SITE.replace("simulated_motions = 12\n", 'simulated_sampling = "tilted"\n'), r"^site\.simulated_sampling: only with site\.simulated_motions"),
         ('[site]\nruptures = "one.csv"\nsimulated_motions = 4\nsimulated_sampling = "tilted"\n',
          r'^site\.simulated_sampling: "tilted" takes a given or fitted scenario, not a site of ruptures'),
     ],
@@ -195,26 +174,3 @@ def test_bad_sampling_is_one_line_naming_the_field(tmp_path, site, message):
     with pytest.raises(ExperimentError, match=message) as error:
         parse_experiment(tomllib.loads(_text(site)), tmp_path)
     assert "\n" not in str(error.value)
-
-
-def test_the_benchmark_s_copy_adds_the_sampling_line(tmp_path):
-    flagship = REPOSITORY / "experiments" / "risk" / "fixed_pair.toml"
-    old, new = flagship.read_text().splitlines(), with_simulated(flagship, None, tmp_path, "tilted").read_text().splitlines()
-    assert len(new) == len(old) + 1 and [line for line in new if line not in old] == ['simulated_sampling = "tilted"']
-
-
-def test_the_benchmark_s_parameter_rows_count_each_stripe_s_chosen_simulated_motions(tilted_experiment):
-    from benchmarks.flagship_selection import COLUMNS, parameter_rows
-
-    selection = tilted_experiment.selection
-    rows = parameter_rows(tilted_experiment)
-    assert [len(row) for row in rows] == [len(COLUMNS)] * 2
-    for row, chosen in zip(rows, selection.selections):
-        count = sum(str(m) in selection.simulated for m in chosen["motion"].values)
-        assert row[1] == str(count) and (count == 0 or float(row[5]) > 0.0)
-
-
-def test_the_benchmark_s_copy_replaces_the_seed(tmp_path):
-    flagship = REPOSITORY / "experiments" / "risk" / "isolated.toml"
-    old, new = flagship.read_text().splitlines(), with_simulated(flagship, None, tmp_path, seed=7).read_text().splitlines()
-    assert len(new) == len(old) and [line for line in new if line not in old] == ["seed = 7"]
