@@ -174,3 +174,12 @@ def test_bad_sampling_is_one_line_naming_the_field(tmp_path, site, message):
     with pytest.raises(ExperimentError, match=message) as error:
         parse_experiment(tomllib.loads(_text(site)), tmp_path)
     assert "\n" not in str(error.value)
+
+
+def test_the_reports_words_say_a_tilted_pool_is_each_stripe_s_own():
+    """The pool as the report and the risk summary describe it: a tilted pool's motions are each stripe's own, drawn toward its
+    level; the scenario's are not said to be."""
+    plain = SimulatedMotions(2000, "hazard_compatible", "any", 1, 0.01)
+    tilted = SimulatedMotions(4000, "hazard_compatible", "any", 1, 0.01, "tilted")
+    assert plain.pool_words == "2000 simulated motions of each stripe's scenario"
+    assert tilted.pool_words == "4000 simulated motions of each stripe's scenario (each stripe's own, importance-sampled toward its level)"

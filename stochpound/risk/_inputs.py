@@ -319,7 +319,7 @@ def assumptions(store: xr.Dataset, scenes: Mapping[tuple[Any, ...], Scene] | Non
     count, pool = sum(source.count for source in sources) + len(simulated), sum(source.count for source in definition.motions)
     selection = definition.intensity.selection if definition.intensity is not None else None
     generated = selection.simulated if selection is not None else None
-    pool_words = f"{pool} records" + (f" and {generated.count} simulated motions of each stripe's scenario" if generated else "")
+    pool_words = f"{pool} records" + (f" and {generated.pool_words}" if generated else "")
     suite = (f"{counted(count, 'motion')} ran ({', '.join(suites)}), "
              + (f"selected per stripe by {selection.method.replace('_', ' ')} from a pool of {pool_words}" if selection
                 else "every motion scaled to every stripe (no selection)"))

@@ -67,6 +67,16 @@ class SimulatedMotions:
             written["sampling"] = self.sampling
         return written
 
+    @property
+    def sampling_words(self) -> str:
+        """How the motions were drawn, in words to follow their count: "" for the scenario's own, a parenthesis for a tilted pool."""
+        return " (each stripe's own, importance-sampled toward its level)" if self.sampling == "tilted" else ""
+
+    @property
+    def pool_words(self) -> str:
+        """The pool's simulated motions in words, e.g. ``2000 simulated motions of each stripe's scenario`` (:attr:`sampling_words`)."""
+        return f"{self.count} simulated motions of each stripe's scenario{self.sampling_words}"
+
 
 @dataclass(frozen=True)
 class Selection:

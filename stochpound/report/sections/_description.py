@@ -379,7 +379,8 @@ def motions_table(definitions: Iterable[StoreDefinition]) -> Table:
         if setting is not None:
             rows.append([definition.name, f"{simulated[0]} … {simulated[-1]} ({len(simulated)} simulated)",
                          f"{setting.model} site-motion model ({setting.calibration}) of each stripe's scenario, seed {setting.seed}; the "
-                         f"{len(simulated)} chosen for some stripe of the {setting.count} simulated per stripe", f"{number(setting.dt)} s",
+                         f"{len(simulated)} chosen for some stripe of the {setting.count} simulated per stripe"
+                         f"{setting.sampling_words}", f"{number(setting.dt)} s",
                          f"1 each ({len(simulated)})"])
             simulated_rows.append(len(simulated))
     frame = pd.DataFrame(rows, columns=["experiment", "motion", "definition", "step, duration", "realizations"])

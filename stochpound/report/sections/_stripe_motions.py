@@ -26,8 +26,7 @@ def stripe_motions_text(store: xr.Dataset) -> str:
     selection = store.pound.intensity.selection if store.pound.intensity is not None else None
     method = (selection.method if selection is not None else "a selection").replace("_", "-")
     if selection is not None and selection.simulated is not None:  # the record axis holds the chosen simulated motions only
-        pool = (f"{int(np.sum(store['record_kind'].values != 'simulated'))} records and {selection.simulated.count} simulated motions "
-                "of each stripe's scenario")
+        pool = f"{int(np.sum(store['record_kind'].values != 'simulated'))} records and {selection.simulated.pool_words}"
     text = (f"{count} per stripe, chosen by {method} selection from a pool of {pool} and scaled to the stripe's level "
             f"(scale factors {np.nanmin(scale):.3g}–{np.nanmax(scale):.3g})")
     ranges = scenario_ranges(store)
