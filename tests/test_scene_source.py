@@ -135,3 +135,19 @@ def test_a_complete_store_is_kept_when_only_the_scene_source_changed(tmp_path: P
     assert after.attrs["definition_sha256"] == before.attrs["definition_sha256"]
     for name, values in before.data_vars.items():
         assert values.equals(after[name]), name
+
+
+def test_a_complete_store_run_from_another_file_records_that_file(tmp_path: Path) -> None:
+    """The same experiment from a copy elsewhere, with other comments, onto the store: nothing runs, and the store records
+    the copy's text and path (before, it kept the first file's path beside the copy's text, so a report named a file
+    whose text was not the store's)."""
+    text = f'[experiment]\nname = "pair"\n{FIXED}\n{REST}'
+    first = run_experiment(load_experiment(write_experiment(tmp_path, text, "pair.toml")), workers=0, progress=False)
+    (tmp_path / "moved").mkdir()
+    copy = write_experiment(tmp_path / "moved", "# the copy users keep\n" + text, "pair.toml")
+    again = run_experiment(load_experiment(copy), workers=0, progress=False, store=first.store)
+    assert again.nothing_to_run
+    with open_store(first.store) as store:
+        attrs = store.load().attrs
+    assert attrs["experiment_text"] == copy.read_text()
+    assert Path(attrs["experiment_file"]).resolve() == copy.resolve()

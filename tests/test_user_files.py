@@ -148,7 +148,7 @@ def test_check_of_a_pool_too_small_for_its_motions_is_one_line(tmp_path):
     records = '[[records]]\nsuite = "fema_p695_far_field"\nmembers = ["01a", "03b", "05a"]\n\n'
     text = text[:text.index("[[records]]")] + records + text[text.index("[intensity]"):]
     path = tmp_path / "cs.toml"
-    text = re.sub(r"(?m)^simulated_motions = .*\n", "", re.sub(r"(?m)^motions = \d+", "motions = 4", text))  # the three records only
+    text = re.sub(r"(?m)^simulated_(motions|sampling) = .*\n", "", re.sub(r"(?m)^motions = \d+", "motions = 4", text))  # the three records only
     assert not re.search(r"(?m)^simulated_motions", text)
     path.write_text(text)
     _one_line_error(invoke("experiment", "check", str(path)), "intensity.motions: only", "fewer than motions = 4")
