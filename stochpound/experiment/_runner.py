@@ -35,7 +35,7 @@ from stochpound.experiment._estimate import LARGE_RUN_BYTES, LARGE_RUN_CASES, Ru
 from stochpound.experiment._experiment import Experiment
 from stochpound.experiment._parts import FolderLock, PartBuffer, RunEntry, append_run, parts_folder, remove_temporaries
 from stochpound.experiment._session import (StoreSession, check_store, check_store_path, clear_store, code_identity, machine, missing_summaries, now,
-                                           store_complete, stored_definition, stored_file, stored_text)
+                                           store_complete, stored_definition, stored_text)
 from stochpound.experiment._sources import ResolvedMotion, resolve_motions
 from stochpound.experiment._spec import ExperimentError, load_definition
 from stochpound.experiment._file_assembly import PartsIndex
@@ -227,8 +227,8 @@ def run_experiment(
             stored, new = stored_definition(store), json.loads(experiment.definition_json)
             # the scene's provenance alone (the same content, from another file or inline) leaves the store as it is
             changed = [key for key in NOT_IN_IDENTITY if key != "scene_source" and stored.get(key) != new.get(key)]
-            if stored_text(store) != experiment.text or stored_file(store) != experiment.path:  # the same definition, another text
-                changed.append("text")  # (comments) or another file: the store records the file's text and path
+            if stored_text(store) != experiment.text:  # the same definition, another text (comments): the store records the
+                changed.append("text")  # file's text and path
             if changed:
                 _record_hazard(store, experiment, {label: m.grid for label, m in motions.items()}, say, changed)
             return RunReport(store, experiment.n_cases, experiment.n_cases, elapsed=time.monotonic() - started, nothing_to_run=True)
@@ -318,8 +318,8 @@ def _record_hazard(store: Path, experiment: Experiment, grids: dict[str, tuple[f
         if table in changed:
             say(f"{store}: the [{table}] changed; no run depends on it: the cases are kept and the new table is recorded in the store")
     if "text" in changed:
-        say(f"{store}: the experiment file's text or path changed, not its definition's identity (comments, the scene's source, the file's "
-            "place); the cases are kept and the new text and path are recorded in the store")
+        say(f"{store}: the experiment file's text changed, not its definition's identity (comments, the scene's source); the cases are kept "
+            "and the new text and its file's path are recorded in the store")
     if "site" in changed:
         say(f"{store}: how the [site] scenario was obtained is recorded in the store (no run depends on it: the cases are kept)")
     if "hazard" not in changed:

@@ -76,19 +76,10 @@ def stored_definition(store: Path) -> dict[str, Any]:
 
 def stored_text(store: Path) -> str:
     """The experiment text an existing store file records (its ``experiment_text`` attribute; "" without one)."""
-    return _stored_attribute(store, "experiment_text")
-
-
-def stored_file(store: Path) -> str:
-    """The experiment file's path an existing store file records (its ``experiment_file`` attribute; "" without one)."""
-    return _stored_attribute(store, "experiment_file")
-
-
-def _stored_attribute(store: Path, name: str) -> str:
     import h5py
 
     with h5py.File(store, "r") as handle:
-        return _text(handle.attrs[name]) if name in handle.attrs else ""
+        return _text(handle.attrs["experiment_text"]) if "experiment_text" in handle.attrs else ""
 
 
 def check_store(store: Path, sha256: str) -> bool:
@@ -284,9 +275,9 @@ class StoreSession:
         definition, text_sha256 = json.loads(experiment.definition_json), hashlib.sha256(experiment.text.encode()).hexdigest()
         if (folder / DEFINITION_FILE).exists():
             record = read_experiment_json(folder)
-            if record.definition != definition or record.text != experiment.text or record.file != experiment.path:
-                # the same runs (checked by check_store), another hazard, or another text of the same definition (its comments)
-                # or the same text from another file: record it, with the file it came from
+            if record.definition != definition or record.text != experiment.text:  # the same runs (checked by check_store), another
+                # hazard, or another text of the same definition (its comments): record it, with the file it came from (the same
+                # text from a store's copy elsewhere leaves the store as it is)
                 record = dataclasses.replace(record, definition=definition, definition_sha256=experiment.sha256, text=experiment.text,
                                              text_sha256=text_sha256, file=experiment.path, base_dir=str(experiment.base_dir.resolve()))
                 write_experiment_json(folder, record)

@@ -445,7 +445,7 @@ class StoreRisk:
         return degenerate_text(np.concatenate(statuses), self.hazard, "rule rows") if statuses else ""
 
     def coarse_change(self) -> float:
-        """The largest |g*_coarse / g* − 1| over the configurations and targets, g*_coarse read off the gap grid as first made
+        """The largest ``|g*_coarse / g* − 1|`` over the configurations and targets, g*_coarse read off the gap grid as first made
         (before its refinement near each g*): how far interpolating across the coarse grid's brackets moves g*, λ_P(g) being a
         step function of g (NaN where the grid was given, not refined)."""
         return float(self.separation.attrs["coarse_change"]) if "coarse_change" in self.separation.attrs else math.nan

@@ -164,7 +164,7 @@ def rate_collapses_apart(demand: xr.DataArray, collapsed: xr.DataArray, threshol
     hz : HazardCurve
         The site's hazard.
     collapse : xarray.Dataset, optional
-        :func:`collapse_fit` of ``collapsed`` already made (several demands of the same runs share it); default fitted here.
+        ``collapse_fit`` of ``collapsed`` already made (several demands of the same runs share it); default fitted here.
 
     Returns
     -------

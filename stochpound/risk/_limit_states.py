@@ -346,7 +346,7 @@ def limit_state_bounds(risk: xr.Dataset, apart: bool = False) -> tuple[xr.DataAr
 
 
 def judged_ratio(risk: xr.Dataset, apart: bool = False) -> xr.DataArray:
-    """λ/λ_target as an objective is judged on: the fit's ratio (:func:`objective_ratio`) where the runs pin λ
+    """λ/λ_target as an objective is judged on: the fit's ratio (``objective_ratio``) where the runs pin λ
     (:func:`limit_state_pinned`), else the lower bound's, λ⁻/λ_target (:func:`limit_state_bounds`): a limit state whose fit the
     runs do not pin misses its objective only where the runs alone say so (NaN without an objective)."""
     ratio = objective_ratio(risk, apart)
