@@ -37,10 +37,10 @@ import xarray as xr
 
 from stochpound.hazard import HazardCurve
 from stochpound.risk import _inputs
-from stochpound.risk._fragility import DECREASING, FIT, lognormal_cdf
+from stochpound.risk._fragility import DECREASING, lognormal_cdf
 from stochpound.risk._fragility_ensemble import limit_state_events, stripe_fragility
 from stochpound.risk._maf import mean_annual_frequency, risk_targeted_separation
-from stochpound.risk._stripe_coverage import stripes_only_maf, stripes_upper_maf, unidentified
+from stochpound.risk._stripe_coverage import identified, stripes_only_maf, stripes_upper_maf
 
 MODEL_DRIFT_LIMIT = 0.05
 """Peak storey drift ratio beyond which a run is beyond what the model represents: a collapse (no strength loss or collapse is modelled)."""
@@ -89,7 +89,7 @@ class CollapseRisk:
         extra["runs beyond the model"] = [f"{int(k)} of {int(n)}" for k, n in zip(extra["collapsed"], extra["runs"])]
         extra = extra.drop(columns=["collapsed", "runs"])
         if "maf_lower" in self.collapse:  # where the stripes do not identify P(C | IM), λ_C is its extrapolation: what they bound it to
-            loose = _dims_only((unidentified(self.collapse) != "") | (self.collapse["status"] != FIT))
+            loose = _dims_only(~identified(self.collapse))
             bounds = xr.Dataset({"loose": loose, "lower": _dims_only(self.collapse["maf_lower"]), "upper": _dims_only(self.collapse["maf_upper"])})
             table = bounds.to_dataframe().reset_index() if config else pd.DataFrame({name: [bounds[name].item()] for name in bounds.data_vars})
             table[COLLAPSE_BOUNDS] = [f"[{low:.3g}, {high:.3g}]" if flag else "identified" for flag, low, high in
@@ -119,8 +119,7 @@ class CollapseRisk:
     def _unpinned_text(self) -> str:
         """Where the stripes do not identify P(C | IM) (its median beyond the top stripe, β ≥ 0.8, or a step), that λ_C rests on
         the fit's extrapolation and the bounds the stripes' fractions alone give it; "" where they identify it everywhere."""
-        why = unidentified(self.collapse)
-        loose = (why != "") | (self.collapse["status"] != FIT)
+        loose = ~identified(self.collapse)
         if not bool(loose.any()) or "maf_lower" not in self.collapse:
             return ""
         low, high = self.collapse["maf_lower"].where(loose), self.collapse["maf_upper"].where(loose)

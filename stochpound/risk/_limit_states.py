@@ -38,7 +38,7 @@ from stochpound.risk._maf import mean_annual_frequency
 from stochpound.risk._chain import CONFIDENCE, YEARS, fit_name
 from stochpound.risk._collapse import MODEL_DRIFT_LIMIT, beyond_model, collapse_fit, rate_collapses_apart
 from stochpound.risk._fragility import FIT, NEVER
-from stochpound.risk._stripe_coverage import at_lowest_stripe, stripes_only_maf, stripes_upper_maf, unidentified
+from stochpound.risk._stripe_coverage import at_lowest_stripe, identified, stripes_only_maf, stripes_upper_maf, unidentified
 
 
 OBJECTIVE_YEARS = 50.0
@@ -276,7 +276,7 @@ def limit_state_risk(store: xr.Dataset, limit_states: Sequence[LimitState], hz: 
             result[f"{name}_collapses_apart"] = both[f"{name}_collapses_apart"].assign_attrs(
                 long_name=f"{name} of the credible runs' fit (the runs beyond the model left out)")
         result["beyond_model"] = collapsed.sum("record").assign_attrs(units="1", long_name="runs beyond the model (collapses) per stripe")
-        result["collapse_identified"] = ((collapse["status"] == FIT) & (unidentified(collapse) == "")).reset_coords(drop=True).assign_attrs(
+        result["collapse_identified"] = identified(collapse).reset_coords(drop=True).assign_attrs(
             long_name="whether P(C | IM) is a lognormal the stripes identify")
     twins = _inputs.contact_free_twins(result["maf"])
     if twins is not None:
@@ -331,10 +331,10 @@ def limit_state_pinned(risk: xr.Dataset, apart: bool = False) -> xr.DataArray:
     if "status" not in fit:
         return xr.ones_like(risk["maf"], dtype=bool)
     known = "intensity" in fit.coords
-    identified = (unidentified(fit) == "" if known else xr.ones_like(fit["status"], dtype=bool)) & (fit["status"] == FIT)
+    pinned = identified(fit) if known else fit["status"] == FIT
     if apart and "collapse_identified" in risk:  # no credible run reaches it: λ is λ_C, pinned where P(C | IM) is
-        identified = identified | ((fit["status"] == NEVER) & risk["collapse_identified"])
-    return identified
+        pinned = pinned | ((fit["status"] == NEVER) & risk["collapse_identified"])
+    return pinned
 
 
 def limit_state_bounds(risk: xr.Dataset, apart: bool = False) -> tuple[xr.DataArray, xr.DataArray] | None:

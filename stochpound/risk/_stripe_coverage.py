@@ -221,6 +221,12 @@ UNIDENTIFIED_BETA = 0.8
 wider than record-to-record dispersion (0.3–0.6 for storey drifts, FEMA P-58) and than a stripe set usually spans."""
 
 
+def identified(fragility: xr.Dataset) -> xr.DataArray:
+    """Where a stripes fit is a lognormal its runs identify (bool): neither a step nor flat, and :func:`unidentified` finds
+    nothing against it."""
+    return (fragility["status"] == FIT) & (unidentified(fragility) == "")
+
+
 def unidentified(fragility: xr.Dataset) -> xr.DataArray:
     """Why a lognormal stripes fit is not identified by its runs, in words ("" where it is, or where the fit is a step):
     ``θ beyond the top stripe`` (its median lies where no run went) or ``β ≥ 0.8`` (``UNIDENTIFIED_BETA``)."""
