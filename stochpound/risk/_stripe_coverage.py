@@ -179,8 +179,7 @@ def stripes_only_maf(fragility: xr.Dataset, hz: HazardCurve) -> xr.DataArray:
     order = np.argsort(levels)
     rates = np.asarray(hz(np.minimum(levels[order], hz.support[1])), dtype=float)
     bins = xr.DataArray(rates - np.append(rates[1:], 0.0), dims="intensity", coords={"intensity": levels[order]})
-    fraction = fragility["exceeded"] / fragility["runs"].where(fragility["runs"] > 0)
-    return (fraction.sel(intensity=levels[order]) * bins).sum("intensity", min_count=1).assign_attrs(
+    return (_fractions(fragility, levels[order]) * bins).sum("intensity", min_count=1).assign_attrs(
         units="1/yr", long_name="mean annual frequency from the stripes' fractions alone (nothing below the lowest stripe)")
 
 
@@ -209,7 +208,7 @@ def stripes_upper_maf(fragility: xr.Dataset, hz: HazardCurve) -> xr.DataArray:
     rates = np.asarray(hz(np.clip(levels, hz.support[0], hz.support[1])), dtype=float)
     below = np.append(float(hz(hz.support[0])), rates[:-1])  # λ at the lower end of each stripe's bin (x_{j-1}, x_j]
     bins = xr.DataArray(below - rates, dims="intensity", coords={"intensity": levels})
-    fraction = (fragility["exceeded"] / fragility["runs"].where(fragility["runs"] > 0)).sel(intensity=levels)
+    fraction = _fractions(fragility, levels)
     with np.errstate(invalid="ignore"):  # a bin of no exceedance adds nothing, even below a hazard without a lower end (λ(lo) = inf)
         parts = (fraction * bins).where(fraction != 0.0, 0.0).where(fraction.notnull())
     return (parts.sum("intensity", min_count=1) + rates[-1]).assign_attrs(
@@ -219,6 +218,11 @@ def stripes_upper_maf(fragility: xr.Dataset, hz: HazardCurve) -> xr.DataArray:
 UNIDENTIFIED_BETA = 0.8
 """β from which a lognormal fit is not identified by the stripes: its 16–84 % range spans e^{2β} ≈ 5 times in intensity,
 wider than record-to-record dispersion (0.3–0.6 for storey drifts, FEMA P-58) and than a stripe set usually spans."""
+
+
+def _fractions(fragility: xr.Dataset, levels: np.ndarray) -> xr.DataArray:
+    """Each stripe's fraction of runs that exceeded, k_j/n_j (NaN where none ran), at ``levels`` in that order."""
+    return (fragility["exceeded"] / fragility["runs"].where(fragility["runs"] > 0)).sel(intensity=levels)
 
 
 def identified(fragility: xr.Dataset) -> xr.DataArray:
