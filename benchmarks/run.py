@@ -11,6 +11,7 @@ comparison with an earlier revision (:mod:`benchmarks.compare`),
 ``python -m benchmarks measure_free`` the measure-free risk at the demo site (:mod:`benchmarks.measure_free`),
 ``python -m benchmarks simulated_pool`` the cost of a pool of simulated motions per motion (:mod:`benchmarks.simulated_pool`),
 ``python -m benchmarks flagship_selection FILE`` a flagship's stripes chosen without running a case (:mod:`benchmarks.flagship_selection`),
+``python -m benchmarks measure_seeds run|table FOLDER`` g* by conditioning measure and selection seed at Fox Plaza (:mod:`benchmarks.measure_seeds`),
 ``python -m benchmarks inelastic_demand`` simulated and recorded motions' inelastic demand at matched spectra (:mod:`benchmarks.inelastic_demand`).
 
 The thread pools of BLAS, OpenMP and numba are set to one thread here,
@@ -35,7 +36,7 @@ import time  # noqa: E402
 from pathlib import Path  # noqa: E402
 
 from benchmarks import compare, experiment_scale, measure_free, rare_events, rare_moat, report, site_motions, spectrum, startup, suite, yielding  # noqa: E402
-from benchmarks import inelastic_demand, measure_comparison, simulated_pool  # noqa: E402
+from benchmarks import inelastic_demand, measure_comparison, measure_seeds, simulated_pool  # noqa: E402
 from benchmarks.sections import keep_sections  # noqa: E402
 from benchmarks.timing import REPOSITORY  # noqa: E402
 
@@ -83,6 +84,8 @@ def main(argv: list[str] | None = None) -> int:
         from benchmarks import flagship_selection
 
         return flagship_selection.main(argv[1:])
+    if argv[:1] == ["measure_seeds"]:
+        return measure_seeds.main(argv[1:])
     if argv[:1] == ["inelastic_demand"]:
         return inelastic_demand.main(argv[1:])
     arguments = parse_arguments(argv)
@@ -99,7 +102,7 @@ def main(argv: list[str] | None = None) -> int:
     old = markdown.read_text() if markdown.exists() else ""
     sections = (experiment_scale.SECTION, compare.SECTION, spectrum.SECTION, yielding.SECTION, site_motions.SECTION, site_motions.HELD_OUT,
                 startup.SECTION, measure_free.SECTION, rare_moat.SECTION)
-    sections += (measure_comparison.SECTION, inelastic_demand.SECTION, simulated_pool.SECTION, simulated_pool.STARTUP)
+    sections += (measure_comparison.SECTION, measure_seeds.SECTION, inelastic_demand.SECTION, simulated_pool.SECTION, simulated_pool.STARTUP)
     markdown.write_text(keep_sections(old, report.document(results, info, elapsed), sections))
     print(f"wrote {markdown} and {figure} in {elapsed:.1f} s")
     return 0

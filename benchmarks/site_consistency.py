@@ -104,11 +104,13 @@ SCENARIO = (7.5, 10.0, "strike_slip", 0.01)
 @dataclass(frozen=True)
 class Pool:
     """The stripes' motions: ``motions`` a stripe, ``simulated`` site-based stochastic motions of each stripe's scenario added to the
-    100 records (``[site] simulated_motions``; 0: none), at most ``max_per_earthquake`` of an earthquake a stripe (None: no limit)."""
+    100 records (``[site] simulated_motions``; 0: none), drawn by ``sampling`` (``[site] simulated_sampling``: "scenario", or "tilted"
+    to each stripe's level), at most ``max_per_earthquake`` of an earthquake a stripe (None: no limit)."""
 
     motions: int = 20
     simulated: int = 0
     max_per_earthquake: int | None = None
+    sampling: str = "scenario"
 
     def intensity_lines(self) -> str:
         """The pool's lines of the ``[intensity]`` table."""
@@ -116,7 +118,9 @@ class Pool:
 
     def site_lines(self) -> str:
         """The pool's lines of the ``[site]`` table."""
-        return f"simulated_motions = {self.simulated}\n" if self.simulated else ""
+        if not self.simulated:
+            return ""
+        return f"simulated_motions = {self.simulated}\n" + ("" if self.sampling == "scenario" else f'simulated_sampling = "{self.sampling}"\n')
 
 
 #: The records alone, 20 motions a stripe (the pool of docs/intensity.md's first tables).
@@ -315,8 +319,10 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--motions", type=int, default=RECORDS_ONLY.motions, help="motions a stripe (default %(default)s)")
     parser.add_argument("--simulated-motions", type=int, default=0, help="site-based stochastic motions of each stripe's scenario added to the pool")
     parser.add_argument("--max-per-earthquake", type=int, default=None, help="at most this many motions of an earthquake a stripe")
+    parser.add_argument("--sampling", choices=("scenario", "tilted"), default="scenario",
+                        help="how the simulated motions are drawn ([site] simulated_sampling; default %(default)s)")
     args = parser.parse_args(argv)
-    args.pool = Pool(args.motions, args.simulated_motions, args.max_per_earthquake)
+    args.pool = Pool(args.motions, args.simulated_motions, args.max_per_earthquake, args.sampling)
     args.site = FOX_PLAZA if args.site == "fox_plaza" else _scenario_site(parser, args.scenario)
     args.return_periods = args.site.return_periods if args.return_periods is None else np.asarray(args.return_periods, dtype=float)
     args.measures = list(args.site.measures) if args.measures is None else args.measures

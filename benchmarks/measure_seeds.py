@@ -1,0 +1,225 @@
+"""g* by conditioning measure and selection seed at Fox Plaza: ``python -m benchmarks measure_seeds run|table FOLDER``.
+
+Issue 43's measure/seed study, on a pool of records and simulated motions. For every configuration of
+:mod:`benchmarks.site_consistency` (the elastic fixed pair beside its stiff or flexible neighbour; Building 1 on the friction
+pendulum, μ 0.05, no moat, stiff neighbour; contact-free), every Fox Plaza measure (PGA, PSA(T1 = 0.3 s), PSA(1 s),
+PSA(2 s), PSA(3 s), each with its own scenario fitted to the site's curves) and every selection seed: one experiment
+(:func:`benchmarks.site_consistency.measure_risk`: 40 motions a stripe, at most 3 of an earthquake, scale factor ≤ 5, from
+the 100 FEMA P695 records and ``--simulated`` site-based stochastic motions a stripe drawn by ``--sampling``; the selection's
+seed is the motions' seed too, so another seed is another pool).
+
+``run FOLDER`` keeps each experiment's result in ``FOLDER/<configuration>/<measure>-seed<k>.nc``: the rate of pounding over
+the gap grid from a lognormal demand per stripe (:func:`stochpound.risk.stripe_demand_rate`), g* at 10 % and 2 % in 50
+years from it, and the selection's diagnostics (the fitted scenario, the stripes' ε, their differences from the target). A
+result already there is not run again: an interrupted study resumes, and two invocations with different
+``--configurations`` run side by side (one core each).
+
+``table FOLDER`` prints the study's two tables from the results and, with ``--write``, rewrites the section of
+docs/benchmarks.md between its markers: per configuration and target, each measure's median g* over the seeds (their
+range), the spread over the measures' medians and over measures and seeds, the largest seed-to-seed spread of one measure
+in g* and in the rate of pounding at that measure's median g*; per configuration and measure, the selections' misses.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import time
+from pathlib import Path
+
+import numpy as np
+import xarray as xr
+
+from benchmarks.report import machine
+from benchmarks.sections import Section
+from benchmarks.site_consistency import CONFIGURATIONS, MEASURES, Pool, measure_risk
+from benchmarks.timing import REPOSITORY
+
+SECTION = Section("<!-- measure seeds: start -->", "<!-- measure seeds: end -->")
+#: The selection seeds of the study.
+SEEDS = (1, 2, 3, 4, 5)
+#: The diagnostics of a store's selection kept with a result.
+SELECTION = ("site_magnitude", "site_distance_km", "target_epsilon", "selection_misses_target", "selection_mean_ln", "selection_std_ln",
+             "target_median", "target_sigma_ln", "selection_simulated", "selection_earthquakes")
+
+
+def result_path(folder: Path, configuration: str, measure: str, seed: int) -> Path:
+    """Where one experiment's result is kept."""
+    name = measure.replace("(", "").replace(")", "").replace(" = ", "_").replace(" ", "").replace(".", "p").lower()
+    return folder / configuration.replace(" ", "_") / f"{name}-seed{seed}.nc"
+
+
+def run_one(folder: Path, configuration: str, measure: str, seed: int, pool: Pool) -> xr.Dataset:
+    """One experiment's result (module docstring): its pounding rate over the gap grid, g* and the selection's diagnostics."""
+    from stochpound.risk import contact_free_closure, risk_targeted_separation, stripe_demand_rate
+
+    work = folder / "work" / f"{configuration.replace(' ', '_')}-{seed}"
+    work.mkdir(parents=True, exist_ok=True)
+    began = time.time()
+    store, risk = measure_risk(work, measure, configuration, seed=seed, pool=pool)
+    rate = stripe_demand_rate(contact_free_closure(store), risk.fragility["gap"].values, risk.hazard)
+    separation = risk_targeted_separation(xr.Dataset({"maf": rate}), risk.separation["target"].values, risk.years)["separation"]
+    kept = store[[name for name in SELECTION if name in store]].drop_encoding().assign(rate=rate, separation=separation)
+    kept.attrs = {"configuration": configuration, "measure": measure, "seed": seed, "simulated": pool.simulated, "sampling": pool.sampling,
+                  "seconds": time.time() - began}
+    return kept
+
+
+def run(folder: Path, configurations: list[str], measures: list[str], seeds: list[int], pool: Pool) -> None:
+    """Every result not yet in ``folder`` (module docstring), one after the other."""
+    for configuration in configurations:
+        for seed in seeds:
+            for measure in measures:
+                path = result_path(folder, configuration, measure, seed)
+                if path.exists():
+                    continue
+                path.parent.mkdir(parents=True, exist_ok=True)
+                result = run_one(folder, configuration, measure, seed, pool)
+                result.to_netcdf(path.with_suffix(".part"))
+                os.replace(path.with_suffix(".part"), path)
+                print(f"{configuration}, {measure}, seed {seed}: {result.attrs['seconds']:.0f} s", flush=True)
+
+
+def _cells(values: xr.DataArray) -> list[tuple[str, dict]]:
+    """The configuration cells of a result's variable (its dimensions other than gap, target and intensity), named."""
+    others = [d for d in values.dims if d not in ("gap", "target", "measure", "seed")]
+    if not others:
+        return [("", {})]
+    stacked = values.stack(cell=others)
+    cells = []
+    for cell in stacked["cell"].values:
+        cell = cell if isinstance(cell, tuple) else (cell,)
+        cells.append((", ".join(f"{v} {d}" for d, v in zip(others, cell)), dict(zip(others, cell))))
+    return cells
+
+
+def _rate_at(rate: xr.DataArray, gap: float) -> float:
+    """The rate of pounding (1/yr) at ``gap`` (m), interpolated in log rate over the result's own gap grid (the results' grids
+    differ: joined, each holds NaN at the others' gaps)."""
+    rate = rate.dropna("gap")
+    gaps, rates = rate["gap"].values, np.log(np.maximum(rate.values, 1e-300))
+    return float(np.exp(np.interp(gap, gaps, rates)))
+
+
+def load(folder: Path, configuration: str, measures: list[str], seeds: list[int]) -> tuple[xr.DataArray, xr.DataArray, dict]:
+    """g* (measure × seed × target × cells), the rate (measure × seed × gap × cells) and the selections of a configuration."""
+    separations, rates, selections = [], [], {}
+    for measure in measures:
+        runs = [xr.open_dataset(result_path(folder, configuration, measure, seed)).load() for seed in seeds]
+        separations.append(xr.concat([r["separation"] for r in runs], dim="seed"))
+        rates.append(xr.concat([r["rate"] for r in runs], dim="seed", join="outer"))  # each on its own gap grid
+        selections[measure] = runs
+    coords = {"measure": measures, "seed": seeds}
+    return (xr.concat(separations, dim="measure").assign_coords(coords), xr.concat(rates, dim="measure", join="outer").assign_coords(coords),
+            selections)
+
+
+def spread_rows(configuration: str, separation: xr.DataArray, rate: xr.DataArray) -> list[list[str]]:
+    """The g* table's rows of a configuration (module docstring)."""
+    rows = []
+    for name, cell in _cells(separation):
+        for target in separation["target"].values:
+            g = separation.sel(target=target, **cell)
+            medians = g.median("seed")
+            row = [f"{configuration}{', ' + name if name else ''}, {target:.0%} in 50 yr"]
+            row += [f"{float(medians.sel(measure=m)):.3f} ({float(g.sel(measure=m).min()):.3f}–{float(g.sel(measure=m).max()):.3f})"
+                    for m in g["measure"].values]
+            seed_spread = g.max("seed") / g.min("seed")
+            worst = str(seed_spread.idxmax("measure").values)
+            lam = {m: [_rate_at(rate.sel(measure=m, seed=s, **cell), float(medians.sel(measure=m))) for s in g["seed"].values]
+                   for m in g["measure"].values}
+            lam_spread = {m: max(v) / min(v) for m, v in lam.items()}
+            worst_lam = max(lam_spread, key=lam_spread.get)
+            row += [f"×{float(medians.max() / medians.min()):.2f}", f"×{float(g.max() / g.min()):.2f}",
+                    f"×{float(seed_spread.max()):.2f} ({worst})", f"×{lam_spread[worst_lam]:.2f} ({worst_lam})"]
+            rows.append(row)
+    return rows
+
+
+def selection_rows(configuration: str, selections: dict) -> list[list[str]]:
+    """The selections' table rows of a configuration: per measure, the fitted scenario (seed 1's), the stripes' ε, the stripes
+    that miss their target over all seeds, the worst difference and what the stripes hold."""
+    rows = []
+    for measure, runs in selections.items():
+        first = runs[0]
+        misses = sum(int(r["selection_misses_target"].sum()) for r in runs)
+        total = sum(r.sizes["intensity"] for r in runs)
+        worst_mean = max(float(np.abs(r["selection_mean_ln"] - np.log(r["target_median"])).max()) for r in runs)
+        worst_std = max(float(np.abs(r["selection_std_ln"] - r["target_sigma_ln"]).max()) for r in runs)
+        simulated = np.concatenate([r["selection_simulated"].values for r in runs])
+        earthquakes = np.concatenate([r["selection_earthquakes"].values for r in runs])
+        eps = first["target_epsilon"].values
+        rows.append([f"{configuration}, {measure}", f"M {float(first['site_magnitude'][0]):.2g} at {float(first['site_distance_km'][0]):.3g} km",
+                     f"{eps.min():.1f} to {eps.max():.1f}", f"{misses} of {total}", f"{worst_mean:.2f} / {worst_std:.2f}",
+                     f"{simulated.min()}–{simulated.max()}", f"{earthquakes.min()}–{earthquakes.max()}"])
+    return rows
+
+
+def _markdown(header: list[str], rows: list[list[str]]) -> list[str]:
+    return ["| " + " | ".join(header) + " |", "|" + "---|" * len(header), *("| " + " | ".join(row) + " |" for row in rows)]
+
+
+def section(folder: Path, configurations: list[str], measures: list[str], seeds: list[int]) -> str:
+    """The section of docs/benchmarks.md (its markers included)."""
+    spreads, selected, seconds, settings = [], [], [], None
+    for configuration in configurations:
+        separation, rate, selections = load(folder, configuration, measures, seeds)
+        spreads += spread_rows(configuration, separation, rate)
+        selected += selection_rows(configuration, selections)
+        seconds += [r.attrs["seconds"] for runs in selections.values() for r in runs]
+        settings = settings or selections[measures[0]][0].attrs
+    provenance = json.loads((folder / "provenance.json").read_text()) if (folder / "provenance.json").exists() else {}
+    lines = [SECTION.start, "## g* by conditioning measure and selection seed at Fox Plaza", "",
+             f"`python -m benchmarks measure_seeds run FOLDER --simulated {settings['simulated']} --sampling {settings['sampling']}`, then "
+             "`python -m benchmarks measure_seeds table FOLDER --write` (issue 43's measure/seed study; "
+             f"{len(seconds)} experiments, {min(seconds):.0f}–{max(seconds):.0f} s each, {sum(seconds) / 60:.0f} min in all; "
+             f"commit {provenance.get('commit', 'unknown')}, started {provenance.get('date', 'unknown')}, "
+             f"load {provenance.get('load average (1 min) at start', 'unknown')} at start). The elastic buildings of `benchmarks.site_consistency`, "
+             "contact-free, stripes at the intensities of 10, 25, 72, 224, 475, 975, 2475 and 5000 years of each measure "
+             "(PSA(0.3 s)'s curve stops at 3431 years: its top stripe there), each measure with its own scenario fitted to the "
+             "site's PGA, PSA(1, 2, 3 s) curves (and its own), Vs30 400 m/s, reverse faulting; 40 motions a stripe, at most 3 of "
+             "one earthquake, scale factor ≤ 5, from the 100 FEMA P695 records and "
+             f"{settings['simulated']} site-based stochastic motions a stripe ({settings['sampling']} sampling, `[site] simulated_sampling`; "
+             "the hazard-compatible model with its current calibration; the selection's seed is the motions' seed too, so another "
+             f"seed is another pool). Seeds {', '.join(map(str, seeds))}. g* (m) from a lognormal demand per stripe "
+             "(`stripe_demand_rate`): the median over the seeds (their range); the spread over the measures' medians and over "
+             "every measure and seed; the largest seed-to-seed spread of one measure, in g* and in the rate of pounding λ at "
+             "that measure's median g*:", ""]
+    lines += _markdown(["configuration, target", *measures, "max/min over the measures' medians", "over measures and seeds",
+                        "seed spread of g*, largest (measure)", "seed spread of λ at the median g*, largest (measure)"], spreads)
+    lines += ["", "The selections, over all seeds: the fitted scenario, the stripes' ε, the stripes that miss their target by "
+              "more than 0.1 in the mean or σ of ln Sa at some period, the worst difference, and what the stripes hold:", ""]
+    lines += _markdown(["configuration, measure", "fitted scenario", "ε of the stripes", "stripes off by > 0.1", "worst: mean / σ of ln Sa off by",
+                        "simulated of 40 a stripe", "earthquakes a stripe"], selected)
+    lines += ["", "Not run: Sa_avg (the bundled Fox Plaza curves are per period; a curve of the average needs the site's ruptures, "
+              "which are not bundled: `benchmarks.site_consistency --site scenario` has it). Conclusions: "
+              "[intensity.md](intensity.md) (\"The measure and seed study on tilted pools\").", SECTION.end]
+    return "\n".join(lines) + "\n"
+
+
+def main(argv: list[str] | None = None) -> int:
+    """``run`` or ``table`` (module docstring)."""
+    parser = argparse.ArgumentParser(prog="python -m benchmarks measure_seeds", description=__doc__.splitlines()[0])
+    parser.add_argument("action", choices=("run", "table"))
+    parser.add_argument("folder", type=Path)
+    parser.add_argument("--configurations", nargs="+", default=list(CONFIGURATIONS), choices=list(CONFIGURATIONS))
+    parser.add_argument("--measures", nargs="+", default=list(MEASURES), choices=list(MEASURES))
+    parser.add_argument("--seeds", nargs="+", type=int, default=list(SEEDS))
+    parser.add_argument("--simulated", type=int, default=2000, help="simulated motions a stripe (default %(default)s)")
+    parser.add_argument("--sampling", choices=("scenario", "tilted"), default="tilted")
+    parser.add_argument("--write", action="store_true", help="rewrite the section of docs/benchmarks.md")
+    arguments = parser.parse_args(argv)
+    if arguments.action == "run":
+        arguments.folder.mkdir(parents=True, exist_ok=True)
+        provenance = arguments.folder / "provenance.json"
+        if not provenance.exists():
+            provenance.write_text(json.dumps({**machine(), "date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime())}))
+        run(arguments.folder, arguments.configurations, arguments.measures, arguments.seeds,
+            Pool(40, arguments.simulated, 3, arguments.sampling))
+        return 0
+    text = section(arguments.folder, arguments.configurations, arguments.measures, arguments.seeds)
+    print(text)
+    if arguments.write:
+        SECTION.write(REPOSITORY / "docs" / "benchmarks.md", text)
+    return 0

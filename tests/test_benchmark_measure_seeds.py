@@ -1,0 +1,61 @@
+"""benchmarks.measure_seeds: the study's tables from its kept results, and a run that resumes without redoing a result."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import xarray as xr
+
+from benchmarks import measure_seeds
+from benchmarks.site_consistency import Pool
+
+GAPS = np.linspace(0.01, 1.0, 100)
+
+
+def _result(scale: float, decay: float, separation: list[list[float]], gaps: np.ndarray = GAPS) -> xr.Dataset:
+    """A result of two neighbours: the rate scale·exp(−gap/decay) (1/yr) over ``gaps`` (m), the g* given (neighbour × target)."""
+    rate = xr.DataArray(np.outer(scale * np.exp(-gaps / decay), [1.0, 1.0]), dims=("gap", "neighbour"),
+                        coords={"gap": gaps, "neighbour": ["stiff", "flexible"]})
+    g = xr.DataArray(separation, dims=("neighbour", "target"), coords={"neighbour": ["stiff", "flexible"], "target": [0.1, 0.02]})
+    return xr.Dataset({"rate": rate, "separation": g})
+
+
+def test_the_spread_table_gives_the_medians_and_the_spreads_over_measures_seeds_and_rates() -> None:
+    scales = {"PGA": [1.0, 2.0, 1.5], "PSA(1 s)": [1.0, 1.0, 1.0]}
+    g = {"PGA": [0.10, 0.12, 0.11], "PSA(1 s)": [0.13, 0.13, 0.14]}
+    separation = xr.concat([xr.concat([_result(scales[m][k], 0.1, [[g[m][k], 2 * g[m][k]], [g[m][k], 2 * g[m][k]]])["separation"]
+                                       for k in range(3)], dim="seed") for m in scales], dim="measure")
+    # each result on its own gap grid, as the risk chain's grids differ from store to store (joined, NaN at the others' gaps)
+    rate = xr.concat([xr.concat([_result(scales[m][k], 0.1, [[0, 0], [0, 0]], GAPS * (1 + 0.003 * (3 * j + k)))["rate"] for k in range(3)], dim="seed",
+                                join="outer") for j, m in enumerate(scales)], dim="measure", join="outer")
+    coords = {"measure": list(scales), "seed": [1, 2, 3]}
+    rows = measure_seeds.spread_rows("fixed pair", separation.assign_coords(coords), rate.assign_coords(coords))
+    assert len(rows) == 4  # two neighbours × two targets
+    first = rows[0]
+    assert first[0] == "fixed pair, stiff neighbour, 10% in 50 yr"
+    assert first[1] == "0.110 (0.100–0.120)" and first[2] == "0.130 (0.130–0.140)"
+    assert first[3] == f"×{0.13 / 0.11:.2f}"  # over the measures' medians
+    assert first[4] == f"×{0.14 / 0.10:.2f}"  # over every measure and seed
+    assert first[5] == f"×{0.12 / 0.10:.2f} (PGA)"
+    assert first[6] == "×2.00 (PGA)"  # the rates differ by their scale alone, wherever they are read
+
+
+def test_a_run_keeps_each_result_and_does_not_redo_it(tmp_path, monkeypatch) -> None:
+    done = []
+
+    def fake(folder, configuration, measure, seed, pool):
+        done.append((configuration, measure, seed))
+        return _result(1.0, 0.1, [[0.1, 0.2], [0.1, 0.2]]).assign_attrs(seconds=1.0)
+
+    monkeypatch.setattr(measure_seeds, "run_one", fake)
+    pool = Pool(40, 10, 3, "tilted")
+    measure_seeds.run(tmp_path, ["fixed pair"], ["PGA", "PSA(1 s)"], [1, 2], pool)
+    assert len(done) == 4
+    measure_seeds.run(tmp_path, ["fixed pair", "isolated"], ["PGA", "PSA(1 s)"], [1, 2], pool)
+    assert done[4:] == [("isolated", m, s) for s in (1, 2) for m in ("PGA", "PSA(1 s)")]
+    assert measure_seeds.result_path(tmp_path, "fixed pair", "PSA(T1 = 0.3 s)", 3).name == "psat1_0p3s-seed3.nc"
+
+
+@pytest.mark.parametrize("sampling, line", [("tilted", 'simulated_sampling = "tilted"\n'), ("scenario", "")])
+def test_the_pool_writes_its_sampling_only_when_tilted(sampling: str, line: str) -> None:
+    assert Pool(40, 2000, 3, sampling).site_lines() == "simulated_motions = 2000\n" + line
