@@ -37,6 +37,8 @@ from benchmarks.site_consistency import CONFIGURATIONS, MEASURES, Pool, measure_
 from benchmarks.timing import REPOSITORY
 
 SECTION = Section("<!-- measure seeds: start -->", "<!-- measure seeds: end -->")
+#: The study's first run (untilted pools of 1000, 2026-12-02), a section of docs/benchmarks.md no command writes: kept as measured.
+UNTILTED = Section("<!-- measure seeds untilted: start -->", "<!-- measure seeds untilted: end -->")
 #: The selection seeds of the study.
 SEEDS = (1, 2, 3, 4, 5)
 #: The diagnostics of a store's selection kept with a result.

@@ -102,7 +102,7 @@ def main(argv: list[str] | None = None) -> int:
     old = markdown.read_text() if markdown.exists() else ""
     sections = (experiment_scale.SECTION, compare.SECTION, spectrum.SECTION, yielding.SECTION, site_motions.SECTION, site_motions.HELD_OUT,
                 startup.SECTION, measure_free.SECTION, rare_moat.SECTION)
-    sections += (measure_comparison.SECTION, measure_seeds.SECTION, inelastic_demand.SECTION, simulated_pool.SECTION, simulated_pool.STARTUP)
+    sections += (measure_comparison.SECTION, measure_seeds.UNTILTED, measure_seeds.SECTION, inelastic_demand.SECTION, simulated_pool.SECTION, simulated_pool.STARTUP)
     markdown.write_text(keep_sections(old, report.document(results, info, elapsed), sections))
     print(f"wrote {markdown} and {figure} in {elapsed:.1f} s")
     return 0

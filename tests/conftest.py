@@ -47,10 +47,10 @@ def laws_store(tmp_path_factory):
 def tilted_experiment(tmp_path_factory):
     """A small experiment of a pool tilted to each stripe (:func:`tests.helpers.tilted_site_text`; its pilot reduced to 48
     motions), its selection made."""
-    from stochpound.experiment import _site
+    from stochpound.experiment import _stripe_pools
 
     with pytest.MonkeyPatch.context() as patch:
-        patch.setattr(_site, "TILT_PILOT", 48)
+        patch.setattr(_stripe_pools, "TILT_PILOT", 48)
         experiment = load_experiment(write_experiment(tmp_path_factory.mktemp("tilted"), tilted_site_text(), "tilted.toml"))
         experiment.selection
         return experiment

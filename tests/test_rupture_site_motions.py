@@ -12,7 +12,7 @@ from scipy.stats import norm
 from stochpound import open_store
 from stochpound.analysis import RuptureSite
 from stochpound.experiment._runner import load_experiment, run_experiment
-from stochpound.experiment._site import largest_remainders, rupture_allotment
+from stochpound.experiment._stripe_pools import largest_remainders, rupture_allotment
 from stochpound.experiment._sources import resolve_motions
 from stochpound.experiment._spec import ExperimentError, parse_experiment
 from stochpound.motions import GEOMETRY_FIELDS, Scenario, site_model_provenance, site_motions

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from stochpound.experiment import _site
+from stochpound.experiment import _stripe_pools
 from stochpound.motions import Scenario, conditional_spectrum, response_spectrum, scenario_distribution, select_motions, selection_pool, site_motions
 from stochpound.motions import _site_model
 from stochpound.motions._selection import array_pool, pool_intensity
@@ -50,21 +50,21 @@ def test_the_array_pool_is_the_records_pool_bit_for_bit(motions, measure, period
 @pytest.fixture(scope="module")
 def full_pool() -> xr.Dataset:
     with pytest.MonkeyPatch.context() as patch:
-        patch.setattr(_site, "SIMULATED_CHUNK", 16)
-        return _site.simulated_pool(TABLE, PERIODS, "psa", 1.0, G)
+        patch.setattr(_stripe_pools, "SIMULATED_CHUNK", 16)
+        return _stripe_pools.simulated_pool(TABLE, PERIODS, "psa", 1.0, G)
 
 
 def _screened(monkeypatch, screen: float, threads: int = 1) -> xr.Dataset:
-    monkeypatch.setattr(_site, "SIMULATED_CHUNK", 16)
-    monkeypatch.setattr(_site, "SCREEN_BASE", 12)
+    monkeypatch.setattr(_stripe_pools, "SIMULATED_CHUNK", 16)
+    monkeypatch.setattr(_stripe_pools, "SCREEN_BASE", 12)
     monkeypatch.setattr(_site_model, "motion_threads", lambda: threads)
-    return _site.simulated_pool(TABLE, PERIODS, "psa", 1.0, G, screen)
+    return _stripe_pools.simulated_pool(TABLE, PERIODS, "psa", 1.0, G, screen)
 
 
 def test_the_pool_is_every_motion_of_the_table_with_its_realization(full_pool):
     """Chunk by chunk, the pool holds the table's n motions in order, each the spectrum of the motion its realization regenerates."""
     assert full_pool["motion"].values.tolist() == [str(i) for i in range(TABLE["n"])]
-    again = _site.table_accelerations(TABLE, [7, 30])
+    again = _stripe_pools.table_accelerations(TABLE, [7, 30])
     np.testing.assert_array_equal(full_pool["psa"].values[[7, 30]], pseudo_spectra(again, 0.01, PERIODS) / G)
     np.testing.assert_array_equal(full_pool["intensity"].values[[7, 30]], pool_intensity(again, 0.01, "psa", 1.0, 0.05, G))
 
@@ -93,11 +93,11 @@ def test_the_screen_level_is_the_top_stripe_s_epsilon_less_the_margin(monkeypatc
                for level, scenario in zip((median * 2.0, median * 4.0, median * 20.0), scenarios)]
     top = float(targets[1].attrs["epsilon"])
     assert top > float(targets[0].attrs["epsilon"])
-    big = SimulatedMotions(_site.SCREEN_BASE + 1, "hazard_compatible", "any", 1, 0.01)
-    level = _site.screen_level(big, 0, scenarios, targets, "psa", 1.0)
-    assert np.log(level / median) / sigma == pytest.approx(top - _site.SCREEN_MARGIN, abs=1e-12)
-    assert _site.screen_level(big, 1, scenarios, targets, "psa", 1.0) == level
-    assert _site.screen_level(SimulatedMotions(_site.SCREEN_BASE, "hazard_compatible", "any", 1, 0.01), 0, scenarios, targets, "psa", 1.0) is None
+    big = SimulatedMotions(_stripe_pools.SCREEN_BASE + 1, "hazard_compatible", "any", 1, 0.01)
+    level = _stripe_pools.screen_level(big, 0, scenarios, targets, "psa", 1.0)
+    assert np.log(level / median) / sigma == pytest.approx(top - _stripe_pools.SCREEN_MARGIN, abs=1e-12)
+    assert _stripe_pools.screen_level(big, 1, scenarios, targets, "psa", 1.0) == level
+    assert _stripe_pools.screen_level(SimulatedMotions(_stripe_pools.SCREEN_BASE, "hazard_compatible", "any", 1, 0.01), 0, scenarios, targets, "psa", 1.0) is None
 
 
 def test_the_screened_pool_chooses_as_the_full_pool_where_its_choices_lie_beyond_the_screen(monkeypatch, full_pool):
@@ -123,8 +123,8 @@ def test_an_experiment_s_stripes_select_from_the_screened_pool(tmp_path, monkeyp
     from stochpound.experiment._runner import load_experiment
     from tests.helpers import SITE_SCENE, write_experiment
 
-    monkeypatch.setattr(_site, "SCREEN_BASE", 6)
-    monkeypatch.setattr(_site, "SCREEN_MARGIN", 0.5)
+    monkeypatch.setattr(_stripe_pools, "SCREEN_BASE", 6)
+    monkeypatch.setattr(_stripe_pools, "SCREEN_MARGIN", 0.5)
     records = "".join(f'\n[[records]]\nrecord = "fema_p695_far_field/{i:02d}{c}"\nduration = 5.0\n' for i in (1, 2) for c in "ab")
     intensity = ('[intensity]\nmeasure = "psa"\nperiod = 0.5\nlevels = [0.3, 0.1]\nselection = "conditional_spectrum"\nmotions = 4\n'
                  'max_scale_factor = 5.0\nseed = 2\n')
@@ -135,7 +135,7 @@ def test_an_experiment_s_stripes_select_from_the_screened_pool(tmp_path, monkeyp
     median, sigma = scenario_distribution("psa", 0.5, scenario=scenario)
     top = max(float(target.attrs["epsilon"]) for target in selection.targets)
     table = {**TABLE, "magnitude": 7.0, "n": 16, "seed": 2}
-    own = np.log(pool_intensity(_site.table_accelerations(table, range(16)), 0.01, "psa", 0.5, 0.05, G) / median) / sigma
+    own = np.log(pool_intensity(_stripe_pools.table_accelerations(table, range(16)), 0.01, "psa", 0.5, 0.05, G) / median) / sigma
     kept = 6 + int(np.sum(own[6:] >= top - 0.5))
     assert 6 < kept < 16  # the screen leaves some out and keeps some
     assert all(chosen.attrs["pool"] == 4 + kept for chosen in selection.selections)

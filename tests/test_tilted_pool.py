@@ -12,7 +12,7 @@ import tomllib
 import numpy as np
 import pytest
 
-from stochpound.experiment import _site
+from stochpound.experiment import _stripe_pools
 from stochpound.experiment._spec import ExperimentError, parse_experiment
 from stochpound.model.scene_file import scene_from_dict
 from stochpound.motions import Scenario, parameter_normals, site_motions, site_motions_from_normals
@@ -57,11 +57,11 @@ def test_the_fit_is_least_squares_and_the_shift_centres_the_line_on_the_level_al
     rng = np.random.default_rng(8)
     z = rng.standard_normal((500, 6))
     slope = np.array([0.3, -0.1, 0.0, 0.25, 0.05, -0.2])
-    exact = _site.Tilt.fit(z, -1.2 + z @ slope)
+    exact = _stripe_pools.Tilt.fit(z, -1.2 + z @ slope)
     assert exact.intercept == pytest.approx(-1.2, abs=1e-12) and np.allclose(exact.slope, slope, atol=1e-12)
     noisy = -1.2 + z @ slope + 0.3 * rng.standard_normal(500)
     expected = np.linalg.lstsq(np.column_stack([np.ones(500), z]), noisy, rcond=None)[0]
-    fitted = _site.Tilt.fit(z, noisy)
+    fitted = _stripe_pools.Tilt.fit(z, noisy)
     np.testing.assert_allclose([fitted.intercept, *fitted.slope], expected, rtol=0, atol=1e-12)
     shift = np.array(exact.shift(0.9))
     t = (math.log(0.9) + 1.2) / float(slope @ slope)
@@ -75,7 +75,7 @@ def test_the_shift_keeps_the_normals_distribution_given_their_projection_and_mov
     direction moves the orthogonal part (the check can fail)."""
     rng = np.random.default_rng(11)
     slope = np.array([0.4, -0.2, 0.1, 0.3])
-    tilt = _site.Tilt(-1.0, tuple(slope))
+    tilt = _stripe_pools.Tilt(-1.0, tuple(slope))
     unit = slope / np.linalg.norm(slope)
     orthogonal = np.eye(4) - np.outer(unit, unit)
     n = 40_000
@@ -101,8 +101,8 @@ def test_the_tilted_pool_s_definition_and_tables(tilted_experiment):
     selection = tilted_experiment.selection
     assert any(selection.simulated)  # the test below regenerates one
     with pytest.MonkeyPatch.context() as patch:
-        patch.setattr(_site, "TILT_PILOT", 48)
-        tables = [_site.tilted_sources(setting, stripe, SCENARIO, level, {}, "psa", 0.5, G)
+        patch.setattr(_stripe_pools, "TILT_PILOT", 48)
+        tables = [_stripe_pools.tilted_sources(setting, stripe, SCENARIO, level, {}, "psa", 0.5, G)
                   for stripe, level in enumerate([0.2, 0.6])]
     first = [next(iter(t.values())).motion for t in tables]
     assert first[0]["seed"] != first[1]["seed"] and all(len(t["normal_shift"]) == NORMALS for t in first)
@@ -120,18 +120,18 @@ def test_a_chosen_tilted_motion_is_regenerated_bit_for_bit_from_its_table_alone(
     table = source.motion
     building = {"name": "B1", "mass": [1.0e5], "stiffness": [1.5e7], "damping_ratio": 0.05}
     alone = scene_from_dict({"building": [building], "motion": dict(table)}).motion.values
-    rows = {int(i): row for chunk_rows, accelerations, _ in _site.table_chunks(table, "psa", 0.5, G)
+    rows = {int(i): row for chunk_rows, accelerations, _ in _stripe_pools.table_chunks(table, "psa", 0.5, G)
             for i, row in zip(chunk_rows, accelerations)}
     assert alone.tobytes() == rows[table["realization"]].tobytes()
 
 
 def test_the_tilt_is_the_same_whatever_the_threads(monkeypatch):
     setting = SimulatedMotions(8, "hazard_compatible", "x", 3, 0.01, "tilted")
-    monkeypatch.setattr(_site, "TILT_PILOT", 24)
+    monkeypatch.setattr(_stripe_pools, "TILT_PILOT", 24)
     tilts = []
     for threads in (1, 2):
         monkeypatch.setattr(_site_model, "motion_threads", lambda threads=threads: threads)
-        tilts.append(_site.tilt_pilot(setting, SCENARIO, "psa", 0.5, G))
+        tilts.append(_stripe_pools.tilt_pilot(setting, SCENARIO, "psa", 0.5, G))
     assert tilts[0] == tilts[1]
 
 
@@ -139,12 +139,12 @@ def test_a_tilted_pool_centres_its_stripe_s_measure_on_the_level(monkeypatch):
     """64 tilted motions at a level of ε ≈ 2: their mean ln IM* lies within 3 standard errors of ln level, the untilted
     scenario's 4 or more below it (the check can fail)."""
     setting = SimulatedMotions(64, "hazard_compatible", "x", 5, 0.01, "tilted")
-    monkeypatch.setattr(_site, "TILT_PILOT", 64)
-    pilot = _site.scenario_table(setting, SCENARIO, 64, 5)
-    untilted = np.log(np.concatenate([i for _, _, i in _site.table_chunks(pilot, "psa", 0.5, G)]))
+    monkeypatch.setattr(_stripe_pools, "TILT_PILOT", 64)
+    pilot = _stripe_pools.scenario_table(setting, SCENARIO, 64, 5)
+    untilted = np.log(np.concatenate([i for _, _, i in _stripe_pools.table_chunks(pilot, "psa", 0.5, G)]))
     level = math.exp(untilted.mean() + 2.0 * untilted.std())
-    table = next(iter(_site.tilted_sources(setting, 0, SCENARIO, level, {}, "psa", 0.5, G).values())).motion
-    tilted = np.log(np.concatenate([i for _, _, i in _site.table_chunks(table, "psa", 0.5, G)]))
+    table = next(iter(_stripe_pools.tilted_sources(setting, 0, SCENARIO, level, {}, "psa", 0.5, G).values())).motion
+    tilted = np.log(np.concatenate([i for _, _, i in _stripe_pools.table_chunks(table, "psa", 0.5, G)]))
     error = tilted.std(ddof=1) / math.sqrt(tilted.size)
     assert abs(tilted.mean() - math.log(level)) < 3.0 * error
     assert math.log(level) - untilted.mean() > 4.0 * untilted.std(ddof=1) / math.sqrt(untilted.size)

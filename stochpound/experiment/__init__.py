@@ -39,7 +39,8 @@ from stochpound.experiment._estimate import LARGE_RUN_BYTES, LARGE_RUN_CASES  # 
 from stochpound.store import CASE  # noqa: F401
 from stochpound.experiment._measure_choice import hazard_measures, measure_choice  # noqa: F401
 from stochpound.experiment._parts import parts_folder, read_experiment_json  # noqa: F401
-from stochpound.experiment._site import TILT_PILOT, Tilt, periods_of_interest, scenario_table, table_chunks, table_scenario, tilted_seed  # noqa: F401
+from stochpound.experiment._site import periods_of_interest  # noqa: F401
+from stochpound.experiment._stripe_pools import TILT_PILOT, Tilt, scenario_table, table_chunks, table_scenario, tilted_seed  # noqa: F401
 from stochpound.experiment._sources import resolve_motions  # noqa: F401
 from stochpound.experiment._file_assembly import PartsIndex  # noqa: F401
 from stochpound.experiment._rare_event_table import CLOSURES  # noqa: F401

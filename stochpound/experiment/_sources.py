@@ -18,7 +18,7 @@ import numpy as np
 from stochpound import motions as synthetic_motions
 from stochpound.experiment._experiment import Experiment
 from stochpound.experiment._intensity import check_resolution, ensemble_intensity
-from stochpound.experiment._site import simulated_motions
+from stochpound.experiment._stripe_pools import simulated_motions
 from stochpound.store import CASE, MotionSource, canonical_json, with_motion
 from stochpound.experiment._spec import ExperimentError, field_errors
 from stochpound.motions.ground import GroundMotion, SampledMotion
