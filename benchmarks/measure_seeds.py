@@ -33,7 +33,7 @@ import xarray as xr
 
 from benchmarks.report import machine
 from benchmarks.sections import Section
-from benchmarks.site_consistency import CONFIGURATIONS, MEASURES, Pool, measure_risk
+from benchmarks.site_consistency import CONFIGURATIONS, FOX_PLAZA, MEASURE_ARGS, SCENARIO, Pool, Site, measure_risk, scenario_site
 from benchmarks.timing import REPOSITORY
 
 SECTION = Section("<!-- measure seeds: start -->", "<!-- measure seeds: end -->")
@@ -52,14 +52,14 @@ def result_path(folder: Path, configuration: str, measure: str, seed: int) -> Pa
     return folder / configuration.replace(" ", "_") / f"{name}-seed{seed}.nc"
 
 
-def run_one(folder: Path, configuration: str, measure: str, seed: int, pool: Pool) -> xr.Dataset:
+def run_one(folder: Path, configuration: str, measure: str, seed: int, pool: Pool, site: Site = FOX_PLAZA) -> xr.Dataset:
     """One experiment's result (module docstring): its pounding rate over the gap grid, g* and the selection's diagnostics."""
     from stochpound.risk import contact_free_closure, risk_targeted_separation, stripe_demand_rate
 
     work = folder / "work" / f"{configuration.replace(' ', '_')}-{seed}"
     work.mkdir(parents=True, exist_ok=True)
     began = time.time()
-    store, risk = measure_risk(work, measure, configuration, seed=seed, pool=pool)
+    store, risk = measure_risk(work, measure, configuration, seed=seed, pool=pool, site=site)
     rate = stripe_demand_rate(contact_free_closure(store), risk.fragility["gap"].values, risk.hazard)
     separation = risk_targeted_separation(xr.Dataset({"maf": rate}), risk.separation["target"].values, risk.years)["separation"]
     kept = store[[name for name in SELECTION if name in store]].drop_encoding().assign(rate=rate, separation=separation)
@@ -68,7 +68,7 @@ def run_one(folder: Path, configuration: str, measure: str, seed: int, pool: Poo
     return kept
 
 
-def run(folder: Path, configurations: list[str], measures: list[str], seeds: list[int], pool: Pool) -> None:
+def run(folder: Path, configurations: list[str], measures: list[str], seeds: list[int], pool: Pool, site: Site = FOX_PLAZA) -> None:
     """Every result not yet in ``folder`` (module docstring), one after the other."""
     for configuration in configurations:
         for seed in seeds:
@@ -77,7 +77,7 @@ def run(folder: Path, configurations: list[str], measures: list[str], seeds: lis
                 if path.exists():
                     continue
                 path.parent.mkdir(parents=True, exist_ok=True)
-                result = run_one(folder, configuration, measure, seed, pool)
+                result = run_one(folder, configuration, measure, seed, pool, site)
                 result.to_netcdf(path.with_suffix(".part"))
                 os.replace(path.with_suffix(".part"), path)
                 print(f"{configuration}, {measure}, seed {seed}: {result.attrs['seconds']:.0f} s", flush=True)
@@ -162,22 +162,35 @@ def _markdown(header: list[str], rows: list[list[str]]) -> list[str]:
     return ["| " + " | ".join(header) + " |", "|" + "---|" * len(header), *("| " + " | ".join(row) + " |" for row in rows)]
 
 
-def section(folder: Path, configurations: list[str], measures: list[str], seeds: list[int]) -> str:
-    """The section of docs/benchmarks.md (its markers included)."""
-    spreads, selected, seconds, settings = [], [], [], None
+def tables(folder: Path, configurations: list[str], measures: list[str], seeds: list[int]) -> tuple[list[list[str]], list[list[str]], list[float], dict]:
+    """The rows of the g* table and of the selections' table, each experiment's seconds and the first result's settings."""
+    spreads, selected, seconds, settings = [], [], [], {}
     for configuration in configurations:
         separation, rate, selections = load(folder, configuration, measures, seeds)
         spreads += spread_rows(configuration, separation, rate)
         selected += selection_rows(configuration, selections)
         seconds += [r.attrs["seconds"] for runs in selections.values() for r in runs]
         settings = settings or selections[measures[0]][0].attrs
+    return spreads, selected, seconds, settings
+
+
+G_HEADER = ["max/min over the measures' medians", "over measures and seeds", "seed spread of g*, largest (measure)",
+            "seed spread of λ at the median g*, largest (measure)"]
+SELECTION_HEADER = ["configuration, measure", "fitted scenario", "ε of the stripes", "stripes off by > 0.1", "worst: mean / σ of ln Sa off by",
+                    "simulated of 40 a stripe", "earthquakes a stripe"]
+
+
+def section(folder: Path, configurations: list[str], measures: list[str], seeds: list[int]) -> str:
+    """The section of docs/benchmarks.md (its markers included)."""
+    spreads, selected, seconds, settings = tables(folder, configurations, measures, seeds)
     provenance = json.loads((folder / "provenance.json").read_text()) if (folder / "provenance.json").exists() else {}
     lines = [SECTION.start, "## g* by conditioning measure and selection seed at Fox Plaza", "",
              f"`python -m benchmarks measure_seeds run FOLDER --simulated {settings['simulated']} --sampling {settings['sampling']}`, then "
              "`python -m benchmarks measure_seeds table FOLDER --write` (issue 43's measure/seed study; "
              f"{len(seconds)} experiments, {min(seconds):.0f}–{max(seconds):.0f} s each, {sum(seconds) / 60:.0f} min in all; "
              f"commit {provenance.get('commit', 'unknown')}, started {provenance.get('date', 'unknown')}, "
-             f"load {provenance.get('load average (1 min) at start', 'unknown')} at start). The elastic buildings of `benchmarks.site_consistency`, "
+             f"load {provenance.get('load average (1 min) at start', 'unknown')} as the first began; two invocations, one per configuration, "
+             "may share the cores, and then each experiment's time is under that load). The elastic buildings of `benchmarks.site_consistency`, "
              "contact-free, stripes at the intensities of 10, 25, 72, 224, 475, 975, 2475 and 5000 years of each measure "
              "(PSA(0.3 s)'s curve stops at 3431 years: its top stripe there), each measure with its own scenario fitted to the "
              "site's PGA, PSA(1, 2, 3 s) curves (and its own), Vs30 400 m/s, reverse faulting; 40 motions a stripe, at most 3 of "
@@ -188,12 +201,10 @@ def section(folder: Path, configurations: list[str], measures: list[str], seeds:
              "(`stripe_demand_rate`): the median over the seeds (their range); the spread over the measures' medians and over "
              "every measure and seed; the largest seed-to-seed spread of one measure, in g* and in the rate of pounding λ at "
              "that measure's median g*:", ""]
-    lines += _markdown(["configuration, target", *measures, "max/min over the measures' medians", "over measures and seeds",
-                        "seed spread of g*, largest (measure)", "seed spread of λ at the median g*, largest (measure)"], spreads)
+    lines += _markdown(["configuration, target", *measures, *G_HEADER], spreads)
     lines += ["", "The selections, over all seeds: the fitted scenario, the stripes' ε, the stripes that miss their target by "
               "more than 0.1 in the mean or σ of ln Sa at some period, the worst difference, and what the stripes hold:", ""]
-    lines += _markdown(["configuration, measure", "fitted scenario", "ε of the stripes", "stripes off by > 0.1", "worst: mean / σ of ln Sa off by",
-                        "simulated of 40 a stripe", "earthquakes a stripe"], selected)
+    lines += _markdown(SELECTION_HEADER, selected)
     lines += ["", "Not run: Sa_avg (the bundled Fox Plaza curves are per period; a curve of the average needs the site's ruptures, "
               "which are not bundled: `benchmarks.site_consistency --site scenario` has it). Conclusions: "
               "[intensity.md](intensity.md) (\"The measure and seed study on tilted pools\").", SECTION.end]
@@ -206,19 +217,33 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("action", choices=("run", "table"))
     parser.add_argument("folder", type=Path)
     parser.add_argument("--configurations", nargs="+", default=list(CONFIGURATIONS), choices=list(CONFIGURATIONS))
-    parser.add_argument("--measures", nargs="+", default=list(MEASURES), choices=list(MEASURES))
+    parser.add_argument("--measures", nargs="+", default=None, choices=list(MEASURE_ARGS), help="default: the site's")
     parser.add_argument("--seeds", nargs="+", type=int, default=list(SEEDS))
     parser.add_argument("--simulated", type=int, default=2000, help="simulated motions a stripe (default %(default)s)")
     parser.add_argument("--sampling", choices=("scenario", "tilted"), default="tilted")
-    parser.add_argument("--write", action="store_true", help="rewrite the section of docs/benchmarks.md")
+    parser.add_argument("--write", action="store_true", help="rewrite the section of docs/benchmarks.md (Fox Plaza's study)")
+    parser.add_argument("--site", choices=("fox_plaza", "scenario"), default="fox_plaza",
+                        help="the bundled Fox Plaza site, or benchmarks.site_consistency's site of one scenario (--scenario)")
+    parser.add_argument("--scenario", nargs=4, metavar=("M", "R_KM", "MECHANISM", "RATE"), default=list(SCENARIO))
     arguments = parser.parse_args(argv)
+    site = FOX_PLAZA if arguments.site == "fox_plaza" else scenario_site(float(arguments.scenario[0]), float(arguments.scenario[1]),
+                                                                         arguments.scenario[2], float(arguments.scenario[3]))
+    arguments.measures = list(site.measures) if arguments.measures is None else arguments.measures
+    if not set(arguments.measures) <= set(site.measures):
+        parser.error(f"--measures: the site {site.name} has hazard curves of {', '.join(site.measures)} only")
+    if arguments.write and site is not FOX_PLAZA:
+        parser.error("--write: the section is Fox Plaza's study; print the site of one scenario's tables without it")
     if arguments.action == "run":
         arguments.folder.mkdir(parents=True, exist_ok=True)
         provenance = arguments.folder / "provenance.json"
         if not provenance.exists():
             provenance.write_text(json.dumps({**machine(), "date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime())}))
         run(arguments.folder, arguments.configurations, arguments.measures, arguments.seeds,
-            Pool(40, arguments.simulated, 3, arguments.sampling))
+            Pool(40, arguments.simulated, 3, arguments.sampling), site)
+        return 0
+    if site is not FOX_PLAZA:  # the tables alone
+        spreads, selected, _, _ = tables(arguments.folder, arguments.configurations, arguments.measures, arguments.seeds)
+        print("\n".join(_markdown(["configuration, target", *arguments.measures, *G_HEADER], spreads) + [""] + _markdown(SELECTION_HEADER, selected)))
         return 0
     text = section(arguments.folder, arguments.configurations, arguments.measures, arguments.seeds)
     print(text)
