@@ -43,7 +43,7 @@ def test_the_spread_table_gives_the_medians_and_the_spreads_over_measures_seeds_
 def test_a_run_keeps_each_result_and_does_not_redo_it(tmp_path, monkeypatch) -> None:
     done = []
 
-    def fake(folder, configuration, measure, seed, pool):
+    def fake(folder, configuration, measure, seed, pool, site):
         done.append((configuration, measure, seed))
         return _result(1.0, 0.1, [[0.1, 0.2], [0.1, 0.2]]).assign_attrs(seconds=1.0)
 
