@@ -33,7 +33,8 @@ import xarray as xr
 
 from benchmarks.report import machine
 from benchmarks.sections import Section
-from benchmarks.site_consistency import CONFIGURATIONS, FOX_PLAZA, MEASURE_ARGS, SCENARIO, Pool, Site, measure_risk, scenario_site
+from benchmarks.site_consistency import (CONFIGURATIONS, FOX_PLAZA, MEASURE_ARGS, RETURN_PERIODS, SCENARIO, Pool, Site, lognormal_rate, measure_risk,
+                                         rate_g_star, scenario_site)
 from benchmarks.timing import REPOSITORY
 
 SECTION = Section("<!-- measure seeds: start -->", "<!-- measure seeds: end -->")
@@ -41,6 +42,8 @@ SECTION = Section("<!-- measure seeds: start -->", "<!-- measure seeds: end -->"
 UNTILTED = Section("<!-- measure seeds untilted: start -->", "<!-- measure seeds untilted: end -->")
 #: The selection seeds of the study.
 SEEDS = (1, 2, 3, 4, 5)
+#: Motions a stripe, and the most of one earthquake in it.
+MOTIONS, MAX_PER_EARTHQUAKE = 40, 3
 #: The diagnostics of a store's selection kept with a result.
 SELECTION = ("site_magnitude", "site_distance_km", "target_epsilon", "selection_misses_target", "selection_mean_ln", "selection_std_ln",
              "target_median", "target_sigma_ln", "selection_simulated", "selection_earthquakes")
@@ -54,15 +57,12 @@ def result_path(folder: Path, configuration: str, measure: str, seed: int) -> Pa
 
 def run_one(folder: Path, configuration: str, measure: str, seed: int, pool: Pool, site: Site = FOX_PLAZA) -> xr.Dataset:
     """One experiment's result (module docstring): its pounding rate over the gap grid, g* and the selection's diagnostics."""
-    from stochpound.risk import contact_free_closure, risk_targeted_separation, stripe_demand_rate
-
     work = folder / "work" / f"{configuration.replace(' ', '_')}-{seed}"
     work.mkdir(parents=True, exist_ok=True)
     began = time.time()
     store, risk = measure_risk(work, measure, configuration, seed=seed, pool=pool, site=site)
-    rate = stripe_demand_rate(contact_free_closure(store), risk.fragility["gap"].values, risk.hazard)
-    separation = risk_targeted_separation(xr.Dataset({"maf": rate}), risk.separation["target"].values, risk.years)["separation"]
-    kept = store[[name for name in SELECTION if name in store]].drop_encoding().assign(rate=rate, separation=separation)
+    rate = lognormal_rate(store, risk)
+    kept = store[[name for name in SELECTION if name in store]].drop_encoding().assign(rate=rate, separation=rate_g_star(rate, risk))
     kept.attrs = {"configuration": configuration, "measure": measure, "seed": seed, "simulated": pool.simulated, "sampling": pool.sampling,
                   "seconds": time.time() - began}
     return kept
@@ -84,7 +84,7 @@ def run(folder: Path, configurations: list[str], measures: list[str], seeds: lis
 
 
 def _cells(values: xr.DataArray) -> list[tuple[str, dict]]:
-    """The configuration cells of a result's variable (its dimensions other than gap, target and intensity), named."""
+    """The configuration cells of a result's variable (its dimensions other than gap, target, measure and seed), named."""
     others = [d for d in values.dims if d not in ("gap", "target", "measure", "seed")]
     if not others:
         return [("", {})]
@@ -177,7 +177,7 @@ def tables(folder: Path, configurations: list[str], measures: list[str], seeds: 
 G_HEADER = ["max/min over the measures' medians", "over measures and seeds", "seed spread of g*, largest (measure)",
             "seed spread of λ at the median g*, largest (measure)"]
 SELECTION_HEADER = ["configuration, measure", "fitted scenario", "ε of the stripes", "stripes off by > 0.1", "worst: mean / σ of ln Sa off by",
-                    "simulated of 40 a stripe", "earthquakes a stripe"]
+                    f"simulated of {MOTIONS} a stripe", "earthquakes a stripe"]
 
 
 def section(folder: Path, configurations: list[str], measures: list[str], seeds: list[int]) -> str:
@@ -191,9 +191,9 @@ def section(folder: Path, configurations: list[str], measures: list[str], seeds:
              f"commit {provenance.get('commit', 'unknown')}, started {provenance.get('date', 'unknown')}, "
              f"load {provenance.get('load average (1 min) at start', 'unknown')} as the first began; two invocations, one per configuration, "
              "may share the cores, and then each experiment's time is under that load). The elastic buildings of `benchmarks.site_consistency`, "
-             "contact-free, stripes at the intensities of 10, 25, 72, 224, 475, 975, 2475 and 5000 years of each measure "
+             f"contact-free, stripes at the intensities of {', '.join(f'{t:g}' for t in RETURN_PERIODS[:-1])} and {RETURN_PERIODS[-1]:g} years of each measure "
              "(PSA(0.3 s)'s curve stops at 3431 years: its top stripe there), each measure with its own scenario fitted to the "
-             "site's PGA, PSA(1, 2, 3 s) curves (and its own), Vs30 400 m/s, reverse faulting; 40 motions a stripe, at most 3 of "
+             f"site's PGA, PSA(1, 2, 3 s) curves (and its own), Vs30 400 m/s, reverse faulting; {MOTIONS} motions a stripe, at most {MAX_PER_EARTHQUAKE} of "
              "one earthquake, scale factor ≤ 5, from the 100 FEMA P695 records and "
              f"{settings['simulated']} site-based stochastic motions a stripe ({settings['sampling']} sampling, `[site] simulated_sampling`; "
              "the hazard-compatible model with its current calibration; the selection's seed is the motions' seed too, so another "
@@ -237,9 +237,9 @@ def main(argv: list[str] | None = None) -> int:
         arguments.folder.mkdir(parents=True, exist_ok=True)
         provenance = arguments.folder / "provenance.json"
         if not provenance.exists():
-            provenance.write_text(json.dumps({**machine(), "date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime())}))
+            provenance.write_text(json.dumps(machine()))  # its commit, date and load as the study starts
         run(arguments.folder, arguments.configurations, arguments.measures, arguments.seeds,
-            Pool(40, arguments.simulated, 3, arguments.sampling), site)
+            Pool(MOTIONS, arguments.simulated, MAX_PER_EARTHQUAKE, arguments.sampling), site)
         return 0
     if site is not FOX_PLAZA:  # the tables alone
         spreads, selected, _, _ = tables(arguments.folder, arguments.configurations, arguments.measures, arguments.seeds)

@@ -213,14 +213,24 @@ def measure_risk(folder: Path, measure: str, configuration: str, bootstrap: int 
     return store, store_risk(store, site.hazard(measure), targets=(0.1, 0.02), bootstrap=bootstrap)
 
 
-def lognormal_g_star(store: xr.Dataset, risk: StoreRisk) -> xr.DataArray:
-    """g* (m) at the risk's targets from a lognormal demand per stripe (:func:`stochpound.risk.stripe_demand_rate`) over the
-    risk's gap grid: every run's closure enters, not only whether it reaches a gap."""
-    from stochpound.risk import contact_free_closure, risk_targeted_separation, stripe_demand_rate
+def lognormal_rate(store: xr.Dataset, risk: StoreRisk) -> xr.DataArray:
+    """The rate of pounding (1/yr) over the risk's gap grid from a lognormal demand per stripe
+    (:func:`stochpound.risk.stripe_demand_rate`): every run's closure enters, not only whether it reaches a gap."""
+    from stochpound.risk import contact_free_closure, stripe_demand_rate
 
-    rate = stripe_demand_rate(contact_free_closure(store), risk.fragility["gap"].values, risk.hazard)
-    targets = risk.separation["target"].values
-    return risk_targeted_separation(xr.Dataset({"maf": rate}), targets, risk.years)["separation"]
+    return stripe_demand_rate(contact_free_closure(store), risk.fragility["gap"].values, risk.hazard)
+
+
+def rate_g_star(rate: xr.DataArray, risk: StoreRisk) -> xr.DataArray:
+    """g* (m) at the risk's targets of a rate of pounding over gaps (1/yr)."""
+    from stochpound.risk import risk_targeted_separation
+
+    return risk_targeted_separation(xr.Dataset({"maf": rate}), risk.separation["target"].values, risk.years)["separation"]
+
+
+def lognormal_g_star(store: xr.Dataset, risk: StoreRisk) -> xr.DataArray:
+    """g* (m) at the risk's targets from a lognormal demand per stripe (:func:`lognormal_rate`)."""
+    return rate_g_star(lognormal_rate(store, risk), risk)
 
 
 def g_star(folder: Path, measure: str, configuration: str, site: Site = FOX_PLAZA) -> xr.DataArray:
