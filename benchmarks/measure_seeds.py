@@ -34,7 +34,7 @@ import xarray as xr
 from benchmarks.report import machine
 from benchmarks.sections import Section
 from benchmarks.site_consistency import (CONFIGURATIONS, FOX_PLAZA, MEASURE_ARGS, RETURN_PERIODS, SCENARIO, Pool, Site, lognormal_rate, measure_risk,
-                                         rate_g_star, scenario_site)
+                                         parse_scenario_site, rate_g_star, site_measures)
 from benchmarks.timing import REPOSITORY
 
 SECTION = Section("<!-- measure seeds: start -->", "<!-- measure seeds: end -->")
@@ -226,11 +226,8 @@ def main(argv: list[str] | None = None) -> int:
                         help="the bundled Fox Plaza site, or benchmarks.site_consistency's site of one scenario (--scenario)")
     parser.add_argument("--scenario", nargs=4, metavar=("M", "R_KM", "MECHANISM", "RATE"), default=list(SCENARIO))
     arguments = parser.parse_args(argv)
-    site = FOX_PLAZA if arguments.site == "fox_plaza" else scenario_site(float(arguments.scenario[0]), float(arguments.scenario[1]),
-                                                                         arguments.scenario[2], float(arguments.scenario[3]))
-    arguments.measures = list(site.measures) if arguments.measures is None else arguments.measures
-    if not set(arguments.measures) <= set(site.measures):
-        parser.error(f"--measures: the site {site.name} has hazard curves of {', '.join(site.measures)} only")
+    site = FOX_PLAZA if arguments.site == "fox_plaza" else parse_scenario_site(parser, arguments.scenario)
+    arguments.measures = site_measures(parser, site, arguments.measures)
     if arguments.write and site is not FOX_PLAZA:
         parser.error("--write: the section is Fox Plaza's study; print the site of one scenario's tables without it")
     if arguments.action == "run":

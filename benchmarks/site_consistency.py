@@ -297,7 +297,7 @@ def _subfolder(folder: Path, name: str) -> Path:
     return folder / name
 
 
-def _scenario_site(parser: argparse.ArgumentParser, values: list[str]) -> Site:
+def parse_scenario_site(parser: argparse.ArgumentParser, values: list[str]) -> Site:
     """The site of ``--scenario M R_KM MECHANISM RATE``; a bad value ends the run with a one-line usage error naming it."""
     from stochpound import SiteError
 
@@ -309,6 +309,14 @@ def _scenario_site(parser: argparse.ArgumentParser, values: list[str]) -> Site:
         return scenario_site(magnitude, distance_km, values[2], rate)
     except (SiteError, ValueError) as error:
         parser.error(f"--scenario: {error}")
+
+
+def site_measures(parser: argparse.ArgumentParser, site: Site, measures: list[str] | None) -> list[str]:
+    """``--measures``, by default the site's; one the site has no hazard curve of ends the run with a one-line usage error."""
+    measures = list(site.measures) if measures is None else measures
+    if not set(measures) <= set(site.measures):
+        parser.error(f"--measures: the site {site.name} has hazard curves of {', '.join(site.measures)} only")
+    return measures
 
 
 def main(argv: list[str] | None = None) -> None:
@@ -333,11 +341,9 @@ def main(argv: list[str] | None = None) -> None:
                         help="how the simulated motions are drawn ([site] simulated_sampling; default %(default)s)")
     args = parser.parse_args(argv)
     args.pool = Pool(args.motions, args.simulated_motions, args.max_per_earthquake, args.sampling)
-    args.site = FOX_PLAZA if args.site == "fox_plaza" else _scenario_site(parser, args.scenario)
+    args.site = FOX_PLAZA if args.site == "fox_plaza" else parse_scenario_site(parser, args.scenario)
     args.return_periods = args.site.return_periods if args.return_periods is None else np.asarray(args.return_periods, dtype=float)
-    args.measures = list(args.site.measures) if args.measures is None else args.measures
-    if not set(args.measures) <= set(args.site.measures):
-        parser.error(f"--measures: the site {args.site.name} has hazard curves of {', '.join(args.site.measures)} only")
+    args.measures = site_measures(parser, args.site, args.measures)
     print(f"site: {args.site.name}; stripes at return periods {', '.join(f'{t:g}' for t in args.return_periods)} yr")
     figure = Figure(figsize=(7.5, 3.4), layout="constrained")
     axes = figure.subplots(1, 2, sharey=True)
