@@ -11,13 +11,15 @@ import pytest
 from stochpound.experiment import load_experiment, run_experiment
 from tests.helpers import laws_pair_text, tilted_site_text, write_experiment
 
-#: The test files that take longest (measured, whole suite on 2 cores, 2026-12-02), longest first: they start first;
+#: The test files that take longest (measured, whole suite on 2 cores, 2026-12-03), longest first: they start first;
 #: every other file follows in the usual order. Only the order changes: every test still runs.
 LONGEST_FIRST = (
-    "test_benchmark_site_consistency.py", "test_experiment_cli.py", "test_engine_compile.py", "test_experiment_resume.py",
-    "test_report_study.py", "test_docs.py", "test_numba_cache.py", "test_report_laws.py", "test_random_scenes.py",
-    "test_report_engineer.py", "test_scaling.py", "test_experiment_distributed.py", "test_experiment_startup.py",
-    "test_report_preserved.py", "test_getting_started.py", "test_report_stochastic.py",
+    "test_benchmark_site_consistency.py", "test_experiment_cli.py", "test_report_study.py", "test_engine_compile.py",
+    "test_random_scenes.py", "test_experiment_resume.py", "test_docs.py", "test_risk_workflow.py", "test_rare_event_experiment.py",
+    "test_report_laws.py", "test_report_engineer.py", "test_report_preserved.py", "test_numba_cache.py", "test_exact.py",
+    "test_energy_and_hard_cases.py", "test_measure_free_store.py", "test_scaling.py", "test_report_yielding.py",
+    "test_risk_one_event.py", "test_experiment_distributed.py", "test_experiment_store.py", "test_report_stochastic.py",
+    "test_getting_started.py", "test_experiment_startup.py",
 )  # fmt: skip
 
 

@@ -34,6 +34,7 @@ before firing at the threshold (``events._after_dip``).
 
 from __future__ import annotations
 
+import os
 
 import numpy as np
 import pytest
@@ -45,7 +46,8 @@ from tests.helpers import random_scene
 
 
 TOLERANCE = 1e-9  # of max(1 m, largest |y|), every floor's total displacement over the whole record
-SEEDS = range(60)
+#: The scenes' seeds: 30 in the suite (seeds 2, 16, 21 and 25 of the docstring among them); STOCHPOUND_RANDOM_SCENES=N sweeps seeds 0 to N - 1.
+SEEDS = range(int(os.environ.get("STOCHPOUND_RANDOM_SCENES", "30")))
 MAX_STEP = 2e-4  # s: the independent integration's largest step, so that no gap closes and opens again unseen within one
 
 
@@ -186,7 +188,7 @@ class _Ground:
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("seed", [1, 3, 5, 8, 13, 21])
+@pytest.mark.parametrize("seed", [1, 3, 21])  # 3: sustained contacts; 21: zero-gap, barely touching impacts (5, 8 and 13 passed too)
 def test_an_independent_integration_agrees_on_fixed_buildings(seed):
     """Fixed-base random scenes: the exact solver against :func:`independent_run`, the same impacts and displacements.
 
