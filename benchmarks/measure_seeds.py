@@ -1,4 +1,4 @@
-"""g* by conditioning measure and selection seed at Fox Plaza: ``python -m benchmarks measure_seeds run|table FOLDER``.
+"""g* by conditioning measure and selection seed at Fox Plaza: ``python -m benchmarks measure_seeds run|table|consistency FOLDER``.
 
 Issue 43's measure/seed study, on a pool of records and simulated motions. For every configuration of
 :mod:`benchmarks.site_consistency` (the elastic fixed pair beside its stiff or flexible neighbour; Building 1 on the friction
@@ -18,6 +18,13 @@ result already there is not run again: an interrupted study resumes, and two inv
 docs/benchmarks.md between its markers: per configuration and target, each measure's median g* over the seeds (their
 range), the spread over the measures' medians and over measures and seeds, the largest seed-to-seed spread of one measure
 in g* and in the rate of pounding at that measure's median g*; per configuration and measure, the selections' misses.
+
+``consistency FOLDER`` prints, per configuration and conditioning measure, the site's hazard of every measure of the site
+(Sa_avg(0.5–4 s) too at a site of one scenario) recomputed from the stripes' motions as they ran (the stores ``run`` keeps in
+``FOLDER/work``) over the site's own curve, at 10 % and 2 % in 50 years: the median over the seeds (their range)
+(:func:`stochpound.risk.site_consistency`), over the seeds whose stripes reach the target (their number when not all: the others' motions, scaled as they ran, never
+reach that level, a ratio of 0). A measure whose stripes carry the site's shaking at the building's periods gives
+ratios near 1 there.
 """
 
 from __future__ import annotations
@@ -31,10 +38,12 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
+from stochpound.motions import Measure
+
 from benchmarks.report import machine
 from benchmarks.sections import Section
-from benchmarks.site_consistency import (CONFIGURATIONS, FOX_PLAZA, MEASURE_ARGS, RETURN_PERIODS, SCENARIO, Pool, Site, lognormal_rate, measure_risk,
-                                         parse_scenario_site, rate_g_star, site_measures)
+from benchmarks.site_consistency import (CONFIGURATIONS, FOX_PLAZA, MEASURE_ARGS, RETURN_PERIODS, SCENARIO, Pool, Site, experiment_file, lognormal_rate,
+                                         measure_risk, parse_scenario_site, rate_g_star, site_measures)
 from benchmarks.timing import REPOSITORY
 
 SECTION = Section("<!-- measure seeds: start -->", "<!-- measure seeds: end -->")
@@ -55,9 +64,14 @@ def result_path(folder: Path, configuration: str, measure: str, seed: int) -> Pa
     return folder / configuration.replace(" ", "_") / f"{name}-seed{seed}.nc"
 
 
+def work_folder(folder: Path, configuration: str, seed: int) -> Path:
+    """Where one configuration and seed's experiments run, their files and stores kept."""
+    return folder / "work" / f"{configuration.replace(' ', '_')}-{seed}"
+
+
 def run_one(folder: Path, configuration: str, measure: str, seed: int, pool: Pool, site: Site = FOX_PLAZA) -> xr.Dataset:
     """One experiment's result (module docstring): its pounding rate over the gap grid, g* and the selection's diagnostics."""
-    work = folder / "work" / f"{configuration.replace(' ', '_')}-{seed}"
+    work = work_folder(folder, configuration, seed)
     work.mkdir(parents=True, exist_ok=True)
     began = time.time()
     store, risk = measure_risk(work, measure, configuration, seed=seed, pool=pool, site=site)
@@ -158,6 +172,57 @@ def selection_rows(configuration: str, selections: dict) -> list[list[str]]:
     return rows
 
 
+def measure_of(name: str) -> Measure:
+    """The :class:`~stochpound.motions.Measure` of a measure's name in :data:`~benchmarks.site_consistency.MEASURE_ARGS`."""
+    kind, period = MEASURE_ARGS[name]
+    return Measure(kind, periods=tuple(period)) if kind == "sa_avg" else Measure(kind, period=period)
+
+
+def consistency(folder: Path, configuration: str, measures: list[str], seeds: list[int], site: Site) -> xr.DataArray:
+    """The site's hazard of every measure of ``site`` recomputed from the stripes of each conditioning measure's stores (kept by
+    ``run`` in ``FOLDER/work``) over the site's own curve, at 10 % and 2 % in 50 years
+    (:func:`stochpound.risk.site_consistency`, :func:`~stochpound.risk.consistency_at_targets`): conditioning × checked × seed × target.
+
+    Raises
+    ------
+    FileNotFoundError
+        Naming the store of a conditioning measure and seed that ``run`` has not made.
+    """
+    from stochpound import open_store
+    from stochpound.risk import consistency_at_targets, site_consistency
+
+    curves = {name: site.hazard(name) for name in site.measures}
+    ratios = np.full((len(measures), len(curves), len(seeds), 2), np.nan)
+    for i, measure in enumerate(measures):
+        for k, seed in enumerate(seeds):
+            path = experiment_file(work_folder(folder, configuration, seed), measure).with_suffix(".nc")
+            if not path.exists():
+                raise FileNotFoundError(f"{path.name} of {configuration}, seed {seed}: not in {path.parent.parent.name}/ (run it first)")
+            with open_store(path) as store:
+                checked = site_consistency(store, {measure_of(name): curve for name, curve in curves.items()}, hazard=curves[measure])
+            for j, result in enumerate(checked.values()):
+                ratios[i, j, k] = consistency_at_targets(result)
+    return xr.DataArray(ratios, dims=("measure", "checked", "seed", "target"),
+                        coords={"measure": measures, "checked": list(curves), "seed": seeds, "target": ["10 % in 50 yr", "2 % in 50 yr"]})
+
+
+def consistency_rows(configuration: str, ratios: xr.DataArray) -> list[list[str]]:
+    """Per conditioning measure, each checked measure's recomputed / site hazard: the median over the seeds (their range) at 10 % / 2 %
+    in 50 years."""
+    def cell(values: np.ndarray) -> str:
+        finite = values[np.isfinite(values)]
+        if not finite.size:
+            return "–"
+        reached = "" if finite.size == values.size else f", {finite.size} of {values.size} seeds"
+        return f"{np.median(finite):.2f} ({finite.min():.2f}–{finite.max():.2f}{reached})"
+
+    def cells(values: xr.DataArray) -> str:
+        return " / ".join(cell(v) for v in values.transpose("target", "seed").values)
+
+    return [[f"{configuration}, {measure}", *(cells(ratios.sel(measure=measure, checked=name)) for name in ratios["checked"].values)]
+            for measure in ratios["measure"].values]
+
+
 def _markdown(header: list[str], rows: list[list[str]]) -> list[str]:
     return ["| " + " | ".join(header) + " |", "|" + "---|" * len(header), *("| " + " | ".join(row) + " |" for row in rows)]
 
@@ -212,9 +277,9 @@ def section(folder: Path, configurations: list[str], measures: list[str], seeds:
 
 
 def main(argv: list[str] | None = None) -> int:
-    """``run`` or ``table`` (module docstring)."""
+    """``run``, ``table`` or ``consistency`` (module docstring)."""
     parser = argparse.ArgumentParser(prog="python -m benchmarks measure_seeds", description=__doc__.splitlines()[0])
-    parser.add_argument("action", choices=("run", "table"))
+    parser.add_argument("action", choices=("run", "table", "consistency"))
     parser.add_argument("folder", type=Path)
     parser.add_argument("--configurations", nargs="+", default=list(CONFIGURATIONS), choices=list(CONFIGURATIONS))
     parser.add_argument("--measures", nargs="+", default=None, choices=list(MEASURE_ARGS), help="default: the site's")
@@ -237,6 +302,11 @@ def main(argv: list[str] | None = None) -> int:
             provenance.write_text(json.dumps(machine()))  # its commit, date and load as the study starts
         run(arguments.folder, arguments.configurations, arguments.measures, arguments.seeds,
             Pool(MOTIONS, arguments.simulated, MAX_PER_EARTHQUAKE, arguments.sampling), site)
+        return 0
+    if arguments.action == "consistency":
+        for configuration in arguments.configurations:
+            ratios = consistency(arguments.folder, configuration, arguments.measures, arguments.seeds, site)
+            print("\n".join(_markdown(["conditioning measure", *ratios["checked"].values], consistency_rows(configuration, ratios))) + "\n")
         return 0
     if site is not FOX_PLAZA:  # the tables alone
         spreads, selected, _, _ = tables(arguments.folder, arguments.configurations, arguments.measures, arguments.seeds)

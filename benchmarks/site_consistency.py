@@ -194,6 +194,11 @@ def experiment_text(measure: str, configuration: str, seed: int | None = None, r
             table + pool.site_lines())
 
 
+def experiment_file(folder: Path, measure: str) -> Path:
+    """The experiment file :func:`measure_risk` writes in ``folder`` for ``measure`` (its store: the same name, ``.nc``)."""
+    return folder / f"{measure.replace('(', '').replace(' s)', '').replace(' ', '').replace('.', 'p').lower()}.toml"
+
+
 def measure_risk(folder: Path, measure: str, configuration: str, bootstrap: int = 0, seed: int | None = None,
                  return_periods: np.ndarray | None = None, site: Site = FOX_PLAZA, pool: Pool = RECORDS_ONLY) -> tuple[xr.Dataset, StoreRisk]:
     """The store and the risk answer (g* at 10 % and 2 % in 50 years, ``bootstrap`` resamples for its 95 % interval) of one
@@ -203,8 +208,7 @@ def measure_risk(folder: Path, measure: str, configuration: str, bootstrap: int 
     from stochpound.risk import store_risk
     from stochpound.experiment import load_experiment, run_experiment
 
-    name = f"{measure.replace('(', '').replace(' s)', '').replace(' ', '').replace('.', 'p').lower()}.toml"
-    path = folder / name
+    path = experiment_file(folder, measure)
     path.write_text(experiment_text(measure, configuration, seed, return_periods, site, pool))
     report = run_experiment(load_experiment(path), workers=0, progress=False, checkpoint=float("inf"))  # no store written mid-run: read at the end only
     if not report.complete:

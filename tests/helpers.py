@@ -603,3 +603,14 @@ def tilted_site_text(site: str = TILTED_SITE) -> str:
     intensity = ('[intensity]\nmeasure = "psa"\nperiod = 0.5\nlevels = [0.6, 0.2]\nselection = "conditional_spectrum"\nmotions = 4\n'
                  'max_scale_factor = 5.0\nseed = 2\n')
     return f'[experiment]\nname = "tilted"\n{SITE_SCENE}\n[grid]\ngap = ["inf"]\n{records}\n{intensity}{site}\n[solver]\nmethod = "exact"\n'
+
+
+def stripes_site_text(hazard: str) -> str:
+    """An experiment of two conditional-spectrum stripes of PSA(1 s) (0.5611 and 0.9299 g, 4 motions each of 12 FEMA P695
+    far-field components, 5 s of each) under :data:`SITE_SCENE`, contact-free and at a 5 cm gap, with the ``[hazard]`` lines given."""
+    members = [f"fema_p695_far_field/{i:02d}{c}" for i in range(1, 7) for c in "ab"]
+    records = "".join(f'\n[[records]]\nrecord = "{name}"\nduration = 5.0\n' for name in members)
+    intensity = ('[intensity]\nmeasure = "psa"\nperiod = 1.0\ndamping = 0.05\nunits = "g"\nlevels = [0.5611, 0.9299]\nselection = "conditional_spectrum"\n'
+                 'motions = 4\nmax_scale_factor = 8.0\nseed = 3\n'
+                 '[site]\nvs30 = 400.0\nmagnitude = 7.2\ndistance_km = 10.0\nmechanism = "reverse"\n')
+    return f'[experiment]\nname = "site"\n{SITE_SCENE}\n[grid]\ngap = ["inf", 0.05]\n{records}\n{intensity}\n{hazard}\n[solver]\nmethod = "exact"\n'

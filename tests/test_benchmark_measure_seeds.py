@@ -59,3 +59,33 @@ def test_a_run_keeps_each_result_and_does_not_redo_it(tmp_path, monkeypatch) -> 
 @pytest.mark.parametrize("sampling, line", [("tilted", 'simulated_sampling = "tilted"\n'), ("scenario", "")])
 def test_the_pool_writes_its_sampling_only_when_tilted(sampling: str, line: str) -> None:
     assert Pool(40, 2000, 3, sampling).site_lines() == "simulated_motions = 2000\n" + line
+
+
+@pytest.mark.slow
+def test_consistency_reads_the_kept_stores_and_gives_each_curve_at_the_targets_over_the_seeds(tmp_path) -> None:
+    """``consistency`` on a store kept where ``run`` keeps it: the ratios of stochpound.risk's own check, one row per conditioning
+    measure with the median and range over the seeds; a store not run is named."""
+    from stochpound import open_store
+    from stochpound.experiment import load_experiment, run_experiment
+    from stochpound.risk import consistency_at_targets, site_consistency
+    from benchmarks.site_consistency import FOX_PLAZA, experiment_file
+    from tests.helpers import stripes_site_text, write_experiment
+
+    work = measure_seeds.work_folder(tmp_path, "isolated", 1)
+    work.mkdir(parents=True)
+    text = stripes_site_text('[hazard]\nbundled = "fox_plaza_los_angeles_sa1p0s"\n')
+    report = run_experiment(load_experiment(write_experiment(work, text, experiment_file(work, "PSA(1 s)").name)), workers=0, progress=False)
+    assert report.store == experiment_file(work, "PSA(1 s)").with_suffix(".nc")
+    ratios = measure_seeds.consistency(tmp_path, "isolated", ["PSA(1 s)"], [1], FOX_PLAZA)
+    assert list(ratios["checked"].values) == list(FOX_PLAZA.measures)
+    with open_store(report.store) as store:
+        expected = {name: consistency_at_targets(site_consistency(store)[name]) for name in ("PGA", "PSA(2 s)")}
+    for name, values in expected.items():
+        np.testing.assert_allclose(ratios.sel(measure="PSA(1 s)", checked=name, seed=1).values, values, rtol=1e-12, equal_nan=True)
+    pga = expected["PGA"]
+    assert np.all(np.isfinite(pga)) and np.all(np.isnan(expected["PSA(2 s)"]))  # two stripes of 4 motions reach PGA's targets, not PSA(2 s)'s
+    row = dict(zip(["conditioning", *FOX_PLAZA.measures], measure_seeds.consistency_rows("isolated", ratios)[0]))
+    assert row["conditioning"] == "isolated, PSA(1 s)" and row["PSA(2 s)"] == "– / –"
+    assert row["PGA"] == f"{pga[0]:.2f} ({pga[0]:.2f}–{pga[0]:.2f}) / {pga[1]:.2f} ({pga[1]:.2f}–{pga[1]:.2f})"
+    with pytest.raises(FileNotFoundError, match="psa2.nc of isolated, seed 1: not in work/"):
+        measure_seeds.consistency(tmp_path, "isolated", ["PSA(2 s)"], [1], FOX_PLAZA)

@@ -9,25 +9,19 @@ import xarray as xr
 from stochpound import open_store
 from stochpound.analysis import HazardCurve, bundled_site_curves, rate_from_probability, stripe_rate_weights
 from stochpound.experiment._runner import load_experiment, run_experiment
+from stochpound.motions import Measure
 from stochpound.report.render import FigureItem, Paragraph
 from stochpound.report.sections import intensity_section
 from stochpound.risk import TARGETS, consistency_at_targets, site_consistency
-from tests.helpers import SITE_SCENE as SCENE
-from tests.helpers import write_experiment
+from tests.helpers import stripes_site_text, write_experiment
 
 SITE = "fox_plaza_los_angeles"
 SITE_PERIODS = (0.03, 0.05, 0.1, 0.15, 0.2, 0.3, 0.4, 0.5, 0.6, 0.75, 1.0, 1.5, 2.0, 3.0, 4.0, 5.0)
 """The periods (s) of the bundled site's PSA curves (besides its PGA one)."""
-MEMBERS = [f"fema_p695_far_field/{i:02d}{c}" for i in range(1, 7) for c in "ab"]
-RECORDS = "".join(f'\n[[records]]\nrecord = "{name}"\nduration = 5.0\n' for name in MEMBERS)
-INTENSITY = ('[intensity]\nmeasure = "psa"\nperiod = 1.0\ndamping = 0.05\nunits = "g"\nlevels = [0.5611, 0.9299]\nselection = "conditional_spectrum"\n'
-             'motions = 4\nmax_scale_factor = 8.0\nseed = 3\n'
-             '[site]\nvs30 = 400.0\nmagnitude = 7.2\ndistance_km = 10.0\nmechanism = "reverse"\n')
 
 
 def _store(tmp_path, hazard: str) -> xr.Dataset:
-    text = f'[experiment]\nname = "site"\n{SCENE}\n[grid]\ngap = ["inf", 0.05]\n{RECORDS}\n{INTENSITY}\n{hazard}\n[solver]\nmethod = "exact"\n'
-    report = run_experiment(load_experiment(write_experiment(tmp_path, text, "site.toml")), workers=0, progress=False)
+    report = run_experiment(load_experiment(write_experiment(tmp_path, stripes_site_text(hazard), "site.toml")), workers=0, progress=False)
     return open_store(report.store).load()
 
 
@@ -66,6 +60,45 @@ def test_recomputed_from_the_motions_as_they_ran_and_shown_in_the_report(tmp_pat
     for label, data in result.items():
         shown = "/".join("beyond the curve" if np.isnan(r) else f"{r:.2f}" for r in consistency_at_targets(data))
         assert f"{label} {shown}" in text
+
+
+def test_given_curves_are_recomputed_as_the_sites_own_and_sa_avg_is_the_geometric_mean_of_the_stored_spectrum(tmp_path) -> None:
+    store = _store(tmp_path, f'[hazard]\nbundled = "{SITE}_sa1p0s"\n')
+    own = HazardCurve.bundled(f"{SITE}_sa1p0s")
+    sa_avg = Measure("sa_avg", periods=(0.5, 1.0, 2.0))
+    curves = {Measure("pga"): HazardCurve.bundled(f"{SITE}_pga"), Measure("psa", period=2.0, damping=0.05): HazardCurve.bundled(f"{SITE}_sa2p0s"),
+              sa_avg: HazardCurve.bundled(f"{SITE}_sa1p0s")}
+    given = site_consistency(store, curves, hazard=own)
+    assert list(given) == ["PGA", "PSA(2 s)", "Sa_avg(0.5-2 s)"]
+    default = site_consistency(store)
+    for label in ("PGA", "PSA(2 s)"):  # the same numbers as the bundled site's own check
+        xr.testing.assert_identical(given[label], default[label])
+    # Sa_avg by hand: each motion that ran, the geometric mean of its stored PSA (log-log at 0.5, 1 and 2 s) times its scale factor
+    levels, log_t = store["intensity"].values, np.log(store["spectrum_period"].values)
+    weights = stripe_rate_weights(levels, own)
+    expected = np.zeros(own.im.size)
+    for j in range(levels.size):
+        cases = store.isel(intensity=j, realization=0).sel(gap=np.inf)
+        ran = [r for r in cases.record.values if int(cases.case_status.sel(record=r)) == 1]
+        log_psa = [np.interp(np.log(sa_avg.periods), log_t, np.log(cases.motion_psa.sel(record=r).values)) for r in ran]
+        spectra = np.array([np.exp(np.mean(row)) / 9.81 * float(cases.scale_factor.sel(record=r)) for row, r in zip(log_psa, ran)])
+        expected += weights[j] * (spectra[:, None] > np.asarray(own.im)[None, :]).mean(axis=0)
+    np.testing.assert_allclose(given["Sa_avg(0.5-2 s)"]["recomputed"].values, expected, rtol=1e-12)
+    # what the stored motions do not give is refused, naming the field
+    for measure, message in [(Measure("pgv"), "curves: PGV is not recomputed"), (Measure("psa", period=8.0), "curves: PSA.8 s. needs the spectrum at 8-8 s"),
+                             (Measure("psa", period=1.0, damping=0.02), "curves: PSA.T = 1 s, 2 % damping. needs the spectrum at its damping")]:
+        with pytest.raises(ValueError, match=message):
+            site_consistency(store, {measure: own})
+
+
+def test_a_store_without_a_hazard_of_its_own_is_checked_against_the_hazard_given(tmp_path) -> None:
+    store = _store(tmp_path, "")
+    curves = {Measure("psa", period=2.0): HazardCurve.bundled(f"{SITE}_sa2p0s")}
+    assert site_consistency(store, curves) == {}  # no hazard of its stripes: nothing to weigh them with
+    own = HazardCurve.bundled(f"{SITE}_sa1p0s")
+    result = site_consistency(store, curves, hazard=own)["PSA(2 s)"]
+    np.testing.assert_allclose(result["site"].values, curves[Measure("psa", period=2.0)].rate, rtol=1e-12)
+    assert np.all(np.isfinite(result["recomputed"].values)) and result["recomputed"].values.max() > 0
 
 
 def test_nothing_without_a_bundled_site(tmp_path) -> None:

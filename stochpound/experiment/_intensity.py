@@ -39,7 +39,7 @@ from stochpound.model import fields as toml_fields
 from stochpound.experiment._site import parse_selection
 from stochpound.motions import arias_intensity, peak_ground_motion, response_spectrum, significant_duration
 from stochpound._errors import IntensityError
-from stochpound.motions import Measure
+from stochpound.motions import MODEL_DAMPING, Measure
 from stochpound.store import MEASURES, ExperimentGrid, GapAxis, Intensity, Label, MuAxis, TomlTable, VariantAxis
 
 INTENSITY_METHODS = ("stripes", "ida")
@@ -58,7 +58,8 @@ oscillator tuned above it responds to the interpolation between samples,
 not to the recorded ground motion."""
 SPECTRUM_PERIODS = np.geomspace(0.05, 5.0, 25)
 """Periods (s) of the unscaled spectrum stored for every motion (5 % damping)."""
-SPECTRUM_DAMPING = 0.05
+SPECTRUM_DAMPING = MODEL_DAMPING
+"""Damping ratio of the stored spectrum: the ground-motion models' 5 % (what the risk's site-consistency check reads it at)."""
 CaseVariables = dict[str, float | np.ndarray]
 """A case's per-case variables by store name (:data:`SUMMARIES`): numbers, and arrays (``motion_psa`` over :data:`SPECTRUM_PERIODS`)."""
 _KEYS = {"measure", "period", "periods", "damping", "levels", "units", "method", "synthetic", "selection", "motions", "max_scale_factor", "seed", "max_per_earthquake", "exclude_pulses"}

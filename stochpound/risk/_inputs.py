@@ -723,14 +723,14 @@ def contact_free_twins(data: xr.DataArray) -> xr.DataArray | None:
 
 @dataclasses.dataclass(frozen=True)
 class StripeSpectraRuns:
-    """What the site-consistency check reads of a stripes store whose hazard is a bundled curve.
+    """What the site-consistency check reads of a stripes store.
 
     Attributes
     ----------
-    bundled : str
-        The store's bundled hazard curve's name.
+    bundled : str or None
+        The store's bundled hazard curve's name (None where its hazard is not a bundled curve).
     hazard : HazardCurve
-        The store's hazard curve.
+        The hazard of the stripes' measure: the store's, or the one given.
     scale_factor : xarray.DataArray
         Per ``intensity`` and ``record``; NaN where the motion did not run in the stripe.
     pga : xarray.DataArray
@@ -743,7 +743,7 @@ class StripeSpectraRuns:
         The scene's acceleration of gravity, m/s².
     """
 
-    bundled: str
+    bundled: str | None
     hazard: HazardCurve
     scale_factor: xr.DataArray
     pga: xr.DataArray
@@ -752,11 +752,11 @@ class StripeSpectraRuns:
     g: float
 
 
-def stripe_spectra_runs(store: xr.Dataset) -> StripeSpectraRuns | None:
-    """What the site-consistency check reads of a stripes store whose hazard is a bundled curve (:class:`StripeSpectraRuns`),
-    or None for a store without stripes, spectra or a bundled hazard."""
+def stripe_spectra_runs(store: xr.Dataset, hazard: HazardCurve | None = None) -> StripeSpectraRuns | None:
+    """What the site-consistency check reads of a stripes store (:class:`StripeSpectraRuns`), its stripes' hazard the store's
+    or ``hazard``; None for a store without stripes or spectra, or without a hazard of its own when ``hazard`` is not given."""
     entry = store.pound.hazard
-    if "intensity" not in store.dims or entry is None or entry.bundled is None or "motion_psa" not in store:
+    if "intensity" not in store.dims or "motion_psa" not in store or (entry is None and hazard is None):
         return None
     keep = ("intensity", "record", "realization", "spectrum_period")
 
@@ -765,8 +765,8 @@ def stripe_spectra_runs(store: xr.Dataset) -> StripeSpectraRuns | None:
 
     ran = (store["case_status"] == 1).any([d for d in store["case_status"].dims if d not in keep])
     return StripeSpectraRuns(
-        bundled=entry.bundled,
-        hazard=site_hazard(store),
+        bundled=entry.bundled if entry is not None else None,
+        hazard=hazard if hazard is not None else site_hazard(store),
         scale_factor=store_motions(first("scale_factor").where(ran)),
         pga=store_motions(first("motion_pga")),
         psa=store_motions(first("motion_psa")),
