@@ -37,7 +37,8 @@ def site_consistency(store: xr.Dataset, curves: Mapping[Measure, HazardCurve] | 
         The curves to check (PGA, PSA at a period or Sa_avg over periods within the stored spectrum's, its intensities in g),
         by their measure; default: every other curve of the store's bundled site.
     hazard : HazardCurve, optional
-        The hazard of the stripes' own measure, for a store that carries none (a site given to the risk as curves).
+        The hazard of the stripes' own measure (default: the store's); needed for a store that carries none (a site given to
+        the risk as curves).
 
     Returns
     -------
