@@ -172,12 +172,6 @@ def selection_rows(configuration: str, selections: dict) -> list[list[str]]:
     return rows
 
 
-def measure_of(name: str) -> Measure:
-    """The :class:`~stochpound.motions.Measure` of a measure's name in :data:`~benchmarks.site_consistency.MEASURE_ARGS`."""
-    kind, period = MEASURE_ARGS[name]
-    return Measure(kind, periods=tuple(period)) if kind == "sa_avg" else Measure(kind, period=period)
-
-
 def consistency(folder: Path, configuration: str, measures: list[str], seeds: list[int], site: Site) -> xr.DataArray:
     """The site's hazard of every measure of ``site`` recomputed from the stripes of each conditioning measure's stores (kept by
     ``run`` in ``FOLDER/work``) over the site's own curve, at 10 % and 2 % in 50 years
@@ -192,6 +186,7 @@ def consistency(folder: Path, configuration: str, measures: list[str], seeds: li
     from stochpound.risk import consistency_at_targets, site_consistency
 
     curves = {name: site.hazard(name) for name in site.measures}
+    by_measure = {Measure.of(*MEASURE_ARGS[name]): curve for name, curve in curves.items()}
     ratios = np.full((len(measures), len(curves), len(seeds), 2), np.nan)
     for i, measure in enumerate(measures):
         for k, seed in enumerate(seeds):
@@ -199,7 +194,7 @@ def consistency(folder: Path, configuration: str, measures: list[str], seeds: li
             if not path.exists():
                 raise FileNotFoundError(f"{path.name} of {configuration}, seed {seed}: not in {path.parent.parent.name}/ (run it first)")
             with open_store(path) as store:
-                checked = site_consistency(store, {measure_of(name): curve for name, curve in curves.items()}, hazard=curves[measure])
+                checked = site_consistency(store, by_measure, hazard=curves[measure])
             for j, result in enumerate(checked.values()):
                 ratios[i, j, k] = consistency_at_targets(result)
     return xr.DataArray(ratios, dims=("measure", "checked", "seed", "target"),

@@ -75,9 +75,8 @@ def _unscaled(runs: StripeSpectraRuns, measure: Measure) -> xr.DataArray:
     their geometric mean)."""
     if measure.kind == "pga":
         return runs.pga
-    if measure.kind == "psa":
-        return _interpolated(runs.psa, runs.spectrum_periods, [measure.period]).isel(period=0, drop=True)
-    return np.exp(np.log(_interpolated(runs.psa, runs.spectrum_periods, list(measure.periods))).mean("period"))
+    psa = _interpolated(runs.psa, runs.spectrum_periods, list(np.atleast_1d(measure.spectral_period)))
+    return psa.isel(period=0, drop=True) if measure.kind == "psa" else np.exp(np.log(psa).mean("period"))
 
 
 def _check_stored(measure: Measure, spectrum_periods: np.ndarray) -> None:
@@ -86,8 +85,8 @@ def _check_stored(measure: Measure, spectrum_periods: np.ndarray) -> None:
         raise ValueError(f"curves: {measure.label} is not recomputed from the stored motions (PGA, PSA and Sa_avg are)")
     if measure.damping not in (None, MODEL_DAMPING):
         raise ValueError(f"curves: {measure.description} needs the spectrum at its damping; the store holds it at {MODEL_DAMPING:g}")
-    periods = [measure.period] if measure.kind == "psa" else list(measure.periods)
-    if measure.kind != "pga" and not (spectrum_periods[0] * (1 - 1e-9) <= min(periods) and max(periods) <= spectrum_periods[-1] * (1 + 1e-9)):
+    periods = np.atleast_1d(measure.spectral_period) if measure.is_spectral else None
+    if periods is not None and not (spectrum_periods[0] * (1 - 1e-9) <= periods.min() and periods.max() <= spectrum_periods[-1] * (1 + 1e-9)):
         raise ValueError(f"curves: {measure.label} needs the spectrum at {min(periods):g}-{max(periods):g} s; the store holds "
                          f"{spectrum_periods[0]:g}-{spectrum_periods[-1]:g} s")
 
