@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
+import _thread
 import signal
 import sys
+import threading
 from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 from typing import Any, Union
@@ -42,6 +44,17 @@ class _NotingCtrlC:
             signal.default_int_handler(signum, frame)
 
 
+REPEAT_DELAY = 0.05
+"""Seconds after which a Ctrl-C swallowed by a finaliser is raised again (:func:`noting_ctrl_c`): the finaliser has ended."""
+
+
+def _interrupt_main_soon() -> None:
+    """SIGINT's handler called in the main thread again :data:`REPEAT_DELAY` seconds from now (from a timer thread)."""
+    timer = threading.Timer(REPEAT_DELAY, _thread.interrupt_main, args=(signal.SIGINT,))
+    timer.daemon = True
+    timer.start()
+
+
 @contextmanager
 def noting_ctrl_c(raising: bool = True) -> Iterator[list[int]]:
     """Inside the block, SIGINT is noted in the list yielded and, if ``raising``, raises KeyboardInterrupt as Python's own handler does.
@@ -51,9 +64,11 @@ def noting_ctrl_c(raising: bool = True) -> Iterator[list[int]]:
     nor outside the main thread (no signal handlers there). A block inside
     another shares its list and sets ``raising`` for its length (a command
     raises; the code around it, which would print its own message, only
-    notes). A KeyboardInterrupt raised in a finaliser is not printed as
-    "Exception ignored" with its traceback: it is noted (the caller ends as
-    interrupted).
+    notes). A KeyboardInterrupt raised in a finaliser (``__del__``, a weakref
+    callback), where Python would print "Exception ignored" with its
+    traceback and go on, is not printed: while ``raising`` it is raised
+    again in the code the finaliser interrupted (:data:`REPEAT_DELAY` later),
+    so the work stops then and not when it would have ended.
     """
     current = signal.getsignal(signal.SIGINT)
     if isinstance(current, _NotingCtrlC):
@@ -70,8 +85,13 @@ def noting_ctrl_c(raising: bool = True) -> Iterator[list[int]]:
     printing_unraisable = sys.unraisablehook
 
     def unraisable(report: Any) -> None:
-        if not (handler.noted and report.exc_type is KeyboardInterrupt):
-            printing_unraisable(report)
+        try:
+            if not (handler.noted and report.exc_type is KeyboardInterrupt):
+                printing_unraisable(report)
+            elif handler.raising:
+                _interrupt_main_soon()
+        except KeyboardInterrupt:  # a Ctrl-C meanwhile, here: raised again too
+            _interrupt_main_soon()
 
     sys.unraisablehook = unraisable
     try:

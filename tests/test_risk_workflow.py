@@ -304,7 +304,8 @@ def test_ctrl_c_at_any_moment_exits_130_without_a_traceback(isolated_store, tmp_
     ``-X importtime`` prints on stderr, not from the process's start: on a loaded machine Python's own start-up, before the
     command has a handler (a Ctrl-C there is Python's, with its traceback), can outlast any fixed delay."""
     # 20 000 resamples keep `risk` busy for about 25 s on an idle machine, well past the last moment (200 000: about 250 s, all of
-    # which one run of the suite spent here once, 2026-12-03, the signal seemingly not taken; not reproduced in isolation)
+    # which one run of the suite spent here once: the Ctrl-C met a finaliser, and was then raised only at the command's end;
+    # now it is raised again at once, test_experiment_cli.py::test_a_ctrl_c_raised_in_a_finaliser_stops_the_work_at_once)
     commands = [["risk", str(isolated_store), "--bootstrap", "20000"], ["report", "build", str(isolated_store), "--out", str(tmp_path / "out")]]
     for command in commands:
         process = subprocess.Popen([*PYTHON_WITH_CTRL_C, "-X", "importtime", "-m", "stochpound", *command], stdout=subprocess.PIPE,

@@ -38,12 +38,13 @@ def interruptible(work: Callable[[], T], loading: bool = False) -> T:
     Also when a library turned the Ctrl-C's KeyboardInterrupt into an error
     of its own (an HDF5 or netCDF read cut short fails with its message; an
     extension module's import with ``ImportError: initialization failed``):
-    an error raised after a Ctrl-C is the Ctrl-C. And when the
-    KeyboardInterrupt never reached ``work``: raised inside a finaliser
-    (``__del__``, a weakref callback), where Python prints it as "Exception
-    ignored" and goes on, or caught by a library; ``work`` then returns and
-    the command ends as interrupted. A Ctrl-C noted by an enclosing block
-    before ``work`` starts ends it before it starts.
+    an error raised after a Ctrl-C is the Ctrl-C. One raised inside a
+    finaliser (``__del__``, a weakref callback), where Python would print it
+    as "Exception ignored" and go on, is raised again in ``work`` at once
+    (``stochpound._signals.noting_ctrl_c``). One a library caught never
+    reaches ``work``: ``work`` then returns and the command ends as
+    interrupted. A Ctrl-C noted by an enclosing block before ``work`` starts
+    ends it before it starts.
     """
     from stochpound._signals import noting_ctrl_c
 
