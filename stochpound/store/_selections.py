@@ -44,8 +44,8 @@ def fixed_base(data: Data) -> Data:
     return data.sel(mu=FIXED_BASE)
 
 
-def select_case(store: xr.Dataset, **labels: Any) -> xr.Dataset:
-    """The store at the given labels; labels of dimensions the store lacks are ignored.
+def select_case(store: Data, **labels: Any) -> Data:
+    """The store (or one of its variables) at the given labels; labels of dimensions it lacks are ignored.
 
     A ``realization`` of length 1 is squeezed. A label missing from its
     dimension raises ``KeyError`` (callers show such cells as missing).

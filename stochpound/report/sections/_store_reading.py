@@ -80,8 +80,12 @@ def value(store: xr.Dataset | None, variable: str, scale: float = 1.0, **labels:
     """One number of a store (NaN when the store, the variable or the case is missing, or it did not finish)."""
     if store is None or variable not in store:
         return float("nan")
+    array = store[variable]  # selected alone: selecting the whole store slices every variable (a report reads hundreds of values)
     try:
-        data = select(store, **labels)[variable]
+        for dim in set(labels) & set(store.dims) - set(array.dims):
+            if dim in store.indexes:  # a label the store lacks is a missing case, whether or not the variable has its dimension
+                store.indexes[dim].get_loc(labels[dim])
+        data = select(array, **labels)
     except KeyError:
         return float("nan")
     if data.size != 1:
