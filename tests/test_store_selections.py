@@ -60,3 +60,17 @@ def test_fixed_base_twins() -> None:
     twin = fixed_base(store)
     assert float(twin["mu"]) == math.inf and "mu" not in twin.dims
     np.testing.assert_allclose(twin["closure"].sel(neighbour="stiff").values.ravel(), [1.2])
+
+
+def test_a_report_value_reads_one_case_of_one_variable_and_a_missing_label_is_nan() -> None:
+    """``value`` (the reports' one number) selects its variable alone: the same number as the whole store at the labels, a
+    realization of one squeezed; a label the store lacks is a missing case (NaN) even on a dimension the variable does not have,
+    as when the whole store was selected."""
+    from stochpound.report.sections import value
+
+    store = _store([0.01, 0.02], [0.03]).assign(peak=("neighbour", [1.5, 2.5])).expand_dims(realization=[0])
+    assert value(store, "closure", neighbour="flexible", gap_top=0.03, gap=0.02, mu=0.1) == pytest.approx(2.0 + 0.3 + 0.1)
+    assert value(store, "peak", scale=2.0, neighbour="flexible", gap=0.02, mu=0.1) == 5.0
+    assert math.isnan(value(store, "peak", neighbour="flexible", gap=0.05))
+    assert math.isnan(value(store, "closure", neighbour="flexible", gap_top=0.03, gap=0.05, mu=0.1))
+    assert math.isnan(value(store, "missing", neighbour="flexible"))
