@@ -274,6 +274,9 @@ class FolderRecord:
         Each motion's label, time step (s) and number of samples.
     created : str
         When the folder was created (UTC, ISO 8601).
+    choice_sha256 : str
+        The identity of the stripes' choice of motions the folder's cases ran (``experiment._session.choice_sha256``); "" where the
+        stripes choose none, or in a folder written before it was kept.
     """
 
     definition_sha256: str
@@ -284,20 +287,21 @@ class FolderRecord:
     base_dir: str = "."
     motion_grids: tuple[tuple[str, float, int], ...] = ()
     created: str = ""
+    choice_sha256: str = ""
 
     @classmethod
     def from_json(cls, data: Any) -> FolderRecord:
         """The record of an ``experiment.json``'s contents (the fields a folder of an older stochpound lacks take their defaults)."""
         grids = tuple((label, float(grid[0]), int(grid[1])) for label, grid in data["motion_grids"].items())
-        known = {name: data[name] for name in ("definition", "text", "text_sha256", "file", "base_dir", "created") if name in data}
+        known = {name: data[name] for name in ("definition", "text", "text_sha256", "file", "base_dir", "created", "choice_sha256") if name in data}
         return cls(data["definition_sha256"], motion_grids=grids, **known)
 
     def to_json(self) -> dict[str, Any]:
         """The ``experiment.json`` contents, its fields in the order they are written."""
         written = {"definition_sha256": self.definition_sha256, "definition": self.definition, "text": self.text, "text_sha256": self.text_sha256,
                    "file": self.file, "base_dir": self.base_dir, "motion_grids": {label: [dt, samples] for label, dt, samples in self.motion_grids},
-                   "created": self.created}
-        return {key: value for key, value in written.items() if key != "definition" or value is not None}
+                   "created": self.created, "choice_sha256": self.choice_sha256}
+        return {key: value for key, value in written.items() if not (key == "definition" and value is None or key == "choice_sha256" and not value)}
 
     @property
     def identity(self) -> str:

@@ -21,7 +21,7 @@ import numpy as np
 
 from stochpound import __version__
 from stochpound.experiment._experiment import Experiment
-from stochpound.store import KINDS, MotionTable
+from stochpound.store import KINDS, MotionTable, canonical_json
 from stochpound._atomic import check_not_input, temporaries
 from stochpound.experiment._parts import (DEFINITION_FILE, RUNS_FILE, FolderRecord, RunEntry, part_paths, parts_folder, read_experiment_json, read_runs,
                                           write_experiment_json)
@@ -34,6 +34,54 @@ from stochpound.experiment._file_assembly import PartsIndex, write_store
 def now() -> str:
     """Current UTC time, ISO 8601."""
     return _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")
+
+
+def choice_sha256(records: list[str], record_motions: list[str], scale_factors: np.ndarray) -> str:
+    """The identity of a choice of the stripes' motions: the pool's motions (labels and scene tables, in the ``record`` order)
+    and each stripe's scale factors (intensity × record, NaN where the motion is not chosen), every bit of them."""
+    scales = [[None if np.isnan(value) else float(value).hex() for value in row] for row in np.asarray(scale_factors, dtype=float)]
+    table = {"record": [str(label) for label in records], "record_motion": [str(motion) for motion in record_motions], "scale_factor": scales}
+    return hashlib.sha256(json.dumps(table, sort_keys=True).encode()).hexdigest()
+
+
+def experiment_choice(experiment: Experiment) -> str:
+    """:func:`choice_sha256` of the motions the experiment's stripes choose ("" where they choose none)."""
+    if experiment.selection is None:
+        return ""
+    motions = experiment.motions
+    scales = experiment.selection.coordinates()["selection_scale_factor"].values
+    return choice_sha256(list(motions), [canonical_json(motions[label].motion) for label in motions], scales)
+
+
+def stored_choice(store: Path) -> str:
+    """:func:`choice_sha256` of the choice a store file records ("" without one: no file, no selection, unreadable)."""
+    import xarray as xr
+
+    try:
+        with xr.open_dataset(store, engine="h5netcdf", decode_times=False) as data:
+            if "selection_scale_factor" not in data.variables:
+                return ""
+            return choice_sha256(list(data["record"].values), list(data["record_motion"].values), data["selection_scale_factor"].values)
+    except (OSError, ValueError, KeyError):
+        return ""
+
+
+def check_choice(store: Path, record: FolderRecord, choice: str) -> None:
+    """Refuse to add cases to a store whose finished cases ran another choice of the stripes' motions.
+
+    The choice is recorded in the parts folder (``choice_sha256``), or read from the store file for a folder written before
+    it was kept. It changes only with the selection's code (another version of stochpound, or a constant of its pools): the
+    definition, and so the store's identity, is the same, but a case of a stripe would run another motion than its neighbours.
+
+    Raises
+    ------
+    ExperimentError
+        One line naming the store, if the folder holds finished cases of another choice.
+    """
+    recorded = record.choice_sha256 or (stored_choice(store) if store.is_file() else "")
+    if choice and recorded and recorded != choice and part_paths(parts_folder(store)):
+        raise ExperimentError(f"{store}: its finished cases ran another choice of the stripes' motions than this stochpound makes for the same "
+                              "definition (the selection's code changed since); use --restart to run every case again, or --store to write elsewhere")
 
 
 def store_identity(store: Path) -> str:
@@ -269,22 +317,32 @@ class StoreSession:
 
     @classmethod
     def create(cls, store: Path, experiment: Experiment, motion_grids: dict[str, tuple[float, int]]) -> "StoreSession":
-        """Open the parts folder for a run, writing ``experiment.json`` if it is new."""
+        """Open the parts folder for a run, writing ``experiment.json`` if it is new.
+
+        Raises
+        ------
+        ExperimentError
+            If the folder's finished cases ran another choice of the stripes' motions than the experiment's now
+            (:func:`check_choice`).
+        """
         folder = parts_folder(store)
         folder.mkdir(parents=True, exist_ok=True)
         definition, text_sha256 = json.loads(experiment.definition_json), hashlib.sha256(experiment.text.encode()).hexdigest()
+        choice = experiment_choice(experiment)
         if (folder / DEFINITION_FILE).exists():
             record = read_experiment_json(folder)
-            if record.definition != definition or record.text != experiment.text:  # the same runs (checked by check_store), another
-                # hazard, or another text of the same definition (its comments): record it, with the file it came from (the same
-                # text from a store's copy elsewhere leaves the store as it is)
+            check_choice(store, record, choice)
+            if record.definition != definition or record.text != experiment.text or record.choice_sha256 != choice:  # the same runs
+                # (checked by check_store), another hazard, or another text of the same definition (its comments): record it, with
+                # the file it came from (the same text from a store's copy elsewhere leaves the store as it is)
                 record = dataclasses.replace(record, definition=definition, definition_sha256=experiment.sha256, text=experiment.text,
-                                             text_sha256=text_sha256, file=experiment.path, base_dir=str(experiment.base_dir.resolve()))
+                                             text_sha256=text_sha256, file=experiment.path, base_dir=str(experiment.base_dir.resolve()),
+                                             choice_sha256=choice)
                 write_experiment_json(folder, record)
         else:
             grids = tuple((label, dt, samples) for label, (dt, samples) in motion_grids.items())
             record = FolderRecord(experiment.sha256, definition, experiment.text, text_sha256, experiment.path, str(experiment.base_dir.resolve()),
-                                  grids, now())
+                                  grids, now(), choice)
             write_experiment_json(folder, record)
         return cls(store, experiment, record)
 
