@@ -48,9 +48,15 @@ REPEAT_DELAY = 0.05
 """Seconds after which a Ctrl-C swallowed by a finaliser is raised again (:func:`noting_ctrl_c`): the finaliser has ended."""
 
 
-def _interrupt_main_soon() -> None:
-    """SIGINT's handler called in the main thread again :data:`REPEAT_DELAY` seconds from now (from a timer thread)."""
-    timer = threading.Timer(REPEAT_DELAY, _thread.interrupt_main, args=(signal.SIGINT,))
+def _interrupt_main_soon(handler: _NotingCtrlC) -> None:
+    """``handler`` called in the main thread again :data:`REPEAT_DELAY` seconds from now (from a timer thread), if it is still
+    SIGINT's handler and raising then (the block may have ended meanwhile: then nothing)."""
+
+    def again() -> None:
+        if handler.raising and signal.getsignal(signal.SIGINT) is handler:
+            _thread.interrupt_main(signal.SIGINT)
+
+    timer = threading.Timer(REPEAT_DELAY, again)
     timer.daemon = True
     timer.start()
 
@@ -89,9 +95,9 @@ def noting_ctrl_c(raising: bool = True) -> Iterator[list[int]]:
             if not (handler.noted and report.exc_type is KeyboardInterrupt):
                 printing_unraisable(report)
             elif handler.raising:
-                _interrupt_main_soon()
+                _interrupt_main_soon(handler)
         except KeyboardInterrupt:  # a Ctrl-C meanwhile, here: raised again too
-            _interrupt_main_soon()
+            _interrupt_main_soon(handler)
 
     sys.unraisablehook = unraisable
     try:
