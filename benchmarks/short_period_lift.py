@@ -6,7 +6,10 @@ high-passed at 1 Hz (4th-order Butterworth, zero phase): how much its content
 below 1 Hz adds to its peak response at a short period (nearly its peak
 acceleration). It is printed by the motion's ε at T* (against the conditional
 spectrum's own model, the NGA-West2 average of the motion's scenario,
-``scenario_spectrum``), beside the mean ε at 0.043 s:
+``scenario_spectrum``), beside the mean ε at 0.043 s, the median ratio of
+the peak of the motion's content below 1 Hz to the peak of its content above
+(low-passed and high-passed alike), and the share of motions whose two peaks
+are within 1 s of each other:
 
 - for the bundled FEMA P695 record components (far-field and near-field sets,
   each recording once), each at its own scenario (its metadata's magnitude,
@@ -44,15 +47,18 @@ CHUNK = 256
 
 @dataclass(frozen=True)
 class Lifts:
-    """Per motion: ε at (T_SHORT, T*) and the lift of ln Sa(T_SHORT) (module docstring)."""
+    """Per motion: ε at (T_SHORT, T*), the lift of ln Sa(T_SHORT) (module docstring), the ratio of the peak of its content
+    below :data:`HIGH_PASS_HZ` to the peak of its content above, and the time of the first peak minus that of the second (s)."""
 
     epsilon: np.ndarray  # [n, 2]
     lift: np.ndarray  # [n]
+    peak_ratio: np.ndarray  # [n]
+    lag: np.ndarray  # [n]
 
     @classmethod
     def concatenate(cls, parts: list[Lifts]) -> Lifts:
         """The motions of ``parts`` together."""
-        return cls(np.vstack([p.epsilon for p in parts]), np.concatenate([p.lift for p in parts]))
+        return cls(*(np.concatenate([getattr(p, name) for p in parts]) for name in ("epsilon", "lift", "peak_ratio", "lag")))
 
 
 def lifts(acceleration: np.ndarray, dt: float, scenario, t_star: float) -> Lifts:
@@ -62,11 +68,14 @@ def lifts(acceleration: np.ndarray, dt: float, scenario, t_star: float) -> Lifts
     from stochpound.motions import pseudo_spectra, scenario_spectrum
 
     periods = np.array([T_SHORT, t_star])
-    high_pass = butter(4, HIGH_PASS_HZ, "highpass", fs=1.0 / dt, output="sos")
+    high = sosfiltfilt(butter(4, HIGH_PASS_HZ, "highpass", fs=1.0 / dt, output="sos"), acceleration, axis=-1)
+    low = sosfiltfilt(butter(4, HIGH_PASS_HZ, "lowpass", fs=1.0 / dt, output="sos"), acceleration, axis=-1)
     ln_sa = np.log(pseudo_spectra(acceleration, dt, periods))
-    ln_high = np.log(pseudo_spectra(sosfiltfilt(high_pass, acceleration, axis=-1), dt, periods[:1]))[:, 0]
+    ln_high = np.log(pseudo_spectra(high, dt, periods[:1]))[:, 0]
     mean, sigma = scenario_spectrum(periods, scenario)
-    return Lifts((ln_sa - np.log(9.81) - mean) / sigma, ln_sa[:, 0] - ln_high)
+    ratio = np.abs(low).max(axis=-1) / np.abs(high).max(axis=-1)
+    lag = (np.argmax(np.abs(low), axis=-1) - np.argmax(np.abs(high), axis=-1)) * dt
+    return Lifts((ln_sa - np.log(9.81) - mean) / sigma, ln_sa[:, 0] - ln_high, ratio, lag)
 
 
 def record_scenarios() -> Iterator[tuple[np.ndarray, float, object]]:
@@ -99,12 +108,13 @@ def simulated(scenario, n: int, seed: int, t_star: float) -> Lifts:
 def table(title: str, data: Lifts, t_star: float) -> str:
     """A markdown table of ``data`` by bins of ε at T*, and the slope of the lift on it."""
     rows = [f"**{title}** ({len(data.lift)} motions; slope of the lift on ε(T*): {np.polyfit(data.epsilon[:, 1], data.lift, 1)[0]:.3f})", "",
-            f"| ε({t_star:g} s) | motions | mean ε({T_SHORT:g} s) | lift: mean | median |", "|---|---:|---:|---:|---:|"]
+            f"| ε({t_star:g} s) | motions | mean ε({T_SHORT:g} s) | lift: mean | median | peak below / above 1 Hz: median | peaks within 1 s |",
+            "|---|---:|---:|---:|---:|---:|---:|"]
     for low, high in zip(BINS, BINS[1:]):
         inside = (data.epsilon[:, 1] >= low) & (data.epsilon[:, 1] < high)
         if inside.any():
             rows.append(f"| [{low:g}, {high:g}) | {int(inside.sum())} | {data.epsilon[inside, 0].mean():+.2f} | {data.lift[inside].mean():.3f} | "
-                        f"{np.median(data.lift[inside]):.3f} |")
+                        f"{np.median(data.lift[inside]):.3f} | {np.median(data.peak_ratio[inside]):.2f} | {np.mean(np.abs(data.lag[inside]) < 1.0):.2f} |")
     return "\n".join(rows)
 
 

@@ -27,5 +27,5 @@ def test_the_lift_is_what_content_below_1_hz_adds_to_the_short_period_peak() -> 
 def test_the_command_prints_the_records_and_the_simulated_motions_by_epsilon(capsys) -> None:
     assert main(["--limit", "4", "--n", "2"]) == 0
     out = capsys.readouterr().out
-    assert "**Records (FEMA P695)** (4 motions;" in out and "| ε(2 s) | motions | mean ε(0.043 s) | lift: mean | median |" in out
+    assert "**Records (FEMA P695)** (4 motions;" in out and "| ε(2 s) | motions | mean ε(0.043 s) | lift: mean | median | peak below / above 1 Hz: median | peaks within 1 s |" in out
     assert "**Simulated, 2 of each record's scenario (" in out
