@@ -151,12 +151,19 @@ def write_store(store: Path, definition: RareEventDefinition, levels: list[Finis
 
 
 def is_rare_event_store(path: str | Path) -> bool:
-    """Whether a file is a rare-event experiment's store (False for any other file)."""
+    """Whether a file is a rare-event experiment's store (False for any other file).
+
+    Read from the file's ``kind`` attribute alone (HDF5), not by opening it as a dataset: a report asks it of every store
+    it is given, and a grid's store has hundreds of variables to index.
+    """
+    import h5py
+
     try:
-        with xr.open_dataset(path, engine="h5netcdf") as data:
-            return data.attrs.get("kind") == KIND
+        with h5py.File(path, "r") as handle:
+            kind = handle.attrs.get("kind")
     except (OSError, ValueError):
         return False
+    return (kind.decode() if isinstance(kind, bytes) else kind) == KIND
 
 
 def open_rare_event_store(path: str | Path) -> xr.Dataset:
