@@ -10,7 +10,7 @@ import json
 
 import pytest
 
-from stochpound.experiment import _stripe_pools, load_experiment, run_experiment
+from stochpound.experiment import _stripe_pools, load_experiment, run_experiment, store_status
 from stochpound.experiment._parts import DEFINITION_FILE, parts_folder, part_paths, read_experiment_json
 from stochpound.experiment._session import check_choice, experiment_choice, stored_choice
 from stochpound.experiment._spec import ExperimentError
@@ -36,6 +36,9 @@ def test_a_resume_that_would_choose_other_motions_is_refused_and_the_same_choice
     with pytest.raises(ExperimentError, match=r"tilted\.nc: its finished cases ran another choice of the stripes' motions .*--restart"):
         _run(path, 40, monkeypatch)
     assert sorted(part_paths(folder)) == parts and not store.exists()  # nothing lost, nothing written
+    status = store_status(store)  # nor does `status`, which would write the file with the choice it makes now
+    assert not status.rebuilt and "another choice of the stripes' motions" in status.not_rebuilt and not store.exists()
+    assert status.n_done == report.total  # the finished cases, all of them in the parts
 
     experiment, report = _run(path, 48, monkeypatch)
     assert report.complete and report.done_before == report.total and stored_choice(store) == choice

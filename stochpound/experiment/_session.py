@@ -409,6 +409,17 @@ class StoreSession:
             "runs": json.dumps([run.to_json() for run in runs]),
         }
 
+    def check_choice(self) -> None:
+        """:func:`check_choice` of the session's store against the choice its experiment makes now (a session made by
+        :meth:`open` from the folder's record chooses again when it rebuilds the file).
+
+        Raises
+        ------
+        ExperimentError
+            If the folder's finished cases ran another choice of the stripes' motions.
+        """
+        check_choice(self.store, self.record, experiment_choice(self.experiment))
+
     def rebuild(self) -> Path:
         """(Re)write the store file atomically from the parts (scanned again: parts written since count)."""
         return write_store(self.experiment, self.scan(), self.motion_grids, self.attrs(), self.store)

@@ -96,7 +96,11 @@ def store_status(store: str | Path, rebuild: bool = True) -> StatusReport:
     try:
         if rebuilt:
             try:
+                session.check_choice()
                 session.rebuild()
+            except ExperimentError as error:  # cases of another choice of the stripes' motions: the file is not rewritten with this one
+                rebuilt, not_rebuilt = False, str(error)
+                session.scan()
             except OSError as error:  # a full disk, say: the parts and the old store file are intact; the status is still known
                 rebuilt, not_rebuilt = False, os_error_message(error)
                 session.scan()
