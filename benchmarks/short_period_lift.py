@@ -65,7 +65,7 @@ def lifts(acceleration: np.ndarray, dt: float, scenario, t_star: float) -> Lifts
     """The lifts of motions ``acceleration`` [n, n_time] (m/s², step ``dt`` s) of ``scenario``."""
     from scipy.signal import butter, sosfiltfilt
 
-    from stochpound.motions import pseudo_spectra, scenario_spectrum
+    from stochpound.motions import DEFAULT_G, pseudo_spectra, scenario_spectrum
 
     periods = np.array([T_SHORT, t_star])
     high = sosfiltfilt(butter(4, HIGH_PASS_HZ, "highpass", fs=1.0 / dt, output="sos"), acceleration, axis=-1)
@@ -75,12 +75,12 @@ def lifts(acceleration: np.ndarray, dt: float, scenario, t_star: float) -> Lifts
     mean, sigma = scenario_spectrum(periods, scenario)
     ratio = np.abs(low).max(axis=-1) / np.abs(high).max(axis=-1)
     lag = (np.argmax(np.abs(low), axis=-1) - np.argmax(np.abs(high), axis=-1)) * dt
-    return Lifts((ln_sa - np.log(9.81) - mean) / sigma, ln_sa[:, 0] - ln_high, ratio, lag)
+    return Lifts((ln_sa - np.log(DEFAULT_G) - mean) / sigma, ln_sa[:, 0] - ln_high, ratio, lag)
 
 
 def record_scenarios() -> Iterator[tuple[np.ndarray, float, object]]:
     """Each bundled P695 record component once (by RSN and component): its acceleration (m/s²), step and scenario."""
-    from stochpound.motions import Scenario
+    from stochpound.motions import DEFAULT_G, Scenario
     from stochpound.motions.records import load_suite
 
     seen = set()
@@ -91,7 +91,7 @@ def record_scenarios() -> Iterator[tuple[np.ndarray, float, object]]:
                 continue
             seen.add((meta["rsn"], meta["component"]))
             scenario = Scenario(float(meta["magnitude"]), float(meta["distance"]), float(meta["vs30"]), MECHANISMS[str(meta["fault_type"])])
-            yield record.acceleration(g=9.81), record.dt, scenario
+            yield record.acceleration(g=DEFAULT_G), record.dt, scenario
 
 
 def simulated(scenario, n: int, seed: int, t_star: float) -> Lifts:

@@ -223,15 +223,18 @@ def blocks(shape: tuple[int, ...], block: tuple[int, ...]) -> Iterator[tuple[sli
         yield tuple(slice(s, min(s + b, n)) for s, b, n in zip(starts, block, shape))
 
 
+def record_motions(experiment: Experiment) -> list[str]:
+    """Each motion's scene table as the store's ``record_motion`` holds it (canonical JSON), in the ``record`` order."""
+    return [canonical_json(motion.motion) for motion in experiment.motions.values()]
+
+
 def _coordinates(experiment: Experiment, motion_grids: Mapping[str, tuple[float, int]]) -> dict[str, xr.Variable]:
     coords: dict[str, xr.Variable] = {}
     for dim in experiment.dims:
         coords[dim.name] = _dim_coordinate(experiment, dim)
     motions = experiment.motions
     coords["record_kind"] = xr.Variable(("record",), np.array([motions[m].kind for m in motions], dtype=object), {"units": "1", "long_name": "record or synthetic ensemble"})
-    coords["record_motion"] = xr.Variable(
-        ("record",), np.array([canonical_json(motions[m].motion) for m in motions], dtype=object), {"units": "1", "long_name": "the motion's scene table (JSON)"}
-    )
+    coords["record_motion"] = xr.Variable(("record",), np.array(record_motions(experiment), dtype=object), {"units": "1", "long_name": "the motion's scene table (JSON)"})
     coords.update(_suite_coordinates(experiment))
     if experiment.selection is not None:
         coords.update(experiment.selection.coordinates())

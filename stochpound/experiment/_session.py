@@ -21,13 +21,13 @@ import numpy as np
 
 from stochpound import __version__
 from stochpound.experiment._experiment import Experiment
-from stochpound.store import KINDS, MotionTable, canonical_json
+from stochpound.store import KINDS, MotionTable
 from stochpound._atomic import check_not_input, temporaries
 from stochpound.experiment._parts import (DEFINITION_FILE, RUNS_FILE, FolderRecord, RunEntry, part_paths, parts_folder, read_experiment_json, read_runs,
                                           write_experiment_json)
 from stochpound.experiment._spec import ExperimentError
 from stochpound.store import definition_sha256
-from stochpound.experiment._file_layout import PREFIX, layout
+from stochpound.experiment._file_layout import PREFIX, layout, record_motions
 from stochpound.experiment._file_assembly import PartsIndex, write_store
 
 
@@ -36,11 +36,11 @@ def now() -> str:
     return _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")
 
 
-def choice_sha256(records: list[str], record_motions: list[str], scale_factors: np.ndarray) -> str:
+def choice_sha256(records: list[str], motion_tables: list[str], scale_factors: np.ndarray) -> str:
     """The identity of a choice of the stripes' motions: the pool's motions (labels and scene tables, in the ``record`` order)
     and each stripe's scale factors (intensity × record, NaN where the motion is not chosen), every bit of them."""
     scales = [[None if np.isnan(value) else float(value).hex() for value in row] for row in np.asarray(scale_factors, dtype=float)]
-    table = {"record": [str(label) for label in records], "record_motion": [str(motion) for motion in record_motions], "scale_factor": scales}
+    table = {"record": [str(label) for label in records], "record_motion": [str(motion) for motion in motion_tables], "scale_factor": scales}
     return hashlib.sha256(json.dumps(table, sort_keys=True).encode()).hexdigest()
 
 
@@ -48,9 +48,8 @@ def experiment_choice(experiment: Experiment) -> str:
     """:func:`choice_sha256` of the motions the experiment's stripes choose ("" where they choose none)."""
     if experiment.selection is None:
         return ""
-    motions = experiment.motions
     scales = experiment.selection.coordinates()["selection_scale_factor"].values
-    return choice_sha256(list(motions), [canonical_json(motions[label].motion) for label in motions], scales)
+    return choice_sha256(list(experiment.motions), record_motions(experiment), scales)
 
 
 def stored_choice(store: Path) -> str:
