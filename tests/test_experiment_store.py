@@ -169,7 +169,8 @@ def test_numpy_summaries_equal_the_analysis_definitions(mu1, mu2):
 
 
 def test_both_netcdf_engines_read_the_same_store(small_store):
-    """The file xarray writes through h5netcdf, filled block by block with h5py, reads the same with netCDF4 (the C library)."""
+    """The file xarray creates through the netCDF C library (its netCDF4 back end), filled block by block with h5py, reads the
+    same with h5netcdf (HDF5 through h5py) and with netCDF4."""
     _, store = small_store
     with xr.open_dataset(store, engine="h5netcdf") as a, xr.open_dataset(store, engine="netcdf4") as b:
         assert sorted(a.variables) == sorted(b.variables) and set(a.coords) == set(b.coords)
@@ -177,6 +178,17 @@ def test_both_netcdf_engines_read_the_same_store(small_store):
             assert a[name].dtype == b[name].dtype and a[name].dims == b[name].dims, name
             np.testing.assert_array_equal(a[name].values, b[name].values, err_msg=name)
         assert a.attrs == b.attrs
+
+
+def test_a_store_written_through_h5netcdf_opens_the_same(small_store, tmp_path):
+    """Stores written before the store's metadata went through the netCDF C library were created by h5netcdf: open_store
+    (netCDF4 engine) reads such a file as the same dataset."""
+    _, store = small_store
+    earlier = tmp_path / "earlier.nc"
+    with xr.open_dataset(store, engine="h5netcdf") as data:
+        data.load().to_netcdf(earlier, engine="h5netcdf")
+    with open_store(store) as expected, open_store(earlier) as actual:
+        xr.testing.assert_identical(actual.load(), expected.load())
 
 
 def test_a_large_ensemble_is_chunked_along_realization(tmp_path):
@@ -228,24 +240,22 @@ def test_the_store_is_written_under_a_lock_of_this_process_while_a_dask_client_i
     store must hold the same data."""
     from distributed import Client, LocalCluster
     from distributed import Lock as DistributedLock
-    from xarray.backends import H5NetCDFStore
+    from xarray.backends import NetCDF4DataStore
 
     from stochpound.experiment import _file_assembly as file_assembly
     from stochpound.experiment._session import StoreSession
 
     opened = []
 
-    class RecordingStore(H5NetCDFStore):
-        @classmethod
-        def open(cls, *args, **kwargs):
-            store = H5NetCDFStore.open(*args, **kwargs)
-            opened.append(store)
-            return store
+    class RecordingStore(NetCDF4DataStore):
+        def __init__(self, *args, **kwargs):
+            super().__init__(*args, **kwargs)
+            opened.append(self)
 
     def locks(lock):  # the locks inside xarray's CombinedLock
         return [inner for part in lock.locks for inner in locks(part)] if hasattr(lock, "locks") else [lock]
 
-    monkeypatch.setattr(file_assembly, "H5NetCDFStore", RecordingStore)
+    monkeypatch.setattr(file_assembly, "NetCDF4DataStore", RecordingStore)
     _, store = small_store
     session = StoreSession.open(store)
     rebuilt = tmp_path / "rebuilt.nc"

