@@ -46,8 +46,11 @@ from tests.helpers import random_scene
 
 
 TOLERANCE = 1e-9  # of max(1 m, largest |y|), every floor's total displacement over the whole record
-#: The scenes' seeds: 30 in the suite (seeds 2, 16, 21 and 25 of the docstring among them); STOCHPOUND_RANDOM_SCENES=N sweeps seeds 0 to N - 1.
-SEEDS = range(int(os.environ.get("STOCHPOUND_RANDOM_SCENES", "30")))
+#: The seeds the docstring names: scenes that once found a fault or are ill-conditioned; always run.
+NAMED_SEEDS = {2, 16, 21, 25}
+#: The scenes' seeds: 0 to 19 and the named ones in the suite (22 scenes); STOCHPOUND_RANDOM_SCENES=N sweeps seeds 0 to N - 1
+#: (and the named ones): 60 passed (docs/solvers.md).
+SEEDS = sorted(set(range(int(os.environ.get("STOCHPOUND_RANDOM_SCENES", "20")))) | NAMED_SEEDS)
 MAX_STEP = 2e-4  # s: the independent integration's largest step, so that no gap closes and opens again unseen within one
 
 
