@@ -1,11 +1,11 @@
-"""Why the store goes through the netCDF C library: ``python -m benchmarks.store_io [STORE] [--repeat 5]``.
+"""Why the store's metadata is created through the netCDF C library: ``python -m benchmarks.store_io [STORE] [--repeat 5]``.
 
 Times, in one run and alternating the two back ends, xarray's two netCDF4/HDF5
 engines on an experiment store (by default the quick start's, run into a
 temporary folder first):
 
 - *open*: ``xarray.open_dataset(STORE, engine=..., chunks={})`` and close, what
-  ``stochpound.open_store`` does (it uses ``netcdf4``);
+  ``stochpound.open_store`` does (it uses ``h5netcdf``: docs/experiments.md, "The store", says why);
 - *create*: ``Dataset.to_netcdf(..., engine=..., compute=False)`` of the store
   opened lazily, which creates every variable's metadata and leaves the data
   unwritten, what the store's writer does before it fills the blocks with h5py

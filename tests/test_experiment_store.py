@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import hashlib
-import re
 
 import dask.array
 import numpy as np
@@ -284,13 +283,3 @@ def test_a_changed_comment_is_recorded_without_running_again(tmp_path):
         for name, values in before.items():
             np.testing.assert_array_equal(ds[name].values, values)
 
-
-def test_the_store_io_benchmark_times_both_engines_on_a_store(small_store, capsys):
-    """benchmarks.store_io: a table of open and create, h5netcdf against netcdf4, on the store given."""
-    from benchmarks.store_io import main
-
-    _, store = small_store
-    assert main([str(store), "--repeat", "1"]) == 0
-    out = capsys.readouterr().out
-    assert f"Store `{store.name}`, " in out and "| operation | h5netcdf (s) | netcdf4 (s) | h5netcdf / netcdf4 |" in out
-    assert re.search(r"\| open \| [\d.]+ \| [\d.]+ \| [\d.]+ \|", out) and re.search(r"\| create \| [\d.]+ \| [\d.]+ \| [\d.]+ \|", out)

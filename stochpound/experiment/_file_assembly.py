@@ -3,7 +3,7 @@
 The file is created with every variable's metadata and chunking
 (:meth:`stochpound.experiment._file_layout.Layout.template`, written by xarray's
 netCDF4 back end, the netCDF C library, so that xarray and netCDF tools read it
-as any xarray-written file; seven times faster than through h5netcdf, whose
+as any xarray-written file; 4-5 times faster than through h5netcdf, whose
 Python layer looks every dimension up again for each variable) but no data; then each block of the grid (:func:`stochpound.experiment._file_layout.blocks`)
 is assembled in memory from the parts that hold its cases and written as
 one hyperslab per variable. The impact table's rows follow the cases in

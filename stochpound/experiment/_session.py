@@ -57,7 +57,7 @@ def stored_choice(store: Path) -> str:
     import xarray as xr
 
     try:
-        with xr.open_dataset(store, engine="netcdf4", decode_times=False) as data:
+        with xr.open_dataset(store, engine="h5netcdf", decode_times=False) as data:
             if "selection_scale_factor" not in data.variables:
                 return ""
             return choice_sha256(list(data["record"].values), list(data["record_motion"].values), data["selection_scale_factor"].values)

@@ -63,7 +63,7 @@ def open_store(path: str | Path, chunks: Any = None, *, edited: str = "warn") ->
     if not path.is_file():
         raise ExperimentError(f"{path}: store not found")
     try:
-        dataset = xr.open_dataset(path, engine="netcdf4", chunks={} if chunks is None else chunks)
+        dataset = xr.open_dataset(path, engine="h5netcdf", chunks={} if chunks is None else chunks)
     except (OSError, ValueError) as error:
         raise ExperimentError(f"{path}: not a readable netCDF4/HDF5 file ({error})") from None
     if "definition_sha256" not in dataset.attrs:
