@@ -182,7 +182,7 @@ def test_both_netcdf_engines_read_the_same_store(small_store):
 
 def test_a_store_written_through_h5netcdf_opens_the_same(small_store, tmp_path):
     """Stores written before the store's metadata went through the netCDF C library were created by h5netcdf: open_store
-    (netCDF4 engine) reads such a file as the same dataset."""
+    reads such a file as the same dataset as one created through the netCDF library."""
     _, store = small_store
     earlier = tmp_path / "earlier.nc"
     with xr.open_dataset(store, engine="h5netcdf") as data:
@@ -282,4 +282,3 @@ def test_a_changed_comment_is_recorded_without_running_again(tmp_path):
         assert ds.attrs["experiment_sha256"] == hashlib.sha256(commented.encode()).hexdigest()
         for name, values in before.items():
             np.testing.assert_array_equal(ds[name].values, values)
-
