@@ -126,14 +126,13 @@ def _fit(response: xr.DataArray, im: xr.DataArray, covariates: Mapping[str, xr.D
     from scipy.stats import linregress
 
     runs = [d for d in ("intensity", "record") if d in response.dims]
-    stacked = {name: value.broadcast_like(response).stack(_run=runs) for name, value in {"d": response, "im": im, **covariates}.items()}
-    configurations = [d for d in stacked["d"].dims if d != "_run"]
-    shape = [stacked["d"].sizes[d] for d in configurations]
+    configurations = [d for d in response.dims if d not in runs]
+    shape = [response.sizes[d] for d in configurations]
+    flat = {name: _by_configuration(value, response, configurations + runs, shape) for name, value in {"d": response, "im": im, **covariates}.items()}
     names = ["beta", "slope", "runs"] + [f"{kind}_{key}" for key in covariates for kind in ("trend", "p")]
     out = {name: np.full(shape, np.nan) for name in names}
     for index in np.ndindex(*shape):
-        where = dict(zip(configurations, index))
-        d, x = (stacked[k].isel(where).values.astype(float) for k in ("d", "im"))
+        d, x = flat["d"][index], flat["im"][index]
         ok = np.isfinite(d) & (d > 0) & np.isfinite(x) & (x > 0)
         out["runs"][index] = ok.sum()
         if ok.sum() < 3:
@@ -143,9 +142,22 @@ def _fit(response: xr.DataArray, im: xr.DataArray, covariates: Mapping[str, xr.D
         out["beta"][index] = np.sqrt(np.sum(residual**2) / (ok.sum() - 2))
         out["slope"][index] = fit.slope
         for key in covariates:
-            c = stacked[key].isel(where).values.astype(float)[ok]
+            c = flat[key][index][ok]
             if np.all(np.isfinite(c)) and np.ptp(c) > 1e-12 * max(1.0, np.max(np.abs(c))):
                 trend = linregress(c, residual)
                 out[f"trend_{key}"][index], out[f"p_{key}"][index] = trend.slope, trend.pvalue
-    coords = {d: stacked["d"][d] for d in configurations}
+    coords = {d: response[d] for d in configurations}
     return xr.Dataset({name: (configurations, value) for name, value in out.items()}, coords=coords)
+
+
+def _by_configuration(value: xr.DataArray, response: xr.DataArray, order: list[str], shape: list[int]) -> np.ndarray:
+    """``value`` on ``response``'s dimensions as floats of shape ``shape`` + (runs,): the runs (stripes, then motions) in C order.
+
+    ``value`` has the same labels as ``response`` on the dimensions they share (both are read from one store: checked).
+    """
+    for dim in value.dims:
+        index = response.indexes.get(dim)
+        if dim in value.indexes and (index is None or not value.indexes[dim].equals(index)):
+            raise ValueError(f"{value.name or 'value'}: its {dim!r} labels are not the response's")
+    expanded = value.variable.set_dims({dim: response.sizes[dim] for dim in order})
+    return expanded.transpose(*order).values.astype(float).reshape(*shape, -1)

@@ -613,10 +613,10 @@ class EfficiencyRuns:
 def efficiency_runs(store: xr.Dataset, studied: str | None) -> EfficiencyRuns:
     """What measure efficiency reads of a stripes (contact-free cases) or IDA store (:class:`EfficiencyRuns`), every motion on one dimension ``record``."""
     free = store.isel({d: 0 for d in gap_dims(store)}) if is_ida(store) else contact_free(store)
-    responses = {"closure": contact_free_closure(store)}
+    responses = {"closure": contact_free_closure(store).load()}  # read once: every candidate measure is fitted to them
     sliding = None if is_ida(store) else base_displacement(free, studied)
     if sliding is not None:
-        responses["base_displacement"] = sliding
+        responses["base_displacement"] = sliding.load()
     setting = intensity_setting(store)
     psa_in_g = setting is not None and setting.measure.kind == "psa" and setting.measure.damping == 0.05 and setting.units == "g"
     return EfficiencyRuns(
@@ -628,7 +628,7 @@ def efficiency_runs(store: xr.Dataset, studied: str | None) -> EfficiencyRuns:
         pgv=store_motions(free["motion_pgv"]).load(),
         intensity=store_motions(free["motion_intensity"]).load(),
         conditioning=float(setting.measure.period) if psa_in_g else None,
-        covariates={name: store_motions(free[name]) for name in ("record_magnitude", "record_distance") if name in free.coords},
+        covariates={name: store_motions(free[name]).load() for name in ("record_magnitude", "record_distance") if name in free.coords},
     )
 
 
