@@ -15,15 +15,14 @@ import pytest
 from stochpound.experiment import load_experiment, run_experiment
 from tests.helpers import laws_pair_text, tilted_site_text, write_experiment
 
-#: The test files that take longest (measured, whole suite on 2 cores, 2026-12-03), longest first: they start first;
+#: The test files that take longest (measured, whole suite on 2 cores, 2026-12-03, session 10), longest first: they start first;
 #: every other file follows in the usual order. Only the order changes: every test still runs.
 LONGEST_FIRST = (
-    "test_benchmark_site_consistency.py", "test_experiment_cli.py", "test_report_study.py", "test_engine_compile.py",
-    "test_random_scenes.py", "test_experiment_resume.py", "test_docs.py", "test_risk_workflow.py", "test_rare_event_experiment.py",
-    "test_report_laws.py", "test_report_engineer.py", "test_report_preserved.py", "test_numba_cache.py", "test_exact.py",
-    "test_energy_and_hard_cases.py", "test_measure_free_store.py", "test_scaling.py", "test_report_yielding.py",
-    "test_risk_one_event.py", "test_experiment_distributed.py", "test_experiment_store.py", "test_report_stochastic.py",
-    "test_getting_started.py", "test_experiment_startup.py",
+    "test_experiment_cli.py", "test_docs.py", "test_risk_workflow.py", "test_random_scenes.py", "test_experiment_resume.py",
+    "test_engine_compile.py", "test_report_study.py", "test_rare_event_experiment.py", "test_exact.py", "test_energy_and_hard_cases.py",
+    "test_numba_cache.py", "test_report_yielding.py", "test_engine_fuzz.py", "test_measure_free_store.py", "test_report_preserved.py",
+    "test_report_laws.py", "test_report_engineer.py", "test_fitted_scenarios.py", "test_experiment_store.py", "test_report_render.py",
+    "test_report_moat_clearance.py", "test_scaling.py", "test_experiment_distributed.py", "test_yielding.py",
 )  # fmt: skip
 
 
@@ -50,10 +49,21 @@ def _fill_numba_cache() -> None:
     site_motions(7.0, 20.0, 400.0, "strike_slip", n=1, seed=0, duration=1.0)
 
 
-def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
-    """The files of :data:`LONGEST_FIRST` first, in its order; the tests of a file in their own order."""
+def pytest_addoption(parser: pytest.Parser) -> None:
+    """``--benchmarks``: also run the tests marked ``benchmark`` (a benchmark's experiments, minutes each)."""
+    parser.addoption("--benchmarks", action="store_true", help="also run the tests marked benchmark: the done-when experiments of the benchmarks (minutes)")
+
+
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    """The files of :data:`LONGEST_FIRST` first, in its order; the tests of a file in their own order; without
+    ``--benchmarks``, the tests marked ``benchmark`` skipped, each with the reason (``-ra`` lists them)."""
     rank = {name: place for place, name in enumerate(LONGEST_FIRST)}
     items.sort(key=lambda item: rank.get(item.path.name, len(LONGEST_FIRST)))  # stable: the rest keep their order
+    if not config.getoption("--benchmarks"):
+        skip = pytest.mark.skip(reason="a benchmark's done-when experiment (minutes): run with --benchmarks")
+        for item in items:
+            if item.get_closest_marker("benchmark"):
+                item.add_marker(skip)
 
 
 @pytest.fixture(scope="module")

@@ -10,7 +10,9 @@ The same check at a site of one scenario (benchmarks.site_consistency's ``--site
 year), whose four curves come from the conditional spectrum's own models: hazard-consistent by construction, so the measures must
 agree there unless the pool or the stripes fail to carry the site's shaking (docs/intensity.md, finding 8).
 
-Run: ``pytest -m slow tests/test_benchmark_site_consistency.py -s`` (prints the g* tables; about 5 minutes on 2 cores). A configuration
+The four experiments' tests carry the ``benchmark`` marker: the suite skips them unless pytest is given ``--benchmarks`` (they are
+the benchmark's experiments, not checks of one code path, and took 75 s of the suite's 10 minutes on 2 cores; docs/contributing.md).
+Run: ``pytest --benchmarks tests/test_benchmark_site_consistency.py -s`` (prints the g* tables; about 2 minutes on 2 cores). A configuration
 whose spread is beyond the limit after some measures stops there (more measures can only widen it): its table has those measures only.
 """
 
@@ -28,6 +30,7 @@ LIMIT = 1.3  # the largest max/min of g* over the measures that passes
 
 
 @pytest.mark.slow
+@pytest.mark.benchmark
 @pytest.mark.parametrize("configuration", [
     "fixed pair",
     pytest.param("isolated", marks=pytest.mark.xfail(strict=True, reason=(
@@ -45,6 +48,7 @@ def test_g_star_hardly_depends_on_the_conditioning_measure(tmp_path, configurati
 
 
 @pytest.mark.slow
+@pytest.mark.benchmark
 @pytest.mark.parametrize("configuration", ["fixed pair", "isolated"])
 def test_at_a_site_of_one_scenario_g_star_hardly_depends_on_the_conditioning_measure(tmp_path, configuration: str) -> None:
     assert _spread(tmp_path, configuration, scenario_site(*SCENARIO)) <= LIMIT

@@ -41,11 +41,13 @@ def test_no_project_file_cites_a_document_outside_the_project():
 
 
 def test_the_readme_names_the_suites_duration_and_the_slow_marker():
-    """Beside the test command: how long the whole suite takes, and the quick run without the `slow` tests."""
+    """Beside the test command: how long the whole suite takes, the quick run without the `slow` tests, and how to run the
+    `benchmark` tests the suite skips."""
     text = (ROOT / "README.md").read_text()
     tests = text[text.index("<!-- test-command") : text.index("## What it does")]
     assert re.search(r"whole suite takes about \d+ minutes on 2 cores", tests)
     quick = re.search(r'`(python -m pytest[^`]* -m "not slow")`', tests)
     assert quick and re.search(r"quick run of about \d+ minutes", tests), "the README's quick test command"
     markers = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["pytest"]["ini_options"]["markers"]
-    assert [marker.split(":")[0] for marker in markers] == ["slow"]
+    assert [marker.split(":")[0] for marker in markers] == ["slow", "benchmark"]
+    assert "--benchmarks" in tests, "the README says how to run the tests the suite skips"

@@ -133,7 +133,7 @@ def single_against_mu(store: xr.Dataset) -> list[FigureItem]:
         mus = finite[finite > 0] if without_frictionless else finite
         lines, frictionless = {}, []
         for record in records:
-            data = select(store, record=record, mu=finite)[variable]
+            data = select(store[[variable]], record=record, mu=finite)[variable]
             values = (data.sel(building=building) if building else data) * factor
             lines[record_label(record)] = values.sel(mu=mus).values
             if without_frictionless and 0.0 in finite:
@@ -192,7 +192,8 @@ def _lines_against_mu(store: xr.Dataset, isolation: str, variable: str, factor: 
     lines = {}
     for neighbour in NEIGHBOURS:
         for model in models:
-            case = select(store, isolation=isolation, neighbour=neighbour, gap=0.02, mu=finite, model=model, record="el_centro")
+            read = store[[name for name in (variable, "impacts") if name in store]]  # not every variable: select slices each
+            case = select(read, isolation=isolation, neighbour=neighbour, gap=0.02, mu=finite, model=model, record="el_centro")
             name = NEIGHBOURS[neighbour] + ("" if model == "corrected" else ", study's equations")
             if variable in ("peak_impact_force", "longest_impact"):
                 lines[name] = _where_impacts(case, variable) * factor
