@@ -92,7 +92,7 @@ def _variable(store: xr.Dataset, variable: str) -> xr.DataArray:
     if array.size > _READ_MAX_VALUES:
         return array
     entry = _READ.get(id(store))
-    if entry is None or entry[0] is not store:
+    if entry is None:  # an entry's store is alive (the entry holds it): its id is that store's
         entry = _READ[id(store)] = (store, {})
         while len(_READ) > _READ_STORES:
             _READ.popitem(last=False)
