@@ -1,8 +1,9 @@
 """Shared fixtures of the tests (shared builders and helpers are in ``tests/helpers.py``), and the order the files run in.
 
-Before any test, the process that starts the run fills numba's on-disk cache with the compiled kernels
-(:func:`_fill_numba_cache`): the tests and the processes they start then load them instead of each compiling them
-cold at the same time (the tests of a cold compile set a cache folder of their own).
+Before any test of a run with ``-n N``, the process that starts the workers fills numba's on-disk cache with the compiled
+kernels (:func:`_fill_numba_cache`): the workers and the processes their tests start then load them instead of each
+compiling them cold at the same time (the tests of a cold compile set a cache folder of their own). A run in one process
+compiles each kernel once, where it is first used.
 
 With ``-n N`` the suite runs file by file (xdist's ``loadfile``: a file's module fixtures are built once, on the worker
 that runs the whole file, not on each worker its tests would be spread over), the longest files first
@@ -27,13 +28,13 @@ LONGEST_FIRST = (
 
 
 def pytest_configure(config: pytest.Config) -> None:
-    """xdist's ``load`` (what ``-n N`` alone gives) becomes ``loadfile``, its files in the collection's order; the process that
-    starts the run (not an xdist worker) fills numba's cache first."""
+    """xdist's ``load`` (what ``-n N`` alone gives) becomes ``loadfile``, its files in the collection's order; with ``-n N``,
+    the process that starts the workers fills numba's cache first."""
     if getattr(config.option, "dist", "no") == "load":
         config.option.dist = "loadfile"
         config.option.loadscopereorder = False
-    if not hasattr(config, "workerinput") and not (config.option.collectonly or config.option.help):
-        _fill_numba_cache()
+    if config.getoption("numprocesses", None) and not hasattr(config, "workerinput") and not (config.option.collectonly or config.option.help):
+        _fill_numba_cache()  # xdist's controller: several processes would compile the same kernels at once
 
 
 def _fill_numba_cache() -> None:

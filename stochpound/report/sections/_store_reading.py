@@ -8,6 +8,7 @@ from pathlib import Path
 from typing import Any
 
 import hashlib
+import weakref
 
 import xarray as xr
 
@@ -77,9 +78,10 @@ select = select_case
 """The store at the given labels (:func:`stochpound.store.select_case`)."""
 
 
-#: The variables :func:`value` has read whole, by store: ``id(store)`` -> (the store, its variables in memory). The entry holds
-#: the store itself, so that its ``id`` is not reused while the entry lives; the last :data:`_READ_STORES` stores only.
-_READ: OrderedDict[int, tuple[xr.Dataset, dict[str, xr.DataArray]]] = OrderedDict()
+#: The variables :func:`value` has read whole, by store: ``id(store)`` -> (a weak reference to the store, its variables in
+#: memory). The reference does not keep the store (and its file) open; it tells a live store from a later one that got the
+#: same ``id``. The last :data:`_READ_STORES` stores only.
+_READ: OrderedDict[int, tuple[weakref.ref, dict[str, xr.DataArray]]] = OrderedDict()
 _READ_STORES = 4
 #: The largest variable (values) :func:`value` reads whole; a larger one is read at the case only.
 _READ_MAX_VALUES = 1_000_000
@@ -92,8 +94,8 @@ def _variable(store: xr.Dataset, variable: str) -> xr.DataArray:
     if array.size > _READ_MAX_VALUES:
         return array
     entry = _READ.get(id(store))
-    if entry is None:  # an entry's store is alive (the entry holds it): its id is that store's
-        entry = _READ[id(store)] = (store, {})
+    if entry is None or entry[0]() is not store:  # none yet, or that of a store gone since, whose id this one reuses
+        entry = _READ[id(store)] = (weakref.ref(store), {})
         while len(_READ) > _READ_STORES:
             _READ.popitem(last=False)
     _READ.move_to_end(id(store))

@@ -190,9 +190,9 @@ def _lines_against_mu(store: xr.Dataset, isolation: str, variable: str, factor: 
     finite = np.array(isolated_mus(store["mu"].values))
     models = list(store["model"].values) if "model" in store.dims else ["corrected"]
     lines = {}
+    read = store[[name for name in (variable, "impacts") if name in store]]  # not every variable: select slices each
     for neighbour in NEIGHBOURS:
         for model in models:
-            read = store[[name for name in (variable, "impacts") if name in store]]  # not every variable: select slices each
             case = select(read, isolation=isolation, neighbour=neighbour, gap=0.02, mu=finite, model=model, record="el_centro")
             name = NEIGHBOURS[neighbour] + ("" if model == "corrected" else ", study's equations")
             if variable in ("peak_impact_force", "longest_impact"):
