@@ -1,4 +1,4 @@
-"""g* by conditioning measure and selection seed at Fox Plaza: ``python -m benchmarks measure_seeds run|table|consistency FOLDER``.
+"""g* by conditioning measure and selection seed at Fox Plaza: ``python -m benchmarks measure_seeds run|table|consistency|measure_free FOLDER``.
 
 Issue 43's measure/seed study, on a pool of records and simulated motions. For every configuration of
 :mod:`benchmarks.site_consistency` (the elastic fixed pair beside its stiff or flexible neighbour; Building 1 on the friction
@@ -25,6 +25,13 @@ in g* and in the rate of pounding at that measure's median g*; per configuration
 (:func:`stochpound.risk.site_consistency`), over the seeds whose stripes reach the target (their number when not all: the others' motions, scaled as they ran, never
 reach that level, a ratio of 0). A measure whose stripes carry the site's shaking at the building's periods gives
 ratios near 1 there.
+
+``measure_free FOLDER`` (a site of one scenario, ``--site scenario``: Fox Plaza has no ruptures) prints, per configuration, each
+measure's g* (the median over the seeds, their range) beside the answer without a measure at the same scenario
+(:func:`stochpound.analysis.store_measure_free`, ``--runs`` runs of simulated motions of the scenario on the configuration's scene),
+and before them the site-motion model's own curves of every measure at the site's levels of 10 % and 2 % in 50 years
+(:func:`model_curves`): the answer without a measure is the model's world, the measures' chains the site curves', and the two are
+the same world only where the model's curves are the site's.
 """
 
 from __future__ import annotations
@@ -34,11 +41,13 @@ import json
 import os
 import time
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
+import pandas as pd
 import xarray as xr
 
-from stochpound.motions import Measure
+from stochpound.motions import DEFAULT_G as G, Measure
 
 from benchmarks.report import machine
 from benchmarks.sections import Section
@@ -46,11 +55,16 @@ from benchmarks.site_consistency import (CONFIGURATIONS, FOX_PLAZA, MEASURE_ARGS
                                          measure_risk, parse_scenario_site, rate_g_star, site_measures)
 from benchmarks.timing import REPOSITORY
 
+if TYPE_CHECKING:
+    from stochpound.analysis import StoreMeasureFree
+
 SECTION = Section("<!-- measure seeds: start -->", "<!-- measure seeds: end -->")
 #: The study's first run (untilted pools of 1000, 2026-12-02), a section of docs/benchmarks.md no command writes: kept as measured.
 UNTILTED = Section("<!-- measure seeds untilted: start -->", "<!-- measure seeds untilted: end -->")
 #: The selection seeds of the study.
 SEEDS = (1, 2, 3, 4, 5)
+#: Bullet 3's tolerance: measures agree when their g* lie within this ratio.
+AGREEMENT = 1.3
 #: Motions a stripe, and the most of one earthquake in it.
 MOTIONS, MAX_PER_EARTHQUAKE = 40, 3
 #: The diagnostics of a store's selection kept with a result.
@@ -201,6 +215,80 @@ def consistency(folder: Path, configuration: str, measures: list[str], seeds: li
                         coords={"measure": measures, "checked": list(curves), "seed": seeds, "target": ["10 % in 50 yr", "2 % in 50 yr"]})
 
 
+def measure_free(folder: Path, configuration: str, measures: list[str], seeds: list[int], site: Site, runs: int,
+                 workers: int) -> tuple[pd.DataFrame, StoreMeasureFree]:
+    """Each measure's g* (the lognormal demand per stripe of ``run``'s results, over the seeds) beside the answer without a measure
+    at the site's ruptures (:func:`stochpound.analysis.store_measure_free`, ``runs`` runs, the motions' seed 1, on the configuration's
+    scene as the first measure's first seed's store ran it), compared by :func:`stochpound.analysis.compare_measures` (within
+    ×1.3, bullet 3's tolerance).
+
+    Raises
+    ------
+    FileNotFoundError
+        Naming the store that ``run`` has not made.
+    """
+    from stochpound import open_store
+    from stochpound.analysis import compare_measures, store_measure_free
+
+    separation, _, _ = load(folder, configuration, measures, seeds)
+    path = experiment_file(work_folder(folder, configuration, seeds[0]), measures[0]).with_suffix(".nc")
+    if not path.exists():
+        raise FileNotFoundError(f"{path.name} of {configuration}, seed {seeds[0]}: not in {path.parent.parent.name}/ (run it first)")
+    with open_store(path) as store:
+        free = store_measure_free(store.load(), site.ruptures, runs=runs, seed=1, workers=workers)
+    conditioned = {m: [separation.sel(measure=m, seed=s, drop=True) for s in seeds] for m in measures}
+    return compare_measures(conditioned, free, tolerance=AGREEMENT), free
+
+
+def model_curves(site: Site, measures: list[str], motions: int, seed: int = 7) -> pd.DataFrame:
+    """The site-motion model's own hazard at the site's ruptures against the site's curves, per measure and target (10 % and 2 % in
+    50 years): λ_model(x) = Σ_r ν_r × the fraction of ``motions`` motions of rupture r (seed ``seed``) beyond x, at the site's level x
+    of the target's rate, over that rate; and the model's level at that rate over the site's. The answer without a measure is
+    the model's: where these part from 1 at the measure's period, the model's shaking there is not the site's curve."""
+    from stochpound.motions import pseudo_spectra, site_motions
+
+    periods = np.unique([p for kind, period in map(MEASURE_ARGS.get, measures) if kind != "pga" for p in np.atleast_1d(period)])
+    values = {m: [] for m in measures}
+    for scenario, _ in site.ruptures:
+        per_rupture = {m: [] for m in measures}
+        for start in range(0, motions, 2000):
+            batch = site_motions(scenario=scenario, n=motions, seed=seed, realizations=list(range(start, min(motions, start + 2000))))
+            acceleration = batch["acceleration"].values
+            psa = pseudo_spectra(acceleration, float(batch.attrs["dt"]), periods) / G if periods.size else None
+            for m in measures:
+                kind, period = MEASURE_ARGS[m]
+                if kind == "pga":
+                    per_rupture[m].append(np.abs(acceleration).max(axis=1) / G)
+                else:
+                    columns = np.searchsorted(periods, np.atleast_1d(period))
+                    per_rupture[m].append(np.exp(np.log(psa[:, columns]).mean(axis=1)))
+        for m in measures:
+            values[m].append(np.concatenate(per_rupture[m]))
+    rows = []
+    rates = np.array([rate for _, rate in site.ruptures])
+    for probability in (0.1, 0.02):
+        target = -np.log1p(-probability) / 50.0
+        for m in measures:
+            x = float(site.hazard(m).intensity_at(target))
+            model = float(sum(nu * np.mean(v > x) for nu, v in zip(rates, values[m])))
+            pooled = np.concatenate(values[m])
+            weights = np.concatenate([np.full(v.size, nu / v.size) for nu, v in zip(rates, values[m])])
+            order = np.argsort(pooled)[::-1]
+            passed = np.searchsorted(np.cumsum(weights[order]), target)  # going down the motions, the one at which λ passes the target
+            model_level = float(pooled[order][min(passed, pooled.size - 1)])
+            rows.append({"target": probability, "measure": m, "site level": x, "model rate / site rate": model / target,
+                         "model level / site level": model_level / x})
+    return pd.DataFrame(rows).set_index(["target", "measure"])
+
+
+def measure_free_rows(comparison: pd.DataFrame) -> list[list[str]]:
+    """The rows of :func:`measure_free`'s table: per configuration, measure and target, the median g* over the seeds (their range),
+    the answer without a measure (its interval) and their ratio."""
+    return [[f"{configuration}, {measure}, {target:.0%} in 50 yr", f"{row['median']:.3f} ({row['lowest']:.3f}–{row['highest']:.3f})",
+             f"{row['measure-free']:.3f} ({row['lower']:.3f}–{row['upper']:.3f})", f"{row['ratio']:.2f}"]
+            for (configuration, measure, target), row in comparison.iterrows()]
+
+
 def consistency_rows(configuration: str, ratios: xr.DataArray) -> list[list[str]]:
     """Per conditioning measure, each checked measure's recomputed / site hazard: the median over the seeds (their range) at 10 % / 2 %
     in 50 years."""
@@ -274,7 +362,7 @@ def section(folder: Path, configurations: list[str], measures: list[str], seeds:
 def main(argv: list[str] | None = None) -> int:
     """``run``, ``table`` or ``consistency`` (module docstring)."""
     parser = argparse.ArgumentParser(prog="python -m benchmarks measure_seeds", description=__doc__.splitlines()[0])
-    parser.add_argument("action", choices=("run", "table", "consistency"))
+    parser.add_argument("action", choices=("run", "table", "consistency", "measure_free"))
     parser.add_argument("folder", type=Path)
     parser.add_argument("--configurations", nargs="+", default=list(CONFIGURATIONS), choices=list(CONFIGURATIONS))
     parser.add_argument("--measures", nargs="+", default=None, choices=list(MEASURE_ARGS), help="default: the site's")
@@ -285,6 +373,10 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--site", choices=("fox_plaza", "scenario"), default="fox_plaza",
                         help="the bundled Fox Plaza site, or benchmarks.site_consistency's site of one scenario (--scenario)")
     parser.add_argument("--scenario", nargs=4, metavar=("M", "R_KM", "MECHANISM", "RATE"), default=list(SCENARIO))
+    parser.add_argument("--runs", type=int, default=20000, help="measure_free: runs of the answer without a measure (default %(default)s)")
+    parser.add_argument("--workers", type=int, default=1, help="measure_free: its processes (default %(default)s)")
+    parser.add_argument("--model-motions", type=int, default=20000,
+                        help="measure_free: motions a rupture for the model's own curves (default %(default)s)")
     arguments = parser.parse_args(argv)
     site = FOX_PLAZA if arguments.site == "fox_plaza" else parse_scenario_site(parser, arguments.scenario)
     arguments.measures = site_measures(parser, site, arguments.measures)
@@ -297,6 +389,20 @@ def main(argv: list[str] | None = None) -> int:
             provenance.write_text(json.dumps(machine()))  # its commit, date and load as the study starts
         run(arguments.folder, arguments.configurations, arguments.measures, arguments.seeds,
             Pool(MOTIONS, arguments.simulated, MAX_PER_EARTHQUAKE, arguments.sampling), site)
+        return 0
+    if arguments.action == "measure_free":
+        if site.ruptures is None:
+            parser.error("measure_free: the answer without a measure needs the site's ruptures: give --site scenario")
+        curves = model_curves(site, arguments.measures, arguments.model_motions)
+        print("\n".join(_markdown(["target, measure", "site's level (g)", "model's rate there / site's", "model's level / site's"],
+                                  [[f"{t:.0%} in 50 yr, {m}", f"{row['site level']:.4f}", f"{row['model rate / site rate']:.2f}",
+                                    f"{row['model level / site level']:.2f}"] for (t, m), row in curves.iterrows()])) + "\n", flush=True)
+        for configuration in arguments.configurations:
+            comparison, free = measure_free(arguments.folder, configuration, arguments.measures, arguments.seeds, site, arguments.runs,
+                                            arguments.workers)
+            print("\n".join(_markdown(["configuration, measure, target", "g* (m): median over the seeds (range)",
+                                        "without a measure (95 % interval)", "ratio"], measure_free_rows(comparison))))
+            print(free.conditions())
         return 0
     if arguments.action == "consistency":
         for configuration in arguments.configurations:

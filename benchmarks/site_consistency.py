@@ -62,7 +62,7 @@ import xarray as xr
 from benchmarks.timing import REPOSITORY
 
 if TYPE_CHECKING:
-    from stochpound.analysis import HazardCurve
+    from stochpound.analysis import HazardCurve, RuptureSite
     from stochpound.risk import StoreRisk
 
 RETURN_PERIODS = np.array([10.0, 25.0, 72.0, 224.0, 475.0, 975.0, 2475.0, 5000.0])
@@ -129,14 +129,15 @@ RECORDS_ONLY = Pool()
 
 @dataclass(frozen=True)
 class Site:
-    """Where the stripes are: each measure's hazard curve, the experiment's ``[site]`` table, the default stripes' return periods (yr)
-    and the measures it has a hazard curve of."""
+    """Where the stripes are: each measure's hazard curve, the experiment's ``[site]`` table, the default stripes' return periods (yr),
+    the measures it has a hazard curve of, and its ruptures where it has them (a site of one scenario: the answer without a measure)."""
 
     name: str
     hazard: Callable[[str], HazardCurve]
     table: str
     return_periods: np.ndarray
     measures: tuple[str, ...]
+    ruptures: RuptureSite | None = None
 
 
 def _bundled_hazard(measure: str) -> HazardCurve:
@@ -155,7 +156,8 @@ def scenario_site(magnitude: float, distance_km: float, mechanism: str, rate: fl
     """A site shaken by one scenario recurring at ``rate`` (1/yr): its curves from the conditional spectrum's models, the scenario given
     at every level. Default stripes: 1.5 / rate years (the scenario's median shaking, ε about −0.4), the return periods of
     :data:`RETURN_PERIODS` beyond it, and 10 000 years. Its measures: Fox Plaza's four and :data:`SA_AVG`."""
-    from stochpound.analysis import scenario_hazard
+    from stochpound.analysis import RuptureSite, scenario_hazard
+    from stochpound.motions import given_scenario
 
     def hazard(measure: str) -> HazardCurve:
         kind, period = MEASURE_ARGS[measure]
@@ -164,7 +166,9 @@ def scenario_site(magnitude: float, distance_km: float, mechanism: str, rate: fl
     hazard(next(iter(MEASURE_ARGS)))  # the scenario and the rate checked (SiteError, ValueError naming the field) before they are used
     table = f'[site]\nmagnitude = {magnitude}\ndistance_km = {distance_km}\nvs30 = {vs30}\nmechanism = "{mechanism}"\n'
     lowest = 1.5 / rate
-    return Site("scenario", hazard, table, np.unique(np.r_[lowest, RETURN_PERIODS[RETURN_PERIODS > lowest], 10000.0]), tuple(MEASURE_ARGS))
+    ruptures = RuptureSite.from_scenarios([(given_scenario(None, magnitude, distance_km, vs30, mechanism), rate)], name="scenario")
+    return Site("scenario", hazard, table, np.unique(np.r_[lowest, RETURN_PERIODS[RETURN_PERIODS > lowest], 10000.0]), tuple(MEASURE_ARGS),
+                ruptures)
 
 
 def _intensity_lines(measure: str) -> str:

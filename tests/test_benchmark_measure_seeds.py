@@ -89,3 +89,36 @@ def test_consistency_reads_the_kept_stores_and_gives_each_curve_at_the_targets_o
     assert row["PGA"] == f"{pga[0]:.2f} ({pga[0]:.2f}–{pga[0]:.2f}) / {pga[1]:.2f} ({pga[1]:.2f}–{pga[1]:.2f})"
     with pytest.raises(FileNotFoundError, match="psa2.nc of isolated, seed 1: not in work/"):
         measure_seeds.consistency(tmp_path, "isolated", ["PSA(2 s)"], [1], FOX_PLAZA)
+
+
+def test_the_model_s_own_curves_are_its_motions_counted_at_the_site_s_levels(monkeypatch) -> None:
+    """``model_curves`` at a site of one scenario (ν = 0.1 /yr): with motions whose PGA is known, the model's rate at the site's level
+    of each target is ν × the share of motions beyond it, and the model's level at the target's rate is the motion at which ν × the
+    share beyond first passes it."""
+    import stochpound.motions
+    from benchmarks.site_consistency import scenario_site
+
+    site = scenario_site(7.0, 20.0, "strike_slip", 0.1)
+    n = 5000
+    pga = np.linspace(0.001, 2.0, n)[::-1]  # g; motion i a single sample of that acceleration
+
+    def motions(*, scenario, n, seed, realizations):
+        return xr.Dataset({"acceleration": (("realization", "time"), pga[realizations, None] * stochpound.motions.DEFAULT_G)},
+                          attrs={"dt": 0.01})
+
+    monkeypatch.setattr(stochpound.motions, "site_motions", motions)
+    curves = measure_seeds.model_curves(site, ["PGA"], n)
+    for probability in (0.1, 0.02):
+        target = -np.log1p(-probability) / 50.0
+        row = curves.loc[(probability, "PGA")]
+        level = float(site.hazard("PGA").intensity_at(target))
+        assert row["site level"] == pytest.approx(level, rel=1e-12)
+        assert row["model rate / site rate"] == pytest.approx(0.1 * np.mean(pga > level) / target, rel=1e-12)
+        passed = int(np.ceil(target / 0.1 * n - 1e-9))  # the motions (from the strongest) whose weights 0.1/n first reach the rate
+        assert row["model level / site level"] == pytest.approx(pga[passed - 1] / level, rel=1e-12)
+
+
+def test_the_measure_free_comparison_needs_a_site_of_ruptures(capsys) -> None:
+    with pytest.raises(SystemExit):
+        measure_seeds.main(["measure_free", "folder"])
+    assert "measure_free: the answer without a measure needs the site's ruptures: give --site scenario" in capsys.readouterr().err
