@@ -245,6 +245,7 @@ def model_curves(site: Site, measures: list[str], motions: int, seed: int = 7) -
     50 years): λ_model(x) = Σ_r ν_r × the fraction of ``motions`` motions of rupture r (seed ``seed``) beyond x, at the site's level x
     of the target's rate, over that rate; and the model's level at that rate over the site's. The answer without a measure is
     the model's: where these part from 1 at the measure's period, the model's shaking there is not the site's curve."""
+    from stochpound.analysis import rate_from_probability
     from stochpound.motions import pseudo_spectra, site_motions
 
     periods = np.unique([p for kind, period in map(MEASURE_ARGS.get, measures) if kind != "pga" for p in np.atleast_1d(period)])
@@ -265,20 +266,18 @@ def model_curves(site: Site, measures: list[str], motions: int, seed: int = 7) -
         for m in measures:
             values[m].append(np.concatenate(per_rupture[m]))
     rows = []
-    rates = np.array([rate for _, rate in site.ruptures])
-    for probability in (0.1, 0.02):
-        target = -np.log1p(-probability) / 50.0
-        for m in measures:
+    rates = [rate for _, rate in site.ruptures]
+    for m in measures:
+        order = np.argsort(np.concatenate(values[m]))[::-1]  # every motion from the strongest, with its weight ν_r / n_r
+        pooled = np.concatenate(values[m])[order]
+        weights = np.concatenate([np.full(v.size, nu / v.size) for nu, v in zip(rates, values[m])])[order]
+        for probability in (0.1, 0.02):
+            target = float(rate_from_probability(probability))
             x = float(site.hazard(m).intensity_at(target))
-            model = float(sum(nu * np.mean(v > x) for nu, v in zip(rates, values[m])))
-            pooled = np.concatenate(values[m])
-            weights = np.concatenate([np.full(v.size, nu / v.size) for nu, v in zip(rates, values[m])])
-            order = np.argsort(pooled)[::-1]
-            passed = np.searchsorted(np.cumsum(weights[order]), target)  # going down the motions, the one at which λ passes the target
-            model_level = float(pooled[order][min(passed, pooled.size - 1)])
-            rows.append({"target": probability, "measure": m, "site level": x, "model rate / site rate": model / target,
-                         "model level / site level": model_level / x})
-    return pd.DataFrame(rows).set_index(["target", "measure"])
+            passed = np.searchsorted(np.cumsum(weights), target)  # going down the motions, the one at which λ passes the target
+            rows.append({"target": probability, "measure": m, "site level": x, "model rate / site rate": weights[pooled > x].sum() / target,
+                         "model level / site level": pooled[min(passed, pooled.size - 1)] / x})
+    return pd.DataFrame(rows).set_index(["target", "measure"]).sort_index(level="target", ascending=False, sort_remaining=False)
 
 
 def measure_free_rows(comparison: pd.DataFrame) -> list[list[str]]:
@@ -360,7 +359,7 @@ def section(folder: Path, configurations: list[str], measures: list[str], seeds:
 
 
 def main(argv: list[str] | None = None) -> int:
-    """``run``, ``table`` or ``consistency`` (module docstring)."""
+    """``run``, ``table``, ``consistency`` or ``measure_free`` (module docstring)."""
     parser = argparse.ArgumentParser(prog="python -m benchmarks measure_seeds", description=__doc__.splitlines()[0])
     parser.add_argument("action", choices=("run", "table", "consistency", "measure_free"))
     parser.add_argument("folder", type=Path)

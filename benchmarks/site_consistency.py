@@ -159,14 +159,16 @@ def scenario_site(magnitude: float, distance_km: float, mechanism: str, rate: fl
     from stochpound.analysis import RuptureSite, scenario_hazard
     from stochpound.motions import given_scenario
 
+    scenario = given_scenario(None, magnitude, distance_km, vs30, mechanism)  # checked (SiteError naming the field), its geometry estimated once
+
     def hazard(measure: str) -> HazardCurve:
         kind, period = MEASURE_ARGS[measure]
-        return scenario_hazard(kind, period, magnitude=magnitude, distance_km=distance_km, vs30=vs30, mechanism=mechanism, rate=rate)
+        return scenario_hazard(kind, period, scenario=scenario, rate=rate)
 
-    hazard(next(iter(MEASURE_ARGS)))  # the scenario and the rate checked (SiteError, ValueError naming the field) before they are used
+    hazard(next(iter(MEASURE_ARGS)))  # the rate checked (ValueError naming it) before it is used
     table = f'[site]\nmagnitude = {magnitude}\ndistance_km = {distance_km}\nvs30 = {vs30}\nmechanism = "{mechanism}"\n'
     lowest = 1.5 / rate
-    ruptures = RuptureSite.from_scenarios([(given_scenario(None, magnitude, distance_km, vs30, mechanism), rate)], name="scenario")
+    ruptures = RuptureSite.from_scenarios([(scenario, rate)], name="scenario")  # the same scenario as the curves': the answer without a measure
     return Site("scenario", hazard, table, np.unique(np.r_[lowest, RETURN_PERIODS[RETURN_PERIODS > lowest], 10000.0]), tuple(MEASURE_ARGS),
                 ruptures)
 
