@@ -27,7 +27,9 @@ reach that level, a ratio of 0). A measure whose stripes carry the site's shakin
 ratios near 1 there.
 
 ``measure_free FOLDER`` (a site of one scenario, ``--site scenario``: Fox Plaza has no ruptures) prints, per configuration, each
-measure's g* (the median over the seeds, their range) beside the answer without a measure at the same scenario
+measure's g* (the median over the seeds, their range; ``--estimator lognormal``, the default, from the results' lognormal demand
+per stripe, or ``fragility`` from the risk chain's own fits to each gap's counts, :func:`fragility_separation`) beside the answer
+without a measure at the same scenario
 (:func:`stochpound.analysis.store_measure_free`, ``--runs`` runs of simulated motions of the scenario on the configuration's scene),
 and before them the site-motion model's own curves of every measure at the site's levels of 10 % and 2 % in 50 years
 (:func:`model_curves`): the answer without a measure is the model's world, the measures' chains the site curves', and the two are
@@ -215,9 +217,27 @@ def consistency(folder: Path, configuration: str, measures: list[str], seeds: li
                         coords={"measure": measures, "checked": list(curves), "seed": seeds, "target": ["10 % in 50 yr", "2 % in 50 yr"]})
 
 
+def fragility_separation(folder: Path, configuration: str, measures: list[str], seeds: list[int], site: Site) -> xr.DataArray:
+    """g* (m; measure × seed × target × cells) of the risk chain's own estimator, the lognormal fragility fitted to the counts of
+    each gap (:func:`stochpound.risk.store_risk`, no bootstrap), from the stores ``run`` kept in ``FOLDER/work``."""
+    from stochpound import open_store
+    from stochpound.risk import store_risk
+
+    by_measure = []
+    for measure in measures:
+        by_seed = []
+        for seed in seeds:
+            with open_store(experiment_file(work_folder(folder, configuration, seed), measure).with_suffix(".nc")) as store:
+                risk = store_risk(store.load(), site.hazard(measure), targets=(0.1, 0.02))
+            by_seed.append(risk.separation["separation"].reset_coords(drop=True))
+        by_measure.append(xr.concat(by_seed, dim="seed"))
+    return xr.concat(by_measure, dim="measure").assign_coords(measure=measures, seed=seeds)
+
+
 def measure_free(folder: Path, configuration: str, measures: list[str], seeds: list[int], site: Site, runs: int,
-                 workers: int) -> tuple[pd.DataFrame, StoreMeasureFree]:
-    """Each measure's g* (the lognormal demand per stripe of ``run``'s results, over the seeds) beside the answer without a measure
+                 workers: int, estimator: str = "lognormal") -> tuple[pd.DataFrame, StoreMeasureFree]:
+    """Each measure's g* (over the seeds; ``estimator`` "lognormal": the lognormal demand per stripe of ``run``'s results,
+    "fragility": :func:`fragility_separation`) beside the answer without a measure
     at the site's ruptures (:func:`stochpound.analysis.store_measure_free`, ``runs`` runs, the motions' seed 1, on the configuration's
     scene as the first measure's first seed's store ran it), compared by :func:`stochpound.analysis.compare_measures` (within
     ×1.3, bullet 3's tolerance).
@@ -230,7 +250,8 @@ def measure_free(folder: Path, configuration: str, measures: list[str], seeds: l
     from stochpound import open_store
     from stochpound.analysis import compare_measures, store_measure_free
 
-    separation, _, _ = load(folder, configuration, measures, seeds)
+    separation = (load(folder, configuration, measures, seeds)[0] if estimator == "lognormal" else
+                  fragility_separation(folder, configuration, measures, seeds, site))
     path = experiment_file(work_folder(folder, configuration, seeds[0]), measures[0]).with_suffix(".nc")
     if not path.exists():
         raise FileNotFoundError(f"{path.name} of {configuration}, seed {seeds[0]}: not in {path.parent.parent.name}/ (run it first)")
@@ -246,38 +267,53 @@ def model_curves(site: Site, measures: list[str], motions: int, seed: int = 7) -
     of the target's rate, over that rate; and the model's level at that rate over the site's. The answer without a measure is
     the model's: where these part from 1 at the measure's period, the model's shaking there is not the site's curve."""
     from stochpound.analysis import rate_from_probability
-    from stochpound.motions import pseudo_spectra, site_motions
+    from stochpound.motions import site_motions
 
-    periods = np.unique([p for kind, period in map(MEASURE_ARGS.get, measures) if kind != "pga" for p in np.atleast_1d(period)])
     values = {m: [] for m in measures}
     for scenario, _ in site.ruptures:
         per_rupture = {m: [] for m in measures}
         for start in range(0, motions, 2000):
             batch = site_motions(scenario=scenario, n=motions, seed=seed, realizations=list(range(start, min(motions, start + 2000))))
-            acceleration = batch["acceleration"].values
-            psa = pseudo_spectra(acceleration, float(batch.attrs["dt"]), periods) / G if periods.size else None
-            for m in measures:
-                kind, period = MEASURE_ARGS[m]
-                if kind == "pga":
-                    per_rupture[m].append(np.abs(acceleration).max(axis=1) / G)
-                else:
-                    columns = np.searchsorted(periods, np.atleast_1d(period))
-                    per_rupture[m].append(np.exp(np.log(psa[:, columns]).mean(axis=1)))
+            for m, v in measure_values(batch["acceleration"].values, float(batch.attrs["dt"]), measures).items():
+                per_rupture[m].append(v)
         for m in measures:
             values[m].append(np.concatenate(per_rupture[m]))
     rows = []
     rates = [rate for _, rate in site.ruptures]
     for m in measures:
-        order = np.argsort(np.concatenate(values[m]))[::-1]  # every motion from the strongest, with its weight ν_r / n_r
-        pooled = np.concatenate(values[m])[order]
-        weights = np.concatenate([np.full(v.size, nu / v.size) for nu, v in zip(rates, values[m])])[order]
+        pooled = np.concatenate(values[m])
+        weights = np.concatenate([np.full(v.size, nu / v.size) for nu, v in zip(rates, values[m])])
         for probability in (0.1, 0.02):
             target = float(rate_from_probability(probability))
             x = float(site.hazard(m).intensity_at(target))
-            passed = np.searchsorted(np.cumsum(weights), target)  # going down the motions, the one at which λ passes the target
             rows.append({"target": probability, "measure": m, "site level": x, "model rate / site rate": weights[pooled > x].sum() / target,
-                         "model level / site level": pooled[min(passed, pooled.size - 1)] / x})
+                         "model level / site level": level_at_rate(pooled, weights, target) / x})
     return pd.DataFrame(rows).set_index(["target", "measure"]).sort_index(level="target", ascending=False, sort_remaining=False)
+
+
+def measure_values(acceleration: np.ndarray, dt: float, measures: list[str]) -> dict[str, np.ndarray]:
+    """Each measure's value (g) of every motion (rows of ``acceleration``, m/s², at ``dt`` s): PGA, PSA at a period, or Sa_avg the
+    geometric mean of PSA over its periods (5 % damping)."""
+    from stochpound.motions import pseudo_spectra
+
+    periods = np.unique([p for kind, period in map(MEASURE_ARGS.get, measures) if kind != "pga" for p in np.atleast_1d(period)])
+    psa = pseudo_spectra(acceleration, dt, periods) / G if periods.size else None
+    values = {}
+    for m in measures:
+        kind, period = MEASURE_ARGS[m]
+        if kind == "pga":
+            values[m] = np.abs(acceleration).max(axis=1) / G
+        else:
+            values[m] = np.exp(np.log(psa[:, np.searchsorted(periods, np.atleast_1d(period))]).mean(axis=1))
+    return values
+
+
+def level_at_rate(values: np.ndarray, weights: np.ndarray, target: float) -> float:
+    """The value at which, going down ``values`` from the largest and summing their ``weights`` (1/yr), the rate first reaches
+    ``target`` (1/yr); the smallest value if it never does."""
+    order = np.argsort(values, kind="stable")[::-1]
+    passed = np.searchsorted(np.cumsum(np.asarray(weights)[order]), target)
+    return float(np.asarray(values)[order][min(passed, values.size - 1)])
 
 
 def measure_free_rows(comparison: pd.DataFrame) -> list[list[str]]:
@@ -305,7 +341,7 @@ def consistency_rows(configuration: str, ratios: xr.DataArray) -> list[list[str]
             for measure in ratios["measure"].values]
 
 
-def _markdown(header: list[str], rows: list[list[str]]) -> list[str]:
+def markdown(header: list[str], rows: list[list[str]]) -> list[str]:
     return ["| " + " | ".join(header) + " |", "|" + "---|" * len(header), *("| " + " | ".join(row) + " |" for row in rows)]
 
 
@@ -348,10 +384,10 @@ def section(folder: Path, configurations: list[str], measures: list[str], seeds:
              "(`stripe_demand_rate`): the median over the seeds (their range); the spread over the measures' medians and over "
              "every measure and seed; the largest seed-to-seed spread of one measure, in g* and in the rate of pounding λ at "
              "that measure's median g*:", ""]
-    lines += _markdown(["configuration, target", *measures, *G_HEADER], spreads)
+    lines += markdown(["configuration, target", *measures, *G_HEADER], spreads)
     lines += ["", "The selections, over all seeds: the fitted scenario, the stripes' ε, the stripes that miss their target by "
               "more than 0.1 in the mean or σ of ln Sa at some period, the worst difference, and what the stripes hold:", ""]
-    lines += _markdown(SELECTION_HEADER, selected)
+    lines += markdown(SELECTION_HEADER, selected)
     lines += ["", "Not run: Sa_avg (the bundled Fox Plaza curves are per period; a curve of the average needs the site's ruptures, "
               "which are not bundled: `benchmarks.site_consistency --site scenario` has it). Conclusions: "
               "[intensity.md](intensity.md) (\"The measure and seed study on tilted pools\").", SECTION.end]
@@ -376,6 +412,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--workers", type=int, default=1, help="measure_free: its processes (default %(default)s)")
     parser.add_argument("--model-motions", type=int, default=20000,
                         help="measure_free: motions a rupture for the model's own curves (default %(default)s)")
+    parser.add_argument("--estimator", choices=("lognormal", "fragility"), default="lognormal",
+                        help="measure_free: each measure's g* from a lognormal demand per stripe (default) or the risk chain's fragility fits")
     arguments = parser.parse_args(argv)
     site = FOX_PLAZA if arguments.site == "fox_plaza" else parse_scenario_site(parser, arguments.scenario)
     arguments.measures = site_measures(parser, site, arguments.measures)
@@ -393,24 +431,24 @@ def main(argv: list[str] | None = None) -> int:
         if site.ruptures is None:
             parser.error("measure_free: the answer without a measure needs the site's ruptures: give --site scenario")
         curves = model_curves(site, arguments.measures, arguments.model_motions)
-        print("\n".join(_markdown(["target, measure", "site's level (g)", "model's rate there / site's", "model's level / site's"],
+        print("\n".join(markdown(["target, measure", "site's level (g)", "model's rate there / site's", "model's level / site's"],
                                   [[f"{t:.0%} in 50 yr, {m}", f"{row['site level']:.4f}", f"{row['model rate / site rate']:.2f}",
                                     f"{row['model level / site level']:.2f}"] for (t, m), row in curves.iterrows()])) + "\n", flush=True)
         for configuration in arguments.configurations:
             comparison, free = measure_free(arguments.folder, configuration, arguments.measures, arguments.seeds, site, arguments.runs,
-                                            arguments.workers)
-            print("\n".join(_markdown(["configuration, measure, target", "g* (m): median over the seeds (range)",
+                                            arguments.workers, arguments.estimator)
+            print("\n".join(markdown(["configuration, measure, target", "g* (m): median over the seeds (range)",
                                         "without a measure (95 % interval)", "ratio"], measure_free_rows(comparison))))
             print(free.conditions())
         return 0
     if arguments.action == "consistency":
         for configuration in arguments.configurations:
             ratios = consistency(arguments.folder, configuration, arguments.measures, arguments.seeds, site)
-            print("\n".join(_markdown(["conditioning measure", *ratios["checked"].values], consistency_rows(configuration, ratios))) + "\n")
+            print("\n".join(markdown(["conditioning measure", *ratios["checked"].values], consistency_rows(configuration, ratios))) + "\n")
         return 0
     if site is not FOX_PLAZA:  # the tables alone
         spreads, selected, _, _ = tables(arguments.folder, arguments.configurations, arguments.measures, arguments.seeds)
-        print("\n".join(_markdown(["configuration, target", *arguments.measures, *G_HEADER], spreads) + [""] + _markdown(SELECTION_HEADER, selected)))
+        print("\n".join(markdown(["configuration, target", *arguments.measures, *G_HEADER], spreads) + [""] + markdown(SELECTION_HEADER, selected)))
         return 0
     text = section(arguments.folder, arguments.configurations, arguments.measures, arguments.seeds)
     print(text)

@@ -12,6 +12,7 @@ comparison with an earlier revision (:mod:`benchmarks.compare`),
 ``python -m benchmarks simulated_pool`` the cost of a pool of simulated motions per motion (:mod:`benchmarks.simulated_pool`),
 ``python -m benchmarks flagship_selection FILE`` a flagship's stripes chosen without running a case (:mod:`benchmarks.flagship_selection`),
 ``python -m benchmarks measure_seeds run|table FOLDER`` g* by conditioning measure and selection seed at Fox Plaza (:mod:`benchmarks.measure_seeds`),
+``python -m benchmarks stripe_tails FOLDER`` a measure's g* from the site-motion model's own stripes (:mod:`benchmarks.stripe_tails`),
 ``python -m benchmarks inelastic_demand`` simulated and recorded motions' inelastic demand at matched spectra (:mod:`benchmarks.inelastic_demand`).
 
 The thread pools of BLAS, OpenMP and numba are set to one thread here,
@@ -36,7 +37,7 @@ import time  # noqa: E402
 from pathlib import Path  # noqa: E402
 
 from benchmarks import compare, experiment_scale, measure_free, rare_events, rare_moat, report, site_motions, spectrum, startup, suite, yielding  # noqa: E402
-from benchmarks import inelastic_demand, measure_comparison, measure_seeds, simulated_pool  # noqa: E402
+from benchmarks import inelastic_demand, measure_comparison, measure_seeds, simulated_pool, stripe_tails  # noqa: E402
 from benchmarks.sections import keep_sections  # noqa: E402
 from benchmarks.timing import REPOSITORY  # noqa: E402
 
@@ -86,6 +87,8 @@ def main(argv: list[str] | None = None) -> int:
         return flagship_selection.main(argv[1:])
     if argv[:1] == ["measure_seeds"]:
         return measure_seeds.main(argv[1:])
+    if argv[:1] == ["stripe_tails"]:
+        return stripe_tails.main(argv[1:])
     if argv[:1] == ["inelastic_demand"]:
         return inelastic_demand.main(argv[1:])
     arguments = parse_arguments(argv)

@@ -122,3 +122,35 @@ def test_the_measure_free_comparison_needs_a_site_of_ruptures(capsys) -> None:
     with pytest.raises(SystemExit):
         measure_seeds.main(["measure_free", "folder"])
     assert "measure_free: the answer without a measure needs the site's ruptures: give --site scenario" in capsys.readouterr().err
+
+
+def test_the_fragility_estimator_reads_the_risk_chain_s_g_star_of_each_measure_and_seed_s_store(monkeypatch, tmp_path) -> None:
+    """``fragility_separation`` opens the store ``run`` kept for each measure and seed and keeps ``store_risk``'s g* (10 % and
+    2 % in 50 years) under that measure and seed."""
+    import contextlib
+
+    import stochpound
+    import stochpound.risk
+    from benchmarks.site_consistency import experiment_file, scenario_site
+
+    site = scenario_site(7.0, 20.0, "strike_slip", 0.1)
+    opened = []
+
+    @contextlib.contextmanager
+    def open_store(path):
+        opened.append(path)
+        yield xr.Dataset(attrs={"path": str(path)})
+
+    def store_risk(store, hazard, targets):
+        value = 0.1 * len(opened)  # the n-th store opened gives g* = 0.1 n (10 %), 0.2 n (2 %)
+        separation = xr.DataArray([[value, 2 * value]], dims=("neighbour", "target"), coords={"neighbour": ["stiff"], "target": list(targets)})
+        return type("Risk", (), {"separation": xr.Dataset({"separation": separation}).assign_coords(target_rate=("target", [0.0, 0.0]))})()
+
+    monkeypatch.setattr(stochpound, "open_store", open_store)
+    monkeypatch.setattr(stochpound.risk, "store_risk", store_risk)
+    g = measure_seeds.fragility_separation(tmp_path, "isolated", ["PGA", "PSA(2 s)"], [1, 3], site)
+    assert opened == [experiment_file(measure_seeds.work_folder(tmp_path, "isolated", s), m).with_suffix(".nc")
+                      for m in ("PGA", "PSA(2 s)") for s in (1, 3)]
+    assert g.sel(measure="PSA(2 s)", seed=1, neighbour="stiff", target=0.1) == pytest.approx(0.3)
+    assert g.sel(measure="PGA", seed=3, neighbour="stiff", target=0.02) == pytest.approx(0.4)
+    assert "target_rate" not in g.coords

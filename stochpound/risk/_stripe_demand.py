@@ -25,7 +25,14 @@ the rate above the table's end counted at its end (trapezoids on
 from :data:`BEYOND` e-folds below the lowest stripe to as many above the
 highest). It is how Lin, Haselton & Baker (2013) compute drift hazard from
 stripes; the price of its small sampling spread is the lognormal assumption
-at each stripe, which the counts-based fits do not make.
+at each stripe, which the counts-based fits do not make. That price is
+real where the measure is far from the periods that govern the demand:
+within a stripe ln D is then a mixture over the shaking the measure does
+not fix, right-skewed, and a stripe's normal misses its upper tail, which
+is where a rare threshold's rate comes from. The sliding base's closure on
+PGA or PSA at the superstructure's period is such a case: g* there comes
+out low by ×1.3–1.8 (docs/intensity.md, "The short-period measures part by
+their stripes' lognormal").
 """
 
 from __future__ import annotations
