@@ -430,6 +430,8 @@ def main(argv: list[str] | None = None) -> int:
     if arguments.action == "measure_free":
         if site.ruptures is None:
             parser.error("measure_free: the answer without a measure needs the site's ruptures: give --site scenario")
+        if arguments.runs < 2 * len(site.ruptures):
+            parser.error(f"--runs: must be at least {2 * len(site.ruptures)} (two runs of each of the site's ruptures), got {arguments.runs}")
         curves = model_curves(site, arguments.measures, arguments.model_motions)
         print("\n".join(markdown(["target, measure", "site's level (g)", "model's rate there / site's", "model's level / site's"],
                                   [[f"{t:.0%} in 50 yr, {m}", f"{row['site level']:.4f}", f"{row['model rate / site rate']:.2f}",

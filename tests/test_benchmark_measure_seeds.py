@@ -122,6 +122,9 @@ def test_the_measure_free_comparison_needs_a_site_of_ruptures(capsys) -> None:
     with pytest.raises(SystemExit):
         measure_seeds.main(["measure_free", "folder"])
     assert "measure_free: the answer without a measure needs the site's ruptures: give --site scenario" in capsys.readouterr().err
+    with pytest.raises(SystemExit):
+        measure_seeds.main(["measure_free", "folder", "--site", "scenario", "--runs", "1"])
+    assert "--runs: must be at least 2 (two runs of each of the site's ruptures), got 1" in capsys.readouterr().err
 
 
 def test_the_fragility_estimator_reads_the_risk_chain_s_g_star_of_each_measure_and_seed_s_store(monkeypatch, tmp_path) -> None:
