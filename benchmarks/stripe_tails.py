@@ -175,10 +175,14 @@ def main(argv: list[str] | None = None) -> int:
     measures = site_measures(parser, site, arguments.measures)
     if not 2 <= arguments.nearest <= arguments.motions:
         parser.error(f"--nearest: must be 2 to --motions ({arguments.motions}), got {arguments.nearest}")
+    for configuration in arguments.configurations:  # every store checked before the model's world is made (minutes)
+        for seed in arguments.seeds:
+            for measure in measures:
+                path = experiment_file(work_folder(arguments.folder, configuration, seed), measure).with_suffix(".nc")
+                if not path.exists():
+                    parser.error(f"{configuration}, seed {seed}: no store {path.name} in the folder (run measure_seeds run first)")
     for configuration in arguments.configurations:
         first = experiment_file(work_folder(arguments.folder, configuration, arguments.seeds[0]), measures[0]).with_suffix(".nc")
-        if not first.exists():
-            parser.error(f"{configuration}, seed {arguments.seeds[0]}: no store {first.name} in the folder (run measure_seeds run first)")
         with open_store(first) as store:
             world = model_world(site, store.load(), measures, arguments.motions, arguments.seed)
         print("\n".join(table(rows(world, site, arguments.folder, configuration, measures, arguments.seeds, arguments.nearest))))

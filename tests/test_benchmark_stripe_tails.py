@@ -82,3 +82,16 @@ def test_a_missing_store_or_too_few_nearest_runs_is_refused_in_one_line(tmp_path
     with pytest.raises(SystemExit):
         stripe_tails.main([str(tmp_path), "--nearest", "1"])
     assert "--nearest: must be 2 to --motions" in capsys.readouterr().err
+
+
+def test_a_store_missing_at_any_seed_is_refused_before_the_model_s_world_is_made(tmp_path, capsys) -> None:
+    from benchmarks.measure_seeds import work_folder
+    from benchmarks.site_consistency import experiment_file
+
+    for measure in ("PGA", "PSA(2 s)"):  # seed 1's stores there (empty files: the check reads none), seed 2's not
+        path = experiment_file(work_folder(tmp_path, "isolated", 1), measure).with_suffix(".nc")
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.touch()
+    with pytest.raises(SystemExit):
+        stripe_tails.main([str(tmp_path), "--configurations", "isolated", "--measures", "PGA", "PSA(2 s)", "--seeds", "1", "2"])
+    assert "isolated, seed 2: no store pga.nc" in capsys.readouterr().err
