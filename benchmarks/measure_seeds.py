@@ -17,7 +17,9 @@ result already there is not run again: an interrupted study resumes, and two inv
 ``table FOLDER`` prints the study's two tables from the results and, with ``--write``, rewrites the section of
 docs/benchmarks.md between its markers: per configuration and target, each measure's median g* over the seeds (their
 range), the spread over the measures' medians and over measures and seeds, the largest seed-to-seed spread of one measure
-in g* and in the rate of pounding at that measure's median g*; per configuration and measure, the selections' misses.
+in g* and in the rate of pounding at that measure's median g*; per configuration and measure, the selections' misses. With
+``--estimator fragility`` g* and the rate come from the risk chain's own fits to the stores kept in ``FOLDER/work``
+(:func:`fragility_separation`) instead of the results' lognormal demand (printed only: the section is the lognormal demand's).
 
 ``consistency FOLDER`` prints, per configuration and conditioning measure, the site's hazard of every measure of the site
 (Sa_avg(0.5–4 s) too at a site of one scenario) recomputed from the stripes' motions as they ran (the stores ``run`` keeps in
@@ -217,21 +219,35 @@ def consistency(folder: Path, configuration: str, measures: list[str], seeds: li
                         coords={"measure": measures, "checked": list(curves), "seed": seeds, "target": ["10 % in 50 yr", "2 % in 50 yr"]})
 
 
-def fragility_separation(folder: Path, configuration: str, measures: list[str], seeds: list[int], site: Site) -> xr.DataArray:
+def fragility_separation(folder: Path, configuration: str, measures: list[str], seeds: list[int], site: Site) -> tuple[xr.DataArray, xr.DataArray]:
     """g* (m; measure × seed × target × cells) of the risk chain's own estimator, the lognormal fragility fitted to the counts of
-    each gap (:func:`stochpound.risk.store_risk`, no bootstrap), from the stores ``run`` kept in ``FOLDER/work``."""
+    each gap (:func:`stochpound.risk.store_risk`, no bootstrap), from the stores ``run`` kept in ``FOLDER/work``, and the rate
+    of pounding λ_P(g) it reads g* from (1/yr; measure × seed × gap × cells, each store on its own gap grid, NaN at the others').
+
+    Raises
+    ------
+    FileNotFoundError
+        Naming the store of a measure and seed that ``run`` has not made.
+    """
     from stochpound import open_store
     from stochpound.risk import store_risk
 
-    by_measure = []
+    separations, rates = [], []
     for measure in measures:
-        by_seed = []
+        by_seed, rate_by_seed = [], []
         for seed in seeds:
-            with open_store(experiment_file(work_folder(folder, configuration, seed), measure).with_suffix(".nc")) as store:
+            path = experiment_file(work_folder(folder, configuration, seed), measure).with_suffix(".nc")
+            if not path.exists():
+                raise FileNotFoundError(f"{path.name} of {configuration}, seed {seed}: not in {path.parent.parent.name}/ (run it first)")
+            with open_store(path) as store:
                 risk = store_risk(store.load(), site.hazard(measure), targets=(0.1, 0.02))
             by_seed.append(risk.separation["separation"].reset_coords(drop=True))
-        by_measure.append(xr.concat(by_seed, dim="seed"))
-    return xr.concat(by_measure, dim="measure").assign_coords(measure=measures, seed=seeds)
+            rate_by_seed.append(risk.non_increasing_maf().reset_coords(drop=True))
+        separations.append(xr.concat(by_seed, dim="seed"))
+        rates.append(xr.concat(rate_by_seed, dim="seed", join="outer"))
+    coords = {"measure": measures, "seed": seeds}
+    return (xr.concat(separations, dim="measure").assign_coords(coords),
+            xr.concat(rates, dim="measure", join="outer").assign_coords(coords))
 
 
 def measure_free(folder: Path, configuration: str, measures: list[str], seeds: list[int], site: Site, runs: int,
@@ -251,7 +267,7 @@ def measure_free(folder: Path, configuration: str, measures: list[str], seeds: l
     from stochpound.analysis import compare_measures, store_measure_free
 
     separation = (load(folder, configuration, measures, seeds)[0] if estimator == "lognormal" else
-                  fragility_separation(folder, configuration, measures, seeds, site))
+                  fragility_separation(folder, configuration, measures, seeds, site)[0])
     path = experiment_file(work_folder(folder, configuration, seeds[0]), measures[0]).with_suffix(".nc")
     if not path.exists():
         raise FileNotFoundError(f"{path.name} of {configuration}, seed {seeds[0]}: not in {path.parent.parent.name}/ (run it first)")
@@ -345,11 +361,16 @@ def markdown(header: list[str], rows: list[list[str]]) -> list[str]:
     return ["| " + " | ".join(header) + " |", "|" + "---|" * len(header), *("| " + " | ".join(row) + " |" for row in rows)]
 
 
-def tables(folder: Path, configurations: list[str], measures: list[str], seeds: list[int]) -> tuple[list[list[str]], list[list[str]], list[float], dict]:
-    """The rows of the g* table and of the selections' table, each experiment's seconds and the first result's settings."""
+def tables(folder: Path, configurations: list[str], measures: list[str], seeds: list[int], estimator: str = "lognormal",
+           site: Site = FOX_PLAZA) -> tuple[list[list[str]], list[list[str]], list[float], dict]:
+    """The rows of the g* table and of the selections' table, each experiment's seconds and the first result's settings; g* and
+    λ_P from the results' lognormal demand per stripe (``estimator`` "lognormal") or the risk chain's fits to the stores kept in
+    ``FOLDER/work`` at ``site`` ("fragility", :func:`fragility_separation`)."""
     spreads, selected, seconds, settings = [], [], [], {}
     for configuration in configurations:
         separation, rate, selections = load(folder, configuration, measures, seeds)
+        if estimator == "fragility":
+            separation, rate = fragility_separation(folder, configuration, measures, seeds, site)
         spreads += spread_rows(configuration, separation, rate)
         selected += selection_rows(configuration, selections)
         seconds += [r.attrs["seconds"] for runs in selections.values() for r in runs]
@@ -413,7 +434,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--model-motions", type=int, default=20000,
                         help="measure_free: motions a rupture for the model's own curves (default %(default)s)")
     parser.add_argument("--estimator", choices=("lognormal", "fragility"), default="lognormal",
-                        help="measure_free: each measure's g* from a lognormal demand per stripe (default) or the risk chain's fragility fits")
+                        help="measure_free and table: each measure's g* from a lognormal demand per stripe (default) or the risk chain's fragility fits")
     arguments = parser.parse_args(argv)
     site = FOX_PLAZA if arguments.site == "fox_plaza" else parse_scenario_site(parser, arguments.scenario)
     arguments.measures = site_measures(parser, site, arguments.measures)
@@ -448,8 +469,11 @@ def main(argv: list[str] | None = None) -> int:
             ratios = consistency(arguments.folder, configuration, arguments.measures, arguments.seeds, site)
             print("\n".join(markdown(["conditioning measure", *ratios["checked"].values], consistency_rows(configuration, ratios))) + "\n")
         return 0
-    if site is not FOX_PLAZA:  # the tables alone
-        spreads, selected, _, _ = tables(arguments.folder, arguments.configurations, arguments.measures, arguments.seeds)
+    if arguments.write and arguments.estimator != "lognormal":
+        parser.error("--write: the section is the lognormal demand's; print the fragility estimator's tables without it")
+    if site is not FOX_PLAZA or arguments.estimator != "lognormal":  # the tables alone
+        spreads, selected, _, _ = tables(arguments.folder, arguments.configurations, arguments.measures, arguments.seeds, arguments.estimator,
+                                         site)
         print("\n".join(markdown(["configuration, target", *arguments.measures, *G_HEADER], spreads) + [""] + markdown(SELECTION_HEADER, selected)))
         return 0
     text = section(arguments.folder, arguments.configurations, arguments.measures, arguments.seeds)

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 import xarray as xr
@@ -145,15 +147,52 @@ def test_the_fragility_estimator_reads_the_risk_chain_s_g_star_of_each_measure_a
         yield xr.Dataset(attrs={"path": str(path)})
 
     def store_risk(store, hazard, targets):
-        value = 0.1 * len(opened)  # the n-th store opened gives g* = 0.1 n (10 %), 0.2 n (2 %)
+        value = 0.1 * len(opened)  # the n-th store opened gives g* = 0.1 n (10 %), 0.2 n (2 %), λ_P = n / g on its grid
         separation = xr.DataArray([[value, 2 * value]], dims=("neighbour", "target"), coords={"neighbour": ["stiff"], "target": list(targets)})
-        return type("Risk", (), {"separation": xr.Dataset({"separation": separation}).assign_coords(target_rate=("target", [0.0, 0.0]))})()
+        gaps = [value, 1.0]  # each store its own grid
+        maf = xr.DataArray([[len(opened) / g for g in gaps]], dims=("neighbour", "gap"), coords={"neighbour": ["stiff"], "gap": gaps})
+        return type("Risk", (), {"separation": xr.Dataset({"separation": separation}).assign_coords(target_rate=("target", [0.0, 0.0])),
+                                 "non_increasing_maf": lambda self: maf.assign_coords(years=50.0)})()
 
+    for seed in (1, 3):
+        for measure in ("PGA", "PSA(2 s)"):
+            path = experiment_file(measure_seeds.work_folder(tmp_path, "isolated", seed), measure).with_suffix(".nc")
+            path.parent.mkdir(parents=True, exist_ok=True)
+            path.touch()
     monkeypatch.setattr(stochpound, "open_store", open_store)
     monkeypatch.setattr(stochpound.risk, "store_risk", store_risk)
-    g = measure_seeds.fragility_separation(tmp_path, "isolated", ["PGA", "PSA(2 s)"], [1, 3], site)
+    g, rate = measure_seeds.fragility_separation(tmp_path, "isolated", ["PGA", "PSA(2 s)"], [1, 3], site)
     assert opened == [experiment_file(measure_seeds.work_folder(tmp_path, "isolated", s), m).with_suffix(".nc")
                       for m in ("PGA", "PSA(2 s)") for s in (1, 3)]
     assert g.sel(measure="PSA(2 s)", seed=1, neighbour="stiff", target=0.1) == pytest.approx(0.3)
     assert g.sel(measure="PGA", seed=3, neighbour="stiff", target=0.02) == pytest.approx(0.4)
-    assert "target_rate" not in g.coords
+    assert "target_rate" not in g.coords and "years" not in rate.coords
+    own = rate.sel(measure="PSA(2 s)", seed=3, neighbour="stiff").dropna("gap")  # the 4th store: its own two gaps, NaN at the others'
+    assert own["gap"].values.tolist() == pytest.approx([0.4, 1.0]) and own.values.tolist() == pytest.approx([10.0, 4.0])
+    assert rate.sizes["gap"] == 5
+
+
+def test_the_fragility_estimator_names_a_store_run_has_not_made(tmp_path) -> None:
+    from benchmarks.site_consistency import scenario_site
+
+    with pytest.raises(FileNotFoundError, match=r"pga\.nc of isolated, seed 2: not in work/ \(run it first\)"):
+        measure_seeds.fragility_separation(tmp_path, "isolated", ["PGA"], [2], scenario_site(7.0, 20.0, "strike_slip", 0.1))
+
+
+def test_the_table_of_the_fragility_estimator_is_printed_not_written(capsys) -> None:
+    with pytest.raises(SystemExit):
+        measure_seeds.main(["table", "folder", "--estimator", "fragility", "--write"])
+    assert "--write: the section is the lognormal demand's; print the fragility estimator's tables without it" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("estimator", ["lognormal", "fragility"])
+def test_the_tables_take_g_star_and_the_rate_from_the_estimator_asked_for(monkeypatch, estimator: str) -> None:
+    """``table --estimator fragility`` reads g* and λ_P from the risk chain's fits, the selections still from the kept results."""
+    kept = {"lognormal": ("lognormal g*", "lognormal rate"), "fragility": ("fragility g*", "fragility rate")}
+    result = type("Result", (), {"attrs": {"seconds": 1.0}})()
+    monkeypatch.setattr(measure_seeds, "load", lambda folder, configuration, measures, seeds: (*kept["lognormal"], {"PGA": [result]}))
+    monkeypatch.setattr(measure_seeds, "fragility_separation", lambda folder, configuration, measures, seeds, site: kept["fragility"])
+    monkeypatch.setattr(measure_seeds, "spread_rows", lambda configuration, separation, rate: [[separation, rate]])
+    monkeypatch.setattr(measure_seeds, "selection_rows", lambda configuration, selections: [[configuration, len(selections)]])
+    spreads, selected, seconds, _ = measure_seeds.tables(Path("folder"), ["isolated"], ["PGA"], [1], estimator)
+    assert spreads == [list(kept[estimator])] and selected == [["isolated", 1]] and seconds == [1.0]
