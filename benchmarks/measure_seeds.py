@@ -282,7 +282,7 @@ def model_curves(site: Site, measures: list[str], motions: int, seed: int = 7) -
     50 years): λ_model(x) = Σ_r ν_r × the fraction of ``motions`` motions of rupture r (seed ``seed``) beyond x, at the site's level x
     of the target's rate, over that rate; and the model's level at that rate over the site's. The answer without a measure is
     the model's: where these part from 1 at the measure's period, the model's shaking there is not the site's curve."""
-    from stochpound.analysis import rate_from_probability
+    from stochpound.analysis import rate_from_probability, rate_weighted_levels
     from stochpound.motions import site_motions
 
     values = {m: [] for m in measures}
@@ -303,7 +303,7 @@ def model_curves(site: Site, measures: list[str], motions: int, seed: int = 7) -
             target = float(rate_from_probability(probability))
             x = float(site.hazard(m).intensity_at(target))
             rows.append({"target": probability, "measure": m, "site level": x, "model rate / site rate": weights[pooled > x].sum() / target,
-                         "model level / site level": level_at_rate(pooled, weights, target) / x})
+                         "model level / site level": rate_weighted_levels(values[m], rates, [target])[0] / x})
     return pd.DataFrame(rows).set_index(["target", "measure"]).sort_index(level="target", ascending=False, sort_remaining=False)
 
 
@@ -322,14 +322,6 @@ def measure_values(acceleration: np.ndarray, dt: float, measures: list[str]) -> 
         else:
             values[m] = np.exp(np.log(psa[:, np.searchsorted(periods, np.atleast_1d(period))]).mean(axis=1))
     return values
-
-
-def level_at_rate(values: np.ndarray, weights: np.ndarray, target: float) -> float:
-    """The value at which, going down ``values`` from the largest and summing their ``weights`` (1/yr), the rate first reaches
-    ``target`` (1/yr); the smallest value if it never does."""
-    order = np.argsort(values, kind="stable")[::-1]
-    passed = np.searchsorted(np.cumsum(np.asarray(weights)[order]), target)
-    return float(np.asarray(values)[order][min(passed, values.size - 1)])
 
 
 def measure_free_rows(comparison: pd.DataFrame) -> list[list[str]]:

@@ -30,7 +30,7 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
-from benchmarks.measure_seeds import SEEDS, level_at_rate, markdown, measure_values, work_folder
+from benchmarks.measure_seeds import SEEDS, markdown, measure_values, work_folder
 from benchmarks.site_consistency import CONFIGURATIONS, MEASURE_ARGS, SCENARIO, Site, experiment_file, parse_scenario_site, site_measures
 
 #: Runs of the model's world, and the nearest of them that make a stripe (the experiment's motions a stripe).
@@ -83,14 +83,14 @@ def lognormal_tail(stripes: np.ndarray, gap: float, tail: float = TAIL) -> tuple
     D > 0 expects (module docstring)."""
     from scipy.special import ndtr
 
-    observed, expected = 0, 0.0
-    for row in np.asarray(stripes, dtype=float):
-        ran = row[np.isfinite(row)]
-        logs = np.log(ran[ran > 0.0])
-        share = logs.size / ran.size * float(ndtr((logs.mean() - np.log(gap)) / logs.std(ddof=1)))
-        if share < tail:
-            observed += int(np.count_nonzero(ran >= gap))
-            expected += share * ran.size
+    from stochpound.risk import stripe_demand_moments
+
+    stripes = np.asarray(stripes, dtype=float)
+    mean, std, fraction = stripe_demand_moments(stripes)
+    share = fraction * ndtr((mean - np.log(gap)) / std)  # of a stripe's runs, expected at or above the gap
+    tailed = share < tail
+    observed = int(np.count_nonzero(stripes[tailed] >= gap))
+    expected = float((share * np.isfinite(stripes).sum(-1))[tailed].sum())
     return observed, expected
 
 
@@ -116,7 +116,7 @@ def rows(world: xr.Dataset, site: Site, folder: Path, configuration: str, measur
     ln D in the model's and the experiment's stripes, and the experiment's runs beyond the answer's g* at 2 % in 50 years against
     the lognormal's expectation."""
     from stochpound import open_store
-    from stochpound.analysis import rate_from_probability
+    from stochpound.analysis import rate_from_probability, rate_weighted_levels
     from stochpound.risk import contact_free_closure
 
     (_, nu), = site.ruptures
@@ -131,8 +131,7 @@ def rows(world: xr.Dataset, site: Site, folder: Path, configuration: str, measur
     for labels in (world["closure"].isel(motion=0).stack(cell=cells).indexes["cell"] if cells else [()]):
         where = dict(zip(cells, labels if isinstance(labels, tuple) else (labels,)))
         closure = world["closure"].sel(where).values
-        weights = np.full(closure.size, nu / closure.size)
-        answer = np.array([level_at_rate(closure, weights, float(rate_from_probability(p))) for p in TARGETS])
+        answer = rate_weighted_levels([closure], [nu], [float(rate_from_probability(p)) for p in TARGETS])
         gaps = np.exp(np.linspace(np.log(answer.min() / 20.0), np.log(answer.max() * 20.0), 400))
         for m in measures:
             levels = experiment[(m, seeds[0])]["intensity"].values

@@ -53,15 +53,6 @@ def test_skewness_is_the_median_over_stripes_of_ln_d_s_sample_skewness() -> None
     assert stripe_tails.skewness(stripes) == pytest.approx(np.median([stats.skew(np.log(row)) for row in stripes]), rel=1e-12)
 
 
-def test_the_level_at_a_rate_is_where_the_weights_summed_from_the_largest_first_reach_it() -> None:
-    values = np.array([0.3, 0.9, 0.1, 0.5])
-    weights = np.full(4, 0.25)
-    assert measure_seeds.level_at_rate(values, weights, 0.5) == 0.5  # 0.9 then 0.5: 0.25 + 0.25 reaches 0.5
-    assert measure_seeds.level_at_rate(values, weights, 0.3) == 0.5
-    assert measure_seeds.level_at_rate(values, weights, 0.2) == 0.9
-    assert measure_seeds.level_at_rate(values, weights, 2.0) == 0.1  # never reached: the smallest
-
-
 def test_the_measures_of_a_motion_are_its_pga_and_its_pseudo_spectral_accelerations() -> None:
     from stochpound.motions import DEFAULT_G, response_spectrum
 

@@ -17,7 +17,7 @@ from scipy.special import ndtr
 
 import stochpound
 from stochpound._errors import SiteError
-from stochpound.analysis import RuptureSite, measure_free_risk, rate_from_probability
+from stochpound.analysis import RuptureSite, measure_free_risk, rate_from_probability, rate_weighted_levels
 from stochpound.analysis import _measure_free
 from stochpound.motions import site_motions
 
@@ -96,6 +96,16 @@ def test_the_level_is_the_smallest_response_whose_rate_meets_the_target(pair_res
         assert rate_at <= target < rate_below
         assert result.level_lower.values.min() <= level <= result.level_upper.values.max()
     assert result.attrs["runs"] == 2 * 6 + 4 == int(result.motions.sum())
+
+
+def test_rate_weighted_levels_is_where_the_weights_summed_from_the_largest_first_exceed_the_target(pair_result):
+    """Two ruptures, ν 0.2 on 2 runs and 0.3 on 3: the runs' weights 0.1 (0.9, 0.3) and 0.1 (0.5, 0.1, 0.7), summed from the largest
+    0.1, 0.2, 0.3, 0.4, 0.5; and the estimator's own levels are this function's on its runs."""
+    values, rates = [np.array([0.9, 0.3]), np.array([0.5, 0.1, 0.7])], [0.2, 0.3]
+    np.testing.assert_array_equal(rate_weighted_levels(values, rates, [0.05, 0.15, 0.25, 0.45, 0.5, 0.6]), [0.9, 0.7, 0.5, 0.1, 0.0, 0.0])
+    result = pair_result
+    runs = [row[np.isfinite(row)] for row in result.response_value.values]
+    np.testing.assert_array_equal(rate_weighted_levels(runs, result.rate.values, result.target_rate.values), result.level.values)
 
 
 def test_the_same_seed_gives_the_same_result_whatever_the_batches(pair_result, monkeypatch):

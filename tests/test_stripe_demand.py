@@ -7,7 +7,7 @@ import pytest
 import xarray as xr
 from scipy import special
 
-from stochpound.risk import HazardCurve, limit_state_events, risk_curve, stripe_demand_rate, stripe_fragility
+from stochpound.risk import HazardCurve, limit_state_events, risk_curve, stripe_demand_moments, stripe_demand_rate, stripe_fragility
 
 LEVELS = np.array([0.1, 0.2, 0.4, 0.8])
 A, B, S = np.log(0.05), 1.2, 0.45  # ln D = A + B ln x + S z: median 0.05 m at x = 1 g
@@ -74,6 +74,19 @@ def test_runs_that_never_reach_zero_count_as_below_every_threshold_and_unrun_mot
     full = stripe_demand_rate(demand, thresholds, hz)
     np.testing.assert_allclose(stripe_demand_rate(halved, thresholds, hz), 0.5 * full, rtol=1e-12)
     np.testing.assert_allclose(stripe_demand_rate(unrun, thresholds, hz), full, rtol=1e-12)
+
+
+def test_the_moments_of_a_stripe_are_those_of_ln_d_over_its_runs_with_d_above_zero() -> None:
+    """Stripe 1: ln D = ln 0.05 + 0.45 z (z of mean 0, sample σ 1) on 20 runs, 5 of them 0 and 5 not run; stripe 2: 3 runs, one 0."""
+    z = _standard_sample(15)
+    first = np.concatenate([0.05 * np.exp(0.45 * z), np.zeros(5), np.full(5, np.nan)])
+    second = np.concatenate([[0.1, 0.4, 0.0], np.full(22, np.nan)])
+    mean, std, fraction = stripe_demand_moments(np.stack([first, second]))
+    assert mean == pytest.approx([np.log(0.05), 0.5 * np.log(0.04)], rel=1e-12)
+    assert std == pytest.approx([0.45, np.log(4.0) / np.sqrt(2.0)], rel=1e-12)
+    assert fraction == pytest.approx([15 / 20, 2 / 3], rel=1e-12)
+    with pytest.raises(ValueError, match="every stripe needs at least two runs with a demand > 0"):
+        stripe_demand_moments(np.array([[0.1, 0.0, np.nan]]))
 
 
 def test_configurations_get_their_own_curve() -> None:

@@ -31,7 +31,8 @@ from stochpound.analysis._separation import pounding_curve, required_separation,
 from stochpound.codes import contact_demands, fixed_base_cqc, separation_rules, store_contact_demands
 from stochpound.analysis._subset_simulation import RESPONSES, subset_simulation
 from stochpound.analysis._linear_importance import linear_importance_sampling, oscillator_rows, surrogate_level, uncovered_share
-from stochpound.analysis._measure_free import MEASURE_FREE_RESPONSES, MeasureFreeDemand, measure_free_demands, measure_free_risk
+from stochpound.analysis._measure_free import (MEASURE_FREE_RESPONSES, MeasureFreeDemand, measure_free_demands, measure_free_risk,
+                                               rate_weighted_levels)
 from stochpound.analysis._measure_free_store import MEASURE_FREE_RUNS, StoreMeasureFree, scene_demands, store_measure_free
 from stochpound.analysis._measure_comparison import compare_measures
 from stochpound.analysis._sufficiency import SUFFICIENCY_LEVEL, StoreSufficiency, Sufficiency, store_sufficiency, stripe_regression
@@ -162,6 +163,7 @@ __all__ = [
     "RESPONSES",
     "measure_free_risk",
     "measure_free_demands",
+    "rate_weighted_levels",
     "MeasureFreeDemand",
     "store_measure_free",
     "StoreMeasureFree",

@@ -426,7 +426,7 @@ def response_reader(scene: Scene, demand: MeasureFreeDemand) -> Callable[[xr.Dat
 
 def neyman_allocation(values: Sequence[np.ndarray], rates: np.ndarray, target_rate: float, extra: int) -> np.ndarray:
     """Extra runs per rupture, ∝ ν_r √(p_r (1 − p_r)) at the first stage's level of ``target_rate`` (module docstring), summing to ``extra``."""
-    level = _levels(values, rates, np.array([target_rate]))[0]
+    level = rate_weighted_levels(values, rates, [target_rate])[0]
     p = np.array([max(_lognormal_exceedance(v, level), np.count_nonzero(v >= level) / v.size) for v in values])
     spread = rates * np.sqrt(p * (1.0 - p))
     if not spread.sum() > 0.0:
@@ -472,9 +472,31 @@ def _level_from(sorted_responses: np.ndarray, cumulative: np.ndarray, target_rat
     return np.where(reached, sorted_responses[first], 0.0)
 
 
-def _levels(values: Sequence[np.ndarray], rates: np.ndarray, target_rates: np.ndarray) -> np.ndarray:
-    responses, _, weight = _weights(values, rates)
-    return _level_from(responses, np.cumsum(weight), target_rates)
+def rate_weighted_levels(values: Sequence[np.ndarray], rates: np.ndarray | Sequence[float], target_rates: np.ndarray | Sequence[float]) -> np.ndarray:
+    """The level a response exceeds at each target rate, from runs of each rupture weighted by its rate (the measure-free estimate).
+
+    Each of rupture r's n_r runs carries ν_r/n_r; λ̂(x) is the summed weight of
+    the runs with a response above x, and the level is the smallest x with
+    λ̂(x) ≤ the target: the response at which the weights summed from the
+    largest first exceed the target.
+
+    Parameters
+    ----------
+    values : sequence of numpy.ndarray
+        Each rupture's runs' responses (any units; 1-D, at least one run).
+    rates : array_like
+        ν_r, each rupture's annual rate (1/yr), one per entry of ``values``.
+    target_rates : array_like
+        The rates (1/yr) to read the level at.
+
+    Returns
+    -------
+    numpy.ndarray
+        One level per target rate, in the responses' units; 0 where all the
+        runs' weight does not exceed the target.
+    """
+    responses, _, weight = _weights([np.asarray(v, dtype=float) for v in values], np.asarray(rates, dtype=float))
+    return _level_from(responses, np.cumsum(weight), np.asarray(target_rates, dtype=float))
 
 
 @dataclass(frozen=True)

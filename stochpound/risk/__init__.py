@@ -21,7 +21,7 @@ experiment store, :func:`read_risk_inputs` reads once what the chain needs
 :meth:`StoreRisk.separation_frame`, :meth:`StoreRisk.rules_frame`) the
 report renders and ``stochpound risk`` prints; :func:`stripe_demand_rate`
 the same rate curve from a lognormal demand per stripe (every run's value,
-not only the counts); :func:`store_demands` gives
+not only the counts; :func:`stripe_demand_moments` its parameters per stripe); :func:`store_demands` gives
 the demand hazard curves and the moat walls' limit state
 (:class:`StoreDemands`); :func:`limit_state_risk` the fragility and MAF of
 limit states beyond first contact (:class:`LimitState`: drift ratios,
@@ -84,7 +84,7 @@ from stochpound.risk._sensitivity import ALTERNATIVES, MODELLING_DISPERSIONS, Se
 from stochpound.risk._damage import DAMAGE_DEMANDS, DEFAULT_LIMIT_STATES, DEFAULT_SOURCE as DEFAULT_LIMIT_STATES_SOURCE, MODEL_DRIFT_LIMIT, StoreDamage, store_damage
 from stochpound.hazard import hazard_consistency, read_hazard_file, stripe_rate_weights
 from stochpound.risk._site_consistency import consistency_at_targets, site_consistency
-from stochpound.risk._stripe_demand import stripe_demand_rate
+from stochpound.risk._stripe_demand import stripe_demand_moments, stripe_demand_rate
 from stochpound.risk._stripe_coverage import (UNIDENTIFIED_BETA, at_lowest_stripe, fragility_at_separation, maf_outside_stripes, stripes_only_maf, stripes_upper_maf,
                                               unidentified)
 
@@ -104,6 +104,7 @@ __all__ = [
     "rate_from_probability",
     "return_period",
     "demand_hazard_curve",
+    "stripe_demand_moments",
     "stripe_demand_rate",
     "maf_outside_stripes",
     "fragility_at_separation",

@@ -96,9 +96,26 @@ def stripe_demand_rate(demand: xr.DataArray, thresholds: Sequence[float] | np.nd
     return rate.assign_coords({dim: d}).transpose(dim, ...).assign_attrs(units="1/yr", long_name="annual rate of the demand reaching the threshold")
 
 
-def _stripe_moments(values: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Per stripe (the last axis the runs, NaN not run): the mean and sample standard deviation of ln D over the runs with D > 0,
-    and their fraction of the stripe's runs."""
+def stripe_demand_moments(values: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The lognormal demand of each stripe (module docstring): m_j, s_j and p_j.
+
+    Parameters
+    ----------
+    values : numpy.ndarray
+        Demands (..., run), the last axis a stripe's runs (e.g. closures, m);
+        NaN where a motion did not run.
+
+    Returns
+    -------
+    mean, std, fraction : numpy.ndarray
+        Over the leading axes: the mean and sample standard deviation (n − 1)
+        of ln D over the runs with D > 0, and their fraction of the runs.
+
+    Raises
+    ------
+    ValueError
+        A stripe with fewer than two runs with D > 0.
+    """
     values = np.asarray(values, dtype=float)
     ran = np.isfinite(values)
     positive = ran & (values > 0.0)
@@ -116,7 +133,7 @@ def _rate_kernel(values: np.ndarray, levels: np.ndarray, thresholds: np.ndarray,
     """λ_D at every threshold from runs (..., stripe, run)."""
     from scipy import special
 
-    mean, std, fraction = _stripe_moments(values)
+    mean, std, fraction = stripe_demand_moments(values)
     log_levels = np.log(levels)
     lo, hi = hz.support
     start = np.log(lo) if lo > 0.0 else log_levels[0] - BEYOND
