@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -204,9 +205,9 @@ def risk(store: Path, hazard: str | None, hazard_measure: str | None, hazard_uni
         _check_csv(csv_dir, [(store, "the store"), (hazard or "", "the --hazard file"), (limit_states or "", "the --limit-states file"),
                              (design or "", "the --design file")])
     try:
-        with store_variables([store]):
-            data = open_store(store, edited="accept" if accept_edited else "refuse")
-            alternatives = [(kind, open_store(path, edited="accept" if accept_edited else "refuse")) for kind, path in others]
+        with store_variables([store]), contextlib.ExitStack() as opened:  # every store closed once the answer is read
+            data = opened.enter_context(open_store(store, edited="accept" if accept_edited else "refuse"))
+            alternatives = [(kind, opened.enter_context(open_store(path, edited="accept" if accept_edited else "refuse"))) for kind, path in others]
             for kind, other in alternatives:  # refused before any work
                 check_alternative(data, other, kind)
             hz = site_hazard(data, hazard, measure=hazard_measure, units=hazard_units, investigation_time=investigation_time,
