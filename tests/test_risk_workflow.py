@@ -212,13 +212,17 @@ def test_cli_prints_separation_and_rules(isolated_store, tmp_path):
     assert "rule" in written["rules.csv"].splitlines()[0] and "separation" not in written["rules.csv"].splitlines()[0]
 
 
-def test_cli_closes_the_store_it_read(isolated_store):
-    """Once it has answered, ``stochpound risk`` holds the store open no more: it can be opened for writing in the same process."""
+def test_cli_closes_the_store_it_read(isolated_store, tmp_path):
+    """Once it has answered, ``stochpound risk`` holds the store open no more: it can be opened for writing in the same process
+    (a copy, which no other test of the module has opened)."""
+    import shutil
+
     import h5py
 
-    result = CliRunner().invoke(main, ["risk", str(isolated_store)])
+    store = Path(shutil.copy(isolated_store, tmp_path / "copy.nc"))
+    result = CliRunner().invoke(main, ["risk", str(store)])
     assert result.exit_code == 0, result.output
-    h5py.File(isolated_store, "r+").close()  # "file is already open for read-only" while a dataset still holds it
+    h5py.File(store, "r+").close()  # "file is already open for read-only" while a dataset still holds it
 
 
 def test_cli_errors_are_one_line(isolated_store, fixed_stores, tmp_path):
