@@ -87,6 +87,25 @@ def work_folder(folder: Path, configuration: str, seed: int) -> Path:
     return folder / "work" / f"{configuration.replace(' ', '_')}-{seed}"
 
 
+def store_path(folder: Path, configuration: str, measure: str, seed: int) -> Path:
+    """Where ``run`` keeps the store of one configuration, measure and seed (in ``FOLDER/work``)."""
+    return experiment_file(work_folder(folder, configuration, seed), measure).with_suffix(".nc")
+
+
+def kept_store(folder: Path, configuration: str, measure: str, seed: int) -> Path:
+    """The store ``run`` kept for one configuration, measure and seed (:func:`store_path`).
+
+    Raises
+    ------
+    FileNotFoundError
+        Naming the store, if ``run`` has not made it.
+    """
+    path = store_path(folder, configuration, measure, seed)
+    if not path.exists():
+        raise FileNotFoundError(f"{path.name} of {configuration}, seed {seed}: not in {path.parent.parent.name}/ (run it first)")
+    return path
+
+
 def run_one(folder: Path, configuration: str, measure: str, seed: int, pool: Pool, site: Site = FOX_PLAZA) -> xr.Dataset:
     """One experiment's result (module docstring): its pounding rate over the gap grid, g* and the selection's diagnostics."""
     work = work_folder(folder, configuration, seed)
@@ -208,10 +227,7 @@ def consistency(folder: Path, configuration: str, measures: list[str], seeds: li
     ratios = np.full((len(measures), len(curves), len(seeds), 2), np.nan)
     for i, measure in enumerate(measures):
         for k, seed in enumerate(seeds):
-            path = experiment_file(work_folder(folder, configuration, seed), measure).with_suffix(".nc")
-            if not path.exists():
-                raise FileNotFoundError(f"{path.name} of {configuration}, seed {seed}: not in {path.parent.parent.name}/ (run it first)")
-            with open_store(path) as store:
+            with open_store(kept_store(folder, configuration, measure, seed)) as store:
                 checked = site_consistency(store, by_measure, hazard=curves[measure])
             for j, result in enumerate(checked.values()):
                 ratios[i, j, k] = consistency_at_targets(result)
@@ -236,10 +252,7 @@ def fragility_separation(folder: Path, configuration: str, measures: list[str], 
     for measure in measures:
         by_seed, rate_by_seed = [], []
         for seed in seeds:
-            path = experiment_file(work_folder(folder, configuration, seed), measure).with_suffix(".nc")
-            if not path.exists():
-                raise FileNotFoundError(f"{path.name} of {configuration}, seed {seed}: not in {path.parent.parent.name}/ (run it first)")
-            with open_store(path) as store:
+            with open_store(kept_store(folder, configuration, measure, seed)) as store:
                 risk = store_risk(store.load(), site.hazard(measure), targets=(0.1, 0.02))
             by_seed.append(risk.separation["separation"].reset_coords(drop=True))
             rate_by_seed.append(risk.non_increasing_maf().reset_coords(drop=True))
@@ -268,10 +281,7 @@ def measure_free(folder: Path, configuration: str, measures: list[str], seeds: l
 
     separation = (load(folder, configuration, measures, seeds)[0] if estimator == "lognormal" else
                   fragility_separation(folder, configuration, measures, seeds, site)[0])
-    path = experiment_file(work_folder(folder, configuration, seeds[0]), measures[0]).with_suffix(".nc")
-    if not path.exists():
-        raise FileNotFoundError(f"{path.name} of {configuration}, seed {seeds[0]}: not in {path.parent.parent.name}/ (run it first)")
-    with open_store(path) as store:
+    with open_store(kept_store(folder, configuration, measures[0], seeds[0])) as store:
         free = store_measure_free(store.load(), site.ruptures, runs=runs, seed=1, workers=workers)
     conditioned = {m: [separation.sel(measure=m, seed=s, drop=True) for s in seeds] for m in measures}
     return compare_measures(conditioned, free, tolerance=AGREEMENT), free

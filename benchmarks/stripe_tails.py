@@ -30,8 +30,8 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
-from benchmarks.measure_seeds import SEEDS, markdown, measure_values, work_folder
-from benchmarks.site_consistency import CONFIGURATIONS, MEASURE_ARGS, SCENARIO, Site, experiment_file, parse_scenario_site, site_measures
+from benchmarks.measure_seeds import SEEDS, markdown, measure_values, store_path
+from benchmarks.site_consistency import CONFIGURATIONS, MEASURE_ARGS, SCENARIO, Site, parse_scenario_site, site_measures
 
 #: Runs of the model's world, and the nearest of them that make a stripe (the experiment's motions a stripe).
 MOTIONS, NEAREST = 20000, 40
@@ -120,7 +120,7 @@ def rows(world: xr.Dataset, site: Site, folder: Path, configuration: str, measur
     from stochpound.risk import contact_free_closure
 
     (_, nu), = site.ruptures
-    stores = {(m, s): open_store(experiment_file(work_folder(folder, configuration, s), m).with_suffix(".nc")) for m in measures for s in seeds}
+    stores = {(m, s): open_store(store_path(folder, configuration, m, s)) for m in measures for s in seeds}
     try:
         experiment = {key: contact_free_closure(store).load() for key, store in stores.items()}
     finally:
@@ -177,11 +177,11 @@ def main(argv: list[str] | None = None) -> int:
     for configuration in arguments.configurations:  # every store checked before the model's world is made (minutes)
         for seed in arguments.seeds:
             for measure in measures:
-                path = experiment_file(work_folder(arguments.folder, configuration, seed), measure).with_suffix(".nc")
+                path = store_path(arguments.folder, configuration, measure, seed)
                 if not path.exists():
                     parser.error(f"{configuration}, seed {seed}: no store {path.name} in the folder (run measure_seeds run first)")
     for configuration in arguments.configurations:
-        first = experiment_file(work_folder(arguments.folder, configuration, arguments.seeds[0]), measures[0]).with_suffix(".nc")
+        first = store_path(arguments.folder, configuration, measures[0], arguments.seeds[0])
         with open_store(first) as store:
             world = model_world(site, store.load(), measures, arguments.motions, arguments.seed)
         print("\n".join(table(rows(world, site, arguments.folder, configuration, measures, arguments.seeds, arguments.nearest))))
