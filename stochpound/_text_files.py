@@ -58,3 +58,8 @@ def decode_text(raw: bytes, shown: str, error: type[Exception] = ValueError, len
     except UnicodeDecodeError as failure:
         position = start + failure.start
         raise error(f"{shown}: not UTF-8 text (byte 0x{raw[position]:02x} at position {position}); save it as UTF-8") from None
+
+
+def attribute_text(value: object) -> str:
+    """An HDF5 attribute h5py read as text (a store's ``definition``, ``kind``): bytes decoded as UTF-8, anything else as ``str``."""
+    return value.decode() if isinstance(value, bytes) else str(value)

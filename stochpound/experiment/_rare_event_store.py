@@ -30,6 +30,7 @@ import numpy as np
 import xarray as xr
 
 from stochpound._atomic import replacing
+from stochpound._text_files import attribute_text
 from stochpound.analysis import INITIAL_SCALE, PROPOSALS, SubsetLevel, curve_dataset, curve_thresholds, exceedance, exceedance_quantiles, level_attributes, level_probability
 from stochpound.experiment._parts import parts_folder
 from stochpound.experiment._rare_event_table import RareEventDefinition
@@ -163,7 +164,7 @@ def is_rare_event_store(path: str | Path) -> bool:
             kind = handle.attrs.get("kind")
     except (OSError, ValueError):
         return False
-    return (kind.decode() if isinstance(kind, bytes) else kind) == KIND
+    return kind is not None and attribute_text(kind) == KIND
 
 
 def open_rare_event_store(path: str | Path) -> xr.Dataset:

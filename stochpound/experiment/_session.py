@@ -23,6 +23,7 @@ from stochpound import __version__
 from stochpound.experiment._experiment import Experiment
 from stochpound.store import KINDS, MotionTable
 from stochpound._atomic import check_not_input, temporaries
+from stochpound._text_files import attribute_text
 from stochpound.experiment._parts import (DEFINITION_FILE, RUNS_FILE, FolderRecord, RunEntry, part_paths, parts_folder, read_experiment_json, read_runs,
                                           write_experiment_json)
 from stochpound.experiment._spec import ExperimentError
@@ -100,17 +101,13 @@ def store_identity(store: Path) -> str:
     try:
         with h5py.File(store, "r") as handle:
             if "definition" in handle.attrs:
-                return definition_sha256(json.loads(_text(handle.attrs["definition"])))
+                return definition_sha256(json.loads(attribute_text(handle.attrs["definition"])))
             value = handle.attrs["definition_sha256"]
     except KeyError:
         raise ExperimentError(f"{store}: not a stochpound experiment store (no definition_sha256 attribute)") from None
     except OSError as error:
         raise ExperimentError(f"{store}: not a readable netCDF4/HDF5 file ({error})") from None
-    return _text(value)
-
-
-def _text(value: Any) -> str:
-    return value.decode() if isinstance(value, bytes) else str(value)
+    return attribute_text(value)
 
 
 def stored_definition(store: Path) -> dict[str, Any]:
@@ -118,7 +115,7 @@ def stored_definition(store: Path) -> dict[str, Any]:
     import h5py
 
     with h5py.File(store, "r") as handle:
-        return json.loads(_text(handle.attrs["definition"])) if "definition" in handle.attrs else {}
+        return json.loads(attribute_text(handle.attrs["definition"])) if "definition" in handle.attrs else {}
 
 
 def stored_text(store: Path) -> str:
@@ -126,7 +123,7 @@ def stored_text(store: Path) -> str:
     import h5py
 
     with h5py.File(store, "r") as handle:
-        return _text(handle.attrs["experiment_text"]) if "experiment_text" in handle.attrs else ""
+        return attribute_text(handle.attrs["experiment_text"]) if "experiment_text" in handle.attrs else ""
 
 
 def check_store(store: Path, sha256: str) -> bool:
