@@ -241,8 +241,8 @@ def section(oscillator_runs: dict, pair_runs: dict, info: dict[str, str]) -> str
         "",
         "The reported CoV is the genealogy's (docs/rare-events.md, \"The coefficient of variation\"); Au & Beck's leaves out the levels' "
         "correlation. The 95 % intervals are the report's, p·exp(±1.96 δ) with δ the reported CoV (and the reference's CoV) combined. "
-        "Within 3 reported CoV: on the log scale of those intervals, \\|ln(estimate / reference)\\| ≤ 3δ (in brackets the largest ratio of "
-        "the two over the runs), and on the linear one, \\|estimate − reference\\| ≤ 3δ × reference, which the estimator's right skew "
+        "Within 3 reported CoV: on the log scale of those intervals, |ln(estimate / reference)| ≤ 3δ (in brackets the largest ratio of "
+        "the two over the runs), and on the linear one, |estimate − reference| ≤ 3δ × reference, which the estimator's right skew "
         "fails more often (docs/rare-events.md, \"Reading the CoV\"). "
         f"The empirical CoV is the root mean square of the estimates' relative error from the reference; from {repeats} runs it is "
         f"itself uncertain by about 1/√{2 * repeats - 2} ≈ {1 / math.sqrt(2 * repeats - 2):.0%} for Gaussian estimates (more for skewed ones): the ratio's "

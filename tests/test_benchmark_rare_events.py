@@ -57,18 +57,22 @@ def test_the_moat_benchmark_reduced_agrees_with_crude_monte_carlo(tmp_path):
 @pytest.mark.slow
 def test_repeated_runs_on_the_linear_pair_scatter_as_their_reported_cov():
     """The linear pair's top-floor closure under white noise (the benchmark's map), 20 runs (seeds 0–19, N = 1000, p0 = 0.1) at
-    0.07 m (P ≈ 2e-4; the oscillator's test is at 3e-5): every estimate within 3 reported CoV of ISEE's, and the mean reported CoV
-    (the genealogy's) within 25 % of the empirical one (the root mean square relative error from the reference). At 0.077 m
-    (1.3e-5) at least one of these 20 estimates (2.7 times the reference) lies beyond 3 of its reported CoV (docs/rare-events.md)."""
+    0.07 and 0.083 m (P ≈ 2e-4 and 1.1e-6): every estimate within 3 reported CoV of ISEE's on the log scale of the report's
+    intervals (|ln(estimate / reference)| ≤ 3δ; docs/rare-events.md, "Reading the CoV"), and the mean reported CoV (the
+    genealogy's) within 25 % of the empirical one (the root mean square relative error from the reference). Twenty runs do not
+    pin a root mean square of a skewed estimator: at 0.077 m (1.3e-5) these 20 give 0.74 of it (1.07 of the spread of ln), seeds
+    20–39 and 40–59 0.70 and 1.10 (the docs' 60 runs: 0.78)."""
     from stochpound.analysis import subset_simulation
 
     pair = linear_pair(**PAIR_WHITE_NOISE)
-    reference, reference_cov = pair.isee(0.07, 2000, seed=5)
-    assert reference_cov < 0.02
-    runs = [subset_simulation(pair.peak, thresholds=[0.07], samples_per_level=1000, p0=0.1, seed=seed, dimension=pair.n, max_levels=40)
+    thresholds = [0.07, 0.083]
+    references = [pair.isee(b, 2000, seed=5) for b in thresholds]
+    assert all(cov < 0.02 for _, cov in references)
+    runs = [subset_simulation(pair.peak, thresholds=thresholds, samples_per_level=1000, p0=0.1, seed=seed, dimension=pair.n, max_levels=40)
             for seed in range(20)]
-    estimates = np.array([r.probability.values[0] for r in runs])
-    reported = np.array([r.cov.values[0] for r in runs])
-    assert np.all(np.abs(estimates - reference) < 3.0 * np.hypot(reported, reference_cov) * reference)
-    empirical = math.sqrt(np.mean((estimates / reference - 1.0) ** 2))
-    assert abs(reported.mean() / empirical - 1.0) < 0.25, (reported.mean(), empirical)
+    for column, (reference, reference_cov) in enumerate(references):
+        estimates = np.array([r.probability.values[column] for r in runs])
+        reported = np.array([r.cov.values[column] for r in runs])
+        assert np.all(np.abs(np.log(estimates / reference)) <= 3.0 * np.hypot(reported, reference_cov))
+        empirical = math.sqrt(np.mean((estimates / reference - 1.0) ** 2))
+        assert abs(reported.mean() / empirical - 1.0) < 0.25, (thresholds[column], reported.mean(), empirical)
