@@ -1,5 +1,5 @@
 """How much long-period content lifts a motion's short-period Sa, in the bundled records and in simulated motions:
-``python -m benchmarks.short_period_lift [--t-star 2.0] [--n 20] [--scenario M R_RUP MECHANISM --pool 3000]``.
+``python -m benchmarks.short_period_lift [--t-star 2.0] [--n 20] [--scenario M R_RUP MECHANISM --pool 3000 --vs30 400]``.
 
 The lift of a motion is ln Sa(0.043 s) − ln Sa(0.043 s) of the same motion
 high-passed at 1 Hz (4th-order Butterworth, zero phase): how much its content
@@ -17,7 +17,7 @@ are within 1 s of each other:
 - for ``n`` simulated motions (the hazard-compatible model) of each of those
   scenarios the model's range holds (seeds 100 + the record's place);
 - with ``--scenario``, for ``pool`` simulated motions of one scenario (Vs30
-  400 m/s, seed 1: a flagship's pool), whose ε at T* reaches further.
+  ``--vs30``, default 400 m/s, seed 1: a flagship's pool), whose ε at T* reaches further.
 
 Why (docs/intensity.md, "Why the top stripe's short periods stay high"): a stripe
 of high ε at T* = 2 s needs motions whose short periods are low for their
@@ -129,6 +129,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--limit", type=int, default=None, help="the first LIMIT record components only")
     parser.add_argument("--scenario", nargs=3, metavar=("M", "R_RUP", "MECHANISM"), default=None)
     parser.add_argument("--pool", type=int, default=3000, help="simulated motions of --scenario")
+    parser.add_argument("--vs30", type=float, default=400.0, help="Vs30 of --scenario, m/s")
     a = parser.parse_args(argv)
     recorded, modelled, outside = [], [], 0
     for place, (acceleration, dt, scenario) in enumerate(record_scenarios()):
@@ -143,8 +144,8 @@ def main(argv: list[str] | None = None) -> int:
     print(table(f"Simulated, {a.n} of each record's scenario ({outside} scenarios outside the model's range left out)",
                 Lifts.concatenate(modelled), a.t_star))
     if a.scenario is not None:
-        scenario = Scenario(float(a.scenario[0]), float(a.scenario[1]), 400.0, a.scenario[2])
-        print("\n" + table(f"Simulated, M {scenario.magnitude:g} at {scenario.distance_km:g} km, {scenario.mechanism}, Vs30 400 m/s, seed 1",
+        scenario = Scenario(float(a.scenario[0]), float(a.scenario[1]), a.vs30, a.scenario[2])
+        print("\n" + table(f"Simulated, M {scenario.magnitude:g} at {scenario.distance_km:g} km, {scenario.mechanism}, Vs30 {a.vs30:g} m/s, seed 1",
                            simulated(scenario, a.pool, 1, a.t_star), a.t_star))
     return 0
 
