@@ -56,7 +56,7 @@ from stochpound.motions import DEFAULT_G as G, Measure
 from benchmarks.report import machine
 from benchmarks.sections import Section
 from benchmarks.site_consistency import (CONFIGURATIONS, FOX_PLAZA, MEASURE_ARGS, RETURN_PERIODS, SCENARIO, Pool, Site, experiment_file, lognormal_rate,
-                                         measure_risk, parse_scenario_site, rate_g_star, site_measures)
+                                         fox_plaza_site, measure_risk, parse_scenario_site, rate_g_star, site_measures)
 from benchmarks.timing import REPOSITORY
 
 if TYPE_CHECKING:
@@ -431,6 +431,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--site", choices=("fox_plaza", "scenario"), default="fox_plaza",
                         help="the bundled Fox Plaza site, or benchmarks.site_consistency's site of one scenario (--scenario)")
     parser.add_argument("--scenario", nargs=4, metavar=("M", "R_KM", "MECHANISM", "RATE"), default=list(SCENARIO))
+    parser.add_argument("--vs30", type=float, default=400.0,
+                        help="--site fox_plaza: the Vs30 assumed (m/s), its scenarios fitted at it (default %(default)s; benchmarks.site_condition)")
     parser.add_argument("--runs", type=int, default=20000, help="measure_free: runs of the answer without a measure (default %(default)s)")
     parser.add_argument("--workers", type=int, default=1, help="measure_free: its processes (default %(default)s)")
     parser.add_argument("--model-motions", type=int, default=20000,
@@ -438,10 +440,12 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--estimator", choices=("lognormal", "fragility"), default="lognormal",
                         help="measure_free and table: each measure's g* from a lognormal demand per stripe (default) or the risk chain's fragility fits")
     arguments = parser.parse_args(argv)
-    site = FOX_PLAZA if arguments.site == "fox_plaza" else parse_scenario_site(parser, arguments.scenario)
+    if arguments.site != "fox_plaza" and arguments.vs30 != 400.0:
+        parser.error("--vs30: Fox Plaza's assumed Vs30; the site of one scenario takes its own in --scenario's site")
+    site = fox_plaza_site(arguments.vs30) if arguments.site == "fox_plaza" else parse_scenario_site(parser, arguments.scenario)
     arguments.measures = site_measures(parser, site, arguments.measures)
     if arguments.write and site is not FOX_PLAZA:
-        parser.error("--write: the section is Fox Plaza's study; print the site of one scenario's tables without it")
+        parser.error("--write: the section is Fox Plaza's study at Vs30 400 m/s; print another site's tables without it")
     if arguments.action == "run":
         arguments.folder.mkdir(parents=True, exist_ok=True)
         provenance = arguments.folder / "provenance.json"

@@ -51,7 +51,7 @@ from __future__ import annotations
 import argparse
 import tempfile
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -150,6 +150,14 @@ def _bundled_hazard(measure: str) -> HazardCurve:
 #: PSA(T1)'s to them and its own.
 FOX_PLAZA = Site("fox_plaza", _bundled_hazard, '[site]\nscenario = "fitted"\ncurves = [' + ", ".join(f'"{name}"' for name in CURVES) +
                  ']\nvs30 = 400.0\nmechanism = "reverse"\n', RETURN_PERIODS, tuple(MEASURES))
+
+
+def fox_plaza_site(vs30: float = 400.0) -> Site:
+    """:data:`FOX_PLAZA` with another assumed Vs30 (m/s): its scenarios fitted at that Vs30 (benchmarks.site_condition: the curves imply
+    a softer site than 400 m/s). :data:`FOX_PLAZA` itself at 400."""
+    if vs30 == 400.0:
+        return FOX_PLAZA
+    return replace(FOX_PLAZA, name=f"fox_plaza_vs30_{vs30:g}", table=FOX_PLAZA.table.replace("vs30 = 400.0", f"vs30 = {float(vs30)}"))
 
 
 def scenario_site(magnitude: float, distance_km: float, mechanism: str, rate: float, vs30: float = 400.0) -> Site:

@@ -196,3 +196,19 @@ def test_the_tables_take_g_star_and_the_rate_from_the_estimator_asked_for(monkey
     monkeypatch.setattr(measure_seeds, "selection_rows", lambda configuration, selections: [[configuration, len(selections)]])
     spreads, selected, seconds, _ = measure_seeds.tables(Path("folder"), ["isolated"], ["PGA"], [1], estimator)
     assert spreads == [list(kept[estimator])] and selected == [["isolated", 1]] and seconds == [1.0]
+
+
+def test_fox_plaza_at_another_vs30_is_its_own_site_and_only_fox_plaza_takes_one(capsys) -> None:
+    """``--vs30`` fits Fox Plaza's scenarios at another Vs30 (its ``[site]`` table's, under its own name, so that its stores do not
+    mix with the 400 m/s study's); 400 m/s is the site itself; the site of one scenario refuses it, and ``--write`` refuses any other."""
+    from benchmarks.site_consistency import FOX_PLAZA, fox_plaza_site
+
+    assert fox_plaza_site() is FOX_PLAZA and fox_plaza_site(400.0) is FOX_PLAZA
+    soft = fox_plaza_site(300.0)
+    assert "vs30 = 300.0" in soft.table and "vs30 = 400.0" not in soft.table and soft.name != FOX_PLAZA.name
+    assert soft.table.replace("vs30 = 300.0", "vs30 = 400.0") == FOX_PLAZA.table
+    for argv, message in ((["table", "x", "--site", "scenario", "--vs30", "300"], "--vs30: Fox Plaza's assumed Vs30"),
+                          (["table", "x", "--vs30", "300", "--write"], "--write: the section is Fox Plaza's study at Vs30 400 m/s")):
+        with pytest.raises(SystemExit):
+            measure_seeds.main(argv)
+        assert message in capsys.readouterr().err
