@@ -200,7 +200,7 @@ def experiment_text(measure: str, configuration: str, seed: int | None = None, r
     levels = curve.intensity_at(np.maximum(1.0 / periods, float(curve.rate.min())))  # a curve that stops short (PSA(0.3 s): 3431 yr): its last level
     base, variants = CONFIGURATIONS[configuration]
     table = site.table
-    if site.name == FOX_PLAZA.name and MEASURES[measure] not in CURVES:  # the scenario fitted to the four curves and the measure's own
+    if 'scenario = "fitted"' in table and MEASURES[measure] not in CURVES:  # a scenario fitted to the four curves and the measure's own
         table = table.replace(f'"{CURVES[-1]}"]', f'"{CURVES[-1]}", "{MEASURES[measure]}"]')
     return (f'[experiment]\nname = "site_{site.name}"\nstudied = "B1"\n{PAIR.format(base=base, variants=variants)}\n[intensity]\n'
             f"{_intensity_lines(measure)}\nlevels = [{', '.join(f'{x:.4f}' for x in levels)}]\n"

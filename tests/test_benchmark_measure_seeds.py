@@ -212,3 +212,12 @@ def test_fox_plaza_at_another_vs30_is_its_own_site_and_only_fox_plaza_takes_one(
         with pytest.raises(SystemExit):
             measure_seeds.main(argv)
         assert message in capsys.readouterr().err
+
+
+def test_fox_plaza_at_another_vs30_fits_a_measure_of_its_own_curve_to_it_too() -> None:
+    """PSA(T1)'s experiment at 300 m/s fits its scenario to the four curves and its own, as at 400 m/s."""
+    from benchmarks.site_consistency import FOX_PLAZA, MEASURES, experiment_text, fox_plaza_site
+
+    measure = next(m for m in MEASURES if "T1" in m)
+    assert f'"{MEASURES[measure]}"]' in experiment_text(measure, "isolated", site=fox_plaza_site(300.0))
+    assert f'"{MEASURES[measure]}"]' in experiment_text(measure, "isolated", site=FOX_PLAZA)
