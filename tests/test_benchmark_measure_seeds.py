@@ -120,10 +120,21 @@ def test_the_model_s_own_curves_are_its_motions_counted_at_the_site_s_levels(mon
         assert row["model level / site level"] == pytest.approx(pga[passed - 1] / level, rel=1e-12)
 
 
-def test_the_measure_free_comparison_needs_a_site_of_ruptures(capsys) -> None:
+def test_the_measure_free_comparison_at_fox_plaza_takes_ruptures_fitted_to_its_curves(capsys) -> None:
+    """Fox Plaza gives no ruptures: the answer without a measure runs on the ones fitted to its 17 curves at the assumed Vs30, within
+    the site-motion model's range (M 5.5-8, R_rup 5-100 km); at 300 m/s six, their curves within 0.20 rms in ln rate (docs quote it)."""
+    from stochpound.motions import SITE_MOTION_LIMITS
+
     with pytest.raises(SystemExit):
-        measure_seeds.main(["measure_free", "folder"])
-    assert "measure_free: the answer without a measure needs the site's ruptures: give --site scenario" in capsys.readouterr().err
+        measure_seeds.main(["measure_free", "folder", "--vs30", "300", "--runs", "1"])
+    printed = capsys.readouterr()
+    assert "--runs: must be at least 12 (two runs of each of the site's ruptures), got 1" in printed.err
+    assert "fitted to its 17 curves at Vs30 300 m/s (rms of ln(recomputed / site) 0.20, largest 0.63)" in printed.out
+    site = measure_seeds.fitted_ruptures(300.0)
+    for field in ("magnitude", "distance_km"):
+        low, high = SITE_MOTION_LIMITS[field]
+        assert all(low <= getattr(scenario, field) <= high for scenario, _ in site)
+    assert site.vs30 == 300.0 and min(site.rate) > 0
     with pytest.raises(SystemExit):
         measure_seeds.main(["measure_free", "folder", "--site", "scenario", "--runs", "1"])
     assert "--runs: must be at least 2 (two runs of each of the site's ruptures), got 1" in capsys.readouterr().err

@@ -30,7 +30,7 @@ def test_the_fit_gives_back_a_site_of_its_candidates_at_its_vs30_and_not_at_anot
         curves = _curves_of(made)
         exact, _, kept = fit_ruptures(300.0, curves)
         other, periods, _ = fit_ruptures(760.0, curves)
-    assert np.abs(exact).max() < 1e-6 and kept >= 1  # not necessarily the two: M and R trade off
+    assert np.abs(exact).max() < 1e-6 and len(kept) >= 1 and min(kept.rate) > 0  # not necessarily the two: M and R trade off
     assert np.sqrt(np.mean(other**2)) > 0.3 and other[periods >= 1.0].mean() < -0.3
 
 
