@@ -11,7 +11,11 @@ Building 1's base displacement (isolated) and each building's storey drift
 (the largest over its storeys); the runs and the time they took.
 
 Rewrites the section "The answer without an intensity measure" of
-``docs/benchmarks.md``.
+``docs/benchmarks.md``. ``--fox-plaza VS30`` runs the same at the ruptures
+fitted to the bundled Fox Plaza curves at that Vs30 (m/s; the flagships'
+own site, which gives curves, not ruptures:
+:func:`benchmarks.measure_seeds.fitted_ruptures`) and prints the table
+instead: the flagships' g* beside an answer without a measure.
 """
 
 from __future__ import annotations
@@ -62,9 +66,8 @@ def flagship_scene(file: str, neighbour: list[float], mu: float | None) -> stoch
     return stochpound.scene_from_dict(table)
 
 
-def measure(motions: int, extra: int, seed: int, bootstrap: int, workers: int, log=print) -> list[tuple[str, tuple]]:
-    """Each configuration's results, one per demand of its scene (the closure first, which the extra runs are allocated for)."""
-    site = RuptureSite.bundled(SITE)
+def measure(motions: int, extra: int, seed: int, bootstrap: int, workers: int, site: RuptureSite, log=print) -> list[tuple[str, tuple]]:
+    """Each configuration's results at ``site``, one per demand of its scene (the closure first, which the extra runs are allocated for)."""
     results = []
     for label, file, neighbour, mu in CONFIGURATIONS:
         scene = flagship_scene(file, neighbour, mu)
@@ -134,10 +137,18 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--bootstrap", type=int, default=1000)
     parser.add_argument("--workers", type=int, default=1, help="worker processes (the result does not depend on them)")
     parser.add_argument("--out", type=Path, default=REPOSITORY / "docs" / "benchmarks.md")
+    parser.add_argument("--fox-plaza", type=float, metavar="VS30", default=None,
+                        help="at the ruptures fitted to Fox Plaza's curves at this Vs30 (m/s) instead of the demo site; the table printed, not written")
     arguments = parser.parse_args(argv)
+    if arguments.fox_plaza is not None:
+        from benchmarks.measure_seeds import fitted_ruptures
+
+        results = measure(arguments.motions, arguments.extra, arguments.seed, arguments.bootstrap, arguments.workers, fitted_ruptures(arguments.fox_plaza))
+        print("\n".join(table(results)))
+        return 0
     info = report.machine()
     start = time.perf_counter()
-    results = measure(arguments.motions, arguments.extra, arguments.seed, arguments.bootstrap, arguments.workers)
+    results = measure(arguments.motions, arguments.extra, arguments.seed, arguments.bootstrap, arguments.workers, RuptureSite.bundled(SITE))
     SECTION.write(arguments.out, section(results, arguments, info, time.perf_counter() - start))
     print(f"wrote the section 'The answer without an intensity measure' of {arguments.out}")
     return 0

@@ -31,3 +31,15 @@ def test_a_reduced_run_writes_the_section_with_every_configuration_and_target(tm
     assert demands == [3, 3, 4]  # closure and both storey drifts; the isolated building's base displacement too
     assert len(rows) == 2 * sum(demands) and sum("closure: g*" in row for row in rows) == 2 * len(demands)
     assert all(" 34 |" in row for row in rows)  # 14 ruptures x 2 + 6 runs
+
+
+@pytest.mark.slow
+def test_at_fox_plaza_it_runs_on_the_ruptures_fitted_to_its_curves_and_prints_the_table_without_writing(tmp_path, capsys):
+    out = tmp_path / "benchmarks.md"
+    out.write_text("# Benchmarks\n")
+    assert measure_free.main(["--fox-plaza", "300", "--motions", "2", "--extra", "6", "--bootstrap", "100", "--out", str(out)]) == 0
+    printed = capsys.readouterr().out
+    assert "fitted to its 17 curves at Vs30 300 m/s" in printed
+    rows = [line for line in printed.splitlines() if line.startswith("| ") and "in 50 yr" in line]
+    assert len(rows) == 2 * (3 + 3 + 4) and all(" 18 |" in row for row in rows)  # 6 ruptures x 2 + 6 runs
+    assert out.read_text() == "# Benchmarks\n"
