@@ -142,7 +142,9 @@ def main(argv: list[str] | None = None) -> int:
     arguments = parser.parse_args(argv)
     if arguments.fox_plaza is not None:
         from benchmarks.measure_seeds import fitted_ruptures
+        from benchmarks.site_consistency import check_site_vs30
 
+        check_site_vs30(parser, "--fox-plaza", arguments.fox_plaza)
         results = measure(arguments.motions, arguments.extra, arguments.seed, arguments.bootstrap, arguments.workers, fitted_ruptures(arguments.fox_plaza))
         print("\n".join(table(results)))
         return 0

@@ -60,8 +60,9 @@ from stochpound.motions import DEFAULT_G as G, Measure
 from benchmarks.report import machine
 from benchmarks.sections import Section
 from benchmarks.site_condition import fit_ruptures, site_curves
-from benchmarks.site_consistency import (CONFIGURATIONS, FOX_PLAZA, MEASURE_ARGS, RETURN_PERIODS, SCENARIO, Pool, Site, experiment_file, lognormal_rate,
-                                         fox_plaza_site, measure_risk, parse_scenario_site, rate_g_star, site_measures)
+from benchmarks.site_consistency import (CONFIGURATIONS, FOX_PLAZA, MEASURE_ARGS, RETURN_PERIODS, SCENARIO, Pool, Site, check_site_vs30,
+                                         experiment_file, fox_plaza_site, lognormal_rate, measure_risk, parse_scenario_site, rate_g_star,
+                                         site_measures)
 from benchmarks.timing import REPOSITORY
 
 if TYPE_CHECKING:
@@ -458,6 +459,8 @@ def main(argv: list[str] | None = None) -> int:
     arguments = parser.parse_args(argv)
     if arguments.site != "fox_plaza" and arguments.vs30 != 400.0:
         parser.error("--vs30: Fox Plaza's assumed Vs30; the site of one scenario takes its own in --scenario's site")
+    if arguments.site == "fox_plaza":
+        check_site_vs30(parser, "--vs30", arguments.vs30)
     site = fox_plaza_site(arguments.vs30) if arguments.site == "fox_plaza" else parse_scenario_site(parser, arguments.scenario)
     arguments.measures = site_measures(parser, site, arguments.measures)
     if arguments.write and site is not FOX_PLAZA:

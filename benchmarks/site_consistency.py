@@ -315,6 +315,19 @@ def _subfolder(folder: Path, name: str) -> Path:
     return folder / name
 
 
+def check_site_vs30(parser: argparse.ArgumentParser, option: str, vs30: float) -> None:
+    """End the run with a one-line usage error naming ``option`` unless ``vs30`` (m/s) lies within both the NGA-West2 models' range
+    (the fitted scenarios') and the site-motion model's (the simulated motions')."""
+    from stochpound import SiteError
+    from stochpound.motions import SITE_MOTION_LIMITS, Scenario
+
+    try:
+        Scenario.of(6.0, 10.0, vs30, "reverse", names={"vs30": option})
+        Scenario.of(6.0, 10.0, vs30, "reverse", names={"vs30": option}, limits=SITE_MOTION_LIMITS, source="the site-motion model's range")
+    except SiteError as error:
+        parser.error(str(error))
+
+
 def parse_scenario_site(parser: argparse.ArgumentParser, values: list[str]) -> Site:
     """The site of ``--scenario M R_KM MECHANISM RATE``; a bad value ends the run with a one-line usage error naming it."""
     from stochpound import SiteError

@@ -43,3 +43,10 @@ def test_at_fox_plaza_it_runs_on_the_ruptures_fitted_to_its_curves_and_prints_th
     rows = [line for line in printed.splitlines() if line.startswith("| ") and "in 50 yr" in line]
     assert len(rows) == 2 * (3 + 3 + 4) and all(" 18 |" in row for row in rows)  # 6 ruptures x 2 + 6 runs
     assert out.read_text() == "# Benchmarks\n"
+
+
+def test_fox_plaza_s_vs30_outside_the_models_is_a_one_line_usage_error(tmp_path, capsys):
+    with pytest.raises(SystemExit):
+        measure_free.main(["--fox-plaza", "1050", "--out", str(tmp_path / "benchmarks.md")])
+    assert "--fox-plaza: must be within 180-1000 (the NGA-West2 models' range), got 1050.0" in capsys.readouterr().err
+    assert not (tmp_path / "benchmarks.md").exists()

@@ -232,3 +232,12 @@ def test_fox_plaza_at_another_vs30_fits_a_measure_of_its_own_curve_to_it_too() -
     measure = next(m for m in MEASURES if "T1" in m)
     assert f'"{MEASURES[measure]}"]' in experiment_text(measure, "isolated", site=fox_plaza_site(300.0))
     assert f'"{MEASURES[measure]}"]' in experiment_text(measure, "isolated", site=FOX_PLAZA)
+
+
+@pytest.mark.parametrize(("vs30", "message"), [("50", "--vs30: must be within 180-1000 (the NGA-West2 models' range), got 50.0"),
+                                              ("190", "--vs30: must be within 200-1100 (the site-motion model's range), got 190.0")])
+def test_fox_plaza_s_vs30_outside_the_models_is_a_one_line_usage_error(capsys, vs30: str, message: str) -> None:
+    for action in ("run", "measure_free"):
+        with pytest.raises(SystemExit):
+            measure_seeds.main([action, "folder", "--vs30", vs30])
+        assert message in capsys.readouterr().err
