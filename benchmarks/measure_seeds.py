@@ -297,7 +297,7 @@ def measure_free(folder: Path, configuration: str, measures: list[str], seeds: l
 def fitted_ruptures(vs30: float) -> RuptureSite:
     """Fox Plaza's stand-in ruptures at ``vs30`` (m/s): :func:`benchmarks.site_condition.fit_ruptures` on its 17 curves within the
     site-motion model's range, printed with how closely their curves give back the site's and the ruptures and rates kept."""
-    error, _, site = fit_ruptures(vs30, site_curves())
+    error, _, site = fit_ruptures(vs30, site_curves(), name=f"fox_plaza_fitted_vs30_{vs30:g}")
     print(f"Fox Plaza's ruptures fitted to its 17 curves at Vs30 {vs30:g} m/s (rms of ln(recomputed / site) {np.sqrt(np.mean(error**2)):.2f}, "
           f"largest {np.abs(error).max():.2f}): " + "; ".join(f"M {scenario.magnitude:g} at {scenario.distance_km:g} km {scenario.mechanism} "
                                                             f"{rate:.3g}/yr" for scenario, rate in site) + "\n", flush=True)

@@ -72,9 +72,10 @@ def site_curves() -> list[tuple[str, float | None, np.ndarray, np.ndarray]]:
 
 
 def fit_ruptures(vs30: float, curves: list[tuple[str, float | None, np.ndarray, np.ndarray]], magnitudes: tuple[float, ...] = MAGNITUDES,
-                 distances: tuple[float, ...] = DISTANCES) -> tuple[np.ndarray, np.ndarray, RuptureSite]:
+                 distances: tuple[float, ...] = DISTANCES, name: str = "") -> tuple[np.ndarray, np.ndarray, RuptureSite]:
     """ln(recomputed / site) at every fitted point of ``curves`` (:func:`site_curves`' form), the point's period (0 for PGA, s)
-    and the ruptures the fit keeps (a site of them, their fitted annual rates), candidates ``magnitudes`` × ``distances`` (km)."""
+    and the ruptures the fit keeps (a site of them named ``name``, their fitted annual rates), candidates ``magnitudes`` ×
+    ``distances`` (km)."""
     candidates = [Scenario(m, r, vs30, mechanism) for mechanism in MECHANISMS for m in magnitudes for r in distances]
     site = RuptureSite.from_scenarios([(scenario, 1.0) for scenario in candidates])
     blocks, periods = [], []
@@ -85,8 +86,8 @@ def fit_ruptures(vs30: float, curves: list[tuple[str, float | None, np.ndarray, 
     matrix = np.vstack(blocks)
     rates, _ = nnls(matrix, np.ones(len(matrix)))
     fitted = RuptureSite.from_scenarios([(scenario, float(rate)) for scenario, rate in zip(candidates, rates) if rate > 0],
-                                        name=f"{SITE}_fitted_vs30_{vs30:g}",
-                                        source=f"annual rates fitted to the {len(curves)} bundled {SITE} curves (benchmarks.site_condition)")
+                                        name=name, source=f"annual rates fitted to {len(curves)} hazard curves at Vs30 {vs30:g} m/s "
+                                                                 "(benchmarks.site_condition)")
     return np.log(matrix @ rates), np.array(periods), fitted
 
 
