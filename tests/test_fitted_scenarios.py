@@ -150,7 +150,7 @@ def test_the_definition_keeps_how_the_scenario_was_obtained_as_data_outside_the_
     "site, field",
     [
         (FITTED_SITE.replace('"fitted"', '"disaggregated"'), "site.scenario:"),
-        (FITTED_SITE.replace(CURVES, '["fox_plaza_los_angeles_pga", "nowhere"]'), "site.curves:"),
+        (FITTED_SITE.replace(CURVES, '["fox_plaza_los_angeles_pga", "nowhere"]'), "site.curves[1]:"),
         (FITTED_SITE.replace(CURVES, '["fox_plaza_los_angeles_pga", "fox_plaza_los_angeles_sa2p0s"]'), "site.curves:"),
         (FITTED_SITE.replace(CURVES, '["fox_plaza_los_angeles_sa1p0s"]'), "site.curves:"),
         (FITTED_SITE + "magnitude = 7.0\n", "site.magnitude:"),
@@ -160,6 +160,81 @@ def test_the_definition_keeps_how_the_scenario_was_obtained_as_data_outside_the_
     ],
 )
 def test_bad_fitted_site_is_one_line_naming_the_field(tmp_path, site: str, field: str) -> None:
+    with pytest.raises(ExperimentError) as error:
+        parse_experiment(tomllib.loads(_text(FITTED_SELECTION, site)), tmp_path)
+    assert str(error.value).startswith(field) and "\n" not in str(error.value)
+
+
+def _copy_curve(tmp_path, name: str, header: str) -> str:
+    """A bundled curve written as a user's hazard-curve file with ``header`` (its '#' lines), in ``tmp_path``; its file name."""
+    curve = HazardCurve.bundled(name)
+    rows = "\n".join(f"{float(x)!r},{float(y)!r}" for x, y in zip(curve.im, curve.rate))
+    (tmp_path / f"{name}.csv").write_text(f"{header}im,rate\n{rows}\n")
+    return f"{name}.csv"
+
+
+def test_a_fitted_site_takes_hazard_curve_files_and_fits_them_as_the_same_bundled_curves(tmp_path) -> None:
+    """The user's own curves (files beside the experiment, their measure stated by the header or by the entry) give the same fitted
+    scenario as the same numbers bundled; the definition names each curve by its file."""
+    pga = _copy_curve(tmp_path, "fox_plaza_los_angeles_pga", "# My site, from the USGS tool\n# Measure: PGA, in g\n")
+    sa1 = _copy_curve(tmp_path, "fox_plaza_los_angeles_sa1p0s", "# My site\n")  # the entry states its measure
+    files = f'["{pga}", {{ file = "{sa1}", measure = "psa", period = 1.0, damping = 0.05, units = "g" }}, "fox_plaza_los_angeles_sa2p0s"]'
+    from_files = parse_experiment(tomllib.loads(_text(FITTED_SELECTION, FITTED_SITE.replace(CURVES, files))), tmp_path)
+    bundled = parse_experiment(tomllib.loads(_text(FITTED_SELECTION, FITTED_SITE)), tmp_path)
+    assert from_files["intensity"]["site"] == bundled["intensity"]["site"]
+    assert from_files["site"]["curves"] == [pga, sa1, "fox_plaza_los_angeles_sa2p0s"]
+    changed = FITTED_SITE.replace(CURVES, files).replace(", damping = 0.05", "")  # a PSA curve without its damping: nobody states it
+    with pytest.raises(ExperimentError, match=r"^site\.curves\[1\]\.damping: not stated"):
+        parse_experiment(tomllib.loads(_text(FITTED_SELECTION, changed)), tmp_path)
+
+
+def test_a_fitted_site_conditions_on_sa_avg_from_a_curve_file_stating_its_periods(tmp_path) -> None:
+    """Sa_avg has no bundled curve: its curve comes as a file whose entry states the measure and periods; the fit reproduces the
+    PSA curves from stripes of Sa_avg, as fit_scenarios does given the same curves."""
+    from stochpound.analysis import RuptureSite
+
+    periods = (0.5, 1.0, 2.0)
+    site = RuptureSite.from_scenarios([(Scenario_of(7.0, 20.0), 0.01), (Scenario_of(6.0, 10.0), 0.05)], name="two")
+    curve = site.hazard_curve("sa_avg", periods)
+    (tmp_path / "sa_avg.csv").write_text("# Sa_avg of two ruptures\nim,rate\n" + "\n".join(f"{float(x)!r},{float(y)!r}" for x, y in zip(curve.im, curve.rate)) + "\n")
+    entry = '{ file = "sa_avg.csv", measure = "sa_avg", periods = [0.5, 1.0, 2.0], damping = 0.05, units = "g" }'
+    levels = curve.intensity_at(np.array([1 / 100.0, 1 / 1000.0]))
+    selection = (f'measure = "sa_avg"\nperiods = [0.5, 1.0, 2.0]\nlevels = [{levels[0]:.4f}, {levels[1]:.4f}]\n'
+                 'selection = "conditional_spectrum"\nmotions = 4\nmax_scale_factor = 5.0\n')
+    text = FITTED_SITE.replace(CURVES, f'[{entry}, "fox_plaza_los_angeles_sa1p0s", "fox_plaza_los_angeles_sa2p0s"]')
+    scenarios = parse_experiment(tomllib.loads(_text(selection, text)), tmp_path)["intensity"]["site"]
+    read = HazardCurve.from_file(tmp_path / "sa_avg.csv")
+    others = [(T, HazardCurve.bundled(name).im, HazardCurve.bundled(name).rate) for T, name in ((1.0, "fox_plaza_los_angeles_sa1p0s"), (2.0, "fox_plaza_los_angeles_sa2p0s"))]
+    ordered = np.array([float(f"{x:.4f}") for x in levels])
+    fine = fit_levels(ordered, read.support[1], read.support[0])
+    assert scenarios == fit_scenarios("sa_avg", periods, ordered, fine, stripe_rate_weights(fine, read), others, 400.0, "reverse")
+    as_other = FITTED_SITE.replace(CURVES, f'["fox_plaza_los_angeles_pga", "fox_plaza_los_angeles_sa1p0s", {entry}]')  # Sa_avg is not fitted
+    with pytest.raises(ExperimentError, match=r"^site\.curves\[2\]: the fit reproduces curves of PGA or PSA"):
+        parse_experiment(tomllib.loads(_text(FITTED_SELECTION, as_other)), tmp_path)
+
+
+def Scenario_of(magnitude: float, distance_km: float):
+    from stochpound.motions import Scenario
+
+    return Scenario.of(magnitude, distance_km, 400.0, "reverse")
+
+
+@pytest.mark.parametrize(
+    "entry, field",
+    [
+        ('"missing.csv"', "site.curves[0]: 'missing.csv' is neither a bundled hazard curve nor a file"),
+        ('{ file = "bare.csv" }', "site.curves[0].measure: not stated"),
+        ('{ file = "bare.csv", measure = "pga", units = "cm/s2" }', "site.curves[0].units: the fit takes curves in g"),
+        ('{ file = "bare.csv", measure = "psa", period = 0.3, damping = 0.02, units = "g" }', "site.curves[0].damping: the NGA-West2 models give 5 %"),
+        ('{ file = "bare.csv", measure = "pga", units = "g", bogus = 1 }', "site.curves[0].bogus: unknown field"),
+        ("3", "site.curves[0]: a bundled hazard curve's name, a hazard-curve file or a table"),
+        ('{ file = "rare.csv", measure = "psa", period = 0.3, damping = 0.05, units = "g" }', "site.curves: the site's PSA(0.3 s) curve has no intensity"),
+    ],
+)
+def test_a_bad_curve_entry_is_one_line_naming_it(tmp_path, entry: str, field: str) -> None:
+    (tmp_path / "bare.csv").write_text("im,rate\n0.1,0.01\n1.0,0.0001\n")
+    (tmp_path / "rare.csv").write_text("im,rate\n0.1,1e-7\n1.0,1e-8\n")  # no rate within the stripes' rates
+    site = FITTED_SITE.replace(CURVES, f'[{entry}, "fox_plaza_los_angeles_sa1p0s", "fox_plaza_los_angeles_sa2p0s"]')
     with pytest.raises(ExperimentError) as error:
         parse_experiment(tomllib.loads(_text(FITTED_SELECTION, site)), tmp_path)
     assert str(error.value).startswith(field) and "\n" not in str(error.value)

@@ -80,6 +80,7 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
+from stochpound.hazard import site_curve_label
 from stochpound.model import fields as toml_fields
 from stochpound.motions import CONDITIONING_MEASURES, MODEL_DAMPING, PERIOD_RANGE, Measure, Scenario
 from stochpound.store import CONDITIONAL_SPECTRUM, SCENARIO_KINDS, ExperimentGrid, Intensity, MotionSource, Selection, SimulatedMotions, Site
@@ -167,9 +168,9 @@ def parse_selection(table: Mapping[str, Any], site: Any, levels: list[float], se
             note += f" (the pool: {simulated.count} simulated motions a stripe of the causal ruptures, allotted by their disaggregation weights)"
         return Selection(selection, motions, max_scale, seed, mixture_scenarios(ruptures, levels, measure), max_per_earthquake, exclude_pulses,
                          simulated=simulated, ruptures=ruptures.to_entry(identity=True)), note
-    scenarios = parse_site(site, levels, measure)
+    scenarios = parse_site(site, levels, measure, base_dir)
     if toml_fields.TomlTable(site, "site", raises=SiteError).string("scenario", SCENARIO_KINDS[0]) == "fitted":
-        note += f" (the scenario fitted to the site's hazard curves {', '.join(map(str, site['curves']))}, standing in for a disaggregation)"
+        note += f" (the scenario fitted to the site's hazard curves {', '.join(map(site_curve_label, site['curves']))}, standing in for a disaggregation)"
     return Selection(selection, motions, max_scale, seed, scenarios, max_per_earthquake, exclude_pulses, simulated=parse_simulated(site, seed)), note
 
 
@@ -253,11 +254,12 @@ def site_entry(site: Any, intensity: Intensity | None) -> Site | None:
     if "ruptures" in site:
         return Site("ruptures", ruptures=site["ruptures"])
     kind = toml_fields.TomlTable(site, "site", raises=SiteError).string("scenario", SCENARIO_KINDS[0])
-    return Site(kind, curves=tuple(site["curves"])) if kind == "fitted" else Site(kind)
+    return Site(kind, curves=tuple(map(site_curve_label, site["curves"]))) if kind == "fitted" else Site(kind)
 
 
-def parse_site(site: Any, levels: list[float], measure: Measure) -> tuple[Scenario, ...]:
-    """One scenario per level, in the order of the sorted levels, from the ``[site]`` table (given, or fitted to its ``curves``)."""
+def parse_site(site: Any, levels: list[float], measure: Measure, base_dir: Path = Path(".")) -> tuple[Scenario, ...]:
+    """One scenario per level, in the order of the sorted levels, from the ``[site]`` table (given, or fitted to its ``curves``, files
+    relative to ``base_dir``)."""
     from stochpound._errors import SiteError
 
     if not isinstance(site, dict):
@@ -265,7 +267,7 @@ def parse_site(site: Any, levels: list[float], measure: Measure) -> tuple[Scenar
     scenario_kind = toml_fields.TomlTable(site, "site", raises=SiteError).string("scenario", SCENARIO_KINDS[0], choices=SCENARIO_KINDS[:2],
                                                                      hint='a site of ruptures: ruptures = "<file or bundled site>"')
     if scenario_kind == "fitted":
-        return fitted_site(site, levels, measure)
+        return fitted_site(site, levels, measure, base_dir)
     if "curves" in site:
         raise SiteError('site.curves: only with site.scenario = "fitted"')
     toml_fields.reject_unknown(site, {*SITE_FIELDS, "scenario", "simulated_motions", "simulated_sampling"}, "site")
@@ -290,15 +292,16 @@ def parse_site(site: Any, levels: list[float], measure: Measure) -> tuple[Scenar
     return tuple(scenarios[i] for i in order)
 
 
-def fitted_site(site: Mapping[str, Any], levels: list[float], conditioning_measure: Measure) -> tuple[Scenario, ...]:
-    """The scenario of every level (sorted) fitted to the site's bundled hazard curves (:func:`stochpound.motions.fit_scenarios`).
+def fitted_site(site: Mapping[str, Any], levels: list[float], conditioning_measure: Measure, base_dir: Path = Path(".")) -> tuple[Scenario, ...]:
+    """The scenario of every level (sorted) fitted to the site's hazard curves (:func:`stochpound.motions.fit_scenarios`).
 
-    ``site.curves`` names bundled curves (:func:`stochpound.analysis.bundled_curves`):
-    the one of the conditioning measure gives the stripes' rates, the others
-    (PGA or PSA) are reproduced by the fit.
+    ``site.curves`` lists bundled curves (:func:`stochpound.analysis.bundled_curves`) or hazard-curve files (relative to
+    ``base_dir``), each read by :func:`stochpound.hazard.site_curve`: the one of the conditioning measure gives the stripes'
+    rates, the others (PGA or PSA) are reproduced by the fit.
     """
     from stochpound._errors import SiteError
-    from stochpound.analysis import HazardCurve, bundled_curves, bundled_measure, stripe_rate_weights
+    from stochpound.analysis import stripe_rate_weights
+    from stochpound.hazard import site_curve
     from stochpound.motions import fit_levels, fit_scenarios
 
     toml_fields.reject_unknown(site, {"scenario", "curves", "vs30", "mechanism", "simulated_motions", "simulated_sampling"}, "site")
@@ -309,18 +312,19 @@ def fitted_site(site: Mapping[str, Any], levels: list[float], conditioning_measu
             raise SiteError(f'site.{key}: one value with scenario = "fitted", got a list')
     Scenario.of(6.0, 10.0, site["vs30"], site["mechanism"], names={"vs30": "site.vs30", "mechanism": "site.mechanism"})
     curves = toml_fields.TomlTable(site, "site", raises=SiteError).raw("curves")
-    known = bundled_curves()
-    if not isinstance(curves, list) or len(curves) < 2 or any(name not in known for name in curves):
-        raise SiteError(f'site.curves: two or more of the bundled hazard curves ({", ".join(known)}), got {curves!r}')
+    if not isinstance(curves, list) or len(curves) < 2:
+        raise SiteError(f"site.curves: two or more of the site's hazard curves (bundled curves' names or hazard-curve files), got {curves!r}")
     conditioning = None
     others = []
-    for name in curves:
-        measure = bundled_measure(name)
-        curve = HazardCurve.bundled(name)
-        if measure.kind == conditioning_measure.kind and measure.period == conditioning_measure.period:
+    for index, entry in enumerate(curves):
+        where = f"site.curves[{index}]"
+        measure, curve = site_curve(entry, base_dir, where)
+        if measure.kind == conditioning_measure.kind and measure.spectral_period == conditioning_measure.spectral_period:
             conditioning = curve
-        else:
+        elif measure.kind in ("pga", "psa"):
             others.append((measure.period, curve.im, curve.rate))
+        else:
+            raise SiteError(f"{where}: the fit reproduces curves of PGA or PSA; {measure.description} only as the conditioning measure's curve")
     if conditioning is None:
         raise SiteError("site.curves: none of them is the curve of the conditioning measure ([intensity] measure and period)")
     if not others:
@@ -328,8 +332,11 @@ def fitted_site(site: Mapping[str, Any], levels: list[float], conditioning_measu
     ordered = sorted(float(level) for level in levels)
     try:
         fine = fit_levels(ordered, conditioning.support[1], conditioning.support[0])
-        scenarios = fit_scenarios(conditioning_measure.kind, conditioning_measure.period, ordered, fine, stripe_rate_weights(fine, conditioning, "intensity.levels"),
+        scenarios = fit_scenarios(conditioning_measure.kind, conditioning_measure.spectral_period, ordered, fine, stripe_rate_weights(fine, conditioning, "intensity.levels"),
                                   others, float(site["vs30"]), site["mechanism"])
+    except SiteError as error:  # the fit's own, naming its argument: the file's field instead
+        message = str(error)
+        raise SiteError(f"site.curves: {message.removeprefix('others: ')}" if message.startswith("others:") else f"intensity.{message}") from None
     except ValueError as error:  # a level outside the conditioning curve
         raise SiteError(f"intensity.levels: outside the site's curve of the conditioning measure ({error})") from None
     return tuple(Scenario(**scenario) for scenario in scenarios)

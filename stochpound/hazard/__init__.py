@@ -8,6 +8,7 @@ nshmp-haz's files with what it is a curve of (a :class:`StatedMeasure`;
 an experiment file's ``[hazard]`` table into the canonical entry a store
 carries, :func:`stored_hazard` gives a store's curve back and
 :func:`hazard_option` reads ``stochpound risk --hazard``;
+:func:`site_curve` reads an entry of ``[site] curves`` (the curves a fitted scenario is fitted to);
 :func:`hazard_consistency` recomputes the hazard at another measure from
 the stripes' motions; :func:`scenario_hazard` is the hazard of a site
 shaken by one earthquake scenario, consistent with the ground-motion models
@@ -29,6 +30,7 @@ from stochpound.hazard._setting import check_covers, hazard_curve, hazard_option
 
 # For the other packages of stochpound (their interface to this one, not public API: not in __all__).
 from stochpound.hazard._ruptures import SITE_FIELDS as RUPTURE_SITE_FIELDS, named_rupture_site  # noqa: F401
+from stochpound.hazard._site_curves import site_curve, site_curve_label  # noqa: F401
 
 __all__ = [
     "HazardCurve",

@@ -51,7 +51,7 @@ import xarray as xr
 
 from stochpound._errors import IntensityError
 from stochpound.hazard._curve import BUNDLED_UNITS, HazardCurve, bundled_curves, bundled_measure, bundled_path
-from stochpound.hazard._files import StatedMeasure, parse_units, read_hazard_file, unit_factor
+from stochpound.hazard._files import HazardFile, StatedMeasure, parse_units, read_hazard_file, unit_factor
 from stochpound.hazard._ruptures import SITE_FIELDS as RUPTURE_SITE_FIELDS, named_rupture_site
 from stochpound.motions import Measure
 from stochpound.store import MEASURES, Hazard, Intensity, TomlTable
@@ -112,7 +112,7 @@ def parse_hazard(file: TomlTable, intensity: Intensity | None, base_dir: Path, g
             raise IntensityError(f"hazard.{key}: only with ruptures = ... (the site of a rupture table)")
     extrapolate = table.boolean("extrapolate", default=False)
     measure, units = intensity.measure, intensity.units
-    stated, investigation_time = _stated_fields(table), table.number("investigation_time", None, low=0.0, low_open=True)
+    stated, investigation_time = stated_fields(table), table.number("investigation_time", None, low=0.0, low_open=True)
     sources: dict[str, str] = {}
     power_law = None
     if source == "bundled":
@@ -181,8 +181,9 @@ def check_covers(curve: HazardCurve, levels: Sequence[float], where: str, what: 
                              "to extend it as power laws (stated in the report)")
 
 
-def _stated_fields(table: TomlTable) -> StatedMeasure:
-    """What ``[hazard]`` states of its curve's measure: measure, period(s), damping, units (each None when not stated)."""
+def stated_fields(table: TomlTable) -> StatedMeasure:
+    """What a table (``[hazard]``, an entry of ``[site] curves``) states of its curve's measure: measure, period(s), damping, units
+    (each None when not stated); its errors name the table's fields."""
     kind = table.string("measure", None, choices=MEASURES)
     period = table.number("period", None, low=0.0, low_open=True)
     damping = table.number("damping", None, low=0.0, high=1.0, high_open=True)
@@ -191,12 +192,25 @@ def _stated_fields(table: TomlTable) -> StatedMeasure:
     try:
         return StatedMeasure(kind, period, periods, damping, None if units is None else parse_units(units))
     except ValueError as error:
-        raise IntensityError(f"hazard.{error}") from None
+        raise IntensityError(f"{table.name}.{error}") from None
 
 
 def _read(path: Path, given: StatedMeasure, investigation_time: float | None, site: Any, measure: Measure, units: str, g: float,
           extrapolate: bool, where: str) -> HazardCurve:
     """A hazard file's curve, its measure (the file's, completed by ``given``) checked against ``measure``, converted to ``units`` and to rates."""
+    read = read_stated(path, given, investigation_time, site, where)
+    _check_measure(where, read.stated, measure)
+    return stated_curve(read, path, units, g, investigation_time, extrapolate, measure.description, where)
+
+
+def read_stated(path: Path, given: StatedMeasure, investigation_time: float | None, site: Any, where: str) -> HazardFile:
+    """A hazard file as read, its measure the file's completed by ``given`` and every part its kind needs stated.
+
+    Raises
+    ------
+    IntensityError
+        Naming ``where``'s field: an unreadable file, a part the file and ``given`` state differently, a part nobody states.
+    """
     try:
         read = read_hazard_file(path, site=site)
     except (ValueError, UnicodeDecodeError) as error:
@@ -213,9 +227,14 @@ def _read(path: Path, given: StatedMeasure, investigation_time: float | None, si
         if key not in stated:
             example = " (e.g. 'PSA(1.0 s, 5 %) in g')" if key in ("period", "damping") and where.startswith("--") else ""
             raise IntensityError(f"{_field(where, key)}: not stated: {path.name} does not give its curve's {key}; state it{example}")
-    _check_measure(where, read.stated, measure)
+    return read
+
+
+def stated_curve(read: HazardFile, path: Path, units: str, g: float, investigation_time: float | None, extrapolate: bool, description: str,
+                 where: str) -> HazardCurve:
+    """The annual-rate curve of a file read by :func:`read_stated`, in ``units`` (:meth:`~stochpound.analysis.HazardFile.curve`)."""
     try:
-        return read.curve(units, g, investigation_time=investigation_time, extrapolate=extrapolate, description=measure.description)
+        return read.curve(units, g, investigation_time=investigation_time, extrapolate=extrapolate, description=description)
     except ValueError as error:
         message = str(error)
         if message.startswith("investigation_time:"):
