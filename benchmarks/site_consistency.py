@@ -28,7 +28,10 @@ earthquake (docs/intensity.md, "the pool extended by simulated motions").
 At Fox Plaza the measures are PGA, PSA(1 s), PSA(2 s), PSA(3 s) and PSA at
 Building 1's own period on a fixed base, PSA(T1 = 0.3 s) (its scenario
 fitted to the four curves and its own; its curve stops at 3431 years, its
-top stripe there).
+top stripe there) and the average spectral acceleration over 0.5-4 s,
+``Sa_avg(0.5-4 s)``, whose curve is DERIVED, not published: the hazard of
+the ruptures fitted to the site's 17 curves (:func:`fox_plaza_sa_avg`),
+written beside the experiment and given to ``[site] curves`` as a file.
 
 ``--site scenario`` runs the same at a site shaken by one earthquake
 scenario (``--scenario M R mechanism rate``, default M 7.5 at 10 km,
@@ -52,6 +55,7 @@ import argparse
 import tempfile
 from collections.abc import Callable
 from dataclasses import dataclass, replace
+from functools import lru_cache, partial
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -138,26 +142,56 @@ class Site:
     return_periods: np.ndarray
     measures: tuple[str, ...]
     ruptures: RuptureSite | None = None
+    derived: tuple[str, ...] = ()
+    """The measures whose curve is not the site's own but derived; a fitted scenario reads it from a file beside the experiment
+    (:func:`derived_curve_file`)."""
+
+    def derived_curve_file(self, measure: str) -> str:
+        """The file name of the derived curve of ``measure``, beside the experiment."""
+        return f"{self.name}_{experiment_file(Path('.'), measure).stem}.csv"
 
 
-def _bundled_hazard(measure: str) -> HazardCurve:
+@lru_cache(maxsize=4)
+def fox_plaza_sa_avg(vs30: float) -> HazardCurve:
+    """Fox Plaza's hazard of :data:`SA_AVG`, DERIVED: no curve of it is published for the site, so it is the curve of the ruptures
+    fitted to the site's 17 curves at ``vs30`` (m/s; :func:`benchmarks.site_condition.fit_ruptures`, the stand-in whose answer without
+    a measure referees the measures), with that provenance."""
+    from benchmarks.site_condition import fit_ruptures, site_curves
+
+    error, _, ruptures = fit_ruptures(vs30, site_curves(), name=f"fox_plaza_fitted_vs30_{vs30:g}")
+    curve = ruptures.hazard_curve(*MEASURE_ARGS[SA_AVG])
+    curve.source = (f"Fox Plaza (Los Angeles), {SA_AVG} in g, DERIVED: the hazard of the {len(ruptures)} ruptures whose NGA-West2 curves "
+                    f"give back the site's 17 bundled curves at Vs30 {vs30:g} m/s (rms {np.sqrt(np.mean(error ** 2)):.2f} in ln rate; "
+                    "python -m benchmarks.site_condition's fit_ruptures), not a published curve")
+    return curve
+
+
+def _fox_plaza_hazard(vs30: float, measure: str) -> HazardCurve:
+    """Fox Plaza's curve of ``measure``: bundled, or for :data:`SA_AVG` derived at ``vs30`` (:func:`fox_plaza_sa_avg`)."""
     from stochpound.analysis import HazardCurve
 
-    return HazardCurve.bundled(MEASURES[measure])
+    return fox_plaza_sa_avg(vs30) if measure == SA_AVG else HazardCurve.bundled(MEASURES[measure])
+
+
+def curve_file_text(curve: HazardCurve) -> str:
+    """A hazard curve as stochpound's CSV file (its provenance in the comment lines, intensities in g)."""
+    comments = "".join(f"# {line}\n" for line in curve.source.splitlines())
+    return comments + "im,rate\n" + "".join(f"{float(x)!r},{float(y)!r}\n" for x, y in zip(curve.im, curve.rate))
 
 
 #: The bundled Fox Plaza site, the scenario fitted to its four curves (Vs30 and mechanism assumed: the curves state neither);
-#: PSA(T1)'s to them and its own.
-FOX_PLAZA = Site("fox_plaza", _bundled_hazard, '[site]\nscenario = "fitted"\ncurves = [' + ", ".join(f'"{name}"' for name in CURVES) +
-                 ']\nvs30 = 400.0\nmechanism = "reverse"\n', RETURN_PERIODS, tuple(MEASURES))
+#: PSA(T1)'s to them and its own; Sa_avg's to them and its derived curve (:func:`fox_plaza_sa_avg`), written beside the experiment.
+FOX_PLAZA = Site("fox_plaza", partial(_fox_plaza_hazard, 400.0), '[site]\nscenario = "fitted"\ncurves = [' + ", ".join(f'"{name}"' for name in CURVES) +
+                 ']\nvs30 = 400.0\nmechanism = "reverse"\n', RETURN_PERIODS, (*MEASURES, SA_AVG), derived=(SA_AVG,))
 
 
 def fox_plaza_site(vs30: float = 400.0) -> Site:
     """:data:`FOX_PLAZA` with another assumed Vs30 (m/s): its scenarios fitted at that Vs30 (benchmarks.site_condition: the curves imply
-    a softer site than 400 m/s). :data:`FOX_PLAZA` itself at 400."""
+    a softer site than 400 m/s), its derived Sa_avg curve too. :data:`FOX_PLAZA` itself at 400."""
     if vs30 == 400.0:
         return FOX_PLAZA
-    return replace(FOX_PLAZA, name=f"fox_plaza_vs30_{vs30:g}", table=FOX_PLAZA.table.replace("vs30 = 400.0", f"vs30 = {float(vs30)}"))
+    return replace(FOX_PLAZA, name=f"fox_plaza_vs30_{vs30:g}", hazard=partial(_fox_plaza_hazard, float(vs30)),
+                   table=FOX_PLAZA.table.replace("vs30 = 400.0", f"vs30 = {float(vs30)}"))
 
 
 def scenario_site(magnitude: float, distance_km: float, mechanism: str, rate: float, vs30: float = 400.0) -> Site:
@@ -200,7 +234,11 @@ def experiment_text(measure: str, configuration: str, seed: int | None = None, r
     levels = curve.intensity_at(np.maximum(1.0 / periods, float(curve.rate.min())))  # a curve that stops short (PSA(0.3 s): 3431 yr): its last level
     base, variants = CONFIGURATIONS[configuration]
     table = site.table
-    if 'scenario = "fitted"' in table and MEASURES[measure] not in CURVES:  # a scenario fitted to the four curves and the measure's own
+    if 'scenario = "fitted"' in table and measure in site.derived:  # the four curves and the measure's derived one, its file stating it
+        kind, period = MEASURE_ARGS[measure]
+        entry = f'{{ file = "{site.derived_curve_file(measure)}", measure = "{kind}", periods = [{", ".join(f"{t:g}" for t in period)}], damping = 0.05, units = "g" }}'
+        table = table.replace(f'"{CURVES[-1]}"]', f'"{CURVES[-1]}", {entry}]')
+    elif 'scenario = "fitted"' in table and MEASURES[measure] not in CURVES:  # a scenario fitted to the four curves and the measure's own
         table = table.replace(f'"{CURVES[-1]}"]', f'"{CURVES[-1]}", "{MEASURES[measure]}"]')
     return (f'[experiment]\nname = "site_{site.name}"\nstudied = "B1"\n{PAIR.format(base=base, variants=variants)}\n[intensity]\n'
             f"{_intensity_lines(measure)}\nlevels = [{', '.join(f'{x:.4f}' for x in levels)}]\n"
@@ -223,6 +261,8 @@ def measure_risk(folder: Path, measure: str, configuration: str, bootstrap: int 
     from stochpound.experiment import load_experiment, run_experiment
 
     path = experiment_file(folder, measure)
+    if measure in site.derived:
+        (folder / site.derived_curve_file(measure)).write_text(curve_file_text(site.hazard(measure)))
     path.write_text(experiment_text(measure, configuration, seed, return_periods, site, pool))
     report = run_experiment(load_experiment(path), workers=0, progress=False, checkpoint=float("inf"))  # no store written mid-run: read at the end only
     if not report.complete:
