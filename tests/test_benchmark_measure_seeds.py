@@ -241,3 +241,27 @@ def test_fox_plaza_s_vs30_outside_the_models_is_a_one_line_usage_error(capsys, v
         with pytest.raises(SystemExit):
             measure_seeds.main([action, "folder", "--vs30", vs30])
         assert message in capsys.readouterr().err
+
+
+def test_fox_plaza_s_sa_avg_is_fitted_to_its_derived_curve_read_from_a_file_beside_the_experiment(tmp_path) -> None:
+    """Fox Plaza publishes no Sa_avg curve: the study's is the fitted ruptures' (its file says DERIVED), written beside the
+    experiment and given to ``[site] curves`` as a file stating its measure; the experiment fits its scenario to it and the four
+    curves, at the site's own Vs30 (300 m/s: the curve of that Vs30's ruptures, not 400's)."""
+    import tomllib
+
+    from benchmarks.site_consistency import FOX_PLAZA, SA_AVG, curve_file_text, experiment_text, fox_plaza_site
+    from stochpound.analysis import HazardCurve
+    from stochpound.experiment._spec import parse_experiment
+
+    soft = fox_plaza_site(300.0)
+    assert SA_AVG in FOX_PLAZA.measures and SA_AVG in soft.derived
+    assert not (soft.hazard(SA_AVG).rate == FOX_PLAZA.hazard(SA_AVG).rate).all()
+    name = soft.derived_curve_file(SA_AVG)
+    (tmp_path / name).write_text(curve_file_text(soft.hazard(SA_AVG)))
+    text = experiment_text(SA_AVG, "isolated", 1, site=soft)
+    assert f'file = "{name}", measure = "sa_avg"' in text
+    definition = parse_experiment(tomllib.loads(text), tmp_path)
+    assert name in definition["site"]["curves"] and "DERIVED" in (tmp_path / name).read_text()
+    assert {scenario["vs30"] for scenario in definition["intensity"]["site"]} == {300.0}
+    read = HazardCurve.from_file(tmp_path / name)
+    np.testing.assert_array_equal(read.rate, soft.hazard(SA_AVG).rate)  # the file holds the curve's numbers exactly
