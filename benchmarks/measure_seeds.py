@@ -15,6 +15,11 @@ years from it, and the selection's diagnostics (the fitted scenario, the stripes
 result already there is not run again: an interrupted study resumes, and two invocations with different
 ``--configurations`` run side by side (one core each).
 
+``--site fox_plaza_ruptures`` (with ``--sampling scenario``) runs the same study at Fox Plaza's stand-in ruptures
+(:func:`benchmarks.site_consistency.fox_plaza_ruptures_site`: the ruptures fitted to its 17 curves at ``--vs30``, every measure's
+curve theirs, each stripe's target their exact conditional spectrum, its simulated motions their causal ruptures'): no fitted
+scenario, so what still parts there is the chain's own.
+
 ``table FOLDER`` prints the study's two tables from the results and, with ``--write``, rewrites the section of
 docs/benchmarks.md between its markers: per configuration and target, each measure's median g* over the seeds (their
 range), the spread over the measures' medians and over measures and seeds, the largest seed-to-seed spread of one measure
@@ -60,8 +65,8 @@ from stochpound.motions import DEFAULT_G as G, Measure
 
 from benchmarks.report import machine
 from benchmarks.sections import Section
-from benchmarks.site_condition import fit_ruptures, site_curves
 from benchmarks.site_consistency import (CONFIGURATIONS, FOX_PLAZA, MEASURE_ARGS, RETURN_PERIODS, SA_AVG, SCENARIO, Pool, Site, check_site_vs30,
+                                         fox_plaza_ruptures, fox_plaza_ruptures_site,
                                          experiment_file, fox_plaza_site, lognormal_rate, measure_risk, parse_scenario_site, rate_g_star,
                                          site_measures)
 from benchmarks.timing import REPOSITORY
@@ -297,8 +302,9 @@ def measure_free(folder: Path, configuration: str, measures: list[str], seeds: l
 
 def fitted_ruptures(vs30: float) -> RuptureSite:
     """Fox Plaza's stand-in ruptures at ``vs30`` (m/s): :func:`benchmarks.site_condition.fit_ruptures` on its 17 curves within the
-    site-motion model's range, printed with how closely their curves give back the site's and the ruptures and rates kept."""
-    error, _, site = fit_ruptures(vs30, site_curves(), name=f"fox_plaza_fitted_vs30_{vs30:g}")
+    site-motion model's range (:func:`benchmarks.site_consistency.fox_plaza_ruptures`), printed with how closely their curves give
+    back the site's and the ruptures and rates kept."""
+    error, site = fox_plaza_ruptures(float(vs30))
     print(f"Fox Plaza's ruptures fitted to its 17 curves at Vs30 {vs30:g} m/s (rms of ln(recomputed / site) {np.sqrt(np.mean(error**2)):.2f}, "
           f"largest {np.abs(error).max():.2f}): " + "; ".join(f"M {scenario.magnitude:g} at {scenario.distance_km:g} km {scenario.mechanism} "
                                                             f"{rate:.3g}/yr" for scenario, rate in site) + "\n", flush=True)
@@ -450,8 +456,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--simulated", type=int, default=2000, help="simulated motions a stripe (default %(default)s)")
     parser.add_argument("--sampling", choices=("scenario", "tilted"), default="tilted")
     parser.add_argument("--write", action="store_true", help="rewrite the section of docs/benchmarks.md (Fox Plaza's study)")
-    parser.add_argument("--site", choices=("fox_plaza", "scenario"), default="fox_plaza",
-                        help="the bundled Fox Plaza site, or benchmarks.site_consistency's site of one scenario (--scenario)")
+    parser.add_argument("--site", choices=("fox_plaza", "fox_plaza_ruptures", "scenario"), default="fox_plaza",
+                        help="the bundled Fox Plaza site; its stand-in ruptures at --vs30 as a site of ruptures (exact conditional spectra); "
+                             "or benchmarks.site_consistency's site of one scenario (--scenario)")
     parser.add_argument("--scenario", nargs=4, metavar=("M", "R_KM", "MECHANISM", "RATE"), default=list(SCENARIO))
     parser.add_argument("--vs30", type=float, default=400.0,
                         help="--site fox_plaza: the Vs30 assumed (m/s), its scenarios fitted at it (default %(default)s; benchmarks.site_condition)")
@@ -462,11 +469,14 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--estimator", choices=("lognormal", "fragility"), default="lognormal",
                         help="measure_free and table: each measure's g* from a lognormal demand per stripe (default) or the risk chain's fragility fits")
     arguments = parser.parse_args(argv)
-    if arguments.site != "fox_plaza" and arguments.vs30 != 400.0:
+    if arguments.site == "scenario" and arguments.vs30 != 400.0:
         parser.error("--vs30: Fox Plaza's assumed Vs30; the site of one scenario takes its own in --scenario's site")
-    if arguments.site == "fox_plaza":
+    if arguments.site != "scenario":
         check_site_vs30(parser, "--vs30", arguments.vs30)
-    site = fox_plaza_site(arguments.vs30) if arguments.site == "fox_plaza" else parse_scenario_site(parser, arguments.scenario)
+    if arguments.site == "fox_plaza_ruptures" and arguments.action == "run" and arguments.sampling != "scenario":
+        parser.error("--sampling: a site of ruptures draws each stripe's simulated motions from its causal ruptures: --sampling scenario")
+    site = (fox_plaza_site(arguments.vs30) if arguments.site == "fox_plaza" else fox_plaza_ruptures_site(arguments.vs30)
+            if arguments.site == "fox_plaza_ruptures" else parse_scenario_site(parser, arguments.scenario))
     arguments.measures = site_measures(parser, site, arguments.measures)
     if arguments.write and site is not FOX_PLAZA:
         parser.error("--write: the section is Fox Plaza's study at Vs30 400 m/s; print another site's tables without it")

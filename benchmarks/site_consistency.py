@@ -145,20 +145,37 @@ class Site:
     derived: tuple[str, ...] = ()
     """The measures whose curve is not the site's own but derived; a fitted scenario reads it from a file beside the experiment
     (:func:`derived_curve_file`)."""
+    files: tuple[tuple[str, str], ...] = ()
+    """Files the ``table`` names, as (name, text), written beside every experiment (a site of ruptures' rupture table)."""
 
     def derived_curve_file(self, measure: str) -> str:
         """The file name of the derived curve of ``measure``, beside the experiment."""
         return f"{self.name}_{experiment_file(Path('.'), measure).stem}.csv"
 
+    def companion_files(self, measure: str) -> dict[str, str]:
+        """The files an experiment of ``measure`` at the site reads beside it, by name: :attr:`files` and a derived curve's."""
+        files = dict(self.files)
+        if measure in self.derived:
+            files[self.derived_curve_file(measure)] = curve_file_text(self.hazard(measure))
+        return files
+
+
+@lru_cache(maxsize=4)
+def fox_plaza_ruptures(vs30: float) -> tuple[np.ndarray, RuptureSite]:
+    """Fox Plaza's stand-in ruptures at ``vs30`` (m/s): :func:`benchmarks.site_condition.fit_ruptures` on its 17 curves within the
+    site-motion model's range, and ln(recomputed / site) at every fitted point of the curves."""
+    from benchmarks.site_condition import fit_ruptures, site_curves
+
+    error, _, ruptures = fit_ruptures(vs30, site_curves(), name=f"fox_plaza_fitted_vs30_{vs30:g}")
+    return error, ruptures
+
 
 @lru_cache(maxsize=4)
 def fox_plaza_sa_avg(vs30: float) -> HazardCurve:
     """Fox Plaza's hazard of :data:`SA_AVG`, DERIVED: no curve of it is published for the site, so it is the curve of the ruptures
-    fitted to the site's 17 curves at ``vs30`` (m/s; :func:`benchmarks.site_condition.fit_ruptures`, the stand-in whose answer without
-    a measure referees the measures), with that provenance."""
-    from benchmarks.site_condition import fit_ruptures, site_curves
-
-    error, _, ruptures = fit_ruptures(vs30, site_curves(), name=f"fox_plaza_fitted_vs30_{vs30:g}")
+    fitted to the site's 17 curves at ``vs30`` (m/s; :func:`fox_plaza_ruptures`, the stand-in whose answer without a measure referees
+    the measures), with that provenance."""
+    error, ruptures = fox_plaza_ruptures(vs30)
     curve = ruptures.hazard_curve(*MEASURE_ARGS[SA_AVG])
     curve.source = (f"Fox Plaza (Los Angeles), {SA_AVG} in g, DERIVED: the hazard of the {len(ruptures)} ruptures whose NGA-West2 curves "
                     f"give back the site's 17 bundled curves at Vs30 {vs30:g} m/s (rms {np.sqrt(np.mean(error ** 2)):.2f} in ln rate; "
@@ -183,6 +200,36 @@ def curve_file_text(curve: HazardCurve) -> str:
 #: PSA(T1)'s to them and its own; Sa_avg's to them and its derived curve (:func:`fox_plaza_sa_avg`), written beside the experiment.
 FOX_PLAZA = Site("fox_plaza", partial(_fox_plaza_hazard, 400.0), '[site]\nscenario = "fitted"\ncurves = [' + ", ".join(f'"{name}"' for name in CURVES) +
                  ']\nvs30 = 400.0\nmechanism = "reverse"\n', RETURN_PERIODS, (*MEASURES, SA_AVG), derived=(SA_AVG,))
+
+
+def rupture_table_text(ruptures: RuptureSite) -> str:
+    """A site of ruptures as a rupture table file: its source in the comment lines, its site fields, one row per rupture (every
+    number written exactly, so the file reads back as the same site)."""
+    from stochpound.analysis import RUPTURE_COLUMNS
+
+    lines = [f"# {line}" for line in (ruptures.source or ruptures.name).splitlines()]
+    lines += [f"# {key}: {float(value)!r}" for key, value in ruptures.site_fields().items() if value is not None]
+    lines.append(",".join(("name", *RUPTURE_COLUMNS)))
+    for index, name in enumerate(ruptures.names):
+        row = ruptures.row(index)
+        lines.append(",".join([name, *(row[column] if isinstance(row[column], str) else repr(float(row[column])) for column in RUPTURE_COLUMNS)]))
+    return "\n".join(lines) + "\n"
+
+
+def fox_plaza_ruptures_site(vs30: float = 400.0) -> Site:
+    """Fox Plaza's stand-in ruptures at ``vs30`` (m/s; :func:`fox_plaza_ruptures`) as a site of ruptures: every measure's curve is
+    theirs, the stripes' targets their exact conditional spectra (``[site] ruptures``, the table written beside the experiment),
+    the pool's simulated motions their causal ruptures', and the answer without a measure the same ruptures'. What is left of the
+    measures' parting there is the chain's, not the fitted scenario's."""
+    _, ruptures = fox_plaza_ruptures(float(vs30))
+    name = f"{ruptures.name}.csv"
+
+    def hazard(measure: str) -> HazardCurve:
+        kind, period = MEASURE_ARGS[measure]
+        return ruptures.hazard_curve(kind, period)
+
+    return Site(f"fox_plaza_ruptures_vs30_{vs30:g}", hazard, f'[site]\nruptures = "{name}"\n', RETURN_PERIODS, tuple(MEASURE_ARGS), ruptures,
+                files=((name, rupture_table_text(ruptures)),))
 
 
 def fox_plaza_site(vs30: float = 400.0) -> Site:
@@ -261,8 +308,8 @@ def measure_risk(folder: Path, measure: str, configuration: str, bootstrap: int 
     from stochpound.experiment import load_experiment, run_experiment
 
     path = experiment_file(folder, measure)
-    if measure in site.derived:
-        (folder / site.derived_curve_file(measure)).write_text(curve_file_text(site.hazard(measure)))
+    for name, text in site.companion_files(measure).items():
+        (folder / name).write_text(text)
     path.write_text(experiment_text(measure, configuration, seed, return_periods, site, pool))
     report = run_experiment(load_experiment(path), workers=0, progress=False, checkpoint=float("inf"))  # no store written mid-run: read at the end only
     if not report.complete:

@@ -265,3 +265,24 @@ def test_fox_plaza_s_sa_avg_is_fitted_to_its_derived_curve_read_from_a_file_besi
     assert {scenario["vs30"] for scenario in definition["intensity"]["site"]} == {300.0}
     read = HazardCurve.from_file(tmp_path / name)
     np.testing.assert_array_equal(read.rate, soft.hazard(SA_AVG).rate)  # the file holds the curve's numbers exactly
+
+
+def test_fox_plaza_s_stand_in_ruptures_are_a_site_of_ruptures_whose_table_reads_back_as_the_same_site(tmp_path, capsys) -> None:
+    """``--site fox_plaza_ruptures``: the ruptures fitted to Fox Plaza's curves, written as a rupture table beside the experiment,
+    read back as the very site (the targets' exact conditional spectra and the answer without a measure are of the same ruptures);
+    its stripes' simulated motions come from their causal ruptures, so a tilted pool is refused before anything runs."""
+    import tomllib
+
+    from benchmarks.site_consistency import Pool, experiment_text, fox_plaza_ruptures_site
+    from stochpound.analysis import RuptureSite
+    from stochpound.experiment._spec import parse_experiment
+
+    site = fox_plaza_ruptures_site(400.0)
+    (name, text), = site.companion_files("PSA(2 s)").items()
+    (tmp_path / name).write_text(text)
+    assert RuptureSite.from_file(tmp_path / name) == site.ruptures and "vs30: 400.0" in text
+    definition = parse_experiment(tomllib.loads(experiment_text("PSA(2 s)", "isolated", 1, site=site, pool=Pool(40, 200, 3))), tmp_path)
+    assert definition["site"] == {"scenario": "ruptures", "ruptures": name}
+    with pytest.raises(SystemExit):
+        measure_seeds.main(["run", str(tmp_path), "--site", "fox_plaza_ruptures"])
+    assert "--sampling: a site of ruptures draws" in capsys.readouterr().err
