@@ -74,7 +74,7 @@ def test_reduced_held_out_check_against_nga_west2():
 
 
 def test_the_tail_section_states_whether_the_ratios_are_within_the_band():
-    result = {"site": "demo_three_sources", "n": 10, "seed": 11, "return_periods": [475.0, 2475.0], "names": ["a", "b"],
+    result = {"site": "demo_three_sources", "n": 10, "seed": 11, "periods": [None, 1.0], "return_periods": [475.0, 2475.0], "names": ["a", "b"],
               "levels": np.full((2, 2), 0.5), "hazard": np.full((2, 2), 1e-3), "ratio": np.array([[1.0, 0.9], [1.1, 1.2]]),
               "low": np.full((2, 2), 0.7), "high": np.full((2, 2), 1.4), "largest_share": [["a", "b"], ["a", "a"]]}
     met = tail_section(result, INFO, 60.0)
@@ -96,6 +96,6 @@ def test_reduced_tail_check_on_the_hanging_wall():
     epsilons = np.array([0.0, 1.0, 2.0])
     levels = np.array([np.exp(site.moments(measure, period)[0][0] + epsilons * site.moments(measure, period)[1][0])
                        for measure, period in (("pga", None), ("psa", 1.0))])
-    counted = rupture_exceedance(site, 300, 11, levels)[0]
+    counted = rupture_exceedance(site, 300, 11, levels, periods=(None, 1.0))[0]
     expected = np.array([0.5 * math.erfc(e / math.sqrt(2.0)) for e in epsilons])[None, :]
     assert np.all(np.abs(counted - expected) <= 3.0 * np.sqrt(expected * (1.0 - expected) / 300))
