@@ -22,7 +22,7 @@ from typing import Any
 from stochpound._errors import IntensityError, SiteError
 from stochpound.hazard._curve import HazardCurve, bundled_curves, bundled_measure
 from stochpound.hazard._setting import read_stated, stated_curve, stated_fields
-from stochpound.motions import Measure
+from stochpound.motions import DEFAULT_G, Measure
 from stochpound.store import TomlTable
 
 ENTRY_KEYS = ("file", "measure", "period", "periods", "damping", "units", "investigation_time", "site")
@@ -68,7 +68,7 @@ def site_curve(entry: Any, base_dir: Path, where: str) -> tuple[Measure, HazardC
                             f"{read.stated.units}; convert them")
         if measure.damping is not None and measure.damping != MODEL_DAMPING:
             raise SiteError(f"{where}.damping: the NGA-West2 models give 5 % damped spectra only (0.05), got {measure.damping!r}")
-        return measure, stated_curve(read, path, "g", 1.0, investigation_time, False, measure.description, where)
+        return measure, stated_curve(read, path, "g", DEFAULT_G, investigation_time, False, measure.description, where)
     except SiteError:
         raise
     except IntensityError as error:
