@@ -165,11 +165,15 @@ def test_bad_fitted_site_is_one_line_naming_the_field(tmp_path, site: str, field
     assert str(error.value).startswith(field) and "\n" not in str(error.value)
 
 
+def _write_curve(path, curve: HazardCurve, header: str) -> None:
+    """``curve`` written as a user's hazard-curve file at ``path``, its numbers exactly, after ``header`` (its '#' lines)."""
+    rows = "\n".join(f"{float(x)!r},{float(y)!r}" for x, y in zip(curve.im, curve.rate))
+    path.write_text(f"{header}im,rate\n{rows}\n")
+
+
 def _copy_curve(tmp_path, name: str, header: str) -> str:
     """A bundled curve written as a user's hazard-curve file with ``header`` (its '#' lines), in ``tmp_path``; its file name."""
-    curve = HazardCurve.bundled(name)
-    rows = "\n".join(f"{float(x)!r},{float(y)!r}" for x, y in zip(curve.im, curve.rate))
-    (tmp_path / f"{name}.csv").write_text(f"{header}im,rate\n{rows}\n")
+    _write_curve(tmp_path / f"{name}.csv", HazardCurve.bundled(name), header)
     return f"{name}.csv"
 
 
@@ -196,7 +200,7 @@ def test_a_fitted_site_conditions_on_sa_avg_from_a_curve_file_stating_its_period
     periods = (0.5, 1.0, 2.0)
     site = RuptureSite.from_scenarios([(Scenario_of(7.0, 20.0), 0.01), (Scenario_of(6.0, 10.0), 0.05)], name="two")
     curve = site.hazard_curve("sa_avg", periods)
-    (tmp_path / "sa_avg.csv").write_text("# Sa_avg of two ruptures\nim,rate\n" + "\n".join(f"{float(x)!r},{float(y)!r}" for x, y in zip(curve.im, curve.rate)) + "\n")
+    _write_curve(tmp_path / "sa_avg.csv", curve, "# Sa_avg of two ruptures\n")
     entry = '{ file = "sa_avg.csv", measure = "sa_avg", periods = [0.5, 1.0, 2.0], damping = 0.05, units = "g" }'
     levels = curve.intensity_at(np.array([1 / 100.0, 1 / 1000.0]))
     selection = (f'measure = "sa_avg"\nperiods = [0.5, 1.0, 2.0]\nlevels = [{levels[0]:.4f}, {levels[1]:.4f}]\n'
