@@ -32,6 +32,7 @@ that any scenario in the range has its layer.
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
+from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
@@ -74,8 +75,12 @@ FIT_SCENARIOS: tuple[tuple[float, float, float, str], ...] = SCENARIOS + (
 #: nearly independent). Narrowed, they leave most of the σ of ln Sa to the shape layer, whose correlation the fit sets;
 #: the durations (D5–95, t_mid) keep their published spread (docs/site-motions.md).
 RESIDUAL_SCALE: dict[str, float] = {"arias_intensity": 0.5, "d5_95": 1.0, "t_mid": 1.0, "f_mid": 0.4, "f_slope": 0.4, "zeta_f": 0.4}
-#: Fixed-point iterations of the fit (each simulates every scenario's motions once).
+#: Fixed-point iterations of the fit on every scenario's own layer (each simulates every scenario's motions once).
 ITERATIONS = 6
+#: Fixed-point iterations after them on the regressions' layer (each simulates every scenario's motions once).
+REGRESSED_ITERATIONS = 2
+#: The name a calibration fitted by :func:`fit_calibration` carries (stores name the calibration their motions came from).
+CALIBRATION_NAME = "nga_west2_calibration_4"
 #: Ridge weight of the shape layer's regressions (per coefficient, the intercept free).
 RIDGE = 1e-3
 #: Motions simulated at a time where only their spectra are kept (memory: 8 n_time bytes a motion).
@@ -193,36 +198,60 @@ def _ridge(features: np.ndarray, values: np.ndarray) -> np.ndarray:
     return np.linalg.solve(features.T @ features + penalty, features.T @ values).T
 
 
-def fit_calibration(n: int = 200, seed: int = 7, dt: float = 0.01, scenarios: Sequence[tuple] = FIT_SCENARIOS,
-                    iterations: int = ITERATIONS) -> dict:
-    """Fit the spectral-shape layer (module docstring) on ``n`` motions of every scenario; its coefficients and diagnostics."""
-    base, k = base_model(), len(SHAPE_PERIODS)
+def _draw_all(base: SiteModel, scenarios: Sequence[tuple], gains: np.ndarray, spreads: np.ndarray, cholesky: np.ndarray, n: int,
+              seed: int, dt: float, workers: int) -> list[np.ndarray]:
+    """ln Sa [n, SHAPE_PERIODS] of every scenario's motions through its layer (scenario i: realizations of seed + 1000 i), on ``workers`` processes."""
     shape_columns = [CHECK_PERIODS.index(p) for p in SHAPE_PERIODS]
+    jobs = [(base, s, gains[i], spreads[i], cholesky, n, seed + 1000 * i, dt) for i, s in enumerate(scenarios)]
+    if workers <= 1:
+        return [_shape_draw(*job)[:, shape_columns] for job in jobs]
+    with ProcessPoolExecutor(workers) as pool:
+        return [ln_sa[:, shape_columns] for ln_sa in pool.map(_shape_draw, *zip(*jobs))]
+
+
+def _regressed_layer(x: np.ndarray, targets: list, gains: np.ndarray, variances: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The regressions of r = μ − gain and v = σ² − d² (:func:`_ridge`), and the mean gains and spreads they give at the scenarios."""
+    mean, sigma = (np.array([t[k] for t in targets]) for k in (0, 1))
+    r_coefficients, v_coefficients = _ridge(x, mean - gains), _ridge(x, sigma**2 - variances)
+    return r_coefficients, v_coefficients, mean - x @ r_coefficients.T, np.sqrt(np.maximum(sigma**2 - x @ v_coefficients.T, 0.0))
+
+
+def fit_calibration(n: int = 400, seed: int = 7, dt: float = 0.01, scenarios: Sequence[tuple] = FIT_SCENARIOS,
+                    iterations: int = ITERATIONS, regressed_iterations: int = REGRESSED_ITERATIONS, workers: int = 1) -> dict:
+    """Fit the spectral-shape layer (module docstring) on ``n`` motions of every scenario; its coefficients and diagnostics.
+
+    The first ``iterations`` move every scenario's own layer; the ``regressed_iterations`` after them simulate every
+    scenario through the regressions' layer and move the data the regressions are fitted to by that layer's misses, so
+    that the misses left are the regressions' own, not only the scenarios'. ``workers`` processes share the scenarios
+    (the numbers do not depend on how many).
+    """
+    base, k = base_model(), len(SHAPE_PERIODS)
     targets = [target(s, SHAPE_PERIODS) for s in scenarios]
+    x = np.array([shape_features(Scenario(*s)) for s in scenarios])
     bj = _node_correlation(list(SHAPE_PERIODS))
-    gains, spreads = np.zeros((len(scenarios), k)), np.zeros((len(scenarios), k))
+    gains, variances = np.zeros((len(scenarios), k)), np.zeros((len(scenarios), k))  # the data: mean gain and d² of every scenario
     correlation, history = np.eye(k), []
-    for iteration in range(iterations):
-        cholesky = np.linalg.cholesky(correlation)
-        changes, misses = [], []
-        for i, scenario in enumerate(scenarios):
-            ln_sa = _shape_draw(base, scenario, gains[i], spreads[i], cholesky, n, seed + 1000 * i, dt)[:, shape_columns]
+    for iteration in range(iterations + regressed_iterations):
+        used_gains, used_spreads = gains, np.sqrt(np.maximum(variances, 0.0))
+        if iteration >= iterations:
+            *_, used_gains, used_spreads = _regressed_layer(x, targets, gains, variances)
+        draws = _draw_all(base, scenarios, used_gains, used_spreads, np.linalg.cholesky(correlation), n, seed, dt, workers)
+        wanted, spread_products, misses = np.zeros((k, k)), np.zeros((k, k)), []
+        for i, ln_sa in enumerate(draws):
             mean, sigma = targets[i]
             covariance = np.cov(ln_sa.T)
             simulated = np.sqrt(np.diag(covariance))
             misses.append((np.max(np.abs(ln_sa.mean(axis=0) - mean)), np.max(np.abs(simulated - sigma))))
             gains[i] += mean - ln_sa.mean(axis=0)
-            old = spreads[i].copy()
-            spreads[i] = np.sqrt(np.maximum(spreads[i] ** 2 + sigma**2 - simulated**2, 0.0))
-            wanted = bj * np.outer(sigma, sigma) - covariance + np.outer(old, old) * correlation  # the shape layer's covariance wanted
-            changes.append((wanted, np.outer(spreads[i], spreads[i])))
-        numerator = sum(w for w, _ in changes)
-        denominator = sum(d for _, d in changes)
-        correlation = nearest_correlation(np.where(denominator > 1e-3, numerator / np.maximum(denominator, 1e-3), np.eye(k)))
+            variances[i] += sigma**2 - simulated**2
+            if iteration < iterations:
+                variances[i] = np.maximum(variances[i], 0.0)
+            spread = np.sqrt(np.maximum(variances[i], 0.0))
+            wanted += bj * np.outer(sigma, sigma) - covariance + np.outer(used_spreads[i], used_spreads[i]) * correlation
+            spread_products += np.outer(spread, spread)
+        correlation = nearest_correlation(np.where(spread_products > 1e-3, wanted / np.maximum(spread_products, 1e-3), np.eye(k)))
         history.append([float(np.max([m[0] for m in misses])), float(np.max([m[1] for m in misses]))])
-    x = np.array([shape_features(Scenario(*s)) for s in scenarios])
-    means = np.array([t[0] for t in targets]) - gains
-    variances = np.array([t[1] ** 2 for t in targets]) - spreads**2
-    return {"periods": list(SHAPE_PERIODS), "mean": _ridge(x, means).tolist(), "variance": _ridge(x, variances).tolist(),
+    r_coefficients, v_coefficients, *_ = _regressed_layer(x, targets, gains, variances)
+    return {"name": CALIBRATION_NAME, "periods": list(SHAPE_PERIODS), "mean": r_coefficients.tolist(), "variance": v_coefficients.tolist(),
             "correlation": correlation.tolist(), "residual_scale": dict(RESIDUAL_SCALE), "history": history, "n": n, "seed": seed,
-            "iterations": iterations, "scenarios": [list(s) for s in scenarios]}
+            "iterations": iterations, "regressed_iterations": regressed_iterations, "scenarios": [list(s) for s in scenarios]}
