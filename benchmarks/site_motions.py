@@ -175,7 +175,7 @@ def write_calibration(fit: dict[str, Any], elapsed: float) -> Path:
         "sigma_ln = 0.0",
         "",
         "[spectral_shape]  # ln gain at periods T_j: mu_j - mean_j . x + sqrt(max(sigma_j^2 - variance_j . x, 0)) (L z)_j, L L' = correlation;",
-        "# x = [1, M - 7, ln(R/25), ln(Vs30/750), reverse, normal, (M - 7)^2, (M - 7) ln(R/25), ln(R/25)^2, ln(Vs30/750)^2]",
+        "# x = [1, M - 7, ln(R/25), ln(Vs30/750), reverse, normal, (M - 7)^2, (M - 7) ln(R/25), ln(R/25)^2, ln(Vs30/750)^2, ln(R/25) ln(Vs30/750)]",
         f"periods = [{', '.join(f'{p:g}' for p in fit['periods'])}]",
         "mean = [", *_rows(fit["mean"]), "]",
         "variance = [", *_rows(fit["variance"]), "]",

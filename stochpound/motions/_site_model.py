@@ -77,8 +77,8 @@ ZETA_MAX = 0.95
 IRF_TOLERANCE = 1e-4
 #: Features of the calibration's adjustments: 1, M − 7, ln(R/25), ln(Vs30/750), reverse, normal, (M − 7)², (M − 7) ln(R/25).
 FEATURES = ("intercept", "magnitude", "ln_distance", "ln_vs30", "reverse", "normal", "magnitude_squared", "magnitude_ln_distance")
-#: Features of the spectral-shape layer's regressions: FEATURES, then ln(R/25)² and ln(Vs30/750)².
-SHAPE_FEATURES = FEATURES + ("ln_distance_squared", "ln_vs30_squared")
+#: Features of the spectral-shape layer's regressions: FEATURES, then ln(R/25)², ln(Vs30/750)² and ln(R/25) ln(Vs30/750).
+SHAPE_FEATURES = FEATURES + ("ln_distance_squared", "ln_vs30_squared", "ln_distance_ln_vs30")
 
 
 @dataclass(frozen=True)
@@ -231,6 +231,8 @@ def _shape(table: Mapping[str, list]) -> SpectralShape:
     """The calibration file's ``[spectral_shape]`` table: periods, the base's mean and variance regressions, the gains' correlation."""
     if tuple(table["periods"]) != SHAPE_PERIODS:  # pragma: no cover - the data file's own consistency
         raise ValueError(f"{CALIBRATION_FILE}: spectral_shape.periods must be {SHAPE_PERIODS}")
+    if any(len(row) != len(SHAPE_FEATURES) for row in (*table["mean"], *table["variance"])):  # pragma: no cover - the same
+        raise ValueError(f"{CALIBRATION_FILE}: spectral_shape.mean and .variance need one coefficient per feature {SHAPE_FEATURES}")
     return SpectralShape(tuple(float(p) for p in table["periods"]), np.array(table["mean"], dtype=float),
                          np.array(table["variance"], dtype=float), np.linalg.cholesky(np.array(table["correlation"], dtype=float)))
 
@@ -238,7 +240,7 @@ def _shape(table: Mapping[str, list]) -> SpectralShape:
 def shape_features(scenario: Scenario) -> np.ndarray:
     """The spectral-shape layer's features (:data:`SHAPE_FEATURES`) of a scenario."""
     x = scenario_features(scenario)
-    return np.concatenate([x, [x[2] ** 2, x[3] ** 2]])
+    return np.concatenate([x, [x[2] ** 2, x[3] ** 2, x[2] * x[3]]])
 
 
 def shape_gains(shape: SpectralShape, scenario: Scenario) -> tuple[np.ndarray, np.ndarray]:
