@@ -9,7 +9,9 @@ import pytest
 import xarray as xr
 
 from stochpound.experiment import _stripe_pools
-from stochpound.motions import Scenario, conditional_spectrum, response_spectrum, scenario_distribution, select_motions, selection_pool, site_motions
+from stochpound.motions import (
+    Scenario, conditional_spectrum, response_spectrum, scenario_distribution, select_motions, selection_pool, site_model_provenance, site_motions,
+)  # fmt: skip
 from stochpound.motions import _site_model
 from stochpound.motions._selection import array_pool, pool_intensity
 from stochpound.motions._spectrum import pseudo_spectra
@@ -19,7 +21,7 @@ SCENARIO = Scenario(6.5, 20.0, 400.0, "strike_slip")
 PERIODS = np.geomspace(0.05, 3.0, 12)
 G = 9.81
 TABLE = {"type": "site_motions", "magnitude": 6.5, "distance_km": 20.0, "vs30": 400.0, "mechanism": "strike_slip", "n": 48, "seed": 5,
-         "dt": 0.01, "model": "hazard_compatible", "calibration": "any"}
+         "dt": 0.01, "model": "hazard_compatible", "calibration": site_model_provenance("hazard_compatible")}
 
 
 @pytest.fixture(scope="module")
@@ -67,6 +69,17 @@ def test_the_pool_is_every_motion_of_the_table_with_its_realization(full_pool):
     again = _stripe_pools.table_accelerations(TABLE, [7, 30])
     np.testing.assert_array_equal(full_pool["psa"].values[[7, 30]], pseudo_spectra(again, 0.01, PERIODS) / G)
     np.testing.assert_array_equal(full_pool["intensity"].values[[7, 30]], pool_intensity(again, 0.01, "psa", 1.0, 0.05, G))
+
+
+def test_a_table_of_another_calibration_is_refused_not_regenerated_with_this_one():
+    """A store's table names the calibration its motions came from; another calibration's motions are not given in their place."""
+    from stochpound import SiteError
+
+    unnamed = {key: value for key, value in TABLE.items() if key != "calibration"}
+    np.testing.assert_array_equal(_stripe_pools.table_accelerations(TABLE, [3]), _stripe_pools.table_accelerations(unnamed, [3]))
+    stale = "rezaeian_der_kiureghian_2010 + nga_west2_calibration_3"
+    with pytest.raises(SiteError, match=r"^calibration: 'rezaeian_der_kiureghian_2010 \+ nga_west2_calibration_3' is not the calibration of model"):
+        _stripe_pools.table_accelerations({**TABLE, "calibration": stale}, [3])
 
 
 def test_the_screen_keeps_the_first_motions_and_every_one_beyond_its_level(monkeypatch, full_pool):

@@ -15,7 +15,7 @@ import pytest
 from stochpound.experiment import _stripe_pools
 from stochpound.experiment._spec import ExperimentError, parse_experiment
 from stochpound.model.scene_file import scene_from_dict
-from stochpound.motions import Scenario, parameter_normals, site_motions, site_motions_from_normals
+from stochpound.motions import Scenario, parameter_normals, site_model_provenance, site_motions, site_motions_from_normals
 from stochpound.motions import _site_model
 from stochpound.motions._site_motions import _after_parameters
 from stochpound.store import SimulatedMotions
@@ -126,7 +126,7 @@ def test_a_chosen_tilted_motion_is_regenerated_bit_for_bit_from_its_table_alone(
 
 
 def test_the_tilt_is_the_same_whatever_the_threads(monkeypatch):
-    setting = SimulatedMotions(8, "hazard_compatible", "x", 3, 0.01, "tilted")
+    setting = SimulatedMotions(8, "hazard_compatible", site_model_provenance(), 3, 0.01, "tilted")
     monkeypatch.setattr(_stripe_pools, "TILT_PILOT", 24)
     tilts = []
     for threads in (1, 2):
@@ -138,7 +138,7 @@ def test_the_tilt_is_the_same_whatever_the_threads(monkeypatch):
 def test_a_tilted_pool_centres_its_stripe_s_measure_on_the_level(monkeypatch):
     """64 tilted motions at a level of ε ≈ 2: their mean ln IM* lies within 3 standard errors of ln level, the untilted
     scenario's 4 or more below it (the check can fail)."""
-    setting = SimulatedMotions(64, "hazard_compatible", "x", 5, 0.01, "tilted")
+    setting = SimulatedMotions(64, "hazard_compatible", site_model_provenance(), 5, 0.01, "tilted")
     monkeypatch.setattr(_stripe_pools, "TILT_PILOT", 64)
     pilot = _stripe_pools.scenario_table(setting, SCENARIO, 64, 5)
     untilted = np.log(np.concatenate([i for _, _, i in _stripe_pools.table_chunks(pilot, "psa", 0.5, G)]))

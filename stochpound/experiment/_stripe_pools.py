@@ -198,9 +198,21 @@ def simulated_accelerations(sources: Sequence[MotionSource], duration: float | N
 
 
 def table_accelerations(table: Mapping[str, float | str], realizations: Sequence[int], duration: float | None = None) -> np.ndarray:
-    """The ground accelerations (m/s², one row per realization) of a simulated motions' table (:func:`simulated_accelerations`)."""
-    from stochpound.motions import site_motions
+    """The ground accelerations (m/s², one row per realization) of a simulated motions' table (:func:`simulated_accelerations`).
 
+    Raises
+    ------
+    SiteError
+        The table names a calibration other than its model's here (a store written with another calibration): its motions
+        cannot be regenerated, and other motions are not given in their place.
+    """
+    from stochpound._errors import SiteError
+    from stochpound.motions import site_model_provenance, site_motions
+
+    calibration = site_model_provenance(str(table["model"]))
+    if table.get("calibration", calibration) != calibration:
+        raise SiteError(f"calibration: {table['calibration']!r} is not the calibration of model {table['model']!r} here ({calibration!r}): "
+                        "the stored motions cannot be regenerated (run the experiment again, or use the stochpound that wrote it)")
     generated = site_motions(scenario=table_scenario(table), n=table["n"], seed=table["seed"], dt=table["dt"], model=table["model"],
                              realizations=list(realizations), duration=duration, normal_shift=table["normal_shift"] if "normal_shift" in table else None)
     return generated["acceleration"].values
