@@ -160,7 +160,8 @@ def write_calibration(fit: dict[str, Any], elapsed: float) -> Path:
         "# Hazard-compatible calibration of the Rezaeian & Der Kiureghian (2010) model (docs/site-motions.md).",
         "# Written by `python -m benchmarks site_motions calibrate` (stochpound.motions._site_calibration.fit_calibration):",
         f"# {fit['n']} motions per scenario (scenario i: realizations of seed {fit['seed']} + 1000 i), dt 0.01 s, {fit['iterations']} fixed-point",
-        f"# iterations on each scenario's own layer then {fit['regressed_iterations']} on the regressions' layer, against the NGA-West2 average (ASK14, BSSA14, CB14, CY14 in pygmm: mean of ln medians, rms of sigmas) and the",
+        f"# iterations on each scenario's own layer then {fit['regressed_iterations']} on the regressions' layer, against the NGA-West2 average "
+        "(ASK14, BSSA14, CB14, CY14 in pygmm: mean of ln medians, rms of sigmas) and the",
         f"# Baker-Jayaram (2008) correlation; commit {info['commit']}, {info['date']}, {elapsed:.0f} s. Largest |ln ratio| of medians /",
         f"# |sigma difference| over the fit's scenarios and shape periods at each iteration's simulation: {history}.",
         "# Scenarios (M, R_rup km, Vs30 m/s, mechanism): " + "; ".join(f"{s[0]:g} {s[1]:g} {s[2]:g} {s[3]}" for s in fit["scenarios"]),
