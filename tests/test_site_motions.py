@@ -302,3 +302,16 @@ def test_pga_and_the_short_periods_keep_their_sigma_and_their_correlation():
         i, j = (CHECK_PERIODS.index(p) for p in pair)
         bj = _node_correlation(list(pair))[0, 1]
         assert abs(np.corrcoef(pooled[:, i], pooled[:, j])[0, 1] - bj) <= 0.15 + 3 * (1 - bj**2) / math.sqrt(len(pooled)), pair
+
+
+def test_the_fit_is_the_same_on_one_or_two_processes_and_its_last_iterations_use_the_regressions():
+    """fit_calibration's numbers do not depend on its workers; with no iteration on the regressions' layer its
+    regressions are those of the scenarios' own layers, and one more iteration through the regressions changes them."""
+    from stochpound.motions._site_calibration import FIT_SCENARIOS, fit_calibration
+
+    small = {"n": 8, "scenarios": FIT_SCENARIOS[:3], "iterations": 1}
+    one, two = fit_calibration(**small, regressed_iterations=1, workers=1), fit_calibration(**small, regressed_iterations=1, workers=2)
+    assert (one["mean"], one["variance"], one["correlation"], one["history"]) == (two["mean"], two["variance"], two["correlation"], two["history"])
+    assert len(one["history"]) == 2 and one["regressed_iterations"] == 1
+    own = fit_calibration(**small, regressed_iterations=0)
+    assert own["history"] == one["history"][:1] and not np.allclose(own["mean"], one["mean"])
