@@ -156,7 +156,7 @@ class Site:
         """The files an experiment of ``measure`` at the site reads beside it, by name: :attr:`files` and a derived curve's."""
         files = dict(self.files)
         if measure in self.derived:
-            files[self.derived_curve_file(measure)] = curve_file_text(self.hazard(measure))
+            files[self.derived_curve_file(measure)] = self.hazard(measure).to_csv()
         return files
 
 
@@ -190,30 +190,10 @@ def _fox_plaza_hazard(vs30: float, measure: str) -> HazardCurve:
     return fox_plaza_sa_avg(vs30) if measure == SA_AVG else HazardCurve.bundled(MEASURES[measure])
 
 
-def curve_file_text(curve: HazardCurve) -> str:
-    """A hazard curve as stochpound's CSV file (its provenance in the comment lines, intensities in g)."""
-    comments = "".join(f"# {line}\n" for line in curve.source.splitlines())
-    return comments + "im,rate\n" + "".join(f"{float(x)!r},{float(y)!r}\n" for x, y in zip(curve.im, curve.rate))
-
-
 #: The bundled Fox Plaza site, the scenario fitted to its four curves (Vs30 and mechanism assumed: the curves state neither);
 #: PSA(T1)'s to them and its own; Sa_avg's to them and its derived curve (:func:`fox_plaza_sa_avg`), written beside the experiment.
 FOX_PLAZA = Site("fox_plaza", partial(_fox_plaza_hazard, 400.0), '[site]\nscenario = "fitted"\ncurves = [' + ", ".join(f'"{name}"' for name in CURVES) +
                  ']\nvs30 = 400.0\nmechanism = "reverse"\n', RETURN_PERIODS, (*MEASURES, SA_AVG), derived=(SA_AVG,))
-
-
-def rupture_table_text(ruptures: RuptureSite) -> str:
-    """A site of ruptures as a rupture table file: its source in the comment lines, its site fields, one row per rupture (every
-    number written exactly, so the file reads back as the same site)."""
-    from stochpound.analysis import RUPTURE_COLUMNS
-
-    lines = [f"# {line}" for line in (ruptures.source or ruptures.name).splitlines()]
-    lines += [f"# {key}: {float(value)!r}" for key, value in ruptures.site_fields().items() if value is not None]
-    lines.append(",".join(("name", *RUPTURE_COLUMNS)))
-    for index, name in enumerate(ruptures.names):
-        row = ruptures.row(index)
-        lines.append(",".join([name, *(row[column] if isinstance(row[column], str) else repr(float(row[column])) for column in RUPTURE_COLUMNS)]))
-    return "\n".join(lines) + "\n"
 
 
 def fox_plaza_ruptures_site(vs30: float = 400.0) -> Site:
@@ -229,7 +209,7 @@ def fox_plaza_ruptures_site(vs30: float = 400.0) -> Site:
         return ruptures.hazard_curve(kind, period)
 
     return Site(f"fox_plaza_ruptures_vs30_{vs30:g}", hazard, f'[site]\nruptures = "{name}"\n', RETURN_PERIODS, tuple(MEASURE_ARGS), ruptures,
-                files=((name, rupture_table_text(ruptures)),))
+                files=((name, ruptures.to_csv()),))
 
 
 def fox_plaza_site(vs30: float = 400.0) -> Site:

@@ -249,7 +249,7 @@ def test_fox_plaza_s_sa_avg_is_fitted_to_its_derived_curve_read_from_a_file_besi
     curves, at the site's own Vs30 (300 m/s: the curve of that Vs30's ruptures, not 400's)."""
     import tomllib
 
-    from benchmarks.site_consistency import FOX_PLAZA, SA_AVG, curve_file_text, experiment_text, fox_plaza_site
+    from benchmarks.site_consistency import FOX_PLAZA, SA_AVG, experiment_text, fox_plaza_site
     from stochpound.analysis import HazardCurve
     from stochpound.experiment._spec import parse_experiment
 
@@ -257,7 +257,7 @@ def test_fox_plaza_s_sa_avg_is_fitted_to_its_derived_curve_read_from_a_file_besi
     assert SA_AVG in FOX_PLAZA.measures and SA_AVG in soft.derived
     assert not (soft.hazard(SA_AVG).rate == FOX_PLAZA.hazard(SA_AVG).rate).all()
     name = soft.derived_curve_file(SA_AVG)
-    (tmp_path / name).write_text(curve_file_text(soft.hazard(SA_AVG)))
+    soft.hazard(SA_AVG).to_csv(tmp_path / name)
     text = experiment_text(SA_AVG, "isolated", 1, site=soft)
     assert f'file = "{name}", measure = "sa_avg"' in text
     definition = parse_experiment(tomllib.loads(text), tmp_path)

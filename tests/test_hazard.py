@@ -102,3 +102,14 @@ def test_bad_tables_name_the_field(im, rate, field):
 def test_bad_arguments_name_the_field(call, field):
     with pytest.raises(ValueError, match=f"^{field}"):
         call()
+
+
+def test_a_curve_written_as_csv_reads_back_as_the_same_table(tmp_path):
+    """HazardCurve.to_csv writes what from_file reads: the same intensities and rates to the bit, and the provenance."""
+    curve = HazardCurve.bundled(bundled_curves()[0])
+    path = tmp_path / "again.csv"
+    assert curve.to_csv(path) is None and path.read_text() == curve.to_csv()
+    again = HazardCurve.from_file(path)
+    assert again.im.tolist() == curve.im.tolist() and again.rate.tolist() == curve.rate.tolist() and again.source == curve.source
+    with pytest.raises(ValueError, match="^to_csv: a power law has no table"):
+        HazardCurve.power_law(1e-3, 2.5).to_csv()

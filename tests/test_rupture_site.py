@@ -361,3 +361,13 @@ def test_a_run_of_a_site_of_ruptures_stores_and_reports_the_mixture(tmp_path, de
     assert store.pound.hazard.source == "ruptures"
     words = " ".join(block.text for block in intensity_section("ruptures", store).blocks if isinstance(block, Paragraph))
     assert f"0.2 g: the ruptures' mean M {store.site_magnitude.values[1]:.3g} at {store.site_distance_km.values[1]:.3g} km" in words
+
+
+def test_a_site_written_as_a_rupture_table_reads_back_as_the_same_site(tmp_path):
+    """RuptureSite.to_csv writes what from_file reads: the same ruptures (every column, exactly), names, site fields and source."""
+    site = RuptureSite.bundled("demo_three_sources", vs30=400.0)
+    path = tmp_path / "again.csv"
+    assert site.to_csv(path) is None and path.read_text() == site.to_csv()
+    again = RuptureSite.from_file(path, name=site.name)
+    assert again.to_entry() == site.to_entry()
+    assert again.hazard_curve("psa", 1.0).rate.tolist() == site.hazard_curve("psa", 1.0).rate.tolist()

@@ -167,6 +167,34 @@ class HazardCurve:
         return cls(im, rate, extrapolate=extrapolate, measure=measure, units=units,
                    source="\n".join(comments) or str(path))
 
+    def to_csv(self, path: str | Path | None = None) -> str | None:
+        """The table as the CSV file :meth:`from_file` reads back (the same intensities, rates and ``source``).
+
+        Parameters
+        ----------
+        path : str or Path, optional
+            Where to write it; without it the text is returned.
+
+        Returns
+        -------
+        str or None
+            The file's text (``source`` as ``#`` comment lines, a header ``im,rate``, one row per intensity, every
+            number written exactly), or None once written to ``path``.
+
+        Raises
+        ------
+        ValueError
+            A power law (:meth:`power_law`): it has no table.
+        """
+        if self.power is not None:
+            raise ValueError("to_csv: a power law has no table to write (HazardCurve.power_law)")
+        text = "".join(f"# {line}\n" for line in self.source.splitlines())
+        text += "im,rate\n" + "".join(f"{float(x)!r},{float(y)!r}\n" for x, y in zip(self.im, self.rate))
+        if path is None:
+            return text
+        Path(path).write_text(text)
+        return None
+
     @classmethod
     def bundled(cls, name: str, *, extrapolate: bool = False) -> HazardCurve:
         """A hazard curve shipped with stochpound (``data/hazard/<name>.csv``; :func:`~stochpound.analysis.bundled_curves` lists them)."""
