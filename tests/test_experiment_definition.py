@@ -53,6 +53,10 @@ IDENTITIES = {
     "88dc01b72bd04d6cc226d840a04e24e42421faa9c2bb9dc91a42aab11c0fbfde": "1c1c4b385d2565d2acbc4cbeaa272192f8711728fdffad85425e17a0a5896d41",  # experiments/risk/isolated.toml ([design])
     "76706a47b9ed8d9b9c00281719f78adbbf7cc7ecaa91ed77f8fc343f9cafa29d": "4258c4eeb0c817062b1559066dd537d4c3acf1a9335728732bda3c4116274969",  # experiments/risk/fixed_pair.toml (calibration 3)
     "a9c66c0e67c4e663ca9e1a34a5de92a19ee03c1d8baacb45bb4cf61b70167667": "dab82088050ceca0dcd40466dc94da4533d36efdfff06e7f1145108398b5b3b9",  # experiments/risk/isolated.toml (calibration 3)
+    # calibration 4 of the site motions: the definitions name it, so these files' stores of calibration 3 are refused
+    "3fd94462383c2c24ee90e370f9f660432ad80b2a147abbcefbc4f63eac0b23b9": "80a800da40b90acc89555feacef32267181a67014591281f7558f1066b61d0d5",  # experiments/risk/fixed_pair.toml (calibration 4)
+    "f92271bfab4de9cbe54273e9251be8f1481ef9bedc9860afe355b5bfabb6cfaf": "e221f41b4391da05a806a8dd4e30fb896c6f56bfa28574aabd89e50c53a4ba9b",  # experiments/risk/isolated.toml (calibration 4)
+    "2795ab6e166ac0bb0c81264023f74f552426266b1da168551c05111afd5cda99": "1d806055c86a373833f66b75190ab07ef6258b322cbe6f6ff55925b6903153f5",  # stochastic/scenario_m7_20km.toml (calibration 4)
     "6721b840847f3c887a64063a94280b5d169110c60ef231755da91b89a8300078": "d63aa13f0c17c62515a7f33d09c8af15f2d12f6063f66110f23227a68f70937f",  # experiments/study/gap_study.toml (declares reproduces)
     "2991b119a5949c2c82f9b2fe3c5ea23ba8308484f5adbaf6202633df2547e55f": "0fee6ef18974eda7fe49d0fa885cd06ca430f684281d7e09d9aa13ae02729a4e",  # experiments/study/harmonic.toml (declares reproduces)
     "b7cb8955ddf0e1110227ccc8d346f24b89c5f33cd69da9d0bcda4bfe1400fd19": "dc1f1332c3bbb0688ce5cc07bf78b719f5f9f549de5f0725493b705c41748dec",  # experiments/study/pair_mu.toml (declares reproduces)
@@ -75,6 +79,8 @@ HAZARD_IDENTITIES = {
     "88dc01b72bd04d6cc226d840a04e24e42421faa9c2bb9dc91a42aab11c0fbfde": "9364efe22b86c445b311bde449ccf19393a749628c5f0f6e9f4cff43e66a9a41",  # experiments/risk/isolated.toml ([design])
     "76706a47b9ed8d9b9c00281719f78adbbf7cc7ecaa91ed77f8fc343f9cafa29d": "f30423076bf791f10e274b0f0743bda704505337bda66785bf6631aedaf67b47",  # experiments/risk/fixed_pair.toml (calibration 3)
     "a9c66c0e67c4e663ca9e1a34a5de92a19ee03c1d8baacb45bb4cf61b70167667": "1190d4e22c8eaa71ec0e300d71dc4c348397c36780196be326b7c93f305de0ae",  # experiments/risk/isolated.toml (calibration 3)
+    "3fd94462383c2c24ee90e370f9f660432ad80b2a147abbcefbc4f63eac0b23b9": "4fe970ab06ea26a4a9f36d1b5471df56e80d0360ded99b62e91a6b450eac5e03",  # experiments/risk/fixed_pair.toml (calibration 4)
+    "f92271bfab4de9cbe54273e9251be8f1481ef9bedc9860afe355b5bfabb6cfaf": "fa04f6d5fb7b0ea7dbfe90b50324099a7bc2542d288e341f259d7a2976910475",  # experiments/risk/isolated.toml (calibration 4)
 }
 
 

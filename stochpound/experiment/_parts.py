@@ -182,6 +182,19 @@ def read_part(path: Path, names: Sequence[str] | None = None) -> dict[str, np.nd
         return None
 
 
+def recorded_cases(folder: Path) -> int:
+    """Finished cases the parts of ``folder`` record, on whatever grid they ran (distinct positions of each kind).
+
+    A folder whose cases ran another choice of the stripes' motions has a grid (its records) that today's choice does not
+    rebuild, so its positions cannot be placed in today's grid: this counts them as written. Unreadable parts count none.
+    """
+    positions: dict[str, set[tuple[int, ...]]] = {}
+    for path in part_paths(folder):
+        for key, rows in (read_part(path, ("position",)) or {}).items():
+            positions.setdefault(split_key(key)[0], set()).update(tuple(int(v) for v in row) for row in np.atleast_2d(rows))
+    return sum(len(kind_positions) for kind_positions in positions.values())
+
+
 def part_paths(folder: Path) -> list[Path]:
     """The part files of a folder, by name."""
     if not folder.is_dir():

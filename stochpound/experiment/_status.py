@@ -12,7 +12,7 @@ import numpy as np
 from stochpound._errors import os_error_message
 from stochpound.store import open_store
 from stochpound.store import KINDS, Case, ExperimentGrid
-from stochpound.experiment._parts import DEFINITION_FILE, FolderLock, parts_folder
+from stochpound.experiment._parts import DEFINITION_FILE, FolderLock, parts_folder, recorded_cases
 from stochpound.experiment._session import StoreSession
 from stochpound.experiment._spec import ExperimentError
 from stochpound.experiment._file_layout import PREFIX
@@ -36,6 +36,9 @@ class StatusReport:
     not_rebuilt : str
         Why a rebuild that was due failed (one line naming the file, e.g. a
         full disk), or "" (the parts and the old store file are intact).
+    recorded : int or None
+        Where the parts ran another choice of the stripes' motions (their grid is not the one today's choice gives):
+        the finished cases they record, counted as written; None otherwise.
     """
 
     store: Path
@@ -44,10 +47,13 @@ class StatusReport:
     running: bool = False
     rebuilt: bool = False
     not_rebuilt: str = ""
+    recorded: int | None = None
 
     @property
     def n_done(self) -> int:
-        """Finished cases."""
+        """Finished cases (those the parts record, where they ran another choice of the stripes' motions)."""
+        if self.recorded is not None:
+            return self.recorded
         return sum(int(mask.sum()) for mask in self.done_mask.values())
 
     @property
@@ -92,14 +98,14 @@ def store_status(store: str | Path, rebuild: bool = True) -> StatusReport:
     except OSError:  # the lock file cannot be made or opened for writing (a read-only disk): only read
         running, writable = lock.held(), False
     rebuilt = rebuild and writable and not running
-    not_rebuilt = ""
+    not_rebuilt, recorded = "", None
     try:
         if rebuilt:
             try:
                 session.check_choice()
                 session.rebuild()
             except ExperimentError as error:  # cases of another choice of the stripes' motions: the file is not rewritten with this one
-                rebuilt, not_rebuilt = False, str(error)
+                rebuilt, not_rebuilt, recorded = False, str(error), recorded_cases(session.folder)
                 session.scan()
             except OSError as error:  # a full disk, say: the parts and the old store file are intact; the status is still known
                 rebuilt, not_rebuilt = False, os_error_message(error)
@@ -109,7 +115,7 @@ def store_status(store: str | Path, rebuild: bool = True) -> StatusReport:
     finally:
         lock.release()
     done = {kind: session.index.done(kind) for kind in KINDS}
-    return StatusReport(store, session.experiment, done, running, rebuilt, not_rebuilt)
+    return StatusReport(store, session.experiment, done, running, rebuilt, not_rebuilt, recorded)
 
 
 def _from_file(store: Path) -> StatusReport:

@@ -210,7 +210,7 @@ def table_accelerations(table: Mapping[str, float | str], realizations: Sequence
     from stochpound.motions import site_model_provenance, site_motions
 
     calibration = site_model_provenance(str(table["model"]))
-    if table.get("calibration", calibration) != calibration:
+    if "calibration" in table and table["calibration"] != calibration:
         raise SiteError(f"calibration: {table['calibration']!r} is not the calibration of model {table['model']!r} here ({calibration!r}): "
                         "the stored motions cannot be regenerated (run the experiment again, or use the stochpound that wrote it)")
     generated = site_motions(scenario=table_scenario(table), n=table["n"], seed=table["seed"], dt=table["dt"], model=table["model"],
