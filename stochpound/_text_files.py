@@ -63,3 +63,12 @@ def decode_text(raw: bytes, shown: str, error: type[Exception] = ValueError, len
 def attribute_text(value: object) -> str:
     """An HDF5 attribute h5py read as text (a store's ``definition``, ``kind``): bytes decoded as UTF-8, anything else as ``str``."""
     return value.decode() if isinstance(value, bytes) else str(value)
+
+
+def written_or_returned(text: str, path: str | Path | None) -> str | None:
+    """A writer's result, as pandas' ``to_csv`` gives it: ``text`` itself without ``path``; else ``text`` written there
+    (UTF-8) and None."""
+    if path is None:
+        return text
+    Path(path).write_text(text, encoding="utf-8")
+    return None

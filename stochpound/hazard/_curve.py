@@ -22,7 +22,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from stochpound._data_files import bundled_data_dir
-from stochpound._text_files import read_text_file
+from stochpound._text_files import read_text_file, written_or_returned
 from stochpound.motions import Measure
 
 BUNDLED_FOLDER = "hazard"
@@ -168,18 +168,9 @@ class HazardCurve:
                    source="\n".join(comments) or str(path))
 
     def to_csv(self, path: str | Path | None = None) -> str | None:
-        """The table as the CSV file :meth:`from_file` reads back (the same intensities, rates and ``source``).
-
-        Parameters
-        ----------
-        path : str or Path, optional
-            Where to write it; without it the text is returned.
-
-        Returns
-        -------
-        str or None
-            The file's text (``source`` as ``#`` comment lines, a header ``im,rate``, one row per intensity, every
-            number written exactly), or None once written to ``path``.
+        """The table as the CSV file :meth:`from_file` reads back, the same intensities, rates and ``source``: ``source`` as
+        ``#`` comment lines, a header ``im,rate``, one row per intensity, every number written exactly. The text, or None
+        once written to ``path`` (str or Path).
 
         Raises
         ------
@@ -190,10 +181,7 @@ class HazardCurve:
             raise ValueError("to_csv: a power law has no table to write (HazardCurve.power_law)")
         text = "".join(f"# {line}\n" for line in self.source.splitlines())
         text += "im,rate\n" + "".join(f"{float(x)!r},{float(y)!r}\n" for x, y in zip(self.im, self.rate))
-        if path is None:
-            return text
-        Path(path).write_text(text)
-        return None
+        return written_or_returned(text, path)
 
     @classmethod
     def bundled(cls, name: str, *, extrapolate: bool = False) -> HazardCurve:

@@ -48,6 +48,7 @@ import xarray as xr
 
 from stochpound._data_files import bundled_data_dir
 from stochpound._errors import SiteError
+from stochpound._text_files import written_or_returned
 from stochpound.hazard._curve import HazardCurve
 from stochpound.motions import (
     MECHANISMS,
@@ -211,31 +212,16 @@ class RuptureSite:
         return {key: list(value) if isinstance(value := getattr(self, key), tuple) else value for key in kept}
 
     def to_csv(self, path: str | Path | None = None) -> str | None:
-        """The site as a rupture table, the file :meth:`from_file` reads back as the same site.
-
-        Parameters
-        ----------
-        path : str or Path, optional
-            Where to write it; without it the text is returned.
-
-        Returns
-        -------
-        str or None
-            The file's text (``source``, or the name, as ``#`` comment lines, the site fields given as ``# key: value``,
-            a header ``name`` and :data:`RUPTURE_COLUMNS`, one row per rupture, every number written exactly), or None
-            once written to ``path``.
-        """
+        """The site as the rupture table :meth:`from_file` reads back as the same site: ``source`` (or the name) as ``#``
+        comment lines, the site fields given as ``# key: value`` lines, a header ``name`` and :data:`RUPTURE_COLUMNS`, one row
+        per rupture, every number written exactly. The text, or None once written to ``path`` (str or Path)."""
         lines = [f"# {line}" for line in (self.source or self.name).splitlines()]
         lines += [f"# {key}: {float(value)!r}" for key, value in self.site_fields().items() if value is not None]
         lines.append(",".join(("name", *RUPTURE_COLUMNS)))
         for index, name in enumerate(self.names):
             row = self.row(index)
             lines.append(",".join([name, *(value if isinstance(value := row[column], str) else repr(float(value)) for column in RUPTURE_COLUMNS)]))
-        text = "\n".join(lines) + "\n"
-        if path is None:
-            return text
-        Path(path).write_text(text)
-        return None
+        return written_or_returned("\n".join(lines) + "\n", path)
 
     # ------------------------------------------------------------ the ruptures
 
