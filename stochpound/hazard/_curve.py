@@ -170,7 +170,12 @@ class HazardCurve:
     def to_csv(self, path: str | Path | None = None) -> str | None:
         """The table as the CSV file :meth:`from_file` reads back, the same intensities, rates and ``source``: ``source`` as
         ``#`` comment lines, a header ``im,rate``, one row per intensity, every number written exactly. The text, or None
-        once written to ``path`` (str or Path).
+        once written to ``path``.
+
+        Parameters
+        ----------
+        path : str or Path, optional
+            Where to write the curve's file; None returns its text.
 
         Raises
         ------

@@ -214,7 +214,13 @@ class RuptureSite:
     def to_csv(self, path: str | Path | None = None) -> str | None:
         """The site as the rupture table :meth:`from_file` reads back as the same site: ``source`` (or the name) as ``#``
         comment lines, the site fields given as ``# key: value`` lines, a header ``name`` and :data:`RUPTURE_COLUMNS`, one row
-        per rupture, every number written exactly. The text, or None once written to ``path`` (str or Path)."""
+        per rupture, every number written exactly. The text, or None once written to ``path``.
+
+        Parameters
+        ----------
+        path : str or Path, optional
+            Where to write the rupture table; None returns its text.
+        """
         lines = [f"# {line}" for line in (self.source or self.name).splitlines()]
         lines += [f"# {key}: {float(value)!r}" for key, value in self.site_fields().items() if value is not None]
         lines.append(",".join(("name", *RUPTURE_COLUMNS)))
