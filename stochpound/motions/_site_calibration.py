@@ -48,7 +48,8 @@ from stochpound.motions._conditional import MODEL_DAMPING, _average_model, _node
 from stochpound.motions._scenario import Scenario
 from stochpound.motions._seeding import realization_rng
 from stochpound.motions._site_model import (
-    PARAMETER_NORMALS, PARAMETERS, SHAPE_PERIODS, SiteModel, load_site_model, motion_parameters, motions_from_parameters, shape_features,
+    PARAMETER_NORMALS, PARAMETERS, SHAPE_PERIODS, SiteModel, layer_gains, load_site_model, motion_parameters, motions_from_parameters,
+    shape_features,
 )  # fmt: skip
 from stochpound.motions._spectrum import _spectrum_kernel
 
@@ -219,7 +220,7 @@ def _regressed_layer(x: np.ndarray, targets: list, gains: np.ndarray, variances:
     """The regressions of r = μ − gain and v = σ² − d² (:func:`_ridge`), and the mean gains and spreads they give at the scenarios."""
     mean, sigma = (np.array([t[k] for t in targets]) for k in (0, 1))
     r_coefficients, v_coefficients = _ridge(x, mean - gains), _ridge(x, sigma**2 - variances)
-    return r_coefficients, v_coefficients, mean - x @ r_coefficients.T, np.sqrt(np.maximum(sigma**2 - x @ v_coefficients.T, 0.0))
+    return r_coefficients, v_coefficients, *layer_gains(mean, sigma, r_coefficients, v_coefficients, x)
 
 
 def fit_calibration(n: int = 400, seed: int = 7, dt: float = 0.01, scenarios: Sequence[tuple] = FIT_SCENARIOS,

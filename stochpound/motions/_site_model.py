@@ -248,8 +248,16 @@ def shape_gains(shape: SpectralShape, scenario: Scenario) -> tuple[np.ndarray, n
     from stochpound.motions._conditional import _average_model
 
     mean, sigma = _average_model(list(shape.periods), scenario)
-    x = shape_features(scenario)
-    return mean - shape.mean @ x, np.sqrt(np.maximum(sigma**2 - shape.variance @ x, 0.0))
+    return layer_gains(mean, sigma, shape.mean, shape.variance, shape_features(scenario))
+
+
+def layer_gains(mean: np.ndarray, sigma: np.ndarray, mean_coefficients: np.ndarray, variance_coefficients: np.ndarray,
+                features: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The shape layer's mean gain μ − r and spread d = √max(σ² − v, 0) (ln, at its periods) from the regressions of the base's
+    mean r and variance v (coefficients [period, feature]) at ``features`` ([feature], or [scenario, feature] with ``mean`` and
+    ``sigma`` [scenario, period]): :class:`SpectralShape`'s rule, for a model and for its fit alike."""
+    r, v = (np.asarray(coefficients) @ np.asarray(features).T for coefficients in (mean_coefficients, variance_coefficients))
+    return mean - r.T, np.sqrt(np.maximum(sigma**2 - v.T, 0.0))
 
 
 def scenario_features(scenario: Scenario) -> np.ndarray:
