@@ -57,7 +57,7 @@ def scenario_source(label: str, table: TomlTable, max_realizations: int) -> Moti
         (the site-motion model's calibrated range), got 9.0``): an unknown or
         missing field, a value out of its range, a calibration not the model's.
     """
-    from stochpound.motions import site_model_provenance, site_motions
+    from stochpound.motions import site_motions, stated_calibration
 
     if "realization" in table:
         raise table.error("realization", "not used here (realizations start .. start + count - 1 are run)")
@@ -73,10 +73,7 @@ def scenario_source(label: str, table: TomlTable, max_realizations: int) -> Moti
     model = table.string("model", DEFAULT_MODEL)
     duration = table.raw("duration")
     try:
-        calibration = site_model_provenance(model)
-        if table.raw("calibration", calibration) != calibration:
-            raise SiteError(f"calibration: {table.raw('calibration')!r} is not the calibration of model {model!r} here ({calibration!r}): "
-                            "the motions cannot be regenerated")
+        calibration = stated_calibration(model, table.raw("calibration", None))
         first = site_motions(**scenario, n=start + count, seed=seed, dt=dt, duration=duration, model=model, realizations=[start])
     except SiteError as error:
         key, _, problem = str(error).partition(": ")

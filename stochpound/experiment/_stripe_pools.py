@@ -206,13 +206,9 @@ def table_accelerations(table: Mapping[str, float | str], realizations: Sequence
         The table names a calibration other than its model's here (a store written with another calibration): its motions
         cannot be regenerated, and other motions are not given in their place.
     """
-    from stochpound._errors import SiteError
-    from stochpound.motions import site_model_provenance, site_motions
+    from stochpound.motions import site_motions, stated_calibration
 
-    calibration = site_model_provenance(str(table["model"]))
-    if "calibration" in table and table["calibration"] != calibration:
-        raise SiteError(f"calibration: {table['calibration']!r} is not the calibration of model {table['model']!r} here ({calibration!r}): "
-                        "the stored motions cannot be regenerated (run the experiment again, or use the stochpound that wrote it)")
+    stated_calibration(str(table["model"]), table["calibration"] if "calibration" in table else None)
     generated = site_motions(scenario=table_scenario(table), n=table["n"], seed=table["seed"], dt=table["dt"], model=table["model"],
                              realizations=list(realizations), duration=duration, normal_shift=table["normal_shift"] if "normal_shift" in table else None)
     return generated["acceleration"].values

@@ -231,7 +231,7 @@ def _site_motion(table: TomlTable, per_sample: int) -> SampledMotion:
     normals (a motion of a tilted pool, :func:`~stochpound.motions.site_motions`).
     """
     from stochpound._errors import SiteError
-    from stochpound.motions import GEOMETRY_FIELDS, Scenario, site_model_provenance, site_motions
+    from stochpound.motions import GEOMETRY_FIELDS, Scenario, site_motions, stated_calibration
 
     model = table.string("model", "hazard_compatible")
     realization = table.raw("realization", 0)
@@ -243,9 +243,7 @@ def _site_motion(table: TomlTable, per_sample: int) -> SampledMotion:
     if isinstance(realization, bool) or not isinstance(realization, int) or not (0 <= realization < n if isinstance(n, int) else realization >= 0):
         raise SceneError(f"motion.realization: must be an integer within 0 and n - 1 = {n!r} - 1, got {realization!r}")
     try:
-        if "calibration" in table and table.raw("calibration") != site_model_provenance(model):
-            raise SceneError(f"motion.calibration: {table.raw('calibration')!r} is not the calibration of model {model!r} here "
-                             f"({site_model_provenance(model)!r}): the motion cannot be regenerated")
+        stated_calibration(model, table.raw("calibration", None))
         table.string("rupture", "")
         scenario = Scenario(**{key: table.raw(key) for key in ("magnitude", "distance_km", "vs30", "mechanism", *GEOMETRY_FIELDS) if key in table})
         generated = site_motions(scenario=scenario, n=n, seed=table.raw("seed"), dt=table.raw("dt", 0.01), model=model,

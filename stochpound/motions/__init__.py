@@ -94,6 +94,7 @@ from stochpound.motions._spectrum import pseudo_spectra  # noqa: F401
 from stochpound.motions._site_calibration import calibration_table, fit_calibration  # noqa: F401
 from stochpound.motions._site_motions import parameter_normals  # noqa: F401  (the experiment's pool tilted to each stripe)
 from stochpound.motions._site_motions import SITE_MOTION_LIMITS  # noqa: F401  (the analysis's measure-free risk clamps to it)
+from stochpound.motions._site_motions import stated_calibration  # noqa: F401  (scene files, ensembles and stripe pools refuse another calibration)
 
 __all__ = [
     "ENVELOPES",

@@ -262,3 +262,19 @@ def site_model_provenance(model: str = "hazard_compatible") -> str:
     if model not in MODELS:
         raise SiteError(f"model: must be one of {', '.join(MODELS)}, got {model!r}")
     return load_site_model(model).provenance
+
+
+def stated_calibration(model: str, stated: str | None) -> str:
+    """The calibration of ``model`` here (:func:`site_model_provenance`), refusing another one ``stated`` by a table or a store.
+
+    Raises
+    ------
+    SiteError
+        An unknown model, or ``stated`` (when not None) not this model's calibration: motions written with another
+        calibration cannot be regenerated, and this one's are not given in their place.
+    """
+    calibration = site_model_provenance(model)
+    if stated is not None and stated != calibration:
+        raise SiteError(f"calibration: {stated!r} is not the calibration of model {model!r} here ({calibration!r}): the motions cannot be "
+                        "regenerated (run again with this stochpound, or use the one that wrote them)")
+    return calibration
