@@ -10,7 +10,8 @@ stripe, its level, ε, N Φ(−ε) (the pool's simulated motions expected beyond
 the stripe's ε), the pool's motions after the pre-screen, the chosen set's
 recorded and simulated motions, the largest share of one earthquake, and its
 worst differences from the target in mean and standard deviation of ln Sa
-(with their periods): a markdown table, then the time the selection took
+(with their periods) and whether any set of its pool could meet the target's
+mean (the selection's linear-programming bound, ``target_reachable``): a markdown table, then the time the selection took
 (from the file's loading), the load at its start and the commit; with
 ``--picks FILE`` every stripe's chosen motions and scale factors as JSON
 (to compare two trees' selections); with ``--parameters`` per stripe the
@@ -37,12 +38,15 @@ from benchmarks.report import machine
 
 SIMULATED_LINE = re.compile(r"^simulated_motions\s*=\s*\d+", re.MULTILINE)
 """The ``[site] simulated_motions`` line of a flagship file."""
+SAMPLING_LINE = re.compile(r'^simulated_sampling\s*=\s*"[a-z]+"', re.MULTILINE)
+"""The ``[site] simulated_sampling`` line of a flagship file, where it has one (replaced, not repeated, by ``--sampling``)."""
 SEED_LINE = re.compile(r"^seed\s*=\s*\d+", re.MULTILINE)
 """The ``[intensity] seed`` line of a flagship file (its only ``seed``)."""
 
 
 def with_simulated(path: Path, count: int | None, folder: Path, sampling: str | None = None, seed: int | None = None) -> Path:
-    """The experiment file with ``simulated_motions = count``, on the next line ``simulated_sampling = sampling``, and ``seed = seed``
+    """The experiment file with ``simulated_motions = count``, ``simulated_sampling = sampling`` (its line replaced, else one added
+    after ``simulated_motions``), and ``seed = seed``
     (a copy in ``folder``; the file itself when all are None)."""
     if count is None and sampling is None and seed is None:
         return path
@@ -50,7 +54,9 @@ def with_simulated(path: Path, count: int | None, folder: Path, sampling: str | 
     found = SIMULATED_LINE.search(text)
     if not found:
         raise SystemExit(f"{path.name}: no [site] simulated_motions line to replace")
-    if sampling is not None:
+    if sampling is not None and SAMPLING_LINE.search(text):
+        text = SAMPLING_LINE.sub(f'simulated_sampling = "{sampling}"', text, count=1)
+    elif sampling is not None:
         end = text.index("\n", found.end())
         text = f'{text[:end]}\nsimulated_sampling = "{sampling}"{text[end:]}'
     if count is not None:
@@ -84,7 +90,7 @@ def stripe_rows(experiment, count: int, tilted: bool = False) -> list[list[str]]
         miss = max(np.max(np.abs(mean)), np.max(np.abs(sigma))) > 0.1
         rows.append([f"{level:.3g}", f"{epsilon:.2f}", "-" if tilted else f"{count * ndtr(-epsilon):.1f}", str(selection.attrs["pool"]),
                      f"{selection.sizes['selected'] - simulated} + {simulated}", f"{share:.3f}", worst(mean, periods), worst(sigma, periods),
-                     "**miss**" if miss else "met"])
+                     "**miss**" if miss else "met", "yes" if selection.attrs["target_reachable"] else "**no**"])
     return rows
 
 
@@ -145,7 +151,8 @@ def main(argv: list[str] | None = None) -> int:
         experiment.selection
         elapsed = time.time() - began
     count = experiment.intensity.selection.simulated.count
-    header = ["level (g)", "ε", "N Φ(−ε)", "pool", "recorded + simulated", "largest share of an earthquake", "mean", "σ", ""]
+    header = ["level (g)", "ε", "N Φ(−ε)", "pool", "recorded + simulated", "largest share of an earthquake", "mean", "σ", "",
+              "mean reachable"]
     sampling = experiment.intensity.selection.simulated.sampling
     print(f"{arguments.experiment.name}, N = {count} ({sampling}), seed {experiment.intensity.selection.seed}, {experiment.selection.periods[0]:.3g}-{experiment.selection.periods[-1]:.3g} s")
     print("| " + " | ".join(header) + " |")

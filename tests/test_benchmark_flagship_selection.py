@@ -37,22 +37,31 @@ class _Selection:
                                        "earthquake": ("selected", ["e1", "e1", "e2", "simulated 1.7"]),
                                        "mean_ln": ("period", np.log([0.5, 0.3]) + [0.15, -0.02]), "median": ("period", [0.5, 0.3]),
                                        "std_ln": ("period", [0.5, 0.6]), "sigma_ln": ("period", [0.55, 0.6])},
-                                      coords={"period": periods}, attrs={"pool": 2100})]
+                                      coords={"period": periods}, attrs={"pool": 2100, "target_reachable": 0})]
 
 
 def test_a_stripe_s_row_gives_its_counts_shares_and_worst_misses():
     """The row: level, ε, N Φ(−ε), pool, recorded + simulated, the largest share of one earthquake, the worst differences, the verdict."""
     row = stripe_rows(type("E", (), {"selection": _Selection()})(), 1000)[0]
-    assert row == ["0.5", "2.00", "22.8", "2100", "3 + 1", "0.500", "+0.150 (0.1 s)", "-0.050 (0.1 s)", "**miss**"]
+    assert row == ["0.5", "2.00", "22.8", "2100", "3 + 1", "0.500", "+0.150 (0.1 s)", "-0.050 (0.1 s)", "**miss**", "**no**"]
     assert worst(np.array([0.01, -0.09]), np.array([1.0, 2.0])) == "-0.090 (2 s)"
     assert stripe_rows(type("E", (), {"selection": _Selection()})(), 1000, tilted=True)[0][2] == "-"
 
 
 
-def test_the_benchmark_s_copy_adds_the_sampling_line(tmp_path):
-    flagship = REPOSITORY / "experiments" / "risk" / "fixed_pair.toml"
-    old, new = flagship.read_text().splitlines(), with_simulated(flagship, None, tmp_path, "tilted").read_text().splitlines()
-    assert len(new) == len(old) + 1 and [line for line in new if line not in old] == ['simulated_sampling = "tilted"']
+def test_the_benchmark_s_copy_replaces_the_sampling_line_or_adds_one(tmp_path):
+    """A flagship's ``simulated_sampling`` line is replaced, not repeated (a repeated key is not TOML); a file without one gets one
+    after its ``simulated_motions`` line."""
+    flagship = REPOSITORY / "experiments" / "risk" / "isolated.toml"
+    old, new = flagship.read_text().splitlines(), with_simulated(flagship, None, tmp_path, "scenario").read_text().splitlines()
+    changed = [(a, b) for a, b in zip(old, new) if a != b]
+    assert len(new) == len(old) and len(changed) == 1 and changed[0][1].startswith('simulated_sampling = "scenario" ')
+    bare = tmp_path / "bare" / "isolated.toml"
+    bare.parent.mkdir()
+    bare.write_text("\n".join(line for line in old if not line.startswith("simulated_sampling")) + "\n")
+    added = with_simulated(bare, None, tmp_path, "tilted").read_text().splitlines()
+    assert added[added.index(next(line for line in added if line.startswith("simulated_motions"))) + 1] == 'simulated_sampling = "tilted"'
+    assert len(added) == len(old)
 
 
 def test_the_benchmark_s_parameter_rows_count_each_stripe_s_chosen_simulated_motions(tilted_experiment):

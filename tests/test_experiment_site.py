@@ -78,6 +78,7 @@ def test_each_stripe_runs_its_chosen_motions_and_the_store_keeps_the_selection(t
         assert store.site_magnitude.values[j] == magnitude and store.site_mechanism.values[j] == "strike_slip"
         miss = misses_target(expected["mean_ln"].values, expected["std_ln"].values, target["median"].values, target["sigma_ln"].values)
         assert store.selection_misses_target.values[j] == int(miss)
+        assert store.selection_target_reachable.values[j] == expected.attrs["target_reachable"]
     # the report shows every stripe's target against its chosen set, and the stripes that miss it
     section = intensity_section("site", store)
     assert any(isinstance(block, FigureItem) and block.key == "intensity-selection-site" for block in section.blocks)

@@ -3,10 +3,11 @@
 from __future__ import annotations
 
 import numpy as np
+import xarray as xr
 import pytest
 
 from stochpound import SiteError
-from stochpound.motions import conditional_spectrum, select_motions, selection_periods, selection_pool
+from stochpound.motions import conditional_spectrum, misses_target, select_motions, selection_periods, selection_pool
 from stochpound.motions.records import load_suite
 
 PERIODS = selection_periods([0.5, 1.2, 3.0], [1.0])  # a pair of 0.5 and 1.2 s, isolated at 3 s; T* = 1 s
@@ -45,6 +46,7 @@ def test_the_selected_set_matches_the_target_mean_and_std(pool, level: float, ma
     assert np.max(np.abs(ln_sa.mean(axis=0) - np.log(cs["median"].values))) < 0.1
     assert np.max(np.abs(ln_sa.std(axis=0, ddof=1) - cs["sigma_ln"].values)) < 0.1
     assert np.allclose(ln_sa[:, list(PERIODS).index(1.0)], np.log(level))
+    assert selection.attrs["target_reachable"] == 1
 
 
 def test_the_same_seed_gives_the_same_selection(pool) -> None:
@@ -63,3 +65,39 @@ def test_bad_input_is_one_line_naming_the_field(pool, arguments: dict, field: st
     with pytest.raises(SiteError) as error:
         select_motions(pool, target(0.8, 7.3, 10.0), **({"motions": 10, "max_scale_factor": 4.0} | arguments))
     assert str(error.value).startswith(f"{field}:") and "\n" not in str(error.value)
+
+
+def _two_period_pool(recordings: list[str]) -> tuple[xr.Dataset, xr.Dataset]:
+    """Four motions at T* = 1 s (all at the level, 0.4 g): earthquake A's two at 0.1 g at 2 s, B's two e times higher; a target of 0.1 g at 2 s."""
+    periods = [1.0, 2.0]
+    psa = np.array([[0.4, 0.1], [0.4, 0.1], [0.4, 0.1 * np.e], [0.4, 0.1 * np.e]])
+    pool = xr.Dataset({"psa": (("motion", "period"), psa), "intensity": ("motion", psa[:, 0]), "earthquake": ("motion", ["A", "A", "B", "B"]),
+                       "recording": ("motion", recordings), "pulse": ("motion", [False] * 4)},
+                      coords={"motion": ["a1", "a2", "b1", "b2"], "period": periods})
+    target = xr.Dataset({"median": ("period", [0.4, 0.1]), "sigma_ln": ("period", [0.0, 0.05]), "correlation": (("period", "other"), np.eye(2))},
+                        coords={"period": periods}, attrs={"level": 0.4})
+    return pool, target
+
+
+@pytest.mark.parametrize("recordings, max_per_earthquake, reachable", [
+    (["a1", "a2", "b1", "b2"], None, 1),  # A's two motions are the target exactly
+    (["a1", "a2", "b1", "b2"], 1, 0),     # one of A at most: the set's mean at 2 s is at least 0.5 above the target's
+    (["a", "a", "b1", "b2"], None, 0),    # A's two are one recording: the same
+])  # fmt: skip
+def test_the_selection_says_whether_any_set_of_the_pool_can_meet_the_target_mean(recordings, max_per_earthquake, reachable) -> None:
+    """``target_reachable`` is 0 exactly where every set the rules allow misses the target's mean by more than the tolerance."""
+    pool, target = _two_period_pool(recordings)
+    selection = select_motions(pool, target, 2, 1.0, seed=1, max_per_earthquake=max_per_earthquake)
+    missed = bool(misses_target(selection["mean_ln"].values, selection["std_ln"].values, selection["median"].values, selection["sigma_ln"].values))
+    assert selection.attrs["target_reachable"] == reachable and missed == (not reachable)
+    if not reachable:  # every allowed pair has its mean at 2 s 0.5 or 1 above the target's: the bound is right to say none reaches it
+        assert selection["mean_ln"].values[1] - np.log(0.1) >= 0.5 - 1e-12
+
+
+def test_a_target_the_pools_spectra_cannot_bend_to_is_unreachable(pool) -> None:
+    """A target 0.5 below every record's ln Sa at the longest period (relative to T*): no set reaches it, and the selection says so."""
+    cs = target(0.3, 7.0, 15.0)
+    lowest = np.min(np.log(pool["psa"].values[:, -1] * 0.3 / pool["intensity"].values))
+    bent = cs.assign(median=cs["median"].copy(data=np.concatenate([cs["median"].values[:-1], [np.exp(lowest - 0.5)]])))
+    assert select_motions(pool, cs, 15, 4.0, seed=3).attrs["target_reachable"] == 1
+    assert select_motions(pool, bent, 15, 4.0, seed=3).attrs["target_reachable"] == 0

@@ -132,3 +132,20 @@ def test_the_motion_table_caption_counts_one_simulated_row_per_experiment() -> N
         "experiment, the 522 simulated motions some stripe chose).")
     assert "in one row, the 40 simulated motions" in motions_caption(3, 8, [40])
     assert motions_caption(8, 8).endswith("seed and size.")
+
+
+def test_a_stripe_whose_pool_cannot_meet_its_target_is_named_as_the_pools_miss(cs_store) -> None:
+    """The intensity section says which missed stripes no set of their pool could meet (``selection_target_reachable`` 0), and
+    nothing of it where every miss was reachable or the store predates the bound."""
+    from stochpound.report.render import Paragraph
+    from stochpound.report.sections._intensity import intensity_section
+    from stochpound.risk import unreachable_targets
+
+    missed = cs_store.assign(selection_misses_target=cs_store.selection_misses_target.copy(data=[1, 1]))
+    proven = missed.assign(selection_target_reachable=missed.selection_target_reachable.copy(data=[1, 0]))
+    older = missed.drop_vars("selection_target_reachable")
+    assert unreachable_targets(proven) == [0.1] and unreachable_targets(missed.assign(selection_target_reachable=missed.selection_target_reachable * 0 + 1)) == []
+    assert unreachable_targets(older) == []
+    texts = [" ".join(b.text for b in intensity_section("site", store).blocks if isinstance(b, Paragraph)) for store in (proven, older)]
+    assert "At 0.1 g no set of the pool's motions can meet the target's mean" in texts[0]
+    assert "no set of the pool" not in texts[1] and "misses its target" in texts[1]

@@ -417,6 +417,11 @@ class StripeSelections:
                 ("intensity",), misses_target(stack["mean_ln"], stack["std_ln"], stack["median"], stack["sigma_ln"]).astype(np.int8),
                 {"units": "1", "long_name": f"1 where the stripe's selection misses its target (mean or std of ln Sa off by > {TARGET_TOLERANCE:g} at a period)"},
             ),
+            "selection_target_reachable": xr.Variable(
+                ("intensity",), np.array([s.attrs["target_reachable"] for s in self.selections], dtype=np.int8),
+                {"units": "1", "long_name": f"0 where no set of the stripe's pool can meet its target's mean within {TARGET_TOLERANCE:g} at every "
+                 "period (a linear-programming bound over its candidates and rules): a miss there is the pool's, not the search's"},
+            ),
             "target_epsilon": xr.Variable(("intensity",), np.array([s["epsilon"] for s in scenario]), {"units": "1", "long_name": "epsilon of the level in its scenario"}),
             "site_magnitude": xr.Variable(("intensity",), np.array([s["magnitude"] for s in scenario]), {"units": "1", "long_name": "scenario moment magnitude"}),
             "site_distance_km": xr.Variable(("intensity",), np.array([s["distance_km"] for s in scenario]), {"units": "km", "long_name": "scenario rupture distance"}),

@@ -19,6 +19,17 @@ of :func:`~stochpound.motions.conditional_spectrum` over a period range):
    of 0.1, holds the worst period down);
 5. steps 2–4 are repeated for 20 simulated sets and the set of least misfit kept.
 
+Whether the pool can meet the target at all (:func:`_mean_reachable`): a
+linear programme over weights w ∈ [0, 1] of the candidates, Σ w = ``motions``,
+at most one of a recording and ``max_per_earthquake`` of an earthquake,
+asks for Σ w ln Sa / ``motions`` within :data:`TARGET_TOLERANCE` of the
+target's mean at every period. Every set the rules allow is such a w, so
+where the programme has no solution no set of the pool meets the target's
+mean: a miss is then the pool's (its motions lack the shape), not the
+greedy search's. Where it has one, a set may still miss (the weights need
+not be 0 or 1, and the σ is not asked for). The selection's dataset says
+which (``target_reachable``).
+
 Rules of the field: a set never holds the same recording twice (a motion
 is known by its PEER record sequence number and component where the
 metadata give them, else by its name); with ``max_per_earthquake`` it holds
@@ -52,6 +63,9 @@ from collections.abc import Sequence
 
 import numpy as np
 import xarray as xr
+
+from scipy import sparse
+from scipy.optimize import linprog
 
 from stochpound._errors import SiteError
 from stochpound.stats import earthquake_identities
@@ -274,7 +288,11 @@ def select_motions(pool: xr.Dataset, target: xr.Dataset, motions: int, max_scale
     xarray.Dataset
         Over ``selected``: ``motion`` (names), ``scale_factor``, ``earthquake``; over
         ``period``: the set's ``mean_ln`` and ``std_ln`` (sample, n − 1) of
-        the scaled ln Sa, the target's ``median`` and ``sigma_ln``.
+        the scaled ln Sa, the target's ``median`` and ``sigma_ln``. Attributes:
+        ``level``, ``max_scale_factor``, ``seed``, ``pool`` (its motions),
+        ``candidates`` (those within ``max_scale_factor`` and the rules) and
+        ``target_reachable`` (1, or 0 where no set of the candidates can meet
+        the target's mean within :data:`TARGET_TOLERANCE`: :func:`_mean_reachable`).
 
     Raises
     ------
@@ -344,8 +362,31 @@ def select_motions(pool: xr.Dataset, target: xr.Dataset, motions: int, max_scale
             "sigma_ln": target["sigma_ln"],
         },
         coords={"period": target.period},
-        attrs={"level": level, "max_scale_factor": float(max_scale_factor), "seed": int(seed), "pool": int(scale.size), "candidates": int(eligible.size)},
+        attrs={"level": level, "max_scale_factor": float(max_scale_factor), "seed": int(seed), "pool": int(scale.size), "candidates": int(eligible.size),
+               "target_reachable": int(_mean_reachable(ln_sa, mean, motions, rules))},
     )
+
+
+def _mean_reachable(ln_sa: np.ndarray, mean: np.ndarray, motions: int, rules: _Rules, tolerance: float = TARGET_TOLERANCE) -> bool:
+    """Whether weights w ∈ [0, 1] of the candidates (rows of ``ln_sa``, scaled ln Sa), Σ w = ``motions``, within the
+    ``rules`` (Σ w ≤ 1 over a recording's rows, ≤ the cap over an earthquake's), give a weighted mean of ln Sa within
+    ``tolerance`` of ``mean`` at every period (module docstring: False proves that no set of the candidates meets it)."""
+    n = ln_sa.shape[0]
+    groups = [(labels, 1.0) for labels in (rules.recording,)] + ([(rules.earthquake, float(rules.cap))] if np.isfinite(rules.cap) else [])
+    rows, bounds = [sparse.csr_matrix(np.vstack([ln_sa.T, -ln_sa.T]) / motions)], [np.concatenate([mean + tolerance, tolerance - mean])]
+    for labels, cap in groups:
+        sizes = np.bincount(labels)
+        shared = np.flatnonzero(sizes > cap)  # a group no larger than its cap is bounded by w ≤ 1 already
+        if shared.size:
+            member = np.isin(labels, shared)
+            group_rows = np.searchsorted(shared, labels[member])
+            rows.append(sparse.csr_matrix((np.ones(int(member.sum())), (group_rows, np.flatnonzero(member))), shape=(shared.size, n)))
+            bounds.append(np.full(shared.size, cap))
+    result = linprog(np.zeros(n), A_ub=sparse.vstack(rows).tocsr(), b_ub=np.concatenate(bounds), A_eq=np.ones((1, n)), b_eq=[float(motions)],
+                     bounds=(0.0, 1.0), method="highs")
+    if result.status not in (0, 2):  # 0: a solution, 2: none; anything else is not an answer
+        raise RuntimeError(f"the selection's reachability programme stopped without an answer: {result.message}")
+    return bool(result.status == 0)
 
 
 def misses_target(mean_ln: np.ndarray, std_ln: np.ndarray, median: np.ndarray, sigma_ln: np.ndarray) -> np.ndarray:

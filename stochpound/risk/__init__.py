@@ -67,7 +67,7 @@ from stochpound.risk._code_gaps import (
 from stochpound.risk._design_rules import DESIGN_RULE_LEVELS, design_rules_risk, design_separations
 from stochpound.risk._site_spectrum import site_mce
 from stochpound.risk._inputs import (RiskInputError, RiskInputs, contact_free_closure, has_risk, read_risk_inputs, selection_misses, site_hazard,
-                                    stripes_beyond_truncation)
+                                    stripes_beyond_truncation, unreachable_targets)
 from stochpound.risk._inputs import configuration_scene
 from stochpound.risk._inputs import stripe_motions  # noqa: F401  (for stochpound.experiment.measure_choice: not public API)
 from stochpound.risk._chain import StoreRisk, pounding_fragility, risk_gaps, store_risk
@@ -188,6 +188,7 @@ __all__ = [
     "most_efficient",
     "has_risk",
     "selection_misses",
+    "unreachable_targets",
     "stripes_beyond_truncation",
     "site_hazard",
     "stripe_rate_weights",

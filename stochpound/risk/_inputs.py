@@ -450,6 +450,15 @@ def selection_misses(store: xr.Dataset) -> list[float]:
     return [float(level) for level, flag in zip(store["intensity"].values, flags) if flag]
 
 
+def unreachable_targets(store: xr.Dataset) -> list[float]:
+    """The levels (in the levels' units) whose stripe misses its target and whose pool cannot meet its mean at all
+    (``selection_target_reachable`` 0: no set of the pool can, a linear-programming bound); [] for a store that does not say."""
+    if "selection_target_reachable" not in store:
+        return []
+    unreachable = dict(zip(store["intensity"].values, store["selection_target_reachable"].values == 0))
+    return [level for level in selection_misses(store) if unreachable[level]]
+
+
 def stripes_beyond_truncation(store: xr.Dataset) -> list[float]:
     """The levels (in the levels' units) whose stripe's scenario puts them beyond ε :data:`~stochpound.motions.TRUNCATION_EPSILON`.
 
