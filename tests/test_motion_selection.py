@@ -79,19 +79,28 @@ def _two_period_pool(recordings: list[str]) -> tuple[xr.Dataset, xr.Dataset]:
     return pool, target
 
 
-@pytest.mark.parametrize("recordings, max_per_earthquake, reachable", [
-    (["a1", "a2", "b1", "b2"], None, 1),  # A's two motions are the target exactly
-    (["a1", "a2", "b1", "b2"], 1, 0),     # one of A at most: the set's mean at 2 s is at least 0.5 above the target's
-    (["a", "a", "b1", "b2"], None, 0),    # A's two are one recording: the same
+@pytest.mark.parametrize("recordings, max_per_earthquake, reachable, bound", [
+    (["a1", "a2", "b1", "b2"], None, 1, 0.0),  # A's two motions are the target's mean exactly
+    (["a1", "a2", "b1", "b2"], 1, 0, 0.5),     # one of A at most: the best set's mean at 2 s is 0.5 above the target's
+    (["a", "a", "b1", "b2"], None, 0, 0.5),    # A's two are one recording: the same
 ])  # fmt: skip
-def test_the_selection_says_whether_any_set_of_the_pool_can_meet_the_target_mean(recordings, max_per_earthquake, reachable) -> None:
-    """``target_reachable`` is 0 exactly where every set the rules allow misses the target's mean by more than the tolerance."""
+def test_the_selection_says_how_close_any_set_of_the_pool_can_come_to_the_target_mean(recordings, max_per_earthquake, reachable, bound) -> None:
+    """``mean_bound`` is the least worst-period miss of the mean any set the rules allow has (here exact: whole weights are
+    optimal), and ``target_reachable`` is 0 where that exceeds the tolerance."""
     pool, target = _two_period_pool(recordings)
     selection = select_motions(pool, target, 2, 1.0, seed=1, max_per_earthquake=max_per_earthquake)
     missed = bool(misses_target(selection["mean_ln"].values, selection["std_ln"].values, selection["median"].values, selection["sigma_ln"].values))
     assert selection.attrs["target_reachable"] == reachable and missed == (not reachable)
-    if not reachable:  # every allowed pair has its mean at 2 s 0.5 or 1 above the target's: the bound is right to say none reaches it
-        assert selection["mean_ln"].values[1] - np.log(0.1) >= 0.5 - 1e-12
+    assert selection.attrs["mean_bound"] == pytest.approx(bound, abs=1e-9)
+    assert np.max(np.abs(selection["mean_ln"].values - np.log(selection["median"].values))) == pytest.approx(bound, abs=1e-9)  # attained
+
+
+def test_a_pool_that_meets_the_mean_but_cannot_spread_is_unreachable() -> None:
+    """Four motions alike at 2 s: any set's σ there is 0 against the target's 0.5, though the mean is met exactly."""
+    pool, target = _two_period_pool(["a1", "a2", "b1", "b2"])
+    pool = pool.assign(psa=pool["psa"].copy(data=np.array([[0.4, 0.1]] * 4)))
+    selection = select_motions(pool, target.assign(sigma_ln=("period", [0.0, 0.5])), 2, 1.0, seed=1)
+    assert selection.attrs["mean_bound"] == pytest.approx(0.0, abs=1e-9) and selection.attrs["target_reachable"] == 0
 
 
 def test_a_target_the_pools_spectra_cannot_bend_to_is_unreachable(pool) -> None:

@@ -147,5 +147,5 @@ def test_a_stripe_whose_pool_cannot_meet_its_target_is_named_as_the_pools_miss(c
     assert unreachable_targets(proven) == [0.1] and unreachable_targets(missed.assign(selection_target_reachable=missed.selection_target_reachable * 0 + 1)) == []
     assert unreachable_targets(older) == []
     texts = [" ".join(b.text for b in intensity_section("site", store).blocks if isinstance(b, Paragraph)) for store in (proven, older)]
-    assert "At 0.1 g no set of the pool's motions can meet the target's mean" in texts[0]
+    assert "At 0.1 g no set of the pool's motions can meet the target within 0.1" in texts[0]
     assert "no set of the pool" not in texts[1] and "misses its target" in texts[1]

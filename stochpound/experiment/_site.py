@@ -419,8 +419,8 @@ class StripeSelections:
             ),
             "selection_target_reachable": xr.Variable(
                 ("intensity",), np.array([s.attrs["target_reachable"] for s in self.selections], dtype=np.int8),
-                {"units": "1", "long_name": f"0 where no set of the stripe's pool can meet its target's mean within {TARGET_TOLERANCE:g} at every "
-                 "period (a linear-programming bound over its candidates and rules): a miss there is the pool's, not the search's"},
+                {"units": "1", "long_name": f"0 where no set of the stripe's pool can meet its target's mean and std of ln Sa within {TARGET_TOLERANCE:g} "
+                 "at every period (linear-programming bounds over its candidates and rules): a miss there is the pool's, not the search's"},
             ),
             "target_epsilon": xr.Variable(("intensity",), np.array([s["epsilon"] for s in scenario]), {"units": "1", "long_name": "epsilon of the level in its scenario"}),
             "site_magnitude": xr.Variable(("intensity",), np.array([s["magnitude"] for s in scenario]), {"units": "1", "long_name": "scenario moment magnitude"}),

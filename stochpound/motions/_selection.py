@@ -17,18 +17,27 @@ of :func:`~stochpound.motions.conditional_spectrum` over a period range):
    deviation (n − 1) of ln Sa from the target's, until a full pass changes
    nothing (the quartic term, as large as the quadratic one at a difference
    of 0.1, holds the worst period down);
-5. steps 2–4 are repeated for 20 simulated sets and the set of least misfit kept.
+5. steps 2–4 are repeated for 20 simulated sets;
+6. one more start: the linear programme below, its weights' heaviest
+   candidates (the rules kept), then step 4; of the 21 sets the one of least
+   misfit is kept.
 
-Whether the pool can meet the target at all (:func:`_mean_reachable`): a
-linear programme over weights w ∈ [0, 1] of the candidates, Σ w = ``motions``,
-at most one of a recording and ``max_per_earthquake`` of an earthquake,
-asks for Σ w ln Sa / ``motions`` within :data:`TARGET_TOLERANCE` of the
-target's mean at every period. Every set the rules allow is such a w, so
-where the programme has no solution no set of the pool meets the target's
-mean: a miss is then the pool's (its motions lack the shape), not the
-greedy search's. Where it has one, a set may still miss (the weights need
-not be 0 or 1, and the σ is not asked for). The selection's dataset says
-which (``target_reachable``).
+The programme: weights w ∈ [0, 1] of the candidates, Σ w = ``motions``, at
+most 1 over the motions of one recording and ``max_per_earthquake`` over
+those of one earthquake, whose weighted mean of the scaled ln Sa lies within
+t of the target's mean at every period, t the least it can be. Every set
+the rules allow is such a w, so **no set of the pool comes closer to the
+target's mean than t at its worst period** (``mean_bound``). A second
+programme asks for the mean within :data:`TARGET_TOLERANCE` and, at every
+period, for the weighted sum of squares about the target's mean to allow
+a standard deviation within the tolerance of the target's (a set's variance
+is that sum, over n − 1, less n / (n − 1) times its mean's squared miss).
+Where either fails (``target_reachable`` 0) no set of the pool meets the
+target within the tolerance: a miss is the pool's, its motions lack the
+target's shape, not the search's. Where both succeed a set may still miss
+(the weights need not be whole); the first programme's heaviest candidates
+are then a start near the target's mean for the swaps, which the simulated
+sets, drawn about the target, may not reach at high ε.
 
 Rules of the field: a set never holds the same recording twice (a motion
 is known by its PEER record sequence number and component where the
@@ -290,9 +299,12 @@ def select_motions(pool: xr.Dataset, target: xr.Dataset, motions: int, max_scale
         ``period``: the set's ``mean_ln`` and ``std_ln`` (sample, n − 1) of
         the scaled ln Sa, the target's ``median`` and ``sigma_ln``. Attributes:
         ``level``, ``max_scale_factor``, ``seed``, ``pool`` (its motions),
-        ``candidates`` (those within ``max_scale_factor`` and the rules) and
-        ``target_reachable`` (1, or 0 where no set of the candidates can meet
-        the target's mean within :data:`TARGET_TOLERANCE`: :func:`_mean_reachable`).
+        ``candidates`` (those within ``max_scale_factor`` and the rules),
+        ``mean_bound`` (no set of the candidates has its mean of ln Sa closer
+        to the target's than this at its worst period: the module docstring's
+        programme) and ``target_reachable`` (0 where no set of the candidates
+        can meet the target's mean and σ within :data:`TARGET_TOLERANCE`, 1
+        where the programmes do not rule it out).
 
     Raises
     ------
@@ -348,7 +360,11 @@ def select_motions(pool: xr.Dataset, target: xr.Dataset, motions: int, max_scale
         misfit = _set_misfit(ln_sa[chosen], mean, sigma)
         if best is None or misfit < best[0]:
             best = (misfit, chosen)
-    chosen = best[1]
+    bound, programme_weights = _programme(ln_sa, mean, sigma, motions, rules)
+    chosen = _swap(ln_sa, _heaviest_allowed(programme_weights, motions, rules), mean, sigma, rules)
+    if _set_misfit(ln_sa[chosen], mean, sigma) >= best[0]:
+        chosen = best[1]
+    reachable = bound <= TARGET_TOLERANCE and _programme(ln_sa, mean, sigma, motions, rules, TARGET_TOLERANCE) is not None
     picked = eligible[chosen]
     spectra = ln_sa[chosen]
     return xr.Dataset(
@@ -363,30 +379,54 @@ def select_motions(pool: xr.Dataset, target: xr.Dataset, motions: int, max_scale
         },
         coords={"period": target.period},
         attrs={"level": level, "max_scale_factor": float(max_scale_factor), "seed": int(seed), "pool": int(scale.size), "candidates": int(eligible.size),
-               "target_reachable": int(_mean_reachable(ln_sa, mean, motions, rules))},
+               "mean_bound": bound, "target_reachable": int(reachable)},
     )
 
 
-def _mean_reachable(ln_sa: np.ndarray, mean: np.ndarray, motions: int, rules: _Rules, tolerance: float = TARGET_TOLERANCE) -> bool:
-    """Whether weights w ∈ [0, 1] of the candidates (rows of ``ln_sa``, scaled ln Sa), Σ w = ``motions``, within the
-    ``rules`` (Σ w ≤ 1 over a recording's rows, ≤ the cap over an earthquake's), give a weighted mean of ln Sa within
-    ``tolerance`` of ``mean`` at every period (module docstring: False proves that no set of the candidates meets it)."""
-    n = ln_sa.shape[0]
-    groups = [(labels, 1.0) for labels in (rules.recording,)] + ([(rules.earthquake, float(rules.cap))] if np.isfinite(rules.cap) else [])
-    rows, bounds = [sparse.csr_matrix(np.vstack([ln_sa.T, -ln_sa.T]) / motions)], [np.concatenate([mean + tolerance, tolerance - mean])]
+def _programme(ln_sa: np.ndarray, mean: np.ndarray, sigma: np.ndarray, motions: int, rules: _Rules,
+               tolerance: float | None = None) -> tuple[float, np.ndarray] | None:
+    """The least t, and its weights w ∈ [0, 1] of the candidates (rows of ``ln_sa``, scaled ln Sa), Σ w = ``motions``, within
+    the ``rules`` (Σ w ≤ 1 over a recording's rows, ≤ the cap over an earthquake's), such that the weighted mean of ln Sa is
+    within t of ``mean`` at every period (module docstring).
+
+    With ``tolerance``, t may not exceed it, and at every period the weighted sum of squares about the target's mean,
+    S = Σ w (ln Sa − mean)² / (motions − 1), must lie within [(σ − tolerance)², (σ + tolerance)² + motions tolerance² /
+    (motions − 1)]: a set within ``tolerance`` of the target's mean and σ satisfies both (its variance is S less
+    motions / (motions − 1) times its mean's squared miss). None where no weights do.
+    """
+    n, periods = ln_sa.shape
+    rows = [sparse.hstack([sparse.csr_matrix(np.vstack([ln_sa.T, -ln_sa.T]) / motions), sparse.csr_matrix(-np.ones((2 * periods, 1)))])]
+    bounds = [np.concatenate([mean, -mean])]
+    if tolerance is not None:
+        squares = ((ln_sa - mean) ** 2).T / (motions - 1)
+        rows.append(sparse.hstack([sparse.csr_matrix(np.vstack([squares, -squares])), sparse.csr_matrix((2 * periods, 1))]))
+        bounds.append(np.concatenate([(sigma + tolerance) ** 2 + motions * tolerance**2 / (motions - 1), -np.maximum(sigma - tolerance, 0.0) ** 2]))
+    groups = [(rules.recording, 1.0)] + ([(rules.earthquake, float(rules.cap))] if np.isfinite(rules.cap) else [])
     for labels, cap in groups:
-        sizes = np.bincount(labels)
-        shared = np.flatnonzero(sizes > cap)  # a group no larger than its cap is bounded by w ≤ 1 already
+        shared = np.flatnonzero(np.bincount(labels) > cap)  # a group no larger than its cap is bounded by w ≤ 1 already
         if shared.size:
-            member = np.isin(labels, shared)
-            group_rows = np.searchsorted(shared, labels[member])
-            rows.append(sparse.csr_matrix((np.ones(int(member.sum())), (group_rows, np.flatnonzero(member))), shape=(shared.size, n)))
+            member = np.flatnonzero(np.isin(labels, shared))
+            rows.append(sparse.csr_matrix((np.ones(member.size), (np.searchsorted(shared, labels[member]), member)), shape=(shared.size, n + 1)))
             bounds.append(np.full(shared.size, cap))
-    result = linprog(np.zeros(n), A_ub=sparse.vstack(rows).tocsr(), b_ub=np.concatenate(bounds), A_eq=np.ones((1, n)), b_eq=[float(motions)],
-                     bounds=(0.0, 1.0), method="highs")
-    if result.status not in (0, 2):  # 0: a solution, 2: none; anything else is not an answer
-        raise RuntimeError(f"the selection's reachability programme stopped without an answer: {result.message}")
-    return bool(result.status == 0)
+    objective = np.zeros(n + 1)
+    objective[-1] = 1.0
+    result = linprog(objective, A_ub=sparse.vstack(rows).tocsr(), b_ub=np.concatenate(bounds), A_eq=np.append(np.ones(n), 0.0)[None, :],
+                     b_eq=[float(motions)], bounds=[(0.0, 1.0)] * n + [(0.0, tolerance)], method="highs")
+    if result.status == 2 and tolerance is not None:
+        return None
+    if result.status != 0:  # without a tolerance a set, hence a solution, exists: the rules' capacity was checked
+        raise RuntimeError(f"the selection's programme for the target stopped without an answer: {result.message}")
+    return float(result.x[-1]), result.x[:-1]
+
+
+def _heaviest_allowed(weights: np.ndarray, motions: int, rules: _Rules) -> list[int]:
+    """``motions`` candidates, the heaviest first (ties to the earlier row), each allowed by the rules beside those before it."""
+    order = np.lexsort((np.arange(weights.size), -weights))
+    chosen: list[int] = []
+    while len(chosen) < motions:
+        allowed = rules.allowed(chosen)
+        chosen.append(int(next(i for i in order if allowed[i])))
+    return chosen
 
 
 def misses_target(mean_ln: np.ndarray, std_ln: np.ndarray, median: np.ndarray, sigma_ln: np.ndarray) -> np.ndarray:

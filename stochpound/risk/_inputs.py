@@ -451,8 +451,8 @@ def selection_misses(store: xr.Dataset) -> list[float]:
 
 
 def unreachable_targets(store: xr.Dataset) -> list[float]:
-    """The levels (in the levels' units) whose stripe misses its target and whose pool cannot meet its mean at all
-    (``selection_target_reachable`` 0: no set of the pool can, a linear-programming bound); [] for a store that does not say."""
+    """The levels (in the levels' units) whose stripe misses its target and whose pool cannot meet it at all
+    (``selection_target_reachable`` 0: no set of the pool can, by linear-programming bounds); [] for a store that does not say."""
     if "selection_target_reachable" not in store:
         return []
     unreachable = dict(zip(store["intensity"].values, store["selection_target_reachable"].values == 0))

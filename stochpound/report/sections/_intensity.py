@@ -289,8 +289,8 @@ def _unreachable_text(store: xr.Dataset, setting: Intensity) -> str:
     unreachable = unreachable_targets(store)
     if not unreachable:
         return ""
-    return (f" At {', '.join(f'{level:g}' for level in unreachable)} {setting.units} no set of the pool's motions can meet the target's mean "
-            f"within {TARGET_TOLERANCE:g} at every period (a linear-programming bound over the pool under the selection's rules): the miss "
+    return (f" At {', '.join(f'{level:g}' for level in unreachable)} {setting.units} no set of the pool's motions can meet the target "
+            f"within {TARGET_TOLERANCE:g} at every period (linear-programming bounds over the pool under the selection's rules): the miss "
             "is the pool's, whose motions lack the target's spectral shape there, and another search of the same pool would not remove it.")
 
 
