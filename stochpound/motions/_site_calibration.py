@@ -87,7 +87,9 @@ ITERATIONS = 6
 #: Fixed-point iterations after them on the regressions' layer (each simulates every scenario's motions once).
 REGRESSED_ITERATIONS = 2
 #: The name a calibration fitted by :func:`fit_calibration` carries (stores name the calibration their motions came from).
-CALIBRATION_NAME = "nga_west2_calibration_4"
+CALIBRATION_NAME = "nga_west2_calibration_5"
+#: Periods the fit simulates (s; None: PGA, which moves the first node's gain with PSA(0.05 s)'s: :func:`fit_calibration`).
+FIT_PERIODS: tuple[float | None, ...] = (None, *SHAPE_PERIODS)
 #: Ridge weight of the shape layer's regressions (per coefficient, the intercept free).
 RIDGE = 1e-3
 #: Motions simulated at a time where only their spectra are kept (memory: 8 n_time bytes a motion).
@@ -207,8 +209,8 @@ def _ridge(features: np.ndarray, values: np.ndarray) -> np.ndarray:
 
 def _draw_all(base: SiteModel, scenarios: Sequence[tuple], gains: np.ndarray, spreads: np.ndarray, cholesky: np.ndarray, n: int,
               seed: int, dt: float, workers: int) -> list[np.ndarray]:
-    """ln Sa [n, SHAPE_PERIODS] of every scenario's motions through its layer (scenario i: realizations of seed + 1000 i), on ``workers`` processes."""
-    shape_columns = [CHECK_PERIODS.index(p) for p in SHAPE_PERIODS]
+    """ln Sa [n, FIT_PERIODS] of every scenario's motions through its layer (scenario i: realizations of seed + 1000 i), on ``workers`` processes."""
+    shape_columns = [CHECK_PERIODS.index(p) for p in FIT_PERIODS]
     jobs = [(base, s, gains[i], spreads[i], cholesky, n, seed + 1000 * i, dt) for i, s in enumerate(scenarios)]
     if workers <= 1:
         return [_shape_draw(*job)[:, shape_columns] for job in jobs]
@@ -234,6 +236,7 @@ def fit_calibration(n: int = 400, seed: int = 7, dt: float = 0.01, scenarios: Se
     """
     base, k = base_model(), len(SHAPE_PERIODS)
     targets = [target(s, SHAPE_PERIODS) for s in scenarios]
+    pga_targets = [float(target(s, (None,))[0][0]) for s in scenarios]
     x = np.array([shape_features(Scenario(*s)) for s in scenarios])
     bj = _node_correlation(list(SHAPE_PERIODS))
     gains, variances = np.zeros((len(scenarios), k)), np.zeros((len(scenarios), k))  # the data: mean gain and d² of every scenario
@@ -244,12 +247,14 @@ def fit_calibration(n: int = 400, seed: int = 7, dt: float = 0.01, scenarios: Se
             *_, used_gains, used_spreads = _regressed_layer(x, targets, gains, variances)
         draws = _draw_all(base, scenarios, used_gains, used_spreads, np.linalg.cholesky(correlation), n, seed, dt, workers)
         wanted, spread_products, misses = np.zeros((k, k)), np.zeros((k, k)), []
-        for i, ln_sa in enumerate(draws):
+        for i, (pga, ln_sa) in enumerate((draw[:, 0], draw[:, 1:]) for draw in draws):
             mean, sigma = targets[i]
             covariance = np.cov(ln_sa.T)
             simulated = np.sqrt(np.diag(covariance))
-            misses.append((np.max(np.abs(ln_sa.mean(axis=0) - mean)), np.max(np.abs(simulated - sigma))))
+            pga_miss = pga_targets[i] - pga.mean()
+            misses.append((max(np.max(np.abs(ln_sa.mean(axis=0) - mean)), abs(pga_miss)), np.max(np.abs(simulated - sigma))))
             gains[i] += mean - ln_sa.mean(axis=0)
+            gains[i, 0] += 0.5 * (pga_miss - (mean[0] - ln_sa[:, 0].mean()))  # the first node: the mean of its own miss and PGA's
             variances[i] += sigma**2 - simulated**2
             if iteration < iterations:
                 variances[i] = np.maximum(variances[i], 0.0)
