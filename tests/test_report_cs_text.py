@@ -77,7 +77,8 @@ def test_risk_warns_of_stripes_that_miss_their_target_or_lie_beyond_the_truncati
     assert stripes_beyond_truncation(cs_store) == [] and np.all(cs_store.target_epsilon.values <= 3.0)
     clean = cs_store.assign(selection_misses_target=cs_store.selection_misses_target * 0)
     flagged = cs_store.assign(selection_misses_target=cs_store.selection_misses_target.copy(data=[0, 1]),
-                              target_epsilon=cs_store.target_epsilon.copy(data=[1.0, 3.4]))
+                              target_epsilon=cs_store.target_epsilon.copy(data=[1.0, 3.4]),
+                              selection_target_reachable=cs_store.selection_target_reachable.copy(data=[1, 1]))
     assert selection_misses(flagged) == [0.1] and stripes_beyond_truncation(flagged) == [0.1]
     # the design summary's assumptions name them too (the flagships' listed neither, though their 2 %/50 yr stripe missed)
     from stochpound.risk._inputs import assumptions
@@ -135,17 +136,17 @@ def test_the_motion_table_caption_counts_one_simulated_row_per_experiment() -> N
 
 
 def test_a_stripe_whose_pool_cannot_meet_its_target_is_named_as_the_pools_miss(cs_store) -> None:
-    """The intensity section says which missed stripes no set of their pool could meet (``selection_target_reachable`` 0), and
-    nothing of it where every miss was reachable or the store predates the bound."""
-    from stochpound.report.render import Paragraph
-    from stochpound.report.sections._intensity import intensity_section
+    """The risk answer's assumptions (the report's Risk section shows them) say which missed stripes no set of their pool
+    could meet (``selection_target_reachable`` 0), and nothing of it where every miss was reachable or the store predates
+    the bound."""
     from stochpound.risk import unreachable_targets
+    from stochpound.risk._inputs import assumptions
 
     missed = cs_store.assign(selection_misses_target=cs_store.selection_misses_target.copy(data=[1, 1]))
     proven = missed.assign(selection_target_reachable=missed.selection_target_reachable.copy(data=[1, 0]))
+    reachable = missed.assign(selection_target_reachable=missed.selection_target_reachable.copy(data=[1, 1]))
     older = missed.drop_vars("selection_target_reachable")
-    assert unreachable_targets(proven) == [0.1] and unreachable_targets(missed.assign(selection_target_reachable=missed.selection_target_reachable * 0 + 1)) == []
-    assert unreachable_targets(older) == []
-    texts = [" ".join(b.text for b in intensity_section("site", store).blocks if isinstance(b, Paragraph)) for store in (proven, older)]
-    assert "At 0.1 g no set of the pool's motions can meet the target within 0.1" in texts[0]
-    assert "no set of the pool" not in texts[1] and "misses its target" in texts[1]
+    assert unreachable_targets(proven) == [0.1] and unreachable_targets(reachable) == [] and unreachable_targets(older) == []
+    said = [assumptions(store)["selection fit"] for store in (proven, reachable, older)]
+    assert "; at the stripes 0.1 g no set of the pool's motions can meet the target within 0.1 (linear-programming bounds" in said[0]
+    assert all("no set of the pool" not in text and "miss their conditional-spectrum target" in text for text in said[1:])

@@ -336,8 +336,12 @@ def _selection_fit(store: xr.Dataset) -> dict[str, str]:
     misses, beyond = selection_misses(store), stripes_beyond_truncation(store)
     intensity = store.pound.definition.intensity
     units = f" {intensity.units}" if intensity is not None and intensity.units else ""
+    unreachable = unreachable_targets(store)
     said = ([f"the motions chosen at the stripes {', '.join(f'{level:.4g}' for level in misses)}{units} miss their conditional-spectrum "
              "target (mean or standard deviation of ln Sa off by more than 0.1 at a period)"] if misses else []) + (
+            [f"at the stripes {', '.join(f'{level:.4g}' for level in unreachable)}{units} no set of the pool's motions can meet the target "
+             "within 0.1 (linear-programming bounds over the pool under the selection's rules): the miss is the pool's, whose motions "
+             "lack the target's spectral shape there"] if unreachable else []) + (
             [f"the scenario puts the stripes {', '.join(f'{level:.4g}' for level in beyond)}{units} beyond ε {TRUNCATION_EPSILON:g}, "
              "where hazard models truncate the ground motion"] if beyond else [])
     return {"selection fit": "; ".join(said) + ": the answer takes those stripes' motions as the site's there"} if said else {}

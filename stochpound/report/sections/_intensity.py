@@ -45,7 +45,6 @@ from stochpound.risk import (
     selection_misses,
     site_consistency,
     stripes_beyond_truncation,
-    unreachable_targets,
 )
 from stochpound.store import Intensity, has_contact_free, scenario_kind, stripe_holdings, with_contacts
 
@@ -277,21 +276,10 @@ def _selection_text(store: xr.Dataset, setting: Intensity) -> str:
         if not missed
         else f"The selection misses its target (mean or standard deviation of ln Sa off by more than {TARGET_TOLERANCE:g} at a period) at the "
         f"stripes {', '.join(f'{level:g}' for level in missed)} {setting.units}: their motions do not represent the site's at that intensity."
-        f"{_unreachable_text(store, setting)}"
     )
     return (f"The motions of every stripe were chosen for the site: the conditional spectrum of the stripe's scenario (Vs30 "
             f"{float(store['site_vs30'].values[0]):g} m/s, {store['site_mechanism'].values[0]} faulting): {scenarios}.{truncation} {verdict}"
             f"{_holdings(store, setting)}")
-
-
-def _unreachable_text(store: xr.Dataset, setting: Intensity) -> str:
-    """Of the stripes that miss their target, those whose pool cannot meet its mean at all ("" where none, or the store does not say)."""
-    unreachable = unreachable_targets(store)
-    if not unreachable:
-        return ""
-    return (f" At {', '.join(f'{level:g}' for level in unreachable)} {setting.units} no set of the pool's motions can meet the target "
-            f"within {TARGET_TOLERANCE:g} at every period (linear-programming bounds over the pool under the selection's rules): the miss "
-            "is the pool's, whose motions lack the target's spectral shape there, and another search of the same pool would not remove it.")
 
 
 def _fitted_text(store: xr.Dataset, consistency: bool) -> str:
