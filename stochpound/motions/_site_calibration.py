@@ -20,7 +20,9 @@ L the lower factor of the gains' correlation and z the motion's 12 shape
 normals. Fit: for every scenario of :data:`FIT_SCENARIOS`, n motions with
 common random numbers; at each of :data:`ITERATIONS` fixed-point iterations
 their ln Sa moves every scenario's gain by the miss of the median
-(μ_j − simulated mean) and its spread by the miss of the variance
+(μ_j − simulated mean; the first node's, 0.05 s, by the mean of its own
+miss and PGA's, so that PGA, which the short-period band makes together,
+is a target too) and its spread by the miss of the variance
 (d_j² += σ_j² − simulated variance), and the correlation becomes the
 covariance the layer must add (Baker–Jayaram's times σ σ, minus the
 simulated one without the layer's), summed over the scenarios and divided
@@ -210,12 +212,12 @@ def _ridge(features: np.ndarray, values: np.ndarray) -> np.ndarray:
 def _draw_all(base: SiteModel, scenarios: Sequence[tuple], gains: np.ndarray, spreads: np.ndarray, cholesky: np.ndarray, n: int,
               seed: int, dt: float, workers: int) -> list[np.ndarray]:
     """ln Sa [n, FIT_PERIODS] of every scenario's motions through its layer (scenario i: realizations of seed + 1000 i), on ``workers`` processes."""
-    shape_columns = [CHECK_PERIODS.index(p) for p in FIT_PERIODS]
+    fit_columns = [CHECK_PERIODS.index(p) for p in FIT_PERIODS]
     jobs = [(base, s, gains[i], spreads[i], cholesky, n, seed + 1000 * i, dt) for i, s in enumerate(scenarios)]
     if workers <= 1:
-        return [_shape_draw(*job)[:, shape_columns] for job in jobs]
+        return [_shape_draw(*job)[:, fit_columns] for job in jobs]
     with ProcessPoolExecutor(workers) as pool:
-        return [ln_sa[:, shape_columns] for ln_sa in pool.map(_shape_draw, *zip(*jobs))]
+        return [ln_sa[:, fit_columns] for ln_sa in pool.map(_shape_draw, *zip(*jobs))]
 
 
 def _regressed_layer(x: np.ndarray, targets: list, gains: np.ndarray, variances: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
