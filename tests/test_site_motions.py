@@ -315,3 +315,28 @@ def test_the_fit_is_the_same_on_one_or_two_processes_and_its_last_iterations_use
     assert len(one["history"]) == 2 and one["regressed_iterations"] == 1
     own = fit_calibration(**small, regressed_iterations=0)
     assert own["history"] == one["history"][:1] and not np.allclose(own["mean"], one["mean"])
+
+
+def test_the_fit_moves_the_first_node_by_the_mean_of_its_own_and_pga_s_misses(monkeypatch):
+    """PGA is a target of the fit: with the simulation replaced by draws that miss PGA by 0.3 and nothing else, one iteration
+    raises the 0.05 s node's gain by 0.15 (half of it) against draws that miss nothing, and no other node's (the regressions
+    are linear in their data and their intercept is free, so a constant shift of the data is their intercept's)."""
+    import stochpound.motions._site_calibration as calibration
+
+    scenarios = calibration.FIT_SCENARIOS[:15]
+    noise = np.random.default_rng(5).normal(0.0, 0.5, (len(scenarios), 40, len(calibration.FIT_PERIODS)))
+
+    def draws(pga_miss):
+        def _draw_all(base, fitted, gains, spreads, cholesky, n, seed, dt, workers):
+            means = [np.array(target(s, calibration.FIT_PERIODS)[0]) - np.eye(len(calibration.FIT_PERIODS))[0] * pga_miss for s in fitted]
+            return [m + e for m, e in zip(means, noise)]
+        return _draw_all
+
+    fits = []
+    for pga_miss in (0.3, 0.0):
+        monkeypatch.setattr(calibration, "_draw_all", draws(pga_miss))
+        fits.append(calibration.fit_calibration(n=40, scenarios=scenarios, iterations=1, regressed_iterations=0))
+    difference = np.array(fits[0]["mean"]) - np.array(fits[1]["mean"])  # rows: nodes; columns: features, the intercept first
+    expected = np.zeros_like(difference)
+    expected[0, 0] = -0.15  # r = mu - gain: the gain 0.15 higher
+    np.testing.assert_allclose(difference, expected, atol=1e-9)
