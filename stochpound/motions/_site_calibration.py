@@ -237,8 +237,9 @@ def fit_calibration(n: int = 400, seed: int = 7, dt: float = 0.01, scenarios: Se
     (the numbers do not depend on how many).
     """
     base, k = base_model(), len(SHAPE_PERIODS)
-    targets = [target(s, SHAPE_PERIODS) for s in scenarios]
-    pga_targets = [float(target(s, (None,))[0][0]) for s in scenarios]
+    fit_targets = [target(s, FIT_PERIODS) for s in scenarios]  # PGA first, then the nodes
+    targets = [(mean[1:], sigma[1:]) for mean, sigma in fit_targets]
+    pga_targets = [float(mean[0]) for mean, _ in fit_targets]
     x = np.array([shape_features(Scenario(*s)) for s in scenarios])
     bj = _node_correlation(list(SHAPE_PERIODS))
     gains, variances = np.zeros((len(scenarios), k)), np.zeros((len(scenarios), k))  # the data: mean gain and d² of every scenario
@@ -253,10 +254,10 @@ def fit_calibration(n: int = 400, seed: int = 7, dt: float = 0.01, scenarios: Se
             mean, sigma = targets[i]
             covariance = np.cov(ln_sa.T)
             simulated = np.sqrt(np.diag(covariance))
-            pga_miss = pga_targets[i] - pga.mean()
-            misses.append((max(np.max(np.abs(ln_sa.mean(axis=0) - mean)), abs(pga_miss)), np.max(np.abs(simulated - sigma))))
-            gains[i] += mean - ln_sa.mean(axis=0)
-            gains[i, 0] += 0.5 * (pga_miss - (mean[0] - ln_sa[:, 0].mean()))  # the first node: the mean of its own miss and PGA's
+            median_miss, pga_miss = mean - ln_sa.mean(axis=0), pga_targets[i] - pga.mean()
+            misses.append((max(np.max(np.abs(median_miss)), abs(pga_miss)), np.max(np.abs(simulated - sigma))))
+            gains[i] += median_miss
+            gains[i, 0] += 0.5 * (pga_miss - median_miss[0])  # the first node: the mean of its own miss and PGA's
             variances[i] += sigma**2 - simulated**2
             if iteration < iterations:
                 variances[i] = np.maximum(variances[i], 0.0)
