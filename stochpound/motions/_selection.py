@@ -32,7 +32,8 @@ programme asks for the mean within :data:`TARGET_TOLERANCE` and, at every
 period, for the weighted sum of squares about the target's mean to allow
 a standard deviation within the tolerance of the target's (a set's variance
 is that sum, over n − 1, less n / (n − 1) times its mean's squared miss).
-Where either fails (``target_reachable`` 0) no set of the pool meets the
+(It runs only where the chosen set misses: a set that meets the target
+proves it reachable.) Where either fails (``target_reachable`` 0) no set of the pool meets the
 target within the tolerance: a miss is the pool's, its motions lack the
 target's shape, not the search's. Where both succeed a set may still miss
 (the weights need not be whole); the first programme's heaviest candidates
@@ -364,9 +365,10 @@ def select_motions(pool: xr.Dataset, target: xr.Dataset, motions: int, max_scale
     chosen = _swap(ln_sa, _heaviest_allowed(programme_weights, motions, rules), mean, sigma, rules)
     if _set_misfit(ln_sa[chosen], mean, sigma) >= best[0]:
         chosen = best[1]
-    reachable = bound <= TARGET_TOLERANCE and _programme(ln_sa, mean, sigma, motions, rules, TARGET_TOLERANCE) is not None
-    picked = eligible[chosen]
     spectra = ln_sa[chosen]
+    met = not misses_target(spectra.mean(axis=0), spectra.std(axis=0, ddof=1), target["median"].values, sigma)  # a set that meets it proves it reachable
+    reachable = met or (bound <= TARGET_TOLERANCE and _programme(ln_sa, mean, sigma, motions, rules, TARGET_TOLERANCE) is not None)
+    picked = eligible[chosen]
     return xr.Dataset(
         {
             "motion": ("selected", pool["motion"].values[picked]),
