@@ -58,7 +58,7 @@ IDENTITIES = {
     "f92271bfab4de9cbe54273e9251be8f1481ef9bedc9860afe355b5bfabb6cfaf": "e221f41b4391da05a806a8dd4e30fb896c6f56bfa28574aabd89e50c53a4ba9b",  # experiments/risk/isolated.toml (calibration 4)
     "2795ab6e166ac0bb0c81264023f74f552426266b1da168551c05111afd5cda99": "1d806055c86a373833f66b75190ab07ef6258b322cbe6f6ff55925b6903153f5",  # stochastic/scenario_m7_20km.toml (calibration 4)
     # calibration 5 (PGA a target of the fit): again the definitions name it
-    "8c8ae246d32944798cbafd40ba7431c34e6a750f04e3eb13609ec4b919155b10": "19af4ddbe7eff219f664da68827d55ff6741dd8ac0e43e23f98deb0c4a9303a5",  # experiments/risk/fixed_pair.toml (calibration 5)
+    "7e603f72ad6dc2cc4b5c236cb38f39ae5a01f44568c2bf98c9066e3225e5bf54": "19af4ddbe7eff219f664da68827d55ff6741dd8ac0e43e23f98deb0c4a9303a5",  # experiments/risk/fixed_pair.toml (calibration 5)
     "06dbe7e36e949190951cf046a9f82a161824739cfba7655e097b2799acfd9aac": "f3a55921fe5950299f3d307d982b7299e8774974b41e24b05d5b62dd6ec1d324",  # experiments/risk/isolated.toml (calibration 5)
     "86a14251ac8a879609661c0ee758218c34b18419c2f3f3245a49e31e5e8e98b2": "50bf72d5c1c26fa27c41be45d6b3540cd8555ce3fb349b4a41b013253ed6da88",  # stochastic/scenario_m7_20km.toml (calibration 5)
     "6721b840847f3c887a64063a94280b5d169110c60ef231755da91b89a8300078": "d63aa13f0c17c62515a7f33d09c8af15f2d12f6063f66110f23227a68f70937f",  # experiments/study/gap_study.toml (declares reproduces)
@@ -85,7 +85,7 @@ HAZARD_IDENTITIES = {
     "a9c66c0e67c4e663ca9e1a34a5de92a19ee03c1d8baacb45bb4cf61b70167667": "1190d4e22c8eaa71ec0e300d71dc4c348397c36780196be326b7c93f305de0ae",  # experiments/risk/isolated.toml (calibration 3)
     "3fd94462383c2c24ee90e370f9f660432ad80b2a147abbcefbc4f63eac0b23b9": "4fe970ab06ea26a4a9f36d1b5471df56e80d0360ded99b62e91a6b450eac5e03",  # experiments/risk/fixed_pair.toml (calibration 4)
     "f92271bfab4de9cbe54273e9251be8f1481ef9bedc9860afe355b5bfabb6cfaf": "fa04f6d5fb7b0ea7dbfe90b50324099a7bc2542d288e341f259d7a2976910475",  # experiments/risk/isolated.toml (calibration 4)
-    "8c8ae246d32944798cbafd40ba7431c34e6a750f04e3eb13609ec4b919155b10": "e8a52964ed05bb590075e96c91a507adfa7db174d9a1f1cf345a835553b0feb7",  # experiments/risk/fixed_pair.toml (calibration 5)
+    "7e603f72ad6dc2cc4b5c236cb38f39ae5a01f44568c2bf98c9066e3225e5bf54": "e8a52964ed05bb590075e96c91a507adfa7db174d9a1f1cf345a835553b0feb7",  # experiments/risk/fixed_pair.toml (calibration 5)
     "06dbe7e36e949190951cf046a9f82a161824739cfba7655e097b2799acfd9aac": "bb00a5032692533bf1de73116dde6e4b73e6ca5656a40f2eb4b315d16eda8a2b",  # experiments/risk/isolated.toml (calibration 5)
 }
 
