@@ -5,7 +5,7 @@ Issue 43's measure/seed study, on a pool of records and simulated motions. For e
 pendulum, μ 0.05, no moat, stiff neighbour; contact-free), every Fox Plaza measure (PGA, PSA(T1 = 0.3 s), PSA(1 s),
 PSA(2 s), PSA(3 s), and Sa_avg(0.5-4 s) on its derived curve, :func:`benchmarks.site_consistency.fox_plaza_sa_avg`; each with its own
 scenario fitted to the site's curves) and every selection seed: one experiment
-(:func:`benchmarks.site_consistency.measure_risk`: 40 motions a stripe, at most 3 of an earthquake, scale factor ≤ 5, from
+(:func:`benchmarks.site_consistency.measure_risk`: ``--motions`` motions a stripe, 40 unless stated, at most 3 of an earthquake, scale factor ≤ 5, from
 the 100 FEMA P695 records and ``--simulated`` site-based stochastic motions a stripe drawn by ``--sampling``; the selection's
 seed is the motions' seed too, so another seed is another pool).
 
@@ -127,18 +127,29 @@ def run_one(folder: Path, configuration: str, measure: str, seed: int, pool: Poo
     store, risk = measure_risk(work, measure, configuration, seed=seed, pool=pool, site=site)
     rate = lognormal_rate(store, risk)
     kept = store[[name for name in SELECTION if name in store]].drop_encoding().assign(rate=rate, separation=rate_g_star(rate, risk))
-    kept.attrs = {"configuration": configuration, "measure": measure, "seed": seed, "simulated": pool.simulated, "sampling": pool.sampling,
-                  "seconds": time.time() - began}
+    kept.attrs = {"configuration": configuration, "measure": measure, "seed": seed, "motions": pool.motions, "simulated": pool.simulated,
+                  "sampling": pool.sampling, "seconds": time.time() - began}
     return kept
 
 
 def run(folder: Path, configurations: list[str], measures: list[str], seeds: list[int], pool: Pool, site: Site = FOX_PLAZA) -> None:
-    """Every result not yet in ``folder`` (module docstring), one after the other."""
+    """Every result not yet in ``folder`` (module docstring), one after the other.
+
+    Raises
+    ------
+    SystemExit
+        Naming ``--motions``, where a result already in ``folder`` ran another number of motions a stripe than ``pool``'s.
+    """
     for configuration in configurations:
         for seed in seeds:
             for measure in measures:
                 path = result_path(folder, configuration, measure, seed)
                 if path.exists():
+                    with xr.open_dataset(path) as kept:
+                        motions = int(kept.attrs.get("motions", MOTIONS))  # results from before the option ran MOTIONS
+                    if motions != pool.motions:
+                        raise SystemExit(f"--motions: {path.parent.name}/{path.name} in {folder.name}/ ran {motions} motions a stripe, "
+                                         f"not {pool.motions}: another number needs another folder")
                     continue
                 path.parent.mkdir(parents=True, exist_ok=True)
                 result = run_one(folder, configuration, measure, seed, pool, site)
@@ -407,7 +418,13 @@ def tables(folder: Path, configurations: list[str], measures: list[str], seeds: 
 G_HEADER = ["max/min over the measures' medians", "over measures and seeds", "seed spread of g*, largest (measure)",
             "seed spread of λ at the median g*, largest (measure)"]
 SELECTION_HEADER = ["configuration, measure", "fitted scenario", "ε of the stripes", "stripes off by > 0.1", "worst: mean / σ of ln Sa off by",
-                    f"simulated of {MOTIONS} a stripe", "earthquakes a stripe"]
+                    "simulated motions a stripe", "earthquakes a stripe"]
+
+
+def _motions_option(settings: dict) -> str:
+    """The ``--motions`` option of a study's command, where its results ran other than :data:`MOTIONS` a stripe."""
+    motions = settings.get("motions", MOTIONS)
+    return "" if motions == MOTIONS else f" --motions {motions}"
 
 
 def section(folder: Path, configurations: list[str], measures: list[str], seeds: list[int]) -> str:
@@ -415,7 +432,8 @@ def section(folder: Path, configurations: list[str], measures: list[str], seeds:
     spreads, selected, seconds, settings = tables(folder, configurations, measures, seeds)
     provenance = json.loads((folder / "provenance.json").read_text()) if (folder / "provenance.json").exists() else {}
     lines = [SECTION.start, "## g* by conditioning measure and selection seed at Fox Plaza", "",
-             f"`python -m benchmarks measure_seeds run FOLDER --simulated {settings['simulated']} --sampling {settings['sampling']}`, then "
+             f"`python -m benchmarks measure_seeds run FOLDER{_motions_option(settings)} --simulated {settings['simulated']} --sampling "
+             f"{settings['sampling']}`, then "
              "`python -m benchmarks measure_seeds table FOLDER --write` (issue 43's measure/seed study; "
              f"{len(seconds)} experiments, {min(seconds):.0f}–{max(seconds):.0f} s each, {sum(seconds) / 60:.0f} min in all; "
              f"commit {provenance.get('commit', 'unknown')}, started {provenance.get('date', 'unknown')}, "
@@ -423,7 +441,7 @@ def section(folder: Path, configurations: list[str], measures: list[str], seeds:
              "may share the cores, and then each experiment's time is under that load). The elastic buildings of `benchmarks.site_consistency`, "
              f"contact-free, stripes at the intensities of {', '.join(f'{t:g}' for t in RETURN_PERIODS[:-1])} and {RETURN_PERIODS[-1]:g} years of each measure "
              "(PSA(0.3 s)'s curve stops at 3431 years: its top stripe there), each measure with its own scenario fitted to the "
-             f"site's PGA, PSA(1, 2, 3 s) curves (and its own), Vs30 400 m/s, reverse faulting; {MOTIONS} motions a stripe, at most {MAX_PER_EARTHQUAKE} of "
+             f"site's PGA, PSA(1, 2, 3 s) curves (and its own), Vs30 400 m/s, reverse faulting; {settings.get('motions', MOTIONS)} motions a stripe, at most {MAX_PER_EARTHQUAKE} of "
              "one earthquake, scale factor ≤ 5, from the 100 FEMA P695 records and "
              f"{settings['simulated']} site-based stochastic motions a stripe ({settings['sampling']} sampling, `[site] simulated_sampling`; "
              "the hazard-compatible model with its current calibration; the selection's seed is the motions' seed too, so another "
@@ -453,6 +471,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--configurations", nargs="+", default=list(CONFIGURATIONS), choices=list(CONFIGURATIONS))
     parser.add_argument("--measures", nargs="+", default=None, choices=list(MEASURE_ARGS), help="default: the site's")
     parser.add_argument("--seeds", nargs="+", type=int, default=list(SEEDS))
+    parser.add_argument("--motions", type=int, default=MOTIONS, help="run: motions a stripe (default %(default)s; another number, another folder)")
     parser.add_argument("--simulated", type=int, default=2000, help="simulated motions a stripe (default %(default)s)")
     parser.add_argument("--sampling", choices=("scenario", "tilted"), default="tilted")
     parser.add_argument("--write", action="store_true", help="rewrite the section of docs/benchmarks.md (Fox Plaza's study)")
@@ -486,7 +505,7 @@ def main(argv: list[str] | None = None) -> int:
         if not provenance.exists():
             provenance.write_text(json.dumps(machine()))  # its commit, date and load as the study starts
         run(arguments.folder, arguments.configurations, arguments.measures, arguments.seeds,
-            Pool(MOTIONS, arguments.simulated, MAX_PER_EARTHQUAKE, arguments.sampling), site)
+            Pool(arguments.motions, arguments.simulated, MAX_PER_EARTHQUAKE, arguments.sampling), site)
         return 0
     if arguments.action == "measure_free":
         if site.ruptures is None:  # Fox Plaza: ruptures fitted to its 17 curves stand in for the ones it does not give

@@ -56,6 +56,9 @@ def test_a_run_keeps_each_result_and_does_not_redo_it(tmp_path, monkeypatch) -> 
     measure_seeds.run(tmp_path, ["fixed pair", "isolated"], ["PGA", "PSA(1 s)"], [1, 2], pool)
     assert done[4:] == [("isolated", m, s) for s in (1, 2) for m in ("PGA", "PSA(1 s)")]
     assert measure_seeds.result_path(tmp_path, "fixed pair", "PSA(T1 = 0.3 s)", 3).name == "psat1_0p3s-seed3.nc"
+    with pytest.raises(SystemExit, match=r"--motions: .*ran 40 motions a stripe, not 120"):  # a folder holds one number of motions
+        measure_seeds.run(tmp_path, ["fixed pair"], ["PGA"], [1], Pool(120, 10, 3, "tilted"))
+    assert len(done) == 8
 
 
 @pytest.mark.parametrize("sampling, line", [("tilted", 'simulated_sampling = "tilted"\n'), ("scenario", "")])
