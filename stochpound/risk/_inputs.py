@@ -30,7 +30,7 @@ from stochpound.codes import store_contact_demands
 from stochpound.hazard import HazardCurve, check_covers, hazard_curve, hazard_option, parse_units, stored_hazard, StatedMeasure
 from stochpound.model import Scene
 from stochpound.model.scene_tables import BuildingTable
-from stochpound.motions import DEFAULT_G, TRUNCATION_EPSILON
+from stochpound.motions import DEFAULT_G, TARGET_TOLERANCE, TRUNCATION_EPSILON
 from stochpound.risk._assumptions import scene_assumptions, simulated_motions_text
 from stochpound.risk._code_rules import MINIMUM_MOTIONS
 from stochpound.store import (LIMIT_STATE_DEMANDS, Definition, Design, Intensity, Label, LimitStates, MuAxis, cases_done, check_finished as _check_finished, contact_free, gap_dims,
@@ -338,9 +338,9 @@ def _selection_fit(store: xr.Dataset) -> dict[str, str]:
     units = f" {intensity.units}" if intensity is not None and intensity.units else ""
     unreachable = unreachable_targets(store)
     said = ([f"the motions chosen at the stripes {', '.join(f'{level:.4g}' for level in misses)}{units} miss their conditional-spectrum "
-             "target (mean or standard deviation of ln Sa off by more than 0.1 at a period)"] if misses else []) + (
+             f"target (mean or standard deviation of ln Sa off by more than {TARGET_TOLERANCE:g} at a period)"] if misses else []) + (
             [f"at the stripes {', '.join(f'{level:.4g}' for level in unreachable)}{units} no set of the pool's motions can meet the target "
-             "within 0.1 (linear-programming bounds over the pool under the selection's rules): the miss is the pool's, whose motions "
+             f"within {TARGET_TOLERANCE:g} (linear-programming bounds over the pool under the selection's rules): the miss is the pool's, whose motions "
              "lack the target's spectral shape there"] if unreachable else []) + (
             [f"the scenario puts the stripes {', '.join(f'{level:.4g}' for level in beyond)}{units} beyond ε {TRUNCATION_EPSILON:g}, "
              "where hazard models truncate the ground motion"] if beyond else [])
