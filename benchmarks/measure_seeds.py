@@ -456,8 +456,7 @@ def section(folder: Path, configurations: list[str], measures: list[str], seeds:
     if SA_AVG in measures:
         lines += ["", f"{SA_AVG}'s curve is DERIVED, not published (the bundled Fox Plaza curves are per period): the hazard of the "
                   "ruptures fitted to the site's 17 curves at Vs30 400 m/s (`benchmarks.site_consistency.fox_plaza_sa_avg`), its scenario "
-                  "fitted to the four curves and that one, given to `[site] curves` as a file; its experiments ran after the others' "
-                  "(the study resumed with `--measures \"Sa_avg(0.5-4 s)\"`, on a later commit than the one above)."]
+                  "fitted to the four curves and that one, given to `[site] curves` as a file."]
     lines += ["", "Conclusions: [intensity.md](intensity.md) (\"The measure and seed study on tilted pools\", \"Which measure is right at "
               "Fox Plaza\").", SECTION.end]
     return "\n".join(lines) + "\n"
