@@ -146,7 +146,7 @@ def run(folder: Path, configurations: list[str], measures: list[str], seeds: lis
                 path = result_path(folder, configuration, measure, seed)
                 if path.exists():
                     with xr.open_dataset(path) as kept:
-                        motions = int(kept.attrs.get("motions", MOTIONS))  # results from before the option ran MOTIONS
+                        motions = result_motions(kept.attrs)
                     if motions != pool.motions:
                         raise SystemExit(f"--motions: {path.parent.name}/{path.name} in {folder.name}/ ran {motions} motions a stripe, "
                                          f"not {pool.motions}: another number needs another folder")
@@ -421,9 +421,14 @@ SELECTION_HEADER = ["configuration, measure", "fitted scenario", "ε of the stri
                     "simulated motions a stripe", "earthquakes a stripe"]
 
 
+def result_motions(settings: dict) -> int:
+    """The motions a stripe of a result (its attributes): :data:`MOTIONS` for results from before ``--motions``."""
+    return int(settings.get("motions", MOTIONS))
+
+
 def _motions_option(settings: dict) -> str:
     """The ``--motions`` option of a study's command, where its results ran other than :data:`MOTIONS` a stripe."""
-    motions = settings.get("motions", MOTIONS)
+    motions = result_motions(settings)
     return "" if motions == MOTIONS else f" --motions {motions}"
 
 
@@ -441,7 +446,7 @@ def section(folder: Path, configurations: list[str], measures: list[str], seeds:
              "may share the cores, and then each experiment's time is under that load). The elastic buildings of `benchmarks.site_consistency`, "
              f"contact-free, stripes at the intensities of {', '.join(f'{t:g}' for t in RETURN_PERIODS[:-1])} and {RETURN_PERIODS[-1]:g} years of each measure "
              "(PSA(0.3 s)'s curve stops at 3431 years: its top stripe there), each measure with its own scenario fitted to the "
-             f"site's PGA, PSA(1, 2, 3 s) curves (and its own), Vs30 400 m/s, reverse faulting; {settings.get('motions', MOTIONS)} motions a stripe, at most {MAX_PER_EARTHQUAKE} of "
+             f"site's PGA, PSA(1, 2, 3 s) curves (and its own), Vs30 400 m/s, reverse faulting; {result_motions(settings)} motions a stripe, at most {MAX_PER_EARTHQUAKE} of "
              "one earthquake, scale factor ≤ 5, from the 100 FEMA P695 records and "
              f"{settings['simulated']} site-based stochastic motions a stripe ({settings['sampling']} sampling, `[site] simulated_sampling`; "
              "the hazard-compatible model with its current calibration; the selection's seed is the motions' seed too, so another "
