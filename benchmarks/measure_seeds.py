@@ -492,6 +492,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--estimator", choices=("lognormal", "fragility"), default="lognormal",
                         help="measure_free and table: each measure's g* from a lognormal demand per stripe (default) or the risk chain's fragility fits")
     arguments = parser.parse_args(argv)
+    if arguments.motions < 2:  # before the folder is made: the experiments' own check would come as a traceback, mid-study
+        parser.error(f"--motions: must be at least 2 motions a stripe, got {arguments.motions}")
     if arguments.site == "scenario" and arguments.vs30 != 400.0:
         parser.error("--vs30: Fox Plaza's assumed Vs30; the site of one scenario takes its own in --scenario's site")
     if arguments.site != "scenario":

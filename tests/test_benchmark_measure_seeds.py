@@ -289,3 +289,10 @@ def test_fox_plaza_s_stand_in_ruptures_are_a_site_of_ruptures_whose_table_reads_
     with pytest.raises(SystemExit):
         measure_seeds.main(["run", str(tmp_path), "--site", "fox_plaza_ruptures"])
     assert "--sampling: a site of ruptures draws" in capsys.readouterr().err
+
+
+def test_too_few_motions_a_stripe_are_refused_before_the_folder_is_made(tmp_path, capsys) -> None:
+    with pytest.raises(SystemExit):
+        measure_seeds.main(["run", str(tmp_path / "study"), "--motions", "1"])
+    assert "--motions: must be at least 2 motions a stripe, got 1" in capsys.readouterr().err
+    assert not (tmp_path / "study").exists()
