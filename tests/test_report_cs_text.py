@@ -100,6 +100,21 @@ def test_risk_warns_of_stripes_that_miss_their_target_or_lie_beyond_the_truncati
             "at a period) at the stripes 0.1 g") in outputs[1]
     assert ("warning: the scenario puts the stripes 0.1 g beyond ε 3, where hazard models truncate the ground motion: no earthquake of "
             "that scenario causes them there") in outputs[1]
+    assert "no set of the pool's motions can meet the target" not in outputs[0] + outputs[1]  # reachable: the search's miss
+
+
+def test_risk_warns_of_stripes_whose_pool_cannot_meet_the_target(cs_store, tmp_path) -> None:
+    """``stochpound risk`` says where a stripe's miss is the pool's (``selection_target_reachable`` 0), as the report's
+    assumptions do; it said only that the stripe missed."""
+    unreachable = cs_store.assign(selection_misses_target=cs_store.selection_misses_target.copy(data=[0, 1]),
+                                  selection_target_reachable=cs_store.selection_target_reachable.copy(data=[1, 0]))
+    unreachable.to_netcdf(tmp_path / "unreachable.nc")
+    result = invoke("risk", str(tmp_path / "unreachable.nc"), "--bootstrap", "0")
+    assert result.exit_code == 0, result.output
+    assert ("warning: at the stripes 0.1 g no set of the pool's motions can meet the target within 0.1 (linear-programming bounds under "
+            "the selection's rules): the pool lacks the target's spectral shape there (more or tilted simulated motions may supply it)"
+            ) in result.stdout
+    assert "the motions chosen for the site miss their conditional-spectrum target" in result.stdout
 
 
 def test_the_motion_table_lists_the_motions_that_ran_not_the_pool(cs_store) -> None:

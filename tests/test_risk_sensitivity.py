@@ -35,7 +35,7 @@ def _inputs(motions: int = 40, levels: tuple[float, ...] = (0.2, 0.4, 0.8, 1.6),
                            coords={"mu": [0.05, 0.08], "intensity": grid, "record": [f"r{i}" for i in range(motions)]})
     return RiskInputs(setting=None, hazard=HAZARD, studied=None, method="stripes", closure=closure, motion_intensity=None, motions=motions,
                       stripes=grid.size, progress="", experiment="synthetic", assumptions={}, design=None, demands=None, isolator=None,
-                      dtm_note="", scenes={}, selection_misses=(), beyond_truncation=())
+                      dtm_note="", scenes={}, selection_misses=(), unreachable_targets=(), beyond_truncation=())
 
 
 def _exact(inputs: RiskInputs, grid: np.ndarray, mu: float, target: float) -> float:

@@ -221,7 +221,8 @@ def risk(store: Path, hazard: str | None, hazard_measure: str | None, hazard_uni
             if others and result.method != "stripes":
                 raise click.BadParameter("the sensitivity table is of stripes; the store holds IDA capacities", param_hint="--sensitivity-store")
             spread = None if result.method != "stripes" else separation_sensitivity(result, data, collapse, alternatives=alternatives)
-            missed, beyond = inputs.selection_misses, inputs.beyond_truncation  # every read of the store before the first answer
+            missed, unreachable, beyond = inputs.selection_misses, inputs.unreachable_targets, inputs.beyond_truncation  # every read of the
+            # store before the first answer
             measure_lines = efficient_measure_lines(data, hazard)
             free = None if site is None else measure_free_answer(data, site, ruptures_runs, seed, targets, years, workers)
     except (StochpoundError, ValueError) as error:
@@ -236,6 +237,10 @@ def risk(store: Path, hazard: str | None, hazard_measure: str | None, hazard_uni
     if missed:
         click.echo(f"warning: the motions chosen for the site miss their conditional-spectrum target (mean or std of ln Sa off by more than "
                    f"{TARGET_TOLERANCE:g} at a period) at the stripes {', '.join(f'{level:g}' for level in missed)} {result.setting.units}")
+    if unreachable:
+        click.echo(f"warning: at the stripes {', '.join(f'{level:g}' for level in unreachable)} {result.setting.units} no set of the pool's "
+                   f"motions can meet the target within {TARGET_TOLERANCE:g} (linear-programming bounds under the selection's rules): the "
+                   "pool lacks the target's spectral shape there (more or tilted simulated motions may supply it)")
     if beyond:
         click.echo(f"warning: the scenario puts the stripes {', '.join(f'{level:g}' for level in beyond)} {result.setting.units} beyond "
                    f"ε {TRUNCATION_EPSILON:g}, where hazard models truncate the ground motion: no earthquake of that scenario causes them there")

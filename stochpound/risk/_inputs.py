@@ -107,6 +107,8 @@ class RiskInputs:
         ``CASE_DIMS``, in their order), for the design analysis; empty without a design.
     selection_misses : tuple of float
         The levels whose stripe's selection for the site misses its target (:func:`selection_misses`).
+    unreachable_targets : tuple of float
+        Of ``selection_misses``, the levels whose pool no set can meet the target from (:func:`unreachable_targets`).
     beyond_truncation : tuple of float
         The levels whose stripe's scenario puts them beyond the ground motion's truncation (:func:`stripes_beyond_truncation`).
     """
@@ -128,6 +130,7 @@ class RiskInputs:
     dtm_note: str
     scenes: dict[tuple[Any, ...], Scene]
     selection_misses: tuple[float, ...]
+    unreachable_targets: tuple[float, ...]
     beyond_truncation: tuple[float, ...]
 
 
@@ -168,7 +171,7 @@ def read_risk_inputs(store: xr.Dataset, hazard: HazardCurve | None = None, *, st
     read = {"setting": intensity_setting(store), "motion_intensity": motion_intensity(store) if ida else None,
             "stripes": stripes_run(store, closure), "progress": progress(store), "experiment": experiment_name(store),
             "assumptions": assumptions(store, _scenes_or_none(store, closure)), "selection_misses": tuple(selection_misses(store)),
-            "beyond_truncation": tuple(stripes_beyond_truncation(store))}
+            "unreachable_targets": tuple(unreachable_targets(store)), "beyond_truncation": tuple(stripes_beyond_truncation(store))}
     scenes = configuration_scenes(store, demands["peak_closure"]) if demands is not None and design is not None else {}
     return RiskInputs(hazard=hazard, studied=studied, method="ida" if ida else "stripes", closure=closure, motions=motions, design=design,
                       demands=demands, isolator=isolator, dtm_note=dtm_note, scenes=scenes, **read)
