@@ -67,8 +67,8 @@ IDENTITIES = {
     "9eb3e480c894b5bc34df43b5b9a8de0d7f73faa83a3f65cbeb7e49152b4225f2": "82e15f9008cd583a3af79c9689770e8de7646b09322d1ecfd1d153b940b451e2",  # experiments/study/pair_records.toml (declares reproduces)
     # experiments/study/single_isolated.toml (declares reproduces)
     "9a9e8639340c6742f144c3a5eee10f4e5d01d648a5ae3fe097441832f7061a34": "740a608956d013e4f9f9a57339b973a7409ce0f1f55a9322ee58b8ba12740eec",
-    "a7884a051c76c657764f6b0fdadf29aeabb15cf2d539a42ad52e0341048c5d61": "19af4ddbe7eff219f664da68827d55ff6741dd8ac0e43e23f98deb0c4a9303a5",  # experiments/risk/fixed_pair.toml (calibration 5, comments of session 21)
-    "a96b3a7a523ad673a30620482f99af6dbe405d5e25d8dd6eb1448c9b1b8e00e5": "f3a55921fe5950299f3d307d982b7299e8774974b41e24b05d5b62dd6ec1d324",  # experiments/risk/isolated.toml (calibration 5, comments of session 21)
+    "a7884a051c76c657764f6b0fdadf29aeabb15cf2d539a42ad52e0341048c5d61": "19af4ddbe7eff219f664da68827d55ff6741dd8ac0e43e23f98deb0c4a9303a5",  # experiments/risk/fixed_pair.toml (session 21)
+    "a96b3a7a523ad673a30620482f99af6dbe405d5e25d8dd6eb1448c9b1b8e00e5": "f3a55921fe5950299f3d307d982b7299e8774974b41e24b05d5b62dd6ec1d324",  # experiments/risk/isolated.toml (session 21)
     "26d2a268b3f4a622628565cd51e3367cf1c79becaa7c01aec4e1f43cf88b8054": "f9c42487b3ad4b044644d20558a72579ee254c36dab4f07defbe929c5049175c",  # experiments/risk/seed2/fixed_pair.toml
     "169bb8d74abd642f9a11b0ed00ae026bdc51595cdabc07f759e2d75a4ec4ac63": "792ca848b7699a1606f1904541f65233e4b1d967c180bd85f4128a4528dbafbf",  # experiments/risk/seed2/isolated.toml
 }
@@ -91,8 +91,8 @@ HAZARD_IDENTITIES = {
     "f92271bfab4de9cbe54273e9251be8f1481ef9bedc9860afe355b5bfabb6cfaf": "fa04f6d5fb7b0ea7dbfe90b50324099a7bc2542d288e341f259d7a2976910475",  # experiments/risk/isolated.toml (calibration 4)
     "7e603f72ad6dc2cc4b5c236cb38f39ae5a01f44568c2bf98c9066e3225e5bf54": "e8a52964ed05bb590075e96c91a507adfa7db174d9a1f1cf345a835553b0feb7",  # experiments/risk/fixed_pair.toml (calibration 5)
     "06dbe7e36e949190951cf046a9f82a161824739cfba7655e097b2799acfd9aac": "bb00a5032692533bf1de73116dde6e4b73e6ca5656a40f2eb4b315d16eda8a2b",  # experiments/risk/isolated.toml (calibration 5)
-    "a7884a051c76c657764f6b0fdadf29aeabb15cf2d539a42ad52e0341048c5d61": "e8a52964ed05bb590075e96c91a507adfa7db174d9a1f1cf345a835553b0feb7",  # experiments/risk/fixed_pair.toml (calibration 5, comments of session 21)
-    "a96b3a7a523ad673a30620482f99af6dbe405d5e25d8dd6eb1448c9b1b8e00e5": "bb00a5032692533bf1de73116dde6e4b73e6ca5656a40f2eb4b315d16eda8a2b",  # experiments/risk/isolated.toml (calibration 5, comments of session 21)
+    "a7884a051c76c657764f6b0fdadf29aeabb15cf2d539a42ad52e0341048c5d61": "e8a52964ed05bb590075e96c91a507adfa7db174d9a1f1cf345a835553b0feb7",  # experiments/risk/fixed_pair.toml (session 21)
+    "a96b3a7a523ad673a30620482f99af6dbe405d5e25d8dd6eb1448c9b1b8e00e5": "bb00a5032692533bf1de73116dde6e4b73e6ca5656a40f2eb4b315d16eda8a2b",  # experiments/risk/isolated.toml (session 21)
     "26d2a268b3f4a622628565cd51e3367cf1c79becaa7c01aec4e1f43cf88b8054": "768a20c21d19f144dd0ddcc36a279b7c66038e0399b9ad5e0e12b4d13143632d",  # experiments/risk/seed2/fixed_pair.toml
     "169bb8d74abd642f9a11b0ed00ae026bdc51595cdabc07f759e2d75a4ec4ac63": "4c9942a1608fa2898b61a701a0267b8ef007bb560e3f4671f7160b3727d7ca03",  # experiments/risk/seed2/isolated.toml
 }

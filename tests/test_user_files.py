@@ -146,7 +146,7 @@ def test_a_byte_order_mark_is_not_an_error(tmp_path):
 def test_check_of_a_pool_too_small_for_its_motions_is_one_line(tmp_path):
     text = (REPOSITORY / "experiments" / "risk" / "fixed_pair.toml").read_text()
     records = '[[records]]\nsuite = "fema_p695_far_field"\nmembers = ["01a", "03b", "05a"]\n\n'
-    text = text[:text.index("[[records]]")] + records + text[text.index("[intensity]"):]
+    text = text[:text.index("\n[[records]]") + 1] + records + text[text.index("\n[intensity]") + 1:]  # the tables, not the comments naming them
     path = tmp_path / "cs.toml"
     text = re.sub(r"(?m)^simulated_(motions|sampling) = .*\n", "", re.sub(r"(?m)^motions = \d+", "motions = 4", text))  # the three records only
     assert not re.search(r"(?m)^simulated_motions", text)
