@@ -2,7 +2,7 @@
 
 Loads the experiment file (its scenario fitted, ``[site] simulated_motions``
 replaced by ``--simulated N`` where given, ``[site] simulated_sampling = S``
-added with ``--sampling``, ``[intensity] seed`` replaced by ``--seed``), computes its selection (the fit,
+added with ``--sampling``, ``[intensity] seed`` replaced by ``--seed`` as ``stochpound experiment run --seed`` does), computes its selection (the fit,
 the pool of records and simulated motions, pre-screened beyond
 ``SCREEN_BASE`` (stochpound.experiment's site selection) motions, and every stripe's
 choice: :attr:`stochpound.experiment.Experiment.selection`) and prints, per
@@ -40,15 +40,12 @@ SIMULATED_LINE = re.compile(r"^simulated_motions\s*=\s*\d+", re.MULTILINE)
 """The ``[site] simulated_motions`` line of a flagship file."""
 SAMPLING_LINE = re.compile(r'^simulated_sampling\s*=\s*"[a-z]+"', re.MULTILINE)
 """The ``[site] simulated_sampling`` line of a flagship file, where it has one (replaced, not repeated, by ``--sampling``)."""
-SEED_LINE = re.compile(r"^seed\s*=\s*\d+", re.MULTILINE)
-"""The ``[intensity] seed`` line of a flagship file (its only ``seed``)."""
 
 
-def with_simulated(path: Path, count: int | None, folder: Path, sampling: str | None = None, seed: int | None = None) -> Path:
-    """The experiment file with ``simulated_motions = count``, ``simulated_sampling = sampling`` (its line replaced, else one added
-    after ``simulated_motions``), and ``seed = seed``
-    (a copy in ``folder``; the file itself when all are None)."""
-    if count is None and sampling is None and seed is None:
+def with_simulated(path: Path, count: int | None, folder: Path, sampling: str | None = None) -> Path:
+    """The experiment file with ``simulated_motions = count`` and ``simulated_sampling = sampling`` (its line replaced, else one
+    added after ``simulated_motions``): a copy in ``folder``; the file itself when both are None."""
+    if count is None and sampling is None:
         return path
     text = path.read_text()
     found = SIMULATED_LINE.search(text)
@@ -61,10 +58,6 @@ def with_simulated(path: Path, count: int | None, folder: Path, sampling: str | 
         text = f'{text[:end]}\nsimulated_sampling = "{sampling}"{text[end:]}'
     if count is not None:
         text = SIMULATED_LINE.sub(f"simulated_motions = {count}", text, count=1)
-    if seed is not None:
-        if len(SEED_LINE.findall(text)) != 1:
-            raise SystemExit(f"{path.name}: not one seed line to replace")
-        text = SEED_LINE.sub(f"seed = {seed}", text)
     copy = folder / path.name
     copy.write_text(text)
     return copy
@@ -147,7 +140,7 @@ def main(argv: list[str] | None = None) -> int:
     info = machine()  # the commit and load as the run starts
     with tempfile.TemporaryDirectory() as folder:
         began = time.time()
-        experiment = load_experiment(with_simulated(arguments.experiment, arguments.simulated, Path(folder), arguments.sampling, arguments.seed))
+        experiment = load_experiment(with_simulated(arguments.experiment, arguments.simulated, Path(folder), arguments.sampling), seed=arguments.seed)
         experiment.selection
         elapsed = time.time() - began
     count = experiment.intensity.selection.simulated.count

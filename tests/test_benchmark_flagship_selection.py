@@ -73,9 +73,3 @@ def test_the_benchmark_s_parameter_rows_count_each_stripe_s_chosen_simulated_mot
     for row, chosen in zip(rows, selection.selections):
         count = sum(str(m) in selection.simulated for m in chosen["motion"].values)
         assert row[1] == str(count) and (count == 0 or float(row[5]) > 0.0)
-
-
-def test_the_benchmark_s_copy_replaces_the_seed(tmp_path):
-    flagship = REPOSITORY / "experiments" / "risk" / "isolated.toml"
-    old, new = flagship.read_text().splitlines(), with_simulated(flagship, None, tmp_path, seed=7).read_text().splitlines()
-    assert len(new) == len(old) and [line for line in new if line not in old] == ["seed = 7"]

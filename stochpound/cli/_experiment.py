@@ -36,8 +36,12 @@ def experiment() -> None:
 @click.option("--checkpoint", type=click.FloatRange(min=0.0), default=30.0, show_default=True, help="Seconds between rebuilds of the store file during the run.")
 @click.option("--yes", "large_ok", is_flag=True, help=f"Run a large experiment (over {LARGE_RUN_CASES:,} cases or {format_bytes(LARGE_RUN_BYTES)} of store to write) without asking.")
 @click.option("--quiet", is_flag=True, help="No progress bar and no start-up messages.")
+@click.option("--seed", type=click.IntRange(min=0), default=None,
+              help="Run with this [intensity] seed instead of the file's (the conditional-spectrum selection's: another sample of motions); "
+                   "the store records the file's text with that seed (default store: seedN/ beside the file, e.g. seed2/NAME.nc).")
 def run_command(
-    experiment_files: tuple[str, ...], store: str | None, workers: int | None, scheduler: str | None, restart: bool, batch_size: int | None, checkpoint: float, large_ok: bool, quiet: bool
+    experiment_files: tuple[str, ...], store: str | None, workers: int | None, scheduler: str | None, restart: bool, batch_size: int | None, checkpoint: float, large_ok: bool, quiet: bool,
+    seed: int | None,
 ) -> None:
     """Run the missing cases of each EXPERIMENT_FILE into its store, one after the other.
 
@@ -46,7 +50,7 @@ def run_command(
     them. Ctrl-C stops cleanly. Every file is checked before any runs; the
     time and size of each run are estimated before it starts.
     """
-    from stochpound.experiment import is_rare_event_file, load_experiment, load_rare_event, run_experiment
+    from stochpound.experiment import is_rare_event_file, load_experiment, load_rare_event, run_experiment, seed_store
 
     if workers is not None and scheduler is not None:
         raise click.BadParameter("give --workers or --scheduler, not both", param_hint="--workers")
@@ -57,9 +61,11 @@ def run_command(
     for path in experiment_files:
         with _errors_of(path, several):
             if is_rare_event_file(path):  # a [rare_event] table: one subset simulation (docs/rare-events.md)
+                if seed is not None:
+                    raise click.BadParameter(f"{path}: a [rare_event] file's seed is its [rare_event] seed, not set by --seed", param_hint="--seed")
                 loaded.append(load_rare_event(path))
                 continue
-            loaded.append(load_experiment(path))
+            loaded.append(load_experiment(path, seed=seed))
             say_scene_warnings([f"{path}: {line}" if several else line for line in experiment_warnings(loaded[-1])])
     failed = False
     for experiment_file, definition in zip(experiment_files, loaded):
@@ -69,10 +75,11 @@ def run_command(
             with _errors_of(experiment_file, several):
                 _run_rare_event(definition, store, workers, scheduler, restart, quiet)
             continue
+        target = store if store is not None or seed is None else seed_store(experiment_file, seed)
         with _errors_of(experiment_file, several), _silenced(quiet):
             try:
                 report = run_experiment(
-                    definition, store, workers=workers, scheduler=scheduler, restart=restart, progress=not quiet, checkpoint=checkpoint,
+                    definition, target, workers=workers, scheduler=scheduler, restart=restart, progress=not quiet, checkpoint=checkpoint,
                     batch_size=batch_size, large_ok=large_ok, say=None if quiet else _say,
                 )
             except KeyboardInterrupt:  # a second Ctrl-C while the first one's clean-up ran

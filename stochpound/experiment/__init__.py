@@ -25,7 +25,7 @@ from stochpound.store import (
 )
 from stochpound.experiment._experiment import Experiment
 from stochpound.store import Case, Dim
-from stochpound.experiment._runner import RunReport, default_store, load_experiment, run_experiment
+from stochpound.experiment._runner import RunReport, default_store, load_experiment, run_experiment, seed_store
 from stochpound.experiment._status import StatusReport, store_status
 from stochpound.experiment._rare_event_run import RareEventReport, rare_event_sampler, run_rare_event
 from stochpound.experiment._rare_event_check import crude_check
@@ -74,6 +74,7 @@ __all__ = [
     "StatusReport",
     "VariantAxis",
     "default_store",
+    "seed_store",
     "is_fixed_base",
     "is_gap_axis",
     "load_experiment",

@@ -124,15 +124,24 @@ class RunReport:
         return self.done == self.total
 
 
-def load_experiment(path: str | Path) -> Experiment:
+def load_experiment(path: str | Path, *, seed: int | None = None) -> Experiment:
     """Read, validate and expand an experiment file (every scene of the grid is checked).
+
+    Parameters
+    ----------
+    path : str or Path
+        The experiment file.
+    seed : int, optional
+        Run it with this ``[intensity] seed`` (>= 0) instead of the file's: the seed of a conditional-spectrum selection,
+        which chooses the stripes' motions and draws their simulated ones. The experiment's text is the file's with its
+        seed line set (``stochpound experiment run --seed``; its store records that text); default store :func:`seed_store`.
 
     Raises
     ------
     ExperimentError
-        Naming the field and the allowed values.
+        Naming the field and the allowed values; with ``seed``, a file without a conditional-spectrum selection.
     """
-    definition, text = load_definition(path)
+    definition, text = load_definition(path, seed)
     experiment = Experiment(definition, text, Path(path).parent, str(path))
     experiment.validate()
     return experiment
@@ -141,6 +150,12 @@ def load_experiment(path: str | Path) -> Experiment:
 def default_store(experiment_path: str | Path) -> Path:
     """The default store of an experiment file: beside it, suffix ``.nc``."""
     return Path(experiment_path).with_suffix(".nc")
+
+
+def seed_store(experiment_path: str | Path, seed: int) -> Path:
+    """The default store of an experiment file run with another ``[intensity] seed``: ``seed<seed>/<its name>.nc`` beside it."""
+    path = Path(experiment_path)
+    return path.parent / f"seed{seed}" / path.with_suffix(".nc").name
 
 
 def run_experiment(

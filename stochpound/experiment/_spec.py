@@ -36,6 +36,7 @@ from stochpound.motions import SYNTHETIC_TYPES
 from stochpound.experiment._scenario_ensembles import scenario_source
 from stochpound.experiment._intensity import parse_intensity
 from stochpound.experiment._site import site_entry
+from stochpound.experiment._reseed import reseeded
 from stochpound.model.fields import is_number
 from stochpound.model.contact import ELEMENT_KEYS
 from stochpound.store import apply_overrides, building_names
@@ -73,7 +74,7 @@ _RESERVED_DIMS = {
 TIME_HISTORY_VARIABLES = tuple(TIME_HISTORIES)
 
 
-def load_definition(path: str | Path) -> tuple[dict[str, Any], str]:
+def load_definition(path: str | Path, seed: int | None = None) -> tuple[dict[str, Any], str]:
     """Read an experiment file and return its canonical definition and its text.
 
     Parameters
@@ -81,6 +82,9 @@ def load_definition(path: str | Path) -> tuple[dict[str, Any], str]:
     path : str or Path
         The TOML experiment file. A base scene given as a path is resolved
         against the file's folder, and so are record files.
+    seed : int, optional
+        Another ``[intensity] seed`` than the file's: the text returned is the file's with its seed line set to it
+        (``stochpound.experiment._reseed``).
 
     Raises
     ------
@@ -96,6 +100,8 @@ def load_definition(path: str | Path) -> tuple[dict[str, Any], str]:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as error:
         raise ExperimentError(f"{path}: not valid TOML: {error}") from None
+    if seed is not None:
+        text, data = reseeded(text, data, seed, str(path))
     return parse_experiment(data, base_dir=path.parent, default_name=path.stem), text
 
 

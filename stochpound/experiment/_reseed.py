@@ -1,0 +1,78 @@
+"""An experiment file's text with another ``[intensity] seed``: ``stochpound experiment run --seed``.
+
+The seed of a conditional-spectrum selection chooses a stripe's motions and
+draws its simulated ones; another seed is the same experiment with another
+sample of motions (the report's "selection seed" sensitivity). Rather than a
+copy of the file, the run edits one line of its text: the ``seed`` line of its
+``[intensity]`` table (added after the table's header where the file has
+none). The edited text is what the store records, so the store says the
+seed it ran with, and a rerun of the same command finds the same definition
+and resumes. The edit is checked: the edited text, read as TOML, must equal
+the file's with that one value changed, else the file is refused (a layout
+the line edit cannot reach: a dotted or inline ``intensity`` table).
+"""
+
+from __future__ import annotations
+
+import copy
+import re
+import tomllib
+from typing import Any
+
+from stochpound._errors import ExperimentError
+from stochpound.store import CONDITIONAL_SPECTRUM
+
+_HEADER = re.compile(r"^\s*\[\s*intensity\s*\]\s*(#.*)?$")
+"""The ``[intensity]`` table's header line."""
+_TABLE = re.compile(r"^\s*\[")
+"""A table's header line (the end of the one before it)."""
+_SEED = re.compile(r"^(\s*seed\s*=\s*)[^#\s]+(.*)$")
+"""A ``seed = <value>`` line: its key, and what follows the value (a comment)."""
+
+
+def reseeded(text: str, data: dict[str, Any], seed: int, source: str) -> tuple[str, dict[str, Any]]:
+    """``text``, an experiment file's, with its ``[intensity] seed`` set to ``seed`` (module docstring), and its TOML.
+
+    Parameters
+    ----------
+    text : str
+        The experiment file's text.
+    data : dict
+        ``text`` read as TOML (unchanged).
+    seed : int
+        The selection's seed (>= 0).
+    source : str
+        The file, for the error message.
+
+    Returns
+    -------
+    (str, dict)
+        The text with that one line changed or added, and it read as TOML.
+
+    Raises
+    ------
+    ExperimentError
+        One line: a seed that is not an integer >= 0, a file with no conditional-spectrum selection in an ``[intensity]``
+        table, or one whose seed the line edit cannot set alone.
+    """
+    if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
+        raise ExperimentError(f"--seed: must be an integer >= 0, got {seed!r}")
+    if not isinstance(data.get("intensity"), dict) or data["intensity"].get("selection") != CONDITIONAL_SPECTRUM:
+        raise ExperimentError(f'--seed: {source} has no [intensity] selection = "{CONDITIONAL_SPECTRUM}", whose seed it sets')
+    lines = text.splitlines(keepends=True)
+    start = next((i for i, line in enumerate(lines) if _HEADER.match(line)), None)
+    if start is not None:
+        end = next((i for i in range(start + 1, len(lines)) if _TABLE.match(lines[i])), len(lines))
+        found = next((i for i in range(start + 1, end) if _SEED.match(lines[i].rstrip("\r\n"))), None)
+        if found is None:
+            lines.insert(start + 1, f"seed = {seed}\n")
+        else:
+            body = lines[found].rstrip("\r\n")
+            lines[found] = _SEED.sub(rf"\g<1>{seed}\g<2>", body) + lines[found][len(body):]
+    edited = "".join(lines)
+    expected = copy.deepcopy(data)
+    expected["intensity"]["seed"] = seed
+    edited_data = tomllib.loads(edited) if start is not None else None
+    if edited_data != expected:
+        raise ExperimentError(f"--seed: cannot set the [intensity] seed of {source} alone by editing its seed line (set it in the file)")
+    return edited, edited_data

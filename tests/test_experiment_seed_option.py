@@ -1,0 +1,93 @@
+"""``stochpound experiment run --seed``: the same experiment with another [intensity] seed, into its own store, no copy of the file."""
+
+from __future__ import annotations
+
+import tomllib
+
+import pytest
+import xarray as xr
+
+from stochpound._errors import ExperimentError
+from stochpound.experiment import load_experiment, seed_store
+from stochpound.experiment._reseed import reseeded
+from tests.helpers import invoke, stripes_site_text
+
+SELECTION = '[intensity]\nmeasure = "psa"\nselection = "conditional_spectrum"\n'
+
+
+def _reseeded(text: str, seed: int) -> str:
+    return reseeded(text, tomllib.loads(text), seed, "x.toml")[0]
+
+
+def test_the_seed_line_of_the_intensity_table_alone_is_set_its_comment_kept():
+    text = f'[experiment]\nseed = 9\n{SELECTION}seed = 1   # the selection\'s\nmotions = 4\n[site]\nseed = 8\n'
+    assert _reseeded(text, 5) == f'[experiment]\nseed = 9\n{SELECTION}seed = 5   # the selection\'s\nmotions = 4\n[site]\nseed = 8\n'
+
+
+def test_a_file_without_a_seed_line_gets_one_after_the_header():
+    text = f"{SELECTION}motions = 4\n"
+    edited = _reseeded(text, 3)
+    assert edited == '[intensity]\nseed = 3\nmeasure = "psa"\nselection = "conditional_spectrum"\nmotions = 4\n'
+    assert tomllib.loads(edited)["intensity"]["seed"] == 3
+
+
+@pytest.mark.parametrize(("text", "message"), [
+    ('[intensity]\nmeasure = "psa"\nlevels = [0.1]\n', '--seed: x.toml has no [intensity] selection = "conditional_spectrum", whose seed it sets'),
+    ('[experiment]\nname = "a"\n', '--seed: x.toml has no [intensity] selection = "conditional_spectrum", whose seed it sets'),
+    ('intensity = { selection = "conditional_spectrum", seed = 1 }\n',
+     "--seed: cannot set the [intensity] seed of x.toml alone by editing its seed line (set it in the file)"),
+])
+def test_a_file_whose_seed_the_edit_cannot_set_is_refused_in_one_line(text: str, message: str):
+    with pytest.raises(ExperimentError) as raised:
+        _reseeded(text, 2)
+    assert str(raised.value) == message
+
+
+def test_a_negative_seed_is_refused():
+    with pytest.raises(ExperimentError, match=r"--seed: must be an integer >= 0, got -1"):
+        _reseeded(f"{SELECTION}seed = 1\n", -1)
+
+
+@pytest.fixture(scope="module")
+def seeded(tmp_path_factory):
+    """A small conditional-spectrum experiment run by the CLI with its own seed (3) and with --seed 7."""
+    folder = tmp_path_factory.mktemp("seeded")
+    path = folder / "site.toml"
+    path.write_text(stripes_site_text(""))
+    runs = [invoke("experiment", "run", str(path), "--workers", "0", "--quiet", *extra) for extra in ((), ("--seed", "7"))]
+    return path, runs
+
+
+def test_the_seed_run_goes_to_its_own_store_and_records_the_reseeded_text(seeded):
+    from stochpound.risk import check_alternative
+
+    path, runs = seeded
+    assert [run.exit_code for run in runs] == [0, 0], [run.output for run in runs]
+    store = seed_store(path, 7)
+    assert store == path.parent / "seed7" / "site.nc" and store.is_file()
+    with xr.open_dataset(path.with_suffix(".nc")) as main, xr.open_dataset(store) as other:
+        assert check_alternative(main, other, "seed") == "selection seed 7"  # the same experiment but for the seed
+        assert other.attrs["experiment_text"] == path.read_text().replace("seed = 3\n", "seed = 7\n")
+        assert not main["selection_mean_ln"].equals(other["selection_mean_ln"])  # another seed, other motions
+    assert load_experiment(path, seed=7).sha256 != load_experiment(path).sha256
+
+
+def test_rerunning_the_seed_command_finds_its_store_complete(seeded):
+    path, _ = seeded
+    again = invoke("experiment", "run", str(path), "--workers", "0", "--quiet", "--seed", "7")
+    assert again.exit_code == 0 and "nothing to run" in again.output.lower(), again.output
+
+
+def test_seed_refuses_a_file_without_a_selection_in_one_line(tmp_path):
+    path = tmp_path / "plain.toml"
+    path.write_text('[experiment]\nname = "plain"\n')
+    result = invoke("experiment", "run", str(path), "--seed", "2")
+    assert result.exit_code == 1
+    assert result.output.strip().splitlines()[-1] == f'Error: --seed: {path} has no [intensity] selection = "conditional_spectrum", whose seed it sets'
+
+
+def test_seed_refuses_a_rare_event_file_in_one_line():
+    path = "experiments/stochastic/rare/firm_stiff_fixed.toml"
+    result = invoke("experiment", "run", path, "--seed", "2")
+    assert result.exit_code == 2
+    assert f"{path}: a [rare_event] file's seed is its [rare_event] seed, not set by --seed" in result.output
