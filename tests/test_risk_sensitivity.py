@@ -13,6 +13,7 @@ from __future__ import annotations
 import tomllib
 
 import numpy as np
+import pandas as pd
 import pytest
 import xarray as xr
 
@@ -213,3 +214,18 @@ def test_a_wall_store_gives_its_own_g_star_in_the_table_and_the_cli_and_report_s
     assert len(tables) == 1 and column in tables[0].frame.columns
     with pytest.raises(RiskInputError, match=r"^--sensitivity-store measure=stiff.nc: measure store \(risk\): differs from risk in more "):
         _alternatives({"risk": soft}, [("measure", wall_stores["stiff"])], "refuse")
+
+
+def test_several_seed_columns_give_the_seeds_spread_of_g_star_in_words():
+    """With the store's seed and others, the text gives the largest ratio of a row's g* over the seeds (rows with an infinite
+    g* at some seed left out and counted); one other seed gives no such sentence."""
+    from stochpound.risk import sensitivity_text
+
+    index = pd.MultiIndex.from_tuples([("a", "10 % in 50 yr"), ("b", "10 % in 50 yr"), ("c", "2 % in 50 yr")], names=["config", "target"])
+    frame = pd.DataFrame({"g* (m)": [0.10, 0.20, 0.30], "selection seed 2": [0.12, 0.25, np.inf], "selection seed 2: Δ (%)": [20.0, 25.0, np.inf],
+                          "selection seed 3": [0.09, 0.21, 0.31], "selection seed 3: Δ (%)": [-10.0, 5.0, 10 / 3]}, index=index)
+    text = sensitivity_text(frame, not_evaluated=())
+    # row a: 0.12 / 0.09 = 1.333; row b: 0.25 / 0.20 = 1.25; row c has an infinite g*
+    assert ("the 3 selection seeds together (the store's and 2 others): g* spans up to ×1.33 in a row (its largest over its smallest, "
+            "over the 2 of 3 rows finite at every seed)") in text
+    assert "selection seeds together" not in sensitivity_text(frame.drop(columns=["selection seed 3", "selection seed 3: Δ (%)"]), not_evaluated=())

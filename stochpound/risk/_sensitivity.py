@@ -262,8 +262,9 @@ def _with_dispersion(fragility: xr.Dataset, dispersion: float, hazard: object, t
 
 
 def sensitivity_text(frame: pd.DataFrame, grid: str = "", not_evaluated: Sequence[str] = tuple(ALTERNATIVES)) -> str:
-    """The table's message in words: how the chain's grid was made, the largest change of each choice, what is not evaluated
-    (each of ``not_evaluated``, kinds of ``ALTERNATIVES``, with what would evaluate it) and what the interval bounds."""
+    """The table's message in words: how the chain's grid was made, the largest change of each choice, with several
+    selection seeds their spread (a row's largest g* over its smallest), what is not evaluated (each of ``not_evaluated``,
+    kinds of ``ALTERNATIVES``, with what would evaluate it) and what the interval bounds."""
     changes = [column for column in frame.columns if column.endswith("Δ (%)")]
     said = []
     for column in changes:
@@ -271,6 +272,7 @@ def sensitivity_text(frame: pd.DataFrame, grid: str = "", not_evaluated: Sequenc
         finite = values[np.isfinite(values)]
         what = column.removesuffix(": Δ (%)")
         said.append(f"{what}: up to {np.max(np.abs(finite)):.1f} %" if finite.size else f"{what}: no finite change (g* inf on one side)")
+    said.extend(_seeds_spread(frame))
     grid_said = f" The chain's gap grid: {grid}." if grid else ""
     missing = ("; ".join(f"{ALTERNATIVES[kind]} (needs {EVALUATED_BY[kind]})" for kind in not_evaluated))
     unsaid = f" Not evaluated (each needs other runs): {missing}." if missing else ""
@@ -278,6 +280,20 @@ def sensitivity_text(frame: pd.DataFrame, grid: str = "", not_evaluated: Sequenc
             + grid_said + " β_m cannot spread a gap no run closes (a 'never' step has no θ): its λ stays 0, so g* with β_m stops at the "
             f"widest gap some run closes.{unsaid} The interval of g* and the gap to design to (its upper bound) bound the "
             "record-to-record sampling of the motions only, none of these choices.")
+
+
+def _seeds_spread(frame: pd.DataFrame) -> list[str]:
+    """With two or more selection-seed columns, the spread of g* over the store's seed and theirs, in words (none with fewer)."""
+    seeds = [column for column in frame.columns if column.startswith("selection seed ") and not column.endswith("Δ (%)")]
+    if len(seeds) < 2:
+        return []
+    values = frame[["g* (m)", *seeds]].to_numpy(dtype=float)
+    rows = [row for row in values if np.all(np.isfinite(row)) and np.all(row > 0.0)]
+    if not rows:
+        return [f"the {len(seeds) + 1} selection seeds together: no row with a finite g* > 0 at every seed"]
+    spread = max(float(row.max() / row.min()) for row in rows)
+    return [f"the {len(seeds) + 1} selection seeds together (the store's and {len(seeds)} others): g* spans up to ×{spread:.2f} in a row "
+            f"(its largest over its smallest, over the {len(rows)} of {len(values)} rows finite at every seed)"]
 
 
 def _dims_only(data: xr.DataArray) -> xr.DataArray:
