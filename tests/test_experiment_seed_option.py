@@ -91,3 +91,12 @@ def test_seed_refuses_a_rare_event_file_in_one_line():
     result = invoke("experiment", "run", path, "--seed", "2")
     assert result.exit_code == 2
     assert f"{path}: a [rare_event] file's seed is its [rare_event] seed, not set by --seed" in result.output
+
+
+def test_the_api_s_default_store_of_a_reseeded_experiment_is_its_seed_store(seeded):
+    """load_experiment(path, seed=7) run without a store finds the CLI's seed-7 store complete: not the file's own store."""
+    from stochpound.experiment import run_experiment
+
+    path, _ = seeded
+    report = run_experiment(load_experiment(path, seed=7), workers=0, progress=False)
+    assert report.store == seed_store(path, 7) and report.nothing_to_run

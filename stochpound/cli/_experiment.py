@@ -50,7 +50,7 @@ def run_command(
     them. Ctrl-C stops cleanly. Every file is checked before any runs; the
     time and size of each run are estimated before it starts.
     """
-    from stochpound.experiment import is_rare_event_file, load_experiment, load_rare_event, run_experiment, seed_store
+    from stochpound.experiment import is_rare_event_file, load_experiment, load_rare_event, run_experiment
 
     if workers is not None and scheduler is not None:
         raise click.BadParameter("give --workers or --scheduler, not both", param_hint="--workers")
@@ -75,11 +75,10 @@ def run_command(
             with _errors_of(experiment_file, several):
                 _run_rare_event(definition, store, workers, scheduler, restart, quiet)
             continue
-        target = store if store is not None or seed is None else seed_store(experiment_file, seed)
         with _errors_of(experiment_file, several), _silenced(quiet):
             try:
                 report = run_experiment(
-                    definition, target, workers=workers, scheduler=scheduler, restart=restart, progress=not quiet, checkpoint=checkpoint,
+                    definition, store, workers=workers, scheduler=scheduler, restart=restart, progress=not quiet, checkpoint=checkpoint,
                     batch_size=batch_size, large_ok=large_ok, say=None if quiet else _say,
                 )
             except KeyboardInterrupt:  # a second Ctrl-C while the first one's clean-up ran

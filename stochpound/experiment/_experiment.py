@@ -22,6 +22,10 @@ class Experiment(ExperimentGrid):
     Its parameters are :class:`~stochpound.store.ExperimentGrid`'s but ``choice``: the run chooses the stripes' motions itself.
     """
 
+    seed_override: int | None = None
+    """The ``[intensity] seed`` it was loaded with instead of its file's (``load_experiment(path, seed=…)``), else None:
+    its default store is then :func:`~stochpound.experiment.seed_store`'s."""
+
     @cached_property
     def selection(self) -> StripeSelections | None:
         """The motions chosen for every stripe (``[intensity] selection = "conditional_spectrum"``), chosen when first asked for; None otherwise."""

@@ -143,6 +143,7 @@ def load_experiment(path: str | Path, *, seed: int | None = None) -> Experiment:
     """
     definition, text = load_definition(path, seed)
     experiment = Experiment(definition, text, Path(path).parent, str(path))
+    experiment.seed_override = seed
     experiment.validate()
     return experiment
 
@@ -178,7 +179,7 @@ def run_experiment(
     experiment : Experiment
         From :func:`load_experiment`.
     store : str or Path, optional
-        Store file (default: beside the experiment file, ``.nc``).
+        Store file (default: beside the experiment file, ``.nc``; :func:`seed_store` for an experiment loaded with another seed).
     workers : int, optional
         Local dask worker processes (default: the machine's cores, or none
         when the cases' CPU time is estimated under 3 s: a small run ends
@@ -226,7 +227,9 @@ def run_experiment(
     started = time.monotonic()
     quiet = say is None
     say = say or (lambda message: None)
-    store = Path(store) if store is not None else default_store(experiment.path or f"{experiment.name}.toml")
+    source = experiment.path or f"{experiment.name}.toml"
+    seed = experiment.seed_override
+    store = Path(store) if store is not None else default_store(source) if seed is None else seed_store(source, seed)
     check_store_path(store, experiment, restart)
     motions = resolve_motions(experiment)
     repair = False
