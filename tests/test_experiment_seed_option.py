@@ -9,14 +9,14 @@ import xarray as xr
 
 from stochpound._errors import ExperimentError
 from stochpound.experiment import load_experiment, seed_store
-from stochpound.experiment._reseed import reseeded
+from stochpound.experiment._reseed import reseeded_text
 from tests.helpers import invoke, stripes_site_text
 
 SELECTION = '[intensity]\nmeasure = "psa"\nselection = "conditional_spectrum"\n'
 
 
 def _reseeded(text: str, seed: int) -> str:
-    return reseeded(text, tomllib.loads(text), seed, "x.toml")[0]
+    return reseeded_text(text, seed, "x.toml")
 
 
 def test_the_seed_line_of_the_intensity_table_alone_is_set_its_comment_kept():

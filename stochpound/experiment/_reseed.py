@@ -14,10 +14,8 @@ the line edit cannot reach: a dotted or inline ``intensity`` table).
 
 from __future__ import annotations
 
-import copy
 import re
 import tomllib
-from typing import Any
 
 from stochpound._errors import ExperimentError
 from stochpound.store import CONDITIONAL_SPECTRUM
@@ -30,15 +28,13 @@ _SEED = re.compile(r"^(\s*seed\s*=\s*)[^#\s]+(.*)$")
 """A ``seed = <value>`` line: its key, and what follows the value (a comment)."""
 
 
-def reseeded(text: str, data: dict[str, Any], seed: int, source: str) -> tuple[str, dict[str, Any]]:
-    """``text``, an experiment file's, with its ``[intensity] seed`` set to ``seed`` (module docstring), and its TOML.
+def reseeded_text(text: str, seed: int, source: str) -> str:
+    """``text``, an experiment file's (valid TOML), with its ``[intensity] seed`` set to ``seed`` (module docstring).
 
     Parameters
     ----------
     text : str
         The experiment file's text.
-    data : dict
-        ``text`` read as TOML (unchanged).
     seed : int
         The selection's seed (>= 0).
     source : str
@@ -46,8 +42,8 @@ def reseeded(text: str, data: dict[str, Any], seed: int, source: str) -> tuple[s
 
     Returns
     -------
-    (str, dict)
-        The text with that one line changed or added, and it read as TOML.
+    str
+        The text with that one line changed or added.
 
     Raises
     ------
@@ -57,7 +53,9 @@ def reseeded(text: str, data: dict[str, Any], seed: int, source: str) -> tuple[s
     """
     if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
         raise ExperimentError(f"--seed: must be an integer >= 0, got {seed!r}")
-    if not isinstance(data.get("intensity"), dict) or data["intensity"].get("selection") != CONDITIONAL_SPECTRUM:
+    expected = tomllib.loads(text)
+    intensity = expected["intensity"] if "intensity" in expected else None
+    if not isinstance(intensity, dict) or "selection" not in intensity or intensity["selection"] != CONDITIONAL_SPECTRUM:
         raise ExperimentError(f'--seed: {source} has no [intensity] selection = "{CONDITIONAL_SPECTRUM}", whose seed it sets')
     lines = text.splitlines(keepends=True)
     start = next((i for i, line in enumerate(lines) if _HEADER.match(line)), None)
@@ -70,9 +68,7 @@ def reseeded(text: str, data: dict[str, Any], seed: int, source: str) -> tuple[s
             body = lines[found].rstrip("\r\n")
             lines[found] = _SEED.sub(rf"\g<1>{seed}\g<2>", body) + lines[found][len(body):]
     edited = "".join(lines)
-    expected = copy.deepcopy(data)
-    expected["intensity"]["seed"] = seed
-    edited_data = tomllib.loads(edited) if start is not None else None
-    if edited_data != expected:
+    intensity["seed"] = seed
+    if start is None or tomllib.loads(edited) != expected:
         raise ExperimentError(f"--seed: cannot set the [intensity] seed of {source} alone by editing its seed line (set it in the file)")
-    return edited, edited_data
+    return edited

@@ -36,7 +36,7 @@ from stochpound.motions import SYNTHETIC_TYPES
 from stochpound.experiment._scenario_ensembles import scenario_source
 from stochpound.experiment._intensity import parse_intensity
 from stochpound.experiment._site import site_entry
-from stochpound.experiment._reseed import reseeded
+from stochpound.experiment._reseed import reseeded_text
 from stochpound.model.fields import is_number
 from stochpound.model.contact import ELEMENT_KEYS
 from stochpound.store import apply_overrides, building_names
@@ -101,7 +101,8 @@ def load_definition(path: str | Path, seed: int | None = None) -> tuple[dict[str
     except tomllib.TOMLDecodeError as error:
         raise ExperimentError(f"{path}: not valid TOML: {error}") from None
     if seed is not None:
-        text, data = reseeded(text, data, seed, str(path))
+        text = reseeded_text(text, seed, str(path))
+        data = tomllib.loads(text)
     return parse_experiment(data, base_dir=path.parent, default_name=path.stem), text
 
 
