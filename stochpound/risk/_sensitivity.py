@@ -54,6 +54,8 @@ EVALUATED_BY = {
     "wall": "a store of the same experiment with the moat walls' stiffness of a retaining wall with backfill (docs/risk.md)",
 }
 """What would evaluate each choice of ``ALTERNATIVES``."""
+SEED_COLUMN = "selection seed"
+"""The head of a seed alternative's column (``selection seed 2``), by which the text finds the seeds' columns."""
 _ANY = ("name", "description", "design", "limit_states", "scene_source", "output", "intensity.note")
 """Entries of a definition no g* depends on: they may differ between a store and its alternative."""
 _ALLOWED = {
@@ -211,7 +213,7 @@ def check_alternative(store: xr.Dataset, other: xr.Dataset, kind: str) -> str:
         return f"measure {intensity_setting(other).description}"
     values = sorted({_value(theirs, path) for path in chosen})
     shown = ", ".join(f"{value:.3g}" for value in values)
-    return f"selection seed {shown}" if kind == "seed" else f"wall stiffness {shown} N/m"
+    return f"{SEED_COLUMN} {shown}" if kind == "seed" else f"wall stiffness {shown} N/m"
 
 
 def _value(entry: object, path: str) -> float:
@@ -284,7 +286,7 @@ def sensitivity_text(frame: pd.DataFrame, grid: str = "", not_evaluated: Sequenc
 
 def _seeds_spread(frame: pd.DataFrame) -> list[str]:
     """With two or more selection-seed columns, the spread of g* over the store's seed and theirs, in words (none with fewer)."""
-    seeds = [column for column in frame.columns if column.startswith("selection seed ") and not column.endswith("Δ (%)")]
+    seeds = [column for column in frame.columns if column.startswith(f"{SEED_COLUMN} ") and not column.endswith("Δ (%)")]
     if len(seeds) < 2:
         return []
     values = frame[["g* (m)", *seeds]].to_numpy(dtype=float)
