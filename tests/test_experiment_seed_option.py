@@ -43,6 +43,13 @@ def test_a_file_whose_seed_the_edit_cannot_set_is_refused_in_one_line(text: str,
     assert str(raised.value) == message
 
 
+@pytest.mark.parametrize(("text", "seed"), [(f"{SELECTION}seed = 4\n", 4), (SELECTION, 1)])  # the selection's default seed: 1
+def test_the_file_s_own_seed_is_refused_rather_than_run_twice(text: str, seed: int):
+    with pytest.raises(ExperimentError) as raised:
+        _reseeded(text, seed)
+    assert str(raised.value) == f"--seed: {seed} is x.toml's own [intensity] seed: run the file without --seed (its store is beside it)"
+
+
 def test_a_negative_seed_is_refused():
     with pytest.raises(ExperimentError, match=r"--seed: must be an integer >= 0, got -1"):
         _reseeded(f"{SELECTION}seed = 1\n", -1)

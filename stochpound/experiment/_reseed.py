@@ -18,6 +18,7 @@ import re
 import tomllib
 
 from stochpound._errors import ExperimentError
+from stochpound.experiment._site import DEFAULT_SEED
 from stochpound.store import CONDITIONAL_SPECTRUM
 
 _HEADER = re.compile(r"^\s*\[\s*intensity\s*\]\s*(#.*)?$")
@@ -49,7 +50,8 @@ def reseeded_text(text: str, seed: int, source: str) -> str:
     ------
     ExperimentError
         One line: a seed that is not an integer >= 0, a file with no conditional-spectrum selection in an ``[intensity]``
-        table, or one whose seed the line edit cannot set alone.
+        table, the file's own seed (its store is the file's: nothing to run twice), or a file whose seed the line edit
+        cannot set alone.
     """
     if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
         raise ExperimentError(f"--seed: must be an integer >= 0, got {seed!r}")
@@ -57,6 +59,8 @@ def reseeded_text(text: str, seed: int, source: str) -> str:
     intensity = expected["intensity"] if "intensity" in expected else None
     if not isinstance(intensity, dict) or "selection" not in intensity or intensity["selection"] != CONDITIONAL_SPECTRUM:
         raise ExperimentError(f'--seed: {source} has no [intensity] selection = "{CONDITIONAL_SPECTRUM}", whose seed it sets')
+    if (intensity["seed"] if "seed" in intensity else DEFAULT_SEED) == seed:
+        raise ExperimentError(f"--seed: {seed} is {source}'s own [intensity] seed: run the file without --seed (its store is beside it)")
     lines = text.splitlines(keepends=True)
     start = next((i for i, line in enumerate(lines) if _HEADER.match(line)), None)
     if start is not None:
