@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import tomllib
 
+import numpy as np
 import pytest
 import xarray as xr
 
@@ -57,11 +58,11 @@ def test_a_negative_seed_is_refused():
 
 @pytest.fixture(scope="module")
 def seeded(tmp_path_factory):
-    """A small conditional-spectrum experiment run by the CLI with its own seed (3) and with --seed 7."""
+    """A small conditional-spectrum experiment run by the CLI with its own seed (3) and with --seed 7 and 8."""
     folder = tmp_path_factory.mktemp("seeded")
     path = folder / "site.toml"
-    path.write_text(stripes_site_text(""))
-    runs = [invoke("experiment", "run", str(path), "--workers", "0", "--quiet", *extra) for extra in ((), ("--seed", "7"))]
+    path.write_text(stripes_site_text('[hazard]\nbundled = "fox_plaza_los_angeles_sa1p0s"\n'))
+    runs = [invoke("experiment", "run", str(path), "--workers", "0", "--quiet", *extra) for extra in ((), ("--seed", "7"), ("--seed", "8"))]
     return path, runs
 
 
@@ -69,7 +70,7 @@ def test_the_seed_run_goes_to_its_own_store_and_records_the_reseeded_text(seeded
     from stochpound.risk import check_alternative
 
     path, runs = seeded
-    assert [run.exit_code for run in runs] == [0, 0], [run.output for run in runs]
+    assert [run.exit_code for run in runs] == [0, 0, 0], [run.output for run in runs]
     store = seed_store(path, 7)
     assert store == path.parent / "seed7" / "site.nc" and store.is_file()
     with xr.open_dataset(path.with_suffix(".nc")) as main, xr.open_dataset(store) as other:
@@ -107,3 +108,20 @@ def test_the_api_s_default_store_of_a_reseeded_experiment_is_its_seed_store(seed
     path, _ = seeded
     report = run_experiment(load_experiment(path, seed=7), workers=0, progress=False)
     assert report.store == seed_store(path, 7) and report.nothing_to_run
+
+
+def test_three_seeds_give_the_sensitivity_table_their_median_and_largest_g_star(seeded):
+    """With the store's seed and two seed stores, the table adds the median and the largest g* over the three, each
+    with its change from g*: recomputed here from the three seeds' own columns."""
+    from stochpound.risk import separation_sensitivity, store_risk
+
+    path, _ = seeded
+    with xr.open_dataset(path.with_suffix(".nc")) as main, xr.open_dataset(seed_store(path, 7)) as seven, \
+            xr.open_dataset(seed_store(path, 8)) as eight:
+        risk = store_risk(main, bootstrap=0)
+        frame = separation_sensitivity(risk, main, alternatives=[("seed", seven), ("seed", eight)]).frame
+    over = frame[["g* (m)", "selection seed 7", "selection seed 8"]].to_numpy(dtype=float)
+    np.testing.assert_array_equal(frame["selection seeds (3): median"].to_numpy(dtype=float), np.median(over, axis=1))
+    np.testing.assert_array_equal(frame["selection seeds (3): largest"].to_numpy(dtype=float), np.max(over, axis=1))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        np.testing.assert_allclose(frame["selection seeds (3): largest: Δ (%)"], 100 * (over.max(axis=1) / over[:, 0] - 1))

@@ -229,3 +229,17 @@ def test_several_seed_columns_give_the_seeds_spread_of_g_star_in_words():
     assert ("the 3 selection seeds together (the store's and 2 others): g* spans up to ×1.33 in a row (its largest over its smallest, "
             "over the 2 of 3 rows finite at every seed)") in text
     assert "selection seeds together" not in sensitivity_text(frame.drop(columns=["selection seed 3", "selection seed 3: Δ (%)"]), not_evaluated=())
+
+
+def test_the_seeds_summary_is_the_median_and_the_largest_g_star_over_the_seeds():
+    """Three seeds or more (the store's first): their median and largest g* per row, an infinite g* kept as the largest;
+    fewer than three give no summary."""
+    from stochpound.risk._sensitivity import seeds_summary
+
+    rows = {"target": [0.1, 0.02]}
+    seeds = [xr.DataArray(values, dims="target", coords=rows) for values in ([0.10, 0.30], [0.14, np.inf], [0.12, 0.20], [0.11, 0.25])]
+    summary = seeds_summary(seeds)
+    assert list(summary) == ["selection seeds (4): median", "selection seeds (4): largest"]
+    np.testing.assert_allclose(summary["selection seeds (4): median"].values, [0.115, 0.275])
+    np.testing.assert_array_equal(summary["selection seeds (4): largest"].values, [0.14, np.inf])
+    assert seeds_summary(seeds[:2]) == {}

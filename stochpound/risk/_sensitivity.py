@@ -114,7 +114,8 @@ def separation_sensitivity(risk: object, store: xr.Dataset | RiskInputs, collaps
     Returns
     -------
     Sensitivity
-        Its ``frame``: indexed by the configuration and ``target``; columns ``g* (m)`` and, per choice, its g* and ``Δ (%)``.
+        Its ``frame``: indexed by the configuration and ``target``; columns ``g* (m)`` and, per choice, its g* and ``Δ (%)``;
+        with two seed stores or more, also the median and the largest g* over the seeds (:func:`seeds_summary`).
 
     Raises
     ------
@@ -143,13 +144,37 @@ def separation_sensitivity(risk: object, store: xr.Dataset | RiskInputs, collaps
         columns["collapses apart"] = collapse.separation["separation"]
     for value in dispersions:
         columns[f"β_m = {value:g}"] = _with_dispersion(risk.fragility, value, risk.hazard, targets, years)
+    seeds = [columns["g* (m)"]]
     for (kind, other), label in zip(alternatives, labels):
         hazard = site_hazard(other) if kind == "measure" else risk.hazard
-        columns[_unique(label, columns)] = store_risk(other, hazard, targets, years, bootstrap=0, partial=bool(risk.progress)).separation[
-            "separation"]
+        name = _unique(label, columns)
+        columns[name] = store_risk(other, hazard, targets, years, bootstrap=0, partial=bool(risk.progress)).separation["separation"]
+        if kind == "seed":
+            seeds.append(columns[name])
+    columns.update(seeds_summary(seeds))
     given = {kind for kind, _ in alternatives}
     moot = set() if isinstance(store, RiskInputs) or has_walls(store) else {"wall"}  # no wall: its stiffness is no choice of this answer
     return Sensitivity(_table(columns, years), risk.grid, tuple(k for k in ALTERNATIVES if k not in given | moot))
+
+
+def seeds_summary(seeds: Sequence[xr.DataArray]) -> dict[str, xr.DataArray]:
+    """The median and the largest g* (m) over the selection seeds: the store's g* and its seed alternatives', in that order.
+
+    Parameters
+    ----------
+    seeds : sequence of xarray.DataArray
+        g* of the store and of each seed store, over the same configurations and targets.
+
+    Returns
+    -------
+    dict of str to xarray.DataArray
+        ``selection seeds (N): median`` and ``selection seeds (N): largest`` with three seeds or more (the store's and two
+        others: where its g* lies among them); none with fewer.
+    """
+    if len(seeds) < 3:
+        return {}
+    over = xr.concat([_dims_only(seed) for seed in seeds], dim="seed")
+    return {f"{SEED_COLUMN}s ({len(seeds)}): median": over.median("seed"), f"{SEED_COLUMN}s ({len(seeds)}): largest": over.max("seed")}
 
 
 def _table(columns: Mapping[str, xr.DataArray], years: float) -> pd.DataFrame:
