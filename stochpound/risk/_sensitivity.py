@@ -115,7 +115,7 @@ def separation_sensitivity(risk: object, store: xr.Dataset | RiskInputs, collaps
     -------
     Sensitivity
         Its ``frame``: indexed by the configuration and ``target``; columns ``g* (m)`` and, per choice, its g* and ``Δ (%)``;
-        with two seed stores or more, also the median and the largest g* over the seeds (:func:`seeds_summary`).
+        with two seed stores or more, also the median and the largest g* over the seeds (``seeds_summary``).
 
     Raises
     ------
