@@ -56,6 +56,8 @@ EVALUATED_BY = {
 """What would evaluate each choice of ``ALTERNATIVES``."""
 SEED_COLUMN = "selection seed"
 """The head of a seed alternative's column (``selection seed 2``), by which the text finds the seeds' columns."""
+SUMMARISED_SEEDS = 3
+"""The fewest selection seeds (the store's and its seed alternatives') over which the table and its text summarise g*."""
 _ANY = ("name", "description", "design", "limit_states", "scene_source", "output", "intensity.note")
 """Entries of a definition no g* depends on: they may differ between a store and its alternative."""
 _ALLOWED = {
@@ -168,10 +170,10 @@ def seeds_summary(seeds: Sequence[xr.DataArray]) -> dict[str, xr.DataArray]:
     Returns
     -------
     dict of str to xarray.DataArray
-        ``selection seeds (N): median`` and ``selection seeds (N): largest`` with three seeds or more (the store's and two
-        others: where its g* lies among them); none with fewer.
+        ``selection seeds (N): median`` and ``selection seeds (N): largest`` with ``SUMMARISED_SEEDS`` (3) seeds or more (the
+        store's and two others: where its g* lies among them); none with fewer.
     """
-    if len(seeds) < 3:
+    if len(seeds) < SUMMARISED_SEEDS:
         return {}
     over = xr.concat([_dims_only(seed) for seed in seeds], dim="seed")
     return {f"{SEED_COLUMN}s ({len(seeds)}): median": over.median("seed"), f"{SEED_COLUMN}s ({len(seeds)}): largest": over.max("seed")}
@@ -310,9 +312,9 @@ def sensitivity_text(frame: pd.DataFrame, grid: str = "", not_evaluated: Sequenc
 
 
 def _seeds_spread(frame: pd.DataFrame) -> list[str]:
-    """With two or more selection-seed columns, the spread of g* over the store's seed and theirs, in words (none with fewer)."""
+    """With ``SUMMARISED_SEEDS`` seeds or more (the store's and its seed columns'), the spread of g* over them in words (none with fewer)."""
     seeds = [column for column in frame.columns if column.startswith(f"{SEED_COLUMN} ") and not column.endswith("Δ (%)")]
-    if len(seeds) < 2:
+    if 1 + len(seeds) < SUMMARISED_SEEDS:  # the store's seed and its alternatives'
         return []
     values = frame[["g* (m)", *seeds]].to_numpy(dtype=float)
     rows = [row for row in values if np.all(np.isfinite(row)) and np.all(row > 0.0)]
