@@ -85,6 +85,17 @@ def test_isotonic_rate_keeps_a_monotone_curve_and_fills_missing_gaps():
     np.testing.assert_allclose(_nonincreasing_rate(rising), [1e-2, 2e-3, 2e-3, 1e-4], rtol=1e-12)  # the pooled pair's geometric mean
 
 
+def test_isotonic_rate_gives_back_the_zeros_of_gaps_no_run_closes():
+    """Trailing zeros (no run pounds at the wider gaps) stay 0, weighted or not, so g* interpolates linearly in λ into them
+    (they entered the fit as the smallest double, and exp(ln tiny) rounds above tiny); g* of a target between 4e-3 at 0.1 m
+    and 0 at 0.2 m lies a fraction 1 − 1e-3 / 4e-3 of the way in ln g: 0.1 · 2^0.75."""
+    curve = np.array([1e-2, 4e-3, 0.0, 0.0])
+    gaps = np.array([0.05, 0.1, 0.2, 0.4])
+    np.testing.assert_array_equal(_nonincreasing_rate(curve)[2:], 0.0)
+    np.testing.assert_array_equal(_nonincreasing_rate(curve, np.array([1.0, 0.7, 0.3, 0.5]))[2:], 0.0)
+    np.testing.assert_allclose(_separation_kernel(curve, gaps, np.array([1e-3])), [0.1 * 2.0**0.75], rtol=1e-12)
+
+
 def test_stripe_fragility_resamples_the_events_of_a_store():
     import xarray as xr
 

@@ -439,8 +439,8 @@ def non_increasing(maf: np.ndarray, weights: np.ndarray | None = None) -> np.nda
         if known.sum() > 1:
             with np.errstate(divide="ignore"):
                 logs = np.maximum(np.log(row[known]), tiny)
-            values = np.exp(optimize.isotonic_regression(logs, weights=None if weights is None else weights[known], increasing=False).x)
-            out[known] = np.where(values > np.finfo(float).tiny, values, 0.0)
+            fitted_logs = optimize.isotonic_regression(logs, weights=None if weights is None else weights[known], increasing=False).x
+            out[known] = np.where(fitted_logs > tiny + 1.0, np.exp(fitted_logs), 0.0)  # a pool of zeros alone (its mean ln tiny, to rounding) is 0 again
         elif known.any():
             out[known] = row[known]
         out[:] = np.fmin.accumulate(out)  # NaN positions take the value before them
