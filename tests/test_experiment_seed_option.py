@@ -125,3 +125,5 @@ def test_three_seeds_give_the_sensitivity_table_their_median_and_largest_g_star(
     np.testing.assert_array_equal(frame["selection seeds (3): largest"].to_numpy(dtype=float), np.max(over, axis=1))
     with np.errstate(invalid="ignore", divide="ignore"):
         np.testing.assert_allclose(frame["selection seeds (3): largest: Δ (%)"], 100 * (over.max(axis=1) / over[:, 0] - 1))
+    spread = frame["selection seeds (3): λ_P at their median g*: largest / smallest (×)"].to_numpy(dtype=float)
+    assert np.all((spread >= 1.0) | np.isnan(spread)) and list(frame.columns)[-1].endswith("(×)")

@@ -243,3 +243,55 @@ def test_the_seeds_summary_is_the_median_and_the_largest_g_star_over_the_seeds()
     np.testing.assert_allclose(summary["selection seeds (4): median"].values, [0.115, 0.275])
     np.testing.assert_array_equal(summary["selection seeds (4): largest"].values, [0.14, np.inf])
     assert seeds_summary(seeds[:2]) == {}
+
+
+def _power_law_curve(scales: list[float], gaps: np.ndarray) -> xr.Dataset:
+    """A risk curve λ_P(g) = a · g^−3 (1/yr) per configuration ``a`` of ``scales``, over ``gaps`` (m)."""
+    maf = np.asarray(scales)[:, None] * gaps[None, :] ** -3.0
+    return xr.Dataset({"maf": (("a", "gap"), maf)}, coords={"a": scales, "gap": gaps})
+
+
+def test_the_rate_at_a_gap_is_the_power_law_s_own_and_inverts_g_star():
+    """λ_P read between grid gaps (ln λ linear in ln g) is exact for a power law; at g* of a target it gives back the target's
+    rate on a noisy curve too (the same isotonic envelope and interpolation as g*); off the grid it is NaN."""
+    from stochpound.risk._maf import rate_at_separation, risk_targeted_separation
+
+    gaps = np.geomspace(0.01, 0.5, 9)
+    curve = _power_law_curve([1e-7, 4e-7], gaps)
+    at = xr.DataArray([0.0123, 0.2, 0.5, 0.6, np.inf], dims="at")
+    rate = rate_at_separation(curve, at)
+    expected = np.asarray([1e-7, 4e-7])[:, None] * at.values[None, :3] ** -3.0
+    np.testing.assert_allclose(rate.values[:, :3], expected, rtol=1e-12)
+    assert np.isnan(rate.values[:, 3:]).all()
+    noisy = curve.assign(maf=curve["maf"] * np.exp(0.3 * np.random.default_rng(3).standard_normal(curve["maf"].shape)))
+    separation = risk_targeted_separation(noisy, (0.10, 0.02), 50.0)
+    np.testing.assert_allclose(rate_at_separation(noisy, separation["separation"]).values,
+                               np.broadcast_to(separation["target_rate"].values, (2, 2)), rtol=1e-10)
+
+
+def test_the_seeds_rate_spread_is_the_largest_rate_over_the_smallest_at_the_gap():
+    """Three seeds' power laws a · g^−3 read at one gap per row: max a / min a whatever the gap; a seed whose λ_P is 0 there
+    (and another's not) gives inf; a gap off a seed's grid NaN."""
+    from stochpound.risk._sensitivity import seeds_rate_spread
+
+    gaps = np.geomspace(0.01, 0.5, 9)
+    curves = [_power_law_curve([1e-7, 2e-7], gaps), _power_law_curve([3e-7, 2e-7], gaps), _power_law_curve([2e-7, 5e-7], gaps)]
+    at = xr.DataArray([0.05, 0.3], dims="a", coords={"a": [1e-7, 2e-7]})
+    spread = seeds_rate_spread([c.assign_coords(a=[1e-7, 2e-7]) for c in curves], at)
+    np.testing.assert_allclose(spread.values, [3.0, 2.5], rtol=1e-12)
+    silent = curves[0].assign(maf=curves[0]["maf"] * 0.0)
+    np.testing.assert_array_equal(seeds_rate_spread([silent, curves[1].assign_coords(a=[1e-7, 2e-7])], at).values, [np.inf, np.inf])
+    assert seeds_rate_spread(curves[:1], at.copy(data=[0.05, 0.7])).isnull().values.tolist() == [False, True]
+
+
+def test_the_seeds_spread_says_the_rate_spread_beside_g_star_s():
+    """The text adds λ_P's spread at the seeds' median g*, its largest over the rows where it is finite (an inf row left out)."""
+    from stochpound.risk._sensitivity import RATE_SPREAD, sensitivity_text
+
+    index = pd.MultiIndex.from_tuples([("a", "10 % in 50 yr"), ("b", "10 % in 50 yr"), ("c", "10 % in 50 yr")], names=["case", "target"])
+    frame = pd.DataFrame({"g* (m)": [0.10, 0.20, 0.30], "selection seed 2": [0.12, 0.25, 0.33], "selection seed 2: Δ (%)": [20.0, 25.0, 10.0],
+                          "selection seed 3": [0.09, 0.21, 0.31], "selection seed 3: Δ (%)": [-10.0, 5.0, 10 / 3],
+                          f"selection seeds (3): {RATE_SPREAD}": [1.8, np.inf, 2.4]}, index=index)
+    text = sensitivity_text(frame, not_evaluated=())
+    assert ("g* spans up to ×1.33 in a row (its largest over its smallest, over the 3 of 3 rows finite at every seed), and the rate of "
+            "pounding λ_P at their median g* spans up to ×2.40 (over the 2 of 3 rows where every seed's λ_P there is > 0)") in text

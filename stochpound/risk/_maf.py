@@ -336,6 +336,30 @@ def risk_targeted_separation(curve: xr.Dataset, targets: Sequence[float] = TARGE
     ).assign_attrs(years=years, **no_interval_attrs(curve))
 
 
+def rate_at_separation(curve: xr.Dataset, separation: xr.DataArray, dim: str = "gap") -> xr.DataArray:
+    """λ_P (1/yr) at given gaps: the inverse of :func:`risk_targeted_separation` on the same curve.
+
+    The curve's ``maf`` is made non-increasing as g* reads it (isotonic in ln λ, each gap weighted by the share of ln g it
+    stands for) and interpolated between the two grid gaps that bracket each gap, linearly in ln λ against ln g (in λ where
+    the wider gap's λ is 0, against g from a zero gap): at g* of a target inside the grid it gives back the target's rate.
+
+    Parameters
+    ----------
+    curve : xarray.Dataset
+        From :func:`risk_curve`, with ``maf`` over ``dim`` (ascending gaps, m).
+    separation : xarray.DataArray
+        The gaps (m) to read λ_P at, over some of the curve's other dimensions and, e.g., ``target``.
+
+    Returns
+    -------
+    xarray.DataArray
+        λ_P (1/yr) over the dimensions of both; NaN where the gap is not finite or lies outside the grid.
+    """
+    gaps = np.asarray(curve[dim].values, dtype=float)
+    rate = xr.apply_ufunc(_rate_kernel, curve["maf"], separation, kwargs={"gaps": gaps}, input_core_dims=[[dim], []], vectorize=True)
+    return rate.assign_attrs(units="1/yr", long_name="mean annual frequency of pounding at the gap")
+
+
 def no_interval_attrs(data: xr.Dataset) -> dict[str, str]:
     """``data``'s ``no_interval`` attribute (why its motions gave no interval: :func:`~stochpound.risk.stripe_fragility`), to pass on."""
     return {"no_interval": data.attrs["no_interval"]} if "no_interval" in data.attrs else {}
@@ -478,3 +502,19 @@ def _separation_kernel(maf: np.ndarray, gaps: np.ndarray, rates: np.ndarray) -> 
     separation = np.where(g_hi > 0.0, in_log_gap, g_hi + fraction * (g_lo - g_hi))
     separation = np.where(~found, np.inf, np.where(index == 0, gaps[0], separation))
     return np.where(np.isnan(maf).all(-1)[..., None], np.nan, separation)
+
+
+def _rate_kernel(maf: np.ndarray, at: float, gaps: np.ndarray) -> float:
+    """λ_P at the gap ``at`` of one curve (``maf`` over ``gaps``): the interpolation :func:`_separation_kernel` inverts."""
+    if not (np.isfinite(at) and gaps[0] <= at <= gaps[-1]) or np.isnan(maf).all():
+        return np.nan
+    envelope = non_increasing(maf, gap_weights(gaps))
+    upper = int(np.clip(np.searchsorted(gaps, at, side="right"), 1, gaps.size - 1))
+    g_narrow, g_wide = gaps[upper - 1], gaps[upper]
+    lam_narrow, lam_wide = envelope[upper - 1], envelope[upper]
+    fraction = np.log(at / g_narrow) / np.log(g_wide / g_narrow) if g_narrow > 0.0 else (at - g_narrow) / (g_wide - g_narrow)
+    if not np.isfinite(lam_narrow):
+        return float(lam_wide) if fraction == 1.0 else np.inf
+    if lam_wide > 0.0:
+        return float(np.exp(np.log(lam_narrow) + fraction * np.log(lam_wide / lam_narrow)))
+    return float(lam_narrow + fraction * (lam_wide - lam_narrow))

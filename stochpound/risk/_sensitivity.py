@@ -40,7 +40,7 @@ from stochpound.risk._collapse import CollapseRisk
 from stochpound.risk._fragility import DECREASING, EMPTY, NEVER, ALWAYS
 from stochpound.risk._gap_grid import refinement_gaps
 from stochpound.risk._inputs import RiskInputError, RiskInputs, has_walls, store_definition, experiment_name, intensity_setting, site_hazard
-from stochpound.risk._maf import mean_annual_frequency, risk_targeted_separation
+from stochpound.risk._maf import mean_annual_frequency, rate_at_separation, risk_targeted_separation
 
 REFINEMENT = 4
 """How many times finer the table's refinement splits each bracket of a g* of the chain's (already refined) grid."""
@@ -58,6 +58,8 @@ SEED_COLUMN = "selection seed"
 """The head of a seed alternative's column (``selection seed 2``), by which the text finds the seeds' columns."""
 SUMMARISED_SEEDS = 3
 """The fewest selection seeds (the store's and its seed alternatives') over which the table and its text summarise g*."""
+RATE_SPREAD = "λ_P at their median g*: largest / smallest (×)"
+"""The tail of the head of the seeds' rate spread (``selection seeds (5): λ_P at their median g*: …``), a column with no Δ."""
 _ANY = ("name", "description", "design", "limit_states", "scene_source", "output", "intensity.note")
 """Entries of a definition no g* depends on: they may differ between a store and its alternative."""
 _ALLOWED = {
@@ -146,17 +148,21 @@ def separation_sensitivity(risk: object, store: xr.Dataset | RiskInputs, collaps
         columns["collapses apart"] = collapse.separation["separation"]
     for value in dispersions:
         columns[f"β_m = {value:g}"] = _with_dispersion(risk.fragility, value, risk.hazard, targets, years)
-    seeds = [columns["g* (m)"]]
+    seeds = [risk]
     for (kind, other), label in zip(alternatives, labels):
         hazard = site_hazard(other) if kind == "measure" else risk.hazard
         name = _unique(label, columns)
-        columns[name] = store_risk(other, hazard, targets, years, bootstrap=0, partial=bool(risk.progress)).separation["separation"]
+        answer = store_risk(other, hazard, targets, years, bootstrap=0, partial=bool(risk.progress))
+        columns[name] = answer.separation["separation"]
         if kind == "seed":
-            seeds.append(columns[name])
-    columns.update(seeds_summary(seeds))
+            seeds.append(answer)
+    summary = seeds_summary([seed.separation["separation"] for seed in seeds])
+    columns.update(summary)
+    plain = {} if not summary else {f"{SEED_COLUMN}s ({len(seeds)}): {RATE_SPREAD}": seeds_rate_spread(
+        [seed.curve for seed in seeds], summary[f"{SEED_COLUMN}s ({len(seeds)}): median"])}
     given = {kind for kind, _ in alternatives}
     moot = set() if isinstance(store, RiskInputs) or has_walls(store) else {"wall"}  # no wall: its stiffness is no choice of this answer
-    return Sensitivity(_table(columns, years), risk.grid, tuple(k for k in ALTERNATIVES if k not in given | moot))
+    return Sensitivity(_table(columns, years, plain), risk.grid, tuple(k for k in ALTERNATIVES if k not in given | moot))
 
 
 def seeds_summary(seeds: Sequence[xr.DataArray]) -> dict[str, xr.DataArray]:
@@ -179,18 +185,41 @@ def seeds_summary(seeds: Sequence[xr.DataArray]) -> dict[str, xr.DataArray]:
     return {f"{SEED_COLUMN}s ({len(seeds)}): median": over.median("seed"), f"{SEED_COLUMN}s ({len(seeds)}): largest": over.max("seed")}
 
 
-def _table(columns: Mapping[str, xr.DataArray], years: float) -> pd.DataFrame:
-    """The sensitivity frame of g* per choice (``columns``, the first ``g* (m)``): each with its Δ (%) from g*."""
-    table = xr.Dataset({name: _dims_only(data) for name, data in columns.items()}).to_dataframe()
+def seeds_rate_spread(curves: Sequence[xr.Dataset], at: xr.DataArray) -> xr.DataArray:
+    """The spread of the rate of pounding over the selection seeds at one gap per row: the largest λ_P over the smallest (×).
+
+    Parameters
+    ----------
+    curves : sequence of xarray.Dataset
+        The risk curve (``maf`` over ``gap``, 1/yr) of each seed's store (:class:`~stochpound.risk.StoreRisk`'s ``curve``).
+    at : xarray.DataArray
+        The gap (m) per configuration and target to read every curve at: the seeds' median g* (``seeds_summary``).
+
+    Returns
+    -------
+    xarray.DataArray
+        max λ_P / min λ_P over the seeds (≥ 1), per configuration and target; ``inf`` where some seed's λ_P there is 0 (no
+        run of that seed closes the gap) and another's not, NaN where the gap is not finite or lies outside a seed's grid.
+    """
+    rates = xr.concat([_dims_only(rate_at_separation(curve, at)) for curve in curves], dim="seed")
+    largest, smallest = rates.max("seed", skipna=False), rates.min("seed", skipna=False)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return xr.where(largest > 0.0, largest / smallest, 1.0).where(largest.notnull())
+
+
+def _table(columns: Mapping[str, xr.DataArray], years: float, plain: Mapping[str, xr.DataArray]) -> pd.DataFrame:
+    """The sensitivity frame of g* per choice (``columns``, the first ``g* (m)``): each with its Δ (%) from g*; then ``plain``
+    (columns of other units, no Δ)."""
+    table = xr.Dataset({name: _dims_only(data) for name, data in {**columns, **plain}.items()}).to_dataframe()
     frame = table.reset_index()
     frame["target"] = [f"{100 * p:g} % in {years:g} yr" for p in frame["target"]]
-    config = [name for name in frame.columns if name not in columns and name != "target"]
+    config = [name for name in frame.columns if name not in columns and name not in plain and name != "target"]
     frame = frame.set_index([*config, "target"])
     base = frame["g* (m)"]
     for name in [c for c in columns if c != "g* (m)"]:
         with np.errstate(invalid="ignore", divide="ignore"):
             frame[f"{name}: Δ (%)"] = 100.0 * (frame[name] / base - 1.0)
-    return frame[["g* (m)", *(c for name in columns if name != "g* (m)" for c in (name, f"{name}: Δ (%)"))]]
+    return frame[["g* (m)", *(c for name in columns if name != "g* (m)" for c in (name, f"{name}: Δ (%)")), *plain]]
 
 
 def _unique(label: str, taken: Mapping[str, xr.DataArray]) -> str:
@@ -322,7 +351,20 @@ def _seeds_spread(frame: pd.DataFrame) -> list[str]:
         return [f"the {len(seeds) + 1} selection seeds together: no row with a finite g* > 0 at every seed"]
     spread = max(float(row.max() / row.min()) for row in rows)
     return [f"the {len(seeds) + 1} selection seeds together (the store's and {len(seeds)} others): g* spans up to ×{spread:.2f} in a row "
-            f"(its largest over its smallest, over the {len(rows)} of {len(values)} rows finite at every seed)"]
+            f"(its largest over its smallest, over the {len(rows)} of {len(values)} rows finite at every seed){_rate_spread(frame)}"]
+
+
+def _rate_spread(frame: pd.DataFrame) -> str:
+    """The seeds' spread of λ_P at their median g* (the ``RATE_SPREAD`` column) in words, as a clause ("" without the column)."""
+    column = next((c for c in frame.columns if c.endswith(RATE_SPREAD)), None)
+    if column is None:
+        return ""
+    values = frame[column].to_numpy(dtype=float)
+    finite = values[np.isfinite(values)]
+    if not finite.size:
+        return ", and λ_P at their median g* is 0 at some seed (or the gap off its grid) in every row"
+    return (f", and the rate of pounding λ_P at their median g* spans up to ×{finite.max():.2f} (over the {finite.size} of {values.size} "
+            "rows where every seed's λ_P there is > 0)")
 
 
 def _dims_only(data: xr.DataArray) -> xr.DataArray:

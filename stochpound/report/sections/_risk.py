@@ -139,8 +139,8 @@ def risk_section(name: str, risk: StoreRisk, demands: StoreDemands | None = None
         section.add(Paragraph(sensitivity.text()))
         section.add(Table(f"risk-sensitivity-{name}", f"Experiment {name}: g* under each choice it rests on, each alone (no bootstrap; "
                           "the selection seed, the measure and the moat wall's stiffness from other stores, where given), with its change from "
-                          "g*", sensitivity.frame,
-                          formats={c: ("{:.1f}" if c.endswith("(%)") else "{:.3f}") for c in sensitivity.frame.columns}))
+                          "g* (with three selection seeds or more, their median and largest g* and the spread of λ_P over them at that median)",
+                          sensitivity.frame, formats={c: _sensitivity_format(c) for c in sensitivity.frame.columns}))
     section.add(Paragraph(_hazard_text(risk)))
     for block in _measure_choice_blocks(name, risk, choice):
         section.add(block)
@@ -156,6 +156,11 @@ def risk_section(name: str, risk: StoreRisk, demands: StoreDemands | None = None
     if moat:
         section.add(Paragraph(moat))
     return section
+
+
+def _sensitivity_format(column: str) -> str:
+    """The format of a sensitivity table's column: Δ in % to 0.1, a ratio (×) to 0.01, a gap (m) to the mm."""
+    return "{:.1f}" if column.endswith("(%)") else "{:.2f}" if column.endswith("(×)") else "{:.3f}"
 
 
 def _separation_table(name: str, risk: StoreRisk) -> Table:
