@@ -43,7 +43,7 @@ from stochpound.risk._design_rules import DESIGN_RULE_NAMES, design_assumptions,
 from stochpound.risk._fragility_ensemble import BOOTSTRAP, fragility_band, fragility_surface, homogeneous_capacities, ida_fragility, limit_state_events, stripe_fragility
 from stochpound.risk._fragility import DECREASING, EMPTY, FIT, STATUS
 from stochpound.risk._gap_grid import GRID_TOLERANCE, MAX_REFINEMENTS, grid_note, refinement_gaps
-from stochpound.risk._maf import TARGETS, degenerate_text, non_increasing, risk_curve, risk_targeted_separation
+from stochpound.risk._maf import TARGETS, degenerate_text, non_increasing, risk_curve, risk_targeted_separation, target_text
 from stochpound.risk._stripe_coverage import at_lowest_stripe, maf_outside_stripes, top_capped_maf
 
 YEARS = 50.0
@@ -752,11 +752,6 @@ def _coarse_change(refined: xr.DataArray, coarse: xr.DataArray | None) -> float:
         change = np.abs(np.asarray(coarse.values, dtype=float) / np.asarray(refined.values, dtype=float) - 1.0)
     change = change[np.isfinite(change)]
     return float(change.max()) if change.size else math.nan
-
-
-def target_text(probability: float, years: float = YEARS) -> str:
-    """A target in words: ``10 % in 50 yr``."""
-    return f"{100 * probability:g} % in {years:g} yr"
 
 
 def design_text(probability: float, stripe: float, years: float = YEARS) -> str:

@@ -39,7 +39,7 @@ from stochpound.hazard import HazardCurve
 from stochpound.risk import _inputs
 from stochpound.risk._fragility import DECREASING, lognormal_cdf
 from stochpound.risk._fragility_ensemble import limit_state_events, stripe_fragility
-from stochpound.risk._maf import mean_annual_frequency, risk_targeted_separation
+from stochpound.risk._maf import mean_annual_frequency, risk_targeted_separation, target_text
 from stochpound.risk._stripe_coverage import identified, stripes_only_maf, stripes_upper_maf
 
 MODEL_DRIFT_LIMIT = 0.05
@@ -81,7 +81,7 @@ class CollapseRisk:
         P(C | IM) (``COLLAPSE_BOUNDS``), and its runs beyond the model."""
         rows = xr.Dataset({"g* as run (m)": _dims_only(as_run["separation"]),
                            "g* collapses apart (m)": _dims_only(self.separation["separation"])}).to_dataframe().reset_index()
-        rows["target"] = [f"{100 * p:g} % in {years:g} yr" for p in rows["target"]]
+        rows["target"] = [target_text(p, years) for p in rows["target"]]
         config = [name for name in rows.columns if name not in ("target", "g* as run (m)", "g* collapses apart (m)")]
         counts = xr.Dataset({"λ_C (1/yr)": _dims_only(self.collapse["maf"]), "collapsed": _dims_only(self.collapse["exceeded"].sum("intensity")),
                              "runs": _dims_only(self.collapse["runs"].sum("intensity"))})
@@ -103,7 +103,7 @@ class CollapseRisk:
         theta, beta = self.collapse["theta"], self.collapse["beta"]
         fits = (f"θ = {float(theta.min()):.3g}" + (f"–{float(theta.max()):.3g}" if float(theta.max()) != float(theta.min()) else "")
                 + f", β = {float(beta.min()):.2g}" + (f"–{float(beta.max()):.2g}" if float(beta.max()) != float(beta.min()) else ""))
-        beyond = [f"{100 * float(p):g} % in {years:g} yr" for p in self.separation["target"].values
+        beyond = [target_text(float(p), years) for p in self.separation["target"].values
                   if bool(np.isinf(self.separation["separation"].sel(target=p)).any())]
         return (f"Collapse as FEMA P-58 treats it: {self.collapsed} of {self.runs} contact-free runs pass a {100 * MODEL_DRIFT_LIMIT:g} % "
                 "storey drift, beyond what the model represents (no strength loss or collapse is modelled); they are counted apart as "

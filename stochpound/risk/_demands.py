@@ -27,7 +27,7 @@ from collections.abc import Hashable, Sequence
 from stochpound.hazard import HazardCurve, rate_from_probability
 from stochpound.risk import _inputs
 from stochpound.risk._fragility_ensemble import BOOTSTRAP
-from stochpound.risk._maf import demand_hazard_curve
+from stochpound.risk._maf import demand_hazard_curve, target_text
 from stochpound.risk._chain import CONFIDENCE, YEARS, non_increasing_along
 from stochpound.risk._collapse import beyond_model, collapse_fit, rate_collapses_apart
 
@@ -95,7 +95,7 @@ class StoreDemands:
             for labels in _configurations(curve["maf"]):
                 for target in targets:
                     allowed = float(rate_from_probability(float(target), years))
-                    row = {"demand": f"{label} ({self.units[label]})", **labels, "target": f"{100 * float(target):g} % in {years:g} yr"}
+                    row = {"demand": f"{label} ({self.units[label]})", **labels, "target": target_text(float(target), years)}
                     for way, maf in ways.items():
                         row[way] = _level_at(curve["level"].values, maf.sel(labels).values, allowed)
                     rows.append(row)

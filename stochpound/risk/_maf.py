@@ -360,6 +360,11 @@ def rate_at_separation(curve: xr.Dataset, separation: xr.DataArray, dim: str = "
     return rate.assign_attrs(units="1/yr", long_name="mean annual frequency of pounding at the gap")
 
 
+def target_text(probability: float, years: float) -> str:
+    """A target in words: ``10 % in 50 yr`` (a probability of pounding in ``years``)."""
+    return f"{100 * probability:g} % in {years:g} yr"
+
+
 def no_interval_attrs(data: xr.Dataset) -> dict[str, str]:
     """``data``'s ``no_interval`` attribute (why its motions gave no interval: :func:`~stochpound.risk.stripe_fragility`), to pass on."""
     return {"no_interval": data.attrs["no_interval"]} if "no_interval" in data.attrs else {}

@@ -40,7 +40,7 @@ from stochpound.risk._collapse import CollapseRisk
 from stochpound.risk._fragility import DECREASING, EMPTY, NEVER, ALWAYS
 from stochpound.risk._gap_grid import refinement_gaps
 from stochpound.risk._inputs import RiskInputError, RiskInputs, has_walls, store_definition, experiment_name, intensity_setting, site_hazard
-from stochpound.risk._maf import mean_annual_frequency, rate_at_separation, risk_targeted_separation
+from stochpound.risk._maf import mean_annual_frequency, rate_at_separation, risk_targeted_separation, target_text
 
 REFINEMENT = 4
 """How many times finer the table's refinement splits each bracket of a g* of the chain's (already refined) grid."""
@@ -212,7 +212,7 @@ def _table(columns: Mapping[str, xr.DataArray], years: float, plain: Mapping[str
     (columns of other units, no Δ)."""
     table = xr.Dataset({name: _dims_only(data) for name, data in {**columns, **plain}.items()}).to_dataframe()
     frame = table.reset_index()
-    frame["target"] = [f"{100 * p:g} % in {years:g} yr" for p in frame["target"]]
+    frame["target"] = [target_text(p, years) for p in frame["target"]]
     config = [name for name in frame.columns if name not in columns and name not in plain and name != "target"]
     frame = frame.set_index([*config, "target"])
     base = frame["g* (m)"]
