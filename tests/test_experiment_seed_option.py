@@ -119,8 +119,14 @@ def test_three_seeds_give_the_sensitivity_table_their_median_and_largest_g_star(
     with xr.open_dataset(path.with_suffix(".nc")) as main, xr.open_dataset(seed_store(path, 7)) as seven, \
             xr.open_dataset(seed_store(path, 8)) as eight:
         risk = store_risk(main, bootstrap=0)
-        frame = separation_sensitivity(risk, main, alternatives=[("seed", seven), ("seed", eight)]).frame
+        sensitivity = separation_sensitivity(risk, main, alternatives=[("seed", seven), ("seed", eight)])
+    frame = sensitivity.frame
     over = frame[["g* (m)", "selection seed 7", "selection seed 8"]].to_numpy(dtype=float)
+    both = sensitivity.seeds_beside_design(risk.design_frame(), risk.years)  # no bootstrap: the gap to design to is g* itself
+    withheld = int(risk.design_frame()["design"].isna().sum())  # g* only a lower bound: no gap to design to, the row left out
+    assert len(both) == int(np.isfinite(over).all(axis=1).sum()) - withheld > 0
+    np.testing.assert_array_equal(both["largest"].to_numpy(), frame.loc[both.index, "selection seeds (3): largest"].to_numpy())
+    np.testing.assert_array_equal(both["design"].to_numpy(), frame.loc[both.index, "g* (m)"].to_numpy())
     np.testing.assert_array_equal(frame["selection seeds (3): median"].to_numpy(dtype=float), np.median(over, axis=1))
     np.testing.assert_array_equal(frame["selection seeds (3): largest"].to_numpy(dtype=float), np.max(over, axis=1))
     with np.errstate(invalid="ignore", divide="ignore"):

@@ -295,3 +295,49 @@ def test_the_seeds_spread_says_the_rate_spread_beside_g_star_s():
     text = sensitivity_text(frame, not_evaluated=())
     assert ("g* spans up to ×1.33 in a row (its largest over its smallest, over the 3 of 3 rows finite at every seed), and the rate of "
             "pounding λ_P at their median g* spans up to ×2.40 (over the 2 of 3 rows where every seed's λ_P there is > 0)") in text
+
+
+def _seeds_frame() -> pd.DataFrame:
+    """A sensitivity frame of two configurations × two targets with three seeds (the store's and seeds 2, 3) and their summary."""
+    from stochpound.risk._sensitivity import seeds_summary, _table
+
+    rows = {"neighbour": ["stiff", "flexible"], "target": [0.10, 0.02]}
+    seeds = [xr.DataArray(values, dims=("neighbour", "target"), coords=rows)
+             for values in ([[0.030, 0.050], [0.060, 0.090]], [[0.036, 0.064], [0.058, 0.098]], [[0.035, 0.055], [0.061, np.inf]])]
+    columns = {"g* (m)": seeds[0], "selection seed 2": seeds[1], "selection seed 3": seeds[2], **seeds_summary(seeds)}
+    return _table(columns, 50.0, {})
+
+
+def test_the_seeds_largest_g_star_is_set_beside_the_gap_to_design_to():
+    """Per row the seeds' largest g* and the design frame's gap (its numeric targets labelled as the table's); a row with an
+    infinite largest g* left out; fewer than three seeds: nothing."""
+    from stochpound.risk import Sensitivity
+
+    design = pd.DataFrame({"neighbour": ["stiff", "stiff", "flexible", "flexible"], "target": [0.10, 0.02, 0.10, 0.02],
+                           "design": [0.034, 0.066, 0.065, 0.120], "basis": ["upper bound"] * 4})
+    sensitivity = Sensitivity(_seeds_frame())
+    assert sensitivity.seeds == 3
+    both = sensitivity.seeds_beside_design(design, 50.0)
+    assert [tuple(index) for index in both.index] == [("stiff", "10 % in 50 yr"), ("stiff", "2 % in 50 yr"), ("flexible", "10 % in 50 yr")]
+    np.testing.assert_array_equal(both["largest"].to_numpy(), [0.036, 0.064, 0.061])
+    np.testing.assert_array_equal(both["design"].to_numpy(), [0.034, 0.066, 0.065])
+    fewer = Sensitivity(_seeds_frame().drop(columns=[c for c in _seeds_frame().columns if c.startswith(("selection seed 3", "selection seeds"))]))
+    assert fewer.seeds == 0 and fewer.seeds_beside_design(design, 50.0).empty
+
+
+def test_the_design_summary_says_where_the_seeds_largest_g_star_lies_above_the_gap_to_design_to():
+    """The report's sentence names the rows above (one of three here) with both gaps, or says all rows stay within."""
+    from types import SimpleNamespace
+
+    from stochpound.report.sections._risk import seeds_beside_design_text
+    from stochpound.risk import Sensitivity
+
+    design = pd.DataFrame({"neighbour": ["stiff", "stiff", "flexible", "flexible"], "target": [0.10, 0.02, 0.10, 0.02],
+                           "design": [0.034, 0.066, 0.065, 0.120], "basis": ["upper bound"] * 4})
+    risk = SimpleNamespace(design_frame=lambda: design.copy(), years=50.0)
+    assert seeds_beside_design_text(risk, Sensitivity(_seeds_frame())) == (
+        " Over the 3 selection seeds of the sensitivity table, the largest g* lies above the gap to design to in 1 of 3 rows (neighbour "
+        "stiff, 10 % in 50 yr: 0.036 m against 0.034 m): that bound does not cover which motions are chosen.")
+    wider = SimpleNamespace(design_frame=lambda: design.assign(design=design["design"] + 0.01), years=50.0)
+    assert seeds_beside_design_text(wider, Sensitivity(_seeds_frame())) == (
+        " Over the 3 selection seeds of the sensitivity table, the largest g* stays within the gap to design to in all 3 rows.")

@@ -92,6 +92,34 @@ class Sensitivity:
         """The table's message in words (:func:`sensitivity_text`)."""
         return sensitivity_text(self.frame, self.grid, self.not_evaluated)
 
+    @property
+    def seeds(self) -> int:
+        """How many selection seeds the table summarises: the store's and its seed stores' (0 below ``SUMMARISED_SEEDS``)."""
+        count = 1 + len(_seed_columns(self.frame))
+        return count if count >= SUMMARISED_SEEDS else 0
+
+    def seeds_beside_design(self, design: pd.DataFrame, years: float) -> pd.DataFrame:
+        """The largest g* over the selection seeds beside the gap to design to, per row where both are finite.
+
+        Parameters
+        ----------
+        design : pandas.DataFrame
+            :meth:`~stochpound.risk.StoreRisk.design_frame` of the store: the configuration's dimensions, ``target``
+            (probabilities) and ``design`` (m).
+        years : float
+            The targets' exposure time (yr).
+
+        Returns
+        -------
+        pandas.DataFrame
+            Indexed as ``frame``; columns ``design`` and ``largest`` (m); empty below ``SUMMARISED_SEEDS`` seeds.
+        """
+        if not self.seeds:
+            return pd.DataFrame(columns=["design", "largest"])
+        labelled = design.assign(target=[target_text(p, years) for p in design["target"]]).set_index(list(self.frame.index.names))
+        both = pd.DataFrame({"design": labelled["design"], "largest": self.frame[f"{SEED_COLUMN}s ({self.seeds}): largest"]})
+        return both[np.isfinite(both.to_numpy(dtype=float)).all(axis=1)]
+
 
 def separation_sensitivity(risk: object, store: xr.Dataset | RiskInputs, collapse: CollapseRisk | None = None,
                            dispersions: Sequence[float] = MODELLING_DISPERSIONS, refinement: int = REFINEMENT,
@@ -342,7 +370,7 @@ def sensitivity_text(frame: pd.DataFrame, grid: str = "", not_evaluated: Sequenc
 
 def _seeds_spread(frame: pd.DataFrame) -> list[str]:
     """With ``SUMMARISED_SEEDS`` seeds or more (the store's and its seed columns'), the spread of g* over them in words (none with fewer)."""
-    seeds = [column for column in frame.columns if column.startswith(f"{SEED_COLUMN} ") and not column.endswith("Δ (%)")]
+    seeds = _seed_columns(frame)
     if 1 + len(seeds) < SUMMARISED_SEEDS:  # the store's seed and its alternatives'
         return []
     values = frame[["g* (m)", *seeds]].to_numpy(dtype=float)
@@ -352,6 +380,11 @@ def _seeds_spread(frame: pd.DataFrame) -> list[str]:
     spread = max(float(row.max() / row.min()) for row in rows)
     return [f"the {len(seeds) + 1} selection seeds together (the store's and {len(seeds)} others): g* spans up to ×{spread:.2f} in a row "
             f"(its largest over its smallest, over the {len(rows)} of {len(values)} rows finite at every seed){_rate_spread(frame)}"]
+
+
+def _seed_columns(frame: pd.DataFrame) -> list[str]:
+    """The g* columns of the seed alternatives (``selection seed 2``, …), not their Δ nor the seeds' summary."""
+    return [column for column in frame.columns if column.startswith(f"{SEED_COLUMN} ") and not column.endswith("Δ (%)")]
 
 
 def _rate_spread(frame: pd.DataFrame) -> str:

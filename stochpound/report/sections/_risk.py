@@ -129,7 +129,7 @@ def risk_section(name: str, risk: StoreRisk, demands: StoreDemands | None = None
     section = Section(f"Risk: experiment {name}", key=f"risk-{name}")
     section.add(Paragraph(headline_text(name, risk)))
     collapse = collapse if collapse is not None and collapse.collapsed else None
-    section.add(Paragraph(design_summary_text(risk, demands, damage, collapse)))
+    section.add(Paragraph(design_summary_text(risk, demands, damage, collapse, sensitivity)))
     if collapse is not None:
         section.add(Paragraph(collapse.text(risk.years)))
         section.add(Table(f"risk-collapse-{name}", f"Experiment {name}: g* both ways, every run as computed and the runs beyond the "
@@ -172,11 +172,12 @@ def _separation_table(name: str, risk: StoreRisk) -> Table:
 
 
 def design_summary_text(risk: StoreRisk, demands: StoreDemands | None = None, damage: StoreDamage | None = None,
-                        collapse: CollapseRisk | None = None) -> str:
+                        collapse: CollapseRisk | None = None, sensitivity: Sensitivity | None = None) -> str:
     """The design summary: the governing limit state (once: each limit state is judged against its own objective, the same at
     every target), what limits the separation at each target (pounding at g*, or the moat clearance in the configurations whose
-    base reaches it more often than the target allows), the gap to design to, which code rules meet their level, and what the
-    answer rests on (hazard, scenario, structural model, suite), all from the chain's results and the store."""
+    base reaches it more often than the target allows), the gap to design to (with several selection seeds in ``sensitivity``,
+    where their largest g* lies above it), which code rules meet their level, and what the answer rests on (hazard, scenario,
+    structural model, suite), all from the chain's results and the store."""
     targets = risk.separation["target"].values
     limits = "; ".join(_separation_limit(risk, demands, float(t)) for t in targets)
     if risk.rules_frame().empty:
@@ -195,7 +196,8 @@ def design_summary_text(risk: StoreRisk, demands: StoreDemands | None = None, da
     else:
         judged = (f"Limit state judged (no structural limit state with an objective, so none is ranked against it; at g*, what limits "
                   f"the separation): {limits}.")
-    return (f"Design summary. {judged} {design_value_text(risk)} {meets} The answer holds only for what it "
+    seeds = "" if sensitivity is None else seeds_beside_design_text(risk, sensitivity)
+    return (f"Design summary. {judged} {design_value_text(risk)}{seeds} {meets} The answer holds only for what it "
             f"rests on; a change to any of these voids it: {rests}.")
 
 
@@ -347,6 +349,20 @@ def design_value_text(risk: StoreRisk) -> str:
             "sampling of the motions only (which records were drawn), none of the choices the answer rests on (the gap grid, the "
             "collapse treatment, modelling dispersion, the selection seed, the conditioning measure"
             + (", the moat wall's stiffness" if "moat walls" in risk.assumptions else "") + ": the sensitivity table).")
+
+
+def seeds_beside_design_text(risk: StoreRisk, sensitivity: Sensitivity) -> str:
+    """With three selection seeds or more, whether their largest g* lies above the gap to design to, where and by how much,
+    as a sentence after a leading space ("" with fewer seeds or no row to compare)."""
+    both = sensitivity.seeds_beside_design(risk.design_frame(), risk.years)
+    if both.empty:
+        return ""
+    above = both[both["largest"] > both["design"]]
+    where = "; ".join(f"{labels_text(dict(zip(both.index.names[:-1], index[:-1]))) or 'the scene'}, {index[-1]}: {row.largest:.3f} m against "
+                      f"{row.design:.3f} m" for index, row in above.iterrows())
+    said = (f"lies above the gap to design to in {len(above)} of {len(both)} rows ({where}): that bound does not cover which motions are "
+            "chosen" if len(above) else f"stays within the gap to design to in all {len(both)} rows")
+    return f" Over the {sensitivity.seeds} selection seeds of the sensitivity table, the largest g* {said}."
 
 
 def _motions_text(risk: StoreRisk) -> str:
