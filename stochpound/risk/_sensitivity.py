@@ -363,8 +363,8 @@ def sensitivity_text(frame: pd.DataFrame, grid: str = "", not_evaluated: Sequenc
     missing = ("; ".join(f"{ALTERNATIVES[kind]} (needs {EVALUATED_BY[kind]})" for kind in not_evaluated))
     unsaid = f" Not evaluated (each needs other runs): {missing}." if missing else ""
     return ("Sensitivity of g* to the choices it rests on (each alone, no bootstrap; Δ from g*): " + "; ".join(said) + "."
-            + grid_said + " β_m cannot spread a gap no run closes (a 'never' step has no θ): its λ stays 0, so g* with β_m stops at the "
-            f"widest gap some run closes.{unsaid} The interval of g* and the gap to design to (its upper bound) bound the "
+            + grid_said + " β_m cannot spread a gap no run closes (a 'never' step has no θ): its λ stays 0, so g* with β_m stops short of the "
+            f"first gap of the grid no run closes (λ interpolated linearly to 0 there).{unsaid} The interval of g* and the gap to design to (its upper bound) bound the "
             "record-to-record sampling of the motions only, none of these choices.")
 
 
