@@ -117,7 +117,7 @@ class Sensitivity:
         if not self.seeds:
             return pd.DataFrame(columns=["design", "largest"])
         labelled = design.assign(target=[target_text(p, years) for p in design["target"]]).set_index(list(self.frame.index.names))
-        both = pd.DataFrame({"design": labelled["design"], "largest": self.frame[f"{SEED_COLUMN}s ({self.seeds}): largest"]})
+        both = pd.DataFrame({"design": labelled["design"], "largest": self.frame[seeds_column(self.seeds, "largest")]})
         return both[np.isfinite(both.to_numpy(dtype=float)).all(axis=1)]
 
 
@@ -186,8 +186,8 @@ def separation_sensitivity(risk: object, store: xr.Dataset | RiskInputs, collaps
             seeds.append(answer)
     summary = seeds_summary([seed.separation["separation"] for seed in seeds])
     columns.update(summary)
-    plain = {} if not summary else {f"{SEED_COLUMN}s ({len(seeds)}): {RATE_SPREAD}": seeds_rate_spread(
-        [seed.curve for seed in seeds], summary[f"{SEED_COLUMN}s ({len(seeds)}): median"])}
+    plain = {} if not summary else {seeds_column(len(seeds), RATE_SPREAD): seeds_rate_spread(
+        [seed.curve for seed in seeds], summary[seeds_column(len(seeds), "median")])}
     given = {kind for kind, _ in alternatives}
     moot = set() if isinstance(store, RiskInputs) or has_walls(store) else {"wall"}  # no wall: its stiffness is no choice of this answer
     return Sensitivity(_table(columns, years, plain), risk.grid, tuple(k for k in ALTERNATIVES if k not in given | moot))
@@ -210,7 +210,12 @@ def seeds_summary(seeds: Sequence[xr.DataArray]) -> dict[str, xr.DataArray]:
     if len(seeds) < SUMMARISED_SEEDS:
         return {}
     over = xr.concat([_dims_only(seed) for seed in seeds], dim="seed")
-    return {f"{SEED_COLUMN}s ({len(seeds)}): median": over.median("seed"), f"{SEED_COLUMN}s ({len(seeds)}): largest": over.max("seed")}
+    return {seeds_column(len(seeds), "median"): over.median("seed"), seeds_column(len(seeds), "largest"): over.max("seed")}
+
+
+def seeds_column(count: int, what: str) -> str:
+    """The head of a column summarising ``count`` selection seeds: ``selection seeds (5): median``."""
+    return f"{SEED_COLUMN}s ({count}): {what}"
 
 
 def seeds_rate_spread(curves: Sequence[xr.Dataset], at: xr.DataArray) -> xr.DataArray:
