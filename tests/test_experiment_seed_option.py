@@ -133,3 +133,20 @@ def test_three_seeds_give_the_sensitivity_table_their_median_and_largest_g_star(
         np.testing.assert_allclose(frame["selection seeds (3): largest: Δ (%)"], 100 * (over.max(axis=1) / over[:, 0] - 1))
     spread = frame["selection seeds (3): λ_P at their median g*: largest / smallest (×)"].to_numpy(dtype=float)
     assert np.all((spread >= 1.0) | np.isnan(spread)) and list(frame.columns)[-1].endswith("(×)")
+
+
+def test_the_risk_cli_sets_the_seeds_largest_g_star_beside_the_gap_to_design_to(seeded):
+    """`stochpound risk` with two seed stores prints, after the sensitivity table, the three seeds' largest g* beside the gap
+    to design to, and how many rows lie above it: the count matches the rows the API marks."""
+    from stochpound.risk import separation_sensitivity, store_risk
+
+    path, _ = seeded
+    stores = [path.with_suffix(".nc"), seed_store(path, 7), seed_store(path, 8)]
+    result = invoke("risk", str(stores[0]), "--bootstrap", "40", *(f"--sensitivity-store=seed={store}" for store in stores[1:]))
+    assert result.exit_code == 0, result.output
+    with xr.open_dataset(stores[0]) as main, xr.open_dataset(stores[1]) as seven, xr.open_dataset(stores[2]) as eight:
+        risk = store_risk(main, bootstrap=40)
+        both = separation_sensitivity(risk, main, alternatives=[("seed", seven), ("seed", eight)]).seeds_beside_design(risk.design_frame(), risk.years)
+    assert not both.empty and both["above"].tolist() == (both["largest"] > both["design"]).tolist()
+    assert (f"The 3 selection seeds' largest g* beside the gap to design to (m): above it in {int(both['above'].sum())} of {len(both)} rows "
+            "(the gap to design to does not bound which motions are chosen):") in result.output

@@ -112,13 +112,15 @@ class Sensitivity:
         Returns
         -------
         pandas.DataFrame
-            Indexed as ``frame``; columns ``design`` and ``largest`` (m); empty below ``SUMMARISED_SEEDS`` seeds.
+            Indexed as ``frame``; columns ``design`` and ``largest`` (m) and ``above`` (the largest wider than the gap to
+            design to); empty below ``SUMMARISED_SEEDS`` seeds.
         """
         if not self.seeds:
-            return pd.DataFrame(columns=["design", "largest"])
+            return pd.DataFrame(columns=["design", "largest", "above"])
         labelled = design.assign(target=[target_text(p, years) for p in design["target"]]).set_index(list(self.frame.index.names))
         both = pd.DataFrame({"design": labelled["design"], "largest": self.frame[seeds_column(self.seeds, "largest")]})
-        return both[np.isfinite(both.to_numpy(dtype=float)).all(axis=1)]
+        both = both[np.isfinite(both.to_numpy(dtype=float)).all(axis=1)]
+        return both.assign(above=both["largest"] > both["design"])
 
 
 def separation_sensitivity(risk: object, store: xr.Dataset | RiskInputs, collapse: CollapseRisk | None = None,

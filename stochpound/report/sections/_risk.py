@@ -357,7 +357,7 @@ def seeds_beside_design_text(risk: StoreRisk, sensitivity: Sensitivity) -> str:
     both = sensitivity.seeds_beside_design(risk.design_frame(), risk.years)
     if both.empty:
         return ""
-    above = both[both["largest"] > both["design"]]
+    above = both[both["above"]]
     where = "; ".join(f"{labels_text(dict(zip(both.index.names[:-1], index[:-1]))) or 'the scene'}, {index[-1]}: {row.largest:.3f} m against "
                       f"{row.design:.3f} m" for index, row in above.iterrows())
     said = (f"lies above the gap to design to in {len(above)} of {len(both)} rows ({where}): that bound does not cover which motions are "
