@@ -294,7 +294,10 @@ def test_the_seeds_spread_says_the_rate_spread_beside_g_star_s():
                           f"selection seeds (3): {RATE_SPREAD}": [1.8, np.inf, 2.4]}, index=index)
     text = sensitivity_text(frame, not_evaluated=())
     assert ("g* spans up to ×1.33 in a row (its largest over its smallest, over the 3 of 3 rows finite at every seed), and the rate of "
-            "pounding λ_P at their median g* spans up to ×2.40 (over the 2 of 3 rows where every seed's λ_P there is > 0)") in text
+            "pounding λ_P at their median g* spans up to ×2.40 (over the 2 of 3 rows where every seed's λ_P there is > 0 and the median "
+            "on the gap grid)") in text
+    nowhere = frame.assign(**{f"selection seeds (3): {RATE_SPREAD}": [np.inf, np.nan, np.inf]})
+    assert "and λ_P at their median g* is 0 at some seed, or the median off the gap grid, in every row" in sensitivity_text(nowhere, not_evaluated=())
 
 
 def _seeds_frame() -> pd.DataFrame:
