@@ -95,8 +95,7 @@ class Sensitivity:
     @property
     def seeds(self) -> int:
         """How many selection seeds the table summarises: the store's and its seed stores' (0 below ``SUMMARISED_SEEDS``)."""
-        count = 1 + len(_seed_columns(self.frame))
-        return count if count >= SUMMARISED_SEEDS else 0
+        return _summarised_seeds(self.frame)
 
     def seeds_beside_design(self, design: pd.DataFrame, years: float) -> pd.DataFrame:
         """The largest g* over the selection seeds beside the gap to design to, per row where both are finite.
@@ -377,9 +376,9 @@ def sensitivity_text(frame: pd.DataFrame, grid: str = "", not_evaluated: Sequenc
 
 def _seeds_spread(frame: pd.DataFrame) -> list[str]:
     """With ``SUMMARISED_SEEDS`` seeds or more (the store's and its seed columns'), the spread of g* over them in words (none with fewer)."""
-    seeds = _seed_columns(frame)
-    if 1 + len(seeds) < SUMMARISED_SEEDS:  # the store's seed and its alternatives'
+    if not _summarised_seeds(frame):
         return []
+    seeds = _seed_columns(frame)
     values = frame[["g* (m)", *seeds]].to_numpy(dtype=float)
     rows = [row for row in values if np.all(np.isfinite(row)) and np.all(row > 0.0)]
     if not rows:
@@ -392,6 +391,12 @@ def _seeds_spread(frame: pd.DataFrame) -> list[str]:
 def _seed_columns(frame: pd.DataFrame) -> list[str]:
     """The g* columns of the seed alternatives (``selection seed 2``, …), not their Δ nor the seeds' summary."""
     return [column for column in frame.columns if column.startswith(f"{SEED_COLUMN} ") and not column.endswith("Δ (%)")]
+
+
+def _summarised_seeds(frame: pd.DataFrame) -> int:
+    """How many selection seeds ``frame`` summarises, the store's and its seed columns' (0 below ``SUMMARISED_SEEDS``)."""
+    count = 1 + len(_seed_columns(frame))
+    return count if count >= SUMMARISED_SEEDS else 0
 
 
 def _rate_spread(frame: pd.DataFrame) -> str:
