@@ -356,7 +356,9 @@ def rate_at_separation(curve: xr.Dataset, separation: xr.DataArray, dim: str = "
         λ_P (1/yr) over the dimensions of both; NaN where the gap is not finite or lies outside the grid.
     """
     gaps = np.asarray(curve[dim].values, dtype=float)
-    rate = xr.apply_ufunc(_rate_kernel, curve["maf"], separation, kwargs={"gaps": gaps}, input_core_dims=[[dim], []], vectorize=True)
+    envelope = xr.apply_ufunc(non_increasing, curve["maf"], kwargs={"weights": gap_weights(gaps)}, input_core_dims=[[dim]],
+                              output_core_dims=[[dim]]).where(curve["maf"].notnull().any(dim))  # once per curve; NaN where it has no rate
+    rate = xr.apply_ufunc(_rate_kernel, envelope, separation, kwargs={"gaps": gaps}, input_core_dims=[[dim], []], vectorize=True)
     return rate.assign_attrs(units="1/yr", long_name="mean annual frequency of pounding at the gap")
 
 
@@ -509,11 +511,11 @@ def _separation_kernel(maf: np.ndarray, gaps: np.ndarray, rates: np.ndarray) -> 
     return np.where(np.isnan(maf).all(-1)[..., None], np.nan, separation)
 
 
-def _rate_kernel(maf: np.ndarray, at: float, gaps: np.ndarray) -> float:
-    """λ_P at the gap ``at`` of one curve (``maf`` over ``gaps``): the interpolation :func:`_separation_kernel` inverts."""
-    if not (np.isfinite(at) and gaps[0] <= at <= gaps[-1]) or np.isnan(maf).all():
+def _rate_kernel(envelope: np.ndarray, at: float, gaps: np.ndarray) -> float:
+    """λ_P at the gap ``at`` of one non-increasing curve (``envelope`` over ``gaps``): the interpolation :func:`_separation_kernel`
+    inverts."""
+    if not (np.isfinite(at) and gaps[0] <= at <= gaps[-1]) or np.isnan(envelope).all():
         return np.nan
-    envelope = non_increasing(maf, gap_weights(gaps))
     upper = int(np.clip(np.searchsorted(gaps, at, side="right"), 1, gaps.size - 1))
     g_narrow, g_wide = gaps[upper - 1], gaps[upper]
     lam_narrow, lam_wide = envelope[upper - 1], envelope[upper]
