@@ -344,3 +344,6 @@ def test_the_design_summary_says_where_the_seeds_largest_g_star_lies_above_the_g
     wider = SimpleNamespace(design_frame=lambda: design.assign(design=design["design"] + 0.01), years=50.0)
     assert seeds_beside_design_text(wider, Sensitivity(_seeds_frame())) == (
         " Over the 3 selection seeds of the sensitivity table, the largest g* stays within the gap to design to in all 3 rows.")
+    one = SimpleNamespace(design_frame=lambda: design.assign(design=[0.040, np.nan, np.nan, np.nan]), years=50.0)  # the others withheld
+    assert seeds_beside_design_text(one, Sensitivity(_seeds_frame())) == (
+        " Over the 3 selection seeds of the sensitivity table, the largest g* stays within the gap to design to in 1 row.")

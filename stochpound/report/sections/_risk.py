@@ -360,8 +360,8 @@ def seeds_beside_design_text(risk: StoreRisk, sensitivity: Sensitivity) -> str:
     above = both[both["above"]]
     where = "; ".join(f"{labels_text(dict(zip(both.index.names[:-1], index[:-1]))) or 'the scene'}, {index[-1]}: {row.largest:.3f} m against "
                       f"{row.design:.3f} m" for index, row in above.iterrows())
-    said = (f"lies above the gap to design to in {len(above)} of {len(both)} rows ({where}): that bound does not cover which motions are "
-            "chosen" if len(above) else f"stays within the gap to design to in all {len(both)} rows")
+    said = (f"lies above the gap to design to in {len(above)} of {counted(len(both), 'row')} ({where}): that bound does not cover which "
+            "motions are chosen" if len(above) else f"stays within the gap to design to in {'all ' if len(both) > 1 else ''}{counted(len(both), 'row')}")
     return f" Over the {sensitivity.seeds} selection seeds of the sensitivity table, the largest g* {said}."
 
 
