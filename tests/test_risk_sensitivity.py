@@ -347,3 +347,24 @@ def test_the_design_summary_says_where_the_seeds_largest_g_star_lies_above_the_g
     one = SimpleNamespace(design_frame=lambda: design.assign(design=[0.040, np.nan, np.nan, np.nan]), years=50.0)  # the others withheld
     assert seeds_beside_design_text(one, Sensitivity(_seeds_frame())) == (
         " Over the 3 selection seeds of the sensitivity table, the largest g* stays within the gap to design to in 1 row.")
+
+
+def test_the_envelope_drawn_is_the_one_g_star_reads_on_a_refined_grid():
+    """On a grid refined near g* (unequal steps in ln g) the isotonic envelope weighs each gap by the share of ln g it stands
+    for, as g* does: read at g* (ln λ linear in ln g) it gives back the target's rate, where the envelope with equal weights
+    would not; a curve without a rate stays NaN."""
+    from stochpound.risk._maf import non_increasing, risk_targeted_separation, separation_envelope
+
+    gaps = np.unique(np.concatenate([np.geomspace(0.01, 0.5, 7), np.geomspace(0.05, 0.07, 6)]))
+    curve = _power_law_curve([1e-6, 3e-6], gaps)
+    curve = curve.assign(maf=curve["maf"] * np.exp(0.4 * np.random.default_rng(5).standard_normal(curve["maf"].shape)))
+    curve = xr.concat([curve, curve.isel(a=[0]).assign_coords(a=[0.0]) * np.nan], "a")
+    separation = risk_targeted_separation(curve, (0.10,), 50.0)["separation"].isel(target=0)
+    envelope = separation_envelope(curve["maf"])
+    for row, g_star in enumerate(separation.values[:2]):
+        read = np.exp(np.interp(np.log(g_star), np.log(gaps), np.log(envelope.values[row])))
+        assert read == pytest.approx(-np.log(0.9) / 50.0, rel=1e-10)
+    equal = non_increasing(curve["maf"].values[:2])
+    misread = [np.exp(np.interp(np.log(g), np.log(gaps), np.log(equal[row]))) for row, g in enumerate(separation.values[:2])]
+    assert not np.allclose(misread, -np.log(0.9) / 50.0, rtol=1e-3)
+    assert envelope.isel(a=2).isnull().all()

@@ -43,7 +43,7 @@ from stochpound.risk._design_rules import DESIGN_RULE_NAMES, design_assumptions,
 from stochpound.risk._fragility_ensemble import BOOTSTRAP, fragility_band, fragility_surface, homogeneous_capacities, ida_fragility, limit_state_events, stripe_fragility
 from stochpound.risk._fragility import DECREASING, EMPTY, FIT, STATUS
 from stochpound.risk._gap_grid import GRID_TOLERANCE, MAX_REFINEMENTS, grid_note, refinement_gaps
-from stochpound.risk._maf import TARGETS, degenerate_text, non_increasing, risk_curve, risk_targeted_separation, target_text
+from stochpound.risk._maf import TARGETS, degenerate_text, non_increasing, risk_curve, risk_targeted_separation, separation_envelope, target_text
 from stochpound.risk._stripe_coverage import at_lowest_stripe, maf_outside_stripes, top_capped_maf
 
 YEARS = 50.0
@@ -451,8 +451,9 @@ class StoreRisk:
         return float(self.separation.attrs["coarse_change"]) if "coarse_change" in self.separation.attrs else math.nan
 
     def non_increasing_maf(self) -> xr.DataArray:
-        """λ_P(g) made non-increasing along the gaps (isotonic regression in ln λ, pool-adjacent-violators: the curve g* is read from; 1/yr)."""
-        return non_increasing_along(self.curve["maf"], "gap")
+        """λ_P(g) made non-increasing along the gaps as g* reads it (the isotonic fit of ln λ with the gaps' weights,
+        ``stochpound.risk._maf.separation_envelope``; NaN along a configuration without a rate; 1/yr)."""
+        return separation_envelope(self.curve["maf"])
 
     def hazard_levels(self, probabilities: Sequence[float] = (0.10, 0.02)) -> dict[float, float]:
         """The hazard's intensity (IM units) at each probability of exceedance in ``years``."""

@@ -355,11 +355,26 @@ def rate_at_separation(curve: xr.Dataset, separation: xr.DataArray, dim: str = "
     xarray.DataArray
         λ_P (1/yr) over the dimensions of both; NaN where the gap is not finite or lies outside the grid.
     """
-    gaps = np.asarray(curve[dim].values, dtype=float)
-    envelope = xr.apply_ufunc(non_increasing, curve["maf"], kwargs={"weights": gap_weights(gaps)}, input_core_dims=[[dim]],
-                              output_core_dims=[[dim]]).where(curve["maf"].notnull().any(dim))  # once per curve; NaN where it has no rate
-    rate = xr.apply_ufunc(_rate_kernel, envelope, separation, kwargs={"gaps": gaps}, input_core_dims=[[dim], []], vectorize=True)
+    envelope = separation_envelope(curve["maf"], dim)  # once per curve
+    rate = xr.apply_ufunc(_rate_kernel, envelope, separation, kwargs={"gaps": np.asarray(curve[dim].values, dtype=float)},
+                          input_core_dims=[[dim], []], vectorize=True)
     return rate.assign_attrs(units="1/yr", long_name="mean annual frequency of pounding at the gap")
+
+
+def separation_envelope(maf: xr.DataArray, dim: str = "gap") -> xr.DataArray:
+    """λ_P(g) made non-increasing as g* reads it (:func:`risk_targeted_separation`): the isotonic fit of ln λ along ``dim``, each gap
+    weighted by the share of ln g it stands for (``gap_weights``); NaN along a curve that has no rate (1/yr).
+
+    Parameters
+    ----------
+    maf : xarray.DataArray
+        λ_P (1/yr) over ``dim`` (ascending gaps, m) and any other dimensions.
+    dim : str
+        The gap dimension.
+    """
+    weights = gap_weights(np.asarray(maf[dim].values, dtype=float))
+    envelope = xr.apply_ufunc(non_increasing, maf, kwargs={"weights": weights}, input_core_dims=[[dim]], output_core_dims=[[dim]])
+    return envelope.transpose(*maf.dims).where(maf.notnull().any(dim))
 
 
 def target_text(probability: float, years: float) -> str:
