@@ -6,6 +6,7 @@ import dataclasses
 import re
 
 import numpy as np
+import xarray as xr
 import pytest
 
 from stochpound import open_store
@@ -88,6 +89,11 @@ def test_risk_warns_of_stripes_that_miss_their_target_or_lie_beyond_the_truncati
         "the motions chosen at the stripes 0.1 g miss their conditional-spectrum target (mean or standard deviation of ln Sa off by "
         "more than 0.1 at a period); the scenario puts the stripes 0.1 g beyond ε 3, where hazard models truncate the ground motion: "
         "the answer takes those stripes' motions as the site's there")
+    chosen = clean.assign(selection_tolerance_first=xr.DataArray(np.array([0, 1], dtype=np.int8), dims="intensity"))
+    assert "selection rule" not in assumptions(clean) and "selection fit" not in assumptions(chosen)
+    assert assumptions(chosen)["selection rule"] == (
+        "the motions of the stripes 0.1 g were chosen with the tolerance first ([intensity] tolerance_first): within 0.1 of the target "
+        "at every period, where the set of least misfit missed, at the cost of a set nearer the tolerance's edge at other periods")
     outputs = []
     for name, store in (("clean", clean), ("flagged", flagged)):
         store.to_netcdf(tmp_path / f"{name}.nc")

@@ -115,6 +115,21 @@ def test_the_simulated_motions_are_part_of_the_identity(tmp_path) -> None:
     assert "simulated_motions" not in entry and "max_per_earthquake" not in entry
 
 
+def test_tolerance_first_is_a_rule_of_the_definition_and_the_store_says_which_stripes_it_chose(tmp_path) -> None:
+    """``[intensity] tolerance_first = true`` is in the definition and the identity (absent, nothing is); the selection's store
+    variables say per stripe whether it chose the set; a value that is not a boolean is a one-line error naming the field."""
+    ruled = load_experiment(write_experiment(tmp_path, _text(SELECTION + "tolerance_first = true\n"), "t.toml"))
+    plain = load_experiment(write_experiment(tmp_path, _text(), "p.toml"))
+    assert ruled.definition.to_dict()["intensity"]["tolerance_first"] is True and "tolerance_first" not in plain.definition.to_dict()["intensity"]
+    assert ruled.sha256 != plain.sha256 and ruled.intensity.selection.rules["tolerance_first"] is True
+    chosen_by = ruled.selection.coordinates()["selection_tolerance_first"]
+    expected = [int(s.attrs["chosen_by"] == "tolerance") for s in ruled.selection.selections]
+    assert chosen_by.dims == ("intensity",) and chosen_by.values.tolist() == expected
+    with pytest.raises(ExperimentError, match=r"^intensity.tolerance_first: ") as error:
+        load_experiment(write_experiment(tmp_path, _text(SELECTION + 'tolerance_first = "yes"\n'), "y.toml"))
+    assert "\n" not in str(error.value)
+
+
 def _pool(names: list[str], periods: np.ndarray) -> object:
     return selection_pool([load_suite_member(name) for name in names], periods, "psa", 0.5)
 

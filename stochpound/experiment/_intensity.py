@@ -62,7 +62,8 @@ SPECTRUM_DAMPING = MODEL_DAMPING
 """Damping ratio of the stored spectrum: the ground-motion models' 5 % (what the risk's site-consistency check reads it at)."""
 CaseVariables = dict[str, float | np.ndarray]
 """A case's per-case variables by store name (:data:`SUMMARIES`): numbers, and arrays (``motion_psa`` over :data:`SPECTRUM_PERIODS`)."""
-_KEYS = {"measure", "period", "periods", "damping", "levels", "units", "method", "synthetic", "selection", "motions", "max_scale_factor", "seed", "max_per_earthquake", "exclude_pulses"}
+_KEYS = {"measure", "period", "periods", "damping", "levels", "units", "method", "synthetic", "selection", "motions", "max_scale_factor", "seed",
+         "max_per_earthquake", "exclude_pulses", "tolerance_first"}
 
 #: Per-case variables of an intensity-conditioned store: units and long names (units of levels filled in).
 SUMMARIES: dict[str, tuple[str, str]] = {

@@ -59,7 +59,10 @@ level; each motion's table keeps s (``normal_shift``). No pre-screen.
 earthquake in a stripe; no limit unless given) and ``exclude_pulses = true``
 (no record the metadata mark as a pulse) are the selection's rules
 (:func:`stochpound.motions.select_motions`); a stripe never holds the same
-recording twice.
+recording twice. ``tolerance_first = true`` puts the target's tolerance
+before the misfit: a stripe whose set of least misfit misses its target
+takes a set within the tolerance where the selection's integer programme
+finds one (the store's ``selection_tolerance_first``).
 
 The simulated motions of the pools (their tables, chunks, pre-screen, tilt and
 ruptures' shares) are :mod:`stochpound.experiment._stripe_pools`'s.
@@ -98,7 +101,7 @@ SIMULATED_DT = 0.01
 """Time step of the simulated motions, s."""
 SIMULATED_LIMIT = 100_000
 """Largest ``[site] simulated_motions`` (per stripe)."""
-RULES = ("max_per_earthquake", "exclude_pulses")
+RULES = ("max_per_earthquake", "exclude_pulses", "tolerance_first")
 """``[intensity]`` fields of the selection's rules (:attr:`stochpound.store.Selection.rules`), in the definition only where given."""
 PER_LEVEL = ("magnitude", "distance_km", "mechanism")
 """``[site]`` fields that take one value per level."""
@@ -159,7 +162,7 @@ def parse_selection(table: Mapping[str, Any], site: Any, levels: list[float], se
     max_scale = intensity_table.number("max_scale_factor", low=1.0)
     seed = intensity_table.integer("seed", DEFAULT_SEED, low=0)
     note = f"{motions} motions per stripe chosen from the pool and scaled to the conditional spectrum of its scenario"
-    max_per_earthquake, exclude_pulses = parse_rules(table)
+    max_per_earthquake, exclude_pulses, tolerance_first = parse_rules(table)
     if isinstance(site, dict) and "ruptures" in site:
         ruptures = rupture_site(site, base_dir)
         simulated = parse_simulated(site, seed)
@@ -167,15 +170,17 @@ def parse_selection(table: Mapping[str, Any], site: Any, levels: list[float], se
         if simulated is not None:
             note += f" (the pool: {simulated.count} simulated motions a stripe of the causal ruptures, allotted by their disaggregation weights)"
         return Selection(selection, motions, max_scale, seed, mixture_scenarios(ruptures, levels, measure), max_per_earthquake, exclude_pulses,
+                         tolerance_first=tolerance_first,
                          simulated=simulated, ruptures=ruptures.to_entry(identity=True)), note
     scenarios = parse_site(site, levels, measure, base_dir)
     if toml_fields.TomlTable(site, "site", raises=SiteError).string("scenario", SCENARIO_KINDS[0]) == "fitted":
         note += f" (the scenario fitted to the site's hazard curves {', '.join(map(site_curve_label, site['curves']))}, standing in for a disaggregation)"
-    return Selection(selection, motions, max_scale, seed, scenarios, max_per_earthquake, exclude_pulses, simulated=parse_simulated(site, seed)), note
+    return Selection(selection, motions, max_scale, seed, scenarios, max_per_earthquake, exclude_pulses, simulated=parse_simulated(site, seed),
+                     tolerance_first=tolerance_first), note
 
 
-def parse_rules(table: Mapping[str, Any]) -> tuple[int | None, bool | None]:
-    """The selection's rules, ``max_per_earthquake`` and ``exclude_pulses``: each None unless the table gives it (so that the definitions
+def parse_rules(table: Mapping[str, Any]) -> tuple[int | None, bool | None, bool | None]:
+    """The selection's rules, ``max_per_earthquake``, ``exclude_pulses`` and ``tolerance_first``: each None unless the table gives it (so that the definitions
     of files without them keep their identity)."""
     from stochpound._errors import SiteError
 
@@ -184,7 +189,8 @@ def parse_rules(table: Mapping[str, Any]) -> tuple[int | None, bool | None]:
         raise SiteError("intensity.max_per_earthquake: at most this many motions of one earthquake per stripe, an integer >= 1, "
                         f"got {max_per_earthquake!r}")
     exclude_pulses = toml_fields.boolean(table, "exclude_pulses", "intensity", default=False) if "exclude_pulses" in table else None
-    return max_per_earthquake, exclude_pulses
+    tolerance_first = toml_fields.boolean(table, "tolerance_first", "intensity", default=False) if "tolerance_first" in table else None
+    return max_per_earthquake, exclude_pulses, tolerance_first
 
 
 def parse_simulated(site: Mapping[str, Any], seed: int) -> SimulatedMotions | None:
@@ -421,6 +427,11 @@ class StripeSelections:
                 ("intensity",), np.array([s.attrs["target_reachable"] for s in self.selections], dtype=np.int8),
                 {"units": "1", "long_name": f"0 where no set of the stripe's pool can meet its target's mean and std of ln Sa within {TARGET_TOLERANCE:g} "
                  "at every period (linear-programming bounds over its candidates and rules): a miss there is the pool's, not the search's"},
+            ),
+            "selection_tolerance_first": xr.Variable(
+                ("intensity",), np.array([s.attrs["chosen_by"] == "tolerance" for s in self.selections], dtype=np.int8),
+                {"units": "1", "long_name": "1 where the stripe's set of least misfit missed its target and [intensity] tolerance_first "
+                 "chose a set within the tolerance instead"},
             ),
             "target_epsilon": xr.Variable(("intensity",), np.array([s["epsilon"] for s in scenario]), {"units": "1", "long_name": "epsilon of the level in its scenario"}),
             "site_magnitude": xr.Variable(("intensity",), np.array([s["magnitude"] for s in scenario]), {"units": "1", "long_name": "scenario moment magnitude"}),

@@ -335,11 +335,13 @@ def assumptions(store: xr.Dataset, scenes: Mapping[tuple[Any, ...], Scene] | Non
 
 def _selection_fit(store: xr.Dataset) -> dict[str, str]:
     """{"selection fit": ...} naming the stripes whose chosen motions miss their conditional-spectrum target and those its
-    scenario puts beyond the truncation ε, which the answer still takes as the site's motions; {} where there are none."""
+    scenario puts beyond the truncation ε, which the answer still takes as the site's motions, and {"selection rule": ...}
+    naming those whose set ``tolerance_first`` chose; {} where there are none."""
     misses, beyond = selection_misses(store), stripes_beyond_truncation(store)
     intensity = store.pound.definition.intensity
     units = f" {intensity.units}" if intensity is not None and intensity.units else ""
     unreachable = unreachable_targets(store)
+    tolerance = tolerance_first_stripes(store)
     said = ([f"the motions chosen at the stripes {', '.join(f'{level:.4g}' for level in misses)}{units} miss their conditional-spectrum "
              f"target (mean or standard deviation of ln Sa off by more than {TARGET_TOLERANCE:g} at a period)"] if misses else []) + (
             [f"at the stripes {', '.join(f'{level:.4g}' for level in unreachable)}{units} no set of the pool's motions can meet the target "
@@ -347,7 +349,19 @@ def _selection_fit(store: xr.Dataset) -> dict[str, str]:
              "lack the target's spectral shape there"] if unreachable else []) + (
             [f"the scenario puts the stripes {', '.join(f'{level:.4g}' for level in beyond)}{units} beyond ε {TRUNCATION_EPSILON:g}, "
              "where hazard models truncate the ground motion"] if beyond else [])
-    return {"selection fit": "; ".join(said) + ": the answer takes those stripes' motions as the site's there"} if said else {}
+    chosen = ([f"the motions of the stripes {', '.join(f'{level:.4g}' for level in tolerance)}{units} were chosen with the tolerance first "
+               f"([intensity] tolerance_first): within {TARGET_TOLERANCE:g} of the target at every period, where the set of least misfit "
+               "missed, at the cost of a set nearer the tolerance's edge at other periods"] if tolerance else [])
+    fit = {"selection fit": "; ".join(said) + ": the answer takes those stripes' motions as the site's there"} if said else {}
+    return fit | ({"selection rule": "; ".join(chosen)} if chosen else {})
+
+
+def tolerance_first_stripes(store: xr.Dataset) -> list[float]:
+    """The levels (in the levels' units) whose stripe's set ``[intensity] tolerance_first`` chose (``selection_tolerance_first``); [] for a
+    store without it."""
+    if "selection_tolerance_first" not in store:
+        return []
+    return [float(level) for level, flag in zip(store["intensity"].values, store["selection_tolerance_first"].values) if flag]
 
 
 def _base_words(mu: MuAxis | None, building: BuildingTable) -> str:

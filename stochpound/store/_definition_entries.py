@@ -56,6 +56,7 @@ class IntensityEntry(TypedDict):
     seed: NotRequired[int]
     max_per_earthquake: NotRequired[int]
     exclude_pulses: NotRequired[bool]
+    tolerance_first: NotRequired[bool]
     site: NotRequired[list[ScenarioEntry]]
     ruptures: NotRequired[Mapping[str, object]]  # a site of ruptures' own entry (stochpound.analysis.RuptureSite.to_entry)
     simulated_motions: NotRequired[SimulatedMotionsEntry]

@@ -98,6 +98,9 @@ class Selection:
         At most this many motions of one earthquake per stripe; None: not given (no limit).
     exclude_pulses : bool or None
         Whether records marked as pulses are left out of the pool; None: not given (kept).
+    tolerance_first : bool or None
+        Whether a stripe whose set of least misfit misses its target takes a set within the tolerance where the integer
+        programme finds one (``stochpound.motions.select_motions``); None: not given (the set of least misfit).
     ruptures : mapping or None
         A site of ruptures' canonical entry (``stochpound.analysis.RuptureSite.to_entry``), whose exact
         conditional spectra are the targets; None for a given or fitted scenario.
@@ -114,6 +117,7 @@ class Selection:
     exclude_pulses: bool | None = None
     ruptures: Mapping[str, Any] | None = None
     simulated: SimulatedMotions | None = None
+    tolerance_first: bool | None = None
 
     @classmethod
     def from_entry(cls, entry: Mapping[str, Any]) -> Selection | None:
@@ -125,7 +129,7 @@ class Selection:
         return cls(entry["selection"], entry["motions"], entry["max_scale_factor"], entry["seed"],
                    tuple(Scenario(s["magnitude"], s["distance_km"], s["vs30"], s["mechanism"]) for s in entry["site"]),
                    table.integer("max_per_earthquake", None, low=1), table.raw("exclude_pulses"), None if ruptures is None else ruptures.values,
-                   SimulatedMotions.from_entry(simulated.values) if simulated is not None else None)
+                   SimulatedMotions.from_entry(simulated.values) if simulated is not None else None, table.raw("tolerance_first"))
 
     def entry(self) -> dict[str, Any]:
         """The selection's keys of the canonical ``intensity`` entry (the optional ones only where given)."""
@@ -139,6 +143,7 @@ class Selection:
 
     @property
     def rules(self) -> dict[str, int | bool]:
-        """The selection's rules that were given, as ``stochpound.motions.select_motions`` takes them (``max_per_earthquake``, ``exclude_pulses``)."""
-        given = {"max_per_earthquake": self.max_per_earthquake, "exclude_pulses": self.exclude_pulses}
+        """The selection's rules that were given, as ``stochpound.motions.select_motions`` takes them (``max_per_earthquake``, ``exclude_pulses``,
+        ``tolerance_first``)."""
+        given = {"max_per_earthquake": self.max_per_earthquake, "exclude_pulses": self.exclude_pulses, "tolerance_first": self.tolerance_first}
         return {key: value for key, value in given.items() if value is not None}
