@@ -10,8 +10,9 @@ stripe, its level, ε, N Φ(−ε) (the pool's simulated motions expected beyond
 the stripe's ε), the pool's motions after the pre-screen, the chosen set's
 recorded and simulated motions, the largest share of one earthquake, and its
 worst differences from the target in mean and standard deviation of ln Sa
-(with their periods) and whether any set of its pool could meet the target's
-mean (the selection's linear-programming bound, ``target_reachable``): a markdown table, then the time the selection took
+(with their periods), whether any set of its pool could meet the target's
+mean (the selection's linear-programming bound, ``target_reachable``) and which rule chose the set (``misfit``, or ``tolerance``
+where ``[intensity] tolerance_first`` replaced a set that missed): a markdown table, then the time the selection took
 (from the file's loading), the load at its start and the commit; with
 ``--picks FILE`` every stripe's chosen motions and scale factors as JSON
 (to compare two trees' selections); with ``--parameters`` per stripe the
@@ -83,7 +84,7 @@ def stripe_rows(experiment, count: int, tilted: bool = False) -> list[list[str]]
         miss = max(np.max(np.abs(mean)), np.max(np.abs(sigma))) > 0.1
         rows.append([f"{level:.3g}", f"{epsilon:.2f}", "-" if tilted else f"{count * ndtr(-epsilon):.1f}", str(selection.attrs["pool"]),
                      f"{selection.sizes['selected'] - simulated} + {simulated}", f"{share:.3f}", worst(mean, periods), worst(sigma, periods),
-                     "**miss**" if miss else "met", "yes" if selection.attrs["target_reachable"] else "**no**"])
+                     "**miss**" if miss else "met", "yes" if selection.attrs["target_reachable"] else "**no**", selection.attrs["chosen_by"]])
     return rows
 
 
@@ -145,7 +146,7 @@ def main(argv: list[str] | None = None) -> int:
         elapsed = time.time() - began
     count = experiment.intensity.selection.simulated.count
     header = ["level (g)", "ε", "N Φ(−ε)", "pool", "recorded + simulated", "largest share of an earthquake", "mean", "σ", "",
-              "mean reachable"]
+              "mean reachable", "chosen by"]
     sampling = experiment.intensity.selection.simulated.sampling
     print(f"{arguments.experiment.name}, N = {count} ({sampling}), seed {experiment.intensity.selection.seed}, {experiment.selection.periods[0]:.3g}-{experiment.selection.periods[-1]:.3g} s")
     print("| " + " | ".join(header) + " |")

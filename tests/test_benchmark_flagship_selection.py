@@ -37,13 +37,13 @@ class _Selection:
                                        "earthquake": ("selected", ["e1", "e1", "e2", "simulated 1.7"]),
                                        "mean_ln": ("period", np.log([0.5, 0.3]) + [0.15, -0.02]), "median": ("period", [0.5, 0.3]),
                                        "std_ln": ("period", [0.5, 0.6]), "sigma_ln": ("period", [0.55, 0.6])},
-                                      coords={"period": periods}, attrs={"pool": 2100, "target_reachable": 0})]
+                                      coords={"period": periods}, attrs={"pool": 2100, "target_reachable": 0, "chosen_by": "misfit"})]
 
 
 def test_a_stripe_s_row_gives_its_counts_shares_and_worst_misses():
-    """The row: level, ε, N Φ(−ε), pool, recorded + simulated, the largest share of one earthquake, the worst differences, the verdict."""
+    """The row: level, ε, N Φ(−ε), pool, recorded + simulated, the largest share of one earthquake, the worst differences, the verdict, the rule that chose the set."""
     row = stripe_rows(type("E", (), {"selection": _Selection()})(), 1000)[0]
-    assert row == ["0.5", "2.00", "22.8", "2100", "3 + 1", "0.500", "+0.150 (0.1 s)", "-0.050 (0.1 s)", "**miss**", "**no**"]
+    assert row == ["0.5", "2.00", "22.8", "2100", "3 + 1", "0.500", "+0.150 (0.1 s)", "-0.050 (0.1 s)", "**miss**", "**no**", "misfit"]
     assert worst(np.array([0.01, -0.09]), np.array([1.0, 2.0])) == "-0.090 (2 s)"
     assert stripe_rows(type("E", (), {"selection": _Selection()})(), 1000, tilted=True)[0][2] == "-"
 
