@@ -92,7 +92,6 @@ seeds) reuse it.
 
 from __future__ import annotations
 
-import copy
 from collections.abc import Sequence
 
 import numpy as np
@@ -582,9 +581,7 @@ class _Rules:
 
     def subset(self, rows: np.ndarray) -> _Rules:
         """The rules of the candidates ``rows`` (indices) alone."""
-        part = copy.copy(self)
-        part.earthquake, part.recording = self.earthquake[rows], self.recording[rows]
-        return part
+        return _Rules(self.earthquake[rows], self.recording[rows], None if np.isinf(self.cap) else int(self.cap))
 
     def allowed(self, taken: list[int]) -> np.ndarray:
         """Candidates a set holding the rows ``taken`` may add (bool, one per row)."""
