@@ -60,8 +60,9 @@ most :data:`_TOLERANCE_ROUNDS` times). A set found within the tolerance is
 then improved by swaps of least misfit that keep it within, and replaces
 the set of least misfit; where none is found that set stays, and misses
 (``chosen_by`` says which rule chose the set). Measured on the isolated risk
-flagship's top stripe (ε 3.5, 7926 candidates): a set within the tolerance
-in 35–120 s, where the greedy's missed by 0.11–0.13 at 0.043 s.
+flagship's top stripe (ε 3.5, 7926 candidates, selection seeds 1–5;
+docs/intensity.md, "The tolerance first"): a set within the tolerance in
+every seed, where the set of least misfit missed by 0.11–0.13 at 0.043 s.
 
 Rules of the field: a set never holds the same recording twice (a motion
 is known by its PEER record sequence number and component where the
@@ -124,7 +125,7 @@ QUARTIC_WEIGHT = 100.0
 _MAX_PASSES = 50
 #: Candidates of the integer programme of ``tolerance_first``: the linear relaxation's own, then those of least reduced cost.
 TOLERANCE_CANDIDATES = 3000
-#: Misses of the set's mean (its worst) at which the relaxation of the σ floor takes a tangent, before any cut of a set found.
+#: Misses of the set's mean (the same at every period) at whose tangents the σ floor of ``tolerance_first`` is relaxed, before any cut.
 _TANGENTS = (-TARGET_TOLERANCE, -TARGET_TOLERANCE / 2, 0.0, TARGET_TOLERANCE / 2, TARGET_TOLERANCE)
 #: Rounds of the integer programme, each with a cut at the mean's misses of the set the one before found that misses on σ.
 _TOLERANCE_ROUNDS = 3
