@@ -229,6 +229,7 @@ def test_several_seed_columns_give_the_seeds_spread_of_g_star_in_words():
     assert ("the 3 selection seeds together (the store's and 2 others): g* spans up to ×1.33 in a row (its largest over its smallest, "
             "over the 2 of 3 rows finite at every seed)") in text
     assert "selection seeds together" not in sensitivity_text(frame.drop(columns=["selection seed 3", "selection seed 3: Δ (%)"]), not_evaluated=())
+    assert "over the 1 of 1 row finite at every seed" in sensitivity_text(frame.iloc[:1], not_evaluated=())
 
 
 def test_the_seeds_summary_is_the_median_and_the_largest_g_star_over_the_seeds():

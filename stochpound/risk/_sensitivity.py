@@ -36,6 +36,7 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
+from stochpound._plurals import counted
 from stochpound.risk._collapse import CollapseRisk
 from stochpound.risk._fragility import DECREASING, EMPTY, NEVER, ALWAYS
 from stochpound.risk._gap_grid import refinement_gaps
@@ -385,7 +386,7 @@ def _seeds_spread(frame: pd.DataFrame) -> list[str]:
         return [f"the {len(seeds) + 1} selection seeds together: no row with a finite g* > 0 at every seed"]
     spread = max(float(row.max() / row.min()) for row in rows)
     return [f"the {len(seeds) + 1} selection seeds together (the store's and {len(seeds)} others): g* spans up to ×{spread:.2f} in a row "
-            f"(its largest over its smallest, over the {len(rows)} of {len(values)} rows finite at every seed){_rate_spread(frame)}"]
+            f"(its largest over its smallest, over the {len(rows)} of {counted(len(values), 'row')} finite at every seed){_rate_spread(frame)}"]
 
 
 def _seed_columns(frame: pd.DataFrame) -> list[str]:
