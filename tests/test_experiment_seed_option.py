@@ -9,6 +9,7 @@ import pytest
 import xarray as xr
 
 from stochpound._errors import ExperimentError
+from stochpound._plurals import counted
 from stochpound.experiment import load_experiment, seed_store
 from stochpound.experiment._reseed import reseeded_text
 from tests.helpers import invoke, stripes_site_text
@@ -148,5 +149,5 @@ def test_the_risk_cli_sets_the_seeds_largest_g_star_beside_the_gap_to_design_to(
         risk = store_risk(main, bootstrap=40)
         both = separation_sensitivity(risk, main, alternatives=[("seed", seven), ("seed", eight)]).seeds_beside_design(risk.design_frame(), risk.years)
     assert not both.empty and both["above"].tolist() == (both["largest"] > both["design"]).tolist()
-    assert (f"The 3 selection seeds' largest g* beside the gap to design to (m): above it in {int(both['above'].sum())} of {len(both)} rows "
+    assert (f"The 3 selection seeds' largest g* beside the gap to design to (m): above it in {int(both['above'].sum())} of {counted(len(both), 'row')} "
             "(the gap to design to does not bound which motions are chosen):") in result.output

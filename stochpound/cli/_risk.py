@@ -286,7 +286,7 @@ def risk(store: Path, hazard: str | None, hazard_measure: str | None, hazard_uni
         seeds = spread.seeds_beside_design(design, years)
         if not seeds.empty:
             click.echo(f"\nThe {spread.seeds} selection seeds' largest g* beside the gap to design to (m): above it in {int(seeds['above'].sum())} "
-                       f"of {len(seeds)} rows (the gap to design to does not bound which motions are chosen):")
+                       f"of {counted(len(seeds), 'row')} (the gap to design to does not bound which motions are chosen):")
             click.echo(seeds.to_string(float_format=lambda v: f"{v:.3f}"))
     degenerate = result.degenerate_text()
     if degenerate:
