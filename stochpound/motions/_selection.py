@@ -461,18 +461,25 @@ def _tolerance_set(ln_sa: np.ndarray, median: np.ndarray, sigma: np.ndarray, mot
     improved by swaps that keep it within; None where the programme finds none."""
     mean = np.log(median)
     tangents = [np.full(mean.size, miss) for miss in _TANGENTS]
-    relaxed = _tolerance_programme(ln_sa, mean, sigma, motions, rules, tangents, integer=False)
-    if relaxed is None:
+    n, periods = ln_sa.shape
+    matrix, lower, upper = _tolerance_system(ln_sa, mean, sigma, motions, rules, tangents)
+    rows = np.isfinite(upper), np.isfinite(lower)
+    cost = np.concatenate([np.zeros(n), np.ones(periods)])  # the weights cost nothing, the mean's misses u ≥ |miss| one each
+    relaxed = linprog(cost, A_ub=sparse.vstack([matrix[rows[0]], -matrix[rows[1]]]), b_ub=np.concatenate([upper[rows[0]], -lower[rows[1]]]),
+                      bounds=[(0.0, 1.0)] * n + [(0.0, None)] * periods, method="highs")
+    if relaxed.status != 0:
         return None
-    weights, reduced_cost = relaxed
-    order = np.lexsort((reduced_cost, weights <= 1e-9))  # the relaxation's own candidates, then the least reduced cost
+    order = np.lexsort((relaxed.lower.marginals[:n], relaxed.x[:n] <= 1e-9))  # the relaxation's own candidates, then the least reduced cost
     kept = np.sort(order[:TOLERANCE_CANDIDATES])
     part, part_rules = ln_sa[kept], rules.subset(kept)
+    cost = np.concatenate([np.zeros(kept.size), np.ones(periods)])
+    bounds = Bounds(np.zeros(cost.size), np.concatenate([np.ones(kept.size), np.full(periods, np.inf)]))
     for _ in range(_TOLERANCE_ROUNDS):
-        found = _tolerance_programme(part, mean, sigma, motions, part_rules, tangents, integer=True)
-        if found is None:
+        found = milp(cost, integrality=1.0 - cost, bounds=bounds, options={"node_limit": 1},  # whole weights, the misses continuous
+                     constraints=LinearConstraint(*_tolerance_system(part, mean, sigma, motions, part_rules, tangents)))
+        if found.x is None:
             return None
-        chosen = list(np.flatnonzero(found[0] > 0.5))
+        chosen = list(np.flatnonzero(found.x[: kept.size] > 0.5))
         spectra = part[chosen]
         if not misses_target(spectra.mean(axis=0), spectra.std(axis=0, ddof=1), median, sigma):
             return [int(kept[row]) for row in _swap(part, chosen, mean, sigma, part_rules, within=median)]
@@ -480,17 +487,17 @@ def _tolerance_set(ln_sa: np.ndarray, median: np.ndarray, sigma: np.ndarray, mot
     return None
 
 
-def _tolerance_programme(ln_sa: np.ndarray, mean: np.ndarray, sigma: np.ndarray, motions: int, rules: _Rules, tangents: list[np.ndarray],
-                         integer: bool) -> tuple[np.ndarray, np.ndarray] | None:
-    """The programme of ``tolerance_first`` (module docstring) over the rows of ``ln_sa``: its weights and their reduced costs
-    (zeros for the integer programme), or None where it has no solution (or the integer one found none at its first node)."""
+def _tolerance_system(ln_sa: np.ndarray, mean: np.ndarray, sigma: np.ndarray, motions: int, rules: _Rules,
+                      tangents: list[np.ndarray]) -> tuple[sparse.csr_matrix, np.ndarray, np.ndarray]:
+    """The constraints of ``tolerance_first``'s programme (module docstring) over the rows of ``ln_sa``: its matrix and row bounds
+    over the candidates' weights, then the mean's misses u ≥ |miss| per period (the objective's)."""
     n, periods = ln_sa.shape
     tolerance = TARGET_TOLERANCE
     mean_rows = sparse.csr_matrix(ln_sa.T / motions)
     squares = sparse.csr_matrix(((ln_sa - mean) ** 2).T / (motions - 1))
     ratio = motions / (motions - 1)
     floor = np.maximum(sigma - tolerance, 0.0) ** 2
-    blocks = [  # (weights' rows, misses' rows, lower, upper); the misses u ≥ |mean's miss| are the objective's
+    blocks = [  # (weights' rows, misses' rows, lower, upper)
         (np.ones((1, n)), np.zeros((1, periods)), [motions], [motions]),
         (mean_rows, np.zeros((periods, periods)), mean - tolerance, mean + tolerance),
         (mean_rows, -np.eye(periods), np.full(periods, -np.inf), mean),
@@ -498,20 +505,11 @@ def _tolerance_programme(ln_sa: np.ndarray, mean: np.ndarray, sigma: np.ndarray,
         (squares, np.zeros((periods, periods)), np.full(periods, -np.inf), (sigma + tolerance) ** 2),
         *[(squares - sparse.diags(2.0 * ratio * miss) @ mean_rows, np.zeros((periods, periods)),
            floor - 2.0 * ratio * miss * mean - ratio * miss**2, np.full(periods, np.inf)) for miss in tangents],
-        *[(row[:, :n], np.zeros((row.shape[0], periods)), np.full(row.shape[0], -np.inf), cap) for row, cap in rules.rows(n + 1)],
+        *[(row, np.zeros((row.shape[0], periods)), np.full(row.shape[0], -np.inf), cap) for row, cap in rules.rows(n)],
     ]
     matrix = sparse.vstack([sparse.hstack([sparse.csr_matrix(a), sparse.csr_matrix(b)]) for a, b, _, _ in blocks]).tocsr()
-    lower, upper = np.concatenate([np.asarray(b[2], dtype=float) for b in blocks]), np.concatenate([np.asarray(b[3], dtype=float) for b in blocks])
-    objective = np.concatenate([np.zeros(n), np.ones(periods)])
-    bounds = [(0.0, 1.0)] * n + [(0.0, None)] * periods
-    if not integer:
-        rows = np.isfinite(upper), np.isfinite(lower)
-        result = linprog(objective, A_ub=sparse.vstack([matrix[rows[0]], -matrix[rows[1]]]), b_ub=np.concatenate([upper[rows[0]], -lower[rows[1]]]),
-                         bounds=bounds, method="highs")
-        return (result.x[:n], result.lower.marginals[:n]) if result.status == 0 else None
-    result = milp(objective, integrality=np.concatenate([np.ones(n), np.zeros(periods)]), bounds=Bounds(np.zeros(n + periods),
-                  np.concatenate([np.ones(n), np.full(periods, np.inf)])), constraints=LinearConstraint(matrix, lower, upper), options={"node_limit": 1})
-    return None if result.x is None else (result.x[:n], np.zeros(n))
+    lower, upper = (np.concatenate([np.asarray(block[k], dtype=float) for block in blocks]) for k in (2, 3))
+    return matrix, lower, upper
 
 
 def _heaviest_allowed(weights: np.ndarray, motions: int, rules: _Rules) -> list[int]:
