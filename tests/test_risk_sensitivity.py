@@ -299,6 +299,7 @@ def test_the_seeds_spread_says_the_rate_spread_beside_g_star_s():
             "on the gap grid)") in text
     nowhere = frame.assign(**{f"selection seeds (3): {RATE_SPREAD}": [np.inf, np.nan, np.inf]})
     assert "and λ_P at their median g* is 0 at some seed, or the median off the gap grid, in every row" in sensitivity_text(nowhere, not_evaluated=())
+    assert "(over the 1 of 1 row where every seed's λ_P there is > 0" in sensitivity_text(frame.iloc[:1], not_evaluated=())
 
 
 def _seeds_frame() -> pd.DataFrame:

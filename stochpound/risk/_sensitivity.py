@@ -409,8 +409,8 @@ def _rate_spread(frame: pd.DataFrame) -> str:
     finite = values[np.isfinite(values)]
     if not finite.size:
         return ", and λ_P at their median g* is 0 at some seed, or the median off the gap grid, in every row"
-    return (f", and the rate of pounding λ_P at their median g* spans up to ×{finite.max():.2f} (over the {finite.size} of {values.size} "
-            "rows where every seed's λ_P there is > 0 and the median on the gap grid)")
+    return (f", and the rate of pounding λ_P at their median g* spans up to ×{finite.max():.2f} (over the {finite.size} of "
+            f"{counted(values.size, 'row')} where every seed's λ_P there is > 0 and the median on the gap grid)")
 
 
 def _dims_only(data: xr.DataArray) -> xr.DataArray:
